@@ -1,0 +1,95 @@
+#include "algorithms/data.hpp"
+
+#include <set>
+
+namespace proxgen {
+
+Data::Data(const System& sys) {
+  const Model& m = sys.model;
+  const int N = m.numBodies();
+  I.resize(N, Mat6::Zero());
+  S.resize(N);
+  for (int i = 1; i < N; ++i) {
+    I[i] = m.bodies[i].inertia.matrix();
+    S[i] = m.motionSubspace(i);
+  }
+  liMi.resize(N);
+  oMi.resize(N);
+  v.assign(N, Vec6::Zero());
+  a.assign(N, Vec6::Zero());
+  c.assign(N, Vec6::Zero());
+  IA.assign(N, Mat6::Zero());
+  pA.assign(N, Vec6::Zero());
+  dp.assign(N, Vec6::Zero());
+  U.resize(N);
+  Dinv.resize(N);
+  u.resize(N);
+  for (int i = 1; i < N; ++i) {
+    const int n = m.bodies[i].joint.nv;
+    U[i] = Mat6N::Zero(6, n);
+    Dinv[i] = MatNN::Zero(n, n);
+    u[i] = VecN::Zero(n);
+  }
+
+  terms.resize(sys.constraints.size());
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+    const int r = sys.constraints[k].rows();
+    terms[k].K = MatN6::Zero(r, 6);
+    terms[k].k = VecN::Zero(r);
+  }
+  support = sys.supportBodies();
+  onSupport.assign(N, 0);
+  for (int i : support) onSupport[i] = 1;
+  lambda = VecX::Zero(sys.nc);
+  dlambda = VecX::Zero(sys.nc);
+
+  // Rows of each subtree: the body's own rows (layout order), then its
+  // children's subtrees in child order. Built leaves first.
+  subtreeRows.assign(N, {});
+  for (int i = N - 1; i >= 0; --i) {
+    std::vector<int> rows;
+    for (const Constraint& c : sys.constraints)
+      if (c.body == i)
+        for (int r = 0; r < c.rows(); ++r) rows.push_back(c.row + r);
+    for (int ch : m.bodies[i].children) rows.insert(rows.end(), subtreeRows[ch].begin(), subtreeRows[ch].end());
+    subtreeRows[i] = std::move(rows);
+  }
+  KA.resize(N);
+  lA.resize(N);
+  LA.resize(N);
+  KS.resize(N);
+  for (int i = 0; i < N; ++i) {
+    const int mi = int(subtreeRows[i].size());
+    KA[i] = MatX::Zero(6, mi);
+    lA[i] = VecX::Zero(mi);
+    LA[i] = MatX::Zero(mi, mi);
+    KS[i] = MatX::Zero(i > 0 ? m.bodies[i].joint.nv : 0, mi);
+  }
+  G = MatX::Zero(sys.nc, sys.nc);
+  llt = Eigen::LLT<MatX>(sys.nc);
+  yfree = VecX::Zero(sys.nc);
+  lambdaTree = VecX::Zero(sys.nc);
+  rhs = VecX::Zero(sys.nc);
+
+  qdd = VecX::Zero(m.nv);
+  tau = VecX::Zero(m.nv);
+  h = VecX::Zero(m.nv);
+  M = MatX::Zero(m.nv, m.nv);
+  J = MatX::Zero(sys.nc, m.nv);
+  gamma = VecX::Zero(sys.nc);
+  aStar = VecX::Zero(sys.nc);
+  Ic.assign(N, Mat6::Zero());
+  f.assign(N, Vec6::Zero());
+  dofParent.assign(m.nv, -1);
+  for (int i = 1; i < N; ++i) {
+    const Joint& j = m.bodies[i].joint;
+    const int p = m.bodies[i].parent;
+    const int parentLastDof = p > 0 ? m.bodies[p].joint.idx_v + m.bodies[p].joint.nv - 1 : -1;
+    for (int k = 0; k < j.nv; ++k) dofParent[j.idx_v + k] = k == 0 ? parentLastDof : j.idx_v + k - 1;
+  }
+  Mmu = MatX::Zero(m.nv, m.nv);
+  JMinv = MatX::Zero(sys.nc, m.nv);
+  work = VecX::Zero(std::max(m.nv, sys.nc));
+}
+
+}  // namespace proxgen

@@ -1,0 +1,85 @@
+#include "algorithms/prox_pv.hpp"
+
+#include "algorithms/aba.hpp"
+#include "algorithms/constraints.hpp"
+
+namespace proxgen {
+
+void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu, int iterations) {
+  const Model& m = sys.model;
+  const int N = m.numBodies();
+  aba_steps::initialise(sys, d, q, v);
+  computeConstraintTerms(sys, d);
+
+  // Each constrained body starts its rows: KA = K^T, lA = -k, LA = 0.
+  for (int i = 0; i < N; ++i) {
+    d.KA[i].setZero();
+    d.lA[i].setZero();
+    d.LA[i].setZero();
+  }
+  for (int i = 0; i < N; ++i) {
+    int col = 0;
+    for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+      const Constraint& c = sys.constraints[k];
+      if (c.body != i) continue;
+      d.KA[i].middleCols(col, c.rows()) = d.terms[k].K.transpose();
+      d.lA[i].segment(col, c.rows()) = -d.terms[k].k;
+      col += c.rows();
+    }
+  }
+
+  // Backward: plain ABA elimination, and the subtree rows handed to the parent.
+  for (int i = N - 1; i >= 1; --i) {
+    aba_steps::eliminate(sys, d, i, tau);
+    const int mi = int(d.subtreeRows[i].size());
+    if (mi == 0) continue;
+    d.KS[i].noalias() = d.S[i].transpose() * d.KA[i];
+    const int p = m.bodies[i].parent;
+    // Columns of subtree i inside the parent's arrays: after the parent's own
+    // rows and its earlier children's subtrees (Data's construction order).
+    int offset = int(d.subtreeRows[p].size());
+    for (auto ch = m.bodies[p].children.rbegin(); ch != m.bodies[p].children.rend(); ++ch) {
+      offset -= int(d.subtreeRows[*ch].size());
+      if (*ch == i) break;
+    }
+    const Mat6 X = d.liMi[i].motionMatrixInv();
+    const Vec6 aFree = d.c[i] + d.S[i] * (d.Dinv[i] * (d.u[i] - d.U[i].transpose() * d.c[i]));
+    d.KA[p].middleCols(offset, mi).noalias() = X.transpose() * (d.KA[i] - d.U[i] * (d.Dinv[i] * d.KS[i]));
+    d.LA[p].block(offset, offset, mi, mi) = d.LA[i] + d.KS[i].transpose() * d.Dinv[i] * d.KS[i];
+    d.lA[p].segment(offset, mi) = d.lA[i] + d.KA[i].transpose() * aFree;
+  }
+
+  // Root: y_free = lA_0 + KA_0^T a_0 ; (G + I/mu) lambda+ = y_free + lambda/mu.
+  aba_steps::setRootAcceleration(sys, d);
+  const std::vector<int>& rows = d.subtreeRows[0];
+  const int nc = sys.nc;
+  d.yfree = d.lA[0] + d.KA[0].transpose() * d.a[0];
+  d.G = d.LA[0];
+  d.G.diagonal().array() += 1.0 / mu;
+  d.llt.compute(d.G);
+  d.lambdaTree.setZero();
+  for (int k = 0; k < iterations && nc > 0; ++k) {
+    d.rhs = d.yfree + d.lambdaTree / mu;
+    d.lambdaTree = d.llt.solve(d.rhs);
+  }
+  for (int r = 0; r < nc; ++r) d.lambda[rows[r]] = d.lambdaTree[r];
+
+  // Forward: qdd_i = D^-1 (u_i - KS_i lambda_(i) - U^T a'_i).
+  for (int i = 1; i < N; ++i) {
+    const int mi = int(d.subtreeRows[i].size());
+    if (mi > 0) {
+      auto lam = d.work.head(mi);  // this subtree's multipliers, gathered
+      for (int r = 0; r < mi; ++r) lam[r] = d.lambda[d.subtreeRows[i][r]];
+      const VecN u0 = d.u[i];
+      d.u[i].noalias() -= d.KS[i] * lam;
+      aba_steps::accelerate(sys, d, i);
+      d.u[i] = u0;
+    } else {
+      aba_steps::accelerate(sys, d, i);
+    }
+  }
+  d.iterationsDone = iterations;
+  d.residual = constraintResidual(sys, d);
+}
+
+}  // namespace proxgen

@@ -1,0 +1,149 @@
+#include "model/state.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "model/error.hpp"
+
+namespace proxgen {
+namespace {
+
+using nlohmann::json;
+
+inline constexpr std::size_t kMaxStateBytes = 64u << 20;
+
+double finiteNumber(const json& x, const std::string& where, const std::string& element) {
+  if (!x.is_number()) fail(where, element, fmt::format("expected a number, got {}", x.type_name()));
+  const double d = x.get<double>();
+  if (!std::isfinite(d)) fail(where, element, "is not finite");
+  return d;
+}
+
+// Fills `n` slots of out starting at `at` from a number (n == 1) or a list of n numbers.
+void readSlots(const json& x, int n, VecX& out, int at, const std::string& where, const std::string& element) {
+  if (n == 1 && !x.is_array()) {
+    out[at] = finiteNumber(x, where, element);
+    return;
+  }
+  if (!x.is_array() || int(x.size()) != n) fail(where, element, fmt::format("expected a list of {} numbers", n));
+  for (int k = 0; k < n; ++k) out[at + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
+}
+
+void checkKeys(const Model& model, const json& j, const std::string& where, const std::string& field) {
+  for (const auto& item : j.items())
+    if (model.findJointBody(item.key()) < 0)
+      fail(where, fmt::format("{}.{}", field, quoted(item.key())), "is not a joint of the model");
+}
+
+json slotsToJson(const VecX& x, int at, int n) {
+  if (n == 1) return x[at];
+  json a = json::array();
+  for (int k = 0; k < n; ++k) a.push_back(x[at + k]);
+  return a;
+}
+
+}  // namespace
+
+VecX configurationFromJson(const Model& model, const json& j, const std::string& where) {
+  if (!j.is_object()) fail(where, "q", "expected an object keyed by joint name");
+  checkKeys(model, j, where, "q");
+  VecX q(model.nq);
+  for (int i = 1; i < model.numBodies(); ++i) {
+    const Joint& jt = model.bodies[i].joint;
+    const std::string element = fmt::format("q.{}", quoted(jt.name));
+    if (!j.contains(jt.name)) fail(where, element, "missing");
+    readSlots(j.at(jt.name), jt.nq, q, jt.idx_q, where, element);
+    if (jt.type == JointType::FreeFlyer) {
+      auto quat = q.segment<4>(jt.idx_q + 3);
+      const double n = quat.norm();
+      if (!(n > 1e-8)) fail(where, element, "the quaternion [qx qy qz qw] has zero norm");
+      quat /= n;  // documented: a non-unit quaternion is normalised
+    }
+  }
+  return q;
+}
+
+VecX velocityFromJson(const Model& model, const json& j, const std::string& where, bool missingIsZero) {
+  VecX x = VecX::Zero(model.nv);
+  const std::string field = missingIsZero ? "tau" : "v";
+  if (!j.is_object()) fail(where, field, "expected an object keyed by joint name");
+  checkKeys(model, j, where, field);
+  for (int i = 1; i < model.numBodies(); ++i) {
+    const Joint& jt = model.bodies[i].joint;
+    const std::string element = fmt::format("{}.{}", field, quoted(jt.name));
+    if (!j.contains(jt.name)) {
+      if (missingIsZero) continue;
+      fail(where, element, "missing");
+    }
+    readSlots(j.at(jt.name), jt.nv, x, jt.idx_v, where, element);
+  }
+  return x;
+}
+
+State stateFromJson(const Model& model, const json& j, const std::string& where) {
+  if (!j.is_object()) fail(where, "", "a state must be an object with keys q, v and optionally tau");
+  for (const auto& item : j.items())
+    if (item.key() != "q" && item.key() != "v" && item.key() != "tau")
+      fail(where, quoted(item.key()), "unknown key (expected q, v, tau)");
+  if (!j.contains("q")) fail(where, "q", "missing");
+  if (!j.contains("v")) fail(where, "v", "missing");
+  State s;
+  s.q = configurationFromJson(model, j.at("q"), where);
+  s.v = velocityFromJson(model, j.at("v"), where, false);
+  s.tau = j.contains("tau") ? velocityFromJson(model, j.at("tau"), where, true) : VecX::Zero(model.nv);
+  return s;
+}
+
+std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) fail(path, "", "cannot open file");
+  const std::streamoff size = in.tellg();
+  if (size < 0) fail(path, "", "cannot read file (is it a directory?)");
+  if (std::size_t(size) > kMaxStateBytes) fail(path, "", fmt::format("file is {} bytes, more than the {} allowed", size, kMaxStateBytes));
+  std::string text(std::size_t(size), '\0');
+  in.seekg(0);
+  in.read(text.data(), size);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    fail(path, "", fmt::format("malformed JSON: {}", e.what()));
+  }
+  std::vector<State> states;
+  if (isList) *isList = j.is_array();
+  if (j.is_array()) {
+    for (std::size_t k = 0; k < j.size(); ++k) states.push_back(stateFromJson(model, j[k], fmt::format("{}: [{}]", path, k)));
+  } else {
+    states.push_back(stateFromJson(model, j, path));
+  }
+  return states;
+}
+
+json velocityToJson(const Model& model, const VecX& x) {
+  json out = json::object();
+  for (int i = 1; i < model.numBodies(); ++i) {
+    const Joint& jt = model.bodies[i].joint;
+    out[jt.name] = slotsToJson(x, jt.idx_v, jt.nv);
+  }
+  return out;
+}
+
+json configurationToJson(const Model& model, const VecX& q) {
+  json out = json::object();
+  for (int i = 1; i < model.numBodies(); ++i) {
+    const Joint& jt = model.bodies[i].joint;
+    out[jt.name] = slotsToJson(q, jt.idx_q, jt.nq);
+  }
+  return out;
+}
+
+json rowsToJson(const System& sys, const VecX& lambda) {
+  json out = json::object();
+  for (const Constraint& c : sys.constraints) out[c.name] = slotsToJson(lambda, c.row, c.rows());
+  return out;
+}
+
+}  // namespace proxgen

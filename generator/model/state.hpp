@@ -1,0 +1,36 @@
+// States (q, v, tau) and results as JSON keyed by joint and constraint names
+// (PRODUCT.md, "States and results"), through nlohmann-json.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace proxgen {
+
+struct State {
+  VecX q, v, tau;
+};
+
+/// Reads one state object. Every joint must appear in q and v; a joint missing
+/// from tau gets 0. The free-flyer quaternion must have a finite, non-zero norm
+/// and is normalised. `where` names the file and the element for messages.
+State stateFromJson(const Model& model, const nlohmann::json& j, const std::string& where);
+
+/// Reads a file holding one state object or a list of them. `isList` tells which.
+std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList = nullptr);
+
+/// A joint-space vector (nv) keyed by joint name: scalars, or 6-vectors for a free flyer.
+nlohmann::json velocityToJson(const Model& model, const VecX& x);
+/// A configuration (nq) keyed by joint name.
+nlohmann::json configurationToJson(const Model& model, const VecX& q);
+/// Stacked constraint rows keyed by constraint name.
+nlohmann::json rowsToJson(const System& sys, const VecX& lambda);
+
+/// Reads a joint-space vector keyed by joint name (the inverse of velocityToJson).
+VecX velocityFromJson(const Model& model, const nlohmann::json& j, const std::string& where, bool missingIsZero);
+VecX configurationFromJson(const Model& model, const nlohmann::json& j, const std::string& where);
+
+}  // namespace proxgen
