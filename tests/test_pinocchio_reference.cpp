@@ -49,7 +49,9 @@ void checkReference(const std::string& caseName) {
       EXPECT_LT(test::relErr(d.qdd, qddOf(keys[K - 1])), 1e-9) << caseName << " cABA K=" << K;
       proxPv(sys, d, st.q, st.v, st.tau, mu, K);
       EXPECT_LT(test::relErr(d.qdd, qddOf(keys[K - 1])), 1e-9) << caseName << " PV K=" << K;
-      if (K == 3) EXPECT_LT(test::relErr(d.lambda, lamRef), 1e-9) << caseName << " PV lambda";
+      if (K == 3) {
+        EXPECT_LT(test::relErr(d.lambda, lamRef), 1e-9) << caseName << " PV lambda";
+      }
     }
     constrainedAba(sys, d, st.q, st.v, st.tau, mu, 200);
     EXPECT_LT(test::relErr(d.qdd, qddOf("qdd_converged")), 1e-9) << caseName << " cABA converged";

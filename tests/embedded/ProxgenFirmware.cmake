@@ -95,7 +95,7 @@ function(proxgen_add_firmware name)
     CXX_STANDARD ${FW_CXX_STANDARD}
     CXX_STANDARD_REQUIRED ON
     CXX_EXTENSIONS OFF
-    LINK_DEPENDS "${ld_script};${ld_dir}/sections.ld"
+    LINK_DEPENDS "${ld_script};${ld_dir}/sections.ld;${PROXGEN_FIRMWARE_DIR}/ProxgenFirmwarePost.cmake;${PROXGEN_FIRMWARE_DIR}/stack_report.py"
     PROXGEN_MACHINE "${FW_MACHINE}")
   target_include_directories(${name} PRIVATE ${FW_INCLUDE_DIRS}
                                              "${PROXGEN_FIRMWARE_DIR}/support/include")

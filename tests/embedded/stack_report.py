@@ -198,6 +198,9 @@ def worst_paths(funcs, root):
             warnings.add(f"dynamic (unbounded) frame in {name}")
         best = (0, [])
         for c in sorted(f.callees):
+            if c == INDIRECT:
+                warnings.add(f"indirect call(s) in {name}: not followed")
+                continue
             r = visit(c)
             if r[0] > best[0]:
                 best = r
