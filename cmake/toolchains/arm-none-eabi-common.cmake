@@ -35,9 +35,15 @@ find_program(PROXGEN_ARM_NM      NAMES "${_proxgen_tc_prefix}nm" arm-none-eabi-n
 set(_proxgen_common_flags
     "${PROXGEN_EMBEDDED_CPU_FLAGS} -ffunction-sections -fdata-sections -fstack-usage --specs=nano.specs")
 
-set(CMAKE_C_FLAGS_INIT   "${_proxgen_common_flags}")
-set(CMAKE_CXX_FLAGS_INIT "${_proxgen_common_flags} -fno-exceptions -fno-rtti -fno-threadsafe-statics")
-set(CMAKE_ASM_FLAGS_INIT "${PROXGEN_EMBEDDED_CPU_FLAGS}")
+set(PROXGEN_EMBEDDED_C_FLAGS   "${_proxgen_common_flags}")
+set(PROXGEN_EMBEDDED_CXX_FLAGS "${_proxgen_common_flags} -fno-exceptions -fno-rtti -fno-threadsafe-statics")
+set(PROXGEN_EMBEDDED_ASM_FLAGS "${PROXGEN_EMBEDDED_CPU_FLAGS}")
+# Note: CMake ignores *_FLAGS_INIT when CMAKE_<LANG>_FLAGS is given on the command line
+# (-DCMAKE_CXX_FLAGS=...). tests/embedded/ProxgenFirmware.cmake detects that and puts the
+# PROXGEN_EMBEDDED_<LANG>_FLAGS back in front.
+set(CMAKE_C_FLAGS_INIT   "${PROXGEN_EMBEDDED_C_FLAGS}")
+set(CMAKE_CXX_FLAGS_INIT "${PROXGEN_EMBEDDED_CXX_FLAGS}")
+set(CMAKE_ASM_FLAGS_INIT "${PROXGEN_EMBEDDED_ASM_FLAGS}")
 
 # Our own vector table and reset handler (no crt0, no crti/crtbegin): -nostartfiles.
 # Unused sections are dropped: --gc-sections (pairs with -ffunction/-fdata-sections).
@@ -58,4 +64,5 @@ set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 # Let try_compile() projects see the CPU description too.
 list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES
      PROXGEN_EMBEDDED_CPU_FLAGS PROXGEN_EMBEDDED_CPU PROXGEN_EMBEDDED_MACHINE
-     PROXGEN_EMBEDDED_SCALAR ARM_NONE_EABI_TOOLCHAIN_DIR)
+     PROXGEN_EMBEDDED_SCALAR PROXGEN_EMBEDDED_C_FLAGS PROXGEN_EMBEDDED_CXX_FLAGS
+     PROXGEN_EMBEDDED_ASM_FLAGS ARM_NONE_EABI_TOOLCHAIN_DIR)

@@ -1,18 +1,165 @@
-// proxgen check (placeholder until implemented; exits 2).
+// proxgen check: what proxgen made of a URDF (and a layout). As text, a summary
+// for people: bodies in depth-first order, their joints, merged links, DoF,
+// constraint rows and the support set. With --json, the vector layout every
+// generated solver uses (PRODUCT.md, "The generated solver"), so a tool can map
+// names to slots. Model warnings (mimic joints, ...) go to stderr.
+#include <fmt/format.h>
+
 #include <cstdio>
-#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
+#include "model/error.hpp"
+#include "model/layout.hpp"
+#include "model/urdf.hpp"
 
 namespace proxgen::cli {
+namespace {
+
+using ordered_json = nlohmann::ordered_json;
+
+struct CheckOptions {
+  std::string urdf, layout;
+  bool floating = false, json = false;
+};
+
+// The layout decides the base; --floating is for a URDF checked without one.
+System loadForCheck(const CheckOptions& o) {
+  if (o.layout.empty()) return loadSystemWithoutLayout(o.urdf, o.floating);
+  const Layout layout = loadLayout(o.layout);
+  if (o.floating && !layout.floatingBase)
+    fail("command line", "--floating", fmt::format("conflicts with {} (its base is fixed)", o.layout));
+  return bindLayout(loadUrdf(o.urdf, layout.floatingBase), layout);
+}
+
+const char* constraintTypeName(ConstraintType t) { return t == ConstraintType::Weld6D ? "6d" : "3d"; }
+
+/// URDF links merged into body i by fixed joints (every frame on i but the body's own link).
+std::vector<std::string> mergedLinks(const Model& m, int i) {
+  std::vector<std::string> out;
+  for (const Frame& f : m.frames)
+    if (f.body == i && f.name != m.bodies[i].link) out.push_back(f.name);
+  return out;
+}
+
+ordered_json vec3Json(const Vec3& x) { return ordered_json::array({x[0], x[1], x[2]}); }
+
+ordered_json jointJson(const Model& m, int i) {
+  const Body& b = m.bodies[i];
+  const Joint& j = b.joint;
+  ordered_json out = {{"name", j.name}, {"type", jointTypeName(j.type)}, {"idx_q", j.idx_q}, {"nq", j.nq},
+                      {"idx_v", j.idx_v}, {"nv", j.nv}, {"urdf_type", j.urdfType}, {"body", i}, {"link", b.link}};
+  if (j.type != JointType::FreeFlyer) out["axis"] = vec3Json(j.axis);
+  if (j.hasPositionLimits || j.velocityLimit != 0 || j.effortLimit != 0) {
+    ordered_json limits = ordered_json::object();
+    if (j.hasPositionLimits) {
+      limits["lower"] = j.lower;
+      limits["upper"] = j.upper;
+    }
+    limits["velocity"] = j.velocityLimit;
+    limits["effort"] = j.effortLimit;
+    out["limits"] = limits;
+  }
+  if (!j.mimicOf.empty()) out["mimic"] = j.mimicOf;
+  return out;
+}
+
+ordered_json constraintJson(const System& sys, const Constraint& c) {
+  return {{"name", c.name}, {"link", c.link}, {"type", constraintTypeName(c.type)}, {"row", c.row},
+          {"rows", c.rows()}, {"body", c.body}, {"body_link", sys.model.bodies[c.body].link}};
+}
+
+ordered_json bodyJson(const Model& m, int i) {
+  const Body& b = m.bodies[i];
+  return {{"index", i}, {"link", b.link}, {"parent", b.parent}, {"joint", b.joint.name},
+          {"merged_links", mergedLinks(m, i)}};
+}
+
+ordered_json layoutJson(const System& sys) {
+  const Model& m = sys.model;
+  ordered_json out = {{"nq", m.nq}, {"nv", m.nv}, {"nc", sys.nc}};
+  out["joints"] = ordered_json::array();
+  for (int i = 1; i < m.numBodies(); ++i) out["joints"].push_back(jointJson(m, i));
+  out["constraints"] = ordered_json::array();
+  for (const Constraint& c : sys.constraints) out["constraints"].push_back(constraintJson(sys, c));
+  out["bodies"] = ordered_json::array();  // body 0, the world, is the parent 0 of the roots
+  for (int i = 1; i < m.numBodies(); ++i) out["bodies"].push_back(bodyJson(m, i));
+  out["support"] = sys.supportBodies();
+  out["robot"] = m.name;
+  out["base"] = m.floatingBase ? "floating" : "fixed";
+  out["gravity"] = vec3Json(m.gravity);
+  out["mu"] = sys.mu;
+  out["iterations"] = sys.iterations;
+  return out;
+}
+
+std::string joinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out.empty() ? "-" : out;
+}
+
+std::string bodiesText(const Model& m) {
+  std::string out = "bodies (depth-first; parent 0 is the world):\n";
+  out += fmt::format("  {:>3} {:<24} {:>6}  {:<24} {:<10} {:>5} {:>5}  {:<22} {}\n", "#", "link", "parent", "joint",
+                     "type", "idx_q", "idx_v", "axis", "merged links");
+  for (int i = 1; i < m.numBodies(); ++i) {
+    const Body& b = m.bodies[i];
+    const Joint& j = b.joint;
+    const std::string axis = j.type == JointType::FreeFlyer ? "-" : fmt::format("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2]);
+    out += fmt::format("  {:>3} {:<24} {:>6}  {:<24} {:<10} {:>5} {:>5}  {:<22} {}\n", i, b.link, b.parent, j.name,
+                       j.urdfType, j.idx_q, j.idx_v, axis, joinNames(mergedLinks(m, i)));
+  }
+  return out;
+}
+
+std::string constraintsText(const System& sys) {
+  if (sys.constraints.empty()) return "constraints: none\n";
+  std::string out = "constraints (rows in layout order):\n";
+  for (const Constraint& c : sys.constraints)
+    out += fmt::format("  {:<24} {} on link {} (body {}, {}), rows {}..{}\n", c.name, constraintTypeName(c.type), c.link,
+                       c.body, sys.model.bodies[c.body].link, c.row, c.row + c.rows() - 1);
+  return out;
+}
+
+std::string supportText(const System& sys) {
+  std::vector<std::string> names;
+  for (int i : sys.supportBodies()) names.push_back(fmt::format("{} {}", i, sys.model.bodies[i].link));
+  return fmt::format("support (bodies on the paths from constrained bodies to the root): {}\n", joinNames(names));
+}
+
+std::string summaryText(const System& sys) {
+  const Model& m = sys.model;
+  std::string out = fmt::format("robot {} ({}), {} base\n", m.name, m.sourcePath, m.floatingBase ? "floating" : "fixed");
+  if (!sys.layoutPath.empty())
+    out += fmt::format("layout {}: mu {}, iterations {}\n", sys.layoutPath, sys.mu, sys.iterations);
+  out += fmt::format("gravity [{}, {}, {}]\n", m.gravity[0], m.gravity[1], m.gravity[2]);
+  out += fmt::format("nq {}, nv {} (DoF), nc {}, {} moving bodies, {} links\n\n", m.nq, m.nv, sys.nc,
+                     m.numBodies() - 1, m.frames.size());
+  out += bodiesText(m) + "\n" + constraintsText(sys) + supportText(sys);
+  return out;
+}
+
+void runCheck(const CheckOptions& o) {
+  const System sys = loadForCheck(o);
+  // Built in full before anything is printed: an error leaves stdout empty.
+  const std::string out = o.json ? layoutJson(sys).dump(2) + "\n" : summaryText(sys);
+  for (const std::string& w : sys.model.warnings) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
+  std::fputs(out.c_str(), stdout);
+}
+
+}  // namespace
 
 void addCheck(CLI::App& app) {
-  auto* cmd = app.add_subcommand("check", "not implemented yet");
-  cmd->allow_extras();
-  cmd->callback([] {
-    std::fprintf(stderr, "proxgen: check is not implemented yet\n");
-    std::exit(2);
-  });
+  auto opts = std::make_shared<CheckOptions>();
+  auto* cmd = app.add_subcommand("check", "model summary: bodies, joints in order, DoF, constraint rows, support");
+  cmd->add_option("urdf", opts->urdf, "robot URDF")->required();
+  cmd->add_option("--layout", opts->layout, "constraint layout (YAML)");
+  cmd->add_flag("--floating", opts->floating, "free-flyer root (without --layout; a layout says `base:`)");
+  cmd->add_flag("--json", opts->json, "print the vector layout as JSON (the generated solvers' slots)");
+  cmd->callback([opts] { runCheck(*opts); });
 }
 
 }  // namespace proxgen::cli

@@ -35,6 +35,21 @@ if(NOT DEFINED PROXGEN_EMBEDDED_CPU)
     "-DCMAKE_TOOLCHAIN_FILE=<repo>/cmake/toolchains/arm-none-eabi-cortex-m7.cmake (or -m4f)")
 endif()
 
+# -DCMAKE_CXX_FLAGS=... on the command line replaces the toolchain's CMAKE_CXX_FLAGS_INIT, and
+# with it the CPU/FPU flags: put them back in front (for targets of this directory and below).
+foreach(_lang C CXX ASM)
+  if(DEFINED CMAKE_${_lang}_COMPILER_LOADED AND DEFINED PROXGEN_EMBEDDED_${_lang}_FLAGS)
+    if(NOT " ${CMAKE_${_lang}_FLAGS} " MATCHES " -mcpu=")
+      if(NOT _lang STREQUAL "ASM" AND " ${CMAKE_${_lang}_FLAGS} " MATCHES " --specs=")
+        message(FATAL_ERROR "CMAKE_${_lang}_FLAGS has --specs but no -mcpu: it replaced the "
+                            "toolchain's flags; add '${PROXGEN_EMBEDDED_CPU_FLAGS}' to it")
+      endif()
+      message(STATUS "proxgen: CMAKE_${_lang}_FLAGS lacks the toolchain's flags, prepending them")
+      set(CMAKE_${_lang}_FLAGS "${PROXGEN_EMBEDDED_${_lang}_FLAGS} ${CMAKE_${_lang}_FLAGS}")
+    endif()
+  endif()
+endforeach()
+
 find_package(Python3 COMPONENTS Interpreter QUIET)
 include(CheckCXXCompilerFlag)
 check_cxx_compiler_flag("-fcallgraph-info=su" PROXGEN_HAVE_CALLGRAPH_INFO)
@@ -108,6 +123,8 @@ function(proxgen_add_firmware name)
     target_compile_options(${name} PRIVATE -fcallgraph-info=su)
   endif()
   target_link_options(${name} PRIVATE
+    -nostartfiles -Wl,--gc-sections  # also in the toolchain's linker flags; repeated in case
+                                     # CMAKE_EXE_LINKER_FLAGS was replaced on the command line
     "-L${ld_dir}" "-T${ld_script}"
     "-Wl,--defsym=__stack_size=${FW_STACK_SIZE}"
     "-Wl,-Map=$<TARGET_FILE_DIR:${name}>/${name}.map"

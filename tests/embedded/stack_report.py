@@ -58,7 +58,7 @@ def walk(paths, ext):
                     yield os.path.join(root, f)
 
 
-def read_ci(paths, funcs):
+def read_ci(paths, funcs, canon):
     count = 0
     for path in walk(paths, ".ci"):
         count += 1
@@ -67,13 +67,13 @@ def read_ci(paths, funcs):
                 line = line.strip()
                 m = NODE_RE.match(line)
                 if m:
-                    title, label = m.group(1), m.group(2)
+                    key, label = canon(m.group(1)), m.group(2)
                     parts = label.split("\\n")
                     st = STACK_RE.search(label)
-                    f = funcs.get(title)
+                    f = funcs.get(key)
                     if f is None:
-                        f = funcs[title] = Func(title)
-                    if parts:
+                        f = funcs[key] = Func(key)
+                    if parts and (st or f.pretty == key):
                         f.pretty = parts[0]
                     if len(parts) > 1 and not f.where:
                         f.where = parts[1]
@@ -85,7 +85,7 @@ def read_ci(paths, funcs):
                     continue
                 m = EDGE_RE.match(line)
                 if m:
-                    src, dst = m.group(1), m.group(2)
+                    src, dst = canon(m.group(1)), canon(m.group(2))
                     funcs.setdefault(src, Func(src)).callees.add(dst)
     return count
 
@@ -122,7 +122,38 @@ def count_regs(operands):
     return total
 
 
-def read_elf(elf, objdump, funcs):
+SYM_RE = re.compile(r"^([0-9a-f]+)\s.*\sF\s+\S+\s+[0-9a-f]+\s+(.+)$")
+
+
+def read_symbols(elf, objdump):
+    """Function symbols of the ELF: name -> set of addresses (aliases such as C1/C2 share one)."""
+    try:
+        out = subprocess.run([objdump, "-t", elf], check=True, capture_output=True,
+                             text=True).stdout
+    except (OSError, subprocess.CalledProcessError) as e:
+        print(f"stack_report: cannot read symbols of {elf}: {e}", file=sys.stderr)
+        return {}
+    names = {}
+    for line in out.splitlines():
+        m = SYM_RE.match(line)
+        if m:
+            names.setdefault(m.group(2).strip(), set()).add(int(m.group(1), 16) & ~1)
+    return names
+
+
+def make_canon(symbols):
+    """Maps a .ci title or symbol name to one key per function: '@<address>' when the ELF has
+    exactly one function of that name (merges aliases and file-qualified local names)."""
+    def canon(title):
+        bare = title.rsplit(":", 1)[-1]  # .ci titles of local functions are "file:symbol"
+        addrs = symbols.get(bare)
+        if addrs and len(addrs) == 1:
+            return "@%x" % next(iter(addrs))
+        return title
+    return canon
+
+
+def read_elf(elf, objdump, funcs, symbols):
     try:
         out = subprocess.run([objdump, "-d", "--no-show-raw-insn", elf], check=True,
                              capture_output=True, text=True).stdout
@@ -130,6 +161,7 @@ def read_elf(elf, objdump, funcs):
         print(f"stack_report: cannot disassemble {elf}: {e}", file=sys.stderr)
         return 0
     cur = None
+    cur_elf_only = False
     n = 0
     for line in out.splitlines():
         m = FUNC_HDR_RE.match(line)
@@ -138,9 +170,12 @@ def read_elf(elf, objdump, funcs):
             if name.startswith("$") or name.startswith(".L"):
                 continue
             n += 1
-            cur = funcs.get(name)
+            key = "@%x" % (int(m.group(1), 16) & ~1)
+            cur = funcs.get(key)
             if cur is None:
-                cur = funcs[name] = Func(name)
+                cur = funcs[key] = Func(key)
+            if cur.pretty == key:
+                cur.pretty = name
             if cur.source != "ci":
                 cur.source, cur.frame, cur.kind = "elf", 0, "est."
             cur_elf_only = cur.source == "elf"
@@ -165,8 +200,11 @@ def read_elf(elf, objdump, funcs):
         if base in ("bl", "b") or (base.startswith("b") and base[1:] in (
                 "eq", "ne", "cs", "cc", "hs", "lo", "mi", "pl", "vs", "vc",
                 "hi", "ls", "ge", "lt", "gt", "le", "al")):
-            if t and t.group(2) is None and t.group(1) != cur.name:
-                cur.callees.add(t.group(1))
+            if t and t.group(2) is None:
+                addr = re.match(r"\s*([0-9a-f]+)", args)
+                key = "@%x" % (int(addr.group(1), 16) & ~1) if addr else t.group(1)
+                if key != cur.name:
+                    cur.callees.add(key)
         elif base == "blx" and not t:
             cur.callees.add(INDIRECT)
         elif base == "bx" and args.strip() not in ("lr",):
@@ -191,15 +229,15 @@ def worst_paths(funcs, root):
             memo[name] = (0, [name])
             return memo[name]
         if name in on_stack:
-            warnings.add(f"recursion through {name}: depth unbounded (one level counted)")
+            warnings.add(f"recursion through {f.pretty}: depth unbounded (one level counted)")
             return (0, [])
         on_stack.add(name)
         if f.kind and "dynamic" in f.kind and "bounded" not in f.kind:
-            warnings.add(f"dynamic (unbounded) frame in {name}")
+            warnings.add(f"dynamic (unbounded) frame in {f.pretty}")
         best = (0, [])
         for c in sorted(f.callees):
             if c == INDIRECT:
-                warnings.add(f"indirect call(s) in {name}: not followed")
+                warnings.add(f"indirect call(s) in {f.pretty}: not followed")
                 continue
             r = visit(c)
             if r[0] > best[0]:
@@ -242,8 +280,10 @@ def main(argv):
         ap.error("give object directories and/or --elf")
 
     funcs = {}
-    n_ci = read_ci(args.paths, funcs)
-    n_elf = read_elf(args.elf, args.objdump, funcs) if args.elf else 0
+    symbols = read_symbols(args.elf, args.objdump) if args.elf else {}
+    canon = make_canon(symbols)
+    n_ci = read_ci(args.paths, funcs, canon)
+    n_elf = read_elf(args.elf, args.objdump, funcs, symbols) if args.elf else 0
     report = []
     title = args.elf or ", ".join(args.paths)
     report.append(f"stack report for {title}")
@@ -263,18 +303,19 @@ def main(argv):
     # Only keep functions that exist in the final image, when we have it (drops inlined ones).
     roots = args.root or ["Reset_Handler", "main"]
     for root in roots:
-        if root not in funcs:
+        if canon(root) not in funcs:
             report.append(f"\nroot {root}: not found")
             continue
-        total, path, warns = worst_paths(funcs, root)
+        total, path, warns = worst_paths(funcs, canon(root))
         report.append(f"\nworst stack from {root}: {total} bytes")
         report.append(f"  {'frame':>7s} {'cumul':>7s}  function")
         report.extend(fmt_path(funcs, path))
         for w in warns:
             report.append(f"  warning: {w}")
-    handlers = [n for n in funcs if n.endswith("_Handler") and n != "Reset_Handler"]
+    handlers = [k for k, f in funcs.items()
+                if re.search(r"\b\w+_Handler\b", f.pretty) and "Reset_Handler" not in f.pretty]
     if handlers:
-        worst_h = max((worst_paths(funcs, h)[0], h) for h in handlers)
+        worst_h = max((worst_paths(funcs, h)[0], funcs[h].pretty) for h in handlers)
         report.append(f"\nlargest exception-handler path: {worst_h[1]} {worst_h[0]} bytes "
                       "(+32..104 bytes of hardware exception frame) - on top of the thread stack")
     ci_funcs = sorted((f for f in funcs.values() if f.source == "ci" and f.frame is not None),

@@ -1,0 +1,61 @@
+# proxgen_add_solver(<target> URDF <file> LAYOUT <file>
+#                    [SCALAR double|float] [NAME <namespace>] [OUTPUT_DIR <dir>])
+#
+# Generates a solver for one robot and layout at build time and makes it a
+# static library target <target> to link. The solver is regenerated whenever
+# the URDF, the layout or the proxgen executable changes. NAME defaults to
+# <target>; the generated header is <NAME>.hpp.
+#
+# Needs PROXGEN_EXECUTABLE (path or generator expression), PROXGEN_EXECUTABLE_DEPENDS
+# (what the generation step depends on for "proxgen changed") and
+# PROXGEN_RUNTIME_INCLUDE_DIR; proxgenConfig.cmake and the in-tree build set them.
+function(proxgen_add_solver target)
+  cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR" "")
+  if(PAS_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "proxgen_add_solver(${target}): unknown arguments: ${PAS_UNPARSED_ARGUMENTS}")
+  endif()
+  foreach(required URDF LAYOUT)
+    if(NOT PAS_${required})
+      message(FATAL_ERROR "proxgen_add_solver(${target}): ${required} <file> is required")
+    endif()
+  endforeach()
+  if(NOT PAS_SCALAR)
+    set(PAS_SCALAR double)
+  endif()
+  if(NOT PAS_SCALAR MATCHES "^(double|float)$")
+    message(FATAL_ERROR "proxgen_add_solver(${target}): SCALAR must be double or float, not '${PAS_SCALAR}'")
+  endif()
+  if(NOT PAS_NAME)
+    set(PAS_NAME ${target})
+  endif()
+  if(NOT PAS_NAME MATCHES "^[A-Za-z][A-Za-z0-9_]*$")
+    message(FATAL_ERROR "proxgen_add_solver(${target}): NAME '${PAS_NAME}' is not a C++ identifier")
+  endif()
+  if(NOT PAS_OUTPUT_DIR)
+    set(PAS_OUTPUT_DIR "${CMAKE_CURRENT_BINARY_DIR}/proxgen/${target}")
+  endif()
+  get_filename_component(urdf "${PAS_URDF}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  get_filename_component(layout "${PAS_LAYOUT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  foreach(input "${urdf}" "${layout}")
+    if(NOT EXISTS "${input}")
+      message(FATAL_ERROR "proxgen_add_solver(${target}): ${input} does not exist")
+    endif()
+  endforeach()
+  if(NOT PROXGEN_EXECUTABLE OR NOT PROXGEN_RUNTIME_INCLUDE_DIR)
+    message(FATAL_ERROR "proxgen_add_solver: use find_package(proxgen) or the proxgen source tree first")
+  endif()
+
+  set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
+  set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
+  add_custom_command(
+    OUTPUT "${hpp}" "${cpp}"
+    COMMAND "${PROXGEN_EXECUTABLE}" generate "${urdf}" --layout "${layout}" --out "${PAS_OUTPUT_DIR}"
+            --name "${PAS_NAME}" --scalar "${PAS_SCALAR}"
+    DEPENDS "${urdf}" "${layout}" ${PROXGEN_EXECUTABLE_DEPENDS}
+    COMMENT "proxgen: generating ${PAS_NAME} (${PAS_SCALAR}) from ${urdf}"
+    VERBATIM)
+  add_library(${target} STATIC "${cpp}" "${hpp}")
+  target_include_directories(${target} PUBLIC "${PAS_OUTPUT_DIR}" "${PROXGEN_RUNTIME_INCLUDE_DIR}")
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  set_target_properties(${target} PROPERTIES PROXGEN_HEADER "${hpp}" PROXGEN_SOURCE "${cpp}")
+endfunction()
