@@ -8,6 +8,7 @@
 
 #include "model/cases.hpp"
 #include "model/model.hpp"
+#include "model/state.hpp"
 
 namespace proxgen::test {
 
@@ -29,12 +30,9 @@ std::vector<Case> sharedCases();
 /// Path of a file in the shared models folder.
 std::string modelPath(const std::string& file);
 
-/// A random state: joints uniform in [-1, 1] rad (inside limits when the joint has
-/// them), a random unit quaternion, velocities and torques in [-1, 1].
-struct RandomState {
-  VecX q, v, tau;
-};
-RandomState randomState(const Model& m, std::mt19937& rng);
+/// A random state (proxgen::randomState: inside joint limits, random unit quaternion).
+using RandomState = State;
+inline RandomState randomState(const Model& m, std::mt19937& rng) { return proxgen::randomState(m, rng); }
 
 /// max |a - b| / max(1, max |b|): relative to the size of the reference vector.
 double relErr(const VecX& a, const VecX& b);

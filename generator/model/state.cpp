@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -98,6 +100,8 @@ State stateFromJson(const Model& model, const json& j, const std::string& where)
 }
 
 std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList) {
+  // A directory opens as a stream on Linux and reports a size of 2^63 - 1.
+  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a state file");
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) fail(path, "", "cannot open file");
   const std::streamoff size = in.tellg();
@@ -107,10 +111,17 @@ std::vector<State> loadStates(const Model& model, const std::string& path, bool*
   in.seekg(0);
   in.read(text.data(), size);
   json j;
+  // The last key read tells the user where a bad token (e.g. an overflowing
+  // 1e999, which nlohmann reports as out_of_range, not parse_error) was.
+  std::string lastKey;
+  const json::parser_callback_t track = [&lastKey](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::key) lastKey = parsed.get<std::string>();
+    return true;
+  };
   try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    fail(path, "", fmt::format("malformed JSON: {}", e.what()));
+    j = json::parse(text, track);
+  } catch (const json::exception& e) {
+    fail(path, lastKey.empty() ? "" : fmt::format("after key {}", quoted(lastKey)), fmt::format("invalid JSON: {}", e.what()));
   }
   std::vector<State> states;
   if (isList) *isList = j.is_array();
@@ -144,6 +155,27 @@ json rowsToJson(const System& sys, const VecX& lambda) {
   json out = json::object();
   for (const Constraint& c : sys.constraints) out[c.name] = slotsToJson(lambda, c.row, c.rows());
   return out;
+}
+
+State randomState(const Model& m, std::mt19937& rng) {
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  State s{VecX::Zero(m.nq), VecX::Zero(m.nv), VecX::Zero(m.nv)};
+  for (int i = 1; i < m.numBodies(); ++i) {
+    const Joint& j = m.bodies[i].joint;
+    if (j.type == JointType::FreeFlyer) {
+      for (int k = 0; k < 3; ++k) s.q[j.idx_q + k] = U(rng);
+      const Eigen::Vector4d quat(N(rng), N(rng), N(rng), N(rng));  // normal -> uniform on the sphere
+      s.q.segment<4>(j.idx_q + 3) = quat.normalized();
+    } else if (j.hasPositionLimits && j.upper > j.lower) {
+      s.q[j.idx_q] = std::uniform_real_distribution<double>(j.lower, j.upper)(rng);
+    } else {
+      s.q[j.idx_q] = U(rng);
+    }
+  }
+  for (int k = 0; k < m.nv; ++k) s.v[k] = U(rng);
+  for (int k = 0; k < m.nv; ++k) s.tau[k] = U(rng);
+  return s;
 }
 
 }  // namespace proxgen

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -32,5 +33,10 @@ nlohmann::json rowsToJson(const System& sys, const VecX& lambda);
 /// Reads a joint-space vector keyed by joint name (the inverse of velocityToJson).
 VecX velocityFromJson(const Model& model, const nlohmann::json& j, const std::string& where, bool missingIsZero);
 VecX configurationFromJson(const Model& model, const nlohmann::json& j, const std::string& where);
+
+/// A random state for tests and `verify`: joints uniform inside their limits
+/// (in [-1, 1] rad or m without limits), a uniformly random unit quaternion and
+/// base position in [-1, 1]^3, velocities and torques uniform in [-1, 1].
+State randomState(const Model& model, std::mt19937& rng);
 
 }  // namespace proxgen
