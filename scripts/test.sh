@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Every test: the build with all test suites (unit, generated-vs-generic,
+# downstream package, benchmark smoke runs), then the embedded checks under
+# qemu, the sanitizer build and the bounded fuzz runs.
+# Environment: PROXGEN_SKIP_SLOW=1 skips the sanitizer and fuzz stages.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc)
+start=$(date +%s)
+stage() { echo; echo "== [$(( $(date +%s) - start ))s] $*"; }
+
+stage "configure + build (Release)"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j "$jobs"
+
+stage "ctest"
+ctest --test-dir build --output-on-failure -j "$jobs"
+
+if [ -x tests/embedded/check.sh ]; then
+  stage "embedded: cross-compile and run under qemu"
+  tests/embedded/check.sh build
+fi
+
+if [ "${PROXGEN_SKIP_SLOW:-0}" != 1 ]; then
+  if [ -x scripts/sanitize.sh ]; then
+    stage "ASan + UBSan build of the test suite"
+    scripts/sanitize.sh
+  fi
+  if [ -x tests/fuzz/run.sh ]; then
+    stage "fuzzing (bounded)"
+    tests/fuzz/run.sh
+  fi
+fi
+stage "all tests passed"
