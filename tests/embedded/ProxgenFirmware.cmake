@@ -12,6 +12,8 @@
 #       [CXX_STANDARD 17]              # default 17
 #       [STACK_SIZE bytes]             # least free RAM above .bss, checked at link; default 131072
 #       [TIMEOUT seconds]              # qemu run time limit of the test; default 60
+#       [STACK_ROOTS name...]          # extra roots for the worst-stack report, e.g. the solver
+#                                      # entry points "arm::constrained_aba" "arm::prox_pv"
 #       [NO_SOFT_DOUBLE]               # fail the build if double-precision soft-float helpers
 #                                      # (__aeabi_dadd, ...) are linked: for float solvers on M4F
 #       [NO_TEST] [EXCLUDE_FROM_ALL])
@@ -67,7 +69,8 @@ set(_PROXGEN_FW_CPU_mps2-an386 cortex-m4)
 function(proxgen_add_firmware name)
   set(options NO_SOFT_DOUBLE NO_TEST EXCLUDE_FROM_ALL)
   set(one_value MACHINE STACK_SIZE TIMEOUT CXX_STANDARD)
-  set(multi_value SOURCES INCLUDE_DIRS COMPILE_DEFINITIONS COMPILE_OPTIONS LINK_LIBRARIES)
+  set(multi_value SOURCES INCLUDE_DIRS COMPILE_DEFINITIONS COMPILE_OPTIONS LINK_LIBRARIES
+                  STACK_ROOTS)
   cmake_parse_arguments(FW "${options}" "${one_value}" "${multi_value}" ${ARGN})
   if(FW_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "proxgen_add_firmware(${name}): unknown arguments ${FW_UNPARSED_ARGUMENTS}")
@@ -149,6 +152,7 @@ function(proxgen_add_firmware name)
             "-DPYTHON=${python}"
             "-DSTACK_SCRIPT=${PROXGEN_FIRMWARE_DIR}/stack_report.py"
             "-DNO_SOFT_DOUBLE=${FW_NO_SOFT_DOUBLE}"
+            "-DSTACK_ROOTS=${FW_STACK_ROOTS}"
             -P "${PROXGEN_FIRMWARE_DIR}/ProxgenFirmwarePost.cmake"
     VERBATIM)
 

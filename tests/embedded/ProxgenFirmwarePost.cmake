@@ -1,6 +1,6 @@
 # Post-link step of proxgen_add_firmware (run with cmake -P): size report, optional soft-double
 # check, stack report. Inputs (-D): ELF NAME OUT_DIR OBJ_DIR SIZE NM OBJDUMP PYTHON STACK_SCRIPT
-# NO_SOFT_DOUBLE.
+# NO_SOFT_DOUBLE STACK_ROOTS (;-list).
 
 # Size: Berkeley (text = flash code+rodata+vectors, data = initialised RAM, also stored in
 # flash, bss = zeroed RAM) and per section (SysV).
@@ -33,8 +33,12 @@ if(NO_SOFT_DOUBLE)
 endif()
 
 if(PYTHON AND EXISTS "${STACK_SCRIPT}")
+  set(roots --root Reset_Handler --root main)
+  foreach(r IN LISTS STACK_ROOTS)
+    list(APPEND roots --root "${r}")
+  endforeach()
   execute_process(COMMAND "${PYTHON}" "${STACK_SCRIPT}" --elf "${ELF}" --objdump "${OBJDUMP}"
-                          --out "${OUT_DIR}/${NAME}.stack.txt" "${OBJ_DIR}"
+                          ${roots} --out "${OUT_DIR}/${NAME}.stack.txt" "${OBJ_DIR}"
                   OUTPUT_VARIABLE stack_out RESULT_VARIABLE rc)
   if(rc EQUAL 0)
     string(REGEX MATCH "worst stack from Reset_Handler: [0-9]+ bytes" line "${stack_out}")

@@ -26,6 +26,15 @@ if ! command -v "$qemu" >/dev/null 2>&1; then
   exit 125
 fi
 
+# An image for the M7's FPv5 on the M4's FPv4-SP machine faults at its first double-precision
+# instruction: refuse it up front when readelf can tell (ELF build attributes).
+if [[ $machine == mps2-an386 || $machine == mps2-an385 ]] && command -v arm-none-eabi-readelf >/dev/null 2>&1; then
+  if arm-none-eabi-readelf -A "$elf" 2>/dev/null | grep -q 'Tag_FP_arch: FPv5'; then
+    echo "run-qemu.sh: $elf is built for an FPv5 (Cortex-M7) FPU; $machine has none: use mps2-an500" >&2
+    exit 125
+  fi
+fi
+
 # -nographic: no display, UART/monitor on stdio; stdin from /dev/null so that qemu neither
 # waits for nor steals the caller's terminal input. -kernel loads the ELF by its load
 # addresses; the M-profile core then takes SP and PC from the vector table at 0x0.

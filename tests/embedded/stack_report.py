@@ -17,7 +17,8 @@ Exception handlers run on top of the thread's stack: add the largest handler pat
 interrupts are enabled (test firmware enables none).
 
 usage: stack_report.py [--elf fw.elf] [--objdump arm-none-eabi-objdump]
-                       [--root NAME ...] [--top N] [--out FILE] DIR_OR_FILE...
+                       [--root NAME]... [--top N] [--out FILE] DIR_OR_FILE...
+--root: a symbol, or part of a demangled name ("demo::cholesky_solve"); repeatable.
 DIR_OR_FILE: object directories (searched recursively for .ci and .su) or single files.
 Exit status 0; 2 on bad arguments.
 """
@@ -272,7 +273,9 @@ def main(argv):
     ap.add_argument("paths", nargs="*", help="object directories or .ci/.su files")
     ap.add_argument("--elf", help="linked firmware, for library code and final call edges")
     ap.add_argument("--objdump", default="arm-none-eabi-objdump")
-    ap.add_argument("--root", action="append", help="root function(s); default Reset_Handler, main")
+    ap.add_argument("--root", action="append",
+                    help="root function: symbol, or part of a demangled name (e.g. "
+                         "'arm::prox_pv'); repeatable; default Reset_Handler and main")
     ap.add_argument("--top", type=int, default=10, help="largest frames to list")
     ap.add_argument("--out", help="write the report here as well as to stdout")
     args = ap.parse_args(argv)
@@ -303,15 +306,21 @@ def main(argv):
     # Only keep functions that exist in the final image, when we have it (drops inlined ones).
     roots = args.root or ["Reset_Handler", "main"]
     for root in roots:
-        if canon(root) not in funcs:
+        if canon(root) in funcs:
+            keys = [canon(root)]
+        else:  # a demangled name or a part of one, e.g. "arm::prox_pv"
+            keys = sorted(k for k, f in funcs.items() if root in f.pretty and f.source)
+        if not keys:
             report.append(f"\nroot {root}: not found")
             continue
-        total, path, warns = worst_paths(funcs, canon(root))
-        report.append(f"\nworst stack from {root}: {total} bytes")
-        report.append(f"  {'frame':>7s} {'cumul':>7s}  function")
-        report.extend(fmt_path(funcs, path))
-        for w in warns:
-            report.append(f"  warning: {w}")
+        for key in keys:
+            total, path, warns = worst_paths(funcs, key)
+            label = root if len(keys) == 1 else funcs[key].pretty
+            report.append(f"\nworst stack from {label}: {total} bytes")
+            report.append(f"  {'frame':>7s} {'cumul':>7s}  function")
+            report.extend(fmt_path(funcs, path))
+            for w in warns:
+                report.append(f"  warning: {w}")
     handlers = [k for k, f in funcs.items()
                 if re.search(r"\b\w+_Handler\b", f.pretty) and "Reset_Handler" not in f.pretty]
     if handlers:

@@ -7,6 +7,7 @@
 #include "cholesky6.hpp"
 #include "fw/io.hpp"
 #include "fw/stack.hpp"
+#include "fw/trace.hpp"
 
 namespace {
 
@@ -54,7 +55,10 @@ bool run_case(const char* name, const Scalar* x_true, Scalar tol) {
   fw::print("case ");
   fw::print(name);
   fw::print(":\n");
-  if (!demo::cholesky_solve(g_A, g_b, g_L, g_x)) {
+  fw::trace_begin();  // count_insns.py: instructions of one solve
+  const bool spd = demo::cholesky_solve(g_A, g_b, g_L, g_x);
+  fw::trace_end();
+  if (!spd) {
     fw::print("  cholesky_solve: matrix not positive definite\n");
     return false;
   }
@@ -120,11 +124,18 @@ int main() {
   if (!run_case("exact", kXExact, Scalar(0))) ++failures;
   if (!run_case("decimal", kXDecimal, tol)) ++failures;
 
+  const std::size_t stack_used = fw::stack_high_water();
   fw::print("stack high water: ");
-  fw::print_int(static_cast<long long>(fw::stack_high_water()));
-  fw::print(" bytes of ");
+  fw::print_int(static_cast<long long>(stack_used));
+  fw::print(" bytes (budget ");
+  fw::print_int(static_cast<long long>(fw::stack_budget()));
+  fw::print(", free RAM ");
   fw::print_int(static_cast<long long>(fw::stack_capacity()));
-  fw::print("\n");
+  fw::print(")\n");
+  if (stack_used >= fw::stack_budget()) {
+    fw::print("stack budget exceeded\n");
+    ++failures;
+  }
   fw::print(failures == 0 ? "fw_demo: PASS\n" : "fw_demo: FAIL\n");
   return failures == 0 ? 0 : 1;
 }

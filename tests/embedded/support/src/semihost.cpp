@@ -28,3 +28,12 @@ void exit(int code) noexcept {
 }
 
 }  // namespace fw
+
+// Markers for count_insns.py: real, distinct, never inlined or merged functions whose entry the
+// instruction trace shows by name.
+extern "C" __attribute__((noinline, noipa, used)) void fw_trace_begin() noexcept {
+  __asm volatile("nop  @ fw_trace_begin" ::: "memory");
+}
+extern "C" __attribute__((noinline, noipa, used)) void fw_trace_end() noexcept {
+  __asm volatile("nop  @ fw_trace_end\n nop" ::: "memory");
+}

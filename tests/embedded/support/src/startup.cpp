@@ -1,7 +1,7 @@
 // Vector table, reset handler and fault handlers for Cortex-M3/M4/M7 firmware (no crt0).
 //
-// Reset_Handler: sets SP, enables the FPU (CPACR), copies .data, clears .bss, paints the free
-// stack area for fw::stack_high_water(), runs C++ static constructors (__preinit_array,
+// Reset_Handler: sets SP, enables the FPU (CPACR), copies .data, clears .bss, paints the
+// stack budget for fw::stack_high_water(), runs C++ static constructors (__preinit_array,
 // __init_array), calls main() and exits through semihosting with main's return value.
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +17,7 @@ extern "C" {
 // From the linker script (sections.ld).
 extern std::uint32_t __stack_top[];
 extern std::uint32_t __stack_limit[];
+extern std::uint32_t __stack_paint_bottom[];
 extern std::uint32_t _sidata[];
 extern std::uint32_t _sdata[];
 extern std::uint32_t _edata[];
@@ -85,12 +86,13 @@ extern "C" __attribute__((noreturn, used)) void fw_reset_c() {
   for (std::uint32_t *src = _sidata, *dst = _sdata; dst < _edata;) *dst++ = *src++;
   // .bss: zero.
   for (std::uint32_t* dst = _sbss; dst < _ebss;) *dst++ = 0;
-  // Paint the free stack area below the current SP (leave 64 bytes for this frame).
+  // Paint the stack budget (top __stack_size bytes of RAM) below the current SP, leaving 64
+  // bytes for this frame.
   {
     std::uint32_t* sp;
     __asm volatile("mov %0, sp" : "=r"(sp));
     std::uint32_t* end = sp - 16;
-    for (volatile std::uint32_t* p = __stack_limit; p < end; ++p) *p = kStackPaint;
+    for (volatile std::uint32_t* p = __stack_paint_bottom; p < end; ++p) *p = kStackPaint;
   }
   // C++ static constructors (and C constructor functions).
   for (void (**f)() = __preinit_array_start; f < __preinit_array_end; ++f) (*f)();
@@ -153,7 +155,7 @@ extern "C" __attribute__((naked)) void Default_Handler() {
 namespace fw {
 
 std::size_t stack_high_water() noexcept {
-  const volatile std::uint32_t* p = __stack_limit;
+  const volatile std::uint32_t* p = __stack_paint_bottom;
   const volatile std::uint32_t* top = __stack_top;
   while (p < top && *p == kStackPaint) ++p;
   return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(top) -
@@ -163,6 +165,11 @@ std::size_t stack_high_water() noexcept {
 std::size_t stack_capacity() noexcept {
   return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(__stack_top) -
                                   reinterpret_cast<std::uintptr_t>(__stack_limit));
+}
+
+std::size_t stack_budget() noexcept {
+  return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(__stack_top) -
+                                  reinterpret_cast<std::uintptr_t>(__stack_paint_bottom));
 }
 
 const char* cpu_name() noexcept { return PROXGEN_FW_CPU_NAME; }

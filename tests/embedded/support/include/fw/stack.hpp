@@ -1,5 +1,6 @@
-// Run-time stack measurement. The reset handler fills the free RAM between .bss and the stack
-// pointer with a pattern before main(); the high-water mark is the deepest word overwritten.
+// Run-time stack measurement. The reset handler fills the stack budget (the top STACK_SIZE
+// bytes of RAM, see proxgen_add_firmware) below the stack pointer with a pattern before main();
+// the high-water mark is the deepest word overwritten.
 #pragma once
 #include <cstddef>
 
@@ -7,7 +8,11 @@ namespace fw {
 
 // Bytes of stack used so far (the deepest point reached since reset, including the frames of
 // the start-up code). Scans memory: call it at the end of a test, not in a hot loop.
+// Saturates at stack_budget(): a result equal to the budget means the budget was exceeded.
 std::size_t stack_high_water() noexcept;
+
+// Bytes painted for the measurement: min(STACK_SIZE, stack_capacity()).
+std::size_t stack_budget() noexcept;
 
 // Bytes available between the end of .bss and the top of RAM.
 std::size_t stack_capacity() noexcept;
