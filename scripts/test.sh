@@ -18,7 +18,7 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 
 if [ -x tests/embedded/check.sh ]; then
   stage "embedded: cross-compile and run under qemu"
-  tests/embedded/check.sh build
+  tests/embedded/check.sh build/embedded
 fi
 
 if [ "${PROXGEN_SKIP_SLOW:-0}" != 1 ]; then
