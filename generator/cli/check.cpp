@@ -5,6 +5,7 @@
 // names to slots. Model warnings (mimic joints, ...) go to stderr.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -101,18 +102,33 @@ std::string joinNames(const std::vector<std::string>& names) {
   return out.empty() ? "-" : out;
 }
 
+// Left-aligned columns as wide as their widest cell.
+std::string table(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& row : rows)
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      if (width.size() <= c) width.push_back(0);
+      width[c] = std::max(width[c], row[c].size());
+    }
+  std::string out;
+  for (const auto& row : rows) {
+    std::string line = " ";
+    for (std::size_t c = 0; c < row.size(); ++c) line += fmt::format(" {:<{}}", row[c], c + 1 < row.size() ? width[c] : 0);
+    out += line + "\n";
+  }
+  return out;
+}
+
 std::string bodiesText(const Model& m) {
-  std::string out = "bodies (depth-first; parent 0 is the world):\n";
-  out += fmt::format("  {:>3} {:<24} {:>6}  {:<24} {:<10} {:>5} {:>5}  {:<22} {}\n", "#", "link", "parent", "joint",
-                     "type", "idx_q", "idx_v", "axis", "merged links");
+  std::vector<std::vector<std::string>> rows = {{"#", "link", "parent", "joint", "type", "idx_q", "idx_v", "axis", "merged links"}};
   for (int i = 1; i < m.numBodies(); ++i) {
     const Body& b = m.bodies[i];
     const Joint& j = b.joint;
     const std::string axis = j.type == JointType::FreeFlyer ? "-" : fmt::format("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2]);
-    out += fmt::format("  {:>3} {:<24} {:>6}  {:<24} {:<10} {:>5} {:>5}  {:<22} {}\n", i, b.link, b.parent, j.name,
-                       j.urdfType, j.idx_q, j.idx_v, axis, joinNames(mergedLinks(m, i)));
+    rows.push_back({std::to_string(i), b.link, std::to_string(b.parent), j.name, j.urdfType, std::to_string(j.idx_q),
+                    std::to_string(j.idx_v), axis, joinNames(mergedLinks(m, i))});
   }
-  return out;
+  return "bodies (depth-first; parent 0 is the world):\n" + table(rows);
 }
 
 std::string constraintsText(const System& sys) {

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -148,6 +150,8 @@ class Reader {
 };
 
 std::string readSmallFile(const std::string& path, std::size_t limit) {
+  // A directory opens as a stream on Linux and reports a size of 2^63 - 1.
+  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a layout file");
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) fail(path, "", "cannot open file");
   const std::streamoff size = in.tellg();

@@ -1,9 +1,9 @@
 // URDF -> Model.
 //
-// urdfdom does the parsing and the tree checks (cycles, two roots, unknown
-// parents). Before it, tinyxml2 checks that the file is well-formed XML and
-// records the line of every <link> and <joint>, so our own errors can point at
-// the element. After it, we walk the tree depth-first, merge fixed joints and
+// urdfdom does the parsing and the tree checks (two roots, unknown parents).
+// Before it, tinyxml2 checks that the file is well-formed XML, records the line
+// of every <link> and <joint>, so our own errors can point at the element, and
+// names a joint that closes a cycle. After it, we walk the tree depth-first, merge fixed joints and
 // validate every number that will reach a solver.
 #include "model/urdf.hpp"
 
@@ -13,6 +13,8 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
+#include <sys/stat.h>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -25,13 +27,17 @@ namespace proxgen {
 namespace {
 
 // Collects what urdfdom reports through console_bridge instead of letting it
-// print to the terminal; the first error becomes part of our message.
+// print to the terminal; its errors become our message. urdfdom logs some
+// errors (an <inertial> number that is not a double) and still returns a
+// model with zeros in their place, so any logged error is fatal.
 class Capture : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && firstError.empty()) firstError = text;
+    if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR || count++ >= 3) return;
+    errors += (errors.empty() ? "" : "; ") + text;
   }
-  std::string firstError;
+  std::string errors;  // the first three, joined
+  int count = 0;
 };
 
 std::mutex g_urdfdomMutex;  // console_bridge's handler is process-global
@@ -39,6 +45,25 @@ std::mutex g_urdfdomMutex;  // console_bridge's handler is process-global
 struct LineIndex {
   std::map<std::string, int> link, joint;
 };
+
+// urdfdom only says "no root link" for a closed chain; this names a joint that
+// closes it. `parentJoint` maps a child link to (parent link, joint).
+void checkNoCycle(const std::map<std::string, std::pair<std::string, std::string>>& parentJoint,
+                  const LineIndex& index, const std::string& path) {
+  for (const auto& start : parentJoint) {
+    std::string link = start.first;
+    // More steps up than there are joints means the walk went round a cycle.
+    for (std::size_t steps = 0; parentJoint.count(link); ++steps) {
+      const auto& [parent, joint] = parentJoint.at(link);
+      if (steps > parentJoint.size()) {
+        const auto line = index.joint.find(joint);
+        fail(line == index.joint.end() ? path : fmt::format("{}:{}", path, line->second),
+             fmt::format("joint {}", quoted(joint)), "closes a kinematic cycle: a URDF must be a tree");
+      }
+      link = parent;
+    }
+  }
+}
 
 LineIndex indexLines(const std::string& xml, const std::string& path) {
   tinyxml2::XMLDocument doc;
@@ -48,12 +73,19 @@ LineIndex indexLines(const std::string& xml, const std::string& path) {
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) fail(path, "", "no <robot> element at the top level: not a URDF file");
   LineIndex index;
+  std::map<std::string, std::pair<std::string, std::string>> parentJoint;
   for (auto* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const char* name = e->Attribute("name");
     if (!name) continue;
     if (std::string(e->Name()) == "link") index.link.emplace(name, e->GetLineNum());
-    if (std::string(e->Name()) == "joint") index.joint.emplace(name, e->GetLineNum());
+    if (std::string(e->Name()) != "joint") continue;
+    index.joint.emplace(name, e->GetLineNum());
+    const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
+    const tinyxml2::XMLElement* child = e->FirstChildElement("child");
+    if (parent && child && parent->Attribute("link") && child->Attribute("link"))
+      parentJoint.emplace(child->Attribute("link"), std::make_pair(std::string(parent->Attribute("link")), std::string(name)));
   }
+  checkNoCycle(parentJoint, index, path);
   return index;
 }
 
@@ -283,17 +315,19 @@ Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBa
     try {
       urdf = urdf::parseURDF(xml);
     } catch (const std::exception& e) {
-      capture.firstError = e.what();
+      capture.errors = e.what();
       urdf.reset();
     }
     console_bridge::restorePreviousOutputHandler();
-    urdfdomError = capture.firstError;
+    urdfdomError = capture.errors;
   }
-  if (!urdf) fail(path, "", fmt::format("not a valid URDF: {}", urdfdomError.empty() ? "urdfdom rejected it" : urdfdomError));
+  if (!urdf || !urdfdomError.empty()) fail(path, "", fmt::format("not a valid URDF: {}", urdfdomError.empty() ? "urdfdom rejected it" : urdfdomError));
   return Builder(path, lines, floatingBase).build(*urdf);
 }
 
 Model loadUrdf(const std::string& path, bool floatingBase) {
+  // A directory opens as a stream on Linux and reports a size of 2^63 - 1.
+  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a URDF file");
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) fail(path, "", "cannot open file");
   const std::streamoff size = in.tellg();
