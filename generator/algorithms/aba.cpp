@@ -15,24 +15,45 @@ void initialise(const System& sys, Data& d, const VecX& q, const VecX& v) {
 
 void eliminate(const System& sys, Data& d, int i, const VecX& tau) {
   const Joint& j = sys.model.bodies[i].joint;
-  d.U[i].noalias() = d.IA[i] * d.S[i];
-  d.Dinv[i] = (d.S[i].transpose() * d.U[i]).inverse();
-  d.u[i] = tau.segment(j.idx_v, j.nv) - d.S[i].transpose() * d.pA[i];
   const int p = sys.model.bodies[i].parent;
+  if (j.nv == 1) {  // almost every joint: D is a scalar
+    const Vec6 S = d.S[i].col(0);
+    const Vec6 U = d.IA[i] * S;
+    const double Dinv = 1.0 / S.dot(U);
+    d.U[i] = U;
+    d.Dinv[i](0, 0) = Dinv;
+    d.u[i](0) = tau[j.idx_v] - S.dot(d.pA[i]);
+    if (p == 0) return;
+    const Mat6 Ia = d.IA[i] - (Dinv * U) * U.transpose();
+    const Vec6 pa = d.pA[i] + Ia * d.c[i] + (Dinv * d.u[i](0)) * U;
+    d.IA[p] += d.liMi[i].actInertia(Ia);
+    d.pA[p] += d.liMi[i].actForce(pa);
+    return;
+  }
+  // The free flyer (S = identity, the only multi-DoF joint): U = IA, D = IA.
+  d.U[i] = d.IA[i];
+  d.Dinv[i] = Mat6(d.IA[i]).inverse();
+  d.u[i] = tau.segment<6>(j.idx_v) - d.pA[i];
   if (p == 0) return;
-  const Mat6N UDinv = d.U[i] * d.Dinv[i];
+  const Mat6 UDinv = d.U[i] * d.Dinv[i];
   const Mat6 Ia = d.IA[i] - UDinv * d.U[i].transpose();
   const Vec6 pa = d.pA[i] + Ia * d.c[i] + UDinv * d.u[i];
-  const Mat6 X = d.liMi[i].motionMatrixInv();
-  d.IA[p].noalias() += X.transpose() * Ia * X;
+  d.IA[p] += d.liMi[i].actInertia(Ia);
   d.pA[p] += d.liMi[i].actForce(pa);
 }
 
 void accelerate(const System& sys, Data& d, int i) {
   const Joint& j = sys.model.bodies[i].joint;
   const Vec6 a = d.liMi[i].actInvMotion(d.a[sys.model.bodies[i].parent]) + d.c[i];
-  d.qdd.segment(j.idx_v, j.nv) = d.Dinv[i] * (d.u[i] - d.U[i].transpose() * a);
-  d.a[i] = a + d.S[i] * d.qdd.segment(j.idx_v, j.nv);
+  if (j.nv == 1) {
+    const double qdd = d.Dinv[i](0, 0) * (d.u[i](0) - d.U[i].col(0).dot(a));
+    d.qdd[j.idx_v] = qdd;
+    d.a[i] = a + qdd * d.S[i].col(0);
+    return;
+  }
+  const Vec6 qdd = Mat6(d.Dinv[i]) * (Vec6(d.u[i]) - Mat6(d.U[i]).transpose() * a);  // free flyer
+  d.qdd.segment<6>(j.idx_v) = qdd;
+  d.a[i] = a + qdd;
 }
 
 void setRootAcceleration(const System& sys, Data& d) { d.a[0] = stack(-sys.model.gravity, Vec3::Zero()); }

@@ -22,8 +22,7 @@ const MatX& crba(const System& sys, Data& d, const VecX& q) {
     }
     const int p = m.bodies[i].parent;
     if (p > 0) {
-      const Mat6 X = d.liMi[i].motionMatrixInv();
-      d.Ic[p] += X.transpose() * d.Ic[i] * X;
+      d.Ic[p] += d.liMi[i].actInertia(d.Ic[i]);
     }
   }
   return d.M;

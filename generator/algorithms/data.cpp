@@ -58,12 +58,14 @@ Data::Data(const System& sys) {
   lA.resize(N);
   LA.resize(N);
   KS.resize(N);
+  DinvKS.resize(N);
   for (int i = 0; i < N; ++i) {
     const int mi = int(subtreeRows[i].size());
     KA[i] = MatX::Zero(6, mi);
     lA[i] = VecX::Zero(mi);
     LA[i] = MatX::Zero(mi, mi);
     KS[i] = MatX::Zero(i > 0 ? m.bodies[i].joint.nv : 0, mi);
+    DinvKS[i] = KS[i];
   }
   G = MatX::Zero(sys.nc, sys.nc);
   llt = Eigen::LLT<MatX>(sys.nc);
@@ -90,6 +92,9 @@ Data::Data(const System& sys) {
   Mmu = MatX::Zero(m.nv, m.nv);
   JMinv = MatX::Zero(sys.nc, m.nv);
   work = VecX::Zero(std::max(m.nv, sys.nc));
+  LD = MatX::Zero(m.nv, m.nv);
+  jsB = VecX::Zero(m.nv);
+  rowRes = VecX::Zero(sys.nc);
 }
 
 }  // namespace proxgen

@@ -57,6 +57,7 @@ struct Data {
   std::vector<VecX> lA;   // m_(i)
   std::vector<MatX> LA;   // m_(i) x m_(i)
   std::vector<MatX> KS;   // n_i x m_(i)
+  std::vector<MatX> DinvKS;  // D_i^-1 KS_i
   MatX G;                 // Delassus (tree order)
   VecX yfree, lambdaTree, rhs;
   Eigen::LLT<MatX> llt;
@@ -74,6 +75,11 @@ struct Data {
   MatX Mmu;          // M + mu J^T J (proxLTLs)
   MatX JMinv;        // workspace for proxLTL
   VecX work;
+
+  // Joint-space algorithms (proxLTL, proxLTLs), appended.
+  MatX LD;          // sparse L^T D L factor in place: D on the diagonal, L strictly below
+  VecX jsB;         // right-hand side / intermediate of the sparse solves (nv)
+  VecX rowRes;      // J qdd + gamma - aStar (nc, layout order)
 
   int iterationsDone = 0;
   double residual = 0;  // ||J qdd + gamma - aStar|| of the last solve (when computed)

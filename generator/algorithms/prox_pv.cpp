@@ -42,25 +42,35 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
       offset -= int(d.subtreeRows[*ch].size());
       if (*ch == i) break;
     }
-    const Mat6 X = d.liMi[i].motionMatrixInv();
     const Vec6 aFree = d.c[i] + d.S[i] * (d.Dinv[i] * (d.u[i] - d.U[i].transpose() * d.c[i]));
-    d.KA[p].middleCols(offset, mi).noalias() = X.transpose() * (d.KA[i] - d.U[i] * (d.Dinv[i] * d.KS[i]));
-    d.LA[p].block(offset, offset, mi, mi) = d.LA[i] + d.KS[i].transpose() * d.Dinv[i] * d.KS[i];
-    d.lA[p].segment(offset, mi) = d.lA[i] + d.KA[i].transpose() * aFree;
+    d.lA[p].segment(offset, mi) = d.lA[i];
+    d.lA[p].segment(offset, mi).noalias() += d.KA[i].transpose() * aFree;
+    d.DinvKS[i].noalias() = d.Dinv[i] * d.KS[i];
+    d.LA[p].block(offset, offset, mi, mi) = d.LA[i];
+    if (m.bodies[i].joint.nv == 1) {  // rank-one updates (outer products, not matrix products)
+      d.LA[p].block(offset, offset, mi, mi).noalias() += d.KS[i].row(0).transpose() * d.DinvKS[i].row(0);
+      d.KA[i].noalias() -= d.U[i].col(0) * d.DinvKS[i].row(0);
+    } else {
+      d.LA[p].block(offset, offset, mi, mi).noalias() += d.KS[i].transpose() * d.DinvKS[i];
+      d.KA[i].noalias() -= d.U[i] * d.DinvKS[i];
+    }
+    // KA_i is not needed after this: it now holds KA_i - U D^-1 KS, the rows seen through the joint.
+    for (int col = 0; col < mi; ++col) d.KA[p].col(offset + col) = d.liMi[i].actForce(d.KA[i].col(col));
   }
 
   // Root: y_free = lA_0 + KA_0^T a_0 ; (G + I/mu) lambda+ = y_free + lambda/mu.
   aba_steps::setRootAcceleration(sys, d);
   const std::vector<int>& rows = d.subtreeRows[0];
   const int nc = sys.nc;
-  d.yfree = d.lA[0] + d.KA[0].transpose() * d.a[0];
+  d.yfree = d.lA[0];
+  d.yfree.noalias() += d.KA[0].transpose() * d.a[0];
   d.G = d.LA[0];
   d.G.diagonal().array() += 1.0 / mu;
   d.llt.compute(d.G);
   d.lambdaTree.setZero();
   for (int k = 0; k < iterations && nc > 0; ++k) {
-    d.rhs = d.yfree + d.lambdaTree / mu;
-    d.lambdaTree = d.llt.solve(d.rhs);
+    d.lambdaTree = d.yfree + d.lambdaTree / mu;
+    d.llt.solveInPlace(d.lambdaTree);
   }
   for (int r = 0; r < nc; ++r) d.lambda[rows[r]] = d.lambdaTree[r];
 

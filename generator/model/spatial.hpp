@@ -73,6 +73,23 @@ struct SE3 {
   Vec6 actInvForce(const Vec6& f) const {
     return stack(R.transpose() * f.head<3>(), R.transpose() * (f.tail<3>() - p.cross(f.head<3>())));
   }
+  /// A 6x6 spatial inertia (symmetric) given in B coordinates, expressed in A:
+  /// X^T I X with X = motionMatrixInv(), computed by 3x3 blocks (rotate, then
+  /// shift by p) at about half the cost of the two 6x6 products.
+  Mat6 actInertia(const Mat6& I) const {
+    const Mat3 A = R * I.topLeftCorner<3, 3>() * R.transpose();
+    const Mat3 B = R * I.topRightCorner<3, 3>() * R.transpose();
+    const Mat3 C = R * I.bottomRightCorner<3, 3>() * R.transpose();
+    const Mat3 P = skew(p);
+    const Mat3 top = B - A * P;  // A P^T + B, with P^T = -P
+    const Mat3 PB = P * B;
+    Mat6 out;
+    out.topLeftCorner<3, 3>() = A;
+    out.topRightCorner<3, 3>() = top;
+    out.bottomLeftCorner<3, 3>() = top.transpose();
+    out.bottomRightCorner<3, 3>() = C + PB + PB.transpose() - P * A * P;
+    return out;
+  }
   /// 6x6 matrix of actMotion (maps B motion coordinates to A).
   Mat6 motionMatrix() const {
     Mat6 X = Mat6::Zero();

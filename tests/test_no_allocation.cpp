@@ -1,0 +1,91 @@
+// "No allocation inside a solve" (PRODUCT.md): every generic algorithm runs on
+// the preallocated Data. This executable is linked with --wrap=malloc/calloc/
+// realloc (tests/CMakeLists.txt), so every heap allocation made by proxgen_core's
+// code, Eigen's included, passes through the counters below; a solve must leave
+// them unchanged.
+#include <cstdlib>
+#include <new>
+
+#include "algorithms/aba.hpp"
+#include "algorithms/constrained_aba.hpp"
+#include "algorithms/prox_ltl.hpp"
+#include "algorithms/prox_ltls.hpp"
+#include "algorithms/prox_pv.hpp"
+#include "support.hpp"
+
+namespace {
+bool g_counting = false;  // set while a solve runs
+long g_allocations = 0;
+}  // namespace
+
+extern "C" {
+void* __real_malloc(std::size_t);
+void* __real_calloc(std::size_t, std::size_t);
+void* __real_realloc(void*, std::size_t);
+void* __wrap_malloc(std::size_t n) {
+  if (g_counting) ++g_allocations;
+  return __real_malloc(n);
+}
+void* __wrap_calloc(std::size_t n, std::size_t s) {
+  if (g_counting) ++g_allocations;
+  return __real_calloc(n, s);
+}
+void* __wrap_realloc(void* p, std::size_t n) {
+  if (g_counting) ++g_allocations;
+  return __real_realloc(p, n);
+}
+}
+
+void* operator new(std::size_t n) {
+  if (g_counting) ++g_allocations;
+  if (void* p = __real_malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace proxgen {
+namespace {
+
+using Solver = void (*)(const System&, Data&, const VecX&, const VecX&, const VecX&, double, int);
+
+long allocationsOf(const System& sys, Data& d, const test::RandomState& s, Solver solve) {
+  solve(sys, d, s.q, s.v, s.tau, 1e4, 3);  // warm-up: lazy one-time set-up is allowed
+  g_allocations = 0;
+  g_counting = true;
+  solve(sys, d, s.q, s.v, s.tau, 1e4, 3);
+  solve(sys, d, s.q, s.v, s.tau, 100.0, 5);
+  g_counting = false;
+  return g_allocations;
+}
+
+TEST(NoAllocation, CounterWorks) {
+  // The check itself can fail: an allocation made while counting is seen.
+  g_allocations = 0;
+  g_counting = true;
+  VecX x = VecX::Zero(50);
+  asm volatile("" : : "r"(x.data()) : "memory");  // keep the allocation from being elided
+  g_counting = false;
+  EXPECT_GT(g_allocations, 0);
+}
+
+TEST(NoAllocation, GenericSolversOnEverySharedCase) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Case& c : test::sharedCases()) {
+    const System sys = loadCaseSystem(c);
+    Data d(sys);
+    std::mt19937 rng(7);
+    const test::RandomState s = test::randomState(sys.model, rng);
+    const Solver aba3 = [](const System& y, Data& dd, const VecX& q, const VecX& v, const VecX& t, double, int) {
+      aba(y, dd, q, v, t);
+    };
+    EXPECT_EQ(allocationsOf(sys, d, s, aba3), 0) << c.name << " aba";
+    EXPECT_EQ(allocationsOf(sys, d, s, &constrainedAba), 0) << c.name << " constrainedAba";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxPv), 0) << c.name << " proxPv";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxLtl), 0) << c.name << " proxLtl";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxLtls), 0) << c.name << " proxLtls";
+  }
+}
+
+}  // namespace
+}  // namespace proxgen
