@@ -20,8 +20,12 @@ DenseProblem assembleDense(const System& sys, const VecX& q, const VecX& v, cons
 /// qdd = qdd_free - M^-1 J^T lambda.
 void denseProx(const DenseProblem& p, double mu, int iterations, VecX& qdd, VecX& lambda);
 
-/// The exact constrained answer: [M J^T; J 0] [qdd; lambda] = [tau - h; aStar - gamma]
-/// by a rank-revealing solve (minimum-norm least squares when J is rank deficient).
+/// The exact constrained answer: lambda = G^+ (J qdd_free + gamma - aStar) with
+/// G = J M^-1 J^T by a rank-revealing (complete orthogonal) decomposition, minimum
+/// norm, and qdd = qdd_free - M^-1 J^T lambda. For a full-rank J this is the
+/// solution of [M J^T; J 0] [qdd; lambda] = [tau - h; aStar - gamma]; for redundant
+/// or inconsistent rows it is the least-squares answer the prox iteration's qdd
+/// converges to.
 void denseExact(const DenseProblem& p, VecX& qdd, VecX& lambda);
 
 }  // namespace proxgen
