@@ -1,0 +1,349 @@
+#!/usr/bin/env python3
+"""Writes bench/RESULTS.md and its plots from one run of bench/run.sh.
+
+    report.py --build BUILD_DIR --suite suite.json --calls calls.json
+              --scaling scaling.json --out-dir bench/ [--no-compile]
+
+Inputs: the Google Benchmark JSON of proxgen_bench and proxgen_bench_scaling
+(run with repetitions and aggregates), the instruction counts of count_calls.py,
+and BUILD_DIR/bench/bench_config.json (compiler and generated sources, for the
+compile time and object size of each generated solver). Standard library only;
+plots through gnuplot.
+"""
+import argparse
+import json
+import math
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+# Pinocchio 3.7 on this project's machine kind, K = 3, mu = 1e4 (its mu = 1e-4),
+# median of 60 repetitions, CPU: AMD EPYC KVM 2 vCPU. Copied from
+# shared/design/anchor-timings.md ("What to beat"); Ir = callgrind instructions per call.
+ANCHOR = {
+    # case: (nv, rows, aba us, cABA us, PV us, proxLTL us, aba Ir, cABA Ir, PV Ir)
+    "iiwa_h3": (7, 3, 1.43, 1.89, 1.77, 2.04, 17163, 23942, 25060),
+    "iiwa_h6": (7, 6, 1.42, 1.93, 2.31, 2.60, 17163, 24661, 32524),
+    "solo_f3x2": (18, 6, 3.10, 3.54, 3.75, 4.46, 38347, 46436, 50678),
+    "solo_f3x4": (18, 12, 3.12, 4.16, 4.93, 6.00, 38347, 54513, 68253),
+    "talos_f6x2": (50, 12, 10.31, 10.27, 11.48, 14.51, 120892, 130907, 154158),
+    "talos_f6x2_h6x2": (50, 24, 10.11, 11.66, 15.20, 21.06, 120892, 148425, 217970),
+    "atlas_shadow_f6x2": (84, 12, 18.38, 17.11, 18.20, 26.94, 210850, 216168, 239096),
+    "atlas_shadow_f6x2_t3x5": (84, 27, 18.08, 20.07, 24.74, 41.34, 210850, 251572, 355675),
+    "atlas_shadow_f6x2_t3x10": (84, 42, 18.47, 23.09, 34.51, 58.38, 210850, 284707, 533331),
+}
+# Which Pinocchio column each of our algorithms is compared with (time index, Ir index).
+ANCHOR_COLUMN = {"aba": (2, 6), "caba": (3, 7), "pv": (4, 8), "ltl": (5, None),
+                 "gen_caba": (3, 7), "gen_pv": (4, 8)}
+ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"]
+LABEL = {"aba": "ABA", "caba": "cABA", "pv": "proxPV", "ltl": "proxLTL", "ltls": "proxLTLs",
+         "gen_caba": "generated cABA", "gen_pv": "generated proxPV"}
+TARGET = 1.0 / 3.0  # anchor-timings.md: generated solvers at most a third of Pinocchio's figures
+
+
+# ---------------------------------------------------------------- inputs
+def medians(path):
+    """{run_name: (median cpu time us, median real time us, counters)} from Google Benchmark JSON."""
+    with open(path) as f:
+        data = json.load(f)
+    scale = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}
+    out = {}
+    for b in data["benchmarks"]:
+        # Aggregates: keep the median only; a run without repetitions has single iterations.
+        if b.get("run_type") == "aggregate" and b.get("aggregate_name") != "median":
+            continue
+        k = scale[b["time_unit"]]
+        counters = {c: b[c] for c in ("nv", "nc", "n", "m") if c in b}
+        out[b["run_name"]] = (b["cpu_time"] * k, b["real_time"] * k, counters)
+    return out, data.get("context", {})
+
+
+def load_calls(path):
+    if not path or not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        return {(r["case"], r["algorithm"]): r["ir_per_call"] for r in json.load(f)}
+
+
+# ---------------------------------------------------------------- formatting
+def fmt_us(x):
+    return "—" if x is None else (f"{x:.3g}" if x < 10 else f"{x:.1f}")
+
+
+def fmt_ir(x):
+    return "—" if x is None else f"{x:,.0f}"
+
+
+def fmt_ratio(a, b):
+    return "—" if a is None or b is None else f"{a / b:.2f}"
+
+
+# ---------------------------------------------------------------- compile time, object size
+def compile_generated(build_dir):
+    """[(case, cpu seconds, wall seconds, text, data, bss)] of each generated .cpp compiled alone at -O2."""
+    cfg_path = os.path.join(build_dir, "bench", "bench_config.json")
+    if not os.path.exists(cfg_path):
+        return []
+    with open(cfg_path) as f:
+        cfg = json.load(f)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="proxgen-compile-") as tmp:
+        for g in cfg["generated"]:
+            src = g["source"]
+            obj = os.path.join(tmp, g["case"] + ".o")
+            cmd = [cfg["cxx"], "-std=c++17", "-O2", "-I", os.path.dirname(src), "-I", cfg["runtime_include"],
+                   "-c", src, "-o", obj]
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            start = time.perf_counter()
+            subprocess.run(cmd, check=True)
+            wall = time.perf_counter() - start
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+            size = subprocess.run(["size", obj], check=True, stdout=subprocess.PIPE, text=True).stdout
+            text, data, bss = (int(x) for x in size.splitlines()[1].split()[:3])
+            rows.append((g["case"], cpu, wall, text, data, bss))
+    return rows
+
+
+# ---------------------------------------------------------------- scaling fits
+def loglog_slope(points):
+    """Least-squares slope of log t against log x."""
+    xs = [math.log(x) for x, _ in points]
+    ys = [math.log(t) for _, t in points]
+    mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+    sxx = sum((x - mx) ** 2 for x in xs)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else float("nan")
+
+
+def scaling_series(scaling):
+    """{(shape, alg): {(n, m): time}} from names <shape>/n:<n>/m:<m>/<alg>."""
+    series = {}
+    for name, (cpu, _, _) in scaling.items():
+        shape, n, m, alg = name.split("/")
+        series.setdefault((shape, alg), {})[(int(n[2:]), int(m[2:]))] = cpu
+    return series
+
+
+def sweep(points, fixed, axis):
+    """Points of a series along n (axis 0, m == fixed) or along m (axis 1, n == fixed), sorted."""
+    other = 1 - axis
+    return sorted((key[axis], t) for key, t in points.items() if key[other] == fixed)
+
+
+# ---------------------------------------------------------------- plots
+def gnuplot(script):
+    if not shutil.which("gnuplot"):
+        print("report: gnuplot not found, no plots", file=sys.stderr)
+        return False
+    subprocess.run(["gnuplot"], input=script, text=True, check=True)
+    return True
+
+
+def plot_dof(suite, cases, out_png, tmp):
+    lines = []
+    for alg in ALGORITHMS:
+        pts = sorted((suite[f"{c}/{alg}"][2]["nv"], suite[f"{c}/{alg}"][2]["nc"], suite[f"{c}/{alg}"][0])
+                     for c in cases if f"{c}/{alg}" in suite)
+        if not pts:
+            continue
+        path = os.path.join(tmp, f"dof_{alg}.dat")
+        with open(path, "w") as f:
+            f.writelines(f"{nv} {t}\n" for nv, _, t in pts)
+        lines.append(f"'{path}' using 1:2 with linespoints title '{LABEL[alg]}'")
+    return gnuplot(f"""set terminal pngcairo size 900,600
+set output '{out_png}'
+set title 'Time per call against DoF (the nine shared cases, K = 3, mu = 1e4; median CPU time)'
+set xlabel 'DoF (nv)'
+set ylabel 'time per call [us]'
+set logscale xy
+set xrange [5:120]
+set pointsize 1.3
+set key top left
+set grid
+plot {', '.join(lines)}
+""")
+
+
+def plot_scaling(series, fixed_m, fixed_ns, out_png, tmp):
+    panels = []
+    for axis, fixeds, xlabel in ((0, [fixed_m], f"DoF n (m = {fixed_m} rows)"),
+                                 (1, fixed_ns, "constraint rows m (n = " + ", ".join(map(str, fixed_ns)) + ")")):
+        lines = []
+        for (shape, alg), pts in sorted(series.items()):
+            for fixed in fixeds:
+                s = sweep(pts, fixed, axis)
+                if len(s) < 2:
+                    continue
+                path = os.path.join(tmp, f"scal_{axis}_{fixed}_{shape}_{alg}.dat")
+                with open(path, "w") as f:
+                    f.writelines(f"{x} {t}\n" for x, t in s)
+                title = f"{shape} {LABEL[alg]}" + (f", n = {fixed}" if axis == 1 else "")
+                lines.append(f"'{path}' using 1:2 with linespoints title '{title}'")
+        panels.append(f"set xlabel '{xlabel}'\nplot {', '.join(lines)}\n")
+    return gnuplot(f"""set terminal pngcairo size 1400,600
+set output '{out_png}'
+set multiplot layout 1,2 title 'Scaling on synthetic robots (generic solvers, K = 3, mu = 1e4; median CPU time)'
+set ylabel 'time per call [us]'
+set logscale xy
+set key top left
+set grid
+{panels[0]}{panels[1]}unset multiplot
+""")
+
+
+# ---------------------------------------------------------------- report
+def case_tables(suite, calls, cases):
+    out = ["## Per case and algorithm", "",
+           "Time: median over repetitions of the mean CPU time per call (µs). Ir: instructions per call "
+           "(callgrind). Pinocchio: anchor-timings.md, same cases and settings; ratios below 1 mean faster "
+           "than Pinocchio.", ""]
+    for c in cases:
+        first = next((suite[f"{c}/{a}"] for a in ALGORITHMS if f"{c}/{a}" in suite), None)
+        if first is None:
+            continue
+        nv, nc = first[2].get("nv"), first[2].get("nc")
+        out += [f"### {c} (nv = {nv:.0f}, constraint rows m = {nc:.0f})", "",
+                "| algorithm | time µs | Ir/call | Pinocchio µs | Pinocchio Ir | time / Pinocchio | Ir / Pinocchio |",
+                "|---|---|---|---|---|---|---|"]
+        for a in ALGORITHMS:
+            if f"{c}/{a}" not in suite:
+                continue
+            t = suite[f"{c}/{a}"][0]
+            ir = calls.get((c, a))
+            ti, ii = ANCHOR_COLUMN.get(a, (None, None))
+            pt = ANCHOR[c][ti] if c in ANCHOR and ti is not None else None
+            pi = ANCHOR[c][ii] if c in ANCHOR and ii is not None else None
+            out.append(f"| {LABEL[a]} | {fmt_us(t)} | {fmt_ir(ir)} | {fmt_us(pt)} | {fmt_ir(pi)} | "
+                       f"{fmt_ratio(t, pt)} | {fmt_ratio(ir, pi)} |")
+        out.append("")
+    return out
+
+
+def summary_table(suite, calls, cases):
+    """Generated / generic and generated / Pinocchio, per case, for cABA and proxPV."""
+    out = ["## Generated solvers: ratios", "",
+           f"Target (anchor-timings.md): generated / Pinocchio at most {TARGET:.2f}, in time and in instructions. "
+           "Pinocchio's times were measured on a quiet machine of this kind, ours on a shared one (load average "
+           "above): the instruction ratios are the ones to hold against the target, the time ratios are "
+           "pessimistic.",
+           "", "| case | nv | m | cABA gen/generic time | Ir | cABA gen/Pinocchio time | Ir | "
+           "PV gen/generic time | Ir | PV gen/Pinocchio time | Ir |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    any_generated = False
+    for c in cases:
+        row = []
+        for gen, generic, col in (("gen_caba", "caba", 3), ("gen_pv", "pv", 4)):
+            tg = suite.get(f"{c}/{gen}", (None,))[0]
+            tb = suite.get(f"{c}/{generic}", (None,))[0]
+            ig, ib = calls.get((c, gen)), calls.get((c, generic))
+            any_generated |= tg is not None
+            row += [fmt_ratio(tg, tb), fmt_ratio(ig, ib), fmt_ratio(tg, ANCHOR[c][col]),
+                    fmt_ratio(ig, ANCHOR[c][col + 4])]
+        counters = next((suite[f"{c}/{a}"][2] for a in ALGORITHMS if f"{c}/{a}" in suite), {})
+        out.append(f"| {c} | {counters.get('nv', 0):.0f} | {counters.get('nc', 0):.0f} | " + " | ".join(row) + " |")
+    if not any_generated:
+        out += ["", "**The generated solvers were not part of this run** (PROXGEN_BENCH_GENERATED off, or "
+                "`proxgen generate` not available yet): the generated columns are empty."]
+    return out + [""]
+
+
+def compile_table(rows):
+    if not rows:
+        return ["## Generated solvers: compile time and object size", "",
+                "No generated solvers in this build.", ""]
+    out = ["## Generated solvers: compile time and object size", "",
+           "Each generated `.cpp` compiled alone with `-std=c++17 -O2` (CPU time of the compiler, and wall "
+           "time on the shared machine); `size` of the object in bytes.", "",
+           "| case | compile CPU s | wall s | text | data | bss |", "|---|---|---|---|---|---|"]
+    for case, cpu, wall, text, data, bss in rows:
+        out.append(f"| {case} | {cpu:.2f} | {wall:.2f} | {text:,} | {data:,} | {bss:,} |")
+    return out + [""]
+
+
+def scaling_section(series, fixed_m, fixed_ns, have_plot):
+    out = ["## Scaling on synthetic robots", "",
+           "Serial chains and complete binary trees of n revolute joints on a fixed base, with m/3 point "
+           "contacts (the chain's tip and bodies evenly spaced below it; leaves of the tree evenly spread). "
+           "Generic solvers only. Exponents: least-squares slope of log(time) against log(n) at "
+           f"m = {fixed_m}, and against log(m) at fixed n (m up to 39, and, at n = 128, on to 192 rows to "
+           "expose the m^3 term); \"upper\" fits only the three largest sizes of the sweep. "
+           "A slope against m is flattened by the part of the time that does not depend on m (ABA's O(n)), "
+           "hence the sweep at a small n too.", "",
+           "| shape | algorithm | sweep | exponent (all) | exponent (upper) | range |", "|---|---|---|---|---|---|"]
+    rng = lambda s: f"{s[0][0]}–{s[-1][0]}" if s else "—"
+    for (shape, alg), pts in sorted(series.items()):
+        sweeps = [(f"time ~ n^p, m = {fixed_m}", sweep(pts, fixed_m, 0))]
+        for n in fixed_ns:
+            s = sweep(pts, n, 1)
+            sweeps.append((f"time ~ m^q, n = {n}", [p for p in s if p[0] <= 40]))
+            if any(p[0] > 40 for p in s):
+                sweeps.append((f"time ~ m^q, n = {n}, all m", s))
+        for label, s in sweeps:
+            if len(s) < 2:
+                continue
+            out.append(f"| {shape} | {LABEL[alg]} | {label} | {loglog_slope(s):.2f} | "
+                       f"{loglog_slope(s[-3:]):.2f} | {rng(s)} |")
+    out.append("")
+    out.append("Times (µs):")
+    out.append("")
+    out.append("| shape | algorithm | n | m | time µs |")
+    out.append("|---|---|---|---|---|")
+    for (shape, alg), pts in sorted(series.items()):
+        for (n, m), t in sorted(pts.items()):
+            out.append(f"| {shape} | {LABEL[alg]} | {n} | {m} | {fmt_us(t)} |")
+    out.append("")
+    if have_plot:
+        out += ["![scaling](scaling.png)", ""]
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--suite", required=True)
+    ap.add_argument("--calls")
+    ap.add_argument("--scaling")
+    ap.add_argument("--out-dir", required=True)
+    ap.add_argument("--no-compile", action="store_true", help="skip timing the generated solvers' compile")
+    ap.add_argument("--command", default="bench/run.sh", help="the command line to quote in the report")
+    ap.add_argument("--fixed-m", type=int, default=6)
+    ap.add_argument("--fixed-n", default="32,128", help="the n of the m sweeps, comma-separated")
+    args = ap.parse_args()
+
+    suite, context = medians(args.suite)
+    calls = load_calls(args.calls)
+    cases = [c for c in ANCHOR if any(f"{c}/{a}" in suite for a in ALGORITHMS)]
+    compile_rows = [] if args.no_compile else compile_generated(args.build)
+    scaling = medians(args.scaling)[0] if args.scaling and os.path.exists(args.scaling) else {}
+    series = scaling_series(scaling)
+    fixed_ns = [int(x) for x in args.fixed_n.split(",")]
+
+    os.makedirs(args.out_dir, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="proxgen-plot-") as tmp:
+        have_dof = plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp)
+        have_scaling = bool(series) and plot_scaling(series, args.fixed_m, fixed_ns,
+                                                     os.path.join(args.out_dir, "scaling.png"), tmp)
+
+    load = context.get("load_avg", [])
+    lines = ["# Benchmark results", "",
+             f"Written by `{args.command}` ({context.get('date', '?')}, host {context.get('host_name', '?')}, "
+             f"{context.get('num_cpus', '?')} CPUs at {context.get('mhz_per_cpu', '?')} MHz, load average "
+             f"{', '.join(f'{x:.1f}' for x in load) or '?'} at the start). All numbers come from this one run; "
+             "see docs/benchmarks.md for the method. K = 3 multiplier updates, mu = 1e4.", ""]
+    lines += summary_table(suite, calls, cases)
+    lines += case_tables(suite, calls, cases)
+    if have_dof:
+        lines += ["![time against DoF](time_vs_dof.png)", ""]
+    lines += compile_table(compile_rows)
+    if series:
+        lines += scaling_section(series, args.fixed_m, fixed_ns, have_scaling)
+    with open(os.path.join(args.out_dir, "RESULTS.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print(f"report: wrote {os.path.join(args.out_dir, 'RESULTS.md')}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,64 @@
+#!/bin/sh
+# bench/run.sh [BUILD_DIR]: build the benchmarks in Release, run the suite, the
+# callgrind instruction counts and the scaling study, and write bench/RESULTS.md
+# with its plots (docs/benchmarks.md). BUILD_DIR defaults to build-bench in the
+# source tree.
+#
+# Environment knobs (defaults in brackets):
+#   JOBS [1]          ninja -j for the build
+#   REPETITIONS [20]  repetitions per benchmark (the report takes their median)
+#   MIN_TIME [0.1]    seconds per repetition (--benchmark_min_time)
+#   CALLS [1000]      calls per callgrind run (the other run makes none)
+#   CMAKE_ARGS []     extra configure arguments, e.g. -DPROXGEN_BENCH_GENERATED=OFF
+#   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE: set to 1 to leave that part out
+set -eu
+
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(dirname "$here")
+build=${1:-$root/build-bench}
+case $build in /*) ;; *) build=$(pwd)/$build ;; esac
+results=$build/bench/results
+reps=${REPETITIONS:-20}
+min_time=${MIN_TIME:-0.1}
+
+echo "== configure and build ($build, Release)"
+# shellcheck disable=SC2086  # CMAKE_ARGS is a list of arguments
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release ${CMAKE_ARGS:-} >/dev/null
+ninja -C "$build" -j"${JOBS:-1}" proxgen_bench_all
+mkdir -p "$results"
+
+gbench_flags="--benchmark_repetitions=$reps --benchmark_min_time=$min_time
+  --benchmark_report_aggregates_only=true --benchmark_enable_random_interleaving=true
+  --benchmark_out_format=json"
+
+echo "== suite: $reps repetitions of ${min_time}s, random interleaving"
+# shellcheck disable=SC2086
+"$build/bench/proxgen_bench" $gbench_flags --benchmark_out="$results/suite.json"
+
+calls_json=""
+if [ "${SKIP_CALLGRIND:-0}" != 1 ]; then
+  if command -v valgrind >/dev/null; then
+    echo "== instructions per call (callgrind, ${CALLS:-1000} calls minus none)"
+    python3 "$here/count_calls.py" "$build" "$results/calls.json" --calls "${CALLS:-1000}"
+    calls_json=$results/calls.json
+  else
+    echo "run.sh: valgrind not found, no instruction counts" >&2
+  fi
+fi
+
+scaling_json=""
+if [ "${SKIP_SCALING:-0}" != 1 ]; then
+  echo "== scaling study on synthetic robots"
+  # shellcheck disable=SC2086
+  "$build/bench/proxgen_bench_scaling" --out "$results/scaling-models" $gbench_flags \
+    --benchmark_out="$results/scaling.json"
+  scaling_json=$results/scaling.json
+fi
+
+echo "== report"
+set -- --build "$build" --suite "$results/suite.json" --out-dir "$here" \
+  --command "bench/run.sh (REPETITIONS=$reps MIN_TIME=$min_time CALLS=${CALLS:-1000})"
+[ -n "$calls_json" ] && set -- "$@" --calls "$calls_json"
+[ -n "$scaling_json" ] && set -- "$@" --scaling "$scaling_json"
+[ "${SKIP_COMPILE:-0}" = 1 ] && set -- "$@" --no-compile
+python3 "$here/report.py" "$@"
