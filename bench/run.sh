@@ -23,7 +23,7 @@ min_time=${MIN_TIME:-0.1}
 
 echo "== configure and build ($build, Release)"
 # shellcheck disable=SC2086  # CMAKE_ARGS is a list of arguments
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release ${CMAKE_ARGS:-} >/dev/null
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPROXGEN_BENCH_REUSE_TEST_SOLVERS=OFF ${CMAKE_ARGS:-} >/dev/null
 ninja -C "$build" -j"${JOBS:-1}" proxgen_bench_all
 mkdir -p "$results"
 

@@ -68,7 +68,9 @@ Data::Data(const System& sys) {
     DinvKS[i] = KS[i];
   }
   G = MatX::Zero(sys.nc, sys.nc);
-  llt = Eigen::LLT<MatX>(sys.nc);
+  // Sizes the factor once. Not `llt = LLT<MatX>(nc)`: that constructor leaves
+  // the status unset and the assignment reads it (UBSan, scripts/sanitize.sh).
+  llt.compute(MatX::Identity(sys.nc, sys.nc));
   yfree = VecX::Zero(sys.nc);
   lambdaTree = VecX::Zero(sys.nc);
   rhs = VecX::Zero(sys.nc);

@@ -1,17 +1,43 @@
-// proxgen generate (placeholder until implemented; exits 2).
+// proxgen generate robot.urdf --layout layout.yaml --out DIR [--name NAME] [--scalar double|float]
+//   or, for one case of a cases file (tests, benchmarks):
+// proxgen generate --cases cases.yaml --case NAME --out DIR [--name NAME] [--scalar double|float]
 #include <cstdio>
-#include <cstdlib>
+#include <memory>
 
 #include "cli/commands.hpp"
+#include "emit/generate.hpp"
+#include "model/error.hpp"
 
 namespace proxgen::cli {
 
 void addGenerate(CLI::App& app) {
-  auto* cmd = app.add_subcommand("generate", "not implemented yet");
-  cmd->allow_extras();
-  cmd->callback([] {
-    std::fprintf(stderr, "proxgen: generate is not implemented yet\n");
-    std::exit(2);
+  struct Options {
+    std::string urdf, layout, cases, caseName, out, name, scalar = "double";
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("generate", "write a flat C++ solver (NAME.hpp, NAME.cpp) for one robot and layout");
+  cmd->add_option("urdf", opt->urdf, "robot URDF");
+  cmd->add_option("--layout", opt->layout, "constraint layout (YAML)");
+  cmd->add_option("--cases", opt->cases, "a cases file (cases.yaml), instead of URDF and layout");
+  cmd->add_option("--case", opt->caseName, "the case of --cases to generate");
+  cmd->add_option("--out", opt->out, "output folder (created if missing)")->required();
+  cmd->add_option("--name", opt->name, "namespace and file name (sanitised; default: the case or the URDF's file name)");
+  cmd->add_option("--scalar", opt->scalar, "double (default) or float")->check(CLI::IsMember({"double", "float"}));
+  cmd->callback([opt] {
+    const bool byCase = !opt->cases.empty() || !opt->caseName.empty();
+    if (byCase && (opt->cases.empty() || opt->caseName.empty() || !opt->urdf.empty() || !opt->layout.empty()))
+      throw Error("generate: --cases and --case go together, without a URDF or --layout");
+    if (!byCase && (opt->urdf.empty() || opt->layout.empty()))
+      throw Error("generate: needs a URDF and --layout (or --cases and --case)");
+    emit::GenerateOptions g;
+    g.urdf = opt->urdf;
+    g.layout = opt->layout;
+    g.casesFile = opt->cases;
+    g.caseName = opt->caseName;
+    g.name = opt->name;
+    g.scalar = emit::parseScalar(opt->scalar);
+    const emit::SolverFiles files = emit::generateFiles(g);
+    for (const std::string& path : emit::writeFiles(files, opt->out)) std::printf("wrote %s\n", path.c_str());
   });
 }
 

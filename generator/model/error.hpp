@@ -21,4 +21,8 @@ std::string describe(const std::string& file, const std::string& element, const 
 /// cut at 80 characters so a hostile 10 kB name cannot flood a terminal.
 std::string quoted(const std::string& name);
 
+/// A third-party library's message (urdfdom, yaml-cpp, nlohmann-json) made fit
+/// for ours: control characters escaped, cut after `maxShown` characters.
+std::string oneLine(const std::string& text, std::size_t maxShown = 200);
+
 }  // namespace proxgen

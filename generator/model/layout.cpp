@@ -135,10 +135,16 @@ class Reader {
       if (list.IsNull()) return L;
       if (!list.IsSequence()) failAt(list, "constraints", "expected a list");
       std::set<std::string> names;
+      int rows = 0;
       for (std::size_t k = 0; k < list.size(); ++k) {
         Constraint c = constraint(list[k], k);
         if (!names.insert(c.name).second)
           failAt(list[k], fmt::format("constraints[{}]", k), fmt::format("duplicate constraint name {}", quoted(c.name)));
+        rows += c.rows();
+        if (rows > kMaxConstraintRows)
+          failAt(list[k], fmt::format("constraints[{}]", k),
+                 fmt::format("more than {} constraint rows: proxgen reads layouts of at most {} rows", kMaxConstraintRows,
+                             kMaxConstraintRows));
         L.constraints.push_back(std::move(c));
       }
     }
@@ -170,12 +176,12 @@ Layout parseLayout(const std::string& yaml, const std::string& path) {
   try {
     root = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
-    fail(e.mark.is_null() ? path : fmt::format("{}:{}", path, e.mark.line + 1), "", fmt::format("malformed YAML: {}", e.msg));
+    fail(e.mark.is_null() ? path : fmt::format("{}:{}", path, e.mark.line + 1), "", fmt::format("malformed YAML: {}", oneLine(e.msg)));
   }
   try {
     return Reader(path).layout(root);
   } catch (const YAML::Exception& e) {
-    fail(e.mark.is_null() ? path : fmt::format("{}:{}", path, e.mark.line + 1), "", fmt::format("invalid layout: {}", e.msg));
+    fail(e.mark.is_null() ? path : fmt::format("{}:{}", path, e.mark.line + 1), "", fmt::format("invalid layout: {}", oneLine(e.msg)));
   }
 }
 

@@ -7,6 +7,12 @@
 
 namespace proxgen {
 
+/// Most constraint rows a layout may declare (6 per weld, 3 per point contact).
+/// The generic solvers' memory grows with their square (proxPV keeps an m x m
+/// block per support body: at most 256^2 * kMaxTreeDepth doubles = 0.27 GB);
+/// real layouts have under 50 (docs/guarantees.md).
+inline constexpr int kMaxConstraintRows = 256;
+
 /// Reads a layout file. Unknown keys are errors (a typo must not silently drop a
 /// constraint). Throws proxgen::Error ("FILE:LINE: element: what is wrong").
 Layout loadLayout(const std::string& path);

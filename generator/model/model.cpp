@@ -35,6 +35,17 @@ std::string quoted(const std::string& name) {
   return out + "'";
 }
 
+std::string oneLine(const std::string& text, std::size_t maxShown) {
+  std::string out;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (k == maxShown) return out + fmt::format("... ({} bytes)", text.size());
+    const unsigned char c = static_cast<unsigned char>(text[k]);
+    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += char(c);
+  }
+  return out;
+}
+
 const char* jointTypeName(JointType t) {
   switch (t) {
     case JointType::Revolute: return "revolute";

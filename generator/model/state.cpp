@@ -121,7 +121,7 @@ std::vector<State> loadStates(const Model& model, const std::string& path, bool*
   try {
     j = json::parse(text, track);
   } catch (const json::exception& e) {
-    fail(path, lastKey.empty() ? "" : fmt::format("after key {}", proxgen::quoted(lastKey)), fmt::format("invalid JSON: {}", e.what()));
+    fail(path, lastKey.empty() ? "" : fmt::format("after key {}", proxgen::quoted(lastKey)), fmt::format("invalid JSON: {}", oneLine(e.what())));
   }
   std::vector<State> states;
   if (isList) *isList = j.is_array();

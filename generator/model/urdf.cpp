@@ -15,11 +15,13 @@
 #include <Eigen/Eigenvalues>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
 #include "model/error.hpp"
 
@@ -29,12 +31,13 @@ namespace {
 // Collects what urdfdom reports through console_bridge instead of letting it
 // print to the terminal; its errors become our message. urdfdom logs some
 // errors (an <inertial> number that is not a double) and still returns a
-// model with zeros in their place, so any logged error is fatal.
+// model with zeros in their place, so any logged error is fatal. urdfdom
+// quotes names and values raw, hence oneLine().
 class Capture : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
     if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR || count++ >= 3) return;
-    errors += (errors.empty() ? "" : "; ") + text;
+    errors += (errors.empty() ? "" : "; ") + oneLine(text);
   }
   std::string errors;  // the first three, joined
   int count = 0;
@@ -47,20 +50,37 @@ struct LineIndex {
 };
 
 // urdfdom only says "no root link" for a closed chain; this names a joint that
-// closes it. `parentJoint` maps a child link to (parent link, joint).
-void checkNoCycle(const std::map<std::string, std::pair<std::string, std::string>>& parentJoint,
-                  const LineIndex& index, const std::string& path) {
+// closes it. It also refuses a tree deeper than kMaxTreeDepth, which the
+// depth-first Builder would recurse into until the stack overflows. Each link's
+// depth is found once, so this stays linear in the number of links (a 50 MB
+// chain). `parentJoint` maps a child link to (parent link, joint).
+void checkTreeShape(const std::map<std::string, std::pair<std::string, std::string>>& parentJoint,
+                    const LineIndex& index, const std::string& path) {
+  const auto failAtJoint = [&](const std::string& joint, const std::string& what) {
+    const auto line = index.joint.find(joint);
+    fail(line == index.joint.end() ? path : fmt::format("{}:{}", path, line->second),
+         fmt::format("joint {}", quoted(joint)), what);
+  };
+  std::map<std::string, std::size_t> depth;  // joints between a link and its root link
+  std::vector<std::string> walk;
   for (const auto& start : parentJoint) {
+    // Up to a root or to a link whose depth is known. More steps up than there
+    // are joints means the walk went round a cycle.
+    walk.clear();
     std::string link = start.first;
-    // More steps up than there are joints means the walk went round a cycle.
-    for (std::size_t steps = 0; parentJoint.count(link); ++steps) {
+    while (parentJoint.count(link) && !depth.count(link)) {
       const auto& [parent, joint] = parentJoint.at(link);
-      if (steps > parentJoint.size()) {
-        const auto line = index.joint.find(joint);
-        fail(line == index.joint.end() ? path : fmt::format("{}:{}", path, line->second),
-             fmt::format("joint {}", quoted(joint)), "closes a kinematic cycle: a URDF must be a tree");
-      }
+      if (walk.size() > parentJoint.size()) failAtJoint(joint, "closes a kinematic cycle: a URDF must be a tree");
+      walk.push_back(link);
       link = parent;
+    }
+    std::size_t d = depth.count(link) ? depth.at(link) : 0;
+    for (auto it = walk.rbegin(); it != walk.rend(); ++it) {
+      depth[*it] = ++d;
+      if (d > kMaxTreeDepth)
+        failAtJoint(parentJoint.at(*it).second,
+                    fmt::format("is {} joints below the root link; proxgen reads trees at most {} joints deep", d,
+                                kMaxTreeDepth));
     }
   }
 }
@@ -74,7 +94,15 @@ LineIndex indexLines(const std::string& xml, const std::string& path) {
   if (!robot) fail(path, "", "no <robot> element at the top level: not a URDF file");
   LineIndex index;
   std::map<std::string, std::pair<std::string, std::string>> parentJoint;
+  std::size_t links = 0, joints = 0;
   for (auto* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    // Bounded before urdfdom builds its own copy and we build the model.
+    links += std::string(e->Name()) == "link";
+    joints += std::string(e->Name()) == "joint";
+    if (links > kMaxUrdfLinks || joints > kMaxUrdfLinks)
+      fail(fmt::format("{}:{}", path, e->GetLineNum()), "",
+           fmt::format("more than {} <{}> elements: proxgen reads robots of at most {} links", kMaxUrdfLinks,
+                       e->Name(), kMaxUrdfLinks));
     const char* name = e->Attribute("name");
     if (!name) continue;
     if (std::string(e->Name()) == "link") index.link.emplace(name, e->GetLineNum());
@@ -85,7 +113,7 @@ LineIndex indexLines(const std::string& xml, const std::string& path) {
     if (parent && child && parent->Attribute("link") && child->Attribute("link"))
       parentJoint.emplace(child->Attribute("link"), std::make_pair(std::string(parent->Attribute("link")), std::string(name)));
   }
-  checkNoCycle(parentJoint, index, path);
+  checkTreeShape(parentJoint, index, path);
   return index;
 }
 
@@ -305,6 +333,11 @@ class Builder {
 }  // namespace
 
 Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBase) {
+  // The two XML parsers (tinyxml2 here, TinyXML inside urdfdom) each build a
+  // DOM of ~100-200 bytes per node: bounded through the tags before either runs.
+  const std::size_t tags = std::size_t(std::count(xml.begin(), xml.end(), '<'));
+  if (tags > kMaxUrdfTags)
+    fail(path, "", fmt::format("has {} markup tags ('<'), more than the {} proxgen reads", tags, kMaxUrdfTags));
   const LineIndex lines = indexLines(xml, path);
   urdf::ModelInterfaceSharedPtr urdf;
   std::string urdfdomError;
@@ -315,7 +348,7 @@ Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBa
     try {
       urdf = urdf::parseURDF(xml);
     } catch (const std::exception& e) {
-      capture.errors = e.what();
+      capture.errors = oneLine(e.what());
       urdf.reset();
     }
     console_bridge::restorePreviousOutputHandler();

@@ -11,6 +11,27 @@ namespace proxgen {
 /// huge input fails fast with a clear message instead of exhausting memory.
 inline constexpr std::size_t kMaxUrdfBytes = 64u << 20;
 
+/// Most markup tags ('<' characters: elements, end tags, comments) read, 256 per
+/// link at the link limit; real URDFs have 10 to 40 per link. Counted before any
+/// XML parser runs: their DOMs take ~100-200 bytes per node, so this bounds the
+/// memory a file of many tiny elements costs (a 63 MB file of `<a/>` took
+/// 3.7 GB before); see docs/guarantees.md.
+inline constexpr std::size_t kMaxUrdfTags = 1u << 20;
+
+/// Most <link> (and <joint>) elements read: so at most 4095 moving joints and
+/// 4101 DoF. Refused right after the XML parse, before urdfdom and the model
+/// builder run. The bound that matters is the generic solvers' Data: its dense
+/// joint-space matrices take 24 nv^2 bytes (0.4 GB at the limit, 0.1 GB at
+/// 2000 DoF); see docs/guarantees.md.
+inline constexpr std::size_t kMaxUrdfLinks = 4096;
+
+/// Deepest kinematic tree read (joints, fixed ones included, from the root link
+/// to a leaf). Deeper trees are refused before the model is built, which
+/// recurses once per level: 1.6 kB of stack per level in a Release build,
+/// 7.8 kB under ASan, so 512 levels fit an 8 MB stack with room to spare in
+/// both (docs/guarantees.md). Real robots are below 50.
+inline constexpr std::size_t kMaxTreeDepth = 512;
+
 /// Reads a URDF file into a Model. With `floatingBase` the root link becomes a
 /// free-flyer body (joint `root_joint`); otherwise it is welded to the world.
 /// Throws proxgen::Error ("FILE:LINE: joint 'x': what is wrong") on bad input.

@@ -1,0 +1,36 @@
+// Plan -> text: the two files of a generated solver (templates/solver.*.tpl
+// filled with fmt). Every body gets its own block in tree order, headed by a
+// comment naming its link and joint; the arithmetic is printed through the
+// expression printer (expr.hpp), so the constants of the tree (transforms,
+// inertias, axes, constraint placements) are literals with their exact zeros
+// and ones folded away.
+#pragma once
+
+#include <string>
+
+#include "emit/plan.hpp"
+
+namespace proxgen::emit {
+
+/// What the banner of the files records about the inputs (names without
+/// directories, so the files do not depend on where the inputs were).
+struct SolverInputs {
+  std::string urdfName, urdfSha256;
+  std::string layoutName, layoutSha256;
+  std::string command;  // how to regenerate (without the output folder)
+};
+
+struct SolverFiles {
+  std::string headerName, header;  // NAME.hpp
+  std::string sourceName, source;  // NAME.cpp
+};
+
+/// Size statistics of an emitted solver (live statements, multiplications).
+struct SolverStats {
+  int statements = 0, temporaries = 0, multiplies = 0;
+  int workspaceScalars = 0;
+};
+
+SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& inputs, SolverStats* stats = nullptr);
+
+}  // namespace proxgen::emit

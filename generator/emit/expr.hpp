@@ -1,0 +1,172 @@
+// The expression printer of the emitter: a scalar expression is a constant plus
+// a sum of constant * atom terms, where an atom is a run-time value (an input,
+// a workspace member, a local temporary) or the product of two such values.
+// Constants are known at generation time, so exact zeros and ones fold away
+// here (the C++ compiler may not drop `0.0 * x` or `x + 0.0` without
+// fast-math). Products of two run-time expressions are materialised into
+// temporaries first, so every printed line stays a flat sum of products.
+//
+// CodeBuilder collects the statements of one function as a tree of blocks and
+// prints only the temporaries that some store (transitively) needs, so the
+// emitter can compute freely and never leave an unused variable behind.
+#pragma once
+
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace proxgen::emit {
+
+enum class ScalarType { Double, Float };
+
+struct Term {
+  int atom = 0;
+  double coeff = 0;
+};
+
+class Expr {
+ public:
+  Expr() = default;
+  Expr(double constant) : c_(constant == 0.0 ? 0.0 : constant) {}  // NOLINT: constants convert
+  static Expr atom(int id, double coeff = 1.0);
+
+  double constant() const { return c_; }
+  const std::vector<Term>& terms() const { return terms_; }
+  bool isConstant() const { return terms_.empty(); }
+  bool isZero() const { return terms_.empty() && c_ == 0.0; }
+  /// One term and no constant: coeff * atom.
+  bool isScaledAtom() const { return terms_.size() == 1 && c_ == 0.0; }
+  /// Number of terms plus one for a non-zero constant.
+  int size() const { return int(terms_.size()) + (c_ != 0.0 ? 1 : 0); }
+
+  friend Expr operator+(const Expr& a, const Expr& b);
+  friend Expr operator-(const Expr& a, const Expr& b);
+  friend Expr operator-(const Expr& a);
+  friend Expr operator*(double k, const Expr& a);
+  Expr& operator+=(const Expr& b) { return *this = *this + b; }
+  Expr& operator-=(const Expr& b) { return *this = *this - b; }
+
+ private:
+  double c_ = 0.0;
+  std::vector<Term> terms_;  // sorted by atom id, no zero coefficients
+};
+
+class CodeBuilder {
+ public:
+  explicit CodeBuilder(ScalarType scalar);
+
+  ScalarType scalar() const { return scalar_; }
+  /// A literal of the solver's Scalar type ("0.5", "0.5f"); throws proxgen::Error
+  /// when a constant does not fit the type.
+  std::string literal(double v) const;
+
+  // ---- atoms
+  /// A value that stays valid in the whole function (an input such as q[3],
+  /// a function-scope constant such as mu).
+  Expr input(const std::string& text);
+  /// The current value of a workspace member (w.IA_x[3]); see store().
+  Expr member(const std::string& text);
+
+  // ---- arithmetic that may print temporaries
+  Expr mul(const Expr& a, const Expr& b);
+  /// e as a plain atom: itself when it is one already, else a temporary.
+  Expr temp(const Expr& e, const std::string& hint = "t");
+  /// A temporary when e is more than coeff * atom (before use in many products).
+  Expr flat(const Expr& e, const std::string& hint = "t") { return e.size() > 1 || (e.size() == 1 && !e.isScaledAtom()) ? temp(e, hint) : e; }
+  Expr recip(const Expr& e, const std::string& hint = "inv");
+  Expr sqrt(const Expr& e, const std::string& hint = "r");
+  /// fn(arg) for a one-argument <cmath> function, as a temporary.
+  Expr call(const std::string& fn, const Expr& arg, const std::string& hint);
+
+  /// A named temporary with a raw right-hand side (printed only when used).
+  Expr define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses);
+  /// True for +-(an input or a member): a value worth no statement of its own.
+  bool isAlias(const Expr& e) const;
+  /// The same expression in this builder, from another one's members and inputs
+  /// (a temporary cannot cross functions: that is an error).
+  /// `cache` maps the other builder's atoms to this one's (-1: not yet seen);
+  /// pass the same vector for every expression of one hand-over.
+  Expr import(const CodeBuilder& from, const Expr& e, std::vector<int>& cache);
+
+  // ---- statements
+  /// member = e; returns the member's new value. Earlier values of the member
+  /// become stale: printing an expression that still holds one is an error
+  /// (it would read the new value where the old one was meant).
+  Expr store(const std::string& member, const Expr& e);
+  /// member = rhs; with a raw right-hand side (a function call).
+  Expr storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses);
+  /// A raw statement or comment line with the atoms it reads.
+  void line(const std::string& text, const std::vector<Expr>& uses = {});
+  void comment(const std::string& text);
+  void blank();
+  /// Opens a nested block: `head` is printed before the braces' contents
+  /// ("{" or "for (...) {"), with comment lines above it.
+  void open(const std::string& head, const std::vector<std::string>& comments = {});
+  void close();
+  int depth() const { return int(stack_.size()) - 1; }
+  int statementCount() const { return int(stmts_.size()); }
+
+  std::string print(const Expr& e) const;
+  /// print() without the staleness checks (for comparing states).
+  std::string describe(const Expr& e) const;
+  /// The function body, indented by `indent` spaces, without the unused temporaries.
+  std::string render(int indent) const;
+
+  /// Number of multiplications in the live statements (for the docs' statistics).
+  struct Stats {
+    int statements = 0, temporaries = 0, multiplies = 0;
+  };
+  Stats stats() const;
+
+ private:
+  struct Atom {
+    std::string text;
+    int f1 = -1, f2 = -1;   // factors of a product atom
+    int block = 0;          // block that declared it (0: function scope)
+    int stmt = -1;          // statement defining a temporary
+    bool stale = false;     // a member overwritten since
+    bool dead = false;      // a temporary whose block has closed
+    bool temp = false;
+  };
+  struct Stmt {
+    std::string text;
+    int defines = -1;       // temporary atom defined here
+    std::vector<int> uses;  // simple atoms read
+    int multiplies = 0;
+    bool always = false;    // stores, comments, raw lines
+  };
+  struct Node {
+    bool isBlock = false;
+    int index = 0;
+  };
+  struct Block {
+    std::string head;
+    std::vector<std::string> comments;
+    std::vector<Node> nodes;
+    std::map<std::string, int> memo;  // canonical expression -> temporary atom
+  };
+
+  int newAtom(Atom a);
+  Expr refresh(const std::string& member);
+  std::string key(const Expr& e) const;
+  void collectUses(const Expr& e, std::vector<int>& uses) const;
+  void check(const Expr& e) const;
+  int addStmt(Stmt s);
+  std::string freshName(const std::string& hint);
+  int countMultiplies(const Expr& e) const;
+  void markLive(int block, std::vector<char>& live) const;
+  bool blockLive(int block, const std::vector<char>& live) const;
+  void renderBlock(int block, int indent, const std::vector<char>& live, std::string& out) const;
+
+  ScalarType scalar_;
+  std::vector<Atom> atoms_;
+  std::unordered_map<std::string, int> byText_;        // current atom of an input/member
+  std::map<std::pair<int, int>, int> products_;
+  std::vector<Stmt> stmts_;
+  std::vector<Block> blocks_;
+  std::vector<int> stack_;
+  std::map<std::string, int> nameCount_;
+};
+
+}  // namespace proxgen::emit

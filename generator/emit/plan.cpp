@@ -1,0 +1,136 @@
+#include "emit/plan.hpp"
+
+#include <set>
+
+#include "emit/identifiers.hpp"
+
+namespace proxgen::emit {
+
+const char* jointClassName(JointClass c) {
+  switch (c) {
+    case JointClass::RevoluteX: return "revolute about x";
+    case JointClass::RevoluteY: return "revolute about y";
+    case JointClass::RevoluteZ: return "revolute about z";
+    case JointClass::RevoluteAxis: return "revolute about a general axis";
+    case JointClass::PrismaticX: return "prismatic along x";
+    case JointClass::PrismaticY: return "prismatic along y";
+    case JointClass::PrismaticZ: return "prismatic along z";
+    case JointClass::PrismaticAxis: return "prismatic along a general axis";
+    case JointClass::FreeFlyer: return "free flyer";
+  }
+  return "?";
+}
+
+namespace {
+
+// An axis that is exactly +-e_k (as parsed) makes S a signed unit vector.
+void classify(const Joint& j, BodyPlan& b) {
+  if (j.type == JointType::FreeFlyer) {
+    b.jointClass = JointClass::FreeFlyer;
+    return;
+  }
+  const bool revolute = j.type == JointType::Revolute;
+  for (int k = 0; k < 3; ++k) {
+    const bool others = j.axis[(k + 1) % 3] == 0.0 && j.axis[(k + 2) % 3] == 0.0;
+    if (others && (j.axis[k] == 1.0 || j.axis[k] == -1.0)) {
+      b.axis = k;
+      b.axisSign = j.axis[k];
+      b.jointClass = JointClass(int(revolute ? JointClass::RevoluteX : JointClass::PrismaticX) + k);
+      return;
+    }
+  }
+  b.jointClass = revolute ? JointClass::RevoluteAxis : JointClass::PrismaticAxis;
+}
+
+int countNonzeros(const Mat3& m) {
+  int n = 0;
+  for (int k = 0; k < 9; ++k) n += m(k / 3, k % 3) != 0.0;
+  return n;
+}
+
+}  // namespace
+
+Plan makePlan(const System& sys, const std::string& name, ScalarType scalar) {
+  const Model& m = sys.model;
+  const int N = m.numBodies();
+  Plan plan;
+  plan.name = sanitizeIdentifier(name);
+  plan.scalar = scalar;
+  plan.nq = m.nq;
+  plan.nv = m.nv;
+  plan.nc = sys.nc;
+  plan.floatingBase = m.floatingBase;
+  plan.mu = sys.mu;
+  plan.iterations = sys.iterations;
+
+  IdentifierSet ids;
+  plan.bodies.resize(std::size_t(N));
+  for (int i = 0; i < N; ++i) {
+    const Body& body = m.bodies[std::size_t(i)];
+    BodyPlan& b = plan.bodies[std::size_t(i)];
+    b.index = i;
+    b.parent = body.parent;
+    b.link = body.link;
+    b.children = body.children;
+    if (i == 0) {
+      b.ident = ids.make("world", 0);
+      continue;
+    }
+    b.joint = body.joint.name;
+    b.ident = ids.make(body.link, i);
+    classify(body.joint, b);
+    b.idx_q = body.joint.idx_q;
+    b.nq = body.joint.nq;
+    b.idx_v = body.joint.idx_v;
+    b.nv = body.joint.nv;
+    b.treeRotationNonzeros = countNonzeros(body.treePlacement.R);
+    for (int k = 0; k < 3; ++k) b.treeTranslationNonzeros += body.treePlacement.p[k] != 0.0;
+    const Mat6 I = body.inertia.matrix();
+    for (int r = 0; r < 6; ++r)
+      for (int c = r; c < 6; ++c) b.inertiaNonzeros += I(r, c) != 0.0;
+  }
+
+  IdentifierSet cids;
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    ConstraintPlan cp;
+    cp.name = c.name;
+    cp.link = c.link;
+    cp.ident = cids.make(c.name, int(k));
+    cp.body = c.body;
+    cp.row = c.row;
+    cp.rows = c.rows();
+    cp.weld = c.type == ConstraintType::Weld6D;
+    plan.constraints.push_back(cp);
+    plan.bodies[std::size_t(c.body)].constraints.push_back(int(k));
+    if (c.kp != 0)
+      for (int i : m.pathToRoot(c.body)) plan.bodies[std::size_t(i)].needsPlacement = true;
+  }
+
+  plan.support = sys.supportBodies();
+  const std::set<int> support(plan.support.begin(), plan.support.end());
+  for (int i = 1; i < N; ++i) {
+    plan.bodies[std::size_t(i)].onSupport = support.count(i) > 0;
+    plan.bodies[std::size_t(i)].needsGravity = support.count(i) > 0;
+    if (!support.count(i)) plan.offSupport.push_back(i);
+  }
+
+  // Subtree rows, leaves first: own rows (layout order), then each child's.
+  for (int i = N - 1; i >= 0; --i) {
+    BodyPlan& b = plan.bodies[std::size_t(i)];
+    for (int k : b.constraints)
+      for (int r = 0; r < plan.constraints[std::size_t(k)].rows; ++r)
+        b.subtreeRows.push_back(plan.constraints[std::size_t(k)].row + r);
+    int offset = int(b.subtreeRows.size());
+    for (int ch : b.children) {
+      BodyPlan& c = plan.bodies[std::size_t(ch)];
+      c.offsetInParent = offset;
+      offset += c.m();
+      b.subtreeRows.insert(b.subtreeRows.end(), c.subtreeRows.begin(), c.subtreeRows.end());
+    }
+  }
+  plan.rootRows = plan.bodies[0].subtreeRows;
+  return plan;
+}
+
+}  // namespace proxgen::emit

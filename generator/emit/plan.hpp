@@ -1,0 +1,75 @@
+// What generation decides, as plain data (GENERATOR.md "Plan"): per body its
+// joint class, its identifier, whether it is on the constraint support, the
+// constraint rows of its subtree and where they sit in its parent's; the
+// support and off-support bodies; the Delassus rows in tree order. The emitter
+// prints from this and the System; tests compare it with the generic solvers'
+// run-time view (System::supportBodies, Data::subtreeRows).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "emit/expr.hpp"
+#include "model/model.hpp"
+
+namespace proxgen::emit {
+
+enum class JointClass {
+  RevoluteX, RevoluteY, RevoluteZ, RevoluteAxis,      // about +-x/y/z, or a general unit axis
+  PrismaticX, PrismaticY, PrismaticZ, PrismaticAxis,  // along +-x/y/z, or a general unit axis
+  FreeFlyer,
+};
+const char* jointClassName(JointClass c);
+
+struct BodyPlan {
+  int index = 0;
+  int parent = -1;
+  std::string link, joint;   // raw names (comments only, escaped)
+  std::string ident;         // sanitised, unique: v_<ident>, IA_<ident>, ...
+  JointClass jointClass = JointClass::RevoluteZ;
+  int axis = -1;             // 0/1/2 for an axis along x/y/z, else -1
+  double axisSign = 1.0;     // +1 or -1 for such an axis
+  int idx_q = 0, nq = 0, idx_v = 0, nv = 0;
+  std::vector<int> children;
+  bool onSupport = false;
+  std::vector<int> constraints;  // constraints on this body (indices, layout order)
+  /// Constraint rows (layout numbering) of the subtree, in subtree order: the
+  /// body's own rows, then each child's subtree in child order.
+  std::vector<int> subtreeRows;
+  /// First column of this subtree's rows in the parent's KA / LA / lA.
+  int offsetInParent = 0;
+  /// Zero patterns known at generation time (for the docs and the tests).
+  int treeRotationNonzeros = 0;     // of 9
+  int treeTranslationNonzeros = 0;  // of 3
+  int inertiaNonzeros = 0;          // of the 21 entries of the symmetric 6x6
+  bool needsGravity = false;        // on the support: carries R_i^T g for the k_i terms
+  bool needsPlacement = false;      // on a path to a constraint with kp != 0: world placement
+  int m() const { return int(subtreeRows.size()); }
+};
+
+struct ConstraintPlan {
+  std::string name, link;  // raw (comments only)
+  std::string ident;
+  int body = 0;
+  int row = 0, rows = 0;
+  bool weld = true;  // 6d, else 3d point contact
+};
+
+struct Plan {
+  std::string name;  // namespace, sanitised
+  ScalarType scalar = ScalarType::Double;
+  int nq = 0, nv = 0, nc = 0;
+  bool floatingBase = false;
+  double mu = 1e4;
+  int iterations = 3;
+  std::vector<BodyPlan> bodies;      // [0] = the world
+  std::vector<int> support;          // ascending (tree order)
+  std::vector<int> offSupport;       // the other moving bodies, ascending
+  std::vector<int> rootRows;         // Delassus rows in tree order (= bodies[0].subtreeRows)
+  std::vector<ConstraintPlan> constraints;  // layout order
+};
+
+/// The plan of one solver; `name` is sanitised into the namespace name.
+Plan makePlan(const System& sys, const std::string& name, ScalarType scalar);
+
+}  // namespace proxgen::emit

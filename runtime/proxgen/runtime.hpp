@@ -1,0 +1,83 @@
+// The runtime of the solvers proxgen generates: the little they call that is
+// not straight-line arithmetic. Header-only, fixed size, no heap, no
+// exceptions, no RTTI, nothing but <cmath>; templated on the solver's Scalar.
+//
+// The generated code prints every product itself (constants folded at
+// generation time), so what is left here is the SE(3) logarithm that a
+// Baumgarte position gain on a 6D constraint needs.
+#pragma once
+
+#include <cmath>
+
+// The generated files split their straight-line code into functions of a few
+// bodies each; kept out of line, they keep the compiler's time linear in the
+// robot's size (a call costs a few instructions per part).
+#if defined(__GNUC__) || defined(__clang__)
+#define PROXGEN_RT_NOINLINE __attribute__((noinline))
+#elif defined(_MSC_VER)
+#define PROXGEN_RT_NOINLINE __declspec(noinline)
+#else
+#define PROXGEN_RT_NOINLINE
+#endif
+
+namespace proxgen_rt {
+
+inline constexpr int version_major = 0, version_minor = 1;
+
+/// Angle and unit axis of a rotation matrix R (row-major), as Eigen's
+/// AngleAxis(Quaternion(R)) computes them: the quaternion by Shepperd's method
+/// (largest diagonal pivot), then angle = 2 atan2(|vec|, |w|) in [0, pi].
+template <class S>
+inline void angle_axis(const S* R, S& angle, S* axis) noexcept {
+  const S trace = R[0] + R[4] + R[8];
+  S q[4];  // x, y, z, w
+  if (trace > S(0)) {
+    S t = std::sqrt(trace + S(1));
+    q[3] = S(0.5) * t;
+    t = S(0.5) / t;
+    q[0] = (R[7] - R[5]) * t;
+    q[1] = (R[2] - R[6]) * t;
+    q[2] = (R[3] - R[1]) * t;
+  } else {
+    int i = 0;
+    if (R[4] > R[0]) i = 1;
+    if (R[8] > R[4 * i]) i = 2;
+    const int j = (i + 1) % 3, k = (j + 1) % 3;
+    S t = std::sqrt(R[4 * i] - R[4 * j] - R[4 * k] + S(1));
+    q[i] = S(0.5) * t;
+    t = S(0.5) / t;
+    q[3] = (R[3 * k + j] - R[3 * j + k]) * t;
+    q[j] = (R[3 * j + i] + R[3 * i + j]) * t;
+    q[k] = (R[3 * k + i] + R[3 * i + k]) * t;
+  }
+  S n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  if (n == S(0)) {
+    angle = S(0);
+    axis[0] = S(1);
+    axis[1] = S(0);
+    axis[2] = S(0);
+    return;
+  }
+  angle = S(2) * std::atan2(n, std::fabs(q[3]));
+  if (q[3] < S(0)) n = -n;
+  for (int c = 0; c < 3; ++c) axis[c] = q[c] / n;
+}
+
+/// log of the placement {R, p} as a twist [linear; angular]:
+/// w = angle * axis, linear = Jl(w)^-1 p (the inverse left Jacobian of SO(3)).
+template <class S>
+inline void log6(const S* R, const S* p, S* out) noexcept {
+  S t, a[3];
+  angle_axis(R, t, a);
+  const S w[3] = {t * a[0], t * a[1], t * a[2]};
+  // Jinv = I - 1/2 [w] + coef [w]^2, coef -> 1/12 as t -> 0.
+  const S coef = t > S(1e-6) ? (S(1) - t * std::sin(t) / (S(2) * (S(1) - std::cos(t)))) / (t * t) : S(1) / S(12);
+  const S wxp[3] = {w[1] * p[2] - w[2] * p[1], w[2] * p[0] - w[0] * p[2], w[0] * p[1] - w[1] * p[0]};
+  const S wxwxp[3] = {w[1] * wxp[2] - w[2] * wxp[1], w[2] * wxp[0] - w[0] * wxp[2], w[0] * wxp[1] - w[1] * wxp[0]};
+  for (int c = 0; c < 3; ++c) {
+    out[c] = p[c] - S(0.5) * wxp[c] + coef * wxwxp[c];
+    out[3 + c] = w[c];
+  }
+}
+
+}  // namespace proxgen_rt

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# AddressSanitizer + UndefinedBehaviorSanitizer build of the project and its
+# test suite (gcc), in build-asan, then ctest there.
+#
+# What runs: every GoogleTest suite (tests/test_*.cpp) and the generated-solver
+# tests, compiled with -fsanitize=address,undefined, -O1 and with assertions on
+# (no NDEBUG: Eigen's index checks and _GLIBCXX_ASSERTIONS catch what ASan cannot
+# see inside fixed-size storage). Any sanitizer report aborts the test.
+# What does not run:
+#   - label `package` (downstream_project): it installs proxgen and configures
+#     another project with the installed package; that tests packaging, not
+#     memory safety, and the Release ctest run covers it.
+#   - the benchmarks (PROXGEN_BUILD_BENCH=OFF, so no `bench-smoke` tests):
+#     timing an instrumented build means nothing, and the solvers they compile
+#     are compiled and run sanitised by the generated-solver tests already.
+#
+# Environment: ASAN_BUILD (default build-asan), JOBS (default nproc),
+# CTEST_ARGS (extra ctest arguments, e.g. "-R hardening").
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${ASAN_BUILD:-$root/build-asan}"
+jobs="${JOBS:-$(nproc)}"
+
+# Every check aborts on its first report, except `null`, which is recoverable so
+# that the one Eigen false alarm below can be suppressed (halt_on_error=1 still
+# aborts on any other null report).
+flags="-fsanitize=address,undefined -fno-sanitize-recover=all -fsanitize-recover=null -fno-omit-frame-pointer -D_GLIBCXX_ASSERTIONS"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+  -DPROXGEN_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS=$flags" \
+  "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined" \
+  "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=address,undefined"
+cmake --build "$build" -j "$jobs"
+
+# detect_leaks: every test process must free what it allocates.
+# detect_stack_use_after_return: catches references to a finished solve's locals.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:detect_stack_use_after_return=1:abort_on_error=1:strict_string_checks=1}"
+# Eigen 3.4's triangular solve takes &rhs.coeffRef(0, 0) of a right-hand side
+# with zero columns (an LLT solve with J^T when there are no constraint rows):
+# a reference bound to an empty matrix's null data pointer, never read.
+cat > "$build/ubsan.supp" <<'SUPP'
+null:Eigen/src/Core/PlainObjectBase.h
+SUPP
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1:suppressions=$build/ubsan.supp}"
+# shellcheck disable=SC2086
+ctest --test-dir "$build" --output-on-failure -j "$jobs" -LE package ${CTEST_ARGS:-}
+echo "sanitize: ASan + UBSan test run passed"

@@ -1,0 +1,197 @@
+// One generated solver against the generic solvers it was generated from:
+// 100 random states, K = 0, 1, 2, 3 and converged (100), mu = 100 and 1e4;
+// the generated constrainedABA against constrainedAba, proxPV against proxPv.
+//
+// Built once per solver by tests/generated/CMakeLists.txt, with
+//   PROXGEN_SOLVER_HEADER     "name.hpp"
+//   PROXGEN_SOLVER_NAMESPACE  name
+//   PROXGEN_SOLVER_CASE       "case" of the shared cases.yaml, or
+//   PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT   the inputs it was generated from.
+//
+// Tolerance. The generated code runs the recursions of the generic code with
+// the operations in another order (constants folded, sums regrouped, the
+// double-angle form of the joint rotations, a Cholesky for the free flyer's
+// 6 x 6 inertia where the generic code inverts it, the Delassus factor by limbs
+// plus a rank-6 Woodbury update). Each has a forward error of order eps kappa,
+// kappa the condition number of what the algorithm solves at that state, and
+// so has their difference:
+//   constrainedABA qdd:    kappa(M + mu J^T J), the matrix every solve eliminates
+//                          (it grows with mu: at mu = 1e4 on gram-scale
+//                          fingertips cABA's own round-off reaches 1e-9);
+//   constrainedABA lambda: lambda = mu (J qdd + gamma - a*) amplifies the error
+//                          of qdd by mu |J|: kappa (1 + mu |J| |qdd| / |lambda|);
+//   proxPV qdd and lambda: kappa(M) (G and y_free come out of the articulated
+//                          recursion) + kappa(G + I/mu) (the proximal solve).
+// (tests/numerics.hpp's roundoffBounds judge a generic solver against the dense
+// reference; they do not carry cABA's mu |J| amplification of lambda, which a
+// comparison of two recursive implementations meets.) relErr (max |gen - generic|
+// / max(1, max |generic|)) of each must stay below max(floor, 16 eps kappa).
+// Measured over the nine shared cases and the three examples, in double and in
+// float, error / (eps kappa) stays below 3: 16 leaves a margin of five. The
+// floor is 1e-12 in double (where kappa is small the two agree to a few eps)
+// and 64 eps = 4e-6 in float, whose inputs are rounded to float first so that
+// the generic solver answers the same question. An error in the generated
+// arithmetic (a dropped term, a wrong sign) shows at every state, including the
+// well-conditioned ones where the bound is tight: the test also checks that at
+// mu = 100 most states have an informative bound (below 1e-9 in double, 1e-2
+// in float).
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <type_traits>
+#include <vector>
+
+#include PROXGEN_SOLVER_HEADER
+#include "algorithms/constrained_aba.hpp"
+#include "algorithms/crba.hpp"
+#include "algorithms/data.hpp"
+#include "algorithms/jacobians.hpp"
+#include "algorithms/prox_pv.hpp"
+#include "model/cases.hpp"
+#include "model/layout.hpp"
+#include "numerics.hpp"
+#include "support.hpp"
+
+namespace {
+
+namespace gen = PROXGEN_SOLVER_NAMESPACE;
+using proxgen::VecX;
+constexpr bool kFloat = std::is_same_v<gen::Scalar, float>;
+constexpr double kEps = kFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;  // unit round-off
+constexpr double kFloor = kFloat ? 64 * kEps : 1e-12;
+constexpr double kSafety = 1;
+
+proxgen::System loadSolverSystem() {
+#ifdef PROXGEN_SOLVER_CASE
+  for (const proxgen::Case& c : proxgen::test::sharedCases())
+    if (c.name == PROXGEN_SOLVER_CASE) return proxgen::loadCaseSystem(c);
+  ADD_FAILURE() << "case " << PROXGEN_SOLVER_CASE << " not in the shared cases.yaml";
+  return {};
+#else
+  return proxgen::loadSystem(PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT);
+#endif
+}
+
+// The generated solver on one state (rounded to its Scalar), results in double.
+template <class Solve>
+void runGenerated(Solve solve, const proxgen::test::RandomState& s, double mu, int K, VecX& qdd, VecX& lambda) {
+  std::vector<gen::Scalar> q(gen::nq), v(gen::nv), tau(gen::nv), a(gen::nv), l(std::size_t(std::max(gen::nc, 1)));
+  for (int k = 0; k < gen::nq; ++k) q[std::size_t(k)] = gen::Scalar(s.q[k]);
+  for (int k = 0; k < gen::nv; ++k) {
+    v[std::size_t(k)] = gen::Scalar(s.v[k]);
+    tau[std::size_t(k)] = gen::Scalar(s.tau[k]);
+  }
+  gen::Settings settings;
+  settings.mu = gen::Scalar(mu);
+  settings.iterations = K;
+  static gen::Workspace w;  // tens of kB for the big robots: not on the stack
+  solve(q.data(), v.data(), tau.data(), settings, w, a.data(), l.data());
+  qdd.resize(gen::nv);
+  lambda.resize(gen::nc);
+  for (int k = 0; k < gen::nv; ++k) qdd[k] = double(a[std::size_t(k)]);
+  for (int k = 0; k < gen::nc; ++k) lambda[k] = double(l[std::size_t(k)]);
+}
+
+// The state as the generated solver sees it (inputs rounded to its Scalar), so
+// the generic solver answers the same question.
+proxgen::test::RandomState rounded(proxgen::test::RandomState s) {
+  for (VecX* x : {&s.q, &s.v, &s.tau})
+    for (int k = 0; k < x->size(); ++k) (*x)[k] = double(gen::Scalar((*x)[k]));
+  return s;
+}
+
+double conditionSym(const proxgen::MatX& A) { return proxgen::test::scaledCondition(A); }
+
+double maxAbs1(const VecX& x) { return std::max(1.0, x.size() ? x.cwiseAbs().maxCoeff() : 0.0); }
+
+struct Worst {
+  double error = 0, ratio = 0;  // largest relErr, largest relErr / tolerance
+  int informative = 0, total = 0;
+  void add(double err, double tol) {
+    error = std::max(error, err);
+    ratio = std::max(ratio, err / tol);
+    informative += tol <= (kFloat ? 1e-2 : 1e-9);
+    ++total;
+  }
+};
+
+class Generated : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    sys_ = loadSolverSystem();
+    ASSERT_EQ(sys_.model.nq, gen::nq);
+    ASSERT_EQ(sys_.model.nv, gen::nv);
+    ASSERT_EQ(sys_.nc, gen::nc);
+  }
+  proxgen::System sys_;
+};
+
+TEST_F(Generated, SettingsDefaultsAreTheLayouts) {
+  const gen::Settings s;
+  EXPECT_EQ(double(s.mu), double(gen::Scalar(sys_.mu)));
+  EXPECT_EQ(s.iterations, sys_.iterations);
+}
+
+TEST_F(Generated, MatchesTheGenericSolvers) {
+  proxgen::Data d(sys_), dense(sys_);
+  std::mt19937 rng(20261125);
+  const std::vector<int> Ks = {0, 1, 2, 3, 100};
+  const std::vector<double> mus = {100.0, 1e4};
+  Worst cq[2], cl[2], pq[2], pl[2];  // per mu: constrainedABA qdd, lambda; proxPV qdd, lambda
+  VecX qdd, lambda;
+  for (int n = 0; n < 100; ++n) {
+    const proxgen::test::RandomState s = rounded(proxgen::test::randomState(sys_.model, rng));
+    proxgen::crba(sys_, dense, s.q);
+    proxgen::constraintJacobian(sys_, dense, s.q, s.v);
+    const proxgen::MatX& M = dense.M;
+    const proxgen::MatX& J = dense.J;
+    const double kM = conditionSym(M);
+    for (std::size_t m = 0; m < mus.size(); ++m) {
+      const double mu = mus[m];
+      const double kC = conditionSym(M + mu * J.transpose() * J);
+      proxgen::MatX G = J * M.ldlt().solve(J.transpose());
+      G.diagonal().array() += 1.0 / mu;
+      const double dual = std::max(kFloor, kSafety * kEps * (kM + conditionSym(G)));
+      const double primal = std::max(kFloor, kSafety * kEps * kC);
+      for (int K : Ks) {
+        const std::string where = "state " + std::to_string(n) + ", mu " + std::to_string(mu) + ", K " + std::to_string(K);
+        proxgen::constrainedAba(sys_, d, s.q, s.v, s.tau, mu, K);
+        runGenerated(gen::constrained_aba, s, mu, K, qdd, lambda);
+        double err = proxgen::test::relErr(qdd, d.qdd);
+        EXPECT_LE(err, primal) << "constrained_aba qdd, " << where;
+        cq[m].add(err, primal);
+        const double multiplier =
+            std::max(kFloor, kSafety * kEps * kC * (1 + mu * J.norm() * maxAbs1(d.qdd) / maxAbs1(d.lambda)));
+        err = proxgen::test::relErr(lambda, d.lambda);
+        EXPECT_LE(err, multiplier) << "constrained_aba lambda, " << where;
+        cl[m].add(err, multiplier);
+
+        proxgen::proxPv(sys_, d, s.q, s.v, s.tau, mu, K);
+        runGenerated(gen::prox_pv, s, mu, K, qdd, lambda);
+        err = proxgen::test::relErr(qdd, d.qdd);
+        EXPECT_LE(err, dual) << "prox_pv qdd, " << where;
+        pq[m].add(err, dual);
+        err = proxgen::test::relErr(lambda, d.lambda);
+        EXPECT_LE(err, dual) << "prox_pv lambda, " << where;
+        pl[m].add(err, dual);
+      }
+    }
+  }
+  for (std::size_t m = 0; m < mus.size(); ++m) {
+    std::printf("mu = %g: largest relErr (and / tolerance): constrainedABA qdd %.1e (%.2f) lambda %.1e (%.2f), "
+                "proxPV qdd %.1e (%.2f) lambda %.1e (%.2f)\n",
+                mus[m], cq[m].error, cq[m].ratio, cl[m].error, cl[m].ratio, pq[m].error, pq[m].ratio, pl[m].error,
+                pl[m].ratio);
+    // At the small mu the bound must say something at most states, or the
+    // comparison proves nothing.
+    if (m == 0) {
+      for (const Worst* w : {&cq[m], &pq[m]})
+        EXPECT_GE(2 * w->informative, w->total) << "fewer than half the states have an informative tolerance";
+    }
+  }
+}
+
+}  // namespace

@@ -1,0 +1,143 @@
+// The shape of every generated solver built by tests/generated:
+// - its .cpp has no loop or branch but the iteration loops over K (exact text
+//   allow-listed): no loop over bodies, no branch on joint type;
+// - its object references no heap (malloc, operator new, ...) and no exception
+//   machinery (__cxa_throw, the personality routine, the unwinder).
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(s);
+  while (std::getline(in, item, sep))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The generated code has no string or character literals (names only reach
+// comments), so removing // comments leaves exactly the code.
+std::string stripComments(const std::string& text) {
+  std::string out;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (text.compare(k, 2, "//") == 0) {
+      k = text.find('\n', k);
+      if (k == std::string::npos) break;
+    }
+    out += text[k];
+  }
+  return out;
+}
+
+bool identChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Every loop or branch construct of `code`, as "keyword: statement head".
+// Allowed: the constrainedABA loop (iterations 2..K) and the proxPV loop (K steps).
+std::vector<std::string> forbiddenControlFlow(const std::string& code) {
+  static const std::vector<std::string> allowed = {"for (int k = 2; k <= s.iterations; ++k) {",
+                                                   "for (int k = 0; k < s.iterations; ++k) {"};
+  static const std::vector<std::string> keywords = {"for", "while", "do", "if", "else", "switch", "case", "goto"};
+  std::vector<std::string> found;
+  for (std::size_t k = 0; k < code.size(); ++k) {
+    if (code[k] == '?' || code.compare(k, 2, "&&") == 0 || code.compare(k, 2, "||") == 0 || code[k] == '"' ||
+        code[k] == '\'') {
+      found.push_back(code.substr(k, code.find('\n', k) - k));
+      continue;
+    }
+    if (!identChar(code[k]) || (k > 0 && identChar(code[k - 1]))) continue;
+    std::size_t end = k;
+    while (end < code.size() && identChar(code[end])) ++end;
+    const std::string word = code.substr(k, end - k);
+    for (const std::string& kw : keywords) {
+      if (word != kw) continue;
+      const std::string head = code.substr(k, code.find('{', k) + 1 - k);
+      bool ok = false;
+      for (const std::string& a : allowed) ok |= head == a;
+      if (!ok) found.push_back(head);
+    }
+    k = end - 1;
+  }
+  return found;
+}
+
+TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
+  // The checker itself, on code that must fail it and code that must pass.
+  EXPECT_EQ(forbiddenControlFlow("void f() { for (int i = 0; i < 3; ++i) { x(); } }").size(), 1u);
+  EXPECT_EQ(forbiddenControlFlow("void f() { if (a) { b(); } }").size(), 1u);
+  EXPECT_EQ(forbiddenControlFlow("y = c ? 1.0 : 2.0;").size(), 1u);
+  EXPECT_EQ(forbiddenControlFlow("while (x) {}").size(), 1u);
+  EXPECT_EQ(forbiddenControlFlow("switch (t) { case 1: {} }").size(), 2u);
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < s.iterations; ++k) {\n    w.x = iff + format;\n  }").empty());
+  EXPECT_TRUE(forbiddenControlFlow(stripComments("// if (a) for (;;)\nx = 1;")).empty());
+}
+
+TEST(GeneratedStructure, OnlyTheIterationLoopsLoopOrBranch) {
+  const std::vector<std::string> sources = split(PROXGEN_GENERATED_SOURCES, '|');
+  ASSERT_FALSE(sources.empty());
+  for (const std::string& path : sources) {
+    const std::string code = stripComments(readFile(path));
+    ASSERT_FALSE(code.empty()) << path;
+    for (const std::string& f : forbiddenControlFlow(code)) ADD_FAILURE() << path << ": " << f;
+  }
+}
+
+// Symbols of a static library, one name per line (nm -C: demangled).
+std::vector<std::string> symbols(const std::string& library) {
+  std::vector<std::string> out;
+  const std::string cmd = std::string(PROXGEN_NM) + " -C '" + library + "' 2>/dev/null";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char line[4096];
+  while (std::fgets(line, sizeof line, p)) {
+    std::string l(line);
+    while (!l.empty() && (l.back() == '\n' || l.back() == '\r')) l.pop_back();
+    // "<value> <type> <name>" or "<blank> U <name>": the name follows the type letter.
+    if (l.size() > 19 && l[17] != ' ' && l[18] == ' ') out.push_back(l.substr(19));
+  }
+  pclose(p);
+  return out;
+}
+
+bool forbiddenSymbol(const std::string& s) {
+  for (const char* exact : {"malloc", "calloc", "realloc", "free", "aligned_alloc", "posix_memalign", "memalign"})
+    if (s == exact) return true;
+  for (const char* prefix : {"operator new", "operator delete"})
+    if (s.rfind(prefix, 0) == 0) return true;
+  for (const char* part : {"__cxa_throw", "__cxa_allocate_exception", "__cxa_begin_catch", "__gxx_personality", "_Unwind_"})
+    if (s.find(part) != std::string::npos) return true;
+  return false;
+}
+
+TEST(GeneratedStructure, ObjectsUseNoHeapAndNoExceptions) {
+  EXPECT_TRUE(forbiddenSymbol("malloc") && forbiddenSymbol("operator new(unsigned long)") &&
+              forbiddenSymbol("__gxx_personality_v0") && forbiddenSymbol("_Unwind_Resume"));
+  EXPECT_FALSE(forbiddenSymbol("arm::(anonymous namespace)::accelerate_free_bodies(arm::Workspace&)"));
+  const std::vector<std::string> libraries = split(PROXGEN_GENERATED_LIBRARIES, '|');
+  ASSERT_FALSE(libraries.empty());
+  for (const std::string& lib : libraries) {
+    const std::vector<std::string> syms = symbols(lib);
+    bool entry = false;  // nm really listed this solver: its entry point is there
+    for (const std::string& s : syms) {
+      entry |= s.find("::constrained_aba(") != std::string::npos;
+      if (forbiddenSymbol(s)) ADD_FAILURE() << lib << " references " << s;
+    }
+    EXPECT_TRUE(entry) << "nm found no constrained_aba in " << lib;
+  }
+}
+
+}  // namespace
