@@ -1,47 +1,57 @@
-// The solvers checked in under generated/ are what the current generator writes
-// for the inputs beside them, byte for byte. When the generator, the templates
-// or an input changes, this fails until they are regenerated with the command
-// printed below.
-#include <cstdlib>
-#include <filesystem>
+// The checked-in solvers under generated/ are what the current generator
+// writes for their checked-in inputs, byte for byte. When this fails, the
+// generator or an input changed: regenerate with the command in the message
+// and commit the result.
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <sstream>
 
+#include "emit/generate.hpp"
 #include "support.hpp"
 
-namespace fs = std::filesystem;
-
+namespace proxgen::emit {
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
-class GeneratedFresh : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(GeneratedFresh, CheckedInFilesMatchTheGenerator) {
-  const std::string robot = GetParam();
-  const fs::path dir = fs::path(proxgen::test::sourceDir()) / "generated" / robot;
-  const fs::path out = fs::path(::testing::TempDir()) / ("proxgen-fresh-" + robot);
-  fs::remove_all(out);
-  const std::string cmd = std::string("\"") + PROXGEN_BINARY_PATH + "\" generate \"" + (dir / (robot + ".urdf")).string() +
-                          "\" --layout \"" + (dir / "layout.yaml").string() + "\" --out \"" + out.string() +
-                          "\" --name " + robot + " > /dev/null";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  for (const std::string ext : {".hpp", ".cpp"}) {
-    const std::string file = robot + ext;
-    ASSERT_TRUE(fs::exists(dir / file)) << "generated/" << robot << "/" << file << " is not checked in";
-    EXPECT_TRUE(slurp(out / file) == slurp(dir / file))
-        << "generated/" << robot << "/" << file << " is stale; regenerate with:\n  proxgen generate generated/" << robot
-        << "/" << robot << ".urdf --layout generated/" << robot << "/layout.yaml --out generated/" << robot
-        << " --name " << robot;
+// The first line where two texts differ, for the message.
+std::string firstDifference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  for (int line = 1;; ++line) {
+    const bool ea = !std::getline(sa, la), eb = !std::getline(sb, lb);
+    if (ea && eb) return "(no line differs)";
+    if (ea || eb || la != lb)
+      return "line " + std::to_string(line) + ":\n  checked in: " + (ea ? "<end>" : la.substr(0, 160)) +
+             "\n  generated:  " + (eb ? "<end>" : lb.substr(0, 160));
   }
-  fs::remove_all(out);
 }
 
-INSTANTIATE_TEST_SUITE_P(Examples, GeneratedFresh, ::testing::Values("arm", "quadruped", "humanoid"));
+TEST(GeneratedFresh, CheckedInSolversMatchTheGenerator) {
+  for (const char* robot : {"arm", "quadruped", "humanoid"}) {
+    const std::string dir = test::sourceDir() + "/generated/" + robot;
+    GenerateOptions g;
+    g.urdf = dir + "/" + robot + ".urdf";
+    g.layout = dir + "/layout.yaml";
+    g.name = robot;
+    const SolverFiles files = generateFiles(g);
+    const std::string command = "proxgen generate generated/" + std::string(robot) + "/" + robot +
+                                ".urdf --layout generated/" + robot + "/layout.yaml --out generated/" + robot +
+                                " --name " + robot;
+    for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source}}) {
+      const std::string path = dir + "/" + name;
+      const std::string checkedIn = readFile(path);
+      EXPECT_EQ(checkedIn, text) << "generated/" << robot << "/" << name << " is stale ("
+                                 << firstDifference(checkedIn, text) << ")\nregenerate it with:\n  " << command;
+    }
+  }
+}
 
 }  // namespace
+}  // namespace proxgen::emit

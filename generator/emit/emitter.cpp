@@ -106,7 +106,7 @@ struct Quantity {
   const char* prefix;
   const char* what;
 };
-constexpr Quantity kSin{"sq", "sin q"}, kCos{"cq", "cos q"}, kRJ{"RJ", "joint rotation (row-major)"},
+constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"cq", "cos q"}, kRJ{"RJ", "joint rotation (row-major)"},
     kV{"v", "velocity"}, kC{"c", "velocity-product acceleration"}, kPA{"pA", "bias force"},
     kIA{"IA", "articulated inertia (upper triangle)"}, kG{"g", "gravity in body coordinates"},
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},
@@ -315,7 +315,8 @@ void Emitter::jointTransform(int i) {
   }
   const Vec3 a = j.axis;
   if (j.type == JointType::Prismatic) {
-    const Expr qi = cb.input(q(j.idx_q));
+    // Kept in the workspace: the backward and forward passes (other functions) need it.
+    const Expr qi = cb.store(member(kQ, i, 0, 0), cb.input(q(j.idx_q)));
     for (int k = 0; k < 3; ++k) b.XJ.p[std::size_t(k)] = a[k] * qi;
     return;
   }
@@ -714,7 +715,8 @@ bool Emitter::reads(const std::string& body, const std::string& name) {
 void Emitter::endPart() {
   if (!part_) return;
   const std::string body = render(*part_);
-  const std::string name = fmt::format("{}_{}", host_.name, host_.parts++);
+  const bool empty = body.find_first_not_of(" \n") == std::string::npos;
+  const std::string name = fmt::format("{}_{}", host_.name, empty ? -1 : host_.parts++);
   std::vector<std::string> params, args;
   std::vector<Expr> uses;
   for (const char* p : {"q", "v", "tau"})
@@ -728,17 +730,20 @@ void Emitter::endPart() {
       args.push_back(p);
       uses.push_back(std::string(p) == "mu" ? hostMu_ : hostInvMu_);
     }
-  params.push_back("Workspace& w");
-  args.push_back("w");
+  if (reads(body, "w")) {
+    params.push_back("Workspace& w");
+    args.push_back("w");
+  }
   std::string sig, call;
   for (std::size_t k = 0; k < params.size(); ++k) {
     sig += (k ? ", " : "") + params[k];
     call += (k ? ", " : "") + args[k];
   }
-  partsText_ += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", name, sig, body);
   st_ = translate(st_, *part_, *host_.cb);
   cb_ = host_.cb;
   part_ = nullptr;
+  if (empty) return;  // everything folded to constants: no function
+  partsText_ += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", name, sig, body);
   cb_->line(fmt::format("{}({});", name, call), uses);
 }
 

@@ -138,6 +138,17 @@ std::string CodeBuilder::print(const Expr& e) const {
 }
 
 std::string CodeBuilder::describe(const Expr& e) const {
+  // A common factor of two or more terms prints once: c*(x - y), not c*x - c*y.
+  if (e.constant() == 0.0 && e.terms().size() > 1) {
+    const double c = std::abs(e.terms()[0].coeff);
+    bool common = c != 1.0;
+    for (const Term& t : e.terms()) common = common && std::abs(t.coeff) == c;
+    if (common) {
+      Expr unit;
+      for (const Term& t : e.terms()) unit += Expr::atom(t.atom, t.coeff / c);
+      return literal(c) + "*(" + describe(unit) + ")";
+    }
+  }
   std::string s;
   if (e.constant() != 0.0 || e.terms().empty()) s = literal(e.constant());
   for (const Term& t : e.terms()) {

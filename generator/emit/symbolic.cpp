@@ -235,9 +235,10 @@ V6 actInvMotion(CodeBuilder& cb, const XSym& X, const V6& m) {
 }
 
 V6 actForce(CodeBuilder& cb, const XSym& X, const V6& f) {
-  const V3 l = rotate(cb, X.R, lin(f));
+  V3 l = rotate(cb, X.R, lin(f));
   V3 a = rotate(cb, X.R, ang(f));
   if (!isZero(X.p)) {
+    for (Expr& e : l) e = cb.flat(e);  // R f_l once, for the result and for p x (R f_l)
     const V3 pxl = cross(cb, X.p, l);
     for (std::size_t i = 0; i < 3; ++i) a[i] += pxl[i];
   }

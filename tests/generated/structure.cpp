@@ -31,15 +31,16 @@ std::string readFile(const std::string& path) {
 }
 
 // The generated code has no string or character literals (names only reach
-// comments), so removing // comments leaves exactly the code.
+// comments), so removing // comments and the template's #include / #pragma
+// lines leaves exactly the code (any other directive stays and is reported).
 std::string stripComments(const std::string& text) {
   std::string out;
-  for (std::size_t k = 0; k < text.size(); ++k) {
-    if (text.compare(k, 2, "//") == 0) {
-      k = text.find('\n', k);
-      if (k == std::string::npos) break;
-    }
-    out += text[k];
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("#include ", 0) == 0 || line == "#pragma once") continue;
+    const std::size_t c = line.find("//");
+    out += (c == std::string::npos ? line : line.substr(0, c)) + "\n";
   }
   return out;
 }
@@ -55,7 +56,7 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
   std::vector<std::string> found;
   for (std::size_t k = 0; k < code.size(); ++k) {
     if (code[k] == '?' || code.compare(k, 2, "&&") == 0 || code.compare(k, 2, "||") == 0 || code[k] == '"' ||
-        code[k] == '\'') {
+        code[k] == '\'' || code[k] == '#') {
       found.push_back(code.substr(k, code.find('\n', k) - k));
       continue;
     }
@@ -84,6 +85,8 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_EQ(forbiddenControlFlow("switch (t) { case 1: {} }").size(), 2u);
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < s.iterations; ++k) {\n    w.x = iff + format;\n  }").empty());
   EXPECT_TRUE(forbiddenControlFlow(stripComments("// if (a) for (;;)\nx = 1;")).empty());
+  EXPECT_TRUE(forbiddenControlFlow(stripComments("#include \"a.hpp\"\n#pragma once\n")).empty());
+  EXPECT_EQ(forbiddenControlFlow(stripComments("#define X 1\n")).size(), 1u);
 }
 
 TEST(GeneratedStructure, OnlyTheIterationLoopsLoopOrBranch) {

@@ -1,0 +1,126 @@
+// `proxgen generate` as a user runs it (the binary): bad input gets the
+// loaders' one-line errors and leaves nothing in --out; good input writes
+// exactly NAME.hpp and NAME.cpp (creating --out), nothing else.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code = -1;
+  std::string output;  // stdout and stderr
+};
+
+std::string binary() {
+  const char* dir = std::getenv("PROXGEN_BINARY");  // set by tests/CMakeLists.txt: the build's generator/
+  return dir ? std::string(dir) + "/proxgen" : "";
+}
+
+Outcome run(const std::string& args) {
+  Outcome r;
+  FILE* p = popen((binary() + " generate " + args + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::set<std::string> listing(const fs::path& dir) {
+  std::set<std::string> out;
+  if (fs::exists(dir))
+    for (const auto& e : fs::directory_iterator(dir)) out.insert(e.path().filename().string());
+  return out;
+}
+
+class GenerateCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (binary().empty() || !fs::exists(binary())) GTEST_SKIP() << "no proxgen binary (PROXGEN_BINARY)";
+    tmp_ = fs::temp_directory_path() / ("proxgen_test_emit_cli_" + std::to_string(::getpid()));
+    fs::remove_all(tmp_);
+    fs::create_directories(tmp_);
+  }
+  void TearDown() override { fs::remove_all(tmp_); }
+  fs::path tmp_;
+  const std::string data_ = PROXGEN_TEST_DATA_DIR;
+  const std::string arm_ = proxgen::test::sourceDir() + "/generated/arm";
+};
+
+TEST_F(GenerateCommand, WritesTheTwoFilesAndCreatesTheFolder) {
+  const fs::path out = tmp_ / "new" / "folder";
+  const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --name arm");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp"}));
+  // Again into the same folder: replaced, still nothing else (no temporary left).
+  ASSERT_EQ(run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --name arm").code, 0);
+  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp"}));
+}
+
+TEST_F(GenerateCommand, TheNameIsSanitised) {
+  const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + tmp_.string() +
+                    " --name '../../evil name'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(listing(tmp_), (std::set<std::string>{"evil_name.hpp", "evil_name.cpp"}));
+}
+
+// Each bad input: exit code 1, one "proxgen: error:" line naming the file,
+// and no output folder (nor anything in an existing one).
+TEST_F(GenerateCommand, BadInputLeavesNothing) {
+  struct Bad {
+    std::string args, mentions;
+  };
+  const std::string good = data_ + "/good/arm3.urdf";
+  const std::vector<Bad> bad = {
+      {data_ + "/bad/not_xml.urdf --layout " + data_ + "/good/arm3_tool.yaml", "not_xml.urdf"},
+      {data_ + "/bad/zero_axis.urdf --layout " + data_ + "/good/arm3_tool.yaml", "zero_axis.urdf"},
+      {good + " --layout " + data_ + "/bad/unknown_link.yaml", "unknown_link.yaml"},
+      {good + " --layout " + data_ + "/bad/malformed.yaml", "malformed.yaml"},
+      {good + " --layout " + data_ + "/bad/mu_negative.yaml", "mu_negative.yaml"},
+      {good + " --layout " + tmp_.string() + "/missing.yaml", "missing.yaml"},
+      {"--cases " + data_ + "/good/arm3_tool.yaml --case nothing", "arm3_tool.yaml"},
+  };
+  const fs::path existing = tmp_ / "existing";
+  fs::create_directories(existing);
+  for (const Bad& b : bad) {
+    const fs::path fresh = tmp_ / "fresh";
+    for (const fs::path& out : {fresh, existing}) {
+      const Outcome r = run(b.args + " --out " + out.string());
+      EXPECT_EQ(r.code, 1) << b.args << "\n" << r.output;
+      EXPECT_EQ(r.output.rfind("proxgen: error: ", 0), 0u) << r.output;
+      EXPECT_NE(r.output.find(b.mentions), std::string::npos) << r.output;
+      EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+    }
+    EXPECT_FALSE(fs::exists(fresh)) << b.args;
+    EXPECT_TRUE(listing(existing).empty()) << b.args;
+  }
+}
+
+TEST_F(GenerateCommand, BadOptionsLeaveNothing) {
+  const fs::path out = tmp_ / "out";
+  EXPECT_NE(run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --scalar half").code, 0);
+  EXPECT_NE(run(arm_ + "/arm.urdf --out " + out.string()).code, 0);  // no layout
+  EXPECT_FALSE(fs::exists(out));
+  // --out naming a file.
+  const fs::path file = tmp_ / "a_file";
+  { std::FILE* f = std::fopen(file.c_str(), "w"); std::fclose(f); }
+  const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + file.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("not a folder"), std::string::npos) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,149 @@
+// `proxgen check` warns when a layout would make a float constrainedABA lose accuracy:
+// it folds the penalty mu (a mass) into the inertia of every body on the constraint support,
+// and a float keeps the lightest one's own inertia only to u mu / m (u = 2^-24). The warning
+// fires above u mu / m = 1e-3 (docs/embedded.md, "Float accuracy": the measured float errors of
+// the generated solvers under qemu were 0.1 to 9 times this estimate).
+//
+// The expected numbers are derived here from the model (lightest support body, its mass), not
+// copied from the binary's output. Inputs: the repository's example quadruped (always present).
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "model/layout.hpp"
+#include "support.hpp"
+
+namespace proxgen {
+namespace {
+
+constexpr double kU = 0x1p-24;        // float unit roundoff
+constexpr double kThreshold = 1e-3;   // the warning's criterion on kU * mu / m
+
+struct ProcessResult {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string shellQuoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::filesystem::path tempPath(const std::string& suffix) {
+  static std::atomic<int> counter{0};
+  return std::filesystem::temp_directory_path() /
+         ("proxgen_floatwarn_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + suffix);
+}
+
+ProcessResult runProxgen(const std::vector<std::string>& args) {
+  const std::filesystem::path out = tempPath(".out"), err = tempPath(".err");
+  std::string cmd = shellQuoted(PROXGEN_BINARY_PATH);
+  for (const std::string& a : args) cmd += " " + shellQuoted(a);
+  cmd += " >" + shellQuoted(out.string()) + " 2>" + shellQuoted(err.string());
+  const int status = std::system(cmd.c_str());
+  ProcessResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return r;
+}
+
+const std::string kUrdf = test::sourceDir() + "/generated/quadruped/quadruped.urdf";
+const std::string kLayout = test::sourceDir() + "/generated/quadruped/layout.yaml";
+
+/// The example's layout with its `mu:` replaced, in a temporary file removed by the fixture.
+class FloatWarning : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    for (const auto& p : temps_) std::filesystem::remove(p);
+  }
+  std::string layoutWithMu(double mu) {
+    const std::string text = std::regex_replace(slurp(kLayout), std::regex("\nmu:[^\n]*"), fmt::format("\nmu: {}", mu));
+    EXPECT_NE(text.find(fmt::format("\nmu: {}", mu)), std::string::npos) << "the example layout has no mu line";
+    temps_.push_back(tempPath(".yaml"));
+    std::ofstream(temps_.back()) << text;
+    return temps_.back().string();
+  }
+
+  // The lightest body with mass on the constraint support, from the library.
+  void SetUp() override {
+    const System sys = loadSystem(kUrdf, kLayout);
+    for (int b : sys.supportBodies()) {
+      const Body& body = sys.model.bodies[std::size_t(b)];
+      if (b > 0 && body.inertia.mass > 0 && (mass_ == 0 || body.inertia.mass < mass_)) {
+        mass_ = body.inertia.mass;
+        link_ = body.link;
+      }
+    }
+    ASSERT_GT(mass_, 0);
+    layoutMu_ = sys.mu;
+  }
+  /// mu at which kU * mu / m equals the threshold.
+  double muAtThreshold() const { return kThreshold * mass_ / kU; }
+
+  std::vector<std::filesystem::path> temps_;
+  double mass_ = 0, layoutMu_ = 0;
+  std::string link_;
+};
+
+// 10 % above the threshold: warns, names the body and gives the estimate.
+TEST_F(FloatWarning, WarnsAboveTheThreshold) {
+  const double mu = 1.1 * muAtThreshold();
+  const ProcessResult r = runProxgen({"check", kUrdf, "--layout", layoutWithMu(mu)});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("proxgen: warning:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'" + link_ + "'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("{:.1e}", kU * mu / mass_)), std::string::npos) << r.err;  // 1.1e-03
+  EXPECT_NE(r.err.find("prox_pv"), std::string::npos) << "the warning must say what to do:\n" << r.err;
+}
+
+// 10 % below: silent.
+TEST_F(FloatWarning, SilentBelowTheThreshold) {
+  const ProcessResult r = runProxgen({"check", kUrdf, "--layout", layoutWithMu(0.9 * muAtThreshold())});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("constrained_aba"), std::string::npos) << r.err;
+}
+
+// The example quadruped's own layout (mu = 1e4, shanks of 64 g) is above the threshold:
+// float constrainedABA lost 1e-2 on it under qemu (docs/embedded.md).
+TEST_F(FloatWarning, TheExampleQuadrupedsLayoutWarns) {
+  ASSERT_GT(kU * layoutMu_ / mass_, kThreshold);
+  const ProcessResult r = runProxgen({"check", kUrdf, "--layout", kLayout});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("{:.1e}", kU * layoutMu_ / mass_)), std::string::npos) << r.err;
+}
+
+// The warning goes to stderr only: --json output stays parseable.
+TEST_F(FloatWarning, JsonOnStdoutStaysClean) {
+  const ProcessResult r = runProxgen({"check", kUrdf, "--layout", kLayout, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("constrained_aba"), std::string::npos) << r.err;
+  EXPECT_TRUE(nlohmann::json::accept(r.out)) << r.out;
+}
+
+// Without a layout there are no constraints, no penalty and no warning.
+TEST_F(FloatWarning, NoLayoutNoWarning) {
+  const ProcessResult r = runProxgen({"check", kUrdf, "--floating"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("constrained_aba"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace proxgen
