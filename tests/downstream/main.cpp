@@ -3,6 +3,7 @@
 // same numbers to the last bit, and the Settings defaults must be the layout's.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "arm.hpp"
