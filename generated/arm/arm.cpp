@@ -11,7 +11,7 @@ namespace arm {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     w.sq_shoulder_link = std::sin(q[0]);
@@ -68,6 +68,9 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.g_forearm_link[0] = w.g_upper_arm_link[0]*w.cq_forearm_link + w.g_upper_arm_link[1]*w.sq_forearm_link;
     w.g_forearm_link[1] = -w.g_upper_arm_link[0]*w.sq_forearm_link + w.g_upper_arm_link[1]*w.cq_forearm_link;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     w.sq_wrist_1_link = std::sin(q[3]);
@@ -84,18 +87,18 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.c_wrist_1_link[1] = -v[3]*w.v_wrist_1_link[0];
     w.c_wrist_1_link[3] = v[3]*w.v_wrist_1_link[4];
     w.c_wrist_1_link[4] = -v[3]*w.v_wrist_1_link[3];
-    const Scalar h9 = 1.37*w.v_wrist_1_link[0] + 0.180155*w.v_wrist_1_link[4] + 0.0223858*w.v_wrist_1_link[5];
-    const Scalar h10 = 1.37*w.v_wrist_1_link[1] - 0.180155*w.v_wrist_1_link[3];
-    const Scalar h11 = 1.37*w.v_wrist_1_link[2] - 0.0223858*w.v_wrist_1_link[3];
-    const Scalar h12 = -0.180155*w.v_wrist_1_link[1] - 0.0223858*w.v_wrist_1_link[2] + 0.026393728972000003*w.v_wrist_1_link[3];
-    const Scalar h13 = 0.180155*w.v_wrist_1_link[0] + 0.026027945000000004*w.v_wrist_1_link[4] + 0.0029437327000000004*w.v_wrist_1_link[5];
-    const Scalar h14 = 0.0223858*w.v_wrist_1_link[0] + 0.0029437327000000004*w.v_wrist_1_link[4] + 0.0017529089719999999*w.v_wrist_1_link[5];
-    w.pA_wrist_1_link[0] = -w.v_wrist_1_link[5]*h10 + w.v_wrist_1_link[4]*h11;
-    w.pA_wrist_1_link[1] = -w.v_wrist_1_link[3]*h11 + w.v_wrist_1_link[5]*h9;
-    w.pA_wrist_1_link[2] = -w.v_wrist_1_link[4]*h9 + w.v_wrist_1_link[3]*h10;
-    w.pA_wrist_1_link[3] = -w.v_wrist_1_link[5]*h13 + w.v_wrist_1_link[4]*h14 - w.v_wrist_1_link[2]*h10 + w.v_wrist_1_link[1]*h11;
-    w.pA_wrist_1_link[4] = -w.v_wrist_1_link[3]*h14 + w.v_wrist_1_link[5]*h12 - w.v_wrist_1_link[0]*h11 + w.v_wrist_1_link[2]*h9;
-    w.pA_wrist_1_link[5] = -w.v_wrist_1_link[4]*h12 + w.v_wrist_1_link[3]*h13 - w.v_wrist_1_link[1]*h9 + w.v_wrist_1_link[0]*h10;
+    const Scalar h0 = 1.37*w.v_wrist_1_link[0] + 0.180155*w.v_wrist_1_link[4] + 0.0223858*w.v_wrist_1_link[5];
+    const Scalar h1 = 1.37*w.v_wrist_1_link[1] - 0.180155*w.v_wrist_1_link[3];
+    const Scalar h2 = 1.37*w.v_wrist_1_link[2] - 0.0223858*w.v_wrist_1_link[3];
+    const Scalar h3 = -0.180155*w.v_wrist_1_link[1] - 0.0223858*w.v_wrist_1_link[2] + 0.026393728972000003*w.v_wrist_1_link[3];
+    const Scalar h4 = 0.180155*w.v_wrist_1_link[0] + 0.026027945000000004*w.v_wrist_1_link[4] + 0.0029437327000000004*w.v_wrist_1_link[5];
+    const Scalar h5 = 0.0223858*w.v_wrist_1_link[0] + 0.0029437327000000004*w.v_wrist_1_link[4] + 0.0017529089719999999*w.v_wrist_1_link[5];
+    w.pA_wrist_1_link[0] = -w.v_wrist_1_link[5]*h1 + w.v_wrist_1_link[4]*h2;
+    w.pA_wrist_1_link[1] = -w.v_wrist_1_link[3]*h2 + w.v_wrist_1_link[5]*h0;
+    w.pA_wrist_1_link[2] = -w.v_wrist_1_link[4]*h0 + w.v_wrist_1_link[3]*h1;
+    w.pA_wrist_1_link[3] = -w.v_wrist_1_link[5]*h4 + w.v_wrist_1_link[4]*h5 - w.v_wrist_1_link[2]*h1 + w.v_wrist_1_link[1]*h2;
+    w.pA_wrist_1_link[4] = -w.v_wrist_1_link[3]*h5 + w.v_wrist_1_link[5]*h3 - w.v_wrist_1_link[0]*h2 + w.v_wrist_1_link[2]*h0;
+    w.pA_wrist_1_link[5] = -w.v_wrist_1_link[4]*h3 + w.v_wrist_1_link[3]*h4 - w.v_wrist_1_link[1]*h0 + w.v_wrist_1_link[0]*h1;
     w.g_wrist_1_link[0] = w.g_forearm_link[0]*w.cq_wrist_1_link + w.g_forearm_link[1]*w.sq_wrist_1_link;
     w.g_wrist_1_link[1] = -w.g_forearm_link[0]*w.sq_wrist_1_link + w.g_forearm_link[1]*w.cq_wrist_1_link;
   }
@@ -115,24 +118,24 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.c_wrist_2_link[1] = -v[4]*w.v_wrist_2_link[0];
     w.c_wrist_2_link[3] = v[4]*w.v_wrist_2_link[4];
     w.c_wrist_2_link[4] = -v[4]*w.v_wrist_2_link[3];
-    const Scalar h15 = 1.3*w.v_wrist_2_link[0] + 0.12727*w.v_wrist_2_link[4] - 0.021242*w.v_wrist_2_link[5];
-    const Scalar h16 = 1.3*w.v_wrist_2_link[1] - 0.12727*w.v_wrist_2_link[3];
-    const Scalar h17 = 1.3*w.v_wrist_2_link[2] + 0.021242*w.v_wrist_2_link[3];
-    const Scalar h18 = -0.12727*w.v_wrist_2_link[1] + 0.021242*w.v_wrist_2_link[2] + 0.015024952279999998*w.v_wrist_2_link[3];
-    const Scalar h19 = 0.12727*w.v_wrist_2_link[0] + 0.014677857999999998*w.v_wrist_2_link[4] - 0.0020795918*w.v_wrist_2_link[5];
-    const Scalar h20 = -0.021242*w.v_wrist_2_link[0] - 0.0020795918*w.v_wrist_2_link[4] + 0.00166334428*w.v_wrist_2_link[5];
-    w.pA_wrist_2_link[0] = -w.v_wrist_2_link[5]*h16 + w.v_wrist_2_link[4]*h17;
-    w.pA_wrist_2_link[1] = -w.v_wrist_2_link[3]*h17 + w.v_wrist_2_link[5]*h15;
-    w.pA_wrist_2_link[2] = -w.v_wrist_2_link[4]*h15 + w.v_wrist_2_link[3]*h16;
-    w.pA_wrist_2_link[3] = -w.v_wrist_2_link[5]*h19 + w.v_wrist_2_link[4]*h20 - w.v_wrist_2_link[2]*h16 + w.v_wrist_2_link[1]*h17;
-    w.pA_wrist_2_link[4] = -w.v_wrist_2_link[3]*h20 + w.v_wrist_2_link[5]*h18 - w.v_wrist_2_link[0]*h17 + w.v_wrist_2_link[2]*h15;
-    w.pA_wrist_2_link[5] = -w.v_wrist_2_link[4]*h18 + w.v_wrist_2_link[3]*h19 - w.v_wrist_2_link[1]*h15 + w.v_wrist_2_link[0]*h16;
+    const Scalar h6 = 1.3*w.v_wrist_2_link[0] + 0.12727*w.v_wrist_2_link[4] - 0.021242*w.v_wrist_2_link[5];
+    const Scalar h7 = 1.3*w.v_wrist_2_link[1] - 0.12727*w.v_wrist_2_link[3];
+    const Scalar h8 = 1.3*w.v_wrist_2_link[2] + 0.021242*w.v_wrist_2_link[3];
+    const Scalar h9 = -0.12727*w.v_wrist_2_link[1] + 0.021242*w.v_wrist_2_link[2] + 0.015024952279999998*w.v_wrist_2_link[3];
+    const Scalar h10 = 0.12727*w.v_wrist_2_link[0] + 0.014677857999999998*w.v_wrist_2_link[4] - 0.0020795918*w.v_wrist_2_link[5];
+    const Scalar h11 = -0.021242*w.v_wrist_2_link[0] - 0.0020795918*w.v_wrist_2_link[4] + 0.00166334428*w.v_wrist_2_link[5];
+    w.pA_wrist_2_link[0] = -w.v_wrist_2_link[5]*h7 + w.v_wrist_2_link[4]*h8;
+    w.pA_wrist_2_link[1] = -w.v_wrist_2_link[3]*h8 + w.v_wrist_2_link[5]*h6;
+    w.pA_wrist_2_link[2] = -w.v_wrist_2_link[4]*h6 + w.v_wrist_2_link[3]*h7;
+    w.pA_wrist_2_link[3] = -w.v_wrist_2_link[5]*h10 + w.v_wrist_2_link[4]*h11 - w.v_wrist_2_link[2]*h7 + w.v_wrist_2_link[1]*h8;
+    w.pA_wrist_2_link[4] = -w.v_wrist_2_link[3]*h11 + w.v_wrist_2_link[5]*h9 - w.v_wrist_2_link[0]*h8 + w.v_wrist_2_link[2]*h6;
+    w.pA_wrist_2_link[5] = -w.v_wrist_2_link[4]*h9 + w.v_wrist_2_link[3]*h10 - w.v_wrist_2_link[1]*h6 + w.v_wrist_2_link[0]*h7;
     w.g_wrist_2_link[0] = w.g_wrist_1_link[0]*w.cq_wrist_2_link;
     w.g_wrist_2_link[1] = -w.g_wrist_1_link[0]*w.sq_wrist_2_link;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.sq_wrist_3_link = std::sin(q[5]);
@@ -165,7 +168,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.U_wrist_3_link[5] = 0.0003695625 + mu;
@@ -210,81 +213,84 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_wrist_2_link[4] = w.pA_wrist_2_link[4] + pa5 + 0.0997*t5;
     w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq_wrist_3_link*pa3 - w.cq_wrist_3_link*pa4;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
     w.Dinv_wrist_2_link = 1.0 / w.IA_wrist_2_link[20];
     w.u_wrist_2_link[0] = -w.pA_wrist_2_link[5] + tau[4];
-    const Scalar t7 = w.IA_wrist_2_link[5]*w.Dinv_wrist_2_link;
-    const Scalar t8 = w.IA_wrist_2_link[14]*w.Dinv_wrist_2_link;
-    const Scalar t9 = w.IA_wrist_2_link[19]*w.Dinv_wrist_2_link;
-    const Scalar t10 = w.IA_wrist_2_link[20]*w.Dinv_wrist_2_link;
-    const Scalar Ia4 = w.IA_wrist_2_link[0] - w.IA_wrist_2_link[5]*t7;
-    const Scalar Ia5 = w.IA_wrist_2_link[4] - w.IA_wrist_2_link[19]*t7;
-    const Scalar Ia6 = w.IA_wrist_2_link[11] - w.IA_wrist_2_link[14]*t8;
-    const Scalar Ia7 = w.IA_wrist_2_link[18] - w.IA_wrist_2_link[19]*t9;
-    const Scalar t11 = -w.IA_wrist_2_link[14]*t7;
-    const Scalar t12 = -w.IA_wrist_2_link[19]*t8;
-    const Scalar pa6 = w.pA_wrist_2_link[0] + w.u_wrist_2_link[0]*t7 + w.c_wrist_2_link[0]*Ia4 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[3] + w.c_wrist_2_link[4]*Ia5;
-    const Scalar pa7 = w.pA_wrist_2_link[1] + w.c_wrist_2_link[1]*w.IA_wrist_2_link[6] + w.c_wrist_2_link[3]*w.IA_wrist_2_link[8];
-    const Scalar pa8 = w.pA_wrist_2_link[2] + w.u_wrist_2_link[0]*t8 + w.c_wrist_2_link[0]*t11 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[12] + w.c_wrist_2_link[4]*t12;
-    const Scalar pa9 = w.pA_wrist_2_link[3] + w.c_wrist_2_link[0]*w.IA_wrist_2_link[3] + w.c_wrist_2_link[1]*w.IA_wrist_2_link[8] + w.c_wrist_2_link[3]*w.IA_wrist_2_link[15] + w.c_wrist_2_link[4]*w.IA_wrist_2_link[16];
-    const Scalar pa10 = w.pA_wrist_2_link[4] + w.u_wrist_2_link[0]*t9 + w.c_wrist_2_link[0]*Ia5 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[16] + w.c_wrist_2_link[4]*Ia7;
-    const Scalar pa11 = w.pA_wrist_2_link[5] + w.u_wrist_2_link[0]*t10;
-    const Scalar C21 = -w.sq_wrist_2_link*w.sq_wrist_2_link + w.cq_wrist_2_link*w.cq_wrist_2_link;
-    const Scalar h0 = 0.5*(-w.IA_wrist_2_link[6] + Ia4);
-    const Scalar m0 = 0.5*(w.IA_wrist_2_link[6] + Ia4);
-    const Scalar t13 = 2.0*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    const Scalar t14 = 0.5*(w.IA_wrist_2_link[8] + Ia5);
-    const Scalar d0 = -t13*t14 + 0.5*w.IA_wrist_2_link[3]*C21;
-    const Scalar qq0 = C21*t14 + 0.5*w.IA_wrist_2_link[3]*t13;
-    const Scalar h1 = 0.5*(w.IA_wrist_2_link[15] - Ia7);
-    const Scalar m1 = 0.5*(w.IA_wrist_2_link[15] + Ia7);
-    const Scalar d1 = -w.IA_wrist_2_link[16]*t13 + C21*h1;
-    const Scalar qq1 = w.IA_wrist_2_link[16]*C21 + t13*h1;
-    const Scalar t15 = m0 + C21*h0;
-    const Scalar t16 = m0 - C21*h0;
-    const Scalar t17 = 0.5*w.IA_wrist_2_link[3] + d0;
-    const Scalar t18 = -0.5*w.IA_wrist_2_link[8] + 0.5*Ia5 + qq0;
-    const Scalar t19 = w.sq_wrist_2_link*t12 - w.cq_wrist_2_link*w.IA_wrist_2_link[12];
-    const Scalar t20 = -w.cq_wrist_2_link*t12 - w.sq_wrist_2_link*w.IA_wrist_2_link[12];
-    const Scalar t21 = 0.5*w.IA_wrist_2_link[8] - 0.5*Ia5 + qq0;
-    const Scalar t22 = 0.5*w.IA_wrist_2_link[3] - d0;
-    const Scalar t23 = 0.1333*w.cq_wrist_2_link*t11 + t17;
-    const Scalar t24 = -0.1333*Ia6 + t19;
-    const Scalar t25 = 0.1333*w.sq_wrist_2_link*t11 + t21;
-    const Scalar t26 = w.cq_wrist_2_link*pa6 - w.sq_wrist_2_link*pa7;
-    const Scalar t27 = w.sq_wrist_2_link*pa6 + w.cq_wrist_2_link*pa7;
-    w.IA_wrist_1_link[0] = 1.37 + t15;
-    w.IA_wrist_1_link[1] = -w.cq_wrist_2_link*t11;
-    w.IA_wrist_1_link[2] = h0*t13;
-    w.IA_wrist_1_link[3] = t23;
-    w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t15;
-    w.IA_wrist_1_link[5] = 0.0223858 + t18;
-    w.IA_wrist_1_link[6] = 1.37 + Ia6;
-    w.IA_wrist_1_link[7] = -w.sq_wrist_2_link*t11;
-    w.IA_wrist_1_link[8] = -0.180155 + t24;
-    w.IA_wrist_1_link[9] = -0.1333*w.cq_wrist_2_link*t11;
-    w.IA_wrist_1_link[10] = t20;
-    w.IA_wrist_1_link[11] = 1.37 + t16;
-    w.IA_wrist_1_link[12] = -0.0223858 + t25;
-    w.IA_wrist_1_link[13] = 0.1333*h0*t13;
-    w.IA_wrist_1_link[14] = t22;
-    w.IA_wrist_1_link[15] = 0.026393728972000003 + m1 + d1 - 0.1333*t19 - 0.1333*t24;
-    w.IA_wrist_1_link[16] = 0.01776889*w.cq_wrist_2_link*t11 + 0.1333*t17;
-    w.IA_wrist_1_link[17] = qq1 - 0.1333*t20;
-    w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t15;
-    w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t18;
+    const Scalar t0 = w.IA_wrist_2_link[5]*w.Dinv_wrist_2_link;
+    const Scalar t1 = w.IA_wrist_2_link[14]*w.Dinv_wrist_2_link;
+    const Scalar t2 = w.IA_wrist_2_link[19]*w.Dinv_wrist_2_link;
+    const Scalar t3 = w.IA_wrist_2_link[20]*w.Dinv_wrist_2_link;
+    const Scalar Ia0 = w.IA_wrist_2_link[0] - w.IA_wrist_2_link[5]*t0;
+    const Scalar Ia1 = w.IA_wrist_2_link[4] - w.IA_wrist_2_link[19]*t0;
+    const Scalar Ia2 = w.IA_wrist_2_link[11] - w.IA_wrist_2_link[14]*t1;
+    const Scalar Ia3 = w.IA_wrist_2_link[18] - w.IA_wrist_2_link[19]*t2;
+    const Scalar t4 = -w.IA_wrist_2_link[14]*t0;
+    const Scalar t5 = -w.IA_wrist_2_link[19]*t1;
+    const Scalar pa0 = w.pA_wrist_2_link[0] + w.u_wrist_2_link[0]*t0 + w.c_wrist_2_link[0]*Ia0 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[3] + w.c_wrist_2_link[4]*Ia1;
+    const Scalar pa1 = w.pA_wrist_2_link[1] + w.c_wrist_2_link[1]*w.IA_wrist_2_link[6] + w.c_wrist_2_link[3]*w.IA_wrist_2_link[8];
+    const Scalar pa2 = w.pA_wrist_2_link[2] + w.u_wrist_2_link[0]*t1 + w.c_wrist_2_link[0]*t4 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[12] + w.c_wrist_2_link[4]*t5;
+    const Scalar pa3 = w.pA_wrist_2_link[3] + w.c_wrist_2_link[0]*w.IA_wrist_2_link[3] + w.c_wrist_2_link[1]*w.IA_wrist_2_link[8] + w.c_wrist_2_link[3]*w.IA_wrist_2_link[15] + w.c_wrist_2_link[4]*w.IA_wrist_2_link[16];
+    const Scalar pa4 = w.pA_wrist_2_link[4] + w.u_wrist_2_link[0]*t2 + w.c_wrist_2_link[0]*Ia1 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[16] + w.c_wrist_2_link[4]*Ia3;
+    const Scalar pa5 = w.pA_wrist_2_link[5] + w.u_wrist_2_link[0]*t3;
+    const Scalar C20 = -w.sq_wrist_2_link*w.sq_wrist_2_link + w.cq_wrist_2_link*w.cq_wrist_2_link;
+    const Scalar h0 = 0.5*(-w.IA_wrist_2_link[6] + Ia0);
+    const Scalar m0 = 0.5*(w.IA_wrist_2_link[6] + Ia0);
+    const Scalar t6 = 2.0*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    const Scalar t7 = 0.5*(w.IA_wrist_2_link[8] + Ia1);
+    const Scalar d0 = -t6*t7 + 0.5*w.IA_wrist_2_link[3]*C20;
+    const Scalar qq0 = C20*t7 + 0.5*w.IA_wrist_2_link[3]*t6;
+    const Scalar h1 = 0.5*(w.IA_wrist_2_link[15] - Ia3);
+    const Scalar m1 = 0.5*(w.IA_wrist_2_link[15] + Ia3);
+    const Scalar d1 = -w.IA_wrist_2_link[16]*t6 + C20*h1;
+    const Scalar qq1 = w.IA_wrist_2_link[16]*C20 + t6*h1;
+    const Scalar t8 = m0 + C20*h0;
+    const Scalar t9 = m0 - C20*h0;
+    const Scalar t10 = 0.5*w.IA_wrist_2_link[3] + d0;
+    const Scalar t11 = -0.5*w.IA_wrist_2_link[8] + 0.5*Ia1 + qq0;
+    const Scalar t12 = w.sq_wrist_2_link*t5 - w.cq_wrist_2_link*w.IA_wrist_2_link[12];
+    const Scalar t13 = -w.cq_wrist_2_link*t5 - w.sq_wrist_2_link*w.IA_wrist_2_link[12];
+    const Scalar t14 = 0.5*w.IA_wrist_2_link[8] - 0.5*Ia1 + qq0;
+    const Scalar t15 = 0.5*w.IA_wrist_2_link[3] - d0;
+    const Scalar t16 = 0.1333*w.cq_wrist_2_link*t4 + t10;
+    const Scalar t17 = -0.1333*Ia2 + t12;
+    const Scalar t18 = 0.1333*w.sq_wrist_2_link*t4 + t14;
+    const Scalar t19 = w.cq_wrist_2_link*pa0 - w.sq_wrist_2_link*pa1;
+    const Scalar t20 = w.sq_wrist_2_link*pa0 + w.cq_wrist_2_link*pa1;
+    w.IA_wrist_1_link[0] = 1.37 + t8;
+    w.IA_wrist_1_link[1] = -w.cq_wrist_2_link*t4;
+    w.IA_wrist_1_link[2] = h0*t6;
+    w.IA_wrist_1_link[3] = t16;
+    w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t8;
+    w.IA_wrist_1_link[5] = 0.0223858 + t11;
+    w.IA_wrist_1_link[6] = 1.37 + Ia2;
+    w.IA_wrist_1_link[7] = -w.sq_wrist_2_link*t4;
+    w.IA_wrist_1_link[8] = -0.180155 + t17;
+    w.IA_wrist_1_link[9] = -0.1333*w.cq_wrist_2_link*t4;
+    w.IA_wrist_1_link[10] = t13;
+    w.IA_wrist_1_link[11] = 1.37 + t9;
+    w.IA_wrist_1_link[12] = -0.0223858 + t18;
+    w.IA_wrist_1_link[13] = 0.1333*h0*t6;
+    w.IA_wrist_1_link[14] = t15;
+    w.IA_wrist_1_link[15] = 0.026393728972000003 + m1 + d1 - 0.1333*t12 - 0.1333*t17;
+    w.IA_wrist_1_link[16] = 0.01776889*w.cq_wrist_2_link*t4 + 0.1333*t10;
+    w.IA_wrist_1_link[17] = qq1 - 0.1333*t13;
+    w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t8;
+    w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t11;
     w.IA_wrist_1_link[20] = 0.0017529089719999999 + m1 - d1;
-    w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t26;
-    w.pA_wrist_1_link[1] = w.pA_wrist_1_link[1] - pa8;
-    w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t27;
-    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa8 + w.cq_wrist_2_link*pa9 - w.sq_wrist_2_link*pa10;
-    w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - pa11 + 0.1333*t26;
-    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa9 + w.cq_wrist_2_link*pa10;
+    w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t19;
+    w.pA_wrist_1_link[1] = w.pA_wrist_1_link[1] - pa2;
+    w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t20;
+    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa2 + w.cq_wrist_2_link*pa3 - w.sq_wrist_2_link*pa4;
+    w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - pa5 + 0.1333*t19;
+    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa3 + w.cq_wrist_2_link*pa4;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     w.Dinv_wrist_1_link = 1.0 / w.IA_wrist_1_link[20];
@@ -376,7 +382,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     w.Dinv_forearm_link = 1.0 / w.IA_forearm_link[20];
@@ -468,7 +474,7 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
     w.Dinv_upper_arm_link = 1.0 / w.IA_upper_arm_link[20];
@@ -560,7 +566,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
@@ -580,8 +586,8 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
-    w.a_upper_arm_link[3] = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    w.a_upper_arm_link[4] = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    w.a_upper_arm_link[3] = t1;
+    w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
   }
   // accelerate body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
@@ -593,11 +599,11 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noex
     const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
-    w.a_forearm_link[0] = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    w.a_forearm_link[1] = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
+    w.a_forearm_link[0] = t5;
+    w.a_forearm_link[1] = t6;
     w.a_forearm_link[2] = 0.425*w.a_upper_arm_link[4];
-    w.a_forearm_link[3] = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    w.a_forearm_link[4] = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    w.a_forearm_link[3] = t7;
+    w.a_forearm_link[4] = t8;
     w.a_forearm_link[5] = w.a_upper_arm_link[5] + w.qdd[2];
   }
   // accelerate body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
@@ -610,62 +616,71 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noex
     const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
-    w.a_wrist_1_link[0] = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    w.a_wrist_1_link[1] = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
+    w.a_wrist_1_link[0] = t12;
+    w.a_wrist_1_link[1] = t13;
     w.a_wrist_1_link[2] = t11;
-    w.a_wrist_1_link[3] = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    w.a_wrist_1_link[4] = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    w.a_wrist_1_link[3] = t14;
+    w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.qdd[3];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
-    const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t20 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t21 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t19 - w.IA_wrist_2_link[14]*t18 - w.IA_wrist_2_link[19]*t20 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
-    w.qdd[4] = w.Dinv_wrist_2_link*t21;
-    w.a_wrist_2_link[0] = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[1] = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[2] = t18;
-    w.a_wrist_2_link[3] = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    w.a_wrist_2_link[4] = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t0 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
+    const Scalar t1 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
+    const Scalar t2 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.sq_wrist_2_link;
+    const Scalar t3 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.cq_wrist_2_link;
+    const Scalar t4 = w.c_wrist_2_link[3] + w.a_wrist_1_link[3]*w.cq_wrist_2_link + w.a_wrist_1_link[5]*w.sq_wrist_2_link;
+    const Scalar t5 = w.c_wrist_2_link[4] - w.a_wrist_1_link[3]*w.sq_wrist_2_link + w.a_wrist_1_link[5]*w.cq_wrist_2_link;
+    const Scalar t6 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t2 - w.IA_wrist_2_link[14]*t1 - w.IA_wrist_2_link[19]*t5 + w.a_wrist_1_link[4]*w.IA_wrist_2_link[20];
+    w.qdd[4] = w.Dinv_wrist_2_link*t6;
+    w.a_wrist_2_link[0] = t2;
+    w.a_wrist_2_link[1] = t3;
+    w.a_wrist_2_link[2] = t1;
+    w.a_wrist_2_link[3] = t4;
+    w.a_wrist_2_link[4] = t5;
     w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.qdd[4];
   }
   // accelerate body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t22 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t23 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t24 = w.u_wrist_3_link[0] - w.U_wrist_3_link[5]*w.a_wrist_2_link[4];
-    w.qdd[5] = w.Dinv_wrist_3_link*t24;
-    w.a_wrist_3_link[0] = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t22 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[1] = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t22 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[2] = t23;
-    w.a_wrist_3_link[3] = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    w.a_wrist_3_link[4] = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t7 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t8 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t9 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t7 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
+    const Scalar t10 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t7 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
+    const Scalar t11 = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t12 = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t13 = w.u_wrist_3_link[0] - w.U_wrist_3_link[5]*w.a_wrist_2_link[4];
+    w.qdd[5] = w.Dinv_wrist_3_link*t13;
+    w.a_wrist_3_link[0] = t9;
+    w.a_wrist_3_link[1] = t10;
+    w.a_wrist_3_link[2] = t8;
+    w.a_wrist_3_link[3] = t11;
+    w.a_wrist_3_link[4] = t12;
     w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.qdd[5];
   }
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t25 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.dlambda[0] = mu*t25;
+    const Scalar t14 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
+    w.dlambda[0] = t14*mu;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t26 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.dlambda[1] = mu*t26;
+    const Scalar t15 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
+    w.dlambda[1] = mu*t15;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t27 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t27;
+    const Scalar t16 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*t16;
     w.lambda[2] = w.dlambda[2];
-    w.dlambda[3] = mu*w.a_wrist_3_link[3];
+    w.dlambda[3] = w.a_wrist_3_link[3]*mu;
     w.lambda[3] = w.dlambda[3];
-    w.dlambda[4] = mu*w.a_wrist_3_link[4];
+    w.dlambda[4] = w.a_wrist_3_link[4]*mu;
     w.lambda[4] = w.dlambda[4];
-    w.dlambda[5] = mu*w.a_wrist_3_link[5];
+    w.dlambda[5] = w.a_wrist_3_link[5]*mu;
     w.lambda[5] = w.dlambda[5];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_7(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.u_wrist_3_link[0] = w.u_wrist_3_link[0] - w.dlambda[5];
@@ -718,43 +733,46 @@ PROXGEN_RT_NOINLINE void caba_5(Workspace& w) noexcept {
     w.dp_forearm_link[4] = 0.3922*t16 + w.sq_wrist_1_link*t17 + w.cq_wrist_1_link*t18;
     w.dp_forearm_link[5] = t19 - 0.3922*t21;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_8(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    w.u_forearm_link[0] = w.u_forearm_link[0] - w.dp_forearm_link[5];
-    const Scalar t22 = -w.Dinv_forearm_link*w.dp_forearm_link[5];
-    const Scalar t23 = w.dp_forearm_link[0] + w.IA_forearm_link[5]*t22;
-    const Scalar t24 = w.dp_forearm_link[1] + w.IA_forearm_link[10]*t22;
-    const Scalar t25 = w.dp_forearm_link[2] + w.IA_forearm_link[14]*t22;
-    const Scalar t26 = w.dp_forearm_link[3] + w.IA_forearm_link[17]*t22;
-    const Scalar t27 = w.dp_forearm_link[4] + w.IA_forearm_link[19]*t22;
-    const Scalar t28 = w.dp_forearm_link[5] + w.IA_forearm_link[20]*t22;
-    const Scalar t29 = w.cq_forearm_link*t23 - w.sq_forearm_link*t24;
-    const Scalar t30 = w.sq_forearm_link*t23 + w.cq_forearm_link*t24;
-    w.dp_upper_arm_link[0] = t29;
-    w.dp_upper_arm_link[1] = t30;
-    w.dp_upper_arm_link[2] = t25;
-    w.dp_upper_arm_link[3] = w.cq_forearm_link*t26 - w.sq_forearm_link*t27;
-    w.dp_upper_arm_link[4] = 0.425*t25 + w.sq_forearm_link*t26 + w.cq_forearm_link*t27;
-    w.dp_upper_arm_link[5] = t28 - 0.425*t30;
+    w.u_forearm_link[0] = -w.dp_forearm_link[5] + w.u_forearm_link[0];
+    const Scalar t0 = -w.dp_forearm_link[5]*w.Dinv_forearm_link;
+    const Scalar t1 = w.dp_forearm_link[0] + w.IA_forearm_link[5]*t0;
+    const Scalar t2 = w.dp_forearm_link[1] + w.IA_forearm_link[10]*t0;
+    const Scalar t3 = w.dp_forearm_link[2] + w.IA_forearm_link[14]*t0;
+    const Scalar t4 = w.dp_forearm_link[3] + w.IA_forearm_link[17]*t0;
+    const Scalar t5 = w.dp_forearm_link[4] + w.IA_forearm_link[19]*t0;
+    const Scalar t6 = w.dp_forearm_link[5] + w.IA_forearm_link[20]*t0;
+    const Scalar t7 = w.cq_forearm_link*t1 - w.sq_forearm_link*t2;
+    const Scalar t8 = w.sq_forearm_link*t1 + w.cq_forearm_link*t2;
+    w.dp_upper_arm_link[0] = t7;
+    w.dp_upper_arm_link[1] = t8;
+    w.dp_upper_arm_link[2] = t3;
+    w.dp_upper_arm_link[3] = w.cq_forearm_link*t4 - w.sq_forearm_link*t5;
+    w.dp_upper_arm_link[4] = 0.425*t3 + w.sq_forearm_link*t4 + w.cq_forearm_link*t5;
+    w.dp_upper_arm_link[5] = t6 - 0.425*t8;
   }
   // reduced sweep: body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
     w.u_upper_arm_link[0] = w.u_upper_arm_link[0] - w.dp_upper_arm_link[5];
-    const Scalar t31 = -w.Dinv_upper_arm_link*w.dp_upper_arm_link[5];
-    const Scalar t32 = w.dp_upper_arm_link[0] + w.IA_upper_arm_link[5]*t31;
-    const Scalar t33 = w.dp_upper_arm_link[1] + w.IA_upper_arm_link[10]*t31;
-    const Scalar t34 = w.dp_upper_arm_link[2] + w.IA_upper_arm_link[14]*t31;
-    const Scalar t35 = w.dp_upper_arm_link[3] + w.IA_upper_arm_link[17]*t31;
-    const Scalar t36 = w.dp_upper_arm_link[4] + w.IA_upper_arm_link[19]*t31;
-    const Scalar t37 = w.dp_upper_arm_link[5] + w.IA_upper_arm_link[20]*t31;
-    const Scalar t38 = w.cq_upper_arm_link*t32 - w.sq_upper_arm_link*t33;
-    const Scalar t39 = w.sq_upper_arm_link*t32 + w.cq_upper_arm_link*t33;
-    w.dp_shoulder_link[0] = t38;
-    w.dp_shoulder_link[1] = -t34;
-    w.dp_shoulder_link[2] = t39;
-    w.dp_shoulder_link[3] = 0.1625*t34 + w.cq_upper_arm_link*t35 - w.sq_upper_arm_link*t36;
-    w.dp_shoulder_link[4] = -t37 + 0.1625*t38;
-    w.dp_shoulder_link[5] = w.sq_upper_arm_link*t35 + w.cq_upper_arm_link*t36;
+    const Scalar t9 = -w.Dinv_upper_arm_link*w.dp_upper_arm_link[5];
+    const Scalar t10 = w.dp_upper_arm_link[0] + w.IA_upper_arm_link[5]*t9;
+    const Scalar t11 = w.dp_upper_arm_link[1] + w.IA_upper_arm_link[10]*t9;
+    const Scalar t12 = w.dp_upper_arm_link[2] + w.IA_upper_arm_link[14]*t9;
+    const Scalar t13 = w.dp_upper_arm_link[3] + w.IA_upper_arm_link[17]*t9;
+    const Scalar t14 = w.dp_upper_arm_link[4] + w.IA_upper_arm_link[19]*t9;
+    const Scalar t15 = w.dp_upper_arm_link[5] + w.IA_upper_arm_link[20]*t9;
+    const Scalar t16 = w.cq_upper_arm_link*t10 - w.sq_upper_arm_link*t11;
+    const Scalar t17 = w.sq_upper_arm_link*t10 + w.cq_upper_arm_link*t11;
+    w.dp_shoulder_link[0] = t16;
+    w.dp_shoulder_link[1] = -t12;
+    w.dp_shoulder_link[2] = t17;
+    w.dp_shoulder_link[3] = 0.1625*t12 + w.cq_upper_arm_link*t13 - w.sq_upper_arm_link*t14;
+    w.dp_shoulder_link[4] = -t15 + 0.1625*t16;
+    w.dp_shoulder_link[5] = w.sq_upper_arm_link*t13 + w.cq_upper_arm_link*t14;
   }
   // reduced sweep: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
@@ -762,25 +780,25 @@ PROXGEN_RT_NOINLINE void caba_5(Workspace& w) noexcept {
   }
   // accelerate body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    const Scalar t40 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
-    w.qdd[0] = w.Dinv_shoulder_link*t40;
+    const Scalar t18 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
+    w.qdd[0] = w.Dinv_shoulder_link*t18;
     w.a_shoulder_link[5] = w.qdd[0];
   }
   // accelerate body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t41 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t42 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t43 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t41 - w.IA_upper_arm_link[19]*t42;
-    w.qdd[1] = w.Dinv_upper_arm_link*t43;
+    const Scalar t19 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
+    const Scalar t20 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    const Scalar t21 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t19 - w.IA_upper_arm_link[19]*t20;
+    w.qdd[1] = w.Dinv_upper_arm_link*t21;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
-    w.a_upper_arm_link[3] = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    w.a_upper_arm_link[4] = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    w.a_upper_arm_link[3] = t19;
+    w.a_upper_arm_link[4] = t20;
     w.a_upper_arm_link[5] = w.qdd[1];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     const Scalar t0 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
@@ -790,11 +808,11 @@ PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& w) noexcept {
     const Scalar t4 = w.c_forearm_link[4] - w.a_upper_arm_link[3]*w.sq_forearm_link + w.a_upper_arm_link[4]*w.cq_forearm_link;
     const Scalar t5 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t1 - w.IA_forearm_link[10]*t2 - 0.425*w.a_upper_arm_link[4]*w.IA_forearm_link[14] - w.IA_forearm_link[17]*t3 - w.IA_forearm_link[19]*t4 - w.a_upper_arm_link[5]*w.IA_forearm_link[20];
     w.qdd[2] = w.Dinv_forearm_link*t5;
-    w.a_forearm_link[0] = w.c_forearm_link[0] + w.a_upper_arm_link[0]*w.cq_forearm_link + w.sq_forearm_link*t0;
-    w.a_forearm_link[1] = w.c_forearm_link[1] - w.a_upper_arm_link[0]*w.sq_forearm_link + w.cq_forearm_link*t0;
+    w.a_forearm_link[0] = t1;
+    w.a_forearm_link[1] = t2;
     w.a_forearm_link[2] = 0.425*w.a_upper_arm_link[4];
-    w.a_forearm_link[3] = w.c_forearm_link[3] + w.a_upper_arm_link[3]*w.cq_forearm_link + w.a_upper_arm_link[4]*w.sq_forearm_link;
-    w.a_forearm_link[4] = w.c_forearm_link[4] - w.a_upper_arm_link[3]*w.sq_forearm_link + w.a_upper_arm_link[4]*w.cq_forearm_link;
+    w.a_forearm_link[3] = t3;
+    w.a_forearm_link[4] = t4;
     w.a_forearm_link[5] = w.a_upper_arm_link[5] + w.qdd[2];
   }
   // accelerate body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
@@ -807,11 +825,11 @@ PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& w) noexcept {
     const Scalar t11 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t12 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t8 - w.IA_wrist_1_link[10]*t9 - w.IA_wrist_1_link[14]*t7 - w.IA_wrist_1_link[17]*t10 - w.IA_wrist_1_link[19]*t11 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t12;
-    w.a_wrist_1_link[0] = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t6;
-    w.a_wrist_1_link[1] = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t6;
+    w.a_wrist_1_link[0] = t8;
+    w.a_wrist_1_link[1] = t9;
     w.a_wrist_1_link[2] = t7;
-    w.a_wrist_1_link[3] = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    w.a_wrist_1_link[4] = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    w.a_wrist_1_link[3] = t10;
+    w.a_wrist_1_link[4] = t11;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.qdd[3];
   }
   // accelerate body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
@@ -819,39 +837,48 @@ PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& w) noexcept {
     const Scalar t13 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t14 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
     const Scalar t15 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t13 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t16 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t17 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t15 - w.IA_wrist_2_link[14]*t14 - w.IA_wrist_2_link[19]*t16 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
-    w.qdd[4] = w.Dinv_wrist_2_link*t17;
-    w.a_wrist_2_link[0] = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t13 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[1] = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t13 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t16 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t13 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t17 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t18 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t19 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t15 - w.IA_wrist_2_link[14]*t14 - w.IA_wrist_2_link[19]*t18 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
+    w.qdd[4] = w.Dinv_wrist_2_link*t19;
+    w.a_wrist_2_link[0] = t15;
+    w.a_wrist_2_link[1] = t16;
     w.a_wrist_2_link[2] = t14;
-    w.a_wrist_2_link[3] = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    w.a_wrist_2_link[4] = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    w.a_wrist_2_link[3] = t17;
+    w.a_wrist_2_link[4] = t18;
     w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.qdd[4];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_10(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t18 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t19 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t20 = w.u_wrist_3_link[0] - w.U_wrist_3_link[5]*w.a_wrist_2_link[4];
-    w.qdd[5] = w.Dinv_wrist_3_link*t20;
-    w.a_wrist_3_link[0] = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t18 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[1] = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t18 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[2] = t19;
-    w.a_wrist_3_link[3] = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    w.a_wrist_3_link[4] = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t6 = w.u_wrist_3_link[0] - w.a_wrist_2_link[4]*w.U_wrist_3_link[5];
+    w.qdd[5] = w.Dinv_wrist_3_link*t6;
+    w.a_wrist_3_link[0] = t2;
+    w.a_wrist_3_link[1] = t3;
+    w.a_wrist_3_link[2] = t1;
+    w.a_wrist_3_link[3] = t4;
+    w.a_wrist_3_link[4] = t5;
     w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.qdd[5];
   }
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t21 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.dlambda[0] = t21*mu;
+    const Scalar t7 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
+    w.dlambda[0] = t7*mu;
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t22 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.dlambda[1] = mu*t22;
+    const Scalar t8 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
+    w.dlambda[1] = mu*t8;
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t23 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t23;
+    const Scalar t9 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*t9;
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
     w.dlambda[3] = w.a_wrist_3_link[3]*mu;
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
@@ -862,7 +889,7 @@ PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.Dinv_wrist_3_link = 1.0 / 0.0003695625;
@@ -987,7 +1014,7 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     w.Dinv_wrist_1_link = 1.0 / w.IA_wrist_1_link[20];
@@ -1149,7 +1176,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     w.Dinv_forearm_link = 1.0 / w.IA_forearm_link[20];
@@ -1311,7 +1338,7 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
     w.Dinv_upper_arm_link = 1.0 / w.IA_upper_arm_link[20];
@@ -1473,7 +1500,7 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
@@ -1496,8 +1523,8 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
     const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
-    w.a_upper_arm_link[3] = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    w.a_upper_arm_link[4] = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    w.a_upper_arm_link[3] = t1;
+    w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.Dinv_upper_arm_link*t3;
   }
   // free acceleration (lambda = 0): body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
@@ -1508,11 +1535,11 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
     const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
     const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
-    w.a_forearm_link[0] = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    w.a_forearm_link[1] = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
+    w.a_forearm_link[0] = t5;
+    w.a_forearm_link[1] = t6;
     w.a_forearm_link[2] = 0.425*w.a_upper_arm_link[4];
-    w.a_forearm_link[3] = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    w.a_forearm_link[4] = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    w.a_forearm_link[3] = t7;
+    w.a_forearm_link[4] = t8;
     w.a_forearm_link[5] = w.a_upper_arm_link[5] + w.Dinv_forearm_link*t9;
   }
   // free acceleration (lambda = 0): body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
@@ -1524,36 +1551,47 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
     const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
-    w.a_wrist_1_link[0] = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    w.a_wrist_1_link[1] = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
+    w.a_wrist_1_link[0] = t12;
+    w.a_wrist_1_link[1] = t13;
     w.a_wrist_1_link[2] = t11;
-    w.a_wrist_1_link[3] = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    w.a_wrist_1_link[4] = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    w.a_wrist_1_link[3] = t14;
+    w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.Dinv_wrist_1_link*t16;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
-    const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = 0.057172965000000006*w.c_wrist_2_link[0] + 0.0056619090105*w.c_wrist_2_link[4] + w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - 0.0056619090105*w.sq_wrist_2_link*w.a_wrist_1_link[3] + 0.0056619090105*w.cq_wrist_2_link*w.a_wrist_1_link[5] + 0.057172965000000006*w.cq_wrist_2_link*t17 + 0.057172965000000006*w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[0] = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[1] = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[2] = t18;
-    w.a_wrist_2_link[3] = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    w.a_wrist_2_link[4] = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
-    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.Dinv_wrist_2_link*t19;
+    const Scalar t0 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
+    const Scalar t1 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
+    const Scalar t2 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.sq_wrist_2_link;
+    const Scalar t3 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.cq_wrist_2_link;
+    const Scalar t4 = w.c_wrist_2_link[3] + w.a_wrist_1_link[3]*w.cq_wrist_2_link + w.a_wrist_1_link[5]*w.sq_wrist_2_link;
+    const Scalar t5 = w.c_wrist_2_link[4] - w.a_wrist_1_link[3]*w.sq_wrist_2_link + w.a_wrist_1_link[5]*w.cq_wrist_2_link;
+    const Scalar t6 = 0.005433872322232001*w.a_wrist_1_link[4] + w.u_wrist_2_link[0] + 0.057172965000000006*t2 + 0.0056619090105*t5;
+    w.a_wrist_2_link[0] = t2;
+    w.a_wrist_2_link[1] = t3;
+    w.a_wrist_2_link[2] = t1;
+    w.a_wrist_2_link[3] = t4;
+    w.a_wrist_2_link[4] = t5;
+    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.Dinv_wrist_2_link*t6;
   }
   // free acceleration (lambda = 0): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t20 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t21 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t22 = w.u_wrist_3_link[0] - 0.0003695625*w.a_wrist_2_link[4];
-    w.a_wrist_3_link[0] = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t20 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[1] = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t20 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[2] = t21;
-    w.a_wrist_3_link[3] = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    w.a_wrist_3_link[4] = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
-    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.Dinv_wrist_3_link*t22;
+    const Scalar t7 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t8 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t9 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t7 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
+    const Scalar t10 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t7 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
+    const Scalar t11 = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t12 = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t13 = w.u_wrist_3_link[0] - 0.0003695625*w.a_wrist_2_link[4];
+    w.a_wrist_3_link[0] = t9;
+    w.a_wrist_3_link[1] = t10;
+    w.a_wrist_3_link[2] = t8;
+    w.a_wrist_3_link[3] = t11;
+    w.a_wrist_3_link[4] = t12;
+    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.Dinv_wrist_3_link*t13;
   }
   // free row accelerations y_free = K a - k (tree order)
   {
@@ -1566,7 +1604,7 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_6(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = inv_mu + w.KSD_shoulder_link[0]*w.KA_shoulder_link[5] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[5] + w.KSD_forearm_link[0]*w.KA_forearm_link[5] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[5] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[5];
@@ -1622,12 +1660,15 @@ PROXGEN_RT_NOINLINE void pv_5(Scalar inv_mu, Workspace& w) noexcept {
     const Scalar inv4 = 1.0 / r4;
     w.Linv[4] = inv4;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_7(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t15 = w.Dinv_wrist_3_link + inv_mu;
-    const Scalar r5 = std::sqrt(t15);
-    const Scalar inv5 = 1.0 / r5;
-    w.Linv[5] = inv5;
+    const Scalar t0 = w.Dinv_wrist_3_link + inv_mu;
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[5] = inv0;
   }
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
@@ -1637,7 +1678,7 @@ PROXGEN_RT_NOINLINE void pv_5(Scalar inv_mu, Workspace& w) noexcept {
   w.lambda[5] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_6(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -1666,7 +1707,7 @@ PROXGEN_RT_NOINLINE void pv_6(Scalar inv_mu, Workspace& w) noexcept {
   w.lambda[5] = w.Linv[5]*t10;
 }
 
-PROXGEN_RT_NOINLINE void pv_7(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0] - w.KA_shoulder_link[5]*w.lambda[0] - w.KA_shoulder_link[11]*w.lambda[1] - w.KA_shoulder_link[17]*w.lambda[2] - w.KA_shoulder_link[23]*w.lambda[3] - w.KA_shoulder_link[29]*w.lambda[4];
@@ -1681,8 +1722,8 @@ PROXGEN_RT_NOINLINE void pv_7(Workspace& w) noexcept {
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
-    w.a_upper_arm_link[3] = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    w.a_upper_arm_link[4] = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    w.a_upper_arm_link[3] = t1;
+    w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
   }
   // accelerate, with the multipliers of the subtree rows: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
@@ -1694,11 +1735,11 @@ PROXGEN_RT_NOINLINE void pv_7(Workspace& w) noexcept {
     const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.KA_forearm_link[5]*w.lambda[0] - w.KA_forearm_link[11]*w.lambda[1] - w.KA_forearm_link[17]*w.lambda[2] - w.KA_forearm_link[23]*w.lambda[3] - w.KA_forearm_link[29]*w.lambda[4] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
-    w.a_forearm_link[0] = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    w.a_forearm_link[1] = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
+    w.a_forearm_link[0] = t5;
+    w.a_forearm_link[1] = t6;
     w.a_forearm_link[2] = 0.425*w.a_upper_arm_link[4];
-    w.a_forearm_link[3] = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    w.a_forearm_link[4] = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    w.a_forearm_link[3] = t7;
+    w.a_forearm_link[4] = t8;
     w.a_forearm_link[5] = w.a_upper_arm_link[5] + w.qdd[2];
   }
   // accelerate, with the multipliers of the subtree rows: body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
@@ -1711,37 +1752,48 @@ PROXGEN_RT_NOINLINE void pv_7(Workspace& w) noexcept {
     const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.KA_wrist_1_link[5]*w.lambda[0] - w.KA_wrist_1_link[11]*w.lambda[1] - w.KA_wrist_1_link[17]*w.lambda[2] - w.KA_wrist_1_link[23]*w.lambda[3] - w.KA_wrist_1_link[29]*w.lambda[4] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
-    w.a_wrist_1_link[0] = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    w.a_wrist_1_link[1] = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
+    w.a_wrist_1_link[0] = t12;
+    w.a_wrist_1_link[1] = t13;
     w.a_wrist_1_link[2] = t11;
-    w.a_wrist_1_link[3] = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    w.a_wrist_1_link[4] = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    w.a_wrist_1_link[3] = t14;
+    w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.qdd[3];
   }
   // accelerate, with the multipliers of the subtree rows: body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
     const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = 0.057172965000000006*w.c_wrist_2_link[0] + 0.0056619090105*w.c_wrist_2_link[4] + w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - w.KA_wrist_2_link[5]*w.lambda[0] - w.KA_wrist_2_link[11]*w.lambda[1] - w.KA_wrist_2_link[23]*w.lambda[3] - w.KA_wrist_2_link[29]*w.lambda[4] - 0.0056619090105*w.sq_wrist_2_link*w.a_wrist_1_link[3] + 0.0056619090105*w.cq_wrist_2_link*w.a_wrist_1_link[5] + 0.057172965000000006*w.cq_wrist_2_link*t17 + 0.057172965000000006*w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.qdd[4] = w.Dinv_wrist_2_link*t19;
-    w.a_wrist_2_link[0] = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    w.a_wrist_2_link[1] = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - w.KA_wrist_2_link[5]*w.lambda[0] - w.KA_wrist_2_link[11]*w.lambda[1] - w.KA_wrist_2_link[23]*w.lambda[3] - w.KA_wrist_2_link[29]*w.lambda[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
+    w.qdd[4] = w.Dinv_wrist_2_link*t23;
+    w.a_wrist_2_link[0] = t19;
+    w.a_wrist_2_link[1] = t20;
     w.a_wrist_2_link[2] = t18;
-    w.a_wrist_2_link[3] = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    w.a_wrist_2_link[4] = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    w.a_wrist_2_link[3] = t21;
+    w.a_wrist_2_link[4] = t22;
     w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.qdd[4];
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_10(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t20 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t21 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t22 = w.u_wrist_3_link[0] - w.lambda[5] - 0.0003695625*w.a_wrist_2_link[4];
-    w.qdd[5] = w.Dinv_wrist_3_link*t22;
-    w.a_wrist_3_link[0] = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t20 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[1] = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t20 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    w.a_wrist_3_link[2] = t21;
-    w.a_wrist_3_link[3] = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    w.a_wrist_3_link[4] = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
+    const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t6 = -0.0003695625*w.a_wrist_2_link[4] + w.u_wrist_3_link[0] - w.lambda[5];
+    w.qdd[5] = w.Dinv_wrist_3_link*t6;
+    w.a_wrist_3_link[0] = t2;
+    w.a_wrist_3_link[1] = t3;
+    w.a_wrist_3_link[2] = t1;
+    w.a_wrist_3_link[3] = t4;
+    w.a_wrist_3_link[4] = t5;
     w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.qdd[5];
   }
 }
@@ -1751,6 +1803,7 @@ PROXGEN_RT_NOINLINE void pv_7(Workspace& w) noexcept {
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   kinematics_0(q, v, w);
   kinematics_1(q, v, w);
+  kinematics_2(q, v, w);
 }
 
 // Articulated-body elimination of the bodies off the constraint support
@@ -1778,11 +1831,15 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   caba_1(tau, w);
   caba_2(tau, w);
   caba_3(tau, w);
-  caba_4(tau, mu, w);
+  caba_4(tau, w);
+  caba_5(tau, w);
+  caba_6(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_5(w);
-    caba_6(mu, w);
+    caba_7(w);
+    caba_8(w);
+    caba_9(w);
+    caba_10(mu, w);
   }
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
@@ -1810,13 +1867,16 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_2(tau, w);
   pv_3(tau, w);
   pv_4(tau, w);
+  pv_5(w);
   const Scalar inv_mu = 1.0 / s.mu;
-  pv_5(inv_mu, w);
+  pv_6(inv_mu, w);
+  pv_7(inv_mu, w);
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
-    pv_6(inv_mu, w);
+    pv_8(inv_mu, w);
   }
-  pv_7(w);
+  pv_9(w);
+  pv_10(w);
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];

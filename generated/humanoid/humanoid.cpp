@@ -11,7 +11,7 @@ namespace humanoid {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     w.RJ_pelvis[0] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[4]*q[4];
@@ -72,6 +72,9 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.g_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t6 + w.sq_l_hip_yaw_link*t7;
     w.g_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t6 + w.cq_l_hip_yaw_link*t7;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.sq_l_hip_roll_link = std::sin(q[8]);
@@ -85,16 +88,16 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.c_l_hip_roll_link[2] = -v[7]*w.v_l_hip_roll_link[1];
     w.c_l_hip_roll_link[4] = v[7]*w.v_l_hip_roll_link[5];
     w.c_l_hip_roll_link[5] = -v[7]*w.v_l_hip_roll_link[4];
-    const Scalar h8 = 0.5*w.v_l_hip_yaw_link[0] - 0.015*w.v_l_hip_roll_link[4];
-    const Scalar h9 = 0.5*w.v_l_hip_roll_link[1] + 0.015*w.v_l_hip_roll_link[3];
-    const Scalar h10 = 0.015*w.v_l_hip_roll_link[1] + 0.00095*w.v_l_hip_roll_link[3];
-    const Scalar h11 = -0.015*w.v_l_hip_yaw_link[0] + 0.00095*w.v_l_hip_roll_link[4];
-    w.pA_l_hip_roll_link[0] = -w.v_l_hip_roll_link[5]*h9 + 0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[4];
-    w.pA_l_hip_roll_link[1] = -0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[3] + w.v_l_hip_roll_link[5]*h8;
-    w.pA_l_hip_roll_link[2] = -w.v_l_hip_roll_link[4]*h8 + w.v_l_hip_roll_link[3]*h9;
-    w.pA_l_hip_roll_link[3] = -w.v_l_hip_roll_link[5]*h11 + 0.0005*w.v_l_hip_roll_link[4]*w.v_l_hip_roll_link[5] - w.v_l_hip_roll_link[2]*h9 + 0.5*w.v_l_hip_roll_link[1]*w.v_l_hip_roll_link[2];
-    w.pA_l_hip_roll_link[4] = -0.0005*w.v_l_hip_roll_link[3]*w.v_l_hip_roll_link[5] + w.v_l_hip_roll_link[5]*h10 - 0.5*w.v_l_hip_yaw_link[0]*w.v_l_hip_roll_link[2] + w.v_l_hip_roll_link[2]*h8;
-    w.pA_l_hip_roll_link[5] = -w.v_l_hip_roll_link[4]*h10 + w.v_l_hip_roll_link[3]*h11 - w.v_l_hip_roll_link[1]*h8 + w.v_l_hip_yaw_link[0]*h9;
+    const Scalar h0 = 0.5*w.v_l_hip_yaw_link[0] - 0.015*w.v_l_hip_roll_link[4];
+    const Scalar h1 = 0.5*w.v_l_hip_roll_link[1] + 0.015*w.v_l_hip_roll_link[3];
+    const Scalar h2 = 0.015*w.v_l_hip_roll_link[1] + 0.00095*w.v_l_hip_roll_link[3];
+    const Scalar h3 = -0.015*w.v_l_hip_yaw_link[0] + 0.00095*w.v_l_hip_roll_link[4];
+    w.pA_l_hip_roll_link[0] = -w.v_l_hip_roll_link[5]*h1 + 0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[4];
+    w.pA_l_hip_roll_link[1] = -0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[3] + w.v_l_hip_roll_link[5]*h0;
+    w.pA_l_hip_roll_link[2] = -w.v_l_hip_roll_link[4]*h0 + w.v_l_hip_roll_link[3]*h1;
+    w.pA_l_hip_roll_link[3] = -w.v_l_hip_roll_link[5]*h3 + 0.0005*w.v_l_hip_roll_link[4]*w.v_l_hip_roll_link[5] - w.v_l_hip_roll_link[2]*h1 + 0.5*w.v_l_hip_roll_link[1]*w.v_l_hip_roll_link[2];
+    w.pA_l_hip_roll_link[4] = -0.0005*w.v_l_hip_roll_link[3]*w.v_l_hip_roll_link[5] + w.v_l_hip_roll_link[5]*h2 - 0.5*w.v_l_hip_yaw_link[0]*w.v_l_hip_roll_link[2] + w.v_l_hip_roll_link[2]*h0;
+    w.pA_l_hip_roll_link[5] = -w.v_l_hip_roll_link[4]*h2 + w.v_l_hip_roll_link[3]*h3 - w.v_l_hip_roll_link[1]*h0 + w.v_l_hip_yaw_link[0]*h1;
     w.g_l_hip_roll_link[1] = w.g_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.g_pelvis[2]*w.sq_l_hip_roll_link;
     w.g_l_hip_roll_link[2] = -w.g_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.g_pelvis[2]*w.cq_l_hip_roll_link;
   }
@@ -102,37 +105,37 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
   {
     w.sq_l_thigh = std::sin(q[9]);
     w.cq_l_thigh = std::cos(q[9]);
-    const Scalar t8 = 0.9950041652780258*w.v_l_hip_roll_link[3] + 0.09983341664682815*w.v_l_hip_roll_link[5];
-    const Scalar t9 = -0.09983341664682815*w.v_l_hip_roll_link[3] + 0.9950041652780258*w.v_l_hip_roll_link[5];
-    const Scalar t10 = 0.9950041652780258*w.v_l_hip_yaw_link[0] + 0.09983341664682815*w.v_l_hip_roll_link[2];
-    const Scalar t11 = -0.09983341664682815*w.v_l_hip_yaw_link[0] + 0.9950041652780258*w.v_l_hip_roll_link[2];
-    w.v_l_thigh[0] = w.cq_l_thigh*t10 - w.sq_l_thigh*t11;
-    w.v_l_thigh[2] = w.sq_l_thigh*t10 + w.cq_l_thigh*t11;
-    w.v_l_thigh[3] = w.cq_l_thigh*t8 - w.sq_l_thigh*t9;
+    const Scalar t0 = 0.9950041652780258*w.v_l_hip_roll_link[3] + 0.09983341664682815*w.v_l_hip_roll_link[5];
+    const Scalar t1 = -0.09983341664682815*w.v_l_hip_roll_link[3] + 0.9950041652780258*w.v_l_hip_roll_link[5];
+    const Scalar t2 = 0.9950041652780258*w.v_l_hip_yaw_link[0] + 0.09983341664682815*w.v_l_hip_roll_link[2];
+    const Scalar t3 = -0.09983341664682815*w.v_l_hip_yaw_link[0] + 0.9950041652780258*w.v_l_hip_roll_link[2];
+    w.v_l_thigh[0] = w.cq_l_thigh*t2 - w.sq_l_thigh*t3;
+    w.v_l_thigh[2] = w.sq_l_thigh*t2 + w.cq_l_thigh*t3;
+    w.v_l_thigh[3] = w.cq_l_thigh*t0 - w.sq_l_thigh*t1;
     w.v_l_thigh[4] = w.v_l_hip_roll_link[4] + v[8];
-    w.v_l_thigh[5] = w.sq_l_thigh*t8 + w.cq_l_thigh*t9;
+    w.v_l_thigh[5] = w.sq_l_thigh*t0 + w.cq_l_thigh*t1;
     w.c_l_thigh[0] = -v[8]*w.v_l_thigh[2];
     w.c_l_thigh[2] = v[8]*w.v_l_thigh[0];
     w.c_l_thigh[3] = -v[8]*w.v_l_thigh[5];
     w.c_l_thigh[5] = v[8]*w.v_l_thigh[3];
-    const Scalar h12 = 7.0*w.v_l_thigh[0] - 1.29954125*w.v_l_thigh[4];
-    const Scalar h13 = 7.0*w.v_l_hip_roll_link[1] + 1.29954125*w.v_l_thigh[3];
-    const Scalar h14 = 1.29954125*w.v_l_hip_roll_link[1] + 0.3755072987089375*w.v_l_thigh[3];
-    const Scalar h15 = -1.29954125*w.v_l_thigh[0] + 0.3755072987089375*w.v_l_thigh[4];
-    w.pA_l_thigh[0] = -w.v_l_thigh[5]*h13 + 7.0*w.v_l_thigh[2]*w.v_l_thigh[4];
-    w.pA_l_thigh[1] = -7.0*w.v_l_thigh[2]*w.v_l_thigh[3] + w.v_l_thigh[5]*h12;
-    w.pA_l_thigh[2] = -w.v_l_thigh[4]*h12 + w.v_l_thigh[3]*h13;
-    w.pA_l_thigh[3] = -w.v_l_thigh[5]*h15 + 0.0196875*w.v_l_thigh[4]*w.v_l_thigh[5] - w.v_l_thigh[2]*h13 + 7.0*w.v_l_hip_roll_link[1]*w.v_l_thigh[2];
-    w.pA_l_thigh[4] = -0.0196875*w.v_l_thigh[3]*w.v_l_thigh[5] + w.v_l_thigh[5]*h14 - 7.0*w.v_l_thigh[0]*w.v_l_thigh[2] + w.v_l_thigh[2]*h12;
-    w.pA_l_thigh[5] = -w.v_l_thigh[4]*h14 + w.v_l_thigh[3]*h15 - w.v_l_hip_roll_link[1]*h12 + w.v_l_thigh[0]*h13;
-    const Scalar t12 = 0.9950041652780258*w.g_l_hip_yaw_link[0] + 0.09983341664682815*w.g_l_hip_roll_link[2];
-    const Scalar t13 = -0.09983341664682815*w.g_l_hip_yaw_link[0] + 0.9950041652780258*w.g_l_hip_roll_link[2];
-    w.g_l_thigh[0] = w.cq_l_thigh*t12 - w.sq_l_thigh*t13;
-    w.g_l_thigh[2] = w.sq_l_thigh*t12 + w.cq_l_thigh*t13;
+    const Scalar h4 = 7.0*w.v_l_thigh[0] - 1.29954125*w.v_l_thigh[4];
+    const Scalar h5 = 7.0*w.v_l_hip_roll_link[1] + 1.29954125*w.v_l_thigh[3];
+    const Scalar h6 = 1.29954125*w.v_l_hip_roll_link[1] + 0.3755072987089375*w.v_l_thigh[3];
+    const Scalar h7 = -1.29954125*w.v_l_thigh[0] + 0.3755072987089375*w.v_l_thigh[4];
+    w.pA_l_thigh[0] = -w.v_l_thigh[5]*h5 + 7.0*w.v_l_thigh[2]*w.v_l_thigh[4];
+    w.pA_l_thigh[1] = -7.0*w.v_l_thigh[2]*w.v_l_thigh[3] + w.v_l_thigh[5]*h4;
+    w.pA_l_thigh[2] = -w.v_l_thigh[4]*h4 + w.v_l_thigh[3]*h5;
+    w.pA_l_thigh[3] = -w.v_l_thigh[5]*h7 + 0.0196875*w.v_l_thigh[4]*w.v_l_thigh[5] - w.v_l_thigh[2]*h5 + 7.0*w.v_l_hip_roll_link[1]*w.v_l_thigh[2];
+    w.pA_l_thigh[4] = -0.0196875*w.v_l_thigh[3]*w.v_l_thigh[5] + w.v_l_thigh[5]*h6 - 7.0*w.v_l_thigh[0]*w.v_l_thigh[2] + w.v_l_thigh[2]*h4;
+    w.pA_l_thigh[5] = -w.v_l_thigh[4]*h6 + w.v_l_thigh[3]*h7 - w.v_l_hip_roll_link[1]*h4 + w.v_l_thigh[0]*h5;
+    const Scalar t4 = 0.9950041652780258*w.g_l_hip_yaw_link[0] + 0.09983341664682815*w.g_l_hip_roll_link[2];
+    const Scalar t5 = -0.09983341664682815*w.g_l_hip_yaw_link[0] + 0.9950041652780258*w.g_l_hip_roll_link[2];
+    w.g_l_thigh[0] = w.cq_l_thigh*t4 - w.sq_l_thigh*t5;
+    w.g_l_thigh[2] = w.sq_l_thigh*t4 + w.cq_l_thigh*t5;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     w.sq_l_shank = std::sin(q[10]);
@@ -196,6 +199,9 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.g_l_ankle_link[0] = w.cq_l_ankle_link*t14 - w.sq_l_ankle_link*t15;
     w.g_l_ankle_link[2] = w.sq_l_ankle_link*t14 + w.cq_l_ankle_link*t15;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     w.sq_l_foot = std::sin(q[12]);
@@ -209,25 +215,22 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.c_l_foot[2] = -v[11]*w.v_l_foot[1];
     w.c_l_foot[4] = v[11]*w.v_l_foot[5];
     w.c_l_foot[5] = -v[11]*w.v_l_foot[4];
-    const Scalar h4 = 1.015*w.v_l_ankle_link[0] - 0.027912499999999996*w.v_l_foot[4];
-    const Scalar h5 = 1.015*w.v_l_foot[1] + 0.027912499999999996*w.v_l_foot[3] + 0.06495999999999999*w.v_l_foot[5];
-    const Scalar h6 = 1.015*w.v_l_foot[2] - 0.06495999999999999*w.v_l_foot[4];
-    const Scalar h7 = 0.027912499999999996*w.v_l_foot[1] + 0.00194517348958*w.v_l_foot[3] + 0.0017863999999999998*w.v_l_foot[5];
-    const Scalar h8 = -0.027912499999999996*w.v_l_ankle_link[0] - 0.06495999999999999*w.v_l_foot[2] + 0.00936987670937*w.v_l_foot[4];
-    const Scalar h9 = 0.06495999999999999*w.v_l_foot[1] + 0.0017863999999999998*w.v_l_foot[3] + 0.00860228295937*w.v_l_foot[5];
-    w.pA_l_foot[0] = -w.v_l_foot[5]*h5 + w.v_l_foot[4]*h6;
-    w.pA_l_foot[1] = -w.v_l_foot[3]*h6 + w.v_l_foot[5]*h4;
-    w.pA_l_foot[2] = -w.v_l_foot[4]*h4 + w.v_l_foot[3]*h5;
-    w.pA_l_foot[3] = -w.v_l_foot[5]*h8 + w.v_l_foot[4]*h9 - w.v_l_foot[2]*h5 + w.v_l_foot[1]*h6;
-    w.pA_l_foot[4] = -w.v_l_foot[3]*h9 + w.v_l_foot[5]*h7 - w.v_l_ankle_link[0]*h6 + w.v_l_foot[2]*h4;
-    w.pA_l_foot[5] = -w.v_l_foot[4]*h7 + w.v_l_foot[3]*h8 - w.v_l_foot[1]*h4 + w.v_l_ankle_link[0]*h5;
+    const Scalar h0 = 1.015*w.v_l_ankle_link[0] - 0.027912499999999996*w.v_l_foot[4];
+    const Scalar h1 = 1.015*w.v_l_foot[1] + 0.027912499999999996*w.v_l_foot[3] + 0.06495999999999999*w.v_l_foot[5];
+    const Scalar h2 = 1.015*w.v_l_foot[2] - 0.06495999999999999*w.v_l_foot[4];
+    const Scalar h3 = 0.027912499999999996*w.v_l_foot[1] + 0.00194517348958*w.v_l_foot[3] + 0.0017863999999999998*w.v_l_foot[5];
+    const Scalar h4 = -0.027912499999999996*w.v_l_ankle_link[0] - 0.06495999999999999*w.v_l_foot[2] + 0.00936987670937*w.v_l_foot[4];
+    const Scalar h5 = 0.06495999999999999*w.v_l_foot[1] + 0.0017863999999999998*w.v_l_foot[3] + 0.00860228295937*w.v_l_foot[5];
+    w.pA_l_foot[0] = -w.v_l_foot[5]*h1 + w.v_l_foot[4]*h2;
+    w.pA_l_foot[1] = -w.v_l_foot[3]*h2 + w.v_l_foot[5]*h0;
+    w.pA_l_foot[2] = -w.v_l_foot[4]*h0 + w.v_l_foot[3]*h1;
+    w.pA_l_foot[3] = -w.v_l_foot[5]*h4 + w.v_l_foot[4]*h5 - w.v_l_foot[2]*h1 + w.v_l_foot[1]*h2;
+    w.pA_l_foot[4] = -w.v_l_foot[3]*h5 + w.v_l_foot[5]*h3 - w.v_l_ankle_link[0]*h2 + w.v_l_foot[2]*h0;
+    w.pA_l_foot[5] = -w.v_l_foot[4]*h3 + w.v_l_foot[3]*h4 - w.v_l_foot[1]*h0 + w.v_l_ankle_link[0]*h1;
     w.g_l_foot[1] = w.g_l_hip_roll_link[1]*w.cq_l_foot + w.g_l_ankle_link[2]*w.sq_l_foot;
     w.g_l_foot[2] = -w.g_l_hip_roll_link[1]*w.sq_l_foot + w.g_l_ankle_link[2]*w.cq_l_foot;
     // constraint 'left_foot' (6d) on link 'l_sole': rows 0..5
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.sq_r_hip_yaw_link = std::sin(q[13]);
@@ -248,21 +251,24 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspac
     w.c_r_hip_yaw_link[1] = -v[12]*w.v_r_hip_yaw_link[0];
     w.c_r_hip_yaw_link[3] = v[12]*w.v_r_hip_yaw_link[4];
     w.c_r_hip_yaw_link[4] = -v[12]*w.v_r_hip_yaw_link[3];
-    const Scalar h0 = 0.5*w.v_r_hip_yaw_link[0] + 0.02*w.v_r_hip_yaw_link[4];
-    const Scalar h1 = 0.5*w.v_r_hip_yaw_link[1] - 0.02*w.v_r_hip_yaw_link[3];
-    const Scalar h2 = -0.02*w.v_r_hip_yaw_link[1] + 0.0013*w.v_r_hip_yaw_link[3];
-    const Scalar h3 = 0.02*w.v_r_hip_yaw_link[0] + 0.0013*w.v_r_hip_yaw_link[4];
-    w.pA_r_hip_yaw_link[0] = -w.v_r_hip_yaw_link[5]*h1 + 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[4];
-    w.pA_r_hip_yaw_link[1] = -0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[3] + w.v_r_hip_yaw_link[5]*h0;
-    w.pA_r_hip_yaw_link[2] = -w.v_r_hip_yaw_link[4]*h0 + w.v_r_hip_yaw_link[3]*h1;
-    w.pA_r_hip_yaw_link[3] = -w.v_r_hip_yaw_link[5]*h3 + 0.0005*w.v_r_hip_yaw_link[4]*w.v_r_hip_yaw_link[5] - w.v_r_hip_yaw_link[2]*h1 + 0.5*w.v_r_hip_yaw_link[1]*w.v_r_hip_yaw_link[2];
-    w.pA_r_hip_yaw_link[4] = -0.0005*w.v_r_hip_yaw_link[3]*w.v_r_hip_yaw_link[5] + w.v_r_hip_yaw_link[5]*h2 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_yaw_link[2] + w.v_r_hip_yaw_link[2]*h0;
-    w.pA_r_hip_yaw_link[5] = -w.v_r_hip_yaw_link[4]*h2 + w.v_r_hip_yaw_link[3]*h3 - w.v_r_hip_yaw_link[1]*h0 + w.v_r_hip_yaw_link[0]*h1;
+    const Scalar h6 = 0.5*w.v_r_hip_yaw_link[0] + 0.02*w.v_r_hip_yaw_link[4];
+    const Scalar h7 = 0.5*w.v_r_hip_yaw_link[1] - 0.02*w.v_r_hip_yaw_link[3];
+    const Scalar h8 = -0.02*w.v_r_hip_yaw_link[1] + 0.0013*w.v_r_hip_yaw_link[3];
+    const Scalar h9 = 0.02*w.v_r_hip_yaw_link[0] + 0.0013*w.v_r_hip_yaw_link[4];
+    w.pA_r_hip_yaw_link[0] = -w.v_r_hip_yaw_link[5]*h7 + 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[4];
+    w.pA_r_hip_yaw_link[1] = -0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[3] + w.v_r_hip_yaw_link[5]*h6;
+    w.pA_r_hip_yaw_link[2] = -w.v_r_hip_yaw_link[4]*h6 + w.v_r_hip_yaw_link[3]*h7;
+    w.pA_r_hip_yaw_link[3] = -w.v_r_hip_yaw_link[5]*h9 + 0.0005*w.v_r_hip_yaw_link[4]*w.v_r_hip_yaw_link[5] - w.v_r_hip_yaw_link[2]*h7 + 0.5*w.v_r_hip_yaw_link[1]*w.v_r_hip_yaw_link[2];
+    w.pA_r_hip_yaw_link[4] = -0.0005*w.v_r_hip_yaw_link[3]*w.v_r_hip_yaw_link[5] + w.v_r_hip_yaw_link[5]*h8 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_yaw_link[2] + w.v_r_hip_yaw_link[2]*h6;
+    w.pA_r_hip_yaw_link[5] = -w.v_r_hip_yaw_link[4]*h8 + w.v_r_hip_yaw_link[3]*h9 - w.v_r_hip_yaw_link[1]*h6 + w.v_r_hip_yaw_link[0]*h7;
     const Scalar t6 = 0.9961917745544759*w.g_pelvis[0] - 0.08718915247898762*w.g_pelvis[1];
     const Scalar t7 = 0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
     w.g_r_hip_yaw_link[0] = w.cq_r_hip_yaw_link*t6 + w.sq_r_hip_yaw_link*t7;
     w.g_r_hip_yaw_link[1] = -w.sq_r_hip_yaw_link*t6 + w.cq_r_hip_yaw_link*t7;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.sq_r_hip_roll_link = std::sin(q[14]);
@@ -276,16 +282,16 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspac
     w.c_r_hip_roll_link[2] = -v[13]*w.v_r_hip_roll_link[1];
     w.c_r_hip_roll_link[4] = v[13]*w.v_r_hip_roll_link[5];
     w.c_r_hip_roll_link[5] = -v[13]*w.v_r_hip_roll_link[4];
-    const Scalar h4 = 0.5*w.v_r_hip_yaw_link[0] - 0.015*w.v_r_hip_roll_link[4];
-    const Scalar h5 = 0.5*w.v_r_hip_roll_link[1] + 0.015*w.v_r_hip_roll_link[3];
-    const Scalar h6 = 0.015*w.v_r_hip_roll_link[1] + 0.00095*w.v_r_hip_roll_link[3];
-    const Scalar h7 = -0.015*w.v_r_hip_yaw_link[0] + 0.00095*w.v_r_hip_roll_link[4];
-    w.pA_r_hip_roll_link[0] = -w.v_r_hip_roll_link[5]*h5 + 0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[4];
-    w.pA_r_hip_roll_link[1] = -0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[3] + w.v_r_hip_roll_link[5]*h4;
-    w.pA_r_hip_roll_link[2] = -w.v_r_hip_roll_link[4]*h4 + w.v_r_hip_roll_link[3]*h5;
-    w.pA_r_hip_roll_link[3] = -w.v_r_hip_roll_link[5]*h7 + 0.0005*w.v_r_hip_roll_link[4]*w.v_r_hip_roll_link[5] - w.v_r_hip_roll_link[2]*h5 + 0.5*w.v_r_hip_roll_link[1]*w.v_r_hip_roll_link[2];
-    w.pA_r_hip_roll_link[4] = -0.0005*w.v_r_hip_roll_link[3]*w.v_r_hip_roll_link[5] + w.v_r_hip_roll_link[5]*h6 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_roll_link[2] + w.v_r_hip_roll_link[2]*h4;
-    w.pA_r_hip_roll_link[5] = -w.v_r_hip_roll_link[4]*h6 + w.v_r_hip_roll_link[3]*h7 - w.v_r_hip_roll_link[1]*h4 + w.v_r_hip_yaw_link[0]*h5;
+    const Scalar h0 = 0.5*w.v_r_hip_yaw_link[0] - 0.015*w.v_r_hip_roll_link[4];
+    const Scalar h1 = 0.5*w.v_r_hip_roll_link[1] + 0.015*w.v_r_hip_roll_link[3];
+    const Scalar h2 = 0.015*w.v_r_hip_roll_link[1] + 0.00095*w.v_r_hip_roll_link[3];
+    const Scalar h3 = -0.015*w.v_r_hip_yaw_link[0] + 0.00095*w.v_r_hip_roll_link[4];
+    w.pA_r_hip_roll_link[0] = -w.v_r_hip_roll_link[5]*h1 + 0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[4];
+    w.pA_r_hip_roll_link[1] = -0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[3] + w.v_r_hip_roll_link[5]*h0;
+    w.pA_r_hip_roll_link[2] = -w.v_r_hip_roll_link[4]*h0 + w.v_r_hip_roll_link[3]*h1;
+    w.pA_r_hip_roll_link[3] = -w.v_r_hip_roll_link[5]*h3 + 0.0005*w.v_r_hip_roll_link[4]*w.v_r_hip_roll_link[5] - w.v_r_hip_roll_link[2]*h1 + 0.5*w.v_r_hip_roll_link[1]*w.v_r_hip_roll_link[2];
+    w.pA_r_hip_roll_link[4] = -0.0005*w.v_r_hip_roll_link[3]*w.v_r_hip_roll_link[5] + w.v_r_hip_roll_link[5]*h2 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_roll_link[2] + w.v_r_hip_roll_link[2]*h0;
+    w.pA_r_hip_roll_link[5] = -w.v_r_hip_roll_link[4]*h2 + w.v_r_hip_roll_link[3]*h3 - w.v_r_hip_roll_link[1]*h0 + w.v_r_hip_yaw_link[0]*h1;
     w.g_r_hip_roll_link[1] = w.g_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.g_pelvis[2]*w.sq_r_hip_roll_link;
     w.g_r_hip_roll_link[2] = -w.g_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.g_pelvis[2]*w.cq_r_hip_roll_link;
   }
@@ -293,37 +299,37 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspac
   {
     w.sq_r_thigh = std::sin(q[15]);
     w.cq_r_thigh = std::cos(q[15]);
-    const Scalar t8 = 0.9950041652780258*w.v_r_hip_roll_link[3] + 0.09983341664682815*w.v_r_hip_roll_link[5];
-    const Scalar t9 = -0.09983341664682815*w.v_r_hip_roll_link[3] + 0.9950041652780258*w.v_r_hip_roll_link[5];
-    const Scalar t10 = 0.9950041652780258*w.v_r_hip_yaw_link[0] + 0.09983341664682815*w.v_r_hip_roll_link[2];
-    const Scalar t11 = -0.09983341664682815*w.v_r_hip_yaw_link[0] + 0.9950041652780258*w.v_r_hip_roll_link[2];
-    w.v_r_thigh[0] = w.cq_r_thigh*t10 - w.sq_r_thigh*t11;
-    w.v_r_thigh[2] = w.sq_r_thigh*t10 + w.cq_r_thigh*t11;
-    w.v_r_thigh[3] = w.cq_r_thigh*t8 - w.sq_r_thigh*t9;
+    const Scalar t0 = 0.9950041652780258*w.v_r_hip_roll_link[3] + 0.09983341664682815*w.v_r_hip_roll_link[5];
+    const Scalar t1 = -0.09983341664682815*w.v_r_hip_roll_link[3] + 0.9950041652780258*w.v_r_hip_roll_link[5];
+    const Scalar t2 = 0.9950041652780258*w.v_r_hip_yaw_link[0] + 0.09983341664682815*w.v_r_hip_roll_link[2];
+    const Scalar t3 = -0.09983341664682815*w.v_r_hip_yaw_link[0] + 0.9950041652780258*w.v_r_hip_roll_link[2];
+    w.v_r_thigh[0] = w.cq_r_thigh*t2 - w.sq_r_thigh*t3;
+    w.v_r_thigh[2] = w.sq_r_thigh*t2 + w.cq_r_thigh*t3;
+    w.v_r_thigh[3] = w.cq_r_thigh*t0 - w.sq_r_thigh*t1;
     w.v_r_thigh[4] = w.v_r_hip_roll_link[4] + v[14];
-    w.v_r_thigh[5] = w.sq_r_thigh*t8 + w.cq_r_thigh*t9;
+    w.v_r_thigh[5] = w.sq_r_thigh*t0 + w.cq_r_thigh*t1;
     w.c_r_thigh[0] = -v[14]*w.v_r_thigh[2];
     w.c_r_thigh[2] = v[14]*w.v_r_thigh[0];
     w.c_r_thigh[3] = -v[14]*w.v_r_thigh[5];
     w.c_r_thigh[5] = v[14]*w.v_r_thigh[3];
-    const Scalar h8 = 7.0*w.v_r_thigh[0] - 1.29954125*w.v_r_thigh[4];
-    const Scalar h9 = 7.0*w.v_r_hip_roll_link[1] + 1.29954125*w.v_r_thigh[3];
-    const Scalar h10 = 1.29954125*w.v_r_hip_roll_link[1] + 0.3755072987089375*w.v_r_thigh[3];
-    const Scalar h11 = -1.29954125*w.v_r_thigh[0] + 0.3755072987089375*w.v_r_thigh[4];
-    w.pA_r_thigh[0] = -w.v_r_thigh[5]*h9 + 7.0*w.v_r_thigh[2]*w.v_r_thigh[4];
-    w.pA_r_thigh[1] = -7.0*w.v_r_thigh[2]*w.v_r_thigh[3] + w.v_r_thigh[5]*h8;
-    w.pA_r_thigh[2] = -w.v_r_thigh[4]*h8 + w.v_r_thigh[3]*h9;
-    w.pA_r_thigh[3] = -w.v_r_thigh[5]*h11 + 0.0196875*w.v_r_thigh[4]*w.v_r_thigh[5] - w.v_r_thigh[2]*h9 + 7.0*w.v_r_hip_roll_link[1]*w.v_r_thigh[2];
-    w.pA_r_thigh[4] = -0.0196875*w.v_r_thigh[3]*w.v_r_thigh[5] + w.v_r_thigh[5]*h10 - 7.0*w.v_r_thigh[0]*w.v_r_thigh[2] + w.v_r_thigh[2]*h8;
-    w.pA_r_thigh[5] = -w.v_r_thigh[4]*h10 + w.v_r_thigh[3]*h11 - w.v_r_hip_roll_link[1]*h8 + w.v_r_thigh[0]*h9;
-    const Scalar t12 = 0.9950041652780258*w.g_r_hip_yaw_link[0] + 0.09983341664682815*w.g_r_hip_roll_link[2];
-    const Scalar t13 = -0.09983341664682815*w.g_r_hip_yaw_link[0] + 0.9950041652780258*w.g_r_hip_roll_link[2];
-    w.g_r_thigh[0] = w.cq_r_thigh*t12 - w.sq_r_thigh*t13;
-    w.g_r_thigh[2] = w.sq_r_thigh*t12 + w.cq_r_thigh*t13;
+    const Scalar h4 = 7.0*w.v_r_thigh[0] - 1.29954125*w.v_r_thigh[4];
+    const Scalar h5 = 7.0*w.v_r_hip_roll_link[1] + 1.29954125*w.v_r_thigh[3];
+    const Scalar h6 = 1.29954125*w.v_r_hip_roll_link[1] + 0.3755072987089375*w.v_r_thigh[3];
+    const Scalar h7 = -1.29954125*w.v_r_thigh[0] + 0.3755072987089375*w.v_r_thigh[4];
+    w.pA_r_thigh[0] = -w.v_r_thigh[5]*h5 + 7.0*w.v_r_thigh[2]*w.v_r_thigh[4];
+    w.pA_r_thigh[1] = -7.0*w.v_r_thigh[2]*w.v_r_thigh[3] + w.v_r_thigh[5]*h4;
+    w.pA_r_thigh[2] = -w.v_r_thigh[4]*h4 + w.v_r_thigh[3]*h5;
+    w.pA_r_thigh[3] = -w.v_r_thigh[5]*h7 + 0.0196875*w.v_r_thigh[4]*w.v_r_thigh[5] - w.v_r_thigh[2]*h5 + 7.0*w.v_r_hip_roll_link[1]*w.v_r_thigh[2];
+    w.pA_r_thigh[4] = -0.0196875*w.v_r_thigh[3]*w.v_r_thigh[5] + w.v_r_thigh[5]*h6 - 7.0*w.v_r_thigh[0]*w.v_r_thigh[2] + w.v_r_thigh[2]*h4;
+    w.pA_r_thigh[5] = -w.v_r_thigh[4]*h6 + w.v_r_thigh[3]*h7 - w.v_r_hip_roll_link[1]*h4 + w.v_r_thigh[0]*h5;
+    const Scalar t4 = 0.9950041652780258*w.g_r_hip_yaw_link[0] + 0.09983341664682815*w.g_r_hip_roll_link[2];
+    const Scalar t5 = -0.09983341664682815*w.g_r_hip_yaw_link[0] + 0.9950041652780258*w.g_r_hip_roll_link[2];
+    w.g_r_thigh[0] = w.cq_r_thigh*t4 - w.sq_r_thigh*t5;
+    w.g_r_thigh[2] = w.sq_r_thigh*t4 + w.cq_r_thigh*t5;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     w.sq_r_shank = std::sin(q[16]);
@@ -387,6 +393,9 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.g_r_ankle_link[0] = w.cq_r_ankle_link*t14 - w.sq_r_ankle_link*t15;
     w.g_r_ankle_link[2] = w.sq_r_ankle_link*t14 + w.cq_r_ankle_link*t15;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     w.sq_r_foot = std::sin(q[18]);
@@ -400,25 +409,22 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.c_r_foot[2] = -v[17]*w.v_r_foot[1];
     w.c_r_foot[4] = v[17]*w.v_r_foot[5];
     w.c_r_foot[5] = -v[17]*w.v_r_foot[4];
-    const Scalar h4 = 1.015*w.v_r_ankle_link[0] - 0.027912499999999996*w.v_r_foot[4];
-    const Scalar h5 = 1.015*w.v_r_foot[1] + 0.027912499999999996*w.v_r_foot[3] + 0.06495999999999999*w.v_r_foot[5];
-    const Scalar h6 = 1.015*w.v_r_foot[2] - 0.06495999999999999*w.v_r_foot[4];
-    const Scalar h7 = 0.027912499999999996*w.v_r_foot[1] + 0.00194517348958*w.v_r_foot[3] + 0.0017863999999999998*w.v_r_foot[5];
-    const Scalar h8 = -0.027912499999999996*w.v_r_ankle_link[0] - 0.06495999999999999*w.v_r_foot[2] + 0.00936987670937*w.v_r_foot[4];
-    const Scalar h9 = 0.06495999999999999*w.v_r_foot[1] + 0.0017863999999999998*w.v_r_foot[3] + 0.00860228295937*w.v_r_foot[5];
-    w.pA_r_foot[0] = -w.v_r_foot[5]*h5 + w.v_r_foot[4]*h6;
-    w.pA_r_foot[1] = -w.v_r_foot[3]*h6 + w.v_r_foot[5]*h4;
-    w.pA_r_foot[2] = -w.v_r_foot[4]*h4 + w.v_r_foot[3]*h5;
-    w.pA_r_foot[3] = -w.v_r_foot[5]*h8 + w.v_r_foot[4]*h9 - w.v_r_foot[2]*h5 + w.v_r_foot[1]*h6;
-    w.pA_r_foot[4] = -w.v_r_foot[3]*h9 + w.v_r_foot[5]*h7 - w.v_r_ankle_link[0]*h6 + w.v_r_foot[2]*h4;
-    w.pA_r_foot[5] = -w.v_r_foot[4]*h7 + w.v_r_foot[3]*h8 - w.v_r_foot[1]*h4 + w.v_r_ankle_link[0]*h5;
+    const Scalar h0 = 1.015*w.v_r_ankle_link[0] - 0.027912499999999996*w.v_r_foot[4];
+    const Scalar h1 = 1.015*w.v_r_foot[1] + 0.027912499999999996*w.v_r_foot[3] + 0.06495999999999999*w.v_r_foot[5];
+    const Scalar h2 = 1.015*w.v_r_foot[2] - 0.06495999999999999*w.v_r_foot[4];
+    const Scalar h3 = 0.027912499999999996*w.v_r_foot[1] + 0.00194517348958*w.v_r_foot[3] + 0.0017863999999999998*w.v_r_foot[5];
+    const Scalar h4 = -0.027912499999999996*w.v_r_ankle_link[0] - 0.06495999999999999*w.v_r_foot[2] + 0.00936987670937*w.v_r_foot[4];
+    const Scalar h5 = 0.06495999999999999*w.v_r_foot[1] + 0.0017863999999999998*w.v_r_foot[3] + 0.00860228295937*w.v_r_foot[5];
+    w.pA_r_foot[0] = -w.v_r_foot[5]*h1 + w.v_r_foot[4]*h2;
+    w.pA_r_foot[1] = -w.v_r_foot[3]*h2 + w.v_r_foot[5]*h0;
+    w.pA_r_foot[2] = -w.v_r_foot[4]*h0 + w.v_r_foot[3]*h1;
+    w.pA_r_foot[3] = -w.v_r_foot[5]*h4 + w.v_r_foot[4]*h5 - w.v_r_foot[2]*h1 + w.v_r_foot[1]*h2;
+    w.pA_r_foot[4] = -w.v_r_foot[3]*h5 + w.v_r_foot[5]*h3 - w.v_r_ankle_link[0]*h2 + w.v_r_foot[2]*h0;
+    w.pA_r_foot[5] = -w.v_r_foot[4]*h3 + w.v_r_foot[3]*h4 - w.v_r_foot[1]*h0 + w.v_r_ankle_link[0]*h1;
     w.g_r_foot[1] = w.g_r_hip_roll_link[1]*w.cq_r_foot + w.g_r_ankle_link[2]*w.sq_r_foot;
     w.g_r_foot[2] = -w.g_r_hip_roll_link[1]*w.sq_r_foot + w.g_r_ankle_link[2]*w.cq_r_foot;
     // constraint 'right_foot' (6d) on link 'r_sole': rows 6..11
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.sq_abdomen = std::sin(q[19]);
@@ -434,28 +440,31 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspac
     w.c_abdomen[1] = -v[18]*w.v_abdomen[0];
     w.c_abdomen[3] = v[18]*w.v_abdomen[4];
     w.c_abdomen[4] = -v[18]*w.v_abdomen[3];
-    const Scalar h0 = 9.73*w.v_abdomen[0] + 0.81732*w.v_abdomen[4];
-    const Scalar h1 = 9.73*w.v_abdomen[1] - 0.81732*w.v_abdomen[3];
-    const Scalar h2 = -0.81732*w.v_abdomen[1] + 0.15987363*w.v_abdomen[3];
-    const Scalar h3 = 0.81732*w.v_abdomen[0] + 0.11933196333330001*w.v_abdomen[4];
-    w.pA_abdomen[0] = -w.v_abdomen[5]*h1 + 9.73*v[2]*w.v_abdomen[4];
-    w.pA_abdomen[1] = -9.73*v[2]*w.v_abdomen[3] + w.v_abdomen[5]*h0;
-    w.pA_abdomen[2] = -w.v_abdomen[4]*h0 + w.v_abdomen[3]*h1;
-    w.pA_abdomen[3] = -w.v_abdomen[5]*h3 + 0.105408333333*w.v_abdomen[4]*w.v_abdomen[5] - v[2]*h1 + 9.73*v[2]*w.v_abdomen[1];
-    w.pA_abdomen[4] = -0.105408333333*w.v_abdomen[3]*w.v_abdomen[5] + w.v_abdomen[5]*h2 - 9.73*v[2]*w.v_abdomen[0] + v[2]*h0;
-    w.pA_abdomen[5] = -w.v_abdomen[4]*h2 + w.v_abdomen[3]*h3 - w.v_abdomen[1]*h0 + w.v_abdomen[0]*h1;
+    const Scalar h6 = 9.73*w.v_abdomen[0] + 0.81732*w.v_abdomen[4];
+    const Scalar h7 = 9.73*w.v_abdomen[1] - 0.81732*w.v_abdomen[3];
+    const Scalar h8 = -0.81732*w.v_abdomen[1] + 0.15987363*w.v_abdomen[3];
+    const Scalar h9 = 0.81732*w.v_abdomen[0] + 0.11933196333330001*w.v_abdomen[4];
+    w.pA_abdomen[0] = -w.v_abdomen[5]*h7 + 9.73*v[2]*w.v_abdomen[4];
+    w.pA_abdomen[1] = -9.73*v[2]*w.v_abdomen[3] + w.v_abdomen[5]*h6;
+    w.pA_abdomen[2] = -w.v_abdomen[4]*h6 + w.v_abdomen[3]*h7;
+    w.pA_abdomen[3] = -w.v_abdomen[5]*h9 + 0.105408333333*w.v_abdomen[4]*w.v_abdomen[5] - v[2]*h7 + 9.73*v[2]*w.v_abdomen[1];
+    w.pA_abdomen[4] = -0.105408333333*w.v_abdomen[3]*w.v_abdomen[5] + w.v_abdomen[5]*h8 - 9.73*v[2]*w.v_abdomen[0] + v[2]*h6;
+    w.pA_abdomen[5] = -w.v_abdomen[4]*h8 + w.v_abdomen[3]*h9 - w.v_abdomen[1]*h6 + w.v_abdomen[0]*h7;
     w.g_abdomen[0] = w.g_pelvis[0]*w.cq_abdomen + w.g_pelvis[1]*w.sq_abdomen;
     w.g_abdomen[1] = -w.g_pelvis[0]*w.sq_abdomen + w.g_pelvis[1]*w.cq_abdomen;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.sq_chest = std::sin(q[20]);
     w.cq_chest = std::cos(q[20]);
-    const Scalar t2 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
-    const Scalar t3 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
-    w.v_chest[0] = w.cq_chest*t2 - v[2]*w.sq_chest;
-    w.v_chest[1] = t3;
-    w.v_chest[2] = w.sq_chest*t2 + v[2]*w.cq_chest;
+    const Scalar t0 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
+    const Scalar t1 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
+    w.v_chest[0] = w.cq_chest*t0 - v[2]*w.sq_chest;
+    w.v_chest[1] = t1;
+    w.v_chest[2] = w.sq_chest*t0 + v[2]*w.cq_chest;
     w.v_chest[3] = w.v_abdomen[3]*w.cq_chest - w.v_abdomen[5]*w.sq_chest;
     w.v_chest[4] = w.v_abdomen[4] + v[19];
     w.v_chest[5] = w.v_abdomen[3]*w.sq_chest + w.v_abdomen[5]*w.cq_chest;
@@ -463,16 +472,16 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspac
     w.c_chest[2] = v[19]*w.v_chest[0];
     w.c_chest[3] = -v[19]*w.v_chest[5];
     w.c_chest[5] = v[19]*w.v_chest[3];
-    const Scalar h4 = 13.92*w.v_chest[0] + 0.726624*w.v_chest[4];
-    const Scalar h5 = 13.92*w.v_chest[1] - 0.726624*w.v_chest[3];
-    const Scalar h6 = -0.726624*w.v_chest[1] + 0.2775857728*w.v_chest[3];
-    const Scalar h7 = 0.726624*w.v_chest[0] + 0.19162977280000001*w.v_chest[4];
-    w.pA_chest[0] = -w.v_chest[5]*h5 + 13.92*w.v_chest[2]*w.v_chest[4];
-    w.pA_chest[1] = -13.92*w.v_chest[2]*w.v_chest[3] + w.v_chest[5]*h4;
-    w.pA_chest[2] = -w.v_chest[4]*h4 + w.v_chest[3]*h5;
-    w.pA_chest[3] = -w.v_chest[5]*h7 + 0.198244*w.v_chest[4]*w.v_chest[5] - w.v_chest[2]*h5 + 13.92*w.v_chest[1]*w.v_chest[2];
-    w.pA_chest[4] = -0.198244*w.v_chest[3]*w.v_chest[5] + w.v_chest[5]*h6 - 13.92*w.v_chest[0]*w.v_chest[2] + w.v_chest[2]*h4;
-    w.pA_chest[5] = -w.v_chest[4]*h6 + w.v_chest[3]*h7 - w.v_chest[1]*h4 + w.v_chest[0]*h5;
+    const Scalar h0 = 13.92*w.v_chest[0] + 0.726624*w.v_chest[4];
+    const Scalar h1 = 13.92*w.v_chest[1] - 0.726624*w.v_chest[3];
+    const Scalar h2 = -0.726624*w.v_chest[1] + 0.2775857728*w.v_chest[3];
+    const Scalar h3 = 0.726624*w.v_chest[0] + 0.19162977280000001*w.v_chest[4];
+    w.pA_chest[0] = -w.v_chest[5]*h1 + 13.92*w.v_chest[2]*w.v_chest[4];
+    w.pA_chest[1] = -13.92*w.v_chest[2]*w.v_chest[3] + w.v_chest[5]*h0;
+    w.pA_chest[2] = -w.v_chest[4]*h0 + w.v_chest[3]*h1;
+    w.pA_chest[3] = -w.v_chest[5]*h3 + 0.198244*w.v_chest[4]*w.v_chest[5] - w.v_chest[2]*h1 + 13.92*w.v_chest[1]*w.v_chest[2];
+    w.pA_chest[4] = -0.198244*w.v_chest[3]*w.v_chest[5] + w.v_chest[5]*h2 - 13.92*w.v_chest[0]*w.v_chest[2] + w.v_chest[2]*h0;
+    w.pA_chest[5] = -w.v_chest[4]*h2 + w.v_chest[3]*h3 - w.v_chest[1]*h0 + w.v_chest[0]*h1;
     w.g_chest[0] = w.g_abdomen[0]*w.cq_chest - w.g_pelvis[2]*w.sq_chest;
     w.g_chest[2] = w.g_abdomen[0]*w.sq_chest + w.g_pelvis[2]*w.cq_chest;
   }
@@ -480,39 +489,39 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspac
   {
     w.sq_l_shoulder_pitch_link = std::sin(q[21]);
     w.cq_l_shoulder_pitch_link = std::cos(q[21]);
-    const Scalar t4 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
-    const Scalar t5 = w.v_chest[1] - 0.254*w.v_chest[3];
-    const Scalar t6 = w.v_chest[2] + 0.19*w.v_chest[3];
-    const Scalar t7 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
-    const Scalar t8 = -0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] + 0.2548890642384102*w.v_chest[5];
-    const Scalar t9 = -0.1676999117594225*w.v_chest[3] - 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
-    const Scalar t10 = 0.9848134698792882*t4 + 0.17361575258114187*t6;
-    const Scalar t11 = -0.04493516596384369*t4 + 0.9659256678396477*t5 + 0.2548890642384102*t6;
-    const Scalar t12 = -0.1676999117594225*t4 - 0.2588196364430848*t5 + 0.9512566085906322*t6;
-    w.v_l_shoulder_pitch_link[0] = w.cq_l_shoulder_pitch_link*t10 - w.sq_l_shoulder_pitch_link*t12;
-    w.v_l_shoulder_pitch_link[1] = t11;
-    w.v_l_shoulder_pitch_link[2] = w.sq_l_shoulder_pitch_link*t10 + w.cq_l_shoulder_pitch_link*t12;
-    w.v_l_shoulder_pitch_link[3] = w.cq_l_shoulder_pitch_link*t7 - w.sq_l_shoulder_pitch_link*t9;
-    w.v_l_shoulder_pitch_link[4] = v[20] + t8;
-    w.v_l_shoulder_pitch_link[5] = w.sq_l_shoulder_pitch_link*t7 + w.cq_l_shoulder_pitch_link*t9;
+    const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
+    const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
+    const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
+    const Scalar t5 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
+    const Scalar t6 = -0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] + 0.2548890642384102*w.v_chest[5];
+    const Scalar t7 = -0.1676999117594225*w.v_chest[3] - 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
+    const Scalar t8 = 0.9848134698792882*t2 + 0.17361575258114187*t4;
+    const Scalar t9 = -0.04493516596384369*t2 + 0.9659256678396477*t3 + 0.2548890642384102*t4;
+    const Scalar t10 = -0.1676999117594225*t2 - 0.2588196364430848*t3 + 0.9512566085906322*t4;
+    w.v_l_shoulder_pitch_link[0] = w.cq_l_shoulder_pitch_link*t8 - w.sq_l_shoulder_pitch_link*t10;
+    w.v_l_shoulder_pitch_link[1] = t9;
+    w.v_l_shoulder_pitch_link[2] = w.sq_l_shoulder_pitch_link*t8 + w.cq_l_shoulder_pitch_link*t10;
+    w.v_l_shoulder_pitch_link[3] = w.cq_l_shoulder_pitch_link*t5 - w.sq_l_shoulder_pitch_link*t7;
+    w.v_l_shoulder_pitch_link[4] = v[20] + t6;
+    w.v_l_shoulder_pitch_link[5] = w.sq_l_shoulder_pitch_link*t5 + w.cq_l_shoulder_pitch_link*t7;
     w.c_l_shoulder_pitch_link[0] = -v[20]*w.v_l_shoulder_pitch_link[2];
     w.c_l_shoulder_pitch_link[2] = v[20]*w.v_l_shoulder_pitch_link[0];
     w.c_l_shoulder_pitch_link[3] = -v[20]*w.v_l_shoulder_pitch_link[5];
     w.c_l_shoulder_pitch_link[5] = v[20]*w.v_l_shoulder_pitch_link[3];
-    const Scalar h8 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_pitch_link[5];
-    const Scalar h9 = 0.3*w.v_l_shoulder_pitch_link[2] + 0.009*w.v_l_shoulder_pitch_link[3];
-    const Scalar h10 = 0.009*w.v_l_shoulder_pitch_link[2] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[3];
-    const Scalar h11 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[5];
-    w.pA_l_shoulder_pitch_link[0] = -0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[4]*h9;
-    w.pA_l_shoulder_pitch_link[1] = -w.v_l_shoulder_pitch_link[3]*h9 + w.v_l_shoulder_pitch_link[5]*h8;
-    w.pA_l_shoulder_pitch_link[2] = -w.v_l_shoulder_pitch_link[4]*h8 + 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[3];
-    w.pA_l_shoulder_pitch_link[3] = -0.000192*w.v_l_shoulder_pitch_link[4]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[4]*h11 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[2] + w.v_l_shoulder_pitch_link[1]*h9;
-    w.pA_l_shoulder_pitch_link[4] = -w.v_l_shoulder_pitch_link[3]*h11 + w.v_l_shoulder_pitch_link[5]*h10 - w.v_l_shoulder_pitch_link[0]*h9 + w.v_l_shoulder_pitch_link[2]*h8;
-    w.pA_l_shoulder_pitch_link[5] = -w.v_l_shoulder_pitch_link[4]*h10 + 0.000192*w.v_l_shoulder_pitch_link[3]*w.v_l_shoulder_pitch_link[4] - w.v_l_shoulder_pitch_link[1]*h8 + 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_pitch_link[1];
+    const Scalar h4 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_pitch_link[5];
+    const Scalar h5 = 0.3*w.v_l_shoulder_pitch_link[2] + 0.009*w.v_l_shoulder_pitch_link[3];
+    const Scalar h6 = 0.009*w.v_l_shoulder_pitch_link[2] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[3];
+    const Scalar h7 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[5];
+    w.pA_l_shoulder_pitch_link[0] = -0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[4]*h5;
+    w.pA_l_shoulder_pitch_link[1] = -w.v_l_shoulder_pitch_link[3]*h5 + w.v_l_shoulder_pitch_link[5]*h4;
+    w.pA_l_shoulder_pitch_link[2] = -w.v_l_shoulder_pitch_link[4]*h4 + 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[3];
+    w.pA_l_shoulder_pitch_link[3] = -0.000192*w.v_l_shoulder_pitch_link[4]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[4]*h7 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[2] + w.v_l_shoulder_pitch_link[1]*h5;
+    w.pA_l_shoulder_pitch_link[4] = -w.v_l_shoulder_pitch_link[3]*h7 + w.v_l_shoulder_pitch_link[5]*h6 - w.v_l_shoulder_pitch_link[0]*h5 + w.v_l_shoulder_pitch_link[2]*h4;
+    w.pA_l_shoulder_pitch_link[5] = -w.v_l_shoulder_pitch_link[4]*h6 + 0.000192*w.v_l_shoulder_pitch_link[3]*w.v_l_shoulder_pitch_link[4] - w.v_l_shoulder_pitch_link[1]*h4 + 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_pitch_link[1];
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
     w.sq_l_shoulder_roll_link = std::sin(q[22]);
@@ -561,6 +570,9 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* q, const Scalar* v, Workspac
     w.pA_l_upper_arm[4] = -0.0019845*w.v_l_upper_arm[3]*w.v_l_upper_arm[5] + w.v_l_upper_arm[5]*h6 - 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[0] + w.v_l_shoulder_roll_link[2]*h4;
     w.pA_l_upper_arm[5] = -w.v_l_upper_arm[4]*h6 + w.v_l_upper_arm[3]*h7 - w.v_l_upper_arm[1]*h4 + w.v_l_upper_arm[0]*h5;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
     w.sq_l_forearm = std::sin(q[24]);
@@ -581,16 +593,16 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* q, const Scalar* v, Workspac
     w.c_l_forearm[2] = v[23]*w.v_l_forearm[0];
     w.c_l_forearm[3] = -v[23]*w.v_l_forearm[5];
     w.c_l_forearm[5] = v[23]*w.v_l_forearm[3];
-    const Scalar h8 = 0.92*w.v_l_forearm[0] - 0.10107580000000001*w.v_l_forearm[4];
-    const Scalar h9 = 0.92*w.v_l_forearm[1] + 0.10107580000000001*w.v_l_forearm[3];
-    const Scalar h10 = 0.10107580000000001*w.v_l_forearm[1] + 0.01661854208147*w.v_l_forearm[3];
-    const Scalar h11 = -0.10107580000000001*w.v_l_forearm[0] + 0.01661854208147*w.v_l_forearm[4];
-    w.pA_l_forearm[0] = -w.v_l_forearm[5]*h9 + 0.92*w.v_l_forearm[2]*w.v_l_forearm[4];
-    w.pA_l_forearm[1] = -0.92*w.v_l_forearm[2]*w.v_l_forearm[3] + w.v_l_forearm[5]*h8;
-    w.pA_l_forearm[2] = -w.v_l_forearm[4]*h8 + w.v_l_forearm[3]*h9;
-    w.pA_l_forearm[3] = -w.v_l_forearm[5]*h11 + 0.0005635*w.v_l_forearm[4]*w.v_l_forearm[5] - w.v_l_forearm[2]*h9 + 0.92*w.v_l_forearm[1]*w.v_l_forearm[2];
-    w.pA_l_forearm[4] = -0.0005635*w.v_l_forearm[3]*w.v_l_forearm[5] + w.v_l_forearm[5]*h10 - 0.92*w.v_l_forearm[0]*w.v_l_forearm[2] + w.v_l_forearm[2]*h8;
-    w.pA_l_forearm[5] = -w.v_l_forearm[4]*h10 + w.v_l_forearm[3]*h11 - w.v_l_forearm[1]*h8 + w.v_l_forearm[0]*h9;
+    const Scalar h0 = 0.92*w.v_l_forearm[0] - 0.10107580000000001*w.v_l_forearm[4];
+    const Scalar h1 = 0.92*w.v_l_forearm[1] + 0.10107580000000001*w.v_l_forearm[3];
+    const Scalar h2 = 0.10107580000000001*w.v_l_forearm[1] + 0.01661854208147*w.v_l_forearm[3];
+    const Scalar h3 = -0.10107580000000001*w.v_l_forearm[0] + 0.01661854208147*w.v_l_forearm[4];
+    w.pA_l_forearm[0] = -w.v_l_forearm[5]*h1 + 0.92*w.v_l_forearm[2]*w.v_l_forearm[4];
+    w.pA_l_forearm[1] = -0.92*w.v_l_forearm[2]*w.v_l_forearm[3] + w.v_l_forearm[5]*h0;
+    w.pA_l_forearm[2] = -w.v_l_forearm[4]*h0 + w.v_l_forearm[3]*h1;
+    w.pA_l_forearm[3] = -w.v_l_forearm[5]*h3 + 0.0005635*w.v_l_forearm[4]*w.v_l_forearm[5] - w.v_l_forearm[2]*h1 + 0.92*w.v_l_forearm[1]*w.v_l_forearm[2];
+    w.pA_l_forearm[4] = -0.0005635*w.v_l_forearm[3]*w.v_l_forearm[5] + w.v_l_forearm[5]*h2 - 0.92*w.v_l_forearm[0]*w.v_l_forearm[2] + w.v_l_forearm[2]*h0;
+    w.pA_l_forearm[5] = -w.v_l_forearm[4]*h2 + w.v_l_forearm[3]*h3 - w.v_l_forearm[1]*h0 + w.v_l_forearm[0]*h1;
   }
   // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
@@ -607,20 +619,20 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* q, const Scalar* v, Workspac
     w.c_l_wrist_yaw_link[1] = -v[24]*w.v_l_wrist_yaw_link[0];
     w.c_l_wrist_yaw_link[3] = v[24]*w.v_l_wrist_yaw_link[4];
     w.c_l_wrist_yaw_link[4] = -v[24]*w.v_l_wrist_yaw_link[3];
-    const Scalar h12 = 0.1*w.v_l_wrist_yaw_link[0] + 0.001*w.v_l_wrist_yaw_link[4];
-    const Scalar h13 = 0.1*w.v_l_wrist_yaw_link[1] - 0.001*w.v_l_wrist_yaw_link[3];
-    const Scalar h14 = -0.001*w.v_l_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[3];
-    const Scalar h15 = 0.001*w.v_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[4];
-    w.pA_l_wrist_yaw_link[0] = -w.v_l_wrist_yaw_link[5]*h13 + 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[4];
-    w.pA_l_wrist_yaw_link[1] = -0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[3] + w.v_l_wrist_yaw_link[5]*h12;
-    w.pA_l_wrist_yaw_link[2] = -w.v_l_wrist_yaw_link[4]*h12 + w.v_l_wrist_yaw_link[3]*h13;
-    w.pA_l_wrist_yaw_link[3] = -w.v_l_wrist_yaw_link[5]*h15 + 2.5e-05*w.v_l_wrist_yaw_link[4]*w.v_l_wrist_yaw_link[5] - w.v_l_forearm[2]*h13 + 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[1];
-    w.pA_l_wrist_yaw_link[4] = -2.5e-05*w.v_l_wrist_yaw_link[3]*w.v_l_wrist_yaw_link[5] + w.v_l_wrist_yaw_link[5]*h14 - 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[0] + w.v_l_forearm[2]*h12;
-    w.pA_l_wrist_yaw_link[5] = -w.v_l_wrist_yaw_link[4]*h14 + w.v_l_wrist_yaw_link[3]*h15 - w.v_l_wrist_yaw_link[1]*h12 + w.v_l_wrist_yaw_link[0]*h13;
+    const Scalar h4 = 0.1*w.v_l_wrist_yaw_link[0] + 0.001*w.v_l_wrist_yaw_link[4];
+    const Scalar h5 = 0.1*w.v_l_wrist_yaw_link[1] - 0.001*w.v_l_wrist_yaw_link[3];
+    const Scalar h6 = -0.001*w.v_l_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[3];
+    const Scalar h7 = 0.001*w.v_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[4];
+    w.pA_l_wrist_yaw_link[0] = -w.v_l_wrist_yaw_link[5]*h5 + 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[4];
+    w.pA_l_wrist_yaw_link[1] = -0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[3] + w.v_l_wrist_yaw_link[5]*h4;
+    w.pA_l_wrist_yaw_link[2] = -w.v_l_wrist_yaw_link[4]*h4 + w.v_l_wrist_yaw_link[3]*h5;
+    w.pA_l_wrist_yaw_link[3] = -w.v_l_wrist_yaw_link[5]*h7 + 2.5e-05*w.v_l_wrist_yaw_link[4]*w.v_l_wrist_yaw_link[5] - w.v_l_forearm[2]*h5 + 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[1];
+    w.pA_l_wrist_yaw_link[4] = -2.5e-05*w.v_l_wrist_yaw_link[3]*w.v_l_wrist_yaw_link[5] + w.v_l_wrist_yaw_link[5]*h6 - 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[0] + w.v_l_forearm[2]*h4;
+    w.pA_l_wrist_yaw_link[5] = -w.v_l_wrist_yaw_link[4]*h6 + w.v_l_wrist_yaw_link[3]*h7 - w.v_l_wrist_yaw_link[1]*h4 + w.v_l_wrist_yaw_link[0]*h5;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
     w.sq_l_wrist_pitch_link = std::sin(q[26]);
@@ -669,6 +681,9 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* q, const Scalar* v, Workspac
     w.pA_l_hand[4] = -0.000284375*w.v_l_hand[3]*w.v_l_hand[5] + w.v_l_hand[5]*h6 - 0.42*w.v_l_wrist_pitch_link[0]*w.v_l_hand[2] + w.v_l_hand[2]*h4;
     w.pA_l_hand[5] = -w.v_l_hand[4]*h6 + w.v_l_hand[3]*h7 - w.v_l_hand[1]*h4 + w.v_l_wrist_pitch_link[0]*h5;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
     w.sq_neck_link = std::sin(q[28]);
@@ -684,16 +699,16 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* q, const Scalar* v, Workspac
     w.c_neck_link[1] = -v[27]*w.v_neck_link[0];
     w.c_neck_link[3] = v[27]*w.v_neck_link[4];
     w.c_neck_link[4] = -v[27]*w.v_neck_link[3];
-    const Scalar h8 = 0.5*w.v_neck_link[0] + 0.015*w.v_neck_link[4];
-    const Scalar h9 = 0.5*w.v_neck_link[1] - 0.015*w.v_neck_link[3];
-    const Scalar h10 = -0.015*w.v_neck_link[1] + 0.0007700000000000001*w.v_neck_link[3];
-    const Scalar h11 = 0.015*w.v_neck_link[0] + 0.0007700000000000001*w.v_neck_link[4];
-    w.pA_neck_link[0] = -w.v_neck_link[5]*h9 + 0.5*w.v_chest[2]*w.v_neck_link[4];
-    w.pA_neck_link[1] = -0.5*w.v_chest[2]*w.v_neck_link[3] + w.v_neck_link[5]*h8;
-    w.pA_neck_link[2] = -w.v_neck_link[4]*h8 + w.v_neck_link[3]*h9;
-    w.pA_neck_link[3] = -w.v_neck_link[5]*h11 + 0.00032*w.v_neck_link[4]*w.v_neck_link[5] - w.v_chest[2]*h9 + 0.5*w.v_chest[2]*w.v_neck_link[1];
-    w.pA_neck_link[4] = -0.00032*w.v_neck_link[3]*w.v_neck_link[5] + w.v_neck_link[5]*h10 - 0.5*w.v_chest[2]*w.v_neck_link[0] + w.v_chest[2]*h8;
-    w.pA_neck_link[5] = -w.v_neck_link[4]*h10 + w.v_neck_link[3]*h11 - w.v_neck_link[1]*h8 + w.v_neck_link[0]*h9;
+    const Scalar h0 = 0.5*w.v_neck_link[0] + 0.015*w.v_neck_link[4];
+    const Scalar h1 = 0.5*w.v_neck_link[1] - 0.015*w.v_neck_link[3];
+    const Scalar h2 = -0.015*w.v_neck_link[1] + 0.0007700000000000001*w.v_neck_link[3];
+    const Scalar h3 = 0.015*w.v_neck_link[0] + 0.0007700000000000001*w.v_neck_link[4];
+    w.pA_neck_link[0] = -w.v_neck_link[5]*h1 + 0.5*w.v_chest[2]*w.v_neck_link[4];
+    w.pA_neck_link[1] = -0.5*w.v_chest[2]*w.v_neck_link[3] + w.v_neck_link[5]*h0;
+    w.pA_neck_link[2] = -w.v_neck_link[4]*h0 + w.v_neck_link[3]*h1;
+    w.pA_neck_link[3] = -w.v_neck_link[5]*h3 + 0.00032*w.v_neck_link[4]*w.v_neck_link[5] - w.v_chest[2]*h1 + 0.5*w.v_chest[2]*w.v_neck_link[1];
+    w.pA_neck_link[4] = -0.00032*w.v_neck_link[3]*w.v_neck_link[5] + w.v_neck_link[5]*h2 - 0.5*w.v_chest[2]*w.v_neck_link[0] + w.v_chest[2]*h0;
+    w.pA_neck_link[5] = -w.v_neck_link[4]*h2 + w.v_neck_link[3]*h3 - w.v_neck_link[1]*h0 + w.v_neck_link[0]*h1;
   }
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
@@ -711,20 +726,20 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* q, const Scalar* v, Workspac
     w.c_head[2] = v[28]*w.v_head[0];
     w.c_head[3] = -v[28]*w.v_head[5];
     w.c_head[5] = v[28]*w.v_head[3];
-    const Scalar h12 = 5.17*w.v_head[0] + 0.4717625*w.v_head[4];
-    const Scalar h13 = 5.17*w.v_head[1] - 0.4717625*w.v_head[3];
-    const Scalar h14 = -0.4717625*w.v_head[1] + 0.07202788281129999*w.v_head[3];
-    const Scalar h15 = 0.4717625*w.v_head[0] + 0.07202788281129999*w.v_head[4];
-    w.pA_head[0] = -w.v_head[5]*h13 + 5.17*w.v_head[2]*w.v_head[4];
-    w.pA_head[1] = -5.17*w.v_head[2]*w.v_head[3] + w.v_head[5]*h12;
-    w.pA_head[2] = -w.v_head[4]*h12 + w.v_head[3]*h13;
-    w.pA_head[3] = -w.v_head[5]*h15 + 0.0167508*w.v_head[4]*w.v_head[5] - w.v_head[2]*h13 + 5.17*w.v_head[1]*w.v_head[2];
-    w.pA_head[4] = -0.0167508*w.v_head[3]*w.v_head[5] + w.v_head[5]*h14 - 5.17*w.v_head[0]*w.v_head[2] + w.v_head[2]*h12;
-    w.pA_head[5] = -w.v_head[4]*h14 + w.v_head[3]*h15 - w.v_head[1]*h12 + w.v_head[0]*h13;
+    const Scalar h4 = 5.17*w.v_head[0] + 0.4717625*w.v_head[4];
+    const Scalar h5 = 5.17*w.v_head[1] - 0.4717625*w.v_head[3];
+    const Scalar h6 = -0.4717625*w.v_head[1] + 0.07202788281129999*w.v_head[3];
+    const Scalar h7 = 0.4717625*w.v_head[0] + 0.07202788281129999*w.v_head[4];
+    w.pA_head[0] = -w.v_head[5]*h5 + 5.17*w.v_head[2]*w.v_head[4];
+    w.pA_head[1] = -5.17*w.v_head[2]*w.v_head[3] + w.v_head[5]*h4;
+    w.pA_head[2] = -w.v_head[4]*h4 + w.v_head[3]*h5;
+    w.pA_head[3] = -w.v_head[5]*h7 + 0.0167508*w.v_head[4]*w.v_head[5] - w.v_head[2]*h5 + 5.17*w.v_head[1]*w.v_head[2];
+    w.pA_head[4] = -0.0167508*w.v_head[3]*w.v_head[5] + w.v_head[5]*h6 - 5.17*w.v_head[0]*w.v_head[2] + w.v_head[2]*h4;
+    w.pA_head[5] = -w.v_head[4]*h6 + w.v_head[3]*h7 - w.v_head[1]*h4 + w.v_head[0]*h5;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     w.sq_r_shoulder_pitch_link = std::sin(q[30]);
@@ -791,6 +806,9 @@ PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* q, const Scalar* v, Workspac
     w.g_r_shoulder_roll_link[1] = w.g_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.g_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
     w.g_r_shoulder_roll_link[2] = -w.g_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.g_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.sq_r_upper_arm = std::sin(q[32]);
@@ -804,22 +822,19 @@ PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* q, const Scalar* v, Workspac
     w.c_r_upper_arm[1] = -v[31]*w.v_r_upper_arm[0];
     w.c_r_upper_arm[3] = v[31]*w.v_r_upper_arm[4];
     w.c_r_upper_arm[4] = -v[31]*w.v_r_upper_arm[3];
-    const Scalar h8 = 1.96*w.v_r_upper_arm[0] - 0.27815927999999995*w.v_r_upper_arm[4];
-    const Scalar h9 = 1.96*w.v_r_upper_arm[1] + 0.27815927999999995*w.v_r_upper_arm[3];
-    const Scalar h10 = 0.27815927999999995*w.v_r_upper_arm[1] + 0.061007086312239986*w.v_r_upper_arm[3];
-    const Scalar h11 = -0.27815927999999995*w.v_r_upper_arm[0] + 0.061007086312239986*w.v_r_upper_arm[4];
-    w.pA_r_upper_arm[0] = -w.v_r_upper_arm[5]*h9 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[4];
-    w.pA_r_upper_arm[1] = -1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[3] + w.v_r_upper_arm[5]*h8;
-    w.pA_r_upper_arm[2] = -w.v_r_upper_arm[4]*h8 + w.v_r_upper_arm[3]*h9;
-    w.pA_r_upper_arm[3] = -w.v_r_upper_arm[5]*h11 + 0.0019845*w.v_r_upper_arm[4]*w.v_r_upper_arm[5] - w.v_r_shoulder_roll_link[2]*h9 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[1];
-    w.pA_r_upper_arm[4] = -0.0019845*w.v_r_upper_arm[3]*w.v_r_upper_arm[5] + w.v_r_upper_arm[5]*h10 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[0] + w.v_r_shoulder_roll_link[2]*h8;
-    w.pA_r_upper_arm[5] = -w.v_r_upper_arm[4]*h10 + w.v_r_upper_arm[3]*h11 - w.v_r_upper_arm[1]*h8 + w.v_r_upper_arm[0]*h9;
+    const Scalar h0 = 1.96*w.v_r_upper_arm[0] - 0.27815927999999995*w.v_r_upper_arm[4];
+    const Scalar h1 = 1.96*w.v_r_upper_arm[1] + 0.27815927999999995*w.v_r_upper_arm[3];
+    const Scalar h2 = 0.27815927999999995*w.v_r_upper_arm[1] + 0.061007086312239986*w.v_r_upper_arm[3];
+    const Scalar h3 = -0.27815927999999995*w.v_r_upper_arm[0] + 0.061007086312239986*w.v_r_upper_arm[4];
+    w.pA_r_upper_arm[0] = -w.v_r_upper_arm[5]*h1 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[4];
+    w.pA_r_upper_arm[1] = -1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[3] + w.v_r_upper_arm[5]*h0;
+    w.pA_r_upper_arm[2] = -w.v_r_upper_arm[4]*h0 + w.v_r_upper_arm[3]*h1;
+    w.pA_r_upper_arm[3] = -w.v_r_upper_arm[5]*h3 + 0.0019845*w.v_r_upper_arm[4]*w.v_r_upper_arm[5] - w.v_r_shoulder_roll_link[2]*h1 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[1];
+    w.pA_r_upper_arm[4] = -0.0019845*w.v_r_upper_arm[3]*w.v_r_upper_arm[5] + w.v_r_upper_arm[5]*h2 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[0] + w.v_r_shoulder_roll_link[2]*h0;
+    w.pA_r_upper_arm[5] = -w.v_r_upper_arm[4]*h2 + w.v_r_upper_arm[3]*h3 - w.v_r_upper_arm[1]*h0 + w.v_r_upper_arm[0]*h1;
     w.g_r_upper_arm[0] = w.g_r_shoulder_pitch_link[0]*w.cq_r_upper_arm + w.g_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
     w.g_r_upper_arm[1] = -w.g_r_shoulder_pitch_link[0]*w.sq_r_upper_arm + w.g_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     w.sq_r_forearm = std::sin(q[33]);
@@ -840,29 +855,32 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* q, const Scalar* v, Workspac
     w.c_r_forearm[2] = v[32]*w.v_r_forearm[0];
     w.c_r_forearm[3] = -v[32]*w.v_r_forearm[5];
     w.c_r_forearm[5] = v[32]*w.v_r_forearm[3];
-    const Scalar h0 = 0.92*w.v_r_forearm[0] - 0.10107580000000001*w.v_r_forearm[4];
-    const Scalar h1 = 0.92*w.v_r_forearm[1] + 0.10107580000000001*w.v_r_forearm[3];
-    const Scalar h2 = 0.10107580000000001*w.v_r_forearm[1] + 0.01661854208147*w.v_r_forearm[3];
-    const Scalar h3 = -0.10107580000000001*w.v_r_forearm[0] + 0.01661854208147*w.v_r_forearm[4];
-    w.pA_r_forearm[0] = -w.v_r_forearm[5]*h1 + 0.92*w.v_r_forearm[2]*w.v_r_forearm[4];
-    w.pA_r_forearm[1] = -0.92*w.v_r_forearm[2]*w.v_r_forearm[3] + w.v_r_forearm[5]*h0;
-    w.pA_r_forearm[2] = -w.v_r_forearm[4]*h0 + w.v_r_forearm[3]*h1;
-    w.pA_r_forearm[3] = -w.v_r_forearm[5]*h3 + 0.0005635*w.v_r_forearm[4]*w.v_r_forearm[5] - w.v_r_forearm[2]*h1 + 0.92*w.v_r_forearm[1]*w.v_r_forearm[2];
-    w.pA_r_forearm[4] = -0.0005635*w.v_r_forearm[3]*w.v_r_forearm[5] + w.v_r_forearm[5]*h2 - 0.92*w.v_r_forearm[0]*w.v_r_forearm[2] + w.v_r_forearm[2]*h0;
-    w.pA_r_forearm[5] = -w.v_r_forearm[4]*h2 + w.v_r_forearm[3]*h3 - w.v_r_forearm[1]*h0 + w.v_r_forearm[0]*h1;
+    const Scalar h4 = 0.92*w.v_r_forearm[0] - 0.10107580000000001*w.v_r_forearm[4];
+    const Scalar h5 = 0.92*w.v_r_forearm[1] + 0.10107580000000001*w.v_r_forearm[3];
+    const Scalar h6 = 0.10107580000000001*w.v_r_forearm[1] + 0.01661854208147*w.v_r_forearm[3];
+    const Scalar h7 = -0.10107580000000001*w.v_r_forearm[0] + 0.01661854208147*w.v_r_forearm[4];
+    w.pA_r_forearm[0] = -w.v_r_forearm[5]*h5 + 0.92*w.v_r_forearm[2]*w.v_r_forearm[4];
+    w.pA_r_forearm[1] = -0.92*w.v_r_forearm[2]*w.v_r_forearm[3] + w.v_r_forearm[5]*h4;
+    w.pA_r_forearm[2] = -w.v_r_forearm[4]*h4 + w.v_r_forearm[3]*h5;
+    w.pA_r_forearm[3] = -w.v_r_forearm[5]*h7 + 0.0005635*w.v_r_forearm[4]*w.v_r_forearm[5] - w.v_r_forearm[2]*h5 + 0.92*w.v_r_forearm[1]*w.v_r_forearm[2];
+    w.pA_r_forearm[4] = -0.0005635*w.v_r_forearm[3]*w.v_r_forearm[5] + w.v_r_forearm[5]*h6 - 0.92*w.v_r_forearm[0]*w.v_r_forearm[2] + w.v_r_forearm[2]*h4;
+    w.pA_r_forearm[5] = -w.v_r_forearm[4]*h6 + w.v_r_forearm[3]*h7 - w.v_r_forearm[1]*h4 + w.v_r_forearm[0]*h5;
     const Scalar t6 = 0.29552020666133966*w.g_r_shoulder_roll_link[2] + 0.955336489125606*w.g_r_upper_arm[0];
     const Scalar t7 = 0.955336489125606*w.g_r_shoulder_roll_link[2] - 0.29552020666133966*w.g_r_upper_arm[0];
     w.g_r_forearm[0] = w.cq_r_forearm*t6 - w.sq_r_forearm*t7;
     w.g_r_forearm[2] = w.sq_r_forearm*t6 + w.cq_r_forearm*t7;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     w.sq_r_wrist_yaw_link = std::sin(q[34]);
     w.cq_r_wrist_yaw_link = std::cos(q[34]);
-    const Scalar t8 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
-    const Scalar t9 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
-    w.v_r_wrist_yaw_link[0] = w.cq_r_wrist_yaw_link*t8 + w.sq_r_wrist_yaw_link*t9;
-    w.v_r_wrist_yaw_link[1] = -w.sq_r_wrist_yaw_link*t8 + w.cq_r_wrist_yaw_link*t9;
+    const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
+    const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
+    w.v_r_wrist_yaw_link[0] = w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
+    w.v_r_wrist_yaw_link[1] = -w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
     w.v_r_wrist_yaw_link[3] = w.v_r_forearm[3]*w.cq_r_wrist_yaw_link + w.v_r_forearm[4]*w.sq_r_wrist_yaw_link;
     w.v_r_wrist_yaw_link[4] = -w.v_r_forearm[3]*w.sq_r_wrist_yaw_link + w.v_r_forearm[4]*w.cq_r_wrist_yaw_link;
     w.v_r_wrist_yaw_link[5] = w.v_r_forearm[5] + v[33];
@@ -870,16 +888,16 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* q, const Scalar* v, Workspac
     w.c_r_wrist_yaw_link[1] = -v[33]*w.v_r_wrist_yaw_link[0];
     w.c_r_wrist_yaw_link[3] = v[33]*w.v_r_wrist_yaw_link[4];
     w.c_r_wrist_yaw_link[4] = -v[33]*w.v_r_wrist_yaw_link[3];
-    const Scalar h4 = 0.1*w.v_r_wrist_yaw_link[0] + 0.001*w.v_r_wrist_yaw_link[4];
-    const Scalar h5 = 0.1*w.v_r_wrist_yaw_link[1] - 0.001*w.v_r_wrist_yaw_link[3];
-    const Scalar h6 = -0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[3];
-    const Scalar h7 = 0.001*w.v_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[4];
-    w.pA_r_wrist_yaw_link[0] = -w.v_r_wrist_yaw_link[5]*h5 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[4];
-    w.pA_r_wrist_yaw_link[1] = -0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[3] + w.v_r_wrist_yaw_link[5]*h4;
-    w.pA_r_wrist_yaw_link[2] = -w.v_r_wrist_yaw_link[4]*h4 + w.v_r_wrist_yaw_link[3]*h5;
-    w.pA_r_wrist_yaw_link[3] = -w.v_r_wrist_yaw_link[5]*h7 + 2.5e-05*w.v_r_wrist_yaw_link[4]*w.v_r_wrist_yaw_link[5] - w.v_r_forearm[2]*h5 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[1];
-    w.pA_r_wrist_yaw_link[4] = -2.5e-05*w.v_r_wrist_yaw_link[3]*w.v_r_wrist_yaw_link[5] + w.v_r_wrist_yaw_link[5]*h6 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[0] + w.v_r_forearm[2]*h4;
-    w.pA_r_wrist_yaw_link[5] = -w.v_r_wrist_yaw_link[4]*h6 + w.v_r_wrist_yaw_link[3]*h7 - w.v_r_wrist_yaw_link[1]*h4 + w.v_r_wrist_yaw_link[0]*h5;
+    const Scalar h0 = 0.1*w.v_r_wrist_yaw_link[0] + 0.001*w.v_r_wrist_yaw_link[4];
+    const Scalar h1 = 0.1*w.v_r_wrist_yaw_link[1] - 0.001*w.v_r_wrist_yaw_link[3];
+    const Scalar h2 = -0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[3];
+    const Scalar h3 = 0.001*w.v_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[4];
+    w.pA_r_wrist_yaw_link[0] = -w.v_r_wrist_yaw_link[5]*h1 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[4];
+    w.pA_r_wrist_yaw_link[1] = -0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[3] + w.v_r_wrist_yaw_link[5]*h0;
+    w.pA_r_wrist_yaw_link[2] = -w.v_r_wrist_yaw_link[4]*h0 + w.v_r_wrist_yaw_link[3]*h1;
+    w.pA_r_wrist_yaw_link[3] = -w.v_r_wrist_yaw_link[5]*h3 + 2.5e-05*w.v_r_wrist_yaw_link[4]*w.v_r_wrist_yaw_link[5] - w.v_r_forearm[2]*h1 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[1];
+    w.pA_r_wrist_yaw_link[4] = -2.5e-05*w.v_r_wrist_yaw_link[3]*w.v_r_wrist_yaw_link[5] + w.v_r_wrist_yaw_link[5]*h2 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[0] + w.v_r_forearm[2]*h0;
+    w.pA_r_wrist_yaw_link[5] = -w.v_r_wrist_yaw_link[4]*h2 + w.v_r_wrist_yaw_link[3]*h3 - w.v_r_wrist_yaw_link[1]*h0 + w.v_r_wrist_yaw_link[0]*h1;
     w.g_r_wrist_yaw_link[0] = w.g_r_forearm[0]*w.cq_r_wrist_yaw_link + w.g_r_upper_arm[1]*w.sq_r_wrist_yaw_link;
     w.g_r_wrist_yaw_link[1] = -w.g_r_forearm[0]*w.sq_r_wrist_yaw_link + w.g_r_upper_arm[1]*w.cq_r_wrist_yaw_link;
   }
@@ -896,22 +914,22 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* q, const Scalar* v, Workspac
     w.c_r_wrist_pitch_link[2] = v[34]*w.v_r_wrist_pitch_link[0];
     w.c_r_wrist_pitch_link[3] = -v[34]*w.v_r_wrist_pitch_link[5];
     w.c_r_wrist_pitch_link[5] = v[34]*w.v_r_wrist_pitch_link[3];
-    const Scalar h8 = 0.1*w.v_r_wrist_pitch_link[0] - 0.001*w.v_r_wrist_pitch_link[4];
-    const Scalar h9 = 0.1*w.v_r_wrist_yaw_link[1] + 0.001*w.v_r_wrist_pitch_link[3];
-    const Scalar h10 = 0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_pitch_link[3];
-    const Scalar h11 = -0.001*w.v_r_wrist_pitch_link[0] + 3.5000000000000004e-05*w.v_r_wrist_pitch_link[4];
-    w.pA_r_wrist_pitch_link[0] = -w.v_r_wrist_pitch_link[5]*h9 + 0.1*w.v_r_wrist_pitch_link[2]*w.v_r_wrist_pitch_link[4];
-    w.pA_r_wrist_pitch_link[1] = -0.1*w.v_r_wrist_pitch_link[2]*w.v_r_wrist_pitch_link[3] + w.v_r_wrist_pitch_link[5]*h8;
-    w.pA_r_wrist_pitch_link[2] = -w.v_r_wrist_pitch_link[4]*h8 + w.v_r_wrist_pitch_link[3]*h9;
-    w.pA_r_wrist_pitch_link[3] = -w.v_r_wrist_pitch_link[5]*h11 + 2.5e-05*w.v_r_wrist_pitch_link[4]*w.v_r_wrist_pitch_link[5] - w.v_r_wrist_pitch_link[2]*h9 + 0.1*w.v_r_wrist_yaw_link[1]*w.v_r_wrist_pitch_link[2];
-    w.pA_r_wrist_pitch_link[4] = -2.5e-05*w.v_r_wrist_pitch_link[3]*w.v_r_wrist_pitch_link[5] + w.v_r_wrist_pitch_link[5]*h10 - 0.1*w.v_r_wrist_pitch_link[0]*w.v_r_wrist_pitch_link[2] + w.v_r_wrist_pitch_link[2]*h8;
-    w.pA_r_wrist_pitch_link[5] = -w.v_r_wrist_pitch_link[4]*h10 + w.v_r_wrist_pitch_link[3]*h11 - w.v_r_wrist_yaw_link[1]*h8 + w.v_r_wrist_pitch_link[0]*h9;
+    const Scalar h4 = 0.1*w.v_r_wrist_pitch_link[0] - 0.001*w.v_r_wrist_pitch_link[4];
+    const Scalar h5 = 0.1*w.v_r_wrist_yaw_link[1] + 0.001*w.v_r_wrist_pitch_link[3];
+    const Scalar h6 = 0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_pitch_link[3];
+    const Scalar h7 = -0.001*w.v_r_wrist_pitch_link[0] + 3.5000000000000004e-05*w.v_r_wrist_pitch_link[4];
+    w.pA_r_wrist_pitch_link[0] = -w.v_r_wrist_pitch_link[5]*h5 + 0.1*w.v_r_wrist_pitch_link[2]*w.v_r_wrist_pitch_link[4];
+    w.pA_r_wrist_pitch_link[1] = -0.1*w.v_r_wrist_pitch_link[2]*w.v_r_wrist_pitch_link[3] + w.v_r_wrist_pitch_link[5]*h4;
+    w.pA_r_wrist_pitch_link[2] = -w.v_r_wrist_pitch_link[4]*h4 + w.v_r_wrist_pitch_link[3]*h5;
+    w.pA_r_wrist_pitch_link[3] = -w.v_r_wrist_pitch_link[5]*h7 + 2.5e-05*w.v_r_wrist_pitch_link[4]*w.v_r_wrist_pitch_link[5] - w.v_r_wrist_pitch_link[2]*h5 + 0.1*w.v_r_wrist_yaw_link[1]*w.v_r_wrist_pitch_link[2];
+    w.pA_r_wrist_pitch_link[4] = -2.5e-05*w.v_r_wrist_pitch_link[3]*w.v_r_wrist_pitch_link[5] + w.v_r_wrist_pitch_link[5]*h6 - 0.1*w.v_r_wrist_pitch_link[0]*w.v_r_wrist_pitch_link[2] + w.v_r_wrist_pitch_link[2]*h4;
+    w.pA_r_wrist_pitch_link[5] = -w.v_r_wrist_pitch_link[4]*h6 + w.v_r_wrist_pitch_link[3]*h7 - w.v_r_wrist_yaw_link[1]*h4 + w.v_r_wrist_pitch_link[0]*h5;
     w.g_r_wrist_pitch_link[0] = w.g_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.g_r_forearm[2]*w.sq_r_wrist_pitch_link;
     w.g_r_wrist_pitch_link[2] = w.g_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.g_r_forearm[2]*w.cq_r_wrist_pitch_link;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_15(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.sq_r_hand = std::sin(q[36]);
@@ -946,7 +964,7 @@ PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* q, const Scalar* v, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_0(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
     w.Dinv_head = 1.0 / 0.07202788281129999;
@@ -1044,7 +1062,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_0(const Scalar* tau, Workspace& w) noexc
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
     w.Dinv_l_hand = 1.0 / 0.005164645770899999;
@@ -1119,83 +1137,86 @@ PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* tau, Workspace& w) noexc
     w.pA_l_wrist_yaw_link[4] = w.pA_l_wrist_yaw_link[4] + pa10;
     w.pA_l_wrist_yaw_link[5] = w.pA_l_wrist_yaw_link[5] - w.sq_l_wrist_pitch_link*pa9 + w.cq_l_wrist_pitch_link*pa11;
   }
+}
+
+PROXGEN_RT_NOINLINE void eliminate_free_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
     w.Dinv_l_wrist_yaw_link = 1.0 / w.IA_l_wrist_yaw_link[20];
     w.u_l_wrist_yaw_link[0] = -w.pA_l_wrist_yaw_link[5] + tau[24];
-    const Scalar t5 = w.IA_l_wrist_yaw_link[5]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t6 = w.IA_l_wrist_yaw_link[10]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t7 = w.IA_l_wrist_yaw_link[14]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t8 = w.IA_l_wrist_yaw_link[17]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t9 = w.IA_l_wrist_yaw_link[20]*w.Dinv_l_wrist_yaw_link;
-    const Scalar Ia4 = w.IA_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t5;
-    const Scalar Ia5 = w.IA_l_wrist_yaw_link[1] - w.IA_l_wrist_yaw_link[10]*t5;
-    const Scalar Ia6 = w.IA_l_wrist_yaw_link[2] - w.IA_l_wrist_yaw_link[14]*t5;
-    const Scalar Ia7 = w.IA_l_wrist_yaw_link[3] - w.IA_l_wrist_yaw_link[17]*t5;
-    const Scalar Ia8 = w.IA_l_wrist_yaw_link[6] - w.IA_l_wrist_yaw_link[10]*t6;
-    const Scalar Ia9 = w.IA_l_wrist_yaw_link[7] - w.IA_l_wrist_yaw_link[14]*t6;
-    const Scalar Ia10 = w.IA_l_wrist_yaw_link[8] - w.IA_l_wrist_yaw_link[17]*t6;
-    const Scalar Ia11 = w.IA_l_wrist_yaw_link[11] - w.IA_l_wrist_yaw_link[14]*t7;
-    const Scalar Ia12 = w.IA_l_wrist_yaw_link[12] - w.IA_l_wrist_yaw_link[17]*t7;
-    const Scalar Ia13 = w.IA_l_wrist_yaw_link[15] - w.IA_l_wrist_yaw_link[17]*t8;
-    const Scalar pa12 = 0.001*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[0] + w.u_l_wrist_yaw_link[0]*t5 + w.c_l_wrist_yaw_link[0]*Ia4 + w.c_l_wrist_yaw_link[1]*Ia5 + w.c_l_wrist_yaw_link[3]*Ia7;
-    const Scalar pa13 = w.pA_l_wrist_yaw_link[1] + w.u_l_wrist_yaw_link[0]*t6 + w.c_l_wrist_yaw_link[0]*Ia5 + w.c_l_wrist_yaw_link[1]*Ia8 + w.c_l_wrist_yaw_link[3]*Ia10;
-    const Scalar pa14 = w.pA_l_wrist_yaw_link[2] + w.u_l_wrist_yaw_link[0]*t7 + w.c_l_wrist_yaw_link[0]*Ia6 + w.c_l_wrist_yaw_link[1]*Ia9 + w.c_l_wrist_yaw_link[3]*Ia12;
-    const Scalar pa15 = w.pA_l_wrist_yaw_link[3] + w.u_l_wrist_yaw_link[0]*t8 + w.c_l_wrist_yaw_link[0]*Ia7 + w.c_l_wrist_yaw_link[1]*Ia10 + w.c_l_wrist_yaw_link[3]*Ia13;
-    const Scalar pa16 = 0.001*w.c_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[4];
-    const Scalar pa17 = w.pA_l_wrist_yaw_link[5] + w.u_l_wrist_yaw_link[0]*t9;
-    const Scalar C22 = -w.sq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link + w.cq_l_wrist_yaw_link*w.cq_l_wrist_yaw_link;
-    const Scalar h3 = 0.5*(Ia4 - Ia8);
-    const Scalar m3 = 0.5*(Ia4 + Ia8);
-    const Scalar t10 = 2.0*w.cq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link;
-    const Scalar d0 = -Ia5*t10 + C22*h3;
-    const Scalar qq0 = Ia5*C22 + h3*t10;
-    const Scalar t11 = 0.0005 + 0.5*Ia10;
-    const Scalar d1 = -t10*t11 + 0.5*Ia7*C22;
-    const Scalar qq1 = C22*t11 + 0.5*Ia7*t10;
-    const Scalar h4 = -1.7500000000000002e-05 + 0.5*Ia13;
-    const Scalar m4 = 1.7500000000000002e-05 + 0.5*Ia13;
-    const Scalar t12 = m3 + d0;
-    const Scalar t13 = -w.sq_l_wrist_yaw_link*Ia9 + w.cq_l_wrist_yaw_link*Ia6;
-    const Scalar t14 = m3 - d0;
-    const Scalar t15 = w.cq_l_wrist_yaw_link*Ia9 + w.sq_l_wrist_yaw_link*Ia6;
-    const Scalar t16 = 0.5*Ia7 + d1;
-    const Scalar t17 = 0.0005 - 0.5*Ia10 + qq1;
-    const Scalar t18 = -0.0005 + 0.5*Ia10 + qq1;
-    const Scalar t19 = 0.5*Ia7 - d1;
-    const Scalar t20 = 0.2555*qq0 + t16;
-    const Scalar t21 = -0.2555*t12 + t17;
-    const Scalar t22 = 0.2555*t14 + t18;
-    const Scalar t23 = -0.2555*qq0 + t19;
-    const Scalar t24 = w.cq_l_wrist_yaw_link*Ia12 + 0.2555*t15;
-    const Scalar t25 = w.sq_l_wrist_yaw_link*Ia12 - 0.2555*t13;
-    const Scalar t26 = w.cq_l_wrist_yaw_link*pa12 - w.sq_l_wrist_yaw_link*pa13;
-    const Scalar t27 = w.sq_l_wrist_yaw_link*pa12 + w.cq_l_wrist_yaw_link*pa13;
-    w.IA_l_forearm[0] = 0.92 + t12;
+    const Scalar t0 = w.IA_l_wrist_yaw_link[5]*w.Dinv_l_wrist_yaw_link;
+    const Scalar t1 = w.IA_l_wrist_yaw_link[10]*w.Dinv_l_wrist_yaw_link;
+    const Scalar t2 = w.IA_l_wrist_yaw_link[14]*w.Dinv_l_wrist_yaw_link;
+    const Scalar t3 = w.IA_l_wrist_yaw_link[17]*w.Dinv_l_wrist_yaw_link;
+    const Scalar t4 = w.IA_l_wrist_yaw_link[20]*w.Dinv_l_wrist_yaw_link;
+    const Scalar Ia0 = w.IA_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t0;
+    const Scalar Ia1 = w.IA_l_wrist_yaw_link[1] - w.IA_l_wrist_yaw_link[10]*t0;
+    const Scalar Ia2 = w.IA_l_wrist_yaw_link[2] - w.IA_l_wrist_yaw_link[14]*t0;
+    const Scalar Ia3 = w.IA_l_wrist_yaw_link[3] - w.IA_l_wrist_yaw_link[17]*t0;
+    const Scalar Ia4 = w.IA_l_wrist_yaw_link[6] - w.IA_l_wrist_yaw_link[10]*t1;
+    const Scalar Ia5 = w.IA_l_wrist_yaw_link[7] - w.IA_l_wrist_yaw_link[14]*t1;
+    const Scalar Ia6 = w.IA_l_wrist_yaw_link[8] - w.IA_l_wrist_yaw_link[17]*t1;
+    const Scalar Ia7 = w.IA_l_wrist_yaw_link[11] - w.IA_l_wrist_yaw_link[14]*t2;
+    const Scalar Ia8 = w.IA_l_wrist_yaw_link[12] - w.IA_l_wrist_yaw_link[17]*t2;
+    const Scalar Ia9 = w.IA_l_wrist_yaw_link[15] - w.IA_l_wrist_yaw_link[17]*t3;
+    const Scalar pa0 = 0.001*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[0] + w.u_l_wrist_yaw_link[0]*t0 + w.c_l_wrist_yaw_link[0]*Ia0 + w.c_l_wrist_yaw_link[1]*Ia1 + w.c_l_wrist_yaw_link[3]*Ia3;
+    const Scalar pa1 = w.pA_l_wrist_yaw_link[1] + w.u_l_wrist_yaw_link[0]*t1 + w.c_l_wrist_yaw_link[0]*Ia1 + w.c_l_wrist_yaw_link[1]*Ia4 + w.c_l_wrist_yaw_link[3]*Ia6;
+    const Scalar pa2 = w.pA_l_wrist_yaw_link[2] + w.u_l_wrist_yaw_link[0]*t2 + w.c_l_wrist_yaw_link[0]*Ia2 + w.c_l_wrist_yaw_link[1]*Ia5 + w.c_l_wrist_yaw_link[3]*Ia8;
+    const Scalar pa3 = w.pA_l_wrist_yaw_link[3] + w.u_l_wrist_yaw_link[0]*t3 + w.c_l_wrist_yaw_link[0]*Ia3 + w.c_l_wrist_yaw_link[1]*Ia6 + w.c_l_wrist_yaw_link[3]*Ia9;
+    const Scalar pa4 = 0.001*w.c_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[4];
+    const Scalar pa5 = w.pA_l_wrist_yaw_link[5] + w.u_l_wrist_yaw_link[0]*t4;
+    const Scalar C20 = -w.sq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link + w.cq_l_wrist_yaw_link*w.cq_l_wrist_yaw_link;
+    const Scalar h0 = 0.5*(Ia0 - Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar t6 = 0.0005 + 0.5*Ia6;
+    const Scalar d1 = -t5*t6 + 0.5*Ia3*C20;
+    const Scalar qq1 = C20*t6 + 0.5*Ia3*t5;
+    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia9;
+    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia9;
+    const Scalar t7 = m0 + d0;
+    const Scalar t8 = -w.sq_l_wrist_yaw_link*Ia5 + w.cq_l_wrist_yaw_link*Ia2;
+    const Scalar t9 = m0 - d0;
+    const Scalar t10 = w.cq_l_wrist_yaw_link*Ia5 + w.sq_l_wrist_yaw_link*Ia2;
+    const Scalar t11 = 0.5*Ia3 + d1;
+    const Scalar t12 = 0.0005 - 0.5*Ia6 + qq1;
+    const Scalar t13 = -0.0005 + 0.5*Ia6 + qq1;
+    const Scalar t14 = 0.5*Ia3 - d1;
+    const Scalar t15 = 0.2555*qq0 + t11;
+    const Scalar t16 = -0.2555*t7 + t12;
+    const Scalar t17 = 0.2555*t9 + t13;
+    const Scalar t18 = -0.2555*qq0 + t14;
+    const Scalar t19 = w.cq_l_wrist_yaw_link*Ia8 + 0.2555*t10;
+    const Scalar t20 = w.sq_l_wrist_yaw_link*Ia8 - 0.2555*t8;
+    const Scalar t21 = w.cq_l_wrist_yaw_link*pa0 - w.sq_l_wrist_yaw_link*pa1;
+    const Scalar t22 = w.sq_l_wrist_yaw_link*pa0 + w.cq_l_wrist_yaw_link*pa1;
+    w.IA_l_forearm[0] = 0.92 + t7;
     w.IA_l_forearm[1] = qq0;
-    w.IA_l_forearm[2] = t13;
-    w.IA_l_forearm[3] = t20;
-    w.IA_l_forearm[4] = -0.10107580000000001 + t21;
-    w.IA_l_forearm[6] = 0.92 + t14;
-    w.IA_l_forearm[7] = t15;
-    w.IA_l_forearm[8] = 0.10107580000000001 + t22;
-    w.IA_l_forearm[9] = t23;
-    w.IA_l_forearm[11] = 0.92 + Ia11;
-    w.IA_l_forearm[12] = t24;
-    w.IA_l_forearm[13] = t25;
-    w.IA_l_forearm[15] = 0.01661854208147 + m4 + C22*h4 + 0.2555*t18 + 0.2555*t22;
-    w.IA_l_forearm[16] = t10*h4 - 0.2555*t16 + 0.2555*t23;
-    w.IA_l_forearm[18] = 0.01661854208147 + m4 - C22*h4 - 0.2555*t17 - 0.2555*t21;
-    w.pA_l_forearm[0] = w.pA_l_forearm[0] + t26;
-    w.pA_l_forearm[1] = w.pA_l_forearm[1] + t27;
-    w.pA_l_forearm[2] = w.pA_l_forearm[2] + pa14;
-    w.pA_l_forearm[3] = w.pA_l_forearm[3] + w.cq_l_wrist_yaw_link*pa15 - w.sq_l_wrist_yaw_link*pa16 + 0.2555*t27;
-    w.pA_l_forearm[4] = w.pA_l_forearm[4] + w.sq_l_wrist_yaw_link*pa15 + w.cq_l_wrist_yaw_link*pa16 - 0.2555*t26;
-    w.pA_l_forearm[5] = w.pA_l_forearm[5] + pa17;
+    w.IA_l_forearm[2] = t8;
+    w.IA_l_forearm[3] = t15;
+    w.IA_l_forearm[4] = -0.10107580000000001 + t16;
+    w.IA_l_forearm[6] = 0.92 + t9;
+    w.IA_l_forearm[7] = t10;
+    w.IA_l_forearm[8] = 0.10107580000000001 + t17;
+    w.IA_l_forearm[9] = t18;
+    w.IA_l_forearm[11] = 0.92 + Ia7;
+    w.IA_l_forearm[12] = t19;
+    w.IA_l_forearm[13] = t20;
+    w.IA_l_forearm[15] = 0.01661854208147 + m1 + C20*h1 + 0.2555*t13 + 0.2555*t17;
+    w.IA_l_forearm[16] = t5*h1 - 0.2555*t11 + 0.2555*t18;
+    w.IA_l_forearm[18] = 0.01661854208147 + m1 - C20*h1 - 0.2555*t12 - 0.2555*t16;
+    w.pA_l_forearm[0] = w.pA_l_forearm[0] + t21;
+    w.pA_l_forearm[1] = w.pA_l_forearm[1] + t22;
+    w.pA_l_forearm[2] = w.pA_l_forearm[2] + pa2;
+    w.pA_l_forearm[3] = w.pA_l_forearm[3] + w.cq_l_wrist_yaw_link*pa3 - w.sq_l_wrist_yaw_link*pa4 + 0.2555*t22;
+    w.pA_l_forearm[4] = w.pA_l_forearm[4] + w.sq_l_wrist_yaw_link*pa3 + w.cq_l_wrist_yaw_link*pa4 - 0.2555*t21;
+    w.pA_l_forearm[5] = w.pA_l_forearm[5] + pa5;
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
     w.Dinv_l_forearm = 1.0 / w.IA_l_forearm[18];
@@ -1295,7 +1316,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_2(const Scalar* tau, Workspace& w) noexc
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
     w.Dinv_l_upper_arm = 1.0 / w.IA_l_upper_arm[20];
@@ -1364,66 +1385,69 @@ PROXGEN_RT_NOINLINE void eliminate_free_3(const Scalar* tau, Workspace& w) noexc
     w.pA_l_shoulder_roll_link[4] = w.pA_l_shoulder_roll_link[4] + w.sq_l_upper_arm*pa3 + w.cq_l_upper_arm*pa4;
     w.pA_l_shoulder_roll_link[5] = w.pA_l_shoulder_roll_link[5] + pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void eliminate_free_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
     w.Dinv_l_shoulder_roll_link = 1.0 / w.IA_l_shoulder_roll_link[15];
     w.u_l_shoulder_roll_link[0] = -w.pA_l_shoulder_roll_link[3] + tau[21];
-    const Scalar t8 = w.IA_l_shoulder_roll_link[3]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t9 = w.IA_l_shoulder_roll_link[8]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t10 = w.IA_l_shoulder_roll_link[12]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t11 = w.IA_l_shoulder_roll_link[15]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t12 = w.IA_l_shoulder_roll_link[16]*w.Dinv_l_shoulder_roll_link;
-    const Scalar Ia15 = w.IA_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*t8;
-    const Scalar Ia16 = w.IA_l_shoulder_roll_link[1] - w.IA_l_shoulder_roll_link[8]*t8;
-    const Scalar Ia17 = w.IA_l_shoulder_roll_link[2] - w.IA_l_shoulder_roll_link[12]*t8;
-    const Scalar Ia18 = w.IA_l_shoulder_roll_link[4] - w.IA_l_shoulder_roll_link[16]*t8;
-    const Scalar Ia19 = w.IA_l_shoulder_roll_link[6] - w.IA_l_shoulder_roll_link[8]*t9;
-    const Scalar Ia20 = w.IA_l_shoulder_roll_link[7] - w.IA_l_shoulder_roll_link[12]*t9;
-    const Scalar Ia21 = w.IA_l_shoulder_roll_link[9] - w.IA_l_shoulder_roll_link[16]*t9;
-    const Scalar Ia22 = w.IA_l_shoulder_roll_link[11] - w.IA_l_shoulder_roll_link[12]*t10;
-    const Scalar Ia23 = w.IA_l_shoulder_roll_link[13] - w.IA_l_shoulder_roll_link[16]*t10;
-    const Scalar Ia24 = w.IA_l_shoulder_roll_link[18] - w.IA_l_shoulder_roll_link[16]*t12;
-    const Scalar pa6 = w.pA_l_shoulder_roll_link[0] + w.u_l_shoulder_roll_link[0]*t8 + w.c_l_shoulder_roll_link[1]*Ia16 + w.c_l_shoulder_roll_link[2]*Ia17 + w.c_l_shoulder_roll_link[4]*Ia18;
-    const Scalar pa7 = w.pA_l_shoulder_roll_link[1] + w.u_l_shoulder_roll_link[0]*t9 + w.c_l_shoulder_roll_link[1]*Ia19 + w.c_l_shoulder_roll_link[2]*Ia20 + w.c_l_shoulder_roll_link[4]*Ia21;
-    const Scalar pa8 = w.pA_l_shoulder_roll_link[2] + w.u_l_shoulder_roll_link[0]*t10 + w.c_l_shoulder_roll_link[1]*Ia20 + w.c_l_shoulder_roll_link[2]*Ia22 + w.c_l_shoulder_roll_link[4]*Ia23;
-    const Scalar pa9 = w.pA_l_shoulder_roll_link[3] + w.u_l_shoulder_roll_link[0]*t11;
-    const Scalar pa10 = w.pA_l_shoulder_roll_link[4] + w.u_l_shoulder_roll_link[0]*t12 + w.c_l_shoulder_roll_link[1]*Ia21 + w.c_l_shoulder_roll_link[2]*Ia23 + w.c_l_shoulder_roll_link[4]*Ia24;
-    const Scalar pa11 = 0.000192*w.c_l_shoulder_roll_link[5] + w.pA_l_shoulder_roll_link[5];
-    const Scalar C21 = -w.sq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link + w.cq_l_shoulder_roll_link*w.cq_l_shoulder_roll_link;
-    const Scalar h3 = 0.5*(Ia19 - Ia22);
-    const Scalar m3 = 0.5*(Ia19 + Ia22);
-    const Scalar t13 = 2.0*w.cq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link;
-    const Scalar d3 = -Ia20*t13 + C21*h3;
-    const Scalar qq3 = Ia20*C21 + h3*t13;
-    const Scalar d4 = 0.5*(-Ia23*t13 + Ia21*C21);
-    const Scalar qq4 = 0.5*(Ia23*C21 + Ia21*t13);
-    const Scalar h4 = -9.6e-05 + 0.5*Ia24;
-    const Scalar m4 = 9.6e-05 + 0.5*Ia24;
-    w.IA_l_shoulder_pitch_link[0] = 0.3 + Ia15;
-    w.IA_l_shoulder_pitch_link[1] = -w.sq_l_shoulder_roll_link*Ia17 + w.cq_l_shoulder_roll_link*Ia16;
-    w.IA_l_shoulder_pitch_link[2] = w.cq_l_shoulder_roll_link*Ia17 + w.sq_l_shoulder_roll_link*Ia16;
-    w.IA_l_shoulder_pitch_link[4] = w.cq_l_shoulder_roll_link*Ia18;
-    w.IA_l_shoulder_pitch_link[5] = -0.009 + w.sq_l_shoulder_roll_link*Ia18;
-    w.IA_l_shoulder_pitch_link[6] = 0.3 + m3 + d3;
-    w.IA_l_shoulder_pitch_link[7] = qq3;
-    w.IA_l_shoulder_pitch_link[9] = 0.5*Ia21 + d4;
-    w.IA_l_shoulder_pitch_link[10] = -0.5*Ia23 + qq4;
-    w.IA_l_shoulder_pitch_link[11] = 0.3 + m3 - d3;
-    w.IA_l_shoulder_pitch_link[13] = 0.5*Ia23 + qq4;
-    w.IA_l_shoulder_pitch_link[14] = 0.5*Ia21 - d4;
-    w.IA_l_shoulder_pitch_link[18] = 0.000192 + m4 + C21*h4;
-    w.IA_l_shoulder_pitch_link[19] = t13*h4;
-    w.IA_l_shoulder_pitch_link[20] = 0.00046199999999999995 + m4 - C21*h4;
-    w.pA_l_shoulder_pitch_link[0] = w.pA_l_shoulder_pitch_link[0] + pa6;
-    w.pA_l_shoulder_pitch_link[1] = w.pA_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*pa7 - w.sq_l_shoulder_roll_link*pa8;
-    w.pA_l_shoulder_pitch_link[2] = w.pA_l_shoulder_pitch_link[2] + w.sq_l_shoulder_roll_link*pa7 + w.cq_l_shoulder_roll_link*pa8;
-    w.pA_l_shoulder_pitch_link[3] = w.pA_l_shoulder_pitch_link[3] + pa9;
-    w.pA_l_shoulder_pitch_link[4] = w.pA_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*pa10 - w.sq_l_shoulder_roll_link*pa11;
-    w.pA_l_shoulder_pitch_link[5] = w.pA_l_shoulder_pitch_link[5] + w.sq_l_shoulder_roll_link*pa10 + w.cq_l_shoulder_roll_link*pa11;
+    const Scalar t0 = w.IA_l_shoulder_roll_link[3]*w.Dinv_l_shoulder_roll_link;
+    const Scalar t1 = w.IA_l_shoulder_roll_link[8]*w.Dinv_l_shoulder_roll_link;
+    const Scalar t2 = w.IA_l_shoulder_roll_link[12]*w.Dinv_l_shoulder_roll_link;
+    const Scalar t3 = w.IA_l_shoulder_roll_link[15]*w.Dinv_l_shoulder_roll_link;
+    const Scalar t4 = w.IA_l_shoulder_roll_link[16]*w.Dinv_l_shoulder_roll_link;
+    const Scalar Ia0 = w.IA_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*t0;
+    const Scalar Ia1 = w.IA_l_shoulder_roll_link[1] - w.IA_l_shoulder_roll_link[8]*t0;
+    const Scalar Ia2 = w.IA_l_shoulder_roll_link[2] - w.IA_l_shoulder_roll_link[12]*t0;
+    const Scalar Ia3 = w.IA_l_shoulder_roll_link[4] - w.IA_l_shoulder_roll_link[16]*t0;
+    const Scalar Ia4 = w.IA_l_shoulder_roll_link[6] - w.IA_l_shoulder_roll_link[8]*t1;
+    const Scalar Ia5 = w.IA_l_shoulder_roll_link[7] - w.IA_l_shoulder_roll_link[12]*t1;
+    const Scalar Ia6 = w.IA_l_shoulder_roll_link[9] - w.IA_l_shoulder_roll_link[16]*t1;
+    const Scalar Ia7 = w.IA_l_shoulder_roll_link[11] - w.IA_l_shoulder_roll_link[12]*t2;
+    const Scalar Ia8 = w.IA_l_shoulder_roll_link[13] - w.IA_l_shoulder_roll_link[16]*t2;
+    const Scalar Ia9 = w.IA_l_shoulder_roll_link[18] - w.IA_l_shoulder_roll_link[16]*t4;
+    const Scalar pa0 = w.pA_l_shoulder_roll_link[0] + w.u_l_shoulder_roll_link[0]*t0 + w.c_l_shoulder_roll_link[1]*Ia1 + w.c_l_shoulder_roll_link[2]*Ia2 + w.c_l_shoulder_roll_link[4]*Ia3;
+    const Scalar pa1 = w.pA_l_shoulder_roll_link[1] + w.u_l_shoulder_roll_link[0]*t1 + w.c_l_shoulder_roll_link[1]*Ia4 + w.c_l_shoulder_roll_link[2]*Ia5 + w.c_l_shoulder_roll_link[4]*Ia6;
+    const Scalar pa2 = w.pA_l_shoulder_roll_link[2] + w.u_l_shoulder_roll_link[0]*t2 + w.c_l_shoulder_roll_link[1]*Ia5 + w.c_l_shoulder_roll_link[2]*Ia7 + w.c_l_shoulder_roll_link[4]*Ia8;
+    const Scalar pa3 = w.pA_l_shoulder_roll_link[3] + w.u_l_shoulder_roll_link[0]*t3;
+    const Scalar pa4 = w.pA_l_shoulder_roll_link[4] + w.u_l_shoulder_roll_link[0]*t4 + w.c_l_shoulder_roll_link[1]*Ia6 + w.c_l_shoulder_roll_link[2]*Ia8 + w.c_l_shoulder_roll_link[4]*Ia9;
+    const Scalar pa5 = 0.000192*w.c_l_shoulder_roll_link[5] + w.pA_l_shoulder_roll_link[5];
+    const Scalar C20 = -w.sq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link + w.cq_l_shoulder_roll_link*w.cq_l_shoulder_roll_link;
+    const Scalar h0 = 0.5*(Ia4 - Ia7);
+    const Scalar m0 = 0.5*(Ia4 + Ia7);
+    const Scalar t5 = 2.0*w.cq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link;
+    const Scalar d0 = -Ia5*t5 + C20*h0;
+    const Scalar qq0 = Ia5*C20 + h0*t5;
+    const Scalar d1 = 0.5*(-Ia8*t5 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia8*C20 + Ia6*t5);
+    const Scalar h1 = -9.6e-05 + 0.5*Ia9;
+    const Scalar m1 = 9.6e-05 + 0.5*Ia9;
+    w.IA_l_shoulder_pitch_link[0] = 0.3 + Ia0;
+    w.IA_l_shoulder_pitch_link[1] = -w.sq_l_shoulder_roll_link*Ia2 + w.cq_l_shoulder_roll_link*Ia1;
+    w.IA_l_shoulder_pitch_link[2] = w.cq_l_shoulder_roll_link*Ia2 + w.sq_l_shoulder_roll_link*Ia1;
+    w.IA_l_shoulder_pitch_link[4] = w.cq_l_shoulder_roll_link*Ia3;
+    w.IA_l_shoulder_pitch_link[5] = -0.009 + w.sq_l_shoulder_roll_link*Ia3;
+    w.IA_l_shoulder_pitch_link[6] = 0.3 + m0 + d0;
+    w.IA_l_shoulder_pitch_link[7] = qq0;
+    w.IA_l_shoulder_pitch_link[9] = 0.5*Ia6 + d1;
+    w.IA_l_shoulder_pitch_link[10] = -0.5*Ia8 + qq1;
+    w.IA_l_shoulder_pitch_link[11] = 0.3 + m0 - d0;
+    w.IA_l_shoulder_pitch_link[13] = 0.5*Ia8 + qq1;
+    w.IA_l_shoulder_pitch_link[14] = 0.5*Ia6 - d1;
+    w.IA_l_shoulder_pitch_link[18] = 0.000192 + m1 + C20*h1;
+    w.IA_l_shoulder_pitch_link[19] = t5*h1;
+    w.IA_l_shoulder_pitch_link[20] = 0.00046199999999999995 + m1 - C20*h1;
+    w.pA_l_shoulder_pitch_link[0] = w.pA_l_shoulder_pitch_link[0] + pa0;
+    w.pA_l_shoulder_pitch_link[1] = w.pA_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*pa1 - w.sq_l_shoulder_roll_link*pa2;
+    w.pA_l_shoulder_pitch_link[2] = w.pA_l_shoulder_pitch_link[2] + w.sq_l_shoulder_roll_link*pa1 + w.cq_l_shoulder_roll_link*pa2;
+    w.pA_l_shoulder_pitch_link[3] = w.pA_l_shoulder_pitch_link[3] + pa3;
+    w.pA_l_shoulder_pitch_link[4] = w.pA_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*pa4 - w.sq_l_shoulder_roll_link*pa5;
+    w.pA_l_shoulder_pitch_link[5] = w.pA_l_shoulder_pitch_link[5] + w.sq_l_shoulder_roll_link*pa4 + w.cq_l_shoulder_roll_link*pa5;
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_4(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
     w.Dinv_l_shoulder_pitch_link = 1.0 / w.IA_l_shoulder_pitch_link[18];
@@ -1538,7 +1562,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_4(const Scalar* tau, Workspace& w) noexc
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.U_r_hand[1] = 0.04016628 + 0.13*mu;
@@ -1623,83 +1647,86 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_r_wrist_yaw_link[4] = w.pA_r_wrist_yaw_link[4] + pa10;
     w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq_r_wrist_pitch_link*pa9 + w.cq_r_wrist_pitch_link*pa11;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     w.Dinv_r_wrist_yaw_link = 1.0 / w.IA_r_wrist_yaw_link[20];
     w.u_r_wrist_yaw_link[0] = -w.pA_r_wrist_yaw_link[5] + tau[33];
-    const Scalar t7 = w.IA_r_wrist_yaw_link[5]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t8 = w.IA_r_wrist_yaw_link[10]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t9 = w.IA_r_wrist_yaw_link[14]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t10 = w.IA_r_wrist_yaw_link[17]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t11 = w.IA_r_wrist_yaw_link[20]*w.Dinv_r_wrist_yaw_link;
-    const Scalar Ia7 = w.IA_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t7;
-    const Scalar Ia8 = w.IA_r_wrist_yaw_link[1] - w.IA_r_wrist_yaw_link[10]*t7;
-    const Scalar Ia9 = w.IA_r_wrist_yaw_link[2] - w.IA_r_wrist_yaw_link[14]*t7;
-    const Scalar Ia10 = w.IA_r_wrist_yaw_link[3] - w.IA_r_wrist_yaw_link[17]*t7;
-    const Scalar Ia11 = w.IA_r_wrist_yaw_link[6] - w.IA_r_wrist_yaw_link[10]*t8;
-    const Scalar Ia12 = w.IA_r_wrist_yaw_link[7] - w.IA_r_wrist_yaw_link[14]*t8;
-    const Scalar Ia13 = w.IA_r_wrist_yaw_link[8] - w.IA_r_wrist_yaw_link[17]*t8;
-    const Scalar Ia14 = w.IA_r_wrist_yaw_link[11] - w.IA_r_wrist_yaw_link[14]*t9;
-    const Scalar Ia15 = w.IA_r_wrist_yaw_link[12] - w.IA_r_wrist_yaw_link[17]*t9;
-    const Scalar Ia16 = w.IA_r_wrist_yaw_link[15] - w.IA_r_wrist_yaw_link[17]*t10;
-    const Scalar pa12 = 0.001*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[0] + w.u_r_wrist_yaw_link[0]*t7 + w.c_r_wrist_yaw_link[0]*Ia7 + w.c_r_wrist_yaw_link[1]*Ia8 + w.c_r_wrist_yaw_link[3]*Ia10;
-    const Scalar pa13 = w.pA_r_wrist_yaw_link[1] + w.u_r_wrist_yaw_link[0]*t8 + w.c_r_wrist_yaw_link[0]*Ia8 + w.c_r_wrist_yaw_link[1]*Ia11 + w.c_r_wrist_yaw_link[3]*Ia13;
-    const Scalar pa14 = w.pA_r_wrist_yaw_link[2] + w.u_r_wrist_yaw_link[0]*t9 + w.c_r_wrist_yaw_link[0]*Ia9 + w.c_r_wrist_yaw_link[1]*Ia12 + w.c_r_wrist_yaw_link[3]*Ia15;
-    const Scalar pa15 = w.pA_r_wrist_yaw_link[3] + w.u_r_wrist_yaw_link[0]*t10 + w.c_r_wrist_yaw_link[0]*Ia10 + w.c_r_wrist_yaw_link[1]*Ia13 + w.c_r_wrist_yaw_link[3]*Ia16;
-    const Scalar pa16 = 0.001*w.c_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[4];
-    const Scalar pa17 = w.pA_r_wrist_yaw_link[5] + w.u_r_wrist_yaw_link[0]*t11;
-    const Scalar C22 = -w.sq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link + w.cq_r_wrist_yaw_link*w.cq_r_wrist_yaw_link;
-    const Scalar h4 = 0.5*(Ia7 - Ia11);
-    const Scalar m4 = 0.5*(Ia7 + Ia11);
-    const Scalar t12 = 2.0*w.cq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
-    const Scalar d0 = -Ia8*t12 + C22*h4;
-    const Scalar qq0 = Ia8*C22 + h4*t12;
-    const Scalar t13 = 0.0005 + 0.5*Ia13;
-    const Scalar d1 = -t12*t13 + 0.5*Ia10*C22;
-    const Scalar qq1 = C22*t13 + 0.5*Ia10*t12;
-    const Scalar h5 = -1.7500000000000002e-05 + 0.5*Ia16;
-    const Scalar m5 = 1.7500000000000002e-05 + 0.5*Ia16;
-    const Scalar t14 = m4 + d0;
-    const Scalar t15 = -w.sq_r_wrist_yaw_link*Ia12 + w.cq_r_wrist_yaw_link*Ia9;
-    const Scalar t16 = m4 - d0;
-    const Scalar t17 = w.cq_r_wrist_yaw_link*Ia12 + w.sq_r_wrist_yaw_link*Ia9;
-    const Scalar t18 = 0.5*Ia10 + d1;
-    const Scalar t19 = 0.0005 - 0.5*Ia13 + qq1;
-    const Scalar t20 = -0.0005 + 0.5*Ia13 + qq1;
-    const Scalar t21 = 0.5*Ia10 - d1;
-    const Scalar t22 = 0.2555*qq0 + t18;
-    const Scalar t23 = -0.2555*t14 + t19;
-    const Scalar t24 = 0.2555*t16 + t20;
-    const Scalar t25 = -0.2555*qq0 + t21;
-    const Scalar t26 = w.cq_r_wrist_yaw_link*Ia15 + 0.2555*t17;
-    const Scalar t27 = w.sq_r_wrist_yaw_link*Ia15 - 0.2555*t15;
-    const Scalar t28 = w.cq_r_wrist_yaw_link*pa12 - w.sq_r_wrist_yaw_link*pa13;
-    const Scalar t29 = w.sq_r_wrist_yaw_link*pa12 + w.cq_r_wrist_yaw_link*pa13;
-    w.IA_r_forearm[0] = 0.92 + t14;
+    const Scalar t0 = w.IA_r_wrist_yaw_link[5]*w.Dinv_r_wrist_yaw_link;
+    const Scalar t1 = w.IA_r_wrist_yaw_link[10]*w.Dinv_r_wrist_yaw_link;
+    const Scalar t2 = w.IA_r_wrist_yaw_link[14]*w.Dinv_r_wrist_yaw_link;
+    const Scalar t3 = w.IA_r_wrist_yaw_link[17]*w.Dinv_r_wrist_yaw_link;
+    const Scalar t4 = w.IA_r_wrist_yaw_link[20]*w.Dinv_r_wrist_yaw_link;
+    const Scalar Ia0 = w.IA_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t0;
+    const Scalar Ia1 = w.IA_r_wrist_yaw_link[1] - w.IA_r_wrist_yaw_link[10]*t0;
+    const Scalar Ia2 = w.IA_r_wrist_yaw_link[2] - w.IA_r_wrist_yaw_link[14]*t0;
+    const Scalar Ia3 = w.IA_r_wrist_yaw_link[3] - w.IA_r_wrist_yaw_link[17]*t0;
+    const Scalar Ia4 = w.IA_r_wrist_yaw_link[6] - w.IA_r_wrist_yaw_link[10]*t1;
+    const Scalar Ia5 = w.IA_r_wrist_yaw_link[7] - w.IA_r_wrist_yaw_link[14]*t1;
+    const Scalar Ia6 = w.IA_r_wrist_yaw_link[8] - w.IA_r_wrist_yaw_link[17]*t1;
+    const Scalar Ia7 = w.IA_r_wrist_yaw_link[11] - w.IA_r_wrist_yaw_link[14]*t2;
+    const Scalar Ia8 = w.IA_r_wrist_yaw_link[12] - w.IA_r_wrist_yaw_link[17]*t2;
+    const Scalar Ia9 = w.IA_r_wrist_yaw_link[15] - w.IA_r_wrist_yaw_link[17]*t3;
+    const Scalar pa0 = 0.001*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[0] + w.u_r_wrist_yaw_link[0]*t0 + w.c_r_wrist_yaw_link[0]*Ia0 + w.c_r_wrist_yaw_link[1]*Ia1 + w.c_r_wrist_yaw_link[3]*Ia3;
+    const Scalar pa1 = w.pA_r_wrist_yaw_link[1] + w.u_r_wrist_yaw_link[0]*t1 + w.c_r_wrist_yaw_link[0]*Ia1 + w.c_r_wrist_yaw_link[1]*Ia4 + w.c_r_wrist_yaw_link[3]*Ia6;
+    const Scalar pa2 = w.pA_r_wrist_yaw_link[2] + w.u_r_wrist_yaw_link[0]*t2 + w.c_r_wrist_yaw_link[0]*Ia2 + w.c_r_wrist_yaw_link[1]*Ia5 + w.c_r_wrist_yaw_link[3]*Ia8;
+    const Scalar pa3 = w.pA_r_wrist_yaw_link[3] + w.u_r_wrist_yaw_link[0]*t3 + w.c_r_wrist_yaw_link[0]*Ia3 + w.c_r_wrist_yaw_link[1]*Ia6 + w.c_r_wrist_yaw_link[3]*Ia9;
+    const Scalar pa4 = 0.001*w.c_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[4];
+    const Scalar pa5 = w.pA_r_wrist_yaw_link[5] + w.u_r_wrist_yaw_link[0]*t4;
+    const Scalar C20 = -w.sq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link + w.cq_r_wrist_yaw_link*w.cq_r_wrist_yaw_link;
+    const Scalar h0 = 0.5*(Ia0 - Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar t6 = 0.0005 + 0.5*Ia6;
+    const Scalar d1 = -t5*t6 + 0.5*Ia3*C20;
+    const Scalar qq1 = C20*t6 + 0.5*Ia3*t5;
+    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia9;
+    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia9;
+    const Scalar t7 = m0 + d0;
+    const Scalar t8 = -w.sq_r_wrist_yaw_link*Ia5 + w.cq_r_wrist_yaw_link*Ia2;
+    const Scalar t9 = m0 - d0;
+    const Scalar t10 = w.cq_r_wrist_yaw_link*Ia5 + w.sq_r_wrist_yaw_link*Ia2;
+    const Scalar t11 = 0.5*Ia3 + d1;
+    const Scalar t12 = 0.0005 - 0.5*Ia6 + qq1;
+    const Scalar t13 = -0.0005 + 0.5*Ia6 + qq1;
+    const Scalar t14 = 0.5*Ia3 - d1;
+    const Scalar t15 = 0.2555*qq0 + t11;
+    const Scalar t16 = -0.2555*t7 + t12;
+    const Scalar t17 = 0.2555*t9 + t13;
+    const Scalar t18 = -0.2555*qq0 + t14;
+    const Scalar t19 = w.cq_r_wrist_yaw_link*Ia8 + 0.2555*t10;
+    const Scalar t20 = w.sq_r_wrist_yaw_link*Ia8 - 0.2555*t8;
+    const Scalar t21 = w.cq_r_wrist_yaw_link*pa0 - w.sq_r_wrist_yaw_link*pa1;
+    const Scalar t22 = w.sq_r_wrist_yaw_link*pa0 + w.cq_r_wrist_yaw_link*pa1;
+    w.IA_r_forearm[0] = 0.92 + t7;
     w.IA_r_forearm[1] = qq0;
-    w.IA_r_forearm[2] = t15;
-    w.IA_r_forearm[3] = t22;
-    w.IA_r_forearm[4] = -0.10107580000000001 + t23;
-    w.IA_r_forearm[6] = 0.92 + t16;
-    w.IA_r_forearm[7] = t17;
-    w.IA_r_forearm[8] = 0.10107580000000001 + t24;
-    w.IA_r_forearm[9] = t25;
-    w.IA_r_forearm[11] = 0.92 + Ia14;
-    w.IA_r_forearm[12] = t26;
-    w.IA_r_forearm[13] = t27;
-    w.IA_r_forearm[15] = 0.01661854208147 + m5 + C22*h5 + 0.2555*t20 + 0.2555*t24;
-    w.IA_r_forearm[16] = t12*h5 - 0.2555*t18 + 0.2555*t25;
-    w.IA_r_forearm[18] = 0.01661854208147 + m5 - C22*h5 - 0.2555*t19 - 0.2555*t23;
-    w.pA_r_forearm[0] = w.pA_r_forearm[0] + t28;
-    w.pA_r_forearm[1] = w.pA_r_forearm[1] + t29;
-    w.pA_r_forearm[2] = w.pA_r_forearm[2] + pa14;
-    w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa15 - w.sq_r_wrist_yaw_link*pa16 + 0.2555*t29;
-    w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa15 + w.cq_r_wrist_yaw_link*pa16 - 0.2555*t28;
-    w.pA_r_forearm[5] = w.pA_r_forearm[5] + pa17;
+    w.IA_r_forearm[2] = t8;
+    w.IA_r_forearm[3] = t15;
+    w.IA_r_forearm[4] = -0.10107580000000001 + t16;
+    w.IA_r_forearm[6] = 0.92 + t9;
+    w.IA_r_forearm[7] = t10;
+    w.IA_r_forearm[8] = 0.10107580000000001 + t17;
+    w.IA_r_forearm[9] = t18;
+    w.IA_r_forearm[11] = 0.92 + Ia7;
+    w.IA_r_forearm[12] = t19;
+    w.IA_r_forearm[13] = t20;
+    w.IA_r_forearm[15] = 0.01661854208147 + m1 + C20*h1 + 0.2555*t13 + 0.2555*t17;
+    w.IA_r_forearm[16] = t5*h1 - 0.2555*t11 + 0.2555*t18;
+    w.IA_r_forearm[18] = 0.01661854208147 + m1 - C20*h1 - 0.2555*t12 - 0.2555*t16;
+    w.pA_r_forearm[0] = w.pA_r_forearm[0] + t21;
+    w.pA_r_forearm[1] = w.pA_r_forearm[1] + t22;
+    w.pA_r_forearm[2] = w.pA_r_forearm[2] + pa2;
+    w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa3 - w.sq_r_wrist_yaw_link*pa4 + 0.2555*t22;
+    w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa3 + w.cq_r_wrist_yaw_link*pa4 - 0.2555*t21;
+    w.pA_r_forearm[5] = w.pA_r_forearm[5] + pa5;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     w.Dinv_r_forearm = 1.0 / w.IA_r_forearm[18];
@@ -1799,7 +1826,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.Dinv_r_upper_arm = 1.0 / w.IA_r_upper_arm[20];
@@ -1868,66 +1895,69 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Workspace& w) noexcept {
     w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
     w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     w.Dinv_r_shoulder_roll_link = 1.0 / w.IA_r_shoulder_roll_link[15];
     w.u_r_shoulder_roll_link[0] = -w.pA_r_shoulder_roll_link[3] + tau[30];
-    const Scalar t8 = w.IA_r_shoulder_roll_link[3]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t9 = w.IA_r_shoulder_roll_link[8]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t10 = w.IA_r_shoulder_roll_link[12]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t11 = w.IA_r_shoulder_roll_link[15]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t12 = w.IA_r_shoulder_roll_link[16]*w.Dinv_r_shoulder_roll_link;
-    const Scalar Ia15 = w.IA_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*t8;
-    const Scalar Ia16 = w.IA_r_shoulder_roll_link[1] - w.IA_r_shoulder_roll_link[8]*t8;
-    const Scalar Ia17 = w.IA_r_shoulder_roll_link[2] - w.IA_r_shoulder_roll_link[12]*t8;
-    const Scalar Ia18 = w.IA_r_shoulder_roll_link[4] - w.IA_r_shoulder_roll_link[16]*t8;
-    const Scalar Ia19 = w.IA_r_shoulder_roll_link[6] - w.IA_r_shoulder_roll_link[8]*t9;
-    const Scalar Ia20 = w.IA_r_shoulder_roll_link[7] - w.IA_r_shoulder_roll_link[12]*t9;
-    const Scalar Ia21 = w.IA_r_shoulder_roll_link[9] - w.IA_r_shoulder_roll_link[16]*t9;
-    const Scalar Ia22 = w.IA_r_shoulder_roll_link[11] - w.IA_r_shoulder_roll_link[12]*t10;
-    const Scalar Ia23 = w.IA_r_shoulder_roll_link[13] - w.IA_r_shoulder_roll_link[16]*t10;
-    const Scalar Ia24 = w.IA_r_shoulder_roll_link[18] - w.IA_r_shoulder_roll_link[16]*t12;
-    const Scalar pa6 = w.pA_r_shoulder_roll_link[0] + w.u_r_shoulder_roll_link[0]*t8 + w.c_r_shoulder_roll_link[1]*Ia16 + w.c_r_shoulder_roll_link[2]*Ia17 + w.c_r_shoulder_roll_link[4]*Ia18;
-    const Scalar pa7 = w.pA_r_shoulder_roll_link[1] + w.u_r_shoulder_roll_link[0]*t9 + w.c_r_shoulder_roll_link[1]*Ia19 + w.c_r_shoulder_roll_link[2]*Ia20 + w.c_r_shoulder_roll_link[4]*Ia21;
-    const Scalar pa8 = w.pA_r_shoulder_roll_link[2] + w.u_r_shoulder_roll_link[0]*t10 + w.c_r_shoulder_roll_link[1]*Ia20 + w.c_r_shoulder_roll_link[2]*Ia22 + w.c_r_shoulder_roll_link[4]*Ia23;
-    const Scalar pa9 = w.pA_r_shoulder_roll_link[3] + w.u_r_shoulder_roll_link[0]*t11;
-    const Scalar pa10 = w.pA_r_shoulder_roll_link[4] + w.u_r_shoulder_roll_link[0]*t12 + w.c_r_shoulder_roll_link[1]*Ia21 + w.c_r_shoulder_roll_link[2]*Ia23 + w.c_r_shoulder_roll_link[4]*Ia24;
-    const Scalar pa11 = 0.000192*w.c_r_shoulder_roll_link[5] + w.pA_r_shoulder_roll_link[5];
-    const Scalar C21 = -w.sq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link + w.cq_r_shoulder_roll_link*w.cq_r_shoulder_roll_link;
-    const Scalar h3 = 0.5*(Ia19 - Ia22);
-    const Scalar m3 = 0.5*(Ia19 + Ia22);
-    const Scalar t13 = 2.0*w.cq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
-    const Scalar d3 = -Ia20*t13 + C21*h3;
-    const Scalar qq3 = Ia20*C21 + h3*t13;
-    const Scalar d4 = 0.5*(-Ia23*t13 + Ia21*C21);
-    const Scalar qq4 = 0.5*(Ia23*C21 + Ia21*t13);
-    const Scalar h4 = -9.6e-05 + 0.5*Ia24;
-    const Scalar m4 = 9.6e-05 + 0.5*Ia24;
-    w.IA_r_shoulder_pitch_link[0] = 0.3 + Ia15;
-    w.IA_r_shoulder_pitch_link[1] = -w.sq_r_shoulder_roll_link*Ia17 + w.cq_r_shoulder_roll_link*Ia16;
-    w.IA_r_shoulder_pitch_link[2] = w.cq_r_shoulder_roll_link*Ia17 + w.sq_r_shoulder_roll_link*Ia16;
-    w.IA_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*Ia18;
-    w.IA_r_shoulder_pitch_link[5] = 0.009 + w.sq_r_shoulder_roll_link*Ia18;
-    w.IA_r_shoulder_pitch_link[6] = 0.3 + m3 + d3;
-    w.IA_r_shoulder_pitch_link[7] = qq3;
-    w.IA_r_shoulder_pitch_link[9] = 0.5*Ia21 + d4;
-    w.IA_r_shoulder_pitch_link[10] = -0.5*Ia23 + qq4;
-    w.IA_r_shoulder_pitch_link[11] = 0.3 + m3 - d3;
-    w.IA_r_shoulder_pitch_link[13] = 0.5*Ia23 + qq4;
-    w.IA_r_shoulder_pitch_link[14] = 0.5*Ia21 - d4;
-    w.IA_r_shoulder_pitch_link[18] = 0.000192 + m4 + C21*h4;
-    w.IA_r_shoulder_pitch_link[19] = t13*h4;
-    w.IA_r_shoulder_pitch_link[20] = 0.00046199999999999995 + m4 - C21*h4;
-    w.pA_r_shoulder_pitch_link[0] = w.pA_r_shoulder_pitch_link[0] + pa6;
-    w.pA_r_shoulder_pitch_link[1] = w.pA_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*pa7 - w.sq_r_shoulder_roll_link*pa8;
-    w.pA_r_shoulder_pitch_link[2] = w.pA_r_shoulder_pitch_link[2] + w.sq_r_shoulder_roll_link*pa7 + w.cq_r_shoulder_roll_link*pa8;
-    w.pA_r_shoulder_pitch_link[3] = w.pA_r_shoulder_pitch_link[3] + pa9;
-    w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa10 - w.sq_r_shoulder_roll_link*pa11;
-    w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa10 + w.cq_r_shoulder_roll_link*pa11;
+    const Scalar t0 = w.IA_r_shoulder_roll_link[3]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t1 = w.IA_r_shoulder_roll_link[8]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t2 = w.IA_r_shoulder_roll_link[12]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t3 = w.IA_r_shoulder_roll_link[15]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t4 = w.IA_r_shoulder_roll_link[16]*w.Dinv_r_shoulder_roll_link;
+    const Scalar Ia0 = w.IA_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*t0;
+    const Scalar Ia1 = w.IA_r_shoulder_roll_link[1] - w.IA_r_shoulder_roll_link[8]*t0;
+    const Scalar Ia2 = w.IA_r_shoulder_roll_link[2] - w.IA_r_shoulder_roll_link[12]*t0;
+    const Scalar Ia3 = w.IA_r_shoulder_roll_link[4] - w.IA_r_shoulder_roll_link[16]*t0;
+    const Scalar Ia4 = w.IA_r_shoulder_roll_link[6] - w.IA_r_shoulder_roll_link[8]*t1;
+    const Scalar Ia5 = w.IA_r_shoulder_roll_link[7] - w.IA_r_shoulder_roll_link[12]*t1;
+    const Scalar Ia6 = w.IA_r_shoulder_roll_link[9] - w.IA_r_shoulder_roll_link[16]*t1;
+    const Scalar Ia7 = w.IA_r_shoulder_roll_link[11] - w.IA_r_shoulder_roll_link[12]*t2;
+    const Scalar Ia8 = w.IA_r_shoulder_roll_link[13] - w.IA_r_shoulder_roll_link[16]*t2;
+    const Scalar Ia9 = w.IA_r_shoulder_roll_link[18] - w.IA_r_shoulder_roll_link[16]*t4;
+    const Scalar pa0 = w.pA_r_shoulder_roll_link[0] + w.u_r_shoulder_roll_link[0]*t0 + w.c_r_shoulder_roll_link[1]*Ia1 + w.c_r_shoulder_roll_link[2]*Ia2 + w.c_r_shoulder_roll_link[4]*Ia3;
+    const Scalar pa1 = w.pA_r_shoulder_roll_link[1] + w.u_r_shoulder_roll_link[0]*t1 + w.c_r_shoulder_roll_link[1]*Ia4 + w.c_r_shoulder_roll_link[2]*Ia5 + w.c_r_shoulder_roll_link[4]*Ia6;
+    const Scalar pa2 = w.pA_r_shoulder_roll_link[2] + w.u_r_shoulder_roll_link[0]*t2 + w.c_r_shoulder_roll_link[1]*Ia5 + w.c_r_shoulder_roll_link[2]*Ia7 + w.c_r_shoulder_roll_link[4]*Ia8;
+    const Scalar pa3 = w.pA_r_shoulder_roll_link[3] + w.u_r_shoulder_roll_link[0]*t3;
+    const Scalar pa4 = w.pA_r_shoulder_roll_link[4] + w.u_r_shoulder_roll_link[0]*t4 + w.c_r_shoulder_roll_link[1]*Ia6 + w.c_r_shoulder_roll_link[2]*Ia8 + w.c_r_shoulder_roll_link[4]*Ia9;
+    const Scalar pa5 = 0.000192*w.c_r_shoulder_roll_link[5] + w.pA_r_shoulder_roll_link[5];
+    const Scalar C20 = -w.sq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link + w.cq_r_shoulder_roll_link*w.cq_r_shoulder_roll_link;
+    const Scalar h0 = 0.5*(Ia4 - Ia7);
+    const Scalar m0 = 0.5*(Ia4 + Ia7);
+    const Scalar t5 = 2.0*w.cq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
+    const Scalar d0 = -Ia5*t5 + C20*h0;
+    const Scalar qq0 = Ia5*C20 + h0*t5;
+    const Scalar d1 = 0.5*(-Ia8*t5 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia8*C20 + Ia6*t5);
+    const Scalar h1 = -9.6e-05 + 0.5*Ia9;
+    const Scalar m1 = 9.6e-05 + 0.5*Ia9;
+    w.IA_r_shoulder_pitch_link[0] = 0.3 + Ia0;
+    w.IA_r_shoulder_pitch_link[1] = -w.sq_r_shoulder_roll_link*Ia2 + w.cq_r_shoulder_roll_link*Ia1;
+    w.IA_r_shoulder_pitch_link[2] = w.cq_r_shoulder_roll_link*Ia2 + w.sq_r_shoulder_roll_link*Ia1;
+    w.IA_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*Ia3;
+    w.IA_r_shoulder_pitch_link[5] = 0.009 + w.sq_r_shoulder_roll_link*Ia3;
+    w.IA_r_shoulder_pitch_link[6] = 0.3 + m0 + d0;
+    w.IA_r_shoulder_pitch_link[7] = qq0;
+    w.IA_r_shoulder_pitch_link[9] = 0.5*Ia6 + d1;
+    w.IA_r_shoulder_pitch_link[10] = -0.5*Ia8 + qq1;
+    w.IA_r_shoulder_pitch_link[11] = 0.3 + m0 - d0;
+    w.IA_r_shoulder_pitch_link[13] = 0.5*Ia8 + qq1;
+    w.IA_r_shoulder_pitch_link[14] = 0.5*Ia6 - d1;
+    w.IA_r_shoulder_pitch_link[18] = 0.000192 + m1 + C20*h1;
+    w.IA_r_shoulder_pitch_link[19] = t5*h1;
+    w.IA_r_shoulder_pitch_link[20] = 0.00046199999999999995 + m1 - C20*h1;
+    w.pA_r_shoulder_pitch_link[0] = w.pA_r_shoulder_pitch_link[0] + pa0;
+    w.pA_r_shoulder_pitch_link[1] = w.pA_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*pa1 - w.sq_r_shoulder_roll_link*pa2;
+    w.pA_r_shoulder_pitch_link[2] = w.pA_r_shoulder_pitch_link[2] + w.sq_r_shoulder_roll_link*pa1 + w.cq_r_shoulder_roll_link*pa2;
+    w.pA_r_shoulder_pitch_link[3] = w.pA_r_shoulder_pitch_link[3] + pa3;
+    w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa4 - w.sq_r_shoulder_roll_link*pa5;
+    w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa4 + w.cq_r_shoulder_roll_link*pa5;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     w.Dinv_r_shoulder_pitch_link = 1.0 / w.IA_r_shoulder_pitch_link[18];
@@ -2042,7 +2072,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.Dinv_chest = 1.0 / w.IA_chest[18];
@@ -2134,7 +2164,7 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_abdomen = 1.0 / w.IA_abdomen[20];
@@ -2223,7 +2253,7 @@ PROXGEN_RT_NOINLINE void caba_5(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_6(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu;
@@ -2271,106 +2301,109 @@ PROXGEN_RT_NOINLINE void caba_6(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_r_ankle_link[4] = w.cq_r_foot*pa4 - w.sq_r_foot*pa5;
     w.pA_r_ankle_link[5] = w.sq_r_foot*pa4 + w.cq_r_foot*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
     w.u_r_ankle_link[0] = -w.pA_r_ankle_link[4] + tau[16];
-    const Scalar t4 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
-    const Scalar t5 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
-    const Scalar t6 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
-    const Scalar t7 = w.IA_r_ankle_link[18]*w.Dinv_r_ankle_link;
-    const Scalar t8 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
-    const Scalar Ia6 = w.IA_r_ankle_link[0] - w.IA_r_ankle_link[4]*t4;
-    const Scalar Ia7 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t4;
-    const Scalar Ia8 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t5;
-    const Scalar Ia9 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t5;
-    const Scalar Ia10 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t5;
-    const Scalar Ia11 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t6;
-    const Scalar Ia12 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t6;
-    const Scalar Ia13 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t8;
-    const Scalar t9 = -w.IA_r_ankle_link[13]*t4;
-    const Scalar t10 = -w.IA_r_ankle_link[9]*t4;
-    const Scalar pa6 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t4 + w.c_r_ankle_link[0]*Ia6 + w.c_r_ankle_link[2]*t9 + w.c_r_ankle_link[5]*Ia7;
-    const Scalar pa7 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t5 + w.c_r_ankle_link[0]*t10 + w.c_r_ankle_link[2]*Ia9 + w.c_r_ankle_link[5]*Ia10;
-    const Scalar pa8 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t6 + w.c_r_ankle_link[0]*t9 + w.c_r_ankle_link[2]*Ia11 + w.c_r_ankle_link[5]*Ia12;
-    const Scalar pa9 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
-    const Scalar pa10 = w.pA_r_ankle_link[4] + w.u_r_ankle_link[0]*t7;
-    const Scalar pa11 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t8 + w.c_r_ankle_link[0]*Ia7 + w.c_r_ankle_link[2]*Ia12 + w.c_r_ankle_link[5]*Ia13;
-    const Scalar C21 = -w.sq_r_ankle_link*w.sq_r_ankle_link + w.cq_r_ankle_link*w.cq_r_ankle_link;
-    const Scalar h2 = 0.5*(-Ia6 + Ia11);
-    const Scalar m2 = 0.5*(Ia6 + Ia11);
-    const Scalar t11 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar d0 = -t9*t11 + C21*h2;
-    const Scalar qq0 = t9*C21 + h2*t11;
-    const Scalar d1 = 0.5*(-Ia7*t11 + Ia12*C21);
-    const Scalar qq1 = 0.5*(Ia7*C21 + Ia12*t11);
-    const Scalar h3 = -3.6e-05 + 0.5*Ia13;
-    const Scalar m3 = 3.6e-05 + 0.5*Ia13;
-    const Scalar t12 = 0.9950041652780258*m2 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t13 = 0.09983341664682815*w.sq_r_ankle_link*t10 - 0.09983341664682815*w.cq_r_ankle_link*Ia9 + 0.9950041652780258*w.cq_r_ankle_link*t10 + 0.9950041652780258*w.sq_r_ankle_link*Ia9;
-    const Scalar t14 = -0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t15 = w.cq_r_ankle_link*t10 + w.sq_r_ankle_link*Ia9;
-    const Scalar t16 = -w.sq_r_ankle_link*t10 + w.cq_r_ankle_link*Ia9;
-    const Scalar t17 = 0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t19 = 0.9950041652780258*m2 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t20 = 0.04991670832341408*Ia7 + 0.4975020826390129*Ia12 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t21 = 0.4975020826390129*Ia7 - 0.04991670832341408*Ia12 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t22 = -0.4975020826390129*Ia7 + 0.04991670832341408*Ia12 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t23 = 0.04991670832341408*Ia7 + 0.4975020826390129*Ia12 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t24 = 0.9950041652780258*m3 - 0.9950041652780258*C21*h3 - 0.09983341664682815*t11*h3;
-    const Scalar t25 = -0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t11*h3;
-    const Scalar t26 = 0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t11*h3;
-    const Scalar t27 = 0.9950041652780258*m3 + 0.9950041652780258*C21*h3 + 0.09983341664682815*t11*h3;
-    const Scalar t28 = 0.9950041652780258*t12 - 0.09983341664682815*t14;
-    const Scalar t29 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t30 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t31 = 0.09983341664682815*t17 + 0.9950041652780258*t19;
-    const Scalar t32 = 0.9950041652780258*t20 - 0.09983341664682815*t21;
-    const Scalar t33 = 0.09983341664682815*t20 + 0.9950041652780258*t21;
-    const Scalar t34 = -0.09983341664682815*w.cq_r_ankle_link*Ia10 + 0.9950041652780258*w.sq_r_ankle_link*Ia10;
-    const Scalar t35 = 0.9950041652780258*w.cq_r_ankle_link*Ia10 + 0.09983341664682815*w.sq_r_ankle_link*Ia10;
-    const Scalar t36 = 0.9950041652780258*t22 - 0.09983341664682815*t23;
-    const Scalar t37 = 0.09983341664682815*t22 + 0.9950041652780258*t23;
-    const Scalar t38 = 0.4305*t13 + t32;
-    const Scalar t39 = 0.4305*Ia8 + t34;
-    const Scalar t40 = 0.4305*t30 + t36;
-    const Scalar t41 = w.cq_r_ankle_link*pa6 + w.sq_r_ankle_link*pa8;
-    const Scalar t42 = -w.sq_r_ankle_link*pa6 + w.cq_r_ankle_link*pa8;
-    const Scalar t43 = w.cq_r_ankle_link*pa9 + w.sq_r_ankle_link*pa11;
-    const Scalar t44 = -w.sq_r_ankle_link*pa9 + w.cq_r_ankle_link*pa11;
-    const Scalar t45 = 0.9950041652780258*t41 - 0.09983341664682815*t42;
-    const Scalar t46 = 0.09983341664682815*t41 + 0.9950041652780258*t42;
-    w.IA_r_shank[0] = 3.055 + t28;
-    w.IA_r_shank[1] = t13;
-    w.IA_r_shank[2] = t29;
-    w.IA_r_shank[3] = t38;
-    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t28;
-    w.IA_r_shank[5] = t33;
-    w.IA_r_shank[6] = 3.055 + Ia8;
-    w.IA_r_shank[7] = t30;
-    w.IA_r_shank[8] = 0.5694718575000001 + t39;
-    w.IA_r_shank[9] = -0.4305*t13;
-    w.IA_r_shank[10] = t35;
-    w.IA_r_shank[11] = 3.055 + t31;
-    w.IA_r_shank[12] = t40;
-    w.IA_r_shank[13] = -0.4305*t29;
-    w.IA_r_shank[14] = t37;
-    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t24 - 0.09983341664682815*t25 + 0.4305*t34 + 0.4305*t39;
-    w.IA_r_shank[16] = -0.18533025*t13 - 0.4305*t32;
-    w.IA_r_shank[17] = 0.09983341664682815*t24 + 0.9950041652780258*t25 + 0.4305*t35;
-    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t28;
-    w.IA_r_shank[19] = -0.4305*t33;
-    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t26 + 0.9950041652780258*t27;
-    w.pA_r_shank[0] = w.pA_r_shank[0] + t45;
-    w.pA_r_shank[1] = w.pA_r_shank[1] + pa7;
-    w.pA_r_shank[2] = w.pA_r_shank[2] + t46;
-    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa7 + 0.9950041652780258*t43 - 0.09983341664682815*t44;
-    w.pA_r_shank[4] = w.pA_r_shank[4] + pa10 - 0.4305*t45;
-    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t43 + 0.9950041652780258*t44;
+    const Scalar t0 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
+    const Scalar t1 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
+    const Scalar t2 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
+    const Scalar t3 = w.IA_r_ankle_link[18]*w.Dinv_r_ankle_link;
+    const Scalar t4 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
+    const Scalar Ia0 = w.IA_r_ankle_link[0] - w.IA_r_ankle_link[4]*t0;
+    const Scalar Ia1 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t0;
+    const Scalar Ia2 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t1;
+    const Scalar Ia3 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t1;
+    const Scalar Ia4 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t1;
+    const Scalar Ia5 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t2;
+    const Scalar Ia6 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t2;
+    const Scalar Ia7 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t4;
+    const Scalar t5 = -w.IA_r_ankle_link[13]*t0;
+    const Scalar t6 = -w.IA_r_ankle_link[9]*t0;
+    const Scalar pa0 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t0 + w.c_r_ankle_link[0]*Ia0 + w.c_r_ankle_link[2]*t5 + w.c_r_ankle_link[5]*Ia1;
+    const Scalar pa1 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t1 + w.c_r_ankle_link[0]*t6 + w.c_r_ankle_link[2]*Ia3 + w.c_r_ankle_link[5]*Ia4;
+    const Scalar pa2 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t2 + w.c_r_ankle_link[0]*t5 + w.c_r_ankle_link[2]*Ia5 + w.c_r_ankle_link[5]*Ia6;
+    const Scalar pa3 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
+    const Scalar pa4 = w.pA_r_ankle_link[4] + w.u_r_ankle_link[0]*t3;
+    const Scalar pa5 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t4 + w.c_r_ankle_link[0]*Ia1 + w.c_r_ankle_link[2]*Ia6 + w.c_r_ankle_link[5]*Ia7;
+    const Scalar C20 = -w.sq_r_ankle_link*w.sq_r_ankle_link + w.cq_r_ankle_link*w.cq_r_ankle_link;
+    const Scalar h0 = 0.5*(-Ia0 + Ia5);
+    const Scalar m0 = 0.5*(Ia0 + Ia5);
+    const Scalar t7 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
+    const Scalar d0 = -t5*t7 + C20*h0;
+    const Scalar qq0 = t5*C20 + h0*t7;
+    const Scalar d1 = 0.5*(-Ia1*t7 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia1*C20 + Ia6*t7);
+    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
+    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
+    const Scalar t8 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
+    const Scalar t9 = 0.09983341664682815*w.sq_r_ankle_link*t6 - 0.09983341664682815*w.cq_r_ankle_link*Ia3 + 0.9950041652780258*w.cq_r_ankle_link*t6 + 0.9950041652780258*w.sq_r_ankle_link*Ia3;
+    const Scalar t10 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t11 = w.cq_r_ankle_link*t6 + w.sq_r_ankle_link*Ia3;
+    const Scalar t12 = -w.sq_r_ankle_link*t6 + w.cq_r_ankle_link*Ia3;
+    const Scalar t13 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t15 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
+    const Scalar t16 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
+    const Scalar t17 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t18 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t19 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
+    const Scalar t20 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t7*h1;
+    const Scalar t21 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t22 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t23 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t7*h1;
+    const Scalar t24 = 0.9950041652780258*t8 - 0.09983341664682815*t10;
+    const Scalar t25 = 0.09983341664682815*t8 + 0.9950041652780258*t10;
+    const Scalar t26 = 0.09983341664682815*t11 + 0.9950041652780258*t12;
+    const Scalar t27 = 0.09983341664682815*t13 + 0.9950041652780258*t15;
+    const Scalar t28 = 0.9950041652780258*t16 - 0.09983341664682815*t17;
+    const Scalar t29 = 0.09983341664682815*t16 + 0.9950041652780258*t17;
+    const Scalar t30 = -0.09983341664682815*w.cq_r_ankle_link*Ia4 + 0.9950041652780258*w.sq_r_ankle_link*Ia4;
+    const Scalar t31 = 0.9950041652780258*w.cq_r_ankle_link*Ia4 + 0.09983341664682815*w.sq_r_ankle_link*Ia4;
+    const Scalar t32 = 0.9950041652780258*t18 - 0.09983341664682815*t19;
+    const Scalar t33 = 0.09983341664682815*t18 + 0.9950041652780258*t19;
+    const Scalar t34 = 0.4305*t9 + t28;
+    const Scalar t35 = 0.4305*Ia2 + t30;
+    const Scalar t36 = 0.4305*t26 + t32;
+    const Scalar t37 = w.cq_r_ankle_link*pa0 + w.sq_r_ankle_link*pa2;
+    const Scalar t38 = -w.sq_r_ankle_link*pa0 + w.cq_r_ankle_link*pa2;
+    const Scalar t39 = w.cq_r_ankle_link*pa3 + w.sq_r_ankle_link*pa5;
+    const Scalar t40 = -w.sq_r_ankle_link*pa3 + w.cq_r_ankle_link*pa5;
+    const Scalar t41 = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+    const Scalar t42 = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    w.IA_r_shank[0] = 3.055 + t24;
+    w.IA_r_shank[1] = t9;
+    w.IA_r_shank[2] = t25;
+    w.IA_r_shank[3] = t34;
+    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t24;
+    w.IA_r_shank[5] = t29;
+    w.IA_r_shank[6] = 3.055 + Ia2;
+    w.IA_r_shank[7] = t26;
+    w.IA_r_shank[8] = 0.5694718575000001 + t35;
+    w.IA_r_shank[9] = -0.4305*t9;
+    w.IA_r_shank[10] = t31;
+    w.IA_r_shank[11] = 3.055 + t27;
+    w.IA_r_shank[12] = t36;
+    w.IA_r_shank[13] = -0.4305*t25;
+    w.IA_r_shank[14] = t33;
+    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t20 - 0.09983341664682815*t21 + 0.4305*t30 + 0.4305*t35;
+    w.IA_r_shank[16] = -0.18533025*t9 - 0.4305*t28;
+    w.IA_r_shank[17] = 0.09983341664682815*t20 + 0.9950041652780258*t21 + 0.4305*t31;
+    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t24;
+    w.IA_r_shank[19] = -0.4305*t29;
+    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t22 + 0.9950041652780258*t23;
+    w.pA_r_shank[0] = w.pA_r_shank[0] + t41;
+    w.pA_r_shank[1] = w.pA_r_shank[1] + pa1;
+    w.pA_r_shank[2] = w.pA_r_shank[2] + t42;
+    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
+    w.pA_r_shank[4] = w.pA_r_shank[4] + pa4 - 0.4305*t41;
+    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_7(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
@@ -2483,7 +2516,7 @@ PROXGEN_RT_NOINLINE void caba_7(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_8(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
     w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
@@ -2575,7 +2608,7 @@ PROXGEN_RT_NOINLINE void caba_8(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_9(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
@@ -2633,105 +2666,108 @@ PROXGEN_RT_NOINLINE void caba_9(const Scalar* tau, Workspace& w) noexcept {
     w.pA_r_hip_yaw_link[4] = w.pA_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*pa4 - w.sq_r_hip_roll_link*pa5;
     w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa4 + w.cq_r_hip_roll_link*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
     w.u_r_hip_yaw_link[0] = -w.pA_r_hip_yaw_link[5] + tau[12];
-    const Scalar t6 = w.IA_r_hip_yaw_link[5]*w.Dinv_r_hip_yaw_link;
-    const Scalar t7 = w.IA_r_hip_yaw_link[10]*w.Dinv_r_hip_yaw_link;
-    const Scalar t8 = w.IA_r_hip_yaw_link[14]*w.Dinv_r_hip_yaw_link;
-    const Scalar t9 = w.IA_r_hip_yaw_link[19]*w.Dinv_r_hip_yaw_link;
-    const Scalar t10 = w.IA_r_hip_yaw_link[20]*w.Dinv_r_hip_yaw_link;
-    const Scalar Ia10 = w.IA_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t6;
-    const Scalar Ia11 = w.IA_r_hip_yaw_link[1] - w.IA_r_hip_yaw_link[10]*t6;
-    const Scalar Ia12 = w.IA_r_hip_yaw_link[2] - w.IA_r_hip_yaw_link[14]*t6;
-    const Scalar Ia13 = w.IA_r_hip_yaw_link[4] - w.IA_r_hip_yaw_link[19]*t6;
-    const Scalar Ia14 = w.IA_r_hip_yaw_link[6] - w.IA_r_hip_yaw_link[10]*t7;
-    const Scalar Ia15 = w.IA_r_hip_yaw_link[7] - w.IA_r_hip_yaw_link[14]*t7;
-    const Scalar Ia16 = w.IA_r_hip_yaw_link[9] - w.IA_r_hip_yaw_link[19]*t7;
-    const Scalar Ia17 = w.IA_r_hip_yaw_link[11] - w.IA_r_hip_yaw_link[14]*t8;
-    const Scalar Ia18 = w.IA_r_hip_yaw_link[13] - w.IA_r_hip_yaw_link[19]*t8;
-    const Scalar Ia19 = w.IA_r_hip_yaw_link[18] - w.IA_r_hip_yaw_link[19]*t9;
-    const Scalar pa6 = w.pA_r_hip_yaw_link[0] + w.u_r_hip_yaw_link[0]*t6 + w.c_r_hip_yaw_link[0]*Ia10 + w.c_r_hip_yaw_link[1]*Ia11 + w.c_r_hip_yaw_link[4]*Ia13;
-    const Scalar pa7 = -0.02*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[1] + w.u_r_hip_yaw_link[0]*t7 + w.c_r_hip_yaw_link[0]*Ia11 + w.c_r_hip_yaw_link[1]*Ia14 + w.c_r_hip_yaw_link[4]*Ia16;
-    const Scalar pa8 = w.pA_r_hip_yaw_link[2] + w.u_r_hip_yaw_link[0]*t8 + w.c_r_hip_yaw_link[0]*Ia12 + w.c_r_hip_yaw_link[1]*Ia15 + w.c_r_hip_yaw_link[4]*Ia18;
-    const Scalar pa9 = -0.02*w.c_r_hip_yaw_link[1] + 0.0013*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[3];
-    const Scalar pa10 = w.pA_r_hip_yaw_link[4] + w.u_r_hip_yaw_link[0]*t9 + w.c_r_hip_yaw_link[0]*Ia13 + w.c_r_hip_yaw_link[1]*Ia16 + w.c_r_hip_yaw_link[4]*Ia19;
-    const Scalar pa11 = w.pA_r_hip_yaw_link[5] + w.u_r_hip_yaw_link[0]*t10;
-    const Scalar C21 = -w.sq_r_hip_yaw_link*w.sq_r_hip_yaw_link + w.cq_r_hip_yaw_link*w.cq_r_hip_yaw_link;
-    const Scalar h2 = 0.5*(Ia10 - Ia14);
-    const Scalar m2 = 0.5*(Ia10 + Ia14);
-    const Scalar t11 = 2.0*w.cq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
-    const Scalar d2 = -Ia11*t11 + C21*h2;
-    const Scalar qq2 = Ia11*C21 + h2*t11;
-    const Scalar t12 = -0.01 + 0.5*Ia13;
-    const Scalar d3 = -t11*t12 - 0.5*Ia16*C21;
-    const Scalar qq3 = C21*t12 - 0.5*Ia16*t11;
-    const Scalar h3 = 0.00065 - 0.5*Ia19;
-    const Scalar m3 = 0.00065 + 0.5*Ia19;
-    const Scalar t13 = 0.9961917745544759*m2 + 0.9961917745544759*d2 + 0.08718915247898762*qq2;
-    const Scalar t14 = 0.08718915247898762*m2 - 0.08718915247898762*d2 + 0.9961917745544759*qq2;
-    const Scalar t15 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia15 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia12 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia15 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia12;
-    const Scalar t16 = -0.08718915247898762*m2 - 0.08718915247898762*d2 + 0.9961917745544759*qq2;
-    const Scalar t17 = 0.9961917745544759*m2 - 0.9961917745544759*d2 - 0.08718915247898762*qq2;
-    const Scalar t18 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia15 - 0.08718915247898762*w.cq_r_hip_yaw_link*Ia12 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia15 + 0.9961917745544759*w.sq_r_hip_yaw_link*Ia12;
-    const Scalar t21 = -0.0008718915247898762 - 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 + 0.9961917745544759*d3 + 0.08718915247898762*qq3;
-    const Scalar t22 = 0.00996191774554476 + 0.49809588727723797*Ia13 + 0.04359457623949381*Ia16 - 0.08718915247898762*d3 + 0.9961917745544759*qq3;
-    const Scalar t23 = -0.00996191774554476 - 0.49809588727723797*Ia13 - 0.04359457623949381*Ia16 - 0.08718915247898762*d3 + 0.9961917745544759*qq3;
-    const Scalar t24 = -0.0008718915247898762 - 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 - 0.9961917745544759*d3 - 0.08718915247898762*qq3;
-    const Scalar t25 = 0.9961917745544759*m3 + 0.9961917745544759*C21*h3 + 0.08718915247898762*t11*h3;
-    const Scalar t26 = 0.08718915247898762*m3 - 0.08718915247898762*C21*h3 + 0.9961917745544759*t11*h3;
-    const Scalar t27 = -0.08718915247898762*m3 - 0.08718915247898762*C21*h3 + 0.9961917745544759*t11*h3;
-    const Scalar t28 = 0.9961917745544759*m3 - 0.9961917745544759*C21*h3 - 0.08718915247898762*t11*h3;
-    const Scalar t29 = 0.9961917745544759*t13 + 0.08718915247898762*t14;
-    const Scalar t30 = -0.08718915247898762*t13 + 0.9961917745544759*t14;
-    const Scalar t31 = -0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t32 = 0.9961917745544759*t21 + 0.08718915247898762*t22;
-    const Scalar t33 = -0.08718915247898762*t21 + 0.9961917745544759*t22;
-    const Scalar t34 = 0.9961917745544759*t23 + 0.08718915247898762*t24;
-    const Scalar t35 = -0.08718915247898762*t23 + 0.9961917745544759*t24;
-    const Scalar t36 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia18 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia18;
-    const Scalar t37 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia18 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia18;
-    const Scalar t38 = -0.0875*t15 + t32;
-    const Scalar t39 = -0.0875*t18 + t34;
-    const Scalar t40 = -0.0875*Ia17 + t36;
-    const Scalar t41 = w.cq_r_hip_yaw_link*pa6 - w.sq_r_hip_yaw_link*pa7;
-    const Scalar t42 = w.sq_r_hip_yaw_link*pa6 + w.cq_r_hip_yaw_link*pa7;
-    const Scalar t43 = w.cq_r_hip_yaw_link*pa9 - w.sq_r_hip_yaw_link*pa10;
-    const Scalar t44 = w.sq_r_hip_yaw_link*pa9 + w.cq_r_hip_yaw_link*pa10;
-    const Scalar t45 = 0.9961917745544759*t41 + 0.08718915247898762*t42;
-    const Scalar t46 = -0.08718915247898762*t41 + 0.9961917745544759*t42;
-    w.IA_pelvis[0] = w.IA_pelvis[0] + t29;
-    w.IA_pelvis[1] = w.IA_pelvis[1] + t30;
-    w.IA_pelvis[2] = w.IA_pelvis[2] + t15;
-    w.IA_pelvis[3] = w.IA_pelvis[3] + t38;
-    w.IA_pelvis[4] = w.IA_pelvis[4] + t33;
-    w.IA_pelvis[5] = 0.0875*t29;
-    w.IA_pelvis[6] = w.IA_pelvis[6] + t31;
-    w.IA_pelvis[7] = w.IA_pelvis[7] + t18;
-    w.IA_pelvis[8] = w.IA_pelvis[8] + t39;
-    w.IA_pelvis[9] = w.IA_pelvis[9] + t35;
-    w.IA_pelvis[10] = 0.0875*t30;
-    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia17;
-    w.IA_pelvis[12] = w.IA_pelvis[12] + t40;
-    w.IA_pelvis[13] = w.IA_pelvis[13] + t37;
-    w.IA_pelvis[14] = 0.0875*t15;
-    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t25 + 0.08718915247898762*t26 - 0.0875*t36 - 0.0875*t40;
-    w.IA_pelvis[16] = w.IA_pelvis[16] - 0.08718915247898762*t25 + 0.9961917745544759*t26 - 0.0875*t37;
-    w.IA_pelvis[17] = -0.007656249999999999*t15 + 0.0875*t32;
-    w.IA_pelvis[18] = w.IA_pelvis[18] - 0.08718915247898762*t27 + 0.9961917745544759*t28;
-    w.IA_pelvis[19] = 0.0875*t33;
-    w.IA_pelvis[20] = 0.0860166666667 + 0.007656249999999999*t29;
-    w.pA_pelvis[0] = w.pA_pelvis[0] + t45;
-    w.pA_pelvis[1] = w.pA_pelvis[1] + t46;
-    w.pA_pelvis[2] = w.pA_pelvis[2] + pa8;
-    w.pA_pelvis[3] = w.pA_pelvis[3] - 0.0875*pa8 + 0.9961917745544759*t43 + 0.08718915247898762*t44;
-    w.pA_pelvis[4] = w.pA_pelvis[4] - 0.08718915247898762*t43 + 0.9961917745544759*t44;
-    w.pA_pelvis[5] = w.pA_pelvis[5] + pa11 + 0.0875*t45;
+    const Scalar t0 = w.IA_r_hip_yaw_link[5]*w.Dinv_r_hip_yaw_link;
+    const Scalar t1 = w.IA_r_hip_yaw_link[10]*w.Dinv_r_hip_yaw_link;
+    const Scalar t2 = w.IA_r_hip_yaw_link[14]*w.Dinv_r_hip_yaw_link;
+    const Scalar t3 = w.IA_r_hip_yaw_link[19]*w.Dinv_r_hip_yaw_link;
+    const Scalar t4 = w.IA_r_hip_yaw_link[20]*w.Dinv_r_hip_yaw_link;
+    const Scalar Ia0 = w.IA_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t0;
+    const Scalar Ia1 = w.IA_r_hip_yaw_link[1] - w.IA_r_hip_yaw_link[10]*t0;
+    const Scalar Ia2 = w.IA_r_hip_yaw_link[2] - w.IA_r_hip_yaw_link[14]*t0;
+    const Scalar Ia3 = w.IA_r_hip_yaw_link[4] - w.IA_r_hip_yaw_link[19]*t0;
+    const Scalar Ia4 = w.IA_r_hip_yaw_link[6] - w.IA_r_hip_yaw_link[10]*t1;
+    const Scalar Ia5 = w.IA_r_hip_yaw_link[7] - w.IA_r_hip_yaw_link[14]*t1;
+    const Scalar Ia6 = w.IA_r_hip_yaw_link[9] - w.IA_r_hip_yaw_link[19]*t1;
+    const Scalar Ia7 = w.IA_r_hip_yaw_link[11] - w.IA_r_hip_yaw_link[14]*t2;
+    const Scalar Ia8 = w.IA_r_hip_yaw_link[13] - w.IA_r_hip_yaw_link[19]*t2;
+    const Scalar Ia9 = w.IA_r_hip_yaw_link[18] - w.IA_r_hip_yaw_link[19]*t3;
+    const Scalar pa0 = w.pA_r_hip_yaw_link[0] + w.u_r_hip_yaw_link[0]*t0 + w.c_r_hip_yaw_link[0]*Ia0 + w.c_r_hip_yaw_link[1]*Ia1 + w.c_r_hip_yaw_link[4]*Ia3;
+    const Scalar pa1 = -0.02*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[1] + w.u_r_hip_yaw_link[0]*t1 + w.c_r_hip_yaw_link[0]*Ia1 + w.c_r_hip_yaw_link[1]*Ia4 + w.c_r_hip_yaw_link[4]*Ia6;
+    const Scalar pa2 = w.pA_r_hip_yaw_link[2] + w.u_r_hip_yaw_link[0]*t2 + w.c_r_hip_yaw_link[0]*Ia2 + w.c_r_hip_yaw_link[1]*Ia5 + w.c_r_hip_yaw_link[4]*Ia8;
+    const Scalar pa3 = -0.02*w.c_r_hip_yaw_link[1] + 0.0013*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[3];
+    const Scalar pa4 = w.pA_r_hip_yaw_link[4] + w.u_r_hip_yaw_link[0]*t3 + w.c_r_hip_yaw_link[0]*Ia3 + w.c_r_hip_yaw_link[1]*Ia6 + w.c_r_hip_yaw_link[4]*Ia9;
+    const Scalar pa5 = w.pA_r_hip_yaw_link[5] + w.u_r_hip_yaw_link[0]*t4;
+    const Scalar C20 = -w.sq_r_hip_yaw_link*w.sq_r_hip_yaw_link + w.cq_r_hip_yaw_link*w.cq_r_hip_yaw_link;
+    const Scalar h0 = 0.5*(Ia0 - Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar t6 = -0.01 + 0.5*Ia3;
+    const Scalar d1 = -t5*t6 - 0.5*Ia6*C20;
+    const Scalar qq1 = C20*t6 - 0.5*Ia6*t5;
+    const Scalar h1 = 0.00065 - 0.5*Ia9;
+    const Scalar m1 = 0.00065 + 0.5*Ia9;
+    const Scalar t7 = 0.9961917745544759*m0 + 0.9961917745544759*d0 + 0.08718915247898762*qq0;
+    const Scalar t8 = 0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
+    const Scalar t9 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia5 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia2 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia5 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia2;
+    const Scalar t10 = -0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
+    const Scalar t11 = 0.9961917745544759*m0 - 0.9961917745544759*d0 - 0.08718915247898762*qq0;
+    const Scalar t12 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia5 - 0.08718915247898762*w.cq_r_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_r_hip_yaw_link*Ia2;
+    const Scalar t15 = -0.0008718915247898762 - 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 + 0.08718915247898762*qq1;
+    const Scalar t16 = 0.00996191774554476 + 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
+    const Scalar t17 = -0.00996191774554476 - 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
+    const Scalar t18 = -0.0008718915247898762 - 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 - 0.9961917745544759*d1 - 0.08718915247898762*qq1;
+    const Scalar t19 = 0.9961917745544759*m1 + 0.9961917745544759*C20*h1 + 0.08718915247898762*t5*h1;
+    const Scalar t20 = 0.08718915247898762*m1 - 0.08718915247898762*C20*h1 + 0.9961917745544759*t5*h1;
+    const Scalar t21 = -0.08718915247898762*m1 - 0.08718915247898762*C20*h1 + 0.9961917745544759*t5*h1;
+    const Scalar t22 = 0.9961917745544759*m1 - 0.9961917745544759*C20*h1 - 0.08718915247898762*t5*h1;
+    const Scalar t23 = 0.9961917745544759*t7 + 0.08718915247898762*t8;
+    const Scalar t24 = -0.08718915247898762*t7 + 0.9961917745544759*t8;
+    const Scalar t25 = -0.08718915247898762*t10 + 0.9961917745544759*t11;
+    const Scalar t26 = 0.9961917745544759*t15 + 0.08718915247898762*t16;
+    const Scalar t27 = -0.08718915247898762*t15 + 0.9961917745544759*t16;
+    const Scalar t28 = 0.9961917745544759*t17 + 0.08718915247898762*t18;
+    const Scalar t29 = -0.08718915247898762*t17 + 0.9961917745544759*t18;
+    const Scalar t30 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia8 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia8;
+    const Scalar t31 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia8;
+    const Scalar t32 = -0.0875*t9 + t26;
+    const Scalar t33 = -0.0875*t12 + t28;
+    const Scalar t34 = -0.0875*Ia7 + t30;
+    const Scalar t35 = w.cq_r_hip_yaw_link*pa0 - w.sq_r_hip_yaw_link*pa1;
+    const Scalar t36 = w.sq_r_hip_yaw_link*pa0 + w.cq_r_hip_yaw_link*pa1;
+    const Scalar t37 = w.cq_r_hip_yaw_link*pa3 - w.sq_r_hip_yaw_link*pa4;
+    const Scalar t38 = w.sq_r_hip_yaw_link*pa3 + w.cq_r_hip_yaw_link*pa4;
+    const Scalar t39 = 0.9961917745544759*t35 + 0.08718915247898762*t36;
+    const Scalar t40 = -0.08718915247898762*t35 + 0.9961917745544759*t36;
+    w.IA_pelvis[0] = w.IA_pelvis[0] + t23;
+    w.IA_pelvis[1] = w.IA_pelvis[1] + t24;
+    w.IA_pelvis[2] = w.IA_pelvis[2] + t9;
+    w.IA_pelvis[3] = w.IA_pelvis[3] + t32;
+    w.IA_pelvis[4] = w.IA_pelvis[4] + t27;
+    w.IA_pelvis[5] = 0.0875*t23;
+    w.IA_pelvis[6] = w.IA_pelvis[6] + t25;
+    w.IA_pelvis[7] = w.IA_pelvis[7] + t12;
+    w.IA_pelvis[8] = w.IA_pelvis[8] + t33;
+    w.IA_pelvis[9] = w.IA_pelvis[9] + t29;
+    w.IA_pelvis[10] = 0.0875*t24;
+    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia7;
+    w.IA_pelvis[12] = w.IA_pelvis[12] + t34;
+    w.IA_pelvis[13] = w.IA_pelvis[13] + t31;
+    w.IA_pelvis[14] = 0.0875*t9;
+    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t19 + 0.08718915247898762*t20 - 0.0875*t30 - 0.0875*t34;
+    w.IA_pelvis[16] = w.IA_pelvis[16] - 0.08718915247898762*t19 + 0.9961917745544759*t20 - 0.0875*t31;
+    w.IA_pelvis[17] = -0.007656249999999999*t9 + 0.0875*t26;
+    w.IA_pelvis[18] = w.IA_pelvis[18] - 0.08718915247898762*t21 + 0.9961917745544759*t22;
+    w.IA_pelvis[19] = 0.0875*t27;
+    w.IA_pelvis[20] = 0.0860166666667 + 0.007656249999999999*t23;
+    w.pA_pelvis[0] = w.pA_pelvis[0] + t39;
+    w.pA_pelvis[1] = w.pA_pelvis[1] + t40;
+    w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
+    w.pA_pelvis[3] = w.pA_pelvis[3] - 0.0875*pa2 + 0.9961917745544759*t37 + 0.08718915247898762*t38;
+    w.pA_pelvis[4] = w.pA_pelvis[4] - 0.08718915247898762*t37 + 0.9961917745544759*t38;
+    w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 + 0.0875*t39;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_10(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu;
@@ -2779,106 +2815,109 @@ PROXGEN_RT_NOINLINE void caba_10(const Scalar* tau, Scalar mu, Workspace& w) noe
     w.pA_l_ankle_link[4] = w.cq_l_foot*pa4 - w.sq_l_foot*pa5;
     w.pA_l_ankle_link[5] = w.sq_l_foot*pa4 + w.cq_l_foot*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
     w.u_l_ankle_link[0] = -w.pA_l_ankle_link[4] + tau[10];
-    const Scalar t4 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
-    const Scalar t5 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
-    const Scalar t6 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
-    const Scalar t7 = w.IA_l_ankle_link[18]*w.Dinv_l_ankle_link;
-    const Scalar t8 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
-    const Scalar Ia6 = w.IA_l_ankle_link[0] - w.IA_l_ankle_link[4]*t4;
-    const Scalar Ia7 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t4;
-    const Scalar Ia8 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t5;
-    const Scalar Ia9 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t5;
-    const Scalar Ia10 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t5;
-    const Scalar Ia11 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t6;
-    const Scalar Ia12 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t6;
-    const Scalar Ia13 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t8;
-    const Scalar t9 = -w.IA_l_ankle_link[13]*t4;
-    const Scalar t10 = -w.IA_l_ankle_link[9]*t4;
-    const Scalar pa6 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t4 + w.c_l_ankle_link[0]*Ia6 + w.c_l_ankle_link[2]*t9 + w.c_l_ankle_link[5]*Ia7;
-    const Scalar pa7 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t5 + w.c_l_ankle_link[0]*t10 + w.c_l_ankle_link[2]*Ia9 + w.c_l_ankle_link[5]*Ia10;
-    const Scalar pa8 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t6 + w.c_l_ankle_link[0]*t9 + w.c_l_ankle_link[2]*Ia11 + w.c_l_ankle_link[5]*Ia12;
-    const Scalar pa9 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
-    const Scalar pa10 = w.pA_l_ankle_link[4] + w.u_l_ankle_link[0]*t7;
-    const Scalar pa11 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t8 + w.c_l_ankle_link[0]*Ia7 + w.c_l_ankle_link[2]*Ia12 + w.c_l_ankle_link[5]*Ia13;
-    const Scalar C21 = -w.sq_l_ankle_link*w.sq_l_ankle_link + w.cq_l_ankle_link*w.cq_l_ankle_link;
-    const Scalar h2 = 0.5*(-Ia6 + Ia11);
-    const Scalar m2 = 0.5*(Ia6 + Ia11);
-    const Scalar t11 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar d0 = -t9*t11 + C21*h2;
-    const Scalar qq0 = t9*C21 + h2*t11;
-    const Scalar d1 = 0.5*(-Ia7*t11 + Ia12*C21);
-    const Scalar qq1 = 0.5*(Ia7*C21 + Ia12*t11);
-    const Scalar h3 = -3.6e-05 + 0.5*Ia13;
-    const Scalar m3 = 3.6e-05 + 0.5*Ia13;
-    const Scalar t12 = 0.9950041652780258*m2 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t13 = 0.09983341664682815*w.sq_l_ankle_link*t10 - 0.09983341664682815*w.cq_l_ankle_link*Ia9 + 0.9950041652780258*w.cq_l_ankle_link*t10 + 0.9950041652780258*w.sq_l_ankle_link*Ia9;
-    const Scalar t14 = -0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t15 = w.cq_l_ankle_link*t10 + w.sq_l_ankle_link*Ia9;
-    const Scalar t16 = -w.sq_l_ankle_link*t10 + w.cq_l_ankle_link*Ia9;
-    const Scalar t17 = 0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t19 = 0.9950041652780258*m2 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t20 = 0.04991670832341408*Ia7 + 0.4975020826390129*Ia12 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t21 = 0.4975020826390129*Ia7 - 0.04991670832341408*Ia12 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t22 = -0.4975020826390129*Ia7 + 0.04991670832341408*Ia12 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t23 = 0.04991670832341408*Ia7 + 0.4975020826390129*Ia12 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t24 = 0.9950041652780258*m3 - 0.9950041652780258*C21*h3 - 0.09983341664682815*t11*h3;
-    const Scalar t25 = -0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t11*h3;
-    const Scalar t26 = 0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t11*h3;
-    const Scalar t27 = 0.9950041652780258*m3 + 0.9950041652780258*C21*h3 + 0.09983341664682815*t11*h3;
-    const Scalar t28 = 0.9950041652780258*t12 - 0.09983341664682815*t14;
-    const Scalar t29 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t30 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t31 = 0.09983341664682815*t17 + 0.9950041652780258*t19;
-    const Scalar t32 = 0.9950041652780258*t20 - 0.09983341664682815*t21;
-    const Scalar t33 = 0.09983341664682815*t20 + 0.9950041652780258*t21;
-    const Scalar t34 = -0.09983341664682815*w.cq_l_ankle_link*Ia10 + 0.9950041652780258*w.sq_l_ankle_link*Ia10;
-    const Scalar t35 = 0.9950041652780258*w.cq_l_ankle_link*Ia10 + 0.09983341664682815*w.sq_l_ankle_link*Ia10;
-    const Scalar t36 = 0.9950041652780258*t22 - 0.09983341664682815*t23;
-    const Scalar t37 = 0.09983341664682815*t22 + 0.9950041652780258*t23;
-    const Scalar t38 = 0.4305*t13 + t32;
-    const Scalar t39 = 0.4305*Ia8 + t34;
-    const Scalar t40 = 0.4305*t30 + t36;
-    const Scalar t41 = w.cq_l_ankle_link*pa6 + w.sq_l_ankle_link*pa8;
-    const Scalar t42 = -w.sq_l_ankle_link*pa6 + w.cq_l_ankle_link*pa8;
-    const Scalar t43 = w.cq_l_ankle_link*pa9 + w.sq_l_ankle_link*pa11;
-    const Scalar t44 = -w.sq_l_ankle_link*pa9 + w.cq_l_ankle_link*pa11;
-    const Scalar t45 = 0.9950041652780258*t41 - 0.09983341664682815*t42;
-    const Scalar t46 = 0.09983341664682815*t41 + 0.9950041652780258*t42;
-    w.IA_l_shank[0] = 3.055 + t28;
-    w.IA_l_shank[1] = t13;
-    w.IA_l_shank[2] = t29;
-    w.IA_l_shank[3] = t38;
-    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t28;
-    w.IA_l_shank[5] = t33;
-    w.IA_l_shank[6] = 3.055 + Ia8;
-    w.IA_l_shank[7] = t30;
-    w.IA_l_shank[8] = 0.5694718575000001 + t39;
-    w.IA_l_shank[9] = -0.4305*t13;
-    w.IA_l_shank[10] = t35;
-    w.IA_l_shank[11] = 3.055 + t31;
-    w.IA_l_shank[12] = t40;
-    w.IA_l_shank[13] = -0.4305*t29;
-    w.IA_l_shank[14] = t37;
-    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t24 - 0.09983341664682815*t25 + 0.4305*t34 + 0.4305*t39;
-    w.IA_l_shank[16] = -0.18533025*t13 - 0.4305*t32;
-    w.IA_l_shank[17] = 0.09983341664682815*t24 + 0.9950041652780258*t25 + 0.4305*t35;
-    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t28;
-    w.IA_l_shank[19] = -0.4305*t33;
-    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t26 + 0.9950041652780258*t27;
-    w.pA_l_shank[0] = w.pA_l_shank[0] + t45;
-    w.pA_l_shank[1] = w.pA_l_shank[1] + pa7;
-    w.pA_l_shank[2] = w.pA_l_shank[2] + t46;
-    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa7 + 0.9950041652780258*t43 - 0.09983341664682815*t44;
-    w.pA_l_shank[4] = w.pA_l_shank[4] + pa10 - 0.4305*t45;
-    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t43 + 0.9950041652780258*t44;
+    const Scalar t0 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
+    const Scalar t1 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
+    const Scalar t2 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
+    const Scalar t3 = w.IA_l_ankle_link[18]*w.Dinv_l_ankle_link;
+    const Scalar t4 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
+    const Scalar Ia0 = w.IA_l_ankle_link[0] - w.IA_l_ankle_link[4]*t0;
+    const Scalar Ia1 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t0;
+    const Scalar Ia2 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t1;
+    const Scalar Ia3 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t1;
+    const Scalar Ia4 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t1;
+    const Scalar Ia5 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t2;
+    const Scalar Ia6 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t2;
+    const Scalar Ia7 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t4;
+    const Scalar t5 = -w.IA_l_ankle_link[13]*t0;
+    const Scalar t6 = -w.IA_l_ankle_link[9]*t0;
+    const Scalar pa0 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t0 + w.c_l_ankle_link[0]*Ia0 + w.c_l_ankle_link[2]*t5 + w.c_l_ankle_link[5]*Ia1;
+    const Scalar pa1 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t1 + w.c_l_ankle_link[0]*t6 + w.c_l_ankle_link[2]*Ia3 + w.c_l_ankle_link[5]*Ia4;
+    const Scalar pa2 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t2 + w.c_l_ankle_link[0]*t5 + w.c_l_ankle_link[2]*Ia5 + w.c_l_ankle_link[5]*Ia6;
+    const Scalar pa3 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
+    const Scalar pa4 = w.pA_l_ankle_link[4] + w.u_l_ankle_link[0]*t3;
+    const Scalar pa5 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t4 + w.c_l_ankle_link[0]*Ia1 + w.c_l_ankle_link[2]*Ia6 + w.c_l_ankle_link[5]*Ia7;
+    const Scalar C20 = -w.sq_l_ankle_link*w.sq_l_ankle_link + w.cq_l_ankle_link*w.cq_l_ankle_link;
+    const Scalar h0 = 0.5*(-Ia0 + Ia5);
+    const Scalar m0 = 0.5*(Ia0 + Ia5);
+    const Scalar t7 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
+    const Scalar d0 = -t5*t7 + C20*h0;
+    const Scalar qq0 = t5*C20 + h0*t7;
+    const Scalar d1 = 0.5*(-Ia1*t7 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia1*C20 + Ia6*t7);
+    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
+    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
+    const Scalar t8 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
+    const Scalar t9 = 0.09983341664682815*w.sq_l_ankle_link*t6 - 0.09983341664682815*w.cq_l_ankle_link*Ia3 + 0.9950041652780258*w.cq_l_ankle_link*t6 + 0.9950041652780258*w.sq_l_ankle_link*Ia3;
+    const Scalar t10 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t11 = w.cq_l_ankle_link*t6 + w.sq_l_ankle_link*Ia3;
+    const Scalar t12 = -w.sq_l_ankle_link*t6 + w.cq_l_ankle_link*Ia3;
+    const Scalar t13 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t15 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
+    const Scalar t16 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
+    const Scalar t17 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t18 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t19 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
+    const Scalar t20 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t7*h1;
+    const Scalar t21 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t22 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t23 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t7*h1;
+    const Scalar t24 = 0.9950041652780258*t8 - 0.09983341664682815*t10;
+    const Scalar t25 = 0.09983341664682815*t8 + 0.9950041652780258*t10;
+    const Scalar t26 = 0.09983341664682815*t11 + 0.9950041652780258*t12;
+    const Scalar t27 = 0.09983341664682815*t13 + 0.9950041652780258*t15;
+    const Scalar t28 = 0.9950041652780258*t16 - 0.09983341664682815*t17;
+    const Scalar t29 = 0.09983341664682815*t16 + 0.9950041652780258*t17;
+    const Scalar t30 = -0.09983341664682815*w.cq_l_ankle_link*Ia4 + 0.9950041652780258*w.sq_l_ankle_link*Ia4;
+    const Scalar t31 = 0.9950041652780258*w.cq_l_ankle_link*Ia4 + 0.09983341664682815*w.sq_l_ankle_link*Ia4;
+    const Scalar t32 = 0.9950041652780258*t18 - 0.09983341664682815*t19;
+    const Scalar t33 = 0.09983341664682815*t18 + 0.9950041652780258*t19;
+    const Scalar t34 = 0.4305*t9 + t28;
+    const Scalar t35 = 0.4305*Ia2 + t30;
+    const Scalar t36 = 0.4305*t26 + t32;
+    const Scalar t37 = w.cq_l_ankle_link*pa0 + w.sq_l_ankle_link*pa2;
+    const Scalar t38 = -w.sq_l_ankle_link*pa0 + w.cq_l_ankle_link*pa2;
+    const Scalar t39 = w.cq_l_ankle_link*pa3 + w.sq_l_ankle_link*pa5;
+    const Scalar t40 = -w.sq_l_ankle_link*pa3 + w.cq_l_ankle_link*pa5;
+    const Scalar t41 = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+    const Scalar t42 = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    w.IA_l_shank[0] = 3.055 + t24;
+    w.IA_l_shank[1] = t9;
+    w.IA_l_shank[2] = t25;
+    w.IA_l_shank[3] = t34;
+    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t24;
+    w.IA_l_shank[5] = t29;
+    w.IA_l_shank[6] = 3.055 + Ia2;
+    w.IA_l_shank[7] = t26;
+    w.IA_l_shank[8] = 0.5694718575000001 + t35;
+    w.IA_l_shank[9] = -0.4305*t9;
+    w.IA_l_shank[10] = t31;
+    w.IA_l_shank[11] = 3.055 + t27;
+    w.IA_l_shank[12] = t36;
+    w.IA_l_shank[13] = -0.4305*t25;
+    w.IA_l_shank[14] = t33;
+    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t20 - 0.09983341664682815*t21 + 0.4305*t30 + 0.4305*t35;
+    w.IA_l_shank[16] = -0.18533025*t9 - 0.4305*t28;
+    w.IA_l_shank[17] = 0.09983341664682815*t20 + 0.9950041652780258*t21 + 0.4305*t31;
+    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t24;
+    w.IA_l_shank[19] = -0.4305*t29;
+    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t22 + 0.9950041652780258*t23;
+    w.pA_l_shank[0] = w.pA_l_shank[0] + t41;
+    w.pA_l_shank[1] = w.pA_l_shank[1] + pa1;
+    w.pA_l_shank[2] = w.pA_l_shank[2] + t42;
+    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
+    w.pA_l_shank[4] = w.pA_l_shank[4] + pa4 - 0.4305*t41;
+    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_11(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
@@ -2991,7 +3030,7 @@ PROXGEN_RT_NOINLINE void caba_11(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_12(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
     w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
@@ -3083,7 +3122,7 @@ PROXGEN_RT_NOINLINE void caba_12(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_13(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
@@ -3141,105 +3180,108 @@ PROXGEN_RT_NOINLINE void caba_13(const Scalar* tau, Workspace& w) noexcept {
     w.pA_l_hip_yaw_link[4] = w.pA_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*pa4 - w.sq_l_hip_roll_link*pa5;
     w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa4 + w.cq_l_hip_roll_link*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
     w.u_l_hip_yaw_link[0] = -w.pA_l_hip_yaw_link[5] + tau[6];
-    const Scalar t6 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
-    const Scalar t7 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
-    const Scalar t8 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
-    const Scalar t9 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
-    const Scalar t10 = w.IA_l_hip_yaw_link[20]*w.Dinv_l_hip_yaw_link;
-    const Scalar Ia10 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t6;
-    const Scalar Ia11 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t6;
-    const Scalar Ia12 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t6;
-    const Scalar Ia13 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t6;
-    const Scalar Ia14 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t7;
-    const Scalar Ia15 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t7;
-    const Scalar Ia16 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t7;
-    const Scalar Ia17 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t8;
-    const Scalar Ia18 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t8;
-    const Scalar Ia19 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t9;
-    const Scalar pa6 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t6 + w.c_l_hip_yaw_link[0]*Ia10 + w.c_l_hip_yaw_link[1]*Ia11 + w.c_l_hip_yaw_link[4]*Ia13;
-    const Scalar pa7 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t7 + w.c_l_hip_yaw_link[0]*Ia11 + w.c_l_hip_yaw_link[1]*Ia14 + w.c_l_hip_yaw_link[4]*Ia16;
-    const Scalar pa8 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t8 + w.c_l_hip_yaw_link[0]*Ia12 + w.c_l_hip_yaw_link[1]*Ia15 + w.c_l_hip_yaw_link[4]*Ia18;
-    const Scalar pa9 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
-    const Scalar pa10 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t9 + w.c_l_hip_yaw_link[0]*Ia13 + w.c_l_hip_yaw_link[1]*Ia16 + w.c_l_hip_yaw_link[4]*Ia19;
-    const Scalar pa11 = w.pA_l_hip_yaw_link[5] + w.u_l_hip_yaw_link[0]*t10;
-    const Scalar C21 = -w.sq_l_hip_yaw_link*w.sq_l_hip_yaw_link + w.cq_l_hip_yaw_link*w.cq_l_hip_yaw_link;
-    const Scalar h2 = 0.5*(Ia10 - Ia14);
-    const Scalar m2 = 0.5*(Ia10 + Ia14);
-    const Scalar t11 = 2.0*w.cq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
-    const Scalar d2 = -Ia11*t11 + C21*h2;
-    const Scalar qq2 = Ia11*C21 + h2*t11;
-    const Scalar t12 = -0.01 + 0.5*Ia13;
-    const Scalar d3 = -t11*t12 - 0.5*Ia16*C21;
-    const Scalar qq3 = C21*t12 - 0.5*Ia16*t11;
-    const Scalar h3 = 0.00065 - 0.5*Ia19;
-    const Scalar m3 = 0.00065 + 0.5*Ia19;
-    const Scalar t13 = 0.9961917745544759*m2 + 0.9961917745544759*d2 - 0.08718915247898762*qq2;
-    const Scalar t14 = -0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
-    const Scalar t15 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia15 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia12 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia15 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia12;
-    const Scalar t16 = 0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
-    const Scalar t17 = 0.9961917745544759*m2 - 0.9961917745544759*d2 + 0.08718915247898762*qq2;
-    const Scalar t18 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia15 + 0.08718915247898762*w.cq_l_hip_yaw_link*Ia12 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia15 + 0.9961917745544759*w.sq_l_hip_yaw_link*Ia12;
-    const Scalar t21 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 + 0.9961917745544759*d3 - 0.08718915247898762*qq3;
-    const Scalar t22 = 0.00996191774554476 + 0.49809588727723797*Ia13 - 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
-    const Scalar t23 = -0.00996191774554476 - 0.49809588727723797*Ia13 + 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
-    const Scalar t24 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 - 0.9961917745544759*d3 + 0.08718915247898762*qq3;
-    const Scalar t25 = 0.9961917745544759*m3 + 0.9961917745544759*C21*h3 - 0.08718915247898762*t11*h3;
-    const Scalar t26 = -0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t11*h3;
-    const Scalar t27 = 0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t11*h3;
-    const Scalar t28 = 0.9961917745544759*m3 - 0.9961917745544759*C21*h3 + 0.08718915247898762*t11*h3;
-    const Scalar t29 = 0.9961917745544759*t13 - 0.08718915247898762*t14;
-    const Scalar t30 = 0.08718915247898762*t13 + 0.9961917745544759*t14;
-    const Scalar t31 = 0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t32 = 0.9961917745544759*t21 - 0.08718915247898762*t22;
-    const Scalar t33 = 0.08718915247898762*t21 + 0.9961917745544759*t22;
-    const Scalar t34 = 0.9961917745544759*t23 - 0.08718915247898762*t24;
-    const Scalar t35 = 0.08718915247898762*t23 + 0.9961917745544759*t24;
-    const Scalar t36 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia18 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia18;
-    const Scalar t37 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia18 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia18;
-    const Scalar t38 = 0.0875*t15 + t32;
-    const Scalar t39 = 0.0875*t18 + t34;
-    const Scalar t40 = 0.0875*Ia17 + t36;
-    const Scalar t41 = w.cq_l_hip_yaw_link*pa6 - w.sq_l_hip_yaw_link*pa7;
-    const Scalar t42 = w.sq_l_hip_yaw_link*pa6 + w.cq_l_hip_yaw_link*pa7;
-    const Scalar t43 = w.cq_l_hip_yaw_link*pa9 - w.sq_l_hip_yaw_link*pa10;
-    const Scalar t44 = w.sq_l_hip_yaw_link*pa9 + w.cq_l_hip_yaw_link*pa10;
-    const Scalar t45 = 0.9961917745544759*t41 - 0.08718915247898762*t42;
-    const Scalar t46 = 0.08718915247898762*t41 + 0.9961917745544759*t42;
-    w.IA_pelvis[0] = w.IA_pelvis[0] + t29;
-    w.IA_pelvis[1] = w.IA_pelvis[1] + t30;
-    w.IA_pelvis[2] = w.IA_pelvis[2] + t15;
-    w.IA_pelvis[3] = w.IA_pelvis[3] + t38;
-    w.IA_pelvis[4] = w.IA_pelvis[4] + t33;
-    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t29;
-    w.IA_pelvis[6] = w.IA_pelvis[6] + t31;
-    w.IA_pelvis[7] = w.IA_pelvis[7] + t18;
-    w.IA_pelvis[8] = w.IA_pelvis[8] + t39;
-    w.IA_pelvis[9] = w.IA_pelvis[9] + t35;
-    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t30;
-    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia17;
-    w.IA_pelvis[12] = w.IA_pelvis[12] + t40;
-    w.IA_pelvis[13] = w.IA_pelvis[13] + t37;
-    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t15;
-    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t25 - 0.08718915247898762*t26 + 0.0875*t36 + 0.0875*t40;
-    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t25 + 0.9961917745544759*t26 + 0.0875*t37;
-    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t15 - 0.0875*t32;
-    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t27 + 0.9961917745544759*t28;
-    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t33;
-    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t29;
-    w.pA_pelvis[0] = w.pA_pelvis[0] + t45;
-    w.pA_pelvis[1] = w.pA_pelvis[1] + t46;
-    w.pA_pelvis[2] = w.pA_pelvis[2] + pa8;
-    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa8 + 0.9961917745544759*t43 - 0.08718915247898762*t44;
-    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t43 + 0.9961917745544759*t44;
-    w.pA_pelvis[5] = w.pA_pelvis[5] + pa11 - 0.0875*t45;
+    const Scalar t0 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
+    const Scalar t1 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
+    const Scalar t2 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
+    const Scalar t3 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
+    const Scalar t4 = w.IA_l_hip_yaw_link[20]*w.Dinv_l_hip_yaw_link;
+    const Scalar Ia0 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t0;
+    const Scalar Ia1 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t0;
+    const Scalar Ia2 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t0;
+    const Scalar Ia3 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t0;
+    const Scalar Ia4 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t1;
+    const Scalar Ia5 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t1;
+    const Scalar Ia6 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t1;
+    const Scalar Ia7 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t2;
+    const Scalar Ia8 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t2;
+    const Scalar Ia9 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t3;
+    const Scalar pa0 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t0 + w.c_l_hip_yaw_link[0]*Ia0 + w.c_l_hip_yaw_link[1]*Ia1 + w.c_l_hip_yaw_link[4]*Ia3;
+    const Scalar pa1 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t1 + w.c_l_hip_yaw_link[0]*Ia1 + w.c_l_hip_yaw_link[1]*Ia4 + w.c_l_hip_yaw_link[4]*Ia6;
+    const Scalar pa2 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t2 + w.c_l_hip_yaw_link[0]*Ia2 + w.c_l_hip_yaw_link[1]*Ia5 + w.c_l_hip_yaw_link[4]*Ia8;
+    const Scalar pa3 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
+    const Scalar pa4 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t3 + w.c_l_hip_yaw_link[0]*Ia3 + w.c_l_hip_yaw_link[1]*Ia6 + w.c_l_hip_yaw_link[4]*Ia9;
+    const Scalar pa5 = w.pA_l_hip_yaw_link[5] + w.u_l_hip_yaw_link[0]*t4;
+    const Scalar C20 = -w.sq_l_hip_yaw_link*w.sq_l_hip_yaw_link + w.cq_l_hip_yaw_link*w.cq_l_hip_yaw_link;
+    const Scalar h0 = 0.5*(Ia0 - Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar t6 = -0.01 + 0.5*Ia3;
+    const Scalar d1 = -t5*t6 - 0.5*Ia6*C20;
+    const Scalar qq1 = C20*t6 - 0.5*Ia6*t5;
+    const Scalar h1 = 0.00065 - 0.5*Ia9;
+    const Scalar m1 = 0.00065 + 0.5*Ia9;
+    const Scalar t7 = 0.9961917745544759*m0 + 0.9961917745544759*d0 - 0.08718915247898762*qq0;
+    const Scalar t8 = -0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
+    const Scalar t9 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia5 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia2 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia5 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia2;
+    const Scalar t10 = 0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
+    const Scalar t11 = 0.9961917745544759*m0 - 0.9961917745544759*d0 + 0.08718915247898762*qq0;
+    const Scalar t12 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia5 + 0.08718915247898762*w.cq_l_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_l_hip_yaw_link*Ia2;
+    const Scalar t15 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 - 0.08718915247898762*qq1;
+    const Scalar t16 = 0.00996191774554476 + 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
+    const Scalar t17 = -0.00996191774554476 - 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
+    const Scalar t18 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 - 0.9961917745544759*d1 + 0.08718915247898762*qq1;
+    const Scalar t19 = 0.9961917745544759*m1 + 0.9961917745544759*C20*h1 - 0.08718915247898762*t5*h1;
+    const Scalar t20 = -0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t5*h1;
+    const Scalar t21 = 0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t5*h1;
+    const Scalar t22 = 0.9961917745544759*m1 - 0.9961917745544759*C20*h1 + 0.08718915247898762*t5*h1;
+    const Scalar t23 = 0.9961917745544759*t7 - 0.08718915247898762*t8;
+    const Scalar t24 = 0.08718915247898762*t7 + 0.9961917745544759*t8;
+    const Scalar t25 = 0.08718915247898762*t10 + 0.9961917745544759*t11;
+    const Scalar t26 = 0.9961917745544759*t15 - 0.08718915247898762*t16;
+    const Scalar t27 = 0.08718915247898762*t15 + 0.9961917745544759*t16;
+    const Scalar t28 = 0.9961917745544759*t17 - 0.08718915247898762*t18;
+    const Scalar t29 = 0.08718915247898762*t17 + 0.9961917745544759*t18;
+    const Scalar t30 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia8 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia8;
+    const Scalar t31 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia8;
+    const Scalar t32 = 0.0875*t9 + t26;
+    const Scalar t33 = 0.0875*t12 + t28;
+    const Scalar t34 = 0.0875*Ia7 + t30;
+    const Scalar t35 = w.cq_l_hip_yaw_link*pa0 - w.sq_l_hip_yaw_link*pa1;
+    const Scalar t36 = w.sq_l_hip_yaw_link*pa0 + w.cq_l_hip_yaw_link*pa1;
+    const Scalar t37 = w.cq_l_hip_yaw_link*pa3 - w.sq_l_hip_yaw_link*pa4;
+    const Scalar t38 = w.sq_l_hip_yaw_link*pa3 + w.cq_l_hip_yaw_link*pa4;
+    const Scalar t39 = 0.9961917745544759*t35 - 0.08718915247898762*t36;
+    const Scalar t40 = 0.08718915247898762*t35 + 0.9961917745544759*t36;
+    w.IA_pelvis[0] = w.IA_pelvis[0] + t23;
+    w.IA_pelvis[1] = w.IA_pelvis[1] + t24;
+    w.IA_pelvis[2] = w.IA_pelvis[2] + t9;
+    w.IA_pelvis[3] = w.IA_pelvis[3] + t32;
+    w.IA_pelvis[4] = w.IA_pelvis[4] + t27;
+    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t23;
+    w.IA_pelvis[6] = w.IA_pelvis[6] + t25;
+    w.IA_pelvis[7] = w.IA_pelvis[7] + t12;
+    w.IA_pelvis[8] = w.IA_pelvis[8] + t33;
+    w.IA_pelvis[9] = w.IA_pelvis[9] + t29;
+    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t24;
+    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia7;
+    w.IA_pelvis[12] = w.IA_pelvis[12] + t34;
+    w.IA_pelvis[13] = w.IA_pelvis[13] + t31;
+    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t9;
+    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t19 - 0.08718915247898762*t20 + 0.0875*t30 + 0.0875*t34;
+    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t19 + 0.9961917745544759*t20 + 0.0875*t31;
+    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t9 - 0.0875*t26;
+    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t21 + 0.9961917745544759*t22;
+    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t27;
+    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t23;
+    w.pA_pelvis[0] = w.pA_pelvis[0] + t39;
+    w.pA_pelvis[1] = w.pA_pelvis[1] + t40;
+    w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
+    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa2 + 0.9961917745544759*t37 - 0.08718915247898762*t38;
+    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t37 + 0.9961917745544759*t38;
+    w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 - 0.0875*t39;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_14(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_pelvis[0]);
@@ -3297,36 +3339,39 @@ PROXGEN_RT_NOINLINE void caba_14(const Scalar* tau, Workspace& w) noexcept {
     w.u_pelvis[4] = -w.pA_pelvis[4] + tau[4];
     w.u_pelvis[5] = -w.pA_pelvis[5] + tau[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t15 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
-    const Scalar t16 = w.Linv_pelvis[0]*t15;
-    const Scalar t17 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t16;
-    const Scalar t18 = w.Linv_pelvis[1]*t17;
-    const Scalar t19 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t16 - w.L_pelvis[7]*t18;
-    const Scalar t20 = w.Linv_pelvis[2]*t19;
-    const Scalar t21 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t16 - w.L_pelvis[8]*t18 - w.L_pelvis[12]*t20;
-    const Scalar t22 = w.Linv_pelvis[3]*t21;
-    const Scalar t23 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t16 - w.L_pelvis[9]*t18 - w.L_pelvis[13]*t20 - w.L_pelvis[16]*t22;
-    const Scalar t24 = w.Linv_pelvis[4]*t23;
-    const Scalar t25 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t16 - w.L_pelvis[10]*t18 - w.L_pelvis[14]*t20 - w.L_pelvis[17]*t22 - w.L_pelvis[19]*t24;
-    const Scalar t26 = w.Linv_pelvis[5]*t25;
-    const Scalar t27 = w.Linv_pelvis[5]*t26;
-    const Scalar t28 = w.Linv_pelvis[4]*t23 - w.L_pelvis[19]*t27;
-    const Scalar t29 = w.Linv_pelvis[4]*t28;
-    const Scalar t30 = w.Linv_pelvis[3]*t21 - w.L_pelvis[16]*t29 - w.L_pelvis[17]*t27;
-    const Scalar t31 = w.Linv_pelvis[3]*t30;
-    const Scalar t32 = w.Linv_pelvis[2]*t19 - w.L_pelvis[12]*t31 - w.L_pelvis[13]*t29 - w.L_pelvis[14]*t27;
-    const Scalar t33 = w.Linv_pelvis[2]*t32;
-    const Scalar t34 = w.Linv_pelvis[1]*t17 - w.L_pelvis[7]*t33 - w.L_pelvis[8]*t31 - w.L_pelvis[9]*t29 - w.L_pelvis[10]*t27;
-    const Scalar t35 = w.Linv_pelvis[1]*t34;
-    const Scalar t36 = w.Linv_pelvis[0]*t15 - w.L_pelvis[1]*t35 - w.L_pelvis[2]*t33 - w.L_pelvis[3]*t31 - w.L_pelvis[4]*t29 - w.L_pelvis[5]*t27;
-    w.qdd[0] = w.Linv_pelvis[0]*t36;
-    w.qdd[1] = w.Linv_pelvis[1]*t34;
-    w.qdd[2] = w.Linv_pelvis[2]*t32;
-    w.qdd[3] = w.Linv_pelvis[3]*t30;
-    w.qdd[4] = w.Linv_pelvis[4]*t28;
-    w.qdd[5] = w.Linv_pelvis[5]*t26;
+    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t1 = w.Linv_pelvis[0]*t0;
+    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t3 = w.Linv_pelvis[1]*t2;
+    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t5 = w.Linv_pelvis[2]*t4;
+    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t7 = w.Linv_pelvis[3]*t6;
+    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t9 = w.Linv_pelvis[4]*t8;
+    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t11 = w.Linv_pelvis[5]*t10;
+    const Scalar t12 = w.Linv_pelvis[5]*t11;
+    const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
+    const Scalar t14 = w.Linv_pelvis[4]*t13;
+    const Scalar t15 = w.Linv_pelvis[3]*t6 - w.L_pelvis[16]*t14 - w.L_pelvis[17]*t12;
+    const Scalar t16 = w.Linv_pelvis[3]*t15;
+    const Scalar t17 = w.Linv_pelvis[2]*t4 - w.L_pelvis[12]*t16 - w.L_pelvis[13]*t14 - w.L_pelvis[14]*t12;
+    const Scalar t18 = w.Linv_pelvis[2]*t17;
+    const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
+    const Scalar t20 = w.Linv_pelvis[1]*t19;
+    const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
+    w.qdd[0] = w.Linv_pelvis[0]*t21;
+    w.qdd[1] = w.Linv_pelvis[1]*t19;
+    w.qdd[2] = w.Linv_pelvis[2]*t17;
+    w.qdd[3] = w.Linv_pelvis[3]*t15;
+    w.qdd[4] = w.Linv_pelvis[4]*t13;
+    w.qdd[5] = w.Linv_pelvis[5]*t11;
     w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
     w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
     w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
@@ -3334,387 +3379,417 @@ PROXGEN_RT_NOINLINE void caba_14(const Scalar* tau, Workspace& w) noexcept {
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_15(Workspace& w) noexcept {
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t0 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t1 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t2 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t3 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t4 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
-    const Scalar t5 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t0;
-    const Scalar t6 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t4 + w.sq_l_hip_yaw_link*t5;
-    const Scalar t7 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t4 + w.cq_l_hip_yaw_link*t5;
-    const Scalar t8 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t2 + w.cq_l_hip_yaw_link*t3;
-    const Scalar t9 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t6 - w.IA_l_hip_yaw_link[10]*t7 - w.IA_l_hip_yaw_link[14]*t1 - w.IA_l_hip_yaw_link[19]*t8 - w.a_pelvis[5]*w.IA_l_hip_yaw_link[20];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t9;
-    w.a_l_hip_yaw_link[0] = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t4 + w.sq_l_hip_yaw_link*t5;
-    w.a_l_hip_yaw_link[1] = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t4 + w.cq_l_hip_yaw_link*t5;
-    w.a_l_hip_yaw_link[2] = t1;
-    w.a_l_hip_yaw_link[3] = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t2 + w.sq_l_hip_yaw_link*t3;
-    w.a_l_hip_yaw_link[4] = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t2 + w.cq_l_hip_yaw_link*t3;
+    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
+    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
+    const Scalar t24 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t25 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t26 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
+    const Scalar t27 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
+    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
+    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
+    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
+    w.a_l_hip_yaw_link[0] = t28;
+    w.a_l_hip_yaw_link[1] = t29;
+    w.a_l_hip_yaw_link[2] = t23;
+    w.a_l_hip_yaw_link[3] = t30;
+    w.a_l_hip_yaw_link[4] = t31;
     w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    const Scalar t10 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t11 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t12 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t13 = w.u_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t10 - w.IA_l_hip_roll_link[12]*t11 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t12;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t13;
+    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
+    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
+    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
+    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
+    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
+    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
     w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[2] = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
+    w.a_l_hip_roll_link[1] = t0;
+    w.a_l_hip_roll_link[2] = t1;
     w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    w.a_l_hip_roll_link[5] = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
+    w.a_l_hip_roll_link[4] = t2;
+    w.a_l_hip_roll_link[5] = t3;
   }
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
-    const Scalar t14 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t15 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t16 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t17 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t18 = w.c_l_thigh[0] + w.cq_l_thigh*t16 - w.sq_l_thigh*t17;
-    const Scalar t19 = w.c_l_thigh[2] + w.sq_l_thigh*t16 + w.cq_l_thigh*t17;
-    const Scalar t20 = w.c_l_thigh[3] + w.cq_l_thigh*t14 - w.sq_l_thigh*t15;
-    const Scalar t21 = w.c_l_thigh[5] + w.sq_l_thigh*t14 + w.cq_l_thigh*t15;
-    const Scalar t22 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t18 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t19 - w.IA_l_thigh[16]*t20 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t21;
-    w.qdd[8] = w.Dinv_l_thigh*t22;
-    w.a_l_thigh[0] = w.c_l_thigh[0] + w.cq_l_thigh*t16 - w.sq_l_thigh*t17;
+    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
+    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
+    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
+    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
+    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
+    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
+    w.qdd[8] = w.Dinv_l_thigh*t13;
+    w.a_l_thigh[0] = t9;
     w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = w.c_l_thigh[2] + w.sq_l_thigh*t16 + w.cq_l_thigh*t17;
-    w.a_l_thigh[3] = w.c_l_thigh[3] + w.cq_l_thigh*t14 - w.sq_l_thigh*t15;
+    w.a_l_thigh[2] = t10;
+    w.a_l_thigh[3] = t11;
     w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = w.c_l_thigh[5] + w.sq_l_thigh*t14 + w.cq_l_thigh*t15;
+    w.a_l_thigh[5] = t12;
   }
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
-    const Scalar t23 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t24 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t25 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t26 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t27 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t23;
-    const Scalar t28 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t23;
-    const Scalar t29 = w.c_l_shank[0] + w.cq_l_shank*t27 - w.sq_l_shank*t28;
-    const Scalar t30 = w.c_l_shank[2] + w.sq_l_shank*t27 + w.cq_l_shank*t28;
-    const Scalar t31 = w.c_l_shank[3] + w.cq_l_shank*t25 - w.sq_l_shank*t26;
-    const Scalar t32 = w.c_l_shank[5] + w.sq_l_shank*t25 + w.cq_l_shank*t26;
-    const Scalar t33 = w.u_l_shank[0] - w.IA_l_shank[4]*t29 - w.IA_l_shank[9]*t24 - w.IA_l_shank[13]*t30 - w.IA_l_shank[16]*t31 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t32;
-    w.qdd[9] = w.Dinv_l_shank*t33;
-    w.a_l_shank[0] = w.c_l_shank[0] + w.cq_l_shank*t27 - w.sq_l_shank*t28;
-    w.a_l_shank[1] = t24;
-    w.a_l_shank[2] = w.c_l_shank[2] + w.sq_l_shank*t27 + w.cq_l_shank*t28;
-    w.a_l_shank[3] = w.c_l_shank[3] + w.cq_l_shank*t25 - w.sq_l_shank*t26;
+    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
+    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
+    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
+    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
+    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
+    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
+    w.qdd[9] = w.Dinv_l_shank*t24;
+    w.a_l_shank[0] = t20;
+    w.a_l_shank[1] = t15;
+    w.a_l_shank[2] = t21;
+    w.a_l_shank[3] = t22;
     w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = w.c_l_shank[5] + w.sq_l_shank*t25 + w.cq_l_shank*t26;
+    w.a_l_shank[5] = t23;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
-    const Scalar t34 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t35 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t36 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t37 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t38 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t34;
-    const Scalar t39 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t34;
-    const Scalar t40 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t38 - w.sq_l_ankle_link*t39;
-    const Scalar t41 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t38 + w.cq_l_ankle_link*t39;
-    const Scalar t42 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t36 + w.cq_l_ankle_link*t37;
-    const Scalar t43 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t40 - w.IA_l_ankle_link[9]*t35 - w.IA_l_ankle_link[13]*t41 - w.IA_l_ankle_link[18]*w.a_l_shank[4] - w.IA_l_ankle_link[19]*t42;
-    w.qdd[10] = w.Dinv_l_ankle_link*t43;
-    w.a_l_ankle_link[0] = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t38 - w.sq_l_ankle_link*t39;
-    w.a_l_ankle_link[1] = t35;
-    w.a_l_ankle_link[2] = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t38 + w.cq_l_ankle_link*t39;
-    w.a_l_ankle_link[3] = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t36 - w.sq_l_ankle_link*t37;
+    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
+    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
+    const Scalar t2 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
+    const Scalar t3 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
+    const Scalar t4 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
+    const Scalar t5 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
+    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
+    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
+    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
+    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
+    w.qdd[10] = w.Dinv_l_ankle_link*t10;
+    w.a_l_ankle_link[0] = t6;
+    w.a_l_ankle_link[1] = t1;
+    w.a_l_ankle_link[2] = t7;
+    w.a_l_ankle_link[3] = t8;
     w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t36 + w.cq_l_ankle_link*t37;
+    w.a_l_ankle_link[5] = t9;
   }
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    const Scalar t44 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t45 = -0.0017863999999999998*w.c_l_foot[5] + w.u_l_foot[0] + 0.0017863999999999998*w.sq_l_foot*w.a_l_ankle_link[4] - 0.0017863999999999998*w.cq_l_foot*w.a_l_ankle_link[5] - w.U_l_foot[1]*t44 - w.U_l_foot[3]*w.a_l_ankle_link[3];
-    w.qdd[11] = w.Dinv_l_foot*t45;
+    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t15 = w.u_l_foot[0] - 0.0017863999999999998*t14 - w.U_l_foot[1]*t11 - w.U_l_foot[3]*w.a_l_ankle_link[3];
+    w.qdd[11] = w.Dinv_l_foot*t15;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    w.a_l_foot[2] = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    w.a_l_foot[1] = t11;
+    w.a_l_foot[2] = t12;
     w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    w.a_l_foot[5] = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    w.a_l_foot[4] = t13;
+    w.a_l_foot[5] = t14;
+  }
+  // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
+  {
+    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
+    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
+    const Scalar t18 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t19 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t20 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
+    const Scalar t21 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
+    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
+    w.a_r_hip_yaw_link[0] = t22;
+    w.a_r_hip_yaw_link[1] = t23;
+    w.a_r_hip_yaw_link[2] = t17;
+    w.a_r_hip_yaw_link[3] = t24;
+    w.a_r_hip_yaw_link[4] = t25;
+    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_16(Workspace& w) noexcept {
-  // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t0 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t1 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t2 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t3 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t4 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
-    const Scalar t5 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t0;
-    const Scalar t6 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t4 + w.sq_r_hip_yaw_link*t5;
-    const Scalar t7 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t4 + w.cq_r_hip_yaw_link*t5;
-    const Scalar t8 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t2 + w.cq_r_hip_yaw_link*t3;
-    const Scalar t9 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t6 - w.IA_r_hip_yaw_link[10]*t7 - w.IA_r_hip_yaw_link[14]*t1 - w.IA_r_hip_yaw_link[19]*t8 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t9;
-    w.a_r_hip_yaw_link[0] = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t4 + w.sq_r_hip_yaw_link*t5;
-    w.a_r_hip_yaw_link[1] = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t4 + w.cq_r_hip_yaw_link*t5;
-    w.a_r_hip_yaw_link[2] = t1;
-    w.a_r_hip_yaw_link[3] = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t2 + w.sq_r_hip_yaw_link*t3;
-    w.a_r_hip_yaw_link[4] = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t2 + w.cq_r_hip_yaw_link*t3;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
+PROXGEN_RT_NOINLINE void caba_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    const Scalar t10 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t11 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t12 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t13 = w.u_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t10 - w.IA_r_hip_roll_link[12]*t11 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t12;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t13;
+    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
+    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
+    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
+    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
+    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
+    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
     w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[2] = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
+    w.a_r_hip_roll_link[1] = t0;
+    w.a_r_hip_roll_link[2] = t1;
     w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    w.a_r_hip_roll_link[5] = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
+    w.a_r_hip_roll_link[4] = t2;
+    w.a_r_hip_roll_link[5] = t3;
   }
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
-    const Scalar t14 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t15 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t16 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t17 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t18 = w.c_r_thigh[0] + w.cq_r_thigh*t16 - w.sq_r_thigh*t17;
-    const Scalar t19 = w.c_r_thigh[2] + w.sq_r_thigh*t16 + w.cq_r_thigh*t17;
-    const Scalar t20 = w.c_r_thigh[3] + w.cq_r_thigh*t14 - w.sq_r_thigh*t15;
-    const Scalar t21 = w.c_r_thigh[5] + w.sq_r_thigh*t14 + w.cq_r_thigh*t15;
-    const Scalar t22 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t18 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t19 - w.IA_r_thigh[16]*t20 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t21;
-    w.qdd[14] = w.Dinv_r_thigh*t22;
-    w.a_r_thigh[0] = w.c_r_thigh[0] + w.cq_r_thigh*t16 - w.sq_r_thigh*t17;
+    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
+    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
+    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
+    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
+    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
+    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
+    w.qdd[14] = w.Dinv_r_thigh*t13;
+    w.a_r_thigh[0] = t9;
     w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = w.c_r_thigh[2] + w.sq_r_thigh*t16 + w.cq_r_thigh*t17;
-    w.a_r_thigh[3] = w.c_r_thigh[3] + w.cq_r_thigh*t14 - w.sq_r_thigh*t15;
+    w.a_r_thigh[2] = t10;
+    w.a_r_thigh[3] = t11;
     w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = w.c_r_thigh[5] + w.sq_r_thigh*t14 + w.cq_r_thigh*t15;
+    w.a_r_thigh[5] = t12;
   }
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
-    const Scalar t23 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t24 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t25 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t26 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t27 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t23;
-    const Scalar t28 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t23;
-    const Scalar t29 = w.c_r_shank[0] + w.cq_r_shank*t27 - w.sq_r_shank*t28;
-    const Scalar t30 = w.c_r_shank[2] + w.sq_r_shank*t27 + w.cq_r_shank*t28;
-    const Scalar t31 = w.c_r_shank[3] + w.cq_r_shank*t25 - w.sq_r_shank*t26;
-    const Scalar t32 = w.c_r_shank[5] + w.sq_r_shank*t25 + w.cq_r_shank*t26;
-    const Scalar t33 = w.u_r_shank[0] - w.IA_r_shank[4]*t29 - w.IA_r_shank[9]*t24 - w.IA_r_shank[13]*t30 - w.IA_r_shank[16]*t31 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t32;
-    w.qdd[15] = w.Dinv_r_shank*t33;
-    w.a_r_shank[0] = w.c_r_shank[0] + w.cq_r_shank*t27 - w.sq_r_shank*t28;
-    w.a_r_shank[1] = t24;
-    w.a_r_shank[2] = w.c_r_shank[2] + w.sq_r_shank*t27 + w.cq_r_shank*t28;
-    w.a_r_shank[3] = w.c_r_shank[3] + w.cq_r_shank*t25 - w.sq_r_shank*t26;
+    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
+    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
+    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
+    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
+    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
+    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
+    w.qdd[15] = w.Dinv_r_shank*t24;
+    w.a_r_shank[0] = t20;
+    w.a_r_shank[1] = t15;
+    w.a_r_shank[2] = t21;
+    w.a_r_shank[3] = t22;
     w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = w.c_r_shank[5] + w.sq_r_shank*t25 + w.cq_r_shank*t26;
-  }
-  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    const Scalar t34 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t35 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t36 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t37 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t38 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t34;
-    const Scalar t39 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t34;
-    const Scalar t40 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t38 - w.sq_r_ankle_link*t39;
-    const Scalar t41 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t38 + w.cq_r_ankle_link*t39;
-    const Scalar t42 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t36 + w.cq_r_ankle_link*t37;
-    const Scalar t43 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t40 - w.IA_r_ankle_link[9]*t35 - w.IA_r_ankle_link[13]*t41 - w.IA_r_ankle_link[18]*w.a_r_shank[4] - w.IA_r_ankle_link[19]*t42;
-    w.qdd[16] = w.Dinv_r_ankle_link*t43;
-    w.a_r_ankle_link[0] = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t38 - w.sq_r_ankle_link*t39;
-    w.a_r_ankle_link[1] = t35;
-    w.a_r_ankle_link[2] = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t38 + w.cq_r_ankle_link*t39;
-    w.a_r_ankle_link[3] = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t36 - w.sq_r_ankle_link*t37;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t36 + w.cq_r_ankle_link*t37;
-  }
-  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar t44 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t45 = -0.0017863999999999998*w.c_r_foot[5] + w.u_r_foot[0] + 0.0017863999999999998*w.sq_r_foot*w.a_r_ankle_link[4] - 0.0017863999999999998*w.cq_r_foot*w.a_r_ankle_link[5] - w.U_r_foot[1]*t44 - w.U_r_foot[3]*w.a_r_ankle_link[3];
-    w.qdd[17] = w.Dinv_r_foot*t45;
-    w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[2] = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    w.a_r_foot[5] = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    w.a_r_shank[5] = t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_17(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  {
+    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
+    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
+    const Scalar t2 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
+    const Scalar t3 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
+    const Scalar t4 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
+    const Scalar t5 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
+    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
+    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
+    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
+    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
+    w.qdd[16] = w.Dinv_r_ankle_link*t10;
+    w.a_r_ankle_link[0] = t6;
+    w.a_r_ankle_link[1] = t1;
+    w.a_r_ankle_link[2] = t7;
+    w.a_r_ankle_link[3] = t8;
+    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
+    w.a_r_ankle_link[5] = t9;
+  }
+  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  {
+    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t15 = w.u_r_foot[0] - 0.0017863999999999998*t14 - w.U_r_foot[1]*t11 - w.U_r_foot[3]*w.a_r_ankle_link[3];
+    w.qdd[17] = w.Dinv_r_foot*t15;
+    w.a_r_foot[0] = w.a_r_ankle_link[0];
+    w.a_r_foot[1] = t11;
+    w.a_r_foot[2] = t12;
+    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
+    w.a_r_foot[4] = t13;
+    w.a_r_foot[5] = t14;
+  }
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t0 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t1 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t2 = w.c_abdomen[0] + w.cq_abdomen*t0 + w.sq_abdomen*t1;
-    const Scalar t3 = w.c_abdomen[1] - w.sq_abdomen*t0 + w.cq_abdomen*t1;
-    const Scalar t4 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t5 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t6 = w.u_abdomen[0] - w.IA_abdomen[5]*t2 - w.IA_abdomen[10]*t3 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t4 - w.IA_abdomen[19]*t5 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t6;
-    w.a_abdomen[0] = w.c_abdomen[0] + w.cq_abdomen*t0 + w.sq_abdomen*t1;
-    w.a_abdomen[1] = w.c_abdomen[1] - w.sq_abdomen*t0 + w.cq_abdomen*t1;
+    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.qdd[18] = w.Dinv_abdomen*t22;
+    w.a_abdomen[0] = t18;
+    w.a_abdomen[1] = t19;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    w.a_abdomen[4] = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    w.a_abdomen[3] = t20;
+    w.a_abdomen[4] = t21;
     w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    const Scalar t7 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t8 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t9 = w.c_chest[0] + w.cq_chest*t7 - w.sq_chest*w.a_abdomen[2];
-    const Scalar t10 = w.c_chest[2] + w.sq_chest*t7 + w.cq_chest*w.a_abdomen[2];
-    const Scalar t11 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    const Scalar t12 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-    const Scalar t13 = w.u_chest[0] - w.IA_chest[4]*t9 - w.IA_chest[9]*t8 - w.IA_chest[13]*t10 - w.IA_chest[16]*t11 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t12;
-    w.qdd[19] = w.Dinv_chest*t13;
-    w.a_chest[0] = w.c_chest[0] + w.cq_chest*t7 - w.sq_chest*w.a_abdomen[2];
-    w.a_chest[1] = t8;
-    w.a_chest[2] = w.c_chest[2] + w.sq_chest*t7 + w.cq_chest*w.a_abdomen[2];
-    w.a_chest[3] = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
+    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
+    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
+    w.qdd[19] = w.Dinv_chest*t6;
+    w.a_chest[0] = t2;
+    w.a_chest[1] = t1;
+    w.a_chest[2] = t3;
+    w.a_chest[3] = t4;
     w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
+    w.a_chest[5] = t5;
   }
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    const Scalar t14 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t15 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t16 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t17 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t18 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t19 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t20 = 0.9848134698792882*t14 + 0.17361575258114187*t16;
-    const Scalar t21 = 0.04493516596384369*t14 + 0.9659256678396477*t15 - 0.2548890642384102*t16;
-    const Scalar t22 = -0.1676999117594225*t14 + 0.2588196364430848*t15 + 0.9512566085906322*t16;
-    const Scalar t23 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t20 - w.sq_r_shoulder_pitch_link*t22;
-    const Scalar t24 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t20 + w.cq_r_shoulder_pitch_link*t22;
-    const Scalar t25 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t17 + w.cq_r_shoulder_pitch_link*t19;
-    const Scalar t26 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t23 - w.IA_r_shoulder_pitch_link[9]*t21 - w.IA_r_shoulder_pitch_link[13]*t24 - w.IA_r_shoulder_pitch_link[18]*t18 - w.IA_r_shoulder_pitch_link[19]*t25;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t26;
-    w.a_r_shoulder_pitch_link[0] = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t20 - w.sq_r_shoulder_pitch_link*t22;
-    w.a_r_shoulder_pitch_link[1] = t21;
-    w.a_r_shoulder_pitch_link[2] = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t20 + w.cq_r_shoulder_pitch_link*t22;
-    w.a_r_shoulder_pitch_link[3] = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t17 - w.sq_r_shoulder_pitch_link*t19;
-    w.a_r_shoulder_pitch_link[4] = t18 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t17 + w.cq_r_shoulder_pitch_link*t19;
+    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t10 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t11 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t12 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t13 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
+    const Scalar t14 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
+    const Scalar t15 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
+    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t14 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t11 - w.IA_r_shoulder_pitch_link[19]*t19;
+    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
+    w.a_r_shoulder_pitch_link[0] = t16;
+    w.a_r_shoulder_pitch_link[1] = t14;
+    w.a_r_shoulder_pitch_link[2] = t17;
+    w.a_r_shoulder_pitch_link[3] = t18;
+    w.a_r_shoulder_pitch_link[4] = t11 + w.qdd[29];
+    w.a_r_shoulder_pitch_link[5] = t19;
   }
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    const Scalar t27 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t28 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t29 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t30 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t27 - w.IA_r_shoulder_roll_link[12]*t28 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t29;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t30;
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
+    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    w.a_r_shoulder_roll_link[2] = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    w.a_r_shoulder_roll_link[1] = t21;
+    w.a_r_shoulder_roll_link[2] = t22;
     w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    w.a_r_shoulder_roll_link[5] = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    w.a_r_shoulder_roll_link[4] = t23;
+    w.a_r_shoulder_roll_link[5] = t24;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t31 = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t32 = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t33 = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t34 = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t35 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t31 - w.IA_r_upper_arm[10]*t32 - w.IA_r_upper_arm[14]*w.a_r_shoulder_roll_link[2] - w.IA_r_upper_arm[17]*t33 - w.IA_r_upper_arm[19]*t34 - w.IA_r_upper_arm[20]*w.a_r_shoulder_roll_link[5];
-    w.qdd[31] = w.Dinv_r_upper_arm*t35;
-    w.a_r_upper_arm[0] = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    w.a_r_upper_arm[1] = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
+    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
+    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
+    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
+    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    w.qdd[31] = w.Dinv_r_upper_arm*t4;
+    w.a_r_upper_arm[0] = t0;
+    w.a_r_upper_arm[1] = t1;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    w.a_r_upper_arm[4] = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
+    w.a_r_upper_arm[3] = t2;
+    w.a_r_upper_arm[4] = t3;
     w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
   }
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    const Scalar t36 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t37 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t38 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t39 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t40 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t36;
-    const Scalar t41 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t36;
-    const Scalar t42 = w.c_r_forearm[0] + w.cq_r_forearm*t40 - w.sq_r_forearm*t41;
-    const Scalar t43 = w.c_r_forearm[2] + w.sq_r_forearm*t40 + w.cq_r_forearm*t41;
-    const Scalar t44 = w.c_r_forearm[3] + w.cq_r_forearm*t38 - w.sq_r_forearm*t39;
-    const Scalar t45 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t42 - w.IA_r_forearm[9]*t37 - w.IA_r_forearm[13]*t43 - w.IA_r_forearm[16]*t44 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t45;
-    w.a_r_forearm[0] = w.c_r_forearm[0] + w.cq_r_forearm*t40 - w.sq_r_forearm*t41;
-    w.a_r_forearm[1] = t37;
-    w.a_r_forearm[2] = w.c_r_forearm[2] + w.sq_r_forearm*t40 + w.cq_r_forearm*t41;
-    w.a_r_forearm[3] = w.c_r_forearm[3] + w.cq_r_forearm*t38 - w.sq_r_forearm*t39;
+    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t7 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t8 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t9 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
+    const Scalar t10 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
+    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
+    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
+    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
+    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    w.qdd[32] = w.Dinv_r_forearm*t15;
+    w.a_r_forearm[0] = t11;
+    w.a_r_forearm[1] = t6;
+    w.a_r_forearm[2] = t12;
+    w.a_r_forearm[3] = t13;
     w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = w.c_r_forearm[5] + w.sq_r_forearm*t38 + w.cq_r_forearm*t39;
+    w.a_r_forearm[5] = t14;
+  }
+  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+  {
+    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
+    w.a_r_wrist_yaw_link[0] = t18;
+    w.a_r_wrist_yaw_link[1] = t19;
+    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
+    w.a_r_wrist_yaw_link[3] = t20;
+    w.a_r_wrist_yaw_link[4] = t21;
+    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_18(Scalar mu, Workspace& w) noexcept {
-  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    const Scalar t0 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t1 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t2 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
-    const Scalar t3 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
-    const Scalar t4 = w.c_r_wrist_yaw_link[3] + w.a_r_forearm[3]*w.cq_r_wrist_yaw_link + w.a_r_forearm[4]*w.sq_r_wrist_yaw_link;
-    const Scalar t5 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t2 - w.IA_r_wrist_yaw_link[10]*t3 - w.a_r_forearm[2]*w.IA_r_wrist_yaw_link[14] - w.IA_r_wrist_yaw_link[17]*t4 - w.a_r_forearm[5]*w.IA_r_wrist_yaw_link[20];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t5;
-    w.a_r_wrist_yaw_link[0] = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
-    w.a_r_wrist_yaw_link[1] = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
-    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = w.c_r_wrist_yaw_link[3] + w.a_r_forearm[3]*w.cq_r_wrist_yaw_link + w.a_r_forearm[4]*w.sq_r_wrist_yaw_link;
-    w.a_r_wrist_yaw_link[4] = w.c_r_wrist_yaw_link[4] - w.a_r_forearm[3]*w.sq_r_wrist_yaw_link + w.a_r_forearm[4]*w.cq_r_wrist_yaw_link;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
-  }
+PROXGEN_RT_NOINLINE void caba_28(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t6 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t7 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t8 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t6 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t7;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t8;
-    w.a_r_wrist_pitch_link[0] = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
+    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
+    w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    w.a_r_wrist_pitch_link[3] = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[2] = t1;
+    w.a_r_wrist_pitch_link[3] = t2;
     w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[5] = t3;
   }
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t9 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t10 = w.u_r_hand[0] - w.U_r_hand[1]*t9 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
-    w.qdd[35] = w.Dinv_r_hand*t10;
+    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t9 = w.u_r_hand[0] - w.U_r_hand[1]*t5 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
+    w.qdd[35] = w.Dinv_r_hand*t9;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.a_r_hand[2] = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    w.a_r_hand[1] = t5;
+    w.a_r_hand[2] = t6;
     w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    w.a_r_hand[5] = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    w.a_r_hand[4] = t7;
+    w.a_r_hand[5] = t8;
   }
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t11 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = t11*mu;
+    const Scalar t10 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = t10*mu;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t12 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t12;
+    const Scalar t11 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*t11;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t13 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t13;
+    const Scalar t12 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*t12;
     w.lambda[2] = w.dlambda[2];
     w.dlambda[3] = w.a_l_foot[3]*mu;
     w.lambda[3] = w.dlambda[3];
@@ -3722,14 +3797,14 @@ PROXGEN_RT_NOINLINE void caba_18(Scalar mu, Workspace& w) noexcept {
     w.lambda[4] = w.dlambda[4];
     w.dlambda[5] = w.a_l_foot[5]*mu;
     w.lambda[5] = w.dlambda[5];
-    const Scalar t14 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t14;
+    const Scalar t13 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*t13;
     w.lambda[6] = w.dlambda[6];
-    const Scalar t15 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t15;
+    const Scalar t14 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*t14;
     w.lambda[7] = w.dlambda[7];
-    const Scalar t16 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t16;
+    const Scalar t15 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*t15;
     w.lambda[8] = w.dlambda[8];
     w.dlambda[9] = w.a_r_foot[3]*mu;
     w.lambda[9] = w.dlambda[9];
@@ -3737,19 +3812,19 @@ PROXGEN_RT_NOINLINE void caba_18(Scalar mu, Workspace& w) noexcept {
     w.lambda[10] = w.dlambda[10];
     w.dlambda[11] = w.a_r_foot[5]*mu;
     w.lambda[11] = w.dlambda[11];
-    const Scalar t17 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.dlambda[12] = mu*t17;
+    const Scalar t16 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
+    w.dlambda[12] = mu*t16;
     w.lambda[12] = w.dlambda[12];
-    const Scalar t18 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
-    w.dlambda[13] = mu*t18;
+    const Scalar t17 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
+    w.dlambda[13] = mu*t17;
     w.lambda[13] = w.dlambda[13];
-    const Scalar t19 = -w.k_right_hand[2] + w.a_r_hand[2];
-    w.dlambda[14] = mu*t19;
+    const Scalar t18 = -w.k_right_hand[2] + w.a_r_hand[2];
+    w.dlambda[14] = mu*t18;
     w.lambda[14] = w.dlambda[14];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_19(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.u_r_hand[0] = w.u_r_hand[0] - 0.13*w.dlambda[12];
@@ -3817,245 +3892,251 @@ PROXGEN_RT_NOINLINE void caba_19(Workspace& w) noexcept {
     w.dp_r_upper_arm[4] = t20 - 0.3255*t25;
     w.dp_r_upper_arm[5] = 0.29552020666133966*t23 + 0.955336489125606*t24;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_30(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    w.u_r_upper_arm[0] = w.u_r_upper_arm[0] - w.dp_r_upper_arm[5];
-    const Scalar t27 = -w.Dinv_r_upper_arm*w.dp_r_upper_arm[5];
-    const Scalar t28 = w.dp_r_upper_arm[0] + w.IA_r_upper_arm[5]*t27;
-    const Scalar t29 = w.dp_r_upper_arm[1] + w.IA_r_upper_arm[10]*t27;
-    const Scalar t30 = w.dp_r_upper_arm[2] + w.IA_r_upper_arm[14]*t27;
-    const Scalar t31 = w.dp_r_upper_arm[3] + w.IA_r_upper_arm[17]*t27;
-    const Scalar t32 = w.dp_r_upper_arm[4] + w.IA_r_upper_arm[19]*t27;
-    const Scalar t33 = w.dp_r_upper_arm[5] + w.IA_r_upper_arm[20]*t27;
-    w.dp_r_shoulder_roll_link[0] = w.cq_r_upper_arm*t28 - w.sq_r_upper_arm*t29;
-    w.dp_r_shoulder_roll_link[1] = w.sq_r_upper_arm*t28 + w.cq_r_upper_arm*t29;
-    w.dp_r_shoulder_roll_link[2] = t30;
-    w.dp_r_shoulder_roll_link[3] = w.cq_r_upper_arm*t31 - w.sq_r_upper_arm*t32;
-    w.dp_r_shoulder_roll_link[4] = w.sq_r_upper_arm*t31 + w.cq_r_upper_arm*t32;
-    w.dp_r_shoulder_roll_link[5] = t33;
+    w.u_r_upper_arm[0] = -w.dp_r_upper_arm[5] + w.u_r_upper_arm[0];
+    const Scalar t0 = -w.dp_r_upper_arm[5]*w.Dinv_r_upper_arm;
+    const Scalar t1 = w.dp_r_upper_arm[0] + w.IA_r_upper_arm[5]*t0;
+    const Scalar t2 = w.dp_r_upper_arm[1] + w.IA_r_upper_arm[10]*t0;
+    const Scalar t3 = w.dp_r_upper_arm[2] + w.IA_r_upper_arm[14]*t0;
+    const Scalar t4 = w.dp_r_upper_arm[3] + w.IA_r_upper_arm[17]*t0;
+    const Scalar t5 = w.dp_r_upper_arm[4] + w.IA_r_upper_arm[19]*t0;
+    const Scalar t6 = w.dp_r_upper_arm[5] + w.IA_r_upper_arm[20]*t0;
+    w.dp_r_shoulder_roll_link[0] = w.cq_r_upper_arm*t1 - w.sq_r_upper_arm*t2;
+    w.dp_r_shoulder_roll_link[1] = w.sq_r_upper_arm*t1 + w.cq_r_upper_arm*t2;
+    w.dp_r_shoulder_roll_link[2] = t3;
+    w.dp_r_shoulder_roll_link[3] = w.cq_r_upper_arm*t4 - w.sq_r_upper_arm*t5;
+    w.dp_r_shoulder_roll_link[4] = w.sq_r_upper_arm*t4 + w.cq_r_upper_arm*t5;
+    w.dp_r_shoulder_roll_link[5] = t6;
   }
   // reduced sweep: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     w.u_r_shoulder_roll_link[0] = w.u_r_shoulder_roll_link[0] - w.dp_r_shoulder_roll_link[3];
-    const Scalar t34 = -w.Dinv_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[3];
-    const Scalar t35 = w.dp_r_shoulder_roll_link[0] + w.IA_r_shoulder_roll_link[3]*t34;
-    const Scalar t36 = w.dp_r_shoulder_roll_link[1] + w.IA_r_shoulder_roll_link[8]*t34;
-    const Scalar t37 = w.dp_r_shoulder_roll_link[2] + w.IA_r_shoulder_roll_link[12]*t34;
-    const Scalar t38 = w.dp_r_shoulder_roll_link[3] + w.IA_r_shoulder_roll_link[15]*t34;
-    const Scalar t39 = w.dp_r_shoulder_roll_link[4] + w.IA_r_shoulder_roll_link[16]*t34;
-    w.dp_r_shoulder_pitch_link[0] = t35;
-    w.dp_r_shoulder_pitch_link[1] = w.cq_r_shoulder_roll_link*t36 - w.sq_r_shoulder_roll_link*t37;
-    w.dp_r_shoulder_pitch_link[2] = w.sq_r_shoulder_roll_link*t36 + w.cq_r_shoulder_roll_link*t37;
-    w.dp_r_shoulder_pitch_link[3] = t38;
-    w.dp_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*t39 - w.sq_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[5];
-    w.dp_r_shoulder_pitch_link[5] = w.sq_r_shoulder_roll_link*t39 + w.cq_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[5];
+    const Scalar t7 = -w.Dinv_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[3];
+    const Scalar t8 = w.dp_r_shoulder_roll_link[0] + w.IA_r_shoulder_roll_link[3]*t7;
+    const Scalar t9 = w.dp_r_shoulder_roll_link[1] + w.IA_r_shoulder_roll_link[8]*t7;
+    const Scalar t10 = w.dp_r_shoulder_roll_link[2] + w.IA_r_shoulder_roll_link[12]*t7;
+    const Scalar t11 = w.dp_r_shoulder_roll_link[3] + w.IA_r_shoulder_roll_link[15]*t7;
+    const Scalar t12 = w.dp_r_shoulder_roll_link[4] + w.IA_r_shoulder_roll_link[16]*t7;
+    w.dp_r_shoulder_pitch_link[0] = t8;
+    w.dp_r_shoulder_pitch_link[1] = w.cq_r_shoulder_roll_link*t9 - w.sq_r_shoulder_roll_link*t10;
+    w.dp_r_shoulder_pitch_link[2] = w.sq_r_shoulder_roll_link*t9 + w.cq_r_shoulder_roll_link*t10;
+    w.dp_r_shoulder_pitch_link[3] = t11;
+    w.dp_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*t12 - w.sq_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[5];
+    w.dp_r_shoulder_pitch_link[5] = w.sq_r_shoulder_roll_link*t12 + w.cq_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[5];
+  }
+  // reduced sweep: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+  {
+    w.u_r_shoulder_pitch_link[0] = w.u_r_shoulder_pitch_link[0] - w.dp_r_shoulder_pitch_link[4];
+    const Scalar t13 = -w.Dinv_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[4];
+    const Scalar t14 = w.dp_r_shoulder_pitch_link[0] + w.IA_r_shoulder_pitch_link[4]*t13;
+    const Scalar t15 = w.dp_r_shoulder_pitch_link[1] + w.IA_r_shoulder_pitch_link[9]*t13;
+    const Scalar t16 = w.dp_r_shoulder_pitch_link[2] + w.IA_r_shoulder_pitch_link[13]*t13;
+    const Scalar t17 = w.dp_r_shoulder_pitch_link[4] + w.IA_r_shoulder_pitch_link[18]*t13;
+    const Scalar t18 = w.dp_r_shoulder_pitch_link[5] + w.IA_r_shoulder_pitch_link[19]*t13;
+    const Scalar t19 = w.cq_r_shoulder_pitch_link*t14 + w.sq_r_shoulder_pitch_link*t16;
+    const Scalar t20 = -w.sq_r_shoulder_pitch_link*t14 + w.cq_r_shoulder_pitch_link*t16;
+    const Scalar t21 = w.cq_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[3] + w.sq_r_shoulder_pitch_link*t18;
+    const Scalar t22 = -w.sq_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t18;
+    const Scalar t23 = 0.04493516596384369*t15 + 0.9848134698792882*t19 - 0.1676999117594225*t20;
+    const Scalar t24 = 0.9659256678396477*t15 + 0.2588196364430848*t20;
+    const Scalar t25 = -0.2548890642384102*t15 + 0.17361575258114187*t19 + 0.9512566085906322*t20;
+    w.dp_chest[0] = t23;
+    w.dp_chest[1] = t24;
+    w.dp_chest[2] = t25;
+    w.dp_chest[3] = 0.04493516596384369*t17 + 0.9848134698792882*t21 - 0.1676999117594225*t22 - 0.254*t24 - 0.19*t25;
+    w.dp_chest[4] = 0.9659256678396477*t17 + 0.2588196364430848*t22 + 0.254*t23;
+    w.dp_chest[5] = -0.2548890642384102*t17 + 0.17361575258114187*t21 + 0.9512566085906322*t22 + 0.19*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_20(Workspace& w) noexcept {
-  // reduced sweep: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    w.u_r_shoulder_pitch_link[0] = -w.dp_r_shoulder_pitch_link[4] + w.u_r_shoulder_pitch_link[0];
-    const Scalar t0 = -w.dp_r_shoulder_pitch_link[4]*w.Dinv_r_shoulder_pitch_link;
-    const Scalar t1 = w.dp_r_shoulder_pitch_link[0] + w.IA_r_shoulder_pitch_link[4]*t0;
-    const Scalar t2 = w.dp_r_shoulder_pitch_link[1] + w.IA_r_shoulder_pitch_link[9]*t0;
-    const Scalar t3 = w.dp_r_shoulder_pitch_link[2] + w.IA_r_shoulder_pitch_link[13]*t0;
-    const Scalar t4 = w.dp_r_shoulder_pitch_link[4] + w.IA_r_shoulder_pitch_link[18]*t0;
-    const Scalar t5 = w.dp_r_shoulder_pitch_link[5] + w.IA_r_shoulder_pitch_link[19]*t0;
-    const Scalar t6 = w.cq_r_shoulder_pitch_link*t1 + w.sq_r_shoulder_pitch_link*t3;
-    const Scalar t7 = -w.sq_r_shoulder_pitch_link*t1 + w.cq_r_shoulder_pitch_link*t3;
-    const Scalar t8 = w.cq_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[3] + w.sq_r_shoulder_pitch_link*t5;
-    const Scalar t9 = -w.sq_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t5;
-    const Scalar t10 = 0.04493516596384369*t2 + 0.9848134698792882*t6 - 0.1676999117594225*t7;
-    const Scalar t11 = 0.9659256678396477*t2 + 0.2588196364430848*t7;
-    const Scalar t12 = -0.2548890642384102*t2 + 0.17361575258114187*t6 + 0.9512566085906322*t7;
-    w.dp_chest[0] = t10;
-    w.dp_chest[1] = t11;
-    w.dp_chest[2] = t12;
-    w.dp_chest[3] = 0.04493516596384369*t4 + 0.9848134698792882*t8 - 0.1676999117594225*t9 - 0.254*t11 - 0.19*t12;
-    w.dp_chest[4] = 0.9659256678396477*t4 + 0.2588196364430848*t9 + 0.254*t10;
-    w.dp_chest[5] = -0.2548890642384102*t4 + 0.17361575258114187*t8 + 0.9512566085906322*t9 + 0.19*t10;
-  }
+PROXGEN_RT_NOINLINE void caba_31(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    w.u_chest[0] = w.u_chest[0] - w.dp_chest[4];
-    const Scalar t13 = -w.Dinv_chest*w.dp_chest[4];
-    const Scalar t14 = w.dp_chest[0] + w.IA_chest[4]*t13;
-    const Scalar t15 = w.dp_chest[1] + w.IA_chest[9]*t13;
-    const Scalar t16 = w.dp_chest[2] + w.IA_chest[13]*t13;
-    const Scalar t17 = w.dp_chest[3] + w.IA_chest[16]*t13;
-    const Scalar t18 = w.dp_chest[4] + w.IA_chest[18]*t13;
-    const Scalar t19 = w.dp_chest[5] + w.IA_chest[19]*t13;
-    const Scalar t20 = w.cq_chest*t14 + w.sq_chest*t16;
-    const Scalar t21 = -w.sq_chest*t14 + w.cq_chest*t16;
-    w.dp_abdomen[0] = t20;
-    w.dp_abdomen[1] = t15;
-    w.dp_abdomen[2] = t21;
-    w.dp_abdomen[3] = -0.15*t15 + w.cq_chest*t17 + w.sq_chest*t19;
-    w.dp_abdomen[4] = t18 + 0.15*t20;
-    w.dp_abdomen[5] = -w.sq_chest*t17 + w.cq_chest*t19;
+    w.u_chest[0] = -w.dp_chest[4] + w.u_chest[0];
+    const Scalar t0 = -w.dp_chest[4]*w.Dinv_chest;
+    const Scalar t1 = w.dp_chest[0] + w.IA_chest[4]*t0;
+    const Scalar t2 = w.dp_chest[1] + w.IA_chest[9]*t0;
+    const Scalar t3 = w.dp_chest[2] + w.IA_chest[13]*t0;
+    const Scalar t4 = w.dp_chest[3] + w.IA_chest[16]*t0;
+    const Scalar t5 = w.dp_chest[4] + w.IA_chest[18]*t0;
+    const Scalar t6 = w.dp_chest[5] + w.IA_chest[19]*t0;
+    const Scalar t7 = w.cq_chest*t1 + w.sq_chest*t3;
+    const Scalar t8 = -w.sq_chest*t1 + w.cq_chest*t3;
+    w.dp_abdomen[0] = t7;
+    w.dp_abdomen[1] = t2;
+    w.dp_abdomen[2] = t8;
+    w.dp_abdomen[3] = -0.15*t2 + w.cq_chest*t4 + w.sq_chest*t6;
+    w.dp_abdomen[4] = t5 + 0.15*t7;
+    w.dp_abdomen[5] = -w.sq_chest*t4 + w.cq_chest*t6;
   }
   // reduced sweep: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.u_abdomen[0] = w.u_abdomen[0] - w.dp_abdomen[5];
-    const Scalar t22 = -w.Dinv_abdomen*w.dp_abdomen[5];
-    const Scalar t23 = w.dp_abdomen[0] + w.IA_abdomen[5]*t22;
-    const Scalar t24 = w.dp_abdomen[1] + w.IA_abdomen[10]*t22;
-    const Scalar t25 = w.dp_abdomen[2] + w.IA_abdomen[14]*t22;
-    const Scalar t26 = w.dp_abdomen[3] + w.IA_abdomen[17]*t22;
-    const Scalar t27 = w.dp_abdomen[4] + w.IA_abdomen[19]*t22;
-    const Scalar t28 = w.dp_abdomen[5] + w.IA_abdomen[20]*t22;
-    const Scalar t29 = w.cq_abdomen*t23 - w.sq_abdomen*t24;
-    const Scalar t30 = w.sq_abdomen*t23 + w.cq_abdomen*t24;
-    w.dp_pelvis[0] = t29;
-    w.dp_pelvis[1] = t30;
-    w.dp_pelvis[2] = t25;
-    w.dp_pelvis[3] = w.cq_abdomen*t26 - w.sq_abdomen*t27 - 0.1*t30;
-    w.dp_pelvis[4] = w.sq_abdomen*t26 + w.cq_abdomen*t27 + 0.1*t29;
-    w.dp_pelvis[5] = t28;
+    const Scalar t9 = -w.Dinv_abdomen*w.dp_abdomen[5];
+    const Scalar t10 = w.dp_abdomen[0] + w.IA_abdomen[5]*t9;
+    const Scalar t11 = w.dp_abdomen[1] + w.IA_abdomen[10]*t9;
+    const Scalar t12 = w.dp_abdomen[2] + w.IA_abdomen[14]*t9;
+    const Scalar t13 = w.dp_abdomen[3] + w.IA_abdomen[17]*t9;
+    const Scalar t14 = w.dp_abdomen[4] + w.IA_abdomen[19]*t9;
+    const Scalar t15 = w.dp_abdomen[5] + w.IA_abdomen[20]*t9;
+    const Scalar t16 = w.cq_abdomen*t10 - w.sq_abdomen*t11;
+    const Scalar t17 = w.sq_abdomen*t10 + w.cq_abdomen*t11;
+    w.dp_pelvis[0] = t16;
+    w.dp_pelvis[1] = t17;
+    w.dp_pelvis[2] = t12;
+    w.dp_pelvis[3] = w.cq_abdomen*t13 - w.sq_abdomen*t14 - 0.1*t17;
+    w.dp_pelvis[4] = w.sq_abdomen*t13 + w.cq_abdomen*t14 + 0.1*t16;
+    w.dp_pelvis[5] = t15;
   }
   // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     const Scalar du0 = -0.06825*w.dlambda[7] - w.dlambda[9];
     w.u_r_foot[0] = w.u_r_foot[0] + du0;
-    const Scalar t31 = w.Dinv_r_foot*du0;
-    const Scalar t32 = w.dlambda[7] + w.U_r_foot[1]*t31;
-    const Scalar t33 = 0.06825*w.dlambda[7] + w.dlambda[9] + w.U_r_foot[3]*t31;
-    const Scalar t34 = -0.06825*w.dlambda[6] + w.dlambda[10];
-    const Scalar t35 = w.dlambda[11] + 0.0017863999999999998*w.Dinv_r_foot*du0;
+    const Scalar t18 = w.Dinv_r_foot*du0;
+    const Scalar t19 = w.dlambda[7] + w.U_r_foot[1]*t18;
+    const Scalar t20 = 0.06825*w.dlambda[7] + w.dlambda[9] + w.U_r_foot[3]*t18;
+    const Scalar t21 = -0.06825*w.dlambda[6] + w.dlambda[10];
+    const Scalar t22 = w.dlambda[11] + 0.0017863999999999998*w.Dinv_r_foot*du0;
     w.dp_r_ankle_link[0] = w.dlambda[6];
-    w.dp_r_ankle_link[1] = w.cq_r_foot*t32 - w.sq_r_foot*w.dlambda[8];
-    w.dp_r_ankle_link[2] = w.sq_r_foot*t32 + w.cq_r_foot*w.dlambda[8];
-    w.dp_r_ankle_link[3] = t33;
-    w.dp_r_ankle_link[4] = w.cq_r_foot*t34 - w.sq_r_foot*t35;
-    w.dp_r_ankle_link[5] = w.sq_r_foot*t34 + w.cq_r_foot*t35;
-  }
-  // reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    w.u_r_ankle_link[0] = w.u_r_ankle_link[0] - w.dp_r_ankle_link[4];
-    const Scalar t36 = -w.Dinv_r_ankle_link*w.dp_r_ankle_link[4];
-    const Scalar t37 = w.dp_r_ankle_link[0] + w.IA_r_ankle_link[4]*t36;
-    const Scalar t38 = w.dp_r_ankle_link[1] + w.IA_r_ankle_link[9]*t36;
-    const Scalar t39 = w.dp_r_ankle_link[2] + w.IA_r_ankle_link[13]*t36;
-    const Scalar t40 = w.dp_r_ankle_link[4] + w.IA_r_ankle_link[18]*t36;
-    const Scalar t41 = w.dp_r_ankle_link[5] + w.IA_r_ankle_link[19]*t36;
-    const Scalar t42 = w.cq_r_ankle_link*t37 + w.sq_r_ankle_link*t39;
-    const Scalar t43 = -w.sq_r_ankle_link*t37 + w.cq_r_ankle_link*t39;
-    const Scalar t44 = w.cq_r_ankle_link*w.dp_r_ankle_link[3] + w.sq_r_ankle_link*t41;
-    const Scalar t45 = -w.sq_r_ankle_link*w.dp_r_ankle_link[3] + w.cq_r_ankle_link*t41;
-    const Scalar t46 = 0.9950041652780258*t42 - 0.09983341664682815*t43;
-    const Scalar t47 = 0.09983341664682815*t42 + 0.9950041652780258*t43;
-    w.dp_r_shank[0] = t46;
-    w.dp_r_shank[1] = t38;
-    w.dp_r_shank[2] = t47;
-    w.dp_r_shank[3] = 0.4305*t38 + 0.9950041652780258*t44 - 0.09983341664682815*t45;
-    w.dp_r_shank[4] = t40 - 0.4305*t46;
-    w.dp_r_shank[5] = 0.09983341664682815*t44 + 0.9950041652780258*t45;
+    w.dp_r_ankle_link[1] = w.cq_r_foot*t19 - w.sq_r_foot*w.dlambda[8];
+    w.dp_r_ankle_link[2] = w.sq_r_foot*t19 + w.cq_r_foot*w.dlambda[8];
+    w.dp_r_ankle_link[3] = t20;
+    w.dp_r_ankle_link[4] = w.cq_r_foot*t21 - w.sq_r_foot*t22;
+    w.dp_r_ankle_link[5] = w.sq_r_foot*t21 + w.cq_r_foot*t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_21(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_32(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  {
+    w.u_r_ankle_link[0] = -w.dp_r_ankle_link[4] + w.u_r_ankle_link[0];
+    const Scalar t0 = -w.dp_r_ankle_link[4]*w.Dinv_r_ankle_link;
+    const Scalar t1 = w.dp_r_ankle_link[0] + w.IA_r_ankle_link[4]*t0;
+    const Scalar t2 = w.dp_r_ankle_link[1] + w.IA_r_ankle_link[9]*t0;
+    const Scalar t3 = w.dp_r_ankle_link[2] + w.IA_r_ankle_link[13]*t0;
+    const Scalar t4 = w.dp_r_ankle_link[4] + w.IA_r_ankle_link[18]*t0;
+    const Scalar t5 = w.dp_r_ankle_link[5] + w.IA_r_ankle_link[19]*t0;
+    const Scalar t6 = w.cq_r_ankle_link*t1 + w.sq_r_ankle_link*t3;
+    const Scalar t7 = -w.sq_r_ankle_link*t1 + w.cq_r_ankle_link*t3;
+    const Scalar t8 = w.cq_r_ankle_link*w.dp_r_ankle_link[3] + w.sq_r_ankle_link*t5;
+    const Scalar t9 = -w.sq_r_ankle_link*w.dp_r_ankle_link[3] + w.cq_r_ankle_link*t5;
+    const Scalar t10 = 0.9950041652780258*t6 - 0.09983341664682815*t7;
+    const Scalar t11 = 0.09983341664682815*t6 + 0.9950041652780258*t7;
+    w.dp_r_shank[0] = t10;
+    w.dp_r_shank[1] = t2;
+    w.dp_r_shank[2] = t11;
+    w.dp_r_shank[3] = 0.4305*t2 + 0.9950041652780258*t8 - 0.09983341664682815*t9;
+    w.dp_r_shank[4] = t4 - 0.4305*t10;
+    w.dp_r_shank[5] = 0.09983341664682815*t8 + 0.9950041652780258*t9;
+  }
   // reduced sweep: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
-    w.u_r_shank[0] = -w.dp_r_shank[4] + w.u_r_shank[0];
-    const Scalar t0 = -w.dp_r_shank[4]*w.Dinv_r_shank;
-    const Scalar t1 = w.dp_r_shank[0] + w.IA_r_shank[4]*t0;
-    const Scalar t2 = w.dp_r_shank[1] + w.IA_r_shank[9]*t0;
-    const Scalar t3 = w.dp_r_shank[2] + w.IA_r_shank[13]*t0;
-    const Scalar t4 = w.dp_r_shank[3] + w.IA_r_shank[16]*t0;
-    const Scalar t5 = w.dp_r_shank[4] + w.IA_r_shank[18]*t0;
-    const Scalar t6 = w.dp_r_shank[5] + w.IA_r_shank[19]*t0;
-    const Scalar t7 = w.cq_r_shank*t1 + w.sq_r_shank*t3;
-    const Scalar t8 = -w.sq_r_shank*t1 + w.cq_r_shank*t3;
-    const Scalar t9 = w.cq_r_shank*t4 + w.sq_r_shank*t6;
-    const Scalar t10 = -w.sq_r_shank*t4 + w.cq_r_shank*t6;
-    const Scalar t11 = 0.9800665778412416*t7 + 0.19866933079506124*t8;
-    const Scalar t12 = -0.19866933079506124*t7 + 0.9800665778412416*t8;
-    w.dp_r_thigh[0] = t11;
-    w.dp_r_thigh[1] = t2;
-    w.dp_r_thigh[2] = t12;
-    w.dp_r_thigh[3] = 0.42875*t2 + 0.9800665778412416*t9 + 0.19866933079506124*t10;
-    w.dp_r_thigh[4] = t5 - 0.42875*t11;
-    w.dp_r_thigh[5] = -0.19866933079506124*t9 + 0.9800665778412416*t10;
+    w.u_r_shank[0] = w.u_r_shank[0] - w.dp_r_shank[4];
+    const Scalar t12 = -w.Dinv_r_shank*w.dp_r_shank[4];
+    const Scalar t13 = w.dp_r_shank[0] + w.IA_r_shank[4]*t12;
+    const Scalar t14 = w.dp_r_shank[1] + w.IA_r_shank[9]*t12;
+    const Scalar t15 = w.dp_r_shank[2] + w.IA_r_shank[13]*t12;
+    const Scalar t16 = w.dp_r_shank[3] + w.IA_r_shank[16]*t12;
+    const Scalar t17 = w.dp_r_shank[4] + w.IA_r_shank[18]*t12;
+    const Scalar t18 = w.dp_r_shank[5] + w.IA_r_shank[19]*t12;
+    const Scalar t19 = w.cq_r_shank*t13 + w.sq_r_shank*t15;
+    const Scalar t20 = -w.sq_r_shank*t13 + w.cq_r_shank*t15;
+    const Scalar t21 = w.cq_r_shank*t16 + w.sq_r_shank*t18;
+    const Scalar t22 = -w.sq_r_shank*t16 + w.cq_r_shank*t18;
+    const Scalar t23 = 0.9800665778412416*t19 + 0.19866933079506124*t20;
+    const Scalar t24 = -0.19866933079506124*t19 + 0.9800665778412416*t20;
+    w.dp_r_thigh[0] = t23;
+    w.dp_r_thigh[1] = t14;
+    w.dp_r_thigh[2] = t24;
+    w.dp_r_thigh[3] = 0.42875*t14 + 0.9800665778412416*t21 + 0.19866933079506124*t22;
+    w.dp_r_thigh[4] = t17 - 0.42875*t23;
+    w.dp_r_thigh[5] = -0.19866933079506124*t21 + 0.9800665778412416*t22;
   }
   // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
     w.u_r_thigh[0] = w.u_r_thigh[0] - w.dp_r_thigh[4];
-    const Scalar t13 = -w.Dinv_r_thigh*w.dp_r_thigh[4];
-    const Scalar t14 = w.dp_r_thigh[0] + w.IA_r_thigh[4]*t13;
-    const Scalar t15 = w.dp_r_thigh[1] + w.IA_r_thigh[9]*t13;
-    const Scalar t16 = w.dp_r_thigh[2] + w.IA_r_thigh[13]*t13;
-    const Scalar t17 = w.dp_r_thigh[3] + w.IA_r_thigh[16]*t13;
-    const Scalar t18 = w.dp_r_thigh[4] + w.IA_r_thigh[18]*t13;
-    const Scalar t19 = w.dp_r_thigh[5] + w.IA_r_thigh[19]*t13;
-    const Scalar t20 = w.cq_r_thigh*t14 + w.sq_r_thigh*t16;
-    const Scalar t21 = -w.sq_r_thigh*t14 + w.cq_r_thigh*t16;
-    const Scalar t22 = w.cq_r_thigh*t17 + w.sq_r_thigh*t19;
-    const Scalar t23 = -w.sq_r_thigh*t17 + w.cq_r_thigh*t19;
-    w.dp_r_hip_roll_link[0] = 0.9950041652780258*t20 - 0.09983341664682815*t21;
-    w.dp_r_hip_roll_link[1] = t15;
-    w.dp_r_hip_roll_link[2] = 0.09983341664682815*t20 + 0.9950041652780258*t21;
-    w.dp_r_hip_roll_link[3] = 0.9950041652780258*t22 - 0.09983341664682815*t23;
-    w.dp_r_hip_roll_link[4] = t18;
-    w.dp_r_hip_roll_link[5] = 0.09983341664682815*t22 + 0.9950041652780258*t23;
+    const Scalar t25 = -w.Dinv_r_thigh*w.dp_r_thigh[4];
+    const Scalar t26 = w.dp_r_thigh[0] + w.IA_r_thigh[4]*t25;
+    const Scalar t27 = w.dp_r_thigh[1] + w.IA_r_thigh[9]*t25;
+    const Scalar t28 = w.dp_r_thigh[2] + w.IA_r_thigh[13]*t25;
+    const Scalar t29 = w.dp_r_thigh[3] + w.IA_r_thigh[16]*t25;
+    const Scalar t30 = w.dp_r_thigh[4] + w.IA_r_thigh[18]*t25;
+    const Scalar t31 = w.dp_r_thigh[5] + w.IA_r_thigh[19]*t25;
+    const Scalar t32 = w.cq_r_thigh*t26 + w.sq_r_thigh*t28;
+    const Scalar t33 = -w.sq_r_thigh*t26 + w.cq_r_thigh*t28;
+    const Scalar t34 = w.cq_r_thigh*t29 + w.sq_r_thigh*t31;
+    const Scalar t35 = -w.sq_r_thigh*t29 + w.cq_r_thigh*t31;
+    w.dp_r_hip_roll_link[0] = 0.9950041652780258*t32 - 0.09983341664682815*t33;
+    w.dp_r_hip_roll_link[1] = t27;
+    w.dp_r_hip_roll_link[2] = 0.09983341664682815*t32 + 0.9950041652780258*t33;
+    w.dp_r_hip_roll_link[3] = 0.9950041652780258*t34 - 0.09983341664682815*t35;
+    w.dp_r_hip_roll_link[4] = t30;
+    w.dp_r_hip_roll_link[5] = 0.09983341664682815*t34 + 0.9950041652780258*t35;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_33(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    w.u_r_hip_roll_link[0] = w.u_r_hip_roll_link[0] - w.dp_r_hip_roll_link[3];
-    const Scalar t24 = -w.Dinv_r_hip_roll_link*w.dp_r_hip_roll_link[3];
-    const Scalar t25 = w.dp_r_hip_roll_link[0] + w.IA_r_hip_roll_link[3]*t24;
-    const Scalar t26 = w.dp_r_hip_roll_link[1] + w.IA_r_hip_roll_link[8]*t24;
-    const Scalar t27 = w.dp_r_hip_roll_link[2] + w.IA_r_hip_roll_link[12]*t24;
-    const Scalar t28 = w.dp_r_hip_roll_link[3] + w.IA_r_hip_roll_link[15]*t24;
-    const Scalar t29 = w.dp_r_hip_roll_link[5] + w.IA_r_hip_roll_link[17]*t24;
-    w.dp_r_hip_yaw_link[0] = t25;
-    w.dp_r_hip_yaw_link[1] = w.cq_r_hip_roll_link*t26 - w.sq_r_hip_roll_link*t27;
-    w.dp_r_hip_yaw_link[2] = w.sq_r_hip_roll_link*t26 + w.cq_r_hip_roll_link*t27;
-    w.dp_r_hip_yaw_link[3] = t28;
-    w.dp_r_hip_yaw_link[4] = w.cq_r_hip_roll_link*w.dp_r_hip_roll_link[4] - w.sq_r_hip_roll_link*t29;
-    w.dp_r_hip_yaw_link[5] = w.sq_r_hip_roll_link*w.dp_r_hip_roll_link[4] + w.cq_r_hip_roll_link*t29;
+    w.u_r_hip_roll_link[0] = -w.dp_r_hip_roll_link[3] + w.u_r_hip_roll_link[0];
+    const Scalar t0 = -w.dp_r_hip_roll_link[3]*w.Dinv_r_hip_roll_link;
+    const Scalar t1 = w.dp_r_hip_roll_link[0] + w.IA_r_hip_roll_link[3]*t0;
+    const Scalar t2 = w.dp_r_hip_roll_link[1] + w.IA_r_hip_roll_link[8]*t0;
+    const Scalar t3 = w.dp_r_hip_roll_link[2] + w.IA_r_hip_roll_link[12]*t0;
+    const Scalar t4 = w.dp_r_hip_roll_link[3] + w.IA_r_hip_roll_link[15]*t0;
+    const Scalar t5 = w.dp_r_hip_roll_link[5] + w.IA_r_hip_roll_link[17]*t0;
+    w.dp_r_hip_yaw_link[0] = t1;
+    w.dp_r_hip_yaw_link[1] = w.cq_r_hip_roll_link*t2 - w.sq_r_hip_roll_link*t3;
+    w.dp_r_hip_yaw_link[2] = w.sq_r_hip_roll_link*t2 + w.cq_r_hip_roll_link*t3;
+    w.dp_r_hip_yaw_link[3] = t4;
+    w.dp_r_hip_yaw_link[4] = w.cq_r_hip_roll_link*w.dp_r_hip_roll_link[4] - w.sq_r_hip_roll_link*t5;
+    w.dp_r_hip_yaw_link[5] = w.sq_r_hip_roll_link*w.dp_r_hip_roll_link[4] + w.cq_r_hip_roll_link*t5;
   }
   // reduced sweep: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.u_r_hip_yaw_link[0] = w.u_r_hip_yaw_link[0] - w.dp_r_hip_yaw_link[5];
-    const Scalar t30 = -w.Dinv_r_hip_yaw_link*w.dp_r_hip_yaw_link[5];
-    const Scalar t31 = w.dp_r_hip_yaw_link[0] + w.IA_r_hip_yaw_link[5]*t30;
-    const Scalar t32 = w.dp_r_hip_yaw_link[1] + w.IA_r_hip_yaw_link[10]*t30;
-    const Scalar t33 = w.dp_r_hip_yaw_link[2] + w.IA_r_hip_yaw_link[14]*t30;
-    const Scalar t34 = w.dp_r_hip_yaw_link[4] + w.IA_r_hip_yaw_link[19]*t30;
-    const Scalar t35 = w.dp_r_hip_yaw_link[5] + w.IA_r_hip_yaw_link[20]*t30;
-    const Scalar t36 = w.cq_r_hip_yaw_link*t31 - w.sq_r_hip_yaw_link*t32;
-    const Scalar t37 = w.sq_r_hip_yaw_link*t31 + w.cq_r_hip_yaw_link*t32;
-    const Scalar t38 = w.cq_r_hip_yaw_link*w.dp_r_hip_yaw_link[3] - w.sq_r_hip_yaw_link*t34;
-    const Scalar t39 = w.sq_r_hip_yaw_link*w.dp_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t34;
-    const Scalar t40 = 0.9961917745544759*t36 + 0.08718915247898762*t37;
-    const Scalar t41 = -0.08718915247898762*t36 + 0.9961917745544759*t37;
-    w.dp_pelvis[0] = w.dp_pelvis[0] + t40;
-    w.dp_pelvis[1] = w.dp_pelvis[1] + t41;
-    w.dp_pelvis[2] = w.dp_pelvis[2] + t33;
-    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t33 + 0.9961917745544759*t38 + 0.08718915247898762*t39;
-    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*t38 + 0.9961917745544759*t39;
-    w.dp_pelvis[5] = w.dp_pelvis[5] + t35 + 0.0875*t40;
+    const Scalar t6 = -w.Dinv_r_hip_yaw_link*w.dp_r_hip_yaw_link[5];
+    const Scalar t7 = w.dp_r_hip_yaw_link[0] + w.IA_r_hip_yaw_link[5]*t6;
+    const Scalar t8 = w.dp_r_hip_yaw_link[1] + w.IA_r_hip_yaw_link[10]*t6;
+    const Scalar t9 = w.dp_r_hip_yaw_link[2] + w.IA_r_hip_yaw_link[14]*t6;
+    const Scalar t10 = w.dp_r_hip_yaw_link[4] + w.IA_r_hip_yaw_link[19]*t6;
+    const Scalar t11 = w.dp_r_hip_yaw_link[5] + w.IA_r_hip_yaw_link[20]*t6;
+    const Scalar t12 = w.cq_r_hip_yaw_link*t7 - w.sq_r_hip_yaw_link*t8;
+    const Scalar t13 = w.sq_r_hip_yaw_link*t7 + w.cq_r_hip_yaw_link*t8;
+    const Scalar t14 = w.cq_r_hip_yaw_link*w.dp_r_hip_yaw_link[3] - w.sq_r_hip_yaw_link*t10;
+    const Scalar t15 = w.sq_r_hip_yaw_link*w.dp_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t10;
+    const Scalar t16 = 0.9961917745544759*t12 + 0.08718915247898762*t13;
+    const Scalar t17 = -0.08718915247898762*t12 + 0.9961917745544759*t13;
+    w.dp_pelvis[0] = w.dp_pelvis[0] + t16;
+    w.dp_pelvis[1] = w.dp_pelvis[1] + t17;
+    w.dp_pelvis[2] = w.dp_pelvis[2] + t9;
+    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t9 + 0.9961917745544759*t14 + 0.08718915247898762*t15;
+    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*t14 + 0.9961917745544759*t15;
+    w.dp_pelvis[5] = w.dp_pelvis[5] + t11 + 0.0875*t16;
   }
   // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     const Scalar du0 = -0.06825*w.dlambda[1] - w.dlambda[3];
     w.u_l_foot[0] = w.u_l_foot[0] + du0;
-    const Scalar t42 = w.Dinv_l_foot*du0;
-    const Scalar t43 = w.dlambda[1] + w.U_l_foot[1]*t42;
-    const Scalar t44 = 0.06825*w.dlambda[1] + w.dlambda[3] + w.U_l_foot[3]*t42;
-    const Scalar t45 = -0.06825*w.dlambda[0] + w.dlambda[4];
-    const Scalar t46 = w.dlambda[5] + 0.0017863999999999998*w.Dinv_l_foot*du0;
+    const Scalar t18 = w.Dinv_l_foot*du0;
+    const Scalar t19 = w.dlambda[1] + w.U_l_foot[1]*t18;
+    const Scalar t20 = 0.06825*w.dlambda[1] + w.dlambda[3] + w.U_l_foot[3]*t18;
+    const Scalar t21 = -0.06825*w.dlambda[0] + w.dlambda[4];
+    const Scalar t22 = w.dlambda[5] + 0.0017863999999999998*w.Dinv_l_foot*du0;
     w.dp_l_ankle_link[0] = w.dlambda[0];
-    w.dp_l_ankle_link[1] = w.cq_l_foot*t43 - w.sq_l_foot*w.dlambda[2];
-    w.dp_l_ankle_link[2] = w.sq_l_foot*t43 + w.cq_l_foot*w.dlambda[2];
-    w.dp_l_ankle_link[3] = t44;
-    w.dp_l_ankle_link[4] = w.cq_l_foot*t45 - w.sq_l_foot*t46;
-    w.dp_l_ankle_link[5] = w.sq_l_foot*t45 + w.cq_l_foot*t46;
+    w.dp_l_ankle_link[1] = w.cq_l_foot*t19 - w.sq_l_foot*w.dlambda[2];
+    w.dp_l_ankle_link[2] = w.sq_l_foot*t19 + w.cq_l_foot*w.dlambda[2];
+    w.dp_l_ankle_link[3] = t20;
+    w.dp_l_ankle_link[4] = w.cq_l_foot*t21 - w.sq_l_foot*t22;
+    w.dp_l_ankle_link[5] = w.sq_l_foot*t21 + w.cq_l_foot*t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_22(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_34(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.u_l_ankle_link[0] = -w.dp_l_ankle_link[4] + w.u_l_ankle_link[0];
@@ -4122,86 +4203,86 @@ PROXGEN_RT_NOINLINE void caba_22(Workspace& w) noexcept {
     w.dp_l_hip_roll_link[4] = t30;
     w.dp_l_hip_roll_link[5] = 0.09983341664682815*t34 + 0.9950041652780258*t35;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    w.u_l_hip_roll_link[0] = w.u_l_hip_roll_link[0] - w.dp_l_hip_roll_link[3];
-    const Scalar t36 = -w.Dinv_l_hip_roll_link*w.dp_l_hip_roll_link[3];
-    const Scalar t37 = w.dp_l_hip_roll_link[0] + w.IA_l_hip_roll_link[3]*t36;
-    const Scalar t38 = w.dp_l_hip_roll_link[1] + w.IA_l_hip_roll_link[8]*t36;
-    const Scalar t39 = w.dp_l_hip_roll_link[2] + w.IA_l_hip_roll_link[12]*t36;
-    const Scalar t40 = w.dp_l_hip_roll_link[3] + w.IA_l_hip_roll_link[15]*t36;
-    const Scalar t41 = w.dp_l_hip_roll_link[5] + w.IA_l_hip_roll_link[17]*t36;
-    w.dp_l_hip_yaw_link[0] = t37;
-    w.dp_l_hip_yaw_link[1] = w.cq_l_hip_roll_link*t38 - w.sq_l_hip_roll_link*t39;
-    w.dp_l_hip_yaw_link[2] = w.sq_l_hip_roll_link*t38 + w.cq_l_hip_roll_link*t39;
-    w.dp_l_hip_yaw_link[3] = t40;
-    w.dp_l_hip_yaw_link[4] = w.cq_l_hip_roll_link*w.dp_l_hip_roll_link[4] - w.sq_l_hip_roll_link*t41;
-    w.dp_l_hip_yaw_link[5] = w.sq_l_hip_roll_link*w.dp_l_hip_roll_link[4] + w.cq_l_hip_roll_link*t41;
+    w.u_l_hip_roll_link[0] = -w.dp_l_hip_roll_link[3] + w.u_l_hip_roll_link[0];
+    const Scalar t0 = -w.dp_l_hip_roll_link[3]*w.Dinv_l_hip_roll_link;
+    const Scalar t1 = w.dp_l_hip_roll_link[0] + w.IA_l_hip_roll_link[3]*t0;
+    const Scalar t2 = w.dp_l_hip_roll_link[1] + w.IA_l_hip_roll_link[8]*t0;
+    const Scalar t3 = w.dp_l_hip_roll_link[2] + w.IA_l_hip_roll_link[12]*t0;
+    const Scalar t4 = w.dp_l_hip_roll_link[3] + w.IA_l_hip_roll_link[15]*t0;
+    const Scalar t5 = w.dp_l_hip_roll_link[5] + w.IA_l_hip_roll_link[17]*t0;
+    w.dp_l_hip_yaw_link[0] = t1;
+    w.dp_l_hip_yaw_link[1] = w.cq_l_hip_roll_link*t2 - w.sq_l_hip_roll_link*t3;
+    w.dp_l_hip_yaw_link[2] = w.sq_l_hip_roll_link*t2 + w.cq_l_hip_roll_link*t3;
+    w.dp_l_hip_yaw_link[3] = t4;
+    w.dp_l_hip_yaw_link[4] = w.cq_l_hip_roll_link*w.dp_l_hip_roll_link[4] - w.sq_l_hip_roll_link*t5;
+    w.dp_l_hip_yaw_link[5] = w.sq_l_hip_roll_link*w.dp_l_hip_roll_link[4] + w.cq_l_hip_roll_link*t5;
   }
   // reduced sweep: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.u_l_hip_yaw_link[0] = w.u_l_hip_yaw_link[0] - w.dp_l_hip_yaw_link[5];
-    const Scalar t42 = -w.Dinv_l_hip_yaw_link*w.dp_l_hip_yaw_link[5];
-    const Scalar t43 = w.dp_l_hip_yaw_link[0] + w.IA_l_hip_yaw_link[5]*t42;
-    const Scalar t44 = w.dp_l_hip_yaw_link[1] + w.IA_l_hip_yaw_link[10]*t42;
-    const Scalar t45 = w.dp_l_hip_yaw_link[2] + w.IA_l_hip_yaw_link[14]*t42;
-    const Scalar t46 = w.dp_l_hip_yaw_link[4] + w.IA_l_hip_yaw_link[19]*t42;
-    const Scalar t47 = w.dp_l_hip_yaw_link[5] + w.IA_l_hip_yaw_link[20]*t42;
-    const Scalar t48 = w.cq_l_hip_yaw_link*t43 - w.sq_l_hip_yaw_link*t44;
-    const Scalar t49 = w.sq_l_hip_yaw_link*t43 + w.cq_l_hip_yaw_link*t44;
-    const Scalar t50 = w.cq_l_hip_yaw_link*w.dp_l_hip_yaw_link[3] - w.sq_l_hip_yaw_link*t46;
-    const Scalar t51 = w.sq_l_hip_yaw_link*w.dp_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t46;
-    const Scalar t52 = 0.9961917745544759*t48 - 0.08718915247898762*t49;
-    const Scalar t53 = 0.08718915247898762*t48 + 0.9961917745544759*t49;
-    w.dp_pelvis[0] = w.dp_pelvis[0] + t52;
-    w.dp_pelvis[1] = w.dp_pelvis[1] + t53;
-    w.dp_pelvis[2] = w.dp_pelvis[2] + t45;
-    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t45 + 0.9961917745544759*t50 - 0.08718915247898762*t51;
-    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*t50 + 0.9961917745544759*t51;
-    w.dp_pelvis[5] = w.dp_pelvis[5] + t47 - 0.0875*t52;
+    const Scalar t6 = -w.Dinv_l_hip_yaw_link*w.dp_l_hip_yaw_link[5];
+    const Scalar t7 = w.dp_l_hip_yaw_link[0] + w.IA_l_hip_yaw_link[5]*t6;
+    const Scalar t8 = w.dp_l_hip_yaw_link[1] + w.IA_l_hip_yaw_link[10]*t6;
+    const Scalar t9 = w.dp_l_hip_yaw_link[2] + w.IA_l_hip_yaw_link[14]*t6;
+    const Scalar t10 = w.dp_l_hip_yaw_link[4] + w.IA_l_hip_yaw_link[19]*t6;
+    const Scalar t11 = w.dp_l_hip_yaw_link[5] + w.IA_l_hip_yaw_link[20]*t6;
+    const Scalar t12 = w.cq_l_hip_yaw_link*t7 - w.sq_l_hip_yaw_link*t8;
+    const Scalar t13 = w.sq_l_hip_yaw_link*t7 + w.cq_l_hip_yaw_link*t8;
+    const Scalar t14 = w.cq_l_hip_yaw_link*w.dp_l_hip_yaw_link[3] - w.sq_l_hip_yaw_link*t10;
+    const Scalar t15 = w.sq_l_hip_yaw_link*w.dp_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t10;
+    const Scalar t16 = 0.9961917745544759*t12 - 0.08718915247898762*t13;
+    const Scalar t17 = 0.08718915247898762*t12 + 0.9961917745544759*t13;
+    w.dp_pelvis[0] = w.dp_pelvis[0] + t16;
+    w.dp_pelvis[1] = w.dp_pelvis[1] + t17;
+    w.dp_pelvis[2] = w.dp_pelvis[2] + t9;
+    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t9 + 0.9961917745544759*t14 - 0.08718915247898762*t15;
+    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*t14 + 0.9961917745544759*t15;
+    w.dp_pelvis[5] = w.dp_pelvis[5] + t11 - 0.0875*t16;
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_23(Workspace& w) noexcept {
   // reduced sweep: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    w.u_pelvis[0] = -w.dp_pelvis[0] + w.u_pelvis[0];
-    w.u_pelvis[1] = -w.dp_pelvis[1] + w.u_pelvis[1];
-    w.u_pelvis[2] = -w.dp_pelvis[2] + w.u_pelvis[2];
-    w.u_pelvis[3] = -w.dp_pelvis[3] + w.u_pelvis[3];
-    w.u_pelvis[4] = -w.dp_pelvis[4] + w.u_pelvis[4];
-    w.u_pelvis[5] = -w.dp_pelvis[5] + w.u_pelvis[5];
+    w.u_pelvis[0] = w.u_pelvis[0] - w.dp_pelvis[0];
+    w.u_pelvis[1] = w.u_pelvis[1] - w.dp_pelvis[1];
+    w.u_pelvis[2] = w.u_pelvis[2] - w.dp_pelvis[2];
+    w.u_pelvis[3] = w.u_pelvis[3] - w.dp_pelvis[3];
+    w.u_pelvis[4] = w.u_pelvis[4] - w.dp_pelvis[4];
+    w.u_pelvis[5] = w.u_pelvis[5] - w.dp_pelvis[5];
   }
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
-    const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
-    const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
-    const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
-    const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
-    const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
-    const Scalar t11 = w.Linv_pelvis[5]*t10;
-    const Scalar t12 = w.Linv_pelvis[5]*t11;
-    const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
-    const Scalar t14 = w.Linv_pelvis[4]*t13;
-    const Scalar t15 = w.Linv_pelvis[3]*t6 - w.L_pelvis[16]*t14 - w.L_pelvis[17]*t12;
-    const Scalar t16 = w.Linv_pelvis[3]*t15;
-    const Scalar t17 = w.Linv_pelvis[2]*t4 - w.L_pelvis[12]*t16 - w.L_pelvis[13]*t14 - w.L_pelvis[14]*t12;
-    const Scalar t18 = w.Linv_pelvis[2]*t17;
-    const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
-    const Scalar t20 = w.Linv_pelvis[1]*t19;
-    const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
-    w.qdd[0] = w.Linv_pelvis[0]*t21;
-    w.qdd[1] = w.Linv_pelvis[1]*t19;
-    w.qdd[2] = w.Linv_pelvis[2]*t17;
-    w.qdd[3] = w.Linv_pelvis[3]*t15;
-    w.qdd[4] = w.Linv_pelvis[4]*t13;
-    w.qdd[5] = w.Linv_pelvis[5]*t11;
+    const Scalar t18 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t19 = w.Linv_pelvis[0]*t18;
+    const Scalar t20 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t19;
+    const Scalar t21 = w.Linv_pelvis[1]*t20;
+    const Scalar t22 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t19 - w.L_pelvis[7]*t21;
+    const Scalar t23 = w.Linv_pelvis[2]*t22;
+    const Scalar t24 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t19 - w.L_pelvis[8]*t21 - w.L_pelvis[12]*t23;
+    const Scalar t25 = w.Linv_pelvis[3]*t24;
+    const Scalar t26 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t19 - w.L_pelvis[9]*t21 - w.L_pelvis[13]*t23 - w.L_pelvis[16]*t25;
+    const Scalar t27 = w.Linv_pelvis[4]*t26;
+    const Scalar t28 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t19 - w.L_pelvis[10]*t21 - w.L_pelvis[14]*t23 - w.L_pelvis[17]*t25 - w.L_pelvis[19]*t27;
+    const Scalar t29 = w.Linv_pelvis[5]*t28;
+    const Scalar t30 = w.Linv_pelvis[5]*t29;
+    const Scalar t31 = w.Linv_pelvis[4]*t26 - w.L_pelvis[19]*t30;
+    const Scalar t32 = w.Linv_pelvis[4]*t31;
+    const Scalar t33 = w.Linv_pelvis[3]*t24 - w.L_pelvis[16]*t32 - w.L_pelvis[17]*t30;
+    const Scalar t34 = w.Linv_pelvis[3]*t33;
+    const Scalar t35 = w.Linv_pelvis[2]*t22 - w.L_pelvis[12]*t34 - w.L_pelvis[13]*t32 - w.L_pelvis[14]*t30;
+    const Scalar t36 = w.Linv_pelvis[2]*t35;
+    const Scalar t37 = w.Linv_pelvis[1]*t20 - w.L_pelvis[7]*t36 - w.L_pelvis[8]*t34 - w.L_pelvis[9]*t32 - w.L_pelvis[10]*t30;
+    const Scalar t38 = w.Linv_pelvis[1]*t37;
+    const Scalar t39 = w.Linv_pelvis[0]*t18 - w.L_pelvis[1]*t38 - w.L_pelvis[2]*t36 - w.L_pelvis[3]*t34 - w.L_pelvis[4]*t32 - w.L_pelvis[5]*t30;
+    w.qdd[0] = w.Linv_pelvis[0]*t39;
+    w.qdd[1] = w.Linv_pelvis[1]*t37;
+    w.qdd[2] = w.Linv_pelvis[2]*t35;
+    w.qdd[3] = w.Linv_pelvis[3]*t33;
+    w.qdd[4] = w.Linv_pelvis[4]*t31;
+    w.qdd[5] = w.Linv_pelvis[5]*t29;
     w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
     w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
     w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
@@ -4209,62 +4290,67 @@ PROXGEN_RT_NOINLINE void caba_23(Workspace& w) noexcept {
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_36(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t24 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t25 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t26 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
-    const Scalar t27 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t30 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t31 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t30 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t31;
-    w.a_l_hip_yaw_link[0] = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    w.a_l_hip_yaw_link[1] = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    w.a_l_hip_yaw_link[4] = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    const Scalar t0 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
+    const Scalar t1 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
+    const Scalar t2 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t3 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t4 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
+    const Scalar t5 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t0;
+    const Scalar t6 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t4 + w.sq_l_hip_yaw_link*t5;
+    const Scalar t7 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t4 + w.cq_l_hip_yaw_link*t5;
+    const Scalar t8 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t2 + w.sq_l_hip_yaw_link*t3;
+    const Scalar t9 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t2 + w.cq_l_hip_yaw_link*t3;
+    const Scalar t10 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t6 - w.IA_l_hip_yaw_link[10]*t7 - w.IA_l_hip_yaw_link[14]*t1 - w.IA_l_hip_yaw_link[19]*t9 - w.a_pelvis[5]*w.IA_l_hip_yaw_link[20];
+    w.qdd[6] = w.Dinv_l_hip_yaw_link*t10;
+    w.a_l_hip_yaw_link[0] = t6;
+    w.a_l_hip_yaw_link[1] = t7;
+    w.a_l_hip_yaw_link[2] = t1;
+    w.a_l_hip_yaw_link[3] = t8;
+    w.a_l_hip_yaw_link[4] = t9;
     w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
   }
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    const Scalar t32 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t33 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t34 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t35 = w.u_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t32 - w.IA_l_hip_roll_link[12]*t33 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t34;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t35;
+    const Scalar t11 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
+    const Scalar t12 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
+    const Scalar t13 = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
+    const Scalar t14 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
+    const Scalar t15 = w.u_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t11 - w.IA_l_hip_roll_link[12]*t12 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t14;
+    w.qdd[7] = w.Dinv_l_hip_roll_link*t15;
     w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[2] = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
+    w.a_l_hip_roll_link[1] = t11;
+    w.a_l_hip_roll_link[2] = t12;
     w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    w.a_l_hip_roll_link[5] = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
+    w.a_l_hip_roll_link[4] = t13;
+    w.a_l_hip_roll_link[5] = t14;
   }
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
-    const Scalar t36 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t37 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t38 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t39 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t40 = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
-    const Scalar t41 = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    const Scalar t42 = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
-    const Scalar t43 = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
-    const Scalar t44 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t40 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t41 - w.IA_l_thigh[16]*t42 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t43;
-    w.qdd[8] = w.Dinv_l_thigh*t44;
-    w.a_l_thigh[0] = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
+    const Scalar t16 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
+    const Scalar t17 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
+    const Scalar t18 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
+    const Scalar t19 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
+    const Scalar t20 = w.c_l_thigh[0] + w.cq_l_thigh*t18 - w.sq_l_thigh*t19;
+    const Scalar t21 = w.c_l_thigh[2] + w.sq_l_thigh*t18 + w.cq_l_thigh*t19;
+    const Scalar t22 = w.c_l_thigh[3] + w.cq_l_thigh*t16 - w.sq_l_thigh*t17;
+    const Scalar t23 = w.c_l_thigh[5] + w.sq_l_thigh*t16 + w.cq_l_thigh*t17;
+    const Scalar t24 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t20 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t21 - w.IA_l_thigh[16]*t22 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t23;
+    w.qdd[8] = w.Dinv_l_thigh*t24;
+    w.a_l_thigh[0] = t20;
     w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    w.a_l_thigh[3] = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
+    w.a_l_thigh[2] = t21;
+    w.a_l_thigh[3] = t22;
     w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
+    w.a_l_thigh[5] = t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_24(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     const Scalar t0 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
@@ -4279,12 +4365,12 @@ PROXGEN_RT_NOINLINE void caba_24(Workspace& w) noexcept {
     const Scalar t9 = w.c_l_shank[5] + w.sq_l_shank*t2 + w.cq_l_shank*t3;
     const Scalar t10 = w.u_l_shank[0] - w.IA_l_shank[4]*t6 - w.IA_l_shank[9]*t1 - w.IA_l_shank[13]*t7 - w.IA_l_shank[16]*t8 - w.a_l_thigh[4]*w.IA_l_shank[18] - w.IA_l_shank[19]*t9;
     w.qdd[9] = w.Dinv_l_shank*t10;
-    w.a_l_shank[0] = w.c_l_shank[0] + w.cq_l_shank*t4 - w.sq_l_shank*t5;
+    w.a_l_shank[0] = t6;
     w.a_l_shank[1] = t1;
-    w.a_l_shank[2] = w.c_l_shank[2] + w.sq_l_shank*t4 + w.cq_l_shank*t5;
-    w.a_l_shank[3] = w.c_l_shank[3] + w.cq_l_shank*t2 - w.sq_l_shank*t3;
+    w.a_l_shank[2] = t7;
+    w.a_l_shank[3] = t8;
     w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = w.c_l_shank[5] + w.sq_l_shank*t2 + w.cq_l_shank*t3;
+    w.a_l_shank[5] = t9;
   }
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
@@ -4296,84 +4382,93 @@ PROXGEN_RT_NOINLINE void caba_24(Workspace& w) noexcept {
     const Scalar t16 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t11;
     const Scalar t17 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t15 - w.sq_l_ankle_link*t16;
     const Scalar t18 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t15 + w.cq_l_ankle_link*t16;
-    const Scalar t19 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t13 + w.cq_l_ankle_link*t14;
-    const Scalar t20 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t17 - w.IA_l_ankle_link[9]*t12 - w.IA_l_ankle_link[13]*t18 - w.IA_l_ankle_link[18]*w.a_l_shank[4] - w.IA_l_ankle_link[19]*t19;
-    w.qdd[10] = w.Dinv_l_ankle_link*t20;
-    w.a_l_ankle_link[0] = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t15 - w.sq_l_ankle_link*t16;
+    const Scalar t19 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t13 - w.sq_l_ankle_link*t14;
+    const Scalar t20 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t13 + w.cq_l_ankle_link*t14;
+    const Scalar t21 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t17 - w.IA_l_ankle_link[9]*t12 - w.IA_l_ankle_link[13]*t18 - w.IA_l_ankle_link[18]*w.a_l_shank[4] - w.IA_l_ankle_link[19]*t20;
+    w.qdd[10] = w.Dinv_l_ankle_link*t21;
+    w.a_l_ankle_link[0] = t17;
     w.a_l_ankle_link[1] = t12;
-    w.a_l_ankle_link[2] = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t15 + w.cq_l_ankle_link*t16;
-    w.a_l_ankle_link[3] = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t13 - w.sq_l_ankle_link*t14;
+    w.a_l_ankle_link[2] = t18;
+    w.a_l_ankle_link[3] = t19;
     w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t13 + w.cq_l_ankle_link*t14;
+    w.a_l_ankle_link[5] = t20;
   }
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    const Scalar t21 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t22 = -0.0017863999999999998*w.c_l_foot[5] + w.u_l_foot[0] + 0.0017863999999999998*w.sq_l_foot*w.a_l_ankle_link[4] - 0.0017863999999999998*w.cq_l_foot*w.a_l_ankle_link[5] - w.U_l_foot[1]*t21 - w.U_l_foot[3]*w.a_l_ankle_link[3];
-    w.qdd[11] = w.Dinv_l_foot*t22;
+    const Scalar t22 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t23 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t24 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t25 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t26 = w.u_l_foot[0] - 0.0017863999999999998*t25 - w.U_l_foot[1]*t22 - w.U_l_foot[3]*w.a_l_ankle_link[3];
+    w.qdd[11] = w.Dinv_l_foot*t26;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    w.a_l_foot[2] = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    w.a_l_foot[1] = t22;
+    w.a_l_foot[2] = t23;
     w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    w.a_l_foot[5] = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    w.a_l_foot[4] = t24;
+    w.a_l_foot[5] = t25;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t23 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t24 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t25 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t26 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t27 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t23;
-    const Scalar t28 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t23;
-    const Scalar t29 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t27 + w.sq_r_hip_yaw_link*t28;
-    const Scalar t30 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t27 + w.cq_r_hip_yaw_link*t28;
-    const Scalar t31 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t25 + w.cq_r_hip_yaw_link*t26;
-    const Scalar t32 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t29 - w.IA_r_hip_yaw_link[10]*t30 - w.IA_r_hip_yaw_link[14]*t24 - w.IA_r_hip_yaw_link[19]*t31 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t32;
-    w.a_r_hip_yaw_link[0] = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t27 + w.sq_r_hip_yaw_link*t28;
-    w.a_r_hip_yaw_link[1] = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t27 + w.cq_r_hip_yaw_link*t28;
-    w.a_r_hip_yaw_link[2] = t24;
-    w.a_r_hip_yaw_link[3] = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t25 + w.sq_r_hip_yaw_link*t26;
-    w.a_r_hip_yaw_link[4] = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t25 + w.cq_r_hip_yaw_link*t26;
+    const Scalar t0 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
+    const Scalar t1 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
+    const Scalar t2 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t3 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t4 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
+    const Scalar t5 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t0;
+    const Scalar t6 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t4 + w.sq_r_hip_yaw_link*t5;
+    const Scalar t7 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t4 + w.cq_r_hip_yaw_link*t5;
+    const Scalar t8 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t2 + w.sq_r_hip_yaw_link*t3;
+    const Scalar t9 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t2 + w.cq_r_hip_yaw_link*t3;
+    const Scalar t10 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t6 - w.IA_r_hip_yaw_link[10]*t7 - w.IA_r_hip_yaw_link[14]*t1 - w.IA_r_hip_yaw_link[19]*t9 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    w.qdd[12] = w.Dinv_r_hip_yaw_link*t10;
+    w.a_r_hip_yaw_link[0] = t6;
+    w.a_r_hip_yaw_link[1] = t7;
+    w.a_r_hip_yaw_link[2] = t1;
+    w.a_r_hip_yaw_link[3] = t8;
+    w.a_r_hip_yaw_link[4] = t9;
     w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
   }
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    const Scalar t33 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t34 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t35 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t36 = w.u_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t33 - w.IA_r_hip_roll_link[12]*t34 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t35;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t36;
+    const Scalar t11 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
+    const Scalar t12 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
+    const Scalar t13 = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
+    const Scalar t14 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
+    const Scalar t15 = w.u_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t11 - w.IA_r_hip_roll_link[12]*t12 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t14;
+    w.qdd[13] = w.Dinv_r_hip_roll_link*t15;
     w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[2] = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
+    w.a_r_hip_roll_link[1] = t11;
+    w.a_r_hip_roll_link[2] = t12;
     w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    w.a_r_hip_roll_link[5] = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
+    w.a_r_hip_roll_link[4] = t13;
+    w.a_r_hip_roll_link[5] = t14;
   }
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
-    const Scalar t37 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t38 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t39 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t40 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t41 = w.c_r_thigh[0] + w.cq_r_thigh*t39 - w.sq_r_thigh*t40;
-    const Scalar t42 = w.c_r_thigh[2] + w.sq_r_thigh*t39 + w.cq_r_thigh*t40;
-    const Scalar t43 = w.c_r_thigh[3] + w.cq_r_thigh*t37 - w.sq_r_thigh*t38;
-    const Scalar t44 = w.c_r_thigh[5] + w.sq_r_thigh*t37 + w.cq_r_thigh*t38;
-    const Scalar t45 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t41 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t42 - w.IA_r_thigh[16]*t43 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t44;
-    w.qdd[14] = w.Dinv_r_thigh*t45;
-    w.a_r_thigh[0] = w.c_r_thigh[0] + w.cq_r_thigh*t39 - w.sq_r_thigh*t40;
+    const Scalar t16 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
+    const Scalar t17 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
+    const Scalar t18 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
+    const Scalar t19 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
+    const Scalar t20 = w.c_r_thigh[0] + w.cq_r_thigh*t18 - w.sq_r_thigh*t19;
+    const Scalar t21 = w.c_r_thigh[2] + w.sq_r_thigh*t18 + w.cq_r_thigh*t19;
+    const Scalar t22 = w.c_r_thigh[3] + w.cq_r_thigh*t16 - w.sq_r_thigh*t17;
+    const Scalar t23 = w.c_r_thigh[5] + w.sq_r_thigh*t16 + w.cq_r_thigh*t17;
+    const Scalar t24 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t20 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t21 - w.IA_r_thigh[16]*t22 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t23;
+    w.qdd[14] = w.Dinv_r_thigh*t24;
+    w.a_r_thigh[0] = t20;
     w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = w.c_r_thigh[2] + w.sq_r_thigh*t39 + w.cq_r_thigh*t40;
-    w.a_r_thigh[3] = w.c_r_thigh[3] + w.cq_r_thigh*t37 - w.sq_r_thigh*t38;
+    w.a_r_thigh[2] = t21;
+    w.a_r_thigh[3] = t22;
     w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = w.c_r_thigh[5] + w.sq_r_thigh*t37 + w.cq_r_thigh*t38;
+    w.a_r_thigh[5] = t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_25(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     const Scalar t0 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
@@ -4388,12 +4483,12 @@ PROXGEN_RT_NOINLINE void caba_25(Workspace& w) noexcept {
     const Scalar t9 = w.c_r_shank[5] + w.sq_r_shank*t2 + w.cq_r_shank*t3;
     const Scalar t10 = w.u_r_shank[0] - w.IA_r_shank[4]*t6 - w.IA_r_shank[9]*t1 - w.IA_r_shank[13]*t7 - w.IA_r_shank[16]*t8 - w.a_r_thigh[4]*w.IA_r_shank[18] - w.IA_r_shank[19]*t9;
     w.qdd[15] = w.Dinv_r_shank*t10;
-    w.a_r_shank[0] = w.c_r_shank[0] + w.cq_r_shank*t4 - w.sq_r_shank*t5;
+    w.a_r_shank[0] = t6;
     w.a_r_shank[1] = t1;
-    w.a_r_shank[2] = w.c_r_shank[2] + w.sq_r_shank*t4 + w.cq_r_shank*t5;
-    w.a_r_shank[3] = w.c_r_shank[3] + w.cq_r_shank*t2 - w.sq_r_shank*t3;
+    w.a_r_shank[2] = t7;
+    w.a_r_shank[3] = t8;
     w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = w.c_r_shank[5] + w.sq_r_shank*t2 + w.cq_r_shank*t3;
+    w.a_r_shank[5] = t9;
   }
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
@@ -4405,188 +4500,207 @@ PROXGEN_RT_NOINLINE void caba_25(Workspace& w) noexcept {
     const Scalar t16 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t11;
     const Scalar t17 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t15 - w.sq_r_ankle_link*t16;
     const Scalar t18 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t15 + w.cq_r_ankle_link*t16;
-    const Scalar t19 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t13 + w.cq_r_ankle_link*t14;
-    const Scalar t20 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t17 - w.IA_r_ankle_link[9]*t12 - w.IA_r_ankle_link[13]*t18 - w.IA_r_ankle_link[18]*w.a_r_shank[4] - w.IA_r_ankle_link[19]*t19;
-    w.qdd[16] = w.Dinv_r_ankle_link*t20;
-    w.a_r_ankle_link[0] = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t15 - w.sq_r_ankle_link*t16;
+    const Scalar t19 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t13 - w.sq_r_ankle_link*t14;
+    const Scalar t20 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t13 + w.cq_r_ankle_link*t14;
+    const Scalar t21 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t17 - w.IA_r_ankle_link[9]*t12 - w.IA_r_ankle_link[13]*t18 - w.IA_r_ankle_link[18]*w.a_r_shank[4] - w.IA_r_ankle_link[19]*t20;
+    w.qdd[16] = w.Dinv_r_ankle_link*t21;
+    w.a_r_ankle_link[0] = t17;
     w.a_r_ankle_link[1] = t12;
-    w.a_r_ankle_link[2] = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t15 + w.cq_r_ankle_link*t16;
-    w.a_r_ankle_link[3] = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t13 - w.sq_r_ankle_link*t14;
+    w.a_r_ankle_link[2] = t18;
+    w.a_r_ankle_link[3] = t19;
     w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t13 + w.cq_r_ankle_link*t14;
+    w.a_r_ankle_link[5] = t20;
   }
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    const Scalar t21 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t22 = -0.0017863999999999998*w.c_r_foot[5] + w.u_r_foot[0] + 0.0017863999999999998*w.sq_r_foot*w.a_r_ankle_link[4] - 0.0017863999999999998*w.cq_r_foot*w.a_r_ankle_link[5] - w.U_r_foot[1]*t21 - w.U_r_foot[3]*w.a_r_ankle_link[3];
-    w.qdd[17] = w.Dinv_r_foot*t22;
+    const Scalar t22 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t23 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t24 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t25 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t26 = w.u_r_foot[0] - 0.0017863999999999998*t25 - w.U_r_foot[1]*t22 - w.U_r_foot[3]*w.a_r_ankle_link[3];
+    w.qdd[17] = w.Dinv_r_foot*t26;
     w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[2] = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    w.a_r_foot[1] = t22;
+    w.a_r_foot[2] = t23;
     w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    w.a_r_foot[5] = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    w.a_r_foot[4] = t24;
+    w.a_r_foot[5] = t25;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t23 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t24 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t25 = w.c_abdomen[0] + w.cq_abdomen*t23 + w.sq_abdomen*t24;
-    const Scalar t26 = w.c_abdomen[1] - w.sq_abdomen*t23 + w.cq_abdomen*t24;
-    const Scalar t27 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t28 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t29 = w.u_abdomen[0] - w.IA_abdomen[5]*t25 - w.IA_abdomen[10]*t26 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t27 - w.IA_abdomen[19]*t28 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t29;
-    w.a_abdomen[0] = w.c_abdomen[0] + w.cq_abdomen*t23 + w.sq_abdomen*t24;
-    w.a_abdomen[1] = w.c_abdomen[1] - w.sq_abdomen*t23 + w.cq_abdomen*t24;
+    const Scalar t0 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t1 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t2 = w.c_abdomen[0] + w.cq_abdomen*t0 + w.sq_abdomen*t1;
+    const Scalar t3 = w.c_abdomen[1] - w.sq_abdomen*t0 + w.cq_abdomen*t1;
+    const Scalar t4 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
+    const Scalar t5 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t6 = w.u_abdomen[0] - w.IA_abdomen[5]*t2 - w.IA_abdomen[10]*t3 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t4 - w.IA_abdomen[19]*t5 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.qdd[18] = w.Dinv_abdomen*t6;
+    w.a_abdomen[0] = t2;
+    w.a_abdomen[1] = t3;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    w.a_abdomen[4] = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    w.a_abdomen[3] = t4;
+    w.a_abdomen[4] = t5;
     w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
   }
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    const Scalar t30 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t31 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t32 = w.c_chest[0] + w.cq_chest*t30 - w.sq_chest*w.a_abdomen[2];
-    const Scalar t33 = w.c_chest[2] + w.sq_chest*t30 + w.cq_chest*w.a_abdomen[2];
-    const Scalar t34 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    const Scalar t35 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-    const Scalar t36 = w.u_chest[0] - w.IA_chest[4]*t32 - w.IA_chest[9]*t31 - w.IA_chest[13]*t33 - w.IA_chest[16]*t34 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t35;
-    w.qdd[19] = w.Dinv_chest*t36;
-    w.a_chest[0] = w.c_chest[0] + w.cq_chest*t30 - w.sq_chest*w.a_abdomen[2];
-    w.a_chest[1] = t31;
-    w.a_chest[2] = w.c_chest[2] + w.sq_chest*t30 + w.cq_chest*w.a_abdomen[2];
-    w.a_chest[3] = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
+    const Scalar t7 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t8 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t9 = w.c_chest[0] + w.cq_chest*t7 - w.sq_chest*w.a_abdomen[2];
+    const Scalar t10 = w.c_chest[2] + w.sq_chest*t7 + w.cq_chest*w.a_abdomen[2];
+    const Scalar t11 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
+    const Scalar t12 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
+    const Scalar t13 = w.u_chest[0] - w.IA_chest[4]*t9 - w.IA_chest[9]*t8 - w.IA_chest[13]*t10 - w.IA_chest[16]*t11 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t12;
+    w.qdd[19] = w.Dinv_chest*t13;
+    w.a_chest[0] = t9;
+    w.a_chest[1] = t8;
+    w.a_chest[2] = t10;
+    w.a_chest[3] = t11;
     w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
+    w.a_chest[5] = t12;
   }
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    const Scalar t37 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t38 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t39 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t40 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t41 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t42 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t43 = 0.9848134698792882*t37 + 0.17361575258114187*t39;
-    const Scalar t44 = 0.04493516596384369*t37 + 0.9659256678396477*t38 - 0.2548890642384102*t39;
-    const Scalar t45 = -0.1676999117594225*t37 + 0.2588196364430848*t38 + 0.9512566085906322*t39;
-    const Scalar t46 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t43 - w.sq_r_shoulder_pitch_link*t45;
-    const Scalar t47 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t43 + w.cq_r_shoulder_pitch_link*t45;
-    const Scalar t48 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t40 + w.cq_r_shoulder_pitch_link*t42;
-    const Scalar t49 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t46 - w.IA_r_shoulder_pitch_link[9]*t44 - w.IA_r_shoulder_pitch_link[13]*t47 - w.IA_r_shoulder_pitch_link[18]*t41 - w.IA_r_shoulder_pitch_link[19]*t48;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t49;
-    w.a_r_shoulder_pitch_link[0] = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t43 - w.sq_r_shoulder_pitch_link*t45;
-    w.a_r_shoulder_pitch_link[1] = t44;
-    w.a_r_shoulder_pitch_link[2] = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t43 + w.cq_r_shoulder_pitch_link*t45;
-    w.a_r_shoulder_pitch_link[3] = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t40 - w.sq_r_shoulder_pitch_link*t42;
-    w.a_r_shoulder_pitch_link[4] = t41 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t40 + w.cq_r_shoulder_pitch_link*t42;
+    const Scalar t14 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t15 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t16 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t17 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t18 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t19 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t20 = 0.9848134698792882*t14 + 0.17361575258114187*t16;
+    const Scalar t21 = 0.04493516596384369*t14 + 0.9659256678396477*t15 - 0.2548890642384102*t16;
+    const Scalar t22 = -0.1676999117594225*t14 + 0.2588196364430848*t15 + 0.9512566085906322*t16;
+    const Scalar t23 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t20 - w.sq_r_shoulder_pitch_link*t22;
+    const Scalar t24 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t20 + w.cq_r_shoulder_pitch_link*t22;
+    const Scalar t25 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t17 - w.sq_r_shoulder_pitch_link*t19;
+    const Scalar t26 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t17 + w.cq_r_shoulder_pitch_link*t19;
+    const Scalar t27 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t23 - w.IA_r_shoulder_pitch_link[9]*t21 - w.IA_r_shoulder_pitch_link[13]*t24 - w.IA_r_shoulder_pitch_link[18]*t18 - w.IA_r_shoulder_pitch_link[19]*t26;
+    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t27;
+    w.a_r_shoulder_pitch_link[0] = t23;
+    w.a_r_shoulder_pitch_link[1] = t21;
+    w.a_r_shoulder_pitch_link[2] = t24;
+    w.a_r_shoulder_pitch_link[3] = t25;
+    w.a_r_shoulder_pitch_link[4] = t18 + w.qdd[29];
+    w.a_r_shoulder_pitch_link[5] = t26;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_26(Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     const Scalar t0 = w.c_r_shoulder_roll_link[1] + w.a_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
     const Scalar t1 = w.c_r_shoulder_roll_link[2] - w.a_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
     const Scalar t2 = w.c_r_shoulder_roll_link[4] + w.a_r_shoulder_pitch_link[4]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.sq_r_shoulder_roll_link;
-    const Scalar t3 = w.u_r_shoulder_roll_link[0] - w.a_r_shoulder_pitch_link[0]*w.IA_r_shoulder_roll_link[3] - w.IA_r_shoulder_roll_link[8]*t0 - w.IA_r_shoulder_roll_link[12]*t1 - w.a_r_shoulder_pitch_link[3]*w.IA_r_shoulder_roll_link[15] - w.IA_r_shoulder_roll_link[16]*t2;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t3;
+    const Scalar t3 = w.c_r_shoulder_roll_link[5] - w.a_r_shoulder_pitch_link[4]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.cq_r_shoulder_roll_link;
+    const Scalar t4 = w.u_r_shoulder_roll_link[0] - w.a_r_shoulder_pitch_link[0]*w.IA_r_shoulder_roll_link[3] - w.IA_r_shoulder_roll_link[8]*t0 - w.IA_r_shoulder_roll_link[12]*t1 - w.a_r_shoulder_pitch_link[3]*w.IA_r_shoulder_roll_link[15] - w.IA_r_shoulder_roll_link[16]*t2;
+    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t4;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = w.c_r_shoulder_roll_link[1] + w.a_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
-    w.a_r_shoulder_roll_link[2] = w.c_r_shoulder_roll_link[2] - w.a_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
+    w.a_r_shoulder_roll_link[1] = t0;
+    w.a_r_shoulder_roll_link[2] = t1;
     w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = w.c_r_shoulder_roll_link[4] + w.a_r_shoulder_pitch_link[4]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.sq_r_shoulder_roll_link;
-    w.a_r_shoulder_roll_link[5] = w.c_r_shoulder_roll_link[5] - w.a_r_shoulder_pitch_link[4]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.cq_r_shoulder_roll_link;
+    w.a_r_shoulder_roll_link[4] = t2;
+    w.a_r_shoulder_roll_link[5] = t3;
   }
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t4 = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t5 = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t6 = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t7 = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t8 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t4 - w.IA_r_upper_arm[10]*t5 - w.IA_r_upper_arm[14]*w.a_r_shoulder_roll_link[2] - w.IA_r_upper_arm[17]*t6 - w.IA_r_upper_arm[19]*t7 - w.IA_r_upper_arm[20]*w.a_r_shoulder_roll_link[5];
-    w.qdd[31] = w.Dinv_r_upper_arm*t8;
-    w.a_r_upper_arm[0] = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    w.a_r_upper_arm[1] = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
+    const Scalar t5 = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
+    const Scalar t6 = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
+    const Scalar t7 = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
+    const Scalar t8 = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
+    const Scalar t9 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t5 - w.IA_r_upper_arm[10]*t6 - w.IA_r_upper_arm[14]*w.a_r_shoulder_roll_link[2] - w.IA_r_upper_arm[17]*t7 - w.IA_r_upper_arm[19]*t8 - w.IA_r_upper_arm[20]*w.a_r_shoulder_roll_link[5];
+    w.qdd[31] = w.Dinv_r_upper_arm*t9;
+    w.a_r_upper_arm[0] = t5;
+    w.a_r_upper_arm[1] = t6;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    w.a_r_upper_arm[4] = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
+    w.a_r_upper_arm[3] = t7;
+    w.a_r_upper_arm[4] = t8;
     w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
   }
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    const Scalar t9 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t10 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t11 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t12 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t13 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t9;
-    const Scalar t14 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t9;
-    const Scalar t15 = w.c_r_forearm[0] + w.cq_r_forearm*t13 - w.sq_r_forearm*t14;
-    const Scalar t16 = w.c_r_forearm[2] + w.sq_r_forearm*t13 + w.cq_r_forearm*t14;
-    const Scalar t17 = w.c_r_forearm[3] + w.cq_r_forearm*t11 - w.sq_r_forearm*t12;
-    const Scalar t18 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t15 - w.IA_r_forearm[9]*t10 - w.IA_r_forearm[13]*t16 - w.IA_r_forearm[16]*t17 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t18;
-    w.a_r_forearm[0] = w.c_r_forearm[0] + w.cq_r_forearm*t13 - w.sq_r_forearm*t14;
-    w.a_r_forearm[1] = t10;
-    w.a_r_forearm[2] = w.c_r_forearm[2] + w.sq_r_forearm*t13 + w.cq_r_forearm*t14;
-    w.a_r_forearm[3] = w.c_r_forearm[3] + w.cq_r_forearm*t11 - w.sq_r_forearm*t12;
+    const Scalar t10 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t11 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t12 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t13 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t14 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t10;
+    const Scalar t15 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t10;
+    const Scalar t16 = w.c_r_forearm[0] + w.cq_r_forearm*t14 - w.sq_r_forearm*t15;
+    const Scalar t17 = w.c_r_forearm[2] + w.sq_r_forearm*t14 + w.cq_r_forearm*t15;
+    const Scalar t18 = w.c_r_forearm[3] + w.cq_r_forearm*t12 - w.sq_r_forearm*t13;
+    const Scalar t19 = w.c_r_forearm[5] + w.sq_r_forearm*t12 + w.cq_r_forearm*t13;
+    const Scalar t20 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t16 - w.IA_r_forearm[9]*t11 - w.IA_r_forearm[13]*t17 - w.IA_r_forearm[16]*t18 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    w.qdd[32] = w.Dinv_r_forearm*t20;
+    w.a_r_forearm[0] = t16;
+    w.a_r_forearm[1] = t11;
+    w.a_r_forearm[2] = t17;
+    w.a_r_forearm[3] = t18;
     w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = w.c_r_forearm[5] + w.sq_r_forearm*t11 + w.cq_r_forearm*t12;
+    w.a_r_forearm[5] = t19;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_42(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    const Scalar t19 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t20 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t21 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t19 + w.sq_r_wrist_yaw_link*t20;
-    const Scalar t22 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t19 + w.cq_r_wrist_yaw_link*t20;
-    const Scalar t23 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t24 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t21 - w.IA_r_wrist_yaw_link[10]*t22 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t23 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t24;
-    w.a_r_wrist_yaw_link[0] = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t19 + w.sq_r_wrist_yaw_link*t20;
-    w.a_r_wrist_yaw_link[1] = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t19 + w.cq_r_wrist_yaw_link*t20;
+    const Scalar t0 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t1 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t2 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
+    const Scalar t3 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
+    const Scalar t4 = w.c_r_wrist_yaw_link[3] + w.a_r_forearm[3]*w.cq_r_wrist_yaw_link + w.a_r_forearm[4]*w.sq_r_wrist_yaw_link;
+    const Scalar t5 = w.c_r_wrist_yaw_link[4] - w.a_r_forearm[3]*w.sq_r_wrist_yaw_link + w.a_r_forearm[4]*w.cq_r_wrist_yaw_link;
+    const Scalar t6 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t2 - w.IA_r_wrist_yaw_link[10]*t3 - w.a_r_forearm[2]*w.IA_r_wrist_yaw_link[14] - w.IA_r_wrist_yaw_link[17]*t4 - w.a_r_forearm[5]*w.IA_r_wrist_yaw_link[20];
+    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t6;
+    w.a_r_wrist_yaw_link[0] = t2;
+    w.a_r_wrist_yaw_link[1] = t3;
     w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    w.a_r_wrist_yaw_link[4] = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    w.a_r_wrist_yaw_link[3] = t4;
+    w.a_r_wrist_yaw_link[4] = t5;
     w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
   }
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t25 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t26 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t27 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t25 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t26;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t27;
-    w.a_r_wrist_pitch_link[0] = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t7 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t8 = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t9 = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    const Scalar t10 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    const Scalar t11 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t7 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t10;
+    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t11;
+    w.a_r_wrist_pitch_link[0] = t7;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    w.a_r_wrist_pitch_link[3] = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[2] = t8;
+    w.a_r_wrist_pitch_link[3] = t9;
     w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[5] = t10;
   }
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t28 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t29 = w.u_r_hand[0] - w.U_r_hand[1]*t28 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
-    w.qdd[35] = w.Dinv_r_hand*t29;
+    const Scalar t12 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t13 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t14 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t15 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t16 = w.u_r_hand[0] - w.U_r_hand[1]*t12 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
+    w.qdd[35] = w.Dinv_r_hand*t16;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.a_r_hand[2] = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    w.a_r_hand[1] = t12;
+    w.a_r_hand[2] = t13;
     w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    w.a_r_hand[5] = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    w.a_r_hand[4] = t14;
+    w.a_r_hand[5] = t15;
   }
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t30 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = t30*mu;
+    const Scalar t17 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = t17*mu;
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t31 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t31;
+    const Scalar t18 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*t18;
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t32 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t32;
+    const Scalar t19 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*t19;
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
     w.dlambda[3] = w.a_l_foot[3]*mu;
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
@@ -4594,14 +4708,14 @@ PROXGEN_RT_NOINLINE void caba_26(Scalar mu, Workspace& w) noexcept {
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
     w.dlambda[5] = w.a_l_foot[5]*mu;
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t33 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t33;
+    const Scalar t20 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*t20;
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t34 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t34;
+    const Scalar t21 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*t21;
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t35 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t35;
+    const Scalar t22 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*t22;
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
     w.dlambda[9] = w.a_r_foot[3]*mu;
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
@@ -4609,19 +4723,19 @@ PROXGEN_RT_NOINLINE void caba_26(Scalar mu, Workspace& w) noexcept {
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
     w.dlambda[11] = w.a_r_foot[5]*mu;
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    const Scalar t36 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.dlambda[12] = mu*t36;
+    const Scalar t23 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
+    w.dlambda[12] = mu*t23;
     w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    const Scalar t37 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
-    w.dlambda[13] = mu*t37;
+    const Scalar t24 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
+    w.dlambda[13] = mu*t24;
     w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    const Scalar t38 = -w.k_right_hand[2] + w.a_r_hand[2];
-    w.dlambda[14] = mu*t38;
+    const Scalar t25 = -w.k_right_hand[2] + w.a_r_hand[2];
+    w.dlambda[14] = mu*t25;
     w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_0(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_0(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
     const Scalar t0 = w.a_chest[0] + 0.254*w.a_chest[4] - 0.19*w.a_chest[5];
@@ -4635,126 +4749,139 @@ PROXGEN_RT_NOINLINE void accelerate_free_0(Workspace& w) noexcept {
     const Scalar t8 = -0.1676999117594225*t0 - 0.2588196364430848*t1 + 0.9512566085906322*t2;
     const Scalar t9 = w.c_l_shoulder_pitch_link[0] + w.cq_l_shoulder_pitch_link*t6 - w.sq_l_shoulder_pitch_link*t8;
     const Scalar t10 = w.c_l_shoulder_pitch_link[2] + w.sq_l_shoulder_pitch_link*t6 + w.cq_l_shoulder_pitch_link*t8;
-    const Scalar t11 = w.c_l_shoulder_pitch_link[5] + w.sq_l_shoulder_pitch_link*t3 + w.cq_l_shoulder_pitch_link*t5;
-    const Scalar t12 = w.u_l_shoulder_pitch_link[0] - w.IA_l_shoulder_pitch_link[4]*t9 - w.IA_l_shoulder_pitch_link[9]*t7 - w.IA_l_shoulder_pitch_link[13]*t10 - w.IA_l_shoulder_pitch_link[18]*t4 - w.IA_l_shoulder_pitch_link[19]*t11;
-    w.qdd[20] = w.Dinv_l_shoulder_pitch_link*t12;
-    w.a_l_shoulder_pitch_link[0] = w.c_l_shoulder_pitch_link[0] + w.cq_l_shoulder_pitch_link*t6 - w.sq_l_shoulder_pitch_link*t8;
+    const Scalar t11 = w.c_l_shoulder_pitch_link[3] + w.cq_l_shoulder_pitch_link*t3 - w.sq_l_shoulder_pitch_link*t5;
+    const Scalar t12 = w.c_l_shoulder_pitch_link[5] + w.sq_l_shoulder_pitch_link*t3 + w.cq_l_shoulder_pitch_link*t5;
+    const Scalar t13 = w.u_l_shoulder_pitch_link[0] - w.IA_l_shoulder_pitch_link[4]*t9 - w.IA_l_shoulder_pitch_link[9]*t7 - w.IA_l_shoulder_pitch_link[13]*t10 - w.IA_l_shoulder_pitch_link[18]*t4 - w.IA_l_shoulder_pitch_link[19]*t12;
+    w.qdd[20] = w.Dinv_l_shoulder_pitch_link*t13;
+    w.a_l_shoulder_pitch_link[0] = t9;
     w.a_l_shoulder_pitch_link[1] = t7;
-    w.a_l_shoulder_pitch_link[2] = w.c_l_shoulder_pitch_link[2] + w.sq_l_shoulder_pitch_link*t6 + w.cq_l_shoulder_pitch_link*t8;
-    w.a_l_shoulder_pitch_link[3] = w.c_l_shoulder_pitch_link[3] + w.cq_l_shoulder_pitch_link*t3 - w.sq_l_shoulder_pitch_link*t5;
+    w.a_l_shoulder_pitch_link[2] = t10;
+    w.a_l_shoulder_pitch_link[3] = t11;
     w.a_l_shoulder_pitch_link[4] = t4 + w.qdd[20];
-    w.a_l_shoulder_pitch_link[5] = w.c_l_shoulder_pitch_link[5] + w.sq_l_shoulder_pitch_link*t3 + w.cq_l_shoulder_pitch_link*t5;
+    w.a_l_shoulder_pitch_link[5] = t12;
   }
   // accelerate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
-    const Scalar t13 = w.c_l_shoulder_roll_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
-    const Scalar t14 = w.c_l_shoulder_roll_link[2] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
-    const Scalar t15 = w.c_l_shoulder_roll_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
-    const Scalar t16 = w.u_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*w.a_l_shoulder_pitch_link[0] - w.IA_l_shoulder_roll_link[8]*t13 - w.IA_l_shoulder_roll_link[12]*t14 - w.IA_l_shoulder_roll_link[15]*w.a_l_shoulder_pitch_link[3] - w.IA_l_shoulder_roll_link[16]*t15;
-    w.qdd[21] = w.Dinv_l_shoulder_roll_link*t16;
+    const Scalar t14 = w.c_l_shoulder_roll_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
+    const Scalar t15 = w.c_l_shoulder_roll_link[2] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
+    const Scalar t16 = w.c_l_shoulder_roll_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
+    const Scalar t17 = w.c_l_shoulder_roll_link[5] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
+    const Scalar t18 = w.u_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*w.a_l_shoulder_pitch_link[0] - w.IA_l_shoulder_roll_link[8]*t14 - w.IA_l_shoulder_roll_link[12]*t15 - w.IA_l_shoulder_roll_link[15]*w.a_l_shoulder_pitch_link[3] - w.IA_l_shoulder_roll_link[16]*t16;
+    w.qdd[21] = w.Dinv_l_shoulder_roll_link*t18;
     w.a_l_shoulder_roll_link[0] = w.a_l_shoulder_pitch_link[0];
-    w.a_l_shoulder_roll_link[1] = w.c_l_shoulder_roll_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
-    w.a_l_shoulder_roll_link[2] = w.c_l_shoulder_roll_link[2] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
+    w.a_l_shoulder_roll_link[1] = t14;
+    w.a_l_shoulder_roll_link[2] = t15;
     w.a_l_shoulder_roll_link[3] = w.a_l_shoulder_pitch_link[3] + w.qdd[21];
-    w.a_l_shoulder_roll_link[4] = w.c_l_shoulder_roll_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
-    w.a_l_shoulder_roll_link[5] = w.c_l_shoulder_roll_link[5] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
+    w.a_l_shoulder_roll_link[4] = t16;
+    w.a_l_shoulder_roll_link[5] = t17;
   }
   // accelerate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    const Scalar t17 = w.c_l_upper_arm[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[1];
-    const Scalar t18 = w.c_l_upper_arm[1] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[1];
-    const Scalar t19 = w.c_l_upper_arm[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[4];
-    const Scalar t20 = w.c_l_upper_arm[4] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[4];
-    const Scalar t21 = w.u_l_upper_arm[0] - w.IA_l_upper_arm[5]*t17 - w.IA_l_upper_arm[10]*t18 - w.IA_l_upper_arm[14]*w.a_l_shoulder_roll_link[2] - w.IA_l_upper_arm[17]*t19 - w.IA_l_upper_arm[19]*t20 - w.IA_l_upper_arm[20]*w.a_l_shoulder_roll_link[5];
-    w.qdd[22] = w.Dinv_l_upper_arm*t21;
-    w.a_l_upper_arm[0] = w.c_l_upper_arm[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[1];
-    w.a_l_upper_arm[1] = w.c_l_upper_arm[1] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[1];
+    const Scalar t19 = w.c_l_upper_arm[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[1];
+    const Scalar t20 = w.c_l_upper_arm[1] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[1];
+    const Scalar t21 = w.c_l_upper_arm[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[4];
+    const Scalar t22 = w.c_l_upper_arm[4] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[4];
+    const Scalar t23 = w.u_l_upper_arm[0] - w.IA_l_upper_arm[5]*t19 - w.IA_l_upper_arm[10]*t20 - w.IA_l_upper_arm[14]*w.a_l_shoulder_roll_link[2] - w.IA_l_upper_arm[17]*t21 - w.IA_l_upper_arm[19]*t22 - w.IA_l_upper_arm[20]*w.a_l_shoulder_roll_link[5];
+    w.qdd[22] = w.Dinv_l_upper_arm*t23;
+    w.a_l_upper_arm[0] = t19;
+    w.a_l_upper_arm[1] = t20;
     w.a_l_upper_arm[2] = w.a_l_shoulder_roll_link[2];
-    w.a_l_upper_arm[3] = w.c_l_upper_arm[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[4];
-    w.a_l_upper_arm[4] = w.c_l_upper_arm[4] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[4];
+    w.a_l_upper_arm[3] = t21;
+    w.a_l_upper_arm[4] = t22;
     w.a_l_upper_arm[5] = w.a_l_shoulder_roll_link[5] + w.qdd[22];
   }
+}
+
+PROXGEN_RT_NOINLINE void accelerate_free_1(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
-    const Scalar t22 = w.a_l_upper_arm[0] - 0.3255*w.a_l_upper_arm[4];
-    const Scalar t23 = w.a_l_upper_arm[1] + 0.3255*w.a_l_upper_arm[3];
-    const Scalar t24 = 0.955336489125606*w.a_l_upper_arm[3] + 0.29552020666133966*w.a_l_upper_arm[5];
-    const Scalar t25 = -0.29552020666133966*w.a_l_upper_arm[3] + 0.955336489125606*w.a_l_upper_arm[5];
-    const Scalar t26 = 0.29552020666133966*w.a_l_upper_arm[2] + 0.955336489125606*t22;
-    const Scalar t27 = 0.955336489125606*w.a_l_upper_arm[2] - 0.29552020666133966*t22;
-    const Scalar t28 = w.c_l_forearm[0] + w.cq_l_forearm*t26 - w.sq_l_forearm*t27;
-    const Scalar t29 = w.c_l_forearm[2] + w.sq_l_forearm*t26 + w.cq_l_forearm*t27;
-    const Scalar t30 = w.c_l_forearm[3] + w.cq_l_forearm*t24 - w.sq_l_forearm*t25;
-    const Scalar t31 = w.u_l_forearm[0] - w.IA_l_forearm[4]*t28 - w.IA_l_forearm[9]*t23 - w.IA_l_forearm[13]*t29 - w.IA_l_forearm[16]*t30 - w.IA_l_forearm[18]*w.a_l_upper_arm[4];
-    w.qdd[23] = w.Dinv_l_forearm*t31;
-    w.a_l_forearm[0] = w.c_l_forearm[0] + w.cq_l_forearm*t26 - w.sq_l_forearm*t27;
-    w.a_l_forearm[1] = t23;
-    w.a_l_forearm[2] = w.c_l_forearm[2] + w.sq_l_forearm*t26 + w.cq_l_forearm*t27;
-    w.a_l_forearm[3] = w.c_l_forearm[3] + w.cq_l_forearm*t24 - w.sq_l_forearm*t25;
+    const Scalar t0 = w.a_l_upper_arm[0] - 0.3255*w.a_l_upper_arm[4];
+    const Scalar t1 = w.a_l_upper_arm[1] + 0.3255*w.a_l_upper_arm[3];
+    const Scalar t2 = 0.955336489125606*w.a_l_upper_arm[3] + 0.29552020666133966*w.a_l_upper_arm[5];
+    const Scalar t3 = -0.29552020666133966*w.a_l_upper_arm[3] + 0.955336489125606*w.a_l_upper_arm[5];
+    const Scalar t4 = 0.29552020666133966*w.a_l_upper_arm[2] + 0.955336489125606*t0;
+    const Scalar t5 = 0.955336489125606*w.a_l_upper_arm[2] - 0.29552020666133966*t0;
+    const Scalar t6 = w.c_l_forearm[0] + w.cq_l_forearm*t4 - w.sq_l_forearm*t5;
+    const Scalar t7 = w.c_l_forearm[2] + w.sq_l_forearm*t4 + w.cq_l_forearm*t5;
+    const Scalar t8 = w.c_l_forearm[3] + w.cq_l_forearm*t2 - w.sq_l_forearm*t3;
+    const Scalar t9 = w.c_l_forearm[5] + w.sq_l_forearm*t2 + w.cq_l_forearm*t3;
+    const Scalar t10 = w.u_l_forearm[0] - w.IA_l_forearm[4]*t6 - w.IA_l_forearm[9]*t1 - w.IA_l_forearm[13]*t7 - w.IA_l_forearm[16]*t8 - w.a_l_upper_arm[4]*w.IA_l_forearm[18];
+    w.qdd[23] = w.Dinv_l_forearm*t10;
+    w.a_l_forearm[0] = t6;
+    w.a_l_forearm[1] = t1;
+    w.a_l_forearm[2] = t7;
+    w.a_l_forearm[3] = t8;
     w.a_l_forearm[4] = w.a_l_upper_arm[4] + w.qdd[23];
-    w.a_l_forearm[5] = w.c_l_forearm[5] + w.sq_l_forearm*t24 + w.cq_l_forearm*t25;
+    w.a_l_forearm[5] = t9;
   }
   // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
-    const Scalar t32 = w.a_l_forearm[0] - 0.2555*w.a_l_forearm[4];
-    const Scalar t33 = w.a_l_forearm[1] + 0.2555*w.a_l_forearm[3];
-    const Scalar t34 = w.c_l_wrist_yaw_link[0] + w.cq_l_wrist_yaw_link*t32 + w.sq_l_wrist_yaw_link*t33;
-    const Scalar t35 = w.c_l_wrist_yaw_link[1] - w.sq_l_wrist_yaw_link*t32 + w.cq_l_wrist_yaw_link*t33;
-    const Scalar t36 = w.c_l_wrist_yaw_link[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[3] + w.sq_l_wrist_yaw_link*w.a_l_forearm[4];
-    const Scalar t37 = w.u_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t34 - w.IA_l_wrist_yaw_link[10]*t35 - w.IA_l_wrist_yaw_link[14]*w.a_l_forearm[2] - w.IA_l_wrist_yaw_link[17]*t36 - w.IA_l_wrist_yaw_link[20]*w.a_l_forearm[5];
-    w.qdd[24] = w.Dinv_l_wrist_yaw_link*t37;
-    w.a_l_wrist_yaw_link[0] = w.c_l_wrist_yaw_link[0] + w.cq_l_wrist_yaw_link*t32 + w.sq_l_wrist_yaw_link*t33;
-    w.a_l_wrist_yaw_link[1] = w.c_l_wrist_yaw_link[1] - w.sq_l_wrist_yaw_link*t32 + w.cq_l_wrist_yaw_link*t33;
+    const Scalar t11 = w.a_l_forearm[0] - 0.2555*w.a_l_forearm[4];
+    const Scalar t12 = w.a_l_forearm[1] + 0.2555*w.a_l_forearm[3];
+    const Scalar t13 = w.c_l_wrist_yaw_link[0] + w.cq_l_wrist_yaw_link*t11 + w.sq_l_wrist_yaw_link*t12;
+    const Scalar t14 = w.c_l_wrist_yaw_link[1] - w.sq_l_wrist_yaw_link*t11 + w.cq_l_wrist_yaw_link*t12;
+    const Scalar t15 = w.c_l_wrist_yaw_link[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[3] + w.sq_l_wrist_yaw_link*w.a_l_forearm[4];
+    const Scalar t16 = w.c_l_wrist_yaw_link[4] - w.sq_l_wrist_yaw_link*w.a_l_forearm[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[4];
+    const Scalar t17 = w.u_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t13 - w.IA_l_wrist_yaw_link[10]*t14 - w.IA_l_wrist_yaw_link[14]*w.a_l_forearm[2] - w.IA_l_wrist_yaw_link[17]*t15 - w.IA_l_wrist_yaw_link[20]*w.a_l_forearm[5];
+    w.qdd[24] = w.Dinv_l_wrist_yaw_link*t17;
+    w.a_l_wrist_yaw_link[0] = t13;
+    w.a_l_wrist_yaw_link[1] = t14;
     w.a_l_wrist_yaw_link[2] = w.a_l_forearm[2];
-    w.a_l_wrist_yaw_link[3] = w.c_l_wrist_yaw_link[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[3] + w.sq_l_wrist_yaw_link*w.a_l_forearm[4];
-    w.a_l_wrist_yaw_link[4] = w.c_l_wrist_yaw_link[4] - w.sq_l_wrist_yaw_link*w.a_l_forearm[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[4];
+    w.a_l_wrist_yaw_link[3] = t15;
+    w.a_l_wrist_yaw_link[4] = t16;
     w.a_l_wrist_yaw_link[5] = w.a_l_forearm[5] + w.qdd[24];
   }
   // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    const Scalar t38 = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
-    const Scalar t39 = w.c_l_wrist_pitch_link[5] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
-    const Scalar t40 = w.u_l_wrist_pitch_link[0] - w.IA_l_wrist_pitch_link[4]*t38 - w.IA_l_wrist_pitch_link[18]*w.a_l_wrist_yaw_link[4] - w.IA_l_wrist_pitch_link[19]*t39;
-    w.qdd[25] = w.Dinv_l_wrist_pitch_link*t40;
-    w.a_l_wrist_pitch_link[0] = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
+    const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
+    const Scalar t19 = w.c_l_wrist_pitch_link[2] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
+    const Scalar t20 = w.c_l_wrist_pitch_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
+    const Scalar t21 = w.c_l_wrist_pitch_link[5] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
+    const Scalar t22 = w.u_l_wrist_pitch_link[0] - w.IA_l_wrist_pitch_link[4]*t18 - w.IA_l_wrist_pitch_link[18]*w.a_l_wrist_yaw_link[4] - w.IA_l_wrist_pitch_link[19]*t21;
+    w.qdd[25] = w.Dinv_l_wrist_pitch_link*t22;
+    w.a_l_wrist_pitch_link[0] = t18;
     w.a_l_wrist_pitch_link[1] = w.a_l_wrist_yaw_link[1];
-    w.a_l_wrist_pitch_link[2] = w.c_l_wrist_pitch_link[2] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
-    w.a_l_wrist_pitch_link[3] = w.c_l_wrist_pitch_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
+    w.a_l_wrist_pitch_link[2] = t19;
+    w.a_l_wrist_pitch_link[3] = t20;
     w.a_l_wrist_pitch_link[4] = w.a_l_wrist_yaw_link[4] + w.qdd[25];
-    w.a_l_wrist_pitch_link[5] = w.c_l_wrist_pitch_link[5] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
+    w.a_l_wrist_pitch_link[5] = t21;
   }
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_1(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    const Scalar t0 = -0.005164645770899999*w.a_l_wrist_pitch_link[3] - 0.04016628*w.c_l_hand[1] + w.u_l_hand[0] - 0.04016628*w.a_l_wrist_pitch_link[1]*w.cq_l_hand - 0.04016628*w.a_l_wrist_pitch_link[2]*w.sq_l_hand;
-    w.qdd[26] = w.Dinv_l_hand*t0;
+    const Scalar t0 = w.c_l_hand[1] + w.a_l_wrist_pitch_link[1]*w.cq_l_hand + w.a_l_wrist_pitch_link[2]*w.sq_l_hand;
+    const Scalar t4 = -0.005164645770899999*w.a_l_wrist_pitch_link[3] + w.u_l_hand[0] - 0.04016628*t0;
+    w.qdd[26] = w.Dinv_l_hand*t4;
   }
   // accelerate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
-    const Scalar t1 = w.a_chest[0] + 0.29*w.a_chest[4];
-    const Scalar t2 = w.a_chest[1] - 0.29*w.a_chest[3];
-    const Scalar t3 = w.c_neck_link[1] - w.sq_neck_link*t1 + w.cq_neck_link*t2;
-    const Scalar t4 = w.c_neck_link[3] + w.a_chest[3]*w.cq_neck_link + w.a_chest[4]*w.sq_neck_link;
-    const Scalar t5 = w.u_neck_link[0] - w.IA_neck_link[10]*t3 - w.IA_neck_link[17]*t4 - w.a_chest[5]*w.IA_neck_link[20];
-    w.qdd[27] = w.Dinv_neck_link*t5;
-    w.a_neck_link[0] = w.c_neck_link[0] + w.cq_neck_link*t1 + w.sq_neck_link*t2;
-    w.a_neck_link[1] = w.c_neck_link[1] - w.sq_neck_link*t1 + w.cq_neck_link*t2;
+    const Scalar t5 = w.a_chest[0] + 0.29*w.a_chest[4];
+    const Scalar t6 = w.a_chest[1] - 0.29*w.a_chest[3];
+    const Scalar t7 = w.c_neck_link[0] + w.cq_neck_link*t5 + w.sq_neck_link*t6;
+    const Scalar t8 = w.c_neck_link[1] - w.sq_neck_link*t5 + w.cq_neck_link*t6;
+    const Scalar t9 = w.c_neck_link[3] + w.a_chest[3]*w.cq_neck_link + w.a_chest[4]*w.sq_neck_link;
+    const Scalar t10 = w.c_neck_link[4] - w.a_chest[3]*w.sq_neck_link + w.a_chest[4]*w.cq_neck_link;
+    const Scalar t11 = w.u_neck_link[0] - w.IA_neck_link[10]*t8 - w.IA_neck_link[17]*t9 - w.a_chest[5]*w.IA_neck_link[20];
+    w.qdd[27] = w.Dinv_neck_link*t11;
+    w.a_neck_link[0] = t7;
+    w.a_neck_link[1] = t8;
     w.a_neck_link[2] = w.a_chest[2];
-    w.a_neck_link[3] = w.c_neck_link[3] + w.a_chest[3]*w.cq_neck_link + w.a_chest[4]*w.sq_neck_link;
-    w.a_neck_link[4] = w.c_neck_link[4] - w.a_chest[3]*w.sq_neck_link + w.a_chest[4]*w.cq_neck_link;
+    w.a_neck_link[3] = t9;
+    w.a_neck_link[4] = t10;
     w.a_neck_link[5] = w.a_chest[5] + w.qdd[27];
   }
   // accelerate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    const Scalar t6 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
-    const Scalar t8 = -0.4717625*w.c_head[0] + w.u_head[0] - 0.07202788281129999*w.a_neck_link[4] - 0.4717625*w.cq_head*t6 + 0.4717625*w.sq_head*w.a_neck_link[2];
-    w.qdd[28] = w.Dinv_head*t8;
+    const Scalar t12 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
+    const Scalar t14 = w.c_head[0] + w.cq_head*t12 - w.sq_head*w.a_neck_link[2];
+    const Scalar t18 = w.u_head[0] - 0.07202788281129999*w.a_neck_link[4] - 0.4717625*t14;
+    w.qdd[28] = w.Dinv_head*t18;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.Dinv_r_hand = 1.0 / 0.005164645770899999;
@@ -4852,7 +4979,7 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     w.Dinv_r_wrist_yaw_link = 1.0 / w.IA_r_wrist_yaw_link[20];
@@ -4955,7 +5082,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     w.Dinv_r_forearm = 1.0 / w.IA_r_forearm[18];
@@ -5100,7 +5227,7 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.Dinv_r_upper_arm = 1.0 / w.IA_r_upper_arm[20];
@@ -5204,7 +5331,7 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     w.Dinv_r_shoulder_roll_link = 1.0 / w.IA_r_shoulder_roll_link[15];
@@ -5294,7 +5421,7 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     w.Dinv_r_shoulder_pitch_link = 1.0 / w.IA_r_shoulder_pitch_link[18];
@@ -5457,7 +5584,7 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_6(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.Dinv_chest = 1.0 / w.IA_chest[18];
@@ -5591,7 +5718,7 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_7(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_abdomen = 1.0 / w.IA_abdomen[20];
@@ -5719,7 +5846,7 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_8(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     w.Dinv_r_foot = 1.0 / 0.00194517348958;
@@ -5777,185 +5904,188 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* tau, Workspace& w) noexcept {
     w.KA_r_ankle_link[34] = -w.sq_r_foot;
     w.KA_r_ankle_link[35] = w.cq_r_foot;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
     w.u_r_ankle_link[0] = -w.pA_r_ankle_link[4] + tau[16];
-    const Scalar t3 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
-    const Scalar t4 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
-    const Scalar t5 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
-    const Scalar t6 = w.IA_r_ankle_link[18]*w.Dinv_r_ankle_link;
-    const Scalar t7 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
-    const Scalar Ia3 = 1.2149999999999999 - w.IA_r_ankle_link[4]*t3;
-    const Scalar Ia4 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t3;
-    const Scalar Ia5 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t4;
-    const Scalar Ia6 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t4;
-    const Scalar Ia7 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t4;
-    const Scalar Ia8 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t5;
-    const Scalar Ia9 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t5;
-    const Scalar Ia10 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t7;
-    const Scalar t8 = -w.IA_r_ankle_link[13]*t3;
-    const Scalar t9 = -w.IA_r_ankle_link[9]*t3;
-    const Scalar pa6 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t3 + w.c_r_ankle_link[0]*Ia3 + w.c_r_ankle_link[2]*t8 + w.c_r_ankle_link[5]*Ia4;
-    const Scalar pa7 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t4 + w.c_r_ankle_link[0]*t9 + w.c_r_ankle_link[2]*Ia6 + w.c_r_ankle_link[5]*Ia7;
-    const Scalar pa8 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t5 + w.c_r_ankle_link[0]*t8 + w.c_r_ankle_link[2]*Ia8 + w.c_r_ankle_link[5]*Ia9;
-    const Scalar pa9 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
-    const Scalar pa10 = w.pA_r_ankle_link[4] + w.u_r_ankle_link[0]*t6;
-    const Scalar pa11 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t7 + w.c_r_ankle_link[0]*Ia4 + w.c_r_ankle_link[2]*Ia9 + w.c_r_ankle_link[5]*Ia10;
-    const Scalar C21 = -w.sq_r_ankle_link*w.sq_r_ankle_link + w.cq_r_ankle_link*w.cq_r_ankle_link;
-    const Scalar h2 = 0.5*(-Ia3 + Ia8);
-    const Scalar m2 = 0.5*(Ia3 + Ia8);
-    const Scalar t10 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar d0 = -t8*t10 + C21*h2;
-    const Scalar qq0 = t8*C21 + h2*t10;
-    const Scalar d1 = 0.5*(-Ia4*t10 + Ia9*C21);
-    const Scalar qq1 = 0.5*(Ia4*C21 + Ia9*t10);
-    const Scalar h3 = -3.6e-05 + 0.5*Ia10;
-    const Scalar m3 = 3.6e-05 + 0.5*Ia10;
-    const Scalar t11 = 0.9950041652780258*m2 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t12 = 0.09983341664682815*w.sq_r_ankle_link*t9 - 0.09983341664682815*w.cq_r_ankle_link*Ia6 + 0.9950041652780258*w.cq_r_ankle_link*t9 + 0.9950041652780258*w.sq_r_ankle_link*Ia6;
-    const Scalar t13 = -0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = w.cq_r_ankle_link*t9 + w.sq_r_ankle_link*Ia6;
-    const Scalar t15 = -w.sq_r_ankle_link*t9 + w.cq_r_ankle_link*Ia6;
-    const Scalar t16 = 0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t18 = 0.9950041652780258*m2 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t19 = 0.04991670832341408*Ia4 + 0.4975020826390129*Ia9 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t20 = 0.4975020826390129*Ia4 - 0.04991670832341408*Ia9 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t21 = -0.4975020826390129*Ia4 + 0.04991670832341408*Ia9 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t22 = 0.04991670832341408*Ia4 + 0.4975020826390129*Ia9 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t23 = 0.9950041652780258*m3 - 0.9950041652780258*C21*h3 - 0.09983341664682815*t10*h3;
-    const Scalar t24 = -0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t10*h3;
-    const Scalar t25 = 0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t10*h3;
-    const Scalar t26 = 0.9950041652780258*m3 + 0.9950041652780258*C21*h3 + 0.09983341664682815*t10*h3;
-    const Scalar t27 = 0.9950041652780258*t11 - 0.09983341664682815*t13;
-    const Scalar t28 = 0.09983341664682815*t11 + 0.9950041652780258*t13;
-    const Scalar t29 = 0.09983341664682815*t14 + 0.9950041652780258*t15;
-    const Scalar t30 = 0.09983341664682815*t16 + 0.9950041652780258*t18;
-    const Scalar t31 = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    const Scalar t32 = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    const Scalar t33 = -0.09983341664682815*w.cq_r_ankle_link*Ia7 + 0.9950041652780258*w.sq_r_ankle_link*Ia7;
-    const Scalar t34 = 0.9950041652780258*w.cq_r_ankle_link*Ia7 + 0.09983341664682815*w.sq_r_ankle_link*Ia7;
-    const Scalar t35 = 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    const Scalar t36 = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    const Scalar t37 = 0.4305*t12 + t31;
-    const Scalar t38 = 0.4305*Ia5 + t33;
-    const Scalar t39 = 0.4305*t29 + t35;
-    const Scalar t40 = w.cq_r_ankle_link*pa6 + w.sq_r_ankle_link*pa8;
-    const Scalar t41 = -w.sq_r_ankle_link*pa6 + w.cq_r_ankle_link*pa8;
-    const Scalar t42 = w.cq_r_ankle_link*pa9 + w.sq_r_ankle_link*pa11;
-    const Scalar t43 = -w.sq_r_ankle_link*pa9 + w.cq_r_ankle_link*pa11;
-    const Scalar t44 = 0.9950041652780258*t40 - 0.09983341664682815*t41;
-    const Scalar t45 = 0.09983341664682815*t40 + 0.9950041652780258*t41;
-    w.IA_r_shank[0] = 3.055 + t27;
-    w.IA_r_shank[1] = t12;
-    w.IA_r_shank[2] = t28;
-    w.IA_r_shank[3] = t37;
-    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t27;
-    w.IA_r_shank[5] = t32;
-    w.IA_r_shank[6] = 3.055 + Ia5;
-    w.IA_r_shank[7] = t29;
-    w.IA_r_shank[8] = 0.5694718575000001 + t38;
-    w.IA_r_shank[9] = -0.4305*t12;
-    w.IA_r_shank[10] = t34;
-    w.IA_r_shank[11] = 3.055 + t30;
-    w.IA_r_shank[12] = t39;
-    w.IA_r_shank[13] = -0.4305*t28;
-    w.IA_r_shank[14] = t36;
-    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t23 - 0.09983341664682815*t24 + 0.4305*t33 + 0.4305*t38;
-    w.IA_r_shank[16] = -0.18533025*t12 - 0.4305*t31;
-    w.IA_r_shank[17] = 0.09983341664682815*t23 + 0.9950041652780258*t24 + 0.4305*t34;
-    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t27;
-    w.IA_r_shank[19] = -0.4305*t32;
-    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_r_shank[0] = w.pA_r_shank[0] + t44;
-    w.pA_r_shank[1] = w.pA_r_shank[1] + pa7;
-    w.pA_r_shank[2] = w.pA_r_shank[2] + t45;
-    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa7 + 0.9950041652780258*t42 - 0.09983341664682815*t43;
-    w.pA_r_shank[4] = w.pA_r_shank[4] + pa10 - 0.4305*t44;
-    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t42 + 0.9950041652780258*t43;
+    const Scalar t0 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
+    const Scalar t1 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
+    const Scalar t2 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
+    const Scalar t3 = w.IA_r_ankle_link[18]*w.Dinv_r_ankle_link;
+    const Scalar t4 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
+    const Scalar Ia0 = 1.2149999999999999 - w.IA_r_ankle_link[4]*t0;
+    const Scalar Ia1 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t0;
+    const Scalar Ia2 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t1;
+    const Scalar Ia3 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t1;
+    const Scalar Ia4 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t1;
+    const Scalar Ia5 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t2;
+    const Scalar Ia6 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t2;
+    const Scalar Ia7 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t4;
+    const Scalar t5 = -w.IA_r_ankle_link[13]*t0;
+    const Scalar t6 = -w.IA_r_ankle_link[9]*t0;
+    const Scalar pa0 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t0 + w.c_r_ankle_link[0]*Ia0 + w.c_r_ankle_link[2]*t5 + w.c_r_ankle_link[5]*Ia1;
+    const Scalar pa1 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t1 + w.c_r_ankle_link[0]*t6 + w.c_r_ankle_link[2]*Ia3 + w.c_r_ankle_link[5]*Ia4;
+    const Scalar pa2 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t2 + w.c_r_ankle_link[0]*t5 + w.c_r_ankle_link[2]*Ia5 + w.c_r_ankle_link[5]*Ia6;
+    const Scalar pa3 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
+    const Scalar pa4 = w.pA_r_ankle_link[4] + w.u_r_ankle_link[0]*t3;
+    const Scalar pa5 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t4 + w.c_r_ankle_link[0]*Ia1 + w.c_r_ankle_link[2]*Ia6 + w.c_r_ankle_link[5]*Ia7;
+    const Scalar C20 = -w.sq_r_ankle_link*w.sq_r_ankle_link + w.cq_r_ankle_link*w.cq_r_ankle_link;
+    const Scalar h0 = 0.5*(-Ia0 + Ia5);
+    const Scalar m0 = 0.5*(Ia0 + Ia5);
+    const Scalar t7 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
+    const Scalar d0 = -t5*t7 + C20*h0;
+    const Scalar qq0 = t5*C20 + h0*t7;
+    const Scalar d1 = 0.5*(-Ia1*t7 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia1*C20 + Ia6*t7);
+    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
+    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
+    const Scalar t8 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
+    const Scalar t9 = 0.09983341664682815*w.sq_r_ankle_link*t6 - 0.09983341664682815*w.cq_r_ankle_link*Ia3 + 0.9950041652780258*w.cq_r_ankle_link*t6 + 0.9950041652780258*w.sq_r_ankle_link*Ia3;
+    const Scalar t10 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t11 = w.cq_r_ankle_link*t6 + w.sq_r_ankle_link*Ia3;
+    const Scalar t12 = -w.sq_r_ankle_link*t6 + w.cq_r_ankle_link*Ia3;
+    const Scalar t13 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t15 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
+    const Scalar t16 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
+    const Scalar t17 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t18 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t19 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
+    const Scalar t20 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t7*h1;
+    const Scalar t21 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t22 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t23 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t7*h1;
+    const Scalar t24 = 0.9950041652780258*t8 - 0.09983341664682815*t10;
+    const Scalar t25 = 0.09983341664682815*t8 + 0.9950041652780258*t10;
+    const Scalar t26 = 0.09983341664682815*t11 + 0.9950041652780258*t12;
+    const Scalar t27 = 0.09983341664682815*t13 + 0.9950041652780258*t15;
+    const Scalar t28 = 0.9950041652780258*t16 - 0.09983341664682815*t17;
+    const Scalar t29 = 0.09983341664682815*t16 + 0.9950041652780258*t17;
+    const Scalar t30 = -0.09983341664682815*w.cq_r_ankle_link*Ia4 + 0.9950041652780258*w.sq_r_ankle_link*Ia4;
+    const Scalar t31 = 0.9950041652780258*w.cq_r_ankle_link*Ia4 + 0.09983341664682815*w.sq_r_ankle_link*Ia4;
+    const Scalar t32 = 0.9950041652780258*t18 - 0.09983341664682815*t19;
+    const Scalar t33 = 0.09983341664682815*t18 + 0.9950041652780258*t19;
+    const Scalar t34 = 0.4305*t9 + t28;
+    const Scalar t35 = 0.4305*Ia2 + t30;
+    const Scalar t36 = 0.4305*t26 + t32;
+    const Scalar t37 = w.cq_r_ankle_link*pa0 + w.sq_r_ankle_link*pa2;
+    const Scalar t38 = -w.sq_r_ankle_link*pa0 + w.cq_r_ankle_link*pa2;
+    const Scalar t39 = w.cq_r_ankle_link*pa3 + w.sq_r_ankle_link*pa5;
+    const Scalar t40 = -w.sq_r_ankle_link*pa3 + w.cq_r_ankle_link*pa5;
+    const Scalar t41 = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+    const Scalar t42 = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    w.IA_r_shank[0] = 3.055 + t24;
+    w.IA_r_shank[1] = t9;
+    w.IA_r_shank[2] = t25;
+    w.IA_r_shank[3] = t34;
+    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t24;
+    w.IA_r_shank[5] = t29;
+    w.IA_r_shank[6] = 3.055 + Ia2;
+    w.IA_r_shank[7] = t26;
+    w.IA_r_shank[8] = 0.5694718575000001 + t35;
+    w.IA_r_shank[9] = -0.4305*t9;
+    w.IA_r_shank[10] = t31;
+    w.IA_r_shank[11] = 3.055 + t27;
+    w.IA_r_shank[12] = t36;
+    w.IA_r_shank[13] = -0.4305*t25;
+    w.IA_r_shank[14] = t33;
+    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t20 - 0.09983341664682815*t21 + 0.4305*t30 + 0.4305*t35;
+    w.IA_r_shank[16] = -0.18533025*t9 - 0.4305*t28;
+    w.IA_r_shank[17] = 0.09983341664682815*t20 + 0.9950041652780258*t21 + 0.4305*t31;
+    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t24;
+    w.IA_r_shank[19] = -0.4305*t29;
+    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t22 + 0.9950041652780258*t23;
+    w.pA_r_shank[0] = w.pA_r_shank[0] + t41;
+    w.pA_r_shank[1] = w.pA_r_shank[1] + pa1;
+    w.pA_r_shank[2] = w.pA_r_shank[2] + t42;
+    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
+    w.pA_r_shank[4] = w.pA_r_shank[4] + pa4 - 0.4305*t41;
+    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
     w.KSD_r_ankle_link[0] = w.KA_r_ankle_link[4]*w.Dinv_r_ankle_link;
     w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[10]*w.Dinv_r_ankle_link;
     w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[22]*w.Dinv_r_ankle_link;
     w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[28]*w.Dinv_r_ankle_link;
     w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[34]*w.Dinv_r_ankle_link;
-    const Scalar t46 = 1.0 - w.KA_r_ankle_link[4]*t3;
-    const Scalar t47 = -w.KA_r_ankle_link[4]*t5;
-    const Scalar t48 = w.KA_r_ankle_link[5] - w.KA_r_ankle_link[4]*t7;
-    const Scalar t49 = w.cq_r_ankle_link*t46 + w.sq_r_ankle_link*t47;
-    const Scalar t50 = -w.sq_r_ankle_link*t46 + w.cq_r_ankle_link*t47;
-    const Scalar t51 = 0.9950041652780258*t49 - 0.09983341664682815*t50;
-    const Scalar t52 = 0.09983341664682815*t49 + 0.9950041652780258*t50;
-    w.KA_r_shank[0] = t51;
-    w.KA_r_shank[1] = -w.KA_r_ankle_link[4]*t4;
-    w.KA_r_shank[2] = t52;
-    w.KA_r_shank[3] = -0.4305*w.KA_r_ankle_link[4]*t4 + 0.9950041652780258*w.sq_r_ankle_link*t48 - 0.09983341664682815*w.cq_r_ankle_link*t48;
-    w.KA_r_shank[4] = -0.4305*t51;
-    w.KA_r_shank[5] = 0.09983341664682815*w.sq_r_ankle_link*t48 + 0.9950041652780258*w.cq_r_ankle_link*t48;
-    const Scalar t53 = w.KA_r_ankle_link[7] - w.KA_r_ankle_link[10]*t4;
-    const Scalar t54 = w.KA_r_ankle_link[8] - w.KA_r_ankle_link[10]*t5;
-    const Scalar t55 = -w.KA_r_ankle_link[10]*t3;
-    const Scalar t56 = w.KA_r_ankle_link[11] - w.KA_r_ankle_link[10]*t7;
-    const Scalar t57 = w.cq_r_ankle_link*t55 + w.sq_r_ankle_link*t54;
-    const Scalar t58 = -w.sq_r_ankle_link*t55 + w.cq_r_ankle_link*t54;
-    const Scalar t59 = 0.9950041652780258*t57 - 0.09983341664682815*t58;
-    const Scalar t60 = 0.09983341664682815*t57 + 0.9950041652780258*t58;
-    w.KA_r_shank[6] = t59;
-    w.KA_r_shank[7] = t53;
-    w.KA_r_shank[8] = t60;
-    w.KA_r_shank[9] = 0.4305*t53 + 0.9950041652780258*w.sq_r_ankle_link*t56 - 0.09983341664682815*w.cq_r_ankle_link*t56;
-    w.KA_r_shank[10] = -0.4305*t59;
-    w.KA_r_shank[11] = 0.09983341664682815*w.sq_r_ankle_link*t56 + 0.9950041652780258*w.cq_r_ankle_link*t56;
-    const Scalar t61 = 0.9950041652780258*w.sq_r_ankle_link*w.KA_r_ankle_link[14] - 0.09983341664682815*w.cq_r_ankle_link*w.KA_r_ankle_link[14];
-    const Scalar t62 = 0.09983341664682815*w.sq_r_ankle_link*w.KA_r_ankle_link[14] + 0.9950041652780258*w.cq_r_ankle_link*w.KA_r_ankle_link[14];
-    w.KA_r_shank[12] = t61;
+    const Scalar t43 = 1.0 - w.KA_r_ankle_link[4]*t0;
+    const Scalar t44 = -w.KA_r_ankle_link[4]*t2;
+    const Scalar t45 = w.KA_r_ankle_link[5] - w.KA_r_ankle_link[4]*t4;
+    const Scalar t46 = w.cq_r_ankle_link*t43 + w.sq_r_ankle_link*t44;
+    const Scalar t47 = -w.sq_r_ankle_link*t43 + w.cq_r_ankle_link*t44;
+    const Scalar t48 = 0.9950041652780258*t46 - 0.09983341664682815*t47;
+    const Scalar t49 = 0.09983341664682815*t46 + 0.9950041652780258*t47;
+    w.KA_r_shank[0] = t48;
+    w.KA_r_shank[1] = -w.KA_r_ankle_link[4]*t1;
+    w.KA_r_shank[2] = t49;
+    w.KA_r_shank[3] = -0.4305*w.KA_r_ankle_link[4]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t45 - 0.09983341664682815*w.cq_r_ankle_link*t45;
+    w.KA_r_shank[4] = -0.4305*t48;
+    w.KA_r_shank[5] = 0.09983341664682815*w.sq_r_ankle_link*t45 + 0.9950041652780258*w.cq_r_ankle_link*t45;
+    const Scalar t50 = w.KA_r_ankle_link[7] - w.KA_r_ankle_link[10]*t1;
+    const Scalar t51 = w.KA_r_ankle_link[8] - w.KA_r_ankle_link[10]*t2;
+    const Scalar t52 = -w.KA_r_ankle_link[10]*t0;
+    const Scalar t53 = w.KA_r_ankle_link[11] - w.KA_r_ankle_link[10]*t4;
+    const Scalar t54 = w.cq_r_ankle_link*t52 + w.sq_r_ankle_link*t51;
+    const Scalar t55 = -w.sq_r_ankle_link*t52 + w.cq_r_ankle_link*t51;
+    const Scalar t56 = 0.9950041652780258*t54 - 0.09983341664682815*t55;
+    const Scalar t57 = 0.09983341664682815*t54 + 0.9950041652780258*t55;
+    w.KA_r_shank[6] = t56;
+    w.KA_r_shank[7] = t50;
+    w.KA_r_shank[8] = t57;
+    w.KA_r_shank[9] = 0.4305*t50 + 0.9950041652780258*w.sq_r_ankle_link*t53 - 0.09983341664682815*w.cq_r_ankle_link*t53;
+    w.KA_r_shank[10] = -0.4305*t56;
+    w.KA_r_shank[11] = 0.09983341664682815*w.sq_r_ankle_link*t53 + 0.9950041652780258*w.cq_r_ankle_link*t53;
+    const Scalar t58 = 0.9950041652780258*w.sq_r_ankle_link*w.KA_r_ankle_link[14] - 0.09983341664682815*w.cq_r_ankle_link*w.KA_r_ankle_link[14];
+    const Scalar t59 = 0.09983341664682815*w.sq_r_ankle_link*w.KA_r_ankle_link[14] + 0.9950041652780258*w.cq_r_ankle_link*w.KA_r_ankle_link[14];
+    w.KA_r_shank[12] = t58;
     w.KA_r_shank[13] = w.KA_r_ankle_link[13];
-    w.KA_r_shank[14] = t62;
+    w.KA_r_shank[14] = t59;
     w.KA_r_shank[15] = 0.4305*w.KA_r_ankle_link[13];
-    w.KA_r_shank[16] = -0.4305*t61;
-    const Scalar t63 = w.KA_r_ankle_link[19] - w.KA_r_ankle_link[22]*t4;
-    const Scalar t64 = w.KA_r_ankle_link[20] - w.KA_r_ankle_link[22]*t5;
-    const Scalar t65 = -w.KA_r_ankle_link[22]*t3;
-    const Scalar t66 = w.KA_r_ankle_link[23] - w.KA_r_ankle_link[22]*t7;
-    const Scalar t67 = w.cq_r_ankle_link*t65 + w.sq_r_ankle_link*t64;
-    const Scalar t68 = -w.sq_r_ankle_link*t65 + w.cq_r_ankle_link*t64;
-    const Scalar t69 = 0.9950041652780258*t67 - 0.09983341664682815*t68;
-    const Scalar t70 = 0.09983341664682815*t67 + 0.9950041652780258*t68;
-    w.KA_r_shank[18] = t69;
-    w.KA_r_shank[19] = t63;
-    w.KA_r_shank[20] = t70;
-    w.KA_r_shank[21] = 0.4305*t63 + 0.9950041652780258*w.sq_r_ankle_link*t66 - 0.09983341664682815*w.cq_r_ankle_link*t66;
-    w.KA_r_shank[22] = -0.4305*t69;
-    w.KA_r_shank[23] = 0.09983341664682815*w.sq_r_ankle_link*t66 + 0.9950041652780258*w.cq_r_ankle_link*t66;
-    const Scalar t71 = -w.KA_r_ankle_link[28]*t3;
-    const Scalar t72 = -w.KA_r_ankle_link[28]*t5;
-    const Scalar t73 = w.KA_r_ankle_link[29] - w.KA_r_ankle_link[28]*t7;
-    const Scalar t74 = w.cq_r_ankle_link*t71 + w.sq_r_ankle_link*t72;
-    const Scalar t75 = -w.sq_r_ankle_link*t71 + w.cq_r_ankle_link*t72;
-    const Scalar t76 = 0.9950041652780258*t74 - 0.09983341664682815*t75;
-    const Scalar t77 = 0.09983341664682815*t74 + 0.9950041652780258*t75;
-    w.KA_r_shank[24] = t76;
-    w.KA_r_shank[25] = -w.KA_r_ankle_link[28]*t4;
-    w.KA_r_shank[26] = t77;
-    w.KA_r_shank[27] = -0.4305*w.KA_r_ankle_link[28]*t4 + 0.9950041652780258*w.sq_r_ankle_link*t73 - 0.09983341664682815*w.cq_r_ankle_link*t73;
-    w.KA_r_shank[28] = -0.4305*t76;
-    w.KA_r_shank[29] = 0.09983341664682815*w.sq_r_ankle_link*t73 + 0.9950041652780258*w.cq_r_ankle_link*t73;
-    const Scalar t78 = -w.KA_r_ankle_link[34]*t3;
-    const Scalar t79 = -w.KA_r_ankle_link[34]*t5;
-    const Scalar t80 = w.KA_r_ankle_link[35] - w.KA_r_ankle_link[34]*t7;
-    const Scalar t81 = w.cq_r_ankle_link*t78 + w.sq_r_ankle_link*t79;
-    const Scalar t82 = -w.sq_r_ankle_link*t78 + w.cq_r_ankle_link*t79;
-    const Scalar t83 = 0.9950041652780258*t81 - 0.09983341664682815*t82;
-    const Scalar t84 = 0.09983341664682815*t81 + 0.9950041652780258*t82;
-    w.KA_r_shank[30] = t83;
-    w.KA_r_shank[31] = -w.KA_r_ankle_link[34]*t4;
-    w.KA_r_shank[32] = t84;
-    w.KA_r_shank[33] = -0.4305*w.KA_r_ankle_link[34]*t4 + 0.9950041652780258*w.sq_r_ankle_link*t80 - 0.09983341664682815*w.cq_r_ankle_link*t80;
-    w.KA_r_shank[34] = -0.4305*t83;
-    w.KA_r_shank[35] = 0.09983341664682815*w.sq_r_ankle_link*t80 + 0.9950041652780258*w.cq_r_ankle_link*t80;
+    w.KA_r_shank[16] = -0.4305*t58;
+    const Scalar t60 = w.KA_r_ankle_link[19] - w.KA_r_ankle_link[22]*t1;
+    const Scalar t61 = w.KA_r_ankle_link[20] - w.KA_r_ankle_link[22]*t2;
+    const Scalar t62 = -w.KA_r_ankle_link[22]*t0;
+    const Scalar t63 = w.KA_r_ankle_link[23] - w.KA_r_ankle_link[22]*t4;
+    const Scalar t64 = w.cq_r_ankle_link*t62 + w.sq_r_ankle_link*t61;
+    const Scalar t65 = -w.sq_r_ankle_link*t62 + w.cq_r_ankle_link*t61;
+    const Scalar t66 = 0.9950041652780258*t64 - 0.09983341664682815*t65;
+    const Scalar t67 = 0.09983341664682815*t64 + 0.9950041652780258*t65;
+    w.KA_r_shank[18] = t66;
+    w.KA_r_shank[19] = t60;
+    w.KA_r_shank[20] = t67;
+    w.KA_r_shank[21] = 0.4305*t60 + 0.9950041652780258*w.sq_r_ankle_link*t63 - 0.09983341664682815*w.cq_r_ankle_link*t63;
+    w.KA_r_shank[22] = -0.4305*t66;
+    w.KA_r_shank[23] = 0.09983341664682815*w.sq_r_ankle_link*t63 + 0.9950041652780258*w.cq_r_ankle_link*t63;
+    const Scalar t68 = -w.KA_r_ankle_link[28]*t0;
+    const Scalar t69 = -w.KA_r_ankle_link[28]*t2;
+    const Scalar t70 = w.KA_r_ankle_link[29] - w.KA_r_ankle_link[28]*t4;
+    const Scalar t71 = w.cq_r_ankle_link*t68 + w.sq_r_ankle_link*t69;
+    const Scalar t72 = -w.sq_r_ankle_link*t68 + w.cq_r_ankle_link*t69;
+    const Scalar t73 = 0.9950041652780258*t71 - 0.09983341664682815*t72;
+    const Scalar t74 = 0.09983341664682815*t71 + 0.9950041652780258*t72;
+    w.KA_r_shank[24] = t73;
+    w.KA_r_shank[25] = -w.KA_r_ankle_link[28]*t1;
+    w.KA_r_shank[26] = t74;
+    w.KA_r_shank[27] = -0.4305*w.KA_r_ankle_link[28]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t70 - 0.09983341664682815*w.cq_r_ankle_link*t70;
+    w.KA_r_shank[28] = -0.4305*t73;
+    w.KA_r_shank[29] = 0.09983341664682815*w.sq_r_ankle_link*t70 + 0.9950041652780258*w.cq_r_ankle_link*t70;
+    const Scalar t75 = -w.KA_r_ankle_link[34]*t0;
+    const Scalar t76 = -w.KA_r_ankle_link[34]*t2;
+    const Scalar t77 = w.KA_r_ankle_link[35] - w.KA_r_ankle_link[34]*t4;
+    const Scalar t78 = w.cq_r_ankle_link*t75 + w.sq_r_ankle_link*t76;
+    const Scalar t79 = -w.sq_r_ankle_link*t75 + w.cq_r_ankle_link*t76;
+    const Scalar t80 = 0.9950041652780258*t78 - 0.09983341664682815*t79;
+    const Scalar t81 = 0.09983341664682815*t78 + 0.9950041652780258*t79;
+    w.KA_r_shank[30] = t80;
+    w.KA_r_shank[31] = -w.KA_r_ankle_link[34]*t1;
+    w.KA_r_shank[32] = t81;
+    w.KA_r_shank[33] = -0.4305*w.KA_r_ankle_link[34]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t77 - 0.09983341664682815*w.cq_r_ankle_link*t77;
+    w.KA_r_shank[34] = -0.4305*t80;
+    w.KA_r_shank[35] = 0.09983341664682815*w.sq_r_ankle_link*t77 + 0.9950041652780258*w.cq_r_ankle_link*t77;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_9(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
@@ -6176,7 +6306,7 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_10(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
     w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
@@ -6358,7 +6488,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_11(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
@@ -6478,7 +6608,7 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_12(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
@@ -6667,7 +6797,7 @@ PROXGEN_RT_NOINLINE void pv_12(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_13(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_14(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     w.Dinv_l_foot = 1.0 / 0.00194517348958;
@@ -6725,185 +6855,188 @@ PROXGEN_RT_NOINLINE void pv_13(const Scalar* tau, Workspace& w) noexcept {
     w.KA_l_ankle_link[34] = -w.sq_l_foot;
     w.KA_l_ankle_link[35] = w.cq_l_foot;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
     w.u_l_ankle_link[0] = -w.pA_l_ankle_link[4] + tau[10];
-    const Scalar t3 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
-    const Scalar t4 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
-    const Scalar t5 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
-    const Scalar t6 = w.IA_l_ankle_link[18]*w.Dinv_l_ankle_link;
-    const Scalar t7 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
-    const Scalar Ia3 = 1.2149999999999999 - w.IA_l_ankle_link[4]*t3;
-    const Scalar Ia4 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t3;
-    const Scalar Ia5 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t4;
-    const Scalar Ia6 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t4;
-    const Scalar Ia7 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t4;
-    const Scalar Ia8 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t5;
-    const Scalar Ia9 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t5;
-    const Scalar Ia10 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t7;
-    const Scalar t8 = -w.IA_l_ankle_link[13]*t3;
-    const Scalar t9 = -w.IA_l_ankle_link[9]*t3;
-    const Scalar pa6 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t3 + w.c_l_ankle_link[0]*Ia3 + w.c_l_ankle_link[2]*t8 + w.c_l_ankle_link[5]*Ia4;
-    const Scalar pa7 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t4 + w.c_l_ankle_link[0]*t9 + w.c_l_ankle_link[2]*Ia6 + w.c_l_ankle_link[5]*Ia7;
-    const Scalar pa8 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t5 + w.c_l_ankle_link[0]*t8 + w.c_l_ankle_link[2]*Ia8 + w.c_l_ankle_link[5]*Ia9;
-    const Scalar pa9 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
-    const Scalar pa10 = w.pA_l_ankle_link[4] + w.u_l_ankle_link[0]*t6;
-    const Scalar pa11 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t7 + w.c_l_ankle_link[0]*Ia4 + w.c_l_ankle_link[2]*Ia9 + w.c_l_ankle_link[5]*Ia10;
-    const Scalar C21 = -w.sq_l_ankle_link*w.sq_l_ankle_link + w.cq_l_ankle_link*w.cq_l_ankle_link;
-    const Scalar h2 = 0.5*(-Ia3 + Ia8);
-    const Scalar m2 = 0.5*(Ia3 + Ia8);
-    const Scalar t10 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar d0 = -t8*t10 + C21*h2;
-    const Scalar qq0 = t8*C21 + h2*t10;
-    const Scalar d1 = 0.5*(-Ia4*t10 + Ia9*C21);
-    const Scalar qq1 = 0.5*(Ia4*C21 + Ia9*t10);
-    const Scalar h3 = -3.6e-05 + 0.5*Ia10;
-    const Scalar m3 = 3.6e-05 + 0.5*Ia10;
-    const Scalar t11 = 0.9950041652780258*m2 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t12 = 0.09983341664682815*w.sq_l_ankle_link*t9 - 0.09983341664682815*w.cq_l_ankle_link*Ia6 + 0.9950041652780258*w.cq_l_ankle_link*t9 + 0.9950041652780258*w.sq_l_ankle_link*Ia6;
-    const Scalar t13 = -0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = w.cq_l_ankle_link*t9 + w.sq_l_ankle_link*Ia6;
-    const Scalar t15 = -w.sq_l_ankle_link*t9 + w.cq_l_ankle_link*Ia6;
-    const Scalar t16 = 0.09983341664682815*m2 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t18 = 0.9950041652780258*m2 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t19 = 0.04991670832341408*Ia4 + 0.4975020826390129*Ia9 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t20 = 0.4975020826390129*Ia4 - 0.04991670832341408*Ia9 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t21 = -0.4975020826390129*Ia4 + 0.04991670832341408*Ia9 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t22 = 0.04991670832341408*Ia4 + 0.4975020826390129*Ia9 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t23 = 0.9950041652780258*m3 - 0.9950041652780258*C21*h3 - 0.09983341664682815*t10*h3;
-    const Scalar t24 = -0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t10*h3;
-    const Scalar t25 = 0.09983341664682815*m3 - 0.09983341664682815*C21*h3 + 0.9950041652780258*t10*h3;
-    const Scalar t26 = 0.9950041652780258*m3 + 0.9950041652780258*C21*h3 + 0.09983341664682815*t10*h3;
-    const Scalar t27 = 0.9950041652780258*t11 - 0.09983341664682815*t13;
-    const Scalar t28 = 0.09983341664682815*t11 + 0.9950041652780258*t13;
-    const Scalar t29 = 0.09983341664682815*t14 + 0.9950041652780258*t15;
-    const Scalar t30 = 0.09983341664682815*t16 + 0.9950041652780258*t18;
-    const Scalar t31 = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    const Scalar t32 = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    const Scalar t33 = -0.09983341664682815*w.cq_l_ankle_link*Ia7 + 0.9950041652780258*w.sq_l_ankle_link*Ia7;
-    const Scalar t34 = 0.9950041652780258*w.cq_l_ankle_link*Ia7 + 0.09983341664682815*w.sq_l_ankle_link*Ia7;
-    const Scalar t35 = 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    const Scalar t36 = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    const Scalar t37 = 0.4305*t12 + t31;
-    const Scalar t38 = 0.4305*Ia5 + t33;
-    const Scalar t39 = 0.4305*t29 + t35;
-    const Scalar t40 = w.cq_l_ankle_link*pa6 + w.sq_l_ankle_link*pa8;
-    const Scalar t41 = -w.sq_l_ankle_link*pa6 + w.cq_l_ankle_link*pa8;
-    const Scalar t42 = w.cq_l_ankle_link*pa9 + w.sq_l_ankle_link*pa11;
-    const Scalar t43 = -w.sq_l_ankle_link*pa9 + w.cq_l_ankle_link*pa11;
-    const Scalar t44 = 0.9950041652780258*t40 - 0.09983341664682815*t41;
-    const Scalar t45 = 0.09983341664682815*t40 + 0.9950041652780258*t41;
-    w.IA_l_shank[0] = 3.055 + t27;
-    w.IA_l_shank[1] = t12;
-    w.IA_l_shank[2] = t28;
-    w.IA_l_shank[3] = t37;
-    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t27;
-    w.IA_l_shank[5] = t32;
-    w.IA_l_shank[6] = 3.055 + Ia5;
-    w.IA_l_shank[7] = t29;
-    w.IA_l_shank[8] = 0.5694718575000001 + t38;
-    w.IA_l_shank[9] = -0.4305*t12;
-    w.IA_l_shank[10] = t34;
-    w.IA_l_shank[11] = 3.055 + t30;
-    w.IA_l_shank[12] = t39;
-    w.IA_l_shank[13] = -0.4305*t28;
-    w.IA_l_shank[14] = t36;
-    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t23 - 0.09983341664682815*t24 + 0.4305*t33 + 0.4305*t38;
-    w.IA_l_shank[16] = -0.18533025*t12 - 0.4305*t31;
-    w.IA_l_shank[17] = 0.09983341664682815*t23 + 0.9950041652780258*t24 + 0.4305*t34;
-    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t27;
-    w.IA_l_shank[19] = -0.4305*t32;
-    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_l_shank[0] = w.pA_l_shank[0] + t44;
-    w.pA_l_shank[1] = w.pA_l_shank[1] + pa7;
-    w.pA_l_shank[2] = w.pA_l_shank[2] + t45;
-    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa7 + 0.9950041652780258*t42 - 0.09983341664682815*t43;
-    w.pA_l_shank[4] = w.pA_l_shank[4] + pa10 - 0.4305*t44;
-    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t42 + 0.9950041652780258*t43;
+    const Scalar t0 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
+    const Scalar t1 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
+    const Scalar t2 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
+    const Scalar t3 = w.IA_l_ankle_link[18]*w.Dinv_l_ankle_link;
+    const Scalar t4 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
+    const Scalar Ia0 = 1.2149999999999999 - w.IA_l_ankle_link[4]*t0;
+    const Scalar Ia1 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t0;
+    const Scalar Ia2 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t1;
+    const Scalar Ia3 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t1;
+    const Scalar Ia4 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t1;
+    const Scalar Ia5 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t2;
+    const Scalar Ia6 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t2;
+    const Scalar Ia7 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t4;
+    const Scalar t5 = -w.IA_l_ankle_link[13]*t0;
+    const Scalar t6 = -w.IA_l_ankle_link[9]*t0;
+    const Scalar pa0 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t0 + w.c_l_ankle_link[0]*Ia0 + w.c_l_ankle_link[2]*t5 + w.c_l_ankle_link[5]*Ia1;
+    const Scalar pa1 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t1 + w.c_l_ankle_link[0]*t6 + w.c_l_ankle_link[2]*Ia3 + w.c_l_ankle_link[5]*Ia4;
+    const Scalar pa2 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t2 + w.c_l_ankle_link[0]*t5 + w.c_l_ankle_link[2]*Ia5 + w.c_l_ankle_link[5]*Ia6;
+    const Scalar pa3 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
+    const Scalar pa4 = w.pA_l_ankle_link[4] + w.u_l_ankle_link[0]*t3;
+    const Scalar pa5 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t4 + w.c_l_ankle_link[0]*Ia1 + w.c_l_ankle_link[2]*Ia6 + w.c_l_ankle_link[5]*Ia7;
+    const Scalar C20 = -w.sq_l_ankle_link*w.sq_l_ankle_link + w.cq_l_ankle_link*w.cq_l_ankle_link;
+    const Scalar h0 = 0.5*(-Ia0 + Ia5);
+    const Scalar m0 = 0.5*(Ia0 + Ia5);
+    const Scalar t7 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
+    const Scalar d0 = -t5*t7 + C20*h0;
+    const Scalar qq0 = t5*C20 + h0*t7;
+    const Scalar d1 = 0.5*(-Ia1*t7 + Ia6*C20);
+    const Scalar qq1 = 0.5*(Ia1*C20 + Ia6*t7);
+    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
+    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
+    const Scalar t8 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
+    const Scalar t9 = 0.09983341664682815*w.sq_l_ankle_link*t6 - 0.09983341664682815*w.cq_l_ankle_link*Ia3 + 0.9950041652780258*w.cq_l_ankle_link*t6 + 0.9950041652780258*w.sq_l_ankle_link*Ia3;
+    const Scalar t10 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t11 = w.cq_l_ankle_link*t6 + w.sq_l_ankle_link*Ia3;
+    const Scalar t12 = -w.sq_l_ankle_link*t6 + w.cq_l_ankle_link*Ia3;
+    const Scalar t13 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
+    const Scalar t15 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
+    const Scalar t16 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
+    const Scalar t17 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t18 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
+    const Scalar t19 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
+    const Scalar t20 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t7*h1;
+    const Scalar t21 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t22 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t7*h1;
+    const Scalar t23 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t7*h1;
+    const Scalar t24 = 0.9950041652780258*t8 - 0.09983341664682815*t10;
+    const Scalar t25 = 0.09983341664682815*t8 + 0.9950041652780258*t10;
+    const Scalar t26 = 0.09983341664682815*t11 + 0.9950041652780258*t12;
+    const Scalar t27 = 0.09983341664682815*t13 + 0.9950041652780258*t15;
+    const Scalar t28 = 0.9950041652780258*t16 - 0.09983341664682815*t17;
+    const Scalar t29 = 0.09983341664682815*t16 + 0.9950041652780258*t17;
+    const Scalar t30 = -0.09983341664682815*w.cq_l_ankle_link*Ia4 + 0.9950041652780258*w.sq_l_ankle_link*Ia4;
+    const Scalar t31 = 0.9950041652780258*w.cq_l_ankle_link*Ia4 + 0.09983341664682815*w.sq_l_ankle_link*Ia4;
+    const Scalar t32 = 0.9950041652780258*t18 - 0.09983341664682815*t19;
+    const Scalar t33 = 0.09983341664682815*t18 + 0.9950041652780258*t19;
+    const Scalar t34 = 0.4305*t9 + t28;
+    const Scalar t35 = 0.4305*Ia2 + t30;
+    const Scalar t36 = 0.4305*t26 + t32;
+    const Scalar t37 = w.cq_l_ankle_link*pa0 + w.sq_l_ankle_link*pa2;
+    const Scalar t38 = -w.sq_l_ankle_link*pa0 + w.cq_l_ankle_link*pa2;
+    const Scalar t39 = w.cq_l_ankle_link*pa3 + w.sq_l_ankle_link*pa5;
+    const Scalar t40 = -w.sq_l_ankle_link*pa3 + w.cq_l_ankle_link*pa5;
+    const Scalar t41 = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+    const Scalar t42 = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    w.IA_l_shank[0] = 3.055 + t24;
+    w.IA_l_shank[1] = t9;
+    w.IA_l_shank[2] = t25;
+    w.IA_l_shank[3] = t34;
+    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t24;
+    w.IA_l_shank[5] = t29;
+    w.IA_l_shank[6] = 3.055 + Ia2;
+    w.IA_l_shank[7] = t26;
+    w.IA_l_shank[8] = 0.5694718575000001 + t35;
+    w.IA_l_shank[9] = -0.4305*t9;
+    w.IA_l_shank[10] = t31;
+    w.IA_l_shank[11] = 3.055 + t27;
+    w.IA_l_shank[12] = t36;
+    w.IA_l_shank[13] = -0.4305*t25;
+    w.IA_l_shank[14] = t33;
+    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t20 - 0.09983341664682815*t21 + 0.4305*t30 + 0.4305*t35;
+    w.IA_l_shank[16] = -0.18533025*t9 - 0.4305*t28;
+    w.IA_l_shank[17] = 0.09983341664682815*t20 + 0.9950041652780258*t21 + 0.4305*t31;
+    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t24;
+    w.IA_l_shank[19] = -0.4305*t29;
+    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t22 + 0.9950041652780258*t23;
+    w.pA_l_shank[0] = w.pA_l_shank[0] + t41;
+    w.pA_l_shank[1] = w.pA_l_shank[1] + pa1;
+    w.pA_l_shank[2] = w.pA_l_shank[2] + t42;
+    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
+    w.pA_l_shank[4] = w.pA_l_shank[4] + pa4 - 0.4305*t41;
+    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
     w.KSD_l_ankle_link[0] = w.KA_l_ankle_link[4]*w.Dinv_l_ankle_link;
     w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[10]*w.Dinv_l_ankle_link;
     w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[22]*w.Dinv_l_ankle_link;
     w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[28]*w.Dinv_l_ankle_link;
     w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[34]*w.Dinv_l_ankle_link;
-    const Scalar t46 = 1.0 - w.KA_l_ankle_link[4]*t3;
-    const Scalar t47 = -w.KA_l_ankle_link[4]*t5;
-    const Scalar t48 = w.KA_l_ankle_link[5] - w.KA_l_ankle_link[4]*t7;
-    const Scalar t49 = w.cq_l_ankle_link*t46 + w.sq_l_ankle_link*t47;
-    const Scalar t50 = -w.sq_l_ankle_link*t46 + w.cq_l_ankle_link*t47;
-    const Scalar t51 = 0.9950041652780258*t49 - 0.09983341664682815*t50;
-    const Scalar t52 = 0.09983341664682815*t49 + 0.9950041652780258*t50;
-    w.KA_l_shank[0] = t51;
-    w.KA_l_shank[1] = -w.KA_l_ankle_link[4]*t4;
-    w.KA_l_shank[2] = t52;
-    w.KA_l_shank[3] = -0.4305*w.KA_l_ankle_link[4]*t4 + 0.9950041652780258*w.sq_l_ankle_link*t48 - 0.09983341664682815*w.cq_l_ankle_link*t48;
-    w.KA_l_shank[4] = -0.4305*t51;
-    w.KA_l_shank[5] = 0.09983341664682815*w.sq_l_ankle_link*t48 + 0.9950041652780258*w.cq_l_ankle_link*t48;
-    const Scalar t53 = w.KA_l_ankle_link[7] - w.KA_l_ankle_link[10]*t4;
-    const Scalar t54 = w.KA_l_ankle_link[8] - w.KA_l_ankle_link[10]*t5;
-    const Scalar t55 = -w.KA_l_ankle_link[10]*t3;
-    const Scalar t56 = w.KA_l_ankle_link[11] - w.KA_l_ankle_link[10]*t7;
-    const Scalar t57 = w.cq_l_ankle_link*t55 + w.sq_l_ankle_link*t54;
-    const Scalar t58 = -w.sq_l_ankle_link*t55 + w.cq_l_ankle_link*t54;
-    const Scalar t59 = 0.9950041652780258*t57 - 0.09983341664682815*t58;
-    const Scalar t60 = 0.09983341664682815*t57 + 0.9950041652780258*t58;
-    w.KA_l_shank[6] = t59;
-    w.KA_l_shank[7] = t53;
-    w.KA_l_shank[8] = t60;
-    w.KA_l_shank[9] = 0.4305*t53 + 0.9950041652780258*w.sq_l_ankle_link*t56 - 0.09983341664682815*w.cq_l_ankle_link*t56;
-    w.KA_l_shank[10] = -0.4305*t59;
-    w.KA_l_shank[11] = 0.09983341664682815*w.sq_l_ankle_link*t56 + 0.9950041652780258*w.cq_l_ankle_link*t56;
-    const Scalar t61 = 0.9950041652780258*w.sq_l_ankle_link*w.KA_l_ankle_link[14] - 0.09983341664682815*w.cq_l_ankle_link*w.KA_l_ankle_link[14];
-    const Scalar t62 = 0.09983341664682815*w.sq_l_ankle_link*w.KA_l_ankle_link[14] + 0.9950041652780258*w.cq_l_ankle_link*w.KA_l_ankle_link[14];
-    w.KA_l_shank[12] = t61;
+    const Scalar t43 = 1.0 - w.KA_l_ankle_link[4]*t0;
+    const Scalar t44 = -w.KA_l_ankle_link[4]*t2;
+    const Scalar t45 = w.KA_l_ankle_link[5] - w.KA_l_ankle_link[4]*t4;
+    const Scalar t46 = w.cq_l_ankle_link*t43 + w.sq_l_ankle_link*t44;
+    const Scalar t47 = -w.sq_l_ankle_link*t43 + w.cq_l_ankle_link*t44;
+    const Scalar t48 = 0.9950041652780258*t46 - 0.09983341664682815*t47;
+    const Scalar t49 = 0.09983341664682815*t46 + 0.9950041652780258*t47;
+    w.KA_l_shank[0] = t48;
+    w.KA_l_shank[1] = -w.KA_l_ankle_link[4]*t1;
+    w.KA_l_shank[2] = t49;
+    w.KA_l_shank[3] = -0.4305*w.KA_l_ankle_link[4]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t45 - 0.09983341664682815*w.cq_l_ankle_link*t45;
+    w.KA_l_shank[4] = -0.4305*t48;
+    w.KA_l_shank[5] = 0.09983341664682815*w.sq_l_ankle_link*t45 + 0.9950041652780258*w.cq_l_ankle_link*t45;
+    const Scalar t50 = w.KA_l_ankle_link[7] - w.KA_l_ankle_link[10]*t1;
+    const Scalar t51 = w.KA_l_ankle_link[8] - w.KA_l_ankle_link[10]*t2;
+    const Scalar t52 = -w.KA_l_ankle_link[10]*t0;
+    const Scalar t53 = w.KA_l_ankle_link[11] - w.KA_l_ankle_link[10]*t4;
+    const Scalar t54 = w.cq_l_ankle_link*t52 + w.sq_l_ankle_link*t51;
+    const Scalar t55 = -w.sq_l_ankle_link*t52 + w.cq_l_ankle_link*t51;
+    const Scalar t56 = 0.9950041652780258*t54 - 0.09983341664682815*t55;
+    const Scalar t57 = 0.09983341664682815*t54 + 0.9950041652780258*t55;
+    w.KA_l_shank[6] = t56;
+    w.KA_l_shank[7] = t50;
+    w.KA_l_shank[8] = t57;
+    w.KA_l_shank[9] = 0.4305*t50 + 0.9950041652780258*w.sq_l_ankle_link*t53 - 0.09983341664682815*w.cq_l_ankle_link*t53;
+    w.KA_l_shank[10] = -0.4305*t56;
+    w.KA_l_shank[11] = 0.09983341664682815*w.sq_l_ankle_link*t53 + 0.9950041652780258*w.cq_l_ankle_link*t53;
+    const Scalar t58 = 0.9950041652780258*w.sq_l_ankle_link*w.KA_l_ankle_link[14] - 0.09983341664682815*w.cq_l_ankle_link*w.KA_l_ankle_link[14];
+    const Scalar t59 = 0.09983341664682815*w.sq_l_ankle_link*w.KA_l_ankle_link[14] + 0.9950041652780258*w.cq_l_ankle_link*w.KA_l_ankle_link[14];
+    w.KA_l_shank[12] = t58;
     w.KA_l_shank[13] = w.KA_l_ankle_link[13];
-    w.KA_l_shank[14] = t62;
+    w.KA_l_shank[14] = t59;
     w.KA_l_shank[15] = 0.4305*w.KA_l_ankle_link[13];
-    w.KA_l_shank[16] = -0.4305*t61;
-    const Scalar t63 = w.KA_l_ankle_link[19] - w.KA_l_ankle_link[22]*t4;
-    const Scalar t64 = w.KA_l_ankle_link[20] - w.KA_l_ankle_link[22]*t5;
-    const Scalar t65 = -w.KA_l_ankle_link[22]*t3;
-    const Scalar t66 = w.KA_l_ankle_link[23] - w.KA_l_ankle_link[22]*t7;
-    const Scalar t67 = w.cq_l_ankle_link*t65 + w.sq_l_ankle_link*t64;
-    const Scalar t68 = -w.sq_l_ankle_link*t65 + w.cq_l_ankle_link*t64;
-    const Scalar t69 = 0.9950041652780258*t67 - 0.09983341664682815*t68;
-    const Scalar t70 = 0.09983341664682815*t67 + 0.9950041652780258*t68;
-    w.KA_l_shank[18] = t69;
-    w.KA_l_shank[19] = t63;
-    w.KA_l_shank[20] = t70;
-    w.KA_l_shank[21] = 0.4305*t63 + 0.9950041652780258*w.sq_l_ankle_link*t66 - 0.09983341664682815*w.cq_l_ankle_link*t66;
-    w.KA_l_shank[22] = -0.4305*t69;
-    w.KA_l_shank[23] = 0.09983341664682815*w.sq_l_ankle_link*t66 + 0.9950041652780258*w.cq_l_ankle_link*t66;
-    const Scalar t71 = -w.KA_l_ankle_link[28]*t3;
-    const Scalar t72 = -w.KA_l_ankle_link[28]*t5;
-    const Scalar t73 = w.KA_l_ankle_link[29] - w.KA_l_ankle_link[28]*t7;
-    const Scalar t74 = w.cq_l_ankle_link*t71 + w.sq_l_ankle_link*t72;
-    const Scalar t75 = -w.sq_l_ankle_link*t71 + w.cq_l_ankle_link*t72;
-    const Scalar t76 = 0.9950041652780258*t74 - 0.09983341664682815*t75;
-    const Scalar t77 = 0.09983341664682815*t74 + 0.9950041652780258*t75;
-    w.KA_l_shank[24] = t76;
-    w.KA_l_shank[25] = -w.KA_l_ankle_link[28]*t4;
-    w.KA_l_shank[26] = t77;
-    w.KA_l_shank[27] = -0.4305*w.KA_l_ankle_link[28]*t4 + 0.9950041652780258*w.sq_l_ankle_link*t73 - 0.09983341664682815*w.cq_l_ankle_link*t73;
-    w.KA_l_shank[28] = -0.4305*t76;
-    w.KA_l_shank[29] = 0.09983341664682815*w.sq_l_ankle_link*t73 + 0.9950041652780258*w.cq_l_ankle_link*t73;
-    const Scalar t78 = -w.KA_l_ankle_link[34]*t3;
-    const Scalar t79 = -w.KA_l_ankle_link[34]*t5;
-    const Scalar t80 = w.KA_l_ankle_link[35] - w.KA_l_ankle_link[34]*t7;
-    const Scalar t81 = w.cq_l_ankle_link*t78 + w.sq_l_ankle_link*t79;
-    const Scalar t82 = -w.sq_l_ankle_link*t78 + w.cq_l_ankle_link*t79;
-    const Scalar t83 = 0.9950041652780258*t81 - 0.09983341664682815*t82;
-    const Scalar t84 = 0.09983341664682815*t81 + 0.9950041652780258*t82;
-    w.KA_l_shank[30] = t83;
-    w.KA_l_shank[31] = -w.KA_l_ankle_link[34]*t4;
-    w.KA_l_shank[32] = t84;
-    w.KA_l_shank[33] = -0.4305*w.KA_l_ankle_link[34]*t4 + 0.9950041652780258*w.sq_l_ankle_link*t80 - 0.09983341664682815*w.cq_l_ankle_link*t80;
-    w.KA_l_shank[34] = -0.4305*t83;
-    w.KA_l_shank[35] = 0.09983341664682815*w.sq_l_ankle_link*t80 + 0.9950041652780258*w.cq_l_ankle_link*t80;
+    w.KA_l_shank[16] = -0.4305*t58;
+    const Scalar t60 = w.KA_l_ankle_link[19] - w.KA_l_ankle_link[22]*t1;
+    const Scalar t61 = w.KA_l_ankle_link[20] - w.KA_l_ankle_link[22]*t2;
+    const Scalar t62 = -w.KA_l_ankle_link[22]*t0;
+    const Scalar t63 = w.KA_l_ankle_link[23] - w.KA_l_ankle_link[22]*t4;
+    const Scalar t64 = w.cq_l_ankle_link*t62 + w.sq_l_ankle_link*t61;
+    const Scalar t65 = -w.sq_l_ankle_link*t62 + w.cq_l_ankle_link*t61;
+    const Scalar t66 = 0.9950041652780258*t64 - 0.09983341664682815*t65;
+    const Scalar t67 = 0.09983341664682815*t64 + 0.9950041652780258*t65;
+    w.KA_l_shank[18] = t66;
+    w.KA_l_shank[19] = t60;
+    w.KA_l_shank[20] = t67;
+    w.KA_l_shank[21] = 0.4305*t60 + 0.9950041652780258*w.sq_l_ankle_link*t63 - 0.09983341664682815*w.cq_l_ankle_link*t63;
+    w.KA_l_shank[22] = -0.4305*t66;
+    w.KA_l_shank[23] = 0.09983341664682815*w.sq_l_ankle_link*t63 + 0.9950041652780258*w.cq_l_ankle_link*t63;
+    const Scalar t68 = -w.KA_l_ankle_link[28]*t0;
+    const Scalar t69 = -w.KA_l_ankle_link[28]*t2;
+    const Scalar t70 = w.KA_l_ankle_link[29] - w.KA_l_ankle_link[28]*t4;
+    const Scalar t71 = w.cq_l_ankle_link*t68 + w.sq_l_ankle_link*t69;
+    const Scalar t72 = -w.sq_l_ankle_link*t68 + w.cq_l_ankle_link*t69;
+    const Scalar t73 = 0.9950041652780258*t71 - 0.09983341664682815*t72;
+    const Scalar t74 = 0.09983341664682815*t71 + 0.9950041652780258*t72;
+    w.KA_l_shank[24] = t73;
+    w.KA_l_shank[25] = -w.KA_l_ankle_link[28]*t1;
+    w.KA_l_shank[26] = t74;
+    w.KA_l_shank[27] = -0.4305*w.KA_l_ankle_link[28]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t70 - 0.09983341664682815*w.cq_l_ankle_link*t70;
+    w.KA_l_shank[28] = -0.4305*t73;
+    w.KA_l_shank[29] = 0.09983341664682815*w.sq_l_ankle_link*t70 + 0.9950041652780258*w.cq_l_ankle_link*t70;
+    const Scalar t75 = -w.KA_l_ankle_link[34]*t0;
+    const Scalar t76 = -w.KA_l_ankle_link[34]*t2;
+    const Scalar t77 = w.KA_l_ankle_link[35] - w.KA_l_ankle_link[34]*t4;
+    const Scalar t78 = w.cq_l_ankle_link*t75 + w.sq_l_ankle_link*t76;
+    const Scalar t79 = -w.sq_l_ankle_link*t75 + w.cq_l_ankle_link*t76;
+    const Scalar t80 = 0.9950041652780258*t78 - 0.09983341664682815*t79;
+    const Scalar t81 = 0.09983341664682815*t78 + 0.9950041652780258*t79;
+    w.KA_l_shank[30] = t80;
+    w.KA_l_shank[31] = -w.KA_l_ankle_link[34]*t1;
+    w.KA_l_shank[32] = t81;
+    w.KA_l_shank[33] = -0.4305*w.KA_l_ankle_link[34]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t77 - 0.09983341664682815*w.cq_l_ankle_link*t77;
+    w.KA_l_shank[34] = -0.4305*t80;
+    w.KA_l_shank[35] = 0.09983341664682815*w.sq_l_ankle_link*t77 + 0.9950041652780258*w.cq_l_ankle_link*t77;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_14(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
@@ -7124,7 +7257,7 @@ PROXGEN_RT_NOINLINE void pv_14(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_15(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
     w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
@@ -7306,7 +7439,7 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_16(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
@@ -7426,7 +7559,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_17(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
@@ -7615,7 +7748,7 @@ PROXGEN_RT_NOINLINE void pv_17(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_18(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_pelvis[0]);
@@ -7915,7 +8048,7 @@ PROXGEN_RT_NOINLINE void pv_18(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_19(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
@@ -7957,69 +8090,74 @@ PROXGEN_RT_NOINLINE void pv_19(Workspace& w) noexcept {
     const Scalar t27 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
     const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
     const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t30 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t31 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t30 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.a_l_hip_yaw_link[0] = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    w.a_l_hip_yaw_link[1] = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
+    w.a_l_hip_yaw_link[0] = t28;
+    w.a_l_hip_yaw_link[1] = t29;
     w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    w.a_l_hip_yaw_link[4] = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_l_hip_yaw_link*t31;
-  }
-  // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t32 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t33 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t34 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t35 = w.u_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t32 - w.IA_l_hip_roll_link[12]*t33 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t34;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[2] = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.Dinv_l_hip_roll_link*t35;
-    w.a_l_hip_roll_link[4] = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    w.a_l_hip_roll_link[5] = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-  }
-  // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t36 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t37 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t38 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t39 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t40 = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
-    const Scalar t41 = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    const Scalar t42 = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
-    const Scalar t43 = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
-    const Scalar t44 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t40 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t41 - w.IA_l_thigh[16]*t42 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t43;
-    w.a_l_thigh[0] = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    w.a_l_thigh[3] = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.Dinv_l_thigh*t44;
-    w.a_l_thigh[5] = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
-  }
-  // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t45 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t46 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t47 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t48 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t49 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t45;
-    const Scalar t50 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t45;
-    const Scalar t51 = w.c_l_shank[0] + w.cq_l_shank*t49 - w.sq_l_shank*t50;
-    const Scalar t52 = w.c_l_shank[2] + w.sq_l_shank*t49 + w.cq_l_shank*t50;
-    const Scalar t53 = w.c_l_shank[3] + w.cq_l_shank*t47 - w.sq_l_shank*t48;
-    const Scalar t54 = w.c_l_shank[5] + w.sq_l_shank*t47 + w.cq_l_shank*t48;
-    const Scalar t55 = w.u_l_shank[0] - w.IA_l_shank[4]*t51 - w.IA_l_shank[9]*t46 - w.IA_l_shank[13]*t52 - w.IA_l_shank[16]*t53 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t54;
-    w.a_l_shank[0] = w.c_l_shank[0] + w.cq_l_shank*t49 - w.sq_l_shank*t50;
-    w.a_l_shank[1] = t46;
-    w.a_l_shank[2] = w.c_l_shank[2] + w.sq_l_shank*t49 + w.cq_l_shank*t50;
-    w.a_l_shank[3] = w.c_l_shank[3] + w.cq_l_shank*t47 - w.sq_l_shank*t48;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.Dinv_l_shank*t55;
-    w.a_l_shank[5] = w.c_l_shank[5] + w.sq_l_shank*t47 + w.cq_l_shank*t48;
+    w.a_l_hip_yaw_link[3] = t30;
+    w.a_l_hip_yaw_link[4] = t31;
+    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_l_hip_yaw_link*t32;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_20(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  {
+    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
+    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
+    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
+    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
+    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
+    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
+    w.a_l_hip_roll_link[1] = t0;
+    w.a_l_hip_roll_link[2] = t1;
+    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.Dinv_l_hip_roll_link*t4;
+    w.a_l_hip_roll_link[4] = t2;
+    w.a_l_hip_roll_link[5] = t3;
+  }
+  // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  {
+    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
+    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
+    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
+    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
+    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
+    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
+    w.a_l_thigh[0] = t9;
+    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
+    w.a_l_thigh[2] = t10;
+    w.a_l_thigh[3] = t11;
+    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.Dinv_l_thigh*t13;
+    w.a_l_thigh[5] = t12;
+  }
+  // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  {
+    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
+    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
+    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
+    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
+    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
+    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
+    w.a_l_shank[0] = t20;
+    w.a_l_shank[1] = t15;
+    w.a_l_shank[2] = t21;
+    w.a_l_shank[3] = t22;
+    w.a_l_shank[4] = w.a_l_thigh[4] + w.Dinv_l_shank*t24;
+    w.a_l_shank[5] = t23;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
@@ -8030,98 +8168,108 @@ PROXGEN_RT_NOINLINE void pv_20(Workspace& w) noexcept {
     const Scalar t5 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
     const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
     const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t8 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t9 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t8;
-    w.a_l_ankle_link[0] = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
+    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
+    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
+    w.a_l_ankle_link[0] = t6;
     w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    w.a_l_ankle_link[3] = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
-    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.Dinv_l_ankle_link*t9;
-    w.a_l_ankle_link[5] = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    w.a_l_ankle_link[2] = t7;
+    w.a_l_ankle_link[3] = t8;
+    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.Dinv_l_ankle_link*t10;
+    w.a_l_ankle_link[5] = t9;
   }
   // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    const Scalar t10 = -0.027912499999999996*w.c_l_foot[1] - 0.0017863999999999998*w.c_l_foot[5] + w.u_l_foot[0] - 0.00194517348958*w.a_l_ankle_link[3] + 0.0017863999999999998*w.sq_l_foot*w.a_l_ankle_link[4] - 0.0017863999999999998*w.cq_l_foot*w.a_l_ankle_link[5] - 0.027912499999999996*w.cq_l_foot*w.a_l_ankle_link[1] - 0.027912499999999996*w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t15 = w.u_l_foot[0] - 0.00194517348958*w.a_l_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    w.a_l_foot[2] = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.Dinv_l_foot*t10;
-    w.a_l_foot[4] = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    w.a_l_foot[5] = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    w.a_l_foot[1] = t11;
+    w.a_l_foot[2] = t12;
+    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.Dinv_l_foot*t15;
+    w.a_l_foot[4] = t13;
+    w.a_l_foot[5] = t14;
   }
   // free acceleration (lambda = 0): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t11 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t12 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t13 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t14 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t15 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t11;
-    const Scalar t16 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t11;
-    const Scalar t17 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t15 + w.sq_r_hip_yaw_link*t16;
-    const Scalar t18 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t15 + w.cq_r_hip_yaw_link*t16;
-    const Scalar t19 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t13 + w.cq_r_hip_yaw_link*t14;
-    const Scalar t20 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t17 - w.IA_r_hip_yaw_link[10]*t18 - w.IA_r_hip_yaw_link[14]*t12 - w.IA_r_hip_yaw_link[19]*t19 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.a_r_hip_yaw_link[0] = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t15 + w.sq_r_hip_yaw_link*t16;
-    w.a_r_hip_yaw_link[1] = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t15 + w.cq_r_hip_yaw_link*t16;
-    w.a_r_hip_yaw_link[2] = t12;
-    w.a_r_hip_yaw_link[3] = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t13 + w.sq_r_hip_yaw_link*t14;
-    w.a_r_hip_yaw_link[4] = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t13 + w.cq_r_hip_yaw_link*t14;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_r_hip_yaw_link*t20;
-  }
-  // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t21 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t22 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t23 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t24 = w.u_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t21 - w.IA_r_hip_roll_link[12]*t22 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t23;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[2] = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.Dinv_r_hip_roll_link*t24;
-    w.a_r_hip_roll_link[4] = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    w.a_r_hip_roll_link[5] = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-  }
-  // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t25 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t26 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t27 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t28 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t29 = w.c_r_thigh[0] + w.cq_r_thigh*t27 - w.sq_r_thigh*t28;
-    const Scalar t30 = w.c_r_thigh[2] + w.sq_r_thigh*t27 + w.cq_r_thigh*t28;
-    const Scalar t31 = w.c_r_thigh[3] + w.cq_r_thigh*t25 - w.sq_r_thigh*t26;
-    const Scalar t32 = w.c_r_thigh[5] + w.sq_r_thigh*t25 + w.cq_r_thigh*t26;
-    const Scalar t33 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t29 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t30 - w.IA_r_thigh[16]*t31 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t32;
-    w.a_r_thigh[0] = w.c_r_thigh[0] + w.cq_r_thigh*t27 - w.sq_r_thigh*t28;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = w.c_r_thigh[2] + w.sq_r_thigh*t27 + w.cq_r_thigh*t28;
-    w.a_r_thigh[3] = w.c_r_thigh[3] + w.cq_r_thigh*t25 - w.sq_r_thigh*t26;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.Dinv_r_thigh*t33;
-    w.a_r_thigh[5] = w.c_r_thigh[5] + w.sq_r_thigh*t25 + w.cq_r_thigh*t26;
-  }
-  // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t34 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t35 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t36 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t37 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t38 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t34;
-    const Scalar t39 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t34;
-    const Scalar t40 = w.c_r_shank[0] + w.cq_r_shank*t38 - w.sq_r_shank*t39;
-    const Scalar t41 = w.c_r_shank[2] + w.sq_r_shank*t38 + w.cq_r_shank*t39;
-    const Scalar t42 = w.c_r_shank[3] + w.cq_r_shank*t36 - w.sq_r_shank*t37;
-    const Scalar t43 = w.c_r_shank[5] + w.sq_r_shank*t36 + w.cq_r_shank*t37;
-    const Scalar t44 = w.u_r_shank[0] - w.IA_r_shank[4]*t40 - w.IA_r_shank[9]*t35 - w.IA_r_shank[13]*t41 - w.IA_r_shank[16]*t42 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t43;
-    w.a_r_shank[0] = w.c_r_shank[0] + w.cq_r_shank*t38 - w.sq_r_shank*t39;
-    w.a_r_shank[1] = t35;
-    w.a_r_shank[2] = w.c_r_shank[2] + w.sq_r_shank*t38 + w.cq_r_shank*t39;
-    w.a_r_shank[3] = w.c_r_shank[3] + w.cq_r_shank*t36 - w.sq_r_shank*t37;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.Dinv_r_shank*t44;
-    w.a_r_shank[5] = w.c_r_shank[5] + w.sq_r_shank*t36 + w.cq_r_shank*t37;
+    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
+    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
+    const Scalar t18 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t19 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t20 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
+    const Scalar t21 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
+    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    w.a_r_hip_yaw_link[0] = t22;
+    w.a_r_hip_yaw_link[1] = t23;
+    w.a_r_hip_yaw_link[2] = t17;
+    w.a_r_hip_yaw_link[3] = t24;
+    w.a_r_hip_yaw_link[4] = t25;
+    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_r_hip_yaw_link*t26;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_21(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  {
+    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
+    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
+    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
+    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
+    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
+    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
+    w.a_r_hip_roll_link[1] = t0;
+    w.a_r_hip_roll_link[2] = t1;
+    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.Dinv_r_hip_roll_link*t4;
+    w.a_r_hip_roll_link[4] = t2;
+    w.a_r_hip_roll_link[5] = t3;
+  }
+  // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  {
+    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
+    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
+    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
+    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
+    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
+    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
+    w.a_r_thigh[0] = t9;
+    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
+    w.a_r_thigh[2] = t10;
+    w.a_r_thigh[3] = t11;
+    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.Dinv_r_thigh*t13;
+    w.a_r_thigh[5] = t12;
+  }
+  // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  {
+    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
+    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
+    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
+    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
+    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
+    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
+    w.a_r_shank[0] = t20;
+    w.a_r_shank[1] = t15;
+    w.a_r_shank[2] = t21;
+    w.a_r_shank[3] = t22;
+    w.a_r_shank[4] = w.a_r_thigh[4] + w.Dinv_r_shank*t24;
+    w.a_r_shank[5] = t23;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
@@ -8132,164 +8280,185 @@ PROXGEN_RT_NOINLINE void pv_21(Workspace& w) noexcept {
     const Scalar t5 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
     const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
     const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t8 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t9 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t8;
-    w.a_r_ankle_link[0] = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
+    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
+    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
+    w.a_r_ankle_link[0] = t6;
     w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    w.a_r_ankle_link[3] = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.Dinv_r_ankle_link*t9;
-    w.a_r_ankle_link[5] = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    w.a_r_ankle_link[2] = t7;
+    w.a_r_ankle_link[3] = t8;
+    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.Dinv_r_ankle_link*t10;
+    w.a_r_ankle_link[5] = t9;
   }
   // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    const Scalar t10 = -0.027912499999999996*w.c_r_foot[1] - 0.0017863999999999998*w.c_r_foot[5] + w.u_r_foot[0] - 0.00194517348958*w.a_r_ankle_link[3] + 0.0017863999999999998*w.sq_r_foot*w.a_r_ankle_link[4] - 0.0017863999999999998*w.cq_r_foot*w.a_r_ankle_link[5] - 0.027912499999999996*w.cq_r_foot*w.a_r_ankle_link[1] - 0.027912499999999996*w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t15 = w.u_r_foot[0] - 0.00194517348958*w.a_r_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
     w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[2] = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.Dinv_r_foot*t10;
-    w.a_r_foot[4] = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    w.a_r_foot[5] = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    w.a_r_foot[1] = t11;
+    w.a_r_foot[2] = t12;
+    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.Dinv_r_foot*t15;
+    w.a_r_foot[4] = t13;
+    w.a_r_foot[5] = t14;
   }
   // free acceleration (lambda = 0): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t11 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t12 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t13 = w.c_abdomen[0] + w.cq_abdomen*t11 + w.sq_abdomen*t12;
-    const Scalar t14 = w.c_abdomen[1] - w.sq_abdomen*t11 + w.cq_abdomen*t12;
-    const Scalar t15 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t16 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t17 = w.u_abdomen[0] - w.IA_abdomen[5]*t13 - w.IA_abdomen[10]*t14 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t15 - w.IA_abdomen[19]*t16 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.a_abdomen[0] = w.c_abdomen[0] + w.cq_abdomen*t11 + w.sq_abdomen*t12;
-    w.a_abdomen[1] = w.c_abdomen[1] - w.sq_abdomen*t11 + w.cq_abdomen*t12;
+    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.a_abdomen[0] = t18;
+    w.a_abdomen[1] = t19;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    w.a_abdomen[4] = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    w.a_abdomen[5] = w.a_pelvis[5] + w.Dinv_abdomen*t17;
-  }
-  // free acceleration (lambda = 0): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  {
-    const Scalar t18 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t19 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t20 = w.c_chest[0] + w.cq_chest*t18 - w.sq_chest*w.a_abdomen[2];
-    const Scalar t21 = w.c_chest[2] + w.sq_chest*t18 + w.cq_chest*w.a_abdomen[2];
-    const Scalar t22 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    const Scalar t23 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-    const Scalar t24 = w.u_chest[0] - w.IA_chest[4]*t20 - w.IA_chest[9]*t19 - w.IA_chest[13]*t21 - w.IA_chest[16]*t22 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t23;
-    w.a_chest[0] = w.c_chest[0] + w.cq_chest*t18 - w.sq_chest*w.a_abdomen[2];
-    w.a_chest[1] = t19;
-    w.a_chest[2] = w.c_chest[2] + w.sq_chest*t18 + w.cq_chest*w.a_abdomen[2];
-    w.a_chest[3] = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    w.a_chest[4] = w.a_abdomen[4] + w.Dinv_chest*t24;
-    w.a_chest[5] = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-  }
-  // free acceleration (lambda = 0): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    const Scalar t25 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t26 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t27 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t28 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t29 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t30 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t31 = 0.9848134698792882*t25 + 0.17361575258114187*t27;
-    const Scalar t32 = 0.04493516596384369*t25 + 0.9659256678396477*t26 - 0.2548890642384102*t27;
-    const Scalar t33 = -0.1676999117594225*t25 + 0.2588196364430848*t26 + 0.9512566085906322*t27;
-    const Scalar t34 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t31 - w.sq_r_shoulder_pitch_link*t33;
-    const Scalar t35 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t31 + w.cq_r_shoulder_pitch_link*t33;
-    const Scalar t36 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t28 + w.cq_r_shoulder_pitch_link*t30;
-    const Scalar t37 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t34 - w.IA_r_shoulder_pitch_link[9]*t32 - w.IA_r_shoulder_pitch_link[13]*t35 - w.IA_r_shoulder_pitch_link[18]*t29 - w.IA_r_shoulder_pitch_link[19]*t36;
-    w.a_r_shoulder_pitch_link[0] = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t31 - w.sq_r_shoulder_pitch_link*t33;
-    w.a_r_shoulder_pitch_link[1] = t32;
-    w.a_r_shoulder_pitch_link[2] = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t31 + w.cq_r_shoulder_pitch_link*t33;
-    w.a_r_shoulder_pitch_link[3] = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t28 - w.sq_r_shoulder_pitch_link*t30;
-    w.a_r_shoulder_pitch_link[4] = t29 + w.Dinv_r_shoulder_pitch_link*t37;
-    w.a_r_shoulder_pitch_link[5] = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t28 + w.cq_r_shoulder_pitch_link*t30;
-  }
-  // free acceleration (lambda = 0): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t38 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t39 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t40 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t41 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t38 - w.IA_r_shoulder_roll_link[12]*t39 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t40;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    w.a_r_shoulder_roll_link[2] = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.Dinv_r_shoulder_roll_link*t41;
-    w.a_r_shoulder_roll_link[4] = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    w.a_r_shoulder_roll_link[5] = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-  }
-  // free acceleration (lambda = 0): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  {
-    const Scalar t42 = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t43 = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t44 = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t45 = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t46 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t42 - w.IA_r_upper_arm[10]*t43 - w.IA_r_upper_arm[14]*w.a_r_shoulder_roll_link[2] - w.IA_r_upper_arm[17]*t44 - w.IA_r_upper_arm[19]*t45 - w.IA_r_upper_arm[20]*w.a_r_shoulder_roll_link[5];
-    w.a_r_upper_arm[0] = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    w.a_r_upper_arm[1] = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    w.a_r_upper_arm[4] = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.Dinv_r_upper_arm*t46;
+    w.a_abdomen[3] = t20;
+    w.a_abdomen[4] = t21;
+    w.a_abdomen[5] = w.a_pelvis[5] + w.Dinv_abdomen*t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_22(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
+  {
+    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
+    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
+    w.a_chest[0] = t2;
+    w.a_chest[1] = t1;
+    w.a_chest[2] = t3;
+    w.a_chest[3] = t4;
+    w.a_chest[4] = w.a_abdomen[4] + w.Dinv_chest*t6;
+    w.a_chest[5] = t5;
+  }
+  // free acceleration (lambda = 0): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+  {
+    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t10 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t11 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t12 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t13 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
+    const Scalar t14 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
+    const Scalar t15 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
+    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t14 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t11 - w.IA_r_shoulder_pitch_link[19]*t19;
+    w.a_r_shoulder_pitch_link[0] = t16;
+    w.a_r_shoulder_pitch_link[1] = t14;
+    w.a_r_shoulder_pitch_link[2] = t17;
+    w.a_r_shoulder_pitch_link[3] = t18;
+    w.a_r_shoulder_pitch_link[4] = t11 + w.Dinv_r_shoulder_pitch_link*t20;
+    w.a_r_shoulder_pitch_link[5] = t19;
+  }
+  // free acceleration (lambda = 0): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+  {
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
+    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
+    w.a_r_shoulder_roll_link[1] = t21;
+    w.a_r_shoulder_roll_link[2] = t22;
+    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.Dinv_r_shoulder_roll_link*t25;
+    w.a_r_shoulder_roll_link[4] = t23;
+    w.a_r_shoulder_roll_link[5] = t24;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
+  {
+    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
+    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
+    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
+    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    w.a_r_upper_arm[0] = t0;
+    w.a_r_upper_arm[1] = t1;
+    w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
+    w.a_r_upper_arm[3] = t2;
+    w.a_r_upper_arm[4] = t3;
+    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.Dinv_r_upper_arm*t4;
+  }
   // free acceleration (lambda = 0): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    const Scalar t0 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t1 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t2 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t3 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t4 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t0;
-    const Scalar t5 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t0;
-    const Scalar t6 = w.c_r_forearm[0] + w.cq_r_forearm*t4 - w.sq_r_forearm*t5;
-    const Scalar t7 = w.c_r_forearm[2] + w.sq_r_forearm*t4 + w.cq_r_forearm*t5;
-    const Scalar t8 = w.c_r_forearm[3] + w.cq_r_forearm*t2 - w.sq_r_forearm*t3;
-    const Scalar t9 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t6 - w.IA_r_forearm[9]*t1 - w.IA_r_forearm[13]*t7 - w.IA_r_forearm[16]*t8 - w.a_r_upper_arm[4]*w.IA_r_forearm[18];
-    w.a_r_forearm[0] = w.c_r_forearm[0] + w.cq_r_forearm*t4 - w.sq_r_forearm*t5;
-    w.a_r_forearm[1] = t1;
-    w.a_r_forearm[2] = w.c_r_forearm[2] + w.sq_r_forearm*t4 + w.cq_r_forearm*t5;
-    w.a_r_forearm[3] = w.c_r_forearm[3] + w.cq_r_forearm*t2 - w.sq_r_forearm*t3;
-    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.Dinv_r_forearm*t9;
-    w.a_r_forearm[5] = w.c_r_forearm[5] + w.sq_r_forearm*t2 + w.cq_r_forearm*t3;
+    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t7 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t8 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t9 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
+    const Scalar t10 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
+    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
+    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
+    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
+    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    w.a_r_forearm[0] = t11;
+    w.a_r_forearm[1] = t6;
+    w.a_r_forearm[2] = t12;
+    w.a_r_forearm[3] = t13;
+    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.Dinv_r_forearm*t15;
+    w.a_r_forearm[5] = t14;
   }
   // free acceleration (lambda = 0): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    const Scalar t10 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t11 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t12 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t10 + w.sq_r_wrist_yaw_link*t11;
-    const Scalar t13 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t10 + w.cq_r_wrist_yaw_link*t11;
-    const Scalar t14 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t15 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t12 - w.IA_r_wrist_yaw_link[10]*t13 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t14 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.a_r_wrist_yaw_link[0] = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t10 + w.sq_r_wrist_yaw_link*t11;
-    w.a_r_wrist_yaw_link[1] = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t10 + w.cq_r_wrist_yaw_link*t11;
+    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    w.a_r_wrist_yaw_link[0] = t18;
+    w.a_r_wrist_yaw_link[1] = t19;
     w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    w.a_r_wrist_yaw_link[4] = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.Dinv_r_wrist_yaw_link*t15;
+    w.a_r_wrist_yaw_link[3] = t20;
+    w.a_r_wrist_yaw_link[4] = t21;
+    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.Dinv_r_wrist_yaw_link*t22;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t16 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t17 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t18 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t16 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t17;
-    w.a_r_wrist_pitch_link[0] = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
+    w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    w.a_r_wrist_pitch_link[3] = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.Dinv_r_wrist_pitch_link*t18;
-    w.a_r_wrist_pitch_link[5] = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[2] = t1;
+    w.a_r_wrist_pitch_link[3] = t2;
+    w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.Dinv_r_wrist_pitch_link*t4;
+    w.a_r_wrist_pitch_link[5] = t3;
   }
   // free acceleration (lambda = 0): body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t19 = -0.04016628*w.c_r_hand[1] + w.u_r_hand[0] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*w.cq_r_hand*w.a_r_wrist_pitch_link[1] - 0.04016628*w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t9 = w.u_r_hand[0] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.a_r_hand[2] = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.Dinv_r_hand*t19;
-    w.a_r_hand[4] = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    w.a_r_hand[5] = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    w.a_r_hand[1] = t5;
+    w.a_r_hand[2] = t6;
+    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.Dinv_r_hand*t9;
+    w.a_r_hand[4] = t7;
+    w.a_r_hand[5] = t8;
   }
   // free row accelerations y_free = K a - k (tree order)
   {
@@ -8311,7 +8480,7 @@ PROXGEN_RT_NOINLINE void pv_22(Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_23(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_29(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = inv_mu + w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[5] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[3] + w.KSD_l_thigh[0]*w.KA_l_thigh[4] + w.KSD_l_shank[0]*w.KA_l_shank[4] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[4];
@@ -8368,169 +8537,172 @@ PROXGEN_RT_NOINLINE void pv_23(Scalar inv_mu, Workspace& w) noexcept {
     const Scalar t17 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[23] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[5]*w.KA_l_thigh[22] + w.KSD_l_shank[5]*w.KA_l_shank[22] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[22] - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
     w.L[44] = w.Linv[3]*t17;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_30(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t18 = inv_mu + w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[29] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[27] + w.KSD_l_thigh[4]*w.KA_l_thigh[28] + w.KSD_l_shank[4]*w.KA_l_shank[28] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[28] - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
-    const Scalar r4 = std::sqrt(t18);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[4] = inv4;
-    const Scalar t19 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[29] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[27] + w.KSD_l_thigh[5]*w.KA_l_thigh[28] + w.KSD_l_shank[5]*w.KA_l_shank[28] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[28] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
-    w.L[55] = w.Linv[4]*t19;
+    const Scalar t0 = inv_mu + w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[29] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[27] + w.KSD_l_thigh[4]*w.KA_l_thigh[28] + w.KSD_l_shank[4]*w.KA_l_shank[28] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[28] - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[4] = inv0;
+    const Scalar t1 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[29] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[27] + w.KSD_l_thigh[5]*w.KA_l_thigh[28] + w.KSD_l_shank[5]*w.KA_l_shank[28] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[28] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
+    w.L[55] = w.Linv[4]*t1;
   }
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t20 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[33] + w.KSD_l_thigh[5]*w.KA_l_thigh[34] + w.KSD_l_shank[5]*w.KA_l_shank[34] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[34] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
-    const Scalar r5 = std::sqrt(t20);
-    const Scalar inv5 = 1.0 / r5;
-    w.Linv[5] = inv5;
+    const Scalar t2 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[33] + w.KSD_l_thigh[5]*w.KA_l_thigh[34] + w.KSD_l_shank[5]*w.KA_l_shank[34] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[34] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
+    const Scalar r1 = std::sqrt(t2);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[5] = inv1;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t21 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[0]*w.KA_r_thigh[4] + w.KSD_r_shank[0]*w.KA_r_shank[4] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4];
-    const Scalar r6 = std::sqrt(t21);
-    const Scalar inv6 = 1.0 / r6;
-    w.Linv[6] = inv6;
-    const Scalar t22 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[1]*w.KA_r_thigh[4] + w.KSD_r_shank[1]*w.KA_r_shank[4] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4];
-    w.L[76] = w.Linv[6]*t22;
-    const Scalar t23 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[2]*w.KA_r_thigh[4] + w.KSD_r_shank[2]*w.KA_r_shank[4];
-    w.L[77] = w.Linv[6]*t23;
-    const Scalar t24 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4] + w.KSD_r_shank[3]*w.KA_r_shank[4] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4];
-    w.L[78] = w.Linv[6]*t24;
-    const Scalar t25 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4] + w.KSD_r_shank[4]*w.KA_r_shank[4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4];
-    w.L[79] = w.Linv[6]*t25;
-    const Scalar t26 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4] + w.KSD_r_shank[5]*w.KA_r_shank[4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4];
-    w.L[80] = w.Linv[6]*t26;
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[0]*w.KA_r_thigh[4] + w.KSD_r_shank[0]*w.KA_r_shank[4] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4];
+    const Scalar r2 = std::sqrt(t3);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[6] = inv2;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[1]*w.KA_r_thigh[4] + w.KSD_r_shank[1]*w.KA_r_shank[4] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4];
+    w.L[76] = w.Linv[6]*t4;
+    const Scalar t5 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[2]*w.KA_r_thigh[4] + w.KSD_r_shank[2]*w.KA_r_shank[4];
+    w.L[77] = w.Linv[6]*t5;
+    const Scalar t6 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4] + w.KSD_r_shank[3]*w.KA_r_shank[4] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4];
+    w.L[78] = w.Linv[6]*t6;
+    const Scalar t7 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4] + w.KSD_r_shank[4]*w.KA_r_shank[4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4];
+    w.L[79] = w.Linv[6]*t7;
+    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4] + w.KSD_r_shank[5]*w.KA_r_shank[4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4];
+    w.L[80] = w.Linv[6]*t8;
   }
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t27 = 0.06825*w.KSD_r_foot[1] + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[1]*w.KA_r_thigh[10] + w.KSD_r_shank[1]*w.KA_r_shank[10] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[10] - w.L[76]*w.L[76];
-    const Scalar r7 = std::sqrt(t27);
-    const Scalar inv7 = 1.0 / r7;
-    w.Linv[7] = inv7;
-    const Scalar t28 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[2]*w.KA_r_thigh[10] + w.KSD_r_shank[2]*w.KA_r_shank[10] - w.L[76]*w.L[77];
-    w.L[85] = w.Linv[7]*t28;
-    const Scalar t29 = 0.06825*w.Dinv_r_foot + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[3]*w.KA_r_thigh[10] + w.KSD_r_shank[3]*w.KA_r_shank[10] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[10] - w.L[76]*w.L[78];
-    w.L[86] = w.Linv[7]*t29;
-    const Scalar t30 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[4]*w.KA_r_thigh[10] + w.KSD_r_shank[4]*w.KA_r_shank[10] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[10] - w.L[76]*w.L[79];
-    w.L[87] = w.Linv[7]*t30;
-    const Scalar t31 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[5]*w.KA_r_thigh[10] + w.KSD_r_shank[5]*w.KA_r_shank[10] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[10] - w.L[76]*w.L[80];
-    w.L[88] = w.Linv[7]*t31;
+    const Scalar t9 = 0.06825*w.KSD_r_foot[1] + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[1]*w.KA_r_thigh[10] + w.KSD_r_shank[1]*w.KA_r_shank[10] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[10] - w.L[76]*w.L[76];
+    const Scalar r3 = std::sqrt(t9);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[7] = inv3;
+    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[2]*w.KA_r_thigh[10] + w.KSD_r_shank[2]*w.KA_r_shank[10] - w.L[76]*w.L[77];
+    w.L[85] = w.Linv[7]*t10;
+    const Scalar t11 = 0.06825*w.Dinv_r_foot + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[3]*w.KA_r_thigh[10] + w.KSD_r_shank[3]*w.KA_r_shank[10] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[10] - w.L[76]*w.L[78];
+    w.L[86] = w.Linv[7]*t11;
+    const Scalar t12 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[4]*w.KA_r_thigh[10] + w.KSD_r_shank[4]*w.KA_r_shank[10] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[10] - w.L[76]*w.L[79];
+    w.L[87] = w.Linv[7]*t12;
+    const Scalar t13 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[11] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[9] + w.KSD_r_thigh[5]*w.KA_r_thigh[10] + w.KSD_r_shank[5]*w.KA_r_shank[10] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[10] - w.L[76]*w.L[80];
+    w.L[88] = w.Linv[7]*t13;
+  }
+  // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t14 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[2]*w.KA_r_thigh[16] + w.KSD_r_shank[2]*w.KA_r_shank[16] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
+    const Scalar r4 = std::sqrt(t14);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[8] = inv4;
+    const Scalar t15 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[3]*w.KA_r_thigh[16] + w.KSD_r_shank[3]*w.KA_r_shank[16] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
+    w.L[93] = w.Linv[8]*t15;
+    const Scalar t16 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[4]*w.KA_r_thigh[16] + w.KSD_r_shank[4]*w.KA_r_shank[16] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
+    w.L[94] = w.Linv[8]*t16;
+    const Scalar t17 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[5]*w.KA_r_thigh[16] + w.KSD_r_shank[5]*w.KA_r_shank[16] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
+    w.L[95] = w.Linv[8]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& w) noexcept {
-  // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t0 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[2]*w.KA_r_thigh[16] + w.KSD_r_shank[2]*w.KA_r_shank[16] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
-    const Scalar r0 = std::sqrt(t0);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[8] = inv0;
-    const Scalar t1 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[3]*w.KA_r_thigh[16] + w.KSD_r_shank[3]*w.KA_r_shank[16] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
-    w.L[93] = w.Linv[8]*t1;
-    const Scalar t2 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[4]*w.KA_r_thigh[16] + w.KSD_r_shank[4]*w.KA_r_shank[16] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
-    w.L[94] = w.Linv[8]*t2;
-    const Scalar t3 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[17] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[15] + w.KSD_r_thigh[5]*w.KA_r_thigh[16] + w.KSD_r_shank[5]*w.KA_r_shank[16] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
-    w.L[95] = w.Linv[8]*t3;
-  }
+PROXGEN_RT_NOINLINE void pv_31(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t4 = w.Dinv_r_foot + inv_mu + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[3]*w.KA_r_thigh[22] + w.KSD_r_shank[3]*w.KA_r_shank[22] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[22] - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
-    const Scalar r1 = std::sqrt(t4);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[9] = inv1;
-    const Scalar t5 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[4]*w.KA_r_thigh[22] + w.KSD_r_shank[4]*w.KA_r_shank[22] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[22] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
-    w.L[100] = w.Linv[9]*t5;
-    const Scalar t6 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[5]*w.KA_r_thigh[22] + w.KSD_r_shank[5]*w.KA_r_shank[22] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[22] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
-    w.L[101] = w.Linv[9]*t6;
+    const Scalar t0 = w.Dinv_r_foot + inv_mu + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[3]*w.KA_r_thigh[22] + w.KSD_r_shank[3]*w.KA_r_shank[22] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[22] - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[9] = inv0;
+    const Scalar t1 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[4]*w.KA_r_thigh[22] + w.KSD_r_shank[4]*w.KA_r_shank[22] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[22] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
+    w.L[100] = w.Linv[9]*t1;
+    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[23] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[5]*w.KA_r_thigh[22] + w.KSD_r_shank[5]*w.KA_r_shank[22] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[22] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
+    w.L[101] = w.Linv[9]*t2;
   }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t7 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[29] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[27] + w.KSD_r_thigh[4]*w.KA_r_thigh[28] + w.KSD_r_shank[4]*w.KA_r_shank[28] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[28] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
-    const Scalar r2 = std::sqrt(t7);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[10] = inv2;
-    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[29] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[27] + w.KSD_r_thigh[5]*w.KA_r_thigh[28] + w.KSD_r_shank[5]*w.KA_r_shank[28] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[28] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
-    w.L[106] = w.Linv[10]*t8;
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[29] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[27] + w.KSD_r_thigh[4]*w.KA_r_thigh[28] + w.KSD_r_shank[4]*w.KA_r_shank[28] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[28] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
+    const Scalar r1 = std::sqrt(t3);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[10] = inv1;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[29] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[27] + w.KSD_r_thigh[5]*w.KA_r_thigh[28] + w.KSD_r_shank[5]*w.KA_r_shank[28] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[28] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
+    w.L[106] = w.Linv[10]*t4;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[33] + w.KSD_r_thigh[5]*w.KA_r_thigh[34] + w.KSD_r_shank[5]*w.KA_r_shank[34] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[34] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
-    const Scalar r3 = std::sqrt(t9);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[11] = inv3;
+    const Scalar t5 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[33] + w.KSD_r_thigh[5]*w.KA_r_thigh[34] + w.KSD_r_shank[5]*w.KA_r_shank[34] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[34] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
+    const Scalar r2 = std::sqrt(t5);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[11] = inv2;
   }
   // G + I/mu = L L^T, column 12 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t10 = 0.13*w.KSD_r_hand[0] + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5] + w.KSD_chest[0]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[0]*w.KA_r_forearm[4];
-    const Scalar r4 = std::sqrt(t10);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[12] = inv4;
-    const Scalar t11 = w.KSD_abdomen[1]*w.KA_abdomen[5] + w.KSD_chest[1]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[1]*w.KA_r_forearm[4];
-    w.L[115] = w.Linv[12]*t11;
-    const Scalar t12 = w.KSD_abdomen[2]*w.KA_abdomen[5] + w.KSD_chest[2]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[2]*w.KA_r_forearm[4];
-    w.L[116] = w.Linv[12]*t12;
+    const Scalar t6 = 0.13*w.KSD_r_hand[0] + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5] + w.KSD_chest[0]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[0]*w.KA_r_forearm[4];
+    const Scalar r3 = std::sqrt(t6);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[12] = inv3;
+    const Scalar t7 = w.KSD_abdomen[1]*w.KA_abdomen[5] + w.KSD_chest[1]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[1]*w.KA_r_forearm[4];
+    w.L[115] = w.Linv[12]*t7;
+    const Scalar t8 = w.KSD_abdomen[2]*w.KA_abdomen[5] + w.KSD_chest[2]*w.KA_chest[4] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5] + w.KSD_r_forearm[2]*w.KA_r_forearm[4];
+    w.L[116] = w.Linv[12]*t8;
   }
   // G + I/mu = L L^T, column 13 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t13 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[11] + w.KSD_chest[1]*w.KA_chest[10] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[10] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[9] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[11] + w.KSD_r_forearm[1]*w.KA_r_forearm[10] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[11] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[10] - w.L[115]*w.L[115];
-    const Scalar r5 = std::sqrt(t13);
-    const Scalar inv5 = 1.0 / r5;
-    w.Linv[13] = inv5;
-    const Scalar t14 = w.KSD_abdomen[2]*w.KA_abdomen[11] + w.KSD_chest[2]*w.KA_chest[10] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[10] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[9] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[11] + w.KSD_r_forearm[2]*w.KA_r_forearm[10] - w.L[115]*w.L[116];
-    w.L[118] = w.Linv[13]*t14;
+    const Scalar t9 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[11] + w.KSD_chest[1]*w.KA_chest[10] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[10] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[9] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[11] + w.KSD_r_forearm[1]*w.KA_r_forearm[10] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[11] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[10] - w.L[115]*w.L[115];
+    const Scalar r4 = std::sqrt(t9);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[13] = inv4;
+    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[11] + w.KSD_chest[2]*w.KA_chest[10] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[10] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[9] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[11] + w.KSD_r_forearm[2]*w.KA_r_forearm[10] - w.L[115]*w.L[116];
+    w.L[118] = w.Linv[13]*t10;
   }
   // G + I/mu = L L^T, column 14 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t15 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[17] + w.KSD_chest[2]*w.KA_chest[16] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[16] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[15] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[17] + w.KSD_r_forearm[2]*w.KA_r_forearm[16] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
-    const Scalar r6 = std::sqrt(t15);
-    const Scalar inv6 = 1.0 / r6;
-    w.Linv[14] = inv6;
+    const Scalar t11 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[17] + w.KSD_chest[2]*w.KA_chest[16] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[16] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[15] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[17] + w.KSD_r_forearm[2]*w.KA_r_forearm[16] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
+    const Scalar r5 = std::sqrt(t11);
+    const Scalar inv5 = 1.0 / r5;
+    w.Linv[14] = inv5;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t16 = w.Z_pelvis[0]*w.Linv[0];
-    const Scalar t17 = w.Z_pelvis[6] - w.L[1]*t16;
-    const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_pelvis[12] - w.L[2]*t16 - w.L[16]*t18;
-    const Scalar t20 = w.Linv[2]*t19;
-    const Scalar t21 = w.Z_pelvis[18] - w.L[3]*t16 - w.L[17]*t18 - w.L[30]*t20;
-    const Scalar t22 = w.Linv[3]*t21;
-    const Scalar t23 = w.Z_pelvis[24] - w.L[4]*t16 - w.L[18]*t18 - w.L[31]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Linv[4]*t23;
-    const Scalar t25 = w.Z_pelvis[30] - w.L[5]*t16 - w.L[19]*t18 - w.L[32]*t20 - w.L[44]*t22 - w.L[55]*t24;
-    const Scalar t26 = w.Z_pelvis[36]*w.Linv[6];
-    const Scalar t27 = w.Z_pelvis[42] - w.L[76]*t26;
-    const Scalar t28 = w.Linv[7]*t27;
-    const Scalar t29 = w.Z_pelvis[48] - w.L[77]*t26 - w.L[85]*t28;
-    const Scalar t30 = w.Linv[8]*t29;
-    const Scalar t31 = w.Z_pelvis[54] - w.L[78]*t26 - w.L[86]*t28 - w.L[93]*t30;
-    const Scalar t32 = w.Linv[9]*t31;
-    const Scalar t33 = w.Z_pelvis[60] - w.L[79]*t26 - w.L[87]*t28 - w.L[94]*t30 - w.L[100]*t32;
-    const Scalar t34 = w.Linv[10]*t33;
-    const Scalar t35 = w.Z_pelvis[66] - w.L[80]*t26 - w.L[88]*t28 - w.L[95]*t30 - w.L[101]*t32 - w.L[106]*t34;
-    const Scalar t36 = w.Z_pelvis[72]*w.Linv[12];
-    const Scalar t37 = w.Z_pelvis[78] - w.L[115]*t36;
-    const Scalar t38 = w.Linv[13]*t37;
-    const Scalar t39 = w.Z_pelvis[84] - w.L[116]*t36 - w.L[118]*t38;
+    const Scalar t12 = w.Z_pelvis[0]*w.Linv[0];
+    const Scalar t13 = w.Z_pelvis[6] - w.L[1]*t12;
+    const Scalar t14 = w.Linv[1]*t13;
+    const Scalar t15 = w.Z_pelvis[12] - w.L[2]*t12 - w.L[16]*t14;
+    const Scalar t16 = w.Linv[2]*t15;
+    const Scalar t17 = w.Z_pelvis[18] - w.L[3]*t12 - w.L[17]*t14 - w.L[30]*t16;
+    const Scalar t18 = w.Linv[3]*t17;
+    const Scalar t19 = w.Z_pelvis[24] - w.L[4]*t12 - w.L[18]*t14 - w.L[31]*t16 - w.L[43]*t18;
+    const Scalar t20 = w.Linv[4]*t19;
+    const Scalar t21 = w.Z_pelvis[30] - w.L[5]*t12 - w.L[19]*t14 - w.L[32]*t16 - w.L[44]*t18 - w.L[55]*t20;
+    const Scalar t22 = w.Z_pelvis[36]*w.Linv[6];
+    const Scalar t23 = w.Z_pelvis[42] - w.L[76]*t22;
+    const Scalar t24 = w.Linv[7]*t23;
+    const Scalar t25 = w.Z_pelvis[48] - w.L[77]*t22 - w.L[85]*t24;
+    const Scalar t26 = w.Linv[8]*t25;
+    const Scalar t27 = w.Z_pelvis[54] - w.L[78]*t22 - w.L[86]*t24 - w.L[93]*t26;
+    const Scalar t28 = w.Linv[9]*t27;
+    const Scalar t29 = w.Z_pelvis[60] - w.L[79]*t22 - w.L[87]*t24 - w.L[94]*t26 - w.L[100]*t28;
+    const Scalar t30 = w.Linv[10]*t29;
+    const Scalar t31 = w.Z_pelvis[66] - w.L[80]*t22 - w.L[88]*t24 - w.L[95]*t26 - w.L[101]*t28 - w.L[106]*t30;
+    const Scalar t32 = w.Z_pelvis[72]*w.Linv[12];
+    const Scalar t33 = w.Z_pelvis[78] - w.L[115]*t32;
+    const Scalar t34 = w.Linv[13]*t33;
+    const Scalar t35 = w.Z_pelvis[84] - w.L[116]*t32 - w.L[118]*t34;
     w.W[0] = w.Z_pelvis[0]*w.Linv[0];
-    w.W[6] = w.Linv[1]*t17;
-    w.W[12] = w.Linv[2]*t19;
-    w.W[18] = w.Linv[3]*t21;
-    w.W[24] = w.Linv[4]*t23;
-    w.W[30] = w.Linv[5]*t25;
+    w.W[6] = w.Linv[1]*t13;
+    w.W[12] = w.Linv[2]*t15;
+    w.W[18] = w.Linv[3]*t17;
+    w.W[24] = w.Linv[4]*t19;
+    w.W[30] = w.Linv[5]*t21;
     w.W[36] = w.Z_pelvis[36]*w.Linv[6];
-    w.W[42] = w.Linv[7]*t27;
-    w.W[48] = w.Linv[8]*t29;
-    w.W[54] = w.Linv[9]*t31;
-    w.W[60] = w.Linv[10]*t33;
-    w.W[66] = w.Linv[11]*t35;
+    w.W[42] = w.Linv[7]*t23;
+    w.W[48] = w.Linv[8]*t25;
+    w.W[54] = w.Linv[9]*t27;
+    w.W[60] = w.Linv[10]*t29;
+    w.W[66] = w.Linv[11]*t31;
     w.W[72] = w.Z_pelvis[72]*w.Linv[12];
-    w.W[78] = w.Linv[13]*t37;
-    w.W[84] = w.Linv[14]*t39;
+    w.W[78] = w.Linv[13]*t33;
+    w.W[84] = w.Linv[14]*t35;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_25(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_32(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
     const Scalar t0 = w.Z_pelvis[1]*w.Linv[0];
@@ -8615,195 +8787,198 @@ PROXGEN_RT_NOINLINE void pv_25(Workspace& w) noexcept {
     w.W[80] = w.Linv[13]*t45;
     w.W[86] = w.Linv[14]*t47;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_33(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t48 = w.Z_pelvis[3]*w.Linv[0];
-    const Scalar t49 = w.Z_pelvis[9] - w.L[1]*t48;
-    const Scalar t50 = w.Linv[1]*t49;
-    const Scalar t51 = w.Z_pelvis[15] - w.L[2]*t48 - w.L[16]*t50;
-    const Scalar t52 = w.Linv[2]*t51;
-    const Scalar t53 = w.Z_pelvis[21] - w.L[3]*t48 - w.L[17]*t50 - w.L[30]*t52;
-    const Scalar t54 = w.Linv[3]*t53;
-    const Scalar t55 = w.Z_pelvis[27] - w.L[4]*t48 - w.L[18]*t50 - w.L[31]*t52 - w.L[43]*t54;
-    const Scalar t56 = w.Linv[4]*t55;
-    const Scalar t57 = w.Z_pelvis[33] - w.L[5]*t48 - w.L[19]*t50 - w.L[32]*t52 - w.L[44]*t54 - w.L[55]*t56;
-    const Scalar t58 = w.Z_pelvis[39]*w.Linv[6];
-    const Scalar t59 = w.Z_pelvis[45] - w.L[76]*t58;
-    const Scalar t60 = w.Linv[7]*t59;
-    const Scalar t61 = w.Z_pelvis[51] - w.L[77]*t58 - w.L[85]*t60;
-    const Scalar t62 = w.Linv[8]*t61;
-    const Scalar t63 = w.Z_pelvis[57] - w.L[78]*t58 - w.L[86]*t60 - w.L[93]*t62;
-    const Scalar t64 = w.Linv[9]*t63;
-    const Scalar t65 = w.Z_pelvis[63] - w.L[79]*t58 - w.L[87]*t60 - w.L[94]*t62 - w.L[100]*t64;
-    const Scalar t66 = w.Linv[10]*t65;
-    const Scalar t67 = w.Z_pelvis[69] - w.L[80]*t58 - w.L[88]*t60 - w.L[95]*t62 - w.L[101]*t64 - w.L[106]*t66;
-    const Scalar t68 = w.Z_pelvis[75]*w.Linv[12];
-    const Scalar t69 = w.Z_pelvis[81] - w.L[115]*t68;
-    const Scalar t70 = w.Linv[13]*t69;
-    const Scalar t71 = w.Z_pelvis[87] - w.L[116]*t68 - w.L[118]*t70;
+    const Scalar t0 = w.Z_pelvis[3]*w.Linv[0];
+    const Scalar t1 = w.Z_pelvis[9] - w.L[1]*t0;
+    const Scalar t2 = w.Linv[1]*t1;
+    const Scalar t3 = w.Z_pelvis[15] - w.L[2]*t0 - w.L[16]*t2;
+    const Scalar t4 = w.Linv[2]*t3;
+    const Scalar t5 = w.Z_pelvis[21] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
+    const Scalar t6 = w.Linv[3]*t5;
+    const Scalar t7 = w.Z_pelvis[27] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Linv[4]*t7;
+    const Scalar t9 = w.Z_pelvis[33] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
+    const Scalar t10 = w.Z_pelvis[39]*w.Linv[6];
+    const Scalar t11 = w.Z_pelvis[45] - w.L[76]*t10;
+    const Scalar t12 = w.Linv[7]*t11;
+    const Scalar t13 = w.Z_pelvis[51] - w.L[77]*t10 - w.L[85]*t12;
+    const Scalar t14 = w.Linv[8]*t13;
+    const Scalar t15 = w.Z_pelvis[57] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
+    const Scalar t16 = w.Linv[9]*t15;
+    const Scalar t17 = w.Z_pelvis[63] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
+    const Scalar t18 = w.Linv[10]*t17;
+    const Scalar t19 = w.Z_pelvis[69] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
+    const Scalar t20 = w.Z_pelvis[75]*w.Linv[12];
+    const Scalar t21 = w.Z_pelvis[81] - w.L[115]*t20;
+    const Scalar t22 = w.Linv[13]*t21;
+    const Scalar t23 = w.Z_pelvis[87] - w.L[116]*t20 - w.L[118]*t22;
     w.W[3] = w.Z_pelvis[3]*w.Linv[0];
-    w.W[9] = w.Linv[1]*t49;
-    w.W[15] = w.Linv[2]*t51;
-    w.W[21] = w.Linv[3]*t53;
-    w.W[27] = w.Linv[4]*t55;
-    w.W[33] = w.Linv[5]*t57;
+    w.W[9] = w.Linv[1]*t1;
+    w.W[15] = w.Linv[2]*t3;
+    w.W[21] = w.Linv[3]*t5;
+    w.W[27] = w.Linv[4]*t7;
+    w.W[33] = w.Linv[5]*t9;
     w.W[39] = w.Z_pelvis[39]*w.Linv[6];
-    w.W[45] = w.Linv[7]*t59;
-    w.W[51] = w.Linv[8]*t61;
-    w.W[57] = w.Linv[9]*t63;
-    w.W[63] = w.Linv[10]*t65;
-    w.W[69] = w.Linv[11]*t67;
+    w.W[45] = w.Linv[7]*t11;
+    w.W[51] = w.Linv[8]*t13;
+    w.W[57] = w.Linv[9]*t15;
+    w.W[63] = w.Linv[10]*t17;
+    w.W[69] = w.Linv[11]*t19;
     w.W[75] = w.Z_pelvis[75]*w.Linv[12];
-    w.W[81] = w.Linv[13]*t69;
-    w.W[87] = w.Linv[14]*t71;
+    w.W[81] = w.Linv[13]*t21;
+    w.W[87] = w.Linv[14]*t23;
+  }
+  // W = L^-1 Z^T, column 4
+  {
+    const Scalar t24 = w.Z_pelvis[4]*w.Linv[0];
+    const Scalar t25 = w.Z_pelvis[10] - w.L[1]*t24;
+    const Scalar t26 = w.Linv[1]*t25;
+    const Scalar t27 = w.Z_pelvis[16] - w.L[2]*t24 - w.L[16]*t26;
+    const Scalar t28 = w.Linv[2]*t27;
+    const Scalar t29 = w.Z_pelvis[22] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
+    const Scalar t30 = w.Linv[3]*t29;
+    const Scalar t31 = w.Z_pelvis[28] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
+    const Scalar t32 = w.Linv[4]*t31;
+    const Scalar t33 = w.Z_pelvis[34] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
+    const Scalar t34 = w.Z_pelvis[40]*w.Linv[6];
+    const Scalar t35 = w.Z_pelvis[46] - w.L[76]*t34;
+    const Scalar t36 = w.Linv[7]*t35;
+    const Scalar t37 = w.Z_pelvis[52] - w.L[77]*t34 - w.L[85]*t36;
+    const Scalar t38 = w.Linv[8]*t37;
+    const Scalar t39 = w.Z_pelvis[58] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
+    const Scalar t40 = w.Linv[9]*t39;
+    const Scalar t41 = w.Z_pelvis[64] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
+    const Scalar t42 = w.Linv[10]*t41;
+    const Scalar t43 = w.Z_pelvis[70] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
+    const Scalar t44 = w.Z_pelvis[76]*w.Linv[12];
+    const Scalar t45 = w.Z_pelvis[82] - w.L[115]*t44;
+    const Scalar t46 = w.Linv[13]*t45;
+    const Scalar t47 = w.Z_pelvis[88] - w.L[116]*t44 - w.L[118]*t46;
+    w.W[4] = w.Z_pelvis[4]*w.Linv[0];
+    w.W[10] = w.Linv[1]*t25;
+    w.W[16] = w.Linv[2]*t27;
+    w.W[22] = w.Linv[3]*t29;
+    w.W[28] = w.Linv[4]*t31;
+    w.W[34] = w.Linv[5]*t33;
+    w.W[40] = w.Z_pelvis[40]*w.Linv[6];
+    w.W[46] = w.Linv[7]*t35;
+    w.W[52] = w.Linv[8]*t37;
+    w.W[58] = w.Linv[9]*t39;
+    w.W[64] = w.Linv[10]*t41;
+    w.W[70] = w.Linv[11]*t43;
+    w.W[76] = w.Z_pelvis[76]*w.Linv[12];
+    w.W[82] = w.Linv[13]*t45;
+    w.W[88] = w.Linv[14]*t47;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_26(Workspace& w) noexcept {
-  // W = L^-1 Z^T, column 4
-  {
-    const Scalar t0 = w.Z_pelvis[4]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[10] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[16] - w.L[2]*t0 - w.L[16]*t2;
-    const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[22] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[28] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[34] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[40]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[46] - w.L[76]*t10;
-    const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[52] - w.L[77]*t10 - w.L[85]*t12;
-    const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[58] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[64] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[70] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[76]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[82] - w.L[115]*t20;
-    const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[88] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[4] = w.Z_pelvis[4]*w.Linv[0];
-    w.W[10] = w.Linv[1]*t1;
-    w.W[16] = w.Linv[2]*t3;
-    w.W[22] = w.Linv[3]*t5;
-    w.W[28] = w.Linv[4]*t7;
-    w.W[34] = w.Linv[5]*t9;
-    w.W[40] = w.Z_pelvis[40]*w.Linv[6];
-    w.W[46] = w.Linv[7]*t11;
-    w.W[52] = w.Linv[8]*t13;
-    w.W[58] = w.Linv[9]*t15;
-    w.W[64] = w.Linv[10]*t17;
-    w.W[70] = w.Linv[11]*t19;
-    w.W[76] = w.Z_pelvis[76]*w.Linv[12];
-    w.W[82] = w.Linv[13]*t21;
-    w.W[88] = w.Linv[14]*t23;
-  }
+PROXGEN_RT_NOINLINE void pv_34(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t24 = w.Z_pelvis[5]*w.Linv[0];
-    const Scalar t25 = w.Z_pelvis[11] - w.L[1]*t24;
-    const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_pelvis[17] - w.L[2]*t24 - w.L[16]*t26;
-    const Scalar t28 = w.Linv[2]*t27;
-    const Scalar t29 = w.Z_pelvis[23] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
-    const Scalar t30 = w.Linv[3]*t29;
-    const Scalar t31 = w.Z_pelvis[29] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
-    const Scalar t32 = w.Linv[4]*t31;
-    const Scalar t33 = w.Z_pelvis[35] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
-    const Scalar t34 = w.Z_pelvis[41]*w.Linv[6];
-    const Scalar t35 = w.Z_pelvis[47] - w.L[76]*t34;
-    const Scalar t36 = w.Linv[7]*t35;
-    const Scalar t37 = w.Z_pelvis[53] - w.L[77]*t34 - w.L[85]*t36;
-    const Scalar t38 = w.Linv[8]*t37;
-    const Scalar t39 = w.Z_pelvis[59] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
-    const Scalar t40 = w.Linv[9]*t39;
-    const Scalar t41 = w.Z_pelvis[65] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
-    const Scalar t42 = w.Linv[10]*t41;
-    const Scalar t43 = w.Z_pelvis[71] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
-    const Scalar t44 = w.Z_pelvis[77]*w.Linv[12];
-    const Scalar t45 = w.Z_pelvis[83] - w.L[115]*t44;
-    const Scalar t46 = w.Linv[13]*t45;
-    const Scalar t47 = w.Z_pelvis[89] - w.L[116]*t44 - w.L[118]*t46;
+    const Scalar t0 = w.Z_pelvis[5]*w.Linv[0];
+    const Scalar t1 = w.Z_pelvis[11] - w.L[1]*t0;
+    const Scalar t2 = w.Linv[1]*t1;
+    const Scalar t3 = w.Z_pelvis[17] - w.L[2]*t0 - w.L[16]*t2;
+    const Scalar t4 = w.Linv[2]*t3;
+    const Scalar t5 = w.Z_pelvis[23] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
+    const Scalar t6 = w.Linv[3]*t5;
+    const Scalar t7 = w.Z_pelvis[29] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Linv[4]*t7;
+    const Scalar t9 = w.Z_pelvis[35] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
+    const Scalar t10 = w.Z_pelvis[41]*w.Linv[6];
+    const Scalar t11 = w.Z_pelvis[47] - w.L[76]*t10;
+    const Scalar t12 = w.Linv[7]*t11;
+    const Scalar t13 = w.Z_pelvis[53] - w.L[77]*t10 - w.L[85]*t12;
+    const Scalar t14 = w.Linv[8]*t13;
+    const Scalar t15 = w.Z_pelvis[59] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
+    const Scalar t16 = w.Linv[9]*t15;
+    const Scalar t17 = w.Z_pelvis[65] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
+    const Scalar t18 = w.Linv[10]*t17;
+    const Scalar t19 = w.Z_pelvis[71] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
+    const Scalar t20 = w.Z_pelvis[77]*w.Linv[12];
+    const Scalar t21 = w.Z_pelvis[83] - w.L[115]*t20;
+    const Scalar t22 = w.Linv[13]*t21;
+    const Scalar t23 = w.Z_pelvis[89] - w.L[116]*t20 - w.L[118]*t22;
     w.W[5] = w.Z_pelvis[5]*w.Linv[0];
-    w.W[11] = w.Linv[1]*t25;
-    w.W[17] = w.Linv[2]*t27;
-    w.W[23] = w.Linv[3]*t29;
-    w.W[29] = w.Linv[4]*t31;
-    w.W[35] = w.Linv[5]*t33;
+    w.W[11] = w.Linv[1]*t1;
+    w.W[17] = w.Linv[2]*t3;
+    w.W[23] = w.Linv[3]*t5;
+    w.W[29] = w.Linv[4]*t7;
+    w.W[35] = w.Linv[5]*t9;
     w.W[41] = w.Z_pelvis[41]*w.Linv[6];
-    w.W[47] = w.Linv[7]*t35;
-    w.W[53] = w.Linv[8]*t37;
-    w.W[59] = w.Linv[9]*t39;
-    w.W[65] = w.Linv[10]*t41;
-    w.W[71] = w.Linv[11]*t43;
+    w.W[47] = w.Linv[7]*t11;
+    w.W[53] = w.Linv[8]*t13;
+    w.W[59] = w.Linv[9]*t15;
+    w.W[65] = w.Linv[10]*t17;
+    w.W[71] = w.Linv[11]*t19;
     w.W[77] = w.Z_pelvis[77]*w.Linv[12];
-    w.W[83] = w.Linv[13]*t45;
-    w.W[89] = w.Linv[14]*t47;
+    w.W[83] = w.Linv[13]*t21;
+    w.W[89] = w.Linv[14]*t23;
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t48 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66] + w.W[72]*w.W[72] + w.W[78]*w.W[78] + w.W[84]*w.W[84];
-    const Scalar r0 = std::sqrt(t48);
+    const Scalar t24 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66] + w.W[72]*w.W[72] + w.W[78]*w.W[78] + w.W[84]*w.W[84];
+    const Scalar r0 = std::sqrt(t24);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t49 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67] + w.W[72]*w.W[73] + w.W[78]*w.W[79] + w.W[84]*w.W[85];
-    w.LS[1] = w.LSinv[0]*t49;
-    const Scalar t50 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68] + w.W[72]*w.W[74] + w.W[78]*w.W[80] + w.W[84]*w.W[86];
-    w.LS[2] = w.LSinv[0]*t50;
-    const Scalar t51 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69] + w.W[72]*w.W[75] + w.W[78]*w.W[81] + w.W[84]*w.W[87];
-    w.LS[3] = w.LSinv[0]*t51;
-    const Scalar t52 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70] + w.W[72]*w.W[76] + w.W[78]*w.W[82] + w.W[84]*w.W[88];
-    w.LS[4] = w.LSinv[0]*t52;
-    const Scalar t53 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71] + w.W[72]*w.W[77] + w.W[78]*w.W[83] + w.W[84]*w.W[89];
-    w.LS[5] = w.LSinv[0]*t53;
-    const Scalar t54 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] + w.W[73]*w.W[73] + w.W[79]*w.W[79] + w.W[85]*w.W[85] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t54);
+    const Scalar t25 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67] + w.W[72]*w.W[73] + w.W[78]*w.W[79] + w.W[84]*w.W[85];
+    w.LS[1] = w.LSinv[0]*t25;
+    const Scalar t26 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68] + w.W[72]*w.W[74] + w.W[78]*w.W[80] + w.W[84]*w.W[86];
+    w.LS[2] = w.LSinv[0]*t26;
+    const Scalar t27 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69] + w.W[72]*w.W[75] + w.W[78]*w.W[81] + w.W[84]*w.W[87];
+    w.LS[3] = w.LSinv[0]*t27;
+    const Scalar t28 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70] + w.W[72]*w.W[76] + w.W[78]*w.W[82] + w.W[84]*w.W[88];
+    w.LS[4] = w.LSinv[0]*t28;
+    const Scalar t29 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71] + w.W[72]*w.W[77] + w.W[78]*w.W[83] + w.W[84]*w.W[89];
+    w.LS[5] = w.LSinv[0]*t29;
+    const Scalar t30 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] + w.W[73]*w.W[73] + w.W[79]*w.W[79] + w.W[85]*w.W[85] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t30);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t55 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] + w.W[73]*w.W[74] + w.W[79]*w.W[80] + w.W[85]*w.W[86] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t55;
-    const Scalar t56 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] + w.W[73]*w.W[75] + w.W[79]*w.W[81] + w.W[85]*w.W[87] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t56;
-    const Scalar t57 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] + w.W[73]*w.W[76] + w.W[79]*w.W[82] + w.W[85]*w.W[88] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t57;
-    const Scalar t58 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] + w.W[73]*w.W[77] + w.W[79]*w.W[83] + w.W[85]*w.W[89] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t58;
-    const Scalar t59 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] + w.W[74]*w.W[74] + w.W[80]*w.W[80] + w.W[86]*w.W[86] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t59);
+    const Scalar t31 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] + w.W[73]*w.W[74] + w.W[79]*w.W[80] + w.W[85]*w.W[86] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t31;
+    const Scalar t32 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] + w.W[73]*w.W[75] + w.W[79]*w.W[81] + w.W[85]*w.W[87] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t32;
+    const Scalar t33 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] + w.W[73]*w.W[76] + w.W[79]*w.W[82] + w.W[85]*w.W[88] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t33;
+    const Scalar t34 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] + w.W[73]*w.W[77] + w.W[79]*w.W[83] + w.W[85]*w.W[89] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t34;
+    const Scalar t35 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] + w.W[74]*w.W[74] + w.W[80]*w.W[80] + w.W[86]*w.W[86] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t35);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t60 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] + w.W[74]*w.W[75] + w.W[80]*w.W[81] + w.W[86]*w.W[87] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t60;
-    const Scalar t61 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] + w.W[74]*w.W[76] + w.W[80]*w.W[82] + w.W[86]*w.W[88] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t61;
-    const Scalar t62 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] + w.W[74]*w.W[77] + w.W[80]*w.W[83] + w.W[86]*w.W[89] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t62;
-    const Scalar t63 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] + w.W[75]*w.W[75] + w.W[81]*w.W[81] + w.W[87]*w.W[87] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t63);
+    const Scalar t36 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] + w.W[74]*w.W[75] + w.W[80]*w.W[81] + w.W[86]*w.W[87] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t36;
+    const Scalar t37 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] + w.W[74]*w.W[76] + w.W[80]*w.W[82] + w.W[86]*w.W[88] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t37;
+    const Scalar t38 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] + w.W[74]*w.W[77] + w.W[80]*w.W[83] + w.W[86]*w.W[89] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t38;
+    const Scalar t39 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] + w.W[75]*w.W[75] + w.W[81]*w.W[81] + w.W[87]*w.W[87] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t39);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t64 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] + w.W[75]*w.W[76] + w.W[81]*w.W[82] + w.W[87]*w.W[88] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t64;
-    const Scalar t65 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] + w.W[75]*w.W[77] + w.W[81]*w.W[83] + w.W[87]*w.W[89] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t65;
-    const Scalar t66 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] + w.W[76]*w.W[76] + w.W[82]*w.W[82] + w.W[88]*w.W[88] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t66);
+    const Scalar t40 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] + w.W[75]*w.W[76] + w.W[81]*w.W[82] + w.W[87]*w.W[88] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t40;
+    const Scalar t41 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] + w.W[75]*w.W[77] + w.W[81]*w.W[83] + w.W[87]*w.W[89] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t41;
+    const Scalar t42 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] + w.W[76]*w.W[76] + w.W[82]*w.W[82] + w.W[88]*w.W[88] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t42);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t67 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] + w.W[76]*w.W[77] + w.W[82]*w.W[83] + w.W[88]*w.W[89] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t67;
-    const Scalar t68 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] + w.W[77]*w.W[77] + w.W[83]*w.W[83] + w.W[89]*w.W[89] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t68);
+    const Scalar t43 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] + w.W[76]*w.W[77] + w.W[82]*w.W[83] + w.W[88]*w.W[89] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t43;
+    const Scalar t44 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] + w.W[77]*w.W[77] + w.W[83]*w.W[83] + w.W[89]*w.W[89] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t44);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_27(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
   w.lambda[2] = 0.0;
@@ -8821,7 +8996,7 @@ PROXGEN_RT_NOINLINE void pv_27(Workspace& w) noexcept {
   w.lambda[14] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_28(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_36(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -8931,7 +9106,7 @@ PROXGEN_RT_NOINLINE void pv_28(Scalar inv_mu, Workspace& w) noexcept {
   w.lambda[14] = w.Linv[14]*z14;
 }
 
-PROXGEN_RT_NOINLINE void pv_29(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0]*w.lambda[0] - w.KA_pelvis[6]*w.lambda[1] - w.KA_pelvis[12]*w.lambda[2] - w.KA_pelvis[18]*w.lambda[3] - w.KA_pelvis[24]*w.lambda[4] - w.KA_pelvis[30]*w.lambda[5] - w.KA_pelvis[36]*w.lambda[6] - w.KA_pelvis[42]*w.lambda[7] - w.KA_pelvis[48]*w.lambda[8] - w.KA_pelvis[54]*w.lambda[9] - w.KA_pelvis[60]*w.lambda[10] - w.KA_pelvis[66]*w.lambda[11] - w.KA_pelvis[72]*w.lambda[12] - w.KA_pelvis[78]*w.lambda[13] - w.KA_pelvis[84]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
@@ -8979,73 +9154,78 @@ PROXGEN_RT_NOINLINE void pv_29(Workspace& w) noexcept {
     const Scalar t27 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
     const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
     const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t30 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t31 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[5]*w.lambda[0] - w.KA_l_hip_yaw_link[11]*w.lambda[1] - w.KA_l_hip_yaw_link[17]*w.lambda[2] - w.KA_l_hip_yaw_link[23]*w.lambda[3] - w.KA_l_hip_yaw_link[29]*w.lambda[4] - w.KA_l_hip_yaw_link[35]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t30 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t31;
-    w.a_l_hip_yaw_link[0] = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    w.a_l_hip_yaw_link[1] = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[5]*w.lambda[0] - w.KA_l_hip_yaw_link[11]*w.lambda[1] - w.KA_l_hip_yaw_link[17]*w.lambda[2] - w.KA_l_hip_yaw_link[23]*w.lambda[3] - w.KA_l_hip_yaw_link[29]*w.lambda[4] - w.KA_l_hip_yaw_link[35]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
+    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
+    w.a_l_hip_yaw_link[0] = t28;
+    w.a_l_hip_yaw_link[1] = t29;
     w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    w.a_l_hip_yaw_link[4] = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    w.a_l_hip_yaw_link[3] = t30;
+    w.a_l_hip_yaw_link[4] = t31;
     w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t32 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t33 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t34 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t35 = w.u_l_hip_roll_link[0] - w.KA_l_hip_roll_link[3]*w.lambda[0] - w.KA_l_hip_roll_link[9]*w.lambda[1] - w.KA_l_hip_roll_link[15]*w.lambda[2] - w.KA_l_hip_roll_link[21]*w.lambda[3] - w.KA_l_hip_roll_link[27]*w.lambda[4] - w.KA_l_hip_roll_link[33]*w.lambda[5] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t32 - w.IA_l_hip_roll_link[12]*t33 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t34;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t35;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[2] = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    w.a_l_hip_roll_link[5] = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t36 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t37 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t38 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t39 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t40 = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
-    const Scalar t41 = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    const Scalar t42 = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
-    const Scalar t43 = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
-    const Scalar t44 = w.u_l_thigh[0] - w.KA_l_thigh[4]*w.lambda[0] - w.KA_l_thigh[10]*w.lambda[1] - w.KA_l_thigh[16]*w.lambda[2] - w.KA_l_thigh[22]*w.lambda[3] - w.KA_l_thigh[28]*w.lambda[4] - w.KA_l_thigh[34]*w.lambda[5] - w.IA_l_thigh[4]*t40 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t41 - w.IA_l_thigh[16]*t42 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t43;
-    w.qdd[8] = w.Dinv_l_thigh*t44;
-    w.a_l_thigh[0] = w.c_l_thigh[0] + w.cq_l_thigh*t38 - w.sq_l_thigh*t39;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = w.c_l_thigh[2] + w.sq_l_thigh*t38 + w.cq_l_thigh*t39;
-    w.a_l_thigh[3] = w.c_l_thigh[3] + w.cq_l_thigh*t36 - w.sq_l_thigh*t37;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = w.c_l_thigh[5] + w.sq_l_thigh*t36 + w.cq_l_thigh*t37;
-  }
-  // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t45 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t46 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t47 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t48 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t49 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t45;
-    const Scalar t50 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t45;
-    const Scalar t51 = w.c_l_shank[0] + w.cq_l_shank*t49 - w.sq_l_shank*t50;
-    const Scalar t52 = w.c_l_shank[2] + w.sq_l_shank*t49 + w.cq_l_shank*t50;
-    const Scalar t53 = w.c_l_shank[3] + w.cq_l_shank*t47 - w.sq_l_shank*t48;
-    const Scalar t54 = w.c_l_shank[5] + w.sq_l_shank*t47 + w.cq_l_shank*t48;
-    const Scalar t55 = w.u_l_shank[0] - w.KA_l_shank[4]*w.lambda[0] - w.KA_l_shank[10]*w.lambda[1] - w.KA_l_shank[16]*w.lambda[2] - w.KA_l_shank[22]*w.lambda[3] - w.KA_l_shank[28]*w.lambda[4] - w.KA_l_shank[34]*w.lambda[5] - w.IA_l_shank[4]*t51 - w.IA_l_shank[9]*t46 - w.IA_l_shank[13]*t52 - w.IA_l_shank[16]*t53 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t54;
-    w.qdd[9] = w.Dinv_l_shank*t55;
-    w.a_l_shank[0] = w.c_l_shank[0] + w.cq_l_shank*t49 - w.sq_l_shank*t50;
-    w.a_l_shank[1] = t46;
-    w.a_l_shank[2] = w.c_l_shank[2] + w.sq_l_shank*t49 + w.cq_l_shank*t50;
-    w.a_l_shank[3] = w.c_l_shank[3] + w.cq_l_shank*t47 - w.sq_l_shank*t48;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = w.c_l_shank[5] + w.sq_l_shank*t47 + w.cq_l_shank*t48;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_30(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  {
+    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
+    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
+    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
+    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
+    const Scalar t4 = w.u_l_hip_roll_link[0] - w.KA_l_hip_roll_link[3]*w.lambda[0] - w.KA_l_hip_roll_link[9]*w.lambda[1] - w.KA_l_hip_roll_link[15]*w.lambda[2] - w.KA_l_hip_roll_link[21]*w.lambda[3] - w.KA_l_hip_roll_link[27]*w.lambda[4] - w.KA_l_hip_roll_link[33]*w.lambda[5] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
+    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
+    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
+    w.a_l_hip_roll_link[1] = t0;
+    w.a_l_hip_roll_link[2] = t1;
+    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
+    w.a_l_hip_roll_link[4] = t2;
+    w.a_l_hip_roll_link[5] = t3;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  {
+    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
+    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
+    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
+    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
+    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
+    const Scalar t13 = w.u_l_thigh[0] - w.KA_l_thigh[4]*w.lambda[0] - w.KA_l_thigh[10]*w.lambda[1] - w.KA_l_thigh[16]*w.lambda[2] - w.KA_l_thigh[22]*w.lambda[3] - w.KA_l_thigh[28]*w.lambda[4] - w.KA_l_thigh[34]*w.lambda[5] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
+    w.qdd[8] = w.Dinv_l_thigh*t13;
+    w.a_l_thigh[0] = t9;
+    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
+    w.a_l_thigh[2] = t10;
+    w.a_l_thigh[3] = t11;
+    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
+    w.a_l_thigh[5] = t12;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  {
+    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
+    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
+    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
+    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
+    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
+    const Scalar t24 = w.u_l_shank[0] - w.KA_l_shank[4]*w.lambda[0] - w.KA_l_shank[10]*w.lambda[1] - w.KA_l_shank[16]*w.lambda[2] - w.KA_l_shank[22]*w.lambda[3] - w.KA_l_shank[28]*w.lambda[4] - w.KA_l_shank[34]*w.lambda[5] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
+    w.qdd[9] = w.Dinv_l_shank*t24;
+    w.a_l_shank[0] = t20;
+    w.a_l_shank[1] = t15;
+    w.a_l_shank[2] = t21;
+    w.a_l_shank[3] = t22;
+    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
+    w.a_l_shank[5] = t23;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
@@ -9056,104 +9236,114 @@ PROXGEN_RT_NOINLINE void pv_30(Workspace& w) noexcept {
     const Scalar t5 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
     const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
     const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t8 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t9 = w.u_l_ankle_link[0] - w.KA_l_ankle_link[4]*w.lambda[0] - w.KA_l_ankle_link[10]*w.lambda[1] - w.KA_l_ankle_link[22]*w.lambda[3] - w.KA_l_ankle_link[28]*w.lambda[4] - w.KA_l_ankle_link[34]*w.lambda[5] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t8;
-    w.qdd[10] = w.Dinv_l_ankle_link*t9;
-    w.a_l_ankle_link[0] = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
+    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
+    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    const Scalar t10 = w.u_l_ankle_link[0] - w.KA_l_ankle_link[4]*w.lambda[0] - w.KA_l_ankle_link[10]*w.lambda[1] - w.KA_l_ankle_link[22]*w.lambda[3] - w.KA_l_ankle_link[28]*w.lambda[4] - w.KA_l_ankle_link[34]*w.lambda[5] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
+    w.qdd[10] = w.Dinv_l_ankle_link*t10;
+    w.a_l_ankle_link[0] = t6;
     w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    w.a_l_ankle_link[3] = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
+    w.a_l_ankle_link[2] = t7;
+    w.a_l_ankle_link[3] = t8;
     w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    w.a_l_ankle_link[5] = t9;
   }
   // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    const Scalar t10 = -0.027912499999999996*w.c_l_foot[1] - 0.0017863999999999998*w.c_l_foot[5] + w.u_l_foot[0] - 0.06825*w.lambda[1] - w.lambda[3] - 0.00194517348958*w.a_l_ankle_link[3] + 0.0017863999999999998*w.sq_l_foot*w.a_l_ankle_link[4] - 0.0017863999999999998*w.cq_l_foot*w.a_l_ankle_link[5] - 0.027912499999999996*w.cq_l_foot*w.a_l_ankle_link[1] - 0.027912499999999996*w.sq_l_foot*w.a_l_ankle_link[2];
-    w.qdd[11] = w.Dinv_l_foot*t10;
+    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t15 = w.u_l_foot[0] - 0.06825*w.lambda[1] - w.lambda[3] - 0.00194517348958*w.a_l_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
+    w.qdd[11] = w.Dinv_l_foot*t15;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    w.a_l_foot[2] = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    w.a_l_foot[1] = t11;
+    w.a_l_foot[2] = t12;
     w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    w.a_l_foot[5] = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    w.a_l_foot[4] = t13;
+    w.a_l_foot[5] = t14;
   }
   // accelerate, with the multipliers of the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t11 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t12 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t13 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t14 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t15 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t11;
-    const Scalar t16 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t11;
-    const Scalar t17 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t15 + w.sq_r_hip_yaw_link*t16;
-    const Scalar t18 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t15 + w.cq_r_hip_yaw_link*t16;
-    const Scalar t19 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t13 + w.cq_r_hip_yaw_link*t14;
-    const Scalar t20 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[5]*w.lambda[6] - w.KA_r_hip_yaw_link[11]*w.lambda[7] - w.KA_r_hip_yaw_link[17]*w.lambda[8] - w.KA_r_hip_yaw_link[23]*w.lambda[9] - w.KA_r_hip_yaw_link[29]*w.lambda[10] - w.KA_r_hip_yaw_link[35]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t17 - w.IA_r_hip_yaw_link[10]*t18 - w.IA_r_hip_yaw_link[14]*t12 - w.IA_r_hip_yaw_link[19]*t19 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t20;
-    w.a_r_hip_yaw_link[0] = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t15 + w.sq_r_hip_yaw_link*t16;
-    w.a_r_hip_yaw_link[1] = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t15 + w.cq_r_hip_yaw_link*t16;
-    w.a_r_hip_yaw_link[2] = t12;
-    w.a_r_hip_yaw_link[3] = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t13 + w.sq_r_hip_yaw_link*t14;
-    w.a_r_hip_yaw_link[4] = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t13 + w.cq_r_hip_yaw_link*t14;
+    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
+    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
+    const Scalar t18 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t19 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t20 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
+    const Scalar t21 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
+    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[5]*w.lambda[6] - w.KA_r_hip_yaw_link[11]*w.lambda[7] - w.KA_r_hip_yaw_link[17]*w.lambda[8] - w.KA_r_hip_yaw_link[23]*w.lambda[9] - w.KA_r_hip_yaw_link[29]*w.lambda[10] - w.KA_r_hip_yaw_link[35]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
+    w.a_r_hip_yaw_link[0] = t22;
+    w.a_r_hip_yaw_link[1] = t23;
+    w.a_r_hip_yaw_link[2] = t17;
+    w.a_r_hip_yaw_link[3] = t24;
+    w.a_r_hip_yaw_link[4] = t25;
     w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t21 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t22 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t23 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t24 = w.u_r_hip_roll_link[0] - w.KA_r_hip_roll_link[3]*w.lambda[6] - w.KA_r_hip_roll_link[9]*w.lambda[7] - w.KA_r_hip_roll_link[15]*w.lambda[8] - w.KA_r_hip_roll_link[21]*w.lambda[9] - w.KA_r_hip_roll_link[27]*w.lambda[10] - w.KA_r_hip_roll_link[33]*w.lambda[11] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t21 - w.IA_r_hip_roll_link[12]*t22 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t23;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t24;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[2] = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    w.a_r_hip_roll_link[5] = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t25 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t26 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t27 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t28 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t29 = w.c_r_thigh[0] + w.cq_r_thigh*t27 - w.sq_r_thigh*t28;
-    const Scalar t30 = w.c_r_thigh[2] + w.sq_r_thigh*t27 + w.cq_r_thigh*t28;
-    const Scalar t31 = w.c_r_thigh[3] + w.cq_r_thigh*t25 - w.sq_r_thigh*t26;
-    const Scalar t32 = w.c_r_thigh[5] + w.sq_r_thigh*t25 + w.cq_r_thigh*t26;
-    const Scalar t33 = w.u_r_thigh[0] - w.KA_r_thigh[4]*w.lambda[6] - w.KA_r_thigh[10]*w.lambda[7] - w.KA_r_thigh[16]*w.lambda[8] - w.KA_r_thigh[22]*w.lambda[9] - w.KA_r_thigh[28]*w.lambda[10] - w.KA_r_thigh[34]*w.lambda[11] - w.IA_r_thigh[4]*t29 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t30 - w.IA_r_thigh[16]*t31 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t32;
-    w.qdd[14] = w.Dinv_r_thigh*t33;
-    w.a_r_thigh[0] = w.c_r_thigh[0] + w.cq_r_thigh*t27 - w.sq_r_thigh*t28;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = w.c_r_thigh[2] + w.sq_r_thigh*t27 + w.cq_r_thigh*t28;
-    w.a_r_thigh[3] = w.c_r_thigh[3] + w.cq_r_thigh*t25 - w.sq_r_thigh*t26;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = w.c_r_thigh[5] + w.sq_r_thigh*t25 + w.cq_r_thigh*t26;
-  }
-  // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t34 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t35 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t36 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t37 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t38 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t34;
-    const Scalar t39 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t34;
-    const Scalar t40 = w.c_r_shank[0] + w.cq_r_shank*t38 - w.sq_r_shank*t39;
-    const Scalar t41 = w.c_r_shank[2] + w.sq_r_shank*t38 + w.cq_r_shank*t39;
-    const Scalar t42 = w.c_r_shank[3] + w.cq_r_shank*t36 - w.sq_r_shank*t37;
-    const Scalar t43 = w.c_r_shank[5] + w.sq_r_shank*t36 + w.cq_r_shank*t37;
-    const Scalar t44 = w.u_r_shank[0] - w.KA_r_shank[4]*w.lambda[6] - w.KA_r_shank[10]*w.lambda[7] - w.KA_r_shank[16]*w.lambda[8] - w.KA_r_shank[22]*w.lambda[9] - w.KA_r_shank[28]*w.lambda[10] - w.KA_r_shank[34]*w.lambda[11] - w.IA_r_shank[4]*t40 - w.IA_r_shank[9]*t35 - w.IA_r_shank[13]*t41 - w.IA_r_shank[16]*t42 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t43;
-    w.qdd[15] = w.Dinv_r_shank*t44;
-    w.a_r_shank[0] = w.c_r_shank[0] + w.cq_r_shank*t38 - w.sq_r_shank*t39;
-    w.a_r_shank[1] = t35;
-    w.a_r_shank[2] = w.c_r_shank[2] + w.sq_r_shank*t38 + w.cq_r_shank*t39;
-    w.a_r_shank[3] = w.c_r_shank[3] + w.cq_r_shank*t36 - w.sq_r_shank*t37;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = w.c_r_shank[5] + w.sq_r_shank*t36 + w.cq_r_shank*t37;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_31(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  {
+    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
+    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
+    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
+    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
+    const Scalar t4 = w.u_r_hip_roll_link[0] - w.KA_r_hip_roll_link[3]*w.lambda[6] - w.KA_r_hip_roll_link[9]*w.lambda[7] - w.KA_r_hip_roll_link[15]*w.lambda[8] - w.KA_r_hip_roll_link[21]*w.lambda[9] - w.KA_r_hip_roll_link[27]*w.lambda[10] - w.KA_r_hip_roll_link[33]*w.lambda[11] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
+    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
+    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
+    w.a_r_hip_roll_link[1] = t0;
+    w.a_r_hip_roll_link[2] = t1;
+    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
+    w.a_r_hip_roll_link[4] = t2;
+    w.a_r_hip_roll_link[5] = t3;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  {
+    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
+    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
+    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
+    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
+    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
+    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
+    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
+    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
+    const Scalar t13 = w.u_r_thigh[0] - w.KA_r_thigh[4]*w.lambda[6] - w.KA_r_thigh[10]*w.lambda[7] - w.KA_r_thigh[16]*w.lambda[8] - w.KA_r_thigh[22]*w.lambda[9] - w.KA_r_thigh[28]*w.lambda[10] - w.KA_r_thigh[34]*w.lambda[11] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
+    w.qdd[14] = w.Dinv_r_thigh*t13;
+    w.a_r_thigh[0] = t9;
+    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
+    w.a_r_thigh[2] = t10;
+    w.a_r_thigh[3] = t11;
+    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
+    w.a_r_thigh[5] = t12;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  {
+    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
+    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
+    const Scalar t16 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
+    const Scalar t17 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
+    const Scalar t18 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t19 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
+    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
+    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
+    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
+    const Scalar t24 = w.u_r_shank[0] - w.KA_r_shank[4]*w.lambda[6] - w.KA_r_shank[10]*w.lambda[7] - w.KA_r_shank[16]*w.lambda[8] - w.KA_r_shank[22]*w.lambda[9] - w.KA_r_shank[28]*w.lambda[10] - w.KA_r_shank[34]*w.lambda[11] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
+    w.qdd[15] = w.Dinv_r_shank*t24;
+    w.a_r_shank[0] = t20;
+    w.a_r_shank[1] = t15;
+    w.a_r_shank[2] = t21;
+    w.a_r_shank[3] = t22;
+    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
+    w.a_r_shank[5] = t23;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
@@ -9164,101 +9354,111 @@ PROXGEN_RT_NOINLINE void pv_31(Workspace& w) noexcept {
     const Scalar t5 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
     const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
     const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t8 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t9 = w.u_r_ankle_link[0] - w.KA_r_ankle_link[4]*w.lambda[6] - w.KA_r_ankle_link[10]*w.lambda[7] - w.KA_r_ankle_link[22]*w.lambda[9] - w.KA_r_ankle_link[28]*w.lambda[10] - w.KA_r_ankle_link[34]*w.lambda[11] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t8;
-    w.qdd[16] = w.Dinv_r_ankle_link*t9;
-    w.a_r_ankle_link[0] = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
+    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
+    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    const Scalar t10 = w.u_r_ankle_link[0] - w.KA_r_ankle_link[4]*w.lambda[6] - w.KA_r_ankle_link[10]*w.lambda[7] - w.KA_r_ankle_link[22]*w.lambda[9] - w.KA_r_ankle_link[28]*w.lambda[10] - w.KA_r_ankle_link[34]*w.lambda[11] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
+    w.qdd[16] = w.Dinv_r_ankle_link*t10;
+    w.a_r_ankle_link[0] = t6;
     w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    w.a_r_ankle_link[3] = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
+    w.a_r_ankle_link[2] = t7;
+    w.a_r_ankle_link[3] = t8;
     w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    w.a_r_ankle_link[5] = t9;
   }
   // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    const Scalar t10 = -0.027912499999999996*w.c_r_foot[1] - 0.0017863999999999998*w.c_r_foot[5] + w.u_r_foot[0] - 0.06825*w.lambda[7] - w.lambda[9] - 0.00194517348958*w.a_r_ankle_link[3] + 0.0017863999999999998*w.sq_r_foot*w.a_r_ankle_link[4] - 0.0017863999999999998*w.cq_r_foot*w.a_r_ankle_link[5] - 0.027912499999999996*w.cq_r_foot*w.a_r_ankle_link[1] - 0.027912499999999996*w.sq_r_foot*w.a_r_ankle_link[2];
-    w.qdd[17] = w.Dinv_r_foot*t10;
+    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t15 = w.u_r_foot[0] - 0.06825*w.lambda[7] - w.lambda[9] - 0.00194517348958*w.a_r_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
+    w.qdd[17] = w.Dinv_r_foot*t15;
     w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    w.a_r_foot[2] = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    w.a_r_foot[1] = t11;
+    w.a_r_foot[2] = t12;
     w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    w.a_r_foot[5] = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    w.a_r_foot[4] = t13;
+    w.a_r_foot[5] = t14;
   }
   // accelerate, with the multipliers of the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t11 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t12 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t13 = w.c_abdomen[0] + w.cq_abdomen*t11 + w.sq_abdomen*t12;
-    const Scalar t14 = w.c_abdomen[1] - w.sq_abdomen*t11 + w.cq_abdomen*t12;
-    const Scalar t15 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t16 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t17 = w.u_abdomen[0] - w.KA_abdomen[5]*w.lambda[12] - w.KA_abdomen[11]*w.lambda[13] - w.KA_abdomen[17]*w.lambda[14] - w.IA_abdomen[5]*t13 - w.IA_abdomen[10]*t14 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t15 - w.IA_abdomen[19]*t16 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t17;
-    w.a_abdomen[0] = w.c_abdomen[0] + w.cq_abdomen*t11 + w.sq_abdomen*t12;
-    w.a_abdomen[1] = w.c_abdomen[1] - w.sq_abdomen*t11 + w.cq_abdomen*t12;
+    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t22 = w.u_abdomen[0] - w.KA_abdomen[5]*w.lambda[12] - w.KA_abdomen[11]*w.lambda[13] - w.KA_abdomen[17]*w.lambda[14] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.qdd[18] = w.Dinv_abdomen*t22;
+    w.a_abdomen[0] = t18;
+    w.a_abdomen[1] = t19;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    w.a_abdomen[4] = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    w.a_abdomen[3] = t20;
+    w.a_abdomen[4] = t21;
     w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  {
-    const Scalar t18 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t19 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t20 = w.c_chest[0] + w.cq_chest*t18 - w.sq_chest*w.a_abdomen[2];
-    const Scalar t21 = w.c_chest[2] + w.sq_chest*t18 + w.cq_chest*w.a_abdomen[2];
-    const Scalar t22 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    const Scalar t23 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-    const Scalar t24 = w.u_chest[0] - w.KA_chest[4]*w.lambda[12] - w.KA_chest[10]*w.lambda[13] - w.KA_chest[16]*w.lambda[14] - w.IA_chest[4]*t20 - w.IA_chest[9]*t19 - w.IA_chest[13]*t21 - w.IA_chest[16]*t22 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t23;
-    w.qdd[19] = w.Dinv_chest*t24;
-    w.a_chest[0] = w.c_chest[0] + w.cq_chest*t18 - w.sq_chest*w.a_abdomen[2];
-    w.a_chest[1] = t19;
-    w.a_chest[2] = w.c_chest[2] + w.sq_chest*t18 + w.cq_chest*w.a_abdomen[2];
-    w.a_chest[3] = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    const Scalar t25 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t26 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t27 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t28 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t29 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t30 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t31 = 0.9848134698792882*t25 + 0.17361575258114187*t27;
-    const Scalar t32 = 0.04493516596384369*t25 + 0.9659256678396477*t26 - 0.2548890642384102*t27;
-    const Scalar t33 = -0.1676999117594225*t25 + 0.2588196364430848*t26 + 0.9512566085906322*t27;
-    const Scalar t34 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t31 - w.sq_r_shoulder_pitch_link*t33;
-    const Scalar t35 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t31 + w.cq_r_shoulder_pitch_link*t33;
-    const Scalar t36 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t28 + w.cq_r_shoulder_pitch_link*t30;
-    const Scalar t37 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4]*w.lambda[12] - w.KA_r_shoulder_pitch_link[10]*w.lambda[13] - w.KA_r_shoulder_pitch_link[16]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t34 - w.IA_r_shoulder_pitch_link[9]*t32 - w.IA_r_shoulder_pitch_link[13]*t35 - w.IA_r_shoulder_pitch_link[18]*t29 - w.IA_r_shoulder_pitch_link[19]*t36;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t37;
-    w.a_r_shoulder_pitch_link[0] = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t31 - w.sq_r_shoulder_pitch_link*t33;
-    w.a_r_shoulder_pitch_link[1] = t32;
-    w.a_r_shoulder_pitch_link[2] = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t31 + w.cq_r_shoulder_pitch_link*t33;
-    w.a_r_shoulder_pitch_link[3] = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t28 - w.sq_r_shoulder_pitch_link*t30;
-    w.a_r_shoulder_pitch_link[4] = t29 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t28 + w.cq_r_shoulder_pitch_link*t30;
-  }
-  // accelerate, with the multipliers of the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t38 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t39 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t40 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t41 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3]*w.lambda[12] - w.KA_r_shoulder_roll_link[9]*w.lambda[13] - w.KA_r_shoulder_roll_link[15]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t38 - w.IA_r_shoulder_roll_link[12]*t39 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t40;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t41;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    w.a_r_shoulder_roll_link[2] = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    w.a_r_shoulder_roll_link[5] = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_32(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
+  {
+    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
+    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t6 = w.u_chest[0] - w.KA_chest[4]*w.lambda[12] - w.KA_chest[10]*w.lambda[13] - w.KA_chest[16]*w.lambda[14] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
+    w.qdd[19] = w.Dinv_chest*t6;
+    w.a_chest[0] = t2;
+    w.a_chest[1] = t1;
+    w.a_chest[2] = t3;
+    w.a_chest[3] = t4;
+    w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
+    w.a_chest[5] = t5;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+  {
+    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t10 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t11 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t12 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t13 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
+    const Scalar t14 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
+    const Scalar t15 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
+    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4]*w.lambda[12] - w.KA_r_shoulder_pitch_link[10]*w.lambda[13] - w.KA_r_shoulder_pitch_link[16]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t14 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t11 - w.IA_r_shoulder_pitch_link[19]*t19;
+    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
+    w.a_r_shoulder_pitch_link[0] = t16;
+    w.a_r_shoulder_pitch_link[1] = t14;
+    w.a_r_shoulder_pitch_link[2] = t17;
+    w.a_r_shoulder_pitch_link[3] = t18;
+    w.a_r_shoulder_pitch_link[4] = t11 + w.qdd[29];
+    w.a_r_shoulder_pitch_link[5] = t19;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+  {
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3]*w.lambda[12] - w.KA_r_shoulder_roll_link[9]*w.lambda[13] - w.KA_r_shoulder_roll_link[15]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
+    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
+    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
+    w.a_r_shoulder_roll_link[1] = t21;
+    w.a_r_shoulder_roll_link[2] = t22;
+    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
+    w.a_r_shoulder_roll_link[4] = t23;
+    w.a_r_shoulder_roll_link[5] = t24;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_43(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
@@ -9267,11 +9467,11 @@ PROXGEN_RT_NOINLINE void pv_32(Workspace& w) noexcept {
     const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
     const Scalar t4 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[5]*w.lambda[12] - w.KA_r_upper_arm[11]*w.lambda[13] - w.KA_r_upper_arm[17]*w.lambda[14] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
     w.qdd[31] = w.Dinv_r_upper_arm*t4;
-    w.a_r_upper_arm[0] = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    w.a_r_upper_arm[1] = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
+    w.a_r_upper_arm[0] = t0;
+    w.a_r_upper_arm[1] = t1;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    w.a_r_upper_arm[4] = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    w.a_r_upper_arm[3] = t2;
+    w.a_r_upper_arm[4] = t3;
     w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
   }
   // accelerate, with the multipliers of the subtree rows: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
@@ -9285,54 +9485,65 @@ PROXGEN_RT_NOINLINE void pv_32(Workspace& w) noexcept {
     const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
     const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
     const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
-    const Scalar t14 = w.u_r_forearm[0] - w.KA_r_forearm[4]*w.lambda[12] - w.KA_r_forearm[10]*w.lambda[13] - w.KA_r_forearm[16]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t14;
-    w.a_r_forearm[0] = w.c_r_forearm[0] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
+    const Scalar t15 = w.u_r_forearm[0] - w.KA_r_forearm[4]*w.lambda[12] - w.KA_r_forearm[10]*w.lambda[13] - w.KA_r_forearm[16]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    w.qdd[32] = w.Dinv_r_forearm*t15;
+    w.a_r_forearm[0] = t11;
     w.a_r_forearm[1] = t6;
-    w.a_r_forearm[2] = w.c_r_forearm[2] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
-    w.a_r_forearm[3] = w.c_r_forearm[3] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
+    w.a_r_forearm[2] = t12;
+    w.a_r_forearm[3] = t13;
     w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = w.c_r_forearm[5] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
+    w.a_r_forearm[5] = t14;
   }
   // accelerate, with the multipliers of the subtree rows: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    const Scalar t15 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t16 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t17 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t15 + w.sq_r_wrist_yaw_link*t16;
-    const Scalar t18 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t15 + w.cq_r_wrist_yaw_link*t16;
-    const Scalar t19 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t20 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[11]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t17 - w.IA_r_wrist_yaw_link[10]*t18 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t19 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t20;
-    w.a_r_wrist_yaw_link[0] = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t15 + w.sq_r_wrist_yaw_link*t16;
-    w.a_r_wrist_yaw_link[1] = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t15 + w.cq_r_wrist_yaw_link*t16;
+    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[11]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
+    w.a_r_wrist_yaw_link[0] = t18;
+    w.a_r_wrist_yaw_link[1] = t19;
     w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    w.a_r_wrist_yaw_link[4] = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    w.a_r_wrist_yaw_link[3] = t20;
+    w.a_r_wrist_yaw_link[4] = t21;
     w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_44(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t21 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t22 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t23 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[10]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t21 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t22;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t23;
-    w.a_r_wrist_pitch_link[0] = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[10]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
+    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
+    w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    w.a_r_wrist_pitch_link[3] = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[2] = t1;
+    w.a_r_wrist_pitch_link[3] = t2;
     w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
+    w.a_r_wrist_pitch_link[5] = t3;
   }
   // accelerate, with the multipliers of the subtree rows: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t24 = -0.04016628*w.c_r_hand[1] + w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*w.cq_r_hand*w.a_r_wrist_pitch_link[1] - 0.04016628*w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.qdd[35] = w.Dinv_r_hand*t24;
+    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t9 = w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
+    w.qdd[35] = w.Dinv_r_hand*t9;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    w.a_r_hand[2] = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    w.a_r_hand[1] = t5;
+    w.a_r_hand[2] = t6;
     w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    w.a_r_hand[5] = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    w.a_r_hand[4] = t7;
+    w.a_r_hand[5] = t8;
   }
 }
 
@@ -9349,6 +9560,12 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   kinematics_7(q, v, w);
   kinematics_8(q, v, w);
   kinematics_9(q, v, w);
+  kinematics_10(q, v, w);
+  kinematics_11(q, v, w);
+  kinematics_12(q, v, w);
+  kinematics_13(q, v, w);
+  kinematics_14(q, v, w);
+  kinematics_15(q, v, w);
 }
 
 // Articulated-body elimination of the bodies off the constraint support
@@ -9359,12 +9576,15 @@ void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
   eliminate_free_2(tau, w);
   eliminate_free_3(tau, w);
   eliminate_free_4(tau, w);
+  eliminate_free_5(tau, w);
+  eliminate_free_6(tau, w);
 }
 
 // Accelerations of the bodies off the support, once their ancestors are final.
 void accelerate_free_bodies(Workspace& w) noexcept {
   accelerate_free_0(w);
   accelerate_free_1(w);
+  accelerate_free_2(w);
 }
 
 }  // namespace
@@ -9382,29 +9602,45 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   caba_3(tau, w);
   caba_4(tau, w);
   caba_5(tau, w);
-  caba_6(tau, mu, w);
+  caba_6(tau, w);
   caba_7(tau, w);
-  caba_8(tau, w);
+  caba_8(tau, mu, w);
   caba_9(tau, w);
-  caba_10(tau, mu, w);
+  caba_10(tau, w);
   caba_11(tau, w);
   caba_12(tau, w);
   caba_13(tau, w);
-  caba_14(tau, w);
-  caba_15(w);
-  caba_16(w);
-  caba_17(w);
-  caba_18(mu, w);
+  caba_14(tau, mu, w);
+  caba_15(tau, w);
+  caba_16(tau, w);
+  caba_17(tau, w);
+  caba_18(tau, w);
+  caba_19(tau, w);
+  caba_20(tau, w);
+  caba_21(w);
+  caba_22(w);
+  caba_23(w);
+  caba_24(w);
+  caba_25(w);
+  caba_26(w);
+  caba_27(w);
+  caba_28(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_19(w);
-    caba_20(w);
-    caba_21(w);
-    caba_22(w);
-    caba_23(w);
-    caba_24(w);
-    caba_25(w);
-    caba_26(mu, w);
+    caba_29(w);
+    caba_30(w);
+    caba_31(w);
+    caba_32(w);
+    caba_33(w);
+    caba_34(w);
+    caba_35(w);
+    caba_36(w);
+    caba_37(w);
+    caba_38(w);
+    caba_39(w);
+    caba_40(w);
+    caba_41(w);
+    caba_42(mu, w);
   }
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
@@ -9485,24 +9721,36 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_16(tau, w);
   pv_17(tau, w);
   pv_18(tau, w);
-  pv_19(w);
-  pv_20(w);
+  pv_19(tau, w);
+  pv_20(tau, w);
   pv_21(w);
   pv_22(w);
-  const Scalar inv_mu = 1.0 / s.mu;
-  pv_23(inv_mu, w);
-  pv_24(inv_mu, w);
+  pv_23(w);
+  pv_24(w);
   pv_25(w);
   pv_26(w);
   pv_27(w);
+  pv_28(w);
+  const Scalar inv_mu = 1.0 / s.mu;
+  pv_29(inv_mu, w);
+  pv_30(inv_mu, w);
+  pv_31(inv_mu, w);
+  pv_32(w);
+  pv_33(w);
+  pv_34(w);
+  pv_35(w);
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
-    pv_28(inv_mu, w);
+    pv_36(inv_mu, w);
   }
-  pv_29(w);
-  pv_30(w);
-  pv_31(w);
-  pv_32(w);
+  pv_37(w);
+  pv_38(w);
+  pv_39(w);
+  pv_40(w);
+  pv_41(w);
+  pv_42(w);
+  pv_43(w);
+  pv_44(w);
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];

@@ -431,8 +431,9 @@ struct Workspace {
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };
 
-// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out. K = s.iterations multiplier
-// updates from lambda = 0; both give the same iterates up to round-off.
+// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).
+// K = s.iterations multiplier updates from lambda = 0; both algorithms give the
+// same iterates up to round-off.
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,

@@ -11,7 +11,7 @@ namespace quadruped {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     w.RJ_trunk[0] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[4]*q[4];
@@ -77,14 +77,17 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.g_LF_hip[1] = w.g_trunk[0]*w.RJ_LF_hip[1] + w.g_trunk[1]*w.cq_LF_hip + w.g_trunk[2]*w.RJ_LF_hip[7];
     w.g_LF_hip[2] = w.g_trunk[0]*w.RJ_LF_hip[2] + w.g_trunk[1]*w.RJ_LF_hip[5] + w.g_trunk[2]*w.RJ_LF_hip[8];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.sq_LF_thigh = std::sin(q[8]);
     w.cq_LF_thigh = std::cos(q[8]);
-    const Scalar t3 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
-    const Scalar t4 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
-    w.v_LF_thigh[0] = w.cq_LF_thigh*t3 - w.sq_LF_thigh*t4;
-    w.v_LF_thigh[2] = w.sq_LF_thigh*t3 + w.cq_LF_thigh*t4;
+    const Scalar t0 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
+    const Scalar t1 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
+    w.v_LF_thigh[0] = w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
+    w.v_LF_thigh[2] = w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
     w.v_LF_thigh[3] = w.v_LF_hip[3]*w.cq_LF_thigh - w.v_LF_hip[5]*w.sq_LF_thigh;
     w.v_LF_thigh[4] = w.v_LF_hip[4] + v[7];
     w.v_LF_thigh[5] = w.v_LF_hip[3]*w.sq_LF_thigh + w.v_LF_hip[5]*w.cq_LF_thigh;
@@ -92,33 +95,30 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* q, const Scalar* v, Workspac
     w.c_LF_thigh[2] = v[7]*w.v_LF_thigh[0];
     w.c_LF_thigh[3] = -v[7]*w.v_LF_thigh[5];
     w.c_LF_thigh[5] = v[7]*w.v_LF_thigh[3];
-    const Scalar h7 = 0.6890000000000001*w.v_LF_thigh[0] - 0.01268*w.v_LF_thigh[4] + 0.010144*w.v_LF_thigh[5];
-    const Scalar h8 = 0.6890000000000001*w.v_LF_hip[1] + 0.01268*w.v_LF_thigh[3];
-    const Scalar h9 = 0.6890000000000001*w.v_LF_thigh[2] - 0.010144*w.v_LF_thigh[3];
-    const Scalar h10 = 0.01268*w.v_LF_hip[1] - 0.010144*w.v_LF_thigh[2] + 0.002431904*w.v_LF_thigh[3];
-    const Scalar h11 = -0.01268*w.v_LF_thigh[0] + 0.0024196*w.v_LF_thigh[4] - 0.00020288*w.v_LF_thigh[5];
-    const Scalar h12 = 0.010144*w.v_LF_thigh[0] - 0.00020288*w.v_LF_thigh[4] + 0.0006033039999999999*w.v_LF_thigh[5];
-    w.pA_LF_thigh[0] = -w.v_LF_thigh[5]*h8 + w.v_LF_thigh[4]*h9;
-    w.pA_LF_thigh[1] = -w.v_LF_thigh[3]*h9 + w.v_LF_thigh[5]*h7;
-    w.pA_LF_thigh[2] = -w.v_LF_thigh[4]*h7 + w.v_LF_thigh[3]*h8;
-    w.pA_LF_thigh[3] = -w.v_LF_thigh[5]*h11 + w.v_LF_thigh[4]*h12 - w.v_LF_thigh[2]*h8 + w.v_LF_hip[1]*h9;
-    w.pA_LF_thigh[4] = -w.v_LF_thigh[3]*h12 + w.v_LF_thigh[5]*h10 - w.v_LF_thigh[0]*h9 + w.v_LF_thigh[2]*h7;
-    w.pA_LF_thigh[5] = -w.v_LF_thigh[4]*h10 + w.v_LF_thigh[3]*h11 - w.v_LF_hip[1]*h7 + w.v_LF_thigh[0]*h8;
+    const Scalar h0 = 0.6890000000000001*w.v_LF_thigh[0] - 0.01268*w.v_LF_thigh[4] + 0.010144*w.v_LF_thigh[5];
+    const Scalar h1 = 0.6890000000000001*w.v_LF_hip[1] + 0.01268*w.v_LF_thigh[3];
+    const Scalar h2 = 0.6890000000000001*w.v_LF_thigh[2] - 0.010144*w.v_LF_thigh[3];
+    const Scalar h3 = 0.01268*w.v_LF_hip[1] - 0.010144*w.v_LF_thigh[2] + 0.002431904*w.v_LF_thigh[3];
+    const Scalar h4 = -0.01268*w.v_LF_thigh[0] + 0.0024196*w.v_LF_thigh[4] - 0.00020288*w.v_LF_thigh[5];
+    const Scalar h5 = 0.010144*w.v_LF_thigh[0] - 0.00020288*w.v_LF_thigh[4] + 0.0006033039999999999*w.v_LF_thigh[5];
+    w.pA_LF_thigh[0] = -w.v_LF_thigh[5]*h1 + w.v_LF_thigh[4]*h2;
+    w.pA_LF_thigh[1] = -w.v_LF_thigh[3]*h2 + w.v_LF_thigh[5]*h0;
+    w.pA_LF_thigh[2] = -w.v_LF_thigh[4]*h0 + w.v_LF_thigh[3]*h1;
+    w.pA_LF_thigh[3] = -w.v_LF_thigh[5]*h4 + w.v_LF_thigh[4]*h5 - w.v_LF_thigh[2]*h1 + w.v_LF_hip[1]*h2;
+    w.pA_LF_thigh[4] = -w.v_LF_thigh[3]*h5 + w.v_LF_thigh[5]*h3 - w.v_LF_thigh[0]*h2 + w.v_LF_thigh[2]*h0;
+    w.pA_LF_thigh[5] = -w.v_LF_thigh[4]*h3 + w.v_LF_thigh[3]*h4 - w.v_LF_hip[1]*h0 + w.v_LF_thigh[0]*h1;
     w.g_LF_thigh[0] = w.g_LF_hip[0]*w.cq_LF_thigh - w.g_LF_hip[2]*w.sq_LF_thigh;
     w.g_LF_thigh[2] = w.g_LF_hip[0]*w.sq_LF_thigh + w.g_LF_hip[2]*w.cq_LF_thigh;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     w.sq_LF_shank = std::sin(q[9]);
     w.cq_LF_shank = std::cos(q[9]);
-    const Scalar t0 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
-    const Scalar t1 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
-    w.v_LF_shank[0] = w.cq_LF_shank*t0 - w.v_LF_thigh[2]*w.sq_LF_shank;
-    w.v_LF_shank[1] = t1;
-    w.v_LF_shank[2] = w.sq_LF_shank*t0 + w.v_LF_thigh[2]*w.cq_LF_shank;
+    const Scalar t2 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
+    const Scalar t3 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
+    w.v_LF_shank[0] = w.cq_LF_shank*t2 - w.v_LF_thigh[2]*w.sq_LF_shank;
+    w.v_LF_shank[1] = t3;
+    w.v_LF_shank[2] = w.sq_LF_shank*t2 + w.v_LF_thigh[2]*w.cq_LF_shank;
     w.v_LF_shank[3] = w.v_LF_thigh[3]*w.cq_LF_shank - w.v_LF_thigh[5]*w.sq_LF_shank;
     w.v_LF_shank[4] = w.v_LF_thigh[4] + v[8];
     w.v_LF_shank[5] = w.v_LF_thigh[3]*w.sq_LF_shank + w.v_LF_thigh[5]*w.cq_LF_shank;
@@ -126,26 +126,29 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.c_LF_shank[2] = v[8]*w.v_LF_shank[0];
     w.c_LF_shank[3] = -v[8]*w.v_LF_shank[5];
     w.c_LF_shank[5] = v[8]*w.v_LF_shank[3];
-    const Scalar h0 = 0.064*w.v_LF_shank[0] - 0.003904*w.v_LF_shank[4];
-    const Scalar h1 = 0.064*w.v_LF_shank[1] + 0.003904*w.v_LF_shank[3];
-    const Scalar h2 = 0.003904*w.v_LF_shank[1] + 0.000483144*w.v_LF_shank[3];
-    const Scalar h3 = -0.003904*w.v_LF_shank[0] + 0.000486144*w.v_LF_shank[4];
-    w.pA_LF_shank[0] = -w.v_LF_shank[5]*h1 + 0.064*w.v_LF_shank[2]*w.v_LF_shank[4];
-    w.pA_LF_shank[1] = -0.064*w.v_LF_shank[2]*w.v_LF_shank[3] + w.v_LF_shank[5]*h0;
-    w.pA_LF_shank[2] = -w.v_LF_shank[4]*h0 + w.v_LF_shank[3]*h1;
-    w.pA_LF_shank[3] = -w.v_LF_shank[5]*h3 + 6e-06*w.v_LF_shank[4]*w.v_LF_shank[5] - w.v_LF_shank[2]*h1 + 0.064*w.v_LF_shank[1]*w.v_LF_shank[2];
-    w.pA_LF_shank[4] = -6e-06*w.v_LF_shank[3]*w.v_LF_shank[5] + w.v_LF_shank[5]*h2 - 0.064*w.v_LF_shank[0]*w.v_LF_shank[2] + w.v_LF_shank[2]*h0;
-    w.pA_LF_shank[5] = -w.v_LF_shank[4]*h2 + w.v_LF_shank[3]*h3 - w.v_LF_shank[1]*h0 + w.v_LF_shank[0]*h1;
+    const Scalar h6 = 0.064*w.v_LF_shank[0] - 0.003904*w.v_LF_shank[4];
+    const Scalar h7 = 0.064*w.v_LF_shank[1] + 0.003904*w.v_LF_shank[3];
+    const Scalar h8 = 0.003904*w.v_LF_shank[1] + 0.000483144*w.v_LF_shank[3];
+    const Scalar h9 = -0.003904*w.v_LF_shank[0] + 0.000486144*w.v_LF_shank[4];
+    w.pA_LF_shank[0] = -w.v_LF_shank[5]*h7 + 0.064*w.v_LF_shank[2]*w.v_LF_shank[4];
+    w.pA_LF_shank[1] = -0.064*w.v_LF_shank[2]*w.v_LF_shank[3] + w.v_LF_shank[5]*h6;
+    w.pA_LF_shank[2] = -w.v_LF_shank[4]*h6 + w.v_LF_shank[3]*h7;
+    w.pA_LF_shank[3] = -w.v_LF_shank[5]*h9 + 6e-06*w.v_LF_shank[4]*w.v_LF_shank[5] - w.v_LF_shank[2]*h7 + 0.064*w.v_LF_shank[1]*w.v_LF_shank[2];
+    w.pA_LF_shank[4] = -6e-06*w.v_LF_shank[3]*w.v_LF_shank[5] + w.v_LF_shank[5]*h8 - 0.064*w.v_LF_shank[0]*w.v_LF_shank[2] + w.v_LF_shank[2]*h6;
+    w.pA_LF_shank[5] = -w.v_LF_shank[4]*h8 + w.v_LF_shank[3]*h9 - w.v_LF_shank[1]*h6 + w.v_LF_shank[0]*h7;
     w.g_LF_shank[0] = w.g_LF_thigh[0]*w.cq_LF_shank - w.g_LF_thigh[2]*w.sq_LF_shank;
     w.g_LF_shank[2] = w.g_LF_thigh[0]*w.sq_LF_shank + w.g_LF_thigh[2]*w.cq_LF_shank;
     // constraint 'lf_foot' (3d) on link 'LF_foot': rows 0..2
-    const Scalar t2 = w.v_LF_shank[1] + 0.195*w.v_LF_shank[3];
-    const Scalar t3 = w.v_LF_shank[2] + 0.004*w.v_LF_shank[3];
-    const Scalar t4 = w.v_LF_shank[0] - 0.195*w.v_LF_shank[4] - 0.004*w.v_LF_shank[5];
-    w.k_lf_foot[0] = -w.g_LF_shank[0] + w.v_LF_shank[5]*t2 - w.v_LF_shank[4]*t3;
-    w.k_lf_foot[1] = -w.g_LF_hip[1] + w.v_LF_shank[3]*t3 - w.v_LF_shank[5]*t4;
-    w.k_lf_foot[2] = -w.g_LF_shank[2] + w.v_LF_shank[4]*t4 - w.v_LF_shank[3]*t2;
+    const Scalar t4 = w.v_LF_shank[1] + 0.195*w.v_LF_shank[3];
+    const Scalar t5 = w.v_LF_shank[2] + 0.004*w.v_LF_shank[3];
+    const Scalar t6 = w.v_LF_shank[0] - 0.195*w.v_LF_shank[4] - 0.004*w.v_LF_shank[5];
+    w.k_lf_foot[0] = -w.g_LF_shank[0] + w.v_LF_shank[5]*t4 - w.v_LF_shank[4]*t5;
+    w.k_lf_foot[1] = -w.g_LF_hip[1] + w.v_LF_shank[3]*t5 - w.v_LF_shank[5]*t6;
+    w.k_lf_foot[2] = -w.g_LF_shank[2] + w.v_LF_shank[4]*t6 - w.v_LF_shank[3]*t4;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.sq_LH_hip = std::sin(q[10]);
@@ -158,12 +161,12 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.RJ_LH_hip[6] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
     w.RJ_LH_hip[7] = 0.9950371902099892*w.sq_LH_hip;
     w.RJ_LH_hip[8] = 0.009900990099009901 + 0.9900990099009901*w.cq_LH_hip;
-    const Scalar t5 = v[0] - 0.049*v[5];
-    const Scalar t6 = v[1] - 0.19*v[5];
-    const Scalar t7 = v[2] + 0.049*v[3] + 0.19*v[4];
-    w.v_LH_hip[0] = w.RJ_LH_hip[0]*t5 + w.RJ_LH_hip[3]*t6 + w.RJ_LH_hip[6]*t7;
-    w.v_LH_hip[1] = w.RJ_LH_hip[1]*t5 + w.cq_LH_hip*t6 + w.RJ_LH_hip[7]*t7;
-    w.v_LH_hip[2] = w.RJ_LH_hip[2]*t5 + w.RJ_LH_hip[5]*t6 + w.RJ_LH_hip[8]*t7;
+    const Scalar t0 = v[0] - 0.049*v[5];
+    const Scalar t1 = v[1] - 0.19*v[5];
+    const Scalar t2 = v[2] + 0.049*v[3] + 0.19*v[4];
+    w.v_LH_hip[0] = w.RJ_LH_hip[0]*t0 + w.RJ_LH_hip[3]*t1 + w.RJ_LH_hip[6]*t2;
+    w.v_LH_hip[1] = w.RJ_LH_hip[1]*t0 + w.cq_LH_hip*t1 + w.RJ_LH_hip[7]*t2;
+    w.v_LH_hip[2] = w.RJ_LH_hip[2]*t0 + w.RJ_LH_hip[5]*t1 + w.RJ_LH_hip[8]*t2;
     w.v_LH_hip[3] = 0.9950371902099892*v[9] + v[3]*w.RJ_LH_hip[0] + v[4]*w.RJ_LH_hip[3] + v[5]*w.RJ_LH_hip[6];
     w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[1] + v[4]*w.cq_LH_hip + v[5]*w.RJ_LH_hip[7];
     w.v_LH_hip[5] = -0.09950371902099892*v[9] + v[3]*w.RJ_LH_hip[2] + v[4]*w.RJ_LH_hip[5] + v[5]*w.RJ_LH_hip[8];
@@ -173,17 +176,17 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.c_LH_hip[3] = -0.09950371902099892*v[9]*w.v_LH_hip[4];
     w.c_LH_hip[4] = 0.09950371902099892*v[9]*w.v_LH_hip[3] + 0.9950371902099892*v[9]*w.v_LH_hip[5];
     w.c_LH_hip[5] = -0.9950371902099892*v[9]*w.v_LH_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
-    const Scalar h6 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
-    const Scalar h7 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
-    const Scalar h8 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
-    w.pA_LH_hip[0] = -0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5] + w.v_LH_hip[4]*h5;
-    w.pA_LH_hip[1] = -w.v_LH_hip[3]*h5 + w.v_LH_hip[5]*h4;
-    w.pA_LH_hip[2] = -w.v_LH_hip[4]*h4 + 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3];
-    w.pA_LH_hip[3] = -w.v_LH_hip[5]*h7 + w.v_LH_hip[4]*h8 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2] + w.v_LH_hip[1]*h5;
-    w.pA_LH_hip[4] = -w.v_LH_hip[3]*h8 + w.v_LH_hip[5]*h6 - w.v_LH_hip[0]*h5 + w.v_LH_hip[2]*h4;
-    w.pA_LH_hip[5] = -w.v_LH_hip[4]*h6 + w.v_LH_hip[3]*h7 - w.v_LH_hip[1]*h4 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1];
+    const Scalar h0 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
+    const Scalar h2 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
+    const Scalar h3 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
+    const Scalar h4 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
+    w.pA_LH_hip[0] = -0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5] + w.v_LH_hip[4]*h1;
+    w.pA_LH_hip[1] = -w.v_LH_hip[3]*h1 + w.v_LH_hip[5]*h0;
+    w.pA_LH_hip[2] = -w.v_LH_hip[4]*h0 + 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3];
+    w.pA_LH_hip[3] = -w.v_LH_hip[5]*h3 + w.v_LH_hip[4]*h4 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2] + w.v_LH_hip[1]*h1;
+    w.pA_LH_hip[4] = -w.v_LH_hip[3]*h4 + w.v_LH_hip[5]*h2 - w.v_LH_hip[0]*h1 + w.v_LH_hip[2]*h0;
+    w.pA_LH_hip[5] = -w.v_LH_hip[4]*h2 + w.v_LH_hip[3]*h3 - w.v_LH_hip[1]*h0 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1];
     w.g_LH_hip[0] = w.g_trunk[0]*w.RJ_LH_hip[0] + w.g_trunk[1]*w.RJ_LH_hip[3] + w.g_trunk[2]*w.RJ_LH_hip[6];
     w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[1] + w.g_trunk[1]*w.cq_LH_hip + w.g_trunk[2]*w.RJ_LH_hip[7];
     w.g_LH_hip[2] = w.g_trunk[0]*w.RJ_LH_hip[2] + w.g_trunk[1]*w.RJ_LH_hip[5] + w.g_trunk[2]*w.RJ_LH_hip[8];
@@ -192,10 +195,10 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
   {
     w.sq_LH_thigh = std::sin(q[11]);
     w.cq_LH_thigh = std::cos(q[11]);
-    const Scalar t8 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
-    const Scalar t9 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
-    w.v_LH_thigh[0] = w.cq_LH_thigh*t8 - w.sq_LH_thigh*t9;
-    w.v_LH_thigh[2] = w.sq_LH_thigh*t8 + w.cq_LH_thigh*t9;
+    const Scalar t3 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
+    const Scalar t4 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
+    w.v_LH_thigh[0] = w.cq_LH_thigh*t3 - w.sq_LH_thigh*t4;
+    w.v_LH_thigh[2] = w.sq_LH_thigh*t3 + w.cq_LH_thigh*t4;
     w.v_LH_thigh[3] = w.v_LH_hip[3]*w.cq_LH_thigh - w.v_LH_hip[5]*w.sq_LH_thigh;
     w.v_LH_thigh[4] = w.v_LH_hip[4] + v[10];
     w.v_LH_thigh[5] = w.v_LH_hip[3]*w.sq_LH_thigh + w.v_LH_hip[5]*w.cq_LH_thigh;
@@ -203,24 +206,24 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* q, const Scalar* v, Workspac
     w.c_LH_thigh[2] = v[10]*w.v_LH_thigh[0];
     w.c_LH_thigh[3] = -v[10]*w.v_LH_thigh[5];
     w.c_LH_thigh[5] = v[10]*w.v_LH_thigh[3];
-    const Scalar h9 = 0.6890000000000001*w.v_LH_thigh[0] - 0.01268*w.v_LH_thigh[4] + 0.010144*w.v_LH_thigh[5];
-    const Scalar h10 = 0.6890000000000001*w.v_LH_hip[1] + 0.01268*w.v_LH_thigh[3];
-    const Scalar h11 = 0.6890000000000001*w.v_LH_thigh[2] - 0.010144*w.v_LH_thigh[3];
-    const Scalar h12 = 0.01268*w.v_LH_hip[1] - 0.010144*w.v_LH_thigh[2] + 0.002431904*w.v_LH_thigh[3];
-    const Scalar h13 = -0.01268*w.v_LH_thigh[0] + 0.0024196*w.v_LH_thigh[4] - 0.00020288*w.v_LH_thigh[5];
-    const Scalar h14 = 0.010144*w.v_LH_thigh[0] - 0.00020288*w.v_LH_thigh[4] + 0.0006033039999999999*w.v_LH_thigh[5];
-    w.pA_LH_thigh[0] = -w.v_LH_thigh[5]*h10 + w.v_LH_thigh[4]*h11;
-    w.pA_LH_thigh[1] = -w.v_LH_thigh[3]*h11 + w.v_LH_thigh[5]*h9;
-    w.pA_LH_thigh[2] = -w.v_LH_thigh[4]*h9 + w.v_LH_thigh[3]*h10;
-    w.pA_LH_thigh[3] = -w.v_LH_thigh[5]*h13 + w.v_LH_thigh[4]*h14 - w.v_LH_thigh[2]*h10 + w.v_LH_hip[1]*h11;
-    w.pA_LH_thigh[4] = -w.v_LH_thigh[3]*h14 + w.v_LH_thigh[5]*h12 - w.v_LH_thigh[0]*h11 + w.v_LH_thigh[2]*h9;
-    w.pA_LH_thigh[5] = -w.v_LH_thigh[4]*h12 + w.v_LH_thigh[3]*h13 - w.v_LH_hip[1]*h9 + w.v_LH_thigh[0]*h10;
+    const Scalar h5 = 0.6890000000000001*w.v_LH_thigh[0] - 0.01268*w.v_LH_thigh[4] + 0.010144*w.v_LH_thigh[5];
+    const Scalar h6 = 0.6890000000000001*w.v_LH_hip[1] + 0.01268*w.v_LH_thigh[3];
+    const Scalar h7 = 0.6890000000000001*w.v_LH_thigh[2] - 0.010144*w.v_LH_thigh[3];
+    const Scalar h8 = 0.01268*w.v_LH_hip[1] - 0.010144*w.v_LH_thigh[2] + 0.002431904*w.v_LH_thigh[3];
+    const Scalar h9 = -0.01268*w.v_LH_thigh[0] + 0.0024196*w.v_LH_thigh[4] - 0.00020288*w.v_LH_thigh[5];
+    const Scalar h10 = 0.010144*w.v_LH_thigh[0] - 0.00020288*w.v_LH_thigh[4] + 0.0006033039999999999*w.v_LH_thigh[5];
+    w.pA_LH_thigh[0] = -w.v_LH_thigh[5]*h6 + w.v_LH_thigh[4]*h7;
+    w.pA_LH_thigh[1] = -w.v_LH_thigh[3]*h7 + w.v_LH_thigh[5]*h5;
+    w.pA_LH_thigh[2] = -w.v_LH_thigh[4]*h5 + w.v_LH_thigh[3]*h6;
+    w.pA_LH_thigh[3] = -w.v_LH_thigh[5]*h9 + w.v_LH_thigh[4]*h10 - w.v_LH_thigh[2]*h6 + w.v_LH_hip[1]*h7;
+    w.pA_LH_thigh[4] = -w.v_LH_thigh[3]*h10 + w.v_LH_thigh[5]*h8 - w.v_LH_thigh[0]*h7 + w.v_LH_thigh[2]*h5;
+    w.pA_LH_thigh[5] = -w.v_LH_thigh[4]*h8 + w.v_LH_thigh[3]*h9 - w.v_LH_hip[1]*h5 + w.v_LH_thigh[0]*h6;
     w.g_LH_thigh[0] = w.g_LH_hip[0]*w.cq_LH_thigh - w.g_LH_hip[2]*w.sq_LH_thigh;
     w.g_LH_thigh[2] = w.g_LH_hip[0]*w.sq_LH_thigh + w.g_LH_hip[2]*w.cq_LH_thigh;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     w.sq_LH_shank = std::sin(q[12]);
@@ -299,14 +302,17 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspac
     w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[1] + w.g_trunk[1]*w.cq_RF_hip + w.g_trunk[2]*w.RJ_RF_hip[7];
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[2] + w.g_trunk[1]*w.RJ_RF_hip[5] + w.g_trunk[2]*w.RJ_RF_hip[8];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.sq_RF_thigh = std::sin(q[14]);
     w.cq_RF_thigh = std::cos(q[14]);
-    const Scalar t8 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
-    const Scalar t9 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
-    w.v_RF_thigh[0] = w.cq_RF_thigh*t8 - w.sq_RF_thigh*t9;
-    w.v_RF_thigh[2] = w.sq_RF_thigh*t8 + w.cq_RF_thigh*t9;
+    const Scalar t0 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
+    const Scalar t1 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
+    w.v_RF_thigh[0] = w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
+    w.v_RF_thigh[2] = w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
     w.v_RF_thigh[3] = w.v_RF_hip[3]*w.cq_RF_thigh - w.v_RF_hip[5]*w.sq_RF_thigh;
     w.v_RF_thigh[4] = w.v_RF_hip[4] + v[13];
     w.v_RF_thigh[5] = w.v_RF_hip[3]*w.sq_RF_thigh + w.v_RF_hip[5]*w.cq_RF_thigh;
@@ -314,33 +320,30 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* q, const Scalar* v, Workspac
     w.c_RF_thigh[2] = v[13]*w.v_RF_thigh[0];
     w.c_RF_thigh[3] = -v[13]*w.v_RF_thigh[5];
     w.c_RF_thigh[5] = v[13]*w.v_RF_thigh[3];
-    const Scalar h9 = 0.6890000000000001*w.v_RF_thigh[0] - 0.01268*w.v_RF_thigh[4] - 0.010144*w.v_RF_thigh[5];
-    const Scalar h10 = 0.6890000000000001*w.v_RF_hip[1] + 0.01268*w.v_RF_thigh[3];
-    const Scalar h11 = 0.6890000000000001*w.v_RF_thigh[2] + 0.010144*w.v_RF_thigh[3];
-    const Scalar h12 = 0.01268*w.v_RF_hip[1] + 0.010144*w.v_RF_thigh[2] + 0.002431904*w.v_RF_thigh[3];
-    const Scalar h13 = -0.01268*w.v_RF_thigh[0] + 0.0024196*w.v_RF_thigh[4] + 0.00020288*w.v_RF_thigh[5];
-    const Scalar h14 = -0.010144*w.v_RF_thigh[0] + 0.00020288*w.v_RF_thigh[4] + 0.0006033039999999999*w.v_RF_thigh[5];
-    w.pA_RF_thigh[0] = -w.v_RF_thigh[5]*h10 + w.v_RF_thigh[4]*h11;
-    w.pA_RF_thigh[1] = -w.v_RF_thigh[3]*h11 + w.v_RF_thigh[5]*h9;
-    w.pA_RF_thigh[2] = -w.v_RF_thigh[4]*h9 + w.v_RF_thigh[3]*h10;
-    w.pA_RF_thigh[3] = -w.v_RF_thigh[5]*h13 + w.v_RF_thigh[4]*h14 - w.v_RF_thigh[2]*h10 + w.v_RF_hip[1]*h11;
-    w.pA_RF_thigh[4] = -w.v_RF_thigh[3]*h14 + w.v_RF_thigh[5]*h12 - w.v_RF_thigh[0]*h11 + w.v_RF_thigh[2]*h9;
-    w.pA_RF_thigh[5] = -w.v_RF_thigh[4]*h12 + w.v_RF_thigh[3]*h13 - w.v_RF_hip[1]*h9 + w.v_RF_thigh[0]*h10;
+    const Scalar h0 = 0.6890000000000001*w.v_RF_thigh[0] - 0.01268*w.v_RF_thigh[4] - 0.010144*w.v_RF_thigh[5];
+    const Scalar h1 = 0.6890000000000001*w.v_RF_hip[1] + 0.01268*w.v_RF_thigh[3];
+    const Scalar h2 = 0.6890000000000001*w.v_RF_thigh[2] + 0.010144*w.v_RF_thigh[3];
+    const Scalar h3 = 0.01268*w.v_RF_hip[1] + 0.010144*w.v_RF_thigh[2] + 0.002431904*w.v_RF_thigh[3];
+    const Scalar h4 = -0.01268*w.v_RF_thigh[0] + 0.0024196*w.v_RF_thigh[4] + 0.00020288*w.v_RF_thigh[5];
+    const Scalar h5 = -0.010144*w.v_RF_thigh[0] + 0.00020288*w.v_RF_thigh[4] + 0.0006033039999999999*w.v_RF_thigh[5];
+    w.pA_RF_thigh[0] = -w.v_RF_thigh[5]*h1 + w.v_RF_thigh[4]*h2;
+    w.pA_RF_thigh[1] = -w.v_RF_thigh[3]*h2 + w.v_RF_thigh[5]*h0;
+    w.pA_RF_thigh[2] = -w.v_RF_thigh[4]*h0 + w.v_RF_thigh[3]*h1;
+    w.pA_RF_thigh[3] = -w.v_RF_thigh[5]*h4 + w.v_RF_thigh[4]*h5 - w.v_RF_thigh[2]*h1 + w.v_RF_hip[1]*h2;
+    w.pA_RF_thigh[4] = -w.v_RF_thigh[3]*h5 + w.v_RF_thigh[5]*h3 - w.v_RF_thigh[0]*h2 + w.v_RF_thigh[2]*h0;
+    w.pA_RF_thigh[5] = -w.v_RF_thigh[4]*h3 + w.v_RF_thigh[3]*h4 - w.v_RF_hip[1]*h0 + w.v_RF_thigh[0]*h1;
     w.g_RF_thigh[0] = w.g_RF_hip[0]*w.cq_RF_thigh - w.g_RF_hip[2]*w.sq_RF_thigh;
     w.g_RF_thigh[2] = w.g_RF_hip[0]*w.sq_RF_thigh + w.g_RF_hip[2]*w.cq_RF_thigh;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     w.sq_RF_shank = std::sin(q[15]);
     w.cq_RF_shank = std::cos(q[15]);
-    const Scalar t0 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
-    const Scalar t1 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
-    w.v_RF_shank[0] = w.cq_RF_shank*t0 - w.v_RF_thigh[2]*w.sq_RF_shank;
-    w.v_RF_shank[1] = t1;
-    w.v_RF_shank[2] = w.sq_RF_shank*t0 + w.v_RF_thigh[2]*w.cq_RF_shank;
+    const Scalar t2 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
+    const Scalar t3 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
+    w.v_RF_shank[0] = w.cq_RF_shank*t2 - w.v_RF_thigh[2]*w.sq_RF_shank;
+    w.v_RF_shank[1] = t3;
+    w.v_RF_shank[2] = w.sq_RF_shank*t2 + w.v_RF_thigh[2]*w.cq_RF_shank;
     w.v_RF_shank[3] = w.v_RF_thigh[3]*w.cq_RF_shank - w.v_RF_thigh[5]*w.sq_RF_shank;
     w.v_RF_shank[4] = w.v_RF_thigh[4] + v[14];
     w.v_RF_shank[5] = w.v_RF_thigh[3]*w.sq_RF_shank + w.v_RF_thigh[5]*w.cq_RF_shank;
@@ -348,26 +351,29 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.c_RF_shank[2] = v[14]*w.v_RF_shank[0];
     w.c_RF_shank[3] = -v[14]*w.v_RF_shank[5];
     w.c_RF_shank[5] = v[14]*w.v_RF_shank[3];
-    const Scalar h0 = 0.064*w.v_RF_shank[0] - 0.003904*w.v_RF_shank[4];
-    const Scalar h1 = 0.064*w.v_RF_shank[1] + 0.003904*w.v_RF_shank[3];
-    const Scalar h2 = 0.003904*w.v_RF_shank[1] + 0.000483144*w.v_RF_shank[3];
-    const Scalar h3 = -0.003904*w.v_RF_shank[0] + 0.000486144*w.v_RF_shank[4];
-    w.pA_RF_shank[0] = -w.v_RF_shank[5]*h1 + 0.064*w.v_RF_shank[2]*w.v_RF_shank[4];
-    w.pA_RF_shank[1] = -0.064*w.v_RF_shank[2]*w.v_RF_shank[3] + w.v_RF_shank[5]*h0;
-    w.pA_RF_shank[2] = -w.v_RF_shank[4]*h0 + w.v_RF_shank[3]*h1;
-    w.pA_RF_shank[3] = -w.v_RF_shank[5]*h3 + 6e-06*w.v_RF_shank[4]*w.v_RF_shank[5] - w.v_RF_shank[2]*h1 + 0.064*w.v_RF_shank[1]*w.v_RF_shank[2];
-    w.pA_RF_shank[4] = -6e-06*w.v_RF_shank[3]*w.v_RF_shank[5] + w.v_RF_shank[5]*h2 - 0.064*w.v_RF_shank[0]*w.v_RF_shank[2] + w.v_RF_shank[2]*h0;
-    w.pA_RF_shank[5] = -w.v_RF_shank[4]*h2 + w.v_RF_shank[3]*h3 - w.v_RF_shank[1]*h0 + w.v_RF_shank[0]*h1;
+    const Scalar h6 = 0.064*w.v_RF_shank[0] - 0.003904*w.v_RF_shank[4];
+    const Scalar h7 = 0.064*w.v_RF_shank[1] + 0.003904*w.v_RF_shank[3];
+    const Scalar h8 = 0.003904*w.v_RF_shank[1] + 0.000483144*w.v_RF_shank[3];
+    const Scalar h9 = -0.003904*w.v_RF_shank[0] + 0.000486144*w.v_RF_shank[4];
+    w.pA_RF_shank[0] = -w.v_RF_shank[5]*h7 + 0.064*w.v_RF_shank[2]*w.v_RF_shank[4];
+    w.pA_RF_shank[1] = -0.064*w.v_RF_shank[2]*w.v_RF_shank[3] + w.v_RF_shank[5]*h6;
+    w.pA_RF_shank[2] = -w.v_RF_shank[4]*h6 + w.v_RF_shank[3]*h7;
+    w.pA_RF_shank[3] = -w.v_RF_shank[5]*h9 + 6e-06*w.v_RF_shank[4]*w.v_RF_shank[5] - w.v_RF_shank[2]*h7 + 0.064*w.v_RF_shank[1]*w.v_RF_shank[2];
+    w.pA_RF_shank[4] = -6e-06*w.v_RF_shank[3]*w.v_RF_shank[5] + w.v_RF_shank[5]*h8 - 0.064*w.v_RF_shank[0]*w.v_RF_shank[2] + w.v_RF_shank[2]*h6;
+    w.pA_RF_shank[5] = -w.v_RF_shank[4]*h8 + w.v_RF_shank[3]*h9 - w.v_RF_shank[1]*h6 + w.v_RF_shank[0]*h7;
     w.g_RF_shank[0] = w.g_RF_thigh[0]*w.cq_RF_shank - w.g_RF_thigh[2]*w.sq_RF_shank;
     w.g_RF_shank[2] = w.g_RF_thigh[0]*w.sq_RF_shank + w.g_RF_thigh[2]*w.cq_RF_shank;
     // constraint 'rf_foot' (3d) on link 'RF_foot': rows 3..5
-    const Scalar t2 = w.v_RF_shank[1] + 0.195*w.v_RF_shank[3];
-    const Scalar t3 = w.v_RF_shank[2] - 0.004*w.v_RF_shank[3];
-    const Scalar t4 = w.v_RF_shank[0] - 0.195*w.v_RF_shank[4] + 0.004*w.v_RF_shank[5];
-    w.k_rf_foot[0] = -w.g_RF_shank[0] + w.v_RF_shank[5]*t2 - w.v_RF_shank[4]*t3;
-    w.k_rf_foot[1] = -w.g_RF_hip[1] + w.v_RF_shank[3]*t3 - w.v_RF_shank[5]*t4;
-    w.k_rf_foot[2] = -w.g_RF_shank[2] + w.v_RF_shank[4]*t4 - w.v_RF_shank[3]*t2;
+    const Scalar t4 = w.v_RF_shank[1] + 0.195*w.v_RF_shank[3];
+    const Scalar t5 = w.v_RF_shank[2] - 0.004*w.v_RF_shank[3];
+    const Scalar t6 = w.v_RF_shank[0] - 0.195*w.v_RF_shank[4] + 0.004*w.v_RF_shank[5];
+    w.k_rf_foot[0] = -w.g_RF_shank[0] + w.v_RF_shank[5]*t4 - w.v_RF_shank[4]*t5;
+    w.k_rf_foot[1] = -w.g_RF_hip[1] + w.v_RF_shank[3]*t5 - w.v_RF_shank[5]*t6;
+    w.k_rf_foot[2] = -w.g_RF_shank[2] + w.v_RF_shank[4]*t6 - w.v_RF_shank[3]*t4;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.sq_RH_hip = std::sin(q[16]);
@@ -380,12 +386,12 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.RJ_RH_hip[6] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
     w.RJ_RH_hip[7] = 0.9950371902099892*w.sq_RH_hip;
     w.RJ_RH_hip[8] = 0.009900990099009901 + 0.9900990099009901*w.cq_RH_hip;
-    const Scalar t5 = v[0] + 0.049*v[5];
-    const Scalar t6 = v[1] - 0.19*v[5];
-    const Scalar t7 = v[2] - 0.049*v[3] + 0.19*v[4];
-    w.v_RH_hip[0] = w.RJ_RH_hip[0]*t5 + w.RJ_RH_hip[3]*t6 + w.RJ_RH_hip[6]*t7;
-    w.v_RH_hip[1] = w.RJ_RH_hip[1]*t5 + w.cq_RH_hip*t6 + w.RJ_RH_hip[7]*t7;
-    w.v_RH_hip[2] = w.RJ_RH_hip[2]*t5 + w.RJ_RH_hip[5]*t6 + w.RJ_RH_hip[8]*t7;
+    const Scalar t0 = v[0] + 0.049*v[5];
+    const Scalar t1 = v[1] - 0.19*v[5];
+    const Scalar t2 = v[2] - 0.049*v[3] + 0.19*v[4];
+    w.v_RH_hip[0] = w.RJ_RH_hip[0]*t0 + w.RJ_RH_hip[3]*t1 + w.RJ_RH_hip[6]*t2;
+    w.v_RH_hip[1] = w.RJ_RH_hip[1]*t0 + w.cq_RH_hip*t1 + w.RJ_RH_hip[7]*t2;
+    w.v_RH_hip[2] = w.RJ_RH_hip[2]*t0 + w.RJ_RH_hip[5]*t1 + w.RJ_RH_hip[8]*t2;
     w.v_RH_hip[3] = 0.9950371902099892*v[15] + v[3]*w.RJ_RH_hip[0] + v[4]*w.RJ_RH_hip[3] + v[5]*w.RJ_RH_hip[6];
     w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[1] + v[4]*w.cq_RH_hip + v[5]*w.RJ_RH_hip[7];
     w.v_RH_hip[5] = -0.09950371902099892*v[15] + v[3]*w.RJ_RH_hip[2] + v[4]*w.RJ_RH_hip[5] + v[5]*w.RJ_RH_hip[8];
@@ -395,17 +401,17 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.c_RH_hip[3] = -0.09950371902099892*v[15]*w.v_RH_hip[4];
     w.c_RH_hip[4] = 0.09950371902099892*v[15]*w.v_RH_hip[3] + 0.9950371902099892*v[15]*w.v_RH_hip[5];
     w.c_RH_hip[5] = -0.9950371902099892*v[15]*w.v_RH_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
-    const Scalar h6 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
-    const Scalar h7 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
-    const Scalar h8 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
-    w.pA_RH_hip[0] = -0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5] + w.v_RH_hip[4]*h5;
-    w.pA_RH_hip[1] = -w.v_RH_hip[3]*h5 + w.v_RH_hip[5]*h4;
-    w.pA_RH_hip[2] = -w.v_RH_hip[4]*h4 + 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3];
-    w.pA_RH_hip[3] = -w.v_RH_hip[5]*h7 + w.v_RH_hip[4]*h8 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2] + w.v_RH_hip[1]*h5;
-    w.pA_RH_hip[4] = -w.v_RH_hip[3]*h8 + w.v_RH_hip[5]*h6 - w.v_RH_hip[0]*h5 + w.v_RH_hip[2]*h4;
-    w.pA_RH_hip[5] = -w.v_RH_hip[4]*h6 + w.v_RH_hip[3]*h7 - w.v_RH_hip[1]*h4 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1];
+    const Scalar h0 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
+    const Scalar h2 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
+    const Scalar h3 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
+    const Scalar h4 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
+    w.pA_RH_hip[0] = -0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5] + w.v_RH_hip[4]*h1;
+    w.pA_RH_hip[1] = -w.v_RH_hip[3]*h1 + w.v_RH_hip[5]*h0;
+    w.pA_RH_hip[2] = -w.v_RH_hip[4]*h0 + 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3];
+    w.pA_RH_hip[3] = -w.v_RH_hip[5]*h3 + w.v_RH_hip[4]*h4 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2] + w.v_RH_hip[1]*h1;
+    w.pA_RH_hip[4] = -w.v_RH_hip[3]*h4 + w.v_RH_hip[5]*h2 - w.v_RH_hip[0]*h1 + w.v_RH_hip[2]*h0;
+    w.pA_RH_hip[5] = -w.v_RH_hip[4]*h2 + w.v_RH_hip[3]*h3 - w.v_RH_hip[1]*h0 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1];
     w.g_RH_hip[0] = w.g_trunk[0]*w.RJ_RH_hip[0] + w.g_trunk[1]*w.RJ_RH_hip[3] + w.g_trunk[2]*w.RJ_RH_hip[6];
     w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[1] + w.g_trunk[1]*w.cq_RH_hip + w.g_trunk[2]*w.RJ_RH_hip[7];
     w.g_RH_hip[2] = w.g_trunk[0]*w.RJ_RH_hip[2] + w.g_trunk[1]*w.RJ_RH_hip[5] + w.g_trunk[2]*w.RJ_RH_hip[8];
@@ -414,10 +420,10 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
   {
     w.sq_RH_thigh = std::sin(q[17]);
     w.cq_RH_thigh = std::cos(q[17]);
-    const Scalar t8 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
-    const Scalar t9 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
-    w.v_RH_thigh[0] = w.cq_RH_thigh*t8 - w.sq_RH_thigh*t9;
-    w.v_RH_thigh[2] = w.sq_RH_thigh*t8 + w.cq_RH_thigh*t9;
+    const Scalar t3 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
+    const Scalar t4 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
+    w.v_RH_thigh[0] = w.cq_RH_thigh*t3 - w.sq_RH_thigh*t4;
+    w.v_RH_thigh[2] = w.sq_RH_thigh*t3 + w.cq_RH_thigh*t4;
     w.v_RH_thigh[3] = w.v_RH_hip[3]*w.cq_RH_thigh - w.v_RH_hip[5]*w.sq_RH_thigh;
     w.v_RH_thigh[4] = w.v_RH_hip[4] + v[16];
     w.v_RH_thigh[5] = w.v_RH_hip[3]*w.sq_RH_thigh + w.v_RH_hip[5]*w.cq_RH_thigh;
@@ -425,24 +431,24 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* q, const Scalar* v, Workspac
     w.c_RH_thigh[2] = v[16]*w.v_RH_thigh[0];
     w.c_RH_thigh[3] = -v[16]*w.v_RH_thigh[5];
     w.c_RH_thigh[5] = v[16]*w.v_RH_thigh[3];
-    const Scalar h9 = 0.6890000000000001*w.v_RH_thigh[0] - 0.01268*w.v_RH_thigh[4] - 0.010144*w.v_RH_thigh[5];
-    const Scalar h10 = 0.6890000000000001*w.v_RH_hip[1] + 0.01268*w.v_RH_thigh[3];
-    const Scalar h11 = 0.6890000000000001*w.v_RH_thigh[2] + 0.010144*w.v_RH_thigh[3];
-    const Scalar h12 = 0.01268*w.v_RH_hip[1] + 0.010144*w.v_RH_thigh[2] + 0.002431904*w.v_RH_thigh[3];
-    const Scalar h13 = -0.01268*w.v_RH_thigh[0] + 0.0024196*w.v_RH_thigh[4] + 0.00020288*w.v_RH_thigh[5];
-    const Scalar h14 = -0.010144*w.v_RH_thigh[0] + 0.00020288*w.v_RH_thigh[4] + 0.0006033039999999999*w.v_RH_thigh[5];
-    w.pA_RH_thigh[0] = -w.v_RH_thigh[5]*h10 + w.v_RH_thigh[4]*h11;
-    w.pA_RH_thigh[1] = -w.v_RH_thigh[3]*h11 + w.v_RH_thigh[5]*h9;
-    w.pA_RH_thigh[2] = -w.v_RH_thigh[4]*h9 + w.v_RH_thigh[3]*h10;
-    w.pA_RH_thigh[3] = -w.v_RH_thigh[5]*h13 + w.v_RH_thigh[4]*h14 - w.v_RH_thigh[2]*h10 + w.v_RH_hip[1]*h11;
-    w.pA_RH_thigh[4] = -w.v_RH_thigh[3]*h14 + w.v_RH_thigh[5]*h12 - w.v_RH_thigh[0]*h11 + w.v_RH_thigh[2]*h9;
-    w.pA_RH_thigh[5] = -w.v_RH_thigh[4]*h12 + w.v_RH_thigh[3]*h13 - w.v_RH_hip[1]*h9 + w.v_RH_thigh[0]*h10;
+    const Scalar h5 = 0.6890000000000001*w.v_RH_thigh[0] - 0.01268*w.v_RH_thigh[4] - 0.010144*w.v_RH_thigh[5];
+    const Scalar h6 = 0.6890000000000001*w.v_RH_hip[1] + 0.01268*w.v_RH_thigh[3];
+    const Scalar h7 = 0.6890000000000001*w.v_RH_thigh[2] + 0.010144*w.v_RH_thigh[3];
+    const Scalar h8 = 0.01268*w.v_RH_hip[1] + 0.010144*w.v_RH_thigh[2] + 0.002431904*w.v_RH_thigh[3];
+    const Scalar h9 = -0.01268*w.v_RH_thigh[0] + 0.0024196*w.v_RH_thigh[4] + 0.00020288*w.v_RH_thigh[5];
+    const Scalar h10 = -0.010144*w.v_RH_thigh[0] + 0.00020288*w.v_RH_thigh[4] + 0.0006033039999999999*w.v_RH_thigh[5];
+    w.pA_RH_thigh[0] = -w.v_RH_thigh[5]*h6 + w.v_RH_thigh[4]*h7;
+    w.pA_RH_thigh[1] = -w.v_RH_thigh[3]*h7 + w.v_RH_thigh[5]*h5;
+    w.pA_RH_thigh[2] = -w.v_RH_thigh[4]*h5 + w.v_RH_thigh[3]*h6;
+    w.pA_RH_thigh[3] = -w.v_RH_thigh[5]*h9 + w.v_RH_thigh[4]*h10 - w.v_RH_thigh[2]*h6 + w.v_RH_hip[1]*h7;
+    w.pA_RH_thigh[4] = -w.v_RH_thigh[3]*h10 + w.v_RH_thigh[5]*h8 - w.v_RH_thigh[0]*h7 + w.v_RH_thigh[2]*h5;
+    w.pA_RH_thigh[5] = -w.v_RH_thigh[4]*h8 + w.v_RH_thigh[3]*h9 - w.v_RH_hip[1]*h5 + w.v_RH_thigh[0]*h6;
     w.g_RH_thigh[0] = w.g_RH_hip[0]*w.cq_RH_thigh - w.g_RH_hip[2]*w.sq_RH_thigh;
     w.g_RH_thigh[2] = w.g_RH_hip[0]*w.sq_RH_thigh + w.g_RH_hip[2]*w.cq_RH_thigh;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     w.sq_RH_shank = std::sin(q[18]);
@@ -481,7 +487,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* q, const Scalar* v, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     const Scalar t0 = 0.195*w.k_rh_foot[1] - 0.004*w.k_rh_foot[2];
@@ -544,83 +550,86 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_RH_thigh[4] = w.pA_RH_thigh[4] + pa4 - 0.209*t11;
     w.pA_RH_thigh[5] = w.pA_RH_thigh[5] - w.sq_RH_shank*pa3 + w.cq_RH_shank*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
     w.u_RH_thigh[0] = -w.pA_RH_thigh[4] + tau[16];
-    const Scalar t13 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar t14 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar t15 = w.IA_RH_thigh[16]*w.Dinv_RH_thigh;
-    const Scalar t16 = w.IA_RH_thigh[18]*w.Dinv_RH_thigh;
-    const Scalar t17 = w.IA_RH_thigh[19]*w.Dinv_RH_thigh;
-    const Scalar Ia6 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t13;
-    const Scalar Ia7 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t13;
-    const Scalar Ia8 = w.IA_RH_thigh[3] - w.IA_RH_thigh[16]*t13;
-    const Scalar Ia9 = w.IA_RH_thigh[5] - w.IA_RH_thigh[19]*t13;
-    const Scalar Ia10 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t14;
-    const Scalar Ia11 = w.IA_RH_thigh[12] - w.IA_RH_thigh[16]*t14;
-    const Scalar Ia12 = w.IA_RH_thigh[14] - w.IA_RH_thigh[19]*t14;
-    const Scalar Ia13 = w.IA_RH_thigh[15] - w.IA_RH_thigh[16]*t15;
-    const Scalar Ia14 = w.IA_RH_thigh[17] - w.IA_RH_thigh[19]*t15;
-    const Scalar Ia15 = w.IA_RH_thigh[20] - w.IA_RH_thigh[19]*t17;
-    const Scalar pa6 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t13 + w.c_RH_thigh[0]*Ia6 + w.c_RH_thigh[2]*Ia7 + w.c_RH_thigh[3]*Ia8 + w.c_RH_thigh[5]*Ia9;
-    const Scalar pa7 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
-    const Scalar pa8 = w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t14 + w.c_RH_thigh[0]*Ia7 + w.c_RH_thigh[2]*Ia10 + w.c_RH_thigh[3]*Ia11 + w.c_RH_thigh[5]*Ia12;
-    const Scalar pa9 = w.pA_RH_thigh[3] + w.u_RH_thigh[0]*t15 + w.c_RH_thigh[0]*Ia8 + w.c_RH_thigh[2]*Ia11 + w.c_RH_thigh[3]*Ia13 + w.c_RH_thigh[5]*Ia14;
-    const Scalar pa10 = w.pA_RH_thigh[4] + w.u_RH_thigh[0]*t16;
-    const Scalar pa11 = w.pA_RH_thigh[5] + w.u_RH_thigh[0]*t17 + w.c_RH_thigh[0]*Ia9 + w.c_RH_thigh[2]*Ia12 + w.c_RH_thigh[3]*Ia14 + w.c_RH_thigh[5]*Ia15;
-    const Scalar C21 = -w.sq_RH_thigh*w.sq_RH_thigh + w.cq_RH_thigh*w.cq_RH_thigh;
-    const Scalar h2 = 0.5*(-Ia6 + Ia10);
-    const Scalar m2 = 0.5*(Ia6 + Ia10);
-    const Scalar t18 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
-    const Scalar d0 = -Ia7*t18 + C21*h2;
-    const Scalar qq0 = Ia7*C21 + h2*t18;
-    const Scalar h3 = 0.5*(-Ia8 + Ia12);
-    const Scalar m3 = 0.5*(Ia8 + Ia12);
-    const Scalar t19 = 0.5*(Ia9 + Ia11);
-    const Scalar d1 = -t18*t19 + C21*h3;
-    const Scalar qq1 = C21*t19 + t18*h3;
-    const Scalar h4 = 0.5*(-Ia13 + Ia15);
-    const Scalar m4 = 0.5*(Ia13 + Ia15);
-    const Scalar d2 = -Ia14*t18 + C21*h4;
-    const Scalar qq2 = Ia14*C21 + t18*h4;
-    const Scalar t20 = m2 - d0;
-    const Scalar t21 = m2 + d0;
-    const Scalar t22 = m3 - d1;
-    const Scalar t23 = 0.5*Ia9 - 0.5*Ia11 + qq1;
-    const Scalar t24 = w.cq_RH_thigh*w.IA_RH_thigh[8] + w.sq_RH_thigh*w.IA_RH_thigh[10];
-    const Scalar t25 = -w.sq_RH_thigh*w.IA_RH_thigh[8] + w.cq_RH_thigh*w.IA_RH_thigh[10];
-    const Scalar t26 = -0.5*Ia9 + 0.5*Ia11 + qq1;
-    const Scalar t27 = m3 + d1;
-    const Scalar t28 = -0.062*qq0 + t22;
-    const Scalar t29 = 0.062*t20 + t23;
-    const Scalar t30 = -0.062*t21 + t26;
-    const Scalar t31 = 0.062*qq0 + t27;
-    const Scalar t32 = w.cq_RH_thigh*pa6 + w.sq_RH_thigh*pa8;
-    const Scalar t33 = -w.sq_RH_thigh*pa6 + w.cq_RH_thigh*pa8;
-    w.IA_RH_hip[0] = 0.5950000000000001 + t20;
+    const Scalar t0 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
+    const Scalar t1 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
+    const Scalar t2 = w.IA_RH_thigh[16]*w.Dinv_RH_thigh;
+    const Scalar t3 = w.IA_RH_thigh[18]*w.Dinv_RH_thigh;
+    const Scalar t4 = w.IA_RH_thigh[19]*w.Dinv_RH_thigh;
+    const Scalar Ia0 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t0;
+    const Scalar Ia2 = w.IA_RH_thigh[3] - w.IA_RH_thigh[16]*t0;
+    const Scalar Ia3 = w.IA_RH_thigh[5] - w.IA_RH_thigh[19]*t0;
+    const Scalar Ia4 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t1;
+    const Scalar Ia5 = w.IA_RH_thigh[12] - w.IA_RH_thigh[16]*t1;
+    const Scalar Ia6 = w.IA_RH_thigh[14] - w.IA_RH_thigh[19]*t1;
+    const Scalar Ia7 = w.IA_RH_thigh[15] - w.IA_RH_thigh[16]*t2;
+    const Scalar Ia8 = w.IA_RH_thigh[17] - w.IA_RH_thigh[19]*t2;
+    const Scalar Ia9 = w.IA_RH_thigh[20] - w.IA_RH_thigh[19]*t4;
+    const Scalar pa0 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t0 + w.c_RH_thigh[0]*Ia0 + w.c_RH_thigh[2]*Ia1 + w.c_RH_thigh[3]*Ia2 + w.c_RH_thigh[5]*Ia3;
+    const Scalar pa1 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
+    const Scalar pa2 = w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t1 + w.c_RH_thigh[0]*Ia1 + w.c_RH_thigh[2]*Ia4 + w.c_RH_thigh[3]*Ia5 + w.c_RH_thigh[5]*Ia6;
+    const Scalar pa3 = w.pA_RH_thigh[3] + w.u_RH_thigh[0]*t2 + w.c_RH_thigh[0]*Ia2 + w.c_RH_thigh[2]*Ia5 + w.c_RH_thigh[3]*Ia7 + w.c_RH_thigh[5]*Ia8;
+    const Scalar pa4 = w.pA_RH_thigh[4] + w.u_RH_thigh[0]*t3;
+    const Scalar pa5 = w.pA_RH_thigh[5] + w.u_RH_thigh[0]*t4 + w.c_RH_thigh[0]*Ia3 + w.c_RH_thigh[2]*Ia6 + w.c_RH_thigh[3]*Ia8 + w.c_RH_thigh[5]*Ia9;
+    const Scalar C20 = -w.sq_RH_thigh*w.sq_RH_thigh + w.cq_RH_thigh*w.cq_RH_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar h1 = 0.5*(-Ia2 + Ia6);
+    const Scalar m1 = 0.5*(Ia2 + Ia6);
+    const Scalar t6 = 0.5*(Ia3 + Ia5);
+    const Scalar d1 = -t5*t6 + C20*h1;
+    const Scalar qq1 = C20*t6 + t5*h1;
+    const Scalar h2 = 0.5*(-Ia7 + Ia9);
+    const Scalar m2 = 0.5*(Ia7 + Ia9);
+    const Scalar d2 = -Ia8*t5 + C20*h2;
+    const Scalar qq2 = Ia8*C20 + t5*h2;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = m1 - d1;
+    const Scalar t10 = 0.5*Ia3 - 0.5*Ia5 + qq1;
+    const Scalar t11 = w.cq_RH_thigh*w.IA_RH_thigh[8] + w.sq_RH_thigh*w.IA_RH_thigh[10];
+    const Scalar t12 = -w.sq_RH_thigh*w.IA_RH_thigh[8] + w.cq_RH_thigh*w.IA_RH_thigh[10];
+    const Scalar t13 = -0.5*Ia3 + 0.5*Ia5 + qq1;
+    const Scalar t14 = m1 + d1;
+    const Scalar t15 = -0.062*qq0 + t9;
+    const Scalar t16 = 0.062*t7 + t10;
+    const Scalar t17 = -0.062*t8 + t13;
+    const Scalar t18 = 0.062*qq0 + t14;
+    const Scalar t19 = w.cq_RH_thigh*pa0 + w.sq_RH_thigh*pa2;
+    const Scalar t20 = -w.sq_RH_thigh*pa0 + w.cq_RH_thigh*pa2;
+    w.IA_RH_hip[0] = 0.5950000000000001 + t7;
     w.IA_RH_hip[2] = qq0;
-    w.IA_RH_hip[3] = t28;
-    w.IA_RH_hip[5] = 0.02164 + t29;
+    w.IA_RH_hip[3] = t15;
+    w.IA_RH_hip[5] = 0.02164 + t16;
     w.IA_RH_hip[6] = 0.5950000000000001 + w.IA_RH_thigh[6];
-    w.IA_RH_hip[8] = t24;
-    w.IA_RH_hip[10] = t25;
-    w.IA_RH_hip[11] = 0.5950000000000001 + t21;
-    w.IA_RH_hip[12] = -0.02164 + t30;
-    w.IA_RH_hip[14] = t31;
-    w.IA_RH_hip[15] = 0.0012018399999999998 + m4 - d2 - 0.062*t26 - 0.062*t30;
-    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t22 - 0.062*t31;
-    w.IA_RH_hip[20] = 0.00126484 + m4 + d2 + 0.062*t23 + 0.062*t29;
-    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t32;
-    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa7;
-    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t33;
-    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa9 + w.sq_RH_thigh*pa11 - 0.062*t33;
-    w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa10;
-    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa9 + w.cq_RH_thigh*pa11 + 0.062*t32;
+    w.IA_RH_hip[8] = t11;
+    w.IA_RH_hip[10] = t12;
+    w.IA_RH_hip[11] = 0.5950000000000001 + t8;
+    w.IA_RH_hip[12] = -0.02164 + t17;
+    w.IA_RH_hip[14] = t18;
+    w.IA_RH_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t13 - 0.062*t17;
+    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t9 - 0.062*t18;
+    w.IA_RH_hip[20] = 0.00126484 + m2 + d2 + 0.062*t10 + 0.062*t16;
+    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t19;
+    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa1;
+    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t20;
+    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa3 + w.sq_RH_thigh*pa5 - 0.062*t20;
+    w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa4;
+    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa5 + 0.062*t19;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -747,7 +756,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     const Scalar t0 = 0.195*w.k_rf_foot[1] - 0.004*w.k_rf_foot[2];
@@ -810,83 +819,86 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_RF_thigh[4] = w.pA_RF_thigh[4] + pa4 - 0.209*t11;
     w.pA_RF_thigh[5] = w.pA_RF_thigh[5] - w.sq_RF_shank*pa3 + w.cq_RF_shank*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
     w.u_RF_thigh[0] = -w.pA_RF_thigh[4] + tau[13];
-    const Scalar t13 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar t14 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar t15 = w.IA_RF_thigh[16]*w.Dinv_RF_thigh;
-    const Scalar t16 = w.IA_RF_thigh[18]*w.Dinv_RF_thigh;
-    const Scalar t17 = w.IA_RF_thigh[19]*w.Dinv_RF_thigh;
-    const Scalar Ia6 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t13;
-    const Scalar Ia7 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t13;
-    const Scalar Ia8 = w.IA_RF_thigh[3] - w.IA_RF_thigh[16]*t13;
-    const Scalar Ia9 = w.IA_RF_thigh[5] - w.IA_RF_thigh[19]*t13;
-    const Scalar Ia10 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t14;
-    const Scalar Ia11 = w.IA_RF_thigh[12] - w.IA_RF_thigh[16]*t14;
-    const Scalar Ia12 = w.IA_RF_thigh[14] - w.IA_RF_thigh[19]*t14;
-    const Scalar Ia13 = w.IA_RF_thigh[15] - w.IA_RF_thigh[16]*t15;
-    const Scalar Ia14 = w.IA_RF_thigh[17] - w.IA_RF_thigh[19]*t15;
-    const Scalar Ia15 = w.IA_RF_thigh[20] - w.IA_RF_thigh[19]*t17;
-    const Scalar pa6 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t13 + w.c_RF_thigh[0]*Ia6 + w.c_RF_thigh[2]*Ia7 + w.c_RF_thigh[3]*Ia8 + w.c_RF_thigh[5]*Ia9;
-    const Scalar pa7 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
-    const Scalar pa8 = w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t14 + w.c_RF_thigh[0]*Ia7 + w.c_RF_thigh[2]*Ia10 + w.c_RF_thigh[3]*Ia11 + w.c_RF_thigh[5]*Ia12;
-    const Scalar pa9 = w.pA_RF_thigh[3] + w.u_RF_thigh[0]*t15 + w.c_RF_thigh[0]*Ia8 + w.c_RF_thigh[2]*Ia11 + w.c_RF_thigh[3]*Ia13 + w.c_RF_thigh[5]*Ia14;
-    const Scalar pa10 = w.pA_RF_thigh[4] + w.u_RF_thigh[0]*t16;
-    const Scalar pa11 = w.pA_RF_thigh[5] + w.u_RF_thigh[0]*t17 + w.c_RF_thigh[0]*Ia9 + w.c_RF_thigh[2]*Ia12 + w.c_RF_thigh[3]*Ia14 + w.c_RF_thigh[5]*Ia15;
-    const Scalar C21 = -w.sq_RF_thigh*w.sq_RF_thigh + w.cq_RF_thigh*w.cq_RF_thigh;
-    const Scalar h2 = 0.5*(-Ia6 + Ia10);
-    const Scalar m2 = 0.5*(Ia6 + Ia10);
-    const Scalar t18 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
-    const Scalar d0 = -Ia7*t18 + C21*h2;
-    const Scalar qq0 = Ia7*C21 + h2*t18;
-    const Scalar h3 = 0.5*(-Ia8 + Ia12);
-    const Scalar m3 = 0.5*(Ia8 + Ia12);
-    const Scalar t19 = 0.5*(Ia9 + Ia11);
-    const Scalar d1 = -t18*t19 + C21*h3;
-    const Scalar qq1 = C21*t19 + t18*h3;
-    const Scalar h4 = 0.5*(-Ia13 + Ia15);
-    const Scalar m4 = 0.5*(Ia13 + Ia15);
-    const Scalar d2 = -Ia14*t18 + C21*h4;
-    const Scalar qq2 = Ia14*C21 + t18*h4;
-    const Scalar t20 = m2 - d0;
-    const Scalar t21 = m2 + d0;
-    const Scalar t22 = m3 - d1;
-    const Scalar t23 = 0.5*Ia9 - 0.5*Ia11 + qq1;
-    const Scalar t24 = w.cq_RF_thigh*w.IA_RF_thigh[8] + w.sq_RF_thigh*w.IA_RF_thigh[10];
-    const Scalar t25 = -w.sq_RF_thigh*w.IA_RF_thigh[8] + w.cq_RF_thigh*w.IA_RF_thigh[10];
-    const Scalar t26 = -0.5*Ia9 + 0.5*Ia11 + qq1;
-    const Scalar t27 = m3 + d1;
-    const Scalar t28 = -0.062*qq0 + t22;
-    const Scalar t29 = 0.062*t20 + t23;
-    const Scalar t30 = -0.062*t21 + t26;
-    const Scalar t31 = 0.062*qq0 + t27;
-    const Scalar t32 = w.cq_RF_thigh*pa6 + w.sq_RF_thigh*pa8;
-    const Scalar t33 = -w.sq_RF_thigh*pa6 + w.cq_RF_thigh*pa8;
-    w.IA_RF_hip[0] = 0.5950000000000001 + t20;
+    const Scalar t0 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
+    const Scalar t1 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
+    const Scalar t2 = w.IA_RF_thigh[16]*w.Dinv_RF_thigh;
+    const Scalar t3 = w.IA_RF_thigh[18]*w.Dinv_RF_thigh;
+    const Scalar t4 = w.IA_RF_thigh[19]*w.Dinv_RF_thigh;
+    const Scalar Ia0 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t0;
+    const Scalar Ia2 = w.IA_RF_thigh[3] - w.IA_RF_thigh[16]*t0;
+    const Scalar Ia3 = w.IA_RF_thigh[5] - w.IA_RF_thigh[19]*t0;
+    const Scalar Ia4 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t1;
+    const Scalar Ia5 = w.IA_RF_thigh[12] - w.IA_RF_thigh[16]*t1;
+    const Scalar Ia6 = w.IA_RF_thigh[14] - w.IA_RF_thigh[19]*t1;
+    const Scalar Ia7 = w.IA_RF_thigh[15] - w.IA_RF_thigh[16]*t2;
+    const Scalar Ia8 = w.IA_RF_thigh[17] - w.IA_RF_thigh[19]*t2;
+    const Scalar Ia9 = w.IA_RF_thigh[20] - w.IA_RF_thigh[19]*t4;
+    const Scalar pa0 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t0 + w.c_RF_thigh[0]*Ia0 + w.c_RF_thigh[2]*Ia1 + w.c_RF_thigh[3]*Ia2 + w.c_RF_thigh[5]*Ia3;
+    const Scalar pa1 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
+    const Scalar pa2 = w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t1 + w.c_RF_thigh[0]*Ia1 + w.c_RF_thigh[2]*Ia4 + w.c_RF_thigh[3]*Ia5 + w.c_RF_thigh[5]*Ia6;
+    const Scalar pa3 = w.pA_RF_thigh[3] + w.u_RF_thigh[0]*t2 + w.c_RF_thigh[0]*Ia2 + w.c_RF_thigh[2]*Ia5 + w.c_RF_thigh[3]*Ia7 + w.c_RF_thigh[5]*Ia8;
+    const Scalar pa4 = w.pA_RF_thigh[4] + w.u_RF_thigh[0]*t3;
+    const Scalar pa5 = w.pA_RF_thigh[5] + w.u_RF_thigh[0]*t4 + w.c_RF_thigh[0]*Ia3 + w.c_RF_thigh[2]*Ia6 + w.c_RF_thigh[3]*Ia8 + w.c_RF_thigh[5]*Ia9;
+    const Scalar C20 = -w.sq_RF_thigh*w.sq_RF_thigh + w.cq_RF_thigh*w.cq_RF_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar h1 = 0.5*(-Ia2 + Ia6);
+    const Scalar m1 = 0.5*(Ia2 + Ia6);
+    const Scalar t6 = 0.5*(Ia3 + Ia5);
+    const Scalar d1 = -t5*t6 + C20*h1;
+    const Scalar qq1 = C20*t6 + t5*h1;
+    const Scalar h2 = 0.5*(-Ia7 + Ia9);
+    const Scalar m2 = 0.5*(Ia7 + Ia9);
+    const Scalar d2 = -Ia8*t5 + C20*h2;
+    const Scalar qq2 = Ia8*C20 + t5*h2;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = m1 - d1;
+    const Scalar t10 = 0.5*Ia3 - 0.5*Ia5 + qq1;
+    const Scalar t11 = w.cq_RF_thigh*w.IA_RF_thigh[8] + w.sq_RF_thigh*w.IA_RF_thigh[10];
+    const Scalar t12 = -w.sq_RF_thigh*w.IA_RF_thigh[8] + w.cq_RF_thigh*w.IA_RF_thigh[10];
+    const Scalar t13 = -0.5*Ia3 + 0.5*Ia5 + qq1;
+    const Scalar t14 = m1 + d1;
+    const Scalar t15 = -0.062*qq0 + t9;
+    const Scalar t16 = 0.062*t7 + t10;
+    const Scalar t17 = -0.062*t8 + t13;
+    const Scalar t18 = 0.062*qq0 + t14;
+    const Scalar t19 = w.cq_RF_thigh*pa0 + w.sq_RF_thigh*pa2;
+    const Scalar t20 = -w.sq_RF_thigh*pa0 + w.cq_RF_thigh*pa2;
+    w.IA_RF_hip[0] = 0.5950000000000001 + t7;
     w.IA_RF_hip[2] = qq0;
-    w.IA_RF_hip[3] = t28;
-    w.IA_RF_hip[5] = 0.02164 + t29;
+    w.IA_RF_hip[3] = t15;
+    w.IA_RF_hip[5] = 0.02164 + t16;
     w.IA_RF_hip[6] = 0.5950000000000001 + w.IA_RF_thigh[6];
-    w.IA_RF_hip[8] = t24;
-    w.IA_RF_hip[10] = t25;
-    w.IA_RF_hip[11] = 0.5950000000000001 + t21;
-    w.IA_RF_hip[12] = -0.02164 + t30;
-    w.IA_RF_hip[14] = t31;
-    w.IA_RF_hip[15] = 0.0012018399999999998 + m4 - d2 - 0.062*t26 - 0.062*t30;
-    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t22 - 0.062*t31;
-    w.IA_RF_hip[20] = 0.00126484 + m4 + d2 + 0.062*t23 + 0.062*t29;
-    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t32;
-    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa7;
-    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t33;
-    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa9 + w.sq_RF_thigh*pa11 - 0.062*t33;
-    w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa10;
-    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa9 + w.cq_RF_thigh*pa11 + 0.062*t32;
+    w.IA_RF_hip[8] = t11;
+    w.IA_RF_hip[10] = t12;
+    w.IA_RF_hip[11] = 0.5950000000000001 + t8;
+    w.IA_RF_hip[12] = -0.02164 + t17;
+    w.IA_RF_hip[14] = t18;
+    w.IA_RF_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t13 - 0.062*t17;
+    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t9 - 0.062*t18;
+    w.IA_RF_hip[20] = 0.00126484 + m2 + d2 + 0.062*t10 + 0.062*t16;
+    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t19;
+    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa1;
+    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t20;
+    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa3 + w.sq_RF_thigh*pa5 - 0.062*t20;
+    w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa4;
+    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa5 + 0.062*t19;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
@@ -1013,7 +1025,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     const Scalar t0 = 0.195*w.k_lh_foot[1] + 0.004*w.k_lh_foot[2];
@@ -1076,83 +1088,86 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_LH_thigh[4] = w.pA_LH_thigh[4] + pa4 - 0.209*t11;
     w.pA_LH_thigh[5] = w.pA_LH_thigh[5] - w.sq_LH_shank*pa3 + w.cq_LH_shank*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
     w.u_LH_thigh[0] = -w.pA_LH_thigh[4] + tau[10];
-    const Scalar t13 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar t14 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar t15 = w.IA_LH_thigh[16]*w.Dinv_LH_thigh;
-    const Scalar t16 = w.IA_LH_thigh[18]*w.Dinv_LH_thigh;
-    const Scalar t17 = w.IA_LH_thigh[19]*w.Dinv_LH_thigh;
-    const Scalar Ia6 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t13;
-    const Scalar Ia7 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t13;
-    const Scalar Ia8 = w.IA_LH_thigh[3] - w.IA_LH_thigh[16]*t13;
-    const Scalar Ia9 = w.IA_LH_thigh[5] - w.IA_LH_thigh[19]*t13;
-    const Scalar Ia10 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t14;
-    const Scalar Ia11 = w.IA_LH_thigh[12] - w.IA_LH_thigh[16]*t14;
-    const Scalar Ia12 = w.IA_LH_thigh[14] - w.IA_LH_thigh[19]*t14;
-    const Scalar Ia13 = w.IA_LH_thigh[15] - w.IA_LH_thigh[16]*t15;
-    const Scalar Ia14 = w.IA_LH_thigh[17] - w.IA_LH_thigh[19]*t15;
-    const Scalar Ia15 = w.IA_LH_thigh[20] - w.IA_LH_thigh[19]*t17;
-    const Scalar pa6 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t13 + w.c_LH_thigh[0]*Ia6 + w.c_LH_thigh[2]*Ia7 + w.c_LH_thigh[3]*Ia8 + w.c_LH_thigh[5]*Ia9;
-    const Scalar pa7 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
-    const Scalar pa8 = w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t14 + w.c_LH_thigh[0]*Ia7 + w.c_LH_thigh[2]*Ia10 + w.c_LH_thigh[3]*Ia11 + w.c_LH_thigh[5]*Ia12;
-    const Scalar pa9 = w.pA_LH_thigh[3] + w.u_LH_thigh[0]*t15 + w.c_LH_thigh[0]*Ia8 + w.c_LH_thigh[2]*Ia11 + w.c_LH_thigh[3]*Ia13 + w.c_LH_thigh[5]*Ia14;
-    const Scalar pa10 = w.pA_LH_thigh[4] + w.u_LH_thigh[0]*t16;
-    const Scalar pa11 = w.pA_LH_thigh[5] + w.u_LH_thigh[0]*t17 + w.c_LH_thigh[0]*Ia9 + w.c_LH_thigh[2]*Ia12 + w.c_LH_thigh[3]*Ia14 + w.c_LH_thigh[5]*Ia15;
-    const Scalar C21 = -w.sq_LH_thigh*w.sq_LH_thigh + w.cq_LH_thigh*w.cq_LH_thigh;
-    const Scalar h2 = 0.5*(-Ia6 + Ia10);
-    const Scalar m2 = 0.5*(Ia6 + Ia10);
-    const Scalar t18 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
-    const Scalar d0 = -Ia7*t18 + C21*h2;
-    const Scalar qq0 = Ia7*C21 + h2*t18;
-    const Scalar h3 = 0.5*(-Ia8 + Ia12);
-    const Scalar m3 = 0.5*(Ia8 + Ia12);
-    const Scalar t19 = 0.5*(Ia9 + Ia11);
-    const Scalar d1 = -t18*t19 + C21*h3;
-    const Scalar qq1 = C21*t19 + t18*h3;
-    const Scalar h4 = 0.5*(-Ia13 + Ia15);
-    const Scalar m4 = 0.5*(Ia13 + Ia15);
-    const Scalar d2 = -Ia14*t18 + C21*h4;
-    const Scalar qq2 = Ia14*C21 + t18*h4;
-    const Scalar t20 = m2 - d0;
-    const Scalar t21 = m2 + d0;
-    const Scalar t22 = m3 - d1;
-    const Scalar t23 = 0.5*Ia9 - 0.5*Ia11 + qq1;
-    const Scalar t24 = w.cq_LH_thigh*w.IA_LH_thigh[8] + w.sq_LH_thigh*w.IA_LH_thigh[10];
-    const Scalar t25 = -w.sq_LH_thigh*w.IA_LH_thigh[8] + w.cq_LH_thigh*w.IA_LH_thigh[10];
-    const Scalar t26 = -0.5*Ia9 + 0.5*Ia11 + qq1;
-    const Scalar t27 = m3 + d1;
-    const Scalar t28 = 0.062*qq0 + t22;
-    const Scalar t29 = -0.062*t20 + t23;
-    const Scalar t30 = 0.062*t21 + t26;
-    const Scalar t31 = -0.062*qq0 + t27;
-    const Scalar t32 = w.cq_LH_thigh*pa6 + w.sq_LH_thigh*pa8;
-    const Scalar t33 = -w.sq_LH_thigh*pa6 + w.cq_LH_thigh*pa8;
-    w.IA_LH_hip[0] = 0.5950000000000001 + t20;
+    const Scalar t0 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
+    const Scalar t1 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
+    const Scalar t2 = w.IA_LH_thigh[16]*w.Dinv_LH_thigh;
+    const Scalar t3 = w.IA_LH_thigh[18]*w.Dinv_LH_thigh;
+    const Scalar t4 = w.IA_LH_thigh[19]*w.Dinv_LH_thigh;
+    const Scalar Ia0 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t0;
+    const Scalar Ia2 = w.IA_LH_thigh[3] - w.IA_LH_thigh[16]*t0;
+    const Scalar Ia3 = w.IA_LH_thigh[5] - w.IA_LH_thigh[19]*t0;
+    const Scalar Ia4 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t1;
+    const Scalar Ia5 = w.IA_LH_thigh[12] - w.IA_LH_thigh[16]*t1;
+    const Scalar Ia6 = w.IA_LH_thigh[14] - w.IA_LH_thigh[19]*t1;
+    const Scalar Ia7 = w.IA_LH_thigh[15] - w.IA_LH_thigh[16]*t2;
+    const Scalar Ia8 = w.IA_LH_thigh[17] - w.IA_LH_thigh[19]*t2;
+    const Scalar Ia9 = w.IA_LH_thigh[20] - w.IA_LH_thigh[19]*t4;
+    const Scalar pa0 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t0 + w.c_LH_thigh[0]*Ia0 + w.c_LH_thigh[2]*Ia1 + w.c_LH_thigh[3]*Ia2 + w.c_LH_thigh[5]*Ia3;
+    const Scalar pa1 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
+    const Scalar pa2 = w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t1 + w.c_LH_thigh[0]*Ia1 + w.c_LH_thigh[2]*Ia4 + w.c_LH_thigh[3]*Ia5 + w.c_LH_thigh[5]*Ia6;
+    const Scalar pa3 = w.pA_LH_thigh[3] + w.u_LH_thigh[0]*t2 + w.c_LH_thigh[0]*Ia2 + w.c_LH_thigh[2]*Ia5 + w.c_LH_thigh[3]*Ia7 + w.c_LH_thigh[5]*Ia8;
+    const Scalar pa4 = w.pA_LH_thigh[4] + w.u_LH_thigh[0]*t3;
+    const Scalar pa5 = w.pA_LH_thigh[5] + w.u_LH_thigh[0]*t4 + w.c_LH_thigh[0]*Ia3 + w.c_LH_thigh[2]*Ia6 + w.c_LH_thigh[3]*Ia8 + w.c_LH_thigh[5]*Ia9;
+    const Scalar C20 = -w.sq_LH_thigh*w.sq_LH_thigh + w.cq_LH_thigh*w.cq_LH_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar h1 = 0.5*(-Ia2 + Ia6);
+    const Scalar m1 = 0.5*(Ia2 + Ia6);
+    const Scalar t6 = 0.5*(Ia3 + Ia5);
+    const Scalar d1 = -t5*t6 + C20*h1;
+    const Scalar qq1 = C20*t6 + t5*h1;
+    const Scalar h2 = 0.5*(-Ia7 + Ia9);
+    const Scalar m2 = 0.5*(Ia7 + Ia9);
+    const Scalar d2 = -Ia8*t5 + C20*h2;
+    const Scalar qq2 = Ia8*C20 + t5*h2;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = m1 - d1;
+    const Scalar t10 = 0.5*Ia3 - 0.5*Ia5 + qq1;
+    const Scalar t11 = w.cq_LH_thigh*w.IA_LH_thigh[8] + w.sq_LH_thigh*w.IA_LH_thigh[10];
+    const Scalar t12 = -w.sq_LH_thigh*w.IA_LH_thigh[8] + w.cq_LH_thigh*w.IA_LH_thigh[10];
+    const Scalar t13 = -0.5*Ia3 + 0.5*Ia5 + qq1;
+    const Scalar t14 = m1 + d1;
+    const Scalar t15 = 0.062*qq0 + t9;
+    const Scalar t16 = -0.062*t7 + t10;
+    const Scalar t17 = 0.062*t8 + t13;
+    const Scalar t18 = -0.062*qq0 + t14;
+    const Scalar t19 = w.cq_LH_thigh*pa0 + w.sq_LH_thigh*pa2;
+    const Scalar t20 = -w.sq_LH_thigh*pa0 + w.cq_LH_thigh*pa2;
+    w.IA_LH_hip[0] = 0.5950000000000001 + t7;
     w.IA_LH_hip[2] = qq0;
-    w.IA_LH_hip[3] = t28;
-    w.IA_LH_hip[5] = -0.02164 + t29;
+    w.IA_LH_hip[3] = t15;
+    w.IA_LH_hip[5] = -0.02164 + t16;
     w.IA_LH_hip[6] = 0.5950000000000001 + w.IA_LH_thigh[6];
-    w.IA_LH_hip[8] = t24;
-    w.IA_LH_hip[10] = t25;
-    w.IA_LH_hip[11] = 0.5950000000000001 + t21;
-    w.IA_LH_hip[12] = 0.02164 + t30;
-    w.IA_LH_hip[14] = t31;
-    w.IA_LH_hip[15] = 0.0012018399999999998 + m4 - d2 + 0.062*t26 + 0.062*t30;
-    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t22 + 0.062*t31;
-    w.IA_LH_hip[20] = 0.00126484 + m4 + d2 - 0.062*t23 - 0.062*t29;
-    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t32;
-    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa7;
-    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t33;
-    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa9 + w.sq_LH_thigh*pa11 + 0.062*t33;
-    w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa10;
-    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa9 + w.cq_LH_thigh*pa11 - 0.062*t32;
+    w.IA_LH_hip[8] = t11;
+    w.IA_LH_hip[10] = t12;
+    w.IA_LH_hip[11] = 0.5950000000000001 + t8;
+    w.IA_LH_hip[12] = 0.02164 + t17;
+    w.IA_LH_hip[14] = t18;
+    w.IA_LH_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t13 + 0.062*t17;
+    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t9 + 0.062*t18;
+    w.IA_LH_hip[20] = 0.00126484 + m2 + d2 - 0.062*t10 - 0.062*t16;
+    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t19;
+    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa1;
+    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t20;
+    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa3 + w.sq_LH_thigh*pa5 + 0.062*t20;
+    w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa4;
+    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa5 - 0.062*t19;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
@@ -1279,7 +1294,7 @@ PROXGEN_RT_NOINLINE void caba_5(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_6(const Scalar* tau, Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     const Scalar t0 = 0.195*w.k_lf_foot[1] + 0.004*w.k_lf_foot[2];
@@ -1342,83 +1357,86 @@ PROXGEN_RT_NOINLINE void caba_6(const Scalar* tau, Scalar mu, Workspace& w) noex
     w.pA_LF_thigh[4] = w.pA_LF_thigh[4] + pa4 - 0.209*t11;
     w.pA_LF_thigh[5] = w.pA_LF_thigh[5] - w.sq_LF_shank*pa3 + w.cq_LF_shank*pa5;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
     w.u_LF_thigh[0] = -w.pA_LF_thigh[4] + tau[7];
-    const Scalar t13 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar t14 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar t15 = w.IA_LF_thigh[16]*w.Dinv_LF_thigh;
-    const Scalar t16 = w.IA_LF_thigh[18]*w.Dinv_LF_thigh;
-    const Scalar t17 = w.IA_LF_thigh[19]*w.Dinv_LF_thigh;
-    const Scalar Ia6 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t13;
-    const Scalar Ia7 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t13;
-    const Scalar Ia8 = w.IA_LF_thigh[3] - w.IA_LF_thigh[16]*t13;
-    const Scalar Ia9 = w.IA_LF_thigh[5] - w.IA_LF_thigh[19]*t13;
-    const Scalar Ia10 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t14;
-    const Scalar Ia11 = w.IA_LF_thigh[12] - w.IA_LF_thigh[16]*t14;
-    const Scalar Ia12 = w.IA_LF_thigh[14] - w.IA_LF_thigh[19]*t14;
-    const Scalar Ia13 = w.IA_LF_thigh[15] - w.IA_LF_thigh[16]*t15;
-    const Scalar Ia14 = w.IA_LF_thigh[17] - w.IA_LF_thigh[19]*t15;
-    const Scalar Ia15 = w.IA_LF_thigh[20] - w.IA_LF_thigh[19]*t17;
-    const Scalar pa6 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t13 + w.c_LF_thigh[0]*Ia6 + w.c_LF_thigh[2]*Ia7 + w.c_LF_thigh[3]*Ia8 + w.c_LF_thigh[5]*Ia9;
-    const Scalar pa7 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
-    const Scalar pa8 = w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t14 + w.c_LF_thigh[0]*Ia7 + w.c_LF_thigh[2]*Ia10 + w.c_LF_thigh[3]*Ia11 + w.c_LF_thigh[5]*Ia12;
-    const Scalar pa9 = w.pA_LF_thigh[3] + w.u_LF_thigh[0]*t15 + w.c_LF_thigh[0]*Ia8 + w.c_LF_thigh[2]*Ia11 + w.c_LF_thigh[3]*Ia13 + w.c_LF_thigh[5]*Ia14;
-    const Scalar pa10 = w.pA_LF_thigh[4] + w.u_LF_thigh[0]*t16;
-    const Scalar pa11 = w.pA_LF_thigh[5] + w.u_LF_thigh[0]*t17 + w.c_LF_thigh[0]*Ia9 + w.c_LF_thigh[2]*Ia12 + w.c_LF_thigh[3]*Ia14 + w.c_LF_thigh[5]*Ia15;
-    const Scalar C21 = -w.sq_LF_thigh*w.sq_LF_thigh + w.cq_LF_thigh*w.cq_LF_thigh;
-    const Scalar h2 = 0.5*(-Ia6 + Ia10);
-    const Scalar m2 = 0.5*(Ia6 + Ia10);
-    const Scalar t18 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
-    const Scalar d0 = -Ia7*t18 + C21*h2;
-    const Scalar qq0 = Ia7*C21 + h2*t18;
-    const Scalar h3 = 0.5*(-Ia8 + Ia12);
-    const Scalar m3 = 0.5*(Ia8 + Ia12);
-    const Scalar t19 = 0.5*(Ia9 + Ia11);
-    const Scalar d1 = -t18*t19 + C21*h3;
-    const Scalar qq1 = C21*t19 + t18*h3;
-    const Scalar h4 = 0.5*(-Ia13 + Ia15);
-    const Scalar m4 = 0.5*(Ia13 + Ia15);
-    const Scalar d2 = -Ia14*t18 + C21*h4;
-    const Scalar qq2 = Ia14*C21 + t18*h4;
-    const Scalar t20 = m2 - d0;
-    const Scalar t21 = m2 + d0;
-    const Scalar t22 = m3 - d1;
-    const Scalar t23 = 0.5*Ia9 - 0.5*Ia11 + qq1;
-    const Scalar t24 = w.cq_LF_thigh*w.IA_LF_thigh[8] + w.sq_LF_thigh*w.IA_LF_thigh[10];
-    const Scalar t25 = -w.sq_LF_thigh*w.IA_LF_thigh[8] + w.cq_LF_thigh*w.IA_LF_thigh[10];
-    const Scalar t26 = -0.5*Ia9 + 0.5*Ia11 + qq1;
-    const Scalar t27 = m3 + d1;
-    const Scalar t28 = 0.062*qq0 + t22;
-    const Scalar t29 = -0.062*t20 + t23;
-    const Scalar t30 = 0.062*t21 + t26;
-    const Scalar t31 = -0.062*qq0 + t27;
-    const Scalar t32 = w.cq_LF_thigh*pa6 + w.sq_LF_thigh*pa8;
-    const Scalar t33 = -w.sq_LF_thigh*pa6 + w.cq_LF_thigh*pa8;
-    w.IA_LF_hip[0] = 0.5950000000000001 + t20;
+    const Scalar t0 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
+    const Scalar t1 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
+    const Scalar t2 = w.IA_LF_thigh[16]*w.Dinv_LF_thigh;
+    const Scalar t3 = w.IA_LF_thigh[18]*w.Dinv_LF_thigh;
+    const Scalar t4 = w.IA_LF_thigh[19]*w.Dinv_LF_thigh;
+    const Scalar Ia0 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t0;
+    const Scalar Ia2 = w.IA_LF_thigh[3] - w.IA_LF_thigh[16]*t0;
+    const Scalar Ia3 = w.IA_LF_thigh[5] - w.IA_LF_thigh[19]*t0;
+    const Scalar Ia4 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t1;
+    const Scalar Ia5 = w.IA_LF_thigh[12] - w.IA_LF_thigh[16]*t1;
+    const Scalar Ia6 = w.IA_LF_thigh[14] - w.IA_LF_thigh[19]*t1;
+    const Scalar Ia7 = w.IA_LF_thigh[15] - w.IA_LF_thigh[16]*t2;
+    const Scalar Ia8 = w.IA_LF_thigh[17] - w.IA_LF_thigh[19]*t2;
+    const Scalar Ia9 = w.IA_LF_thigh[20] - w.IA_LF_thigh[19]*t4;
+    const Scalar pa0 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t0 + w.c_LF_thigh[0]*Ia0 + w.c_LF_thigh[2]*Ia1 + w.c_LF_thigh[3]*Ia2 + w.c_LF_thigh[5]*Ia3;
+    const Scalar pa1 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
+    const Scalar pa2 = w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t1 + w.c_LF_thigh[0]*Ia1 + w.c_LF_thigh[2]*Ia4 + w.c_LF_thigh[3]*Ia5 + w.c_LF_thigh[5]*Ia6;
+    const Scalar pa3 = w.pA_LF_thigh[3] + w.u_LF_thigh[0]*t2 + w.c_LF_thigh[0]*Ia2 + w.c_LF_thigh[2]*Ia5 + w.c_LF_thigh[3]*Ia7 + w.c_LF_thigh[5]*Ia8;
+    const Scalar pa4 = w.pA_LF_thigh[4] + w.u_LF_thigh[0]*t3;
+    const Scalar pa5 = w.pA_LF_thigh[5] + w.u_LF_thigh[0]*t4 + w.c_LF_thigh[0]*Ia3 + w.c_LF_thigh[2]*Ia6 + w.c_LF_thigh[3]*Ia8 + w.c_LF_thigh[5]*Ia9;
+    const Scalar C20 = -w.sq_LF_thigh*w.sq_LF_thigh + w.cq_LF_thigh*w.cq_LF_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia4);
+    const Scalar m0 = 0.5*(Ia0 + Ia4);
+    const Scalar t5 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
+    const Scalar d0 = -Ia1*t5 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t5;
+    const Scalar h1 = 0.5*(-Ia2 + Ia6);
+    const Scalar m1 = 0.5*(Ia2 + Ia6);
+    const Scalar t6 = 0.5*(Ia3 + Ia5);
+    const Scalar d1 = -t5*t6 + C20*h1;
+    const Scalar qq1 = C20*t6 + t5*h1;
+    const Scalar h2 = 0.5*(-Ia7 + Ia9);
+    const Scalar m2 = 0.5*(Ia7 + Ia9);
+    const Scalar d2 = -Ia8*t5 + C20*h2;
+    const Scalar qq2 = Ia8*C20 + t5*h2;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = m1 - d1;
+    const Scalar t10 = 0.5*Ia3 - 0.5*Ia5 + qq1;
+    const Scalar t11 = w.cq_LF_thigh*w.IA_LF_thigh[8] + w.sq_LF_thigh*w.IA_LF_thigh[10];
+    const Scalar t12 = -w.sq_LF_thigh*w.IA_LF_thigh[8] + w.cq_LF_thigh*w.IA_LF_thigh[10];
+    const Scalar t13 = -0.5*Ia3 + 0.5*Ia5 + qq1;
+    const Scalar t14 = m1 + d1;
+    const Scalar t15 = 0.062*qq0 + t9;
+    const Scalar t16 = -0.062*t7 + t10;
+    const Scalar t17 = 0.062*t8 + t13;
+    const Scalar t18 = -0.062*qq0 + t14;
+    const Scalar t19 = w.cq_LF_thigh*pa0 + w.sq_LF_thigh*pa2;
+    const Scalar t20 = -w.sq_LF_thigh*pa0 + w.cq_LF_thigh*pa2;
+    w.IA_LF_hip[0] = 0.5950000000000001 + t7;
     w.IA_LF_hip[2] = qq0;
-    w.IA_LF_hip[3] = t28;
-    w.IA_LF_hip[5] = -0.02164 + t29;
+    w.IA_LF_hip[3] = t15;
+    w.IA_LF_hip[5] = -0.02164 + t16;
     w.IA_LF_hip[6] = 0.5950000000000001 + w.IA_LF_thigh[6];
-    w.IA_LF_hip[8] = t24;
-    w.IA_LF_hip[10] = t25;
-    w.IA_LF_hip[11] = 0.5950000000000001 + t21;
-    w.IA_LF_hip[12] = 0.02164 + t30;
-    w.IA_LF_hip[14] = t31;
-    w.IA_LF_hip[15] = 0.0012018399999999998 + m4 - d2 + 0.062*t26 + 0.062*t30;
-    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t22 + 0.062*t31;
-    w.IA_LF_hip[20] = 0.00126484 + m4 + d2 - 0.062*t23 - 0.062*t29;
-    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t32;
-    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa7;
-    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t33;
-    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa9 + w.sq_LF_thigh*pa11 + 0.062*t33;
-    w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa10;
-    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa9 + w.cq_LF_thigh*pa11 - 0.062*t32;
+    w.IA_LF_hip[8] = t11;
+    w.IA_LF_hip[10] = t12;
+    w.IA_LF_hip[11] = 0.5950000000000001 + t8;
+    w.IA_LF_hip[12] = 0.02164 + t17;
+    w.IA_LF_hip[14] = t18;
+    w.IA_LF_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t13 + 0.062*t17;
+    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t9 + 0.062*t18;
+    w.IA_LF_hip[20] = 0.00126484 + m2 + d2 - 0.062*t10 - 0.062*t16;
+    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t19;
+    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa1;
+    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t20;
+    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa3 + w.sq_LF_thigh*pa5 + 0.062*t20;
+    w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa4;
+    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa5 - 0.062*t19;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_7(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
@@ -1545,7 +1563,7 @@ PROXGEN_RT_NOINLINE void caba_7(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_8(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_trunk[0]);
@@ -1603,36 +1621,39 @@ PROXGEN_RT_NOINLINE void caba_8(const Scalar* tau, Workspace& w) noexcept {
     w.u_trunk[4] = -w.pA_trunk[4] + tau[4];
     w.u_trunk[5] = -w.pA_trunk[5] + tau[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t15 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
-    const Scalar t16 = w.Linv_trunk[0]*t15;
-    const Scalar t17 = w.u_trunk[1] - 9.81*w.RJ_trunk[6]*w.IA_trunk[1] - 9.81*w.RJ_trunk[7]*w.IA_trunk[6] - 9.81*w.RJ_trunk[8]*w.IA_trunk[7] - w.L_trunk[1]*t16;
-    const Scalar t18 = w.Linv_trunk[1]*t17;
-    const Scalar t19 = w.u_trunk[2] - 9.81*w.RJ_trunk[6]*w.IA_trunk[2] - 9.81*w.RJ_trunk[7]*w.IA_trunk[7] - 9.81*w.RJ_trunk[8]*w.IA_trunk[11] - w.L_trunk[2]*t16 - w.L_trunk[7]*t18;
-    const Scalar t20 = w.Linv_trunk[2]*t19;
-    const Scalar t21 = w.u_trunk[3] - 9.81*w.RJ_trunk[6]*w.IA_trunk[3] - 9.81*w.RJ_trunk[7]*w.IA_trunk[8] - 9.81*w.RJ_trunk[8]*w.IA_trunk[12] - w.L_trunk[3]*t16 - w.L_trunk[8]*t18 - w.L_trunk[12]*t20;
-    const Scalar t22 = w.Linv_trunk[3]*t21;
-    const Scalar t23 = w.u_trunk[4] - 9.81*w.RJ_trunk[6]*w.IA_trunk[4] - 9.81*w.RJ_trunk[7]*w.IA_trunk[9] - 9.81*w.RJ_trunk[8]*w.IA_trunk[13] - w.L_trunk[4]*t16 - w.L_trunk[9]*t18 - w.L_trunk[13]*t20 - w.L_trunk[16]*t22;
-    const Scalar t24 = w.Linv_trunk[4]*t23;
-    const Scalar t25 = w.u_trunk[5] - 9.81*w.RJ_trunk[6]*w.IA_trunk[5] - 9.81*w.RJ_trunk[7]*w.IA_trunk[10] - 9.81*w.RJ_trunk[8]*w.IA_trunk[14] - w.L_trunk[5]*t16 - w.L_trunk[10]*t18 - w.L_trunk[14]*t20 - w.L_trunk[17]*t22 - w.L_trunk[19]*t24;
-    const Scalar t26 = w.Linv_trunk[5]*t25;
-    const Scalar t27 = w.Linv_trunk[5]*t26;
-    const Scalar t28 = w.Linv_trunk[4]*t23 - w.L_trunk[19]*t27;
-    const Scalar t29 = w.Linv_trunk[4]*t28;
-    const Scalar t30 = w.Linv_trunk[3]*t21 - w.L_trunk[16]*t29 - w.L_trunk[17]*t27;
-    const Scalar t31 = w.Linv_trunk[3]*t30;
-    const Scalar t32 = w.Linv_trunk[2]*t19 - w.L_trunk[12]*t31 - w.L_trunk[13]*t29 - w.L_trunk[14]*t27;
-    const Scalar t33 = w.Linv_trunk[2]*t32;
-    const Scalar t34 = w.Linv_trunk[1]*t17 - w.L_trunk[7]*t33 - w.L_trunk[8]*t31 - w.L_trunk[9]*t29 - w.L_trunk[10]*t27;
-    const Scalar t35 = w.Linv_trunk[1]*t34;
-    const Scalar t36 = w.Linv_trunk[0]*t15 - w.L_trunk[1]*t35 - w.L_trunk[2]*t33 - w.L_trunk[3]*t31 - w.L_trunk[4]*t29 - w.L_trunk[5]*t27;
-    w.qdd[0] = w.Linv_trunk[0]*t36;
-    w.qdd[1] = w.Linv_trunk[1]*t34;
-    w.qdd[2] = w.Linv_trunk[2]*t32;
-    w.qdd[3] = w.Linv_trunk[3]*t30;
-    w.qdd[4] = w.Linv_trunk[4]*t28;
-    w.qdd[5] = w.Linv_trunk[5]*t26;
+    const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
+    const Scalar t1 = w.Linv_trunk[0]*t0;
+    const Scalar t2 = w.u_trunk[1] - 9.81*w.RJ_trunk[6]*w.IA_trunk[1] - 9.81*w.RJ_trunk[7]*w.IA_trunk[6] - 9.81*w.RJ_trunk[8]*w.IA_trunk[7] - w.L_trunk[1]*t1;
+    const Scalar t3 = w.Linv_trunk[1]*t2;
+    const Scalar t4 = w.u_trunk[2] - 9.81*w.RJ_trunk[6]*w.IA_trunk[2] - 9.81*w.RJ_trunk[7]*w.IA_trunk[7] - 9.81*w.RJ_trunk[8]*w.IA_trunk[11] - w.L_trunk[2]*t1 - w.L_trunk[7]*t3;
+    const Scalar t5 = w.Linv_trunk[2]*t4;
+    const Scalar t6 = w.u_trunk[3] - 9.81*w.RJ_trunk[6]*w.IA_trunk[3] - 9.81*w.RJ_trunk[7]*w.IA_trunk[8] - 9.81*w.RJ_trunk[8]*w.IA_trunk[12] - w.L_trunk[3]*t1 - w.L_trunk[8]*t3 - w.L_trunk[12]*t5;
+    const Scalar t7 = w.Linv_trunk[3]*t6;
+    const Scalar t8 = w.u_trunk[4] - 9.81*w.RJ_trunk[6]*w.IA_trunk[4] - 9.81*w.RJ_trunk[7]*w.IA_trunk[9] - 9.81*w.RJ_trunk[8]*w.IA_trunk[13] - w.L_trunk[4]*t1 - w.L_trunk[9]*t3 - w.L_trunk[13]*t5 - w.L_trunk[16]*t7;
+    const Scalar t9 = w.Linv_trunk[4]*t8;
+    const Scalar t10 = w.u_trunk[5] - 9.81*w.RJ_trunk[6]*w.IA_trunk[5] - 9.81*w.RJ_trunk[7]*w.IA_trunk[10] - 9.81*w.RJ_trunk[8]*w.IA_trunk[14] - w.L_trunk[5]*t1 - w.L_trunk[10]*t3 - w.L_trunk[14]*t5 - w.L_trunk[17]*t7 - w.L_trunk[19]*t9;
+    const Scalar t11 = w.Linv_trunk[5]*t10;
+    const Scalar t12 = w.Linv_trunk[5]*t11;
+    const Scalar t13 = w.Linv_trunk[4]*t8 - w.L_trunk[19]*t12;
+    const Scalar t14 = w.Linv_trunk[4]*t13;
+    const Scalar t15 = w.Linv_trunk[3]*t6 - w.L_trunk[16]*t14 - w.L_trunk[17]*t12;
+    const Scalar t16 = w.Linv_trunk[3]*t15;
+    const Scalar t17 = w.Linv_trunk[2]*t4 - w.L_trunk[12]*t16 - w.L_trunk[13]*t14 - w.L_trunk[14]*t12;
+    const Scalar t18 = w.Linv_trunk[2]*t17;
+    const Scalar t19 = w.Linv_trunk[1]*t2 - w.L_trunk[7]*t18 - w.L_trunk[8]*t16 - w.L_trunk[9]*t14 - w.L_trunk[10]*t12;
+    const Scalar t20 = w.Linv_trunk[1]*t19;
+    const Scalar t21 = w.Linv_trunk[0]*t0 - w.L_trunk[1]*t20 - w.L_trunk[2]*t18 - w.L_trunk[3]*t16 - w.L_trunk[4]*t14 - w.L_trunk[5]*t12;
+    w.qdd[0] = w.Linv_trunk[0]*t21;
+    w.qdd[1] = w.Linv_trunk[1]*t19;
+    w.qdd[2] = w.Linv_trunk[2]*t17;
+    w.qdd[3] = w.Linv_trunk[3]*t15;
+    w.qdd[4] = w.Linv_trunk[4]*t13;
+    w.qdd[5] = w.Linv_trunk[5]*t11;
     w.a_trunk[0] = 9.81*w.RJ_trunk[6] + w.qdd[0];
     w.a_trunk[1] = 9.81*w.RJ_trunk[7] + w.qdd[1];
     w.a_trunk[2] = 9.81*w.RJ_trunk[8] + w.qdd[2];
@@ -1640,261 +1661,276 @@ PROXGEN_RT_NOINLINE void caba_8(const Scalar* tau, Workspace& w) noexcept {
     w.a_trunk[4] = w.qdd[4];
     w.a_trunk[5] = w.qdd[5];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_9(Workspace& w) noexcept {
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t0 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t0 + w.RJ_LF_hip[3]*t1 + w.RJ_LF_hip[6]*t2;
-    const Scalar t4 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[7]*t2;
-    const Scalar t5 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t0 + w.RJ_LF_hip[5]*t1 + w.RJ_LF_hip[8]*t2;
-    const Scalar t6 = w.c_LF_hip[3] + w.a_trunk[3]*w.RJ_LF_hip[0] + w.a_trunk[4]*w.RJ_LF_hip[3] + w.a_trunk[5]*w.RJ_LF_hip[6];
-    const Scalar t7 = w.c_LF_hip[5] + w.a_trunk[3]*w.RJ_LF_hip[2] + w.a_trunk[4]*w.RJ_LF_hip[5] + w.a_trunk[5]*w.RJ_LF_hip[8];
-    const Scalar t8 = -5.780668556524933e-05*w.c_LF_hip[4] + w.u_LF_hip[0] - 5.780668556524933e-05*w.a_trunk[3]*w.RJ_LF_hip[1] - 5.780668556524933e-05*w.a_trunk[4]*w.cq_LF_hip - 5.780668556524933e-05*w.a_trunk[5]*w.RJ_LF_hip[7] - w.U_LF_hip[0]*t3 - w.U_LF_hip[1]*t4 - w.U_LF_hip[2]*t5 - w.U_LF_hip[3]*t6 - w.U_LF_hip[5]*t7;
-    w.qdd[6] = w.Dinv_LF_hip*t8;
-    w.a_LF_hip[0] = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t0 + w.RJ_LF_hip[3]*t1 + w.RJ_LF_hip[6]*t2;
-    w.a_LF_hip[1] = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[7]*t2;
-    w.a_LF_hip[2] = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t0 + w.RJ_LF_hip[5]*t1 + w.RJ_LF_hip[8]*t2;
-    w.a_LF_hip[3] = w.c_LF_hip[3] + w.a_trunk[3]*w.RJ_LF_hip[0] + w.a_trunk[4]*w.RJ_LF_hip[3] + w.a_trunk[5]*w.RJ_LF_hip[6] + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = w.c_LF_hip[4] + w.a_trunk[3]*w.RJ_LF_hip[1] + w.a_trunk[4]*w.cq_LF_hip + w.a_trunk[5]*w.RJ_LF_hip[7];
-    w.a_LF_hip[5] = w.c_LF_hip[5] + w.a_trunk[3]*w.RJ_LF_hip[2] + w.a_trunk[4]*w.RJ_LF_hip[5] + w.a_trunk[5]*w.RJ_LF_hip[8] + 0.09950371902099893*w.qdd[6];
+    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
+    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
+    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
+    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
+    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
+    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
+    w.qdd[6] = w.Dinv_LF_hip*t31;
+    w.a_LF_hip[0] = t25;
+    w.a_LF_hip[1] = t26;
+    w.a_LF_hip[2] = t27;
+    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
+    w.a_LF_hip[4] = t29;
+    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
-    const Scalar t9 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t10 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t11 = w.c_LF_thigh[0] + w.cq_LF_thigh*t9 - w.sq_LF_thigh*t10;
-    const Scalar t12 = w.c_LF_thigh[2] + w.sq_LF_thigh*t9 + w.cq_LF_thigh*t10;
-    const Scalar t13 = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t14 = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t15 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t11 - w.IA_LF_thigh[13]*t12 - w.IA_LF_thigh[16]*t13 - w.IA_LF_thigh[18]*w.a_LF_hip[4] - w.IA_LF_thigh[19]*t14;
-    w.qdd[7] = w.Dinv_LF_thigh*t15;
-    w.a_LF_thigh[0] = w.c_LF_thigh[0] + w.cq_LF_thigh*t9 - w.sq_LF_thigh*t10;
+    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
+    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
+    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
+    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
+    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
+    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
+    const Scalar t6 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.IA_LF_thigh[16]*t4 - w.a_LF_hip[4]*w.IA_LF_thigh[18] - w.IA_LF_thigh[19]*t5;
+    w.qdd[7] = w.Dinv_LF_thigh*t6;
+    w.a_LF_thigh[0] = t2;
     w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = w.c_LF_thigh[2] + w.sq_LF_thigh*t9 + w.cq_LF_thigh*t10;
-    w.a_LF_thigh[3] = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
+    w.a_LF_thigh[2] = t3;
+    w.a_LF_thigh[3] = t4;
     w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
+    w.a_LF_thigh[5] = t5;
   }
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    const Scalar t16 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t17 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t18 = w.c_LF_shank[0] + w.cq_LF_shank*t16 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t19 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t20 = w.u_LF_shank[0] - w.U_LF_shank[0]*t18 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t19;
-    w.qdd[8] = w.Dinv_LF_shank*t20;
-    w.a_LF_shank[0] = w.c_LF_shank[0] + w.cq_LF_shank*t16 - w.sq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[1] = t17;
-    w.a_LF_shank[2] = w.c_LF_shank[2] + w.sq_LF_shank*t16 + w.cq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[3] = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
+    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
+    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t13 = w.u_LF_shank[0] - w.U_LF_shank[0]*t9 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t12;
+    w.qdd[8] = w.Dinv_LF_shank*t13;
+    w.a_LF_shank[0] = t9;
+    w.a_LF_shank[1] = t8;
+    w.a_LF_shank[2] = t10;
+    w.a_LF_shank[3] = t11;
     w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    w.a_LF_shank[5] = t12;
   }
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t21 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t22 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t24 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t21 + w.RJ_LH_hip[3]*t22 + w.RJ_LH_hip[6]*t23;
-    const Scalar t25 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t21 + w.cq_LH_hip*t22 + w.RJ_LH_hip[7]*t23;
-    const Scalar t26 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t21 + w.RJ_LH_hip[5]*t22 + w.RJ_LH_hip[8]*t23;
-    const Scalar t27 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
-    const Scalar t28 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
-    const Scalar t29 = -5.7617628499109426e-05*w.c_LH_hip[4] + w.u_LH_hip[0] - 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_LH_hip[1] - 5.7617628499109426e-05*w.a_trunk[4]*w.cq_LH_hip - 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_LH_hip[7] - w.U_LH_hip[0]*t24 - w.U_LH_hip[1]*t25 - w.U_LH_hip[2]*t26 - w.U_LH_hip[3]*t27 - w.U_LH_hip[5]*t28;
-    w.qdd[9] = w.Dinv_LH_hip*t29;
-    w.a_LH_hip[0] = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t21 + w.RJ_LH_hip[3]*t22 + w.RJ_LH_hip[6]*t23;
-    w.a_LH_hip[1] = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t21 + w.cq_LH_hip*t22 + w.RJ_LH_hip[7]*t23;
-    w.a_LH_hip[2] = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t21 + w.RJ_LH_hip[5]*t22 + w.RJ_LH_hip[8]*t23;
-    w.a_LH_hip[3] = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6] + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
-    w.a_LH_hip[5] = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8] - 0.09950371902099892*w.qdd[9];
+    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t14 + w.RJ_LH_hip[3]*t15 + w.RJ_LH_hip[6]*t16;
+    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[7]*t16;
+    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t14 + w.RJ_LH_hip[5]*t15 + w.RJ_LH_hip[8]*t16;
+    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
+    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
+    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
+    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
+    w.qdd[9] = w.Dinv_LH_hip*t23;
+    w.a_LH_hip[0] = t17;
+    w.a_LH_hip[1] = t18;
+    w.a_LH_hip[2] = t19;
+    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
+    w.a_LH_hip[4] = t21;
+    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
-    const Scalar t30 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t31 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t32 = w.c_LH_thigh[0] + w.cq_LH_thigh*t30 - w.sq_LH_thigh*t31;
-    const Scalar t33 = w.c_LH_thigh[2] + w.sq_LH_thigh*t30 + w.cq_LH_thigh*t31;
-    const Scalar t34 = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t35 = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t36 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t32 - w.IA_LH_thigh[13]*t33 - w.IA_LH_thigh[16]*t34 - w.IA_LH_thigh[18]*w.a_LH_hip[4] - w.IA_LH_thigh[19]*t35;
-    w.qdd[10] = w.Dinv_LH_thigh*t36;
-    w.a_LH_thigh[0] = w.c_LH_thigh[0] + w.cq_LH_thigh*t30 - w.sq_LH_thigh*t31;
+    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
+    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
+    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
+    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
+    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
+    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
+    const Scalar t6 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.IA_LH_thigh[16]*t4 - w.a_LH_hip[4]*w.IA_LH_thigh[18] - w.IA_LH_thigh[19]*t5;
+    w.qdd[10] = w.Dinv_LH_thigh*t6;
+    w.a_LH_thigh[0] = t2;
     w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = w.c_LH_thigh[2] + w.sq_LH_thigh*t30 + w.cq_LH_thigh*t31;
-    w.a_LH_thigh[3] = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
+    w.a_LH_thigh[2] = t3;
+    w.a_LH_thigh[3] = t4;
     w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
+    w.a_LH_thigh[5] = t5;
   }
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    const Scalar t37 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t38 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t39 = w.c_LH_shank[0] + w.cq_LH_shank*t37 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t40 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t41 = w.u_LH_shank[0] - w.U_LH_shank[0]*t39 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t40;
-    w.qdd[11] = w.Dinv_LH_shank*t41;
-    w.a_LH_shank[0] = w.c_LH_shank[0] + w.cq_LH_shank*t37 - w.sq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[1] = t38;
-    w.a_LH_shank[2] = w.c_LH_shank[2] + w.sq_LH_shank*t37 + w.cq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[3] = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
+    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
+    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t13 = w.u_LH_shank[0] - w.U_LH_shank[0]*t9 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t12;
+    w.qdd[11] = w.Dinv_LH_shank*t13;
+    w.a_LH_shank[0] = t9;
+    w.a_LH_shank[1] = t8;
+    w.a_LH_shank[2] = t10;
+    w.a_LH_shank[3] = t11;
     w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    w.a_LH_shank[5] = t12;
+  }
+  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t14 + w.RJ_RF_hip[3]*t15 + w.RJ_RF_hip[6]*t16;
+    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[7]*t16;
+    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t14 + w.RJ_RF_hip[5]*t15 + w.RJ_RF_hip[8]*t16;
+    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
+    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
+    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
+    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
+    w.qdd[12] = w.Dinv_RF_hip*t23;
+    w.a_RF_hip[0] = t17;
+    w.a_RF_hip[1] = t18;
+    w.a_RF_hip[2] = t19;
+    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
+    w.a_RF_hip[4] = t21;
+    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_10(Workspace& w) noexcept {
-  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t0 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t0 + w.RJ_RF_hip[3]*t1 + w.RJ_RF_hip[6]*t2;
-    const Scalar t4 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[7]*t2;
-    const Scalar t5 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t0 + w.RJ_RF_hip[5]*t1 + w.RJ_RF_hip[8]*t2;
-    const Scalar t6 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
-    const Scalar t7 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
-    const Scalar t8 = 5.780668556524933e-05*w.c_RF_hip[4] + w.u_RF_hip[0] + 5.780668556524933e-05*w.a_trunk[3]*w.RJ_RF_hip[1] + 5.780668556524933e-05*w.a_trunk[4]*w.cq_RF_hip + 5.780668556524933e-05*w.a_trunk[5]*w.RJ_RF_hip[7] - w.U_RF_hip[0]*t3 - w.U_RF_hip[1]*t4 - w.U_RF_hip[2]*t5 - w.U_RF_hip[3]*t6 - w.U_RF_hip[5]*t7;
-    w.qdd[12] = w.Dinv_RF_hip*t8;
-    w.a_RF_hip[0] = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t0 + w.RJ_RF_hip[3]*t1 + w.RJ_RF_hip[6]*t2;
-    w.a_RF_hip[1] = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[7]*t2;
-    w.a_RF_hip[2] = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t0 + w.RJ_RF_hip[5]*t1 + w.RJ_RF_hip[8]*t2;
-    w.a_RF_hip[3] = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6] + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
-    w.a_RF_hip[5] = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8] + 0.09950371902099893*w.qdd[12];
-  }
+PROXGEN_RT_NOINLINE void caba_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
-    const Scalar t9 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t10 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t11 = w.c_RF_thigh[0] + w.cq_RF_thigh*t9 - w.sq_RF_thigh*t10;
-    const Scalar t12 = w.c_RF_thigh[2] + w.sq_RF_thigh*t9 + w.cq_RF_thigh*t10;
-    const Scalar t13 = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t14 = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t15 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t11 - w.IA_RF_thigh[13]*t12 - w.IA_RF_thigh[16]*t13 - w.IA_RF_thigh[18]*w.a_RF_hip[4] - w.IA_RF_thigh[19]*t14;
-    w.qdd[13] = w.Dinv_RF_thigh*t15;
-    w.a_RF_thigh[0] = w.c_RF_thigh[0] + w.cq_RF_thigh*t9 - w.sq_RF_thigh*t10;
+    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
+    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
+    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
+    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
+    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
+    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
+    const Scalar t6 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.IA_RF_thigh[16]*t4 - w.a_RF_hip[4]*w.IA_RF_thigh[18] - w.IA_RF_thigh[19]*t5;
+    w.qdd[13] = w.Dinv_RF_thigh*t6;
+    w.a_RF_thigh[0] = t2;
     w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = w.c_RF_thigh[2] + w.sq_RF_thigh*t9 + w.cq_RF_thigh*t10;
-    w.a_RF_thigh[3] = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
+    w.a_RF_thigh[2] = t3;
+    w.a_RF_thigh[3] = t4;
     w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
+    w.a_RF_thigh[5] = t5;
   }
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    const Scalar t16 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t17 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t18 = w.c_RF_shank[0] + w.cq_RF_shank*t16 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t19 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t20 = w.u_RF_shank[0] - w.U_RF_shank[0]*t18 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t19;
-    w.qdd[14] = w.Dinv_RF_shank*t20;
-    w.a_RF_shank[0] = w.c_RF_shank[0] + w.cq_RF_shank*t16 - w.sq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[1] = t17;
-    w.a_RF_shank[2] = w.c_RF_shank[2] + w.sq_RF_shank*t16 + w.cq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[3] = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
+    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
+    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t13 = w.u_RF_shank[0] - w.U_RF_shank[0]*t9 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t12;
+    w.qdd[14] = w.Dinv_RF_shank*t13;
+    w.a_RF_shank[0] = t9;
+    w.a_RF_shank[1] = t8;
+    w.a_RF_shank[2] = t10;
+    w.a_RF_shank[3] = t11;
     w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    w.a_RF_shank[5] = t12;
   }
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t21 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t22 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t24 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t21 + w.RJ_RH_hip[3]*t22 + w.RJ_RH_hip[6]*t23;
-    const Scalar t25 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t21 + w.cq_RH_hip*t22 + w.RJ_RH_hip[7]*t23;
-    const Scalar t26 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t21 + w.RJ_RH_hip[5]*t22 + w.RJ_RH_hip[8]*t23;
-    const Scalar t27 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
-    const Scalar t28 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
-    const Scalar t29 = 5.7617628499109426e-05*w.c_RH_hip[4] + w.u_RH_hip[0] + 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_RH_hip[1] + 5.7617628499109426e-05*w.a_trunk[4]*w.cq_RH_hip + 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_RH_hip[7] - w.U_RH_hip[0]*t24 - w.U_RH_hip[1]*t25 - w.U_RH_hip[2]*t26 - w.U_RH_hip[3]*t27 - w.U_RH_hip[5]*t28;
-    w.qdd[15] = w.Dinv_RH_hip*t29;
-    w.a_RH_hip[0] = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t21 + w.RJ_RH_hip[3]*t22 + w.RJ_RH_hip[6]*t23;
-    w.a_RH_hip[1] = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t21 + w.cq_RH_hip*t22 + w.RJ_RH_hip[7]*t23;
-    w.a_RH_hip[2] = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t21 + w.RJ_RH_hip[5]*t22 + w.RJ_RH_hip[8]*t23;
-    w.a_RH_hip[3] = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6] + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
-    w.a_RH_hip[5] = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8] - 0.09950371902099892*w.qdd[15];
-  }
-  // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t30 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t31 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t32 = w.c_RH_thigh[0] + w.cq_RH_thigh*t30 - w.sq_RH_thigh*t31;
-    const Scalar t33 = w.c_RH_thigh[2] + w.sq_RH_thigh*t30 + w.cq_RH_thigh*t31;
-    const Scalar t34 = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t35 = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t36 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t32 - w.IA_RH_thigh[13]*t33 - w.IA_RH_thigh[16]*t34 - w.IA_RH_thigh[18]*w.a_RH_hip[4] - w.IA_RH_thigh[19]*t35;
-    w.qdd[16] = w.Dinv_RH_thigh*t36;
-    w.a_RH_thigh[0] = w.c_RH_thigh[0] + w.cq_RH_thigh*t30 - w.sq_RH_thigh*t31;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = w.c_RH_thigh[2] + w.sq_RH_thigh*t30 + w.cq_RH_thigh*t31;
-    w.a_RH_thigh[3] = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
-  }
-  // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t37 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t38 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t39 = w.c_RH_shank[0] + w.cq_RH_shank*t37 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t40 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t41 = w.u_RH_shank[0] - w.U_RH_shank[0]*t39 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t40;
-    w.qdd[17] = w.Dinv_RH_shank*t41;
-    w.a_RH_shank[0] = w.c_RH_shank[0] + w.cq_RH_shank*t37 - w.sq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[1] = t38;
-    w.a_RH_shank[2] = w.c_RH_shank[2] + w.sq_RH_shank*t37 + w.cq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[3] = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t14 + w.RJ_RH_hip[3]*t15 + w.RJ_RH_hip[6]*t16;
+    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[7]*t16;
+    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t14 + w.RJ_RH_hip[5]*t15 + w.RJ_RH_hip[8]*t16;
+    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
+    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
+    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
+    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
+    w.qdd[15] = w.Dinv_RH_hip*t23;
+    w.a_RH_hip[0] = t17;
+    w.a_RH_hip[1] = t18;
+    w.a_RH_hip[2] = t19;
+    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
+    w.a_RH_hip[4] = t21;
+    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_11(Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_17(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+  {
+    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
+    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
+    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
+    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
+    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
+    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
+    const Scalar t6 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.IA_RH_thigh[16]*t4 - w.a_RH_hip[4]*w.IA_RH_thigh[18] - w.IA_RH_thigh[19]*t5;
+    w.qdd[16] = w.Dinv_RH_thigh*t6;
+    w.a_RH_thigh[0] = t2;
+    w.a_RH_thigh[1] = w.a_RH_hip[1];
+    w.a_RH_thigh[2] = t3;
+    w.a_RH_thigh[3] = t4;
+    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
+    w.a_RH_thigh[5] = t5;
+  }
+  // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
+  {
+    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
+    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
+    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t13 = w.u_RH_shank[0] - w.U_RH_shank[0]*t9 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t12;
+    w.qdd[17] = w.Dinv_RH_shank*t13;
+    w.a_RH_shank[0] = t9;
+    w.a_RH_shank[1] = t8;
+    w.a_RH_shank[2] = t10;
+    w.a_RH_shank[3] = t11;
+    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
+    w.a_RH_shank[5] = t12;
+  }
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.dlambda[0] = t0*mu;
+    const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.dlambda[0] = t14*mu;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.dlambda[1] = mu*t1;
+    const Scalar t15 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.dlambda[1] = mu*t15;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.dlambda[2] = mu*t2;
+    const Scalar t16 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.dlambda[2] = mu*t16;
     w.lambda[2] = w.dlambda[2];
-    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.dlambda[3] = mu*t3;
+    const Scalar t17 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.dlambda[3] = mu*t17;
     w.lambda[3] = w.dlambda[3];
-    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.dlambda[4] = mu*t4;
+    const Scalar t18 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.dlambda[4] = mu*t18;
     w.lambda[4] = w.dlambda[4];
-    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.dlambda[5] = mu*t5;
+    const Scalar t19 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.dlambda[5] = mu*t19;
     w.lambda[5] = w.dlambda[5];
-    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.dlambda[6] = mu*t6;
+    const Scalar t20 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.dlambda[6] = mu*t20;
     w.lambda[6] = w.dlambda[6];
-    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.dlambda[7] = mu*t7;
+    const Scalar t21 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.dlambda[7] = mu*t21;
     w.lambda[7] = w.dlambda[7];
-    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.dlambda[8] = mu*t8;
+    const Scalar t22 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.dlambda[8] = mu*t22;
     w.lambda[8] = w.dlambda[8];
-    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.dlambda[9] = mu*t9;
+    const Scalar t23 = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
+    w.dlambda[9] = mu*t23;
     w.lambda[9] = w.dlambda[9];
-    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.dlambda[10] = mu*t10;
+    const Scalar t24 = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
+    w.dlambda[10] = mu*t24;
     w.lambda[10] = w.dlambda[10];
-    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
-    w.dlambda[11] = mu*t11;
+    const Scalar t25 = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
+    w.dlambda[11] = mu*t25;
     w.lambda[11] = w.dlambda[11];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_12(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_18(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     w.u_RH_shank[0] = w.u_RH_shank[0] + 0.195*w.dlambda[9];
@@ -1951,65 +1987,68 @@ PROXGEN_RT_NOINLINE void caba_12(Workspace& w) noexcept {
     w.dp_trunk[4] = w.RJ_RH_hip[3]*t19 + w.cq_RH_hip*t20 + w.RJ_RH_hip[5]*t21 + 0.19*t24;
     w.dp_trunk[5] = w.RJ_RH_hip[6]*t19 + w.RJ_RH_hip[7]*t20 + w.RJ_RH_hip[8]*t21 + 0.049*t22 - 0.19*t23;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_19(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     w.u_RF_shank[0] = w.u_RF_shank[0] + 0.195*w.dlambda[3];
-    const Scalar t25 = 0.195*w.Dinv_RF_shank*w.dlambda[3];
-    const Scalar t26 = w.dlambda[3] + w.U_RF_shank[0]*t25;
-    const Scalar t27 = 0.195*w.dlambda[4] - 0.004*w.dlambda[5];
-    const Scalar t28 = -0.195*w.dlambda[3] + w.U_RF_shank[4]*t25;
-    const Scalar t29 = 0.004*w.dlambda[3] + w.U_RF_shank[5]*t25;
-    const Scalar t30 = w.cq_RF_shank*t26 + w.sq_RF_shank*w.dlambda[5];
-    const Scalar t31 = -w.sq_RF_shank*t26 + w.cq_RF_shank*w.dlambda[5];
-    w.dp_RF_thigh[0] = t30;
+    const Scalar t0 = 0.195*w.Dinv_RF_shank*w.dlambda[3];
+    const Scalar t1 = w.dlambda[3] + w.U_RF_shank[0]*t0;
+    const Scalar t2 = 0.195*w.dlambda[4] - 0.004*w.dlambda[5];
+    const Scalar t3 = -0.195*w.dlambda[3] + w.U_RF_shank[4]*t0;
+    const Scalar t4 = 0.004*w.dlambda[3] + w.U_RF_shank[5]*t0;
+    const Scalar t5 = w.cq_RF_shank*t1 + w.sq_RF_shank*w.dlambda[5];
+    const Scalar t6 = -w.sq_RF_shank*t1 + w.cq_RF_shank*w.dlambda[5];
+    w.dp_RF_thigh[0] = t5;
     w.dp_RF_thigh[1] = w.dlambda[4];
-    w.dp_RF_thigh[2] = t31;
-    w.dp_RF_thigh[3] = 0.209*w.dlambda[4] + w.cq_RF_shank*t27 + w.sq_RF_shank*t29;
-    w.dp_RF_thigh[4] = t28 - 0.209*t30;
-    w.dp_RF_thigh[5] = -w.sq_RF_shank*t27 + w.cq_RF_shank*t29;
+    w.dp_RF_thigh[2] = t6;
+    w.dp_RF_thigh[3] = 0.209*w.dlambda[4] + w.cq_RF_shank*t2 + w.sq_RF_shank*t4;
+    w.dp_RF_thigh[4] = t3 - 0.209*t5;
+    w.dp_RF_thigh[5] = -w.sq_RF_shank*t2 + w.cq_RF_shank*t4;
   }
   // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.u_RF_thigh[0] = w.u_RF_thigh[0] - w.dp_RF_thigh[4];
-    const Scalar t32 = -w.Dinv_RF_thigh*w.dp_RF_thigh[4];
-    const Scalar t33 = w.dp_RF_thigh[0] + w.IA_RF_thigh[4]*t32;
-    const Scalar t34 = w.dp_RF_thigh[2] + w.IA_RF_thigh[13]*t32;
-    const Scalar t35 = w.dp_RF_thigh[3] + w.IA_RF_thigh[16]*t32;
-    const Scalar t36 = w.dp_RF_thigh[4] + w.IA_RF_thigh[18]*t32;
-    const Scalar t37 = w.dp_RF_thigh[5] + w.IA_RF_thigh[19]*t32;
-    const Scalar t38 = w.cq_RF_thigh*t33 + w.sq_RF_thigh*t34;
-    const Scalar t39 = -w.sq_RF_thigh*t33 + w.cq_RF_thigh*t34;
-    w.dp_RF_hip[0] = t38;
+    const Scalar t7 = -w.Dinv_RF_thigh*w.dp_RF_thigh[4];
+    const Scalar t8 = w.dp_RF_thigh[0] + w.IA_RF_thigh[4]*t7;
+    const Scalar t9 = w.dp_RF_thigh[2] + w.IA_RF_thigh[13]*t7;
+    const Scalar t10 = w.dp_RF_thigh[3] + w.IA_RF_thigh[16]*t7;
+    const Scalar t11 = w.dp_RF_thigh[4] + w.IA_RF_thigh[18]*t7;
+    const Scalar t12 = w.dp_RF_thigh[5] + w.IA_RF_thigh[19]*t7;
+    const Scalar t13 = w.cq_RF_thigh*t8 + w.sq_RF_thigh*t9;
+    const Scalar t14 = -w.sq_RF_thigh*t8 + w.cq_RF_thigh*t9;
+    w.dp_RF_hip[0] = t13;
     w.dp_RF_hip[1] = w.dp_RF_thigh[1];
-    w.dp_RF_hip[2] = t39;
-    w.dp_RF_hip[3] = w.cq_RF_thigh*t35 + w.sq_RF_thigh*t37 - 0.062*t39;
-    w.dp_RF_hip[4] = t36;
-    w.dp_RF_hip[5] = -w.sq_RF_thigh*t35 + w.cq_RF_thigh*t37 + 0.062*t38;
+    w.dp_RF_hip[2] = t14;
+    w.dp_RF_hip[3] = w.cq_RF_thigh*t10 + w.sq_RF_thigh*t12 - 0.062*t14;
+    w.dp_RF_hip[4] = t11;
+    w.dp_RF_hip[5] = -w.sq_RF_thigh*t10 + w.cq_RF_thigh*t12 + 0.062*t13;
   }
   // reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar du1 = -0.9950371902099893*w.dp_RF_hip[3] - 0.09950371902099893*w.dp_RF_hip[5];
-    w.u_RF_hip[0] = w.u_RF_hip[0] + du1;
-    const Scalar t40 = w.Dinv_RF_hip*du1;
-    const Scalar t41 = w.dp_RF_hip[0] + w.U_RF_hip[0]*t40;
-    const Scalar t42 = w.dp_RF_hip[1] + w.U_RF_hip[1]*t40;
-    const Scalar t43 = w.dp_RF_hip[2] + w.U_RF_hip[2]*t40;
-    const Scalar t44 = w.dp_RF_hip[3] + w.U_RF_hip[3]*t40;
-    const Scalar t45 = w.dp_RF_hip[4] - 5.780668556524933e-05*w.Dinv_RF_hip*du1;
-    const Scalar t46 = w.dp_RF_hip[5] + w.U_RF_hip[5]*t40;
-    const Scalar t47 = w.RJ_RF_hip[0]*t41 + w.RJ_RF_hip[1]*t42 + w.RJ_RF_hip[2]*t43;
-    const Scalar t48 = w.RJ_RF_hip[3]*t41 + w.cq_RF_hip*t42 + w.RJ_RF_hip[5]*t43;
-    const Scalar t49 = w.RJ_RF_hip[6]*t41 + w.RJ_RF_hip[7]*t42 + w.RJ_RF_hip[8]*t43;
-    w.dp_trunk[0] = w.dp_trunk[0] + t47;
-    w.dp_trunk[1] = w.dp_trunk[1] + t48;
-    w.dp_trunk[2] = w.dp_trunk[2] + t49;
-    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_RF_hip[0]*t44 + w.RJ_RF_hip[1]*t45 + w.RJ_RF_hip[2]*t46 - 0.049*t49;
-    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_RF_hip[3]*t44 + w.cq_RF_hip*t45 + w.RJ_RF_hip[5]*t46 - 0.19*t49;
-    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_RF_hip[6]*t44 + w.RJ_RF_hip[7]*t45 + w.RJ_RF_hip[8]*t46 + 0.049*t47 + 0.19*t48;
+    const Scalar du0 = -0.9950371902099893*w.dp_RF_hip[3] - 0.09950371902099893*w.dp_RF_hip[5];
+    w.u_RF_hip[0] = w.u_RF_hip[0] + du0;
+    const Scalar t15 = w.Dinv_RF_hip*du0;
+    const Scalar t16 = w.dp_RF_hip[0] + w.U_RF_hip[0]*t15;
+    const Scalar t17 = w.dp_RF_hip[1] + w.U_RF_hip[1]*t15;
+    const Scalar t18 = w.dp_RF_hip[2] + w.U_RF_hip[2]*t15;
+    const Scalar t19 = w.dp_RF_hip[3] + w.U_RF_hip[3]*t15;
+    const Scalar t20 = w.dp_RF_hip[4] - 5.780668556524933e-05*w.Dinv_RF_hip*du0;
+    const Scalar t21 = w.dp_RF_hip[5] + w.U_RF_hip[5]*t15;
+    const Scalar t22 = w.RJ_RF_hip[0]*t16 + w.RJ_RF_hip[1]*t17 + w.RJ_RF_hip[2]*t18;
+    const Scalar t23 = w.RJ_RF_hip[3]*t16 + w.cq_RF_hip*t17 + w.RJ_RF_hip[5]*t18;
+    const Scalar t24 = w.RJ_RF_hip[6]*t16 + w.RJ_RF_hip[7]*t17 + w.RJ_RF_hip[8]*t18;
+    w.dp_trunk[0] = w.dp_trunk[0] + t22;
+    w.dp_trunk[1] = w.dp_trunk[1] + t23;
+    w.dp_trunk[2] = w.dp_trunk[2] + t24;
+    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_RF_hip[0]*t19 + w.RJ_RF_hip[1]*t20 + w.RJ_RF_hip[2]*t21 - 0.049*t24;
+    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_RF_hip[3]*t19 + w.cq_RF_hip*t20 + w.RJ_RF_hip[5]*t21 - 0.19*t24;
+    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_RF_hip[6]*t19 + w.RJ_RF_hip[7]*t20 + w.RJ_RF_hip[8]*t21 + 0.049*t22 + 0.19*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_13(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_20(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     w.u_LH_shank[0] = w.u_LH_shank[0] + 0.195*w.dlambda[6];
@@ -2066,65 +2105,68 @@ PROXGEN_RT_NOINLINE void caba_13(Workspace& w) noexcept {
     w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_LH_hip[3]*t19 + w.cq_LH_hip*t20 + w.RJ_LH_hip[5]*t21 + 0.19*t24;
     w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_LH_hip[6]*t19 + w.RJ_LH_hip[7]*t20 + w.RJ_LH_hip[8]*t21 - 0.049*t22 - 0.19*t23;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     w.u_LF_shank[0] = w.u_LF_shank[0] + 0.195*w.dlambda[0];
-    const Scalar t25 = 0.195*w.Dinv_LF_shank*w.dlambda[0];
-    const Scalar t26 = w.dlambda[0] + w.U_LF_shank[0]*t25;
-    const Scalar t27 = 0.195*w.dlambda[1] + 0.004*w.dlambda[2];
-    const Scalar t28 = -0.195*w.dlambda[0] + w.U_LF_shank[4]*t25;
-    const Scalar t29 = -0.004*w.dlambda[0] + w.U_LF_shank[5]*t25;
-    const Scalar t30 = w.cq_LF_shank*t26 + w.sq_LF_shank*w.dlambda[2];
-    const Scalar t31 = -w.sq_LF_shank*t26 + w.cq_LF_shank*w.dlambda[2];
-    w.dp_LF_thigh[0] = t30;
+    const Scalar t0 = 0.195*w.Dinv_LF_shank*w.dlambda[0];
+    const Scalar t1 = w.dlambda[0] + w.U_LF_shank[0]*t0;
+    const Scalar t2 = 0.195*w.dlambda[1] + 0.004*w.dlambda[2];
+    const Scalar t3 = -0.195*w.dlambda[0] + w.U_LF_shank[4]*t0;
+    const Scalar t4 = -0.004*w.dlambda[0] + w.U_LF_shank[5]*t0;
+    const Scalar t5 = w.cq_LF_shank*t1 + w.sq_LF_shank*w.dlambda[2];
+    const Scalar t6 = -w.sq_LF_shank*t1 + w.cq_LF_shank*w.dlambda[2];
+    w.dp_LF_thigh[0] = t5;
     w.dp_LF_thigh[1] = w.dlambda[1];
-    w.dp_LF_thigh[2] = t31;
-    w.dp_LF_thigh[3] = 0.209*w.dlambda[1] + w.cq_LF_shank*t27 + w.sq_LF_shank*t29;
-    w.dp_LF_thigh[4] = t28 - 0.209*t30;
-    w.dp_LF_thigh[5] = -w.sq_LF_shank*t27 + w.cq_LF_shank*t29;
+    w.dp_LF_thigh[2] = t6;
+    w.dp_LF_thigh[3] = 0.209*w.dlambda[1] + w.cq_LF_shank*t2 + w.sq_LF_shank*t4;
+    w.dp_LF_thigh[4] = t3 - 0.209*t5;
+    w.dp_LF_thigh[5] = -w.sq_LF_shank*t2 + w.cq_LF_shank*t4;
   }
   // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.u_LF_thigh[0] = w.u_LF_thigh[0] - w.dp_LF_thigh[4];
-    const Scalar t32 = -w.Dinv_LF_thigh*w.dp_LF_thigh[4];
-    const Scalar t33 = w.dp_LF_thigh[0] + w.IA_LF_thigh[4]*t32;
-    const Scalar t34 = w.dp_LF_thigh[2] + w.IA_LF_thigh[13]*t32;
-    const Scalar t35 = w.dp_LF_thigh[3] + w.IA_LF_thigh[16]*t32;
-    const Scalar t36 = w.dp_LF_thigh[4] + w.IA_LF_thigh[18]*t32;
-    const Scalar t37 = w.dp_LF_thigh[5] + w.IA_LF_thigh[19]*t32;
-    const Scalar t38 = w.cq_LF_thigh*t33 + w.sq_LF_thigh*t34;
-    const Scalar t39 = -w.sq_LF_thigh*t33 + w.cq_LF_thigh*t34;
-    w.dp_LF_hip[0] = t38;
+    const Scalar t7 = -w.Dinv_LF_thigh*w.dp_LF_thigh[4];
+    const Scalar t8 = w.dp_LF_thigh[0] + w.IA_LF_thigh[4]*t7;
+    const Scalar t9 = w.dp_LF_thigh[2] + w.IA_LF_thigh[13]*t7;
+    const Scalar t10 = w.dp_LF_thigh[3] + w.IA_LF_thigh[16]*t7;
+    const Scalar t11 = w.dp_LF_thigh[4] + w.IA_LF_thigh[18]*t7;
+    const Scalar t12 = w.dp_LF_thigh[5] + w.IA_LF_thigh[19]*t7;
+    const Scalar t13 = w.cq_LF_thigh*t8 + w.sq_LF_thigh*t9;
+    const Scalar t14 = -w.sq_LF_thigh*t8 + w.cq_LF_thigh*t9;
+    w.dp_LF_hip[0] = t13;
     w.dp_LF_hip[1] = w.dp_LF_thigh[1];
-    w.dp_LF_hip[2] = t39;
-    w.dp_LF_hip[3] = w.cq_LF_thigh*t35 + w.sq_LF_thigh*t37 + 0.062*t39;
-    w.dp_LF_hip[4] = t36;
-    w.dp_LF_hip[5] = -w.sq_LF_thigh*t35 + w.cq_LF_thigh*t37 - 0.062*t38;
+    w.dp_LF_hip[2] = t14;
+    w.dp_LF_hip[3] = w.cq_LF_thigh*t10 + w.sq_LF_thigh*t12 + 0.062*t14;
+    w.dp_LF_hip[4] = t11;
+    w.dp_LF_hip[5] = -w.sq_LF_thigh*t10 + w.cq_LF_thigh*t12 - 0.062*t13;
   }
   // reduced sweep: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar du1 = -0.9950371902099893*w.dp_LF_hip[3] - 0.09950371902099893*w.dp_LF_hip[5];
-    w.u_LF_hip[0] = w.u_LF_hip[0] + du1;
-    const Scalar t40 = w.Dinv_LF_hip*du1;
-    const Scalar t41 = w.dp_LF_hip[0] + w.U_LF_hip[0]*t40;
-    const Scalar t42 = w.dp_LF_hip[1] + w.U_LF_hip[1]*t40;
-    const Scalar t43 = w.dp_LF_hip[2] + w.U_LF_hip[2]*t40;
-    const Scalar t44 = w.dp_LF_hip[3] + w.U_LF_hip[3]*t40;
-    const Scalar t45 = w.dp_LF_hip[4] + 5.780668556524933e-05*w.Dinv_LF_hip*du1;
-    const Scalar t46 = w.dp_LF_hip[5] + w.U_LF_hip[5]*t40;
-    const Scalar t47 = w.RJ_LF_hip[0]*t41 + w.RJ_LF_hip[1]*t42 + w.RJ_LF_hip[2]*t43;
-    const Scalar t48 = w.RJ_LF_hip[3]*t41 + w.cq_LF_hip*t42 + w.RJ_LF_hip[5]*t43;
-    const Scalar t49 = w.RJ_LF_hip[6]*t41 + w.RJ_LF_hip[7]*t42 + w.RJ_LF_hip[8]*t43;
-    w.dp_trunk[0] = w.dp_trunk[0] + t47;
-    w.dp_trunk[1] = w.dp_trunk[1] + t48;
-    w.dp_trunk[2] = w.dp_trunk[2] + t49;
-    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_LF_hip[0]*t44 + w.RJ_LF_hip[1]*t45 + w.RJ_LF_hip[2]*t46 + 0.049*t49;
-    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_LF_hip[3]*t44 + w.cq_LF_hip*t45 + w.RJ_LF_hip[5]*t46 - 0.19*t49;
-    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_LF_hip[6]*t44 + w.RJ_LF_hip[7]*t45 + w.RJ_LF_hip[8]*t46 - 0.049*t47 + 0.19*t48;
+    const Scalar du0 = -0.9950371902099893*w.dp_LF_hip[3] - 0.09950371902099893*w.dp_LF_hip[5];
+    w.u_LF_hip[0] = w.u_LF_hip[0] + du0;
+    const Scalar t15 = w.Dinv_LF_hip*du0;
+    const Scalar t16 = w.dp_LF_hip[0] + w.U_LF_hip[0]*t15;
+    const Scalar t17 = w.dp_LF_hip[1] + w.U_LF_hip[1]*t15;
+    const Scalar t18 = w.dp_LF_hip[2] + w.U_LF_hip[2]*t15;
+    const Scalar t19 = w.dp_LF_hip[3] + w.U_LF_hip[3]*t15;
+    const Scalar t20 = w.dp_LF_hip[4] + 5.780668556524933e-05*w.Dinv_LF_hip*du0;
+    const Scalar t21 = w.dp_LF_hip[5] + w.U_LF_hip[5]*t15;
+    const Scalar t22 = w.RJ_LF_hip[0]*t16 + w.RJ_LF_hip[1]*t17 + w.RJ_LF_hip[2]*t18;
+    const Scalar t23 = w.RJ_LF_hip[3]*t16 + w.cq_LF_hip*t17 + w.RJ_LF_hip[5]*t18;
+    const Scalar t24 = w.RJ_LF_hip[6]*t16 + w.RJ_LF_hip[7]*t17 + w.RJ_LF_hip[8]*t18;
+    w.dp_trunk[0] = w.dp_trunk[0] + t22;
+    w.dp_trunk[1] = w.dp_trunk[1] + t23;
+    w.dp_trunk[2] = w.dp_trunk[2] + t24;
+    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_LF_hip[0]*t19 + w.RJ_LF_hip[1]*t20 + w.RJ_LF_hip[2]*t21 + 0.049*t24;
+    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_LF_hip[3]*t19 + w.cq_LF_hip*t20 + w.RJ_LF_hip[5]*t21 - 0.19*t24;
+    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_LF_hip[6]*t19 + w.RJ_LF_hip[7]*t20 + w.RJ_LF_hip[8]*t21 - 0.049*t22 + 0.19*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_14(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     w.u_trunk[0] = -w.dp_trunk[0] + w.u_trunk[0];
@@ -2171,60 +2213,66 @@ PROXGEN_RT_NOINLINE void caba_14(Workspace& w) noexcept {
     w.a_trunk[4] = w.qdd[4];
     w.a_trunk[5] = w.qdd[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
-    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
-    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
-    const Scalar t30 = -5.780668556524933e-05*w.c_LF_hip[4] + w.u_LF_hip[0] - 5.780668556524933e-05*w.RJ_LF_hip[1]*w.a_trunk[3] - 5.780668556524933e-05*w.cq_LF_hip*w.a_trunk[4] - 5.780668556524933e-05*w.RJ_LF_hip[7]*w.a_trunk[5] - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t29;
-    w.qdd[6] = w.Dinv_LF_hip*t30;
-    w.a_LF_hip[0] = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
-    w.a_LF_hip[1] = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
-    w.a_LF_hip[2] = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
-    w.a_LF_hip[3] = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5] + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
-    w.a_LF_hip[5] = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5] + 0.09950371902099893*w.qdd[6];
+    const Scalar t0 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t2 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t3 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t0 + w.RJ_LF_hip[3]*t1 + w.RJ_LF_hip[6]*t2;
+    const Scalar t4 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[7]*t2;
+    const Scalar t5 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t0 + w.RJ_LF_hip[5]*t1 + w.RJ_LF_hip[8]*t2;
+    const Scalar t6 = w.c_LF_hip[3] + w.a_trunk[3]*w.RJ_LF_hip[0] + w.a_trunk[4]*w.RJ_LF_hip[3] + w.a_trunk[5]*w.RJ_LF_hip[6];
+    const Scalar t7 = w.c_LF_hip[4] + w.a_trunk[3]*w.RJ_LF_hip[1] + w.a_trunk[4]*w.cq_LF_hip + w.a_trunk[5]*w.RJ_LF_hip[7];
+    const Scalar t8 = w.c_LF_hip[5] + w.a_trunk[3]*w.RJ_LF_hip[2] + w.a_trunk[4]*w.RJ_LF_hip[5] + w.a_trunk[5]*w.RJ_LF_hip[8];
+    const Scalar t9 = w.u_LF_hip[0] - 5.780668556524933e-05*t7 - w.U_LF_hip[0]*t3 - w.U_LF_hip[1]*t4 - w.U_LF_hip[2]*t5 - w.U_LF_hip[3]*t6 - w.U_LF_hip[5]*t8;
+    w.qdd[6] = w.Dinv_LF_hip*t9;
+    w.a_LF_hip[0] = t3;
+    w.a_LF_hip[1] = t4;
+    w.a_LF_hip[2] = t5;
+    w.a_LF_hip[3] = t6 + 0.9950371902099893*w.qdd[6];
+    w.a_LF_hip[4] = t7;
+    w.a_LF_hip[5] = t8 + 0.09950371902099893*w.qdd[6];
   }
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
-    const Scalar t31 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t32 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t33 = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
-    const Scalar t34 = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    const Scalar t35 = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t36 = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t37 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t33 - w.IA_LF_thigh[13]*t34 - w.IA_LF_thigh[16]*t35 - w.IA_LF_thigh[18]*w.a_LF_hip[4] - w.IA_LF_thigh[19]*t36;
-    w.qdd[7] = w.Dinv_LF_thigh*t37;
-    w.a_LF_thigh[0] = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
+    const Scalar t10 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
+    const Scalar t11 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
+    const Scalar t12 = w.c_LF_thigh[0] + w.cq_LF_thigh*t10 - w.sq_LF_thigh*t11;
+    const Scalar t13 = w.c_LF_thigh[2] + w.sq_LF_thigh*t10 + w.cq_LF_thigh*t11;
+    const Scalar t14 = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
+    const Scalar t15 = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
+    const Scalar t16 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t12 - w.IA_LF_thigh[13]*t13 - w.IA_LF_thigh[16]*t14 - w.IA_LF_thigh[18]*w.a_LF_hip[4] - w.IA_LF_thigh[19]*t15;
+    w.qdd[7] = w.Dinv_LF_thigh*t16;
+    w.a_LF_thigh[0] = t12;
     w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    w.a_LF_thigh[3] = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
+    w.a_LF_thigh[2] = t13;
+    w.a_LF_thigh[3] = t14;
     w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
+    w.a_LF_thigh[5] = t15;
   }
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    const Scalar t38 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t39 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t40 = w.c_LF_shank[0] + w.cq_LF_shank*t38 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t41 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t42 = w.u_LF_shank[0] - w.U_LF_shank[0]*t40 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t41;
-    w.qdd[8] = w.Dinv_LF_shank*t42;
-    w.a_LF_shank[0] = w.c_LF_shank[0] + w.cq_LF_shank*t38 - w.sq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[1] = t39;
-    w.a_LF_shank[2] = w.c_LF_shank[2] + w.sq_LF_shank*t38 + w.cq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[3] = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t17 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
+    const Scalar t18 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
+    const Scalar t19 = w.c_LF_shank[0] + w.cq_LF_shank*t17 - w.sq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t20 = w.c_LF_shank[2] + w.sq_LF_shank*t17 + w.cq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t21 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t22 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t23 = w.u_LF_shank[0] - w.U_LF_shank[0]*t19 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t22;
+    w.qdd[8] = w.Dinv_LF_shank*t23;
+    w.a_LF_shank[0] = t19;
+    w.a_LF_shank[1] = t18;
+    w.a_LF_shank[2] = t20;
+    w.a_LF_shank[3] = t21;
     w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    w.a_LF_shank[5] = t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_15(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t0 = w.a_trunk[0] - 0.049*w.a_trunk[5];
@@ -2234,102 +2282,111 @@ PROXGEN_RT_NOINLINE void caba_15(Workspace& w) noexcept {
     const Scalar t4 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t0 + w.cq_LH_hip*t1 + w.RJ_LH_hip[7]*t2;
     const Scalar t5 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t0 + w.RJ_LH_hip[5]*t1 + w.RJ_LH_hip[8]*t2;
     const Scalar t6 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
-    const Scalar t7 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
-    const Scalar t8 = -5.7617628499109426e-05*w.c_LH_hip[4] + w.u_LH_hip[0] - 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_LH_hip[1] - 5.7617628499109426e-05*w.a_trunk[4]*w.cq_LH_hip - 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_LH_hip[7] - w.U_LH_hip[0]*t3 - w.U_LH_hip[1]*t4 - w.U_LH_hip[2]*t5 - w.U_LH_hip[3]*t6 - w.U_LH_hip[5]*t7;
-    w.qdd[9] = w.Dinv_LH_hip*t8;
-    w.a_LH_hip[0] = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t0 + w.RJ_LH_hip[3]*t1 + w.RJ_LH_hip[6]*t2;
-    w.a_LH_hip[1] = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t0 + w.cq_LH_hip*t1 + w.RJ_LH_hip[7]*t2;
-    w.a_LH_hip[2] = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t0 + w.RJ_LH_hip[5]*t1 + w.RJ_LH_hip[8]*t2;
-    w.a_LH_hip[3] = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6] + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
-    w.a_LH_hip[5] = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8] - 0.09950371902099892*w.qdd[9];
+    const Scalar t7 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
+    const Scalar t8 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
+    const Scalar t9 = w.u_LH_hip[0] - 5.7617628499109426e-05*t7 - w.U_LH_hip[0]*t3 - w.U_LH_hip[1]*t4 - w.U_LH_hip[2]*t5 - w.U_LH_hip[3]*t6 - w.U_LH_hip[5]*t8;
+    w.qdd[9] = w.Dinv_LH_hip*t9;
+    w.a_LH_hip[0] = t3;
+    w.a_LH_hip[1] = t4;
+    w.a_LH_hip[2] = t5;
+    w.a_LH_hip[3] = t6 + 0.9950371902099892*w.qdd[9];
+    w.a_LH_hip[4] = t7;
+    w.a_LH_hip[5] = t8 - 0.09950371902099892*w.qdd[9];
   }
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
-    const Scalar t9 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t10 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t11 = w.c_LH_thigh[0] + w.cq_LH_thigh*t9 - w.sq_LH_thigh*t10;
-    const Scalar t12 = w.c_LH_thigh[2] + w.sq_LH_thigh*t9 + w.cq_LH_thigh*t10;
-    const Scalar t13 = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t14 = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t15 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t11 - w.IA_LH_thigh[13]*t12 - w.IA_LH_thigh[16]*t13 - w.IA_LH_thigh[18]*w.a_LH_hip[4] - w.IA_LH_thigh[19]*t14;
-    w.qdd[10] = w.Dinv_LH_thigh*t15;
-    w.a_LH_thigh[0] = w.c_LH_thigh[0] + w.cq_LH_thigh*t9 - w.sq_LH_thigh*t10;
+    const Scalar t10 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
+    const Scalar t11 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
+    const Scalar t12 = w.c_LH_thigh[0] + w.cq_LH_thigh*t10 - w.sq_LH_thigh*t11;
+    const Scalar t13 = w.c_LH_thigh[2] + w.sq_LH_thigh*t10 + w.cq_LH_thigh*t11;
+    const Scalar t14 = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
+    const Scalar t15 = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
+    const Scalar t16 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t12 - w.IA_LH_thigh[13]*t13 - w.IA_LH_thigh[16]*t14 - w.IA_LH_thigh[18]*w.a_LH_hip[4] - w.IA_LH_thigh[19]*t15;
+    w.qdd[10] = w.Dinv_LH_thigh*t16;
+    w.a_LH_thigh[0] = t12;
     w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = w.c_LH_thigh[2] + w.sq_LH_thigh*t9 + w.cq_LH_thigh*t10;
-    w.a_LH_thigh[3] = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
+    w.a_LH_thigh[2] = t13;
+    w.a_LH_thigh[3] = t14;
     w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
+    w.a_LH_thigh[5] = t15;
   }
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    const Scalar t16 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t17 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t18 = w.c_LH_shank[0] + w.cq_LH_shank*t16 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t19 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t20 = w.u_LH_shank[0] - w.U_LH_shank[0]*t18 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t19;
-    w.qdd[11] = w.Dinv_LH_shank*t20;
-    w.a_LH_shank[0] = w.c_LH_shank[0] + w.cq_LH_shank*t16 - w.sq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[1] = t17;
-    w.a_LH_shank[2] = w.c_LH_shank[2] + w.sq_LH_shank*t16 + w.cq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[3] = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t17 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
+    const Scalar t18 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
+    const Scalar t19 = w.c_LH_shank[0] + w.cq_LH_shank*t17 - w.sq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t20 = w.c_LH_shank[2] + w.sq_LH_shank*t17 + w.cq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t21 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t22 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t23 = w.u_LH_shank[0] - w.U_LH_shank[0]*t19 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t22;
+    w.qdd[11] = w.Dinv_LH_shank*t23;
+    w.a_LH_shank[0] = t19;
+    w.a_LH_shank[1] = t18;
+    w.a_LH_shank[2] = t20;
+    w.a_LH_shank[3] = t21;
     w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-  }
-  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t21 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t22 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t24 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t21 + w.RJ_RF_hip[3]*t22 + w.RJ_RF_hip[6]*t23;
-    const Scalar t25 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t21 + w.cq_RF_hip*t22 + w.RJ_RF_hip[7]*t23;
-    const Scalar t26 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t21 + w.RJ_RF_hip[5]*t22 + w.RJ_RF_hip[8]*t23;
-    const Scalar t27 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
-    const Scalar t28 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
-    const Scalar t29 = 5.780668556524933e-05*w.c_RF_hip[4] + w.u_RF_hip[0] + 5.780668556524933e-05*w.a_trunk[3]*w.RJ_RF_hip[1] + 5.780668556524933e-05*w.a_trunk[4]*w.cq_RF_hip + 5.780668556524933e-05*w.a_trunk[5]*w.RJ_RF_hip[7] - w.U_RF_hip[0]*t24 - w.U_RF_hip[1]*t25 - w.U_RF_hip[2]*t26 - w.U_RF_hip[3]*t27 - w.U_RF_hip[5]*t28;
-    w.qdd[12] = w.Dinv_RF_hip*t29;
-    w.a_RF_hip[0] = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t21 + w.RJ_RF_hip[3]*t22 + w.RJ_RF_hip[6]*t23;
-    w.a_RF_hip[1] = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t21 + w.cq_RF_hip*t22 + w.RJ_RF_hip[7]*t23;
-    w.a_RF_hip[2] = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t21 + w.RJ_RF_hip[5]*t22 + w.RJ_RF_hip[8]*t23;
-    w.a_RF_hip[3] = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6] + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
-    w.a_RF_hip[5] = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8] + 0.09950371902099893*w.qdd[12];
-  }
-  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t30 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t31 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t32 = w.c_RF_thigh[0] + w.cq_RF_thigh*t30 - w.sq_RF_thigh*t31;
-    const Scalar t33 = w.c_RF_thigh[2] + w.sq_RF_thigh*t30 + w.cq_RF_thigh*t31;
-    const Scalar t34 = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t35 = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t36 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t32 - w.IA_RF_thigh[13]*t33 - w.IA_RF_thigh[16]*t34 - w.IA_RF_thigh[18]*w.a_RF_hip[4] - w.IA_RF_thigh[19]*t35;
-    w.qdd[13] = w.Dinv_RF_thigh*t36;
-    w.a_RF_thigh[0] = w.c_RF_thigh[0] + w.cq_RF_thigh*t30 - w.sq_RF_thigh*t31;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = w.c_RF_thigh[2] + w.sq_RF_thigh*t30 + w.cq_RF_thigh*t31;
-    w.a_RF_thigh[3] = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
-  }
-  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t37 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t38 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t39 = w.c_RF_shank[0] + w.cq_RF_shank*t37 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t40 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t41 = w.u_RF_shank[0] - w.U_RF_shank[0]*t39 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t40;
-    w.qdd[14] = w.Dinv_RF_shank*t41;
-    w.a_RF_shank[0] = w.c_RF_shank[0] + w.cq_RF_shank*t37 - w.sq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[1] = t38;
-    w.a_RF_shank[2] = w.c_RF_shank[2] + w.sq_RF_shank*t37 + w.cq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[3] = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    w.a_LH_shank[5] = t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_16(Scalar mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void caba_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t0 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t2 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t3 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t0 + w.RJ_RF_hip[3]*t1 + w.RJ_RF_hip[6]*t2;
+    const Scalar t4 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[7]*t2;
+    const Scalar t5 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t0 + w.RJ_RF_hip[5]*t1 + w.RJ_RF_hip[8]*t2;
+    const Scalar t6 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
+    const Scalar t7 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
+    const Scalar t8 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
+    const Scalar t9 = w.u_RF_hip[0] + 5.780668556524933e-05*t7 - w.U_RF_hip[0]*t3 - w.U_RF_hip[1]*t4 - w.U_RF_hip[2]*t5 - w.U_RF_hip[3]*t6 - w.U_RF_hip[5]*t8;
+    w.qdd[12] = w.Dinv_RF_hip*t9;
+    w.a_RF_hip[0] = t3;
+    w.a_RF_hip[1] = t4;
+    w.a_RF_hip[2] = t5;
+    w.a_RF_hip[3] = t6 + 0.9950371902099893*w.qdd[12];
+    w.a_RF_hip[4] = t7;
+    w.a_RF_hip[5] = t8 + 0.09950371902099893*w.qdd[12];
+  }
+  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  {
+    const Scalar t10 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
+    const Scalar t11 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
+    const Scalar t12 = w.c_RF_thigh[0] + w.cq_RF_thigh*t10 - w.sq_RF_thigh*t11;
+    const Scalar t13 = w.c_RF_thigh[2] + w.sq_RF_thigh*t10 + w.cq_RF_thigh*t11;
+    const Scalar t14 = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
+    const Scalar t15 = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
+    const Scalar t16 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t12 - w.IA_RF_thigh[13]*t13 - w.IA_RF_thigh[16]*t14 - w.IA_RF_thigh[18]*w.a_RF_hip[4] - w.IA_RF_thigh[19]*t15;
+    w.qdd[13] = w.Dinv_RF_thigh*t16;
+    w.a_RF_thigh[0] = t12;
+    w.a_RF_thigh[1] = w.a_RF_hip[1];
+    w.a_RF_thigh[2] = t13;
+    w.a_RF_thigh[3] = t14;
+    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
+    w.a_RF_thigh[5] = t15;
+  }
+  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  {
+    const Scalar t17 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
+    const Scalar t18 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
+    const Scalar t19 = w.c_RF_shank[0] + w.cq_RF_shank*t17 - w.sq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t20 = w.c_RF_shank[2] + w.sq_RF_shank*t17 + w.cq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t21 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t22 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t23 = w.u_RF_shank[0] - w.U_RF_shank[0]*t19 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t22;
+    w.qdd[14] = w.Dinv_RF_shank*t23;
+    w.a_RF_shank[0] = t19;
+    w.a_RF_shank[1] = t18;
+    w.a_RF_shank[2] = t20;
+    w.a_RF_shank[3] = t21;
+    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
+    w.a_RF_shank[5] = t22;
+  }
+}
+
+PROXGEN_RT_NOINLINE void caba_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t0 = w.a_trunk[0] + 0.049*w.a_trunk[5];
@@ -2339,90 +2396,96 @@ PROXGEN_RT_NOINLINE void caba_16(Scalar mu, Workspace& w) noexcept {
     const Scalar t4 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t0 + w.cq_RH_hip*t1 + w.RJ_RH_hip[7]*t2;
     const Scalar t5 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t0 + w.RJ_RH_hip[5]*t1 + w.RJ_RH_hip[8]*t2;
     const Scalar t6 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
-    const Scalar t7 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
-    const Scalar t8 = 5.7617628499109426e-05*w.c_RH_hip[4] + w.u_RH_hip[0] + 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_RH_hip[1] + 5.7617628499109426e-05*w.a_trunk[4]*w.cq_RH_hip + 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_RH_hip[7] - w.U_RH_hip[0]*t3 - w.U_RH_hip[1]*t4 - w.U_RH_hip[2]*t5 - w.U_RH_hip[3]*t6 - w.U_RH_hip[5]*t7;
-    w.qdd[15] = w.Dinv_RH_hip*t8;
-    w.a_RH_hip[0] = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t0 + w.RJ_RH_hip[3]*t1 + w.RJ_RH_hip[6]*t2;
-    w.a_RH_hip[1] = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t0 + w.cq_RH_hip*t1 + w.RJ_RH_hip[7]*t2;
-    w.a_RH_hip[2] = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t0 + w.RJ_RH_hip[5]*t1 + w.RJ_RH_hip[8]*t2;
-    w.a_RH_hip[3] = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6] + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
-    w.a_RH_hip[5] = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8] - 0.09950371902099892*w.qdd[15];
+    const Scalar t7 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
+    const Scalar t8 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
+    const Scalar t9 = w.u_RH_hip[0] + 5.7617628499109426e-05*t7 - w.U_RH_hip[0]*t3 - w.U_RH_hip[1]*t4 - w.U_RH_hip[2]*t5 - w.U_RH_hip[3]*t6 - w.U_RH_hip[5]*t8;
+    w.qdd[15] = w.Dinv_RH_hip*t9;
+    w.a_RH_hip[0] = t3;
+    w.a_RH_hip[1] = t4;
+    w.a_RH_hip[2] = t5;
+    w.a_RH_hip[3] = t6 + 0.9950371902099892*w.qdd[15];
+    w.a_RH_hip[4] = t7;
+    w.a_RH_hip[5] = t8 - 0.09950371902099892*w.qdd[15];
   }
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
-    const Scalar t9 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t10 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t11 = w.c_RH_thigh[0] + w.cq_RH_thigh*t9 - w.sq_RH_thigh*t10;
-    const Scalar t12 = w.c_RH_thigh[2] + w.sq_RH_thigh*t9 + w.cq_RH_thigh*t10;
-    const Scalar t13 = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t14 = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t15 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t11 - w.IA_RH_thigh[13]*t12 - w.IA_RH_thigh[16]*t13 - w.IA_RH_thigh[18]*w.a_RH_hip[4] - w.IA_RH_thigh[19]*t14;
-    w.qdd[16] = w.Dinv_RH_thigh*t15;
-    w.a_RH_thigh[0] = w.c_RH_thigh[0] + w.cq_RH_thigh*t9 - w.sq_RH_thigh*t10;
+    const Scalar t10 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
+    const Scalar t11 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
+    const Scalar t12 = w.c_RH_thigh[0] + w.cq_RH_thigh*t10 - w.sq_RH_thigh*t11;
+    const Scalar t13 = w.c_RH_thigh[2] + w.sq_RH_thigh*t10 + w.cq_RH_thigh*t11;
+    const Scalar t14 = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
+    const Scalar t15 = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
+    const Scalar t16 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t12 - w.IA_RH_thigh[13]*t13 - w.IA_RH_thigh[16]*t14 - w.IA_RH_thigh[18]*w.a_RH_hip[4] - w.IA_RH_thigh[19]*t15;
+    w.qdd[16] = w.Dinv_RH_thigh*t16;
+    w.a_RH_thigh[0] = t12;
     w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = w.c_RH_thigh[2] + w.sq_RH_thigh*t9 + w.cq_RH_thigh*t10;
-    w.a_RH_thigh[3] = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
+    w.a_RH_thigh[2] = t13;
+    w.a_RH_thigh[3] = t14;
     w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
+    w.a_RH_thigh[5] = t15;
   }
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    const Scalar t16 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t17 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t18 = w.c_RH_shank[0] + w.cq_RH_shank*t16 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t19 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t20 = w.u_RH_shank[0] - w.U_RH_shank[0]*t18 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t19;
-    w.qdd[17] = w.Dinv_RH_shank*t20;
-    w.a_RH_shank[0] = w.c_RH_shank[0] + w.cq_RH_shank*t16 - w.sq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[1] = t17;
-    w.a_RH_shank[2] = w.c_RH_shank[2] + w.sq_RH_shank*t16 + w.cq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[3] = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t17 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
+    const Scalar t18 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
+    const Scalar t19 = w.c_RH_shank[0] + w.cq_RH_shank*t17 - w.sq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t20 = w.c_RH_shank[2] + w.sq_RH_shank*t17 + w.cq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t21 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t22 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t23 = w.u_RH_shank[0] - w.U_RH_shank[0]*t19 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t22;
+    w.qdd[17] = w.Dinv_RH_shank*t23;
+    w.a_RH_shank[0] = t19;
+    w.a_RH_shank[1] = t18;
+    w.a_RH_shank[2] = t20;
+    w.a_RH_shank[3] = t21;
     w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    w.a_RH_shank[5] = t22;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_27(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t21 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.dlambda[0] = t21*mu;
+    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.dlambda[0] = t0*mu;
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t22 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.dlambda[1] = mu*t22;
+    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t23 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.dlambda[2] = mu*t23;
+    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    const Scalar t24 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.dlambda[3] = mu*t24;
+    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.dlambda[3] = mu*t3;
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    const Scalar t25 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.dlambda[4] = mu*t25;
+    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.dlambda[4] = mu*t4;
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    const Scalar t26 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.dlambda[5] = mu*t26;
+    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.dlambda[5] = mu*t5;
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t27 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.dlambda[6] = mu*t27;
+    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.dlambda[6] = mu*t6;
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t28 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.dlambda[7] = mu*t28;
+    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.dlambda[7] = mu*t7;
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t29 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.dlambda[8] = mu*t29;
+    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.dlambda[8] = mu*t8;
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    const Scalar t30 = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
-    w.dlambda[9] = mu*t30;
+    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.dlambda[9] = mu*t9;
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    const Scalar t31 = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
-    w.dlambda[10] = mu*t31;
+    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.dlambda[10] = mu*t10;
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    const Scalar t32 = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
-    w.dlambda[11] = mu*t32;
+    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.dlambda[11] = mu*t11;
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     w.Dinv_RH_shank = 1.0 / 0.000486144;
@@ -2475,97 +2538,100 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* tau, Workspace& w) noexcept {
     w.KA_RH_thigh[16] = -0.209*w.sq_RH_shank;
     w.KA_RH_thigh[17] = 0.004*w.sq_RH_shank;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
     w.u_RH_thigh[0] = -w.pA_RH_thigh[4] + tau[16];
-    const Scalar t7 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar t8 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar t9 = w.IA_RH_thigh[18]*w.Dinv_RH_thigh;
-    const Scalar Ia1 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t7;
-    const Scalar Ia2 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t7;
-    const Scalar Ia3 = -0.010144 - 0.00020288*w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar Ia4 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t8;
-    const Scalar Ia5 = w.IA_RH_thigh[20] - 4.11602944e-08*w.Dinv_RH_thigh;
-    const Scalar t10 = -0.00020288*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar pa6 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t7 + w.c_RH_thigh[0]*Ia1 + w.c_RH_thigh[2]*Ia2 + w.c_RH_thigh[5]*Ia3;
-    const Scalar pa7 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
-    const Scalar pa8 = 0.010144*w.c_RH_thigh[3] + w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t8 + w.c_RH_thigh[0]*Ia2 + w.c_RH_thigh[2]*Ia4 + w.c_RH_thigh[5]*t10;
-    const Scalar pa9 = 0.010144*w.c_RH_thigh[2] + w.pA_RH_thigh[3] + w.c_RH_thigh[3]*w.IA_RH_thigh[15] + w.c_RH_thigh[5]*w.IA_RH_thigh[17];
-    const Scalar pa10 = w.pA_RH_thigh[4] + w.u_RH_thigh[0]*t9;
-    const Scalar pa11 = w.pA_RH_thigh[5] + 0.00020288*w.Dinv_RH_thigh*w.u_RH_thigh[0] + w.c_RH_thigh[0]*Ia3 + w.c_RH_thigh[2]*t10 + w.c_RH_thigh[3]*w.IA_RH_thigh[17] + w.c_RH_thigh[5]*Ia5;
-    const Scalar C21 = -w.sq_RH_thigh*w.sq_RH_thigh + w.cq_RH_thigh*w.cq_RH_thigh;
-    const Scalar h1 = 0.5*(-Ia1 + Ia4);
-    const Scalar m1 = 0.5*(Ia1 + Ia4);
-    const Scalar t11 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
-    const Scalar d0 = -Ia2*t11 + C21*h1;
-    const Scalar qq0 = Ia2*C21 + h1*t11;
-    const Scalar t12 = 0.005072 + 0.5*Ia3;
-    const Scalar t13 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar d1 = -t11*t12 + C21*t13;
-    const Scalar qq1 = C21*t12 + t11*t13;
-    const Scalar h2 = 0.5*(-w.IA_RH_thigh[15] + Ia5);
-    const Scalar m2 = 0.5*(w.IA_RH_thigh[15] + Ia5);
-    const Scalar d2 = -w.IA_RH_thigh[17]*t11 + C21*h2;
-    const Scalar qq2 = w.IA_RH_thigh[17]*C21 + t11*h2;
-    const Scalar t14 = m1 - d0;
-    const Scalar t15 = m1 + d0;
-    const Scalar t16 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh - d1;
-    const Scalar t17 = -0.005072 + 0.5*Ia3 + qq1;
-    const Scalar t18 = w.cq_RH_thigh*w.IA_RH_thigh[8] + w.sq_RH_thigh*w.IA_RH_thigh[10];
-    const Scalar t19 = -w.sq_RH_thigh*w.IA_RH_thigh[8] + w.cq_RH_thigh*w.IA_RH_thigh[10];
-    const Scalar t20 = 0.005072 - 0.5*Ia3 + qq1;
-    const Scalar t21 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh + d1;
-    const Scalar t22 = -0.062*qq0 + t16;
-    const Scalar t23 = 0.062*t14 + t17;
-    const Scalar t24 = -0.062*t15 + t20;
-    const Scalar t25 = 0.062*qq0 + t21;
-    const Scalar t26 = w.cq_RH_thigh*pa6 + w.sq_RH_thigh*pa8;
-    const Scalar t27 = -w.sq_RH_thigh*pa6 + w.cq_RH_thigh*pa8;
-    w.IA_RH_hip[0] = 0.5950000000000001 + t14;
+    const Scalar t0 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
+    const Scalar t1 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
+    const Scalar t2 = w.IA_RH_thigh[18]*w.Dinv_RH_thigh;
+    const Scalar Ia0 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t0;
+    const Scalar Ia2 = -0.010144 - 0.00020288*w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
+    const Scalar Ia3 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t1;
+    const Scalar Ia4 = w.IA_RH_thigh[20] - 4.11602944e-08*w.Dinv_RH_thigh;
+    const Scalar t3 = -0.00020288*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
+    const Scalar pa0 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t0 + w.c_RH_thigh[0]*Ia0 + w.c_RH_thigh[2]*Ia1 + w.c_RH_thigh[5]*Ia2;
+    const Scalar pa1 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
+    const Scalar pa2 = 0.010144*w.c_RH_thigh[3] + w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t1 + w.c_RH_thigh[0]*Ia1 + w.c_RH_thigh[2]*Ia3 + w.c_RH_thigh[5]*t3;
+    const Scalar pa3 = 0.010144*w.c_RH_thigh[2] + w.pA_RH_thigh[3] + w.c_RH_thigh[3]*w.IA_RH_thigh[15] + w.c_RH_thigh[5]*w.IA_RH_thigh[17];
+    const Scalar pa4 = w.pA_RH_thigh[4] + w.u_RH_thigh[0]*t2;
+    const Scalar pa5 = w.pA_RH_thigh[5] + 0.00020288*w.Dinv_RH_thigh*w.u_RH_thigh[0] + w.c_RH_thigh[0]*Ia2 + w.c_RH_thigh[2]*t3 + w.c_RH_thigh[3]*w.IA_RH_thigh[17] + w.c_RH_thigh[5]*Ia4;
+    const Scalar C20 = -w.sq_RH_thigh*w.sq_RH_thigh + w.cq_RH_thigh*w.cq_RH_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia3);
+    const Scalar m0 = 0.5*(Ia0 + Ia3);
+    const Scalar t4 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
+    const Scalar d0 = -Ia1*t4 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t4;
+    const Scalar t5 = 0.005072 + 0.5*Ia2;
+    const Scalar t6 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
+    const Scalar d1 = -t4*t5 + C20*t6;
+    const Scalar qq1 = C20*t5 + t4*t6;
+    const Scalar h1 = 0.5*(-w.IA_RH_thigh[15] + Ia4);
+    const Scalar m1 = 0.5*(w.IA_RH_thigh[15] + Ia4);
+    const Scalar d2 = -w.IA_RH_thigh[17]*t4 + C20*h1;
+    const Scalar qq2 = w.IA_RH_thigh[17]*C20 + t4*h1;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh - d1;
+    const Scalar t10 = -0.005072 + 0.5*Ia2 + qq1;
+    const Scalar t11 = w.cq_RH_thigh*w.IA_RH_thigh[8] + w.sq_RH_thigh*w.IA_RH_thigh[10];
+    const Scalar t12 = -w.sq_RH_thigh*w.IA_RH_thigh[8] + w.cq_RH_thigh*w.IA_RH_thigh[10];
+    const Scalar t13 = 0.005072 - 0.5*Ia2 + qq1;
+    const Scalar t14 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh + d1;
+    const Scalar t15 = -0.062*qq0 + t9;
+    const Scalar t16 = 0.062*t7 + t10;
+    const Scalar t17 = -0.062*t8 + t13;
+    const Scalar t18 = 0.062*qq0 + t14;
+    const Scalar t19 = w.cq_RH_thigh*pa0 + w.sq_RH_thigh*pa2;
+    const Scalar t20 = -w.sq_RH_thigh*pa0 + w.cq_RH_thigh*pa2;
+    w.IA_RH_hip[0] = 0.5950000000000001 + t7;
     w.IA_RH_hip[2] = qq0;
-    w.IA_RH_hip[3] = t22;
-    w.IA_RH_hip[5] = 0.02164 + t23;
-    w.IA_RH_hip[8] = t18;
-    w.IA_RH_hip[10] = t19;
-    w.IA_RH_hip[11] = 0.5950000000000001 + t15;
-    w.IA_RH_hip[12] = -0.02164 + t24;
-    w.IA_RH_hip[14] = t25;
-    w.IA_RH_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t20 - 0.062*t24;
-    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t16 - 0.062*t25;
-    w.IA_RH_hip[20] = 0.00126484 + m2 + d2 + 0.062*t17 + 0.062*t23;
-    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t26;
-    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa7;
-    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t27;
-    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa9 + w.sq_RH_thigh*pa11 - 0.062*t27;
-    w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa10;
-    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa9 + w.cq_RH_thigh*pa11 + 0.062*t26;
+    w.IA_RH_hip[3] = t15;
+    w.IA_RH_hip[5] = 0.02164 + t16;
+    w.IA_RH_hip[8] = t11;
+    w.IA_RH_hip[10] = t12;
+    w.IA_RH_hip[11] = 0.5950000000000001 + t8;
+    w.IA_RH_hip[12] = -0.02164 + t17;
+    w.IA_RH_hip[14] = t18;
+    w.IA_RH_hip[15] = 0.0012018399999999998 + m1 - d2 - 0.062*t13 - 0.062*t17;
+    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t9 - 0.062*t18;
+    w.IA_RH_hip[20] = 0.00126484 + m1 + d2 + 0.062*t10 + 0.062*t16;
+    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t19;
+    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa1;
+    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t20;
+    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa3 + w.sq_RH_thigh*pa5 - 0.062*t20;
+    w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa4;
+    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa5 + 0.062*t19;
     w.KSD_RH_thigh[0] = w.KA_RH_thigh[4]*w.Dinv_RH_thigh;
     w.KSD_RH_thigh[2] = w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
-    const Scalar t28 = w.KA_RH_thigh[0] - w.KA_RH_thigh[4]*t7;
-    const Scalar t29 = w.KA_RH_thigh[2] - w.KA_RH_thigh[4]*t8;
-    const Scalar t30 = w.KA_RH_thigh[5] - 0.00020288*w.KA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar t31 = w.cq_RH_thigh*t28 + w.sq_RH_thigh*t29;
-    const Scalar t32 = -w.sq_RH_thigh*t28 + w.cq_RH_thigh*t29;
-    w.KA_RH_hip[0] = t31;
-    w.KA_RH_hip[2] = t32;
-    w.KA_RH_hip[3] = w.cq_RH_thigh*w.KA_RH_thigh[3] + w.sq_RH_thigh*t30 - 0.062*t32;
-    w.KA_RH_hip[5] = -w.sq_RH_thigh*w.KA_RH_thigh[3] + w.cq_RH_thigh*t30 + 0.062*t31;
+    const Scalar t21 = w.KA_RH_thigh[0] - w.KA_RH_thigh[4]*t0;
+    const Scalar t22 = w.KA_RH_thigh[2] - w.KA_RH_thigh[4]*t1;
+    const Scalar t23 = w.KA_RH_thigh[5] - 0.00020288*w.KA_RH_thigh[4]*w.Dinv_RH_thigh;
+    const Scalar t24 = w.cq_RH_thigh*t21 + w.sq_RH_thigh*t22;
+    const Scalar t25 = -w.sq_RH_thigh*t21 + w.cq_RH_thigh*t22;
+    w.KA_RH_hip[0] = t24;
+    w.KA_RH_hip[2] = t25;
+    w.KA_RH_hip[3] = w.cq_RH_thigh*w.KA_RH_thigh[3] + w.sq_RH_thigh*t23 - 0.062*t25;
+    w.KA_RH_hip[5] = -w.sq_RH_thigh*w.KA_RH_thigh[3] + w.cq_RH_thigh*t23 + 0.062*t24;
     w.KA_RH_hip[9] = w.cq_RH_thigh*w.KA_RH_thigh[9] + w.sq_RH_thigh*w.KA_RH_thigh[11];
     w.KA_RH_hip[11] = -w.sq_RH_thigh*w.KA_RH_thigh[9] + w.cq_RH_thigh*w.KA_RH_thigh[11];
-    const Scalar t33 = w.KA_RH_thigh[12] - w.KA_RH_thigh[16]*t7;
-    const Scalar t34 = w.KA_RH_thigh[14] - w.KA_RH_thigh[16]*t8;
-    const Scalar t35 = w.KA_RH_thigh[17] - 0.00020288*w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
-    const Scalar t36 = w.cq_RH_thigh*t33 + w.sq_RH_thigh*t34;
-    const Scalar t37 = -w.sq_RH_thigh*t33 + w.cq_RH_thigh*t34;
-    w.KA_RH_hip[12] = t36;
-    w.KA_RH_hip[14] = t37;
-    w.KA_RH_hip[15] = w.cq_RH_thigh*w.KA_RH_thigh[15] + w.sq_RH_thigh*t35 - 0.062*t37;
-    w.KA_RH_hip[17] = -w.sq_RH_thigh*w.KA_RH_thigh[15] + w.cq_RH_thigh*t35 + 0.062*t36;
+    const Scalar t26 = w.KA_RH_thigh[12] - w.KA_RH_thigh[16]*t0;
+    const Scalar t27 = w.KA_RH_thigh[14] - w.KA_RH_thigh[16]*t1;
+    const Scalar t28 = w.KA_RH_thigh[17] - 0.00020288*w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
+    const Scalar t29 = w.cq_RH_thigh*t26 + w.sq_RH_thigh*t27;
+    const Scalar t30 = -w.sq_RH_thigh*t26 + w.cq_RH_thigh*t27;
+    w.KA_RH_hip[12] = t29;
+    w.KA_RH_hip[14] = t30;
+    w.KA_RH_hip[15] = w.cq_RH_thigh*w.KA_RH_thigh[15] + w.sq_RH_thigh*t28 - 0.062*t30;
+    w.KA_RH_hip[17] = -w.sq_RH_thigh*w.KA_RH_thigh[15] + w.cq_RH_thigh*t28 + 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -2743,7 +2809,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     w.Dinv_RF_shank = 1.0 / 0.000486144;
@@ -2796,97 +2862,100 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* tau, Workspace& w) noexcept {
     w.KA_RF_thigh[16] = -0.209*w.sq_RF_shank;
     w.KA_RF_thigh[17] = 0.004*w.sq_RF_shank;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
     w.u_RF_thigh[0] = -w.pA_RF_thigh[4] + tau[13];
-    const Scalar t7 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar t8 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar t9 = w.IA_RF_thigh[18]*w.Dinv_RF_thigh;
-    const Scalar Ia1 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t7;
-    const Scalar Ia2 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t7;
-    const Scalar Ia3 = -0.010144 - 0.00020288*w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar Ia4 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t8;
-    const Scalar Ia5 = w.IA_RF_thigh[20] - 4.11602944e-08*w.Dinv_RF_thigh;
-    const Scalar t10 = -0.00020288*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar pa6 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t7 + w.c_RF_thigh[0]*Ia1 + w.c_RF_thigh[2]*Ia2 + w.c_RF_thigh[5]*Ia3;
-    const Scalar pa7 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
-    const Scalar pa8 = 0.010144*w.c_RF_thigh[3] + w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t8 + w.c_RF_thigh[0]*Ia2 + w.c_RF_thigh[2]*Ia4 + w.c_RF_thigh[5]*t10;
-    const Scalar pa9 = 0.010144*w.c_RF_thigh[2] + w.pA_RF_thigh[3] + w.c_RF_thigh[3]*w.IA_RF_thigh[15] + w.c_RF_thigh[5]*w.IA_RF_thigh[17];
-    const Scalar pa10 = w.pA_RF_thigh[4] + w.u_RF_thigh[0]*t9;
-    const Scalar pa11 = w.pA_RF_thigh[5] + 0.00020288*w.Dinv_RF_thigh*w.u_RF_thigh[0] + w.c_RF_thigh[0]*Ia3 + w.c_RF_thigh[2]*t10 + w.c_RF_thigh[3]*w.IA_RF_thigh[17] + w.c_RF_thigh[5]*Ia5;
-    const Scalar C21 = -w.sq_RF_thigh*w.sq_RF_thigh + w.cq_RF_thigh*w.cq_RF_thigh;
-    const Scalar h1 = 0.5*(-Ia1 + Ia4);
-    const Scalar m1 = 0.5*(Ia1 + Ia4);
-    const Scalar t11 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
-    const Scalar d0 = -Ia2*t11 + C21*h1;
-    const Scalar qq0 = Ia2*C21 + h1*t11;
-    const Scalar t12 = 0.005072 + 0.5*Ia3;
-    const Scalar t13 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar d1 = -t11*t12 + C21*t13;
-    const Scalar qq1 = C21*t12 + t11*t13;
-    const Scalar h2 = 0.5*(-w.IA_RF_thigh[15] + Ia5);
-    const Scalar m2 = 0.5*(w.IA_RF_thigh[15] + Ia5);
-    const Scalar d2 = -w.IA_RF_thigh[17]*t11 + C21*h2;
-    const Scalar qq2 = w.IA_RF_thigh[17]*C21 + t11*h2;
-    const Scalar t14 = m1 - d0;
-    const Scalar t15 = m1 + d0;
-    const Scalar t16 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh - d1;
-    const Scalar t17 = -0.005072 + 0.5*Ia3 + qq1;
-    const Scalar t18 = w.cq_RF_thigh*w.IA_RF_thigh[8] + w.sq_RF_thigh*w.IA_RF_thigh[10];
-    const Scalar t19 = -w.sq_RF_thigh*w.IA_RF_thigh[8] + w.cq_RF_thigh*w.IA_RF_thigh[10];
-    const Scalar t20 = 0.005072 - 0.5*Ia3 + qq1;
-    const Scalar t21 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh + d1;
-    const Scalar t22 = -0.062*qq0 + t16;
-    const Scalar t23 = 0.062*t14 + t17;
-    const Scalar t24 = -0.062*t15 + t20;
-    const Scalar t25 = 0.062*qq0 + t21;
-    const Scalar t26 = w.cq_RF_thigh*pa6 + w.sq_RF_thigh*pa8;
-    const Scalar t27 = -w.sq_RF_thigh*pa6 + w.cq_RF_thigh*pa8;
-    w.IA_RF_hip[0] = 0.5950000000000001 + t14;
+    const Scalar t0 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
+    const Scalar t1 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
+    const Scalar t2 = w.IA_RF_thigh[18]*w.Dinv_RF_thigh;
+    const Scalar Ia0 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t0;
+    const Scalar Ia2 = -0.010144 - 0.00020288*w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
+    const Scalar Ia3 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t1;
+    const Scalar Ia4 = w.IA_RF_thigh[20] - 4.11602944e-08*w.Dinv_RF_thigh;
+    const Scalar t3 = -0.00020288*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
+    const Scalar pa0 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t0 + w.c_RF_thigh[0]*Ia0 + w.c_RF_thigh[2]*Ia1 + w.c_RF_thigh[5]*Ia2;
+    const Scalar pa1 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
+    const Scalar pa2 = 0.010144*w.c_RF_thigh[3] + w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t1 + w.c_RF_thigh[0]*Ia1 + w.c_RF_thigh[2]*Ia3 + w.c_RF_thigh[5]*t3;
+    const Scalar pa3 = 0.010144*w.c_RF_thigh[2] + w.pA_RF_thigh[3] + w.c_RF_thigh[3]*w.IA_RF_thigh[15] + w.c_RF_thigh[5]*w.IA_RF_thigh[17];
+    const Scalar pa4 = w.pA_RF_thigh[4] + w.u_RF_thigh[0]*t2;
+    const Scalar pa5 = w.pA_RF_thigh[5] + 0.00020288*w.Dinv_RF_thigh*w.u_RF_thigh[0] + w.c_RF_thigh[0]*Ia2 + w.c_RF_thigh[2]*t3 + w.c_RF_thigh[3]*w.IA_RF_thigh[17] + w.c_RF_thigh[5]*Ia4;
+    const Scalar C20 = -w.sq_RF_thigh*w.sq_RF_thigh + w.cq_RF_thigh*w.cq_RF_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia3);
+    const Scalar m0 = 0.5*(Ia0 + Ia3);
+    const Scalar t4 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
+    const Scalar d0 = -Ia1*t4 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t4;
+    const Scalar t5 = 0.005072 + 0.5*Ia2;
+    const Scalar t6 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
+    const Scalar d1 = -t4*t5 + C20*t6;
+    const Scalar qq1 = C20*t5 + t4*t6;
+    const Scalar h1 = 0.5*(-w.IA_RF_thigh[15] + Ia4);
+    const Scalar m1 = 0.5*(w.IA_RF_thigh[15] + Ia4);
+    const Scalar d2 = -w.IA_RF_thigh[17]*t4 + C20*h1;
+    const Scalar qq2 = w.IA_RF_thigh[17]*C20 + t4*h1;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh - d1;
+    const Scalar t10 = -0.005072 + 0.5*Ia2 + qq1;
+    const Scalar t11 = w.cq_RF_thigh*w.IA_RF_thigh[8] + w.sq_RF_thigh*w.IA_RF_thigh[10];
+    const Scalar t12 = -w.sq_RF_thigh*w.IA_RF_thigh[8] + w.cq_RF_thigh*w.IA_RF_thigh[10];
+    const Scalar t13 = 0.005072 - 0.5*Ia2 + qq1;
+    const Scalar t14 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh + d1;
+    const Scalar t15 = -0.062*qq0 + t9;
+    const Scalar t16 = 0.062*t7 + t10;
+    const Scalar t17 = -0.062*t8 + t13;
+    const Scalar t18 = 0.062*qq0 + t14;
+    const Scalar t19 = w.cq_RF_thigh*pa0 + w.sq_RF_thigh*pa2;
+    const Scalar t20 = -w.sq_RF_thigh*pa0 + w.cq_RF_thigh*pa2;
+    w.IA_RF_hip[0] = 0.5950000000000001 + t7;
     w.IA_RF_hip[2] = qq0;
-    w.IA_RF_hip[3] = t22;
-    w.IA_RF_hip[5] = 0.02164 + t23;
-    w.IA_RF_hip[8] = t18;
-    w.IA_RF_hip[10] = t19;
-    w.IA_RF_hip[11] = 0.5950000000000001 + t15;
-    w.IA_RF_hip[12] = -0.02164 + t24;
-    w.IA_RF_hip[14] = t25;
-    w.IA_RF_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t20 - 0.062*t24;
-    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t16 - 0.062*t25;
-    w.IA_RF_hip[20] = 0.00126484 + m2 + d2 + 0.062*t17 + 0.062*t23;
-    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t26;
-    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa7;
-    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t27;
-    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa9 + w.sq_RF_thigh*pa11 - 0.062*t27;
-    w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa10;
-    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa9 + w.cq_RF_thigh*pa11 + 0.062*t26;
+    w.IA_RF_hip[3] = t15;
+    w.IA_RF_hip[5] = 0.02164 + t16;
+    w.IA_RF_hip[8] = t11;
+    w.IA_RF_hip[10] = t12;
+    w.IA_RF_hip[11] = 0.5950000000000001 + t8;
+    w.IA_RF_hip[12] = -0.02164 + t17;
+    w.IA_RF_hip[14] = t18;
+    w.IA_RF_hip[15] = 0.0012018399999999998 + m1 - d2 - 0.062*t13 - 0.062*t17;
+    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t9 - 0.062*t18;
+    w.IA_RF_hip[20] = 0.00126484 + m1 + d2 + 0.062*t10 + 0.062*t16;
+    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t19;
+    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa1;
+    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t20;
+    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa3 + w.sq_RF_thigh*pa5 - 0.062*t20;
+    w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa4;
+    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa5 + 0.062*t19;
     w.KSD_RF_thigh[0] = w.KA_RF_thigh[4]*w.Dinv_RF_thigh;
     w.KSD_RF_thigh[2] = w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
-    const Scalar t28 = w.KA_RF_thigh[0] - w.KA_RF_thigh[4]*t7;
-    const Scalar t29 = w.KA_RF_thigh[2] - w.KA_RF_thigh[4]*t8;
-    const Scalar t30 = w.KA_RF_thigh[5] - 0.00020288*w.KA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar t31 = w.cq_RF_thigh*t28 + w.sq_RF_thigh*t29;
-    const Scalar t32 = -w.sq_RF_thigh*t28 + w.cq_RF_thigh*t29;
-    w.KA_RF_hip[0] = t31;
-    w.KA_RF_hip[2] = t32;
-    w.KA_RF_hip[3] = w.cq_RF_thigh*w.KA_RF_thigh[3] + w.sq_RF_thigh*t30 - 0.062*t32;
-    w.KA_RF_hip[5] = -w.sq_RF_thigh*w.KA_RF_thigh[3] + w.cq_RF_thigh*t30 + 0.062*t31;
+    const Scalar t21 = w.KA_RF_thigh[0] - w.KA_RF_thigh[4]*t0;
+    const Scalar t22 = w.KA_RF_thigh[2] - w.KA_RF_thigh[4]*t1;
+    const Scalar t23 = w.KA_RF_thigh[5] - 0.00020288*w.KA_RF_thigh[4]*w.Dinv_RF_thigh;
+    const Scalar t24 = w.cq_RF_thigh*t21 + w.sq_RF_thigh*t22;
+    const Scalar t25 = -w.sq_RF_thigh*t21 + w.cq_RF_thigh*t22;
+    w.KA_RF_hip[0] = t24;
+    w.KA_RF_hip[2] = t25;
+    w.KA_RF_hip[3] = w.cq_RF_thigh*w.KA_RF_thigh[3] + w.sq_RF_thigh*t23 - 0.062*t25;
+    w.KA_RF_hip[5] = -w.sq_RF_thigh*w.KA_RF_thigh[3] + w.cq_RF_thigh*t23 + 0.062*t24;
     w.KA_RF_hip[9] = w.cq_RF_thigh*w.KA_RF_thigh[9] + w.sq_RF_thigh*w.KA_RF_thigh[11];
     w.KA_RF_hip[11] = -w.sq_RF_thigh*w.KA_RF_thigh[9] + w.cq_RF_thigh*w.KA_RF_thigh[11];
-    const Scalar t33 = w.KA_RF_thigh[12] - w.KA_RF_thigh[16]*t7;
-    const Scalar t34 = w.KA_RF_thigh[14] - w.KA_RF_thigh[16]*t8;
-    const Scalar t35 = w.KA_RF_thigh[17] - 0.00020288*w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
-    const Scalar t36 = w.cq_RF_thigh*t33 + w.sq_RF_thigh*t34;
-    const Scalar t37 = -w.sq_RF_thigh*t33 + w.cq_RF_thigh*t34;
-    w.KA_RF_hip[12] = t36;
-    w.KA_RF_hip[14] = t37;
-    w.KA_RF_hip[15] = w.cq_RF_thigh*w.KA_RF_thigh[15] + w.sq_RF_thigh*t35 - 0.062*t37;
-    w.KA_RF_hip[17] = -w.sq_RF_thigh*w.KA_RF_thigh[15] + w.cq_RF_thigh*t35 + 0.062*t36;
+    const Scalar t26 = w.KA_RF_thigh[12] - w.KA_RF_thigh[16]*t0;
+    const Scalar t27 = w.KA_RF_thigh[14] - w.KA_RF_thigh[16]*t1;
+    const Scalar t28 = w.KA_RF_thigh[17] - 0.00020288*w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
+    const Scalar t29 = w.cq_RF_thigh*t26 + w.sq_RF_thigh*t27;
+    const Scalar t30 = -w.sq_RF_thigh*t26 + w.cq_RF_thigh*t27;
+    w.KA_RF_hip[12] = t29;
+    w.KA_RF_hip[14] = t30;
+    w.KA_RF_hip[15] = w.cq_RF_thigh*w.KA_RF_thigh[15] + w.sq_RF_thigh*t28 - 0.062*t30;
+    w.KA_RF_hip[17] = -w.sq_RF_thigh*w.KA_RF_thigh[15] + w.cq_RF_thigh*t28 + 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
@@ -3064,7 +3133,7 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     w.Dinv_LH_shank = 1.0 / 0.000486144;
@@ -3117,97 +3186,100 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* tau, Workspace& w) noexcept {
     w.KA_LH_thigh[16] = -0.209*w.sq_LH_shank;
     w.KA_LH_thigh[17] = -0.004*w.sq_LH_shank;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
     w.u_LH_thigh[0] = -w.pA_LH_thigh[4] + tau[10];
-    const Scalar t7 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar t8 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar t9 = w.IA_LH_thigh[18]*w.Dinv_LH_thigh;
-    const Scalar Ia1 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t7;
-    const Scalar Ia2 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t7;
-    const Scalar Ia3 = 0.010144 + 0.00020288*w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar Ia4 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t8;
-    const Scalar Ia5 = w.IA_LH_thigh[20] - 4.11602944e-08*w.Dinv_LH_thigh;
-    const Scalar t10 = 0.00020288*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar pa6 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t7 + w.c_LH_thigh[0]*Ia1 + w.c_LH_thigh[2]*Ia2 + w.c_LH_thigh[5]*Ia3;
-    const Scalar pa7 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
-    const Scalar pa8 = -0.010144*w.c_LH_thigh[3] + w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t8 + w.c_LH_thigh[0]*Ia2 + w.c_LH_thigh[2]*Ia4 + w.c_LH_thigh[5]*t10;
-    const Scalar pa9 = -0.010144*w.c_LH_thigh[2] + w.pA_LH_thigh[3] + w.c_LH_thigh[3]*w.IA_LH_thigh[15] + w.c_LH_thigh[5]*w.IA_LH_thigh[17];
-    const Scalar pa10 = w.pA_LH_thigh[4] + w.u_LH_thigh[0]*t9;
-    const Scalar pa11 = w.pA_LH_thigh[5] - 0.00020288*w.Dinv_LH_thigh*w.u_LH_thigh[0] + w.c_LH_thigh[0]*Ia3 + w.c_LH_thigh[2]*t10 + w.c_LH_thigh[3]*w.IA_LH_thigh[17] + w.c_LH_thigh[5]*Ia5;
-    const Scalar C21 = -w.sq_LH_thigh*w.sq_LH_thigh + w.cq_LH_thigh*w.cq_LH_thigh;
-    const Scalar h1 = 0.5*(-Ia1 + Ia4);
-    const Scalar m1 = 0.5*(Ia1 + Ia4);
-    const Scalar t11 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
-    const Scalar d0 = -Ia2*t11 + C21*h1;
-    const Scalar qq0 = Ia2*C21 + h1*t11;
-    const Scalar t12 = -0.005072 + 0.5*Ia3;
-    const Scalar t13 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar d1 = -t11*t12 + C21*t13;
-    const Scalar qq1 = C21*t12 + t11*t13;
-    const Scalar h2 = 0.5*(-w.IA_LH_thigh[15] + Ia5);
-    const Scalar m2 = 0.5*(w.IA_LH_thigh[15] + Ia5);
-    const Scalar d2 = -w.IA_LH_thigh[17]*t11 + C21*h2;
-    const Scalar qq2 = w.IA_LH_thigh[17]*C21 + t11*h2;
-    const Scalar t14 = m1 - d0;
-    const Scalar t15 = m1 + d0;
-    const Scalar t16 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh - d1;
-    const Scalar t17 = 0.005072 + 0.5*Ia3 + qq1;
-    const Scalar t18 = w.cq_LH_thigh*w.IA_LH_thigh[8] + w.sq_LH_thigh*w.IA_LH_thigh[10];
-    const Scalar t19 = -w.sq_LH_thigh*w.IA_LH_thigh[8] + w.cq_LH_thigh*w.IA_LH_thigh[10];
-    const Scalar t20 = -0.005072 - 0.5*Ia3 + qq1;
-    const Scalar t21 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh + d1;
-    const Scalar t22 = 0.062*qq0 + t16;
-    const Scalar t23 = -0.062*t14 + t17;
-    const Scalar t24 = 0.062*t15 + t20;
-    const Scalar t25 = -0.062*qq0 + t21;
-    const Scalar t26 = w.cq_LH_thigh*pa6 + w.sq_LH_thigh*pa8;
-    const Scalar t27 = -w.sq_LH_thigh*pa6 + w.cq_LH_thigh*pa8;
-    w.IA_LH_hip[0] = 0.5950000000000001 + t14;
+    const Scalar t0 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
+    const Scalar t1 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
+    const Scalar t2 = w.IA_LH_thigh[18]*w.Dinv_LH_thigh;
+    const Scalar Ia0 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t0;
+    const Scalar Ia2 = 0.010144 + 0.00020288*w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
+    const Scalar Ia3 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t1;
+    const Scalar Ia4 = w.IA_LH_thigh[20] - 4.11602944e-08*w.Dinv_LH_thigh;
+    const Scalar t3 = 0.00020288*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
+    const Scalar pa0 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t0 + w.c_LH_thigh[0]*Ia0 + w.c_LH_thigh[2]*Ia1 + w.c_LH_thigh[5]*Ia2;
+    const Scalar pa1 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
+    const Scalar pa2 = -0.010144*w.c_LH_thigh[3] + w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t1 + w.c_LH_thigh[0]*Ia1 + w.c_LH_thigh[2]*Ia3 + w.c_LH_thigh[5]*t3;
+    const Scalar pa3 = -0.010144*w.c_LH_thigh[2] + w.pA_LH_thigh[3] + w.c_LH_thigh[3]*w.IA_LH_thigh[15] + w.c_LH_thigh[5]*w.IA_LH_thigh[17];
+    const Scalar pa4 = w.pA_LH_thigh[4] + w.u_LH_thigh[0]*t2;
+    const Scalar pa5 = w.pA_LH_thigh[5] - 0.00020288*w.Dinv_LH_thigh*w.u_LH_thigh[0] + w.c_LH_thigh[0]*Ia2 + w.c_LH_thigh[2]*t3 + w.c_LH_thigh[3]*w.IA_LH_thigh[17] + w.c_LH_thigh[5]*Ia4;
+    const Scalar C20 = -w.sq_LH_thigh*w.sq_LH_thigh + w.cq_LH_thigh*w.cq_LH_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia3);
+    const Scalar m0 = 0.5*(Ia0 + Ia3);
+    const Scalar t4 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
+    const Scalar d0 = -Ia1*t4 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t4;
+    const Scalar t5 = -0.005072 + 0.5*Ia2;
+    const Scalar t6 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
+    const Scalar d1 = -t4*t5 + C20*t6;
+    const Scalar qq1 = C20*t5 + t4*t6;
+    const Scalar h1 = 0.5*(-w.IA_LH_thigh[15] + Ia4);
+    const Scalar m1 = 0.5*(w.IA_LH_thigh[15] + Ia4);
+    const Scalar d2 = -w.IA_LH_thigh[17]*t4 + C20*h1;
+    const Scalar qq2 = w.IA_LH_thigh[17]*C20 + t4*h1;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh - d1;
+    const Scalar t10 = 0.005072 + 0.5*Ia2 + qq1;
+    const Scalar t11 = w.cq_LH_thigh*w.IA_LH_thigh[8] + w.sq_LH_thigh*w.IA_LH_thigh[10];
+    const Scalar t12 = -w.sq_LH_thigh*w.IA_LH_thigh[8] + w.cq_LH_thigh*w.IA_LH_thigh[10];
+    const Scalar t13 = -0.005072 - 0.5*Ia2 + qq1;
+    const Scalar t14 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh + d1;
+    const Scalar t15 = 0.062*qq0 + t9;
+    const Scalar t16 = -0.062*t7 + t10;
+    const Scalar t17 = 0.062*t8 + t13;
+    const Scalar t18 = -0.062*qq0 + t14;
+    const Scalar t19 = w.cq_LH_thigh*pa0 + w.sq_LH_thigh*pa2;
+    const Scalar t20 = -w.sq_LH_thigh*pa0 + w.cq_LH_thigh*pa2;
+    w.IA_LH_hip[0] = 0.5950000000000001 + t7;
     w.IA_LH_hip[2] = qq0;
-    w.IA_LH_hip[3] = t22;
-    w.IA_LH_hip[5] = -0.02164 + t23;
-    w.IA_LH_hip[8] = t18;
-    w.IA_LH_hip[10] = t19;
-    w.IA_LH_hip[11] = 0.5950000000000001 + t15;
-    w.IA_LH_hip[12] = 0.02164 + t24;
-    w.IA_LH_hip[14] = t25;
-    w.IA_LH_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t20 + 0.062*t24;
-    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t16 + 0.062*t25;
-    w.IA_LH_hip[20] = 0.00126484 + m2 + d2 - 0.062*t17 - 0.062*t23;
-    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t26;
-    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa7;
-    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t27;
-    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa9 + w.sq_LH_thigh*pa11 + 0.062*t27;
-    w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa10;
-    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa9 + w.cq_LH_thigh*pa11 - 0.062*t26;
+    w.IA_LH_hip[3] = t15;
+    w.IA_LH_hip[5] = -0.02164 + t16;
+    w.IA_LH_hip[8] = t11;
+    w.IA_LH_hip[10] = t12;
+    w.IA_LH_hip[11] = 0.5950000000000001 + t8;
+    w.IA_LH_hip[12] = 0.02164 + t17;
+    w.IA_LH_hip[14] = t18;
+    w.IA_LH_hip[15] = 0.0012018399999999998 + m1 - d2 + 0.062*t13 + 0.062*t17;
+    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t9 + 0.062*t18;
+    w.IA_LH_hip[20] = 0.00126484 + m1 + d2 - 0.062*t10 - 0.062*t16;
+    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t19;
+    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa1;
+    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t20;
+    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa3 + w.sq_LH_thigh*pa5 + 0.062*t20;
+    w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa4;
+    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa5 - 0.062*t19;
     w.KSD_LH_thigh[0] = w.KA_LH_thigh[4]*w.Dinv_LH_thigh;
     w.KSD_LH_thigh[2] = w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
-    const Scalar t28 = w.KA_LH_thigh[0] - w.KA_LH_thigh[4]*t7;
-    const Scalar t29 = w.KA_LH_thigh[2] - w.KA_LH_thigh[4]*t8;
-    const Scalar t30 = w.KA_LH_thigh[5] + 0.00020288*w.KA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar t31 = w.cq_LH_thigh*t28 + w.sq_LH_thigh*t29;
-    const Scalar t32 = -w.sq_LH_thigh*t28 + w.cq_LH_thigh*t29;
-    w.KA_LH_hip[0] = t31;
-    w.KA_LH_hip[2] = t32;
-    w.KA_LH_hip[3] = w.cq_LH_thigh*w.KA_LH_thigh[3] + w.sq_LH_thigh*t30 + 0.062*t32;
-    w.KA_LH_hip[5] = -w.sq_LH_thigh*w.KA_LH_thigh[3] + w.cq_LH_thigh*t30 - 0.062*t31;
+    const Scalar t21 = w.KA_LH_thigh[0] - w.KA_LH_thigh[4]*t0;
+    const Scalar t22 = w.KA_LH_thigh[2] - w.KA_LH_thigh[4]*t1;
+    const Scalar t23 = w.KA_LH_thigh[5] + 0.00020288*w.KA_LH_thigh[4]*w.Dinv_LH_thigh;
+    const Scalar t24 = w.cq_LH_thigh*t21 + w.sq_LH_thigh*t22;
+    const Scalar t25 = -w.sq_LH_thigh*t21 + w.cq_LH_thigh*t22;
+    w.KA_LH_hip[0] = t24;
+    w.KA_LH_hip[2] = t25;
+    w.KA_LH_hip[3] = w.cq_LH_thigh*w.KA_LH_thigh[3] + w.sq_LH_thigh*t23 + 0.062*t25;
+    w.KA_LH_hip[5] = -w.sq_LH_thigh*w.KA_LH_thigh[3] + w.cq_LH_thigh*t23 - 0.062*t24;
     w.KA_LH_hip[9] = w.cq_LH_thigh*w.KA_LH_thigh[9] + w.sq_LH_thigh*w.KA_LH_thigh[11];
     w.KA_LH_hip[11] = -w.sq_LH_thigh*w.KA_LH_thigh[9] + w.cq_LH_thigh*w.KA_LH_thigh[11];
-    const Scalar t33 = w.KA_LH_thigh[12] - w.KA_LH_thigh[16]*t7;
-    const Scalar t34 = w.KA_LH_thigh[14] - w.KA_LH_thigh[16]*t8;
-    const Scalar t35 = w.KA_LH_thigh[17] + 0.00020288*w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
-    const Scalar t36 = w.cq_LH_thigh*t33 + w.sq_LH_thigh*t34;
-    const Scalar t37 = -w.sq_LH_thigh*t33 + w.cq_LH_thigh*t34;
-    w.KA_LH_hip[12] = t36;
-    w.KA_LH_hip[14] = t37;
-    w.KA_LH_hip[15] = w.cq_LH_thigh*w.KA_LH_thigh[15] + w.sq_LH_thigh*t35 + 0.062*t37;
-    w.KA_LH_hip[17] = -w.sq_LH_thigh*w.KA_LH_thigh[15] + w.cq_LH_thigh*t35 - 0.062*t36;
+    const Scalar t26 = w.KA_LH_thigh[12] - w.KA_LH_thigh[16]*t0;
+    const Scalar t27 = w.KA_LH_thigh[14] - w.KA_LH_thigh[16]*t1;
+    const Scalar t28 = w.KA_LH_thigh[17] + 0.00020288*w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
+    const Scalar t29 = w.cq_LH_thigh*t26 + w.sq_LH_thigh*t27;
+    const Scalar t30 = -w.sq_LH_thigh*t26 + w.cq_LH_thigh*t27;
+    w.KA_LH_hip[12] = t29;
+    w.KA_LH_hip[14] = t30;
+    w.KA_LH_hip[15] = w.cq_LH_thigh*w.KA_LH_thigh[15] + w.sq_LH_thigh*t28 + 0.062*t30;
+    w.KA_LH_hip[17] = -w.sq_LH_thigh*w.KA_LH_thigh[15] + w.cq_LH_thigh*t28 - 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
@@ -3385,7 +3457,7 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_6(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     w.Dinv_LF_shank = 1.0 / 0.000486144;
@@ -3438,97 +3510,100 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* tau, Workspace& w) noexcept {
     w.KA_LF_thigh[16] = -0.209*w.sq_LF_shank;
     w.KA_LF_thigh[17] = -0.004*w.sq_LF_shank;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
     w.u_LF_thigh[0] = -w.pA_LF_thigh[4] + tau[7];
-    const Scalar t7 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar t8 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar t9 = w.IA_LF_thigh[18]*w.Dinv_LF_thigh;
-    const Scalar Ia1 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t7;
-    const Scalar Ia2 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t7;
-    const Scalar Ia3 = 0.010144 + 0.00020288*w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar Ia4 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t8;
-    const Scalar Ia5 = w.IA_LF_thigh[20] - 4.11602944e-08*w.Dinv_LF_thigh;
-    const Scalar t10 = 0.00020288*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar pa6 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t7 + w.c_LF_thigh[0]*Ia1 + w.c_LF_thigh[2]*Ia2 + w.c_LF_thigh[5]*Ia3;
-    const Scalar pa7 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
-    const Scalar pa8 = -0.010144*w.c_LF_thigh[3] + w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t8 + w.c_LF_thigh[0]*Ia2 + w.c_LF_thigh[2]*Ia4 + w.c_LF_thigh[5]*t10;
-    const Scalar pa9 = -0.010144*w.c_LF_thigh[2] + w.pA_LF_thigh[3] + w.c_LF_thigh[3]*w.IA_LF_thigh[15] + w.c_LF_thigh[5]*w.IA_LF_thigh[17];
-    const Scalar pa10 = w.pA_LF_thigh[4] + w.u_LF_thigh[0]*t9;
-    const Scalar pa11 = w.pA_LF_thigh[5] - 0.00020288*w.Dinv_LF_thigh*w.u_LF_thigh[0] + w.c_LF_thigh[0]*Ia3 + w.c_LF_thigh[2]*t10 + w.c_LF_thigh[3]*w.IA_LF_thigh[17] + w.c_LF_thigh[5]*Ia5;
-    const Scalar C21 = -w.sq_LF_thigh*w.sq_LF_thigh + w.cq_LF_thigh*w.cq_LF_thigh;
-    const Scalar h1 = 0.5*(-Ia1 + Ia4);
-    const Scalar m1 = 0.5*(Ia1 + Ia4);
-    const Scalar t11 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
-    const Scalar d0 = -Ia2*t11 + C21*h1;
-    const Scalar qq0 = Ia2*C21 + h1*t11;
-    const Scalar t12 = -0.005072 + 0.5*Ia3;
-    const Scalar t13 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar d1 = -t11*t12 + C21*t13;
-    const Scalar qq1 = C21*t12 + t11*t13;
-    const Scalar h2 = 0.5*(-w.IA_LF_thigh[15] + Ia5);
-    const Scalar m2 = 0.5*(w.IA_LF_thigh[15] + Ia5);
-    const Scalar d2 = -w.IA_LF_thigh[17]*t11 + C21*h2;
-    const Scalar qq2 = w.IA_LF_thigh[17]*C21 + t11*h2;
-    const Scalar t14 = m1 - d0;
-    const Scalar t15 = m1 + d0;
-    const Scalar t16 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh - d1;
-    const Scalar t17 = 0.005072 + 0.5*Ia3 + qq1;
-    const Scalar t18 = w.cq_LF_thigh*w.IA_LF_thigh[8] + w.sq_LF_thigh*w.IA_LF_thigh[10];
-    const Scalar t19 = -w.sq_LF_thigh*w.IA_LF_thigh[8] + w.cq_LF_thigh*w.IA_LF_thigh[10];
-    const Scalar t20 = -0.005072 - 0.5*Ia3 + qq1;
-    const Scalar t21 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh + d1;
-    const Scalar t22 = 0.062*qq0 + t16;
-    const Scalar t23 = -0.062*t14 + t17;
-    const Scalar t24 = 0.062*t15 + t20;
-    const Scalar t25 = -0.062*qq0 + t21;
-    const Scalar t26 = w.cq_LF_thigh*pa6 + w.sq_LF_thigh*pa8;
-    const Scalar t27 = -w.sq_LF_thigh*pa6 + w.cq_LF_thigh*pa8;
-    w.IA_LF_hip[0] = 0.5950000000000001 + t14;
+    const Scalar t0 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
+    const Scalar t1 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
+    const Scalar t2 = w.IA_LF_thigh[18]*w.Dinv_LF_thigh;
+    const Scalar Ia0 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t0;
+    const Scalar Ia1 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t0;
+    const Scalar Ia2 = 0.010144 + 0.00020288*w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
+    const Scalar Ia3 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t1;
+    const Scalar Ia4 = w.IA_LF_thigh[20] - 4.11602944e-08*w.Dinv_LF_thigh;
+    const Scalar t3 = 0.00020288*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
+    const Scalar pa0 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t0 + w.c_LF_thigh[0]*Ia0 + w.c_LF_thigh[2]*Ia1 + w.c_LF_thigh[5]*Ia2;
+    const Scalar pa1 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
+    const Scalar pa2 = -0.010144*w.c_LF_thigh[3] + w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t1 + w.c_LF_thigh[0]*Ia1 + w.c_LF_thigh[2]*Ia3 + w.c_LF_thigh[5]*t3;
+    const Scalar pa3 = -0.010144*w.c_LF_thigh[2] + w.pA_LF_thigh[3] + w.c_LF_thigh[3]*w.IA_LF_thigh[15] + w.c_LF_thigh[5]*w.IA_LF_thigh[17];
+    const Scalar pa4 = w.pA_LF_thigh[4] + w.u_LF_thigh[0]*t2;
+    const Scalar pa5 = w.pA_LF_thigh[5] - 0.00020288*w.Dinv_LF_thigh*w.u_LF_thigh[0] + w.c_LF_thigh[0]*Ia2 + w.c_LF_thigh[2]*t3 + w.c_LF_thigh[3]*w.IA_LF_thigh[17] + w.c_LF_thigh[5]*Ia4;
+    const Scalar C20 = -w.sq_LF_thigh*w.sq_LF_thigh + w.cq_LF_thigh*w.cq_LF_thigh;
+    const Scalar h0 = 0.5*(-Ia0 + Ia3);
+    const Scalar m0 = 0.5*(Ia0 + Ia3);
+    const Scalar t4 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
+    const Scalar d0 = -Ia1*t4 + C20*h0;
+    const Scalar qq0 = Ia1*C20 + h0*t4;
+    const Scalar t5 = -0.005072 + 0.5*Ia2;
+    const Scalar t6 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
+    const Scalar d1 = -t4*t5 + C20*t6;
+    const Scalar qq1 = C20*t5 + t4*t6;
+    const Scalar h1 = 0.5*(-w.IA_LF_thigh[15] + Ia4);
+    const Scalar m1 = 0.5*(w.IA_LF_thigh[15] + Ia4);
+    const Scalar d2 = -w.IA_LF_thigh[17]*t4 + C20*h1;
+    const Scalar qq2 = w.IA_LF_thigh[17]*C20 + t4*h1;
+    const Scalar t7 = m0 - d0;
+    const Scalar t8 = m0 + d0;
+    const Scalar t9 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh - d1;
+    const Scalar t10 = 0.005072 + 0.5*Ia2 + qq1;
+    const Scalar t11 = w.cq_LF_thigh*w.IA_LF_thigh[8] + w.sq_LF_thigh*w.IA_LF_thigh[10];
+    const Scalar t12 = -w.sq_LF_thigh*w.IA_LF_thigh[8] + w.cq_LF_thigh*w.IA_LF_thigh[10];
+    const Scalar t13 = -0.005072 - 0.5*Ia2 + qq1;
+    const Scalar t14 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh + d1;
+    const Scalar t15 = 0.062*qq0 + t9;
+    const Scalar t16 = -0.062*t7 + t10;
+    const Scalar t17 = 0.062*t8 + t13;
+    const Scalar t18 = -0.062*qq0 + t14;
+    const Scalar t19 = w.cq_LF_thigh*pa0 + w.sq_LF_thigh*pa2;
+    const Scalar t20 = -w.sq_LF_thigh*pa0 + w.cq_LF_thigh*pa2;
+    w.IA_LF_hip[0] = 0.5950000000000001 + t7;
     w.IA_LF_hip[2] = qq0;
-    w.IA_LF_hip[3] = t22;
-    w.IA_LF_hip[5] = -0.02164 + t23;
-    w.IA_LF_hip[8] = t18;
-    w.IA_LF_hip[10] = t19;
-    w.IA_LF_hip[11] = 0.5950000000000001 + t15;
-    w.IA_LF_hip[12] = 0.02164 + t24;
-    w.IA_LF_hip[14] = t25;
-    w.IA_LF_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t20 + 0.062*t24;
-    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t16 + 0.062*t25;
-    w.IA_LF_hip[20] = 0.00126484 + m2 + d2 - 0.062*t17 - 0.062*t23;
-    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t26;
-    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa7;
-    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t27;
-    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa9 + w.sq_LF_thigh*pa11 + 0.062*t27;
-    w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa10;
-    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa9 + w.cq_LF_thigh*pa11 - 0.062*t26;
+    w.IA_LF_hip[3] = t15;
+    w.IA_LF_hip[5] = -0.02164 + t16;
+    w.IA_LF_hip[8] = t11;
+    w.IA_LF_hip[10] = t12;
+    w.IA_LF_hip[11] = 0.5950000000000001 + t8;
+    w.IA_LF_hip[12] = 0.02164 + t17;
+    w.IA_LF_hip[14] = t18;
+    w.IA_LF_hip[15] = 0.0012018399999999998 + m1 - d2 + 0.062*t13 + 0.062*t17;
+    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t9 + 0.062*t18;
+    w.IA_LF_hip[20] = 0.00126484 + m1 + d2 - 0.062*t10 - 0.062*t16;
+    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t19;
+    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa1;
+    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t20;
+    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa3 + w.sq_LF_thigh*pa5 + 0.062*t20;
+    w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa4;
+    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa5 - 0.062*t19;
     w.KSD_LF_thigh[0] = w.KA_LF_thigh[4]*w.Dinv_LF_thigh;
     w.KSD_LF_thigh[2] = w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
-    const Scalar t28 = w.KA_LF_thigh[0] - w.KA_LF_thigh[4]*t7;
-    const Scalar t29 = w.KA_LF_thigh[2] - w.KA_LF_thigh[4]*t8;
-    const Scalar t30 = w.KA_LF_thigh[5] + 0.00020288*w.KA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar t31 = w.cq_LF_thigh*t28 + w.sq_LF_thigh*t29;
-    const Scalar t32 = -w.sq_LF_thigh*t28 + w.cq_LF_thigh*t29;
-    w.KA_LF_hip[0] = t31;
-    w.KA_LF_hip[2] = t32;
-    w.KA_LF_hip[3] = w.cq_LF_thigh*w.KA_LF_thigh[3] + w.sq_LF_thigh*t30 + 0.062*t32;
-    w.KA_LF_hip[5] = -w.sq_LF_thigh*w.KA_LF_thigh[3] + w.cq_LF_thigh*t30 - 0.062*t31;
+    const Scalar t21 = w.KA_LF_thigh[0] - w.KA_LF_thigh[4]*t0;
+    const Scalar t22 = w.KA_LF_thigh[2] - w.KA_LF_thigh[4]*t1;
+    const Scalar t23 = w.KA_LF_thigh[5] + 0.00020288*w.KA_LF_thigh[4]*w.Dinv_LF_thigh;
+    const Scalar t24 = w.cq_LF_thigh*t21 + w.sq_LF_thigh*t22;
+    const Scalar t25 = -w.sq_LF_thigh*t21 + w.cq_LF_thigh*t22;
+    w.KA_LF_hip[0] = t24;
+    w.KA_LF_hip[2] = t25;
+    w.KA_LF_hip[3] = w.cq_LF_thigh*w.KA_LF_thigh[3] + w.sq_LF_thigh*t23 + 0.062*t25;
+    w.KA_LF_hip[5] = -w.sq_LF_thigh*w.KA_LF_thigh[3] + w.cq_LF_thigh*t23 - 0.062*t24;
     w.KA_LF_hip[9] = w.cq_LF_thigh*w.KA_LF_thigh[9] + w.sq_LF_thigh*w.KA_LF_thigh[11];
     w.KA_LF_hip[11] = -w.sq_LF_thigh*w.KA_LF_thigh[9] + w.cq_LF_thigh*w.KA_LF_thigh[11];
-    const Scalar t33 = w.KA_LF_thigh[12] - w.KA_LF_thigh[16]*t7;
-    const Scalar t34 = w.KA_LF_thigh[14] - w.KA_LF_thigh[16]*t8;
-    const Scalar t35 = w.KA_LF_thigh[17] + 0.00020288*w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
-    const Scalar t36 = w.cq_LF_thigh*t33 + w.sq_LF_thigh*t34;
-    const Scalar t37 = -w.sq_LF_thigh*t33 + w.cq_LF_thigh*t34;
-    w.KA_LF_hip[12] = t36;
-    w.KA_LF_hip[14] = t37;
-    w.KA_LF_hip[15] = w.cq_LF_thigh*w.KA_LF_thigh[15] + w.sq_LF_thigh*t35 + 0.062*t37;
-    w.KA_LF_hip[17] = -w.sq_LF_thigh*w.KA_LF_thigh[15] + w.cq_LF_thigh*t35 - 0.062*t36;
+    const Scalar t26 = w.KA_LF_thigh[12] - w.KA_LF_thigh[16]*t0;
+    const Scalar t27 = w.KA_LF_thigh[14] - w.KA_LF_thigh[16]*t1;
+    const Scalar t28 = w.KA_LF_thigh[17] + 0.00020288*w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
+    const Scalar t29 = w.cq_LF_thigh*t26 + w.sq_LF_thigh*t27;
+    const Scalar t30 = -w.sq_LF_thigh*t26 + w.cq_LF_thigh*t27;
+    w.KA_LF_hip[12] = t29;
+    w.KA_LF_hip[14] = t30;
+    w.KA_LF_hip[15] = w.cq_LF_thigh*w.KA_LF_thigh[15] + w.sq_LF_thigh*t28 + 0.062*t30;
+    w.KA_LF_hip[17] = -w.sq_LF_thigh*w.KA_LF_thigh[15] + w.cq_LF_thigh*t28 - 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_7(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
@@ -3706,7 +3781,7 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_8(const Scalar* tau, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_trunk[0]);
@@ -3958,7 +4033,7 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* tau, Workspace& w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_9(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
@@ -3999,194 +4074,231 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& w) noexcept {
     const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
     const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
     const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
-    const Scalar t30 = -5.780668556524933e-05*w.c_LF_hip[4] + w.u_LF_hip[0] - 5.780668556524933e-05*w.RJ_LF_hip[1]*w.a_trunk[3] - 5.780668556524933e-05*w.cq_LF_hip*w.a_trunk[4] - 5.780668556524933e-05*w.RJ_LF_hip[7]*w.a_trunk[5] - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t29;
-    w.a_LF_hip[0] = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
-    w.a_LF_hip[1] = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
-    w.a_LF_hip[2] = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
-    w.a_LF_hip[3] = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5] + 0.9950371902099893*w.Dinv_LF_hip*t30;
-    w.a_LF_hip[4] = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
-    w.a_LF_hip[5] = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5] + 0.09950371902099893*w.Dinv_LF_hip*t30;
-  }
-  // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t31 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t32 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t33 = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
-    const Scalar t34 = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    const Scalar t35 = 0.00020288*w.c_LF_thigh[5] + w.u_LF_thigh[0] + 0.00020288*w.sq_LF_thigh*w.a_LF_hip[3] + 0.00020288*w.cq_LF_thigh*w.a_LF_hip[5] - w.IA_LF_thigh[4]*t33 - w.IA_LF_thigh[13]*t34 - w.IA_LF_thigh[18]*w.a_LF_hip[4];
-    w.a_LF_thigh[0] = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    w.a_LF_thigh[3] = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.Dinv_LF_thigh*t35;
-    w.a_LF_thigh[5] = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
-  }
-  // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t36 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t37 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t38 = 0.003904*w.c_LF_shank[0] + w.u_LF_shank[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*w.cq_LF_shank*t36 - 0.003904*w.sq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[0] = w.c_LF_shank[0] + w.cq_LF_shank*t36 - w.sq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[1] = t37;
-    w.a_LF_shank[2] = w.c_LF_shank[2] + w.sq_LF_shank*t36 + w.cq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[3] = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.Dinv_LF_shank*t38;
-    w.a_LF_shank[5] = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-  }
-  // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t39 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t40 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t41 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t42 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t39 + w.RJ_LH_hip[3]*t40 + w.RJ_LH_hip[6]*t41;
-    const Scalar t43 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t39 + w.cq_LH_hip*t40 + w.RJ_LH_hip[7]*t41;
-    const Scalar t44 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t39 + w.RJ_LH_hip[5]*t40 + w.RJ_LH_hip[8]*t41;
-    const Scalar t45 = w.c_LH_hip[3] + w.RJ_LH_hip[0]*w.a_trunk[3] + w.RJ_LH_hip[3]*w.a_trunk[4] + w.RJ_LH_hip[6]*w.a_trunk[5];
-    const Scalar t46 = w.c_LH_hip[5] + w.RJ_LH_hip[2]*w.a_trunk[3] + w.RJ_LH_hip[5]*w.a_trunk[4] + w.RJ_LH_hip[8]*w.a_trunk[5];
-    const Scalar t47 = -5.7617628499109426e-05*w.c_LH_hip[4] + w.u_LH_hip[0] - 5.7617628499109426e-05*w.RJ_LH_hip[1]*w.a_trunk[3] - 5.7617628499109426e-05*w.cq_LH_hip*w.a_trunk[4] - 5.7617628499109426e-05*w.RJ_LH_hip[7]*w.a_trunk[5] - w.U_LH_hip[0]*t42 - w.U_LH_hip[1]*t43 - w.U_LH_hip[2]*t44 - w.U_LH_hip[3]*t45 - w.U_LH_hip[5]*t46;
-    w.a_LH_hip[0] = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t39 + w.RJ_LH_hip[3]*t40 + w.RJ_LH_hip[6]*t41;
-    w.a_LH_hip[1] = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t39 + w.cq_LH_hip*t40 + w.RJ_LH_hip[7]*t41;
-    w.a_LH_hip[2] = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t39 + w.RJ_LH_hip[5]*t40 + w.RJ_LH_hip[8]*t41;
-    w.a_LH_hip[3] = w.c_LH_hip[3] + w.RJ_LH_hip[0]*w.a_trunk[3] + w.RJ_LH_hip[3]*w.a_trunk[4] + w.RJ_LH_hip[6]*w.a_trunk[5] + 0.9950371902099892*w.Dinv_LH_hip*t47;
-    w.a_LH_hip[4] = w.c_LH_hip[4] + w.RJ_LH_hip[1]*w.a_trunk[3] + w.cq_LH_hip*w.a_trunk[4] + w.RJ_LH_hip[7]*w.a_trunk[5];
-    w.a_LH_hip[5] = w.c_LH_hip[5] + w.RJ_LH_hip[2]*w.a_trunk[3] + w.RJ_LH_hip[5]*w.a_trunk[4] + w.RJ_LH_hip[8]*w.a_trunk[5] - 0.09950371902099892*w.Dinv_LH_hip*t47;
-  }
-  // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t48 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t49 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t50 = w.c_LH_thigh[0] + w.cq_LH_thigh*t48 - w.sq_LH_thigh*t49;
-    const Scalar t51 = w.c_LH_thigh[2] + w.sq_LH_thigh*t48 + w.cq_LH_thigh*t49;
-    const Scalar t52 = 0.00020288*w.c_LH_thigh[5] + w.u_LH_thigh[0] + 0.00020288*w.sq_LH_thigh*w.a_LH_hip[3] + 0.00020288*w.cq_LH_thigh*w.a_LH_hip[5] - w.IA_LH_thigh[4]*t50 - w.IA_LH_thigh[13]*t51 - w.IA_LH_thigh[18]*w.a_LH_hip[4];
-    w.a_LH_thigh[0] = w.c_LH_thigh[0] + w.cq_LH_thigh*t48 - w.sq_LH_thigh*t49;
-    w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = w.c_LH_thigh[2] + w.sq_LH_thigh*t48 + w.cq_LH_thigh*t49;
-    w.a_LH_thigh[3] = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
-    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.Dinv_LH_thigh*t52;
-    w.a_LH_thigh[5] = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
+    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
+    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
+    w.a_LF_hip[0] = t25;
+    w.a_LF_hip[1] = t26;
+    w.a_LF_hip[2] = t27;
+    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.Dinv_LF_hip*t31;
+    w.a_LF_hip[4] = t29;
+    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.Dinv_LF_hip*t31;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_10(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  {
+    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
+    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
+    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
+    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
+    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
+    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
+    const Scalar t6 = w.u_LF_thigh[0] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
+    w.a_LF_thigh[0] = t2;
+    w.a_LF_thigh[1] = w.a_LF_hip[1];
+    w.a_LF_thigh[2] = t3;
+    w.a_LF_thigh[3] = t4;
+    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.Dinv_LF_thigh*t6;
+    w.a_LF_thigh[5] = t5;
+  }
+  // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  {
+    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
+    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
+    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t13 = w.u_LF_shank[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*t9;
+    w.a_LF_shank[0] = t9;
+    w.a_LF_shank[1] = t8;
+    w.a_LF_shank[2] = t10;
+    w.a_LF_shank[3] = t11;
+    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.Dinv_LF_shank*t13;
+    w.a_LF_shank[5] = t12;
+  }
+  // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t14 + w.RJ_LH_hip[3]*t15 + w.RJ_LH_hip[6]*t16;
+    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[7]*t16;
+    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t14 + w.RJ_LH_hip[5]*t15 + w.RJ_LH_hip[8]*t16;
+    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
+    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
+    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
+    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
+    w.a_LH_hip[0] = t17;
+    w.a_LH_hip[1] = t18;
+    w.a_LH_hip[2] = t19;
+    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.Dinv_LH_hip*t23;
+    w.a_LH_hip[4] = t21;
+    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.Dinv_LH_hip*t23;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  {
+    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
+    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
+    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
+    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
+    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
+    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
+    const Scalar t6 = w.u_LH_thigh[0] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
+    w.a_LH_thigh[0] = t2;
+    w.a_LH_thigh[1] = w.a_LH_hip[1];
+    w.a_LH_thigh[2] = t3;
+    w.a_LH_thigh[3] = t4;
+    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.Dinv_LH_thigh*t6;
+    w.a_LH_thigh[5] = t5;
+  }
   // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    const Scalar t0 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t1 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t2 = -0.000486144*w.a_LH_thigh[4] + 0.003904*w.c_LH_shank[0] + w.u_LH_shank[0] + 0.003904*w.cq_LH_shank*t0 - 0.003904*w.a_LH_thigh[2]*w.sq_LH_shank;
-    w.a_LH_shank[0] = w.c_LH_shank[0] + w.cq_LH_shank*t0 - w.a_LH_thigh[2]*w.sq_LH_shank;
-    w.a_LH_shank[1] = t1;
-    w.a_LH_shank[2] = w.c_LH_shank[2] + w.sq_LH_shank*t0 + w.a_LH_thigh[2]*w.cq_LH_shank;
-    w.a_LH_shank[3] = w.c_LH_shank[3] + w.a_LH_thigh[3]*w.cq_LH_shank - w.a_LH_thigh[5]*w.sq_LH_shank;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.Dinv_LH_shank*t2;
-    w.a_LH_shank[5] = w.c_LH_shank[5] + w.a_LH_thigh[3]*w.sq_LH_shank + w.a_LH_thigh[5]*w.cq_LH_shank;
+    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
+    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
+    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t13 = w.u_LH_shank[0] - 0.000486144*w.a_LH_thigh[4] + 0.003904*t9;
+    w.a_LH_shank[0] = t9;
+    w.a_LH_shank[1] = t8;
+    w.a_LH_shank[2] = t10;
+    w.a_LH_shank[3] = t11;
+    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.Dinv_LH_shank*t13;
+    w.a_LH_shank[5] = t12;
   }
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t3 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t4 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t5 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t6 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t3 + w.RJ_RF_hip[3]*t4 + w.RJ_RF_hip[6]*t5;
-    const Scalar t7 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t3 + w.cq_RF_hip*t4 + w.RJ_RF_hip[7]*t5;
-    const Scalar t8 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t3 + w.RJ_RF_hip[5]*t4 + w.RJ_RF_hip[8]*t5;
-    const Scalar t9 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
-    const Scalar t10 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
-    const Scalar t11 = 5.780668556524933e-05*w.c_RF_hip[4] + w.u_RF_hip[0] + 5.780668556524933e-05*w.a_trunk[3]*w.RJ_RF_hip[1] + 5.780668556524933e-05*w.a_trunk[4]*w.cq_RF_hip + 5.780668556524933e-05*w.a_trunk[5]*w.RJ_RF_hip[7] - w.U_RF_hip[0]*t6 - w.U_RF_hip[1]*t7 - w.U_RF_hip[2]*t8 - w.U_RF_hip[3]*t9 - w.U_RF_hip[5]*t10;
-    w.a_RF_hip[0] = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t3 + w.RJ_RF_hip[3]*t4 + w.RJ_RF_hip[6]*t5;
-    w.a_RF_hip[1] = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t3 + w.cq_RF_hip*t4 + w.RJ_RF_hip[7]*t5;
-    w.a_RF_hip[2] = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t3 + w.RJ_RF_hip[5]*t4 + w.RJ_RF_hip[8]*t5;
-    w.a_RF_hip[3] = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6] + 0.9950371902099893*w.Dinv_RF_hip*t11;
-    w.a_RF_hip[4] = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
-    w.a_RF_hip[5] = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8] + 0.09950371902099893*w.Dinv_RF_hip*t11;
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t14 + w.RJ_RF_hip[3]*t15 + w.RJ_RF_hip[6]*t16;
+    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[7]*t16;
+    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t14 + w.RJ_RF_hip[5]*t15 + w.RJ_RF_hip[8]*t16;
+    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
+    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
+    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
+    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
+    w.a_RF_hip[0] = t17;
+    w.a_RF_hip[1] = t18;
+    w.a_RF_hip[2] = t19;
+    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.Dinv_RF_hip*t23;
+    w.a_RF_hip[4] = t21;
+    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.Dinv_RF_hip*t23;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
-    const Scalar t12 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t13 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t14 = w.c_RF_thigh[0] + w.cq_RF_thigh*t12 - w.sq_RF_thigh*t13;
-    const Scalar t15 = w.c_RF_thigh[2] + w.sq_RF_thigh*t12 + w.cq_RF_thigh*t13;
-    const Scalar t16 = -0.00020288*w.c_RF_thigh[5] + w.u_RF_thigh[0] - 0.00020288*w.sq_RF_thigh*w.a_RF_hip[3] - 0.00020288*w.cq_RF_thigh*w.a_RF_hip[5] - w.IA_RF_thigh[4]*t14 - w.IA_RF_thigh[13]*t15 - w.IA_RF_thigh[18]*w.a_RF_hip[4];
-    w.a_RF_thigh[0] = w.c_RF_thigh[0] + w.cq_RF_thigh*t12 - w.sq_RF_thigh*t13;
+    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
+    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
+    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
+    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
+    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
+    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
+    const Scalar t6 = w.u_RF_thigh[0] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
+    w.a_RF_thigh[0] = t2;
     w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = w.c_RF_thigh[2] + w.sq_RF_thigh*t12 + w.cq_RF_thigh*t13;
-    w.a_RF_thigh[3] = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.Dinv_RF_thigh*t16;
-    w.a_RF_thigh[5] = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
+    w.a_RF_thigh[2] = t3;
+    w.a_RF_thigh[3] = t4;
+    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.Dinv_RF_thigh*t6;
+    w.a_RF_thigh[5] = t5;
   }
   // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    const Scalar t17 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t18 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t19 = 0.003904*w.c_RF_shank[0] + w.u_RF_shank[0] - 0.000486144*w.a_RF_thigh[4] + 0.003904*w.cq_RF_shank*t17 - 0.003904*w.sq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[0] = w.c_RF_shank[0] + w.cq_RF_shank*t17 - w.sq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[1] = t18;
-    w.a_RF_shank[2] = w.c_RF_shank[2] + w.sq_RF_shank*t17 + w.cq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[3] = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.Dinv_RF_shank*t19;
-    w.a_RF_shank[5] = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
+    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
+    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t13 = w.u_RF_shank[0] - 0.000486144*w.a_RF_thigh[4] + 0.003904*t9;
+    w.a_RF_shank[0] = t9;
+    w.a_RF_shank[1] = t8;
+    w.a_RF_shank[2] = t10;
+    w.a_RF_shank[3] = t11;
+    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.Dinv_RF_shank*t13;
+    w.a_RF_shank[5] = t12;
   }
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t20 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t21 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t22 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t23 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t20 + w.RJ_RH_hip[3]*t21 + w.RJ_RH_hip[6]*t22;
-    const Scalar t24 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t20 + w.cq_RH_hip*t21 + w.RJ_RH_hip[7]*t22;
-    const Scalar t25 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t20 + w.RJ_RH_hip[5]*t21 + w.RJ_RH_hip[8]*t22;
-    const Scalar t26 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
-    const Scalar t27 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
-    const Scalar t28 = 5.7617628499109426e-05*w.c_RH_hip[4] + w.u_RH_hip[0] + 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_RH_hip[1] + 5.7617628499109426e-05*w.a_trunk[4]*w.cq_RH_hip + 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_RH_hip[7] - w.U_RH_hip[0]*t23 - w.U_RH_hip[1]*t24 - w.U_RH_hip[2]*t25 - w.U_RH_hip[3]*t26 - w.U_RH_hip[5]*t27;
-    w.a_RH_hip[0] = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t20 + w.RJ_RH_hip[3]*t21 + w.RJ_RH_hip[6]*t22;
-    w.a_RH_hip[1] = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t20 + w.cq_RH_hip*t21 + w.RJ_RH_hip[7]*t22;
-    w.a_RH_hip[2] = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t20 + w.RJ_RH_hip[5]*t21 + w.RJ_RH_hip[8]*t22;
-    w.a_RH_hip[3] = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6] + 0.9950371902099892*w.Dinv_RH_hip*t28;
-    w.a_RH_hip[4] = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
-    w.a_RH_hip[5] = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8] - 0.09950371902099892*w.Dinv_RH_hip*t28;
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t14 + w.RJ_RH_hip[3]*t15 + w.RJ_RH_hip[6]*t16;
+    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[7]*t16;
+    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t14 + w.RJ_RH_hip[5]*t15 + w.RJ_RH_hip[8]*t16;
+    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
+    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
+    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
+    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
+    w.a_RH_hip[0] = t17;
+    w.a_RH_hip[1] = t18;
+    w.a_RH_hip[2] = t19;
+    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.Dinv_RH_hip*t23;
+    w.a_RH_hip[4] = t21;
+    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.Dinv_RH_hip*t23;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_17(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
-    const Scalar t29 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t30 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t31 = w.c_RH_thigh[0] + w.cq_RH_thigh*t29 - w.sq_RH_thigh*t30;
-    const Scalar t32 = w.c_RH_thigh[2] + w.sq_RH_thigh*t29 + w.cq_RH_thigh*t30;
-    const Scalar t33 = -0.00020288*w.c_RH_thigh[5] + w.u_RH_thigh[0] - 0.00020288*w.sq_RH_thigh*w.a_RH_hip[3] - 0.00020288*w.cq_RH_thigh*w.a_RH_hip[5] - w.IA_RH_thigh[4]*t31 - w.IA_RH_thigh[13]*t32 - w.IA_RH_thigh[18]*w.a_RH_hip[4];
-    w.a_RH_thigh[0] = w.c_RH_thigh[0] + w.cq_RH_thigh*t29 - w.sq_RH_thigh*t30;
+    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
+    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
+    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
+    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
+    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
+    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
+    const Scalar t6 = w.u_RH_thigh[0] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
+    w.a_RH_thigh[0] = t2;
     w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = w.c_RH_thigh[2] + w.sq_RH_thigh*t29 + w.cq_RH_thigh*t30;
-    w.a_RH_thigh[3] = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.Dinv_RH_thigh*t33;
-    w.a_RH_thigh[5] = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
+    w.a_RH_thigh[2] = t3;
+    w.a_RH_thigh[3] = t4;
+    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.Dinv_RH_thigh*t6;
+    w.a_RH_thigh[5] = t5;
   }
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    const Scalar t34 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t35 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t36 = 0.003904*w.c_RH_shank[0] + w.u_RH_shank[0] - 0.000486144*w.a_RH_thigh[4] + 0.003904*w.cq_RH_shank*t34 - 0.003904*w.sq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[0] = w.c_RH_shank[0] + w.cq_RH_shank*t34 - w.sq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[1] = t35;
-    w.a_RH_shank[2] = w.c_RH_shank[2] + w.sq_RH_shank*t34 + w.cq_RH_shank*w.a_RH_thigh[2];
-    w.a_RH_shank[3] = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.Dinv_RH_shank*t36;
-    w.a_RH_shank[5] = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
+    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
+    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t13 = w.u_RH_shank[0] - 0.000486144*w.a_RH_thigh[4] + 0.003904*t9;
+    w.a_RH_shank[0] = t9;
+    w.a_RH_shank[1] = t8;
+    w.a_RH_shank[2] = t10;
+    w.a_RH_shank[3] = t11;
+    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.Dinv_RH_shank*t13;
+    w.a_RH_shank[5] = t12;
   }
   // free row accelerations y_free = K a - k (tree order)
   {
     w.yfree[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
     w.yfree[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
     w.yfree[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.yfree[6] = -w.k_rf_foot[0] + w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5];
-    w.yfree[7] = -w.k_rf_foot[1] + w.a_RF_shank[1] + 0.195*w.a_RF_shank[3];
-    w.yfree[8] = -w.k_rf_foot[2] + w.a_RF_shank[2] - 0.004*w.a_RF_shank[3];
-    w.yfree[3] = -w.k_lh_foot[0] + w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5];
-    w.yfree[4] = -w.k_lh_foot[1] + w.a_LH_shank[1] + 0.195*w.a_LH_shank[3];
-    w.yfree[5] = -w.k_lh_foot[2] + w.a_LH_shank[2] + 0.004*w.a_LH_shank[3];
+    w.yfree[6] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.yfree[7] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.yfree[8] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.yfree[3] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.yfree[4] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.yfree[5] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
     w.yfree[9] = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
     w.yfree[10] = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
     w.yfree[11] = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_11(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_18(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = -0.195*w.KSD_LF_shank[0] + inv_mu + w.KSD_LF_hip[0]*w.KS_LF_hip[0] + w.KSD_LF_thigh[0]*w.KA_LF_thigh[4];
@@ -4252,83 +4364,86 @@ PROXGEN_RT_NOINLINE void pv_11(Scalar inv_mu, Workspace& w) noexcept {
     const Scalar t14 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4];
     w.L[59] = w.Linv[6]*t14;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_19(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t15 = inv_mu + w.KSD_RF_hip[1]*w.KS_RF_hip[1] - w.L[58]*w.L[58];
-    const Scalar r7 = std::sqrt(t15);
-    const Scalar inv7 = 1.0 / r7;
-    w.Linv[7] = inv7;
-    const Scalar t16 = w.KSD_RF_hip[2]*w.KS_RF_hip[1] - w.L[58]*w.L[59];
-    w.L[64] = w.Linv[7]*t16;
+    const Scalar t0 = inv_mu + w.KSD_RF_hip[1]*w.KS_RF_hip[1] - w.L[58]*w.L[58];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[7] = inv0;
+    const Scalar t1 = w.KSD_RF_hip[2]*w.KS_RF_hip[1] - w.L[58]*w.L[59];
+    w.L[64] = w.Linv[7]*t1;
   }
   // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t17 = inv_mu + w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[16] - w.L[59]*w.L[59] - w.L[64]*w.L[64];
-    const Scalar r8 = std::sqrt(t17);
-    const Scalar inv8 = 1.0 / r8;
-    w.Linv[8] = inv8;
+    const Scalar t2 = inv_mu + w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[16] - w.L[59]*w.L[59] - w.L[64]*w.L[64];
+    const Scalar r1 = std::sqrt(t2);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t18 = -0.195*w.KSD_RH_shank[0] + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4];
-    const Scalar r9 = std::sqrt(t18);
-    const Scalar inv9 = 1.0 / r9;
-    w.Linv[9] = inv9;
-    const Scalar t19 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
-    w.L[73] = w.Linv[9]*t19;
-    const Scalar t20 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4];
-    w.L[74] = w.Linv[9]*t20;
+    const Scalar t3 = -0.195*w.KSD_RH_shank[0] + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4];
+    const Scalar r2 = std::sqrt(t3);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[9] = inv2;
+    const Scalar t4 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
+    w.L[73] = w.Linv[9]*t4;
+    const Scalar t5 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4];
+    w.L[74] = w.Linv[9]*t5;
   }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t21 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
-    const Scalar r10 = std::sqrt(t21);
-    const Scalar inv10 = 1.0 / r10;
-    w.Linv[10] = inv10;
-    const Scalar t22 = w.KSD_RH_hip[2]*w.KS_RH_hip[1] - w.L[73]*w.L[74];
-    w.L[76] = w.Linv[10]*t22;
+    const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
+    const Scalar r3 = std::sqrt(t6);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[10] = inv3;
+    const Scalar t7 = w.KSD_RH_hip[2]*w.KS_RH_hip[1] - w.L[73]*w.L[74];
+    w.L[76] = w.Linv[10]*t7;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t23 = inv_mu + w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[16] - w.L[74]*w.L[74] - w.L[76]*w.L[76];
-    const Scalar r11 = std::sqrt(t23);
-    const Scalar inv11 = 1.0 / r11;
-    w.Linv[11] = inv11;
+    const Scalar t8 = inv_mu + w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[16] - w.L[74]*w.L[74] - w.L[76]*w.L[76];
+    const Scalar r4 = std::sqrt(t8);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[11] = inv4;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t24 = w.Z_trunk[0]*w.Linv[0];
-    const Scalar t25 = w.Z_trunk[6] - w.L[1]*t24;
-    const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_trunk[12] - w.L[2]*t24 - w.L[13]*t26;
-    const Scalar t28 = w.Z_trunk[18]*w.Linv[3];
-    const Scalar t29 = w.Z_trunk[24] - w.L[34]*t28;
-    const Scalar t30 = w.Linv[4]*t29;
-    const Scalar t31 = w.Z_trunk[30] - w.L[35]*t28 - w.L[43]*t30;
-    const Scalar t32 = w.Z_trunk[36]*w.Linv[6];
-    const Scalar t33 = w.Z_trunk[42] - w.L[58]*t32;
-    const Scalar t34 = w.Linv[7]*t33;
-    const Scalar t35 = w.Z_trunk[48] - w.L[59]*t32 - w.L[64]*t34;
-    const Scalar t36 = w.Z_trunk[54]*w.Linv[9];
-    const Scalar t37 = w.Z_trunk[60] - w.L[73]*t36;
-    const Scalar t38 = w.Linv[10]*t37;
-    const Scalar t39 = w.Z_trunk[66] - w.L[74]*t36 - w.L[76]*t38;
+    const Scalar t9 = w.Z_trunk[0]*w.Linv[0];
+    const Scalar t10 = w.Z_trunk[6] - w.L[1]*t9;
+    const Scalar t11 = w.Linv[1]*t10;
+    const Scalar t12 = w.Z_trunk[12] - w.L[2]*t9 - w.L[13]*t11;
+    const Scalar t13 = w.Z_trunk[18]*w.Linv[3];
+    const Scalar t14 = w.Z_trunk[24] - w.L[34]*t13;
+    const Scalar t15 = w.Linv[4]*t14;
+    const Scalar t16 = w.Z_trunk[30] - w.L[35]*t13 - w.L[43]*t15;
+    const Scalar t17 = w.Z_trunk[36]*w.Linv[6];
+    const Scalar t18 = w.Z_trunk[42] - w.L[58]*t17;
+    const Scalar t19 = w.Linv[7]*t18;
+    const Scalar t20 = w.Z_trunk[48] - w.L[59]*t17 - w.L[64]*t19;
+    const Scalar t21 = w.Z_trunk[54]*w.Linv[9];
+    const Scalar t22 = w.Z_trunk[60] - w.L[73]*t21;
+    const Scalar t23 = w.Linv[10]*t22;
+    const Scalar t24 = w.Z_trunk[66] - w.L[74]*t21 - w.L[76]*t23;
     w.W[0] = w.Z_trunk[0]*w.Linv[0];
-    w.W[6] = w.Linv[1]*t25;
-    w.W[12] = w.Linv[2]*t27;
+    w.W[6] = w.Linv[1]*t10;
+    w.W[12] = w.Linv[2]*t12;
     w.W[18] = w.Z_trunk[18]*w.Linv[3];
-    w.W[24] = w.Linv[4]*t29;
-    w.W[30] = w.Linv[5]*t31;
+    w.W[24] = w.Linv[4]*t14;
+    w.W[30] = w.Linv[5]*t16;
     w.W[36] = w.Z_trunk[36]*w.Linv[6];
-    w.W[42] = w.Linv[7]*t33;
-    w.W[48] = w.Linv[8]*t35;
+    w.W[42] = w.Linv[7]*t18;
+    w.W[48] = w.Linv[8]*t20;
     w.W[54] = w.Z_trunk[54]*w.Linv[9];
-    w.W[60] = w.Linv[10]*t37;
-    w.W[66] = w.Linv[11]*t39;
+    w.W[60] = w.Linv[10]*t22;
+    w.W[66] = w.Linv[11]*t24;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_12(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_20(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
     const Scalar t0 = w.Z_trunk[1]*w.Linv[0];
@@ -4391,162 +4506,165 @@ PROXGEN_RT_NOINLINE void pv_12(Workspace& w) noexcept {
     w.W[62] = w.Linv[10]*t29;
     w.W[68] = w.Linv[11]*t31;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t32 = w.Z_trunk[3]*w.Linv[0];
-    const Scalar t33 = w.Z_trunk[9] - w.L[1]*t32;
-    const Scalar t34 = w.Linv[1]*t33;
-    const Scalar t35 = w.Z_trunk[15] - w.L[2]*t32 - w.L[13]*t34;
-    const Scalar t36 = w.Z_trunk[21]*w.Linv[3];
-    const Scalar t37 = w.Z_trunk[27] - w.L[34]*t36;
-    const Scalar t38 = w.Linv[4]*t37;
-    const Scalar t39 = w.Z_trunk[33] - w.L[35]*t36 - w.L[43]*t38;
-    const Scalar t40 = w.Z_trunk[39]*w.Linv[6];
-    const Scalar t41 = w.Z_trunk[45] - w.L[58]*t40;
-    const Scalar t42 = w.Linv[7]*t41;
-    const Scalar t43 = w.Z_trunk[51] - w.L[59]*t40 - w.L[64]*t42;
-    const Scalar t44 = w.Z_trunk[57]*w.Linv[9];
-    const Scalar t45 = w.Z_trunk[63] - w.L[73]*t44;
-    const Scalar t46 = w.Linv[10]*t45;
-    const Scalar t47 = w.Z_trunk[69] - w.L[74]*t44 - w.L[76]*t46;
+    const Scalar t0 = w.Z_trunk[3]*w.Linv[0];
+    const Scalar t1 = w.Z_trunk[9] - w.L[1]*t0;
+    const Scalar t2 = w.Linv[1]*t1;
+    const Scalar t3 = w.Z_trunk[15] - w.L[2]*t0 - w.L[13]*t2;
+    const Scalar t4 = w.Z_trunk[21]*w.Linv[3];
+    const Scalar t5 = w.Z_trunk[27] - w.L[34]*t4;
+    const Scalar t6 = w.Linv[4]*t5;
+    const Scalar t7 = w.Z_trunk[33] - w.L[35]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Z_trunk[39]*w.Linv[6];
+    const Scalar t9 = w.Z_trunk[45] - w.L[58]*t8;
+    const Scalar t10 = w.Linv[7]*t9;
+    const Scalar t11 = w.Z_trunk[51] - w.L[59]*t8 - w.L[64]*t10;
+    const Scalar t12 = w.Z_trunk[57]*w.Linv[9];
+    const Scalar t13 = w.Z_trunk[63] - w.L[73]*t12;
+    const Scalar t14 = w.Linv[10]*t13;
+    const Scalar t15 = w.Z_trunk[69] - w.L[74]*t12 - w.L[76]*t14;
     w.W[3] = w.Z_trunk[3]*w.Linv[0];
-    w.W[9] = w.Linv[1]*t33;
-    w.W[15] = w.Linv[2]*t35;
+    w.W[9] = w.Linv[1]*t1;
+    w.W[15] = w.Linv[2]*t3;
     w.W[21] = w.Z_trunk[21]*w.Linv[3];
-    w.W[27] = w.Linv[4]*t37;
-    w.W[33] = w.Linv[5]*t39;
+    w.W[27] = w.Linv[4]*t5;
+    w.W[33] = w.Linv[5]*t7;
     w.W[39] = w.Z_trunk[39]*w.Linv[6];
-    w.W[45] = w.Linv[7]*t41;
-    w.W[51] = w.Linv[8]*t43;
+    w.W[45] = w.Linv[7]*t9;
+    w.W[51] = w.Linv[8]*t11;
     w.W[57] = w.Z_trunk[57]*w.Linv[9];
-    w.W[63] = w.Linv[10]*t45;
-    w.W[69] = w.Linv[11]*t47;
+    w.W[63] = w.Linv[10]*t13;
+    w.W[69] = w.Linv[11]*t15;
+  }
+  // W = L^-1 Z^T, column 4
+  {
+    const Scalar t16 = w.Z_trunk[4]*w.Linv[0];
+    const Scalar t17 = w.Z_trunk[10] - w.L[1]*t16;
+    const Scalar t18 = w.Linv[1]*t17;
+    const Scalar t19 = w.Z_trunk[16] - w.L[2]*t16 - w.L[13]*t18;
+    const Scalar t20 = w.Z_trunk[22]*w.Linv[3];
+    const Scalar t21 = w.Z_trunk[28] - w.L[34]*t20;
+    const Scalar t22 = w.Linv[4]*t21;
+    const Scalar t23 = w.Z_trunk[34] - w.L[35]*t20 - w.L[43]*t22;
+    const Scalar t24 = w.Z_trunk[40]*w.Linv[6];
+    const Scalar t25 = w.Z_trunk[46] - w.L[58]*t24;
+    const Scalar t26 = w.Linv[7]*t25;
+    const Scalar t27 = w.Z_trunk[52] - w.L[59]*t24 - w.L[64]*t26;
+    const Scalar t28 = w.Z_trunk[58]*w.Linv[9];
+    const Scalar t29 = w.Z_trunk[64] - w.L[73]*t28;
+    const Scalar t30 = w.Linv[10]*t29;
+    const Scalar t31 = w.Z_trunk[70] - w.L[74]*t28 - w.L[76]*t30;
+    w.W[4] = w.Z_trunk[4]*w.Linv[0];
+    w.W[10] = w.Linv[1]*t17;
+    w.W[16] = w.Linv[2]*t19;
+    w.W[22] = w.Z_trunk[22]*w.Linv[3];
+    w.W[28] = w.Linv[4]*t21;
+    w.W[34] = w.Linv[5]*t23;
+    w.W[40] = w.Z_trunk[40]*w.Linv[6];
+    w.W[46] = w.Linv[7]*t25;
+    w.W[52] = w.Linv[8]*t27;
+    w.W[58] = w.Z_trunk[58]*w.Linv[9];
+    w.W[64] = w.Linv[10]*t29;
+    w.W[70] = w.Linv[11]*t31;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_13(Workspace& w) noexcept {
-  // W = L^-1 Z^T, column 4
-  {
-    const Scalar t0 = w.Z_trunk[4]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[10] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[16] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[22]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[28] - w.L[34]*t4;
-    const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[34] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[40]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[46] - w.L[58]*t8;
-    const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[52] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[58]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[64] - w.L[73]*t12;
-    const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[70] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[4] = w.Z_trunk[4]*w.Linv[0];
-    w.W[10] = w.Linv[1]*t1;
-    w.W[16] = w.Linv[2]*t3;
-    w.W[22] = w.Z_trunk[22]*w.Linv[3];
-    w.W[28] = w.Linv[4]*t5;
-    w.W[34] = w.Linv[5]*t7;
-    w.W[40] = w.Z_trunk[40]*w.Linv[6];
-    w.W[46] = w.Linv[7]*t9;
-    w.W[52] = w.Linv[8]*t11;
-    w.W[58] = w.Z_trunk[58]*w.Linv[9];
-    w.W[64] = w.Linv[10]*t13;
-    w.W[70] = w.Linv[11]*t15;
-  }
+PROXGEN_RT_NOINLINE void pv_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t16 = w.Z_trunk[5]*w.Linv[0];
-    const Scalar t17 = w.Z_trunk[11] - w.L[1]*t16;
-    const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_trunk[17] - w.L[2]*t16 - w.L[13]*t18;
-    const Scalar t20 = w.Z_trunk[23]*w.Linv[3];
-    const Scalar t21 = w.Z_trunk[29] - w.L[34]*t20;
-    const Scalar t22 = w.Linv[4]*t21;
-    const Scalar t23 = w.Z_trunk[35] - w.L[35]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Z_trunk[41]*w.Linv[6];
-    const Scalar t25 = w.Z_trunk[47] - w.L[58]*t24;
-    const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_trunk[53] - w.L[59]*t24 - w.L[64]*t26;
-    const Scalar t28 = w.Z_trunk[59]*w.Linv[9];
-    const Scalar t29 = w.Z_trunk[65] - w.L[73]*t28;
-    const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_trunk[71] - w.L[74]*t28 - w.L[76]*t30;
+    const Scalar t0 = w.Z_trunk[5]*w.Linv[0];
+    const Scalar t1 = w.Z_trunk[11] - w.L[1]*t0;
+    const Scalar t2 = w.Linv[1]*t1;
+    const Scalar t3 = w.Z_trunk[17] - w.L[2]*t0 - w.L[13]*t2;
+    const Scalar t4 = w.Z_trunk[23]*w.Linv[3];
+    const Scalar t5 = w.Z_trunk[29] - w.L[34]*t4;
+    const Scalar t6 = w.Linv[4]*t5;
+    const Scalar t7 = w.Z_trunk[35] - w.L[35]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Z_trunk[41]*w.Linv[6];
+    const Scalar t9 = w.Z_trunk[47] - w.L[58]*t8;
+    const Scalar t10 = w.Linv[7]*t9;
+    const Scalar t11 = w.Z_trunk[53] - w.L[59]*t8 - w.L[64]*t10;
+    const Scalar t12 = w.Z_trunk[59]*w.Linv[9];
+    const Scalar t13 = w.Z_trunk[65] - w.L[73]*t12;
+    const Scalar t14 = w.Linv[10]*t13;
+    const Scalar t15 = w.Z_trunk[71] - w.L[74]*t12 - w.L[76]*t14;
     w.W[5] = w.Z_trunk[5]*w.Linv[0];
-    w.W[11] = w.Linv[1]*t17;
-    w.W[17] = w.Linv[2]*t19;
+    w.W[11] = w.Linv[1]*t1;
+    w.W[17] = w.Linv[2]*t3;
     w.W[23] = w.Z_trunk[23]*w.Linv[3];
-    w.W[29] = w.Linv[4]*t21;
-    w.W[35] = w.Linv[5]*t23;
+    w.W[29] = w.Linv[4]*t5;
+    w.W[35] = w.Linv[5]*t7;
     w.W[41] = w.Z_trunk[41]*w.Linv[6];
-    w.W[47] = w.Linv[7]*t25;
-    w.W[53] = w.Linv[8]*t27;
+    w.W[47] = w.Linv[7]*t9;
+    w.W[53] = w.Linv[8]*t11;
     w.W[59] = w.Z_trunk[59]*w.Linv[9];
-    w.W[65] = w.Linv[10]*t29;
-    w.W[71] = w.Linv[11]*t31;
+    w.W[65] = w.Linv[10]*t13;
+    w.W[71] = w.Linv[11]*t15;
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t32 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66];
-    const Scalar r0 = std::sqrt(t32);
+    const Scalar t16 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66];
+    const Scalar r0 = std::sqrt(t16);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t33 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67];
-    w.LS[1] = w.LSinv[0]*t33;
-    const Scalar t34 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68];
-    w.LS[2] = w.LSinv[0]*t34;
-    const Scalar t35 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69];
-    w.LS[3] = w.LSinv[0]*t35;
-    const Scalar t36 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70];
-    w.LS[4] = w.LSinv[0]*t36;
-    const Scalar t37 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71];
-    w.LS[5] = w.LSinv[0]*t37;
-    const Scalar t38 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t38);
+    const Scalar t17 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67];
+    w.LS[1] = w.LSinv[0]*t17;
+    const Scalar t18 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68];
+    w.LS[2] = w.LSinv[0]*t18;
+    const Scalar t19 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69];
+    w.LS[3] = w.LSinv[0]*t19;
+    const Scalar t20 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70];
+    w.LS[4] = w.LSinv[0]*t20;
+    const Scalar t21 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71];
+    w.LS[5] = w.LSinv[0]*t21;
+    const Scalar t22 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t22);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t39 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t39;
-    const Scalar t40 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t40;
-    const Scalar t41 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t41;
-    const Scalar t42 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t42;
-    const Scalar t43 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t43);
+    const Scalar t23 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t23;
+    const Scalar t24 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t24;
+    const Scalar t25 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t25;
+    const Scalar t26 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t26;
+    const Scalar t27 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t27);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t44 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t44;
-    const Scalar t45 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t45;
-    const Scalar t46 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t46;
-    const Scalar t47 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t47);
+    const Scalar t28 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t28;
+    const Scalar t29 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t29;
+    const Scalar t30 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t30;
+    const Scalar t31 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t31);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t48 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t48;
-    const Scalar t49 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t49;
-    const Scalar t50 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t50);
+    const Scalar t32 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t32;
+    const Scalar t33 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t33;
+    const Scalar t34 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t34);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t51 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t51;
-    const Scalar t52 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t52);
+    const Scalar t35 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t35;
+    const Scalar t36 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t36);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_14(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
   w.lambda[2] = 0.0;
@@ -4561,7 +4679,7 @@ PROXGEN_RT_NOINLINE void pv_14(Workspace& w) noexcept {
   w.lambda[11] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_15(Scalar inv_mu, Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -4651,7 +4769,7 @@ PROXGEN_RT_NOINLINE void pv_15(Scalar inv_mu, Workspace& w) noexcept {
   w.lambda[11] = w.Linv[11]*z11;
 }
 
-PROXGEN_RT_NOINLINE void pv_16(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - w.KA_trunk[0]*w.lambda[0] - w.KA_trunk[6]*w.lambda[1] - w.KA_trunk[12]*w.lambda[2] - w.KA_trunk[18]*w.lambda[6] - w.KA_trunk[24]*w.lambda[7] - w.KA_trunk[30]*w.lambda[8] - w.KA_trunk[36]*w.lambda[3] - w.KA_trunk[42]*w.lambda[4] - w.KA_trunk[48]*w.lambda[5] - w.KA_trunk[54]*w.lambda[9] - w.KA_trunk[60]*w.lambda[10] - w.KA_trunk[66]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
@@ -4698,190 +4816,224 @@ PROXGEN_RT_NOINLINE void pv_16(Workspace& w) noexcept {
     const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
     const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
     const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
-    const Scalar t30 = -5.780668556524933e-05*w.c_LF_hip[4] + w.u_LF_hip[0] - w.KS_LF_hip[0]*w.lambda[0] - w.KS_LF_hip[1]*w.lambda[1] - w.KS_LF_hip[2]*w.lambda[2] - 5.780668556524933e-05*w.RJ_LF_hip[1]*w.a_trunk[3] - 5.780668556524933e-05*w.cq_LF_hip*w.a_trunk[4] - 5.780668556524933e-05*w.RJ_LF_hip[7]*w.a_trunk[5] - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t29;
-    w.qdd[6] = w.Dinv_LF_hip*t30;
-    w.a_LF_hip[0] = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
-    w.a_LF_hip[1] = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
-    w.a_LF_hip[2] = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
-    w.a_LF_hip[3] = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5] + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
-    w.a_LF_hip[5] = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5] + 0.09950371902099893*w.qdd[6];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t31 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t32 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t33 = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
-    const Scalar t34 = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    const Scalar t35 = 0.00020288*w.c_LF_thigh[5] + w.u_LF_thigh[0] - w.KA_LF_thigh[4]*w.lambda[0] - w.KA_LF_thigh[16]*w.lambda[2] + 0.00020288*w.sq_LF_thigh*w.a_LF_hip[3] + 0.00020288*w.cq_LF_thigh*w.a_LF_hip[5] - w.IA_LF_thigh[4]*t33 - w.IA_LF_thigh[13]*t34 - w.IA_LF_thigh[18]*w.a_LF_hip[4];
-    w.qdd[7] = w.Dinv_LF_thigh*t35;
-    w.a_LF_thigh[0] = w.c_LF_thigh[0] + w.cq_LF_thigh*t31 - w.sq_LF_thigh*t32;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = w.c_LF_thigh[2] + w.sq_LF_thigh*t31 + w.cq_LF_thigh*t32;
-    w.a_LF_thigh[3] = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t36 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t37 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t38 = 0.003904*w.c_LF_shank[0] + w.u_LF_shank[0] + 0.195*w.lambda[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*w.cq_LF_shank*t36 - 0.003904*w.sq_LF_shank*w.a_LF_thigh[2];
-    w.qdd[8] = w.Dinv_LF_shank*t38;
-    w.a_LF_shank[0] = w.c_LF_shank[0] + w.cq_LF_shank*t36 - w.sq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[1] = t37;
-    w.a_LF_shank[2] = w.c_LF_shank[2] + w.sq_LF_shank*t36 + w.cq_LF_shank*w.a_LF_thigh[2];
-    w.a_LF_shank[3] = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t39 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t40 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t41 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t42 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t39 + w.RJ_LH_hip[3]*t40 + w.RJ_LH_hip[6]*t41;
-    const Scalar t43 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t39 + w.cq_LH_hip*t40 + w.RJ_LH_hip[7]*t41;
-    const Scalar t44 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t39 + w.RJ_LH_hip[5]*t40 + w.RJ_LH_hip[8]*t41;
-    const Scalar t45 = w.c_LH_hip[3] + w.RJ_LH_hip[0]*w.a_trunk[3] + w.RJ_LH_hip[3]*w.a_trunk[4] + w.RJ_LH_hip[6]*w.a_trunk[5];
-    const Scalar t46 = w.c_LH_hip[5] + w.RJ_LH_hip[2]*w.a_trunk[3] + w.RJ_LH_hip[5]*w.a_trunk[4] + w.RJ_LH_hip[8]*w.a_trunk[5];
-    const Scalar t47 = -5.7617628499109426e-05*w.c_LH_hip[4] + w.u_LH_hip[0] - w.KS_LH_hip[0]*w.lambda[6] - w.KS_LH_hip[1]*w.lambda[7] - w.KS_LH_hip[2]*w.lambda[8] - 5.7617628499109426e-05*w.RJ_LH_hip[1]*w.a_trunk[3] - 5.7617628499109426e-05*w.cq_LH_hip*w.a_trunk[4] - 5.7617628499109426e-05*w.RJ_LH_hip[7]*w.a_trunk[5] - w.U_LH_hip[0]*t42 - w.U_LH_hip[1]*t43 - w.U_LH_hip[2]*t44 - w.U_LH_hip[3]*t45 - w.U_LH_hip[5]*t46;
-    w.qdd[9] = w.Dinv_LH_hip*t47;
-    w.a_LH_hip[0] = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t39 + w.RJ_LH_hip[3]*t40 + w.RJ_LH_hip[6]*t41;
-    w.a_LH_hip[1] = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t39 + w.cq_LH_hip*t40 + w.RJ_LH_hip[7]*t41;
-    w.a_LH_hip[2] = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t39 + w.RJ_LH_hip[5]*t40 + w.RJ_LH_hip[8]*t41;
-    w.a_LH_hip[3] = w.c_LH_hip[3] + w.RJ_LH_hip[0]*w.a_trunk[3] + w.RJ_LH_hip[3]*w.a_trunk[4] + w.RJ_LH_hip[6]*w.a_trunk[5] + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = w.c_LH_hip[4] + w.RJ_LH_hip[1]*w.a_trunk[3] + w.cq_LH_hip*w.a_trunk[4] + w.RJ_LH_hip[7]*w.a_trunk[5];
-    w.a_LH_hip[5] = w.c_LH_hip[5] + w.RJ_LH_hip[2]*w.a_trunk[3] + w.RJ_LH_hip[5]*w.a_trunk[4] + w.RJ_LH_hip[8]*w.a_trunk[5] - 0.09950371902099892*w.qdd[9];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
+    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
+    const Scalar t31 = w.u_LF_hip[0] - w.KS_LF_hip[0]*w.lambda[0] - w.KS_LF_hip[1]*w.lambda[1] - w.KS_LF_hip[2]*w.lambda[2] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
+    w.qdd[6] = w.Dinv_LF_hip*t31;
+    w.a_LF_hip[0] = t25;
+    w.a_LF_hip[1] = t26;
+    w.a_LF_hip[2] = t27;
+    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
+    w.a_LF_hip[4] = t29;
+    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_17(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  {
+    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
+    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
+    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
+    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
+    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
+    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
+    const Scalar t6 = w.u_LF_thigh[0] - w.KA_LF_thigh[4]*w.lambda[0] - w.KA_LF_thigh[16]*w.lambda[2] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
+    w.qdd[7] = w.Dinv_LF_thigh*t6;
+    w.a_LF_thigh[0] = t2;
+    w.a_LF_thigh[1] = w.a_LF_hip[1];
+    w.a_LF_thigh[2] = t3;
+    w.a_LF_thigh[3] = t4;
+    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
+    w.a_LF_thigh[5] = t5;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  {
+    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
+    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
+    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t13 = w.u_LF_shank[0] + 0.195*w.lambda[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*t9;
+    w.qdd[8] = w.Dinv_LF_shank*t13;
+    w.a_LF_shank[0] = t9;
+    w.a_LF_shank[1] = t8;
+    w.a_LF_shank[2] = t10;
+    w.a_LF_shank[3] = t11;
+    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
+    w.a_LF_shank[5] = t12;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t14 + w.RJ_LH_hip[3]*t15 + w.RJ_LH_hip[6]*t16;
+    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[7]*t16;
+    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t14 + w.RJ_LH_hip[5]*t15 + w.RJ_LH_hip[8]*t16;
+    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
+    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
+    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
+    const Scalar t23 = w.u_LH_hip[0] - w.KS_LH_hip[0]*w.lambda[6] - w.KS_LH_hip[1]*w.lambda[7] - w.KS_LH_hip[2]*w.lambda[8] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
+    w.qdd[9] = w.Dinv_LH_hip*t23;
+    w.a_LH_hip[0] = t17;
+    w.a_LH_hip[1] = t18;
+    w.a_LH_hip[2] = t19;
+    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
+    w.a_LH_hip[4] = t21;
+    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
     const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
     const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
     const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    const Scalar t4 = 0.00020288*w.c_LH_thigh[5] + w.u_LH_thigh[0] - w.KA_LH_thigh[4]*w.lambda[6] - w.KA_LH_thigh[16]*w.lambda[8] + 0.00020288*w.a_LH_hip[3]*w.sq_LH_thigh + 0.00020288*w.a_LH_hip[5]*w.cq_LH_thigh - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
-    w.qdd[10] = w.Dinv_LH_thigh*t4;
-    w.a_LH_thigh[0] = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
+    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
+    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
+    const Scalar t6 = w.u_LH_thigh[0] - w.KA_LH_thigh[4]*w.lambda[6] - w.KA_LH_thigh[16]*w.lambda[8] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
+    w.qdd[10] = w.Dinv_LH_thigh*t6;
+    w.a_LH_thigh[0] = t2;
     w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    w.a_LH_thigh[3] = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
+    w.a_LH_thigh[2] = t3;
+    w.a_LH_thigh[3] = t4;
     w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
+    w.a_LH_thigh[5] = t5;
   }
   // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    const Scalar t5 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t6 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t7 = 0.003904*w.c_LH_shank[0] + w.u_LH_shank[0] + 0.195*w.lambda[6] - 0.000486144*w.a_LH_thigh[4] + 0.003904*w.cq_LH_shank*t5 - 0.003904*w.sq_LH_shank*w.a_LH_thigh[2];
-    w.qdd[11] = w.Dinv_LH_shank*t7;
-    w.a_LH_shank[0] = w.c_LH_shank[0] + w.cq_LH_shank*t5 - w.sq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[1] = t6;
-    w.a_LH_shank[2] = w.c_LH_shank[2] + w.sq_LH_shank*t5 + w.cq_LH_shank*w.a_LH_thigh[2];
-    w.a_LH_shank[3] = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
+    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
+    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t13 = w.u_LH_shank[0] + 0.195*w.lambda[6] - 0.000486144*w.a_LH_thigh[4] + 0.003904*t9;
+    w.qdd[11] = w.Dinv_LH_shank*t13;
+    w.a_LH_shank[0] = t9;
+    w.a_LH_shank[1] = t8;
+    w.a_LH_shank[2] = t10;
+    w.a_LH_shank[3] = t11;
     w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    w.a_LH_shank[5] = t12;
   }
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t8 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t9 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t10 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t11 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t8 + w.RJ_RF_hip[3]*t9 + w.RJ_RF_hip[6]*t10;
-    const Scalar t12 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t8 + w.cq_RF_hip*t9 + w.RJ_RF_hip[7]*t10;
-    const Scalar t13 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t8 + w.RJ_RF_hip[5]*t9 + w.RJ_RF_hip[8]*t10;
-    const Scalar t14 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
-    const Scalar t15 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
-    const Scalar t16 = 5.780668556524933e-05*w.c_RF_hip[4] + w.u_RF_hip[0] - w.KS_RF_hip[0]*w.lambda[3] - w.KS_RF_hip[1]*w.lambda[4] - w.KS_RF_hip[2]*w.lambda[5] + 5.780668556524933e-05*w.a_trunk[3]*w.RJ_RF_hip[1] + 5.780668556524933e-05*w.a_trunk[4]*w.cq_RF_hip + 5.780668556524933e-05*w.a_trunk[5]*w.RJ_RF_hip[7] - w.U_RF_hip[0]*t11 - w.U_RF_hip[1]*t12 - w.U_RF_hip[2]*t13 - w.U_RF_hip[3]*t14 - w.U_RF_hip[5]*t15;
-    w.qdd[12] = w.Dinv_RF_hip*t16;
-    w.a_RF_hip[0] = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t8 + w.RJ_RF_hip[3]*t9 + w.RJ_RF_hip[6]*t10;
-    w.a_RF_hip[1] = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t8 + w.cq_RF_hip*t9 + w.RJ_RF_hip[7]*t10;
-    w.a_RF_hip[2] = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t8 + w.RJ_RF_hip[5]*t9 + w.RJ_RF_hip[8]*t10;
-    w.a_RF_hip[3] = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6] + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
-    w.a_RF_hip[5] = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8] + 0.09950371902099893*w.qdd[12];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t17 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t18 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t19 = w.c_RF_thigh[0] + w.cq_RF_thigh*t17 - w.sq_RF_thigh*t18;
-    const Scalar t20 = w.c_RF_thigh[2] + w.sq_RF_thigh*t17 + w.cq_RF_thigh*t18;
-    const Scalar t21 = -0.00020288*w.c_RF_thigh[5] + w.u_RF_thigh[0] - w.KA_RF_thigh[4]*w.lambda[3] - w.KA_RF_thigh[16]*w.lambda[5] - 0.00020288*w.sq_RF_thigh*w.a_RF_hip[3] - 0.00020288*w.cq_RF_thigh*w.a_RF_hip[5] - w.IA_RF_thigh[4]*t19 - w.IA_RF_thigh[13]*t20 - w.IA_RF_thigh[18]*w.a_RF_hip[4];
-    w.qdd[13] = w.Dinv_RF_thigh*t21;
-    w.a_RF_thigh[0] = w.c_RF_thigh[0] + w.cq_RF_thigh*t17 - w.sq_RF_thigh*t18;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = w.c_RF_thigh[2] + w.sq_RF_thigh*t17 + w.cq_RF_thigh*t18;
-    w.a_RF_thigh[3] = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t22 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t23 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t24 = 0.003904*w.c_RF_shank[0] + w.u_RF_shank[0] + 0.195*w.lambda[3] - 0.000486144*w.a_RF_thigh[4] + 0.003904*w.cq_RF_shank*t22 - 0.003904*w.sq_RF_shank*w.a_RF_thigh[2];
-    w.qdd[14] = w.Dinv_RF_shank*t24;
-    w.a_RF_shank[0] = w.c_RF_shank[0] + w.cq_RF_shank*t22 - w.sq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[1] = t23;
-    w.a_RF_shank[2] = w.c_RF_shank[2] + w.sq_RF_shank*t22 + w.cq_RF_shank*w.a_RF_thigh[2];
-    w.a_RF_shank[3] = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t25 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t26 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t27 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t28 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t25 + w.RJ_RH_hip[3]*t26 + w.RJ_RH_hip[6]*t27;
-    const Scalar t29 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t25 + w.cq_RH_hip*t26 + w.RJ_RH_hip[7]*t27;
-    const Scalar t30 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t25 + w.RJ_RH_hip[5]*t26 + w.RJ_RH_hip[8]*t27;
-    const Scalar t31 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
-    const Scalar t32 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
-    const Scalar t33 = 5.7617628499109426e-05*w.c_RH_hip[4] + w.u_RH_hip[0] - w.KS_RH_hip[0]*w.lambda[9] - w.KS_RH_hip[1]*w.lambda[10] - w.KS_RH_hip[2]*w.lambda[11] + 5.7617628499109426e-05*w.a_trunk[3]*w.RJ_RH_hip[1] + 5.7617628499109426e-05*w.a_trunk[4]*w.cq_RH_hip + 5.7617628499109426e-05*w.a_trunk[5]*w.RJ_RH_hip[7] - w.U_RH_hip[0]*t28 - w.U_RH_hip[1]*t29 - w.U_RH_hip[2]*t30 - w.U_RH_hip[3]*t31 - w.U_RH_hip[5]*t32;
-    w.qdd[15] = w.Dinv_RH_hip*t33;
-    w.a_RH_hip[0] = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t25 + w.RJ_RH_hip[3]*t26 + w.RJ_RH_hip[6]*t27;
-    w.a_RH_hip[1] = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t25 + w.cq_RH_hip*t26 + w.RJ_RH_hip[7]*t27;
-    w.a_RH_hip[2] = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t25 + w.RJ_RH_hip[5]*t26 + w.RJ_RH_hip[8]*t27;
-    w.a_RH_hip[3] = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6] + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
-    w.a_RH_hip[5] = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8] - 0.09950371902099892*w.qdd[15];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t34 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t35 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t36 = w.c_RH_thigh[0] + w.cq_RH_thigh*t34 - w.sq_RH_thigh*t35;
-    const Scalar t37 = w.c_RH_thigh[2] + w.sq_RH_thigh*t34 + w.cq_RH_thigh*t35;
-    const Scalar t38 = -0.00020288*w.c_RH_thigh[5] + w.u_RH_thigh[0] - w.KA_RH_thigh[4]*w.lambda[9] - w.KA_RH_thigh[16]*w.lambda[11] - 0.00020288*w.sq_RH_thigh*w.a_RH_hip[3] - 0.00020288*w.cq_RH_thigh*w.a_RH_hip[5] - w.IA_RH_thigh[4]*t36 - w.IA_RH_thigh[13]*t37 - w.IA_RH_thigh[18]*w.a_RH_hip[4];
-    w.qdd[16] = w.Dinv_RH_thigh*t38;
-    w.a_RH_thigh[0] = w.c_RH_thigh[0] + w.cq_RH_thigh*t34 - w.sq_RH_thigh*t35;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = w.c_RH_thigh[2] + w.sq_RH_thigh*t34 + w.cq_RH_thigh*t35;
-    w.a_RH_thigh[3] = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t14 + w.RJ_RF_hip[3]*t15 + w.RJ_RF_hip[6]*t16;
+    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[7]*t16;
+    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t14 + w.RJ_RF_hip[5]*t15 + w.RJ_RF_hip[8]*t16;
+    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
+    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
+    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
+    const Scalar t23 = w.u_RF_hip[0] - w.KS_RF_hip[0]*w.lambda[3] - w.KS_RF_hip[1]*w.lambda[4] - w.KS_RF_hip[2]*w.lambda[5] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
+    w.qdd[12] = w.Dinv_RF_hip*t23;
+    w.a_RF_hip[0] = t17;
+    w.a_RF_hip[1] = t18;
+    w.a_RF_hip[2] = t19;
+    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
+    w.a_RF_hip[4] = t21;
+    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_18(Workspace& w) noexcept {
+PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  {
+    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
+    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
+    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
+    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
+    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
+    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
+    const Scalar t6 = w.u_RF_thigh[0] - w.KA_RF_thigh[4]*w.lambda[3] - w.KA_RF_thigh[16]*w.lambda[5] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
+    w.qdd[13] = w.Dinv_RF_thigh*t6;
+    w.a_RF_thigh[0] = t2;
+    w.a_RF_thigh[1] = w.a_RF_hip[1];
+    w.a_RF_thigh[2] = t3;
+    w.a_RF_thigh[3] = t4;
+    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
+    w.a_RF_thigh[5] = t5;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  {
+    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
+    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
+    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t13 = w.u_RF_shank[0] + 0.195*w.lambda[3] - 0.000486144*w.a_RF_thigh[4] + 0.003904*t9;
+    w.qdd[14] = w.Dinv_RF_shank*t13;
+    w.a_RF_shank[0] = t9;
+    w.a_RF_shank[1] = t8;
+    w.a_RF_shank[2] = t10;
+    w.a_RF_shank[3] = t11;
+    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
+    w.a_RF_shank[5] = t12;
+  }
+  // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t14 + w.RJ_RH_hip[3]*t15 + w.RJ_RH_hip[6]*t16;
+    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[7]*t16;
+    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t14 + w.RJ_RH_hip[5]*t15 + w.RJ_RH_hip[8]*t16;
+    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
+    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
+    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
+    const Scalar t23 = w.u_RH_hip[0] - w.KS_RH_hip[0]*w.lambda[9] - w.KS_RH_hip[1]*w.lambda[10] - w.KS_RH_hip[2]*w.lambda[11] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
+    w.qdd[15] = w.Dinv_RH_hip*t23;
+    w.a_RH_hip[0] = t17;
+    w.a_RH_hip[1] = t18;
+    w.a_RH_hip[2] = t19;
+    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
+    w.a_RH_hip[4] = t21;
+    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+  {
+    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
+    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
+    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
+    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
+    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
+    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
+    const Scalar t6 = w.u_RH_thigh[0] - w.KA_RH_thigh[4]*w.lambda[9] - w.KA_RH_thigh[16]*w.lambda[11] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
+    w.qdd[16] = w.Dinv_RH_thigh*t6;
+    w.a_RH_thigh[0] = t2;
+    w.a_RH_thigh[1] = w.a_RH_hip[1];
+    w.a_RH_thigh[2] = t3;
+    w.a_RH_thigh[3] = t4;
+    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
+    w.a_RH_thigh[5] = t5;
+  }
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    const Scalar t0 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t1 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t2 = -0.000486144*w.a_RH_thigh[4] + 0.003904*w.c_RH_shank[0] + w.u_RH_shank[0] + 0.195*w.lambda[9] + 0.003904*w.cq_RH_shank*t0 - 0.003904*w.a_RH_thigh[2]*w.sq_RH_shank;
-    w.qdd[17] = w.Dinv_RH_shank*t2;
-    w.a_RH_shank[0] = w.c_RH_shank[0] + w.cq_RH_shank*t0 - w.a_RH_thigh[2]*w.sq_RH_shank;
-    w.a_RH_shank[1] = t1;
-    w.a_RH_shank[2] = w.c_RH_shank[2] + w.sq_RH_shank*t0 + w.a_RH_thigh[2]*w.cq_RH_shank;
-    w.a_RH_shank[3] = w.c_RH_shank[3] + w.a_RH_thigh[3]*w.cq_RH_shank - w.a_RH_thigh[5]*w.sq_RH_shank;
+    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
+    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
+    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t13 = w.u_RH_shank[0] + 0.195*w.lambda[9] - 0.000486144*w.a_RH_thigh[4] + 0.003904*t9;
+    w.qdd[17] = w.Dinv_RH_shank*t13;
+    w.a_RH_shank[0] = t9;
+    w.a_RH_shank[1] = t8;
+    w.a_RH_shank[2] = t10;
+    w.a_RH_shank[3] = t11;
     w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = w.c_RH_shank[5] + w.a_RH_thigh[3]*w.sq_RH_shank + w.a_RH_thigh[5]*w.cq_RH_shank;
+    w.a_RH_shank[5] = t12;
   }
 }
 
@@ -4893,6 +5045,8 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   kinematics_2(q, v, w);
   kinematics_3(q, v, w);
   kinematics_4(q, v, w);
+  kinematics_5(q, v, w);
+  kinematics_6(q, v, w);
 }
 
 // Articulated-body elimination of the bodies off the constraint support
@@ -4918,23 +5072,34 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   eliminate_free_bodies(tau, w);
   caba_0(tau, mu, w);
   caba_1(tau, w);
-  caba_2(tau, mu, w);
-  caba_3(tau, w);
-  caba_4(tau, mu, w);
+  caba_2(tau, w);
+  caba_3(tau, mu, w);
+  caba_4(tau, w);
   caba_5(tau, w);
   caba_6(tau, mu, w);
   caba_7(tau, w);
   caba_8(tau, w);
-  caba_9(w);
-  caba_10(w);
-  caba_11(mu, w);
+  caba_9(tau, mu, w);
+  caba_10(tau, w);
+  caba_11(tau, w);
+  caba_12(tau, w);
+  caba_13(w);
+  caba_14(w);
+  caba_15(w);
+  caba_16(w);
+  caba_17(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_12(w);
-    caba_13(w);
-    caba_14(w);
-    caba_15(w);
-    caba_16(mu, w);
+    caba_18(w);
+    caba_19(w);
+    caba_20(w);
+    caba_21(w);
+    caba_22(w);
+    caba_23(w);
+    caba_24(w);
+    caba_25(w);
+    caba_26(w);
+    caba_27(mu, w);
   }
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
@@ -4984,20 +5149,31 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_6(tau, w);
   pv_7(tau, w);
   pv_8(tau, w);
-  pv_9(w);
-  pv_10(w);
-  const Scalar inv_mu = 1.0 / s.mu;
-  pv_11(inv_mu, w);
-  pv_12(w);
+  pv_9(tau, w);
+  pv_10(tau, w);
+  pv_11(tau, w);
+  pv_12(tau, w);
   pv_13(w);
   pv_14(w);
-  // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
-  for (int k = 0; k < s.iterations; ++k) {
-    pv_15(inv_mu, w);
-  }
+  pv_15(w);
   pv_16(w);
   pv_17(w);
-  pv_18(w);
+  const Scalar inv_mu = 1.0 / s.mu;
+  pv_18(inv_mu, w);
+  pv_19(inv_mu, w);
+  pv_20(w);
+  pv_21(w);
+  pv_22(w);
+  pv_23(w);
+  // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
+  for (int k = 0; k < s.iterations; ++k) {
+    pv_24(inv_mu, w);
+  }
+  pv_25(w);
+  pv_26(w);
+  pv_27(w);
+  pv_28(w);
+  pv_29(w);
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];

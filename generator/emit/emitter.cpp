@@ -87,10 +87,11 @@ void forEachExpr(State& s, const std::function<void(Expr&)>& f) {
   for (V6& x : s.W) v6(x);
 }
 
-State translate(State s, const CodeBuilder& from, CodeBuilder& to) {
+void translate(State& s, const CodeBuilder& from, CodeBuilder& to) {
   std::vector<int> cache;
-  forEachExpr(s, [&](Expr& e) { e = to.import(from, e, cache); });
-  return s;
+  forEachExpr(s, [&](Expr& e) {
+    if (!e.isConstant()) e = to.import(from, e, cache);
+  });
 }
 
 // ------------------------------------------------------------------ members
@@ -193,7 +194,7 @@ class Emitter {
   std::vector<Expr> backwardSolve(const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& y);
 
   // functions
-  static constexpr int kPartBudget = 80;  // statements per part function (before dead-code removal)
+  static constexpr int kPartBudget = 40;  // statements per part (before dead-code removal): measured best
   struct Host {
     std::string name;
     CodeBuilder* cb = nullptr;
@@ -231,6 +232,7 @@ class Emitter {
   Host host_;
   Expr hostMu_, hostInvMu_;     // the host's mu and 1/mu, passed to parts
   std::vector<std::unique_ptr<CodeBuilder>> builders_;  // all of them, alive for translations
+  std::shared_ptr<NameTable> names_ = std::make_shared<NameTable>();
   std::string partsText_;
   State st_;
   std::vector<Member> members_;
@@ -566,7 +568,8 @@ void Emitter::accelerate(int i, const std::vector<Expr>& uEff, bool storeQdd) {
   CodeBuilder& cb = *cb_;
   BodySym& b = bs(i);
   const BodyPlan& p = bp(i);
-  const V6 ap = add(motionToChild(i, p.parent == 0 ? rootAcceleration() : bs(p.parent).a), b.c);
+  V6 ap = add(motionToChild(i, p.parent == 0 ? rootAcceleration() : bs(p.parent).a), b.c);
+  flatten(cb, ap, "t");  // used twice: in U^T a' and in a
   const int n = p.nv;
   std::vector<Expr> r(static_cast<std::size_t>(n));
   for (int d = 0; d < n; ++d) r[std::size_t(d)] = uEff[std::size_t(d)] - dot(cb, b.U[std::size_t(d)], ap);
@@ -671,8 +674,8 @@ void Emitter::freeRowAccelerations() {
 // calls to part functions, each holding a few bodies' blocks: small functions
 // keep the compiler's time linear in the robot's size.
 void Emitter::beginHost(const std::string& name) {
-  auto cb = std::make_unique<CodeBuilder>(plan_.scalar);
-  if (cb_) st_ = translate(st_, *cb_, *cb);
+  auto cb = std::make_unique<CodeBuilder>(plan_.scalar, names_);
+  if (cb_) translate(st_, *cb_, *cb);
   cb_ = cb.get();
   host_ = {name, cb.get(), 0};
   builders_.push_back(std::move(cb));
@@ -681,8 +684,8 @@ void Emitter::beginHost(const std::string& name) {
 void Emitter::boundary() {
   if (part_ && part_->statementCount() >= kPartBudget) endPart();
   if (part_) return;
-  auto cb = std::make_unique<CodeBuilder>(plan_.scalar);
-  st_ = translate(st_, *cb_, *cb);
+  auto cb = std::make_unique<CodeBuilder>(plan_.scalar, names_);
+  translate(st_, *cb_, *cb);
   cb_ = part_ = cb.get();
   builders_.push_back(std::move(cb));
 }
@@ -721,7 +724,7 @@ void Emitter::endPart() {
   std::vector<Expr> uses;
   for (const char* p : {"q", "v", "tau"})
     if (reads(body, p)) {
-      params.push_back(fmt::format("const Scalar* {}", p));
+      params.push_back(fmt::format("const Scalar* PROXGEN_RT_RESTRICT {}", p));
       args.push_back(p);
     }
   for (const char* p : {"mu", "inv_mu"})
@@ -731,7 +734,7 @@ void Emitter::endPart() {
       uses.push_back(std::string(p) == "mu" ? hostMu_ : hostInvMu_);
     }
   if (reads(body, "w")) {
-    params.push_back("Workspace& w");
+    params.push_back("Workspace& PROXGEN_RT_RESTRICT w");
     args.push_back("w");
   }
   std::string sig, call;
@@ -739,7 +742,7 @@ void Emitter::endPart() {
     sig += (k ? ", " : "") + params[k];
     call += (k ? ", " : "") + args[k];
   }
-  st_ = translate(st_, *part_, *host_.cb);
+  translate(st_, *part_, *host_.cb);
   cb_ = host_.cb;
   part_ = nullptr;
   if (empty) return;  // everything folded to constants: no function

@@ -56,7 +56,14 @@ Expr operator*(double k, const Expr& a) {
 
 // ---------------------------------------------------------------- CodeBuilder
 
-CodeBuilder::CodeBuilder(ScalarType scalar) : scalar_(scalar) {
+int NameTable::id(const std::string& name) {
+  const auto [it, inserted] = ids_.emplace(name, int(names_.size()));
+  if (inserted) names_.push_back(name);
+  return it->second;
+}
+
+CodeBuilder::CodeBuilder(ScalarType scalar, std::shared_ptr<NameTable> names)
+    : scalar_(scalar), names_(names ? std::move(names) : std::make_shared<NameTable>()) {
   blocks_.push_back({});
   stack_.push_back(0);
 }
@@ -81,14 +88,21 @@ int CodeBuilder::newAtom(Atom a) {
   return int(atoms_.size()) - 1;
 }
 
+int& CodeBuilder::current(int name) {
+  if (byName_.size() <= std::size_t(name)) byName_.resize(std::size_t(name) + 1, -1);
+  return byName_[std::size_t(name)];
+}
+
 Expr CodeBuilder::input(const std::string& text) {
-  auto it = byText_.find(text);
-  if (it != byText_.end()) return Expr::atom(it->second);
-  Atom a;
-  a.text = text;
-  const int id = newAtom(a);
-  byText_[text] = id;
-  return Expr::atom(id);
+  const int name = names_->id(text);
+  int& atom = current(name);
+  if (atom < 0) {
+    Atom a;
+    a.text = text;
+    a.name = name;
+    atom = newAtom(std::move(a));
+  }
+  return Expr::atom(current(name));
 }
 
 Expr CodeBuilder::member(const std::string& text) { return input(text); }
@@ -306,6 +320,15 @@ Expr CodeBuilder::import(const CodeBuilder& from, const Expr& e, std::vector<int
         dead.text = a.text;
         dead.dead = true;
         x = Expr::atom(newAtom(dead));
+      } else if (a.name >= 0 && from.names_ == names_) {
+        int& atom = current(a.name);  // the same name, found by number
+        if (atom < 0) {
+          Atom b;
+          b.text = a.text;
+          b.name = a.name;
+          atom = newAtom(std::move(b));
+        }
+        x = Expr::atom(atom);
       } else {
         x = input(a.text);
       }
@@ -318,12 +341,13 @@ Expr CodeBuilder::import(const CodeBuilder& from, const Expr& e, std::vector<int
 }
 
 Expr CodeBuilder::refresh(const std::string& member) {
-  auto it = byText_.find(member);
-  if (it != byText_.end()) atoms_[it->second].stale = true;
+  const int name = names_->id(member);
+  if (current(name) >= 0) atoms_[std::size_t(current(name))].stale = true;
   Atom a;
   a.text = member;
-  const int id = newAtom(a);
-  byText_[member] = id;
+  a.name = name;
+  const int id = newAtom(std::move(a));
+  current(name) = id;
   return Expr::atom(id);
 }
 

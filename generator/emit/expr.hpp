@@ -12,6 +12,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -52,9 +53,21 @@ class Expr {
   std::vector<Term> terms_;  // sorted by atom id, no zero coefficients
 };
 
+/// Names of inputs and members, numbered once for all the builders of one
+/// solver, so a hand-over between builders maps atoms by number, not by text.
+class NameTable {
+ public:
+  int id(const std::string& name);
+  const std::string& name(int id) const { return names_[std::size_t(id)]; }
+
+ private:
+  std::unordered_map<std::string, int> ids_;
+  std::vector<std::string> names_;
+};
+
 class CodeBuilder {
  public:
-  explicit CodeBuilder(ScalarType scalar);
+  explicit CodeBuilder(ScalarType scalar, std::shared_ptr<NameTable> names = nullptr);
 
   ScalarType scalar() const { return scalar_; }
   /// A literal of the solver's Scalar type ("0.5", "0.5f"); throws proxgen::Error
@@ -124,6 +137,7 @@ class CodeBuilder {
     std::string text;
     int f1 = -1, f2 = -1;   // factors of a product atom
     int block = 0;          // block that declared it (0: function scope)
+    int name = -1;          // NameTable id of an input or member
     int stmt = -1;          // statement defining a temporary
     bool stale = false;     // a member overwritten since
     bool dead = false;      // a temporary whose block has closed
@@ -149,6 +163,7 @@ class CodeBuilder {
 
   int newAtom(Atom a);
   Expr refresh(const std::string& member);
+  int& current(int name);
   std::string key(const Expr& e) const;
   void collectUses(const Expr& e, std::vector<int>& uses) const;
   void check(const Expr& e) const;
@@ -161,7 +176,8 @@ class CodeBuilder {
 
   ScalarType scalar_;
   std::vector<Atom> atoms_;
-  std::unordered_map<std::string, int> byText_;        // current atom of an input/member
+  std::shared_ptr<NameTable> names_;
+  std::vector<int> byName_;  // NameTable id -> current atom of that input/member (-1: none yet)
   std::map<std::pair<int, int>, int> products_;
   std::vector<Stmt> stmts_;
   std::vector<Block> blocks_;
