@@ -12,29 +12,36 @@
 // the operations in another order (constants folded, sums regrouped, the
 // double-angle form of the joint rotations, a Cholesky for the free flyer's
 // 6 x 6 inertia where the generic code inverts it, the Delassus factor by limbs
-// plus a rank-6 Woodbury update). Each has a forward error of order eps kappa,
-// kappa the condition number of what the algorithm solves at that state, and
-// so has their difference:
+// plus a rank-6 Woodbury update). Each is backward stable, so each has a forward
+// error of about c n u kappa (u the unit round-off of its Scalar, n = nv + nc
+// steps, c = 10 as in the generic equivalence tests, tests/numerics.hpp), kappa
+// the condition number of what the algorithm solves at that state; so has their
+// difference:
 //   constrainedABA qdd:    kappa(M + mu J^T J), the matrix every solve eliminates
 //                          (it grows with mu: at mu = 1e4 on gram-scale
 //                          fingertips cABA's own round-off reaches 1e-9);
-//   constrainedABA lambda: lambda = mu (J qdd + gamma - a*) amplifies the error
-//                          of qdd by mu |J|: kappa (1 + mu |J| |qdd| / |lambda|);
+//   constrainedABA lambda: lambda = mu (K a - k) is mu times a difference of
+//                          body accelerations (J qdd, and gravity in both a and k),
+//                          whose error it multiplies by mu:
+//                          kappa (1 + mu (|J| |qdd| + |g|) / |lambda|);
 //   proxPV qdd and lambda: kappa(M) (G and y_free come out of the articulated
 //                          recursion) + kappa(G + I/mu) (the proximal solve).
-// (tests/numerics.hpp's roundoffBounds judge a generic solver against the dense
-// reference; they do not carry cABA's mu |J| amplification of lambda, which a
-// comparison of two recursive implementations meets.) relErr (max |gen - generic|
-// / max(1, max |generic|)) of each must stay below max(floor, 16 eps kappa).
-// Measured over the nine shared cases and the three examples, in double and in
-// float, error / (eps kappa) stays below 3: 16 leaves a margin of five. The
-// floor is 1e-12 in double (where kappa is small the two agree to a few eps)
-// and 64 eps = 4e-6 in float, whose inputs are rounded to float first so that
-// the generic solver answers the same question. An error in the generated
-// arithmetic (a dropped term, a wrong sign) shows at every state, including the
-// well-conditioned ones where the bound is tight: the test also checks that at
-// mu = 100 at least half the states have a bound below 1e-6 in double (1e-1 in
-// float), so that no such error can hide behind ill-conditioned states.
+// relErr (max |gen - generic| / max(1, max |generic|)) of each must stay below
+// max(floor, c n u kappa); the floor is 1e-12 in double and 64 u = 4e-6 in
+// float. Float solvers take inputs rounded to float, so that the generic
+// solver (in double) answers the same question, and the same argument holds
+// with float's u: at ill-conditioned states (a UR5e near a singular pose has
+// kappa(G + I/mu) ~ 1e7) the float bound says little, which is what float can
+// promise there. Each test prints its largest error and error / bound per
+// algorithm and mu; over all of tests/generated the largest error / bound was
+// 0.40 when this was written (a margin of 2.5). The 1e-12 is the floor,
+// met wherever the conditioning allows it: constrainedABA at mu = 1e4 is not
+// (1e-10 to 6e-10 on Solo and Atlas, the same size as the generic cABA's own
+// distance to the dense reference, docs/verification.md).
+// An error in the generated arithmetic (a dropped term, a wrong sign) shows at
+// every state, including the well-conditioned ones: the test also requires, in
+// double, that at least half of the states at mu = 100 have bounds below 1e-3,
+// so no such error can hide behind ill-conditioned states.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -61,9 +68,7 @@ using proxgen::VecX;
 constexpr bool kFloat = std::is_same_v<gen::Scalar, float>;
 constexpr double kEps = kFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;  // unit round-off
 constexpr double kFloor = kFloat ? 64 * kEps : 1e-12;
-// Backward-error growth of an n-step elimination: c n eps kappa with c = 10 and
-// n = nv + nc, as in the generic equivalence tests (tests/numerics.hpp).
-constexpr double kSafety = 10.0 * (gen::nv + gen::nc);
+constexpr double kSafety = 10.0 * (gen::nv + gen::nc);  // c n
 
 proxgen::System loadSolverSystem() {
 #ifdef PROXGEN_SOLVER_CASE
@@ -114,12 +119,9 @@ double maxAbs1(const VecX& x) { return std::max(1.0, x.size() ? x.cwiseAbs().max
 
 struct Worst {
   double error = 0, ratio = 0;  // largest relErr, largest relErr / tolerance
-  int informative = 0, total = 0;
   void add(double err, double tol) {
     error = std::max(error, err);
     ratio = std::max(ratio, err / tol);
-    informative += tol <= (kFloat ? 1e-1 : 1e-6);
-    ++total;
   }
 };
 
@@ -147,6 +149,13 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
   const std::vector<double> mus = {100.0, 1e4};
   Worst cq[2], cl[2], pq[2], pl[2];  // per mu: constrainedABA qdd, lambda; proxPV qdd, lambda
   VecX qdd, lambda;
+  // States whose bounds at mu = 100 are tight enough that a wrong term (a
+  // dropped or mis-signed contribution of 0.1 % of the answer or more) could not
+  // pass: 1e-3. Checked in double only: a float solver is the same emitted code
+  // with float literals, and float's u kappa (kappa(M) reaches 1e7 on Talos)
+  // leaves its bounds above that at most states.
+  constexpr double kInformative = 1e-3;
+  int informative = 0;
   for (int n = 0; n < 100; ++n) {
     const proxgen::test::RandomState s = rounded(proxgen::test::randomState(sys_.model, rng));
     proxgen::crba(sys_, dense, s.q);
@@ -159,13 +168,9 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
       const double kC = conditionSym(M + mu * J.transpose() * J);
       proxgen::MatX G = J * M.ldlt().solve(J.transpose());
       G.diagonal().array() += 1.0 / mu;
-      // float: the solver runs in float against the double generic solver; the
-      // conditioning of the gram-scale and near-singular states (UR5e at a
-      // stretched pose: kappa(G + I/mu) ~ 1e6) puts float's eps kappa near 1e-1, so
-      // the float comparison is a sanity bound (a wrong term gives O(1)); float
-      // accuracy is measured and reported in docs/embedded.md.
-      const double dual = kFloat ? 1e-1 : std::max(kFloor, kSafety * kEps * (kM + conditionSym(G)));
-      const double primal = kFloat ? 1e-1 : std::max(kFloor, kSafety * kEps * kC);
+      const double dual = std::max(kFloor, kSafety * kEps * (kM + conditionSym(G)));
+      const double primal = std::max(kFloor, kSafety * kEps * kC);
+      if (m == 0) informative += primal <= kInformative && dual <= kInformative;
       for (int K : Ks) {
         const std::string where = "state " + std::to_string(n) + ", mu " + std::to_string(mu) + ", K " + std::to_string(K);
         proxgen::constrainedAba(sys_, d, s.q, s.v, s.tau, mu, K);
@@ -173,8 +178,8 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
         double err = proxgen::test::relErr(qdd, d.qdd);
         EXPECT_LE(err, primal) << "constrained_aba qdd, " << where;
         cq[m].add(err, primal);
-        const double multiplier = kFloat ? 1e-1 :
-            std::max(kFloor, kSafety * kEps * kC * (1 + mu * J.norm() * maxAbs1(d.qdd) / maxAbs1(d.lambda)));
+        const double accelerations = J.norm() * maxAbs1(d.qdd) + sys_.model.gravity.norm();
+        const double multiplier = std::max(primal, kSafety * kEps * kC * mu * accelerations / maxAbs1(d.lambda));
         err = proxgen::test::relErr(lambda, d.lambda);
         EXPECT_LE(err, multiplier) << "constrained_aba lambda, " << where;
         cl[m].add(err, multiplier);
@@ -190,6 +195,10 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
       }
     }
   }
+  // An error in the generated arithmetic shows at every state: it must not be
+  // able to hide behind ill-conditioned ones.
+  if (!kFloat) EXPECT_GE(informative, 50) << "too few states where the bounds could catch a wrong term";
+  std::printf("states with bounds <= %g at mu = 100: %d of 100\n", kInformative, informative);
   for (std::size_t m = 0; m < mus.size(); ++m) {
     std::printf("mu = %g: largest relErr (and / tolerance): constrainedABA qdd %.1e (%.2f) lambda %.1e (%.2f), "
                 "proxPV qdd %.1e (%.2f) lambda %.1e (%.2f)\n",
