@@ -1,6 +1,7 @@
 // `proxgen generate` as a user runs it (the binary): bad input gets the
 // loaders' one-line errors and leaves nothing in --out; good input writes
-// exactly NAME.hpp and NAME.cpp (creating --out), nothing else.
+// exactly NAME.hpp and NAME.cpp (creating --out), nothing else. `proxgen
+// verify` passes on good input and fails when the tolerance is below round-off.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -29,15 +30,23 @@ std::string binary() {
   return dir ? std::string(dir) + "/proxgen" : "";
 }
 
-Outcome run(const std::string& args) {
+Outcome runCommand(const std::string& command, const std::string& args) {
   Outcome r;
-  FILE* p = popen((binary() + " generate " + args + " 2>&1").c_str(), "r");
+  FILE* p = popen((binary() + " " + command + " " + args + " 2>&1").c_str(), "r");
   if (!p) return r;
   char buf[4096];
   while (std::fgets(buf, sizeof buf, p)) r.output += buf;
   const int status = pclose(p);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+Outcome run(const std::string& args) { return runCommand("generate", args); }
+
+int countOf(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
 }
 
 std::set<std::string> listing(const fs::path& dir) {
@@ -121,6 +130,38 @@ TEST_F(GenerateCommand, BadOptionsLeaveNothing) {
   const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + file.string());
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("not a folder"), std::string::npos) << r.output;
+}
+
+// `proxgen verify` generates, compiles (with the compiler proxgen was built
+// with: a few seconds for the arm) and compares with the generic solvers.
+TEST_F(GenerateCommand, VerifyPassesOnTheArmAndFailsBelowRoundoff) {
+  const std::string inputs = arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --samples 3";
+  const Outcome ok = runCommand("verify", inputs);
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("PASSED: tolerance 1e-08"), std::string::npos) << ok.output;
+  // 2 algorithms x (qdd, lambda) x K in {1, 2, 3, converged}, each judged.
+  EXPECT_EQ(countOf(ok.output, "  ok\n"), 16) << ok.output;
+  // A tolerance below round-off (the arm's proxPV differs by ~1e-11): the same
+  // comparison fails, says which lines, and exits 1.
+  const Outcome strict = runCommand("verify", inputs + " --tolerance 1e-300");
+  EXPECT_EQ(strict.code, 1) << strict.output;
+  EXPECT_GT(countOf(strict.output, "  FAIL\n"), 0) << strict.output;
+  EXPECT_NE(strict.output.find("FAILED: tolerance 1e-300"), std::string::npos) << strict.output;
+}
+
+TEST_F(GenerateCommand, VerifyOneSharedCase) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = proxgen::test::modelsDir() + "/cases.yaml";
+  const Outcome ok = runCommand("verify", "--cases " + cases + " --case iiwa_h3 --samples 3");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("case iiwa_h3 of"), std::string::npos) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "  ok\n"), 16) << ok.output;
+  const Outcome missing = runCommand("verify", "--cases " + cases + " --case no_such_case");
+  EXPECT_EQ(missing.code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("no case 'no_such_case'"), std::string::npos) << missing.output;
+  const Outcome mixed = runCommand("verify", arm_ + "/arm.urdf --cases " + cases + " --case iiwa_h3");
+  EXPECT_EQ(mixed.code, 1) << mixed.output;
+  EXPECT_NE(mixed.output.find("--cases and --case go together"), std::string::npos) << mixed.output;
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // compiler proxgen was built with, run it on random states and compare qdd and
 // the multipliers with the generic solvers at K = 1, 2, 3 and at convergence.
 // This is what a user runs on their own robot before trusting a generated solver.
+//   proxgen verify robot.urdf --layout layout.yaml [--samples N]
+//   proxgen verify --cases cases.yaml --case NAME [--samples N]
 #include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,6 +18,7 @@
 #include "algorithms/constrained_aba.hpp"
 #include "algorithms/prox_pv.hpp"
 #include "cli/commands.hpp"
+#include "model/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"
@@ -26,7 +29,7 @@ namespace proxgen::cli {
 namespace {
 
 struct VerifyOptions {
-  std::string urdf, layout, scalar = "double", keep;
+  std::string urdf, layout, cases, caseName, scalar = "double", keep;
   int samples = 20;
   unsigned seed = 1;
   double tolerance = 0;  // 0: the scalar's default
@@ -112,8 +115,16 @@ double relErr(const VecX& a, const VecX& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
 }
 
+// The System of the options: a URDF and a layout, or one case of a cases file.
+System loadVerified(const VerifyOptions& o) {
+  if (o.cases.empty()) return loadSystem(o.urdf, o.layout);
+  for (const Case& c : loadCases(o.cases))
+    if (c.name == o.caseName) return loadCaseSystem(c);
+  throw Error(fmt::format("{}: no case {}", o.cases, quoted(o.caseName)));
+}
+
 int verify(const VerifyOptions& o) {
-  const System sys = loadSystem(o.urdf, o.layout);
+  const System sys = loadVerified(o);
   const Model& m = sys.model;
   // Default tolerances: the generated and the generic solver do the same
   // operations in a different order, so they differ by about cond * eps. A wrong
@@ -138,9 +149,13 @@ int verify(const VerifyOptions& o) {
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw Error("verify: cannot find the proxgen executable");
   const auto t0 = std::chrono::steady_clock::now();
-  if (runProcess({self.string(), "generate", o.urdf, "--layout", o.layout, "--out", tmp.string(), "--name",
-                  "proxgen_verify_solver", "--scalar", o.scalar},
-                 tmp / "generate.log") != 0)
+  std::vector<std::string> generate = {self.string(), "generate"};
+  if (o.cases.empty())
+    generate.insert(generate.end(), {o.urdf, "--layout", o.layout});
+  else
+    generate.insert(generate.end(), {"--cases", o.cases, "--case", o.caseName});
+  generate.insert(generate.end(), {"--out", tmp.string(), "--name", "proxgen_verify_solver", "--scalar", o.scalar});
+  if (runProcess(generate, tmp / "generate.log") != 0)
     throw Error(fmt::format("verify: generation failed:\n{}", slurp(tmp / "generate.log")));
   const auto t1 = std::chrono::steady_clock::now();
   std::ofstream(tmp / "driver.cpp") << kDriver;
@@ -210,7 +225,8 @@ int verify(const VerifyOptions& o) {
 
   const double secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); }(t0, t1);
   const double csecs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); }(t1, t2);
-  fmt::print("proxgen verify: {} ({} bodies, nq = {}, nv = {}, nc = {}), scalar {}\n", o.urdf, m.numBodies() - 1, m.nq,
+  const std::string what = o.cases.empty() ? o.urdf : fmt::format("case {} of {}", o.caseName, o.cases);
+  fmt::print("proxgen verify: {} ({} bodies, nq = {}, nv = {}, nc = {}), scalar {}\n", what, m.numBodies() - 1, m.nq,
              m.nv, sys.nc, o.scalar);
   fmt::print("generated in {:.2f} s, compiled (-O2) in {:.1f} s; {} random states x mu in {{{:g}, 100}}\n", secs, csecs,
              o.samples, sys.mu);
@@ -235,8 +251,10 @@ int verify(const VerifyOptions& o) {
 void addVerify(CLI::App& app) {
   auto o = std::make_shared<VerifyOptions>();
   auto* cmd = app.add_subcommand("verify", "generate, compile and compare a solver with the generic solvers");
-  cmd->add_option("urdf", o->urdf, "robot URDF")->required();
-  cmd->add_option("--layout", o->layout, "constraint layout (YAML)")->required();
+  cmd->add_option("urdf", o->urdf, "robot URDF");
+  cmd->add_option("--layout", o->layout, "constraint layout (YAML)");
+  cmd->add_option("--cases", o->cases, "a cases file (cases.yaml), instead of URDF and layout");
+  cmd->add_option("--case", o->caseName, "the case of --cases to verify");
   cmd->add_option("--samples", o->samples, "random states")->check(CLI::Range(1, 100000));
   cmd->add_option("--scalar", o->scalar, "double or float")->check(CLI::IsMember({"double", "float"}));
   cmd->add_option("--tolerance", o->tolerance, "largest relative error accepted (default 1e-8 double, 1e-2 float)")
@@ -244,6 +262,11 @@ void addVerify(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--keep", o->keep, "copy the generated solver, driver and logs to this folder");
   cmd->callback([o] {
+    const bool byCase = !o->cases.empty() || !o->caseName.empty();
+    if (byCase && (o->cases.empty() || o->caseName.empty() || !o->urdf.empty() || !o->layout.empty()))
+      throw Error("verify: --cases and --case go together, without a URDF or --layout");
+    if (!byCase && (o->urdf.empty() || o->layout.empty()))
+      throw Error("verify: needs a URDF and --layout (or --cases and --case)");
     const int rc = verify(*o);
     if (rc != 0) std::exit(rc);
   });

@@ -197,7 +197,9 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
   }
   // An error in the generated arithmetic shows at every state: it must not be
   // able to hide behind ill-conditioned ones.
-  if (!kFloat) EXPECT_GE(informative, 50) << "too few states where the bounds could catch a wrong term";
+  if (!kFloat) {
+    EXPECT_GE(informative, 50) << "too few states where the bounds could catch a wrong term";
+  }
   std::printf("states with bounds <= %g at mu = 100: %d of 100\n", kInformative, informative);
   for (std::size_t m = 0; m < mus.size(); ++m) {
     std::printf("mu = %g: largest relErr (and / tolerance): constrainedABA qdd %.1e (%.2f) lambda %.1e (%.2f), "
