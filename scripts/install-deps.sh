@@ -8,6 +8,7 @@ packages=(
   valgrind gnuplot-nox binutils
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm
   clang libclang-rt-14-dev
+  locales
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
