@@ -2,7 +2,7 @@
 # Generation time, compile time (-O2, the solver .cpp alone), object size
 # (text + data) and, with --instructions, instructions per call (callgrind,
 # K = 3, the layout's mu) of the generated solvers of the nine shared cases:
-# the table of docs/generator.md.
+# the table "Generation and compile cost" of the README.
 #
 #   tests/generated/measure.sh BUILD_DIR [--instructions] [--cxx g++]
 #

@@ -1,0 +1,33 @@
+// The generic side of the generated-solver tests (harness_lib.cpp, compiled
+// once): harness.cpp, built once per solver, describes its solver with a
+// SolverUnderTest and calls these from its tests.
+#pragma once
+
+#include <functional>
+
+#include "model/model.hpp"
+
+namespace proxgen::test {
+
+/// One generated solver, seen through double-precision vectors.
+struct SolverUnderTest {
+  enum Algorithm { kConstrainedAba, kProxPv };
+  int nq = 0, nv = 0, nc = 0;
+  bool isFloat = false;  // Scalar = float: inputs are rounded to float before both solvers see them
+  /// Runs the generated algorithm on (q, v, tau), already representable in its
+  /// Scalar, with this mu and K; writes qdd (nv) and lambda (nc).
+  std::function<void(Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, VecX& qdd,
+                     VecX& lambda)>
+      run;
+};
+
+/// The System a solver was generated from: a case of the shared cases.yaml
+/// (caseName), or a URDF and a layout.
+System loadSolverSystem(const char* caseName, const char* urdf, const char* layout);
+
+/// 100 random states, K = 0, 1, 2, 3, 100, mu = 100 and 1e4: the generated
+/// constrainedABA against constrainedAba and proxPV against proxPv, within the
+/// bounds argued in harness_lib.cpp.
+void expectMatchesTheGenericSolvers(const SolverUnderTest& solver, const System& sys);
+
+}  // namespace proxgen::test
