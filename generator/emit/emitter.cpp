@@ -307,10 +307,13 @@ void Emitter::jointTransform(int i) {
     // q = [x y z qx qy qz qw]; R as Eigen's Quaternion::toRotationMatrix (unnormalised input used as given).
     const Expr x = cb.input(q(j.idx_q + 3)), y = cb.input(q(j.idx_q + 4)), z = cb.input(q(j.idx_q + 5)),
                w = cb.input(q(j.idx_q + 6));
-    auto two = [&](const Expr& a, const Expr& b2) { return 2.0 * cb.mul(a, b2); };
-    const M3 R = {1.0 - two(y, y) - two(z, z), two(x, y) - two(w, z), two(x, z) + two(w, y),
-                  two(x, y) + two(w, z), 1.0 - two(x, x) - two(z, z), two(y, z) - two(w, x),
-                  two(x, z) - two(w, y), two(y, z) + two(w, x), 1.0 - two(x, x) - two(y, y)};
+    // 2 a b + s 2 c d, the products in this order (see mulAdd in symbolic.cpp).
+    auto two = [&](const Expr& a, const Expr& b2, double s, const Expr& c, const Expr& d) {
+      return 2.0 * mulAdd(cb, a, b2, s, c, d);
+    };
+    const M3 R = {1.0 - two(y, y, 1.0, z, z), two(x, y, -1.0, w, z), two(x, z, 1.0, w, y),
+                  two(x, y, 1.0, w, z), 1.0 - two(x, x, 1.0, z, z), two(y, z, -1.0, w, x),
+                  two(x, z, -1.0, w, y), two(y, z, 1.0, w, x), 1.0 - two(x, x, 1.0, y, y)};
     for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = keepQ(kRJ, i, 9, k, R[std::size_t(k)]);
     b.XJ.p = {cb.input(q(j.idx_q)), cb.input(q(j.idx_q + 1)), cb.input(q(j.idx_q + 2))};
     return;
@@ -506,7 +509,8 @@ void Emitter::eliminateOneDof(int i, bool caba) {
   for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = keepQ(kU, i, 6, r, U[std::size_t(r)]);
   const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
   b.Dinv = cb.storeRaw(member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D});
-  b.u.assign(1, putQ(kUu, i, 1, 0, cb.input(tauIn(p.idx_v)) - dot(cb, S, pA)));
+  const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
+  b.u.assign(1, putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));
   if (p.parent == 0) return;
   // Ia = IA - U D^-1 U^T (its row and column along an axis-aligned S vanish:
   // Ia S = 0) ; pa = pA + Ia c + U D^-1 u.
@@ -836,7 +840,8 @@ void Emitter::updateMultipliers(bool first) {
     const std::vector<Expr> Ka = constraintRows(int(k), c.body == 0 ? rootAcceleration() : bs(c.body).a);
     for (int j = 0; j < c.rows(); ++j) {
       const int row = c.row + j;
-      const Expr dl = cb.mul(cb.input("mu"), cb.flat(Ka[std::size_t(j)] - st_.k[k][std::size_t(j)]));
+      const Expr mu = cb.input("mu");  // before the difference's temporary: see mulAdd in symbolic.cpp
+      const Expr dl = cb.mul(mu, cb.flat(Ka[std::size_t(j)] - st_.k[k][std::size_t(j)]));
       st_.dlambda[std::size_t(row)] = put(member("dlambda", plan_.nc, row, "latest multiplier increment"), dl);
       st_.lambda[std::size_t(row)] = put(member("lambda", plan_.nc, row, "multipliers (layout order)"),
                                          first ? st_.dlambda[std::size_t(row)]
@@ -1029,7 +1034,8 @@ void Emitter::delassusCholesky() {
     CodeBuilder& cb = *cb_;
     cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
     const bool full = freeFlyerWithRows() < 0;
-    Expr d = delassus(j, j, full) + cb.input("inv_mu");
+    Expr d = delassus(j, j, full);  // before inv_mu: see mulAdd in symbolic.cpp
+    d += cb.input("inv_mu");
     for (int k = 0; k < j; ++k) d -= cb.mul(st_.L(j, k), st_.L(j, k));
     const Expr r = cb.sqrt(d, "r");
     st_.Linv[std::size_t(j)] = put(member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));

@@ -42,6 +42,16 @@ bool isSignedPermutation(const M3& R) {
   return true;
 }
 
+// a*b + s c*d, the two products made in this order. C++ leaves the order in
+// which an operator's operands are evaluated unspecified (gcc and clang differ),
+// and the order in which products are made decides the order of terms in the
+// emitted text: every expression that makes two products says which is first,
+// so a proxgen built by any compiler writes the same bytes.
+Expr mulAdd(CodeBuilder& cb, const Expr& a, const Expr& b, double s, const Expr& c, const Expr& d) {
+  const Expr first = cb.mul(a, b);
+  return first + s * cb.mul(c, d);
+}
+
 namespace {
 
 bool isIdentity(const M3& R) {
@@ -93,27 +103,27 @@ bool planarRotation(const M3& R, int& a, int& i, int& j) {
 // of the plain R X R^T.
 G3 rotateBlockPlanar(CodeBuilder& cb, const M3& R, const G3& X, bool symmetric, int a, int i, int j) {
   const Expr c = at(R, i, i), x = at(R, j, i);
-  const Expr C2 = cb.flat(cb.mul(c, c) - cb.mul(x, x), "C2");
+  const Expr C2 = cb.flat(mulAdd(cb, c, c, -1.0, x, x), "C2");
   const Expr S2 = cb.flat(2.0 * cb.mul(c, x), "S2");
   auto idx = [](int r, int col) { return std::size_t(3 * r + col); };
   G3 out = X;
   // Column a (and row a): rotated as vectors.
-  out[idx(i, a)] = cb.mul(c, X[idx(i, a)]) + cb.mul(at(R, i, j), X[idx(j, a)]);
-  out[idx(j, a)] = cb.mul(x, X[idx(i, a)]) + cb.mul(c, X[idx(j, a)]);
+  out[idx(i, a)] = mulAdd(cb, c, X[idx(i, a)], 1.0, at(R, i, j), X[idx(j, a)]);
+  out[idx(j, a)] = mulAdd(cb, x, X[idx(i, a)], 1.0, c, X[idx(j, a)]);
   if (symmetric) {
     out[idx(a, i)] = out[idx(i, a)];
     out[idx(a, j)] = out[idx(j, a)];
   } else {
-    out[idx(a, i)] = cb.mul(c, X[idx(a, i)]) + cb.mul(at(R, i, j), X[idx(a, j)]);
-    out[idx(a, j)] = cb.mul(x, X[idx(a, i)]) + cb.mul(c, X[idx(a, j)]);
+    out[idx(a, i)] = mulAdd(cb, c, X[idx(a, i)], 1.0, at(R, i, j), X[idx(a, j)]);
+    out[idx(a, j)] = mulAdd(cb, x, X[idx(a, i)], 1.0, c, X[idx(a, j)]);
   }
   const Expr p = X[idx(i, i)], r = X[idx(j, j)];
   const Expr q = symmetric ? X[idx(i, j)] : 0.5 * (X[idx(i, j)] + X[idx(j, i)]);
   const Expr k = symmetric ? Expr() : 0.5 * (X[idx(i, j)] - X[idx(j, i)]);
   const Expr h = cb.flat(0.5 * (p - r), "h"), m = cb.flat(0.5 * (p + r), "m");
   // r' from its own formula, not p + r - p': no cancellation when r' << p'.
-  const Expr d = cb.flat(cb.mul(h, C2) - cb.mul(q, S2), "d");
-  const Expr qq = cb.flat(cb.mul(h, S2) + cb.mul(q, C2), "qq");
+  const Expr d = cb.flat(mulAdd(cb, h, C2, -1.0, q, S2), "d");
+  const Expr qq = cb.flat(mulAdd(cb, h, S2, 1.0, q, C2), "qq");
   out[idx(i, i)] = m + d;
   out[idx(j, j)] = m - d;
   out[idx(i, j)] = qq + k;
@@ -185,8 +195,8 @@ V3 rotateT(CodeBuilder& cb, const M3& R, const V3& x0) {
 }
 
 V3 cross(CodeBuilder& cb, const V3& a, const V3& b) {
-  return {cb.mul(a[1], b[2]) - cb.mul(a[2], b[1]), cb.mul(a[2], b[0]) - cb.mul(a[0], b[2]),
-          cb.mul(a[0], b[1]) - cb.mul(a[1], b[0])};
+  return {mulAdd(cb, a[1], b[2], -1.0, a[2], b[1]), mulAdd(cb, a[2], b[0], -1.0, a[0], b[2]),
+          mulAdd(cb, a[0], b[1], -1.0, a[1], b[0])};
 }
 
 V3 lin(const V6& x) { return {x[0], x[1], x[2]}; }
@@ -231,7 +241,8 @@ V6 actInvMotion(CodeBuilder& cb, const XSym& X, const V6& m) {
     const V3 pxa = cross(cb, X.p, a);
     for (std::size_t i = 0; i < 3; ++i) l[i] -= pxa[i];
   }
-  return stack(rotateT(cb, X.R, l), rotateT(cb, X.R, a));
+  const V3 rl = rotateT(cb, X.R, l);  // before R^T a: see mulAdd
+  return stack(rl, rotateT(cb, X.R, a));
 }
 
 V6 actForce(CodeBuilder& cb, const XSym& X, const V6& f) {

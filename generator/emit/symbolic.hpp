@@ -61,6 +61,9 @@ bool isSignedPermutation(const M3& R);
 V3 rotate(CodeBuilder& cb, const M3& R, const V3& x);     // R x
 V3 rotateT(CodeBuilder& cb, const M3& R, const V3& x);    // R^T x
 V3 cross(CodeBuilder& cb, const V3& a, const V3& b);
+/// a*b + s c*d with the products made in this order, whatever the compiler
+/// (the order decides the emitted text; C++ does not fix an operator's).
+Expr mulAdd(CodeBuilder& cb, const Expr& a, const Expr& b, double s, const Expr& c, const Expr& d);
 V3 lin(const V6& x);
 V3 ang(const V6& x);
 V6 stack(const V3& l, const V3& a);
