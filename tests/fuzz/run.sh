@@ -20,9 +20,13 @@ jobs="${JOBS:-$(nproc)}"
 
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 mkdir -p "$build"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_COMPILER=clang++ -DPROXGEN_FUZZ=ON -DPROXGEN_BUILD_TESTS=OFF -DPROXGEN_BUILD_BENCH=OFF \
-  "-DCMAKE_CXX_FLAGS=$flags" > "$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
+# A build folder configured with PROXGEN_FUZZ=ON already (scripts/sanitize.sh's,
+# which CI passes here) is used as it is; otherwise configure one for fuzzing.
+if ! grep -qs '^PROXGEN_FUZZ:BOOL=ON' "$build/CMakeCache.txt"; then
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_COMPILER=clang++ -DPROXGEN_FUZZ=ON -DPROXGEN_BUILD_TESTS=OFF -DPROXGEN_BUILD_BENCH=OFF \
+    "-DCMAKE_CXX_FLAGS=$flags" > "$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
+fi
 cmake --build "$build" --target fuzz_all -j "$jobs"
 
 if [ -z "${FUZZ_TARGETS:-}" ]; then
