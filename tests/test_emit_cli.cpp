@@ -158,7 +158,7 @@ TEST_F(GenerateCommand, VerifyOneSharedCase) {
   EXPECT_EQ(countOf(ok.output, "  ok\n"), 16) << ok.output;
   const Outcome missing = runCommand("verify", "--cases " + cases + " --case no_such_case");
   EXPECT_EQ(missing.code, 1) << missing.output;
-  EXPECT_NE(missing.output.find("no case 'no_such_case'"), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("no case named 'no_such_case'"), std::string::npos) << missing.output;
   const Outcome mixed = runCommand("verify", arm_ + "/arm.urdf --cases " + cases + " --case iiwa_h3");
   EXPECT_EQ(mixed.code, 1) << mixed.output;
   EXPECT_NE(mixed.output.find("--cases and --case go together"), std::string::npos) << mixed.output;

@@ -86,8 +86,11 @@ TEST(Plan, JointClassesAndZeroPatterns) {
   // of 9, none of 3), a point mass off the origin has a sparse inertia.
   EXPECT_EQ(pq.bodies[1].treeRotationNonzeros, 3);
   EXPECT_EQ(pq.bodies[1].treeTranslationNonzeros, 0);
-  for (const BodyPlan& b : pq.bodies)
-    if (b.index > 0) EXPECT_LE(b.inertiaNonzeros, 21);
+  for (const BodyPlan& b : pq.bodies) {
+    if (b.index > 0) {
+      EXPECT_LE(b.inertiaNonzeros, 21);
+    }
+  }
 }
 
 TEST(Plan, NegativeAxesAreSignedPicks) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace proxgen::cli {
 
@@ -10,5 +11,10 @@ void addCheck(CLI::App& app);     // check.cpp
 void addEval(CLI::App& app);      // eval.cpp
 void addGenerate(CLI::App& app);  // generate.cpp
 void addVerify(CLI::App& app);    // verify.cpp
+
+/// The robot of `generate` and `verify`: a URDF and --layout, or --cases and
+/// --case, never a mix (generate.cpp).
+void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
+                       const std::string& cases, const std::string& caseName);
 
 }  // namespace proxgen::cli

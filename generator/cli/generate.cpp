@@ -1,6 +1,8 @@
 // proxgen generate robot.urdf --layout layout.yaml --out DIR [--name NAME] [--scalar double|float]
 //   or, for one case of a cases file (tests, benchmarks):
 // proxgen generate --cases cases.yaml --case NAME --out DIR [--name NAME] [--scalar double|float]
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <memory>
 
@@ -9,6 +11,15 @@
 #include "model/error.hpp"
 
 namespace proxgen::cli {
+
+void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
+                       const std::string& cases, const std::string& caseName) {
+  const bool byCase = !cases.empty() || !caseName.empty();
+  if (byCase && (cases.empty() || caseName.empty() || !urdf.empty() || !layout.empty()))
+    throw Error(fmt::format("{}: --cases and --case go together, without a URDF or --layout", command));
+  if (!byCase && (urdf.empty() || layout.empty()))
+    throw Error(fmt::format("{}: needs a URDF and --layout (or --cases and --case)", command));
+}
 
 void addGenerate(CLI::App& app) {
   struct Options {
@@ -24,11 +35,7 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--name", opt->name, "namespace and file name (sanitised; default: the case or the URDF's file name)");
   cmd->add_option("--scalar", opt->scalar, "double (default) or float")->check(CLI::IsMember({"double", "float"}));
   cmd->callback([opt] {
-    const bool byCase = !opt->cases.empty() || !opt->caseName.empty();
-    if (byCase && (opt->cases.empty() || opt->caseName.empty() || !opt->urdf.empty() || !opt->layout.empty()))
-      throw Error("generate: --cases and --case go together, without a URDF or --layout");
-    if (!byCase && (opt->urdf.empty() || opt->layout.empty()))
-      throw Error("generate: needs a URDF and --layout (or --cases and --case)");
+    checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
     emit::GenerateOptions g;
     g.urdf = opt->urdf;
     g.layout = opt->layout;

@@ -117,10 +117,7 @@ double relErr(const VecX& a, const VecX& b) {
 
 // The System of the options: a URDF and a layout, or one case of a cases file.
 System loadVerified(const VerifyOptions& o) {
-  if (o.cases.empty()) return loadSystem(o.urdf, o.layout);
-  for (const Case& c : loadCases(o.cases))
-    if (c.name == o.caseName) return loadCaseSystem(c);
-  throw Error(fmt::format("{}: no case {}", o.cases, quoted(o.caseName)));
+  return o.cases.empty() ? loadSystem(o.urdf, o.layout) : loadCaseSystem(loadCase(o.cases, o.caseName));
 }
 
 int verify(const VerifyOptions& o) {
@@ -262,11 +259,7 @@ void addVerify(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--keep", o->keep, "copy the generated solver, driver and logs to this folder");
   cmd->callback([o] {
-    const bool byCase = !o->cases.empty() || !o->caseName.empty();
-    if (byCase && (o->cases.empty() || o->caseName.empty() || !o->urdf.empty() || !o->layout.empty()))
-      throw Error("verify: --cases and --case go together, without a URDF or --layout");
-    if (!byCase && (o->urdf.empty() || o->layout.empty()))
-      throw Error("verify: needs a URDF and --layout (or --cases and --case)");
+    checkRobotOptions("verify", o->urdf, o->layout, o->cases, o->caseName);
     const int rc = verify(*o);
     if (rc != 0) std::exit(rc);
   });

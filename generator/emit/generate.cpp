@@ -27,21 +27,18 @@ namespace {
 const char* scalarName(ScalarType t) { return t == ScalarType::Float ? "float" : "double"; }
 
 SolverFiles generateCase(const GenerateOptions& options, SolverStats* stats) {
-  for (const Case& c : loadCases(options.casesFile)) {
-    if (c.name != options.caseName) continue;
-    const System sys = loadCaseSystem(c);
-    const Plan plan = makePlan(sys, options.name.empty() ? c.name : options.name, options.scalar);
-    SolverInputs in;
-    in.urdfName = fs::path(c.urdfPath).filename().string();
-    in.layoutName = fmt::format("{} (case {})", fs::path(options.casesFile).filename().string(), c.name);
-    in.urdfSha256 = sha256File(c.urdfPath);
-    in.layoutSha256 = sha256File(options.casesFile);
-    in.command = fmt::format("proxgen generate --cases {} --case {} --out DIR --name {} --scalar {}",
-                             fs::path(options.casesFile).filename().string(), c.name, plan.name,
-                             scalarName(options.scalar));
-    return emitSolver(sys, plan, in, stats);
-  }
-  fail(options.casesFile, "cases", fmt::format("no case named {}", quoted(options.caseName)));
+  const Case c = loadCase(options.casesFile, options.caseName);
+  const System sys = loadCaseSystem(c);
+  const Plan plan = makePlan(sys, options.name.empty() ? c.name : options.name, options.scalar);
+  SolverInputs in;
+  in.urdfName = fs::path(c.urdfPath).filename().string();
+  in.layoutName = fmt::format("{} (case {})", fs::path(options.casesFile).filename().string(), c.name);
+  in.urdfSha256 = sha256File(c.urdfPath);
+  in.layoutSha256 = sha256File(options.casesFile);
+  in.command = fmt::format("proxgen generate --cases {} --case {} --out DIR --name {} --scalar {}",
+                           fs::path(options.casesFile).filename().string(), c.name, plan.name,
+                           scalarName(options.scalar));
+  return emitSolver(sys, plan, in, stats);
 }
 
 }  // namespace

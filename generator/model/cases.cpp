@@ -11,6 +11,12 @@
 
 namespace proxgen {
 
+Case loadCase(const std::string& path, const std::string& name) {
+  for (Case& c : loadCases(path))
+    if (c.name == name) return std::move(c);
+  fail(path, "cases", fmt::format("no case named {}", quoted(name)));
+}
+
 std::vector<Case> loadCases(const std::string& path) {
   YAML::Node root;
   try {

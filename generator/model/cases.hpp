@@ -17,6 +17,10 @@ struct Case {
 
 std::vector<Case> loadCases(const std::string& path);
 
+/// The case called `name` of the cases file `path`; an Error naming the file
+/// when there is none.
+Case loadCase(const std::string& path, const std::string& name);
+
 /// Loads the System of one case.
 System loadCaseSystem(const Case& c);
 
