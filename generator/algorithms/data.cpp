@@ -54,16 +54,23 @@ Data::Data(const System& sys) {
     for (int ch : m.bodies[i].children) rows.insert(rows.end(), subtreeRows[ch].begin(), subtreeRows[ch].end());
     subtreeRows[i] = std::move(rows);
   }
+  // Where each subtree's rows start in the root's (tree) order: after the
+  // parent's start, its own rows and its earlier children's subtrees.
+  subtreeStart.assign(N, 0);
+  for (int p = 0; p < N; ++p) {
+    int next = subtreeStart[p] + int(subtreeRows[p].size());
+    for (int ch : m.bodies[p].children) next -= int(subtreeRows[ch].size());
+    for (int ch : m.bodies[p].children) {
+      subtreeStart[ch] = next;
+      next += int(subtreeRows[ch].size());
+    }
+  }
   KA.resize(N);
-  lA.resize(N);
-  LA.resize(N);
   KS.resize(N);
   DinvKS.resize(N);
   for (int i = 0; i < N; ++i) {
     const int mi = int(subtreeRows[i].size());
     KA[i] = MatX::Zero(6, mi);
-    lA[i] = VecX::Zero(mi);
-    LA[i] = MatX::Zero(mi, mi);
     KS[i] = MatX::Zero(i > 0 ? m.bodies[i].joint.nv : 0, mi);
     DinvKS[i] = KS[i];
   }

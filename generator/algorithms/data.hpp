@@ -52,13 +52,14 @@ struct Data {
   VecX lambda, dlambda;               // multipliers (stacked rows, layout order)
 
   // proxPV: rows of each body's subtree, in tree order.
+  // Subtree i's rows are the contiguous block [subtreeStart[i], + m_(i)) of the
+  // root's order, so lA_i and LA_i are blocks of yfree and G, summed in place.
   std::vector<std::vector<int>> subtreeRows;  // row indices (layout numbering) per body
+  std::vector<int> subtreeStart;              // first tree-order row of each subtree
   std::vector<MatX> KA;   // 6 x m_(i)
-  std::vector<VecX> lA;   // m_(i)
-  std::vector<MatX> LA;   // m_(i) x m_(i)
   std::vector<MatX> KS;   // n_i x m_(i)
   std::vector<MatX> DinvKS;  // D_i^-1 KS_i
-  MatX G;                 // Delassus (tree order)
+  MatX G;                 // Delassus (tree order; proxPV fills only its lower triangle)
   VecX yfree, lambdaTree, rhs;
   Eigen::LLT<MatX> llt;
 

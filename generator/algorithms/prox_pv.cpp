@@ -11,19 +11,21 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
   aba_steps::initialise(sys, d, q, v);
   computeConstraintTerms(sys, d);
 
-  // Each constrained body starts its rows: KA = K^T, lA = -k, LA = 0.
-  for (int i = 0; i < N; ++i) {
-    d.KA[i].setZero();
-    d.lA[i].setZero();
-    d.LA[i].setZero();
-  }
+  // ALGORITHMS.md 4.2 with lA_i and LA_i kept in place: subtree i's rows are
+  // the block [s_i, s_i + m_(i)) of the tree order, so "lA_p[rows of i] = lA_i + ..."
+  // and "LA_p[block of i] = LA_i + ..." add into that block of y_free and G,
+  // and nothing is copied from child to parent.
+  d.yfree.setZero();
+  d.G.setZero();
+
+  // Each constrained body starts its rows: KA = K^T, lA = -k.
   for (int i = 0; i < N; ++i) {
     int col = 0;
     for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
       const Constraint& c = sys.constraints[k];
       if (c.body != i) continue;
       d.KA[i].middleCols(col, c.rows()) = d.terms[k].K.transpose();
-      d.lA[i].segment(col, c.rows()) = -d.terms[k].k;
+      d.yfree.segment(d.subtreeStart[i] + col, c.rows()) = -d.terms[k].k;
       col += c.rows();
     }
   }
@@ -33,38 +35,31 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
     aba_steps::eliminate(sys, d, i, tau);
     const int mi = int(d.subtreeRows[i].size());
     if (mi == 0) continue;
-    d.KS[i].noalias() = d.S[i].transpose() * d.KA[i];
     const int p = m.bodies[i].parent;
-    // Columns of subtree i inside the parent's arrays: after the parent's own
-    // rows and its earlier children's subtrees (Data's construction order).
-    int offset = int(d.subtreeRows[p].size());
-    for (auto ch = m.bodies[p].children.rbegin(); ch != m.bodies[p].children.rend(); ++ch) {
-      offset -= int(d.subtreeRows[*ch].size());
-      if (*ch == i) break;
-    }
+    const int si = d.subtreeStart[i];
+    const int offset = si - d.subtreeStart[p];  // subtree i's columns in KA_p
+    d.KS[i].noalias() = d.S[i].transpose() * d.KA[i];
     const Vec6 aFree = d.c[i] + d.S[i] * (d.Dinv[i] * (d.u[i] - d.U[i].transpose() * d.c[i]));
-    d.lA[p].segment(offset, mi) = d.lA[i];
-    d.lA[p].segment(offset, mi).noalias() += d.KA[i].transpose() * aFree;
+    d.yfree.segment(si, mi).noalias() += d.KA[i].transpose() * aFree;
     d.DinvKS[i].noalias() = d.Dinv[i] * d.KS[i];
-    d.LA[p].block(offset, offset, mi, mi) = d.LA[i];
+    auto LAi = d.G.block(si, si, mi, mi);  // only its lower triangle is kept: the LLT reads no more
     if (m.bodies[i].joint.nv == 1) {  // rank-one updates (outer products, not matrix products)
-      d.LA[p].block(offset, offset, mi, mi).noalias() += d.KS[i].row(0).transpose() * d.DinvKS[i].row(0);
+      LAi.selfadjointView<Eigen::Lower>().rankUpdate(d.KS[i].row(0).transpose(), d.Dinv[i](0, 0));
       d.KA[i].noalias() -= d.U[i].col(0) * d.DinvKS[i].row(0);
     } else {
-      d.LA[p].block(offset, offset, mi, mi).noalias() += d.KS[i].transpose() * d.DinvKS[i];
+      LAi.noalias() += d.KS[i].transpose() * d.DinvKS[i];
       d.KA[i].noalias() -= d.U[i] * d.DinvKS[i];
     }
     // KA_i is not needed after this: it now holds KA_i - U D^-1 KS, the rows seen through the joint.
     for (int col = 0; col < mi; ++col) d.KA[p].col(offset + col) = d.liMi[i].actForce(d.KA[i].col(col));
   }
 
-  // Root: y_free = lA_0 + KA_0^T a_0 ; (G + I/mu) lambda+ = y_free + lambda/mu.
+  // Root: y_free = lA_0 + KA_0^T a_0 ; (G + I/mu) lambda+ = y_free + lambda/mu,
+  // G = LA_0 (lower triangle).
   aba_steps::setRootAcceleration(sys, d);
   const std::vector<int>& rows = d.subtreeRows[0];
   const int nc = sys.nc;
-  d.yfree = d.lA[0];
   d.yfree.noalias() += d.KA[0].transpose() * d.a[0];
-  d.G = d.LA[0];
   d.G.diagonal().array() += 1.0 / mu;
   d.llt.compute(d.G);
   d.lambdaTree.setZero();
@@ -78,10 +73,8 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
   for (int i = 1; i < N; ++i) {
     const int mi = int(d.subtreeRows[i].size());
     if (mi > 0) {
-      auto lam = d.work.head(mi);  // this subtree's multipliers, gathered
-      for (int r = 0; r < mi; ++r) lam[r] = d.lambda[d.subtreeRows[i][r]];
       const VecN u0 = d.u[i];
-      d.u[i].noalias() -= d.KS[i] * lam;
+      d.u[i].noalias() -= d.KS[i] * d.lambdaTree.segment(d.subtreeStart[i], mi);  // lambda_(i)
       aba_steps::accelerate(sys, d, i);
       d.u[i] = u0;
     } else {
