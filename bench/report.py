@@ -14,6 +14,7 @@ import argparse
 import json
 import math
 import os
+import re
 import resource
 import shutil
 import subprocess
@@ -84,7 +85,8 @@ def fmt_ratio(a, b):
 
 # ---------------------------------------------------------------- compile time, object size
 def compile_generated(build_dir):
-    """[(case, cpu seconds, wall seconds, text, data, bss)] of each generated .cpp compiled alone at -O2."""
+    """[(case, cpu seconds, wall seconds, text, data, bss)] of each generated .cpp compiled alone at -O2
+    (with the build's -march, if any)."""
     cfg_path = os.path.join(build_dir, "bench", "bench_config.json")
     if not os.path.exists(cfg_path):
         return []
@@ -95,7 +97,8 @@ def compile_generated(build_dir):
         for g in cfg["generated"]:
             src = g["source"]
             obj = os.path.join(tmp, g["case"] + ".o")
-            cmd = [cfg["cxx"], "-std=c++17", "-O2", "-I", os.path.dirname(src), "-I", cfg["runtime_include"],
+            march = [f"-march={cfg['march']}"] if cfg.get("march") else []
+            cmd = [cfg["cxx"], "-std=c++17", "-O2", *march, "-I", os.path.dirname(src), "-I", cfg["runtime_include"],
                    "-c", src, "-o", obj]
             before = resource.getrusage(resource.RUSAGE_CHILDREN)
             start = time.perf_counter()
@@ -250,12 +253,37 @@ def summary_table(suite, calls, cases):
     return out + [""]
 
 
-def compile_table(rows):
+def build_march(build_dir):
+    """The -march of the benchmarked build (bench_config.json), or "" for the compiler's default."""
+    cfg_path = os.path.join(build_dir, "bench", "bench_config.json")
+    if not os.path.exists(cfg_path):
+        return ""
+    with open(cfg_path) as f:
+        return json.load(f).get("march", "")
+
+
+def cpu_description():
+    """The processor as /proc/cpuinfo names it, with the vector extensions that matter here."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            info = f.read()
+    except OSError:
+        return "?"
+    field = lambda key: (re.search(rf"^{key}\s*:\s*(.*)$", info, re.M) or [None, "?"])[1].strip()
+    flags = set(field("flags").split())
+    vector = [x for x in ("avx2", "fma", "avx512f") if x in flags]
+    missing = [x for x in ("avx512f",) if x not in flags]
+    return (f"{field('model name')} (family {field('cpu family')}, model {field('model')}; "
+            f"{', '.join(vector) or 'no AVX'}{'; no ' + ', '.join(missing) if missing else ''})")
+
+
+def compile_table(rows, march):
     if not rows:
         return ["## Generated solvers: compile time and object size", "",
                 "No generated solvers in this build.", ""]
     out = ["## Generated solvers: compile time and object size", "",
-           "Each generated `.cpp` compiled alone with `-std=c++17 -O2` (CPU time of the compiler, and wall "
+           f"Each generated `.cpp` compiled alone with `-std=c++17 -O2{' -march=' + march if march else ''}` "
+           "(CPU time of the compiler, and wall "
            "time on the shared machine); `size` of the object in bytes.", "",
            "| case | compile CPU s | wall s | text | data | bss |", "|---|---|---|---|---|---|"]
     for case, cpu, wall, text, data, bss in rows:
@@ -328,16 +356,19 @@ def main():
                                                      os.path.join(args.out_dir, "scaling.png"), tmp)
 
     load = context.get("load_avg", [])
+    march = build_march(args.build)
     lines = ["# Benchmark results", "",
              f"Written by `{args.command}` ({context.get('date', '?')}, host {context.get('host_name', '?')}, "
              f"{context.get('num_cpus', '?')} CPUs at {context.get('mhz_per_cpu', '?')} MHz, load average "
              f"{', '.join(f'{x:.1f}' for x in load) or '?'} at the start). All numbers come from this one run; "
-             "see docs/benchmarks.md for the method. K = 3 multiplier updates, mu = 1e4.", ""]
+             "see docs/benchmarks.md for the method. K = 3 multiplier updates, mu = 1e4.", "",
+             f"Processor: {cpu_description()}. Everything (generic and generated) compiled with "
+             f"`-O3 -DNDEBUG{' -march=' + march if march else ''}` (`PROXGEN_MARCH`).", ""]
     lines += summary_table(suite, calls, cases)
     lines += case_tables(suite, calls, cases)
     if have_dof:
         lines += ["![time against DoF](time_vs_dof.png)", ""]
-    lines += compile_table(compile_rows)
+    lines += compile_table(compile_rows, march)
     if series:
         lines += scaling_section(series, args.fixed_m, fixed_ns, have_scaling)
     with open(os.path.join(args.out_dir, "RESULTS.md"), "w") as f:

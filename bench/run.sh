@@ -9,6 +9,8 @@
 #   REPETITIONS [20]  repetitions per benchmark (the report takes their median)
 #   MIN_TIME [0.1]    seconds per repetition (--benchmark_min_time)
 #   CALLS [1000]      calls per callgrind run (the other run makes none)
+#   MARCH [native]    -march of the whole build (PROXGEN_MARCH); MARCH= for the
+#                     compiler's default (x86-64 baseline)
 #   CMAKE_ARGS []     extra configure arguments, e.g. -DPROXGEN_BENCH_GENERATED=OFF
 #   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE: set to 1 to leave that part out
 set -eu
@@ -20,10 +22,12 @@ case $build in /*) ;; *) build=$(pwd)/$build ;; esac
 results=$build/bench/results
 reps=${REPETITIONS:-20}
 min_time=${MIN_TIME:-0.1}
+march=${MARCH-native}
 
 echo "== configure and build ($build, Release)"
 # shellcheck disable=SC2086  # CMAKE_ARGS is a list of arguments
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPROXGEN_BENCH_REUSE_TEST_SOLVERS=OFF ${CMAKE_ARGS:-} >/dev/null
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPROXGEN_BENCH_REUSE_TEST_SOLVERS=OFF \
+  -DPROXGEN_MARCH="$march" ${CMAKE_ARGS:-} >/dev/null
 ninja -C "$build" -j"${JOBS:-1}" proxgen_bench_all
 mkdir -p "$results"
 
@@ -35,6 +39,16 @@ echo "== suite: $reps repetitions of ${min_time}s, random interleaving"
 # shellcheck disable=SC2086
 "$build/bench/proxgen_bench" $gbench_flags --benchmark_out="$results/suite.json"
 
+scaling_json=""
+if [ "${SKIP_SCALING:-0}" != 1 ]; then
+  echo "== scaling study on synthetic robots"
+  # shellcheck disable=SC2086
+  "$build/bench/proxgen_bench_scaling" --out "$results/scaling-models" $gbench_flags \
+    --benchmark_out="$results/scaling.json"
+  scaling_json=$results/scaling.json
+fi
+
+# Callgrind last: its counts do not depend on the machine's load, the timings above do.
 calls_json=""
 if [ "${SKIP_CALLGRIND:-0}" != 1 ]; then
   if command -v valgrind >/dev/null; then
@@ -46,18 +60,9 @@ if [ "${SKIP_CALLGRIND:-0}" != 1 ]; then
   fi
 fi
 
-scaling_json=""
-if [ "${SKIP_SCALING:-0}" != 1 ]; then
-  echo "== scaling study on synthetic robots"
-  # shellcheck disable=SC2086
-  "$build/bench/proxgen_bench_scaling" --out "$results/scaling-models" $gbench_flags \
-    --benchmark_out="$results/scaling.json"
-  scaling_json=$results/scaling.json
-fi
-
 echo "== report"
 set -- --build "$build" --suite "$results/suite.json" --out-dir "$here" \
-  --command "bench/run.sh (REPETITIONS=$reps MIN_TIME=$min_time CALLS=${CALLS:-1000})"
+  --command "bench/run.sh (REPETITIONS=$reps MIN_TIME=$min_time CALLS=${CALLS:-1000} MARCH=$march)"
 [ -n "$calls_json" ] && set -- "$@" --calls "$calls_json"
 [ -n "$scaling_json" ] && set -- "$@" --scaling "$scaling_json"
 [ "${SKIP_COMPILE:-0}" = 1 ] && set -- "$@" --no-compile

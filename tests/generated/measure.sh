@@ -4,20 +4,23 @@
 # K = 3, the layout's mu) of the generated solvers of the nine shared cases:
 # the table "Generation and compile cost" of the README.
 #
-#   tests/generated/measure.sh BUILD_DIR [--instructions] [--cxx g++]
+#   tests/generated/measure.sh BUILD_DIR [--instructions] [--cxx g++] [--march native]
 #
 # BUILD_DIR holds the built `proxgen` (BUILD_DIR/generator/proxgen); the models
 # are ../shared/models (or $PROXGEN_MODELS_DIR). Times are wall-clock seconds
 # of one run and user-CPU seconds; on a loaded machine expect them to spread.
+# --march X compiles with -march=X (default: the compiler's, x86-64 baseline).
 set -euo pipefail
-build=${1:?usage: measure.sh BUILD_DIR [--instructions] [--cxx CXX]}
+build=${1:?usage: measure.sh BUILD_DIR [--instructions] [--cxx CXX] [--march X]}
 shift
 instructions=0
 cxx=${CXX:-g++}
+march=()
 while [[ $# -gt 0 ]]; do
   case $1 in
     --instructions) instructions=1 ;;
     --cxx) cxx=$2; shift ;;
+    --march) march=("-march=$2"); shift ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -42,13 +45,13 @@ for c in $cases; do
   t0=$(date +%s%N)
   "$proxgen" generate --cases "$models/cases.yaml" --case "$c" --out "$out" --name "$c" > /dev/null
   t1=$(date +%s%N)
-  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 -O2 -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
+  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 -O2 "${march[@]}" -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
   read -r wall user < "$work/time"
   bytes=$(size "$out/$c.o" | awk 'NR == 2 { print $1 + $2 }')
   lines=$(wc -l < "$out/$c.cpp")
   printf '| %s | %s | %s (%s) | %s | %s' "$c" "$(seconds "$t0" "$t1")" "$wall" "$user" "$lines" "$bytes"
   if [[ $instructions == 1 ]]; then
-    "$cxx" -std=c++17 -O2 -I"$out" -DSOLVER_HEADER="\"$c.hpp\"" -DSOLVER=$c "$here/icount.cpp" "$out/$c.o" -o "$out/icount"
+    "$cxx" -std=c++17 -O2 "${march[@]}" -I"$out" -DSOLVER_HEADER="\"$c.hpp\"" -DSOLVER=$c "$here/icount.cpp" "$out/$c.o" -o "$out/icount"
     for alg in 0 1; do
       n1000=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$out/icount" 1000 $alg 2>&1 | sed -n 's/.*Collected : //p')
       n0=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$out/icount" 0 $alg 2>&1 | sed -n 's/.*Collected : //p')
