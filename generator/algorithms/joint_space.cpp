@@ -50,8 +50,9 @@ void assemble(const System& sys, Data& d, const VecX& q, const VecX& v) {
 
 void factorLtdl(const std::vector<int>& parent, MatX& H) {
   for (int k = int(parent.size()) - 1; k >= 0; --k) {
+    const double invD = 1.0 / H(k, k);  // one division per dof, not one per ancestor
     for (int i = parent[k]; i >= 0; i = parent[i]) {
-      const double a = H(k, i) / H(k, k);
+      const double a = H(k, i) * invD;
       for (int j = i; j >= 0; j = parent[j]) H(i, j) -= a * H(k, j);
       H(k, i) = a;
     }

@@ -19,18 +19,25 @@ void rowsTimesLinv(const System& sys, Data& d) {
 }
 
 // G = J M^-1 J^T = Y D^-1 Y^T. Rows of two constraints meet only on their
-// common ancestors; walking the first one's chain visits all of them.
+// common ancestors: the walk starts at the deepest dof both chains share
+// (dofs are numbered parents first, so the larger index steps up).
 void delassus(const System& sys, Data& d) {
   const std::vector<int>& parent = d.dofParent;
   const MatX& Y = d.JMinv;
+  d.work.head(sys.model.nv) = d.LD.diagonal().cwiseInverse();  // D^-1
   for (std::size_t a = 0; a < sys.constraints.size(); ++a) {
     const Constraint& ca = sys.constraints[a];
     for (std::size_t b = a; b < sys.constraints.size(); ++b) {
       const Constraint& cb = sys.constraints[b];
+      int common = lastDof(sys.model, ca.body);
+      for (int other = lastDof(sys.model, cb.body); common != other;) {
+        if (common > other) common = parent[common];
+        else other = parent[other];
+      }
       for (int ra = ca.row; ra < ca.row + ca.rows(); ++ra)
         for (int rb = cb.row; rb < cb.row + cb.rows(); ++rb) {
           double g = 0;
-          for (int k = lastDof(sys.model, ca.body); k >= 0; k = parent[k]) g += Y(ra, k) * Y(rb, k) / d.LD(k, k);
+          for (int k = common; k >= 0; k = parent[k]) g += Y(ra, k) * d.work[k] * Y(rb, k);
           d.G(ra, rb) = g;
           d.G(rb, ra) = g;
         }
