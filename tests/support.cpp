@@ -1,7 +1,13 @@
 #include "support.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace proxgen::test {
 
@@ -27,6 +33,51 @@ std::string sourceDir() { return PROXGEN_TEST_SOURCE_DIR; }
 double relErr(const VecX& a, const VecX& b) {
   if (a.size() == 0) return 0.0;
   return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string shellQuoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+ProcessResult runProgram(const std::string& program, const std::vector<std::string>& args) {
+  const TempFile out(".out"), err(".err");
+  std::string cmd = shellQuoted(program);
+  for (const std::string& a : args) cmd += " " + shellQuoted(a);
+  cmd += " >" + shellQuoted(out.path()) + " 2>" + shellQuoted(err.path());
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out.path()), slurp(err.path())};
+}
+
+TempFile::TempFile(const std::string& suffix) {
+  static std::atomic<int> counter{0};
+  path_ = (std::filesystem::temp_directory_path() /
+           ("proxgen_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + suffix))
+              .string();
+}
+
+TempFile::~TempFile() {
+  std::error_code ec;
+  std::filesystem::remove(path_, ec);
+}
+
+const std::string& TempFile::write(const std::string& text) const {
+  std::ofstream(path_, std::ios::binary) << text;
+  return path_;
+}
+
+const std::string& TempFile::sized(std::uintmax_t bytes) const {
+  std::ofstream(path_, std::ios::binary).put('x');
+  std::filesystem::resize_file(path_, bytes);
+  return path_;
 }
 
 }  // namespace proxgen::test

@@ -3,10 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "model/cases.hpp"
+#include "model/error.hpp"
 #include "model/model.hpp"
 #include "model/state.hpp"
 
@@ -39,5 +43,56 @@ double relErr(const VecX& a, const VecX& b);
 
 /// The repository's root (for generated/ and tests/data).
 std::string sourceDir();
+
+// --- files and child processes (the tests that run the `proxgen` binary) -----
+
+/// The whole file as bytes ("" when it cannot be read).
+std::string slurp(const std::filesystem::path& p);
+
+/// `s` in single quotes for /bin/sh, embedded quotes escaped.
+std::string shellQuoted(const std::string& s);
+
+/// How a child process ended and what it printed.
+struct ProcessResult {
+  int code = -1;  // exit status, -1 if it did not exit normally
+  std::string out, err;
+};
+
+/// Runs `program args...` through /bin/sh, stdout and stderr captured in
+/// temporary files (removed afterwards). Every argument is shell-quoted.
+ProcessResult runProgram(const std::string& program, const std::vector<std::string>& args);
+
+/// A file in the temporary folder, unique to this process and object (the name
+/// ends in `suffix`), removed when the object goes.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& suffix);
+  ~TempFile();
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  const std::string& path() const { return path_; }
+  /// Writes `text` (bytes as given); returns the path.
+  const std::string& write(const std::string& text) const;
+  /// A sparse file of `bytes` bytes, for size limits; returns the path.
+  const std::string& sized(std::uintmax_t bytes) const;
+
+ private:
+  std::string path_;
+};
+
+/// The message of the proxgen::Error that `load` must throw ("" otherwise, with a failure).
+template <class Load>
+std::string errorOf(Load&& load) {
+  try {
+    load();
+  } catch (const Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw something other than proxgen::Error: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "accepted the input";
+  return "";
+}
 
 }  // namespace proxgen::test

@@ -4,15 +4,8 @@
 // tests/data/bad; the layouts and states there are read against
 // tests/data/good/arm3.urdf. The last suite runs the `proxgen` binary: exit code
 // non-zero, the message on stderr, nothing on stdout.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <atomic>
-#include <cstdlib>
-#include <filesystem>
 #include <fstream>
 #include <initializer_list>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +17,9 @@
 
 namespace proxgen {
 namespace {
+
+using test::errorOf;
+using test::ProcessResult;
 
 std::string bad(const std::string& file) { return std::string(PROXGEN_TEST_DATA_DIR) + "/bad/" + file; }
 std::string good(const std::string& file) { return std::string(PROXGEN_TEST_DATA_DIR) + "/good/" + file; }
@@ -37,21 +33,6 @@ std::string at(const std::string& path, const std::string& needle) {
     if (line.find(needle) != std::string::npos) return path + ":" + std::to_string(n);
   ADD_FAILURE() << needle << " not in " << path;
   return path;
-}
-
-/// The message of the proxgen::Error that `load` must throw ("" otherwise, with a failure).
-template <class Load>
-std::string errorOf(Load&& load) {
-  try {
-    load();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw something other than proxgen::Error: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "accepted a bad input";
-  return "";
 }
 
 /// The message is one line and holds every part (file, element, what).
@@ -265,42 +246,7 @@ TEST(BadState, BadItemOfAList) {
 
 // --- the binary: exit code, stderr, empty stdout -------------------------------
 
-struct ProcessResult {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string shellQuoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// Runs `proxgen ARGS...` with stdout and stderr captured to temporary files.
-ProcessResult runProxgen(const std::vector<std::string>& args) {
-  static std::atomic<int> counter{0};
-  const auto dir = std::filesystem::temp_directory_path();
-  const std::string tag = "proxgen_bad_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
-  const auto out = dir / (tag + ".out"), err = dir / (tag + ".err");
-  std::string cmd = shellQuoted(PROXGEN_BINARY_PATH);
-  for (const std::string& a : args) cmd += " " + shellQuoted(a);
-  cmd += " >" + shellQuoted(out.string()) + " 2>" + shellQuoted(err.string());
-  const int status = std::system(cmd.c_str());
-  ProcessResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return r;
-}
+ProcessResult runProxgen(const std::vector<std::string>& args) { return test::runProgram(PROXGEN_BINARY_PATH, args); }
 
 /// Exit 1, stdout empty, stderr exactly one "proxgen: error:" line holding every part.
 void expectRefused(const ProcessResult& r, std::initializer_list<std::string> parts) {

@@ -9,15 +9,7 @@
 // bit-identical inputs; the binary prints every double the same round-trip way.
 // Any difference would be a real bug (a different default, a lost digit, a
 // slot in the wrong place), so no tolerance is allowed.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <atomic>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -40,51 +32,10 @@ std::string good(const std::string& file) { return std::string(PROXGEN_TEST_DATA
 
 // --- running the binary ------------------------------------------------------
 
-struct ProcessResult {
-  int code = -1;
-  std::string out, err;
-};
+using test::ProcessResult;
+using test::TempFile;
 
-std::string shellQuoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// A file in the temporary folder, unique to this process, removed at scope exit.
-class TempFile {
- public:
-  explicit TempFile(const std::string& suffix) {
-    static std::atomic<int> counter{0};
-    path_ = (std::filesystem::temp_directory_path() /
-             ("proxgen_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + suffix))
-                .string();
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-  void write(const std::string& text) const { std::ofstream(path_, std::ios::binary) << text; }
-
- private:
-  std::string path_;
-};
-
-ProcessResult runProxgen(const std::vector<std::string>& args) {
-  const TempFile out(".out"), err(".err");
-  std::string cmd = shellQuoted(PROXGEN_BINARY_PATH);
-  for (const std::string& a : args) cmd += " " + shellQuoted(a);
-  cmd += " >" + shellQuoted(out.path()) + " 2>" + shellQuoted(err.path());
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out.path()), slurp(err.path())};
-}
+ProcessResult runProxgen(const std::vector<std::string>& args) { return test::runProgram(PROXGEN_BINARY_PATH, args); }
 
 /// Runs proxgen, expects success, parses stdout as JSON.
 json runJson(const std::vector<std::string>& args) {

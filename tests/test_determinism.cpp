@@ -14,7 +14,6 @@
 #include <filesystem>
 #include <fstream>
 #include <locale>
-#include <sstream>
 #include <string>
 
 #include <sys/wait.h>
@@ -32,12 +31,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kComma = "de_DE.UTF-8";
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 int shell(const std::string& command) {
   const int status = std::system(command.c_str());

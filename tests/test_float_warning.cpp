@@ -7,16 +7,10 @@
 // The expected numbers are derived here from the model (lightest support body, its mass), not
 // copied from the binary's output. Inputs: the repository's example quadruped (always present).
 #include <fmt/format.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -29,41 +23,11 @@ namespace {
 constexpr double kU = 0x1p-24;        // float unit roundoff
 constexpr double kThreshold = 1e-3;   // the warning's criterion on kU * mu / m
 
-struct ProcessResult {
-  int code = -1;
-  std::string out, err;
-};
+using test::ProcessResult;
+using test::slurp;
+using test::TempFile;
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string shellQuoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::filesystem::path tempPath(const std::string& suffix) {
-  static std::atomic<int> counter{0};
-  return std::filesystem::temp_directory_path() /
-         ("proxgen_floatwarn_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + suffix);
-}
-
-ProcessResult runProxgen(const std::vector<std::string>& args) {
-  const std::filesystem::path out = tempPath(".out"), err = tempPath(".err");
-  std::string cmd = shellQuoted(PROXGEN_BINARY_PATH);
-  for (const std::string& a : args) cmd += " " + shellQuoted(a);
-  cmd += " >" + shellQuoted(out.string()) + " 2>" + shellQuoted(err.string());
-  const int status = std::system(cmd.c_str());
-  ProcessResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return r;
-}
+ProcessResult runProxgen(const std::vector<std::string>& args) { return test::runProgram(PROXGEN_BINARY_PATH, args); }
 
 const std::string kUrdf = test::sourceDir() + "/generated/quadruped/quadruped.urdf";
 const std::string kLayout = test::sourceDir() + "/generated/quadruped/layout.yaml";
@@ -71,15 +35,10 @@ const std::string kLayout = test::sourceDir() + "/generated/quadruped/layout.yam
 /// The example's layout with its `mu:` replaced, in a temporary file removed by the fixture.
 class FloatWarning : public ::testing::Test {
  protected:
-  void TearDown() override {
-    for (const auto& p : temps_) std::filesystem::remove(p);
-  }
   std::string layoutWithMu(double mu) {
     const std::string text = std::regex_replace(slurp(kLayout), std::regex("\nmu:[^\n]*"), fmt::format("\nmu: {}", mu));
     EXPECT_NE(text.find(fmt::format("\nmu: {}", mu)), std::string::npos) << "the example layout has no mu line";
-    temps_.push_back(tempPath(".yaml"));
-    std::ofstream(temps_.back()) << text;
-    return temps_.back().string();
+    return temps_.emplace_back(std::make_unique<TempFile>(".yaml"))->write(text);
   }
 
   // The lightest body with mass on the constraint support, from the library.
@@ -98,7 +57,7 @@ class FloatWarning : public ::testing::Test {
   /// mu at which kU * mu / m equals the threshold.
   double muAtThreshold() const { return kThreshold * mass_ / kU; }
 
-  std::vector<std::filesystem::path> temps_;
+  std::vector<std::unique_ptr<TempFile>> temps_;  // removed with the fixture
   double mass_ = 0, layoutMu_ = 0;
   std::string link_;
 };

@@ -4,7 +4,6 @@
 // and commit the result.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <sstream>
 
 #include "emit/generate.hpp"
@@ -12,13 +11,6 @@
 
 namespace proxgen::emit {
 namespace {
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // The first line where two texts differ, for the message.
 std::string firstDifference(const std::string& a, const std::string& b) {
@@ -46,7 +38,7 @@ TEST(GeneratedFresh, CheckedInSolversMatchTheGenerator) {
                                 " --name " + robot;
     for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source}}) {
       const std::string path = dir + "/" + name;
-      const std::string checkedIn = readFile(path);
+      const std::string checkedIn = test::slurp(path);
       EXPECT_EQ(checkedIn, text) << "generated/" << robot << "/" << name << " is stale ("
                                  << firstDifference(checkedIn, text) << ")\nregenerate it with:\n  " << command;
     }

@@ -10,9 +10,7 @@
 #include <limits>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "algorithms/aba.hpp"
@@ -37,54 +35,8 @@ using test::kEps;
 std::string hostile(const std::string& file) { return std::string(PROXGEN_TEST_DATA_DIR) + "/hostile/" + file; }
 std::string good(const std::string& file) { return std::string(PROXGEN_TEST_DATA_DIR) + "/good/" + file; }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// A file in the temporary folder, removed at the end of the test.
-class TempFile {
- public:
-  explicit TempFile(const std::string& stem)
-      : path_((fs::temp_directory_path() / ("proxgen_hardening_" + std::to_string(::getpid()) + "_" + stem)).string()) {}
-  ~TempFile() {
-    std::error_code ec;
-    fs::remove(path_, ec);
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  const std::string& write(const std::string& text) const {
-    std::ofstream(path_, std::ios::binary) << text;
-    return path_;
-  }
-  /// A sparse file of `bytes` zeros: refused by size before it is read.
-  const std::string& sized(std::uintmax_t bytes) const {
-    std::ofstream(path_, std::ios::binary).put('x');
-    fs::resize_file(path_, bytes);
-    return path_;
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-/// The message of the proxgen::Error that `load` must throw ("" otherwise, with a failure).
-template <class Load>
-std::string errorOf(Load&& load) {
-  try {
-    load();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw something other than proxgen::Error: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "accepted the input";
-  return "";
-}
+using test::errorOf;
+using test::TempFile;
 
 // An error message is one line of printable text, bounded whatever the input.
 // The bound: quoted() shows at most 80 characters of a name, each at most as a
@@ -611,8 +563,8 @@ std::string withZeroAxis(const std::string& xml, const std::string& jointStart) 
 }
 
 TEST(HostileNames, MessagesQuotingThemStayOneBoundedLine) {
-  const std::string names = readFile(hostile("names.urdf"));
-  const std::string longNames = readFile(hostile("long_names.urdf"));
+  const std::string names = test::slurp(hostile("names.urdf"));
+  const std::string longNames = test::slurp(hostile("long_names.urdf"));
   // URDF errors naming a joint with newlines, one with a trailing backslash, one of 10 kB.
   std::string m = errorOf([&] { parseUrdf(withZeroAxis(names, "<joint name=\"line1&#10;#include &lt;cstdlib&gt;&#10;\""), "n.urdf", false); });
   expectOneBoundedLine(m, "n.urdf");
@@ -635,7 +587,7 @@ TEST(HostileNames, MessagesQuotingThemStayOneBoundedLine) {
   expectOneBoundedLine(m, "layout.yaml");
 
   // A state keyed by an unknown 10 kB joint name, and one missing a hostile joint.
-  nlohmann::json j = nlohmann::json::parse(readFile(hostile("names_state.json")));
+  nlohmann::json j = nlohmann::json::parse(test::slurp(hostile("names_state.json")));
   j["q"].erase("root_joint");  // the model here has a fixed base
   j["v"].erase("root_joint");
   EXPECT_NO_THROW(stateFromJson(model, j, "state.json"));
