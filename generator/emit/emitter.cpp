@@ -113,8 +113,8 @@ constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"cq", "c
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},
     kL{"L", "Cholesky factor of IA (lower, packed by rows of the upper)"}, kLinv{"Linv", "1 / diag(L)"},
     kUu{"u", "tau - S^T pA"}, kA{"a", "acceleration (gravity-shifted)"}, kDP{"dp", "reduced-sweep force"},
-    kKA{"KA", "constraint force directions of the subtree rows (column-major)"},
-    kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (column-major)"},
+    kKA{"KA", "constraint force directions of the subtree rows (row-major: row r, column j at r m + j)"},
+    kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (row-major)"},
     kK{"k", "constraint right-hand side"};
 
 std::string q(int k) { return fmt::format("q[{}]", k); }
@@ -194,6 +194,8 @@ class Emitter {
   std::vector<Expr> backwardSolve(const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& y);
 
   // functions
+  /// Slots per row of the row-major KA and Z: m columns and one unused slot.
+  static int rowStride(int m) { return m + 1; }
   static constexpr int kPartBudget = 40;  // statements per part (before dead-code removal): measured best
   struct Host {
     std::string name;
@@ -605,6 +607,11 @@ void Emitter::pvRows(int i) {
 // assembles it from KS and KSD = D^-1 KS. The lA recursion gives the rows'
 // free accelerations y_free = K a_free - k: emitPv takes them from a forward
 // pass with lambda = 0 instead (fewer products for many rows).
+// KA is stored row-major: each column goes through the same arithmetic with
+// the same coefficients, so with a row's columns adjacent in memory the
+// compiler packs 2 or 4 columns into one vector instruction (SLP). A row of m
+// columns takes m + 1 slots (rowStride): the unused slot keeps the stores of
+// two rows, which differ in their arithmetic, out of one store group.
 void Emitter::pvRowsOneDof(int i) {
   CodeBuilder& cb = *cb_;
   BodySym& b = bs(i);
@@ -628,7 +635,8 @@ void Emitter::pvRowsOneDof(int i) {
     if (along >= 0) col[std::size_t(along)] = Expr();  // S^T (KA - U D^-1 KS) = 0
     const V6 f = forceToParent(i, col);
     for (int r = 0; r < 6; ++r)
-      par.KA[std::size_t(off + j)][std::size_t(r)] = putQ(kKA, p.parent, 6 * mp, 6 * (off + j) + r, f[std::size_t(r)]);
+      par.KA[std::size_t(off + j)][std::size_t(r)] =
+          putQ(kKA, p.parent, 6 * rowStride(mp), r * rowStride(mp) + off + j, f[std::size_t(r)]);
   }
 }
 
@@ -644,7 +652,8 @@ void Emitter::pvRowsFreeFlyer(int i) {
   for (int j = 0; j < m; ++j) {
     const std::vector<Expr> z =
         forwardSolve(b.L, b.Linv, std::vector<Expr>(b.KA[std::size_t(j)].begin(), b.KA[std::size_t(j)].end()));
-    for (int d = 0; d < 6; ++d) b.Z[std::size_t(j)][std::size_t(d)] = keepQ(kZ, i, 6 * m, 6 * j + d, z[std::size_t(d)]);
+    for (int d = 0; d < 6; ++d)
+      b.Z[std::size_t(j)][std::size_t(d)] = keepQ(kZ, i, 6 * rowStride(m), d * rowStride(m) + j, z[std::size_t(d)]);
   }
 }
 
