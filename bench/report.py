@@ -230,9 +230,10 @@ def summary_table(suite, calls, cases):
     """Generated / generic and generated / Pinocchio, per case, for cABA and proxPV."""
     out = ["## Generated solvers: ratios", "",
            f"Target (anchor-timings.md): generated / Pinocchio at most {TARGET:.2f}, in time and in instructions. "
-           "Pinocchio's times were measured on a quiet machine of this kind, ours on a shared one (load average "
-           "above): the instruction ratios are the ones to hold against the target, the time ratios are "
-           "pessimistic.",
+           "Pinocchio's times were measured on a quiet machine with AVX-512 (a newer processor than the one "
+           "named above), ours on a shared one (load average above): the instruction ratios are the ones to hold "
+           "against the target; the time ratios to Pinocchio carry the difference of machines "
+           "(docs/benchmarks.md, \"This machine and the anchors\"). Generated / generic is measured in this run.",
            "", "| case | nv | m | cABA gen/generic time | Ir | cABA gen/Pinocchio time | Ir | "
            "PV gen/generic time | Ir | PV gen/Pinocchio time | Ir |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     any_generated = False

@@ -2,7 +2,7 @@
 // it folds the penalty mu (a mass) into the inertia of every body on the constraint support,
 // and a float keeps the lightest one's own inertia only to u mu / m (u = 2^-24). The warning
 // fires above u mu / m = 1e-3 (docs/embedded.md, "Float accuracy": the measured float errors of
-// the generated solvers under qemu were 0.05 to 5 times this estimate at mu = 1e4).
+// the generated solvers under qemu were 0.05 to 12 times this estimate at mu = 1e4).
 //
 // The expected numbers are derived here from the model (lightest support body, its mass), not
 // copied from the binary's output. Inputs: the repository's example quadruped (always present).

@@ -162,8 +162,8 @@ std::string summaryText(const System& sys) {
 // mu K^T K (mu is a mass, kg) to the inertia of every body on the constraint support, so in
 // float (unit roundoff u = 2^-24) the lightest one keeps its own inertia only to u mu / m.
 // Measured under qemu on a Cortex-M4F at mu = 1e4, the float constrainedABA's relative error
-// was 0.05 to 5 times this estimate on the twelve project cases; proxPV does not fold mu into
-// inertias and stayed within 6.1e-4. Above 1e-3 (0.1 %) we warn. Massless bodies carry no
+// was 0.05 to 12 times this estimate on the twelve project cases; proxPV does not fold mu into
+// inertias and stayed within 6.1e-4 (3.4e-4 with the emitter of commit 6247c84). Above 1e-3 (0.1 %) we warn. Massless bodies carry no
 // inertia of their own to lose and are skipped.
 constexpr double kFloatUnitRoundoff = 0x1p-24;
 constexpr double kFloatWarnAbove = 1e-3;
@@ -181,7 +181,7 @@ std::string floatAccuracyWarning(const System& sys) {
   return fmt::format(
       "{}: mu = {} and the lightest body on the constraint support is {} ({:.3g} kg): a float solver's "
       "constrained_aba (--scalar float) is expected to lose about 2^-24 * mu / m = {:.1e} relative accuracy "
-      "(measured 0.05 to 5 times that); in float use prox_pv, or mu <= {:.2g} with more iterations, or "
+      "(measured 0.05 to 12 times that); in float use prox_pv, or mu <= {:.2g} with more iterations, or "
       "double (docs/embedded.md, \"Float accuracy\")",
       sys.layoutPath, sys.mu, quoted(sys.model.bodies[light].link), m, estimate, kFloatWarnAbove * m / kFloatUnitRoundoff);
 }
