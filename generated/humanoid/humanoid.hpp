@@ -383,44 +383,44 @@ struct Workspace {
   Scalar a_l_wrist_pitch_link[6]; // acceleration (gravity-shifted), body 21
   Scalar a_neck_link[6];       // acceleration (gravity-shifted), body 23
   Scalar KSD_r_hand[3];        // D^-1 S^T KA, body 31
-  Scalar KA_r_wrist_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 30
+  Scalar KA_r_wrist_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 30
   Scalar KSD_r_wrist_pitch_link[3]; // D^-1 S^T KA, body 30
-  Scalar KA_r_wrist_yaw_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 29
+  Scalar KA_r_wrist_yaw_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 29
   Scalar KSD_r_wrist_yaw_link[3]; // D^-1 S^T KA, body 29
-  Scalar KA_r_forearm[24];     // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 28
+  Scalar KA_r_forearm[24];     // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 28
   Scalar KSD_r_forearm[3];     // D^-1 S^T KA, body 28
-  Scalar KA_r_upper_arm[24];   // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 27
+  Scalar KA_r_upper_arm[24];   // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 27
   Scalar KSD_r_upper_arm[3];   // D^-1 S^T KA, body 27
-  Scalar KA_r_shoulder_roll_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 26
+  Scalar KA_r_shoulder_roll_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 26
   Scalar KSD_r_shoulder_roll_link[3]; // D^-1 S^T KA, body 26
-  Scalar KA_r_shoulder_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 25
+  Scalar KA_r_shoulder_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 25
   Scalar KSD_r_shoulder_pitch_link[3]; // D^-1 S^T KA, body 25
-  Scalar KA_chest[24];         // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 15
+  Scalar KA_chest[24];         // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 15
   Scalar KSD_chest[3];         // D^-1 S^T KA, body 15
-  Scalar KA_abdomen[24];       // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 14
+  Scalar KA_abdomen[24];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 14
   Scalar KSD_abdomen[3];       // D^-1 S^T KA, body 14
-  Scalar KA_pelvis[96];        // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 1
+  Scalar KA_pelvis[96];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
   Scalar KSD_r_foot[6];        // D^-1 S^T KA, body 13
-  Scalar KA_r_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 12
+  Scalar KA_r_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 12
   Scalar KSD_r_ankle_link[6];  // D^-1 S^T KA, body 12
-  Scalar KA_r_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 11
+  Scalar KA_r_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 11
   Scalar KSD_r_shank[6];       // D^-1 S^T KA, body 11
-  Scalar KA_r_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 10
+  Scalar KA_r_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 10
   Scalar KSD_r_thigh[6];       // D^-1 S^T KA, body 10
-  Scalar KA_r_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 9
+  Scalar KA_r_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 9
   Scalar KSD_r_hip_roll_link[6]; // D^-1 S^T KA, body 9
-  Scalar KA_r_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 8
+  Scalar KA_r_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 8
   Scalar KSD_r_hip_yaw_link[6]; // D^-1 S^T KA, body 8
   Scalar KSD_l_foot[6];        // D^-1 S^T KA, body 7
-  Scalar KA_l_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 6
+  Scalar KA_l_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 6
   Scalar KSD_l_ankle_link[6];  // D^-1 S^T KA, body 6
-  Scalar KA_l_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 5
+  Scalar KA_l_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
   Scalar KSD_l_shank[6];       // D^-1 S^T KA, body 5
-  Scalar KA_l_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 4
+  Scalar KA_l_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 4
   Scalar KSD_l_thigh[6];       // D^-1 S^T KA, body 4
-  Scalar KA_l_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 3
+  Scalar KA_l_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 3
   Scalar KSD_l_hip_roll_link[6]; // D^-1 S^T KA, body 3
-  Scalar KA_l_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 2
+  Scalar KA_l_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 2
   Scalar KSD_l_hip_yaw_link[6]; // D^-1 S^T KA, body 2
   Scalar Z_pelvis[96];         // L^-1 KA (row-major), body 1
   Scalar yfree[15];            // free row accelerations (tree order)

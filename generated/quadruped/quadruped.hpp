@@ -198,28 +198,28 @@ struct Workspace {
   Scalar dp_LF_thigh[6];       // reduced-sweep force, body 3
   Scalar dp_LF_hip[6];         // reduced-sweep force, body 2
   Scalar KSD_RH_shank[3];      // D^-1 S^T KA, body 13
-  Scalar KA_RH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 12
+  Scalar KA_RH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 12
   Scalar KSD_RH_thigh[3];      // D^-1 S^T KA, body 12
-  Scalar KA_RH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 11
+  Scalar KA_RH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 11
   Scalar KS_RH_hip[3];         // S^T KA, body 11
   Scalar KSD_RH_hip[3];        // D^-1 S^T KA, body 11
-  Scalar KA_trunk[78];         // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 1
+  Scalar KA_trunk[78];         // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
   Scalar KSD_RF_shank[3];      // D^-1 S^T KA, body 10
-  Scalar KA_RF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 9
+  Scalar KA_RF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 9
   Scalar KSD_RF_thigh[3];      // D^-1 S^T KA, body 9
-  Scalar KA_RF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 8
+  Scalar KA_RF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 8
   Scalar KS_RF_hip[3];         // S^T KA, body 8
   Scalar KSD_RF_hip[3];        // D^-1 S^T KA, body 8
   Scalar KSD_LH_shank[3];      // D^-1 S^T KA, body 7
-  Scalar KA_LH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 6
+  Scalar KA_LH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 6
   Scalar KSD_LH_thigh[3];      // D^-1 S^T KA, body 6
-  Scalar KA_LH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 5
+  Scalar KA_LH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
   Scalar KS_LH_hip[3];         // S^T KA, body 5
   Scalar KSD_LH_hip[3];        // D^-1 S^T KA, body 5
   Scalar KSD_LF_shank[3];      // D^-1 S^T KA, body 4
-  Scalar KA_LF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 3
+  Scalar KA_LF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 3
   Scalar KSD_LF_thigh[3];      // D^-1 S^T KA, body 3
-  Scalar KA_LF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r m + j), body 2
+  Scalar KA_LF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 2
   Scalar KS_LF_hip[3];         // S^T KA, body 2
   Scalar KSD_LF_hip[3];        // D^-1 S^T KA, body 2
   Scalar Z_trunk[78];          // L^-1 KA (row-major), body 1

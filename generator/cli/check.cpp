@@ -162,9 +162,10 @@ std::string summaryText(const System& sys) {
 // mu K^T K (mu is a mass, kg) to the inertia of every body on the constraint support, so in
 // float (unit roundoff u = 2^-24) the lightest one keeps its own inertia only to u mu / m.
 // Measured under qemu on a Cortex-M4F at mu = 1e4, the float constrainedABA's relative error
-// was 0.05 to 12 times this estimate on the twelve project cases; proxPV does not fold mu into
-// inertias and stayed within 6.1e-4 (3.4e-4 with the emitter of commit 6247c84). Above 1e-3 (0.1 %) we warn. Massless bodies carry no
-// inertia of their own to lose and are skipped.
+// was 0.05 to 12 times this estimate on the twelve project cases (the ratio moves with the
+// order of operations); proxPV does not fold mu into inertias and stayed within 6.1e-4.
+// Above 1e-3 (0.1 %) we warn. Massless bodies carry no inertia of their own to lose and are
+// skipped.
 constexpr double kFloatUnitRoundoff = 0x1p-24;
 constexpr double kFloatWarnAbove = 1e-3;
 

@@ -113,7 +113,7 @@ constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"cq", "c
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},
     kL{"L", "Cholesky factor of IA (lower, packed by rows of the upper)"}, kLinv{"Linv", "1 / diag(L)"},
     kUu{"u", "tau - S^T pA"}, kA{"a", "acceleration (gravity-shifted)"}, kDP{"dp", "reduced-sweep force"},
-    kKA{"KA", "constraint force directions of the subtree rows (row-major: row r, column j at r m + j)"},
+    kKA{"KA", "constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j)"},
     kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (row-major)"},
     kK{"k", "constraint right-hand side"};
 
