@@ -63,12 +63,6 @@ std::string layoutYaml(const Layout& L) {
   return y;
 }
 
-const Case& sharedCase(const std::vector<Case>& cases, const std::string& name) {
-  for (const Case& c : cases)
-    if (c.name == name) return c;
-  throw std::runtime_error("no case " + name + " in cases.yaml");
-}
-
 json stateJson(const Model& m, const State& s) {
   return {{"q", configurationToJson(m, s.q)}, {"v", velocityToJson(m, s.v)}, {"tau", velocityToJson(m, s.tau)}};
 }
@@ -200,9 +194,8 @@ TEST(CliCheck, TextNamesEveryBodyAndConstraint) {
 
 TEST(CliCheck, JsonOfTheSharedCases) {
   PROXGEN_REQUIRE_MODELS();
-  const std::vector<Case> cases = test::sharedCases();
   for (const char* name : {"iiwa_h6", "talos_f6x2_h6x2"}) {
-    const Case& c = sharedCase(cases, name);
+    const Case c = loadCase(test::modelPath("cases.yaml"), name);
     const TempFile layout(".yaml");
     layout.write(layoutYaml(c.layout));
     const System sys = loadSystem(c.urdfPath, layout.path());
@@ -226,8 +219,7 @@ TEST(CliEval, SmallArmEveryAlgorithm) {
 
 TEST(CliEval, SoloSameNumbersAsTheLibrary) {
   PROXGEN_REQUIRE_MODELS();
-  const std::vector<Case> cases = test::sharedCases();
-  const Case& c = sharedCase(cases, "solo_f3x2");
+  const Case c = loadCase(test::modelPath("cases.yaml"), "solo_f3x2");
   const TempFile layout(".yaml"), one(".json"), list(".json");
   layout.write(layoutYaml(c.layout));
   const System sys = loadSystem(c.urdfPath, layout.path());
