@@ -328,8 +328,10 @@ void Emitter::jointTransform(int i) {
     return;
   }
   // Revolute: R = c I + s [a]x + (1 - c) a a^T; an axis along +-x/y/z folds to picks of c and s.
-  const Expr s = cb.storeRaw(member(kSin, i, 0, 0), fmt::format("std::sin({})", q(j.idx_q)), {cb.input(q(j.idx_q))});
-  const Expr c = cb.storeRaw(member(kCos, i, 0, 0), fmt::format("std::cos({})", q(j.idx_q)), {cb.input(q(j.idx_q))});
+  const std::string sm = member(kSin, i, 0, 0), cm = member(kCos, i, 0, 0);
+  const std::vector<Expr> sc =
+      cb.storeByCall(fmt::format("proxgen_rt::sincos({}, {}, {});", q(j.idx_q), sm, cm), {sm, cm}, {cb.input(q(j.idx_q))});
+  const Expr &s = sc[0], &c = sc[1];
   const Mat3 K = skew(a), A = a * a.transpose();
   for (int r = 0; r < 3; ++r)
     for (int col = 0; col < 3; ++col) {

@@ -351,6 +351,14 @@ Expr CodeBuilder::refresh(const std::string& member) {
   return Expr::atom(id);
 }
 
+std::vector<Expr> CodeBuilder::storeByCall(const std::string& text, const std::vector<std::string>& members,
+                                           const std::vector<Expr>& uses) {
+  line(text, uses);
+  std::vector<Expr> out;
+  for (const std::string& m : members) out.push_back(refresh(m));
+  return out;
+}
+
 void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses) {
   Stmt s;
   s.text = text;

@@ -109,6 +109,10 @@ class CodeBuilder {
   Expr store(const std::string& member, const Expr& e);
   /// member = rhs; with a raw right-hand side (a function call).
   Expr storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses);
+  /// A raw statement that writes several members (a call with output
+  /// arguments); returns their new values, in order.
+  std::vector<Expr> storeByCall(const std::string& text, const std::vector<std::string>& members,
+                                const std::vector<Expr>& uses);
   /// A raw statement or comment line with the atoms it reads.
   void line(const std::string& text, const std::vector<Expr>& uses = {});
   void comment(const std::string& text);
