@@ -14,15 +14,13 @@ namespace {
 PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    w.sq_shoulder_link = std::sin(q[0]);
-    w.cq_shoulder_link = std::cos(q[0]);
+    proxgen_rt::sincos(q[0], w.sq_shoulder_link, w.cq_shoulder_link);
     w.pA_shoulder_link[1] = 0.0072587300000000006*v[0]*v[0];
     w.pA_shoulder_link[3] = -0.0009936475497000002*v[0]*v[0];
   }
   // body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    w.sq_upper_arm_link = std::sin(q[1]);
-    w.cq_upper_arm_link = std::cos(q[1]);
+    proxgen_rt::sincos(q[1], w.sq_upper_arm_link, w.cq_upper_arm_link);
     w.v_upper_arm_link[3] = v[0]*w.sq_upper_arm_link;
     w.v_upper_arm_link[4] = v[0]*w.cq_upper_arm_link;
     w.c_upper_arm_link[3] = v[1]*w.v_upper_arm_link[4];
@@ -41,8 +39,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    w.sq_forearm_link = std::sin(q[2]);
-    w.cq_forearm_link = std::cos(q[2]);
+    proxgen_rt::sincos(q[2], w.sq_forearm_link, w.cq_forearm_link);
     w.v_forearm_link[0] = -0.425*v[1]*w.sq_forearm_link;
     w.v_forearm_link[1] = -0.425*v[1]*w.cq_forearm_link;
     w.v_forearm_link[2] = 0.425*w.v_upper_arm_link[4];
@@ -73,8 +70,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
-    w.sq_wrist_1_link = std::sin(q[3]);
-    w.cq_wrist_1_link = std::cos(q[3]);
+    proxgen_rt::sincos(q[3], w.sq_wrist_1_link, w.cq_wrist_1_link);
     const Scalar t0 = w.v_forearm_link[1] - 0.3922*w.v_forearm_link[5];
     const Scalar t1 = w.v_forearm_link[2] + 0.3922*w.v_forearm_link[4];
     w.v_wrist_1_link[0] = w.v_forearm_link[0]*w.cq_wrist_1_link + w.sq_wrist_1_link*t0;
@@ -104,8 +100,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    w.sq_wrist_2_link = std::sin(q[4]);
-    w.cq_wrist_2_link = std::cos(q[4]);
+    proxgen_rt::sincos(q[4], w.sq_wrist_2_link, w.cq_wrist_2_link);
     const Scalar t2 = w.v_wrist_1_link[0] + 0.1333*w.v_wrist_1_link[4];
     const Scalar t3 = -w.v_wrist_1_link[1] + 0.1333*w.v_wrist_1_link[3];
     w.v_wrist_2_link[0] = w.cq_wrist_2_link*t2 + w.v_wrist_1_link[2]*w.sq_wrist_2_link;
@@ -138,8 +133,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    w.sq_wrist_3_link = std::sin(q[5]);
-    w.cq_wrist_3_link = std::cos(q[5]);
+    proxgen_rt::sincos(q[5], w.sq_wrist_3_link, w.cq_wrist_3_link);
     const Scalar t0 = w.v_wrist_2_link[0] + 0.0997*w.v_wrist_2_link[4];
     const Scalar t1 = w.v_wrist_2_link[1] - 0.0997*w.v_wrist_2_link[3];
     w.v_wrist_3_link[0] = w.cq_wrist_3_link*t0 - w.v_wrist_2_link[2]*w.sq_wrist_3_link;
@@ -973,9 +967,6 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - pa10 + 0.1333*t9;
     w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa8 + w.cq_wrist_2_link*pa9;
     w.KSD_wrist_2_link[0] = w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
-    w.KSD_wrist_2_link[1] = w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
-    w.KSD_wrist_2_link[3] = w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
-    w.KSD_wrist_2_link[4] = w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
     const Scalar t11 = w.KA_wrist_2_link[0] + 0.057172965000000006*w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
     const Scalar t12 = w.KA_wrist_2_link[28] + 0.0056619090105*w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
     w.KA_wrist_1_link[0] = w.cq_wrist_2_link*t11;
@@ -984,6 +975,7 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_wrist_1_link[21] = 0.1333*w.KA_wrist_2_link[14] + w.cq_wrist_2_link*w.KA_wrist_2_link[21] - w.sq_wrist_2_link*t12;
     w.KA_wrist_1_link[28] = 0.1333*w.cq_wrist_2_link*t11;
     w.KA_wrist_1_link[35] = w.sq_wrist_2_link*w.KA_wrist_2_link[21] + w.cq_wrist_2_link*t12;
+    w.KSD_wrist_2_link[1] = w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
     const Scalar t13 = w.KA_wrist_2_link[1] + 0.057172965000000006*w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
     const Scalar t14 = w.KA_wrist_2_link[29] + 0.0056619090105*w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
     w.KA_wrist_1_link[1] = w.cq_wrist_2_link*t13;
@@ -997,6 +989,7 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_wrist_1_link[23] = -0.0997*w.cq_wrist_2_link;
     w.KA_wrist_1_link[30] = -0.1333*w.sq_wrist_2_link;
     w.KA_wrist_1_link[37] = -0.0997*w.sq_wrist_2_link;
+    w.KSD_wrist_2_link[3] = w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
     const Scalar t15 = 0.057172965000000006*w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
     const Scalar t16 = 0.0056619090105*w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
     w.KA_wrist_1_link[3] = w.cq_wrist_2_link*t15;
@@ -1004,6 +997,7 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_wrist_1_link[24] = w.cq_wrist_2_link*w.KA_wrist_2_link[24] - w.sq_wrist_2_link*t16;
     w.KA_wrist_1_link[31] = 0.1333*w.cq_wrist_2_link*t15;
     w.KA_wrist_1_link[38] = w.sq_wrist_2_link*w.KA_wrist_2_link[24] + w.cq_wrist_2_link*t16;
+    w.KSD_wrist_2_link[4] = w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
     const Scalar t17 = 0.057172965000000006*w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
     const Scalar t18 = 0.0056619090105*w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
     w.KA_wrist_1_link[4] = w.cq_wrist_2_link*t17;
@@ -1104,10 +1098,6 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq_wrist_1_link*pa3 + w.cq_wrist_1_link*pa4;
     w.pA_forearm_link[5] = w.pA_forearm_link[5] + pa5 - 0.3922*t25;
     w.KSD_wrist_1_link[0] = w.KA_wrist_1_link[35]*w.Dinv_wrist_1_link;
-    w.KSD_wrist_1_link[1] = w.KA_wrist_1_link[36]*w.Dinv_wrist_1_link;
-    w.KSD_wrist_1_link[2] = w.KA_wrist_1_link[37]*w.Dinv_wrist_1_link;
-    w.KSD_wrist_1_link[3] = w.KA_wrist_1_link[38]*w.Dinv_wrist_1_link;
-    w.KSD_wrist_1_link[4] = w.KA_wrist_1_link[39]*w.Dinv_wrist_1_link;
     const Scalar t26 = w.KA_wrist_1_link[0] - w.KA_wrist_1_link[35]*t0;
     const Scalar t27 = w.KA_wrist_1_link[7] - w.KA_wrist_1_link[35]*t1;
     const Scalar t28 = w.KA_wrist_1_link[14] - w.KA_wrist_1_link[35]*t2;
@@ -1121,6 +1111,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_forearm_link[21] = w.cq_wrist_1_link*t29 - w.sq_wrist_1_link*t30;
     w.KA_forearm_link[28] = 0.3922*t28 + w.sq_wrist_1_link*t29 + w.cq_wrist_1_link*t30;
     w.KA_forearm_link[35] = -0.3922*t32;
+    w.KSD_wrist_1_link[1] = w.KA_wrist_1_link[36]*w.Dinv_wrist_1_link;
     const Scalar t33 = w.KA_wrist_1_link[1] - w.KA_wrist_1_link[36]*t0;
     const Scalar t34 = w.KA_wrist_1_link[8] - w.KA_wrist_1_link[36]*t1;
     const Scalar t35 = w.KA_wrist_1_link[15] - w.KA_wrist_1_link[36]*t2;
@@ -1134,6 +1125,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_forearm_link[22] = w.cq_wrist_1_link*t36 - w.sq_wrist_1_link*t37;
     w.KA_forearm_link[29] = 0.3922*t35 + w.sq_wrist_1_link*t36 + w.cq_wrist_1_link*t37;
     w.KA_forearm_link[36] = -0.3922*t39;
+    w.KSD_wrist_1_link[2] = w.KA_wrist_1_link[37]*w.Dinv_wrist_1_link;
     const Scalar t40 = w.KA_wrist_1_link[2] - w.KA_wrist_1_link[37]*t0;
     const Scalar t41 = w.KA_wrist_1_link[16] - w.KA_wrist_1_link[37]*t2;
     const Scalar t42 = -w.KA_wrist_1_link[37]*t1;
@@ -1147,6 +1139,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_forearm_link[23] = w.cq_wrist_1_link*t43 - w.sq_wrist_1_link*t44;
     w.KA_forearm_link[30] = 0.3922*t41 + w.sq_wrist_1_link*t43 + w.cq_wrist_1_link*t44;
     w.KA_forearm_link[37] = -0.3922*t46;
+    w.KSD_wrist_1_link[3] = w.KA_wrist_1_link[38]*w.Dinv_wrist_1_link;
     const Scalar t47 = w.KA_wrist_1_link[3] - w.KA_wrist_1_link[38]*t0;
     const Scalar t48 = w.KA_wrist_1_link[17] - w.KA_wrist_1_link[38]*t2;
     const Scalar t49 = -w.KA_wrist_1_link[38]*t1;
@@ -1160,6 +1153,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_forearm_link[24] = w.cq_wrist_1_link*t50 - w.sq_wrist_1_link*t51;
     w.KA_forearm_link[31] = 0.3922*t48 + w.sq_wrist_1_link*t50 + w.cq_wrist_1_link*t51;
     w.KA_forearm_link[38] = -0.3922*t53;
+    w.KSD_wrist_1_link[4] = w.KA_wrist_1_link[39]*w.Dinv_wrist_1_link;
     const Scalar t54 = w.KA_wrist_1_link[4] - w.KA_wrist_1_link[39]*t0;
     const Scalar t55 = w.KA_wrist_1_link[18] - w.KA_wrist_1_link[39]*t2;
     const Scalar t56 = -w.KA_wrist_1_link[39]*t1;
@@ -1265,76 +1259,23 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_upper_arm_link[3] = w.pA_upper_arm_link[3] + w.cq_forearm_link*pa3 - w.sq_forearm_link*pa4;
     w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq_forearm_link*pa3 + w.cq_forearm_link*pa4;
     w.pA_upper_arm_link[5] = w.pA_upper_arm_link[5] + pa5 - 0.425*t22;
-    w.KSD_forearm_link[0] = w.KA_forearm_link[35]*w.Dinv_forearm_link;
-    w.KSD_forearm_link[1] = w.KA_forearm_link[36]*w.Dinv_forearm_link;
-    w.KSD_forearm_link[2] = w.KA_forearm_link[37]*w.Dinv_forearm_link;
-    w.KSD_forearm_link[3] = w.KA_forearm_link[38]*w.Dinv_forearm_link;
-    w.KSD_forearm_link[4] = w.KA_forearm_link[39]*w.Dinv_forearm_link;
-    const Scalar t23 = w.KA_forearm_link[0] - w.KA_forearm_link[35]*t0;
-    const Scalar t24 = w.KA_forearm_link[7] - w.KA_forearm_link[35]*t1;
-    const Scalar t25 = w.KA_forearm_link[14] - w.KA_forearm_link[35]*t2;
-    const Scalar t26 = w.KA_forearm_link[21] - w.KA_forearm_link[35]*t3;
-    const Scalar t27 = w.KA_forearm_link[28] - w.KA_forearm_link[35]*t4;
-    const Scalar t28 = w.cq_forearm_link*t23 - w.sq_forearm_link*t24;
-    const Scalar t29 = w.sq_forearm_link*t23 + w.cq_forearm_link*t24;
-    w.KA_upper_arm_link[0] = t28;
-    w.KA_upper_arm_link[7] = t29;
-    w.KA_upper_arm_link[14] = t25;
-    w.KA_upper_arm_link[21] = w.cq_forearm_link*t26 - w.sq_forearm_link*t27;
-    w.KA_upper_arm_link[28] = 0.425*t25 + w.sq_forearm_link*t26 + w.cq_forearm_link*t27;
-    w.KA_upper_arm_link[35] = -0.425*t29;
-    const Scalar t30 = w.KA_forearm_link[1] - w.KA_forearm_link[36]*t0;
-    const Scalar t31 = w.KA_forearm_link[8] - w.KA_forearm_link[36]*t1;
-    const Scalar t32 = w.KA_forearm_link[15] - w.KA_forearm_link[36]*t2;
-    const Scalar t33 = w.KA_forearm_link[22] - w.KA_forearm_link[36]*t3;
-    const Scalar t34 = w.KA_forearm_link[29] - w.KA_forearm_link[36]*t4;
-    const Scalar t35 = w.cq_forearm_link*t30 - w.sq_forearm_link*t31;
-    const Scalar t36 = w.sq_forearm_link*t30 + w.cq_forearm_link*t31;
-    w.KA_upper_arm_link[1] = t35;
-    w.KA_upper_arm_link[8] = t36;
-    w.KA_upper_arm_link[15] = t32;
-    w.KA_upper_arm_link[22] = w.cq_forearm_link*t33 - w.sq_forearm_link*t34;
-    w.KA_upper_arm_link[29] = 0.425*t32 + w.sq_forearm_link*t33 + w.cq_forearm_link*t34;
-    w.KA_upper_arm_link[36] = -0.425*t36;
-    const Scalar t37 = w.KA_forearm_link[2] - w.KA_forearm_link[37]*t0;
-    const Scalar t38 = w.KA_forearm_link[9] - w.KA_forearm_link[37]*t1;
-    const Scalar t39 = w.KA_forearm_link[16] - w.KA_forearm_link[37]*t2;
-    const Scalar t40 = w.KA_forearm_link[23] - w.KA_forearm_link[37]*t3;
-    const Scalar t41 = w.KA_forearm_link[30] - w.KA_forearm_link[37]*t4;
-    const Scalar t42 = w.cq_forearm_link*t37 - w.sq_forearm_link*t38;
-    const Scalar t43 = w.sq_forearm_link*t37 + w.cq_forearm_link*t38;
-    w.KA_upper_arm_link[2] = t42;
-    w.KA_upper_arm_link[9] = t43;
-    w.KA_upper_arm_link[16] = t39;
-    w.KA_upper_arm_link[23] = w.cq_forearm_link*t40 - w.sq_forearm_link*t41;
-    w.KA_upper_arm_link[30] = 0.425*t39 + w.sq_forearm_link*t40 + w.cq_forearm_link*t41;
-    w.KA_upper_arm_link[37] = -0.425*t43;
-    const Scalar t44 = w.KA_forearm_link[3] - w.KA_forearm_link[38]*t0;
-    const Scalar t45 = w.KA_forearm_link[10] - w.KA_forearm_link[38]*t1;
-    const Scalar t46 = w.KA_forearm_link[17] - w.KA_forearm_link[38]*t2;
-    const Scalar t47 = w.KA_forearm_link[24] - w.KA_forearm_link[38]*t3;
-    const Scalar t48 = w.KA_forearm_link[31] - w.KA_forearm_link[38]*t4;
-    const Scalar t49 = w.cq_forearm_link*t44 - w.sq_forearm_link*t45;
-    const Scalar t50 = w.sq_forearm_link*t44 + w.cq_forearm_link*t45;
-    w.KA_upper_arm_link[3] = t49;
-    w.KA_upper_arm_link[10] = t50;
-    w.KA_upper_arm_link[17] = t46;
-    w.KA_upper_arm_link[24] = w.cq_forearm_link*t47 - w.sq_forearm_link*t48;
-    w.KA_upper_arm_link[31] = 0.425*t46 + w.sq_forearm_link*t47 + w.cq_forearm_link*t48;
-    w.KA_upper_arm_link[38] = -0.425*t50;
-    const Scalar t51 = w.KA_forearm_link[4] - w.KA_forearm_link[39]*t0;
-    const Scalar t52 = w.KA_forearm_link[11] - w.KA_forearm_link[39]*t1;
-    const Scalar t53 = w.KA_forearm_link[18] - w.KA_forearm_link[39]*t2;
-    const Scalar t54 = w.KA_forearm_link[25] - w.KA_forearm_link[39]*t3;
-    const Scalar t55 = w.KA_forearm_link[32] - w.KA_forearm_link[39]*t4;
-    const Scalar t56 = w.cq_forearm_link*t51 - w.sq_forearm_link*t52;
-    const Scalar t57 = w.sq_forearm_link*t51 + w.cq_forearm_link*t52;
-    w.KA_upper_arm_link[4] = t56;
-    w.KA_upper_arm_link[11] = t57;
-    w.KA_upper_arm_link[18] = t53;
-    w.KA_upper_arm_link[25] = w.cq_forearm_link*t54 - w.sq_forearm_link*t55;
-    w.KA_upper_arm_link[32] = 0.425*t53 + w.sq_forearm_link*t54 + w.cq_forearm_link*t55;
-    w.KA_upper_arm_link[39] = -0.425*t57;
+    // columns 0 to 4
+    for (int j = 0; j < 5; ++j) {
+      w.KSD_forearm_link[j] = w.Dinv_forearm_link*w.KA_forearm_link[35 + j];
+      const Scalar t23 = w.KA_forearm_link[j] - t0*w.KA_forearm_link[35 + j];
+      const Scalar t24 = w.KA_forearm_link[7 + j] - t1*w.KA_forearm_link[35 + j];
+      const Scalar t25 = w.KA_forearm_link[14 + j] - t2*w.KA_forearm_link[35 + j];
+      const Scalar t26 = w.KA_forearm_link[21 + j] - t3*w.KA_forearm_link[35 + j];
+      const Scalar t27 = w.KA_forearm_link[28 + j] - t4*w.KA_forearm_link[35 + j];
+      const Scalar t28 = w.cq_forearm_link*t23 - w.sq_forearm_link*t24;
+      const Scalar t29 = w.sq_forearm_link*t23 + w.cq_forearm_link*t24;
+      w.KA_upper_arm_link[j] = t28;
+      w.KA_upper_arm_link[7 + j] = t29;
+      w.KA_upper_arm_link[14 + j] = t25;
+      w.KA_upper_arm_link[21 + j] = w.cq_forearm_link*t26 - w.sq_forearm_link*t27;
+      w.KA_upper_arm_link[28 + j] = 0.425*t25 + w.sq_forearm_link*t26 + w.cq_forearm_link*t27;
+      w.KA_upper_arm_link[35 + j] = -0.425*t29;
+    }
   }
 }
 
@@ -1427,76 +1368,23 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_shoulder_link[3] = w.pA_shoulder_link[3] + 0.1625*pa2 + w.cq_upper_arm_link*pa3 - w.sq_upper_arm_link*pa4;
     w.pA_shoulder_link[4] = -pa5 + 0.1625*t21;
     w.pA_shoulder_link[5] = w.sq_upper_arm_link*pa3 + w.cq_upper_arm_link*pa4;
-    w.KSD_upper_arm_link[0] = w.KA_upper_arm_link[35]*w.Dinv_upper_arm_link;
-    w.KSD_upper_arm_link[1] = w.KA_upper_arm_link[36]*w.Dinv_upper_arm_link;
-    w.KSD_upper_arm_link[2] = w.KA_upper_arm_link[37]*w.Dinv_upper_arm_link;
-    w.KSD_upper_arm_link[3] = w.KA_upper_arm_link[38]*w.Dinv_upper_arm_link;
-    w.KSD_upper_arm_link[4] = w.KA_upper_arm_link[39]*w.Dinv_upper_arm_link;
-    const Scalar t23 = w.KA_upper_arm_link[0] - w.KA_upper_arm_link[35]*t0;
-    const Scalar t24 = w.KA_upper_arm_link[7] - w.KA_upper_arm_link[35]*t1;
-    const Scalar t25 = w.KA_upper_arm_link[14] - w.KA_upper_arm_link[35]*t2;
-    const Scalar t26 = w.KA_upper_arm_link[21] - w.KA_upper_arm_link[35]*t3;
-    const Scalar t27 = w.KA_upper_arm_link[28] - w.KA_upper_arm_link[35]*t4;
-    const Scalar t28 = w.cq_upper_arm_link*t23 - w.sq_upper_arm_link*t24;
-    const Scalar t29 = w.sq_upper_arm_link*t23 + w.cq_upper_arm_link*t24;
-    w.KA_shoulder_link[0] = t28;
-    w.KA_shoulder_link[7] = -t25;
-    w.KA_shoulder_link[14] = t29;
-    w.KA_shoulder_link[21] = 0.1625*t25 + w.cq_upper_arm_link*t26 - w.sq_upper_arm_link*t27;
-    w.KA_shoulder_link[28] = 0.1625*t28;
-    w.KA_shoulder_link[35] = w.sq_upper_arm_link*t26 + w.cq_upper_arm_link*t27;
-    const Scalar t30 = w.KA_upper_arm_link[1] - w.KA_upper_arm_link[36]*t0;
-    const Scalar t31 = w.KA_upper_arm_link[8] - w.KA_upper_arm_link[36]*t1;
-    const Scalar t32 = w.KA_upper_arm_link[15] - w.KA_upper_arm_link[36]*t2;
-    const Scalar t33 = w.KA_upper_arm_link[22] - w.KA_upper_arm_link[36]*t3;
-    const Scalar t34 = w.KA_upper_arm_link[29] - w.KA_upper_arm_link[36]*t4;
-    const Scalar t35 = w.cq_upper_arm_link*t30 - w.sq_upper_arm_link*t31;
-    const Scalar t36 = w.sq_upper_arm_link*t30 + w.cq_upper_arm_link*t31;
-    w.KA_shoulder_link[1] = t35;
-    w.KA_shoulder_link[8] = -t32;
-    w.KA_shoulder_link[15] = t36;
-    w.KA_shoulder_link[22] = 0.1625*t32 + w.cq_upper_arm_link*t33 - w.sq_upper_arm_link*t34;
-    w.KA_shoulder_link[29] = 0.1625*t35;
-    w.KA_shoulder_link[36] = w.sq_upper_arm_link*t33 + w.cq_upper_arm_link*t34;
-    const Scalar t37 = w.KA_upper_arm_link[2] - w.KA_upper_arm_link[37]*t0;
-    const Scalar t38 = w.KA_upper_arm_link[9] - w.KA_upper_arm_link[37]*t1;
-    const Scalar t39 = w.KA_upper_arm_link[16] - w.KA_upper_arm_link[37]*t2;
-    const Scalar t40 = w.KA_upper_arm_link[23] - w.KA_upper_arm_link[37]*t3;
-    const Scalar t41 = w.KA_upper_arm_link[30] - w.KA_upper_arm_link[37]*t4;
-    const Scalar t42 = w.cq_upper_arm_link*t37 - w.sq_upper_arm_link*t38;
-    const Scalar t43 = w.sq_upper_arm_link*t37 + w.cq_upper_arm_link*t38;
-    w.KA_shoulder_link[2] = t42;
-    w.KA_shoulder_link[9] = -t39;
-    w.KA_shoulder_link[16] = t43;
-    w.KA_shoulder_link[23] = 0.1625*t39 + w.cq_upper_arm_link*t40 - w.sq_upper_arm_link*t41;
-    w.KA_shoulder_link[30] = 0.1625*t42;
-    w.KA_shoulder_link[37] = w.sq_upper_arm_link*t40 + w.cq_upper_arm_link*t41;
-    const Scalar t44 = w.KA_upper_arm_link[3] - w.KA_upper_arm_link[38]*t0;
-    const Scalar t45 = w.KA_upper_arm_link[10] - w.KA_upper_arm_link[38]*t1;
-    const Scalar t46 = w.KA_upper_arm_link[17] - w.KA_upper_arm_link[38]*t2;
-    const Scalar t47 = w.KA_upper_arm_link[24] - w.KA_upper_arm_link[38]*t3;
-    const Scalar t48 = w.KA_upper_arm_link[31] - w.KA_upper_arm_link[38]*t4;
-    const Scalar t49 = w.cq_upper_arm_link*t44 - w.sq_upper_arm_link*t45;
-    const Scalar t50 = w.sq_upper_arm_link*t44 + w.cq_upper_arm_link*t45;
-    w.KA_shoulder_link[3] = t49;
-    w.KA_shoulder_link[10] = -t46;
-    w.KA_shoulder_link[17] = t50;
-    w.KA_shoulder_link[24] = 0.1625*t46 + w.cq_upper_arm_link*t47 - w.sq_upper_arm_link*t48;
-    w.KA_shoulder_link[31] = 0.1625*t49;
-    w.KA_shoulder_link[38] = w.sq_upper_arm_link*t47 + w.cq_upper_arm_link*t48;
-    const Scalar t51 = w.KA_upper_arm_link[4] - w.KA_upper_arm_link[39]*t0;
-    const Scalar t52 = w.KA_upper_arm_link[11] - w.KA_upper_arm_link[39]*t1;
-    const Scalar t53 = w.KA_upper_arm_link[18] - w.KA_upper_arm_link[39]*t2;
-    const Scalar t54 = w.KA_upper_arm_link[25] - w.KA_upper_arm_link[39]*t3;
-    const Scalar t55 = w.KA_upper_arm_link[32] - w.KA_upper_arm_link[39]*t4;
-    const Scalar t56 = w.cq_upper_arm_link*t51 - w.sq_upper_arm_link*t52;
-    const Scalar t57 = w.sq_upper_arm_link*t51 + w.cq_upper_arm_link*t52;
-    w.KA_shoulder_link[4] = t56;
-    w.KA_shoulder_link[11] = -t53;
-    w.KA_shoulder_link[18] = t57;
-    w.KA_shoulder_link[25] = 0.1625*t53 + w.cq_upper_arm_link*t54 - w.sq_upper_arm_link*t55;
-    w.KA_shoulder_link[32] = 0.1625*t56;
-    w.KA_shoulder_link[39] = w.sq_upper_arm_link*t54 + w.cq_upper_arm_link*t55;
+    // columns 0 to 4
+    for (int j = 0; j < 5; ++j) {
+      w.KSD_upper_arm_link[j] = w.Dinv_upper_arm_link*w.KA_upper_arm_link[35 + j];
+      const Scalar t23 = w.KA_upper_arm_link[j] - t0*w.KA_upper_arm_link[35 + j];
+      const Scalar t24 = w.KA_upper_arm_link[7 + j] - t1*w.KA_upper_arm_link[35 + j];
+      const Scalar t25 = w.KA_upper_arm_link[14 + j] - t2*w.KA_upper_arm_link[35 + j];
+      const Scalar t26 = w.KA_upper_arm_link[21 + j] - t3*w.KA_upper_arm_link[35 + j];
+      const Scalar t27 = w.KA_upper_arm_link[28 + j] - t4*w.KA_upper_arm_link[35 + j];
+      const Scalar t28 = w.cq_upper_arm_link*t23 - w.sq_upper_arm_link*t24;
+      const Scalar t29 = w.sq_upper_arm_link*t23 + w.cq_upper_arm_link*t24;
+      w.KA_shoulder_link[j] = t28;
+      w.KA_shoulder_link[7 + j] = -t25;
+      w.KA_shoulder_link[14 + j] = t29;
+      w.KA_shoulder_link[21 + j] = 0.1625*t25 + w.cq_upper_arm_link*t26 - w.sq_upper_arm_link*t27;
+      w.KA_shoulder_link[28 + j] = 0.1625*t28;
+      w.KA_shoulder_link[35 + j] = w.sq_upper_arm_link*t26 + w.cq_upper_arm_link*t27;
+    }
   }
 }
 
@@ -1505,11 +1393,10 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
   {
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
     w.u_shoulder_link[0] = -w.pA_shoulder_link[5] + tau[0];
-    w.KSD_shoulder_link[0] = w.KA_shoulder_link[35]*w.Dinv_shoulder_link;
-    w.KSD_shoulder_link[1] = w.KA_shoulder_link[36]*w.Dinv_shoulder_link;
-    w.KSD_shoulder_link[2] = w.KA_shoulder_link[37]*w.Dinv_shoulder_link;
-    w.KSD_shoulder_link[3] = w.KA_shoulder_link[38]*w.Dinv_shoulder_link;
-    w.KSD_shoulder_link[4] = w.KA_shoulder_link[39]*w.Dinv_shoulder_link;
+    // columns 0 to 4
+    for (int j = 0; j < 5; ++j) {
+      w.KSD_shoulder_link[j] = w.Dinv_shoulder_link*w.KA_shoulder_link[35 + j];
+    }
   }
   // free acceleration (lambda = 0): body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
@@ -1558,40 +1445,40 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.Dinv_wrist_1_link*t16;
   }
+  // free acceleration (lambda = 0): body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
+  {
+    const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
+    const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
+    w.a_wrist_2_link[0] = t19;
+    w.a_wrist_2_link[1] = t20;
+    w.a_wrist_2_link[2] = t18;
+    w.a_wrist_2_link[3] = t21;
+    w.a_wrist_2_link[4] = t22;
+    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.Dinv_wrist_2_link*t23;
+  }
 }
 
 PROXGEN_RT_NOINLINE void pv_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
-  {
-    const Scalar t0 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
-    const Scalar t1 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t2 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.sq_wrist_2_link;
-    const Scalar t3 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.cq_wrist_2_link;
-    const Scalar t4 = w.c_wrist_2_link[3] + w.a_wrist_1_link[3]*w.cq_wrist_2_link + w.a_wrist_1_link[5]*w.sq_wrist_2_link;
-    const Scalar t5 = w.c_wrist_2_link[4] - w.a_wrist_1_link[3]*w.sq_wrist_2_link + w.a_wrist_1_link[5]*w.cq_wrist_2_link;
-    const Scalar t6 = 0.005433872322232001*w.a_wrist_1_link[4] + w.u_wrist_2_link[0] + 0.057172965000000006*t2 + 0.0056619090105*t5;
-    w.a_wrist_2_link[0] = t2;
-    w.a_wrist_2_link[1] = t3;
-    w.a_wrist_2_link[2] = t1;
-    w.a_wrist_2_link[3] = t4;
-    w.a_wrist_2_link[4] = t5;
-    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.Dinv_wrist_2_link*t6;
-  }
   // free acceleration (lambda = 0): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t7 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t8 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t9 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t7 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    const Scalar t10 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t7 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    const Scalar t11 = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    const Scalar t12 = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
-    const Scalar t13 = w.u_wrist_3_link[0] - 0.0003695625*w.a_wrist_2_link[4];
-    w.a_wrist_3_link[0] = t9;
-    w.a_wrist_3_link[1] = t10;
-    w.a_wrist_3_link[2] = t8;
-    w.a_wrist_3_link[3] = t11;
-    w.a_wrist_3_link[4] = t12;
-    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.Dinv_wrist_3_link*t13;
+    const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t6 = -0.0003695625*w.a_wrist_2_link[4] + w.u_wrist_3_link[0];
+    w.a_wrist_3_link[0] = t2;
+    w.a_wrist_3_link[1] = t3;
+    w.a_wrist_3_link[2] = t1;
+    w.a_wrist_3_link[3] = t4;
+    w.a_wrist_3_link[4] = t5;
+    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.Dinv_wrist_3_link*t6;
   }
   // free row accelerations y_free = K a - k (tree order)
   {

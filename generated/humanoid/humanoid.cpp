@@ -39,8 +39,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    w.sq_l_hip_yaw_link = std::sin(q[7]);
-    w.cq_l_hip_yaw_link = std::cos(q[7]);
+    proxgen_rt::sincos(q[7], w.sq_l_hip_yaw_link, w.cq_l_hip_yaw_link);
     const Scalar t0 = v[0] - 0.0875*v[5];
     const Scalar t1 = v[2] + 0.0875*v[3];
     const Scalar t2 = 0.08718915247898762*v[1] + 0.9961917745544759*t0;
@@ -77,8 +76,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    w.sq_l_hip_roll_link = std::sin(q[8]);
-    w.cq_l_hip_roll_link = std::cos(q[8]);
+    proxgen_rt::sincos(q[8], w.sq_l_hip_roll_link, w.cq_l_hip_roll_link);
     w.v_l_hip_roll_link[1] = w.v_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
     w.v_l_hip_roll_link[2] = -w.v_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
     w.v_l_hip_roll_link[3] = w.v_l_hip_yaw_link[3] + v[7];
@@ -103,8 +101,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
-    w.sq_l_thigh = std::sin(q[9]);
-    w.cq_l_thigh = std::cos(q[9]);
+    proxgen_rt::sincos(q[9], w.sq_l_thigh, w.cq_l_thigh);
     const Scalar t0 = 0.9950041652780258*w.v_l_hip_yaw_link[0] + 0.09983341664682815*w.v_l_hip_roll_link[2];
     const Scalar t1 = -0.09983341664682815*w.v_l_hip_yaw_link[0] + 0.9950041652780258*w.v_l_hip_roll_link[2];
     const Scalar t2 = 0.9950041652780258*w.v_l_hip_roll_link[3] + 0.09983341664682815*w.v_l_hip_roll_link[5];
@@ -138,8 +135,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
-    w.sq_l_shank = std::sin(q[10]);
-    w.cq_l_shank = std::cos(q[10]);
+    proxgen_rt::sincos(q[10], w.sq_l_shank, w.cq_l_shank);
     const Scalar t0 = w.v_l_thigh[0] - 0.42875*w.v_l_thigh[4];
     const Scalar t1 = w.v_l_hip_roll_link[1] + 0.42875*w.v_l_thigh[3];
     const Scalar t2 = -0.19866933079506124*w.v_l_thigh[2] + 0.9800665778412416*t0;
@@ -173,8 +169,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
-    w.sq_l_ankle_link = std::sin(q[11]);
-    w.cq_l_ankle_link = std::cos(q[11]);
+    proxgen_rt::sincos(q[11], w.sq_l_ankle_link, w.cq_l_ankle_link);
     const Scalar t8 = w.v_l_shank[0] - 0.4305*w.v_l_shank[4];
     const Scalar t9 = w.v_l_shank[1] + 0.4305*w.v_l_shank[3];
     const Scalar t10 = 0.09983341664682815*w.v_l_shank[2] + 0.9950041652780258*t8;
@@ -204,8 +199,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    w.sq_l_foot = std::sin(q[12]);
-    w.cq_l_foot = std::cos(q[12]);
+    proxgen_rt::sincos(q[12], w.sq_l_foot, w.cq_l_foot);
     w.v_l_foot[1] = w.v_l_ankle_link[1]*w.cq_l_foot + w.v_l_ankle_link[2]*w.sq_l_foot;
     w.v_l_foot[2] = -w.v_l_ankle_link[1]*w.sq_l_foot + w.v_l_ankle_link[2]*w.cq_l_foot;
     w.v_l_foot[3] = w.v_l_ankle_link[3] + v[11];
@@ -233,8 +227,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    w.sq_r_hip_yaw_link = std::sin(q[13]);
-    w.cq_r_hip_yaw_link = std::cos(q[13]);
+    proxgen_rt::sincos(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
     const Scalar t0 = v[0] + 0.0875*v[5];
     const Scalar t1 = v[2] - 0.0875*v[3];
     const Scalar t2 = -0.08718915247898762*v[1] + 0.9961917745544759*t0;
@@ -271,8 +264,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    w.sq_r_hip_roll_link = std::sin(q[14]);
-    w.cq_r_hip_roll_link = std::cos(q[14]);
+    proxgen_rt::sincos(q[14], w.sq_r_hip_roll_link, w.cq_r_hip_roll_link);
     w.v_r_hip_roll_link[1] = w.v_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
     w.v_r_hip_roll_link[2] = -w.v_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
     w.v_r_hip_roll_link[3] = w.v_r_hip_yaw_link[3] + v[13];
@@ -297,8 +289,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
-    w.sq_r_thigh = std::sin(q[15]);
-    w.cq_r_thigh = std::cos(q[15]);
+    proxgen_rt::sincos(q[15], w.sq_r_thigh, w.cq_r_thigh);
     const Scalar t0 = 0.9950041652780258*w.v_r_hip_yaw_link[0] + 0.09983341664682815*w.v_r_hip_roll_link[2];
     const Scalar t1 = -0.09983341664682815*w.v_r_hip_yaw_link[0] + 0.9950041652780258*w.v_r_hip_roll_link[2];
     const Scalar t2 = 0.9950041652780258*w.v_r_hip_roll_link[3] + 0.09983341664682815*w.v_r_hip_roll_link[5];
@@ -332,8 +323,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
-    w.sq_r_shank = std::sin(q[16]);
-    w.cq_r_shank = std::cos(q[16]);
+    proxgen_rt::sincos(q[16], w.sq_r_shank, w.cq_r_shank);
     const Scalar t0 = w.v_r_thigh[0] - 0.42875*w.v_r_thigh[4];
     const Scalar t1 = w.v_r_hip_roll_link[1] + 0.42875*w.v_r_thigh[3];
     const Scalar t2 = -0.19866933079506124*w.v_r_thigh[2] + 0.9800665778412416*t0;
@@ -367,8 +357,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
-    w.sq_r_ankle_link = std::sin(q[17]);
-    w.cq_r_ankle_link = std::cos(q[17]);
+    proxgen_rt::sincos(q[17], w.sq_r_ankle_link, w.cq_r_ankle_link);
     const Scalar t8 = w.v_r_shank[0] - 0.4305*w.v_r_shank[4];
     const Scalar t9 = w.v_r_shank[1] + 0.4305*w.v_r_shank[3];
     const Scalar t10 = 0.09983341664682815*w.v_r_shank[2] + 0.9950041652780258*t8;
@@ -398,8 +387,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    w.sq_r_foot = std::sin(q[18]);
-    w.cq_r_foot = std::cos(q[18]);
+    proxgen_rt::sincos(q[18], w.sq_r_foot, w.cq_r_foot);
     w.v_r_foot[1] = w.v_r_ankle_link[1]*w.cq_r_foot + w.v_r_ankle_link[2]*w.sq_r_foot;
     w.v_r_foot[2] = -w.v_r_ankle_link[1]*w.sq_r_foot + w.v_r_ankle_link[2]*w.cq_r_foot;
     w.v_r_foot[3] = w.v_r_ankle_link[3] + v[17];
@@ -427,8 +415,7 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    w.sq_abdomen = std::sin(q[19]);
-    w.cq_abdomen = std::cos(q[19]);
+    proxgen_rt::sincos(q[19], w.sq_abdomen, w.cq_abdomen);
     const Scalar t0 = v[0] + 0.1*v[4];
     const Scalar t1 = v[1] - 0.1*v[3];
     w.v_abdomen[0] = w.cq_abdomen*t0 + w.sq_abdomen*t1;
@@ -458,8 +445,7 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    w.sq_chest = std::sin(q[20]);
-    w.cq_chest = std::cos(q[20]);
+    proxgen_rt::sincos(q[20], w.sq_chest, w.cq_chest);
     const Scalar t0 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
     const Scalar t1 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
     w.v_chest[0] = w.cq_chest*t0 - v[2]*w.sq_chest;
@@ -487,8 +473,7 @@ PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
-    w.sq_l_shoulder_pitch_link = std::sin(q[21]);
-    w.cq_l_shoulder_pitch_link = std::cos(q[21]);
+    proxgen_rt::sincos(q[21], w.sq_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link);
     const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
     const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
@@ -524,8 +509,7 @@ PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
-    w.sq_l_shoulder_roll_link = std::sin(q[22]);
-    w.cq_l_shoulder_roll_link = std::cos(q[22]);
+    proxgen_rt::sincos(q[22], w.sq_l_shoulder_roll_link, w.cq_l_shoulder_roll_link);
     w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.sq_l_shoulder_roll_link;
     w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.cq_l_shoulder_roll_link;
     w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
@@ -548,8 +532,7 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    w.sq_l_upper_arm = std::sin(q[23]);
-    w.cq_l_upper_arm = std::cos(q[23]);
+    proxgen_rt::sincos(q[23], w.sq_l_upper_arm, w.cq_l_upper_arm);
     w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.sq_l_upper_arm;
     w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.cq_l_upper_arm;
     w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[4]*w.sq_l_upper_arm;
@@ -575,8 +558,7 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
-    w.sq_l_forearm = std::sin(q[24]);
-    w.cq_l_forearm = std::cos(q[24]);
+    proxgen_rt::sincos(q[24], w.sq_l_forearm, w.cq_l_forearm);
     const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
     const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -606,8 +588,7 @@ PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
-    w.sq_l_wrist_yaw_link = std::sin(q[25]);
-    w.cq_l_wrist_yaw_link = std::cos(q[25]);
+    proxgen_rt::sincos(q[25], w.sq_l_wrist_yaw_link, w.cq_l_wrist_yaw_link);
     const Scalar t6 = w.v_l_forearm[0] - 0.2555*w.v_l_forearm[4];
     const Scalar t7 = w.v_l_forearm[1] + 0.2555*w.v_l_forearm[3];
     w.v_l_wrist_yaw_link[0] = w.cq_l_wrist_yaw_link*t6 + w.sq_l_wrist_yaw_link*t7;
@@ -635,8 +616,7 @@ PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    w.sq_l_wrist_pitch_link = std::sin(q[26]);
-    w.cq_l_wrist_pitch_link = std::cos(q[26]);
+    proxgen_rt::sincos(q[26], w.sq_l_wrist_pitch_link, w.cq_l_wrist_pitch_link);
     w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq_l_wrist_pitch_link - w.v_l_forearm[2]*w.sq_l_wrist_pitch_link;
     w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq_l_wrist_pitch_link + w.v_l_forearm[2]*w.cq_l_wrist_pitch_link;
     w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq_l_wrist_pitch_link - w.v_l_wrist_yaw_link[5]*w.sq_l_wrist_pitch_link;
@@ -659,8 +639,7 @@ PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
   // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    w.sq_l_hand = std::sin(q[27]);
-    w.cq_l_hand = std::cos(q[27]);
+    proxgen_rt::sincos(q[27], w.sq_l_hand, w.cq_l_hand);
     w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq_l_hand + w.v_l_wrist_pitch_link[2]*w.sq_l_hand;
     w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq_l_hand + w.v_l_wrist_pitch_link[2]*w.cq_l_hand;
     w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
@@ -686,8 +665,7 @@ PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, cons
 PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
-    w.sq_neck_link = std::sin(q[28]);
-    w.cq_neck_link = std::cos(q[28]);
+    proxgen_rt::sincos(q[28], w.sq_neck_link, w.cq_neck_link);
     const Scalar t0 = w.v_chest[0] + 0.29*w.v_chest[4];
     const Scalar t1 = w.v_chest[1] - 0.29*w.v_chest[3];
     w.v_neck_link[0] = w.cq_neck_link*t0 + w.sq_neck_link*t1;
@@ -712,8 +690,7 @@ PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    w.sq_head = std::sin(q[29]);
-    w.cq_head = std::cos(q[29]);
+    proxgen_rt::sincos(q[29], w.sq_head, w.cq_head);
     const Scalar t2 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
     const Scalar t3 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
     w.v_head[0] = w.cq_head*t2 - w.v_chest[2]*w.sq_head;
@@ -742,8 +719,7 @@ PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, cons
 PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    w.sq_r_shoulder_pitch_link = std::sin(q[30]);
-    w.cq_r_shoulder_pitch_link = std::cos(q[30]);
+    proxgen_rt::sincos(q[30], w.sq_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link);
     const Scalar t0 = w.v_chest[0] + 0.254*w.v_chest[4] + 0.19*w.v_chest[5];
     const Scalar t1 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t2 = w.v_chest[2] - 0.19*w.v_chest[3];
@@ -782,8 +758,7 @@ PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
   // body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    w.sq_r_shoulder_roll_link = std::sin(q[31]);
-    w.cq_r_shoulder_roll_link = std::cos(q[31]);
+    proxgen_rt::sincos(q[31], w.sq_r_shoulder_roll_link, w.cq_r_shoulder_roll_link);
     w.v_r_shoulder_roll_link[1] = w.v_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
     w.v_r_shoulder_roll_link[2] = -w.v_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
     w.v_r_shoulder_roll_link[3] = w.v_r_shoulder_pitch_link[3] + v[30];
@@ -811,8 +786,7 @@ PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, cons
 PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    w.sq_r_upper_arm = std::sin(q[32]);
-    w.cq_r_upper_arm = std::cos(q[32]);
+    proxgen_rt::sincos(q[32], w.sq_r_upper_arm, w.cq_r_upper_arm);
     w.v_r_upper_arm[0] = w.v_r_shoulder_pitch_link[0]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
     w.v_r_upper_arm[1] = -w.v_r_shoulder_pitch_link[0]*w.sq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
     w.v_r_upper_arm[3] = w.v_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
@@ -837,8 +811,7 @@ PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    w.sq_r_forearm = std::sin(q[33]);
-    w.cq_r_forearm = std::cos(q[33]);
+    proxgen_rt::sincos(q[33], w.sq_r_forearm, w.cq_r_forearm);
     const Scalar t0 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
     const Scalar t1 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -875,8 +848,7 @@ PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, cons
 PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    w.sq_r_wrist_yaw_link = std::sin(q[34]);
-    w.cq_r_wrist_yaw_link = std::cos(q[34]);
+    proxgen_rt::sincos(q[34], w.sq_r_wrist_yaw_link, w.cq_r_wrist_yaw_link);
     const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
     const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
     w.v_r_wrist_yaw_link[0] = w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
@@ -903,8 +875,7 @@ PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
   // body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    w.sq_r_wrist_pitch_link = std::sin(q[35]);
-    w.cq_r_wrist_pitch_link = std::cos(q[35]);
+    proxgen_rt::sincos(q[35], w.sq_r_wrist_pitch_link, w.cq_r_wrist_pitch_link);
     w.v_r_wrist_pitch_link[0] = w.v_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.v_r_forearm[2]*w.sq_r_wrist_pitch_link;
     w.v_r_wrist_pitch_link[2] = w.v_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.v_r_forearm[2]*w.cq_r_wrist_pitch_link;
     w.v_r_wrist_pitch_link[3] = w.v_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.v_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
@@ -932,8 +903,7 @@ PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, cons
 PROXGEN_RT_NOINLINE void kinematics_15(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    w.sq_r_hand = std::sin(q[36]);
-    w.cq_r_hand = std::cos(q[36]);
+    proxgen_rt::sincos(q[36], w.sq_r_hand, w.cq_r_hand);
     w.v_r_hand[1] = w.v_r_wrist_yaw_link[1]*w.cq_r_hand + w.v_r_wrist_pitch_link[2]*w.sq_r_hand;
     w.v_r_hand[2] = -w.v_r_wrist_yaw_link[1]*w.sq_r_hand + w.v_r_wrist_pitch_link[2]*w.cq_r_hand;
     w.v_r_hand[3] = w.v_r_wrist_pitch_link[3] + v[35];
@@ -4963,10 +4933,10 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*pa9 + w.sq_r_wrist_pitch_link*pa11;
     w.pA_r_wrist_yaw_link[4] = w.pA_r_wrist_yaw_link[4] + pa10;
     w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq_r_wrist_pitch_link*pa9 + w.cq_r_wrist_pitch_link*pa11;
-    w.KSD_r_wrist_pitch_link[1] = w.KA_r_wrist_pitch_link[17]*w.Dinv_r_wrist_pitch_link;
     w.KA_r_wrist_yaw_link[0] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[8];
     w.KA_r_wrist_yaw_link[4] = w.KA_r_wrist_pitch_link[4];
     w.KA_r_wrist_yaw_link[8] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[8];
+    w.KSD_r_wrist_pitch_link[1] = w.KA_r_wrist_pitch_link[17]*w.Dinv_r_wrist_pitch_link;
     const Scalar t6 = -1.0 - w.KA_r_wrist_pitch_link[17]*t2;
     const Scalar t7 = w.KA_r_wrist_pitch_link[21] - w.KA_r_wrist_pitch_link[17]*t4;
     w.KA_r_wrist_yaw_link[1] = w.cq_r_wrist_pitch_link*t6;
@@ -5053,7 +5023,6 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa3 - w.sq_r_wrist_yaw_link*pa4 + 0.2555*t22;
     w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa3 + w.cq_r_wrist_yaw_link*pa4 - 0.2555*t21;
     w.pA_r_forearm[5] = w.pA_r_forearm[5] + pa5;
-    w.KSD_r_wrist_yaw_link[1] = w.KA_r_wrist_yaw_link[21]*w.Dinv_r_wrist_yaw_link;
     const Scalar t23 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[4];
     const Scalar t24 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[4];
     w.KA_r_forearm[0] = t23;
@@ -5061,6 +5030,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_forearm[8] = w.KA_r_wrist_yaw_link[8];
     w.KA_r_forearm[12] = 0.2555*t24;
     w.KA_r_forearm[16] = -0.2555*t23;
+    w.KSD_r_wrist_yaw_link[1] = w.KA_r_wrist_yaw_link[21]*w.Dinv_r_wrist_yaw_link;
     const Scalar t25 = w.KA_r_wrist_yaw_link[1] - w.KA_r_wrist_yaw_link[21]*t0;
     const Scalar t26 = w.KA_r_wrist_yaw_link[9] - w.KA_r_wrist_yaw_link[21]*t2;
     const Scalar t27 = -w.KA_r_wrist_yaw_link[21]*t1;
@@ -5180,8 +5150,6 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_upper_arm[4] = w.pA_r_upper_arm[4] + pa4 - 0.3255*t39;
     w.pA_r_upper_arm[5] = w.pA_r_upper_arm[5] + 0.29552020666133966*t37 + 0.955336489125606*t38;
     w.KSD_r_forearm[0] = w.KA_r_forearm[16]*w.Dinv_r_forearm;
-    w.KSD_r_forearm[1] = w.KA_r_forearm[17]*w.Dinv_r_forearm;
-    w.KSD_r_forearm[2] = w.KA_r_forearm[18]*w.Dinv_r_forearm;
     const Scalar t41 = w.KA_r_forearm[0] - w.KA_r_forearm[16]*t0;
     const Scalar t42 = w.KA_r_forearm[4] - w.KA_r_forearm[16]*t1;
     const Scalar t43 = w.KA_r_forearm[8] - w.KA_r_forearm[16]*t2;
@@ -5196,6 +5164,7 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_upper_arm[12] = 0.3255*t42 + 0.955336489125606*w.cq_r_forearm*t44 + 0.29552020666133966*w.sq_r_forearm*t44;
     w.KA_r_upper_arm[16] = -0.3255*t47;
     w.KA_r_upper_arm[20] = 0.29552020666133966*w.cq_r_forearm*t44 - 0.955336489125606*w.sq_r_forearm*t44;
+    w.KSD_r_forearm[1] = w.KA_r_forearm[17]*w.Dinv_r_forearm;
     const Scalar t49 = w.KA_r_forearm[1] - w.KA_r_forearm[17]*t0;
     const Scalar t50 = w.KA_r_forearm[5] - w.KA_r_forearm[17]*t1;
     const Scalar t51 = w.KA_r_forearm[9] - w.KA_r_forearm[17]*t2;
@@ -5210,6 +5179,7 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_upper_arm[13] = 0.3255*t50 + 0.955336489125606*w.cq_r_forearm*t52 + 0.29552020666133966*w.sq_r_forearm*t52;
     w.KA_r_upper_arm[17] = -0.3255*t55;
     w.KA_r_upper_arm[21] = 0.29552020666133966*w.cq_r_forearm*t52 - 0.955336489125606*w.sq_r_forearm*t52;
+    w.KSD_r_forearm[2] = w.KA_r_forearm[18]*w.Dinv_r_forearm;
     const Scalar t57 = w.KA_r_forearm[2] - w.KA_r_forearm[18]*t0;
     const Scalar t58 = w.KA_r_forearm[6] - w.KA_r_forearm[18]*t1;
     const Scalar t59 = w.KA_r_forearm[10] - w.KA_r_forearm[18]*t2;
@@ -5296,8 +5266,6 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
     w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + pa5;
     w.KSD_r_upper_arm[0] = w.KA_r_upper_arm[20]*w.Dinv_r_upper_arm;
-    w.KSD_r_upper_arm[1] = w.KA_r_upper_arm[21]*w.Dinv_r_upper_arm;
-    w.KSD_r_upper_arm[2] = w.KA_r_upper_arm[22]*w.Dinv_r_upper_arm;
     const Scalar t8 = w.KA_r_upper_arm[0] - w.KA_r_upper_arm[20]*t0;
     const Scalar t9 = w.KA_r_upper_arm[4] - w.KA_r_upper_arm[20]*t1;
     const Scalar t10 = w.KA_r_upper_arm[8] - w.KA_r_upper_arm[20]*t2;
@@ -5308,6 +5276,7 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shoulder_roll_link[8] = t10;
     w.KA_r_shoulder_roll_link[12] = w.cq_r_upper_arm*t11 - w.sq_r_upper_arm*t12;
     w.KA_r_shoulder_roll_link[16] = w.sq_r_upper_arm*t11 + w.cq_r_upper_arm*t12;
+    w.KSD_r_upper_arm[1] = w.KA_r_upper_arm[21]*w.Dinv_r_upper_arm;
     const Scalar t13 = w.KA_r_upper_arm[1] - w.KA_r_upper_arm[21]*t0;
     const Scalar t14 = w.KA_r_upper_arm[5] - w.KA_r_upper_arm[21]*t1;
     const Scalar t15 = w.KA_r_upper_arm[9] - w.KA_r_upper_arm[21]*t2;
@@ -5318,6 +5287,7 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shoulder_roll_link[9] = t15;
     w.KA_r_shoulder_roll_link[13] = w.cq_r_upper_arm*t16 - w.sq_r_upper_arm*t17;
     w.KA_r_shoulder_roll_link[17] = w.sq_r_upper_arm*t16 + w.cq_r_upper_arm*t17;
+    w.KSD_r_upper_arm[2] = w.KA_r_upper_arm[22]*w.Dinv_r_upper_arm;
     const Scalar t18 = w.KA_r_upper_arm[2] - w.KA_r_upper_arm[22]*t0;
     const Scalar t19 = w.KA_r_upper_arm[6] - w.KA_r_upper_arm[22]*t1;
     const Scalar t20 = w.KA_r_upper_arm[10] - w.KA_r_upper_arm[22]*t2;
@@ -5389,8 +5359,6 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa4 - w.sq_r_shoulder_roll_link*pa5;
     w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa4 + w.cq_r_shoulder_roll_link*pa5;
     w.KSD_r_shoulder_roll_link[0] = w.KA_r_shoulder_roll_link[12]*w.Dinv_r_shoulder_roll_link;
-    w.KSD_r_shoulder_roll_link[1] = w.KA_r_shoulder_roll_link[13]*w.Dinv_r_shoulder_roll_link;
-    w.KSD_r_shoulder_roll_link[2] = w.KA_r_shoulder_roll_link[14]*w.Dinv_r_shoulder_roll_link;
     const Scalar t6 = w.KA_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[12]*t0;
     const Scalar t7 = w.KA_r_shoulder_roll_link[4] - w.KA_r_shoulder_roll_link[12]*t1;
     const Scalar t8 = w.KA_r_shoulder_roll_link[8] - w.KA_r_shoulder_roll_link[12]*t2;
@@ -5400,6 +5368,7 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shoulder_pitch_link[8] = w.sq_r_shoulder_roll_link*t7 + w.cq_r_shoulder_roll_link*t8;
     w.KA_r_shoulder_pitch_link[16] = w.cq_r_shoulder_roll_link*t9;
     w.KA_r_shoulder_pitch_link[20] = w.sq_r_shoulder_roll_link*t9;
+    w.KSD_r_shoulder_roll_link[1] = w.KA_r_shoulder_roll_link[13]*w.Dinv_r_shoulder_roll_link;
     const Scalar t10 = w.KA_r_shoulder_roll_link[1] - w.KA_r_shoulder_roll_link[13]*t0;
     const Scalar t11 = w.KA_r_shoulder_roll_link[5] - w.KA_r_shoulder_roll_link[13]*t1;
     const Scalar t12 = w.KA_r_shoulder_roll_link[9] - w.KA_r_shoulder_roll_link[13]*t2;
@@ -5409,6 +5378,7 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shoulder_pitch_link[9] = w.sq_r_shoulder_roll_link*t11 + w.cq_r_shoulder_roll_link*t12;
     w.KA_r_shoulder_pitch_link[17] = w.cq_r_shoulder_roll_link*t13;
     w.KA_r_shoulder_pitch_link[21] = w.sq_r_shoulder_roll_link*t13;
+    w.KSD_r_shoulder_roll_link[2] = w.KA_r_shoulder_roll_link[14]*w.Dinv_r_shoulder_roll_link;
     const Scalar t14 = w.KA_r_shoulder_roll_link[2] - w.KA_r_shoulder_roll_link[14]*t0;
     const Scalar t15 = w.KA_r_shoulder_roll_link[6] - w.KA_r_shoulder_roll_link[14]*t1;
     const Scalar t16 = w.KA_r_shoulder_roll_link[10] - w.KA_r_shoulder_roll_link[14]*t2;
@@ -5534,8 +5504,6 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_chest[4] = w.pA_chest[4] + 0.9659256678396477*pa4 + 0.2588196364430848*t51 + 0.254*t52;
     w.pA_chest[5] = w.pA_chest[5] - 0.2548890642384102*pa4 + 0.17361575258114187*t50 + 0.9512566085906322*t51 + 0.19*t52;
     w.KSD_r_shoulder_pitch_link[0] = w.KA_r_shoulder_pitch_link[16]*w.Dinv_r_shoulder_pitch_link;
-    w.KSD_r_shoulder_pitch_link[1] = w.KA_r_shoulder_pitch_link[17]*w.Dinv_r_shoulder_pitch_link;
-    w.KSD_r_shoulder_pitch_link[2] = w.KA_r_shoulder_pitch_link[18]*w.Dinv_r_shoulder_pitch_link;
     const Scalar t55 = w.KA_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[16]*t0;
     const Scalar t56 = w.KA_r_shoulder_pitch_link[4] - w.KA_r_shoulder_pitch_link[16]*t1;
     const Scalar t57 = w.KA_r_shoulder_pitch_link[8] - w.KA_r_shoulder_pitch_link[16]*t2;
@@ -5551,6 +5519,7 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_chest[12] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t58 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t58 - 0.254*t62 - 0.19*t63;
     w.KA_chest[16] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t58 + 0.254*t61;
     w.KA_chest[20] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t58 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t58 + 0.19*t61;
+    w.KSD_r_shoulder_pitch_link[1] = w.KA_r_shoulder_pitch_link[17]*w.Dinv_r_shoulder_pitch_link;
     const Scalar t64 = w.KA_r_shoulder_pitch_link[1] - w.KA_r_shoulder_pitch_link[17]*t0;
     const Scalar t65 = w.KA_r_shoulder_pitch_link[5] - w.KA_r_shoulder_pitch_link[17]*t1;
     const Scalar t66 = w.KA_r_shoulder_pitch_link[9] - w.KA_r_shoulder_pitch_link[17]*t2;
@@ -5566,6 +5535,7 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_chest[13] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t67 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t67 - 0.254*t71 - 0.19*t72;
     w.KA_chest[17] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t67 + 0.254*t70;
     w.KA_chest[21] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t67 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t67 + 0.19*t70;
+    w.KSD_r_shoulder_pitch_link[2] = w.KA_r_shoulder_pitch_link[18]*w.Dinv_r_shoulder_pitch_link;
     const Scalar t73 = w.KA_r_shoulder_pitch_link[2] - w.KA_r_shoulder_pitch_link[18]*t0;
     const Scalar t74 = w.KA_r_shoulder_pitch_link[6] - w.KA_r_shoulder_pitch_link[18]*t1;
     const Scalar t75 = w.KA_r_shoulder_pitch_link[10] - w.KA_r_shoulder_pitch_link[18]*t2;
@@ -5674,8 +5644,6 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_abdomen[4] = w.pA_abdomen[4] + pa4 + 0.15*t21;
     w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq_chest*pa3 + w.cq_chest*pa5;
     w.KSD_chest[0] = w.KA_chest[16]*w.Dinv_chest;
-    w.KSD_chest[1] = w.KA_chest[17]*w.Dinv_chest;
-    w.KSD_chest[2] = w.KA_chest[18]*w.Dinv_chest;
     const Scalar t23 = w.KA_chest[0] - w.KA_chest[16]*t0;
     const Scalar t24 = w.KA_chest[4] - w.KA_chest[16]*t1;
     const Scalar t25 = w.KA_chest[8] - w.KA_chest[16]*t2;
@@ -5689,6 +5657,7 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_abdomen[12] = -0.15*t24 + w.cq_chest*t26 + w.sq_chest*t27;
     w.KA_abdomen[16] = 0.15*t28;
     w.KA_abdomen[20] = -w.sq_chest*t26 + w.cq_chest*t27;
+    w.KSD_chest[1] = w.KA_chest[17]*w.Dinv_chest;
     const Scalar t30 = w.KA_chest[1] - w.KA_chest[17]*t0;
     const Scalar t31 = w.KA_chest[5] - w.KA_chest[17]*t1;
     const Scalar t32 = w.KA_chest[9] - w.KA_chest[17]*t2;
@@ -5702,6 +5671,7 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_abdomen[13] = -0.15*t31 + w.cq_chest*t33 + w.sq_chest*t34;
     w.KA_abdomen[17] = 0.15*t35;
     w.KA_abdomen[21] = -w.sq_chest*t33 + w.cq_chest*t34;
+    w.KSD_chest[2] = w.KA_chest[18]*w.Dinv_chest;
     const Scalar t37 = w.KA_chest[2] - w.KA_chest[18]*t0;
     const Scalar t38 = w.KA_chest[6] - w.KA_chest[18]*t1;
     const Scalar t39 = w.KA_chest[10] - w.KA_chest[18]*t2;
@@ -5805,8 +5775,6 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq_abdomen*pa3 + w.cq_abdomen*pa4 + 0.1*t24;
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5;
     w.KSD_abdomen[0] = w.KA_abdomen[20]*w.Dinv_abdomen;
-    w.KSD_abdomen[1] = w.KA_abdomen[21]*w.Dinv_abdomen;
-    w.KSD_abdomen[2] = w.KA_abdomen[22]*w.Dinv_abdomen;
     const Scalar t26 = w.KA_abdomen[0] - w.KA_abdomen[20]*t0;
     const Scalar t27 = w.KA_abdomen[4] - w.KA_abdomen[20]*t1;
     const Scalar t28 = w.KA_abdomen[8] - w.KA_abdomen[20]*t2;
@@ -5819,6 +5787,7 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_pelvis[44] = t28;
     w.KA_pelvis[60] = w.cq_abdomen*t29 - w.sq_abdomen*t30 - 0.1*t32;
     w.KA_pelvis[76] = w.sq_abdomen*t29 + w.cq_abdomen*t30 + 0.1*t31;
+    w.KSD_abdomen[1] = w.KA_abdomen[21]*w.Dinv_abdomen;
     const Scalar t33 = w.KA_abdomen[1] - w.KA_abdomen[21]*t0;
     const Scalar t34 = w.KA_abdomen[5] - w.KA_abdomen[21]*t1;
     const Scalar t35 = w.KA_abdomen[9] - w.KA_abdomen[21]*t2;
@@ -5831,6 +5800,7 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_pelvis[45] = t35;
     w.KA_pelvis[61] = w.cq_abdomen*t36 - w.sq_abdomen*t37 - 0.1*t39;
     w.KA_pelvis[77] = w.sq_abdomen*t36 + w.cq_abdomen*t37 + 0.1*t38;
+    w.KSD_abdomen[2] = w.KA_abdomen[22]*w.Dinv_abdomen;
     const Scalar t40 = w.KA_abdomen[2] - w.KA_abdomen[22]*t0;
     const Scalar t41 = w.KA_abdomen[6] - w.KA_abdomen[22]*t1;
     const Scalar t42 = w.KA_abdomen[10] - w.KA_abdomen[22]*t2;
@@ -5885,9 +5855,9 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_ankle_link[3] = pa3;
     w.pA_r_ankle_link[4] = w.cq_r_foot*pa4 - w.sq_r_foot*pa5;
     w.pA_r_ankle_link[5] = w.sq_r_foot*pa4 + w.cq_r_foot*pa5;
-    w.KSD_r_foot[1] = 0.06825*w.Dinv_r_foot;
     w.KA_r_ankle_link[28] = -0.06825*w.cq_r_foot;
     w.KA_r_ankle_link[35] = -0.06825*w.sq_r_foot;
+    w.KSD_r_foot[1] = 0.06825*w.Dinv_r_foot;
     const Scalar t2 = 1.0 - 0.001905028125*w.Dinv_r_foot;
     w.KA_r_ankle_link[8] = w.cq_r_foot*t2;
     w.KA_r_ankle_link[15] = w.sq_r_foot*t2;
@@ -6004,10 +5974,6 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shank[4] = w.pA_r_shank[4] + pa4 - 0.4305*t41;
     w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
     w.KSD_r_ankle_link[0] = w.KA_r_ankle_link[28]*w.Dinv_r_ankle_link;
-    w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[29]*w.Dinv_r_ankle_link;
-    w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[31]*w.Dinv_r_ankle_link;
-    w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[32]*w.Dinv_r_ankle_link;
-    w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[33]*w.Dinv_r_ankle_link;
     const Scalar t43 = 1.0 - w.KA_r_ankle_link[28]*t0;
     const Scalar t44 = -w.KA_r_ankle_link[28]*t2;
     const Scalar t45 = w.KA_r_ankle_link[35] - w.KA_r_ankle_link[28]*t4;
@@ -6021,6 +5987,7 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shank[21] = -0.4305*w.KA_r_ankle_link[28]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t45 - 0.09983341664682815*w.cq_r_ankle_link*t45;
     w.KA_r_shank[28] = -0.4305*t48;
     w.KA_r_shank[35] = 0.09983341664682815*w.sq_r_ankle_link*t45 + 0.9950041652780258*w.cq_r_ankle_link*t45;
+    w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[29]*w.Dinv_r_ankle_link;
     const Scalar t50 = w.KA_r_ankle_link[8] - w.KA_r_ankle_link[29]*t1;
     const Scalar t51 = w.KA_r_ankle_link[15] - w.KA_r_ankle_link[29]*t2;
     const Scalar t52 = -w.KA_r_ankle_link[29]*t0;
@@ -6042,6 +6009,7 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shank[16] = t59;
     w.KA_r_shank[23] = 0.4305*w.KA_r_ankle_link[9];
     w.KA_r_shank[30] = -0.4305*t58;
+    w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[31]*w.Dinv_r_ankle_link;
     const Scalar t60 = w.KA_r_ankle_link[10] - w.KA_r_ankle_link[31]*t1;
     const Scalar t61 = w.KA_r_ankle_link[17] - w.KA_r_ankle_link[31]*t2;
     const Scalar t62 = -w.KA_r_ankle_link[31]*t0;
@@ -6056,6 +6024,7 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shank[24] = 0.4305*t60 + 0.9950041652780258*w.sq_r_ankle_link*t63 - 0.09983341664682815*w.cq_r_ankle_link*t63;
     w.KA_r_shank[31] = -0.4305*t66;
     w.KA_r_shank[38] = 0.09983341664682815*w.sq_r_ankle_link*t63 + 0.9950041652780258*w.cq_r_ankle_link*t63;
+    w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[32]*w.Dinv_r_ankle_link;
     const Scalar t68 = -w.KA_r_ankle_link[32]*t0;
     const Scalar t69 = -w.KA_r_ankle_link[32]*t2;
     const Scalar t70 = w.KA_r_ankle_link[39] - w.KA_r_ankle_link[32]*t4;
@@ -6069,6 +6038,7 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_r_shank[25] = -0.4305*w.KA_r_ankle_link[32]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t70 - 0.09983341664682815*w.cq_r_ankle_link*t70;
     w.KA_r_shank[32] = -0.4305*t73;
     w.KA_r_shank[39] = 0.09983341664682815*w.sq_r_ankle_link*t70 + 0.9950041652780258*w.cq_r_ankle_link*t70;
+    w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[33]*w.Dinv_r_ankle_link;
     const Scalar t75 = -w.KA_r_ankle_link[33]*t0;
     const Scalar t76 = -w.KA_r_ankle_link[33]*t2;
     const Scalar t77 = w.KA_r_ankle_link[40] - w.KA_r_ankle_link[33]*t4;
@@ -6196,11 +6166,6 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_thigh[4] = w.pA_r_thigh[4] + pa4 - 0.42875*t43;
     w.pA_r_thigh[5] = w.pA_r_thigh[5] - 0.19866933079506124*t41 + 0.9800665778412416*t42;
     w.KSD_r_shank[0] = w.KA_r_shank[28]*w.Dinv_r_shank;
-    w.KSD_r_shank[1] = w.KA_r_shank[29]*w.Dinv_r_shank;
-    w.KSD_r_shank[2] = w.KA_r_shank[30]*w.Dinv_r_shank;
-    w.KSD_r_shank[3] = w.KA_r_shank[31]*w.Dinv_r_shank;
-    w.KSD_r_shank[4] = w.KA_r_shank[32]*w.Dinv_r_shank;
-    w.KSD_r_shank[5] = w.KA_r_shank[33]*w.Dinv_r_shank;
     const Scalar t45 = w.KA_r_shank[0] - w.KA_r_shank[28]*t0;
     const Scalar t46 = w.KA_r_shank[7] - w.KA_r_shank[28]*t1;
     const Scalar t47 = w.KA_r_shank[14] - w.KA_r_shank[28]*t2;
@@ -6218,6 +6183,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_r_thigh[21] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
     w.KA_r_thigh[28] = -0.42875*t54;
     w.KA_r_thigh[35] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
+    w.KSD_r_shank[1] = w.KA_r_shank[29]*w.Dinv_r_shank;
     const Scalar t56 = w.KA_r_shank[1] - w.KA_r_shank[29]*t0;
     const Scalar t57 = w.KA_r_shank[8] - w.KA_r_shank[29]*t1;
     const Scalar t58 = w.KA_r_shank[15] - w.KA_r_shank[29]*t2;
@@ -6235,6 +6201,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_r_thigh[22] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
     w.KA_r_thigh[29] = -0.42875*t65;
     w.KA_r_thigh[36] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
+    w.KSD_r_shank[2] = w.KA_r_shank[30]*w.Dinv_r_shank;
     const Scalar t67 = w.KA_r_shank[2] - w.KA_r_shank[30]*t0;
     const Scalar t68 = w.KA_r_shank[9] - w.KA_r_shank[30]*t1;
     const Scalar t69 = w.KA_r_shank[16] - w.KA_r_shank[30]*t2;
@@ -6252,6 +6219,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_r_thigh[23] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
     w.KA_r_thigh[30] = -0.42875*t76;
     w.KA_r_thigh[37] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
+    w.KSD_r_shank[3] = w.KA_r_shank[31]*w.Dinv_r_shank;
     const Scalar t78 = w.KA_r_shank[3] - w.KA_r_shank[31]*t0;
     const Scalar t79 = w.KA_r_shank[10] - w.KA_r_shank[31]*t1;
     const Scalar t80 = w.KA_r_shank[17] - w.KA_r_shank[31]*t2;
@@ -6269,6 +6237,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_r_thigh[24] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
     w.KA_r_thigh[31] = -0.42875*t87;
     w.KA_r_thigh[38] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
+    w.KSD_r_shank[4] = w.KA_r_shank[32]*w.Dinv_r_shank;
     const Scalar t89 = w.KA_r_shank[4] - w.KA_r_shank[32]*t0;
     const Scalar t90 = w.KA_r_shank[11] - w.KA_r_shank[32]*t1;
     const Scalar t91 = w.KA_r_shank[18] - w.KA_r_shank[32]*t2;
@@ -6286,6 +6255,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_r_thigh[25] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
     w.KA_r_thigh[32] = -0.42875*t98;
     w.KA_r_thigh[39] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
+    w.KSD_r_shank[5] = w.KA_r_shank[33]*w.Dinv_r_shank;
     const Scalar t100 = w.KA_r_shank[5] - w.KA_r_shank[33]*t0;
     const Scalar t101 = w.KA_r_shank[12] - w.KA_r_shank[33]*t1;
     const Scalar t102 = w.KA_r_shank[19] - w.KA_r_shank[33]*t2;
@@ -6395,96 +6365,25 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_hip_roll_link[3] = w.pA_r_hip_roll_link[3] + 0.9950041652780258*t28 - 0.09983341664682815*t29;
     w.pA_r_hip_roll_link[4] = w.pA_r_hip_roll_link[4] + pa4;
     w.pA_r_hip_roll_link[5] = w.pA_r_hip_roll_link[5] + 0.09983341664682815*t28 + 0.9950041652780258*t29;
-    w.KSD_r_thigh[0] = w.KA_r_thigh[28]*w.Dinv_r_thigh;
-    w.KSD_r_thigh[1] = w.KA_r_thigh[29]*w.Dinv_r_thigh;
-    w.KSD_r_thigh[2] = w.KA_r_thigh[30]*w.Dinv_r_thigh;
-    w.KSD_r_thigh[3] = w.KA_r_thigh[31]*w.Dinv_r_thigh;
-    w.KSD_r_thigh[4] = w.KA_r_thigh[32]*w.Dinv_r_thigh;
-    w.KSD_r_thigh[5] = w.KA_r_thigh[33]*w.Dinv_r_thigh;
-    const Scalar t30 = w.KA_r_thigh[0] - w.KA_r_thigh[28]*t0;
-    const Scalar t31 = w.KA_r_thigh[7] - w.KA_r_thigh[28]*t1;
-    const Scalar t32 = w.KA_r_thigh[14] - w.KA_r_thigh[28]*t2;
-    const Scalar t33 = w.KA_r_thigh[21] - w.KA_r_thigh[28]*t3;
-    const Scalar t34 = w.KA_r_thigh[35] - w.KA_r_thigh[28]*t5;
-    const Scalar t35 = w.cq_r_thigh*t30 + w.sq_r_thigh*t32;
-    const Scalar t36 = -w.sq_r_thigh*t30 + w.cq_r_thigh*t32;
-    const Scalar t37 = w.cq_r_thigh*t33 + w.sq_r_thigh*t34;
-    const Scalar t38 = -w.sq_r_thigh*t33 + w.cq_r_thigh*t34;
-    w.KA_r_hip_roll_link[0] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
-    w.KA_r_hip_roll_link[7] = t31;
-    w.KA_r_hip_roll_link[14] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
-    w.KA_r_hip_roll_link[21] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
-    w.KA_r_hip_roll_link[35] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
-    const Scalar t39 = w.KA_r_thigh[1] - w.KA_r_thigh[29]*t0;
-    const Scalar t40 = w.KA_r_thigh[8] - w.KA_r_thigh[29]*t1;
-    const Scalar t41 = w.KA_r_thigh[15] - w.KA_r_thigh[29]*t2;
-    const Scalar t42 = w.KA_r_thigh[22] - w.KA_r_thigh[29]*t3;
-    const Scalar t43 = w.KA_r_thigh[36] - w.KA_r_thigh[29]*t5;
-    const Scalar t44 = w.cq_r_thigh*t39 + w.sq_r_thigh*t41;
-    const Scalar t45 = -w.sq_r_thigh*t39 + w.cq_r_thigh*t41;
-    const Scalar t46 = w.cq_r_thigh*t42 + w.sq_r_thigh*t43;
-    const Scalar t47 = -w.sq_r_thigh*t42 + w.cq_r_thigh*t43;
-    w.KA_r_hip_roll_link[1] = 0.9950041652780258*t44 - 0.09983341664682815*t45;
-    w.KA_r_hip_roll_link[8] = t40;
-    w.KA_r_hip_roll_link[15] = 0.09983341664682815*t44 + 0.9950041652780258*t45;
-    w.KA_r_hip_roll_link[22] = 0.9950041652780258*t46 - 0.09983341664682815*t47;
-    w.KA_r_hip_roll_link[36] = 0.09983341664682815*t46 + 0.9950041652780258*t47;
-    const Scalar t48 = w.KA_r_thigh[2] - w.KA_r_thigh[30]*t0;
-    const Scalar t49 = w.KA_r_thigh[9] - w.KA_r_thigh[30]*t1;
-    const Scalar t50 = w.KA_r_thigh[16] - w.KA_r_thigh[30]*t2;
-    const Scalar t51 = w.KA_r_thigh[23] - w.KA_r_thigh[30]*t3;
-    const Scalar t52 = w.KA_r_thigh[37] - w.KA_r_thigh[30]*t5;
-    const Scalar t53 = w.cq_r_thigh*t48 + w.sq_r_thigh*t50;
-    const Scalar t54 = -w.sq_r_thigh*t48 + w.cq_r_thigh*t50;
-    const Scalar t55 = w.cq_r_thigh*t51 + w.sq_r_thigh*t52;
-    const Scalar t56 = -w.sq_r_thigh*t51 + w.cq_r_thigh*t52;
-    w.KA_r_hip_roll_link[2] = 0.9950041652780258*t53 - 0.09983341664682815*t54;
-    w.KA_r_hip_roll_link[9] = t49;
-    w.KA_r_hip_roll_link[16] = 0.09983341664682815*t53 + 0.9950041652780258*t54;
-    w.KA_r_hip_roll_link[23] = 0.9950041652780258*t55 - 0.09983341664682815*t56;
-    w.KA_r_hip_roll_link[37] = 0.09983341664682815*t55 + 0.9950041652780258*t56;
-    const Scalar t57 = w.KA_r_thigh[3] - w.KA_r_thigh[31]*t0;
-    const Scalar t58 = w.KA_r_thigh[10] - w.KA_r_thigh[31]*t1;
-    const Scalar t59 = w.KA_r_thigh[17] - w.KA_r_thigh[31]*t2;
-    const Scalar t60 = w.KA_r_thigh[24] - w.KA_r_thigh[31]*t3;
-    const Scalar t61 = w.KA_r_thigh[38] - w.KA_r_thigh[31]*t5;
-    const Scalar t62 = w.cq_r_thigh*t57 + w.sq_r_thigh*t59;
-    const Scalar t63 = -w.sq_r_thigh*t57 + w.cq_r_thigh*t59;
-    const Scalar t64 = w.cq_r_thigh*t60 + w.sq_r_thigh*t61;
-    const Scalar t65 = -w.sq_r_thigh*t60 + w.cq_r_thigh*t61;
-    w.KA_r_hip_roll_link[3] = 0.9950041652780258*t62 - 0.09983341664682815*t63;
-    w.KA_r_hip_roll_link[10] = t58;
-    w.KA_r_hip_roll_link[17] = 0.09983341664682815*t62 + 0.9950041652780258*t63;
-    w.KA_r_hip_roll_link[24] = 0.9950041652780258*t64 - 0.09983341664682815*t65;
-    w.KA_r_hip_roll_link[38] = 0.09983341664682815*t64 + 0.9950041652780258*t65;
-    const Scalar t66 = w.KA_r_thigh[4] - w.KA_r_thigh[32]*t0;
-    const Scalar t67 = w.KA_r_thigh[11] - w.KA_r_thigh[32]*t1;
-    const Scalar t68 = w.KA_r_thigh[18] - w.KA_r_thigh[32]*t2;
-    const Scalar t69 = w.KA_r_thigh[25] - w.KA_r_thigh[32]*t3;
-    const Scalar t70 = w.KA_r_thigh[39] - w.KA_r_thigh[32]*t5;
-    const Scalar t71 = w.cq_r_thigh*t66 + w.sq_r_thigh*t68;
-    const Scalar t72 = -w.sq_r_thigh*t66 + w.cq_r_thigh*t68;
-    const Scalar t73 = w.cq_r_thigh*t69 + w.sq_r_thigh*t70;
-    const Scalar t74 = -w.sq_r_thigh*t69 + w.cq_r_thigh*t70;
-    w.KA_r_hip_roll_link[4] = 0.9950041652780258*t71 - 0.09983341664682815*t72;
-    w.KA_r_hip_roll_link[11] = t67;
-    w.KA_r_hip_roll_link[18] = 0.09983341664682815*t71 + 0.9950041652780258*t72;
-    w.KA_r_hip_roll_link[25] = 0.9950041652780258*t73 - 0.09983341664682815*t74;
-    w.KA_r_hip_roll_link[39] = 0.09983341664682815*t73 + 0.9950041652780258*t74;
-    const Scalar t75 = w.KA_r_thigh[5] - w.KA_r_thigh[33]*t0;
-    const Scalar t76 = w.KA_r_thigh[12] - w.KA_r_thigh[33]*t1;
-    const Scalar t77 = w.KA_r_thigh[19] - w.KA_r_thigh[33]*t2;
-    const Scalar t78 = w.KA_r_thigh[26] - w.KA_r_thigh[33]*t3;
-    const Scalar t79 = w.KA_r_thigh[40] - w.KA_r_thigh[33]*t5;
-    const Scalar t80 = w.cq_r_thigh*t75 + w.sq_r_thigh*t77;
-    const Scalar t81 = -w.sq_r_thigh*t75 + w.cq_r_thigh*t77;
-    const Scalar t82 = w.cq_r_thigh*t78 + w.sq_r_thigh*t79;
-    const Scalar t83 = -w.sq_r_thigh*t78 + w.cq_r_thigh*t79;
-    w.KA_r_hip_roll_link[5] = 0.9950041652780258*t80 - 0.09983341664682815*t81;
-    w.KA_r_hip_roll_link[12] = t76;
-    w.KA_r_hip_roll_link[19] = 0.09983341664682815*t80 + 0.9950041652780258*t81;
-    w.KA_r_hip_roll_link[26] = 0.9950041652780258*t82 - 0.09983341664682815*t83;
-    w.KA_r_hip_roll_link[40] = 0.09983341664682815*t82 + 0.9950041652780258*t83;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_r_thigh[j] = w.Dinv_r_thigh*w.KA_r_thigh[28 + j];
+      const Scalar t30 = w.KA_r_thigh[j] - t0*w.KA_r_thigh[28 + j];
+      const Scalar t31 = w.KA_r_thigh[7 + j] - t1*w.KA_r_thigh[28 + j];
+      const Scalar t32 = w.KA_r_thigh[14 + j] - t2*w.KA_r_thigh[28 + j];
+      const Scalar t33 = w.KA_r_thigh[21 + j] - t3*w.KA_r_thigh[28 + j];
+      const Scalar t34 = w.KA_r_thigh[35 + j] - t5*w.KA_r_thigh[28 + j];
+      const Scalar t35 = w.cq_r_thigh*t30 + w.sq_r_thigh*t32;
+      const Scalar t36 = -w.sq_r_thigh*t30 + w.cq_r_thigh*t32;
+      const Scalar t37 = w.cq_r_thigh*t33 + w.sq_r_thigh*t34;
+      const Scalar t38 = -w.sq_r_thigh*t33 + w.cq_r_thigh*t34;
+      w.KA_r_hip_roll_link[j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
+      w.KA_r_hip_roll_link[7 + j] = t31;
+      w.KA_r_hip_roll_link[14 + j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
+      w.KA_r_hip_roll_link[21 + j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+      w.KA_r_hip_roll_link[28 + j] = 0.0;
+      w.KA_r_hip_roll_link[35 + j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    }
   }
 }
 
@@ -6545,66 +6444,20 @@ PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_hip_yaw_link[3] = w.pA_r_hip_yaw_link[3] + pa3;
     w.pA_r_hip_yaw_link[4] = w.pA_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*pa4 - w.sq_r_hip_roll_link*pa5;
     w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa4 + w.cq_r_hip_roll_link*pa5;
-    w.KSD_r_hip_roll_link[0] = w.KA_r_hip_roll_link[21]*w.Dinv_r_hip_roll_link;
-    w.KSD_r_hip_roll_link[1] = w.KA_r_hip_roll_link[22]*w.Dinv_r_hip_roll_link;
-    w.KSD_r_hip_roll_link[2] = w.KA_r_hip_roll_link[23]*w.Dinv_r_hip_roll_link;
-    w.KSD_r_hip_roll_link[3] = w.KA_r_hip_roll_link[24]*w.Dinv_r_hip_roll_link;
-    w.KSD_r_hip_roll_link[4] = w.KA_r_hip_roll_link[25]*w.Dinv_r_hip_roll_link;
-    w.KSD_r_hip_roll_link[5] = w.KA_r_hip_roll_link[26]*w.Dinv_r_hip_roll_link;
-    const Scalar t6 = w.KA_r_hip_roll_link[0] - w.KA_r_hip_roll_link[21]*t0;
-    const Scalar t7 = w.KA_r_hip_roll_link[7] - w.KA_r_hip_roll_link[21]*t1;
-    const Scalar t8 = w.KA_r_hip_roll_link[14] - w.KA_r_hip_roll_link[21]*t2;
-    const Scalar t9 = w.KA_r_hip_roll_link[35] - w.KA_r_hip_roll_link[21]*t4;
-    w.KA_r_hip_yaw_link[0] = t6;
-    w.KA_r_hip_yaw_link[7] = w.cq_r_hip_roll_link*t7 - w.sq_r_hip_roll_link*t8;
-    w.KA_r_hip_yaw_link[14] = w.sq_r_hip_roll_link*t7 + w.cq_r_hip_roll_link*t8;
-    w.KA_r_hip_yaw_link[28] = -w.sq_r_hip_roll_link*t9;
-    w.KA_r_hip_yaw_link[35] = w.cq_r_hip_roll_link*t9;
-    const Scalar t10 = w.KA_r_hip_roll_link[1] - w.KA_r_hip_roll_link[22]*t0;
-    const Scalar t11 = w.KA_r_hip_roll_link[8] - w.KA_r_hip_roll_link[22]*t1;
-    const Scalar t12 = w.KA_r_hip_roll_link[15] - w.KA_r_hip_roll_link[22]*t2;
-    const Scalar t13 = w.KA_r_hip_roll_link[36] - w.KA_r_hip_roll_link[22]*t4;
-    w.KA_r_hip_yaw_link[1] = t10;
-    w.KA_r_hip_yaw_link[8] = w.cq_r_hip_roll_link*t11 - w.sq_r_hip_roll_link*t12;
-    w.KA_r_hip_yaw_link[15] = w.sq_r_hip_roll_link*t11 + w.cq_r_hip_roll_link*t12;
-    w.KA_r_hip_yaw_link[29] = -w.sq_r_hip_roll_link*t13;
-    w.KA_r_hip_yaw_link[36] = w.cq_r_hip_roll_link*t13;
-    const Scalar t14 = w.KA_r_hip_roll_link[2] - w.KA_r_hip_roll_link[23]*t0;
-    const Scalar t15 = w.KA_r_hip_roll_link[9] - w.KA_r_hip_roll_link[23]*t1;
-    const Scalar t16 = w.KA_r_hip_roll_link[16] - w.KA_r_hip_roll_link[23]*t2;
-    const Scalar t17 = w.KA_r_hip_roll_link[37] - w.KA_r_hip_roll_link[23]*t4;
-    w.KA_r_hip_yaw_link[2] = t14;
-    w.KA_r_hip_yaw_link[9] = w.cq_r_hip_roll_link*t15 - w.sq_r_hip_roll_link*t16;
-    w.KA_r_hip_yaw_link[16] = w.sq_r_hip_roll_link*t15 + w.cq_r_hip_roll_link*t16;
-    w.KA_r_hip_yaw_link[30] = -w.sq_r_hip_roll_link*t17;
-    w.KA_r_hip_yaw_link[37] = w.cq_r_hip_roll_link*t17;
-    const Scalar t18 = w.KA_r_hip_roll_link[3] - w.KA_r_hip_roll_link[24]*t0;
-    const Scalar t19 = w.KA_r_hip_roll_link[10] - w.KA_r_hip_roll_link[24]*t1;
-    const Scalar t20 = w.KA_r_hip_roll_link[17] - w.KA_r_hip_roll_link[24]*t2;
-    const Scalar t21 = w.KA_r_hip_roll_link[38] - w.KA_r_hip_roll_link[24]*t4;
-    w.KA_r_hip_yaw_link[3] = t18;
-    w.KA_r_hip_yaw_link[10] = w.cq_r_hip_roll_link*t19 - w.sq_r_hip_roll_link*t20;
-    w.KA_r_hip_yaw_link[17] = w.sq_r_hip_roll_link*t19 + w.cq_r_hip_roll_link*t20;
-    w.KA_r_hip_yaw_link[31] = -w.sq_r_hip_roll_link*t21;
-    w.KA_r_hip_yaw_link[38] = w.cq_r_hip_roll_link*t21;
-    const Scalar t22 = w.KA_r_hip_roll_link[4] - w.KA_r_hip_roll_link[25]*t0;
-    const Scalar t23 = w.KA_r_hip_roll_link[11] - w.KA_r_hip_roll_link[25]*t1;
-    const Scalar t24 = w.KA_r_hip_roll_link[18] - w.KA_r_hip_roll_link[25]*t2;
-    const Scalar t25 = w.KA_r_hip_roll_link[39] - w.KA_r_hip_roll_link[25]*t4;
-    w.KA_r_hip_yaw_link[4] = t22;
-    w.KA_r_hip_yaw_link[11] = w.cq_r_hip_roll_link*t23 - w.sq_r_hip_roll_link*t24;
-    w.KA_r_hip_yaw_link[18] = w.sq_r_hip_roll_link*t23 + w.cq_r_hip_roll_link*t24;
-    w.KA_r_hip_yaw_link[32] = -w.sq_r_hip_roll_link*t25;
-    w.KA_r_hip_yaw_link[39] = w.cq_r_hip_roll_link*t25;
-    const Scalar t26 = w.KA_r_hip_roll_link[5] - w.KA_r_hip_roll_link[26]*t0;
-    const Scalar t27 = w.KA_r_hip_roll_link[12] - w.KA_r_hip_roll_link[26]*t1;
-    const Scalar t28 = w.KA_r_hip_roll_link[19] - w.KA_r_hip_roll_link[26]*t2;
-    const Scalar t29 = w.KA_r_hip_roll_link[40] - w.KA_r_hip_roll_link[26]*t4;
-    w.KA_r_hip_yaw_link[5] = t26;
-    w.KA_r_hip_yaw_link[12] = w.cq_r_hip_roll_link*t27 - w.sq_r_hip_roll_link*t28;
-    w.KA_r_hip_yaw_link[19] = w.sq_r_hip_roll_link*t27 + w.cq_r_hip_roll_link*t28;
-    w.KA_r_hip_yaw_link[33] = -w.sq_r_hip_roll_link*t29;
-    w.KA_r_hip_yaw_link[40] = w.cq_r_hip_roll_link*t29;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_r_hip_roll_link[j] = w.Dinv_r_hip_roll_link*w.KA_r_hip_roll_link[21 + j];
+      const Scalar t6 = w.KA_r_hip_roll_link[j] - t0*w.KA_r_hip_roll_link[21 + j];
+      const Scalar t7 = w.KA_r_hip_roll_link[7 + j] - t1*w.KA_r_hip_roll_link[21 + j];
+      const Scalar t8 = w.KA_r_hip_roll_link[14 + j] - t2*w.KA_r_hip_roll_link[21 + j];
+      const Scalar t9 = w.KA_r_hip_roll_link[35 + j] - t4*w.KA_r_hip_roll_link[21 + j];
+      w.KA_r_hip_yaw_link[j] = t6;
+      w.KA_r_hip_yaw_link[7 + j] = w.cq_r_hip_roll_link*t7 - w.sq_r_hip_roll_link*t8;
+      w.KA_r_hip_yaw_link[14 + j] = w.sq_r_hip_roll_link*t7 + w.cq_r_hip_roll_link*t8;
+      w.KA_r_hip_yaw_link[21 + j] = 0.0;
+      w.KA_r_hip_yaw_link[28 + j] = w.cq_r_hip_roll_link*w.KA_r_hip_roll_link[28 + j] - w.sq_r_hip_roll_link*t9;
+      w.KA_r_hip_yaw_link[35 + j] = w.sq_r_hip_roll_link*w.KA_r_hip_roll_link[28 + j] + w.cq_r_hip_roll_link*t9;
+    }
   }
 }
 
@@ -6704,96 +6557,26 @@ PROXGEN_RT_NOINLINE void pv_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_pelvis[3] = w.pA_pelvis[3] - 0.0875*pa2 + 0.9961917745544759*t37 + 0.08718915247898762*t38;
     w.pA_pelvis[4] = w.pA_pelvis[4] - 0.08718915247898762*t37 + 0.9961917745544759*t38;
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 + 0.0875*t39;
-    w.KSD_r_hip_yaw_link[0] = w.KA_r_hip_yaw_link[35]*w.Dinv_r_hip_yaw_link;
-    w.KSD_r_hip_yaw_link[1] = w.KA_r_hip_yaw_link[36]*w.Dinv_r_hip_yaw_link;
-    w.KSD_r_hip_yaw_link[2] = w.KA_r_hip_yaw_link[37]*w.Dinv_r_hip_yaw_link;
-    w.KSD_r_hip_yaw_link[3] = w.KA_r_hip_yaw_link[38]*w.Dinv_r_hip_yaw_link;
-    w.KSD_r_hip_yaw_link[4] = w.KA_r_hip_yaw_link[39]*w.Dinv_r_hip_yaw_link;
-    w.KSD_r_hip_yaw_link[5] = w.KA_r_hip_yaw_link[40]*w.Dinv_r_hip_yaw_link;
-    const Scalar t41 = w.KA_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[35]*t0;
-    const Scalar t42 = w.KA_r_hip_yaw_link[7] - w.KA_r_hip_yaw_link[35]*t1;
-    const Scalar t43 = w.KA_r_hip_yaw_link[14] - w.KA_r_hip_yaw_link[35]*t2;
-    const Scalar t44 = w.KA_r_hip_yaw_link[28] - w.KA_r_hip_yaw_link[35]*t3;
-    const Scalar t45 = w.cq_r_hip_yaw_link*t41 - w.sq_r_hip_yaw_link*t42;
-    const Scalar t46 = w.sq_r_hip_yaw_link*t41 + w.cq_r_hip_yaw_link*t42;
-    const Scalar t47 = 0.9961917745544759*t45 + 0.08718915247898762*t46;
-    const Scalar t48 = -0.08718915247898762*t45 + 0.9961917745544759*t46;
-    w.KA_pelvis[6] = t47;
-    w.KA_pelvis[22] = t48;
-    w.KA_pelvis[38] = t43;
-    w.KA_pelvis[54] = -0.0875*t43 - 0.9961917745544759*w.sq_r_hip_yaw_link*t44 + 0.08718915247898762*w.cq_r_hip_yaw_link*t44;
-    w.KA_pelvis[70] = 0.08718915247898762*w.sq_r_hip_yaw_link*t44 + 0.9961917745544759*w.cq_r_hip_yaw_link*t44;
-    w.KA_pelvis[86] = 0.0875*t47;
-    const Scalar t49 = w.KA_r_hip_yaw_link[1] - w.KA_r_hip_yaw_link[36]*t0;
-    const Scalar t50 = w.KA_r_hip_yaw_link[8] - w.KA_r_hip_yaw_link[36]*t1;
-    const Scalar t51 = w.KA_r_hip_yaw_link[15] - w.KA_r_hip_yaw_link[36]*t2;
-    const Scalar t52 = w.KA_r_hip_yaw_link[29] - w.KA_r_hip_yaw_link[36]*t3;
-    const Scalar t53 = w.cq_r_hip_yaw_link*t49 - w.sq_r_hip_yaw_link*t50;
-    const Scalar t54 = w.sq_r_hip_yaw_link*t49 + w.cq_r_hip_yaw_link*t50;
-    const Scalar t55 = 0.9961917745544759*t53 + 0.08718915247898762*t54;
-    const Scalar t56 = -0.08718915247898762*t53 + 0.9961917745544759*t54;
-    w.KA_pelvis[7] = t55;
-    w.KA_pelvis[23] = t56;
-    w.KA_pelvis[39] = t51;
-    w.KA_pelvis[55] = -0.0875*t51 - 0.9961917745544759*w.sq_r_hip_yaw_link*t52 + 0.08718915247898762*w.cq_r_hip_yaw_link*t52;
-    w.KA_pelvis[71] = 0.08718915247898762*w.sq_r_hip_yaw_link*t52 + 0.9961917745544759*w.cq_r_hip_yaw_link*t52;
-    w.KA_pelvis[87] = 0.0875*t55;
-    const Scalar t57 = w.KA_r_hip_yaw_link[2] - w.KA_r_hip_yaw_link[37]*t0;
-    const Scalar t58 = w.KA_r_hip_yaw_link[9] - w.KA_r_hip_yaw_link[37]*t1;
-    const Scalar t59 = w.KA_r_hip_yaw_link[16] - w.KA_r_hip_yaw_link[37]*t2;
-    const Scalar t60 = w.KA_r_hip_yaw_link[30] - w.KA_r_hip_yaw_link[37]*t3;
-    const Scalar t61 = w.cq_r_hip_yaw_link*t57 - w.sq_r_hip_yaw_link*t58;
-    const Scalar t62 = w.sq_r_hip_yaw_link*t57 + w.cq_r_hip_yaw_link*t58;
-    const Scalar t63 = 0.9961917745544759*t61 + 0.08718915247898762*t62;
-    const Scalar t64 = -0.08718915247898762*t61 + 0.9961917745544759*t62;
-    w.KA_pelvis[8] = t63;
-    w.KA_pelvis[24] = t64;
-    w.KA_pelvis[40] = t59;
-    w.KA_pelvis[56] = -0.0875*t59 - 0.9961917745544759*w.sq_r_hip_yaw_link*t60 + 0.08718915247898762*w.cq_r_hip_yaw_link*t60;
-    w.KA_pelvis[72] = 0.08718915247898762*w.sq_r_hip_yaw_link*t60 + 0.9961917745544759*w.cq_r_hip_yaw_link*t60;
-    w.KA_pelvis[88] = 0.0875*t63;
-    const Scalar t65 = w.KA_r_hip_yaw_link[3] - w.KA_r_hip_yaw_link[38]*t0;
-    const Scalar t66 = w.KA_r_hip_yaw_link[10] - w.KA_r_hip_yaw_link[38]*t1;
-    const Scalar t67 = w.KA_r_hip_yaw_link[17] - w.KA_r_hip_yaw_link[38]*t2;
-    const Scalar t68 = w.KA_r_hip_yaw_link[31] - w.KA_r_hip_yaw_link[38]*t3;
-    const Scalar t69 = w.cq_r_hip_yaw_link*t65 - w.sq_r_hip_yaw_link*t66;
-    const Scalar t70 = w.sq_r_hip_yaw_link*t65 + w.cq_r_hip_yaw_link*t66;
-    const Scalar t71 = 0.9961917745544759*t69 + 0.08718915247898762*t70;
-    const Scalar t72 = -0.08718915247898762*t69 + 0.9961917745544759*t70;
-    w.KA_pelvis[9] = t71;
-    w.KA_pelvis[25] = t72;
-    w.KA_pelvis[41] = t67;
-    w.KA_pelvis[57] = -0.0875*t67 - 0.9961917745544759*w.sq_r_hip_yaw_link*t68 + 0.08718915247898762*w.cq_r_hip_yaw_link*t68;
-    w.KA_pelvis[73] = 0.08718915247898762*w.sq_r_hip_yaw_link*t68 + 0.9961917745544759*w.cq_r_hip_yaw_link*t68;
-    w.KA_pelvis[89] = 0.0875*t71;
-    const Scalar t73 = w.KA_r_hip_yaw_link[4] - w.KA_r_hip_yaw_link[39]*t0;
-    const Scalar t74 = w.KA_r_hip_yaw_link[11] - w.KA_r_hip_yaw_link[39]*t1;
-    const Scalar t75 = w.KA_r_hip_yaw_link[18] - w.KA_r_hip_yaw_link[39]*t2;
-    const Scalar t76 = w.KA_r_hip_yaw_link[32] - w.KA_r_hip_yaw_link[39]*t3;
-    const Scalar t77 = w.cq_r_hip_yaw_link*t73 - w.sq_r_hip_yaw_link*t74;
-    const Scalar t78 = w.sq_r_hip_yaw_link*t73 + w.cq_r_hip_yaw_link*t74;
-    const Scalar t79 = 0.9961917745544759*t77 + 0.08718915247898762*t78;
-    const Scalar t80 = -0.08718915247898762*t77 + 0.9961917745544759*t78;
-    w.KA_pelvis[10] = t79;
-    w.KA_pelvis[26] = t80;
-    w.KA_pelvis[42] = t75;
-    w.KA_pelvis[58] = -0.0875*t75 - 0.9961917745544759*w.sq_r_hip_yaw_link*t76 + 0.08718915247898762*w.cq_r_hip_yaw_link*t76;
-    w.KA_pelvis[74] = 0.08718915247898762*w.sq_r_hip_yaw_link*t76 + 0.9961917745544759*w.cq_r_hip_yaw_link*t76;
-    w.KA_pelvis[90] = 0.0875*t79;
-    const Scalar t81 = w.KA_r_hip_yaw_link[5] - w.KA_r_hip_yaw_link[40]*t0;
-    const Scalar t82 = w.KA_r_hip_yaw_link[12] - w.KA_r_hip_yaw_link[40]*t1;
-    const Scalar t83 = w.KA_r_hip_yaw_link[19] - w.KA_r_hip_yaw_link[40]*t2;
-    const Scalar t84 = w.KA_r_hip_yaw_link[33] - w.KA_r_hip_yaw_link[40]*t3;
-    const Scalar t85 = w.cq_r_hip_yaw_link*t81 - w.sq_r_hip_yaw_link*t82;
-    const Scalar t86 = w.sq_r_hip_yaw_link*t81 + w.cq_r_hip_yaw_link*t82;
-    const Scalar t87 = 0.9961917745544759*t85 + 0.08718915247898762*t86;
-    const Scalar t88 = -0.08718915247898762*t85 + 0.9961917745544759*t86;
-    w.KA_pelvis[11] = t87;
-    w.KA_pelvis[27] = t88;
-    w.KA_pelvis[43] = t83;
-    w.KA_pelvis[59] = -0.0875*t83 - 0.9961917745544759*w.sq_r_hip_yaw_link*t84 + 0.08718915247898762*w.cq_r_hip_yaw_link*t84;
-    w.KA_pelvis[75] = 0.08718915247898762*w.sq_r_hip_yaw_link*t84 + 0.9961917745544759*w.cq_r_hip_yaw_link*t84;
-    w.KA_pelvis[91] = 0.0875*t87;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_r_hip_yaw_link[j] = w.Dinv_r_hip_yaw_link*w.KA_r_hip_yaw_link[35 + j];
+      const Scalar t41 = w.KA_r_hip_yaw_link[j] - t0*w.KA_r_hip_yaw_link[35 + j];
+      const Scalar t42 = w.KA_r_hip_yaw_link[7 + j] - t1*w.KA_r_hip_yaw_link[35 + j];
+      const Scalar t43 = w.KA_r_hip_yaw_link[14 + j] - t2*w.KA_r_hip_yaw_link[35 + j];
+      const Scalar t44 = w.KA_r_hip_yaw_link[28 + j] - t3*w.KA_r_hip_yaw_link[35 + j];
+      const Scalar t45 = w.cq_r_hip_yaw_link*t41 - w.sq_r_hip_yaw_link*t42;
+      const Scalar t46 = w.sq_r_hip_yaw_link*t41 + w.cq_r_hip_yaw_link*t42;
+      const Scalar t47 = w.cq_r_hip_yaw_link*w.KA_r_hip_yaw_link[21 + j] - w.sq_r_hip_yaw_link*t44;
+      const Scalar t48 = w.sq_r_hip_yaw_link*w.KA_r_hip_yaw_link[21 + j] + w.cq_r_hip_yaw_link*t44;
+      const Scalar t49 = 0.9961917745544759*t45 + 0.08718915247898762*t46;
+      const Scalar t50 = -0.08718915247898762*t45 + 0.9961917745544759*t46;
+      w.KA_pelvis[6 + j] = t49;
+      w.KA_pelvis[22 + j] = t50;
+      w.KA_pelvis[38 + j] = t43;
+      w.KA_pelvis[54 + j] = -0.0875*t43 + 0.9961917745544759*t47 + 0.08718915247898762*t48;
+      w.KA_pelvis[70 + j] = -0.08718915247898762*t47 + 0.9961917745544759*t48;
+      w.KA_pelvis[86 + j] = 0.0875*t49;
+    }
   }
 }
 
@@ -6836,9 +6619,9 @@ PROXGEN_RT_NOINLINE void pv_14(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_ankle_link[3] = pa3;
     w.pA_l_ankle_link[4] = w.cq_l_foot*pa4 - w.sq_l_foot*pa5;
     w.pA_l_ankle_link[5] = w.sq_l_foot*pa4 + w.cq_l_foot*pa5;
-    w.KSD_l_foot[1] = 0.06825*w.Dinv_l_foot;
     w.KA_l_ankle_link[28] = -0.06825*w.cq_l_foot;
     w.KA_l_ankle_link[35] = -0.06825*w.sq_l_foot;
+    w.KSD_l_foot[1] = 0.06825*w.Dinv_l_foot;
     const Scalar t2 = 1.0 - 0.001905028125*w.Dinv_l_foot;
     w.KA_l_ankle_link[8] = w.cq_l_foot*t2;
     w.KA_l_ankle_link[15] = w.sq_l_foot*t2;
@@ -6955,10 +6738,6 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_shank[4] = w.pA_l_shank[4] + pa4 - 0.4305*t41;
     w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
     w.KSD_l_ankle_link[0] = w.KA_l_ankle_link[28]*w.Dinv_l_ankle_link;
-    w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[29]*w.Dinv_l_ankle_link;
-    w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[31]*w.Dinv_l_ankle_link;
-    w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[32]*w.Dinv_l_ankle_link;
-    w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[33]*w.Dinv_l_ankle_link;
     const Scalar t43 = 1.0 - w.KA_l_ankle_link[28]*t0;
     const Scalar t44 = -w.KA_l_ankle_link[28]*t2;
     const Scalar t45 = w.KA_l_ankle_link[35] - w.KA_l_ankle_link[28]*t4;
@@ -6972,6 +6751,7 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_shank[21] = -0.4305*w.KA_l_ankle_link[28]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t45 - 0.09983341664682815*w.cq_l_ankle_link*t45;
     w.KA_l_shank[28] = -0.4305*t48;
     w.KA_l_shank[35] = 0.09983341664682815*w.sq_l_ankle_link*t45 + 0.9950041652780258*w.cq_l_ankle_link*t45;
+    w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[29]*w.Dinv_l_ankle_link;
     const Scalar t50 = w.KA_l_ankle_link[8] - w.KA_l_ankle_link[29]*t1;
     const Scalar t51 = w.KA_l_ankle_link[15] - w.KA_l_ankle_link[29]*t2;
     const Scalar t52 = -w.KA_l_ankle_link[29]*t0;
@@ -6993,6 +6773,7 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_shank[16] = t59;
     w.KA_l_shank[23] = 0.4305*w.KA_l_ankle_link[9];
     w.KA_l_shank[30] = -0.4305*t58;
+    w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[31]*w.Dinv_l_ankle_link;
     const Scalar t60 = w.KA_l_ankle_link[10] - w.KA_l_ankle_link[31]*t1;
     const Scalar t61 = w.KA_l_ankle_link[17] - w.KA_l_ankle_link[31]*t2;
     const Scalar t62 = -w.KA_l_ankle_link[31]*t0;
@@ -7007,6 +6788,7 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_shank[24] = 0.4305*t60 + 0.9950041652780258*w.sq_l_ankle_link*t63 - 0.09983341664682815*w.cq_l_ankle_link*t63;
     w.KA_l_shank[31] = -0.4305*t66;
     w.KA_l_shank[38] = 0.09983341664682815*w.sq_l_ankle_link*t63 + 0.9950041652780258*w.cq_l_ankle_link*t63;
+    w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[32]*w.Dinv_l_ankle_link;
     const Scalar t68 = -w.KA_l_ankle_link[32]*t0;
     const Scalar t69 = -w.KA_l_ankle_link[32]*t2;
     const Scalar t70 = w.KA_l_ankle_link[39] - w.KA_l_ankle_link[32]*t4;
@@ -7020,6 +6802,7 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_shank[25] = -0.4305*w.KA_l_ankle_link[32]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t70 - 0.09983341664682815*w.cq_l_ankle_link*t70;
     w.KA_l_shank[32] = -0.4305*t73;
     w.KA_l_shank[39] = 0.09983341664682815*w.sq_l_ankle_link*t70 + 0.9950041652780258*w.cq_l_ankle_link*t70;
+    w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[33]*w.Dinv_l_ankle_link;
     const Scalar t75 = -w.KA_l_ankle_link[33]*t0;
     const Scalar t76 = -w.KA_l_ankle_link[33]*t2;
     const Scalar t77 = w.KA_l_ankle_link[40] - w.KA_l_ankle_link[33]*t4;
@@ -7147,11 +6930,6 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_thigh[4] = w.pA_l_thigh[4] + pa4 - 0.42875*t43;
     w.pA_l_thigh[5] = w.pA_l_thigh[5] - 0.19866933079506124*t41 + 0.9800665778412416*t42;
     w.KSD_l_shank[0] = w.KA_l_shank[28]*w.Dinv_l_shank;
-    w.KSD_l_shank[1] = w.KA_l_shank[29]*w.Dinv_l_shank;
-    w.KSD_l_shank[2] = w.KA_l_shank[30]*w.Dinv_l_shank;
-    w.KSD_l_shank[3] = w.KA_l_shank[31]*w.Dinv_l_shank;
-    w.KSD_l_shank[4] = w.KA_l_shank[32]*w.Dinv_l_shank;
-    w.KSD_l_shank[5] = w.KA_l_shank[33]*w.Dinv_l_shank;
     const Scalar t45 = w.KA_l_shank[0] - w.KA_l_shank[28]*t0;
     const Scalar t46 = w.KA_l_shank[7] - w.KA_l_shank[28]*t1;
     const Scalar t47 = w.KA_l_shank[14] - w.KA_l_shank[28]*t2;
@@ -7169,6 +6947,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_thigh[21] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
     w.KA_l_thigh[28] = -0.42875*t54;
     w.KA_l_thigh[35] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
+    w.KSD_l_shank[1] = w.KA_l_shank[29]*w.Dinv_l_shank;
     const Scalar t56 = w.KA_l_shank[1] - w.KA_l_shank[29]*t0;
     const Scalar t57 = w.KA_l_shank[8] - w.KA_l_shank[29]*t1;
     const Scalar t58 = w.KA_l_shank[15] - w.KA_l_shank[29]*t2;
@@ -7186,6 +6965,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_thigh[22] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
     w.KA_l_thigh[29] = -0.42875*t65;
     w.KA_l_thigh[36] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
+    w.KSD_l_shank[2] = w.KA_l_shank[30]*w.Dinv_l_shank;
     const Scalar t67 = w.KA_l_shank[2] - w.KA_l_shank[30]*t0;
     const Scalar t68 = w.KA_l_shank[9] - w.KA_l_shank[30]*t1;
     const Scalar t69 = w.KA_l_shank[16] - w.KA_l_shank[30]*t2;
@@ -7203,6 +6983,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_thigh[23] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
     w.KA_l_thigh[30] = -0.42875*t76;
     w.KA_l_thigh[37] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
+    w.KSD_l_shank[3] = w.KA_l_shank[31]*w.Dinv_l_shank;
     const Scalar t78 = w.KA_l_shank[3] - w.KA_l_shank[31]*t0;
     const Scalar t79 = w.KA_l_shank[10] - w.KA_l_shank[31]*t1;
     const Scalar t80 = w.KA_l_shank[17] - w.KA_l_shank[31]*t2;
@@ -7220,6 +7001,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_thigh[24] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
     w.KA_l_thigh[31] = -0.42875*t87;
     w.KA_l_thigh[38] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
+    w.KSD_l_shank[4] = w.KA_l_shank[32]*w.Dinv_l_shank;
     const Scalar t89 = w.KA_l_shank[4] - w.KA_l_shank[32]*t0;
     const Scalar t90 = w.KA_l_shank[11] - w.KA_l_shank[32]*t1;
     const Scalar t91 = w.KA_l_shank[18] - w.KA_l_shank[32]*t2;
@@ -7237,6 +7019,7 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_l_thigh[25] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
     w.KA_l_thigh[32] = -0.42875*t98;
     w.KA_l_thigh[39] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
+    w.KSD_l_shank[5] = w.KA_l_shank[33]*w.Dinv_l_shank;
     const Scalar t100 = w.KA_l_shank[5] - w.KA_l_shank[33]*t0;
     const Scalar t101 = w.KA_l_shank[12] - w.KA_l_shank[33]*t1;
     const Scalar t102 = w.KA_l_shank[19] - w.KA_l_shank[33]*t2;
@@ -7346,96 +7129,25 @@ PROXGEN_RT_NOINLINE void pv_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_hip_roll_link[3] = w.pA_l_hip_roll_link[3] + 0.9950041652780258*t28 - 0.09983341664682815*t29;
     w.pA_l_hip_roll_link[4] = w.pA_l_hip_roll_link[4] + pa4;
     w.pA_l_hip_roll_link[5] = w.pA_l_hip_roll_link[5] + 0.09983341664682815*t28 + 0.9950041652780258*t29;
-    w.KSD_l_thigh[0] = w.KA_l_thigh[28]*w.Dinv_l_thigh;
-    w.KSD_l_thigh[1] = w.KA_l_thigh[29]*w.Dinv_l_thigh;
-    w.KSD_l_thigh[2] = w.KA_l_thigh[30]*w.Dinv_l_thigh;
-    w.KSD_l_thigh[3] = w.KA_l_thigh[31]*w.Dinv_l_thigh;
-    w.KSD_l_thigh[4] = w.KA_l_thigh[32]*w.Dinv_l_thigh;
-    w.KSD_l_thigh[5] = w.KA_l_thigh[33]*w.Dinv_l_thigh;
-    const Scalar t30 = w.KA_l_thigh[0] - w.KA_l_thigh[28]*t0;
-    const Scalar t31 = w.KA_l_thigh[7] - w.KA_l_thigh[28]*t1;
-    const Scalar t32 = w.KA_l_thigh[14] - w.KA_l_thigh[28]*t2;
-    const Scalar t33 = w.KA_l_thigh[21] - w.KA_l_thigh[28]*t3;
-    const Scalar t34 = w.KA_l_thigh[35] - w.KA_l_thigh[28]*t5;
-    const Scalar t35 = w.cq_l_thigh*t30 + w.sq_l_thigh*t32;
-    const Scalar t36 = -w.sq_l_thigh*t30 + w.cq_l_thigh*t32;
-    const Scalar t37 = w.cq_l_thigh*t33 + w.sq_l_thigh*t34;
-    const Scalar t38 = -w.sq_l_thigh*t33 + w.cq_l_thigh*t34;
-    w.KA_l_hip_roll_link[0] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
-    w.KA_l_hip_roll_link[7] = t31;
-    w.KA_l_hip_roll_link[14] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
-    w.KA_l_hip_roll_link[21] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
-    w.KA_l_hip_roll_link[35] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
-    const Scalar t39 = w.KA_l_thigh[1] - w.KA_l_thigh[29]*t0;
-    const Scalar t40 = w.KA_l_thigh[8] - w.KA_l_thigh[29]*t1;
-    const Scalar t41 = w.KA_l_thigh[15] - w.KA_l_thigh[29]*t2;
-    const Scalar t42 = w.KA_l_thigh[22] - w.KA_l_thigh[29]*t3;
-    const Scalar t43 = w.KA_l_thigh[36] - w.KA_l_thigh[29]*t5;
-    const Scalar t44 = w.cq_l_thigh*t39 + w.sq_l_thigh*t41;
-    const Scalar t45 = -w.sq_l_thigh*t39 + w.cq_l_thigh*t41;
-    const Scalar t46 = w.cq_l_thigh*t42 + w.sq_l_thigh*t43;
-    const Scalar t47 = -w.sq_l_thigh*t42 + w.cq_l_thigh*t43;
-    w.KA_l_hip_roll_link[1] = 0.9950041652780258*t44 - 0.09983341664682815*t45;
-    w.KA_l_hip_roll_link[8] = t40;
-    w.KA_l_hip_roll_link[15] = 0.09983341664682815*t44 + 0.9950041652780258*t45;
-    w.KA_l_hip_roll_link[22] = 0.9950041652780258*t46 - 0.09983341664682815*t47;
-    w.KA_l_hip_roll_link[36] = 0.09983341664682815*t46 + 0.9950041652780258*t47;
-    const Scalar t48 = w.KA_l_thigh[2] - w.KA_l_thigh[30]*t0;
-    const Scalar t49 = w.KA_l_thigh[9] - w.KA_l_thigh[30]*t1;
-    const Scalar t50 = w.KA_l_thigh[16] - w.KA_l_thigh[30]*t2;
-    const Scalar t51 = w.KA_l_thigh[23] - w.KA_l_thigh[30]*t3;
-    const Scalar t52 = w.KA_l_thigh[37] - w.KA_l_thigh[30]*t5;
-    const Scalar t53 = w.cq_l_thigh*t48 + w.sq_l_thigh*t50;
-    const Scalar t54 = -w.sq_l_thigh*t48 + w.cq_l_thigh*t50;
-    const Scalar t55 = w.cq_l_thigh*t51 + w.sq_l_thigh*t52;
-    const Scalar t56 = -w.sq_l_thigh*t51 + w.cq_l_thigh*t52;
-    w.KA_l_hip_roll_link[2] = 0.9950041652780258*t53 - 0.09983341664682815*t54;
-    w.KA_l_hip_roll_link[9] = t49;
-    w.KA_l_hip_roll_link[16] = 0.09983341664682815*t53 + 0.9950041652780258*t54;
-    w.KA_l_hip_roll_link[23] = 0.9950041652780258*t55 - 0.09983341664682815*t56;
-    w.KA_l_hip_roll_link[37] = 0.09983341664682815*t55 + 0.9950041652780258*t56;
-    const Scalar t57 = w.KA_l_thigh[3] - w.KA_l_thigh[31]*t0;
-    const Scalar t58 = w.KA_l_thigh[10] - w.KA_l_thigh[31]*t1;
-    const Scalar t59 = w.KA_l_thigh[17] - w.KA_l_thigh[31]*t2;
-    const Scalar t60 = w.KA_l_thigh[24] - w.KA_l_thigh[31]*t3;
-    const Scalar t61 = w.KA_l_thigh[38] - w.KA_l_thigh[31]*t5;
-    const Scalar t62 = w.cq_l_thigh*t57 + w.sq_l_thigh*t59;
-    const Scalar t63 = -w.sq_l_thigh*t57 + w.cq_l_thigh*t59;
-    const Scalar t64 = w.cq_l_thigh*t60 + w.sq_l_thigh*t61;
-    const Scalar t65 = -w.sq_l_thigh*t60 + w.cq_l_thigh*t61;
-    w.KA_l_hip_roll_link[3] = 0.9950041652780258*t62 - 0.09983341664682815*t63;
-    w.KA_l_hip_roll_link[10] = t58;
-    w.KA_l_hip_roll_link[17] = 0.09983341664682815*t62 + 0.9950041652780258*t63;
-    w.KA_l_hip_roll_link[24] = 0.9950041652780258*t64 - 0.09983341664682815*t65;
-    w.KA_l_hip_roll_link[38] = 0.09983341664682815*t64 + 0.9950041652780258*t65;
-    const Scalar t66 = w.KA_l_thigh[4] - w.KA_l_thigh[32]*t0;
-    const Scalar t67 = w.KA_l_thigh[11] - w.KA_l_thigh[32]*t1;
-    const Scalar t68 = w.KA_l_thigh[18] - w.KA_l_thigh[32]*t2;
-    const Scalar t69 = w.KA_l_thigh[25] - w.KA_l_thigh[32]*t3;
-    const Scalar t70 = w.KA_l_thigh[39] - w.KA_l_thigh[32]*t5;
-    const Scalar t71 = w.cq_l_thigh*t66 + w.sq_l_thigh*t68;
-    const Scalar t72 = -w.sq_l_thigh*t66 + w.cq_l_thigh*t68;
-    const Scalar t73 = w.cq_l_thigh*t69 + w.sq_l_thigh*t70;
-    const Scalar t74 = -w.sq_l_thigh*t69 + w.cq_l_thigh*t70;
-    w.KA_l_hip_roll_link[4] = 0.9950041652780258*t71 - 0.09983341664682815*t72;
-    w.KA_l_hip_roll_link[11] = t67;
-    w.KA_l_hip_roll_link[18] = 0.09983341664682815*t71 + 0.9950041652780258*t72;
-    w.KA_l_hip_roll_link[25] = 0.9950041652780258*t73 - 0.09983341664682815*t74;
-    w.KA_l_hip_roll_link[39] = 0.09983341664682815*t73 + 0.9950041652780258*t74;
-    const Scalar t75 = w.KA_l_thigh[5] - w.KA_l_thigh[33]*t0;
-    const Scalar t76 = w.KA_l_thigh[12] - w.KA_l_thigh[33]*t1;
-    const Scalar t77 = w.KA_l_thigh[19] - w.KA_l_thigh[33]*t2;
-    const Scalar t78 = w.KA_l_thigh[26] - w.KA_l_thigh[33]*t3;
-    const Scalar t79 = w.KA_l_thigh[40] - w.KA_l_thigh[33]*t5;
-    const Scalar t80 = w.cq_l_thigh*t75 + w.sq_l_thigh*t77;
-    const Scalar t81 = -w.sq_l_thigh*t75 + w.cq_l_thigh*t77;
-    const Scalar t82 = w.cq_l_thigh*t78 + w.sq_l_thigh*t79;
-    const Scalar t83 = -w.sq_l_thigh*t78 + w.cq_l_thigh*t79;
-    w.KA_l_hip_roll_link[5] = 0.9950041652780258*t80 - 0.09983341664682815*t81;
-    w.KA_l_hip_roll_link[12] = t76;
-    w.KA_l_hip_roll_link[19] = 0.09983341664682815*t80 + 0.9950041652780258*t81;
-    w.KA_l_hip_roll_link[26] = 0.9950041652780258*t82 - 0.09983341664682815*t83;
-    w.KA_l_hip_roll_link[40] = 0.09983341664682815*t82 + 0.9950041652780258*t83;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_l_thigh[j] = w.Dinv_l_thigh*w.KA_l_thigh[28 + j];
+      const Scalar t30 = w.KA_l_thigh[j] - t0*w.KA_l_thigh[28 + j];
+      const Scalar t31 = w.KA_l_thigh[7 + j] - t1*w.KA_l_thigh[28 + j];
+      const Scalar t32 = w.KA_l_thigh[14 + j] - t2*w.KA_l_thigh[28 + j];
+      const Scalar t33 = w.KA_l_thigh[21 + j] - t3*w.KA_l_thigh[28 + j];
+      const Scalar t34 = w.KA_l_thigh[35 + j] - t5*w.KA_l_thigh[28 + j];
+      const Scalar t35 = w.cq_l_thigh*t30 + w.sq_l_thigh*t32;
+      const Scalar t36 = -w.sq_l_thigh*t30 + w.cq_l_thigh*t32;
+      const Scalar t37 = w.cq_l_thigh*t33 + w.sq_l_thigh*t34;
+      const Scalar t38 = -w.sq_l_thigh*t33 + w.cq_l_thigh*t34;
+      w.KA_l_hip_roll_link[j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
+      w.KA_l_hip_roll_link[7 + j] = t31;
+      w.KA_l_hip_roll_link[14 + j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
+      w.KA_l_hip_roll_link[21 + j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+      w.KA_l_hip_roll_link[28 + j] = 0.0;
+      w.KA_l_hip_roll_link[35 + j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+    }
   }
 }
 
@@ -7496,66 +7208,20 @@ PROXGEN_RT_NOINLINE void pv_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_hip_yaw_link[3] = w.pA_l_hip_yaw_link[3] + pa3;
     w.pA_l_hip_yaw_link[4] = w.pA_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*pa4 - w.sq_l_hip_roll_link*pa5;
     w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa4 + w.cq_l_hip_roll_link*pa5;
-    w.KSD_l_hip_roll_link[0] = w.KA_l_hip_roll_link[21]*w.Dinv_l_hip_roll_link;
-    w.KSD_l_hip_roll_link[1] = w.KA_l_hip_roll_link[22]*w.Dinv_l_hip_roll_link;
-    w.KSD_l_hip_roll_link[2] = w.KA_l_hip_roll_link[23]*w.Dinv_l_hip_roll_link;
-    w.KSD_l_hip_roll_link[3] = w.KA_l_hip_roll_link[24]*w.Dinv_l_hip_roll_link;
-    w.KSD_l_hip_roll_link[4] = w.KA_l_hip_roll_link[25]*w.Dinv_l_hip_roll_link;
-    w.KSD_l_hip_roll_link[5] = w.KA_l_hip_roll_link[26]*w.Dinv_l_hip_roll_link;
-    const Scalar t6 = w.KA_l_hip_roll_link[0] - w.KA_l_hip_roll_link[21]*t0;
-    const Scalar t7 = w.KA_l_hip_roll_link[7] - w.KA_l_hip_roll_link[21]*t1;
-    const Scalar t8 = w.KA_l_hip_roll_link[14] - w.KA_l_hip_roll_link[21]*t2;
-    const Scalar t9 = w.KA_l_hip_roll_link[35] - w.KA_l_hip_roll_link[21]*t4;
-    w.KA_l_hip_yaw_link[0] = t6;
-    w.KA_l_hip_yaw_link[7] = w.cq_l_hip_roll_link*t7 - w.sq_l_hip_roll_link*t8;
-    w.KA_l_hip_yaw_link[14] = w.sq_l_hip_roll_link*t7 + w.cq_l_hip_roll_link*t8;
-    w.KA_l_hip_yaw_link[28] = -w.sq_l_hip_roll_link*t9;
-    w.KA_l_hip_yaw_link[35] = w.cq_l_hip_roll_link*t9;
-    const Scalar t10 = w.KA_l_hip_roll_link[1] - w.KA_l_hip_roll_link[22]*t0;
-    const Scalar t11 = w.KA_l_hip_roll_link[8] - w.KA_l_hip_roll_link[22]*t1;
-    const Scalar t12 = w.KA_l_hip_roll_link[15] - w.KA_l_hip_roll_link[22]*t2;
-    const Scalar t13 = w.KA_l_hip_roll_link[36] - w.KA_l_hip_roll_link[22]*t4;
-    w.KA_l_hip_yaw_link[1] = t10;
-    w.KA_l_hip_yaw_link[8] = w.cq_l_hip_roll_link*t11 - w.sq_l_hip_roll_link*t12;
-    w.KA_l_hip_yaw_link[15] = w.sq_l_hip_roll_link*t11 + w.cq_l_hip_roll_link*t12;
-    w.KA_l_hip_yaw_link[29] = -w.sq_l_hip_roll_link*t13;
-    w.KA_l_hip_yaw_link[36] = w.cq_l_hip_roll_link*t13;
-    const Scalar t14 = w.KA_l_hip_roll_link[2] - w.KA_l_hip_roll_link[23]*t0;
-    const Scalar t15 = w.KA_l_hip_roll_link[9] - w.KA_l_hip_roll_link[23]*t1;
-    const Scalar t16 = w.KA_l_hip_roll_link[16] - w.KA_l_hip_roll_link[23]*t2;
-    const Scalar t17 = w.KA_l_hip_roll_link[37] - w.KA_l_hip_roll_link[23]*t4;
-    w.KA_l_hip_yaw_link[2] = t14;
-    w.KA_l_hip_yaw_link[9] = w.cq_l_hip_roll_link*t15 - w.sq_l_hip_roll_link*t16;
-    w.KA_l_hip_yaw_link[16] = w.sq_l_hip_roll_link*t15 + w.cq_l_hip_roll_link*t16;
-    w.KA_l_hip_yaw_link[30] = -w.sq_l_hip_roll_link*t17;
-    w.KA_l_hip_yaw_link[37] = w.cq_l_hip_roll_link*t17;
-    const Scalar t18 = w.KA_l_hip_roll_link[3] - w.KA_l_hip_roll_link[24]*t0;
-    const Scalar t19 = w.KA_l_hip_roll_link[10] - w.KA_l_hip_roll_link[24]*t1;
-    const Scalar t20 = w.KA_l_hip_roll_link[17] - w.KA_l_hip_roll_link[24]*t2;
-    const Scalar t21 = w.KA_l_hip_roll_link[38] - w.KA_l_hip_roll_link[24]*t4;
-    w.KA_l_hip_yaw_link[3] = t18;
-    w.KA_l_hip_yaw_link[10] = w.cq_l_hip_roll_link*t19 - w.sq_l_hip_roll_link*t20;
-    w.KA_l_hip_yaw_link[17] = w.sq_l_hip_roll_link*t19 + w.cq_l_hip_roll_link*t20;
-    w.KA_l_hip_yaw_link[31] = -w.sq_l_hip_roll_link*t21;
-    w.KA_l_hip_yaw_link[38] = w.cq_l_hip_roll_link*t21;
-    const Scalar t22 = w.KA_l_hip_roll_link[4] - w.KA_l_hip_roll_link[25]*t0;
-    const Scalar t23 = w.KA_l_hip_roll_link[11] - w.KA_l_hip_roll_link[25]*t1;
-    const Scalar t24 = w.KA_l_hip_roll_link[18] - w.KA_l_hip_roll_link[25]*t2;
-    const Scalar t25 = w.KA_l_hip_roll_link[39] - w.KA_l_hip_roll_link[25]*t4;
-    w.KA_l_hip_yaw_link[4] = t22;
-    w.KA_l_hip_yaw_link[11] = w.cq_l_hip_roll_link*t23 - w.sq_l_hip_roll_link*t24;
-    w.KA_l_hip_yaw_link[18] = w.sq_l_hip_roll_link*t23 + w.cq_l_hip_roll_link*t24;
-    w.KA_l_hip_yaw_link[32] = -w.sq_l_hip_roll_link*t25;
-    w.KA_l_hip_yaw_link[39] = w.cq_l_hip_roll_link*t25;
-    const Scalar t26 = w.KA_l_hip_roll_link[5] - w.KA_l_hip_roll_link[26]*t0;
-    const Scalar t27 = w.KA_l_hip_roll_link[12] - w.KA_l_hip_roll_link[26]*t1;
-    const Scalar t28 = w.KA_l_hip_roll_link[19] - w.KA_l_hip_roll_link[26]*t2;
-    const Scalar t29 = w.KA_l_hip_roll_link[40] - w.KA_l_hip_roll_link[26]*t4;
-    w.KA_l_hip_yaw_link[5] = t26;
-    w.KA_l_hip_yaw_link[12] = w.cq_l_hip_roll_link*t27 - w.sq_l_hip_roll_link*t28;
-    w.KA_l_hip_yaw_link[19] = w.sq_l_hip_roll_link*t27 + w.cq_l_hip_roll_link*t28;
-    w.KA_l_hip_yaw_link[33] = -w.sq_l_hip_roll_link*t29;
-    w.KA_l_hip_yaw_link[40] = w.cq_l_hip_roll_link*t29;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_l_hip_roll_link[j] = w.Dinv_l_hip_roll_link*w.KA_l_hip_roll_link[21 + j];
+      const Scalar t6 = w.KA_l_hip_roll_link[j] - t0*w.KA_l_hip_roll_link[21 + j];
+      const Scalar t7 = w.KA_l_hip_roll_link[7 + j] - t1*w.KA_l_hip_roll_link[21 + j];
+      const Scalar t8 = w.KA_l_hip_roll_link[14 + j] - t2*w.KA_l_hip_roll_link[21 + j];
+      const Scalar t9 = w.KA_l_hip_roll_link[35 + j] - t4*w.KA_l_hip_roll_link[21 + j];
+      w.KA_l_hip_yaw_link[j] = t6;
+      w.KA_l_hip_yaw_link[7 + j] = w.cq_l_hip_roll_link*t7 - w.sq_l_hip_roll_link*t8;
+      w.KA_l_hip_yaw_link[14 + j] = w.sq_l_hip_roll_link*t7 + w.cq_l_hip_roll_link*t8;
+      w.KA_l_hip_yaw_link[21 + j] = 0.0;
+      w.KA_l_hip_yaw_link[28 + j] = w.cq_l_hip_roll_link*w.KA_l_hip_roll_link[28 + j] - w.sq_l_hip_roll_link*t9;
+      w.KA_l_hip_yaw_link[35 + j] = w.sq_l_hip_roll_link*w.KA_l_hip_roll_link[28 + j] + w.cq_l_hip_roll_link*t9;
+    }
   }
 }
 
@@ -7655,96 +7321,26 @@ PROXGEN_RT_NOINLINE void pv_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa2 + 0.9961917745544759*t37 - 0.08718915247898762*t38;
     w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t37 + 0.9961917745544759*t38;
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 - 0.0875*t39;
-    w.KSD_l_hip_yaw_link[0] = w.KA_l_hip_yaw_link[35]*w.Dinv_l_hip_yaw_link;
-    w.KSD_l_hip_yaw_link[1] = w.KA_l_hip_yaw_link[36]*w.Dinv_l_hip_yaw_link;
-    w.KSD_l_hip_yaw_link[2] = w.KA_l_hip_yaw_link[37]*w.Dinv_l_hip_yaw_link;
-    w.KSD_l_hip_yaw_link[3] = w.KA_l_hip_yaw_link[38]*w.Dinv_l_hip_yaw_link;
-    w.KSD_l_hip_yaw_link[4] = w.KA_l_hip_yaw_link[39]*w.Dinv_l_hip_yaw_link;
-    w.KSD_l_hip_yaw_link[5] = w.KA_l_hip_yaw_link[40]*w.Dinv_l_hip_yaw_link;
-    const Scalar t41 = w.KA_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[35]*t0;
-    const Scalar t42 = w.KA_l_hip_yaw_link[7] - w.KA_l_hip_yaw_link[35]*t1;
-    const Scalar t43 = w.KA_l_hip_yaw_link[14] - w.KA_l_hip_yaw_link[35]*t2;
-    const Scalar t44 = w.KA_l_hip_yaw_link[28] - w.KA_l_hip_yaw_link[35]*t3;
-    const Scalar t45 = w.cq_l_hip_yaw_link*t41 - w.sq_l_hip_yaw_link*t42;
-    const Scalar t46 = w.sq_l_hip_yaw_link*t41 + w.cq_l_hip_yaw_link*t42;
-    const Scalar t47 = 0.9961917745544759*t45 - 0.08718915247898762*t46;
-    const Scalar t48 = 0.08718915247898762*t45 + 0.9961917745544759*t46;
-    w.KA_pelvis[0] = t47;
-    w.KA_pelvis[16] = t48;
-    w.KA_pelvis[32] = t43;
-    w.KA_pelvis[48] = 0.0875*t43 - 0.9961917745544759*w.sq_l_hip_yaw_link*t44 - 0.08718915247898762*w.cq_l_hip_yaw_link*t44;
-    w.KA_pelvis[64] = -0.08718915247898762*w.sq_l_hip_yaw_link*t44 + 0.9961917745544759*w.cq_l_hip_yaw_link*t44;
-    w.KA_pelvis[80] = -0.0875*t47;
-    const Scalar t49 = w.KA_l_hip_yaw_link[1] - w.KA_l_hip_yaw_link[36]*t0;
-    const Scalar t50 = w.KA_l_hip_yaw_link[8] - w.KA_l_hip_yaw_link[36]*t1;
-    const Scalar t51 = w.KA_l_hip_yaw_link[15] - w.KA_l_hip_yaw_link[36]*t2;
-    const Scalar t52 = w.KA_l_hip_yaw_link[29] - w.KA_l_hip_yaw_link[36]*t3;
-    const Scalar t53 = w.cq_l_hip_yaw_link*t49 - w.sq_l_hip_yaw_link*t50;
-    const Scalar t54 = w.sq_l_hip_yaw_link*t49 + w.cq_l_hip_yaw_link*t50;
-    const Scalar t55 = 0.9961917745544759*t53 - 0.08718915247898762*t54;
-    const Scalar t56 = 0.08718915247898762*t53 + 0.9961917745544759*t54;
-    w.KA_pelvis[1] = t55;
-    w.KA_pelvis[17] = t56;
-    w.KA_pelvis[33] = t51;
-    w.KA_pelvis[49] = 0.0875*t51 - 0.9961917745544759*w.sq_l_hip_yaw_link*t52 - 0.08718915247898762*w.cq_l_hip_yaw_link*t52;
-    w.KA_pelvis[65] = -0.08718915247898762*w.sq_l_hip_yaw_link*t52 + 0.9961917745544759*w.cq_l_hip_yaw_link*t52;
-    w.KA_pelvis[81] = -0.0875*t55;
-    const Scalar t57 = w.KA_l_hip_yaw_link[2] - w.KA_l_hip_yaw_link[37]*t0;
-    const Scalar t58 = w.KA_l_hip_yaw_link[9] - w.KA_l_hip_yaw_link[37]*t1;
-    const Scalar t59 = w.KA_l_hip_yaw_link[16] - w.KA_l_hip_yaw_link[37]*t2;
-    const Scalar t60 = w.KA_l_hip_yaw_link[30] - w.KA_l_hip_yaw_link[37]*t3;
-    const Scalar t61 = w.cq_l_hip_yaw_link*t57 - w.sq_l_hip_yaw_link*t58;
-    const Scalar t62 = w.sq_l_hip_yaw_link*t57 + w.cq_l_hip_yaw_link*t58;
-    const Scalar t63 = 0.9961917745544759*t61 - 0.08718915247898762*t62;
-    const Scalar t64 = 0.08718915247898762*t61 + 0.9961917745544759*t62;
-    w.KA_pelvis[2] = t63;
-    w.KA_pelvis[18] = t64;
-    w.KA_pelvis[34] = t59;
-    w.KA_pelvis[50] = 0.0875*t59 - 0.9961917745544759*w.sq_l_hip_yaw_link*t60 - 0.08718915247898762*w.cq_l_hip_yaw_link*t60;
-    w.KA_pelvis[66] = -0.08718915247898762*w.sq_l_hip_yaw_link*t60 + 0.9961917745544759*w.cq_l_hip_yaw_link*t60;
-    w.KA_pelvis[82] = -0.0875*t63;
-    const Scalar t65 = w.KA_l_hip_yaw_link[3] - w.KA_l_hip_yaw_link[38]*t0;
-    const Scalar t66 = w.KA_l_hip_yaw_link[10] - w.KA_l_hip_yaw_link[38]*t1;
-    const Scalar t67 = w.KA_l_hip_yaw_link[17] - w.KA_l_hip_yaw_link[38]*t2;
-    const Scalar t68 = w.KA_l_hip_yaw_link[31] - w.KA_l_hip_yaw_link[38]*t3;
-    const Scalar t69 = w.cq_l_hip_yaw_link*t65 - w.sq_l_hip_yaw_link*t66;
-    const Scalar t70 = w.sq_l_hip_yaw_link*t65 + w.cq_l_hip_yaw_link*t66;
-    const Scalar t71 = 0.9961917745544759*t69 - 0.08718915247898762*t70;
-    const Scalar t72 = 0.08718915247898762*t69 + 0.9961917745544759*t70;
-    w.KA_pelvis[3] = t71;
-    w.KA_pelvis[19] = t72;
-    w.KA_pelvis[35] = t67;
-    w.KA_pelvis[51] = 0.0875*t67 - 0.9961917745544759*w.sq_l_hip_yaw_link*t68 - 0.08718915247898762*w.cq_l_hip_yaw_link*t68;
-    w.KA_pelvis[67] = -0.08718915247898762*w.sq_l_hip_yaw_link*t68 + 0.9961917745544759*w.cq_l_hip_yaw_link*t68;
-    w.KA_pelvis[83] = -0.0875*t71;
-    const Scalar t73 = w.KA_l_hip_yaw_link[4] - w.KA_l_hip_yaw_link[39]*t0;
-    const Scalar t74 = w.KA_l_hip_yaw_link[11] - w.KA_l_hip_yaw_link[39]*t1;
-    const Scalar t75 = w.KA_l_hip_yaw_link[18] - w.KA_l_hip_yaw_link[39]*t2;
-    const Scalar t76 = w.KA_l_hip_yaw_link[32] - w.KA_l_hip_yaw_link[39]*t3;
-    const Scalar t77 = w.cq_l_hip_yaw_link*t73 - w.sq_l_hip_yaw_link*t74;
-    const Scalar t78 = w.sq_l_hip_yaw_link*t73 + w.cq_l_hip_yaw_link*t74;
-    const Scalar t79 = 0.9961917745544759*t77 - 0.08718915247898762*t78;
-    const Scalar t80 = 0.08718915247898762*t77 + 0.9961917745544759*t78;
-    w.KA_pelvis[4] = t79;
-    w.KA_pelvis[20] = t80;
-    w.KA_pelvis[36] = t75;
-    w.KA_pelvis[52] = 0.0875*t75 - 0.9961917745544759*w.sq_l_hip_yaw_link*t76 - 0.08718915247898762*w.cq_l_hip_yaw_link*t76;
-    w.KA_pelvis[68] = -0.08718915247898762*w.sq_l_hip_yaw_link*t76 + 0.9961917745544759*w.cq_l_hip_yaw_link*t76;
-    w.KA_pelvis[84] = -0.0875*t79;
-    const Scalar t81 = w.KA_l_hip_yaw_link[5] - w.KA_l_hip_yaw_link[40]*t0;
-    const Scalar t82 = w.KA_l_hip_yaw_link[12] - w.KA_l_hip_yaw_link[40]*t1;
-    const Scalar t83 = w.KA_l_hip_yaw_link[19] - w.KA_l_hip_yaw_link[40]*t2;
-    const Scalar t84 = w.KA_l_hip_yaw_link[33] - w.KA_l_hip_yaw_link[40]*t3;
-    const Scalar t85 = w.cq_l_hip_yaw_link*t81 - w.sq_l_hip_yaw_link*t82;
-    const Scalar t86 = w.sq_l_hip_yaw_link*t81 + w.cq_l_hip_yaw_link*t82;
-    const Scalar t87 = 0.9961917745544759*t85 - 0.08718915247898762*t86;
-    const Scalar t88 = 0.08718915247898762*t85 + 0.9961917745544759*t86;
-    w.KA_pelvis[5] = t87;
-    w.KA_pelvis[21] = t88;
-    w.KA_pelvis[37] = t83;
-    w.KA_pelvis[53] = 0.0875*t83 - 0.9961917745544759*w.sq_l_hip_yaw_link*t84 - 0.08718915247898762*w.cq_l_hip_yaw_link*t84;
-    w.KA_pelvis[69] = -0.08718915247898762*w.sq_l_hip_yaw_link*t84 + 0.9961917745544759*w.cq_l_hip_yaw_link*t84;
-    w.KA_pelvis[85] = -0.0875*t87;
+    // columns 0 to 5
+    for (int j = 0; j < 6; ++j) {
+      w.KSD_l_hip_yaw_link[j] = w.Dinv_l_hip_yaw_link*w.KA_l_hip_yaw_link[35 + j];
+      const Scalar t41 = w.KA_l_hip_yaw_link[j] - t0*w.KA_l_hip_yaw_link[35 + j];
+      const Scalar t42 = w.KA_l_hip_yaw_link[7 + j] - t1*w.KA_l_hip_yaw_link[35 + j];
+      const Scalar t43 = w.KA_l_hip_yaw_link[14 + j] - t2*w.KA_l_hip_yaw_link[35 + j];
+      const Scalar t44 = w.KA_l_hip_yaw_link[28 + j] - t3*w.KA_l_hip_yaw_link[35 + j];
+      const Scalar t45 = w.cq_l_hip_yaw_link*t41 - w.sq_l_hip_yaw_link*t42;
+      const Scalar t46 = w.sq_l_hip_yaw_link*t41 + w.cq_l_hip_yaw_link*t42;
+      const Scalar t47 = w.cq_l_hip_yaw_link*w.KA_l_hip_yaw_link[21 + j] - w.sq_l_hip_yaw_link*t44;
+      const Scalar t48 = w.sq_l_hip_yaw_link*w.KA_l_hip_yaw_link[21 + j] + w.cq_l_hip_yaw_link*t44;
+      const Scalar t49 = 0.9961917745544759*t45 - 0.08718915247898762*t46;
+      const Scalar t50 = 0.08718915247898762*t45 + 0.9961917745544759*t46;
+      w.KA_pelvis[j] = t49;
+      w.KA_pelvis[16 + j] = t50;
+      w.KA_pelvis[32 + j] = t43;
+      w.KA_pelvis[48 + j] = 0.0875*t43 + 0.9961917745544759*t47 - 0.08718915247898762*t48;
+      w.KA_pelvis[64 + j] = 0.08718915247898762*t47 + 0.9961917745544759*t48;
+      w.KA_pelvis[80 + j] = -0.0875*t49;
+    }
   }
 }
 

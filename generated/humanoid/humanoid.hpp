@@ -384,10 +384,10 @@ struct Workspace {
   Scalar a_neck_link[6];       // acceleration (gravity-shifted), body 23
   Scalar KSD_r_hand[3];        // D^-1 S^T KA, body 31
   Scalar KA_r_wrist_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 30
-  Scalar KSD_r_wrist_pitch_link[3]; // D^-1 S^T KA, body 30
   Scalar KA_r_wrist_yaw_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 29
-  Scalar KSD_r_wrist_yaw_link[3]; // D^-1 S^T KA, body 29
+  Scalar KSD_r_wrist_pitch_link[3]; // D^-1 S^T KA, body 30
   Scalar KA_r_forearm[24];     // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 28
+  Scalar KSD_r_wrist_yaw_link[3]; // D^-1 S^T KA, body 29
   Scalar KSD_r_forearm[3];     // D^-1 S^T KA, body 28
   Scalar KA_r_upper_arm[24];   // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 27
   Scalar KSD_r_upper_arm[3];   // D^-1 S^T KA, body 27
@@ -400,8 +400,8 @@ struct Workspace {
   Scalar KA_abdomen[24];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 14
   Scalar KSD_abdomen[3];       // D^-1 S^T KA, body 14
   Scalar KA_pelvis[96];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
-  Scalar KSD_r_foot[6];        // D^-1 S^T KA, body 13
   Scalar KA_r_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 12
+  Scalar KSD_r_foot[6];        // D^-1 S^T KA, body 13
   Scalar KSD_r_ankle_link[6];  // D^-1 S^T KA, body 12
   Scalar KA_r_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 11
   Scalar KSD_r_shank[6];       // D^-1 S^T KA, body 11
@@ -411,8 +411,8 @@ struct Workspace {
   Scalar KSD_r_hip_roll_link[6]; // D^-1 S^T KA, body 9
   Scalar KA_r_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 8
   Scalar KSD_r_hip_yaw_link[6]; // D^-1 S^T KA, body 8
-  Scalar KSD_l_foot[6];        // D^-1 S^T KA, body 7
   Scalar KA_l_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 6
+  Scalar KSD_l_foot[6];        // D^-1 S^T KA, body 7
   Scalar KSD_l_ankle_link[6];  // D^-1 S^T KA, body 6
   Scalar KA_l_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
   Scalar KSD_l_shank[6];       // D^-1 S^T KA, body 5

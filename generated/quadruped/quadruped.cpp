@@ -37,8 +37,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    w.sq_LF_hip = std::sin(q[7]);
-    w.cq_LF_hip = std::cos(q[7]);
+    proxgen_rt::sincos(q[7], w.sq_LF_hip, w.cq_LF_hip);
     w.RJ_LF_hip[0] = 0.9900990099009903 + 0.009900990099009688*w.cq_LF_hip;
     w.RJ_LF_hip[1] = -0.09950371902099893*w.sq_LF_hip;
     w.RJ_LF_hip[2] = 0.09900990099009904 - 0.09900990099009904*w.cq_LF_hip;
@@ -82,8 +81,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
-    w.sq_LF_thigh = std::sin(q[8]);
-    w.cq_LF_thigh = std::cos(q[8]);
+    proxgen_rt::sincos(q[8], w.sq_LF_thigh, w.cq_LF_thigh);
     const Scalar t0 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
     const Scalar t1 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
     w.v_LF_thigh[0] = w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
@@ -112,8 +110,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    w.sq_LF_shank = std::sin(q[9]);
-    w.cq_LF_shank = std::cos(q[9]);
+    proxgen_rt::sincos(q[9], w.sq_LF_shank, w.cq_LF_shank);
     const Scalar t2 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
     const Scalar t3 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
     w.v_LF_shank[0] = w.cq_LF_shank*t2 - w.v_LF_thigh[2]*w.sq_LF_shank;
@@ -151,8 +148,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    w.sq_LH_hip = std::sin(q[10]);
-    w.cq_LH_hip = std::cos(q[10]);
+    proxgen_rt::sincos(q[10], w.sq_LH_hip, w.cq_LH_hip);
     w.RJ_LH_hip[0] = 0.9900990099009901 + 0.00990099009900991*w.cq_LH_hip;
     w.RJ_LH_hip[1] = 0.09950371902099892*w.sq_LH_hip;
     w.RJ_LH_hip[2] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
@@ -193,8 +189,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
-    w.sq_LH_thigh = std::sin(q[11]);
-    w.cq_LH_thigh = std::cos(q[11]);
+    proxgen_rt::sincos(q[11], w.sq_LH_thigh, w.cq_LH_thigh);
     const Scalar t3 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
     const Scalar t4 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
     w.v_LH_thigh[0] = w.cq_LH_thigh*t3 - w.sq_LH_thigh*t4;
@@ -226,8 +221,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    w.sq_LH_shank = std::sin(q[12]);
-    w.cq_LH_shank = std::cos(q[12]);
+    proxgen_rt::sincos(q[12], w.sq_LH_shank, w.cq_LH_shank);
     const Scalar t0 = w.v_LH_thigh[0] - 0.209*w.v_LH_thigh[4];
     const Scalar t1 = w.v_LH_hip[1] + 0.209*w.v_LH_thigh[3];
     w.v_LH_shank[0] = w.cq_LH_shank*t0 - w.v_LH_thigh[2]*w.sq_LH_shank;
@@ -262,8 +256,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    w.sq_RF_hip = std::sin(q[13]);
-    w.cq_RF_hip = std::cos(q[13]);
+    proxgen_rt::sincos(q[13], w.sq_RF_hip, w.cq_RF_hip);
     w.RJ_RF_hip[0] = 0.9900990099009903 + 0.009900990099009688*w.cq_RF_hip;
     w.RJ_RF_hip[1] = -0.09950371902099893*w.sq_RF_hip;
     w.RJ_RF_hip[2] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
@@ -307,8 +300,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
-    w.sq_RF_thigh = std::sin(q[14]);
-    w.cq_RF_thigh = std::cos(q[14]);
+    proxgen_rt::sincos(q[14], w.sq_RF_thigh, w.cq_RF_thigh);
     const Scalar t0 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
     const Scalar t1 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
     w.v_RF_thigh[0] = w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
@@ -337,8 +329,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    w.sq_RF_shank = std::sin(q[15]);
-    w.cq_RF_shank = std::cos(q[15]);
+    proxgen_rt::sincos(q[15], w.sq_RF_shank, w.cq_RF_shank);
     const Scalar t2 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
     const Scalar t3 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
     w.v_RF_shank[0] = w.cq_RF_shank*t2 - w.v_RF_thigh[2]*w.sq_RF_shank;
@@ -376,8 +367,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    w.sq_RH_hip = std::sin(q[16]);
-    w.cq_RH_hip = std::cos(q[16]);
+    proxgen_rt::sincos(q[16], w.sq_RH_hip, w.cq_RH_hip);
     w.RJ_RH_hip[0] = 0.9900990099009901 + 0.00990099009900991*w.cq_RH_hip;
     w.RJ_RH_hip[1] = 0.09950371902099892*w.sq_RH_hip;
     w.RJ_RH_hip[2] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
@@ -418,8 +408,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
-    w.sq_RH_thigh = std::sin(q[17]);
-    w.cq_RH_thigh = std::cos(q[17]);
+    proxgen_rt::sincos(q[17], w.sq_RH_thigh, w.cq_RH_thigh);
     const Scalar t3 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
     const Scalar t4 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
     w.v_RH_thigh[0] = w.cq_RH_thigh*t3 - w.sq_RH_thigh*t4;
@@ -451,8 +440,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
 PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    w.sq_RH_shank = std::sin(q[18]);
-    w.cq_RH_shank = std::cos(q[18]);
+    proxgen_rt::sincos(q[18], w.sq_RH_shank, w.cq_RH_shank);
     const Scalar t0 = w.v_RH_thigh[0] - 0.209*w.v_RH_thigh[4];
     const Scalar t1 = w.v_RH_hip[1] + 0.209*w.v_RH_thigh[3];
     w.v_RH_shank[0] = w.cq_RH_shank*t0 - w.v_RH_thigh[2]*w.sq_RH_shank;
@@ -2607,7 +2595,6 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa4;
     w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa5 + 0.062*t19;
     w.KSD_RH_thigh[0] = w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
-    w.KSD_RH_thigh[2] = w.KA_RH_thigh[18]*w.Dinv_RH_thigh;
     const Scalar t21 = w.KA_RH_thigh[0] - w.KA_RH_thigh[16]*t0;
     const Scalar t22 = w.KA_RH_thigh[8] - w.KA_RH_thigh[16]*t1;
     const Scalar t23 = w.KA_RH_thigh[20] - 0.00020288*w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
@@ -2619,6 +2606,7 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_RH_hip[20] = -w.sq_RH_thigh*w.KA_RH_thigh[12] + w.cq_RH_thigh*t23 + 0.062*t24;
     w.KA_RH_hip[13] = w.cq_RH_thigh*w.KA_RH_thigh[13] + w.sq_RH_thigh*w.KA_RH_thigh[21];
     w.KA_RH_hip[21] = -w.sq_RH_thigh*w.KA_RH_thigh[13] + w.cq_RH_thigh*w.KA_RH_thigh[21];
+    w.KSD_RH_thigh[2] = w.KA_RH_thigh[18]*w.Dinv_RH_thigh;
     const Scalar t26 = w.KA_RH_thigh[2] - w.KA_RH_thigh[18]*t0;
     const Scalar t27 = w.KA_RH_thigh[10] - w.KA_RH_thigh[18]*t1;
     const Scalar t28 = w.KA_RH_thigh[22] - 0.00020288*w.KA_RH_thigh[18]*w.Dinv_RH_thigh;
@@ -2756,11 +2744,7 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[3]*pa3 + w.cq_RH_hip*pa4 + w.RJ_RH_hip[5]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RH_hip[6]*pa3 + w.RJ_RH_hip[7]*pa4 + w.RJ_RH_hip[8]*pa5 + 0.049*t61 - 0.19*t62;
     w.KS_RH_hip[0] = 0.9950371902099892*w.KA_RH_hip[12] - 0.09950371902099892*w.KA_RH_hip[20];
-    w.KS_RH_hip[1] = 0.9950371902099892*w.KA_RH_hip[13] - 0.09950371902099892*w.KA_RH_hip[21];
-    w.KS_RH_hip[2] = 0.9950371902099892*w.KA_RH_hip[14] - 0.09950371902099892*w.KA_RH_hip[22];
     w.KSD_RH_hip[0] = w.Dinv_RH_hip*w.KS_RH_hip[0];
-    w.KSD_RH_hip[1] = w.Dinv_RH_hip*w.KS_RH_hip[1];
-    w.KSD_RH_hip[2] = w.Dinv_RH_hip*w.KS_RH_hip[2];
     const Scalar t64 = w.KA_RH_hip[0] - t0*w.KS_RH_hip[0];
     const Scalar t65 = w.KA_RH_hip[8] - t2*w.KS_RH_hip[0];
     const Scalar t66 = -t1*w.KS_RH_hip[0];
@@ -2776,6 +2760,8 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[48] = w.RJ_RH_hip[0]*t67 + w.RJ_RH_hip[1]*t69 + w.RJ_RH_hip[2]*t68 - 0.049*t72;
     w.KA_trunk[61] = w.RJ_RH_hip[3]*t67 + w.cq_RH_hip*t69 + w.RJ_RH_hip[5]*t68 + 0.19*t72;
     w.KA_trunk[74] = w.RJ_RH_hip[6]*t67 + w.RJ_RH_hip[7]*t69 + w.RJ_RH_hip[8]*t68 + 0.049*t70 - 0.19*t71;
+    w.KS_RH_hip[1] = 0.9950371902099892*w.KA_RH_hip[13] - 0.09950371902099892*w.KA_RH_hip[21];
+    w.KSD_RH_hip[1] = w.Dinv_RH_hip*w.KS_RH_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_RH_hip[1];
     const Scalar t74 = -t0*w.KS_RH_hip[1];
     const Scalar t75 = -t2*w.KS_RH_hip[1];
@@ -2791,6 +2777,8 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[49] = w.RJ_RH_hip[0]*t76 + w.RJ_RH_hip[1]*t78 + w.RJ_RH_hip[2]*t77 - 0.049*t81;
     w.KA_trunk[62] = w.RJ_RH_hip[3]*t76 + w.cq_RH_hip*t78 + w.RJ_RH_hip[5]*t77 + 0.19*t81;
     w.KA_trunk[75] = w.RJ_RH_hip[6]*t76 + w.RJ_RH_hip[7]*t78 + w.RJ_RH_hip[8]*t77 + 0.049*t79 - 0.19*t80;
+    w.KS_RH_hip[2] = 0.9950371902099892*w.KA_RH_hip[14] - 0.09950371902099892*w.KA_RH_hip[22];
+    w.KSD_RH_hip[2] = w.Dinv_RH_hip*w.KS_RH_hip[2];
     const Scalar t82 = w.KA_RH_hip[2] - t0*w.KS_RH_hip[2];
     const Scalar t83 = w.KA_RH_hip[10] - t2*w.KS_RH_hip[2];
     const Scalar t84 = -t1*w.KS_RH_hip[2];
@@ -2931,7 +2919,6 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa4;
     w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa5 + 0.062*t19;
     w.KSD_RF_thigh[0] = w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
-    w.KSD_RF_thigh[2] = w.KA_RF_thigh[18]*w.Dinv_RF_thigh;
     const Scalar t21 = w.KA_RF_thigh[0] - w.KA_RF_thigh[16]*t0;
     const Scalar t22 = w.KA_RF_thigh[8] - w.KA_RF_thigh[16]*t1;
     const Scalar t23 = w.KA_RF_thigh[20] - 0.00020288*w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
@@ -2943,6 +2930,7 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_RF_hip[20] = -w.sq_RF_thigh*w.KA_RF_thigh[12] + w.cq_RF_thigh*t23 + 0.062*t24;
     w.KA_RF_hip[13] = w.cq_RF_thigh*w.KA_RF_thigh[13] + w.sq_RF_thigh*w.KA_RF_thigh[21];
     w.KA_RF_hip[21] = -w.sq_RF_thigh*w.KA_RF_thigh[13] + w.cq_RF_thigh*w.KA_RF_thigh[21];
+    w.KSD_RF_thigh[2] = w.KA_RF_thigh[18]*w.Dinv_RF_thigh;
     const Scalar t26 = w.KA_RF_thigh[2] - w.KA_RF_thigh[18]*t0;
     const Scalar t27 = w.KA_RF_thigh[10] - w.KA_RF_thigh[18]*t1;
     const Scalar t28 = w.KA_RF_thigh[22] - 0.00020288*w.KA_RF_thigh[18]*w.Dinv_RF_thigh;
@@ -3080,11 +3068,7 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RF_hip[3]*pa3 + w.cq_RF_hip*pa4 + w.RJ_RF_hip[5]*pa5 - 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RF_hip[6]*pa3 + w.RJ_RF_hip[7]*pa4 + w.RJ_RF_hip[8]*pa5 + 0.049*t61 + 0.19*t62;
     w.KS_RF_hip[0] = 0.9950371902099893*w.KA_RF_hip[12] + 0.09950371902099893*w.KA_RF_hip[20];
-    w.KS_RF_hip[1] = 0.9950371902099893*w.KA_RF_hip[13] + 0.09950371902099893*w.KA_RF_hip[21];
-    w.KS_RF_hip[2] = 0.9950371902099893*w.KA_RF_hip[14] + 0.09950371902099893*w.KA_RF_hip[22];
     w.KSD_RF_hip[0] = w.Dinv_RF_hip*w.KS_RF_hip[0];
-    w.KSD_RF_hip[1] = w.Dinv_RF_hip*w.KS_RF_hip[1];
-    w.KSD_RF_hip[2] = w.Dinv_RF_hip*w.KS_RF_hip[2];
     const Scalar t64 = w.KA_RF_hip[0] - t0*w.KS_RF_hip[0];
     const Scalar t65 = w.KA_RF_hip[8] - t2*w.KS_RF_hip[0];
     const Scalar t66 = -t1*w.KS_RF_hip[0];
@@ -3100,6 +3084,8 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[45] = w.RJ_RF_hip[0]*t67 + w.RJ_RF_hip[1]*t69 + w.RJ_RF_hip[2]*t68 - 0.049*t72;
     w.KA_trunk[58] = w.RJ_RF_hip[3]*t67 + w.cq_RF_hip*t69 + w.RJ_RF_hip[5]*t68 - 0.19*t72;
     w.KA_trunk[71] = w.RJ_RF_hip[6]*t67 + w.RJ_RF_hip[7]*t69 + w.RJ_RF_hip[8]*t68 + 0.049*t70 + 0.19*t71;
+    w.KS_RF_hip[1] = 0.9950371902099893*w.KA_RF_hip[13] + 0.09950371902099893*w.KA_RF_hip[21];
+    w.KSD_RF_hip[1] = w.Dinv_RF_hip*w.KS_RF_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_RF_hip[1];
     const Scalar t74 = -t0*w.KS_RF_hip[1];
     const Scalar t75 = -t2*w.KS_RF_hip[1];
@@ -3115,6 +3101,8 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[46] = w.RJ_RF_hip[0]*t76 + w.RJ_RF_hip[1]*t78 + w.RJ_RF_hip[2]*t77 - 0.049*t81;
     w.KA_trunk[59] = w.RJ_RF_hip[3]*t76 + w.cq_RF_hip*t78 + w.RJ_RF_hip[5]*t77 - 0.19*t81;
     w.KA_trunk[72] = w.RJ_RF_hip[6]*t76 + w.RJ_RF_hip[7]*t78 + w.RJ_RF_hip[8]*t77 + 0.049*t79 + 0.19*t80;
+    w.KS_RF_hip[2] = 0.9950371902099893*w.KA_RF_hip[14] + 0.09950371902099893*w.KA_RF_hip[22];
+    w.KSD_RF_hip[2] = w.Dinv_RF_hip*w.KS_RF_hip[2];
     const Scalar t82 = w.KA_RF_hip[2] - t0*w.KS_RF_hip[2];
     const Scalar t83 = w.KA_RF_hip[10] - t2*w.KS_RF_hip[2];
     const Scalar t84 = -t1*w.KS_RF_hip[2];
@@ -3255,7 +3243,6 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa4;
     w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa5 - 0.062*t19;
     w.KSD_LH_thigh[0] = w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
-    w.KSD_LH_thigh[2] = w.KA_LH_thigh[18]*w.Dinv_LH_thigh;
     const Scalar t21 = w.KA_LH_thigh[0] - w.KA_LH_thigh[16]*t0;
     const Scalar t22 = w.KA_LH_thigh[8] - w.KA_LH_thigh[16]*t1;
     const Scalar t23 = w.KA_LH_thigh[20] + 0.00020288*w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
@@ -3267,6 +3254,7 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_LH_hip[20] = -w.sq_LH_thigh*w.KA_LH_thigh[12] + w.cq_LH_thigh*t23 - 0.062*t24;
     w.KA_LH_hip[13] = w.cq_LH_thigh*w.KA_LH_thigh[13] + w.sq_LH_thigh*w.KA_LH_thigh[21];
     w.KA_LH_hip[21] = -w.sq_LH_thigh*w.KA_LH_thigh[13] + w.cq_LH_thigh*w.KA_LH_thigh[21];
+    w.KSD_LH_thigh[2] = w.KA_LH_thigh[18]*w.Dinv_LH_thigh;
     const Scalar t26 = w.KA_LH_thigh[2] - w.KA_LH_thigh[18]*t0;
     const Scalar t27 = w.KA_LH_thigh[10] - w.KA_LH_thigh[18]*t1;
     const Scalar t28 = w.KA_LH_thigh[22] + 0.00020288*w.KA_LH_thigh[18]*w.Dinv_LH_thigh;
@@ -3404,11 +3392,7 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LH_hip[3]*pa3 + w.cq_LH_hip*pa4 + w.RJ_LH_hip[5]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LH_hip[6]*pa3 + w.RJ_LH_hip[7]*pa4 + w.RJ_LH_hip[8]*pa5 - 0.049*t61 - 0.19*t62;
     w.KS_LH_hip[0] = 0.9950371902099892*w.KA_LH_hip[12] - 0.09950371902099892*w.KA_LH_hip[20];
-    w.KS_LH_hip[1] = 0.9950371902099892*w.KA_LH_hip[13] - 0.09950371902099892*w.KA_LH_hip[21];
-    w.KS_LH_hip[2] = 0.9950371902099892*w.KA_LH_hip[14] - 0.09950371902099892*w.KA_LH_hip[22];
     w.KSD_LH_hip[0] = w.Dinv_LH_hip*w.KS_LH_hip[0];
-    w.KSD_LH_hip[1] = w.Dinv_LH_hip*w.KS_LH_hip[1];
-    w.KSD_LH_hip[2] = w.Dinv_LH_hip*w.KS_LH_hip[2];
     const Scalar t64 = w.KA_LH_hip[0] - t0*w.KS_LH_hip[0];
     const Scalar t65 = w.KA_LH_hip[8] - t2*w.KS_LH_hip[0];
     const Scalar t66 = -t1*w.KS_LH_hip[0];
@@ -3424,6 +3408,8 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[42] = w.RJ_LH_hip[0]*t67 + w.RJ_LH_hip[1]*t69 + w.RJ_LH_hip[2]*t68 + 0.049*t72;
     w.KA_trunk[55] = w.RJ_LH_hip[3]*t67 + w.cq_LH_hip*t69 + w.RJ_LH_hip[5]*t68 + 0.19*t72;
     w.KA_trunk[68] = w.RJ_LH_hip[6]*t67 + w.RJ_LH_hip[7]*t69 + w.RJ_LH_hip[8]*t68 - 0.049*t70 - 0.19*t71;
+    w.KS_LH_hip[1] = 0.9950371902099892*w.KA_LH_hip[13] - 0.09950371902099892*w.KA_LH_hip[21];
+    w.KSD_LH_hip[1] = w.Dinv_LH_hip*w.KS_LH_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_LH_hip[1];
     const Scalar t74 = -t0*w.KS_LH_hip[1];
     const Scalar t75 = -t2*w.KS_LH_hip[1];
@@ -3439,6 +3425,8 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.KA_trunk[43] = w.RJ_LH_hip[0]*t76 + w.RJ_LH_hip[1]*t78 + w.RJ_LH_hip[2]*t77 + 0.049*t81;
     w.KA_trunk[56] = w.RJ_LH_hip[3]*t76 + w.cq_LH_hip*t78 + w.RJ_LH_hip[5]*t77 + 0.19*t81;
     w.KA_trunk[69] = w.RJ_LH_hip[6]*t76 + w.RJ_LH_hip[7]*t78 + w.RJ_LH_hip[8]*t77 - 0.049*t79 - 0.19*t80;
+    w.KS_LH_hip[2] = 0.9950371902099892*w.KA_LH_hip[14] - 0.09950371902099892*w.KA_LH_hip[22];
+    w.KSD_LH_hip[2] = w.Dinv_LH_hip*w.KS_LH_hip[2];
     const Scalar t82 = w.KA_LH_hip[2] - t0*w.KS_LH_hip[2];
     const Scalar t83 = w.KA_LH_hip[10] - t2*w.KS_LH_hip[2];
     const Scalar t84 = -t1*w.KS_LH_hip[2];
@@ -3579,7 +3567,6 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa4;
     w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa5 - 0.062*t19;
     w.KSD_LF_thigh[0] = w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
-    w.KSD_LF_thigh[2] = w.KA_LF_thigh[18]*w.Dinv_LF_thigh;
     const Scalar t21 = w.KA_LF_thigh[0] - w.KA_LF_thigh[16]*t0;
     const Scalar t22 = w.KA_LF_thigh[8] - w.KA_LF_thigh[16]*t1;
     const Scalar t23 = w.KA_LF_thigh[20] + 0.00020288*w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
@@ -3591,6 +3578,7 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_LF_hip[20] = -w.sq_LF_thigh*w.KA_LF_thigh[12] + w.cq_LF_thigh*t23 - 0.062*t24;
     w.KA_LF_hip[13] = w.cq_LF_thigh*w.KA_LF_thigh[13] + w.sq_LF_thigh*w.KA_LF_thigh[21];
     w.KA_LF_hip[21] = -w.sq_LF_thigh*w.KA_LF_thigh[13] + w.cq_LF_thigh*w.KA_LF_thigh[21];
+    w.KSD_LF_thigh[2] = w.KA_LF_thigh[18]*w.Dinv_LF_thigh;
     const Scalar t26 = w.KA_LF_thigh[2] - w.KA_LF_thigh[18]*t0;
     const Scalar t27 = w.KA_LF_thigh[10] - w.KA_LF_thigh[18]*t1;
     const Scalar t28 = w.KA_LF_thigh[22] + 0.00020288*w.KA_LF_thigh[18]*w.Dinv_LF_thigh;
@@ -3728,11 +3716,7 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LF_hip[3]*pa3 + w.cq_LF_hip*pa4 + w.RJ_LF_hip[5]*pa5 - 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LF_hip[6]*pa3 + w.RJ_LF_hip[7]*pa4 + w.RJ_LF_hip[8]*pa5 - 0.049*t61 + 0.19*t62;
     w.KS_LF_hip[0] = 0.9950371902099893*w.KA_LF_hip[12] + 0.09950371902099893*w.KA_LF_hip[20];
-    w.KS_LF_hip[1] = 0.9950371902099893*w.KA_LF_hip[13] + 0.09950371902099893*w.KA_LF_hip[21];
-    w.KS_LF_hip[2] = 0.9950371902099893*w.KA_LF_hip[14] + 0.09950371902099893*w.KA_LF_hip[22];
     w.KSD_LF_hip[0] = w.Dinv_LF_hip*w.KS_LF_hip[0];
-    w.KSD_LF_hip[1] = w.Dinv_LF_hip*w.KS_LF_hip[1];
-    w.KSD_LF_hip[2] = w.Dinv_LF_hip*w.KS_LF_hip[2];
     const Scalar t64 = w.KA_LF_hip[0] - t0*w.KS_LF_hip[0];
     const Scalar t65 = w.KA_LF_hip[8] - t2*w.KS_LF_hip[0];
     const Scalar t66 = -t1*w.KS_LF_hip[0];
@@ -3748,6 +3732,8 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_trunk[39] = w.RJ_LF_hip[0]*t67 + w.RJ_LF_hip[1]*t69 + w.RJ_LF_hip[2]*t68 + 0.049*t72;
     w.KA_trunk[52] = w.RJ_LF_hip[3]*t67 + w.cq_LF_hip*t69 + w.RJ_LF_hip[5]*t68 - 0.19*t72;
     w.KA_trunk[65] = w.RJ_LF_hip[6]*t67 + w.RJ_LF_hip[7]*t69 + w.RJ_LF_hip[8]*t68 - 0.049*t70 + 0.19*t71;
+    w.KS_LF_hip[1] = 0.9950371902099893*w.KA_LF_hip[13] + 0.09950371902099893*w.KA_LF_hip[21];
+    w.KSD_LF_hip[1] = w.Dinv_LF_hip*w.KS_LF_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_LF_hip[1];
     const Scalar t74 = -t0*w.KS_LF_hip[1];
     const Scalar t75 = -t2*w.KS_LF_hip[1];
@@ -3763,6 +3749,8 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.KA_trunk[40] = w.RJ_LF_hip[0]*t76 + w.RJ_LF_hip[1]*t78 + w.RJ_LF_hip[2]*t77 + 0.049*t81;
     w.KA_trunk[53] = w.RJ_LF_hip[3]*t76 + w.cq_LF_hip*t78 + w.RJ_LF_hip[5]*t77 - 0.19*t81;
     w.KA_trunk[66] = w.RJ_LF_hip[6]*t76 + w.RJ_LF_hip[7]*t78 + w.RJ_LF_hip[8]*t77 - 0.049*t79 + 0.19*t80;
+    w.KS_LF_hip[2] = 0.9950371902099893*w.KA_LF_hip[14] + 0.09950371902099893*w.KA_LF_hip[22];
+    w.KSD_LF_hip[2] = w.Dinv_LF_hip*w.KS_LF_hip[2];
     const Scalar t82 = w.KA_LF_hip[2] - t0*w.KS_LF_hip[2];
     const Scalar t83 = w.KA_LF_hip[10] - t2*w.KS_LF_hip[2];
     const Scalar t84 = -t1*w.KS_LF_hip[2];

@@ -181,6 +181,8 @@ class Emitter {
   void freeRowAccelerations();
   void pvRows(int i);
   void pvRowsOneDof(int i);
+  int loopableColumns(int i, int c0);
+  std::string loopSlot(const Quantity& qy, int body, int size, int idx);
   void pvRowsFreeFlyer(int i);
 
   // algebra
@@ -196,6 +198,9 @@ class Emitter {
   // functions
   /// Slots per row of the row-major KA and Z: m columns and one unused slot.
   static int rowStride(int m) { return m + 1; }
+  /// Runs of at least this many constraint columns that go through the same
+  /// arithmetic are printed as a loop (README, "The generated solver").
+  static constexpr int kLoopColumns = 4;
   static constexpr int kPartBudget = 40;  // statements per part (before dead-code removal): measured best
   struct Host {
     std::string name;
@@ -620,26 +625,98 @@ void Emitter::pvRowsOneDof(int i) {
   const BodyPlan& p = bp(i);
   const int m = p.m(), off = p.offsetInParent;
   const V6& S = b.S[0];
-  b.KS.assign(std::size_t(m), std::vector<Expr>(1));
-  for (int j = 0; j < m; ++j) b.KS[std::size_t(j)][0] = keepQ(kKS, i, m, j, dot(cb, S, b.KA[std::size_t(j)]));
-  b.KSD.resize(std::size_t(m));
-  for (int j = 0; j < m; ++j) b.KSD[std::size_t(j)] = keepQ(kKSD, i, m, j, cb.mul(b.Dinv, b.KS[std::size_t(j)][0]));
-  if (p.parent == 0) return;  // KA_0 only met the root acceleration, in y_free
-  V6 UD;
-  for (int r = 0; r < 6; ++r) UD[std::size_t(r)] = cb.flat(cb.mul(b.U[0][std::size_t(r)], b.Dinv), "UD");
   const int along = axisComponent(p);
-  BodySym& par = bs(p.parent);
-  const int mp = bp(p.parent).m();
-  for (int j = 0; j < m; ++j) {
+  const bool passes = p.parent != 0;  // KA_0 only met the root acceleration, in y_free
+  V6 UD;
+  if (passes)
+    for (int r = 0; r < 6; ++r) UD[std::size_t(r)] = cb.flat(cb.mul(b.U[0][std::size_t(r)], b.Dinv), "UD");
+  b.KS.assign(std::size_t(m), std::vector<Expr>(1));
+  b.KSD.resize(std::size_t(m));
+  auto plain = [&](const Expr& e) { return e.isConstant() || cb.isAlias(e); };  // nothing to store
+  // One column: KS, KSD, and (below the root) its column of the parent's KA.
+  // `ka` reads the column, `at` names slot c0 + j of a member ("[c0 + j]" in
+  // a loop over j, "[c]" unrolled).
+  auto column = [&](const V6& ka, const std::function<std::string(const Quantity&, int, int, int)>& at) {
+    struct Out {
+      Expr ks, ksd;
+      V6 f;
+      bool ksdStored = false;
+    } out;
+    const Expr ks = dot(cb, S, ka);
+    out.ks = plain(ks) ? ks : cb.store(at(kKS, i, m, 0), ks);
+    const Expr ksd = cb.mul(b.Dinv, out.ks);
+    out.ksdStored = !plain(ksd);
+    out.ksd = out.ksdStored ? cb.store(at(kKSD, i, m, 0), ksd) : ksd;
+    if (!passes) return out;
     V6 col;
-    for (int r = 0; r < 6; ++r)
-      col[std::size_t(r)] = b.KA[std::size_t(j)][std::size_t(r)] - cb.mul(UD[std::size_t(r)], b.KS[std::size_t(j)][0]);
+    for (int r = 0; r < 6; ++r) col[std::size_t(r)] = ka[std::size_t(r)] - cb.mul(UD[std::size_t(r)], out.ks);
     if (along >= 0) col[std::size_t(along)] = Expr();  // S^T (KA - U D^-1 KS) = 0
-    const V6 f = forceToParent(i, col);
-    for (int r = 0; r < 6; ++r)
-      par.KA[std::size_t(off + j)][std::size_t(r)] =
-          putQ(kKA, p.parent, 6 * rowStride(mp), r * rowStride(mp) + off + j, f[std::size_t(r)]);
+    out.f = forceToParent(i, col);
+    return out;
+  };
+  const int stride = rowStride(m), mp = passes ? bp(p.parent).m() : 0, pstride = rowStride(mp);
+  BodySym& par = bs(p.parent);
+  for (int c0 = 0; c0 < m;) {
+    const int len = loopableColumns(i, c0);
+    if (len >= kLoopColumns) {
+      // Columns c0 .. c0 + len - 1 go through identical arithmetic: one loop
+      // (vectorised by the compiler) instead of len copies of the code.
+      cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
+      V6 ka;
+      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(loopSlot(kKA, i, 6 * stride, r * stride + c0));
+      const auto out = column(ka, [&](const Quantity& qy, int body, int size, int) { return loopSlot(qy, body, size, c0); });
+      if (passes)
+        for (int r = 0; r < 6; ++r)
+          cb.store(loopSlot(kKA, p.parent, 6 * pstride, r * pstride + off + c0), out.f[std::size_t(r)]);
+      if (!out.ksdStored) throw std::logic_error("emitter: a looped column's D^-1 KS is not stored");
+      cb.close();
+      for (int c = c0; c < c0 + len; ++c) {
+        const auto cu = std::size_t(c);
+        const Expr ks = dot(cb, S, b.KA[cu]);  // the loop's KS for column c: a pick of KA prints nothing
+        b.KS[cu][0] = plain(ks) ? ks : cb.member(member(kKS, i, m, c));
+        b.KSD[cu] = cb.member(member(kKSD, i, m, c));
+        if (passes)
+          for (int r = 0; r < 6; ++r)
+            par.KA[std::size_t(off + c)][std::size_t(r)] = cb.member(member(kKA, p.parent, 6 * pstride, r * pstride + off + c));
+      }
+      c0 += len;
+      continue;
+    }
+    const auto out = column(b.KA[std::size_t(c0)], [&](const Quantity& qy, int body, int size, int) {
+      return member(qy, body, size, c0);
+    });
+    b.KS[std::size_t(c0)][0] = out.ks;
+    b.KSD[std::size_t(c0)] = out.ksd;
+    if (passes)
+      for (int r = 0; r < 6; ++r)
+        par.KA[std::size_t(off + c0)][std::size_t(r)] =
+            putQ(kKA, p.parent, 6 * pstride, r * pstride + off + c0, out.f[std::size_t(r)]);
+    ++c0;
   }
+}
+
+// How many columns from c0 on hold exactly the members KA_i[r * stride + c]
+// (each entry stored, none folded): a loop over them reads the same slots.
+int Emitter::loopableColumns(int i, int c0) {
+  const BodySym& b = bs(i);
+  const int m = bp(i).m(), stride = rowStride(m);
+  int c = c0;
+  for (; c < m; ++c) {
+    bool canonical = true;
+    for (int r = 0; r < 6 && canonical; ++r) {
+      const Expr& e = b.KA[std::size_t(c)][std::size_t(r)];
+      canonical = e.isScaledAtom() && e.terms()[0].coeff == 1.0 &&
+                  e.terms()[0].atom == cb_->member(member(kKA, i, 6 * stride, r * stride + c)).terms()[0].atom;
+    }
+    if (!canonical) break;
+  }
+  return c - c0;
+}
+
+// Slot idx + j of a per-body array member (j: the loop variable).
+std::string Emitter::loopSlot(const Quantity& qy, int body, int size, int idx) {
+  const std::string first = member(qy, body, size, idx);  // declares the member
+  return idx == 0 ? first.substr(0, first.size() - 2) + "j]" : first.substr(0, first.size() - 1) + " + j]";
 }
 
 // At the free flyer (S = I, D = IA = L L^T, parent the world, KA_0 = 0):
