@@ -10,6 +10,7 @@
 # are ../shared/models (or $PROXGEN_MODELS_DIR). Times are wall-clock seconds
 # of one run and user-CPU seconds; on a loaded machine expect them to spread.
 # --march X compiles with -march=X (default: the compiler's, x86-64 baseline).
+# The flags are proxgen_add_solver's (with GCC, -fno-tree-slp-vectorize).
 set -euo pipefail
 build=${1:?usage: measure.sh BUILD_DIR [--instructions] [--cxx CXX] [--march X]}
 shift
@@ -25,6 +26,10 @@ while [[ $# -gt 0 ]]; do
   esac
   shift
 done
+# The flags proxgen_add_solver adds (cmake/ProxgenAddSolver.cmake): with GCC,
+# no basic-block SLP vectorisation.
+extra=()
+if "$cxx" --version | grep -q "Free Software Foundation"; then extra=(-fno-tree-slp-vectorize); fi
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 models=${PROXGEN_MODELS_DIR:-$root/../shared/models}
@@ -45,7 +50,7 @@ for c in $cases; do
   t0=$(date +%s%N)
   "$proxgen" generate --cases "$models/cases.yaml" --case "$c" --out "$out" --name "$c" > /dev/null
   t1=$(date +%s%N)
-  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 -O2 "${march[@]}" -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
+  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 -O2 "${march[@]}" "${extra[@]}" -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
   read -r wall user < "$work/time"
   bytes=$(size "$out/$c.o" | awk 'NR == 2 { print $1 + $2 }')
   lines=$(wc -l < "$out/$c.cpp")
