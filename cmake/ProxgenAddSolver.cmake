@@ -59,8 +59,10 @@ function(proxgen_add_solver target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   # GCC's basic-block vectoriser packs unrelated scalar products of the
   # straight-line code into vectors and pays more in shuffles than it saves:
-  # without it the solvers run 4-15 % fewer instructions and time (README,
-  # "Speed"). Loops (the constraint columns) are still vectorised.
+  # without it the solvers run 2-6 % fewer instructions in 3-9 % less time, and
+  # the largest compile faster (with the column loops: 34 -> 20 s at -O2; docs/benchmarks.md,
+  # "Emitted code").
+  # Loops (the constraint columns) are still vectorised.
   target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-tree-slp-vectorize>)
   set_target_properties(${target} PROPERTIES PROXGEN_HEADER "${hpp}" PROXGEN_SOURCE "${cpp}")
 endfunction()
