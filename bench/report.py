@@ -87,15 +87,9 @@ def fmt_ratio(a, b):
 
 
 # ---------------------------------------------------------------- compile time, object size
-def solver_flags(cxx):
-    """The flags proxgen_add_solver adds (cmake/ProxgenAddSolver.cmake): with GCC, no basic-block SLP."""
-    version = subprocess.run([cxx, "--version"], check=True, stdout=subprocess.PIPE, text=True).stdout
-    return ["-fno-tree-slp-vectorize"] if "Free Software Foundation" in version else []
-
-
 def compile_generated(build_dir):
     """[(case, cpu seconds, wall seconds, text, data, bss)] of each generated .cpp compiled alone at -O2
-    (with the build's -march, if any)."""
+    (with the build's -march, if any, and proxgen_add_solver's options, both from bench_config.json)."""
     cfg_path = os.path.join(build_dir, "bench", "bench_config.json")
     if not os.path.exists(cfg_path):
         return []
@@ -107,7 +101,7 @@ def compile_generated(build_dir):
             src = g["source"]
             obj = os.path.join(tmp, g["case"] + ".o")
             march = [f"-march={cfg['march']}"] if cfg.get("march") else []
-            cmd = [cfg["cxx"], "-std=c++17", "-O2", *march, *solver_flags(cfg["cxx"]), "-I", os.path.dirname(src),
+            cmd = [cfg["cxx"], "-std=c++17", "-O2", *march, *cfg.get("solver_options", []), "-I", os.path.dirname(src),
                    "-I", cfg["runtime_include"],
                    "-c", src, "-o", obj]
             before = resource.getrusage(resource.RUSAGE_CHILDREN)

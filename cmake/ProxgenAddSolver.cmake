@@ -9,6 +9,22 @@
 # Needs PROXGEN_EXECUTABLE (path or generator expression), PROXGEN_EXECUTABLE_DEPENDS
 # (what the generation step depends on for "proxgen changed") and
 # PROXGEN_RUNTIME_INCLUDE_DIR; proxgenConfig.cmake and the in-tree build set them.
+# proxgen_solver_compile_options(<out_var>): the compile options
+# proxgen_add_solver gives a generated solver (the bench's compile-time table
+# uses them too). With GCC, no basic-block vectoriser: it packs unrelated scalar
+# products of the straight-line code into vectors and pays more in shuffles than
+# it saves; without it the solvers run 2-6 % fewer instructions in 3-9 % less
+# time and the largest compile faster (with the column loops: 34 -> 20 s at -O2;
+# docs/benchmarks.md, "Emitted code"). Loops (the constraint columns) are still
+# vectorised.
+function(proxgen_solver_compile_options out)
+  set(options "")
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    list(APPEND options -fno-tree-slp-vectorize)
+  endif()
+  set(${out} "${options}" PARENT_SCOPE)
+endfunction()
+
 function(proxgen_add_solver target)
   cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR" "")
   if(PAS_UNPARSED_ARGUMENTS)
@@ -57,12 +73,7 @@ function(proxgen_add_solver target)
   add_library(${target} STATIC "${cpp}" "${hpp}")
   target_include_directories(${target} PUBLIC "${PAS_OUTPUT_DIR}" "${PROXGEN_RUNTIME_INCLUDE_DIR}")
   target_compile_features(${target} PUBLIC cxx_std_17)
-  # GCC's basic-block vectoriser packs unrelated scalar products of the
-  # straight-line code into vectors and pays more in shuffles than it saves:
-  # without it the solvers run 2-6 % fewer instructions in 3-9 % less time, and
-  # the largest compile faster (with the column loops: 34 -> 20 s at -O2; docs/benchmarks.md,
-  # "Emitted code").
-  # Loops (the constraint columns) are still vectorised.
-  target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-tree-slp-vectorize>)
+  proxgen_solver_compile_options(options)
+  target_compile_options(${target} PRIVATE ${options})
   set_target_properties(${target} PROPERTIES PROXGEN_HEADER "${hpp}" PROXGEN_SOURCE "${cpp}")
 endfunction()

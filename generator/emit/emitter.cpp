@@ -634,19 +634,19 @@ void Emitter::pvRowsOneDof(int i) {
   b.KSD.resize(std::size_t(m));
   auto plain = [&](const Expr& e) { return e.isConstant() || cb.isAlias(e); };  // nothing to store
   // One column: KS, KSD, and (below the root) its column of the parent's KA.
-  // `ka` reads the column, `at` names slot c0 + j of a member ("[c0 + j]" in
-  // a loop over j, "[c]" unrolled).
-  auto column = [&](const V6& ka, const std::function<std::string(const Quantity&, int, int, int)>& at) {
+  // `ka` reads the column, `at` names the column's slot of this body's KS or
+  // KSD ("[c0 + j]" in a loop over j, "[c]" unrolled).
+  auto column = [&](const V6& ka, const std::function<std::string(const Quantity&)>& at) {
     struct Out {
       Expr ks, ksd;
       V6 f;
       bool ksdStored = false;
     } out;
     const Expr ks = dot(cb, S, ka);
-    out.ks = plain(ks) ? ks : cb.store(at(kKS, i, m, 0), ks);
+    out.ks = plain(ks) ? ks : cb.store(at(kKS), ks);
     const Expr ksd = cb.mul(b.Dinv, out.ks);
     out.ksdStored = !plain(ksd);
-    out.ksd = out.ksdStored ? cb.store(at(kKSD, i, m, 0), ksd) : ksd;
+    out.ksd = out.ksdStored ? cb.store(at(kKSD), ksd) : ksd;
     if (!passes) return out;
     V6 col;
     for (int r = 0; r < 6; ++r) col[std::size_t(r)] = ka[std::size_t(r)] - cb.mul(UD[std::size_t(r)], out.ks);
@@ -664,7 +664,7 @@ void Emitter::pvRowsOneDof(int i) {
       cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
       V6 ka;
       for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(loopSlot(kKA, i, 6 * stride, r * stride + c0));
-      const auto out = column(ka, [&](const Quantity& qy, int body, int size, int) { return loopSlot(qy, body, size, c0); });
+      const auto out = column(ka, [&](const Quantity& qy) { return loopSlot(qy, i, m, c0); });
       if (passes)
         for (int r = 0; r < 6; ++r)
           cb.store(loopSlot(kKA, p.parent, 6 * pstride, r * pstride + off + c0), out.f[std::size_t(r)]);
@@ -682,9 +682,7 @@ void Emitter::pvRowsOneDof(int i) {
       c0 += len;
       continue;
     }
-    const auto out = column(b.KA[std::size_t(c0)], [&](const Quantity& qy, int body, int size, int) {
-      return member(qy, body, size, c0);
-    });
+    const auto out = column(b.KA[std::size_t(c0)], [&](const Quantity& qy) { return member(qy, i, m, c0); });
     b.KS[std::size_t(c0)][0] = out.ks;
     b.KSD[std::size_t(c0)] = out.ksd;
     if (passes)
