@@ -4,7 +4,7 @@
 # libFuzzer targets (tests/fuzz/run.sh runs them from it): everything is
 # compiled once, with the fuzzer's coverage instrumentation as well.
 #
-# What runs: every GoogleTest suite (tests/test_*.cpp) and the generated-solver
+# What runs: every GoogleTest suite (tests/*/test_*.cpp) and the generated-solver
 # tests, compiled with -fsanitize=address,undefined at -O0 and with assertions
 # on (no NDEBUG: Eigen's index checks and _GLIBCXX_ASSERTIONS catch what ASan
 # cannot see inside fixed-size storage). Any sanitizer report aborts the test.
@@ -54,7 +54,7 @@ null:Eigen/src/Core/PlainObjectBase.h
 SUPP
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1:suppressions=$build/ubsan.supp}"
 # glibc's setlocale keeps the locale path it builds from LOCPATH (argz) for the
-# life of the process: tests/test_determinism.cpp sets a comma locale that way.
+# life of the process: tests/cli/test_determinism.cpp sets a comma locale that way.
 cat > "$build/lsan.supp" <<'SUPP'
 leak:argz_add_sep
 SUPP

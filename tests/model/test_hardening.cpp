@@ -360,7 +360,7 @@ nlohmann::json armState(bool floating) {
 }
 
 TEST(NumericalEdges, NonFiniteStateIsRejected) {
-  // JSON text cannot hold NaN or Inf (tests/test_bad_input.cpp covers the
+  // JSON text cannot hold NaN or Inf (tests/model/test_bad_input.cpp covers the
   // text); a json value built in code can, and stateFromJson must refuse it.
   const Model m = loadUrdf(good("arm3.urdf"), true);
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
