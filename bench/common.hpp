@@ -12,7 +12,7 @@
 
 namespace proxgen::bench {
 
-// The solver settings of every benchmark (anchor-timings.md: K = 3, mu = 1e4).
+// The solver settings of every benchmark (docs/benchmarks.md, "Anchor figures": K = 3, mu = 1e4).
 inline constexpr int kIterations = 3;
 inline constexpr double kMu = 1e4;
 // As many states as the Pinocchio anchor cycled through, so both read the same

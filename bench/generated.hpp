@@ -1,4 +1,4 @@
-// Adapter from a generated solver (PRODUCT.md, "The generated solver": namespace
+// Adapter from a generated solver (README, "The generated solver": namespace
 // with Scalar, nq, nv, nc, Settings, Workspace, constrained_aba, prox_pv) to the
 // benchmark's Solver interface. The build writes generated_solvers.cpp, which
 // includes every generated header and lists one GeneratedEntry per case.

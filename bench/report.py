@@ -22,9 +22,10 @@ import sys
 import tempfile
 import time
 
-# Pinocchio 3.7 on this project's machine kind, K = 3, mu = 1e4 (its mu = 1e-4),
-# median of 60 repetitions, CPU: AMD EPYC KVM 2 vCPU. Copied from
-# shared/design/anchor-timings.md ("What to beat"); Ir = callgrind instructions per call.
+# Pinocchio 3.7 timings measured by the project's steering team on an AVX-512 EPYC
+# (KVM guest, 2 vCPUs), K = 3, mu = 1e4 (its mu = 1e-4), median of 60 repetitions;
+# Ir = callgrind instructions per call. The same figures, with how they were taken:
+# docs/benchmarks.md, "Anchor figures".
 ANCHOR = {
     # case: (nv, rows, aba us, cABA us, PV us, proxLTL us, aba Ir, cABA Ir, PV Ir)
     "iiwa_h3": (7, 3, 1.43, 1.89, 1.77, 2.04, 17163, 23942, 25060),
@@ -43,7 +44,7 @@ ANCHOR_COLUMN = {"aba": (2, 6), "caba": (3, 7), "pv": (4, 8), "ltl": (5, None),
 ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"]
 LABEL = {"aba": "ABA", "caba": "cABA", "pv": "proxPV", "ltl": "proxLTL", "ltls": "proxLTLs",
          "gen_caba": "generated cABA", "gen_pv": "generated proxPV"}
-TARGET = 1.0 / 3.0  # anchor-timings.md: generated solvers at most a third of Pinocchio's figures
+TARGET = 1.0 / 3.0  # the project's target: generated solvers at most a third of Pinocchio's figures
 
 
 # ---------------------------------------------------------------- inputs
@@ -206,7 +207,7 @@ set grid
 def case_tables(suite, calls, cases):
     out = ["## Per case and algorithm", "",
            "Time: median over repetitions of the mean CPU time per call (µs). Ir: instructions per call "
-           "(callgrind). Pinocchio: anchor-timings.md, same cases and settings; ratios below 1 mean faster "
+           "(callgrind). Pinocchio: the anchor figures of docs/benchmarks.md, same cases and settings; ratios below 1 mean faster "
            "than Pinocchio.", ""]
     for c in cases:
         first = next((suite[f"{c}/{a}"] for a in ALGORITHMS if f"{c}/{a}" in suite), None)
@@ -233,7 +234,7 @@ def case_tables(suite, calls, cases):
 def summary_table(suite, calls, cases):
     """Generated / generic and generated / Pinocchio, per case, for cABA and proxPV."""
     out = ["## Generated solvers: ratios", "",
-           f"Target (anchor-timings.md): generated / Pinocchio at most {TARGET:.2f}, in time and in instructions. "
+           f"Target (docs/benchmarks.md, \"Anchor figures\"): generated / Pinocchio at most {TARGET:.2f}, in time and in instructions. "
            "Pinocchio's times were measured on a quiet machine with AVX-512 (a newer processor than the one "
            "named above), ours on a shared one (load average above): the instruction ratios are the ones to hold "
            "against the target; the time ratios to Pinocchio carry the difference of machines "

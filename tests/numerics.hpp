@@ -67,7 +67,7 @@ inline double scaledCondition(const MatX& A) {
 //    (G on its range when it is singular);
 //  - primal algorithms (cABA, proxLTLs): a solve with M_mu = M + mu J^T J
 //    (cABA's articulated inertias IA + mu K^T K are its Schur complements):
-//    kappa = kappa_s(M_mu), which grows with mu (ALGORITHMS.md: cABA's
+//    kappa = kappa_s(M_mu), which grows with mu (docs/algorithms.md §3: cABA's
 //    round-off grows with mu, proxPV's does not).
 // bound = c n eps kappa, c = 10: two implementations' errors add (2) and each
 // chains about five stable steps (factor, two triangular solves, the Delassus

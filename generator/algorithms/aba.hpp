@@ -17,7 +17,7 @@ void initialise(const System& sys, Data& d, const VecX& q, const VecX& v);
 void eliminate(const System& sys, Data& d, int i, const VecX& tau);
 /// a'_i = X_i a_p + c_i ; qdd_i = D_i^-1 (u_i - U_i^T a'_i) ; a_i = a'_i + S_i qdd_i.
 void accelerate(const System& sys, Data& d, int i);
-/// a_0 = -a_g, the gravity trick (ALGORITHMS.md section 1).
+/// a_0 = -a_g, the gravity trick (docs/algorithms.md §1).
 void setRootAcceleration(const System& sys, Data& d);
 }  // namespace aba_steps
 

@@ -1,4 +1,4 @@
-// constrainedABA (ALGORITHMS.md 4.1): augmented-Lagrangian forward dynamics in
+// constrainedABA (docs/algorithms.md §4.1): augmented-Lagrangian forward dynamics in
 // O(n + m) per solve. The penalty mu K^T K enters the inertia of constrained
 // bodies once; iterations 2..K are reduced sweeps over the constraint support.
 #pragma once

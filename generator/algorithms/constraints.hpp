@@ -1,5 +1,5 @@
 // The per-constraint terms the maximal-coordinate recursions use
-// (ALGORITHMS.md section 2): K_i a_i = k_i on the gravity-shifted acceleration
+// (docs/algorithms.md §2): K_i a_i = k_i on the gravity-shifted acceleration
 // of the constrained body, with k_i = a_star - drift - K_i X_{i,0} a_g.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The dense reference (ALGORITHMS.md section 6). Built only from M (CRBA), h
+// The dense reference (docs/algorithms.md §6). Built only from M (CRBA), h
 // (RNEA with qdd = 0) and the frame Jacobians; the linear algebra is plain
 // dense Eigen, so it shares no recursion with the solvers it checks.
 // Allocates freely: it is ground truth, not a solver.

@@ -1,4 +1,4 @@
-// The dense reference (ALGORITHMS.md section 6): ground truth for tests, built
+// The dense reference (docs/algorithms.md §6): ground truth for tests, built
 // from M (CRBA), h (RNEA), J and gamma (frame Jacobians and kinematics) with
 // dense Eigen linear algebra, and nothing shared with the recursions.
 #pragma once

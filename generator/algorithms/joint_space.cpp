@@ -33,7 +33,7 @@ void fillJacobianRows(const System& sys, Data& d, const Constraint& c) {
 void assemble(const System& sys, Data& d, const VecX& q, const VecX& v) {
   crba(sys, d, q);
   // h = RNEA(q, v, 0). RNEA leaves in d.a the gravity-shifted bias
-  // accelerations a0_i = a_i(qdd = 0) - X_{i,0} a_g (ALGORITHMS.md 1).
+  // accelerations a0_i = a_i(qdd = 0) - X_{i,0} a_g (docs/algorithms.md §1).
   d.qdd.setZero();
   d.h = rnea(sys, d, q, v, d.qdd);
   computeConstraintTerms(sys, d);

@@ -64,7 +64,7 @@ void proxLtl(const System& sys, Data& d, const VecX& q, const VecX& v, const Vec
     d.work.head(nv) = d.jsB.cwiseQuotient(d.LD.diagonal());
     d.yfree.noalias() = d.JMinv * d.work.head(nv);
     d.yfree += d.gamma - d.aStar;
-    // (G + I/mu) lambda+ = y_free + lambda / mu (ALGORITHMS.md 3 and 4.2).
+    // (G + I/mu) lambda+ = y_free + lambda / mu (docs/algorithms.md §3 and §4.2).
     d.G.diagonal().array() += 1.0 / mu;
     d.llt.compute(d.G);
     for (int k = 0; k < iterations; ++k) {

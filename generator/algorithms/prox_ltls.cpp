@@ -44,7 +44,7 @@ void proxLtls(const System& sys, Data& d, const VecX& q, const VecX& v, const Ve
   // Stationarity of the augmented Lagrangian (Gauss' principle + lambda^T r + mu/2 |r|^2,
   // r = J qdd + gamma - aStar): M_mu qdd = tau - h - J^T (lambda + mu (gamma - aStar)).
   // Each iteration: one sparse solve, then lambda += mu r. K updates = K solves,
-  // and the last solve's qdd is qdd^K (ALGORITHMS.md 3).
+  // and the last solve's qdd is qdd^K (docs/algorithms.md §3).
   for (int k = 0; k < iterations; ++k) {
     d.rhs = d.lambda + mu * (d.gamma - d.aStar);
     d.qdd = tau - d.h;

@@ -1,4 +1,4 @@
-// proxLTLs (ALGORITHMS.md 5): joint-space primal. M_mu = M + mu J^T J keeps the
+// proxLTLs (docs/algorithms.md §5.2): joint-space primal. M_mu = M + mu J^T J keeps the
 // branch-induced sparsity of M, so one sparse L^T D L factorisation serves all
 // iterations; each iteration is one sparse solve plus the multiplier update.
 #pragma once

@@ -11,7 +11,7 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
   aba_steps::initialise(sys, d, q, v);
   computeConstraintTerms(sys, d);
 
-  // ALGORITHMS.md 4.2 with lA_i and LA_i kept in place: subtree i's rows are
+  // docs/algorithms.md §4.2 with lA_i and LA_i kept in place: subtree i's rows are
   // the block [s_i, s_i + m_(i)) of the tree order, so "lA_p[rows of i] = lA_i + ..."
   // and "LA_p[block of i] = LA_i + ..." add into that block of y_free and G,
   // and nothing is copied from child to parent.

@@ -1,4 +1,4 @@
-// proxPV (ALGORITHMS.md 4.2): proximal Popov-Vereshchagin. One ABA-like backward
+// proxPV (docs/algorithms.md §4.2): proximal Popov-Vereshchagin. One ABA-like backward
 // sweep that also carries, for the constraint rows of each subtree, their force
 // directions KA, free accelerations lA and Delassus block LA; at the root the
 // m x m Delassus matrix G is factored once with I/mu and the proximal

@@ -182,7 +182,7 @@ double fdTolerance(const VecX& v, const VecX& qdd, const Constraint& c) {
 
 // A point contact on a spinning body: J qdd + gamma = 0 must hold the point's
 // CLASSICAL acceleration (what a world observer measures) at zero, which needs
-// the drift w_C x v_C in gamma (ALGORITHMS.md 2). Checked by finite
+// the drift w_C x v_C in gamma (docs/algorithms.md §2). Checked by finite
 // differences of the point's world velocity, for every algorithm; then the same
 // solve with the drift dropped is shown to miss by exactly that drift.
 TEST(Analytic, PointContactHoldsClassicalAccelerationOnlyWithDrift) {

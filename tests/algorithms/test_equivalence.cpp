@@ -1,4 +1,4 @@
-// The strongest cross-check (ALGORITHMS.md 3): from lambda = 0 with the same
+// The strongest cross-check (docs/algorithms.md §3): from lambda = 0 with the same
 // mu, after K multiplier updates constrainedABA, proxPV, proxLTL, proxLTLs and
 // the dense proximal iteration return the same qdd^K and lambda^K, converged
 // or not. On all nine cases of cases.yaml, at random states, for a small mu

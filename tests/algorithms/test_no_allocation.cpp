@@ -1,4 +1,4 @@
-// "No allocation inside a solve" (PRODUCT.md): every generic algorithm runs on
+// "No allocation inside a solve" (docs/design.md, "Tests by stage"): every generic algorithm runs on
 // the preallocated Data. This executable is linked with --wrap=malloc/calloc/
 // realloc (tests/CMakeLists.txt), so every heap allocation made by proxgen_core's
 // code, Eigen's included, passes through the counters below; a solve must leave

@@ -31,7 +31,7 @@ void checkReference(const std::string& caseName) {
   for (const json& s : ref.at("samples")) {
     const State st = stateFromJson(sys.model, {{"q", s["q"]}, {"v", s["v"]}, {"tau", s["tau"]}}, caseName);
     const auto qddOf = [&](const char* key) { return velocityFromJson(sys.model, s.at(key), caseName, false); };
-    // Pinocchio's lambda is the force on the robot; ours (ALGORITHMS.md) is its negative.
+    // Pinocchio's lambda is the force on the robot; ours (docs/design.md, "Conventions") is its negative.
     VecX lamRef(sys.nc);
     for (const Constraint& c : sys.constraints)
       for (int r = 0; r < c.rows(); ++r) lamRef[c.row + r] = -s.at("lambda_k3").at(c.name)[r].get<double>();

@@ -2,7 +2,7 @@
 // Input: the URDF, a line "---8<---", then the layout; without the marker the
 // whole input is the URDF and the layout welds its last link. Checks what the
 // emitter promises about its text whatever the names and numbers are
-// (PRODUCT.md "Inputs that are wrong"): printable ASCII only, no trigraph,
+// (docs/design.md, "Bad input"): printable ASCII only, no trigraph,
 // no block-comment token, no line splice, no preprocessor line other than the
 // ones every solver has, and code (outside comments and those lines) made of
 // identifiers, numbers and operators only: no quote, backslash, '#', '?' or
