@@ -2,7 +2,7 @@
 # Generation time, compile time (-O2, the solver .cpp alone), object size
 # (text + data) and, with --instructions, instructions per call (callgrind,
 # K = 3, the layout's mu) of the generated solvers of the nine shared cases:
-# the table "Generation and compile cost" of the README.
+# the table "Generation and compile cost" of docs/benchmarks.md.
 #
 #   tests/generated/measure.sh BUILD_DIR [--instructions] [--cxx g++] [--march native]
 #
