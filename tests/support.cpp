@@ -23,7 +23,10 @@ bool underCi() {
 
 std::vector<Case> sharedCases() {
   if (modelsDir().empty()) return {};
-  return loadCases(modelsDir() + "/cases.yaml");
+  std::vector<Case> cases = loadCases(modelsDir() + "/cases.yaml");
+  // The loops over the cases would otherwise pass with no check at all.
+  if (cases.empty()) ADD_FAILURE() << modelsDir() << "/cases.yaml lists no case";
+  return cases;
 }
 
 std::string modelPath(const std::string& file) { return modelsDir() + "/" + file; }
