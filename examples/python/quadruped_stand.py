@@ -11,8 +11,8 @@ base position moves by dt R v_lin, in the world, and the quaternion by the
 exponential map of dt w). Writes a PNG of the base height, the constraint drift
 (how far the feet are from their targets) and the vertical contact forces.
 
-Needs the module: cmake --build build --target pymod_quadruped_stand, then
-  PYTHONPATH=build/python:build/tests/python/modules/quadruped_stand \\
+Needs the module: cmake --build build --target pymod_quadruped_baumgarte, then
+  PYTHONPATH=build/python:build/tests/python/modules/quadruped_baumgarte \\
       python3 examples/python/quadruped_stand.py --out stand.png
 (docs/python.md). --write-layout recomputes the layout's targets.
 """
@@ -185,7 +185,7 @@ def main(argv=None):
         write_layout(LAYOUT)
         print(f"wrote {LAYOUT}")
         return 0
-    import quadruped_stand as solver  # the generated module (PYTHONPATH: see above)
+    import quadruped_baumgarte as solver  # the generated module (PYTHONPATH: see above)
     robot = proxgen.load(URDF, LAYOUT)
     log = simulate(solver, robot, args.duration, args.dt, push=not args.no_push)
     mass = total_mass(URDF)

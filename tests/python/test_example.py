@@ -29,7 +29,7 @@ def test_the_layout_targets_are_the_stance_feet():
     # The solver sees no error at the stance: with v = 0 and tau holding nothing, the
     # Baumgarte term kp (p - p*) vanishes only if the targets are the feet. The layout
     # prints them with repr (exact), so they agree to the kinematics' round-off.
-    solver = module("quadruped_stand")
+    solver = module("quadruped_baumgarte")
     frames = robot.constraint_frames(q0)
     for name, _ in ex.FEET:
         assert np.max(np.abs(frames[name][1] - feet[name])) == 0.0
@@ -40,7 +40,7 @@ def test_the_layout_targets_are_the_stance_feet():
 
 def test_a_run_keeps_the_drift_bounded(tmp_path):
     ex = load_example()
-    solver = module("quadruped_stand")
+    solver = module("quadruped_baumgarte")
     robot = proxgen.load(ex.URDF, ex.LAYOUT)
     log = ex.simulate(solver, robot, duration=1.0, dt=1e-3, push=True)  # through the wobble at 0.5-0.6 s
     drift, residual, speed = log["drift"], log["residual"], log["speed"]
@@ -66,7 +66,7 @@ def test_a_run_keeps_the_drift_bounded(tmp_path):
 
 
 def test_the_script_writes_the_plot(tmp_path):
-    module("quadruped_stand")
+    module("quadruped_baumgarte")
     ex = load_example()
     png, summary = tmp_path / "stand.png", tmp_path / "summary.json"
     assert ex.main(["--duration", "0.3", "--out", str(png), "--summary", str(summary)]) == 0
