@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import proxgen
-from conftest import CASES_FILE, QUADRUPED_DIR, module, random_state, rel_err, require_models
+from conftest import CASES_FILE, QUADRUPED_DIR, SOURCE_DIR, module, random_state, rel_err, require_models
 
 # (module, how to load the same System in the package, scalar)
 MODULES = [
@@ -15,6 +15,8 @@ MODULES = [
                                        os.path.join(QUADRUPED_DIR, "layout.yaml")), "double"),
     ("quadruped_float", lambda: proxgen.load(os.path.join(QUADRUPED_DIR, "quadruped.urdf"),
                                              os.path.join(QUADRUPED_DIR, "layout.yaml")), "float"),
+    ("hostile_names", lambda: proxgen.load(os.path.join(SOURCE_DIR, "tests", "data", "hostile", "names.urdf"),
+                                           os.path.join(SOURCE_DIR, "tests", "data", "hostile", "names.yaml")), "double"),
     ("iiwa_h6", lambda: proxgen.load_case(CASES_FILE, "iiwa_h6"), "double"),
     ("solo_f3x2", lambda: proxgen.load_case(CASES_FILE, "solo_f3x2"), "double"),
 ]
@@ -34,7 +36,7 @@ PAIRS = (("prox_pv", "pv"), ("constrained_aba", "caba"))
 
 
 def load(name, loader):
-    if not name.startswith("quadruped"):
+    if name in ("iiwa_h6", "solo_f3x2"):
         require_models()
     return module(name), loader()
 
