@@ -16,7 +16,7 @@ from collections import namedtuple
 from . import _proxgen
 from ._proxgen import version as __version__  # noqa: F401
 
-__all__ = ["load", "load_case", "case_names", "generate", "verify", "executable", "Robot", "Joint", "ConstraintRows"]
+__all__ = ["load", "load_case", "case_names", "case_urdf", "generate", "verify", "executable", "Robot", "Joint", "ConstraintRows"]
 
 Joint = namedtuple("Joint", "name type link idx_q nq idx_v nv limits")
 ConstraintRows = namedtuple("ConstraintRows", "name type link row rows")

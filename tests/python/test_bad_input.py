@@ -13,24 +13,16 @@ URDF = os.path.join(QUADRUPED_DIR, "quadruped.urdf")
 LAYOUT = os.path.join(QUADRUPED_DIR, "layout.yaml")
 
 
-def solvers(robot):
-    """(name, f(q, v, tau, **kw)) for the package and the generated module."""
-    m = module("quadruped")
-    return [("package", lambda q, v, tau, **kw: robot.eval(q, v, tau, "pv", **kw)),
-            ("module", lambda q, v, tau, **kw: m.prox_pv(q, v, tau, **kw))]
+def solver(robot, which):
+    """f(q, v, tau, **kw): the package's proxPV or the generated module's."""
+    if which == "package":
+        return lambda q, v, tau, **kw: robot.eval(q, v, tau, "pv", **kw)
+    return module("quadruped").prox_pv
 
 
 @pytest.fixture
 def good(quadruped, rng):
     return random_state(quadruped, rng)
-
-
-def each(quadruped):
-    return pytest.mark.parametrize("which", ["package", "module"])
-
-
-def solver(quadruped, which):
-    return dict(solvers(quadruped))[which]
 
 
 WHICH = pytest.mark.parametrize("which", ["package", "module"])
