@@ -8,6 +8,7 @@ packages=(
   valgrind gnuplot-nox binutils
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm
   clang libclang-rt-14-dev
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib python3-yaml
   locales
 )
 SUDO=""
