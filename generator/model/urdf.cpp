@@ -569,13 +569,16 @@ class Builder {
                          m.smallest, m.largest, quoted(b.link), kPsdTolerance));
     }
     for (const IndefiniteLink& l : indefinite_) {
-      const std::string into = l.body == 0 ? std::string("the world, where its inertia has no effect")
-                                           : fmt::format("body {}, whose merged inertia is", quoted(model_.bodies[l.body].link));
+      const std::string body = quoted(model_.bodies[l.body].link);
+      const std::string accepted =
+          l.body == 0 ? "it is merged by fixed joints into the world, where its inertia has no effect"
+          : model_.bodies[l.body].link == l.link
+              ? fmt::format("its body {}, with the links fixed to it merged, is positive semi-definite", body)
+              : fmt::format("it is merged by fixed joints into body {}, whose merged inertia is positive semi-definite", body);
       model_.warnings.push_back(
           warn(where("link", l.link), fmt::format("link {}", quoted(l.link)),
-               fmt::format("rotational inertia is not positive semi-definite (smallest principal moment {:g}); accepted: "
-                           "it is merged by fixed joints into {}",
-                           l.smallest, l.body == 0 ? into : into + " positive semi-definite")));
+               fmt::format("rotational inertia is not positive semi-definite (smallest principal moment {:g}); accepted: {}",
+                           l.smallest, accepted)));
     }
   }
 

@@ -369,6 +369,21 @@ TEST(Warnings, NegligibleIndefiniteLinkOnAFixedJointIsJudgedMerged) {
   EXPECT_TRUE(has(w2.lines[0], "into the world")) << w2.lines[0];
 }
 
+TEST(Warnings, IndefiniteMovingLinkMadeDefiniteByWhatIsFixedToItIsAccepted) {
+  // The moving link's own tensor is the sensor's; a 1 kg link welded to it
+  // (diag 0.01 at its origin) makes the merged body's smallest moment
+  // 0.01 - 3.5e-8 > 0. What the dynamics use is fine: a warning, not an error.
+  CaptureWarnings w;
+  parseUrdf(robot(link("base") + link("arm", kBadSensor) + link("lump") + joint("j", "revolute", "base", "arm") +
+                  joint("weld", "fixed", "arm", "lump")),
+            "t.urdf", false);
+  ASSERT_EQ(w.lines.size(), 1u);
+  EXPECT_TRUE(has(w.lines[0], "link 'arm': rotational inertia is not positive semi-definite (smallest principal moment "
+                              "-3.5e-08); accepted: its body 'arm', with the links fixed to it merged, is positive "
+                              "semi-definite"))
+      << w.lines[0];
+}
+
 TEST(Warnings, GenuinelyIndefiniteMovingBodyStaysRefused) {
   // The same tensor as the moving body itself: nothing merged makes it PSD.
   const std::string alone = robot(link("base") + link("sensor", kBadSensor) + joint("j", "revolute", "base", "sensor"));
