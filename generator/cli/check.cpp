@@ -191,7 +191,6 @@ void runCheck(const CheckOptions& o) {
   const System sys = loadForCheck(o);
   // Built in full before anything is printed: an error leaves stdout empty.
   const std::string out = o.json ? layoutJson(sys).dump(2) + "\n" : summaryText(sys);
-  for (const std::string& w : sys.model.warnings) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
   if (const std::string w = floatAccuracyWarning(sys); !w.empty()) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
   std::fputs(out.c_str(), stdout);
 }

@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "model/error.hpp"
+#include "model/warn.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"proxgen " PROXGEN_VERSION ": generates flat C++ constrained-dynamics solvers for one robot"};
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   proxgen::cli::addVerify(app);
   try {
     app.parse(argc, argv);
+    proxgen::flushWarnings();  // only once the command succeeded: bad input prints one line
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const proxgen::Error& e) {

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "model/error.hpp"
+#include "model/input.hpp"
 #include "model/layout.hpp"
 #include "model/urdf.hpp"
 
@@ -20,7 +21,7 @@ Case loadCase(const std::string& path, const std::string& name) {
 std::vector<Case> loadCases(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(readInputFile(path, 4u << 20, "cases"));  // a regular file only (a FIFO would hang)
   } catch (const YAML::BadFile&) {
     fail(path, "", "cannot open file");
   } catch (const YAML::Exception& e) {

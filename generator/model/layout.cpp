@@ -5,14 +5,12 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
-#include <sys/stat.h>
-
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "model/error.hpp"
+#include "model/input.hpp"
 #include "model/urdf.hpp"
 
 namespace proxgen {
@@ -30,10 +28,18 @@ class Reader {
     fail(file, element, what);
   }
 
+  // Unknown keys and repeated keys are errors: yaml-cpp keeps both entries of
+  // `mu: 1` then `mu: -5` and a lookup finds the first, so the second would be
+  // neither used nor checked.
   void onlyKeys(const YAML::Node& map, const std::string& element, std::initializer_list<const char*> keys) const {
     if (!map.IsMap()) failAt(map, element, "expected a mapping");
+    std::set<std::string> seen;
     for (const auto& kv : map) {
+      if (!kv.first.IsScalar()) failAt(kv.first, element, "a key must be a plain name");
       const std::string key = kv.first.Scalar();
+      if (!seen.insert(key).second)
+        failAt(kv.first, element.empty() ? quoted(key) : fmt::format("{}.{}", element, key),
+               "the key appears twice in the same mapping");
       bool known = false;
       for (const char* k : keys) known = known || key == k;
       if (!known) {
@@ -54,18 +60,27 @@ class Reader {
     in >> x;
     if (in.fail() || !(in >> std::ws).eof()) failAt(n, element, fmt::format("{} is not a number", quoted(n.Scalar())));
     if (!std::isfinite(x)) failAt(n, element, fmt::format("{} is not finite", quoted(n.Scalar())));
+    if (std::abs(x) > kMaxInputMagnitude)
+      failAt(n, element,
+             fmt::format("{} is beyond the largest magnitude proxgen accepts ({:g}): the dynamics would overflow",
+                         quoted(n.Scalar()), kMaxInputMagnitude));
     return x;
   }
 
   int integer(const YAML::Node& n, const std::string& element) const {
     const double x = number(n, element);
-    if (x != std::floor(x) || std::abs(x) > 1e9) failAt(n, element, fmt::format("{} is not an integer", quoted(n.Scalar())));
+    if (x != std::floor(x) || std::abs(x) > 2e9) failAt(n, element, fmt::format("{} is not an integer", quoted(n.Scalar())));
     return int(x);
   }
 
   std::string string(const YAML::Node& n, const std::string& element) const {
     if (!n.IsScalar()) failAt(n, element, "expected a string");
     if (n.Scalar().empty()) failAt(n, element, "is empty");
+    std::size_t at = 0;
+    if (!isValidUtf8(n.Scalar(), &at))
+      failAt(n, element,
+             fmt::format("is not valid UTF-8 (byte 0x{:02x} at offset {}); names must be UTF-8 text",
+                         static_cast<unsigned char>(n.Scalar()[at]), at));
     return n.Scalar();
   }
 
@@ -125,10 +140,17 @@ class Reader {
     if (root["mu"]) {
       L.mu = number(root["mu"], "mu");
       if (!(L.mu > 0)) failAt(root["mu"], "mu", "the penalty mu must be > 0");
+      // The solvers use 1/mu (proxPV, proxLTL): below 1/kMaxInputMagnitude it
+      // would leave the range every other input keeps to.
+      if (L.mu < 1.0 / kMaxInputMagnitude)
+        failAt(root["mu"], "mu", fmt::format("{:g} is below the smallest penalty proxgen accepts ({:g}): 1/mu would overflow "
+                                             "the solvers",
+                                             L.mu, 1.0 / kMaxInputMagnitude));
     }
     if (root["iterations"]) {
       L.iterations = integer(root["iterations"], "iterations");
-      if (L.iterations < 0) failAt(root["iterations"], "iterations", "must be >= 0");
+      if (L.iterations < 0 || L.iterations > kMaxIterations)
+        failAt(root["iterations"], "iterations", fmt::format("{} is outside [0, {}]", L.iterations, kMaxIterations));
     }
     if (root["constraints"]) {
       const YAML::Node list = root["constraints"];
@@ -155,20 +177,6 @@ class Reader {
   std::string path_;
 };
 
-std::string readSmallFile(const std::string& path, std::size_t limit) {
-  // A directory opens as a stream on Linux and reports a size of 2^63 - 1.
-  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a layout file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail(path, "", "cannot open file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail(path, "", "cannot read file (is it a directory?)");
-  if (std::size_t(size) > limit) fail(path, "", fmt::format("file is {} bytes, more than the {} bytes allowed", size, limit));
-  std::string text(std::size_t(size), '\0');
-  in.seekg(0);
-  if (!in.read(text.data(), size)) fail(path, "", "cannot read file");
-  return text;
-}
-
 }  // namespace
 
 Layout parseLayout(const std::string& yaml, const std::string& path) {
@@ -185,7 +193,7 @@ Layout parseLayout(const std::string& yaml, const std::string& path) {
   }
 }
 
-Layout loadLayout(const std::string& path) { return parseLayout(readSmallFile(path, kMaxLayoutBytes), path); }
+Layout loadLayout(const std::string& path) { return parseLayout(readInputFile(path, kMaxLayoutBytes, "layout"), path); }
 
 System loadSystem(const std::string& urdfPath, const std::string& layoutPath) {
   const Layout layout = loadLayout(layoutPath);

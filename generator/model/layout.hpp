@@ -13,6 +13,12 @@ namespace proxgen {
 /// real layouts have under 50 (docs/guarantees.md).
 inline constexpr int kMaxConstraintRows = 256;
 
+/// Most multiplier updates K a layout may ask for (`iterations`), as on the
+/// command line (`--iterations`): beyond it a typo, not a request, and K mu kp e
+/// (the multipliers of an inconsistent row grow with K) would leave the range
+/// kMaxInputMagnitude keeps.
+inline constexpr int kMaxIterations = 1000000;
+
 /// Reads a layout file. Unknown keys are errors (a typo must not silently drop a
 /// constraint). Throws proxgen::Error ("FILE:LINE: element: what is wrong").
 Layout loadLayout(const std::string& path);

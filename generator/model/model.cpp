@@ -2,11 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <set>
 
 #include "model/error.hpp"
+#include "model/input.hpp"
+#include "model/warn.hpp"
 
 namespace proxgen {
 
@@ -141,6 +150,13 @@ System bindLayout(Model model, const Layout& layout) {
       fail(layout.sourcePath, element,
            fmt::format("link {} is not in {}", quoted(c.link), model.sourcePath));
     c.body = model.frames[f].body;
+    // Body 0 is the world: the link is welded to it and its rows of J are zero,
+    // which is almost always a wrong link name (or a fixed base meant floating).
+    if (c.body == 0)
+      model.warnings.push_back(warn(layout.sourcePath, element,
+                                    fmt::format("link {} is fixed to the world (merged into it by fixed joints or the "
+                                                "root of a fixed base): the constraint constrains nothing",
+                                                quoted(c.link))));
     c.placement = model.frames[f].placement * c.offset;
     c.row = row;
     row += c.rows();
@@ -149,6 +165,85 @@ System bindLayout(Model model, const Layout& layout) {
   sys.nc = row;
   sys.model = std::move(model);
   return sys;
+}
+
+// --- input files, names and numbers (shared by the URDF, layout and state readers)
+
+std::string readInputFile(const std::string& path, std::size_t maxBytes, const char* kind) {
+  // O_NONBLOCK: opening a FIFO with no writer would otherwise block in open().
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) fail(path, "", fmt::format("cannot open file ({})", std::strerror(errno)));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail(path, "", fmt::format("cannot read file ({})", std::strerror(errno)));
+  if (S_ISDIR(st.st_mode)) fail(path, "", fmt::format("is a directory, not a {} file", kind));
+  if (!S_ISREG(st.st_mode))
+    fail(path, "", fmt::format("is not a regular file (a FIFO, device or socket): proxgen reads {} files only from "
+                               "regular files, whose size is known before reading",
+                               kind));
+  if (std::uintmax_t(st.st_size) > maxBytes)
+    fail(path, "", fmt::format("file is {} bytes, more than the {} bytes proxgen reads", st.st_size, maxBytes));
+  std::string text(std::size_t(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(path, "", fmt::format("cannot read file ({})", std::strerror(errno)));
+    if (n == 0) break;  // shrank while read: what is there is the file
+    got += std::size_t(n);
+  }
+  text.resize(got);
+  return text;
+}
+
+bool isValidUtf8(const std::string& s, std::size_t* badOffset) {
+  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t k = 0; k < n;) {
+    const unsigned char c = b[k];
+    std::size_t len = 0;
+    unsigned lo = 0x80, hi = 0xbf;  // allowed range of the second byte
+    if (c < 0x80) len = 1;
+    else if (c >= 0xc2 && c <= 0xdf) len = 2;
+    else if (c == 0xe0) len = 3, lo = 0xa0;           // no overlong 3-byte forms
+    else if (c >= 0xe1 && c <= 0xec) len = 3;
+    else if (c == 0xed) len = 3, hi = 0x9f;           // no surrogates
+    else if (c >= 0xee && c <= 0xef) len = 3;
+    else if (c == 0xf0) len = 4, lo = 0x90;           // no overlong 4-byte forms
+    else if (c >= 0xf1 && c <= 0xf3) len = 4;
+    else if (c == 0xf4) len = 4, hi = 0x8f;           // nothing above U+10FFFF
+    bool ok = len > 0 && k + len <= n;
+    for (std::size_t i = 1; ok && i < len; ++i) {
+      const unsigned char t = b[k + i];
+      ok = i == 1 ? (t >= lo && t <= hi) : (t >= 0x80 && t <= 0xbf);
+    }
+    if (!ok) {
+      if (badOffset) *badOffset = k;
+      return false;
+    }
+    k += len;
+  }
+  return true;
+}
+
+void requireUtf8(const std::string& file, const std::string& element, const std::string& name) {
+  std::size_t at = 0;
+  if (!isValidUtf8(name, &at))
+    fail(file, element,
+         fmt::format("the name is not valid UTF-8 (byte 0x{:02x} at offset {}); names must be UTF-8 text",
+                     static_cast<unsigned char>(name[at]), at));
+}
+
+double requireMagnitude(const std::string& file, const std::string& element, double x) {
+  if (!std::isfinite(x)) fail(file, element, "is not finite");
+  if (std::abs(x) > kMaxInputMagnitude)
+    fail(file, element,
+         fmt::format("{:g} is beyond the largest magnitude proxgen accepts ({:g}): the dynamics would overflow", x,
+                     kMaxInputMagnitude));
+  return x;
 }
 
 }  // namespace proxgen

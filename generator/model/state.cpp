@@ -2,26 +2,27 @@
 
 #include <fmt/format.h>
 
-#include <sys/stat.h>
-
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "model/error.hpp"
+#include "model/input.hpp"
 
 namespace proxgen {
 namespace {
 
 using nlohmann::json;
 
-inline constexpr std::size_t kMaxStateBytes = 64u << 20;
+// A state is at most 4 deep: a list of states, a state, q, a free flyer's list.
+inline constexpr int kMaxStateDepth = 4;
+// An object of a state is keyed by joint names (at most 4096 joints, 4101 with
+// a free flyer); bounding it also bounds the keys kept to find repeated ones.
+inline constexpr std::size_t kMaxObjectKeys = 8192;
 
 double finiteNumber(const json& x, const std::string& where, const std::string& element) {
   if (!x.is_number()) fail(where, element, fmt::format("expected a number, got {}", x.type_name()));
-  const double d = x.get<double>();
-  if (!std::isfinite(d)) fail(where, element, "is not finite");
-  return d;
+  return requireMagnitude(where, element, x.get<double>());
 }
 
 // Fills `n` slots of out starting at `at` from a number (n == 1) or a list of n numbers.
@@ -57,13 +58,28 @@ VecX configurationFromJson(const Model& model, const json& j, const std::string&
     const Joint& jt = model.bodies[i].joint;
     const std::string element = fmt::format("q.{}", quoted(jt.name));
     if (!j.contains(jt.name)) fail(where, element, "missing");
-    readSlots(j.at(jt.name), jt.nq, q, jt.idx_q, where, element);
-    if (jt.type == JointType::FreeFlyer) {
-      auto quat = q.segment<4>(jt.idx_q + 3);
-      const double n = quat.norm();
-      if (!(n > 1e-8)) fail(where, element, "the quaternion [qx qy qz qw] has zero norm");
-      quat /= n;  // documented: a non-unit quaternion is normalised
+    if (jt.type != JointType::FreeFlyer) {
+      readSlots(j.at(jt.name), jt.nq, q, jt.idx_q, where, element);
+      continue;
     }
+    const json& x = j.at(jt.name);
+    if (!x.is_array() || x.size() != 7) fail(where, element, "expected a list of 7 numbers");
+    for (int k = 0; k < 3; ++k) q[jt.idx_q + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
+    // The quaternion's components only give a direction: any finite size is
+    // accepted, and it is normalised by its largest component first, so that
+    // [1e200, 1e200, 1e200, 1e200] is [0.5, 0.5, 0.5, 0.5] (its squared norm
+    // would overflow) and a tiny one does not underflow to zero.
+    Eigen::Vector4d quat;
+    for (int k = 0; k < 4; ++k) {
+      const std::string el = fmt::format("{}[{}]", element, k + 3);
+      if (!x[k + 3].is_number()) fail(where, el, fmt::format("expected a number, got {}", x[k + 3].type_name()));
+      quat[k] = x[k + 3].get<double>();
+      if (!std::isfinite(quat[k])) fail(where, el, "is not finite");
+    }
+    const double largest = quat.cwiseAbs().maxCoeff();
+    if (!(largest > 0)) fail(where, element, "the quaternion [qx qy qz qw] has zero norm");
+    quat /= largest;  // now the largest component is +-1: no overflow, no underflow below
+    q.segment<4>(jt.idx_q + 3) = quat / quat.norm();  // documented: a non-unit quaternion is normalised
   }
   return q;
 }
@@ -100,22 +116,38 @@ State stateFromJson(const Model& model, const json& j, const std::string& where)
 }
 
 std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList) {
-  // A directory opens as a stream on Linux and reports a size of 2^63 - 1.
-  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a state file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail(path, "", "cannot open file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail(path, "", "cannot read file (is it a directory?)");
-  if (std::size_t(size) > kMaxStateBytes) fail(path, "", fmt::format("file is {} bytes, more than the {} allowed", size, kMaxStateBytes));
-  std::string text(std::size_t(size), '\0');
-  in.seekg(0);
-  in.read(text.data(), size);
+  const std::string text = readInputFile(path, kMaxStateBytes, "state");
   json j;
   // The last key read tells the user where a bad token (e.g. an overflowing
-  // 1e999, which nlohmann reports as out_of_range, not parse_error) was.
+  // 1e999, which nlohmann reports as out_of_range, not parse_error) was. The
+  // same callback refuses, while parsing, what the DOM would otherwise hold:
+  // nesting deeper than a state has (64 MiB of `[[[[...` took 2.4 GB as a
+  // DOM), more than kMaxStateValues values, and a key repeated in one object
+  // (nlohmann keeps the last one silently).
   std::string lastKey;
-  const json::parser_callback_t track = [&lastKey](int, json::parse_event_t event, json& parsed) {
-    if (event == json::parse_event_t::key) lastKey = parsed.get<std::string>();
+  std::vector<std::set<std::string>> openObjects;
+  std::size_t values = 0;
+  const json::parser_callback_t track = [&](int depth, json::parse_event_t event, json& parsed) {
+    using E = json::parse_event_t;
+    if ((event == E::object_start || event == E::array_start) && depth >= kMaxStateDepth)
+      fail(path, lastKey.empty() ? "" : fmt::format("after key {}", proxgen::quoted(lastKey)),
+           fmt::format("nested more than {} levels deep: a state file is a list of states of q, v, tau "
+                       "(proxgen reads at most {} levels)",
+                       kMaxStateDepth, kMaxStateDepth));
+    if (event == E::object_start) openObjects.emplace_back();
+    if (event == E::object_end && !openObjects.empty()) openObjects.pop_back();
+    if (event == E::key) {
+      lastKey = parsed.get<std::string>();
+      if (!openObjects.empty() && !openObjects.back().insert(lastKey).second)
+        fail(path, fmt::format("key {}", proxgen::quoted(lastKey)), "appears twice in the same object");
+      if (!openObjects.empty() && openObjects.back().size() > kMaxObjectKeys)
+        fail(path, fmt::format("key {}", proxgen::quoted(lastKey)),
+             fmt::format("is one key too many: an object of a state has one key per joint, at most {}", kMaxObjectKeys));
+    }
+    if ((event == E::value || event == E::object_start || event == E::array_start) && ++values > kMaxStateValues)
+      fail(path, "", fmt::format("holds more than {} values: proxgen reads state files of at most {} numbers, lists and "
+                                 "objects",
+                                 kMaxStateValues, kMaxStateValues));
     return true;
   };
   try {
@@ -167,7 +199,7 @@ State randomState(const Model& m, std::mt19937& rng) {
       for (int k = 0; k < 3; ++k) s.q[j.idx_q + k] = U(rng);
       const Eigen::Vector4d quat(N(rng), N(rng), N(rng), N(rng));  // normal -> uniform on the sphere
       s.q.segment<4>(j.idx_q + 3) = quat.normalized();
-    } else if (j.hasPositionLimits && j.upper > j.lower) {
+    } else if (j.hasPositionLimits && j.upper > j.lower && std::isfinite(j.upper - j.lower)) {
       s.q[j.idx_q] = std::uniform_real_distribution<double>(j.lower, j.upper)(rng);
     } else {
       s.q[j.idx_q] = U(rng);

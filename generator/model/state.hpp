@@ -11,6 +11,14 @@
 
 namespace proxgen {
 
+/// Largest state file read (bytes), and most JSON values (numbers, strings,
+/// lists and objects) in one: nlohmann-json's DOM takes 16 bytes per value plus
+/// ~80 per object member, so 4,194,304 values cost under 0.5 GB beside the
+/// text; the largest robot (4101 DoF) needs ~12,300 per state, so a file holds
+/// over 300 of its states (docs/guarantees.md).
+inline constexpr std::size_t kMaxStateBytes = 64u << 20;
+inline constexpr std::size_t kMaxStateValues = 1u << 22;
+
 struct State {
   VecX q, v, tau;
 };

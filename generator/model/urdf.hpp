@@ -32,6 +32,18 @@ inline constexpr std::size_t kMaxUrdfLinks = 4096;
 /// both (docs/guarantees.md). Real robots are below 50.
 inline constexpr std::size_t kMaxTreeDepth = 512;
 
+/// Deepest XML nesting read, and most attributes on one element and in a whole
+/// file. Checked by a scan of the text before either XML parser runs (both
+/// TinyXML, inside urdfdom, and tinyxml2 recurse once per level: tinyxml2 stops
+/// below 100, TinyXML never, and URDFs nest under 10 deep; and both check
+/// an element's attributes for duplicates pairwise: 80,000 attributes on one
+/// element took 24 s). URDF elements have at most 6 attributes (<inertia>) and
+/// real files under 3 per tag; each attribute costs ~100-200 bytes in each DOM,
+/// like a tag, hence the same total as kMaxUrdfTags (docs/guarantees.md).
+inline constexpr std::size_t kMaxXmlDepth = 64;
+inline constexpr std::size_t kMaxXmlAttributesPerElement = 64;
+inline constexpr std::size_t kMaxUrdfAttributes = 1u << 20;
+
 /// Reads a URDF file into a Model. With `floatingBase` the root link becomes a
 /// free-flyer body (joint `root_joint`); otherwise it is welded to the world.
 /// Throws proxgen::Error ("FILE:LINE: joint 'x': what is wrong") on bad input.

@@ -283,17 +283,18 @@ TEST(ResourceBounds, OversizedFilesAreRefusedBeforeReading) {
   // The layout limit (4 MiB) is private to layout.cpp; 64 MiB is above it.
   const std::string ml = errorOf([&] { loadLayout(layout.sized(64u << 20)); });
   expectOneBoundedLine(ml, layout.path());
-  EXPECT_NE(ml.find("bytes allowed"), std::string::npos) << ml;
+  EXPECT_NE(ml.find("bytes proxgen reads"), std::string::npos) << ml;
   // The state limit is 64 MiB (state.cpp).
   const Model arm = loadUrdf(good("arm3.urdf"), false);
   const std::string ms = errorOf([&] { loadStates(arm, state.sized((64u << 20) + 1)); });
   expectOneBoundedLine(ms, state.path());
-  EXPECT_NE(ms.find("allowed"), std::string::npos) << ms;
+  EXPECT_NE(ms.find(fmt::format("more than the {} bytes proxgen reads", kMaxStateBytes)), std::string::npos) << ms;
 }
 
 TEST(ResourceBounds, DeeplyNestedXmlIsAClearError) {
-  // tinyxml2 stops at 100 levels, before urdfdom's recursive TinyXML parser
-  // sees the file. 100000 levels with their end tags are 1.5 MB.
+  // The scan before both XML parsers stops at 64 levels (kMaxXmlDepth), so
+  // urdfdom's recursive TinyXML parser never sees them. 100000 levels with
+  // their end tags are 1.5 MB.
   const std::size_t depth = 100000;
   std::string xml = "<robot name=\"r\"><link name=\"a\">";
   for (std::size_t k = 0; k < depth; ++k) xml += "<x>";
@@ -301,7 +302,7 @@ TEST(ResourceBounds, DeeplyNestedXmlIsAClearError) {
   xml += "</link></robot>";
   const std::string m = errorOf([&] { parseUrdf(xml, "nested.urdf", false); });
   expectOneBoundedLine(m, "nested.urdf");
-  EXPECT_NE(m.find("not well-formed XML"), std::string::npos) << m;
+  EXPECT_NE(m.find(fmt::format("nested more than {} deep", kMaxXmlDepth)), std::string::npos) << m;
 }
 
 TEST(ResourceBounds, DeeplyNestedYamlIsAClearError) {
@@ -322,23 +323,23 @@ TEST(ResourceBounds, DeeplyNestedYamlIsAClearError) {
 
 TEST(ResourceBounds, DeeplyNestedJsonIsAClearError) {
   // nlohmann-json parses and destroys without recursion (3.10+), so depth costs
-  // memory, not stack: an unclosed nesting is a parse error, a closed one is
-  // not a state object.
+  // memory, not stack; the loader's parse callback stops at the fifth level,
+  // deeper than any state, before the DOM holds it.
   const Model arm = loadUrdf(good("arm3.urdf"), false);
   TempFile open("open.json"), closed("closed.json"), inState("in_state.json");
   const std::size_t depth = 100000;
   const std::string m1 = errorOf([&] { loadStates(arm, open.write(std::string(depth, '['))); });
   expectOneBoundedLine(m1, open.path());
-  EXPECT_NE(m1.find("invalid JSON"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("nested more than 4 levels deep"), std::string::npos) << m1;
   const std::string m2 = errorOf([&] { loadStates(arm, closed.write(std::string(depth, '[') + std::string(depth, ']'))); });
   expectOneBoundedLine(m2, closed.path());
-  EXPECT_NE(m2.find("must be an object"), std::string::npos) << m2;
+  EXPECT_NE(m2.find("nested more than 4 levels deep"), std::string::npos) << m2;
   const std::string deep = std::string(depth, '[') + std::string(depth, ']');
   const std::string m3 = errorOf([&] {
     loadStates(arm, inState.write("{\"q\": {\"shoulder\": " + deep + "}, \"v\": {}}"));
   });
   expectOneBoundedLine(m3, inState.path());
-  EXPECT_NE(m3.find("q.'shoulder'"), std::string::npos) << m3;
+  EXPECT_NE(m3.find("after key 'shoulder': nested more than 4 levels deep"), std::string::npos) << m3;
 }
 
 // ---------------------------------------------------------------------------
@@ -384,8 +385,10 @@ TEST(NumericalEdges, ZeroAndNegativeMuAreRejected) {
     EXPECT_NE(m.find("mu.yaml:1: mu: "), std::string::npos) << m;
     EXPECT_NE(m.find("> 0"), std::string::npos) << m;
   }
-  // The smallest positive double is a valid (if useless) penalty.
-  EXPECT_EQ(parseLayout("mu: 4.9e-324\n", "mu.yaml").mu, std::numeric_limits<double>::denorm_min());
+  // The solvers use 1/mu: the smallest positive double, whose reciprocal is
+  // infinite, is refused; 1e-15 (1 / kMaxInputMagnitude) is the smallest accepted.
+  EXPECT_NE(errorOf([] { parseLayout("mu: 4.9e-324\n", "mu.yaml"); }).find("mu.yaml:1: mu: "), std::string::npos);
+  EXPECT_EQ(parseLayout("mu: 1e-15\n", "mu.yaml").mu, 1e-15);
 }
 
 TEST(NumericalEdges, ZeroIterationsIsTheFreeMotionForEveryAlgorithm) {
