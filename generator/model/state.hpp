@@ -1,5 +1,5 @@
 // States (q, v, tau) and results as JSON keyed by joint and constraint names
-// (PRODUCT.md, "States and results"), through nlohmann-json.
+// (README, "States and results (JSON)"), through nlohmann-json.
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>

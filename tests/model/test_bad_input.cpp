@@ -1,6 +1,6 @@
 // Every bad input gets one proxgen::Error whose one-line message names the file
 // (with the line where the loader knows it), the element and what is wrong
-// (PRODUCT.md, "Inputs that are wrong"). The fixtures are small files under
+// (docs/design.md, "Bad input"). The fixtures are small files under
 // tests/data/bad; the layouts and states there are read against
 // tests/data/good/arm3.urdf. The last suite runs the `proxgen` binary: exit code
 // non-zero, the message on stderr, nothing on stdout.

@@ -133,7 +133,7 @@ std::string treeUrdf(int bodies, int branching) {
 
 // Solves a large system with ABA, constrainedABA and proxPV and checks each
 // answer by its residual, which needs no dense reference of that size:
-// RNEA(q, v, qdd) + J^T lambda = tau (ALGORITHMS.md 6; lambda = 0 for ABA).
+// RNEA(q, v, qdd) + J^T lambda = tau (docs/algorithms.md §6; lambda = 0 for ABA).
 // Every solver here is a chain of backward-stable eliminations on M or on
 // M + mu J^T J (tests/numerics.hpp), so the computed answer solves a problem
 // perturbed by ~ n eps relative to the sizes of its terms, and the residual is
@@ -467,7 +467,7 @@ TEST(NumericalEdges, ConstraintOnTheWorldOfAFixedBaseIsInert) {
   // qdd is the motion without it, and its multipliers are those of the
   // residual it cannot reduce: each update adds mu (0 - a*), a* = -kp e
   // (Baumgarte, no velocity: the frame does not move), so lambda^K = K mu kp e
-  // for every algorithm (ALGORITHMS.md 3), and 0 without gains.
+  // for every algorithm (docs/algorithms.md §3), and 0 without gains.
   const double mu = 100, kp = 10;
   Constraint world = constraint("world", "base_link", ConstraintType::Point3D);
   world.offset.p = Vec3(0, 0, 0.05);
