@@ -20,6 +20,19 @@ const char* const kSourceTemplate =
 
 std::string scalarName(ScalarType t) { return t == ScalarType::Float ? "float" : "double"; }
 
+// The functions of the bodies off the constraint support; none when every
+// body is on it (no empty functions).
+std::string freeBodies(const SolverTexts& texts) {
+  if (texts.eliminateFree.empty() && texts.accelerateFree.empty()) return "";
+  return fmt::format(
+      "// Articulated-body elimination of the bodies off the constraint support\n"
+      "// (no constraint below them): the same in both algorithms.\n"
+      "void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {{\n{}}}\n\n"
+      "// Accelerations of the bodies off the support, once their ancestors are final.\n"
+      "void accelerate_free_bodies(Workspace& w) noexcept {{\n{}}}\n\n",
+      texts.eliminateFree, texts.accelerateFree);
+}
+
 }  // namespace
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
@@ -58,7 +71,7 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
                              fmt::arg("parts", texts.parts), fmt::arg("kinematics", texts.kinematics),
-                             fmt::arg("eliminate_free", texts.eliminateFree), fmt::arg("accelerate_free", texts.accelerateFree),
+                             fmt::arg("free_bodies", freeBodies(texts)),
                              fmt::arg("caba", texts.caba), fmt::arg("pv", texts.pv));
   return files;
 }

@@ -16,6 +16,16 @@ std::string Emit::loopSlot(const Quantity& qy, int body, int size, int idx) {
   return ws.loopSlot(base, size, idx, fmt::format("{}, body {}", qy.what, body));
 }
 
+std::string Emit::member(const Quantity& qy, int body, int rows, int cols, int r, int c) {
+  const std::string base = fmt::format("{}_{}", qy.prefix, bp(body).ident);
+  return ws.member(base, rows, cols, r, c, fmt::format("{}, body {}", qy.what, body));
+}
+
+std::string Emit::loopSlot(const Quantity& qy, int body, int rows, int cols, int r, int c) {
+  const std::string base = fmt::format("{}_{}", qy.prefix, bp(body).ident);
+  return ws.loopSlot(base, rows, cols, r, c, fmt::format("{}, body {}", qy.what, body));
+}
+
 std::string Emit::kMember(int k, int j) {
   const ConstraintPlan& c = plan.constraints[std::size_t(k)];
   return member("k_" + c.ident, c.rows, j, fmt::format("{}, constraint {}", kK.what, k));

@@ -33,6 +33,9 @@ struct Emit {
   }
   std::string member(const Quantity& qy, int body, int size, int idx);
   std::string loopSlot(const Quantity& qy, int body, int size, int idx);
+  /// Entry (r, c) of a per-body rows x cols matrix member, and its slot (r, c + j) in a loop over j.
+  std::string member(const Quantity& qy, int body, int rows, int cols, int r, int c);
+  std::string loopSlot(const Quantity& qy, int body, int rows, int cols, int r, int c);
   std::string yMember(int t) { return member("yfree", plan.nc, t, "free row accelerations (tree order)"); }
   std::string kMember(int k, int j);
   std::string lambdaMember(int row) { return member("lambda", plan.nc, row, "multipliers (layout order)"); }

@@ -10,7 +10,9 @@ namespace proxgen::emit {
 
 SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& inputs, SolverStats* stats) {
   Members ws;
-  FunctionWriter fn(plan.scalar);
+  std::vector<std::string> bodyNames;
+  for (const BodyPlan& b : plan.bodies) bodyNames.push_back(b.ident);
+  FunctionWriter fn(plan.scalar, bodyNames);
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;
@@ -21,12 +23,17 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   fn.live().kin = &kin;
   texts.kinematics = fn.endHost({"q", "v", "w"});
 
-  // eliminate_free_bodies(tau, w): the off-support bodies, shared too.
-  fn.beginHost("eliminate_free", fn.lastHost());
-  Articulated free = eliminateFreeBodies(e, kin);
-  fn.live().art = &free;
-  texts.eliminateFree = fn.endHost({"tau", "w"});
+  // eliminate_free_bodies(tau, w): the off-support bodies, shared too (none
+  // when every body is on the support).
+  Articulated free = startElimination(kin);
   const CodeBuilder* afterElimination = fn.lastHost();
+  if (!plan.offSupport.empty()) {
+    fn.beginHost("eliminate_free", fn.lastHost());
+    free = eliminateFreeBodies(e, kin);
+    fn.live().art = &free;
+    texts.eliminateFree = fn.endHost({"tau", "w"});
+    afterElimination = fn.lastHost();
+  }
   fn.live() = Live{};
 
   // The entry points, each from its own copy of that state; the first one

@@ -2,27 +2,24 @@
 
 #include <fmt/format.h>
 
-#include <cctype>
 #include <stdexcept>
 
 namespace proxgen::emit {
 namespace {
 
-// Whether code (not its // comments: the generated files have no string
-// literals) names the identifier `name`.
-bool reads(const std::string& body, const std::string& name) {
-  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-  for (std::size_t k = 0; k < body.size(); ++k) {
-    if (body.compare(k, 2, "//") == 0) {
-      k = body.find('\n', k);
-      if (k == std::string::npos) return false;
-      continue;
-    }
-    if (body.compare(k, name.size(), name) == 0 && (k == 0 || !ident(body[k - 1])) &&
-        (k + name.size() == body.size() || !ident(body[k + name.size()])))
-      return true;
+bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+// Whether a function with these accessed names (CodeBuilder::accessedNames)
+// needs parameter `p`: an array (q, v, tau: "q[3]"), the workspace ("w.x"),
+// or a scalar ("mu").
+bool needs(const std::set<std::string>& names, const std::string& p) {
+  if (p == "w") {
+    const auto it = names.lower_bound("w.");
+    return it != names.end() && startsWith(*it, "w.");
   }
-  return false;
+  if (names.count(p)) return true;
+  const auto it = names.lower_bound(p + "[");
+  return it != names.end() && startsWith(*it, p + "[");
 }
 
 }  // namespace
@@ -36,18 +33,42 @@ void FunctionWriter::translate(const CodeBuilder& from, CodeBuilder& to) {
 
 void FunctionWriter::beginHost(const std::string& name, const CodeBuilder* from) {
   if (part_) throw std::logic_error("emitter: a host opened inside a part");
-  Host h{name, std::make_unique<CodeBuilder>(scalar_, names_), 0, Expr(), Expr()};
+  Host h{name, std::make_unique<CodeBuilder>(scalar_, names_), Expr(), Expr(), "", ""};
   if (from) translate(*from, *h.cb);
   cb_ = h.cb.get();
   hosts_.push_back(std::move(h));
 }
 
-void FunctionWriter::boundary() {
+void FunctionWriter::beginPass(const std::string& name, const std::string& banner) {
+  endPart();
+  hosts_.back().pass = name;
+  hosts_.back().banner = banner;
+}
+
+void FunctionWriter::boundary(int body) { open(bodyNames_[std::size_t(body)]); }
+void FunctionWriter::boundary(const std::string& label) { open(label); }
+
+void FunctionWriter::open(const std::string& label) {
   if (part_ && part_->statementCount() >= kPartBudget) endPart();
-  if (part_) return;
-  part_ = std::make_unique<CodeBuilder>(scalar_, names_);
-  translate(*cb_, *part_);
-  cb_ = part_.get();
+  if (!part_) {
+    part_ = std::make_unique<CodeBuilder>(scalar_, names_);
+    translate(*cb_, *part_);
+    cb_ = part_.get();
+    firstLabel_ = label;
+  }
+  lastLabel_ = label;
+}
+
+// <host>[_<pass>][_<first block>[_to_<last block>]], made unique with _2, _3, ...
+std::string FunctionWriter::partName(const Host& host) {
+  std::string name = host.name;
+  if (!host.pass.empty()) name += "_" + host.pass;
+  if (!firstLabel_.empty()) name += "_" + firstLabel_;
+  if (!lastLabel_.empty() && lastLabel_ != firstLabel_) name += "_to_" + lastLabel_;
+  std::string unique = name;
+  for (int k = 2; partNames_.count(unique); ++k) unique = fmt::format("{}_{}", name, k);
+  partNames_.insert(unique);
+  return unique;
 }
 
 std::string FunctionWriter::render(CodeBuilder& cb) {
@@ -62,22 +83,21 @@ void FunctionWriter::endPart() {
   if (!part_) return;
   Host& host = hosts_.back();
   const std::string body = render(*part_);
-  const bool empty = body.find_first_not_of(" \n") == std::string::npos;
-  const std::string name = fmt::format("{}_{}", host.name, empty ? -1 : host.parts++);
+  const std::set<std::string> accessed = part_->accessedNames();
   std::vector<std::string> params, args;
   std::vector<Expr> uses;
   for (const char* p : {"q", "v", "tau"})
-    if (reads(body, p)) {
+    if (needs(accessed, p)) {
       params.push_back(fmt::format("const Scalar* PROXGEN_RT_RESTRICT {}", p));
       args.push_back(p);
     }
   for (const char* p : {"mu", "inv_mu"})
-    if (reads(body, p)) {
+    if (needs(accessed, p)) {
       params.push_back(fmt::format("Scalar {}", p));
       args.push_back(p);
       uses.push_back(std::string(p) == "mu" ? host.mu : host.invMu);
     }
-  if (reads(body, "w")) {
+  if (needs(accessed, "w")) {
     params.push_back("Workspace& PROXGEN_RT_RESTRICT w");
     args.push_back("w");
   }
@@ -89,9 +109,14 @@ void FunctionWriter::endPart() {
   translate(*part_, *host.cb);
   cb_ = host.cb.get();
   part_.reset();  // its values now live in the host: the part's atoms are not needed again
-  if (empty) return;  // everything folded to constants: no function
+  if (body.find_first_not_of(" \n") == std::string::npos) return;  // everything folded to constants: no function
+  const std::string name = partName(host);
   partsText_ += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", name, sig, body);
-  cb_->line(fmt::format("{}({});", name, call), uses);
+  if (!host.banner.empty()) {
+    cb_->comment("---- " + host.banner);
+    host.banner.clear();
+  }
+  cb_->line(fmt::format("{}({});", name, call), uses, args);
 }
 
 std::string FunctionWriter::endHost(const std::vector<std::string>& params) {
@@ -99,9 +124,10 @@ std::string FunctionWriter::endHost(const std::vector<std::string>& params) {
   Host& host = hosts_.back();
   std::string body = render(*host.cb);
   // A parameter the body never reads (no constraints, no joints) is marked used.
+  const std::set<std::string> accessed = host.cb->accessedNames();
   std::string prefix;
   for (const std::string& p : params)
-    if (!reads(body, p)) prefix += "  static_cast<void>(" + p + ");\n";
+    if (!needs(accessed, p)) prefix += "  static_cast<void>(" + p + ");\n";
   lastHost_ = host.cb.get();
   closed_.push_back(std::move(host.cb));
   hosts_.pop_back();

@@ -1,12 +1,18 @@
 // Where the passes' statements go: a host function (kinematics,
 // constrained_aba, ...) whose body is a list of calls to part functions, each
-// holding a few bodies' blocks; small functions keep the compiler's time
-// linear in the robot's size. A pass calls boundary() before each block; the
-// writer closes the current part when it is full and moves the live pass
-// outputs (body_state.hpp's Live) into the next function.
+// holding a few bodies' blocks of one pass; small functions keep the
+// compiler's time linear in the robot's size. The entry point calls
+// beginPass() before each pass (a one-line banner at the call site), a pass
+// calls boundary() before each block; the writer closes the current part when
+// it is full or the pass ends, names it after its host, its pass and the
+// bodies it holds (caba_backward_LF_foot_to_LF_hip), decides its parameters
+// from what its printed statements read and write (the expression graph, not
+// the text), and moves the live pass outputs (body_state.hpp's Live) into the
+// next function.
 #pragma once
 
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -17,7 +23,9 @@ namespace proxgen::emit {
 
 class FunctionWriter {
  public:
-  explicit FunctionWriter(ScalarType scalar) : scalar_(scalar) {}
+  /// `bodyName(i)`: how part names spell body i (the plan's identifier).
+  FunctionWriter(ScalarType scalar, std::vector<std::string> bodyNames)
+      : scalar_(scalar), bodyNames_(std::move(bodyNames)) {}
 
   /// The builder statements go to now (a part, or the host between parts).
   CodeBuilder& cb() { return *cb_; }
@@ -28,8 +36,15 @@ class FunctionWriter {
   /// Opens a host function; the live outputs move in from `from` (null: none yet).
   /// Hosts nest (a host opened inside another is closed before it continues).
   void beginHost(const std::string& name, const CodeBuilder* from);
-  /// Before a block: opens a part function, or a new one when this one is full.
-  void boundary();
+  /// Starts a pass in the current host: closes the open part; the next parts
+  /// are named <host>_<name>_<range> (<host>_<range> for an empty name), and
+  /// `banner` is printed as "// ---- banner" above the first of their calls.
+  void beginPass(const std::string& name, const std::string& banner);
+  /// Before a block of body `body`: opens a part function, or a new one when
+  /// this one is full.
+  void boundary(int body);
+  /// Before a block that is not a body's: `label` names it ("column_3").
+  void boundary(const std::string& label);
   /// Closes the current part (if any): prints it and its call in the host.
   void endPart();
   /// Closes the host: its body text; its builder stays alive (hostBuilder()) for
@@ -53,9 +68,11 @@ class FunctionWriter {
   struct Host {
     std::string name;
     std::unique_ptr<CodeBuilder> cb;
-    int parts = 0;
     Expr mu, invMu;
+    std::string pass, banner;  // the current pass; its banner until its first call is printed
   };
+  void open(const std::string& label);
+  std::string partName(const Host& host);
   std::string render(CodeBuilder& cb);
   void translate(const CodeBuilder& from, CodeBuilder& to);
 
@@ -67,6 +84,9 @@ class FunctionWriter {
   CodeBuilder* cb_ = nullptr;
   const CodeBuilder* lastHost_ = nullptr;
   Live live_;
+  std::vector<std::string> bodyNames_;
+  std::string firstLabel_, lastLabel_;  // the open part's first and last block
+  std::set<std::string> partNames_;
   std::string partsText_;
   CodeBuilder::Stats stats_;
 };

@@ -20,8 +20,8 @@ inline constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},
     kL{"L", "Cholesky factor of IA (lower, packed by rows of the upper)"}, kLinv{"Linv", "1 / diag(L)"},
     kUu{"u", "tau - S^T pA"}, kA{"a", "acceleration (gravity-shifted)"}, kDP{"dp", "reduced-sweep force"},
-    kKA{"KA", "constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j)"},
-    kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (row-major)"},
+    kKA{"KA", "constraint force directions of the subtree rows (6 x m, one unused column)"},
+    kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (6 x m, one unused column)"},
     kK{"k", "constraint right-hand side"};
 
 class Members {
@@ -30,9 +30,14 @@ class Members {
     std::string name;
     int size = 0;  // 0: a scalar
     std::string comment;
+    int columns = 0;  // > 0: a matrix of size / columns rows
   };
   /// "w.base" (size 0) or "w.base[idx]"; declares the member on first use.
   std::string member(const std::string& base, int size, int idx, const std::string& comment);
+  /// Entry (r, c) of a rows x cols matrix member: "w.base[r][c]".
+  std::string member(const std::string& base, int rows, int cols, int r, int c, const std::string& comment);
+  /// Entry (r, c + j) of a matrix member (j: a loop variable), "w.base[r][c + j]".
+  std::string loopSlot(const std::string& base, int rows, int cols, int r, int c, const std::string& comment);
   /// Slot idx + j of an array member (j: a loop variable), "w.base[idx + j]".
   std::string loopSlot(const std::string& base, int size, int idx, const std::string& comment);
   const std::vector<Member>& all() const { return members_; }

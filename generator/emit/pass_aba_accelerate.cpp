@@ -38,7 +38,7 @@ void accelerateBody(Emit& e, const Kinematics& kin, const Articulated& art, int 
 
 void accelerateSupport(Emit& e, const Kinematics& kin, const Articulated& art, Motion& motion) {
   for (int i : e.plan.support) {
-    e.fn.boundary();
+    e.fn.boundary(i);
     e.openBody(i, "accelerate");
     accelerateBody(e, kin, art, i, art.b[std::size_t(i)].u, true, motion);
     e.cb().close();
@@ -60,7 +60,7 @@ void emitAccelerateFree(Emit& e, Kinematics kin, Articulated art, Motion motion,
   e.fn.live() = Live{&kin, &art, &motion};
   e.fn.beginHost("accelerate_free", e.fn.current());
   for (int i : e.plan.offSupport) {
-    e.fn.boundary();
+    e.fn.boundary(i);
     e.openBody(i, "accelerate");
     accelerateBody(e, kin, art, i, art.b[std::size_t(i)].u, true, motion);
     e.cb().close();
@@ -75,6 +75,7 @@ void emitAccelerateFree(Emit& e, Kinematics kin, Articulated art, Motion motion,
 
 void callAccelerateFree(Emit& e, const Kinematics& kin, const Articulated& art, Motion& motion) {
   e.fn.endPart();
+  if (e.plan.offSupport.empty()) return;  // no function to call
   FreeAccelerations& fa = *e.freeAccel;
   if (!fa.builder) {
     fa.supportAccelerations = accelerations(e.cb(), e.plan.support, motion);
@@ -84,7 +85,7 @@ void callAccelerateFree(Emit& e, const Kinematics& kin, const Articulated& art, 
     // must be the same members in both algorithms.
     throw std::logic_error("emitter: the support accelerations differ between the two algorithms");
   }
-  e.cb().line("accelerate_free_bodies(w);");
+  e.cb().line("accelerate_free_bodies(w);", {}, {"w"});
   std::vector<int> cache;
   for (int i : e.plan.offSupport)
     for (int d = 0; d < e.bp(i).nv; ++d) {

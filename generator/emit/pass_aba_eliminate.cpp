@@ -48,7 +48,13 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   b.U.assign(1, V6{});
   for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
   const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
-  b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D});
+  if (D.isConstant()) {
+    // Folded: the division is correctly rounded here as at run time (in the
+    // solver's scalar type), so the value is the one the code would compute.
+    b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
+  } else {
+    b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D});
+  }
   const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
   b.u.assign(1, e.putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));
   if (p.parent == 0) return;
@@ -125,7 +131,7 @@ Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin) {
   Articulated art = startElimination(kin);
   const InScope<Articulated> scope(e.fn.live().art, &art);
   for (auto it = e.plan.offSupport.rbegin(); it != e.plan.offSupport.rend(); ++it) {
-    e.fn.boundary();
+    e.fn.boundary(*it);
     e.openBody(*it, "eliminate");
     eliminateBody(e, kin, *it, nullptr, art);
     e.cb().close();

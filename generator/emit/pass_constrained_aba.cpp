@@ -14,7 +14,7 @@ namespace {
 
 // lambda += mu (K a - k) for every constraint, keeping the increment for the next sweep.
 void updateMultipliers(Emit& e, const Kinematics& kin, const Motion& motion, bool first, Multipliers& mult) {
-  e.fn.boundary();
+  e.fn.boundary("");
   CodeBuilder& cb = e.cb();
   cb.open("{", {"multiplier update: dlambda = mu (K a - k), lambda += dlambda"});
   for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
@@ -38,7 +38,7 @@ void reducedSweep(Emit& e, const Kinematics& kin, const Multipliers& mult, Artic
   for (int i : e.plan.support) inc.dp[std::size_t(i)] = zero6();
   for (auto it = e.plan.support.rbegin(); it != e.plan.support.rend(); ++it) {
     const int i = *it;
-    e.fn.boundary();
+    e.fn.boundary(i);
     CodeBuilder& cb = e.cb();
     Articulated::Body& b = art.b[std::size_t(i)];
     const Kinematics::Body& kb = kin.b[std::size_t(i)];
@@ -92,9 +92,10 @@ void copyOut(Emit& e, const Motion& motion, const Multipliers& mult) {
   e.fn.endPart();
   CodeBuilder& cb = e.cb();
   for (int j = 0; j < e.plan.nv; ++j)
-    cb.line(fmt::format("qdd[{}] = {};", j, cb.print(motion.qdd[std::size_t(j)])), {motion.qdd[std::size_t(j)]});
+    cb.line(fmt::format("qdd[{}] = {};", j, cb.print(motion.qdd[std::size_t(j)])), {motion.qdd[std::size_t(j)]}, {"qdd"});
   for (int r = 0; r < e.plan.nc; ++r)
-    cb.line(fmt::format("lambda[{}] = {};", r, cb.print(mult.lambda[std::size_t(r)])), {mult.lambda[std::size_t(r)]});
+    cb.line(fmt::format("lambda[{}] = {};", r, cb.print(mult.lambda[std::size_t(r)])), {mult.lambda[std::size_t(r)]},
+            {"lambda"});
 }
 
 std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from) {
@@ -104,24 +105,30 @@ std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const C
   Increments inc{std::vector<V6>(art.b.size(), zero6())};
   e.fn.live() = Live{&kin, &art, &motion, &inc, nullptr, &mult, nullptr};
   e.fn.beginHost("caba", from);
-  e.fn.setHostMu(e.cb().define("mu", "s.mu * Scalar(s.iterations > 0)", {}));
-  e.cb().line("kinematics(q, v, w);");
-  e.cb().line("eliminate_free_bodies(tau, w);");
+  e.fn.setHostMu(e.cb().define("mu", "s.mu * Scalar(s.iterations > 0)", {}, {"s"}));
+  e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
+  if (!plan.offSupport.empty()) e.cb().line("eliminate_free_bodies(tau, w);", {}, {"tau", "w"});
+  e.fn.beginPass("backward", "backward: eliminate the support, the penalty mu K^T K at the constrained bodies");
   for (auto it = plan.support.rbegin(); it != plan.support.rend(); ++it) {
-    e.fn.boundary();
+    e.fn.boundary(*it);
     e.openBody(*it, "eliminate (penalty at the constraints):");
     eliminateBody(e, kin, *it, &kin.k, art);
     e.cb().close();
   }
+  e.fn.beginPass("forward", "forward: accelerations of the support");
   accelerateSupport(e, kin, art, motion);
   if (plan.nc > 0) {
+    e.fn.beginPass("multipliers", "multipliers: dlambda = mu (K a - k), lambda = dlambda");
     updateMultipliers(e, kin, motion, true, mult);
     e.fn.endPart();
     const std::string before = fingerprint(e.cb(), plan.support, motion, art, mult);
     e.cb().open("for (int k = 2; k <= s.iterations; ++k) {",
-                {"Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass)."});
+                {"Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass)."}, {"s"});
+    e.fn.beginPass("reduced", "reduced sweep: u -= S^T dp, dp passes to the parent");
     reducedSweep(e, kin, mult, art, inc);
+    e.fn.beginPass("reforward", "forward: accelerations of the support");
     accelerateSupport(e, kin, art, motion);
+    e.fn.beginPass("update", "multipliers: dlambda = mu (K a - k), lambda += dlambda");
     updateMultipliers(e, kin, motion, false, mult);
     e.fn.endPart();
     if (fingerprint(e.cb(), plan.support, motion, art, mult) != before)

@@ -59,7 +59,7 @@ void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   f.Linv.assign(std::size_t(nc), Expr());
   const bool full = freeFlyerWithRows(e.plan) < 0;
   for (int j = 0; j < nc; ++j) {
-    e.fn.boundary();
+    e.fn.boundary(fmt::format("column_{}", j));
     CodeBuilder& cb = e.cb();
     cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
     Expr d = delassus(cb, a, j, j, full);  // before inv_mu: see mulAdd in symbolic.cpp
@@ -84,16 +84,16 @@ void woodbury(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
   const BodyPlan& b = e.bp(ff);
   f.W.assign(std::size_t(nc), zero6());
   for (int d = 0; d < 6; ++d) {
-    e.fn.boundary();
+    e.fn.boundary(fmt::format("W_{}", d));
     e.cb().open("{", {fmt::format("W = L^-1 Z^T, column {}", d)});
     std::vector<Expr> z(static_cast<std::size_t>(nc));
     for (int j = 0; j < b.m(); ++j) z[std::size_t(b.rowStart + j)] = rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)];
     const std::vector<Expr> w = forwardSolve(e.cb(), f.L, f.Linv, z);
     for (int t = 0; t < nc; ++t)
-      f.W[std::size_t(t)][std::size_t(d)] = e.put(e.member("W", 6 * nc, 6 * t + d, "L^-1 Z^T (row-major)"), w[std::size_t(t)]);
+      f.W[std::size_t(t)][std::size_t(d)] = e.put(e.ws.member("W", nc, 6, t, d, "L^-1 Z^T"), w[std::size_t(t)]);
     e.cb().close();
   }
-  e.fn.boundary();
+  e.fn.boundary("LS");
   CodeBuilder& cb = e.cb();
   cb.open("{", {"S = I + W^T W = LS LS^T"});
   Sym S(6);

@@ -154,7 +154,7 @@ Kinematics emitKinematics(Emit& e) {
   kin.b[0].g = constant(m.gravity);
   kin.b[0].oM = constant(SE3::Identity());
   for (int i = 1; i < m.numBodies(); ++i) {
-    e.fn.boundary();
+    e.fn.boundary(i);
     e.openBody(i, "");
     Kinematics::Body& b = kin.b[std::size_t(i)];
     const Kinematics::Body& parent = kin.b[std::size_t(e.bp(i).parent)];
@@ -165,7 +165,7 @@ Kinematics emitKinematics(Emit& e) {
     e.cb().close();
   }
   if (!e.bp(0).constraints.empty()) {
-    e.fn.boundary();
+    e.fn.boundary("world");
     e.cb().open("{", {"constraints on the world"});
     for (int k : e.bp(0).constraints) kin.k[std::size_t(k)] = constraintTerms(e, k, kin.b[0]);
     e.cb().close();

@@ -18,7 +18,7 @@ int rowStride(int m) { return m + 1; }
 /// arithmetic are printed as a loop (README, "The generated solver").
 constexpr int kLoopColumns = 4;
 
-// How many columns from c0 on hold exactly the members KA_i[r * stride + c]
+// How many columns from c0 on hold exactly the members KA_i[r][c]
 // (each entry stored, none folded): a loop over them reads the same slots.
 int loopableColumns(Emit& e, const ProxRows::Body& b, int i, int c0) {
   const int m = e.bp(i).m(), stride = rowStride(m);
@@ -28,7 +28,7 @@ int loopableColumns(Emit& e, const ProxRows::Body& b, int i, int c0) {
     for (int r = 0; r < 6 && canonical; ++r) {
       const Expr& x = b.KA[std::size_t(c)][std::size_t(r)];
       canonical = x.isScaledAtom() && x.terms()[0].coeff == 1.0 &&
-                  x.terms()[0].atom == e.cb().member(e.member(kKA, i, 6 * stride, r * stride + c)).terms()[0].atom;
+                  x.terms()[0].atom == e.cb().member(e.member(kKA, i, 6, stride, r, c)).terms()[0].atom;
     }
     if (!canonical) break;
   }
@@ -92,11 +92,11 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
       // (vectorised by the compiler) instead of len copies of the code.
       cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
       V6 ka;
-      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6 * stride, r * stride + c0));
+      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
       const auto out = column(ka, [&](const Quantity& qy) { return e.loopSlot(qy, i, m, c0); });
       if (passes)
         for (int r = 0; r < 6; ++r)
-          cb.store(e.loopSlot(kKA, p.parent, 6 * pstride, r * pstride + off + c0), out.f[std::size_t(r)]);
+          cb.store(e.loopSlot(kKA, p.parent, 6, pstride, r, off + c0), out.f[std::size_t(r)]);
       if (!out.ksdStored) throw std::logic_error("emitter: a looped column's D^-1 KS is not stored");
       cb.close();
       for (int c = c0; c < c0 + len; ++c) {
@@ -106,7 +106,7 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
         b.KSD[cu] = cb.member(e.member(kKSD, i, m, c));
         if (passes)
           for (int r = 0; r < 6; ++r)
-            par.KA[std::size_t(off + c)][std::size_t(r)] = cb.member(e.member(kKA, p.parent, 6 * pstride, r * pstride + off + c));
+            par.KA[std::size_t(off + c)][std::size_t(r)] = cb.member(e.member(kKA, p.parent, 6, pstride, r, off + c));
       }
       c0 += len;
       continue;
@@ -117,7 +117,7 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
     if (passes)
       for (int r = 0; r < 6; ++r)
         par.KA[std::size_t(off + c0)][std::size_t(r)] =
-            e.putQ(kKA, p.parent, 6 * pstride, r * pstride + off + c0, out.f[std::size_t(r)]);
+            e.put(e.member(kKA, p.parent, 6, pstride, r, off + c0), out.f[std::size_t(r)]);
     ++c0;
   }
 }
@@ -136,7 +136,7 @@ void rowsFreeFlyer(Emit& e, const Articulated& art, int i, ProxRows& rows) {
     const std::vector<Expr> z =
         forwardSolve(e.cb(), ab.L, ab.Linv, std::vector<Expr>(b.KA[std::size_t(j)].begin(), b.KA[std::size_t(j)].end()));
     for (int d = 0; d < 6; ++d)
-      b.Z[std::size_t(j)][std::size_t(d)] = e.keepQ(kZ, i, 6 * rowStride(m), d * rowStride(m) + j, z[std::size_t(d)]);
+      b.Z[std::size_t(j)][std::size_t(d)] = e.keep(e.member(kZ, i, 6, rowStride(m), d, j), z[std::size_t(d)]);
   }
 }
 
@@ -166,12 +166,12 @@ void initRows(Emit& e, ProxRows& rows) {
 // forward pass over the support (the a_i members are rewritten by the final pass).
 void freeRowAccelerations(Emit& e, const Kinematics& kin, const Articulated& art, Motion& motion, ProxRows& rows) {
   for (int i : e.plan.support) {
-    e.fn.boundary();
+    e.fn.boundary(i);
     e.openBody(i, "free acceleration (lambda = 0):");
     accelerateBody(e, kin, art, i, art.b[std::size_t(i)].u, false, motion);
     e.cb().close();
   }
-  e.fn.boundary();
+  e.fn.boundary("yfree");
   e.cb().open("{", {"free row accelerations y_free = K a - k (tree order)"});
   for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
     const Constraint& c = e.sys.constraints[k];
@@ -204,31 +204,37 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
   DelassusFactor del;
   e.fn.live() = Live{&kin, &art, &motion, nullptr, &rows, &mult, nullptr};
   e.fn.beginHost("pv", from);
-  e.cb().line("kinematics(q, v, w);");
-  e.cb().line("eliminate_free_bodies(tau, w);");
+  e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
+  if (!plan.offSupport.empty()) e.cb().line("eliminate_free_bodies(tau, w);", {}, {"tau", "w"});
   initRows(e, rows);
+  e.fn.beginPass("backward", "backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS");
   for (auto it = plan.support.rbegin(); it != plan.support.rend(); ++it) {
-    e.fn.boundary();
+    e.fn.boundary(*it);
     e.openBody(*it, "eliminate, carrying the subtree rows:");
     eliminateBody(e, kin, *it, nullptr, art);
     carryRows(e, kin, art, *it, rows);
     e.cb().close();
   }
   if (nc > 0) {
+    e.fn.beginPass("free", "free accelerations (lambda = 0) and the rows' y_free = K a - k");
     freeRowAccelerations(e, kin, art, motion, rows);
     e.fn.endPart();
-    e.fn.setHostInvMu(e.cb().define("inv_mu", e.cb().literal(1.0) + " / s.mu", {}));
+    e.fn.setHostInvMu(e.cb().define("inv_mu", e.cb().literal(1.0) + " / s.mu", {}, {"s"}));
+    e.fn.beginPass("delassus", "G + I/mu = L L^T, G assembled from the carried rows");
     del = factorDelassus(e, rows);
     e.fn.live().del = &del;
-    e.fn.boundary();
+    e.fn.beginPass("start", "lambda = 0");
+    e.fn.boundary("");
     const std::vector<int>& tree = plan.rootRows;
     for (int t = 0; t < nc; ++t)
       mult.lambda[std::size_t(tree[std::size_t(t)])] = e.cb().store(e.lambdaMember(tree[std::size_t(t)]), Expr());
     e.fn.endPart();
     const std::string before = fingerprint(e.cb(), mult);
     e.cb().open("for (int k = 0; k < s.iterations; ++k) {",
-                {"K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)"});
-    e.fn.boundary();
+                {"K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)"},
+                {"s"});
+    e.fn.beginPass("proximal", "proximal step: (G + I/mu) lambda = y_free + lambda / mu");
+    e.fn.boundary("");
     std::vector<Expr> rhs(static_cast<std::size_t>(nc));
     for (int t = 0; t < nc; ++t)
       rhs[std::size_t(t)] = rows.yfree[std::size_t(t)] + e.cb().mul(e.cb().input("inv_mu"), mult.lambda[std::size_t(tree[std::size_t(t)])]);
@@ -240,8 +246,9 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
       throw std::logic_error("emitter: the proximal loop does not carry its state consistently");
     e.cb().close();
   }
+  e.fn.beginPass("forward", "forward: accelerations, with the multipliers of the subtree rows");
   for (int i : plan.support) {
-    e.fn.boundary();
+    e.fn.boundary(i);
     e.openBody(i, "accelerate, with the multipliers of the subtree rows:");
     std::vector<Expr> uEff = art.b[std::size_t(i)].u;
     const ProxRows::Body& rb = rows.b[std::size_t(i)];
