@@ -1688,7 +1688,6 @@ PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  static_cast<void>(w);
   kinematics_shoulder_link_to_forearm_link(q, v, w);
   kinematics_wrist_1_link_to_wrist_2_link(q, v, w);
   kinematics_wrist_3_link(q, v, w);

@@ -9114,7 +9114,6 @@ PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROX
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  static_cast<void>(w);
   kinematics_pelvis_to_l_hip_yaw_link(q, v, w);
   kinematics_l_hip_roll_link_to_l_thigh(q, v, w);
   kinematics_l_shank_to_l_ankle_link(q, v, w);
@@ -9136,7 +9135,6 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
 // Articulated-body elimination of the bodies off the constraint support
 // (no constraint below them): the same in both algorithms.
 void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
-  static_cast<void>(w);
   eliminate_free_head_to_neck_link(tau, w);
   eliminate_free_l_hand_to_l_wrist_pitch_link(tau, w);
   eliminate_free_l_wrist_yaw_link(tau, w);
@@ -9148,7 +9146,6 @@ void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
 
 // Accelerations of the bodies off the support, once their ancestors are final.
 void accelerate_free_bodies(Workspace& w) noexcept {
-  static_cast<void>(w);
   accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(w);
   accelerate_free_l_forearm_to_l_wrist_pitch_link(w);
   accelerate_free_l_hand_to_head(w);

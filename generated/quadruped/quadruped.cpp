@@ -5006,7 +5006,6 @@ PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_R
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  static_cast<void>(w);
   kinematics_trunk_to_LF_hip(q, v, w);
   kinematics_LF_thigh_to_LF_shank(q, v, w);
   kinematics_LH_hip_to_LH_thigh(q, v, w);

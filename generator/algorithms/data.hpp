@@ -16,7 +16,7 @@ using MatNN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using MatN6 = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6>;
 
-/// Per-constraint quantities K (rows x 6) and k (rows) of ALGORITHMS.md section 2:
+/// Per-constraint quantities K (rows x 6) and k (rows) of docs/algorithms.md §2:
 /// the constraint reads K a_i = k on its body's (gravity-shifted) acceleration.
 struct ConstraintTerm {
   MatN6 K;

@@ -13,11 +13,11 @@ bool startsWith(const std::string& s, const std::string& prefix) { return s.comp
 // needs parameter `p`: an array (q, v, tau: "q[3]"), the workspace ("w.x"),
 // or a scalar ("mu").
 bool needs(const std::set<std::string>& names, const std::string& p) {
+  if (names.count(p)) return true;  // the name itself (a call's argument)
   if (p == "w") {
     const auto it = names.lower_bound("w.");
     return it != names.end() && startsWith(*it, "w.");
   }
-  if (names.count(p)) return true;
   const auto it = names.lower_bound(p + "[");
   return it != names.end() && startsWith(*it, p + "[");
 }
