@@ -12,16 +12,7 @@ namespace {{
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {{
 {kinematics}}}
 
-// Articulated-body elimination of the bodies off the constraint support
-// (no constraint below them): the same in both algorithms.
-void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {{
-{eliminate_free}}}
-
-// Accelerations of the bodies off the support, once their ancestors are final.
-void accelerate_free_bodies(Workspace& w) noexcept {{
-{accelerate_free}}}
-
-}}  // namespace
+{free_bodies}}}  // namespace
 
 // constrainedABA: the penalty mu K^T K at the constrained bodies, one full
 // sweep, then iterations 2..K as reduced sweeps over the support.

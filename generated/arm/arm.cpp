@@ -11,7 +11,7 @@ namespace arm {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     proxgen_rt::sincos(q[0], w.sq_shoulder_link, w.cq_shoulder_link);
@@ -67,7 +67,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     proxgen_rt::sincos(q[3], w.sq_wrist_1_link, w.cq_wrist_1_link);
@@ -130,7 +130,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     proxgen_rt::sincos(q[5], w.sq_wrist_3_link, w.cq_wrist_3_link);
@@ -162,7 +162,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.U_wrist_3_link[5] = 0.0003695625 + mu;
@@ -209,7 +209,7 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_wrist_2_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
     w.Dinv_wrist_2_link = 1.0 / w.IA_wrist_2_link[20];
@@ -284,7 +284,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     w.Dinv_wrist_1_link = 1.0 / w.IA_wrist_1_link[20];
@@ -376,7 +376,7 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_forearm_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     w.Dinv_forearm_link = 1.0 / w.IA_forearm_link[20];
@@ -468,7 +468,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_upper_arm_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
     w.Dinv_upper_arm_link = 1.0 / w.IA_upper_arm_link[20];
@@ -560,12 +560,15 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_shoulder_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
     w.u_shoulder_link[0] = -w.pA_shoulder_link[5] + tau[0];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_shoulder_link_to_wrist_2_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
@@ -617,53 +620,56 @@ PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
     w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.qdd[3];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    const Scalar t0 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
-    const Scalar t1 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t2 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.sq_wrist_2_link;
-    const Scalar t3 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t0 + w.a_wrist_1_link[2]*w.cq_wrist_2_link;
-    const Scalar t4 = w.c_wrist_2_link[3] + w.a_wrist_1_link[3]*w.cq_wrist_2_link + w.a_wrist_1_link[5]*w.sq_wrist_2_link;
-    const Scalar t5 = w.c_wrist_2_link[4] - w.a_wrist_1_link[3]*w.sq_wrist_2_link + w.a_wrist_1_link[5]*w.cq_wrist_2_link;
-    const Scalar t6 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t2 - w.IA_wrist_2_link[14]*t1 - w.IA_wrist_2_link[19]*t5 + w.a_wrist_1_link[4]*w.IA_wrist_2_link[20];
-    w.qdd[4] = w.Dinv_wrist_2_link*t6;
-    w.a_wrist_2_link[0] = t2;
-    w.a_wrist_2_link[1] = t3;
-    w.a_wrist_2_link[2] = t1;
-    w.a_wrist_2_link[3] = t4;
-    w.a_wrist_2_link[4] = t5;
+    const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
+    const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t23 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t19 - w.IA_wrist_2_link[14]*t18 - w.IA_wrist_2_link[19]*t22 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
+    w.qdd[4] = w.Dinv_wrist_2_link*t23;
+    w.a_wrist_2_link[0] = t19;
+    w.a_wrist_2_link[1] = t20;
+    w.a_wrist_2_link[2] = t18;
+    w.a_wrist_2_link[3] = t21;
+    w.a_wrist_2_link[4] = t22;
     w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.qdd[4];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    const Scalar t7 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
-    const Scalar t8 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t9 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t7 - w.sq_wrist_3_link*w.a_wrist_2_link[2];
-    const Scalar t10 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t7 - w.cq_wrist_3_link*w.a_wrist_2_link[2];
-    const Scalar t11 = w.c_wrist_3_link[3] + w.cq_wrist_3_link*w.a_wrist_2_link[3] - w.sq_wrist_3_link*w.a_wrist_2_link[5];
-    const Scalar t12 = w.c_wrist_3_link[4] - w.sq_wrist_3_link*w.a_wrist_2_link[3] - w.cq_wrist_3_link*w.a_wrist_2_link[5];
-    const Scalar t13 = w.u_wrist_3_link[0] - w.U_wrist_3_link[5]*w.a_wrist_2_link[4];
-    w.qdd[5] = w.Dinv_wrist_3_link*t13;
-    w.a_wrist_3_link[0] = t9;
-    w.a_wrist_3_link[1] = t10;
-    w.a_wrist_3_link[2] = t8;
-    w.a_wrist_3_link[3] = t11;
-    w.a_wrist_3_link[4] = t12;
+    const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
+    const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t6 = w.u_wrist_3_link[0] - w.a_wrist_2_link[4]*w.U_wrist_3_link[5];
+    w.qdd[5] = w.Dinv_wrist_3_link*t6;
+    w.a_wrist_3_link[0] = t2;
+    w.a_wrist_3_link[1] = t3;
+    w.a_wrist_3_link[2] = t1;
+    w.a_wrist_3_link[3] = t4;
+    w.a_wrist_3_link[4] = t5;
     w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.qdd[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t14 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.dlambda[0] = mu*t14;
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.dlambda[0] = mu*t0;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t15 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.dlambda[1] = mu*t15;
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t16 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t16;
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.dlambda[2];
     w.dlambda[3] = w.a_wrist_3_link[3]*mu;
     w.lambda[3] = w.dlambda[3];
@@ -674,7 +680,7 @@ PROXGEN_RT_NOINLINE void caba_6(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noe
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_7(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_wrist_3_link_to_wrist_1_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     w.u_wrist_3_link[0] = w.u_wrist_3_link[0] - w.dlambda[5];
@@ -729,7 +735,7 @@ PROXGEN_RT_NOINLINE void caba_7(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_8(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_forearm_link_to_shoulder_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     w.u_forearm_link[0] = -w.dp_forearm_link[5] + w.u_forearm_link[0];
@@ -772,80 +778,80 @@ PROXGEN_RT_NOINLINE void caba_8(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   {
     w.u_shoulder_link[0] = w.u_shoulder_link[0] - w.dp_shoulder_link[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_shoulder_link_to_wrist_2_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    const Scalar t18 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
-    w.qdd[0] = w.Dinv_shoulder_link*t18;
+    const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
+    w.qdd[0] = w.Dinv_shoulder_link*t0;
     w.a_shoulder_link[5] = w.qdd[0];
   }
   // accelerate body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t19 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t20 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t21 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t19 - w.IA_upper_arm_link[19]*t20;
-    w.qdd[1] = w.Dinv_upper_arm_link*t21;
+    const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
+    const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
+    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    w.qdd[1] = w.Dinv_upper_arm_link*t3;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
-    w.a_upper_arm_link[3] = t19;
-    w.a_upper_arm_link[4] = t20;
+    w.a_upper_arm_link[3] = t1;
+    w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    const Scalar t0 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
-    const Scalar t1 = w.c_forearm_link[0] + w.a_upper_arm_link[0]*w.cq_forearm_link + w.sq_forearm_link*t0;
-    const Scalar t2 = w.c_forearm_link[1] - w.a_upper_arm_link[0]*w.sq_forearm_link + w.cq_forearm_link*t0;
-    const Scalar t3 = w.c_forearm_link[3] + w.a_upper_arm_link[3]*w.cq_forearm_link + w.a_upper_arm_link[4]*w.sq_forearm_link;
-    const Scalar t4 = w.c_forearm_link[4] - w.a_upper_arm_link[3]*w.sq_forearm_link + w.a_upper_arm_link[4]*w.cq_forearm_link;
-    const Scalar t5 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t1 - w.IA_forearm_link[10]*t2 - 0.425*w.a_upper_arm_link[4]*w.IA_forearm_link[14] - w.IA_forearm_link[17]*t3 - w.IA_forearm_link[19]*t4 - w.a_upper_arm_link[5]*w.IA_forearm_link[20];
-    w.qdd[2] = w.Dinv_forearm_link*t5;
-    w.a_forearm_link[0] = t1;
-    w.a_forearm_link[1] = t2;
+    const Scalar t4 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
+    const Scalar t5 = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
+    const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
+    const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
+    w.qdd[2] = w.Dinv_forearm_link*t9;
+    w.a_forearm_link[0] = t5;
+    w.a_forearm_link[1] = t6;
     w.a_forearm_link[2] = 0.425*w.a_upper_arm_link[4];
-    w.a_forearm_link[3] = t3;
-    w.a_forearm_link[4] = t4;
+    w.a_forearm_link[3] = t7;
+    w.a_forearm_link[4] = t8;
     w.a_forearm_link[5] = w.a_upper_arm_link[5] + w.qdd[2];
   }
   // accelerate body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
-    const Scalar t6 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
-    const Scalar t7 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
-    const Scalar t8 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t6;
-    const Scalar t9 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t6;
-    const Scalar t10 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t11 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t12 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t8 - w.IA_wrist_1_link[10]*t9 - w.IA_wrist_1_link[14]*t7 - w.IA_wrist_1_link[17]*t10 - w.IA_wrist_1_link[19]*t11 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
-    w.qdd[3] = w.Dinv_wrist_1_link*t12;
-    w.a_wrist_1_link[0] = t8;
-    w.a_wrist_1_link[1] = t9;
-    w.a_wrist_1_link[2] = t7;
-    w.a_wrist_1_link[3] = t10;
-    w.a_wrist_1_link[4] = t11;
+    const Scalar t10 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
+    const Scalar t11 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
+    const Scalar t12 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
+    const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
+    const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
+    w.qdd[3] = w.Dinv_wrist_1_link*t16;
+    w.a_wrist_1_link[0] = t12;
+    w.a_wrist_1_link[1] = t13;
+    w.a_wrist_1_link[2] = t11;
+    w.a_wrist_1_link[3] = t14;
+    w.a_wrist_1_link[4] = t15;
     w.a_wrist_1_link[5] = w.a_forearm_link[5] + w.qdd[3];
   }
   // accelerate body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    const Scalar t13 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
-    const Scalar t14 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t15 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t13 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t16 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t13 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t17 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t18 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t19 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t15 - w.IA_wrist_2_link[14]*t14 - w.IA_wrist_2_link[19]*t18 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
-    w.qdd[4] = w.Dinv_wrist_2_link*t19;
-    w.a_wrist_2_link[0] = t15;
-    w.a_wrist_2_link[1] = t16;
-    w.a_wrist_2_link[2] = t14;
-    w.a_wrist_2_link[3] = t17;
-    w.a_wrist_2_link[4] = t18;
+    const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
+    const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t23 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t19 - w.IA_wrist_2_link[14]*t18 - w.IA_wrist_2_link[19]*t22 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
+    w.qdd[4] = w.Dinv_wrist_2_link*t23;
+    w.a_wrist_2_link[0] = t19;
+    w.a_wrist_2_link[1] = t20;
+    w.a_wrist_2_link[2] = t18;
+    w.a_wrist_2_link[3] = t21;
+    w.a_wrist_2_link[4] = t22;
     w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.qdd[4];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_10(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
@@ -863,16 +869,19 @@ PROXGEN_RT_NOINLINE void caba_10(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.a_wrist_3_link[4] = t5;
     w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.qdd[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t7 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.dlambda[0] = mu*t7;
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.dlambda[0] = mu*t0;
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t8 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.dlambda[1] = mu*t8;
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t9 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t9;
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
     w.dlambda[3] = w.a_wrist_3_link[3]*mu;
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
@@ -883,16 +892,15 @@ PROXGEN_RT_NOINLINE void caba_10(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_wrist_3_link_to_wrist_2_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    w.Dinv_wrist_3_link = 1.0 / 0.0003695625;
     w.u_wrist_3_link[0] = -w.pA_wrist_3_link[5] + tau[5];
     const Scalar pa0 = 0.365*w.c_wrist_3_link[0] + 0.035930965*w.c_wrist_3_link[4] + w.pA_wrist_3_link[0];
     const Scalar pa1 = 0.365*w.c_wrist_3_link[1] - 0.035930965*w.c_wrist_3_link[3] + w.pA_wrist_3_link[1];
     const Scalar pa2 = -0.035930965*w.c_wrist_3_link[1] + 0.003770528042232001*w.c_wrist_3_link[3] + w.pA_wrist_3_link[3];
     const Scalar pa3 = 0.035930965*w.c_wrist_3_link[0] + 0.003770528042232001*w.c_wrist_3_link[4] + w.pA_wrist_3_link[4];
-    const Scalar pa4 = w.pA_wrist_3_link[5] + 0.0003695625*w.Dinv_wrist_3_link*w.u_wrist_3_link[0];
+    const Scalar pa4 = w.pA_wrist_3_link[5] + 0.9999999999999999*w.u_wrist_3_link[0];
     const Scalar t0 = w.cq_wrist_3_link*pa0 - w.sq_wrist_3_link*pa1;
     const Scalar t1 = -w.sq_wrist_3_link*pa0 - w.cq_wrist_3_link*pa1;
     w.pA_wrist_2_link[0] = w.pA_wrist_2_link[0] + t0;
@@ -901,114 +909,100 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_wrist_2_link[3] = w.pA_wrist_2_link[3] - 0.0997*w.pA_wrist_3_link[2] + w.cq_wrist_3_link*pa2 - w.sq_wrist_3_link*pa3;
     w.pA_wrist_2_link[4] = w.pA_wrist_2_link[4] + pa4 + 0.0997*t0;
     w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq_wrist_3_link*pa2 - w.cq_wrist_3_link*pa3;
-    w.KA_wrist_2_link[0] = w.cq_wrist_3_link;
-    w.KA_wrist_2_link[14] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[21] = -0.0996*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[28] = 0.0997*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[35] = -0.0996*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[1] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[15] = -w.cq_wrist_3_link;
-    w.KA_wrist_2_link[22] = -0.0996*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[29] = -0.0997*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[36] = 0.0996*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[24] = w.cq_wrist_3_link;
-    w.KA_wrist_2_link[38] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[25] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[39] = -w.cq_wrist_3_link;
+    w.KA_wrist_2_link[0][0] = w.cq_wrist_3_link;
+    w.KA_wrist_2_link[2][0] = -w.sq_wrist_3_link;
+    w.KA_wrist_2_link[3][0] = -0.0996*w.sq_wrist_3_link;
+    w.KA_wrist_2_link[4][0] = 0.0997*w.cq_wrist_3_link;
+    w.KA_wrist_2_link[5][0] = -0.0996*w.cq_wrist_3_link;
+    w.KA_wrist_2_link[0][1] = -w.sq_wrist_3_link;
+    w.KA_wrist_2_link[2][1] = -w.cq_wrist_3_link;
+    w.KA_wrist_2_link[3][1] = -0.0996*w.cq_wrist_3_link;
+    w.KA_wrist_2_link[4][1] = -0.0997*w.sq_wrist_3_link;
+    w.KA_wrist_2_link[5][1] = 0.0996*w.sq_wrist_3_link;
+    w.KA_wrist_2_link[3][3] = w.cq_wrist_3_link;
+    w.KA_wrist_2_link[5][3] = -w.sq_wrist_3_link;
+    w.KA_wrist_2_link[3][4] = -w.sq_wrist_3_link;
+    w.KA_wrist_2_link[5][4] = -w.cq_wrist_3_link;
   }
   // eliminate, carrying the subtree rows: body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    w.Dinv_wrist_2_link = 1.0 / 0.005433872322232001;
     w.u_wrist_2_link[0] = -w.pA_wrist_2_link[5] + tau[4];
-    const Scalar Ia0 = 1.665 - 0.003268747926891226*w.Dinv_wrist_2_link;
-    const Scalar Ia1 = 0.1636605 - 0.00032370812569050116*w.Dinv_wrist_2_link;
-    const Scalar Ia2 = 0.01830599085 - 3.205721364318109e-05*w.Dinv_wrist_2_link;
-    const Scalar pa5 = w.pA_wrist_2_link[0] - 0.057172965000000006*w.Dinv_wrist_2_link*w.u_wrist_2_link[0] + w.c_wrist_2_link[0]*Ia0 + w.c_wrist_2_link[4]*Ia1;
+    const Scalar pa5 = 1.0634496261501107*w.c_wrist_2_link[0] + 0.10408822695153502*w.c_wrist_2_link[4] + w.pA_wrist_2_link[0] - 10.521587849255136*w.u_wrist_2_link[0];
     const Scalar pa6 = 1.665*w.c_wrist_2_link[1] - 0.1636605*w.c_wrist_2_link[3] + w.pA_wrist_2_link[1];
     const Scalar pa7 = 0.057172965000000006*w.c_wrist_2_link[3] + w.pA_wrist_2_link[2];
     const Scalar pa8 = -0.1636605*w.c_wrist_2_link[1] + 0.022423613172231998*w.c_wrist_2_link[3] + w.pA_wrist_2_link[3];
-    const Scalar pa9 = w.pA_wrist_2_link[4] - 0.0056619090105*w.Dinv_wrist_2_link*w.u_wrist_2_link[0] + w.c_wrist_2_link[0]*Ia1 + w.c_wrist_2_link[4]*Ia2;
-    const Scalar pa10 = w.pA_wrist_2_link[5] + 0.005433872322232001*w.Dinv_wrist_2_link*w.u_wrist_2_link[0];
+    const Scalar pa9 = 0.10408822695153502*w.c_wrist_2_link[0] + 0.012406475413830647*w.c_wrist_2_link[4] + w.pA_wrist_2_link[4] - 1.041965779603436*w.u_wrist_2_link[0];
+    const Scalar pa10 = w.pA_wrist_2_link[5] + w.u_wrist_2_link[0];
     const Scalar C21 = w.cq_wrist_2_link*w.cq_wrist_2_link - w.sq_wrist_2_link*w.sq_wrist_2_link;
-    const Scalar h0 = -0.8325 + 0.5*Ia0;
-    const Scalar m0 = 0.8325 + 0.5*Ia0;
-    const Scalar t2 = 2.0*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    const Scalar t3 = -0.08183025 + 0.5*Ia1;
-    const Scalar h1 = 0.011211806586115999 - 0.5*Ia2;
-    const Scalar m1 = 0.011211806586115999 + 0.5*Ia2;
-    const Scalar t4 = m0 + C21*h0;
-    const Scalar t5 = m0 - C21*h0;
-    const Scalar t6 = 0.08183025 + 0.5*Ia1 + C21*t3;
-    const Scalar t7 = -0.08183025 - 0.5*Ia1 + C21*t3;
-    const Scalar t8 = -0.22194450000000002 - 0.057172965000000006*w.cq_wrist_2_link;
-    const Scalar t9 = w.cq_wrist_2_link*pa5 - w.sq_wrist_2_link*pa6;
-    const Scalar t10 = w.sq_wrist_2_link*pa5 + w.cq_wrist_2_link*pa6;
-    w.IA_wrist_1_link[0] = 1.37 + t4;
-    w.IA_wrist_1_link[2] = h0*t2;
-    w.IA_wrist_1_link[3] = -t2*t3;
-    w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t4;
-    w.IA_wrist_1_link[5] = 0.0223858 + t6;
-    w.IA_wrist_1_link[8] = -0.180155 + t8;
+    const Scalar t2 = 1.3642248130750554 - 0.30077518692494465*C21;
+    const Scalar t3 = 1.3642248130750554 + 0.30077518692494465*C21;
+    const Scalar t4 = 0.1338743634757675 - 0.02978613652423248*C21;
+    const Scalar t5 = -0.1338743634757675 - 0.02978613652423248*C21;
+    const Scalar t6 = -0.22194450000000002 - 0.057172965000000006*w.cq_wrist_2_link;
+    const Scalar t7 = w.cq_wrist_2_link*pa5 - w.sq_wrist_2_link*pa6;
+    const Scalar t8 = w.sq_wrist_2_link*pa5 + w.cq_wrist_2_link*pa6;
+    w.IA_wrist_1_link[0] = 1.37 + t2;
+    w.IA_wrist_1_link[2] = -0.6015503738498893*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[3] = 0.05957227304846496*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t2;
+    w.IA_wrist_1_link[5] = 0.0223858 + t4;
+    w.IA_wrist_1_link[8] = -0.180155 + t6;
     w.IA_wrist_1_link[10] = -0.057172965000000006*w.sq_wrist_2_link;
-    w.IA_wrist_1_link[11] = 1.37 + t5;
-    w.IA_wrist_1_link[12] = -0.0223858 + t7;
-    w.IA_wrist_1_link[13] = 0.1333*h0*t2;
-    w.IA_wrist_1_link[14] = t2*t3;
-    w.IA_wrist_1_link[15] = 0.026393728972000003 + 0.007621156234500001*w.cq_wrist_2_link + m1 + C21*h1 - 0.1333*t8;
-    w.IA_wrist_1_link[16] = -0.1333*t2*t3;
-    w.IA_wrist_1_link[17] = 0.007621156234500001*w.sq_wrist_2_link + t2*h1;
-    w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t4;
-    w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t6;
-    w.IA_wrist_1_link[20] = 0.0017529089719999999 + m1 - C21*h1;
-    w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t9;
+    w.IA_wrist_1_link[11] = 1.37 + t3;
+    w.IA_wrist_1_link[12] = -0.0223858 + t5;
+    w.IA_wrist_1_link[13] = -0.08018666483419025*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[14] = -0.05957227304846496*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[15] = 0.043808773265031326 + 0.007621156234500001*w.cq_wrist_2_link + 0.0050085688792006755*C21 - 0.1333*t6;
+    w.IA_wrist_1_link[16] = 0.00794098399736038*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[17] = 0.007621156234500001*w.sq_wrist_2_link + 0.010017137758401351*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t2;
+    w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t4;
+    w.IA_wrist_1_link[20] = 0.01916795326503132 - 0.0050085688792006755*C21;
+    w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t7;
     w.pA_wrist_1_link[1] = w.pA_wrist_1_link[1] - pa7;
-    w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t10;
+    w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t8;
     w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa7 + w.cq_wrist_2_link*pa8 - w.sq_wrist_2_link*pa9;
-    w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - pa10 + 0.1333*t9;
+    w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - pa10 + 0.1333*t7;
     w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa8 + w.cq_wrist_2_link*pa9;
-    w.KSD_wrist_2_link[0] = w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
-    const Scalar t11 = w.KA_wrist_2_link[0] + 0.057172965000000006*w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
-    const Scalar t12 = w.KA_wrist_2_link[28] + 0.0056619090105*w.KA_wrist_2_link[35]*w.Dinv_wrist_2_link;
-    w.KA_wrist_1_link[0] = w.cq_wrist_2_link*t11;
-    w.KA_wrist_1_link[7] = -w.KA_wrist_2_link[14];
-    w.KA_wrist_1_link[14] = w.sq_wrist_2_link*t11;
-    w.KA_wrist_1_link[21] = 0.1333*w.KA_wrist_2_link[14] + w.cq_wrist_2_link*w.KA_wrist_2_link[21] - w.sq_wrist_2_link*t12;
-    w.KA_wrist_1_link[28] = 0.1333*w.cq_wrist_2_link*t11;
-    w.KA_wrist_1_link[35] = w.sq_wrist_2_link*w.KA_wrist_2_link[21] + w.cq_wrist_2_link*t12;
-    w.KSD_wrist_2_link[1] = w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
-    const Scalar t13 = w.KA_wrist_2_link[1] + 0.057172965000000006*w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
-    const Scalar t14 = w.KA_wrist_2_link[29] + 0.0056619090105*w.KA_wrist_2_link[36]*w.Dinv_wrist_2_link;
-    w.KA_wrist_1_link[1] = w.cq_wrist_2_link*t13;
-    w.KA_wrist_1_link[8] = -w.KA_wrist_2_link[15];
-    w.KA_wrist_1_link[15] = w.sq_wrist_2_link*t13;
-    w.KA_wrist_1_link[22] = 0.1333*w.KA_wrist_2_link[15] + w.cq_wrist_2_link*w.KA_wrist_2_link[22] - w.sq_wrist_2_link*t14;
-    w.KA_wrist_1_link[29] = 0.1333*w.cq_wrist_2_link*t13;
-    w.KA_wrist_1_link[36] = w.sq_wrist_2_link*w.KA_wrist_2_link[22] + w.cq_wrist_2_link*t14;
-    w.KA_wrist_1_link[2] = -w.sq_wrist_2_link;
-    w.KA_wrist_1_link[16] = w.cq_wrist_2_link;
-    w.KA_wrist_1_link[23] = -0.0997*w.cq_wrist_2_link;
-    w.KA_wrist_1_link[30] = -0.1333*w.sq_wrist_2_link;
-    w.KA_wrist_1_link[37] = -0.0997*w.sq_wrist_2_link;
-    w.KSD_wrist_2_link[3] = w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
-    const Scalar t15 = 0.057172965000000006*w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
-    const Scalar t16 = 0.0056619090105*w.KA_wrist_2_link[38]*w.Dinv_wrist_2_link;
-    w.KA_wrist_1_link[3] = w.cq_wrist_2_link*t15;
-    w.KA_wrist_1_link[17] = w.sq_wrist_2_link*t15;
-    w.KA_wrist_1_link[24] = w.cq_wrist_2_link*w.KA_wrist_2_link[24] - w.sq_wrist_2_link*t16;
-    w.KA_wrist_1_link[31] = 0.1333*w.cq_wrist_2_link*t15;
-    w.KA_wrist_1_link[38] = w.sq_wrist_2_link*w.KA_wrist_2_link[24] + w.cq_wrist_2_link*t16;
-    w.KSD_wrist_2_link[4] = w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
-    const Scalar t17 = 0.057172965000000006*w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
-    const Scalar t18 = 0.0056619090105*w.KA_wrist_2_link[39]*w.Dinv_wrist_2_link;
-    w.KA_wrist_1_link[4] = w.cq_wrist_2_link*t17;
-    w.KA_wrist_1_link[18] = w.sq_wrist_2_link*t17;
-    w.KA_wrist_1_link[25] = w.cq_wrist_2_link*w.KA_wrist_2_link[25] - w.sq_wrist_2_link*t18;
-    w.KA_wrist_1_link[32] = 0.1333*w.cq_wrist_2_link*t17;
-    w.KA_wrist_1_link[39] = w.sq_wrist_2_link*w.KA_wrist_2_link[25] + w.cq_wrist_2_link*t18;
+    w.KSD_wrist_2_link[0] = 184.03082382127872*w.KA_wrist_2_link[5][0];
+    const Scalar t9 = w.KA_wrist_2_link[0][0] + 10.521587849255136*w.KA_wrist_2_link[5][0];
+    const Scalar t10 = w.KA_wrist_2_link[4][0] + 1.041965779603436*w.KA_wrist_2_link[5][0];
+    w.KA_wrist_1_link[0][0] = w.cq_wrist_2_link*t9;
+    w.KA_wrist_1_link[1][0] = -w.KA_wrist_2_link[2][0];
+    w.KA_wrist_1_link[2][0] = w.sq_wrist_2_link*t9;
+    w.KA_wrist_1_link[3][0] = 0.1333*w.KA_wrist_2_link[2][0] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][0] - w.sq_wrist_2_link*t10;
+    w.KA_wrist_1_link[4][0] = 0.1333*w.cq_wrist_2_link*t9;
+    w.KA_wrist_1_link[5][0] = w.sq_wrist_2_link*w.KA_wrist_2_link[3][0] + w.cq_wrist_2_link*t10;
+    w.KSD_wrist_2_link[1] = 184.03082382127872*w.KA_wrist_2_link[5][1];
+    const Scalar t11 = w.KA_wrist_2_link[0][1] + 10.521587849255136*w.KA_wrist_2_link[5][1];
+    const Scalar t12 = w.KA_wrist_2_link[4][1] + 1.041965779603436*w.KA_wrist_2_link[5][1];
+    w.KA_wrist_1_link[0][1] = w.cq_wrist_2_link*t11;
+    w.KA_wrist_1_link[1][1] = -w.KA_wrist_2_link[2][1];
+    w.KA_wrist_1_link[2][1] = w.sq_wrist_2_link*t11;
+    w.KA_wrist_1_link[3][1] = 0.1333*w.KA_wrist_2_link[2][1] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][1] - w.sq_wrist_2_link*t12;
+    w.KA_wrist_1_link[4][1] = 0.1333*w.cq_wrist_2_link*t11;
+    w.KA_wrist_1_link[5][1] = w.sq_wrist_2_link*w.KA_wrist_2_link[3][1] + w.cq_wrist_2_link*t12;
+    w.KA_wrist_1_link[0][2] = -w.sq_wrist_2_link;
+    w.KA_wrist_1_link[2][2] = w.cq_wrist_2_link;
+    w.KA_wrist_1_link[3][2] = -0.0997*w.cq_wrist_2_link;
+    w.KA_wrist_1_link[4][2] = -0.1333*w.sq_wrist_2_link;
+    w.KA_wrist_1_link[5][2] = -0.0997*w.sq_wrist_2_link;
+    w.KSD_wrist_2_link[3] = 184.03082382127872*w.KA_wrist_2_link[5][3];
+    w.KA_wrist_1_link[0][3] = 10.521587849255136*w.cq_wrist_2_link*w.KA_wrist_2_link[5][3];
+    w.KA_wrist_1_link[2][3] = 10.521587849255136*w.sq_wrist_2_link*w.KA_wrist_2_link[5][3];
+    w.KA_wrist_1_link[3][3] = -1.041965779603436*w.sq_wrist_2_link*w.KA_wrist_2_link[5][3] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][3];
+    w.KA_wrist_1_link[4][3] = 1.4025276603057095*w.cq_wrist_2_link*w.KA_wrist_2_link[5][3];
+    w.KA_wrist_1_link[5][3] = 1.041965779603436*w.cq_wrist_2_link*w.KA_wrist_2_link[5][3] + w.sq_wrist_2_link*w.KA_wrist_2_link[3][3];
+    w.KSD_wrist_2_link[4] = 184.03082382127872*w.KA_wrist_2_link[5][4];
+    w.KA_wrist_1_link[0][4] = 10.521587849255136*w.cq_wrist_2_link*w.KA_wrist_2_link[5][4];
+    w.KA_wrist_1_link[2][4] = 10.521587849255136*w.sq_wrist_2_link*w.KA_wrist_2_link[5][4];
+    w.KA_wrist_1_link[3][4] = -1.041965779603436*w.sq_wrist_2_link*w.KA_wrist_2_link[5][4] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][4];
+    w.KA_wrist_1_link[4][4] = 1.4025276603057095*w.cq_wrist_2_link*w.KA_wrist_2_link[5][4];
+    w.KA_wrist_1_link[5][4] = 1.041965779603436*w.cq_wrist_2_link*w.KA_wrist_2_link[5][4] + w.sq_wrist_2_link*w.KA_wrist_2_link[3][4];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
     w.Dinv_wrist_1_link = 1.0 / w.IA_wrist_1_link[20];
@@ -1097,80 +1091,80 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_forearm_link[3] = w.pA_forearm_link[3] + w.cq_wrist_1_link*pa3 - w.sq_wrist_1_link*pa4;
     w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq_wrist_1_link*pa3 + w.cq_wrist_1_link*pa4;
     w.pA_forearm_link[5] = w.pA_forearm_link[5] + pa5 - 0.3922*t25;
-    w.KSD_wrist_1_link[0] = w.KA_wrist_1_link[35]*w.Dinv_wrist_1_link;
-    const Scalar t26 = w.KA_wrist_1_link[0] - w.KA_wrist_1_link[35]*t0;
-    const Scalar t27 = w.KA_wrist_1_link[7] - w.KA_wrist_1_link[35]*t1;
-    const Scalar t28 = w.KA_wrist_1_link[14] - w.KA_wrist_1_link[35]*t2;
-    const Scalar t29 = w.KA_wrist_1_link[21] - w.KA_wrist_1_link[35]*t3;
-    const Scalar t30 = w.KA_wrist_1_link[28] - w.KA_wrist_1_link[35]*t4;
+    w.KSD_wrist_1_link[0] = w.KA_wrist_1_link[5][0]*w.Dinv_wrist_1_link;
+    const Scalar t26 = w.KA_wrist_1_link[0][0] - w.KA_wrist_1_link[5][0]*t0;
+    const Scalar t27 = w.KA_wrist_1_link[1][0] - w.KA_wrist_1_link[5][0]*t1;
+    const Scalar t28 = w.KA_wrist_1_link[2][0] - w.KA_wrist_1_link[5][0]*t2;
+    const Scalar t29 = w.KA_wrist_1_link[3][0] - w.KA_wrist_1_link[5][0]*t3;
+    const Scalar t30 = w.KA_wrist_1_link[4][0] - w.KA_wrist_1_link[5][0]*t4;
     const Scalar t31 = w.cq_wrist_1_link*t26 - w.sq_wrist_1_link*t27;
     const Scalar t32 = w.sq_wrist_1_link*t26 + w.cq_wrist_1_link*t27;
-    w.KA_forearm_link[0] = t31;
-    w.KA_forearm_link[7] = t32;
-    w.KA_forearm_link[14] = t28;
-    w.KA_forearm_link[21] = w.cq_wrist_1_link*t29 - w.sq_wrist_1_link*t30;
-    w.KA_forearm_link[28] = 0.3922*t28 + w.sq_wrist_1_link*t29 + w.cq_wrist_1_link*t30;
-    w.KA_forearm_link[35] = -0.3922*t32;
-    w.KSD_wrist_1_link[1] = w.KA_wrist_1_link[36]*w.Dinv_wrist_1_link;
-    const Scalar t33 = w.KA_wrist_1_link[1] - w.KA_wrist_1_link[36]*t0;
-    const Scalar t34 = w.KA_wrist_1_link[8] - w.KA_wrist_1_link[36]*t1;
-    const Scalar t35 = w.KA_wrist_1_link[15] - w.KA_wrist_1_link[36]*t2;
-    const Scalar t36 = w.KA_wrist_1_link[22] - w.KA_wrist_1_link[36]*t3;
-    const Scalar t37 = w.KA_wrist_1_link[29] - w.KA_wrist_1_link[36]*t4;
+    w.KA_forearm_link[0][0] = t31;
+    w.KA_forearm_link[1][0] = t32;
+    w.KA_forearm_link[2][0] = t28;
+    w.KA_forearm_link[3][0] = w.cq_wrist_1_link*t29 - w.sq_wrist_1_link*t30;
+    w.KA_forearm_link[4][0] = 0.3922*t28 + w.sq_wrist_1_link*t29 + w.cq_wrist_1_link*t30;
+    w.KA_forearm_link[5][0] = -0.3922*t32;
+    w.KSD_wrist_1_link[1] = w.KA_wrist_1_link[5][1]*w.Dinv_wrist_1_link;
+    const Scalar t33 = w.KA_wrist_1_link[0][1] - w.KA_wrist_1_link[5][1]*t0;
+    const Scalar t34 = w.KA_wrist_1_link[1][1] - w.KA_wrist_1_link[5][1]*t1;
+    const Scalar t35 = w.KA_wrist_1_link[2][1] - w.KA_wrist_1_link[5][1]*t2;
+    const Scalar t36 = w.KA_wrist_1_link[3][1] - w.KA_wrist_1_link[5][1]*t3;
+    const Scalar t37 = w.KA_wrist_1_link[4][1] - w.KA_wrist_1_link[5][1]*t4;
     const Scalar t38 = w.cq_wrist_1_link*t33 - w.sq_wrist_1_link*t34;
     const Scalar t39 = w.sq_wrist_1_link*t33 + w.cq_wrist_1_link*t34;
-    w.KA_forearm_link[1] = t38;
-    w.KA_forearm_link[8] = t39;
-    w.KA_forearm_link[15] = t35;
-    w.KA_forearm_link[22] = w.cq_wrist_1_link*t36 - w.sq_wrist_1_link*t37;
-    w.KA_forearm_link[29] = 0.3922*t35 + w.sq_wrist_1_link*t36 + w.cq_wrist_1_link*t37;
-    w.KA_forearm_link[36] = -0.3922*t39;
-    w.KSD_wrist_1_link[2] = w.KA_wrist_1_link[37]*w.Dinv_wrist_1_link;
-    const Scalar t40 = w.KA_wrist_1_link[2] - w.KA_wrist_1_link[37]*t0;
-    const Scalar t41 = w.KA_wrist_1_link[16] - w.KA_wrist_1_link[37]*t2;
-    const Scalar t42 = -w.KA_wrist_1_link[37]*t1;
-    const Scalar t43 = w.KA_wrist_1_link[23] - w.KA_wrist_1_link[37]*t3;
-    const Scalar t44 = w.KA_wrist_1_link[30] - w.KA_wrist_1_link[37]*t4;
+    w.KA_forearm_link[0][1] = t38;
+    w.KA_forearm_link[1][1] = t39;
+    w.KA_forearm_link[2][1] = t35;
+    w.KA_forearm_link[3][1] = w.cq_wrist_1_link*t36 - w.sq_wrist_1_link*t37;
+    w.KA_forearm_link[4][1] = 0.3922*t35 + w.sq_wrist_1_link*t36 + w.cq_wrist_1_link*t37;
+    w.KA_forearm_link[5][1] = -0.3922*t39;
+    w.KSD_wrist_1_link[2] = w.KA_wrist_1_link[5][2]*w.Dinv_wrist_1_link;
+    const Scalar t40 = w.KA_wrist_1_link[0][2] - w.KA_wrist_1_link[5][2]*t0;
+    const Scalar t41 = w.KA_wrist_1_link[2][2] - w.KA_wrist_1_link[5][2]*t2;
+    const Scalar t42 = -w.KA_wrist_1_link[5][2]*t1;
+    const Scalar t43 = w.KA_wrist_1_link[3][2] - w.KA_wrist_1_link[5][2]*t3;
+    const Scalar t44 = w.KA_wrist_1_link[4][2] - w.KA_wrist_1_link[5][2]*t4;
     const Scalar t45 = w.cq_wrist_1_link*t40 - w.sq_wrist_1_link*t42;
     const Scalar t46 = w.sq_wrist_1_link*t40 + w.cq_wrist_1_link*t42;
-    w.KA_forearm_link[2] = t45;
-    w.KA_forearm_link[9] = t46;
-    w.KA_forearm_link[16] = t41;
-    w.KA_forearm_link[23] = w.cq_wrist_1_link*t43 - w.sq_wrist_1_link*t44;
-    w.KA_forearm_link[30] = 0.3922*t41 + w.sq_wrist_1_link*t43 + w.cq_wrist_1_link*t44;
-    w.KA_forearm_link[37] = -0.3922*t46;
-    w.KSD_wrist_1_link[3] = w.KA_wrist_1_link[38]*w.Dinv_wrist_1_link;
-    const Scalar t47 = w.KA_wrist_1_link[3] - w.KA_wrist_1_link[38]*t0;
-    const Scalar t48 = w.KA_wrist_1_link[17] - w.KA_wrist_1_link[38]*t2;
-    const Scalar t49 = -w.KA_wrist_1_link[38]*t1;
-    const Scalar t50 = w.KA_wrist_1_link[24] - w.KA_wrist_1_link[38]*t3;
-    const Scalar t51 = w.KA_wrist_1_link[31] - w.KA_wrist_1_link[38]*t4;
+    w.KA_forearm_link[0][2] = t45;
+    w.KA_forearm_link[1][2] = t46;
+    w.KA_forearm_link[2][2] = t41;
+    w.KA_forearm_link[3][2] = w.cq_wrist_1_link*t43 - w.sq_wrist_1_link*t44;
+    w.KA_forearm_link[4][2] = 0.3922*t41 + w.sq_wrist_1_link*t43 + w.cq_wrist_1_link*t44;
+    w.KA_forearm_link[5][2] = -0.3922*t46;
+    w.KSD_wrist_1_link[3] = w.KA_wrist_1_link[5][3]*w.Dinv_wrist_1_link;
+    const Scalar t47 = w.KA_wrist_1_link[0][3] - w.KA_wrist_1_link[5][3]*t0;
+    const Scalar t48 = w.KA_wrist_1_link[2][3] - w.KA_wrist_1_link[5][3]*t2;
+    const Scalar t49 = -w.KA_wrist_1_link[5][3]*t1;
+    const Scalar t50 = w.KA_wrist_1_link[3][3] - w.KA_wrist_1_link[5][3]*t3;
+    const Scalar t51 = w.KA_wrist_1_link[4][3] - w.KA_wrist_1_link[5][3]*t4;
     const Scalar t52 = w.cq_wrist_1_link*t47 - w.sq_wrist_1_link*t49;
     const Scalar t53 = w.sq_wrist_1_link*t47 + w.cq_wrist_1_link*t49;
-    w.KA_forearm_link[3] = t52;
-    w.KA_forearm_link[10] = t53;
-    w.KA_forearm_link[17] = t48;
-    w.KA_forearm_link[24] = w.cq_wrist_1_link*t50 - w.sq_wrist_1_link*t51;
-    w.KA_forearm_link[31] = 0.3922*t48 + w.sq_wrist_1_link*t50 + w.cq_wrist_1_link*t51;
-    w.KA_forearm_link[38] = -0.3922*t53;
-    w.KSD_wrist_1_link[4] = w.KA_wrist_1_link[39]*w.Dinv_wrist_1_link;
-    const Scalar t54 = w.KA_wrist_1_link[4] - w.KA_wrist_1_link[39]*t0;
-    const Scalar t55 = w.KA_wrist_1_link[18] - w.KA_wrist_1_link[39]*t2;
-    const Scalar t56 = -w.KA_wrist_1_link[39]*t1;
-    const Scalar t57 = w.KA_wrist_1_link[25] - w.KA_wrist_1_link[39]*t3;
-    const Scalar t58 = w.KA_wrist_1_link[32] - w.KA_wrist_1_link[39]*t4;
+    w.KA_forearm_link[0][3] = t52;
+    w.KA_forearm_link[1][3] = t53;
+    w.KA_forearm_link[2][3] = t48;
+    w.KA_forearm_link[3][3] = w.cq_wrist_1_link*t50 - w.sq_wrist_1_link*t51;
+    w.KA_forearm_link[4][3] = 0.3922*t48 + w.sq_wrist_1_link*t50 + w.cq_wrist_1_link*t51;
+    w.KA_forearm_link[5][3] = -0.3922*t53;
+    w.KSD_wrist_1_link[4] = w.KA_wrist_1_link[5][4]*w.Dinv_wrist_1_link;
+    const Scalar t54 = w.KA_wrist_1_link[0][4] - w.KA_wrist_1_link[5][4]*t0;
+    const Scalar t55 = w.KA_wrist_1_link[2][4] - w.KA_wrist_1_link[5][4]*t2;
+    const Scalar t56 = -w.KA_wrist_1_link[5][4]*t1;
+    const Scalar t57 = w.KA_wrist_1_link[3][4] - w.KA_wrist_1_link[5][4]*t3;
+    const Scalar t58 = w.KA_wrist_1_link[4][4] - w.KA_wrist_1_link[5][4]*t4;
     const Scalar t59 = w.cq_wrist_1_link*t54 - w.sq_wrist_1_link*t56;
     const Scalar t60 = w.sq_wrist_1_link*t54 + w.cq_wrist_1_link*t56;
-    w.KA_forearm_link[4] = t59;
-    w.KA_forearm_link[11] = t60;
-    w.KA_forearm_link[18] = t55;
-    w.KA_forearm_link[25] = w.cq_wrist_1_link*t57 - w.sq_wrist_1_link*t58;
-    w.KA_forearm_link[32] = 0.3922*t55 + w.sq_wrist_1_link*t57 + w.cq_wrist_1_link*t58;
-    w.KA_forearm_link[39] = -0.3922*t60;
+    w.KA_forearm_link[0][4] = t59;
+    w.KA_forearm_link[1][4] = t60;
+    w.KA_forearm_link[2][4] = t55;
+    w.KA_forearm_link[3][4] = w.cq_wrist_1_link*t57 - w.sq_wrist_1_link*t58;
+    w.KA_forearm_link[4][4] = 0.3922*t55 + w.sq_wrist_1_link*t57 + w.cq_wrist_1_link*t58;
+    w.KA_forearm_link[5][4] = -0.3922*t60;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     w.Dinv_forearm_link = 1.0 / w.IA_forearm_link[20];
@@ -1261,25 +1255,25 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_upper_arm_link[5] = w.pA_upper_arm_link[5] + pa5 - 0.425*t22;
     // columns 0 to 4
     for (int j = 0; j < 5; ++j) {
-      w.KSD_forearm_link[j] = w.Dinv_forearm_link*w.KA_forearm_link[35 + j];
-      const Scalar t23 = w.KA_forearm_link[j] - t0*w.KA_forearm_link[35 + j];
-      const Scalar t24 = w.KA_forearm_link[7 + j] - t1*w.KA_forearm_link[35 + j];
-      const Scalar t25 = w.KA_forearm_link[14 + j] - t2*w.KA_forearm_link[35 + j];
-      const Scalar t26 = w.KA_forearm_link[21 + j] - t3*w.KA_forearm_link[35 + j];
-      const Scalar t27 = w.KA_forearm_link[28 + j] - t4*w.KA_forearm_link[35 + j];
+      w.KSD_forearm_link[j] = w.Dinv_forearm_link*w.KA_forearm_link[5][j];
+      const Scalar t23 = w.KA_forearm_link[0][j] - t0*w.KA_forearm_link[5][j];
+      const Scalar t24 = w.KA_forearm_link[1][j] - t1*w.KA_forearm_link[5][j];
+      const Scalar t25 = w.KA_forearm_link[2][j] - t2*w.KA_forearm_link[5][j];
+      const Scalar t26 = w.KA_forearm_link[3][j] - t3*w.KA_forearm_link[5][j];
+      const Scalar t27 = w.KA_forearm_link[4][j] - t4*w.KA_forearm_link[5][j];
       const Scalar t28 = w.cq_forearm_link*t23 - w.sq_forearm_link*t24;
       const Scalar t29 = w.sq_forearm_link*t23 + w.cq_forearm_link*t24;
-      w.KA_upper_arm_link[j] = t28;
-      w.KA_upper_arm_link[7 + j] = t29;
-      w.KA_upper_arm_link[14 + j] = t25;
-      w.KA_upper_arm_link[21 + j] = w.cq_forearm_link*t26 - w.sq_forearm_link*t27;
-      w.KA_upper_arm_link[28 + j] = 0.425*t25 + w.sq_forearm_link*t26 + w.cq_forearm_link*t27;
-      w.KA_upper_arm_link[35 + j] = -0.425*t29;
+      w.KA_upper_arm_link[0][j] = t28;
+      w.KA_upper_arm_link[1][j] = t29;
+      w.KA_upper_arm_link[2][j] = t25;
+      w.KA_upper_arm_link[3][j] = w.cq_forearm_link*t26 - w.sq_forearm_link*t27;
+      w.KA_upper_arm_link[4][j] = 0.425*t25 + w.sq_forearm_link*t26 + w.cq_forearm_link*t27;
+      w.KA_upper_arm_link[5][j] = -0.425*t29;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
     w.Dinv_upper_arm_link = 1.0 / w.IA_upper_arm_link[20];
@@ -1370,34 +1364,37 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_shoulder_link[5] = w.sq_upper_arm_link*pa3 + w.cq_upper_arm_link*pa4;
     // columns 0 to 4
     for (int j = 0; j < 5; ++j) {
-      w.KSD_upper_arm_link[j] = w.Dinv_upper_arm_link*w.KA_upper_arm_link[35 + j];
-      const Scalar t23 = w.KA_upper_arm_link[j] - t0*w.KA_upper_arm_link[35 + j];
-      const Scalar t24 = w.KA_upper_arm_link[7 + j] - t1*w.KA_upper_arm_link[35 + j];
-      const Scalar t25 = w.KA_upper_arm_link[14 + j] - t2*w.KA_upper_arm_link[35 + j];
-      const Scalar t26 = w.KA_upper_arm_link[21 + j] - t3*w.KA_upper_arm_link[35 + j];
-      const Scalar t27 = w.KA_upper_arm_link[28 + j] - t4*w.KA_upper_arm_link[35 + j];
+      w.KSD_upper_arm_link[j] = w.Dinv_upper_arm_link*w.KA_upper_arm_link[5][j];
+      const Scalar t23 = w.KA_upper_arm_link[0][j] - t0*w.KA_upper_arm_link[5][j];
+      const Scalar t24 = w.KA_upper_arm_link[1][j] - t1*w.KA_upper_arm_link[5][j];
+      const Scalar t25 = w.KA_upper_arm_link[2][j] - t2*w.KA_upper_arm_link[5][j];
+      const Scalar t26 = w.KA_upper_arm_link[3][j] - t3*w.KA_upper_arm_link[5][j];
+      const Scalar t27 = w.KA_upper_arm_link[4][j] - t4*w.KA_upper_arm_link[5][j];
       const Scalar t28 = w.cq_upper_arm_link*t23 - w.sq_upper_arm_link*t24;
       const Scalar t29 = w.sq_upper_arm_link*t23 + w.cq_upper_arm_link*t24;
-      w.KA_shoulder_link[j] = t28;
-      w.KA_shoulder_link[7 + j] = -t25;
-      w.KA_shoulder_link[14 + j] = t29;
-      w.KA_shoulder_link[21 + j] = 0.1625*t25 + w.cq_upper_arm_link*t26 - w.sq_upper_arm_link*t27;
-      w.KA_shoulder_link[28 + j] = 0.1625*t28;
-      w.KA_shoulder_link[35 + j] = w.sq_upper_arm_link*t26 + w.cq_upper_arm_link*t27;
+      w.KA_shoulder_link[0][j] = t28;
+      w.KA_shoulder_link[1][j] = -t25;
+      w.KA_shoulder_link[2][j] = t29;
+      w.KA_shoulder_link[3][j] = 0.1625*t25 + w.cq_upper_arm_link*t26 - w.sq_upper_arm_link*t27;
+      w.KA_shoulder_link[4][j] = 0.1625*t28;
+      w.KA_shoulder_link[5][j] = w.sq_upper_arm_link*t26 + w.cq_upper_arm_link*t27;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_shoulder_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
     w.u_shoulder_link[0] = -w.pA_shoulder_link[5] + tau[0];
     // columns 0 to 4
     for (int j = 0; j < 5; ++j) {
-      w.KSD_shoulder_link[j] = w.Dinv_shoulder_link*w.KA_shoulder_link[35 + j];
+      w.KSD_shoulder_link[j] = w.Dinv_shoulder_link*w.KA_shoulder_link[5][j];
     }
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_free_shoulder_link_to_wrist_2_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
     const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0];
@@ -1459,11 +1456,11 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.a_wrist_2_link[2] = t18;
     w.a_wrist_2_link[3] = t21;
     w.a_wrist_2_link[4] = t22;
-    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + w.Dinv_wrist_2_link*t23;
+    w.a_wrist_2_link[5] = -w.a_wrist_1_link[4] + 184.03082382127872*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
@@ -1478,7 +1475,7 @@ PROXGEN_RT_NOINLINE void pv_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_wrist_3_link[2] = t1;
     w.a_wrist_3_link[3] = t4;
     w.a_wrist_3_link[4] = t5;
-    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + w.Dinv_wrist_3_link*t6;
+    w.a_wrist_3_link[5] = w.a_wrist_2_link[4] + 2705.9022492812446*t6;
   }
   // free row accelerations y_free = K a - k (tree order)
   {
@@ -1491,72 +1488,75 @@ PROXGEN_RT_NOINLINE void pv_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_6(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_shoulder_link[0]*w.KA_shoulder_link[35] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[35] + w.KSD_forearm_link[0]*w.KA_forearm_link[35] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[35] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[35] + inv_mu;
+    const Scalar t0 = w.KSD_shoulder_link[0]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[0]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[5][0] + inv_mu;
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
-    const Scalar t1 = w.KSD_shoulder_link[1]*w.KA_shoulder_link[35] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[35] + w.KSD_forearm_link[1]*w.KA_forearm_link[35] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[35] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[35];
+    const Scalar t1 = w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][0];
     w.L[1] = w.Linv[0]*t1;
-    const Scalar t2 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[35] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[35] + w.KSD_forearm_link[2]*w.KA_forearm_link[35] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[35];
+    const Scalar t2 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][0];
     w.L[2] = w.Linv[0]*t2;
-    const Scalar t3 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[35] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[35] + w.KSD_forearm_link[3]*w.KA_forearm_link[35] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[35] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[35];
+    const Scalar t3 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][0];
     w.L[3] = w.Linv[0]*t3;
-    const Scalar t4 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[35] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[35] + w.KSD_forearm_link[4]*w.KA_forearm_link[35] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[35] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[35];
+    const Scalar t4 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][0];
     w.L[4] = w.Linv[0]*t4;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t5 = inv_mu + w.KSD_shoulder_link[1]*w.KA_shoulder_link[36] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[36] + w.KSD_forearm_link[1]*w.KA_forearm_link[36] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[36] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[36] - w.L[1]*w.L[1];
+    const Scalar t5 = inv_mu + w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[1];
     const Scalar r1 = std::sqrt(t5);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t6 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[36] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[36] + w.KSD_forearm_link[2]*w.KA_forearm_link[36] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[36] - w.L[1]*w.L[2];
+    const Scalar t6 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][1] - w.L[1]*w.L[2];
     w.L[7] = w.Linv[1]*t6;
-    const Scalar t7 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[36] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[36] + w.KSD_forearm_link[3]*w.KA_forearm_link[36] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[36] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[36] - w.L[1]*w.L[3];
+    const Scalar t7 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[3];
     w.L[8] = w.Linv[1]*t7;
-    const Scalar t8 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[36] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[36] + w.KSD_forearm_link[4]*w.KA_forearm_link[36] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[36] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[36] - w.L[1]*w.L[4];
+    const Scalar t8 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[4];
     w.L[9] = w.Linv[1]*t8;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_shoulder_link[2]*w.KA_shoulder_link[37] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[37] + w.KSD_forearm_link[2]*w.KA_forearm_link[37] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[37] - w.L[2]*w.L[2] - w.L[7]*w.L[7];
+    const Scalar t9 = inv_mu + w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[2] - w.L[7]*w.L[7];
     const Scalar r2 = std::sqrt(t9);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    const Scalar t10 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[37] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[37] + w.KSD_forearm_link[3]*w.KA_forearm_link[37] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[37] - w.L[2]*w.L[3] - w.L[7]*w.L[8];
+    const Scalar t10 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[3] - w.L[7]*w.L[8];
     w.L[12] = w.Linv[2]*t10;
-    const Scalar t11 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[37] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[37] + w.KSD_forearm_link[4]*w.KA_forearm_link[37] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[37] - w.L[2]*w.L[4] - w.L[7]*w.L[9];
+    const Scalar t11 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[4] - w.L[7]*w.L[9];
     w.L[13] = w.Linv[2]*t11;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = inv_mu + w.KSD_shoulder_link[3]*w.KA_shoulder_link[38] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[38] + w.KSD_forearm_link[3]*w.KA_forearm_link[38] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[38] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[38] - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
+    const Scalar t12 = inv_mu + w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
     const Scalar r3 = std::sqrt(t12);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
-    const Scalar t13 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[38] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[38] + w.KSD_forearm_link[4]*w.KA_forearm_link[38] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[38] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[38] - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
+    const Scalar t13 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
     w.L[16] = w.Linv[3]*t13;
   }
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t14 = inv_mu + w.KSD_shoulder_link[4]*w.KA_shoulder_link[39] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[39] + w.KSD_forearm_link[4]*w.KA_forearm_link[39] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[39] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[39] - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
+    const Scalar t14 = inv_mu + w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][4] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][4] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][4] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][4] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][4] - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
     const Scalar r4 = std::sqrt(t14);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[4] = inv4;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_7(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_5(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.Dinv_wrist_3_link + inv_mu;
+    const Scalar t0 = 2705.9022492812446 + inv_mu;
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[5] = inv0;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
   w.lambda[2] = 0.0;
@@ -1565,7 +1565,7 @@ PROXGEN_RT_NOINLINE void pv_7(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) n
   w.lambda[5] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -1594,10 +1594,10 @@ PROXGEN_RT_NOINLINE void pv_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) n
   w.lambda[5] = w.Linv[5]*t10;
 }
 
-PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_shoulder_link_to_wrist_2_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0] - w.KA_shoulder_link[35]*w.lambda[0] - w.KA_shoulder_link[36]*w.lambda[1] - w.KA_shoulder_link[37]*w.lambda[2] - w.KA_shoulder_link[38]*w.lambda[3] - w.KA_shoulder_link[39]*w.lambda[4];
+    const Scalar t0 = -9.81*w.IA_shoulder_link[14] + w.u_shoulder_link[0] - w.KA_shoulder_link[5][0]*w.lambda[0] - w.KA_shoulder_link[5][1]*w.lambda[1] - w.KA_shoulder_link[5][2]*w.lambda[2] - w.KA_shoulder_link[5][3]*w.lambda[3] - w.KA_shoulder_link[5][4]*w.lambda[4];
     w.qdd[0] = w.Dinv_shoulder_link*t0;
     w.a_shoulder_link[5] = w.qdd[0];
   }
@@ -1605,7 +1605,7 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   {
     const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
     const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t3 = w.u_upper_arm_link[0] - w.KA_upper_arm_link[35]*w.lambda[0] - w.KA_upper_arm_link[36]*w.lambda[1] - w.KA_upper_arm_link[37]*w.lambda[2] - w.KA_upper_arm_link[38]*w.lambda[3] - w.KA_upper_arm_link[39]*w.lambda[4] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    const Scalar t3 = w.u_upper_arm_link[0] - w.KA_upper_arm_link[5][0]*w.lambda[0] - w.KA_upper_arm_link[5][1]*w.lambda[1] - w.KA_upper_arm_link[5][2]*w.lambda[2] - w.KA_upper_arm_link[5][3]*w.lambda[3] - w.KA_upper_arm_link[5][4]*w.lambda[4] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
     w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
     w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
@@ -1620,7 +1620,7 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
     const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
     const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
-    const Scalar t9 = w.u_forearm_link[0] - w.KA_forearm_link[35]*w.lambda[0] - w.KA_forearm_link[36]*w.lambda[1] - w.KA_forearm_link[37]*w.lambda[2] - w.KA_forearm_link[38]*w.lambda[3] - w.KA_forearm_link[39]*w.lambda[4] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
+    const Scalar t9 = w.u_forearm_link[0] - w.KA_forearm_link[5][0]*w.lambda[0] - w.KA_forearm_link[5][1]*w.lambda[1] - w.KA_forearm_link[5][2]*w.lambda[2] - w.KA_forearm_link[5][3]*w.lambda[3] - w.KA_forearm_link[5][4]*w.lambda[4] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
     w.a_forearm_link[0] = t5;
     w.a_forearm_link[1] = t6;
@@ -1637,7 +1637,7 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
     const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
     const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t16 = w.u_wrist_1_link[0] - w.KA_wrist_1_link[35]*w.lambda[0] - w.KA_wrist_1_link[36]*w.lambda[1] - w.KA_wrist_1_link[37]*w.lambda[2] - w.KA_wrist_1_link[38]*w.lambda[3] - w.KA_wrist_1_link[39]*w.lambda[4] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
+    const Scalar t16 = w.u_wrist_1_link[0] - w.KA_wrist_1_link[5][0]*w.lambda[0] - w.KA_wrist_1_link[5][1]*w.lambda[1] - w.KA_wrist_1_link[5][2]*w.lambda[2] - w.KA_wrist_1_link[5][3]*w.lambda[3] - w.KA_wrist_1_link[5][4]*w.lambda[4] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
     w.a_wrist_1_link[0] = t12;
     w.a_wrist_1_link[1] = t13;
@@ -1654,8 +1654,8 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
     const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
     const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - w.KA_wrist_2_link[35]*w.lambda[0] - w.KA_wrist_2_link[36]*w.lambda[1] - w.KA_wrist_2_link[38]*w.lambda[3] - w.KA_wrist_2_link[39]*w.lambda[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
-    w.qdd[4] = w.Dinv_wrist_2_link*t23;
+    const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - w.KA_wrist_2_link[5][0]*w.lambda[0] - w.KA_wrist_2_link[5][1]*w.lambda[1] - w.KA_wrist_2_link[5][3]*w.lambda[3] - w.KA_wrist_2_link[5][4]*w.lambda[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
+    w.qdd[4] = 184.03082382127872*t23;
     w.a_wrist_2_link[0] = t19;
     w.a_wrist_2_link[1] = t20;
     w.a_wrist_2_link[2] = t18;
@@ -1665,7 +1665,7 @@ PROXGEN_RT_NOINLINE void pv_9(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_10(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
@@ -1675,7 +1675,7 @@ PROXGEN_RT_NOINLINE void pv_10(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
     const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
     const Scalar t6 = -0.0003695625*w.a_wrist_2_link[4] + w.u_wrist_3_link[0] - w.lambda[5];
-    w.qdd[5] = w.Dinv_wrist_3_link*t6;
+    w.qdd[5] = 2705.9022492812446*t6;
     w.a_wrist_3_link[0] = t2;
     w.a_wrist_3_link[1] = t3;
     w.a_wrist_3_link[2] = t1;
@@ -1688,21 +1688,9 @@ PROXGEN_RT_NOINLINE void pv_10(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  kinematics_0(q, v, w);
-  kinematics_1(q, v, w);
-  kinematics_2(q, v, w);
-}
-
-// Articulated-body elimination of the bodies off the constraint support
-// (no constraint below them): the same in both algorithms.
-void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
-  static_cast<void>(tau);
-  static_cast<void>(w);
-}
-
-// Accelerations of the bodies off the support, once their ancestors are final.
-void accelerate_free_bodies(Workspace& w) noexcept {
-  static_cast<void>(w);
+  kinematics_shoulder_link_to_forearm_link(q, v, w);
+  kinematics_wrist_1_link_to_wrist_2_link(q, v, w);
+  kinematics_wrist_3_link(q, v, w);
 }
 
 }  // namespace
@@ -1713,22 +1701,29 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
-  eliminate_free_bodies(tau, w);
-  caba_0(tau, mu, w);
-  caba_1(tau, w);
-  caba_2(tau, w);
-  caba_3(tau, w);
-  caba_4(tau, w);
-  caba_5(tau, w);
-  caba_6(mu, w);
+  // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
+  caba_backward_wrist_3_link(tau, mu, w);
+  caba_backward_wrist_2_link(tau, w);
+  caba_backward_wrist_1_link(tau, w);
+  caba_backward_forearm_link(tau, w);
+  caba_backward_upper_arm_link(tau, w);
+  caba_backward_shoulder_link(tau, w);
+  // ---- forward: accelerations of the support
+  caba_forward_shoulder_link_to_wrist_2_link(w);
+  caba_forward_wrist_3_link(w);
+  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_7(w);
-    caba_8(w);
-    caba_9(w);
-    caba_10(mu, w);
+    // ---- reduced sweep: u -= S^T dp, dp passes to the parent
+    caba_reduced_wrist_3_link_to_wrist_1_link(w);
+    caba_reduced_forearm_link_to_shoulder_link(w);
+    // ---- forward: accelerations of the support
+    caba_reforward_shoulder_link_to_wrist_2_link(w);
+    caba_reforward_wrist_3_link(w);
+    // ---- multipliers: dlambda = mu (K a - k), lambda += dlambda
+    caba_update(mu, w);
   }
-  accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];
@@ -1748,23 +1743,29 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
   kinematics(q, v, w);
-  eliminate_free_bodies(tau, w);
-  pv_0(tau, w);
-  pv_1(tau, w);
-  pv_2(tau, w);
-  pv_3(tau, w);
-  pv_4(tau, w);
-  pv_5(w);
+  // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
+  pv_backward_wrist_3_link_to_wrist_2_link(tau, w);
+  pv_backward_wrist_1_link(tau, w);
+  pv_backward_forearm_link(tau, w);
+  pv_backward_upper_arm_link(tau, w);
+  pv_backward_shoulder_link(tau, w);
+  // ---- free accelerations (lambda = 0) and the rows' y_free = K a - k
+  pv_free_shoulder_link_to_wrist_2_link(w);
+  pv_free_wrist_3_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
-  pv_6(inv_mu, w);
-  pv_7(inv_mu, w);
+  // ---- G + I/mu = L L^T, G assembled from the carried rows
+  pv_delassus_column_0_to_column_4(inv_mu, w);
+  pv_delassus_column_5(inv_mu, w);
+  // ---- lambda = 0
+  pv_start(w);
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
-    pv_8(inv_mu, w);
+    // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
+    pv_proximal(inv_mu, w);
   }
-  pv_9(w);
-  pv_10(w);
-  accelerate_free_bodies(w);
+  // ---- forward: accelerations, with the multipliers of the subtree rows
+  pv_forward_shoulder_link_to_wrist_2_link(w);
+  pv_forward_wrist_3_link(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];

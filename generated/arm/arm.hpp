@@ -101,15 +101,15 @@ struct Workspace {
   Scalar dp_forearm_link[6];   // reduced-sweep force, body 3
   Scalar dp_upper_arm_link[6]; // reduced-sweep force, body 2
   Scalar dp_shoulder_link[6];  // reduced-sweep force, body 1
-  Scalar KA_wrist_2_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
+  Scalar KA_wrist_2_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 5
   Scalar KSD_wrist_2_link[6];  // D^-1 S^T KA, body 5
-  Scalar KA_wrist_1_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 4
+  Scalar KA_wrist_1_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 4
   Scalar KSD_wrist_1_link[6];  // D^-1 S^T KA, body 4
-  Scalar KA_forearm_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 3
+  Scalar KA_forearm_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 3
   Scalar KSD_forearm_link[6];  // D^-1 S^T KA, body 3
-  Scalar KA_upper_arm_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 2
+  Scalar KA_upper_arm_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 2
   Scalar KSD_upper_arm_link[6]; // D^-1 S^T KA, body 2
-  Scalar KA_shoulder_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
+  Scalar KA_shoulder_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 1
   Scalar KSD_shoulder_link[6]; // D^-1 S^T KA, body 1
   Scalar yfree[6];             // free row accelerations (tree order)
   Scalar Linv[6];              // 1 / diag(L)

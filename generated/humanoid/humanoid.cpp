@@ -11,7 +11,7 @@ namespace humanoid {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     w.RJ_pelvis[0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
@@ -73,7 +73,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     proxgen_rt::sincos(q[8], w.sq_l_hip_roll_link, w.cq_l_hip_roll_link);
@@ -132,7 +132,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     proxgen_rt::sincos(q[10], w.sq_l_shank, w.cq_l_shank);
@@ -196,7 +196,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     proxgen_rt::sincos(q[12], w.sq_l_foot, w.cq_l_foot);
@@ -261,7 +261,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     proxgen_rt::sincos(q[14], w.sq_r_hip_roll_link, w.cq_r_hip_roll_link);
@@ -320,7 +320,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     proxgen_rt::sincos(q[16], w.sq_r_shank, w.cq_r_shank);
@@ -384,7 +384,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     proxgen_rt::sincos(q[18], w.sq_r_foot, w.cq_r_foot);
@@ -442,7 +442,7 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     proxgen_rt::sincos(q[20], w.sq_chest, w.cq_chest);
@@ -506,7 +506,7 @@ PROXGEN_RT_NOINLINE void kinematics_7(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
     proxgen_rt::sincos(q[22], w.sq_l_shoulder_roll_link, w.cq_l_shoulder_roll_link);
@@ -555,7 +555,7 @@ PROXGEN_RT_NOINLINE void kinematics_8(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
     proxgen_rt::sincos(q[24], w.sq_l_forearm, w.cq_l_forearm);
@@ -613,7 +613,7 @@ PROXGEN_RT_NOINLINE void kinematics_9(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
     proxgen_rt::sincos(q[26], w.sq_l_wrist_pitch_link, w.cq_l_wrist_pitch_link);
@@ -662,7 +662,7 @@ PROXGEN_RT_NOINLINE void kinematics_10(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
     proxgen_rt::sincos(q[28], w.sq_neck_link, w.cq_neck_link);
@@ -716,7 +716,7 @@ PROXGEN_RT_NOINLINE void kinematics_11(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     proxgen_rt::sincos(q[30], w.sq_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link);
@@ -783,7 +783,7 @@ PROXGEN_RT_NOINLINE void kinematics_12(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     proxgen_rt::sincos(q[32], w.sq_r_upper_arm, w.cq_r_upper_arm);
@@ -845,7 +845,7 @@ PROXGEN_RT_NOINLINE void kinematics_13(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     proxgen_rt::sincos(q[34], w.sq_r_wrist_yaw_link, w.cq_r_wrist_yaw_link);
@@ -900,7 +900,7 @@ PROXGEN_RT_NOINLINE void kinematics_14(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_15(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     proxgen_rt::sincos(q[36], w.sq_r_hand, w.cq_r_hand);
@@ -934,125 +934,115 @@ PROXGEN_RT_NOINLINE void kinematics_15(const Scalar* PROXGEN_RT_RESTRICT q, cons
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    w.Dinv_head = 1.0 / 0.07202788281129999;
     w.u_head[0] = -w.pA_head[4] + tau[28];
-    const Scalar Ia0 = 5.17 - 0.22255985640624998*w.Dinv_head;
-    const Scalar pa0 = w.pA_head[0] + 0.4717625*w.Dinv_head*w.u_head[0] + w.c_head[0]*Ia0;
+    const Scalar pa0 = 2.0800874866846146*w.c_head[0] + w.pA_head[0] + 6.549720491381543*w.u_head[0];
     const Scalar pa1 = -0.4717625*w.c_head[3] + w.pA_head[1];
     const Scalar pa2 = 5.17*w.c_head[2] + w.pA_head[2];
     const Scalar pa3 = 0.07202788281129999*w.c_head[3] + w.pA_head[3];
-    const Scalar pa4 = w.pA_head[4] + 0.07202788281129999*w.Dinv_head*w.u_head[0];
+    const Scalar pa4 = w.pA_head[4] + w.u_head[0];
     const Scalar pa5 = 0.0167508*w.c_head[5] + w.pA_head[5];
     const Scalar C20 = w.cq_head*w.cq_head - w.sq_head*w.sq_head;
-    const Scalar h0 = 2.585 - 0.5*Ia0;
-    const Scalar m0 = 2.585 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_head*w.sq_head;
-    const Scalar t1 = m0 - C20*h0;
-    const Scalar t2 = m0 + C20*h0;
-    const Scalar t3 = -0.3102 - 0.4717625*w.cq_head;
-    const Scalar t4 = w.cq_head*pa0 + w.sq_head*pa2;
-    const Scalar t5 = -w.sq_head*pa0 + w.cq_head*pa2;
-    w.IA_neck_link[0] = 0.5 + t1;
-    w.IA_neck_link[2] = h0*t0;
-    w.IA_neck_link[4] = 0.015 + 0.06*t1;
-    w.IA_neck_link[8] = -0.015 + t3;
+    const Scalar t0 = 3.6250437433423075 - 1.5449562566576927*C20;
+    const Scalar t1 = 3.6250437433423075 + 1.5449562566576927*C20;
+    const Scalar t2 = -0.3102 - 0.4717625*w.cq_head;
+    const Scalar t3 = w.cq_head*pa0 + w.sq_head*pa2;
+    const Scalar t4 = -w.sq_head*pa0 + w.cq_head*pa2;
+    w.IA_neck_link[0] = 0.5 + t0;
+    w.IA_neck_link[2] = 3.0899125133153853*w.cq_head*w.sq_head;
+    w.IA_neck_link[4] = 0.015 + 0.06*t0;
+    w.IA_neck_link[8] = -0.015 + t2;
     w.IA_neck_link[10] = 0.4717625*w.sq_head;
-    w.IA_neck_link[11] = 0.5 + t2;
-    w.IA_neck_link[13] = 0.06*h0*t0;
-    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq_head + 0.027638541405649995*C20 - 0.06*t3;
+    w.IA_neck_link[11] = 0.5 + t1;
+    w.IA_neck_link[13] = 0.18539475079892312*w.cq_head*w.sq_head;
+    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq_head + 0.027638541405649995*C20 - 0.06*t2;
     w.IA_neck_link[17] = -0.028305749999999998*w.sq_head - 0.05527708281129999*w.cq_head*w.sq_head;
-    w.IA_neck_link[18] = 0.0007700000000000001 + 0.0036*t1;
+    w.IA_neck_link[18] = 0.0007700000000000001 + 0.0036*t0;
     w.IA_neck_link[20] = 0.04470934140564999 - 0.027638541405649995*C20;
-    w.pA_neck_link[0] = w.pA_neck_link[0] + t4;
+    w.pA_neck_link[0] = w.pA_neck_link[0] + t3;
     w.pA_neck_link[1] = w.pA_neck_link[1] + pa1;
-    w.pA_neck_link[2] = w.pA_neck_link[2] + t5;
+    w.pA_neck_link[2] = w.pA_neck_link[2] + t4;
     w.pA_neck_link[3] = w.pA_neck_link[3] - 0.06*pa1 + w.cq_head*pa3 + w.sq_head*pa5;
-    w.pA_neck_link[4] = w.pA_neck_link[4] + pa4 + 0.06*t4;
+    w.pA_neck_link[4] = w.pA_neck_link[4] + pa4 + 0.06*t3;
     w.pA_neck_link[5] = w.pA_neck_link[5] - w.sq_head*pa3 + w.cq_head*pa5;
   }
   // eliminate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
     w.Dinv_neck_link = 1.0 / w.IA_neck_link[20];
     w.u_neck_link[0] = -w.pA_neck_link[5] + tau[27];
-    const Scalar t6 = w.IA_neck_link[10]*w.Dinv_neck_link;
-    const Scalar t7 = w.IA_neck_link[17]*w.Dinv_neck_link;
-    const Scalar t8 = w.IA_neck_link[20]*w.Dinv_neck_link;
-    const Scalar Ia1 = 5.67 - w.IA_neck_link[10]*t6;
-    const Scalar Ia2 = w.IA_neck_link[8] - w.IA_neck_link[17]*t6;
-    const Scalar Ia3 = w.IA_neck_link[15] - w.IA_neck_link[17]*t7;
+    const Scalar t5 = w.IA_neck_link[10]*w.Dinv_neck_link;
+    const Scalar t6 = w.IA_neck_link[17]*w.Dinv_neck_link;
+    const Scalar t7 = w.IA_neck_link[20]*w.Dinv_neck_link;
+    const Scalar Ia0 = 5.67 - w.IA_neck_link[10]*t5;
+    const Scalar Ia1 = w.IA_neck_link[8] - w.IA_neck_link[17]*t5;
+    const Scalar Ia2 = w.IA_neck_link[15] - w.IA_neck_link[17]*t6;
     const Scalar pa6 = w.pA_neck_link[0] + w.c_neck_link[0]*w.IA_neck_link[0] + w.c_neck_link[4]*w.IA_neck_link[4];
-    const Scalar pa7 = w.pA_neck_link[1] + w.u_neck_link[0]*t6 + w.c_neck_link[1]*Ia1 + w.c_neck_link[3]*Ia2;
+    const Scalar pa7 = w.pA_neck_link[1] + w.u_neck_link[0]*t5 + w.c_neck_link[1]*Ia0 + w.c_neck_link[3]*Ia1;
     const Scalar pa8 = w.pA_neck_link[2] + w.c_neck_link[0]*w.IA_neck_link[2] + w.c_neck_link[4]*w.IA_neck_link[13];
-    const Scalar pa9 = w.pA_neck_link[3] + w.u_neck_link[0]*t7 + w.c_neck_link[1]*Ia2 + w.c_neck_link[3]*Ia3;
+    const Scalar pa9 = w.pA_neck_link[3] + w.u_neck_link[0]*t6 + w.c_neck_link[1]*Ia1 + w.c_neck_link[3]*Ia2;
     const Scalar pa10 = w.pA_neck_link[4] + w.c_neck_link[0]*w.IA_neck_link[4] + w.c_neck_link[4]*w.IA_neck_link[18];
-    const Scalar pa11 = w.pA_neck_link[5] + w.u_neck_link[0]*t8;
+    const Scalar pa11 = w.pA_neck_link[5] + w.u_neck_link[0]*t7;
     const Scalar C21 = w.cq_neck_link*w.cq_neck_link - w.sq_neck_link*w.sq_neck_link;
-    const Scalar h1 = 0.5*(w.IA_neck_link[0] - Ia1);
-    const Scalar m1 = 0.5*(w.IA_neck_link[0] + Ia1);
-    const Scalar t9 = 2.0*w.cq_neck_link*w.sq_neck_link;
-    const Scalar t10 = 0.5*(w.IA_neck_link[4] + Ia2);
-    const Scalar h2 = 0.5*(-w.IA_neck_link[18] + Ia3);
-    const Scalar m2 = 0.5*(w.IA_neck_link[18] + Ia3);
-    const Scalar t11 = m1 + C21*h1;
-    const Scalar t12 = m1 - C21*h1;
-    const Scalar t13 = 0.5*w.IA_neck_link[4] - 0.5*Ia2 + C21*t10;
-    const Scalar t14 = -0.5*w.IA_neck_link[4] + 0.5*Ia2 + C21*t10;
-    const Scalar t15 = -0.29*h1*t9 - t9*t10;
-    const Scalar t16 = 0.29*t11 + t13;
-    const Scalar t17 = -0.29*t12 + t14;
-    const Scalar t18 = 0.29*h1*t9 + t9*t10;
-    const Scalar t19 = -0.29*w.sq_neck_link*w.IA_neck_link[2] - w.sq_neck_link*w.IA_neck_link[13];
-    const Scalar t20 = 0.29*w.cq_neck_link*w.IA_neck_link[2] + w.cq_neck_link*w.IA_neck_link[13];
-    const Scalar t21 = w.cq_neck_link*pa6 - w.sq_neck_link*pa7;
-    const Scalar t22 = w.sq_neck_link*pa6 + w.cq_neck_link*pa7;
-    w.IA_chest[0] = 13.92 + t11;
-    w.IA_chest[1] = h1*t9;
+    const Scalar h0 = 0.5*(w.IA_neck_link[0] - Ia0);
+    const Scalar m0 = 0.5*(w.IA_neck_link[0] + Ia0);
+    const Scalar t8 = 2.0*w.cq_neck_link*w.sq_neck_link;
+    const Scalar t9 = 0.5*(w.IA_neck_link[4] + Ia1);
+    const Scalar h1 = 0.5*(-w.IA_neck_link[18] + Ia2);
+    const Scalar m1 = 0.5*(w.IA_neck_link[18] + Ia2);
+    const Scalar t10 = m0 + C21*h0;
+    const Scalar t11 = m0 - C21*h0;
+    const Scalar t12 = 0.5*w.IA_neck_link[4] - 0.5*Ia1 + C21*t9;
+    const Scalar t13 = -0.5*w.IA_neck_link[4] + 0.5*Ia1 + C21*t9;
+    const Scalar t14 = -0.29*h0*t8 - t8*t9;
+    const Scalar t15 = 0.29*t10 + t12;
+    const Scalar t16 = -0.29*t11 + t13;
+    const Scalar t17 = 0.29*h0*t8 + t8*t9;
+    const Scalar t18 = -0.29*w.sq_neck_link*w.IA_neck_link[2] - w.sq_neck_link*w.IA_neck_link[13];
+    const Scalar t19 = 0.29*w.cq_neck_link*w.IA_neck_link[2] + w.cq_neck_link*w.IA_neck_link[13];
+    const Scalar t20 = w.cq_neck_link*pa6 - w.sq_neck_link*pa7;
+    const Scalar t21 = w.sq_neck_link*pa6 + w.cq_neck_link*pa7;
+    w.IA_chest[0] = 13.92 + t10;
+    w.IA_chest[1] = h0*t8;
     w.IA_chest[2] = w.cq_neck_link*w.IA_neck_link[2];
-    w.IA_chest[3] = t15;
-    w.IA_chest[4] = 0.726624 + t16;
-    w.IA_chest[6] = 13.92 + t12;
+    w.IA_chest[3] = t14;
+    w.IA_chest[4] = 0.726624 + t15;
+    w.IA_chest[6] = 13.92 + t11;
     w.IA_chest[7] = w.sq_neck_link*w.IA_neck_link[2];
-    w.IA_chest[8] = -0.726624 + t17;
-    w.IA_chest[9] = t18;
+    w.IA_chest[8] = -0.726624 + t16;
+    w.IA_chest[9] = t17;
     w.IA_chest[11] = 13.92 + w.IA_neck_link[11];
-    w.IA_chest[12] = t19;
-    w.IA_chest[13] = t20;
-    w.IA_chest[15] = 0.2775857728 + m2 + C21*h2 - 0.29*t14 - 0.29*t17;
-    w.IA_chest[16] = -0.29*t9*t10 + t9*h2 - 0.29*t18;
-    w.IA_chest[18] = 0.19162977280000001 + m2 - C21*h2 + 0.29*t13 + 0.29*t16;
-    w.pA_chest[0] = w.pA_chest[0] + t21;
-    w.pA_chest[1] = w.pA_chest[1] + t22;
+    w.IA_chest[12] = t18;
+    w.IA_chest[13] = t19;
+    w.IA_chest[15] = 0.2775857728 + m1 + C21*h1 - 0.29*t13 - 0.29*t16;
+    w.IA_chest[16] = -0.29*t8*t9 + t8*h1 - 0.29*t17;
+    w.IA_chest[18] = 0.19162977280000001 + m1 - C21*h1 + 0.29*t12 + 0.29*t15;
+    w.pA_chest[0] = w.pA_chest[0] + t20;
+    w.pA_chest[1] = w.pA_chest[1] + t21;
     w.pA_chest[2] = w.pA_chest[2] + pa8;
-    w.pA_chest[3] = w.pA_chest[3] + w.cq_neck_link*pa9 - w.sq_neck_link*pa10 - 0.29*t22;
-    w.pA_chest[4] = w.pA_chest[4] + w.sq_neck_link*pa9 + w.cq_neck_link*pa10 + 0.29*t21;
+    w.pA_chest[3] = w.pA_chest[3] + w.cq_neck_link*pa9 - w.sq_neck_link*pa10 - 0.29*t21;
+    w.pA_chest[4] = w.pA_chest[4] + w.sq_neck_link*pa9 + w.cq_neck_link*pa10 + 0.29*t20;
     w.pA_chest[5] = w.pA_chest[5] + pa11;
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_hand_to_l_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    w.Dinv_l_hand = 1.0 / 0.005164645770899999;
     w.u_l_hand[0] = -w.pA_l_hand[3] + tau[26];
-    const Scalar Ia0 = 0.42 - 0.0016133300490384*w.Dinv_l_hand;
     const Scalar pa0 = -0.04016628*w.c_l_hand[4] + w.pA_l_hand[0];
-    const Scalar pa1 = w.pA_l_hand[1] + 0.04016628*w.Dinv_l_hand*w.u_l_hand[0] + w.c_l_hand[1]*Ia0;
+    const Scalar pa1 = 0.1076203866432337*w.c_l_hand[1] + w.pA_l_hand[1] + 7.7771606769849315*w.u_l_hand[0];
     const Scalar pa2 = 0.42*w.c_l_hand[2] + w.pA_l_hand[2];
-    const Scalar pa3 = w.pA_l_hand[3] + 0.005164645770899999*w.Dinv_l_hand*w.u_l_hand[0];
+    const Scalar pa3 = w.pA_l_hand[3] + w.u_l_hand[0];
     const Scalar pa4 = 0.005164645770899999*w.c_l_hand[4] + w.pA_l_hand[4];
     const Scalar pa5 = 0.000284375*w.c_l_hand[5] + w.pA_l_hand[5];
     const Scalar C20 = w.cq_l_hand*w.cq_l_hand - w.sq_l_hand*w.sq_l_hand;
-    const Scalar h0 = -0.21 + 0.5*Ia0;
-    const Scalar m0 = 0.21 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_l_hand*w.sq_l_hand;
     w.IA_l_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq_l_hand;
     w.IA_l_wrist_pitch_link[5] = -0.04016628*w.sq_l_hand;
-    w.IA_l_wrist_pitch_link[6] = 0.1 + m0 + C20*h0;
-    w.IA_l_wrist_pitch_link[7] = h0*t0;
-    w.IA_l_wrist_pitch_link[11] = 0.1 + m0 - C20*h0;
+    w.IA_l_wrist_pitch_link[6] = 0.3638101933216168 - 0.15618980667838314*C20;
+    w.IA_l_wrist_pitch_link[7] = -0.3123796133567663*w.cq_l_hand*w.sq_l_hand;
+    w.IA_l_wrist_pitch_link[11] = 0.3638101933216168 + 0.15618980667838314*C20;
     w.IA_l_wrist_pitch_link[18] = 0.0027595103854499993 + 0.0024401353854499996*C20;
     w.IA_l_wrist_pitch_link[19] = 0.004880270770899999*w.cq_l_hand*w.sq_l_hand;
     w.IA_l_wrist_pitch_link[20] = 0.0027495103854499993 - 0.0024401353854499996*C20;
@@ -1067,39 +1057,39 @@ PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* PROXGEN_RT_RESTRICT tau,
   {
     w.Dinv_l_wrist_pitch_link = 1.0 / w.IA_l_wrist_pitch_link[18];
     w.u_l_wrist_pitch_link[0] = -w.pA_l_wrist_pitch_link[4] + tau[25];
-    const Scalar t1 = w.IA_l_wrist_pitch_link[4]*w.Dinv_l_wrist_pitch_link;
-    const Scalar t2 = w.IA_l_wrist_pitch_link[18]*w.Dinv_l_wrist_pitch_link;
-    const Scalar t3 = w.IA_l_wrist_pitch_link[19]*w.Dinv_l_wrist_pitch_link;
-    const Scalar Ia1 = 0.52 - w.IA_l_wrist_pitch_link[4]*t1;
-    const Scalar Ia2 = w.IA_l_wrist_pitch_link[5] - w.IA_l_wrist_pitch_link[19]*t1;
-    const Scalar Ia3 = w.IA_l_wrist_pitch_link[20] - w.IA_l_wrist_pitch_link[19]*t3;
-    const Scalar pa6 = w.pA_l_wrist_pitch_link[0] + w.u_l_wrist_pitch_link[0]*t1 + w.c_l_wrist_pitch_link[0]*Ia1 + w.c_l_wrist_pitch_link[5]*Ia2;
+    const Scalar t0 = w.IA_l_wrist_pitch_link[4]*w.Dinv_l_wrist_pitch_link;
+    const Scalar t1 = w.IA_l_wrist_pitch_link[18]*w.Dinv_l_wrist_pitch_link;
+    const Scalar t2 = w.IA_l_wrist_pitch_link[19]*w.Dinv_l_wrist_pitch_link;
+    const Scalar Ia0 = 0.52 - w.IA_l_wrist_pitch_link[4]*t0;
+    const Scalar Ia1 = w.IA_l_wrist_pitch_link[5] - w.IA_l_wrist_pitch_link[19]*t0;
+    const Scalar Ia2 = w.IA_l_wrist_pitch_link[20] - w.IA_l_wrist_pitch_link[19]*t2;
+    const Scalar pa6 = w.pA_l_wrist_pitch_link[0] + w.u_l_wrist_pitch_link[0]*t0 + w.c_l_wrist_pitch_link[0]*Ia0 + w.c_l_wrist_pitch_link[5]*Ia1;
     const Scalar pa7 = 0.001*w.c_l_wrist_pitch_link[3] + w.pA_l_wrist_pitch_link[1] + w.c_l_wrist_pitch_link[2]*w.IA_l_wrist_pitch_link[7];
     const Scalar pa8 = w.pA_l_wrist_pitch_link[2] + w.c_l_wrist_pitch_link[2]*w.IA_l_wrist_pitch_link[11];
     const Scalar pa9 = 3.5000000000000004e-05*w.c_l_wrist_pitch_link[3] + w.pA_l_wrist_pitch_link[3];
-    const Scalar pa10 = w.pA_l_wrist_pitch_link[4] + w.u_l_wrist_pitch_link[0]*t2;
-    const Scalar pa11 = w.pA_l_wrist_pitch_link[5] + w.u_l_wrist_pitch_link[0]*t3 + w.c_l_wrist_pitch_link[0]*Ia2 + w.c_l_wrist_pitch_link[5]*Ia3;
+    const Scalar pa10 = w.pA_l_wrist_pitch_link[4] + w.u_l_wrist_pitch_link[0]*t1;
+    const Scalar pa11 = w.pA_l_wrist_pitch_link[5] + w.u_l_wrist_pitch_link[0]*t2 + w.c_l_wrist_pitch_link[0]*Ia1 + w.c_l_wrist_pitch_link[5]*Ia2;
     const Scalar C21 = w.cq_l_wrist_pitch_link*w.cq_l_wrist_pitch_link - w.sq_l_wrist_pitch_link*w.sq_l_wrist_pitch_link;
-    const Scalar h1 = 0.5*(w.IA_l_wrist_pitch_link[11] - Ia1);
-    const Scalar m1 = 0.5*(w.IA_l_wrist_pitch_link[11] + Ia1);
-    const Scalar t4 = 2.0*w.cq_l_wrist_pitch_link*w.sq_l_wrist_pitch_link;
-    const Scalar h2 = -1.7500000000000002e-05 + 0.5*Ia3;
-    const Scalar m2 = 1.7500000000000002e-05 + 0.5*Ia3;
-    w.IA_l_wrist_yaw_link[0] = 0.1 + m1 - C21*h1;
+    const Scalar h0 = 0.5*(w.IA_l_wrist_pitch_link[11] - Ia0);
+    const Scalar m0 = 0.5*(w.IA_l_wrist_pitch_link[11] + Ia0);
+    const Scalar t3 = 2.0*w.cq_l_wrist_pitch_link*w.sq_l_wrist_pitch_link;
+    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia2;
+    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia2;
+    w.IA_l_wrist_yaw_link[0] = 0.1 + m0 - C21*h0;
     w.IA_l_wrist_yaw_link[1] = w.sq_l_wrist_pitch_link*w.IA_l_wrist_pitch_link[7];
-    w.IA_l_wrist_yaw_link[2] = h1*t4;
-    w.IA_l_wrist_yaw_link[3] = 0.5*Ia2*t4;
-    w.IA_l_wrist_yaw_link[5] = 0.5*(Ia2 + Ia2*C21);
+    w.IA_l_wrist_yaw_link[2] = h0*t3;
+    w.IA_l_wrist_yaw_link[3] = 0.5*Ia1*t3;
+    w.IA_l_wrist_yaw_link[5] = 0.5*(Ia1 + Ia1*C21);
     w.IA_l_wrist_yaw_link[6] = 0.1 + w.IA_l_wrist_pitch_link[6];
     w.IA_l_wrist_yaw_link[7] = w.cq_l_wrist_pitch_link*w.IA_l_wrist_pitch_link[7];
     w.IA_l_wrist_yaw_link[8] = -0.001 + 0.001*w.cq_l_wrist_pitch_link;
     w.IA_l_wrist_yaw_link[10] = -0.001*w.sq_l_wrist_pitch_link;
-    w.IA_l_wrist_yaw_link[11] = 0.1 + m1 + C21*h1;
-    w.IA_l_wrist_yaw_link[12] = 0.5*(-Ia2 + Ia2*C21);
-    w.IA_l_wrist_yaw_link[14] = -0.5*Ia2*t4;
-    w.IA_l_wrist_yaw_link[15] = 3.5000000000000004e-05 + m2 - C21*h2;
-    w.IA_l_wrist_yaw_link[17] = t4*h2;
-    w.IA_l_wrist_yaw_link[20] = 2.5e-05 + m2 + C21*h2;
+    w.IA_l_wrist_yaw_link[11] = 0.1 + m0 + C21*h0;
+    w.IA_l_wrist_yaw_link[12] = 0.5*(-Ia1 + Ia1*C21);
+    w.IA_l_wrist_yaw_link[14] = -0.5*Ia1*t3;
+    w.IA_l_wrist_yaw_link[15] = 3.5000000000000004e-05 + m1 - C21*h1;
+    w.IA_l_wrist_yaw_link[17] = t3*h1;
+    w.IA_l_wrist_yaw_link[20] = 2.5e-05 + m1 + C21*h1;
     w.pA_l_wrist_yaw_link[0] = w.pA_l_wrist_yaw_link[0] + w.cq_l_wrist_pitch_link*pa6 + w.sq_l_wrist_pitch_link*pa8;
     w.pA_l_wrist_yaw_link[1] = w.pA_l_wrist_yaw_link[1] + pa7;
     w.pA_l_wrist_yaw_link[2] = w.pA_l_wrist_yaw_link[2] - w.sq_l_wrist_pitch_link*pa6 + w.cq_l_wrist_pitch_link*pa8;
@@ -1109,7 +1099,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_1(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
     w.Dinv_l_wrist_yaw_link = 1.0 / w.IA_l_wrist_yaw_link[20];
@@ -1186,7 +1176,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_2(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
     w.Dinv_l_forearm = 1.0 / w.IA_l_forearm[18];
@@ -1286,7 +1276,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_3(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
     w.Dinv_l_upper_arm = 1.0 / w.IA_l_upper_arm[20];
@@ -1357,7 +1347,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_4(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
     w.Dinv_l_shoulder_roll_link = 1.0 / w.IA_l_shoulder_roll_link[15];
@@ -1417,7 +1407,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_5(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
     w.Dinv_l_shoulder_pitch_link = 1.0 / w.IA_l_shoulder_pitch_link[18];
@@ -1532,7 +1522,7 @@ PROXGEN_RT_NOINLINE void eliminate_free_6(const Scalar* PROXGEN_RT_RESTRICT tau,
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.U_r_hand[1] = 0.04016628 + 0.13*mu;
@@ -1619,7 +1609,7 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     w.Dinv_r_wrist_yaw_link = 1.0 / w.IA_r_wrist_yaw_link[20];
@@ -1696,7 +1686,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     w.Dinv_r_forearm = 1.0 / w.IA_r_forearm[18];
@@ -1796,7 +1786,7 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.Dinv_r_upper_arm = 1.0 / w.IA_r_upper_arm[20];
@@ -1867,7 +1857,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     w.Dinv_r_shoulder_roll_link = 1.0 / w.IA_r_shoulder_roll_link[15];
@@ -1927,7 +1917,7 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     w.Dinv_r_shoulder_pitch_link = 1.0 / w.IA_r_shoulder_pitch_link[18];
@@ -2042,7 +2032,7 @@ PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.Dinv_chest = 1.0 / w.IA_chest[18];
@@ -2134,7 +2124,7 @@ PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_abdomen = 1.0 / w.IA_abdomen[20];
@@ -2223,7 +2213,7 @@ PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
     w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu;
@@ -2273,7 +2263,7 @@ PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
@@ -2373,7 +2363,7 @@ PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
@@ -2486,7 +2476,7 @@ PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
     w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
@@ -2578,7 +2568,7 @@ PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
@@ -2638,7 +2628,7 @@ PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
@@ -2737,7 +2727,7 @@ PROXGEN_RT_NOINLINE void caba_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
     w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu;
@@ -2787,7 +2777,7 @@ PROXGEN_RT_NOINLINE void caba_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar m
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
@@ -2887,7 +2877,7 @@ PROXGEN_RT_NOINLINE void caba_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
@@ -3000,7 +2990,7 @@ PROXGEN_RT_NOINLINE void caba_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
     w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
@@ -3092,7 +3082,7 @@ PROXGEN_RT_NOINLINE void caba_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
@@ -3152,7 +3142,7 @@ PROXGEN_RT_NOINLINE void caba_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
@@ -3251,7 +3241,7 @@ PROXGEN_RT_NOINLINE void caba_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_pelvis[0]);
@@ -3311,7 +3301,7 @@ PROXGEN_RT_NOINLINE void caba_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
@@ -3372,7 +3362,7 @@ PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
@@ -3430,7 +3420,7 @@ PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
@@ -3490,7 +3480,7 @@ PROXGEN_RT_NOINLINE void caba_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
@@ -3548,7 +3538,7 @@ PROXGEN_RT_NOINLINE void caba_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
@@ -3604,7 +3594,7 @@ PROXGEN_RT_NOINLINE void caba_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
@@ -3663,7 +3653,7 @@ PROXGEN_RT_NOINLINE void caba_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
@@ -3719,7 +3709,7 @@ PROXGEN_RT_NOINLINE void caba_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_28(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
     const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
@@ -3750,16 +3740,19 @@ PROXGEN_RT_NOINLINE void caba_28(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.a_r_hand[4] = t7;
     w.a_r_hand[5] = t8;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t10 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = mu*t10;
+    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = mu*t0;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t11 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t11;
+    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t12 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t12;
+    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.dlambda[2];
     w.dlambda[3] = w.a_l_foot[3]*mu;
     w.lambda[3] = w.dlambda[3];
@@ -3767,14 +3760,14 @@ PROXGEN_RT_NOINLINE void caba_28(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.lambda[4] = w.dlambda[4];
     w.dlambda[5] = w.a_l_foot[5]*mu;
     w.lambda[5] = w.dlambda[5];
-    const Scalar t13 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t13;
+    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*t3;
     w.lambda[6] = w.dlambda[6];
-    const Scalar t14 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t14;
+    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*t4;
     w.lambda[7] = w.dlambda[7];
-    const Scalar t15 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t15;
+    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*t5;
     w.lambda[8] = w.dlambda[8];
     w.dlambda[9] = w.a_r_foot[3]*mu;
     w.lambda[9] = w.dlambda[9];
@@ -3782,19 +3775,19 @@ PROXGEN_RT_NOINLINE void caba_28(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.lambda[10] = w.dlambda[10];
     w.dlambda[11] = w.a_r_foot[5]*mu;
     w.lambda[11] = w.dlambda[11];
-    const Scalar t16 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.dlambda[12] = mu*t16;
+    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.dlambda[12] = mu*t6;
     w.lambda[12] = w.dlambda[12];
-    const Scalar t17 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
-    w.dlambda[13] = mu*t17;
+    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.dlambda[13] = mu*t7;
     w.lambda[13] = w.dlambda[13];
-    const Scalar t18 = -w.k_right_hand[2] + w.a_r_hand[2];
-    w.dlambda[14] = mu*t18;
+    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
+    w.dlambda[14] = mu*t8;
     w.lambda[14] = w.dlambda[14];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     w.u_r_hand[0] = w.u_r_hand[0] - 0.13*w.dlambda[12];
@@ -3864,7 +3857,7 @@ PROXGEN_RT_NOINLINE void caba_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_30(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.u_r_upper_arm[0] = -w.dp_r_upper_arm[5] + w.u_r_upper_arm[0];
@@ -3923,7 +3916,7 @@ PROXGEN_RT_NOINLINE void caba_30(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_31(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.u_chest[0] = -w.dp_chest[4] + w.u_chest[0];
@@ -3980,7 +3973,7 @@ PROXGEN_RT_NOINLINE void caba_31(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_32(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     w.u_r_ankle_link[0] = -w.dp_r_ankle_link[4] + w.u_r_ankle_link[0];
@@ -4049,7 +4042,7 @@ PROXGEN_RT_NOINLINE void caba_32(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_33(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_foot(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.u_r_hip_roll_link[0] = -w.dp_r_hip_roll_link[3] + w.u_r_hip_roll_link[0];
@@ -4106,7 +4099,7 @@ PROXGEN_RT_NOINLINE void caba_33(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_34(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_l_ankle_link_to_l_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.u_l_ankle_link[0] = -w.dp_l_ankle_link[4] + w.u_l_ankle_link[0];
@@ -4175,7 +4168,7 @@ PROXGEN_RT_NOINLINE void caba_34(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_l_hip_roll_link_to_pelvis(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.u_l_hip_roll_link[0] = -w.dp_l_hip_roll_link[3] + w.u_l_hip_roll_link[0];
@@ -4223,36 +4216,39 @@ PROXGEN_RT_NOINLINE void caba_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.u_pelvis[4] = w.u_pelvis[4] - w.dp_pelvis[4];
     w.u_pelvis[5] = w.u_pelvis[5] - w.dp_pelvis[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t18 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
-    const Scalar t19 = w.Linv_pelvis[0]*t18;
-    const Scalar t20 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t19;
-    const Scalar t21 = w.Linv_pelvis[1]*t20;
-    const Scalar t22 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t19 - w.L_pelvis[7]*t21;
-    const Scalar t23 = w.Linv_pelvis[2]*t22;
-    const Scalar t24 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t19 - w.L_pelvis[8]*t21 - w.L_pelvis[12]*t23;
-    const Scalar t25 = w.Linv_pelvis[3]*t24;
-    const Scalar t26 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t19 - w.L_pelvis[9]*t21 - w.L_pelvis[13]*t23 - w.L_pelvis[16]*t25;
-    const Scalar t27 = w.Linv_pelvis[4]*t26;
-    const Scalar t28 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t19 - w.L_pelvis[10]*t21 - w.L_pelvis[14]*t23 - w.L_pelvis[17]*t25 - w.L_pelvis[19]*t27;
-    const Scalar t29 = w.Linv_pelvis[5]*t28;
-    const Scalar t30 = w.Linv_pelvis[5]*t29;
-    const Scalar t31 = w.Linv_pelvis[4]*t26 - w.L_pelvis[19]*t30;
-    const Scalar t32 = w.Linv_pelvis[4]*t31;
-    const Scalar t33 = w.Linv_pelvis[3]*t24 - w.L_pelvis[16]*t32 - w.L_pelvis[17]*t30;
-    const Scalar t34 = w.Linv_pelvis[3]*t33;
-    const Scalar t35 = w.Linv_pelvis[2]*t22 - w.L_pelvis[12]*t34 - w.L_pelvis[13]*t32 - w.L_pelvis[14]*t30;
-    const Scalar t36 = w.Linv_pelvis[2]*t35;
-    const Scalar t37 = w.Linv_pelvis[1]*t20 - w.L_pelvis[7]*t36 - w.L_pelvis[8]*t34 - w.L_pelvis[9]*t32 - w.L_pelvis[10]*t30;
-    const Scalar t38 = w.Linv_pelvis[1]*t37;
-    const Scalar t39 = w.Linv_pelvis[0]*t18 - w.L_pelvis[1]*t38 - w.L_pelvis[2]*t36 - w.L_pelvis[3]*t34 - w.L_pelvis[4]*t32 - w.L_pelvis[5]*t30;
-    w.qdd[0] = w.Linv_pelvis[0]*t39;
-    w.qdd[1] = w.Linv_pelvis[1]*t37;
-    w.qdd[2] = w.Linv_pelvis[2]*t35;
-    w.qdd[3] = w.Linv_pelvis[3]*t33;
-    w.qdd[4] = w.Linv_pelvis[4]*t31;
-    w.qdd[5] = w.Linv_pelvis[5]*t29;
+    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t1 = w.Linv_pelvis[0]*t0;
+    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t3 = w.Linv_pelvis[1]*t2;
+    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t5 = w.Linv_pelvis[2]*t4;
+    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t7 = w.Linv_pelvis[3]*t6;
+    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t9 = w.Linv_pelvis[4]*t8;
+    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t11 = w.Linv_pelvis[5]*t10;
+    const Scalar t12 = w.Linv_pelvis[5]*t11;
+    const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
+    const Scalar t14 = w.Linv_pelvis[4]*t13;
+    const Scalar t15 = w.Linv_pelvis[3]*t6 - w.L_pelvis[16]*t14 - w.L_pelvis[17]*t12;
+    const Scalar t16 = w.Linv_pelvis[3]*t15;
+    const Scalar t17 = w.Linv_pelvis[2]*t4 - w.L_pelvis[12]*t16 - w.L_pelvis[13]*t14 - w.L_pelvis[14]*t12;
+    const Scalar t18 = w.Linv_pelvis[2]*t17;
+    const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
+    const Scalar t20 = w.Linv_pelvis[1]*t19;
+    const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
+    w.qdd[0] = w.Linv_pelvis[0]*t21;
+    w.qdd[1] = w.Linv_pelvis[1]*t19;
+    w.qdd[2] = w.Linv_pelvis[2]*t17;
+    w.qdd[3] = w.Linv_pelvis[3]*t15;
+    w.qdd[4] = w.Linv_pelvis[4]*t13;
+    w.qdd[5] = w.Linv_pelvis[5]*t11;
     w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
     w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
     w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
@@ -4260,417 +4256,420 @@ PROXGEN_RT_NOINLINE void caba_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_36(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t0 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t1 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t2 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
-    const Scalar t3 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t0;
-    const Scalar t4 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t5 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t6 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t2 + w.sq_l_hip_yaw_link*t3;
-    const Scalar t7 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t2 + w.cq_l_hip_yaw_link*t3;
-    const Scalar t8 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t4 + w.sq_l_hip_yaw_link*t5;
-    const Scalar t9 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t4 + w.cq_l_hip_yaw_link*t5;
-    const Scalar t10 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t6 - w.IA_l_hip_yaw_link[10]*t7 - w.IA_l_hip_yaw_link[14]*t1 - w.IA_l_hip_yaw_link[19]*t9 - w.a_pelvis[5]*w.IA_l_hip_yaw_link[20];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t10;
-    w.a_l_hip_yaw_link[0] = t6;
-    w.a_l_hip_yaw_link[1] = t7;
-    w.a_l_hip_yaw_link[2] = t1;
-    w.a_l_hip_yaw_link[3] = t8;
-    w.a_l_hip_yaw_link[4] = t9;
+    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
+    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
+    const Scalar t24 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
+    const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
+    const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
+    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
+    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
+    w.a_l_hip_yaw_link[0] = t28;
+    w.a_l_hip_yaw_link[1] = t29;
+    w.a_l_hip_yaw_link[2] = t23;
+    w.a_l_hip_yaw_link[3] = t30;
+    w.a_l_hip_yaw_link[4] = t31;
     w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    const Scalar t11 = w.c_l_hip_roll_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t12 = w.c_l_hip_roll_link[2] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[2];
-    const Scalar t13 = w.c_l_hip_roll_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t14 = w.c_l_hip_roll_link[5] - w.sq_l_hip_roll_link*w.a_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*w.a_l_hip_yaw_link[5];
-    const Scalar t15 = w.u_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*w.a_l_hip_yaw_link[0] - w.IA_l_hip_roll_link[8]*t11 - w.IA_l_hip_roll_link[12]*t12 - w.IA_l_hip_roll_link[15]*w.a_l_hip_yaw_link[3] - w.IA_l_hip_roll_link[17]*t14;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t15;
+    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
+    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
+    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
+    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
+    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
+    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
     w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = t11;
-    w.a_l_hip_roll_link[2] = t12;
+    w.a_l_hip_roll_link[1] = t0;
+    w.a_l_hip_roll_link[2] = t1;
     w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = t13;
-    w.a_l_hip_roll_link[5] = t14;
+    w.a_l_hip_roll_link[4] = t2;
+    w.a_l_hip_roll_link[5] = t3;
   }
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
-    const Scalar t16 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t17 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t18 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t19 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t20 = w.c_l_thigh[0] + w.cq_l_thigh*t16 - w.sq_l_thigh*t17;
-    const Scalar t21 = w.c_l_thigh[2] + w.sq_l_thigh*t16 + w.cq_l_thigh*t17;
-    const Scalar t22 = w.c_l_thigh[3] + w.cq_l_thigh*t18 - w.sq_l_thigh*t19;
-    const Scalar t23 = w.c_l_thigh[5] + w.sq_l_thigh*t18 + w.cq_l_thigh*t19;
-    const Scalar t24 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t20 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t21 - w.IA_l_thigh[16]*t22 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t23;
-    w.qdd[8] = w.Dinv_l_thigh*t24;
-    w.a_l_thigh[0] = t20;
+    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
+    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
+    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
+    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
+    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
+    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
+    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
+    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
+    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
+    w.qdd[8] = w.Dinv_l_thigh*t13;
+    w.a_l_thigh[0] = t9;
     w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = t21;
-    w.a_l_thigh[3] = t22;
+    w.a_l_thigh[2] = t10;
+    w.a_l_thigh[3] = t11;
     w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = t23;
+    w.a_l_thigh[5] = t12;
+  }
+  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  {
+    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
+    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
+    const Scalar t16 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t17 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t18 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
+    const Scalar t19 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
+    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
+    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
+    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
+    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
+    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
+    w.qdd[9] = w.Dinv_l_shank*t24;
+    w.a_l_shank[0] = t20;
+    w.a_l_shank[1] = t15;
+    w.a_l_shank[2] = t21;
+    w.a_l_shank[3] = t22;
+    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
+    w.a_l_shank[5] = t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t0 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t1 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t2 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t0;
-    const Scalar t3 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t0;
-    const Scalar t4 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t5 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t6 = w.c_l_shank[0] + w.cq_l_shank*t2 - w.sq_l_shank*t3;
-    const Scalar t7 = w.c_l_shank[2] + w.sq_l_shank*t2 + w.cq_l_shank*t3;
-    const Scalar t8 = w.c_l_shank[3] + w.cq_l_shank*t4 - w.sq_l_shank*t5;
-    const Scalar t9 = w.c_l_shank[5] + w.sq_l_shank*t4 + w.cq_l_shank*t5;
-    const Scalar t10 = w.u_l_shank[0] - w.IA_l_shank[4]*t6 - w.IA_l_shank[9]*t1 - w.IA_l_shank[13]*t7 - w.IA_l_shank[16]*t8 - w.a_l_thigh[4]*w.IA_l_shank[18] - w.IA_l_shank[19]*t9;
-    w.qdd[9] = w.Dinv_l_shank*t10;
-    w.a_l_shank[0] = t6;
-    w.a_l_shank[1] = t1;
-    w.a_l_shank[2] = t7;
-    w.a_l_shank[3] = t8;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = t9;
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
-    const Scalar t11 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t12 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t13 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t11;
-    const Scalar t14 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t11;
-    const Scalar t15 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t16 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t17 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t13 - w.sq_l_ankle_link*t14;
-    const Scalar t18 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t13 + w.cq_l_ankle_link*t14;
-    const Scalar t19 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t15 - w.sq_l_ankle_link*t16;
-    const Scalar t20 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t15 + w.cq_l_ankle_link*t16;
-    const Scalar t21 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t17 - w.IA_l_ankle_link[9]*t12 - w.IA_l_ankle_link[13]*t18 - w.IA_l_ankle_link[18]*w.a_l_shank[4] - w.IA_l_ankle_link[19]*t20;
-    w.qdd[10] = w.Dinv_l_ankle_link*t21;
-    w.a_l_ankle_link[0] = t17;
-    w.a_l_ankle_link[1] = t12;
-    w.a_l_ankle_link[2] = t18;
-    w.a_l_ankle_link[3] = t19;
+    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
+    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
+    const Scalar t2 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
+    const Scalar t3 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
+    const Scalar t4 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
+    const Scalar t5 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
+    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
+    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
+    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
+    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
+    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
+    w.qdd[10] = w.Dinv_l_ankle_link*t10;
+    w.a_l_ankle_link[0] = t6;
+    w.a_l_ankle_link[1] = t1;
+    w.a_l_ankle_link[2] = t7;
+    w.a_l_ankle_link[3] = t8;
     w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = t20;
+    w.a_l_ankle_link[5] = t9;
   }
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    const Scalar t22 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t23 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t24 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t25 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t26 = w.u_l_foot[0] - 0.0017863999999999998*t25 - w.U_l_foot[1]*t22 - w.U_l_foot[3]*w.a_l_ankle_link[3];
-    w.qdd[11] = w.Dinv_l_foot*t26;
+    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
+    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
+    const Scalar t15 = w.u_l_foot[0] - 0.0017863999999999998*t14 - w.U_l_foot[1]*t11 - w.U_l_foot[3]*w.a_l_ankle_link[3];
+    w.qdd[11] = w.Dinv_l_foot*t15;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = t22;
-    w.a_l_foot[2] = t23;
+    w.a_l_foot[1] = t11;
+    w.a_l_foot[2] = t12;
     w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = t24;
-    w.a_l_foot[5] = t25;
+    w.a_l_foot[4] = t13;
+    w.a_l_foot[5] = t14;
+  }
+  // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
+  {
+    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
+    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
+    const Scalar t18 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
+    const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
+    const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
+    const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
+    w.a_r_hip_yaw_link[0] = t22;
+    w.a_r_hip_yaw_link[1] = t23;
+    w.a_r_hip_yaw_link[2] = t17;
+    w.a_r_hip_yaw_link[3] = t24;
+    w.a_r_hip_yaw_link[4] = t25;
+    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t0 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t1 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t2 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t0;
-    const Scalar t3 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t0;
-    const Scalar t4 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t5 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t6 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t2 + w.sq_r_hip_yaw_link*t3;
-    const Scalar t7 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t2 + w.cq_r_hip_yaw_link*t3;
-    const Scalar t8 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t4 + w.sq_r_hip_yaw_link*t5;
-    const Scalar t9 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t4 + w.cq_r_hip_yaw_link*t5;
-    const Scalar t10 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t6 - w.IA_r_hip_yaw_link[10]*t7 - w.IA_r_hip_yaw_link[14]*t1 - w.IA_r_hip_yaw_link[19]*t9 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t10;
-    w.a_r_hip_yaw_link[0] = t6;
-    w.a_r_hip_yaw_link[1] = t7;
-    w.a_r_hip_yaw_link[2] = t1;
-    w.a_r_hip_yaw_link[3] = t8;
-    w.a_r_hip_yaw_link[4] = t9;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    const Scalar t11 = w.c_r_hip_roll_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t12 = w.c_r_hip_roll_link[2] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[2];
-    const Scalar t13 = w.c_r_hip_roll_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t14 = w.c_r_hip_roll_link[5] - w.sq_r_hip_roll_link*w.a_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*w.a_r_hip_yaw_link[5];
-    const Scalar t15 = w.u_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*w.a_r_hip_yaw_link[0] - w.IA_r_hip_roll_link[8]*t11 - w.IA_r_hip_roll_link[12]*t12 - w.IA_r_hip_roll_link[15]*w.a_r_hip_yaw_link[3] - w.IA_r_hip_roll_link[17]*t14;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t15;
+    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
+    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
+    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
+    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
+    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
+    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
     w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = t11;
-    w.a_r_hip_roll_link[2] = t12;
+    w.a_r_hip_roll_link[1] = t0;
+    w.a_r_hip_roll_link[2] = t1;
     w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = t13;
-    w.a_r_hip_roll_link[5] = t14;
+    w.a_r_hip_roll_link[4] = t2;
+    w.a_r_hip_roll_link[5] = t3;
   }
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
-    const Scalar t16 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t17 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t18 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t19 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t20 = w.c_r_thigh[0] + w.cq_r_thigh*t16 - w.sq_r_thigh*t17;
-    const Scalar t21 = w.c_r_thigh[2] + w.sq_r_thigh*t16 + w.cq_r_thigh*t17;
-    const Scalar t22 = w.c_r_thigh[3] + w.cq_r_thigh*t18 - w.sq_r_thigh*t19;
-    const Scalar t23 = w.c_r_thigh[5] + w.sq_r_thigh*t18 + w.cq_r_thigh*t19;
-    const Scalar t24 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t20 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t21 - w.IA_r_thigh[16]*t22 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t23;
-    w.qdd[14] = w.Dinv_r_thigh*t24;
-    w.a_r_thigh[0] = t20;
+    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
+    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
+    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
+    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
+    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
+    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
+    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
+    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
+    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
+    w.qdd[14] = w.Dinv_r_thigh*t13;
+    w.a_r_thigh[0] = t9;
     w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = t21;
-    w.a_r_thigh[3] = t22;
+    w.a_r_thigh[2] = t10;
+    w.a_r_thigh[3] = t11;
     w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = t23;
+    w.a_r_thigh[5] = t12;
+  }
+  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  {
+    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
+    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
+    const Scalar t16 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
+    const Scalar t17 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
+    const Scalar t18 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
+    const Scalar t19 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
+    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
+    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
+    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
+    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
+    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
+    w.qdd[15] = w.Dinv_r_shank*t24;
+    w.a_r_shank[0] = t20;
+    w.a_r_shank[1] = t15;
+    w.a_r_shank[2] = t21;
+    w.a_r_shank[3] = t22;
+    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
+    w.a_r_shank[5] = t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t0 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t1 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t2 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t0;
-    const Scalar t3 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t0;
-    const Scalar t4 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t5 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t6 = w.c_r_shank[0] + w.cq_r_shank*t2 - w.sq_r_shank*t3;
-    const Scalar t7 = w.c_r_shank[2] + w.sq_r_shank*t2 + w.cq_r_shank*t3;
-    const Scalar t8 = w.c_r_shank[3] + w.cq_r_shank*t4 - w.sq_r_shank*t5;
-    const Scalar t9 = w.c_r_shank[5] + w.sq_r_shank*t4 + w.cq_r_shank*t5;
-    const Scalar t10 = w.u_r_shank[0] - w.IA_r_shank[4]*t6 - w.IA_r_shank[9]*t1 - w.IA_r_shank[13]*t7 - w.IA_r_shank[16]*t8 - w.a_r_thigh[4]*w.IA_r_shank[18] - w.IA_r_shank[19]*t9;
-    w.qdd[15] = w.Dinv_r_shank*t10;
-    w.a_r_shank[0] = t6;
-    w.a_r_shank[1] = t1;
-    w.a_r_shank[2] = t7;
-    w.a_r_shank[3] = t8;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = t9;
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
-    const Scalar t11 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t12 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t13 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t11;
-    const Scalar t14 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t11;
-    const Scalar t15 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t16 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t17 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t13 - w.sq_r_ankle_link*t14;
-    const Scalar t18 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t13 + w.cq_r_ankle_link*t14;
-    const Scalar t19 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t15 - w.sq_r_ankle_link*t16;
-    const Scalar t20 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t15 + w.cq_r_ankle_link*t16;
-    const Scalar t21 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t17 - w.IA_r_ankle_link[9]*t12 - w.IA_r_ankle_link[13]*t18 - w.IA_r_ankle_link[18]*w.a_r_shank[4] - w.IA_r_ankle_link[19]*t20;
-    w.qdd[16] = w.Dinv_r_ankle_link*t21;
-    w.a_r_ankle_link[0] = t17;
-    w.a_r_ankle_link[1] = t12;
-    w.a_r_ankle_link[2] = t18;
-    w.a_r_ankle_link[3] = t19;
+    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
+    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
+    const Scalar t2 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
+    const Scalar t3 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
+    const Scalar t4 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
+    const Scalar t5 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
+    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
+    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
+    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
+    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
+    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
+    w.qdd[16] = w.Dinv_r_ankle_link*t10;
+    w.a_r_ankle_link[0] = t6;
+    w.a_r_ankle_link[1] = t1;
+    w.a_r_ankle_link[2] = t7;
+    w.a_r_ankle_link[3] = t8;
     w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = t20;
+    w.a_r_ankle_link[5] = t9;
   }
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    const Scalar t22 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t23 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t24 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t25 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t26 = w.u_r_foot[0] - 0.0017863999999999998*t25 - w.U_r_foot[1]*t22 - w.U_r_foot[3]*w.a_r_ankle_link[3];
-    w.qdd[17] = w.Dinv_r_foot*t26;
+    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
+    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
+    const Scalar t15 = w.u_r_foot[0] - 0.0017863999999999998*t14 - w.U_r_foot[1]*t11 - w.U_r_foot[3]*w.a_r_ankle_link[3];
+    w.qdd[17] = w.Dinv_r_foot*t15;
     w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = t22;
-    w.a_r_foot[2] = t23;
+    w.a_r_foot[1] = t11;
+    w.a_r_foot[2] = t12;
     w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = t24;
-    w.a_r_foot[5] = t25;
+    w.a_r_foot[4] = t13;
+    w.a_r_foot[5] = t14;
+  }
+  // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
+  {
+    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.qdd[18] = w.Dinv_abdomen*t22;
+    w.a_abdomen[0] = t18;
+    w.a_abdomen[1] = t19;
+    w.a_abdomen[2] = w.a_pelvis[2];
+    w.a_abdomen[3] = t20;
+    w.a_abdomen[4] = t21;
+    w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t0 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t1 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t2 = w.c_abdomen[0] + w.cq_abdomen*t0 + w.sq_abdomen*t1;
-    const Scalar t3 = w.c_abdomen[1] - w.sq_abdomen*t0 + w.cq_abdomen*t1;
-    const Scalar t4 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t5 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t6 = w.u_abdomen[0] - w.IA_abdomen[5]*t2 - w.IA_abdomen[10]*t3 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t4 - w.IA_abdomen[19]*t5 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t6;
-    w.a_abdomen[0] = t2;
-    w.a_abdomen[1] = t3;
-    w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = t4;
-    w.a_abdomen[4] = t5;
-    w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    const Scalar t7 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t8 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t9 = w.c_chest[0] + w.cq_chest*t7 - w.sq_chest*w.a_abdomen[2];
-    const Scalar t10 = w.c_chest[2] + w.sq_chest*t7 + w.cq_chest*w.a_abdomen[2];
-    const Scalar t11 = w.c_chest[3] + w.cq_chest*w.a_abdomen[3] - w.sq_chest*w.a_abdomen[5];
-    const Scalar t12 = w.c_chest[5] + w.sq_chest*w.a_abdomen[3] + w.cq_chest*w.a_abdomen[5];
-    const Scalar t13 = w.u_chest[0] - w.IA_chest[4]*t9 - w.IA_chest[9]*t8 - w.IA_chest[13]*t10 - w.IA_chest[16]*t11 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t12;
-    w.qdd[19] = w.Dinv_chest*t13;
-    w.a_chest[0] = t9;
-    w.a_chest[1] = t8;
-    w.a_chest[2] = t10;
-    w.a_chest[3] = t11;
+    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
+    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
+    w.qdd[19] = w.Dinv_chest*t6;
+    w.a_chest[0] = t2;
+    w.a_chest[1] = t1;
+    w.a_chest[2] = t3;
+    w.a_chest[3] = t4;
     w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = t12;
+    w.a_chest[5] = t5;
   }
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    const Scalar t14 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t15 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t16 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t17 = 0.9848134698792882*t14 + 0.17361575258114187*t16;
-    const Scalar t18 = 0.04493516596384369*t14 + 0.9659256678396477*t15 - 0.2548890642384102*t16;
-    const Scalar t19 = -0.1676999117594225*t14 + 0.2588196364430848*t15 + 0.9512566085906322*t16;
-    const Scalar t20 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t21 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t22 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t23 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t17 - w.sq_r_shoulder_pitch_link*t19;
-    const Scalar t24 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t17 + w.cq_r_shoulder_pitch_link*t19;
-    const Scalar t25 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t20 - w.sq_r_shoulder_pitch_link*t22;
-    const Scalar t26 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t20 + w.cq_r_shoulder_pitch_link*t22;
-    const Scalar t27 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t23 - w.IA_r_shoulder_pitch_link[9]*t18 - w.IA_r_shoulder_pitch_link[13]*t24 - w.IA_r_shoulder_pitch_link[18]*t21 - w.IA_r_shoulder_pitch_link[19]*t26;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t27;
-    w.a_r_shoulder_pitch_link[0] = t23;
-    w.a_r_shoulder_pitch_link[1] = t18;
-    w.a_r_shoulder_pitch_link[2] = t24;
-    w.a_r_shoulder_pitch_link[3] = t25;
-    w.a_r_shoulder_pitch_link[4] = t21 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = t26;
+    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t10 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
+    const Scalar t11 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
+    const Scalar t12 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
+    const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
+    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
+    w.a_r_shoulder_pitch_link[0] = t16;
+    w.a_r_shoulder_pitch_link[1] = t11;
+    w.a_r_shoulder_pitch_link[2] = t17;
+    w.a_r_shoulder_pitch_link[3] = t18;
+    w.a_r_shoulder_pitch_link[4] = t14 + w.qdd[29];
+    w.a_r_shoulder_pitch_link[5] = t19;
+  }
+  // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+  {
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
+    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
+    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
+    w.a_r_shoulder_roll_link[1] = t21;
+    w.a_r_shoulder_roll_link[2] = t22;
+    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
+    w.a_r_shoulder_roll_link[4] = t23;
+    w.a_r_shoulder_roll_link[5] = t24;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t0 = w.c_r_shoulder_roll_link[1] + w.a_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
-    const Scalar t1 = w.c_r_shoulder_roll_link[2] - w.a_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
-    const Scalar t2 = w.c_r_shoulder_roll_link[4] + w.a_r_shoulder_pitch_link[4]*w.cq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.sq_r_shoulder_roll_link;
-    const Scalar t3 = w.c_r_shoulder_roll_link[5] - w.a_r_shoulder_pitch_link[4]*w.sq_r_shoulder_roll_link + w.a_r_shoulder_pitch_link[5]*w.cq_r_shoulder_roll_link;
-    const Scalar t4 = w.u_r_shoulder_roll_link[0] - w.a_r_shoulder_pitch_link[0]*w.IA_r_shoulder_roll_link[3] - w.IA_r_shoulder_roll_link[8]*t0 - w.IA_r_shoulder_roll_link[12]*t1 - w.a_r_shoulder_pitch_link[3]*w.IA_r_shoulder_roll_link[15] - w.IA_r_shoulder_roll_link[16]*t2;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t4;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = t0;
-    w.a_r_shoulder_roll_link[2] = t1;
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = t2;
-    w.a_r_shoulder_roll_link[5] = t3;
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t5 = w.c_r_upper_arm[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t6 = w.c_r_upper_arm[1] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[0] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[1];
-    const Scalar t7 = w.c_r_upper_arm[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.sq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t8 = w.c_r_upper_arm[4] - w.sq_r_upper_arm*w.a_r_shoulder_roll_link[3] + w.cq_r_upper_arm*w.a_r_shoulder_roll_link[4];
-    const Scalar t9 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t5 - w.IA_r_upper_arm[10]*t6 - w.IA_r_upper_arm[14]*w.a_r_shoulder_roll_link[2] - w.IA_r_upper_arm[17]*t7 - w.IA_r_upper_arm[19]*t8 - w.IA_r_upper_arm[20]*w.a_r_shoulder_roll_link[5];
-    w.qdd[31] = w.Dinv_r_upper_arm*t9;
-    w.a_r_upper_arm[0] = t5;
-    w.a_r_upper_arm[1] = t6;
+    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
+    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
+    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
+    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    w.qdd[31] = w.Dinv_r_upper_arm*t4;
+    w.a_r_upper_arm[0] = t0;
+    w.a_r_upper_arm[1] = t1;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = t7;
-    w.a_r_upper_arm[4] = t8;
+    w.a_r_upper_arm[3] = t2;
+    w.a_r_upper_arm[4] = t3;
     w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
   }
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    const Scalar t10 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t11 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t12 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t10;
-    const Scalar t13 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t10;
-    const Scalar t14 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t15 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t16 = w.c_r_forearm[0] + w.cq_r_forearm*t12 - w.sq_r_forearm*t13;
-    const Scalar t17 = w.c_r_forearm[2] + w.sq_r_forearm*t12 + w.cq_r_forearm*t13;
-    const Scalar t18 = w.c_r_forearm[3] + w.cq_r_forearm*t14 - w.sq_r_forearm*t15;
-    const Scalar t19 = w.c_r_forearm[5] + w.sq_r_forearm*t14 + w.cq_r_forearm*t15;
-    const Scalar t20 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t16 - w.IA_r_forearm[9]*t11 - w.IA_r_forearm[13]*t17 - w.IA_r_forearm[16]*t18 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t20;
-    w.a_r_forearm[0] = t16;
-    w.a_r_forearm[1] = t11;
-    w.a_r_forearm[2] = t17;
-    w.a_r_forearm[3] = t18;
+    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t7 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
+    const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
+    const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
+    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
+    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
+    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    w.qdd[32] = w.Dinv_r_forearm*t15;
+    w.a_r_forearm[0] = t11;
+    w.a_r_forearm[1] = t6;
+    w.a_r_forearm[2] = t12;
+    w.a_r_forearm[3] = t13;
     w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = t19;
+    w.a_r_forearm[5] = t14;
+  }
+  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+  {
+    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
+    w.a_r_wrist_yaw_link[0] = t18;
+    w.a_r_wrist_yaw_link[1] = t19;
+    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
+    w.a_r_wrist_yaw_link[3] = t20;
+    w.a_r_wrist_yaw_link[4] = t21;
+    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_42(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    const Scalar t0 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t1 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t2 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
-    const Scalar t3 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
-    const Scalar t4 = w.c_r_wrist_yaw_link[3] + w.a_r_forearm[3]*w.cq_r_wrist_yaw_link + w.a_r_forearm[4]*w.sq_r_wrist_yaw_link;
-    const Scalar t5 = w.c_r_wrist_yaw_link[4] - w.a_r_forearm[3]*w.sq_r_wrist_yaw_link + w.a_r_forearm[4]*w.cq_r_wrist_yaw_link;
-    const Scalar t6 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t2 - w.IA_r_wrist_yaw_link[10]*t3 - w.a_r_forearm[2]*w.IA_r_wrist_yaw_link[14] - w.IA_r_wrist_yaw_link[17]*t4 - w.a_r_forearm[5]*w.IA_r_wrist_yaw_link[20];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t6;
-    w.a_r_wrist_yaw_link[0] = t2;
-    w.a_r_wrist_yaw_link[1] = t3;
-    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = t4;
-    w.a_r_wrist_yaw_link[4] = t5;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t7 = w.c_r_wrist_pitch_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t8 = w.c_r_wrist_pitch_link[2] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[2];
-    const Scalar t9 = w.c_r_wrist_pitch_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] - w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t10 = w.c_r_wrist_pitch_link[5] + w.sq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*w.a_r_wrist_yaw_link[5];
-    const Scalar t11 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t7 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t10;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t11;
-    w.a_r_wrist_pitch_link[0] = t7;
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
+    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
+    w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = t8;
-    w.a_r_wrist_pitch_link[3] = t9;
+    w.a_r_wrist_pitch_link[2] = t1;
+    w.a_r_wrist_pitch_link[3] = t2;
     w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = t10;
+    w.a_r_wrist_pitch_link[5] = t3;
   }
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t12 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t13 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t14 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t15 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t16 = w.u_r_hand[0] - w.U_r_hand[1]*t12 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
-    w.qdd[35] = w.Dinv_r_hand*t16;
+    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t9 = w.u_r_hand[0] - w.U_r_hand[1]*t5 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
+    w.qdd[35] = w.Dinv_r_hand*t9;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = t12;
-    w.a_r_hand[2] = t13;
+    w.a_r_hand[1] = t5;
+    w.a_r_hand[2] = t6;
     w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = t14;
-    w.a_r_hand[5] = t15;
+    w.a_r_hand[4] = t7;
+    w.a_r_hand[5] = t8;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t17 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = mu*t17;
+    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = mu*t0;
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t18 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t18;
+    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t19 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t19;
+    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
     w.dlambda[3] = w.a_l_foot[3]*mu;
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
@@ -4678,14 +4677,14 @@ PROXGEN_RT_NOINLINE void caba_42(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
     w.dlambda[5] = w.a_l_foot[5]*mu;
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t20 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t20;
+    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*t3;
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t21 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t21;
+    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*t4;
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t22 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t22;
+    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*t5;
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
     w.dlambda[9] = w.a_r_foot[3]*mu;
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
@@ -4693,19 +4692,19 @@ PROXGEN_RT_NOINLINE void caba_42(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
     w.dlambda[11] = w.a_r_foot[5]*mu;
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    const Scalar t23 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.dlambda[12] = mu*t23;
+    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.dlambda[12] = mu*t6;
     w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    const Scalar t24 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
-    w.dlambda[13] = mu*t24;
+    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.dlambda[13] = mu*t7;
     w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    const Scalar t25 = -w.k_right_hand[2] + w.a_r_hand[2];
-    w.dlambda[14] = mu*t25;
+    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
+    w.dlambda[14] = mu*t8;
     w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_0(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
     const Scalar t0 = w.a_chest[0] + 0.254*w.a_chest[4] - 0.19*w.a_chest[5];
@@ -4762,7 +4761,7 @@ PROXGEN_RT_NOINLINE void accelerate_free_0(Workspace& PROXGEN_RT_RESTRICT w) noe
   }
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_1(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
     const Scalar t0 = w.a_l_upper_arm[0] - 0.3255*w.a_l_upper_arm[4];
@@ -4818,12 +4817,12 @@ PROXGEN_RT_NOINLINE void accelerate_free_1(Workspace& PROXGEN_RT_RESTRICT w) noe
   }
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_l_hand_to_head(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
     const Scalar t0 = w.c_l_hand[1] + w.a_l_wrist_pitch_link[1]*w.cq_l_hand + w.a_l_wrist_pitch_link[2]*w.sq_l_hand;
     const Scalar t4 = -0.005164645770899999*w.a_l_wrist_pitch_link[3] + w.u_l_hand[0] - 0.04016628*t0;
-    w.qdd[26] = w.Dinv_l_hand*t4;
+    w.qdd[26] = 193.62412145174838*t4;
   }
   // accelerate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
@@ -4847,31 +4846,26 @@ PROXGEN_RT_NOINLINE void accelerate_free_2(Workspace& PROXGEN_RT_RESTRICT w) noe
     const Scalar t12 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
     const Scalar t14 = w.c_head[0] + w.cq_head*t12 - w.sq_head*w.a_neck_link[2];
     const Scalar t18 = w.u_head[0] - 0.07202788281129999*w.a_neck_link[4] - 0.4717625*t14;
-    w.qdd[28] = w.Dinv_head*t18;
+    w.qdd[28] = 13.88351234229415*t18;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_hand_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    w.Dinv_r_hand = 1.0 / 0.005164645770899999;
     w.u_r_hand[0] = -w.pA_r_hand[3] + tau[35];
-    const Scalar Ia0 = 0.42 - 0.0016133300490384*w.Dinv_r_hand;
     const Scalar pa0 = -0.04016628*w.c_r_hand[4] + w.pA_r_hand[0];
-    const Scalar pa1 = w.pA_r_hand[1] + 0.04016628*w.Dinv_r_hand*w.u_r_hand[0] + w.c_r_hand[1]*Ia0;
+    const Scalar pa1 = 0.1076203866432337*w.c_r_hand[1] + w.pA_r_hand[1] + 7.7771606769849315*w.u_r_hand[0];
     const Scalar pa2 = 0.42*w.c_r_hand[2] + w.pA_r_hand[2];
-    const Scalar pa3 = w.pA_r_hand[3] + 0.005164645770899999*w.Dinv_r_hand*w.u_r_hand[0];
+    const Scalar pa3 = w.pA_r_hand[3] + w.u_r_hand[0];
     const Scalar pa4 = 0.005164645770899999*w.c_r_hand[4] + w.pA_r_hand[4];
     const Scalar pa5 = 0.000284375*w.c_r_hand[5] + w.pA_r_hand[5];
     const Scalar C20 = w.cq_r_hand*w.cq_r_hand - w.sq_r_hand*w.sq_r_hand;
-    const Scalar h0 = -0.21 + 0.5*Ia0;
-    const Scalar m0 = 0.21 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_r_hand*w.sq_r_hand;
     w.IA_r_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq_r_hand;
     w.IA_r_wrist_pitch_link[5] = -0.04016628*w.sq_r_hand;
-    w.IA_r_wrist_pitch_link[6] = 0.1 + m0 + C20*h0;
-    w.IA_r_wrist_pitch_link[7] = h0*t0;
-    w.IA_r_wrist_pitch_link[11] = 0.1 + m0 - C20*h0;
+    w.IA_r_wrist_pitch_link[6] = 0.3638101933216168 - 0.15618980667838314*C20;
+    w.IA_r_wrist_pitch_link[7] = -0.3123796133567663*w.cq_r_hand*w.sq_r_hand;
+    w.IA_r_wrist_pitch_link[11] = 0.3638101933216168 + 0.15618980667838314*C20;
     w.IA_r_wrist_pitch_link[18] = 0.0027595103854499993 + 0.0024401353854499996*C20;
     w.IA_r_wrist_pitch_link[19] = 0.004880270770899999*w.cq_r_hand*w.sq_r_hand;
     w.IA_r_wrist_pitch_link[20] = 0.0027495103854499993 - 0.0024401353854499996*C20;
@@ -4881,75 +4875,73 @@ PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_wrist_pitch_link[3] = w.pA_r_wrist_pitch_link[3] + pa3;
     w.pA_r_wrist_pitch_link[4] = w.pA_r_wrist_pitch_link[4] + w.cq_r_hand*pa4 - w.sq_r_hand*pa5;
     w.pA_r_wrist_pitch_link[5] = w.pA_r_wrist_pitch_link[5] + w.sq_r_hand*pa4 + w.cq_r_hand*pa5;
-    w.KSD_r_hand[0] = 0.13*w.Dinv_r_hand;
-    const Scalar t1 = 1.0 - 0.0052216164*w.Dinv_r_hand;
-    w.KA_r_wrist_pitch_link[4] = w.cq_r_hand*t1;
-    w.KA_r_wrist_pitch_link[8] = w.sq_r_hand*t1;
-    w.KA_r_wrist_pitch_link[17] = 0.13*w.cq_r_hand;
-    w.KA_r_wrist_pitch_link[21] = 0.13*w.sq_r_hand;
-    w.KA_r_wrist_pitch_link[6] = -w.sq_r_hand;
-    w.KA_r_wrist_pitch_link[10] = w.cq_r_hand;
+    w.KA_r_wrist_pitch_link[1][0] = -0.011030888008041195*w.cq_r_hand;
+    w.KA_r_wrist_pitch_link[2][0] = -0.011030888008041195*w.sq_r_hand;
+    w.KA_r_wrist_pitch_link[4][1] = 0.13*w.cq_r_hand;
+    w.KA_r_wrist_pitch_link[5][1] = 0.13*w.sq_r_hand;
+    w.KA_r_wrist_pitch_link[1][2] = -w.sq_r_hand;
+    w.KA_r_wrist_pitch_link[2][2] = w.cq_r_hand;
   }
   // eliminate, carrying the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
     w.Dinv_r_wrist_pitch_link = 1.0 / w.IA_r_wrist_pitch_link[18];
     w.u_r_wrist_pitch_link[0] = -w.pA_r_wrist_pitch_link[4] + tau[34];
-    const Scalar t2 = w.IA_r_wrist_pitch_link[4]*w.Dinv_r_wrist_pitch_link;
-    const Scalar t3 = w.IA_r_wrist_pitch_link[18]*w.Dinv_r_wrist_pitch_link;
-    const Scalar t4 = w.IA_r_wrist_pitch_link[19]*w.Dinv_r_wrist_pitch_link;
-    const Scalar Ia1 = 0.52 - w.IA_r_wrist_pitch_link[4]*t2;
-    const Scalar Ia2 = w.IA_r_wrist_pitch_link[5] - w.IA_r_wrist_pitch_link[19]*t2;
-    const Scalar Ia3 = w.IA_r_wrist_pitch_link[20] - w.IA_r_wrist_pitch_link[19]*t4;
-    const Scalar pa6 = w.pA_r_wrist_pitch_link[0] + w.u_r_wrist_pitch_link[0]*t2 + w.c_r_wrist_pitch_link[0]*Ia1 + w.c_r_wrist_pitch_link[5]*Ia2;
+    const Scalar t0 = w.IA_r_wrist_pitch_link[4]*w.Dinv_r_wrist_pitch_link;
+    const Scalar t1 = w.IA_r_wrist_pitch_link[18]*w.Dinv_r_wrist_pitch_link;
+    const Scalar t2 = w.IA_r_wrist_pitch_link[19]*w.Dinv_r_wrist_pitch_link;
+    const Scalar Ia0 = 0.52 - w.IA_r_wrist_pitch_link[4]*t0;
+    const Scalar Ia1 = w.IA_r_wrist_pitch_link[5] - w.IA_r_wrist_pitch_link[19]*t0;
+    const Scalar Ia2 = w.IA_r_wrist_pitch_link[20] - w.IA_r_wrist_pitch_link[19]*t2;
+    const Scalar pa6 = w.pA_r_wrist_pitch_link[0] + w.u_r_wrist_pitch_link[0]*t0 + w.c_r_wrist_pitch_link[0]*Ia0 + w.c_r_wrist_pitch_link[5]*Ia1;
     const Scalar pa7 = 0.001*w.c_r_wrist_pitch_link[3] + w.pA_r_wrist_pitch_link[1] + w.c_r_wrist_pitch_link[2]*w.IA_r_wrist_pitch_link[7];
     const Scalar pa8 = w.pA_r_wrist_pitch_link[2] + w.c_r_wrist_pitch_link[2]*w.IA_r_wrist_pitch_link[11];
     const Scalar pa9 = 3.5000000000000004e-05*w.c_r_wrist_pitch_link[3] + w.pA_r_wrist_pitch_link[3];
-    const Scalar pa10 = w.pA_r_wrist_pitch_link[4] + w.u_r_wrist_pitch_link[0]*t3;
-    const Scalar pa11 = w.pA_r_wrist_pitch_link[5] + w.u_r_wrist_pitch_link[0]*t4 + w.c_r_wrist_pitch_link[0]*Ia2 + w.c_r_wrist_pitch_link[5]*Ia3;
+    const Scalar pa10 = w.pA_r_wrist_pitch_link[4] + w.u_r_wrist_pitch_link[0]*t1;
+    const Scalar pa11 = w.pA_r_wrist_pitch_link[5] + w.u_r_wrist_pitch_link[0]*t2 + w.c_r_wrist_pitch_link[0]*Ia1 + w.c_r_wrist_pitch_link[5]*Ia2;
     const Scalar C21 = w.cq_r_wrist_pitch_link*w.cq_r_wrist_pitch_link - w.sq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
-    const Scalar h1 = 0.5*(w.IA_r_wrist_pitch_link[11] - Ia1);
-    const Scalar m1 = 0.5*(w.IA_r_wrist_pitch_link[11] + Ia1);
-    const Scalar t5 = 2.0*w.cq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
-    const Scalar h2 = -1.7500000000000002e-05 + 0.5*Ia3;
-    const Scalar m2 = 1.7500000000000002e-05 + 0.5*Ia3;
-    w.IA_r_wrist_yaw_link[0] = 0.1 + m1 - C21*h1;
+    const Scalar h0 = 0.5*(w.IA_r_wrist_pitch_link[11] - Ia0);
+    const Scalar m0 = 0.5*(w.IA_r_wrist_pitch_link[11] + Ia0);
+    const Scalar t3 = 2.0*w.cq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
+    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia2;
+    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia2;
+    w.IA_r_wrist_yaw_link[0] = 0.1 + m0 - C21*h0;
     w.IA_r_wrist_yaw_link[1] = w.sq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
-    w.IA_r_wrist_yaw_link[2] = h1*t5;
-    w.IA_r_wrist_yaw_link[3] = 0.5*Ia2*t5;
-    w.IA_r_wrist_yaw_link[5] = 0.5*(Ia2 + Ia2*C21);
+    w.IA_r_wrist_yaw_link[2] = h0*t3;
+    w.IA_r_wrist_yaw_link[3] = 0.5*Ia1*t3;
+    w.IA_r_wrist_yaw_link[5] = 0.5*(Ia1 + Ia1*C21);
     w.IA_r_wrist_yaw_link[6] = 0.1 + w.IA_r_wrist_pitch_link[6];
     w.IA_r_wrist_yaw_link[7] = w.cq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
     w.IA_r_wrist_yaw_link[8] = -0.001 + 0.001*w.cq_r_wrist_pitch_link;
     w.IA_r_wrist_yaw_link[10] = -0.001*w.sq_r_wrist_pitch_link;
-    w.IA_r_wrist_yaw_link[11] = 0.1 + m1 + C21*h1;
-    w.IA_r_wrist_yaw_link[12] = 0.5*(-Ia2 + Ia2*C21);
-    w.IA_r_wrist_yaw_link[14] = -0.5*Ia2*t5;
-    w.IA_r_wrist_yaw_link[15] = 3.5000000000000004e-05 + m2 - C21*h2;
-    w.IA_r_wrist_yaw_link[17] = t5*h2;
-    w.IA_r_wrist_yaw_link[20] = 2.5e-05 + m2 + C21*h2;
+    w.IA_r_wrist_yaw_link[11] = 0.1 + m0 + C21*h0;
+    w.IA_r_wrist_yaw_link[12] = 0.5*(-Ia1 + Ia1*C21);
+    w.IA_r_wrist_yaw_link[14] = -0.5*Ia1*t3;
+    w.IA_r_wrist_yaw_link[15] = 3.5000000000000004e-05 + m1 - C21*h1;
+    w.IA_r_wrist_yaw_link[17] = t3*h1;
+    w.IA_r_wrist_yaw_link[20] = 2.5e-05 + m1 + C21*h1;
     w.pA_r_wrist_yaw_link[0] = w.pA_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*pa6 + w.sq_r_wrist_pitch_link*pa8;
     w.pA_r_wrist_yaw_link[1] = w.pA_r_wrist_yaw_link[1] + pa7;
     w.pA_r_wrist_yaw_link[2] = w.pA_r_wrist_yaw_link[2] - w.sq_r_wrist_pitch_link*pa6 + w.cq_r_wrist_pitch_link*pa8;
     w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*pa9 + w.sq_r_wrist_pitch_link*pa11;
     w.pA_r_wrist_yaw_link[4] = w.pA_r_wrist_yaw_link[4] + pa10;
     w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq_r_wrist_pitch_link*pa9 + w.cq_r_wrist_pitch_link*pa11;
-    w.KA_r_wrist_yaw_link[0] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[8];
-    w.KA_r_wrist_yaw_link[4] = w.KA_r_wrist_pitch_link[4];
-    w.KA_r_wrist_yaw_link[8] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[8];
-    w.KSD_r_wrist_pitch_link[1] = w.KA_r_wrist_pitch_link[17]*w.Dinv_r_wrist_pitch_link;
-    const Scalar t6 = -1.0 - w.KA_r_wrist_pitch_link[17]*t2;
-    const Scalar t7 = w.KA_r_wrist_pitch_link[21] - w.KA_r_wrist_pitch_link[17]*t4;
-    w.KA_r_wrist_yaw_link[1] = w.cq_r_wrist_pitch_link*t6;
-    w.KA_r_wrist_yaw_link[9] = -w.sq_r_wrist_pitch_link*t6;
-    w.KA_r_wrist_yaw_link[13] = w.sq_r_wrist_pitch_link*t7;
-    w.KA_r_wrist_yaw_link[21] = w.cq_r_wrist_pitch_link*t7;
-    w.KA_r_wrist_yaw_link[2] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[10];
-    w.KA_r_wrist_yaw_link[6] = w.KA_r_wrist_pitch_link[6];
-    w.KA_r_wrist_yaw_link[10] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[10];
+    w.KA_r_wrist_yaw_link[0][0] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][0];
+    w.KA_r_wrist_yaw_link[1][0] = w.KA_r_wrist_pitch_link[1][0];
+    w.KA_r_wrist_yaw_link[2][0] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][0];
+    w.KSD_r_wrist_pitch_link[1] = w.KA_r_wrist_pitch_link[4][1]*w.Dinv_r_wrist_pitch_link;
+    const Scalar t4 = -1.0 - w.KA_r_wrist_pitch_link[4][1]*t0;
+    const Scalar t5 = w.KA_r_wrist_pitch_link[5][1] - w.KA_r_wrist_pitch_link[4][1]*t2;
+    w.KA_r_wrist_yaw_link[0][1] = w.cq_r_wrist_pitch_link*t4;
+    w.KA_r_wrist_yaw_link[2][1] = -w.sq_r_wrist_pitch_link*t4;
+    w.KA_r_wrist_yaw_link[3][1] = w.sq_r_wrist_pitch_link*t5;
+    w.KA_r_wrist_yaw_link[5][1] = w.cq_r_wrist_pitch_link*t5;
+    w.KA_r_wrist_yaw_link[0][2] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][2];
+    w.KA_r_wrist_yaw_link[1][2] = w.KA_r_wrist_pitch_link[1][2];
+    w.KA_r_wrist_yaw_link[2][2] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][2];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     w.Dinv_r_wrist_yaw_link = 1.0 / w.IA_r_wrist_yaw_link[20];
@@ -5023,36 +5015,36 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa3 - w.sq_r_wrist_yaw_link*pa4 + 0.2555*t22;
     w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa3 + w.cq_r_wrist_yaw_link*pa4 - 0.2555*t21;
     w.pA_r_forearm[5] = w.pA_r_forearm[5] + pa5;
-    const Scalar t23 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[4];
-    const Scalar t24 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[4];
-    w.KA_r_forearm[0] = t23;
-    w.KA_r_forearm[4] = t24;
-    w.KA_r_forearm[8] = w.KA_r_wrist_yaw_link[8];
-    w.KA_r_forearm[12] = 0.2555*t24;
-    w.KA_r_forearm[16] = -0.2555*t23;
-    w.KSD_r_wrist_yaw_link[1] = w.KA_r_wrist_yaw_link[21]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t25 = w.KA_r_wrist_yaw_link[1] - w.KA_r_wrist_yaw_link[21]*t0;
-    const Scalar t26 = w.KA_r_wrist_yaw_link[9] - w.KA_r_wrist_yaw_link[21]*t2;
-    const Scalar t27 = -w.KA_r_wrist_yaw_link[21]*t1;
-    const Scalar t28 = w.KA_r_wrist_yaw_link[13] - w.KA_r_wrist_yaw_link[21]*t3;
+    const Scalar t23 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][0] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][0];
+    const Scalar t24 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][0] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][0];
+    w.KA_r_forearm[0][0] = t23;
+    w.KA_r_forearm[1][0] = t24;
+    w.KA_r_forearm[2][0] = w.KA_r_wrist_yaw_link[2][0];
+    w.KA_r_forearm[3][0] = 0.2555*t24;
+    w.KA_r_forearm[4][0] = -0.2555*t23;
+    w.KSD_r_wrist_yaw_link[1] = w.KA_r_wrist_yaw_link[5][1]*w.Dinv_r_wrist_yaw_link;
+    const Scalar t25 = w.KA_r_wrist_yaw_link[0][1] - w.KA_r_wrist_yaw_link[5][1]*t0;
+    const Scalar t26 = w.KA_r_wrist_yaw_link[2][1] - w.KA_r_wrist_yaw_link[5][1]*t2;
+    const Scalar t27 = -w.KA_r_wrist_yaw_link[5][1]*t1;
+    const Scalar t28 = w.KA_r_wrist_yaw_link[3][1] - w.KA_r_wrist_yaw_link[5][1]*t3;
     const Scalar t29 = w.cq_r_wrist_yaw_link*t25 - w.sq_r_wrist_yaw_link*t27;
     const Scalar t30 = w.sq_r_wrist_yaw_link*t25 + w.cq_r_wrist_yaw_link*t27;
-    w.KA_r_forearm[1] = t29;
-    w.KA_r_forearm[5] = t30;
-    w.KA_r_forearm[9] = t26;
-    w.KA_r_forearm[13] = w.cq_r_wrist_yaw_link*t28 + 0.2555*t30;
-    w.KA_r_forearm[17] = w.sq_r_wrist_yaw_link*t28 - 0.2555*t29;
-    const Scalar t31 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[2] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[6];
-    const Scalar t32 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[2] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[6];
-    w.KA_r_forearm[2] = t31;
-    w.KA_r_forearm[6] = t32;
-    w.KA_r_forearm[10] = w.KA_r_wrist_yaw_link[10];
-    w.KA_r_forearm[14] = 0.2555*t32;
-    w.KA_r_forearm[18] = -0.2555*t31;
+    w.KA_r_forearm[0][1] = t29;
+    w.KA_r_forearm[1][1] = t30;
+    w.KA_r_forearm[2][1] = t26;
+    w.KA_r_forearm[3][1] = w.cq_r_wrist_yaw_link*t28 + 0.2555*t30;
+    w.KA_r_forearm[4][1] = w.sq_r_wrist_yaw_link*t28 - 0.2555*t29;
+    const Scalar t31 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][2] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][2];
+    const Scalar t32 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][2] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][2];
+    w.KA_r_forearm[0][2] = t31;
+    w.KA_r_forearm[1][2] = t32;
+    w.KA_r_forearm[2][2] = w.KA_r_wrist_yaw_link[2][2];
+    w.KA_r_forearm[3][2] = 0.2555*t32;
+    w.KA_r_forearm[4][2] = -0.2555*t31;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     w.Dinv_r_forearm = 1.0 / w.IA_r_forearm[18];
@@ -5149,55 +5141,55 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_upper_arm[3] = w.pA_r_upper_arm[3] + 0.3255*pa1 + 0.955336489125606*t37 - 0.29552020666133966*t38;
     w.pA_r_upper_arm[4] = w.pA_r_upper_arm[4] + pa4 - 0.3255*t39;
     w.pA_r_upper_arm[5] = w.pA_r_upper_arm[5] + 0.29552020666133966*t37 + 0.955336489125606*t38;
-    w.KSD_r_forearm[0] = w.KA_r_forearm[16]*w.Dinv_r_forearm;
-    const Scalar t41 = w.KA_r_forearm[0] - w.KA_r_forearm[16]*t0;
-    const Scalar t42 = w.KA_r_forearm[4] - w.KA_r_forearm[16]*t1;
-    const Scalar t43 = w.KA_r_forearm[8] - w.KA_r_forearm[16]*t2;
-    const Scalar t44 = w.KA_r_forearm[12] - w.KA_r_forearm[16]*t3;
+    w.KSD_r_forearm[0] = w.KA_r_forearm[4][0]*w.Dinv_r_forearm;
+    const Scalar t41 = w.KA_r_forearm[0][0] - w.KA_r_forearm[4][0]*t0;
+    const Scalar t42 = w.KA_r_forearm[1][0] - w.KA_r_forearm[4][0]*t1;
+    const Scalar t43 = w.KA_r_forearm[2][0] - w.KA_r_forearm[4][0]*t2;
+    const Scalar t44 = w.KA_r_forearm[3][0] - w.KA_r_forearm[4][0]*t3;
     const Scalar t45 = w.cq_r_forearm*t41 + w.sq_r_forearm*t43;
     const Scalar t46 = -w.sq_r_forearm*t41 + w.cq_r_forearm*t43;
     const Scalar t47 = 0.955336489125606*t45 - 0.29552020666133966*t46;
     const Scalar t48 = 0.29552020666133966*t45 + 0.955336489125606*t46;
-    w.KA_r_upper_arm[0] = t47;
-    w.KA_r_upper_arm[4] = t42;
-    w.KA_r_upper_arm[8] = t48;
-    w.KA_r_upper_arm[12] = 0.3255*t42 + 0.955336489125606*w.cq_r_forearm*t44 + 0.29552020666133966*w.sq_r_forearm*t44;
-    w.KA_r_upper_arm[16] = -0.3255*t47;
-    w.KA_r_upper_arm[20] = 0.29552020666133966*w.cq_r_forearm*t44 - 0.955336489125606*w.sq_r_forearm*t44;
-    w.KSD_r_forearm[1] = w.KA_r_forearm[17]*w.Dinv_r_forearm;
-    const Scalar t49 = w.KA_r_forearm[1] - w.KA_r_forearm[17]*t0;
-    const Scalar t50 = w.KA_r_forearm[5] - w.KA_r_forearm[17]*t1;
-    const Scalar t51 = w.KA_r_forearm[9] - w.KA_r_forearm[17]*t2;
-    const Scalar t52 = w.KA_r_forearm[13] - w.KA_r_forearm[17]*t3;
+    w.KA_r_upper_arm[0][0] = t47;
+    w.KA_r_upper_arm[1][0] = t42;
+    w.KA_r_upper_arm[2][0] = t48;
+    w.KA_r_upper_arm[3][0] = 0.3255*t42 + 0.955336489125606*w.cq_r_forearm*t44 + 0.29552020666133966*w.sq_r_forearm*t44;
+    w.KA_r_upper_arm[4][0] = -0.3255*t47;
+    w.KA_r_upper_arm[5][0] = 0.29552020666133966*w.cq_r_forearm*t44 - 0.955336489125606*w.sq_r_forearm*t44;
+    w.KSD_r_forearm[1] = w.KA_r_forearm[4][1]*w.Dinv_r_forearm;
+    const Scalar t49 = w.KA_r_forearm[0][1] - w.KA_r_forearm[4][1]*t0;
+    const Scalar t50 = w.KA_r_forearm[1][1] - w.KA_r_forearm[4][1]*t1;
+    const Scalar t51 = w.KA_r_forearm[2][1] - w.KA_r_forearm[4][1]*t2;
+    const Scalar t52 = w.KA_r_forearm[3][1] - w.KA_r_forearm[4][1]*t3;
     const Scalar t53 = w.cq_r_forearm*t49 + w.sq_r_forearm*t51;
     const Scalar t54 = -w.sq_r_forearm*t49 + w.cq_r_forearm*t51;
     const Scalar t55 = 0.955336489125606*t53 - 0.29552020666133966*t54;
     const Scalar t56 = 0.29552020666133966*t53 + 0.955336489125606*t54;
-    w.KA_r_upper_arm[1] = t55;
-    w.KA_r_upper_arm[5] = t50;
-    w.KA_r_upper_arm[9] = t56;
-    w.KA_r_upper_arm[13] = 0.3255*t50 + 0.955336489125606*w.cq_r_forearm*t52 + 0.29552020666133966*w.sq_r_forearm*t52;
-    w.KA_r_upper_arm[17] = -0.3255*t55;
-    w.KA_r_upper_arm[21] = 0.29552020666133966*w.cq_r_forearm*t52 - 0.955336489125606*w.sq_r_forearm*t52;
-    w.KSD_r_forearm[2] = w.KA_r_forearm[18]*w.Dinv_r_forearm;
-    const Scalar t57 = w.KA_r_forearm[2] - w.KA_r_forearm[18]*t0;
-    const Scalar t58 = w.KA_r_forearm[6] - w.KA_r_forearm[18]*t1;
-    const Scalar t59 = w.KA_r_forearm[10] - w.KA_r_forearm[18]*t2;
-    const Scalar t60 = w.KA_r_forearm[14] - w.KA_r_forearm[18]*t3;
+    w.KA_r_upper_arm[0][1] = t55;
+    w.KA_r_upper_arm[1][1] = t50;
+    w.KA_r_upper_arm[2][1] = t56;
+    w.KA_r_upper_arm[3][1] = 0.3255*t50 + 0.955336489125606*w.cq_r_forearm*t52 + 0.29552020666133966*w.sq_r_forearm*t52;
+    w.KA_r_upper_arm[4][1] = -0.3255*t55;
+    w.KA_r_upper_arm[5][1] = 0.29552020666133966*w.cq_r_forearm*t52 - 0.955336489125606*w.sq_r_forearm*t52;
+    w.KSD_r_forearm[2] = w.KA_r_forearm[4][2]*w.Dinv_r_forearm;
+    const Scalar t57 = w.KA_r_forearm[0][2] - w.KA_r_forearm[4][2]*t0;
+    const Scalar t58 = w.KA_r_forearm[1][2] - w.KA_r_forearm[4][2]*t1;
+    const Scalar t59 = w.KA_r_forearm[2][2] - w.KA_r_forearm[4][2]*t2;
+    const Scalar t60 = w.KA_r_forearm[3][2] - w.KA_r_forearm[4][2]*t3;
     const Scalar t61 = w.cq_r_forearm*t57 + w.sq_r_forearm*t59;
     const Scalar t62 = -w.sq_r_forearm*t57 + w.cq_r_forearm*t59;
     const Scalar t63 = 0.955336489125606*t61 - 0.29552020666133966*t62;
     const Scalar t64 = 0.29552020666133966*t61 + 0.955336489125606*t62;
-    w.KA_r_upper_arm[2] = t63;
-    w.KA_r_upper_arm[6] = t58;
-    w.KA_r_upper_arm[10] = t64;
-    w.KA_r_upper_arm[14] = 0.3255*t58 + 0.955336489125606*w.cq_r_forearm*t60 + 0.29552020666133966*w.sq_r_forearm*t60;
-    w.KA_r_upper_arm[18] = -0.3255*t63;
-    w.KA_r_upper_arm[22] = 0.29552020666133966*w.cq_r_forearm*t60 - 0.955336489125606*w.sq_r_forearm*t60;
+    w.KA_r_upper_arm[0][2] = t63;
+    w.KA_r_upper_arm[1][2] = t58;
+    w.KA_r_upper_arm[2][2] = t64;
+    w.KA_r_upper_arm[3][2] = 0.3255*t58 + 0.955336489125606*w.cq_r_forearm*t60 + 0.29552020666133966*w.sq_r_forearm*t60;
+    w.KA_r_upper_arm[4][2] = -0.3255*t63;
+    w.KA_r_upper_arm[5][2] = 0.29552020666133966*w.cq_r_forearm*t60 - 0.955336489125606*w.sq_r_forearm*t60;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.Dinv_r_upper_arm = 1.0 / w.IA_r_upper_arm[20];
@@ -5265,43 +5257,43 @@ PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shoulder_roll_link[3] = w.pA_r_shoulder_roll_link[3] + w.cq_r_upper_arm*pa3 - w.sq_r_upper_arm*pa4;
     w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
     w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + pa5;
-    w.KSD_r_upper_arm[0] = w.KA_r_upper_arm[20]*w.Dinv_r_upper_arm;
-    const Scalar t8 = w.KA_r_upper_arm[0] - w.KA_r_upper_arm[20]*t0;
-    const Scalar t9 = w.KA_r_upper_arm[4] - w.KA_r_upper_arm[20]*t1;
-    const Scalar t10 = w.KA_r_upper_arm[8] - w.KA_r_upper_arm[20]*t2;
-    const Scalar t11 = w.KA_r_upper_arm[12] - w.KA_r_upper_arm[20]*t3;
-    const Scalar t12 = w.KA_r_upper_arm[16] - w.KA_r_upper_arm[20]*t4;
-    w.KA_r_shoulder_roll_link[0] = w.cq_r_upper_arm*t8 - w.sq_r_upper_arm*t9;
-    w.KA_r_shoulder_roll_link[4] = w.sq_r_upper_arm*t8 + w.cq_r_upper_arm*t9;
-    w.KA_r_shoulder_roll_link[8] = t10;
-    w.KA_r_shoulder_roll_link[12] = w.cq_r_upper_arm*t11 - w.sq_r_upper_arm*t12;
-    w.KA_r_shoulder_roll_link[16] = w.sq_r_upper_arm*t11 + w.cq_r_upper_arm*t12;
-    w.KSD_r_upper_arm[1] = w.KA_r_upper_arm[21]*w.Dinv_r_upper_arm;
-    const Scalar t13 = w.KA_r_upper_arm[1] - w.KA_r_upper_arm[21]*t0;
-    const Scalar t14 = w.KA_r_upper_arm[5] - w.KA_r_upper_arm[21]*t1;
-    const Scalar t15 = w.KA_r_upper_arm[9] - w.KA_r_upper_arm[21]*t2;
-    const Scalar t16 = w.KA_r_upper_arm[13] - w.KA_r_upper_arm[21]*t3;
-    const Scalar t17 = w.KA_r_upper_arm[17] - w.KA_r_upper_arm[21]*t4;
-    w.KA_r_shoulder_roll_link[1] = w.cq_r_upper_arm*t13 - w.sq_r_upper_arm*t14;
-    w.KA_r_shoulder_roll_link[5] = w.sq_r_upper_arm*t13 + w.cq_r_upper_arm*t14;
-    w.KA_r_shoulder_roll_link[9] = t15;
-    w.KA_r_shoulder_roll_link[13] = w.cq_r_upper_arm*t16 - w.sq_r_upper_arm*t17;
-    w.KA_r_shoulder_roll_link[17] = w.sq_r_upper_arm*t16 + w.cq_r_upper_arm*t17;
-    w.KSD_r_upper_arm[2] = w.KA_r_upper_arm[22]*w.Dinv_r_upper_arm;
-    const Scalar t18 = w.KA_r_upper_arm[2] - w.KA_r_upper_arm[22]*t0;
-    const Scalar t19 = w.KA_r_upper_arm[6] - w.KA_r_upper_arm[22]*t1;
-    const Scalar t20 = w.KA_r_upper_arm[10] - w.KA_r_upper_arm[22]*t2;
-    const Scalar t21 = w.KA_r_upper_arm[14] - w.KA_r_upper_arm[22]*t3;
-    const Scalar t22 = w.KA_r_upper_arm[18] - w.KA_r_upper_arm[22]*t4;
-    w.KA_r_shoulder_roll_link[2] = w.cq_r_upper_arm*t18 - w.sq_r_upper_arm*t19;
-    w.KA_r_shoulder_roll_link[6] = w.sq_r_upper_arm*t18 + w.cq_r_upper_arm*t19;
-    w.KA_r_shoulder_roll_link[10] = t20;
-    w.KA_r_shoulder_roll_link[14] = w.cq_r_upper_arm*t21 - w.sq_r_upper_arm*t22;
-    w.KA_r_shoulder_roll_link[18] = w.sq_r_upper_arm*t21 + w.cq_r_upper_arm*t22;
+    w.KSD_r_upper_arm[0] = w.KA_r_upper_arm[5][0]*w.Dinv_r_upper_arm;
+    const Scalar t8 = w.KA_r_upper_arm[0][0] - w.KA_r_upper_arm[5][0]*t0;
+    const Scalar t9 = w.KA_r_upper_arm[1][0] - w.KA_r_upper_arm[5][0]*t1;
+    const Scalar t10 = w.KA_r_upper_arm[2][0] - w.KA_r_upper_arm[5][0]*t2;
+    const Scalar t11 = w.KA_r_upper_arm[3][0] - w.KA_r_upper_arm[5][0]*t3;
+    const Scalar t12 = w.KA_r_upper_arm[4][0] - w.KA_r_upper_arm[5][0]*t4;
+    w.KA_r_shoulder_roll_link[0][0] = w.cq_r_upper_arm*t8 - w.sq_r_upper_arm*t9;
+    w.KA_r_shoulder_roll_link[1][0] = w.sq_r_upper_arm*t8 + w.cq_r_upper_arm*t9;
+    w.KA_r_shoulder_roll_link[2][0] = t10;
+    w.KA_r_shoulder_roll_link[3][0] = w.cq_r_upper_arm*t11 - w.sq_r_upper_arm*t12;
+    w.KA_r_shoulder_roll_link[4][0] = w.sq_r_upper_arm*t11 + w.cq_r_upper_arm*t12;
+    w.KSD_r_upper_arm[1] = w.KA_r_upper_arm[5][1]*w.Dinv_r_upper_arm;
+    const Scalar t13 = w.KA_r_upper_arm[0][1] - w.KA_r_upper_arm[5][1]*t0;
+    const Scalar t14 = w.KA_r_upper_arm[1][1] - w.KA_r_upper_arm[5][1]*t1;
+    const Scalar t15 = w.KA_r_upper_arm[2][1] - w.KA_r_upper_arm[5][1]*t2;
+    const Scalar t16 = w.KA_r_upper_arm[3][1] - w.KA_r_upper_arm[5][1]*t3;
+    const Scalar t17 = w.KA_r_upper_arm[4][1] - w.KA_r_upper_arm[5][1]*t4;
+    w.KA_r_shoulder_roll_link[0][1] = w.cq_r_upper_arm*t13 - w.sq_r_upper_arm*t14;
+    w.KA_r_shoulder_roll_link[1][1] = w.sq_r_upper_arm*t13 + w.cq_r_upper_arm*t14;
+    w.KA_r_shoulder_roll_link[2][1] = t15;
+    w.KA_r_shoulder_roll_link[3][1] = w.cq_r_upper_arm*t16 - w.sq_r_upper_arm*t17;
+    w.KA_r_shoulder_roll_link[4][1] = w.sq_r_upper_arm*t16 + w.cq_r_upper_arm*t17;
+    w.KSD_r_upper_arm[2] = w.KA_r_upper_arm[5][2]*w.Dinv_r_upper_arm;
+    const Scalar t18 = w.KA_r_upper_arm[0][2] - w.KA_r_upper_arm[5][2]*t0;
+    const Scalar t19 = w.KA_r_upper_arm[1][2] - w.KA_r_upper_arm[5][2]*t1;
+    const Scalar t20 = w.KA_r_upper_arm[2][2] - w.KA_r_upper_arm[5][2]*t2;
+    const Scalar t21 = w.KA_r_upper_arm[3][2] - w.KA_r_upper_arm[5][2]*t3;
+    const Scalar t22 = w.KA_r_upper_arm[4][2] - w.KA_r_upper_arm[5][2]*t4;
+    w.KA_r_shoulder_roll_link[0][2] = w.cq_r_upper_arm*t18 - w.sq_r_upper_arm*t19;
+    w.KA_r_shoulder_roll_link[1][2] = w.sq_r_upper_arm*t18 + w.cq_r_upper_arm*t19;
+    w.KA_r_shoulder_roll_link[2][2] = t20;
+    w.KA_r_shoulder_roll_link[3][2] = w.cq_r_upper_arm*t21 - w.sq_r_upper_arm*t22;
+    w.KA_r_shoulder_roll_link[4][2] = w.sq_r_upper_arm*t21 + w.cq_r_upper_arm*t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     w.Dinv_r_shoulder_roll_link = 1.0 / w.IA_r_shoulder_roll_link[15];
@@ -5358,40 +5350,40 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shoulder_pitch_link[3] = w.pA_r_shoulder_pitch_link[3] + pa3;
     w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa4 - w.sq_r_shoulder_roll_link*pa5;
     w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa4 + w.cq_r_shoulder_roll_link*pa5;
-    w.KSD_r_shoulder_roll_link[0] = w.KA_r_shoulder_roll_link[12]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t6 = w.KA_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[12]*t0;
-    const Scalar t7 = w.KA_r_shoulder_roll_link[4] - w.KA_r_shoulder_roll_link[12]*t1;
-    const Scalar t8 = w.KA_r_shoulder_roll_link[8] - w.KA_r_shoulder_roll_link[12]*t2;
-    const Scalar t9 = w.KA_r_shoulder_roll_link[16] - w.KA_r_shoulder_roll_link[12]*t4;
-    w.KA_r_shoulder_pitch_link[0] = t6;
-    w.KA_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*t7 - w.sq_r_shoulder_roll_link*t8;
-    w.KA_r_shoulder_pitch_link[8] = w.sq_r_shoulder_roll_link*t7 + w.cq_r_shoulder_roll_link*t8;
-    w.KA_r_shoulder_pitch_link[16] = w.cq_r_shoulder_roll_link*t9;
-    w.KA_r_shoulder_pitch_link[20] = w.sq_r_shoulder_roll_link*t9;
-    w.KSD_r_shoulder_roll_link[1] = w.KA_r_shoulder_roll_link[13]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t10 = w.KA_r_shoulder_roll_link[1] - w.KA_r_shoulder_roll_link[13]*t0;
-    const Scalar t11 = w.KA_r_shoulder_roll_link[5] - w.KA_r_shoulder_roll_link[13]*t1;
-    const Scalar t12 = w.KA_r_shoulder_roll_link[9] - w.KA_r_shoulder_roll_link[13]*t2;
-    const Scalar t13 = w.KA_r_shoulder_roll_link[17] - w.KA_r_shoulder_roll_link[13]*t4;
-    w.KA_r_shoulder_pitch_link[1] = t10;
-    w.KA_r_shoulder_pitch_link[5] = w.cq_r_shoulder_roll_link*t11 - w.sq_r_shoulder_roll_link*t12;
-    w.KA_r_shoulder_pitch_link[9] = w.sq_r_shoulder_roll_link*t11 + w.cq_r_shoulder_roll_link*t12;
-    w.KA_r_shoulder_pitch_link[17] = w.cq_r_shoulder_roll_link*t13;
-    w.KA_r_shoulder_pitch_link[21] = w.sq_r_shoulder_roll_link*t13;
-    w.KSD_r_shoulder_roll_link[2] = w.KA_r_shoulder_roll_link[14]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t14 = w.KA_r_shoulder_roll_link[2] - w.KA_r_shoulder_roll_link[14]*t0;
-    const Scalar t15 = w.KA_r_shoulder_roll_link[6] - w.KA_r_shoulder_roll_link[14]*t1;
-    const Scalar t16 = w.KA_r_shoulder_roll_link[10] - w.KA_r_shoulder_roll_link[14]*t2;
-    const Scalar t17 = w.KA_r_shoulder_roll_link[18] - w.KA_r_shoulder_roll_link[14]*t4;
-    w.KA_r_shoulder_pitch_link[2] = t14;
-    w.KA_r_shoulder_pitch_link[6] = w.cq_r_shoulder_roll_link*t15 - w.sq_r_shoulder_roll_link*t16;
-    w.KA_r_shoulder_pitch_link[10] = w.sq_r_shoulder_roll_link*t15 + w.cq_r_shoulder_roll_link*t16;
-    w.KA_r_shoulder_pitch_link[18] = w.cq_r_shoulder_roll_link*t17;
-    w.KA_r_shoulder_pitch_link[22] = w.sq_r_shoulder_roll_link*t17;
+    w.KSD_r_shoulder_roll_link[0] = w.KA_r_shoulder_roll_link[3][0]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t6 = w.KA_r_shoulder_roll_link[0][0] - w.KA_r_shoulder_roll_link[3][0]*t0;
+    const Scalar t7 = w.KA_r_shoulder_roll_link[1][0] - w.KA_r_shoulder_roll_link[3][0]*t1;
+    const Scalar t8 = w.KA_r_shoulder_roll_link[2][0] - w.KA_r_shoulder_roll_link[3][0]*t2;
+    const Scalar t9 = w.KA_r_shoulder_roll_link[4][0] - w.KA_r_shoulder_roll_link[3][0]*t4;
+    w.KA_r_shoulder_pitch_link[0][0] = t6;
+    w.KA_r_shoulder_pitch_link[1][0] = w.cq_r_shoulder_roll_link*t7 - w.sq_r_shoulder_roll_link*t8;
+    w.KA_r_shoulder_pitch_link[2][0] = w.sq_r_shoulder_roll_link*t7 + w.cq_r_shoulder_roll_link*t8;
+    w.KA_r_shoulder_pitch_link[4][0] = w.cq_r_shoulder_roll_link*t9;
+    w.KA_r_shoulder_pitch_link[5][0] = w.sq_r_shoulder_roll_link*t9;
+    w.KSD_r_shoulder_roll_link[1] = w.KA_r_shoulder_roll_link[3][1]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t10 = w.KA_r_shoulder_roll_link[0][1] - w.KA_r_shoulder_roll_link[3][1]*t0;
+    const Scalar t11 = w.KA_r_shoulder_roll_link[1][1] - w.KA_r_shoulder_roll_link[3][1]*t1;
+    const Scalar t12 = w.KA_r_shoulder_roll_link[2][1] - w.KA_r_shoulder_roll_link[3][1]*t2;
+    const Scalar t13 = w.KA_r_shoulder_roll_link[4][1] - w.KA_r_shoulder_roll_link[3][1]*t4;
+    w.KA_r_shoulder_pitch_link[0][1] = t10;
+    w.KA_r_shoulder_pitch_link[1][1] = w.cq_r_shoulder_roll_link*t11 - w.sq_r_shoulder_roll_link*t12;
+    w.KA_r_shoulder_pitch_link[2][1] = w.sq_r_shoulder_roll_link*t11 + w.cq_r_shoulder_roll_link*t12;
+    w.KA_r_shoulder_pitch_link[4][1] = w.cq_r_shoulder_roll_link*t13;
+    w.KA_r_shoulder_pitch_link[5][1] = w.sq_r_shoulder_roll_link*t13;
+    w.KSD_r_shoulder_roll_link[2] = w.KA_r_shoulder_roll_link[3][2]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t14 = w.KA_r_shoulder_roll_link[0][2] - w.KA_r_shoulder_roll_link[3][2]*t0;
+    const Scalar t15 = w.KA_r_shoulder_roll_link[1][2] - w.KA_r_shoulder_roll_link[3][2]*t1;
+    const Scalar t16 = w.KA_r_shoulder_roll_link[2][2] - w.KA_r_shoulder_roll_link[3][2]*t2;
+    const Scalar t17 = w.KA_r_shoulder_roll_link[4][2] - w.KA_r_shoulder_roll_link[3][2]*t4;
+    w.KA_r_shoulder_pitch_link[0][2] = t14;
+    w.KA_r_shoulder_pitch_link[1][2] = w.cq_r_shoulder_roll_link*t15 - w.sq_r_shoulder_roll_link*t16;
+    w.KA_r_shoulder_pitch_link[2][2] = w.sq_r_shoulder_roll_link*t15 + w.cq_r_shoulder_roll_link*t16;
+    w.KA_r_shoulder_pitch_link[4][2] = w.cq_r_shoulder_roll_link*t17;
+    w.KA_r_shoulder_pitch_link[5][2] = w.sq_r_shoulder_roll_link*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     w.Dinv_r_shoulder_pitch_link = 1.0 / w.IA_r_shoulder_pitch_link[18];
@@ -5503,58 +5495,58 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_chest[3] = w.pA_chest[3] + 0.04493516596384369*pa4 + 0.9848134698792882*t50 - 0.1676999117594225*t51 - 0.254*t53 - 0.19*t54;
     w.pA_chest[4] = w.pA_chest[4] + 0.9659256678396477*pa4 + 0.2588196364430848*t51 + 0.254*t52;
     w.pA_chest[5] = w.pA_chest[5] - 0.2548890642384102*pa4 + 0.17361575258114187*t50 + 0.9512566085906322*t51 + 0.19*t52;
-    w.KSD_r_shoulder_pitch_link[0] = w.KA_r_shoulder_pitch_link[16]*w.Dinv_r_shoulder_pitch_link;
-    const Scalar t55 = w.KA_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[16]*t0;
-    const Scalar t56 = w.KA_r_shoulder_pitch_link[4] - w.KA_r_shoulder_pitch_link[16]*t1;
-    const Scalar t57 = w.KA_r_shoulder_pitch_link[8] - w.KA_r_shoulder_pitch_link[16]*t2;
-    const Scalar t58 = w.KA_r_shoulder_pitch_link[20] - w.KA_r_shoulder_pitch_link[16]*t4;
+    w.KSD_r_shoulder_pitch_link[0] = w.KA_r_shoulder_pitch_link[4][0]*w.Dinv_r_shoulder_pitch_link;
+    const Scalar t55 = w.KA_r_shoulder_pitch_link[0][0] - w.KA_r_shoulder_pitch_link[4][0]*t0;
+    const Scalar t56 = w.KA_r_shoulder_pitch_link[1][0] - w.KA_r_shoulder_pitch_link[4][0]*t1;
+    const Scalar t57 = w.KA_r_shoulder_pitch_link[2][0] - w.KA_r_shoulder_pitch_link[4][0]*t2;
+    const Scalar t58 = w.KA_r_shoulder_pitch_link[5][0] - w.KA_r_shoulder_pitch_link[4][0]*t4;
     const Scalar t59 = w.cq_r_shoulder_pitch_link*t55 + w.sq_r_shoulder_pitch_link*t57;
     const Scalar t60 = -w.sq_r_shoulder_pitch_link*t55 + w.cq_r_shoulder_pitch_link*t57;
     const Scalar t61 = 0.04493516596384369*t56 + 0.9848134698792882*t59 - 0.1676999117594225*t60;
     const Scalar t62 = 0.9659256678396477*t56 + 0.2588196364430848*t60;
     const Scalar t63 = -0.2548890642384102*t56 + 0.17361575258114187*t59 + 0.9512566085906322*t60;
-    w.KA_chest[0] = t61;
-    w.KA_chest[4] = t62;
-    w.KA_chest[8] = t63;
-    w.KA_chest[12] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t58 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t58 - 0.254*t62 - 0.19*t63;
-    w.KA_chest[16] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t58 + 0.254*t61;
-    w.KA_chest[20] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t58 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t58 + 0.19*t61;
-    w.KSD_r_shoulder_pitch_link[1] = w.KA_r_shoulder_pitch_link[17]*w.Dinv_r_shoulder_pitch_link;
-    const Scalar t64 = w.KA_r_shoulder_pitch_link[1] - w.KA_r_shoulder_pitch_link[17]*t0;
-    const Scalar t65 = w.KA_r_shoulder_pitch_link[5] - w.KA_r_shoulder_pitch_link[17]*t1;
-    const Scalar t66 = w.KA_r_shoulder_pitch_link[9] - w.KA_r_shoulder_pitch_link[17]*t2;
-    const Scalar t67 = w.KA_r_shoulder_pitch_link[21] - w.KA_r_shoulder_pitch_link[17]*t4;
+    w.KA_chest[0][0] = t61;
+    w.KA_chest[1][0] = t62;
+    w.KA_chest[2][0] = t63;
+    w.KA_chest[3][0] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t58 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t58 - 0.254*t62 - 0.19*t63;
+    w.KA_chest[4][0] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t58 + 0.254*t61;
+    w.KA_chest[5][0] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t58 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t58 + 0.19*t61;
+    w.KSD_r_shoulder_pitch_link[1] = w.KA_r_shoulder_pitch_link[4][1]*w.Dinv_r_shoulder_pitch_link;
+    const Scalar t64 = w.KA_r_shoulder_pitch_link[0][1] - w.KA_r_shoulder_pitch_link[4][1]*t0;
+    const Scalar t65 = w.KA_r_shoulder_pitch_link[1][1] - w.KA_r_shoulder_pitch_link[4][1]*t1;
+    const Scalar t66 = w.KA_r_shoulder_pitch_link[2][1] - w.KA_r_shoulder_pitch_link[4][1]*t2;
+    const Scalar t67 = w.KA_r_shoulder_pitch_link[5][1] - w.KA_r_shoulder_pitch_link[4][1]*t4;
     const Scalar t68 = w.cq_r_shoulder_pitch_link*t64 + w.sq_r_shoulder_pitch_link*t66;
     const Scalar t69 = -w.sq_r_shoulder_pitch_link*t64 + w.cq_r_shoulder_pitch_link*t66;
     const Scalar t70 = 0.04493516596384369*t65 + 0.9848134698792882*t68 - 0.1676999117594225*t69;
     const Scalar t71 = 0.9659256678396477*t65 + 0.2588196364430848*t69;
     const Scalar t72 = -0.2548890642384102*t65 + 0.17361575258114187*t68 + 0.9512566085906322*t69;
-    w.KA_chest[1] = t70;
-    w.KA_chest[5] = t71;
-    w.KA_chest[9] = t72;
-    w.KA_chest[13] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t67 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t67 - 0.254*t71 - 0.19*t72;
-    w.KA_chest[17] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t67 + 0.254*t70;
-    w.KA_chest[21] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t67 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t67 + 0.19*t70;
-    w.KSD_r_shoulder_pitch_link[2] = w.KA_r_shoulder_pitch_link[18]*w.Dinv_r_shoulder_pitch_link;
-    const Scalar t73 = w.KA_r_shoulder_pitch_link[2] - w.KA_r_shoulder_pitch_link[18]*t0;
-    const Scalar t74 = w.KA_r_shoulder_pitch_link[6] - w.KA_r_shoulder_pitch_link[18]*t1;
-    const Scalar t75 = w.KA_r_shoulder_pitch_link[10] - w.KA_r_shoulder_pitch_link[18]*t2;
-    const Scalar t76 = w.KA_r_shoulder_pitch_link[22] - w.KA_r_shoulder_pitch_link[18]*t4;
+    w.KA_chest[0][1] = t70;
+    w.KA_chest[1][1] = t71;
+    w.KA_chest[2][1] = t72;
+    w.KA_chest[3][1] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t67 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t67 - 0.254*t71 - 0.19*t72;
+    w.KA_chest[4][1] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t67 + 0.254*t70;
+    w.KA_chest[5][1] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t67 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t67 + 0.19*t70;
+    w.KSD_r_shoulder_pitch_link[2] = w.KA_r_shoulder_pitch_link[4][2]*w.Dinv_r_shoulder_pitch_link;
+    const Scalar t73 = w.KA_r_shoulder_pitch_link[0][2] - w.KA_r_shoulder_pitch_link[4][2]*t0;
+    const Scalar t74 = w.KA_r_shoulder_pitch_link[1][2] - w.KA_r_shoulder_pitch_link[4][2]*t1;
+    const Scalar t75 = w.KA_r_shoulder_pitch_link[2][2] - w.KA_r_shoulder_pitch_link[4][2]*t2;
+    const Scalar t76 = w.KA_r_shoulder_pitch_link[5][2] - w.KA_r_shoulder_pitch_link[4][2]*t4;
     const Scalar t77 = w.cq_r_shoulder_pitch_link*t73 + w.sq_r_shoulder_pitch_link*t75;
     const Scalar t78 = -w.sq_r_shoulder_pitch_link*t73 + w.cq_r_shoulder_pitch_link*t75;
     const Scalar t79 = 0.04493516596384369*t74 + 0.9848134698792882*t77 - 0.1676999117594225*t78;
     const Scalar t80 = 0.9659256678396477*t74 + 0.2588196364430848*t78;
     const Scalar t81 = -0.2548890642384102*t74 + 0.17361575258114187*t77 + 0.9512566085906322*t78;
-    w.KA_chest[2] = t79;
-    w.KA_chest[6] = t80;
-    w.KA_chest[10] = t81;
-    w.KA_chest[14] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t76 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t76 - 0.254*t80 - 0.19*t81;
-    w.KA_chest[18] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t76 + 0.254*t79;
-    w.KA_chest[22] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t76 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t76 + 0.19*t79;
+    w.KA_chest[0][2] = t79;
+    w.KA_chest[1][2] = t80;
+    w.KA_chest[2][2] = t81;
+    w.KA_chest[3][2] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t76 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t76 - 0.254*t80 - 0.19*t81;
+    w.KA_chest[4][2] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t76 + 0.254*t79;
+    w.KA_chest[5][2] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t76 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t76 + 0.19*t79;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.Dinv_chest = 1.0 / w.IA_chest[18];
@@ -5643,52 +5635,52 @@ PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_abdomen[3] = w.pA_abdomen[3] - 0.15*pa1 + w.cq_chest*pa3 + w.sq_chest*pa5;
     w.pA_abdomen[4] = w.pA_abdomen[4] + pa4 + 0.15*t21;
     w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq_chest*pa3 + w.cq_chest*pa5;
-    w.KSD_chest[0] = w.KA_chest[16]*w.Dinv_chest;
-    const Scalar t23 = w.KA_chest[0] - w.KA_chest[16]*t0;
-    const Scalar t24 = w.KA_chest[4] - w.KA_chest[16]*t1;
-    const Scalar t25 = w.KA_chest[8] - w.KA_chest[16]*t2;
-    const Scalar t26 = w.KA_chest[12] - w.KA_chest[16]*t3;
-    const Scalar t27 = w.KA_chest[20] - w.KA_chest[16]*t5;
+    w.KSD_chest[0] = w.KA_chest[4][0]*w.Dinv_chest;
+    const Scalar t23 = w.KA_chest[0][0] - w.KA_chest[4][0]*t0;
+    const Scalar t24 = w.KA_chest[1][0] - w.KA_chest[4][0]*t1;
+    const Scalar t25 = w.KA_chest[2][0] - w.KA_chest[4][0]*t2;
+    const Scalar t26 = w.KA_chest[3][0] - w.KA_chest[4][0]*t3;
+    const Scalar t27 = w.KA_chest[5][0] - w.KA_chest[4][0]*t5;
     const Scalar t28 = w.cq_chest*t23 + w.sq_chest*t25;
     const Scalar t29 = -w.sq_chest*t23 + w.cq_chest*t25;
-    w.KA_abdomen[0] = t28;
-    w.KA_abdomen[4] = t24;
-    w.KA_abdomen[8] = t29;
-    w.KA_abdomen[12] = -0.15*t24 + w.cq_chest*t26 + w.sq_chest*t27;
-    w.KA_abdomen[16] = 0.15*t28;
-    w.KA_abdomen[20] = -w.sq_chest*t26 + w.cq_chest*t27;
-    w.KSD_chest[1] = w.KA_chest[17]*w.Dinv_chest;
-    const Scalar t30 = w.KA_chest[1] - w.KA_chest[17]*t0;
-    const Scalar t31 = w.KA_chest[5] - w.KA_chest[17]*t1;
-    const Scalar t32 = w.KA_chest[9] - w.KA_chest[17]*t2;
-    const Scalar t33 = w.KA_chest[13] - w.KA_chest[17]*t3;
-    const Scalar t34 = w.KA_chest[21] - w.KA_chest[17]*t5;
+    w.KA_abdomen[0][0] = t28;
+    w.KA_abdomen[1][0] = t24;
+    w.KA_abdomen[2][0] = t29;
+    w.KA_abdomen[3][0] = -0.15*t24 + w.cq_chest*t26 + w.sq_chest*t27;
+    w.KA_abdomen[4][0] = 0.15*t28;
+    w.KA_abdomen[5][0] = -w.sq_chest*t26 + w.cq_chest*t27;
+    w.KSD_chest[1] = w.KA_chest[4][1]*w.Dinv_chest;
+    const Scalar t30 = w.KA_chest[0][1] - w.KA_chest[4][1]*t0;
+    const Scalar t31 = w.KA_chest[1][1] - w.KA_chest[4][1]*t1;
+    const Scalar t32 = w.KA_chest[2][1] - w.KA_chest[4][1]*t2;
+    const Scalar t33 = w.KA_chest[3][1] - w.KA_chest[4][1]*t3;
+    const Scalar t34 = w.KA_chest[5][1] - w.KA_chest[4][1]*t5;
     const Scalar t35 = w.cq_chest*t30 + w.sq_chest*t32;
     const Scalar t36 = -w.sq_chest*t30 + w.cq_chest*t32;
-    w.KA_abdomen[1] = t35;
-    w.KA_abdomen[5] = t31;
-    w.KA_abdomen[9] = t36;
-    w.KA_abdomen[13] = -0.15*t31 + w.cq_chest*t33 + w.sq_chest*t34;
-    w.KA_abdomen[17] = 0.15*t35;
-    w.KA_abdomen[21] = -w.sq_chest*t33 + w.cq_chest*t34;
-    w.KSD_chest[2] = w.KA_chest[18]*w.Dinv_chest;
-    const Scalar t37 = w.KA_chest[2] - w.KA_chest[18]*t0;
-    const Scalar t38 = w.KA_chest[6] - w.KA_chest[18]*t1;
-    const Scalar t39 = w.KA_chest[10] - w.KA_chest[18]*t2;
-    const Scalar t40 = w.KA_chest[14] - w.KA_chest[18]*t3;
-    const Scalar t41 = w.KA_chest[22] - w.KA_chest[18]*t5;
+    w.KA_abdomen[0][1] = t35;
+    w.KA_abdomen[1][1] = t31;
+    w.KA_abdomen[2][1] = t36;
+    w.KA_abdomen[3][1] = -0.15*t31 + w.cq_chest*t33 + w.sq_chest*t34;
+    w.KA_abdomen[4][1] = 0.15*t35;
+    w.KA_abdomen[5][1] = -w.sq_chest*t33 + w.cq_chest*t34;
+    w.KSD_chest[2] = w.KA_chest[4][2]*w.Dinv_chest;
+    const Scalar t37 = w.KA_chest[0][2] - w.KA_chest[4][2]*t0;
+    const Scalar t38 = w.KA_chest[1][2] - w.KA_chest[4][2]*t1;
+    const Scalar t39 = w.KA_chest[2][2] - w.KA_chest[4][2]*t2;
+    const Scalar t40 = w.KA_chest[3][2] - w.KA_chest[4][2]*t3;
+    const Scalar t41 = w.KA_chest[5][2] - w.KA_chest[4][2]*t5;
     const Scalar t42 = w.cq_chest*t37 + w.sq_chest*t39;
     const Scalar t43 = -w.sq_chest*t37 + w.cq_chest*t39;
-    w.KA_abdomen[2] = t42;
-    w.KA_abdomen[6] = t38;
-    w.KA_abdomen[10] = t43;
-    w.KA_abdomen[14] = -0.15*t38 + w.cq_chest*t40 + w.sq_chest*t41;
-    w.KA_abdomen[18] = 0.15*t42;
-    w.KA_abdomen[22] = -w.sq_chest*t40 + w.cq_chest*t41;
+    w.KA_abdomen[0][2] = t42;
+    w.KA_abdomen[1][2] = t38;
+    w.KA_abdomen[2][2] = t43;
+    w.KA_abdomen[3][2] = -0.15*t38 + w.cq_chest*t40 + w.sq_chest*t41;
+    w.KA_abdomen[4][2] = 0.15*t42;
+    w.KA_abdomen[5][2] = -w.sq_chest*t40 + w.cq_chest*t41;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_abdomen = 1.0 / w.IA_abdomen[20];
@@ -5774,109 +5766,97 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_pelvis[3] = w.pA_pelvis[3] + w.cq_abdomen*pa3 - w.sq_abdomen*pa4 - 0.1*t25;
     w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq_abdomen*pa3 + w.cq_abdomen*pa4 + 0.1*t24;
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5;
-    w.KSD_abdomen[0] = w.KA_abdomen[20]*w.Dinv_abdomen;
-    const Scalar t26 = w.KA_abdomen[0] - w.KA_abdomen[20]*t0;
-    const Scalar t27 = w.KA_abdomen[4] - w.KA_abdomen[20]*t1;
-    const Scalar t28 = w.KA_abdomen[8] - w.KA_abdomen[20]*t2;
-    const Scalar t29 = w.KA_abdomen[12] - w.KA_abdomen[20]*t3;
-    const Scalar t30 = w.KA_abdomen[16] - w.KA_abdomen[20]*t4;
+    w.KSD_abdomen[0] = w.KA_abdomen[5][0]*w.Dinv_abdomen;
+    const Scalar t26 = w.KA_abdomen[0][0] - w.KA_abdomen[5][0]*t0;
+    const Scalar t27 = w.KA_abdomen[1][0] - w.KA_abdomen[5][0]*t1;
+    const Scalar t28 = w.KA_abdomen[2][0] - w.KA_abdomen[5][0]*t2;
+    const Scalar t29 = w.KA_abdomen[3][0] - w.KA_abdomen[5][0]*t3;
+    const Scalar t30 = w.KA_abdomen[4][0] - w.KA_abdomen[5][0]*t4;
     const Scalar t31 = w.cq_abdomen*t26 - w.sq_abdomen*t27;
     const Scalar t32 = w.sq_abdomen*t26 + w.cq_abdomen*t27;
-    w.KA_pelvis[12] = t31;
-    w.KA_pelvis[28] = t32;
-    w.KA_pelvis[44] = t28;
-    w.KA_pelvis[60] = w.cq_abdomen*t29 - w.sq_abdomen*t30 - 0.1*t32;
-    w.KA_pelvis[76] = w.sq_abdomen*t29 + w.cq_abdomen*t30 + 0.1*t31;
-    w.KSD_abdomen[1] = w.KA_abdomen[21]*w.Dinv_abdomen;
-    const Scalar t33 = w.KA_abdomen[1] - w.KA_abdomen[21]*t0;
-    const Scalar t34 = w.KA_abdomen[5] - w.KA_abdomen[21]*t1;
-    const Scalar t35 = w.KA_abdomen[9] - w.KA_abdomen[21]*t2;
-    const Scalar t36 = w.KA_abdomen[13] - w.KA_abdomen[21]*t3;
-    const Scalar t37 = w.KA_abdomen[17] - w.KA_abdomen[21]*t4;
+    w.KA_pelvis[0][12] = t31;
+    w.KA_pelvis[1][12] = t32;
+    w.KA_pelvis[2][12] = t28;
+    w.KA_pelvis[3][12] = w.cq_abdomen*t29 - w.sq_abdomen*t30 - 0.1*t32;
+    w.KA_pelvis[4][12] = w.sq_abdomen*t29 + w.cq_abdomen*t30 + 0.1*t31;
+    w.KSD_abdomen[1] = w.KA_abdomen[5][1]*w.Dinv_abdomen;
+    const Scalar t33 = w.KA_abdomen[0][1] - w.KA_abdomen[5][1]*t0;
+    const Scalar t34 = w.KA_abdomen[1][1] - w.KA_abdomen[5][1]*t1;
+    const Scalar t35 = w.KA_abdomen[2][1] - w.KA_abdomen[5][1]*t2;
+    const Scalar t36 = w.KA_abdomen[3][1] - w.KA_abdomen[5][1]*t3;
+    const Scalar t37 = w.KA_abdomen[4][1] - w.KA_abdomen[5][1]*t4;
     const Scalar t38 = w.cq_abdomen*t33 - w.sq_abdomen*t34;
     const Scalar t39 = w.sq_abdomen*t33 + w.cq_abdomen*t34;
-    w.KA_pelvis[13] = t38;
-    w.KA_pelvis[29] = t39;
-    w.KA_pelvis[45] = t35;
-    w.KA_pelvis[61] = w.cq_abdomen*t36 - w.sq_abdomen*t37 - 0.1*t39;
-    w.KA_pelvis[77] = w.sq_abdomen*t36 + w.cq_abdomen*t37 + 0.1*t38;
-    w.KSD_abdomen[2] = w.KA_abdomen[22]*w.Dinv_abdomen;
-    const Scalar t40 = w.KA_abdomen[2] - w.KA_abdomen[22]*t0;
-    const Scalar t41 = w.KA_abdomen[6] - w.KA_abdomen[22]*t1;
-    const Scalar t42 = w.KA_abdomen[10] - w.KA_abdomen[22]*t2;
-    const Scalar t43 = w.KA_abdomen[14] - w.KA_abdomen[22]*t3;
-    const Scalar t44 = w.KA_abdomen[18] - w.KA_abdomen[22]*t4;
+    w.KA_pelvis[0][13] = t38;
+    w.KA_pelvis[1][13] = t39;
+    w.KA_pelvis[2][13] = t35;
+    w.KA_pelvis[3][13] = w.cq_abdomen*t36 - w.sq_abdomen*t37 - 0.1*t39;
+    w.KA_pelvis[4][13] = w.sq_abdomen*t36 + w.cq_abdomen*t37 + 0.1*t38;
+    w.KSD_abdomen[2] = w.KA_abdomen[5][2]*w.Dinv_abdomen;
+    const Scalar t40 = w.KA_abdomen[0][2] - w.KA_abdomen[5][2]*t0;
+    const Scalar t41 = w.KA_abdomen[1][2] - w.KA_abdomen[5][2]*t1;
+    const Scalar t42 = w.KA_abdomen[2][2] - w.KA_abdomen[5][2]*t2;
+    const Scalar t43 = w.KA_abdomen[3][2] - w.KA_abdomen[5][2]*t3;
+    const Scalar t44 = w.KA_abdomen[4][2] - w.KA_abdomen[5][2]*t4;
     const Scalar t45 = w.cq_abdomen*t40 - w.sq_abdomen*t41;
     const Scalar t46 = w.sq_abdomen*t40 + w.cq_abdomen*t41;
-    w.KA_pelvis[14] = t45;
-    w.KA_pelvis[30] = t46;
-    w.KA_pelvis[46] = t42;
-    w.KA_pelvis[62] = w.cq_abdomen*t43 - w.sq_abdomen*t44 - 0.1*t46;
-    w.KA_pelvis[78] = w.sq_abdomen*t43 + w.cq_abdomen*t44 + 0.1*t45;
+    w.KA_pelvis[0][14] = t45;
+    w.KA_pelvis[1][14] = t46;
+    w.KA_pelvis[2][14] = t42;
+    w.KA_pelvis[3][14] = w.cq_abdomen*t43 - w.sq_abdomen*t44 - 0.1*t46;
+    w.KA_pelvis[4][14] = w.sq_abdomen*t43 + w.cq_abdomen*t44 + 0.1*t45;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    w.Dinv_r_foot = 1.0 / 0.00194517348958;
     w.u_r_foot[0] = -w.pA_r_foot[3] + tau[17];
-    const Scalar Ia0 = 1.015 - 0.0007791076562499998*w.Dinv_r_foot;
-    const Scalar Ia1 = 0.06495999999999999 - 4.9862889999999986e-05*w.Dinv_r_foot;
-    const Scalar Ia2 = 0.00860228295937 - 3.1912249599999995e-06*w.Dinv_r_foot;
     const Scalar pa0 = -0.027912499999999996*w.c_r_foot[4] + w.pA_r_foot[0];
-    const Scalar pa1 = w.pA_r_foot[1] + 0.027912499999999996*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia0 + w.c_r_foot[5]*Ia1;
+    const Scalar pa1 = 0.614466237626843*w.c_r_foot[1] + 0.039325839208117955*w.c_r_foot[5] + w.pA_r_foot[1] + 14.34961978945479*w.u_r_foot[0];
     const Scalar pa2 = 1.015*w.c_r_foot[2] - 0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2];
-    const Scalar pa3 = w.pA_r_foot[3] + 0.00194517348958*w.Dinv_r_foot*w.u_r_foot[0];
+    const Scalar pa3 = w.pA_r_foot[3] + w.u_r_foot[0];
     const Scalar pa4 = -0.06495999999999999*w.c_r_foot[2] + 0.00936987670937*w.c_r_foot[4] + w.pA_r_foot[4];
-    const Scalar pa5 = w.pA_r_foot[5] + 0.0017863999999999998*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia1 + w.c_r_foot[5]*Ia2;
+    const Scalar pa5 = 0.039325839208117955*w.c_r_foot[1] + 0.006961696668689549*w.c_r_foot[5] + w.pA_r_foot[5] + 0.9183756665251066*w.u_r_foot[0];
     const Scalar C20 = w.cq_r_foot*w.cq_r_foot - w.sq_r_foot*w.sq_r_foot;
-    const Scalar h0 = -0.5075 + 0.5*Ia0;
-    const Scalar m0 = 0.5075 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_r_foot*w.sq_r_foot;
-    const Scalar t1 = -0.032479999999999995 + 0.5*Ia1;
-    const Scalar h1 = 0.004684938354685 - 0.5*Ia2;
-    const Scalar m1 = 0.004684938354685 + 0.5*Ia2;
     w.IA_r_ankle_link[4] = -0.027912499999999996*w.cq_r_foot;
     w.IA_r_ankle_link[5] = -0.027912499999999996*w.sq_r_foot;
-    w.IA_r_ankle_link[6] = 0.2 + m0 + C20*h0;
-    w.IA_r_ankle_link[7] = h0*t0;
-    w.IA_r_ankle_link[9] = -t0*t1;
-    w.IA_r_ankle_link[10] = 0.032479999999999995 + 0.5*Ia1 + C20*t1;
-    w.IA_r_ankle_link[11] = 0.2 + m0 - C20*h0;
-    w.IA_r_ankle_link[13] = -0.032479999999999995 - 0.5*Ia1 + C20*t1;
-    w.IA_r_ankle_link[14] = t0*t1;
-    w.IA_r_ankle_link[18] = 7.2e-05 + m1 + C20*h1;
-    w.IA_r_ankle_link[19] = t0*h1;
-    w.IA_r_ankle_link[20] = 7.2e-05 + m1 - C20*h1;
+    w.IA_r_ankle_link[6] = 1.0147331188134214 - 0.20026688118657843*C20;
+    w.IA_r_ankle_link[7] = -0.40053376237315685*w.cq_r_foot*w.sq_r_foot;
+    w.IA_r_ankle_link[9] = 0.025634160791882035*w.cq_r_foot*w.sq_r_foot;
+    w.IA_r_ankle_link[10] = 0.05214291960405897 - 0.012817080395941018*C20;
+    w.IA_r_ankle_link[11] = 1.0147331188134214 + 0.20026688118657843*C20;
+    w.IA_r_ankle_link[13] = -0.05214291960405897 - 0.012817080395941018*C20;
+    w.IA_r_ankle_link[14] = -0.025634160791882035*w.cq_r_foot*w.sq_r_foot;
+    w.IA_r_ankle_link[18] = 0.008237786689029773 + 0.0012040900203402253*C20;
+    w.IA_r_ankle_link[19] = 0.0024081800406804505*w.cq_r_foot*w.sq_r_foot;
+    w.IA_r_ankle_link[20] = 0.008237786689029773 - 0.0012040900203402253*C20;
     w.pA_r_ankle_link[0] = w.pA_r_ankle_link[0] + pa0;
     w.pA_r_ankle_link[1] = w.pA_r_ankle_link[1] + w.cq_r_foot*pa1 - w.sq_r_foot*pa2;
     w.pA_r_ankle_link[2] = w.pA_r_ankle_link[2] + w.sq_r_foot*pa1 + w.cq_r_foot*pa2;
     w.pA_r_ankle_link[3] = pa3;
     w.pA_r_ankle_link[4] = w.cq_r_foot*pa4 - w.sq_r_foot*pa5;
     w.pA_r_ankle_link[5] = w.sq_r_foot*pa4 + w.cq_r_foot*pa5;
-    w.KA_r_ankle_link[28] = -0.06825*w.cq_r_foot;
-    w.KA_r_ankle_link[35] = -0.06825*w.sq_r_foot;
-    w.KSD_r_foot[1] = 0.06825*w.Dinv_r_foot;
-    const Scalar t2 = 1.0 - 0.001905028125*w.Dinv_r_foot;
-    w.KA_r_ankle_link[8] = w.cq_r_foot*t2;
-    w.KA_r_ankle_link[15] = w.sq_r_foot*t2;
-    w.KA_r_ankle_link[29] = 0.0001219218*w.sq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[36] = -0.0001219218*w.cq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[9] = -w.sq_r_foot;
-    w.KA_r_ankle_link[16] = w.cq_r_foot;
-    w.KA_r_ankle_link[10] = -0.027912499999999996*w.cq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[17] = -0.027912499999999996*w.sq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[31] = 0.0017863999999999998*w.sq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[38] = -0.0017863999999999998*w.cq_r_foot*w.Dinv_r_foot;
-    w.KA_r_ankle_link[32] = w.cq_r_foot;
-    w.KA_r_ankle_link[39] = w.sq_r_foot;
-    w.KA_r_ankle_link[33] = -w.sq_r_foot;
-    w.KA_r_ankle_link[40] = w.cq_r_foot;
+    w.KA_r_ankle_link[4][0] = -0.06825*w.cq_r_foot;
+    w.KA_r_ankle_link[5][0] = -0.06825*w.sq_r_foot;
+    w.KA_r_ankle_link[1][1] = 0.020638449369710488*w.cq_r_foot;
+    w.KA_r_ankle_link[2][1] = 0.020638449369710488*w.sq_r_foot;
+    w.KA_r_ankle_link[4][1] = 0.06267913924033854*w.sq_r_foot;
+    w.KA_r_ankle_link[5][1] = -0.06267913924033854*w.cq_r_foot;
+    w.KA_r_ankle_link[1][2] = -w.sq_r_foot;
+    w.KA_r_ankle_link[2][2] = w.cq_r_foot;
+    w.KA_r_ankle_link[1][3] = -14.34961978945479*w.cq_r_foot;
+    w.KA_r_ankle_link[2][3] = -14.34961978945479*w.sq_r_foot;
+    w.KA_r_ankle_link[4][3] = 0.9183756665251066*w.sq_r_foot;
+    w.KA_r_ankle_link[5][3] = -0.9183756665251066*w.cq_r_foot;
+    w.KA_r_ankle_link[4][4] = w.cq_r_foot;
+    w.KA_r_ankle_link[5][4] = w.sq_r_foot;
+    w.KA_r_ankle_link[4][5] = -w.sq_r_foot;
+    w.KA_r_ankle_link[5][5] = w.cq_r_foot;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
@@ -5973,89 +5953,89 @@ PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
     w.pA_r_shank[4] = w.pA_r_shank[4] + pa4 - 0.4305*t41;
     w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
-    w.KSD_r_ankle_link[0] = w.KA_r_ankle_link[28]*w.Dinv_r_ankle_link;
-    const Scalar t43 = 1.0 - w.KA_r_ankle_link[28]*t0;
-    const Scalar t44 = -w.KA_r_ankle_link[28]*t2;
-    const Scalar t45 = w.KA_r_ankle_link[35] - w.KA_r_ankle_link[28]*t4;
+    w.KSD_r_ankle_link[0] = w.KA_r_ankle_link[4][0]*w.Dinv_r_ankle_link;
+    const Scalar t43 = 1.0 - w.KA_r_ankle_link[4][0]*t0;
+    const Scalar t44 = -w.KA_r_ankle_link[4][0]*t2;
+    const Scalar t45 = w.KA_r_ankle_link[5][0] - w.KA_r_ankle_link[4][0]*t4;
     const Scalar t46 = w.cq_r_ankle_link*t43 + w.sq_r_ankle_link*t44;
     const Scalar t47 = -w.sq_r_ankle_link*t43 + w.cq_r_ankle_link*t44;
     const Scalar t48 = 0.9950041652780258*t46 - 0.09983341664682815*t47;
     const Scalar t49 = 0.09983341664682815*t46 + 0.9950041652780258*t47;
-    w.KA_r_shank[0] = t48;
-    w.KA_r_shank[7] = -w.KA_r_ankle_link[28]*t1;
-    w.KA_r_shank[14] = t49;
-    w.KA_r_shank[21] = -0.4305*w.KA_r_ankle_link[28]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t45 - 0.09983341664682815*w.cq_r_ankle_link*t45;
-    w.KA_r_shank[28] = -0.4305*t48;
-    w.KA_r_shank[35] = 0.09983341664682815*w.sq_r_ankle_link*t45 + 0.9950041652780258*w.cq_r_ankle_link*t45;
-    w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[29]*w.Dinv_r_ankle_link;
-    const Scalar t50 = w.KA_r_ankle_link[8] - w.KA_r_ankle_link[29]*t1;
-    const Scalar t51 = w.KA_r_ankle_link[15] - w.KA_r_ankle_link[29]*t2;
-    const Scalar t52 = -w.KA_r_ankle_link[29]*t0;
-    const Scalar t53 = w.KA_r_ankle_link[36] - w.KA_r_ankle_link[29]*t4;
+    w.KA_r_shank[0][0] = t48;
+    w.KA_r_shank[1][0] = -w.KA_r_ankle_link[4][0]*t1;
+    w.KA_r_shank[2][0] = t49;
+    w.KA_r_shank[3][0] = -0.4305*w.KA_r_ankle_link[4][0]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t45 - 0.09983341664682815*w.cq_r_ankle_link*t45;
+    w.KA_r_shank[4][0] = -0.4305*t48;
+    w.KA_r_shank[5][0] = 0.09983341664682815*w.sq_r_ankle_link*t45 + 0.9950041652780258*w.cq_r_ankle_link*t45;
+    w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[4][1]*w.Dinv_r_ankle_link;
+    const Scalar t50 = w.KA_r_ankle_link[1][1] - w.KA_r_ankle_link[4][1]*t1;
+    const Scalar t51 = w.KA_r_ankle_link[2][1] - w.KA_r_ankle_link[4][1]*t2;
+    const Scalar t52 = -w.KA_r_ankle_link[4][1]*t0;
+    const Scalar t53 = w.KA_r_ankle_link[5][1] - w.KA_r_ankle_link[4][1]*t4;
     const Scalar t54 = w.cq_r_ankle_link*t52 + w.sq_r_ankle_link*t51;
     const Scalar t55 = -w.sq_r_ankle_link*t52 + w.cq_r_ankle_link*t51;
     const Scalar t56 = 0.9950041652780258*t54 - 0.09983341664682815*t55;
     const Scalar t57 = 0.09983341664682815*t54 + 0.9950041652780258*t55;
-    w.KA_r_shank[1] = t56;
-    w.KA_r_shank[8] = t50;
-    w.KA_r_shank[15] = t57;
-    w.KA_r_shank[22] = 0.4305*t50 + 0.9950041652780258*w.sq_r_ankle_link*t53 - 0.09983341664682815*w.cq_r_ankle_link*t53;
-    w.KA_r_shank[29] = -0.4305*t56;
-    w.KA_r_shank[36] = 0.09983341664682815*w.sq_r_ankle_link*t53 + 0.9950041652780258*w.cq_r_ankle_link*t53;
-    const Scalar t58 = 0.9950041652780258*w.sq_r_ankle_link*w.KA_r_ankle_link[16] - 0.09983341664682815*w.cq_r_ankle_link*w.KA_r_ankle_link[16];
-    const Scalar t59 = 0.09983341664682815*w.sq_r_ankle_link*w.KA_r_ankle_link[16] + 0.9950041652780258*w.cq_r_ankle_link*w.KA_r_ankle_link[16];
-    w.KA_r_shank[2] = t58;
-    w.KA_r_shank[9] = w.KA_r_ankle_link[9];
-    w.KA_r_shank[16] = t59;
-    w.KA_r_shank[23] = 0.4305*w.KA_r_ankle_link[9];
-    w.KA_r_shank[30] = -0.4305*t58;
-    w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[31]*w.Dinv_r_ankle_link;
-    const Scalar t60 = w.KA_r_ankle_link[10] - w.KA_r_ankle_link[31]*t1;
-    const Scalar t61 = w.KA_r_ankle_link[17] - w.KA_r_ankle_link[31]*t2;
-    const Scalar t62 = -w.KA_r_ankle_link[31]*t0;
-    const Scalar t63 = w.KA_r_ankle_link[38] - w.KA_r_ankle_link[31]*t4;
+    w.KA_r_shank[0][1] = t56;
+    w.KA_r_shank[1][1] = t50;
+    w.KA_r_shank[2][1] = t57;
+    w.KA_r_shank[3][1] = 0.4305*t50 + 0.9950041652780258*w.sq_r_ankle_link*t53 - 0.09983341664682815*w.cq_r_ankle_link*t53;
+    w.KA_r_shank[4][1] = -0.4305*t56;
+    w.KA_r_shank[5][1] = 0.09983341664682815*w.sq_r_ankle_link*t53 + 0.9950041652780258*w.cq_r_ankle_link*t53;
+    const Scalar t58 = 0.9950041652780258*w.sq_r_ankle_link*w.KA_r_ankle_link[2][2] - 0.09983341664682815*w.cq_r_ankle_link*w.KA_r_ankle_link[2][2];
+    const Scalar t59 = 0.09983341664682815*w.sq_r_ankle_link*w.KA_r_ankle_link[2][2] + 0.9950041652780258*w.cq_r_ankle_link*w.KA_r_ankle_link[2][2];
+    w.KA_r_shank[0][2] = t58;
+    w.KA_r_shank[1][2] = w.KA_r_ankle_link[1][2];
+    w.KA_r_shank[2][2] = t59;
+    w.KA_r_shank[3][2] = 0.4305*w.KA_r_ankle_link[1][2];
+    w.KA_r_shank[4][2] = -0.4305*t58;
+    w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[4][3]*w.Dinv_r_ankle_link;
+    const Scalar t60 = w.KA_r_ankle_link[1][3] - w.KA_r_ankle_link[4][3]*t1;
+    const Scalar t61 = w.KA_r_ankle_link[2][3] - w.KA_r_ankle_link[4][3]*t2;
+    const Scalar t62 = -w.KA_r_ankle_link[4][3]*t0;
+    const Scalar t63 = w.KA_r_ankle_link[5][3] - w.KA_r_ankle_link[4][3]*t4;
     const Scalar t64 = w.cq_r_ankle_link*t62 + w.sq_r_ankle_link*t61;
     const Scalar t65 = -w.sq_r_ankle_link*t62 + w.cq_r_ankle_link*t61;
     const Scalar t66 = 0.9950041652780258*t64 - 0.09983341664682815*t65;
     const Scalar t67 = 0.09983341664682815*t64 + 0.9950041652780258*t65;
-    w.KA_r_shank[3] = t66;
-    w.KA_r_shank[10] = t60;
-    w.KA_r_shank[17] = t67;
-    w.KA_r_shank[24] = 0.4305*t60 + 0.9950041652780258*w.sq_r_ankle_link*t63 - 0.09983341664682815*w.cq_r_ankle_link*t63;
-    w.KA_r_shank[31] = -0.4305*t66;
-    w.KA_r_shank[38] = 0.09983341664682815*w.sq_r_ankle_link*t63 + 0.9950041652780258*w.cq_r_ankle_link*t63;
-    w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[32]*w.Dinv_r_ankle_link;
-    const Scalar t68 = -w.KA_r_ankle_link[32]*t0;
-    const Scalar t69 = -w.KA_r_ankle_link[32]*t2;
-    const Scalar t70 = w.KA_r_ankle_link[39] - w.KA_r_ankle_link[32]*t4;
+    w.KA_r_shank[0][3] = t66;
+    w.KA_r_shank[1][3] = t60;
+    w.KA_r_shank[2][3] = t67;
+    w.KA_r_shank[3][3] = 0.4305*t60 + 0.9950041652780258*w.sq_r_ankle_link*t63 - 0.09983341664682815*w.cq_r_ankle_link*t63;
+    w.KA_r_shank[4][3] = -0.4305*t66;
+    w.KA_r_shank[5][3] = 0.09983341664682815*w.sq_r_ankle_link*t63 + 0.9950041652780258*w.cq_r_ankle_link*t63;
+    w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[4][4]*w.Dinv_r_ankle_link;
+    const Scalar t68 = -w.KA_r_ankle_link[4][4]*t0;
+    const Scalar t69 = -w.KA_r_ankle_link[4][4]*t2;
+    const Scalar t70 = w.KA_r_ankle_link[5][4] - w.KA_r_ankle_link[4][4]*t4;
     const Scalar t71 = w.cq_r_ankle_link*t68 + w.sq_r_ankle_link*t69;
     const Scalar t72 = -w.sq_r_ankle_link*t68 + w.cq_r_ankle_link*t69;
     const Scalar t73 = 0.9950041652780258*t71 - 0.09983341664682815*t72;
     const Scalar t74 = 0.09983341664682815*t71 + 0.9950041652780258*t72;
-    w.KA_r_shank[4] = t73;
-    w.KA_r_shank[11] = -w.KA_r_ankle_link[32]*t1;
-    w.KA_r_shank[18] = t74;
-    w.KA_r_shank[25] = -0.4305*w.KA_r_ankle_link[32]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t70 - 0.09983341664682815*w.cq_r_ankle_link*t70;
-    w.KA_r_shank[32] = -0.4305*t73;
-    w.KA_r_shank[39] = 0.09983341664682815*w.sq_r_ankle_link*t70 + 0.9950041652780258*w.cq_r_ankle_link*t70;
-    w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[33]*w.Dinv_r_ankle_link;
-    const Scalar t75 = -w.KA_r_ankle_link[33]*t0;
-    const Scalar t76 = -w.KA_r_ankle_link[33]*t2;
-    const Scalar t77 = w.KA_r_ankle_link[40] - w.KA_r_ankle_link[33]*t4;
+    w.KA_r_shank[0][4] = t73;
+    w.KA_r_shank[1][4] = -w.KA_r_ankle_link[4][4]*t1;
+    w.KA_r_shank[2][4] = t74;
+    w.KA_r_shank[3][4] = -0.4305*w.KA_r_ankle_link[4][4]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t70 - 0.09983341664682815*w.cq_r_ankle_link*t70;
+    w.KA_r_shank[4][4] = -0.4305*t73;
+    w.KA_r_shank[5][4] = 0.09983341664682815*w.sq_r_ankle_link*t70 + 0.9950041652780258*w.cq_r_ankle_link*t70;
+    w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[4][5]*w.Dinv_r_ankle_link;
+    const Scalar t75 = -w.KA_r_ankle_link[4][5]*t0;
+    const Scalar t76 = -w.KA_r_ankle_link[4][5]*t2;
+    const Scalar t77 = w.KA_r_ankle_link[5][5] - w.KA_r_ankle_link[4][5]*t4;
     const Scalar t78 = w.cq_r_ankle_link*t75 + w.sq_r_ankle_link*t76;
     const Scalar t79 = -w.sq_r_ankle_link*t75 + w.cq_r_ankle_link*t76;
     const Scalar t80 = 0.9950041652780258*t78 - 0.09983341664682815*t79;
     const Scalar t81 = 0.09983341664682815*t78 + 0.9950041652780258*t79;
-    w.KA_r_shank[5] = t80;
-    w.KA_r_shank[12] = -w.KA_r_ankle_link[33]*t1;
-    w.KA_r_shank[19] = t81;
-    w.KA_r_shank[26] = -0.4305*w.KA_r_ankle_link[33]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t77 - 0.09983341664682815*w.cq_r_ankle_link*t77;
-    w.KA_r_shank[33] = -0.4305*t80;
-    w.KA_r_shank[40] = 0.09983341664682815*w.sq_r_ankle_link*t77 + 0.9950041652780258*w.cq_r_ankle_link*t77;
+    w.KA_r_shank[0][5] = t80;
+    w.KA_r_shank[1][5] = -w.KA_r_ankle_link[4][5]*t1;
+    w.KA_r_shank[2][5] = t81;
+    w.KA_r_shank[3][5] = -0.4305*w.KA_r_ankle_link[4][5]*t1 + 0.9950041652780258*w.sq_r_ankle_link*t77 - 0.09983341664682815*w.cq_r_ankle_link*t77;
+    w.KA_r_shank[4][5] = -0.4305*t80;
+    w.KA_r_shank[5][5] = 0.09983341664682815*w.sq_r_ankle_link*t77 + 0.9950041652780258*w.cq_r_ankle_link*t77;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
     w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
@@ -6165,118 +6145,118 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_thigh[3] = w.pA_r_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t41 + 0.19866933079506124*t42;
     w.pA_r_thigh[4] = w.pA_r_thigh[4] + pa4 - 0.42875*t43;
     w.pA_r_thigh[5] = w.pA_r_thigh[5] - 0.19866933079506124*t41 + 0.9800665778412416*t42;
-    w.KSD_r_shank[0] = w.KA_r_shank[28]*w.Dinv_r_shank;
-    const Scalar t45 = w.KA_r_shank[0] - w.KA_r_shank[28]*t0;
-    const Scalar t46 = w.KA_r_shank[7] - w.KA_r_shank[28]*t1;
-    const Scalar t47 = w.KA_r_shank[14] - w.KA_r_shank[28]*t2;
-    const Scalar t48 = w.KA_r_shank[21] - w.KA_r_shank[28]*t3;
-    const Scalar t49 = w.KA_r_shank[35] - w.KA_r_shank[28]*t5;
+    w.KSD_r_shank[0] = w.KA_r_shank[4][0]*w.Dinv_r_shank;
+    const Scalar t45 = w.KA_r_shank[0][0] - w.KA_r_shank[4][0]*t0;
+    const Scalar t46 = w.KA_r_shank[1][0] - w.KA_r_shank[4][0]*t1;
+    const Scalar t47 = w.KA_r_shank[2][0] - w.KA_r_shank[4][0]*t2;
+    const Scalar t48 = w.KA_r_shank[3][0] - w.KA_r_shank[4][0]*t3;
+    const Scalar t49 = w.KA_r_shank[5][0] - w.KA_r_shank[4][0]*t5;
     const Scalar t50 = w.cq_r_shank*t45 + w.sq_r_shank*t47;
     const Scalar t51 = -w.sq_r_shank*t45 + w.cq_r_shank*t47;
     const Scalar t52 = w.cq_r_shank*t48 + w.sq_r_shank*t49;
     const Scalar t53 = -w.sq_r_shank*t48 + w.cq_r_shank*t49;
     const Scalar t54 = 0.9800665778412416*t50 + 0.19866933079506124*t51;
     const Scalar t55 = -0.19866933079506124*t50 + 0.9800665778412416*t51;
-    w.KA_r_thigh[0] = t54;
-    w.KA_r_thigh[7] = t46;
-    w.KA_r_thigh[14] = t55;
-    w.KA_r_thigh[21] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
-    w.KA_r_thigh[28] = -0.42875*t54;
-    w.KA_r_thigh[35] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
-    w.KSD_r_shank[1] = w.KA_r_shank[29]*w.Dinv_r_shank;
-    const Scalar t56 = w.KA_r_shank[1] - w.KA_r_shank[29]*t0;
-    const Scalar t57 = w.KA_r_shank[8] - w.KA_r_shank[29]*t1;
-    const Scalar t58 = w.KA_r_shank[15] - w.KA_r_shank[29]*t2;
-    const Scalar t59 = w.KA_r_shank[22] - w.KA_r_shank[29]*t3;
-    const Scalar t60 = w.KA_r_shank[36] - w.KA_r_shank[29]*t5;
+    w.KA_r_thigh[0][0] = t54;
+    w.KA_r_thigh[1][0] = t46;
+    w.KA_r_thigh[2][0] = t55;
+    w.KA_r_thigh[3][0] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
+    w.KA_r_thigh[4][0] = -0.42875*t54;
+    w.KA_r_thigh[5][0] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
+    w.KSD_r_shank[1] = w.KA_r_shank[4][1]*w.Dinv_r_shank;
+    const Scalar t56 = w.KA_r_shank[0][1] - w.KA_r_shank[4][1]*t0;
+    const Scalar t57 = w.KA_r_shank[1][1] - w.KA_r_shank[4][1]*t1;
+    const Scalar t58 = w.KA_r_shank[2][1] - w.KA_r_shank[4][1]*t2;
+    const Scalar t59 = w.KA_r_shank[3][1] - w.KA_r_shank[4][1]*t3;
+    const Scalar t60 = w.KA_r_shank[5][1] - w.KA_r_shank[4][1]*t5;
     const Scalar t61 = w.cq_r_shank*t56 + w.sq_r_shank*t58;
     const Scalar t62 = -w.sq_r_shank*t56 + w.cq_r_shank*t58;
     const Scalar t63 = w.cq_r_shank*t59 + w.sq_r_shank*t60;
     const Scalar t64 = -w.sq_r_shank*t59 + w.cq_r_shank*t60;
     const Scalar t65 = 0.9800665778412416*t61 + 0.19866933079506124*t62;
     const Scalar t66 = -0.19866933079506124*t61 + 0.9800665778412416*t62;
-    w.KA_r_thigh[1] = t65;
-    w.KA_r_thigh[8] = t57;
-    w.KA_r_thigh[15] = t66;
-    w.KA_r_thigh[22] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
-    w.KA_r_thigh[29] = -0.42875*t65;
-    w.KA_r_thigh[36] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
-    w.KSD_r_shank[2] = w.KA_r_shank[30]*w.Dinv_r_shank;
-    const Scalar t67 = w.KA_r_shank[2] - w.KA_r_shank[30]*t0;
-    const Scalar t68 = w.KA_r_shank[9] - w.KA_r_shank[30]*t1;
-    const Scalar t69 = w.KA_r_shank[16] - w.KA_r_shank[30]*t2;
-    const Scalar t70 = w.KA_r_shank[23] - w.KA_r_shank[30]*t3;
-    const Scalar t71 = -w.KA_r_shank[30]*t5;
+    w.KA_r_thigh[0][1] = t65;
+    w.KA_r_thigh[1][1] = t57;
+    w.KA_r_thigh[2][1] = t66;
+    w.KA_r_thigh[3][1] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
+    w.KA_r_thigh[4][1] = -0.42875*t65;
+    w.KA_r_thigh[5][1] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
+    w.KSD_r_shank[2] = w.KA_r_shank[4][2]*w.Dinv_r_shank;
+    const Scalar t67 = w.KA_r_shank[0][2] - w.KA_r_shank[4][2]*t0;
+    const Scalar t68 = w.KA_r_shank[1][2] - w.KA_r_shank[4][2]*t1;
+    const Scalar t69 = w.KA_r_shank[2][2] - w.KA_r_shank[4][2]*t2;
+    const Scalar t70 = w.KA_r_shank[3][2] - w.KA_r_shank[4][2]*t3;
+    const Scalar t71 = -w.KA_r_shank[4][2]*t5;
     const Scalar t72 = w.cq_r_shank*t67 + w.sq_r_shank*t69;
     const Scalar t73 = -w.sq_r_shank*t67 + w.cq_r_shank*t69;
     const Scalar t74 = w.cq_r_shank*t70 + w.sq_r_shank*t71;
     const Scalar t75 = -w.sq_r_shank*t70 + w.cq_r_shank*t71;
     const Scalar t76 = 0.9800665778412416*t72 + 0.19866933079506124*t73;
     const Scalar t77 = -0.19866933079506124*t72 + 0.9800665778412416*t73;
-    w.KA_r_thigh[2] = t76;
-    w.KA_r_thigh[9] = t68;
-    w.KA_r_thigh[16] = t77;
-    w.KA_r_thigh[23] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
-    w.KA_r_thigh[30] = -0.42875*t76;
-    w.KA_r_thigh[37] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
-    w.KSD_r_shank[3] = w.KA_r_shank[31]*w.Dinv_r_shank;
-    const Scalar t78 = w.KA_r_shank[3] - w.KA_r_shank[31]*t0;
-    const Scalar t79 = w.KA_r_shank[10] - w.KA_r_shank[31]*t1;
-    const Scalar t80 = w.KA_r_shank[17] - w.KA_r_shank[31]*t2;
-    const Scalar t81 = w.KA_r_shank[24] - w.KA_r_shank[31]*t3;
-    const Scalar t82 = w.KA_r_shank[38] - w.KA_r_shank[31]*t5;
+    w.KA_r_thigh[0][2] = t76;
+    w.KA_r_thigh[1][2] = t68;
+    w.KA_r_thigh[2][2] = t77;
+    w.KA_r_thigh[3][2] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
+    w.KA_r_thigh[4][2] = -0.42875*t76;
+    w.KA_r_thigh[5][2] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
+    w.KSD_r_shank[3] = w.KA_r_shank[4][3]*w.Dinv_r_shank;
+    const Scalar t78 = w.KA_r_shank[0][3] - w.KA_r_shank[4][3]*t0;
+    const Scalar t79 = w.KA_r_shank[1][3] - w.KA_r_shank[4][3]*t1;
+    const Scalar t80 = w.KA_r_shank[2][3] - w.KA_r_shank[4][3]*t2;
+    const Scalar t81 = w.KA_r_shank[3][3] - w.KA_r_shank[4][3]*t3;
+    const Scalar t82 = w.KA_r_shank[5][3] - w.KA_r_shank[4][3]*t5;
     const Scalar t83 = w.cq_r_shank*t78 + w.sq_r_shank*t80;
     const Scalar t84 = -w.sq_r_shank*t78 + w.cq_r_shank*t80;
     const Scalar t85 = w.cq_r_shank*t81 + w.sq_r_shank*t82;
     const Scalar t86 = -w.sq_r_shank*t81 + w.cq_r_shank*t82;
     const Scalar t87 = 0.9800665778412416*t83 + 0.19866933079506124*t84;
     const Scalar t88 = -0.19866933079506124*t83 + 0.9800665778412416*t84;
-    w.KA_r_thigh[3] = t87;
-    w.KA_r_thigh[10] = t79;
-    w.KA_r_thigh[17] = t88;
-    w.KA_r_thigh[24] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
-    w.KA_r_thigh[31] = -0.42875*t87;
-    w.KA_r_thigh[38] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
-    w.KSD_r_shank[4] = w.KA_r_shank[32]*w.Dinv_r_shank;
-    const Scalar t89 = w.KA_r_shank[4] - w.KA_r_shank[32]*t0;
-    const Scalar t90 = w.KA_r_shank[11] - w.KA_r_shank[32]*t1;
-    const Scalar t91 = w.KA_r_shank[18] - w.KA_r_shank[32]*t2;
-    const Scalar t92 = w.KA_r_shank[25] - w.KA_r_shank[32]*t3;
-    const Scalar t93 = w.KA_r_shank[39] - w.KA_r_shank[32]*t5;
+    w.KA_r_thigh[0][3] = t87;
+    w.KA_r_thigh[1][3] = t79;
+    w.KA_r_thigh[2][3] = t88;
+    w.KA_r_thigh[3][3] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
+    w.KA_r_thigh[4][3] = -0.42875*t87;
+    w.KA_r_thigh[5][3] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
+    w.KSD_r_shank[4] = w.KA_r_shank[4][4]*w.Dinv_r_shank;
+    const Scalar t89 = w.KA_r_shank[0][4] - w.KA_r_shank[4][4]*t0;
+    const Scalar t90 = w.KA_r_shank[1][4] - w.KA_r_shank[4][4]*t1;
+    const Scalar t91 = w.KA_r_shank[2][4] - w.KA_r_shank[4][4]*t2;
+    const Scalar t92 = w.KA_r_shank[3][4] - w.KA_r_shank[4][4]*t3;
+    const Scalar t93 = w.KA_r_shank[5][4] - w.KA_r_shank[4][4]*t5;
     const Scalar t94 = w.cq_r_shank*t89 + w.sq_r_shank*t91;
     const Scalar t95 = -w.sq_r_shank*t89 + w.cq_r_shank*t91;
     const Scalar t96 = w.cq_r_shank*t92 + w.sq_r_shank*t93;
     const Scalar t97 = -w.sq_r_shank*t92 + w.cq_r_shank*t93;
     const Scalar t98 = 0.9800665778412416*t94 + 0.19866933079506124*t95;
     const Scalar t99 = -0.19866933079506124*t94 + 0.9800665778412416*t95;
-    w.KA_r_thigh[4] = t98;
-    w.KA_r_thigh[11] = t90;
-    w.KA_r_thigh[18] = t99;
-    w.KA_r_thigh[25] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
-    w.KA_r_thigh[32] = -0.42875*t98;
-    w.KA_r_thigh[39] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
-    w.KSD_r_shank[5] = w.KA_r_shank[33]*w.Dinv_r_shank;
-    const Scalar t100 = w.KA_r_shank[5] - w.KA_r_shank[33]*t0;
-    const Scalar t101 = w.KA_r_shank[12] - w.KA_r_shank[33]*t1;
-    const Scalar t102 = w.KA_r_shank[19] - w.KA_r_shank[33]*t2;
-    const Scalar t103 = w.KA_r_shank[26] - w.KA_r_shank[33]*t3;
-    const Scalar t104 = w.KA_r_shank[40] - w.KA_r_shank[33]*t5;
+    w.KA_r_thigh[0][4] = t98;
+    w.KA_r_thigh[1][4] = t90;
+    w.KA_r_thigh[2][4] = t99;
+    w.KA_r_thigh[3][4] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
+    w.KA_r_thigh[4][4] = -0.42875*t98;
+    w.KA_r_thigh[5][4] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
+    w.KSD_r_shank[5] = w.KA_r_shank[4][5]*w.Dinv_r_shank;
+    const Scalar t100 = w.KA_r_shank[0][5] - w.KA_r_shank[4][5]*t0;
+    const Scalar t101 = w.KA_r_shank[1][5] - w.KA_r_shank[4][5]*t1;
+    const Scalar t102 = w.KA_r_shank[2][5] - w.KA_r_shank[4][5]*t2;
+    const Scalar t103 = w.KA_r_shank[3][5] - w.KA_r_shank[4][5]*t3;
+    const Scalar t104 = w.KA_r_shank[5][5] - w.KA_r_shank[4][5]*t5;
     const Scalar t105 = w.cq_r_shank*t100 + w.sq_r_shank*t102;
     const Scalar t106 = -w.sq_r_shank*t100 + w.cq_r_shank*t102;
     const Scalar t107 = w.cq_r_shank*t103 + w.sq_r_shank*t104;
     const Scalar t108 = -w.sq_r_shank*t103 + w.cq_r_shank*t104;
     const Scalar t109 = 0.9800665778412416*t105 + 0.19866933079506124*t106;
     const Scalar t110 = -0.19866933079506124*t105 + 0.9800665778412416*t106;
-    w.KA_r_thigh[5] = t109;
-    w.KA_r_thigh[12] = t101;
-    w.KA_r_thigh[19] = t110;
-    w.KA_r_thigh[26] = 0.42875*t101 + 0.9800665778412416*t107 + 0.19866933079506124*t108;
-    w.KA_r_thigh[33] = -0.42875*t109;
-    w.KA_r_thigh[40] = -0.19866933079506124*t107 + 0.9800665778412416*t108;
+    w.KA_r_thigh[0][5] = t109;
+    w.KA_r_thigh[1][5] = t101;
+    w.KA_r_thigh[2][5] = t110;
+    w.KA_r_thigh[3][5] = 0.42875*t101 + 0.9800665778412416*t107 + 0.19866933079506124*t108;
+    w.KA_r_thigh[4][5] = -0.42875*t109;
+    w.KA_r_thigh[5][5] = -0.19866933079506124*t107 + 0.9800665778412416*t108;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
     w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
@@ -6367,27 +6347,27 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_hip_roll_link[5] = w.pA_r_hip_roll_link[5] + 0.09983341664682815*t28 + 0.9950041652780258*t29;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_r_thigh[j] = w.Dinv_r_thigh*w.KA_r_thigh[28 + j];
-      const Scalar t30 = w.KA_r_thigh[j] - t0*w.KA_r_thigh[28 + j];
-      const Scalar t31 = w.KA_r_thigh[7 + j] - t1*w.KA_r_thigh[28 + j];
-      const Scalar t32 = w.KA_r_thigh[14 + j] - t2*w.KA_r_thigh[28 + j];
-      const Scalar t33 = w.KA_r_thigh[21 + j] - t3*w.KA_r_thigh[28 + j];
-      const Scalar t34 = w.KA_r_thigh[35 + j] - t5*w.KA_r_thigh[28 + j];
+      w.KSD_r_thigh[j] = w.Dinv_r_thigh*w.KA_r_thigh[4][j];
+      const Scalar t30 = w.KA_r_thigh[0][j] - t0*w.KA_r_thigh[4][j];
+      const Scalar t31 = w.KA_r_thigh[1][j] - t1*w.KA_r_thigh[4][j];
+      const Scalar t32 = w.KA_r_thigh[2][j] - t2*w.KA_r_thigh[4][j];
+      const Scalar t33 = w.KA_r_thigh[3][j] - t3*w.KA_r_thigh[4][j];
+      const Scalar t34 = w.KA_r_thigh[5][j] - t5*w.KA_r_thigh[4][j];
       const Scalar t35 = w.cq_r_thigh*t30 + w.sq_r_thigh*t32;
       const Scalar t36 = -w.sq_r_thigh*t30 + w.cq_r_thigh*t32;
       const Scalar t37 = w.cq_r_thigh*t33 + w.sq_r_thigh*t34;
       const Scalar t38 = -w.sq_r_thigh*t33 + w.cq_r_thigh*t34;
-      w.KA_r_hip_roll_link[j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
-      w.KA_r_hip_roll_link[7 + j] = t31;
-      w.KA_r_hip_roll_link[14 + j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
-      w.KA_r_hip_roll_link[21 + j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
-      w.KA_r_hip_roll_link[28 + j] = 0.0;
-      w.KA_r_hip_roll_link[35 + j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+      w.KA_r_hip_roll_link[0][j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
+      w.KA_r_hip_roll_link[1][j] = t31;
+      w.KA_r_hip_roll_link[2][j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
+      w.KA_r_hip_roll_link[3][j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+      w.KA_r_hip_roll_link[4][j] = 0.0;
+      w.KA_r_hip_roll_link[5][j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
@@ -6446,22 +6426,22 @@ PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa4 + w.cq_r_hip_roll_link*pa5;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_r_hip_roll_link[j] = w.Dinv_r_hip_roll_link*w.KA_r_hip_roll_link[21 + j];
-      const Scalar t6 = w.KA_r_hip_roll_link[j] - t0*w.KA_r_hip_roll_link[21 + j];
-      const Scalar t7 = w.KA_r_hip_roll_link[7 + j] - t1*w.KA_r_hip_roll_link[21 + j];
-      const Scalar t8 = w.KA_r_hip_roll_link[14 + j] - t2*w.KA_r_hip_roll_link[21 + j];
-      const Scalar t9 = w.KA_r_hip_roll_link[35 + j] - t4*w.KA_r_hip_roll_link[21 + j];
-      w.KA_r_hip_yaw_link[j] = t6;
-      w.KA_r_hip_yaw_link[7 + j] = w.cq_r_hip_roll_link*t7 - w.sq_r_hip_roll_link*t8;
-      w.KA_r_hip_yaw_link[14 + j] = w.sq_r_hip_roll_link*t7 + w.cq_r_hip_roll_link*t8;
-      w.KA_r_hip_yaw_link[21 + j] = 0.0;
-      w.KA_r_hip_yaw_link[28 + j] = w.cq_r_hip_roll_link*w.KA_r_hip_roll_link[28 + j] - w.sq_r_hip_roll_link*t9;
-      w.KA_r_hip_yaw_link[35 + j] = w.sq_r_hip_roll_link*w.KA_r_hip_roll_link[28 + j] + w.cq_r_hip_roll_link*t9;
+      w.KSD_r_hip_roll_link[j] = w.Dinv_r_hip_roll_link*w.KA_r_hip_roll_link[3][j];
+      const Scalar t6 = w.KA_r_hip_roll_link[0][j] - t0*w.KA_r_hip_roll_link[3][j];
+      const Scalar t7 = w.KA_r_hip_roll_link[1][j] - t1*w.KA_r_hip_roll_link[3][j];
+      const Scalar t8 = w.KA_r_hip_roll_link[2][j] - t2*w.KA_r_hip_roll_link[3][j];
+      const Scalar t9 = w.KA_r_hip_roll_link[5][j] - t4*w.KA_r_hip_roll_link[3][j];
+      w.KA_r_hip_yaw_link[0][j] = t6;
+      w.KA_r_hip_yaw_link[1][j] = w.cq_r_hip_roll_link*t7 - w.sq_r_hip_roll_link*t8;
+      w.KA_r_hip_yaw_link[2][j] = w.sq_r_hip_roll_link*t7 + w.cq_r_hip_roll_link*t8;
+      w.KA_r_hip_yaw_link[3][j] = 0.0;
+      w.KA_r_hip_yaw_link[4][j] = w.cq_r_hip_roll_link*w.KA_r_hip_roll_link[4][j] - w.sq_r_hip_roll_link*t9;
+      w.KA_r_hip_yaw_link[5][j] = w.sq_r_hip_roll_link*w.KA_r_hip_roll_link[4][j] + w.cq_r_hip_roll_link*t9;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
@@ -6559,88 +6539,76 @@ PROXGEN_RT_NOINLINE void pv_13(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 + 0.0875*t39;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_r_hip_yaw_link[j] = w.Dinv_r_hip_yaw_link*w.KA_r_hip_yaw_link[35 + j];
-      const Scalar t41 = w.KA_r_hip_yaw_link[j] - t0*w.KA_r_hip_yaw_link[35 + j];
-      const Scalar t42 = w.KA_r_hip_yaw_link[7 + j] - t1*w.KA_r_hip_yaw_link[35 + j];
-      const Scalar t43 = w.KA_r_hip_yaw_link[14 + j] - t2*w.KA_r_hip_yaw_link[35 + j];
-      const Scalar t44 = w.KA_r_hip_yaw_link[28 + j] - t3*w.KA_r_hip_yaw_link[35 + j];
+      w.KSD_r_hip_yaw_link[j] = w.Dinv_r_hip_yaw_link*w.KA_r_hip_yaw_link[5][j];
+      const Scalar t41 = w.KA_r_hip_yaw_link[0][j] - t0*w.KA_r_hip_yaw_link[5][j];
+      const Scalar t42 = w.KA_r_hip_yaw_link[1][j] - t1*w.KA_r_hip_yaw_link[5][j];
+      const Scalar t43 = w.KA_r_hip_yaw_link[2][j] - t2*w.KA_r_hip_yaw_link[5][j];
+      const Scalar t44 = w.KA_r_hip_yaw_link[4][j] - t3*w.KA_r_hip_yaw_link[5][j];
       const Scalar t45 = w.cq_r_hip_yaw_link*t41 - w.sq_r_hip_yaw_link*t42;
       const Scalar t46 = w.sq_r_hip_yaw_link*t41 + w.cq_r_hip_yaw_link*t42;
-      const Scalar t47 = w.cq_r_hip_yaw_link*w.KA_r_hip_yaw_link[21 + j] - w.sq_r_hip_yaw_link*t44;
-      const Scalar t48 = w.sq_r_hip_yaw_link*w.KA_r_hip_yaw_link[21 + j] + w.cq_r_hip_yaw_link*t44;
+      const Scalar t47 = w.cq_r_hip_yaw_link*w.KA_r_hip_yaw_link[3][j] - w.sq_r_hip_yaw_link*t44;
+      const Scalar t48 = w.sq_r_hip_yaw_link*w.KA_r_hip_yaw_link[3][j] + w.cq_r_hip_yaw_link*t44;
       const Scalar t49 = 0.9961917745544759*t45 + 0.08718915247898762*t46;
       const Scalar t50 = -0.08718915247898762*t45 + 0.9961917745544759*t46;
-      w.KA_pelvis[6 + j] = t49;
-      w.KA_pelvis[22 + j] = t50;
-      w.KA_pelvis[38 + j] = t43;
-      w.KA_pelvis[54 + j] = -0.0875*t43 + 0.9961917745544759*t47 + 0.08718915247898762*t48;
-      w.KA_pelvis[70 + j] = -0.08718915247898762*t47 + 0.9961917745544759*t48;
-      w.KA_pelvis[86 + j] = 0.0875*t49;
+      w.KA_pelvis[0][6 + j] = t49;
+      w.KA_pelvis[1][6 + j] = t50;
+      w.KA_pelvis[2][6 + j] = t43;
+      w.KA_pelvis[3][6 + j] = -0.0875*t43 + 0.9961917745544759*t47 + 0.08718915247898762*t48;
+      w.KA_pelvis[4][6 + j] = -0.08718915247898762*t47 + 0.9961917745544759*t48;
+      w.KA_pelvis[5][6 + j] = 0.0875*t49;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_14(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    w.Dinv_l_foot = 1.0 / 0.00194517348958;
     w.u_l_foot[0] = -w.pA_l_foot[3] + tau[11];
-    const Scalar Ia0 = 1.015 - 0.0007791076562499998*w.Dinv_l_foot;
-    const Scalar Ia1 = 0.06495999999999999 - 4.9862889999999986e-05*w.Dinv_l_foot;
-    const Scalar Ia2 = 0.00860228295937 - 3.1912249599999995e-06*w.Dinv_l_foot;
     const Scalar pa0 = -0.027912499999999996*w.c_l_foot[4] + w.pA_l_foot[0];
-    const Scalar pa1 = w.pA_l_foot[1] + 0.027912499999999996*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia0 + w.c_l_foot[5]*Ia1;
+    const Scalar pa1 = 0.614466237626843*w.c_l_foot[1] + 0.039325839208117955*w.c_l_foot[5] + w.pA_l_foot[1] + 14.34961978945479*w.u_l_foot[0];
     const Scalar pa2 = 1.015*w.c_l_foot[2] - 0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2];
-    const Scalar pa3 = w.pA_l_foot[3] + 0.00194517348958*w.Dinv_l_foot*w.u_l_foot[0];
+    const Scalar pa3 = w.pA_l_foot[3] + w.u_l_foot[0];
     const Scalar pa4 = -0.06495999999999999*w.c_l_foot[2] + 0.00936987670937*w.c_l_foot[4] + w.pA_l_foot[4];
-    const Scalar pa5 = w.pA_l_foot[5] + 0.0017863999999999998*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia1 + w.c_l_foot[5]*Ia2;
+    const Scalar pa5 = 0.039325839208117955*w.c_l_foot[1] + 0.006961696668689549*w.c_l_foot[5] + w.pA_l_foot[5] + 0.9183756665251066*w.u_l_foot[0];
     const Scalar C20 = w.cq_l_foot*w.cq_l_foot - w.sq_l_foot*w.sq_l_foot;
-    const Scalar h0 = -0.5075 + 0.5*Ia0;
-    const Scalar m0 = 0.5075 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_l_foot*w.sq_l_foot;
-    const Scalar t1 = -0.032479999999999995 + 0.5*Ia1;
-    const Scalar h1 = 0.004684938354685 - 0.5*Ia2;
-    const Scalar m1 = 0.004684938354685 + 0.5*Ia2;
     w.IA_l_ankle_link[4] = -0.027912499999999996*w.cq_l_foot;
     w.IA_l_ankle_link[5] = -0.027912499999999996*w.sq_l_foot;
-    w.IA_l_ankle_link[6] = 0.2 + m0 + C20*h0;
-    w.IA_l_ankle_link[7] = h0*t0;
-    w.IA_l_ankle_link[9] = -t0*t1;
-    w.IA_l_ankle_link[10] = 0.032479999999999995 + 0.5*Ia1 + C20*t1;
-    w.IA_l_ankle_link[11] = 0.2 + m0 - C20*h0;
-    w.IA_l_ankle_link[13] = -0.032479999999999995 - 0.5*Ia1 + C20*t1;
-    w.IA_l_ankle_link[14] = t0*t1;
-    w.IA_l_ankle_link[18] = 7.2e-05 + m1 + C20*h1;
-    w.IA_l_ankle_link[19] = t0*h1;
-    w.IA_l_ankle_link[20] = 7.2e-05 + m1 - C20*h1;
+    w.IA_l_ankle_link[6] = 1.0147331188134214 - 0.20026688118657843*C20;
+    w.IA_l_ankle_link[7] = -0.40053376237315685*w.cq_l_foot*w.sq_l_foot;
+    w.IA_l_ankle_link[9] = 0.025634160791882035*w.cq_l_foot*w.sq_l_foot;
+    w.IA_l_ankle_link[10] = 0.05214291960405897 - 0.012817080395941018*C20;
+    w.IA_l_ankle_link[11] = 1.0147331188134214 + 0.20026688118657843*C20;
+    w.IA_l_ankle_link[13] = -0.05214291960405897 - 0.012817080395941018*C20;
+    w.IA_l_ankle_link[14] = -0.025634160791882035*w.cq_l_foot*w.sq_l_foot;
+    w.IA_l_ankle_link[18] = 0.008237786689029773 + 0.0012040900203402253*C20;
+    w.IA_l_ankle_link[19] = 0.0024081800406804505*w.cq_l_foot*w.sq_l_foot;
+    w.IA_l_ankle_link[20] = 0.008237786689029773 - 0.0012040900203402253*C20;
     w.pA_l_ankle_link[0] = w.pA_l_ankle_link[0] + pa0;
     w.pA_l_ankle_link[1] = w.pA_l_ankle_link[1] + w.cq_l_foot*pa1 - w.sq_l_foot*pa2;
     w.pA_l_ankle_link[2] = w.pA_l_ankle_link[2] + w.sq_l_foot*pa1 + w.cq_l_foot*pa2;
     w.pA_l_ankle_link[3] = pa3;
     w.pA_l_ankle_link[4] = w.cq_l_foot*pa4 - w.sq_l_foot*pa5;
     w.pA_l_ankle_link[5] = w.sq_l_foot*pa4 + w.cq_l_foot*pa5;
-    w.KA_l_ankle_link[28] = -0.06825*w.cq_l_foot;
-    w.KA_l_ankle_link[35] = -0.06825*w.sq_l_foot;
-    w.KSD_l_foot[1] = 0.06825*w.Dinv_l_foot;
-    const Scalar t2 = 1.0 - 0.001905028125*w.Dinv_l_foot;
-    w.KA_l_ankle_link[8] = w.cq_l_foot*t2;
-    w.KA_l_ankle_link[15] = w.sq_l_foot*t2;
-    w.KA_l_ankle_link[29] = 0.0001219218*w.sq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[36] = -0.0001219218*w.cq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[9] = -w.sq_l_foot;
-    w.KA_l_ankle_link[16] = w.cq_l_foot;
-    w.KA_l_ankle_link[10] = -0.027912499999999996*w.cq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[17] = -0.027912499999999996*w.sq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[31] = 0.0017863999999999998*w.sq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[38] = -0.0017863999999999998*w.cq_l_foot*w.Dinv_l_foot;
-    w.KA_l_ankle_link[32] = w.cq_l_foot;
-    w.KA_l_ankle_link[39] = w.sq_l_foot;
-    w.KA_l_ankle_link[33] = -w.sq_l_foot;
-    w.KA_l_ankle_link[40] = w.cq_l_foot;
+    w.KA_l_ankle_link[4][0] = -0.06825*w.cq_l_foot;
+    w.KA_l_ankle_link[5][0] = -0.06825*w.sq_l_foot;
+    w.KA_l_ankle_link[1][1] = 0.020638449369710488*w.cq_l_foot;
+    w.KA_l_ankle_link[2][1] = 0.020638449369710488*w.sq_l_foot;
+    w.KA_l_ankle_link[4][1] = 0.06267913924033854*w.sq_l_foot;
+    w.KA_l_ankle_link[5][1] = -0.06267913924033854*w.cq_l_foot;
+    w.KA_l_ankle_link[1][2] = -w.sq_l_foot;
+    w.KA_l_ankle_link[2][2] = w.cq_l_foot;
+    w.KA_l_ankle_link[1][3] = -14.34961978945479*w.cq_l_foot;
+    w.KA_l_ankle_link[2][3] = -14.34961978945479*w.sq_l_foot;
+    w.KA_l_ankle_link[4][3] = 0.9183756665251066*w.sq_l_foot;
+    w.KA_l_ankle_link[5][3] = -0.9183756665251066*w.cq_l_foot;
+    w.KA_l_ankle_link[4][4] = w.cq_l_foot;
+    w.KA_l_ankle_link[5][4] = w.sq_l_foot;
+    w.KA_l_ankle_link[4][5] = -w.sq_l_foot;
+    w.KA_l_ankle_link[5][5] = w.cq_l_foot;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
@@ -6737,89 +6705,89 @@ PROXGEN_RT_NOINLINE void pv_15(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa1 + 0.9950041652780258*t39 - 0.09983341664682815*t40;
     w.pA_l_shank[4] = w.pA_l_shank[4] + pa4 - 0.4305*t41;
     w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t39 + 0.9950041652780258*t40;
-    w.KSD_l_ankle_link[0] = w.KA_l_ankle_link[28]*w.Dinv_l_ankle_link;
-    const Scalar t43 = 1.0 - w.KA_l_ankle_link[28]*t0;
-    const Scalar t44 = -w.KA_l_ankle_link[28]*t2;
-    const Scalar t45 = w.KA_l_ankle_link[35] - w.KA_l_ankle_link[28]*t4;
+    w.KSD_l_ankle_link[0] = w.KA_l_ankle_link[4][0]*w.Dinv_l_ankle_link;
+    const Scalar t43 = 1.0 - w.KA_l_ankle_link[4][0]*t0;
+    const Scalar t44 = -w.KA_l_ankle_link[4][0]*t2;
+    const Scalar t45 = w.KA_l_ankle_link[5][0] - w.KA_l_ankle_link[4][0]*t4;
     const Scalar t46 = w.cq_l_ankle_link*t43 + w.sq_l_ankle_link*t44;
     const Scalar t47 = -w.sq_l_ankle_link*t43 + w.cq_l_ankle_link*t44;
     const Scalar t48 = 0.9950041652780258*t46 - 0.09983341664682815*t47;
     const Scalar t49 = 0.09983341664682815*t46 + 0.9950041652780258*t47;
-    w.KA_l_shank[0] = t48;
-    w.KA_l_shank[7] = -w.KA_l_ankle_link[28]*t1;
-    w.KA_l_shank[14] = t49;
-    w.KA_l_shank[21] = -0.4305*w.KA_l_ankle_link[28]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t45 - 0.09983341664682815*w.cq_l_ankle_link*t45;
-    w.KA_l_shank[28] = -0.4305*t48;
-    w.KA_l_shank[35] = 0.09983341664682815*w.sq_l_ankle_link*t45 + 0.9950041652780258*w.cq_l_ankle_link*t45;
-    w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[29]*w.Dinv_l_ankle_link;
-    const Scalar t50 = w.KA_l_ankle_link[8] - w.KA_l_ankle_link[29]*t1;
-    const Scalar t51 = w.KA_l_ankle_link[15] - w.KA_l_ankle_link[29]*t2;
-    const Scalar t52 = -w.KA_l_ankle_link[29]*t0;
-    const Scalar t53 = w.KA_l_ankle_link[36] - w.KA_l_ankle_link[29]*t4;
+    w.KA_l_shank[0][0] = t48;
+    w.KA_l_shank[1][0] = -w.KA_l_ankle_link[4][0]*t1;
+    w.KA_l_shank[2][0] = t49;
+    w.KA_l_shank[3][0] = -0.4305*w.KA_l_ankle_link[4][0]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t45 - 0.09983341664682815*w.cq_l_ankle_link*t45;
+    w.KA_l_shank[4][0] = -0.4305*t48;
+    w.KA_l_shank[5][0] = 0.09983341664682815*w.sq_l_ankle_link*t45 + 0.9950041652780258*w.cq_l_ankle_link*t45;
+    w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[4][1]*w.Dinv_l_ankle_link;
+    const Scalar t50 = w.KA_l_ankle_link[1][1] - w.KA_l_ankle_link[4][1]*t1;
+    const Scalar t51 = w.KA_l_ankle_link[2][1] - w.KA_l_ankle_link[4][1]*t2;
+    const Scalar t52 = -w.KA_l_ankle_link[4][1]*t0;
+    const Scalar t53 = w.KA_l_ankle_link[5][1] - w.KA_l_ankle_link[4][1]*t4;
     const Scalar t54 = w.cq_l_ankle_link*t52 + w.sq_l_ankle_link*t51;
     const Scalar t55 = -w.sq_l_ankle_link*t52 + w.cq_l_ankle_link*t51;
     const Scalar t56 = 0.9950041652780258*t54 - 0.09983341664682815*t55;
     const Scalar t57 = 0.09983341664682815*t54 + 0.9950041652780258*t55;
-    w.KA_l_shank[1] = t56;
-    w.KA_l_shank[8] = t50;
-    w.KA_l_shank[15] = t57;
-    w.KA_l_shank[22] = 0.4305*t50 + 0.9950041652780258*w.sq_l_ankle_link*t53 - 0.09983341664682815*w.cq_l_ankle_link*t53;
-    w.KA_l_shank[29] = -0.4305*t56;
-    w.KA_l_shank[36] = 0.09983341664682815*w.sq_l_ankle_link*t53 + 0.9950041652780258*w.cq_l_ankle_link*t53;
-    const Scalar t58 = 0.9950041652780258*w.sq_l_ankle_link*w.KA_l_ankle_link[16] - 0.09983341664682815*w.cq_l_ankle_link*w.KA_l_ankle_link[16];
-    const Scalar t59 = 0.09983341664682815*w.sq_l_ankle_link*w.KA_l_ankle_link[16] + 0.9950041652780258*w.cq_l_ankle_link*w.KA_l_ankle_link[16];
-    w.KA_l_shank[2] = t58;
-    w.KA_l_shank[9] = w.KA_l_ankle_link[9];
-    w.KA_l_shank[16] = t59;
-    w.KA_l_shank[23] = 0.4305*w.KA_l_ankle_link[9];
-    w.KA_l_shank[30] = -0.4305*t58;
-    w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[31]*w.Dinv_l_ankle_link;
-    const Scalar t60 = w.KA_l_ankle_link[10] - w.KA_l_ankle_link[31]*t1;
-    const Scalar t61 = w.KA_l_ankle_link[17] - w.KA_l_ankle_link[31]*t2;
-    const Scalar t62 = -w.KA_l_ankle_link[31]*t0;
-    const Scalar t63 = w.KA_l_ankle_link[38] - w.KA_l_ankle_link[31]*t4;
+    w.KA_l_shank[0][1] = t56;
+    w.KA_l_shank[1][1] = t50;
+    w.KA_l_shank[2][1] = t57;
+    w.KA_l_shank[3][1] = 0.4305*t50 + 0.9950041652780258*w.sq_l_ankle_link*t53 - 0.09983341664682815*w.cq_l_ankle_link*t53;
+    w.KA_l_shank[4][1] = -0.4305*t56;
+    w.KA_l_shank[5][1] = 0.09983341664682815*w.sq_l_ankle_link*t53 + 0.9950041652780258*w.cq_l_ankle_link*t53;
+    const Scalar t58 = 0.9950041652780258*w.sq_l_ankle_link*w.KA_l_ankle_link[2][2] - 0.09983341664682815*w.cq_l_ankle_link*w.KA_l_ankle_link[2][2];
+    const Scalar t59 = 0.09983341664682815*w.sq_l_ankle_link*w.KA_l_ankle_link[2][2] + 0.9950041652780258*w.cq_l_ankle_link*w.KA_l_ankle_link[2][2];
+    w.KA_l_shank[0][2] = t58;
+    w.KA_l_shank[1][2] = w.KA_l_ankle_link[1][2];
+    w.KA_l_shank[2][2] = t59;
+    w.KA_l_shank[3][2] = 0.4305*w.KA_l_ankle_link[1][2];
+    w.KA_l_shank[4][2] = -0.4305*t58;
+    w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[4][3]*w.Dinv_l_ankle_link;
+    const Scalar t60 = w.KA_l_ankle_link[1][3] - w.KA_l_ankle_link[4][3]*t1;
+    const Scalar t61 = w.KA_l_ankle_link[2][3] - w.KA_l_ankle_link[4][3]*t2;
+    const Scalar t62 = -w.KA_l_ankle_link[4][3]*t0;
+    const Scalar t63 = w.KA_l_ankle_link[5][3] - w.KA_l_ankle_link[4][3]*t4;
     const Scalar t64 = w.cq_l_ankle_link*t62 + w.sq_l_ankle_link*t61;
     const Scalar t65 = -w.sq_l_ankle_link*t62 + w.cq_l_ankle_link*t61;
     const Scalar t66 = 0.9950041652780258*t64 - 0.09983341664682815*t65;
     const Scalar t67 = 0.09983341664682815*t64 + 0.9950041652780258*t65;
-    w.KA_l_shank[3] = t66;
-    w.KA_l_shank[10] = t60;
-    w.KA_l_shank[17] = t67;
-    w.KA_l_shank[24] = 0.4305*t60 + 0.9950041652780258*w.sq_l_ankle_link*t63 - 0.09983341664682815*w.cq_l_ankle_link*t63;
-    w.KA_l_shank[31] = -0.4305*t66;
-    w.KA_l_shank[38] = 0.09983341664682815*w.sq_l_ankle_link*t63 + 0.9950041652780258*w.cq_l_ankle_link*t63;
-    w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[32]*w.Dinv_l_ankle_link;
-    const Scalar t68 = -w.KA_l_ankle_link[32]*t0;
-    const Scalar t69 = -w.KA_l_ankle_link[32]*t2;
-    const Scalar t70 = w.KA_l_ankle_link[39] - w.KA_l_ankle_link[32]*t4;
+    w.KA_l_shank[0][3] = t66;
+    w.KA_l_shank[1][3] = t60;
+    w.KA_l_shank[2][3] = t67;
+    w.KA_l_shank[3][3] = 0.4305*t60 + 0.9950041652780258*w.sq_l_ankle_link*t63 - 0.09983341664682815*w.cq_l_ankle_link*t63;
+    w.KA_l_shank[4][3] = -0.4305*t66;
+    w.KA_l_shank[5][3] = 0.09983341664682815*w.sq_l_ankle_link*t63 + 0.9950041652780258*w.cq_l_ankle_link*t63;
+    w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[4][4]*w.Dinv_l_ankle_link;
+    const Scalar t68 = -w.KA_l_ankle_link[4][4]*t0;
+    const Scalar t69 = -w.KA_l_ankle_link[4][4]*t2;
+    const Scalar t70 = w.KA_l_ankle_link[5][4] - w.KA_l_ankle_link[4][4]*t4;
     const Scalar t71 = w.cq_l_ankle_link*t68 + w.sq_l_ankle_link*t69;
     const Scalar t72 = -w.sq_l_ankle_link*t68 + w.cq_l_ankle_link*t69;
     const Scalar t73 = 0.9950041652780258*t71 - 0.09983341664682815*t72;
     const Scalar t74 = 0.09983341664682815*t71 + 0.9950041652780258*t72;
-    w.KA_l_shank[4] = t73;
-    w.KA_l_shank[11] = -w.KA_l_ankle_link[32]*t1;
-    w.KA_l_shank[18] = t74;
-    w.KA_l_shank[25] = -0.4305*w.KA_l_ankle_link[32]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t70 - 0.09983341664682815*w.cq_l_ankle_link*t70;
-    w.KA_l_shank[32] = -0.4305*t73;
-    w.KA_l_shank[39] = 0.09983341664682815*w.sq_l_ankle_link*t70 + 0.9950041652780258*w.cq_l_ankle_link*t70;
-    w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[33]*w.Dinv_l_ankle_link;
-    const Scalar t75 = -w.KA_l_ankle_link[33]*t0;
-    const Scalar t76 = -w.KA_l_ankle_link[33]*t2;
-    const Scalar t77 = w.KA_l_ankle_link[40] - w.KA_l_ankle_link[33]*t4;
+    w.KA_l_shank[0][4] = t73;
+    w.KA_l_shank[1][4] = -w.KA_l_ankle_link[4][4]*t1;
+    w.KA_l_shank[2][4] = t74;
+    w.KA_l_shank[3][4] = -0.4305*w.KA_l_ankle_link[4][4]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t70 - 0.09983341664682815*w.cq_l_ankle_link*t70;
+    w.KA_l_shank[4][4] = -0.4305*t73;
+    w.KA_l_shank[5][4] = 0.09983341664682815*w.sq_l_ankle_link*t70 + 0.9950041652780258*w.cq_l_ankle_link*t70;
+    w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[4][5]*w.Dinv_l_ankle_link;
+    const Scalar t75 = -w.KA_l_ankle_link[4][5]*t0;
+    const Scalar t76 = -w.KA_l_ankle_link[4][5]*t2;
+    const Scalar t77 = w.KA_l_ankle_link[5][5] - w.KA_l_ankle_link[4][5]*t4;
     const Scalar t78 = w.cq_l_ankle_link*t75 + w.sq_l_ankle_link*t76;
     const Scalar t79 = -w.sq_l_ankle_link*t75 + w.cq_l_ankle_link*t76;
     const Scalar t80 = 0.9950041652780258*t78 - 0.09983341664682815*t79;
     const Scalar t81 = 0.09983341664682815*t78 + 0.9950041652780258*t79;
-    w.KA_l_shank[5] = t80;
-    w.KA_l_shank[12] = -w.KA_l_ankle_link[33]*t1;
-    w.KA_l_shank[19] = t81;
-    w.KA_l_shank[26] = -0.4305*w.KA_l_ankle_link[33]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t77 - 0.09983341664682815*w.cq_l_ankle_link*t77;
-    w.KA_l_shank[33] = -0.4305*t80;
-    w.KA_l_shank[40] = 0.09983341664682815*w.sq_l_ankle_link*t77 + 0.9950041652780258*w.cq_l_ankle_link*t77;
+    w.KA_l_shank[0][5] = t80;
+    w.KA_l_shank[1][5] = -w.KA_l_ankle_link[4][5]*t1;
+    w.KA_l_shank[2][5] = t81;
+    w.KA_l_shank[3][5] = -0.4305*w.KA_l_ankle_link[4][5]*t1 + 0.9950041652780258*w.sq_l_ankle_link*t77 - 0.09983341664682815*w.cq_l_ankle_link*t77;
+    w.KA_l_shank[4][5] = -0.4305*t80;
+    w.KA_l_shank[5][5] = 0.09983341664682815*w.sq_l_ankle_link*t77 + 0.9950041652780258*w.cq_l_ankle_link*t77;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
     w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
@@ -6929,118 +6897,118 @@ PROXGEN_RT_NOINLINE void pv_16(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_thigh[3] = w.pA_l_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t41 + 0.19866933079506124*t42;
     w.pA_l_thigh[4] = w.pA_l_thigh[4] + pa4 - 0.42875*t43;
     w.pA_l_thigh[5] = w.pA_l_thigh[5] - 0.19866933079506124*t41 + 0.9800665778412416*t42;
-    w.KSD_l_shank[0] = w.KA_l_shank[28]*w.Dinv_l_shank;
-    const Scalar t45 = w.KA_l_shank[0] - w.KA_l_shank[28]*t0;
-    const Scalar t46 = w.KA_l_shank[7] - w.KA_l_shank[28]*t1;
-    const Scalar t47 = w.KA_l_shank[14] - w.KA_l_shank[28]*t2;
-    const Scalar t48 = w.KA_l_shank[21] - w.KA_l_shank[28]*t3;
-    const Scalar t49 = w.KA_l_shank[35] - w.KA_l_shank[28]*t5;
+    w.KSD_l_shank[0] = w.KA_l_shank[4][0]*w.Dinv_l_shank;
+    const Scalar t45 = w.KA_l_shank[0][0] - w.KA_l_shank[4][0]*t0;
+    const Scalar t46 = w.KA_l_shank[1][0] - w.KA_l_shank[4][0]*t1;
+    const Scalar t47 = w.KA_l_shank[2][0] - w.KA_l_shank[4][0]*t2;
+    const Scalar t48 = w.KA_l_shank[3][0] - w.KA_l_shank[4][0]*t3;
+    const Scalar t49 = w.KA_l_shank[5][0] - w.KA_l_shank[4][0]*t5;
     const Scalar t50 = w.cq_l_shank*t45 + w.sq_l_shank*t47;
     const Scalar t51 = -w.sq_l_shank*t45 + w.cq_l_shank*t47;
     const Scalar t52 = w.cq_l_shank*t48 + w.sq_l_shank*t49;
     const Scalar t53 = -w.sq_l_shank*t48 + w.cq_l_shank*t49;
     const Scalar t54 = 0.9800665778412416*t50 + 0.19866933079506124*t51;
     const Scalar t55 = -0.19866933079506124*t50 + 0.9800665778412416*t51;
-    w.KA_l_thigh[0] = t54;
-    w.KA_l_thigh[7] = t46;
-    w.KA_l_thigh[14] = t55;
-    w.KA_l_thigh[21] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
-    w.KA_l_thigh[28] = -0.42875*t54;
-    w.KA_l_thigh[35] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
-    w.KSD_l_shank[1] = w.KA_l_shank[29]*w.Dinv_l_shank;
-    const Scalar t56 = w.KA_l_shank[1] - w.KA_l_shank[29]*t0;
-    const Scalar t57 = w.KA_l_shank[8] - w.KA_l_shank[29]*t1;
-    const Scalar t58 = w.KA_l_shank[15] - w.KA_l_shank[29]*t2;
-    const Scalar t59 = w.KA_l_shank[22] - w.KA_l_shank[29]*t3;
-    const Scalar t60 = w.KA_l_shank[36] - w.KA_l_shank[29]*t5;
+    w.KA_l_thigh[0][0] = t54;
+    w.KA_l_thigh[1][0] = t46;
+    w.KA_l_thigh[2][0] = t55;
+    w.KA_l_thigh[3][0] = 0.42875*t46 + 0.9800665778412416*t52 + 0.19866933079506124*t53;
+    w.KA_l_thigh[4][0] = -0.42875*t54;
+    w.KA_l_thigh[5][0] = -0.19866933079506124*t52 + 0.9800665778412416*t53;
+    w.KSD_l_shank[1] = w.KA_l_shank[4][1]*w.Dinv_l_shank;
+    const Scalar t56 = w.KA_l_shank[0][1] - w.KA_l_shank[4][1]*t0;
+    const Scalar t57 = w.KA_l_shank[1][1] - w.KA_l_shank[4][1]*t1;
+    const Scalar t58 = w.KA_l_shank[2][1] - w.KA_l_shank[4][1]*t2;
+    const Scalar t59 = w.KA_l_shank[3][1] - w.KA_l_shank[4][1]*t3;
+    const Scalar t60 = w.KA_l_shank[5][1] - w.KA_l_shank[4][1]*t5;
     const Scalar t61 = w.cq_l_shank*t56 + w.sq_l_shank*t58;
     const Scalar t62 = -w.sq_l_shank*t56 + w.cq_l_shank*t58;
     const Scalar t63 = w.cq_l_shank*t59 + w.sq_l_shank*t60;
     const Scalar t64 = -w.sq_l_shank*t59 + w.cq_l_shank*t60;
     const Scalar t65 = 0.9800665778412416*t61 + 0.19866933079506124*t62;
     const Scalar t66 = -0.19866933079506124*t61 + 0.9800665778412416*t62;
-    w.KA_l_thigh[1] = t65;
-    w.KA_l_thigh[8] = t57;
-    w.KA_l_thigh[15] = t66;
-    w.KA_l_thigh[22] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
-    w.KA_l_thigh[29] = -0.42875*t65;
-    w.KA_l_thigh[36] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
-    w.KSD_l_shank[2] = w.KA_l_shank[30]*w.Dinv_l_shank;
-    const Scalar t67 = w.KA_l_shank[2] - w.KA_l_shank[30]*t0;
-    const Scalar t68 = w.KA_l_shank[9] - w.KA_l_shank[30]*t1;
-    const Scalar t69 = w.KA_l_shank[16] - w.KA_l_shank[30]*t2;
-    const Scalar t70 = w.KA_l_shank[23] - w.KA_l_shank[30]*t3;
-    const Scalar t71 = -w.KA_l_shank[30]*t5;
+    w.KA_l_thigh[0][1] = t65;
+    w.KA_l_thigh[1][1] = t57;
+    w.KA_l_thigh[2][1] = t66;
+    w.KA_l_thigh[3][1] = 0.42875*t57 + 0.9800665778412416*t63 + 0.19866933079506124*t64;
+    w.KA_l_thigh[4][1] = -0.42875*t65;
+    w.KA_l_thigh[5][1] = -0.19866933079506124*t63 + 0.9800665778412416*t64;
+    w.KSD_l_shank[2] = w.KA_l_shank[4][2]*w.Dinv_l_shank;
+    const Scalar t67 = w.KA_l_shank[0][2] - w.KA_l_shank[4][2]*t0;
+    const Scalar t68 = w.KA_l_shank[1][2] - w.KA_l_shank[4][2]*t1;
+    const Scalar t69 = w.KA_l_shank[2][2] - w.KA_l_shank[4][2]*t2;
+    const Scalar t70 = w.KA_l_shank[3][2] - w.KA_l_shank[4][2]*t3;
+    const Scalar t71 = -w.KA_l_shank[4][2]*t5;
     const Scalar t72 = w.cq_l_shank*t67 + w.sq_l_shank*t69;
     const Scalar t73 = -w.sq_l_shank*t67 + w.cq_l_shank*t69;
     const Scalar t74 = w.cq_l_shank*t70 + w.sq_l_shank*t71;
     const Scalar t75 = -w.sq_l_shank*t70 + w.cq_l_shank*t71;
     const Scalar t76 = 0.9800665778412416*t72 + 0.19866933079506124*t73;
     const Scalar t77 = -0.19866933079506124*t72 + 0.9800665778412416*t73;
-    w.KA_l_thigh[2] = t76;
-    w.KA_l_thigh[9] = t68;
-    w.KA_l_thigh[16] = t77;
-    w.KA_l_thigh[23] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
-    w.KA_l_thigh[30] = -0.42875*t76;
-    w.KA_l_thigh[37] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
-    w.KSD_l_shank[3] = w.KA_l_shank[31]*w.Dinv_l_shank;
-    const Scalar t78 = w.KA_l_shank[3] - w.KA_l_shank[31]*t0;
-    const Scalar t79 = w.KA_l_shank[10] - w.KA_l_shank[31]*t1;
-    const Scalar t80 = w.KA_l_shank[17] - w.KA_l_shank[31]*t2;
-    const Scalar t81 = w.KA_l_shank[24] - w.KA_l_shank[31]*t3;
-    const Scalar t82 = w.KA_l_shank[38] - w.KA_l_shank[31]*t5;
+    w.KA_l_thigh[0][2] = t76;
+    w.KA_l_thigh[1][2] = t68;
+    w.KA_l_thigh[2][2] = t77;
+    w.KA_l_thigh[3][2] = 0.42875*t68 + 0.9800665778412416*t74 + 0.19866933079506124*t75;
+    w.KA_l_thigh[4][2] = -0.42875*t76;
+    w.KA_l_thigh[5][2] = -0.19866933079506124*t74 + 0.9800665778412416*t75;
+    w.KSD_l_shank[3] = w.KA_l_shank[4][3]*w.Dinv_l_shank;
+    const Scalar t78 = w.KA_l_shank[0][3] - w.KA_l_shank[4][3]*t0;
+    const Scalar t79 = w.KA_l_shank[1][3] - w.KA_l_shank[4][3]*t1;
+    const Scalar t80 = w.KA_l_shank[2][3] - w.KA_l_shank[4][3]*t2;
+    const Scalar t81 = w.KA_l_shank[3][3] - w.KA_l_shank[4][3]*t3;
+    const Scalar t82 = w.KA_l_shank[5][3] - w.KA_l_shank[4][3]*t5;
     const Scalar t83 = w.cq_l_shank*t78 + w.sq_l_shank*t80;
     const Scalar t84 = -w.sq_l_shank*t78 + w.cq_l_shank*t80;
     const Scalar t85 = w.cq_l_shank*t81 + w.sq_l_shank*t82;
     const Scalar t86 = -w.sq_l_shank*t81 + w.cq_l_shank*t82;
     const Scalar t87 = 0.9800665778412416*t83 + 0.19866933079506124*t84;
     const Scalar t88 = -0.19866933079506124*t83 + 0.9800665778412416*t84;
-    w.KA_l_thigh[3] = t87;
-    w.KA_l_thigh[10] = t79;
-    w.KA_l_thigh[17] = t88;
-    w.KA_l_thigh[24] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
-    w.KA_l_thigh[31] = -0.42875*t87;
-    w.KA_l_thigh[38] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
-    w.KSD_l_shank[4] = w.KA_l_shank[32]*w.Dinv_l_shank;
-    const Scalar t89 = w.KA_l_shank[4] - w.KA_l_shank[32]*t0;
-    const Scalar t90 = w.KA_l_shank[11] - w.KA_l_shank[32]*t1;
-    const Scalar t91 = w.KA_l_shank[18] - w.KA_l_shank[32]*t2;
-    const Scalar t92 = w.KA_l_shank[25] - w.KA_l_shank[32]*t3;
-    const Scalar t93 = w.KA_l_shank[39] - w.KA_l_shank[32]*t5;
+    w.KA_l_thigh[0][3] = t87;
+    w.KA_l_thigh[1][3] = t79;
+    w.KA_l_thigh[2][3] = t88;
+    w.KA_l_thigh[3][3] = 0.42875*t79 + 0.9800665778412416*t85 + 0.19866933079506124*t86;
+    w.KA_l_thigh[4][3] = -0.42875*t87;
+    w.KA_l_thigh[5][3] = -0.19866933079506124*t85 + 0.9800665778412416*t86;
+    w.KSD_l_shank[4] = w.KA_l_shank[4][4]*w.Dinv_l_shank;
+    const Scalar t89 = w.KA_l_shank[0][4] - w.KA_l_shank[4][4]*t0;
+    const Scalar t90 = w.KA_l_shank[1][4] - w.KA_l_shank[4][4]*t1;
+    const Scalar t91 = w.KA_l_shank[2][4] - w.KA_l_shank[4][4]*t2;
+    const Scalar t92 = w.KA_l_shank[3][4] - w.KA_l_shank[4][4]*t3;
+    const Scalar t93 = w.KA_l_shank[5][4] - w.KA_l_shank[4][4]*t5;
     const Scalar t94 = w.cq_l_shank*t89 + w.sq_l_shank*t91;
     const Scalar t95 = -w.sq_l_shank*t89 + w.cq_l_shank*t91;
     const Scalar t96 = w.cq_l_shank*t92 + w.sq_l_shank*t93;
     const Scalar t97 = -w.sq_l_shank*t92 + w.cq_l_shank*t93;
     const Scalar t98 = 0.9800665778412416*t94 + 0.19866933079506124*t95;
     const Scalar t99 = -0.19866933079506124*t94 + 0.9800665778412416*t95;
-    w.KA_l_thigh[4] = t98;
-    w.KA_l_thigh[11] = t90;
-    w.KA_l_thigh[18] = t99;
-    w.KA_l_thigh[25] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
-    w.KA_l_thigh[32] = -0.42875*t98;
-    w.KA_l_thigh[39] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
-    w.KSD_l_shank[5] = w.KA_l_shank[33]*w.Dinv_l_shank;
-    const Scalar t100 = w.KA_l_shank[5] - w.KA_l_shank[33]*t0;
-    const Scalar t101 = w.KA_l_shank[12] - w.KA_l_shank[33]*t1;
-    const Scalar t102 = w.KA_l_shank[19] - w.KA_l_shank[33]*t2;
-    const Scalar t103 = w.KA_l_shank[26] - w.KA_l_shank[33]*t3;
-    const Scalar t104 = w.KA_l_shank[40] - w.KA_l_shank[33]*t5;
+    w.KA_l_thigh[0][4] = t98;
+    w.KA_l_thigh[1][4] = t90;
+    w.KA_l_thigh[2][4] = t99;
+    w.KA_l_thigh[3][4] = 0.42875*t90 + 0.9800665778412416*t96 + 0.19866933079506124*t97;
+    w.KA_l_thigh[4][4] = -0.42875*t98;
+    w.KA_l_thigh[5][4] = -0.19866933079506124*t96 + 0.9800665778412416*t97;
+    w.KSD_l_shank[5] = w.KA_l_shank[4][5]*w.Dinv_l_shank;
+    const Scalar t100 = w.KA_l_shank[0][5] - w.KA_l_shank[4][5]*t0;
+    const Scalar t101 = w.KA_l_shank[1][5] - w.KA_l_shank[4][5]*t1;
+    const Scalar t102 = w.KA_l_shank[2][5] - w.KA_l_shank[4][5]*t2;
+    const Scalar t103 = w.KA_l_shank[3][5] - w.KA_l_shank[4][5]*t3;
+    const Scalar t104 = w.KA_l_shank[5][5] - w.KA_l_shank[4][5]*t5;
     const Scalar t105 = w.cq_l_shank*t100 + w.sq_l_shank*t102;
     const Scalar t106 = -w.sq_l_shank*t100 + w.cq_l_shank*t102;
     const Scalar t107 = w.cq_l_shank*t103 + w.sq_l_shank*t104;
     const Scalar t108 = -w.sq_l_shank*t103 + w.cq_l_shank*t104;
     const Scalar t109 = 0.9800665778412416*t105 + 0.19866933079506124*t106;
     const Scalar t110 = -0.19866933079506124*t105 + 0.9800665778412416*t106;
-    w.KA_l_thigh[5] = t109;
-    w.KA_l_thigh[12] = t101;
-    w.KA_l_thigh[19] = t110;
-    w.KA_l_thigh[26] = 0.42875*t101 + 0.9800665778412416*t107 + 0.19866933079506124*t108;
-    w.KA_l_thigh[33] = -0.42875*t109;
-    w.KA_l_thigh[40] = -0.19866933079506124*t107 + 0.9800665778412416*t108;
+    w.KA_l_thigh[0][5] = t109;
+    w.KA_l_thigh[1][5] = t101;
+    w.KA_l_thigh[2][5] = t110;
+    w.KA_l_thigh[3][5] = 0.42875*t101 + 0.9800665778412416*t107 + 0.19866933079506124*t108;
+    w.KA_l_thigh[4][5] = -0.42875*t109;
+    w.KA_l_thigh[5][5] = -0.19866933079506124*t107 + 0.9800665778412416*t108;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
     w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
@@ -7131,27 +7099,27 @@ PROXGEN_RT_NOINLINE void pv_17(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_hip_roll_link[5] = w.pA_l_hip_roll_link[5] + 0.09983341664682815*t28 + 0.9950041652780258*t29;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_l_thigh[j] = w.Dinv_l_thigh*w.KA_l_thigh[28 + j];
-      const Scalar t30 = w.KA_l_thigh[j] - t0*w.KA_l_thigh[28 + j];
-      const Scalar t31 = w.KA_l_thigh[7 + j] - t1*w.KA_l_thigh[28 + j];
-      const Scalar t32 = w.KA_l_thigh[14 + j] - t2*w.KA_l_thigh[28 + j];
-      const Scalar t33 = w.KA_l_thigh[21 + j] - t3*w.KA_l_thigh[28 + j];
-      const Scalar t34 = w.KA_l_thigh[35 + j] - t5*w.KA_l_thigh[28 + j];
+      w.KSD_l_thigh[j] = w.Dinv_l_thigh*w.KA_l_thigh[4][j];
+      const Scalar t30 = w.KA_l_thigh[0][j] - t0*w.KA_l_thigh[4][j];
+      const Scalar t31 = w.KA_l_thigh[1][j] - t1*w.KA_l_thigh[4][j];
+      const Scalar t32 = w.KA_l_thigh[2][j] - t2*w.KA_l_thigh[4][j];
+      const Scalar t33 = w.KA_l_thigh[3][j] - t3*w.KA_l_thigh[4][j];
+      const Scalar t34 = w.KA_l_thigh[5][j] - t5*w.KA_l_thigh[4][j];
       const Scalar t35 = w.cq_l_thigh*t30 + w.sq_l_thigh*t32;
       const Scalar t36 = -w.sq_l_thigh*t30 + w.cq_l_thigh*t32;
       const Scalar t37 = w.cq_l_thigh*t33 + w.sq_l_thigh*t34;
       const Scalar t38 = -w.sq_l_thigh*t33 + w.cq_l_thigh*t34;
-      w.KA_l_hip_roll_link[j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
-      w.KA_l_hip_roll_link[7 + j] = t31;
-      w.KA_l_hip_roll_link[14 + j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
-      w.KA_l_hip_roll_link[21 + j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
-      w.KA_l_hip_roll_link[28 + j] = 0.0;
-      w.KA_l_hip_roll_link[35 + j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
+      w.KA_l_hip_roll_link[0][j] = 0.9950041652780258*t35 - 0.09983341664682815*t36;
+      w.KA_l_hip_roll_link[1][j] = t31;
+      w.KA_l_hip_roll_link[2][j] = 0.09983341664682815*t35 + 0.9950041652780258*t36;
+      w.KA_l_hip_roll_link[3][j] = 0.9950041652780258*t37 - 0.09983341664682815*t38;
+      w.KA_l_hip_roll_link[4][j] = 0.0;
+      w.KA_l_hip_roll_link[5][j] = 0.09983341664682815*t37 + 0.9950041652780258*t38;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
@@ -7210,22 +7178,22 @@ PROXGEN_RT_NOINLINE void pv_18(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa4 + w.cq_l_hip_roll_link*pa5;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_l_hip_roll_link[j] = w.Dinv_l_hip_roll_link*w.KA_l_hip_roll_link[21 + j];
-      const Scalar t6 = w.KA_l_hip_roll_link[j] - t0*w.KA_l_hip_roll_link[21 + j];
-      const Scalar t7 = w.KA_l_hip_roll_link[7 + j] - t1*w.KA_l_hip_roll_link[21 + j];
-      const Scalar t8 = w.KA_l_hip_roll_link[14 + j] - t2*w.KA_l_hip_roll_link[21 + j];
-      const Scalar t9 = w.KA_l_hip_roll_link[35 + j] - t4*w.KA_l_hip_roll_link[21 + j];
-      w.KA_l_hip_yaw_link[j] = t6;
-      w.KA_l_hip_yaw_link[7 + j] = w.cq_l_hip_roll_link*t7 - w.sq_l_hip_roll_link*t8;
-      w.KA_l_hip_yaw_link[14 + j] = w.sq_l_hip_roll_link*t7 + w.cq_l_hip_roll_link*t8;
-      w.KA_l_hip_yaw_link[21 + j] = 0.0;
-      w.KA_l_hip_yaw_link[28 + j] = w.cq_l_hip_roll_link*w.KA_l_hip_roll_link[28 + j] - w.sq_l_hip_roll_link*t9;
-      w.KA_l_hip_yaw_link[35 + j] = w.sq_l_hip_roll_link*w.KA_l_hip_roll_link[28 + j] + w.cq_l_hip_roll_link*t9;
+      w.KSD_l_hip_roll_link[j] = w.Dinv_l_hip_roll_link*w.KA_l_hip_roll_link[3][j];
+      const Scalar t6 = w.KA_l_hip_roll_link[0][j] - t0*w.KA_l_hip_roll_link[3][j];
+      const Scalar t7 = w.KA_l_hip_roll_link[1][j] - t1*w.KA_l_hip_roll_link[3][j];
+      const Scalar t8 = w.KA_l_hip_roll_link[2][j] - t2*w.KA_l_hip_roll_link[3][j];
+      const Scalar t9 = w.KA_l_hip_roll_link[5][j] - t4*w.KA_l_hip_roll_link[3][j];
+      w.KA_l_hip_yaw_link[0][j] = t6;
+      w.KA_l_hip_yaw_link[1][j] = w.cq_l_hip_roll_link*t7 - w.sq_l_hip_roll_link*t8;
+      w.KA_l_hip_yaw_link[2][j] = w.sq_l_hip_roll_link*t7 + w.cq_l_hip_roll_link*t8;
+      w.KA_l_hip_yaw_link[3][j] = 0.0;
+      w.KA_l_hip_yaw_link[4][j] = w.cq_l_hip_roll_link*w.KA_l_hip_roll_link[4][j] - w.sq_l_hip_roll_link*t9;
+      w.KA_l_hip_yaw_link[5][j] = w.sq_l_hip_roll_link*w.KA_l_hip_roll_link[4][j] + w.cq_l_hip_roll_link*t9;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
@@ -7323,28 +7291,28 @@ PROXGEN_RT_NOINLINE void pv_19(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_pelvis[5] = w.pA_pelvis[5] + pa5 - 0.0875*t39;
     // columns 0 to 5
     for (int j = 0; j < 6; ++j) {
-      w.KSD_l_hip_yaw_link[j] = w.Dinv_l_hip_yaw_link*w.KA_l_hip_yaw_link[35 + j];
-      const Scalar t41 = w.KA_l_hip_yaw_link[j] - t0*w.KA_l_hip_yaw_link[35 + j];
-      const Scalar t42 = w.KA_l_hip_yaw_link[7 + j] - t1*w.KA_l_hip_yaw_link[35 + j];
-      const Scalar t43 = w.KA_l_hip_yaw_link[14 + j] - t2*w.KA_l_hip_yaw_link[35 + j];
-      const Scalar t44 = w.KA_l_hip_yaw_link[28 + j] - t3*w.KA_l_hip_yaw_link[35 + j];
+      w.KSD_l_hip_yaw_link[j] = w.Dinv_l_hip_yaw_link*w.KA_l_hip_yaw_link[5][j];
+      const Scalar t41 = w.KA_l_hip_yaw_link[0][j] - t0*w.KA_l_hip_yaw_link[5][j];
+      const Scalar t42 = w.KA_l_hip_yaw_link[1][j] - t1*w.KA_l_hip_yaw_link[5][j];
+      const Scalar t43 = w.KA_l_hip_yaw_link[2][j] - t2*w.KA_l_hip_yaw_link[5][j];
+      const Scalar t44 = w.KA_l_hip_yaw_link[4][j] - t3*w.KA_l_hip_yaw_link[5][j];
       const Scalar t45 = w.cq_l_hip_yaw_link*t41 - w.sq_l_hip_yaw_link*t42;
       const Scalar t46 = w.sq_l_hip_yaw_link*t41 + w.cq_l_hip_yaw_link*t42;
-      const Scalar t47 = w.cq_l_hip_yaw_link*w.KA_l_hip_yaw_link[21 + j] - w.sq_l_hip_yaw_link*t44;
-      const Scalar t48 = w.sq_l_hip_yaw_link*w.KA_l_hip_yaw_link[21 + j] + w.cq_l_hip_yaw_link*t44;
+      const Scalar t47 = w.cq_l_hip_yaw_link*w.KA_l_hip_yaw_link[3][j] - w.sq_l_hip_yaw_link*t44;
+      const Scalar t48 = w.sq_l_hip_yaw_link*w.KA_l_hip_yaw_link[3][j] + w.cq_l_hip_yaw_link*t44;
       const Scalar t49 = 0.9961917745544759*t45 - 0.08718915247898762*t46;
       const Scalar t50 = 0.08718915247898762*t45 + 0.9961917745544759*t46;
-      w.KA_pelvis[j] = t49;
-      w.KA_pelvis[16 + j] = t50;
-      w.KA_pelvis[32 + j] = t43;
-      w.KA_pelvis[48 + j] = 0.0875*t43 + 0.9961917745544759*t47 - 0.08718915247898762*t48;
-      w.KA_pelvis[64 + j] = 0.08718915247898762*t47 + 0.9961917745544759*t48;
-      w.KA_pelvis[80 + j] = -0.0875*t49;
+      w.KA_pelvis[0][j] = t49;
+      w.KA_pelvis[1][j] = t50;
+      w.KA_pelvis[2][j] = t43;
+      w.KA_pelvis[3][j] = 0.0875*t43 + 0.9961917745544759*t47 - 0.08718915247898762*t48;
+      w.KA_pelvis[4][j] = 0.08718915247898762*t47 + 0.9961917745544759*t48;
+      w.KA_pelvis[5][j] = -0.0875*t49;
     }
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_pelvis[0]);
@@ -7401,250 +7369,250 @@ PROXGEN_RT_NOINLINE void pv_20(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.u_pelvis[3] = -w.pA_pelvis[3] + tau[3];
     w.u_pelvis[4] = -w.pA_pelvis[4] + tau[4];
     w.u_pelvis[5] = -w.pA_pelvis[5] + tau[5];
-    const Scalar t15 = w.KA_pelvis[0]*w.Linv_pelvis[0];
-    const Scalar t16 = w.KA_pelvis[16] - w.L_pelvis[1]*t15;
+    const Scalar t15 = w.KA_pelvis[0][0]*w.Linv_pelvis[0];
+    const Scalar t16 = w.KA_pelvis[1][0] - w.L_pelvis[1]*t15;
     const Scalar t17 = w.Linv_pelvis[1]*t16;
-    const Scalar t18 = w.KA_pelvis[32] - w.L_pelvis[2]*t15 - w.L_pelvis[7]*t17;
+    const Scalar t18 = w.KA_pelvis[2][0] - w.L_pelvis[2]*t15 - w.L_pelvis[7]*t17;
     const Scalar t19 = w.Linv_pelvis[2]*t18;
-    const Scalar t20 = w.KA_pelvis[48] - w.L_pelvis[3]*t15 - w.L_pelvis[8]*t17 - w.L_pelvis[12]*t19;
+    const Scalar t20 = w.KA_pelvis[3][0] - w.L_pelvis[3]*t15 - w.L_pelvis[8]*t17 - w.L_pelvis[12]*t19;
     const Scalar t21 = w.Linv_pelvis[3]*t20;
-    const Scalar t22 = w.KA_pelvis[64] - w.L_pelvis[4]*t15 - w.L_pelvis[9]*t17 - w.L_pelvis[13]*t19 - w.L_pelvis[16]*t21;
+    const Scalar t22 = w.KA_pelvis[4][0] - w.L_pelvis[4]*t15 - w.L_pelvis[9]*t17 - w.L_pelvis[13]*t19 - w.L_pelvis[16]*t21;
     const Scalar t23 = w.Linv_pelvis[4]*t22;
-    const Scalar t24 = w.KA_pelvis[80] - w.L_pelvis[5]*t15 - w.L_pelvis[10]*t17 - w.L_pelvis[14]*t19 - w.L_pelvis[17]*t21 - w.L_pelvis[19]*t23;
-    w.Z_pelvis[0] = w.KA_pelvis[0]*w.Linv_pelvis[0];
-    w.Z_pelvis[16] = w.Linv_pelvis[1]*t16;
-    w.Z_pelvis[32] = w.Linv_pelvis[2]*t18;
-    w.Z_pelvis[48] = w.Linv_pelvis[3]*t20;
-    w.Z_pelvis[64] = w.Linv_pelvis[4]*t22;
-    w.Z_pelvis[80] = w.Linv_pelvis[5]*t24;
-    const Scalar t25 = w.KA_pelvis[1]*w.Linv_pelvis[0];
-    const Scalar t26 = w.KA_pelvis[17] - w.L_pelvis[1]*t25;
+    const Scalar t24 = w.KA_pelvis[5][0] - w.L_pelvis[5]*t15 - w.L_pelvis[10]*t17 - w.L_pelvis[14]*t19 - w.L_pelvis[17]*t21 - w.L_pelvis[19]*t23;
+    w.Z_pelvis[0][0] = w.KA_pelvis[0][0]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][0] = w.Linv_pelvis[1]*t16;
+    w.Z_pelvis[2][0] = w.Linv_pelvis[2]*t18;
+    w.Z_pelvis[3][0] = w.Linv_pelvis[3]*t20;
+    w.Z_pelvis[4][0] = w.Linv_pelvis[4]*t22;
+    w.Z_pelvis[5][0] = w.Linv_pelvis[5]*t24;
+    const Scalar t25 = w.KA_pelvis[0][1]*w.Linv_pelvis[0];
+    const Scalar t26 = w.KA_pelvis[1][1] - w.L_pelvis[1]*t25;
     const Scalar t27 = w.Linv_pelvis[1]*t26;
-    const Scalar t28 = w.KA_pelvis[33] - w.L_pelvis[2]*t25 - w.L_pelvis[7]*t27;
+    const Scalar t28 = w.KA_pelvis[2][1] - w.L_pelvis[2]*t25 - w.L_pelvis[7]*t27;
     const Scalar t29 = w.Linv_pelvis[2]*t28;
-    const Scalar t30 = w.KA_pelvis[49] - w.L_pelvis[3]*t25 - w.L_pelvis[8]*t27 - w.L_pelvis[12]*t29;
+    const Scalar t30 = w.KA_pelvis[3][1] - w.L_pelvis[3]*t25 - w.L_pelvis[8]*t27 - w.L_pelvis[12]*t29;
     const Scalar t31 = w.Linv_pelvis[3]*t30;
-    const Scalar t32 = w.KA_pelvis[65] - w.L_pelvis[4]*t25 - w.L_pelvis[9]*t27 - w.L_pelvis[13]*t29 - w.L_pelvis[16]*t31;
+    const Scalar t32 = w.KA_pelvis[4][1] - w.L_pelvis[4]*t25 - w.L_pelvis[9]*t27 - w.L_pelvis[13]*t29 - w.L_pelvis[16]*t31;
     const Scalar t33 = w.Linv_pelvis[4]*t32;
-    const Scalar t34 = w.KA_pelvis[81] - w.L_pelvis[5]*t25 - w.L_pelvis[10]*t27 - w.L_pelvis[14]*t29 - w.L_pelvis[17]*t31 - w.L_pelvis[19]*t33;
-    w.Z_pelvis[1] = w.KA_pelvis[1]*w.Linv_pelvis[0];
-    w.Z_pelvis[17] = w.Linv_pelvis[1]*t26;
-    w.Z_pelvis[33] = w.Linv_pelvis[2]*t28;
-    w.Z_pelvis[49] = w.Linv_pelvis[3]*t30;
-    w.Z_pelvis[65] = w.Linv_pelvis[4]*t32;
-    w.Z_pelvis[81] = w.Linv_pelvis[5]*t34;
-    const Scalar t35 = w.KA_pelvis[2]*w.Linv_pelvis[0];
-    const Scalar t36 = w.KA_pelvis[18] - w.L_pelvis[1]*t35;
+    const Scalar t34 = w.KA_pelvis[5][1] - w.L_pelvis[5]*t25 - w.L_pelvis[10]*t27 - w.L_pelvis[14]*t29 - w.L_pelvis[17]*t31 - w.L_pelvis[19]*t33;
+    w.Z_pelvis[0][1] = w.KA_pelvis[0][1]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][1] = w.Linv_pelvis[1]*t26;
+    w.Z_pelvis[2][1] = w.Linv_pelvis[2]*t28;
+    w.Z_pelvis[3][1] = w.Linv_pelvis[3]*t30;
+    w.Z_pelvis[4][1] = w.Linv_pelvis[4]*t32;
+    w.Z_pelvis[5][1] = w.Linv_pelvis[5]*t34;
+    const Scalar t35 = w.KA_pelvis[0][2]*w.Linv_pelvis[0];
+    const Scalar t36 = w.KA_pelvis[1][2] - w.L_pelvis[1]*t35;
     const Scalar t37 = w.Linv_pelvis[1]*t36;
-    const Scalar t38 = w.KA_pelvis[34] - w.L_pelvis[2]*t35 - w.L_pelvis[7]*t37;
+    const Scalar t38 = w.KA_pelvis[2][2] - w.L_pelvis[2]*t35 - w.L_pelvis[7]*t37;
     const Scalar t39 = w.Linv_pelvis[2]*t38;
-    const Scalar t40 = w.KA_pelvis[50] - w.L_pelvis[3]*t35 - w.L_pelvis[8]*t37 - w.L_pelvis[12]*t39;
+    const Scalar t40 = w.KA_pelvis[3][2] - w.L_pelvis[3]*t35 - w.L_pelvis[8]*t37 - w.L_pelvis[12]*t39;
     const Scalar t41 = w.Linv_pelvis[3]*t40;
-    const Scalar t42 = w.KA_pelvis[66] - w.L_pelvis[4]*t35 - w.L_pelvis[9]*t37 - w.L_pelvis[13]*t39 - w.L_pelvis[16]*t41;
+    const Scalar t42 = w.KA_pelvis[4][2] - w.L_pelvis[4]*t35 - w.L_pelvis[9]*t37 - w.L_pelvis[13]*t39 - w.L_pelvis[16]*t41;
     const Scalar t43 = w.Linv_pelvis[4]*t42;
-    const Scalar t44 = w.KA_pelvis[82] - w.L_pelvis[5]*t35 - w.L_pelvis[10]*t37 - w.L_pelvis[14]*t39 - w.L_pelvis[17]*t41 - w.L_pelvis[19]*t43;
-    w.Z_pelvis[2] = w.KA_pelvis[2]*w.Linv_pelvis[0];
-    w.Z_pelvis[18] = w.Linv_pelvis[1]*t36;
-    w.Z_pelvis[34] = w.Linv_pelvis[2]*t38;
-    w.Z_pelvis[50] = w.Linv_pelvis[3]*t40;
-    w.Z_pelvis[66] = w.Linv_pelvis[4]*t42;
-    w.Z_pelvis[82] = w.Linv_pelvis[5]*t44;
-    const Scalar t45 = w.KA_pelvis[3]*w.Linv_pelvis[0];
-    const Scalar t46 = w.KA_pelvis[19] - w.L_pelvis[1]*t45;
+    const Scalar t44 = w.KA_pelvis[5][2] - w.L_pelvis[5]*t35 - w.L_pelvis[10]*t37 - w.L_pelvis[14]*t39 - w.L_pelvis[17]*t41 - w.L_pelvis[19]*t43;
+    w.Z_pelvis[0][2] = w.KA_pelvis[0][2]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][2] = w.Linv_pelvis[1]*t36;
+    w.Z_pelvis[2][2] = w.Linv_pelvis[2]*t38;
+    w.Z_pelvis[3][2] = w.Linv_pelvis[3]*t40;
+    w.Z_pelvis[4][2] = w.Linv_pelvis[4]*t42;
+    w.Z_pelvis[5][2] = w.Linv_pelvis[5]*t44;
+    const Scalar t45 = w.KA_pelvis[0][3]*w.Linv_pelvis[0];
+    const Scalar t46 = w.KA_pelvis[1][3] - w.L_pelvis[1]*t45;
     const Scalar t47 = w.Linv_pelvis[1]*t46;
-    const Scalar t48 = w.KA_pelvis[35] - w.L_pelvis[2]*t45 - w.L_pelvis[7]*t47;
+    const Scalar t48 = w.KA_pelvis[2][3] - w.L_pelvis[2]*t45 - w.L_pelvis[7]*t47;
     const Scalar t49 = w.Linv_pelvis[2]*t48;
-    const Scalar t50 = w.KA_pelvis[51] - w.L_pelvis[3]*t45 - w.L_pelvis[8]*t47 - w.L_pelvis[12]*t49;
+    const Scalar t50 = w.KA_pelvis[3][3] - w.L_pelvis[3]*t45 - w.L_pelvis[8]*t47 - w.L_pelvis[12]*t49;
     const Scalar t51 = w.Linv_pelvis[3]*t50;
-    const Scalar t52 = w.KA_pelvis[67] - w.L_pelvis[4]*t45 - w.L_pelvis[9]*t47 - w.L_pelvis[13]*t49 - w.L_pelvis[16]*t51;
+    const Scalar t52 = w.KA_pelvis[4][3] - w.L_pelvis[4]*t45 - w.L_pelvis[9]*t47 - w.L_pelvis[13]*t49 - w.L_pelvis[16]*t51;
     const Scalar t53 = w.Linv_pelvis[4]*t52;
-    const Scalar t54 = w.KA_pelvis[83] - w.L_pelvis[5]*t45 - w.L_pelvis[10]*t47 - w.L_pelvis[14]*t49 - w.L_pelvis[17]*t51 - w.L_pelvis[19]*t53;
-    w.Z_pelvis[3] = w.KA_pelvis[3]*w.Linv_pelvis[0];
-    w.Z_pelvis[19] = w.Linv_pelvis[1]*t46;
-    w.Z_pelvis[35] = w.Linv_pelvis[2]*t48;
-    w.Z_pelvis[51] = w.Linv_pelvis[3]*t50;
-    w.Z_pelvis[67] = w.Linv_pelvis[4]*t52;
-    w.Z_pelvis[83] = w.Linv_pelvis[5]*t54;
-    const Scalar t55 = w.KA_pelvis[4]*w.Linv_pelvis[0];
-    const Scalar t56 = w.KA_pelvis[20] - w.L_pelvis[1]*t55;
+    const Scalar t54 = w.KA_pelvis[5][3] - w.L_pelvis[5]*t45 - w.L_pelvis[10]*t47 - w.L_pelvis[14]*t49 - w.L_pelvis[17]*t51 - w.L_pelvis[19]*t53;
+    w.Z_pelvis[0][3] = w.KA_pelvis[0][3]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][3] = w.Linv_pelvis[1]*t46;
+    w.Z_pelvis[2][3] = w.Linv_pelvis[2]*t48;
+    w.Z_pelvis[3][3] = w.Linv_pelvis[3]*t50;
+    w.Z_pelvis[4][3] = w.Linv_pelvis[4]*t52;
+    w.Z_pelvis[5][3] = w.Linv_pelvis[5]*t54;
+    const Scalar t55 = w.KA_pelvis[0][4]*w.Linv_pelvis[0];
+    const Scalar t56 = w.KA_pelvis[1][4] - w.L_pelvis[1]*t55;
     const Scalar t57 = w.Linv_pelvis[1]*t56;
-    const Scalar t58 = w.KA_pelvis[36] - w.L_pelvis[2]*t55 - w.L_pelvis[7]*t57;
+    const Scalar t58 = w.KA_pelvis[2][4] - w.L_pelvis[2]*t55 - w.L_pelvis[7]*t57;
     const Scalar t59 = w.Linv_pelvis[2]*t58;
-    const Scalar t60 = w.KA_pelvis[52] - w.L_pelvis[3]*t55 - w.L_pelvis[8]*t57 - w.L_pelvis[12]*t59;
+    const Scalar t60 = w.KA_pelvis[3][4] - w.L_pelvis[3]*t55 - w.L_pelvis[8]*t57 - w.L_pelvis[12]*t59;
     const Scalar t61 = w.Linv_pelvis[3]*t60;
-    const Scalar t62 = w.KA_pelvis[68] - w.L_pelvis[4]*t55 - w.L_pelvis[9]*t57 - w.L_pelvis[13]*t59 - w.L_pelvis[16]*t61;
+    const Scalar t62 = w.KA_pelvis[4][4] - w.L_pelvis[4]*t55 - w.L_pelvis[9]*t57 - w.L_pelvis[13]*t59 - w.L_pelvis[16]*t61;
     const Scalar t63 = w.Linv_pelvis[4]*t62;
-    const Scalar t64 = w.KA_pelvis[84] - w.L_pelvis[5]*t55 - w.L_pelvis[10]*t57 - w.L_pelvis[14]*t59 - w.L_pelvis[17]*t61 - w.L_pelvis[19]*t63;
-    w.Z_pelvis[4] = w.KA_pelvis[4]*w.Linv_pelvis[0];
-    w.Z_pelvis[20] = w.Linv_pelvis[1]*t56;
-    w.Z_pelvis[36] = w.Linv_pelvis[2]*t58;
-    w.Z_pelvis[52] = w.Linv_pelvis[3]*t60;
-    w.Z_pelvis[68] = w.Linv_pelvis[4]*t62;
-    w.Z_pelvis[84] = w.Linv_pelvis[5]*t64;
-    const Scalar t65 = w.KA_pelvis[5]*w.Linv_pelvis[0];
-    const Scalar t66 = w.KA_pelvis[21] - w.L_pelvis[1]*t65;
+    const Scalar t64 = w.KA_pelvis[5][4] - w.L_pelvis[5]*t55 - w.L_pelvis[10]*t57 - w.L_pelvis[14]*t59 - w.L_pelvis[17]*t61 - w.L_pelvis[19]*t63;
+    w.Z_pelvis[0][4] = w.KA_pelvis[0][4]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][4] = w.Linv_pelvis[1]*t56;
+    w.Z_pelvis[2][4] = w.Linv_pelvis[2]*t58;
+    w.Z_pelvis[3][4] = w.Linv_pelvis[3]*t60;
+    w.Z_pelvis[4][4] = w.Linv_pelvis[4]*t62;
+    w.Z_pelvis[5][4] = w.Linv_pelvis[5]*t64;
+    const Scalar t65 = w.KA_pelvis[0][5]*w.Linv_pelvis[0];
+    const Scalar t66 = w.KA_pelvis[1][5] - w.L_pelvis[1]*t65;
     const Scalar t67 = w.Linv_pelvis[1]*t66;
-    const Scalar t68 = w.KA_pelvis[37] - w.L_pelvis[2]*t65 - w.L_pelvis[7]*t67;
+    const Scalar t68 = w.KA_pelvis[2][5] - w.L_pelvis[2]*t65 - w.L_pelvis[7]*t67;
     const Scalar t69 = w.Linv_pelvis[2]*t68;
-    const Scalar t70 = w.KA_pelvis[53] - w.L_pelvis[3]*t65 - w.L_pelvis[8]*t67 - w.L_pelvis[12]*t69;
+    const Scalar t70 = w.KA_pelvis[3][5] - w.L_pelvis[3]*t65 - w.L_pelvis[8]*t67 - w.L_pelvis[12]*t69;
     const Scalar t71 = w.Linv_pelvis[3]*t70;
-    const Scalar t72 = w.KA_pelvis[69] - w.L_pelvis[4]*t65 - w.L_pelvis[9]*t67 - w.L_pelvis[13]*t69 - w.L_pelvis[16]*t71;
+    const Scalar t72 = w.KA_pelvis[4][5] - w.L_pelvis[4]*t65 - w.L_pelvis[9]*t67 - w.L_pelvis[13]*t69 - w.L_pelvis[16]*t71;
     const Scalar t73 = w.Linv_pelvis[4]*t72;
-    const Scalar t74 = w.KA_pelvis[85] - w.L_pelvis[5]*t65 - w.L_pelvis[10]*t67 - w.L_pelvis[14]*t69 - w.L_pelvis[17]*t71 - w.L_pelvis[19]*t73;
-    w.Z_pelvis[5] = w.KA_pelvis[5]*w.Linv_pelvis[0];
-    w.Z_pelvis[21] = w.Linv_pelvis[1]*t66;
-    w.Z_pelvis[37] = w.Linv_pelvis[2]*t68;
-    w.Z_pelvis[53] = w.Linv_pelvis[3]*t70;
-    w.Z_pelvis[69] = w.Linv_pelvis[4]*t72;
-    w.Z_pelvis[85] = w.Linv_pelvis[5]*t74;
-    const Scalar t75 = w.KA_pelvis[6]*w.Linv_pelvis[0];
-    const Scalar t76 = w.KA_pelvis[22] - w.L_pelvis[1]*t75;
+    const Scalar t74 = w.KA_pelvis[5][5] - w.L_pelvis[5]*t65 - w.L_pelvis[10]*t67 - w.L_pelvis[14]*t69 - w.L_pelvis[17]*t71 - w.L_pelvis[19]*t73;
+    w.Z_pelvis[0][5] = w.KA_pelvis[0][5]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][5] = w.Linv_pelvis[1]*t66;
+    w.Z_pelvis[2][5] = w.Linv_pelvis[2]*t68;
+    w.Z_pelvis[3][5] = w.Linv_pelvis[3]*t70;
+    w.Z_pelvis[4][5] = w.Linv_pelvis[4]*t72;
+    w.Z_pelvis[5][5] = w.Linv_pelvis[5]*t74;
+    const Scalar t75 = w.KA_pelvis[0][6]*w.Linv_pelvis[0];
+    const Scalar t76 = w.KA_pelvis[1][6] - w.L_pelvis[1]*t75;
     const Scalar t77 = w.Linv_pelvis[1]*t76;
-    const Scalar t78 = w.KA_pelvis[38] - w.L_pelvis[2]*t75 - w.L_pelvis[7]*t77;
+    const Scalar t78 = w.KA_pelvis[2][6] - w.L_pelvis[2]*t75 - w.L_pelvis[7]*t77;
     const Scalar t79 = w.Linv_pelvis[2]*t78;
-    const Scalar t80 = w.KA_pelvis[54] - w.L_pelvis[3]*t75 - w.L_pelvis[8]*t77 - w.L_pelvis[12]*t79;
+    const Scalar t80 = w.KA_pelvis[3][6] - w.L_pelvis[3]*t75 - w.L_pelvis[8]*t77 - w.L_pelvis[12]*t79;
     const Scalar t81 = w.Linv_pelvis[3]*t80;
-    const Scalar t82 = w.KA_pelvis[70] - w.L_pelvis[4]*t75 - w.L_pelvis[9]*t77 - w.L_pelvis[13]*t79 - w.L_pelvis[16]*t81;
+    const Scalar t82 = w.KA_pelvis[4][6] - w.L_pelvis[4]*t75 - w.L_pelvis[9]*t77 - w.L_pelvis[13]*t79 - w.L_pelvis[16]*t81;
     const Scalar t83 = w.Linv_pelvis[4]*t82;
-    const Scalar t84 = w.KA_pelvis[86] - w.L_pelvis[5]*t75 - w.L_pelvis[10]*t77 - w.L_pelvis[14]*t79 - w.L_pelvis[17]*t81 - w.L_pelvis[19]*t83;
-    w.Z_pelvis[6] = w.KA_pelvis[6]*w.Linv_pelvis[0];
-    w.Z_pelvis[22] = w.Linv_pelvis[1]*t76;
-    w.Z_pelvis[38] = w.Linv_pelvis[2]*t78;
-    w.Z_pelvis[54] = w.Linv_pelvis[3]*t80;
-    w.Z_pelvis[70] = w.Linv_pelvis[4]*t82;
-    w.Z_pelvis[86] = w.Linv_pelvis[5]*t84;
-    const Scalar t85 = w.KA_pelvis[7]*w.Linv_pelvis[0];
-    const Scalar t86 = w.KA_pelvis[23] - w.L_pelvis[1]*t85;
+    const Scalar t84 = w.KA_pelvis[5][6] - w.L_pelvis[5]*t75 - w.L_pelvis[10]*t77 - w.L_pelvis[14]*t79 - w.L_pelvis[17]*t81 - w.L_pelvis[19]*t83;
+    w.Z_pelvis[0][6] = w.KA_pelvis[0][6]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][6] = w.Linv_pelvis[1]*t76;
+    w.Z_pelvis[2][6] = w.Linv_pelvis[2]*t78;
+    w.Z_pelvis[3][6] = w.Linv_pelvis[3]*t80;
+    w.Z_pelvis[4][6] = w.Linv_pelvis[4]*t82;
+    w.Z_pelvis[5][6] = w.Linv_pelvis[5]*t84;
+    const Scalar t85 = w.KA_pelvis[0][7]*w.Linv_pelvis[0];
+    const Scalar t86 = w.KA_pelvis[1][7] - w.L_pelvis[1]*t85;
     const Scalar t87 = w.Linv_pelvis[1]*t86;
-    const Scalar t88 = w.KA_pelvis[39] - w.L_pelvis[2]*t85 - w.L_pelvis[7]*t87;
+    const Scalar t88 = w.KA_pelvis[2][7] - w.L_pelvis[2]*t85 - w.L_pelvis[7]*t87;
     const Scalar t89 = w.Linv_pelvis[2]*t88;
-    const Scalar t90 = w.KA_pelvis[55] - w.L_pelvis[3]*t85 - w.L_pelvis[8]*t87 - w.L_pelvis[12]*t89;
+    const Scalar t90 = w.KA_pelvis[3][7] - w.L_pelvis[3]*t85 - w.L_pelvis[8]*t87 - w.L_pelvis[12]*t89;
     const Scalar t91 = w.Linv_pelvis[3]*t90;
-    const Scalar t92 = w.KA_pelvis[71] - w.L_pelvis[4]*t85 - w.L_pelvis[9]*t87 - w.L_pelvis[13]*t89 - w.L_pelvis[16]*t91;
+    const Scalar t92 = w.KA_pelvis[4][7] - w.L_pelvis[4]*t85 - w.L_pelvis[9]*t87 - w.L_pelvis[13]*t89 - w.L_pelvis[16]*t91;
     const Scalar t93 = w.Linv_pelvis[4]*t92;
-    const Scalar t94 = w.KA_pelvis[87] - w.L_pelvis[5]*t85 - w.L_pelvis[10]*t87 - w.L_pelvis[14]*t89 - w.L_pelvis[17]*t91 - w.L_pelvis[19]*t93;
-    w.Z_pelvis[7] = w.KA_pelvis[7]*w.Linv_pelvis[0];
-    w.Z_pelvis[23] = w.Linv_pelvis[1]*t86;
-    w.Z_pelvis[39] = w.Linv_pelvis[2]*t88;
-    w.Z_pelvis[55] = w.Linv_pelvis[3]*t90;
-    w.Z_pelvis[71] = w.Linv_pelvis[4]*t92;
-    w.Z_pelvis[87] = w.Linv_pelvis[5]*t94;
-    const Scalar t95 = w.KA_pelvis[8]*w.Linv_pelvis[0];
-    const Scalar t96 = w.KA_pelvis[24] - w.L_pelvis[1]*t95;
+    const Scalar t94 = w.KA_pelvis[5][7] - w.L_pelvis[5]*t85 - w.L_pelvis[10]*t87 - w.L_pelvis[14]*t89 - w.L_pelvis[17]*t91 - w.L_pelvis[19]*t93;
+    w.Z_pelvis[0][7] = w.KA_pelvis[0][7]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][7] = w.Linv_pelvis[1]*t86;
+    w.Z_pelvis[2][7] = w.Linv_pelvis[2]*t88;
+    w.Z_pelvis[3][7] = w.Linv_pelvis[3]*t90;
+    w.Z_pelvis[4][7] = w.Linv_pelvis[4]*t92;
+    w.Z_pelvis[5][7] = w.Linv_pelvis[5]*t94;
+    const Scalar t95 = w.KA_pelvis[0][8]*w.Linv_pelvis[0];
+    const Scalar t96 = w.KA_pelvis[1][8] - w.L_pelvis[1]*t95;
     const Scalar t97 = w.Linv_pelvis[1]*t96;
-    const Scalar t98 = w.KA_pelvis[40] - w.L_pelvis[2]*t95 - w.L_pelvis[7]*t97;
+    const Scalar t98 = w.KA_pelvis[2][8] - w.L_pelvis[2]*t95 - w.L_pelvis[7]*t97;
     const Scalar t99 = w.Linv_pelvis[2]*t98;
-    const Scalar t100 = w.KA_pelvis[56] - w.L_pelvis[3]*t95 - w.L_pelvis[8]*t97 - w.L_pelvis[12]*t99;
+    const Scalar t100 = w.KA_pelvis[3][8] - w.L_pelvis[3]*t95 - w.L_pelvis[8]*t97 - w.L_pelvis[12]*t99;
     const Scalar t101 = w.Linv_pelvis[3]*t100;
-    const Scalar t102 = w.KA_pelvis[72] - w.L_pelvis[4]*t95 - w.L_pelvis[9]*t97 - w.L_pelvis[13]*t99 - w.L_pelvis[16]*t101;
+    const Scalar t102 = w.KA_pelvis[4][8] - w.L_pelvis[4]*t95 - w.L_pelvis[9]*t97 - w.L_pelvis[13]*t99 - w.L_pelvis[16]*t101;
     const Scalar t103 = w.Linv_pelvis[4]*t102;
-    const Scalar t104 = w.KA_pelvis[88] - w.L_pelvis[5]*t95 - w.L_pelvis[10]*t97 - w.L_pelvis[14]*t99 - w.L_pelvis[17]*t101 - w.L_pelvis[19]*t103;
-    w.Z_pelvis[8] = w.KA_pelvis[8]*w.Linv_pelvis[0];
-    w.Z_pelvis[24] = w.Linv_pelvis[1]*t96;
-    w.Z_pelvis[40] = w.Linv_pelvis[2]*t98;
-    w.Z_pelvis[56] = w.Linv_pelvis[3]*t100;
-    w.Z_pelvis[72] = w.Linv_pelvis[4]*t102;
-    w.Z_pelvis[88] = w.Linv_pelvis[5]*t104;
-    const Scalar t105 = w.KA_pelvis[9]*w.Linv_pelvis[0];
-    const Scalar t106 = w.KA_pelvis[25] - w.L_pelvis[1]*t105;
+    const Scalar t104 = w.KA_pelvis[5][8] - w.L_pelvis[5]*t95 - w.L_pelvis[10]*t97 - w.L_pelvis[14]*t99 - w.L_pelvis[17]*t101 - w.L_pelvis[19]*t103;
+    w.Z_pelvis[0][8] = w.KA_pelvis[0][8]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][8] = w.Linv_pelvis[1]*t96;
+    w.Z_pelvis[2][8] = w.Linv_pelvis[2]*t98;
+    w.Z_pelvis[3][8] = w.Linv_pelvis[3]*t100;
+    w.Z_pelvis[4][8] = w.Linv_pelvis[4]*t102;
+    w.Z_pelvis[5][8] = w.Linv_pelvis[5]*t104;
+    const Scalar t105 = w.KA_pelvis[0][9]*w.Linv_pelvis[0];
+    const Scalar t106 = w.KA_pelvis[1][9] - w.L_pelvis[1]*t105;
     const Scalar t107 = w.Linv_pelvis[1]*t106;
-    const Scalar t108 = w.KA_pelvis[41] - w.L_pelvis[2]*t105 - w.L_pelvis[7]*t107;
+    const Scalar t108 = w.KA_pelvis[2][9] - w.L_pelvis[2]*t105 - w.L_pelvis[7]*t107;
     const Scalar t109 = w.Linv_pelvis[2]*t108;
-    const Scalar t110 = w.KA_pelvis[57] - w.L_pelvis[3]*t105 - w.L_pelvis[8]*t107 - w.L_pelvis[12]*t109;
+    const Scalar t110 = w.KA_pelvis[3][9] - w.L_pelvis[3]*t105 - w.L_pelvis[8]*t107 - w.L_pelvis[12]*t109;
     const Scalar t111 = w.Linv_pelvis[3]*t110;
-    const Scalar t112 = w.KA_pelvis[73] - w.L_pelvis[4]*t105 - w.L_pelvis[9]*t107 - w.L_pelvis[13]*t109 - w.L_pelvis[16]*t111;
+    const Scalar t112 = w.KA_pelvis[4][9] - w.L_pelvis[4]*t105 - w.L_pelvis[9]*t107 - w.L_pelvis[13]*t109 - w.L_pelvis[16]*t111;
     const Scalar t113 = w.Linv_pelvis[4]*t112;
-    const Scalar t114 = w.KA_pelvis[89] - w.L_pelvis[5]*t105 - w.L_pelvis[10]*t107 - w.L_pelvis[14]*t109 - w.L_pelvis[17]*t111 - w.L_pelvis[19]*t113;
-    w.Z_pelvis[9] = w.KA_pelvis[9]*w.Linv_pelvis[0];
-    w.Z_pelvis[25] = w.Linv_pelvis[1]*t106;
-    w.Z_pelvis[41] = w.Linv_pelvis[2]*t108;
-    w.Z_pelvis[57] = w.Linv_pelvis[3]*t110;
-    w.Z_pelvis[73] = w.Linv_pelvis[4]*t112;
-    w.Z_pelvis[89] = w.Linv_pelvis[5]*t114;
-    const Scalar t115 = w.KA_pelvis[10]*w.Linv_pelvis[0];
-    const Scalar t116 = w.KA_pelvis[26] - w.L_pelvis[1]*t115;
+    const Scalar t114 = w.KA_pelvis[5][9] - w.L_pelvis[5]*t105 - w.L_pelvis[10]*t107 - w.L_pelvis[14]*t109 - w.L_pelvis[17]*t111 - w.L_pelvis[19]*t113;
+    w.Z_pelvis[0][9] = w.KA_pelvis[0][9]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][9] = w.Linv_pelvis[1]*t106;
+    w.Z_pelvis[2][9] = w.Linv_pelvis[2]*t108;
+    w.Z_pelvis[3][9] = w.Linv_pelvis[3]*t110;
+    w.Z_pelvis[4][9] = w.Linv_pelvis[4]*t112;
+    w.Z_pelvis[5][9] = w.Linv_pelvis[5]*t114;
+    const Scalar t115 = w.KA_pelvis[0][10]*w.Linv_pelvis[0];
+    const Scalar t116 = w.KA_pelvis[1][10] - w.L_pelvis[1]*t115;
     const Scalar t117 = w.Linv_pelvis[1]*t116;
-    const Scalar t118 = w.KA_pelvis[42] - w.L_pelvis[2]*t115 - w.L_pelvis[7]*t117;
+    const Scalar t118 = w.KA_pelvis[2][10] - w.L_pelvis[2]*t115 - w.L_pelvis[7]*t117;
     const Scalar t119 = w.Linv_pelvis[2]*t118;
-    const Scalar t120 = w.KA_pelvis[58] - w.L_pelvis[3]*t115 - w.L_pelvis[8]*t117 - w.L_pelvis[12]*t119;
+    const Scalar t120 = w.KA_pelvis[3][10] - w.L_pelvis[3]*t115 - w.L_pelvis[8]*t117 - w.L_pelvis[12]*t119;
     const Scalar t121 = w.Linv_pelvis[3]*t120;
-    const Scalar t122 = w.KA_pelvis[74] - w.L_pelvis[4]*t115 - w.L_pelvis[9]*t117 - w.L_pelvis[13]*t119 - w.L_pelvis[16]*t121;
+    const Scalar t122 = w.KA_pelvis[4][10] - w.L_pelvis[4]*t115 - w.L_pelvis[9]*t117 - w.L_pelvis[13]*t119 - w.L_pelvis[16]*t121;
     const Scalar t123 = w.Linv_pelvis[4]*t122;
-    const Scalar t124 = w.KA_pelvis[90] - w.L_pelvis[5]*t115 - w.L_pelvis[10]*t117 - w.L_pelvis[14]*t119 - w.L_pelvis[17]*t121 - w.L_pelvis[19]*t123;
-    w.Z_pelvis[10] = w.KA_pelvis[10]*w.Linv_pelvis[0];
-    w.Z_pelvis[26] = w.Linv_pelvis[1]*t116;
-    w.Z_pelvis[42] = w.Linv_pelvis[2]*t118;
-    w.Z_pelvis[58] = w.Linv_pelvis[3]*t120;
-    w.Z_pelvis[74] = w.Linv_pelvis[4]*t122;
-    w.Z_pelvis[90] = w.Linv_pelvis[5]*t124;
-    const Scalar t125 = w.KA_pelvis[11]*w.Linv_pelvis[0];
-    const Scalar t126 = w.KA_pelvis[27] - w.L_pelvis[1]*t125;
+    const Scalar t124 = w.KA_pelvis[5][10] - w.L_pelvis[5]*t115 - w.L_pelvis[10]*t117 - w.L_pelvis[14]*t119 - w.L_pelvis[17]*t121 - w.L_pelvis[19]*t123;
+    w.Z_pelvis[0][10] = w.KA_pelvis[0][10]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][10] = w.Linv_pelvis[1]*t116;
+    w.Z_pelvis[2][10] = w.Linv_pelvis[2]*t118;
+    w.Z_pelvis[3][10] = w.Linv_pelvis[3]*t120;
+    w.Z_pelvis[4][10] = w.Linv_pelvis[4]*t122;
+    w.Z_pelvis[5][10] = w.Linv_pelvis[5]*t124;
+    const Scalar t125 = w.KA_pelvis[0][11]*w.Linv_pelvis[0];
+    const Scalar t126 = w.KA_pelvis[1][11] - w.L_pelvis[1]*t125;
     const Scalar t127 = w.Linv_pelvis[1]*t126;
-    const Scalar t128 = w.KA_pelvis[43] - w.L_pelvis[2]*t125 - w.L_pelvis[7]*t127;
+    const Scalar t128 = w.KA_pelvis[2][11] - w.L_pelvis[2]*t125 - w.L_pelvis[7]*t127;
     const Scalar t129 = w.Linv_pelvis[2]*t128;
-    const Scalar t130 = w.KA_pelvis[59] - w.L_pelvis[3]*t125 - w.L_pelvis[8]*t127 - w.L_pelvis[12]*t129;
+    const Scalar t130 = w.KA_pelvis[3][11] - w.L_pelvis[3]*t125 - w.L_pelvis[8]*t127 - w.L_pelvis[12]*t129;
     const Scalar t131 = w.Linv_pelvis[3]*t130;
-    const Scalar t132 = w.KA_pelvis[75] - w.L_pelvis[4]*t125 - w.L_pelvis[9]*t127 - w.L_pelvis[13]*t129 - w.L_pelvis[16]*t131;
+    const Scalar t132 = w.KA_pelvis[4][11] - w.L_pelvis[4]*t125 - w.L_pelvis[9]*t127 - w.L_pelvis[13]*t129 - w.L_pelvis[16]*t131;
     const Scalar t133 = w.Linv_pelvis[4]*t132;
-    const Scalar t134 = w.KA_pelvis[91] - w.L_pelvis[5]*t125 - w.L_pelvis[10]*t127 - w.L_pelvis[14]*t129 - w.L_pelvis[17]*t131 - w.L_pelvis[19]*t133;
-    w.Z_pelvis[11] = w.KA_pelvis[11]*w.Linv_pelvis[0];
-    w.Z_pelvis[27] = w.Linv_pelvis[1]*t126;
-    w.Z_pelvis[43] = w.Linv_pelvis[2]*t128;
-    w.Z_pelvis[59] = w.Linv_pelvis[3]*t130;
-    w.Z_pelvis[75] = w.Linv_pelvis[4]*t132;
-    w.Z_pelvis[91] = w.Linv_pelvis[5]*t134;
-    const Scalar t135 = w.KA_pelvis[12]*w.Linv_pelvis[0];
-    const Scalar t136 = w.KA_pelvis[28] - w.L_pelvis[1]*t135;
+    const Scalar t134 = w.KA_pelvis[5][11] - w.L_pelvis[5]*t125 - w.L_pelvis[10]*t127 - w.L_pelvis[14]*t129 - w.L_pelvis[17]*t131 - w.L_pelvis[19]*t133;
+    w.Z_pelvis[0][11] = w.KA_pelvis[0][11]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][11] = w.Linv_pelvis[1]*t126;
+    w.Z_pelvis[2][11] = w.Linv_pelvis[2]*t128;
+    w.Z_pelvis[3][11] = w.Linv_pelvis[3]*t130;
+    w.Z_pelvis[4][11] = w.Linv_pelvis[4]*t132;
+    w.Z_pelvis[5][11] = w.Linv_pelvis[5]*t134;
+    const Scalar t135 = w.KA_pelvis[0][12]*w.Linv_pelvis[0];
+    const Scalar t136 = w.KA_pelvis[1][12] - w.L_pelvis[1]*t135;
     const Scalar t137 = w.Linv_pelvis[1]*t136;
-    const Scalar t138 = w.KA_pelvis[44] - w.L_pelvis[2]*t135 - w.L_pelvis[7]*t137;
+    const Scalar t138 = w.KA_pelvis[2][12] - w.L_pelvis[2]*t135 - w.L_pelvis[7]*t137;
     const Scalar t139 = w.Linv_pelvis[2]*t138;
-    const Scalar t140 = w.KA_pelvis[60] - w.L_pelvis[3]*t135 - w.L_pelvis[8]*t137 - w.L_pelvis[12]*t139;
+    const Scalar t140 = w.KA_pelvis[3][12] - w.L_pelvis[3]*t135 - w.L_pelvis[8]*t137 - w.L_pelvis[12]*t139;
     const Scalar t141 = w.Linv_pelvis[3]*t140;
-    const Scalar t142 = w.KA_pelvis[76] - w.L_pelvis[4]*t135 - w.L_pelvis[9]*t137 - w.L_pelvis[13]*t139 - w.L_pelvis[16]*t141;
+    const Scalar t142 = w.KA_pelvis[4][12] - w.L_pelvis[4]*t135 - w.L_pelvis[9]*t137 - w.L_pelvis[13]*t139 - w.L_pelvis[16]*t141;
     const Scalar t143 = w.Linv_pelvis[4]*t142;
     const Scalar t144 = -w.L_pelvis[5]*t135 - w.L_pelvis[10]*t137 - w.L_pelvis[14]*t139 - w.L_pelvis[17]*t141 - w.L_pelvis[19]*t143;
-    w.Z_pelvis[12] = w.KA_pelvis[12]*w.Linv_pelvis[0];
-    w.Z_pelvis[28] = w.Linv_pelvis[1]*t136;
-    w.Z_pelvis[44] = w.Linv_pelvis[2]*t138;
-    w.Z_pelvis[60] = w.Linv_pelvis[3]*t140;
-    w.Z_pelvis[76] = w.Linv_pelvis[4]*t142;
-    w.Z_pelvis[92] = w.Linv_pelvis[5]*t144;
-    const Scalar t145 = w.KA_pelvis[13]*w.Linv_pelvis[0];
-    const Scalar t146 = w.KA_pelvis[29] - w.L_pelvis[1]*t145;
+    w.Z_pelvis[0][12] = w.KA_pelvis[0][12]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][12] = w.Linv_pelvis[1]*t136;
+    w.Z_pelvis[2][12] = w.Linv_pelvis[2]*t138;
+    w.Z_pelvis[3][12] = w.Linv_pelvis[3]*t140;
+    w.Z_pelvis[4][12] = w.Linv_pelvis[4]*t142;
+    w.Z_pelvis[5][12] = w.Linv_pelvis[5]*t144;
+    const Scalar t145 = w.KA_pelvis[0][13]*w.Linv_pelvis[0];
+    const Scalar t146 = w.KA_pelvis[1][13] - w.L_pelvis[1]*t145;
     const Scalar t147 = w.Linv_pelvis[1]*t146;
-    const Scalar t148 = w.KA_pelvis[45] - w.L_pelvis[2]*t145 - w.L_pelvis[7]*t147;
+    const Scalar t148 = w.KA_pelvis[2][13] - w.L_pelvis[2]*t145 - w.L_pelvis[7]*t147;
     const Scalar t149 = w.Linv_pelvis[2]*t148;
-    const Scalar t150 = w.KA_pelvis[61] - w.L_pelvis[3]*t145 - w.L_pelvis[8]*t147 - w.L_pelvis[12]*t149;
+    const Scalar t150 = w.KA_pelvis[3][13] - w.L_pelvis[3]*t145 - w.L_pelvis[8]*t147 - w.L_pelvis[12]*t149;
     const Scalar t151 = w.Linv_pelvis[3]*t150;
-    const Scalar t152 = w.KA_pelvis[77] - w.L_pelvis[4]*t145 - w.L_pelvis[9]*t147 - w.L_pelvis[13]*t149 - w.L_pelvis[16]*t151;
+    const Scalar t152 = w.KA_pelvis[4][13] - w.L_pelvis[4]*t145 - w.L_pelvis[9]*t147 - w.L_pelvis[13]*t149 - w.L_pelvis[16]*t151;
     const Scalar t153 = w.Linv_pelvis[4]*t152;
     const Scalar t154 = -w.L_pelvis[5]*t145 - w.L_pelvis[10]*t147 - w.L_pelvis[14]*t149 - w.L_pelvis[17]*t151 - w.L_pelvis[19]*t153;
-    w.Z_pelvis[13] = w.KA_pelvis[13]*w.Linv_pelvis[0];
-    w.Z_pelvis[29] = w.Linv_pelvis[1]*t146;
-    w.Z_pelvis[45] = w.Linv_pelvis[2]*t148;
-    w.Z_pelvis[61] = w.Linv_pelvis[3]*t150;
-    w.Z_pelvis[77] = w.Linv_pelvis[4]*t152;
-    w.Z_pelvis[93] = w.Linv_pelvis[5]*t154;
-    const Scalar t155 = w.KA_pelvis[14]*w.Linv_pelvis[0];
-    const Scalar t156 = w.KA_pelvis[30] - w.L_pelvis[1]*t155;
+    w.Z_pelvis[0][13] = w.KA_pelvis[0][13]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][13] = w.Linv_pelvis[1]*t146;
+    w.Z_pelvis[2][13] = w.Linv_pelvis[2]*t148;
+    w.Z_pelvis[3][13] = w.Linv_pelvis[3]*t150;
+    w.Z_pelvis[4][13] = w.Linv_pelvis[4]*t152;
+    w.Z_pelvis[5][13] = w.Linv_pelvis[5]*t154;
+    const Scalar t155 = w.KA_pelvis[0][14]*w.Linv_pelvis[0];
+    const Scalar t156 = w.KA_pelvis[1][14] - w.L_pelvis[1]*t155;
     const Scalar t157 = w.Linv_pelvis[1]*t156;
-    const Scalar t158 = w.KA_pelvis[46] - w.L_pelvis[2]*t155 - w.L_pelvis[7]*t157;
+    const Scalar t158 = w.KA_pelvis[2][14] - w.L_pelvis[2]*t155 - w.L_pelvis[7]*t157;
     const Scalar t159 = w.Linv_pelvis[2]*t158;
-    const Scalar t160 = w.KA_pelvis[62] - w.L_pelvis[3]*t155 - w.L_pelvis[8]*t157 - w.L_pelvis[12]*t159;
+    const Scalar t160 = w.KA_pelvis[3][14] - w.L_pelvis[3]*t155 - w.L_pelvis[8]*t157 - w.L_pelvis[12]*t159;
     const Scalar t161 = w.Linv_pelvis[3]*t160;
-    const Scalar t162 = w.KA_pelvis[78] - w.L_pelvis[4]*t155 - w.L_pelvis[9]*t157 - w.L_pelvis[13]*t159 - w.L_pelvis[16]*t161;
+    const Scalar t162 = w.KA_pelvis[4][14] - w.L_pelvis[4]*t155 - w.L_pelvis[9]*t157 - w.L_pelvis[13]*t159 - w.L_pelvis[16]*t161;
     const Scalar t163 = w.Linv_pelvis[4]*t162;
     const Scalar t164 = -w.L_pelvis[5]*t155 - w.L_pelvis[10]*t157 - w.L_pelvis[14]*t159 - w.L_pelvis[17]*t161 - w.L_pelvis[19]*t163;
-    w.Z_pelvis[14] = w.KA_pelvis[14]*w.Linv_pelvis[0];
-    w.Z_pelvis[30] = w.Linv_pelvis[1]*t156;
-    w.Z_pelvis[46] = w.Linv_pelvis[2]*t158;
-    w.Z_pelvis[62] = w.Linv_pelvis[3]*t160;
-    w.Z_pelvis[78] = w.Linv_pelvis[4]*t162;
-    w.Z_pelvis[94] = w.Linv_pelvis[5]*t164;
+    w.Z_pelvis[0][14] = w.KA_pelvis[0][14]*w.Linv_pelvis[0];
+    w.Z_pelvis[1][14] = w.Linv_pelvis[1]*t156;
+    w.Z_pelvis[2][14] = w.Linv_pelvis[2]*t158;
+    w.Z_pelvis[3][14] = w.Linv_pelvis[3]*t160;
+    w.Z_pelvis[4][14] = w.Linv_pelvis[4]*t162;
+    w.Z_pelvis[5][14] = w.Linv_pelvis[5]*t164;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
@@ -7698,7 +7666,7 @@ PROXGEN_RT_NOINLINE void pv_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
@@ -7753,7 +7721,7 @@ PROXGEN_RT_NOINLINE void pv_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
@@ -7784,7 +7752,7 @@ PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_l_foot[0] = w.a_l_ankle_link[0];
     w.a_l_foot[1] = t11;
     w.a_l_foot[2] = t12;
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.Dinv_l_foot*t15;
+    w.a_l_foot[3] = w.a_l_ankle_link[3] + 514.0929615568219*t15;
     w.a_l_foot[4] = t13;
     w.a_l_foot[5] = t14;
   }
@@ -7810,7 +7778,7 @@ PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
@@ -7865,7 +7833,7 @@ PROXGEN_RT_NOINLINE void pv_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
@@ -7896,7 +7864,7 @@ PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_r_foot[0] = w.a_r_ankle_link[0];
     w.a_r_foot[1] = t11;
     w.a_r_foot[2] = t12;
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.Dinv_r_foot*t15;
+    w.a_r_foot[3] = w.a_r_ankle_link[3] + 514.0929615568219*t15;
     w.a_r_foot[4] = t13;
     w.a_r_foot[5] = t14;
   }
@@ -7918,7 +7886,7 @@ PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
@@ -7974,7 +7942,7 @@ PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
@@ -8027,7 +7995,7 @@ PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
     const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
@@ -8052,7 +8020,7 @@ PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
     w.a_r_hand[1] = t5;
     w.a_r_hand[2] = t6;
-    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.Dinv_r_hand*t9;
+    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + 193.62412145174838*t9;
     w.a_r_hand[4] = t7;
     w.a_r_hand[5] = t8;
   }
@@ -8076,505 +8044,505 @@ PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_29(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_3(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[0]*w.KA_l_thigh[28] + w.KSD_l_shank[0]*w.KA_l_shank[28] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[28] + inv_mu;
+    const Scalar t0 = w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[0]*w.KA_l_thigh[4][0] + w.KSD_l_shank[0]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[4][0] + inv_mu;
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
-    const Scalar t1 = w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[1]*w.KA_l_thigh[28] + w.KSD_l_shank[1]*w.KA_l_shank[28] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[28];
+    const Scalar t1 = w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][0] + w.KSD_l_shank[1]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][0];
     w.L[1] = w.Linv[0]*t1;
-    const Scalar t2 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[2]*w.KA_l_thigh[28] + w.KSD_l_shank[2]*w.KA_l_shank[28];
+    const Scalar t2 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][0] + w.KSD_l_shank[2]*w.KA_l_shank[4][0];
     w.L[2] = w.Linv[0]*t2;
-    const Scalar t3 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[3]*w.KA_l_thigh[28] + w.KSD_l_shank[3]*w.KA_l_shank[28] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[28];
+    const Scalar t3 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][0] + w.KSD_l_shank[3]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][0];
     w.L[3] = w.Linv[0]*t3;
-    const Scalar t4 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[4]*w.KA_l_thigh[28] + w.KSD_l_shank[4]*w.KA_l_shank[28] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[28];
+    const Scalar t4 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][0] + w.KSD_l_shank[4]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][0];
     w.L[4] = w.Linv[0]*t4;
-    const Scalar t5 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[35] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[21] + w.KSD_l_thigh[5]*w.KA_l_thigh[28] + w.KSD_l_shank[5]*w.KA_l_shank[28] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[28];
+    const Scalar t5 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][0] + w.KSD_l_shank[5]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][0];
     w.L[5] = w.Linv[0]*t5;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = 0.06825*w.KSD_l_foot[1] + inv_mu + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[36] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[22] + w.KSD_l_thigh[1]*w.KA_l_thigh[29] + w.KSD_l_shank[1]*w.KA_l_shank[29] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[29] - w.L[1]*w.L[1];
+    const Scalar t6 = 2.394677145741774 + inv_mu + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][1] + w.KSD_l_shank[1]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[1];
     const Scalar r1 = std::sqrt(t6);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t7 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[36] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[22] + w.KSD_l_thigh[2]*w.KA_l_thigh[29] + w.KSD_l_shank[2]*w.KA_l_shank[29] - w.L[1]*w.L[2];
+    const Scalar t7 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][1] + w.KSD_l_shank[2]*w.KA_l_shank[4][1] - w.L[1]*w.L[2];
     w.L[16] = w.Linv[1]*t7;
-    const Scalar t8 = 0.06825*w.Dinv_l_foot + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[36] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[22] + w.KSD_l_thigh[3]*w.KA_l_thigh[29] + w.KSD_l_shank[3]*w.KA_l_shank[29] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[29] - w.L[1]*w.L[3];
+    const Scalar t8 = 35.0868446262531 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][1] + w.KSD_l_shank[3]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[3];
     w.L[17] = w.Linv[1]*t8;
-    const Scalar t9 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[36] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[22] + w.KSD_l_thigh[4]*w.KA_l_thigh[29] + w.KSD_l_shank[4]*w.KA_l_shank[29] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[29] - w.L[1]*w.L[4];
+    const Scalar t9 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][1] + w.KSD_l_shank[4]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[4];
     w.L[18] = w.Linv[1]*t9;
-    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[36] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[22] + w.KSD_l_thigh[5]*w.KA_l_thigh[29] + w.KSD_l_shank[5]*w.KA_l_shank[29] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[29] - w.L[1]*w.L[5];
+    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][1] + w.KSD_l_shank[5]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[5];
     w.L[19] = w.Linv[1]*t10;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t11 = inv_mu + w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[37] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[23] + w.KSD_l_thigh[2]*w.KA_l_thigh[30] + w.KSD_l_shank[2]*w.KA_l_shank[30] - w.L[2]*w.L[2] - w.L[16]*w.L[16];
+    const Scalar t11 = inv_mu + w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][2] + w.KSD_l_shank[2]*w.KA_l_shank[4][2] - w.L[2]*w.L[2] - w.L[16]*w.L[16];
     const Scalar r2 = std::sqrt(t11);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    const Scalar t12 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[37] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[23] + w.KSD_l_thigh[3]*w.KA_l_thigh[30] + w.KSD_l_shank[3]*w.KA_l_shank[30] - w.L[2]*w.L[3] - w.L[16]*w.L[17];
+    const Scalar t12 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][2] + w.KSD_l_shank[3]*w.KA_l_shank[4][2] - w.L[2]*w.L[3] - w.L[16]*w.L[17];
     w.L[30] = w.Linv[2]*t12;
-    const Scalar t13 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[37] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[23] + w.KSD_l_thigh[4]*w.KA_l_thigh[30] + w.KSD_l_shank[4]*w.KA_l_shank[30] - w.L[2]*w.L[4] - w.L[16]*w.L[18];
+    const Scalar t13 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][2] + w.KSD_l_shank[4]*w.KA_l_shank[4][2] - w.L[2]*w.L[4] - w.L[16]*w.L[18];
     w.L[31] = w.Linv[2]*t13;
-    const Scalar t14 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[37] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[23] + w.KSD_l_thigh[5]*w.KA_l_thigh[30] + w.KSD_l_shank[5]*w.KA_l_shank[30] - w.L[2]*w.L[5] - w.L[16]*w.L[19];
+    const Scalar t14 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][2] + w.KSD_l_shank[5]*w.KA_l_shank[4][2] - w.L[2]*w.L[5] - w.L[16]*w.L[19];
     w.L[32] = w.Linv[2]*t14;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t15 = w.Dinv_l_foot + inv_mu + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[38] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[24] + w.KSD_l_thigh[3]*w.KA_l_thigh[31] + w.KSD_l_shank[3]*w.KA_l_shank[31] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[31] - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
+    const Scalar t15 = 514.0929615568219 + inv_mu + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][3] + w.KSD_l_shank[3]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
     const Scalar r3 = std::sqrt(t15);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
-    const Scalar t16 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[38] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[24] + w.KSD_l_thigh[4]*w.KA_l_thigh[31] + w.KSD_l_shank[4]*w.KA_l_shank[31] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[31] - w.L[3]*w.L[4] - w.L[17]*w.L[18] - w.L[30]*w.L[31];
+    const Scalar t16 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][3] + w.KSD_l_shank[4]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[4] - w.L[17]*w.L[18] - w.L[30]*w.L[31];
     w.L[43] = w.Linv[3]*t16;
-    const Scalar t17 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[38] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[24] + w.KSD_l_thigh[5]*w.KA_l_thigh[31] + w.KSD_l_shank[5]*w.KA_l_shank[31] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[31] - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
+    const Scalar t17 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][3] + w.KSD_l_shank[5]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
     w.L[44] = w.Linv[3]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_30(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_4_to_column_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[39] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[25] + w.KSD_l_thigh[4]*w.KA_l_thigh[32] + w.KSD_l_shank[4]*w.KA_l_shank[32] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[32] + inv_mu - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
+    const Scalar t0 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][4] + w.KSD_l_shank[4]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][4] + inv_mu - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[4] = inv0;
-    const Scalar t1 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[39] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[25] + w.KSD_l_thigh[5]*w.KA_l_thigh[32] + w.KSD_l_shank[5]*w.KA_l_shank[32] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[32] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
+    const Scalar t1 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][4] + w.KSD_l_shank[5]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][4] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
     w.L[55] = w.Linv[4]*t1;
   }
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t2 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[40] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[26] + w.KSD_l_thigh[5]*w.KA_l_thigh[33] + w.KSD_l_shank[5]*w.KA_l_shank[33] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[33] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
+    const Scalar t2 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][5] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][5] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][5] + w.KSD_l_shank[5]*w.KA_l_shank[4][5] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][5] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
     const Scalar r1 = std::sqrt(t2);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[5] = inv1;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[0]*w.KA_r_thigh[28] + w.KSD_r_shank[0]*w.KA_r_shank[28] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[28];
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[0]*w.KA_r_thigh[4][0] + w.KSD_r_shank[0]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4][0];
     const Scalar r2 = std::sqrt(t3);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[6] = inv2;
-    const Scalar t4 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[1]*w.KA_r_thigh[28] + w.KSD_r_shank[1]*w.KA_r_shank[28] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[28];
+    const Scalar t4 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][0] + w.KSD_r_shank[1]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][0];
     w.L[76] = w.Linv[6]*t4;
-    const Scalar t5 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[2]*w.KA_r_thigh[28] + w.KSD_r_shank[2]*w.KA_r_shank[28];
+    const Scalar t5 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][0] + w.KSD_r_shank[2]*w.KA_r_shank[4][0];
     w.L[77] = w.Linv[6]*t5;
-    const Scalar t6 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[3]*w.KA_r_thigh[28] + w.KSD_r_shank[3]*w.KA_r_shank[28] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[28];
+    const Scalar t6 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][0] + w.KSD_r_shank[3]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][0];
     w.L[78] = w.Linv[6]*t6;
-    const Scalar t7 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[4]*w.KA_r_thigh[28] + w.KSD_r_shank[4]*w.KA_r_shank[28] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[28];
+    const Scalar t7 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][0] + w.KSD_r_shank[4]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][0];
     w.L[79] = w.Linv[6]*t7;
-    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[35] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[21] + w.KSD_r_thigh[5]*w.KA_r_thigh[28] + w.KSD_r_shank[5]*w.KA_r_shank[28] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[28];
+    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][0] + w.KSD_r_shank[5]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][0];
     w.L[80] = w.Linv[6]*t8;
   }
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = 0.06825*w.KSD_r_foot[1] + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[36] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[22] + w.KSD_r_thigh[1]*w.KA_r_thigh[29] + w.KSD_r_shank[1]*w.KA_r_shank[29] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[29] - w.L[76]*w.L[76];
+    const Scalar t9 = 2.394677145741774 + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][1] + w.KSD_r_shank[1]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[76];
     const Scalar r3 = std::sqrt(t9);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[7] = inv3;
-    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[36] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[22] + w.KSD_r_thigh[2]*w.KA_r_thigh[29] + w.KSD_r_shank[2]*w.KA_r_shank[29] - w.L[76]*w.L[77];
+    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][1] + w.KSD_r_shank[2]*w.KA_r_shank[4][1] - w.L[76]*w.L[77];
     w.L[85] = w.Linv[7]*t10;
-    const Scalar t11 = 0.06825*w.Dinv_r_foot + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[36] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[22] + w.KSD_r_thigh[3]*w.KA_r_thigh[29] + w.KSD_r_shank[3]*w.KA_r_shank[29] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[29] - w.L[76]*w.L[78];
+    const Scalar t11 = 35.0868446262531 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][1] + w.KSD_r_shank[3]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[78];
     w.L[86] = w.Linv[7]*t11;
-    const Scalar t12 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[36] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[22] + w.KSD_r_thigh[4]*w.KA_r_thigh[29] + w.KSD_r_shank[4]*w.KA_r_shank[29] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[29] - w.L[76]*w.L[79];
+    const Scalar t12 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][1] + w.KSD_r_shank[4]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[79];
     w.L[87] = w.Linv[7]*t12;
-    const Scalar t13 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[36] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[22] + w.KSD_r_thigh[5]*w.KA_r_thigh[29] + w.KSD_r_shank[5]*w.KA_r_shank[29] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[29] - w.L[76]*w.L[80];
+    const Scalar t13 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][1] + w.KSD_r_shank[5]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[80];
     w.L[88] = w.Linv[7]*t13;
   }
   // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t14 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[37] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[23] + w.KSD_r_thigh[2]*w.KA_r_thigh[30] + w.KSD_r_shank[2]*w.KA_r_shank[30] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
+    const Scalar t14 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][2] + w.KSD_r_shank[2]*w.KA_r_shank[4][2] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
     const Scalar r4 = std::sqrt(t14);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[8] = inv4;
-    const Scalar t15 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[37] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[23] + w.KSD_r_thigh[3]*w.KA_r_thigh[30] + w.KSD_r_shank[3]*w.KA_r_shank[30] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
+    const Scalar t15 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][2] + w.KSD_r_shank[3]*w.KA_r_shank[4][2] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
     w.L[93] = w.Linv[8]*t15;
-    const Scalar t16 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[37] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[23] + w.KSD_r_thigh[4]*w.KA_r_thigh[30] + w.KSD_r_shank[4]*w.KA_r_shank[30] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
+    const Scalar t16 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][2] + w.KSD_r_shank[4]*w.KA_r_shank[4][2] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
     w.L[94] = w.Linv[8]*t16;
-    const Scalar t17 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[37] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[23] + w.KSD_r_thigh[5]*w.KA_r_thigh[30] + w.KSD_r_shank[5]*w.KA_r_shank[30] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
+    const Scalar t17 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][2] + w.KSD_r_shank[5]*w.KA_r_shank[4][2] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
     w.L[95] = w.Linv[8]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_31(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.Dinv_r_foot + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[38] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[24] + w.KSD_r_thigh[3]*w.KA_r_thigh[31] + w.KSD_r_shank[3]*w.KA_r_shank[31] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[31] + inv_mu - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
+    const Scalar t0 = 514.0929615568219 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3] + inv_mu - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[9] = inv0;
-    const Scalar t1 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[38] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[24] + w.KSD_r_thigh[4]*w.KA_r_thigh[31] + w.KSD_r_shank[4]*w.KA_r_shank[31] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[31] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
+    const Scalar t1 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][3] + w.KSD_r_shank[4]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
     w.L[100] = w.Linv[9]*t1;
-    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[38] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[24] + w.KSD_r_thigh[5]*w.KA_r_thigh[31] + w.KSD_r_shank[5]*w.KA_r_shank[31] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[31] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
+    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][3] + w.KSD_r_shank[5]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
     w.L[101] = w.Linv[9]*t2;
   }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[39] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[25] + w.KSD_r_thigh[4]*w.KA_r_thigh[32] + w.KSD_r_shank[4]*w.KA_r_shank[32] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[32] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][4] + w.KSD_r_shank[4]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
     const Scalar r1 = std::sqrt(t3);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[10] = inv1;
-    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[39] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[25] + w.KSD_r_thigh[5]*w.KA_r_thigh[32] + w.KSD_r_shank[5]*w.KA_r_shank[32] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[32] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
+    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][4] + w.KSD_r_shank[5]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
     w.L[106] = w.Linv[10]*t4;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t5 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[40] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[26] + w.KSD_r_thigh[5]*w.KA_r_thigh[33] + w.KSD_r_shank[5]*w.KA_r_shank[33] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[33] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
+    const Scalar t5 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][5] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][5] + w.KSD_r_shank[5]*w.KA_r_shank[4][5] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][5] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
     const Scalar r2 = std::sqrt(t5);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[11] = inv2;
   }
   // G + I/mu = L L^T, column 12 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = 0.13*w.KSD_r_hand[0] + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[20] + w.KSD_chest[0]*w.KA_chest[16] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[16] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[12] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[20] + w.KSD_r_forearm[0]*w.KA_r_forearm[16];
+    const Scalar t6 = 3.272247652534548 + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5][0] + w.KSD_chest[0]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[0]*w.KA_r_forearm[4][0];
     const Scalar r3 = std::sqrt(t6);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[12] = inv3;
-    const Scalar t7 = w.KSD_abdomen[1]*w.KA_abdomen[20] + w.KSD_chest[1]*w.KA_chest[16] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[16] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[12] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[20] + w.KSD_r_forearm[1]*w.KA_r_forearm[16];
+    const Scalar t7 = w.KSD_abdomen[1]*w.KA_abdomen[5][0] + w.KSD_chest[1]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][0];
     w.L[115] = w.Linv[12]*t7;
-    const Scalar t8 = w.KSD_abdomen[2]*w.KA_abdomen[20] + w.KSD_chest[2]*w.KA_chest[16] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[16] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[12] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[20] + w.KSD_r_forearm[2]*w.KA_r_forearm[16];
+    const Scalar t8 = w.KSD_abdomen[2]*w.KA_abdomen[5][0] + w.KSD_chest[2]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][0];
     w.L[116] = w.Linv[12]*t8;
   }
   // G + I/mu = L L^T, column 13 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[21] + w.KSD_chest[1]*w.KA_chest[17] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[17] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[13] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[21] + w.KSD_r_forearm[1]*w.KA_r_forearm[17] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[21] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[17] - w.L[115]*w.L[115];
+    const Scalar t9 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[5][1] + w.KSD_chest[1]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][1] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[5][1] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[4][1] - w.L[115]*w.L[115];
     const Scalar r4 = std::sqrt(t9);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[13] = inv4;
-    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[21] + w.KSD_chest[2]*w.KA_chest[17] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[17] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[13] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[21] + w.KSD_r_forearm[2]*w.KA_r_forearm[17] - w.L[115]*w.L[116];
+    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[5][1] + w.KSD_chest[2]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][1] - w.L[115]*w.L[116];
     w.L[118] = w.Linv[13]*t10;
   }
   // G + I/mu = L L^T, column 14 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t11 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[22] + w.KSD_chest[2]*w.KA_chest[18] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[18] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[14] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[22] + w.KSD_r_forearm[2]*w.KA_r_forearm[18] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
+    const Scalar t11 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[5][2] + w.KSD_chest[2]*w.KA_chest[4][2] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][2] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][2] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][2] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][2] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
     const Scalar r5 = std::sqrt(t11);
     const Scalar inv5 = 1.0 / r5;
     w.Linv[14] = inv5;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t12 = w.Z_pelvis[0]*w.Linv[0];
-    const Scalar t13 = w.Z_pelvis[1] - w.L[1]*t12;
+    const Scalar t12 = w.Z_pelvis[0][0]*w.Linv[0];
+    const Scalar t13 = w.Z_pelvis[0][1] - w.L[1]*t12;
     const Scalar t14 = w.Linv[1]*t13;
-    const Scalar t15 = w.Z_pelvis[2] - w.L[2]*t12 - w.L[16]*t14;
+    const Scalar t15 = w.Z_pelvis[0][2] - w.L[2]*t12 - w.L[16]*t14;
     const Scalar t16 = w.Linv[2]*t15;
-    const Scalar t17 = w.Z_pelvis[3] - w.L[3]*t12 - w.L[17]*t14 - w.L[30]*t16;
+    const Scalar t17 = w.Z_pelvis[0][3] - w.L[3]*t12 - w.L[17]*t14 - w.L[30]*t16;
     const Scalar t18 = w.Linv[3]*t17;
-    const Scalar t19 = w.Z_pelvis[4] - w.L[4]*t12 - w.L[18]*t14 - w.L[31]*t16 - w.L[43]*t18;
+    const Scalar t19 = w.Z_pelvis[0][4] - w.L[4]*t12 - w.L[18]*t14 - w.L[31]*t16 - w.L[43]*t18;
     const Scalar t20 = w.Linv[4]*t19;
-    const Scalar t21 = w.Z_pelvis[5] - w.L[5]*t12 - w.L[19]*t14 - w.L[32]*t16 - w.L[44]*t18 - w.L[55]*t20;
-    const Scalar t22 = w.Z_pelvis[6]*w.Linv[6];
-    const Scalar t23 = w.Z_pelvis[7] - w.L[76]*t22;
+    const Scalar t21 = w.Z_pelvis[0][5] - w.L[5]*t12 - w.L[19]*t14 - w.L[32]*t16 - w.L[44]*t18 - w.L[55]*t20;
+    const Scalar t22 = w.Z_pelvis[0][6]*w.Linv[6];
+    const Scalar t23 = w.Z_pelvis[0][7] - w.L[76]*t22;
     const Scalar t24 = w.Linv[7]*t23;
-    const Scalar t25 = w.Z_pelvis[8] - w.L[77]*t22 - w.L[85]*t24;
+    const Scalar t25 = w.Z_pelvis[0][8] - w.L[77]*t22 - w.L[85]*t24;
     const Scalar t26 = w.Linv[8]*t25;
-    const Scalar t27 = w.Z_pelvis[9] - w.L[78]*t22 - w.L[86]*t24 - w.L[93]*t26;
+    const Scalar t27 = w.Z_pelvis[0][9] - w.L[78]*t22 - w.L[86]*t24 - w.L[93]*t26;
     const Scalar t28 = w.Linv[9]*t27;
-    const Scalar t29 = w.Z_pelvis[10] - w.L[79]*t22 - w.L[87]*t24 - w.L[94]*t26 - w.L[100]*t28;
+    const Scalar t29 = w.Z_pelvis[0][10] - w.L[79]*t22 - w.L[87]*t24 - w.L[94]*t26 - w.L[100]*t28;
     const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_pelvis[11] - w.L[80]*t22 - w.L[88]*t24 - w.L[95]*t26 - w.L[101]*t28 - w.L[106]*t30;
-    const Scalar t32 = w.Z_pelvis[12]*w.Linv[12];
-    const Scalar t33 = w.Z_pelvis[13] - w.L[115]*t32;
+    const Scalar t31 = w.Z_pelvis[0][11] - w.L[80]*t22 - w.L[88]*t24 - w.L[95]*t26 - w.L[101]*t28 - w.L[106]*t30;
+    const Scalar t32 = w.Z_pelvis[0][12]*w.Linv[12];
+    const Scalar t33 = w.Z_pelvis[0][13] - w.L[115]*t32;
     const Scalar t34 = w.Linv[13]*t33;
-    const Scalar t35 = w.Z_pelvis[14] - w.L[116]*t32 - w.L[118]*t34;
-    w.W[0] = w.Z_pelvis[0]*w.Linv[0];
-    w.W[6] = w.Linv[1]*t13;
-    w.W[12] = w.Linv[2]*t15;
-    w.W[18] = w.Linv[3]*t17;
-    w.W[24] = w.Linv[4]*t19;
-    w.W[30] = w.Linv[5]*t21;
-    w.W[36] = w.Z_pelvis[6]*w.Linv[6];
-    w.W[42] = w.Linv[7]*t23;
-    w.W[48] = w.Linv[8]*t25;
-    w.W[54] = w.Linv[9]*t27;
-    w.W[60] = w.Linv[10]*t29;
-    w.W[66] = w.Linv[11]*t31;
-    w.W[72] = w.Z_pelvis[12]*w.Linv[12];
-    w.W[78] = w.Linv[13]*t33;
-    w.W[84] = w.Linv[14]*t35;
+    const Scalar t35 = w.Z_pelvis[0][14] - w.L[116]*t32 - w.L[118]*t34;
+    w.W[0][0] = w.Z_pelvis[0][0]*w.Linv[0];
+    w.W[1][0] = w.Linv[1]*t13;
+    w.W[2][0] = w.Linv[2]*t15;
+    w.W[3][0] = w.Linv[3]*t17;
+    w.W[4][0] = w.Linv[4]*t19;
+    w.W[5][0] = w.Linv[5]*t21;
+    w.W[6][0] = w.Z_pelvis[0][6]*w.Linv[6];
+    w.W[7][0] = w.Linv[7]*t23;
+    w.W[8][0] = w.Linv[8]*t25;
+    w.W[9][0] = w.Linv[9]*t27;
+    w.W[10][0] = w.Linv[10]*t29;
+    w.W[11][0] = w.Linv[11]*t31;
+    w.W[12][0] = w.Z_pelvis[0][12]*w.Linv[12];
+    w.W[13][0] = w.Linv[13]*t33;
+    w.W[14][0] = w.Linv[14]*t35;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_32(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_1_to_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
-    const Scalar t0 = w.Z_pelvis[16]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[17] - w.L[1]*t0;
+    const Scalar t0 = w.Z_pelvis[1][0]*w.Linv[0];
+    const Scalar t1 = w.Z_pelvis[1][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[18] - w.L[2]*t0 - w.L[16]*t2;
+    const Scalar t3 = w.Z_pelvis[1][2] - w.L[2]*t0 - w.L[16]*t2;
     const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[19] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
+    const Scalar t5 = w.Z_pelvis[1][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
     const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[20] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
+    const Scalar t7 = w.Z_pelvis[1][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
     const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[21] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[22]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[23] - w.L[76]*t10;
+    const Scalar t9 = w.Z_pelvis[1][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
+    const Scalar t10 = w.Z_pelvis[1][6]*w.Linv[6];
+    const Scalar t11 = w.Z_pelvis[1][7] - w.L[76]*t10;
     const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[24] - w.L[77]*t10 - w.L[85]*t12;
+    const Scalar t13 = w.Z_pelvis[1][8] - w.L[77]*t10 - w.L[85]*t12;
     const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[25] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
+    const Scalar t15 = w.Z_pelvis[1][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
     const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[26] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
+    const Scalar t17 = w.Z_pelvis[1][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
     const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[27] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[28]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[29] - w.L[115]*t20;
+    const Scalar t19 = w.Z_pelvis[1][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
+    const Scalar t20 = w.Z_pelvis[1][12]*w.Linv[12];
+    const Scalar t21 = w.Z_pelvis[1][13] - w.L[115]*t20;
     const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[30] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[1] = w.Z_pelvis[16]*w.Linv[0];
-    w.W[7] = w.Linv[1]*t1;
-    w.W[13] = w.Linv[2]*t3;
-    w.W[19] = w.Linv[3]*t5;
-    w.W[25] = w.Linv[4]*t7;
-    w.W[31] = w.Linv[5]*t9;
-    w.W[37] = w.Z_pelvis[22]*w.Linv[6];
-    w.W[43] = w.Linv[7]*t11;
-    w.W[49] = w.Linv[8]*t13;
-    w.W[55] = w.Linv[9]*t15;
-    w.W[61] = w.Linv[10]*t17;
-    w.W[67] = w.Linv[11]*t19;
-    w.W[73] = w.Z_pelvis[28]*w.Linv[12];
-    w.W[79] = w.Linv[13]*t21;
-    w.W[85] = w.Linv[14]*t23;
+    const Scalar t23 = w.Z_pelvis[1][14] - w.L[116]*t20 - w.L[118]*t22;
+    w.W[0][1] = w.Z_pelvis[1][0]*w.Linv[0];
+    w.W[1][1] = w.Linv[1]*t1;
+    w.W[2][1] = w.Linv[2]*t3;
+    w.W[3][1] = w.Linv[3]*t5;
+    w.W[4][1] = w.Linv[4]*t7;
+    w.W[5][1] = w.Linv[5]*t9;
+    w.W[6][1] = w.Z_pelvis[1][6]*w.Linv[6];
+    w.W[7][1] = w.Linv[7]*t11;
+    w.W[8][1] = w.Linv[8]*t13;
+    w.W[9][1] = w.Linv[9]*t15;
+    w.W[10][1] = w.Linv[10]*t17;
+    w.W[11][1] = w.Linv[11]*t19;
+    w.W[12][1] = w.Z_pelvis[1][12]*w.Linv[12];
+    w.W[13][1] = w.Linv[13]*t21;
+    w.W[14][1] = w.Linv[14]*t23;
   }
   // W = L^-1 Z^T, column 2
   {
-    const Scalar t24 = w.Z_pelvis[32]*w.Linv[0];
-    const Scalar t25 = w.Z_pelvis[33] - w.L[1]*t24;
+    const Scalar t24 = w.Z_pelvis[2][0]*w.Linv[0];
+    const Scalar t25 = w.Z_pelvis[2][1] - w.L[1]*t24;
     const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_pelvis[34] - w.L[2]*t24 - w.L[16]*t26;
+    const Scalar t27 = w.Z_pelvis[2][2] - w.L[2]*t24 - w.L[16]*t26;
     const Scalar t28 = w.Linv[2]*t27;
-    const Scalar t29 = w.Z_pelvis[35] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
+    const Scalar t29 = w.Z_pelvis[2][3] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
     const Scalar t30 = w.Linv[3]*t29;
-    const Scalar t31 = w.Z_pelvis[36] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
+    const Scalar t31 = w.Z_pelvis[2][4] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
     const Scalar t32 = w.Linv[4]*t31;
-    const Scalar t33 = w.Z_pelvis[37] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
-    const Scalar t34 = w.Z_pelvis[38]*w.Linv[6];
-    const Scalar t35 = w.Z_pelvis[39] - w.L[76]*t34;
+    const Scalar t33 = w.Z_pelvis[2][5] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
+    const Scalar t34 = w.Z_pelvis[2][6]*w.Linv[6];
+    const Scalar t35 = w.Z_pelvis[2][7] - w.L[76]*t34;
     const Scalar t36 = w.Linv[7]*t35;
-    const Scalar t37 = w.Z_pelvis[40] - w.L[77]*t34 - w.L[85]*t36;
+    const Scalar t37 = w.Z_pelvis[2][8] - w.L[77]*t34 - w.L[85]*t36;
     const Scalar t38 = w.Linv[8]*t37;
-    const Scalar t39 = w.Z_pelvis[41] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
+    const Scalar t39 = w.Z_pelvis[2][9] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
     const Scalar t40 = w.Linv[9]*t39;
-    const Scalar t41 = w.Z_pelvis[42] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
+    const Scalar t41 = w.Z_pelvis[2][10] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
     const Scalar t42 = w.Linv[10]*t41;
-    const Scalar t43 = w.Z_pelvis[43] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
-    const Scalar t44 = w.Z_pelvis[44]*w.Linv[12];
-    const Scalar t45 = w.Z_pelvis[45] - w.L[115]*t44;
+    const Scalar t43 = w.Z_pelvis[2][11] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
+    const Scalar t44 = w.Z_pelvis[2][12]*w.Linv[12];
+    const Scalar t45 = w.Z_pelvis[2][13] - w.L[115]*t44;
     const Scalar t46 = w.Linv[13]*t45;
-    const Scalar t47 = w.Z_pelvis[46] - w.L[116]*t44 - w.L[118]*t46;
-    w.W[2] = w.Z_pelvis[32]*w.Linv[0];
-    w.W[8] = w.Linv[1]*t25;
-    w.W[14] = w.Linv[2]*t27;
-    w.W[20] = w.Linv[3]*t29;
-    w.W[26] = w.Linv[4]*t31;
-    w.W[32] = w.Linv[5]*t33;
-    w.W[38] = w.Z_pelvis[38]*w.Linv[6];
-    w.W[44] = w.Linv[7]*t35;
-    w.W[50] = w.Linv[8]*t37;
-    w.W[56] = w.Linv[9]*t39;
-    w.W[62] = w.Linv[10]*t41;
-    w.W[68] = w.Linv[11]*t43;
-    w.W[74] = w.Z_pelvis[44]*w.Linv[12];
-    w.W[80] = w.Linv[13]*t45;
-    w.W[86] = w.Linv[14]*t47;
+    const Scalar t47 = w.Z_pelvis[2][14] - w.L[116]*t44 - w.L[118]*t46;
+    w.W[0][2] = w.Z_pelvis[2][0]*w.Linv[0];
+    w.W[1][2] = w.Linv[1]*t25;
+    w.W[2][2] = w.Linv[2]*t27;
+    w.W[3][2] = w.Linv[3]*t29;
+    w.W[4][2] = w.Linv[4]*t31;
+    w.W[5][2] = w.Linv[5]*t33;
+    w.W[6][2] = w.Z_pelvis[2][6]*w.Linv[6];
+    w.W[7][2] = w.Linv[7]*t35;
+    w.W[8][2] = w.Linv[8]*t37;
+    w.W[9][2] = w.Linv[9]*t39;
+    w.W[10][2] = w.Linv[10]*t41;
+    w.W[11][2] = w.Linv[11]*t43;
+    w.W[12][2] = w.Z_pelvis[2][12]*w.Linv[12];
+    w.W[13][2] = w.Linv[13]*t45;
+    w.W[14][2] = w.Linv[14]*t47;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_33(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_3_to_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t0 = w.Z_pelvis[48]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[49] - w.L[1]*t0;
+    const Scalar t0 = w.Z_pelvis[3][0]*w.Linv[0];
+    const Scalar t1 = w.Z_pelvis[3][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[50] - w.L[2]*t0 - w.L[16]*t2;
+    const Scalar t3 = w.Z_pelvis[3][2] - w.L[2]*t0 - w.L[16]*t2;
     const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[51] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
+    const Scalar t5 = w.Z_pelvis[3][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
     const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[52] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
+    const Scalar t7 = w.Z_pelvis[3][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
     const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[53] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[54]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[55] - w.L[76]*t10;
+    const Scalar t9 = w.Z_pelvis[3][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
+    const Scalar t10 = w.Z_pelvis[3][6]*w.Linv[6];
+    const Scalar t11 = w.Z_pelvis[3][7] - w.L[76]*t10;
     const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[56] - w.L[77]*t10 - w.L[85]*t12;
+    const Scalar t13 = w.Z_pelvis[3][8] - w.L[77]*t10 - w.L[85]*t12;
     const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[57] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
+    const Scalar t15 = w.Z_pelvis[3][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
     const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[58] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
+    const Scalar t17 = w.Z_pelvis[3][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
     const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[59] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[60]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[61] - w.L[115]*t20;
+    const Scalar t19 = w.Z_pelvis[3][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
+    const Scalar t20 = w.Z_pelvis[3][12]*w.Linv[12];
+    const Scalar t21 = w.Z_pelvis[3][13] - w.L[115]*t20;
     const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[62] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[3] = w.Z_pelvis[48]*w.Linv[0];
-    w.W[9] = w.Linv[1]*t1;
-    w.W[15] = w.Linv[2]*t3;
-    w.W[21] = w.Linv[3]*t5;
-    w.W[27] = w.Linv[4]*t7;
-    w.W[33] = w.Linv[5]*t9;
-    w.W[39] = w.Z_pelvis[54]*w.Linv[6];
-    w.W[45] = w.Linv[7]*t11;
-    w.W[51] = w.Linv[8]*t13;
-    w.W[57] = w.Linv[9]*t15;
-    w.W[63] = w.Linv[10]*t17;
-    w.W[69] = w.Linv[11]*t19;
-    w.W[75] = w.Z_pelvis[60]*w.Linv[12];
-    w.W[81] = w.Linv[13]*t21;
-    w.W[87] = w.Linv[14]*t23;
+    const Scalar t23 = w.Z_pelvis[3][14] - w.L[116]*t20 - w.L[118]*t22;
+    w.W[0][3] = w.Z_pelvis[3][0]*w.Linv[0];
+    w.W[1][3] = w.Linv[1]*t1;
+    w.W[2][3] = w.Linv[2]*t3;
+    w.W[3][3] = w.Linv[3]*t5;
+    w.W[4][3] = w.Linv[4]*t7;
+    w.W[5][3] = w.Linv[5]*t9;
+    w.W[6][3] = w.Z_pelvis[3][6]*w.Linv[6];
+    w.W[7][3] = w.Linv[7]*t11;
+    w.W[8][3] = w.Linv[8]*t13;
+    w.W[9][3] = w.Linv[9]*t15;
+    w.W[10][3] = w.Linv[10]*t17;
+    w.W[11][3] = w.Linv[11]*t19;
+    w.W[12][3] = w.Z_pelvis[3][12]*w.Linv[12];
+    w.W[13][3] = w.Linv[13]*t21;
+    w.W[14][3] = w.Linv[14]*t23;
   }
   // W = L^-1 Z^T, column 4
   {
-    const Scalar t24 = w.Z_pelvis[64]*w.Linv[0];
-    const Scalar t25 = w.Z_pelvis[65] - w.L[1]*t24;
+    const Scalar t24 = w.Z_pelvis[4][0]*w.Linv[0];
+    const Scalar t25 = w.Z_pelvis[4][1] - w.L[1]*t24;
     const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_pelvis[66] - w.L[2]*t24 - w.L[16]*t26;
+    const Scalar t27 = w.Z_pelvis[4][2] - w.L[2]*t24 - w.L[16]*t26;
     const Scalar t28 = w.Linv[2]*t27;
-    const Scalar t29 = w.Z_pelvis[67] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
+    const Scalar t29 = w.Z_pelvis[4][3] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
     const Scalar t30 = w.Linv[3]*t29;
-    const Scalar t31 = w.Z_pelvis[68] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
+    const Scalar t31 = w.Z_pelvis[4][4] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
     const Scalar t32 = w.Linv[4]*t31;
-    const Scalar t33 = w.Z_pelvis[69] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
-    const Scalar t34 = w.Z_pelvis[70]*w.Linv[6];
-    const Scalar t35 = w.Z_pelvis[71] - w.L[76]*t34;
+    const Scalar t33 = w.Z_pelvis[4][5] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
+    const Scalar t34 = w.Z_pelvis[4][6]*w.Linv[6];
+    const Scalar t35 = w.Z_pelvis[4][7] - w.L[76]*t34;
     const Scalar t36 = w.Linv[7]*t35;
-    const Scalar t37 = w.Z_pelvis[72] - w.L[77]*t34 - w.L[85]*t36;
+    const Scalar t37 = w.Z_pelvis[4][8] - w.L[77]*t34 - w.L[85]*t36;
     const Scalar t38 = w.Linv[8]*t37;
-    const Scalar t39 = w.Z_pelvis[73] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
+    const Scalar t39 = w.Z_pelvis[4][9] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
     const Scalar t40 = w.Linv[9]*t39;
-    const Scalar t41 = w.Z_pelvis[74] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
+    const Scalar t41 = w.Z_pelvis[4][10] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
     const Scalar t42 = w.Linv[10]*t41;
-    const Scalar t43 = w.Z_pelvis[75] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
-    const Scalar t44 = w.Z_pelvis[76]*w.Linv[12];
-    const Scalar t45 = w.Z_pelvis[77] - w.L[115]*t44;
+    const Scalar t43 = w.Z_pelvis[4][11] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
+    const Scalar t44 = w.Z_pelvis[4][12]*w.Linv[12];
+    const Scalar t45 = w.Z_pelvis[4][13] - w.L[115]*t44;
     const Scalar t46 = w.Linv[13]*t45;
-    const Scalar t47 = w.Z_pelvis[78] - w.L[116]*t44 - w.L[118]*t46;
-    w.W[4] = w.Z_pelvis[64]*w.Linv[0];
-    w.W[10] = w.Linv[1]*t25;
-    w.W[16] = w.Linv[2]*t27;
-    w.W[22] = w.Linv[3]*t29;
-    w.W[28] = w.Linv[4]*t31;
-    w.W[34] = w.Linv[5]*t33;
-    w.W[40] = w.Z_pelvis[70]*w.Linv[6];
-    w.W[46] = w.Linv[7]*t35;
-    w.W[52] = w.Linv[8]*t37;
-    w.W[58] = w.Linv[9]*t39;
-    w.W[64] = w.Linv[10]*t41;
-    w.W[70] = w.Linv[11]*t43;
-    w.W[76] = w.Z_pelvis[76]*w.Linv[12];
-    w.W[82] = w.Linv[13]*t45;
-    w.W[88] = w.Linv[14]*t47;
+    const Scalar t47 = w.Z_pelvis[4][14] - w.L[116]*t44 - w.L[118]*t46;
+    w.W[0][4] = w.Z_pelvis[4][0]*w.Linv[0];
+    w.W[1][4] = w.Linv[1]*t25;
+    w.W[2][4] = w.Linv[2]*t27;
+    w.W[3][4] = w.Linv[3]*t29;
+    w.W[4][4] = w.Linv[4]*t31;
+    w.W[5][4] = w.Linv[5]*t33;
+    w.W[6][4] = w.Z_pelvis[4][6]*w.Linv[6];
+    w.W[7][4] = w.Linv[7]*t35;
+    w.W[8][4] = w.Linv[8]*t37;
+    w.W[9][4] = w.Linv[9]*t39;
+    w.W[10][4] = w.Linv[10]*t41;
+    w.W[11][4] = w.Linv[11]*t43;
+    w.W[12][4] = w.Z_pelvis[4][12]*w.Linv[12];
+    w.W[13][4] = w.Linv[13]*t45;
+    w.W[14][4] = w.Linv[14]*t47;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_34(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t0 = w.Z_pelvis[80]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[81] - w.L[1]*t0;
+    const Scalar t0 = w.Z_pelvis[5][0]*w.Linv[0];
+    const Scalar t1 = w.Z_pelvis[5][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[82] - w.L[2]*t0 - w.L[16]*t2;
+    const Scalar t3 = w.Z_pelvis[5][2] - w.L[2]*t0 - w.L[16]*t2;
     const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[83] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
+    const Scalar t5 = w.Z_pelvis[5][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
     const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[84] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
+    const Scalar t7 = w.Z_pelvis[5][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
     const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[85] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[86]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[87] - w.L[76]*t10;
+    const Scalar t9 = w.Z_pelvis[5][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
+    const Scalar t10 = w.Z_pelvis[5][6]*w.Linv[6];
+    const Scalar t11 = w.Z_pelvis[5][7] - w.L[76]*t10;
     const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[88] - w.L[77]*t10 - w.L[85]*t12;
+    const Scalar t13 = w.Z_pelvis[5][8] - w.L[77]*t10 - w.L[85]*t12;
     const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[89] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
+    const Scalar t15 = w.Z_pelvis[5][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
     const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[90] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
+    const Scalar t17 = w.Z_pelvis[5][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
     const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[91] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[92]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[93] - w.L[115]*t20;
+    const Scalar t19 = w.Z_pelvis[5][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
+    const Scalar t20 = w.Z_pelvis[5][12]*w.Linv[12];
+    const Scalar t21 = w.Z_pelvis[5][13] - w.L[115]*t20;
     const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[94] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[5] = w.Z_pelvis[80]*w.Linv[0];
-    w.W[11] = w.Linv[1]*t1;
-    w.W[17] = w.Linv[2]*t3;
-    w.W[23] = w.Linv[3]*t5;
-    w.W[29] = w.Linv[4]*t7;
-    w.W[35] = w.Linv[5]*t9;
-    w.W[41] = w.Z_pelvis[86]*w.Linv[6];
-    w.W[47] = w.Linv[7]*t11;
-    w.W[53] = w.Linv[8]*t13;
-    w.W[59] = w.Linv[9]*t15;
-    w.W[65] = w.Linv[10]*t17;
-    w.W[71] = w.Linv[11]*t19;
-    w.W[77] = w.Z_pelvis[92]*w.Linv[12];
-    w.W[83] = w.Linv[13]*t21;
-    w.W[89] = w.Linv[14]*t23;
+    const Scalar t23 = w.Z_pelvis[5][14] - w.L[116]*t20 - w.L[118]*t22;
+    w.W[0][5] = w.Z_pelvis[5][0]*w.Linv[0];
+    w.W[1][5] = w.Linv[1]*t1;
+    w.W[2][5] = w.Linv[2]*t3;
+    w.W[3][5] = w.Linv[3]*t5;
+    w.W[4][5] = w.Linv[4]*t7;
+    w.W[5][5] = w.Linv[5]*t9;
+    w.W[6][5] = w.Z_pelvis[5][6]*w.Linv[6];
+    w.W[7][5] = w.Linv[7]*t11;
+    w.W[8][5] = w.Linv[8]*t13;
+    w.W[9][5] = w.Linv[9]*t15;
+    w.W[10][5] = w.Linv[10]*t17;
+    w.W[11][5] = w.Linv[11]*t19;
+    w.W[12][5] = w.Z_pelvis[5][12]*w.Linv[12];
+    w.W[13][5] = w.Linv[13]*t21;
+    w.W[14][5] = w.Linv[14]*t23;
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t24 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66] + w.W[72]*w.W[72] + w.W[78]*w.W[78] + w.W[84]*w.W[84];
+    const Scalar t24 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0] + w.W[12][0]*w.W[12][0] + w.W[13][0]*w.W[13][0] + w.W[14][0]*w.W[14][0];
     const Scalar r0 = std::sqrt(t24);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t25 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67] + w.W[72]*w.W[73] + w.W[78]*w.W[79] + w.W[84]*w.W[85];
+    const Scalar t25 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1] + w.W[12][0]*w.W[12][1] + w.W[13][0]*w.W[13][1] + w.W[14][0]*w.W[14][1];
     w.LS[1] = w.LSinv[0]*t25;
-    const Scalar t26 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68] + w.W[72]*w.W[74] + w.W[78]*w.W[80] + w.W[84]*w.W[86];
+    const Scalar t26 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2] + w.W[12][0]*w.W[12][2] + w.W[13][0]*w.W[13][2] + w.W[14][0]*w.W[14][2];
     w.LS[2] = w.LSinv[0]*t26;
-    const Scalar t27 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69] + w.W[72]*w.W[75] + w.W[78]*w.W[81] + w.W[84]*w.W[87];
+    const Scalar t27 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3] + w.W[12][0]*w.W[12][3] + w.W[13][0]*w.W[13][3] + w.W[14][0]*w.W[14][3];
     w.LS[3] = w.LSinv[0]*t27;
-    const Scalar t28 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70] + w.W[72]*w.W[76] + w.W[78]*w.W[82] + w.W[84]*w.W[88];
+    const Scalar t28 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4] + w.W[12][0]*w.W[12][4] + w.W[13][0]*w.W[13][4] + w.W[14][0]*w.W[14][4];
     w.LS[4] = w.LSinv[0]*t28;
-    const Scalar t29 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71] + w.W[72]*w.W[77] + w.W[78]*w.W[83] + w.W[84]*w.W[89];
+    const Scalar t29 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5] + w.W[12][0]*w.W[12][5] + w.W[13][0]*w.W[13][5] + w.W[14][0]*w.W[14][5];
     w.LS[5] = w.LSinv[0]*t29;
-    const Scalar t30 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] + w.W[73]*w.W[73] + w.W[79]*w.W[79] + w.W[85]*w.W[85] - w.LS[1]*w.LS[1];
+    const Scalar t30 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] + w.W[12][1]*w.W[12][1] + w.W[13][1]*w.W[13][1] + w.W[14][1]*w.W[14][1] - w.LS[1]*w.LS[1];
     const Scalar r1 = std::sqrt(t30);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t31 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] + w.W[73]*w.W[74] + w.W[79]*w.W[80] + w.W[85]*w.W[86] - w.LS[1]*w.LS[2];
+    const Scalar t31 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] + w.W[12][1]*w.W[12][2] + w.W[13][1]*w.W[13][2] + w.W[14][1]*w.W[14][2] - w.LS[1]*w.LS[2];
     w.LS[7] = w.LSinv[1]*t31;
-    const Scalar t32 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] + w.W[73]*w.W[75] + w.W[79]*w.W[81] + w.W[85]*w.W[87] - w.LS[1]*w.LS[3];
+    const Scalar t32 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] + w.W[12][1]*w.W[12][3] + w.W[13][1]*w.W[13][3] + w.W[14][1]*w.W[14][3] - w.LS[1]*w.LS[3];
     w.LS[8] = w.LSinv[1]*t32;
-    const Scalar t33 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] + w.W[73]*w.W[76] + w.W[79]*w.W[82] + w.W[85]*w.W[88] - w.LS[1]*w.LS[4];
+    const Scalar t33 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] + w.W[12][1]*w.W[12][4] + w.W[13][1]*w.W[13][4] + w.W[14][1]*w.W[14][4] - w.LS[1]*w.LS[4];
     w.LS[9] = w.LSinv[1]*t33;
-    const Scalar t34 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] + w.W[73]*w.W[77] + w.W[79]*w.W[83] + w.W[85]*w.W[89] - w.LS[1]*w.LS[5];
+    const Scalar t34 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] + w.W[12][1]*w.W[12][5] + w.W[13][1]*w.W[13][5] + w.W[14][1]*w.W[14][5] - w.LS[1]*w.LS[5];
     w.LS[10] = w.LSinv[1]*t34;
-    const Scalar t35 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] + w.W[74]*w.W[74] + w.W[80]*w.W[80] + w.W[86]*w.W[86] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar t35 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] + w.W[12][2]*w.W[12][2] + w.W[13][2]*w.W[13][2] + w.W[14][2]*w.W[14][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
     const Scalar r2 = std::sqrt(t35);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t36 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] + w.W[74]*w.W[75] + w.W[80]*w.W[81] + w.W[86]*w.W[87] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    const Scalar t36 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] + w.W[12][2]*w.W[12][3] + w.W[13][2]*w.W[13][3] + w.W[14][2]*w.W[14][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
     w.LS[12] = w.LSinv[2]*t36;
-    const Scalar t37 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] + w.W[74]*w.W[76] + w.W[80]*w.W[82] + w.W[86]*w.W[88] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    const Scalar t37 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] + w.W[12][2]*w.W[12][4] + w.W[13][2]*w.W[13][4] + w.W[14][2]*w.W[14][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
     w.LS[13] = w.LSinv[2]*t37;
-    const Scalar t38 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] + w.W[74]*w.W[77] + w.W[80]*w.W[83] + w.W[86]*w.W[89] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    const Scalar t38 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] + w.W[12][2]*w.W[12][5] + w.W[13][2]*w.W[13][5] + w.W[14][2]*w.W[14][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
     w.LS[14] = w.LSinv[2]*t38;
-    const Scalar t39 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] + w.W[75]*w.W[75] + w.W[81]*w.W[81] + w.W[87]*w.W[87] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar t39 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] + w.W[12][3]*w.W[12][3] + w.W[13][3]*w.W[13][3] + w.W[14][3]*w.W[14][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
     const Scalar r3 = std::sqrt(t39);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t40 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] + w.W[75]*w.W[76] + w.W[81]*w.W[82] + w.W[87]*w.W[88] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    const Scalar t40 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] + w.W[12][3]*w.W[12][4] + w.W[13][3]*w.W[13][4] + w.W[14][3]*w.W[14][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
     w.LS[16] = w.LSinv[3]*t40;
-    const Scalar t41 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] + w.W[75]*w.W[77] + w.W[81]*w.W[83] + w.W[87]*w.W[89] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    const Scalar t41 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] + w.W[12][3]*w.W[12][5] + w.W[13][3]*w.W[13][5] + w.W[14][3]*w.W[14][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
     w.LS[17] = w.LSinv[3]*t41;
-    const Scalar t42 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] + w.W[76]*w.W[76] + w.W[82]*w.W[82] + w.W[88]*w.W[88] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar t42 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] + w.W[12][4]*w.W[12][4] + w.W[13][4]*w.W[13][4] + w.W[14][4]*w.W[14][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
     const Scalar r4 = std::sqrt(t42);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t43 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] + w.W[76]*w.W[77] + w.W[82]*w.W[83] + w.W[88]*w.W[89] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    const Scalar t43 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] + w.W[12][4]*w.W[12][5] + w.W[13][4]*w.W[13][5] + w.W[14][4]*w.W[14][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
     w.LS[19] = w.LSinv[4]*t43;
-    const Scalar t44 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] + w.W[77]*w.W[77] + w.W[83]*w.W[83] + w.W[89]*w.W[89] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar t44 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] + w.W[12][5]*w.W[12][5] + w.W[13][5]*w.W[13][5] + w.W[14][5]*w.W[14][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
     const Scalar r5 = std::sqrt(t44);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
   w.lambda[2] = 0.0;
@@ -8592,7 +8560,7 @@ PROXGEN_RT_NOINLINE void pv_35(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[14] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_36(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -8623,17 +8591,17 @@ PROXGEN_RT_NOINLINE void pv_36(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   const Scalar t27 = w.Linv[5]*t10;
   const Scalar t28 = w.Linv[11]*t21;
   const Scalar t29 = w.Linv[14]*t26;
-  const Scalar t30 = w.W[0]*t1 + w.W[6]*t3 + w.W[12]*t5 + w.W[18]*t7 + w.W[24]*t9 + w.W[30]*t27 + w.W[36]*t12 + w.W[42]*t14 + w.W[48]*t16 + w.W[54]*t18 + w.W[60]*t20 + w.W[66]*t28 + w.W[72]*t23 + w.W[78]*t25 + w.W[84]*t29;
+  const Scalar t30 = w.W[0][0]*t1 + w.W[1][0]*t3 + w.W[2][0]*t5 + w.W[3][0]*t7 + w.W[4][0]*t9 + w.W[5][0]*t27 + w.W[6][0]*t12 + w.W[7][0]*t14 + w.W[8][0]*t16 + w.W[9][0]*t18 + w.W[10][0]*t20 + w.W[11][0]*t28 + w.W[12][0]*t23 + w.W[13][0]*t25 + w.W[14][0]*t29;
   const Scalar t31 = w.LSinv[0]*t30;
-  const Scalar t32 = w.W[1]*t1 + w.W[7]*t3 + w.W[13]*t5 + w.W[19]*t7 + w.W[25]*t9 + w.W[31]*t27 + w.W[37]*t12 + w.W[43]*t14 + w.W[49]*t16 + w.W[55]*t18 + w.W[61]*t20 + w.W[67]*t28 + w.W[73]*t23 + w.W[79]*t25 + w.W[85]*t29 - w.LS[1]*t31;
+  const Scalar t32 = w.W[0][1]*t1 + w.W[1][1]*t3 + w.W[2][1]*t5 + w.W[3][1]*t7 + w.W[4][1]*t9 + w.W[5][1]*t27 + w.W[6][1]*t12 + w.W[7][1]*t14 + w.W[8][1]*t16 + w.W[9][1]*t18 + w.W[10][1]*t20 + w.W[11][1]*t28 + w.W[12][1]*t23 + w.W[13][1]*t25 + w.W[14][1]*t29 - w.LS[1]*t31;
   const Scalar t33 = w.LSinv[1]*t32;
-  const Scalar t34 = w.W[2]*t1 + w.W[8]*t3 + w.W[14]*t5 + w.W[20]*t7 + w.W[26]*t9 + w.W[32]*t27 + w.W[38]*t12 + w.W[44]*t14 + w.W[50]*t16 + w.W[56]*t18 + w.W[62]*t20 + w.W[68]*t28 + w.W[74]*t23 + w.W[80]*t25 + w.W[86]*t29 - w.LS[2]*t31 - w.LS[7]*t33;
+  const Scalar t34 = w.W[0][2]*t1 + w.W[1][2]*t3 + w.W[2][2]*t5 + w.W[3][2]*t7 + w.W[4][2]*t9 + w.W[5][2]*t27 + w.W[6][2]*t12 + w.W[7][2]*t14 + w.W[8][2]*t16 + w.W[9][2]*t18 + w.W[10][2]*t20 + w.W[11][2]*t28 + w.W[12][2]*t23 + w.W[13][2]*t25 + w.W[14][2]*t29 - w.LS[2]*t31 - w.LS[7]*t33;
   const Scalar t35 = w.LSinv[2]*t34;
-  const Scalar t36 = w.W[3]*t1 + w.W[9]*t3 + w.W[15]*t5 + w.W[21]*t7 + w.W[27]*t9 + w.W[33]*t27 + w.W[39]*t12 + w.W[45]*t14 + w.W[51]*t16 + w.W[57]*t18 + w.W[63]*t20 + w.W[69]*t28 + w.W[75]*t23 + w.W[81]*t25 + w.W[87]*t29 - w.LS[3]*t31 - w.LS[8]*t33 - w.LS[12]*t35;
+  const Scalar t36 = w.W[0][3]*t1 + w.W[1][3]*t3 + w.W[2][3]*t5 + w.W[3][3]*t7 + w.W[4][3]*t9 + w.W[5][3]*t27 + w.W[6][3]*t12 + w.W[7][3]*t14 + w.W[8][3]*t16 + w.W[9][3]*t18 + w.W[10][3]*t20 + w.W[11][3]*t28 + w.W[12][3]*t23 + w.W[13][3]*t25 + w.W[14][3]*t29 - w.LS[3]*t31 - w.LS[8]*t33 - w.LS[12]*t35;
   const Scalar t37 = w.LSinv[3]*t36;
-  const Scalar t38 = w.W[4]*t1 + w.W[10]*t3 + w.W[16]*t5 + w.W[22]*t7 + w.W[28]*t9 + w.W[34]*t27 + w.W[40]*t12 + w.W[46]*t14 + w.W[52]*t16 + w.W[58]*t18 + w.W[64]*t20 + w.W[70]*t28 + w.W[76]*t23 + w.W[82]*t25 + w.W[88]*t29 - w.LS[4]*t31 - w.LS[9]*t33 - w.LS[13]*t35 - w.LS[16]*t37;
+  const Scalar t38 = w.W[0][4]*t1 + w.W[1][4]*t3 + w.W[2][4]*t5 + w.W[3][4]*t7 + w.W[4][4]*t9 + w.W[5][4]*t27 + w.W[6][4]*t12 + w.W[7][4]*t14 + w.W[8][4]*t16 + w.W[9][4]*t18 + w.W[10][4]*t20 + w.W[11][4]*t28 + w.W[12][4]*t23 + w.W[13][4]*t25 + w.W[14][4]*t29 - w.LS[4]*t31 - w.LS[9]*t33 - w.LS[13]*t35 - w.LS[16]*t37;
   const Scalar t39 = w.LSinv[4]*t38;
-  const Scalar t40 = w.W[5]*t1 + w.W[11]*t3 + w.W[17]*t5 + w.W[23]*t7 + w.W[29]*t9 + w.W[35]*t27 + w.W[41]*t12 + w.W[47]*t14 + w.W[53]*t16 + w.W[59]*t18 + w.W[65]*t20 + w.W[71]*t28 + w.W[77]*t23 + w.W[83]*t25 + w.W[89]*t29 - w.LS[5]*t31 - w.LS[10]*t33 - w.LS[14]*t35 - w.LS[17]*t37 - w.LS[19]*t39;
+  const Scalar t40 = w.W[0][5]*t1 + w.W[1][5]*t3 + w.W[2][5]*t5 + w.W[3][5]*t7 + w.W[4][5]*t9 + w.W[5][5]*t27 + w.W[6][5]*t12 + w.W[7][5]*t14 + w.W[8][5]*t16 + w.W[9][5]*t18 + w.W[10][5]*t20 + w.W[11][5]*t28 + w.W[12][5]*t23 + w.W[13][5]*t25 + w.W[14][5]*t29 - w.LS[5]*t31 - w.LS[10]*t33 - w.LS[14]*t35 - w.LS[17]*t37 - w.LS[19]*t39;
   const Scalar t41 = w.LSinv[5]*t40;
   const Scalar t42 = w.LSinv[5]*t41;
   const Scalar t43 = w.LSinv[4]*t38 - w.LS[19]*t42;
@@ -8646,21 +8614,21 @@ PROXGEN_RT_NOINLINE void pv_36(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   const Scalar t50 = w.LSinv[1]*t49;
   const Scalar t51 = w.LSinv[0]*t30 - w.LS[1]*t50 - w.LS[2]*t48 - w.LS[3]*t46 - w.LS[4]*t44 - w.LS[5]*t42;
   const Scalar t52 = w.LSinv[0]*t51;
-  const Scalar z0 = w.Linv[0]*t0 - w.W[0]*t52 - w.W[1]*t50 - w.W[2]*t48 - w.W[3]*t46 - w.W[4]*t44 - w.W[5]*t42;
-  const Scalar z1 = w.Linv[1]*t2 - w.W[6]*t52 - w.W[7]*t50 - w.W[8]*t48 - w.W[9]*t46 - w.W[10]*t44 - w.W[11]*t42;
-  const Scalar z2 = w.Linv[2]*t4 - w.W[12]*t52 - w.W[13]*t50 - w.W[14]*t48 - w.W[15]*t46 - w.W[16]*t44 - w.W[17]*t42;
-  const Scalar z3 = w.Linv[3]*t6 - w.W[18]*t52 - w.W[19]*t50 - w.W[20]*t48 - w.W[21]*t46 - w.W[22]*t44 - w.W[23]*t42;
-  const Scalar z4 = w.Linv[4]*t8 - w.W[24]*t52 - w.W[25]*t50 - w.W[26]*t48 - w.W[27]*t46 - w.W[28]*t44 - w.W[29]*t42;
-  const Scalar z5 = w.Linv[5]*t10 - w.W[30]*t52 - w.W[31]*t50 - w.W[32]*t48 - w.W[33]*t46 - w.W[34]*t44 - w.W[35]*t42;
-  const Scalar z6 = w.Linv[6]*t11 - w.W[36]*t52 - w.W[37]*t50 - w.W[38]*t48 - w.W[39]*t46 - w.W[40]*t44 - w.W[41]*t42;
-  const Scalar z7 = w.Linv[7]*t13 - w.W[42]*t52 - w.W[43]*t50 - w.W[44]*t48 - w.W[45]*t46 - w.W[46]*t44 - w.W[47]*t42;
-  const Scalar z8 = w.Linv[8]*t15 - w.W[48]*t52 - w.W[49]*t50 - w.W[50]*t48 - w.W[51]*t46 - w.W[52]*t44 - w.W[53]*t42;
-  const Scalar z9 = w.Linv[9]*t17 - w.W[54]*t52 - w.W[55]*t50 - w.W[56]*t48 - w.W[57]*t46 - w.W[58]*t44 - w.W[59]*t42;
-  const Scalar z10 = w.Linv[10]*t19 - w.W[60]*t52 - w.W[61]*t50 - w.W[62]*t48 - w.W[63]*t46 - w.W[64]*t44 - w.W[65]*t42;
-  const Scalar z11 = w.Linv[11]*t21 - w.W[66]*t52 - w.W[67]*t50 - w.W[68]*t48 - w.W[69]*t46 - w.W[70]*t44 - w.W[71]*t42;
-  const Scalar z12 = w.Linv[12]*t22 - w.W[72]*t52 - w.W[73]*t50 - w.W[74]*t48 - w.W[75]*t46 - w.W[76]*t44 - w.W[77]*t42;
-  const Scalar z13 = w.Linv[13]*t24 - w.W[78]*t52 - w.W[79]*t50 - w.W[80]*t48 - w.W[81]*t46 - w.W[82]*t44 - w.W[83]*t42;
-  const Scalar z14 = w.Linv[14]*t26 - w.W[84]*t52 - w.W[85]*t50 - w.W[86]*t48 - w.W[87]*t46 - w.W[88]*t44 - w.W[89]*t42;
+  const Scalar z0 = w.Linv[0]*t0 - w.W[0][0]*t52 - w.W[0][1]*t50 - w.W[0][2]*t48 - w.W[0][3]*t46 - w.W[0][4]*t44 - w.W[0][5]*t42;
+  const Scalar z1 = w.Linv[1]*t2 - w.W[1][0]*t52 - w.W[1][1]*t50 - w.W[1][2]*t48 - w.W[1][3]*t46 - w.W[1][4]*t44 - w.W[1][5]*t42;
+  const Scalar z2 = w.Linv[2]*t4 - w.W[2][0]*t52 - w.W[2][1]*t50 - w.W[2][2]*t48 - w.W[2][3]*t46 - w.W[2][4]*t44 - w.W[2][5]*t42;
+  const Scalar z3 = w.Linv[3]*t6 - w.W[3][0]*t52 - w.W[3][1]*t50 - w.W[3][2]*t48 - w.W[3][3]*t46 - w.W[3][4]*t44 - w.W[3][5]*t42;
+  const Scalar z4 = w.Linv[4]*t8 - w.W[4][0]*t52 - w.W[4][1]*t50 - w.W[4][2]*t48 - w.W[4][3]*t46 - w.W[4][4]*t44 - w.W[4][5]*t42;
+  const Scalar z5 = w.Linv[5]*t10 - w.W[5][0]*t52 - w.W[5][1]*t50 - w.W[5][2]*t48 - w.W[5][3]*t46 - w.W[5][4]*t44 - w.W[5][5]*t42;
+  const Scalar z6 = w.Linv[6]*t11 - w.W[6][0]*t52 - w.W[6][1]*t50 - w.W[6][2]*t48 - w.W[6][3]*t46 - w.W[6][4]*t44 - w.W[6][5]*t42;
+  const Scalar z7 = w.Linv[7]*t13 - w.W[7][0]*t52 - w.W[7][1]*t50 - w.W[7][2]*t48 - w.W[7][3]*t46 - w.W[7][4]*t44 - w.W[7][5]*t42;
+  const Scalar z8 = w.Linv[8]*t15 - w.W[8][0]*t52 - w.W[8][1]*t50 - w.W[8][2]*t48 - w.W[8][3]*t46 - w.W[8][4]*t44 - w.W[8][5]*t42;
+  const Scalar z9 = w.Linv[9]*t17 - w.W[9][0]*t52 - w.W[9][1]*t50 - w.W[9][2]*t48 - w.W[9][3]*t46 - w.W[9][4]*t44 - w.W[9][5]*t42;
+  const Scalar z10 = w.Linv[10]*t19 - w.W[10][0]*t52 - w.W[10][1]*t50 - w.W[10][2]*t48 - w.W[10][3]*t46 - w.W[10][4]*t44 - w.W[10][5]*t42;
+  const Scalar z11 = w.Linv[11]*t21 - w.W[11][0]*t52 - w.W[11][1]*t50 - w.W[11][2]*t48 - w.W[11][3]*t46 - w.W[11][4]*t44 - w.W[11][5]*t42;
+  const Scalar z12 = w.Linv[12]*t22 - w.W[12][0]*t52 - w.W[12][1]*t50 - w.W[12][2]*t48 - w.W[12][3]*t46 - w.W[12][4]*t44 - w.W[12][5]*t42;
+  const Scalar z13 = w.Linv[13]*t24 - w.W[13][0]*t52 - w.W[13][1]*t50 - w.W[13][2]*t48 - w.W[13][3]*t46 - w.W[13][4]*t44 - w.W[13][5]*t42;
+  const Scalar z14 = w.Linv[14]*t26 - w.W[14][0]*t52 - w.W[14][1]*t50 - w.W[14][2]*t48 - w.W[14][3]*t46 - w.W[14][4]*t44 - w.W[14][5]*t42;
   const Scalar t53 = w.Linv[14]*z14;
   const Scalar t54 = z13 - w.L[118]*t53;
   const Scalar t55 = w.Linv[13]*t54;
@@ -8702,20 +8670,20 @@ PROXGEN_RT_NOINLINE void pv_36(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   w.lambda[14] = w.Linv[14]*z14;
 }
 
-PROXGEN_RT_NOINLINE void pv_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0]*w.lambda[0] - w.KA_pelvis[1]*w.lambda[1] - w.KA_pelvis[2]*w.lambda[2] - w.KA_pelvis[3]*w.lambda[3] - w.KA_pelvis[4]*w.lambda[4] - w.KA_pelvis[5]*w.lambda[5] - w.KA_pelvis[6]*w.lambda[6] - w.KA_pelvis[7]*w.lambda[7] - w.KA_pelvis[8]*w.lambda[8] - w.KA_pelvis[9]*w.lambda[9] - w.KA_pelvis[10]*w.lambda[10] - w.KA_pelvis[11]*w.lambda[11] - w.KA_pelvis[12]*w.lambda[12] - w.KA_pelvis[13]*w.lambda[13] - w.KA_pelvis[14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0][0]*w.lambda[0] - w.KA_pelvis[0][1]*w.lambda[1] - w.KA_pelvis[0][2]*w.lambda[2] - w.KA_pelvis[0][3]*w.lambda[3] - w.KA_pelvis[0][4]*w.lambda[4] - w.KA_pelvis[0][5]*w.lambda[5] - w.KA_pelvis[0][6]*w.lambda[6] - w.KA_pelvis[0][7]*w.lambda[7] - w.KA_pelvis[0][8]*w.lambda[8] - w.KA_pelvis[0][9]*w.lambda[9] - w.KA_pelvis[0][10]*w.lambda[10] - w.KA_pelvis[0][11]*w.lambda[11] - w.KA_pelvis[0][12]*w.lambda[12] - w.KA_pelvis[0][13]*w.lambda[13] - w.KA_pelvis[0][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
     const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - w.KA_pelvis[16]*w.lambda[0] - w.KA_pelvis[17]*w.lambda[1] - w.KA_pelvis[18]*w.lambda[2] - w.KA_pelvis[19]*w.lambda[3] - w.KA_pelvis[20]*w.lambda[4] - w.KA_pelvis[21]*w.lambda[5] - w.KA_pelvis[22]*w.lambda[6] - w.KA_pelvis[23]*w.lambda[7] - w.KA_pelvis[24]*w.lambda[8] - w.KA_pelvis[25]*w.lambda[9] - w.KA_pelvis[26]*w.lambda[10] - w.KA_pelvis[27]*w.lambda[11] - w.KA_pelvis[28]*w.lambda[12] - w.KA_pelvis[29]*w.lambda[13] - w.KA_pelvis[30]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t2 = w.u_pelvis[1] - w.KA_pelvis[1][0]*w.lambda[0] - w.KA_pelvis[1][1]*w.lambda[1] - w.KA_pelvis[1][2]*w.lambda[2] - w.KA_pelvis[1][3]*w.lambda[3] - w.KA_pelvis[1][4]*w.lambda[4] - w.KA_pelvis[1][5]*w.lambda[5] - w.KA_pelvis[1][6]*w.lambda[6] - w.KA_pelvis[1][7]*w.lambda[7] - w.KA_pelvis[1][8]*w.lambda[8] - w.KA_pelvis[1][9]*w.lambda[9] - w.KA_pelvis[1][10]*w.lambda[10] - w.KA_pelvis[1][11]*w.lambda[11] - w.KA_pelvis[1][12]*w.lambda[12] - w.KA_pelvis[1][13]*w.lambda[13] - w.KA_pelvis[1][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
     const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - w.KA_pelvis[32]*w.lambda[0] - w.KA_pelvis[33]*w.lambda[1] - w.KA_pelvis[34]*w.lambda[2] - w.KA_pelvis[35]*w.lambda[3] - w.KA_pelvis[36]*w.lambda[4] - w.KA_pelvis[37]*w.lambda[5] - w.KA_pelvis[38]*w.lambda[6] - w.KA_pelvis[39]*w.lambda[7] - w.KA_pelvis[40]*w.lambda[8] - w.KA_pelvis[41]*w.lambda[9] - w.KA_pelvis[42]*w.lambda[10] - w.KA_pelvis[43]*w.lambda[11] - w.KA_pelvis[44]*w.lambda[12] - w.KA_pelvis[45]*w.lambda[13] - w.KA_pelvis[46]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t4 = w.u_pelvis[2] - w.KA_pelvis[2][0]*w.lambda[0] - w.KA_pelvis[2][1]*w.lambda[1] - w.KA_pelvis[2][2]*w.lambda[2] - w.KA_pelvis[2][3]*w.lambda[3] - w.KA_pelvis[2][4]*w.lambda[4] - w.KA_pelvis[2][5]*w.lambda[5] - w.KA_pelvis[2][6]*w.lambda[6] - w.KA_pelvis[2][7]*w.lambda[7] - w.KA_pelvis[2][8]*w.lambda[8] - w.KA_pelvis[2][9]*w.lambda[9] - w.KA_pelvis[2][10]*w.lambda[10] - w.KA_pelvis[2][11]*w.lambda[11] - w.KA_pelvis[2][12]*w.lambda[12] - w.KA_pelvis[2][13]*w.lambda[13] - w.KA_pelvis[2][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
     const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - w.KA_pelvis[48]*w.lambda[0] - w.KA_pelvis[49]*w.lambda[1] - w.KA_pelvis[50]*w.lambda[2] - w.KA_pelvis[51]*w.lambda[3] - w.KA_pelvis[52]*w.lambda[4] - w.KA_pelvis[53]*w.lambda[5] - w.KA_pelvis[54]*w.lambda[6] - w.KA_pelvis[55]*w.lambda[7] - w.KA_pelvis[56]*w.lambda[8] - w.KA_pelvis[57]*w.lambda[9] - w.KA_pelvis[58]*w.lambda[10] - w.KA_pelvis[59]*w.lambda[11] - w.KA_pelvis[60]*w.lambda[12] - w.KA_pelvis[61]*w.lambda[13] - w.KA_pelvis[62]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t6 = w.u_pelvis[3] - w.KA_pelvis[3][0]*w.lambda[0] - w.KA_pelvis[3][1]*w.lambda[1] - w.KA_pelvis[3][2]*w.lambda[2] - w.KA_pelvis[3][3]*w.lambda[3] - w.KA_pelvis[3][4]*w.lambda[4] - w.KA_pelvis[3][5]*w.lambda[5] - w.KA_pelvis[3][6]*w.lambda[6] - w.KA_pelvis[3][7]*w.lambda[7] - w.KA_pelvis[3][8]*w.lambda[8] - w.KA_pelvis[3][9]*w.lambda[9] - w.KA_pelvis[3][10]*w.lambda[10] - w.KA_pelvis[3][11]*w.lambda[11] - w.KA_pelvis[3][12]*w.lambda[12] - w.KA_pelvis[3][13]*w.lambda[13] - w.KA_pelvis[3][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
     const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - w.KA_pelvis[64]*w.lambda[0] - w.KA_pelvis[65]*w.lambda[1] - w.KA_pelvis[66]*w.lambda[2] - w.KA_pelvis[67]*w.lambda[3] - w.KA_pelvis[68]*w.lambda[4] - w.KA_pelvis[69]*w.lambda[5] - w.KA_pelvis[70]*w.lambda[6] - w.KA_pelvis[71]*w.lambda[7] - w.KA_pelvis[72]*w.lambda[8] - w.KA_pelvis[73]*w.lambda[9] - w.KA_pelvis[74]*w.lambda[10] - w.KA_pelvis[75]*w.lambda[11] - w.KA_pelvis[76]*w.lambda[12] - w.KA_pelvis[77]*w.lambda[13] - w.KA_pelvis[78]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t8 = w.u_pelvis[4] - w.KA_pelvis[4][0]*w.lambda[0] - w.KA_pelvis[4][1]*w.lambda[1] - w.KA_pelvis[4][2]*w.lambda[2] - w.KA_pelvis[4][3]*w.lambda[3] - w.KA_pelvis[4][4]*w.lambda[4] - w.KA_pelvis[4][5]*w.lambda[5] - w.KA_pelvis[4][6]*w.lambda[6] - w.KA_pelvis[4][7]*w.lambda[7] - w.KA_pelvis[4][8]*w.lambda[8] - w.KA_pelvis[4][9]*w.lambda[9] - w.KA_pelvis[4][10]*w.lambda[10] - w.KA_pelvis[4][11]*w.lambda[11] - w.KA_pelvis[4][12]*w.lambda[12] - w.KA_pelvis[4][13]*w.lambda[13] - w.KA_pelvis[4][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
     const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - w.KA_pelvis[80]*w.lambda[0] - w.KA_pelvis[81]*w.lambda[1] - w.KA_pelvis[82]*w.lambda[2] - w.KA_pelvis[83]*w.lambda[3] - w.KA_pelvis[84]*w.lambda[4] - w.KA_pelvis[85]*w.lambda[5] - w.KA_pelvis[86]*w.lambda[6] - w.KA_pelvis[87]*w.lambda[7] - w.KA_pelvis[88]*w.lambda[8] - w.KA_pelvis[89]*w.lambda[9] - w.KA_pelvis[90]*w.lambda[10] - w.KA_pelvis[91]*w.lambda[11] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t10 = w.u_pelvis[5] - w.KA_pelvis[5][0]*w.lambda[0] - w.KA_pelvis[5][1]*w.lambda[1] - w.KA_pelvis[5][2]*w.lambda[2] - w.KA_pelvis[5][3]*w.lambda[3] - w.KA_pelvis[5][4]*w.lambda[4] - w.KA_pelvis[5][5]*w.lambda[5] - w.KA_pelvis[5][6]*w.lambda[6] - w.KA_pelvis[5][7]*w.lambda[7] - w.KA_pelvis[5][8]*w.lambda[8] - w.KA_pelvis[5][9]*w.lambda[9] - w.KA_pelvis[5][10]*w.lambda[10] - w.KA_pelvis[5][11]*w.lambda[11] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
     const Scalar t11 = w.Linv_pelvis[5]*t10;
     const Scalar t12 = w.Linv_pelvis[5]*t11;
     const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
@@ -8752,7 +8720,7 @@ PROXGEN_RT_NOINLINE void pv_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
     const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
     const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[35]*w.lambda[0] - w.KA_l_hip_yaw_link[36]*w.lambda[1] - w.KA_l_hip_yaw_link[37]*w.lambda[2] - w.KA_l_hip_yaw_link[38]*w.lambda[3] - w.KA_l_hip_yaw_link[39]*w.lambda[4] - w.KA_l_hip_yaw_link[40]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
+    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[5][0]*w.lambda[0] - w.KA_l_hip_yaw_link[5][1]*w.lambda[1] - w.KA_l_hip_yaw_link[5][2]*w.lambda[2] - w.KA_l_hip_yaw_link[5][3]*w.lambda[3] - w.KA_l_hip_yaw_link[5][4]*w.lambda[4] - w.KA_l_hip_yaw_link[5][5]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
     w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
     w.a_l_hip_yaw_link[0] = t28;
     w.a_l_hip_yaw_link[1] = t29;
@@ -8763,14 +8731,14 @@ PROXGEN_RT_NOINLINE void pv_37(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
     const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
     const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
     const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    const Scalar t4 = w.u_l_hip_roll_link[0] - w.KA_l_hip_roll_link[21]*w.lambda[0] - w.KA_l_hip_roll_link[22]*w.lambda[1] - w.KA_l_hip_roll_link[23]*w.lambda[2] - w.KA_l_hip_roll_link[24]*w.lambda[3] - w.KA_l_hip_roll_link[25]*w.lambda[4] - w.KA_l_hip_roll_link[26]*w.lambda[5] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
+    const Scalar t4 = w.u_l_hip_roll_link[0] - w.KA_l_hip_roll_link[3][0]*w.lambda[0] - w.KA_l_hip_roll_link[3][1]*w.lambda[1] - w.KA_l_hip_roll_link[3][2]*w.lambda[2] - w.KA_l_hip_roll_link[3][3]*w.lambda[3] - w.KA_l_hip_roll_link[3][4]*w.lambda[4] - w.KA_l_hip_roll_link[3][5]*w.lambda[5] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
     w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
     w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
     w.a_l_hip_roll_link[1] = t0;
@@ -8789,7 +8757,7 @@ PROXGEN_RT_NOINLINE void pv_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
     const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
     const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
-    const Scalar t13 = w.u_l_thigh[0] - w.KA_l_thigh[28]*w.lambda[0] - w.KA_l_thigh[29]*w.lambda[1] - w.KA_l_thigh[30]*w.lambda[2] - w.KA_l_thigh[31]*w.lambda[3] - w.KA_l_thigh[32]*w.lambda[4] - w.KA_l_thigh[33]*w.lambda[5] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
+    const Scalar t13 = w.u_l_thigh[0] - w.KA_l_thigh[4][0]*w.lambda[0] - w.KA_l_thigh[4][1]*w.lambda[1] - w.KA_l_thigh[4][2]*w.lambda[2] - w.KA_l_thigh[4][3]*w.lambda[3] - w.KA_l_thigh[4][4]*w.lambda[4] - w.KA_l_thigh[4][5]*w.lambda[5] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
     w.qdd[8] = w.Dinv_l_thigh*t13;
     w.a_l_thigh[0] = t9;
     w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
@@ -8810,7 +8778,7 @@ PROXGEN_RT_NOINLINE void pv_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
     const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
     const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
-    const Scalar t24 = w.u_l_shank[0] - w.KA_l_shank[28]*w.lambda[0] - w.KA_l_shank[29]*w.lambda[1] - w.KA_l_shank[30]*w.lambda[2] - w.KA_l_shank[31]*w.lambda[3] - w.KA_l_shank[32]*w.lambda[4] - w.KA_l_shank[33]*w.lambda[5] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
+    const Scalar t24 = w.u_l_shank[0] - w.KA_l_shank[4][0]*w.lambda[0] - w.KA_l_shank[4][1]*w.lambda[1] - w.KA_l_shank[4][2]*w.lambda[2] - w.KA_l_shank[4][3]*w.lambda[3] - w.KA_l_shank[4][4]*w.lambda[4] - w.KA_l_shank[4][5]*w.lambda[5] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
     w.qdd[9] = w.Dinv_l_shank*t24;
     w.a_l_shank[0] = t20;
     w.a_l_shank[1] = t15;
@@ -8821,7 +8789,7 @@ PROXGEN_RT_NOINLINE void pv_38(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
@@ -8834,7 +8802,7 @@ PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
     const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
     const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t10 = w.u_l_ankle_link[0] - w.KA_l_ankle_link[28]*w.lambda[0] - w.KA_l_ankle_link[29]*w.lambda[1] - w.KA_l_ankle_link[31]*w.lambda[3] - w.KA_l_ankle_link[32]*w.lambda[4] - w.KA_l_ankle_link[33]*w.lambda[5] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
+    const Scalar t10 = w.u_l_ankle_link[0] - w.KA_l_ankle_link[4][0]*w.lambda[0] - w.KA_l_ankle_link[4][1]*w.lambda[1] - w.KA_l_ankle_link[4][3]*w.lambda[3] - w.KA_l_ankle_link[4][4]*w.lambda[4] - w.KA_l_ankle_link[4][5]*w.lambda[5] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
     w.qdd[10] = w.Dinv_l_ankle_link*t10;
     w.a_l_ankle_link[0] = t6;
     w.a_l_ankle_link[1] = t1;
@@ -8850,7 +8818,7 @@ PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
     const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
     const Scalar t15 = w.u_l_foot[0] - 0.06825*w.lambda[1] - w.lambda[3] - 0.00194517348958*w.a_l_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.qdd[11] = w.Dinv_l_foot*t15;
+    w.qdd[11] = 514.0929615568219*t15;
     w.a_l_foot[0] = w.a_l_ankle_link[0];
     w.a_l_foot[1] = t11;
     w.a_l_foot[2] = t12;
@@ -8870,7 +8838,7 @@ PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
     const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
     const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
-    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[35]*w.lambda[6] - w.KA_r_hip_yaw_link[36]*w.lambda[7] - w.KA_r_hip_yaw_link[37]*w.lambda[8] - w.KA_r_hip_yaw_link[38]*w.lambda[9] - w.KA_r_hip_yaw_link[39]*w.lambda[10] - w.KA_r_hip_yaw_link[40]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
+    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[5][0]*w.lambda[6] - w.KA_r_hip_yaw_link[5][1]*w.lambda[7] - w.KA_r_hip_yaw_link[5][2]*w.lambda[8] - w.KA_r_hip_yaw_link[5][3]*w.lambda[9] - w.KA_r_hip_yaw_link[5][4]*w.lambda[10] - w.KA_r_hip_yaw_link[5][5]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
     w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
     w.a_r_hip_yaw_link[0] = t22;
     w.a_r_hip_yaw_link[1] = t23;
@@ -8881,14 +8849,14 @@ PROXGEN_RT_NOINLINE void pv_39(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
     const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
     const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
     const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
     const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    const Scalar t4 = w.u_r_hip_roll_link[0] - w.KA_r_hip_roll_link[21]*w.lambda[6] - w.KA_r_hip_roll_link[22]*w.lambda[7] - w.KA_r_hip_roll_link[23]*w.lambda[8] - w.KA_r_hip_roll_link[24]*w.lambda[9] - w.KA_r_hip_roll_link[25]*w.lambda[10] - w.KA_r_hip_roll_link[26]*w.lambda[11] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
+    const Scalar t4 = w.u_r_hip_roll_link[0] - w.KA_r_hip_roll_link[3][0]*w.lambda[6] - w.KA_r_hip_roll_link[3][1]*w.lambda[7] - w.KA_r_hip_roll_link[3][2]*w.lambda[8] - w.KA_r_hip_roll_link[3][3]*w.lambda[9] - w.KA_r_hip_roll_link[3][4]*w.lambda[10] - w.KA_r_hip_roll_link[3][5]*w.lambda[11] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
     w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
     w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
     w.a_r_hip_roll_link[1] = t0;
@@ -8907,7 +8875,7 @@ PROXGEN_RT_NOINLINE void pv_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
     const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
     const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
-    const Scalar t13 = w.u_r_thigh[0] - w.KA_r_thigh[28]*w.lambda[6] - w.KA_r_thigh[29]*w.lambda[7] - w.KA_r_thigh[30]*w.lambda[8] - w.KA_r_thigh[31]*w.lambda[9] - w.KA_r_thigh[32]*w.lambda[10] - w.KA_r_thigh[33]*w.lambda[11] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
+    const Scalar t13 = w.u_r_thigh[0] - w.KA_r_thigh[4][0]*w.lambda[6] - w.KA_r_thigh[4][1]*w.lambda[7] - w.KA_r_thigh[4][2]*w.lambda[8] - w.KA_r_thigh[4][3]*w.lambda[9] - w.KA_r_thigh[4][4]*w.lambda[10] - w.KA_r_thigh[4][5]*w.lambda[11] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
     w.qdd[14] = w.Dinv_r_thigh*t13;
     w.a_r_thigh[0] = t9;
     w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
@@ -8928,7 +8896,7 @@ PROXGEN_RT_NOINLINE void pv_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
     const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
     const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
-    const Scalar t24 = w.u_r_shank[0] - w.KA_r_shank[28]*w.lambda[6] - w.KA_r_shank[29]*w.lambda[7] - w.KA_r_shank[30]*w.lambda[8] - w.KA_r_shank[31]*w.lambda[9] - w.KA_r_shank[32]*w.lambda[10] - w.KA_r_shank[33]*w.lambda[11] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
+    const Scalar t24 = w.u_r_shank[0] - w.KA_r_shank[4][0]*w.lambda[6] - w.KA_r_shank[4][1]*w.lambda[7] - w.KA_r_shank[4][2]*w.lambda[8] - w.KA_r_shank[4][3]*w.lambda[9] - w.KA_r_shank[4][4]*w.lambda[10] - w.KA_r_shank[4][5]*w.lambda[11] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
     w.qdd[15] = w.Dinv_r_shank*t24;
     w.a_r_shank[0] = t20;
     w.a_r_shank[1] = t15;
@@ -8939,7 +8907,7 @@ PROXGEN_RT_NOINLINE void pv_40(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
     const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
@@ -8952,7 +8920,7 @@ PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
     const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
     const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t10 = w.u_r_ankle_link[0] - w.KA_r_ankle_link[28]*w.lambda[6] - w.KA_r_ankle_link[29]*w.lambda[7] - w.KA_r_ankle_link[31]*w.lambda[9] - w.KA_r_ankle_link[32]*w.lambda[10] - w.KA_r_ankle_link[33]*w.lambda[11] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
+    const Scalar t10 = w.u_r_ankle_link[0] - w.KA_r_ankle_link[4][0]*w.lambda[6] - w.KA_r_ankle_link[4][1]*w.lambda[7] - w.KA_r_ankle_link[4][3]*w.lambda[9] - w.KA_r_ankle_link[4][4]*w.lambda[10] - w.KA_r_ankle_link[4][5]*w.lambda[11] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
     w.qdd[16] = w.Dinv_r_ankle_link*t10;
     w.a_r_ankle_link[0] = t6;
     w.a_r_ankle_link[1] = t1;
@@ -8968,7 +8936,7 @@ PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
     const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
     const Scalar t15 = w.u_r_foot[0] - 0.06825*w.lambda[7] - w.lambda[9] - 0.00194517348958*w.a_r_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.qdd[17] = w.Dinv_r_foot*t15;
+    w.qdd[17] = 514.0929615568219*t15;
     w.a_r_foot[0] = w.a_r_ankle_link[0];
     w.a_r_foot[1] = t11;
     w.a_r_foot[2] = t12;
@@ -8984,7 +8952,7 @@ PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
     const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
     const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t22 = w.u_abdomen[0] - w.KA_abdomen[20]*w.lambda[12] - w.KA_abdomen[21]*w.lambda[13] - w.KA_abdomen[22]*w.lambda[14] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
+    const Scalar t22 = w.u_abdomen[0] - w.KA_abdomen[5][0]*w.lambda[12] - w.KA_abdomen[5][1]*w.lambda[13] - w.KA_abdomen[5][2]*w.lambda[14] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
     w.qdd[18] = w.Dinv_abdomen*t22;
     w.a_abdomen[0] = t18;
     w.a_abdomen[1] = t19;
@@ -8995,7 +8963,7 @@ PROXGEN_RT_NOINLINE void pv_41(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
@@ -9004,7 +8972,7 @@ PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
     const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
     const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
-    const Scalar t6 = w.u_chest[0] - w.KA_chest[16]*w.lambda[12] - w.KA_chest[17]*w.lambda[13] - w.KA_chest[18]*w.lambda[14] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
+    const Scalar t6 = w.u_chest[0] - w.KA_chest[4][0]*w.lambda[12] - w.KA_chest[4][1]*w.lambda[13] - w.KA_chest[4][2]*w.lambda[14] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
     w.qdd[19] = w.Dinv_chest*t6;
     w.a_chest[0] = t2;
     w.a_chest[1] = t1;
@@ -9028,7 +8996,7 @@ PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
     const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
     const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
-    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[16]*w.lambda[12] - w.KA_r_shoulder_pitch_link[17]*w.lambda[13] - w.KA_r_shoulder_pitch_link[18]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
+    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4][0]*w.lambda[12] - w.KA_r_shoulder_pitch_link[4][1]*w.lambda[13] - w.KA_r_shoulder_pitch_link[4][2]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
     w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
     w.a_r_shoulder_pitch_link[0] = t16;
     w.a_r_shoulder_pitch_link[1] = t11;
@@ -9043,7 +9011,7 @@ PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
     const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
     const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[12]*w.lambda[12] - w.KA_r_shoulder_roll_link[13]*w.lambda[13] - w.KA_r_shoulder_roll_link[14]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
+    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3][0]*w.lambda[12] - w.KA_r_shoulder_roll_link[3][1]*w.lambda[13] - w.KA_r_shoulder_roll_link[3][2]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
     w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
     w.a_r_shoulder_roll_link[1] = t21;
@@ -9054,14 +9022,14 @@ PROXGEN_RT_NOINLINE void pv_42(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_43(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
     const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
     const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
     const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
-    const Scalar t4 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[20]*w.lambda[12] - w.KA_r_upper_arm[21]*w.lambda[13] - w.KA_r_upper_arm[22]*w.lambda[14] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    const Scalar t4 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[5][0]*w.lambda[12] - w.KA_r_upper_arm[5][1]*w.lambda[13] - w.KA_r_upper_arm[5][2]*w.lambda[14] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
     w.qdd[31] = w.Dinv_r_upper_arm*t4;
     w.a_r_upper_arm[0] = t0;
     w.a_r_upper_arm[1] = t1;
@@ -9082,7 +9050,7 @@ PROXGEN_RT_NOINLINE void pv_43(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
     const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
     const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
-    const Scalar t15 = w.u_r_forearm[0] - w.KA_r_forearm[16]*w.lambda[12] - w.KA_r_forearm[17]*w.lambda[13] - w.KA_r_forearm[18]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
+    const Scalar t15 = w.u_r_forearm[0] - w.KA_r_forearm[4][0]*w.lambda[12] - w.KA_r_forearm[4][1]*w.lambda[13] - w.KA_r_forearm[4][2]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
     w.qdd[32] = w.Dinv_r_forearm*t15;
     w.a_r_forearm[0] = t11;
     w.a_r_forearm[1] = t6;
@@ -9099,7 +9067,7 @@ PROXGEN_RT_NOINLINE void pv_43(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
     const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
     const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[21]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[5][1]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
     w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
     w.a_r_wrist_yaw_link[0] = t18;
     w.a_r_wrist_yaw_link[1] = t19;
@@ -9110,14 +9078,14 @@ PROXGEN_RT_NOINLINE void pv_43(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_44(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
     const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
     const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
     const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
     const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
-    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[17]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
+    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[4][1]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
     w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
     w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
@@ -9133,7 +9101,7 @@ PROXGEN_RT_NOINLINE void pv_44(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
     const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
     const Scalar t9 = w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
-    w.qdd[35] = w.Dinv_r_hand*t9;
+    w.qdd[35] = 193.62412145174838*t9;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
     w.a_r_hand[1] = t5;
     w.a_r_hand[2] = t6;
@@ -9146,41 +9114,41 @@ PROXGEN_RT_NOINLINE void pv_44(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  kinematics_0(q, v, w);
-  kinematics_1(q, v, w);
-  kinematics_2(q, v, w);
-  kinematics_3(q, v, w);
-  kinematics_4(q, v, w);
-  kinematics_5(q, v, w);
-  kinematics_6(q, v, w);
-  kinematics_7(q, v, w);
-  kinematics_8(q, v, w);
-  kinematics_9(q, v, w);
-  kinematics_10(q, v, w);
-  kinematics_11(q, v, w);
-  kinematics_12(q, v, w);
-  kinematics_13(q, v, w);
-  kinematics_14(q, v, w);
-  kinematics_15(q, v, w);
+  kinematics_pelvis_to_l_hip_yaw_link(q, v, w);
+  kinematics_l_hip_roll_link_to_l_thigh(q, v, w);
+  kinematics_l_shank_to_l_ankle_link(q, v, w);
+  kinematics_l_foot_to_r_hip_yaw_link(q, v, w);
+  kinematics_r_hip_roll_link_to_r_thigh(q, v, w);
+  kinematics_r_shank_to_r_ankle_link(q, v, w);
+  kinematics_r_foot_to_abdomen(q, v, w);
+  kinematics_chest_to_l_shoulder_pitch_link(q, v, w);
+  kinematics_l_shoulder_roll_link_to_l_upper_arm(q, v, w);
+  kinematics_l_forearm_to_l_wrist_yaw_link(q, v, w);
+  kinematics_l_wrist_pitch_link_to_l_hand(q, v, w);
+  kinematics_neck_link_to_head(q, v, w);
+  kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(q, v, w);
+  kinematics_r_upper_arm_to_r_forearm(q, v, w);
+  kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(q, v, w);
+  kinematics_r_hand(q, v, w);
 }
 
 // Articulated-body elimination of the bodies off the constraint support
 // (no constraint below them): the same in both algorithms.
 void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
-  eliminate_free_0(tau, w);
-  eliminate_free_1(tau, w);
-  eliminate_free_2(tau, w);
-  eliminate_free_3(tau, w);
-  eliminate_free_4(tau, w);
-  eliminate_free_5(tau, w);
-  eliminate_free_6(tau, w);
+  eliminate_free_head_to_neck_link(tau, w);
+  eliminate_free_l_hand_to_l_wrist_pitch_link(tau, w);
+  eliminate_free_l_wrist_yaw_link(tau, w);
+  eliminate_free_l_forearm(tau, w);
+  eliminate_free_l_upper_arm(tau, w);
+  eliminate_free_l_shoulder_roll_link(tau, w);
+  eliminate_free_l_shoulder_pitch_link(tau, w);
 }
 
 // Accelerations of the bodies off the support, once their ancestors are final.
 void accelerate_free_bodies(Workspace& w) noexcept {
-  accelerate_free_0(w);
-  accelerate_free_1(w);
-  accelerate_free_2(w);
+  accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(w);
+  accelerate_free_l_forearm_to_l_wrist_pitch_link(w);
+  accelerate_free_l_hand_to_head(w);
 }
 
 }  // namespace
@@ -9192,51 +9160,60 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
   eliminate_free_bodies(tau, w);
-  caba_0(tau, mu, w);
-  caba_1(tau, w);
-  caba_2(tau, w);
-  caba_3(tau, w);
-  caba_4(tau, w);
-  caba_5(tau, w);
-  caba_6(tau, w);
-  caba_7(tau, w);
-  caba_8(tau, mu, w);
-  caba_9(tau, w);
-  caba_10(tau, w);
-  caba_11(tau, w);
-  caba_12(tau, w);
-  caba_13(tau, w);
-  caba_14(tau, mu, w);
-  caba_15(tau, w);
-  caba_16(tau, w);
-  caba_17(tau, w);
-  caba_18(tau, w);
-  caba_19(tau, w);
-  caba_20(tau, w);
-  caba_21(w);
-  caba_22(w);
-  caba_23(w);
-  caba_24(w);
-  caba_25(w);
-  caba_26(w);
-  caba_27(w);
-  caba_28(mu, w);
+  // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
+  caba_backward_r_hand_to_r_wrist_pitch_link(tau, mu, w);
+  caba_backward_r_wrist_yaw_link(tau, w);
+  caba_backward_r_forearm(tau, w);
+  caba_backward_r_upper_arm(tau, w);
+  caba_backward_r_shoulder_roll_link(tau, w);
+  caba_backward_r_shoulder_pitch_link(tau, w);
+  caba_backward_chest(tau, w);
+  caba_backward_abdomen(tau, w);
+  caba_backward_r_foot(tau, mu, w);
+  caba_backward_r_ankle_link(tau, w);
+  caba_backward_r_shank(tau, w);
+  caba_backward_r_thigh(tau, w);
+  caba_backward_r_hip_roll_link(tau, w);
+  caba_backward_r_hip_yaw_link(tau, w);
+  caba_backward_l_foot(tau, mu, w);
+  caba_backward_l_ankle_link(tau, w);
+  caba_backward_l_shank(tau, w);
+  caba_backward_l_thigh(tau, w);
+  caba_backward_l_hip_roll_link(tau, w);
+  caba_backward_l_hip_yaw_link(tau, w);
+  caba_backward_pelvis(tau, w);
+  // ---- forward: accelerations of the support
+  caba_forward_pelvis_to_l_hip_yaw_link(w);
+  caba_forward_l_hip_roll_link_to_l_shank(w);
+  caba_forward_l_ankle_link_to_r_hip_yaw_link(w);
+  caba_forward_r_hip_roll_link_to_r_shank(w);
+  caba_forward_r_ankle_link_to_abdomen(w);
+  caba_forward_chest_to_r_shoulder_roll_link(w);
+  caba_forward_r_upper_arm_to_r_wrist_yaw_link(w);
+  caba_forward_r_wrist_pitch_link_to_r_hand(w);
+  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_29(w);
-    caba_30(w);
-    caba_31(w);
-    caba_32(w);
-    caba_33(w);
-    caba_34(w);
-    caba_35(w);
-    caba_36(w);
-    caba_37(w);
-    caba_38(w);
-    caba_39(w);
-    caba_40(w);
-    caba_41(w);
-    caba_42(mu, w);
+    // ---- reduced sweep: u -= S^T dp, dp passes to the parent
+    caba_reduced_r_hand_to_r_forearm(w);
+    caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(w);
+    caba_reduced_chest_to_r_foot(w);
+    caba_reduced_r_ankle_link_to_r_thigh(w);
+    caba_reduced_r_hip_roll_link_to_l_foot(w);
+    caba_reduced_l_ankle_link_to_l_thigh(w);
+    caba_reduced_l_hip_roll_link_to_pelvis(w);
+    // ---- forward: accelerations of the support
+    caba_reforward_pelvis_to_l_hip_yaw_link(w);
+    caba_reforward_l_hip_roll_link_to_l_shank(w);
+    caba_reforward_l_ankle_link_to_r_hip_yaw_link(w);
+    caba_reforward_r_hip_roll_link_to_r_shank(w);
+    caba_reforward_r_ankle_link_to_abdomen(w);
+    caba_reforward_chest_to_r_shoulder_roll_link(w);
+    caba_reforward_r_upper_arm_to_r_wrist_yaw_link(w);
+    caba_reforward_r_wrist_pitch_link_to_r_hand(w);
+    // ---- multipliers: dlambda = mu (K a - k), lambda += dlambda
+    caba_update(mu, w);
   }
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
@@ -9298,55 +9275,61 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
              Scalar* qdd, Scalar* lambda) noexcept {
   kinematics(q, v, w);
   eliminate_free_bodies(tau, w);
-  pv_0(tau, w);
-  pv_1(tau, w);
-  pv_2(tau, w);
-  pv_3(tau, w);
-  pv_4(tau, w);
-  pv_5(tau, w);
-  pv_6(tau, w);
-  pv_7(tau, w);
-  pv_8(tau, w);
-  pv_9(tau, w);
-  pv_10(tau, w);
-  pv_11(tau, w);
-  pv_12(tau, w);
-  pv_13(tau, w);
-  pv_14(tau, w);
-  pv_15(tau, w);
-  pv_16(tau, w);
-  pv_17(tau, w);
-  pv_18(tau, w);
-  pv_19(tau, w);
-  pv_20(tau, w);
-  pv_21(w);
-  pv_22(w);
-  pv_23(w);
-  pv_24(w);
-  pv_25(w);
-  pv_26(w);
-  pv_27(w);
-  pv_28(w);
+  // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
+  pv_backward_r_hand_to_r_wrist_pitch_link(tau, w);
+  pv_backward_r_wrist_yaw_link(tau, w);
+  pv_backward_r_forearm(tau, w);
+  pv_backward_r_upper_arm(tau, w);
+  pv_backward_r_shoulder_roll_link(tau, w);
+  pv_backward_r_shoulder_pitch_link(tau, w);
+  pv_backward_chest(tau, w);
+  pv_backward_abdomen(tau, w);
+  pv_backward_r_foot(tau, w);
+  pv_backward_r_ankle_link(tau, w);
+  pv_backward_r_shank(tau, w);
+  pv_backward_r_thigh(tau, w);
+  pv_backward_r_hip_roll_link(tau, w);
+  pv_backward_r_hip_yaw_link(tau, w);
+  pv_backward_l_foot(tau, w);
+  pv_backward_l_ankle_link(tau, w);
+  pv_backward_l_shank(tau, w);
+  pv_backward_l_thigh(tau, w);
+  pv_backward_l_hip_roll_link(tau, w);
+  pv_backward_l_hip_yaw_link(tau, w);
+  pv_backward_pelvis(tau, w);
+  // ---- free accelerations (lambda = 0) and the rows' y_free = K a - k
+  pv_free_pelvis_to_l_hip_yaw_link(w);
+  pv_free_l_hip_roll_link_to_l_shank(w);
+  pv_free_l_ankle_link_to_r_hip_yaw_link(w);
+  pv_free_r_hip_roll_link_to_r_shank(w);
+  pv_free_r_ankle_link_to_abdomen(w);
+  pv_free_chest_to_r_shoulder_roll_link(w);
+  pv_free_r_upper_arm_to_r_wrist_yaw_link(w);
+  pv_free_r_wrist_pitch_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
-  pv_29(inv_mu, w);
-  pv_30(inv_mu, w);
-  pv_31(inv_mu, w);
-  pv_32(w);
-  pv_33(w);
-  pv_34(w);
-  pv_35(w);
+  // ---- G + I/mu = L L^T, G assembled from the carried rows
+  pv_delassus_column_0_to_column_3(inv_mu, w);
+  pv_delassus_column_4_to_column_8(inv_mu, w);
+  pv_delassus_column_9_to_W_0(inv_mu, w);
+  pv_delassus_W_1_to_W_2(w);
+  pv_delassus_W_3_to_W_4(w);
+  pv_delassus_W_5_to_LS(w);
+  // ---- lambda = 0
+  pv_start(w);
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
-    pv_36(inv_mu, w);
+    // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
+    pv_proximal(inv_mu, w);
   }
-  pv_37(w);
-  pv_38(w);
-  pv_39(w);
-  pv_40(w);
-  pv_41(w);
-  pv_42(w);
-  pv_43(w);
-  pv_44(w);
+  // ---- forward: accelerations, with the multipliers of the subtree rows
+  pv_forward_pelvis_to_l_hip_yaw_link(w);
+  pv_forward_l_hip_roll_link_to_l_shank(w);
+  pv_forward_l_ankle_link_to_r_hip_yaw_link(w);
+  pv_forward_r_hip_roll_link_to_r_shank(w);
+  pv_forward_r_ankle_link_to_abdomen(w);
+  pv_forward_chest_to_r_shoulder_roll_link(w);
+  pv_forward_r_upper_arm_to_r_wrist_yaw_link(w);
+  pv_forward_r_wrist_pitch_link_to_r_hand(w);
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];

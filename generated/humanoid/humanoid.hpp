@@ -59,7 +59,7 @@ struct Settings {
   int iterations = 3;  // multiplier updates K (0: the unconstrained motion)
 };
 
-// Everything one solve writes (23016 bytes): per-body quantities named
+// Everything one solve writes (22880 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_pelvis[9];         // joint rotation (row-major), body 1
@@ -239,13 +239,11 @@ struct Workspace {
   Scalar pA_r_hand[6];         // bias force, body 31
   Scalar g_r_hand[3];          // gravity in body coordinates, body 31
   Scalar k_right_hand[3];      // constraint right-hand side, constraint 2
-  Scalar Dinv_head;            // 1 / (S^T IA S), body 24
   Scalar u_head[1];            // tau - S^T pA, body 24
   Scalar IA_neck_link[21];     // articulated inertia (upper triangle), body 23
   Scalar Dinv_neck_link;       // 1 / (S^T IA S), body 23
   Scalar u_neck_link[1];       // tau - S^T pA, body 23
   Scalar IA_chest[21];         // articulated inertia (upper triangle), body 15
-  Scalar Dinv_l_hand;          // 1 / (S^T IA S), body 22
   Scalar u_l_hand[1];          // tau - S^T pA, body 22
   Scalar IA_l_wrist_pitch_link[21]; // articulated inertia (upper triangle), body 21
   Scalar Dinv_l_wrist_pitch_link; // 1 / (S^T IA S), body 21
@@ -382,51 +380,48 @@ struct Workspace {
   Scalar a_l_wrist_yaw_link[6]; // acceleration (gravity-shifted), body 20
   Scalar a_l_wrist_pitch_link[6]; // acceleration (gravity-shifted), body 21
   Scalar a_neck_link[6];       // acceleration (gravity-shifted), body 23
-  Scalar KSD_r_hand[3];        // D^-1 S^T KA, body 31
-  Scalar KA_r_wrist_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 30
-  Scalar KA_r_wrist_yaw_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 29
+  Scalar KA_r_wrist_pitch_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 30
+  Scalar KA_r_wrist_yaw_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 29
   Scalar KSD_r_wrist_pitch_link[3]; // D^-1 S^T KA, body 30
-  Scalar KA_r_forearm[24];     // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 28
+  Scalar KA_r_forearm[6][4];   // constraint force directions of the subtree rows (6 x m, one unused column), body 28
   Scalar KSD_r_wrist_yaw_link[3]; // D^-1 S^T KA, body 29
   Scalar KSD_r_forearm[3];     // D^-1 S^T KA, body 28
-  Scalar KA_r_upper_arm[24];   // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 27
+  Scalar KA_r_upper_arm[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 27
   Scalar KSD_r_upper_arm[3];   // D^-1 S^T KA, body 27
-  Scalar KA_r_shoulder_roll_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 26
+  Scalar KA_r_shoulder_roll_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 26
   Scalar KSD_r_shoulder_roll_link[3]; // D^-1 S^T KA, body 26
-  Scalar KA_r_shoulder_pitch_link[24]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 25
+  Scalar KA_r_shoulder_pitch_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 25
   Scalar KSD_r_shoulder_pitch_link[3]; // D^-1 S^T KA, body 25
-  Scalar KA_chest[24];         // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 15
+  Scalar KA_chest[6][4];       // constraint force directions of the subtree rows (6 x m, one unused column), body 15
   Scalar KSD_chest[3];         // D^-1 S^T KA, body 15
-  Scalar KA_abdomen[24];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 14
+  Scalar KA_abdomen[6][4];     // constraint force directions of the subtree rows (6 x m, one unused column), body 14
   Scalar KSD_abdomen[3];       // D^-1 S^T KA, body 14
-  Scalar KA_pelvis[96];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
-  Scalar KA_r_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 12
-  Scalar KSD_r_foot[6];        // D^-1 S^T KA, body 13
+  Scalar KA_pelvis[6][16];     // constraint force directions of the subtree rows (6 x m, one unused column), body 1
+  Scalar KA_r_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 12
   Scalar KSD_r_ankle_link[6];  // D^-1 S^T KA, body 12
-  Scalar KA_r_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 11
+  Scalar KA_r_shank[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 11
   Scalar KSD_r_shank[6];       // D^-1 S^T KA, body 11
-  Scalar KA_r_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 10
+  Scalar KA_r_thigh[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 10
   Scalar KSD_r_thigh[6];       // D^-1 S^T KA, body 10
-  Scalar KA_r_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 9
+  Scalar KA_r_hip_roll_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 9
   Scalar KSD_r_hip_roll_link[6]; // D^-1 S^T KA, body 9
-  Scalar KA_r_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 8
+  Scalar KA_r_hip_yaw_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 8
   Scalar KSD_r_hip_yaw_link[6]; // D^-1 S^T KA, body 8
-  Scalar KA_l_ankle_link[42];  // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 6
-  Scalar KSD_l_foot[6];        // D^-1 S^T KA, body 7
+  Scalar KA_l_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 6
   Scalar KSD_l_ankle_link[6];  // D^-1 S^T KA, body 6
-  Scalar KA_l_shank[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
+  Scalar KA_l_shank[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 5
   Scalar KSD_l_shank[6];       // D^-1 S^T KA, body 5
-  Scalar KA_l_thigh[42];       // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 4
+  Scalar KA_l_thigh[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 4
   Scalar KSD_l_thigh[6];       // D^-1 S^T KA, body 4
-  Scalar KA_l_hip_roll_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 3
+  Scalar KA_l_hip_roll_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 3
   Scalar KSD_l_hip_roll_link[6]; // D^-1 S^T KA, body 3
-  Scalar KA_l_hip_yaw_link[42]; // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 2
+  Scalar KA_l_hip_yaw_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 2
   Scalar KSD_l_hip_yaw_link[6]; // D^-1 S^T KA, body 2
-  Scalar Z_pelvis[96];         // L^-1 KA (row-major), body 1
+  Scalar Z_pelvis[6][16];      // L^-1 KA (6 x m, one unused column), body 1
   Scalar yfree[15];            // free row accelerations (tree order)
   Scalar Linv[15];             // 1 / diag(L)
   Scalar L[120];               // Cholesky factor of G + I/mu (lower, packed)
-  Scalar W[90];                // L^-1 Z^T (row-major)
+  Scalar W[15][6];             // L^-1 Z^T
   Scalar LSinv[6];             // 1 / diag(LS)
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };

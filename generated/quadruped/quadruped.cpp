@@ -11,7 +11,7 @@ namespace quadruped {
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     w.RJ_trunk[0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
@@ -78,7 +78,7 @@ PROXGEN_RT_NOINLINE void kinematics_0(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     proxgen_rt::sincos(q[8], w.sq_LF_thigh, w.cq_LF_thigh);
@@ -145,7 +145,7 @@ PROXGEN_RT_NOINLINE void kinematics_1(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     proxgen_rt::sincos(q[10], w.sq_LH_hip, w.cq_LH_hip);
@@ -218,7 +218,7 @@ PROXGEN_RT_NOINLINE void kinematics_2(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     proxgen_rt::sincos(q[12], w.sq_LH_shank, w.cq_LH_shank);
@@ -297,7 +297,7 @@ PROXGEN_RT_NOINLINE void kinematics_3(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     proxgen_rt::sincos(q[14], w.sq_RF_thigh, w.cq_RF_thigh);
@@ -364,7 +364,7 @@ PROXGEN_RT_NOINLINE void kinematics_4(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     proxgen_rt::sincos(q[16], w.sq_RH_hip, w.cq_RH_hip);
@@ -437,7 +437,7 @@ PROXGEN_RT_NOINLINE void kinematics_5(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     proxgen_rt::sincos(q[18], w.sq_RH_shank, w.cq_RH_shank);
@@ -475,7 +475,7 @@ PROXGEN_RT_NOINLINE void kinematics_6(const Scalar* PROXGEN_RT_RESTRICT q, const
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     const Scalar t0 = 0.195*w.k_rh_foot[1] - 0.004*w.k_rh_foot[2];
@@ -540,7 +540,7 @@ PROXGEN_RT_NOINLINE void caba_0(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
@@ -617,7 +617,7 @@ PROXGEN_RT_NOINLINE void caba_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -744,7 +744,7 @@ PROXGEN_RT_NOINLINE void caba_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     const Scalar t0 = 0.195*w.k_rf_foot[1] - 0.004*w.k_rf_foot[2];
@@ -809,7 +809,7 @@ PROXGEN_RT_NOINLINE void caba_3(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
@@ -886,7 +886,7 @@ PROXGEN_RT_NOINLINE void caba_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
@@ -1013,7 +1013,7 @@ PROXGEN_RT_NOINLINE void caba_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     const Scalar t0 = 0.195*w.k_lh_foot[1] + 0.004*w.k_lh_foot[2];
@@ -1078,7 +1078,7 @@ PROXGEN_RT_NOINLINE void caba_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
@@ -1155,7 +1155,7 @@ PROXGEN_RT_NOINLINE void caba_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
@@ -1282,7 +1282,7 @@ PROXGEN_RT_NOINLINE void caba_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     const Scalar t0 = 0.195*w.k_lf_foot[1] + 0.004*w.k_lf_foot[2];
@@ -1347,7 +1347,7 @@ PROXGEN_RT_NOINLINE void caba_9(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
@@ -1424,7 +1424,7 @@ PROXGEN_RT_NOINLINE void caba_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
@@ -1551,7 +1551,7 @@ PROXGEN_RT_NOINLINE void caba_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_trunk[0]);
@@ -1611,7 +1611,7 @@ PROXGEN_RT_NOINLINE void caba_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspac
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
@@ -1671,7 +1671,7 @@ PROXGEN_RT_NOINLINE void caba_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
@@ -1728,7 +1728,7 @@ PROXGEN_RT_NOINLINE void caba_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
@@ -1785,7 +1785,7 @@ PROXGEN_RT_NOINLINE void caba_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
@@ -1842,7 +1842,7 @@ PROXGEN_RT_NOINLINE void caba_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_17(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
@@ -1877,48 +1877,51 @@ PROXGEN_RT_NOINLINE void caba_17(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
     w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
     w.a_RH_shank[5] = t12;
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.dlambda[0] = mu*t14;
+    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.dlambda[0] = mu*t0;
     w.lambda[0] = w.dlambda[0];
-    const Scalar t15 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.dlambda[1] = mu*t15;
+    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.dlambda[1] = mu*t1;
     w.lambda[1] = w.dlambda[1];
-    const Scalar t16 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.dlambda[2] = mu*t16;
+    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.dlambda[2] = mu*t2;
     w.lambda[2] = w.dlambda[2];
-    const Scalar t17 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.dlambda[3] = mu*t17;
+    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.dlambda[3] = mu*t3;
     w.lambda[3] = w.dlambda[3];
-    const Scalar t18 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.dlambda[4] = mu*t18;
+    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.dlambda[4] = mu*t4;
     w.lambda[4] = w.dlambda[4];
-    const Scalar t19 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.dlambda[5] = mu*t19;
+    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.dlambda[5] = mu*t5;
     w.lambda[5] = w.dlambda[5];
-    const Scalar t20 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.dlambda[6] = mu*t20;
+    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.dlambda[6] = mu*t6;
     w.lambda[6] = w.dlambda[6];
-    const Scalar t21 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.dlambda[7] = mu*t21;
+    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.dlambda[7] = mu*t7;
     w.lambda[7] = w.dlambda[7];
-    const Scalar t22 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.dlambda[8] = mu*t22;
+    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.dlambda[8] = mu*t8;
     w.lambda[8] = w.dlambda[8];
-    const Scalar t23 = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
-    w.dlambda[9] = mu*t23;
+    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.dlambda[9] = mu*t9;
     w.lambda[9] = w.dlambda[9];
-    const Scalar t24 = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
-    w.dlambda[10] = mu*t24;
+    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.dlambda[10] = mu*t10;
     w.lambda[10] = w.dlambda[10];
-    const Scalar t25 = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
-    w.dlambda[11] = mu*t25;
+    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.dlambda[11] = mu*t11;
     w.lambda[11] = w.dlambda[11];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_18(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
     w.u_RH_shank[0] = w.u_RH_shank[0] + 0.195*w.dlambda[9];
@@ -1977,7 +1980,7 @@ PROXGEN_RT_NOINLINE void caba_18(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_19(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_RF_shank_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
     w.u_RF_shank[0] = w.u_RF_shank[0] + 0.195*w.dlambda[3];
@@ -2036,7 +2039,7 @@ PROXGEN_RT_NOINLINE void caba_19(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_20(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_LH_shank_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
     w.u_LH_shank[0] = w.u_LH_shank[0] + 0.195*w.dlambda[6];
@@ -2095,7 +2098,7 @@ PROXGEN_RT_NOINLINE void caba_20(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_LF_shank_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
     w.u_LF_shank[0] = w.u_LF_shank[0] + 0.195*w.dlambda[0];
@@ -2154,7 +2157,7 @@ PROXGEN_RT_NOINLINE void caba_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     w.u_trunk[0] = -w.dp_trunk[0] + w.u_trunk[0];
@@ -2164,6 +2167,9 @@ PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.u_trunk[4] = -w.dp_trunk[4] + w.u_trunk[4];
     w.u_trunk[5] = -w.dp_trunk[5] + w.u_trunk[5];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
@@ -2201,237 +2207,237 @@ PROXGEN_RT_NOINLINE void caba_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_trunk[4] = w.qdd[4];
     w.a_trunk[5] = w.qdd[5];
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t0 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t0 + w.RJ_LF_hip[3]*t1 + w.RJ_LF_hip[6]*t2;
-    const Scalar t4 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[7]*t2;
-    const Scalar t5 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t0 + w.RJ_LF_hip[5]*t1 + w.RJ_LF_hip[8]*t2;
-    const Scalar t6 = w.c_LF_hip[3] + w.a_trunk[3]*w.RJ_LF_hip[0] + w.a_trunk[4]*w.RJ_LF_hip[3] + w.a_trunk[5]*w.RJ_LF_hip[6];
-    const Scalar t7 = w.c_LF_hip[4] + w.a_trunk[3]*w.RJ_LF_hip[1] + w.a_trunk[4]*w.cq_LF_hip + w.a_trunk[5]*w.RJ_LF_hip[7];
-    const Scalar t8 = w.c_LF_hip[5] + w.a_trunk[3]*w.RJ_LF_hip[2] + w.a_trunk[4]*w.RJ_LF_hip[5] + w.a_trunk[5]*w.RJ_LF_hip[8];
-    const Scalar t9 = w.u_LF_hip[0] - 5.780668556524933e-05*t7 - w.U_LF_hip[0]*t3 - w.U_LF_hip[1]*t4 - w.U_LF_hip[2]*t5 - w.U_LF_hip[3]*t6 - w.U_LF_hip[5]*t8;
-    w.qdd[6] = w.Dinv_LF_hip*t9;
-    w.a_LF_hip[0] = t3;
-    w.a_LF_hip[1] = t4;
-    w.a_LF_hip[2] = t5;
-    w.a_LF_hip[3] = t6 + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = t7;
-    w.a_LF_hip[5] = t8 + 0.09950371902099893*w.qdd[6];
+    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0]*t22 + w.RJ_LF_hip[3]*t23 + w.RJ_LF_hip[6]*t24;
+    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[7]*t24;
+    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[2]*t22 + w.RJ_LF_hip[5]*t23 + w.RJ_LF_hip[8]*t24;
+    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0]*w.a_trunk[3] + w.RJ_LF_hip[3]*w.a_trunk[4] + w.RJ_LF_hip[6]*w.a_trunk[5];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[7]*w.a_trunk[5];
+    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[2]*w.a_trunk[3] + w.RJ_LF_hip[5]*w.a_trunk[4] + w.RJ_LF_hip[8]*w.a_trunk[5];
+    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
+    w.qdd[6] = w.Dinv_LF_hip*t31;
+    w.a_LF_hip[0] = t25;
+    w.a_LF_hip[1] = t26;
+    w.a_LF_hip[2] = t27;
+    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
+    w.a_LF_hip[4] = t29;
+    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
   }
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
-    const Scalar t10 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t11 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t12 = w.c_LF_thigh[0] + w.cq_LF_thigh*t10 - w.sq_LF_thigh*t11;
-    const Scalar t13 = w.c_LF_thigh[2] + w.sq_LF_thigh*t10 + w.cq_LF_thigh*t11;
-    const Scalar t14 = w.c_LF_thigh[3] + w.cq_LF_thigh*w.a_LF_hip[3] - w.sq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t15 = w.c_LF_thigh[5] + w.sq_LF_thigh*w.a_LF_hip[3] + w.cq_LF_thigh*w.a_LF_hip[5];
-    const Scalar t16 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t12 - w.IA_LF_thigh[13]*t13 - w.IA_LF_thigh[16]*t14 - w.IA_LF_thigh[18]*w.a_LF_hip[4] - w.IA_LF_thigh[19]*t15;
-    w.qdd[7] = w.Dinv_LF_thigh*t16;
-    w.a_LF_thigh[0] = t12;
+    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
+    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
+    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
+    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
+    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
+    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
+    const Scalar t6 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.IA_LF_thigh[16]*t4 - w.a_LF_hip[4]*w.IA_LF_thigh[18] - w.IA_LF_thigh[19]*t5;
+    w.qdd[7] = w.Dinv_LF_thigh*t6;
+    w.a_LF_thigh[0] = t2;
     w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = t13;
-    w.a_LF_thigh[3] = t14;
+    w.a_LF_thigh[2] = t3;
+    w.a_LF_thigh[3] = t4;
     w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = t15;
+    w.a_LF_thigh[5] = t5;
   }
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    const Scalar t17 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t18 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t19 = w.c_LF_shank[0] + w.cq_LF_shank*t17 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t20 = w.c_LF_shank[2] + w.sq_LF_shank*t17 + w.cq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t21 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t22 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t23 = w.u_LF_shank[0] - w.U_LF_shank[0]*t19 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t22;
-    w.qdd[8] = w.Dinv_LF_shank*t23;
-    w.a_LF_shank[0] = t19;
-    w.a_LF_shank[1] = t18;
-    w.a_LF_shank[2] = t20;
-    w.a_LF_shank[3] = t21;
+    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
+    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
+    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
+    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
+    const Scalar t13 = w.u_LF_shank[0] - w.U_LF_shank[0]*t9 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t12;
+    w.qdd[8] = w.Dinv_LF_shank*t13;
+    w.a_LF_shank[0] = t9;
+    w.a_LF_shank[1] = t8;
+    w.a_LF_shank[2] = t10;
+    w.a_LF_shank[3] = t11;
     w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = t22;
+    w.a_LF_shank[5] = t12;
+  }
+  // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t14 + w.RJ_LH_hip[3]*t15 + w.RJ_LH_hip[6]*t16;
+    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[7]*t16;
+    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t14 + w.RJ_LH_hip[5]*t15 + w.RJ_LH_hip[8]*t16;
+    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
+    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
+    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
+    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
+    w.qdd[9] = w.Dinv_LH_hip*t23;
+    w.a_LH_hip[0] = t17;
+    w.a_LH_hip[1] = t18;
+    w.a_LH_hip[2] = t19;
+    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
+    w.a_LH_hip[4] = t21;
+    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_24(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t0 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_LH_hip[0] + w.RJ_LH_hip[0]*t0 + w.RJ_LH_hip[3]*t1 + w.RJ_LH_hip[6]*t2;
-    const Scalar t4 = w.c_LH_hip[1] + w.RJ_LH_hip[1]*t0 + w.cq_LH_hip*t1 + w.RJ_LH_hip[7]*t2;
-    const Scalar t5 = w.c_LH_hip[2] + w.RJ_LH_hip[2]*t0 + w.RJ_LH_hip[5]*t1 + w.RJ_LH_hip[8]*t2;
-    const Scalar t6 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0] + w.a_trunk[4]*w.RJ_LH_hip[3] + w.a_trunk[5]*w.RJ_LH_hip[6];
-    const Scalar t7 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[7];
-    const Scalar t8 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[2] + w.a_trunk[4]*w.RJ_LH_hip[5] + w.a_trunk[5]*w.RJ_LH_hip[8];
-    const Scalar t9 = w.u_LH_hip[0] - 5.7617628499109426e-05*t7 - w.U_LH_hip[0]*t3 - w.U_LH_hip[1]*t4 - w.U_LH_hip[2]*t5 - w.U_LH_hip[3]*t6 - w.U_LH_hip[5]*t8;
-    w.qdd[9] = w.Dinv_LH_hip*t9;
-    w.a_LH_hip[0] = t3;
-    w.a_LH_hip[1] = t4;
-    w.a_LH_hip[2] = t5;
-    w.a_LH_hip[3] = t6 + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = t7;
-    w.a_LH_hip[5] = t8 - 0.09950371902099892*w.qdd[9];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
-    const Scalar t10 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t11 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t12 = w.c_LH_thigh[0] + w.cq_LH_thigh*t10 - w.sq_LH_thigh*t11;
-    const Scalar t13 = w.c_LH_thigh[2] + w.sq_LH_thigh*t10 + w.cq_LH_thigh*t11;
-    const Scalar t14 = w.c_LH_thigh[3] + w.cq_LH_thigh*w.a_LH_hip[3] - w.sq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t15 = w.c_LH_thigh[5] + w.sq_LH_thigh*w.a_LH_hip[3] + w.cq_LH_thigh*w.a_LH_hip[5];
-    const Scalar t16 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t12 - w.IA_LH_thigh[13]*t13 - w.IA_LH_thigh[16]*t14 - w.IA_LH_thigh[18]*w.a_LH_hip[4] - w.IA_LH_thigh[19]*t15;
-    w.qdd[10] = w.Dinv_LH_thigh*t16;
-    w.a_LH_thigh[0] = t12;
+    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
+    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
+    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
+    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
+    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
+    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
+    const Scalar t6 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.IA_LH_thigh[16]*t4 - w.a_LH_hip[4]*w.IA_LH_thigh[18] - w.IA_LH_thigh[19]*t5;
+    w.qdd[10] = w.Dinv_LH_thigh*t6;
+    w.a_LH_thigh[0] = t2;
     w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = t13;
-    w.a_LH_thigh[3] = t14;
+    w.a_LH_thigh[2] = t3;
+    w.a_LH_thigh[3] = t4;
     w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = t15;
+    w.a_LH_thigh[5] = t5;
   }
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    const Scalar t17 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t18 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t19 = w.c_LH_shank[0] + w.cq_LH_shank*t17 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t20 = w.c_LH_shank[2] + w.sq_LH_shank*t17 + w.cq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t21 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t22 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t23 = w.u_LH_shank[0] - w.U_LH_shank[0]*t19 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t22;
-    w.qdd[11] = w.Dinv_LH_shank*t23;
-    w.a_LH_shank[0] = t19;
-    w.a_LH_shank[1] = t18;
-    w.a_LH_shank[2] = t20;
-    w.a_LH_shank[3] = t21;
+    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
+    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
+    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
+    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
+    const Scalar t13 = w.u_LH_shank[0] - w.U_LH_shank[0]*t9 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t12;
+    w.qdd[11] = w.Dinv_LH_shank*t13;
+    w.a_LH_shank[0] = t9;
+    w.a_LH_shank[1] = t8;
+    w.a_LH_shank[2] = t10;
+    w.a_LH_shank[3] = t11;
     w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = t22;
+    w.a_LH_shank[5] = t12;
+  }
+  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t14 + w.RJ_RF_hip[3]*t15 + w.RJ_RF_hip[6]*t16;
+    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[7]*t16;
+    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t14 + w.RJ_RF_hip[5]*t15 + w.RJ_RF_hip[8]*t16;
+    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
+    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
+    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
+    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
+    w.qdd[12] = w.Dinv_RF_hip*t23;
+    w.a_RF_hip[0] = t17;
+    w.a_RF_hip[1] = t18;
+    w.a_RF_hip[2] = t19;
+    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
+    w.a_RF_hip[4] = t21;
+    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t0 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_RF_hip[0] + w.RJ_RF_hip[0]*t0 + w.RJ_RF_hip[3]*t1 + w.RJ_RF_hip[6]*t2;
-    const Scalar t4 = w.c_RF_hip[1] + w.RJ_RF_hip[1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[7]*t2;
-    const Scalar t5 = w.c_RF_hip[2] + w.RJ_RF_hip[2]*t0 + w.RJ_RF_hip[5]*t1 + w.RJ_RF_hip[8]*t2;
-    const Scalar t6 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0] + w.a_trunk[4]*w.RJ_RF_hip[3] + w.a_trunk[5]*w.RJ_RF_hip[6];
-    const Scalar t7 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[7];
-    const Scalar t8 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[2] + w.a_trunk[4]*w.RJ_RF_hip[5] + w.a_trunk[5]*w.RJ_RF_hip[8];
-    const Scalar t9 = w.u_RF_hip[0] + 5.780668556524933e-05*t7 - w.U_RF_hip[0]*t3 - w.U_RF_hip[1]*t4 - w.U_RF_hip[2]*t5 - w.U_RF_hip[3]*t6 - w.U_RF_hip[5]*t8;
-    w.qdd[12] = w.Dinv_RF_hip*t9;
-    w.a_RF_hip[0] = t3;
-    w.a_RF_hip[1] = t4;
-    w.a_RF_hip[2] = t5;
-    w.a_RF_hip[3] = t6 + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = t7;
-    w.a_RF_hip[5] = t8 + 0.09950371902099893*w.qdd[12];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
-    const Scalar t10 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t11 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t12 = w.c_RF_thigh[0] + w.cq_RF_thigh*t10 - w.sq_RF_thigh*t11;
-    const Scalar t13 = w.c_RF_thigh[2] + w.sq_RF_thigh*t10 + w.cq_RF_thigh*t11;
-    const Scalar t14 = w.c_RF_thigh[3] + w.cq_RF_thigh*w.a_RF_hip[3] - w.sq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t15 = w.c_RF_thigh[5] + w.sq_RF_thigh*w.a_RF_hip[3] + w.cq_RF_thigh*w.a_RF_hip[5];
-    const Scalar t16 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t12 - w.IA_RF_thigh[13]*t13 - w.IA_RF_thigh[16]*t14 - w.IA_RF_thigh[18]*w.a_RF_hip[4] - w.IA_RF_thigh[19]*t15;
-    w.qdd[13] = w.Dinv_RF_thigh*t16;
-    w.a_RF_thigh[0] = t12;
+    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
+    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
+    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
+    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
+    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
+    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
+    const Scalar t6 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.IA_RF_thigh[16]*t4 - w.a_RF_hip[4]*w.IA_RF_thigh[18] - w.IA_RF_thigh[19]*t5;
+    w.qdd[13] = w.Dinv_RF_thigh*t6;
+    w.a_RF_thigh[0] = t2;
     w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = t13;
-    w.a_RF_thigh[3] = t14;
+    w.a_RF_thigh[2] = t3;
+    w.a_RF_thigh[3] = t4;
     w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = t15;
+    w.a_RF_thigh[5] = t5;
   }
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    const Scalar t17 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t18 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t19 = w.c_RF_shank[0] + w.cq_RF_shank*t17 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t20 = w.c_RF_shank[2] + w.sq_RF_shank*t17 + w.cq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t21 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t22 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t23 = w.u_RF_shank[0] - w.U_RF_shank[0]*t19 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t22;
-    w.qdd[14] = w.Dinv_RF_shank*t23;
-    w.a_RF_shank[0] = t19;
-    w.a_RF_shank[1] = t18;
-    w.a_RF_shank[2] = t20;
-    w.a_RF_shank[3] = t21;
+    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
+    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
+    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
+    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
+    const Scalar t13 = w.u_RF_shank[0] - w.U_RF_shank[0]*t9 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t12;
+    w.qdd[14] = w.Dinv_RF_shank*t13;
+    w.a_RF_shank[0] = t9;
+    w.a_RF_shank[1] = t8;
+    w.a_RF_shank[2] = t10;
+    w.a_RF_shank[3] = t11;
     w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = t22;
+    w.a_RF_shank[5] = t12;
+  }
+  // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
+    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
+    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
+    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t14 + w.RJ_RH_hip[3]*t15 + w.RJ_RH_hip[6]*t16;
+    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[7]*t16;
+    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t14 + w.RJ_RH_hip[5]*t15 + w.RJ_RH_hip[8]*t16;
+    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
+    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
+    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
+    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
+    w.qdd[15] = w.Dinv_RH_hip*t23;
+    w.a_RH_hip[0] = t17;
+    w.a_RH_hip[1] = t18;
+    w.a_RH_hip[2] = t19;
+    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
+    w.a_RH_hip[4] = t21;
+    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t0 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t1 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t2 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t3 = w.c_RH_hip[0] + w.RJ_RH_hip[0]*t0 + w.RJ_RH_hip[3]*t1 + w.RJ_RH_hip[6]*t2;
-    const Scalar t4 = w.c_RH_hip[1] + w.RJ_RH_hip[1]*t0 + w.cq_RH_hip*t1 + w.RJ_RH_hip[7]*t2;
-    const Scalar t5 = w.c_RH_hip[2] + w.RJ_RH_hip[2]*t0 + w.RJ_RH_hip[5]*t1 + w.RJ_RH_hip[8]*t2;
-    const Scalar t6 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0] + w.a_trunk[4]*w.RJ_RH_hip[3] + w.a_trunk[5]*w.RJ_RH_hip[6];
-    const Scalar t7 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[7];
-    const Scalar t8 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[2] + w.a_trunk[4]*w.RJ_RH_hip[5] + w.a_trunk[5]*w.RJ_RH_hip[8];
-    const Scalar t9 = w.u_RH_hip[0] + 5.7617628499109426e-05*t7 - w.U_RH_hip[0]*t3 - w.U_RH_hip[1]*t4 - w.U_RH_hip[2]*t5 - w.U_RH_hip[3]*t6 - w.U_RH_hip[5]*t8;
-    w.qdd[15] = w.Dinv_RH_hip*t9;
-    w.a_RH_hip[0] = t3;
-    w.a_RH_hip[1] = t4;
-    w.a_RH_hip[2] = t5;
-    w.a_RH_hip[3] = t6 + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = t7;
-    w.a_RH_hip[5] = t8 - 0.09950371902099892*w.qdd[15];
-  }
+PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
-    const Scalar t10 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t11 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t12 = w.c_RH_thigh[0] + w.cq_RH_thigh*t10 - w.sq_RH_thigh*t11;
-    const Scalar t13 = w.c_RH_thigh[2] + w.sq_RH_thigh*t10 + w.cq_RH_thigh*t11;
-    const Scalar t14 = w.c_RH_thigh[3] + w.cq_RH_thigh*w.a_RH_hip[3] - w.sq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t15 = w.c_RH_thigh[5] + w.sq_RH_thigh*w.a_RH_hip[3] + w.cq_RH_thigh*w.a_RH_hip[5];
-    const Scalar t16 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t12 - w.IA_RH_thigh[13]*t13 - w.IA_RH_thigh[16]*t14 - w.IA_RH_thigh[18]*w.a_RH_hip[4] - w.IA_RH_thigh[19]*t15;
-    w.qdd[16] = w.Dinv_RH_thigh*t16;
-    w.a_RH_thigh[0] = t12;
+    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
+    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
+    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
+    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
+    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
+    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
+    const Scalar t6 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.IA_RH_thigh[16]*t4 - w.a_RH_hip[4]*w.IA_RH_thigh[18] - w.IA_RH_thigh[19]*t5;
+    w.qdd[16] = w.Dinv_RH_thigh*t6;
+    w.a_RH_thigh[0] = t2;
     w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = t13;
-    w.a_RH_thigh[3] = t14;
+    w.a_RH_thigh[2] = t3;
+    w.a_RH_thigh[3] = t4;
     w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = t15;
+    w.a_RH_thigh[5] = t5;
   }
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    const Scalar t17 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t18 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t19 = w.c_RH_shank[0] + w.cq_RH_shank*t17 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t20 = w.c_RH_shank[2] + w.sq_RH_shank*t17 + w.cq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t21 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t22 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t23 = w.u_RH_shank[0] - w.U_RH_shank[0]*t19 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t22;
-    w.qdd[17] = w.Dinv_RH_shank*t23;
-    w.a_RH_shank[0] = t19;
-    w.a_RH_shank[1] = t18;
-    w.a_RH_shank[2] = t20;
-    w.a_RH_shank[3] = t21;
+    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
+    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
+    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
+    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
+    const Scalar t13 = w.u_RH_shank[0] - w.U_RH_shank[0]*t9 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t12;
+    w.qdd[17] = w.Dinv_RH_shank*t13;
+    w.a_RH_shank[0] = t9;
+    w.a_RH_shank[1] = t8;
+    w.a_RH_shank[2] = t10;
+    w.a_RH_shank[3] = t11;
     w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = t22;
+    w.a_RH_shank[5] = t12;
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_27(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
     const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -2473,62 +2479,55 @@ PROXGEN_RT_NOINLINE void caba_27(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) no
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_0(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    w.Dinv_RH_shank = 1.0 / 0.000486144;
     w.u_RH_shank[0] = -w.pA_RH_shank[4] + tau[17];
-    const Scalar Ia0 = 0.064 - 1.5241216e-05*w.Dinv_RH_shank;
-    const Scalar pa0 = w.pA_RH_shank[0] - 0.003904*w.Dinv_RH_shank*w.u_RH_shank[0] + w.c_RH_shank[0]*Ia0;
+    const Scalar pa0 = 0.03264876250658241*w.c_RH_shank[0] + w.pA_RH_shank[0] - 8.030542390731965*w.u_RH_shank[0];
     const Scalar pa1 = 0.003904*w.c_RH_shank[3] + w.pA_RH_shank[1];
     const Scalar pa2 = 0.064*w.c_RH_shank[2] + w.pA_RH_shank[2];
     const Scalar pa3 = 0.000483144*w.c_RH_shank[3] + w.pA_RH_shank[3];
-    const Scalar pa4 = w.pA_RH_shank[4] + 0.000486144*w.Dinv_RH_shank*w.u_RH_shank[0];
+    const Scalar pa4 = w.pA_RH_shank[4] + 0.9999999999999999*w.u_RH_shank[0];
     const Scalar pa5 = 6e-06*w.c_RH_shank[5] + w.pA_RH_shank[5];
     const Scalar C20 = w.cq_RH_shank*w.cq_RH_shank - w.sq_RH_shank*w.sq_RH_shank;
-    const Scalar h0 = 0.032 - 0.5*Ia0;
-    const Scalar m0 = 0.032 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_RH_shank*w.sq_RH_shank;
-    const Scalar t1 = m0 - C20*h0;
-    const Scalar t2 = m0 + C20*h0;
-    const Scalar t3 = 0.013375999999999999 + 0.003904*w.cq_RH_shank;
-    const Scalar t4 = w.cq_RH_shank*pa0 + w.sq_RH_shank*pa2;
-    const Scalar t5 = -w.sq_RH_shank*pa0 + w.cq_RH_shank*pa2;
-    w.IA_RH_thigh[0] = 0.6890000000000001 + t1;
-    w.IA_RH_thigh[2] = h0*t0;
-    w.IA_RH_thigh[4] = -0.01268 - 0.209*t1;
-    w.IA_RH_thigh[8] = 0.01268 + t3;
+    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
+    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
+    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_RH_shank;
+    const Scalar t3 = w.cq_RH_shank*pa0 + w.sq_RH_shank*pa2;
+    const Scalar t4 = -w.sq_RH_shank*pa0 + w.cq_RH_shank*pa2;
+    w.IA_RH_thigh[0] = 0.6890000000000001 + t0;
+    w.IA_RH_thigh[2] = 0.03135123749341759*w.cq_RH_shank*w.sq_RH_shank;
+    w.IA_RH_thigh[4] = -0.01268 - 0.209*t0;
+    w.IA_RH_thigh[8] = 0.01268 + t2;
     w.IA_RH_thigh[10] = -0.003904*w.sq_RH_shank;
-    w.IA_RH_thigh[11] = 0.6890000000000001 + t2;
-    w.IA_RH_thigh[13] = -0.209*h0*t0;
-    w.IA_RH_thigh[15] = 0.002676476 + 0.000815936*w.cq_RH_shank + 0.00023857200000000002*C20 + 0.209*t3;
+    w.IA_RH_thigh[11] = 0.6890000000000001 + t1;
+    w.IA_RH_thigh[13] = -0.006552408636124276*w.cq_RH_shank*w.sq_RH_shank;
+    w.IA_RH_thigh[15] = 0.002676476 + 0.000815936*w.cq_RH_shank + 0.00023857200000000002*C20 + 0.209*t2;
     w.IA_RH_thigh[17] = -0.000815936*w.sq_RH_shank - 0.00047714400000000004*w.cq_RH_shank*w.sq_RH_shank;
-    w.IA_RH_thigh[18] = 0.0024196 + 0.043681*t1;
+    w.IA_RH_thigh[18] = 0.0024196 + 0.043681*t0;
     w.IA_RH_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_RH_thigh[0] = w.pA_RH_thigh[0] + t4;
+    w.pA_RH_thigh[0] = w.pA_RH_thigh[0] + t3;
     w.pA_RH_thigh[1] = w.pA_RH_thigh[1] + pa1;
-    w.pA_RH_thigh[2] = w.pA_RH_thigh[2] + t5;
+    w.pA_RH_thigh[2] = w.pA_RH_thigh[2] + t4;
     w.pA_RH_thigh[3] = w.pA_RH_thigh[3] + 0.209*pa1 + w.cq_RH_shank*pa3 + w.sq_RH_shank*pa5;
-    w.pA_RH_thigh[4] = w.pA_RH_thigh[4] + pa4 - 0.209*t4;
+    w.pA_RH_thigh[4] = w.pA_RH_thigh[4] + pa4 - 0.209*t3;
     w.pA_RH_thigh[5] = w.pA_RH_thigh[5] - w.sq_RH_shank*pa3 + w.cq_RH_shank*pa5;
-    w.KSD_RH_shank[0] = -0.195*w.Dinv_RH_shank;
-    const Scalar t6 = 1.0 - 0.00076128*w.Dinv_RH_shank;
-    w.KA_RH_thigh[0] = w.cq_RH_shank*t6;
-    w.KA_RH_thigh[8] = -w.sq_RH_shank*t6;
-    w.KA_RH_thigh[12] = 0.004*w.sq_RH_shank;
-    w.KA_RH_thigh[16] = -0.209*w.cq_RH_shank*t6;
-    w.KA_RH_thigh[20] = 0.004*w.cq_RH_shank;
-    w.KA_RH_thigh[13] = 0.209 + 0.195*w.cq_RH_shank;
-    w.KA_RH_thigh[21] = -0.195*w.sq_RH_shank;
-    w.KA_RH_thigh[2] = w.sq_RH_shank;
-    w.KA_RH_thigh[10] = w.cq_RH_shank;
-    w.KA_RH_thigh[14] = -0.004*w.cq_RH_shank;
-    w.KA_RH_thigh[18] = -0.209*w.sq_RH_shank;
-    w.KA_RH_thigh[22] = 0.004*w.sq_RH_shank;
+    w.KA_RH_thigh[0][0] = -0.5659557661927332*w.cq_RH_shank;
+    w.KA_RH_thigh[2][0] = 0.5659557661927332*w.sq_RH_shank;
+    w.KA_RH_thigh[3][0] = 0.004*w.sq_RH_shank;
+    w.KA_RH_thigh[4][0] = 0.11828475513428124*w.cq_RH_shank;
+    w.KA_RH_thigh[5][0] = 0.004*w.cq_RH_shank;
+    w.KA_RH_thigh[3][1] = 0.209 + 0.195*w.cq_RH_shank;
+    w.KA_RH_thigh[5][1] = -0.195*w.sq_RH_shank;
+    w.KA_RH_thigh[0][2] = w.sq_RH_shank;
+    w.KA_RH_thigh[2][2] = w.cq_RH_shank;
+    w.KA_RH_thigh[3][2] = -0.004*w.cq_RH_shank;
+    w.KA_RH_thigh[4][2] = -0.209*w.sq_RH_shank;
+    w.KA_RH_thigh[5][2] = 0.004*w.sq_RH_shank;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
@@ -2594,32 +2593,32 @@ PROXGEN_RT_NOINLINE void pv_1(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa3 + w.sq_RH_thigh*pa5 - 0.062*t20;
     w.pA_RH_hip[4] = w.pA_RH_hip[4] + pa4;
     w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa5 + 0.062*t19;
-    w.KSD_RH_thigh[0] = w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
-    const Scalar t21 = w.KA_RH_thigh[0] - w.KA_RH_thigh[16]*t0;
-    const Scalar t22 = w.KA_RH_thigh[8] - w.KA_RH_thigh[16]*t1;
-    const Scalar t23 = w.KA_RH_thigh[20] - 0.00020288*w.KA_RH_thigh[16]*w.Dinv_RH_thigh;
+    w.KSD_RH_thigh[0] = w.KA_RH_thigh[4][0]*w.Dinv_RH_thigh;
+    const Scalar t21 = w.KA_RH_thigh[0][0] - w.KA_RH_thigh[4][0]*t0;
+    const Scalar t22 = w.KA_RH_thigh[2][0] - w.KA_RH_thigh[4][0]*t1;
+    const Scalar t23 = w.KA_RH_thigh[5][0] - 0.00020288*w.KA_RH_thigh[4][0]*w.Dinv_RH_thigh;
     const Scalar t24 = w.cq_RH_thigh*t21 + w.sq_RH_thigh*t22;
     const Scalar t25 = -w.sq_RH_thigh*t21 + w.cq_RH_thigh*t22;
-    w.KA_RH_hip[0] = t24;
-    w.KA_RH_hip[8] = t25;
-    w.KA_RH_hip[12] = w.cq_RH_thigh*w.KA_RH_thigh[12] + w.sq_RH_thigh*t23 - 0.062*t25;
-    w.KA_RH_hip[20] = -w.sq_RH_thigh*w.KA_RH_thigh[12] + w.cq_RH_thigh*t23 + 0.062*t24;
-    w.KA_RH_hip[13] = w.cq_RH_thigh*w.KA_RH_thigh[13] + w.sq_RH_thigh*w.KA_RH_thigh[21];
-    w.KA_RH_hip[21] = -w.sq_RH_thigh*w.KA_RH_thigh[13] + w.cq_RH_thigh*w.KA_RH_thigh[21];
-    w.KSD_RH_thigh[2] = w.KA_RH_thigh[18]*w.Dinv_RH_thigh;
-    const Scalar t26 = w.KA_RH_thigh[2] - w.KA_RH_thigh[18]*t0;
-    const Scalar t27 = w.KA_RH_thigh[10] - w.KA_RH_thigh[18]*t1;
-    const Scalar t28 = w.KA_RH_thigh[22] - 0.00020288*w.KA_RH_thigh[18]*w.Dinv_RH_thigh;
+    w.KA_RH_hip[0][0] = t24;
+    w.KA_RH_hip[2][0] = t25;
+    w.KA_RH_hip[3][0] = w.cq_RH_thigh*w.KA_RH_thigh[3][0] + w.sq_RH_thigh*t23 - 0.062*t25;
+    w.KA_RH_hip[5][0] = -w.sq_RH_thigh*w.KA_RH_thigh[3][0] + w.cq_RH_thigh*t23 + 0.062*t24;
+    w.KA_RH_hip[3][1] = w.cq_RH_thigh*w.KA_RH_thigh[3][1] + w.sq_RH_thigh*w.KA_RH_thigh[5][1];
+    w.KA_RH_hip[5][1] = -w.sq_RH_thigh*w.KA_RH_thigh[3][1] + w.cq_RH_thigh*w.KA_RH_thigh[5][1];
+    w.KSD_RH_thigh[2] = w.KA_RH_thigh[4][2]*w.Dinv_RH_thigh;
+    const Scalar t26 = w.KA_RH_thigh[0][2] - w.KA_RH_thigh[4][2]*t0;
+    const Scalar t27 = w.KA_RH_thigh[2][2] - w.KA_RH_thigh[4][2]*t1;
+    const Scalar t28 = w.KA_RH_thigh[5][2] - 0.00020288*w.KA_RH_thigh[4][2]*w.Dinv_RH_thigh;
     const Scalar t29 = w.cq_RH_thigh*t26 + w.sq_RH_thigh*t27;
     const Scalar t30 = -w.sq_RH_thigh*t26 + w.cq_RH_thigh*t27;
-    w.KA_RH_hip[2] = t29;
-    w.KA_RH_hip[10] = t30;
-    w.KA_RH_hip[14] = w.cq_RH_thigh*w.KA_RH_thigh[14] + w.sq_RH_thigh*t28 - 0.062*t30;
-    w.KA_RH_hip[22] = -w.sq_RH_thigh*w.KA_RH_thigh[14] + w.cq_RH_thigh*t28 + 0.062*t29;
+    w.KA_RH_hip[0][2] = t29;
+    w.KA_RH_hip[2][2] = t30;
+    w.KA_RH_hip[3][2] = w.cq_RH_thigh*w.KA_RH_thigh[3][2] + w.sq_RH_thigh*t28 - 0.062*t30;
+    w.KA_RH_hip[5][2] = -w.sq_RH_thigh*w.KA_RH_thigh[3][2] + w.cq_RH_thigh*t28 + 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -2743,116 +2742,109 @@ PROXGEN_RT_NOINLINE void pv_2(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RH_hip[0]*pa3 + w.RJ_RH_hip[1]*pa4 + w.RJ_RH_hip[2]*pa5 - 0.049*t63;
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[3]*pa3 + w.cq_RH_hip*pa4 + w.RJ_RH_hip[5]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RH_hip[6]*pa3 + w.RJ_RH_hip[7]*pa4 + w.RJ_RH_hip[8]*pa5 + 0.049*t61 - 0.19*t62;
-    w.KS_RH_hip[0] = 0.9950371902099892*w.KA_RH_hip[12] - 0.09950371902099892*w.KA_RH_hip[20];
+    w.KS_RH_hip[0] = 0.9950371902099892*w.KA_RH_hip[3][0] - 0.09950371902099892*w.KA_RH_hip[5][0];
     w.KSD_RH_hip[0] = w.Dinv_RH_hip*w.KS_RH_hip[0];
-    const Scalar t64 = w.KA_RH_hip[0] - t0*w.KS_RH_hip[0];
-    const Scalar t65 = w.KA_RH_hip[8] - t2*w.KS_RH_hip[0];
+    const Scalar t64 = w.KA_RH_hip[0][0] - t0*w.KS_RH_hip[0];
+    const Scalar t65 = w.KA_RH_hip[2][0] - t2*w.KS_RH_hip[0];
     const Scalar t66 = -t1*w.KS_RH_hip[0];
-    const Scalar t67 = w.KA_RH_hip[12] - t3*w.KS_RH_hip[0];
-    const Scalar t68 = w.KA_RH_hip[20] - t4*w.KS_RH_hip[0];
+    const Scalar t67 = w.KA_RH_hip[3][0] - t3*w.KS_RH_hip[0];
+    const Scalar t68 = w.KA_RH_hip[5][0] - t4*w.KS_RH_hip[0];
     const Scalar t69 = 5.7617628499109426e-05*w.Dinv_RH_hip*w.KS_RH_hip[0];
     const Scalar t70 = w.RJ_RH_hip[0]*t64 + w.RJ_RH_hip[1]*t66 + w.RJ_RH_hip[2]*t65;
     const Scalar t71 = w.RJ_RH_hip[3]*t64 + w.cq_RH_hip*t66 + w.RJ_RH_hip[5]*t65;
     const Scalar t72 = w.RJ_RH_hip[6]*t64 + w.RJ_RH_hip[7]*t66 + w.RJ_RH_hip[8]*t65;
-    w.KA_trunk[9] = t70;
-    w.KA_trunk[22] = t71;
-    w.KA_trunk[35] = t72;
-    w.KA_trunk[48] = w.RJ_RH_hip[0]*t67 + w.RJ_RH_hip[1]*t69 + w.RJ_RH_hip[2]*t68 - 0.049*t72;
-    w.KA_trunk[61] = w.RJ_RH_hip[3]*t67 + w.cq_RH_hip*t69 + w.RJ_RH_hip[5]*t68 + 0.19*t72;
-    w.KA_trunk[74] = w.RJ_RH_hip[6]*t67 + w.RJ_RH_hip[7]*t69 + w.RJ_RH_hip[8]*t68 + 0.049*t70 - 0.19*t71;
-    w.KS_RH_hip[1] = 0.9950371902099892*w.KA_RH_hip[13] - 0.09950371902099892*w.KA_RH_hip[21];
+    w.KA_trunk[0][9] = t70;
+    w.KA_trunk[1][9] = t71;
+    w.KA_trunk[2][9] = t72;
+    w.KA_trunk[3][9] = w.RJ_RH_hip[0]*t67 + w.RJ_RH_hip[1]*t69 + w.RJ_RH_hip[2]*t68 - 0.049*t72;
+    w.KA_trunk[4][9] = w.RJ_RH_hip[3]*t67 + w.cq_RH_hip*t69 + w.RJ_RH_hip[5]*t68 + 0.19*t72;
+    w.KA_trunk[5][9] = w.RJ_RH_hip[6]*t67 + w.RJ_RH_hip[7]*t69 + w.RJ_RH_hip[8]*t68 + 0.049*t70 - 0.19*t71;
+    w.KS_RH_hip[1] = 0.9950371902099892*w.KA_RH_hip[3][1] - 0.09950371902099892*w.KA_RH_hip[5][1];
     w.KSD_RH_hip[1] = w.Dinv_RH_hip*w.KS_RH_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_RH_hip[1];
     const Scalar t74 = -t0*w.KS_RH_hip[1];
     const Scalar t75 = -t2*w.KS_RH_hip[1];
-    const Scalar t76 = w.KA_RH_hip[13] - t3*w.KS_RH_hip[1];
-    const Scalar t77 = w.KA_RH_hip[21] - t4*w.KS_RH_hip[1];
+    const Scalar t76 = w.KA_RH_hip[3][1] - t3*w.KS_RH_hip[1];
+    const Scalar t77 = w.KA_RH_hip[5][1] - t4*w.KS_RH_hip[1];
     const Scalar t78 = 5.7617628499109426e-05*w.Dinv_RH_hip*w.KS_RH_hip[1];
     const Scalar t79 = w.RJ_RH_hip[0]*t74 + w.RJ_RH_hip[1]*t73 + w.RJ_RH_hip[2]*t75;
     const Scalar t80 = w.RJ_RH_hip[3]*t74 + w.cq_RH_hip*t73 + w.RJ_RH_hip[5]*t75;
     const Scalar t81 = w.RJ_RH_hip[6]*t74 + w.RJ_RH_hip[7]*t73 + w.RJ_RH_hip[8]*t75;
-    w.KA_trunk[10] = t79;
-    w.KA_trunk[23] = t80;
-    w.KA_trunk[36] = t81;
-    w.KA_trunk[49] = w.RJ_RH_hip[0]*t76 + w.RJ_RH_hip[1]*t78 + w.RJ_RH_hip[2]*t77 - 0.049*t81;
-    w.KA_trunk[62] = w.RJ_RH_hip[3]*t76 + w.cq_RH_hip*t78 + w.RJ_RH_hip[5]*t77 + 0.19*t81;
-    w.KA_trunk[75] = w.RJ_RH_hip[6]*t76 + w.RJ_RH_hip[7]*t78 + w.RJ_RH_hip[8]*t77 + 0.049*t79 - 0.19*t80;
-    w.KS_RH_hip[2] = 0.9950371902099892*w.KA_RH_hip[14] - 0.09950371902099892*w.KA_RH_hip[22];
+    w.KA_trunk[0][10] = t79;
+    w.KA_trunk[1][10] = t80;
+    w.KA_trunk[2][10] = t81;
+    w.KA_trunk[3][10] = w.RJ_RH_hip[0]*t76 + w.RJ_RH_hip[1]*t78 + w.RJ_RH_hip[2]*t77 - 0.049*t81;
+    w.KA_trunk[4][10] = w.RJ_RH_hip[3]*t76 + w.cq_RH_hip*t78 + w.RJ_RH_hip[5]*t77 + 0.19*t81;
+    w.KA_trunk[5][10] = w.RJ_RH_hip[6]*t76 + w.RJ_RH_hip[7]*t78 + w.RJ_RH_hip[8]*t77 + 0.049*t79 - 0.19*t80;
+    w.KS_RH_hip[2] = 0.9950371902099892*w.KA_RH_hip[3][2] - 0.09950371902099892*w.KA_RH_hip[5][2];
     w.KSD_RH_hip[2] = w.Dinv_RH_hip*w.KS_RH_hip[2];
-    const Scalar t82 = w.KA_RH_hip[2] - t0*w.KS_RH_hip[2];
-    const Scalar t83 = w.KA_RH_hip[10] - t2*w.KS_RH_hip[2];
+    const Scalar t82 = w.KA_RH_hip[0][2] - t0*w.KS_RH_hip[2];
+    const Scalar t83 = w.KA_RH_hip[2][2] - t2*w.KS_RH_hip[2];
     const Scalar t84 = -t1*w.KS_RH_hip[2];
-    const Scalar t85 = w.KA_RH_hip[14] - t3*w.KS_RH_hip[2];
-    const Scalar t86 = w.KA_RH_hip[22] - t4*w.KS_RH_hip[2];
+    const Scalar t85 = w.KA_RH_hip[3][2] - t3*w.KS_RH_hip[2];
+    const Scalar t86 = w.KA_RH_hip[5][2] - t4*w.KS_RH_hip[2];
     const Scalar t87 = 5.7617628499109426e-05*w.Dinv_RH_hip*w.KS_RH_hip[2];
     const Scalar t88 = w.RJ_RH_hip[0]*t82 + w.RJ_RH_hip[1]*t84 + w.RJ_RH_hip[2]*t83;
     const Scalar t89 = w.RJ_RH_hip[3]*t82 + w.cq_RH_hip*t84 + w.RJ_RH_hip[5]*t83;
     const Scalar t90 = w.RJ_RH_hip[6]*t82 + w.RJ_RH_hip[7]*t84 + w.RJ_RH_hip[8]*t83;
-    w.KA_trunk[11] = t88;
-    w.KA_trunk[24] = t89;
-    w.KA_trunk[37] = t90;
-    w.KA_trunk[50] = w.RJ_RH_hip[0]*t85 + w.RJ_RH_hip[1]*t87 + w.RJ_RH_hip[2]*t86 - 0.049*t90;
-    w.KA_trunk[63] = w.RJ_RH_hip[3]*t85 + w.cq_RH_hip*t87 + w.RJ_RH_hip[5]*t86 + 0.19*t90;
-    w.KA_trunk[76] = w.RJ_RH_hip[6]*t85 + w.RJ_RH_hip[7]*t87 + w.RJ_RH_hip[8]*t86 + 0.049*t88 - 0.19*t89;
+    w.KA_trunk[0][11] = t88;
+    w.KA_trunk[1][11] = t89;
+    w.KA_trunk[2][11] = t90;
+    w.KA_trunk[3][11] = w.RJ_RH_hip[0]*t85 + w.RJ_RH_hip[1]*t87 + w.RJ_RH_hip[2]*t86 - 0.049*t90;
+    w.KA_trunk[4][11] = w.RJ_RH_hip[3]*t85 + w.cq_RH_hip*t87 + w.RJ_RH_hip[5]*t86 + 0.19*t90;
+    w.KA_trunk[5][11] = w.RJ_RH_hip[6]*t85 + w.RJ_RH_hip[7]*t87 + w.RJ_RH_hip[8]*t86 + 0.049*t88 - 0.19*t89;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_3(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    w.Dinv_RF_shank = 1.0 / 0.000486144;
     w.u_RF_shank[0] = -w.pA_RF_shank[4] + tau[14];
-    const Scalar Ia0 = 0.064 - 1.5241216e-05*w.Dinv_RF_shank;
-    const Scalar pa0 = w.pA_RF_shank[0] - 0.003904*w.Dinv_RF_shank*w.u_RF_shank[0] + w.c_RF_shank[0]*Ia0;
+    const Scalar pa0 = 0.03264876250658241*w.c_RF_shank[0] + w.pA_RF_shank[0] - 8.030542390731965*w.u_RF_shank[0];
     const Scalar pa1 = 0.003904*w.c_RF_shank[3] + w.pA_RF_shank[1];
     const Scalar pa2 = 0.064*w.c_RF_shank[2] + w.pA_RF_shank[2];
     const Scalar pa3 = 0.000483144*w.c_RF_shank[3] + w.pA_RF_shank[3];
-    const Scalar pa4 = w.pA_RF_shank[4] + 0.000486144*w.Dinv_RF_shank*w.u_RF_shank[0];
+    const Scalar pa4 = w.pA_RF_shank[4] + 0.9999999999999999*w.u_RF_shank[0];
     const Scalar pa5 = 6e-06*w.c_RF_shank[5] + w.pA_RF_shank[5];
     const Scalar C20 = w.cq_RF_shank*w.cq_RF_shank - w.sq_RF_shank*w.sq_RF_shank;
-    const Scalar h0 = 0.032 - 0.5*Ia0;
-    const Scalar m0 = 0.032 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_RF_shank*w.sq_RF_shank;
-    const Scalar t1 = m0 - C20*h0;
-    const Scalar t2 = m0 + C20*h0;
-    const Scalar t3 = 0.013375999999999999 + 0.003904*w.cq_RF_shank;
-    const Scalar t4 = w.cq_RF_shank*pa0 + w.sq_RF_shank*pa2;
-    const Scalar t5 = -w.sq_RF_shank*pa0 + w.cq_RF_shank*pa2;
-    w.IA_RF_thigh[0] = 0.6890000000000001 + t1;
-    w.IA_RF_thigh[2] = h0*t0;
-    w.IA_RF_thigh[4] = -0.01268 - 0.209*t1;
-    w.IA_RF_thigh[8] = 0.01268 + t3;
+    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
+    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
+    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_RF_shank;
+    const Scalar t3 = w.cq_RF_shank*pa0 + w.sq_RF_shank*pa2;
+    const Scalar t4 = -w.sq_RF_shank*pa0 + w.cq_RF_shank*pa2;
+    w.IA_RF_thigh[0] = 0.6890000000000001 + t0;
+    w.IA_RF_thigh[2] = 0.03135123749341759*w.cq_RF_shank*w.sq_RF_shank;
+    w.IA_RF_thigh[4] = -0.01268 - 0.209*t0;
+    w.IA_RF_thigh[8] = 0.01268 + t2;
     w.IA_RF_thigh[10] = -0.003904*w.sq_RF_shank;
-    w.IA_RF_thigh[11] = 0.6890000000000001 + t2;
-    w.IA_RF_thigh[13] = -0.209*h0*t0;
-    w.IA_RF_thigh[15] = 0.002676476 + 0.000815936*w.cq_RF_shank + 0.00023857200000000002*C20 + 0.209*t3;
+    w.IA_RF_thigh[11] = 0.6890000000000001 + t1;
+    w.IA_RF_thigh[13] = -0.006552408636124276*w.cq_RF_shank*w.sq_RF_shank;
+    w.IA_RF_thigh[15] = 0.002676476 + 0.000815936*w.cq_RF_shank + 0.00023857200000000002*C20 + 0.209*t2;
     w.IA_RF_thigh[17] = -0.000815936*w.sq_RF_shank - 0.00047714400000000004*w.cq_RF_shank*w.sq_RF_shank;
-    w.IA_RF_thigh[18] = 0.0024196 + 0.043681*t1;
+    w.IA_RF_thigh[18] = 0.0024196 + 0.043681*t0;
     w.IA_RF_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_RF_thigh[0] = w.pA_RF_thigh[0] + t4;
+    w.pA_RF_thigh[0] = w.pA_RF_thigh[0] + t3;
     w.pA_RF_thigh[1] = w.pA_RF_thigh[1] + pa1;
-    w.pA_RF_thigh[2] = w.pA_RF_thigh[2] + t5;
+    w.pA_RF_thigh[2] = w.pA_RF_thigh[2] + t4;
     w.pA_RF_thigh[3] = w.pA_RF_thigh[3] + 0.209*pa1 + w.cq_RF_shank*pa3 + w.sq_RF_shank*pa5;
-    w.pA_RF_thigh[4] = w.pA_RF_thigh[4] + pa4 - 0.209*t4;
+    w.pA_RF_thigh[4] = w.pA_RF_thigh[4] + pa4 - 0.209*t3;
     w.pA_RF_thigh[5] = w.pA_RF_thigh[5] - w.sq_RF_shank*pa3 + w.cq_RF_shank*pa5;
-    w.KSD_RF_shank[0] = -0.195*w.Dinv_RF_shank;
-    const Scalar t6 = 1.0 - 0.00076128*w.Dinv_RF_shank;
-    w.KA_RF_thigh[0] = w.cq_RF_shank*t6;
-    w.KA_RF_thigh[8] = -w.sq_RF_shank*t6;
-    w.KA_RF_thigh[12] = 0.004*w.sq_RF_shank;
-    w.KA_RF_thigh[16] = -0.209*w.cq_RF_shank*t6;
-    w.KA_RF_thigh[20] = 0.004*w.cq_RF_shank;
-    w.KA_RF_thigh[13] = 0.209 + 0.195*w.cq_RF_shank;
-    w.KA_RF_thigh[21] = -0.195*w.sq_RF_shank;
-    w.KA_RF_thigh[2] = w.sq_RF_shank;
-    w.KA_RF_thigh[10] = w.cq_RF_shank;
-    w.KA_RF_thigh[14] = -0.004*w.cq_RF_shank;
-    w.KA_RF_thigh[18] = -0.209*w.sq_RF_shank;
-    w.KA_RF_thigh[22] = 0.004*w.sq_RF_shank;
+    w.KA_RF_thigh[0][0] = -0.5659557661927332*w.cq_RF_shank;
+    w.KA_RF_thigh[2][0] = 0.5659557661927332*w.sq_RF_shank;
+    w.KA_RF_thigh[3][0] = 0.004*w.sq_RF_shank;
+    w.KA_RF_thigh[4][0] = 0.11828475513428124*w.cq_RF_shank;
+    w.KA_RF_thigh[5][0] = 0.004*w.cq_RF_shank;
+    w.KA_RF_thigh[3][1] = 0.209 + 0.195*w.cq_RF_shank;
+    w.KA_RF_thigh[5][1] = -0.195*w.sq_RF_shank;
+    w.KA_RF_thigh[0][2] = w.sq_RF_shank;
+    w.KA_RF_thigh[2][2] = w.cq_RF_shank;
+    w.KA_RF_thigh[3][2] = -0.004*w.cq_RF_shank;
+    w.KA_RF_thigh[4][2] = -0.209*w.sq_RF_shank;
+    w.KA_RF_thigh[5][2] = 0.004*w.sq_RF_shank;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
@@ -2918,32 +2910,32 @@ PROXGEN_RT_NOINLINE void pv_4(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa3 + w.sq_RF_thigh*pa5 - 0.062*t20;
     w.pA_RF_hip[4] = w.pA_RF_hip[4] + pa4;
     w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa5 + 0.062*t19;
-    w.KSD_RF_thigh[0] = w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
-    const Scalar t21 = w.KA_RF_thigh[0] - w.KA_RF_thigh[16]*t0;
-    const Scalar t22 = w.KA_RF_thigh[8] - w.KA_RF_thigh[16]*t1;
-    const Scalar t23 = w.KA_RF_thigh[20] - 0.00020288*w.KA_RF_thigh[16]*w.Dinv_RF_thigh;
+    w.KSD_RF_thigh[0] = w.KA_RF_thigh[4][0]*w.Dinv_RF_thigh;
+    const Scalar t21 = w.KA_RF_thigh[0][0] - w.KA_RF_thigh[4][0]*t0;
+    const Scalar t22 = w.KA_RF_thigh[2][0] - w.KA_RF_thigh[4][0]*t1;
+    const Scalar t23 = w.KA_RF_thigh[5][0] - 0.00020288*w.KA_RF_thigh[4][0]*w.Dinv_RF_thigh;
     const Scalar t24 = w.cq_RF_thigh*t21 + w.sq_RF_thigh*t22;
     const Scalar t25 = -w.sq_RF_thigh*t21 + w.cq_RF_thigh*t22;
-    w.KA_RF_hip[0] = t24;
-    w.KA_RF_hip[8] = t25;
-    w.KA_RF_hip[12] = w.cq_RF_thigh*w.KA_RF_thigh[12] + w.sq_RF_thigh*t23 - 0.062*t25;
-    w.KA_RF_hip[20] = -w.sq_RF_thigh*w.KA_RF_thigh[12] + w.cq_RF_thigh*t23 + 0.062*t24;
-    w.KA_RF_hip[13] = w.cq_RF_thigh*w.KA_RF_thigh[13] + w.sq_RF_thigh*w.KA_RF_thigh[21];
-    w.KA_RF_hip[21] = -w.sq_RF_thigh*w.KA_RF_thigh[13] + w.cq_RF_thigh*w.KA_RF_thigh[21];
-    w.KSD_RF_thigh[2] = w.KA_RF_thigh[18]*w.Dinv_RF_thigh;
-    const Scalar t26 = w.KA_RF_thigh[2] - w.KA_RF_thigh[18]*t0;
-    const Scalar t27 = w.KA_RF_thigh[10] - w.KA_RF_thigh[18]*t1;
-    const Scalar t28 = w.KA_RF_thigh[22] - 0.00020288*w.KA_RF_thigh[18]*w.Dinv_RF_thigh;
+    w.KA_RF_hip[0][0] = t24;
+    w.KA_RF_hip[2][0] = t25;
+    w.KA_RF_hip[3][0] = w.cq_RF_thigh*w.KA_RF_thigh[3][0] + w.sq_RF_thigh*t23 - 0.062*t25;
+    w.KA_RF_hip[5][0] = -w.sq_RF_thigh*w.KA_RF_thigh[3][0] + w.cq_RF_thigh*t23 + 0.062*t24;
+    w.KA_RF_hip[3][1] = w.cq_RF_thigh*w.KA_RF_thigh[3][1] + w.sq_RF_thigh*w.KA_RF_thigh[5][1];
+    w.KA_RF_hip[5][1] = -w.sq_RF_thigh*w.KA_RF_thigh[3][1] + w.cq_RF_thigh*w.KA_RF_thigh[5][1];
+    w.KSD_RF_thigh[2] = w.KA_RF_thigh[4][2]*w.Dinv_RF_thigh;
+    const Scalar t26 = w.KA_RF_thigh[0][2] - w.KA_RF_thigh[4][2]*t0;
+    const Scalar t27 = w.KA_RF_thigh[2][2] - w.KA_RF_thigh[4][2]*t1;
+    const Scalar t28 = w.KA_RF_thigh[5][2] - 0.00020288*w.KA_RF_thigh[4][2]*w.Dinv_RF_thigh;
     const Scalar t29 = w.cq_RF_thigh*t26 + w.sq_RF_thigh*t27;
     const Scalar t30 = -w.sq_RF_thigh*t26 + w.cq_RF_thigh*t27;
-    w.KA_RF_hip[2] = t29;
-    w.KA_RF_hip[10] = t30;
-    w.KA_RF_hip[14] = w.cq_RF_thigh*w.KA_RF_thigh[14] + w.sq_RF_thigh*t28 - 0.062*t30;
-    w.KA_RF_hip[22] = -w.sq_RF_thigh*w.KA_RF_thigh[14] + w.cq_RF_thigh*t28 + 0.062*t29;
+    w.KA_RF_hip[0][2] = t29;
+    w.KA_RF_hip[2][2] = t30;
+    w.KA_RF_hip[3][2] = w.cq_RF_thigh*w.KA_RF_thigh[3][2] + w.sq_RF_thigh*t28 - 0.062*t30;
+    w.KA_RF_hip[5][2] = -w.sq_RF_thigh*w.KA_RF_thigh[3][2] + w.cq_RF_thigh*t28 + 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
@@ -3067,116 +3059,109 @@ PROXGEN_RT_NOINLINE void pv_5(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RF_hip[0]*pa3 + w.RJ_RF_hip[1]*pa4 + w.RJ_RF_hip[2]*pa5 - 0.049*t63;
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RF_hip[3]*pa3 + w.cq_RF_hip*pa4 + w.RJ_RF_hip[5]*pa5 - 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RF_hip[6]*pa3 + w.RJ_RF_hip[7]*pa4 + w.RJ_RF_hip[8]*pa5 + 0.049*t61 + 0.19*t62;
-    w.KS_RF_hip[0] = 0.9950371902099893*w.KA_RF_hip[12] + 0.09950371902099893*w.KA_RF_hip[20];
+    w.KS_RF_hip[0] = 0.9950371902099893*w.KA_RF_hip[3][0] + 0.09950371902099893*w.KA_RF_hip[5][0];
     w.KSD_RF_hip[0] = w.Dinv_RF_hip*w.KS_RF_hip[0];
-    const Scalar t64 = w.KA_RF_hip[0] - t0*w.KS_RF_hip[0];
-    const Scalar t65 = w.KA_RF_hip[8] - t2*w.KS_RF_hip[0];
+    const Scalar t64 = w.KA_RF_hip[0][0] - t0*w.KS_RF_hip[0];
+    const Scalar t65 = w.KA_RF_hip[2][0] - t2*w.KS_RF_hip[0];
     const Scalar t66 = -t1*w.KS_RF_hip[0];
-    const Scalar t67 = w.KA_RF_hip[12] - t3*w.KS_RF_hip[0];
-    const Scalar t68 = w.KA_RF_hip[20] - t4*w.KS_RF_hip[0];
+    const Scalar t67 = w.KA_RF_hip[3][0] - t3*w.KS_RF_hip[0];
+    const Scalar t68 = w.KA_RF_hip[5][0] - t4*w.KS_RF_hip[0];
     const Scalar t69 = 5.780668556524933e-05*w.Dinv_RF_hip*w.KS_RF_hip[0];
     const Scalar t70 = w.RJ_RF_hip[0]*t64 + w.RJ_RF_hip[1]*t66 + w.RJ_RF_hip[2]*t65;
     const Scalar t71 = w.RJ_RF_hip[3]*t64 + w.cq_RF_hip*t66 + w.RJ_RF_hip[5]*t65;
     const Scalar t72 = w.RJ_RF_hip[6]*t64 + w.RJ_RF_hip[7]*t66 + w.RJ_RF_hip[8]*t65;
-    w.KA_trunk[6] = t70;
-    w.KA_trunk[19] = t71;
-    w.KA_trunk[32] = t72;
-    w.KA_trunk[45] = w.RJ_RF_hip[0]*t67 + w.RJ_RF_hip[1]*t69 + w.RJ_RF_hip[2]*t68 - 0.049*t72;
-    w.KA_trunk[58] = w.RJ_RF_hip[3]*t67 + w.cq_RF_hip*t69 + w.RJ_RF_hip[5]*t68 - 0.19*t72;
-    w.KA_trunk[71] = w.RJ_RF_hip[6]*t67 + w.RJ_RF_hip[7]*t69 + w.RJ_RF_hip[8]*t68 + 0.049*t70 + 0.19*t71;
-    w.KS_RF_hip[1] = 0.9950371902099893*w.KA_RF_hip[13] + 0.09950371902099893*w.KA_RF_hip[21];
+    w.KA_trunk[0][6] = t70;
+    w.KA_trunk[1][6] = t71;
+    w.KA_trunk[2][6] = t72;
+    w.KA_trunk[3][6] = w.RJ_RF_hip[0]*t67 + w.RJ_RF_hip[1]*t69 + w.RJ_RF_hip[2]*t68 - 0.049*t72;
+    w.KA_trunk[4][6] = w.RJ_RF_hip[3]*t67 + w.cq_RF_hip*t69 + w.RJ_RF_hip[5]*t68 - 0.19*t72;
+    w.KA_trunk[5][6] = w.RJ_RF_hip[6]*t67 + w.RJ_RF_hip[7]*t69 + w.RJ_RF_hip[8]*t68 + 0.049*t70 + 0.19*t71;
+    w.KS_RF_hip[1] = 0.9950371902099893*w.KA_RF_hip[3][1] + 0.09950371902099893*w.KA_RF_hip[5][1];
     w.KSD_RF_hip[1] = w.Dinv_RF_hip*w.KS_RF_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_RF_hip[1];
     const Scalar t74 = -t0*w.KS_RF_hip[1];
     const Scalar t75 = -t2*w.KS_RF_hip[1];
-    const Scalar t76 = w.KA_RF_hip[13] - t3*w.KS_RF_hip[1];
-    const Scalar t77 = w.KA_RF_hip[21] - t4*w.KS_RF_hip[1];
+    const Scalar t76 = w.KA_RF_hip[3][1] - t3*w.KS_RF_hip[1];
+    const Scalar t77 = w.KA_RF_hip[5][1] - t4*w.KS_RF_hip[1];
     const Scalar t78 = 5.780668556524933e-05*w.Dinv_RF_hip*w.KS_RF_hip[1];
     const Scalar t79 = w.RJ_RF_hip[0]*t74 + w.RJ_RF_hip[1]*t73 + w.RJ_RF_hip[2]*t75;
     const Scalar t80 = w.RJ_RF_hip[3]*t74 + w.cq_RF_hip*t73 + w.RJ_RF_hip[5]*t75;
     const Scalar t81 = w.RJ_RF_hip[6]*t74 + w.RJ_RF_hip[7]*t73 + w.RJ_RF_hip[8]*t75;
-    w.KA_trunk[7] = t79;
-    w.KA_trunk[20] = t80;
-    w.KA_trunk[33] = t81;
-    w.KA_trunk[46] = w.RJ_RF_hip[0]*t76 + w.RJ_RF_hip[1]*t78 + w.RJ_RF_hip[2]*t77 - 0.049*t81;
-    w.KA_trunk[59] = w.RJ_RF_hip[3]*t76 + w.cq_RF_hip*t78 + w.RJ_RF_hip[5]*t77 - 0.19*t81;
-    w.KA_trunk[72] = w.RJ_RF_hip[6]*t76 + w.RJ_RF_hip[7]*t78 + w.RJ_RF_hip[8]*t77 + 0.049*t79 + 0.19*t80;
-    w.KS_RF_hip[2] = 0.9950371902099893*w.KA_RF_hip[14] + 0.09950371902099893*w.KA_RF_hip[22];
+    w.KA_trunk[0][7] = t79;
+    w.KA_trunk[1][7] = t80;
+    w.KA_trunk[2][7] = t81;
+    w.KA_trunk[3][7] = w.RJ_RF_hip[0]*t76 + w.RJ_RF_hip[1]*t78 + w.RJ_RF_hip[2]*t77 - 0.049*t81;
+    w.KA_trunk[4][7] = w.RJ_RF_hip[3]*t76 + w.cq_RF_hip*t78 + w.RJ_RF_hip[5]*t77 - 0.19*t81;
+    w.KA_trunk[5][7] = w.RJ_RF_hip[6]*t76 + w.RJ_RF_hip[7]*t78 + w.RJ_RF_hip[8]*t77 + 0.049*t79 + 0.19*t80;
+    w.KS_RF_hip[2] = 0.9950371902099893*w.KA_RF_hip[3][2] + 0.09950371902099893*w.KA_RF_hip[5][2];
     w.KSD_RF_hip[2] = w.Dinv_RF_hip*w.KS_RF_hip[2];
-    const Scalar t82 = w.KA_RF_hip[2] - t0*w.KS_RF_hip[2];
-    const Scalar t83 = w.KA_RF_hip[10] - t2*w.KS_RF_hip[2];
+    const Scalar t82 = w.KA_RF_hip[0][2] - t0*w.KS_RF_hip[2];
+    const Scalar t83 = w.KA_RF_hip[2][2] - t2*w.KS_RF_hip[2];
     const Scalar t84 = -t1*w.KS_RF_hip[2];
-    const Scalar t85 = w.KA_RF_hip[14] - t3*w.KS_RF_hip[2];
-    const Scalar t86 = w.KA_RF_hip[22] - t4*w.KS_RF_hip[2];
+    const Scalar t85 = w.KA_RF_hip[3][2] - t3*w.KS_RF_hip[2];
+    const Scalar t86 = w.KA_RF_hip[5][2] - t4*w.KS_RF_hip[2];
     const Scalar t87 = 5.780668556524933e-05*w.Dinv_RF_hip*w.KS_RF_hip[2];
     const Scalar t88 = w.RJ_RF_hip[0]*t82 + w.RJ_RF_hip[1]*t84 + w.RJ_RF_hip[2]*t83;
     const Scalar t89 = w.RJ_RF_hip[3]*t82 + w.cq_RF_hip*t84 + w.RJ_RF_hip[5]*t83;
     const Scalar t90 = w.RJ_RF_hip[6]*t82 + w.RJ_RF_hip[7]*t84 + w.RJ_RF_hip[8]*t83;
-    w.KA_trunk[8] = t88;
-    w.KA_trunk[21] = t89;
-    w.KA_trunk[34] = t90;
-    w.KA_trunk[47] = w.RJ_RF_hip[0]*t85 + w.RJ_RF_hip[1]*t87 + w.RJ_RF_hip[2]*t86 - 0.049*t90;
-    w.KA_trunk[60] = w.RJ_RF_hip[3]*t85 + w.cq_RF_hip*t87 + w.RJ_RF_hip[5]*t86 - 0.19*t90;
-    w.KA_trunk[73] = w.RJ_RF_hip[6]*t85 + w.RJ_RF_hip[7]*t87 + w.RJ_RF_hip[8]*t86 + 0.049*t88 + 0.19*t89;
+    w.KA_trunk[0][8] = t88;
+    w.KA_trunk[1][8] = t89;
+    w.KA_trunk[2][8] = t90;
+    w.KA_trunk[3][8] = w.RJ_RF_hip[0]*t85 + w.RJ_RF_hip[1]*t87 + w.RJ_RF_hip[2]*t86 - 0.049*t90;
+    w.KA_trunk[4][8] = w.RJ_RF_hip[3]*t85 + w.cq_RF_hip*t87 + w.RJ_RF_hip[5]*t86 - 0.19*t90;
+    w.KA_trunk[5][8] = w.RJ_RF_hip[6]*t85 + w.RJ_RF_hip[7]*t87 + w.RJ_RF_hip[8]*t86 + 0.049*t88 + 0.19*t89;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_6(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    w.Dinv_LH_shank = 1.0 / 0.000486144;
     w.u_LH_shank[0] = -w.pA_LH_shank[4] + tau[11];
-    const Scalar Ia0 = 0.064 - 1.5241216e-05*w.Dinv_LH_shank;
-    const Scalar pa0 = w.pA_LH_shank[0] - 0.003904*w.Dinv_LH_shank*w.u_LH_shank[0] + w.c_LH_shank[0]*Ia0;
+    const Scalar pa0 = 0.03264876250658241*w.c_LH_shank[0] + w.pA_LH_shank[0] - 8.030542390731965*w.u_LH_shank[0];
     const Scalar pa1 = 0.003904*w.c_LH_shank[3] + w.pA_LH_shank[1];
     const Scalar pa2 = 0.064*w.c_LH_shank[2] + w.pA_LH_shank[2];
     const Scalar pa3 = 0.000483144*w.c_LH_shank[3] + w.pA_LH_shank[3];
-    const Scalar pa4 = w.pA_LH_shank[4] + 0.000486144*w.Dinv_LH_shank*w.u_LH_shank[0];
+    const Scalar pa4 = w.pA_LH_shank[4] + 0.9999999999999999*w.u_LH_shank[0];
     const Scalar pa5 = 6e-06*w.c_LH_shank[5] + w.pA_LH_shank[5];
     const Scalar C20 = w.cq_LH_shank*w.cq_LH_shank - w.sq_LH_shank*w.sq_LH_shank;
-    const Scalar h0 = 0.032 - 0.5*Ia0;
-    const Scalar m0 = 0.032 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_LH_shank*w.sq_LH_shank;
-    const Scalar t1 = m0 - C20*h0;
-    const Scalar t2 = m0 + C20*h0;
-    const Scalar t3 = 0.013375999999999999 + 0.003904*w.cq_LH_shank;
-    const Scalar t4 = w.cq_LH_shank*pa0 + w.sq_LH_shank*pa2;
-    const Scalar t5 = -w.sq_LH_shank*pa0 + w.cq_LH_shank*pa2;
-    w.IA_LH_thigh[0] = 0.6890000000000001 + t1;
-    w.IA_LH_thigh[2] = h0*t0;
-    w.IA_LH_thigh[4] = -0.01268 - 0.209*t1;
-    w.IA_LH_thigh[8] = 0.01268 + t3;
+    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
+    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
+    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_LH_shank;
+    const Scalar t3 = w.cq_LH_shank*pa0 + w.sq_LH_shank*pa2;
+    const Scalar t4 = -w.sq_LH_shank*pa0 + w.cq_LH_shank*pa2;
+    w.IA_LH_thigh[0] = 0.6890000000000001 + t0;
+    w.IA_LH_thigh[2] = 0.03135123749341759*w.cq_LH_shank*w.sq_LH_shank;
+    w.IA_LH_thigh[4] = -0.01268 - 0.209*t0;
+    w.IA_LH_thigh[8] = 0.01268 + t2;
     w.IA_LH_thigh[10] = -0.003904*w.sq_LH_shank;
-    w.IA_LH_thigh[11] = 0.6890000000000001 + t2;
-    w.IA_LH_thigh[13] = -0.209*h0*t0;
-    w.IA_LH_thigh[15] = 0.002676476 + 0.000815936*w.cq_LH_shank + 0.00023857200000000002*C20 + 0.209*t3;
+    w.IA_LH_thigh[11] = 0.6890000000000001 + t1;
+    w.IA_LH_thigh[13] = -0.006552408636124276*w.cq_LH_shank*w.sq_LH_shank;
+    w.IA_LH_thigh[15] = 0.002676476 + 0.000815936*w.cq_LH_shank + 0.00023857200000000002*C20 + 0.209*t2;
     w.IA_LH_thigh[17] = -0.000815936*w.sq_LH_shank - 0.00047714400000000004*w.cq_LH_shank*w.sq_LH_shank;
-    w.IA_LH_thigh[18] = 0.0024196 + 0.043681*t1;
+    w.IA_LH_thigh[18] = 0.0024196 + 0.043681*t0;
     w.IA_LH_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_LH_thigh[0] = w.pA_LH_thigh[0] + t4;
+    w.pA_LH_thigh[0] = w.pA_LH_thigh[0] + t3;
     w.pA_LH_thigh[1] = w.pA_LH_thigh[1] + pa1;
-    w.pA_LH_thigh[2] = w.pA_LH_thigh[2] + t5;
+    w.pA_LH_thigh[2] = w.pA_LH_thigh[2] + t4;
     w.pA_LH_thigh[3] = w.pA_LH_thigh[3] + 0.209*pa1 + w.cq_LH_shank*pa3 + w.sq_LH_shank*pa5;
-    w.pA_LH_thigh[4] = w.pA_LH_thigh[4] + pa4 - 0.209*t4;
+    w.pA_LH_thigh[4] = w.pA_LH_thigh[4] + pa4 - 0.209*t3;
     w.pA_LH_thigh[5] = w.pA_LH_thigh[5] - w.sq_LH_shank*pa3 + w.cq_LH_shank*pa5;
-    w.KSD_LH_shank[0] = -0.195*w.Dinv_LH_shank;
-    const Scalar t6 = 1.0 - 0.00076128*w.Dinv_LH_shank;
-    w.KA_LH_thigh[0] = w.cq_LH_shank*t6;
-    w.KA_LH_thigh[8] = -w.sq_LH_shank*t6;
-    w.KA_LH_thigh[12] = -0.004*w.sq_LH_shank;
-    w.KA_LH_thigh[16] = -0.209*w.cq_LH_shank*t6;
-    w.KA_LH_thigh[20] = -0.004*w.cq_LH_shank;
-    w.KA_LH_thigh[13] = 0.209 + 0.195*w.cq_LH_shank;
-    w.KA_LH_thigh[21] = -0.195*w.sq_LH_shank;
-    w.KA_LH_thigh[2] = w.sq_LH_shank;
-    w.KA_LH_thigh[10] = w.cq_LH_shank;
-    w.KA_LH_thigh[14] = 0.004*w.cq_LH_shank;
-    w.KA_LH_thigh[18] = -0.209*w.sq_LH_shank;
-    w.KA_LH_thigh[22] = -0.004*w.sq_LH_shank;
+    w.KA_LH_thigh[0][0] = -0.5659557661927332*w.cq_LH_shank;
+    w.KA_LH_thigh[2][0] = 0.5659557661927332*w.sq_LH_shank;
+    w.KA_LH_thigh[3][0] = -0.004*w.sq_LH_shank;
+    w.KA_LH_thigh[4][0] = 0.11828475513428124*w.cq_LH_shank;
+    w.KA_LH_thigh[5][0] = -0.004*w.cq_LH_shank;
+    w.KA_LH_thigh[3][1] = 0.209 + 0.195*w.cq_LH_shank;
+    w.KA_LH_thigh[5][1] = -0.195*w.sq_LH_shank;
+    w.KA_LH_thigh[0][2] = w.sq_LH_shank;
+    w.KA_LH_thigh[2][2] = w.cq_LH_shank;
+    w.KA_LH_thigh[3][2] = 0.004*w.cq_LH_shank;
+    w.KA_LH_thigh[4][2] = -0.209*w.sq_LH_shank;
+    w.KA_LH_thigh[5][2] = -0.004*w.sq_LH_shank;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
@@ -3242,32 +3227,32 @@ PROXGEN_RT_NOINLINE void pv_7(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa3 + w.sq_LH_thigh*pa5 + 0.062*t20;
     w.pA_LH_hip[4] = w.pA_LH_hip[4] + pa4;
     w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa5 - 0.062*t19;
-    w.KSD_LH_thigh[0] = w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
-    const Scalar t21 = w.KA_LH_thigh[0] - w.KA_LH_thigh[16]*t0;
-    const Scalar t22 = w.KA_LH_thigh[8] - w.KA_LH_thigh[16]*t1;
-    const Scalar t23 = w.KA_LH_thigh[20] + 0.00020288*w.KA_LH_thigh[16]*w.Dinv_LH_thigh;
+    w.KSD_LH_thigh[0] = w.KA_LH_thigh[4][0]*w.Dinv_LH_thigh;
+    const Scalar t21 = w.KA_LH_thigh[0][0] - w.KA_LH_thigh[4][0]*t0;
+    const Scalar t22 = w.KA_LH_thigh[2][0] - w.KA_LH_thigh[4][0]*t1;
+    const Scalar t23 = w.KA_LH_thigh[5][0] + 0.00020288*w.KA_LH_thigh[4][0]*w.Dinv_LH_thigh;
     const Scalar t24 = w.cq_LH_thigh*t21 + w.sq_LH_thigh*t22;
     const Scalar t25 = -w.sq_LH_thigh*t21 + w.cq_LH_thigh*t22;
-    w.KA_LH_hip[0] = t24;
-    w.KA_LH_hip[8] = t25;
-    w.KA_LH_hip[12] = w.cq_LH_thigh*w.KA_LH_thigh[12] + w.sq_LH_thigh*t23 + 0.062*t25;
-    w.KA_LH_hip[20] = -w.sq_LH_thigh*w.KA_LH_thigh[12] + w.cq_LH_thigh*t23 - 0.062*t24;
-    w.KA_LH_hip[13] = w.cq_LH_thigh*w.KA_LH_thigh[13] + w.sq_LH_thigh*w.KA_LH_thigh[21];
-    w.KA_LH_hip[21] = -w.sq_LH_thigh*w.KA_LH_thigh[13] + w.cq_LH_thigh*w.KA_LH_thigh[21];
-    w.KSD_LH_thigh[2] = w.KA_LH_thigh[18]*w.Dinv_LH_thigh;
-    const Scalar t26 = w.KA_LH_thigh[2] - w.KA_LH_thigh[18]*t0;
-    const Scalar t27 = w.KA_LH_thigh[10] - w.KA_LH_thigh[18]*t1;
-    const Scalar t28 = w.KA_LH_thigh[22] + 0.00020288*w.KA_LH_thigh[18]*w.Dinv_LH_thigh;
+    w.KA_LH_hip[0][0] = t24;
+    w.KA_LH_hip[2][0] = t25;
+    w.KA_LH_hip[3][0] = w.cq_LH_thigh*w.KA_LH_thigh[3][0] + w.sq_LH_thigh*t23 + 0.062*t25;
+    w.KA_LH_hip[5][0] = -w.sq_LH_thigh*w.KA_LH_thigh[3][0] + w.cq_LH_thigh*t23 - 0.062*t24;
+    w.KA_LH_hip[3][1] = w.cq_LH_thigh*w.KA_LH_thigh[3][1] + w.sq_LH_thigh*w.KA_LH_thigh[5][1];
+    w.KA_LH_hip[5][1] = -w.sq_LH_thigh*w.KA_LH_thigh[3][1] + w.cq_LH_thigh*w.KA_LH_thigh[5][1];
+    w.KSD_LH_thigh[2] = w.KA_LH_thigh[4][2]*w.Dinv_LH_thigh;
+    const Scalar t26 = w.KA_LH_thigh[0][2] - w.KA_LH_thigh[4][2]*t0;
+    const Scalar t27 = w.KA_LH_thigh[2][2] - w.KA_LH_thigh[4][2]*t1;
+    const Scalar t28 = w.KA_LH_thigh[5][2] + 0.00020288*w.KA_LH_thigh[4][2]*w.Dinv_LH_thigh;
     const Scalar t29 = w.cq_LH_thigh*t26 + w.sq_LH_thigh*t27;
     const Scalar t30 = -w.sq_LH_thigh*t26 + w.cq_LH_thigh*t27;
-    w.KA_LH_hip[2] = t29;
-    w.KA_LH_hip[10] = t30;
-    w.KA_LH_hip[14] = w.cq_LH_thigh*w.KA_LH_thigh[14] + w.sq_LH_thigh*t28 + 0.062*t30;
-    w.KA_LH_hip[22] = -w.sq_LH_thigh*w.KA_LH_thigh[14] + w.cq_LH_thigh*t28 - 0.062*t29;
+    w.KA_LH_hip[0][2] = t29;
+    w.KA_LH_hip[2][2] = t30;
+    w.KA_LH_hip[3][2] = w.cq_LH_thigh*w.KA_LH_thigh[3][2] + w.sq_LH_thigh*t28 + 0.062*t30;
+    w.KA_LH_hip[5][2] = -w.sq_LH_thigh*w.KA_LH_thigh[3][2] + w.cq_LH_thigh*t28 - 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
@@ -3391,116 +3376,109 @@ PROXGEN_RT_NOINLINE void pv_8(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& 
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LH_hip[0]*pa3 + w.RJ_LH_hip[1]*pa4 + w.RJ_LH_hip[2]*pa5 + 0.049*t63;
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LH_hip[3]*pa3 + w.cq_LH_hip*pa4 + w.RJ_LH_hip[5]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LH_hip[6]*pa3 + w.RJ_LH_hip[7]*pa4 + w.RJ_LH_hip[8]*pa5 - 0.049*t61 - 0.19*t62;
-    w.KS_LH_hip[0] = 0.9950371902099892*w.KA_LH_hip[12] - 0.09950371902099892*w.KA_LH_hip[20];
+    w.KS_LH_hip[0] = 0.9950371902099892*w.KA_LH_hip[3][0] - 0.09950371902099892*w.KA_LH_hip[5][0];
     w.KSD_LH_hip[0] = w.Dinv_LH_hip*w.KS_LH_hip[0];
-    const Scalar t64 = w.KA_LH_hip[0] - t0*w.KS_LH_hip[0];
-    const Scalar t65 = w.KA_LH_hip[8] - t2*w.KS_LH_hip[0];
+    const Scalar t64 = w.KA_LH_hip[0][0] - t0*w.KS_LH_hip[0];
+    const Scalar t65 = w.KA_LH_hip[2][0] - t2*w.KS_LH_hip[0];
     const Scalar t66 = -t1*w.KS_LH_hip[0];
-    const Scalar t67 = w.KA_LH_hip[12] - t3*w.KS_LH_hip[0];
-    const Scalar t68 = w.KA_LH_hip[20] - t4*w.KS_LH_hip[0];
+    const Scalar t67 = w.KA_LH_hip[3][0] - t3*w.KS_LH_hip[0];
+    const Scalar t68 = w.KA_LH_hip[5][0] - t4*w.KS_LH_hip[0];
     const Scalar t69 = -5.7617628499109426e-05*w.Dinv_LH_hip*w.KS_LH_hip[0];
     const Scalar t70 = w.RJ_LH_hip[0]*t64 + w.RJ_LH_hip[1]*t66 + w.RJ_LH_hip[2]*t65;
     const Scalar t71 = w.RJ_LH_hip[3]*t64 + w.cq_LH_hip*t66 + w.RJ_LH_hip[5]*t65;
     const Scalar t72 = w.RJ_LH_hip[6]*t64 + w.RJ_LH_hip[7]*t66 + w.RJ_LH_hip[8]*t65;
-    w.KA_trunk[3] = t70;
-    w.KA_trunk[16] = t71;
-    w.KA_trunk[29] = t72;
-    w.KA_trunk[42] = w.RJ_LH_hip[0]*t67 + w.RJ_LH_hip[1]*t69 + w.RJ_LH_hip[2]*t68 + 0.049*t72;
-    w.KA_trunk[55] = w.RJ_LH_hip[3]*t67 + w.cq_LH_hip*t69 + w.RJ_LH_hip[5]*t68 + 0.19*t72;
-    w.KA_trunk[68] = w.RJ_LH_hip[6]*t67 + w.RJ_LH_hip[7]*t69 + w.RJ_LH_hip[8]*t68 - 0.049*t70 - 0.19*t71;
-    w.KS_LH_hip[1] = 0.9950371902099892*w.KA_LH_hip[13] - 0.09950371902099892*w.KA_LH_hip[21];
+    w.KA_trunk[0][3] = t70;
+    w.KA_trunk[1][3] = t71;
+    w.KA_trunk[2][3] = t72;
+    w.KA_trunk[3][3] = w.RJ_LH_hip[0]*t67 + w.RJ_LH_hip[1]*t69 + w.RJ_LH_hip[2]*t68 + 0.049*t72;
+    w.KA_trunk[4][3] = w.RJ_LH_hip[3]*t67 + w.cq_LH_hip*t69 + w.RJ_LH_hip[5]*t68 + 0.19*t72;
+    w.KA_trunk[5][3] = w.RJ_LH_hip[6]*t67 + w.RJ_LH_hip[7]*t69 + w.RJ_LH_hip[8]*t68 - 0.049*t70 - 0.19*t71;
+    w.KS_LH_hip[1] = 0.9950371902099892*w.KA_LH_hip[3][1] - 0.09950371902099892*w.KA_LH_hip[5][1];
     w.KSD_LH_hip[1] = w.Dinv_LH_hip*w.KS_LH_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_LH_hip[1];
     const Scalar t74 = -t0*w.KS_LH_hip[1];
     const Scalar t75 = -t2*w.KS_LH_hip[1];
-    const Scalar t76 = w.KA_LH_hip[13] - t3*w.KS_LH_hip[1];
-    const Scalar t77 = w.KA_LH_hip[21] - t4*w.KS_LH_hip[1];
+    const Scalar t76 = w.KA_LH_hip[3][1] - t3*w.KS_LH_hip[1];
+    const Scalar t77 = w.KA_LH_hip[5][1] - t4*w.KS_LH_hip[1];
     const Scalar t78 = -5.7617628499109426e-05*w.Dinv_LH_hip*w.KS_LH_hip[1];
     const Scalar t79 = w.RJ_LH_hip[0]*t74 + w.RJ_LH_hip[1]*t73 + w.RJ_LH_hip[2]*t75;
     const Scalar t80 = w.RJ_LH_hip[3]*t74 + w.cq_LH_hip*t73 + w.RJ_LH_hip[5]*t75;
     const Scalar t81 = w.RJ_LH_hip[6]*t74 + w.RJ_LH_hip[7]*t73 + w.RJ_LH_hip[8]*t75;
-    w.KA_trunk[4] = t79;
-    w.KA_trunk[17] = t80;
-    w.KA_trunk[30] = t81;
-    w.KA_trunk[43] = w.RJ_LH_hip[0]*t76 + w.RJ_LH_hip[1]*t78 + w.RJ_LH_hip[2]*t77 + 0.049*t81;
-    w.KA_trunk[56] = w.RJ_LH_hip[3]*t76 + w.cq_LH_hip*t78 + w.RJ_LH_hip[5]*t77 + 0.19*t81;
-    w.KA_trunk[69] = w.RJ_LH_hip[6]*t76 + w.RJ_LH_hip[7]*t78 + w.RJ_LH_hip[8]*t77 - 0.049*t79 - 0.19*t80;
-    w.KS_LH_hip[2] = 0.9950371902099892*w.KA_LH_hip[14] - 0.09950371902099892*w.KA_LH_hip[22];
+    w.KA_trunk[0][4] = t79;
+    w.KA_trunk[1][4] = t80;
+    w.KA_trunk[2][4] = t81;
+    w.KA_trunk[3][4] = w.RJ_LH_hip[0]*t76 + w.RJ_LH_hip[1]*t78 + w.RJ_LH_hip[2]*t77 + 0.049*t81;
+    w.KA_trunk[4][4] = w.RJ_LH_hip[3]*t76 + w.cq_LH_hip*t78 + w.RJ_LH_hip[5]*t77 + 0.19*t81;
+    w.KA_trunk[5][4] = w.RJ_LH_hip[6]*t76 + w.RJ_LH_hip[7]*t78 + w.RJ_LH_hip[8]*t77 - 0.049*t79 - 0.19*t80;
+    w.KS_LH_hip[2] = 0.9950371902099892*w.KA_LH_hip[3][2] - 0.09950371902099892*w.KA_LH_hip[5][2];
     w.KSD_LH_hip[2] = w.Dinv_LH_hip*w.KS_LH_hip[2];
-    const Scalar t82 = w.KA_LH_hip[2] - t0*w.KS_LH_hip[2];
-    const Scalar t83 = w.KA_LH_hip[10] - t2*w.KS_LH_hip[2];
+    const Scalar t82 = w.KA_LH_hip[0][2] - t0*w.KS_LH_hip[2];
+    const Scalar t83 = w.KA_LH_hip[2][2] - t2*w.KS_LH_hip[2];
     const Scalar t84 = -t1*w.KS_LH_hip[2];
-    const Scalar t85 = w.KA_LH_hip[14] - t3*w.KS_LH_hip[2];
-    const Scalar t86 = w.KA_LH_hip[22] - t4*w.KS_LH_hip[2];
+    const Scalar t85 = w.KA_LH_hip[3][2] - t3*w.KS_LH_hip[2];
+    const Scalar t86 = w.KA_LH_hip[5][2] - t4*w.KS_LH_hip[2];
     const Scalar t87 = -5.7617628499109426e-05*w.Dinv_LH_hip*w.KS_LH_hip[2];
     const Scalar t88 = w.RJ_LH_hip[0]*t82 + w.RJ_LH_hip[1]*t84 + w.RJ_LH_hip[2]*t83;
     const Scalar t89 = w.RJ_LH_hip[3]*t82 + w.cq_LH_hip*t84 + w.RJ_LH_hip[5]*t83;
     const Scalar t90 = w.RJ_LH_hip[6]*t82 + w.RJ_LH_hip[7]*t84 + w.RJ_LH_hip[8]*t83;
-    w.KA_trunk[5] = t88;
-    w.KA_trunk[18] = t89;
-    w.KA_trunk[31] = t90;
-    w.KA_trunk[44] = w.RJ_LH_hip[0]*t85 + w.RJ_LH_hip[1]*t87 + w.RJ_LH_hip[2]*t86 + 0.049*t90;
-    w.KA_trunk[57] = w.RJ_LH_hip[3]*t85 + w.cq_LH_hip*t87 + w.RJ_LH_hip[5]*t86 + 0.19*t90;
-    w.KA_trunk[70] = w.RJ_LH_hip[6]*t85 + w.RJ_LH_hip[7]*t87 + w.RJ_LH_hip[8]*t86 - 0.049*t88 - 0.19*t89;
+    w.KA_trunk[0][5] = t88;
+    w.KA_trunk[1][5] = t89;
+    w.KA_trunk[2][5] = t90;
+    w.KA_trunk[3][5] = w.RJ_LH_hip[0]*t85 + w.RJ_LH_hip[1]*t87 + w.RJ_LH_hip[2]*t86 + 0.049*t90;
+    w.KA_trunk[4][5] = w.RJ_LH_hip[3]*t85 + w.cq_LH_hip*t87 + w.RJ_LH_hip[5]*t86 + 0.19*t90;
+    w.KA_trunk[5][5] = w.RJ_LH_hip[6]*t85 + w.RJ_LH_hip[7]*t87 + w.RJ_LH_hip[8]*t86 - 0.049*t88 - 0.19*t89;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_9(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    w.Dinv_LF_shank = 1.0 / 0.000486144;
     w.u_LF_shank[0] = -w.pA_LF_shank[4] + tau[8];
-    const Scalar Ia0 = 0.064 - 1.5241216e-05*w.Dinv_LF_shank;
-    const Scalar pa0 = w.pA_LF_shank[0] - 0.003904*w.Dinv_LF_shank*w.u_LF_shank[0] + w.c_LF_shank[0]*Ia0;
+    const Scalar pa0 = 0.03264876250658241*w.c_LF_shank[0] + w.pA_LF_shank[0] - 8.030542390731965*w.u_LF_shank[0];
     const Scalar pa1 = 0.003904*w.c_LF_shank[3] + w.pA_LF_shank[1];
     const Scalar pa2 = 0.064*w.c_LF_shank[2] + w.pA_LF_shank[2];
     const Scalar pa3 = 0.000483144*w.c_LF_shank[3] + w.pA_LF_shank[3];
-    const Scalar pa4 = w.pA_LF_shank[4] + 0.000486144*w.Dinv_LF_shank*w.u_LF_shank[0];
+    const Scalar pa4 = w.pA_LF_shank[4] + 0.9999999999999999*w.u_LF_shank[0];
     const Scalar pa5 = 6e-06*w.c_LF_shank[5] + w.pA_LF_shank[5];
     const Scalar C20 = w.cq_LF_shank*w.cq_LF_shank - w.sq_LF_shank*w.sq_LF_shank;
-    const Scalar h0 = 0.032 - 0.5*Ia0;
-    const Scalar m0 = 0.032 + 0.5*Ia0;
-    const Scalar t0 = 2.0*w.cq_LF_shank*w.sq_LF_shank;
-    const Scalar t1 = m0 - C20*h0;
-    const Scalar t2 = m0 + C20*h0;
-    const Scalar t3 = 0.013375999999999999 + 0.003904*w.cq_LF_shank;
-    const Scalar t4 = w.cq_LF_shank*pa0 + w.sq_LF_shank*pa2;
-    const Scalar t5 = -w.sq_LF_shank*pa0 + w.cq_LF_shank*pa2;
-    w.IA_LF_thigh[0] = 0.6890000000000001 + t1;
-    w.IA_LF_thigh[2] = h0*t0;
-    w.IA_LF_thigh[4] = -0.01268 - 0.209*t1;
-    w.IA_LF_thigh[8] = 0.01268 + t3;
+    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
+    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
+    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_LF_shank;
+    const Scalar t3 = w.cq_LF_shank*pa0 + w.sq_LF_shank*pa2;
+    const Scalar t4 = -w.sq_LF_shank*pa0 + w.cq_LF_shank*pa2;
+    w.IA_LF_thigh[0] = 0.6890000000000001 + t0;
+    w.IA_LF_thigh[2] = 0.03135123749341759*w.cq_LF_shank*w.sq_LF_shank;
+    w.IA_LF_thigh[4] = -0.01268 - 0.209*t0;
+    w.IA_LF_thigh[8] = 0.01268 + t2;
     w.IA_LF_thigh[10] = -0.003904*w.sq_LF_shank;
-    w.IA_LF_thigh[11] = 0.6890000000000001 + t2;
-    w.IA_LF_thigh[13] = -0.209*h0*t0;
-    w.IA_LF_thigh[15] = 0.002676476 + 0.000815936*w.cq_LF_shank + 0.00023857200000000002*C20 + 0.209*t3;
+    w.IA_LF_thigh[11] = 0.6890000000000001 + t1;
+    w.IA_LF_thigh[13] = -0.006552408636124276*w.cq_LF_shank*w.sq_LF_shank;
+    w.IA_LF_thigh[15] = 0.002676476 + 0.000815936*w.cq_LF_shank + 0.00023857200000000002*C20 + 0.209*t2;
     w.IA_LF_thigh[17] = -0.000815936*w.sq_LF_shank - 0.00047714400000000004*w.cq_LF_shank*w.sq_LF_shank;
-    w.IA_LF_thigh[18] = 0.0024196 + 0.043681*t1;
+    w.IA_LF_thigh[18] = 0.0024196 + 0.043681*t0;
     w.IA_LF_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_LF_thigh[0] = w.pA_LF_thigh[0] + t4;
+    w.pA_LF_thigh[0] = w.pA_LF_thigh[0] + t3;
     w.pA_LF_thigh[1] = w.pA_LF_thigh[1] + pa1;
-    w.pA_LF_thigh[2] = w.pA_LF_thigh[2] + t5;
+    w.pA_LF_thigh[2] = w.pA_LF_thigh[2] + t4;
     w.pA_LF_thigh[3] = w.pA_LF_thigh[3] + 0.209*pa1 + w.cq_LF_shank*pa3 + w.sq_LF_shank*pa5;
-    w.pA_LF_thigh[4] = w.pA_LF_thigh[4] + pa4 - 0.209*t4;
+    w.pA_LF_thigh[4] = w.pA_LF_thigh[4] + pa4 - 0.209*t3;
     w.pA_LF_thigh[5] = w.pA_LF_thigh[5] - w.sq_LF_shank*pa3 + w.cq_LF_shank*pa5;
-    w.KSD_LF_shank[0] = -0.195*w.Dinv_LF_shank;
-    const Scalar t6 = 1.0 - 0.00076128*w.Dinv_LF_shank;
-    w.KA_LF_thigh[0] = w.cq_LF_shank*t6;
-    w.KA_LF_thigh[8] = -w.sq_LF_shank*t6;
-    w.KA_LF_thigh[12] = -0.004*w.sq_LF_shank;
-    w.KA_LF_thigh[16] = -0.209*w.cq_LF_shank*t6;
-    w.KA_LF_thigh[20] = -0.004*w.cq_LF_shank;
-    w.KA_LF_thigh[13] = 0.209 + 0.195*w.cq_LF_shank;
-    w.KA_LF_thigh[21] = -0.195*w.sq_LF_shank;
-    w.KA_LF_thigh[2] = w.sq_LF_shank;
-    w.KA_LF_thigh[10] = w.cq_LF_shank;
-    w.KA_LF_thigh[14] = 0.004*w.cq_LF_shank;
-    w.KA_LF_thigh[18] = -0.209*w.sq_LF_shank;
-    w.KA_LF_thigh[22] = -0.004*w.sq_LF_shank;
+    w.KA_LF_thigh[0][0] = -0.5659557661927332*w.cq_LF_shank;
+    w.KA_LF_thigh[2][0] = 0.5659557661927332*w.sq_LF_shank;
+    w.KA_LF_thigh[3][0] = -0.004*w.sq_LF_shank;
+    w.KA_LF_thigh[4][0] = 0.11828475513428124*w.cq_LF_shank;
+    w.KA_LF_thigh[5][0] = -0.004*w.cq_LF_shank;
+    w.KA_LF_thigh[3][1] = 0.209 + 0.195*w.cq_LF_shank;
+    w.KA_LF_thigh[5][1] = -0.195*w.sq_LF_shank;
+    w.KA_LF_thigh[0][2] = w.sq_LF_shank;
+    w.KA_LF_thigh[2][2] = w.cq_LF_shank;
+    w.KA_LF_thigh[3][2] = 0.004*w.cq_LF_shank;
+    w.KA_LF_thigh[4][2] = -0.209*w.sq_LF_shank;
+    w.KA_LF_thigh[5][2] = -0.004*w.sq_LF_shank;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
@@ -3566,32 +3544,32 @@ PROXGEN_RT_NOINLINE void pv_10(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa3 + w.sq_LF_thigh*pa5 + 0.062*t20;
     w.pA_LF_hip[4] = w.pA_LF_hip[4] + pa4;
     w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa5 - 0.062*t19;
-    w.KSD_LF_thigh[0] = w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
-    const Scalar t21 = w.KA_LF_thigh[0] - w.KA_LF_thigh[16]*t0;
-    const Scalar t22 = w.KA_LF_thigh[8] - w.KA_LF_thigh[16]*t1;
-    const Scalar t23 = w.KA_LF_thigh[20] + 0.00020288*w.KA_LF_thigh[16]*w.Dinv_LF_thigh;
+    w.KSD_LF_thigh[0] = w.KA_LF_thigh[4][0]*w.Dinv_LF_thigh;
+    const Scalar t21 = w.KA_LF_thigh[0][0] - w.KA_LF_thigh[4][0]*t0;
+    const Scalar t22 = w.KA_LF_thigh[2][0] - w.KA_LF_thigh[4][0]*t1;
+    const Scalar t23 = w.KA_LF_thigh[5][0] + 0.00020288*w.KA_LF_thigh[4][0]*w.Dinv_LF_thigh;
     const Scalar t24 = w.cq_LF_thigh*t21 + w.sq_LF_thigh*t22;
     const Scalar t25 = -w.sq_LF_thigh*t21 + w.cq_LF_thigh*t22;
-    w.KA_LF_hip[0] = t24;
-    w.KA_LF_hip[8] = t25;
-    w.KA_LF_hip[12] = w.cq_LF_thigh*w.KA_LF_thigh[12] + w.sq_LF_thigh*t23 + 0.062*t25;
-    w.KA_LF_hip[20] = -w.sq_LF_thigh*w.KA_LF_thigh[12] + w.cq_LF_thigh*t23 - 0.062*t24;
-    w.KA_LF_hip[13] = w.cq_LF_thigh*w.KA_LF_thigh[13] + w.sq_LF_thigh*w.KA_LF_thigh[21];
-    w.KA_LF_hip[21] = -w.sq_LF_thigh*w.KA_LF_thigh[13] + w.cq_LF_thigh*w.KA_LF_thigh[21];
-    w.KSD_LF_thigh[2] = w.KA_LF_thigh[18]*w.Dinv_LF_thigh;
-    const Scalar t26 = w.KA_LF_thigh[2] - w.KA_LF_thigh[18]*t0;
-    const Scalar t27 = w.KA_LF_thigh[10] - w.KA_LF_thigh[18]*t1;
-    const Scalar t28 = w.KA_LF_thigh[22] + 0.00020288*w.KA_LF_thigh[18]*w.Dinv_LF_thigh;
+    w.KA_LF_hip[0][0] = t24;
+    w.KA_LF_hip[2][0] = t25;
+    w.KA_LF_hip[3][0] = w.cq_LF_thigh*w.KA_LF_thigh[3][0] + w.sq_LF_thigh*t23 + 0.062*t25;
+    w.KA_LF_hip[5][0] = -w.sq_LF_thigh*w.KA_LF_thigh[3][0] + w.cq_LF_thigh*t23 - 0.062*t24;
+    w.KA_LF_hip[3][1] = w.cq_LF_thigh*w.KA_LF_thigh[3][1] + w.sq_LF_thigh*w.KA_LF_thigh[5][1];
+    w.KA_LF_hip[5][1] = -w.sq_LF_thigh*w.KA_LF_thigh[3][1] + w.cq_LF_thigh*w.KA_LF_thigh[5][1];
+    w.KSD_LF_thigh[2] = w.KA_LF_thigh[4][2]*w.Dinv_LF_thigh;
+    const Scalar t26 = w.KA_LF_thigh[0][2] - w.KA_LF_thigh[4][2]*t0;
+    const Scalar t27 = w.KA_LF_thigh[2][2] - w.KA_LF_thigh[4][2]*t1;
+    const Scalar t28 = w.KA_LF_thigh[5][2] + 0.00020288*w.KA_LF_thigh[4][2]*w.Dinv_LF_thigh;
     const Scalar t29 = w.cq_LF_thigh*t26 + w.sq_LF_thigh*t27;
     const Scalar t30 = -w.sq_LF_thigh*t26 + w.cq_LF_thigh*t27;
-    w.KA_LF_hip[2] = t29;
-    w.KA_LF_hip[10] = t30;
-    w.KA_LF_hip[14] = w.cq_LF_thigh*w.KA_LF_thigh[14] + w.sq_LF_thigh*t28 + 0.062*t30;
-    w.KA_LF_hip[22] = -w.sq_LF_thigh*w.KA_LF_thigh[14] + w.cq_LF_thigh*t28 - 0.062*t29;
+    w.KA_LF_hip[0][2] = t29;
+    w.KA_LF_hip[2][2] = t30;
+    w.KA_LF_hip[3][2] = w.cq_LF_thigh*w.KA_LF_thigh[3][2] + w.sq_LF_thigh*t28 + 0.062*t30;
+    w.KA_LF_hip[5][2] = -w.sq_LF_thigh*w.KA_LF_thigh[3][2] + w.cq_LF_thigh*t28 - 0.062*t29;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
@@ -3715,61 +3693,61 @@ PROXGEN_RT_NOINLINE void pv_11(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LF_hip[0]*pa3 + w.RJ_LF_hip[1]*pa4 + w.RJ_LF_hip[2]*pa5 + 0.049*t63;
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LF_hip[3]*pa3 + w.cq_LF_hip*pa4 + w.RJ_LF_hip[5]*pa5 - 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LF_hip[6]*pa3 + w.RJ_LF_hip[7]*pa4 + w.RJ_LF_hip[8]*pa5 - 0.049*t61 + 0.19*t62;
-    w.KS_LF_hip[0] = 0.9950371902099893*w.KA_LF_hip[12] + 0.09950371902099893*w.KA_LF_hip[20];
+    w.KS_LF_hip[0] = 0.9950371902099893*w.KA_LF_hip[3][0] + 0.09950371902099893*w.KA_LF_hip[5][0];
     w.KSD_LF_hip[0] = w.Dinv_LF_hip*w.KS_LF_hip[0];
-    const Scalar t64 = w.KA_LF_hip[0] - t0*w.KS_LF_hip[0];
-    const Scalar t65 = w.KA_LF_hip[8] - t2*w.KS_LF_hip[0];
+    const Scalar t64 = w.KA_LF_hip[0][0] - t0*w.KS_LF_hip[0];
+    const Scalar t65 = w.KA_LF_hip[2][0] - t2*w.KS_LF_hip[0];
     const Scalar t66 = -t1*w.KS_LF_hip[0];
-    const Scalar t67 = w.KA_LF_hip[12] - t3*w.KS_LF_hip[0];
-    const Scalar t68 = w.KA_LF_hip[20] - t4*w.KS_LF_hip[0];
+    const Scalar t67 = w.KA_LF_hip[3][0] - t3*w.KS_LF_hip[0];
+    const Scalar t68 = w.KA_LF_hip[5][0] - t4*w.KS_LF_hip[0];
     const Scalar t69 = -5.780668556524933e-05*w.Dinv_LF_hip*w.KS_LF_hip[0];
     const Scalar t70 = w.RJ_LF_hip[0]*t64 + w.RJ_LF_hip[1]*t66 + w.RJ_LF_hip[2]*t65;
     const Scalar t71 = w.RJ_LF_hip[3]*t64 + w.cq_LF_hip*t66 + w.RJ_LF_hip[5]*t65;
     const Scalar t72 = w.RJ_LF_hip[6]*t64 + w.RJ_LF_hip[7]*t66 + w.RJ_LF_hip[8]*t65;
-    w.KA_trunk[0] = t70;
-    w.KA_trunk[13] = t71;
-    w.KA_trunk[26] = t72;
-    w.KA_trunk[39] = w.RJ_LF_hip[0]*t67 + w.RJ_LF_hip[1]*t69 + w.RJ_LF_hip[2]*t68 + 0.049*t72;
-    w.KA_trunk[52] = w.RJ_LF_hip[3]*t67 + w.cq_LF_hip*t69 + w.RJ_LF_hip[5]*t68 - 0.19*t72;
-    w.KA_trunk[65] = w.RJ_LF_hip[6]*t67 + w.RJ_LF_hip[7]*t69 + w.RJ_LF_hip[8]*t68 - 0.049*t70 + 0.19*t71;
-    w.KS_LF_hip[1] = 0.9950371902099893*w.KA_LF_hip[13] + 0.09950371902099893*w.KA_LF_hip[21];
+    w.KA_trunk[0][0] = t70;
+    w.KA_trunk[1][0] = t71;
+    w.KA_trunk[2][0] = t72;
+    w.KA_trunk[3][0] = w.RJ_LF_hip[0]*t67 + w.RJ_LF_hip[1]*t69 + w.RJ_LF_hip[2]*t68 + 0.049*t72;
+    w.KA_trunk[4][0] = w.RJ_LF_hip[3]*t67 + w.cq_LF_hip*t69 + w.RJ_LF_hip[5]*t68 - 0.19*t72;
+    w.KA_trunk[5][0] = w.RJ_LF_hip[6]*t67 + w.RJ_LF_hip[7]*t69 + w.RJ_LF_hip[8]*t68 - 0.049*t70 + 0.19*t71;
+    w.KS_LF_hip[1] = 0.9950371902099893*w.KA_LF_hip[3][1] + 0.09950371902099893*w.KA_LF_hip[5][1];
     w.KSD_LF_hip[1] = w.Dinv_LF_hip*w.KS_LF_hip[1];
     const Scalar t73 = 1.0 - t1*w.KS_LF_hip[1];
     const Scalar t74 = -t0*w.KS_LF_hip[1];
     const Scalar t75 = -t2*w.KS_LF_hip[1];
-    const Scalar t76 = w.KA_LF_hip[13] - t3*w.KS_LF_hip[1];
-    const Scalar t77 = w.KA_LF_hip[21] - t4*w.KS_LF_hip[1];
+    const Scalar t76 = w.KA_LF_hip[3][1] - t3*w.KS_LF_hip[1];
+    const Scalar t77 = w.KA_LF_hip[5][1] - t4*w.KS_LF_hip[1];
     const Scalar t78 = -5.780668556524933e-05*w.Dinv_LF_hip*w.KS_LF_hip[1];
     const Scalar t79 = w.RJ_LF_hip[0]*t74 + w.RJ_LF_hip[1]*t73 + w.RJ_LF_hip[2]*t75;
     const Scalar t80 = w.RJ_LF_hip[3]*t74 + w.cq_LF_hip*t73 + w.RJ_LF_hip[5]*t75;
     const Scalar t81 = w.RJ_LF_hip[6]*t74 + w.RJ_LF_hip[7]*t73 + w.RJ_LF_hip[8]*t75;
-    w.KA_trunk[1] = t79;
-    w.KA_trunk[14] = t80;
-    w.KA_trunk[27] = t81;
-    w.KA_trunk[40] = w.RJ_LF_hip[0]*t76 + w.RJ_LF_hip[1]*t78 + w.RJ_LF_hip[2]*t77 + 0.049*t81;
-    w.KA_trunk[53] = w.RJ_LF_hip[3]*t76 + w.cq_LF_hip*t78 + w.RJ_LF_hip[5]*t77 - 0.19*t81;
-    w.KA_trunk[66] = w.RJ_LF_hip[6]*t76 + w.RJ_LF_hip[7]*t78 + w.RJ_LF_hip[8]*t77 - 0.049*t79 + 0.19*t80;
-    w.KS_LF_hip[2] = 0.9950371902099893*w.KA_LF_hip[14] + 0.09950371902099893*w.KA_LF_hip[22];
+    w.KA_trunk[0][1] = t79;
+    w.KA_trunk[1][1] = t80;
+    w.KA_trunk[2][1] = t81;
+    w.KA_trunk[3][1] = w.RJ_LF_hip[0]*t76 + w.RJ_LF_hip[1]*t78 + w.RJ_LF_hip[2]*t77 + 0.049*t81;
+    w.KA_trunk[4][1] = w.RJ_LF_hip[3]*t76 + w.cq_LF_hip*t78 + w.RJ_LF_hip[5]*t77 - 0.19*t81;
+    w.KA_trunk[5][1] = w.RJ_LF_hip[6]*t76 + w.RJ_LF_hip[7]*t78 + w.RJ_LF_hip[8]*t77 - 0.049*t79 + 0.19*t80;
+    w.KS_LF_hip[2] = 0.9950371902099893*w.KA_LF_hip[3][2] + 0.09950371902099893*w.KA_LF_hip[5][2];
     w.KSD_LF_hip[2] = w.Dinv_LF_hip*w.KS_LF_hip[2];
-    const Scalar t82 = w.KA_LF_hip[2] - t0*w.KS_LF_hip[2];
-    const Scalar t83 = w.KA_LF_hip[10] - t2*w.KS_LF_hip[2];
+    const Scalar t82 = w.KA_LF_hip[0][2] - t0*w.KS_LF_hip[2];
+    const Scalar t83 = w.KA_LF_hip[2][2] - t2*w.KS_LF_hip[2];
     const Scalar t84 = -t1*w.KS_LF_hip[2];
-    const Scalar t85 = w.KA_LF_hip[14] - t3*w.KS_LF_hip[2];
-    const Scalar t86 = w.KA_LF_hip[22] - t4*w.KS_LF_hip[2];
+    const Scalar t85 = w.KA_LF_hip[3][2] - t3*w.KS_LF_hip[2];
+    const Scalar t86 = w.KA_LF_hip[5][2] - t4*w.KS_LF_hip[2];
     const Scalar t87 = -5.780668556524933e-05*w.Dinv_LF_hip*w.KS_LF_hip[2];
     const Scalar t88 = w.RJ_LF_hip[0]*t82 + w.RJ_LF_hip[1]*t84 + w.RJ_LF_hip[2]*t83;
     const Scalar t89 = w.RJ_LF_hip[3]*t82 + w.cq_LF_hip*t84 + w.RJ_LF_hip[5]*t83;
     const Scalar t90 = w.RJ_LF_hip[6]*t82 + w.RJ_LF_hip[7]*t84 + w.RJ_LF_hip[8]*t83;
-    w.KA_trunk[2] = t88;
-    w.KA_trunk[15] = t89;
-    w.KA_trunk[28] = t90;
-    w.KA_trunk[41] = w.RJ_LF_hip[0]*t85 + w.RJ_LF_hip[1]*t87 + w.RJ_LF_hip[2]*t86 + 0.049*t90;
-    w.KA_trunk[54] = w.RJ_LF_hip[3]*t85 + w.cq_LF_hip*t87 + w.RJ_LF_hip[5]*t86 - 0.19*t90;
-    w.KA_trunk[67] = w.RJ_LF_hip[6]*t85 + w.RJ_LF_hip[7]*t87 + w.RJ_LF_hip[8]*t86 - 0.049*t88 + 0.19*t89;
+    w.KA_trunk[0][2] = t88;
+    w.KA_trunk[1][2] = t89;
+    w.KA_trunk[2][2] = t90;
+    w.KA_trunk[3][2] = w.RJ_LF_hip[0]*t85 + w.RJ_LF_hip[1]*t87 + w.RJ_LF_hip[2]*t86 + 0.049*t90;
+    w.KA_trunk[4][2] = w.RJ_LF_hip[3]*t85 + w.cq_LF_hip*t87 + w.RJ_LF_hip[5]*t86 - 0.19*t90;
+    w.KA_trunk[5][2] = w.RJ_LF_hip[6]*t85 + w.RJ_LF_hip[7]*t87 + w.RJ_LF_hip[8]*t86 - 0.049*t88 + 0.19*t89;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar r0 = std::sqrt(w.IA_trunk[0]);
@@ -3826,202 +3804,202 @@ PROXGEN_RT_NOINLINE void pv_12(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace&
     w.u_trunk[3] = -w.pA_trunk[3] + tau[3];
     w.u_trunk[4] = -w.pA_trunk[4] + tau[4];
     w.u_trunk[5] = -w.pA_trunk[5] + tau[5];
-    const Scalar t15 = w.KA_trunk[0]*w.Linv_trunk[0];
-    const Scalar t16 = w.KA_trunk[13] - w.L_trunk[1]*t15;
+    const Scalar t15 = w.KA_trunk[0][0]*w.Linv_trunk[0];
+    const Scalar t16 = w.KA_trunk[1][0] - w.L_trunk[1]*t15;
     const Scalar t17 = w.Linv_trunk[1]*t16;
-    const Scalar t18 = w.KA_trunk[26] - w.L_trunk[2]*t15 - w.L_trunk[7]*t17;
+    const Scalar t18 = w.KA_trunk[2][0] - w.L_trunk[2]*t15 - w.L_trunk[7]*t17;
     const Scalar t19 = w.Linv_trunk[2]*t18;
-    const Scalar t20 = w.KA_trunk[39] - w.L_trunk[3]*t15 - w.L_trunk[8]*t17 - w.L_trunk[12]*t19;
+    const Scalar t20 = w.KA_trunk[3][0] - w.L_trunk[3]*t15 - w.L_trunk[8]*t17 - w.L_trunk[12]*t19;
     const Scalar t21 = w.Linv_trunk[3]*t20;
-    const Scalar t22 = w.KA_trunk[52] - w.L_trunk[4]*t15 - w.L_trunk[9]*t17 - w.L_trunk[13]*t19 - w.L_trunk[16]*t21;
+    const Scalar t22 = w.KA_trunk[4][0] - w.L_trunk[4]*t15 - w.L_trunk[9]*t17 - w.L_trunk[13]*t19 - w.L_trunk[16]*t21;
     const Scalar t23 = w.Linv_trunk[4]*t22;
-    const Scalar t24 = w.KA_trunk[65] - w.L_trunk[5]*t15 - w.L_trunk[10]*t17 - w.L_trunk[14]*t19 - w.L_trunk[17]*t21 - w.L_trunk[19]*t23;
-    w.Z_trunk[0] = w.KA_trunk[0]*w.Linv_trunk[0];
-    w.Z_trunk[13] = w.Linv_trunk[1]*t16;
-    w.Z_trunk[26] = w.Linv_trunk[2]*t18;
-    w.Z_trunk[39] = w.Linv_trunk[3]*t20;
-    w.Z_trunk[52] = w.Linv_trunk[4]*t22;
-    w.Z_trunk[65] = w.Linv_trunk[5]*t24;
-    const Scalar t25 = w.KA_trunk[1]*w.Linv_trunk[0];
-    const Scalar t26 = w.KA_trunk[14] - w.L_trunk[1]*t25;
+    const Scalar t24 = w.KA_trunk[5][0] - w.L_trunk[5]*t15 - w.L_trunk[10]*t17 - w.L_trunk[14]*t19 - w.L_trunk[17]*t21 - w.L_trunk[19]*t23;
+    w.Z_trunk[0][0] = w.KA_trunk[0][0]*w.Linv_trunk[0];
+    w.Z_trunk[1][0] = w.Linv_trunk[1]*t16;
+    w.Z_trunk[2][0] = w.Linv_trunk[2]*t18;
+    w.Z_trunk[3][0] = w.Linv_trunk[3]*t20;
+    w.Z_trunk[4][0] = w.Linv_trunk[4]*t22;
+    w.Z_trunk[5][0] = w.Linv_trunk[5]*t24;
+    const Scalar t25 = w.KA_trunk[0][1]*w.Linv_trunk[0];
+    const Scalar t26 = w.KA_trunk[1][1] - w.L_trunk[1]*t25;
     const Scalar t27 = w.Linv_trunk[1]*t26;
-    const Scalar t28 = w.KA_trunk[27] - w.L_trunk[2]*t25 - w.L_trunk[7]*t27;
+    const Scalar t28 = w.KA_trunk[2][1] - w.L_trunk[2]*t25 - w.L_trunk[7]*t27;
     const Scalar t29 = w.Linv_trunk[2]*t28;
-    const Scalar t30 = w.KA_trunk[40] - w.L_trunk[3]*t25 - w.L_trunk[8]*t27 - w.L_trunk[12]*t29;
+    const Scalar t30 = w.KA_trunk[3][1] - w.L_trunk[3]*t25 - w.L_trunk[8]*t27 - w.L_trunk[12]*t29;
     const Scalar t31 = w.Linv_trunk[3]*t30;
-    const Scalar t32 = w.KA_trunk[53] - w.L_trunk[4]*t25 - w.L_trunk[9]*t27 - w.L_trunk[13]*t29 - w.L_trunk[16]*t31;
+    const Scalar t32 = w.KA_trunk[4][1] - w.L_trunk[4]*t25 - w.L_trunk[9]*t27 - w.L_trunk[13]*t29 - w.L_trunk[16]*t31;
     const Scalar t33 = w.Linv_trunk[4]*t32;
-    const Scalar t34 = w.KA_trunk[66] - w.L_trunk[5]*t25 - w.L_trunk[10]*t27 - w.L_trunk[14]*t29 - w.L_trunk[17]*t31 - w.L_trunk[19]*t33;
-    w.Z_trunk[1] = w.KA_trunk[1]*w.Linv_trunk[0];
-    w.Z_trunk[14] = w.Linv_trunk[1]*t26;
-    w.Z_trunk[27] = w.Linv_trunk[2]*t28;
-    w.Z_trunk[40] = w.Linv_trunk[3]*t30;
-    w.Z_trunk[53] = w.Linv_trunk[4]*t32;
-    w.Z_trunk[66] = w.Linv_trunk[5]*t34;
-    const Scalar t35 = w.KA_trunk[2]*w.Linv_trunk[0];
-    const Scalar t36 = w.KA_trunk[15] - w.L_trunk[1]*t35;
+    const Scalar t34 = w.KA_trunk[5][1] - w.L_trunk[5]*t25 - w.L_trunk[10]*t27 - w.L_trunk[14]*t29 - w.L_trunk[17]*t31 - w.L_trunk[19]*t33;
+    w.Z_trunk[0][1] = w.KA_trunk[0][1]*w.Linv_trunk[0];
+    w.Z_trunk[1][1] = w.Linv_trunk[1]*t26;
+    w.Z_trunk[2][1] = w.Linv_trunk[2]*t28;
+    w.Z_trunk[3][1] = w.Linv_trunk[3]*t30;
+    w.Z_trunk[4][1] = w.Linv_trunk[4]*t32;
+    w.Z_trunk[5][1] = w.Linv_trunk[5]*t34;
+    const Scalar t35 = w.KA_trunk[0][2]*w.Linv_trunk[0];
+    const Scalar t36 = w.KA_trunk[1][2] - w.L_trunk[1]*t35;
     const Scalar t37 = w.Linv_trunk[1]*t36;
-    const Scalar t38 = w.KA_trunk[28] - w.L_trunk[2]*t35 - w.L_trunk[7]*t37;
+    const Scalar t38 = w.KA_trunk[2][2] - w.L_trunk[2]*t35 - w.L_trunk[7]*t37;
     const Scalar t39 = w.Linv_trunk[2]*t38;
-    const Scalar t40 = w.KA_trunk[41] - w.L_trunk[3]*t35 - w.L_trunk[8]*t37 - w.L_trunk[12]*t39;
+    const Scalar t40 = w.KA_trunk[3][2] - w.L_trunk[3]*t35 - w.L_trunk[8]*t37 - w.L_trunk[12]*t39;
     const Scalar t41 = w.Linv_trunk[3]*t40;
-    const Scalar t42 = w.KA_trunk[54] - w.L_trunk[4]*t35 - w.L_trunk[9]*t37 - w.L_trunk[13]*t39 - w.L_trunk[16]*t41;
+    const Scalar t42 = w.KA_trunk[4][2] - w.L_trunk[4]*t35 - w.L_trunk[9]*t37 - w.L_trunk[13]*t39 - w.L_trunk[16]*t41;
     const Scalar t43 = w.Linv_trunk[4]*t42;
-    const Scalar t44 = w.KA_trunk[67] - w.L_trunk[5]*t35 - w.L_trunk[10]*t37 - w.L_trunk[14]*t39 - w.L_trunk[17]*t41 - w.L_trunk[19]*t43;
-    w.Z_trunk[2] = w.KA_trunk[2]*w.Linv_trunk[0];
-    w.Z_trunk[15] = w.Linv_trunk[1]*t36;
-    w.Z_trunk[28] = w.Linv_trunk[2]*t38;
-    w.Z_trunk[41] = w.Linv_trunk[3]*t40;
-    w.Z_trunk[54] = w.Linv_trunk[4]*t42;
-    w.Z_trunk[67] = w.Linv_trunk[5]*t44;
-    const Scalar t45 = w.KA_trunk[3]*w.Linv_trunk[0];
-    const Scalar t46 = w.KA_trunk[16] - w.L_trunk[1]*t45;
+    const Scalar t44 = w.KA_trunk[5][2] - w.L_trunk[5]*t35 - w.L_trunk[10]*t37 - w.L_trunk[14]*t39 - w.L_trunk[17]*t41 - w.L_trunk[19]*t43;
+    w.Z_trunk[0][2] = w.KA_trunk[0][2]*w.Linv_trunk[0];
+    w.Z_trunk[1][2] = w.Linv_trunk[1]*t36;
+    w.Z_trunk[2][2] = w.Linv_trunk[2]*t38;
+    w.Z_trunk[3][2] = w.Linv_trunk[3]*t40;
+    w.Z_trunk[4][2] = w.Linv_trunk[4]*t42;
+    w.Z_trunk[5][2] = w.Linv_trunk[5]*t44;
+    const Scalar t45 = w.KA_trunk[0][3]*w.Linv_trunk[0];
+    const Scalar t46 = w.KA_trunk[1][3] - w.L_trunk[1]*t45;
     const Scalar t47 = w.Linv_trunk[1]*t46;
-    const Scalar t48 = w.KA_trunk[29] - w.L_trunk[2]*t45 - w.L_trunk[7]*t47;
+    const Scalar t48 = w.KA_trunk[2][3] - w.L_trunk[2]*t45 - w.L_trunk[7]*t47;
     const Scalar t49 = w.Linv_trunk[2]*t48;
-    const Scalar t50 = w.KA_trunk[42] - w.L_trunk[3]*t45 - w.L_trunk[8]*t47 - w.L_trunk[12]*t49;
+    const Scalar t50 = w.KA_trunk[3][3] - w.L_trunk[3]*t45 - w.L_trunk[8]*t47 - w.L_trunk[12]*t49;
     const Scalar t51 = w.Linv_trunk[3]*t50;
-    const Scalar t52 = w.KA_trunk[55] - w.L_trunk[4]*t45 - w.L_trunk[9]*t47 - w.L_trunk[13]*t49 - w.L_trunk[16]*t51;
+    const Scalar t52 = w.KA_trunk[4][3] - w.L_trunk[4]*t45 - w.L_trunk[9]*t47 - w.L_trunk[13]*t49 - w.L_trunk[16]*t51;
     const Scalar t53 = w.Linv_trunk[4]*t52;
-    const Scalar t54 = w.KA_trunk[68] - w.L_trunk[5]*t45 - w.L_trunk[10]*t47 - w.L_trunk[14]*t49 - w.L_trunk[17]*t51 - w.L_trunk[19]*t53;
-    w.Z_trunk[3] = w.KA_trunk[3]*w.Linv_trunk[0];
-    w.Z_trunk[16] = w.Linv_trunk[1]*t46;
-    w.Z_trunk[29] = w.Linv_trunk[2]*t48;
-    w.Z_trunk[42] = w.Linv_trunk[3]*t50;
-    w.Z_trunk[55] = w.Linv_trunk[4]*t52;
-    w.Z_trunk[68] = w.Linv_trunk[5]*t54;
-    const Scalar t55 = w.KA_trunk[4]*w.Linv_trunk[0];
-    const Scalar t56 = w.KA_trunk[17] - w.L_trunk[1]*t55;
+    const Scalar t54 = w.KA_trunk[5][3] - w.L_trunk[5]*t45 - w.L_trunk[10]*t47 - w.L_trunk[14]*t49 - w.L_trunk[17]*t51 - w.L_trunk[19]*t53;
+    w.Z_trunk[0][3] = w.KA_trunk[0][3]*w.Linv_trunk[0];
+    w.Z_trunk[1][3] = w.Linv_trunk[1]*t46;
+    w.Z_trunk[2][3] = w.Linv_trunk[2]*t48;
+    w.Z_trunk[3][3] = w.Linv_trunk[3]*t50;
+    w.Z_trunk[4][3] = w.Linv_trunk[4]*t52;
+    w.Z_trunk[5][3] = w.Linv_trunk[5]*t54;
+    const Scalar t55 = w.KA_trunk[0][4]*w.Linv_trunk[0];
+    const Scalar t56 = w.KA_trunk[1][4] - w.L_trunk[1]*t55;
     const Scalar t57 = w.Linv_trunk[1]*t56;
-    const Scalar t58 = w.KA_trunk[30] - w.L_trunk[2]*t55 - w.L_trunk[7]*t57;
+    const Scalar t58 = w.KA_trunk[2][4] - w.L_trunk[2]*t55 - w.L_trunk[7]*t57;
     const Scalar t59 = w.Linv_trunk[2]*t58;
-    const Scalar t60 = w.KA_trunk[43] - w.L_trunk[3]*t55 - w.L_trunk[8]*t57 - w.L_trunk[12]*t59;
+    const Scalar t60 = w.KA_trunk[3][4] - w.L_trunk[3]*t55 - w.L_trunk[8]*t57 - w.L_trunk[12]*t59;
     const Scalar t61 = w.Linv_trunk[3]*t60;
-    const Scalar t62 = w.KA_trunk[56] - w.L_trunk[4]*t55 - w.L_trunk[9]*t57 - w.L_trunk[13]*t59 - w.L_trunk[16]*t61;
+    const Scalar t62 = w.KA_trunk[4][4] - w.L_trunk[4]*t55 - w.L_trunk[9]*t57 - w.L_trunk[13]*t59 - w.L_trunk[16]*t61;
     const Scalar t63 = w.Linv_trunk[4]*t62;
-    const Scalar t64 = w.KA_trunk[69] - w.L_trunk[5]*t55 - w.L_trunk[10]*t57 - w.L_trunk[14]*t59 - w.L_trunk[17]*t61 - w.L_trunk[19]*t63;
-    w.Z_trunk[4] = w.KA_trunk[4]*w.Linv_trunk[0];
-    w.Z_trunk[17] = w.Linv_trunk[1]*t56;
-    w.Z_trunk[30] = w.Linv_trunk[2]*t58;
-    w.Z_trunk[43] = w.Linv_trunk[3]*t60;
-    w.Z_trunk[56] = w.Linv_trunk[4]*t62;
-    w.Z_trunk[69] = w.Linv_trunk[5]*t64;
-    const Scalar t65 = w.KA_trunk[5]*w.Linv_trunk[0];
-    const Scalar t66 = w.KA_trunk[18] - w.L_trunk[1]*t65;
+    const Scalar t64 = w.KA_trunk[5][4] - w.L_trunk[5]*t55 - w.L_trunk[10]*t57 - w.L_trunk[14]*t59 - w.L_trunk[17]*t61 - w.L_trunk[19]*t63;
+    w.Z_trunk[0][4] = w.KA_trunk[0][4]*w.Linv_trunk[0];
+    w.Z_trunk[1][4] = w.Linv_trunk[1]*t56;
+    w.Z_trunk[2][4] = w.Linv_trunk[2]*t58;
+    w.Z_trunk[3][4] = w.Linv_trunk[3]*t60;
+    w.Z_trunk[4][4] = w.Linv_trunk[4]*t62;
+    w.Z_trunk[5][4] = w.Linv_trunk[5]*t64;
+    const Scalar t65 = w.KA_trunk[0][5]*w.Linv_trunk[0];
+    const Scalar t66 = w.KA_trunk[1][5] - w.L_trunk[1]*t65;
     const Scalar t67 = w.Linv_trunk[1]*t66;
-    const Scalar t68 = w.KA_trunk[31] - w.L_trunk[2]*t65 - w.L_trunk[7]*t67;
+    const Scalar t68 = w.KA_trunk[2][5] - w.L_trunk[2]*t65 - w.L_trunk[7]*t67;
     const Scalar t69 = w.Linv_trunk[2]*t68;
-    const Scalar t70 = w.KA_trunk[44] - w.L_trunk[3]*t65 - w.L_trunk[8]*t67 - w.L_trunk[12]*t69;
+    const Scalar t70 = w.KA_trunk[3][5] - w.L_trunk[3]*t65 - w.L_trunk[8]*t67 - w.L_trunk[12]*t69;
     const Scalar t71 = w.Linv_trunk[3]*t70;
-    const Scalar t72 = w.KA_trunk[57] - w.L_trunk[4]*t65 - w.L_trunk[9]*t67 - w.L_trunk[13]*t69 - w.L_trunk[16]*t71;
+    const Scalar t72 = w.KA_trunk[4][5] - w.L_trunk[4]*t65 - w.L_trunk[9]*t67 - w.L_trunk[13]*t69 - w.L_trunk[16]*t71;
     const Scalar t73 = w.Linv_trunk[4]*t72;
-    const Scalar t74 = w.KA_trunk[70] - w.L_trunk[5]*t65 - w.L_trunk[10]*t67 - w.L_trunk[14]*t69 - w.L_trunk[17]*t71 - w.L_trunk[19]*t73;
-    w.Z_trunk[5] = w.KA_trunk[5]*w.Linv_trunk[0];
-    w.Z_trunk[18] = w.Linv_trunk[1]*t66;
-    w.Z_trunk[31] = w.Linv_trunk[2]*t68;
-    w.Z_trunk[44] = w.Linv_trunk[3]*t70;
-    w.Z_trunk[57] = w.Linv_trunk[4]*t72;
-    w.Z_trunk[70] = w.Linv_trunk[5]*t74;
-    const Scalar t75 = w.KA_trunk[6]*w.Linv_trunk[0];
-    const Scalar t76 = w.KA_trunk[19] - w.L_trunk[1]*t75;
+    const Scalar t74 = w.KA_trunk[5][5] - w.L_trunk[5]*t65 - w.L_trunk[10]*t67 - w.L_trunk[14]*t69 - w.L_trunk[17]*t71 - w.L_trunk[19]*t73;
+    w.Z_trunk[0][5] = w.KA_trunk[0][5]*w.Linv_trunk[0];
+    w.Z_trunk[1][5] = w.Linv_trunk[1]*t66;
+    w.Z_trunk[2][5] = w.Linv_trunk[2]*t68;
+    w.Z_trunk[3][5] = w.Linv_trunk[3]*t70;
+    w.Z_trunk[4][5] = w.Linv_trunk[4]*t72;
+    w.Z_trunk[5][5] = w.Linv_trunk[5]*t74;
+    const Scalar t75 = w.KA_trunk[0][6]*w.Linv_trunk[0];
+    const Scalar t76 = w.KA_trunk[1][6] - w.L_trunk[1]*t75;
     const Scalar t77 = w.Linv_trunk[1]*t76;
-    const Scalar t78 = w.KA_trunk[32] - w.L_trunk[2]*t75 - w.L_trunk[7]*t77;
+    const Scalar t78 = w.KA_trunk[2][6] - w.L_trunk[2]*t75 - w.L_trunk[7]*t77;
     const Scalar t79 = w.Linv_trunk[2]*t78;
-    const Scalar t80 = w.KA_trunk[45] - w.L_trunk[3]*t75 - w.L_trunk[8]*t77 - w.L_trunk[12]*t79;
+    const Scalar t80 = w.KA_trunk[3][6] - w.L_trunk[3]*t75 - w.L_trunk[8]*t77 - w.L_trunk[12]*t79;
     const Scalar t81 = w.Linv_trunk[3]*t80;
-    const Scalar t82 = w.KA_trunk[58] - w.L_trunk[4]*t75 - w.L_trunk[9]*t77 - w.L_trunk[13]*t79 - w.L_trunk[16]*t81;
+    const Scalar t82 = w.KA_trunk[4][6] - w.L_trunk[4]*t75 - w.L_trunk[9]*t77 - w.L_trunk[13]*t79 - w.L_trunk[16]*t81;
     const Scalar t83 = w.Linv_trunk[4]*t82;
-    const Scalar t84 = w.KA_trunk[71] - w.L_trunk[5]*t75 - w.L_trunk[10]*t77 - w.L_trunk[14]*t79 - w.L_trunk[17]*t81 - w.L_trunk[19]*t83;
-    w.Z_trunk[6] = w.KA_trunk[6]*w.Linv_trunk[0];
-    w.Z_trunk[19] = w.Linv_trunk[1]*t76;
-    w.Z_trunk[32] = w.Linv_trunk[2]*t78;
-    w.Z_trunk[45] = w.Linv_trunk[3]*t80;
-    w.Z_trunk[58] = w.Linv_trunk[4]*t82;
-    w.Z_trunk[71] = w.Linv_trunk[5]*t84;
-    const Scalar t85 = w.KA_trunk[7]*w.Linv_trunk[0];
-    const Scalar t86 = w.KA_trunk[20] - w.L_trunk[1]*t85;
+    const Scalar t84 = w.KA_trunk[5][6] - w.L_trunk[5]*t75 - w.L_trunk[10]*t77 - w.L_trunk[14]*t79 - w.L_trunk[17]*t81 - w.L_trunk[19]*t83;
+    w.Z_trunk[0][6] = w.KA_trunk[0][6]*w.Linv_trunk[0];
+    w.Z_trunk[1][6] = w.Linv_trunk[1]*t76;
+    w.Z_trunk[2][6] = w.Linv_trunk[2]*t78;
+    w.Z_trunk[3][6] = w.Linv_trunk[3]*t80;
+    w.Z_trunk[4][6] = w.Linv_trunk[4]*t82;
+    w.Z_trunk[5][6] = w.Linv_trunk[5]*t84;
+    const Scalar t85 = w.KA_trunk[0][7]*w.Linv_trunk[0];
+    const Scalar t86 = w.KA_trunk[1][7] - w.L_trunk[1]*t85;
     const Scalar t87 = w.Linv_trunk[1]*t86;
-    const Scalar t88 = w.KA_trunk[33] - w.L_trunk[2]*t85 - w.L_trunk[7]*t87;
+    const Scalar t88 = w.KA_trunk[2][7] - w.L_trunk[2]*t85 - w.L_trunk[7]*t87;
     const Scalar t89 = w.Linv_trunk[2]*t88;
-    const Scalar t90 = w.KA_trunk[46] - w.L_trunk[3]*t85 - w.L_trunk[8]*t87 - w.L_trunk[12]*t89;
+    const Scalar t90 = w.KA_trunk[3][7] - w.L_trunk[3]*t85 - w.L_trunk[8]*t87 - w.L_trunk[12]*t89;
     const Scalar t91 = w.Linv_trunk[3]*t90;
-    const Scalar t92 = w.KA_trunk[59] - w.L_trunk[4]*t85 - w.L_trunk[9]*t87 - w.L_trunk[13]*t89 - w.L_trunk[16]*t91;
+    const Scalar t92 = w.KA_trunk[4][7] - w.L_trunk[4]*t85 - w.L_trunk[9]*t87 - w.L_trunk[13]*t89 - w.L_trunk[16]*t91;
     const Scalar t93 = w.Linv_trunk[4]*t92;
-    const Scalar t94 = w.KA_trunk[72] - w.L_trunk[5]*t85 - w.L_trunk[10]*t87 - w.L_trunk[14]*t89 - w.L_trunk[17]*t91 - w.L_trunk[19]*t93;
-    w.Z_trunk[7] = w.KA_trunk[7]*w.Linv_trunk[0];
-    w.Z_trunk[20] = w.Linv_trunk[1]*t86;
-    w.Z_trunk[33] = w.Linv_trunk[2]*t88;
-    w.Z_trunk[46] = w.Linv_trunk[3]*t90;
-    w.Z_trunk[59] = w.Linv_trunk[4]*t92;
-    w.Z_trunk[72] = w.Linv_trunk[5]*t94;
-    const Scalar t95 = w.KA_trunk[8]*w.Linv_trunk[0];
-    const Scalar t96 = w.KA_trunk[21] - w.L_trunk[1]*t95;
+    const Scalar t94 = w.KA_trunk[5][7] - w.L_trunk[5]*t85 - w.L_trunk[10]*t87 - w.L_trunk[14]*t89 - w.L_trunk[17]*t91 - w.L_trunk[19]*t93;
+    w.Z_trunk[0][7] = w.KA_trunk[0][7]*w.Linv_trunk[0];
+    w.Z_trunk[1][7] = w.Linv_trunk[1]*t86;
+    w.Z_trunk[2][7] = w.Linv_trunk[2]*t88;
+    w.Z_trunk[3][7] = w.Linv_trunk[3]*t90;
+    w.Z_trunk[4][7] = w.Linv_trunk[4]*t92;
+    w.Z_trunk[5][7] = w.Linv_trunk[5]*t94;
+    const Scalar t95 = w.KA_trunk[0][8]*w.Linv_trunk[0];
+    const Scalar t96 = w.KA_trunk[1][8] - w.L_trunk[1]*t95;
     const Scalar t97 = w.Linv_trunk[1]*t96;
-    const Scalar t98 = w.KA_trunk[34] - w.L_trunk[2]*t95 - w.L_trunk[7]*t97;
+    const Scalar t98 = w.KA_trunk[2][8] - w.L_trunk[2]*t95 - w.L_trunk[7]*t97;
     const Scalar t99 = w.Linv_trunk[2]*t98;
-    const Scalar t100 = w.KA_trunk[47] - w.L_trunk[3]*t95 - w.L_trunk[8]*t97 - w.L_trunk[12]*t99;
+    const Scalar t100 = w.KA_trunk[3][8] - w.L_trunk[3]*t95 - w.L_trunk[8]*t97 - w.L_trunk[12]*t99;
     const Scalar t101 = w.Linv_trunk[3]*t100;
-    const Scalar t102 = w.KA_trunk[60] - w.L_trunk[4]*t95 - w.L_trunk[9]*t97 - w.L_trunk[13]*t99 - w.L_trunk[16]*t101;
+    const Scalar t102 = w.KA_trunk[4][8] - w.L_trunk[4]*t95 - w.L_trunk[9]*t97 - w.L_trunk[13]*t99 - w.L_trunk[16]*t101;
     const Scalar t103 = w.Linv_trunk[4]*t102;
-    const Scalar t104 = w.KA_trunk[73] - w.L_trunk[5]*t95 - w.L_trunk[10]*t97 - w.L_trunk[14]*t99 - w.L_trunk[17]*t101 - w.L_trunk[19]*t103;
-    w.Z_trunk[8] = w.KA_trunk[8]*w.Linv_trunk[0];
-    w.Z_trunk[21] = w.Linv_trunk[1]*t96;
-    w.Z_trunk[34] = w.Linv_trunk[2]*t98;
-    w.Z_trunk[47] = w.Linv_trunk[3]*t100;
-    w.Z_trunk[60] = w.Linv_trunk[4]*t102;
-    w.Z_trunk[73] = w.Linv_trunk[5]*t104;
-    const Scalar t105 = w.KA_trunk[9]*w.Linv_trunk[0];
-    const Scalar t106 = w.KA_trunk[22] - w.L_trunk[1]*t105;
+    const Scalar t104 = w.KA_trunk[5][8] - w.L_trunk[5]*t95 - w.L_trunk[10]*t97 - w.L_trunk[14]*t99 - w.L_trunk[17]*t101 - w.L_trunk[19]*t103;
+    w.Z_trunk[0][8] = w.KA_trunk[0][8]*w.Linv_trunk[0];
+    w.Z_trunk[1][8] = w.Linv_trunk[1]*t96;
+    w.Z_trunk[2][8] = w.Linv_trunk[2]*t98;
+    w.Z_trunk[3][8] = w.Linv_trunk[3]*t100;
+    w.Z_trunk[4][8] = w.Linv_trunk[4]*t102;
+    w.Z_trunk[5][8] = w.Linv_trunk[5]*t104;
+    const Scalar t105 = w.KA_trunk[0][9]*w.Linv_trunk[0];
+    const Scalar t106 = w.KA_trunk[1][9] - w.L_trunk[1]*t105;
     const Scalar t107 = w.Linv_trunk[1]*t106;
-    const Scalar t108 = w.KA_trunk[35] - w.L_trunk[2]*t105 - w.L_trunk[7]*t107;
+    const Scalar t108 = w.KA_trunk[2][9] - w.L_trunk[2]*t105 - w.L_trunk[7]*t107;
     const Scalar t109 = w.Linv_trunk[2]*t108;
-    const Scalar t110 = w.KA_trunk[48] - w.L_trunk[3]*t105 - w.L_trunk[8]*t107 - w.L_trunk[12]*t109;
+    const Scalar t110 = w.KA_trunk[3][9] - w.L_trunk[3]*t105 - w.L_trunk[8]*t107 - w.L_trunk[12]*t109;
     const Scalar t111 = w.Linv_trunk[3]*t110;
-    const Scalar t112 = w.KA_trunk[61] - w.L_trunk[4]*t105 - w.L_trunk[9]*t107 - w.L_trunk[13]*t109 - w.L_trunk[16]*t111;
+    const Scalar t112 = w.KA_trunk[4][9] - w.L_trunk[4]*t105 - w.L_trunk[9]*t107 - w.L_trunk[13]*t109 - w.L_trunk[16]*t111;
     const Scalar t113 = w.Linv_trunk[4]*t112;
-    const Scalar t114 = w.KA_trunk[74] - w.L_trunk[5]*t105 - w.L_trunk[10]*t107 - w.L_trunk[14]*t109 - w.L_trunk[17]*t111 - w.L_trunk[19]*t113;
-    w.Z_trunk[9] = w.KA_trunk[9]*w.Linv_trunk[0];
-    w.Z_trunk[22] = w.Linv_trunk[1]*t106;
-    w.Z_trunk[35] = w.Linv_trunk[2]*t108;
-    w.Z_trunk[48] = w.Linv_trunk[3]*t110;
-    w.Z_trunk[61] = w.Linv_trunk[4]*t112;
-    w.Z_trunk[74] = w.Linv_trunk[5]*t114;
-    const Scalar t115 = w.KA_trunk[10]*w.Linv_trunk[0];
-    const Scalar t116 = w.KA_trunk[23] - w.L_trunk[1]*t115;
+    const Scalar t114 = w.KA_trunk[5][9] - w.L_trunk[5]*t105 - w.L_trunk[10]*t107 - w.L_trunk[14]*t109 - w.L_trunk[17]*t111 - w.L_trunk[19]*t113;
+    w.Z_trunk[0][9] = w.KA_trunk[0][9]*w.Linv_trunk[0];
+    w.Z_trunk[1][9] = w.Linv_trunk[1]*t106;
+    w.Z_trunk[2][9] = w.Linv_trunk[2]*t108;
+    w.Z_trunk[3][9] = w.Linv_trunk[3]*t110;
+    w.Z_trunk[4][9] = w.Linv_trunk[4]*t112;
+    w.Z_trunk[5][9] = w.Linv_trunk[5]*t114;
+    const Scalar t115 = w.KA_trunk[0][10]*w.Linv_trunk[0];
+    const Scalar t116 = w.KA_trunk[1][10] - w.L_trunk[1]*t115;
     const Scalar t117 = w.Linv_trunk[1]*t116;
-    const Scalar t118 = w.KA_trunk[36] - w.L_trunk[2]*t115 - w.L_trunk[7]*t117;
+    const Scalar t118 = w.KA_trunk[2][10] - w.L_trunk[2]*t115 - w.L_trunk[7]*t117;
     const Scalar t119 = w.Linv_trunk[2]*t118;
-    const Scalar t120 = w.KA_trunk[49] - w.L_trunk[3]*t115 - w.L_trunk[8]*t117 - w.L_trunk[12]*t119;
+    const Scalar t120 = w.KA_trunk[3][10] - w.L_trunk[3]*t115 - w.L_trunk[8]*t117 - w.L_trunk[12]*t119;
     const Scalar t121 = w.Linv_trunk[3]*t120;
-    const Scalar t122 = w.KA_trunk[62] - w.L_trunk[4]*t115 - w.L_trunk[9]*t117 - w.L_trunk[13]*t119 - w.L_trunk[16]*t121;
+    const Scalar t122 = w.KA_trunk[4][10] - w.L_trunk[4]*t115 - w.L_trunk[9]*t117 - w.L_trunk[13]*t119 - w.L_trunk[16]*t121;
     const Scalar t123 = w.Linv_trunk[4]*t122;
-    const Scalar t124 = w.KA_trunk[75] - w.L_trunk[5]*t115 - w.L_trunk[10]*t117 - w.L_trunk[14]*t119 - w.L_trunk[17]*t121 - w.L_trunk[19]*t123;
-    w.Z_trunk[10] = w.KA_trunk[10]*w.Linv_trunk[0];
-    w.Z_trunk[23] = w.Linv_trunk[1]*t116;
-    w.Z_trunk[36] = w.Linv_trunk[2]*t118;
-    w.Z_trunk[49] = w.Linv_trunk[3]*t120;
-    w.Z_trunk[62] = w.Linv_trunk[4]*t122;
-    w.Z_trunk[75] = w.Linv_trunk[5]*t124;
-    const Scalar t125 = w.KA_trunk[11]*w.Linv_trunk[0];
-    const Scalar t126 = w.KA_trunk[24] - w.L_trunk[1]*t125;
+    const Scalar t124 = w.KA_trunk[5][10] - w.L_trunk[5]*t115 - w.L_trunk[10]*t117 - w.L_trunk[14]*t119 - w.L_trunk[17]*t121 - w.L_trunk[19]*t123;
+    w.Z_trunk[0][10] = w.KA_trunk[0][10]*w.Linv_trunk[0];
+    w.Z_trunk[1][10] = w.Linv_trunk[1]*t116;
+    w.Z_trunk[2][10] = w.Linv_trunk[2]*t118;
+    w.Z_trunk[3][10] = w.Linv_trunk[3]*t120;
+    w.Z_trunk[4][10] = w.Linv_trunk[4]*t122;
+    w.Z_trunk[5][10] = w.Linv_trunk[5]*t124;
+    const Scalar t125 = w.KA_trunk[0][11]*w.Linv_trunk[0];
+    const Scalar t126 = w.KA_trunk[1][11] - w.L_trunk[1]*t125;
     const Scalar t127 = w.Linv_trunk[1]*t126;
-    const Scalar t128 = w.KA_trunk[37] - w.L_trunk[2]*t125 - w.L_trunk[7]*t127;
+    const Scalar t128 = w.KA_trunk[2][11] - w.L_trunk[2]*t125 - w.L_trunk[7]*t127;
     const Scalar t129 = w.Linv_trunk[2]*t128;
-    const Scalar t130 = w.KA_trunk[50] - w.L_trunk[3]*t125 - w.L_trunk[8]*t127 - w.L_trunk[12]*t129;
+    const Scalar t130 = w.KA_trunk[3][11] - w.L_trunk[3]*t125 - w.L_trunk[8]*t127 - w.L_trunk[12]*t129;
     const Scalar t131 = w.Linv_trunk[3]*t130;
-    const Scalar t132 = w.KA_trunk[63] - w.L_trunk[4]*t125 - w.L_trunk[9]*t127 - w.L_trunk[13]*t129 - w.L_trunk[16]*t131;
+    const Scalar t132 = w.KA_trunk[4][11] - w.L_trunk[4]*t125 - w.L_trunk[9]*t127 - w.L_trunk[13]*t129 - w.L_trunk[16]*t131;
     const Scalar t133 = w.Linv_trunk[4]*t132;
-    const Scalar t134 = w.KA_trunk[76] - w.L_trunk[5]*t125 - w.L_trunk[10]*t127 - w.L_trunk[14]*t129 - w.L_trunk[17]*t131 - w.L_trunk[19]*t133;
-    w.Z_trunk[11] = w.KA_trunk[11]*w.Linv_trunk[0];
-    w.Z_trunk[24] = w.Linv_trunk[1]*t126;
-    w.Z_trunk[37] = w.Linv_trunk[2]*t128;
-    w.Z_trunk[50] = w.Linv_trunk[3]*t130;
-    w.Z_trunk[63] = w.Linv_trunk[4]*t132;
-    w.Z_trunk[76] = w.Linv_trunk[5]*t134;
+    const Scalar t134 = w.KA_trunk[5][11] - w.L_trunk[5]*t125 - w.L_trunk[10]*t127 - w.L_trunk[14]*t129 - w.L_trunk[17]*t131 - w.L_trunk[19]*t133;
+    w.Z_trunk[0][11] = w.KA_trunk[0][11]*w.Linv_trunk[0];
+    w.Z_trunk[1][11] = w.Linv_trunk[1]*t126;
+    w.Z_trunk[2][11] = w.Linv_trunk[2]*t128;
+    w.Z_trunk[3][11] = w.Linv_trunk[3]*t130;
+    w.Z_trunk[4][11] = w.Linv_trunk[4]*t132;
+    w.Z_trunk[5][11] = w.Linv_trunk[5]*t134;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
@@ -4074,7 +4052,7 @@ PROXGEN_RT_NOINLINE void pv_13(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
@@ -4104,7 +4082,7 @@ PROXGEN_RT_NOINLINE void pv_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_LF_shank[1] = t8;
     w.a_LF_shank[2] = t10;
     w.a_LF_shank[3] = t11;
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.Dinv_LF_shank*t13;
+    w.a_LF_shank[4] = w.a_LF_thigh[4] + 2057.0036861506055*t13;
     w.a_LF_shank[5] = t12;
   }
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
@@ -4128,7 +4106,7 @@ PROXGEN_RT_NOINLINE void pv_14(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
@@ -4158,7 +4136,7 @@ PROXGEN_RT_NOINLINE void pv_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_LH_shank[1] = t8;
     w.a_LH_shank[2] = t10;
     w.a_LH_shank[3] = t11;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.Dinv_LH_shank*t13;
+    w.a_LH_shank[4] = w.a_LH_thigh[4] + 2057.0036861506055*t13;
     w.a_LH_shank[5] = t12;
   }
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
@@ -4182,7 +4160,7 @@ PROXGEN_RT_NOINLINE void pv_15(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
@@ -4212,7 +4190,7 @@ PROXGEN_RT_NOINLINE void pv_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_RF_shank[1] = t8;
     w.a_RF_shank[2] = t10;
     w.a_RF_shank[3] = t11;
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.Dinv_RF_shank*t13;
+    w.a_RF_shank[4] = w.a_RF_thigh[4] + 2057.0036861506055*t13;
     w.a_RF_shank[5] = t12;
   }
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
@@ -4236,7 +4214,7 @@ PROXGEN_RT_NOINLINE void pv_16(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_17(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
@@ -4266,7 +4244,7 @@ PROXGEN_RT_NOINLINE void pv_17(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     w.a_RH_shank[1] = t8;
     w.a_RH_shank[2] = t10;
     w.a_RH_shank[3] = t11;
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.Dinv_RH_shank*t13;
+    w.a_RH_shank[4] = w.a_RH_thigh[4] + 2057.0036861506055*t13;
     w.a_RH_shank[5] = t12;
   }
   // free row accelerations y_free = K a - k (tree order)
@@ -4286,16 +4264,16 @@ PROXGEN_RT_NOINLINE void pv_17(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_18(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = -0.195*w.KSD_LF_shank[0] + w.KSD_LF_hip[0]*w.KS_LF_hip[0] + w.KSD_LF_thigh[0]*w.KA_LF_thigh[16] + inv_mu;
+    const Scalar t0 = 78.21756516587678 + w.KSD_LF_hip[0]*w.KS_LF_hip[0] + w.KSD_LF_thigh[0]*w.KA_LF_thigh[4][0] + inv_mu;
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
     const Scalar t1 = w.KSD_LF_hip[1]*w.KS_LF_hip[0];
     w.L[1] = w.Linv[0]*t1;
-    const Scalar t2 = w.KSD_LF_hip[2]*w.KS_LF_hip[0] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[16];
+    const Scalar t2 = w.KSD_LF_hip[2]*w.KS_LF_hip[0] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][0];
     w.L[2] = w.Linv[0]*t2;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
@@ -4309,20 +4287,20 @@ PROXGEN_RT_NOINLINE void pv_18(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t5 = inv_mu + w.KSD_LF_hip[2]*w.KS_LF_hip[2] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[18] - w.L[2]*w.L[2] - w.L[13]*w.L[13];
+    const Scalar t5 = inv_mu + w.KSD_LF_hip[2]*w.KS_LF_hip[2] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][2] - w.L[2]*w.L[2] - w.L[13]*w.L[13];
     const Scalar r2 = std::sqrt(t5);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = -0.195*w.KSD_LH_shank[0] + inv_mu + w.KSD_LH_hip[0]*w.KS_LH_hip[0] + w.KSD_LH_thigh[0]*w.KA_LH_thigh[16];
+    const Scalar t6 = 78.21756516587678 + inv_mu + w.KSD_LH_hip[0]*w.KS_LH_hip[0] + w.KSD_LH_thigh[0]*w.KA_LH_thigh[4][0];
     const Scalar r3 = std::sqrt(t6);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
     const Scalar t7 = w.KSD_LH_hip[1]*w.KS_LH_hip[0];
     w.L[34] = w.Linv[3]*t7;
-    const Scalar t8 = w.KSD_LH_hip[2]*w.KS_LH_hip[0] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[16];
+    const Scalar t8 = w.KSD_LH_hip[2]*w.KS_LH_hip[0] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][0];
     w.L[35] = w.Linv[3]*t8;
   }
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
@@ -4336,25 +4314,25 @@ PROXGEN_RT_NOINLINE void pv_18(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   }
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t11 = inv_mu + w.KSD_LH_hip[2]*w.KS_LH_hip[2] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[18] - w.L[35]*w.L[35] - w.L[43]*w.L[43];
+    const Scalar t11 = inv_mu + w.KSD_LH_hip[2]*w.KS_LH_hip[2] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][2] - w.L[35]*w.L[35] - w.L[43]*w.L[43];
     const Scalar r5 = std::sqrt(t11);
     const Scalar inv5 = 1.0 / r5;
     w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = -0.195*w.KSD_RF_shank[0] + inv_mu + w.KSD_RF_hip[0]*w.KS_RF_hip[0] + w.KSD_RF_thigh[0]*w.KA_RF_thigh[16];
+    const Scalar t12 = 78.21756516587678 + inv_mu + w.KSD_RF_hip[0]*w.KS_RF_hip[0] + w.KSD_RF_thigh[0]*w.KA_RF_thigh[4][0];
     const Scalar r6 = std::sqrt(t12);
     const Scalar inv6 = 1.0 / r6;
     w.Linv[6] = inv6;
     const Scalar t13 = w.KSD_RF_hip[1]*w.KS_RF_hip[0];
     w.L[58] = w.Linv[6]*t13;
-    const Scalar t14 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[16];
+    const Scalar t14 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][0];
     w.L[59] = w.Linv[6]*t14;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_19(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = w.KSD_RF_hip[1]*w.KS_RF_hip[1] + inv_mu - w.L[58]*w.L[58];
@@ -4366,20 +4344,20 @@ PROXGEN_RT_NOINLINE void pv_19(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   }
   // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t2 = inv_mu + w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[18] - w.L[59]*w.L[59] - w.L[64]*w.L[64];
+    const Scalar t2 = inv_mu + w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][2] - w.L[59]*w.L[59] - w.L[64]*w.L[64];
     const Scalar r1 = std::sqrt(t2);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t3 = -0.195*w.KSD_RH_shank[0] + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[16];
+    const Scalar t3 = 78.21756516587678 + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4][0];
     const Scalar r2 = std::sqrt(t3);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[9] = inv2;
     const Scalar t4 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
     w.L[73] = w.Linv[9]*t4;
-    const Scalar t5 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[16];
+    const Scalar t5 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][0];
     w.L[74] = w.Linv[9]*t5;
   }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
@@ -4393,266 +4371,266 @@ PROXGEN_RT_NOINLINE void pv_19(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t8 = inv_mu + w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[18] - w.L[74]*w.L[74] - w.L[76]*w.L[76];
+    const Scalar t8 = inv_mu + w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][2] - w.L[74]*w.L[74] - w.L[76]*w.L[76];
     const Scalar r4 = std::sqrt(t8);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[11] = inv4;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t9 = w.Z_trunk[0]*w.Linv[0];
-    const Scalar t10 = w.Z_trunk[1] - w.L[1]*t9;
+    const Scalar t9 = w.Z_trunk[0][0]*w.Linv[0];
+    const Scalar t10 = w.Z_trunk[0][1] - w.L[1]*t9;
     const Scalar t11 = w.Linv[1]*t10;
-    const Scalar t12 = w.Z_trunk[2] - w.L[2]*t9 - w.L[13]*t11;
-    const Scalar t13 = w.Z_trunk[3]*w.Linv[3];
-    const Scalar t14 = w.Z_trunk[4] - w.L[34]*t13;
+    const Scalar t12 = w.Z_trunk[0][2] - w.L[2]*t9 - w.L[13]*t11;
+    const Scalar t13 = w.Z_trunk[0][3]*w.Linv[3];
+    const Scalar t14 = w.Z_trunk[0][4] - w.L[34]*t13;
     const Scalar t15 = w.Linv[4]*t14;
-    const Scalar t16 = w.Z_trunk[5] - w.L[35]*t13 - w.L[43]*t15;
-    const Scalar t17 = w.Z_trunk[6]*w.Linv[6];
-    const Scalar t18 = w.Z_trunk[7] - w.L[58]*t17;
+    const Scalar t16 = w.Z_trunk[0][5] - w.L[35]*t13 - w.L[43]*t15;
+    const Scalar t17 = w.Z_trunk[0][6]*w.Linv[6];
+    const Scalar t18 = w.Z_trunk[0][7] - w.L[58]*t17;
     const Scalar t19 = w.Linv[7]*t18;
-    const Scalar t20 = w.Z_trunk[8] - w.L[59]*t17 - w.L[64]*t19;
-    const Scalar t21 = w.Z_trunk[9]*w.Linv[9];
-    const Scalar t22 = w.Z_trunk[10] - w.L[73]*t21;
+    const Scalar t20 = w.Z_trunk[0][8] - w.L[59]*t17 - w.L[64]*t19;
+    const Scalar t21 = w.Z_trunk[0][9]*w.Linv[9];
+    const Scalar t22 = w.Z_trunk[0][10] - w.L[73]*t21;
     const Scalar t23 = w.Linv[10]*t22;
-    const Scalar t24 = w.Z_trunk[11] - w.L[74]*t21 - w.L[76]*t23;
-    w.W[0] = w.Z_trunk[0]*w.Linv[0];
-    w.W[6] = w.Linv[1]*t10;
-    w.W[12] = w.Linv[2]*t12;
-    w.W[18] = w.Z_trunk[3]*w.Linv[3];
-    w.W[24] = w.Linv[4]*t14;
-    w.W[30] = w.Linv[5]*t16;
-    w.W[36] = w.Z_trunk[6]*w.Linv[6];
-    w.W[42] = w.Linv[7]*t18;
-    w.W[48] = w.Linv[8]*t20;
-    w.W[54] = w.Z_trunk[9]*w.Linv[9];
-    w.W[60] = w.Linv[10]*t22;
-    w.W[66] = w.Linv[11]*t24;
+    const Scalar t24 = w.Z_trunk[0][11] - w.L[74]*t21 - w.L[76]*t23;
+    w.W[0][0] = w.Z_trunk[0][0]*w.Linv[0];
+    w.W[1][0] = w.Linv[1]*t10;
+    w.W[2][0] = w.Linv[2]*t12;
+    w.W[3][0] = w.Z_trunk[0][3]*w.Linv[3];
+    w.W[4][0] = w.Linv[4]*t14;
+    w.W[5][0] = w.Linv[5]*t16;
+    w.W[6][0] = w.Z_trunk[0][6]*w.Linv[6];
+    w.W[7][0] = w.Linv[7]*t18;
+    w.W[8][0] = w.Linv[8]*t20;
+    w.W[9][0] = w.Z_trunk[0][9]*w.Linv[9];
+    w.W[10][0] = w.Linv[10]*t22;
+    w.W[11][0] = w.Linv[11]*t24;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_20(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_1_to_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
-    const Scalar t0 = w.Z_trunk[13]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[14] - w.L[1]*t0;
+    const Scalar t0 = w.Z_trunk[1][0]*w.Linv[0];
+    const Scalar t1 = w.Z_trunk[1][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[15] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[16]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[17] - w.L[34]*t4;
+    const Scalar t3 = w.Z_trunk[1][2] - w.L[2]*t0 - w.L[13]*t2;
+    const Scalar t4 = w.Z_trunk[1][3]*w.Linv[3];
+    const Scalar t5 = w.Z_trunk[1][4] - w.L[34]*t4;
     const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[18] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[19]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[20] - w.L[58]*t8;
+    const Scalar t7 = w.Z_trunk[1][5] - w.L[35]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Z_trunk[1][6]*w.Linv[6];
+    const Scalar t9 = w.Z_trunk[1][7] - w.L[58]*t8;
     const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[21] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[22]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[23] - w.L[73]*t12;
+    const Scalar t11 = w.Z_trunk[1][8] - w.L[59]*t8 - w.L[64]*t10;
+    const Scalar t12 = w.Z_trunk[1][9]*w.Linv[9];
+    const Scalar t13 = w.Z_trunk[1][10] - w.L[73]*t12;
     const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[24] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[1] = w.Z_trunk[13]*w.Linv[0];
-    w.W[7] = w.Linv[1]*t1;
-    w.W[13] = w.Linv[2]*t3;
-    w.W[19] = w.Z_trunk[16]*w.Linv[3];
-    w.W[25] = w.Linv[4]*t5;
-    w.W[31] = w.Linv[5]*t7;
-    w.W[37] = w.Z_trunk[19]*w.Linv[6];
-    w.W[43] = w.Linv[7]*t9;
-    w.W[49] = w.Linv[8]*t11;
-    w.W[55] = w.Z_trunk[22]*w.Linv[9];
-    w.W[61] = w.Linv[10]*t13;
-    w.W[67] = w.Linv[11]*t15;
+    const Scalar t15 = w.Z_trunk[1][11] - w.L[74]*t12 - w.L[76]*t14;
+    w.W[0][1] = w.Z_trunk[1][0]*w.Linv[0];
+    w.W[1][1] = w.Linv[1]*t1;
+    w.W[2][1] = w.Linv[2]*t3;
+    w.W[3][1] = w.Z_trunk[1][3]*w.Linv[3];
+    w.W[4][1] = w.Linv[4]*t5;
+    w.W[5][1] = w.Linv[5]*t7;
+    w.W[6][1] = w.Z_trunk[1][6]*w.Linv[6];
+    w.W[7][1] = w.Linv[7]*t9;
+    w.W[8][1] = w.Linv[8]*t11;
+    w.W[9][1] = w.Z_trunk[1][9]*w.Linv[9];
+    w.W[10][1] = w.Linv[10]*t13;
+    w.W[11][1] = w.Linv[11]*t15;
   }
   // W = L^-1 Z^T, column 2
   {
-    const Scalar t16 = w.Z_trunk[26]*w.Linv[0];
-    const Scalar t17 = w.Z_trunk[27] - w.L[1]*t16;
+    const Scalar t16 = w.Z_trunk[2][0]*w.Linv[0];
+    const Scalar t17 = w.Z_trunk[2][1] - w.L[1]*t16;
     const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_trunk[28] - w.L[2]*t16 - w.L[13]*t18;
-    const Scalar t20 = w.Z_trunk[29]*w.Linv[3];
-    const Scalar t21 = w.Z_trunk[30] - w.L[34]*t20;
+    const Scalar t19 = w.Z_trunk[2][2] - w.L[2]*t16 - w.L[13]*t18;
+    const Scalar t20 = w.Z_trunk[2][3]*w.Linv[3];
+    const Scalar t21 = w.Z_trunk[2][4] - w.L[34]*t20;
     const Scalar t22 = w.Linv[4]*t21;
-    const Scalar t23 = w.Z_trunk[31] - w.L[35]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Z_trunk[32]*w.Linv[6];
-    const Scalar t25 = w.Z_trunk[33] - w.L[58]*t24;
+    const Scalar t23 = w.Z_trunk[2][5] - w.L[35]*t20 - w.L[43]*t22;
+    const Scalar t24 = w.Z_trunk[2][6]*w.Linv[6];
+    const Scalar t25 = w.Z_trunk[2][7] - w.L[58]*t24;
     const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_trunk[34] - w.L[59]*t24 - w.L[64]*t26;
-    const Scalar t28 = w.Z_trunk[35]*w.Linv[9];
-    const Scalar t29 = w.Z_trunk[36] - w.L[73]*t28;
+    const Scalar t27 = w.Z_trunk[2][8] - w.L[59]*t24 - w.L[64]*t26;
+    const Scalar t28 = w.Z_trunk[2][9]*w.Linv[9];
+    const Scalar t29 = w.Z_trunk[2][10] - w.L[73]*t28;
     const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_trunk[37] - w.L[74]*t28 - w.L[76]*t30;
-    w.W[2] = w.Z_trunk[26]*w.Linv[0];
-    w.W[8] = w.Linv[1]*t17;
-    w.W[14] = w.Linv[2]*t19;
-    w.W[20] = w.Z_trunk[29]*w.Linv[3];
-    w.W[26] = w.Linv[4]*t21;
-    w.W[32] = w.Linv[5]*t23;
-    w.W[38] = w.Z_trunk[32]*w.Linv[6];
-    w.W[44] = w.Linv[7]*t25;
-    w.W[50] = w.Linv[8]*t27;
-    w.W[56] = w.Z_trunk[35]*w.Linv[9];
-    w.W[62] = w.Linv[10]*t29;
-    w.W[68] = w.Linv[11]*t31;
+    const Scalar t31 = w.Z_trunk[2][11] - w.L[74]*t28 - w.L[76]*t30;
+    w.W[0][2] = w.Z_trunk[2][0]*w.Linv[0];
+    w.W[1][2] = w.Linv[1]*t17;
+    w.W[2][2] = w.Linv[2]*t19;
+    w.W[3][2] = w.Z_trunk[2][3]*w.Linv[3];
+    w.W[4][2] = w.Linv[4]*t21;
+    w.W[5][2] = w.Linv[5]*t23;
+    w.W[6][2] = w.Z_trunk[2][6]*w.Linv[6];
+    w.W[7][2] = w.Linv[7]*t25;
+    w.W[8][2] = w.Linv[8]*t27;
+    w.W[9][2] = w.Z_trunk[2][9]*w.Linv[9];
+    w.W[10][2] = w.Linv[10]*t29;
+    w.W[11][2] = w.Linv[11]*t31;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_21(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_3_to_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t0 = w.Z_trunk[39]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[40] - w.L[1]*t0;
+    const Scalar t0 = w.Z_trunk[3][0]*w.Linv[0];
+    const Scalar t1 = w.Z_trunk[3][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[41] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[42]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[43] - w.L[34]*t4;
+    const Scalar t3 = w.Z_trunk[3][2] - w.L[2]*t0 - w.L[13]*t2;
+    const Scalar t4 = w.Z_trunk[3][3]*w.Linv[3];
+    const Scalar t5 = w.Z_trunk[3][4] - w.L[34]*t4;
     const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[44] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[45]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[46] - w.L[58]*t8;
+    const Scalar t7 = w.Z_trunk[3][5] - w.L[35]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Z_trunk[3][6]*w.Linv[6];
+    const Scalar t9 = w.Z_trunk[3][7] - w.L[58]*t8;
     const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[47] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[48]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[49] - w.L[73]*t12;
+    const Scalar t11 = w.Z_trunk[3][8] - w.L[59]*t8 - w.L[64]*t10;
+    const Scalar t12 = w.Z_trunk[3][9]*w.Linv[9];
+    const Scalar t13 = w.Z_trunk[3][10] - w.L[73]*t12;
     const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[50] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[3] = w.Z_trunk[39]*w.Linv[0];
-    w.W[9] = w.Linv[1]*t1;
-    w.W[15] = w.Linv[2]*t3;
-    w.W[21] = w.Z_trunk[42]*w.Linv[3];
-    w.W[27] = w.Linv[4]*t5;
-    w.W[33] = w.Linv[5]*t7;
-    w.W[39] = w.Z_trunk[45]*w.Linv[6];
-    w.W[45] = w.Linv[7]*t9;
-    w.W[51] = w.Linv[8]*t11;
-    w.W[57] = w.Z_trunk[48]*w.Linv[9];
-    w.W[63] = w.Linv[10]*t13;
-    w.W[69] = w.Linv[11]*t15;
+    const Scalar t15 = w.Z_trunk[3][11] - w.L[74]*t12 - w.L[76]*t14;
+    w.W[0][3] = w.Z_trunk[3][0]*w.Linv[0];
+    w.W[1][3] = w.Linv[1]*t1;
+    w.W[2][3] = w.Linv[2]*t3;
+    w.W[3][3] = w.Z_trunk[3][3]*w.Linv[3];
+    w.W[4][3] = w.Linv[4]*t5;
+    w.W[5][3] = w.Linv[5]*t7;
+    w.W[6][3] = w.Z_trunk[3][6]*w.Linv[6];
+    w.W[7][3] = w.Linv[7]*t9;
+    w.W[8][3] = w.Linv[8]*t11;
+    w.W[9][3] = w.Z_trunk[3][9]*w.Linv[9];
+    w.W[10][3] = w.Linv[10]*t13;
+    w.W[11][3] = w.Linv[11]*t15;
   }
   // W = L^-1 Z^T, column 4
   {
-    const Scalar t16 = w.Z_trunk[52]*w.Linv[0];
-    const Scalar t17 = w.Z_trunk[53] - w.L[1]*t16;
+    const Scalar t16 = w.Z_trunk[4][0]*w.Linv[0];
+    const Scalar t17 = w.Z_trunk[4][1] - w.L[1]*t16;
     const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_trunk[54] - w.L[2]*t16 - w.L[13]*t18;
-    const Scalar t20 = w.Z_trunk[55]*w.Linv[3];
-    const Scalar t21 = w.Z_trunk[56] - w.L[34]*t20;
+    const Scalar t19 = w.Z_trunk[4][2] - w.L[2]*t16 - w.L[13]*t18;
+    const Scalar t20 = w.Z_trunk[4][3]*w.Linv[3];
+    const Scalar t21 = w.Z_trunk[4][4] - w.L[34]*t20;
     const Scalar t22 = w.Linv[4]*t21;
-    const Scalar t23 = w.Z_trunk[57] - w.L[35]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Z_trunk[58]*w.Linv[6];
-    const Scalar t25 = w.Z_trunk[59] - w.L[58]*t24;
+    const Scalar t23 = w.Z_trunk[4][5] - w.L[35]*t20 - w.L[43]*t22;
+    const Scalar t24 = w.Z_trunk[4][6]*w.Linv[6];
+    const Scalar t25 = w.Z_trunk[4][7] - w.L[58]*t24;
     const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_trunk[60] - w.L[59]*t24 - w.L[64]*t26;
-    const Scalar t28 = w.Z_trunk[61]*w.Linv[9];
-    const Scalar t29 = w.Z_trunk[62] - w.L[73]*t28;
+    const Scalar t27 = w.Z_trunk[4][8] - w.L[59]*t24 - w.L[64]*t26;
+    const Scalar t28 = w.Z_trunk[4][9]*w.Linv[9];
+    const Scalar t29 = w.Z_trunk[4][10] - w.L[73]*t28;
     const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_trunk[63] - w.L[74]*t28 - w.L[76]*t30;
-    w.W[4] = w.Z_trunk[52]*w.Linv[0];
-    w.W[10] = w.Linv[1]*t17;
-    w.W[16] = w.Linv[2]*t19;
-    w.W[22] = w.Z_trunk[55]*w.Linv[3];
-    w.W[28] = w.Linv[4]*t21;
-    w.W[34] = w.Linv[5]*t23;
-    w.W[40] = w.Z_trunk[58]*w.Linv[6];
-    w.W[46] = w.Linv[7]*t25;
-    w.W[52] = w.Linv[8]*t27;
-    w.W[58] = w.Z_trunk[61]*w.Linv[9];
-    w.W[64] = w.Linv[10]*t29;
-    w.W[70] = w.Linv[11]*t31;
+    const Scalar t31 = w.Z_trunk[4][11] - w.L[74]*t28 - w.L[76]*t30;
+    w.W[0][4] = w.Z_trunk[4][0]*w.Linv[0];
+    w.W[1][4] = w.Linv[1]*t17;
+    w.W[2][4] = w.Linv[2]*t19;
+    w.W[3][4] = w.Z_trunk[4][3]*w.Linv[3];
+    w.W[4][4] = w.Linv[4]*t21;
+    w.W[5][4] = w.Linv[5]*t23;
+    w.W[6][4] = w.Z_trunk[4][6]*w.Linv[6];
+    w.W[7][4] = w.Linv[7]*t25;
+    w.W[8][4] = w.Linv[8]*t27;
+    w.W[9][4] = w.Z_trunk[4][9]*w.Linv[9];
+    w.W[10][4] = w.Linv[10]*t29;
+    w.W[11][4] = w.Linv[11]*t31;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_22(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t0 = w.Z_trunk[65]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[66] - w.L[1]*t0;
+    const Scalar t0 = w.Z_trunk[5][0]*w.Linv[0];
+    const Scalar t1 = w.Z_trunk[5][1] - w.L[1]*t0;
     const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[67] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[68]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[69] - w.L[34]*t4;
+    const Scalar t3 = w.Z_trunk[5][2] - w.L[2]*t0 - w.L[13]*t2;
+    const Scalar t4 = w.Z_trunk[5][3]*w.Linv[3];
+    const Scalar t5 = w.Z_trunk[5][4] - w.L[34]*t4;
     const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[70] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[71]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[72] - w.L[58]*t8;
+    const Scalar t7 = w.Z_trunk[5][5] - w.L[35]*t4 - w.L[43]*t6;
+    const Scalar t8 = w.Z_trunk[5][6]*w.Linv[6];
+    const Scalar t9 = w.Z_trunk[5][7] - w.L[58]*t8;
     const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[73] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[74]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[75] - w.L[73]*t12;
+    const Scalar t11 = w.Z_trunk[5][8] - w.L[59]*t8 - w.L[64]*t10;
+    const Scalar t12 = w.Z_trunk[5][9]*w.Linv[9];
+    const Scalar t13 = w.Z_trunk[5][10] - w.L[73]*t12;
     const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[76] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[5] = w.Z_trunk[65]*w.Linv[0];
-    w.W[11] = w.Linv[1]*t1;
-    w.W[17] = w.Linv[2]*t3;
-    w.W[23] = w.Z_trunk[68]*w.Linv[3];
-    w.W[29] = w.Linv[4]*t5;
-    w.W[35] = w.Linv[5]*t7;
-    w.W[41] = w.Z_trunk[71]*w.Linv[6];
-    w.W[47] = w.Linv[7]*t9;
-    w.W[53] = w.Linv[8]*t11;
-    w.W[59] = w.Z_trunk[74]*w.Linv[9];
-    w.W[65] = w.Linv[10]*t13;
-    w.W[71] = w.Linv[11]*t15;
+    const Scalar t15 = w.Z_trunk[5][11] - w.L[74]*t12 - w.L[76]*t14;
+    w.W[0][5] = w.Z_trunk[5][0]*w.Linv[0];
+    w.W[1][5] = w.Linv[1]*t1;
+    w.W[2][5] = w.Linv[2]*t3;
+    w.W[3][5] = w.Z_trunk[5][3]*w.Linv[3];
+    w.W[4][5] = w.Linv[4]*t5;
+    w.W[5][5] = w.Linv[5]*t7;
+    w.W[6][5] = w.Z_trunk[5][6]*w.Linv[6];
+    w.W[7][5] = w.Linv[7]*t9;
+    w.W[8][5] = w.Linv[8]*t11;
+    w.W[9][5] = w.Z_trunk[5][9]*w.Linv[9];
+    w.W[10][5] = w.Linv[10]*t13;
+    w.W[11][5] = w.Linv[11]*t15;
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t16 = 1.0 + w.W[0]*w.W[0] + w.W[6]*w.W[6] + w.W[12]*w.W[12] + w.W[18]*w.W[18] + w.W[24]*w.W[24] + w.W[30]*w.W[30] + w.W[36]*w.W[36] + w.W[42]*w.W[42] + w.W[48]*w.W[48] + w.W[54]*w.W[54] + w.W[60]*w.W[60] + w.W[66]*w.W[66];
+    const Scalar t16 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0];
     const Scalar r0 = std::sqrt(t16);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t17 = w.W[0]*w.W[1] + w.W[6]*w.W[7] + w.W[12]*w.W[13] + w.W[18]*w.W[19] + w.W[24]*w.W[25] + w.W[30]*w.W[31] + w.W[36]*w.W[37] + w.W[42]*w.W[43] + w.W[48]*w.W[49] + w.W[54]*w.W[55] + w.W[60]*w.W[61] + w.W[66]*w.W[67];
+    const Scalar t17 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1];
     w.LS[1] = w.LSinv[0]*t17;
-    const Scalar t18 = w.W[0]*w.W[2] + w.W[6]*w.W[8] + w.W[12]*w.W[14] + w.W[18]*w.W[20] + w.W[24]*w.W[26] + w.W[30]*w.W[32] + w.W[36]*w.W[38] + w.W[42]*w.W[44] + w.W[48]*w.W[50] + w.W[54]*w.W[56] + w.W[60]*w.W[62] + w.W[66]*w.W[68];
+    const Scalar t18 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2];
     w.LS[2] = w.LSinv[0]*t18;
-    const Scalar t19 = w.W[0]*w.W[3] + w.W[6]*w.W[9] + w.W[12]*w.W[15] + w.W[18]*w.W[21] + w.W[24]*w.W[27] + w.W[30]*w.W[33] + w.W[36]*w.W[39] + w.W[42]*w.W[45] + w.W[48]*w.W[51] + w.W[54]*w.W[57] + w.W[60]*w.W[63] + w.W[66]*w.W[69];
+    const Scalar t19 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3];
     w.LS[3] = w.LSinv[0]*t19;
-    const Scalar t20 = w.W[0]*w.W[4] + w.W[6]*w.W[10] + w.W[12]*w.W[16] + w.W[18]*w.W[22] + w.W[24]*w.W[28] + w.W[30]*w.W[34] + w.W[36]*w.W[40] + w.W[42]*w.W[46] + w.W[48]*w.W[52] + w.W[54]*w.W[58] + w.W[60]*w.W[64] + w.W[66]*w.W[70];
+    const Scalar t20 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4];
     w.LS[4] = w.LSinv[0]*t20;
-    const Scalar t21 = w.W[0]*w.W[5] + w.W[6]*w.W[11] + w.W[12]*w.W[17] + w.W[18]*w.W[23] + w.W[24]*w.W[29] + w.W[30]*w.W[35] + w.W[36]*w.W[41] + w.W[42]*w.W[47] + w.W[48]*w.W[53] + w.W[54]*w.W[59] + w.W[60]*w.W[65] + w.W[66]*w.W[71];
+    const Scalar t21 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5];
     w.LS[5] = w.LSinv[0]*t21;
-    const Scalar t22 = 1.0 + w.W[1]*w.W[1] + w.W[7]*w.W[7] + w.W[13]*w.W[13] + w.W[19]*w.W[19] + w.W[25]*w.W[25] + w.W[31]*w.W[31] + w.W[37]*w.W[37] + w.W[43]*w.W[43] + w.W[49]*w.W[49] + w.W[55]*w.W[55] + w.W[61]*w.W[61] + w.W[67]*w.W[67] - w.LS[1]*w.LS[1];
+    const Scalar t22 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] - w.LS[1]*w.LS[1];
     const Scalar r1 = std::sqrt(t22);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t23 = w.W[1]*w.W[2] + w.W[7]*w.W[8] + w.W[13]*w.W[14] + w.W[19]*w.W[20] + w.W[25]*w.W[26] + w.W[31]*w.W[32] + w.W[37]*w.W[38] + w.W[43]*w.W[44] + w.W[49]*w.W[50] + w.W[55]*w.W[56] + w.W[61]*w.W[62] + w.W[67]*w.W[68] - w.LS[1]*w.LS[2];
+    const Scalar t23 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] - w.LS[1]*w.LS[2];
     w.LS[7] = w.LSinv[1]*t23;
-    const Scalar t24 = w.W[1]*w.W[3] + w.W[7]*w.W[9] + w.W[13]*w.W[15] + w.W[19]*w.W[21] + w.W[25]*w.W[27] + w.W[31]*w.W[33] + w.W[37]*w.W[39] + w.W[43]*w.W[45] + w.W[49]*w.W[51] + w.W[55]*w.W[57] + w.W[61]*w.W[63] + w.W[67]*w.W[69] - w.LS[1]*w.LS[3];
+    const Scalar t24 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] - w.LS[1]*w.LS[3];
     w.LS[8] = w.LSinv[1]*t24;
-    const Scalar t25 = w.W[1]*w.W[4] + w.W[7]*w.W[10] + w.W[13]*w.W[16] + w.W[19]*w.W[22] + w.W[25]*w.W[28] + w.W[31]*w.W[34] + w.W[37]*w.W[40] + w.W[43]*w.W[46] + w.W[49]*w.W[52] + w.W[55]*w.W[58] + w.W[61]*w.W[64] + w.W[67]*w.W[70] - w.LS[1]*w.LS[4];
+    const Scalar t25 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] - w.LS[1]*w.LS[4];
     w.LS[9] = w.LSinv[1]*t25;
-    const Scalar t26 = w.W[1]*w.W[5] + w.W[7]*w.W[11] + w.W[13]*w.W[17] + w.W[19]*w.W[23] + w.W[25]*w.W[29] + w.W[31]*w.W[35] + w.W[37]*w.W[41] + w.W[43]*w.W[47] + w.W[49]*w.W[53] + w.W[55]*w.W[59] + w.W[61]*w.W[65] + w.W[67]*w.W[71] - w.LS[1]*w.LS[5];
+    const Scalar t26 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] - w.LS[1]*w.LS[5];
     w.LS[10] = w.LSinv[1]*t26;
-    const Scalar t27 = 1.0 + w.W[2]*w.W[2] + w.W[8]*w.W[8] + w.W[14]*w.W[14] + w.W[20]*w.W[20] + w.W[26]*w.W[26] + w.W[32]*w.W[32] + w.W[38]*w.W[38] + w.W[44]*w.W[44] + w.W[50]*w.W[50] + w.W[56]*w.W[56] + w.W[62]*w.W[62] + w.W[68]*w.W[68] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar t27 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
     const Scalar r2 = std::sqrt(t27);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t28 = w.W[2]*w.W[3] + w.W[8]*w.W[9] + w.W[14]*w.W[15] + w.W[20]*w.W[21] + w.W[26]*w.W[27] + w.W[32]*w.W[33] + w.W[38]*w.W[39] + w.W[44]*w.W[45] + w.W[50]*w.W[51] + w.W[56]*w.W[57] + w.W[62]*w.W[63] + w.W[68]*w.W[69] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    const Scalar t28 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
     w.LS[12] = w.LSinv[2]*t28;
-    const Scalar t29 = w.W[2]*w.W[4] + w.W[8]*w.W[10] + w.W[14]*w.W[16] + w.W[20]*w.W[22] + w.W[26]*w.W[28] + w.W[32]*w.W[34] + w.W[38]*w.W[40] + w.W[44]*w.W[46] + w.W[50]*w.W[52] + w.W[56]*w.W[58] + w.W[62]*w.W[64] + w.W[68]*w.W[70] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    const Scalar t29 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
     w.LS[13] = w.LSinv[2]*t29;
-    const Scalar t30 = w.W[2]*w.W[5] + w.W[8]*w.W[11] + w.W[14]*w.W[17] + w.W[20]*w.W[23] + w.W[26]*w.W[29] + w.W[32]*w.W[35] + w.W[38]*w.W[41] + w.W[44]*w.W[47] + w.W[50]*w.W[53] + w.W[56]*w.W[59] + w.W[62]*w.W[65] + w.W[68]*w.W[71] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    const Scalar t30 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
     w.LS[14] = w.LSinv[2]*t30;
-    const Scalar t31 = 1.0 + w.W[3]*w.W[3] + w.W[9]*w.W[9] + w.W[15]*w.W[15] + w.W[21]*w.W[21] + w.W[27]*w.W[27] + w.W[33]*w.W[33] + w.W[39]*w.W[39] + w.W[45]*w.W[45] + w.W[51]*w.W[51] + w.W[57]*w.W[57] + w.W[63]*w.W[63] + w.W[69]*w.W[69] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar t31 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
     const Scalar r3 = std::sqrt(t31);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t32 = w.W[3]*w.W[4] + w.W[9]*w.W[10] + w.W[15]*w.W[16] + w.W[21]*w.W[22] + w.W[27]*w.W[28] + w.W[33]*w.W[34] + w.W[39]*w.W[40] + w.W[45]*w.W[46] + w.W[51]*w.W[52] + w.W[57]*w.W[58] + w.W[63]*w.W[64] + w.W[69]*w.W[70] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    const Scalar t32 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
     w.LS[16] = w.LSinv[3]*t32;
-    const Scalar t33 = w.W[3]*w.W[5] + w.W[9]*w.W[11] + w.W[15]*w.W[17] + w.W[21]*w.W[23] + w.W[27]*w.W[29] + w.W[33]*w.W[35] + w.W[39]*w.W[41] + w.W[45]*w.W[47] + w.W[51]*w.W[53] + w.W[57]*w.W[59] + w.W[63]*w.W[65] + w.W[69]*w.W[71] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    const Scalar t33 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
     w.LS[17] = w.LSinv[3]*t33;
-    const Scalar t34 = 1.0 + w.W[4]*w.W[4] + w.W[10]*w.W[10] + w.W[16]*w.W[16] + w.W[22]*w.W[22] + w.W[28]*w.W[28] + w.W[34]*w.W[34] + w.W[40]*w.W[40] + w.W[46]*w.W[46] + w.W[52]*w.W[52] + w.W[58]*w.W[58] + w.W[64]*w.W[64] + w.W[70]*w.W[70] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar t34 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
     const Scalar r4 = std::sqrt(t34);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t35 = w.W[4]*w.W[5] + w.W[10]*w.W[11] + w.W[16]*w.W[17] + w.W[22]*w.W[23] + w.W[28]*w.W[29] + w.W[34]*w.W[35] + w.W[40]*w.W[41] + w.W[46]*w.W[47] + w.W[52]*w.W[53] + w.W[58]*w.W[59] + w.W[64]*w.W[65] + w.W[70]*w.W[71] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    const Scalar t35 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
     w.LS[19] = w.LSinv[4]*t35;
-    const Scalar t36 = 1.0 + w.W[5]*w.W[5] + w.W[11]*w.W[11] + w.W[17]*w.W[17] + w.W[23]*w.W[23] + w.W[29]*w.W[29] + w.W[35]*w.W[35] + w.W[41]*w.W[41] + w.W[47]*w.W[47] + w.W[53]*w.W[53] + w.W[59]*w.W[59] + w.W[65]*w.W[65] + w.W[71]*w.W[71] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar t36 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
     const Scalar r5 = std::sqrt(t36);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[0] = 0.0;
   w.lambda[1] = 0.0;
   w.lambda[2] = 0.0;
@@ -4667,7 +4645,7 @@ PROXGEN_RT_NOINLINE void pv_23(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   w.lambda[11] = 0.0;
 }
 
-PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
   const Scalar t2 = w.yfree[1] + w.lambda[1]*inv_mu - w.L[1]*t1;
@@ -4692,17 +4670,17 @@ PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   const Scalar t21 = w.Linv[5]*t9;
   const Scalar t22 = w.Linv[8]*t14;
   const Scalar t23 = w.Linv[11]*t19;
-  const Scalar t24 = w.W[0]*t1 + w.W[6]*t3 + w.W[12]*t20 + w.W[18]*t6 + w.W[24]*t8 + w.W[30]*t21 + w.W[36]*t11 + w.W[42]*t13 + w.W[48]*t22 + w.W[54]*t16 + w.W[60]*t18 + w.W[66]*t23;
+  const Scalar t24 = w.W[0][0]*t1 + w.W[1][0]*t3 + w.W[2][0]*t20 + w.W[3][0]*t6 + w.W[4][0]*t8 + w.W[5][0]*t21 + w.W[6][0]*t11 + w.W[7][0]*t13 + w.W[8][0]*t22 + w.W[9][0]*t16 + w.W[10][0]*t18 + w.W[11][0]*t23;
   const Scalar t25 = w.LSinv[0]*t24;
-  const Scalar t26 = w.W[1]*t1 + w.W[7]*t3 + w.W[13]*t20 + w.W[19]*t6 + w.W[25]*t8 + w.W[31]*t21 + w.W[37]*t11 + w.W[43]*t13 + w.W[49]*t22 + w.W[55]*t16 + w.W[61]*t18 + w.W[67]*t23 - w.LS[1]*t25;
+  const Scalar t26 = w.W[0][1]*t1 + w.W[1][1]*t3 + w.W[2][1]*t20 + w.W[3][1]*t6 + w.W[4][1]*t8 + w.W[5][1]*t21 + w.W[6][1]*t11 + w.W[7][1]*t13 + w.W[8][1]*t22 + w.W[9][1]*t16 + w.W[10][1]*t18 + w.W[11][1]*t23 - w.LS[1]*t25;
   const Scalar t27 = w.LSinv[1]*t26;
-  const Scalar t28 = w.W[2]*t1 + w.W[8]*t3 + w.W[14]*t20 + w.W[20]*t6 + w.W[26]*t8 + w.W[32]*t21 + w.W[38]*t11 + w.W[44]*t13 + w.W[50]*t22 + w.W[56]*t16 + w.W[62]*t18 + w.W[68]*t23 - w.LS[2]*t25 - w.LS[7]*t27;
+  const Scalar t28 = w.W[0][2]*t1 + w.W[1][2]*t3 + w.W[2][2]*t20 + w.W[3][2]*t6 + w.W[4][2]*t8 + w.W[5][2]*t21 + w.W[6][2]*t11 + w.W[7][2]*t13 + w.W[8][2]*t22 + w.W[9][2]*t16 + w.W[10][2]*t18 + w.W[11][2]*t23 - w.LS[2]*t25 - w.LS[7]*t27;
   const Scalar t29 = w.LSinv[2]*t28;
-  const Scalar t30 = w.W[3]*t1 + w.W[9]*t3 + w.W[15]*t20 + w.W[21]*t6 + w.W[27]*t8 + w.W[33]*t21 + w.W[39]*t11 + w.W[45]*t13 + w.W[51]*t22 + w.W[57]*t16 + w.W[63]*t18 + w.W[69]*t23 - w.LS[3]*t25 - w.LS[8]*t27 - w.LS[12]*t29;
+  const Scalar t30 = w.W[0][3]*t1 + w.W[1][3]*t3 + w.W[2][3]*t20 + w.W[3][3]*t6 + w.W[4][3]*t8 + w.W[5][3]*t21 + w.W[6][3]*t11 + w.W[7][3]*t13 + w.W[8][3]*t22 + w.W[9][3]*t16 + w.W[10][3]*t18 + w.W[11][3]*t23 - w.LS[3]*t25 - w.LS[8]*t27 - w.LS[12]*t29;
   const Scalar t31 = w.LSinv[3]*t30;
-  const Scalar t32 = w.W[4]*t1 + w.W[10]*t3 + w.W[16]*t20 + w.W[22]*t6 + w.W[28]*t8 + w.W[34]*t21 + w.W[40]*t11 + w.W[46]*t13 + w.W[52]*t22 + w.W[58]*t16 + w.W[64]*t18 + w.W[70]*t23 - w.LS[4]*t25 - w.LS[9]*t27 - w.LS[13]*t29 - w.LS[16]*t31;
+  const Scalar t32 = w.W[0][4]*t1 + w.W[1][4]*t3 + w.W[2][4]*t20 + w.W[3][4]*t6 + w.W[4][4]*t8 + w.W[5][4]*t21 + w.W[6][4]*t11 + w.W[7][4]*t13 + w.W[8][4]*t22 + w.W[9][4]*t16 + w.W[10][4]*t18 + w.W[11][4]*t23 - w.LS[4]*t25 - w.LS[9]*t27 - w.LS[13]*t29 - w.LS[16]*t31;
   const Scalar t33 = w.LSinv[4]*t32;
-  const Scalar t34 = w.W[5]*t1 + w.W[11]*t3 + w.W[17]*t20 + w.W[23]*t6 + w.W[29]*t8 + w.W[35]*t21 + w.W[41]*t11 + w.W[47]*t13 + w.W[53]*t22 + w.W[59]*t16 + w.W[65]*t18 + w.W[71]*t23 - w.LS[5]*t25 - w.LS[10]*t27 - w.LS[14]*t29 - w.LS[17]*t31 - w.LS[19]*t33;
+  const Scalar t34 = w.W[0][5]*t1 + w.W[1][5]*t3 + w.W[2][5]*t20 + w.W[3][5]*t6 + w.W[4][5]*t8 + w.W[5][5]*t21 + w.W[6][5]*t11 + w.W[7][5]*t13 + w.W[8][5]*t22 + w.W[9][5]*t16 + w.W[10][5]*t18 + w.W[11][5]*t23 - w.LS[5]*t25 - w.LS[10]*t27 - w.LS[14]*t29 - w.LS[17]*t31 - w.LS[19]*t33;
   const Scalar t35 = w.LSinv[5]*t34;
   const Scalar t36 = w.LSinv[5]*t35;
   const Scalar t37 = w.LSinv[4]*t32 - w.LS[19]*t36;
@@ -4715,18 +4693,18 @@ PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   const Scalar t44 = w.LSinv[1]*t43;
   const Scalar t45 = w.LSinv[0]*t24 - w.LS[1]*t44 - w.LS[2]*t42 - w.LS[3]*t40 - w.LS[4]*t38 - w.LS[5]*t36;
   const Scalar t46 = w.LSinv[0]*t45;
-  const Scalar z0 = w.Linv[0]*t0 - w.W[0]*t46 - w.W[1]*t44 - w.W[2]*t42 - w.W[3]*t40 - w.W[4]*t38 - w.W[5]*t36;
-  const Scalar z1 = w.Linv[1]*t2 - w.W[6]*t46 - w.W[7]*t44 - w.W[8]*t42 - w.W[9]*t40 - w.W[10]*t38 - w.W[11]*t36;
-  const Scalar z2 = w.Linv[2]*t4 - w.W[12]*t46 - w.W[13]*t44 - w.W[14]*t42 - w.W[15]*t40 - w.W[16]*t38 - w.W[17]*t36;
-  const Scalar z3 = w.Linv[3]*t5 - w.W[18]*t46 - w.W[19]*t44 - w.W[20]*t42 - w.W[21]*t40 - w.W[22]*t38 - w.W[23]*t36;
-  const Scalar z4 = w.Linv[4]*t7 - w.W[24]*t46 - w.W[25]*t44 - w.W[26]*t42 - w.W[27]*t40 - w.W[28]*t38 - w.W[29]*t36;
-  const Scalar z5 = w.Linv[5]*t9 - w.W[30]*t46 - w.W[31]*t44 - w.W[32]*t42 - w.W[33]*t40 - w.W[34]*t38 - w.W[35]*t36;
-  const Scalar z6 = w.Linv[6]*t10 - w.W[36]*t46 - w.W[37]*t44 - w.W[38]*t42 - w.W[39]*t40 - w.W[40]*t38 - w.W[41]*t36;
-  const Scalar z7 = w.Linv[7]*t12 - w.W[42]*t46 - w.W[43]*t44 - w.W[44]*t42 - w.W[45]*t40 - w.W[46]*t38 - w.W[47]*t36;
-  const Scalar z8 = w.Linv[8]*t14 - w.W[48]*t46 - w.W[49]*t44 - w.W[50]*t42 - w.W[51]*t40 - w.W[52]*t38 - w.W[53]*t36;
-  const Scalar z9 = w.Linv[9]*t15 - w.W[54]*t46 - w.W[55]*t44 - w.W[56]*t42 - w.W[57]*t40 - w.W[58]*t38 - w.W[59]*t36;
-  const Scalar z10 = w.Linv[10]*t17 - w.W[60]*t46 - w.W[61]*t44 - w.W[62]*t42 - w.W[63]*t40 - w.W[64]*t38 - w.W[65]*t36;
-  const Scalar z11 = w.Linv[11]*t19 - w.W[66]*t46 - w.W[67]*t44 - w.W[68]*t42 - w.W[69]*t40 - w.W[70]*t38 - w.W[71]*t36;
+  const Scalar z0 = w.Linv[0]*t0 - w.W[0][0]*t46 - w.W[0][1]*t44 - w.W[0][2]*t42 - w.W[0][3]*t40 - w.W[0][4]*t38 - w.W[0][5]*t36;
+  const Scalar z1 = w.Linv[1]*t2 - w.W[1][0]*t46 - w.W[1][1]*t44 - w.W[1][2]*t42 - w.W[1][3]*t40 - w.W[1][4]*t38 - w.W[1][5]*t36;
+  const Scalar z2 = w.Linv[2]*t4 - w.W[2][0]*t46 - w.W[2][1]*t44 - w.W[2][2]*t42 - w.W[2][3]*t40 - w.W[2][4]*t38 - w.W[2][5]*t36;
+  const Scalar z3 = w.Linv[3]*t5 - w.W[3][0]*t46 - w.W[3][1]*t44 - w.W[3][2]*t42 - w.W[3][3]*t40 - w.W[3][4]*t38 - w.W[3][5]*t36;
+  const Scalar z4 = w.Linv[4]*t7 - w.W[4][0]*t46 - w.W[4][1]*t44 - w.W[4][2]*t42 - w.W[4][3]*t40 - w.W[4][4]*t38 - w.W[4][5]*t36;
+  const Scalar z5 = w.Linv[5]*t9 - w.W[5][0]*t46 - w.W[5][1]*t44 - w.W[5][2]*t42 - w.W[5][3]*t40 - w.W[5][4]*t38 - w.W[5][5]*t36;
+  const Scalar z6 = w.Linv[6]*t10 - w.W[6][0]*t46 - w.W[6][1]*t44 - w.W[6][2]*t42 - w.W[6][3]*t40 - w.W[6][4]*t38 - w.W[6][5]*t36;
+  const Scalar z7 = w.Linv[7]*t12 - w.W[7][0]*t46 - w.W[7][1]*t44 - w.W[7][2]*t42 - w.W[7][3]*t40 - w.W[7][4]*t38 - w.W[7][5]*t36;
+  const Scalar z8 = w.Linv[8]*t14 - w.W[8][0]*t46 - w.W[8][1]*t44 - w.W[8][2]*t42 - w.W[8][3]*t40 - w.W[8][4]*t38 - w.W[8][5]*t36;
+  const Scalar z9 = w.Linv[9]*t15 - w.W[9][0]*t46 - w.W[9][1]*t44 - w.W[9][2]*t42 - w.W[9][3]*t40 - w.W[9][4]*t38 - w.W[9][5]*t36;
+  const Scalar z10 = w.Linv[10]*t17 - w.W[10][0]*t46 - w.W[10][1]*t44 - w.W[10][2]*t42 - w.W[10][3]*t40 - w.W[10][4]*t38 - w.W[10][5]*t36;
+  const Scalar z11 = w.Linv[11]*t19 - w.W[11][0]*t46 - w.W[11][1]*t44 - w.W[11][2]*t42 - w.W[11][3]*t40 - w.W[11][4]*t38 - w.W[11][5]*t36;
   const Scalar t47 = w.Linv[11]*z11;
   const Scalar t48 = z10 - w.L[76]*t47;
   const Scalar t49 = w.Linv[10]*t48;
@@ -4757,20 +4735,20 @@ PROXGEN_RT_NOINLINE void pv_24(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) 
   w.lambda[11] = w.Linv[11]*z11;
 }
 
-PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_trunk[0] - w.KA_trunk[0]*w.lambda[0] - w.KA_trunk[1]*w.lambda[1] - w.KA_trunk[2]*w.lambda[2] - w.KA_trunk[3]*w.lambda[6] - w.KA_trunk[4]*w.lambda[7] - w.KA_trunk[5]*w.lambda[8] - w.KA_trunk[6]*w.lambda[3] - w.KA_trunk[7]*w.lambda[4] - w.KA_trunk[8]*w.lambda[5] - w.KA_trunk[9]*w.lambda[9] - w.KA_trunk[10]*w.lambda[10] - w.KA_trunk[11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
+    const Scalar t0 = w.u_trunk[0] - w.KA_trunk[0][0]*w.lambda[0] - w.KA_trunk[0][1]*w.lambda[1] - w.KA_trunk[0][2]*w.lambda[2] - w.KA_trunk[0][3]*w.lambda[6] - w.KA_trunk[0][4]*w.lambda[7] - w.KA_trunk[0][5]*w.lambda[8] - w.KA_trunk[0][6]*w.lambda[3] - w.KA_trunk[0][7]*w.lambda[4] - w.KA_trunk[0][8]*w.lambda[5] - w.KA_trunk[0][9]*w.lambda[9] - w.KA_trunk[0][10]*w.lambda[10] - w.KA_trunk[0][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[0] - 9.81*w.RJ_trunk[7]*w.IA_trunk[1] - 9.81*w.RJ_trunk[8]*w.IA_trunk[2];
     const Scalar t1 = w.Linv_trunk[0]*t0;
-    const Scalar t2 = w.u_trunk[1] - w.KA_trunk[13]*w.lambda[0] - w.KA_trunk[14]*w.lambda[1] - w.KA_trunk[15]*w.lambda[2] - w.KA_trunk[16]*w.lambda[6] - w.KA_trunk[17]*w.lambda[7] - w.KA_trunk[18]*w.lambda[8] - w.KA_trunk[19]*w.lambda[3] - w.KA_trunk[20]*w.lambda[4] - w.KA_trunk[21]*w.lambda[5] - w.KA_trunk[22]*w.lambda[9] - w.KA_trunk[23]*w.lambda[10] - w.KA_trunk[24]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[1] - 9.81*w.RJ_trunk[7]*w.IA_trunk[6] - 9.81*w.RJ_trunk[8]*w.IA_trunk[7] - w.L_trunk[1]*t1;
+    const Scalar t2 = w.u_trunk[1] - w.KA_trunk[1][0]*w.lambda[0] - w.KA_trunk[1][1]*w.lambda[1] - w.KA_trunk[1][2]*w.lambda[2] - w.KA_trunk[1][3]*w.lambda[6] - w.KA_trunk[1][4]*w.lambda[7] - w.KA_trunk[1][5]*w.lambda[8] - w.KA_trunk[1][6]*w.lambda[3] - w.KA_trunk[1][7]*w.lambda[4] - w.KA_trunk[1][8]*w.lambda[5] - w.KA_trunk[1][9]*w.lambda[9] - w.KA_trunk[1][10]*w.lambda[10] - w.KA_trunk[1][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[1] - 9.81*w.RJ_trunk[7]*w.IA_trunk[6] - 9.81*w.RJ_trunk[8]*w.IA_trunk[7] - w.L_trunk[1]*t1;
     const Scalar t3 = w.Linv_trunk[1]*t2;
-    const Scalar t4 = w.u_trunk[2] - w.KA_trunk[26]*w.lambda[0] - w.KA_trunk[27]*w.lambda[1] - w.KA_trunk[28]*w.lambda[2] - w.KA_trunk[29]*w.lambda[6] - w.KA_trunk[30]*w.lambda[7] - w.KA_trunk[31]*w.lambda[8] - w.KA_trunk[32]*w.lambda[3] - w.KA_trunk[33]*w.lambda[4] - w.KA_trunk[34]*w.lambda[5] - w.KA_trunk[35]*w.lambda[9] - w.KA_trunk[36]*w.lambda[10] - w.KA_trunk[37]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[2] - 9.81*w.RJ_trunk[7]*w.IA_trunk[7] - 9.81*w.RJ_trunk[8]*w.IA_trunk[11] - w.L_trunk[2]*t1 - w.L_trunk[7]*t3;
+    const Scalar t4 = w.u_trunk[2] - w.KA_trunk[2][0]*w.lambda[0] - w.KA_trunk[2][1]*w.lambda[1] - w.KA_trunk[2][2]*w.lambda[2] - w.KA_trunk[2][3]*w.lambda[6] - w.KA_trunk[2][4]*w.lambda[7] - w.KA_trunk[2][5]*w.lambda[8] - w.KA_trunk[2][6]*w.lambda[3] - w.KA_trunk[2][7]*w.lambda[4] - w.KA_trunk[2][8]*w.lambda[5] - w.KA_trunk[2][9]*w.lambda[9] - w.KA_trunk[2][10]*w.lambda[10] - w.KA_trunk[2][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[2] - 9.81*w.RJ_trunk[7]*w.IA_trunk[7] - 9.81*w.RJ_trunk[8]*w.IA_trunk[11] - w.L_trunk[2]*t1 - w.L_trunk[7]*t3;
     const Scalar t5 = w.Linv_trunk[2]*t4;
-    const Scalar t6 = w.u_trunk[3] - w.KA_trunk[39]*w.lambda[0] - w.KA_trunk[40]*w.lambda[1] - w.KA_trunk[41]*w.lambda[2] - w.KA_trunk[42]*w.lambda[6] - w.KA_trunk[43]*w.lambda[7] - w.KA_trunk[44]*w.lambda[8] - w.KA_trunk[45]*w.lambda[3] - w.KA_trunk[46]*w.lambda[4] - w.KA_trunk[47]*w.lambda[5] - w.KA_trunk[48]*w.lambda[9] - w.KA_trunk[49]*w.lambda[10] - w.KA_trunk[50]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[3] - 9.81*w.RJ_trunk[7]*w.IA_trunk[8] - 9.81*w.RJ_trunk[8]*w.IA_trunk[12] - w.L_trunk[3]*t1 - w.L_trunk[8]*t3 - w.L_trunk[12]*t5;
+    const Scalar t6 = w.u_trunk[3] - w.KA_trunk[3][0]*w.lambda[0] - w.KA_trunk[3][1]*w.lambda[1] - w.KA_trunk[3][2]*w.lambda[2] - w.KA_trunk[3][3]*w.lambda[6] - w.KA_trunk[3][4]*w.lambda[7] - w.KA_trunk[3][5]*w.lambda[8] - w.KA_trunk[3][6]*w.lambda[3] - w.KA_trunk[3][7]*w.lambda[4] - w.KA_trunk[3][8]*w.lambda[5] - w.KA_trunk[3][9]*w.lambda[9] - w.KA_trunk[3][10]*w.lambda[10] - w.KA_trunk[3][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[3] - 9.81*w.RJ_trunk[7]*w.IA_trunk[8] - 9.81*w.RJ_trunk[8]*w.IA_trunk[12] - w.L_trunk[3]*t1 - w.L_trunk[8]*t3 - w.L_trunk[12]*t5;
     const Scalar t7 = w.Linv_trunk[3]*t6;
-    const Scalar t8 = w.u_trunk[4] - w.KA_trunk[52]*w.lambda[0] - w.KA_trunk[53]*w.lambda[1] - w.KA_trunk[54]*w.lambda[2] - w.KA_trunk[55]*w.lambda[6] - w.KA_trunk[56]*w.lambda[7] - w.KA_trunk[57]*w.lambda[8] - w.KA_trunk[58]*w.lambda[3] - w.KA_trunk[59]*w.lambda[4] - w.KA_trunk[60]*w.lambda[5] - w.KA_trunk[61]*w.lambda[9] - w.KA_trunk[62]*w.lambda[10] - w.KA_trunk[63]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[4] - 9.81*w.RJ_trunk[7]*w.IA_trunk[9] - 9.81*w.RJ_trunk[8]*w.IA_trunk[13] - w.L_trunk[4]*t1 - w.L_trunk[9]*t3 - w.L_trunk[13]*t5 - w.L_trunk[16]*t7;
+    const Scalar t8 = w.u_trunk[4] - w.KA_trunk[4][0]*w.lambda[0] - w.KA_trunk[4][1]*w.lambda[1] - w.KA_trunk[4][2]*w.lambda[2] - w.KA_trunk[4][3]*w.lambda[6] - w.KA_trunk[4][4]*w.lambda[7] - w.KA_trunk[4][5]*w.lambda[8] - w.KA_trunk[4][6]*w.lambda[3] - w.KA_trunk[4][7]*w.lambda[4] - w.KA_trunk[4][8]*w.lambda[5] - w.KA_trunk[4][9]*w.lambda[9] - w.KA_trunk[4][10]*w.lambda[10] - w.KA_trunk[4][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[4] - 9.81*w.RJ_trunk[7]*w.IA_trunk[9] - 9.81*w.RJ_trunk[8]*w.IA_trunk[13] - w.L_trunk[4]*t1 - w.L_trunk[9]*t3 - w.L_trunk[13]*t5 - w.L_trunk[16]*t7;
     const Scalar t9 = w.Linv_trunk[4]*t8;
-    const Scalar t10 = w.u_trunk[5] - w.KA_trunk[65]*w.lambda[0] - w.KA_trunk[66]*w.lambda[1] - w.KA_trunk[67]*w.lambda[2] - w.KA_trunk[68]*w.lambda[6] - w.KA_trunk[69]*w.lambda[7] - w.KA_trunk[70]*w.lambda[8] - w.KA_trunk[71]*w.lambda[3] - w.KA_trunk[72]*w.lambda[4] - w.KA_trunk[73]*w.lambda[5] - w.KA_trunk[74]*w.lambda[9] - w.KA_trunk[75]*w.lambda[10] - w.KA_trunk[76]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[5] - 9.81*w.RJ_trunk[7]*w.IA_trunk[10] - 9.81*w.RJ_trunk[8]*w.IA_trunk[14] - w.L_trunk[5]*t1 - w.L_trunk[10]*t3 - w.L_trunk[14]*t5 - w.L_trunk[17]*t7 - w.L_trunk[19]*t9;
+    const Scalar t10 = w.u_trunk[5] - w.KA_trunk[5][0]*w.lambda[0] - w.KA_trunk[5][1]*w.lambda[1] - w.KA_trunk[5][2]*w.lambda[2] - w.KA_trunk[5][3]*w.lambda[6] - w.KA_trunk[5][4]*w.lambda[7] - w.KA_trunk[5][5]*w.lambda[8] - w.KA_trunk[5][6]*w.lambda[3] - w.KA_trunk[5][7]*w.lambda[4] - w.KA_trunk[5][8]*w.lambda[5] - w.KA_trunk[5][9]*w.lambda[9] - w.KA_trunk[5][10]*w.lambda[10] - w.KA_trunk[5][11]*w.lambda[11] - 9.81*w.RJ_trunk[6]*w.IA_trunk[5] - 9.81*w.RJ_trunk[7]*w.IA_trunk[10] - 9.81*w.RJ_trunk[8]*w.IA_trunk[14] - w.L_trunk[5]*t1 - w.L_trunk[10]*t3 - w.L_trunk[14]*t5 - w.L_trunk[17]*t7 - w.L_trunk[19]*t9;
     const Scalar t11 = w.Linv_trunk[5]*t10;
     const Scalar t12 = w.Linv_trunk[5]*t11;
     const Scalar t13 = w.Linv_trunk[4]*t8 - w.L_trunk[19]*t12;
@@ -4817,7 +4795,7 @@ PROXGEN_RT_NOINLINE void pv_25(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
     const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
@@ -4826,7 +4804,7 @@ PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
     const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
     const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
-    const Scalar t6 = w.u_LF_thigh[0] - w.KA_LF_thigh[16]*w.lambda[0] - w.KA_LF_thigh[18]*w.lambda[2] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
+    const Scalar t6 = w.u_LF_thigh[0] - w.KA_LF_thigh[4][0]*w.lambda[0] - w.KA_LF_thigh[4][2]*w.lambda[2] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
     w.qdd[7] = w.Dinv_LF_thigh*t6;
     w.a_LF_thigh[0] = t2;
     w.a_LF_thigh[1] = w.a_LF_hip[1];
@@ -4844,7 +4822,7 @@ PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
     const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
     const Scalar t13 = w.u_LF_shank[0] + 0.195*w.lambda[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*t9;
-    w.qdd[8] = w.Dinv_LF_shank*t13;
+    w.qdd[8] = 2057.0036861506055*t13;
     w.a_LF_shank[0] = t9;
     w.a_LF_shank[1] = t8;
     w.a_LF_shank[2] = t10;
@@ -4874,7 +4852,7 @@ PROXGEN_RT_NOINLINE void pv_26(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
     const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
@@ -4883,7 +4861,7 @@ PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
     const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
     const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
-    const Scalar t6 = w.u_LH_thigh[0] - w.KA_LH_thigh[16]*w.lambda[6] - w.KA_LH_thigh[18]*w.lambda[8] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
+    const Scalar t6 = w.u_LH_thigh[0] - w.KA_LH_thigh[4][0]*w.lambda[6] - w.KA_LH_thigh[4][2]*w.lambda[8] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
     w.qdd[10] = w.Dinv_LH_thigh*t6;
     w.a_LH_thigh[0] = t2;
     w.a_LH_thigh[1] = w.a_LH_hip[1];
@@ -4901,7 +4879,7 @@ PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
     const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
     const Scalar t13 = w.u_LH_shank[0] + 0.195*w.lambda[6] - 0.000486144*w.a_LH_thigh[4] + 0.003904*t9;
-    w.qdd[11] = w.Dinv_LH_shank*t13;
+    w.qdd[11] = 2057.0036861506055*t13;
     w.a_LH_shank[0] = t9;
     w.a_LH_shank[1] = t8;
     w.a_LH_shank[2] = t10;
@@ -4931,7 +4909,7 @@ PROXGEN_RT_NOINLINE void pv_27(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
     const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
@@ -4940,7 +4918,7 @@ PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
     const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
     const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
-    const Scalar t6 = w.u_RF_thigh[0] - w.KA_RF_thigh[16]*w.lambda[3] - w.KA_RF_thigh[18]*w.lambda[5] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
+    const Scalar t6 = w.u_RF_thigh[0] - w.KA_RF_thigh[4][0]*w.lambda[3] - w.KA_RF_thigh[4][2]*w.lambda[5] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
     w.qdd[13] = w.Dinv_RF_thigh*t6;
     w.a_RF_thigh[0] = t2;
     w.a_RF_thigh[1] = w.a_RF_hip[1];
@@ -4958,7 +4936,7 @@ PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
     const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
     const Scalar t13 = w.u_RF_shank[0] + 0.195*w.lambda[3] - 0.000486144*w.a_RF_thigh[4] + 0.003904*t9;
-    w.qdd[14] = w.Dinv_RF_shank*t13;
+    w.qdd[14] = 2057.0036861506055*t13;
     w.a_RF_shank[0] = t9;
     w.a_RF_shank[1] = t8;
     w.a_RF_shank[2] = t10;
@@ -4988,7 +4966,7 @@ PROXGEN_RT_NOINLINE void pv_28(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
     const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
@@ -4997,7 +4975,7 @@ PROXGEN_RT_NOINLINE void pv_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
     const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
     const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
-    const Scalar t6 = w.u_RH_thigh[0] - w.KA_RH_thigh[16]*w.lambda[9] - w.KA_RH_thigh[18]*w.lambda[11] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
+    const Scalar t6 = w.u_RH_thigh[0] - w.KA_RH_thigh[4][0]*w.lambda[9] - w.KA_RH_thigh[4][2]*w.lambda[11] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
     w.qdd[16] = w.Dinv_RH_thigh*t6;
     w.a_RH_thigh[0] = t2;
     w.a_RH_thigh[1] = w.a_RH_hip[1];
@@ -5015,7 +4993,7 @@ PROXGEN_RT_NOINLINE void pv_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
     const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
     const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
     const Scalar t13 = w.u_RH_shank[0] + 0.195*w.lambda[9] - 0.000486144*w.a_RH_thigh[4] + 0.003904*t9;
-    w.qdd[17] = w.Dinv_RH_shank*t13;
+    w.qdd[17] = 2057.0036861506055*t13;
     w.a_RH_shank[0] = t9;
     w.a_RH_shank[1] = t8;
     w.a_RH_shank[2] = t10;
@@ -5028,25 +5006,13 @@ PROXGEN_RT_NOINLINE void pv_29(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  kinematics_0(q, v, w);
-  kinematics_1(q, v, w);
-  kinematics_2(q, v, w);
-  kinematics_3(q, v, w);
-  kinematics_4(q, v, w);
-  kinematics_5(q, v, w);
-  kinematics_6(q, v, w);
-}
-
-// Articulated-body elimination of the bodies off the constraint support
-// (no constraint below them): the same in both algorithms.
-void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
-  static_cast<void>(tau);
-  static_cast<void>(w);
-}
-
-// Accelerations of the bodies off the support, once their ancestors are final.
-void accelerate_free_bodies(Workspace& w) noexcept {
-  static_cast<void>(w);
+  kinematics_trunk_to_LF_hip(q, v, w);
+  kinematics_LF_thigh_to_LF_shank(q, v, w);
+  kinematics_LH_hip_to_LH_thigh(q, v, w);
+  kinematics_LH_shank_to_RF_hip(q, v, w);
+  kinematics_RF_thigh_to_RF_shank(q, v, w);
+  kinematics_RH_hip_to_RH_thigh(q, v, w);
+  kinematics_RH_shank(q, v, w);
 }
 
 }  // namespace
@@ -5057,39 +5023,45 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
-  eliminate_free_bodies(tau, w);
-  caba_0(tau, mu, w);
-  caba_1(tau, w);
-  caba_2(tau, w);
-  caba_3(tau, mu, w);
-  caba_4(tau, w);
-  caba_5(tau, w);
-  caba_6(tau, mu, w);
-  caba_7(tau, w);
-  caba_8(tau, w);
-  caba_9(tau, mu, w);
-  caba_10(tau, w);
-  caba_11(tau, w);
-  caba_12(tau, w);
-  caba_13(w);
-  caba_14(w);
-  caba_15(w);
-  caba_16(w);
-  caba_17(mu, w);
+  // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
+  caba_backward_RH_shank(tau, mu, w);
+  caba_backward_RH_thigh(tau, w);
+  caba_backward_RH_hip(tau, w);
+  caba_backward_RF_shank(tau, mu, w);
+  caba_backward_RF_thigh(tau, w);
+  caba_backward_RF_hip(tau, w);
+  caba_backward_LH_shank(tau, mu, w);
+  caba_backward_LH_thigh(tau, w);
+  caba_backward_LH_hip(tau, w);
+  caba_backward_LF_shank(tau, mu, w);
+  caba_backward_LF_thigh(tau, w);
+  caba_backward_LF_hip(tau, w);
+  caba_backward_trunk(tau, w);
+  // ---- forward: accelerations of the support
+  caba_forward_trunk_to_LF_hip(w);
+  caba_forward_LF_thigh_to_LH_hip(w);
+  caba_forward_LH_thigh_to_RF_hip(w);
+  caba_forward_RF_thigh_to_RH_hip(w);
+  caba_forward_RH_thigh_to_RH_shank(w);
+  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
-    caba_18(w);
-    caba_19(w);
-    caba_20(w);
-    caba_21(w);
-    caba_22(w);
-    caba_23(w);
-    caba_24(w);
-    caba_25(w);
-    caba_26(w);
-    caba_27(mu, w);
+    // ---- reduced sweep: u -= S^T dp, dp passes to the parent
+    caba_reduced_RH_shank_to_RH_hip(w);
+    caba_reduced_RF_shank_to_RF_hip(w);
+    caba_reduced_LH_shank_to_LH_hip(w);
+    caba_reduced_LF_shank_to_LF_hip(w);
+    caba_reduced_trunk(w);
+    // ---- forward: accelerations of the support
+    caba_reforward_trunk_to_LF_hip(w);
+    caba_reforward_LF_thigh_to_LH_hip(w);
+    caba_reforward_LH_thigh_to_RF_hip(w);
+    caba_reforward_RF_thigh_to_RH_hip(w);
+    caba_reforward_RH_thigh_to_RH_shank(w);
+    // ---- multipliers: dlambda = mu (K a - k), lambda += dlambda
+    caba_update(mu, w);
   }
-  accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];
@@ -5127,42 +5099,46 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
   kinematics(q, v, w);
-  eliminate_free_bodies(tau, w);
-  pv_0(tau, w);
-  pv_1(tau, w);
-  pv_2(tau, w);
-  pv_3(tau, w);
-  pv_4(tau, w);
-  pv_5(tau, w);
-  pv_6(tau, w);
-  pv_7(tau, w);
-  pv_8(tau, w);
-  pv_9(tau, w);
-  pv_10(tau, w);
-  pv_11(tau, w);
-  pv_12(tau, w);
-  pv_13(w);
-  pv_14(w);
-  pv_15(w);
-  pv_16(w);
-  pv_17(w);
+  // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
+  pv_backward_RH_shank(tau, w);
+  pv_backward_RH_thigh(tau, w);
+  pv_backward_RH_hip(tau, w);
+  pv_backward_RF_shank(tau, w);
+  pv_backward_RF_thigh(tau, w);
+  pv_backward_RF_hip(tau, w);
+  pv_backward_LH_shank(tau, w);
+  pv_backward_LH_thigh(tau, w);
+  pv_backward_LH_hip(tau, w);
+  pv_backward_LF_shank(tau, w);
+  pv_backward_LF_thigh(tau, w);
+  pv_backward_LF_hip(tau, w);
+  pv_backward_trunk(tau, w);
+  // ---- free accelerations (lambda = 0) and the rows' y_free = K a - k
+  pv_free_trunk_to_LF_hip(w);
+  pv_free_LF_thigh_to_LH_hip(w);
+  pv_free_LH_thigh_to_RF_hip(w);
+  pv_free_RF_thigh_to_RH_hip(w);
+  pv_free_RH_thigh_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
-  pv_18(inv_mu, w);
-  pv_19(inv_mu, w);
-  pv_20(w);
-  pv_21(w);
-  pv_22(w);
-  pv_23(w);
+  // ---- G + I/mu = L L^T, G assembled from the carried rows
+  pv_delassus_column_0_to_column_6(inv_mu, w);
+  pv_delassus_column_7_to_W_0(inv_mu, w);
+  pv_delassus_W_1_to_W_2(w);
+  pv_delassus_W_3_to_W_4(w);
+  pv_delassus_W_5_to_LS(w);
+  // ---- lambda = 0
+  pv_start(w);
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
-    pv_24(inv_mu, w);
+    // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
+    pv_proximal(inv_mu, w);
   }
-  pv_25(w);
-  pv_26(w);
-  pv_27(w);
-  pv_28(w);
-  pv_29(w);
-  accelerate_free_bodies(w);
+  // ---- forward: accelerations, with the multipliers of the subtree rows
+  pv_forward_trunk_to_LF_hip(w);
+  pv_forward_LF_thigh_to_LH_hip(w);
+  pv_forward_LH_thigh_to_RF_hip(w);
+  pv_forward_RF_thigh_to_RH_hip(w);
+  pv_forward_RH_thigh_to_RH_shank(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];

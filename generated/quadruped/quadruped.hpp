@@ -42,7 +42,7 @@ struct Settings {
   int iterations = 3;  // multiplier updates K (0: the unconstrained motion)
 };
 
-// Everything one solve writes (11256 bytes): per-body quantities named
+// Everything one solve writes (11160 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_trunk[9];          // joint rotation (row-major), body 1
@@ -197,36 +197,32 @@ struct Workspace {
   Scalar dp_LH_hip[6];         // reduced-sweep force, body 5
   Scalar dp_LF_thigh[6];       // reduced-sweep force, body 3
   Scalar dp_LF_hip[6];         // reduced-sweep force, body 2
-  Scalar KSD_RH_shank[3];      // D^-1 S^T KA, body 13
-  Scalar KA_RH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 12
+  Scalar KA_RH_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 12
   Scalar KSD_RH_thigh[3];      // D^-1 S^T KA, body 12
-  Scalar KA_RH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 11
+  Scalar KA_RH_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 11
   Scalar KS_RH_hip[3];         // S^T KA, body 11
   Scalar KSD_RH_hip[3];        // D^-1 S^T KA, body 11
-  Scalar KA_trunk[78];         // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 1
-  Scalar KSD_RF_shank[3];      // D^-1 S^T KA, body 10
-  Scalar KA_RF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 9
+  Scalar KA_trunk[6][13];      // constraint force directions of the subtree rows (6 x m, one unused column), body 1
+  Scalar KA_RF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 9
   Scalar KSD_RF_thigh[3];      // D^-1 S^T KA, body 9
-  Scalar KA_RF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 8
+  Scalar KA_RF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 8
   Scalar KS_RF_hip[3];         // S^T KA, body 8
   Scalar KSD_RF_hip[3];        // D^-1 S^T KA, body 8
-  Scalar KSD_LH_shank[3];      // D^-1 S^T KA, body 7
-  Scalar KA_LH_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 6
+  Scalar KA_LH_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 6
   Scalar KSD_LH_thigh[3];      // D^-1 S^T KA, body 6
-  Scalar KA_LH_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 5
+  Scalar KA_LH_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 5
   Scalar KS_LH_hip[3];         // S^T KA, body 5
   Scalar KSD_LH_hip[3];        // D^-1 S^T KA, body 5
-  Scalar KSD_LF_shank[3];      // D^-1 S^T KA, body 4
-  Scalar KA_LF_thigh[24];      // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 3
+  Scalar KA_LF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 3
   Scalar KSD_LF_thigh[3];      // D^-1 S^T KA, body 3
-  Scalar KA_LF_hip[24];        // constraint force directions of the subtree rows (row-major: row r, column j at r (m + 1) + j), body 2
+  Scalar KA_LF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 2
   Scalar KS_LF_hip[3];         // S^T KA, body 2
   Scalar KSD_LF_hip[3];        // D^-1 S^T KA, body 2
-  Scalar Z_trunk[78];          // L^-1 KA (row-major), body 1
+  Scalar Z_trunk[6][13];       // L^-1 KA (6 x m, one unused column), body 1
   Scalar yfree[12];            // free row accelerations (tree order)
   Scalar Linv[12];             // 1 / diag(L)
   Scalar L[78];                // Cholesky factor of G + I/mu (lower, packed)
-  Scalar W[72];                // L^-1 Z^T (row-major)
+  Scalar W[12][6];             // L^-1 Z^T
   Scalar LSinv[6];             // 1 / diag(LS)
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };

@@ -1,7 +1,5 @@
 #include "algorithms/data.hpp"
 
-#include <set>
-
 namespace proxgen {
 
 Data::Data(const System& sys) {
@@ -37,34 +35,14 @@ Data::Data(const System& sys) {
     terms[k].K = MatN6::Zero(r, 6);
     terms[k].k = VecN::Zero(r);
   }
-  support = sys.supportBodies();
-  onSupport.assign(N, 0);
-  for (int i : support) onSupport[i] = 1;
+  // The tree facts the generated solvers' plan reads too (model/tree.cpp).
+  const ConstraintTree tree = constraintTree(sys);
+  support = tree.support;
+  onSupport = tree.onSupport;
   lambda = VecX::Zero(sys.nc);
   dlambda = VecX::Zero(sys.nc);
-
-  // Rows of each subtree: the body's own rows (layout order), then its
-  // children's subtrees in child order. Built leaves first.
-  subtreeRows.assign(N, {});
-  for (int i = N - 1; i >= 0; --i) {
-    std::vector<int> rows;
-    for (const Constraint& c : sys.constraints)
-      if (c.body == i)
-        for (int r = 0; r < c.rows(); ++r) rows.push_back(c.row + r);
-    for (int ch : m.bodies[i].children) rows.insert(rows.end(), subtreeRows[ch].begin(), subtreeRows[ch].end());
-    subtreeRows[i] = std::move(rows);
-  }
-  // Where each subtree's rows start in the root's (tree) order: after the
-  // parent's start, its own rows and its earlier children's subtrees.
-  subtreeStart.assign(N, 0);
-  for (int p = 0; p < N; ++p) {
-    int next = subtreeStart[p] + int(subtreeRows[p].size());
-    for (int ch : m.bodies[p].children) next -= int(subtreeRows[ch].size());
-    for (int ch : m.bodies[p].children) {
-      subtreeStart[ch] = next;
-      next += int(subtreeRows[ch].size());
-    }
-  }
+  subtreeRows = tree.subtreeRows;
+  subtreeStart = tree.subtreeStart;
   KA.resize(N);
   KS.resize(N);
   DinvKS.resize(N);

@@ -1,5 +1,6 @@
 // Plan -> text: the two files of a generated solver (templates/solver.*.tpl
-// filled with fmt). Every body gets its own block in tree order, headed by a
+// filled with fmt), printed by the passes (passes.hpp, one file per
+// recursion; docs/emitter.md). Every body gets its own block, headed by a
 // comment naming its link and joint; the arithmetic is printed through the
 // expression printer (expr.hpp), so the constants of the tree (transforms,
 // inertias, axes, constraint placements) are literals with their exact zeros

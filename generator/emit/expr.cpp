@@ -270,16 +270,18 @@ Expr CodeBuilder::store(const std::string& member, const Expr& e) {
   collectUses(e, s.uses);
   s.multiplies = countMultiplies(e);
   s.always = true;
+  s.names = {member};
   addStmt(std::move(s));
   return refresh(member);
 }
 
 Expr CodeBuilder::storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses) {
-  line(fmt::format("{} = {};", member, rhs), uses);
+  line(fmt::format("{} = {};", member, rhs), uses, {member});
   return refresh(member);
 }
 
-Expr CodeBuilder::define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses) {
+Expr CodeBuilder::define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses,
+                         const std::vector<std::string>& names) {
   Atom a;
   a.text = name;
   a.block = stack_.back();
@@ -288,6 +290,7 @@ Expr CodeBuilder::define(const std::string& name, const std::string& rhs, const 
   Stmt s;
   s.text = fmt::format("const Scalar {} = {};", name, rhs);
   s.defines = id;
+  s.names = names;
   for (const Expr& e : uses) {
     check(e);
     collectUses(e, s.uses);
@@ -353,16 +356,17 @@ Expr CodeBuilder::refresh(const std::string& member) {
 
 std::vector<Expr> CodeBuilder::storeByCall(const std::string& text, const std::vector<std::string>& members,
                                            const std::vector<Expr>& uses) {
-  line(text, uses);
+  line(text, uses, members);
   std::vector<Expr> out;
   for (const std::string& m : members) out.push_back(refresh(m));
   return out;
 }
 
-void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses) {
+void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses, const std::vector<std::string>& names) {
   Stmt s;
   s.text = text;
   s.always = true;
+  s.names = names;
   for (const Expr& e : uses) {
     check(e);
     collectUses(e, s.uses);
@@ -373,9 +377,11 @@ void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses) {
 void CodeBuilder::comment(const std::string& text) { line("// " + text); }
 void CodeBuilder::blank() { line(""); }
 
-void CodeBuilder::open(const std::string& head, const std::vector<std::string>& comments) {
+void CodeBuilder::open(const std::string& head, const std::vector<std::string>& comments,
+                       const std::vector<std::string>& names) {
   Block b;
   b.head = head;
+  b.names = names;
   b.comments = comments;
   blocks_.push_back(std::move(b));
   const int id = int(blocks_.size()) - 1;
@@ -440,6 +446,21 @@ std::string CodeBuilder::render(int indent) const {
   markLive(0, live);
   std::string out;
   renderBlock(0, indent, live, out);
+  return out;
+}
+
+std::set<std::string> CodeBuilder::accessedNames() const {
+  std::vector<char> live(stmts_.size(), 0);
+  markLive(0, live);
+  std::set<std::string> out;
+  for (std::size_t k = 0; k < stmts_.size(); ++k) {
+    if (!live[k]) continue;
+    for (int a : stmts_[k].uses)
+      if (atoms_[std::size_t(a)].name >= 0) out.insert(atoms_[std::size_t(a)].text);
+    out.insert(stmts_[k].names.begin(), stmts_[k].names.end());
+  }
+  for (std::size_t b = 1; b < blocks_.size(); ++b)
+    if (blockLive(int(b), live)) out.insert(blocks_[b].names.begin(), blocks_[b].names.end());
   return out;
 }
 

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -92,8 +93,10 @@ class CodeBuilder {
   /// fn(arg) for a one-argument <cmath> function, as a temporary.
   Expr call(const std::string& fn, const Expr& arg, const std::string& hint);
 
-  /// A named temporary with a raw right-hand side (printed only when used).
-  Expr define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses);
+  /// A named temporary with a raw right-hand side (printed only when used);
+  /// `names`: the parameters the right-hand side reads.
+  Expr define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses,
+              const std::vector<std::string>& names = {});
   /// True for +-(an input or a member): a value worth no statement of its own.
   bool isAlias(const Expr& e) const;
   /// The same expression in this builder, from another one's members and inputs
@@ -113,13 +116,14 @@ class CodeBuilder {
   /// arguments); returns their new values, in order.
   std::vector<Expr> storeByCall(const std::string& text, const std::vector<std::string>& members,
                                 const std::vector<Expr>& uses);
-  /// A raw statement or comment line with the atoms it reads.
-  void line(const std::string& text, const std::vector<Expr>& uses = {});
+  /// A raw statement or comment line with the atoms it reads and the names
+  /// (function parameters) its text reads or writes besides them.
+  void line(const std::string& text, const std::vector<Expr>& uses = {}, const std::vector<std::string>& names = {});
   void comment(const std::string& text);
   void blank();
   /// Opens a nested block: `head` is printed before the braces' contents
   /// ("{" or "for (...) {"), with comment lines above it.
-  void open(const std::string& head, const std::vector<std::string>& comments = {});
+  void open(const std::string& head, const std::vector<std::string>& comments = {}, const std::vector<std::string>& names = {});
   void close();
   int depth() const { return int(stack_.size()) - 1; }
   int statementCount() const { return int(stmts_.size()); }
@@ -129,6 +133,9 @@ class CodeBuilder {
   std::string describe(const Expr& e) const;
   /// The function body, indented by `indent` spaces, without the unused temporaries.
   std::string render(int indent) const;
+  /// Every input, member and parameter the printed statements read or write
+  /// (the texts: "q[3]", "w.v_x[2]", "mu", "s", ...): what a function's parameter list needs.
+  std::set<std::string> accessedNames() const;
 
   /// Number of multiplications in the live statements (for the docs' statistics).
   struct Stats {
@@ -153,6 +160,7 @@ class CodeBuilder {
     std::vector<int> uses;  // simple atoms read
     int multiplies = 0;
     bool always = false;    // stores, comments, raw lines
+    std::vector<std::string> names;  // members written, parameters a raw text reads or writes
   };
   struct Node {
     bool isBlock = false;
@@ -160,6 +168,7 @@ class CodeBuilder {
   };
   struct Block {
     std::string head;
+    std::vector<std::string> names;  // parameters the head reads
     std::vector<std::string> comments;
     std::vector<Node> nodes;
     std::map<std::string, int> memo;  // canonical expression -> temporary atom

@@ -1,7 +1,5 @@
 #include "emit/plan.hpp"
 
-#include <set>
-
 #include "emit/identifiers.hpp"
 
 namespace proxgen::emit {
@@ -107,29 +105,22 @@ Plan makePlan(const System& sys, const std::string& name, ScalarType scalar) {
       for (int i : m.pathToRoot(c.body)) plan.bodies[std::size_t(i)].needsPlacement = true;
   }
 
-  plan.support = sys.supportBodies();
-  const std::set<int> support(plan.support.begin(), plan.support.end());
+  const ConstraintTree tree = constraintTree(sys);
+  plan.support = tree.support;
   for (int i = 1; i < N; ++i) {
-    plan.bodies[std::size_t(i)].onSupport = support.count(i) > 0;
-    plan.bodies[std::size_t(i)].needsGravity = support.count(i) > 0;
-    if (!support.count(i)) plan.offSupport.push_back(i);
-  }
-
-  // Subtree rows, leaves first: own rows (layout order), then each child's.
-  for (int i = N - 1; i >= 0; --i) {
     BodyPlan& b = plan.bodies[std::size_t(i)];
-    for (int k : b.constraints)
-      for (int r = 0; r < plan.constraints[std::size_t(k)].rows; ++r)
-        b.subtreeRows.push_back(plan.constraints[std::size_t(k)].row + r);
-    int offset = int(b.subtreeRows.size());
-    for (int ch : b.children) {
-      BodyPlan& c = plan.bodies[std::size_t(ch)];
-      c.offsetInParent = offset;
-      offset += c.m();
-      b.subtreeRows.insert(b.subtreeRows.end(), c.subtreeRows.begin(), c.subtreeRows.end());
-    }
+    b.onSupport = tree.onSupport[std::size_t(i)] != 0;
+    b.needsGravity = b.onSupport;
+    if (!b.onSupport) plan.offSupport.push_back(i);
+  }
+  for (int i = 0; i < N; ++i) {
+    BodyPlan& b = plan.bodies[std::size_t(i)];
+    b.subtreeRows = tree.subtreeRows[std::size_t(i)];
+    b.offsetInParent = tree.offsetInParent[std::size_t(i)];
+    b.rowStart = tree.subtreeStart[std::size_t(i)];
   }
   plan.rootRows = plan.bodies[0].subtreeRows;
+  plan.rowPosition = tree.treePosition;
   return plan;
 }
 

@@ -1,9 +1,10 @@
-// What generation decides, as plain data (GENERATOR.md "Plan"): per body its
+// What generation decides, as plain data (docs/design.md, "Plan"): per body its
 // joint class, its identifier, whether it is on the constraint support, the
 // constraint rows of its subtree and where they sit in its parent's; the
 // support and off-support bodies; the Delassus rows in tree order. The emitter
-// prints from this and the System; tests compare it with the generic solvers'
-// run-time view (System::supportBodies, Data::subtreeRows).
+// prints from this and the System. The tree facts (support, subtree rows,
+// tree-order positions) are the model's ConstraintTree, computed once
+// (model/tree.cpp) and read by the generic solvers' Data too.
 #pragma once
 
 #include <string>
@@ -38,6 +39,9 @@ struct BodyPlan {
   std::vector<int> subtreeRows;
   /// First column of this subtree's rows in the parent's KA / LA / lA.
   int offsetInParent = 0;
+  /// Position of the subtree's first row in the root's (tree) order: its rows
+  /// are the block [rowStart, rowStart + m()) of rootRows.
+  int rowStart = 0;
   /// Zero patterns known at generation time (for the docs and the tests).
   int treeRotationNonzeros = 0;     // of 9
   int treeTranslationNonzeros = 0;  // of 3
@@ -66,6 +70,7 @@ struct Plan {
   std::vector<int> support;          // ascending (tree order)
   std::vector<int> offSupport;       // the other moving bodies, ascending
   std::vector<int> rootRows;         // Delassus rows in tree order (= bodies[0].subtreeRows)
+  std::vector<int> rowPosition;      // per layout row: its position in rootRows
   std::vector<ConstraintPlan> constraints;  // layout order
 };
 

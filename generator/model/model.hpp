@@ -116,6 +116,18 @@ struct System {
   std::vector<int> supportBodies() const;
 };
 
+/// The constraint tree of a System, computed once (model/tree.cpp) for the
+/// generic solvers (algorithms/data.cpp) and the generated ones (emit/plan.cpp).
+struct ConstraintTree {
+  std::vector<int> support;                   // = System::supportBodies()
+  std::vector<char> onSupport;                // per body
+  std::vector<std::vector<int>> subtreeRows;  // per body: its own rows (layout order), then each child's subtree's
+  std::vector<int> subtreeStart;              // per body: position of its first row in subtreeRows[0] (tree order)
+  std::vector<int> offsetInParent;            // per body: position of its first row in its parent's subtreeRows
+  std::vector<int> treePosition;              // per layout row: its position in subtreeRows[0]
+};
+ConstraintTree constraintTree(const System& sys);
+
 /// Binds a layout's constraints to a model: resolves links to bodies and frames,
 /// assigns rows. Throws proxgen::Error naming the layout file and the constraint.
 System bindLayout(Model model, const Layout& layout);

@@ -1,8 +1,12 @@
-// The plan (emit/plan.hpp) is what generation decides: it must agree with what
-// the generic solvers compute at run time (System::supportBodies, the rows of
-// each subtree in Data), on the shared cases and the repository's robots.
+// The plan (emit/plan.hpp) is what generation decides. Its tree facts come
+// from one place (model/tree.cpp, ConstraintTree), which the generic solvers
+// read too, so comparing the plan with Data would compare a value with
+// itself: each fact is checked against a derivation of its own here, from the
+// parent links and the constraints alone, on the shared cases and the
+// repository's robots.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "algorithms/data.hpp"
@@ -24,33 +28,89 @@ std::vector<std::pair<std::string, System>> systems() {
   return out;
 }
 
-TEST(Plan, AgreesWithTheGenericSolversRunTimeView) {
+// Body b is in the subtree of body i (b == i or i is an ancestor of b).
+bool inSubtree(const Model& m, int b, int i) {
+  for (; b >= 0; b = m.bodies[std::size_t(b)].parent)
+    if (b == i) return true;
+  return false;
+}
+
+TEST(Plan, TreeFactsAgreeWithAnIndependentDerivation) {
   for (const auto& [name, sys] : systems()) {
     SCOPED_TRACE(name);
+    const Model& m = sys.model;
+    const int N = m.numBodies();
     const Plan plan = makePlan(sys, name, ScalarType::Double);
-    const Data d(sys);
-    EXPECT_EQ(plan.support, sys.supportBodies());
-    EXPECT_EQ(plan.nq, sys.model.nq);
-    EXPECT_EQ(plan.nv, sys.model.nv);
-    EXPECT_EQ(plan.nc, sys.nc);
-    ASSERT_EQ(int(plan.bodies.size()), sys.model.numBodies());
+    ASSERT_EQ(int(plan.bodies.size()), N);
+    // Sizes: sums over the joints and the constraints (not the copies makePlan reads).
+    int nq = 0, nv = 0, nc = 0;
+    for (int i = 1; i < N; ++i) nq += m.bodies[std::size_t(i)].joint.nq, nv += m.bodies[std::size_t(i)].joint.nv;
+    for (const Constraint& c : sys.constraints) nc += c.rows();
+    EXPECT_EQ(plan.nq, nq);
+    EXPECT_EQ(plan.nv, nv);
+    EXPECT_EQ(plan.nc, nc);
+    // The support: the moving bodies with a constrained body in their subtree.
+    std::vector<int> support;
+    for (int i = 1; i < N; ++i) {
+      bool constrained = false;
+      for (const Constraint& c : sys.constraints) constrained |= inSubtree(m, c.body, i);
+      if (constrained) support.push_back(i);
+    }
+    EXPECT_EQ(plan.support, support);
     std::set<int> all(plan.support.begin(), plan.support.end());
     for (int i : plan.offSupport) EXPECT_TRUE(all.insert(i).second) << "body " << i << " on and off the support";
-    EXPECT_EQ(int(all.size()), sys.model.numBodies() - 1);
-    for (int i = 0; i < sys.model.numBodies(); ++i) {
+    EXPECT_EQ(int(all.size()), N - 1);
+    // Bodies are numbered depth first, children in order: a subtree is a
+    // contiguous index range, so its rows in tree order are the rows of the
+    // constraints in that range sorted by (body, row).
+    for (int i = 0; i < N; ++i) {
+      const auto& ch = m.bodies[std::size_t(i)].children;
+      for (std::size_t k = 1; k < ch.size(); ++k) ASSERT_LT(ch[k - 1], ch[k]) << "body " << i << ": children out of order";
+    }
+    auto rowsOf = [&](int i) {
+      std::vector<std::pair<int, int>> keyed;
+      for (const Constraint& c : sys.constraints)
+        if (inSubtree(m, c.body, i))
+          for (int r = 0; r < c.rows(); ++r) keyed.push_back({c.body, c.row + r});
+      std::sort(keyed.begin(), keyed.end());
+      std::vector<int> rows;
+      for (const auto& kr : keyed) rows.push_back(kr.second);
+      return rows;
+    };
+    const std::vector<int> root = rowsOf(0);
+    EXPECT_EQ(plan.rootRows, root);
+    ASSERT_EQ(int(plan.rowPosition.size()), nc);
+    for (int t = 0; t < int(root.size()); ++t) EXPECT_EQ(plan.rowPosition[std::size_t(root[std::size_t(t)])], t);
+    for (int i = 0; i < N; ++i) {
       const BodyPlan& b = plan.bodies[std::size_t(i)];
-      EXPECT_EQ(b.subtreeRows, d.subtreeRows[std::size_t(i)]) << "body " << i;
+      const std::vector<int> rows = rowsOf(i);
+      EXPECT_EQ(b.subtreeRows, rows) << "body " << i;
       EXPECT_EQ(b.m() > 0, i == 0 || b.onSupport) << "body " << i << ": rows exactly on the support";
+      // Its rows are the block of the root's order that starts at rowStart.
+      for (int r = 0; r < b.m(); ++r)
+        EXPECT_EQ(root[std::size_t(b.rowStart + r)], rows[std::size_t(r)]) << "body " << i << ", row " << r;
       if (i == 0) continue;
       // A child's rows sit at its offset in its parent's rows.
       const BodyPlan& p = plan.bodies[std::size_t(b.parent)];
       for (int r = 0; r < b.m(); ++r)
         EXPECT_EQ(p.subtreeRows[std::size_t(b.offsetInParent + r)], b.subtreeRows[std::size_t(r)]) << "body " << i;
     }
-    EXPECT_EQ(plan.rootRows, d.subtreeRows[0]);
-    EXPECT_EQ(int(plan.rootRows.size()), sys.nc);
-    std::set<int> rows(plan.rootRows.begin(), plan.rootRows.end());
-    EXPECT_EQ(int(rows.size()), sys.nc) << "every row once";
+    std::set<int> distinct(plan.rootRows.begin(), plan.rootRows.end());
+    EXPECT_EQ(int(distinct.size()), nc) << "every row once";
+  }
+}
+
+// The generic solvers' Data reads the same tree facts as the plan.
+TEST(Plan, DataReadsTheSameTreeFacts) {
+  for (const auto& [name, sys] : systems()) {
+    SCOPED_TRACE(name);
+    const Plan plan = makePlan(sys, name, ScalarType::Double);
+    const Data d(sys);
+    EXPECT_EQ(d.support, plan.support);
+    for (int i = 0; i < sys.model.numBodies(); ++i) {
+      EXPECT_EQ(d.subtreeRows[std::size_t(i)], plan.bodies[std::size_t(i)].subtreeRows) << "body " << i;
+      EXPECT_EQ(d.subtreeStart[std::size_t(i)], plan.bodies[std::size_t(i)].rowStart) << "body " << i;
+    }
   }
 }
 
@@ -96,8 +156,10 @@ TEST(Plan, JointClassesAndZeroPatterns) {
 TEST(Plan, NegativeAxesAreSignedPicks) {
   PROXGEN_REQUIRE_MODELS();
   // atlas_shadow.urdf has axes "0 -1.0 0" and "-0.0 -1.0 -0.0": about -y.
+  bool found = false;
   for (const Case& c : test::sharedCases()) {
     if (c.name != "atlas_shadow_f6x2") continue;
+    found = true;
     const System sys = loadCaseSystem(c);
     const Plan plan = makePlan(sys, c.name, ScalarType::Double);
     int negative = 0;
@@ -110,6 +172,7 @@ TEST(Plan, NegativeAxesAreSignedPicks) {
     }
     EXPECT_GT(negative, 0);
   }
+  EXPECT_TRUE(found) << "atlas_shadow_f6x2 is not in cases.yaml";
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 //   allow-listed) and proxPV's loops over a run of constraint columns (a
 //   literal trip count, `for (int j = 0; j < 30; ++j) {`): no loop over
 //   bodies, no branch on joint type;
+// - it has no empty function (a body of nothing but static_cast<void>
+//   of unused parameters): a pass that folds away prints no function;
 // - its object references no heap (malloc, operator new, ...) and no exception
 //   machinery (__cxa_throw, the personality routine, the unwinder).
 #include <gtest/gtest.h>
@@ -108,6 +110,45 @@ TEST(GeneratedStructure, OnlyTheIterationLoopsLoopOrBranch) {
 }
 
 // Symbols of a static library, one name per line (nm -C: demangled).
+// The heads of the functions of `code` whose bodies hold no statement but
+// `static_cast<void>(param);` lines (function bodies start after ") noexcept {"
+// at the end of a line and end at a "}" alone at column 0).
+std::vector<std::string> emptyFunctions(const std::string& code) {
+  static const std::regex unused(R"(\s*static_cast<void>\(\w+\);\s*)");
+  std::vector<std::string> found;
+  std::istringstream in(code);
+  std::string line, head;
+  bool inside = false, empty = true;
+  while (std::getline(in, line)) {
+    const std::string open = ") noexcept {";
+    if (!inside && line.size() >= open.size() && line.compare(line.size() - open.size(), open.size(), open) == 0) {
+      inside = true, empty = true, head = line;
+      continue;
+    }
+    if (!inside) continue;
+    if (line == "}") {
+      if (empty) found.push_back(head);
+      inside = false;
+    } else if (!std::regex_match(line, unused) && line.find_first_not_of(' ') != std::string::npos) {
+      empty = false;
+    }
+  }
+  return found;
+}
+
+TEST(GeneratedStructure, TheCheckerFindsEmptyFunctions) {
+  EXPECT_EQ(emptyFunctions("void f(int a) noexcept {\n  static_cast<void>(a);\n}\n").size(), 1u);
+  EXPECT_EQ(emptyFunctions("void f() noexcept {\n}\n").size(), 1u);
+  EXPECT_TRUE(emptyFunctions("void f(int a) noexcept {\n  static_cast<void>(a);\n  w.x = 1.0;\n}\n").empty());
+}
+
+TEST(GeneratedStructure, NoEmptyFunctions) {
+  const std::vector<std::string> sources = split(PROXGEN_GENERATED_SOURCES, '|');
+  ASSERT_FALSE(sources.empty());
+  for (const std::string& path : sources)
+    for (const std::string& f : emptyFunctions(stripComments(readFile(path)))) ADD_FAILURE() << path << ": empty " << f;
+}
+
 std::vector<std::string> symbols(const std::string& library) {
   std::vector<std::string> out;
   const std::string cmd = std::string(PROXGEN_NM) + " -C '" + library + "' 2>/dev/null";

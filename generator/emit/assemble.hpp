@@ -1,0 +1,23 @@
+// The file assembly of a generated solver: the banner, the header (joint and
+// constraint tables, Settings, the Workspace from the member registry) and the
+// source (the part functions, then the hosts and the entry points), filled
+// into templates/*.tpl.
+#pragma once
+
+#include <string>
+
+#include "emit/emitter.hpp"
+#include "emit/members.hpp"
+
+namespace proxgen::emit {
+
+/// The printed bodies of the functions of templates/solver.cpp.tpl.
+struct SolverTexts {
+  std::string parts;  // every part function
+  std::string kinematics, eliminateFree, accelerateFree, caba, pv;
+};
+
+SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
+                          const SolverTexts& texts);
+
+}  // namespace proxgen::emit

@@ -1,0 +1,142 @@
+// The articulated-body elimination (the backward pass of ABA), leaves first:
+// per body U = IA S, D^-1 = (S^T U)^-1, u = tau - S^T pA, and its articulated
+// inertia and bias seen from the parent. constrainedABA adds the penalty
+// mu K^T K at the constrained bodies first (docs/algorithms.md §4.1). The
+// generic counterpart: algorithms/aba.cpp.
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "emit/passes.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+std::string tauIn(int k) { return fmt::format("tau[{}]", k); }
+
+// IA_i += mu K^T K ; pA_i -= mu K^T k for every constraint on body i.
+void penalty(Emit& e, int i, const std::vector<std::vector<Expr>>& kk, Sym& IA, V6& pA) {
+  CodeBuilder& cb = e.cb();
+  const Expr mu = cb.input("mu");
+  for (int k : e.bp(i).constraints) {
+    const Constraint& c = e.sys.constraints[std::size_t(k)];
+    const Mat6 X = c.placement.motionMatrixInv();
+    const auto K = X.topRows(c.rows());
+    const Mat6 KtK = K.transpose() * K;
+    for (int r = 0; r < 6; ++r)
+      for (int col = r; col < 6; ++col) IA(r, col) += KtK(r, col) * mu;
+    for (int r = 0; r < 6; ++r) {
+      Expr Ktk;
+      for (int j = 0; j < c.rows(); ++j) Ktk += K(j, r) * kk[std::size_t(k)][std::size_t(j)];
+      pA[std::size_t(r)] -= cb.mul(mu, Ktk);
+    }
+  }
+}
+
+void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+  CodeBuilder& cb = e.cb();
+  Articulated::Body& b = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  Sym IA = b.IA;
+  V6 pA = b.pA;
+  if (kk) penalty(e, i, *kk, IA, pA);
+  const V6& S = kb.S[0];
+  V6 U;
+  for (int r = 0; r < 6; ++r)
+    for (int k = 0; k < 6; ++k) U[std::size_t(r)] += cb.mul(IA(r, k), S[std::size_t(k)]);
+  b.U.assign(1, V6{});
+  for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
+  const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
+  if (D.isConstant()) {
+    // Folded: the division is correctly rounded here as at run time (in the
+    // solver's scalar type), so the value is the one the code would compute.
+    b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
+  } else {
+    b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D});
+  }
+  const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
+  b.u.assign(1, e.putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));
+  if (p.parent == 0) return;
+  // Ia = IA - U D^-1 U^T (its row and column along an axis-aligned S vanish:
+  // Ia S = 0) ; pa = pA + Ia c + U D^-1 u.
+  V6 UD;
+  for (int r = 0; r < 6; ++r) UD[std::size_t(r)] = cb.flat(cb.mul(b.U[0][std::size_t(r)], b.Dinv), "UD");
+  Sym Ia(6);
+  for (int r = 0; r < 6; ++r)
+    for (int col = r; col < 6; ++col) Ia(r, col) = IA(r, col) - cb.mul(UD[std::size_t(r)], b.U[0][std::size_t(col)]);
+  if (const int along = axisComponent(p); along >= 0)
+    for (int k = 0; k < 6; ++k) Ia(along, k) = Expr();
+  flatten(cb, Ia, "Ia");
+  V6 pa;
+  for (int r = 0; r < 6; ++r) {
+    Expr x = pA[std::size_t(r)] + cb.mul(UD[std::size_t(r)], b.u[0]);
+    for (int k = 0; k < 6; ++k) x += cb.mul(Ia(r, k), kb.c[std::size_t(k)]);
+    pa[std::size_t(r)] = x;
+  }
+  flatten(cb, pa, "pa");
+  const Sym dI = e.inertiaToParent(kb, Ia);
+  const V6 dp = e.forceToParent(kb, pa);
+  Articulated::Body& par = art.b[std::size_t(p.parent)];
+  for (int k = 0; k < 21; ++k)
+    if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  for (int k = 0; k < 6; ++k)
+    if (!dp[std::size_t(k)].isZero())
+      par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
+}
+
+// The free flyer: S = I, so U = IA and D = IA, factored once (LL^T); its
+// parent is the world, so nothing passes on.
+void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+  CodeBuilder& cb = e.cb();
+  Articulated::Body& b = art.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  if (p.parent != 0) throw std::logic_error("emitter: a free flyer below another body");
+  V6 pA = b.pA;
+  if (kk) {
+    penalty(e, i, *kk, b.IA, pA);
+    for (int k = 0; k < 21; ++k) b.IA.packed(k) = e.keepQ(kIA, i, 21, k, b.IA.packed(k));
+  }
+  const Cholesky ch = cholesky(
+      e, b.IA, Expr(), [&](int r, int c) { return e.member(kL, i, 21, Sym::index(6, r, c)); },
+      [&](int r) { return e.member(kLinv, i, 6, r); });
+  b.L = ch.L;
+  b.Linv = ch.inv;
+  b.U.assign(6, V6{});
+  for (int d = 0; d < 6; ++d)
+    for (int r = 0; r < 6; ++r) b.U[std::size_t(d)][std::size_t(r)] = b.IA(r, d);
+  b.u.resize(6);
+  for (int d = 0; d < 6; ++d)
+    b.u[std::size_t(d)] = e.putQ(kUu, i, 6, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(d)]);
+}
+
+}  // namespace
+
+Articulated startElimination(const Kinematics& kin) {
+  Articulated art;
+  art.b.resize(kin.b.size());
+  for (std::size_t i = 0; i < kin.b.size(); ++i) {
+    art.b[i].IA = kin.b[i].IA;
+    art.b[i].pA = kin.b[i].pA;
+  }
+  return art;
+}
+
+void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art) {
+  if (e.bp(i).jointClass == JointClass::FreeFlyer) eliminateFreeFlyer(e, i, k, art);
+  else eliminateOneDof(e, kin, i, k, art);
+}
+
+Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin) {
+  Articulated art = startElimination(kin);
+  const InScope<Articulated> scope(e.fn.live().art, &art);
+  for (auto it = e.plan.offSupport.rbegin(); it != e.plan.offSupport.rend(); ++it) {
+    e.fn.boundary(*it);
+    e.openBody(*it, "eliminate");
+    eliminateBody(e, kin, *it, nullptr, art);
+    e.cb().close();
+  }
+  return art;
+}
+
+}  // namespace proxgen::emit

@@ -1,0 +1,141 @@
+// The Delassus pass of proxPV: G + I/mu = L L^T from the rows the elimination
+// carried up the support (G(t, u) = sum of KSD_i KS_i over the bodies whose
+// subtree holds both rows), and the solves with that factor. With a floating
+// base, G = A + Z^T Z: L factors A (zeros between limbs fold away) and the
+// rank-6 part goes through Woodbury. The generic counterpart:
+// algorithms/prox_pv.cpp (Eigen's LLT of the assembled G).
+#include <fmt/format.h>
+
+#include "emit/passes.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+// Per tree row t: the support bodies whose subtree holds it (ascending) and its column there.
+std::vector<std::vector<std::pair<int, int>>> rowsAt(const Plan& plan) {
+  std::vector<std::vector<std::pair<int, int>>> at(std::size_t(plan.nc));
+  for (int i : plan.support) {
+    const BodyPlan& b = plan.bodies[std::size_t(i)];
+    for (int j = 0; j < b.m(); ++j) at[std::size_t(b.rowStart + j)].push_back({i, j});
+  }
+  return at;
+}
+
+struct Assembly {
+  const Plan& plan;
+  const ProxRows& rows;
+  std::vector<std::vector<std::pair<int, int>>> at;
+};
+
+// G(t, u), rows in tree order (Z_i . Z_i at the free flyer, when withFreeFlyer).
+Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, bool withFreeFlyer) {
+  Expr g;
+  for (const auto& [i, jt] : a.at[std::size_t(t)]) {
+    const BodyPlan& b = a.plan.bodies[std::size_t(i)];
+    if (u < b.rowStart || u >= b.rowStart + b.m()) continue;
+    const int ju = u - b.rowStart;
+    const ProxRows::Body& r = a.rows.b[std::size_t(i)];
+    if (b.jointClass == JointClass::FreeFlyer) {
+      if (!withFreeFlyer) continue;
+      for (int d = 0; d < 6; ++d) g += cb.mul(r.Z[std::size_t(jt)][std::size_t(d)], r.Z[std::size_t(ju)][std::size_t(d)]);
+    } else {
+      g += cb.mul(r.KSD[std::size_t(jt)], r.KS[std::size_t(ju)][0]);
+    }
+  }
+  return g;
+}
+
+// The free-flyer body when it carries constraint rows (floating base), else -1.
+int freeFlyerWithRows(const Plan& plan) {
+  for (int i : plan.support)
+    if (plan.bodies[std::size_t(i)].jointClass == JointClass::FreeFlyer && plan.bodies[std::size_t(i)].m() > 0) return i;
+  return -1;
+}
+
+// G + I/mu = L L^T (or A + I/mu with a floating base), one block (and part) per column.
+void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
+  const int nc = e.plan.nc;
+  f.L = Sym(nc);
+  f.Linv.assign(std::size_t(nc), Expr());
+  const bool full = freeFlyerWithRows(e.plan) < 0;
+  for (int j = 0; j < nc; ++j) {
+    e.fn.boundary(fmt::format("column_{}", j));
+    CodeBuilder& cb = e.cb();
+    cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
+    Expr d = delassus(cb, a, j, j, full);  // before inv_mu: see mulAdd in symbolic.cpp
+    d += cb.input("inv_mu");
+    for (int k = 0; k < j; ++k) d -= cb.mul(f.L(j, k), f.L(j, k));
+    const Expr r = cb.sqrt(d, "r");
+    f.Linv[std::size_t(j)] = e.put(e.member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));
+    for (int i = j + 1; i < nc; ++i) {
+      Expr x = delassus(cb, a, i, j, full);
+      for (int k = 0; k < j; ++k) x -= cb.mul(f.L(i, k), f.L(j, k));
+      f.L(i, j) = e.put(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)"),
+                        cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));
+    }
+    cb.close();
+  }
+}
+
+// (A + Z^T Z)^-1 = L^-T (I - W S^-1 W^T) L^-1 with W = L^-1 Z^T, S = I + W^T W
+// (Woodbury): six forward solves and a 6 x 6 factor instead of a dense one.
+void woodbury(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
+  const int nc = e.plan.nc;
+  const BodyPlan& b = e.bp(ff);
+  f.W.assign(std::size_t(nc), zero6());
+  for (int d = 0; d < 6; ++d) {
+    e.fn.boundary(fmt::format("W_{}", d));
+    e.cb().open("{", {fmt::format("W = L^-1 Z^T, column {}", d)});
+    std::vector<Expr> z(static_cast<std::size_t>(nc));
+    for (int j = 0; j < b.m(); ++j) z[std::size_t(b.rowStart + j)] = rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)];
+    const std::vector<Expr> w = forwardSolve(e.cb(), f.L, f.Linv, z);
+    for (int t = 0; t < nc; ++t)
+      f.W[std::size_t(t)][std::size_t(d)] = e.put(e.ws.member("W", nc, 6, t, d, "L^-1 Z^T"), w[std::size_t(t)]);
+    e.cb().close();
+  }
+  e.fn.boundary("LS");
+  CodeBuilder& cb = e.cb();
+  cb.open("{", {"S = I + W^T W = LS LS^T"});
+  Sym S(6);
+  for (int a = 0; a < 6; ++a)
+    for (int c = a; c < 6; ++c) {
+      Expr x = a == c ? Expr(1.0) : Expr();
+      for (int t = 0; t < nc; ++t) x += cb.mul(f.W[std::size_t(t)][std::size_t(a)], f.W[std::size_t(t)][std::size_t(c)]);
+      S(a, c) = x;
+    }
+  const Cholesky ch = cholesky(
+      e, S, Expr(), [&](int r, int c) { return e.member("LS", 21, Sym::index(6, r, c), "factor of I + W^T W (lower, packed)"); },
+      [&](int r) { return e.member("LSinv", 6, r, "1 / diag(LS)"); });
+  f.LS = ch.L;
+  f.LSinv = ch.inv;
+  cb.close();
+}
+
+}  // namespace
+
+DelassusFactor factorDelassus(Emit& e, const ProxRows& rows) {
+  DelassusFactor f;
+  const InScope<DelassusFactor> scope(e.fn.live().del, &f);
+  const Assembly a{e.plan, rows, rowsAt(e.plan)};
+  factorColumns(e, a, f);
+  if (const int ff = freeFlyerWithRows(e.plan); ff >= 0) woodbury(e, rows, ff, f);
+  return f;
+}
+
+std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vector<Expr>& rhs) {
+  CodeBuilder& cb = e.cb();
+  std::vector<Expr> z = forwardSolve(cb, f.L, f.Linv, rhs);
+  if (!f.W.empty()) {
+    std::vector<Expr> v(6);
+    for (int d = 0; d < 6; ++d)
+      for (std::size_t t = 0; t < z.size(); ++t) v[std::size_t(d)] += cb.mul(f.W[t][std::size_t(d)], z[t]);
+    const std::vector<Expr> x = backwardSolve(cb, f.LS, f.LSinv, forwardSolve(cb, f.LS, f.LSinv, v));
+    for (std::size_t t = 0; t < z.size(); ++t) {
+      for (int d = 0; d < 6; ++d) z[t] -= cb.mul(f.W[t][std::size_t(d)], x[std::size_t(d)]);
+      z[t] = cb.flat(z[t], "z");
+    }
+  }
+  return backwardSolve(cb, f.L, f.Linv, z);
+}
+
+}  // namespace proxgen::emit

@@ -1,0 +1,176 @@
+// The kinematics pass: per body its joint transform, velocity, velocity-product
+// acceleration, bias force v x* I v, gravity in body coordinates (support) and
+// world placement (under a kp constraint); per constraint its right-hand side
+// k (docs/algorithms.md §2). The generic counterpart: algorithms/kinematics.cpp,
+// algorithms/constraints.cpp.
+#include <fmt/format.h>
+
+#include "emit/identifiers.hpp"
+#include "emit/passes.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+std::string q(int k) { return fmt::format("q[{}]", k); }
+std::string vIn(int k) { return fmt::format("v[{}]", k); }
+
+void jointTransform(Emit& e, int i, Kinematics::Body& b) {
+  const Body& body = e.model().bodies[std::size_t(i)];
+  const Joint& j = body.joint;
+  const BodyPlan& p = e.bp(i);
+  b.XT = constant(body.treePlacement);
+  b.XJ = {constant(Mat3(Mat3::Identity())), zero3()};
+  const Mat6X S = e.model().motionSubspace(i);
+  b.S.clear();
+  for (int d = 0; d < j.nv; ++d) b.S.push_back(constant(Vec6(S.col(d))));
+  CodeBuilder& cb = e.cb();
+  if (p.jointClass == JointClass::FreeFlyer) {
+    // q = [x y z qx qy qz qw]; R as Eigen's Quaternion::toRotationMatrix (unnormalised input used as given).
+    const Expr x = cb.input(q(j.idx_q + 3)), y = cb.input(q(j.idx_q + 4)), z = cb.input(q(j.idx_q + 5)),
+               w = cb.input(q(j.idx_q + 6));
+    // 2 a b + s 2 c d, the products in this order (see mulAdd in symbolic.cpp).
+    auto two = [&](const Expr& a, const Expr& b2, double s, const Expr& c, const Expr& d) {
+      return 2.0 * mulAdd(cb, a, b2, s, c, d);
+    };
+    const M3 R = {1.0 - two(y, y, 1.0, z, z), two(x, y, -1.0, w, z), two(x, z, 1.0, w, y),
+                  two(x, y, 1.0, w, z), 1.0 - two(x, x, 1.0, z, z), two(y, z, -1.0, w, x),
+                  two(x, z, -1.0, w, y), two(y, z, 1.0, w, x), 1.0 - two(x, x, 1.0, y, y)};
+    for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = e.keepQ(kRJ, i, 9, k, R[std::size_t(k)]);
+    b.XJ.p = {cb.input(q(j.idx_q)), cb.input(q(j.idx_q + 1)), cb.input(q(j.idx_q + 2))};
+    return;
+  }
+  const Vec3 a = j.axis;
+  if (j.type == JointType::Prismatic) {
+    // Kept in the workspace: the backward and forward passes (other functions) need it.
+    const Expr qi = cb.store(e.member(kQ, i, 0, 0), cb.input(q(j.idx_q)));
+    for (int k = 0; k < 3; ++k) b.XJ.p[std::size_t(k)] = a[k] * qi;
+    return;
+  }
+  // Revolute: R = c I + s [a]x + (1 - c) a a^T; an axis along +-x/y/z folds to picks of c and s.
+  const std::string sm = e.member(kSin, i, 0, 0), cm = e.member(kCos, i, 0, 0);
+  const std::vector<Expr> sc =
+      cb.storeByCall(fmt::format("proxgen_rt::sincos({}, {}, {});", q(j.idx_q), sm, cm), {sm, cm}, {cb.input(q(j.idx_q))});
+  const Expr &s = sc[0], &c = sc[1];
+  const Mat3 K = skew(a), A = a * a.transpose();
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) {
+      const Expr x = A(r, col) + (r == col ? 1.0 : 0.0) * c - A(r, col) * c + K(r, col) * s;
+      b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 9, 3 * r + col, x);
+    }
+}
+
+void velocity(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {
+  const Joint& j = e.model().bodies[std::size_t(i)].joint;
+  CodeBuilder& cb = e.cb();
+  V6 vJ = zero6();
+  for (int d = 0; d < j.nv; ++d) vJ = add(vJ, scale(cb, cb.input(vIn(j.idx_v + d)), b.S[std::size_t(d)]));
+  const V6 v = add(e.motionToChild(b, parent.v), vJ);
+  for (int k = 0; k < 6; ++k) b.v[std::size_t(k)] = e.keepQ(kV, i, 6, k, v[std::size_t(k)]);
+  const V6 c = crossMotion(cb, b.v, vJ);
+  for (int k = 0; k < 6; ++k) b.c[std::size_t(k)] = e.keepQ(kC, i, 6, k, c[std::size_t(k)]);
+  // pA = v x* (I v); IA starts as the body's own inertia (a constant).
+  b.IA = constant(e.model().bodies[std::size_t(i)].inertia.matrix());
+  V6 h = mul(cb, b.IA, b.v);
+  flatten(cb, h, "h");
+  const V6 pA = crossForce(cb, b.v, h);
+  for (int k = 0; k < 6; ++k) b.pA[std::size_t(k)] = e.putQ(kPA, i, 6, k, pA[std::size_t(k)]);
+}
+
+void gravityAndPlacement(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {
+  if (e.bp(i).needsGravity) {
+    const V3 g = rotateT(e.cb(), b.XJ.R, rotateT(e.cb(), b.XT.R, parent.g));
+    for (int k = 0; k < 3; ++k) b.g[std::size_t(k)] = e.keepQ(kG, i, 3, k, g[std::size_t(k)]);
+  }
+  if (e.bp(i).needsPlacement) {
+    const XSym M = compose(e.cb(), compose(e.cb(), parent.oM, b.XT), b.XJ);
+    for (int k = 0; k < 9; ++k) b.oM.R[std::size_t(k)] = e.keepQ(kOR, i, 9, k, e.cb().flat(M.R[std::size_t(k)]));
+    for (int k = 0; k < 3; ++k) b.oM.p[std::size_t(k)] = e.keepQ(kOP, i, 3, k, e.cb().flat(M.p[std::size_t(k)]));
+  }
+}
+
+// k = a_star - drift - K X_{i,0} a_g (docs/algorithms.md §2), as constraints.cpp computes it.
+std::vector<Expr> constraintTerms(Emit& e, int k, const Kinematics::Body& b) {
+  const Constraint& c = e.sys.constraints[std::size_t(k)];
+  const ConstraintPlan& cp = e.plan.constraints[std::size_t(k)];
+  CodeBuilder& cb = e.cb();
+  const int r = c.rows();
+  cb.comment(fmt::format("constraint '{}' ({}) on link '{}': rows {}..{}", escapeComment(c.name), cp.weld ? "6d" : "3d",
+                         escapeComment(c.link), c.row, c.row + r - 1));
+  const V6 vC = actInvMotion(cb, constant(c.placement), b.v);  // twist of the constraint frame
+  std::vector<Expr> kk(static_cast<std::size_t>(r));
+  if (c.kd != 0)
+    for (int j = 0; j < r; ++j) kk[std::size_t(j)] -= c.kd * vC[std::size_t(j)];
+  if (c.kp != 0) {
+    const XSym oMc = compose(cb, b.oM, constant(c.placement));
+    std::vector<Expr> err(static_cast<std::size_t>(r));
+    if (cp.weld) {
+      // log6(target^-1 oMc) through the runtime.
+      const XSym E = compose(cb, constant(c.target.inverse()), oMc);
+      std::vector<Expr> R, p;
+      std::string Rs, ps;
+      for (int j = 0; j < 9; ++j) {
+        R.push_back(cb.flat(E.R[std::size_t(j)]));
+        Rs += (j ? ", " : "") + cb.print(R.back());
+      }
+      for (int j = 0; j < 3; ++j) {
+        p.push_back(cb.flat(E.p[std::size_t(j)]));
+        ps += (j ? ", " : "") + cb.print(p.back());
+      }
+      std::vector<Expr> uses = R;
+      uses.insert(uses.end(), p.begin(), p.end());
+      const std::string id = cp.ident;
+      cb.line(fmt::format("const Scalar kpR_{}[9] = {{{}}};", id, Rs), uses);
+      cb.line(fmt::format("const Scalar kpp_{}[3] = {{{}}};", id, ps), uses);
+      cb.line(fmt::format("Scalar kpe_{}[6];", id));
+      cb.line(fmt::format("proxgen_rt::log6(kpR_{0}, kpp_{0}, kpe_{0});", id));
+      for (int j = 0; j < 6; ++j) err[std::size_t(j)] = cb.input(fmt::format("kpe_{}[{}]", id, j));
+    } else {
+      V3 d;
+      for (int j = 0; j < 3; ++j) d[std::size_t(j)] = oMc.p[std::size_t(j)] - c.target.p[j];
+      const V3 er = rotateT(cb, oMc.R, d);
+      err.assign(er.begin(), er.end());
+    }
+    for (int j = 0; j < r; ++j) kk[std::size_t(j)] -= c.kp * err[std::size_t(j)];
+  }
+  if (!cp.weld) {
+    const V3 drift = cross(cb, ang(vC), lin(vC));  // w_C x v_C
+    for (int j = 0; j < 3; ++j) kk[std::size_t(j)] -= drift[std::size_t(j)];
+  }
+  const std::vector<Expr> Kg = e.constraintRows(k, stack(b.g, zero3()));
+  std::vector<Expr> out(static_cast<std::size_t>(r));
+  for (int j = 0; j < r; ++j) out[std::size_t(j)] = e.keep(e.kMember(k, j), kk[std::size_t(j)] - Kg[std::size_t(j)]);
+  return out;
+}
+
+}  // namespace
+
+Kinematics emitKinematics(Emit& e) {
+  const Model& m = e.model();
+  Kinematics kin;
+  kin.b.resize(std::size_t(m.numBodies()));
+  kin.k.resize(e.sys.constraints.size());
+  const InScope<Kinematics> scope(e.fn.live().kin, &kin);
+  // World: at rest, gravity as given, at the origin.
+  kin.b[0].g = constant(m.gravity);
+  kin.b[0].oM = constant(SE3::Identity());
+  for (int i = 1; i < m.numBodies(); ++i) {
+    e.fn.boundary(i);
+    e.openBody(i, "");
+    Kinematics::Body& b = kin.b[std::size_t(i)];
+    const Kinematics::Body& parent = kin.b[std::size_t(e.bp(i).parent)];
+    jointTransform(e, i, b);
+    velocity(e, i, parent, b);
+    gravityAndPlacement(e, i, parent, b);
+    for (int k : e.bp(i).constraints) kin.k[std::size_t(k)] = constraintTerms(e, k, b);
+    e.cb().close();
+  }
+  if (!e.bp(0).constraints.empty()) {
+    e.fn.boundary("world");
+    e.cb().open("{", {"constraints on the world"});
+    for (int k : e.bp(0).constraints) kin.k[std::size_t(k)] = constraintTerms(e, k, kin.b[0]);
+    e.cb().close();
+  }
+  return kin;
+}
+
+}  // namespace proxgen::emit

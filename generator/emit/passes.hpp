@@ -1,0 +1,71 @@
+// The passes of the emitter, one file each (pass_<name>.cpp), as
+// generator/algorithms/ has one file per recursion. A pass prints the blocks
+// of one recursion into the function being written (Emit::fn) and returns what
+// later passes read (body_state.hpp). The entry points (constrained_aba,
+// prox_pv) are compositions of these calls; emitter.cpp is the list of
+// functions of a solver. docs/emitter.md: how to add one.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "emit/context.hpp"
+
+namespace proxgen::emit {
+
+// ---- pass_kinematics.cpp: joint transforms, v, c, pA = v x* I v, R^T g,
+// world placements, the constraint right-hand sides k.
+Kinematics emitKinematics(Emit& e);
+
+// ---- pass_aba_eliminate.cpp: the articulated-body elimination.
+/// The elimination's starting point: every body's own inertia and bias.
+Articulated startElimination(const Kinematics& kin);
+/// One body: U, D^-1, u, and (below the root) its share of the parent's IA and
+/// pA. With `k`, the penalty mu K^T K of the body's constraints first (constrainedABA).
+void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art);
+/// The bodies off the constraint support, leaves first (the same in both algorithms).
+Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin);
+
+// ---- pass_aba_accelerate.cpp: the forward pass.
+/// a'_i = X_i a_p + c_i ; qdd_i = D^-1 (uEff - U^T a'_i) ; a_i = a'_i + S qdd_i.
+void accelerateBody(Emit& e, const Kinematics& kin, const Articulated& art, int i, const std::vector<Expr>& uEff,
+                    bool storeQdd, Motion& motion);
+/// The support bodies in tree order, with their u.
+void accelerateSupport(Emit& e, const Kinematics& kin, const Articulated& art, Motion& motion);
+/// The off-support bodies: printed once as accelerate_free_bodies (from the
+/// first caller's state), called by both algorithms; their qdd come back into `motion`.
+struct FreeAccelerations {
+  std::string text;                    // the function's body
+  std::string supportAccelerations;    // what it reads, to check the second caller
+  const CodeBuilder* builder = nullptr;
+  Motion out;
+};
+void callAccelerateFree(Emit& e, const Kinematics& kin, const Articulated& art, Motion& motion);
+
+// ---- pass_dense_factor.cpp: dense Cholesky and triangular solves, unrolled.
+struct Cholesky {
+  Sym L;
+  std::vector<Expr> inv;  // 1 / diag(L)
+};
+/// (A + shift I) = L L^T, L's entries stored to Lname(i, j), 1 / L(j, j) to invName(j).
+Cholesky cholesky(Emit& e, const Sym& A, const Expr& shift, const std::function<std::string(int, int)>& Lname,
+                  const std::function<std::string(int)>& invName);
+std::vector<Expr> forwardSolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& b);
+std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& y);
+
+// ---- pass_constrained_aba.cpp: the constrained_aba entry point (body text);
+// kin and art are its own copies of the state after eliminate_free_bodies,
+// whose values live in `from`.
+/// qdd and lambda out of the workspace (the end of both entry points).
+void copyOut(Emit& e, const Motion& motion, const Multipliers& mult);
+std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
+
+// ---- pass_prox_pv.cpp: the prox_pv entry point (body text), as above.
+std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
+
+// ---- pass_delassus_factor.cpp: G + I/mu from proxPV's rows, factored; solves.
+DelassusFactor factorDelassus(Emit& e, const ProxRows& rows);
+/// (G + I/mu)^-1 rhs through the factor (rows in tree order).
+std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vector<Expr>& rhs);
+
+}  // namespace proxgen::emit
