@@ -45,10 +45,42 @@ Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, bool withFreeFly
   return g;
 }
 
-// The free-flyer body when it carries constraint rows (floating base), else -1.
+// The free-flyer body when it carries constraint rows (floating base) and the
+// Woodbury split G = B + Z^T Z suits them, else -1: then G + I/mu is factored
+// whole, Z^T Z included, as the generic proxPv does.
+// The split needs A = B + I/mu well conditioned: woodbury's
+// L^-T (I - W S^-1 W^T) L^-1 subtracts two terms of size mu where A has an
+// eigenvalue of 1/mu, and multiplies the round-off by mu |G| there (a lone
+// welded hull's proxPV qdd was 1.5e-9 off the generic at mu = 1e4, 1.5e-14
+// with the whole factor; tests/generated/single_body/). B has such an
+// eigenvalue, structurally, wherever rows outnumber the one-dof bodies that
+// see them: B sums one rank-one KS^T D^-1 KS per support body below the free
+// flyer, and a row is seen by the bodies on its constraint's path up to the
+// free flyer (none for a constraint on the free flyer itself). So, for each
+// support body j below it: j's subtree rows at most the support bodies of
+// that subtree plus j's ancestors below the free flyer; j's own rows at most
+// j and those ancestors.
 int freeFlyerWithRows(const Plan& plan) {
-  for (int i : plan.support)
-    if (plan.bodies[std::size_t(i)].jointClass == JointClass::FreeFlyer && plan.bodies[std::size_t(i)].m() > 0) return i;
+  auto bp = [&](int i) -> const BodyPlan& { return plan.bodies[std::size_t(i)]; };
+  for (int i : plan.support) {
+    const BodyPlan& ff = bp(i);
+    if (ff.jointClass != JointClass::FreeFlyer || ff.m() == 0) continue;
+    if (!ff.constraints.empty()) return -1;
+    std::vector<int> inSubtree(plan.bodies.size(), 0), above(plan.bodies.size(), 0);
+    for (auto it = plan.support.rbegin(); it != plan.support.rend(); ++it) {
+      inSubtree[std::size_t(*it)] += 1;
+      if (bp(*it).parent > 0) inSubtree[std::size_t(bp(*it).parent)] += inSubtree[std::size_t(*it)];
+    }
+    for (int j : plan.support) {  // ascending: parents first
+      if (j == i) continue;
+      const int p = bp(j).parent;
+      above[std::size_t(j)] = p == i ? 0 : above[std::size_t(p)] + 1;
+      int own = 0;
+      for (int k : bp(j).constraints) own += plan.constraints[std::size_t(k)].rows;
+      if (bp(j).m() > inSubtree[std::size_t(j)] + above[std::size_t(j)] || own > 1 + above[std::size_t(j)]) return -1;
+    }
+    return i;
+  }
   return -1;
 }
 
