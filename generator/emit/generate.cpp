@@ -26,10 +26,28 @@ namespace {
 
 const char* scalarName(ScalarType t) { return t == ScalarType::Float ? "float" : "double"; }
 
+// generate's own size bounds (generate.hpp), before any printing.
+void checkSize(const Plan& plan, const std::string& urdf, const std::string& layout) {
+  const int bodies = int(plan.bodies.size()) - 1;
+  if (bodies > kMaxGenerateBodies)
+    fail(urdf, "robot",
+         fmt::format("{} moving bodies: generate handles at most {} (its time grows with the square of the size; "
+                     "check and eval read up to 4096 links)",
+                     bodies, kMaxGenerateBodies));
+  long rows = 0;
+  for (int i : plan.support) rows += plan.bodies[std::size_t(i)].m();
+  if (rows > kMaxGenerateSupportRows)
+    fail(layout, "constraints",
+         fmt::format("{} rows through {} support bodies ({} row-body pairs): generate handles at most {} "
+                     "(fewer rows, or rows nearer the root)",
+                     plan.nc, plan.support.size(), rows, kMaxGenerateSupportRows));
+}
+
 SolverFiles generateCase(const GenerateOptions& options, SolverStats* stats) {
   const Case c = loadCase(options.casesFile, options.caseName);
   const System sys = loadCaseSystem(c);
   const Plan plan = makePlan(sys, options.name.empty() ? c.name : options.name, options.scalar);
+  checkSize(plan, c.urdfPath, options.casesFile);
   SolverInputs in;
   in.urdfName = fs::path(c.urdfPath).filename().string();
   in.layoutName = fmt::format("{} (case {})", fs::path(options.casesFile).filename().string(), c.name);
@@ -48,6 +66,7 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats) {
   const System sys = loadSystem(options.urdf, options.layout);
   const std::string name = options.name.empty() ? fs::path(options.urdf).stem().string() : options.name;
   const Plan plan = makePlan(sys, name, options.scalar);
+  checkSize(plan, options.urdf, options.layout);
   SolverInputs in;
   in.urdfName = fs::path(options.urdf).filename().string();
   in.layoutName = fs::path(options.layout).filename().string();

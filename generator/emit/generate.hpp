@@ -8,6 +8,17 @@
 
 namespace proxgen::emit {
 
+/// What `generate` accepts beyond the loaders' limits (docs/guarantees.md,
+/// "Resource bounds"). The emitter hands its whole state (every body's
+/// quantities, and the constraint columns each support body carries) to each
+/// part function it starts, so its time grows with the square of the robot:
+/// these keep it to about a minute of CPU, where the loaders' 4096 links
+/// would take several.
+inline constexpr int kMaxGenerateBodies = 1024;  // moving bodies (after fixed-joint merging)
+/// Rows carried through the support: the sum over the support bodies of the
+/// constraint rows in their subtrees (the columns of their KA).
+inline constexpr int kMaxGenerateSupportRows = 4096;
+
 struct GenerateOptions {
   std::string urdf, layout;  // input files
   /// Instead of urdf + layout: one case of a cases file (cases.yaml: a list of
