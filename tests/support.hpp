@@ -16,6 +16,25 @@
 
 namespace proxgen::test {
 
+/// True in a build instrumented by AddressSanitizer (scripts/sanitize.sh):
+/// tests that assert time or memory skip there, where both mean nothing.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kUnderSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kUnderSanitizer = true;
+#else
+inline constexpr bool kUnderSanitizer = false;
+#endif
+#else
+inline constexpr bool kUnderSanitizer = false;
+#endif
+#define PROXGEN_SKIP_UNDER_SANITIZER()                                                       \
+  do {                                                                                       \
+    if (::proxgen::test::kUnderSanitizer)                                                    \
+      GTEST_SKIP() << "time and memory of an instrumented build mean nothing";              \
+  } while (0)
+
 /// The shared models folder (CMake cache PROXGEN_MODELS_DIR), or "" if absent.
 std::string modelsDir();
 bool underCi();

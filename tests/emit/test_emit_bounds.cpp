@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "emit/generate.hpp"
+#include "support.hpp"
 
 namespace {
 
@@ -122,6 +123,7 @@ class GenerateBounds : public ::testing::Test {
 // here. The bound, 120 s, is 8x that: a cubic step, or a constant 8x worse,
 // fails it; a busier machine does not.
 TEST_F(GenerateBounds, TreeAtTheBodyLimitStaysInItsTimeAndMemory) {
+  PROXGEN_SKIP_UNDER_SANITIZER();
   const int n = proxgen::emit::kMaxGenerateBodies;
   const fs::path urdf = write("tree.urdf", treeUrdf(n, 3));
   const fs::path layout =

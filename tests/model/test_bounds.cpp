@@ -22,14 +22,6 @@
 #include "model/urdf.hpp"
 #include "support.hpp"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define PROXGEN_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PROXGEN_UNDER_ASAN 1
-#endif
-#endif
-
 namespace proxgen {
 namespace {
 
@@ -85,15 +77,6 @@ void expectWithinBounds(const ChildRun& r, const std::string& label, double maxC
   EXPECT_LE(r.status, 1) << label << ": " << r.err;  // 0 or a clear error, never an internal one (3)
 }
 
-#define PROXGEN_SKIP_UNDER_ASAN()                                                         \
-  do {                                                                                    \
-    if (PROXGEN_ASAN) GTEST_SKIP() << "time and memory of an instrumented build mean nothing"; \
-  } while (0)
-#ifdef PROXGEN_UNDER_ASAN
-constexpr bool PROXGEN_ASAN = true;
-#else
-constexpr bool PROXGEN_ASAN = false;
-#endif
 
 // A tree of `links` links (1 kg, revolute about x, y, z in turn), link i on
 // (i - 1) / 3 (as tests/model/test_hardening.cpp's treeUrdf); `pad` goes
@@ -121,7 +104,7 @@ std::string tree(int links, int branching, const std::string& pad = "") {
 std::size_t countOf(const std::string& s, char c) { return std::size_t(std::count(s.begin(), s.end(), c)); }
 
 TEST(Bounds, UrdfAtEveryLimit) {
-  PROXGEN_SKIP_UNDER_ASAN();
+  PROXGEN_SKIP_UNDER_SANITIZER();
   TempFile f("bounds.urdf");
   const std::string base = tree(int(kMaxUrdfLinks), 3);
   // Links: 4096, the limit, accepted.
@@ -186,7 +169,7 @@ TEST(Bounds, UrdfAtEveryLimit) {
 std::string arm() { return std::string(PROXGEN_TEST_DATA_DIR) + "/good/arm3.urdf"; }
 
 TEST(Bounds, LayoutAtItsLimit) {
-  PROXGEN_SKIP_UNDER_ASAN();
+  PROXGEN_SKIP_UNDER_SANITIZER();
   TempFile f("bounds.yaml");
   // 4 MiB of welds: refused at the row limit, after yaml-cpp has read it all.
   std::string yaml = "constraints:\n";
@@ -198,7 +181,7 @@ TEST(Bounds, LayoutAtItsLimit) {
 }
 
 TEST(Bounds, StateAtItsLimits) {
-  PROXGEN_SKIP_UNDER_ASAN();
+  PROXGEN_SKIP_UNDER_SANITIZER();
   TempFile layout("bounds.yaml"), f("bounds.json");
   layout.write("constraints:\n  - {name: tip, link: tool, type: 3d}\n");
   // 64 MiB of nested lists: refused at the fifth level (2.4 GB as a DOM before).
