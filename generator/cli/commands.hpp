@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "emit/emitter.hpp"
+
 namespace proxgen::cli {
 
 void addCheck(CLI::App& app);     // check.cpp
@@ -16,5 +18,9 @@ void addVerify(CLI::App& app);    // verify.cpp
 /// --case, never a mix (generate.cpp).
 void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
                        const std::string& cases, const std::string& caseName);
+
+/// The solver of those options (generate.cpp), shared by `generate` and `verify`.
+emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
+                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar);
 
 }  // namespace proxgen::cli

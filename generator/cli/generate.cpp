@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cases/cases.hpp"
 #include "emit/generate.hpp"
 #include "model/error.hpp"
 
@@ -19,6 +20,17 @@ void checkRobotOptions(const char* command, const std::string& urdf, const std::
     throw Error(fmt::format("{}: --cases and --case go together, without a URDF or --layout", command));
   if (!byCase && (urdf.empty() || layout.empty()))
     throw Error(fmt::format("{}: needs a URDF and --layout (or --cases and --case)", command));
+}
+
+emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
+                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar) {
+  if (!cases.empty()) return generateCase(cases, caseName, name, scalar);
+  emit::GenerateOptions g;
+  g.urdf = urdf;
+  g.layout = layout;
+  g.name = name;
+  g.scalar = scalar;
+  return emit::generateFiles(g);
 }
 
 void addGenerate(CLI::App& app) {
@@ -36,15 +48,9 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--scalar", opt->scalar, "double (default) or float")->check(CLI::IsMember({"double", "float"}));
   cmd->callback([opt] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
-    emit::GenerateOptions g;
-    g.urdf = opt->urdf;
-    g.layout = opt->layout;
-    g.casesFile = opt->cases;
-    g.caseName = opt->caseName;
-    g.name = opt->name;
-    g.scalar = emit::parseScalar(opt->scalar);
-    const emit::SolverFiles files = emit::generateFiles(g);
-    for (const std::string& path : emit::writeFiles(files, opt->out)) std::printf("wrote %s\n", path.c_str());
+    const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
+                                                        emit::parseScalar(opt->scalar));
+    for (const std::string& path : emit::writeFiles(emit::solverOutputs(files), opt->out)) std::printf("wrote %s\n", path.c_str());
   });
 }
 
