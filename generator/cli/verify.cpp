@@ -52,6 +52,7 @@ int runProcess(const std::vector<std::string>& argv, const fs::path& log, const 
   const pid_t pid = fork();
   if (pid < 0) throw Error(fmt::format("verify: cannot start {} ({})", argv[0], std::strerror(errno)));
   if (pid == 0) {
+    setpgid(0, 0);  // its own group: the interrupt handler stops it with its children
     if (!in.empty() && !std::freopen(in.c_str(), "r", stdin)) _exit(126);
     if (!std::freopen(log.c_str(), "w", stdout)) _exit(126);
     if (dup2(fileno(stdout), fileno(stderr)) < 0) _exit(126);
@@ -61,6 +62,7 @@ int runProcess(const std::vector<std::string>& argv, const fs::path& log, const 
     execvp(args[0], args.data());
     _exit(127);
   }
+  setpgid(pid, pid);  // also here: the group exists before the handler may need it
   emit::setInterruptChild(pid);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -244,7 +246,8 @@ int verify(const VerifyOptions& o) {
   files.push_back({"driver.cpp", kDriver});
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
-  std::vector<std::string> compile = {PROXGEN_CXX_COMPILER, "-std=c++17"};
+  // -pipe: no assembler files in TMPDIR (fewer temporaries to leave if interrupted).
+  std::vector<std::string> compile = {PROXGEN_CXX_COMPILER, "-std=c++17", "-pipe"};
   for (const std::string& option : solverCompileOptions()) compile.push_back(option);
   compile.insert(compile.end(), {"-I", runtimeDir().string(), "-I", scratch.dir().string(), driverCpp.string(), cpp.string(),
                                  "-o", driver.string()});

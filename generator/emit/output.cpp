@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <ctime>
 #include <mutex>
 #include <set>
 
@@ -38,10 +39,25 @@ volatile std::sig_atomic_t gChild = 0;
 
 extern "C" void removeTemporariesAndDie(int sig) {
   const int savedErrno = errno;
-  // A child still writing into a temporary folder would refill it.
+  // A child still writing into a temporary folder would refill it. SIGTERM
+  // first, to the child's whole process group (a compiler driver and the
+  // compiler proper it runs): the driver then removes its own temporaries (in
+  // TMPDIR); SIGKILL if it has not gone within 5 s.
   if (const pid_t child = gChild; child > 0) {
-    kill(child, SIGKILL);
-    while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
+    kill(-child, SIGTERM);
+    bool gone = false;
+    for (int k = 0; k < 500 && !gone; ++k) {
+      const pid_t r = waitpid(child, nullptr, WNOHANG);
+      gone = r == child || (r < 0 && errno != EINTR);
+      if (!gone) {
+        const timespec pause{0, 10 * 1000 * 1000};
+        nanosleep(&pause, nullptr);
+      }
+    }
+    if (!gone) {
+      kill(-child, SIGKILL);
+      while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
+      }
     }
   }
   // Files first (unlink fails on a folder), then folders, innermost first:

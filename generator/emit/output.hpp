@@ -37,8 +37,8 @@ std::vector<std::string> writeFiles(const std::vector<OutputFile>& files, const 
 
 /// Removes, on SIGINT, SIGTERM, SIGHUP or SIGQUIT, every path registered with
 /// registerTemporary that is still registered, then dies of the signal as it
-/// would have. The handler only calls unlink, rmdir, signal and raise
-/// (async-signal-safe). Called once by the CLI's main.
+/// would have. The handler only calls kill, waitpid, nanosleep, unlink, rmdir,
+/// signal and raise (async-signal-safe). Called once by the CLI's main.
 void installInterruptCleanup();
 
 /// Registers a temporary file or (empty) folder for removal if the process is
@@ -48,8 +48,10 @@ void installInterruptCleanup();
 int registerTemporary(const std::string& path);
 void unregisterTemporary(int slot);
 
-/// The child process (a compiler, verify's driver) the interrupt handler kills
-/// and waits for before it removes the temporaries the child writes into; 0: none.
+/// The child process (a compiler, verify's driver), leader of its own process
+/// group, that the interrupt handler stops (SIGTERM to the group, so a compiler
+/// removes its own temporaries; SIGKILL after 5 s) and waits for before it
+/// removes the temporaries the child writes into; 0: none.
 void setInterruptChild(int pid);
 
 }  // namespace proxgen::emit
