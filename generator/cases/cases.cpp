@@ -60,10 +60,11 @@ std::vector<Case> loadCases(const std::string& path) {
 System loadCaseSystem(const Case& c) { return bindLayout(loadUrdf(c.urdfPath, c.layout.floatingBase), c.layout); }
 
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
-                               emit::ScalarType scalar, emit::SolverStats* stats) {
+                               emit::ScalarType scalar, emit::SolverStats* stats, System* system) {
   namespace fs = std::filesystem;
   const Case c = loadCase(casesFile, caseName);
   const System sys = loadCaseSystem(c);
+  if (system) *system = sys;
   emit::SolverInputs in;
   const std::string file = fs::path(casesFile).filename().string();
   in.urdfName = fs::path(c.urdfPath).filename().string();

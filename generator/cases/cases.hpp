@@ -31,6 +31,6 @@ System loadCaseSystem(const Case& c);
 /// `proxgen generate --cases FILE --case NAME`: the solver of one case
 /// (emit::generateSystem); `name` "" = the case's name.
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
-                               emit::ScalarType scalar, emit::SolverStats* stats = nullptr);
+                               emit::ScalarType scalar, emit::SolverStats* stats = nullptr, System* system = nullptr);
 
 }  // namespace proxgen

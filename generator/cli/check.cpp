@@ -22,7 +22,7 @@ namespace {
 using ordered_json = nlohmann::ordered_json;
 
 struct CheckOptions {
-  std::string urdf, layout;
+  std::string urdf, layout, scalar = "double";
   bool floating = false, json = false;
 };
 
@@ -169,6 +169,8 @@ std::string summaryText(const System& sys) {
 constexpr double kFloatUnitRoundoff = 0x1p-24;
 constexpr double kFloatWarnAbove = 1e-3;
 
+}  // namespace
+
 std::string floatAccuracyWarning(const System& sys) {
   int light = -1;
   for (int b : sys.supportBodies()) {
@@ -187,12 +189,19 @@ std::string floatAccuracyWarning(const System& sys) {
       sys.layoutPath, sys.mu, quoted(sys.model.bodies[light].link), m, estimate, kFloatWarnAbove * m / kFloatUnitRoundoff);
 }
 
+void printWarning(const std::string& text) {
+  if (!text.empty()) std::fprintf(stderr, "proxgen: warning: %s\n", oneLine(text, 1000).c_str());
+}
+
+namespace {
+
 void runCheck(const CheckOptions& o) {
   const System sys = loadForCheck(o);
   // Built in full before anything is printed: an error leaves stdout empty.
   const std::string out = o.json ? layoutJson(sys).dump(2) + "\n" : summaryText(sys);
-  for (const std::string& w : sys.model.warnings) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
-  if (const std::string w = floatAccuracyWarning(sys); !w.empty()) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
+  for (const std::string& w : sys.model.warnings) printWarning(w);
+  // Only when float is asked for: a double user has nothing to act on.
+  if (o.scalar == "float") printWarning(floatAccuracyWarning(sys));
   std::fputs(out.c_str(), stdout);
 }
 
@@ -205,6 +214,9 @@ void addCheck(CLI::App& app) {
   cmd->add_option("--layout", opts->layout, "constraint layout (YAML)");
   cmd->add_flag("--floating", opts->floating, "free-flyer root (without --layout; a layout says `base:`)");
   cmd->add_flag("--json", opts->json, "print the vector layout as JSON (the generated solvers' slots)");
+  cmd->add_option("--scalar", opts->scalar, "double (default) or float: with float, warn if the layout costs a float "
+                                            "solver accuracy")
+      ->check(CLI::IsMember({"double", "float"}));
   cmd->callback([opts] { runCheck(*opts); });
 }
 

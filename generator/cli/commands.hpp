@@ -19,8 +19,15 @@ void addVerify(CLI::App& app);    // verify.cpp
 void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
                        const std::string& cases, const std::string& caseName);
 
-/// The solver of those options (generate.cpp), shared by `generate` and `verify`.
+/// The solver of those options (generate.cpp), shared by `generate` and `verify`;
+/// with --scalar float, the float-accuracy warning (if any) on stderr.
 emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar);
+
+/// The warning that a float constrainedABA loses accuracy with this layout
+/// ("" if none; check.cpp). Printed when float is asked for: generate and
+/// verify with --scalar float, check with --scalar float.
+std::string floatAccuracyWarning(const System& sys);
+void printWarning(const std::string& text);
 
 }  // namespace proxgen::cli

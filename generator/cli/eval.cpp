@@ -195,7 +195,7 @@ void runEval(const EvalOptions& o) {
   // Printed only once everything succeeded: an error leaves stdout empty.
   // nlohmann prints the shortest decimal that reads back as the same double.
   const std::string out = (isList ? results : results.at(0)).dump(2) + "\n";
-  for (const std::string& w : sys.model.warnings) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
+  for (const std::string& w : sys.model.warnings) printWarning(w);
   std::fputs(out.c_str(), stdout);
 }
 

@@ -24,13 +24,20 @@ void checkRobotOptions(const char* command, const std::string& urdf, const std::
 
 emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar) {
-  if (!cases.empty()) return generateCase(cases, caseName, name, scalar);
-  emit::GenerateOptions g;
-  g.urdf = urdf;
-  g.layout = layout;
-  g.name = name;
-  g.scalar = scalar;
-  return emit::generateFiles(g);
+  System sys;
+  emit::SolverFiles files;
+  if (!cases.empty()) {
+    files = generateCase(cases, caseName, name, scalar, nullptr, &sys);
+  } else {
+    emit::GenerateOptions g;
+    g.urdf = urdf;
+    g.layout = layout;
+    g.name = name;
+    g.scalar = scalar;
+    files = emit::generateFiles(g, nullptr, &sys);
+  }
+  if (scalar == emit::ScalarType::Float) printWarning(floatAccuracyWarning(sys));
+  return files;
 }
 
 void addGenerate(CLI::App& app) {

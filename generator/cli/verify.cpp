@@ -220,6 +220,7 @@ int verify(const VerifyOptions& o) {
   const System sys = loadVerified(o);
   const Model& m = sys.model;
   const bool isFloat = o.scalar == "float";
+  if (isFloat) printWarning(floatAccuracyWarning(sys));
 
   Scratch scratch(makeTemporaryFolder());
   const fs::path hpp = scratch.file(std::string(kSolverName) + ".hpp"), cpp = scratch.file(std::string(kSolverName) + ".cpp"),
@@ -241,8 +242,18 @@ int verify(const VerifyOptions& o) {
   } keepOnExit{scratch, o.keep};
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<emit::OutputFile> files = emit::solverOutputs(
-      generateSolverFiles(o.urdf, o.layout, o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar)));
+  // (generateFiles directly, not generateSolverFiles: the warning is out already)
+  std::vector<emit::OutputFile> files;
+  if (!o.cases.empty()) {
+    files = emit::solverOutputs(generateCase(o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar)));
+  } else {
+    emit::GenerateOptions g;
+    g.urdf = o.urdf;
+    g.layout = o.layout;
+    g.name = kSolverName;
+    g.scalar = emit::parseScalar(o.scalar);
+    files = emit::solverOutputs(emit::generateFiles(g));
+  }
   files.push_back({"driver.cpp", kDriver});
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();

@@ -32,8 +32,9 @@ SolverFiles generateSystem(const System& sys, const std::string& name, ScalarTyp
   return emitSolver(sys, plan, in, stats);
 }
 
-SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats) {
+SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, System* system) {
   const System sys = loadSystem(options.urdf, options.layout);
+  if (system) *system = sys;
   const std::string name = options.name.empty() ? fs::path(options.urdf).stem().string() : options.name;
   SolverInputs in;
   in.urdfName = fs::path(options.urdf).filename().string();

@@ -20,7 +20,8 @@ struct GenerateOptions {
 
 /// Loads the inputs and prints the solver in memory. Throws proxgen::Error
 /// (the loaders' messages) on bad input.
-SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = nullptr);
+/// `system`, if given, receives the loaded System (for the CLI's warnings).
+SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = nullptr, System* system = nullptr);
 
 /// The pipeline after loading: the plan of `sys` under `name` (sanitised) and
 /// the emitted files. `in` describes the inputs for the files' banner; its
