@@ -210,7 +210,7 @@ void keepFiles(const Scratch& scratch, const std::string& keep) {
     out.push_back({f, slurp(scratch.dir() / f), f == "driver"});
   }
   emit::writeFiles(out, keep);
-  fmt::print("kept the generated solver, driver and logs in {}\n", keep);
+  fmt::print("kept the generated solver, driver and logs in {}\n", oneLine(keep, 1000));
 }
 
 const char* const kSolverName = "proxgen_verify_solver";
