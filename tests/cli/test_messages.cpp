@@ -66,6 +66,16 @@ TEST(Messages, CommandLineSyntaxErrorsAreOneEscapedLine) {
   EXPECT_GE(unknown.code, 100);
 }
 
+// check's summary prints names as they are, escaped: the hostile fixture's tab,
+// carriage return and newline inside names reach stdout as \x09, \x0d, \x0a.
+TEST(Messages, CheckSummaryEscapesHostileNames) {
+  const ProcessResult r = runProxgen({"check", std::string(PROXGEN_TEST_DATA_DIR) + "/hostile/names.urdf"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (unsigned char c : r.out) EXPECT_FALSE((c < 0x20 && c != '\n') || c == 0x7f) << "raw control byte " << int(c);
+  EXPECT_NE(r.out.find("tab\\x09cr\\x0dend"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("line1\\x0a#include"), std::string::npos) << r.out;
+}
+
 TEST(Messages, EscapingKeepsPrintableUtf8AndEscapesTheRest) {
   EXPECT_EQ(quoted("caf\xc3\xa9"), "'caf\xc3\xa9'");                       // printable UTF-8 kept
   EXPECT_EQ(quoted("\xc2\x9b"), "'\\x9b'");                                 // C1 CSI
