@@ -1,7 +1,7 @@
 // proxgen check: what proxgen made of a URDF (and a layout). As text, a summary
 // for people: bodies in depth-first order, their joints, merged links, DoF,
 // constraint rows and the support set. With --json, the vector layout every
-// generated solver uses (PRODUCT.md, "The generated solver"), so a tool can map
+// generated solver uses (README.md, "The generated solver"), so a tool can map
 // names to slots. Model warnings (mimic joints, ...) go to stderr.
 #include <fmt/format.h>
 

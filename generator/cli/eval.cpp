@@ -1,6 +1,6 @@
 // proxgen eval: runs one generic solver on states read from JSON and prints the
-// results as JSON, keyed by joint and constraint names (PRODUCT.md, "States and
-// results"). One state object gives one result object, a list gives a list.
+// results as JSON, keyed by joint and constraint names (docs/design.md,
+// "Conventions"). One state object gives one result object, a list gives a list.
 // The residual ||J qdd + gamma - aStar|| is recomputed here from the solver's
 // output (constraintJacobian), so it checks the answer rather than repeating
 // what the solver believes.
