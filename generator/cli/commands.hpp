@@ -19,8 +19,8 @@ void addVerify(CLI::App& app);    // verify.cpp
 void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
                        const std::string& cases, const std::string& caseName);
 
-/// The solver of those options (generate.cpp), shared by `generate` and `verify`;
-/// with --scalar float, the float-accuracy warning (if any) on stderr.
+/// The solver of `generate`'s options (generate.cpp): a URDF and a layout, or a
+/// case; with --scalar float, the float-accuracy warning (if any) on stderr.
 emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar);
 

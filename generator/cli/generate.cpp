@@ -57,7 +57,8 @@ void addGenerate(CLI::App& app) {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
     const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
                                                         emit::parseScalar(opt->scalar));
-    for (const std::string& path : emit::writeFiles(emit::solverOutputs(files), opt->out)) std::printf("wrote %s\n", oneLine(path, 1000).c_str());
+    for (const std::string& path : emit::writeFiles(emit::solverOutputs(files), opt->out))
+      std::printf("wrote %s\n", oneLine(path, 1000).c_str());
   });
 }
 
