@@ -10,7 +10,7 @@
 #include <set>
 #include <string>
 
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/layout.hpp"
 
 namespace fs = std::filesystem;

@@ -10,7 +10,7 @@
 #include "algorithms/prox_ltls.hpp"
 #include "algorithms/prox_pv.hpp"
 #include "generated.hpp"
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/error.hpp"
 
 namespace proxgen::bench {

@@ -9,18 +9,31 @@
 # Needs PROXGEN_EXECUTABLE (path or generator expression), PROXGEN_EXECUTABLE_DEPENDS
 # (what the generation step depends on for "proxgen changed") and
 # PROXGEN_RUNTIME_INCLUDE_DIR; proxgenConfig.cmake and the in-tree build set them.
-# proxgen_solver_compile_options(<out_var>): the compile options
-# proxgen_add_solver gives a generated solver (the bench's compile-time table
-# uses them too). With GCC, no basic-block vectoriser: it packs unrelated scalar
+# proxgen_solver_compile_options(<out_var> [CHECKED]): the compile options of
+# every generated solver: what proxgen_add_solver gives one, and with CHECKED
+# what the project's own compiles of generated code add to them (the
+# generated-solver tests in tests/generated, `proxgen verify`, through a list
+# baked in at configure time, and tests/generated/measure.sh, through
+# <build>/generator/solver_compile_options.txt), so what is tested is what users
+# build.
+# Always: with GCC, no basic-block vectoriser: it packs unrelated scalar
 # products of the straight-line code into vectors and pays more in shuffles than
 # it saves; without it the solvers run 2-6 % fewer instructions in 3-9 % less
 # time and the largest compile faster (with the column loops: 34 -> 20 s at -O2;
 # docs/benchmarks.md, "Emitted code"). Loops (the constraint columns) are still
 # vectorised.
+# CHECKED adds: -O2 (the level of every measured figure; a user's build keeps
+# its build type's level), no exceptions and no RTTI (the header contract: a
+# solver needs neither), and warnings as errors (generated code must be
+# warning-free under -Wall -Wextra -Wpedantic).
 function(proxgen_solver_compile_options out)
+  cmake_parse_arguments(PARSE_ARGV 1 PSCO "CHECKED" "" "")
   set(options "")
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
     list(APPEND options -fno-tree-slp-vectorize)
+  endif()
+  if(PSCO_CHECKED)
+    list(APPEND options -O2 -fno-exceptions -fno-rtti -Wall -Wextra -Wpedantic -Werror)
   endif()
   set(${out} "${options}" PARENT_SCOPE)
 endfunction()

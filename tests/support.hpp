@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/error.hpp"
 #include "model/model.hpp"
 #include "model/state.hpp"

@@ -1,7 +1,7 @@
 // proxgen check: what proxgen made of a URDF (and a layout). As text, a summary
 // for people: bodies in depth-first order, their joints, merged links, DoF,
 // constraint rows and the support set. With --json, the vector layout every
-// generated solver uses (PRODUCT.md, "The generated solver"), so a tool can map
+// generated solver uses (README.md, "The generated solver"), so a tool can map
 // names to slots. Model warnings (mimic joints, ...) go to stderr.
 #include <fmt/format.h>
 
@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "model/error.hpp"
+#include "model/warn.hpp"
 #include "model/layout.hpp"
 #include "model/urdf.hpp"
 
@@ -22,7 +23,7 @@ namespace {
 using ordered_json = nlohmann::ordered_json;
 
 struct CheckOptions {
-  std::string urdf, layout;
+  std::string urdf, layout, scalar = "double";
   bool floating = false, json = false;
 };
 
@@ -96,6 +97,11 @@ ordered_json layoutJson(const System& sys) {
   return out;
 }
 
+// A name or path in the summary, escaped like every message (control and C1
+// characters, bytes that are not UTF-8), uncut: the summary names links,
+// joints and files as they are, and a hostile name must not act on the terminal.
+std::string shown(const std::string& text) { return oneLine(text, std::string::npos); }
+
 std::string joinNames(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
@@ -125,8 +131,8 @@ std::string bodiesText(const Model& m) {
     const Body& b = m.bodies[i];
     const Joint& j = b.joint;
     const std::string axis = j.type == JointType::FreeFlyer ? "-" : fmt::format("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2]);
-    rows.push_back({std::to_string(i), b.link, std::to_string(b.parent), j.name, j.urdfType, std::to_string(j.idx_q),
-                    std::to_string(j.idx_v), axis, joinNames(mergedLinks(m, i))});
+    rows.push_back({std::to_string(i), shown(b.link), std::to_string(b.parent), shown(j.name), shown(j.urdfType),
+                    std::to_string(j.idx_q), std::to_string(j.idx_v), axis, shown(joinNames(mergedLinks(m, i)))});
   }
   return "bodies (depth-first; parent 0 is the world):\n" + table(rows);
 }
@@ -135,22 +141,23 @@ std::string constraintsText(const System& sys) {
   if (sys.constraints.empty()) return "constraints: none\n";
   std::string out = "constraints (rows in layout order):\n";
   for (const Constraint& c : sys.constraints)
-    out += fmt::format("  {:<24} {} on link {} (body {}, {}), rows {}..{}\n", c.name, constraintTypeName(c.type), c.link,
-                       c.body, sys.model.bodies[c.body].link, c.row, c.row + c.rows() - 1);
+    out += fmt::format("  {:<24} {} on link {} (body {}, {}), rows {}..{}\n", shown(c.name), constraintTypeName(c.type),
+                       shown(c.link), c.body, shown(sys.model.bodies[c.body].link), c.row, c.row + c.rows() - 1);
   return out;
 }
 
 std::string supportText(const System& sys) {
   std::vector<std::string> names;
-  for (int i : sys.supportBodies()) names.push_back(fmt::format("{} {}", i, sys.model.bodies[i].link));
+  for (int i : sys.supportBodies()) names.push_back(fmt::format("{} {}", i, shown(sys.model.bodies[i].link)));
   return fmt::format("support (bodies on the paths from constrained bodies to the root): {}\n", joinNames(names));
 }
 
 std::string summaryText(const System& sys) {
   const Model& m = sys.model;
-  std::string out = fmt::format("robot {} ({}), {} base\n", m.name, m.sourcePath, m.floatingBase ? "floating" : "fixed");
+  std::string out = fmt::format("robot {} ({}), {} base\n", shown(m.name), shown(m.sourcePath),
+                                m.floatingBase ? "floating" : "fixed");
   if (!sys.layoutPath.empty())
-    out += fmt::format("layout {}: mu {}, iterations {}\n", sys.layoutPath, sys.mu, sys.iterations);
+    out += fmt::format("layout {}: mu {}, iterations {}\n", shown(sys.layoutPath), sys.mu, sys.iterations);
   out += fmt::format("gravity [{}, {}, {}]\n", m.gravity[0], m.gravity[1], m.gravity[2]);
   out += fmt::format("nq {}, nv {} (DoF), nc {}, {} moving bodies, {} links\n\n", m.nq, m.nv, sys.nc,
                      m.numBodies() - 1, m.frames.size());
@@ -168,6 +175,8 @@ std::string summaryText(const System& sys) {
 // skipped.
 constexpr double kFloatUnitRoundoff = 0x1p-24;
 constexpr double kFloatWarnAbove = 1e-3;
+
+}  // namespace
 
 std::string floatAccuracyWarning(const System& sys) {
   int light = -1;
@@ -187,11 +196,19 @@ std::string floatAccuracyWarning(const System& sys) {
       sys.layoutPath, sys.mu, quoted(sys.model.bodies[light].link), m, estimate, kFloatWarnAbove * m / kFloatUnitRoundoff);
 }
 
+void printWarning(const std::string& text) {
+  // Held with the loaders' warnings until the command succeeded (model/warn.hpp).
+  if (!text.empty()) warnLine(text);
+}
+
+namespace {
+
 void runCheck(const CheckOptions& o) {
   const System sys = loadForCheck(o);
   // Built in full before anything is printed: an error leaves stdout empty.
   const std::string out = o.json ? layoutJson(sys).dump(2) + "\n" : summaryText(sys);
-  if (const std::string w = floatAccuracyWarning(sys); !w.empty()) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
+  // Only when float is asked for: a double user has nothing to act on.
+  if (o.scalar == "float") printWarning(floatAccuracyWarning(sys));
   std::fputs(out.c_str(), stdout);
 }
 
@@ -204,6 +221,9 @@ void addCheck(CLI::App& app) {
   cmd->add_option("--layout", opts->layout, "constraint layout (YAML)");
   cmd->add_flag("--floating", opts->floating, "free-flyer root (without --layout; a layout says `base:`)");
   cmd->add_flag("--json", opts->json, "print the vector layout as JSON (the generated solvers' slots)");
+  cmd->add_option("--scalar", opts->scalar, "double (default) or float: with float, warn if the layout costs a float "
+                                            "solver accuracy")
+      ->check(CLI::IsMember({"double", "float"}));
   cmd->callback([opts] { runCheck(*opts); });
 }
 

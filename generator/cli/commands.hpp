@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "emit/emitter.hpp"
+
 namespace proxgen::cli {
 
 void addCheck(CLI::App& app);     // check.cpp
@@ -16,5 +18,18 @@ void addVerify(CLI::App& app);    // verify.cpp
 /// --case, never a mix (generate.cpp).
 void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,
                        const std::string& cases, const std::string& caseName);
+
+/// The solver of `generate`'s options (generate.cpp): a URDF and a layout, or a
+/// case; with --scalar float, the float-accuracy warning (if any) on stderr.
+/// `loaded`, if given, receives the System the solver was generated from.
+emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
+                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar,
+                                      System* loaded = nullptr);
+
+/// The warning that a float constrainedABA loses accuracy with this layout
+/// ("" if none; check.cpp). Printed when float is asked for: generate and
+/// verify with --scalar float, check with --scalar float.
+std::string floatAccuracyWarning(const System& sys);
+void printWarning(const std::string& text);
 
 }  // namespace proxgen::cli

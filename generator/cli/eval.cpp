@@ -1,6 +1,6 @@
 // proxgen eval: runs one generic solver on states read from JSON and prints the
-// results as JSON, keyed by joint and constraint names (PRODUCT.md, "States and
-// results"). One state object gives one result object, a list gives a list.
+// results as JSON, keyed by joint and constraint names (docs/design.md,
+// "Conventions"). One state object gives one result object, a list gives a list.
 // The residual ||J qdd + gamma - aStar|| is recomputed here from the solver's
 // output (constraintJacobian), so it checks the answer rather than repeating
 // what the solver believes.
@@ -130,6 +130,44 @@ ordered_json resultJson(const System& sys, const Answer& a, const std::string& a
           {"algorithm", algorithm}, {"residual", residual}};
 }
 
+// --- overflow: a result that is not finite is an error naming what overflowed
+
+bool finite(const Mat6& x) { return x.allFinite(); }
+bool finite(const Vec6& x) { return x.allFinite(); }
+
+// The first non-finite quantity of one solve, named by body, joint or
+// constraint ("" when all are finite). The body-wise intermediates every
+// recursive algorithm fills (placements, velocities, accelerations, and for the
+// articulated ones the articulated inertias and bias forces) are checked
+// before the outputs: the first quantity that overflowed says why the rest did.
+std::string firstNonFinite(const System& sys, const Data& d, Algorithm algorithm, const Answer& a, double residual) {
+  const Model& m = sys.model;
+  if (algorithm != Algorithm::Dense) {
+    for (int i = 1; i < m.numBodies(); ++i) {
+      const std::string body = fmt::format("body {}", quoted(m.bodies[i].link));
+      if (!d.oMi[i].R.allFinite() || !d.oMi[i].p.allFinite()) return body + " placement";
+      if (!finite(d.v[i])) return body + " velocity";
+      if (!finite(d.a[i])) return body + " acceleration";
+    }
+    if (algorithm == Algorithm::Caba || algorithm == Algorithm::Pv)
+      for (int i = 1; i < m.numBodies(); ++i) {
+        const std::string body = fmt::format("body {}", quoted(m.bodies[i].link));
+        if (!finite(d.IA[i])) return body + " articulated inertia";
+        if (!finite(d.pA[i])) return body + " articulated bias force";
+      }
+  }
+  for (int i = 1; i < m.numBodies(); ++i) {
+    const Joint& j = m.bodies[i].joint;
+    for (int k = 0; k < j.nv; ++k)
+      if (!std::isfinite(a.qdd[j.idx_v + k])) return fmt::format("qdd of joint {}", quoted(j.name));
+  }
+  for (const Constraint& c : sys.constraints)
+    for (int r = 0; r < c.rows(); ++r)
+      if (!std::isfinite(a.lambda[c.row + r])) return fmt::format("lambda of constraint {}", quoted(c.name));
+  if (!std::isfinite(residual)) return "the constraint residual";
+  return "";
+}
+
 void runEval(const EvalOptions& o) {
   const Algorithm algorithm = parseAlgorithm(o.algorithm);
   const System sys = loadSystem(o.urdf, o.layout);
@@ -140,9 +178,19 @@ void runEval(const EvalOptions& o) {
 
   Data d(sys);
   ordered_json results = ordered_json::array();
-  for (const State& s : states) {
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    const State& s = states[k];
     const Answer a = solve(sys, d, algorithm, s, mu, K);
-    results.push_back(resultJson(sys, a, o.algorithm, mu, K, constraintResidual(sys, d, s, a.qdd)));
+    const std::string overflowed = firstNonFinite(sys, d, algorithm, a, 0.0);
+    const double residual = overflowed.empty() ? constraintResidual(sys, d, s, a.qdd) : 0.0;
+    const std::string what = overflowed.empty() ? firstNonFinite(sys, d, algorithm, a, residual) : overflowed;
+    // JSON has no infinity: nlohmann would print null and exit 0 with no answer.
+    if (!what.empty())
+      fail(o.state, isList ? fmt::format("[{}]", k) : "",
+           fmt::format("{} is not finite: {} overflowed double at this state (mu {}, K {}); the inputs are too "
+                       "large or too small for the dynamics",
+                       what, o.algorithm, mu, K));
+    results.push_back(resultJson(sys, a, o.algorithm, mu, K, residual));
   }
   // Printed only once everything succeeded: an error leaves stdout empty.
   // nlohmann prints the shortest decimal that reads back as the same double.

@@ -5,8 +5,11 @@
 
 #include <cstdio>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "cli/commands.hpp"
+#include "cases/cases.hpp"
 #include "emit/generate.hpp"
 #include "emit/python_module.hpp"
 #include "model/error.hpp"
@@ -20,6 +23,26 @@ void checkRobotOptions(const char* command, const std::string& urdf, const std::
     throw Error(fmt::format("{}: --cases and --case go together, without a URDF or --layout", command));
   if (!byCase && (urdf.empty() || layout.empty()))
     throw Error(fmt::format("{}: needs a URDF and --layout (or --cases and --case)", command));
+}
+
+emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
+                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar,
+                                      System* loaded) {
+  System sys;
+  emit::SolverFiles files;
+  if (!cases.empty()) {
+    files = generateCase(cases, caseName, name, scalar, nullptr, &sys);
+  } else {
+    emit::GenerateOptions g;
+    g.urdf = urdf;
+    g.layout = layout;
+    g.name = name;
+    g.scalar = scalar;
+    files = emit::generateFiles(g, nullptr, &sys);
+  }
+  if (scalar == emit::ScalarType::Float) printWarning(floatAccuracyWarning(sys));
+  if (loaded) *loaded = std::move(sys);
+  return files;
 }
 
 void addGenerate(CLI::App& app) {
@@ -39,18 +62,14 @@ void addGenerate(CLI::App& app) {
   cmd->add_flag("--python", opt->python, "also write NAME_python.cpp, a pybind11 module over the solver (docs/python.md)");
   cmd->callback([opt] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
-    emit::GenerateOptions g;
-    g.urdf = opt->urdf;
-    g.layout = opt->layout;
-    g.casesFile = opt->cases;
-    g.caseName = opt->caseName;
-    g.name = opt->name;
-    g.scalar = emit::parseScalar(opt->scalar);
-    const emit::SolverFiles files = emit::generateFiles(g);
-    const emit::PythonModuleFile module = opt->python ? emit::generatePythonModule(g) : emit::PythonModuleFile{};
-    for (const std::string& path : emit::writeFiles(files, opt->out)) std::printf("wrote %s\n", path.c_str());
-    // Not yet atomic with the two files above (writeFiles takes a list soon).
-    if (opt->python) std::printf("wrote %s\n", emit::writePythonModule(module, opt->out).c_str());
+    System sys;
+    const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
+                                                        emit::parseScalar(opt->scalar), &sys);
+    std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
+    // The module source goes through the same atomic write as the solver's files.
+    if (opt->python) outputs.push_back(emit::pythonModuleOutput(sys, files, emit::parseScalar(opt->scalar)));
+    for (const std::string& path : emit::writeFiles(outputs, opt->out))
+      std::printf("wrote %s\n", oneLine(path, 1000).c_str());
   });
 }
 

@@ -2,10 +2,25 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <string>
 
 #include "cli/commands.hpp"
+#include "emit/output.hpp"
 #include "model/error.hpp"
 #include "model/warn.hpp"
+
+namespace {
+
+// Every message leaves through here: one line, control characters, C1 controls
+// and bytes that are not UTF-8 escaped (model/error.hpp oneLine), whoever wrote
+// it (our errors, CLI11's, a library's). Long enough for a path and a reason.
+constexpr std::size_t kMaxMessage = 1000;
+
+void printError(const char* kind, const std::string& what) {
+  std::fprintf(stderr, "proxgen: %s: %s\n", kind, proxgen::oneLine(what, kMaxMessage).c_str());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"proxgen " PROXGEN_VERSION ": generates flat C++ constrained-dynamics solvers for one robot"};
@@ -15,16 +30,28 @@ int main(int argc, char** argv) {
   proxgen::cli::addEval(app);
   proxgen::cli::addGenerate(app);
   proxgen::cli::addVerify(app);
+  // An interrupted generate or verify removes its temporaries (emit/output.hpp).
+  proxgen::emit::installInterruptCleanup();
   try {
     app.parse(argc, argv);
     proxgen::flushWarnings();  // only once the command succeeded: bad input prints one line
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);  // --help, --version: CLI11 prints them, exit 0
+  } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // CLI11's message may quote an argument verbatim (a path after `--` with a
+    // newline in it): escaped like ours, on one line. The exit code stays
+    // CLI11's (100 and above: command-line syntax, docs/cli.md "Errors").
+    printError("error", std::string(e.what()) + " (proxgen --help for usage)");
+    return e.get_exit_code();
   } catch (const proxgen::Error& e) {
-    std::fprintf(stderr, "proxgen: error: %s\n", e.what());
+    printError("error", e.what());
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "proxgen: internal error: %s\n", e.what());
+    printError("internal error", e.what());
     return 3;
   }
   return 0;

@@ -3,12 +3,9 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
-#include <system_error>
 
 #include "emit/hash.hpp"
 #include "emit/plan.hpp"
-#include "model/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 
@@ -43,76 +40,31 @@ void checkSize(const Plan& plan, const std::string& urdf, const std::string& lay
                      plan.nc, plan.support.size(), rows, kMaxGenerateSupportRows));
 }
 
-SolverFiles generateCase(const GenerateOptions& options, SolverStats* stats) {
-  const Case c = loadCase(options.casesFile, options.caseName);
-  const System sys = loadCaseSystem(c);
-  const Plan plan = makePlan(sys, options.name.empty() ? c.name : options.name, options.scalar);
-  checkSize(plan, c.urdfPath, options.casesFile);
-  SolverInputs in;
-  in.urdfName = fs::path(c.urdfPath).filename().string();
-  in.layoutName = fmt::format("{} (case {})", fs::path(options.casesFile).filename().string(), c.name);
-  in.urdfSha256 = sha256File(c.urdfPath);
-  in.layoutSha256 = sha256File(options.casesFile);
-  in.command = fmt::format("proxgen generate --cases {} --case {} --out DIR --name {} --scalar {}",
-                           fs::path(options.casesFile).filename().string(), c.name, plan.name,
-                           scalarName(options.scalar));
+}  // namespace
+
+SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
+                           SolverStats* stats) {
+  const Plan plan = makePlan(sys, name, scalar);
+  checkSize(plan, sys.model.sourcePath, sys.layoutPath);
+  in.command = fmt::format("{} --out DIR --name {} --scalar {}", in.command, plan.name, scalarName(scalar));
   return emitSolver(sys, plan, in, stats);
 }
 
-}  // namespace
-
-SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats) {
-  if (!options.casesFile.empty()) return generateCase(options, stats);
+SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, System* system) {
   const System sys = loadSystem(options.urdf, options.layout);
+  if (system) *system = sys;
   const std::string name = options.name.empty() ? fs::path(options.urdf).stem().string() : options.name;
-  const Plan plan = makePlan(sys, name, options.scalar);
-  checkSize(plan, options.urdf, options.layout);
   SolverInputs in;
   in.urdfName = fs::path(options.urdf).filename().string();
   in.layoutName = fs::path(options.layout).filename().string();
   in.urdfSha256 = sha256File(options.urdf);
   in.layoutSha256 = sha256File(options.layout);
-  in.command = fmt::format("proxgen generate {} --layout {} --out DIR --name {} --scalar {}", in.urdfName,
-                           in.layoutName, plan.name, scalarName(options.scalar));
-  return emitSolver(sys, plan, in, stats);
+  in.command = fmt::format("proxgen generate {} --layout {}", in.urdfName, in.layoutName);
+  return generateSystem(sys, name, options.scalar, in, stats);
 }
 
-namespace {
-
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(text.data(), std::streamsize(text.size()));
-  out.close();
-  if (!out) throw Error(fmt::format("{}: cannot be written", path.string()));
-}
-
-}  // namespace
-
-std::vector<std::string> writeFiles(const SolverFiles& files, const std::string& outDir) {
-  const fs::path dir(outDir);
-  std::error_code ec;
-  const bool existed = fs::is_directory(dir, ec);
-  if (!existed && fs::exists(dir, ec)) throw Error(fmt::format("{}: exists and is not a folder", outDir));
-  if (!existed && !fs::create_directories(dir, ec) && ec)
-    throw Error(fmt::format("{}: cannot create the folder ({})", outDir, ec.message()));
-  const std::vector<std::pair<fs::path, const std::string*>> out = {{dir / files.headerName, &files.header},
-                                                                     {dir / files.sourceName, &files.source}};
-  std::vector<fs::path> temps;
-  try {
-    for (const auto& [path, text] : out) {
-      temps.push_back(dir / ("." + path.filename().string() + ".proxgen-tmp"));
-      writeText(temps.back(), *text);
-    }
-    for (std::size_t k = 0; k < out.size(); ++k) {
-      fs::rename(temps[k], out[k].first, ec);
-      if (ec) throw Error(fmt::format("{}: cannot be written ({})", out[k].first.string(), ec.message()));
-    }
-  } catch (...) {
-    for (const fs::path& t : temps) fs::remove(t, ec);
-    if (!existed) fs::remove(dir, ec);  // only removes it if empty
-    throw;
-  }
-  return {out[0].first.string(), out[1].first.string()};
+std::vector<OutputFile> solverOutputs(const SolverFiles& files) {
+  return {{files.headerName, files.header}, {files.sourceName, files.source}};
 }
 
 }  // namespace proxgen::emit

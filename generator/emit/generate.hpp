@@ -1,10 +1,14 @@
-// `proxgen generate` as a library call: URDF + layout -> plan -> the two files
-// of a solver, written atomically (both or nothing) into the output folder.
+// `proxgen generate` as a library call: URDF + layout -> System -> plan -> the
+// two files of a solver, written atomically (both or nothing) into the output
+// folder (emit/output.hpp). One pipeline: every way in (files here, a case of a
+// cases file in cases/cases.hpp) loads a System and calls generateSystem.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "emit/emitter.hpp"
+#include "emit/output.hpp"
 
 namespace proxgen::emit {
 
@@ -21,21 +25,24 @@ inline constexpr int kMaxGenerateSupportRows = 4096;
 
 struct GenerateOptions {
   std::string urdf, layout;  // input files
-  /// Instead of urdf + layout: one case of a cases file (cases.yaml: a list of
-  /// layouts with `name` and `model`), as the tests and benchmarks use them.
-  std::string casesFile, caseName;
-  std::string name;          // namespace and file stem; "" = the case name or the URDF's file stem
+  std::string name;          // namespace and file stem; "" = the URDF's file stem
   ScalarType scalar = ScalarType::Double;
 };
 
 /// Loads the inputs and prints the solver in memory. Throws proxgen::Error
 /// (the loaders' messages) on bad input.
-SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = nullptr);
+/// `system`, if given, receives the loaded System (for the CLI's warnings).
+SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = nullptr, System* system = nullptr);
 
-/// Writes the files into `outDir` (created if missing): each to a temporary
-/// file in that folder, then renamed, so a failure leaves nothing new behind.
-/// Returns the paths written.
-std::vector<std::string> writeFiles(const SolverFiles& files, const std::string& outDir);
+/// The pipeline after loading: the plan of `sys` under `name` (sanitised) and
+/// the emitted files. `in` describes the inputs for the files' banner; its
+/// `command` is the command's start ("proxgen generate arm.urdf --layout
+/// layout.yaml"), completed here with --out, --name and --scalar.
+SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
+                           SolverStats* stats = nullptr);
+
+/// The solver's files as outputs for writeFiles (emit/output.hpp): NAME.hpp, NAME.cpp.
+std::vector<OutputFile> solverOutputs(const SolverFiles& files);
 
 /// "double" / "float" -> ScalarType; throws proxgen::Error otherwise.
 ScalarType parseScalar(const std::string& s);

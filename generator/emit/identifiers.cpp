@@ -2,15 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
+#include <cstring>
+#include <iterator>
 
 namespace proxgen::emit {
 namespace {
 
 // C++17 keywords and alternative tokens, C++20 keywords (so the files stay
-// valid in later standards), the standard macros the runtime's <cmath> may
-// define, and the namespaces the generated files use.
+// valid in later standards), and the names the generated files themselves use
+// or that common headers outside the standard library define as macros.
 constexpr std::array kReserved = {
     "alignas", "alignof", "and", "and_eq", "asm", "auto", "bitand", "bitor", "bool", "break", "case",
     "catch", "char", "char8_t", "char16_t", "char32_t", "class", "compl", "concept", "const", "consteval",
@@ -22,23 +25,57 @@ constexpr std::array kReserved = {
     "static_assert", "static_cast", "struct", "switch", "template", "this", "thread_local", "throw", "true",
     "try", "typedef", "typeid", "typename", "union", "unsigned", "using", "virtual", "void", "volatile",
     "wchar_t", "while", "xor", "xor_eq", "final", "override", "import", "module",
-    // macros of <cmath>, <cstddef>, <cassert>, <cerrno>, <climits>
-    "NULL", "EOF", "assert", "errno", "offsetof", "INFINITY", "NAN", "HUGE_VAL", "HUGE_VALF", "HUGE_VALL",
-    "FP_NAN", "FP_INFINITE", "FP_ZERO", "FP_NORMAL", "FP_SUBNORMAL", "FP_FAST_FMA", "FP_ILOGB0",
-    "FP_ILOGBNAN", "MATH_ERRNO", "MATH_ERREXCEPT", "math_errhandling", "isnan", "isinf", "isfinite",
-    "signbit", "fpclassify", "isnormal", "EDOM", "ERANGE", "EILSEQ", "CHAR_BIT", "INT_MAX", "INT_MIN",
-    "M_PI", "M_E", "unix", "linux", "i386",
+    // predefined on some targets, and macros of common non-standard headers
+    // (windows.h, sys/param.h, Eigen's namespace)
+    "unix", "linux", "i386", "min", "max", "MIN", "MAX", "TRUE", "FALSE", "ERROR", "DELETE", "IN", "OUT",
+    "OPTIONAL", "interface", "near", "far", "pascal", "cdecl", "small", "Eigen", "noreturn", "complex",
+    "imaginary", "I",
     // namespaces and names the generated files rely on
     "std", "proxgen", "proxgen_rt", "Scalar", "Settings", "Workspace", "main"};
+
+// The global names and macros of the C and C++ libraries (reserved_names.inc:
+// derived by the compiler from the headers, kept honest by a test).
+constexpr const char* kLibraryNames[] = {
+#include "emit/reserved_names.inc"
+};
+
+// Families the C and POSIX standards reserve for the library, so that a name of
+// one is taken on some platform even where this list's headers lack it:
+// POSIX types end in "_t"; errno macros are E + digit or capital; and the
+// macro prefixes of <cmath>, <cfloat>, <climits>, <cstdint>, <cinttypes>,
+// <cfenv>, <csignal>, <clocale>, <fcntl.h> and <sys/stat.h>.
+bool inReservedFamily(const std::string& id) {
+  const auto starts = [&](const char* p) { return id.rfind(p, 0) == 0; };
+  const auto upperAt = [&](std::size_t k) {
+    return id.size() > k && (std::isupper(static_cast<unsigned char>(id[k])) || std::isdigit(static_cast<unsigned char>(id[k])));
+  };
+  if (id.size() > 2 && id.compare(id.size() - 2, 2, "_t") == 0) return true;
+  if (id[0] == 'E' && upperAt(1)) return true;
+  for (const char* p : {"M_", "FP_", "FLT_", "DBL_", "LDBL_", "FE_", "SIG_", "LC_", "O_", "S_I", "F_", "AT_",
+                        "MATH_", "HUGE_", "SIZE_", "PTRDIFF_", "WCHAR_", "WINT_", "SCHAR_", "UCHAR_", "CHAR_",
+                        "SHRT_", "USHRT_", "LONG_", "ULONG_", "LLONG_", "ULLONG_", "EXIT_", "SEEK_"})
+    if (starts(p)) return true;
+  // SIGINT, PRId64, SCNx32, INT8_MAX, UINTMAX_MAX, INT_FAST16_MIN
+  if ((starts("SIG") && upperAt(3)) || (starts("PRI") && id.size() > 3 && std::islower(static_cast<unsigned char>(id[3]))) ||
+      (starts("SCN") && id.size() > 3 && std::islower(static_cast<unsigned char>(id[3]))))
+    return true;
+  if ((starts("INT") && upperAt(3)) || (starts("UINT") && upperAt(4)) || starts("INT_") || starts("UINT_")) return true;
+  return false;
+}
 
 bool isIdentChar(unsigned char c) { return std::isalnum(c) != 0 && c < 0x80; }
 
 }  // namespace
 
 bool isReservedIdentifier(const std::string& id) {
+  // The prefix sanitizeIdentifier gives reserved names is ours: no library
+  // declares a name starting "kw_", so "kw_size_t" is free although it ends in "_t".
+  if (id.empty() || id.rfind("kw_", 0) == 0) return false;
   for (const char* r : kReserved)
     if (id == r) return true;
-  return false;
+  const auto less = [](const char* a, const char* b) { return std::strcmp(a, b) < 0; };
+  if (std::binary_search(std::begin(kLibraryNames), std::end(kLibraryNames), id.c_str(), less)) return true;
+  return inReservedFamily(id);
 }
 
 std::string sanitizeIdentifier(const std::string& name) {

@@ -16,13 +16,17 @@ inline constexpr std::size_t kMaxCommentLength = 120;
 
 /// A safe C++ identifier derived from `name`: ASCII letters, digits and single
 /// underscores only; never empty, never starting with a digit or an underscore,
-/// never ending with an underscore, never containing "__", never a keyword,
-/// an alternative token or a macro of the standard headers; at most
-/// kMaxIdentifierLength characters.
+/// never ending with an underscore, never containing "__", never reserved
+/// (isReservedIdentifier: a reserved name gets the prefix "kw_"); at most
+/// kMaxIdentifierLength characters (+ 3 for the prefix).
 std::string sanitizeIdentifier(const std::string& name);
 
-/// True for C++ keywords, alternative tokens and reserved names the generated
-/// files must not declare (standard macros, `std`, the runtime's namespace).
+/// True for names the generated files must not declare as a namespace or use
+/// as a name: C++ keywords and alternative tokens, every global name and macro
+/// of the C and C++ standard libraries and POSIX (reserved_names.inc), the
+/// families those standards reserve (`*_t`, `E[0-9A-Z]*`, `M_*`, `INT*_MAX`, ...),
+/// common macros of other headers, and the runtime's and files' own names
+/// (`proxgen_rt`, `Scalar`, `Settings`, `Workspace`).
 bool isReservedIdentifier(const std::string& id);
 
 /// Hands out unique identifiers: a sanitised name that is already taken gets

@@ -3,10 +3,8 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
-#include <system_error>
+#include <utility>
 
-#include "model/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 
@@ -65,36 +63,11 @@ PythonModuleFile emitPythonModule(const Plan& plan) {
   return f;
 }
 
-PythonModuleFile generatePythonModule(const GenerateOptions& options) {
-  if (!options.casesFile.empty()) {
-    const Case c = loadCase(options.casesFile, options.caseName);
-    const System sys = loadCaseSystem(c);
-    return emitPythonModule(makePlan(sys, options.name.empty() ? c.name : options.name, options.scalar));
-  }
-  const System sys = loadSystem(options.urdf, options.layout);
-  const std::string name = options.name.empty() ? fs::path(options.urdf).stem().string() : options.name;
-  return emitPythonModule(makePlan(sys, name, options.scalar));
-}
-
-std::string writePythonModule(const PythonModuleFile& file, const std::string& outDir) {
-  const fs::path path = fs::path(outDir) / file.name;
-  const fs::path temp = fs::path(outDir) / ("." + file.name + ".proxgen-tmp");
-  std::error_code ec;
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out.write(file.text.data(), std::streamsize(file.text.size()));
-    out.close();
-    if (!out) {
-      fs::remove(temp, ec);
-      throw Error(fmt::format("{}: cannot be written", path.string()));
-    }
-  }
-  fs::rename(temp, path, ec);
-  if (ec) {
-    fs::remove(temp, ec);
-    throw Error(fmt::format("{}: cannot be written", path.string()));
-  }
-  return path.string();
+OutputFile pythonModuleOutput(const System& sys, const SolverFiles& files, ScalarType scalar) {
+  // The header's stem is the plan's (already sanitised) name.
+  const std::string name = fs::path(files.headerName).stem().string();
+  PythonModuleFile f = emitPythonModule(makePlan(sys, name, scalar));
+  return OutputFile{std::move(f.name), std::move(f.text)};
 }
 
 }  // namespace proxgen::emit

@@ -19,12 +19,10 @@ struct PythonModuleFile {
 /// '?') as an octal escape, so no name from a URDF reaches the code raw.
 PythonModuleFile emitPythonModule(const Plan& plan);
 
-/// The same for what `generateFiles(options)` generates (loads the inputs again).
-PythonModuleFile generatePythonModule(const GenerateOptions& options);
-
-/// Writes one file into `outDir` (which writeFiles created) through a
-/// temporary file and a rename. Returns its path.
-std::string writePythonModule(const PythonModuleFile& file, const std::string& outDir);
+/// NAME_python.cpp for the solver `files` generated from `sys` (same plan name
+/// and scalar), as an output for writeFiles: it is written atomically with the
+/// solver's own files.
+OutputFile pythonModuleOutput(const System& sys, const SolverFiles& files, ScalarType scalar);
 
 /// A C++ string literal (with its quotes) holding exactly the bytes of `s`.
 std::string cppStringLiteral(const std::string& s);

@@ -19,42 +19,6 @@
 
 namespace proxgen {
 
-std::string describe(const std::string& file, const std::string& element, const std::string& what) {
-  if (element.empty()) return fmt::format("{}: {}", file, what);
-  return fmt::format("{}: {}: {}", file, element, what);
-}
-
-void fail(const std::string& file, const std::string& element, const std::string& what) {
-  throw Error(describe(file, element, what));
-}
-
-std::string quoted(const std::string& name) {
-  std::string out = "'";
-  std::size_t shown = 0;
-  for (unsigned char c : name) {
-    if (shown == 80) {
-      out += fmt::format("...' ({} bytes)", name.size());
-      return out;
-    }
-    if (c == '\'' || c == '\\') out += fmt::format("\\{}", char(c));
-    else if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
-    else out += char(c);
-    ++shown;
-  }
-  return out + "'";
-}
-
-std::string oneLine(const std::string& text, std::size_t maxShown) {
-  std::string out;
-  for (std::size_t k = 0; k < text.size(); ++k) {
-    if (k == maxShown) return out + fmt::format("... ({} bytes)", text.size());
-    const unsigned char c = static_cast<unsigned char>(text[k]);
-    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
-    else out += char(c);
-  }
-  return out;
-}
-
 const char* jointTypeName(JointType t) {
   switch (t) {
     case JointType::Revolute: return "revolute";

@@ -17,7 +17,11 @@ namespace proxgen {
 /// record it (Model::warnings).
 std::string warn(const std::string& file, const std::string& element, const std::string& what);
 
-/// Prints the held warnings on stderr, `proxgen: warning: LINE` each, and forgets them.
+/// The same for a line already shaped like an error ("FILE: ELEMENT: WHAT").
+std::string warnLine(const std::string& line);
+
+/// Prints the held warnings on stderr, `proxgen: warning: LINE` each, escaped
+/// like the errors (oneLine), and forgets them.
 void flushWarnings();
 
 /// Where warnings go; a test captures them with its own sink. Returns the old one.

@@ -23,7 +23,7 @@
 #include "algorithms/prox_pv.hpp"
 #include "emit/generate.hpp"
 #include "emit/python_module.hpp"
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"
@@ -233,18 +233,23 @@ py::list constraints(const Robot& r) {
 std::vector<std::string> generate(const std::string& urdf, const std::string& layout, const std::string& cases,
                                   const std::string& caseName, const std::string& out, const std::string& name,
                                   const std::string& scalar, bool python) {
-  emit::GenerateOptions g;
-  g.urdf = urdf;
-  g.layout = layout;
-  g.casesFile = cases;
-  g.caseName = caseName;
-  g.name = name;
-  g.scalar = emit::parseScalar(scalar);
-  const emit::SolverFiles files = emit::generateFiles(g);
-  const emit::PythonModuleFile module = python ? emit::generatePythonModule(g) : emit::PythonModuleFile{};
-  std::vector<std::string> written = emit::writeFiles(files, out);
-  if (python) written.push_back(emit::writePythonModule(module, out));
-  return written;
+  // The CLI's pipeline (cli/generate.cpp): one load, every file through one atomic write.
+  const emit::ScalarType type = emit::parseScalar(scalar);
+  System sys;
+  emit::SolverFiles files;
+  if (!cases.empty()) {
+    files = generateCase(cases, caseName, name, type, nullptr, &sys);
+  } else {
+    emit::GenerateOptions g;
+    g.urdf = urdf;
+    g.layout = layout;
+    g.name = name;
+    g.scalar = type;
+    files = emit::generateFiles(g, nullptr, &sys);
+  }
+  std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
+  if (python) outputs.push_back(emit::pythonModuleOutput(sys, files, type));
+  return emit::writeFiles(outputs, out);
 }
 
 }  // namespace

@@ -47,6 +47,24 @@ TEST(Identifiers, KeywordsAndMacrosGetAPrefix) {
   }
 }
 
+// Issue 19 item 8: names of the C and C++ libraries (functions, types,
+// objects, macros, the families the standards reserve) as a namespace do not
+// compile; they get the prefix, and the prefixed name is free. Whether the
+// list is complete is checked with the compiler in tests/cli/test_reserved_names.cpp.
+TEST(Identifiers, LibraryNamesAndReservedFamiliesGetAPrefix) {
+  for (const char* n : {"j1", "log", "gamma", "size_t", "M_PI_2", "sin", "strlen", "FILE", "tm", "errno", "stdin",
+                        "printf", "environ", "proxgen_rt", "Scalar", "Settings", "Workspace",
+                        // families: POSIX *_t, E*, M_*, INT*_MAX, PRI*, SIG*
+                        "my_type_t", "EFOOBAR", "M_SOMETHING", "INT24_MAX", "UINT_LEAST24_MAX", "PRIdFOO", "SIGFOO"}) {
+    EXPECT_TRUE(isReservedIdentifier(n)) << n;
+    EXPECT_EQ(sanitizeIdentifier(n), std::string("kw_") + n);
+    expectSafeIdentifier(sanitizeIdentifier(n), n);
+  }
+  // Ordinary robot names stay as they are.
+  for (const char* n : {"arm", "LF_thigh", "base_link", "torso", "Elbow", "elbow", "Mass", "interval", "signalling"})
+    EXPECT_EQ(sanitizeIdentifier(n), n);
+}
+
 TEST(Identifiers, LeadingDigitsAndUnderscores) {
   EXPECT_EQ(sanitizeIdentifier("1st_link"), "n1st_link");
   EXPECT_EQ(sanitizeIdentifier("__reserved"), "reserved");

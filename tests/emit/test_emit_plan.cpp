@@ -11,7 +11,7 @@
 
 #include "algorithms/data.hpp"
 #include "emit/plan.hpp"
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/layout.hpp"
 #include "support.hpp"
 

@@ -10,7 +10,11 @@
 # are ../shared/models (or $PROXGEN_MODELS_DIR). Times are wall-clock seconds
 # of one run and user-CPU seconds; on a loaded machine expect them to spread.
 # --march X compiles with -march=X (default: the compiler's, x86-64 baseline).
-# The flags are proxgen_add_solver's (with GCC, -fno-tree-slp-vectorize).
+# The options are those of every compile of generated code,
+# proxgen_solver_compile_options(... CHECKED) of cmake/ProxgenAddSolver.cmake
+# (-O2 and, with GCC, -fno-tree-slp-vectorize among them), as the build wrote
+# them to BUILD_DIR/generator/solver_compile_options.txt; --cxx should name the
+# build's compiler, for which they were chosen.
 set -euo pipefail
 build=${1:?usage: measure.sh BUILD_DIR [--instructions] [--cxx CXX] [--march X]}
 shift
@@ -26,10 +30,9 @@ while [[ $# -gt 0 ]]; do
   esac
   shift
 done
-# The flags proxgen_add_solver adds (cmake/ProxgenAddSolver.cmake): with GCC,
-# no basic-block SLP vectorisation.
-extra=()
-if "$cxx" --version | grep -q "Free Software Foundation"; then extra=(-fno-tree-slp-vectorize); fi
+options_file=$build/generator/solver_compile_options.txt
+[[ -f $options_file ]] || { echo "$options_file missing: configure BUILD_DIR with CMake first" >&2; exit 2; }
+read -r -a options < "$options_file"
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 models=${PROXGEN_MODELS_DIR:-$root/../shared/models}
@@ -50,7 +53,7 @@ for c in $cases; do
   t0=$(date +%s%N)
   "$proxgen" generate --cases "$models/cases.yaml" --case "$c" --out "$out" --name "$c" > /dev/null
   t1=$(date +%s%N)
-  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 -O2 "${march[@]}" "${extra[@]}" -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
+  /usr/bin/time -f '%e %U' -o "$work/time" "$cxx" -std=c++17 "${options[@]}" "${march[@]}" -I"$root/runtime" -I"$out" -c "$out/$c.cpp" -o "$out/$c.o"
   read -r wall user < "$work/time"
   bytes=$(size "$out/$c.o" | awk 'NR == 2 { print $1 + $2 }')
   lines=$(wc -l < "$out/$c.cpp")

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"

@@ -34,7 +34,7 @@
 #include "algorithms/dense_reference.hpp"
 #include "algorithms/prox_pv.hpp"
 #include "emit/generate.hpp"
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 #include "model/error.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"

@@ -1,10 +1,12 @@
-#include "model/cases.hpp"
+#include "cases/cases.hpp"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 
+#include "emit/generate.hpp"
+#include "emit/hash.hpp"
 #include "model/error.hpp"
 #include "model/input.hpp"
 #include "model/layout.hpp"
@@ -34,13 +36,22 @@ std::vector<Case> loadCases(const std::string& path) {
     YAML::Node item = YAML::Clone(root["cases"][k]);
     const std::string element = fmt::format("cases[{}]", k);
     if (!item.IsMap() || !item["name"] || !item["model"]) fail(path, element, "needs `name` and `model`");
+    // Both are text: a list or a map there is an error, not a failed conversion.
+    for (const char* key : {"name", "model"})
+      if (!item[key].IsScalar())
+        fail(fmt::format("{}:{}", path, item[key].Mark().line + 1), fmt::format("{}.{}", element, key),
+             "expected a string, got a list or a map");
     Case c;
-    c.name = item["name"].as<std::string>();
-    c.urdfPath = (dir / item["model"].as<std::string>()).string();
+    c.name = item["name"].Scalar();
+    c.urdfPath = (dir / item["model"].Scalar()).string();
     item.remove("name");
     item.remove("model");
     YAML::Emitter e;
-    e << item;
+    try {
+      e << item;
+    } catch (const YAML::Exception& x) {
+      fail(path, element, fmt::format("cannot be read as a layout: {}", oneLine(x.msg)));
+    }
     c.layout = parseLayout(e.c_str(), fmt::format("{} (case {})", path, c.name));
     out.push_back(std::move(c));
   }
@@ -48,5 +59,21 @@ std::vector<Case> loadCases(const std::string& path) {
 }
 
 System loadCaseSystem(const Case& c) { return bindLayout(loadUrdf(c.urdfPath, c.layout.floatingBase), c.layout); }
+
+emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
+                               emit::ScalarType scalar, emit::SolverStats* stats, System* system) {
+  namespace fs = std::filesystem;
+  const Case c = loadCase(casesFile, caseName);
+  const System sys = loadCaseSystem(c);
+  if (system) *system = sys;
+  emit::SolverInputs in;
+  const std::string file = fs::path(casesFile).filename().string();
+  in.urdfName = fs::path(c.urdfPath).filename().string();
+  in.layoutName = fmt::format("{} (case {})", file, c.name);
+  in.urdfSha256 = emit::sha256File(c.urdfPath);
+  in.layoutSha256 = emit::sha256File(casesFile);
+  in.command = fmt::format("proxgen generate --cases {} --case {}", file, c.name);
+  return emit::generateSystem(sys, name.empty() ? c.name : name, scalar, in, stats);
+}
 
 }  // namespace proxgen

@@ -1,0 +1,115 @@
+// The bounds a generated solver must meet against the generic solvers.
+//
+// The generated code runs the recursions of the generic code with the
+// operations in another order (constants folded, sums regrouped, the
+// double-angle form of the joint rotations, a Cholesky for the free flyer's
+// 6 x 6 inertia where the generic code inverts it, the Delassus factor by limbs
+// plus a rank-6 Woodbury update). Each is backward stable, so each has a forward
+// error of about c n u kappa (u the unit round-off of its Scalar, n = nv + nc
+// steps, c = 10 as in the generic equivalence tests, tests/numerics.hpp), kappa
+// the condition number of what the algorithm solves at that state; so has their
+// difference:
+//   constrainedABA qdd:    kappa(M + mu J^T J), the matrix every solve eliminates
+//                          (it grows with mu: at mu = 1e4 on gram-scale
+//                          fingertips cABA's own round-off reaches 1e-9);
+//   constrainedABA lambda: lambda = mu (K a - k) is mu times a difference of
+//                          body accelerations (J qdd, and gravity in both a and k),
+//                          whose error it multiplies by mu:
+//                          kappa (1 + mu (|J| |qdd| + |g|) / |lambda|);
+//   proxPV qdd and lambda: kappa(M) (G and y_free come out of the articulated
+//                          recursion) + kappa(G + I/mu) (the proximal solve).
+// relErr (max |gen - generic| / max(1, max |generic|)) of each must stay below
+// max(floor, c n u kappa); the floor is 1e-12 in double and 64 u = 4e-6 in
+// float. Float solvers take inputs rounded to float, so that the generic
+// solver (in double) answers the same question, and the same argument holds
+// with float's u: at ill-conditioned states (a UR5e near a singular pose has
+// kappa(G + I/mu) ~ 1e7) the float bound says little, which is what float can
+// promise there. Over all of tests/generated the largest error / bound was
+// 0.40 when this was written (a margin of 2.5). An error in the generated
+// arithmetic (a dropped term, a wrong sign) shows at every state, including
+// the well-conditioned ones, where the bounds are tight (harness_lib.cpp
+// requires enough of those).
+#include "verify/compare.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "algorithms/constrained_aba.hpp"
+#include "algorithms/crba.hpp"
+#include "algorithms/jacobians.hpp"
+#include "algorithms/prox_pv.hpp"
+
+namespace proxgen::verify {
+namespace {
+
+double conditionSym(const MatX& A) {
+  if (A.rows() == 0) return 1.0;
+  const Eigen::SelfAdjointEigenSolver<MatX> eig(A, Eigen::EigenvaluesOnly);
+  return eig.eigenvalues().maxCoeff() / eig.eigenvalues().minCoeff();
+}
+
+double maxAbs1(const VecX& x) { return std::max(1.0, x.size() ? x.cwiseAbs().maxCoeff() : 0.0); }
+
+bool allFinite(const VecX& x) { return x.size() == 0 || x.allFinite(); }
+
+}  // namespace
+
+double relErr(const VecX& a, const VecX& b) {
+  if (a.size() == 0) return 0.0;
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+State roundedToScalar(State s, bool isFloat) {
+  if (!isFloat) return s;
+  for (VecX* x : {&s.q, &s.v, &s.tau})
+    for (int k = 0; k < x->size(); ++k) (*x)[k] = double(float((*x)[k]));
+  return s;
+}
+
+Conditioning conditioningAt(const System& sys, Data& scratch, const State& s, bool isFloat) {
+  Conditioning c;
+  c.isFloat = isFloat;
+  c.eps = isFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;  // 2^-24, 2^-53
+  c.floor = isFloat ? 64 * c.eps : 1e-12;
+  c.safety = 10.0 * (sys.model.nv + sys.nc);
+  crba(sys, scratch, s.q);
+  constraintJacobian(sys, scratch, s.q, s.v);
+  c.M = scratch.M;
+  c.J = scratch.J;
+  c.kappaM = conditionSym(c.M);
+  return c;
+}
+
+Bounds boundsAt(const Conditioning& c, double mu) {
+  Bounds b;
+  b.mu = mu;
+  b.kappaC = conditionSym(c.M + mu * c.J.transpose() * c.J);
+  MatX G = c.J * c.M.ldlt().solve(c.J.transpose());
+  G.diagonal().array() += 1.0 / mu;
+  b.dual = std::max(c.floor, c.safety * c.eps * (c.kappaM + conditionSym(G)));
+  b.primal = std::max(c.floor, c.safety * c.eps * b.kappaC);
+  return b;
+}
+
+double cabaLambdaBound(const System& sys, const Conditioning& c, const Bounds& b, const VecX& genericQdd,
+                       const VecX& genericLambda) {
+  const double accelerations = c.J.norm() * maxAbs1(genericQdd) + sys.model.gravity.norm();
+  return std::max(b.primal, c.safety * c.eps * b.kappaC * b.mu * accelerations / maxAbs1(genericLambda));
+}
+
+Comparison compareWithGeneric(const System& sys, Data& d, const Conditioning& c, const Bounds& b, const State& s,
+                              int K, const GeneratedAnswer& gen) {
+  Comparison out{};
+  constrainedAba(sys, d, s.q, s.v, s.tau, b.mu, K);
+  out.item[0] = {"constrained_aba qdd", relErr(gen.cabaQdd, d.qdd), b.primal,
+                 allFinite(gen.cabaQdd) && allFinite(d.qdd)};
+  out.item[1] = {"constrained_aba lambda", relErr(gen.cabaLambda, d.lambda), cabaLambdaBound(sys, c, b, d.qdd, d.lambda),
+                 allFinite(gen.cabaLambda) && allFinite(d.lambda)};
+  proxPv(sys, d, s.q, s.v, s.tau, b.mu, K);
+  out.item[2] = {"prox_pv qdd", relErr(gen.pvQdd, d.qdd), b.dual, allFinite(gen.pvQdd) && allFinite(d.qdd)};
+  out.item[3] = {"prox_pv lambda", relErr(gen.pvLambda, d.lambda), b.dual, allFinite(gen.pvLambda) && allFinite(d.lambda)};
+  return out;
+}
+
+}  // namespace proxgen::verify

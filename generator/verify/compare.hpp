@@ -1,0 +1,68 @@
+// Comparing a generated solver with the generic solvers it was generated from:
+// the error measure and the conditioning-aware bounds, shared by
+// `proxgen verify` (cli/verify.cpp) and the generated-solver tests
+// (tests/generated/harness_lib.cpp), so what a user runs on their robot is
+// what the project's tests check. The argument for the bounds is in compare.cpp.
+#pragma once
+
+#include <string>
+
+#include "algorithms/data.hpp"
+#include "model/model.hpp"
+#include "model/state.hpp"
+
+namespace proxgen::verify {
+
+/// max |a - b| / max(1, max |b|): relative to the size of the reference vector.
+double relErr(const VecX& a, const VecX& b);
+
+/// The state as a solver of that Scalar sees it (q, v, tau rounded to float
+/// when `isFloat`), so the generic solver (in double) answers the same question.
+State roundedToScalar(State s, bool isFloat);
+
+/// What the bounds of one state need: the joint-space inertia, the constraint
+/// Jacobian and their conditioning (computed once per state, for every mu and K).
+struct Conditioning {
+  bool isFloat = false;
+  double eps = 0;     // unit round-off of the generated Scalar
+  double floor = 0;   // smallest bound: 1e-12 in double, 64 u in float
+  double safety = 0;  // c n, c = 10, n = nv + nc
+  double kappaM = 1;  // condition number of M
+  MatX M, J;
+};
+Conditioning conditioningAt(const System& sys, Data& scratch, const State& s, bool isFloat);
+
+/// The bounds at one mu (every K): `primal` for constrainedABA's qdd, `dual`
+/// for proxPV's qdd and lambda; constrainedABA's lambda also depends on the
+/// answer (cabaLambdaBound).
+struct Bounds {
+  double primal = 0, dual = 0;
+  double kappaC = 1;  // condition number of M + mu J^T J
+  double mu = 0;
+};
+Bounds boundsAt(const Conditioning& c, double mu);
+/// constrainedABA's lambda = mu (K a - k) multiplies the error of J qdd by mu.
+double cabaLambdaBound(const System& sys, const Conditioning& c, const Bounds& b, const VecX& genericQdd,
+                       const VecX& genericLambda);
+
+/// The four results of one generated solve pair at one (state, mu, K).
+struct GeneratedAnswer {
+  VecX cabaQdd, cabaLambda, pvQdd, pvLambda;
+};
+
+/// One compared quantity: its error and the bound it must stay below.
+struct Compared {
+  const char* what;  // "constrained_aba qdd", ...
+  double error, bound;
+  bool finite;       // the generated and the generic values are all finite
+};
+
+/// Runs constrainedAba and proxPv at (s, mu, K) into `d` and compares `gen`
+/// with them: constrained_aba qdd, constrained_aba lambda, prox_pv qdd, prox_pv lambda.
+struct Comparison {
+  Compared item[4];
+};
+Comparison compareWithGeneric(const System& sys, Data& d, const Conditioning& c, const Bounds& b, const State& s,
+                              int K, const GeneratedAnswer& gen);
+
+}  // namespace proxgen::verify
