@@ -42,7 +42,8 @@ struct Named {
 // Every shared case, then the repository's robots: the examples, the example
 // quadruped with Baumgarte gains (a* != 0), the analytic floating arm with gains
 // and with two welds on one link (rank 6 of 12 rows), four coplanar contacts on
-// a box, and a fixed-base arm with prismatic and continuous joints.
+// a box, and a fixed-base arm with prismatic and continuous joints (alone, and
+// with a weld on the world and two constraints on one chain).
 std::vector<Named> allSystems() {
   std::vector<Named> out;
   for (const Case& c : test::sharedCases()) out.push_back({c.name, loadCaseSystem(c)});
@@ -58,6 +59,13 @@ std::vector<Named> allSystems() {
   add("floating arm two welds", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_two_welds.yaml");
   add("box four corners", "tests/data/analytic/box.urdf", "tests/data/analytic/box_4_corners.yaml");
   add("arm3 prismatic+continuous", "tests/data/good/arm3.urdf", "tests/data/good/arm3_tool.yaml");
+  // A weld on the world (zero rows of J: the rows of G are 0 and of Ginv mu),
+  // a weld mid-chain and the tool point below it on the same chain.
+  const test::TempFile world(".yaml");
+  world.write("base: fixed\nconstraints:\n  - {name: ground, link: base_link, type: 6d}\n"
+              "  - {name: upper, link: upper_arm, type: 6d, offset: {xyz: [0.1, 0.2, -0.1]}}\n"
+              "  - {name: tool_point, link: tool, type: 3d, kp: 30, kd: 4, target: {xyz: [0.3, 0.1, 0.5]}}\n");
+  out.push_back({"arm3 world weld + chain", loadSystem(src + "/tests/data/good/arm3.urdf", world.path())});
   return out;
 }
 
