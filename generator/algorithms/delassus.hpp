@@ -8,7 +8,9 @@ namespace proxgen {
 
 /// d.delassusG = J M^-1 J^T, dense from the pieces: M^-1 by
 /// massMatrixInverse, J by constraintJacobianRows, two products. Exactly
-/// symmetric. No allocation (the products use Eigen's stack blocking).
+/// symmetric. No allocation on the shared cases: Eigen's matrix products block
+/// on the stack up to EIGEN_STACK_ALLOCATION_LIMIT (128 kB), which far larger
+/// robots would pass.
 const MatX& delassus(const System& sys, Data& d, const VecX& q);
 
 /// out = J (M + mu J^T J)^-1 J^T for mu >= 0 (mu = 0: G itself) by a
@@ -23,8 +25,9 @@ const MatX& delassus(const System& sys, Data& d, const VecX& q);
 ///    meet (a 6 x 6 map accumulated along unbranched chains, so a column moves
 ///    only at constrained and branching bodies), and every entry once, at the
 ///    nearest common ancestor c of its two rows: K_a T_a^T Phi_c T_b K_b^T.
-/// Cost O(n + m^2) for trees whose constrained and branching support bodies
-/// number O(m) (each row's column is moved once per such body).
+/// Cost O(n + m^2): a row's column moves once per key body (constrained, or
+/// branching on the support) above it, and there are fewer than 2m of those
+/// (branch points are fewer than the constrained bodies, which are at most m).
 /// out must be nc x nc. No allocation; overwrites the ABA quantities, d.terms,
 /// d.KA, d.Phi, d.Tkey, d.keyBelow.
 void delassusRecursion(const System& sys, Data& d, const VecX& q, double mu, MatX& out);
