@@ -59,10 +59,12 @@ void delassusRecursion(const System& sys, Data& d, const VecX& q, double mu, Mat
   // Backward over the support, leaves first.
   for (auto it = d.support.rbegin(); it != d.support.rend(); ++it) {
     const int i = *it;
-    int own = 0, supportChildren = 0, onlyChild = -1;
-    for (const Constraint& c : sys.constraints) own += c.body == i ? c.rows() : 0;
-    for (int ch : m.bodies[i].children)
+    // Own rows: the subtree's less the children's (O(children), not O(m) per body).
+    int own = int(d.subtreeRows[i].size()), supportChildren = 0, onlyChild = -1;
+    for (int ch : m.bodies[i].children) {
+      own -= int(d.subtreeRows[ch].size());
       if (d.onSupport[ch]) ++supportChildren, onlyChild = ch;
+    }
     if (own == 0 && supportChildren == 1) {  // an unbranched link of a chain: accumulate the map only
       const Mat6 T = d.liMi[onlyChild].motionMatrixInv().transpose() * transmission(d, onlyChild);
       d.Tkey[i].noalias() = T * d.Tkey[onlyChild];
