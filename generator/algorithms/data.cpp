@@ -82,6 +82,23 @@ Data::Data(const System& sys) {
   LD = MatX::Zero(m.nv, m.nv);
   jsB = VecX::Zero(m.nv);
   rowRes = VecX::Zero(sys.nc);
+
+  zeroV = VecX::Zero(m.nv);
+  placements = VecX::Zero(12 * Eigen::Index(sys.constraints.size()));
+  Minv = MatX::Zero(m.nv, m.nv);
+  FA.assign(N, MatX::Zero(6, m.nv));
+  subtreeDofEnd.assign(N, 0);
+  for (int i = N - 1; i >= 1; --i) {
+    subtreeDofEnd[i] = std::max(subtreeDofEnd[i], m.bodies[i].joint.idx_v + m.bodies[i].joint.nv);
+    const int p = m.bodies[i].parent;
+    if (p > 0) subtreeDofEnd[p] = std::max(subtreeDofEnd[p], subtreeDofEnd[i]);
+  }
+  Phi.assign(N, Mat6::Zero());
+  Tkey.assign(N, Mat6::Identity());
+  keyBelow.assign(N, -1);
+  delassusG = MatX::Zero(sys.nc, sys.nc);
+  delassusInv = MatX::Zero(sys.nc, sys.nc);
+  JMinvLib = MatX::Zero(sys.nc, m.nv);
 }
 
 }  // namespace proxgen

@@ -82,6 +82,19 @@ struct Data {
   VecX jsB;         // right-hand side / intermediate of the sparse solves (nv)
   VecX rowRes;      // J qdd + gamma - aStar (nc, layout order)
 
+  // Dynamics library (docs/dynamics.md), appended.
+  VecX zeroV;                   // nv zeros: qdd = 0, v = 0 without a temporary
+  VecX placements;              // 12 per constraint: world rotation (row-major), position
+  MatX Minv;                    // M^-1 (mass_matrix_inverse), full
+  std::vector<MatX> FA;         // per body 6 x nv: unit-torque forces, then accelerations (Minv)
+  std::vector<int> subtreeDofEnd;  // one past the last dof of each body's subtree
+  std::vector<Mat6> Phi;        // apparent inverse inertia of each support body (Delassus)
+  std::vector<Mat6> Tkey;       // force map from the nearest key body below into body coordinates
+  std::vector<int> keyBelow;    // that key body (-1 off the support)
+  MatX delassusG;               // J M^-1 J^T (or with M + mu J^T J), layout order
+  MatX delassusInv;             // (G + I/mu)^-1, layout order
+  MatX JMinvLib;                // J M^-1 (nc x nv)
+
   int iterationsDone = 0;
   double residual = 0;  // ||J qdd + gamma - aStar|| of the last solve (when computed)
 };

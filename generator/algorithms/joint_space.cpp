@@ -10,8 +10,6 @@ int lastDof(const Model& m, int body) {
   return body > 0 ? m.bodies[body].joint.idx_v + m.bodies[body].joint.nv - 1 : -1;
 }
 
-namespace {
-
 // Rows of constraint c: K times the body Jacobian of its body, i.e. each
 // ancestor joint's motion subspace seen in the constraint frame C.
 void fillJacobianRows(const System& sys, Data& d, const Constraint& c) {
@@ -27,8 +25,6 @@ void fillJacobianRows(const System& sys, Data& d, const Constraint& c) {
     }
   }
 }
-
-}  // namespace
 
 void assemble(const System& sys, Data& d, const VecX& q, const VecX& v) {
   crba(sys, d, q);

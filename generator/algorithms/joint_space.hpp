@@ -14,6 +14,9 @@ namespace proxgen::joint_space {
 /// d.J, d.gamma, d.aStar at (q, v), layout order. Overwrites d.qdd, d.tau.
 void assemble(const System& sys, Data& d, const VecX& q, const VecX& v);
 
+/// d.J's rows of constraint c (K times its body's Jacobian), from d.oMi.
+void fillJacobianRows(const System& sys, Data& d, const Constraint& c);
+
 /// Last dof of a body (-1 for the world): the start of its ancestor chain.
 int lastDof(const Model& m, int body);
 

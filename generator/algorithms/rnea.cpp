@@ -23,7 +23,7 @@ const VecX& rnea(const System& sys, Data& d, const VecX& q, const VecX& v, const
 }
 
 const VecX& nonLinearEffects(const System& sys, Data& d, const VecX& q, const VecX& v) {
-  d.h = rnea(sys, d, q, v, VecX::Zero(sys.model.nv));
+  d.h = rnea(sys, d, q, v, d.zeroV);  // no temporary: allocation-free (docs/dynamics.md)
   return d.h;
 }
 

@@ -14,6 +14,11 @@ void addEval(CLI::App& app);      // eval.cpp
 void addGenerate(CLI::App& app);  // generate.cpp
 void addVerify(CLI::App& app);    // verify.cpp
 
+/// `eval --compute QUANTITY`: the dynamics library on the states, as JSON
+/// (compute.cpp). mu <= 0 means the layout's.
+void runCompute(const std::string& urdf, const std::string& layout, const std::string& state, const std::string& quantity,
+                double mu);
+
 /// The robot of `generate` and `verify`: a URDF and --layout, or --cases and
 /// --case, never a mix (generate.cpp).
 void checkRobotOptions(const char* command, const std::string& urdf, const std::string& layout,

@@ -34,6 +34,7 @@ const char* const kCommandLine = "command line";
 
 struct EvalOptions {
   std::string urdf, layout, state, algorithm = "caba", iterations, mu;
+  std::string compute;  // --compute: the dynamics library instead of a solver (compute.cpp)
 };
 
 enum class Algorithm { Caba, Pv, Ltl, Ltls, Dense };
@@ -169,6 +170,7 @@ std::string firstNonFinite(const System& sys, const Data& d, Algorithm algorithm
 }
 
 void runEval(const EvalOptions& o) {
+  if (!o.compute.empty()) return runCompute(o.urdf, o.layout, o.state, o.compute, o.mu.empty() ? 0.0 : parseMu(o.mu));
   const Algorithm algorithm = parseAlgorithm(o.algorithm);
   const System sys = loadSystem(o.urdf, o.layout);
   const double mu = o.mu.empty() ? sys.mu : parseMu(o.mu);
@@ -209,6 +211,7 @@ void addEval(CLI::App& app) {
   cmd->add_option("--algorithm", opts->algorithm, "caba | pv | ltl | ltls | dense (default caba)");
   cmd->add_option("--iterations", opts->iterations, "multiplier updates K in [0, 1e6] (default: the layout's)")->type_name("INT");
   cmd->add_option("--mu", opts->mu, "penalty mu > 0, finite (default: the layout's)")->type_name("FLOAT");
+  cmd->add_option("--compute", opts->compute, "print a dynamics-library quantity instead (docs/dynamics.md)")->type_name("QUANTITY");
   cmd->callback([opts] { runEval(*opts); });
 }
 

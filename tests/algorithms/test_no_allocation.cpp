@@ -8,9 +8,15 @@
 
 #include "algorithms/aba.hpp"
 #include "algorithms/constrained_aba.hpp"
+#include "algorithms/constraint_kinematics.hpp"
+#include "algorithms/crba.hpp"
+#include "algorithms/delassus.hpp"
+#include "algorithms/inverse_dynamics.hpp"
+#include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/prox_ltl.hpp"
 #include "algorithms/prox_ltls.hpp"
 #include "algorithms/prox_pv.hpp"
+#include "algorithms/rnea.hpp"
 #include "support.hpp"
 
 namespace {
@@ -84,6 +90,39 @@ TEST(NoAllocation, GenericSolversOnEverySharedCase) {
     EXPECT_EQ(allocationsOf(sys, d, s, &proxPv), 0) << c.name << " proxPv";
     EXPECT_EQ(allocationsOf(sys, d, s, &proxLtl), 0) << c.name << " proxLtl";
     EXPECT_EQ(allocationsOf(sys, d, s, &proxLtls), 0) << c.name << " proxLtls";
+  }
+}
+
+// The dynamics library (docs/dynamics.md): every function, twice after a warm-up.
+TEST(NoAllocation, DynamicsLibraryOnEverySharedCase) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Case& c : test::sharedCases()) {
+    const System sys = loadCaseSystem(c);
+    Data d(sys);
+    std::mt19937 rng(8);
+    const test::RandomState s = test::randomState(sys.model, rng);
+    const VecX lambda = VecX::Ones(sys.nc);
+    MatX out(sys.nc, sys.nc);
+    const auto all = [&] {
+      inverseDynamics(sys, d, s.q, s.v, s.tau, &lambda);
+      inverseDynamics(sys, d, s.q, s.v, s.tau, nullptr);
+      nonLinearEffects(sys, d, s.q, s.v);
+      crba(sys, d, s.q);
+      massMatrixInverse(sys, d, s.q);
+      constraintPlacements(sys, d, s.q);
+      constraintJacobianRows(sys, d, s.q);
+      constraintDrift(sys, d, s.q, s.v);
+      delassus(sys, d, s.q);
+      delassusRecursion(sys, d, s.q, 0.0, out);
+      delassusInverse(sys, d, s.q, 1e4);
+    };
+    all();  // warm-up
+    g_allocations = 0;
+    g_counting = true;
+    all();
+    all();
+    g_counting = false;
+    EXPECT_EQ(g_allocations, 0) << c.name;
   }
 }
 
