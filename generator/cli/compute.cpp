@@ -13,10 +13,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <sys/stat.h>
 #include <vector>
 
 #include "algorithms/constraint_kinematics.hpp"
@@ -27,6 +25,7 @@
 #include "algorithms/rnea.hpp"
 #include "cli/commands.hpp"
 #include "model/error.hpp"
+#include "model/input.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"
 
@@ -35,8 +34,6 @@ namespace {
 
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
-
-inline constexpr std::size_t kMaxStateBytes = 64u << 20;  // as loadStates (state.cpp)
 
 enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse };
 
@@ -59,29 +56,10 @@ Quantity parseQuantity(const std::string& name) {
   fail("command line", "--compute", fmt::format("unknown quantity {} (expected one of {})", quoted(name), valid));
 }
 
-// The state file as JSON (the checks of loadStates: not a directory, readable, size limit).
-json readJsonFile(const std::string& path) {
-  if (struct stat st {}; ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) fail(path, "", "is a directory, not a state file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail(path, "", "cannot open file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail(path, "", "cannot read file (is it a directory?)");
-  if (std::size_t(size) > kMaxStateBytes) fail(path, "", fmt::format("file is {} bytes, more than the {} allowed", size, kMaxStateBytes));
-  std::string text(std::size_t(size), '\0');
-  in.seekg(0);
-  in.read(text.data(), size);
-  try {
-    return json::parse(text);
-  } catch (const json::exception& e) {
-    fail(path, "", fmt::format("invalid JSON: {}", oneLine(e.what())));
-  }
-}
-
 double finiteNumber(const json& x, const std::string& where, const std::string& element) {
   if (!x.is_number()) fail(where, element, "expected a number");
-  const double v = x.get<double>();
-  if (!std::isfinite(v)) fail(where, element, "is not finite");
-  return v;
+  // Finite and at most the inputs' magnitude bound, as every number of a state (model/input.hpp).
+  return requireMagnitude(where, element, x.get<double>());
 }
 
 // n slots at x[at]: a number (n == 1) or a list of n numbers.
@@ -200,13 +178,23 @@ ordered_json computeOne(const System& sys, Data& d, Quantity what, const State& 
   return {};
 }
 
+// Inputs are bounded (model/input.hpp), yet a product can still overflow: no
+// non-finite number is printed (JSON would hold it as null) or exits 0.
+bool allFiniteJson(const ordered_json& x) {
+  if (x.is_number_float()) return std::isfinite(x.get<double>());
+  if (x.is_structured())
+    for (const ordered_json& e : x)
+      if (!allFiniteJson(e)) return false;
+  return true;
+}
+
 }  // namespace
 
 void runCompute(const std::string& urdf, const std::string& layout, const std::string& statePath, const std::string& quantity, double mu) {
   const Quantity what = parseQuantity(quantity);
   const System sys = loadSystem(urdf, layout);
   if (!(mu > 0)) mu = sys.mu;
-  const json file = readJsonFile(statePath);
+  const json file = readStateJson(statePath);
   const bool isList = file.is_array();
   const std::size_t count = isList ? file.size() : 1;
   Data d(sys);
@@ -235,11 +223,11 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
     const State s = stateFromJson(sys.model, object, where);
     ordered_json r = {{"compute", quantity}};
     r.update(computeOne(sys, d, what, s, qdd, hasLambda ? &lambda : nullptr, mu));
+    if (!allFiniteJson(r)) fail(where, quantity, "is not finite at this state (an intermediate overflowed)");
     results.push_back(r);
   }
   // Printed only once everything succeeded: an error leaves stdout empty.
   const std::string out = (isList ? results : results.at(0)).dump(2) + "\n";
-  for (const std::string& w : sys.model.warnings) std::fprintf(stderr, "proxgen: warning: %s\n", w.c_str());
   std::fputs(out.c_str(), stdout);
 }
 

@@ -115,7 +115,7 @@ State stateFromJson(const Model& model, const json& j, const std::string& where)
   return s;
 }
 
-std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList) {
+json readStateJson(const std::string& path) {
   const std::string text = readInputFile(path, kMaxStateBytes, "state");
   json j;
   // The last key read tells the user where a bad token (e.g. an overflowing
@@ -155,6 +155,11 @@ std::vector<State> loadStates(const Model& model, const std::string& path, bool*
   } catch (const json::exception& e) {
     fail(path, lastKey.empty() ? "" : fmt::format("after key {}", proxgen::quoted(lastKey)), fmt::format("invalid JSON: {}", oneLine(e.what())));
   }
+  return j;
+}
+
+std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList) {
+  const json j = readStateJson(path);
   std::vector<State> states;
   if (isList) *isList = j.is_array();
   if (j.is_array()) {

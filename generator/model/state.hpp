@@ -29,6 +29,10 @@ struct State {
 State stateFromJson(const Model& model, const nlohmann::json& j, const std::string& where);
 
 /// Reads a file holding one state object or a list of them. `isList` tells which.
+/// A state file's JSON, read and parsed with every bound and check loadStates
+/// applies (regular file, size, nesting, value count, no repeated key), for
+/// readers of states with more keys (eval --compute's qdd and lambda).
+nlohmann::json readStateJson(const std::string& path);
 std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList = nullptr);
 
 /// A joint-space vector (nv) keyed by joint name: scalars, or 6-vectors for a free flyer.
