@@ -2,13 +2,14 @@
 """Writes bench/RESULTS.md and its plots from one run of bench/run.sh.
 
     report.py --build BUILD_DIR --suite suite.json --calls calls.json
-              --scaling scaling.json --out-dir bench/ [--no-compile]
+              --scaling scaling.json --python python.json --out-dir bench/ [--no-compile]
+    report.py --build BUILD_DIR --python python.json --section python   # that section alone, on stdout
 
 Inputs: the Google Benchmark JSON of proxgen_bench and proxgen_bench_scaling
 (run with repetitions and aggregates), the instruction counts of count_calls.py,
-and BUILD_DIR/bench/bench_config.json (compiler and generated sources, for the
-compile time and object size of each generated solver). Standard library only;
-plots through gnuplot.
+the JSON of python_overhead.py, and BUILD_DIR/bench/bench_config.json (compiler,
+-march and generated sources, for the compile time and object size of each
+generated solver). Standard library only; plots through gnuplot.
 """
 import argparse
 import json
@@ -355,18 +356,70 @@ def scaling_section(series, fixed_m, fixed_ns, have_plot):
     return out
 
 
+def python_section(py, march):
+    """The generated module's call from Python against the C++ call (python_overhead.py's JSON).
+    The section carries its own date and load: run.sh measures it after the suite, and it may be
+    rerun alone (--section python)."""
+    load = ", ".join(f"{x:.1f}" for x in py.get("load_avg", [])) or "?"
+    ver = py.get("versions", {})
+    ver_text = ", ".join(f"{k} {ver[k]}" for k in ("python", "numpy", "pybind11") if k in ver)
+    n = py["N"]
+    mu = py.get("mu", 0)
+    exponent = round(math.log10(mu)) if mu > 0 else None
+    mu_text = f"1e{exponent}" if exponent is not None and mu == 10.0 ** exponent else f"{mu:g}"
+    out = ["## Python", "",
+           f"`bench/python_overhead.py` ({py.get('date', '?')}, host {py.get('host', '?')}, {py.get('cpus', '?')} CPUs, "
+           f"load average {load} at the start; `{py.get('interpreter', '?')}`, {ver_text}): the generated module "
+           f"`{py['module']}` (nq = {py['nq']}, nv = {py['nv']}, nc = {py['nc']}, {py.get('scalar', 'double')}, "
+           f"K = {py.get('iterations', '?')}, mu = {mu_text}) called from Python, against the same "
+           "compiled solver looped in C++ (`_cpp_seconds_per_call`: same flags, workspace and checked state). "
+           f"Processor: {cpu_description()}; module compiled with `-O3 -DNDEBUG{' -march=' + march if march else ''}`. "
+           f"Median over {py['repetitions']} repetitions of {py.get('calls', 100)} single-state calls and "
+           f"{py['batch_repetitions']} repetitions of one {n}-state call (and {n} C++ calls), the fastest repetition "
+           "in brackets; overhead = Python minus C++, of the medians (of the minima in brackets). The "
+           f"{n}-state call is a loop of the scalar solver in C++ with the GIL released, not a batched kernel "
+           "(docs/python.md, \"Speed\").", "",
+           f"| function | C++ call µs | Python call µs | overhead µs | N = {n} in one call ms | "
+           f"{n} C++ calls ms | states/s (N = {n}) |", "|---|---|---|---|---|---|---|"]
+    both = lambda d: f"{d['median']:.2f} ({d['min']:.2f})"
+    for fn in ("prox_pv", "constrained_aba"):
+        if fn not in py:
+            continue
+        r = py[fn]
+        out.append(f"| `{fn}` | {both(r['cpp_us'])} | {both(r['python_us'])} | {both(r['overhead_us'])} | "
+                   f"{both(r['batch_ms'])} | {both(r['cpp_loop_ms'])} | {r['batch_states_per_s']:,.0f} |")
+    return out + [""]
+
+
+def load_python(path):
+    if not path or not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", required=True)
-    ap.add_argument("--suite", required=True)
+    ap.add_argument("--suite")
     ap.add_argument("--calls")
     ap.add_argument("--scaling")
-    ap.add_argument("--out-dir", required=True)
+    ap.add_argument("--python", help="python_overhead.py's JSON")
+    ap.add_argument("--out-dir")
+    ap.add_argument("--section", choices=["python"], help="print that section alone on stdout, write nothing")
     ap.add_argument("--no-compile", action="store_true", help="skip timing the generated solvers' compile")
     ap.add_argument("--command", default="bench/run.sh", help="the command line to quote in the report")
     ap.add_argument("--fixed-m", type=int, default=6)
     ap.add_argument("--fixed-n", default="32,128", help="the n of the m sweeps, comma-separated")
     args = ap.parse_args()
+    if args.section == "python":
+        py = load_python(args.python)
+        if py is None:
+            ap.error("--section python needs --python FILE (an existing python_overhead.py JSON)")
+        print("\n".join(python_section(py, build_march(args.build))))
+        return
+    if not args.suite or not args.out_dir:
+        ap.error("--suite and --out-dir are required (unless --section)")
 
     suite, context = medians(args.suite)
     calls = load_calls(args.calls)
@@ -399,6 +452,9 @@ def main():
     lines += compile_table(compile_rows, march)
     if series:
         lines += scaling_section(series, args.fixed_m, fixed_ns, have_scaling)
+    py = load_python(args.python)
+    if py is not None:
+        lines += python_section(py, march)
     with open(os.path.join(args.out_dir, "RESULTS.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"report: wrote {os.path.join(args.out_dir, 'RESULTS.md')}")

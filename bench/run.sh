@@ -1,8 +1,9 @@
 #!/bin/sh
 # bench/run.sh [BUILD_DIR]: build the benchmarks in Release, run the suite, the
-# callgrind instruction counts and the scaling study, and write bench/RESULTS.md
-# with its plots (docs/benchmarks.md). BUILD_DIR defaults to build-bench in the
-# source tree.
+# callgrind instruction counts, the scaling study and the Python module's
+# overhead (bench/python_overhead.py, when the build has the Python package),
+# and write bench/RESULTS.md with its plots (docs/benchmarks.md). BUILD_DIR
+# defaults to build-bench in the source tree.
 #
 # Environment knobs (defaults in brackets):
 #   JOBS [1]          ninja -j for the build
@@ -12,7 +13,7 @@
 #   MARCH [native]    -march of the whole build (PROXGEN_MARCH); MARCH= for the
 #                     compiler's default (x86-64 baseline)
 #   CMAKE_ARGS []     extra configure arguments, e.g. -DPROXGEN_BENCH_GENERATED=OFF
-#   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE: set to 1 to leave that part out
+#   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE, SKIP_PYTHON: set to 1 to leave that part out
 set -eu
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -28,7 +29,18 @@ echo "== configure and build ($build, Release)"
 # shellcheck disable=SC2086  # CMAKE_ARGS is a list of arguments
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPROXGEN_BENCH_REUSE_TEST_SOLVERS=OFF \
   -DPROXGEN_MARCH="$march" ${CMAKE_ARGS:-} >/dev/null
-ninja -C "$build" -j"${JOBS:-1}" proxgen_bench_all
+# The Python part needs the package's build (PROXGEN_BUILD_PYTHON) and the test
+# module of the example quadruped (tests/python, PROXGEN_BUILD_TESTS).
+python_targets=""
+if [ "${SKIP_PYTHON:-0}" != 1 ]; then
+  if ninja -C "$build" -t targets all | grep -q '^pymod_quadruped:'; then
+    python_targets="proxgen_python_package pymod_quadruped"
+  else
+    echo "run.sh: no Python module in this build (PROXGEN_BUILD_PYTHON or PROXGEN_BUILD_TESTS off), no Python section" >&2
+  fi
+fi
+# shellcheck disable=SC2086  # python_targets is a list of targets
+ninja -C "$build" -j"${JOBS:-1}" proxgen_bench_all $python_targets
 mkdir -p "$results"
 
 gbench_flags="--benchmark_repetitions=$reps --benchmark_min_time=$min_time
@@ -48,6 +60,16 @@ if [ "${SKIP_SCALING:-0}" != 1 ]; then
   scaling_json=$results/scaling.json
 fi
 
+python_json=""
+if [ -n "$python_targets" ]; then
+  # The interpreter the package was built for (Debian's /usr/bin/python3 by default: docs/python.md).
+  python_exe=$(sed -n 's/^Python3_EXECUTABLE:FILEPATH=//p' "$build/CMakeCache.txt")
+  echo "== Python module against the C++ call ($python_exe)"
+  PYTHONPATH="$build/python:$build/tests/python/modules/quadruped" PYTHONDONTWRITEBYTECODE=1 \
+    "${python_exe:-/usr/bin/python3}" "$here/python_overhead.py" --out "$results/python.json" >/dev/null
+  python_json=$results/python.json
+fi
+
 # Callgrind last: its counts do not depend on the machine's load, the timings above do.
 calls_json=""
 if [ "${SKIP_CALLGRIND:-0}" != 1 ]; then
@@ -65,5 +87,6 @@ set -- --build "$build" --suite "$results/suite.json" --out-dir "$here" \
   --command "bench/run.sh (REPETITIONS=$reps MIN_TIME=$min_time CALLS=${CALLS:-1000} MARCH=$march)"
 [ -n "$calls_json" ] && set -- "$@" --calls "$calls_json"
 [ -n "$scaling_json" ] && set -- "$@" --scaling "$scaling_json"
+[ -n "$python_json" ] && set -- "$@" --python "$python_json"
 [ "${SKIP_COMPILE:-0}" = 1 ] && set -- "$@" --no-compile
 python3 "$here/report.py" "$@"
