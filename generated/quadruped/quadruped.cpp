@@ -4,10 +4,10 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4464 + 1204 K (= 8076 at K = 3)
-//     add/sub 1875 + 543 K, mul 2493 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
-//   prox_pv: 8407 + 475 K (= 9832 at K = 3)
-//     add/sub 3493 + 204 K, mul 4740 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
+//   constrained_aba: 4452 + 1204 K (= 8064 at K = 3)
+//     add/sub 1869 + 543 K, mul 2487 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
+//   prox_pv: 8395 + 475 K (= 9820 at K = 3)
+//     add/sub 3487 + 204 K, mul 4734 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
 
 #include "quadruped.hpp"
 
@@ -29,14 +29,12 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.RJ_trunk[6] = 2.0*(q[3]*q[5] - q[4]*q[6]);
     w.RJ_trunk[7] = 2.0*(q[4]*q[5] + q[3]*q[6]);
     w.RJ_trunk[8] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[3]*q[3];
-    const Scalar h0 = 0.012033220000000006*v[3] + 5.421010862427522e-20*v[4];
-    const Scalar h1 = 5.421010862427522e-20*v[3] + 0.039772499999999995*v[4];
     w.pA_trunk[0] = 3.5200000000000005*(v[2]*v[4] - v[1]*v[5]);
     w.pA_trunk[1] = 3.5200000000000005*(v[0]*v[5] - v[2]*v[3]);
     w.pA_trunk[2] = 3.5200000000000005*(v[1]*v[3] - v[0]*v[4]);
-    w.pA_trunk[3] = 0.046770719999999995*v[4]*v[5] - v[5]*h1;
-    w.pA_trunk[4] = -0.046770719999999995*v[3]*v[5] + v[5]*h0;
-    w.pA_trunk[5] = v[3]*h1 - v[4]*h0;
+    w.pA_trunk[3] = 0.0069982199999999994*v[4]*v[5];
+    w.pA_trunk[4] = -0.03473749999999999*v[3]*v[5];
+    w.pA_trunk[5] = 0.02773927999999999*v[3]*v[4];
     w.g_trunk[0] = -9.81*w.RJ_trunk[6];
     w.g_trunk[1] = -9.81*w.RJ_trunk[7];
     w.g_trunk[2] = -9.81*w.RJ_trunk[8];
@@ -67,17 +65,17 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.c_LF_hip[3] = 0.09950371902099893*v[6]*w.v_LF_hip[4];
     w.c_LF_hip[4] = 0.9950371902099893*v[6]*w.v_LF_hip[5] - 0.09950371902099893*v[6]*w.v_LF_hip[3];
     w.c_LF_hip[5] = -0.9950371902099893*v[6]*w.v_LF_hip[4];
-    const Scalar h2 = 0.5950000000000001*w.v_LF_hip[0] - 0.02164*w.v_LF_hip[5];
-    const Scalar h3 = 0.5950000000000001*w.v_LF_hip[2] + 0.02164*w.v_LF_hip[3];
-    const Scalar h4 = 0.02164*w.v_LF_hip[2] + 0.0012018399999999998*w.v_LF_hip[3] + 5.8e-05*w.v_LF_hip[4] + 4.5e-07*w.v_LF_hip[5];
-    const Scalar h5 = 5.8e-05*w.v_LF_hip[3] + 0.000623*w.v_LF_hip[4] + 9.5e-07*w.v_LF_hip[5];
-    const Scalar h6 = -0.02164*w.v_LF_hip[0] + 4.5e-07*w.v_LF_hip[3] + 9.5e-07*w.v_LF_hip[4] + 0.00126484*w.v_LF_hip[5];
-    w.pA_LF_hip[0] = w.v_LF_hip[4]*h3 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[5];
-    w.pA_LF_hip[1] = w.v_LF_hip[5]*h2 - w.v_LF_hip[3]*h3;
-    w.pA_LF_hip[2] = 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[3] - w.v_LF_hip[4]*h2;
-    w.pA_LF_hip[3] = w.v_LF_hip[4]*h6 - w.v_LF_hip[5]*h5 + w.v_LF_hip[1]*h3 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[2];
-    w.pA_LF_hip[4] = w.v_LF_hip[5]*h4 - w.v_LF_hip[3]*h6 + w.v_LF_hip[2]*h2 - w.v_LF_hip[0]*h3;
-    w.pA_LF_hip[5] = w.v_LF_hip[3]*h5 - w.v_LF_hip[4]*h4 + 0.5950000000000001*w.v_LF_hip[0]*w.v_LF_hip[1] - w.v_LF_hip[1]*h2;
+    const Scalar h0 = 0.5950000000000001*w.v_LF_hip[0] - 0.02164*w.v_LF_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_LF_hip[2] + 0.02164*w.v_LF_hip[3];
+    const Scalar h2 = 0.02164*w.v_LF_hip[2] + 0.0012018399999999998*w.v_LF_hip[3] + 5.8e-05*w.v_LF_hip[4] + 4.5e-07*w.v_LF_hip[5];
+    const Scalar h3 = 5.8e-05*w.v_LF_hip[3] + 0.000623*w.v_LF_hip[4] + 9.5e-07*w.v_LF_hip[5];
+    const Scalar h4 = -0.02164*w.v_LF_hip[0] + 4.5e-07*w.v_LF_hip[3] + 9.5e-07*w.v_LF_hip[4] + 0.00126484*w.v_LF_hip[5];
+    w.pA_LF_hip[0] = w.v_LF_hip[4]*h1 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[5];
+    w.pA_LF_hip[1] = w.v_LF_hip[5]*h0 - w.v_LF_hip[3]*h1;
+    w.pA_LF_hip[2] = 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[3] - w.v_LF_hip[4]*h0;
+    w.pA_LF_hip[3] = w.v_LF_hip[4]*h4 - w.v_LF_hip[5]*h3 + w.v_LF_hip[1]*h1 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[2];
+    w.pA_LF_hip[4] = w.v_LF_hip[5]*h2 - w.v_LF_hip[3]*h4 + w.v_LF_hip[2]*h0 - w.v_LF_hip[0]*h1;
+    w.pA_LF_hip[5] = w.v_LF_hip[3]*h3 - w.v_LF_hip[4]*h2 + 0.5950000000000001*w.v_LF_hip[0]*w.v_LF_hip[1] - w.v_LF_hip[1]*h0;
     w.g_LF_hip[0] = w.g_trunk[0]*w.RJ_LF_hip[0] + w.g_trunk[1]*w.RJ_LF_hip[3] + w.g_trunk[2]*w.RJ_LF_hip[6];
     w.g_LF_hip[1] = w.g_trunk[0]*w.RJ_LF_hip[1] + w.g_trunk[1]*w.cq_LF_hip + w.g_trunk[2]*w.RJ_LF_hip[7];
     w.g_LF_hip[2] = w.g_trunk[0]*w.RJ_LF_hip[2] + w.g_trunk[1]*w.RJ_LF_hip[5] + w.g_trunk[2]*w.RJ_LF_hip[8];
@@ -736,7 +734,7 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
     w.IA_trunk[13] = t59;
     w.IA_trunk[14] = t60;
     w.IA_trunk[15] = 0.012033220000000006 + w.RJ_RH_hip[0]*t28 + w.RJ_RH_hip[1]*t29 + w.RJ_RH_hip[2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = 5.421010862427522e-20 + w.RJ_RH_hip[3]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[5]*t30 + 0.19*t49 - 0.049*t59;
+    w.IA_trunk[16] = w.RJ_RH_hip[3]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[5]*t30 + 0.19*t49 - 0.049*t59;
     w.IA_trunk[17] = w.RJ_RH_hip[6]*t28 + w.RJ_RH_hip[7]*t29 + w.RJ_RH_hip[8]*t30 + 0.049*t43 - 0.19*t46 - 0.049*t60;
     w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[3]*t31 + w.cq_RH_hip*t32 + w.RJ_RH_hip[5]*t33 + 0.19*t50 + 0.19*t59;
     w.IA_trunk[19] = w.RJ_RH_hip[6]*t31 + w.RJ_RH_hip[7]*t32 + w.RJ_RH_hip[8]*t33 + 0.049*t44 - 0.19*t47 + 0.19*t60;
@@ -2737,7 +2735,7 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     w.IA_trunk[13] = t59;
     w.IA_trunk[14] = t60;
     w.IA_trunk[15] = 0.012033220000000006 + w.RJ_RH_hip[0]*t28 + w.RJ_RH_hip[1]*t29 + w.RJ_RH_hip[2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = 5.421010862427522e-20 + w.RJ_RH_hip[3]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[5]*t30 + 0.19*t49 - 0.049*t59;
+    w.IA_trunk[16] = w.RJ_RH_hip[3]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[5]*t30 + 0.19*t49 - 0.049*t59;
     w.IA_trunk[17] = w.RJ_RH_hip[6]*t28 + w.RJ_RH_hip[7]*t29 + w.RJ_RH_hip[8]*t30 + 0.049*t43 - 0.19*t46 - 0.049*t60;
     w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[3]*t31 + w.cq_RH_hip*t32 + w.RJ_RH_hip[5]*t33 + 0.19*t50 + 0.19*t59;
     w.IA_trunk[19] = w.RJ_RH_hip[6]*t31 + w.RJ_RH_hip[7]*t32 + w.RJ_RH_hip[8]*t33 + 0.049*t44 - 0.19*t47 + 0.19*t60;

@@ -4,10 +4,10 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4464 + 1204 K (= 8076 at K = 3)
-//     add/sub 1875 + 543 K, mul 2493 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
-//   prox_pv: 8407 + 475 K (= 9832 at K = 3)
-//     add/sub 3493 + 204 K, mul 4740 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
+//   constrained_aba: 4452 + 1204 K (= 8064 at K = 3)
+//     add/sub 1869 + 543 K, mul 2487 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
+//   prox_pv: 8395 + 475 K (= 9820 at K = 3)
+//     add/sub 3487 + 204 K, mul 4734 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
