@@ -68,7 +68,7 @@ struct Settings {
 // Everything one solve writes (22880 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
-  Scalar RJ_pelvis[9];         // joint rotation (row-major), body 1
+  Scalar RJ_pelvis[3][3];      // joint rotation, body 1
   Scalar pA_pelvis[6];         // bias force, body 1
   Scalar g_pelvis[3];          // gravity in body coordinates, body 1
   Scalar sq_l_hip_yaw_link;    // sin q, body 2

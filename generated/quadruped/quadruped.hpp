@@ -51,12 +51,12 @@ struct Settings {
 // Everything one solve writes (11160 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
-  Scalar RJ_trunk[9];          // joint rotation (row-major), body 1
+  Scalar RJ_trunk[3][3];       // joint rotation, body 1
   Scalar pA_trunk[6];          // bias force, body 1
   Scalar g_trunk[3];           // gravity in body coordinates, body 1
   Scalar sq_LF_hip;            // sin q, body 2
   Scalar cq_LF_hip;            // cos q, body 2
-  Scalar RJ_LF_hip[9];         // joint rotation (row-major), body 2
+  Scalar RJ_LF_hip[3][3];      // joint rotation, body 2
   Scalar v_LF_hip[6];          // velocity, body 2
   Scalar c_LF_hip[6];          // velocity-product acceleration, body 2
   Scalar pA_LF_hip[6];         // bias force, body 2
@@ -76,7 +76,7 @@ struct Workspace {
   Scalar k_lf_foot[3];         // constraint right-hand side, constraint 0
   Scalar sq_LH_hip;            // sin q, body 5
   Scalar cq_LH_hip;            // cos q, body 5
-  Scalar RJ_LH_hip[9];         // joint rotation (row-major), body 5
+  Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
   Scalar v_LH_hip[6];          // velocity, body 5
   Scalar c_LH_hip[6];          // velocity-product acceleration, body 5
   Scalar pA_LH_hip[6];         // bias force, body 5
@@ -96,7 +96,7 @@ struct Workspace {
   Scalar k_lh_foot[3];         // constraint right-hand side, constraint 2
   Scalar sq_RF_hip;            // sin q, body 8
   Scalar cq_RF_hip;            // cos q, body 8
-  Scalar RJ_RF_hip[9];         // joint rotation (row-major), body 8
+  Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
   Scalar v_RF_hip[6];          // velocity, body 8
   Scalar c_RF_hip[6];          // velocity-product acceleration, body 8
   Scalar pA_RF_hip[6];         // bias force, body 8
@@ -116,7 +116,7 @@ struct Workspace {
   Scalar k_rf_foot[3];         // constraint right-hand side, constraint 1
   Scalar sq_RH_hip;            // sin q, body 11
   Scalar cq_RH_hip;            // cos q, body 11
-  Scalar RJ_RH_hip[9];         // joint rotation (row-major), body 11
+  Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
   Scalar v_RH_hip[6];          // velocity, body 11
   Scalar c_RH_hip[6];          // velocity-product acceleration, body 11
   Scalar pA_RH_hip[6];         // bias force, body 11

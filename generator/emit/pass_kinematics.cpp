@@ -40,7 +40,7 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
     const M3 R = {1.0 - two(y, y, 1.0, z, z), two(x, y, -1.0, w, z), two(x, z, 1.0, w, y),
                   two(x, y, 1.0, w, z), 1.0 - two(x, x, 1.0, z, z), two(y, z, -1.0, w, x),
                   two(x, z, -1.0, w, y), two(y, z, 1.0, w, x), 1.0 - two(x, x, 1.0, y, y)};
-    for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = e.keepQ(kRJ, i, 9, k, R[std::size_t(k)]);
+    for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = e.keepQ(kRJ, i, 3, 3, k / 3, k % 3, R[std::size_t(k)]);
     b.XJ.p = {cb.input(q(j.idx_q)), cb.input(q(j.idx_q + 1)), cb.input(q(j.idx_q + 2))};
     return;
   }
@@ -61,7 +61,7 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   for (int r = 0; r < 3; ++r)
     for (int col = 0; col < 3; ++col) {
       const Expr x = A(r, col) + (r == col ? 1.0 : 0.0) * c - A(r, col) * c + K(r, col) * s;
-      b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 9, 3 * r + col, x);
+      b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 3, 3, r, col, x);
     }
 }
 
@@ -89,7 +89,8 @@ void gravityAndPlacement(Emit& e, int i, const Kinematics::Body& parent, Kinemat
   }
   if (e.bp(i).needsPlacement) {
     const XSym M = compose(e.cb(), compose(e.cb(), parent.oM, b.XT), b.XJ);
-    for (int k = 0; k < 9; ++k) b.oM.R[std::size_t(k)] = e.keepQ(kOR, i, 9, k, e.cb().flat(M.R[std::size_t(k)]));
+    for (int k = 0; k < 9; ++k)
+      b.oM.R[std::size_t(k)] = e.keepQ(kOR, i, 3, 3, k / 3, k % 3, e.cb().flat(M.R[std::size_t(k)]));
     for (int k = 0; k < 3; ++k) b.oM.p[std::size_t(k)] = e.keepQ(kOP, i, 3, k, e.cb().flat(M.p[std::size_t(k)]));
   }
 }
