@@ -2,6 +2,12 @@
 //   proxgen generate arm.urdf --layout layout.yaml --out DIR --name arm --scalar double
 // robot 'ur5e_arm', arm.urdf sha256 752a820df864dc727fba5a4275f3622d0b64e76af2ef53935995304212ca0138
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
+// Operations per call (the printed statements, everything each entry point
+// calls included; K = Settings::iterations; "a + b K": b per multiplier update):
+//   constrained_aba: 1113 + 316 K (= 2061 at K = 3)
+//     add/sub 467 + 139 K, mul 604 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2147 + 72 K (= 2363 at K = 3)
+//     add/sub 875 + 26 K, mul 1190 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line

@@ -2,6 +2,12 @@
 //   proxgen generate humanoid.urdf --layout layout.yaml --out DIR --name humanoid --scalar double
 // robot 'winter_humanoid', humanoid.urdf sha256 dd4e2ccc5855cb73cbd490c0f8364e352926107cf423590d963bde54e67234ae
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
+// Operations per call (the printed statements, everything each entry point
+// calls included; K = Settings::iterations; "a + b K": b per multiplier update):
+//   constrained_aba: 8676 + 1720 K (= 13836 at K = 3)
+//     add/sub 3477 + 743 K, mul 4969 + 931 K, div 34, neg 160 + 46 K, sqrt 6, sincos 30, log6 0
+//   prox_pv: 16617 + 650 K (= 18567 at K = 3)
+//     add/sub 6637 + 285 K, mul 9565 + 365 K, div 53, neg 305, sqrt 27, sincos 30, log6 0
 
 #include "humanoid.hpp"
 
@@ -14,15 +20,15 @@ namespace {
 PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    w.RJ_pelvis[0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
-    w.RJ_pelvis[1] = 2.0*(q[3]*q[4] - q[5]*q[6]);
-    w.RJ_pelvis[2] = 2.0*(q[3]*q[5] + q[4]*q[6]);
-    w.RJ_pelvis[3] = 2.0*(q[3]*q[4] + q[5]*q[6]);
-    w.RJ_pelvis[4] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[3]*q[3];
-    w.RJ_pelvis[5] = 2.0*(q[4]*q[5] - q[3]*q[6]);
-    w.RJ_pelvis[6] = 2.0*(q[3]*q[5] - q[4]*q[6]);
-    w.RJ_pelvis[7] = 2.0*(q[4]*q[5] + q[3]*q[6]);
-    w.RJ_pelvis[8] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[3]*q[3];
+    w.RJ_pelvis[0][0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
+    w.RJ_pelvis[0][1] = 2.0*(q[3]*q[4] - q[5]*q[6]);
+    w.RJ_pelvis[0][2] = 2.0*(q[3]*q[5] + q[4]*q[6]);
+    w.RJ_pelvis[1][0] = 2.0*(q[3]*q[4] + q[5]*q[6]);
+    w.RJ_pelvis[1][1] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[3]*q[3];
+    w.RJ_pelvis[1][2] = 2.0*(q[4]*q[5] - q[3]*q[6]);
+    w.RJ_pelvis[2][0] = 2.0*(q[3]*q[5] - q[4]*q[6]);
+    w.RJ_pelvis[2][1] = 2.0*(q[4]*q[5] + q[3]*q[6]);
+    w.RJ_pelvis[2][2] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[3]*q[3];
     const Scalar h0 = 7.94*v[0] + 0.71063*v[4];
     const Scalar h1 = 7.94*v[1] - 0.71063*v[3];
     const Scalar h2 = -0.71063*v[1] + 0.138038885*v[3];
@@ -33,9 +39,9 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
     w.pA_pelvis[3] = 0.0860166666667*v[4]*v[5] - v[5]*h3 + 7.94*v[1]*v[2] - v[2]*h1;
     w.pA_pelvis[4] = -0.0860166666667*v[3]*v[5] + v[5]*h2 + v[2]*h0 - 7.94*v[0]*v[2];
     w.pA_pelvis[5] = v[3]*h3 - v[4]*h2 + v[0]*h1 - v[1]*h0;
-    w.g_pelvis[0] = -9.81*w.RJ_pelvis[6];
-    w.g_pelvis[1] = -9.81*w.RJ_pelvis[7];
-    w.g_pelvis[2] = -9.81*w.RJ_pelvis[8];
+    w.g_pelvis[0] = -9.81*w.RJ_pelvis[2][0];
+    w.g_pelvis[1] = -9.81*w.RJ_pelvis[2][1];
+    w.g_pelvis[2] = -9.81*w.RJ_pelvis[2][2];
   }
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
@@ -3304,17 +3310,17 @@ PROXGEN_RT_NOINLINE void caba_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
     const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
     const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
     const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
     const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
     const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
     const Scalar t11 = w.Linv_pelvis[5]*t10;
     const Scalar t12 = w.Linv_pelvis[5]*t11;
     const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
@@ -3332,9 +3338,9 @@ PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGE
     w.qdd[3] = w.Linv_pelvis[3]*t15;
     w.qdd[4] = w.Linv_pelvis[4]*t13;
     w.qdd[5] = w.Linv_pelvis[5]*t11;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
+    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.qdd[0];
+    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.qdd[1];
+    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.qdd[2];
     w.a_pelvis[3] = w.qdd[3];
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];
@@ -4221,17 +4227,17 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_hip_roll_link_to_pelvis(Workspace& PROXG
 PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
     const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
     const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
     const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
     const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
     const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
     const Scalar t11 = w.Linv_pelvis[5]*t10;
     const Scalar t12 = w.Linv_pelvis[5]*t11;
     const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
@@ -4249,9 +4255,9 @@ PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROX
     w.qdd[3] = w.Linv_pelvis[3]*t15;
     w.qdd[4] = w.Linv_pelvis[4]*t13;
     w.qdd[5] = w.Linv_pelvis[5]*t11;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
+    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.qdd[0];
+    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.qdd[1];
+    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.qdd[2];
     w.a_pelvis[3] = w.qdd[3];
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];
@@ -7615,17 +7621,17 @@ PROXGEN_RT_NOINLINE void pv_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT ta
 PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
     const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
     const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
     const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
     const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
     const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
     const Scalar t11 = w.Linv_pelvis[5]*t10;
     const Scalar t12 = w.Linv_pelvis[5]*t11;
     const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
@@ -7637,9 +7643,9 @@ PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_
     const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
     const Scalar t20 = w.Linv_pelvis[1]*t19;
     const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.Linv_pelvis[0]*t21;
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.Linv_pelvis[1]*t19;
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.Linv_pelvis[2]*t17;
+    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.Linv_pelvis[0]*t21;
+    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.Linv_pelvis[1]*t19;
+    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.Linv_pelvis[2]*t17;
     w.a_pelvis[3] = w.Linv_pelvis[3]*t15;
     w.a_pelvis[4] = w.Linv_pelvis[4]*t13;
     w.a_pelvis[5] = w.Linv_pelvis[5]*t11;
@@ -8673,17 +8679,17 @@ PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRI
 PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0][0]*w.lambda[0] - w.KA_pelvis[0][1]*w.lambda[1] - w.KA_pelvis[0][2]*w.lambda[2] - w.KA_pelvis[0][3]*w.lambda[3] - w.KA_pelvis[0][4]*w.lambda[4] - w.KA_pelvis[0][5]*w.lambda[5] - w.KA_pelvis[0][6]*w.lambda[6] - w.KA_pelvis[0][7]*w.lambda[7] - w.KA_pelvis[0][8]*w.lambda[8] - w.KA_pelvis[0][9]*w.lambda[9] - w.KA_pelvis[0][10]*w.lambda[10] - w.KA_pelvis[0][11]*w.lambda[11] - w.KA_pelvis[0][12]*w.lambda[12] - w.KA_pelvis[0][13]*w.lambda[13] - w.KA_pelvis[0][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[2];
+    const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0][0]*w.lambda[0] - w.KA_pelvis[0][1]*w.lambda[1] - w.KA_pelvis[0][2]*w.lambda[2] - w.KA_pelvis[0][3]*w.lambda[3] - w.KA_pelvis[0][4]*w.lambda[4] - w.KA_pelvis[0][5]*w.lambda[5] - w.KA_pelvis[0][6]*w.lambda[6] - w.KA_pelvis[0][7]*w.lambda[7] - w.KA_pelvis[0][8]*w.lambda[8] - w.KA_pelvis[0][9]*w.lambda[9] - w.KA_pelvis[0][10]*w.lambda[10] - w.KA_pelvis[0][11]*w.lambda[11] - w.KA_pelvis[0][12]*w.lambda[12] - w.KA_pelvis[0][13]*w.lambda[13] - w.KA_pelvis[0][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
     const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - w.KA_pelvis[1][0]*w.lambda[0] - w.KA_pelvis[1][1]*w.lambda[1] - w.KA_pelvis[1][2]*w.lambda[2] - w.KA_pelvis[1][3]*w.lambda[3] - w.KA_pelvis[1][4]*w.lambda[4] - w.KA_pelvis[1][5]*w.lambda[5] - w.KA_pelvis[1][6]*w.lambda[6] - w.KA_pelvis[1][7]*w.lambda[7] - w.KA_pelvis[1][8]*w.lambda[8] - w.KA_pelvis[1][9]*w.lambda[9] - w.KA_pelvis[1][10]*w.lambda[10] - w.KA_pelvis[1][11]*w.lambda[11] - w.KA_pelvis[1][12]*w.lambda[12] - w.KA_pelvis[1][13]*w.lambda[13] - w.KA_pelvis[1][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
+    const Scalar t2 = w.u_pelvis[1] - w.KA_pelvis[1][0]*w.lambda[0] - w.KA_pelvis[1][1]*w.lambda[1] - w.KA_pelvis[1][2]*w.lambda[2] - w.KA_pelvis[1][3]*w.lambda[3] - w.KA_pelvis[1][4]*w.lambda[4] - w.KA_pelvis[1][5]*w.lambda[5] - w.KA_pelvis[1][6]*w.lambda[6] - w.KA_pelvis[1][7]*w.lambda[7] - w.KA_pelvis[1][8]*w.lambda[8] - w.KA_pelvis[1][9]*w.lambda[9] - w.KA_pelvis[1][10]*w.lambda[10] - w.KA_pelvis[1][11]*w.lambda[11] - w.KA_pelvis[1][12]*w.lambda[12] - w.KA_pelvis[1][13]*w.lambda[13] - w.KA_pelvis[1][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
     const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - w.KA_pelvis[2][0]*w.lambda[0] - w.KA_pelvis[2][1]*w.lambda[1] - w.KA_pelvis[2][2]*w.lambda[2] - w.KA_pelvis[2][3]*w.lambda[3] - w.KA_pelvis[2][4]*w.lambda[4] - w.KA_pelvis[2][5]*w.lambda[5] - w.KA_pelvis[2][6]*w.lambda[6] - w.KA_pelvis[2][7]*w.lambda[7] - w.KA_pelvis[2][8]*w.lambda[8] - w.KA_pelvis[2][9]*w.lambda[9] - w.KA_pelvis[2][10]*w.lambda[10] - w.KA_pelvis[2][11]*w.lambda[11] - w.KA_pelvis[2][12]*w.lambda[12] - w.KA_pelvis[2][13]*w.lambda[13] - w.KA_pelvis[2][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
+    const Scalar t4 = w.u_pelvis[2] - w.KA_pelvis[2][0]*w.lambda[0] - w.KA_pelvis[2][1]*w.lambda[1] - w.KA_pelvis[2][2]*w.lambda[2] - w.KA_pelvis[2][3]*w.lambda[3] - w.KA_pelvis[2][4]*w.lambda[4] - w.KA_pelvis[2][5]*w.lambda[5] - w.KA_pelvis[2][6]*w.lambda[6] - w.KA_pelvis[2][7]*w.lambda[7] - w.KA_pelvis[2][8]*w.lambda[8] - w.KA_pelvis[2][9]*w.lambda[9] - w.KA_pelvis[2][10]*w.lambda[10] - w.KA_pelvis[2][11]*w.lambda[11] - w.KA_pelvis[2][12]*w.lambda[12] - w.KA_pelvis[2][13]*w.lambda[13] - w.KA_pelvis[2][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
     const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - w.KA_pelvis[3][0]*w.lambda[0] - w.KA_pelvis[3][1]*w.lambda[1] - w.KA_pelvis[3][2]*w.lambda[2] - w.KA_pelvis[3][3]*w.lambda[3] - w.KA_pelvis[3][4]*w.lambda[4] - w.KA_pelvis[3][5]*w.lambda[5] - w.KA_pelvis[3][6]*w.lambda[6] - w.KA_pelvis[3][7]*w.lambda[7] - w.KA_pelvis[3][8]*w.lambda[8] - w.KA_pelvis[3][9]*w.lambda[9] - w.KA_pelvis[3][10]*w.lambda[10] - w.KA_pelvis[3][11]*w.lambda[11] - w.KA_pelvis[3][12]*w.lambda[12] - w.KA_pelvis[3][13]*w.lambda[13] - w.KA_pelvis[3][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
+    const Scalar t6 = w.u_pelvis[3] - w.KA_pelvis[3][0]*w.lambda[0] - w.KA_pelvis[3][1]*w.lambda[1] - w.KA_pelvis[3][2]*w.lambda[2] - w.KA_pelvis[3][3]*w.lambda[3] - w.KA_pelvis[3][4]*w.lambda[4] - w.KA_pelvis[3][5]*w.lambda[5] - w.KA_pelvis[3][6]*w.lambda[6] - w.KA_pelvis[3][7]*w.lambda[7] - w.KA_pelvis[3][8]*w.lambda[8] - w.KA_pelvis[3][9]*w.lambda[9] - w.KA_pelvis[3][10]*w.lambda[10] - w.KA_pelvis[3][11]*w.lambda[11] - w.KA_pelvis[3][12]*w.lambda[12] - w.KA_pelvis[3][13]*w.lambda[13] - w.KA_pelvis[3][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
     const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - w.KA_pelvis[4][0]*w.lambda[0] - w.KA_pelvis[4][1]*w.lambda[1] - w.KA_pelvis[4][2]*w.lambda[2] - w.KA_pelvis[4][3]*w.lambda[3] - w.KA_pelvis[4][4]*w.lambda[4] - w.KA_pelvis[4][5]*w.lambda[5] - w.KA_pelvis[4][6]*w.lambda[6] - w.KA_pelvis[4][7]*w.lambda[7] - w.KA_pelvis[4][8]*w.lambda[8] - w.KA_pelvis[4][9]*w.lambda[9] - w.KA_pelvis[4][10]*w.lambda[10] - w.KA_pelvis[4][11]*w.lambda[11] - w.KA_pelvis[4][12]*w.lambda[12] - w.KA_pelvis[4][13]*w.lambda[13] - w.KA_pelvis[4][14]*w.lambda[14] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
+    const Scalar t8 = w.u_pelvis[4] - w.KA_pelvis[4][0]*w.lambda[0] - w.KA_pelvis[4][1]*w.lambda[1] - w.KA_pelvis[4][2]*w.lambda[2] - w.KA_pelvis[4][3]*w.lambda[3] - w.KA_pelvis[4][4]*w.lambda[4] - w.KA_pelvis[4][5]*w.lambda[5] - w.KA_pelvis[4][6]*w.lambda[6] - w.KA_pelvis[4][7]*w.lambda[7] - w.KA_pelvis[4][8]*w.lambda[8] - w.KA_pelvis[4][9]*w.lambda[9] - w.KA_pelvis[4][10]*w.lambda[10] - w.KA_pelvis[4][11]*w.lambda[11] - w.KA_pelvis[4][12]*w.lambda[12] - w.KA_pelvis[4][13]*w.lambda[13] - w.KA_pelvis[4][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
     const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - w.KA_pelvis[5][0]*w.lambda[0] - w.KA_pelvis[5][1]*w.lambda[1] - w.KA_pelvis[5][2]*w.lambda[2] - w.KA_pelvis[5][3]*w.lambda[3] - w.KA_pelvis[5][4]*w.lambda[4] - w.KA_pelvis[5][5]*w.lambda[5] - w.KA_pelvis[5][6]*w.lambda[6] - w.KA_pelvis[5][7]*w.lambda[7] - w.KA_pelvis[5][8]*w.lambda[8] - w.KA_pelvis[5][9]*w.lambda[9] - w.KA_pelvis[5][10]*w.lambda[10] - w.KA_pelvis[5][11]*w.lambda[11] - 9.81*w.RJ_pelvis[6]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[7]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[8]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
+    const Scalar t10 = w.u_pelvis[5] - w.KA_pelvis[5][0]*w.lambda[0] - w.KA_pelvis[5][1]*w.lambda[1] - w.KA_pelvis[5][2]*w.lambda[2] - w.KA_pelvis[5][3]*w.lambda[3] - w.KA_pelvis[5][4]*w.lambda[4] - w.KA_pelvis[5][5]*w.lambda[5] - w.KA_pelvis[5][6]*w.lambda[6] - w.KA_pelvis[5][7]*w.lambda[7] - w.KA_pelvis[5][8]*w.lambda[8] - w.KA_pelvis[5][9]*w.lambda[9] - w.KA_pelvis[5][10]*w.lambda[10] - w.KA_pelvis[5][11]*w.lambda[11] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
     const Scalar t11 = w.Linv_pelvis[5]*t10;
     const Scalar t12 = w.Linv_pelvis[5]*t11;
     const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
@@ -8701,9 +8707,9 @@ PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_
     w.qdd[3] = w.Linv_pelvis[3]*t15;
     w.qdd[4] = w.Linv_pelvis[4]*t13;
     w.qdd[5] = w.Linv_pelvis[5]*t11;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[6] + w.qdd[0];
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[7] + w.qdd[1];
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[8] + w.qdd[2];
+    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.qdd[0];
+    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.qdd[1];
+    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.qdd[2];
     w.a_pelvis[3] = w.qdd[3];
     w.a_pelvis[4] = w.qdd[4];
     w.a_pelvis[5] = w.qdd[5];

@@ -33,6 +33,24 @@ std::string freeBodies(const SolverTexts& texts) {
       texts.eliminateFree, texts.accelerateFree);
 }
 
+// "a + b K" (b = 0: "a").
+std::string affine(long once, long perK) {
+  if (perK == 0) return fmt::format("{}", once);
+  return fmt::format("{} + {} K", once, perK);
+}
+
+// One entry point's line of the banner's operation count (docs/emitter.md).
+std::string opLine(const std::string& name, const OpCount& n, int K) {
+  const Ops& a = n.once;
+  const Ops& b = n.perK;
+  return fmt::format(
+      "//   {}: {} (= {} at K = {})\n"
+      "//     add/sub {}, mul {}, div {}, neg {}, sqrt {}, sincos {}, log6 {}\n",
+      name, affine(a.total(), b.total()), n.at(K).total(), K, affine(a.add, b.add), affine(a.mul, b.mul),
+      affine(a.div, b.div), affine(a.neg, b.neg), affine(a.sqrt, b.sqrt), affine(a.sincos, b.sincos),
+      affine(a.log6, b.log6));
+}
+
 }  // namespace
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
@@ -55,7 +73,9 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   const std::string banner = fmt::format(
       fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION), fmt::arg("urdf", escapeComment(in.urdfName)),
       fmt::arg("layout", escapeComment(in.layoutName)), fmt::arg("command", escapeComment(in.command)),
-      fmt::arg("robot", escapeComment(m.name)), fmt::arg("urdf_sha", in.urdfSha256), fmt::arg("layout_sha", in.layoutSha256));
+      fmt::arg("robot", escapeComment(m.name)), fmt::arg("urdf_sha", in.urdfSha256), fmt::arg("layout_sha", in.layoutSha256),
+      fmt::arg("operations", opLine("constrained_aba", texts.cabaOps, plan.iterations) +
+                                 opLine("prox_pv", texts.pvOps, plan.iterations)));
 
   SolverFiles files;
   files.headerName = plan.name + ".hpp";

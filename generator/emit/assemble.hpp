@@ -7,6 +7,7 @@
 #include <string>
 
 #include "emit/emitter.hpp"
+#include "emit/expr.hpp"
 #include "emit/members.hpp"
 
 namespace proxgen::emit {
@@ -15,6 +16,7 @@ namespace proxgen::emit {
 struct SolverTexts {
   std::string parts;  // every part function
   std::string kinematics, eliminateFree, accelerateFree, caba, pv;
+  OpCount cabaOps, pvOps;  // per call of each entry point, everything it calls included
 };
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,

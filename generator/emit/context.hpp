@@ -51,6 +51,10 @@ struct Emit {
   Expr keepQ(const Quantity& qy, int body, int size, int idx, const Expr& e) {
     return e.isConstant() || cb().isAlias(e) ? e : cb().store(member(qy, body, size, idx), e);
   }
+  /// The same for entry (r, c) of a rows x cols matrix member.
+  Expr keepQ(const Quantity& qy, int body, int rows, int cols, int r, int c, const Expr& e) {
+    return e.isConstant() || cb().isAlias(e) ? e : cb().store(member(qy, body, rows, cols, r, c), e);
+  }
 
   // ---- structure
   std::vector<std::string> bodyComments(int i, const std::string& stage) const;

@@ -43,6 +43,16 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   texts.accelerateFree = freeAccel.text;
   texts.parts = fn.parts();
 
+  // Operations per call: each entry point calls kinematics and the two
+  // functions of the off-support bodies once (raw lines, not parts).
+  OpCount shared = fn.hostOps("kinematics");
+  shared += fn.hostOps("eliminate_free");
+  shared += fn.hostOps("accelerate_free");
+  texts.cabaOps = fn.hostOps("caba");
+  texts.cabaOps += shared;
+  texts.pvOps = fn.hostOps("pv");
+  texts.pvOps += shared;
+
   if (stats) {
     stats->statements = fn.stats().statements;
     stats->temporaries = fn.stats().temporaries;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <regex>
 #include <stdexcept>
 
 #include "model/error.hpp"
@@ -52,6 +53,36 @@ Expr operator*(double k, const Expr& a) {
     if (c != 0.0) r.terms_.push_back({t.atom, c});
   }
   return r;
+}
+
+// ---------------------------------------------------------------- Ops
+
+Ops& Ops::operator+=(const Ops& o) {
+  add += o.add;
+  mul += o.mul;
+  div += o.div;
+  neg += o.neg;
+  sqrt += o.sqrt;
+  sincos += o.sincos;
+  log6 += o.log6;
+  return *this;
+}
+
+Ops operator*(long k, const Ops& o) {
+  Ops r;
+  r.add = k * o.add;
+  r.mul = k * o.mul;
+  r.div = k * o.div;
+  r.neg = k * o.neg;
+  r.sqrt = k * o.sqrt;
+  r.sincos = k * o.sincos;
+  r.log6 = k * o.log6;
+  return r;
+}
+
+bool operator==(const Ops& a, const Ops& b) {
+  return a.add == b.add && a.mul == b.mul && a.div == b.div && a.neg == b.neg && a.sqrt == b.sqrt &&
+         a.sincos == b.sincos && a.log6 == b.log6;
 }
 
 // ---------------------------------------------------------------- CodeBuilder
@@ -175,6 +206,36 @@ std::string CodeBuilder::describe(const Expr& e) const {
   return s;
 }
 
+// The operations of describe(e), term by term as it prints them: a product
+// atom is one multiplication, a coefficient other than +-1 another, each term
+// after the first an addition or subtraction, a leading term with coefficient
+// -1 a negation (-0.5*x multiplies by the literal -0.5, and a negative
+// constant is a literal: no operation).
+Ops CodeBuilder::countOps(const Expr& e) const {
+  Ops o;
+  if (e.constant() == 0.0 && e.terms().size() > 1) {
+    const double c = std::abs(e.terms()[0].coeff);
+    bool common = c != 1.0;
+    for (const Term& t : e.terms()) common = common && std::abs(t.coeff) == c;
+    if (common) {  // c*(unit)
+      Expr unit;
+      for (const Term& t : e.terms()) unit += Expr::atom(t.atom, t.coeff / c);
+      o = countOps(unit);
+      ++o.mul;
+      return o;
+    }
+  }
+  bool first = e.constant() == 0.0 && !e.terms().empty();
+  for (const Term& t : e.terms()) {
+    if (atoms_[std::size_t(t.atom)].f1 >= 0) ++o.mul;
+    if (std::abs(t.coeff) != 1.0) ++o.mul;
+    if (!first) ++o.add;
+    else if (t.coeff == -1.0) ++o.neg;
+    first = false;
+  }
+  return o;
+}
+
 int CodeBuilder::addStmt(Stmt s) {
   stmts_.push_back(std::move(s));
   const int id = int(stmts_.size()) - 1;
@@ -202,6 +263,7 @@ Expr CodeBuilder::temp(const Expr& e, const std::string& hint) {
   s.defines = id;
   collectUses(e, s.uses);
   s.multiplies = countMultiplies(e);
+  s.ops.once = countOps(e);
   atoms_[id].stmt = addStmt(std::move(s));
   blocks_[stack_.back()].memo[k] = id;
   return Expr::atom(id);
@@ -255,6 +317,10 @@ Expr CodeBuilder::call(const std::string& fn, const Expr& arg, const std::string
   s.defines = id;
   collectUses(arg, s.uses);
   s.multiplies = fn.empty() ? 1 : 0;
+  s.ops.once = countOps(arg);
+  if (fn.empty()) ++s.ops.once.div;
+  else if (fn == "std::sqrt") ++s.ops.once.sqrt;
+  else throw std::logic_error("emitter: no operation count for " + fn);
   atoms_[id].stmt = addStmt(std::move(s));
   return Expr::atom(id);
 }
@@ -269,19 +335,21 @@ Expr CodeBuilder::store(const std::string& member, const Expr& e) {
   s.text = fmt::format("{} = {};", member, print(e));
   collectUses(e, s.uses);
   s.multiplies = countMultiplies(e);
+  s.ops.once = countOps(e);
   s.always = true;
   s.names = {member};
   addStmt(std::move(s));
   return refresh(member);
 }
 
-Expr CodeBuilder::storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses) {
-  line(fmt::format("{} = {};", member, rhs), uses, {member});
+Expr CodeBuilder::storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses,
+                           const Ops& extra) {
+  line(fmt::format("{} = {};", member, rhs), uses, {member}, OpCount{extra, {}});
   return refresh(member);
 }
 
 Expr CodeBuilder::define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses,
-                         const std::vector<std::string>& names) {
+                         const std::vector<std::string>& names, const Ops& extra) {
   Atom a;
   a.text = name;
   a.block = stack_.back();
@@ -291,9 +359,11 @@ Expr CodeBuilder::define(const std::string& name, const std::string& rhs, const 
   s.text = fmt::format("const Scalar {} = {};", name, rhs);
   s.defines = id;
   s.names = names;
+  s.ops.once = extra;
   for (const Expr& e : uses) {
     check(e);
     collectUses(e, s.uses);
+    s.ops.once += countOps(e);
   }
   atoms_[id].stmt = addStmt(std::move(s));
   return Expr::atom(id);
@@ -355,23 +425,32 @@ Expr CodeBuilder::refresh(const std::string& member) {
 }
 
 std::vector<Expr> CodeBuilder::storeByCall(const std::string& text, const std::vector<std::string>& members,
-                                           const std::vector<Expr>& uses) {
-  line(text, uses, members);
+                                           const std::vector<Expr>& uses, const Ops& extra) {
+  line(text, uses, members, OpCount{extra, {}});
   std::vector<Expr> out;
   for (const std::string& m : members) out.push_back(refresh(m));
   return out;
 }
 
-void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses, const std::vector<std::string>& names) {
+void CodeBuilder::line(const std::string& text, const std::vector<Expr>& uses, const std::vector<std::string>& names,
+                       const OpCount& extra) {
   Stmt s;
   s.text = text;
   s.always = true;
   s.names = names;
+  s.ops = extra;
   for (const Expr& e : uses) {
     check(e);
     collectUses(e, s.uses);
+    s.ops.once += countOps(e);
   }
   addStmt(std::move(s));
+}
+
+void CodeBuilder::addOps(const Expr& e, const Ops& extra) {
+  if (!e.isScaledAtom() || atoms_[std::size_t(e.terms()[0].atom)].stmt < 0)
+    throw std::logic_error("emitter: addOps on a value no statement defines");
+  stmts_[std::size_t(atoms_[std::size_t(e.terms()[0].atom)].stmt)].ops.once += extra;
 }
 
 void CodeBuilder::comment(const std::string& text) { line("// " + text); }
@@ -383,6 +462,16 @@ void CodeBuilder::open(const std::string& head, const std::vector<std::string>& 
   b.head = head;
   b.names = names;
   b.comments = comments;
+  if (head.rfind("for", 0) == 0) {
+    // The trip count, for opCount(): the passes print loops of one shape,
+    // for (int k = A; k < N; ++k) or k <= N, N a literal or s.iterations (K).
+    static const std::regex loop(R"(for \(int (\w+) = (-?\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{)");
+    std::smatch m;
+    if (!std::regex_match(head, m, loop)) throw std::logic_error("emitter: no trip count for the loop " + head);
+    const long from = std::stol(m[2].str()), inclusive = m[3].str() == "<=" ? 1 : 0;
+    b.onK = m[4].str() == "s.iterations";
+    b.trips = (b.onK ? 0 : std::stol(m[4].str())) - from + inclusive;
+  }
   blocks_.push_back(std::move(b));
   const int id = int(blocks_.size()) - 1;
   blocks_[stack_.back()].nodes.push_back({true, id});
@@ -461,6 +550,32 @@ std::set<std::string> CodeBuilder::accessedNames() const {
   }
   for (std::size_t b = 1; b < blocks_.size(); ++b)
     if (blockLive(int(b), live)) out.insert(blocks_[b].names.begin(), blocks_[b].names.end());
+  return out;
+}
+
+void CodeBuilder::countBlock(int block, const std::vector<char>& live, OpCount& out) const {
+  for (const Node& n : blocks_[std::size_t(block)].nodes) {
+    if (!n.isBlock) {
+      if (live[std::size_t(n.index)]) out += stmts_[std::size_t(n.index)].ops;
+      continue;
+    }
+    if (!blockLive(n.index, live)) continue;  // not printed
+    const Block& b = blocks_[std::size_t(n.index)];
+    OpCount inner;
+    countBlock(n.index, live, inner);
+    // (trips + K onK) (once + K perK): a K^2 term is a loop on K inside another.
+    if (b.onK && inner.perK.total() != 0) throw std::logic_error("emitter: nested loops on s.iterations");
+    out.once += b.trips * inner.once;
+    out.perK += b.trips * inner.perK;
+    if (b.onK) out.perK += inner.once;
+  }
+}
+
+OpCount CodeBuilder::opCount() const {
+  std::vector<char> live(stmts_.size(), 0);
+  markLive(0, live);
+  OpCount out;
+  countBlock(0, live, out);
   return out;
 }
 

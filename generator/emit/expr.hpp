@@ -22,6 +22,40 @@ namespace proxgen::emit {
 
 enum class ScalarType { Double, Float };
 
+/// Arithmetic of printed statements, counted from the expression graph (how
+/// each expression prints: expr.cpp's countOps), for the files' banner.
+struct Ops {
+  long add = 0;     // binary + and -
+  long mul = 0;
+  long div = 0;
+  long neg = 0;     // unary minus of a run-time value
+  long sqrt = 0;
+  long sincos = 0;  // proxgen_rt::sincos (one sine and one cosine)
+  long log6 = 0;    // proxgen_rt::log6 (the SE(3) logarithm of the runtime)
+  static Ops divisions(long n) { Ops o; o.div = n; return o; }
+  static Ops multiplications(long n) { Ops o; o.mul = n; return o; }
+  Ops& operator+=(const Ops& o);
+  friend Ops operator*(long k, const Ops& o);
+  friend bool operator==(const Ops& a, const Ops& b);
+  long total() const { return add + mul + div + neg + sqrt + sincos + log6; }
+};
+
+/// Operations per call as a function of K, the iteration count: once + K * perK
+/// (a loop `for (k = a; k < s.iterations ...)` runs K - a times).
+struct OpCount {
+  Ops once, perK;
+  OpCount& operator+=(const OpCount& o) {
+    once += o.once;
+    perK += o.perK;
+    return *this;
+  }
+  Ops at(long K) const {
+    Ops r = once;
+    r += K * perK;
+    return r;
+  }
+};
+
 struct Term {
   int atom = 0;
   double coeff = 0;
@@ -95,8 +129,10 @@ class CodeBuilder {
 
   /// A named temporary with a raw right-hand side (printed only when used);
   /// `names`: the parameters the right-hand side reads.
+  /// A raw right-hand side computes its `uses` as printed plus `extra` (what the
+  /// raw text itself does: a division, a runtime call).
   Expr define(const std::string& name, const std::string& rhs, const std::vector<Expr>& uses,
-              const std::vector<std::string>& names = {});
+              const std::vector<std::string>& names = {}, const Ops& extra = {});
   /// True for +-(an input or a member): a value worth no statement of its own.
   bool isAlias(const Expr& e) const;
   /// The same expression in this builder, from another one's members and inputs
@@ -111,14 +147,19 @@ class CodeBuilder {
   /// (it would read the new value where the old one was meant).
   Expr store(const std::string& member, const Expr& e);
   /// member = rhs; with a raw right-hand side (a function call).
-  Expr storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses);
+  Expr storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses, const Ops& extra = {});
   /// A raw statement that writes several members (a call with output
   /// arguments); returns their new values, in order.
   std::vector<Expr> storeByCall(const std::string& text, const std::vector<std::string>& members,
-                                const std::vector<Expr>& uses);
+                                const std::vector<Expr>& uses, const Ops& extra = {});
   /// A raw statement or comment line with the atoms it reads and the names
   /// (function parameters) its text reads or writes besides them.
-  void line(const std::string& text, const std::vector<Expr>& uses = {}, const std::vector<std::string>& names = {});
+  /// `extra`: what the text computes besides printing its uses (a call: the
+  /// callee's count); the uses count as printed whole, once each.
+  void line(const std::string& text, const std::vector<Expr>& uses = {}, const std::vector<std::string>& names = {},
+            const OpCount& extra = {});
+  /// Adds `extra` to the statement that defined temporary `e` (a host's mu).
+  void addOps(const Expr& e, const Ops& extra);
   void comment(const std::string& text);
   void blank();
   /// Opens a nested block: `head` is printed before the braces' contents
@@ -142,6 +183,11 @@ class CodeBuilder {
     int statements = 0, temporaries = 0, multiplies = 0;
   };
   Stats stats() const;
+  /// The arithmetic of the live statements; a loop on s.iterations counts
+  /// in OpCount::perK (its head is read for its trip count: open()).
+  OpCount opCount() const;
+  /// The arithmetic of e as print() prints it.
+  Ops countOps(const Expr& e) const;
 
  private:
   struct Atom {
@@ -161,6 +207,7 @@ class CodeBuilder {
     int multiplies = 0;
     bool always = false;    // stores, comments, raw lines
     std::vector<std::string> names;  // members written, parameters a raw text reads or writes
+    OpCount ops;
   };
   struct Node {
     bool isBlock = false;
@@ -172,6 +219,8 @@ class CodeBuilder {
     std::vector<std::string> comments;
     std::vector<Node> nodes;
     std::map<std::string, int> memo;  // canonical expression -> temporary atom
+    long trips = 1;     // a loop: runs trips (+ K when onK) times
+    bool onK = false;
   };
 
   int newAtom(Atom a);
@@ -185,6 +234,7 @@ class CodeBuilder {
   int countMultiplies(const Expr& e) const;
   void markLive(int block, std::vector<char>& live) const;
   bool blockLive(int block, const std::vector<char>& live) const;
+  void countBlock(int block, const std::vector<char>& live, OpCount& out) const;
   void renderBlock(int block, int indent, const std::vector<char>& live, std::string& out) const;
 
   ScalarType scalar_;

@@ -39,6 +39,21 @@ void FunctionWriter::beginHost(const std::string& name, const CodeBuilder* from)
   hosts_.push_back(std::move(h));
 }
 
+void FunctionWriter::setHostMu(const Expr& mu) {
+  hosts_.back().mu = mu;
+  hosts_.back().cb->addOps(mu, Ops::multiplications(1));
+}
+
+void FunctionWriter::setHostInvMu(const Expr& inv) {
+  hosts_.back().invMu = inv;
+  hosts_.back().cb->addOps(inv, Ops::divisions(1));
+}
+
+OpCount FunctionWriter::hostOps(const std::string& name) const {
+  const auto it = hostOps_.find(name);
+  return it == hostOps_.end() ? OpCount{} : it->second;
+}
+
 void FunctionWriter::beginPass(const std::string& name, const std::string& banner) {
   endPart();
   hosts_.back().pass = name;
@@ -84,6 +99,7 @@ void FunctionWriter::endPart() {
   Host& host = hosts_.back();
   const std::string body = render(*part_);
   const std::set<std::string> accessed = part_->accessedNames();
+  const OpCount ops = part_->opCount();
   std::vector<std::string> params, args;
   std::vector<Expr> uses;
   for (const char* p : {"q", "v", "tau"})
@@ -116,7 +132,7 @@ void FunctionWriter::endPart() {
     cb_->comment("---- " + host.banner);
     host.banner.clear();
   }
-  cb_->line(fmt::format("{}({});", name, call), uses, args);
+  cb_->line(fmt::format("{}({});", name, call), uses, args, ops);
 }
 
 std::string FunctionWriter::endHost(const std::vector<std::string>& params) {
@@ -128,6 +144,7 @@ std::string FunctionWriter::endHost(const std::vector<std::string>& params) {
   std::string prefix;
   for (const std::string& p : params)
     if (!needs(accessed, p)) prefix += "  static_cast<void>(" + p + ");\n";
+  hostOps_[host.name] = host.cb->opCount();
   lastHost_ = host.cb.get();
   closed_.push_back(std::move(host.cb));
   hosts_.pop_back();

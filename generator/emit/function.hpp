@@ -11,6 +11,7 @@
 // next function.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -52,9 +53,14 @@ class FunctionWriter {
   std::string endHost(const std::vector<std::string>& params);
   const CodeBuilder* lastHost() const { return lastHost_; }
 
-  /// The host's mu and 1/mu (defined in the host, passed to parts).
-  void setHostMu(const Expr& mu) { hosts_.back().mu = mu; }
-  void setHostInvMu(const Expr& inv) { hosts_.back().invMu = inv; }
+  /// The host's mu and 1/mu (defined in the host, passed to parts). Their
+  /// definitions are raw texts, `s.mu * Scalar(s.iterations > 0)` and
+  /// `1 / s.mu`: one multiplication and one division, counted here.
+  void setHostMu(const Expr& mu);
+  void setHostInvMu(const Expr& inv);
+  /// The operations of a closed host, its part functions included (not the
+  /// hosts it calls by a raw line: kinematics(...), ...); zero if none closed.
+  OpCount hostOps(const std::string& name) const;
 
   /// Every part function printed so far.
   const std::string& parts() const { return partsText_; }
@@ -87,6 +93,7 @@ class FunctionWriter {
   std::vector<std::string> bodyNames_;
   std::string firstLabel_, lastLabel_;  // the open part's first and last block
   std::set<std::string> partNames_;
+  std::map<std::string, OpCount> hostOps_;
   std::string partsText_;
   CodeBuilder::Stats stats_;
 };

@@ -15,7 +15,7 @@ struct Quantity {
   const char* what;
 };
 inline constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"cq", "cos q"},
-    kRJ{"RJ", "joint rotation (row-major)"}, kV{"v", "velocity"}, kC{"c", "velocity-product acceleration"},
+    kRJ{"RJ", "joint rotation"}, kV{"v", "velocity"}, kC{"c", "velocity-product acceleration"},
     kPA{"pA", "bias force"}, kIA{"IA", "articulated inertia (upper triangle)"}, kG{"g", "gravity in body coordinates"},
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},
     kL{"L", "Cholesky factor of IA (lower, packed by rows of the upper)"}, kLinv{"Linv", "1 / diag(L)"},

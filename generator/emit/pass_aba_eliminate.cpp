@@ -53,7 +53,7 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
     // solver's scalar type), so the value is the one the code would compute.
     b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
   } else {
-    b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D});
+    b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
   }
   const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
   b.u.assign(1, e.putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));

@@ -13,6 +13,11 @@ namespace {
 
 std::string q(int k) { return fmt::format("q[{}]", k); }
 std::string vIn(int k) { return fmt::format("v[{}]", k); }
+Ops sincos() {
+  Ops o;
+  o.sincos = 1;
+  return o;
+}
 
 void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   const Body& body = e.model().bodies[std::size_t(i)];
@@ -35,7 +40,7 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
     const M3 R = {1.0 - two(y, y, 1.0, z, z), two(x, y, -1.0, w, z), two(x, z, 1.0, w, y),
                   two(x, y, 1.0, w, z), 1.0 - two(x, x, 1.0, z, z), two(y, z, -1.0, w, x),
                   two(x, z, -1.0, w, y), two(y, z, 1.0, w, x), 1.0 - two(x, x, 1.0, y, y)};
-    for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = e.keepQ(kRJ, i, 9, k, R[std::size_t(k)]);
+    for (int k = 0; k < 9; ++k) b.XJ.R[std::size_t(k)] = e.keepQ(kRJ, i, 3, 3, k / 3, k % 3, R[std::size_t(k)]);
     b.XJ.p = {cb.input(q(j.idx_q)), cb.input(q(j.idx_q + 1)), cb.input(q(j.idx_q + 2))};
     return;
   }
@@ -49,13 +54,14 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   // Revolute: R = c I + s [a]x + (1 - c) a a^T; an axis along +-x/y/z folds to picks of c and s.
   const std::string sm = e.member(kSin, i, 0, 0), cm = e.member(kCos, i, 0, 0);
   const std::vector<Expr> sc =
-      cb.storeByCall(fmt::format("proxgen_rt::sincos({}, {}, {});", q(j.idx_q), sm, cm), {sm, cm}, {cb.input(q(j.idx_q))});
+      cb.storeByCall(fmt::format("proxgen_rt::sincos({}, {}, {});", q(j.idx_q), sm, cm), {sm, cm}, {cb.input(q(j.idx_q))},
+                     sincos());
   const Expr &s = sc[0], &c = sc[1];
   const Mat3 K = skew(a), A = a * a.transpose();
   for (int r = 0; r < 3; ++r)
     for (int col = 0; col < 3; ++col) {
       const Expr x = A(r, col) + (r == col ? 1.0 : 0.0) * c - A(r, col) * c + K(r, col) * s;
-      b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 9, 3 * r + col, x);
+      b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 3, 3, r, col, x);
     }
 }
 
@@ -83,7 +89,8 @@ void gravityAndPlacement(Emit& e, int i, const Kinematics::Body& parent, Kinemat
   }
   if (e.bp(i).needsPlacement) {
     const XSym M = compose(e.cb(), compose(e.cb(), parent.oM, b.XT), b.XJ);
-    for (int k = 0; k < 9; ++k) b.oM.R[std::size_t(k)] = e.keepQ(kOR, i, 9, k, e.cb().flat(M.R[std::size_t(k)]));
+    for (int k = 0; k < 9; ++k)
+      b.oM.R[std::size_t(k)] = e.keepQ(kOR, i, 3, 3, k / 3, k % 3, e.cb().flat(M.R[std::size_t(k)]));
     for (int k = 0; k < 3; ++k) b.oM.p[std::size_t(k)] = e.keepQ(kOP, i, 3, k, e.cb().flat(M.p[std::size_t(k)]));
   }
 }
@@ -116,13 +123,14 @@ std::vector<Expr> constraintTerms(Emit& e, int k, const Kinematics::Body& b) {
         p.push_back(cb.flat(E.p[std::size_t(j)]));
         ps += (j ? ", " : "") + cb.print(p.back());
       }
-      std::vector<Expr> uses = R;
-      uses.insert(uses.end(), p.begin(), p.end());
       const std::string id = cp.ident;
-      cb.line(fmt::format("const Scalar kpR_{}[9] = {{{}}};", id, Rs), uses);
-      cb.line(fmt::format("const Scalar kpp_{}[3] = {{{}}};", id, ps), uses);
+      // Each line's uses are what it prints (the operation count reads them).
+      cb.line(fmt::format("const Scalar kpR_{}[9] = {{{}}};", id, Rs), R);
+      cb.line(fmt::format("const Scalar kpp_{}[3] = {{{}}};", id, ps), p);
       cb.line(fmt::format("Scalar kpe_{}[6];", id));
-      cb.line(fmt::format("proxgen_rt::log6(kpR_{0}, kpp_{0}, kpe_{0});", id));
+      OpCount log6;
+      log6.once.log6 = 1;
+      cb.line(fmt::format("proxgen_rt::log6(kpR_{0}, kpp_{0}, kpe_{0});", id), {}, {}, log6);
       for (int j = 0; j < 6; ++j) err[std::size_t(j)] = cb.input(fmt::format("kpe_{}[{}]", id, j));
     } else {
       V3 d;

@@ -36,6 +36,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <vector>
@@ -336,8 +337,12 @@ Mat3 toMatrix(const urdf::Rotation& r) {
 }
 
 // Rotation entries within a few ulps of 0 or +-1 are what an rpy of pi/2 in
-// decimal leaves behind; they are snapped here, in the Model, so the generic and
-// the generated solvers see the same numbers and the generator can fold them.
+// decimal leaves behind (cos(1.5707963267948966) = 6.1e-17); they are snapped
+// here, in the Model, so the generic and the generated solvers see the same
+// numbers and the generator can fold them. The entries of a rotation are
+// bounded by 1 in magnitude, so the absolute threshold 1e-15 (4.5 eps) is a
+// relative one: the round-off of a product of three elementary rotations is a
+// few eps, and no rotation a URDF means differs from an exact 0 or +-1 by less.
 Mat3 snapRotation(Mat3 R) {
   for (int k = 0; k < 9; ++k) {
     double& x = R.data()[k];
@@ -496,7 +501,7 @@ class Builder {
       switch (j->type) {
         case urdf::Joint::FIXED: {
           // Merge: the child link's inertia joins this body; the link stays a frame.
-          model_.bodies[body].inertia = model_.bodies[body].inertia + linkInertia(*child, body).transformed(origin);
+          mergeInertia(body, linkInertia(*child, body).transformed(origin));
           model_.frames.push_back({child->name, body, origin, j->name});
           stack.push_back({child, body, origin, 0});  // `top` is invalid from here
           break;
@@ -645,6 +650,35 @@ class Builder {
   bool floating_;
   Model model_;
   std::vector<IndefiniteLink> indefinite_;
+  std::map<int, Vec3> firstMoments_;  // per merged body: sum of m |c| of its parts, per axis
+
+  // Adds a fixed child's inertia to body `body`, then snaps what is round-off
+  // of the sum (the generic and generated solvers then see the same exact
+  // zeros, and the generator folds them). Parts placed symmetrically (the
+  // quadruped's four rotors at +-x, +-y) cancel in exact arithmetic, but the
+  // floating-point sum leaves a residue such as 2^-64 = 5.4e-20 in a product
+  // of inertia, which would survive as a live term `5.4e-20*v[4]`. A sum of n
+  // terms is off by at most about n eps times the sum of their magnitudes, so
+  // a result below 4 eps of that magnitude is indistinguishable from zero:
+  //   - centre of mass, axis k: the first moment m c_k = sum m_i c_ik, against
+  //     sum m_i |c_ik| over the parts;
+  //   - rotational inertia, entry (r, c): against trace(Ic) (a positive
+  //     semi-definite tensor has |I_rc| <= sqrt(I_rr I_cc) <= trace / 2, and
+  //     every term of the sum is one, so the trace bounds their magnitudes).
+  // A physical entry is never that small relative to its body: 4 eps = 9e-16.
+  void mergeInertia(int body, const Inertia& part) {
+    Inertia& I = model_.bodies[std::size_t(body)].inertia;
+    auto [it, first] = firstMoments_.emplace(body, Vec3::Zero());
+    if (first) it->second = I.mass * I.com.cwiseAbs();
+    it->second += part.mass * part.com.cwiseAbs();
+    I = I + part;
+    constexpr double kRoundOff = 4 * std::numeric_limits<double>::epsilon();
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(I.mass * I.com[k]) <= kRoundOff * it->second[k]) I.com[k] = 0.0;
+    const double trace = I.Ic.trace();
+    for (int k = 0; k < 9; ++k)
+      if (std::abs(I.Ic.data()[k]) <= kRoundOff * trace) I.Ic.data()[k] = 0.0;
+  }
 };
 
 }  // namespace

@@ -3,7 +3,9 @@
 // axes, limits, the order of bodies and the q/v slots.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "model/urdf.hpp"
@@ -144,6 +146,56 @@ TEST(UrdfLoad, FloatingBaseAddsAFreeFlyerRoot) {
   const VecX q0 = m.neutral();
   EXPECT_EQ(q0[6], 1.0);  // identity quaternion [qx qy qz qw]
   EXPECT_EQ(q0.head<6>(), VecX::Zero(6));
+}
+
+// Four rotors of 0.055 kg fixed to a trunk at (+-0.125, +-0.049, 0), turned
+// by pitch pi/2 (the example quadruped's trunk): in exact arithmetic their
+// first moments and products of inertia cancel, and the merged trunk is
+// diagonal with its centre of mass at the origin. The floating-point sum
+// leaves residues (2^-64 = 5.4e-20 in I_xy, which the generated code printed
+// as a live term). Merging snaps what is below 4 eps of the magnitudes summed
+// (model/urdf.cpp, mergeInertia): those entries are exactly 0, every other
+// entry is the plain sum's, within that same bound.
+TEST(UrdfLoad, MergedInertiaRoundOffIsSnappedToExactZeros) {
+  std::string urdf = R"(<?xml version="1.0"?>
+<robot name="rotors">
+  <link name="trunk"><inertial><mass value="3.3"/><inertia ixx="0.011253" ixy="0" ixz="0" iyy="0.036203" iyz="0" izz="0.042673"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="trunk"/><child link="leg"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  <link name="leg"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+)";
+  // In the quadruped's merging order (joint names LF, LH, RF, RH): the order decides the residue.
+  const double xs[4] = {0.125, -0.125, 0.125, -0.125}, ys[4] = {0.049, 0.049, -0.049, -0.049};
+  for (int k = 0; k < 4; ++k)
+    urdf += fmt::format(R"(  <joint name="r{0}" type="fixed"><parent link="trunk"/><child link="rotor{0}"/><origin xyz="{1} {2} 0" rpy="0 1.5707963267948966 0"/></joint>
+  <link name="rotor{0}"><inertial><mass value="0.055"/><inertia ixx="0.000033" ixy="0" ixz="0" iyy="0.000033" iyz="0" izz="0.000063"/></inertial></link>
+)",
+                        k, xs[k], ys[k]);
+  urdf += "</robot>\n";
+  const Model m = parseUrdf(urdf, "rotors.urdf", true);
+  const Inertia& trunk = m.bodies[1].inertia;
+  // The plain sum in the loader's order (joints r0..r3 by name), with the
+  // rotation of pitch pi/2 snapped as the loader snaps it: Ry(90) = [[0,0,1],[0,1,0],[-1,0,0]].
+  Mat3 Ry;
+  Ry << 0, 0, 1, 0, 1, 0, -1, 0, 0;
+  Inertia plain{3.3, Vec3::Zero(), Vec3(0.011253, 0.036203, 0.042673).asDiagonal()};
+  for (int k = 0; k < 4; ++k) {
+    const Inertia rotor{0.055, Vec3::Zero(), Vec3(0.000033, 0.000033, 0.000063).asDiagonal()};
+    plain = plain + rotor.transformed(SE3{Ry, Vec3(xs[k], ys[k], 0)});
+  }
+  // The test means something only if the plain sum does leave a residue.
+  const double residue = std::max(plain.com.cwiseAbs().maxCoeff(),
+                                  std::max({std::abs(plain.Ic(0, 1)), std::abs(plain.Ic(0, 2)), std::abs(plain.Ic(1, 2))}));
+  ASSERT_GT(residue, 0.0) << "the plain sum cancels exactly: no round-off to snap";
+  EXPECT_EQ(trunk.com, Vec3::Zero());
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (r != c) EXPECT_EQ(trunk.Ic(r, c), 0.0) << r << "," << c;
+  // The rest is the plain sum's: the snapping moved nothing above its bound,
+  // 4 eps of the trace (the loader's threshold), and the mass is exact.
+  const double bound = 4 * std::numeric_limits<double>::epsilon() * plain.Ic.trace();
+  EXPECT_EQ(trunk.mass, plain.mass);
+  EXPECT_LE((trunk.Ic - plain.Ic).cwiseAbs().maxCoeff(), bound);
+  for (int k = 0; k < 3; ++k) EXPECT_GT(trunk.Ic(k, k), 0.0);
 }
 
 }  // namespace
