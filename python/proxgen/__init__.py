@@ -2,6 +2,7 @@
 
     robot = proxgen.load("robot.urdf", layout="layout.yaml")
     qdd, lam = robot.eval(q, v, tau, algorithm="pv")
+    M, J = robot.mass_matrix(q), robot.constraint_jacobian(q)   # the dynamics library
     proxgen.generate("robot.urdf", "layout.yaml", "out", python=True)
 
 See docs/python.md for the conventions and the bad-input policy.

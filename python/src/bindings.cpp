@@ -1,6 +1,7 @@
 // proxgen._proxgen: the host library seen from Python (wrapped by
 // python/proxgen/__init__.py). Loads a System (URDF + layout file, layout text
-// or none), runs the generic solvers exactly as `proxgen eval` does, reads
+// or none), runs the generic solvers exactly as `proxgen eval` does and the
+// dynamics library as `proxgen eval --compute` does (one state per call), reads
 // states keyed by joint name through the library's JSON reader (the same checks
 // and messages as `eval --state`), and generates solvers in process.
 // proxgen::Error becomes ValueError with its message.
