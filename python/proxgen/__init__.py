@@ -2,6 +2,7 @@
 
     robot = proxgen.load("robot.urdf", layout="layout.yaml")
     qdd, lam = robot.eval(q, v, tau, algorithm="pv")
+    M, J = robot.mass_matrix(q), robot.constraint_jacobian(q)   # the dynamics library
     proxgen.generate("robot.urdf", "layout.yaml", "out", python=True)
 
 See docs/python.md for the conventions and the bad-input policy.
@@ -80,6 +81,50 @@ class Robot:
         """||J qdd + gamma - aStar||: how far qdd is from meeting the constraint rows at
         (q, v), as the "residual" of `proxgen eval`."""
         return self._sys.residual(q, v, qdd)
+
+    # The dynamics library (docs/dynamics.md), as `proxgen eval --compute`: one state per
+    # call (q (nq,), v and qdd (nv,), lam (nc,)), new numpy arrays out, the quaternion
+    # normalised, bad input a ValueError/TypeError naming the argument (docs/python.md).
+
+    def inverse_dynamics(self, q, v, qdd, lam=None):
+        """tau = M(q) qdd + h(q, v) + J(q)^T lam (nv,): the torques that give qdd while the
+        constraints push with lam (nc, layout order; None: no constraint forces)."""
+        return self._sys.inverse_dynamics(q, v, qdd, lam)
+
+    def nonlinear_effects(self, q, v):
+        """h(q, v) (nv,): Coriolis, centrifugal and gravity torques (tau at qdd = 0)."""
+        return self._sys.nonlinear_effects(q, v)
+
+    def mass_matrix(self, q):
+        """M(q) (nv, nv): the joint-space inertia matrix (CRBA)."""
+        return self._sys.mass_matrix(q)
+
+    def mass_matrix_inverse(self, q):
+        """M(q)^-1 (nv, nv), by the O(n^2) ABA-based recursion, exactly symmetric."""
+        return self._sys.mass_matrix_inverse(q)
+
+    def constraint_placements(self, q):
+        """(nconstraints, 4, 4): each constraint frame's world placement [R p; 0 0 0 1],
+        layout order (the rotation and position `eval --compute placements` prints)."""
+        return self._sys.constraint_placements(q)
+
+    def constraint_jacobian(self, q):
+        """J(q) (nc, nv): the constraint rows in each constraint's own frame, layout order
+        (6d: [linear; angular], 3d: linear), as the solvers hold them."""
+        return self._sys.constraint_jacobian(q)
+
+    def constraint_drift(self, q, v):
+        """gamma(q, v) (nc,): J qdd + gamma is the constraint rows' acceleration."""
+        return self._sys.constraint_drift(q, v)
+
+    def delassus(self, q):
+        """G = J M^-1 J^T (nc, nc), layout order."""
+        return self._sys.delassus(q)
+
+    def delassus_inverse(self, q, mu=None):
+        """(G + I/mu)^-1 (nc, nc) for mu > 0 (default: the layout's mu), by the Woodbury
+        identity on the penalised recursion (absolute round-off about eps mu)."""
+        return self._sys.delassus_inverse(q, mu)
 
     def state(self, state=None, *, q=None, v=None, tau=None):
         """(q, v, tau) arrays from values keyed by joint name.

@@ -1,6 +1,7 @@
 // proxgen._proxgen: the host library seen from Python (wrapped by
 // python/proxgen/__init__.py). Loads a System (URDF + layout file, layout text
-// or none), runs the generic solvers exactly as `proxgen eval` does, reads
+// or none), runs the generic solvers exactly as `proxgen eval` does and the
+// dynamics library as `proxgen eval --compute` does (one state per call), reads
 // states keyed by joint name through the library's JSON reader (the same checks
 // and messages as `eval --state`), and generates solvers in process.
 // proxgen::Error becomes ValueError with its message.
@@ -14,13 +15,19 @@
 #include <vector>
 
 #include "algorithms/constrained_aba.hpp"
+#include "algorithms/constraint_kinematics.hpp"
+#include "algorithms/crba.hpp"
 #include "algorithms/data.hpp"
+#include "algorithms/delassus.hpp"
 #include "algorithms/dense_reference.hpp"
 #include "algorithms/jacobians.hpp"
+#include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/kinematics.hpp"
+#include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/prox_ltl.hpp"
 #include "algorithms/prox_ltls.hpp"
 #include "algorithms/prox_pv.hpp"
+#include "algorithms/rnea.hpp"
 #include "emit/generate.hpp"
 #include "emit/python_module.hpp"
 #include "cases/cases.hpp"
@@ -182,6 +189,87 @@ double residual(Robot& r, py::handle q, py::handle v, py::handle qdd) {
   return (r.data.J * VecX::Map(x, r.sys.model.nv) + r.data.gamma - r.data.aStar).norm();
 }
 
+// --- the dynamics library (docs/dynamics.md), one state per call -------------
+
+// One vector argument of shape (n,), real and finite, as a VecX.
+VecX oneVector(py::handle x, int n, const char* arg, const char* sizeName) {
+  py::array_t<double> a = asArray<double>(x, arg);
+  if (a.ndim() != 1 || a.shape(0) != n)
+    throw py::value_error(std::string(arg) + ": expected one state, shape (" + sizeName + ",) = (" + std::to_string(n) +
+                          ",), got " + shapeText(a));
+  checkFinite(a.data(), n, n, arg);
+  return VecX::Map(a.data(), n);
+}
+
+// q checked and with the quaternion normalised, as for eval.
+VecX oneConfiguration(const Robot& r, py::handle q) {
+  const VecX raw = oneVector(q, r.sys.model.nq, "q", "nq");
+  VecX out(raw.size());
+  normalisedConfiguration(raw.data(), raw.size(), r.quaternionAt, 0, false, out.data());
+  return out;
+}
+
+// Inputs are finite, yet a product can overflow: as `eval --compute`, no
+// non-finite result comes back.
+void requireFiniteResult(const double* x, Eigen::Index n, const char* what) {
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (!std::isfinite(x[k])) throw py::value_error(std::string(what) + ": is not finite at this state (an intermediate overflowed)");
+}
+
+py::array_t<double> vectorOut(const VecX& x, const char* what) {
+  requireFiniteResult(x.data(), x.size(), what);
+  return toArray(x);
+}
+
+// A new C-ordered (rows, cols) array from an Eigen (column-major) matrix.
+py::array_t<double> matrixOut(const MatX& A, const char* what) {
+  requireFiniteResult(A.data(), A.size(), what);
+  py::array_t<double> a({A.rows(), A.cols()});
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(a.mutable_data(), A.rows(), A.cols()) = A;
+  return a;
+}
+
+py::array_t<double> inverseDynamicsOf(Robot& r, py::handle q, py::handle v, py::handle qdd, py::handle lam) {
+  const int nv = r.sys.model.nv;
+  const VecX qk = oneConfiguration(r, q), vk = oneVector(v, nv, "v", "nv"), ak = oneVector(qdd, nv, "qdd", "nv");
+  VecX l;
+  if (!lam.is_none()) l = oneVector(lam, r.sys.nc, "lam", "nc");
+  return vectorOut(inverseDynamics(r.sys, r.data, qk, vk, ak, lam.is_none() ? nullptr : &l), "inverse_dynamics");
+}
+
+py::array_t<double> nonlinearEffectsOf(Robot& r, py::handle q, py::handle v) {
+  const VecX qk = oneConfiguration(r, q), vk = oneVector(v, r.sys.model.nv, "v", "nv");
+  return vectorOut(nonLinearEffects(r.sys, r.data, qk, vk), "nonlinear_effects");
+}
+
+// (nconstraints, 4, 4): each constraint frame's world placement as a
+// homogeneous transform [R p; 0 0 0 1] (R from the library's row-major 12 values).
+py::array_t<double> placementsOf(Robot& r, py::handle q) {
+  const VecX& X = constraintPlacements(r.sys, r.data, oneConfiguration(r, q));
+  const py::ssize_t n = py::ssize_t(r.sys.constraints.size());
+  requireFiniteResult(X.data(), 12 * n, "constraint_placements");
+  py::array_t<double> out({n, py::ssize_t(4), py::ssize_t(4)});
+  for (py::ssize_t k = 0; k < n; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) out.mutable_at(k, i, j) = X[12 * k + 3 * i + j];
+      out.mutable_at(k, i, 3) = X[12 * k + 9 + i];
+      out.mutable_at(k, 3, i) = 0.0;
+    }
+    out.mutable_at(k, 3, 3) = 1.0;
+  }
+  return out;
+}
+
+py::array_t<double> driftOf(Robot& r, py::handle q, py::handle v) {
+  const VecX qk = oneConfiguration(r, q), vk = oneVector(v, r.sys.model.nv, "v", "nv");
+  return vectorOut(constraintDrift(r.sys, r.data, qk, vk), "constraint_drift");
+}
+
+py::array_t<double> delassusInverseOf(Robot& r, py::handle q, py::handle mu) {
+  const double m = readMu(mu, r.sys.mu);
+  return matrixOut(delassusInverse(r.sys, r.data, oneConfiguration(r, q), m), "delassus_inverse");
+}
+
 py::tuple readState(Robot& r, py::handle state) {
   if (!py::isinstance<py::dict>(state)) throw py::type_error("state: expected a dict with keys q, v and optionally tau");
   const State s = stateFromJson(r.sys.model, toJson(state, "state"), "state");
@@ -286,7 +374,24 @@ PYBIND11_MODULE(_proxgen, m) {
            py::arg("mu"))
       .def("state", &readState, py::arg("state"))
       .def("constraint_frames", &constraintFrames, py::arg("q"), py::arg("v"))
-      .def("residual", &residual, py::arg("q"), py::arg("v"), py::arg("qdd"));
+      .def("residual", &residual, py::arg("q"), py::arg("v"), py::arg("qdd"))
+      .def("inverse_dynamics", &inverseDynamicsOf, py::arg("q"), py::arg("v"), py::arg("qdd"), py::arg("lam"))
+      .def("nonlinear_effects", &nonlinearEffectsOf, py::arg("q"), py::arg("v"))
+      .def("mass_matrix", [](Robot& r, py::handle q) {
+        return matrixOut(proxgen::crba(r.sys, r.data, oneConfiguration(r, q)), "mass_matrix");
+      }, py::arg("q"))
+      .def("mass_matrix_inverse", [](Robot& r, py::handle q) {
+        return matrixOut(proxgen::massMatrixInverse(r.sys, r.data, oneConfiguration(r, q)), "mass_matrix_inverse");
+      }, py::arg("q"))
+      .def("constraint_placements", &placementsOf, py::arg("q"))
+      .def("constraint_jacobian", [](Robot& r, py::handle q) {
+        return matrixOut(proxgen::constraintJacobianRows(r.sys, r.data, oneConfiguration(r, q)), "constraint_jacobian");
+      }, py::arg("q"))
+      .def("constraint_drift", &driftOf, py::arg("q"), py::arg("v"))
+      .def("delassus", [](Robot& r, py::handle q) {
+        return matrixOut(proxgen::delassus(r.sys, r.data, oneConfiguration(r, q)), "delassus");
+      }, py::arg("q"))
+      .def("delassus_inverse", &delassusInverseOf, py::arg("q"), py::arg("mu"));
 
   m.def("load", [](const std::string& urdf, const std::string& layoutPath) {
     return new Robot(proxgen::loadSystem(urdf, layoutPath));
