@@ -76,4 +76,16 @@ emit::SolverFiles generateCase(const std::string& casesFile, const std::string& 
   return emit::generateSystem(sys, name.empty() ? c.name : name, scalar, in, stats);
 }
 
+emit::SolverFiles generateFromInputs(const std::string& urdf, const std::string& layout, const std::string& casesFile,
+                                     const std::string& caseName, const std::string& name, emit::ScalarType scalar,
+                                     System* system) {
+  if (!casesFile.empty()) return generateCase(casesFile, caseName, name, scalar, nullptr, system);
+  emit::GenerateOptions g;
+  g.urdf = urdf;
+  g.layout = layout;
+  g.name = name;
+  g.scalar = scalar;
+  return emit::generateFiles(g, nullptr, system);
+}
+
 }  // namespace proxgen

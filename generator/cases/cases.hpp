@@ -33,4 +33,11 @@ System loadCaseSystem(const Case& c);
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
                                emit::ScalarType scalar, emit::SolverStats* stats = nullptr, System* system = nullptr);
 
+/// `generate`'s two ways in (the CLI and the Python package): one case of a
+/// cases file when `casesFile` is set, else a URDF and a layout. `system`, if
+/// given, receives the System the solver was generated from.
+emit::SolverFiles generateFromInputs(const std::string& urdf, const std::string& layout, const std::string& casesFile,
+                                     const std::string& caseName, const std::string& name, emit::ScalarType scalar,
+                                     System* system = nullptr);
+
 }  // namespace proxgen

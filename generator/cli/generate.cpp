@@ -29,17 +29,7 @@ emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar,
                                       System* loaded) {
   System sys;
-  emit::SolverFiles files;
-  if (!cases.empty()) {
-    files = generateCase(cases, caseName, name, scalar, nullptr, &sys);
-  } else {
-    emit::GenerateOptions g;
-    g.urdf = urdf;
-    g.layout = layout;
-    g.name = name;
-    g.scalar = scalar;
-    files = emit::generateFiles(g, nullptr, &sys);
-  }
+  const emit::SolverFiles files = generateFromInputs(urdf, layout, cases, caseName, name, scalar, &sys);
   if (scalar == emit::ScalarType::Float) printWarning(floatAccuracyWarning(sys));
   if (loaded) *loaded = std::move(sys);
   return files;

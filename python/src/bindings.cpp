@@ -324,17 +324,7 @@ std::vector<std::string> generate(const std::string& urdf, const std::string& la
   // The CLI's pipeline (cli/generate.cpp): one load, every file through one atomic write.
   const emit::ScalarType type = emit::parseScalar(scalar);
   System sys;
-  emit::SolverFiles files;
-  if (!cases.empty()) {
-    files = generateCase(cases, caseName, name, type, nullptr, &sys);
-  } else {
-    emit::GenerateOptions g;
-    g.urdf = urdf;
-    g.layout = layout;
-    g.name = name;
-    g.scalar = type;
-    files = emit::generateFiles(g, nullptr, &sys);
-  }
+  const emit::SolverFiles files = generateFromInputs(urdf, layout, cases, caseName, name, type, &sys);
   std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
   if (python) outputs.push_back(emit::pythonModuleOutput(sys, files, type));
   return emit::writeFiles(outputs, out);
