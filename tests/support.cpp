@@ -1,5 +1,7 @@
 #include "support.hpp"
 
+#include <fmt/format.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,6 +34,26 @@ std::vector<Case> sharedCases() {
 std::string modelPath(const std::string& file) { return modelsDir() + "/" + file; }
 
 std::string sourceDir() { return PROXGEN_TEST_SOURCE_DIR; }
+
+std::string syntheticTreeUrdf(int links, int branching, const std::string& pad) {
+  std::string xml = "<?xml version=\"1.0\"?>\n<robot name=\"synthetic\">\n";
+  const auto link = [](int i) {
+    return fmt::format(
+        "<link name=\"l{}\"><inertial><origin xyz=\"0 0 0.05\"/><mass value=\"1\"/>"
+        "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>\n",
+        i);
+  };
+  const char* axes[] = {"1 0 0", "0 1 0", "0 0 1"};
+  xml += link(0);
+  for (int i = 1; i < links; ++i) {
+    xml += fmt::format(
+        "<joint name=\"j{}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{}\"/>"
+        "<origin xyz=\"0 0 0.1\"/><axis xyz=\"{}\"/><limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/></joint>\n",
+        i, (i - 1) / branching, i, axes[i % 3]);
+    xml += link(i);
+  }
+  return xml + pad + "</robot>\n";
+}
 
 double relErr(const VecX& a, const VecX& b) {
   if (a.size() == 0) return 0.0;

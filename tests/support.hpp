@@ -63,6 +63,12 @@ double relErr(const VecX& a, const VecX& b);
 /// The repository's root (for generated/ and tests/data).
 std::string sourceDir();
 
+/// A synthetic robot of `links` links: link i (1 kg, 0.1 m from its parent,
+/// revolute about x, y, z in turn) hangs from link (i - 1) / branching, so
+/// branching 1 is a chain; `pad` goes inside <robot> after the tree. The same
+/// robots as tests/data/hostile/make_big_urdf.py writes to files.
+std::string syntheticTreeUrdf(int links, int branching, const std::string& pad = "");
+
 // --- files and child processes (the tests that run the `proxgen` binary) -----
 
 /// The whole file as bytes ("" when it cannot be read).

@@ -66,28 +66,6 @@ Child runGenerate(const std::vector<std::string>& args, const fs::path& log) {
   return r;
 }
 
-// `bodies` moving bodies of 1 kg on revolute joints (axes cycling x, y, z),
-// body i hanging from (i - 1) / branching: the robots of
-// tests/data/hostile/make_big_urdf.py and of treeUrdf in tests/model/test_hardening.cpp.
-std::string treeUrdf(int bodies, int branching) {
-  std::string xml = "<?xml version=\"1.0\"?>\n<robot name=\"synthetic\">\n";
-  const auto link = [](int i) {
-    return fmt::format(
-        "<link name=\"l{}\"><inertial><origin xyz=\"0 0 0.05\"/><mass value=\"1\"/>"
-        "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>\n",
-        i);
-  };
-  const char* axes[] = {"1 0 0", "0 1 0", "0 0 1"};
-  xml += link(0);
-  for (int i = 1; i <= bodies; ++i) {
-    xml += fmt::format(
-        "<joint name=\"j{}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{}\"/>"
-        "<origin xyz=\"0 0 0.1\"/><axis xyz=\"{}\"/><limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/></joint>\n",
-        i, (i - 1) / branching, i, axes[i % 3]);
-    xml += link(i);
-  }
-  return xml + "</robot>\n";
-}
 
 class GenerateBounds : public ::testing::Test {
  protected:
@@ -125,7 +103,7 @@ class GenerateBounds : public ::testing::Test {
 TEST_F(GenerateBounds, TreeAtTheBodyLimitStaysInItsTimeAndMemory) {
   PROXGEN_SKIP_UNDER_SANITIZER();
   const int n = proxgen::emit::kMaxGenerateBodies;
-  const fs::path urdf = write("tree.urdf", treeUrdf(n, 3));
+  const fs::path urdf = write("tree.urdf", proxgen::test::syntheticTreeUrdf(n + 1, 3));
   const fs::path layout =
       write("weld.yaml", fmt::format("base: fixed\nconstraints:\n  - {{name: tip, link: l{}, type: 6d}}\n", n));
   const Child c = runGenerate({urdf.string(), "--layout", layout.string(), "--out", (dir_ / "out").string(), "--name", "big"},
@@ -144,7 +122,7 @@ TEST_F(GenerateBounds, TreeAtTheBodyLimitStaysInItsTimeAndMemory) {
 // loads measured in docs/guarantees.md take under 1 s of CPU), and nothing written.
 TEST_F(GenerateBounds, MoreBodiesThanTheLimitAreRefused) {
   const int n = proxgen::emit::kMaxGenerateBodies + 1;
-  const fs::path urdf = write("tree.urdf", treeUrdf(n, 3));
+  const fs::path urdf = write("tree.urdf", proxgen::test::syntheticTreeUrdf(n + 1, 3));
   const fs::path layout = write("free.yaml", "base: fixed\n");
   const Child c = runGenerate({urdf.string(), "--layout", layout.string(), "--out", (dir_ / "out").string()},
                               dir_ / "log.txt");
@@ -161,7 +139,7 @@ TEST_F(GenerateBounds, MoreBodiesThanTheLimitAreRefused) {
 // and a point, within the layout's 256) on the tip of a 100-body chain: every
 // body of the chain carries all of them, 25,500 row-body pairs.
 TEST_F(GenerateBounds, MoreSupportRowsThanTheLimitAreRefused) {
-  const fs::path urdf = write("chain.urdf", treeUrdf(100, 1));
+  const fs::path urdf = write("chain.urdf", proxgen::test::syntheticTreeUrdf(101, 1));
   std::string yaml = "base: fixed\nconstraints:\n";
   for (int k = 0; k < 42; ++k) yaml += fmt::format("  - {{name: w{}, link: l100, type: 6d}}\n", k);
   yaml += "  - {name: p, link: l100, type: 3d}\n";

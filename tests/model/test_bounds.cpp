@@ -78,35 +78,13 @@ void expectWithinBounds(const ChildRun& r, const std::string& label, double maxC
 }
 
 
-// A tree of `links` links (1 kg, revolute about x, y, z in turn), link i on
-// (i - 1) / 3 (as tests/model/test_hardening.cpp's treeUrdf); `pad` goes
-// inside <robot> after it.
-std::string tree(int links, int branching, const std::string& pad = "") {
-  std::string xml = "<?xml version=\"1.0\"?>\n<robot name=\"bounds\">\n";
-  const auto link = [](int i) {
-    return fmt::format(
-        "<link name=\"l{}\"><inertial><origin xyz=\"0 0 0.05\"/><mass value=\"1\"/>"
-        "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>\n",
-        i);
-  };
-  const char* axes[] = {"1 0 0", "0 1 0", "0 0 1"};
-  xml += link(0);
-  for (int i = 1; i < links; ++i) {
-    xml += fmt::format(
-        "<joint name=\"j{}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{}\"/>"
-        "<origin xyz=\"0 0 0.1\"/><axis xyz=\"{}\"/><limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/></joint>\n",
-        i, (i - 1) / branching, i, axes[i % 3]);
-    xml += link(i);
-  }
-  return xml + pad + "</robot>\n";
-}
 
 std::size_t countOf(const std::string& s, char c) { return std::size_t(std::count(s.begin(), s.end(), c)); }
 
 TEST(Bounds, UrdfAtEveryLimit) {
   PROXGEN_SKIP_UNDER_SANITIZER();
   TempFile f("bounds.urdf");
-  const std::string base = tree(int(kMaxUrdfLinks), 3);
+  const std::string base = test::syntheticTreeUrdf(int(kMaxUrdfLinks), 3);
   // Links: 4096, the limit, accepted.
   {
     const ChildRun r = runProxgen({"check", f.write(base)});
@@ -116,7 +94,7 @@ TEST(Bounds, UrdfAtEveryLimit) {
   // Bytes: the same tree padded with a comment to kMaxUrdfBytes.
   {
     const std::size_t fill = kMaxUrdfBytes - base.size() - 16;
-    const std::string xml = tree(int(kMaxUrdfLinks), 3, "<!--" + std::string(fill, 'x') + "-->\n");
+    const std::string xml = test::syntheticTreeUrdf(int(kMaxUrdfLinks), 3, "<!--" + std::string(fill, 'x') + "-->\n");
     ASSERT_LE(xml.size(), kMaxUrdfBytes);
     const ChildRun r = runProxgen({"check", f.write(xml)});
     EXPECT_EQ(r.status, 0) << r.err;
@@ -128,7 +106,7 @@ TEST(Bounds, UrdfAtEveryLimit) {
     std::string pad = "<gazebo>";
     for (std::size_t k = have; k < kMaxUrdfTags; ++k) pad += "<a/>";
     pad += "</gazebo>\n";
-    const std::string xml = tree(int(kMaxUrdfLinks), 3, pad);
+    const std::string xml = test::syntheticTreeUrdf(int(kMaxUrdfLinks), 3, pad);
     ASSERT_EQ(countOf(xml, '<'), kMaxUrdfTags);
     const ChildRun r = runProxgen({"check", f.write(xml)});
     EXPECT_EQ(r.status, 0) << r.err;
@@ -146,14 +124,14 @@ TEST(Bounds, UrdfAtEveryLimit) {
       attributes += kMaxXmlAttributesPerElement;
     }
     pad += "</gazebo>\n";
-    const std::string xml = tree(int(kMaxUrdfLinks), 3, pad);
+    const std::string xml = test::syntheticTreeUrdf(int(kMaxUrdfLinks), 3, pad);
     const ChildRun r = runProxgen({"check", f.write(xml)});
     EXPECT_EQ(r.status, 0) << r.err;
     expectWithinBounds(r, fmt::format("URDF 4096-link tree + {} attributes, {} bytes", attributes, xml.size()));
   }
   // Depth: a chain of 512 joints, accepted; and 80,000 attributes on one element, refused.
   {
-    const ChildRun r = runProxgen({"check", f.write(tree(int(kMaxTreeDepth) + 1, 1))});
+    const ChildRun r = runProxgen({"check", f.write(test::syntheticTreeUrdf(int(kMaxTreeDepth) + 1, 1))});
     EXPECT_EQ(r.status, 0) << r.err;
     expectWithinBounds(r, "URDF 512-deep chain");
   }

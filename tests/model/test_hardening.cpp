@@ -108,28 +108,6 @@ TEST(FuzzRegression, JsonMessageQuotingALongTokenIsCut) {
 // ---------------------------------------------------------------------------
 // Resource bounds.
 
-// A synthetic robot: body i (1 kg, 0.1 m from its parent, revolute about x, y, z
-// in turn) hangs from (i - 1) / branching, so branching 1 is a chain. The same
-// robots as tests/data/hostile/make_big_urdf.py writes to files.
-std::string treeUrdf(int bodies, int branching) {
-  std::string xml = "<?xml version=\"1.0\"?>\n<robot name=\"synthetic\">\n";
-  const auto link = [](int i) {
-    return fmt::format(
-        "<link name=\"l{}\"><inertial><origin xyz=\"0 0 0.05\"/><mass value=\"1\"/>"
-        "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>\n",
-        i);
-  };
-  const char* axes[] = {"1 0 0", "0 1 0", "0 0 1"};
-  xml += link(0);
-  for (int i = 1; i < bodies; ++i) {
-    xml += fmt::format(
-        "<joint name=\"j{}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{}\"/>"
-        "<origin xyz=\"0 0 0.1\"/><axis xyz=\"{}\"/><limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/></joint>\n",
-        i, (i - 1) / branching, i, axes[i % 3]);
-    xml += link(i);
-  }
-  return xml + "</robot>\n";
-}
 
 // Solves a large system with ABA, constrainedABA and proxPV and checks each
 // answer by its residual, which needs no dense reference of that size:
@@ -196,7 +174,7 @@ void solveLarge(const System& sys, const char* label) {
 }
 
 TEST(ResourceBounds, TwoThousandBodyTreeLoadsAndSolves) {
-  const std::string xml = treeUrdf(2000, 3);
+  const std::string xml = test::syntheticTreeUrdf(2000, 3);
   for (bool floating : {false, true}) {
     const auto t0 = std::chrono::steady_clock::now();
     Model m = parseUrdf(xml, "tree2000.urdf", floating);
@@ -213,7 +191,7 @@ TEST(ResourceBounds, TwoThousandBodyTreeLoadsAndSolves) {
 
 TEST(ResourceBounds, ChainAtTheDepthLimitLoadsAndSolves) {
   // kMaxTreeDepth joints from the root link to the tip: the deepest tree read.
-  const std::string xml = treeUrdf(int(kMaxTreeDepth) + 1, 1);
+  const std::string xml = test::syntheticTreeUrdf(int(kMaxTreeDepth) + 1, 1);
   const auto t0 = std::chrono::steady_clock::now();
   Model m = parseUrdf(xml, "chain.urdf", false);
   std::printf("[ timing   ] chain of %zu joints: parse %.3f s\n", kMaxTreeDepth, seconds(t0));
@@ -225,7 +203,7 @@ TEST(ResourceBounds, ChainAtTheDepthLimitLoadsAndSolves) {
 TEST(ResourceBounds, ChainDeeperThanTheLimitIsRefused) {
   // One joint more than kMaxTreeDepth: refused before the recursive build,
   // naming the first joint past the limit.
-  const std::string xml = treeUrdf(int(kMaxTreeDepth) + 2, 1);
+  const std::string xml = test::syntheticTreeUrdf(int(kMaxTreeDepth) + 2, 1);
   const std::string m = errorOf([&] { parseUrdf(xml, "deep.urdf", false); });
   expectOneBoundedLine(m, "deep.urdf");
   EXPECT_NE(m.find(fmt::format("joint 'j{}'", kMaxTreeDepth + 1)), std::string::npos) << m;
@@ -235,14 +213,14 @@ TEST(ResourceBounds, ChainDeeperThanTheLimitIsRefused) {
 TEST(ResourceBounds, LinkCountIsBounded) {
   // kMaxUrdfLinks links load (parsed only: solving needs 24 nv^2 bytes, 0.4 GB
   // here); one more is refused right after the XML parse, at the extra element.
-  const Model m = parseUrdf(treeUrdf(int(kMaxUrdfLinks), 4), "max.urdf", true);
+  const Model m = parseUrdf(test::syntheticTreeUrdf(int(kMaxUrdfLinks), 4), "max.urdf", true);
   EXPECT_EQ(m.nv, int(kMaxUrdfLinks) - 1 + 6);
-  const std::string msg = errorOf([&] { parseUrdf(treeUrdf(int(kMaxUrdfLinks) + 1, 4), "big.urdf", false); });
+  const std::string msg = errorOf([&] { parseUrdf(test::syntheticTreeUrdf(int(kMaxUrdfLinks) + 1, 4), "big.urdf", false); });
   expectOneBoundedLine(msg, "big.urdf");
   EXPECT_NE(msg.find(fmt::format("at most {} links", kMaxUrdfLinks)), std::string::npos) << msg;
   // A chain of that many links is refused by depth, in one linear pass (the
   // cycle walk it replaced was quadratic in the depth).
-  const std::string deep = errorOf([&] { parseUrdf(treeUrdf(int(kMaxUrdfLinks), 1), "deep.urdf", true); });
+  const std::string deep = errorOf([&] { parseUrdf(test::syntheticTreeUrdf(int(kMaxUrdfLinks), 1), "deep.urdf", true); });
   EXPECT_NE(deep.find("joints deep"), std::string::npos) << deep;
 }
 
