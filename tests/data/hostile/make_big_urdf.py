@@ -7,7 +7,7 @@ docs/guarantees.md (the output is not checked in: it is tens of megabytes).
 Every body is a 1 kg link on a revolute joint (axes cycling x, y, z), 0.1 m
 from its parent; `tree` gives body i the parent (i - 1) // branching (depth
 log_b n), `chain` the parent i - 1 (depth n). tests/model/test_hardening.cpp builds
-the same robots in memory (treeUrdf) for its 2000-body tests.
+the same robots in memory (syntheticTreeUrdf in tests/support.cpp) for its 2000-body tests.
 """
 import argparse
 
