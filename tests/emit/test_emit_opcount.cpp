@@ -13,6 +13,7 @@
 #include <regex>
 #include <sstream>
 
+#include "cases/cases.hpp"
 #include "emit/generate.hpp"
 #include "support.hpp"
 
@@ -295,10 +296,7 @@ TEST(OperationCount, WithGainsTheLogarithmCounts) {
 TEST(OperationCount, SharedCases) {
   PROXGEN_REQUIRE_MODELS();
   for (const char* name : {"iiwa_h3", "solo_f3x4"}) {
-    GenerateOptions g;
-    g.casesFile = test::modelPath("cases.yaml");
-    g.caseName = name;
-    expectCountsMatch(generateFiles(g), name, 3);
+    expectCountsMatch(generateCase(test::modelPath("cases.yaml"), name, "", ScalarType::Double), name, 3);
   }
 }
 
