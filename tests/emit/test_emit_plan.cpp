@@ -36,7 +36,10 @@ bool inSubtree(const Model& m, int b, int i) {
 }
 
 TEST(Plan, TreeFactsAgreeWithAnIndependentDerivation) {
-  for (const auto& [name, sys] : systems()) {
+  for (const auto& entry : systems()) {
+    // Named, not a structured binding: the lambdas below capture it (C++17).
+    const std::string& name = entry.first;
+    const System& sys = entry.second;
     SCOPED_TRACE(name);
     const Model& m = sys.model;
     const int N = m.numBodies();
