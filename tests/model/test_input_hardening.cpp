@@ -222,7 +222,8 @@ TEST(Overflow, LayoutNumbersBeyondTheMagnitudeBoundAreRefused) {
       {"mu: 4.9e-324\n", "l.yaml:1: mu:"},  // 1/mu is infinite
   };
   for (const auto& [yaml, where] : cases) {
-    const std::string m = errorOf([&] { parseLayout(yaml, "l.yaml"); });
+    const std::string& text = yaml;  // a lambda may not capture a structured binding (C++17)
+    const std::string m = errorOf([&] { parseLayout(text, "l.yaml"); });
     EXPECT_TRUE(has(m, where)) << yaml << m;
   }
   // At the bound, accepted.
