@@ -2,7 +2,7 @@
 // sin.urdf) gave a namespace that collides with a global name or a macro of
 // the C and C++ libraries, and code that does not compile, with exit 0.
 //
-// Two checks, both with the build's compiler:
+// Two checks, both with GCC (the compiler the list was derived with; tests/CMakeLists.txt):
 //  - the list is complete for this platform: every identifier of the standard
 //    and POSIX headers that cannot be a namespace at global scope (the
 //    compiler says which), every macro they define (-dM) and every existing
