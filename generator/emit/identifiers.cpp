@@ -93,7 +93,15 @@ std::string sanitizeIdentifier(const std::string& name) {
     out.resize(kMaxIdentifierLength);
     while (out.back() == '_') out.pop_back();
   }
-  if (isReservedIdentifier(out)) out = "kw_" + out;
+  if (isReservedIdentifier(out)) {
+    // The prefix counts against the length too (a 48-character "FP_..." is a
+    // reserved family); "kw_..." is never reserved, so cutting keeps it free.
+    out = "kw_" + out;
+    if (out.size() > kMaxIdentifierLength) {
+      out.resize(kMaxIdentifierLength);
+      while (out.back() == '_') out.pop_back();
+    }
+  }
   return out;
 }
 

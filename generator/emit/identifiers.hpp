@@ -18,7 +18,7 @@ inline constexpr std::size_t kMaxCommentLength = 120;
 /// underscores only; never empty, never starting with a digit or an underscore,
 /// never ending with an underscore, never containing "__", never reserved
 /// (isReservedIdentifier: a reserved name gets the prefix "kw_"); at most
-/// kMaxIdentifierLength characters (+ 3 for the prefix).
+/// kMaxIdentifierLength characters, the prefix included.
 std::string sanitizeIdentifier(const std::string& name);
 
 /// True for names the generated files must not declare as a namespace or use

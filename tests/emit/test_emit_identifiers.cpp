@@ -20,7 +20,7 @@ void expectSafeIdentifier(const std::string& id, const std::string& from) {
   for (char c : id) EXPECT_TRUE(std::isalnum(static_cast<unsigned char>(c)) || c == '_') << id << " from " << from;
   EXPECT_EQ(id.find("__"), std::string::npos) << id;
   EXPECT_NE(id.back(), '_') << id;
-  EXPECT_LE(id.size(), kMaxIdentifierLength + 3) << id;  // + "kw_"
+  EXPECT_LE(id.size(), kMaxIdentifierLength) << id;  // "kw_" included
   EXPECT_FALSE(isReservedIdentifier(id)) << id;
 }
 
@@ -116,6 +116,15 @@ TEST(Identifiers, TenKilobyteNamesAreCut) {
   expectSafeComment(text, "10 kB name");
   EXPECT_LE(text.size(), 4 * kMaxCommentLength + 32);  // at most one 4-byte escape per kept byte, plus the note
   EXPECT_NE(text.find(std::to_string(name.size()) + " bytes"), std::string::npos) << text;
+}
+
+// A reserved family's long name: the prefix counts against the length
+// (fuzz_identifiers found "FP_" followed by 45 letters giving 51 characters).
+TEST(Identifiers, AReservedLongNameStaysWithinTheLengthWithItsPrefix) {
+  const std::string name = "FP_" + std::string(kMaxIdentifierLength, 'O');
+  const std::string id = sanitizeIdentifier(name);
+  expectSafeIdentifier(id, name);
+  EXPECT_EQ(id, "kw_FP_" + std::string(kMaxIdentifierLength - 6, 'O'));
 }
 
 // Random byte strings: the properties hold for every input, not just the ones above.
