@@ -106,10 +106,14 @@ std::string sanitizeIdentifier(const std::string& name) {
 }
 
 std::string IdentifierSet::make(const std::string& name, int index) {
-  std::string id = sanitizeIdentifier(name);
-  if (taken_.count(id)) id = fmt::format("{}_{}", id, index);
+  const std::string stem = sanitizeIdentifier(name);
+  // A suffixed name can fall into a reserved family ("M" taken, "M_2" is one of
+  // M_*: fuzz_identifiers found it); the prefix makes it free, as for a stem.
+  const auto free = [](const std::string& id) { return isReservedIdentifier(id) ? "kw_" + id : id; };
+  std::string id = stem;
+  if (taken_.count(id)) id = free(fmt::format("{}_{}", stem, index));
   // A name that already ended in "_<index>" can still collide; count upwards.
-  for (int k = 2; taken_.count(id); ++k) id = fmt::format("{}_{}_{}", sanitizeIdentifier(name), index, k);
+  for (int k = 2; taken_.count(id); ++k) id = free(fmt::format("{}_{}_{}", stem, index, k));
   taken_.insert(id);
   return id;
 }

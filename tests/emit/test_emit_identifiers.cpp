@@ -118,6 +118,16 @@ TEST(Identifiers, TenKilobyteNamesAreCut) {
   EXPECT_NE(text.find(std::to_string(name.size()) + " bytes"), std::string::npos) << text;
 }
 
+// A uniqueness suffix can make a reserved name: "M" taken, "M_2" is one of the
+// math constants' family M_* (a fuzz_identifiers finding).
+TEST(Identifiers, ASuffixedNameIsNeverReserved) {
+  IdentifierSet set;
+  EXPECT_EQ(set.make("M", 1), "M");
+  const std::string second = set.make("M", 2);
+  expectSafeIdentifier(second, "the second M");
+  EXPECT_EQ(second, "kw_M_2");
+}
+
 // A reserved family's long name: the prefix counts against the length
 // (fuzz_identifiers found "FP_" followed by 45 letters giving 51 characters).
 TEST(Identifiers, AReservedLongNameStaysWithinTheLengthWithItsPrefix) {
