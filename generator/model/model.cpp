@@ -104,6 +104,7 @@ System bindLayout(Model model, const Layout& layout) {
   sys.layoutPath = layout.sourcePath;
   sys.mu = layout.mu;
   sys.iterations = layout.iterations;
+  sys.functions = layout.functions;
   if (layout.hasGravity) model.gravity = layout.gravity;
   int row = 0;
   for (std::size_t k = 0; k < layout.constraints.size(); ++k) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "model/functions.hpp"
 #include "model/spatial.hpp"
 
 namespace proxgen {
@@ -99,6 +100,7 @@ struct Layout {
   Vec3 gravity{0, 0, -9.81};
   double mu = 1e4;
   int iterations = 3;
+  FunctionSet functions;  // `functions: [...]`; default the two solvers
   std::vector<Constraint> constraints;  // unresolved: body/placement/row unset
 };
 
@@ -109,6 +111,7 @@ struct System {
   int nc = 0;                           // total constraint rows
   double mu = 1e4;                      // defaults from the layout
   int iterations = 3;
+  FunctionSet functions;  // what a generated solver of this System holds (model/functions.hpp)
   std::string layoutPath;
 
   int findConstraint(const std::string& name) const;
