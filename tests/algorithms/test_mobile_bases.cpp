@@ -187,7 +187,10 @@ TEST(MobileBases, AllAlgorithmsAgreeWithTheDenseIteration) {
 // h_planar = P^T h_ff (the same body, the same velocities; the holding forces
 // are orthogonal to P). The arm on `base: planar` against the arm on
 // `base: floating`: two different code paths (S = I and S = P) in every
-// recursion. Round-off: c n eps of the entries' size.
+// recursion. This checks S and the velocity-product terms; not the sense of
+// the yaw in the placement, which M and h in body coordinates do not see (with
+// gravity along z), and which the Jacobian and closed-form tests above and
+// below check. Round-off: c n eps of the entries' size.
 TEST(MobileBases, PlanarBaseIsARestrictedFreeFlyer) {
   const System planar = loadSystem(source("generated/arm/arm.urdf"), source("tests/generated/layouts/arm_planar.yaml"));
   const System ff = loadSystemWithoutLayout(source("generated/arm/arm.urdf"), true);
