@@ -85,7 +85,15 @@ VecX configurationFromJson(const Model& model, const json& j, const std::string&
     if (!(largest > 0))
       fail(where, element, ff ? "the quaternion [qx qy qz qw] has zero norm" : "the yaw direction [cos sin] is [0, 0]");
     dir /= largest;  // now the largest component is +-1: no overflow, no underflow below
-    q.segment(jt.idx_q + positions, n - positions) = dir / dir.norm();  // documented: normalised
+    // Documented: normalised. In fixed sizes, so the quaternion's rounding is the
+    // one it always had (a dynamic-size norm may sum in another order).
+    if (ff) {
+      const Eigen::Vector4d quat = dir;
+      q.segment<4>(jt.idx_q + 3) = quat / quat.norm();
+    } else {
+      const Eigen::Vector2d cs = dir;
+      q.segment<2>(jt.idx_q + 2) = cs / cs.norm();
+    }
   }
   return q;
 }
