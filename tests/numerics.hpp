@@ -127,11 +127,23 @@ inline SE3 exp6(const Vec6& xi) {
 }
 
 /// q "+" dv: joint coordinates add; the free flyer moves by its body twist,
-/// M(q') = M(q) exp(dv) (v is the twist in the base's own frame).
+/// M(q') = M(q) exp(dv) (v is the twist in the base's own frame), and a planar
+/// joint likewise by the planar twist [vx vy 0 0 0 wz] (exp6 keeps it planar).
 inline VecX integrate(const Model& m, const VecX& q, const VecX& dv) {
   VecX out = q;
   for (int i = 1; i < m.numBodies(); ++i) {
     const Joint& j = m.bodies[i].joint;
+    if (j.type == JointType::Planar) {
+      const double c = q[j.idx_q + 2], s = q[j.idx_q + 3];
+      Mat3 R;
+      R << c, -s, 0, s, c, 0, 0, 0, 1;
+      const SE3 M{R, Vec3(q[j.idx_q], q[j.idx_q + 1], 0)};
+      Vec6 xi = Vec6::Zero();
+      xi << dv[j.idx_v], dv[j.idx_v + 1], 0, 0, 0, dv[j.idx_v + 2];
+      const SE3 Mp = M * exp6(xi);
+      out.segment<4>(j.idx_q) << Mp.p[0], Mp.p[1], Mp.R(0, 0), Mp.R(1, 0);
+      continue;
+    }
     if (j.type != JointType::FreeFlyer) {
       out[j.idx_q] += dv[j.idx_v];
       continue;

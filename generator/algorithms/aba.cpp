@@ -30,7 +30,23 @@ void eliminate(const System& sys, Data& d, int i, const VecX& tau) {
     d.pA[p] += d.liMi[i].actForce(pa);
     return;
   }
-  // The free flyer (S = identity, the only multi-DoF joint): U = IA, D = IA.
+  if (j.type == JointType::Planar) {  // S = three columns of the identity (x, y, yaw), constant
+    using Mat63 = Eigen::Matrix<double, 6, 3>;
+    const Mat63 S = d.S[i];
+    const Mat63 U = d.IA[i] * S;
+    const Mat3 Dinv = Mat3(S.transpose() * U).inverse();
+    d.U[i] = U;
+    d.Dinv[i] = Dinv;
+    d.u[i] = tau.segment<3>(j.idx_v) - S.transpose() * d.pA[i];
+    if (p == 0) return;
+    const Mat63 UDinv = U * Dinv;
+    const Mat6 Ia = d.IA[i] - UDinv * U.transpose();
+    const Vec6 pa = d.pA[i] + Ia * d.c[i] + UDinv * Vec3(d.u[i]);
+    d.IA[p] += d.liMi[i].actInertia(Ia);
+    d.pA[p] += d.liMi[i].actForce(pa);
+    return;
+  }
+  // The free flyer (S = identity): U = IA, D = IA.
   d.U[i] = d.IA[i];
   d.Dinv[i] = Mat6(d.IA[i]).inverse();
   d.u[i] = tau.segment<6>(j.idx_v) - d.pA[i];
@@ -49,6 +65,13 @@ void accelerate(const System& sys, Data& d, int i) {
     const double qdd = d.Dinv[i](0, 0) * (d.u[i](0) - d.U[i].col(0).dot(a));
     d.qdd[j.idx_v] = qdd;
     d.a[i] = a + qdd * d.S[i].col(0);
+    return;
+  }
+  if (j.type == JointType::Planar) {
+    const Eigen::Matrix<double, 6, 3> S = d.S[i], U = d.U[i];
+    const Vec3 qdd = Mat3(d.Dinv[i]) * (Vec3(d.u[i]) - U.transpose() * a);
+    d.qdd.segment<3>(j.idx_v) = qdd;
+    d.a[i] = a + S * qdd;
     return;
   }
   const Vec6 qdd = Mat6(d.Dinv[i]) * (Vec6(d.u[i]) - Mat6(d.U[i]).transpose() * a);  // free flyer

@@ -58,7 +58,7 @@ std::vector<Case> loadCases(const std::string& path) {
   return out;
 }
 
-System loadCaseSystem(const Case& c) { return bindLayout(loadUrdf(c.urdfPath, c.layout.floatingBase), c.layout); }
+System loadCaseSystem(const Case& c) { return bindLayout(loadUrdf(c.urdfPath, c.layout.base()), c.layout); }
 
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
                                emit::ScalarType scalar, emit::SolverStats* stats, System* system) {

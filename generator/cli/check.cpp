@@ -32,9 +32,12 @@ System loadForCheck(const CheckOptions& o) {
   if (o.layout.empty()) return loadSystemWithoutLayout(o.urdf, o.floating);
   const Layout layout = loadLayout(o.layout);
   if (o.floating && !layout.floatingBase)
-    fail("command line", "--floating", fmt::format("conflicts with {} (its base is fixed)", o.layout));
-  return bindLayout(loadUrdf(o.urdf, layout.floatingBase), layout);
+    fail("command line", "--floating",
+         fmt::format("conflicts with {} (its base is {})", o.layout, layout.planarBase ? "planar" : "fixed"));
+  return bindLayout(loadUrdf(o.urdf, layout.base()), layout);
 }
+
+const char* baseName(const Model& m) { return m.floatingBase ? "floating" : m.planarBase ? "planar" : "fixed"; }
 
 const char* constraintTypeName(ConstraintType t) { return t == ConstraintType::Weld6D ? "6d" : "3d"; }
 
@@ -90,7 +93,7 @@ ordered_json layoutJson(const System& sys) {
   for (int i = 1; i < m.numBodies(); ++i) out["bodies"].push_back(bodyJson(m, i));
   out["support"] = sys.supportBodies();
   out["robot"] = m.name;
-  out["base"] = m.floatingBase ? "floating" : "fixed";
+  out["base"] = baseName(m);
   out["gravity"] = vec3Json(m.gravity);
   out["mu"] = sys.mu;
   out["iterations"] = sys.iterations;
@@ -154,8 +157,7 @@ std::string supportText(const System& sys) {
 
 std::string summaryText(const System& sys) {
   const Model& m = sys.model;
-  std::string out = fmt::format("robot {} ({}), {} base\n", shown(m.name), shown(m.sourcePath),
-                                m.floatingBase ? "floating" : "fixed");
+  std::string out = fmt::format("robot {} ({}), {} base\n", shown(m.name), shown(m.sourcePath), baseName(m));
   if (!sys.layoutPath.empty())
     out += fmt::format("layout {}: mu {}, iterations {}\n", shown(sys.layoutPath), sys.mu, sys.iterations);
   out += fmt::format("gravity [{}, {}, {}]\n", m.gravity[0], m.gravity[1], m.gravity[2]);

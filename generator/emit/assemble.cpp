@@ -83,8 +83,7 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   const CodeBuilder lit(plan.scalar);
   files.header = fmt::format(
       fmt::runtime(kHeaderTemplate), fmt::arg("banner", banner),
-      fmt::arg("q_convention", plan.floatingBase ? "x y z qx qy qz qw of the base, then one value per joint"
-                                                 : "one value per joint"),
+      fmt::arg("q_convention", plan.qConvention),
       fmt::arg("joint_table", joints), fmt::arg("constraint_table", constraints), fmt::arg("name", plan.name),
       fmt::arg("scalar", scalarName(plan.scalar)), fmt::arg("nq", plan.nq), fmt::arg("nv", plan.nv),
       fmt::arg("nc", plan.nc), fmt::arg("mu", lit.literal(plan.mu)), fmt::arg("iterations", plan.iterations),

@@ -36,7 +36,7 @@ struct Articulated {
     V6 pA = zero6();
     std::vector<V6> U;       // IA S, one column per dof
     Expr Dinv;               // 1 / (S^T IA S) for one-dof joints
-    Sym L{6};                // Cholesky factor of IA for the free flyer (lower, off-diagonal)
+    Sym L{6};                // Cholesky factor of D = S^T IA S (= IA for the free flyer; 3 x 3 for a planar joint)
     std::vector<Expr> Linv;  // its inverse diagonal
     std::vector<Expr> u;     // tau - S^T pA (+ multiplier terms in constrainedABA)
   };
@@ -64,7 +64,7 @@ struct ProxRows {
   struct Body {
     std::vector<V6> KA;                  // constraint force directions of the subtree rows
     std::vector<Expr> KSD;               // D^-1 S^T KA, per row (one-dof joints)
-    std::vector<V6> Z;                   // L^-1 KA, per row (the free flyer)
+    std::vector<V6> Z;                   // L^-1 S^T KA, per row (free flyer, planar joint: the first nv entries)
     std::vector<std::vector<Expr>> KS;   // S^T KA, per row
   };
   std::vector<Body> b;

@@ -110,6 +110,73 @@ void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk
     b.u[std::size_t(d)] = e.putQ(kUu, i, 6, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(d)]);
 }
 
+// A planar joint: S picks the components sel (linear x, linear y, angular z),
+// so U = IA S is three columns of IA, D = S^T IA S their 3 x 3 block (LL^T)
+// and u = tau - pA[sel]. Below a moving parent Ia = IA - U D^-1 U^T (whose
+// rows and columns sel vanish: Ia S = 0) and pa = pA + Ia c + U D^-1 u pass on.
+void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+  CodeBuilder& cb = e.cb();
+  Articulated::Body& b = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const int n = int(sel.size());
+  Sym IA = b.IA;
+  V6 pA = b.pA;
+  if (kk) penalty(e, i, *kk, IA, pA);
+  b.U.assign(std::size_t(n), V6{});
+  for (int d = 0; d < n; ++d)
+    for (int r = 0; r < 6; ++r)
+      b.U[std::size_t(d)][std::size_t(r)] = e.keepQ(kU, i, 6 * n, 6 * d + r, IA(r, sel[std::size_t(d)]));
+  Sym D(n);
+  for (int a = 0; a < n; ++a)
+    for (int c = a; c < n; ++c) D(a, c) = b.U[std::size_t(c)][std::size_t(sel[std::size_t(a)])];
+  const Cholesky ch = cholesky(
+      e, D, Expr(), [&](int r, int c) { return e.member(kL, i, n * (n + 1) / 2, Sym::index(n, r, c)); },
+      [&](int r) { return e.member(kLinv, i, n, r); });
+  b.L = ch.L;
+  b.Linv = ch.inv;
+  b.u.resize(std::size_t(n));
+  for (int d = 0; d < n; ++d)
+    b.u[std::size_t(d)] =
+        e.putQ(kUu, i, n, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(sel[std::size_t(d)])]);
+  if (p.parent == 0) return;
+  // Y = L^-1 U^T (one solve per row of U), so U D^-1 U^T = Y^T Y.
+  std::vector<std::vector<Expr>> Y(6);
+  for (int r = 0; r < 6; ++r) {
+    std::vector<Expr> row(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d) row[std::size_t(d)] = b.U[std::size_t(d)][std::size_t(r)];
+    Y[std::size_t(r)] = forwardSolve(cb, b.L, b.Linv, row);
+  }
+  Sym Ia(6);
+  for (int r = 0; r < 6; ++r)
+    for (int col = r; col < 6; ++col) {
+      Expr x = IA(r, col);
+      for (int d = 0; d < n; ++d) x -= cb.mul(Y[std::size_t(r)][std::size_t(d)], Y[std::size_t(col)][std::size_t(d)]);
+      Ia(r, col) = x;
+    }
+  for (int k : sel)
+    for (int c = 0; c < 6; ++c) Ia(k, c) = Expr();
+  flatten(cb, Ia, "Ia");
+  const std::vector<Expr> Du = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, b.u));  // D^-1 u
+  V6 pa;
+  for (int r = 0; r < 6; ++r) {
+    Expr x = pA[std::size_t(r)];
+    for (int d = 0; d < n; ++d) x += cb.mul(b.U[std::size_t(d)][std::size_t(r)], Du[std::size_t(d)]);
+    for (int k = 0; k < 6; ++k) x += cb.mul(Ia(r, k), kb.c[std::size_t(k)]);
+    pa[std::size_t(r)] = x;
+  }
+  flatten(cb, pa, "pa");
+  const Sym dI = e.inertiaToParent(kb, Ia);
+  const V6 dp = e.forceToParent(kb, pa);
+  Articulated::Body& par = art.b[std::size_t(p.parent)];
+  for (int k = 0; k < 21; ++k)
+    if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  for (int k = 0; k < 6; ++k)
+    if (!dp[std::size_t(k)].isZero())
+      par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
+}
+
 }  // namespace
 
 Articulated startElimination(const Kinematics& kin) {
@@ -124,6 +191,7 @@ Articulated startElimination(const Kinematics& kin) {
 
 void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art) {
   if (e.bp(i).jointClass == JointClass::FreeFlyer) eliminateFreeFlyer(e, i, k, art);
+  else if (e.bp(i).jointClass == JointClass::Planar) eliminatePicked(e, kin, i, k, art);
   else eliminateOneDof(e, kin, i, k, art);
 }
 

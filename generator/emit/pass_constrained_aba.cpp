@@ -54,6 +54,27 @@ void reducedSweep(Emit& e, const Kinematics& kin, const Multipliers& mult, Artic
     if (p.jointClass == JointClass::FreeFlyer) {
       for (int d = 0; d < 6; ++d)
         b.u[std::size_t(d)] = cb.store(e.member(kUu, i, 6, d), b.u[std::size_t(d)] - dp[std::size_t(d)]);
+    } else if (p.jointClass == JointClass::Planar) {
+      // u -= S^T dp (S picks sel); below a moving parent dp + U D^-1 (-S^T dp) passes on.
+      const std::vector<int> sel = pickedComponents(p.jointClass);
+      const int n = int(sel.size());
+      std::vector<Expr> du(static_cast<std::size_t>(n));
+      for (int d = 0; d < n; ++d) {
+        du[std::size_t(d)] = -dp[std::size_t(sel[std::size_t(d)])];
+        b.u[std::size_t(d)] = cb.store(e.member(kUu, i, n, d), b.u[std::size_t(d)] + du[std::size_t(d)]);
+      }
+      if (p.parent != 0) {
+        const std::vector<Expr> x = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, du));
+        V6 t;
+        for (int r = 0; r < 6; ++r) {
+          t[std::size_t(r)] = dp[std::size_t(r)];
+          for (int d = 0; d < n; ++d) t[std::size_t(r)] += cb.mul(b.U[std::size_t(d)][std::size_t(r)], x[std::size_t(d)]);
+        }
+        const V6 f = e.forceToParent(kb, t);
+        V6& par = inc.dp[std::size_t(p.parent)];
+        for (int r = 0; r < 6; ++r)
+          if (!f[std::size_t(r)].isZero()) par[std::size_t(r)] = e.putQ(kDP, p.parent, 6, r, par[std::size_t(r)] + f[std::size_t(r)]);
+      }
     } else {
       const Expr du = cb.flat(-dot(cb, kb.S[0], dp), "du");
       b.u[0] = cb.store(e.member(kUu, i, 1, 0), b.u[0] + du);

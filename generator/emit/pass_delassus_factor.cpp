@@ -27,17 +27,18 @@ struct Assembly {
   std::vector<std::vector<std::pair<int, int>>> at;
 };
 
-// G(t, u), rows in tree order (Z_i . Z_i at the free flyer, when withFreeFlyer).
-Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, bool withFreeFlyer) {
+// G(t, u), rows in tree order (Z_i . Z_i at a free flyer or planar joint, but
+// at the free flyer `split` whose share goes through Woodbury).
+Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, int split) {
   Expr g;
   for (const auto& [i, jt] : a.at[std::size_t(t)]) {
     const BodyPlan& b = a.plan.bodies[std::size_t(i)];
     if (u < b.rowStart || u >= b.rowStart + b.m()) continue;
     const int ju = u - b.rowStart;
     const ProxRows::Body& r = a.rows.b[std::size_t(i)];
-    if (b.jointClass == JointClass::FreeFlyer) {
-      if (!withFreeFlyer) continue;
-      for (int d = 0; d < 6; ++d) g += cb.mul(r.Z[std::size_t(jt)][std::size_t(d)], r.Z[std::size_t(ju)][std::size_t(d)]);
+    if (const int n = int(pickedComponents(b.jointClass).size()); n > 0) {
+      if (i == split) continue;
+      for (int d = 0; d < n; ++d) g += cb.mul(r.Z[std::size_t(jt)][std::size_t(d)], r.Z[std::size_t(ju)][std::size_t(d)]);
     } else {
       g += cb.mul(r.KSD[std::size_t(jt)], r.KS[std::size_t(ju)][0]);
     }
@@ -89,18 +90,18 @@ void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   const int nc = e.plan.nc;
   f.L = Sym(nc);
   f.Linv.assign(std::size_t(nc), Expr());
-  const bool full = freeFlyerWithRows(e.plan) < 0;
+  const int split = freeFlyerWithRows(e.plan);
   for (int j = 0; j < nc; ++j) {
     e.fn.boundary(fmt::format("column_{}", j));
     CodeBuilder& cb = e.cb();
     cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
-    Expr d = delassus(cb, a, j, j, full);  // before inv_mu: see mulAdd in symbolic.cpp
+    Expr d = delassus(cb, a, j, j, split);  // before inv_mu: see mulAdd in symbolic.cpp
     d += cb.input("inv_mu");
     for (int k = 0; k < j; ++k) d -= cb.mul(f.L(j, k), f.L(j, k));
     const Expr r = cb.sqrt(d, "r");
     f.Linv[std::size_t(j)] = e.put(e.member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));
     for (int i = j + 1; i < nc; ++i) {
-      Expr x = delassus(cb, a, i, j, full);
+      Expr x = delassus(cb, a, i, j, split);
       for (int k = 0; k < j; ++k) x -= cb.mul(f.L(i, k), f.L(j, k));
       f.L(i, j) = e.put(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)"),
                         cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));

@@ -44,6 +44,17 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
     b.XJ.p = {cb.input(q(j.idx_q)), cb.input(q(j.idx_q + 1)), cb.input(q(j.idx_q + 2))};
     return;
   }
+  if (p.jointClass == JointClass::Planar) {
+    // q = [x y c s]; R = [c -s 0; s c 0; 0 0 1], p = [x y 0], (c, s) used as
+    // given (callers normalise), as Model::jointPlacement. Kept in the
+    // workspace: the backward and forward passes (other functions) need them.
+    std::vector<Expr> qs;
+    for (int k = 0; k < 4; ++k) qs.push_back(cb.store(e.member(kQ, i, 4, k), cb.input(q(j.idx_q + k))));
+    const Expr &c = qs[2], &s = qs[3];
+    b.XJ.R = {c, -s, Expr(), s, c, Expr(), Expr(), Expr(), Expr(1.0)};
+    b.XJ.p = {qs[0], qs[1], Expr()};
+    return;
+  }
   const Vec3 a = j.axis;
   if (j.type == JointType::Prismatic) {
     // Kept in the workspace: the backward and forward passes (other functions) need it.

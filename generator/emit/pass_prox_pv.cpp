@@ -140,9 +140,46 @@ void rowsFreeFlyer(Emit& e, const Articulated& art, int i, ProxRows& rows) {
   }
 }
 
+// At a planar joint (S picks sel, D = L L^T): KS = KA[sel], its share of G is
+// Z^T Z with Z = L^-1 KS, and below a moving parent the parent's KA gets
+// X^T (KA - U D^-1 KS), D^-1 KS = L^-T Z (its components sel vanish).
+void rowsPicked(Emit& e, const Kinematics& kin, const Articulated& art, int i, ProxRows& rows) {
+  CodeBuilder& cb = e.cb();
+  ProxRows::Body& b = rows.b[std::size_t(i)];
+  const Articulated::Body& ab = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const int n = int(sel.size()), m = p.m(), off = p.offsetInParent;
+  const int pstride = p.parent != 0 ? rowStride(e.bp(p.parent).m()) : 0;
+  b.KS.assign(std::size_t(m), std::vector<Expr>(std::size_t(n)));
+  b.Z.assign(std::size_t(m), zero6());
+  for (int j = 0; j < m; ++j) {
+    const V6& ka = b.KA[std::size_t(j)];
+    for (int d = 0; d < n; ++d) b.KS[std::size_t(j)][std::size_t(d)] = ka[std::size_t(sel[std::size_t(d)])];
+    const std::vector<Expr> z = forwardSolve(cb, ab.L, ab.Linv, b.KS[std::size_t(j)]);
+    std::vector<Expr> zk(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d)
+      zk[std::size_t(d)] = b.Z[std::size_t(j)][std::size_t(d)] = e.keep(e.member(kZ, i, n, rowStride(m), d, j), z[std::size_t(d)]);
+    if (p.parent == 0) continue;
+    const std::vector<Expr> x = backwardSolve(cb, ab.L, ab.Linv, zk);  // D^-1 KS
+    V6 col;
+    for (int r = 0; r < 6; ++r) {
+      col[std::size_t(r)] = ka[std::size_t(r)];
+      for (int d = 0; d < n; ++d) col[std::size_t(r)] -= cb.mul(ab.U[std::size_t(d)][std::size_t(r)], x[std::size_t(d)]);
+    }
+    for (int k : sel) col[std::size_t(k)] = Expr();  // S^T (KA - U D^-1 KS) = 0
+    const V6 f = e.forceToParent(kb, col);
+    ProxRows::Body& par = rows.b[std::size_t(p.parent)];
+    for (int r = 0; r < 6; ++r)
+      par.KA[std::size_t(off + j)][std::size_t(r)] = e.put(e.member(kKA, p.parent, 6, pstride, r, off + j), f[std::size_t(r)]);
+  }
+}
+
 void carryRows(Emit& e, const Kinematics& kin, const Articulated& art, int i, ProxRows& rows) {
   if (e.bp(i).m() == 0) return;
   if (e.bp(i).jointClass == JointClass::FreeFlyer) rowsFreeFlyer(e, art, i, rows);
+  else if (e.bp(i).jointClass == JointClass::Planar) rowsPicked(e, kin, art, i, rows);
   else rowsOneDof(e, kin, art, i, rows);
 }
 

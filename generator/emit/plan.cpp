@@ -15,16 +15,23 @@ const char* jointClassName(JointClass c) {
     case JointClass::PrismaticZ: return "prismatic along z";
     case JointClass::PrismaticAxis: return "prismatic along a general axis";
     case JointClass::FreeFlyer: return "free flyer";
+    case JointClass::Planar: return "planar";
   }
   return "?";
+}
+
+std::vector<int> pickedComponents(JointClass c) {
+  if (c == JointClass::FreeFlyer) return {0, 1, 2, 3, 4, 5};
+  if (c == JointClass::Planar) return {0, 1, 5};
+  return {};
 }
 
 namespace {
 
 // An axis that is exactly +-e_k (as parsed) makes S a signed unit vector.
 void classify(const Joint& j, BodyPlan& b) {
-  if (j.type == JointType::FreeFlyer) {
-    b.jointClass = JointClass::FreeFlyer;
+  if (j.type == JointType::FreeFlyer || j.type == JointType::Planar) {
+    b.jointClass = j.type == JointType::FreeFlyer ? JointClass::FreeFlyer : JointClass::Planar;
     return;
   }
   const bool revolute = j.type == JointType::Revolute;
@@ -119,6 +126,15 @@ Plan makePlan(const System& sys, const std::string& name, ScalarType scalar) {
     b.offsetInParent = tree.offsetInParent[std::size_t(i)];
     b.rowStart = tree.subtreeStart[std::size_t(i)];
   }
+  // The q line of the header: the base's slots first when the layout adds one;
+  // a free flyer or planar joint from the URDF is described by the joint table.
+  bool multiDof = false;
+  for (int i = 1; i < N; ++i) multiDof = multiDof || !pickedComponents(plan.bodies[std::size_t(i)].jointClass).empty();
+  plan.qConvention = m.floatingBase ? "x y z qx qy qz qw of the base, then one value per joint"
+                     : m.planarBase ? "x y cos(yaw) sin(yaw) of the base, then one value per joint"
+                     : multiDof     ? "one value per one-dof joint, x y z qx qy qz qw per free flyer, x y cos(yaw) "
+                                      "sin(yaw) per planar joint"
+                                    : "one value per joint";
   plan.rootRows = plan.bodies[0].subtreeRows;
   plan.rowPosition = tree.treePosition;
   return plan;

@@ -19,8 +19,13 @@ enum class JointClass {
   RevoluteX, RevoluteY, RevoluteZ, RevoluteAxis,      // about +-x/y/z, or a general unit axis
   PrismaticX, PrismaticY, PrismaticZ, PrismaticAxis,  // along +-x/y/z, or a general unit axis
   FreeFlyer,
+  Planar,  // x, y, yaw in the joint frame's x-y plane: S picks linear x, linear y, angular z
 };
 const char* jointClassName(JointClass c);
+/// The components of a spatial vector ([linear; angular]) a free flyer's or a
+/// planar joint's S columns pick, one per dof (S = [e_k ...], constant in the
+/// body frame): 0..5, and 0, 1, 5. Empty for a one-dof joint.
+std::vector<int> pickedComponents(JointClass c);
 
 struct BodyPlan {
   int index = 0;
@@ -64,6 +69,7 @@ struct Plan {
   ScalarType scalar = ScalarType::Double;
   int nq = 0, nv = 0, nc = 0;
   bool floatingBase = false;
+  std::string qConvention;  // the header's "q = [...]" line
   double mu = 1e4;
   int iterations = 3;
   std::vector<BodyPlan> bodies;      // [0] = the world

@@ -19,6 +19,7 @@ const char* const kPythonModuleTemplate =
 
 const char* jointTypeText(JointClass c) {
   if (c == JointClass::FreeFlyer) return "free_flyer";
+  if (c == JointClass::Planar) return "planar";
   switch (c) {
     case JointClass::PrismaticX:
     case JointClass::PrismaticY:

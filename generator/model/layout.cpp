@@ -129,9 +129,10 @@ class Reader {
     onlyKeys(root, "", {"base", "gravity", "mu", "iterations", "constraints"});
     if (root["base"]) {
       const std::string base = string(root["base"], "base");
-      if (base != "floating" && base != "fixed")
-        failAt(root["base"], "base", fmt::format("{} is neither 'floating' nor 'fixed'", quoted(base)));
+      if (base != "floating" && base != "fixed" && base != "planar")
+        failAt(root["base"], "base", fmt::format("{} is none of 'fixed', 'floating', 'planar'", quoted(base)));
       L.floatingBase = base == "floating";
+      L.planarBase = base == "planar";
     }
     if (root["gravity"]) {
       L.gravity = vec3(root["gravity"], "gravity");
@@ -197,7 +198,7 @@ Layout loadLayout(const std::string& path) { return parseLayout(readInputFile(pa
 
 System loadSystem(const std::string& urdfPath, const std::string& layoutPath) {
   const Layout layout = loadLayout(layoutPath);
-  return bindLayout(loadUrdf(urdfPath, layout.floatingBase), layout);
+  return bindLayout(loadUrdf(urdfPath, layout.base()), layout);
 }
 
 System loadSystemWithoutLayout(const std::string& urdfPath, bool floatingBase) {

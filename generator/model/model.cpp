@@ -24,6 +24,7 @@ const char* jointTypeName(JointType t) {
     case JointType::Revolute: return "revolute";
     case JointType::Prismatic: return "prismatic";
     case JointType::FreeFlyer: return "floating";
+    case JointType::Planar: return "planar";
   }
   return "?";
 }
@@ -54,6 +55,12 @@ Mat6X Model::motionSubspace(int i) const {
       return S;
     }
     case JointType::FreeFlyer: return Mat6X::Identity(6, 6);
+    case JointType::Planar: {
+      // Constant in the body frame: linear x, linear y, angular z (no joint bias term).
+      Mat6X S = Mat6X::Zero(6, 3);
+      S(0, 0) = S(1, 1) = S(5, 2) = 1.0;
+      return S;
+    }
   }
   return {};
 }
@@ -69,14 +76,24 @@ SE3 Model::jointPlacement(int i, const Eigen::Ref<const VecX>& q) const {
       const Eigen::Quaterniond quat(q[j.idx_q + 6], q[j.idx_q + 3], q[j.idx_q + 4], q[j.idx_q + 5]);
       return b.treePlacement * SE3{quat.toRotationMatrix(), q.segment<3>(j.idx_q)};
     }
+    case JointType::Planar: {
+      // q = [x y c s]; (c, s) is used as given (callers normalise), R = [c -s 0; s c 0; 0 0 1].
+      const double c = q[j.idx_q + 2], s = q[j.idx_q + 3];
+      Mat3 R;
+      R << c, -s, 0, s, c, 0, 0, 0, 1;
+      return b.treePlacement * SE3{R, Vec3(q[j.idx_q], q[j.idx_q + 1], 0.0)};
+    }
   }
   return {};
 }
 
 VecX Model::neutral() const {
   VecX q = VecX::Zero(nq);
-  for (int i = 1; i < numBodies(); ++i)
-    if (bodies[i].joint.type == JointType::FreeFlyer) q[bodies[i].joint.idx_q + 6] = 1.0;
+  for (int i = 1; i < numBodies(); ++i) {
+    const Joint& j = bodies[i].joint;
+    if (j.type == JointType::FreeFlyer) q[j.idx_q + 6] = 1.0;
+    if (j.type == JointType::Planar) q[j.idx_q + 2] = 1.0;
+  }
   return q;
 }
 

@@ -2,10 +2,12 @@
 //
 // A Model is a kinematic tree of bodies in depth-first order. Body 0 is the
 // world. Every other body i has one moving joint connecting it to its parent
-// p(i) < i: revolute (URDF revolute and continuous), prismatic, or the
-// free-flyer root (only when the layout says `base: floating`). URDF links on
+// p(i) < i: revolute (URDF revolute and continuous), prismatic, planar (URDF
+// planar, or the root with `base: planar`) or a free flyer (URDF floating on a
+// link fixed to the world, or the root with `base: floating`). URDF links on
 // fixed joints are merged into the moving body they hang from; they remain
-// available as frames (constraint sites).
+// available as frames (constraint sites). Joint conventions: docs/design.md,
+// "Conventions".
 #pragma once
 
 #include <string>
@@ -16,14 +18,19 @@
 
 namespace proxgen {
 
-enum class JointType { Revolute, Prismatic, FreeFlyer };
+// Planar: q = [x y cos(yaw) sin(yaw)], v = [vx vy wz] in the body frame, the
+// plane the joint frame's x-y plane (Pinocchio's JointModelPlanar).
+enum class JointType { Revolute, Prismatic, FreeFlyer, Planar };
+
+/// How the URDF's root link is attached to the world (layout `base`).
+enum class BaseType { Fixed, Floating, Planar };
 
 const char* jointTypeName(JointType t);
 
 struct Joint {
   std::string name;
   JointType type = JointType::Revolute;
-  std::string urdfType;  // "revolute", "continuous", "prismatic" or "floating" (free flyer)
+  std::string urdfType;  // "revolute", "continuous", "prismatic", "planar" or "floating" (free flyer)
   Vec3 axis = Vec3::UnitZ();  // unit axis in the body frame (revolute/prismatic)
   int idx_q = 0, nq = 1;      // slots in q
   int idx_v = 0, nv = 1;      // slots in v, qdd, tau
@@ -56,7 +63,8 @@ struct Model {
   std::vector<Frame> frames;  // every URDF link, in body order
   int nq = 0, nv = 0;
   Vec3 gravity{0, 0, -9.81};
-  bool floatingBase = false;
+  bool floatingBase = false;  // body 1 is a free flyer on the world (`base: floating` or a URDF floating joint)
+  bool planarBase = false;    // body 1 is a planar joint on the world (`base: planar` or a URDF planar joint)
   std::vector<std::string> warnings;  // e.g. mimic joints solved as independent joints
 
   int numBodies() const { return int(bodies.size()); }  // including the world
@@ -68,7 +76,8 @@ struct Model {
   Mat6X motionSubspace(int i) const;
   /// Placement of body i in its parent at configuration q: X_T,i * X_J(q_i).
   SE3 jointPlacement(int i, const Eigen::Ref<const VecX>& q) const;
-  /// q at the neutral configuration (zeros; identity quaternion for a free flyer).
+  /// q at the neutral configuration (zeros; identity quaternion for a free
+  /// flyer, (cos, sin) = (1, 0) for a planar joint).
   VecX neutral() const;
   /// Bodies on the path from body i to the root, i first, world excluded.
   std::vector<int> pathToRoot(int i) const;
@@ -95,7 +104,9 @@ struct Constraint {
 /// The constraint layout file (YAML) as read.
 struct Layout {
   std::string sourcePath;
-  bool floatingBase = false;
+  bool floatingBase = false;  // `base: floating`
+  bool planarBase = false;    // `base: planar` (never both)
+  BaseType base() const { return floatingBase ? BaseType::Floating : planarBase ? BaseType::Planar : BaseType::Fixed; }
   bool hasGravity = false;
   Vec3 gravity{0, 0, -9.81};
   double mu = 1e4;

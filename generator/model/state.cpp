@@ -14,7 +14,7 @@ namespace {
 
 using nlohmann::json;
 
-// A state is at most 4 deep: a list of states, a state, q, a free flyer's list.
+// A state is at most 4 deep: a list of states, a state, q, a free flyer's (or planar joint's) list.
 inline constexpr int kMaxStateDepth = 4;
 // An object of a state is keyed by joint names (at most 4096 joints, 4101 with
 // a free flyer); bounding it also bounds the keys kept to find repeated ones.
@@ -58,28 +58,42 @@ VecX configurationFromJson(const Model& model, const json& j, const std::string&
     const Joint& jt = model.bodies[i].joint;
     const std::string element = fmt::format("q.{}", quoted(jt.name));
     if (!j.contains(jt.name)) fail(where, element, "missing");
-    if (jt.type != JointType::FreeFlyer) {
+    if (jt.type != JointType::FreeFlyer && jt.type != JointType::Planar) {
       readSlots(j.at(jt.name), jt.nq, q, jt.idx_q, where, element);
       continue;
     }
+    // A free flyer [x y z qx qy qz qw] or a planar joint [x y cos(yaw) sin(yaw)]:
+    // positions, then a direction (the quaternion, or (cos, sin)).
+    const bool ff = jt.type == JointType::FreeFlyer;
+    const int positions = ff ? 3 : 2, n = jt.nq;
     const json& x = j.at(jt.name);
-    if (!x.is_array() || x.size() != 7) fail(where, element, "expected a list of 7 numbers");
-    for (int k = 0; k < 3; ++k) q[jt.idx_q + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
-    // The quaternion's components only give a direction: any finite size is
+    if (!x.is_array() || int(x.size()) != n) fail(where, element, fmt::format("expected a list of {} numbers", n));
+    for (int k = 0; k < positions; ++k) q[jt.idx_q + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
+    // The direction's components only give a direction: any finite size is
     // accepted, and it is normalised by its largest component first, so that
     // [1e200, 1e200, 1e200, 1e200] is [0.5, 0.5, 0.5, 0.5] (its squared norm
     // would overflow) and a tiny one does not underflow to zero.
-    Eigen::Vector4d quat;
-    for (int k = 0; k < 4; ++k) {
-      const std::string el = fmt::format("{}[{}]", element, k + 3);
-      if (!x[k + 3].is_number()) fail(where, el, fmt::format("expected a number, got {}", x[k + 3].type_name()));
-      quat[k] = x[k + 3].get<double>();
-      if (!std::isfinite(quat[k])) fail(where, el, "is not finite");
+    VecX dir(n - positions);
+    for (int k = 0; k < n - positions; ++k) {
+      const std::string el = fmt::format("{}[{}]", element, k + positions);
+      if (!x[k + positions].is_number())
+        fail(where, el, fmt::format("expected a number, got {}", x[k + positions].type_name()));
+      dir[k] = x[k + positions].get<double>();
+      if (!std::isfinite(dir[k])) fail(where, el, "is not finite");
     }
-    const double largest = quat.cwiseAbs().maxCoeff();
-    if (!(largest > 0)) fail(where, element, "the quaternion [qx qy qz qw] has zero norm");
-    quat /= largest;  // now the largest component is +-1: no overflow, no underflow below
-    q.segment<4>(jt.idx_q + 3) = quat / quat.norm();  // documented: a non-unit quaternion is normalised
+    const double largest = dir.cwiseAbs().maxCoeff();
+    if (!(largest > 0))
+      fail(where, element, ff ? "the quaternion [qx qy qz qw] has zero norm" : "the yaw direction [cos sin] is [0, 0]");
+    dir /= largest;  // now the largest component is +-1: no overflow, no underflow below
+    // Documented: normalised. In fixed sizes, so the quaternion's rounding is the
+    // one it always had (a dynamic-size norm may sum in another order).
+    if (ff) {
+      const Eigen::Vector4d quat = dir;
+      q.segment<4>(jt.idx_q + 3) = quat / quat.norm();
+    } else {
+      const Eigen::Vector2d cs = dir;
+      q.segment<2>(jt.idx_q + 2) = cs / cs.norm();
+    }
   }
   return q;
 }
@@ -204,6 +218,12 @@ State randomState(const Model& m, std::mt19937& rng) {
       for (int k = 0; k < 3; ++k) s.q[j.idx_q + k] = U(rng);
       const Eigen::Vector4d quat(N(rng), N(rng), N(rng), N(rng));  // normal -> uniform on the sphere
       s.q.segment<4>(j.idx_q + 3) = quat.normalized();
+    } else if (j.type == JointType::Planar) {
+      // Position in [-1, 1]^2, yaw uniform in [-pi, pi]: (cos, sin) exactly unit to rounding.
+      for (int k = 0; k < 2; ++k) s.q[j.idx_q + k] = U(rng);
+      const double yaw = 3.141592653589793 * U(rng);
+      s.q[j.idx_q + 2] = std::cos(yaw);
+      s.q[j.idx_q + 3] = std::sin(yaw);
     } else if (j.hasPositionLimits && j.upper > j.lower && std::isfinite(j.upper - j.lower)) {
       s.q[j.idx_q] = std::uniform_real_distribution<double>(j.lower, j.upper)(rng);
     } else {

@@ -24,8 +24,8 @@ struct State {
 };
 
 /// Reads one state object. Every joint must appear in q and v; a joint missing
-/// from tau gets 0. The free-flyer quaternion must have a finite, non-zero norm
-/// and is normalised. `where` names the file and the element for messages.
+/// from tau gets 0. The free-flyer quaternion and a planar joint's (cos, sin)
+/// must have a finite, non-zero norm and are normalised. `where` names the file and the element for messages.
 State stateFromJson(const Model& model, const nlohmann::json& j, const std::string& where);
 
 /// Reads a file holding one state object or a list of them. `isList` tells which.
@@ -35,7 +35,8 @@ State stateFromJson(const Model& model, const nlohmann::json& j, const std::stri
 nlohmann::json readStateJson(const std::string& path);
 std::vector<State> loadStates(const Model& model, const std::string& path, bool* isList = nullptr);
 
-/// A joint-space vector (nv) keyed by joint name: scalars, or 6-vectors for a free flyer.
+/// A joint-space vector (nv) keyed by joint name: scalars, or 6-vectors for a
+/// free flyer, 3-vectors for a planar joint.
 nlohmann::json velocityToJson(const Model& model, const VecX& x);
 /// A configuration (nq) keyed by joint name.
 nlohmann::json configurationToJson(const Model& model, const VecX& q);
@@ -48,7 +49,8 @@ VecX configurationFromJson(const Model& model, const nlohmann::json& j, const st
 
 /// A random state for tests and `verify`: joints uniform inside their limits
 /// (in [-1, 1] rad or m without limits), a uniformly random unit quaternion and
-/// base position in [-1, 1]^3, velocities and torques uniform in [-1, 1].
+/// base position in [-1, 1]^3, a planar joint's yaw uniform in [-pi, pi] and
+/// position in [-1, 1]^2, velocities and torques uniform in [-1, 1].
 State randomState(const Model& model, std::mt19937& rng);
 
 }  // namespace proxgen

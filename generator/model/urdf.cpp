@@ -381,27 +381,27 @@ PrincipalMoments principalMoments(const Mat3& I) {
 
 class Builder {
  public:
-  Builder(const std::string& path, const LineIndex& lines, bool floating)
-      : path_(path), lines_(lines), floating_(floating) {}
+  Builder(const std::string& path, const LineIndex& lines, BaseType base) : path_(path), lines_(lines), base_(base) {}
 
   Model build(const urdf::ModelInterface& urdf) {
     model_.name = urdf.getName();
     model_.sourcePath = path_;
-    model_.floatingBase = floating_;
+    model_.floatingBase = base_ == BaseType::Floating;
+    model_.planarBase = base_ == BaseType::Planar;
     model_.bodies.push_back(Body{});  // world
     model_.bodies[0].link = "world";
     const urdf::LinkConstSharedPtr root = urdf.getRoot();
     if (!root) fail(path_, "", "no root link");
     int rootBody = 0;
-    if (floating_) {
+    if (base_ != BaseType::Fixed) {
+      // The joint the layout adds between the world and the root link: always
+      // `root_joint` (Pinocchio's name for it), a free flyer or a planar joint
+      // in the world's x-y plane.
       Body b;
       b.link = root->name;
       b.parent = 0;
       b.joint.name = "root_joint";
-      b.joint.type = JointType::FreeFlyer;
-      b.joint.urdfType = "floating";
-      b.joint.nq = 7;
-      b.joint.nv = 6;
+      setMultiDof(b.joint, base_ == BaseType::Floating ? JointType::FreeFlyer : JointType::Planar);
       b.inertia = linkInertia(*root, 1);
       rootBody = addBody(std::move(b));
     } else {
@@ -463,6 +463,49 @@ class Builder {
     if (n < 1e-9) failAt("joint", j.name, "<axis> has zero length");
     if (n == 1.0) return a;
     return a.stableNormalized();
+  }
+
+  static void setMultiDof(Joint& j, JointType type) {
+    j.type = type;
+    const bool ff = type == JointType::FreeFlyer;
+    j.urdfType = ff ? "floating" : "planar";
+    j.nq = ff ? 7 : 4;
+    j.nv = ff ? 6 : 3;
+    j.axis = Vec3::UnitZ();  // the planar joint's plane normal; unused by a free flyer
+  }
+
+  // A planar joint moves in the x-y plane of its joint frame (<origin>): the
+  // URDF's <axis> (the plane's normal) must be +z. Any other plane is the same
+  // joint with <origin> rotated so that its z axis is the normal; refused
+  // rather than rotated here, which would need a second fixed rotation to keep
+  // the child link frame where URDF puts it and a choice of in-plane x axis
+  // (docs/design.md, "Conventions").
+  void checkPlanarAxis(const urdf::Joint& j) const {
+    const Vec3 a(j.axis.x, j.axis.y, j.axis.z);
+    if (!a.allFinite()) failAt("joint", j.name, "<axis> has a non-finite component");
+    if (a.x() == 0.0 && a.y() == 0.0 && a.z() > 0.0) return;
+    failAt("joint", j.name,
+           fmt::format("planar joint with <axis> [{:g}, {:g}, {:g}] (urdfdom reads a missing <axis> as [1, 0, 0]): proxgen "
+                       "supports planar joints in the x-y plane of the joint frame only, <axis xyz=\"0 0 1\">; rotate the "
+                       "joint's <origin> so that its z axis is the plane's normal",
+                       a.x(), a.y(), a.z()));
+  }
+
+  // A free flyer hangs from the world only (a link welded to it: the root of a
+  // fixed base, or links fixed to it): the generated solvers eliminate a free
+  // flyer as a root body (docs/design.md, "Conventions").
+  void checkFloatingJoint(const urdf::Joint& j, int parentBody) const {
+    if (parentBody == 0) return;
+    const std::string parent = quoted(j.parent_link_name);
+    if (base_ == BaseType::Floating && parentBody == 1)
+      failAt("joint", j.name,
+             fmt::format("floating joint on link {}, which `base: floating` already makes a free flyer: a floating joint "
+                         "in the file is the floating base itself (use `base: fixed` with it), not one below it",
+                         parent));
+    failAt("joint", j.name,
+           fmt::format("floating joint below link {}, which moves: proxgen supports a floating joint only on a link fixed "
+                       "to the world (the root link of a fixed base, or a link welded to it)",
+                       parent));
   }
 
   // Depth-first over the URDF tree from `root`, without recursion (an explicit
@@ -535,10 +578,22 @@ class Builder {
           break;
         }
         case urdf::Joint::FLOATING:
-          failAt("joint", j->name,
-                 "floating joints are only supported as the root (say `base: floating` in the layout)");
-        case urdf::Joint::PLANAR:
-          failAt("joint", j->name, "planar joints are not supported");
+        case urdf::Joint::PLANAR: {
+          const bool floating = j->type == urdf::Joint::FLOATING;
+          if (floating) checkFloatingJoint(*j, body);
+          Body b;
+          b.link = child->name;
+          b.parent = body;
+          b.treePlacement = origin;
+          b.joint.name = j->name;
+          setMultiDof(b.joint, floating ? JointType::FreeFlyer : JointType::Planar);
+          if (!floating) checkPlanarAxis(*j);
+          b.inertia = linkInertia(*child, model_.numBodies());
+          const int i = addBody(std::move(b));
+          model_.frames.push_back({child->name, i, SE3::Identity(), j->name});
+          stack.push_back({child, i, SE3::Identity(), 0});  // `top` is invalid from here
+          break;
+        }
         default:
           failAt("joint", j->name, "unknown joint type");
       }
@@ -647,7 +702,7 @@ class Builder {
 
   std::string path_;
   const LineIndex& lines_;
-  bool floating_;
+  BaseType base_;
   Model model_;
   std::vector<IndefiniteLink> indefinite_;
   std::map<int, Vec3> firstMoments_;  // per merged body: sum of m |c| of its parts, per axis
@@ -683,7 +738,7 @@ class Builder {
 
 }  // namespace
 
-Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBase) {
+Model parseUrdf(const std::string& xml, const std::string& path, BaseType base) {
   // The two XML parsers (tinyxml2 here, TinyXML inside urdfdom) each build a
   // DOM of ~100-200 bytes per node: bounded through the tags before either runs.
   const std::size_t tags = std::size_t(std::count(xml.begin(), xml.end(), '<'));
@@ -709,11 +764,19 @@ Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBa
   if (!urdf.model || !urdfdomError.empty())
     fail(path, "", fmt::format("not a valid URDF: {}", urdfdomError.empty() ? "urdfdom rejected it" : urdfdomError));
   checkUrdfdomModel(*urdf.model, lines, path);
-  return Builder(path, lines, floatingBase).build(*urdf.model);
+  return Builder(path, lines, base).build(*urdf.model);
+}
+
+Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBase) {
+  return parseUrdf(xml, path, floatingBase ? BaseType::Floating : BaseType::Fixed);
+}
+
+Model loadUrdf(const std::string& path, BaseType base) {
+  return parseUrdf(readInputFile(path, kMaxUrdfBytes, "URDF"), path, base);
 }
 
 Model loadUrdf(const std::string& path, bool floatingBase) {
-  return parseUrdf(readInputFile(path, kMaxUrdfBytes, "URDF"), path, floatingBase);
+  return loadUrdf(path, floatingBase ? BaseType::Floating : BaseType::Fixed);
 }
 
 }  // namespace proxgen

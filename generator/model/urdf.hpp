@@ -44,12 +44,17 @@ inline constexpr std::size_t kMaxXmlDepth = 64;
 inline constexpr std::size_t kMaxXmlAttributesPerElement = 64;
 inline constexpr std::size_t kMaxUrdfAttributes = 1u << 20;
 
-/// Reads a URDF file into a Model. With `floatingBase` the root link becomes a
-/// free-flyer body (joint `root_joint`); otherwise it is welded to the world.
-/// Throws proxgen::Error ("FILE:LINE: joint 'x': what is wrong") on bad input.
+/// Reads a URDF file into a Model. With BaseType::Floating the root link becomes
+/// a free-flyer body, with BaseType::Planar a body on a planar joint in the
+/// world's x-y plane (joint `root_joint` either way); with BaseType::Fixed it is
+/// welded to the world. Throws proxgen::Error ("FILE:LINE: joint 'x': what is
+/// wrong") on bad input.
+Model loadUrdf(const std::string& path, BaseType base);
+/// `floatingBase`: BaseType::Floating, else BaseType::Fixed.
 Model loadUrdf(const std::string& path, bool floatingBase);
 
 /// The same from a string already in memory; `path` is only used in messages.
+Model parseUrdf(const std::string& xml, const std::string& path, BaseType base);
 Model parseUrdf(const std::string& xml, const std::string& path, bool floatingBase);
 
 }  // namespace proxgen

@@ -281,6 +281,7 @@ const char* jointTypeText(JointType t) {
     case JointType::Revolute: return "revolute";
     case JointType::Prismatic: return "prismatic";
     case JointType::FreeFlyer: return "free_flyer";
+    case JointType::Planar: return "planar";
   }
   return "";
 }
@@ -388,7 +389,7 @@ PYBIND11_MODULE(_proxgen, m) {
   }, py::arg("urdf"), py::arg("layout"));
   m.def("load_layout_text", [](const std::string& urdf, const std::string& text, const std::string& where) {
     const proxgen::Layout layout = proxgen::parseLayout(text, where);
-    return new Robot(proxgen::bindLayout(proxgen::loadUrdf(urdf, layout.floatingBase), layout));
+    return new Robot(proxgen::bindLayout(proxgen::loadUrdf(urdf, layout.base()), layout));
   }, py::arg("urdf"), py::arg("text"), py::arg("where"));
   m.def("load_without_layout", [](const std::string& urdf, bool floating) {
     return new Robot(proxgen::loadSystemWithoutLayout(urdf, floating));

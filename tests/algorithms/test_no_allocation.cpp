@@ -17,6 +17,7 @@
 #include "algorithms/prox_ltls.hpp"
 #include "algorithms/prox_pv.hpp"
 #include "algorithms/rnea.hpp"
+#include "model/layout.hpp"
 #include "support.hpp"
 
 namespace {
@@ -90,6 +91,26 @@ TEST(NoAllocation, GenericSolversOnEverySharedCase) {
     EXPECT_EQ(allocationsOf(sys, d, s, &proxPv), 0) << c.name << " proxPv";
     EXPECT_EQ(allocationsOf(sys, d, s, &proxLtl), 0) << c.name << " proxLtl";
     EXPECT_EQ(allocationsOf(sys, d, s, &proxLtls), 0) << c.name << " proxLtls";
+  }
+}
+
+// Planar joints (from the root and below a moving body) and a free flyer from
+// the URDF take their own branches in the elimination: no heap there either.
+TEST(NoAllocation, GenericSolversOnMobileBases) {
+  const std::string dir = std::string(PROXGEN_TEST_DATA_DIR) + "/good/";
+  for (const char* name : {"planar_mobile", "floating_joint"}) {
+    const System sys = loadSystem(dir + name + ".urdf", dir + name + ".yaml");
+    Data d(sys);
+    std::mt19937 rng(7);
+    const test::RandomState s = test::randomState(sys.model, rng);
+    const Solver aba3 = [](const System& y, Data& dd, const VecX& q, const VecX& v, const VecX& t, double, int) {
+      aba(y, dd, q, v, t);
+    };
+    EXPECT_EQ(allocationsOf(sys, d, s, aba3), 0) << name << " aba";
+    EXPECT_EQ(allocationsOf(sys, d, s, &constrainedAba), 0) << name << " constrainedAba";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxPv), 0) << name << " proxPv";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxLtl), 0) << name << " proxLtl";
+    EXPECT_EQ(allocationsOf(sys, d, s, &proxLtls), 0) << name << " proxLtls";
   }
 }
 

@@ -249,6 +249,36 @@ TEST(CliEval, SoloSameNumbersAsTheLibrary) {
   }
 }
 
+// A planar base (issue 13 item 3): root_joint's q is [x, y, cos, sin], here
+// (3, 4) for the pair, which eval normalises to (0.6, 0.8) as the library's
+// reader does; v and tau are 3-vectors, and qdd comes back as one.
+TEST(CliEval, PlanarBaseEveryAlgorithm) {
+  const System sys = loadSystem(good("arm3.urdf"), good("arm3_planar.yaml"));
+  ASSERT_EQ(sys.model.bodies[1].joint.type, JointType::Planar);
+  const std::vector<State> states = loadStates(sys.model, good("arm3_planar_state.json"));
+  // (3, 4) / 4 over its norm: 0.6 and 0.8 to 2 ulp.
+  EXPECT_NEAR(states[0].q[2], 0.6, 2e-16);
+  EXPECT_NEAR(states[0].q[3], 0.8, 2e-16);
+  for (const char* algorithm : kAlgorithms) {
+    const json r = runJson({"eval", good("arm3.urdf"), "--layout", good("arm3_planar.yaml"), "--state",
+                            good("arm3_planar_state.json"), "--algorithm", algorithm});
+    expectResult(sys, r, libraryAnswer(sys, algorithm, states[0], sys.mu, sys.iterations), algorithm, sys.mu, sys.iterations);
+    EXPECT_EQ(r.at("qdd").at("root_joint").size(), 3u) << algorithm;
+  }
+  const json j = runJson({"check", good("arm3.urdf"), "--layout", good("arm3_planar.yaml"), "--json"});
+  expectLayoutJson(sys, j);
+  EXPECT_EQ(j.at("base"), "planar");
+  EXPECT_EQ(j.at("joints")[0].at("type"), "planar");
+  // A zero (cos, sin) is one error line naming the file and the joint.
+  const TempFile zero(".json");
+  zero.write(R"({"q": {"root_joint": [0, 0, 0, 0], "shoulder": 0, "elbow": 0, "slide": 0},
+                 "v": {"root_joint": [0, 0, 0], "shoulder": 0, "elbow": 0, "slide": 0}})");
+  const ProcessResult bad = runProxgen({"eval", good("arm3.urdf"), "--layout", good("arm3_planar.yaml"), "--state", zero.path()});
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find(zero.path() + ": q.'root_joint': the yaw direction [cos sin] is [0, 0]"), std::string::npos) << bad.err;
+  EXPECT_TRUE(bad.out.empty()) << bad.out;
+}
+
 TEST(CliEval, FreeMotionAtZeroIterations) {
   // K = 0 is the unconstrained motion: multipliers exactly zero, and the
   // residual is what the free motion violates (the same J, gamma, aStar).

@@ -83,9 +83,12 @@ TEST(BadUrdf, UnknownJointType) {
   expectMessage(errorOf([] { urdf("unknown_joint_type.urdf"); }), {bad("unknown_joint_type.urdf"), "spin_joint", "helical"});
 }
 
-TEST(BadUrdf, PlanarJoint) {
+// A planar joint moves in its joint frame's x-y plane: an <axis> (the plane's
+// normal) other than +z is refused, naming the axis (docs/design.md, "Conventions").
+TEST(BadUrdf, PlanarJointOutsideItsFramesXyPlane) {
   const std::string f = bad("planar_joint.urdf");
-  expectMessage(errorOf([] { urdf("planar_joint.urdf"); }), {at(f, "\"table_joint\""), "joint 'table_joint'", "planar"});
+  expectMessage(errorOf([] { urdf("planar_joint.urdf"); }),
+                {at(f, "\"table_joint\""), "joint 'table_joint'", "planar joint with <axis> [0, 1, 0]", "<axis xyz=\"0 0 1\">"});
 }
 
 TEST(BadUrdf, FloatingJointInsideTheTree) {
@@ -131,7 +134,7 @@ TEST(BadUrdf, HostileNameIsEscapedAndCut) {
   const std::string xml = "<robot name='r'><link name='a'/><link name='b'/><joint name='" + name +
                           "' type='planar'><parent link='a'/><child link='b'/></joint></robot>";
   const std::string m = errorOf([&] { parseUrdf(xml, "inline.urdf", false); });
-  expectMessage(m, {"inline.urdf", "joint 'evil\\x0a", "planar"});
+  expectMessage(m, {"inline.urdf", "joint 'evil\\x0a", "planar joint with <axis> [1, 0, 0]"});  // urdfdom's default axis
   EXPECT_LT(m.size(), 400u) << m;  // quoted() shows 80 characters of a name
 }
 
