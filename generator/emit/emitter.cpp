@@ -1,6 +1,8 @@
 // The functions of a generated solver, in the order they are printed: each is
 // a host written by FunctionWriter (function.hpp) from the passes
 // (passes.hpp, one file each); assemble.cpp puts them into the two files.
+// System::functions says which are printed; a helper (kinematics,
+// joint_transforms, the off-support bodies' functions) only when one needs it.
 #include "emit/emitter.hpp"
 
 #include "emit/assemble.hpp"
@@ -16,31 +18,62 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;
+  const FunctionSet& want = sys.functions;
+  texts.functions = want;
+  const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
+  texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects);
+  texts.withJointTransforms = want.has(Function::MassMatrix) || want.has(Function::MassMatrixInverse);
 
-  // kinematics(q, v, w): shared by both entry points.
-  fn.beginHost("kinematics", nullptr);
-  Kinematics kin = emitKinematics(e);
-  fn.live().kin = &kin;
-  texts.kinematics = fn.endHost({"q", "v", "w"});
-
-  // eliminate_free_bodies(tau, w): the off-support bodies, shared too (none
-  // when every body is on the support).
-  Articulated free = startElimination(kin);
-  const CodeBuilder* afterElimination = fn.lastHost();
-  if (!plan.offSupport.empty()) {
-    fn.beginHost("eliminate_free", fn.lastHost());
-    free = eliminateFreeBodies(e, kin);
-    fn.live().art = &free;
-    texts.eliminateFree = fn.endHost({"tau", "w"});
-    afterElimination = fn.lastHost();
+  // kinematics(q, v, w): shared by the entry points with a velocity.
+  Kinematics kin;
+  const CodeBuilder* afterKinematics = nullptr;
+  if (texts.withKinematics) {
+    fn.beginHost("kinematics", nullptr);
+    kin = emitKinematics(e);
+    fn.live().kin = &kin;
+    texts.kinematics = fn.endHost({"q", "v", "w"});
+    afterKinematics = fn.lastHost();
   }
-  fn.live() = Live{};
 
-  // The entry points, each from its own copy of that state; the first one
-  // also prints accelerate_free_bodies.
-  texts.caba = emitConstrainedAba(e, kin, free, afterElimination);
-  texts.pv = emitProxPv(e, kin, free, afterElimination);
-  texts.accelerateFree = freeAccel.text;
+  if (solvers) {
+    // eliminate_free_bodies(tau, w): the off-support bodies, shared too (none
+    // when every body is on the support).
+    Articulated free = startElimination(kin);
+    const CodeBuilder* afterElimination = fn.lastHost();
+    if (!plan.offSupport.empty()) {
+      fn.beginHost("eliminate_free", fn.lastHost());
+      free = eliminateFreeBodies(e, kin);
+      fn.live().art = &free;
+      texts.eliminateFree = fn.endHost({"tau", "w"});
+      afterElimination = fn.lastHost();
+    }
+    fn.live() = Live{};
+
+    // The entry points, each from its own copy of that state; the first one
+    // also prints accelerate_free_bodies.
+    if (want.has(Function::ConstrainedAba)) texts.caba = emitConstrainedAba(e, kin, free, afterElimination);
+    if (want.has(Function::ProxPv)) texts.pv = emitProxPv(e, kin, free, afterElimination);
+    texts.accelerateFree = freeAccel.text;
+  }
+
+  // The dynamics library (docs/dynamics.md), after the solvers: their members
+  // come first in the Workspace, so a solver without these is what it was.
+  if (want.has(Function::InverseDynamics))
+    texts.library[Function::InverseDynamics] = emitInverseDynamics(e, kin, afterKinematics, false);
+  if (want.has(Function::NonlinearEffects))
+    texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, kin, afterKinematics, true);
+  if (texts.withJointTransforms) {
+    fn.beginHost("joint_transforms", nullptr);
+    Kinematics transforms = emitJointTransforms(e);
+    fn.live().kin = &transforms;
+    texts.jointTransforms = fn.endHost({"q", "w"});
+    fn.live() = Live{};
+    const CodeBuilder* afterTransforms = fn.lastHost();
+    if (want.has(Function::MassMatrix))
+      texts.library[Function::MassMatrix] = emitMassMatrix(e, transforms, afterTransforms);
+    if (want.has(Function::MassMatrixInverse))
+      texts.library[Function::MassMatrixInverse] = emitMassMatrixInverse(e, transforms, afterTransforms);
+  }
   texts.parts = fn.parts();
 
   // Operations per call: each entry point calls kinematics and the two
@@ -52,6 +85,19 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   texts.cabaOps += shared;
   texts.pvOps = fn.hostOps("pv");
   texts.pvOps += shared;
+  const struct {
+    Function f;
+    const char* host;
+    const char* helper;
+  } library[] = {{Function::InverseDynamics, "rnea", "kinematics"},
+                 {Function::NonlinearEffects, "nle", "kinematics"},
+                 {Function::MassMatrix, "crba", "joint_transforms"},
+                 {Function::MassMatrixInverse, "minv", "joint_transforms"}};
+  for (const auto& l : library) {
+    OpCount ops = fn.hostOps(l.host);
+    ops += fn.hostOps(l.helper);
+    texts.libraryOps[l.f] = ops;
+  }
 
   if (stats) {
     stats->statements = fn.stats().statements;
