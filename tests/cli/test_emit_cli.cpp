@@ -132,6 +132,26 @@ TEST_F(GenerateCommand, BadOptionsLeaveNothing) {
   EXPECT_NE(r.output.find("not a folder"), std::string::npos) << r.output;
 }
 
+// --functions with a name that is no function: one line naming the valid ones, nothing written.
+TEST_F(GenerateCommand, AnUnknownFunctionIsOneLineNamingTheValidOnes) {
+  const fs::path out = tmp_ / "out";
+  const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --functions rnea");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output.rfind("proxgen: error: ", 0), 0u) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+  for (const char* part : {"--functions", "'rnea'", "inverse_dynamics", "mass_matrix"})
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << " not in: " << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // The same from a layout: its file, line and element.
+  const fs::path layout = tmp_ / "functions.yaml";
+  { std::FILE* f = std::fopen(layout.c_str(), "w"); std::fputs("functions: [mass_matrix, rnea]\n", f); std::fclose(f); }
+  const Outcome l = run(arm_ + "/arm.urdf --layout " + layout.string() + " --out " + out.string());
+  EXPECT_EQ(l.code, 1) << l.output;
+  for (const char* part : {"functions.yaml:1", "functions[1]", "'rnea'", "constrained_aba"})
+    EXPECT_NE(l.output.find(part), std::string::npos) << part << " not in: " << l.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // `proxgen verify` generates, compiles (with the compiler proxgen was built
 // with: a few seconds for the arm) and compares with the generic solvers.
 TEST_F(GenerateCommand, VerifyPassesOnTheArmAndFailsBelowRoundoff) {
