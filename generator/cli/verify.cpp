@@ -127,12 +127,12 @@ constexpr const char* kDriver = R"(// proxgen verify driver (temporary)
 #include "proxgen_verify_solver.hpp"
 namespace s = proxgen_verify_solver;
 static s::Workspace w;
-static bool readAll(s::Scalar* x, int n) {
+[[maybe_unused]] static bool readAll(s::Scalar* x, int n) {
   double y = 0;
   for (int k = 0; k < n; ++k) { if (std::scanf("%lf", &y) != 1) return false; x[k] = s::Scalar(y); }
   return true;
 }
-static void printAll(const s::Scalar* x, int n) {
+[[maybe_unused]] static void printAll(const s::Scalar* x, int n) {
   for (int k = 0; k < n; ++k) std::printf("%.17g\n", double(x[k]));
 }
 int main() {

@@ -152,6 +152,16 @@ TEST_F(GenerateCommand, AnUnknownFunctionIsOneLineNamingTheValidOnes) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// The Python module binds the two solvers: without them --python is refused, nothing written.
+TEST_F(GenerateCommand, PythonNeedsTheTwoSolvers) {
+  const fs::path out = tmp_ / "out";
+  const Outcome r =
+      run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --python --functions mass_matrix");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("--python binds constrained_aba and prox_pv"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // `proxgen verify` generates, compiles (with the compiler proxgen was built
 // with: a few seconds for the arm) and compares with the generic solvers.
 TEST_F(GenerateCommand, VerifyPassesOnTheArmAndFailsBelowRoundoff) {
