@@ -162,6 +162,21 @@ TEST_F(GenerateCommand, PythonNeedsTheTwoSolvers) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// verify covers the functions it is asked for: here two joint-space ones and
+// no solver (one line each, no solver lines), and fails them below round-off.
+TEST_F(GenerateCommand, VerifyCoversTheFunctionsAskedFor) {
+  const std::string inputs = arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --samples 3 --functions mass_matrix,inverse_dynamics";
+  const Outcome ok = runCommand("verify", inputs);
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "  ok\n"), 2) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "mass_matrix M "), 1) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "inverse_dynamics tau "), 1) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "constrained_aba"), 0) << ok.output;
+  const Outcome strict = runCommand("verify", inputs + " --tolerance 1e-300");
+  EXPECT_EQ(strict.code, 1) << strict.output;
+  EXPECT_GE(countOf(strict.output, "  FAIL\n"), 1) << strict.output;  // an exact 0 error would pass
+}
+
 // `proxgen verify` generates, compiles (with the compiler proxgen was built
 // with: a few seconds for the arm) and compares with the generic solvers.
 TEST_F(GenerateCommand, VerifyPassesOnTheArmAndFailsBelowRoundoff) {
