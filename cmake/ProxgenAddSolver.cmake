@@ -1,10 +1,14 @@
 # proxgen_add_solver(<target> URDF <file> LAYOUT <file>
-#                    [SCALAR double|float] [NAME <namespace>] [OUTPUT_DIR <dir>])
+#                    [SCALAR double|float] [NAME <namespace>] [OUTPUT_DIR <dir>]
+#                    [FUNCTIONS <name>... | all])
 #
 # Generates a solver for one robot and layout at build time and makes it a
 # static library target <target> to link. The solver is regenerated whenever
 # the URDF, the layout or the proxgen executable changes. NAME defaults to
-# <target>; the generated header is <NAME>.hpp.
+# <target>; the generated header is <NAME>.hpp. FUNCTIONS (a list: constrained_aba,
+# prox_pv, inverse_dynamics, nonlinear_effects, mass_matrix, mass_matrix_inverse,
+# ... or all) picks the functions the solver holds, as `generate --functions`
+# (default: the layout's `functions:`, else the two solvers); proxgen checks the names.
 #
 # Needs PROXGEN_EXECUTABLE (path or generator expression), PROXGEN_EXECUTABLE_DEPENDS
 # (what the generation step depends on for "proxgen changed") and
@@ -60,7 +64,7 @@ macro(_proxgen_solver_defaults where prefix target)
 endmacro()
 
 function(proxgen_add_solver target)
-  cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR" "")
+  cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR" "FUNCTIONS")
   if(PAS_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "proxgen_add_solver(${target}): unknown arguments: ${PAS_UNPARSED_ARGUMENTS}")
   endif()
@@ -81,12 +85,20 @@ function(proxgen_add_solver target)
     message(FATAL_ERROR "proxgen_add_solver: use find_package(proxgen) or the proxgen source tree first")
   endif()
 
+  set(functions "")
+  if(DEFINED PAS_FUNCTIONS OR "FUNCTIONS" IN_LIST PAS_KEYWORDS_MISSING_VALUES)
+    if(NOT PAS_FUNCTIONS)
+      message(FATAL_ERROR "proxgen_add_solver(${target}): FUNCTIONS needs at least one function name")
+    endif()
+    list(JOIN PAS_FUNCTIONS "," joined)
+    set(functions --functions "${joined}")
+  endif()
   set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
   set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
   add_custom_command(
     OUTPUT "${hpp}" "${cpp}"
     COMMAND "${PROXGEN_EXECUTABLE}" generate "${urdf}" --layout "${layout}" --out "${PAS_OUTPUT_DIR}"
-            --name "${PAS_NAME}" --scalar "${PAS_SCALAR}"
+            --name "${PAS_NAME}" --scalar "${PAS_SCALAR}" ${functions}
     DEPENDS "${urdf}" "${layout}" ${PROXGEN_EXECUTABLE_DEPENDS}
     COMMENT "proxgen: generating ${PAS_NAME} (${PAS_SCALAR}) from ${urdf}"
     VERBATIM)

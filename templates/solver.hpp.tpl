@@ -26,13 +26,6 @@ struct Settings {{
 struct Workspace {{
 {members}}};
 
-// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).
-// K = s.iterations multiplier updates from lambda = 0; both algorithms give the
-// same iterates up to round-off.
-void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
-                     Scalar* qdd, Scalar* lambda) noexcept;
-void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
-             Scalar* qdd, Scalar* lambda) noexcept;
-
+{declarations}
 }}  // namespace {name}
 )proxgen"

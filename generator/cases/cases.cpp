@@ -61,10 +61,12 @@ std::vector<Case> loadCases(const std::string& path) {
 System loadCaseSystem(const Case& c) { return bindLayout(loadUrdf(c.urdfPath, c.layout.base()), c.layout); }
 
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
-                               emit::ScalarType scalar, emit::SolverStats* stats, System* system) {
+                               emit::ScalarType scalar, emit::SolverStats* stats, System* system,
+                               const std::string& functions) {
   namespace fs = std::filesystem;
   const Case c = loadCase(casesFile, caseName);
-  const System sys = loadCaseSystem(c);
+  System sys = loadCaseSystem(c);
+  if (!functions.empty()) sys.functions = parseFunctionList(functions, "command line", "--functions");
   if (system) *system = sys;
   emit::SolverInputs in;
   const std::string file = fs::path(casesFile).filename().string();
@@ -73,18 +75,20 @@ emit::SolverFiles generateCase(const std::string& casesFile, const std::string& 
   in.urdfSha256 = emit::sha256File(c.urdfPath);
   in.layoutSha256 = emit::sha256File(casesFile);
   in.command = fmt::format("proxgen generate --cases {} --case {}", file, c.name);
+  in.functions = functions;
   return emit::generateSystem(sys, name.empty() ? c.name : name, scalar, in, stats);
 }
 
 emit::SolverFiles generateFromInputs(const std::string& urdf, const std::string& layout, const std::string& casesFile,
                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar,
-                                     System* system) {
-  if (!casesFile.empty()) return generateCase(casesFile, caseName, name, scalar, nullptr, system);
+                                     System* system, const std::string& functions) {
+  if (!casesFile.empty()) return generateCase(casesFile, caseName, name, scalar, nullptr, system, functions);
   emit::GenerateOptions g;
   g.urdf = urdf;
   g.layout = layout;
   g.name = name;
   g.scalar = scalar;
+  g.functions = functions;
   return emit::generateFiles(g, nullptr, system);
 }
 

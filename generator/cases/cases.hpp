@@ -30,14 +30,16 @@ System loadCaseSystem(const Case& c);
 
 /// `proxgen generate --cases FILE --case NAME`: the solver of one case
 /// (emit::generateSystem); `name` "" = the case's name.
+/// `functions`: --functions as given ("" = the case's layout's).
 emit::SolverFiles generateCase(const std::string& casesFile, const std::string& caseName, const std::string& name,
-                               emit::ScalarType scalar, emit::SolverStats* stats = nullptr, System* system = nullptr);
+                               emit::ScalarType scalar, emit::SolverStats* stats = nullptr, System* system = nullptr,
+                               const std::string& functions = "");
 
 /// `generate`'s two ways in (the CLI and the Python package): one case of a
 /// cases file when `casesFile` is set, else a URDF and a layout. `system`, if
 /// given, receives the System the solver was generated from.
 emit::SolverFiles generateFromInputs(const std::string& urdf, const std::string& layout, const std::string& casesFile,
                                      const std::string& caseName, const std::string& name, emit::ScalarType scalar,
-                                     System* system = nullptr);
+                                     System* system = nullptr, const std::string& functions = "");
 
 }  // namespace proxgen

@@ -29,7 +29,7 @@ void checkRobotOptions(const char* command, const std::string& urdf, const std::
 /// `loaded`, if given, receives the System the solver was generated from.
 emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar,
-                                      System* loaded = nullptr);
+                                      System* loaded = nullptr, const std::string& functions = "");
 
 /// The warning that a float constrainedABA loses accuracy with this layout
 /// ("" if none; check.cpp). Printed when float is asked for: generate and

@@ -1,4 +1,5 @@
 // proxgen generate robot.urdf --layout layout.yaml --out DIR [--name NAME] [--scalar double|float] [--python]
+//                  [--functions a,b,...|all]
 //   or, for one case of a cases file (tests, benchmarks):
 // proxgen generate --cases cases.yaml --case NAME --out DIR [--name NAME] [--scalar double|float]
 #include <fmt/format.h>
@@ -27,9 +28,9 @@ void checkRobotOptions(const char* command, const std::string& urdf, const std::
 
 emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string& layout, const std::string& cases,
                                       const std::string& caseName, const std::string& name, emit::ScalarType scalar,
-                                      System* loaded) {
+                                      System* loaded, const std::string& functions) {
   System sys;
-  const emit::SolverFiles files = generateFromInputs(urdf, layout, cases, caseName, name, scalar, &sys);
+  const emit::SolverFiles files = generateFromInputs(urdf, layout, cases, caseName, name, scalar, &sys, functions);
   if (scalar == emit::ScalarType::Float) printWarning(floatAccuracyWarning(sys));
   if (loaded) *loaded = std::move(sys);
   return files;
@@ -37,7 +38,7 @@ emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string
 
 void addGenerate(CLI::App& app) {
   struct Options {
-    std::string urdf, layout, cases, caseName, out, name, scalar = "double";
+    std::string urdf, layout, cases, caseName, out, name, scalar = "double", functions;
     bool python = false;
   };
   auto opt = std::make_shared<Options>();
@@ -49,12 +50,18 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--out", opt->out, "output folder (created if missing)")->required();
   cmd->add_option("--name", opt->name, "namespace and file name (sanitised; default: the case or the URDF's file name)");
   cmd->add_option("--scalar", opt->scalar, "double (default) or float")->check(CLI::IsMember({"double", "float"}));
+  cmd->add_option("--functions", opt->functions,
+                  "the functions the solver holds, a,b,... or all (default: the layout's functions:, else "
+                  "constrained_aba,prox_pv; valid: " + functionNameList() + ")");
   cmd->add_flag("--python", opt->python, "also write NAME_python.cpp, a pybind11 module over the solver (docs/python.md)");
   cmd->callback([opt] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
     System sys;
     const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
-                                                        emit::parseScalar(opt->scalar), &sys);
+                                                        emit::parseScalar(opt->scalar), &sys, opt->functions);
+    // The Python module binds the two solvers (docs/python.md); nothing is written yet.
+    if (opt->python && !(sys.functions.has(Function::ConstrainedAba) && sys.functions.has(Function::ProxPv)))
+      throw Error("generate: --python binds constrained_aba and prox_pv: the function list must hold both");
     std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
     // The module source goes through the same atomic write as the solver's files.
     if (opt->python) outputs.push_back(emit::pythonModuleOutput(sys, files, emit::parseScalar(opt->scalar)));

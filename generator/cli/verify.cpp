@@ -6,14 +6,18 @@
 // with the generic solvers at K = 1, 2, 3 and at convergence, within the
 // conditioning-aware bounds the generated-solver tests use (verify/compare.hpp).
 // This is what a user runs on their own robot before trusting a generated solver.
-//   proxgen verify robot.urdf --layout layout.yaml [--samples N]
-//   proxgen verify --cases cases.yaml --case NAME [--samples N]
+// The joint-space functions the solver holds (layout functions:, --functions)
+// are run on the same states with random qdd and lambda and compared with their
+// generic twins (verify/compare.hpp, compareLibraryWithGeneric).
+//   proxgen verify robot.urdf --layout layout.yaml [--samples N] [--functions a,b|all]
+//   proxgen verify --cases cases.yaml --case NAME [--samples N] [--functions a,b|all]
 #include <fmt/format.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -40,7 +44,7 @@ namespace proxgen::cli {
 namespace {
 
 struct VerifyOptions {
-  std::string urdf, layout, cases, caseName, scalar = "double", keep;
+  std::string urdf, layout, cases, caseName, scalar = "double", keep, functions;
   int samples = 20;
   unsigned seed = 1;
   double tolerance = 0;  // 0: the conditioning-aware bounds of verify/compare.hpp
@@ -113,15 +117,28 @@ fs::path runtimeDir() {
 }
 
 // The driver reads samples (q, v, tau, mu, K) from stdin and prints, per sample,
-// qdd and lambda of constrained_aba then prox_pv, one number per line.
+// qdd and lambda of constrained_aba then prox_pv, one number per line (none
+// unless the solver holds both); then library samples (q, v, qdd, lambda) and,
+// per sample, what each joint-space function it holds returns (compare.hpp's
+// LibraryAnswer order: tau, h, M, Minv). verify.cpp prepends a
+// PROXGEN_VERIFY_HAS_<FUNCTION> 1 line per function held.
 constexpr const char* kDriver = R"(// proxgen verify driver (temporary)
 #include <cstdio>
 #include "proxgen_verify_solver.hpp"
 namespace s = proxgen_verify_solver;
 static s::Workspace w;
+[[maybe_unused]] static bool readAll(s::Scalar* x, int n) {
+  double y = 0;
+  for (int k = 0; k < n; ++k) { if (std::scanf("%lf", &y) != 1) return false; x[k] = s::Scalar(y); }
+  return true;
+}
+[[maybe_unused]] static void printAll(const s::Scalar* x, int n) {
+  for (int k = 0; k < n; ++k) std::printf("%.17g\n", double(x[k]));
+}
 int main() {
   int n = 0;
   if (std::scanf("%d", &n) != 1) return 2;
+#if PROXGEN_VERIFY_HAS_CONSTRAINED_ABA && PROXGEN_VERIFY_HAS_PROX_PV
   for (int t = 0; t < n; ++t) {
     s::Scalar q[s::nq], v[s::nv], tau[s::nv], qdd[s::nv], lambda[s::nc + 1];
     double x = 0;
@@ -140,9 +157,44 @@ int main() {
     for (int k = 0; k < s::nv; ++k) std::printf("%.17g\n", double(qdd[k]));
     for (int k = 0; k < s::nc; ++k) std::printf("%.17g\n", double(lambda[k]));
   }
+#endif
+  int m = 0;
+  if (std::scanf("%d", &m) != 1) return 2;
+  for (int t = 0; t < m; ++t) {
+    static s::Scalar q[s::nq], v[s::nv], qdd[s::nv], lambda[s::nc + 1], out[s::nv * s::nv + 1];
+    if (!readAll(q, s::nq) || !readAll(v, s::nv) || !readAll(qdd, s::nv) || !readAll(lambda, s::nc)) return 2;
+    static_cast<void>(out);
+#if PROXGEN_VERIFY_HAS_INVERSE_DYNAMICS
+    s::inverse_dynamics(q, v, qdd, lambda, w, out);
+    printAll(out, s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_NONLINEAR_EFFECTS
+    s::nonlinear_effects(q, v, w, out);
+    printAll(out, s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_MASS_MATRIX
+    s::mass_matrix(q, w, out);
+    printAll(out, s::nv * s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_MASS_MATRIX_INVERSE
+    s::mass_matrix_inverse(q, w, out);
+    printAll(out, s::nv * s::nv);
+#endif
+  }
   return 0;
 }
 )";
+
+// The driver's defines: one per function the solver holds.
+std::string driverDefines(const FunctionSet& functions) {
+  std::string out;
+  for (const std::string& name : functions.names()) {
+    std::string upper = name;
+    for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+    out += "#define PROXGEN_VERIFY_HAS_" + upper + " 1\n";
+  }
+  return out;
+}
 
 struct Trial {
   int sample, K;
@@ -151,7 +203,9 @@ struct Trial {
 
 // The System of the options: a URDF and a layout, or one case of a cases file.
 System loadVerified(const VerifyOptions& o) {
-  return o.cases.empty() ? loadSystem(o.urdf, o.layout) : loadCaseSystem(loadCase(o.cases, o.caseName));
+  System sys = o.cases.empty() ? loadSystem(o.urdf, o.layout) : loadCaseSystem(loadCase(o.cases, o.caseName));
+  if (!o.functions.empty()) sys.functions = parseFunctionList(o.functions, "command line", "--functions");
+  return sys;
 }
 
 // --keep names a folder; anything else there is refused before the work starts.
@@ -246,16 +300,18 @@ int verify(const VerifyOptions& o) {
   // (generateFiles directly, not generateSolverFiles: the warning is out already)
   std::vector<emit::OutputFile> files;
   if (!o.cases.empty()) {
-    files = emit::solverOutputs(generateCase(o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar)));
+    files = emit::solverOutputs(
+        generateCase(o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar), nullptr, nullptr, o.functions));
   } else {
     emit::GenerateOptions g;
     g.urdf = o.urdf;
     g.layout = o.layout;
     g.name = kSolverName;
     g.scalar = emit::parseScalar(o.scalar);
+    g.functions = o.functions;
     files = emit::solverOutputs(emit::generateFiles(g));
   }
-  files.push_back({"driver.cpp", kDriver});
+  files.push_back({"driver.cpp", driverDefines(sys.functions) + kDriver});
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
   // -pipe: no assembler files in TMPDIR (fewer temporaries to leave if interrupted).
@@ -275,9 +331,24 @@ int verify(const VerifyOptions& o) {
   std::vector<State> states;
   for (int s = 0; s < o.samples; ++s) states.push_back(verify::roundedToScalar(randomState(m, rng), isFloat));
   std::vector<Trial> trials;
-  for (int s = 0; s < o.samples; ++s)
+  const bool solvers = sys.functions.has(Function::ConstrainedAba) && sys.functions.has(Function::ProxPv);
+  for (int s = 0; s < o.samples && solvers; ++s)
     for (double mu : {sys.mu, 100.0})
       for (int K : {1, 2, 3, o.converged}) trials.push_back({s, K, mu});
+  // The joint-space functions' extra inputs: qdd ~ N(0, 1), lambda ~ 10 N(0, 1), per state.
+  const bool library = sys.functions.has(Function::InverseDynamics) || sys.functions.has(Function::NonlinearEffects) ||
+                       sys.functions.has(Function::MassMatrix) || sys.functions.has(Function::MassMatrixInverse);
+  std::vector<verify::LibraryAnswer> libraryIn;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const auto rounded = [&](double x) { return isFloat ? double(float(x)) : x; };
+  for (int s = 0; s < o.samples && library; ++s) {
+    verify::LibraryAnswer a;
+    a.qdd = VecX(m.nv);
+    a.lambda = VecX(sys.nc);
+    for (int k = 0; k < m.nv; ++k) a.qdd[k] = rounded(normal(rng));
+    for (int k = 0; k < sys.nc; ++k) a.lambda[k] = rounded(10.0 * normal(rng));
+    libraryIn.push_back(a);
+  }
   {
     std::ofstream in(input);
     in << trials.size() << "\n";
@@ -289,6 +360,13 @@ int verify(const VerifyOptions& o) {
       put(states[t.sample].v);
       put(states[t.sample].tau);
       in << fmt::format("{} {}\n", t.mu, t.K);
+    }
+    in << libraryIn.size() << "\n";
+    for (std::size_t s = 0; s < libraryIn.size(); ++s) {
+      put(states[s].q);
+      put(states[s].v);
+      put(libraryIn[s].qdd);
+      put(libraryIn[s].lambda);
     }
     if (!in) throw Error(fmt::format("verify: {}: cannot be written", proxgen::quoted(input.string())));
   }
@@ -354,6 +432,28 @@ int verify(const VerifyOptions& o) {
     }
   }
 
+  // The joint-space functions, sample by sample (the driver's order).
+  for (std::size_t s = 0; s < libraryIn.size(); ++s) {
+    verify::LibraryAnswer gen = libraryIn[s];
+    const Trial at{int(s), 0, 0.0};
+    if (sys.functions.has(Function::InverseDynamics)) gen.tau = read(m.nv, "inverse_dynamics tau", at);
+    if (sys.functions.has(Function::NonlinearEffects)) gen.h = read(m.nv, "nonlinear_effects h", at);
+    const auto square = [&](const char* what) {
+      const VecX x = read(m.nv * m.nv, what, at);
+      MatX M(m.nv, m.nv);
+      for (int r = 0; r < m.nv; ++r)
+        for (int c = 0; c < m.nv; ++c) M(r, c) = x[r * m.nv + c];  // row-major
+      return M;
+    };
+    if (sys.functions.has(Function::MassMatrix)) gen.M = square("mass_matrix M");
+    if (sys.functions.has(Function::MassMatrixInverse)) gen.Minv = square("mass_matrix_inverse");
+    for (const verify::Compared& x :
+         verify::compareLibraryWithGeneric(sys, d, conditioning[s], states[s], gen)) {
+      if (!x.finite) throw Error(fmt::format("verify: the generic {} is not finite at sample {}", x.what, s));
+      record(x.what, x.error, x.bound);
+    }
+  }
+
   const double secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); }(t0, t1);
   const double csecs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); }(t1, t2);
   const std::string what = o.cases.empty() ? o.urdf : fmt::format("case {} of {}", o.caseName, o.cases);
@@ -396,6 +496,8 @@ void addVerify(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--keep", o->keep, "copy the generated solver, driver and logs to this folder");
+  cmd->add_option("--functions", o->functions,
+                  "the functions to generate and compare, a,b,... or all (default: the layout's functions:)");
   cmd->callback([o] {
     checkRobotOptions("verify", o->urdf, o->layout, o->cases, o->caseName);
     const int rc = verify(*o);

@@ -51,6 +51,73 @@ std::string opLine(const std::string& name, const OpCount& n, int K) {
       affine(a.log6, b.log6));
 }
 
+// The entry points, in allFunctions() order: what the header declares (with
+// its comment) and the source defines, for the functions the solver holds.
+struct EntryPoint {
+  Function f;
+  const char* header;  // comment lines above the declaration ("" for prox_pv: constrained_aba's)
+  const char* signature;
+  const char* source;  // comment lines above the definition
+};
+const EntryPoint kEntryPoints[] = {
+    {Function::ConstrainedAba,
+     "// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).\n"
+     "// K = s.iterations multiplier updates from lambda = 0; both algorithms give the\n"
+     "// same iterates up to round-off.\n",
+     "void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,\n"
+     "                     Scalar* qdd, Scalar* lambda) noexcept",
+     "// constrainedABA: the penalty mu K^T K at the constrained bodies, one full\n"
+     "// sweep, then iterations 2..K as reduced sweeps over the support.\n"},
+    {Function::ProxPv, "",
+     "void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,\n"
+     "             Scalar* qdd, Scalar* lambda) noexcept",
+     "// proxPV: one sweep carrying the constraint rows up the support, the Delassus\n"
+     "// matrix G + I/mu factored once at the root, K proximal solves, one forward sweep.\n"},
+    {Function::InverseDynamics,
+     "\n// tau = M(q) qdd + h(q, v) + J(q)^T lambda (the constraint force on the robot is\n"
+     "// -J^T lambda, as in the solvers): the torques that give the accelerations qdd\n"
+     "// while the constraints push with multipliers lambda (rows in layout order, J's\n"
+     "// rows in the constraint frames the solvers use); lambda may be nullptr (none).\n",
+     "void inverse_dynamics(const Scalar* q, const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
+     "                      Scalar* tau) noexcept",
+     "// Inverse dynamics (RNEA): kinematics, accelerations and forces root first,\n"
+     "// with the constraint forces K^T lambda at the constrained bodies, then torques leaves first.\n"},
+    {Function::NonlinearEffects,
+     "\n// h(q, v) = inverse_dynamics(q, v, qdd = 0, nullptr): Coriolis, centrifugal and gravity torques.\n",
+     "void nonlinear_effects(const Scalar* q, const Scalar* v, Workspace& w, Scalar* h) noexcept",
+     "// Nonlinear effects: RNEA with qdd = 0 and no constraint forces.\n"},
+    {Function::MassMatrix, "\n// M(q), the joint-space inertia: nv x nv, row-major, full (M[r * nv + c]).\n",
+     "void mass_matrix(const Scalar* q, Workspace& w, Scalar* M) noexcept",
+     "// The joint-space inertia by the composite-rigid-body algorithm.\n"},
+    {Function::MassMatrixInverse,
+     "\n// M(q)^-1: nv x nv, row-major, full, in O(n^2) without factoring M.\n",
+     "void mass_matrix_inverse(const Scalar* q, Workspace& w, Scalar* Minv) noexcept",
+     "// M^-1 by ABA on the nv unit torques at once (v = 0, no gravity).\n"},
+};
+
+// The helpers the entry points call, printed only when one needs them.
+std::string helpers(const SolverTexts& texts) {
+  std::string out;
+  if (texts.withKinematics)
+    out += fmt::format(
+        "// Joint transforms, body velocities v, velocity-product accelerations c, bias\n"
+        "// forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.\n"
+        "void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {{\n{}}}\n\n",
+        texts.kinematics);
+  if (texts.withJointTransforms)
+    out += fmt::format(
+        "// The joint transforms alone, for the functions without a velocity.\n"
+        "void joint_transforms(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
+        texts.jointTransforms);
+  return out;
+}
+
+std::string bodyOf(const SolverTexts& texts, Function f) {
+  if (f == Function::ConstrainedAba) return texts.caba;
+  if (f == Function::ProxPv) return texts.pv;
+  return texts.library.at(f);
+}
+
 }  // namespace
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
@@ -70,12 +137,25 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
                                c.weld ? "6d weld" : "3d point contact", escapeComment(c.link));
   if (constraints.empty()) constraints = "//   (none)\n";
 
+  std::string operations, declarations, definitions;
+  for (const EntryPoint& ep : kEntryPoints) {
+    if (!texts.functions.has(ep.f)) continue;
+    const OpCount ops = ep.f == Function::ConstrainedAba ? texts.cabaOps
+                        : ep.f == Function::ProxPv       ? texts.pvOps
+                                                         : texts.libraryOps.at(ep.f);
+    operations += opLine(functionName(ep.f), ops, plan.iterations);
+    // prox_pv alone takes constrained_aba's comment
+    declarations += std::string(ep.f == Function::ProxPv && !texts.functions.has(Function::ConstrainedAba)
+                                    ? kEntryPoints[0].header
+                                    : ep.header) +
+                    ep.signature + ";\n";
+    definitions += fmt::format("{}{} {{\n{}}}\n\n", ep.source, ep.signature, bodyOf(texts, ep.f));
+  }
   const std::string banner = fmt::format(
       fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION), fmt::arg("urdf", escapeComment(in.urdfName)),
       fmt::arg("layout", escapeComment(in.layoutName)), fmt::arg("command", escapeComment(in.command)),
       fmt::arg("robot", escapeComment(m.name)), fmt::arg("urdf_sha", in.urdfSha256), fmt::arg("layout_sha", in.layoutSha256),
-      fmt::arg("operations", opLine("constrained_aba", texts.cabaOps, plan.iterations) +
-                                 opLine("prox_pv", texts.pvOps, plan.iterations)));
+      fmt::arg("operations", operations));
 
   SolverFiles files;
   files.headerName = plan.name + ".hpp";
@@ -87,11 +167,11 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("joint_table", joints), fmt::arg("constraint_table", constraints), fmt::arg("name", plan.name),
       fmt::arg("scalar", scalarName(plan.scalar)), fmt::arg("nq", plan.nq), fmt::arg("nv", plan.nv),
       fmt::arg("nc", plan.nc), fmt::arg("mu", lit.literal(plan.mu)), fmt::arg("iterations", plan.iterations),
-      fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()));
+      fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()),
+      fmt::arg("declarations", declarations));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
-                             fmt::arg("parts", texts.parts), fmt::arg("kinematics", texts.kinematics),
-                             fmt::arg("free_bodies", freeBodies(texts)),
-                             fmt::arg("caba", texts.caba), fmt::arg("pv", texts.pv));
+                             fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)),
+                             fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));
   return files;
 }
 

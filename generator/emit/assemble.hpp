@@ -4,6 +4,7 @@
 // into templates/*.tpl.
 #pragma once
 
+#include <map>
 #include <string>
 
 #include "emit/emitter.hpp"
@@ -17,6 +18,14 @@ struct SolverTexts {
   std::string parts;  // every part function
   std::string kinematics, eliminateFree, accelerateFree, caba, pv;
   OpCount cabaOps, pvOps;  // per call of each entry point, everything it calls included
+  // What the solver holds (System::functions); the library's entry points
+  // (inverse_dynamics, ...: not the two solvers) with their operations per
+  // call, and the helper they share ("" when none needs it).
+  FunctionSet functions;
+  std::map<Function, std::string> library;
+  std::map<Function, OpCount> libraryOps;
+  std::string jointTransforms;
+  bool withKinematics = false, withJointTransforms = false;
 };
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,

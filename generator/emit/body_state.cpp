@@ -18,6 +18,8 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
   if (s.art) n = std::max(n, s.art->b.size());
   if (s.motion) n = std::max(n, s.motion->a.size());
   if (s.rows) n = std::max(n, s.rows->b.size());
+  if (s.forces) n = std::max(n, s.forces->a.size());
+  if (s.js) n = std::max({n, s.js->Ic.size(), s.js->FA.size()});
   for (std::size_t i = 0; i < n; ++i) {
     Kinematics::Body* kb = s.kin && i < s.kin->b.size() ? &s.kin->b[i] : nullptr;
     Articulated::Body* ab = s.art && i < s.art->b.size() ? &s.art->b[i] : nullptr;
@@ -40,12 +42,18 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
       for (auto& x : rb->KS) vec(x);
     }
     if (ab) f(ab->Dinv), vec(ab->Linv), vec(ab->u);
+    if (s.forces && i < s.forces->a.size()) v6(s.forces->a[i]), v6(s.forces->f[i]);
+    if (s.js && i < s.js->Ic.size()) sym(s.js->Ic[i]);
+    if (s.js && i < s.js->FA.size())
+      for (V6& x : s.js->FA[i]) v6(x);
   }
   if (s.kin)
     for (auto& x : s.kin->k) vec(x);
   if (s.motion) vec(s.motion->qdd);
   if (s.mult) vec(s.mult->lambda), vec(s.mult->dlambda);
   if (s.rows) vec(s.rows->yfree);
+  if (s.forces) vec(s.forces->tau);
+  if (s.js) sym(s.js->upper);
   if (s.del) {
     vec(s.del->Linv), vec(s.del->LSinv);
     sym(s.del->L), sym(s.del->LS);

@@ -80,6 +80,22 @@ struct DelassusFactor {
   std::vector<Expr> LSinv;
 };
 
+/// Inverse dynamics (pass_inverse_dynamics.cpp): per body its acceleration
+/// and the force it passes to its parent; the joint torques.
+struct Forces {
+  std::vector<V6> a, f;
+  std::vector<Expr> tau;
+};
+
+/// The joint-space matrices (pass_mass_matrix.cpp, pass_mass_matrix_inverse.cpp):
+/// per body the composite inertia (CRBA) or the 6 x nv columns of unit-torque
+/// forces, then accelerations (M^-1); the upper triangle of M or M^-1 (packed by rows).
+struct JointSpace {
+  std::vector<Sym> Ic;
+  std::vector<std::vector<V6>> FA;
+  Sym upper;
+};
+
 /// The pass outputs in scope in the function being written: what moves into a
 /// new part function at each boundary (null: not in scope). Visited body by
 /// body in a fixed order, which fixes the order of the atoms in the new
@@ -92,6 +108,8 @@ struct Live {
   ProxRows* rows = nullptr;
   Multipliers* mult = nullptr;
   DelassusFactor* del = nullptr;
+  Forces* forces = nullptr;
+  JointSpace* js = nullptr;
 };
 
 void forEachExpr(Live& live, const std::function<void(Expr&)>& f);

@@ -19,6 +19,9 @@ struct SolverInputs {
   std::string urdfName, urdfSha256;
   std::string layoutName, layoutSha256;
   std::string command;  // how to regenerate (without the output folder)
+  /// `--functions a,b|all` as given, overriding the layout's `functions:`
+  /// ("": the layout's); recorded in the command.
+  std::string functions;
 };
 
 struct SolverFiles {

@@ -102,7 +102,7 @@ void FunctionWriter::endPart() {
   const OpCount ops = part_->opCount();
   std::vector<std::string> params, args;
   std::vector<Expr> uses;
-  for (const char* p : {"q", "v", "tau"})
+  for (const char* p : {"q", "v", "tau", "qdd", "lambda"})  // qdd, lambda: inverse_dynamics's inputs
     if (needs(accessed, p)) {
       params.push_back(fmt::format("const Scalar* PROXGEN_RT_RESTRICT {}", p));
       args.push_back(p);

@@ -44,6 +44,14 @@ void checkSize(const Plan& plan, const std::string& urdf, const std::string& lay
 
 SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
                            SolverStats* stats) {
+  if (!in.functions.empty()) {
+    System selected = sys;
+    selected.functions = parseFunctionList(in.functions, "command line", "--functions");
+    std::string list = in.functions;
+    in.functions.clear();
+    in.command += " --functions " + list;
+    return generateSystem(selected, name, scalar, in, stats);
+  }
   const Plan plan = makePlan(sys, name, scalar);
   checkSize(plan, sys.model.sourcePath, sys.layoutPath);
   in.command = fmt::format("{} --out DIR --name {} --scalar {}", in.command, plan.name, scalarName(scalar));
@@ -51,7 +59,8 @@ SolverFiles generateSystem(const System& sys, const std::string& name, ScalarTyp
 }
 
 SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, System* system) {
-  const System sys = loadSystem(options.urdf, options.layout);
+  System sys = loadSystem(options.urdf, options.layout);
+  if (!options.functions.empty()) sys.functions = parseFunctionList(options.functions, "command line", "--functions");
   if (system) *system = sys;
   const std::string name = options.name.empty() ? fs::path(options.urdf).stem().string() : options.name;
   SolverInputs in;
@@ -60,6 +69,7 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, Sy
   in.urdfSha256 = sha256File(options.urdf);
   in.layoutSha256 = sha256File(options.layout);
   in.command = fmt::format("proxgen generate {} --layout {}", in.urdfName, in.layoutName);
+  in.functions = options.functions;
   return generateSystem(sys, name, options.scalar, in, stats);
 }
 

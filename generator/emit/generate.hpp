@@ -27,6 +27,7 @@ struct GenerateOptions {
   std::string urdf, layout;  // input files
   std::string name;          // namespace and file stem; "" = the URDF's file stem
   ScalarType scalar = ScalarType::Double;
+  std::string functions;     // --functions a,b|all ("" = the layout's functions:)
 };
 
 /// Loads the inputs and prints the solver in memory. Throws proxgen::Error
@@ -37,7 +38,8 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = n
 /// The pipeline after loading: the plan of `sys` under `name` (sanitised) and
 /// the emitted files. `in` describes the inputs for the files' banner; its
 /// `command` is the command's start ("proxgen generate arm.urdf --layout
-/// layout.yaml"), completed here with --out, --name and --scalar.
+/// layout.yaml"), completed here with --out, --name, --scalar and (if given)
+/// --functions, which replaces sys.functions (an unknown name is an error).
 SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
                            SolverStats* stats = nullptr);
 

@@ -22,7 +22,9 @@ inline constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"
     kUu{"u", "tau - S^T pA"}, kA{"a", "acceleration (gravity-shifted)"}, kDP{"dp", "reduced-sweep force"},
     kKA{"KA", "constraint force directions of the subtree rows (6 x m, one unused column)"},
     kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (6 x m, one unused column)"},
-    kK{"k", "constraint right-hand side"};
+    kK{"k", "constraint right-hand side"}, kF{"f", "spatial force (inverse dynamics)"},
+    kIc{"Ic", "composite inertia (upper triangle)"},
+    kFA{"FA", "unit-torque forces, then accelerations, one column per dof (M^-1)"};
 
 class Members {
  public:

@@ -16,6 +16,8 @@ namespace proxgen::emit {
 // ---- pass_kinematics.cpp: joint transforms, v, c, pA = v x* I v, R^T g,
 // world placements, the constraint right-hand sides k.
 Kinematics emitKinematics(Emit& e);
+/// One body's joint placement X_J(q), its motion subspace and tree placement.
+void jointTransform(Emit& e, int i, Kinematics::Body& b);
 
 // ---- pass_aba_eliminate.cpp: the articulated-body elimination.
 /// The elimination's starting point: every body's own inertia and bias.
@@ -67,5 +69,20 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
 DelassusFactor factorDelassus(Emit& e, const ProxRows& rows);
 /// (G + I/mu)^-1 rhs through the factor (rows in tree order).
 std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vector<Expr>& rhs);
+
+// ---- pass_inverse_dynamics.cpp: RNEA with the constraint forces J^T lambda.
+/// The inverse_dynamics host (nonlinear_effects: qdd = 0, no lambda), from its
+/// copy of the state after kinematics, whose values live in `afterKinematics`.
+std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects);
+
+// ---- pass_mass_matrix.cpp: the joint transforms alone, and CRBA.
+/// joint_transforms(q, w): X_J and the bodies' own inertias, for the functions without v.
+Kinematics emitJointTransforms(Emit& e);
+/// out[r * nv + c] = the symmetric matrix whose upper triangle is `upper` (in the host).
+void copyOutSymmetric(Emit& e, const Sym& upper, const char* out);
+std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
+
+// ---- pass_mass_matrix_inverse.cpp: M^-1 in O(n^2) (ABA on the unit torques).
+std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
 
 }  // namespace proxgen::emit

@@ -122,11 +122,30 @@ class Reader {
     return c;
   }
 
+  // `functions: [a, b]`: what a generated solver holds (model/functions.hpp);
+  // each name is checked at its own line.
+  FunctionSet functions(const YAML::Node& list) const {
+    if (!list.IsSequence()) failAt(list, "functions", "expected a list of function names (valid: " + functionNameList() + ")");
+    if (list.size() == 0) failAt(list, "functions", "is empty (valid: " + functionNameList() + ")");
+    FunctionSet set = FunctionSet::none();
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const std::string element = fmt::format("functions[{}]", k);
+      const std::string name = string(list[k], element);
+      Function f;
+      if (!parseFunctionName(name, f))
+        failAt(list[k], element, fmt::format("unknown function {} (valid: {})", quoted(name), functionNameList()));
+      if (set.has(f)) failAt(list[k], element, fmt::format("function {} is listed twice", quoted(name)));
+      set.add(f);
+    }
+    return set;
+  }
+
   Layout layout(const YAML::Node& root) const {
     Layout L;
     L.sourcePath = path_;
-    if (!root.IsMap()) failAt(root, "", "expected a mapping with keys base, gravity, mu, iterations, constraints");
-    onlyKeys(root, "", {"base", "gravity", "mu", "iterations", "constraints"});
+    if (!root.IsMap())
+      failAt(root, "", "expected a mapping with keys base, gravity, mu, iterations, functions, constraints");
+    onlyKeys(root, "", {"base", "gravity", "mu", "iterations", "functions", "constraints"});
     if (root["base"]) {
       const std::string base = string(root["base"], "base");
       if (base != "floating" && base != "fixed" && base != "planar")
@@ -153,6 +172,7 @@ class Reader {
       if (L.iterations < 0 || L.iterations > kMaxIterations)
         failAt(root["iterations"], "iterations", fmt::format("{} is outside [0, {}]", L.iterations, kMaxIterations));
     }
+    if (root["functions"]) L.functions = functions(root["functions"]);
     if (root["constraints"]) {
       const YAML::Node list = root["constraints"];
       if (list.IsNull()) return L;

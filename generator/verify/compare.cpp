@@ -37,6 +37,9 @@
 
 #include "algorithms/constrained_aba.hpp"
 #include "algorithms/crba.hpp"
+#include "algorithms/inverse_dynamics.hpp"
+#include "algorithms/mass_matrix_inverse.hpp"
+#include "algorithms/rnea.hpp"
 #include "algorithms/jacobians.hpp"
 #include "algorithms/prox_pv.hpp"
 
@@ -109,6 +112,78 @@ Comparison compareWithGeneric(const System& sys, Data& d, const Conditioning& c,
   proxPv(sys, d, s.q, s.v, s.tau, b.mu, K);
   out.item[2] = {"prox_pv qdd", relErr(gen.pvQdd, d.qdd), b.dual, allFinite(gen.pvQdd) && allFinite(d.qdd)};
   out.item[3] = {"prox_pv lambda", relErr(gen.pvLambda, d.lambda), b.dual, allFinite(gen.pvLambda) && allFinite(d.lambda)};
+  return out;
+}
+
+// The dynamics library. inverse_dynamics, nonlinear_effects and mass_matrix
+// are recursions without a solve (RNEA, CRBA): sums of products, whose forward
+// error is c n u times the size of the terms summed, not of their result. For
+// the torques that size is |M| |qdd| + |J|^T |lambda| + |h| + |g| (g = h at
+// v = 0: the gravity that h's velocity terms may cancel); for M it is max |M|
+// (every entry of a positive definite M is at most its largest diagonal entry,
+// and the composite inertias summed are all positive semi-definite: no
+// cancellation beyond that size). mass_matrix_inverse solves (the ABA on the
+// unit torques): c n u kappa(M), relative to max(1, max |M^-1|).
+
+double relErr(const MatX& a, const MatX& b) {
+  if (a.size() == 0) return 0.0;
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+double torqueBound(const System& sys, Data& d, const Conditioning& c, const State& s, const VecX& qdd, const VecX& lambda,
+                   const VecX& tau) {
+  VecX size = c.M.cwiseAbs() * qdd.cwiseAbs();
+  if (sys.nc > 0) size += c.J.cwiseAbs().transpose() * lambda.cwiseAbs();
+  const double h = nonLinearEffects(sys, d, s.q, s.v).cwiseAbs().maxCoeff();
+  const double g = nonLinearEffects(sys, d, s.q, d.zeroV).cwiseAbs().maxCoeff();
+  const double terms = (size.size() ? size.maxCoeff() : 0.0) + h + g + (tau.size() ? tau.cwiseAbs().maxCoeff() : 0.0);
+  return std::max(c.floor, c.safety * c.eps * terms / maxAbs1(tau));
+}
+
+namespace {
+
+bool allFinite(const MatX& x) { return x.size() == 0 || x.allFinite(); }
+
+struct LibraryCheck {
+  const char* what;
+  bool (*held)(const LibraryAnswer&);
+  Compared (*compare)(const System&, Data&, const Conditioning&, const State&, const LibraryAnswer&);
+};
+
+const LibraryCheck kLibrary[] = {
+    {"inverse_dynamics", [](const LibraryAnswer& g) { return g.tau.size() > 0; },
+     [](const System& sys, Data& d, const Conditioning& c, const State& s, const LibraryAnswer& g) {
+       const VecX tau = inverseDynamics(sys, d, s.q, s.v, g.qdd, sys.nc > 0 ? &g.lambda : nullptr);
+       return Compared{"inverse_dynamics tau", relErr(g.tau, tau), torqueBound(sys, d, c, s, g.qdd, g.lambda, VecX::Zero(tau.size())),
+                       allFinite(g.tau) && allFinite(tau)};
+     }},
+    {"nonlinear_effects", [](const LibraryAnswer& g) { return g.h.size() > 0; },
+     [](const System& sys, Data& d, const Conditioning& c, const State& s, const LibraryAnswer& g) {
+       const VecX h = nonLinearEffects(sys, d, s.q, s.v);
+       const VecX none = VecX::Zero(sys.nc);
+       return Compared{"nonlinear_effects h", relErr(g.h, h), torqueBound(sys, d, c, s, d.zeroV, none, VecX::Zero(h.size())),
+                       allFinite(g.h) && allFinite(h)};
+     }},
+    {"mass_matrix", [](const LibraryAnswer& g) { return g.M.size() > 0; },
+     [](const System&, Data&, const Conditioning& c, const State&, const LibraryAnswer& g) {  // c.M: crba at s
+       return Compared{"mass_matrix M", relErr(g.M, c.M), std::max(c.floor, c.safety * c.eps),
+                       allFinite(g.M) && allFinite(c.M)};
+     }},
+    {"mass_matrix_inverse", [](const LibraryAnswer& g) { return g.Minv.size() > 0; },
+     [](const System& sys, Data& d, const Conditioning& c, const State& s, const LibraryAnswer& g) {
+       const MatX& Minv = massMatrixInverse(sys, d, s.q);
+       return Compared{"mass_matrix_inverse", relErr(g.Minv, Minv), std::max(c.floor, c.safety * c.eps * c.kappaM),
+                       allFinite(g.Minv) && allFinite(Minv)};
+     }},
+};
+
+}  // namespace
+
+std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                                const LibraryAnswer& gen) {
+  std::vector<Compared> out;
+  for (const LibraryCheck& check : kLibrary)
+    if (check.held(gen)) out.push_back(check.compare(sys, d, c, s, gen));
   return out;
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "algorithms/data.hpp"
 #include "model/model.hpp"
@@ -64,5 +65,32 @@ struct Comparison {
 };
 Comparison compareWithGeneric(const System& sys, Data& d, const Conditioning& c, const Bounds& b, const State& s,
                               int K, const GeneratedAnswer& gen);
+
+// ---- The dynamics library (docs/dynamics.md): each generated function the
+// solver holds against its generic twin, one entry per function in
+// compare.cpp's table (kLibrary), so a new function is a few lines there.
+
+/// One state's inputs beyond (q, v) and what the generated functions returned;
+/// an empty result means the solver does not hold that function.
+struct LibraryAnswer {
+  VecX qdd, lambda;  // inverse_dynamics' inputs (lambda: nc values)
+  VecX tau;          // inverse_dynamics(q, v, qdd, lambda)
+  VecX h;            // nonlinear_effects(q, v)
+  MatX M, Minv;      // mass_matrix(q), mass_matrix_inverse(q)
+};
+
+/// max |gen - generic| / max(1, max |generic|) over the entries of a matrix.
+double relErr(const MatX& a, const MatX& b);
+
+/// The bound for torques tau = M qdd + h + J^T lambda computed by a recursion
+/// without a solve (RNEA, or the residual of a backward-stable solve): c n u
+/// times the size of the terms summed, |M| |qdd| + |J|^T |lambda| + |h| + |g| (+ |tau|),
+/// relative to max(1, |tau|), floor included.
+double torqueBound(const System& sys, Data& d, const Conditioning& c, const State& s, const VecX& qdd,
+                   const VecX& lambda, const VecX& tau);
+
+/// Every function `gen` holds against its generic twin at state s (q, v).
+std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                                const LibraryAnswer& gen);
 
 }  // namespace proxgen::verify

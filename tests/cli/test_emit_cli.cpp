@@ -132,6 +132,51 @@ TEST_F(GenerateCommand, BadOptionsLeaveNothing) {
   EXPECT_NE(r.output.find("not a folder"), std::string::npos) << r.output;
 }
 
+// --functions with a name that is no function: one line naming the valid ones, nothing written.
+TEST_F(GenerateCommand, AnUnknownFunctionIsOneLineNamingTheValidOnes) {
+  const fs::path out = tmp_ / "out";
+  const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --functions rnea");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output.rfind("proxgen: error: ", 0), 0u) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+  for (const char* part : {"--functions", "'rnea'", "inverse_dynamics", "mass_matrix"})
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << " not in: " << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // The same from a layout: its file, line and element.
+  const fs::path layout = tmp_ / "functions.yaml";
+  { std::FILE* f = std::fopen(layout.c_str(), "w"); std::fputs("functions: [mass_matrix, rnea]\n", f); std::fclose(f); }
+  const Outcome l = run(arm_ + "/arm.urdf --layout " + layout.string() + " --out " + out.string());
+  EXPECT_EQ(l.code, 1) << l.output;
+  for (const char* part : {"functions.yaml:1", "functions[1]", "'rnea'", "constrained_aba"})
+    EXPECT_NE(l.output.find(part), std::string::npos) << part << " not in: " << l.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// The Python module binds the two solvers: without them --python is refused, nothing written.
+TEST_F(GenerateCommand, PythonNeedsTheTwoSolvers) {
+  const fs::path out = tmp_ / "out";
+  const Outcome r =
+      run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --python --functions mass_matrix");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("--python binds constrained_aba and prox_pv"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// verify covers the functions it is asked for: here two joint-space ones and
+// no solver (one line each, no solver lines), and fails them below round-off.
+TEST_F(GenerateCommand, VerifyCoversTheFunctionsAskedFor) {
+  const std::string inputs = arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --samples 3 --functions mass_matrix,inverse_dynamics";
+  const Outcome ok = runCommand("verify", inputs);
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "  ok\n"), 2) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "mass_matrix M "), 1) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "inverse_dynamics tau "), 1) << ok.output;
+  EXPECT_EQ(countOf(ok.output, "constrained_aba"), 0) << ok.output;
+  const Outcome strict = runCommand("verify", inputs + " --tolerance 1e-300");
+  EXPECT_EQ(strict.code, 1) << strict.output;
+  EXPECT_GE(countOf(strict.output, "  FAIL\n"), 1) << strict.output;  // an exact 0 error would pass
+}
+
 // `proxgen verify` generates, compiles (with the compiler proxgen was built
 // with: a few seconds for the arm) and compares with the generic solvers.
 TEST_F(GenerateCommand, VerifyPassesOnTheArmAndFailsBelowRoundoff) {

@@ -237,10 +237,11 @@ Poly banner(const std::string& text, const std::string& fn, long* totalAtDefault
   return p;
 }
 
-void expectCountsMatch(const SolverFiles& f, const std::string& what, int K) {
+void expectCountsMatch(const SolverFiles& f, const std::string& what, int K,
+                       const std::vector<std::string>& entries = {"constrained_aba", "prox_pv"}) {
   Source src = functions(f.source);
-  ASSERT_TRUE(src.bodies.count("constrained_aba") && src.bodies.count("prox_pv")) << what;
-  for (const char* fn : {"constrained_aba", "prox_pv"}) {
+  for (const std::string& fn : entries) ASSERT_TRUE(src.bodies.count(fn)) << what << " " << fn;
+  for (const std::string& fn : entries) {
     long total = -1;
     const Poly b = banner(f.source, fn, &total);
     const Poly c = count(src, fn);
@@ -291,6 +292,17 @@ TEST(OperationCount, WithGainsTheLogarithmCounts) {
   const SolverFiles f = generateFiles(example("arm", test::sourceDir() + "/tests/generated/layouts/arm_gains.yaml"));
   expectCountsMatch(f, "arm_gains", 2);  // the layout sets iterations: 2
   EXPECT_NE(f.source.find("log6 1\n"), std::string::npos) << "the arm's one weld with kp: one log6 per call";
+}
+
+TEST(OperationCount, TheJointSpaceFunctionsCountWhatTheyCompute) {
+  // inverse_dynamics (with its nullptr select), nonlinear_effects, mass_matrix, mass_matrix_inverse,
+  // each with the helper it calls (kinematics, joint_transforms).
+  const std::vector<std::string> entries = {"inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"};
+  for (const char* robot : {"arm", "quadruped"}) {
+    GenerateOptions g = example(robot);
+    g.functions = "constrained_aba,prox_pv,inverse_dynamics,nonlinear_effects,mass_matrix,mass_matrix_inverse";
+    expectCountsMatch(generateFiles(g), robot, 3, entries);
+  }
 }
 
 TEST(OperationCount, SharedCases) {

@@ -5,7 +5,8 @@
 //   PROXGEN_SOLVER_HEADER     "name.hpp"
 //   PROXGEN_SOLVER_NAMESPACE  name
 //   PROXGEN_SOLVER_CASE       "case" of the shared cases.yaml, or
-//   PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT   the inputs it was generated from.
+//   PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT   the inputs it was generated from,
+//   PROXGEN_SOLVER_HAS_<FUNCTION>=1  for each function it holds (CONSTRAINED_ABA, MASS_MATRIX, ...).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -27,6 +28,7 @@ using proxgen::test::SolverUnderTest;
 #define PROXGEN_SOLVER_INPUTS nullptr, PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT
 #endif
 
+#if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
 // The generated solver on one state, results in double.
 void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const VecX& vIn, const VecX& tauIn, double mu,
                   int K, VecX& qdd, VecX& lambda) {
@@ -47,6 +49,31 @@ void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const V
   for (int k = 0; k < gen::nv; ++k) qdd[k] = double(a[std::size_t(k)]);
   for (int k = 0; k < gen::nc; ++k) lambda[k] = double(l[std::size_t(k)]);
 }
+#endif
+
+[[maybe_unused]] std::vector<gen::Scalar> toScalar(const VecX& x) {
+  std::vector<gen::Scalar> out(std::size_t(std::max<Eigen::Index>(x.size(), 1)));
+  for (int k = 0; k < x.size(); ++k) out[std::size_t(k)] = gen::Scalar(x[k]);
+  return out;
+}
+
+[[maybe_unused]] VecX toDouble(const std::vector<gen::Scalar>& x, int n) {
+  VecX out(n);
+  for (int k = 0; k < n; ++k) out[k] = double(x[std::size_t(k)]);
+  return out;
+}
+
+[[maybe_unused]] proxgen::MatX squareToDouble(const std::vector<gen::Scalar>& x) {
+  proxgen::MatX out(gen::nv, gen::nv);
+  for (int r = 0; r < gen::nv; ++r)
+    for (int c = 0; c < gen::nv; ++c) out(r, c) = double(x[std::size_t(r * gen::nv + c)]);  // row-major
+  return out;
+}
+
+[[maybe_unused]] gen::Workspace& workspace() {
+  static gen::Workspace w;  // tens of kB for the big robots: not on the stack
+  return w;
+}
 
 class Generated : public ::testing::Test {
  protected:
@@ -65,6 +92,7 @@ TEST_F(Generated, SettingsDefaultsAreTheLayouts) {
   EXPECT_EQ(s.iterations, sys_.iterations);
 }
 
+#if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
 TEST_F(Generated, MatchesTheGenericSolvers) {
   SolverUnderTest solver;
   solver.nq = gen::nq;
@@ -74,5 +102,65 @@ TEST_F(Generated, MatchesTheGenericSolvers) {
   solver.run = runGenerated;
   proxgen::test::expectMatchesTheGenericSolvers(solver, sys_);
 }
+
+#endif
+
+#if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS || PROXGEN_SOLVER_HAS_NONLINEAR_EFFECTS || PROXGEN_SOLVER_HAS_MASS_MATRIX || \
+    PROXGEN_SOLVER_HAS_MASS_MATRIX_INVERSE
+TEST_F(Generated, JointSpaceFunctionsMatchTheGeneric) {
+  proxgen::test::LibraryUnderTest lib;
+  lib.isFloat = std::is_same_v<gen::Scalar, float>;
+#if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS
+  lib.inverseDynamics = [](const VecX& q, const VecX& v, const VecX& qdd, const VecX* lambda, VecX& tau) {
+    std::vector<gen::Scalar> out(gen::nv);
+    const std::vector<gen::Scalar> l = lambda ? toScalar(*lambda) : std::vector<gen::Scalar>();
+    gen::inverse_dynamics(toScalar(q).data(), toScalar(v).data(), toScalar(qdd).data(), lambda ? l.data() : nullptr,
+                          workspace(), out.data());
+    tau = toDouble(out, gen::nv);
+  };
+#endif
+#if PROXGEN_SOLVER_HAS_NONLINEAR_EFFECTS
+  lib.nonlinearEffects = [](const VecX& q, const VecX& v, VecX& h) {
+    std::vector<gen::Scalar> out(gen::nv);
+    gen::nonlinear_effects(toScalar(q).data(), toScalar(v).data(), workspace(), out.data());
+    h = toDouble(out, gen::nv);
+  };
+#endif
+#if PROXGEN_SOLVER_HAS_MASS_MATRIX
+  lib.massMatrix = [](const VecX& q, proxgen::MatX& M) {
+    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv));
+    gen::mass_matrix(toScalar(q).data(), workspace(), out.data());
+    M = squareToDouble(out);
+  };
+#endif
+#if PROXGEN_SOLVER_HAS_MASS_MATRIX_INVERSE
+  lib.massMatrixInverse = [](const VecX& q, proxgen::MatX& Minv) {
+    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv));
+    gen::mass_matrix_inverse(toScalar(q).data(), workspace(), out.data());
+    Minv = squareToDouble(out);
+  };
+#endif
+#if PROXGEN_SOLVER_HAS_PROX_PV
+  SolverUnderTest solver;
+  solver.nq = gen::nq;
+  solver.nv = gen::nv;
+  solver.nc = gen::nc;
+  solver.isFloat = lib.isFloat;
+  solver.run = [](SolverUnderTest::Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, VecX& qdd,
+                  VecX& lambda) {
+    std::vector<gen::Scalar> a(gen::nv), l(std::size_t(std::max(gen::nc, 1)));
+    gen::Settings settings;
+    settings.mu = gen::Scalar(mu);
+    settings.iterations = K;
+    gen::prox_pv(toScalar(q).data(), toScalar(v).data(), toScalar(tau).data(), settings, workspace(), a.data(), l.data());
+    qdd = toDouble(a, gen::nv);
+    lambda = toDouble(l, gen::nc);
+  };
+  proxgen::test::expectLibraryMatchesTheGeneric(lib, &solver, sys_);
+#else
+  proxgen::test::expectLibraryMatchesTheGeneric(lib, nullptr, sys_);
+#endif
+}
+#endif
 
 }  // namespace

@@ -24,6 +24,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -110,6 +112,75 @@ void expectMatchesTheGenericSolvers(const SolverUnderTest& gen, const System& sy
                 mus[m], worst[m][0].error, worst[m][0].ratio, worst[m][1].error, worst[m][1].ratio, worst[m][2].error,
                 worst[m][2].ratio, worst[m][3].error, worst[m][3].ratio);
   }
+}
+
+// The joint-space functions. Bounds: verify/compare.cpp (torqueBound and the
+// table there). The identities, on the generated functions alone:
+//   M Minv - I: |M| |dMinv| + |dM| |Minv|, c n u kappa(M) relative to 1;
+//   nonlinear_effects - inverse_dynamics(qdd = 0, nullptr): two RNEAs of the same
+//     terms, each within torqueBound at qdd = 0, lambda = 0 (twice that bound);
+//   inverse_dynamics(prox_pv's qdd, lambda) - tau: proxPV's qdd comes from a
+//     final ABA sweep on tau - J^T lambda, backward stable, so its residual
+//     M qdd + h + J^T lambda - tau is c n u times the size of the terms whatever
+//     the conditioning: torqueBound with |tau| among the terms, twice (the
+//     residual and this RNEA's own error). (constrainedABA's lambda = mu (J qdd - k)
+//     carries mu u |J|^2 |qdd| into the residual: not this identity's bound.)
+void expectLibraryMatchesTheGeneric(const LibraryUnderTest& lib, const SolverUnderTest* solver, const System& sys) {
+  const bool kFloat = lib.isFloat;
+  const Model& m = sys.model;
+  Data d(sys), dense(sys);
+  std::mt19937 rng(20261201);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const char* statesEnv = std::getenv("PROXGEN_HARNESS_STATES");
+  const int states = statesEnv ? std::max(1, std::atoi(statesEnv)) : 100;
+  std::map<std::string, Worst> worst;
+  const auto check = [&](const std::string& what, double err, double bound, bool finite, const std::string& where) {
+    EXPECT_TRUE(finite) << what << " not finite, " << where;
+    EXPECT_LE(err, bound) << what << ", " << where;
+    worst[what].add(err, bound);
+  };
+  const auto rounded = [&](VecX x) {
+    if (kFloat)
+      for (int k = 0; k < x.size(); ++k) x[k] = double(float(x[k]));
+    return x;
+  };
+  for (int n = 0; n < states; ++n) {
+    const std::string where = "state " + std::to_string(n);
+    const State s = verify::roundedToScalar(test::randomState(m, rng), kFloat);
+    const verify::Conditioning cond = verify::conditioningAt(sys, dense, s, kFloat);
+    verify::LibraryAnswer gen;
+    gen.qdd = VecX(m.nv);
+    gen.lambda = VecX(sys.nc);
+    for (int k = 0; k < m.nv; ++k) gen.qdd[k] = normal(rng);
+    for (int k = 0; k < sys.nc; ++k) gen.lambda[k] = 10.0 * normal(rng);
+    gen.qdd = rounded(gen.qdd);
+    gen.lambda = rounded(gen.lambda);
+    if (lib.inverseDynamics) lib.inverseDynamics(s.q, s.v, gen.qdd, &gen.lambda, gen.tau);
+    if (lib.nonlinearEffects) lib.nonlinearEffects(s.q, s.v, gen.h);
+    if (lib.massMatrix) lib.massMatrix(s.q, gen.M);
+    if (lib.massMatrixInverse) lib.massMatrixInverse(s.q, gen.Minv);
+    for (const verify::Compared& c : verify::compareLibraryWithGeneric(sys, d, cond, s, gen))
+      check(c.what, c.error, c.bound, c.finite, where);
+    const VecX none = VecX::Zero(sys.nc);
+    if (lib.massMatrix && lib.massMatrixInverse)
+      check("M Minv = I", verify::relErr(MatX(gen.M * gen.Minv), MatX::Identity(m.nv, m.nv)),
+            std::max(cond.floor, cond.safety * cond.eps * cond.kappaM), true, where);
+    if (lib.inverseDynamics && lib.nonlinearEffects) {
+      VecX tau0;
+      lib.inverseDynamics(s.q, s.v, d.zeroV, nullptr, tau0);
+      check("nonlinear_effects = inverse_dynamics(0, nullptr)", verify::relErr(gen.h, tau0),
+            2 * verify::torqueBound(sys, d, cond, s, d.zeroV, none, VecX::Zero(m.nv)), true, where);
+    }
+    if (lib.inverseDynamics && solver) {
+      VecX qdd, lambda, tau;
+      solver->run(SolverUnderTest::kProxPv, s.q, s.v, s.tau, sys.mu, 100, qdd, lambda);
+      lib.inverseDynamics(s.q, s.v, qdd, &lambda, tau);
+      check("inverse_dynamics(prox_pv's qdd, lambda) = tau", verify::relErr(tau, s.tau),
+            2 * verify::torqueBound(sys, d, cond, s, qdd, lambda, s.tau), tau.allFinite(), where);
+    }
+  }
+  EXPECT_FALSE(worst.empty()) << "the solver holds none of the joint-space functions";
+  for (const auto& [what, w] : worst) std::printf("%s: largest relErr %.1e (%.2f of the bound)\n", what.c_str(), w.error, w.ratio);
 }
 
 }  // namespace proxgen::test

@@ -30,4 +30,19 @@ System loadSolverSystem(const char* caseName, const char* urdf, const char* layo
 /// bounds argued in harness_lib.cpp.
 void expectMatchesTheGenericSolvers(const SolverUnderTest& solver, const System& sys);
 
+/// The joint-space functions of one generated solver (empty: not held), in double.
+struct LibraryUnderTest {
+  bool isFloat = false;
+  std::function<void(const VecX& q, const VecX& v, const VecX& qdd, const VecX* lambda, VecX& tau)> inverseDynamics;
+  std::function<void(const VecX& q, const VecX& v, VecX& h)> nonlinearEffects;
+  std::function<void(const VecX& q, MatX& M)> massMatrix, massMatrixInverse;
+};
+
+/// Random states (and random qdd, lambda): each function `lib` holds against its
+/// generic twin (verify/compare.cpp's bounds), and the identities M Minv = I,
+/// nonlinear_effects = inverse_dynamics(qdd = 0, nullptr) and, with `solver`
+/// holding prox_pv (null: skipped), inverse_dynamics(q, v, qdd, lambda) = tau
+/// at its answer (q, v, tau) -> (qdd, lambda).
+void expectLibraryMatchesTheGeneric(const LibraryUnderTest& lib, const SolverUnderTest* solver, const System& sys);
+
 }  // namespace proxgen::test

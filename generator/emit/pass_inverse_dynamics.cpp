@@ -1,0 +1,103 @@
+// Inverse dynamics (RNEA) with the constraint forces, root first then leaves
+// first: a_i = X_i a_p + S qdd_i + c_i (a_0 = -g), f_i = I_i a_i + v_i x* I_i v_i
+// (+ K_c^T lambda_c for each constraint c on body i: its rows applied as a
+// wrench at its frame, [linear; angular] for a weld, linear for a point, the
+// rows the solvers use), tau_i = S^T f_i, f_p += X_i^T f_i. So
+// tau = M qdd + h + J^T lambda (the constraint force on the robot is -J^T lambda).
+// The constraint forces enter the same backward sweep as the inertial ones
+// (the generic code adds them in a second one): the sum is the same, in
+// another order. The generic counterpart: algorithms/inverse_dynamics.cpp and
+// algorithms/rnea.cpp (docs/dynamics.md).
+#include <fmt/format.h>
+
+#include "emit/passes.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
+std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
+
+// Fills `out` (in scope: the caller's Live holds it).
+void inverseDynamics(Emit& e, const Kinematics& kin, bool withQdd, bool withLambda, Forces& out) {
+  const Plan& plan = e.plan;
+  const int N = int(plan.bodies.size());
+  e.fn.beginPass("forward", std::string("forward: a = X a_parent + ") + (withQdd ? "S qdd + " : "") + "c, f = I a + v x* I v" +
+                                (withLambda ? " + K^T lambda" : ""));
+  for (int i = 1; i < N; ++i) {
+    e.fn.boundary(i);
+    e.openBody(i, "forward");
+    CodeBuilder& cb = e.cb();
+    const Kinematics::Body& kb = kin.b[std::size_t(i)];
+    const BodyPlan& p = e.bp(i);
+    V6 a = add(e.motionToChild(kb, p.parent == 0 ? e.rootAcceleration() : out.a[std::size_t(p.parent)]), kb.c);
+    if (withQdd)
+      for (int d = 0; d < p.nv; ++d) a = add(a, scale(cb, cb.input(qddIn(p.idx_v + d)), kb.S[std::size_t(d)]));
+    flatten(cb, a, "t");  // used in I a and by the children
+    if (!p.children.empty())
+      for (int k = 0; k < 6; ++k) out.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
+    V6 f = add(mul(cb, kb.IA, a), kb.pA);
+    if (withLambda)
+      for (int k : p.constraints) {
+        const Constraint& c = e.sys.constraints[std::size_t(k)];
+        const Mat6 X = c.placement.motionMatrixInv();  // rows K_c: body motion -> constraint frame
+        for (int r = 0; r < 6; ++r)
+          for (int j = 0; j < c.rows(); ++j)
+            if (X(j, r) != 0) f[std::size_t(r)] += X(j, r) * cb.input(lambdaIn(c.row + j));
+      }
+    for (int k = 0; k < 6; ++k) out.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
+    cb.close();
+  }
+  e.fn.beginPass("backward", "backward: tau = S^T f, f_parent += X^T f");
+  for (int i = N - 1; i >= 1; --i) {
+    e.fn.boundary(i);
+    e.openBody(i, "backward");
+    CodeBuilder& cb = e.cb();
+    const Kinematics::Body& kb = kin.b[std::size_t(i)];
+    const BodyPlan& p = e.bp(i);
+    const V6& f = out.f[std::size_t(i)];
+    for (int d = 0; d < p.nv; ++d)
+      out.tau[std::size_t(p.idx_v + d)] = e.put(e.member("tau_out", plan.nv, p.idx_v + d, "joint torques (inverse dynamics)"),
+                                                dot(cb, kb.S[std::size_t(d)], f));
+    if (p.parent > 0) {
+      const V6 dp = e.forceToParent(kb, f);
+      V6& par = out.f[std::size_t(p.parent)];
+      for (int k = 0; k < 6; ++k)
+        if (!dp[std::size_t(k)].isZero())
+          par[std::size_t(k)] = e.putQ(kF, p.parent, 6, k, par[std::size_t(k)] + dp[std::size_t(k)]);
+    }
+    cb.close();
+  }
+}
+
+}  // namespace
+
+std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects) {
+  const Plan& plan = e.plan;
+  const bool withLambda = !nonlinearEffects && plan.nc > 0;
+  const int N = int(plan.bodies.size());
+  Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
+                std::vector<Expr>(std::size_t(plan.nv))};
+  e.fn.live() = Live{};
+  e.fn.live().kin = &kin;
+  e.fn.live().forces = &forces;
+  e.fn.beginHost(nonlinearEffects ? "nle" : "rnea", afterKinematics);
+  CodeBuilder& host = e.cb();
+  if (withLambda) {
+    // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
+    host.line(fmt::format("static constexpr Scalar kNoMultipliers[{}] = {{}};", plan.nc));
+    host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
+  }
+  host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
+  inverseDynamics(e, kin, !nonlinearEffects, withLambda, forces);
+  e.fn.endPart();
+  const char* out = nonlinearEffects ? "h" : "tau";
+  CodeBuilder& cb = e.cb();
+  for (int j = 0; j < plan.nv; ++j)
+    cb.line(fmt::format("{}[{}] = {};", out, j, cb.print(forces.tau[std::size_t(j)])), {forces.tau[std::size_t(j)]}, {out});
+  std::string text = nonlinearEffects ? e.fn.endHost({"q", "v", "w", "h"}) : e.fn.endHost({"q", "v", "qdd", "lambda", "w", "tau"});
+  e.fn.live() = Live{};
+  return text;
+}
+
+}  // namespace proxgen::emit
