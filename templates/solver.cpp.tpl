@@ -4,6 +4,11 @@ R"proxgen({banner}
 #include "proxgen/runtime.hpp"
 
 namespace {name} {{
+
+// This file was printed for the runtime of the same version (runtime.hpp).
+static_assert(proxgen_rt::version_major == version_major);
+static_assert(proxgen_rt::version_minor == version_minor);
+
 namespace {{
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
@@ -25,6 +30,10 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {{
 {pv}}}
+
+// The largest row of K a - k, stored by the last solve.
+Scalar residual(const Workspace& w) noexcept {{
+{residual}}}
 
 }}  // namespace {name}
 )proxgen"
