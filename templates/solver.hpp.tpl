@@ -46,7 +46,7 @@ struct Settings {{
   int iterations = {iterations};  // multiplier updates K (0: the motion under the forces of lambda0)
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
-  // of 0; the solvers do not read it after they return.
+  // of 0. It is read before lambda is written: it may be the lambda output.
   const Scalar* lambda0 = nullptr;
 }};
 

@@ -132,6 +132,29 @@ TEST_F(Generated, WarmStartMatchesTheGeneric) {
   proxgen::test::expectWarmStartMatchesTheGeneric(solverUnderTest(), sys_);
 }
 
+// The header promises lambda0 is read before lambda is written: the previous
+// step's lambda array can be both (README's controller loop). Same operations
+// on the same values: the same bits.
+TEST_F(Generated, WarmStartMayBeTheLambdaOutput) {
+  if (gen::nc == 0) GTEST_SKIP() << "no constraints";
+  std::vector<gen::Scalar> q(gen::nq, gen::Scalar(0.1)), v(gen::nv, gen::Scalar(0.2)), tau(gen::nv, gen::Scalar(0.3)),
+      qdd(gen::nv), l0(gen::nc), lOut(gen::nc), qddAlias(gen::nv), lAlias(gen::nc);
+  if (sys_.model.floatingBase) q[6] = gen::Scalar(1);  // w of a unit quaternion (0.1, 0.1, 0.1, 1) scaled: fine
+  for (int k = 0; k < gen::nc; ++k) l0[std::size_t(k)] = lAlias[std::size_t(k)] = gen::Scalar(0.5 + k);
+  static gen::Workspace w;
+  for (auto solve : {gen::constrained_aba, gen::prox_pv}) {
+    gen::Settings s;
+    s.lambda0 = l0.data();
+    solve(q.data(), v.data(), tau.data(), s, w, qdd.data(), lOut.data());
+    for (int k = 0; k < gen::nc; ++k) lAlias[std::size_t(k)] = l0[std::size_t(k)];
+    s.lambda0 = lAlias.data();
+    solve(q.data(), v.data(), tau.data(), s, w, qddAlias.data(), lAlias.data());
+    EXPECT_EQ(qddAlias, qdd);
+    EXPECT_EQ(lAlias, lOut);
+    EXPECT_NE(lOut, l0);  // the multipliers moved: the comparison can see a clobbered lambda0
+  }
+}
+
 TEST_F(Generated, ResidualIsTheConstraintResidual) {
   proxgen::test::expectResidualIsTheConstraintResidual(solverUnderTest(), sys_);
 }
