@@ -21,6 +21,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -211,16 +213,25 @@ void expectWarmStartMatchesTheGeneric(const SolverUnderTest& gen, const System& 
       // bias (constrainedABA) or starts the proximal solves from it (proxPV),
       // the same backward-stable steps the bounds are argued for. Without the
       // warm start in the generated code, lambda differs by O(|lambda0|) at K <= 3.
+      // The force of lambda0 adds round-off of its own size to qdd, c n u
+      // max(|M^-1 J^T| |lambda0|) (tests/numerics.hpp, multiplierRoundoff),
+      // which the conditioning bounds do not hold when lambda0 is large (the
+      // redundant rows of arm_gains make the converged lambda grow like K mu);
+      // constrainedABA's lambda = lambda0 + mu (K a - k) carries it times mu |J|.
+      const double warm =
+          cond.safety * cond.eps * ((cond.M.ldlt().solve(cond.J.transpose())).cwiseAbs() * lambda0.cwiseAbs()).maxCoeff();
+      const double Jinf = cond.J.cwiseAbs().rowwise().sum().maxCoeff();
       for (int K : {0, 1, 3}) {
         VecX qdd, lambda;
         gen.runFrom(SolverUnderTest::kConstrainedAba, s.q, s.v, s.tau, mu, K, &lambda0, qdd, lambda);
         constrainedAbaFrom(sys, d, s.q, s.v, s.tau, mu, K, &lambda0);
-        EXPECT_LE(verify::relErr(qdd, d.qdd), b.primal) << "constrained_aba qdd, K " << K << ", " << where;
-        EXPECT_LE(verify::relErr(lambda, d.lambda), verify::cabaLambdaBound(sys, cond, b, d.qdd, d.lambda))
+        EXPECT_LE(verify::relErr(qdd, d.qdd), b.primal + warm) << "constrained_aba qdd, K " << K << ", " << where;
+        EXPECT_LE(verify::relErr(lambda, d.lambda),
+                  verify::cabaLambdaBound(sys, cond, b, d.qdd, d.lambda) + mu * Jinf * warm / std::max(1.0, maxAbs(d.lambda)))
             << "constrained_aba lambda, K " << K << ", " << where;
         gen.runFrom(SolverUnderTest::kProxPv, s.q, s.v, s.tau, mu, K, &lambda0, qdd, lambda);
         proxPvFrom(sys, d, s.q, s.v, s.tau, mu, K, &lambda0);
-        EXPECT_LE(verify::relErr(qdd, d.qdd), b.dual) << "prox_pv qdd, K " << K << ", " << where;
+        EXPECT_LE(verify::relErr(qdd, d.qdd), b.dual + warm) << "prox_pv qdd, K " << K << ", " << where;
         EXPECT_LE(verify::relErr(lambda, d.lambda), b.dual) << "prox_pv lambda, K " << K << ", " << where;
         if (K == 0) {
           EXPECT_EQ(lambda, lambda0) << "K = 0 returns lambda0, " << where;
@@ -254,12 +265,12 @@ void expectWarmStartMatchesTheGeneric(const SolverUnderTest& gen, const System& 
 }
 
 void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const System& sys) {
-  Data d(sys);
+  Data d(sys), dense(sys);
   std::mt19937 rng(20261203);
   const double eps = gen.isFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;
   const double safety = 10.0 * (sys.model.nv + sys.nc);
   const std::vector<int> Ks = {0, 1, 3, 10};
-  int decreased = 0, pairs = 0;
+  int contracted = 0;
   double worst = 0;
   for (int n = 0; n < apiStates(); ++n) {
     const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
@@ -281,9 +292,21 @@ void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const Sys
       aStar.segment(c.row, c.rows()) = baumgarteTarget(c, oMc, vC);
     }
     const double Jinf = sys.nc ? J.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
+    // The smallest eigenvalue of the Delassus matrix G = J M^-1 J^T: from
+    // lambda = 0 the residual of iterate K is, in G's eigenbasis, y_j rho_j^K,
+    // rho_j = 1 / (1 + mu g_j) (docs/algorithms.md §4.3), so where
+    // sqrt(nc) rho_max^10 < 1/2 it must fall by half from K = 0 to K = 10
+    // (|r|_inf <= |r|_2 <= rho_max^K |y|_2 <= rho_max^K sqrt(nc) |y|_inf).
+    // Redundant or inconsistent rows (g_min = 0) keep a part of y: no claim.
+    double gMin = 0;
+    if (sys.nc > 0) {
+      const verify::Conditioning cond = verify::conditioningAt(sys, dense, s, gen.isFloat);
+      const MatX G = cond.J * cond.M.ldlt().solve(cond.J.transpose());
+      gMin = Eigen::SelfAdjointEigenSolver<MatX>(G, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
+    }
     for (double mu : {100.0, 1e4}) {
       for (int a = 0; a < 2; ++a) {
-        std::vector<double> res;
+        std::vector<double> res, tols;
         for (int K : Ks) {
           VecX qdd, lambda;
           const double r = gen.runFrom(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, nullptr, qdd, lambda);
@@ -298,26 +321,29 @@ void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const Sys
           EXPECT_NEAR(r, expected, tol) << "algorithm " << a << ", K " << K << ", mu " << mu << ", state " << n;
           worst = std::max(worst, std::fabs(r - expected) / tol);
           res.push_back(r);
+          tols.push_back(tol);
         }
         // Both algorithms are proximal-point iterations on the multipliers
         // (the residual of iterate k is (lambda_k - lambda_{k-1}) / mu), whose
         // successive steps never grow in the 2-norm; the inf-norm residual can
-        // grow by at most sqrt(nc) from one K to a later one (plus round-off).
+        // grow by at most sqrt(nc) from one K to a later one (plus the round-off
+        // of both, the tolerance above).
         for (std::size_t k = 1; k < res.size(); ++k) {
-          EXPECT_LE(res[k], std::sqrt(double(sys.nc)) * res[k - 1] + safety * eps * (1 + res[0]))
+          EXPECT_LE(res[k], std::sqrt(double(sys.nc)) * (res[k - 1] + tols[k - 1]) + tols[k])
               << "algorithm " << a << ", K " << Ks[k] << ", mu " << mu << ", state " << n;
-          ++pairs;
-          decreased += res[k] < res[k - 1];
+        }
+        const double rho = gMin > 0 ? 1.0 / (1.0 + mu * gMin) : 1.0;
+        if (std::sqrt(double(sys.nc)) * std::pow(rho, 10) < 0.5) {
+          ++contracted;
+          EXPECT_LE(res.back(), 0.5 * res[0] + tols.back() + tols[0])
+              << "algorithm " << a << ", mu " << mu << ", state " << n << ": K = 10 did not halve the residual of K = 0";
         }
       }
     }
   }
-  std::printf("residual: largest |residual(w) - ||J qdd + gamma - a*||_inf| / tolerance %.1e; decreased in %d of %d steps of K\n",
-              worst, decreased, pairs);
-  // K = 0 is the unconstrained motion (residual O(|g|)): the steps that shrink it must be the rule.
-  if (sys.nc > 0) {
-    EXPECT_GE(2 * decreased, pairs) << "the residual did not decrease with K";
-  }
+  std::printf("residual: largest |residual(w) - ||J qdd + gamma - a*||_inf| / tolerance %.1e; "
+              "K = 10 checked to halve it in %d (state, mu, algorithm) triples\n",
+              worst, contracted);
 }
 
 }  // namespace proxgen::test
