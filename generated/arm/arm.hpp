@@ -161,9 +161,10 @@ struct Workspace {
 
 // In: q[nq], v[nv], tau[nv] (none of them inside w). The quaternion of a free
 // flyer need not be unit: it is normalised as `proxgen eval` does (divided by
-// its largest magnitude, then by its norm), so q and q scaled by any positive
-// or negative factor give the same answer. A zero quaternion (eval refuses
-// it) or a non-finite one gives NaN in every output.
+// its largest magnitude, then by its norm), so the quaternion scaled by any
+// non-zero factor gives the same answer (bit for bit for a power of two or -1,
+// else to round-off). A zero quaternion (eval refuses it) or a non-finite one
+// gives NaN in every output.
 // Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.
 // Sign: the constraint force on the robot is -J^T lambda, so
 // M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library
