@@ -4,6 +4,11 @@ R"proxgen({banner}
 #include "proxgen/runtime.hpp"
 
 namespace {name} {{
+
+// This file was printed for the runtime of the same version (runtime.hpp).
+static_assert(proxgen_rt::version_major == version_major);
+static_assert(proxgen_rt::version_minor == version_minor);
+
 namespace {{
 
 // The parts the functions below call in order: each holds a few bodies' blocks.

@@ -4,16 +4,21 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1113 + 316 K (= 2061 at K = 3)
-//     add/sub 467 + 139 K, mul 604 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2147 + 72 K (= 2363 at K = 3)
-//     add/sub 875 + 26 K, mul 1190 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1130 + 316 K (= 2078 at K = 3)
+//     add/sub 482 + 139 K, mul 606 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
+//     add/sub 880 + 26 K, mul 1192 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 
 #include "arm.hpp"
 
 #include "proxgen/runtime.hpp"
 
 namespace arm {
+
+// This file was printed for the runtime of the same version (runtime.hpp).
+static_assert(proxgen_rt::version_major == version_major);
+static_assert(proxgen_rt::version_minor == version_minor);
+
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
@@ -173,18 +178,18 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RES
   {
     w.U_wrist_3_link[5] = 0.0003695625 + mu;
     w.Dinv_wrist_3_link = 1.0 / w.U_wrist_3_link[5];
-    w.u_wrist_3_link[0] = -w.pA_wrist_3_link[5] + tau[5];
+    w.u_wrist_3_link[0] = -w.pA_wrist_3_link[5] - w.lambda[5] + tau[5];
     const Scalar t0 = w.U_wrist_3_link[5]*w.Dinv_wrist_3_link;
     const Scalar Ia0 = 0.365 + mu;
     const Scalar Ia1 = 0.035930965 + 0.0996*mu;
     const Scalar Ia2 = -0.035930965 - 0.0996*mu;
     const Scalar Ia3 = 0.003770528042232001 + 1.00992016*mu;
-    const Scalar pa0 = w.pA_wrist_3_link[0] + w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
-    const Scalar pa1 = w.pA_wrist_3_link[1] + w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
-    const Scalar pa2 = w.pA_wrist_3_link[2] + w.g_wrist_2_link[1]*mu;
-    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
-    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
-    const Scalar pa5 = w.pA_wrist_3_link[5] + w.u_wrist_3_link[0]*t0;
+    const Scalar pa0 = w.pA_wrist_3_link[0] + w.lambda[0] + w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
+    const Scalar pa1 = w.pA_wrist_3_link[1] + w.lambda[1] + w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
+    const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu;
+    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
+    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
+    const Scalar pa5 = w.pA_wrist_3_link[5] + w.lambda[5] + w.u_wrist_3_link[0]*t0;
     const Scalar C20 = w.cq_wrist_3_link*w.cq_wrist_3_link - w.sq_wrist_3_link*w.sq_wrist_3_link;
     const Scalar t1 = 0.5*(Ia1 + Ia2);
     const Scalar t2 = 2.0*w.cq_wrist_3_link*w.sq_wrist_3_link;
@@ -668,21 +673,24 @@ PROXGEN_RT_NOINLINE void caba_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRIC
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
-    w.dlambda[0] = mu*t0;
-    w.lambda[0] = w.dlambda[0];
-    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
-    w.dlambda[1] = mu*t1;
-    w.lambda[1] = w.dlambda[1];
-    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t2;
-    w.lambda[2] = w.dlambda[2];
-    w.dlambda[3] = w.a_wrist_3_link[3]*mu;
-    w.lambda[3] = w.dlambda[3];
-    w.dlambda[4] = w.a_wrist_3_link[4]*mu;
-    w.lambda[4] = w.dlambda[4];
-    w.dlambda[5] = w.a_wrist_3_link[5]*mu;
-    w.lambda[5] = w.dlambda[5];
+    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.dlambda[0] = mu*w.residual[0];
+    w.lambda[0] = w.lambda[0] + w.dlambda[0];
+    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.dlambda[1] = mu*w.residual[1];
+    w.lambda[1] = w.lambda[1] + w.dlambda[1];
+    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*w.residual[2];
+    w.lambda[2] = w.lambda[2] + w.dlambda[2];
+    w.residual[3] = w.a_wrist_3_link[3];
+    w.dlambda[3] = mu*w.residual[3];
+    w.lambda[3] = w.lambda[3] + w.dlambda[3];
+    w.residual[4] = w.a_wrist_3_link[4];
+    w.dlambda[4] = mu*w.residual[4];
+    w.lambda[4] = w.lambda[4] + w.dlambda[4];
+    w.residual[5] = w.a_wrist_3_link[5];
+    w.dlambda[5] = mu*w.residual[5];
+    w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
 }
 
@@ -880,20 +888,23 @@ PROXGEN_RT_NOINLINE void caba_reforward_wrist_3_link(Workspace& PROXGEN_RT_RESTR
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
-    w.dlambda[0] = mu*t0;
+    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
-    w.dlambda[1] = mu*t1;
+    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.dlambda[2] = mu*t2;
+    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.dlambda[3] = w.a_wrist_3_link[3]*mu;
+    w.residual[3] = w.a_wrist_3_link[3];
+    w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.dlambda[4] = w.a_wrist_3_link[4]*mu;
+    w.residual[4] = w.a_wrist_3_link[4];
+    w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.dlambda[5] = w.a_wrist_3_link[5]*mu;
+    w.residual[5] = w.a_wrist_3_link[5];
+    w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
 }
@@ -1562,15 +1573,6 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_5(Scalar inv_mu, Workspace& PROXGEN_
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  w.lambda[0] = 0.0;
-  w.lambda[1] = 0.0;
-  w.lambda[2] = 0.0;
-  w.lambda[3] = 0.0;
-  w.lambda[4] = 0.0;
-  w.lambda[5] = 0.0;
-}
-
 PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
@@ -1691,6 +1693,18 @@ PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT 
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // residual rows K a - k (layout order)
+  {
+    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[3] = w.a_wrist_3_link[3];
+    w.residual[4] = w.a_wrist_3_link[4];
+    w.residual[5] = w.a_wrist_3_link[5];
+  }
+}
+
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
@@ -1707,6 +1721,14 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_wrist_3_link(tau, mu, w);
   caba_backward_wrist_2_link(tau, w);
@@ -1717,7 +1739,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   // ---- forward: accelerations of the support
   caba_forward_shoulder_link_to_wrist_2_link(w);
   caba_forward_wrist_3_link(w);
-  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  // ---- multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda
   caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
@@ -1762,8 +1784,14 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   // ---- G + I/mu = L L^T, G assembled from the carried rows
   pv_delassus_column_0_to_column_4(inv_mu, w);
   pv_delassus_column_5(inv_mu, w);
-  // ---- lambda = 0
-  pv_start(w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
@@ -1772,6 +1800,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   // ---- forward: accelerations, with the multipliers of the subtree rows
   pv_forward_shoulder_link_to_wrist_2_link(w);
   pv_forward_wrist_3_link(w);
+  // ---- the rows' residual K a - k of the final accelerations
+  pv_residual(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];
@@ -1784,6 +1814,11 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   lambda[3] = w.lambda[3];
   lambda[4] = w.lambda[4];
   lambda[5] = w.lambda[5];
+}
+
+// The largest row of K a - k, stored by the last solve.
+Scalar residual(const Workspace& w) noexcept {
+  return proxgen_rt::largest_magnitude_of<nc>(w.residual);
 }
 
 }  // namespace arm

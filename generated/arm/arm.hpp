@@ -4,16 +4,15 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1113 + 316 K (= 2061 at K = 3)
-//     add/sub 467 + 139 K, mul 604 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2147 + 72 K (= 2363 at K = 3)
-//     add/sub 875 + 26 K, mul 1190 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1130 + 316 K (= 2078 at K = 3)
+//     add/sub 482 + 139 K, mul 606 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
+//     add/sub 880 + 26 K, mul 1192 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
 // code. Conventions: q = [one value per joint], v and qdd in the joint order below,
-// lambda rows in layout order; the constraint force on the robot is -J^T lambda,
-// so M qdd + h = tau - J^T lambda. Needs only "proxgen/runtime.hpp".
+// lambda rows in layout order. Needs only "proxgen/runtime.hpp".
 //
 // Joint order (slots in q | v):
 //   q[0..0] v[0..0]  joint 'shoulder_pan_joint' (revolute about z), link 'shoulder_link'
@@ -32,13 +31,50 @@ namespace arm {
 
 using Scalar = double;
 inline constexpr int nq = 6, nv = 6, nc = 6;  // configuration, velocity, constraint rows
+inline constexpr int ncons = 1;  // constraints in the layout (each 3 or 6 rows)
 
+// The proxgen that printed this file; the source checks it against the
+// runtime's proxgen_rt::version_major/minor when it is compiled.
+inline constexpr const char* proxgen_version = "0.1.0";
+inline constexpr int version_major = 0, version_minor = 1;
+
+// Names and slots, so callers never count by hand. Joints in the order above
+// (joint_idx_q[k], joint_idx_v[k]: the first slot of joint k in q and v);
+// constraints in layout order (rows constraint_row[k] ..
+// constraint_row[k] + constraint_rows[k] - 1 of lambda). The strings are the
+// URDF's and the layout's names byte for byte; the identifiers in joint:: and
+// constraint:: are those names sanitised (docs/design.md, "Names in the
+// generated files"), the same ones the workspace members use.
+inline constexpr const char* joint_names[] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"};
+inline constexpr int joint_idx_q[] = {0, 1, 2, 3, 4, 5};
+inline constexpr int joint_idx_v[] = {0, 1, 2, 3, 4, 5};
+inline constexpr const char* constraint_names[] = {"tool"};
+inline constexpr int constraint_row[] = {0};
+inline constexpr int constraint_rows[] = {6};
+namespace joint {  // position in the joint list (joint_names)
+inline constexpr int shoulder_pan_joint = 0;
+inline constexpr int shoulder_lift_joint = 1;
+inline constexpr int elbow_joint = 2;
+inline constexpr int wrist_1_joint = 3;
+inline constexpr int wrist_2_joint = 4;
+inline constexpr int wrist_3_joint = 5;
+}  // namespace joint
+namespace constraint {  // position in the layout (constraint_names)
+inline constexpr int tool = 0;
+}  // namespace constraint
+
+// Set the fields by name (later versions add fields, e.g. a per-constraint
+// activity flag, before lambda0).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
-  int iterations = 3;  // multiplier updates K (0: the unconstrained motion)
+  int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
+  // Warm start: nc multipliers (layout order; e.g. the previous control step's
+  // lambda), or null for lambda = 0. The K updates start from lambda0 instead
+  // of 0. It is read before lambda is written: it may be the lambda output.
+  const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (4872 bytes): per-body quantities named
+// Everything one solve writes (4920 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar sq_shoulder_link;     // sin q, body 1
@@ -75,6 +111,7 @@ struct Workspace {
   Scalar pA_wrist_3_link[6];   // bias force, body 6
   Scalar g_wrist_3_link[3];    // gravity in body coordinates, body 6
   Scalar k_tool[6];            // constraint right-hand side, constraint 0
+  Scalar lambda[6];            // multipliers (layout order)
   Scalar U_wrist_3_link[6];    // IA S, body 6
   Scalar Dinv_wrist_3_link;    // 1 / (S^T IA S), body 6
   Scalar u_wrist_3_link[1];    // tau - S^T pA, body 6
@@ -100,8 +137,8 @@ struct Workspace {
   Scalar a_wrist_1_link[6];    // acceleration (gravity-shifted), body 4
   Scalar a_wrist_2_link[6];    // acceleration (gravity-shifted), body 5
   Scalar a_wrist_3_link[6];    // acceleration (gravity-shifted), body 6
+  Scalar residual[6];          // rows of J qdd + gamma - a* of the last solve (residual(w))
   Scalar dlambda[6];           // latest multiplier increment
-  Scalar lambda[6];            // multipliers (layout order)
   Scalar dp_wrist_2_link[6];   // reduced-sweep force, body 5
   Scalar dp_wrist_1_link[6];   // reduced-sweep force, body 4
   Scalar dp_forearm_link[6];   // reduced-sweep force, body 3
@@ -122,12 +159,30 @@ struct Workspace {
   Scalar L[21];                // Cholesky factor of G + I/mu (lower, packed)
 };
 
-// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).
-// K = s.iterations multiplier updates from lambda = 0; both algorithms give the
-// same iterates up to round-off.
+// In: q[nq], v[nv], tau[nv] (none of them inside w). The quaternion of a free
+// flyer need not be unit: it is normalised as `proxgen eval` does (divided by
+// its largest magnitude, then by its norm), so the quaternion scaled by any
+// non-zero factor gives the same answer (bit for bit for a power of two or -1,
+// else to round-off). A zero quaternion (eval refuses it) or a non-finite one
+// gives NaN in every output.
+// Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.
+// Sign: the constraint force on the robot is -J^T lambda, so
+// M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library
+// where it enters as + J^T f, is -lambda.
+// K = s.iterations proximal multiplier updates
+//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)
+// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
+// round-off. From a lambda0 that already solves the constraints the update
+// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept;
+
+// ||J qdd + gamma - a*||_inf of the last solve with w (qdd its output, a* the
+// layout's Baumgarte target, rows as lambda): how far the K-th iterate is from
+// satisfying the constraints, to choose K by accuracy. NaN if a row is not
+// finite; 0 without constraints.
+Scalar residual(const Workspace& w) noexcept;
 
 }  // namespace arm

@@ -4,31 +4,49 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8676 + 1720 K (= 13836 at K = 3)
-//     add/sub 3477 + 743 K, mul 4969 + 931 K, div 34, neg 160 + 46 K, sqrt 6, sincos 30, log6 0
-//   prox_pv: 16617 + 650 K (= 18567 at K = 3)
-//     add/sub 6637 + 285 K, mul 9565 + 365 K, div 53, neg 305, sqrt 27, sincos 30, log6 0
+//   constrained_aba: 8744 + 1720 K (= 13904 at K = 3)
+//     add/sub 3521 + 743 K, mul 4990 + 931 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16657 + 650 K (= 18607 at K = 3)
+//     add/sub 6655 + 285 K, mul 9583 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 
 #include "humanoid.hpp"
 
 #include "proxgen/runtime.hpp"
 
 namespace humanoid {
+
+// This file was printed for the runtime of the same version (runtime.hpp).
+static_assert(proxgen_rt::version_major == version_major);
+static_assert(proxgen_rt::version_minor == version_minor);
+
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
-    w.RJ_pelvis[0][0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
-    w.RJ_pelvis[0][1] = 2.0*(q[3]*q[4] - q[5]*q[6]);
-    w.RJ_pelvis[0][2] = 2.0*(q[3]*q[5] + q[4]*q[6]);
-    w.RJ_pelvis[1][0] = 2.0*(q[3]*q[4] + q[5]*q[6]);
-    w.RJ_pelvis[1][1] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[3]*q[3];
-    w.RJ_pelvis[1][2] = 2.0*(q[4]*q[5] - q[3]*q[6]);
-    w.RJ_pelvis[2][0] = 2.0*(q[3]*q[5] - q[4]*q[6]);
-    w.RJ_pelvis[2][1] = 2.0*(q[4]*q[5] + q[3]*q[6]);
-    w.RJ_pelvis[2][2] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[3]*q[3];
+    const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
+    const Scalar inv0 = 1.0 / qscale;
+    const Scalar qs0 = q[3]*inv0;
+    const Scalar qs1 = q[4]*inv0;
+    const Scalar qs2 = q[5]*inv0;
+    const Scalar qs3 = q[6]*inv0;
+    const Scalar t0 = qs0*qs0 + qs1*qs1 + qs2*qs2 + qs3*qs3;
+    const Scalar qn0 = std::sqrt(t0);
+    const Scalar inv1 = 1.0 / qn0;
+    const Scalar qu0 = qs0*inv1;
+    const Scalar qu1 = qs1*inv1;
+    const Scalar qu2 = qs2*inv1;
+    const Scalar qu3 = qs3*inv1;
+    w.RJ_pelvis[0][0] = 1.0 - 2.0*qu1*qu1 - 2.0*qu2*qu2;
+    w.RJ_pelvis[0][1] = 2.0*(qu0*qu1 - qu2*qu3);
+    w.RJ_pelvis[0][2] = 2.0*(qu0*qu2 + qu1*qu3);
+    w.RJ_pelvis[1][0] = 2.0*(qu0*qu1 + qu2*qu3);
+    w.RJ_pelvis[1][1] = 1.0 - 2.0*qu2*qu2 - 2.0*qu0*qu0;
+    w.RJ_pelvis[1][2] = 2.0*(qu1*qu2 - qu0*qu3);
+    w.RJ_pelvis[2][0] = 2.0*(qu0*qu2 - qu1*qu3);
+    w.RJ_pelvis[2][1] = 2.0*(qu1*qu2 + qu0*qu3);
+    w.RJ_pelvis[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
     const Scalar h0 = 7.94*v[0] + 0.71063*v[4];
     const Scalar h1 = 7.94*v[1] - 0.71063*v[3];
     const Scalar h2 = -0.71063*v[1] + 0.138038885*v[3];
@@ -46,17 +64,17 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos(q[7], w.sq_l_hip_yaw_link, w.cq_l_hip_yaw_link);
-    const Scalar t0 = v[0] - 0.0875*v[5];
-    const Scalar t1 = v[2] + 0.0875*v[3];
-    const Scalar t2 = 0.08718915247898762*v[1] + 0.9961917745544759*t0;
-    const Scalar t3 = 0.9961917745544759*v[1] - 0.08718915247898762*t0;
-    const Scalar t4 = 0.9961917745544759*v[3] + 0.08718915247898762*v[4];
-    const Scalar t5 = -0.08718915247898762*v[3] + 0.9961917745544759*v[4];
-    w.v_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t2 + w.sq_l_hip_yaw_link*t3;
-    w.v_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t2 + w.cq_l_hip_yaw_link*t3;
-    w.v_l_hip_yaw_link[2] = t1;
-    w.v_l_hip_yaw_link[3] = w.cq_l_hip_yaw_link*t4 + w.sq_l_hip_yaw_link*t5;
-    w.v_l_hip_yaw_link[4] = -w.sq_l_hip_yaw_link*t4 + w.cq_l_hip_yaw_link*t5;
+    const Scalar t1 = v[0] - 0.0875*v[5];
+    const Scalar t2 = v[2] + 0.0875*v[3];
+    const Scalar t3 = 0.08718915247898762*v[1] + 0.9961917745544759*t1;
+    const Scalar t4 = 0.9961917745544759*v[1] - 0.08718915247898762*t1;
+    const Scalar t5 = 0.9961917745544759*v[3] + 0.08718915247898762*v[4];
+    const Scalar t6 = -0.08718915247898762*v[3] + 0.9961917745544759*v[4];
+    w.v_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t3 + w.sq_l_hip_yaw_link*t4;
+    w.v_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t3 + w.cq_l_hip_yaw_link*t4;
+    w.v_l_hip_yaw_link[2] = t2;
+    w.v_l_hip_yaw_link[3] = w.cq_l_hip_yaw_link*t5 + w.sq_l_hip_yaw_link*t6;
+    w.v_l_hip_yaw_link[4] = -w.sq_l_hip_yaw_link*t5 + w.cq_l_hip_yaw_link*t6;
     w.v_l_hip_yaw_link[5] = v[5] + v[6];
     w.c_l_hip_yaw_link[0] = v[6]*w.v_l_hip_yaw_link[1];
     w.c_l_hip_yaw_link[1] = -v[6]*w.v_l_hip_yaw_link[0];
@@ -72,10 +90,10 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
     w.pA_l_hip_yaw_link[3] = 0.0005*w.v_l_hip_yaw_link[4]*w.v_l_hip_yaw_link[5] - w.v_l_hip_yaw_link[5]*h7 + 0.5*w.v_l_hip_yaw_link[1]*w.v_l_hip_yaw_link[2] - w.v_l_hip_yaw_link[2]*h5;
     w.pA_l_hip_yaw_link[4] = w.v_l_hip_yaw_link[5]*h6 - 0.0005*w.v_l_hip_yaw_link[3]*w.v_l_hip_yaw_link[5] + w.v_l_hip_yaw_link[2]*h4 - 0.5*w.v_l_hip_yaw_link[0]*w.v_l_hip_yaw_link[2];
     w.pA_l_hip_yaw_link[5] = w.v_l_hip_yaw_link[3]*h7 - w.v_l_hip_yaw_link[4]*h6 + w.v_l_hip_yaw_link[0]*h5 - w.v_l_hip_yaw_link[1]*h4;
-    const Scalar t6 = 0.9961917745544759*w.g_pelvis[0] + 0.08718915247898762*w.g_pelvis[1];
-    const Scalar t7 = -0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
-    w.g_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t6 + w.sq_l_hip_yaw_link*t7;
-    w.g_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t6 + w.cq_l_hip_yaw_link*t7;
+    const Scalar t7 = 0.9961917745544759*w.g_pelvis[0] + 0.08718915247898762*w.g_pelvis[1];
+    const Scalar t8 = -0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
+    w.g_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t7 + w.sq_l_hip_yaw_link*t8;
+    w.g_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t7 + w.cq_l_hip_yaw_link*t8;
   }
 }
 
@@ -1534,18 +1552,18 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
     w.U_r_hand[1] = 0.04016628 + 0.13*mu;
     w.U_r_hand[3] = 0.005164645770899999 + 0.016900000000000002*mu;
     w.Dinv_r_hand = 1.0 / w.U_r_hand[3];
-    w.u_r_hand[0] = -w.pA_r_hand[3] + 0.13*w.k_right_hand[0]*mu + tau[35];
+    w.u_r_hand[0] = -w.pA_r_hand[3] - 0.13*w.lambda[12] + 0.13*w.k_right_hand[0]*mu + tau[35];
     const Scalar t0 = w.U_r_hand[1]*w.Dinv_r_hand;
     const Scalar t1 = w.U_r_hand[3]*w.Dinv_r_hand;
     const Scalar Ia0 = 0.42 + mu;
     const Scalar Ia1 = -0.04016628 - 0.13*mu;
     const Scalar Ia2 = 0.42 + mu - w.U_r_hand[1]*t0;
     const Scalar Ia3 = 0.005164645770899999 + 0.016900000000000002*mu;
-    const Scalar pa0 = w.pA_r_hand[0] + w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia1;
-    const Scalar pa1 = w.pA_r_hand[1] - w.k_right_hand[0]*mu + w.u_r_hand[0]*t0 + w.c_r_hand[1]*Ia2;
-    const Scalar pa2 = w.pA_r_hand[2] - w.k_right_hand[2]*mu + w.c_r_hand[2]*Ia0;
-    const Scalar pa3 = w.pA_r_hand[3] - 0.13*w.k_right_hand[0]*mu + w.u_r_hand[0]*t1;
-    const Scalar pa4 = w.pA_r_hand[4] - 0.13*w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia3;
+    const Scalar pa0 = w.pA_r_hand[0] - w.lambda[13] + w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia1;
+    const Scalar pa1 = w.pA_r_hand[1] + w.lambda[12] - w.k_right_hand[0]*mu + w.u_r_hand[0]*t0 + w.c_r_hand[1]*Ia2;
+    const Scalar pa2 = w.pA_r_hand[2] + w.lambda[14] - w.k_right_hand[2]*mu + w.c_r_hand[2]*Ia0;
+    const Scalar pa3 = w.pA_r_hand[3] + 0.13*w.lambda[12] - 0.13*w.k_right_hand[0]*mu + w.u_r_hand[0]*t1;
+    const Scalar pa4 = w.pA_r_hand[4] + 0.13*w.lambda[13] - 0.13*w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia3;
     const Scalar pa5 = 0.000284375*w.c_r_hand[5] + w.pA_r_hand[5];
     const Scalar C20 = w.cq_r_hand*w.cq_r_hand - w.sq_r_hand*w.sq_r_hand;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
@@ -2225,7 +2243,7 @@ PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT 
     w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu;
     w.U_r_foot[3] = 0.00194517348958 + 1.0046580625*mu;
     w.Dinv_r_foot = 1.0 / w.U_r_foot[3];
-    w.u_r_foot[0] = -w.pA_r_foot[3] - 0.06825*w.g_r_foot[1]*mu + tau[17];
+    w.u_r_foot[0] = -w.pA_r_foot[3] - 0.06825*w.lambda[7] - w.lambda[9] - 0.06825*w.g_r_foot[1]*mu + tau[17];
     const Scalar t0 = w.U_r_foot[1]*w.Dinv_r_foot;
     const Scalar t1 = w.U_r_foot[3]*w.Dinv_r_foot;
     const Scalar Ia0 = 1.015 + mu;
@@ -2234,12 +2252,12 @@ PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT 
     const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_r_foot[1]*w.Dinv_r_foot;
     const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu;
     const Scalar Ia5 = 0.00860228295937 + mu - 3.1912249599999995e-06*w.Dinv_r_foot;
-    const Scalar pa0 = w.pA_r_foot[0] + w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_r_foot[1] + w.g_r_foot[1]*mu + w.u_r_foot[0]*t0 + w.c_r_foot[1]*Ia2 + w.c_r_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2] + w.g_r_foot[2]*mu + w.c_r_foot[2]*Ia0;
-    const Scalar pa3 = w.pA_r_foot[3] + 0.06825*w.g_r_foot[1]*mu + w.u_r_foot[0]*t1;
-    const Scalar pa4 = -0.06495999999999999*w.c_r_foot[2] + w.pA_r_foot[4] - 0.06825*w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia4;
-    const Scalar pa5 = w.pA_r_foot[5] + 0.0017863999999999998*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia3 + w.c_r_foot[5]*Ia5;
+    const Scalar pa0 = w.pA_r_foot[0] + w.lambda[6] + w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia1;
+    const Scalar pa1 = w.pA_r_foot[1] + w.lambda[7] + w.g_r_foot[1]*mu + w.u_r_foot[0]*t0 + w.c_r_foot[1]*Ia2 + w.c_r_foot[5]*Ia3;
+    const Scalar pa2 = -0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2] + w.lambda[8] + w.g_r_foot[2]*mu + w.c_r_foot[2]*Ia0;
+    const Scalar pa3 = w.pA_r_foot[3] + 0.06825*w.lambda[7] + w.lambda[9] + 0.06825*w.g_r_foot[1]*mu + w.u_r_foot[0]*t1;
+    const Scalar pa4 = -0.06495999999999999*w.c_r_foot[2] + w.pA_r_foot[4] - 0.06825*w.lambda[6] + w.lambda[10] - 0.06825*w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia4;
+    const Scalar pa5 = w.pA_r_foot[5] + w.lambda[11] + 0.0017863999999999998*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia3 + w.c_r_foot[5]*Ia5;
     const Scalar C20 = w.cq_r_foot*w.cq_r_foot - w.sq_r_foot*w.sq_r_foot;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -2739,7 +2757,7 @@ PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT 
     w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu;
     w.U_l_foot[3] = 0.00194517348958 + 1.0046580625*mu;
     w.Dinv_l_foot = 1.0 / w.U_l_foot[3];
-    w.u_l_foot[0] = -w.pA_l_foot[3] - 0.06825*w.g_l_foot[1]*mu + tau[11];
+    w.u_l_foot[0] = -w.pA_l_foot[3] - 0.06825*w.lambda[1] - w.lambda[3] - 0.06825*w.g_l_foot[1]*mu + tau[11];
     const Scalar t0 = w.U_l_foot[1]*w.Dinv_l_foot;
     const Scalar t1 = w.U_l_foot[3]*w.Dinv_l_foot;
     const Scalar Ia0 = 1.015 + mu;
@@ -2748,12 +2766,12 @@ PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT 
     const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_l_foot[1]*w.Dinv_l_foot;
     const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu;
     const Scalar Ia5 = 0.00860228295937 + mu - 3.1912249599999995e-06*w.Dinv_l_foot;
-    const Scalar pa0 = w.pA_l_foot[0] + w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_l_foot[1] + w.g_l_foot[1]*mu + w.u_l_foot[0]*t0 + w.c_l_foot[1]*Ia2 + w.c_l_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2] + w.g_l_foot[2]*mu + w.c_l_foot[2]*Ia0;
-    const Scalar pa3 = w.pA_l_foot[3] + 0.06825*w.g_l_foot[1]*mu + w.u_l_foot[0]*t1;
-    const Scalar pa4 = -0.06495999999999999*w.c_l_foot[2] + w.pA_l_foot[4] - 0.06825*w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia4;
-    const Scalar pa5 = w.pA_l_foot[5] + 0.0017863999999999998*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia3 + w.c_l_foot[5]*Ia5;
+    const Scalar pa0 = w.pA_l_foot[0] + w.lambda[0] + w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia1;
+    const Scalar pa1 = w.pA_l_foot[1] + w.lambda[1] + w.g_l_foot[1]*mu + w.u_l_foot[0]*t0 + w.c_l_foot[1]*Ia2 + w.c_l_foot[5]*Ia3;
+    const Scalar pa2 = -0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2] + w.lambda[2] + w.g_l_foot[2]*mu + w.c_l_foot[2]*Ia0;
+    const Scalar pa3 = w.pA_l_foot[3] + 0.06825*w.lambda[1] + w.lambda[3] + 0.06825*w.g_l_foot[1]*mu + w.u_l_foot[0]*t1;
+    const Scalar pa4 = -0.06495999999999999*w.c_l_foot[2] + w.pA_l_foot[4] - 0.06825*w.lambda[0] + w.lambda[4] - 0.06825*w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia4;
+    const Scalar pa5 = w.pA_l_foot[5] + w.lambda[5] + 0.0017863999999999998*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia3 + w.c_l_foot[5]*Ia5;
     const Scalar C20 = w.cq_l_foot*w.cq_l_foot - w.sq_l_foot*w.sq_l_foot;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -3751,45 +3769,51 @@ PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PR
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = mu*t0;
-    w.lambda[0] = w.dlambda[0];
-    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t1;
-    w.lambda[1] = w.dlambda[1];
-    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t2;
-    w.lambda[2] = w.dlambda[2];
-    w.dlambda[3] = w.a_l_foot[3]*mu;
-    w.lambda[3] = w.dlambda[3];
-    w.dlambda[4] = w.a_l_foot[4]*mu;
-    w.lambda[4] = w.dlambda[4];
-    w.dlambda[5] = w.a_l_foot[5]*mu;
-    w.lambda[5] = w.dlambda[5];
-    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t3;
-    w.lambda[6] = w.dlambda[6];
-    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t4;
-    w.lambda[7] = w.dlambda[7];
-    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t5;
-    w.lambda[8] = w.dlambda[8];
-    w.dlambda[9] = w.a_r_foot[3]*mu;
-    w.lambda[9] = w.dlambda[9];
-    w.dlambda[10] = w.a_r_foot[4]*mu;
-    w.lambda[10] = w.dlambda[10];
-    w.dlambda[11] = w.a_r_foot[5]*mu;
-    w.lambda[11] = w.dlambda[11];
-    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.dlambda[12] = mu*t6;
-    w.lambda[12] = w.dlambda[12];
-    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
-    w.dlambda[13] = mu*t7;
-    w.lambda[13] = w.dlambda[13];
-    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
-    w.dlambda[14] = mu*t8;
-    w.lambda[14] = w.dlambda[14];
+    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = mu*w.residual[0];
+    w.lambda[0] = w.lambda[0] + w.dlambda[0];
+    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*w.residual[1];
+    w.lambda[1] = w.lambda[1] + w.dlambda[1];
+    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*w.residual[2];
+    w.lambda[2] = w.lambda[2] + w.dlambda[2];
+    w.residual[3] = w.a_l_foot[3];
+    w.dlambda[3] = mu*w.residual[3];
+    w.lambda[3] = w.lambda[3] + w.dlambda[3];
+    w.residual[4] = w.a_l_foot[4];
+    w.dlambda[4] = mu*w.residual[4];
+    w.lambda[4] = w.lambda[4] + w.dlambda[4];
+    w.residual[5] = w.a_l_foot[5];
+    w.dlambda[5] = mu*w.residual[5];
+    w.lambda[5] = w.lambda[5] + w.dlambda[5];
+    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*w.residual[6];
+    w.lambda[6] = w.lambda[6] + w.dlambda[6];
+    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*w.residual[7];
+    w.lambda[7] = w.lambda[7] + w.dlambda[7];
+    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*w.residual[8];
+    w.lambda[8] = w.lambda[8] + w.dlambda[8];
+    w.residual[9] = w.a_r_foot[3];
+    w.dlambda[9] = mu*w.residual[9];
+    w.lambda[9] = w.lambda[9] + w.dlambda[9];
+    w.residual[10] = w.a_r_foot[4];
+    w.dlambda[10] = mu*w.residual[10];
+    w.lambda[10] = w.lambda[10] + w.dlambda[10];
+    w.residual[11] = w.a_r_foot[5];
+    w.dlambda[11] = mu*w.residual[11];
+    w.lambda[11] = w.lambda[11] + w.dlambda[11];
+    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.dlambda[12] = mu*w.residual[12];
+    w.lambda[12] = w.lambda[12] + w.dlambda[12];
+    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.dlambda[13] = mu*w.residual[13];
+    w.lambda[13] = w.lambda[13] + w.dlambda[13];
+    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+    w.dlambda[14] = mu*w.residual[14];
+    w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
 }
 
@@ -4668,44 +4692,50 @@ PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.dlambda[0] = mu*t0;
+    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.dlambda[1] = mu*t1;
+    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.dlambda[2] = mu*t2;
+    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
+    w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.dlambda[3] = w.a_l_foot[3]*mu;
+    w.residual[3] = w.a_l_foot[3];
+    w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.dlambda[4] = w.a_l_foot[4]*mu;
+    w.residual[4] = w.a_l_foot[4];
+    w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.dlambda[5] = w.a_l_foot[5]*mu;
+    w.residual[5] = w.a_l_foot[5];
+    w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.dlambda[6] = mu*t3;
+    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.dlambda[7] = mu*t4;
+    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.dlambda[8] = mu*t5;
+    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
+    w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.dlambda[9] = w.a_r_foot[3]*mu;
+    w.residual[9] = w.a_r_foot[3];
+    w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.dlambda[10] = w.a_r_foot[4]*mu;
+    w.residual[10] = w.a_r_foot[4];
+    w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.dlambda[11] = w.a_r_foot[5]*mu;
+    w.residual[11] = w.a_r_foot[5];
+    w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.dlambda[12] = mu*t6;
+    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.dlambda[12] = mu*w.residual[12];
     w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
-    w.dlambda[13] = mu*t7;
+    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.dlambda[13] = mu*w.residual[13];
     w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
-    w.dlambda[14] = mu*t8;
+    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+    w.dlambda[14] = mu*w.residual[14];
     w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
 }
@@ -8548,24 +8578,6 @@ PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w)
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  w.lambda[0] = 0.0;
-  w.lambda[1] = 0.0;
-  w.lambda[2] = 0.0;
-  w.lambda[3] = 0.0;
-  w.lambda[4] = 0.0;
-  w.lambda[5] = 0.0;
-  w.lambda[6] = 0.0;
-  w.lambda[7] = 0.0;
-  w.lambda[8] = 0.0;
-  w.lambda[9] = 0.0;
-  w.lambda[10] = 0.0;
-  w.lambda[11] = 0.0;
-  w.lambda[12] = 0.0;
-  w.lambda[13] = 0.0;
-  w.lambda[14] = 0.0;
-}
-
 PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
@@ -9117,6 +9129,27 @@ PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROX
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // residual rows K a - k (layout order)
+  {
+    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
+    w.residual[3] = w.a_l_foot[3];
+    w.residual[4] = w.a_l_foot[4];
+    w.residual[5] = w.a_l_foot[5];
+    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
+    w.residual[9] = w.a_r_foot[3];
+    w.residual[10] = w.a_r_foot[4];
+    w.residual[11] = w.a_r_foot[5];
+    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+  }
+}
+
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
@@ -9166,6 +9199,23 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
   eliminate_free_bodies(tau, w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
+  w.lambda[6] = lambda0[6];
+  w.lambda[7] = lambda0[7];
+  w.lambda[8] = lambda0[8];
+  w.lambda[9] = lambda0[9];
+  w.lambda[10] = lambda0[10];
+  w.lambda[11] = lambda0[11];
+  w.lambda[12] = lambda0[12];
+  w.lambda[13] = lambda0[13];
+  w.lambda[14] = lambda0[14];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_r_hand_to_r_wrist_pitch_link(tau, mu, w);
   caba_backward_r_wrist_yaw_link(tau, w);
@@ -9197,7 +9247,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   caba_forward_chest_to_r_shoulder_roll_link(w);
   caba_forward_r_upper_arm_to_r_wrist_yaw_link(w);
   caba_forward_r_wrist_pitch_link_to_r_hand(w);
-  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  // ---- multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda
   caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
@@ -9320,8 +9370,23 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_delassus_W_1_to_W_2(w);
   pv_delassus_W_3_to_W_4(w);
   pv_delassus_W_5_to_LS(w);
-  // ---- lambda = 0
-  pv_start(w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
+  w.lambda[6] = lambda0[6];
+  w.lambda[7] = lambda0[7];
+  w.lambda[8] = lambda0[8];
+  w.lambda[9] = lambda0[9];
+  w.lambda[10] = lambda0[10];
+  w.lambda[11] = lambda0[11];
+  w.lambda[12] = lambda0[12];
+  w.lambda[13] = lambda0[13];
+  w.lambda[14] = lambda0[14];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
@@ -9336,6 +9401,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_forward_chest_to_r_shoulder_roll_link(w);
   pv_forward_r_upper_arm_to_r_wrist_yaw_link(w);
   pv_forward_r_wrist_pitch_link_to_r_hand(w);
+  // ---- the rows' residual K a - k of the final accelerations
+  pv_residual(w);
   accelerate_free_bodies(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
@@ -9388,6 +9455,11 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   lambda[12] = w.lambda[12];
   lambda[13] = w.lambda[13];
   lambda[14] = w.lambda[14];
+}
+
+// The largest row of K a - k, stored by the last solve.
+Scalar residual(const Workspace& w) noexcept {
+  return proxgen_rt::largest_magnitude_of<nc>(w.residual);
 }
 
 }  // namespace humanoid

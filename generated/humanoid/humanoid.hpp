@@ -4,16 +4,15 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8676 + 1720 K (= 13836 at K = 3)
-//     add/sub 3477 + 743 K, mul 4969 + 931 K, div 34, neg 160 + 46 K, sqrt 6, sincos 30, log6 0
-//   prox_pv: 16617 + 650 K (= 18567 at K = 3)
-//     add/sub 6637 + 285 K, mul 9565 + 365 K, div 53, neg 305, sqrt 27, sincos 30, log6 0
+//   constrained_aba: 8744 + 1720 K (= 13904 at K = 3)
+//     add/sub 3521 + 743 K, mul 4990 + 931 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16657 + 650 K (= 18607 at K = 3)
+//     add/sub 6655 + 285 K, mul 9583 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
 // code. Conventions: q = [x y z qx qy qz qw of the base, then one value per joint], v and qdd in the joint order below,
-// lambda rows in layout order; the constraint force on the robot is -J^T lambda,
-// so M qdd + h = tau - J^T lambda. Needs only "proxgen/runtime.hpp".
+// lambda rows in layout order. Needs only "proxgen/runtime.hpp".
 //
 // Joint order (slots in q | v):
 //   q[0..6] v[0..5]  joint 'root_joint' (free flyer), link 'pelvis'
@@ -59,13 +58,77 @@ namespace humanoid {
 
 using Scalar = double;
 inline constexpr int nq = 37, nv = 36, nc = 15;  // configuration, velocity, constraint rows
+inline constexpr int ncons = 3;  // constraints in the layout (each 3 or 6 rows)
 
+// The proxgen that printed this file; the source checks it against the
+// runtime's proxgen_rt::version_major/minor when it is compiled.
+inline constexpr const char* proxgen_version = "0.1.0";
+inline constexpr int version_major = 0, version_minor = 1;
+
+// Names and slots, so callers never count by hand. Joints in the order above
+// (joint_idx_q[k], joint_idx_v[k]: the first slot of joint k in q and v);
+// constraints in layout order (rows constraint_row[k] ..
+// constraint_row[k] + constraint_rows[k] - 1 of lambda). The strings are the
+// URDF's and the layout's names byte for byte; the identifiers in joint:: and
+// constraint:: are those names sanitised (docs/design.md, "Names in the
+// generated files"), the same ones the workspace members use.
+inline constexpr const char* joint_names[] = {"root_joint", "l_hip_yaw", "l_hip_roll", "l_hip_pitch", "l_knee", "l_ankle_pitch", "l_ankle_roll", "r_hip_yaw", "r_hip_roll", "r_hip_pitch", "r_knee", "r_ankle_pitch", "r_ankle_roll", "torso_yaw", "torso_pitch", "l_shoulder_pitch", "l_shoulder_roll", "l_shoulder_yaw", "l_elbow", "l_wrist_yaw", "l_wrist_pitch", "l_wrist_roll", "neck_yaw", "neck_pitch", "r_shoulder_pitch", "r_shoulder_roll", "r_shoulder_yaw", "r_elbow", "r_wrist_yaw", "r_wrist_pitch", "r_wrist_roll"};
+inline constexpr int joint_idx_q[] = {0, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 35, 36};
+inline constexpr int joint_idx_v[] = {0, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 35};
+inline constexpr const char* constraint_names[] = {"left_foot", "right_foot", "right_hand"};
+inline constexpr int constraint_row[] = {0, 6, 12};
+inline constexpr int constraint_rows[] = {6, 6, 3};
+namespace joint {  // position in the joint list (joint_names)
+inline constexpr int root_joint = 0;
+inline constexpr int l_hip_yaw = 1;
+inline constexpr int l_hip_roll = 2;
+inline constexpr int l_hip_pitch = 3;
+inline constexpr int l_knee = 4;
+inline constexpr int l_ankle_pitch = 5;
+inline constexpr int l_ankle_roll = 6;
+inline constexpr int r_hip_yaw = 7;
+inline constexpr int r_hip_roll = 8;
+inline constexpr int r_hip_pitch = 9;
+inline constexpr int r_knee = 10;
+inline constexpr int r_ankle_pitch = 11;
+inline constexpr int r_ankle_roll = 12;
+inline constexpr int torso_yaw = 13;
+inline constexpr int torso_pitch = 14;
+inline constexpr int l_shoulder_pitch = 15;
+inline constexpr int l_shoulder_roll = 16;
+inline constexpr int l_shoulder_yaw = 17;
+inline constexpr int l_elbow = 18;
+inline constexpr int l_wrist_yaw = 19;
+inline constexpr int l_wrist_pitch = 20;
+inline constexpr int l_wrist_roll = 21;
+inline constexpr int neck_yaw = 22;
+inline constexpr int neck_pitch = 23;
+inline constexpr int r_shoulder_pitch = 24;
+inline constexpr int r_shoulder_roll = 25;
+inline constexpr int r_shoulder_yaw = 26;
+inline constexpr int r_elbow = 27;
+inline constexpr int r_wrist_yaw = 28;
+inline constexpr int r_wrist_pitch = 29;
+inline constexpr int r_wrist_roll = 30;
+}  // namespace joint
+namespace constraint {  // position in the layout (constraint_names)
+inline constexpr int left_foot = 0;
+inline constexpr int right_foot = 1;
+inline constexpr int right_hand = 2;
+}  // namespace constraint
+
+// Set the fields by name (later versions add fields, e.g. a per-constraint
+// activity flag, before lambda0).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
-  int iterations = 3;  // multiplier updates K (0: the unconstrained motion)
+  int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
+  // Warm start: nc multipliers (layout order; e.g. the previous control step's
+  // lambda), or null for lambda = 0. The K updates start from lambda0 instead
+  // of 0. It is read before lambda is written: it may be the lambda output.
+  const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (22880 bytes): per-body quantities named
+// Everything one solve writes (23000 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_pelvis[3][3];      // joint rotation, body 1
@@ -269,6 +332,7 @@ struct Workspace {
   Scalar IA_l_shoulder_pitch_link[21]; // articulated inertia (upper triangle), body 16
   Scalar Dinv_l_shoulder_pitch_link; // 1 / (S^T IA S), body 16
   Scalar u_l_shoulder_pitch_link[1]; // tau - S^T pA, body 16
+  Scalar lambda[15];           // multipliers (layout order)
   Scalar U_r_hand[6];          // IA S, body 31
   Scalar Dinv_r_hand;          // 1 / (S^T IA S), body 31
   Scalar u_r_hand[1];          // tau - S^T pA, body 31
@@ -358,8 +422,8 @@ struct Workspace {
   Scalar a_r_wrist_yaw_link[6]; // acceleration (gravity-shifted), body 29
   Scalar a_r_wrist_pitch_link[6]; // acceleration (gravity-shifted), body 30
   Scalar a_r_hand[6];          // acceleration (gravity-shifted), body 31
+  Scalar residual[15];         // rows of J qdd + gamma - a* of the last solve (residual(w))
   Scalar dlambda[15];          // latest multiplier increment
-  Scalar lambda[15];           // multipliers (layout order)
   Scalar dp_r_wrist_pitch_link[6]; // reduced-sweep force, body 30
   Scalar dp_r_wrist_yaw_link[6]; // reduced-sweep force, body 29
   Scalar dp_r_forearm[6];      // reduced-sweep force, body 28
@@ -432,12 +496,30 @@ struct Workspace {
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };
 
-// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).
-// K = s.iterations multiplier updates from lambda = 0; both algorithms give the
-// same iterates up to round-off.
+// In: q[nq], v[nv], tau[nv] (none of them inside w). The quaternion of a free
+// flyer need not be unit: it is normalised as `proxgen eval` does (divided by
+// its largest magnitude, then by its norm), so the quaternion scaled by any
+// non-zero factor gives the same answer (bit for bit for a power of two or -1,
+// else to round-off). A zero quaternion (eval refuses it) or a non-finite one
+// gives NaN in every output.
+// Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.
+// Sign: the constraint force on the robot is -J^T lambda, so
+// M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library
+// where it enters as + J^T f, is -lambda.
+// K = s.iterations proximal multiplier updates
+//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)
+// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
+// round-off. From a lambda0 that already solves the constraints the update
+// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept;
+
+// ||J qdd + gamma - a*||_inf of the last solve with w (qdd its output, a* the
+// layout's Baumgarte target, rows as lambda): how far the K-th iterate is from
+// satisfying the constraints, to choose K by accuracy. NaN if a row is not
+// finite; 0 without constraints.
+Scalar residual(const Workspace& w) noexcept;
 
 }  // namespace humanoid

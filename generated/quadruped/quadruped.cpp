@@ -4,31 +4,49 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4452 + 1204 K (= 8064 at K = 3)
-//     add/sub 1869 + 543 K, mul 2487 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
-//   prox_pv: 8395 + 475 K (= 9820 at K = 3)
-//     add/sub 3487 + 204 K, mul 4734 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
+//   constrained_aba: 4534 + 1204 K (= 8146 at K = 3)
+//     add/sub 1916 + 543 K, mul 2519 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8457 + 475 K (= 9882 at K = 3)
+//     add/sub 3518 + 204 K, mul 4762 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 
 #include "quadruped.hpp"
 
 #include "proxgen/runtime.hpp"
 
 namespace quadruped {
+
+// This file was printed for the runtime of the same version (runtime.hpp).
+static_assert(proxgen_rt::version_major == version_major);
+static_assert(proxgen_rt::version_minor == version_minor);
+
 namespace {
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
-    w.RJ_trunk[0][0] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[5]*q[5];
-    w.RJ_trunk[0][1] = 2.0*(q[3]*q[4] - q[5]*q[6]);
-    w.RJ_trunk[0][2] = 2.0*(q[3]*q[5] + q[4]*q[6]);
-    w.RJ_trunk[1][0] = 2.0*(q[3]*q[4] + q[5]*q[6]);
-    w.RJ_trunk[1][1] = 1.0 - 2.0*q[5]*q[5] - 2.0*q[3]*q[3];
-    w.RJ_trunk[1][2] = 2.0*(q[4]*q[5] - q[3]*q[6]);
-    w.RJ_trunk[2][0] = 2.0*(q[3]*q[5] - q[4]*q[6]);
-    w.RJ_trunk[2][1] = 2.0*(q[4]*q[5] + q[3]*q[6]);
-    w.RJ_trunk[2][2] = 1.0 - 2.0*q[4]*q[4] - 2.0*q[3]*q[3];
+    const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
+    const Scalar inv0 = 1.0 / qscale;
+    const Scalar qs0 = q[3]*inv0;
+    const Scalar qs1 = q[4]*inv0;
+    const Scalar qs2 = q[5]*inv0;
+    const Scalar qs3 = q[6]*inv0;
+    const Scalar t0 = qs0*qs0 + qs1*qs1 + qs2*qs2 + qs3*qs3;
+    const Scalar qn0 = std::sqrt(t0);
+    const Scalar inv1 = 1.0 / qn0;
+    const Scalar qu0 = qs0*inv1;
+    const Scalar qu1 = qs1*inv1;
+    const Scalar qu2 = qs2*inv1;
+    const Scalar qu3 = qs3*inv1;
+    w.RJ_trunk[0][0] = 1.0 - 2.0*qu1*qu1 - 2.0*qu2*qu2;
+    w.RJ_trunk[0][1] = 2.0*(qu0*qu1 - qu2*qu3);
+    w.RJ_trunk[0][2] = 2.0*(qu0*qu2 + qu1*qu3);
+    w.RJ_trunk[1][0] = 2.0*(qu0*qu1 + qu2*qu3);
+    w.RJ_trunk[1][1] = 1.0 - 2.0*qu2*qu2 - 2.0*qu0*qu0;
+    w.RJ_trunk[1][2] = 2.0*(qu1*qu2 - qu0*qu3);
+    w.RJ_trunk[2][0] = 2.0*(qu0*qu2 - qu1*qu3);
+    w.RJ_trunk[2][1] = 2.0*(qu1*qu2 + qu0*qu3);
+    w.RJ_trunk[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
     w.pA_trunk[0] = 3.5200000000000005*(v[2]*v[4] - v[1]*v[5]);
     w.pA_trunk[1] = 3.5200000000000005*(v[0]*v[5] - v[2]*v[3]);
     w.pA_trunk[2] = 3.5200000000000005*(v[1]*v[3] - v[0]*v[4]);
@@ -50,12 +68,12 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.RJ_LF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_LF_hip;
     w.RJ_LF_hip[2][1] = 0.9950371902099893*w.sq_LF_hip;
     w.RJ_LF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_LF_hip;
-    const Scalar t0 = v[0] - 0.049*v[5];
-    const Scalar t1 = v[1] + 0.19*v[5];
-    const Scalar t2 = v[2] + 0.049*v[3] - 0.19*v[4];
-    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t0 + w.RJ_LF_hip[1][0]*t1 + w.RJ_LF_hip[2][0]*t2;
-    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[2][1]*t2;
-    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t0 + w.RJ_LF_hip[1][2]*t1 + w.RJ_LF_hip[2][2]*t2;
+    const Scalar t1 = v[0] - 0.049*v[5];
+    const Scalar t2 = v[1] + 0.19*v[5];
+    const Scalar t3 = v[2] + 0.049*v[3] - 0.19*v[4];
+    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t1 + w.RJ_LF_hip[1][0]*t2 + w.RJ_LF_hip[2][0]*t3;
+    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t1 + w.cq_LF_hip*t2 + w.RJ_LF_hip[2][1]*t3;
+    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t1 + w.RJ_LF_hip[1][2]*t2 + w.RJ_LF_hip[2][2]*t3;
     w.v_LF_hip[3] = 0.9950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][0] + v[4]*w.RJ_LF_hip[1][0] + v[5]*w.RJ_LF_hip[2][0];
     w.v_LF_hip[4] = v[3]*w.RJ_LF_hip[0][1] + v[4]*w.cq_LF_hip + v[5]*w.RJ_LF_hip[2][1];
     w.v_LF_hip[5] = 0.09950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][2] + v[4]*w.RJ_LF_hip[1][2] + v[5]*w.RJ_LF_hip[2][2];
@@ -487,7 +505,7 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRIC
     w.U_RH_shank[4] = 0.000486144 + 0.038025*mu;
     w.U_RH_shank[5] = -0.0007800000000000001*mu;
     w.Dinv_RH_shank = 1.0 / w.U_RH_shank[4];
-    w.u_RH_shank[0] = -w.pA_RH_shank[4] - 0.195*w.k_rh_foot[0]*mu + tau[17];
+    w.u_RH_shank[0] = -w.pA_RH_shank[4] + 0.195*w.lambda[9] - 0.195*w.k_rh_foot[0]*mu + tau[17];
     const Scalar t1 = w.U_RH_shank[0]*w.Dinv_RH_shank;
     const Scalar t2 = w.U_RH_shank[4]*w.Dinv_RH_shank;
     const Scalar t3 = w.U_RH_shank[5]*w.Dinv_RH_shank;
@@ -497,12 +515,12 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRIC
     const Scalar Ia3 = 0.003904 + 0.195*mu;
     const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
     const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_RH_shank[5]*t3;
-    const Scalar pa0 = w.pA_RH_shank[0] - w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t1 + w.c_RH_shank[0]*Ia0 + w.c_RH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RH_shank[1] - w.k_rh_foot[1]*mu + w.c_RH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RH_shank[2] - w.k_rh_foot[2]*mu + w.c_RH_shank[2]*Ia2 - 0.004*w.c_RH_shank[3]*mu;
-    const Scalar pa3 = w.pA_RH_shank[3] - mu*t0 - 0.004*w.c_RH_shank[2]*mu + w.c_RH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RH_shank[4] + 0.195*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t2;
-    const Scalar pa5 = w.pA_RH_shank[5] - 0.004*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t3 + w.c_RH_shank[0]*Ia1 + w.c_RH_shank[5]*Ia5;
+    const Scalar pa0 = w.pA_RH_shank[0] + w.lambda[9] - w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t1 + w.c_RH_shank[0]*Ia0 + w.c_RH_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_RH_shank[1] + w.lambda[10] - w.k_rh_foot[1]*mu + w.c_RH_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_RH_shank[2] + w.lambda[11] - w.k_rh_foot[2]*mu + w.c_RH_shank[2]*Ia2 - 0.004*w.c_RH_shank[3]*mu;
+    const Scalar pa3 = w.pA_RH_shank[3] + 0.195*w.lambda[10] - 0.004*w.lambda[11] - mu*t0 - 0.004*w.c_RH_shank[2]*mu + w.c_RH_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_RH_shank[4] - 0.195*w.lambda[9] + 0.195*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t2;
+    const Scalar pa5 = w.pA_RH_shank[5] + 0.004*w.lambda[9] - 0.004*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t3 + w.c_RH_shank[0]*Ia1 + w.c_RH_shank[5]*Ia5;
     const Scalar C20 = w.cq_RH_shank*w.cq_RH_shank - w.sq_RH_shank*w.sq_RH_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -756,7 +774,7 @@ PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRIC
     w.U_RF_shank[4] = 0.000486144 + 0.038025*mu;
     w.U_RF_shank[5] = -0.0007800000000000001*mu;
     w.Dinv_RF_shank = 1.0 / w.U_RF_shank[4];
-    w.u_RF_shank[0] = -w.pA_RF_shank[4] - 0.195*w.k_rf_foot[0]*mu + tau[14];
+    w.u_RF_shank[0] = -w.pA_RF_shank[4] + 0.195*w.lambda[3] - 0.195*w.k_rf_foot[0]*mu + tau[14];
     const Scalar t1 = w.U_RF_shank[0]*w.Dinv_RF_shank;
     const Scalar t2 = w.U_RF_shank[4]*w.Dinv_RF_shank;
     const Scalar t3 = w.U_RF_shank[5]*w.Dinv_RF_shank;
@@ -766,12 +784,12 @@ PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRIC
     const Scalar Ia3 = 0.003904 + 0.195*mu;
     const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
     const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_RF_shank[5]*t3;
-    const Scalar pa0 = w.pA_RF_shank[0] - w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t1 + w.c_RF_shank[0]*Ia0 + w.c_RF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RF_shank[1] - w.k_rf_foot[1]*mu + w.c_RF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RF_shank[2] - w.k_rf_foot[2]*mu + w.c_RF_shank[2]*Ia2 - 0.004*w.c_RF_shank[3]*mu;
-    const Scalar pa3 = w.pA_RF_shank[3] - mu*t0 - 0.004*w.c_RF_shank[2]*mu + w.c_RF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RF_shank[4] + 0.195*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t2;
-    const Scalar pa5 = w.pA_RF_shank[5] - 0.004*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t3 + w.c_RF_shank[0]*Ia1 + w.c_RF_shank[5]*Ia5;
+    const Scalar pa0 = w.pA_RF_shank[0] + w.lambda[3] - w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t1 + w.c_RF_shank[0]*Ia0 + w.c_RF_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_RF_shank[1] + w.lambda[4] - w.k_rf_foot[1]*mu + w.c_RF_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_RF_shank[2] + w.lambda[5] - w.k_rf_foot[2]*mu + w.c_RF_shank[2]*Ia2 - 0.004*w.c_RF_shank[3]*mu;
+    const Scalar pa3 = w.pA_RF_shank[3] + 0.195*w.lambda[4] - 0.004*w.lambda[5] - mu*t0 - 0.004*w.c_RF_shank[2]*mu + w.c_RF_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_RF_shank[4] - 0.195*w.lambda[3] + 0.195*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t2;
+    const Scalar pa5 = w.pA_RF_shank[5] + 0.004*w.lambda[3] - 0.004*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t3 + w.c_RF_shank[0]*Ia1 + w.c_RF_shank[5]*Ia5;
     const Scalar C20 = w.cq_RF_shank*w.cq_RF_shank - w.sq_RF_shank*w.sq_RF_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -1025,7 +1043,7 @@ PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRIC
     w.U_LH_shank[4] = 0.000486144 + 0.038025*mu;
     w.U_LH_shank[5] = 0.0007800000000000001*mu;
     w.Dinv_LH_shank = 1.0 / w.U_LH_shank[4];
-    w.u_LH_shank[0] = -w.pA_LH_shank[4] - 0.195*w.k_lh_foot[0]*mu + tau[11];
+    w.u_LH_shank[0] = -w.pA_LH_shank[4] + 0.195*w.lambda[6] - 0.195*w.k_lh_foot[0]*mu + tau[11];
     const Scalar t1 = w.U_LH_shank[0]*w.Dinv_LH_shank;
     const Scalar t2 = w.U_LH_shank[4]*w.Dinv_LH_shank;
     const Scalar t3 = w.U_LH_shank[5]*w.Dinv_LH_shank;
@@ -1035,12 +1053,12 @@ PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRIC
     const Scalar Ia3 = 0.003904 + 0.195*mu;
     const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
     const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_LH_shank[5]*t3;
-    const Scalar pa0 = w.pA_LH_shank[0] - w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t1 + w.c_LH_shank[0]*Ia0 + w.c_LH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LH_shank[1] - w.k_lh_foot[1]*mu + w.c_LH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LH_shank[2] - w.k_lh_foot[2]*mu + w.c_LH_shank[2]*Ia2 + 0.004*w.c_LH_shank[3]*mu;
-    const Scalar pa3 = w.pA_LH_shank[3] - mu*t0 + 0.004*w.c_LH_shank[2]*mu + w.c_LH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LH_shank[4] + 0.195*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t2;
-    const Scalar pa5 = w.pA_LH_shank[5] + 0.004*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t3 + w.c_LH_shank[0]*Ia1 + w.c_LH_shank[5]*Ia5;
+    const Scalar pa0 = w.pA_LH_shank[0] + w.lambda[6] - w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t1 + w.c_LH_shank[0]*Ia0 + w.c_LH_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_LH_shank[1] + w.lambda[7] - w.k_lh_foot[1]*mu + w.c_LH_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_LH_shank[2] + w.lambda[8] - w.k_lh_foot[2]*mu + w.c_LH_shank[2]*Ia2 + 0.004*w.c_LH_shank[3]*mu;
+    const Scalar pa3 = w.pA_LH_shank[3] + 0.195*w.lambda[7] + 0.004*w.lambda[8] - mu*t0 + 0.004*w.c_LH_shank[2]*mu + w.c_LH_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_LH_shank[4] - 0.195*w.lambda[6] + 0.195*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t2;
+    const Scalar pa5 = w.pA_LH_shank[5] - 0.004*w.lambda[6] + 0.004*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t3 + w.c_LH_shank[0]*Ia1 + w.c_LH_shank[5]*Ia5;
     const Scalar C20 = w.cq_LH_shank*w.cq_LH_shank - w.sq_LH_shank*w.sq_LH_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -1294,7 +1312,7 @@ PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRIC
     w.U_LF_shank[4] = 0.000486144 + 0.038025*mu;
     w.U_LF_shank[5] = 0.0007800000000000001*mu;
     w.Dinv_LF_shank = 1.0 / w.U_LF_shank[4];
-    w.u_LF_shank[0] = -w.pA_LF_shank[4] - 0.195*w.k_lf_foot[0]*mu + tau[8];
+    w.u_LF_shank[0] = -w.pA_LF_shank[4] + 0.195*w.lambda[0] - 0.195*w.k_lf_foot[0]*mu + tau[8];
     const Scalar t1 = w.U_LF_shank[0]*w.Dinv_LF_shank;
     const Scalar t2 = w.U_LF_shank[4]*w.Dinv_LF_shank;
     const Scalar t3 = w.U_LF_shank[5]*w.Dinv_LF_shank;
@@ -1304,12 +1322,12 @@ PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRIC
     const Scalar Ia3 = 0.003904 + 0.195*mu;
     const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
     const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_LF_shank[5]*t3;
-    const Scalar pa0 = w.pA_LF_shank[0] - w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t1 + w.c_LF_shank[0]*Ia0 + w.c_LF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LF_shank[1] - w.k_lf_foot[1]*mu + w.c_LF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LF_shank[2] - w.k_lf_foot[2]*mu + w.c_LF_shank[2]*Ia2 + 0.004*w.c_LF_shank[3]*mu;
-    const Scalar pa3 = w.pA_LF_shank[3] - mu*t0 + 0.004*w.c_LF_shank[2]*mu + w.c_LF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LF_shank[4] + 0.195*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t2;
-    const Scalar pa5 = w.pA_LF_shank[5] + 0.004*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t3 + w.c_LF_shank[0]*Ia1 + w.c_LF_shank[5]*Ia5;
+    const Scalar pa0 = w.pA_LF_shank[0] + w.lambda[0] - w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t1 + w.c_LF_shank[0]*Ia0 + w.c_LF_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_LF_shank[1] + w.lambda[1] - w.k_lf_foot[1]*mu + w.c_LF_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_LF_shank[2] + w.lambda[2] - w.k_lf_foot[2]*mu + w.c_LF_shank[2]*Ia2 + 0.004*w.c_LF_shank[3]*mu;
+    const Scalar pa3 = w.pA_LF_shank[3] + 0.195*w.lambda[1] + 0.004*w.lambda[2] - mu*t0 + 0.004*w.c_LF_shank[2]*mu + w.c_LF_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_LF_shank[4] - 0.195*w.lambda[0] + 0.195*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t2;
+    const Scalar pa5 = w.pA_LF_shank[5] - 0.004*w.lambda[0] + 0.004*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t3 + w.c_LF_shank[0]*Ia1 + w.c_LF_shank[5]*Ia5;
     const Scalar C20 = w.cq_LF_shank*w.cq_LF_shank - w.sq_LF_shank*w.sq_LF_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
@@ -1886,42 +1904,42 @@ PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.dlambda[0] = mu*t0;
-    w.lambda[0] = w.dlambda[0];
-    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.dlambda[1] = mu*t1;
-    w.lambda[1] = w.dlambda[1];
-    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.dlambda[2] = mu*t2;
-    w.lambda[2] = w.dlambda[2];
-    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.dlambda[3] = mu*t3;
-    w.lambda[3] = w.dlambda[3];
-    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.dlambda[4] = mu*t4;
-    w.lambda[4] = w.dlambda[4];
-    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.dlambda[5] = mu*t5;
-    w.lambda[5] = w.dlambda[5];
-    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.dlambda[6] = mu*t6;
-    w.lambda[6] = w.dlambda[6];
-    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.dlambda[7] = mu*t7;
-    w.lambda[7] = w.dlambda[7];
-    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.dlambda[8] = mu*t8;
-    w.lambda[8] = w.dlambda[8];
-    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.dlambda[9] = mu*t9;
-    w.lambda[9] = w.dlambda[9];
-    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.dlambda[10] = mu*t10;
-    w.lambda[10] = w.dlambda[10];
-    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
-    w.dlambda[11] = mu*t11;
-    w.lambda[11] = w.dlambda[11];
+    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.dlambda[0] = mu*w.residual[0];
+    w.lambda[0] = w.lambda[0] + w.dlambda[0];
+    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.dlambda[1] = mu*w.residual[1];
+    w.lambda[1] = w.lambda[1] + w.dlambda[1];
+    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.dlambda[2] = mu*w.residual[2];
+    w.lambda[2] = w.lambda[2] + w.dlambda[2];
+    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.dlambda[3] = mu*w.residual[3];
+    w.lambda[3] = w.lambda[3] + w.dlambda[3];
+    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.dlambda[4] = mu*w.residual[4];
+    w.lambda[4] = w.lambda[4] + w.dlambda[4];
+    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.dlambda[5] = mu*w.residual[5];
+    w.lambda[5] = w.lambda[5] + w.dlambda[5];
+    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.dlambda[6] = mu*w.residual[6];
+    w.lambda[6] = w.lambda[6] + w.dlambda[6];
+    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.dlambda[7] = mu*w.residual[7];
+    w.lambda[7] = w.lambda[7] + w.dlambda[7];
+    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.dlambda[8] = mu*w.residual[8];
+    w.lambda[8] = w.lambda[8] + w.dlambda[8];
+    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.dlambda[9] = mu*w.residual[9];
+    w.lambda[9] = w.lambda[9] + w.dlambda[9];
+    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.dlambda[10] = mu*w.residual[10];
+    w.lambda[10] = w.lambda[10] + w.dlambda[10];
+    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.dlambda[11] = mu*w.residual[11];
+    w.lambda[11] = w.lambda[11] + w.dlambda[11];
   }
 }
 
@@ -2444,41 +2462,41 @@ PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda
   {
-    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.dlambda[0] = mu*t0;
+    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.dlambda[1] = mu*t1;
+    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.dlambda[2] = mu*t2;
+    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.dlambda[3] = mu*t3;
+    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.dlambda[4] = mu*t4;
+    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.dlambda[5] = mu*t5;
+    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.dlambda[6] = mu*t6;
+    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.dlambda[7] = mu*t7;
+    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.dlambda[8] = mu*t8;
+    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.dlambda[9] = mu*t9;
+    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.dlambda[10] = mu*t10;
+    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
-    w.dlambda[11] = mu*t11;
+    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
   }
 }
@@ -4634,21 +4652,6 @@ PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w)
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_start(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  w.lambda[0] = 0.0;
-  w.lambda[1] = 0.0;
-  w.lambda[2] = 0.0;
-  w.lambda[6] = 0.0;
-  w.lambda[7] = 0.0;
-  w.lambda[8] = 0.0;
-  w.lambda[3] = 0.0;
-  w.lambda[4] = 0.0;
-  w.lambda[5] = 0.0;
-  w.lambda[9] = 0.0;
-  w.lambda[10] = 0.0;
-  w.lambda[11] = 0.0;
-}
-
 PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   const Scalar t0 = w.yfree[0] + w.lambda[0]*inv_mu;
   const Scalar t1 = w.Linv[0]*t0;
@@ -5007,6 +5010,24 @@ PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_R
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // residual rows K a - k (layout order)
+  {
+    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+  }
+}
+
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
@@ -5027,6 +5048,20 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
   kinematics(q, v, w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
+  w.lambda[6] = lambda0[6];
+  w.lambda[7] = lambda0[7];
+  w.lambda[8] = lambda0[8];
+  w.lambda[9] = lambda0[9];
+  w.lambda[10] = lambda0[10];
+  w.lambda[11] = lambda0[11];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_RH_shank(tau, mu, w);
   caba_backward_RH_thigh(tau, w);
@@ -5047,7 +5082,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   caba_forward_LH_thigh_to_RF_hip(w);
   caba_forward_RF_thigh_to_RH_hip(w);
   caba_forward_RH_thigh_to_RH_shank(w);
-  // ---- multipliers: dlambda = mu (K a - k), lambda = dlambda
+  // ---- multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda
   caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
@@ -5130,8 +5165,20 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_delassus_W_1_to_W_2(w);
   pv_delassus_W_3_to_W_4(w);
   pv_delassus_W_5_to_LS(w);
-  // ---- lambda = 0
-  pv_start(w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
+  w.lambda[0] = lambda0[0];
+  w.lambda[1] = lambda0[1];
+  w.lambda[2] = lambda0[2];
+  w.lambda[3] = lambda0[3];
+  w.lambda[4] = lambda0[4];
+  w.lambda[5] = lambda0[5];
+  w.lambda[6] = lambda0[6];
+  w.lambda[7] = lambda0[7];
+  w.lambda[8] = lambda0[8];
+  w.lambda[9] = lambda0[9];
+  w.lambda[10] = lambda0[10];
+  w.lambda[11] = lambda0[11];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
@@ -5143,6 +5190,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_forward_LH_thigh_to_RF_hip(w);
   pv_forward_RF_thigh_to_RH_hip(w);
   pv_forward_RH_thigh_to_RH_shank(w);
+  // ---- the rows' residual K a - k of the final accelerations
+  pv_residual(w);
   qdd[0] = w.qdd[0];
   qdd[1] = w.qdd[1];
   qdd[2] = w.qdd[2];
@@ -5173,6 +5222,11 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   lambda[9] = w.lambda[9];
   lambda[10] = w.lambda[10];
   lambda[11] = w.lambda[11];
+}
+
+// The largest row of K a - k, stored by the last solve.
+Scalar residual(const Workspace& w) noexcept {
+  return proxgen_rt::largest_magnitude_of<nc>(w.residual);
 }
 
 }  // namespace quadruped

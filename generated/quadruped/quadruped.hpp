@@ -4,16 +4,15 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4452 + 1204 K (= 8064 at K = 3)
-//     add/sub 1869 + 543 K, mul 2487 + 635 K, div 18, neg 60 + 26 K, sqrt 6, sincos 12, log6 0
-//   prox_pv: 8395 + 475 K (= 9820 at K = 3)
-//     add/sub 3487 + 204 K, mul 4734 + 271 K, div 33, neg 105, sqrt 24, sincos 12, log6 0
+//   constrained_aba: 4534 + 1204 K (= 8146 at K = 3)
+//     add/sub 1916 + 543 K, mul 2519 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8457 + 475 K (= 9882 at K = 3)
+//     add/sub 3518 + 204 K, mul 4762 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
 // code. Conventions: q = [x y z qx qy qz qw of the base, then one value per joint], v and qdd in the joint order below,
-// lambda rows in layout order; the constraint force on the robot is -J^T lambda,
-// so M qdd + h = tau - J^T lambda. Needs only "proxgen/runtime.hpp".
+// lambda rows in layout order. Needs only "proxgen/runtime.hpp".
 //
 // Joint order (slots in q | v):
 //   q[0..6] v[0..5]  joint 'root_joint' (free flyer), link 'trunk'
@@ -42,13 +41,60 @@ namespace quadruped {
 
 using Scalar = double;
 inline constexpr int nq = 19, nv = 18, nc = 12;  // configuration, velocity, constraint rows
+inline constexpr int ncons = 4;  // constraints in the layout (each 3 or 6 rows)
 
+// The proxgen that printed this file; the source checks it against the
+// runtime's proxgen_rt::version_major/minor when it is compiled.
+inline constexpr const char* proxgen_version = "0.1.0";
+inline constexpr int version_major = 0, version_minor = 1;
+
+// Names and slots, so callers never count by hand. Joints in the order above
+// (joint_idx_q[k], joint_idx_v[k]: the first slot of joint k in q and v);
+// constraints in layout order (rows constraint_row[k] ..
+// constraint_row[k] + constraint_rows[k] - 1 of lambda). The strings are the
+// URDF's and the layout's names byte for byte; the identifiers in joint:: and
+// constraint:: are those names sanitised (docs/design.md, "Names in the
+// generated files"), the same ones the workspace members use.
+inline constexpr const char* joint_names[] = {"root_joint", "LF_HAA", "LF_HFE", "LF_KFE", "LH_HAA", "LH_HFE", "LH_KFE", "RF_HAA", "RF_HFE", "RF_KFE", "RH_HAA", "RH_HFE", "RH_KFE"};
+inline constexpr int joint_idx_q[] = {0, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18};
+inline constexpr int joint_idx_v[] = {0, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17};
+inline constexpr const char* constraint_names[] = {"lf_foot", "rf_foot", "lh_foot", "rh_foot"};
+inline constexpr int constraint_row[] = {0, 3, 6, 9};
+inline constexpr int constraint_rows[] = {3, 3, 3, 3};
+namespace joint {  // position in the joint list (joint_names)
+inline constexpr int root_joint = 0;
+inline constexpr int LF_HAA = 1;
+inline constexpr int LF_HFE = 2;
+inline constexpr int LF_KFE = 3;
+inline constexpr int LH_HAA = 4;
+inline constexpr int LH_HFE = 5;
+inline constexpr int LH_KFE = 6;
+inline constexpr int RF_HAA = 7;
+inline constexpr int RF_HFE = 8;
+inline constexpr int RF_KFE = 9;
+inline constexpr int RH_HAA = 10;
+inline constexpr int RH_HFE = 11;
+inline constexpr int RH_KFE = 12;
+}  // namespace joint
+namespace constraint {  // position in the layout (constraint_names)
+inline constexpr int lf_foot = 0;
+inline constexpr int rf_foot = 1;
+inline constexpr int lh_foot = 2;
+inline constexpr int rh_foot = 3;
+}  // namespace constraint
+
+// Set the fields by name (later versions add fields, e.g. a per-constraint
+// activity flag, before lambda0).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
-  int iterations = 3;  // multiplier updates K (0: the unconstrained motion)
+  int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
+  // Warm start: nc multipliers (layout order; e.g. the previous control step's
+  // lambda), or null for lambda = 0. The K updates start from lambda0 instead
+  // of 0. It is read before lambda is written: it may be the lambda output.
+  const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (11160 bytes): per-body quantities named
+// Everything one solve writes (11256 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_trunk[3][3];       // joint rotation, body 1
@@ -134,6 +180,7 @@ struct Workspace {
   Scalar pA_RH_shank[6];       // bias force, body 13
   Scalar g_RH_shank[3];        // gravity in body coordinates, body 13
   Scalar k_rh_foot[3];         // constraint right-hand side, constraint 3
+  Scalar lambda[12];           // multipliers (layout order)
   Scalar U_RH_shank[6];        // IA S, body 13
   Scalar Dinv_RH_shank;        // 1 / (S^T IA S), body 13
   Scalar u_RH_shank[1];        // tau - S^T pA, body 13
@@ -192,8 +239,8 @@ struct Workspace {
   Scalar a_RH_hip[6];          // acceleration (gravity-shifted), body 11
   Scalar a_RH_thigh[6];        // acceleration (gravity-shifted), body 12
   Scalar a_RH_shank[6];        // acceleration (gravity-shifted), body 13
+  Scalar residual[12];         // rows of J qdd + gamma - a* of the last solve (residual(w))
   Scalar dlambda[12];          // latest multiplier increment
-  Scalar lambda[12];           // multipliers (layout order)
   Scalar dp_RH_thigh[6];       // reduced-sweep force, body 12
   Scalar dp_RH_hip[6];         // reduced-sweep force, body 11
   Scalar dp_trunk[6];          // reduced-sweep force, body 1
@@ -233,12 +280,30 @@ struct Workspace {
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };
 
-// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).
-// K = s.iterations multiplier updates from lambda = 0; both algorithms give the
-// same iterates up to round-off.
+// In: q[nq], v[nv], tau[nv] (none of them inside w). The quaternion of a free
+// flyer need not be unit: it is normalised as `proxgen eval` does (divided by
+// its largest magnitude, then by its norm), so the quaternion scaled by any
+// non-zero factor gives the same answer (bit for bit for a power of two or -1,
+// else to round-off). A zero quaternion (eval refuses it) or a non-finite one
+// gives NaN in every output.
+// Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.
+// Sign: the constraint force on the robot is -J^T lambda, so
+// M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library
+// where it enters as + J^T f, is -lambda.
+// K = s.iterations proximal multiplier updates
+//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)
+// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
+// round-off. From a lambda0 that already solves the constraints the update
+// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept;
+
+// ||J qdd + gamma - a*||_inf of the last solve with w (qdd its output, a* the
+// layout's Baumgarte target, rows as lambda): how far the K-th iterate is from
+// satisfying the constraints, to choose K by accuracy. NaN if a row is not
+// finite; 0 without constraints.
+Scalar residual(const Workspace& w) noexcept;
 
 }  // namespace quadruped

@@ -19,13 +19,26 @@ void updateMultipliers(const System& sys, Data& d, double mu) {
 
 void constrainedAba(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu,
                     int iterations) {
+  constrainedAbaFrom(sys, d, q, v, tau, mu, iterations, nullptr);
+}
+
+void constrainedAbaFrom(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu,
+                        int iterations, const VecX* lambda0) {
   const Model& m = sys.model;
   const int N = m.numBodies();
   aba_steps::initialise(sys, d, q, v);
   computeConstraintTerms(sys, d);
-  d.lambda.setZero();
+  if (lambda0) d.lambda = *lambda0;
+  else d.lambda.setZero();
 
-  // Penalty on the constrained bodies, before the backward pass (lambda = 0):
+  // The warm start's force on the constrained bodies (the force on the robot
+  // is -K^T lambda): pA_i += K^T lambda0.
+  if (lambda0)
+    for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+      const Constraint& c = sys.constraints[k];
+      if (c.body > 0) d.pA[c.body].noalias() += d.terms[k].K.transpose() * d.lambda.segment(c.row, c.rows());
+    }
+  // Penalty on the constrained bodies, before the backward pass:
   // IA_i += mu K^T K ; pA_i += -mu K^T k.
   if (iterations > 0) {
     for (std::size_t k = 0; k < sys.constraints.size(); ++k) {

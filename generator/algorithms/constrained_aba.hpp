@@ -12,5 +12,9 @@ namespace proxgen {
 /// is -J^T lambda).
 void constrainedAba(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu,
                     int iterations);
+/// The same from lambda = *lambda0 (the warm start, docs/algorithms.md §4.3; null: 0):
+/// K = 0 gives lambda = lambda0 and the motion under its forces.
+void constrainedAbaFrom(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu,
+                        int iterations, const VecX* lambda0);
 
 }  // namespace proxgen

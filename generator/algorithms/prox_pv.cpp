@@ -6,6 +6,11 @@
 namespace proxgen {
 
 void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu, int iterations) {
+  proxPvFrom(sys, d, q, v, tau, mu, iterations, nullptr);
+}
+
+void proxPvFrom(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu, int iterations,
+                const VecX* lambda0) {
   const Model& m = sys.model;
   const int N = m.numBodies();
   aba_steps::initialise(sys, d, q, v);
@@ -63,6 +68,8 @@ void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX
   d.G.diagonal().array() += 1.0 / mu;
   d.llt.compute(d.G);
   d.lambdaTree.setZero();
+  if (lambda0)
+    for (int r = 0; r < nc; ++r) d.lambdaTree[r] = (*lambda0)[rows[r]];  // the warm start, in tree order
   for (int k = 0; k < iterations && nc > 0; ++k) {
     d.lambdaTree = d.yfree + d.lambdaTree / mu;
     d.llt.solveInPlace(d.lambdaTree);

@@ -11,5 +11,9 @@ namespace proxgen {
 
 /// K proximal iterations from lambda = 0; results in d.qdd, d.lambda (layout order).
 void proxPv(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu, int iterations);
+/// The same from lambda = *lambda0 (layout order; the warm start,
+/// docs/algorithms.md §4.3; null: 0). K = 0: lambda = lambda0 and the motion under its forces.
+void proxPvFrom(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& tau, double mu, int iterations,
+                const VecX* lambda0);
 
 }  // namespace proxgen

@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
 #include "emit/identifiers.hpp"
 
 namespace proxgen::emit {
@@ -61,9 +65,21 @@ struct EntryPoint {
 };
 const EntryPoint kEntryPoints[] = {
     {Function::ConstrainedAba,
-     "// q[nq], v[nv], tau[nv] in; qdd[nv], lambda[nc] out (none of them inside w).\n"
-     "// K = s.iterations multiplier updates from lambda = 0; both algorithms give the\n"
-     "// same iterates up to round-off.\n",
+     "// In: q[nq], v[nv], tau[nv] (none of them inside w). The quaternion of a free\n"
+     "// flyer need not be unit: it is normalised as `proxgen eval` does (divided by\n"
+     "// its largest magnitude, then by its norm), so the quaternion scaled by any\n"
+     "// non-zero factor gives the same answer (bit for bit for a power of two or -1,\n"
+     "// else to round-off). A zero quaternion (eval refuses it) or a non-finite one\n"
+     "// gives NaN in every output.\n"
+     "// Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.\n"
+     "// Sign: the constraint force on the robot is -J^T lambda, so\n"
+     "// M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library\n"
+     "// where it enters as + J^T f, is -lambda.\n"
+     "// K = s.iterations proximal multiplier updates\n"
+     "//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)\n"
+     "// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to\n"
+     "// round-off. From a lambda0 that already solves the constraints the update\n"
+     "// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).\n",
      "void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,\n"
      "                     Scalar* qdd, Scalar* lambda) noexcept",
      "// constrainedABA: the penalty mu K^T K at the constrained bodies, one full\n"
@@ -118,6 +134,50 @@ std::string bodyOf(const SolverTexts& texts, Function f) {
   return texts.library.at(f);
 }
 
+// The names and slots of the header (docs/design.md, "Names in the generated
+// files"): string arrays of the raw names, slot arrays, and an index per joint
+// and per constraint under its sanitised identifier.
+struct Names {
+  std::string jointNames, jointQ, jointV, jointIds, consNames, consRow, consRows, consIds, empty;
+};
+Names namesAndSlots(const Plan& plan) {
+  Names n;
+  IdentifierSet jointIds;  // joints have no identifier in the plan: made here, unique by position
+  const auto sep = [](const std::string& s) { return s.empty() ? "" : ", "; };
+  for (std::size_t i = 1; i < plan.bodies.size(); ++i) {
+    const BodyPlan& b = plan.bodies[i];
+    const int k = int(i) - 1;
+    n.jointNames += sep(n.jointNames) + cStringLiteral(b.joint);
+    n.jointQ += fmt::format("{}{}", sep(n.jointQ), b.idx_q);
+    n.jointV += fmt::format("{}{}", sep(n.jointV), b.idx_v);
+    n.jointIds += fmt::format("inline constexpr int {} = {};\n", jointIds.make(b.joint, k), k);
+  }
+  for (std::size_t k = 0; k < plan.constraints.size(); ++k) {
+    const ConstraintPlan& c = plan.constraints[k];
+    n.consNames += sep(n.consNames) + cStringLiteral(c.name);
+    n.consRow += fmt::format("{}{}", sep(n.consRow), c.row);
+    n.consRows += fmt::format("{}{}", sep(n.consRows), c.rows);
+    n.consIds += fmt::format("inline constexpr int {} = {};\n", c.ident, k);
+  }
+  // A C++ array cannot be empty: one placeholder entry, said so.
+  if (n.jointNames.empty()) {
+    n.jointNames = "nullptr", n.jointQ = n.jointV = "0";
+    n.empty += "\n// No joints: the joint arrays hold one placeholder entry (nullptr, 0).";
+  }
+  if (n.consNames.empty()) {
+    n.consNames = "nullptr", n.consRow = n.consRows = "0";
+    n.empty += "\n// No constraints (ncons = 0): the constraint arrays hold one placeholder entry (nullptr, 0).";
+  }
+  return n;
+}
+
+// major.minor of PROXGEN_VERSION ("0.1.0").
+std::pair<int, int> versionNumbers() {
+  int major = 0, minor = 0;
+  if (std::sscanf(PROXGEN_VERSION, "%d.%d", &major, &minor) != 2) throw std::logic_error("PROXGEN_VERSION is not major.minor");
+  return {major, minor};
+}
+
 }  // namespace
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
@@ -151,6 +211,19 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
                     ep.signature + ";\n";
     definitions += fmt::format("{}{} {{\n{}}}\n\n", ep.source, ep.signature, bodyOf(texts, ep.f));
   }
+  // residual(w): the last solve's, so only with a solver.
+  if (texts.functions.has(Function::ConstrainedAba) || texts.functions.has(Function::ProxPv)) {
+    declarations +=
+        "\n// ||J qdd + gamma - a*||_inf of the last solve with w (qdd its output, a* the\n"
+        "// layout's Baumgarte target, rows as lambda): how far the K-th iterate is from\n"
+        "// satisfying the constraints, to choose K by accuracy. NaN if a row is not\n"
+        "// finite; 0 without constraints.\n"
+        "Scalar residual(const Workspace& w) noexcept;\n";
+    definitions += fmt::format("// The largest row of K a - k, stored by the last solve.\n"
+                               "Scalar residual(const Workspace& w) noexcept {{\n{}}}\n\n",
+                               plan.nc > 0 ? "  return proxgen_rt::largest_magnitude_of<nc>(w.residual);\n"
+                                           : "  static_cast<void>(w);\n  return Scalar(0);\n");
+  }
   const std::string banner = fmt::format(
       fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION), fmt::arg("urdf", escapeComment(in.urdfName)),
       fmt::arg("layout", escapeComment(in.layoutName)), fmt::arg("command", escapeComment(in.command)),
@@ -161,6 +234,8 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   files.headerName = plan.name + ".hpp";
   files.sourceName = plan.name + ".cpp";
   const CodeBuilder lit(plan.scalar);
+  const Names n = namesAndSlots(plan);
+  const auto [major, minor] = versionNumbers();
   files.header = fmt::format(
       fmt::runtime(kHeaderTemplate), fmt::arg("banner", banner),
       fmt::arg("q_convention", plan.qConvention),
@@ -168,7 +243,12 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("scalar", scalarName(plan.scalar)), fmt::arg("nq", plan.nq), fmt::arg("nv", plan.nv),
       fmt::arg("nc", plan.nc), fmt::arg("mu", lit.literal(plan.mu)), fmt::arg("iterations", plan.iterations),
       fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()),
-      fmt::arg("declarations", declarations));
+      fmt::arg("declarations", declarations), fmt::arg("ncons", plan.constraints.size()),
+      fmt::arg("version", PROXGEN_VERSION), fmt::arg("version_major", major), fmt::arg("version_minor", minor),
+      fmt::arg("empty_arrays", n.empty), fmt::arg("joint_names", n.jointNames), fmt::arg("joint_idx_q", n.jointQ),
+      fmt::arg("joint_idx_v", n.jointV), fmt::arg("joint_ids", n.jointIds), fmt::arg("constraint_names", n.consNames),
+      fmt::arg("constraint_row", n.consRow), fmt::arg("constraint_rows", n.consRows),
+      fmt::arg("constraint_ids", n.consIds));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
                              fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)),
                              fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));

@@ -144,4 +144,18 @@ std::string escapeComment(const std::string& text) {
   return out;
 }
 
+std::string cStringLiteral(const std::string& text) {
+  std::string out = "\"";
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const unsigned char c = static_cast<unsigned char>(text[k]);
+    // A '*' next to a '/' is escaped too: the file then holds no "/*" or "*/"
+    // anywhere, as for names in comments (tests/fuzz/fuzz_emit.cpp checks the text).
+    const bool nextToSlash = c == '*' && ((k > 0 && text[k - 1] == '/') || (k + 1 < text.size() && text[k + 1] == '/'));
+    if (c == '"' || c == '\\' || c == '?') out += std::string("\\") + char(c);
+    else if (c >= 0x20 && c < 0x7f && !nextToSlash) out += char(c);
+    else out += fmt::format("\\{:03o}", c);
+  }
+  return out + "\"";
+}
+
 }  // namespace proxgen::emit

@@ -45,4 +45,11 @@ class IdentifierSet {
 /// (trigraphs), cut at kMaxCommentLength characters with the byte count noted.
 std::string escapeComment(const std::string& text);
 
+/// `text` as a C and C++ string literal, quotes included, that holds exactly
+/// its bytes: printable ASCII as is, except `"`, `\` and `?` (no trigraph)
+/// escaped by a backslash; every other byte, and a `*` next to a `/` (no
+/// comment token), as a three-digit octal escape (which, unlike \x, cannot
+/// run into the next character).
+std::string cStringLiteral(const std::string& text);
+
 }  // namespace proxgen::emit

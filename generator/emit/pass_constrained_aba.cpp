@@ -12,8 +12,10 @@
 namespace proxgen::emit {
 namespace {
 
-// lambda += mu (K a - k) for every constraint, keeping the increment for the next sweep.
-void updateMultipliers(Emit& e, const Kinematics& kin, const Motion& motion, bool first, Multipliers& mult) {
+// lambda += mu (K a - k) for every constraint, keeping the increment for the
+// next sweep, and K a - k itself: the rows' residual J qdd + gamma - a* of the
+// accelerations just computed (residual(w) reads the last one).
+void updateMultipliers(Emit& e, const Kinematics& kin, const Motion& motion, Multipliers& mult) {
   e.fn.boundary("");
   CodeBuilder& cb = e.cb();
   cb.open("{", {"multiplier update: dlambda = mu (K a - k), lambda += dlambda"});
@@ -23,11 +25,10 @@ void updateMultipliers(Emit& e, const Kinematics& kin, const Motion& motion, boo
     for (int j = 0; j < c.rows(); ++j) {
       const int row = c.row + j;
       const Expr mu = cb.input("mu");  // before the difference's temporary: see mulAdd in symbolic.cpp
-      const Expr dl = cb.mul(mu, cb.flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]));
+      const Expr res = cb.store(residualMember(e, row), Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+      const Expr dl = cb.mul(mu, res);
       mult.dlambda[std::size_t(row)] = e.put(e.member("dlambda", e.plan.nc, row, "latest multiplier increment"), dl);
-      mult.lambda[std::size_t(row)] =
-          e.put(e.lambdaMember(row), first ? mult.dlambda[std::size_t(row)]
-                                           : mult.lambda[std::size_t(row)] + mult.dlambda[std::size_t(row)]);
+      mult.lambda[std::size_t(row)] = e.put(e.lambdaMember(row), mult.lambda[std::size_t(row)] + mult.dlambda[std::size_t(row)]);
     }
   }
   cb.close();
@@ -92,6 +93,19 @@ void reducedSweep(Emit& e, const Kinematics& kin, const Multipliers& mult, Artic
   }
 }
 
+// pA_i += K^T lambda0 for the constraints on body i: the warm start's force
+// (the force on the robot is -K^T lambda), so the first sweep solves for
+// lambda0 + mu (K a - k) as the generic constrainedAba does.
+void warmStartForce(Emit& e, int i, const Multipliers& mult, Articulated& art) {
+  V6& pA = art.b[std::size_t(i)].pA;
+  for (int k : e.bp(i).constraints) {
+    const Constraint& c = e.sys.constraints[std::size_t(k)];
+    const Mat6 X = c.placement.motionMatrixInv();
+    for (int r = 0; r < 6; ++r)
+      for (int j = 0; j < c.rows(); ++j) pA[std::size_t(r)] += X(j, r) * mult.lambda[std::size_t(c.row + j)];
+  }
+}
+
 // What the iteration loop carries: the same expressions at its start and end.
 std::string fingerprint(const CodeBuilder& cb, const std::vector<int>& bodies, const Motion& motion, const Articulated& art,
                         const Multipliers& mult) {
@@ -107,6 +121,22 @@ std::string fingerprint(const CodeBuilder& cb, const std::vector<int>& bodies, c
 }
 
 }  // namespace
+
+std::string residualMember(Emit& e, int row) {
+  return e.member("residual", e.plan.nc, row, "rows of J qdd + gamma - a* of the last solve (residual(w))");
+}
+
+// In the host, before the first sweep: lambda = lambda0 (s.lambda0, or zeros
+// when it is null: the runtime's pointer select).
+void startMultipliers(Emit& e, Multipliers& mult) {
+  if (e.plan.nc == 0) return;
+  e.fn.endPart();
+  CodeBuilder& cb = e.cb();
+  cb.comment("---- warm start: lambda = s.lambda0, or 0 when it is null");
+  cb.line("const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);", {}, {"s"});
+  for (int r = 0; r < e.plan.nc; ++r)
+    mult.lambda[std::size_t(r)] = cb.store(e.lambdaMember(r), cb.input(fmt::format("lambda0[{}]", r)));
+}
 
 // qdd and lambda out of the workspace.
 void copyOut(Emit& e, const Motion& motion, const Multipliers& mult) {
@@ -129,18 +159,20 @@ std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const C
   e.fn.setHostMu(e.cb().define("mu", "s.mu * Scalar(s.iterations > 0)", {}, {"s"}));
   e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   if (!plan.offSupport.empty()) e.cb().line("eliminate_free_bodies(tau, w);", {}, {"tau", "w"});
+  startMultipliers(e, mult);
   e.fn.beginPass("backward", "backward: eliminate the support, the penalty mu K^T K at the constrained bodies");
   for (auto it = plan.support.rbegin(); it != plan.support.rend(); ++it) {
     e.fn.boundary(*it);
     e.openBody(*it, "eliminate (penalty at the constraints):");
+    warmStartForce(e, *it, mult, art);
     eliminateBody(e, kin, *it, &kin.k, art);
     e.cb().close();
   }
   e.fn.beginPass("forward", "forward: accelerations of the support");
   accelerateSupport(e, kin, art, motion);
   if (plan.nc > 0) {
-    e.fn.beginPass("multipliers", "multipliers: dlambda = mu (K a - k), lambda = dlambda");
-    updateMultipliers(e, kin, motion, true, mult);
+    e.fn.beginPass("multipliers", "multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda");
+    updateMultipliers(e, kin, motion, mult);
     e.fn.endPart();
     const std::string before = fingerprint(e.cb(), plan.support, motion, art, mult);
     e.cb().open("for (int k = 2; k <= s.iterations; ++k) {",
@@ -150,7 +182,7 @@ std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const C
     e.fn.beginPass("reforward", "forward: accelerations of the support");
     accelerateSupport(e, kin, art, motion);
     e.fn.beginPass("update", "multipliers: dlambda = mu (K a - k), lambda += dlambda");
-    updateMultipliers(e, kin, motion, false, mult);
+    updateMultipliers(e, kin, motion, mult);
     e.fn.endPart();
     if (fingerprint(e.cb(), plan.support, motion, art, mult) != before)
       throw std::logic_error("emitter: the iteration loop does not carry its state consistently");

@@ -32,9 +32,28 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   for (int d = 0; d < j.nv; ++d) b.S.push_back(constant(Vec6(S.col(d))));
   CodeBuilder& cb = e.cb();
   if (p.jointClass == JointClass::FreeFlyer) {
-    // q = [x y z qx qy qz qw]; R as Eigen's Quaternion::toRotationMatrix (unnormalised input used as given).
-    const Expr x = cb.input(q(j.idx_q + 3)), y = cb.input(q(j.idx_q + 4)), z = cb.input(q(j.idx_q + 5)),
-               w = cb.input(q(j.idx_q + 6));
+    // q = [x y z qx qy qz qw]. The quaternion is normalised as `proxgen eval`
+    // normalises it (model/state.cpp): divided by its largest magnitude (a
+    // branch-free select of the runtime), so its squared norm neither
+    // overflows nor underflows, then by its norm. A zero quaternion, which eval
+    // refuses, gives 1 / 0 here and NaN in every output (documented in the
+    // header). Then R as Eigen's Quaternion::toRotationMatrix.
+    std::vector<Expr> raw;
+    for (int k = 3; k < 7; ++k) raw.push_back(cb.input(q(j.idx_q + k)));
+    const Expr largest = cb.define(
+        "qscale",
+        fmt::format("proxgen_rt::largest_magnitude({}, {}, {}, {})", cb.print(raw[0]), cb.print(raw[1]),
+                    cb.print(raw[2]), cb.print(raw[3])),
+        raw);
+    const Expr toLargest = cb.recip(largest, "inv");
+    std::vector<Expr> scaled;
+    Expr norm2;
+    for (const Expr& c : raw) scaled.push_back(cb.temp(cb.mul(c, toLargest), "qs"));
+    for (const Expr& c : scaled) norm2 += cb.mul(c, c);
+    const Expr toUnit = cb.recip(cb.sqrt(norm2, "qn"), "inv");
+    std::vector<Expr> unit;
+    for (const Expr& c : scaled) unit.push_back(cb.temp(cb.mul(c, toUnit), "qu"));
+    const Expr &x = unit[0], &y = unit[1], &z = unit[2], &w = unit[3];
     // 2 a b + s 2 c d, the products in this order (see mulAdd in symbolic.cpp).
     auto two = [&](const Expr& a, const Expr& b2, double s, const Expr& c, const Expr& d) {
       return 2.0 * mulAdd(cb, a, b2, s, c, d);

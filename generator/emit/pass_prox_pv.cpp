@@ -221,6 +221,20 @@ void freeRowAccelerations(Emit& e, const Kinematics& kin, const Articulated& art
   e.cb().close();
 }
 
+// The rows' residual K a - k = J qdd + gamma - a* of the final accelerations
+// (residual(w) reads it; constrainedABA stores it in its multiplier update).
+void storeResidual(Emit& e, const Kinematics& kin, const Motion& motion) {
+  e.fn.beginPass("residual", "the rows' residual K a - k of the final accelerations");
+  e.fn.boundary("");
+  e.cb().open("{", {"residual rows K a - k (layout order)"});
+  for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
+    const Constraint& c = e.sys.constraints[k];
+    const std::vector<Expr> Ka = e.constraintRows(int(k), c.body == 0 ? e.rootAcceleration() : motion.a[std::size_t(c.body)]);
+    for (int j = 0; j < c.rows(); ++j) e.cb().store(residualMember(e, c.row + j), Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+  }
+  e.cb().close();
+}
+
 std::string fingerprint(const CodeBuilder& cb, const Multipliers& mult) {
   std::string f;
   for (const Expr& x : mult.lambda) f += cb.describe(x) + ";";
@@ -260,12 +274,8 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
     e.fn.beginPass("delassus", "G + I/mu = L L^T, G assembled from the carried rows");
     del = factorDelassus(e, rows);
     e.fn.live().del = &del;
-    e.fn.beginPass("start", "lambda = 0");
-    e.fn.boundary("");
+    startMultipliers(e, mult);
     const std::vector<int>& tree = plan.rootRows;
-    for (int t = 0; t < nc; ++t)
-      mult.lambda[std::size_t(tree[std::size_t(t)])] = e.cb().store(e.lambdaMember(tree[std::size_t(t)]), Expr());
-    e.fn.endPart();
     const std::string before = fingerprint(e.cb(), mult);
     e.cb().open("for (int k = 0; k < s.iterations; ++k) {",
                 {"K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)"},
@@ -296,6 +306,7 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
     accelerateBody(e, kin, art, i, uEff, true, motion);
     e.cb().close();
   }
+  if (nc > 0) storeResidual(e, kin, motion);
   callAccelerateFree(e, kin, art, motion);
   copyOut(e, motion, mult);
   std::string text = e.fn.endHost({"q", "v", "tau", "s", "w", "qdd", "lambda"});

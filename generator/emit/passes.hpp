@@ -60,6 +60,10 @@ std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector
 // whose values live in `from`.
 /// qdd and lambda out of the workspace (the end of both entry points).
 void copyOut(Emit& e, const Motion& motion, const Multipliers& mult);
+/// The warm start in the host: lambda = s.lambda0 (or 0); and the member of
+/// the rows' residual K a - k that residual(w) reads (both entry points).
+void startMultipliers(Emit& e, Multipliers& mult);
+std::string residualMember(Emit& e, int row);
 std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
 
 // ---- pass_prox_pv.cpp: the prox_pv entry point (body text), as above.

@@ -4,8 +4,9 @@
 //
 // The generated code prints every product itself (constants folded at
 // generation time), so what is left here is the sine and cosine of the joint
-// angles and the SE(3) logarithm that a Baumgarte position gain on a 6D
-// constraint needs.
+// angles, the SE(3) logarithm that a Baumgarte position gain on a 6D
+// constraint needs, and three selects (the quaternion's scale, the warm start,
+// the residual's largest row).
 #pragma once
 
 #include <cmath>
@@ -28,7 +29,46 @@
 
 namespace proxgen_rt {
 
-inline constexpr int version_major = 0, version_minor = 1;
+// The runtime's version: a generated source checks it against the proxgen
+// that printed it (static_assert), so a solver is never compiled against a
+// runtime whose helpers may differ. PROXGEN_RT_VERSION_* for preprocessor use.
+#define PROXGEN_RT_VERSION_MAJOR 0
+#define PROXGEN_RT_VERSION_MINOR 1
+inline constexpr int version_major = PROXGEN_RT_VERSION_MAJOR, version_minor = PROXGEN_RT_VERSION_MINOR;
+
+/// max(|a|, |b|, |c|, |d|), branch-free (compare-and-select: maxsd on x86):
+/// the free-flyer quaternion is divided by it before it is normalised, as
+/// `proxgen eval` does, so that no squared norm overflows or underflows. A
+/// NaN component is not propagated here; it reaches the outputs through the
+/// division that follows.
+template <class S>
+inline S largest_magnitude(S a, S b, S c, S d) noexcept {
+  const S x = std::fabs(a), y = std::fabs(b), z = std::fabs(c), t = std::fabs(d);
+  const S xy = x > y ? x : y, zt = z > t ? z : t;
+  return xy > zt ? xy : zt;
+}
+
+/// The warm start of a solver with N constraint rows: `lambda0` itself, or N
+/// zeros when it is null (a pointer select, no branch on the data).
+template <int N, class S>
+inline const S* initial_multipliers(const S* lambda0) noexcept {
+  static constexpr S zeros[N] = {};
+  return lambda0 ? lambda0 : zeros;
+}
+
+/// max_r |x[r]| over N values; NaN when one of them is NaN or infinite (the
+/// sum of x - x is 0 for finite values only), so a failed solve never reads
+/// as a small residual.
+template <int N, class S>
+inline S largest_magnitude_of(const S* x) noexcept {
+  S largest = S(0), invalid = S(0);
+  for (int r = 0; r < N; ++r) {
+    const S a = std::fabs(x[r]);
+    largest = a > largest ? a : largest;
+    invalid += x[r] - x[r];
+  }
+  return largest + invalid;
+}
 
 /// s = sin(x), c = cos(x). For double: one reduction to r = x - k pi/2,
 /// |r| <= pi/4 (pi/2 in three parts, Cody and Waite), the sine and cosine

@@ -45,8 +45,9 @@ TEST(WorkspaceMembers, RotationsAreThreeByThree) {
     }
   }
   // Entry (2, 1) of the free flyer's rotation, row-major k = 7 before:
-  // 2 (y z + x w) with q = [x y z qx qy qz qw] (Eigen's toRotationMatrix).
-  EXPECT_NE(quad.source.find("w.RJ_trunk[2][1] = 2.0*(q[4]*q[5] + q[3]*q[6]);"), std::string::npos);
+  // 2 (y z + x w) with q = [x y z qx qy qz qw] (Eigen's toRotationMatrix), of
+  // the normalised quaternion qu0..qu3 (pass_kinematics.cpp).
+  EXPECT_NE(quad.source.find("w.RJ_trunk[2][1] = 2.0*(qu1*qu2 + qu0*qu3);"), std::string::npos);
 }
 
 }  // namespace

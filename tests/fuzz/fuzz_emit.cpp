@@ -5,8 +5,9 @@
 // (docs/design.md, "Bad input"): printable ASCII only, no trigraph,
 // no block-comment token, no line splice, no preprocessor line other than the
 // ones every solver has, and code (outside comments and those lines) made of
-// identifiers, numbers and operators only: no quote, backslash, '#', '?' or
-// other character a raw name would bring along. The same bytes on a second run.
+// identifiers, numbers, operators and string literals of escaped names only
+// (no raw quote, backslash, '#', '?' or other character a raw name would
+// bring along). The same bytes on a second run.
 #include <cctype>
 #include <cstddef>
 #include <cstdint>
@@ -58,14 +59,41 @@ const std::set<std::string>& allowedDirectives() {
   return lines;
 }
 
-/// The text outside // comments and preprocessor lines.
+// A line's code: without its // comment and its string literals (the
+// header's name arrays hold the raw names as emit::cStringLiteral writes
+// them). A literal must hold only printable characters other than '"', a
+// backslash and '?', and the escapes of a quote, a backslash, '?' and \ooo.
+std::string withoutStringLiterals(const std::string& line) {
+  std::string out;
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    if (line.compare(k, 2, "//") == 0) break;
+    if (line[k] != '"') {
+      out += line[k];
+      continue;
+    }
+    for (++k; k < line.size() && line[k] != '"'; ++k) {
+      if (line[k] == '?') broken("unescaped '?' in a string literal", line);
+      if (line[k] != '\\') continue;
+      const bool simple = k + 1 < line.size() && std::string_view("\"\\?").find(line[k + 1]) != std::string_view::npos;
+      bool octal = k + 3 < line.size();
+      for (std::size_t j = 1; j <= 3 && octal; ++j) octal = line[k + j] >= '0' && line[k + j] <= '7';
+      if (!simple && !octal) broken("unknown escape in a string literal", line);
+      k += simple ? 1 : 3;
+    }
+    if (k >= line.size()) broken("unterminated string literal", line);
+    out += "s";
+  }
+  return out;
+}
+
+/// The text outside // comments, preprocessor lines and string literals.
 std::string codeOf(const std::string& text) {
   std::string code;
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
     const std::size_t first = line.find_first_not_of(' ');
     if (first != std::string::npos && line[first] == '#') continue;
-    code += line.substr(0, line.find("//")) + "\n";
+    code += withoutStringLiterals(line) + "\n";
   }
   return code;
 }

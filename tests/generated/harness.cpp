@@ -10,11 +10,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
+#include <string>
 #include <type_traits>
 #include <vector>
 
 #include PROXGEN_SOLVER_HEADER
 #include "harness_lib.hpp"
+#include "proxgen/runtime.hpp"
 
 namespace {
 
@@ -29,10 +32,12 @@ using proxgen::test::SolverUnderTest;
 #endif
 
 #if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
-// The generated solver on one state, results in double.
-void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const VecX& vIn, const VecX& tauIn, double mu,
-                  int K, VecX& qdd, VecX& lambda) {
-  std::vector<gen::Scalar> q(gen::nq), v(gen::nv), tau(gen::nv), a(gen::nv), l(std::size_t(std::max(gen::nc, 1)));
+// The generated solver on one state, results in double; lambda0 (nc values)
+// or null is Settings::lambda0. Returns residual(w).
+double runGeneratedFrom(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const VecX& vIn, const VecX& tauIn,
+                        double mu, int K, const VecX* lambda0In, VecX& qdd, VecX& lambda) {
+  std::vector<gen::Scalar> q(gen::nq), v(gen::nv), tau(gen::nv), a(gen::nv), l(std::size_t(std::max(gen::nc, 1))),
+      l0(std::size_t(std::max(gen::nc, 1)));
   for (int k = 0; k < gen::nq; ++k) q[std::size_t(k)] = gen::Scalar(qIn[k]);
   for (int k = 0; k < gen::nv; ++k) {
     v[std::size_t(k)] = gen::Scalar(vIn[k]);
@@ -41,6 +46,10 @@ void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const V
   gen::Settings settings;
   settings.mu = gen::Scalar(mu);
   settings.iterations = K;
+  if (lambda0In) {
+    for (int k = 0; k < gen::nc; ++k) l0[std::size_t(k)] = gen::Scalar((*lambda0In)[k]);
+    settings.lambda0 = l0.data();
+  }
   static gen::Workspace w;  // tens of kB for the big robots: not on the stack
   const auto solve = algorithm == SolverUnderTest::kConstrainedAba ? gen::constrained_aba : gen::prox_pv;
   solve(q.data(), v.data(), tau.data(), settings, w, a.data(), l.data());
@@ -48,6 +57,23 @@ void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const V
   lambda.resize(gen::nc);
   for (int k = 0; k < gen::nv; ++k) qdd[k] = double(a[std::size_t(k)]);
   for (int k = 0; k < gen::nc; ++k) lambda[k] = double(l[std::size_t(k)]);
+  return double(gen::residual(w));
+}
+
+void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu,
+                  int K, VecX& qdd, VecX& lambda) {
+  runGeneratedFrom(algorithm, q, v, tau, mu, K, nullptr, qdd, lambda);
+}
+
+SolverUnderTest solverUnderTest() {
+  SolverUnderTest solver;
+  solver.nq = gen::nq;
+  solver.nv = gen::nv;
+  solver.nc = gen::nc;
+  solver.isFloat = std::is_same_v<gen::Scalar, float>;
+  solver.run = runGenerated;
+  solver.runFrom = runGeneratedFrom;
+  return solver;
 }
 #endif
 
@@ -94,13 +120,71 @@ TEST_F(Generated, SettingsDefaultsAreTheLayouts) {
 
 #if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
 TEST_F(Generated, MatchesTheGenericSolvers) {
-  SolverUnderTest solver;
-  solver.nq = gen::nq;
-  solver.nv = gen::nv;
-  solver.nc = gen::nc;
-  solver.isFloat = std::is_same_v<gen::Scalar, float>;
-  solver.run = runGenerated;
-  proxgen::test::expectMatchesTheGenericSolvers(solver, sys_);
+  proxgen::test::expectMatchesTheGenericSolvers(solverUnderTest(), sys_);
+}
+
+// ---- The controller API of issue 18 (items 1, 3, 4): names and slots, the
+// version, the quaternion's scale, the warm start, the residual.
+TEST_F(Generated, NamesAndSlotsAreTheModels) {
+  const proxgen::Model& m = sys_.model;
+  const int joints = m.numBodies() - 1;
+  ASSERT_EQ(int(std::size(gen::joint_names)), std::max(joints, 1));  // one placeholder when empty
+  for (int k = 0; k < joints; ++k) {
+    const proxgen::Joint& j = m.bodies[std::size_t(k + 1)].joint;
+    EXPECT_EQ(std::string(gen::joint_names[k]), j.name) << "joint " << k;  // byte for byte
+    EXPECT_EQ(gen::joint_idx_q[k], j.idx_q) << j.name;
+    EXPECT_EQ(gen::joint_idx_v[k], j.idx_v) << j.name;
+  }
+  ASSERT_EQ(gen::ncons, int(sys_.constraints.size()));
+  ASSERT_EQ(int(std::size(gen::constraint_names)), std::max(gen::ncons, 1));
+  for (int k = 0; k < gen::ncons; ++k) {
+    const proxgen::Constraint& c = sys_.constraints[std::size_t(k)];
+    EXPECT_EQ(std::string(gen::constraint_names[k]), c.name) << "constraint " << k;
+    EXPECT_EQ(gen::constraint_row[k], c.row) << c.name;
+    EXPECT_EQ(gen::constraint_rows[k], c.rows()) << c.name;
+  }
+}
+
+TEST_F(Generated, VersionIsTheGeneratorsAndTheRuntimes) {
+  EXPECT_STREQ(gen::proxgen_version, PROXGEN_VERSION);
+  EXPECT_EQ(gen::version_major, proxgen_rt::version_major);
+  EXPECT_EQ(gen::version_minor, proxgen_rt::version_minor);
+}
+
+TEST_F(Generated, QuaternionScaleIsIgnored) {
+  if (!sys_.model.floatingBase) GTEST_SKIP() << "no free flyer";
+  proxgen::test::expectQuaternionScaleIsIgnored(solverUnderTest(), sys_);
+}
+
+TEST_F(Generated, WarmStartMatchesTheGeneric) {
+  proxgen::test::expectWarmStartMatchesTheGeneric(solverUnderTest(), sys_);
+}
+
+// The header promises lambda0 is read before lambda is written: the previous
+// step's lambda array can be both (README's controller loop). Same operations
+// on the same values: the same bits.
+TEST_F(Generated, WarmStartMayBeTheLambdaOutput) {
+  if (gen::nc == 0) GTEST_SKIP() << "no constraints";
+  std::vector<gen::Scalar> q(gen::nq, gen::Scalar(0.1)), v(gen::nv, gen::Scalar(0.2)), tau(gen::nv, gen::Scalar(0.3)),
+      qdd(gen::nv), l0(gen::nc), lOut(gen::nc), qddAlias(gen::nv), lAlias(gen::nc);
+  if (sys_.model.floatingBase) q[6] = gen::Scalar(1);  // w of a unit quaternion (0.1, 0.1, 0.1, 1) scaled: fine
+  for (int k = 0; k < gen::nc; ++k) l0[std::size_t(k)] = lAlias[std::size_t(k)] = gen::Scalar(0.5 + k);
+  static gen::Workspace w;
+  for (auto solve : {gen::constrained_aba, gen::prox_pv}) {
+    gen::Settings s;
+    s.lambda0 = l0.data();
+    solve(q.data(), v.data(), tau.data(), s, w, qdd.data(), lOut.data());
+    for (int k = 0; k < gen::nc; ++k) lAlias[std::size_t(k)] = l0[std::size_t(k)];
+    s.lambda0 = lAlias.data();
+    solve(q.data(), v.data(), tau.data(), s, w, qddAlias.data(), lAlias.data());
+    EXPECT_EQ(qddAlias, qdd);
+    EXPECT_EQ(lAlias, lOut);
+    EXPECT_NE(lOut, l0);  // the multipliers moved: the comparison can see a clobbered lambda0
+  }
+}
+
+TEST_F(Generated, ResidualIsTheConstraintResidual) {
+  proxgen::test::expectResidualIsTheConstraintResidual(solverUnderTest(), sys_);
 }
 
 #endif

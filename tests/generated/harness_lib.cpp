@@ -21,15 +21,23 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <string>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "algorithms/constrained_aba.hpp"
+#include "algorithms/constraint_kinematics.hpp"
+#include "algorithms/constraints.hpp"
 #include "algorithms/data.hpp"
+#include "algorithms/prox_pv.hpp"
 #include "cases/cases.hpp"
 #include "model/layout.hpp"
 #include "support.hpp"
@@ -181,6 +189,232 @@ void expectLibraryMatchesTheGeneric(const LibraryUnderTest& lib, const SolverUnd
   }
   EXPECT_FALSE(worst.empty()) << "the solver holds none of the joint-space functions";
   for (const auto& [what, w] : worst) std::printf("%s: largest relErr %.1e (%.2f of the bound)\n", what.c_str(), w.error, w.ratio);
+}
+
+}  // namespace proxgen::test
+
+// ---- The controller API of issue 18 (items 1 and 3) ------------------------
+namespace proxgen::test {
+namespace {
+
+// 20 states for each check below (PROXGEN_HARNESS_STATES lowers it, as above).
+int apiStates() {
+  const char* env = std::getenv("PROXGEN_HARNESS_STATES");
+  return env ? std::max(1, std::min(20, std::atoi(env))) : 20;
+}
+
+// The first slot of the free flyer's quaternion in q, or -1.
+int quaternionSlot(const Model& m) {
+  for (int i = 1; i < m.numBodies(); ++i)
+    if (m.bodies[std::size_t(i)].joint.type == JointType::FreeFlyer) return m.bodies[std::size_t(i)].joint.idx_q + 3;
+  return -1;
+}
+
+double maxAbs(const VecX& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
+
+}  // namespace
+
+void expectQuaternionScaleIsIgnored(const SolverUnderTest& gen, const System& sys) {
+  const int at = quaternionSlot(sys.model);
+  ASSERT_GE(at, 0) << "no free flyer";
+  Data d(sys), dense(sys);
+  std::mt19937 rng(20261201);
+  const double mu = 1e4;
+  const int K = 3;
+  for (int n = 0; n < apiStates(); ++n) {
+    const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
+    const std::string where = "state " + std::to_string(n);
+    VecX qdd[2], lambda[2];
+    for (int a = 0; a < 2; ++a) gen.run(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, qdd[a], lambda[a]);
+    // Scaling by a power of two or by -1 is exact in binary floating point and
+    // commutes with every rounding (no overflow or underflow at these sizes):
+    // the largest magnitude scales by |f|, its reciprocal by 1 / |f|, and the
+    // scaled components, hence the normalised ones, are those of q up to the
+    // sign, which R (quadratic in q) drops. So the answer is the same bit for bit.
+    for (double f : {2.0, -1.0, 0.5}) {
+      State t = s;
+      t.q.segment<4>(at) *= f;
+      for (int a = 0; a < 2; ++a) {
+        VecX qddF, lambdaF;
+        gen.run(SolverUnderTest::Algorithm(a), t.q, t.v, t.tau, mu, K, qddF, lambdaF);
+        EXPECT_EQ(qddF, qdd[a]) << "quaternion x " << f << ", algorithm " << a << ", " << where;
+        EXPECT_EQ(lambdaF, lambda[a]) << "quaternion x " << f << ", algorithm " << a << ", " << where;
+      }
+    }
+    // Other factors round: the normalised quaternion is the unit one within a
+    // few u (the scaled input's rounding, the division by the largest
+    // magnitude, the norm), the size of the round-off of the rotation's own
+    // computation, which the bounds against the generic (c n u kappa, c n >= 10
+    // (nv + nc)) already cover many times. Unnormalised (before the fix),
+    // x 1e-3 gives R ~ 1e-6 I: an O(1) error.
+    const verify::Conditioning cond = verify::conditioningAt(sys, dense, s, gen.isFloat);
+    const verify::Bounds bounds = verify::boundsAt(cond, mu);
+    for (double f : {1e-3, 1e3}) {
+      State t = s;
+      t.q.segment<4>(at) *= f;
+      t = verify::roundedToScalar(t, gen.isFloat);
+      verify::GeneratedAnswer answer;
+      gen.run(SolverUnderTest::kConstrainedAba, t.q, t.v, t.tau, mu, K, answer.cabaQdd, answer.cabaLambda);
+      gen.run(SolverUnderTest::kProxPv, t.q, t.v, t.tau, mu, K, answer.pvQdd, answer.pvLambda);
+      const verify::Comparison c = verify::compareWithGeneric(sys, d, cond, bounds, s, K, answer);
+      for (const verify::Compared& x : c.item)
+        EXPECT_LE(x.error, x.bound) << x.what << ", quaternion x " << f << ", " << where;
+    }
+  }
+}
+
+void expectWarmStartMatchesTheGeneric(const SolverUnderTest& gen, const System& sys) {
+  Data d(sys), dense(sys);
+  std::mt19937 rng(20261202);
+  for (int n = 0; n < apiStates(); ++n) {
+    const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
+    const verify::Conditioning cond = verify::conditioningAt(sys, dense, s, gen.isFloat);
+    for (double mu : {100.0, 1e4}) {
+      const verify::Bounds b = verify::boundsAt(cond, mu);
+      const std::string where = "state " + std::to_string(n) + ", mu " + std::to_string(mu);
+      // The previous control step's multipliers: the converged ones at a
+      // nearby state (v and tau changed by 10 %), in the solver's Scalar.
+      State prev = s;
+      prev.v *= 0.9;
+      prev.tau *= 1.1;
+      proxPv(sys, d, prev.q, prev.v, prev.tau, mu, 100);
+      VecX lambda0 = verify::roundedToScalar(State{d.lambda, VecX(), VecX()}, gen.isFloat).q;
+      // The generated warm start against the generic one, with the bounds of
+      // expectMatchesTheGenericSolvers: the warm start adds K^T lambda0 to the
+      // bias (constrainedABA) or starts the proximal solves from it (proxPV),
+      // the same backward-stable steps the bounds are argued for. Without the
+      // warm start in the generated code, lambda differs by O(|lambda0|) at K <= 3.
+      // The force of lambda0 adds round-off of its own size to qdd, c n u
+      // max(|M^-1 J^T| |lambda0|) (tests/numerics.hpp, multiplierRoundoff),
+      // which the conditioning bounds do not hold when lambda0 is large (the
+      // redundant rows of arm_gains make the converged lambda grow like K mu);
+      // constrainedABA's lambda = lambda0 + mu (K a - k) carries it times mu |J|.
+      const double warm =
+          cond.safety * cond.eps * ((cond.M.ldlt().solve(cond.J.transpose())).cwiseAbs() * lambda0.cwiseAbs()).maxCoeff();
+      const double Jinf = cond.J.cwiseAbs().rowwise().sum().maxCoeff();
+      for (int K : {0, 1, 3}) {
+        VecX qdd, lambda;
+        gen.runFrom(SolverUnderTest::kConstrainedAba, s.q, s.v, s.tau, mu, K, &lambda0, qdd, lambda);
+        constrainedAbaFrom(sys, d, s.q, s.v, s.tau, mu, K, &lambda0);
+        EXPECT_LE(verify::relErr(qdd, d.qdd), b.primal + warm) << "constrained_aba qdd, K " << K << ", " << where;
+        EXPECT_LE(verify::relErr(lambda, d.lambda),
+                  verify::cabaLambdaBound(sys, cond, b, d.qdd, d.lambda) + mu * Jinf * warm / std::max(1.0, maxAbs(d.lambda)))
+            << "constrained_aba lambda, K " << K << ", " << where;
+        gen.runFrom(SolverUnderTest::kProxPv, s.q, s.v, s.tau, mu, K, &lambda0, qdd, lambda);
+        proxPvFrom(sys, d, s.q, s.v, s.tau, mu, K, &lambda0);
+        EXPECT_LE(verify::relErr(qdd, d.qdd), b.dual + warm) << "prox_pv qdd, K " << K << ", " << where;
+        EXPECT_LE(verify::relErr(lambda, d.lambda), b.dual) << "prox_pv lambda, K " << K << ", " << where;
+        if (K == 0) {
+          EXPECT_EQ(lambda, lambda0) << "K = 0 returns lambda0, " << where;
+        }
+      }
+      // One update from the K-th iterate is iterate K + 1 (the iteration is
+      // lambda_{k+1} = f(lambda_k) in both algorithms); at K = 100 the iterate
+      // has converged and is a fixed point. lambda0 = the generic K-th iterate,
+      // so the generated solve is compared with the generic warm start (within
+      // the bound, as above) plus the generic warm start's distance to its cold
+      // iterate K + 1 (two orders of the same backward-stable steps: the same
+      // bound): twice the bound.
+      for (int K : {3, 100}) {
+        VecX qdd, lambda;
+        constrainedAba(sys, d, s.q, s.v, s.tau, mu, K);
+        VecX fromK = verify::roundedToScalar(State{d.lambda, VecX(), VecX()}, gen.isFloat).q;
+        gen.runFrom(SolverUnderTest::kConstrainedAba, s.q, s.v, s.tau, mu, 1, &fromK, qdd, lambda);
+        constrainedAba(sys, d, s.q, s.v, s.tau, mu, K + 1);
+        EXPECT_LE(verify::relErr(qdd, d.qdd), 2 * b.primal) << "constrained_aba qdd, 1 from " << K << ", " << where;
+        EXPECT_LE(verify::relErr(lambda, d.lambda), 2 * verify::cabaLambdaBound(sys, cond, b, d.qdd, d.lambda))
+            << "constrained_aba lambda, 1 from " << K << ", " << where;
+        proxPv(sys, d, s.q, s.v, s.tau, mu, K);
+        fromK = verify::roundedToScalar(State{d.lambda, VecX(), VecX()}, gen.isFloat).q;
+        gen.runFrom(SolverUnderTest::kProxPv, s.q, s.v, s.tau, mu, 1, &fromK, qdd, lambda);
+        proxPv(sys, d, s.q, s.v, s.tau, mu, K + 1);
+        EXPECT_LE(verify::relErr(qdd, d.qdd), 2 * b.dual) << "prox_pv qdd, 1 from " << K << ", " << where;
+        EXPECT_LE(verify::relErr(lambda, d.lambda), 2 * b.dual) << "prox_pv lambda, 1 from " << K << ", " << where;
+      }
+    }
+  }
+}
+
+void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const System& sys) {
+  Data d(sys), dense(sys);
+  std::mt19937 rng(20261203);
+  const double eps = gen.isFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;
+  const double safety = 10.0 * (sys.model.nv + sys.nc);
+  const std::vector<int> Ks = {0, 1, 3, 10};
+  int contracted = 0;
+  double worst = 0;
+  for (int n = 0; n < apiStates(); ++n) {
+    const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
+    // J, gamma and a* at the state (constraint_kinematics.hpp; a* from the
+    // frames' placements and twists J v, as constraints.cpp forms it).
+    const MatX J = constraintJacobianRows(sys, d, s.q);
+    const VecX gamma = constraintDrift(sys, d, s.q, s.v);
+    const VecX placements = constraintPlacements(sys, d, s.q);
+    const VecX twist = J * s.v;
+    VecX aStar = VecX::Zero(sys.nc);
+    for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+      const Constraint& c = sys.constraints[k];
+      SE3 oMc;
+      for (int r = 0; r < 3; ++r)
+        for (int col = 0; col < 3; ++col) oMc.R(r, col) = placements[12 * Eigen::Index(k) + 3 * r + col];
+      oMc.p = placements.segment<3>(12 * Eigen::Index(k) + 9);
+      Vec6 vC = Vec6::Zero();
+      vC.head(c.rows()) = twist.segment(c.row, c.rows());
+      aStar.segment(c.row, c.rows()) = baumgarteTarget(c, oMc, vC);
+    }
+    const double Jinf = sys.nc ? J.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
+    // The smallest eigenvalue of the Delassus matrix G = J M^-1 J^T: from
+    // lambda = 0 the residual of iterate K is, in G's eigenbasis, y_j rho_j^K,
+    // rho_j = 1 / (1 + mu g_j) (docs/algorithms.md §4.3), so where
+    // sqrt(nc) rho_max^10 < 1/2 it must fall by half from K = 0 to K = 10
+    // (|r|_inf <= |r|_2 <= rho_max^K |y|_2 <= rho_max^K sqrt(nc) |y|_inf).
+    // Redundant or inconsistent rows (g_min = 0) keep a part of y: no claim.
+    double gMin = 0;
+    if (sys.nc > 0) {
+      const verify::Conditioning cond = verify::conditioningAt(sys, dense, s, gen.isFloat);
+      const MatX G = cond.J * cond.M.ldlt().solve(cond.J.transpose());
+      gMin = Eigen::SelfAdjointEigenSolver<MatX>(G, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
+    }
+    for (double mu : {100.0, 1e4}) {
+      for (int a = 0; a < 2; ++a) {
+        std::vector<double> res, tols;
+        for (int K : Ks) {
+          VecX qdd, lambda;
+          const double r = gen.runFrom(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, nullptr, qdd, lambda);
+          const double expected = maxAbs(J * qdd + gamma - aStar);
+          // Both sides evaluate J qdd + gamma - a* from the same qdd, in other
+          // orders (body accelerations up the tree, with the gravity offset
+          // that k takes out again; or the rows J qdd): each within c n u of
+          // the size of its summands, |J| |qdd| + |gamma| + |a*| + |g|. No
+          // solve is involved, so no condition number.
+          const double scale = Jinf * maxAbs(qdd) + maxAbs(gamma) + maxAbs(aStar) + sys.model.gravity.norm();
+          const double tol = safety * eps * scale;
+          EXPECT_NEAR(r, expected, tol) << "algorithm " << a << ", K " << K << ", mu " << mu << ", state " << n;
+          worst = std::max(worst, std::fabs(r - expected) / tol);
+          res.push_back(r);
+          tols.push_back(tol);
+        }
+        // Both algorithms are proximal-point iterations on the multipliers
+        // (the residual of iterate k is (lambda_k - lambda_{k-1}) / mu), whose
+        // successive steps never grow in the 2-norm; the inf-norm residual can
+        // grow by at most sqrt(nc) from one K to a later one (plus the round-off
+        // of both, the tolerance above).
+        for (std::size_t k = 1; k < res.size(); ++k) {
+          EXPECT_LE(res[k], std::sqrt(double(sys.nc)) * (res[k - 1] + tols[k - 1]) + tols[k])
+              << "algorithm " << a << ", K " << Ks[k] << ", mu " << mu << ", state " << n;
+        }
+        const double rho = gMin > 0 ? 1.0 / (1.0 + mu * gMin) : 1.0;
+        if (std::sqrt(double(sys.nc)) * std::pow(rho, 10) < 0.5) {
+          ++contracted;
+          EXPECT_LE(res.back(), 0.5 * res[0] + tols.back() + tols[0])
+              << "algorithm " << a << ", mu " << mu << ", state " << n << ": K = 10 did not halve the residual of K = 0";
+        }
+      }
+    }
+  }
+  std::printf("residual: largest |residual(w) - ||J qdd + gamma - a*||_inf| / tolerance %.1e; "
+              "K = 10 checked to halve it in %d (state, mu, algorithm) triples\n",
+              worst, contracted);
 }
 
 }  // namespace proxgen::test

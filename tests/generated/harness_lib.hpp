@@ -19,6 +19,11 @@ struct SolverUnderTest {
   std::function<void(Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, VecX& qdd,
                      VecX& lambda)>
       run;
+  /// The same with a warm start (lambda0: nc values, layout order, or null for
+  /// Settings::lambda0 = nullptr); returns residual(w) of that solve.
+  std::function<double(Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, const VecX* lambda0,
+                       VecX& qdd, VecX& lambda)>
+      runFrom;
 };
 
 /// The System a solver was generated from: a case of the shared cases.yaml
@@ -44,5 +49,16 @@ struct LibraryUnderTest {
 /// holding prox_pv (null: skipped), inverse_dynamics(q, v, qdd, lambda) = tau
 /// at its answer (q, v, tau) -> (qdd, lambda).
 void expectLibraryMatchesTheGeneric(const LibraryUnderTest& lib, const SolverUnderTest* solver, const System& sys);
+
+// ---- the controller API of issue 18 (items 1 and 3): argued in harness_lib.cpp.
+/// A free-flyer quaternion scaled by 2, -1, 0.5 gives the unit one's answer bit
+/// for bit, scaled by 1e-3 and 1e3 the generic answer within the bounds.
+void expectQuaternionScaleIsIgnored(const SolverUnderTest& solver, const System& sys);
+/// Warm starts against the generic solvers' warm starts, and K = 1 from the
+/// K-th iterate against iterate K + 1 (a converged lambda0 is a fixed point).
+void expectWarmStartMatchesTheGeneric(const SolverUnderTest& solver, const System& sys);
+/// residual(w) against ||J qdd + gamma - a*||_inf from constraint_kinematics.hpp
+/// on the generated qdd, and its decrease with K.
+void expectResidualIsTheConstraintResidual(const SolverUnderTest& solver, const System& sys);
 
 }  // namespace proxgen::test
