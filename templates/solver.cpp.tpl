@@ -12,7 +12,7 @@ namespace {{
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {{
 {kinematics}}}
 
-{free_bodies}}}  // namespace
+{free_bodies}{constraint_joints}}}  // namespace
 
 // constrainedABA: the penalty mu K^T K at the constrained bodies, one full
 // sweep, then iterations 2..K as reduced sweeps over the support.
@@ -25,6 +25,6 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {{
 {pv}}}
-
+{constraint_functions}
 }}  // namespace {name}
 )proxgen"

@@ -33,6 +33,6 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept;
-
+{constraint_declarations}
 }}  // namespace {name}
 )proxgen"

@@ -33,6 +33,56 @@ std::string freeBodies(const SolverTexts& texts) {
       texts.eliminateFree, texts.accelerateFree);
 }
 
+// The constraint functions that were selected (docs/dynamics.md): their
+// declarations for the header, their definitions, and constraint_joints (the
+// joint transforms they share) for the source's anonymous namespace.
+struct ConstraintFunctionTexts {
+  std::string declarations, definitions, helper;
+};
+ConstraintFunctionTexts constraintFunctions(const SolverTexts& t) {
+  struct One {
+    const std::string& body;
+    const char *doc, *signature;
+  };
+  const One all[] = {
+      {t.placements,
+       "// Per constraint (layout order) 12 values: its frame's rotation in the world\n"
+       "// (3 x 3, row-major), then the frame's origin in the world.\n",
+       "void constraint_placements(const Scalar* q, Workspace& w, Scalar* X) noexcept"},
+      {t.jacobian, "// J (nc x nv, row-major): the constraint frames' velocity rows are J v.\n",
+       "void constraint_jacobian(const Scalar* q, Workspace& w, Scalar* J) noexcept"},
+      {t.drift,
+       "// gamma (nc): J qdd + gamma is the constraint frames' acceleration the solvers\n"
+       "// hold to a* (of a point, the classical acceleration of its origin).\n",
+       "void constraint_drift(const Scalar* q, const Scalar* v, Workspace& w, Scalar* gamma) noexcept"},
+      {t.delassus,
+       "// G = J M^-1 J^T (nc x nc, row-major), by a recursion over the constraint\n"
+       "// support: neither M nor J is formed.\n",
+       "void delassus(const Scalar* q, Workspace& w, Scalar* G) noexcept"},
+      {t.delassusInverse,
+       "// (G + I / s.mu)^-1 (nc x nc, row-major) = mu I - mu^2 J (M + mu J^T J)^-1 J^T by the\n"
+       "// same recursion with the penalty mu J^T J, no nc x nc factorisation; its\n"
+       "// absolute round-off is about eps s.mu (the two terms cancel).\n",
+       "void delassus_inverse(const Scalar* q, const Settings& s, Workspace& w, Scalar* Ginv) noexcept"},
+  };
+  ConstraintFunctionTexts out;
+  for (const One& f : all) {
+    if (f.body.empty()) continue;
+    out.declarations += fmt::format("{}{};\n", f.doc, f.signature);
+    out.definitions += fmt::format("\n{}{} {{\n{}}}\n", f.doc, f.signature, f.body);
+  }
+  if (!out.declarations.empty())
+    out.declarations = "\n// The constraint functions: rows in layout order, in the constraint frames the\n"
+                       "// solvers use (6d weld: [linear; angular] of the frame, in the frame; 3d point:\n"
+                       "// the linear rows); the constraint force on the robot is -J^T lambda.\n" +
+                       out.declarations;
+  if (!t.constraintJoints.empty())
+    out.helper = fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
+                             "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
+                             t.constraintJoints);
+  return out;
+}
+
 // "a + b K" (b = 0: "a").
 std::string affine(long once, long perK) {
   if (perK == 0) return fmt::format("{}", once);
@@ -81,6 +131,7 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   files.headerName = plan.name + ".hpp";
   files.sourceName = plan.name + ".cpp";
   const CodeBuilder lit(plan.scalar);
+  const ConstraintFunctionTexts cons = constraintFunctions(texts);
   files.header = fmt::format(
       fmt::runtime(kHeaderTemplate), fmt::arg("banner", banner),
       fmt::arg("q_convention", plan.floatingBase ? "x y z qx qy qz qw of the base, then one value per joint"
@@ -88,11 +139,13 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("joint_table", joints), fmt::arg("constraint_table", constraints), fmt::arg("name", plan.name),
       fmt::arg("scalar", scalarName(plan.scalar)), fmt::arg("nq", plan.nq), fmt::arg("nv", plan.nv),
       fmt::arg("nc", plan.nc), fmt::arg("mu", lit.literal(plan.mu)), fmt::arg("iterations", plan.iterations),
-      fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()));
+      fmt::arg("workspace_bytes", ws.scalars() * scalarBytes), fmt::arg("members", ws.declarations()),
+      fmt::arg("constraint_declarations", cons.declarations));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
                              fmt::arg("parts", texts.parts), fmt::arg("kinematics", texts.kinematics),
                              fmt::arg("free_bodies", freeBodies(texts)),
-                             fmt::arg("caba", texts.caba), fmt::arg("pv", texts.pv));
+                             fmt::arg("caba", texts.caba), fmt::arg("pv", texts.pv),
+                             fmt::arg("constraint_joints", cons.helper), fmt::arg("constraint_functions", cons.definitions));
   return files;
 }
 

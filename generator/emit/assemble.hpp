@@ -17,6 +17,8 @@ struct SolverTexts {
   std::string parts;  // every part function
   std::string kinematics, eliminateFree, accelerateFree, caba, pv;
   OpCount cabaOps, pvOps;  // per call of each entry point, everything it calls included
+  // The constraint functions' bodies (empty: not selected) and their helper constraint_joints.
+  std::string constraintJoints, placements, jacobian, drift, delassus, delassusInverse;
 };
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,

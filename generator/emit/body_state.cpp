@@ -51,6 +51,10 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
     sym(s.del->L), sym(s.del->LS);
     for (V6& x : s.del->W) v6(x);
   }
+  if (s.cons) {
+    for (Sym& m : s.cons->Phi) sym(m);
+    vec(s.cons->out);
+  }
 }
 
 }  // namespace proxgen::emit

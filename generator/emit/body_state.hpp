@@ -80,6 +80,14 @@ struct DelassusFactor {
   std::vector<Expr> LSinv;
 };
 
+/// The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp):
+/// the apparent inverse inertia of each support body (Delassus) and the
+/// entries of the function's output, which its host copies out.
+struct ConstraintOutputs {
+  std::vector<Sym> Phi;
+  std::vector<Expr> out;
+};
+
 /// The pass outputs in scope in the function being written: what moves into a
 /// new part function at each boundary (null: not in scope). Visited body by
 /// body in a fixed order, which fixes the order of the atoms in the new
@@ -92,6 +100,7 @@ struct Live {
   ProxRows* rows = nullptr;
   Multipliers* mult = nullptr;
   DelassusFactor* del = nullptr;
+  ConstraintOutputs* cons = nullptr;  // visited last: the solvers' order is unchanged
 };
 
 void forEachExpr(Live& live, const std::function<void(Expr&)>& f);

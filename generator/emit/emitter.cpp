@@ -7,6 +7,25 @@
 #include "emit/passes.hpp"
 
 namespace proxgen::emit {
+namespace {
+
+// The constraint functions that are selected (pass_constraint_kinematics.cpp, pass_delassus.cpp).
+void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* afterKinematics, SolverTexts& texts) {
+  const FunctionSet& f = e.sys.functions;
+  const bool delassus = f.has(Function::Delassus) || f.has(Function::DelassusInverse);
+  ConstraintJoints joints;
+  if (delassus || f.has(Function::ConstraintPlacements) || f.has(Function::ConstraintJacobian)) {
+    joints = emitConstraintJoints(e, delassus);
+    texts.constraintJoints = joints.text;
+  }
+  if (f.has(Function::ConstraintPlacements)) texts.placements = emitConstraintPlacements(e, joints);
+  if (f.has(Function::ConstraintJacobian)) texts.jacobian = emitConstraintJacobian(e, joints);
+  if (f.has(Function::ConstraintDrift)) texts.drift = emitConstraintDrift(e, kin, afterKinematics);
+  if (f.has(Function::Delassus)) texts.delassus = emitDelassus(e, joints, false);
+  if (f.has(Function::DelassusInverse)) texts.delassusInverse = emitDelassus(e, joints, true);
+}
+
+}  // namespace
 
 SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& inputs, SolverStats* stats) {
   Members ws;
@@ -41,6 +60,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   texts.caba = emitConstrainedAba(e, kin, free, afterElimination);
   texts.pv = emitProxPv(e, kin, free, afterElimination);
   texts.accelerateFree = freeAccel.text;
+  emitConstraintFunctions(e, kin, afterElimination, texts);
   texts.parts = fn.parts();
 
   // Operations per call: each entry point calls kinematics and the two

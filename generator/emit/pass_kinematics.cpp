@@ -19,6 +19,8 @@ Ops sincos() {
   return o;
 }
 
+}  // namespace
+
 void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   const Body& body = e.model().bodies[std::size_t(i)];
   const Joint& j = body.joint;
@@ -64,6 +66,8 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
       b.XJ.R[std::size_t(3 * r + col)] = p.axis >= 0 ? x : e.keepQ(kRJ, i, 3, 3, r, col, x);
     }
 }
+
+namespace {
 
 void velocity(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {
   const Joint& j = e.model().bodies[std::size_t(i)].joint;

@@ -16,13 +16,17 @@ namespace proxgen::emit {
 // ---- pass_kinematics.cpp: joint transforms, v, c, pA = v x* I v, R^T g,
 // world placements, the constraint right-hand sides k.
 Kinematics emitKinematics(Emit& e);
+/// Body i's XT, XJ at q and S (the first step of emitKinematics).
+void jointTransform(Emit& e, int i, Kinematics::Body& b);
 
 // ---- pass_aba_eliminate.cpp: the articulated-body elimination.
 /// The elimination's starting point: every body's own inertia and bias.
 Articulated startElimination(const Kinematics& kin);
 /// One body: U, D^-1, u, and (below the root) its share of the parent's IA and
 /// pA. With `k`, the penalty mu K^T K of the body's constraints first (constrainedABA).
-void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art);
+/// Without `bias`, IA, U and D only (no tau, u, pA: the Delassus functions).
+void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art,
+                   bool bias = true);
 /// The bodies off the constraint support, leaves first (the same in both algorithms).
 Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin);
 
@@ -67,5 +71,26 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
 DelassusFactor factorDelassus(Emit& e, const ProxRows& rows);
 /// (G + I/mu)^-1 rhs through the factor (rows in tree order).
 std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vector<Expr>& rhs);
+
+// ---- pass_constraint_kinematics.cpp: constraint_placements, constraint_jacobian,
+// constraint_drift, and the joint transforms the functions of q alone start from.
+struct ConstraintJoints {
+  Kinematics kin;                     // XT, XJ, S, the bodies' own inertias (v = c = 0)
+  const CodeBuilder* host = nullptr;  // the helper's state, imported by the functions
+  std::string text;                   // the body of constraint_joints(q, w)
+};
+/// The helper host constraint_joints(q, w): the joint transforms of every body
+/// (`all`: the Delassus functions need the off-support inertias) or of the support.
+ConstraintJoints emitConstraintJoints(Emit& e, bool all);
+/// The functions' bodies; drift calls kinematics(q, v, w), whose state (kin) lives in `from`.
+std::string emitConstraintPlacements(Emit& e, const ConstraintJoints& joints);
+std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints);
+std::string emitConstraintDrift(Emit& e, const Kinematics& kin, const CodeBuilder* from);
+/// Ends the open part and copies `out` (the host's values) to the output array `name`.
+void copyOutput(Emit& e, const std::string& name, const std::vector<Expr>& out);
+
+// ---- pass_delassus.cpp: delassus (G = J M^-1 J^T) and, with `inverse`,
+// delassus_inverse ((G + I/mu)^-1 by Woodbury on the penalised recursion).
+std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);
 
 }  // namespace proxgen::emit
