@@ -37,7 +37,7 @@ emit::SolverFiles generateSolverFiles(const std::string& urdf, const std::string
 
 void addGenerate(CLI::App& app) {
   struct Options {
-    std::string urdf, layout, cases, caseName, out, name, scalar = "double";
+    std::string urdf, layout, cases, caseName, out, name, scalar = "double", functions;
     bool python = false;
   };
   auto opt = std::make_shared<Options>();
@@ -50,8 +50,10 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--name", opt->name, "namespace and file name (sanitised; default: the case or the URDF's file name)");
   cmd->add_option("--scalar", opt->scalar, "double (default) or float")->check(CLI::IsMember({"double", "float"}));
   cmd->add_flag("--python", opt->python, "also write NAME_python.cpp, a pybind11 module over the solver (docs/python.md)");
+  cmd->add_option("--functions", opt->functions, "TEMP glue: the functions to emit (a,b,... or all)");
   cmd->callback([opt] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
+    if (!opt->functions.empty()) emit::setFunctionsOverride(parseFunctionList(opt->functions, "--functions", "functions"));
     System sys;
     const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
                                                         emit::parseScalar(opt->scalar), &sys);

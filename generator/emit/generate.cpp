@@ -40,10 +40,25 @@ void checkSize(const Plan& plan, const std::string& urdf, const std::string& lay
                      plan.nc, plan.support.size(), rows, kMaxGenerateSupportRows));
 }
 
+bool hasOverride = false;
+FunctionSet functionsOverride;
+
 }  // namespace
 
-SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
+void setFunctionsOverride(const FunctionSet& functions) {
+  hasOverride = true;
+  functionsOverride = functions;
+}
+
+SolverFiles generateSystem(const System& sysIn, const std::string& name, ScalarType scalar, SolverInputs in,
                            SolverStats* stats) {
+  System sys = sysIn;
+  if (hasOverride) {
+    sys.functions = functionsOverride;
+    std::string list;
+    for (const std::string& f : functionsOverride.names()) list += (list.empty() ? "" : ",") + f;
+    in.command += " --functions " + list;
+  }
   const Plan plan = makePlan(sys, name, scalar);
   checkSize(plan, sys.model.sourcePath, sys.layoutPath);
   in.command = fmt::format("{} --out DIR --name {} --scalar {}", in.command, plan.name, scalarName(scalar));

@@ -44,6 +44,10 @@ SolverFiles generateSystem(const System& sys, const std::string& name, ScalarTyp
 /// The solver's files as outputs for writeFiles (emit/output.hpp): NAME.hpp, NAME.cpp.
 std::vector<OutputFile> solverOutputs(const SolverFiles& files);
 
+/// TEMP glue (branch dyncons, replaced by the selection of branch dynjoint):
+/// the functions `generate --functions` asks for, over the layout's.
+void setFunctionsOverride(const FunctionSet& functions);
+
 /// "double" / "float" -> ScalarType; throws proxgen::Error otherwise.
 ScalarType parseScalar(const std::string& s);
 
