@@ -61,8 +61,9 @@ ConstraintFunctionTexts constraintFunctions(const SolverTexts& t) {
        "void delassus(const Scalar* q, Workspace& w, Scalar* G) noexcept"},
       {t.delassusInverse,
        "// (G + I / s.mu)^-1 (nc x nc, row-major) = mu I - mu^2 J (M + mu J^T J)^-1 J^T by the\n"
-       "// same recursion with the penalty mu J^T J, no nc x nc factorisation; its\n"
-       "// absolute round-off is about eps s.mu (the two terms cancel).\n",
+       "// same recursion with the penalty mu J^T J, no nc x nc factorisation. The two\n"
+       "// terms cancel: its absolute round-off is about eps kappa(M + mu J^T J) mu (in\n"
+       "// float at large mu, factor delassus's G instead).\n",
        "void delassus_inverse(const Scalar* q, const Settings& s, Workspace& w, Scalar* Ginv) noexcept"},
   };
   ConstraintFunctionTexts out;

@@ -53,6 +53,7 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
   }
   if (s.cons) {
     for (Sym& m : s.cons->Phi) sym(m);
+    for (auto& x : s.cons->T) vec(x);
     vec(s.cons->out);
   }
 }

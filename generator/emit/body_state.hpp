@@ -85,6 +85,7 @@ struct DelassusFactor {
 /// entries of the function's output, which its host copies out.
 struct ConstraintOutputs {
   std::vector<Sym> Phi;
+  std::vector<std::vector<Expr>> T;  // per body: a 6 x 6 map of the rows below (empty: none)
   std::vector<Expr> out;
 };
 

@@ -8,9 +8,11 @@
 //  - forward over the support, the apparent inverse inertia
 //    Phi_i = S D^-1 S^T + P^T (iXp Phi_p iXp^T) P, P = 1 - U D^-1 S^T
 //    (at a free flyer, IA^-1 = L^-T L^-1 from its Cholesky factor);
-//  - backward over the support, each row's force direction carried up as
-//    proxPV carries it (B = X^T P per joint), and every entry once, at the
-//    body where its two rows meet: KA_a . Phi KA_b.
+//  - backward over the support, each row's force direction carried up
+//    (B = X^T P per joint; along an unbranched link with more than
+//    kMapColumns columns, the 6 x 6 product of the B's instead, so columns
+//    move only at the key bodies: constrained or branching), and every entry
+//    once, at the body where its two rows meet: KA_a . Phi KA_b.
 // delassus_inverse is then mu I - mu^2 J (M + mu J^T J)^-1 J^T (Woodbury).
 // Its round-off: the two terms cancel to the answer's size, so its absolute
 // error is about eps mu^2 |J M_mu^-1 J^T| ~ eps mu (delassus.hpp's note).
@@ -24,6 +26,7 @@ namespace {
 
 constexpr Quantity kPhi{"Phi", "apparent inverse inertia (upper triangle)"};
 constexpr Quantity kKD{"KD", "constraint force directions of the subtree rows (Delassus), 6 x m"};
+constexpr Quantity kT{"T", "map of the rows' force directions below (Delassus), 6 x 6"};
 
 // The halves of a 6 x 6 swapped ([linear; angular] <-> [angular; linear]):
 // a motion transform is the force transform of the same placement with its
@@ -97,18 +100,81 @@ Sym apparentInverseInertia(Emit& e, const Kinematics& kin, const Articulated& ar
   return Phi;
 }
 
-// Entries of the pairs of rows that meet at body i (own rows with every row,
-// rows of two different children), once each; the carried columns to the parent.
-void rowsAt(Emit& e, const Kinematics& kin, const Articulated& art, ConstraintOutputs& st, ProxRows& rows, int i,
-            bool inverse) {
+// Above this many columns, an unbranched link of the support without rows of
+// its own accumulates the 6 x 6 map B (its child's B times the child's map,
+// six column moves) instead of moving every column (docs/dynamics.md): what
+// keeps the columns' moves to the key bodies, O(n + m^2) as the generic
+// recursion (its Data::Tkey).
+constexpr int kMapColumns = 6;
+
+// B x = X^T (x - U D^-1 S^T x): a force on child `ch` carried to its parent.
+V6 throughJoint(Emit& e, const Kinematics& kin, const Articulated& art, int ch, const V6& x) {
+  CodeBuilder& cb = e.cb();
+  const Articulated::Body& ab = art.b[std::size_t(ch)];
+  const Kinematics::Body& kb = kin.b[std::size_t(ch)];
+  const Expr ks = cb.flat(dot(cb, kb.S[0], x), "ks");
+  V6 f;
+  for (int r = 0; r < 6; ++r) f[std::size_t(r)] = x[std::size_t(r)] - cb.mul(cb.mul(ab.U[0][std::size_t(r)], ab.Dinv), ks);
+  return e.forceToParent(kb, f);
+}
+
+// T x for a row-major 6 x 6 map T (empty: the identity).
+V6 apply(CodeBuilder& cb, const std::vector<Expr>& T, const V6& x) {
+  if (T.empty()) return x;
+  V6 y;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) y[std::size_t(r)] += cb.mul(T[std::size_t(6 * r + c)], x[std::size_t(c)]);
+  return y;
+}
+
+// Body i of the backward sweep: the columns of its support children moved in
+// (or, on an unbranched link with many columns, only their map extended), then
+// the entries of the pairs of rows that meet here (own rows with every row,
+// rows of two different children), once each.
+void rowsAt(Emit& e, const Kinematics& kin, const Articulated& art, ConstraintOutputs& st, ProxRows& rows,
+            std::vector<int>& keyBelow, int i, bool inverse) {
   CodeBuilder& cb = e.cb();
   const Plan& plan = e.plan;
   const BodyPlan& p = e.bp(i);
   const int m = p.m();
   ProxRows::Body& b = rows.b[std::size_t(i)];
+  std::vector<int> supportChildren;
+  int own = m;
+  for (int ch : p.children)
+    if (e.bp(ch).onSupport) supportChildren.push_back(ch), own -= e.bp(ch).m();
+  keyBelow[std::size_t(i)] = i;
+  const bool link = own == 0 && supportChildren.size() == 1;  // no pair of rows meets here
+  if (link && p.parent == 0) return;                          // nor above: the world does not move
+  if (link && m > kMapColumns) {
+    // T_i = B_ch T_ch, column by column; the columns stay at keyBelow.
+    const int ch = supportChildren[0];
+    const std::vector<Expr>& Tch = st.T[std::size_t(ch)];
+    std::vector<Expr>& T = st.T[std::size_t(i)];
+    T.assign(36, Expr());
+    for (int c = 0; c < 6; ++c) {
+      V6 col;
+      if (Tch.empty()) col[std::size_t(c)] = 1.0;
+      else for (int r = 0; r < 6; ++r) col[std::size_t(r)] = Tch[std::size_t(6 * r + c)];
+      const V6 y = throughJoint(e, kin, art, ch, col);
+      for (int r = 0; r < 6; ++r) T[std::size_t(6 * r + c)] = e.put(e.member(kT, i, 6, 6, r, c), y[std::size_t(r)]);
+    }
+    keyBelow[std::size_t(i)] = keyBelow[std::size_t(ch)];
+    return;
+  }
+  for (int ch : supportChildren) {
+    const BodyPlan& cp = e.bp(ch);
+    const ProxRows::Body& from = rows.b[std::size_t(keyBelow[std::size_t(ch)])];
+    for (int c = 0; c < cp.m(); ++c) {
+      const V6 y = throughJoint(e, kin, art, ch, apply(cb, st.T[std::size_t(ch)], from.KA[std::size_t(c)]));
+      const int col = cp.offsetInParent + c;
+      for (int r = 0; r < 6; ++r)
+        b.KA[std::size_t(col)][std::size_t(r)] = e.put(e.member(kKD, i, 6, m, r, col), y[std::size_t(r)]);
+    }
+  }
+  if (link) return;
   // group[c]: -1 for an own row, else the support child whose subtree holds column c.
   std::vector<int> group(std::size_t(m), -1);
-  for (int ch : p.children) {
+  for (int ch : supportChildren) {
     const BodyPlan& cp = e.bp(ch);
     for (int c = 0; c < cp.m(); ++c) group[std::size_t(cp.offsetInParent + c)] = ch;
   }
@@ -133,23 +199,6 @@ void rowsAt(Emit& e, const Kinematics& kin, const Articulated& art, ConstraintOu
       st.out[std::size_t(ra * plan.nc + rc)] = st.out[std::size_t(rc * plan.nc + ra)] = g;
     }
   }
-  if (p.parent == 0) return;
-  // B KA = X^T (KA - U D^-1 S^T KA) into the parent's columns.
-  const Articulated::Body& ab = art.b[std::size_t(i)];
-  const Kinematics::Body& kb = kin.b[std::size_t(i)];
-  V6 UD;
-  for (int r = 0; r < 6; ++r) UD[std::size_t(r)] = cb.flat(cb.mul(ab.U[0][std::size_t(r)], ab.Dinv), "UD");
-  const int mp = e.bp(p.parent).m();
-  for (int c = 0; c < m; ++c) {
-    const Expr ks = cb.flat(dot(cb, kb.S[0], b.KA[std::size_t(c)]), "ks");
-    V6 f;
-    for (int r = 0; r < 6; ++r) f[std::size_t(r)] = b.KA[std::size_t(c)][std::size_t(r)] - cb.mul(UD[std::size_t(r)], ks);
-    const V6 fp = e.forceToParent(kb, f);
-    const int col = p.offsetInParent + c;
-    for (int r = 0; r < 6; ++r)
-      rows.b[std::size_t(p.parent)].KA[std::size_t(col)][std::size_t(r)] =
-          e.put(e.member(kKD, p.parent, 6, mp, r, col), fp[std::size_t(r)]);
-  }
 }
 
 }  // namespace
@@ -161,6 +210,8 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse) 
   Articulated art = startElimination(kin);
   ConstraintOutputs st;
   st.Phi.assign(std::size_t(N), Sym());
+  st.T.assign(std::size_t(N), {});
+  std::vector<int> keyBelow(std::size_t(N), 0);
   st.out.assign(std::size_t(plan.nc * plan.nc), Expr());
   ProxRows rows;
   rows.b.resize(std::size_t(N));
@@ -215,7 +266,7 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse) 
     for (auto it = plan.support.rbegin(); it != plan.support.rend(); ++it) {
       e.fn.boundary(*it);
       e.openBody(*it, "rows meeting here:");
-      rowsAt(e, kin, art, st, rows, *it, inverse);
+      rowsAt(e, kin, art, st, rows, keyBelow, *it, inverse);
       e.cb().close();
     }
   }
