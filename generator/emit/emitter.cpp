@@ -9,8 +9,9 @@
 namespace proxgen::emit {
 namespace {
 
-// The constraint functions that are selected (pass_constraint_kinematics.cpp, pass_delassus.cpp).
-void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* afterKinematics, SolverTexts& texts) {
+// The constraint functions that are selected (pass_constraint_kinematics.cpp,
+// pass_delassus.cpp); kin's values (after kinematics) live in `from`.
+void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* from, SolverTexts& texts) {
   const FunctionSet& f = e.sys.functions;
   const bool delassus = f.has(Function::Delassus) || f.has(Function::DelassusInverse);
   ConstraintJoints joints;
@@ -20,7 +21,7 @@ void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* 
   }
   if (f.has(Function::ConstraintPlacements)) texts.placements = emitConstraintPlacements(e, joints);
   if (f.has(Function::ConstraintJacobian)) texts.jacobian = emitConstraintJacobian(e, joints);
-  if (f.has(Function::ConstraintDrift)) texts.drift = emitConstraintDrift(e, kin, afterKinematics);
+  if (f.has(Function::ConstraintDrift)) texts.drift = emitConstraintDrift(e, kin, from);
   if (f.has(Function::Delassus)) texts.delassus = emitDelassus(e, joints, false);
   if (f.has(Function::DelassusInverse)) texts.delassusInverse = emitDelassus(e, joints, true);
 }
