@@ -120,7 +120,8 @@ fs::path runtimeDir() {
 // qdd and lambda of constrained_aba then prox_pv, one number per line (none
 // unless the solver holds both); then library samples (q, v, qdd, lambda) and,
 // per sample, what each joint-space function it holds returns (compare.hpp's
-// LibraryAnswer order: tau, h, M, Minv). verify.cpp prepends a
+// LibraryAnswer order: tau, h, M, Minv, then ConstraintAnswer's: X, J, gamma,
+// G, Ginv at the layout's mu). verify.cpp prepends a
 // PROXGEN_VERIFY_HAS_<FUNCTION> 1 line per function held.
 constexpr const char* kDriver = R"(// proxgen verify driver (temporary)
 #include <cstdio>
@@ -161,7 +162,8 @@ int main() {
   int m = 0;
   if (std::scanf("%d", &m) != 1) return 2;
   for (int t = 0; t < m; ++t) {
-    static s::Scalar q[s::nq], v[s::nv], qdd[s::nv], lambda[s::nc + 1], out[s::nv * s::nv + 1];
+    static s::Scalar q[s::nq], v[s::nv], qdd[s::nv], lambda[s::nc + 1],
+        out[s::nv * s::nv + 12 * s::ncons + s::nc * s::nv + s::nc * s::nc + 1];
     if (!readAll(q, s::nq) || !readAll(v, s::nv) || !readAll(qdd, s::nv) || !readAll(lambda, s::nc)) return 2;
     static_cast<void>(out);
 #if PROXGEN_VERIFY_HAS_INVERSE_DYNAMICS
@@ -179,6 +181,26 @@ int main() {
 #if PROXGEN_VERIFY_HAS_MASS_MATRIX_INVERSE
     s::mass_matrix_inverse(q, w, out);
     printAll(out, s::nv * s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_PLACEMENTS
+    s::constraint_placements(q, w, out);
+    printAll(out, 12 * s::ncons);
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_JACOBIAN
+    s::constraint_jacobian(q, w, out);
+    printAll(out, s::nc * s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_DRIFT
+    s::constraint_drift(q, v, w, out);
+    printAll(out, s::nc);
+#endif
+#if PROXGEN_VERIFY_HAS_DELASSUS
+    s::delassus(q, w, out);
+    printAll(out, s::nc * s::nc);
+#endif
+#if PROXGEN_VERIFY_HAS_DELASSUS_INVERSE
+    s::delassus_inverse(q, s::Settings{}, w, out);  // the layout's mu
+    printAll(out, s::nc * s::nc);
 #endif
   }
   return 0;
@@ -336,8 +358,9 @@ int verify(const VerifyOptions& o) {
     for (double mu : {sys.mu, 100.0})
       for (int K : {1, 2, 3, o.converged}) trials.push_back({s, K, mu});
   // The joint-space functions' extra inputs: qdd ~ N(0, 1), lambda ~ 10 N(0, 1), per state.
-  const bool library = sys.functions.has(Function::InverseDynamics) || sys.functions.has(Function::NonlinearEffects) ||
-                       sys.functions.has(Function::MassMatrix) || sys.functions.has(Function::MassMatrixInverse);
+  bool library = false;  // any function beyond the two solvers
+  for (Function f : allFunctions())
+    library = library || (sys.functions.has(f) && f != Function::ConstrainedAba && f != Function::ProxPv);
   std::vector<verify::LibraryAnswer> libraryIn;
   std::normal_distribution<double> normal(0.0, 1.0);
   const auto rounded = [&](double x) { return isFloat ? double(float(x)) : x; };
@@ -447,8 +470,18 @@ int verify(const VerifyOptions& o) {
     };
     if (sys.functions.has(Function::MassMatrix)) gen.M = square("mass_matrix M");
     if (sys.functions.has(Function::MassMatrixInverse)) gen.Minv = square("mass_matrix_inverse");
-    for (const verify::Compared& x :
-         verify::compareLibraryWithGeneric(sys, d, conditioning[s], states[s], gen)) {
+    verify::ConstraintAnswer cons;  // row-major, as the driver prints them
+    const int ncons = int(sys.constraints.size());
+    if (sys.functions.has(Function::ConstraintPlacements)) cons.X = read(12 * ncons, "constraint_placements", at);
+    if (sys.functions.has(Function::ConstraintJacobian)) cons.J = read(sys.nc * m.nv, "constraint_jacobian", at);
+    if (sys.functions.has(Function::ConstraintDrift)) cons.gamma = read(sys.nc, "constraint_drift", at);
+    if (sys.functions.has(Function::Delassus)) cons.G = read(sys.nc * sys.nc, "delassus", at);
+    if (sys.functions.has(Function::DelassusInverse)) cons.Ginv = read(sys.nc * sys.nc, "delassus_inverse", at);
+    cons.mu = sys.mu;
+    std::vector<verify::Compared> items = verify::compareLibraryWithGeneric(sys, d, conditioning[s], states[s], gen);
+    for (const verify::Compared& x : verify::compareConstraintFunctions(sys, d, conditioning[s], states[s], cons))
+      items.push_back(x);
+    for (const verify::Compared& x : items) {
       if (!x.finite) throw Error(fmt::format("verify: the generic {} is not finite at sample {}", x.what, s));
       record(x.what, x.error, x.bound);
     }

@@ -109,6 +109,35 @@ const EntryPoint kEntryPoints[] = {
      "\n// M(q)^-1: nv x nv, row-major, full, in O(n^2) without factoring M.\n",
      "void mass_matrix_inverse(const Scalar* q, Workspace& w, Scalar* Minv) noexcept",
      "// M^-1 by ABA on the nv unit torques at once (v = 0, no gravity).\n"},
+    {Function::ConstraintPlacements,
+     "\n// The constraint functions: rows in layout order, in the constraint frames the\n"
+     "// solvers use (6d weld: [linear; angular] of the frame, in the frame; 3d point:\n"
+     "// the linear rows); the constraint force on the robot is -J^T lambda.\n"
+     "// Per constraint (layout order) 12 values: its frame's rotation in the world\n"
+     "// (3 x 3, row-major), then the frame's origin in the world.\n",
+     "void constraint_placements(const Scalar* q, Workspace& w, Scalar* X) noexcept",
+     "// The constraint frames in the world: the support bodies' placements root first.\n"},
+    {Function::ConstraintJacobian, "\n// J (nc x nv, row-major): the constraint frames' velocity rows are J v.\n",
+     "void constraint_jacobian(const Scalar* q, Workspace& w, Scalar* J) noexcept",
+     "// J: each row's direction carried up the tree as a force; each joint reads its column.\n"},
+    {Function::ConstraintDrift,
+     "\n// gamma (nc): J qdd + gamma is the constraint frames' acceleration the solvers\n"
+     "// hold to a* (of a point, the classical acceleration of its origin).\n",
+     "void constraint_drift(const Scalar* q, const Scalar* v, Workspace& w, Scalar* gamma) noexcept",
+     "// gamma: the rows' acceleration at qdd = 0 without gravity, plus w x v for a point.\n"},
+    {Function::Delassus,
+     "\n// G = J M^-1 J^T (nc x nc, row-major), by a recursion over the constraint\n"
+     "// support: neither M nor J is formed.\n",
+     "void delassus(const Scalar* q, Workspace& w, Scalar* G) noexcept",
+     "// G: the articulated inertias, the apparent inverse inertias Phi root first, and\n"
+     "// every entry once where its two rows meet (O(n + m^2)).\n"},
+    {Function::DelassusInverse,
+     "\n// (G + I / s.mu)^-1 (nc x nc, row-major) = mu I - mu^2 J (M + mu J^T J)^-1 J^T by the\n"
+     "// same recursion with the penalty mu J^T J, no nc x nc factorisation. The two\n"
+     "// terms cancel: its absolute round-off is about eps kappa(M + mu J^T J) mu (in\n"
+     "// float at large mu, factor delassus's G instead).\n",
+     "void delassus_inverse(const Scalar* q, const Settings& s, Workspace& w, Scalar* Ginv) noexcept",
+     "// (G + I/mu)^-1 by Woodbury on the penalised recursion.\n"},
 };
 
 // The helpers the entry points call, printed only when one needs them.
@@ -125,6 +154,10 @@ std::string helpers(const SolverTexts& texts) {
         "// The joint transforms alone, for the functions without a velocity.\n"
         "void joint_transforms(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
         texts.jointTransforms);
+  if (!texts.constraintJoints.empty())
+    out += fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
+                       "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
+                       texts.constraintJoints);
   return out;
 }
 

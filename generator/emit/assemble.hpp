@@ -26,6 +26,8 @@ struct SolverTexts {
   std::map<Function, OpCount> libraryOps;
   std::string jointTransforms;
   bool withKinematics = false, withJointTransforms = false;
+  // The helper of the constraint functions of q alone ("" when none is held).
+  std::string constraintJoints;
 };
 
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,

@@ -59,6 +59,11 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
     sym(s.del->L), sym(s.del->LS);
     for (V6& x : s.del->W) v6(x);
   }
+  if (s.cons) {
+    for (Sym& m : s.cons->Phi) sym(m);
+    for (auto& x : s.cons->T) vec(x);
+    vec(s.cons->out);
+  }
 }
 
 }  // namespace proxgen::emit

@@ -96,6 +96,15 @@ struct JointSpace {
   Sym upper;
 };
 
+/// The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp):
+/// the apparent inverse inertia of each support body (Delassus) and the
+/// entries of the function's output, which its host copies out.
+struct ConstraintOutputs {
+  std::vector<Sym> Phi;
+  std::vector<std::vector<Expr>> T;  // per body: a 6 x 6 map of the rows below (empty: none)
+  std::vector<Expr> out;
+};
+
 /// The pass outputs in scope in the function being written: what moves into a
 /// new part function at each boundary (null: not in scope). Visited body by
 /// body in a fixed order, which fixes the order of the atoms in the new
@@ -110,6 +119,7 @@ struct Live {
   DelassusFactor* del = nullptr;
   Forces* forces = nullptr;
   JointSpace* js = nullptr;
+  ConstraintOutputs* cons = nullptr;  // visited last: the solvers' order is unchanged
 };
 
 void forEachExpr(Live& live, const std::function<void(Expr&)>& f);

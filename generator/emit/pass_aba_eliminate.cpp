@@ -33,7 +33,8 @@ void penalty(Emit& e, int i, const std::vector<std::vector<Expr>>& kk, Sym& IA, 
   }
 }
 
-void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art,
+                     bool bias) {
   CodeBuilder& cb = e.cb();
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
@@ -55,8 +56,10 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   } else {
     b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
   }
-  const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
-  b.u.assign(1, e.putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));
+  if (bias) {
+    const Expr tau = cb.input(tauIn(p.idx_v));  // before the products: see mulAdd in symbolic.cpp
+    b.u.assign(1, e.putQ(kUu, i, 1, 0, tau - dot(cb, S, pA)));
+  }
   if (p.parent == 0) return;
   // Ia = IA - U D^-1 U^T (its row and column along an axis-aligned S vanish:
   // Ia S = 0) ; pa = pA + Ia c + U D^-1 u.
@@ -68,6 +71,15 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   if (const int along = axisComponent(p); along >= 0)
     for (int k = 0; k < 6; ++k) Ia(along, k) = Expr();
   flatten(cb, Ia, "Ia");
+  Articulated::Body& par = art.b[std::size_t(p.parent)];
+  auto passInertia = [&](const Sym& dI) {
+    for (int k = 0; k < 21; ++k)
+      if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  };
+  if (!bias) {  // the articulated inertia only (the Delassus functions)
+    passInertia(e.inertiaToParent(kb, Ia));
+    return;
+  }
   V6 pa;
   for (int r = 0; r < 6; ++r) {
     Expr x = pA[std::size_t(r)] + cb.mul(UD[std::size_t(r)], b.u[0]);
@@ -77,9 +89,7 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   flatten(cb, pa, "pa");
   const Sym dI = e.inertiaToParent(kb, Ia);
   const V6 dp = e.forceToParent(kb, pa);
-  Articulated::Body& par = art.b[std::size_t(p.parent)];
-  for (int k = 0; k < 21; ++k)
-    if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  passInertia(dI);
   for (int k = 0; k < 6; ++k)
     if (!dp[std::size_t(k)].isZero())
       par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
@@ -87,7 +97,7 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
 
 // The free flyer: S = I, so U = IA and D = IA, factored once (LL^T); its
 // parent is the world, so nothing passes on.
-void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art, bool bias) {
   CodeBuilder& cb = e.cb();
   Articulated::Body& b = art.b[std::size_t(i)];
   const BodyPlan& p = e.bp(i);
@@ -105,6 +115,7 @@ void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk
   b.U.assign(6, V6{});
   for (int d = 0; d < 6; ++d)
     for (int r = 0; r < 6; ++r) b.U[std::size_t(d)][std::size_t(r)] = b.IA(r, d);
+  if (!bias) return;
   b.u.resize(6);
   for (int d = 0; d < 6; ++d)
     b.u[std::size_t(d)] = e.putQ(kUu, i, 6, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(d)]);
@@ -114,7 +125,8 @@ void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk
 // so U = IA S is three columns of IA, D = S^T IA S their 3 x 3 block (LL^T)
 // and u = tau - pA[sel]. Below a moving parent Ia = IA - U D^-1 U^T (whose
 // rows and columns sel vanish: Ia S = 0) and pa = pA + Ia c + U D^-1 u pass on.
-void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art) {
+void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art,
+                     bool bias) {
   CodeBuilder& cb = e.cb();
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
@@ -136,10 +148,12 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
       [&](int r) { return e.member(kLinv, i, n, r); });
   b.L = ch.L;
   b.Linv = ch.inv;
-  b.u.resize(std::size_t(n));
-  for (int d = 0; d < n; ++d)
-    b.u[std::size_t(d)] =
-        e.putQ(kUu, i, n, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(sel[std::size_t(d)])]);
+  if (bias) {
+    b.u.resize(std::size_t(n));
+    for (int d = 0; d < n; ++d)
+      b.u[std::size_t(d)] =
+          e.putQ(kUu, i, n, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(sel[std::size_t(d)])]);
+  }
   if (p.parent == 0) return;
   // Y = L^-1 U^T (one solve per row of U), so U D^-1 U^T = Y^T Y.
   std::vector<std::vector<Expr>> Y(6);
@@ -158,6 +172,15 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
   for (int k : sel)
     for (int c = 0; c < 6; ++c) Ia(k, c) = Expr();
   flatten(cb, Ia, "Ia");
+  Articulated::Body& par = art.b[std::size_t(p.parent)];
+  auto passInertia = [&](const Sym& dI) {
+    for (int k = 0; k < 21; ++k)
+      if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  };
+  if (!bias) {  // the articulated inertia only (the Delassus functions)
+    passInertia(e.inertiaToParent(kb, Ia));
+    return;
+  }
   const std::vector<Expr> Du = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, b.u));  // D^-1 u
   V6 pa;
   for (int r = 0; r < 6; ++r) {
@@ -169,9 +192,7 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
   flatten(cb, pa, "pa");
   const Sym dI = e.inertiaToParent(kb, Ia);
   const V6 dp = e.forceToParent(kb, pa);
-  Articulated::Body& par = art.b[std::size_t(p.parent)];
-  for (int k = 0; k < 21; ++k)
-    if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  passInertia(dI);
   for (int k = 0; k < 6; ++k)
     if (!dp[std::size_t(k)].isZero())
       par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
@@ -189,10 +210,11 @@ Articulated startElimination(const Kinematics& kin) {
   return art;
 }
 
-void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art) {
-  if (e.bp(i).jointClass == JointClass::FreeFlyer) eliminateFreeFlyer(e, i, k, art);
-  else if (e.bp(i).jointClass == JointClass::Planar) eliminatePicked(e, kin, i, k, art);
-  else eliminateOneDof(e, kin, i, k, art);
+void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art,
+                   bool bias) {
+  if (e.bp(i).jointClass == JointClass::FreeFlyer) eliminateFreeFlyer(e, i, k, art, bias);
+  else if (e.bp(i).jointClass == JointClass::Planar) eliminatePicked(e, kin, i, k, art, bias);
+  else eliminateOneDof(e, kin, i, k, art, bias);
 }
 
 Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin) {

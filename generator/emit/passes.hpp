@@ -24,7 +24,9 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b);
 Articulated startElimination(const Kinematics& kin);
 /// One body: U, D^-1, u, and (below the root) its share of the parent's IA and
 /// pA. With `k`, the penalty mu K^T K of the body's constraints first (constrainedABA).
-void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art);
+/// Without `bias`, IA, U and D only (no tau, u, pA: the Delassus functions).
+void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art,
+                   bool bias = true);
 /// The bodies off the constraint support, leaves first (the same in both algorithms).
 Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin);
 
@@ -88,5 +90,26 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
 
 // ---- pass_mass_matrix_inverse.cpp: M^-1 in O(n^2) (ABA on the unit torques).
 std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
+
+// ---- pass_constraint_kinematics.cpp: constraint_placements, constraint_jacobian,
+// constraint_drift, and the joint transforms the functions of q alone start from.
+struct ConstraintJoints {
+  Kinematics kin;                     // XT, XJ, S, the bodies' own inertias (v = c = 0)
+  const CodeBuilder* host = nullptr;  // the helper's state, imported by the functions
+  std::string text;                   // the body of constraint_joints(q, w)
+};
+/// The helper host constraint_joints(q, w): the joint transforms of every body
+/// (`all`: the Delassus functions need the off-support inertias) or of the support.
+ConstraintJoints emitConstraintJoints(Emit& e, bool all);
+/// The functions' bodies; drift calls kinematics(q, v, w), whose state (kin) lives in `from`.
+std::string emitConstraintPlacements(Emit& e, const ConstraintJoints& joints);
+std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints);
+std::string emitConstraintDrift(Emit& e, const Kinematics& kin, const CodeBuilder* from);
+/// Ends the open part and copies `out` (the host's values) to the output array `name`.
+void copyOutput(Emit& e, const std::string& name, const std::vector<Expr>& out);
+
+// ---- pass_delassus.cpp: delassus (G = J M^-1 J^T) and, with `inverse`,
+// delassus_inverse ((G + I/mu)^-1 by Woodbury on the penalised recursion).
+std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);
 
 }  // namespace proxgen::emit

@@ -36,6 +36,8 @@
 #include <cmath>
 
 #include "algorithms/constrained_aba.hpp"
+#include "algorithms/constraint_kinematics.hpp"
+#include "algorithms/delassus.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
@@ -184,6 +186,43 @@ std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, cons
   std::vector<Compared> out;
   for (const LibraryCheck& check : kLibrary)
     if (check.held(gen)) out.push_back(check.compare(sys, d, c, s, gen));
+  return out;
+}
+
+// ---- The constraint functions. The generated code computes the same
+// quantities as the generic one with the operations in another order (the
+// same steps as argued above: c n u kappa, c n = safety):
+//  - placements, J: products of the joint transforms along a path, each step
+//    well conditioned (rotations): c n u relative to max(1, |reference|);
+//  - gamma: sums of velocity products; the terms scale with |v|, so the bound
+//    is c n u (1 + |v|_1) (as tests/algorithms/test_dynamics_library.cpp);
+//  - G = J M^-1 J^T: a solve with M inside a recursion: c n u kappa(M);
+//  - (G + I/mu)^-1 = mu I - mu^2 J M_mu^-1 J^T: the two terms cancel down to the
+//    answer, so the absolute error is mu^2 times the error of J M_mu^-1 J^T
+//    (c n u kappa(M_mu) / mu, as |J M_mu^-1 J^T| <= 1/mu): c n u kappa(M_mu) mu,
+//    in the generic twin too (twice that for the difference), relative to
+//    max(1, |reference|).
+std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                                 const ConstraintAnswer& gen) {
+  std::vector<Compared> out;
+  const double base = std::max(c.floor, c.safety * c.eps);
+  auto add = [&](const char* what, const VecX& g, const VecX& ref, double bound) {
+    out.push_back({what, relErr(g, ref), bound, allFinite(g) && allFinite(ref)});
+  };
+  auto rowMajor = [](const MatX& A) {
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R = A;
+    return VecX(Eigen::Map<const VecX>(R.data(), R.size()));
+  };
+  if (gen.X.size()) add("constraint_placements", gen.X, constraintPlacements(sys, d, s.q), base);
+  if (gen.J.size()) add("constraint_jacobian", gen.J, rowMajor(constraintJacobianRows(sys, d, s.q)), base);
+  if (gen.gamma.size())
+    add("constraint_drift", gen.gamma, constraintDrift(sys, d, s.q, s.v), base * (1 + s.v.cwiseAbs().sum()));
+  if (gen.G.size()) add("delassus", gen.G, rowMajor(delassus(sys, d, s.q)), std::max(c.floor, c.safety * c.eps * c.kappaM));
+  if (gen.Ginv.size()) {
+    const Bounds b = boundsAt(c, gen.mu);
+    const VecX ref = rowMajor(delassusInverse(sys, d, s.q, gen.mu));
+    add("delassus_inverse", gen.Ginv, ref, std::max(c.floor, 2 * c.safety * c.eps * b.kappaC * gen.mu / maxAbs1(ref)));
+  }
   return out;
 }
 

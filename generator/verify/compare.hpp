@@ -93,4 +93,17 @@ double torqueBound(const System& sys, Data& d, const Conditioning& c, const Stat
 std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, const Conditioning& c, const State& s,
                                                 const LibraryAnswer& gen);
 
+// ---- The constraint functions (constraint_placements, constraint_jacobian,
+// constraint_drift, delassus, delassus_inverse) against their generic twins
+// (algorithms/constraint_kinematics.hpp, algorithms/delassus.hpp); bounds
+// argued in compare.cpp. A self-contained block.
+struct ConstraintAnswer {
+  // Row-major as the generated functions write them; an empty vector: not generated.
+  VecX X, J, gamma, G, Ginv;
+  double mu = 0;  // the s.mu delassus_inverse ran with
+};
+/// One Compared per function present in `gen` (in the order above).
+std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                                 const ConstraintAnswer& gen);
+
 }  // namespace proxgen::verify
