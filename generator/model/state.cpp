@@ -63,7 +63,14 @@ VecX configurationFromJson(const Model& model, const json& j, const std::string&
       continue;
     }
     const json& x = j.at(jt.name);
-    if (!x.is_array() || x.size() != 7) fail(where, element, "expected a list of 7 numbers");
+    // The count given and the order expected: a pose with roll-pitch-yaw (6
+    // numbers) or a bare quaternion (4) is the usual mistake.
+    if (!x.is_array() || x.size() != 7)
+      fail(where, element,
+           fmt::format("expected a list of 7 numbers [x y z qx qy qz qw] for free-flyer joint {} (position, then the "
+                       "quaternion with w last), got {}",
+                       quoted(jt.name),
+                       x.is_array() ? fmt::format("a list of {}", x.size()) : std::string(x.type_name())));
     for (int k = 0; k < 3; ++k) q[jt.idx_q + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
     // The quaternion's components only give a direction: any finite size is
     // accepted, and it is normalised by its largest component first, so that
