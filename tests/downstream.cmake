@@ -47,7 +47,8 @@ set(build "${WORK_DIR}/build")
 run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/downstream" -B "${build}" -G Ninja
     -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release
     -DARM_URDF=${WORK_DIR}/inputs/arm.urdf -DARM_LAYOUT=${WORK_DIR}/inputs/layout.yaml
-    -DCHECKED_IN_DIR=${SOURCE_DIR}/generated/arm -DCMAKE_EXPORT_COMPILE_COMMANDS=ON)
+    -DCHECKED_IN_DIR=${SOURCE_DIR}/generated/arm -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
+    "-DCMAKE_CXX_FLAGS=")  # not the environment's CXXFLAGS: the -O flags below are then known
 # A chosen build type keeps its level: Release's -O3, no -O2 from proxgen after it.
 compile_command("${build}" "/arm_built.cpp" solver_command)
 optimisation_flags("${solver_command}" solver_levels)
