@@ -107,5 +107,15 @@ function(proxgen_add_solver target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   proxgen_solver_compile_options(options)
   target_compile_options(${target} PRIVATE ${options})
+  # A project that sets no build type gets no -O flag from CMake at all, and a
+  # solver compiled at -O0 is more than twice as slow as at -O2, the level of
+  # docs/benchmarks.md (README, "Install and packaging"). With an empty build
+  # type, and no -O in the project's CMAKE_CXX_FLAGS, the solver alone gets
+  # -O2. A chosen build type (Debug included: -O0 was asked for) or -O level is
+  # never overridden, and target_compile_options(<target> PRIVATE -O...) after
+  # this call comes later on the command line and wins.
+  if(NOT CMAKE_CXX_FLAGS MATCHES "(^| )-O")
+    target_compile_options(${target} PRIVATE $<$<STREQUAL:$<CONFIG>,>:-O2>)
+  endif()
   set_target_properties(${target} PROPERTIES PROXGEN_HEADER "${hpp}" PROXGEN_SOURCE "${cpp}")
 endfunction()

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "emit/output.hpp"
@@ -20,6 +21,30 @@ void printError(const char* kind, const std::string& what) {
   std::fprintf(stderr, "proxgen: %s: %s\n", kind, proxgen::oneLine(what, kMaxMessage).c_str());
 }
 
+// CLI11 reads an unknown first word (`proxgen chek`) as a stray argument and
+// reports "A subcommand is required". The first word that is not an option is
+// the command (proxgen itself takes no option with a value): an unknown one is
+// named, with the valid ones and, when one is a typo away (two edits, or the
+// word begins it), a suggestion. "" when the command is known or absent.
+std::string unknownCommand(int argc, char** argv, const std::vector<std::string>& commands) {
+  for (int k = 1; k < argc; ++k) {
+    const std::string word = argv[k];
+    if (!word.empty() && word[0] == '-') continue;
+    for (const std::string& c : commands)
+      if (word == c) return "";
+    std::string valid;
+    for (const std::string& c : commands) valid += (valid.empty() ? "" : ", ") + c;
+    std::vector<std::string> near;
+    for (const std::string& c : commands)
+      if (proxgen::editDistance(word, c) <= 2 || (word.size() >= 2 && c.compare(0, word.size(), word) == 0))
+        near.push_back(c);
+    near = proxgen::closestNames(word, near, 3);
+    return proxgen::describe("command line", "", fmt::format("unknown command {} (valid: {}){}", proxgen::quoted(word), valid,
+                                                             near.empty() ? "" : "; did you mean " + proxgen::quotedList(near) + "?"));
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -32,6 +57,12 @@ int main(int argc, char** argv) {
   proxgen::cli::addVerify(app);
   // An interrupted generate or verify removes its temporaries (emit/output.hpp).
   proxgen::emit::installInterruptCleanup();
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands({})) commands.push_back(sub->get_name());
+  if (const std::string unknown = unknownCommand(argc, argv, commands); !unknown.empty()) {
+    printError("error", unknown);  // bad input like a bad file: exit 1 (docs/cli.md "Errors")
+    return 1;
+  }
   try {
     app.parse(argc, argv);
     proxgen::flushWarnings();  // only once the command succeeded: bad input prints one line

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <numeric>
+
 namespace proxgen {
 
 std::string describe(const std::string& file, const std::string& element, const std::string& what) {
@@ -101,6 +104,46 @@ std::string quoted(const std::string& name) {
 std::string oneLine(const std::string& text, std::size_t maxShown) {
   std::string out;
   appendEscaped(out, text, maxShown, false);
+  return out;
+}
+
+std::size_t editDistance(const std::string& a0, const std::string& b0) {
+  const std::string a = a0.substr(0, 100), b = b0.substr(0, 100);
+  // Optimal string alignment: three rows of the dynamic programme.
+  std::vector<std::size_t> before(b.size() + 1), prev(b.size() + 1), row(b.size() + 1);
+  std::iota(prev.begin(), prev.end(), std::size_t(0));
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t change = a[i - 1] == b[j - 1] ? 0 : 1;
+      row[j] = std::min({prev[j] + 1, row[j - 1] + 1, prev[j - 1] + change});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) row[j] = std::min(row[j], before[j - 2] + 1);
+    }
+    before.swap(prev);
+    prev.swap(row);
+  }
+  return prev[b.size()];
+}
+
+std::vector<std::string> closestNames(const std::string& name, const std::vector<std::string>& candidates,
+                                      std::size_t count) {
+  std::vector<std::pair<std::size_t, std::size_t>> ranked;  // (distance, position)
+  for (std::size_t k = 0; k < candidates.size(); ++k) ranked.emplace_back(editDistance(name, candidates[k]), k);
+  std::stable_sort(ranked.begin(), ranked.end());
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < ranked.size() && out.size() < count; ++k) {
+    const std::string& c = candidates[ranked[k].second];
+    if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+  }
+  return out;
+}
+
+std::string quotedList(const std::vector<std::string>& names, const char* lastJoin) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (k > 0) out += k + 1 == names.size() ? lastJoin : ", ";
+    out += quoted(names[k]);
+  }
   return out;
 }
 

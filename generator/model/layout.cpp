@@ -106,6 +106,7 @@ class Reader {
     c.name = string(n["name"], element + ".name");
     const std::string el = fmt::format("{} {}", element, quoted(c.name));
     c.link = string(n["link"], el + ".link");
+    if (!n["link"].Mark().is_null()) c.linkLine = n["link"].Mark().line + 1;  // for an unknown link (bindLayout)
     const std::string type = string(n["type"], el + ".type");
     if (type == "6d" || type == "6D") c.type = ConstraintType::Weld6D;
     else if (type == "3d" || type == "3D") c.type = ConstraintType::Point3D;

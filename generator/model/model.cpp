@@ -128,9 +128,14 @@ System bindLayout(Model model, const Layout& layout) {
     Constraint c = layout.constraints[k];
     const std::string element = fmt::format("constraints[{}] {}", k, quoted(c.name));
     const int f = model.findFrame(c.link);
-    if (f < 0)
-      fail(layout.sourcePath, element,
-           fmt::format("link {} is not in {}", quoted(c.link), model.sourcePath));
+    if (f < 0) {
+      // The line of `link:` and the nearest link names: most unknown links are typos.
+      std::vector<std::string> links;
+      for (const Frame& frame : model.frames) links.push_back(frame.name);
+      fail(c.linkLine > 0 ? fmt::format("{}:{}", layout.sourcePath, c.linkLine) : layout.sourcePath, element,
+           fmt::format("link {} is not in {} (closest: {})", quoted(c.link), model.sourcePath,
+                       quotedList(closestNames(c.link, links, 3), ", ")));
+    }
     c.body = model.frames[f].body;
     // Body 0 is the world: the link is welded to it and its rows of J are zero,
     // which is almost always a wrong link name (or a fixed base meant floating).
@@ -154,14 +159,16 @@ System bindLayout(Model model, const Layout& layout) {
 std::string readInputFile(const std::string& path, std::size_t maxBytes, const char* kind) {
   // O_NONBLOCK: opening a FIFO with no writer would otherwise block in open().
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) fail(path, "", fmt::format("cannot open file ({})", std::strerror(errno)));
+  // The system's reason, in its words ("No such file or directory",
+  // "Permission denied"): what the user must fix is outside proxgen.
+  if (fd < 0) fail(path, "", fmt::format("cannot open the {} file: {}", kind, std::strerror(errno)));
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) fail(path, "", fmt::format("cannot read file ({})", std::strerror(errno)));
-  if (S_ISDIR(st.st_mode)) fail(path, "", fmt::format("is a directory, not a {} file", kind));
+  if (::fstat(fd, &st) != 0) fail(path, "", fmt::format("cannot read the {} file: {}", kind, std::strerror(errno)));
+  if (S_ISDIR(st.st_mode)) fail(path, "", fmt::format("cannot read the {} file: {}", kind, std::strerror(EISDIR)));
   if (!S_ISREG(st.st_mode))
     fail(path, "", fmt::format("is not a regular file (a FIFO, device or socket): proxgen reads {} files only from "
                                "regular files, whose size is known before reading",
@@ -173,7 +180,7 @@ std::string readInputFile(const std::string& path, std::size_t maxBytes, const c
   while (got < text.size()) {
     const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) fail(path, "", fmt::format("cannot read file ({})", std::strerror(errno)));
+    if (n < 0) fail(path, "", fmt::format("cannot read the {} file: {}", kind, std::strerror(errno)));
     if (n == 0) break;  // shrank while read: what is there is the file
     got += std::size_t(n);
   }

@@ -94,6 +94,7 @@ struct Constraint {
   double kp = 0, kd = 0;  // Baumgarte gains
   bool hasTarget = false;
   SE3 target;         // world placement the frame is held to (needed when kp != 0)
+  int linkLine = 0;   // line of `link:` in the layout, for messages (0: unknown)
   // Resolved against the model:
   int body = 0;       // body carrying the link
   SE3 placement;      // C in body coordinates (link frame * offset)

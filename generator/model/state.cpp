@@ -67,7 +67,15 @@ VecX configurationFromJson(const Model& model, const json& j, const std::string&
     const bool ff = jt.type == JointType::FreeFlyer;
     const int positions = ff ? 3 : 2, n = jt.nq;
     const json& x = j.at(jt.name);
-    if (!x.is_array() || int(x.size()) != n) fail(where, element, fmt::format("expected a list of {} numbers", n));
+    // The count given and the order expected: a pose with roll-pitch-yaw (6
+    // numbers) or a bare quaternion (4) is the usual mistake.
+    if (!x.is_array() || int(x.size()) != n)
+      fail(where, element,
+           fmt::format("expected a list of {} numbers {} for {} joint {} ({}), got {}", n,
+                       ff ? "[x y z qx qy qz qw]" : "[x y cos(yaw) sin(yaw)]", ff ? "free-flyer" : "planar",
+                       quoted(jt.name),
+                       ff ? "position, then the quaternion with w last" : "position, then the direction of yaw",
+                       x.is_array() ? fmt::format("a list of {}", x.size()) : std::string(x.type_name())));
     for (int k = 0; k < positions; ++k) q[jt.idx_q + k] = finiteNumber(x[k], where, fmt::format("{}[{}]", element, k));
     // The direction's components only give a direction: any finite size is
     // accepted, and it is normalised by its largest component first, so that

@@ -3,6 +3,10 @@
 // ESC or a C1 control (U+009B is CSI, as ESC [ is) never reach the terminal
 // raw, CLI11's own messages included; inputs that used to end in an internal
 // error (exit 3) or in `null` with exit 0 are refused.
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -112,6 +116,119 @@ TEST(Messages, AnOverflowingStateIsAnErrorNotNull) {
     expectOneEscapedLine(r);
     EXPECT_NE(r.err.find(state.path()), std::string::npos) << r.err;
   }
+}
+
+// --- issue 18 item 8: messages a user can act on --------------------------
+
+// CLI11 read `proxgen chek` as a stray argument: "A subcommand is required".
+// The word is named, the valid commands listed, and the near one suggested
+// (editDistance("chek", "check") = 1; a prefix of a command counts as near).
+TEST(Messages, AnUnknownCommandIsNamedWithTheValidOnes) {
+  const std::string valid = "(valid: check, eval, generate, verify)";
+  struct Case {
+    std::vector<std::string> args;
+    std::string expected;
+  };
+  for (const Case& c : {Case{{"chek", "robot.urdf"}, "unknown command 'chek' " + valid + "; did you mean 'check'?"},
+                        Case{{"gen"}, "unknown command 'gen' " + valid + "; did you mean 'generate'?"},
+                        Case{{"veirfy"}, "unknown command 'veirfy' " + valid + "; did you mean 'verify'?"},  // a swap is 1
+                        Case{{"frobnicate"}, "unknown command 'frobnicate' " + valid}}) {
+    const ProcessResult r = runProxgen(c.args);
+    expectOneEscapedLine(r);
+    EXPECT_EQ(r.err, "proxgen: error: command line: " + c.expected + "\n");
+  }
+  // What was right stays so: a known command, and no command at all (CLI11's own message).
+  EXPECT_EQ(runProxgen({"--version"}).code, 0);
+  EXPECT_EQ(runProxgen({"check", "--help"}).code, 0);
+  const ProcessResult none = runProxgen({});
+  EXPECT_GE(none.code, 100);
+  EXPECT_NE(none.err.find("A subcommand is required"), std::string::npos) << none.err;
+}
+
+// A file that cannot be opened gets the system's reason, in the system's words
+// (strerror of the errno open() or read() gave), and which file it was meant to be.
+TEST(Messages, AFileThatCannotBeOpenedGivesTheSystemsReason) {
+  TempFile regular(".urdf");
+  regular.write("<robot name=\"r\"/>");
+  const fs::path loop = fs::path(regular.path()).parent_path() / ("proxgen_loop_" + std::to_string(::getpid()) + ".urdf");
+  fs::remove(loop);
+  fs::create_symlink(loop, loop);  // a link to itself: ELOOP
+  struct Case {
+    std::vector<std::string> args;
+    std::string file, expected;
+  };
+  const std::string arm = good("arm3.urdf");
+  for (const Case& c : {
+           Case{{"check", "/nonexistent/robot.urdf"}, "/nonexistent/robot.urdf", "cannot open the URDF file: " + std::string(std::strerror(ENOENT))},
+           Case{{"check", PROXGEN_TEST_DATA_DIR}, PROXGEN_TEST_DATA_DIR, "cannot read the URDF file: " + std::string(std::strerror(EISDIR))},
+           Case{{"check", regular.path() + "/robot.urdf"}, regular.path() + "/robot.urdf", "cannot open the URDF file: " + std::string(std::strerror(ENOTDIR))},
+           Case{{"check", loop.string()}, loop.string(), "cannot open the URDF file: " + std::string(std::strerror(ELOOP))},
+           Case{{"check", arm, "--layout", "/nonexistent.yaml"}, "/nonexistent.yaml", "cannot open the layout file: " + std::string(std::strerror(ENOENT))},
+           Case{{"eval", arm, "--layout", good("arm3_tool.yaml"), "--state", PROXGEN_TEST_DATA_DIR}, PROXGEN_TEST_DATA_DIR,
+                "cannot read the state file: " + std::string(std::strerror(EISDIR))}}) {
+    const ProcessResult r = runProxgen(c.args);
+    expectOneEscapedLine(r);
+    EXPECT_EQ(r.err, "proxgen: error: " + c.file + ": " + c.expected + "\n");
+  }
+  fs::remove(loop);
+  EXPECT_EQ(std::string(std::strerror(EISDIR)), "Is a directory");  // glibc's words, as docs/cli.md quotes them
+}
+
+// Permission denied: only where permissions bind (root reads a file of mode 000).
+TEST(Messages, AnUnreadableFileSaysPermissionDenied) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: mode 000 does not stop root from reading";
+  TempFile locked(".urdf");
+  locked.write("<robot name=\"r\"/>");
+  fs::permissions(locked.path(), fs::perms::none);
+  const ProcessResult r = runProxgen({"check", locked.path()});
+  expectOneEscapedLine(r);
+  EXPECT_EQ(r.err, "proxgen: error: " + locked.path() + ": cannot open the URDF file: " + std::strerror(EACCES) + "\n");
+}
+
+TEST(Messages, XacroInputIsToldToRunXacro) {
+  const std::string f = std::string(PROXGEN_TEST_DATA_DIR) + "/bad/xacro_macro.urdf.xacro";
+  const ProcessResult r = runProxgen({"check", f});
+  expectOneEscapedLine(r);
+  EXPECT_NE(r.err.find("this is a xacro file, not a URDF: run xacro first (xacro " + f + " > " +
+                       std::string(PROXGEN_TEST_DATA_DIR) + "/bad/xacro_macro.urdf)"),
+            std::string::npos)
+      << r.err;
+  // generate writes nothing for it.
+  const fs::path out = fs::temp_directory_path() / ("proxgen_xacro_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  expectOneEscapedLine(runProxgen({"generate", f, "--layout", good("arm3_tool.yaml"), "--out", out.string()}));
+  EXPECT_FALSE(fs::exists(out / "arm3.hpp") || (fs::exists(out) && !fs::is_empty(out)));
+  fs::remove_all(out);
+}
+
+TEST(Messages, UnknownLinkAndFreeFlyerQThroughTheBinary) {
+  const std::string bad = std::string(PROXGEN_TEST_DATA_DIR) + "/bad/";
+  const ProcessResult link = runProxgen({"check", good("arm3.urdf"), "--layout", bad + "unknown_link_typo.yaml"});
+  expectOneEscapedLine(link);
+  EXPECT_EQ(link.err, "proxgen: error: " + bad + "unknown_link_typo.yaml:5: constraints[0] 'grip': link 'uper_arm' is not in " +
+                          good("arm3.urdf") + " (closest: 'upper_arm', 'forearm', 'hand')\n");  // derived in tests/model/test_bad_input.cpp
+  const ProcessResult q = runProxgen({"eval", good("arm3.urdf"), "--layout", good("arm3_floating.yaml"), "--state",
+                                      bad + "state_wrong_length.json"});
+  expectOneEscapedLine(q);
+  EXPECT_EQ(q.err, "proxgen: error: " + bad + "state_wrong_length.json: q.'root_joint': expected a list of 7 numbers [x y z qx qy "
+                       "qz qw] for free-flyer joint 'root_joint' (position, then the quaternion with w last), got a list of 6\n");
+}
+
+// The distance behind every suggestion: textbook values of the optimal string
+// alignment distance (Levenshtein plus swaps of neighbours).
+TEST(Messages, EditDistanceAndClosestNames) {
+  EXPECT_EQ(editDistance("kitten", "sitting"), 3u);  // k->s, e->i, insert g
+  EXPECT_EQ(editDistance("chek", "check"), 1u);
+  EXPECT_EQ(editDistance("ab", "ba"), 1u);            // one swap
+  EXPECT_EQ(editDistance("ca", "abc"), 3u);           // OSA edits no substring twice (Damerau would give 2)
+  EXPECT_EQ(editDistance("", "abc"), 3u);
+  EXPECT_EQ(editDistance("abc", "abc"), 0u);
+  // Only the first 100 bytes count: two 10 kB names differing past them are "equal".
+  EXPECT_EQ(editDistance(std::string(10000, 'a'), std::string(9000, 'a') + std::string(1000, 'b')), 0u);
+  EXPECT_EQ(closestNames("lf_foot", {"rf_foot", "lh_foot", "lf_foot", "base"}, 2), (std::vector<std::string>{"lf_foot", "rf_foot"}));
+  // Ties keep the candidates' order; duplicates are listed once; fewer than asked is fine.
+  EXPECT_EQ(closestNames("b", {"c", "a", "c"}, 3), (std::vector<std::string>{"c", "a"}));
+  EXPECT_EQ(quotedList({"a", "b", "c"}), "'a', 'b' or 'c'");
 }
 
 }  // namespace

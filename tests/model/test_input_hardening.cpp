@@ -337,8 +337,8 @@ TEST(Ambiguous, FifoAndDevicesAreRefusedWithoutBlocking) {
     EXPECT_TRUE(has(errorOf([&] { loadCases(path); }), "is not a regular file")) << path;
   }
   ::unlink(fifo.c_str());
-  // A directory keeps its own message.
-  EXPECT_TRUE(has(errorOf([] { loadLayout(PROXGEN_TEST_DATA_DIR); }), "is a directory"));
+  // A directory keeps its own message, the system's words for it.
+  EXPECT_TRUE(has(errorOf([] { loadLayout(PROXGEN_TEST_DATA_DIR); }), "Is a directory"));
 }
 
 // ---------------------------------------------------------------------------
