@@ -8,6 +8,7 @@
 //   1. M Minv = I                    mass_matrix, mass_matrix_inverse
 //   2. h = ID(q, v, 0, nullptr)      nonlinear_effects, inverse_dynamics
 //   3. ID(q, v, qdd, lambda) = tau   inverse_dynamics at prox_pv's answer (layout mu and K)
+//   3b.   the same at constrained_aba's answer (float: at mu = 100, see kMuPrimal)
 //   4. (G + I/mu) Ginv = I           delassus, delassus_inverse
 //   5. G = J Minv J^T                delassus, constraint_jacobian, mass_matrix_inverse
 //
@@ -55,6 +56,11 @@ constexpr Scalar kN = Scalar(nv);
 // difference of the penalty recursion, not just mu I.
 const Scalar kMuInverse = kFloat ? Scalar(1) : Scalar(1e4);
 
+// mu of constrained_aba in 3b: the layout's in double; in float the largest mu that
+// docs/embedded.md ("Float accuracy") advises for a float constrained_aba on this robot,
+// 1.7e3 m = 108 (m = 0.064 kg, its lightest support body), rounded to 100.
+const Scalar kMuPrimal = kFloat ? Scalar(100) : Scalar(1e4);
+
 gen::Workspace g_w;  // static, so its size is known at link time
 Scalar g_M[nv * nv], g_Minv[nv * nv], g_J[nc * nv], g_G[nc * nc], g_Ginv[nc * nc];
 Scalar g_h[nv], g_id[nv], g_tau[nv], g_qdd[nv], g_lambda[nc], g_gamma[nc];
@@ -96,8 +102,9 @@ struct Check {
   const char* name;
   Scalar err = 0, bound = 0, worst = 0;  // at the state of the worst ratio
 };
-Check g_checks[5] = {{"M Minv = I"}, {"h = ID(q, v, 0)"}, {"ID(q, v, qdd, lambda) = tau"},
-                     {"(G + I/mu) Ginv = I"}, {"G = J Minv J^T"}};
+Check g_checks[6] = {{"M Minv = I"}, {"h = ID(q, v, 0)"}, {"ID(q, v, qdd, lambda) = tau (prox_pv)"},
+                     {"(G + I/mu) Ginv = I"}, {"G = J Minv J^T"},
+                     {"ID(q, v, qdd, lambda) = tau (constrained_aba)"}};
 
 void record(int k, Scalar err, Scalar bound) {
   Check& c = g_checks[k];
@@ -119,7 +126,7 @@ void run_state(int s) {
 
   // Region order: mass_matrix, mass_matrix_inverse, nonlinear_effects, inverse_dynamics,
   // prox_pv, inverse_dynamics, constraint_jacobian, delassus, delassus_inverse,
-  // constraint_placements, constraint_drift.
+  // constrained_aba, inverse_dynamics, constraint_placements, constraint_drift.
   if (trace) fw::trace_begin();
   gen::mass_matrix(q, g_w, g_M);
   if (trace) fw::trace_end();
@@ -267,6 +274,43 @@ void run_state(int s) {
     record(4, err, (2 * kC + 1) * kN * kU * kappa_M);
   }
 
+  // ---- 3b. As 3 at constrained_aba's (qdd, lambda): it solves
+  // (M + mu J^T J) qdd = tau - h - J^T (lambda' + mu (gamma - a*)), then updates
+  // lambda = lambda' + mu (J qdd + gamma - a*) (docs/algorithms.md, the primal iteration), so
+  // M qdd + h + J^T lambda = tau in exact arithmetic too. Its elimination is of M + mu J^T J,
+  // whose backward error is relative to |M| + mu |J^T||J| (the light shanks keep their own
+  // inertia only to u mu / m: part of that backward error), and the update after the solve
+  // multiplies the round-off of J qdd by mu: both are the term mu (|J^T||J||qdd|)_i added to
+  // the scale of 3. Bound: c n u. That term dominates the scale (measured: a relative change d
+  // of one qdd entry shows as an error of ~d / 4e4 at mu = 1e4, ~d / 400 at mu = 100), so in
+  // float (bound 1e-5) at mu = 1e4 a 1 % error in qdd would stay inside the bound: float runs
+  // constrained_aba at kMuPrimal instead (there a 1 % change of qdd[9] fails the check).
+  gen::Settings caba = settings;
+  caba.mu = kMuPrimal;
+  if (trace) fw::trace_begin();
+  gen::constrained_aba(q, v, tau, caba, g_w, g_qdd, g_lambda);
+  if (trace) fw::trace_end();
+  if (trace) fw::trace_begin();
+  gen::inverse_dynamics(q, v, g_qdd, g_lambda, g_w, g_tau);
+  if (trace) fw::trace_end();
+  {
+    Scalar Jqdd[nc];  // (|J||qdd|)_r
+    for (int r = 0; r < nc; ++r) {
+      Jqdd[r] = 0;
+      for (int k = 0; k < nv; ++k) Jqdd[r] += std::fabs(g_J[r * nv + k] * g_qdd[k]);
+    }
+    Scalar err = 0;
+    for (int i = 0; i < nv; ++i) {
+      Scalar scale = std::fabs(g_h[i]) + std::fabs(tau[i]);
+      for (int k = 0; k < nv; ++k) scale += std::fabs(g_M[i * nv + k] * g_qdd[k]);
+      for (int r = 0; r < nc; ++r)
+        scale += std::fabs(g_J[r * nv + i]) * (std::fabs(g_lambda[r]) + caba.mu * Jqdd[r]);
+      const Scalar e = std::fabs(g_tau[i] - tau[i]) / scale;
+      err = max_of(err, std::isfinite(e) ? e : std::numeric_limits<Scalar>::infinity());
+    }
+    record(5, err, kC * kN * kU);
+  }
+
   // The two constraint functions without an identity here: run, finite.
   if (trace) fw::trace_begin();
   gen::constraint_placements(q, g_w, g_X);
@@ -300,6 +344,8 @@ int main() {
   fw::print_int(tc.num_states);
   fw::print("; mu of (G + I/mu) Ginv: ");
   print_num(kMuInverse);
+  fw::print("; mu of constrained_aba: ");
+  print_num(kMuPrimal);
   fw::print("\n");
   if (tc.nq != gen::nq || tc.nv != nv || tc.nc != nc) {
     fw::print("FAILED: the test vectors do not fit this library (nq, nv or nc)\n");
