@@ -18,8 +18,8 @@
 // c = 10 and n = nv as the verification suites' round-off bounds (tests/numerics.hpp): every
 // function is a short chain of backward-stable symmetric eliminations or sums of products.
 // The firmware prints each worst error / bound over the states and exits 1 if any exceeds 1.
-// (constraint_placements and constraint_drift have no identity here; they are called once so
-// that they are linked, run without a fault and enter the stack report.)
+// (constraint_placements and constraint_drift have no identity here; they run at every state
+// and their outputs must be finite, so they are linked, run without a fault and are counted.)
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -82,14 +82,14 @@ void print_num(Scalar v) {
     fw::print_double(v, 3);
 }
 
-// ||A||_inf of an r x c row-major matrix, with rows scaled by 1/sr and columns by 1/sc
-// (nullptr: unscaled); inverse = true multiplies by the scales instead (for an inverse).
-Scalar norm_inf(const Scalar* A, int r, int c, const Scalar* s, bool inverse) {
+// ||A||_inf of a square n x n row-major matrix with entry (i, j) divided by s_i s_j (Jacobi
+// scaling; s = nullptr: unscaled); inverse = true multiplies by s_i s_j instead (for an inverse).
+Scalar norm_inf(const Scalar* A, int n, const Scalar* s, bool inverse) {
   Scalar best = 0;
-  for (int i = 0; i < r; ++i) {
+  for (int i = 0; i < n; ++i) {
     Scalar row = 0;
-    for (int j = 0; j < c; ++j) {
-      Scalar x = std::fabs(A[i * c + j]);
+    for (int j = 0; j < n; ++j) {
+      Scalar x = std::fabs(A[i * n + j]);
       if (s) x = inverse ? x * s[i] * s[j] : x / (s[i] * s[j]);
       row += x;
     }
@@ -141,7 +141,7 @@ void run_state(int s) {
   // error) + n u kappa(Ms) (the product's). kappa(Ms) = ||Ms||_inf ||Ms^-1||_inf from the
   // outputs. (Unscaled, the 9 kg trunk and the 64 g shanks would make the bound far looser.)
   for (int i = 0; i < nv; ++i) g_d[i] = std::sqrt(g_M[i * nv + i]);
-  const Scalar kappa_M = norm_inf(g_M, nv, nv, g_d, false) * norm_inf(g_Minv, nv, nv, g_d, true);
+  const Scalar kappa_M = norm_inf(g_M, nv, g_d, false) * norm_inf(g_Minv, nv, g_d, true);
   {
     Scalar err = 0;
     for (int i = 0; i < nv; ++i)
@@ -231,7 +231,7 @@ void run_state(int s) {
         A[i * nv + j] = g_M[i * nv + j] + mu * x;
       }
     for (int i = 0; i < nv; ++i) dA[i] = std::sqrt(A[i * nv + i]);
-    const Scalar kappa_A = norm_inf(A, nv, nv, dA, false) * norm_inf(g_Minv, nv, nv, dA, true);
+    const Scalar kappa_A = norm_inf(A, nv, dA, false) * norm_inf(g_Minv, nv, dA, true);
     Scalar GI[nc * nc];
     for (int i = 0; i < nc * nc; ++i) GI[i] = g_G[i] + (i % (nc + 1) == 0 ? 1 / mu : Scalar(0));
     Scalar err = 0;
@@ -242,7 +242,7 @@ void run_state(int s) {
         x -= (i == j ? Scalar(1) : Scalar(0));
         err = max_of(err, std::isfinite(x) ? std::fabs(x) : std::numeric_limits<Scalar>::infinity());
       }
-    record(3, err, kC * kN * kU * kappa_A * mu * norm_inf(GI, nc, nc, nullptr, false));
+    record(3, err, kC * kN * kU * kappa_A * mu * norm_inf(GI, nc, nullptr, false));
   }
 
   // ---- 5. G = J Minv J^T. Both sides carry the error of a recursion on M: Minv's, as in 1,
@@ -258,7 +258,7 @@ void run_state(int s) {
       for (int k = 0; k < nv; ++k) row += std::fabs(g_J[r * nv + k]) / g_d[k];
       jd = max_of(jd, row);
     }
-    const Scalar S = norm_inf(g_Minv, nv, nv, g_d, true) * jd * jd;
+    const Scalar S = norm_inf(g_Minv, nv, g_d, true) * jd * jd;
     Scalar err = 0;
     for (int i = 0; i < nc; ++i)
       for (int j = 0; j < nc; ++j) {
