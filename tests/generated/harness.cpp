@@ -167,7 +167,7 @@ TEST_F(Generated, WarmStartMayBeTheLambdaOutput) {
   if (gen::nc == 0) GTEST_SKIP() << "no constraints";
   std::vector<gen::Scalar> q(gen::nq, gen::Scalar(0.1)), v(gen::nv, gen::Scalar(0.2)), tau(gen::nv, gen::Scalar(0.3)),
       qdd(gen::nv), l0(gen::nc), lOut(gen::nc), qddAlias(gen::nv), lAlias(gen::nc);
-  if (sys_.model.floatingBase) q[6] = gen::Scalar(1);  // w of a unit quaternion (0.1, 0.1, 0.1, 1) scaled: fine
+  if (sys_.model.floatingBase && gen::nq > 6) q[6] = gen::Scalar(1);  // w of a unit quaternion (0.1, 0.1, 0.1, 1) scaled: fine
   for (int k = 0; k < gen::nc; ++k) l0[std::size_t(k)] = lAlias[std::size_t(k)] = gen::Scalar(0.5 + k);
   static gen::Workspace w;
   for (auto solve : {gen::constrained_aba, gen::prox_pv}) {
