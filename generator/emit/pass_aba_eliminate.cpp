@@ -33,6 +33,21 @@ void penalty(Emit& e, int i, const std::vector<std::vector<Expr>>& kk, Sym& IA, 
   }
 }
 
+// A body's share of its parent: Ia (and, given, the bias pa) moved into the
+// parent's frame and added to its IA (and pA); both transforms are printed
+// before the sums, as the elimination always printed them.
+void passToParent(Emit& e, const Kinematics::Body& kb, int parent, const Sym& Ia, const V6* pa, Articulated& art) {
+  const Sym dI = e.inertiaToParent(kb, Ia);
+  const V6 dp = pa ? e.forceToParent(kb, *pa) : V6{};
+  Articulated::Body& par = art.b[std::size_t(parent)];
+  for (int k = 0; k < 21; ++k)
+    if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  if (!pa) return;
+  for (int k = 0; k < 6; ++k)
+    if (!dp[std::size_t(k)].isZero())
+      par.pA[std::size_t(k)] = e.putQ(kPA, parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
+}
+
 void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art,
                      bool bias) {
   CodeBuilder& cb = e.cb();
@@ -71,13 +86,8 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   if (const int along = axisComponent(p); along >= 0)
     for (int k = 0; k < 6; ++k) Ia(along, k) = Expr();
   flatten(cb, Ia, "Ia");
-  Articulated::Body& par = art.b[std::size_t(p.parent)];
-  auto passInertia = [&](const Sym& dI) {
-    for (int k = 0; k < 21; ++k)
-      if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
-  };
   if (!bias) {  // the articulated inertia only (the Delassus functions)
-    passInertia(e.inertiaToParent(kb, Ia));
+    passToParent(e, kb, p.parent, Ia, nullptr, art);
     return;
   }
   V6 pa;
@@ -87,12 +97,7 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
     pa[std::size_t(r)] = x;
   }
   flatten(cb, pa, "pa");
-  const Sym dI = e.inertiaToParent(kb, Ia);
-  const V6 dp = e.forceToParent(kb, pa);
-  passInertia(dI);
-  for (int k = 0; k < 6; ++k)
-    if (!dp[std::size_t(k)].isZero())
-      par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
+  passToParent(e, kb, p.parent, Ia, &pa, art);
 }
 
 // The free flyer: S = I, so U = IA and D = IA, factored once (LL^T); its
@@ -172,13 +177,8 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
   for (int k : sel)
     for (int c = 0; c < 6; ++c) Ia(k, c) = Expr();
   flatten(cb, Ia, "Ia");
-  Articulated::Body& par = art.b[std::size_t(p.parent)];
-  auto passInertia = [&](const Sym& dI) {
-    for (int k = 0; k < 21; ++k)
-      if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
-  };
   if (!bias) {  // the articulated inertia only (the Delassus functions)
-    passInertia(e.inertiaToParent(kb, Ia));
+    passToParent(e, kb, p.parent, Ia, nullptr, art);
     return;
   }
   const std::vector<Expr> Du = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, b.u));  // D^-1 u
@@ -190,12 +190,7 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
     pa[std::size_t(r)] = x;
   }
   flatten(cb, pa, "pa");
-  const Sym dI = e.inertiaToParent(kb, Ia);
-  const V6 dp = e.forceToParent(kb, pa);
-  passInertia(dI);
-  for (int k = 0; k < 6; ++k)
-    if (!dp[std::size_t(k)].isZero())
-      par.pA[std::size_t(k)] = e.putQ(kPA, p.parent, 6, k, par.pA[std::size_t(k)] + dp[std::size_t(k)]);
+  passToParent(e, kb, p.parent, Ia, &pa, art);
 }
 
 }  // namespace

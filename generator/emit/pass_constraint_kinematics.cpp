@@ -114,17 +114,8 @@ std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints) {
   out.out.assign(std::size_t(plan.nc * plan.nv), Expr());
   ProxRows rows;
   rows.b.resize(kin.b.size());
-  for (int i : plan.support) {
-    // KA = K^T: the own rows' force directions, then each child's (below).
-    ProxRows::Body& b = rows.b[std::size_t(i)];
-    b.KA.assign(std::size_t(e.bp(i).m()), zero6());
-    int col = 0;
-    for (int k : e.bp(i).constraints) {
-      const Constraint& c = e.sys.constraints[std::size_t(k)];
-      const Mat6 X = c.placement.motionMatrixInv();
-      for (int j = 0; j < c.rows(); ++j, ++col) b.KA[std::size_t(col)] = constant(Vec6(X.row(j).transpose()));
-    }
-  }
+  // KA = K^T: the own rows' force directions, then each child's (below).
+  for (int i : plan.support) initOwnRows(e, i, rows);
   beginFrom(e, "jacobian", joints.host, kin, out, &rows);
   e.cb().line("constraint_joints(q, w);", {}, {"q", "w"});
   // J(row, v_j) = S_j^T X_j^T ... X_i^T K_row^T: each row's direction carried

@@ -215,16 +215,7 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse) 
   st.out.assign(std::size_t(plan.nc * plan.nc), Expr());
   ProxRows rows;
   rows.b.resize(std::size_t(N));
-  for (int i = 0; i < N; ++i) {
-    ProxRows::Body& b = rows.b[std::size_t(i)];
-    b.KA.assign(std::size_t(e.bp(i).m()), zero6());
-    int col = 0;
-    for (int k : e.bp(i).constraints) {
-      const Constraint& c = e.sys.constraints[std::size_t(k)];
-      const Mat6 X = c.placement.motionMatrixInv();
-      for (int j = 0; j < c.rows(); ++j, ++col) b.KA[std::size_t(col)] = constant(Vec6(X.row(j).transpose()));
-    }
-  }
+  for (int i = 0; i < N; ++i) initOwnRows(e, i, rows);
   e.fn.live() = Live{};
   e.fn.live().kin = &kin;
   e.fn.live().art = &art;

@@ -10,6 +10,17 @@
 #include "emit/passes.hpp"
 
 namespace proxgen::emit {
+void initOwnRows(Emit& e, int i, ProxRows& rows) {
+  ProxRows::Body& b = rows.b[std::size_t(i)];
+  b.KA.assign(std::size_t(e.bp(i).m()), zero6());
+  int col = 0;
+  for (int k : e.bp(i).constraints) {
+    const Constraint& c = e.sys.constraints[std::size_t(k)];
+    const Mat6 X = c.placement.motionMatrixInv();
+    for (int j = 0; j < c.rows(); ++j, ++col) b.KA[std::size_t(col)] = constant(Vec6(X.row(j).transpose()));
+  }
+}
+
 namespace {
 
 /// Slots per row of the row-major KA and Z: m columns and one unused slot.
@@ -185,18 +196,8 @@ void carryRows(Emit& e, const Kinematics& kin, const Articulated& art, int i, Pr
 
 // KA of the support bodies (and the world) starts from their own rows: KA = K^T.
 void initRows(Emit& e, ProxRows& rows) {
-  auto init = [&](int i) {
-    ProxRows::Body& b = rows.b[std::size_t(i)];
-    b.KA.assign(std::size_t(e.bp(i).m()), zero6());
-    int col = 0;
-    for (int k : e.bp(i).constraints) {
-      const Constraint& c = e.sys.constraints[std::size_t(k)];
-      const Mat6 X = c.placement.motionMatrixInv();
-      for (int j = 0; j < c.rows(); ++j, ++col) b.KA[std::size_t(col)] = constant(Vec6(X.row(j).transpose()));
-    }
-  };
-  init(0);
-  for (int i : e.plan.support) init(i);
+  initOwnRows(e, 0, rows);
+  for (int i : e.plan.support) initOwnRows(e, i, rows);
 }
 
 // y_free = K a_free - k: the rows' accelerations with lambda = 0, from a

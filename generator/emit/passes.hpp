@@ -70,6 +70,9 @@ std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const C
 
 // ---- pass_prox_pv.cpp: the prox_pv entry point (body text), as above.
 std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
+/// rows.b[i].KA = K_i^T: body i's own rows (layout order) as force directions
+/// in its coordinates, the start of every pass that carries rows up the tree.
+void initOwnRows(Emit& e, int i, ProxRows& rows);
 
 // ---- pass_delassus_factor.cpp: G + I/mu from proxPV's rows, factored; solves.
 DelassusFactor factorDelassus(Emit& e, const ProxRows& rows);
