@@ -376,16 +376,7 @@ int main() {
     if (!ok) ++failures;
   }
 
-  const std::size_t stack_used = fw::stack_high_water();
-  fw::print("stack high water: ");
-  fw::print_int(static_cast<long long>(stack_used));
-  fw::print(" bytes (whole firmware, budget ");
-  fw::print_int(static_cast<long long>(fw::stack_budget()));
-  fw::print(")\n");
-  if (stack_used >= fw::stack_budget()) {
-    fw::print("FAILED: stack budget exceeded\n");
-    ++failures;
-  }
+  if (!fw::report_stack()) ++failures;  // the whole firmware's stack against its budget
   fw::print(failures == 0 ? "library test: PASS\n" : "library test: FAIL\n");
   return failures == 0 ? 0 : 1;
 }

@@ -205,16 +205,7 @@ int main() {
     if (!check(tc.results[k], g_summary[k % per_state])) ++failures;
   for (int k = 0; k < per_state; ++k) print_summary(tc.results[k], g_summary[k]);
 
-  const std::size_t stack_used = fw::stack_high_water();
-  fw::print("stack high water: ");
-  fw::print_int(static_cast<long long>(stack_used));
-  fw::print(" bytes (whole firmware, budget ");
-  fw::print_int(static_cast<long long>(fw::stack_budget()));
-  fw::print(")\n");
-  if (stack_used >= fw::stack_budget()) {
-    fw::print("FAILED: stack budget exceeded\n");
-    ++failures;
-  }
+  if (!fw::report_stack()) ++failures;  // the whole firmware's stack against its budget
   fw::print("results: ");
   fw::print_int(tc.num_results);
   fw::print(", failed: ");

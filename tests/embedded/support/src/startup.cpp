@@ -172,6 +172,20 @@ std::size_t stack_budget() noexcept {
                                   reinterpret_cast<std::uintptr_t>(__stack_paint_bottom));
 }
 
+bool report_stack() noexcept {
+  const std::size_t used = stack_high_water();
+  print("stack high water: ");
+  print_int(static_cast<long long>(used));
+  print(" bytes (budget ");
+  print_int(static_cast<long long>(stack_budget()));
+  print(", free RAM ");
+  print_int(static_cast<long long>(stack_capacity()));
+  print(")\n");
+  if (used < stack_budget()) return true;
+  print("FAILED: stack budget exceeded\n");
+  return false;
+}
+
 const char* cpu_name() noexcept { return PROXGEN_FW_CPU_NAME; }
 
 }  // namespace fw

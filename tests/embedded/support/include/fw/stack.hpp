@@ -17,6 +17,11 @@ std::size_t stack_budget() noexcept;
 // Bytes available between the end of .bss and the top of RAM.
 std::size_t stack_capacity() noexcept;
 
+// Prints "stack high water: N bytes (budget B, free RAM C)" and, when the
+// budget was reached, "FAILED: stack budget exceeded"; false then. Every test
+// firmware ends with it.
+bool report_stack() noexcept;
+
 // The CPU this firmware was built for, e.g. "cortex-m7" (from the toolchain file).
 const char* cpu_name() noexcept;
 
