@@ -215,8 +215,8 @@ TEST_F(ConstraintFunctions, JacobianAndDriftHoldTheConvergedRowsAtTheirTarget) {
     const proxgen::DenseProblem p = proxgen::assembleDense(sys_, s.q, s.v, s.tau);
     const int K = proxgen::test::convergedIterations(p, mu, 1e-10);
     if (K <= 0) continue;  // not settled within the cap: not this identity's question
-    std::vector<gen::Scalar> q = toScalar(s.q), v = toScalar(s.v), tau = toScalar(s.tau), qdd(std::size_t(gen::nv)),
-                             lambda(std::size_t(std::max(gen::nc, 1)));
+    std::vector<gen::Scalar> q = toScalar(s.q), v = toScalar(s.v), tau = toScalar(s.tau),
+                             qdd(static_cast<std::size_t>(gen::nv)), lambda(std::size_t(std::max(gen::nc, 1)));
     gen::Settings st;
     st.mu = gen::Scalar(mu);
     st.iterations = K;
