@@ -13,6 +13,8 @@
 // against the same free flyer in the file, and one closed form.
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "algorithms/aba.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/jacobians.hpp"
@@ -157,6 +159,12 @@ TEST(MobileBases, ConstraintRowsAreDerivativesOfConstraintVelocities) {
 
 // Every algorithm against the dense proximal iteration with the same mu and
 // K (test_equivalence.cpp's check), with the round-off bounds of numerics.hpp.
+// The penalty algorithms (cABA, proxLTLs) read lambda off mu times the rows'
+// acceleration, so lambda's absolute error is mu |J| times qdd's: relative to
+// max(1, |lambda|) that is qdd's bound times mu |J| max(1, |qdd|) / max(1,
+// |lambda|), the bound verify/compare.cpp argues for the generated cABA's
+// lambda (cabaLambdaBound). It matters where lambda is small against
+// mu |J| |qdd| (the URDF floating joint: 1.1e-9 against 5.6e-10 under clang -O0).
 TEST(MobileBases, AllAlgorithmsAgreeWithTheDenseIteration) {
   for (const Named& n : systems()) {
     Data d(n.sys);
@@ -172,8 +180,13 @@ TEST(MobileBases, AllAlgorithmsAgreeWithTheDenseIteration) {
           for (const test::Algorithm& a : test::kAlgorithms) {
             a.run(n.sys, d, s.q, s.v, s.tau, mu, K);
             const double bound = (a.primal ? tol.primal : tol.dual) + test::multiplierRoundoff(p, lRef);
+            double amplify = 1.0;  // the penalty algorithms' lambda (above)
+            if (a.primal && lRef.size())
+              amplify = std::max(1.0, mu * p.J.cwiseAbs().maxCoeff() * std::max(1.0, qRef.cwiseAbs().maxCoeff()) /
+                                          std::max(1.0, lRef.cwiseAbs().maxCoeff()));
             EXPECT_LE(test::relErr(d.qdd, qRef), bound) << n.name << " " << a.name << " mu " << mu << " K " << K;
-            EXPECT_LE(test::relErr(d.lambda, lRef), bound) << n.name << " " << a.name << " mu " << mu << " K " << K;
+            EXPECT_LE(test::relErr(d.lambda, lRef), bound * amplify)
+                << n.name << " " << a.name << " mu " << mu << " K " << K;
           }
         }
       }
