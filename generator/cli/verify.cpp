@@ -301,7 +301,8 @@ int verify(const VerifyOptions& o) {
 
   Scratch scratch(makeTemporaryFolder());
   const fs::path hpp = scratch.file(std::string(kSolverName) + ".hpp"), cpp = scratch.file(std::string(kSolverName) + ".cpp"),
-                 driverCpp = scratch.file("driver.cpp"), driver = scratch.file("driver"),
+                 driverCpp = scratch.file("driver.cpp"), driverObj = scratch.file("driver.o"),
+                 solverObj = scratch.file(std::string(kSolverName) + ".o"), driver = scratch.file("driver"),
                  compileLog = scratch.file("compile.log"), input = scratch.file("input.txt"),
                  output = scratch.file("output.txt");
   // Kept on failure too: the files of a failed compile are what one wants to see.
@@ -336,12 +337,21 @@ int verify(const VerifyOptions& o) {
   files.push_back({"driver.cpp", driverDefines(sys.functions) + kDriver});
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
-  // -pipe: no assembler files in TMPDIR (fewer temporaries to leave if interrupted).
+  // Each source to its own object, then the link: every file the compiler
+  // writes is one of the scratch folder's registered names (-pipe: no
+  // assembler files; -c -o: no objects in TMPDIR), so an interrupt leaves nothing.
   std::vector<std::string> compile = {PROXGEN_CXX_COMPILER, "-std=c++17", "-pipe"};
   for (const std::string& option : solverCompileOptions()) compile.push_back(option);
-  compile.insert(compile.end(), {"-I", runtimeDir().string(), "-I", scratch.dir().string(), driverCpp.string(), cpp.string(),
-                                 "-o", driver.string()});
-  if (runProcess(compile, compileLog) != 0)
+  compile.insert(compile.end(), {"-I", runtimeDir().string(), "-I", scratch.dir().string(), "-c"});
+  const auto compileOne = [&](const fs::path& source, const fs::path& object) {
+    std::vector<std::string> argv = compile;
+    argv.insert(argv.end(), {source.string(), "-o", object.string()});
+    return runProcess(argv, compileLog);
+  };
+  std::vector<std::string> link = {PROXGEN_CXX_COMPILER, "-std=c++17"};
+  for (const std::string& option : solverCompileOptions()) link.push_back(option);
+  link.insert(link.end(), {driverObj.string(), solverObj.string(), "-o", driver.string()});
+  if (compileOne(driverCpp, driverObj) != 0 || compileOne(cpp, solverObj) != 0 || runProcess(link, compileLog) != 0)
     throw Error(fmt::format("verify: the generated solver does not compile ({}): {}", PROXGEN_CXX_COMPILER,
                             firstErrors(slurp(compileLog))));
   const auto t2 = std::chrono::steady_clock::now();

@@ -59,20 +59,35 @@ extern "C" void removeTemporariesAndDie(int sig) {
       while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
       }
     }
+    // The driver gone, the programs it ran (the compiler proper, the linker)
+    // may still be in the group for a moment, and the linker may still create
+    // its output (a registered name) after the removal below: up to 1 s for
+    // the group to empty (a zombie still counts, so at most that long).
+    for (int k = 0; k < 100 && kill(-child, 0) == 0; ++k) {
+      const timespec pause{0, 10 * 1000 * 1000};
+      nanosleep(&pause, nullptr);
+    }
   }
   // Files first (unlink fails on a folder), then folders, innermost first:
-  // repeat rmdir until no pass removes anything more (nested folders).
-  for (int k = 0; k < kSlots; ++k)
-    if (gUsed[k] && unlink(gPaths[k]) == 0) gUsed[k] = 0;
-  for (int pass = 0; pass < kSlots; ++pass) {
-    bool removed = false;
+  // repeat rmdir until no pass removes anything more (nested folders). A file
+  // that reappears (a late writer) keeps its folder: more rounds while any
+  // registered path still exists (20 at most, 10 ms apart).
+  for (int round = 0; round < 20; ++round) {
     for (int k = 0; k < kSlots; ++k)
-      if (gUsed[k] && rmdir(gPaths[k]) == 0) {
-        gUsed[k] = 0;
-        removed = true;
-      }
-    if (!removed) break;
+      if (gUsed[k]) unlink(gPaths[k]);
+    for (int pass = 0; pass < kSlots; ++pass) {
+      bool removed = false;
+      for (int k = 0; k < kSlots; ++k)
+        if (gUsed[k] && rmdir(gPaths[k]) == 0) removed = true;
+      if (!removed) break;
+    }
+    bool left = false;
+    for (int k = 0; k < kSlots && !left; ++k) left = gUsed[k] && access(gPaths[k], F_OK) == 0;
+    if (!left) break;
+    const timespec pause{0, 10 * 1000 * 1000};
+    nanosleep(&pause, nullptr);
   }
+  for (int k = 0; k < kSlots; ++k) gUsed[k] = 0;
   errno = savedErrno;
   // Die of the signal, as without the handler (the parent sees WIFSIGNALED).
   std::signal(sig, SIG_DFL);
