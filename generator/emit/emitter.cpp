@@ -5,11 +5,8 @@
 // joint_transforms, the off-support bodies' functions) only when one needs it.
 #include "emit/emitter.hpp"
 
-#include <fmt/format.h>
-
 #include "emit/assemble.hpp"
 #include "emit/passes.hpp"
-#include "model/error.hpp"
 
 namespace proxgen::emit {
 namespace {
