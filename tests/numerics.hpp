@@ -8,6 +8,7 @@
 
 #include "algorithms/constrained_aba.hpp"
 #include "algorithms/dense_reference.hpp"
+#include "algorithms/kinematics.hpp"
 #include "algorithms/prox_ltl.hpp"
 #include "algorithms/prox_ltls.hpp"
 #include "algorithms/prox_pv.hpp"
@@ -124,6 +125,28 @@ inline SE3 exp6(const Vec6& xi) {
   const double a = small ? 0.5 - t * t / 24 : (1 - std::cos(t)) / (t * t);
   const double b = small ? 1.0 / 6 - t * t / 120 : (t - std::sin(t)) / (t * t * t);
   return {Mat3::Identity() + s * W + a * W * W, (Mat3::Identity() + a * W + b * W * W) * v};
+}
+
+/// The constraint rows' acceleration J qdd + gamma by central differences of
+/// the constraint velocities: d0 holds the kinematics at (q, v), dp and dm at
+/// q "+-" h v, v +- h qdd. 6D: the body-fixed frame's velocity in its own
+/// coordinates, whose derivative is its spatial acceleration. 3D: the WORLD
+/// velocity of the point differenced and rotated into C (differencing the
+/// C-frame velocity would lose w x v).
+inline VecX constraintRowsByDifferences(const System& sys, const Data& d0, const Data& dp, const Data& dm, double h) {
+  VecX fd(sys.nc);
+  for (const Constraint& k : sys.constraints) {
+    const Vec6 vp = frameVelocity(dp, k.body, k.placement), vm = frameVelocity(dm, k.body, k.placement);
+    if (k.type == ConstraintType::Weld6D) {
+      fd.segment<6>(k.row) = (vp - vm) / (2 * h);
+    } else {
+      const Mat3 R0 = framePlacement(d0, k.body, k.placement).R;
+      const Vec3 wp = framePlacement(dp, k.body, k.placement).R * vp.head<3>();
+      const Vec3 wm = framePlacement(dm, k.body, k.placement).R * vm.head<3>();
+      fd.segment<3>(k.row) = R0.transpose() * (wp - wm) / (2 * h);
+    }
+  }
+  return fd;
 }
 
 /// q "+" dv: joint coordinates add; the free flyer moves by its body twist,

@@ -150,18 +150,7 @@ TEST(Identities, ConstraintRowsAreDerivativesOfConstraintVelocities) {
       const VecX rows = d0.J * qdd + d0.gamma;
       forwardKinematics(sys, dp, integrate(m, s.q, kH * s.v), s.v + kH * qdd);
       forwardKinematics(sys, dm, integrate(m, s.q, -kH * s.v), s.v - kH * qdd);
-      VecX fd(sys.nc);
-      for (const Constraint& k : sys.constraints) {
-        const Vec6 vp = frameVelocity(dp, k.body, k.placement), vm = frameVelocity(dm, k.body, k.placement);
-        if (k.type == ConstraintType::Weld6D) {
-          fd.segment<6>(k.row) = (vp - vm) / (2 * kH);
-        } else {
-          const Mat3 R0 = framePlacement(d0, k.body, k.placement).R;
-          const Vec3 wp = framePlacement(dp, k.body, k.placement).R * vp.head<3>();
-          const Vec3 wm = framePlacement(dm, k.body, k.placement).R * vm.head<3>();
-          fd.segment<3>(k.row) = R0.transpose() * (wp - wm) / (2 * kH);
-        }
-      }
+      const VecX fd = test::constraintRowsByDifferences(sys, d0, dp, dm, kH);
       const double Omega = 1 + s.v.cwiseAbs().sum();
       const double err = test::relErr(rows, fd), tol = 10 * (kH * kH / 6 * Omega * Omega + kEps / kH);
       EXPECT_LE(err, tol) << c.name << " state " << st;
