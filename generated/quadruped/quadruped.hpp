@@ -84,11 +84,14 @@ inline constexpr int lh_foot = 2;
 inline constexpr int rh_foot = 3;
 }  // namespace constraint
 
-// Set the fields by name (later versions add fields, e.g. a per-constraint
-// activity flag, before lambda0).
+// Set the fields by name (later versions may add fields).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
   int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
+  // Run-time contact schedule: active[k] for constraint k of the layout
+  // (constraint::<name>). An inactive constraint exerts no force: its
+  // multipliers are 0 and the answer is that of the solver generated without it.
+  bool active[4] = {true, true, true, true};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
   // of 0. It is read before lambda is written: it may be the lambda output.

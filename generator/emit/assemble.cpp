@@ -1,5 +1,6 @@
 #include "emit/assemble.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -204,6 +205,13 @@ Names namesAndSlots(const Plan& plan) {
   return n;
 }
 
+// Every constraint active by default: "true, true, ..." (one placeholder without constraints).
+std::string activeInit(const Plan& plan) {
+  std::string init = "true";
+  for (std::size_t k = 1; k < plan.constraints.size(); ++k) init += ", true";
+  return init;
+}
+
 // major.minor of PROXGEN_VERSION ("0.1.0").
 std::pair<int, int> versionNumbers() {
   int major = 0, minor = 0;
@@ -281,7 +289,9 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("empty_arrays", n.empty), fmt::arg("joint_names", n.jointNames), fmt::arg("joint_idx_q", n.jointQ),
       fmt::arg("joint_idx_v", n.jointV), fmt::arg("joint_ids", n.jointIds), fmt::arg("constraint_names", n.consNames),
       fmt::arg("constraint_row", n.consRow), fmt::arg("constraint_rows", n.consRows),
-      fmt::arg("constraint_ids", n.consIds));
+      fmt::arg("constraint_ids", n.consIds), fmt::arg("active_size", std::max<std::size_t>(plan.constraints.size(), 1)),
+      fmt::arg("active_init", activeInit(plan)),
+      fmt::arg("active_note", plan.constraints.empty() ? "\n  // No constraints: one placeholder entry, never read." : ""));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
                              fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)),
                              fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));
