@@ -72,8 +72,8 @@ emit::SolverFiles generateCase(const std::string& casesFile, const std::string& 
   const std::string file = fs::path(casesFile).filename().string();
   in.urdfName = fs::path(c.urdfPath).filename().string();
   in.layoutName = fmt::format("{} (case {})", file, c.name);
-  in.urdfSha256 = emit::sha256File(c.urdfPath);
-  in.layoutSha256 = emit::sha256File(casesFile);
+  in.urdfSha256 = emit::sha256File(c.urdfPath, "URDF");
+  in.layoutSha256 = emit::sha256File(casesFile, "cases");
   in.command = fmt::format("proxgen generate --cases {} --case {}", file, c.name);
   in.functions = functions;
   return emit::generateSystem(sys, name.empty() ? c.name : name, scalar, in, stats);

@@ -66,8 +66,8 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, Sy
   SolverInputs in;
   in.urdfName = fs::path(options.urdf).filename().string();
   in.layoutName = fs::path(options.layout).filename().string();
-  in.urdfSha256 = sha256File(options.urdf);
-  in.layoutSha256 = sha256File(options.layout);
+  in.urdfSha256 = sha256File(options.urdf, "URDF");
+  in.layoutSha256 = sha256File(options.layout, "layout");
   in.command = fmt::format("proxgen generate {} --layout {}", in.urdfName, in.layoutName);
   in.functions = options.functions;
   return generateSystem(sys, name, options.scalar, in, stats);

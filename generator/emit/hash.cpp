@@ -3,10 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
+#include <limits>
 
-#include "model/error.hpp"
+#include "model/input.hpp"
 
 namespace proxgen::emit {
 namespace {
@@ -99,12 +98,11 @@ std::string sha256Hex(const std::string& bytes) {
   return hex;
 }
 
-std::string sha256File(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "", "cannot be read");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return sha256Hex(ss.str());
+std::string sha256File(const std::string& path, const char* kind) {
+  // Through the loaders' reader: the same refusals (FIFOs, devices) and the
+  // system's reason when the file went away since it was loaded. Its size was
+  // bounded by the loader; no second bound here.
+  return sha256Hex(readInputFile(path, std::numeric_limits<std::size_t>::max(), kind));
 }
 
 }  // namespace proxgen::emit

@@ -27,7 +27,8 @@ class Sha256 {
 /// Lower-case hex SHA-256 of a byte string.
 std::string sha256Hex(const std::string& bytes);
 
-/// Lower-case hex SHA-256 of a file's contents; throws proxgen::Error if unreadable.
-std::string sha256File(const std::string& path);
+/// Lower-case hex SHA-256 of a file's contents, read as readInputFile reads
+/// it (`kind` names the file in its message); throws proxgen::Error if unreadable.
+std::string sha256File(const std::string& path, const char* kind);
 
 }  // namespace proxgen::emit

@@ -189,7 +189,9 @@ TEST(UrdfLoad, MergedInertiaRoundOffIsSnappedToExactZeros) {
   EXPECT_EQ(trunk.com, Vec3::Zero());
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
-      if (r != c) EXPECT_EQ(trunk.Ic(r, c), 0.0) << r << "," << c;
+      if (r != c) {
+        EXPECT_EQ(trunk.Ic(r, c), 0.0) << r << "," << c;
+      }
   // The rest is the plain sum's: the snapping moved nothing above its bound,
   // 4 eps of the trace (the loader's threshold), and the mass is exact.
   const double bound = 4 * std::numeric_limits<double>::epsilon() * plain.Ic.trace();
