@@ -24,9 +24,7 @@ std::vector<Case> loadCases(const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::Load(readInputFile(path, 4u << 20, "cases"));  // a regular file only (a FIFO would hang)
-  } catch (const YAML::BadFile&) {
-    fail(path, "", "cannot open file");
-  } catch (const YAML::Exception& e) {
+  } catch (const YAML::Exception& e) {  // readInputFile has refused an unreadable file already
     fail(fmt::format("{}:{}", path, e.mark.line + 1), "", fmt::format("malformed YAML: {}", e.msg));
   }
   if (!root.IsMap() || !root["cases"] || !root["cases"].IsSequence()) fail(path, "cases", "expected a list `cases:`");
