@@ -1,6 +1,6 @@
 # proxgen_add_solver(<target> URDF <file> LAYOUT <file>
 #                    [SCALAR double|float] [NAME <namespace>] [OUTPUT_DIR <dir>]
-#                    [FUNCTIONS <name>... | all])
+#                    [FUNCTIONS <name>... | all] [BATCH <W>])
 #
 # Generates a solver for one robot and layout at build time and makes it a
 # static library target <target> to link. The solver is regenerated whenever
@@ -9,6 +9,9 @@
 # prox_pv, inverse_dynamics, nonlinear_effects, mass_matrix, mass_matrix_inverse,
 # ... or all) picks the functions the solver holds, as `generate --functions`
 # (default: the layout's `functions:`, else the two solvers); proxgen checks the names.
+# BATCH <W> (2, 4, 8 or 16) adds the batched solvers, W states per call
+# (`generate --batch W`, docs/batch.md): <NAME>_batch.hpp and its source in the
+# same library.
 #
 # Needs PROXGEN_EXECUTABLE (path or generator expression), PROXGEN_EXECUTABLE_DEPENDS
 # (what the generation step depends on for "proxgen changed") and
@@ -64,7 +67,7 @@ macro(_proxgen_solver_defaults where prefix target)
 endmacro()
 
 function(proxgen_add_solver target)
-  cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR" "FUNCTIONS")
+  cmake_parse_arguments(PARSE_ARGV 1 PAS "" "URDF;LAYOUT;SCALAR;NAME;OUTPUT_DIR;BATCH" "FUNCTIONS")
   if(PAS_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "proxgen_add_solver(${target}): unknown arguments: ${PAS_UNPARSED_ARGUMENTS}")
   endif()
@@ -95,14 +98,29 @@ function(proxgen_add_solver target)
   endif()
   set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
   set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
+  set(batch "")
+  set(batch_files "")
+  if(DEFINED PAS_BATCH OR "BATCH" IN_LIST PAS_KEYWORDS_MISSING_VALUES)
+    if(NOT PAS_BATCH MATCHES "^(2|4|8|16)$")
+      message(FATAL_ERROR "proxgen_add_solver(${target}): BATCH must be 2, 4, 8 or 16, not '${PAS_BATCH}'")
+    endif()
+    set(batch --batch ${PAS_BATCH})
+    set(batch_files "${PAS_OUTPUT_DIR}/${PAS_NAME}_batch.hpp" "${PAS_OUTPUT_DIR}/${PAS_NAME}_batch.cpp")
+  endif()
   add_custom_command(
-    OUTPUT "${hpp}" "${cpp}"
+    OUTPUT "${hpp}" "${cpp}" ${batch_files}
     COMMAND "${PROXGEN_EXECUTABLE}" generate "${urdf}" --layout "${layout}" --out "${PAS_OUTPUT_DIR}"
-            --name "${PAS_NAME}" --scalar "${PAS_SCALAR}" ${functions}
+            --name "${PAS_NAME}" --scalar "${PAS_SCALAR}" ${functions} ${batch}
     DEPENDS "${urdf}" "${layout}" ${PROXGEN_EXECUTABLE_DEPENDS}
     COMMENT "proxgen: generating ${PAS_NAME} (${PAS_SCALAR}) from ${urdf}"
     VERBATIM)
-  add_library(${target} STATIC "${cpp}" "${hpp}")
+  add_library(${target} STATIC "${cpp}" "${hpp}" ${batch_files})
+  if(batch_files AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # GCC notes that passing 32-byte vectors by value changed ABI in GCC 4.6: a
+    # note on the lanes (proxgen/lanes.hpp) between this file's own functions.
+    set_source_files_properties("${PAS_OUTPUT_DIR}/${PAS_NAME}_batch.cpp" TARGET_DIRECTORY ${target}
+                                PROPERTIES COMPILE_OPTIONS -Wno-psabi)
+  endif()
   target_include_directories(${target} PUBLIC "${PAS_OUTPUT_DIR}" "${PROXGEN_RUNTIME_INCLUDE_DIR}")
   target_compile_features(${target} PUBLIC cxx_std_17)
   proxgen_solver_compile_options(options)
@@ -118,4 +136,9 @@ function(proxgen_add_solver target)
     target_compile_options(${target} PRIVATE $<$<STREQUAL:$<CONFIG>,>:-O2>)
   endif()
   set_target_properties(${target} PROPERTIES PROXGEN_HEADER "${hpp}" PROXGEN_SOURCE "${cpp}")
+  if(batch_files)
+    list(GET batch_files 0 batch_hpp)
+    list(GET batch_files 1 batch_cpp)
+    set_target_properties(${target} PROPERTIES PROXGEN_BATCH_HEADER "${batch_hpp}" PROXGEN_BATCH_SOURCE "${batch_cpp}")
+  endif()
 endfunction()

@@ -1,5 +1,5 @@
 // proxgen generate robot.urdf --layout layout.yaml --out DIR [--name NAME] [--scalar double|float] [--python]
-//                  [--functions a,b,...|all]
+//                  [--functions a,b,...|all] [--batch W]
 //   or, for one case of a cases file (tests, benchmarks):
 // proxgen generate --cases cases.yaml --case NAME --out DIR [--name NAME] [--scalar double|float]
 #include <fmt/format.h>
@@ -11,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "cases/cases.hpp"
+#include "emit/batch.hpp"
 #include "emit/generate.hpp"
 #include "emit/python_module.hpp"
 #include "model/error.hpp"
@@ -40,6 +41,7 @@ void addGenerate(CLI::App& app) {
   struct Options {
     std::string urdf, layout, cases, caseName, out, name, scalar = "double", functions;
     bool python = false;
+    int batch = 0;  // 0: no batched files
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("generate", "write a flat C++ solver (NAME.hpp, NAME.cpp) for one robot and layout");
@@ -53,6 +55,10 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--functions", opt->functions,
                   "the functions the solver holds, a,b,... or all (default: the layout's functions:, else "
                   "constrained_aba,prox_pv; valid: " + functionNameList() + ")");
+  cmd->add_option("--batch", opt->batch,
+                  "also write NAME_batch.hpp and NAME_batch.cpp, the solvers over W states per call in the lanes of a "
+                  "vector register (2, 4, 8 or 16; docs/batch.md)")
+      ->check(CLI::IsMember({2, 4, 8, 16}));
   cmd->add_flag("--python", opt->python, "also write NAME_python.cpp, a pybind11 module over the solver (docs/python.md)");
   cmd->callback([opt] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
@@ -65,6 +71,11 @@ void addGenerate(CLI::App& app) {
     std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
     // The module source goes through the same atomic write as the solver's files.
     if (opt->python) outputs.push_back(emit::pythonModuleOutput(sys, files, emit::parseScalar(opt->scalar)));
+    if (opt->batch != 0) {
+      const emit::BatchFiles batch = emit::batchFiles(files, opt->batch);
+      outputs.push_back({batch.headerName, batch.header});
+      outputs.push_back({batch.sourceName, batch.source});
+    }
     for (const std::string& path : emit::writeFiles(outputs, opt->out))
       std::printf("wrote %s\n", oneLine(path, 1000).c_str());
   });

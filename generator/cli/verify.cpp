@@ -9,8 +9,12 @@
 // The joint-space functions the solver holds (layout functions:, --functions)
 // are run on the same states with random qdd and lambda and compared with their
 // generic twins (verify/compare.hpp, compareLibraryWithGeneric).
-//   proxgen verify robot.urdf --layout layout.yaml [--samples N] [--functions a,b|all]
-//   proxgen verify --cases cases.yaml --case NAME [--samples N] [--functions a,b|all]
+// With --batch W it also generates the batched solvers (NAME_batch.*,
+// docs/batch.md) and checks every lane of their _many and _batch forms against
+// the scalar generated solver on the same states, bit for bit (everything is
+// then compiled with -ffp-contract=off: docs/batch.md, "Lane by lane").
+//   proxgen verify robot.urdf --layout layout.yaml [--samples N] [--functions a,b|all] [--batch W]
+//   proxgen verify --cases cases.yaml --case NAME [--samples N] [--functions a,b|all] [--batch W]
 #include <fmt/format.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -31,6 +35,7 @@
 #include "algorithms/data.hpp"
 #include "cases/cases.hpp"
 #include "cli/commands.hpp"
+#include "emit/batch.hpp"
 #include "emit/generate.hpp"
 #include "emit/output.hpp"
 #include "model/error.hpp"
@@ -49,6 +54,7 @@ struct VerifyOptions {
   unsigned seed = 1;
   double tolerance = 0;  // 0: the conditioning-aware bounds of verify/compare.hpp
   int converged = 100;
+  int batch = 0;  // --batch W (0: no batched solvers)
 };
 
 // Runs argv (no shell), stdout+stderr to `log`; returns the exit status. The
@@ -207,6 +213,98 @@ int main() {
 }
 )";
 
+// The batched solvers' driver (--batch): reads the scalar driver's input (the
+// trials; the library samples are not read), runs the trials sharing (mu, K)
+// through constrained_aba_many and prox_pv_many (a count that is in general
+// not a multiple of W), their first W states (repeated when fewer) through the
+// _batch forms, and compares every answer with the scalar solver's, bit for
+// bit (NaN for NaN). Prints "<answers compared> <answers differing>".
+constexpr const char* kBatchDriver = R"(// proxgen verify batch driver (temporary)
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+#include "proxgen_verify_solver_batch.hpp"
+namespace s = proxgen_verify_solver;
+using S = s::Scalar;
+constexpr int W = s::batch_width;
+static s::Workspace w;
+static s::BatchWorkspace bw;
+static long compared = 0, differ = 0;
+static void check(S batched, S scalar) {
+  ++compared;
+  if (!((std::isnan(batched) && std::isnan(scalar)) || std::memcmp(&batched, &scalar, sizeof batched) == 0)) ++differ;
+}
+int main() {
+  int n = 0;
+  if (std::scanf("%d", &n) != 1 || n < 0) return 2;
+  std::vector<S> q(std::size_t(n * s::nq)), v(std::size_t(n * s::nv)), tau(std::size_t(n * s::nv));
+  std::vector<double> mu(static_cast<std::size_t>(n));
+  std::vector<int> K(static_cast<std::size_t>(n));
+  for (int t = 0; t < n; ++t) {
+    double x = 0;
+    for (int k = 0; k < s::nq; ++k) { if (std::scanf("%lf", &x) != 1) return 2; q[std::size_t(t * s::nq + k)] = S(x); }
+    for (int k = 0; k < s::nv; ++k) { if (std::scanf("%lf", &x) != 1) return 2; v[std::size_t(t * s::nv + k)] = S(x); }
+    for (int k = 0; k < s::nv; ++k) { if (std::scanf("%lf", &x) != 1) return 2; tau[std::size_t(t * s::nv + k)] = S(x); }
+    if (std::scanf("%lf %d", &mu[std::size_t(t)], &K[std::size_t(t)]) != 2) return 2;
+  }
+  std::vector<char> done(static_cast<std::size_t>(n), 0);
+  for (int t0 = 0; t0 < n; ++t0) {
+    if (done[std::size_t(t0)]) continue;
+    std::vector<int> group;
+    for (int t = t0; t < n; ++t)
+      if (!done[std::size_t(t)] && mu[std::size_t(t)] == mu[std::size_t(t0)] && K[std::size_t(t)] == K[std::size_t(t0)]) {
+        group.push_back(t);
+        done[std::size_t(t)] = 1;
+      }
+    const int m = int(group.size());
+    std::vector<S> gq, gv, gtau;
+    for (int t : group) {
+      gq.insert(gq.end(), q.begin() + t * s::nq, q.begin() + (t + 1) * s::nq);
+      gv.insert(gv.end(), v.begin() + t * s::nv, v.begin() + (t + 1) * s::nv);
+      gtau.insert(gtau.end(), tau.begin() + t * s::nv, tau.begin() + (t + 1) * s::nv);
+    }
+    // The first W states of the group, lane-interleaved (lane l: state l mod m).
+    std::vector<S> iq(std::size_t(s::nq * W)), iv(std::size_t(s::nv * W)), itau(std::size_t(s::nv * W));
+    for (int l = 0; l < W; ++l) {
+      const int j = l % m;
+      for (int k = 0; k < s::nq; ++k) iq[std::size_t(k * W + l)] = gq[std::size_t(j * s::nq + k)];
+      for (int k = 0; k < s::nv; ++k) iv[std::size_t(k * W + l)] = gv[std::size_t(j * s::nv + k)];
+      for (int k = 0; k < s::nv; ++k) itau[std::size_t(k * W + l)] = gtau[std::size_t(j * s::nv + k)];
+    }
+    s::Settings st;
+    st.mu = S(mu[std::size_t(t0)]);
+    st.iterations = K[std::size_t(t0)];
+    for (int f = 0; f < 2; ++f) {
+      std::vector<S> qdd(std::size_t(m * s::nv)), lambda(std::size_t(m * s::nc + 1));
+      std::vector<S> bqdd(std::size_t(s::nv * W)), blambda(std::size_t(s::nc * W + 1));
+      if (f == 0) {
+        s::constrained_aba_many(m, gq.data(), gv.data(), gtau.data(), st, bw, qdd.data(), lambda.data());
+        s::constrained_aba_batch(iq.data(), iv.data(), itau.data(), st, bw, bqdd.data(), blambda.data());
+      } else {
+        s::prox_pv_many(m, gq.data(), gv.data(), gtau.data(), st, bw, qdd.data(), lambda.data());
+        s::prox_pv_batch(iq.data(), iv.data(), itau.data(), st, bw, bqdd.data(), blambda.data());
+      }
+      for (int j = 0; j < m; ++j) {
+        S sq[s::nv + 1], sl[s::nc + 1];
+        if (f == 0)
+          s::constrained_aba(&gq[std::size_t(j * s::nq)], &gv[std::size_t(j * s::nv)], &gtau[std::size_t(j * s::nv)], st, w, sq, sl);
+        else
+          s::prox_pv(&gq[std::size_t(j * s::nq)], &gv[std::size_t(j * s::nv)], &gtau[std::size_t(j * s::nv)], st, w, sq, sl);
+        for (int k = 0; k < s::nv; ++k) check(qdd[std::size_t(j * s::nv + k)], sq[k]);
+        for (int r = 0; r < s::nc; ++r) check(lambda[std::size_t(j * s::nc + r)], sl[r]);
+        for (int l = j; l < W; l += m) {
+          for (int k = 0; k < s::nv; ++k) check(bqdd[std::size_t(k * W + l)], sq[k]);
+          for (int r = 0; r < s::nc; ++r) check(blambda[std::size_t(r * W + l)], sl[r]);
+        }
+      }
+    }
+  }
+  std::printf("%ld %ld\n", compared, differ);
+  return 0;
+}
+)";
+
 // The driver's defines: one per function the solver holds.
 std::string driverDefines(const FunctionSet& functions) {
   std::string out;
@@ -321,10 +419,9 @@ int verify(const VerifyOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   // (generateFiles directly, not generateSolverFiles: the warning is out already)
-  std::vector<emit::OutputFile> files;
+  emit::SolverFiles generated;
   if (!o.cases.empty()) {
-    files = emit::solverOutputs(
-        generateCase(o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar), nullptr, nullptr, o.functions));
+    generated = generateCase(o.cases, o.caseName, kSolverName, emit::parseScalar(o.scalar), nullptr, nullptr, o.functions);
   } else {
     emit::GenerateOptions g;
     g.urdf = o.urdf;
@@ -332,9 +429,25 @@ int verify(const VerifyOptions& o) {
     g.name = kSolverName;
     g.scalar = emit::parseScalar(o.scalar);
     g.functions = o.functions;
-    files = emit::solverOutputs(emit::generateFiles(g));
+    generated = emit::generateFiles(g);
   }
+  std::vector<emit::OutputFile> files = emit::solverOutputs(generated);
   files.push_back({"driver.cpp", driverDefines(sys.functions) + kDriver});
+  // --batch: the batched files and their driver, registered before they are written.
+  fs::path batchCpp, batchObj, batchDriverCpp, batchDriverObj, batchDriver, batchOutput;
+  if (o.batch != 0) {
+    const emit::BatchFiles batch = emit::batchFiles(generated, o.batch);
+    scratch.file(batch.headerName);
+    batchCpp = scratch.file(batch.sourceName);
+    batchObj = scratch.file(std::string(kSolverName) + "_batch.o");
+    batchDriverCpp = scratch.file("batch_driver.cpp");
+    batchDriverObj = scratch.file("batch_driver.o");
+    batchDriver = scratch.file("batch_driver");
+    batchOutput = scratch.file("batch_output.txt");
+    files.push_back({batch.headerName, batch.header});
+    files.push_back({batch.sourceName, batch.source});
+    files.push_back({"batch_driver.cpp", kBatchDriver});
+  }
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
   // Each source to its own object, then the link: every file the compiler
@@ -342,6 +455,8 @@ int verify(const VerifyOptions& o) {
   // assembler files; -c -o: no objects in TMPDIR), so an interrupt leaves nothing.
   std::vector<std::string> compile = {PROXGEN_CXX_COMPILER, "-std=c++17", "-pipe"};
   for (const std::string& option : solverCompileOptions()) compile.push_back(option);
+  // The batched lanes are the scalar solver's bits where no multiply-add is fused in one and not the other.
+  if (o.batch != 0) compile.push_back("-ffp-contract=off");
   compile.insert(compile.end(), {"-I", runtimeDir().string(), "-I", scratch.dir().string(), "-c"});
   const auto compileOne = [&](const fs::path& source, const fs::path& object) {
     std::vector<std::string> argv = compile;
@@ -354,6 +469,16 @@ int verify(const VerifyOptions& o) {
   if (compileOne(driverCpp, driverObj) != 0 || compileOne(cpp, solverObj) != 0 || runProcess(link, compileLog) != 0)
     throw Error(fmt::format("verify: the generated solver does not compile ({}): {}", PROXGEN_CXX_COMPILER,
                             firstErrors(slurp(compileLog))));
+  if (o.batch != 0) {
+    std::vector<std::string> batchLink = {PROXGEN_CXX_COMPILER, "-std=c++17"};
+    for (const std::string& option : solverCompileOptions()) batchLink.push_back(option);
+    batchLink.insert(batchLink.end(),
+                     {batchDriverObj.string(), batchObj.string(), solverObj.string(), "-o", batchDriver.string()});
+    if (compileOne(batchDriverCpp, batchDriverObj) != 0 || compileOne(batchCpp, batchObj) != 0 ||
+        runProcess(batchLink, compileLog) != 0)
+      throw Error(fmt::format("verify: the batched solver does not compile ({}): {}", PROXGEN_CXX_COMPILER,
+                              firstErrors(slurp(compileLog))));
+  }
   const auto t2 = std::chrono::steady_clock::now();
 
   // Trials: every sample at K = 1, 2, 3 and converged, at the layout's mu and at
@@ -405,6 +530,14 @@ int verify(const VerifyOptions& o) {
   }
   if (runProcess({driver.string()}, output, input) != 0)
     throw Error(fmt::format("verify: the generated solver's driver failed: {}", firstErrors(slurp(output))));
+  long batchCompared = 0, batchDiffer = 0;
+  if (o.batch != 0) {
+    if (runProcess({batchDriver.string()}, batchOutput, input) != 0)
+      throw Error(fmt::format("verify: the batched solver's driver failed: {}", firstErrors(slurp(batchOutput))));
+    std::istringstream b(slurp(batchOutput));
+    if (!(b >> batchCompared >> batchDiffer) || batchCompared <= 0)
+      throw Error("verify: the batched solver's driver printed no comparison");
+  }
 
   std::istringstream out(slurp(output));
   out.imbue(std::locale::classic());
@@ -514,6 +647,12 @@ int verify(const VerifyOptions& o) {
     ok = ok && pass;
     fmt::print("  {:<40} {:10.3e}  {:8.2e}  {}\n", w.key, w.error, w.ratio, pass ? "ok" : "FAIL");
   }
+  if (o.batch != 0) {
+    const bool pass = batchDiffer == 0;
+    ok = ok && pass;
+    fmt::print("  batched (--batch {}) vs scalar, bit for bit: {} answers, {} differ  {}\n", o.batch, batchCompared,
+               batchDiffer, pass ? "ok" : "FAIL");
+  }
   fmt::print("{}: {}\n", ok ? "PASSED" : "FAILED",
              o.tolerance > 0 ? fmt::format("tolerance {:g}", o.tolerance) : std::string("bounds c n u kappa"));
   if (!o.keep.empty()) {
@@ -541,6 +680,10 @@ void addVerify(CLI::App& app) {
   cmd->add_option("--keep", o->keep, "copy the generated solver, driver and logs to this folder");
   cmd->add_option("--functions", o->functions,
                   "the functions to generate and compare, a,b,... or all (default: the layout's functions:)");
+  cmd->add_option("--batch", o->batch,
+                  "also generate the batched solvers over W lanes (2, 4, 8 or 16) and compare every lane with the "
+                  "scalar solver (docs/batch.md)")
+      ->check(CLI::IsMember({2, 4, 8, 16}));
   cmd->callback([o] {
     checkRobotOptions("verify", o->urdf, o->layout, o->cases, o->caseName);
     const int rc = verify(*o);

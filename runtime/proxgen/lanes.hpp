@@ -1,0 +1,362 @@
+// W values of one Scalar in the lanes of a vector register, for the batched
+// solvers (`proxgen generate --batch W`, docs/batch.md): the solver's
+// straight-line code is the same for every state, so it runs on W states at
+// once. Header-only, fixed size, no heap, no intrinsics headers.
+//
+// With GCC or Clang the lanes are the compilers' vector extension
+// (__attribute__((vector_size))): the compiler maps them to SSE2, AVX2,
+// AVX-512 or NEON registers as the target allows, and splits a vector wider
+// than the target's into several. Any other compiler, or
+// PROXGEN_RT_LANES_SCALAR defined, gets a plain array and a loop per
+// operation (the same answers; no speed-up).
+//
+// Every operation is the scalar one lane by lane: +, -, *, / and sqrt are
+// IEEE operations, correctly rounded per lane; the selects and the sign
+// operations are bit operations; sincos runs the scalar kernel's operations in
+// the same order (and the C library beyond its range, per lane); the SE(3)
+// logarithm runs the scalar function on each lane. So each lane of a batched
+// solver computes what the scalar solver computes on that state, operation for
+// operation (docs/batch.md, "Lane by lane").
+#pragma once
+
+#include <cstring>
+
+#include "runtime.hpp"  // beside this file
+
+#if !defined(PROXGEN_RT_LANES_SCALAR) && (defined(__GNUC__) || defined(__clang__))
+#define PROXGEN_RT_LANES_VECTOR 1
+#else
+#define PROXGEN_RT_LANES_VECTOR 0
+#endif
+
+namespace proxgen_rt {
+
+namespace lanes_detail {
+template <class S>
+struct bits;  // the signed integer of S's size: the lanes of a mask
+template <>
+struct bits<double> {
+  using type = long long;
+};
+template <>
+struct bits<float> {
+  using type = int;
+};
+}  // namespace lanes_detail
+
+template <class S, int W>
+struct lanes;
+
+/// The result of a lane-wise comparison: per lane all ones (true) or zero.
+template <class S, int W>
+struct lanes_mask {
+  using I = typename lanes_detail::bits<S>::type;
+#if PROXGEN_RT_LANES_VECTOR
+  typedef I ivec __attribute__((vector_size(sizeof(S) * W)));
+  ivec m;
+  bool operator[](int l) const noexcept { return m[l] != 0; }
+#else
+  I m[W];
+  bool operator[](int l) const noexcept { return m[l] != 0; }
+#endif
+  friend lanes_mask operator&(const lanes_mask& a, const lanes_mask& b) noexcept {
+    lanes_mask r;
+#if PROXGEN_RT_LANES_VECTOR
+    r.m = a.m & b.m;
+#else
+    for (int l = 0; l < W; ++l) r.m[l] = a.m[l] & b.m[l];
+#endif
+    return r;
+  }
+  friend lanes_mask operator|(const lanes_mask& a, const lanes_mask& b) noexcept {
+    lanes_mask r;
+#if PROXGEN_RT_LANES_VECTOR
+    r.m = a.m | b.m;
+#else
+    for (int l = 0; l < W; ++l) r.m[l] = a.m[l] | b.m[l];
+#endif
+    return r;
+  }
+  friend lanes_mask operator!(const lanes_mask& a) noexcept {
+    lanes_mask r;
+#if PROXGEN_RT_LANES_VECTOR
+    r.m = ~a.m;
+#else
+    for (int l = 0; l < W; ++l) r.m[l] = ~a.m[l];
+#endif
+    return r;
+  }
+};
+
+/// True when some lane of m is.
+template <class S, int W>
+inline bool any(const lanes_mask<S, W>& m) noexcept {
+  bool r = false;
+  for (int l = 0; l < W; ++l) r = r || m[l];
+  return r;
+}
+
+template <class S, int W>
+struct lanes {
+  static_assert(W == 2 || W == 4 || W == 8 || W == 16, "proxgen_rt::lanes: W is 2, 4, 8 or 16");
+  using scalar = S;
+  using mask = lanes_mask<S, W>;
+  using I = typename lanes_detail::bits<S>::type;
+  static constexpr int width = W;
+#if PROXGEN_RT_LANES_VECTOR
+  typedef S vec __attribute__((vector_size(sizeof(S) * W)));
+  typedef I ivec __attribute__((vector_size(sizeof(S) * W)));
+  vec x;
+#else
+  alignas(sizeof(S) * W) S x[W];
+#endif
+
+  lanes() = default;  // uninitialised, as a double is; lanes{} is zero
+  // Every lane s: implicit, so the printed literals and the settings' scalars
+  // enter lane-wise arithmetic as they enter the scalar solver's.
+  lanes(S s) noexcept {  // NOLINT(google-explicit-constructor)
+#if PROXGEN_RT_LANES_VECTOR
+    x = s - vec{};  // s - (+0) is s for every s (-0 and NaN included)
+#else
+    for (int l = 0; l < W; ++l) x[l] = s;
+#endif
+  }
+
+  S operator[](int l) const noexcept { return x[l]; }
+  void set(int l, S s) noexcept { x[l] = s; }
+  /// W consecutive scalars (no alignment needed), and back.
+  static lanes load(const S* p) noexcept {
+    lanes r;
+    std::memcpy(&r.x, p, sizeof r.x);
+    return r;
+  }
+  void store(S* p) const noexcept { std::memcpy(p, &x, sizeof x); }
+
+#if PROXGEN_RT_LANES_VECTOR
+#define PROXGEN_RT_LANES_OP(op)                              \
+  friend lanes operator op(const lanes& a, const lanes& b) noexcept {      \
+    lanes r;                                                 \
+    r.x = a.x op b.x;                                        \
+    return r;                                                \
+  }                                                          \
+  lanes& operator op##=(const lanes& b) noexcept {                  \
+    x = x op b.x;                                            \
+    return *this;                                            \
+  }
+#define PROXGEN_RT_LANES_CMP(op)                             \
+  friend mask operator op(const lanes& a, const lanes& b) noexcept {       \
+    mask r;                                                  \
+    r.m = (ivec)(a.x op b.x);                                \
+    return r;                                                \
+  }
+#else
+#define PROXGEN_RT_LANES_OP(op)                              \
+  friend lanes operator op(const lanes& a, const lanes& b) noexcept {      \
+    lanes r;                                                 \
+    for (int l = 0; l < W; ++l) r.x[l] = a.x[l] op b.x[l];   \
+    return r;                                                \
+  }                                                          \
+  lanes& operator op##=(const lanes& b) noexcept {                  \
+    for (int l = 0; l < W; ++l) x[l] = x[l] op b.x[l];       \
+    return *this;                                            \
+  }
+#define PROXGEN_RT_LANES_CMP(op)                             \
+  friend mask operator op(const lanes& a, const lanes& b) noexcept {       \
+    mask r;                                                  \
+    for (int l = 0; l < W; ++l) r.m[l] = a.x[l] op b.x[l] ? I(-1) : I(0); \
+    return r;                                                \
+  }
+#endif
+  PROXGEN_RT_LANES_OP(+)
+  PROXGEN_RT_LANES_OP(-)
+  PROXGEN_RT_LANES_OP(*)
+  PROXGEN_RT_LANES_OP(/)
+  PROXGEN_RT_LANES_CMP(<)
+  PROXGEN_RT_LANES_CMP(<=)
+  PROXGEN_RT_LANES_CMP(>)
+  PROXGEN_RT_LANES_CMP(>=)
+  PROXGEN_RT_LANES_CMP(==)
+  PROXGEN_RT_LANES_CMP(!=)
+#undef PROXGEN_RT_LANES_OP
+#undef PROXGEN_RT_LANES_CMP
+
+  friend lanes operator-(const lanes& a) noexcept {
+    lanes r;
+#if PROXGEN_RT_LANES_VECTOR
+    r.x = -a.x;
+#else
+    for (int l = 0; l < W; ++l) r.x[l] = -a.x[l];
+#endif
+    return r;
+  }
+  friend lanes operator+(const lanes& a) noexcept { return a; }
+};
+
+/// Per lane: m ? a : b (bit for bit the lane of a or of b).
+template <class S, int W>
+inline lanes<S, W> select(const lanes_mask<S, W>& m, const lanes<S, W>& a, const lanes<S, W>& b) noexcept {
+  lanes<S, W> r;
+#if PROXGEN_RT_LANES_VECTOR
+  using V = typename lanes<S, W>::vec;
+  using IV = typename lanes<S, W>::ivec;
+  r.x = (V)((m.m & (IV)a.x) | (~m.m & (IV)b.x));
+#else
+  for (int l = 0; l < W; ++l) r.x[l] = m[l] ? a.x[l] : b.x[l];
+#endif
+  return r;
+}
+
+/// |a| per lane (the sign bit cleared, as std::fabs does, NaN included).
+template <class S, int W>
+inline lanes<S, W> fabs(const lanes<S, W>& a) noexcept {
+  lanes<S, W> r;
+#if PROXGEN_RT_LANES_VECTOR
+  using V = typename lanes<S, W>::vec;
+  using IV = typename lanes<S, W>::ivec;
+  const IV sign = (IV)(-lanes<S, W>(S(0)).x);  // the sign bit alone
+  r.x = (V)((IV)a.x & ~sign);
+#else
+  for (int l = 0; l < W; ++l) r.x[l] = std::fabs(a.x[l]);
+#endif
+  return r;
+}
+
+/// |magnitude| with the sign of `sign`, per lane (std::copysign).
+template <class S, int W>
+inline lanes<S, W> copysign(const lanes<S, W>& magnitude, const lanes<S, W>& sign) noexcept {
+  lanes<S, W> r;
+#if PROXGEN_RT_LANES_VECTOR
+  using V = typename lanes<S, W>::vec;
+  using IV = typename lanes<S, W>::ivec;
+  const IV bit = (IV)(-lanes<S, W>(S(0)).x);
+  r.x = (V)(((IV)magnitude.x & ~bit) | ((IV)sign.x & bit));
+#else
+  for (int l = 0; l < W; ++l) r.x[l] = std::copysign(magnitude.x[l], sign.x[l]);
+#endif
+  return r;
+}
+
+/// Square root per lane (IEEE, correctly rounded: std::sqrt's answer).
+template <class S, int W>
+inline lanes<S, W> sqrt(const lanes<S, W>& a) noexcept {
+  lanes<S, W> r;
+  for (int l = 0; l < W; ++l) r.x[l] = std::sqrt(a.x[l]);
+  return r;
+}
+
+/// largest_magnitude (runtime.hpp) per lane: the same compares and selects.
+template <class S, int W>
+inline lanes<S, W> largest_magnitude(const lanes<S, W>& a, const lanes<S, W>& b, const lanes<S, W>& c,
+                                     const lanes<S, W>& d) noexcept {
+  const lanes<S, W> x = fabs(a), y = fabs(b), z = fabs(c), t = fabs(d);
+  const lanes<S, W> xy = select(x > y, x, y), zt = select(z > t, z, t);
+  return select(xy > zt, xy, zt);
+}
+
+/// initial_multipliers (runtime.hpp) over lanes: the warm start, or N zero lanes.
+template <int N, class S, int W>
+inline const lanes<S, W>* initial_multipliers(const lanes<S, W>* lambda0) noexcept {
+  static const lanes<S, W> zeros[N] = {};
+  return lambda0 ? lambda0 : zeros;
+}
+
+/// largest_magnitude_of (runtime.hpp) per lane: NaN in a lane with a NaN or
+/// infinite value.
+template <int N, class S, int W>
+inline lanes<S, W> largest_magnitude_of(const lanes<S, W>* x) noexcept {
+  lanes<S, W> largest(S(0)), invalid(S(0));
+  for (int r = 0; r < N; ++r) {
+    const lanes<S, W> a = fabs(x[r]);
+    largest = select(a > largest, a, largest);
+    invalid += x[r] - x[r];
+  }
+  return largest + invalid;
+}
+
+/// sincos (runtime.hpp) per lane. Float: the C library per lane, as the
+/// scalar function. Double: the scalar kernel's operations in the same order
+/// on all lanes at once; the lanes past its range (|x| > 1e5, NaN, infinite)
+/// run it on 0 and then take the C library's answer, lane by lane.
+template <class S, int W>
+inline void sincos(const lanes<S, W>& x, lanes<S, W>& s, lanes<S, W>& c) noexcept {
+  for (int l = 0; l < W; ++l) {
+    S sl, cl;
+    sincos(x[l], sl, cl);
+    s.set(l, sl);
+    c.set(l, cl);
+  }
+}
+
+#if PROXGEN_RT_LANES_VECTOR
+template <int W>
+inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<double, W>& c) noexcept {
+  using L = lanes<double, W>;
+  const L x = x_in;  // read after s and c are written
+  using IV = typename L::ivec;
+  const typename L::mask inside = fabs(x) <= L(1e5);  // false for NaN and infinities
+  const L xr = select(inside, x, L(0.0));  // no lane converts an out-of-range value to an integer
+  // The scalar kernel, operation for operation (runtime.hpp: int(...) truncates, as the conversion here).
+  const IV k = __builtin_convertvector((xr * L(6.36619772367581382433e-01) + copysign(L(0.5), xr)).x, IV);
+  L fk;
+  fk.x = __builtin_convertvector(k, typename L::vec);
+  const L r = ((xr - fk * L(1.57079632673412561417e+00)) - fk * L(6.07710050630396597660e-11)) -
+              fk * L(2.02226624871116645580e-21);
+  const L z = r * r;
+  const L ps = L(8.33333333332248946124e-03) +
+               z * (L(-1.98412698298579493134e-04) +
+                    z * (L(2.75573137070700676789e-06) +
+                         z * (L(-2.50507602534068634195e-08) + z * L(1.58969099521155010221e-10))));
+  const L sr = r + (z * r) * (L(-1.66666666666666324348e-01) + z * ps);
+  const L pc =
+      z * (L(4.16666666666666019037e-02) +
+           z * (L(-1.38888888888741095749e-03) +
+                z * (L(2.48015872894767294178e-05) +
+                     z * (L(-2.75573143513906633035e-07) +
+                          z * (L(2.08757232129817482790e-09) + z * L(-1.13596475577881948265e-11))))));
+  const L hz = L(0.5) * z, w = L(1.0) - hz;
+  const L cr = w + (((L(1.0) - w) - hz) + z * pc);
+  // Quadrant k mod 4, as the scalar table look-ups: sin = sr, cr, -sr, -cr; cos = cr, -sr, -cr, sr.
+  const IV k1 = k + 1, zero = IV{};
+  typename L::mask odd, neg, odd1, neg1;
+  odd.m = (k & 1) != zero;
+  neg.m = (k & 2) != zero;
+  odd1.m = (k1 & 1) != zero;
+  neg1.m = (k1 & 2) != zero;
+  s = select(odd, cr, sr) * select(neg, L(-1.0), L(1.0));
+  c = select(odd1, cr, sr) * select(neg1, L(-1.0), L(1.0));
+  if (any(!inside)) {
+    for (int l = 0; l < W; ++l) {
+      if (inside[l]) continue;
+      s.set(l, std::sin(x[l]));
+      c.set(l, std::cos(x[l]));
+    }
+  }
+}
+#endif
+
+/// angle_axis (runtime.hpp) per lane: it branches on the pivot, so each lane
+/// runs the scalar function.
+template <class S, int W>
+inline void angle_axis(const lanes<S, W>* R, lanes<S, W>& angle, lanes<S, W>* axis) noexcept {
+  for (int l = 0; l < W; ++l) {
+    S Rl[9], al, axl[3];
+    for (int i = 0; i < 9; ++i) Rl[i] = R[i][l];
+    angle_axis(Rl, al, axl);
+    angle.set(l, al);
+    for (int i = 0; i < 3; ++i) axis[i].set(l, axl[i]);
+  }
+}
+
+/// log6 (runtime.hpp) per lane, by the scalar function on each lane.
+template <class S, int W>
+inline void log6(const lanes<S, W>* R, const lanes<S, W>* p, lanes<S, W>* out) noexcept {
+  for (int l = 0; l < W; ++l) {
+    S Rl[9], pl[3], ol[6];
+    for (int i = 0; i < 9; ++i) Rl[i] = R[i][l];
+    for (int i = 0; i < 3; ++i) pl[i] = p[i][l];
+    log6(Rl, pl, ol);
+    for (int i = 0; i < 6; ++i) out[i].set(l, ol[i]);
+  }
+}
+
+}  // namespace proxgen_rt
