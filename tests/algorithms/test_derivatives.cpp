@@ -245,5 +245,80 @@ TEST(Derivatives, ConstrainedDynamicsMatchDifferencesOfConvergedSolves) {
   }
 }
 
+// d qdd / d tau and d lambda / d tau in closed form. The proximal iteration
+// on the tau tangents, (G + I/mu) L+ = J M^-1 + L/mu from L = 0, converges to
+// the minimum-norm solution of G L = J M^-1, L = G^+ J M^-1 (its right-hand
+// side is in range(G) = range(J)), so the limit is
+//   d qdd / d tau = M^-1 - M^-1 J^T G^+ J M^-1,   d lambda / d tau = G^+ J M^-1,
+// independent of mu. The damped M^-1 - M^-1 J^T (G + I/mu)^-1 J M^-1 is the
+// first iterate only; it differs from the limit by M^-1 J^T ((G + I/mu)^-1 -
+// G^+) J M^-1 ~ 1 / (mu g) relative, which the check tells apart wherever
+// that is above the round-off.
+TEST(Derivatives, ConstrainedDqddDtauIsTheProximalLimitNotTheDampedForm) {
+  PROXGEN_REQUIRE_MODELS();
+  int distinguished = 0;
+  for (const Named& s : allSystems()) {
+    const System& sys = s.sys;
+    if (sys.nc == 0) continue;
+    Data d(sys);
+    DerivativeData dd(sys);
+    std::mt19937 rng(34);
+    const State x = test::randomState(sys.model, rng);
+    constrainedDynamicsDerivatives(sys, d, dd, x.q, x.v, x.tau, sys.mu, kConverged);
+    const DenseProblem p = assembleDense(sys, x.q, x.v, x.tau);
+    const MatX Minv = p.M.inverse();
+    const MatX G = p.J * Minv * p.J.transpose();
+    Eigen::CompleteOrthogonalDecomposition<MatX> cod(G.rows(), G.cols());
+    cod.setThreshold(double(G.rows()) * kEps);  // the rank rule of denseExact
+    cod.compute(G);
+    const MatX Gplus = cod.pseudoInverse();
+    const MatX limit = Minv - Minv * p.J.transpose() * Gplus * p.J * Minv;
+    const MatX damped =
+        Minv - Minv * p.J.transpose() * (G + MatX::Identity(sys.nc, sys.nc) / sys.mu).inverse() * p.J * Minv;
+    // Both sides chain solves with M and with G (on its range): relative error
+    // c n eps (kappa_s(M) + kappa_s(G)), the dual bound, on the scale of M^-1.
+    const double bound = test::roundoffBounds(p, sys.mu).dual * std::max(1.0, maxAbs(Minv));
+    EXPECT_LE(maxAbs(dd.dqdd_dtau - limit), bound) << s.name;
+    const MatX P = rangeProjector(p.J);
+    EXPECT_LE(maxAbs(P * dd.dlambda_dtau - Gplus * p.J * Minv), bound * std::max(1.0, maxAbs(Gplus))) << s.name;
+    if (maxAbs(damped - limit) > 100 * bound) {
+      EXPECT_GT(maxAbs(dd.dqdd_dtau - damped), 10 * bound) << s.name;
+      ++distinguished;
+    }
+  }
+  EXPECT_GT(distinguished, 0);  // the two forms were told apart somewhere
+}
+
+// A singular configuration: the iiwa straight up (q = 0) with its hand in
+// point contact, where the vertical row of J vanishes (rank 2 of 3). At v = 0
+// that row is consistent (0 = 0): the proximal limit leaves it without force,
+// and its tangent too, so qdd and the multipliers on range(J) are what the
+// differences of converged solves give, through the same check as above.
+TEST(Derivatives, SingularConfigurationGivesTheProximalLimit) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Case& c : test::sharedCases()) {
+    if (c.name != "iiwa_h3") continue;
+    const System sys = loadCaseSystem(c);
+    State x{sys.model.neutral(), VecX::Zero(sys.model.nv), VecX::Zero(sys.model.nv)};
+    std::mt19937 rng(35);
+    std::uniform_real_distribution<double> u(-5, 5);
+    for (int k = 0; k < sys.model.nv; ++k) x.tau[k] = u(rng);
+    const DenseProblem p = assembleDense(sys, x.q, x.v, x.tau);
+    const Eigen::JacobiSVD<MatX> svd(p.J);
+    ASSERT_LT(svd.singularValues()[2], 1e-12 * svd.singularValues()[0]) << "not a singular configuration";
+    checkConstrained("iiwa_h3 stretched", sys, x, sys.mu);
+    // And the unconstrained ones, where nothing is singular (M > 0).
+    Data d(sys), fd(sys);
+    DerivativeData dd(sys);
+    forwardDynamicsDerivatives(sys, d, dd, x.q, x.v, x.tau);
+    const double delta = 10 * sys.model.nv * kEps * test::scaledCondition(p.M);
+    const auto qdd = [&](const State& y) -> VecX { return aba(sys, fd, y.q, y.v, y.tau); };
+    EXPECT_LE(relErr(dd.dqdd_dq, differences(sys.model, x, Input::Q, qdd)), tolerance(Input::Q, delta));
+    EXPECT_LE(relErr(dd.dqdd_dv, differences(sys.model, x, Input::V, qdd)), tolerance(Input::V, delta));
+    return;
+  }
+  FAIL() << "no iiwa_h3 in the shared cases";
+}
+
 }  // namespace
 }  // namespace proxgen
