@@ -209,25 +209,34 @@ void constrainedDynamicsDerivatives(const System& sys, Data& d, DerivativeData& 
   dd.R1.leftCols(nv) = -dd.dtau_dq;
   dd.R1.middleCols(nv, nv) = -dd.dtau_dv;
   dd.R1.rightCols(nv).setIdentity();
-  dd.lltM.solveInPlace(dd.R1);  // now M^-1 R1
+  dd.R2.leftCols(nv) = dd.dastar_dq - dd.dalpha_dq;
+  dd.R2.middleCols(nv, nv) = dd.dastar_dv - dd.dalpha_dv;
+  dd.R2.rightCols(nv).setZero();
   if (nc > 0) {
-    dd.R2.leftCols(nv) = dd.dastar_dq - dd.dalpha_dq;
-    dd.R2.middleCols(nv, nv) = dd.dastar_dv - dd.dalpha_dv;
-    dd.R2.rightCols(nv).setZero();
     dd.MinvJt = dd.J.transpose();
     dd.lltM.solveInPlace(dd.MinvJt);
     dd.G.noalias() = dd.J * dd.MinvJt;
     dd.G.diagonal().array() += 1.0 / mu;
     dd.lltG.compute(dd.G);
-    dd.C.noalias() = dd.J * dd.R1;
-    dd.C -= dd.R2;
+  }
+  // One input at a time (nv columns): the products' blocking buffers then fit
+  // Eigen's stack allocation on the largest robots (no heap in a call).
+  for (int b = 0; b < 3; ++b) {
+    auto X = dd.R1.middleCols(b * nv, nv);
+    dd.lltM.solveInPlace(X);  // now M^-1 R1
+    if (nc == 0) continue;
+    auto C = dd.C.middleCols(b * nv, nv), L = dd.Lam.middleCols(b * nv, nv);
+    C.noalias() = dd.J * X;
+    C -= dd.R2.middleCols(b * nv, nv);
     // The proximal steps of the forward solve, on the tangents.
-    dd.Lam.setZero();
+    L.setZero();
     for (int k = 0; k < iterations; ++k) {
-      dd.Lam = dd.C + dd.Lam / mu;
-      dd.lltG.solveInPlace(dd.Lam);
+      L = C + L / mu;
+      dd.lltG.solveInPlace(L);
     }
-    dd.R1.noalias() -= dd.MinvJt * dd.Lam;  // X = M^-1 (R1 - J^T L)
+    X.noalias() -= dd.MinvJt * L;  // X = M^-1 (R1 - J^T L)
+  }
+  if (nc > 0) {
     dd.dlambda_dq = dd.Lam.leftCols(nv);
     dd.dlambda_dv = dd.Lam.middleCols(nv, nv);
     dd.dlambda_dtau = dd.Lam.rightCols(nv);
