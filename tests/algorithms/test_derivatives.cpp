@@ -15,11 +15,14 @@
 //    two solves, delta |f| / h.
 //  - q: truncation h^2 |f'''| / 6 and round-off delta |f| / h. The dynamics
 //    depend on q through rotations and lever arms of 0.05 - 1 m, so |f'''| <=
-//    ~1e3 |f| (m^-2 on the shortest links); h = 1e-5 gives truncation
-//    <= 2e-8 |f| and round-off delta / 1e-5.
+//    ~1e3 |f'| (m^-2 on the shortest links); h = 1e-5 gives truncation
+//    <= 2e-8 max(1, |f'|) and round-off delta |f| / 1e-5. Where that a-priori
+//    bound fails (near a singular Jacobian), the constrained checks measure
+//    the truncation (expectDifferences below).
 //  - delta, the relative error of one solve: c n eps kappa (tests/numerics.hpp,
 //    the dual bound of proxPV) for the solvers, c n eps for RNEA (a sum).
-// Errors are relative to the size of the difference quotient, max(1, max|FD|).
+// The unconstrained checks compare relative to max(1, max|FD|) (there |f| and
+// |f'| are of one size); the constrained ones absolutely, with |f| explicit.
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
