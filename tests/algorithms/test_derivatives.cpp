@@ -189,7 +189,7 @@ TEST(Derivatives, ForwardDynamicsMatchDifferencesAndDqddDtauIsMinv) {
 
 // The orthogonal projector onto range(J) (= range(G)), by a complete
 // orthogonal decomposition with the rank rule of denseExact: the part of the
-// multipliers the proximal limit determines (docs/derivatives.md §4).
+// multipliers the proximal limit determines (docs/derivatives.md §3).
 MatX rangeProjector(const MatX& J) {
   Eigen::CompleteOrthogonalDecomposition<MatX> cod(J.rows(), J.cols());
   cod.setThreshold(double(std::max(J.rows(), J.cols())) * kEps);
@@ -239,7 +239,7 @@ TEST(Derivatives, ConstrainedDynamicsMatchDifferencesOfConvergedSolves) {
   PROXGEN_REQUIRE_MODELS();
   for (const Named& s : allSystems()) {
     // Rows on two bodies (the pole's weld and the puck's point) whose
-    // redundancy turns with q: not covered (docs/derivatives.md §4); the same
+    // redundancy turns with q: not covered (docs/derivatives.md §3); the same
     // robot with the point alone is, through both planar joints.
     if (s.name == "planar mobile") continue;
     std::mt19937 rng(33);
