@@ -15,9 +15,10 @@ void addGenerate(CLI::App& app);  // generate.cpp
 void addVerify(CLI::App& app);    // verify.cpp
 
 /// `eval --compute QUANTITY`: the dynamics library on the states, as JSON
-/// (compute.cpp). mu <= 0 means the layout's.
+/// (compute.cpp). mu <= 0 means the layout's; iterations (derivatives only)
+/// < 0 means not given: the converged solve, 200.
 void runCompute(const std::string& urdf, const std::string& layout, const std::string& state, const std::string& quantity,
-                double mu);
+                double mu, int iterations = -1);
 
 /// The robot of `generate` and `verify`: a URDF and --layout, or --cases and
 /// --case, never a mix (generate.cpp).

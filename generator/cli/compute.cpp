@@ -9,6 +9,11 @@
 // inverse_dynamics reads two more keys of each state object: qdd (keyed by
 // joint, every joint) and lambda (keyed by constraint, a list of its rows;
 // optional, missing constraints push with 0). No other quantity accepts them.
+//
+// derivatives (docs/derivatives.md): the converged constrained solution qdd,
+// lambda (proxPV with --mu and --iterations, default 200: the proximal limit)
+// and its six derivative matrices; columns of d/dq are tangent directions
+// q (+) dq, named like the velocity slots.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -20,6 +25,7 @@
 #include "algorithms/constraint_kinematics.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/delassus.hpp"
+#include "algorithms/derivatives.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/rnea.hpp"
@@ -35,7 +41,7 @@ namespace {
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
 
-enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse };
+enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse, Derivatives };
 
 struct QuantityName {
   const char* name;
@@ -45,7 +51,11 @@ const QuantityName kQuantities[] = {{"inverse_dynamics", Quantity::InverseDynami
                                     {"mass_matrix", Quantity::MassMatrix},           {"mass_matrix_inverse", Quantity::MassMatrixInverse},
                                     {"placements", Quantity::Placements},            {"jacobian", Quantity::Jacobian},
                                     {"drift", Quantity::Drift},                      {"delassus", Quantity::Delassus},
-                                    {"delassus_inverse", Quantity::DelassusInverse}};
+                                    {"delassus_inverse", Quantity::DelassusInverse}, {"derivatives", Quantity::Derivatives}};
+
+// The iterations of --compute derivatives when --iterations is not given: the
+// converged solve (K = 200, as tests/algorithms/test_derivatives.cpp).
+constexpr int kConvergedIterations = 200;
 
 Quantity parseQuantity(const std::string& name) {
   std::string valid;
@@ -161,7 +171,24 @@ ordered_json placementsJson(const System& sys, const VecX& X) {
   return out;
 }
 
-ordered_json computeOne(const System& sys, Data& d, Quantity what, const State& s, const VecX& qdd, const VecX* lambda, double mu) {
+ordered_json derivativesJson(const System& sys, Data& d, DerivativeData& dd, const State& s, double mu, int iterations) {
+  const Model& m = sys.model;
+  constrainedDynamicsDerivatives(sys, d, dd, s.q, s.v, s.tau, mu, iterations);
+  const std::vector<std::string> dofs = dofNames(m), rows = rowNames(sys);
+  return {{"mu", mu},
+          {"iterations", iterations},
+          {"qdd", jointsJson(m, dd.qdd)},
+          {"lambda", constraintsJson(sys, dd.lambda)},
+          {"dqdd_dq", matrixJson(dd.dqdd_dq, dofs, dofs)},
+          {"dqdd_dv", matrixJson(dd.dqdd_dv, dofs, dofs)},
+          {"dqdd_dtau", matrixJson(dd.dqdd_dtau, dofs, dofs)},
+          {"dlambda_dq", matrixJson(dd.dlambda_dq, rows, dofs)},
+          {"dlambda_dv", matrixJson(dd.dlambda_dv, rows, dofs)},
+          {"dlambda_dtau", matrixJson(dd.dlambda_dtau, rows, dofs)}};
+}
+
+ordered_json computeOne(const System& sys, Data& d, DerivativeData& dd, Quantity what, const State& s, const VecX& qdd,
+                        const VecX* lambda, double mu, int iterations) {
   const Model& m = sys.model;
   switch (what) {
     case Quantity::InverseDynamics: return {{"tau", jointsJson(m, inverseDynamics(sys, d, s.q, s.v, qdd, lambda))}};
@@ -174,6 +201,7 @@ ordered_json computeOne(const System& sys, Data& d, Quantity what, const State& 
     case Quantity::Delassus: return {{"G", matrixJson(delassus(sys, d, s.q), rowNames(sys), rowNames(sys))}};
     case Quantity::DelassusInverse:
       return {{"mu", mu}, {"Ginv", matrixJson(delassusInverse(sys, d, s.q, mu), rowNames(sys), rowNames(sys))}};
+    case Quantity::Derivatives: return derivativesJson(sys, d, dd, s, mu, iterations);
   }
   return {};
 }
@@ -190,14 +218,19 @@ bool allFiniteJson(const ordered_json& x) {
 
 }  // namespace
 
-void runCompute(const std::string& urdf, const std::string& layout, const std::string& statePath, const std::string& quantity, double mu) {
+void runCompute(const std::string& urdf, const std::string& layout, const std::string& statePath, const std::string& quantity, double mu,
+                int iterations) {
   const Quantity what = parseQuantity(quantity);
   const System sys = loadSystem(urdf, layout);
   if (!(mu > 0)) mu = sys.mu;
+  if (iterations >= 0 && what != Quantity::Derivatives)
+    fail("command line", "--iterations", fmt::format("applies to --compute derivatives only (this is {})", quantity));
+  if (iterations < 0) iterations = kConvergedIterations;
   const json file = readStateJson(statePath);
   const bool isList = file.is_array();
   const std::size_t count = isList ? file.size() : 1;
   Data d(sys);
+  DerivativeData dd(sys);
   ordered_json results = ordered_json::array();
   for (std::size_t k = 0; k < count; ++k) {
     const std::string where = isList ? fmt::format("{}: [{}]", statePath, k) : statePath;
@@ -222,7 +255,7 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
     }
     const State s = stateFromJson(sys.model, object, where);
     ordered_json r = {{"compute", quantity}};
-    r.update(computeOne(sys, d, what, s, qdd, hasLambda ? &lambda : nullptr, mu));
+    r.update(computeOne(sys, d, dd, what, s, qdd, hasLambda ? &lambda : nullptr, mu, iterations));
     if (!allFiniteJson(r)) fail(where, quantity, "is not finite at this state (an intermediate overflowed)");
     results.push_back(r);
   }

@@ -170,7 +170,9 @@ std::string firstNonFinite(const System& sys, const Data& d, Algorithm algorithm
 }
 
 void runEval(const EvalOptions& o) {
-  if (!o.compute.empty()) return runCompute(o.urdf, o.layout, o.state, o.compute, o.mu.empty() ? 0.0 : parseMu(o.mu));
+  if (!o.compute.empty())
+    return runCompute(o.urdf, o.layout, o.state, o.compute, o.mu.empty() ? 0.0 : parseMu(o.mu),
+                      o.iterations.empty() ? -1 : parseIterations(o.iterations));
   const Algorithm algorithm = parseAlgorithm(o.algorithm);
   const System sys = loadSystem(o.urdf, o.layout);
   const double mu = o.mu.empty() ? sys.mu : parseMu(o.mu);

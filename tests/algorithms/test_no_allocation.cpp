@@ -11,6 +11,7 @@
 #include "algorithms/constraint_kinematics.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/delassus.hpp"
+#include "algorithms/derivatives.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/prox_ltl.hpp"
@@ -144,6 +145,32 @@ TEST(NoAllocation, DynamicsLibraryOnEverySharedCase) {
     all();
     g_counting = false;
     EXPECT_EQ(g_allocations, 0) << c.name;
+  }
+}
+
+// The derivatives (docs/derivatives.md) on their preallocated DerivativeData.
+TEST(NoAllocation, DerivativesOnEverySharedCase) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Case& c : test::sharedCases()) {
+    const System sys = loadCaseSystem(c);
+    Data d(sys);
+    DerivativeData dd(sys);
+    std::mt19937 rng(9);
+    const test::RandomState s = test::randomState(sys.model, rng);
+    const VecX lambda = VecX::Ones(sys.nc);
+    for (int f = 0; f < 3; ++f) {
+      const auto run = [&] {
+        if (f == 0) inverseDynamicsDerivatives(sys, d, dd, s.q, s.v, s.tau, &lambda);
+        if (f == 1) forwardDynamicsDerivatives(sys, d, dd, s.q, s.v, s.tau);
+        if (f == 2) constrainedDynamicsDerivatives(sys, d, dd, s.q, s.v, s.tau, 1e4, 3);
+      };
+      run();  // warm-up
+      g_allocations = 0;
+      g_counting = true;
+      run();
+      g_counting = false;
+      EXPECT_EQ(g_allocations, 0) << c.name << " " << (f == 0 ? "inverse" : f == 1 ? "forward" : "constrained");
+    }
   }
 }
 
