@@ -5,7 +5,8 @@
 # Generates a solver for one robot and layout at build time and makes it a
 # static library target <target> to link. The solver is regenerated whenever
 # the URDF, the layout or the proxgen executable changes. NAME defaults to
-# <target>; the generated header is <NAME>.hpp. FUNCTIONS (a list: constrained_aba,
+# <target>; the generated header is <NAME>.hpp, and <NAME>_c.h the C interface
+# (its definitions are compiled into <target> too: a C program links <target>). FUNCTIONS (a list: constrained_aba,
 # prox_pv, inverse_dynamics, nonlinear_effects, mass_matrix, mass_matrix_inverse,
 # ... or all) picks the functions the solver holds, as `generate --functions`
 # (default: the layout's `functions:`, else the two solvers); proxgen checks the names.
@@ -95,14 +96,18 @@ function(proxgen_add_solver target)
   endif()
   set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
   set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
+  # The C interface (NAME_c.h, NAME_c.cpp; docs/design.md "The C interface"):
+  # compiled into the same library, so C code includes NAME_c.h and links <target>.
+  set(c_h "${PAS_OUTPUT_DIR}/${PAS_NAME}_c.h")
+  set(c_cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}_c.cpp")
   add_custom_command(
-    OUTPUT "${hpp}" "${cpp}"
+    OUTPUT "${hpp}" "${cpp}" "${c_h}" "${c_cpp}"
     COMMAND "${PROXGEN_EXECUTABLE}" generate "${urdf}" --layout "${layout}" --out "${PAS_OUTPUT_DIR}"
             --name "${PAS_NAME}" --scalar "${PAS_SCALAR}" ${functions}
     DEPENDS "${urdf}" "${layout}" ${PROXGEN_EXECUTABLE_DEPENDS}
     COMMENT "proxgen: generating ${PAS_NAME} (${PAS_SCALAR}) from ${urdf}"
     VERBATIM)
-  add_library(${target} STATIC "${cpp}" "${hpp}")
+  add_library(${target} STATIC "${cpp}" "${hpp}" "${c_cpp}" "${c_h}")
   target_include_directories(${target} PUBLIC "${PAS_OUTPUT_DIR}" "${PROXGEN_RUNTIME_INCLUDE_DIR}")
   target_compile_features(${target} PUBLIC cxx_std_17)
   proxgen_solver_compile_options(options)
