@@ -8,7 +8,10 @@
 //
 // inverse_dynamics reads two more keys of each state object: qdd (keyed by
 // joint, every joint) and lambda (keyed by constraint, a list of its rows;
-// optional, missing constraints push with 0). No other quantity accepts them.
+// optional, missing constraints push with 0). wrenches reads lambda alone (required,
+// same form): each constraint's wrench on the robot in world axes, force and
+// torque about the constraint frame's origin, the solvers' sign (the constraint
+// force on the robot is -J^T lambda). No other quantity accepts them.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -35,7 +38,7 @@ namespace {
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
 
-enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse };
+enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse, Wrenches };
 
 struct QuantityName {
   const char* name;
@@ -45,7 +48,7 @@ const QuantityName kQuantities[] = {{"inverse_dynamics", Quantity::InverseDynami
                                     {"mass_matrix", Quantity::MassMatrix},           {"mass_matrix_inverse", Quantity::MassMatrixInverse},
                                     {"placements", Quantity::Placements},            {"jacobian", Quantity::Jacobian},
                                     {"drift", Quantity::Drift},                      {"delassus", Quantity::Delassus},
-                                    {"delassus_inverse", Quantity::DelassusInverse}};
+                                    {"delassus_inverse", Quantity::DelassusInverse}, {"wrenches", Quantity::Wrenches}};
 
 Quantity parseQuantity(const std::string& name) {
   std::string valid;
@@ -161,6 +164,15 @@ ordered_json placementsJson(const System& sys, const VecX& X) {
   return out;
 }
 
+// Keyed by constraint name: the force and the torque (about the frame's origin), world axes.
+ordered_json wrenchesJson(const System& sys, const VecX& W) {
+  ordered_json out = ordered_json::object();
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k)
+    out[sys.constraints[k].name] = {{"force", {W[6 * k], W[6 * k + 1], W[6 * k + 2]}},
+                                    {"torque", {W[6 * k + 3], W[6 * k + 4], W[6 * k + 5]}}};
+  return out;
+}
+
 ordered_json computeOne(const System& sys, Data& d, Quantity what, const State& s, const VecX& qdd, const VecX* lambda, double mu) {
   const Model& m = sys.model;
   switch (what) {
@@ -174,6 +186,7 @@ ordered_json computeOne(const System& sys, Data& d, Quantity what, const State& 
     case Quantity::Delassus: return {{"G", matrixJson(delassus(sys, d, s.q), rowNames(sys), rowNames(sys))}};
     case Quantity::DelassusInverse:
       return {{"mu", mu}, {"Ginv", matrixJson(delassusInverse(sys, d, s.q, mu), rowNames(sys), rowNames(sys))}};
+    case Quantity::Wrenches: return {{"wrenches", wrenchesJson(sys, constraintWrenches(sys, d, s.q, *lambda))}};
   }
   return {};
 }
@@ -207,8 +220,14 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
     if (object.is_object()) {
       if (object.contains("qdd") && what != Quantity::InverseDynamics)
         fail(where, "qdd", fmt::format("only --compute inverse_dynamics reads qdd (this is {})", quantity));
-      if (object.contains("lambda") && what != Quantity::InverseDynamics)
-        fail(where, "lambda", fmt::format("only --compute inverse_dynamics reads lambda (this is {})", quantity));
+      if (object.contains("lambda") && what != Quantity::InverseDynamics && what != Quantity::Wrenches)
+        fail(where, "lambda", fmt::format("only --compute inverse_dynamics and wrenches read lambda (this is {})", quantity));
+      if (what == Quantity::Wrenches) {
+        if (!object.contains("lambda")) fail(where, "lambda", "missing (wrenches needs the multipliers, keyed by constraint)");
+        lambda = lambdaFromJson(sys, object.at("lambda"), where);
+        hasLambda = true;
+        object.erase("lambda");
+      }
       if (what == Quantity::InverseDynamics) {
         if (!object.contains("qdd")) fail(where, "qdd", "missing (inverse_dynamics needs the acceleration)");
         qdd = qddFromJson(sys.model, object.at("qdd"), where);
@@ -221,6 +240,7 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
       }
     }
     const State s = stateFromJson(sys.model, object, where);
+    if (what == Quantity::Wrenches && !hasLambda) fail(where, "lambda", "missing (wrenches needs the multipliers)");
     ordered_json r = {{"compute", quantity}};
     r.update(computeOne(sys, d, what, s, qdd, hasLambda ? &lambda : nullptr, mu));
     if (!allFiniteJson(r)) fail(where, quantity, "is not finite at this state (an intermediate overflowed)");

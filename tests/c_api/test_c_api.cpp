@@ -13,6 +13,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "c_calls.h"
@@ -169,6 +172,29 @@ TEST(CApi, TheReadmeControllerLoopsAgree) {
   double largest = 0;
   for (double x : W) largest = std::max(largest, std::abs(x));
   EXPECT_GT(largest, 0.0);  // the loops computed forces (a comparison of zeros could hide a dead loop)
+}
+
+// The README shows both loops as they are compiled here: the text between the
+// markers of this file and of c_calls.c appears in README.md verbatim.
+std::string between(const std::string& path, const std::string& begin, const std::string& end) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  const std::size_t a = text.find(begin), b = text.find(end);
+  if (a == std::string::npos || b == std::string::npos) return "<markers missing in " + path + ">";
+  return text.substr(a + begin.size(), b - a - begin.size());
+}
+
+TEST(CApi, TheReadmeShowsTheCompiledLoops) {
+  const std::string src = PROXGEN_TEST_SOURCE_DIR;
+  std::ifstream in(src + "/README.md");
+  std::stringstream readme;
+  readme << in.rdbuf();
+  const std::string cpp = between(src + "/tests/c_api/test_c_api.cpp", "// README-CPP-BEGIN\n", "// README-CPP-END");
+  const std::string c = between(src + "/tests/c_api/c_calls.c", "/* README-C-BEGIN */\n", "/* README-C-END */");
+  EXPECT_NE(readme.str().find("```cpp\n#include \"quadruped.hpp\"\n" + cpp + "```"), std::string::npos) << cpp;
+  EXPECT_NE(readme.str().find("```c\n" + c + "```"), std::string::npos) << c;
 }
 
 }  // namespace
