@@ -338,6 +338,9 @@ int verify(const VerifyOptions& o) {
     g.functions = o.functions;
     files = emit::solverOutputs(emit::generateFiles(g));
   }
+  // The solver's two files only: the C interface (NAME_c.*) is not what verify
+  // compiles, and every file in the scratch folder must be one it registered.
+  files.resize(2);
   files.push_back({"driver.cpp", driverDefines(sys.functions) + kDriver});
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
