@@ -5,7 +5,8 @@
 # Generates a solver for one robot and layout at build time and makes it a
 # static library target <target> to link. The solver is regenerated whenever
 # the URDF, the layout or the proxgen executable changes. NAME defaults to
-# <target>; the generated header is <NAME>.hpp. FUNCTIONS (a list: constrained_aba,
+# <target>; the generated header is <NAME>.hpp, and <NAME>_c.h the C interface
+# (its definitions are compiled into <target> too: a C program links <target>). FUNCTIONS (a list: constrained_aba,
 # prox_pv, inverse_dynamics, nonlinear_effects, mass_matrix, mass_matrix_inverse,
 # ... or all) picks the functions the solver holds, as `generate --functions`
 # (default: the layout's `functions:`, else the two solvers); proxgen checks the names.
@@ -98,6 +99,10 @@ function(proxgen_add_solver target)
   endif()
   set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
   set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
+  # The C interface (NAME_c.h, NAME_c.cpp; docs/design.md "The C interface"):
+  # compiled into the same library, so C code includes NAME_c.h and links <target>.
+  set(c_h "${PAS_OUTPUT_DIR}/${PAS_NAME}_c.h")
+  set(c_cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}_c.cpp")
   set(batch "")
   set(batch_files "")
   if(DEFINED PAS_BATCH OR "BATCH" IN_LIST PAS_KEYWORDS_MISSING_VALUES)
@@ -108,13 +113,13 @@ function(proxgen_add_solver target)
     set(batch_files "${PAS_OUTPUT_DIR}/${PAS_NAME}_batch.hpp" "${PAS_OUTPUT_DIR}/${PAS_NAME}_batch.cpp")
   endif()
   add_custom_command(
-    OUTPUT "${hpp}" "${cpp}" ${batch_files}
+    OUTPUT "${hpp}" "${cpp}" "${c_h}" "${c_cpp}" ${batch_files}
     COMMAND "${PROXGEN_EXECUTABLE}" generate "${urdf}" --layout "${layout}" --out "${PAS_OUTPUT_DIR}"
             --name "${PAS_NAME}" --scalar "${PAS_SCALAR}" ${functions} ${batch}
     DEPENDS "${urdf}" "${layout}" ${PROXGEN_EXECUTABLE_DEPENDS}
     COMMENT "proxgen: generating ${PAS_NAME} (${PAS_SCALAR}) from ${urdf}"
     VERBATIM)
-  add_library(${target} STATIC "${cpp}" "${hpp}" ${batch_files})
+  add_library(${target} STATIC "${cpp}" "${hpp}" "${c_cpp}" "${c_h}" ${batch_files})
   if(batch_files AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
     # GCC notes that passing 32-byte vectors by value changed ABI in GCC 4.6: a
     # note on the lanes (proxgen/lanes.hpp) between this file's own functions.

@@ -172,7 +172,8 @@ struct Workspace {
 // Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.
 // Sign: the constraint force on the robot is -J^T lambda, so
 // M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library
-// where it enters as + J^T f, is -lambda.
+// where it enters as + J^T f, is -lambda (constraint_wrenches, a function
+// to select, gives each constraint's as a wrench on the robot in world axes).
 // K = s.iterations proximal multiplier updates
 //   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)
 // from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to

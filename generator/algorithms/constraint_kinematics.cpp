@@ -17,6 +17,20 @@ const VecX& constraintPlacements(const System& sys, Data& d, const VecX& q) {
   return d.placements;
 }
 
+const VecX& constraintWrenches(const System& sys, Data& d, const VecX& q, const VecX& lambda) {
+  forwardKinematics(sys, d, q);
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    const Eigen::Index at = 6 * Eigen::Index(k);
+    d.wrenches.segment<6>(at).setZero();
+    if (c.body == 0) continue;  // on the world: no body of the robot feels it
+    const Mat3 R = framePlacement(d, c.body, c.placement).R;
+    d.wrenches.segment<3>(at) = -R * lambda.segment<3>(c.row);
+    if (c.type == ConstraintType::Weld6D) d.wrenches.segment<3>(at + 3) = -R * lambda.segment<3>(c.row + 3);
+  }
+  return d.wrenches;
+}
+
 const MatX& constraintJacobianRows(const System& sys, Data& d, const VecX& q) {
   forwardKinematics(sys, d, q);
   for (const Constraint& c : sys.constraints) joint_space::fillJacobianRows(sys, d, c);

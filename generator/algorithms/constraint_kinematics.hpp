@@ -17,6 +17,15 @@ namespace proxgen {
 /// frame in the world (3 x 3, row-major), then the frame origin in the world.
 const VecX& constraintPlacements(const System& sys, Data& d, const VecX& q);
 
+/// d.wrenches: per constraint (layout order) 6 values, the wrench its
+/// multipliers exert ON THE ROBOT in world axes: the force, then the torque
+/// about the constraint frame's origin (the position of constraintPlacements).
+/// The solvers' sign: the constraint force on the robot is -J^T lambda, so a
+/// weld's wrench is -R [lambda_lin; lambda_ang] and a point's is -R lambda with
+/// zero torque (R: the frame's rotation in the world). A constraint on the
+/// world (rows of zeros) exerts nothing on the robot: zeros.
+const VecX& constraintWrenches(const System& sys, Data& d, const VecX& q, const VecX& lambda);
+
 /// d.J (nc x nv): the rows of each constraint in its own frame C, layout
 /// order; frame twist rows = J v (6d: [v_C; w_C], 3d: v_C). Rows of a
 /// constraint on the world are zero.

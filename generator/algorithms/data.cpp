@@ -85,6 +85,7 @@ Data::Data(const System& sys) {
 
   zeroV = VecX::Zero(m.nv);
   placements = VecX::Zero(12 * Eigen::Index(sys.constraints.size()));
+  wrenches = VecX::Zero(6 * Eigen::Index(sys.constraints.size()));
   Minv = MatX::Zero(m.nv, m.nv);
   FA.assign(N, MatX::Zero(6, m.nv));
   subtreeDofEnd.assign(N, 0);

@@ -85,6 +85,7 @@ struct Data {
   // Dynamics library (docs/dynamics.md), appended.
   VecX zeroV;                   // nv zeros: qdd = 0, v = 0 without a temporary
   VecX placements;              // 12 per constraint: world rotation (row-major), position
+  VecX wrenches;                // 6 per constraint: force, torque on the robot in world axes
   MatX Minv;                    // M^-1 (mass_matrix_inverse), full
   std::vector<MatX> FA;         // per body 6 x nv: unit-torque forces, then accelerations (Minv)
   std::vector<int> subtreeDofEnd;  // one past the last dof of each body's subtree

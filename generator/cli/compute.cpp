@@ -8,7 +8,10 @@
 //
 // inverse_dynamics reads two more keys of each state object: qdd (keyed by
 // joint, every joint) and lambda (keyed by constraint, a list of its rows;
-// optional, missing constraints push with 0). No other quantity accepts them.
+// optional, missing constraints push with 0). wrenches reads lambda alone (required,
+// same form): each constraint's wrench on the robot in world axes, force and
+// torque about the constraint frame's origin, the solvers' sign (the constraint
+// force on the robot is -J^T lambda). No other quantity accepts them.
 //
 // derivatives (docs/derivatives.md): the converged constrained solution qdd,
 // lambda (proxPV with --mu and --iterations, default 200: the proximal limit)
@@ -41,7 +44,7 @@ namespace {
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
 
-enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse, Derivatives };
+enum class Quantity { InverseDynamics, NonlinearEffects, MassMatrix, MassMatrixInverse, Placements, Jacobian, Drift, Delassus, DelassusInverse, Wrenches, Derivatives };
 
 struct QuantityName {
   const char* name;
@@ -51,7 +54,8 @@ const QuantityName kQuantities[] = {{"inverse_dynamics", Quantity::InverseDynami
                                     {"mass_matrix", Quantity::MassMatrix},           {"mass_matrix_inverse", Quantity::MassMatrixInverse},
                                     {"placements", Quantity::Placements},            {"jacobian", Quantity::Jacobian},
                                     {"drift", Quantity::Drift},                      {"delassus", Quantity::Delassus},
-                                    {"delassus_inverse", Quantity::DelassusInverse}, {"derivatives", Quantity::Derivatives}};
+                                    {"delassus_inverse", Quantity::DelassusInverse}, {"wrenches", Quantity::Wrenches},
+                                    {"derivatives", Quantity::Derivatives}};
 
 // The iterations of --compute derivatives when --iterations is not given: the
 // converged solve (K = 200, as tests/algorithms/test_derivatives.cpp).
@@ -171,6 +175,15 @@ ordered_json placementsJson(const System& sys, const VecX& X) {
   return out;
 }
 
+// Keyed by constraint name: the force and the torque (about the frame's origin), world axes.
+ordered_json wrenchesJson(const System& sys, const VecX& W) {
+  ordered_json out = ordered_json::object();
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k)
+    out[sys.constraints[k].name] = {{"force", {W[6 * k], W[6 * k + 1], W[6 * k + 2]}},
+                                    {"torque", {W[6 * k + 3], W[6 * k + 4], W[6 * k + 5]}}};
+  return out;
+}
+
 ordered_json derivativesJson(const System& sys, Data& d, DerivativeData& dd, const State& s, double mu, int iterations) {
   const Model& m = sys.model;
   constrainedDynamicsDerivatives(sys, d, dd, s.q, s.v, s.tau, mu, iterations);
@@ -201,6 +214,7 @@ ordered_json computeOne(const System& sys, Data& d, DerivativeData& dd, Quantity
     case Quantity::Delassus: return {{"G", matrixJson(delassus(sys, d, s.q), rowNames(sys), rowNames(sys))}};
     case Quantity::DelassusInverse:
       return {{"mu", mu}, {"Ginv", matrixJson(delassusInverse(sys, d, s.q, mu), rowNames(sys), rowNames(sys))}};
+    case Quantity::Wrenches: return {{"wrenches", wrenchesJson(sys, constraintWrenches(sys, d, s.q, *lambda))}};
     case Quantity::Derivatives: return derivativesJson(sys, d, dd, s, mu, iterations);
   }
   return {};
@@ -240,8 +254,14 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
     if (object.is_object()) {
       if (object.contains("qdd") && what != Quantity::InverseDynamics)
         fail(where, "qdd", fmt::format("only --compute inverse_dynamics reads qdd (this is {})", quantity));
-      if (object.contains("lambda") && what != Quantity::InverseDynamics)
-        fail(where, "lambda", fmt::format("only --compute inverse_dynamics reads lambda (this is {})", quantity));
+      if (object.contains("lambda") && what != Quantity::InverseDynamics && what != Quantity::Wrenches)
+        fail(where, "lambda", fmt::format("only --compute inverse_dynamics and wrenches read lambda (this is {})", quantity));
+      if (what == Quantity::Wrenches) {
+        if (!object.contains("lambda")) fail(where, "lambda", "missing (wrenches needs the multipliers, keyed by constraint)");
+        lambda = lambdaFromJson(sys, object.at("lambda"), where);
+        hasLambda = true;
+        object.erase("lambda");
+      }
       if (what == Quantity::InverseDynamics) {
         if (!object.contains("qdd")) fail(where, "qdd", "missing (inverse_dynamics needs the acceleration)");
         qdd = qddFromJson(sys.model, object.at("qdd"), where);
@@ -254,6 +274,7 @@ void runCompute(const std::string& urdf, const std::string& layout, const std::s
       }
     }
     const State s = stateFromJson(sys.model, object, where);
+    if (what == Quantity::Wrenches && !hasLambda) fail(where, "lambda", "missing (wrenches needs the multipliers)");
     ordered_json r = {{"compute", quantity}};
     r.update(computeOne(sys, d, dd, what, s, qdd, hasLambda ? &lambda : nullptr, mu, iterations));
     if (!allFiniteJson(r)) fail(where, quantity, "is not finite at this state (an intermediate overflowed)");

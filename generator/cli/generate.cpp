@@ -44,7 +44,7 @@ void addGenerate(CLI::App& app) {
     int batch = 0;  // 0: no batched files
   };
   auto opt = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("generate", "write a flat C++ solver (NAME.hpp, NAME.cpp) for one robot and layout");
+  auto* cmd = app.add_subcommand("generate", "write a flat C++ solver (NAME.hpp, NAME.cpp) and its C interface (NAME_c.h, NAME_c.cpp) for one robot and layout");
   cmd->add_option("urdf", opt->urdf, "robot URDF");
   cmd->add_option("--layout", opt->layout, "constraint layout (YAML)");
   cmd->add_option("--cases", opt->cases, "a cases file (cases.yaml), instead of URDF and layout");

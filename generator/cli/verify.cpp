@@ -127,7 +127,7 @@ fs::path runtimeDir() {
 // unless the solver holds both); then library samples (q, v, qdd, lambda) and,
 // per sample, what each joint-space function it holds returns (compare.hpp's
 // LibraryAnswer order: tau, h, M, Minv, then ConstraintAnswer's: X, J, gamma,
-// G, Ginv at the layout's mu). verify.cpp prepends a
+// G, Ginv at the layout's mu, W from the sample's lambda). verify.cpp prepends a
 // PROXGEN_VERIFY_HAS_<FUNCTION> 1 line per function held.
 constexpr const char* kDriver = R"(// proxgen verify driver (temporary)
 #include <cstdio>
@@ -207,6 +207,10 @@ int main() {
 #if PROXGEN_VERIFY_HAS_DELASSUS_INVERSE
     s::delassus_inverse(q, s::Settings{}, w, out);  // the layout's mu
     printAll(out, s::nc * s::nc);
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_WRENCHES
+    s::constraint_wrenches(q, lambda, w, out);  // the sample's lambda
+    printAll(out, 6 * s::ncons);
 #endif
   }
   return 0;
@@ -432,6 +436,9 @@ int verify(const VerifyOptions& o) {
     generated = emit::generateFiles(g);
   }
   std::vector<emit::OutputFile> files = emit::solverOutputs(generated);
+  // The solver's two files only: the C interface (NAME_c.*) is not what verify
+  // compiles, and every file in the scratch folder must be one it registered.
+  files.resize(2);
   files.push_back({"driver.cpp", driverDefines(sys.functions) + kDriver});
   // --batch: the batched files and their driver, registered before they are written.
   fs::path batchCpp, batchObj, batchDriverCpp, batchDriverObj, batchDriver, batchOutput;
@@ -620,6 +627,8 @@ int verify(const VerifyOptions& o) {
     if (sys.functions.has(Function::ConstraintDrift)) cons.gamma = read(sys.nc, "constraint_drift", at);
     if (sys.functions.has(Function::Delassus)) cons.G = read(sys.nc * sys.nc, "delassus", at);
     if (sys.functions.has(Function::DelassusInverse)) cons.Ginv = read(sys.nc * sys.nc, "delassus_inverse", at);
+    if (sys.functions.has(Function::ConstraintWrenches)) cons.W = read(6 * ncons, "constraint_wrenches", at);
+    cons.lambda = libraryIn[s].lambda;
     cons.mu = sys.mu;
     std::vector<verify::Compared> items = verify::compareLibraryWithGeneric(sys, d, conditioning[s], states[s], gen);
     for (const verify::Compared& x : verify::compareConstraintFunctions(sys, d, conditioning[s], states[s], cons))

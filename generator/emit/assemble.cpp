@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "emit/c_api.hpp"
 #include "emit/identifiers.hpp"
 
 namespace proxgen::emit {
@@ -75,7 +76,8 @@ const EntryPoint kEntryPoints[] = {
      "// Out: qdd[nv] and lambda[nc] (none of them inside w), lambda in layout order.\n"
      "// Sign: the constraint force on the robot is -J^T lambda, so\n"
      "// M qdd + h = tau - J^T lambda: a contact force f on the robot, in a library\n"
-     "// where it enters as + J^T f, is -lambda.\n"
+     "// where it enters as + J^T f, is -lambda (constraint_wrenches, a function\n"
+     "// to select, gives each constraint's as a wrench on the robot in world axes).\n"
      "// K = s.iterations proximal multiplier updates\n"
      "//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)\n"
      "// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to\n"
@@ -139,6 +141,17 @@ const EntryPoint kEntryPoints[] = {
      "// float at large mu, factor delassus's G instead).\n",
      "void delassus_inverse(const Scalar* q, const Settings& s, Workspace& w, Scalar* Ginv) noexcept",
      "// (G + I/mu)^-1 by Woodbury on the penalised recursion.\n"},
+    {Function::ConstraintWrenches,
+     "\n// Per constraint (layout order) 6 values: the wrench of its multipliers ON THE\n"
+     "// ROBOT in world axes, force then torque about the constraint frame's origin\n"
+     "// (constraint_placements' position). With the solvers' sign (the constraint\n"
+     "// force on the robot is -J^T lambda): -R [lambda_lin; lambda_ang] for a 6d\n"
+     "// weld, [-R lambda; 0] for a 3d point (R: the frame's rotation in the world),\n"
+     "// zeros for a constraint on the world. So the force the robot pushes the\n"
+     "// ground with is minus W's; standing still, W's forces sum to -m g. lambda: nc\n"
+     "// values (a solver's output), none of them inside w.\n",
+     "void constraint_wrenches(const Scalar* q, const Scalar* lambda, Workspace& w, Scalar* W) noexcept",
+     "// The wrenches: the support bodies' world rotations root first, -R_C lambda at each constraint.\n"},
 };
 
 // The helpers the entry points call, printed only when one needs them.
@@ -295,6 +308,9 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
                              fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)),
                              fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));
+  CInterfaceFiles c = emitCInterface(plan, texts.functions, banner, ws.scalars() * scalarBytes);
+  files.cHeaderName = std::move(c.headerName), files.cHeader = std::move(c.header);
+  files.cSourceName = std::move(c.sourceName), files.cSource = std::move(c.source);
   return files;
 }
 

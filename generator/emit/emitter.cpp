@@ -17,7 +17,8 @@ void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* 
   const FunctionSet& f = e.sys.functions;
   const bool delassus = f.has(Function::Delassus) || f.has(Function::DelassusInverse);
   ConstraintJoints joints;
-  if (delassus || f.has(Function::ConstraintPlacements) || f.has(Function::ConstraintJacobian)) {
+  if (delassus || f.has(Function::ConstraintPlacements) || f.has(Function::ConstraintJacobian) ||
+      f.has(Function::ConstraintWrenches)) {
     joints = emitConstraintJoints(e, delassus);
     texts.constraintJoints = joints.text;
   }
@@ -27,6 +28,7 @@ void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* 
   if (f.has(Function::ConstraintDrift)) texts.library[Function::ConstraintDrift] = emitConstraintDrift(e, kin, from);
   if (f.has(Function::Delassus)) texts.library[Function::Delassus] = emitDelassus(e, joints, false);
   if (f.has(Function::DelassusInverse)) texts.library[Function::DelassusInverse] = emitDelassus(e, joints, true);
+  if (f.has(Function::ConstraintWrenches)) texts.library[Function::ConstraintWrenches] = emitConstraintWrenches(e, joints);
 }
 
 }  // namespace
@@ -125,7 +127,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
                  {Function::ConstraintJacobian, "jacobian", "joints"},
                  {Function::ConstraintDrift, "drift", "kinematics"},
                  {Function::Delassus, "delassus", "joints"},
-                 {Function::DelassusInverse, "dinv", "joints"}};
+                 {Function::DelassusInverse, "dinv", "joints"},
+                 {Function::ConstraintWrenches, "wrenches", "joints"}};
   for (const auto& l : library) {
     OpCount ops = fn.hostOps(l.host);
     ops += fn.hostOps(l.helper);

@@ -27,6 +27,8 @@ struct SolverInputs {
 struct SolverFiles {
   std::string headerName, header;  // NAME.hpp
   std::string sourceName, source;  // NAME.cpp
+  // The C interface (emit/c_api.hpp): NAME_c.h, NAME_c.cpp.
+  std::string cHeaderName, cHeader, cSourceName, cSource;
 };
 
 /// Size statistics of an emitted solver (live statements, multiplications).

@@ -74,7 +74,10 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats, Sy
 }
 
 std::vector<OutputFile> solverOutputs(const SolverFiles& files) {
-  return {{files.headerName, files.header}, {files.sourceName, files.source}};
+  return {{files.headerName, files.header},
+          {files.sourceName, files.source},
+          {files.cHeaderName, files.cHeader},
+          {files.cSourceName, files.cSource}};
 }
 
 }  // namespace proxgen::emit

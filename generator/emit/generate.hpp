@@ -43,7 +43,8 @@ SolverFiles generateFiles(const GenerateOptions& options, SolverStats* stats = n
 SolverFiles generateSystem(const System& sys, const std::string& name, ScalarType scalar, SolverInputs in,
                            SolverStats* stats = nullptr);
 
-/// The solver's files as outputs for writeFiles (emit/output.hpp): NAME.hpp, NAME.cpp.
+/// The solver's files as outputs for writeFiles (emit/output.hpp): NAME.hpp,
+/// NAME.cpp and its C interface, NAME_c.h and NAME_c.cpp (emit/c_api.hpp).
 std::vector<OutputFile> solverOutputs(const SolverFiles& files);
 
 /// "double" / "float" -> ScalarType; throws proxgen::Error otherwise.

@@ -111,6 +111,10 @@ std::string emitConstraintDrift(Emit& e, const Kinematics& kin, const CodeBuilde
 /// Ends the open part and copies `out` (the host's values) to the output array `name`.
 void copyOutput(Emit& e, const std::string& name, const std::vector<Expr>& out);
 
+// ---- pass_constraint_wrenches.cpp: constraint_wrenches, each constraint's
+// wrench on the robot in world axes from lambda (-R_C lambda).
+std::string emitConstraintWrenches(Emit& e, const ConstraintJoints& joints);
+
 // ---- pass_delassus.cpp: delassus (G = J M^-1 J^T) and, with `inverse`,
 // delassus_inverse ((G + I/mu)^-1 by Woodbury on the penalised recursion).
 std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);

@@ -12,7 +12,7 @@ struct Named {
 };
 
 // allFunctions() order: the solvers, the joint-space quantities, the
-// constraint kinematics, the Delassus operator.
+// constraint kinematics, the Delassus operator, the constraints' world wrenches.
 constexpr Named kFunctions[] = {
     {Function::ConstrainedAba, "constrained_aba"},
     {Function::ProxPv, "prox_pv"},
@@ -25,6 +25,7 @@ constexpr Named kFunctions[] = {
     {Function::ConstraintDrift, "constraint_drift"},
     {Function::Delassus, "delassus"},
     {Function::DelassusInverse, "delassus_inverse"},
+    {Function::ConstraintWrenches, "constraint_wrenches"},
 };
 
 }  // namespace

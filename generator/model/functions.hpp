@@ -22,6 +22,7 @@ enum class Function {
   ConstraintDrift,
   Delassus,
   DelassusInverse,
+  ConstraintWrenches,
 };
 
 /// Every function, in the order the header declares them.

@@ -201,7 +201,10 @@ std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, cons
 //    answer, so the absolute error is mu^2 times the error of J M_mu^-1 J^T
 //    (c n u kappa(M_mu) / mu, as |J M_mu^-1 J^T| <= 1/mu): c n u kappa(M_mu) mu,
 //    in the generic twin too (twice that for the difference), relative to
-//    max(1, |reference|).
+//    max(1, |reference|);
+//  - wrenches W = -R lambda: each entry a sum of 3 products of rotation
+//    entries (each within c n u, as the placements) with lambda: 3 c n u
+//    |lambda|_inf, relative to max(1, |reference|).
 std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, const Conditioning& c, const State& s,
                                                  const ConstraintAnswer& gen) {
   std::vector<Compared> out;
@@ -222,6 +225,10 @@ std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, con
     const Bounds b = boundsAt(c, gen.mu);
     const VecX ref = rowMajor(delassusInverse(sys, d, s.q, gen.mu));
     add("delassus_inverse", gen.Ginv, ref, std::max(c.floor, 2 * c.safety * c.eps * b.kappaC * gen.mu / maxAbs1(ref)));
+  }
+  if (gen.W.size()) {
+    const VecX ref = constraintWrenches(sys, d, s.q, gen.lambda);
+    add("constraint_wrenches", gen.W, ref, std::max(c.floor, 3 * c.safety * c.eps * maxAbs1(gen.lambda) / maxAbs1(ref)));
   }
   return out;
 }

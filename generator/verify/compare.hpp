@@ -94,13 +94,14 @@ std::vector<Compared> compareLibraryWithGeneric(const System& sys, Data& d, cons
                                                 const LibraryAnswer& gen);
 
 // ---- The constraint functions (constraint_placements, constraint_jacobian,
-// constraint_drift, delassus, delassus_inverse) against their generic twins
+// constraint_drift, delassus, delassus_inverse, constraint_wrenches) against their generic twins
 // (algorithms/constraint_kinematics.hpp, algorithms/delassus.hpp); bounds
 // argued in compare.cpp. A self-contained block.
 struct ConstraintAnswer {
   // Row-major as the generated functions write them; an empty vector: not generated.
-  VecX X, J, gamma, G, Ginv;
+  VecX X, J, gamma, G, Ginv, W;
   double mu = 0;  // the s.mu delassus_inverse ran with
+  VecX lambda;    // the nc multipliers constraint_wrenches ran with
 };
 /// One Compared per function present in `gen` (in the order above).
 std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, const Conditioning& c, const State& s,

@@ -164,6 +164,44 @@ TEST(Compute, EveryQuantityEqualsTheLibrary) {
   }
 }
 
+// wrenches reads lambda (keyed by constraint) and prints, per constraint, the
+// force and the torque of constraintWrenches, equal as above.
+TEST(Compute, WrenchesEqualTheLibraryKeyedByConstraint) {
+  for (const Robot& robot : robots()) {
+    const System sys = loadSystem(robot.urdf, robot.layout);
+    std::mt19937 rng(43);
+    json one = stateJson(sys.model, randomState(sys.model, rng));
+    VecX lambda(sys.nc);
+    for (int i = 0; i < sys.nc; ++i) lambda[i] = std::uniform_real_distribution<double>(-50, 50)(rng);
+    json lam = json::object();
+    for (const Constraint& c : sys.constraints) lam[c.name] = std::vector<double>(lambda.data() + c.row, lambda.data() + c.row + c.rows());
+    one["lambda"] = lam;
+    TempFile file(".json");
+    file.write(one.dump());
+    const json r = runCompute(robot, file.path(), "wrenches");
+    json plain = one;
+    plain.erase("lambda");
+    TempFile plainFile(".json");
+    plainFile.write(plain.dump());
+    const State s = loadStates(sys.model, plainFile.path()).at(0);
+    Data d(sys);
+    const VecX W = constraintWrenches(sys, d, s.q, lambda);
+    ASSERT_EQ(r.at("wrenches").size(), sys.constraints.size());
+    for (std::size_t c = 0; c < sys.constraints.size(); ++c) {
+      const json& x = r.at("wrenches").at(sys.constraints[c].name);
+      for (int e = 0; e < 3; ++e) {
+        EXPECT_EQ(x.at("force")[e].get<double>(), W[6 * c + e]);
+        EXPECT_EQ(x.at("torque")[e].get<double>(), W[6 * c + 3 + e]);
+      }
+    }
+    // Without lambda: one clear line.
+    const ProcessResult p = runProxgen({"eval", robot.urdf, "--layout", robot.layout, "--state", plainFile.path(),
+                                        "--compute", "wrenches"});
+    EXPECT_EQ(p.code, 1);
+    EXPECT_NE(p.err.find("lambda: missing"), std::string::npos) << p.err;
+  }
+}
+
 TEST(Compute, LambdaIsOptionalForInverseDynamics) {
   const Robot robot = robots()[1];
   const System sys = loadSystem(robot.urdf, robot.layout);

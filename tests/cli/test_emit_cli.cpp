@@ -70,21 +70,21 @@ class GenerateCommand : public ::testing::Test {
   const std::string arm_ = proxgen::test::sourceDir() + "/generated/arm";
 };
 
-TEST_F(GenerateCommand, WritesTheTwoFilesAndCreatesTheFolder) {
+TEST_F(GenerateCommand, WritesTheSolverAndItsCInterfaceAndCreatesTheFolder) {
   const fs::path out = tmp_ / "new" / "folder";
   const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --name arm");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp"}));
+  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp", "arm_c.h", "arm_c.cpp"}));
   // Again into the same folder: replaced, still nothing else (no temporary left).
   ASSERT_EQ(run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + out.string() + " --name arm").code, 0);
-  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp"}));
+  EXPECT_EQ(listing(out), (std::set<std::string>{"arm.hpp", "arm.cpp", "arm_c.h", "arm_c.cpp"}));
 }
 
 TEST_F(GenerateCommand, TheNameIsSanitised) {
   const Outcome r = run(arm_ + "/arm.urdf --layout " + arm_ + "/layout.yaml --out " + tmp_.string() +
                     " --name '../../evil name'");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(listing(tmp_), (std::set<std::string>{"evil_name.hpp", "evil_name.cpp"}));
+  EXPECT_EQ(listing(tmp_), (std::set<std::string>{"evil_name.hpp", "evil_name.cpp", "evil_name_c.h", "evil_name_c.cpp"}));
 }
 
 // Each bad input: exit code 1, one "proxgen: error:" line naming the file,

@@ -36,7 +36,8 @@ TEST(GeneratedFresh, CheckedInSolversMatchTheGenerator) {
     const std::string command = "proxgen generate generated/" + std::string(robot) + "/" + robot +
                                 ".urdf --layout generated/" + robot + "/layout.yaml --out generated/" + robot +
                                 " --name " + robot;
-    for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source}}) {
+    for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source},
+                                     std::pair{files.cHeaderName, files.cHeader}, std::pair{files.cSourceName, files.cSource}}) {
       const std::string path = dir + "/" + name;
       const std::string checkedIn = test::slurp(path);
       EXPECT_EQ(checkedIn, text) << "generated/" << robot << "/" << name << " is stale ("

@@ -79,7 +79,7 @@ TEST(Output, WritesBothFilesAndNothingElse) {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir / "out")) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"arm3.cpp", "arm3.hpp"}));  // no temporary, no lock file left
+  EXPECT_EQ(names, (std::vector<std::string>{"arm3.cpp", "arm3.hpp", "arm3_c.cpp", "arm3_c.h"}));  // no temporary, no lock file left
 }
 
 // Issue 19 item 4: NAME.cpp a folder made `generate` exit 1 after replacing NAME.hpp.
@@ -155,7 +155,7 @@ TEST(Output, ConcurrentRunsIntoOneFolderNeverMixTheirFiles) {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir / "out")) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"arm3.cpp", "arm3.hpp"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"arm3.cpp", "arm3.hpp", "arm3_c.cpp", "arm3_c.h"}));
 }
 
 // The serialisation itself, deterministically: while another process holds

@@ -11,11 +11,12 @@
 // (PROXGEN_SOLVER_HAS_<NAME>, from proxgen_test_solver's FUNCTIONS).
 #if defined(PROXGEN_SOLVER_HAS_CONSTRAINT_PLACEMENTS) || defined(PROXGEN_SOLVER_HAS_CONSTRAINT_JACOBIAN) || \
     defined(PROXGEN_SOLVER_HAS_CONSTRAINT_DRIFT) || defined(PROXGEN_SOLVER_HAS_DELASSUS) ||                  \
-    defined(PROXGEN_SOLVER_HAS_DELASSUS_INVERSE)
+    defined(PROXGEN_SOLVER_HAS_DELASSUS_INVERSE) || defined(PROXGEN_SOLVER_HAS_CONSTRAINT_WRENCHES)
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -106,6 +107,17 @@ proxgen::verify::ConstraintAnswer runGenerated(const VecX& qIn, const VecX& vIn,
   s.mu = gen::Scalar(mu);
   gen::delassus_inverse(q.data(), s, w, Ginv.data());
   a.Ginv = toDouble(Ginv, nc * nc);
+#endif
+#ifdef PROXGEN_SOLVER_HAS_CONSTRAINT_WRENCHES
+  // Multipliers of the size a solver returns (tens of newtons), distinct per
+  // row and state, rounded to the Scalar as the generated function sees them.
+  VecX lambdaIn(nc);
+  for (int k = 0; k < nc; ++k) lambdaIn[k] = double(gen::Scalar(20.0 * std::sin(1.0 + k + 3.0 * qIn[0])));
+  const std::vector<gen::Scalar> l = toScalar(lambdaIn);
+  std::vector<gen::Scalar> W(std::size_t(6 * std::max(ncons, 1)));
+  gen::constraint_wrenches(q.data(), l.data(), w, W.data());
+  a.W = toDouble(W, 6 * ncons);
+  a.lambda = lambdaIn;
 #endif
   return a;
 }
