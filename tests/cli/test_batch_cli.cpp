@@ -51,10 +51,11 @@ class BatchCli : public ::testing::Test {
 TEST_F(BatchCli, BatchAddsTwoFilesAndLeavesTheScalarOnesAsTheyAre) {
   const ProcessResult r = runProxgen(armGenerate({"--batch", "4"}));
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(out_), (std::set<std::string>{"arm.hpp", "arm.cpp", "arm_batch.hpp", "arm_batch.cpp"}));
+  EXPECT_EQ(listing(out_), (std::set<std::string>{"arm.hpp", "arm.cpp", "arm_c.h", "arm_c.cpp", "arm_batch.hpp",
+                                                  "arm_batch.cpp"}));
   // generated/arm is generated without --batch (tests/cli/test_generated_fresh.cpp keeps it fresh).
-  EXPECT_EQ(proxgen::test::slurp(out_ / "arm.hpp"), proxgen::test::slurp(arm_ + "/arm.hpp"));
-  EXPECT_EQ(proxgen::test::slurp(out_ / "arm.cpp"), proxgen::test::slurp(arm_ + "/arm.cpp"));
+  for (const char* file : {"arm.hpp", "arm.cpp", "arm_c.h", "arm_c.cpp"})
+    EXPECT_EQ(proxgen::test::slurp(out_ / file), proxgen::test::slurp(arm_ + "/" + file)) << file;
   const std::string header = proxgen::test::slurp(out_ / "arm_batch.hpp");
   EXPECT_NE(header.find("inline constexpr int batch_width = 4;"), std::string::npos);
   for (const char* entry : {"void constrained_aba_batch(", "void prox_pv_batch(", "void constrained_aba_many(",
