@@ -398,6 +398,52 @@ def load_python(path):
         return json.load(f)
 
 
+# Kept sections: a "## " section of the old RESULTS.md whose heading this run does not write is
+# hand-written (e.g. "Batched solvers", measured by its own command) and is kept verbatim, after
+# the nearest written section above it (docs/benchmarks.md, "Hand-written sections"). The sections the
+# report writes only with some inputs are listed, so an old copy of them is dropped, never kept.
+REPORT_SECTIONS = ("Scaling on synthetic robots", "Python")
+
+
+def split_sections(lines):
+    """[(heading, lines)] cut before each "## " line outside code fences (heading None: the top)."""
+    out, fenced = [(None, [])], False
+    for line in lines:
+        fenced = fenced != line.startswith("```")
+        if not fenced and line.startswith("## "):
+            out.append((line[3:].strip(), []))
+        out[-1][1].append(line)
+    return out
+
+
+def keep_hand_written(old_path, lines):
+    """lines with the hand-written sections of old_path (if it exists) put back in."""
+    if not os.path.exists(old_path):
+        return lines
+    with open(old_path) as f:
+        old = split_sections(f.read().split("\n"))
+    new = split_sections(lines)
+    written = {h for h, _ in new} | set(REPORT_SECTIONS)
+    after, anchor = {}, None  # written heading -> the hand-written sections that followed it
+    for heading, body in old:
+        if heading is not None and heading not in written:
+            after.setdefault(anchor, []).append(body)
+        elif heading in {h for h, _ in new}:
+            anchor = heading
+    out = []
+
+    def put(body):  # one blank line before and after, as between the written sections
+        while body and body[-1] == "":
+            body = body[:-1]
+        out.extend(([""] if out and out[-1] != "" else []) + body + [""])
+
+    for heading, body in new:  # every anchor is a heading of new (or None, its top)
+        out += body
+        for kept in after.get(heading, []):
+            put(kept)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", required=True)
@@ -455,6 +501,7 @@ def main():
     py = load_python(args.python)
     if py is not None:
         lines += python_section(py, march)
+    lines = keep_hand_written(os.path.join(args.out_dir, "RESULTS.md"), lines)
     with open(os.path.join(args.out_dir, "RESULTS.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"report: wrote {os.path.join(args.out_dir, 'RESULTS.md')}")

@@ -1,7 +1,9 @@
 # ctest driver for the downstream project: install proxgen into a prefix,
 # configure and build a user project against it (proxgen_add_solver,
-# proxgen::runtime, proxgen::core), run it, then change the layout and check
-# that the build regenerates the solver (Settings::mu follows it). Then the
+# proxgen::runtime, proxgen::core; the solver with BATCH 4, its batched forms
+# checked against its scalar ones by main.cpp), run it, then change the layout
+# and check that the build regenerates the solver and its batched source
+# (Settings::mu follows it). Then the
 # optimisation level a solver gets with and without a build type, and the
 # pkg-config files.
 # Inputs: -DBUILD_DIR= (proxgen build tree) -DSOURCE_DIR= (proxgen sources) -DWORK_DIR= (scratch)
@@ -71,6 +73,12 @@ if(LAST_OUTPUT MATCHES "proxgen: generating")
 endif()
 
 # The layout changes: the build must regenerate, and the solver must follow.
+# The batched source too (BATCH 4): its banner holds the layout's hash.
+set(batch_cpp "${build}/proxgen/arm_solver/arm_built_batch.cpp")  # proxgen_add_solver's default OUTPUT_DIR
+file(READ "${batch_cpp}" batch_before)
+if(NOT batch_before MATCHES "--batch 4")
+  message(FATAL_ERROR "${batch_cpp} does not say it was generated with --batch 4")
+endif()
 file(READ "${WORK_DIR}/inputs/layout.yaml" layout)
 string(REGEX REPLACE "\nmu:[^\n]*" "\nmu: 2500" layout "${layout}")
 if(NOT layout MATCHES "\nmu: 2500")
@@ -80,6 +88,10 @@ file(WRITE "${WORK_DIR}/inputs/layout.yaml" "${layout}")
 run(${CMAKE_COMMAND} --build "${build}")
 if(NOT LAST_OUTPUT MATCHES "proxgen: generating arm_built")
   message(FATAL_ERROR "changing the layout did not regenerate the solver:\n${LAST_OUTPUT}")
+endif()
+file(READ "${batch_cpp}" batch_after)
+if(batch_after STREQUAL batch_before)
+  message(FATAL_ERROR "changing the layout did not regenerate ${batch_cpp}")
 endif()
 run("${build}/downstream" 2500)
 message(STATUS "${LAST_OUTPUT}")
