@@ -46,7 +46,7 @@ ANCHOR_COLUMN = {"aba": (2, 6), "caba": (3, 7), "pv": (4, 8), "ltl": (5, None),
 ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv", "mujoco", "pin_caba", "pin_pv"]
 LABEL = {"aba": "ABA", "caba": "cABA", "pv": "proxPV", "ltl": "proxLTL", "ltls": "proxLTLs",
          "gen_caba": "generated cABA", "gen_pv": "generated proxPV",
-         "mujoco": "MuJoCo mj_forward", "pin_caba": "Pinocchio constraintDynamics", "pin_pv": "Pinocchio pv"}
+         "mujoco": "MuJoCo mj_forward", "pin_caba": "Pinocchio constrainedABA", "pin_pv": "Pinocchio pv"}
 # Peers timed in the same run when the build found them (bench/mujoco.cmake, bench/pinocchio.cmake).
 PEERS = ["mujoco", "pin_caba", "pin_pv"]
 TARGET = 1.0 / 3.0  # the project's target: generated solvers at most a third of Pinocchio's figures
@@ -67,7 +67,7 @@ def medians(path, aggregate="median"):
         if b.get("run_type") != "aggregate" and aggregate != "median":
             continue
         k = scale[b["time_unit"]]
-        counters = {c: b[c] for c in b if c in ("nv", "nc", "n", "m") or c.startswith("mj_")}
+        counters = {c: b[c] for c in b if c in ("nv", "nc", "n", "m") or c.startswith(("mj_", "pin_"))}
         out[b["run_name"]] = (b["cpu_time"] * k, b["real_time"] * k, counters)
     return out, data.get("context", {})
 
@@ -474,14 +474,21 @@ def peers_section(suite, cases, context, march, command):
         iters = counter(c, "mj_iter_mean")
         row += ["—" if iters is None else f"{iters:.2f}", sci(counter(c, "mj_free_gap")), sci(counter(c, "mj_cons_gap"))]
         out.append("| " + " | ".join(row) + " |")
+    if pin:
+        gaps = [suite.get(f"{c}/pin_caba", (None, None, {}))[2].get("pin_aba_gap") for c in cases]
+        gaps = [g for g in gaps if g is not None]
+        out += ["", "Pinocchio: `constrainedABA` and `pv` with `ProximalSettings(0, 1/mu, K)`, its headers compiled "
+                "in this build with proxgen's flags (bench/bench_pinocchio.cpp; Pinocchio's ABA against proxgen's "
+                f"on 20 states per case: at most {max(gaps):.1e} relative)." if gaps else ""]
     if not pin:
         out += ["", "Pinocchio: not in this run (CMake found no Pinocchio 3.7 install; bench/pinocchio.cmake). "
                 "The anchor figures above are the Pinocchio comparison of record."]
     return out + ["", "![time against DoF](time_vs_dof.png)", ""]
 
 
-def plot_subtitle(context, march):
-    return (f"{cpu_description()}, {context.get('date', '?')[:10]}\\nproxgen: -O3 -DNDEBUG"
+def plot_subtitle(context, march, suite):
+    pin = any(k.endswith("/pin_caba") or k.endswith("/pin_pv") for k in suite)
+    return (f"{cpu_description()}, {context.get('date', '?')[:10]}\\nproxgen{' and Pinocchio' if pin else ''}: -O3 -DNDEBUG"
             f"{' -march=' + march if march else ' (x86-64 baseline)'}; MuJoCo: Debian's libmujoco-dev build (baseline)")
 
 
@@ -521,7 +528,7 @@ def main():
         march = build_march(args.build)
         if args.out_dir:
             with tempfile.TemporaryDirectory(prefix="proxgen-plot-") as tmp:
-                plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp, plot_subtitle(context, march))
+                plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp, plot_subtitle(context, march, suite))
         print("\n".join(peers_section(suite, cases, context, march, args.command)))
         return
     if not args.suite or not args.out_dir:
@@ -538,7 +545,7 @@ def main():
     os.makedirs(args.out_dir, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="proxgen-plot-") as tmp:
         have_dof = plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp,
-                            plot_subtitle(context, build_march(args.build)))
+                            plot_subtitle(context, build_march(args.build), suite))
         have_scaling = bool(series) and plot_scaling(series, args.fixed_m, fixed_ns,
                                                      os.path.join(args.out_dir, "scaling.png"), tmp)
 
