@@ -26,6 +26,7 @@ void run(benchmark::State& st, Solver* solver, int states, int nv, int nc) {
   }
   st.counters["nv"] = nv;
   st.counters["nc"] = nc;
+  for (const auto& [name, value] : solver->counters()) st.counters[name] = value;
 }
 
 // The fastest repetition, beside Google Benchmark's median: on a shared VM the

@@ -52,7 +52,11 @@ BenchCase loadSharedCase(const std::string& name) {
 }
 
 const std::vector<std::string>& algorithmNames() {
-  static const std::vector<std::string> names{"aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out{"aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"};
+    for (const PeerEntry& p : peerSolvers()) out.emplace_back(p.algorithm);
+    return out;
+  }();
   return names;
 }
 
@@ -104,6 +108,8 @@ std::unique_ptr<Solver> makeGenericSolver(const System& sys, const std::vector<S
 }
 
 std::unique_ptr<Solver> makeSolver(const BenchCase& c, const std::string& algorithm) {
+  for (const PeerEntry& p : peerSolvers())
+    if (algorithm == p.algorithm) return p.make(c);
   if (!isGenerated(algorithm)) return makeGenericSolver(c.sys, c.states, algorithm);
   if (algorithm != "gen_caba" && algorithm != "gen_pv") unknownAlgorithm(algorithm);
   for (const GeneratedEntry& e : generatedSolvers())

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/model.hpp"
@@ -43,10 +44,22 @@ class Solver {
   virtual void solve(int k) = 0;
   /// The joint accelerations of the last call (kept alive by the caller).
   virtual const void* output() const = 0;
+  /// Figures the suite reports beside the time (a peer's agreement with the generic
+  /// solvers, its solver iterations); none by default.
+  virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
 };
 
+/// A peer: another library's solver on the same case and states (bench_mujoco.cpp,
+/// bench_pinocchio.cpp), compiled in only where CMake finds the library.
+struct PeerEntry {
+  const char* algorithm;
+  std::unique_ptr<Solver> (*make)(const BenchCase&);
+};
+/// The peers of this build (peer_solvers.cpp, written by bench/CMakeLists.txt).
+const std::vector<PeerEntry>& peerSolvers();
+
 /// The algorithms, in table order. Generic: aba, caba, pv, ltl, ltls; generated:
-/// gen_caba, gen_pv.
+/// gen_caba, gen_pv; then the peers this build has (mujoco, pin_caba, pin_pv).
 const std::vector<std::string>& algorithmNames();
 bool isGenerated(const std::string& algorithm);
 

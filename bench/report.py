@@ -4,6 +4,7 @@
     report.py --build BUILD_DIR --suite suite.json --calls calls.json
               --scaling scaling.json --python python.json --out-dir bench/ [--no-compile]
     report.py --build BUILD_DIR --python python.json --section python   # that section alone, on stdout
+    report.py --build BUILD_DIR --suite suite.json --section peers [--out-dir bench/]   # the peers, and the plot
 
 Inputs: the Google Benchmark JSON of proxgen_bench and proxgen_bench_scaling
 (run with repetitions and aggregates), the instruction counts of count_calls.py,
@@ -42,9 +43,12 @@ ANCHOR = {
 # Which Pinocchio column each of our algorithms is compared with (time index, Ir index).
 ANCHOR_COLUMN = {"aba": (2, 6), "caba": (3, 7), "pv": (4, 8), "ltl": (5, None),
                  "gen_caba": (3, 7), "gen_pv": (4, 8)}
-ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"]
+ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv", "mujoco", "pin_caba", "pin_pv"]
 LABEL = {"aba": "ABA", "caba": "cABA", "pv": "proxPV", "ltl": "proxLTL", "ltls": "proxLTLs",
-         "gen_caba": "generated cABA", "gen_pv": "generated proxPV"}
+         "gen_caba": "generated cABA", "gen_pv": "generated proxPV",
+         "mujoco": "MuJoCo mj_forward", "pin_caba": "Pinocchio constrainedABA", "pin_pv": "Pinocchio pv"}
+# Peers timed in the same run when the build found them (bench/mujoco.cmake, bench/pinocchio.cmake).
+PEERS = ["mujoco", "pin_caba", "pin_pv"]
 TARGET = 1.0 / 3.0  # the project's target: generated solvers at most a third of Pinocchio's figures
 
 
@@ -63,7 +67,7 @@ def medians(path, aggregate="median"):
         if b.get("run_type") != "aggregate" and aggregate != "median":
             continue
         k = scale[b["time_unit"]]
-        counters = {c: b[c] for c in ("nv", "nc", "n", "m") if c in b}
+        counters = {c: b[c] for c in b if c in ("nv", "nc", "n", "m") or c.startswith(("mj_", "pin_"))}
         out[b["run_name"]] = (b["cpu_time"] * k, b["real_time"] * k, counters)
     return out, data.get("context", {})
 
@@ -152,29 +156,62 @@ def gnuplot(script):
     return True
 
 
-def plot_dof(suite, cases, out_png, tmp):
+# How each series is drawn in the DoF plot: (gnuplot point type, colour). Filled
+# markers are proxgen's generated solvers, open ones its generic solvers, the rest peers.
+DOF_STYLE = {"gen_caba": (7, "#1f77b4"), "gen_pv": (5, "#2ca02c"), "caba": (6, "#1f77b4"), "pv": (4, "#2ca02c"),
+             "aba": (12, "#7f7f7f"), "mujoco": (9, "#d62728"), "pin_caba": (11, "#ff7f0e"), "pin_pv": (13, "#9467bd")}
+
+
+def dof_positions(suite, cases):
+    """{case: x} for the DoF plot: cases of equal nv spread a few percent apart around
+    their nv, in order of constraint rows, so that no two share a column."""
+    groups = {}
+    for c in cases:
+        counters = next((suite[f"{c}/{a}"][2] for a in ALGORITHMS if f"{c}/{a}" in suite), {})
+        groups.setdefault(counters.get("nv", 0), []).append((counters.get("nc", 0), c))
+    x = {}
+    for nv, members in groups.items():
+        members.sort()
+        for j, (_, c) in enumerate(members):
+            x[c] = nv * 1.14 ** (j - (len(members) - 1) / 2)
+    return x, groups
+
+
+def plot_dof(suite, cases, out_png, tmp, subtitle=""):
+    x, groups = dof_positions(suite, cases)
     lines = []
-    for alg in ALGORITHMS:
-        pts = sorted((suite[f"{c}/{alg}"][2]["nv"], suite[f"{c}/{alg}"][2]["nc"], suite[f"{c}/{alg}"][0])
-                     for c in cases if f"{c}/{alg}" in suite)
+    for alg in DOF_STYLE:
+        pts = [(x[c], suite[f"{c}/{alg}"][0]) for c in cases if f"{c}/{alg}" in suite]
         if not pts:
             continue
         path = os.path.join(tmp, f"dof_{alg}.dat")
         with open(path, "w") as f:
-            f.writelines(f"{nv} {t}\n" for nv, _, t in pts)
-        lines.append(f"'{path}' using 1:2 with linespoints title '{LABEL[alg]}'")
-    return gnuplot(f"""set terminal pngcairo size 900,600
+            f.writelines(f"{px} {t}\n" for px, t in sorted(pts))
+        pt, colour = DOF_STYLE[alg]
+        title = ("proxgen generic " if alg in ("aba", "caba", "pv") else "proxgen " if alg in ("gen_caba", "gen_pv") else "") + LABEL[alg]
+        lines.append(f"'{path}' using 1:2 with points pt {pt} ps 1.6 lc rgb '{colour}' title '{title}'")
+    # Each case's constraint rows under its column.
+    labels = "".join(f"set label 'm={suite_rows(suite, c)}' at {x[c]}, graph {0.03 + 0.04 * (k % 2)} center font ',9'\n"
+                     for k, c in enumerate(sorted(cases, key=lambda c: x[c])))
+    xtics = ", ".join(f"'{nv:.0f}' {nv}" for nv in sorted(groups))
+    return gnuplot(f"""set terminal pngcairo size 1150,700
 set output '{out_png}'
-set title 'Time per call against DoF (the nine shared cases, K = 3, mu = 1e4; median CPU time)'
-set xlabel 'DoF (nv)'
+set termoption noenhanced
+set title "Time per call against DoF: one marker per shared case and solver (K = 3, mu = 1e4; median CPU time)\\n{subtitle}"
+set xlabel 'DoF (nv); cases of equal nv side by side, constraint rows m under each'
 set ylabel 'time per call [us]'
 set logscale xy
-set xrange [5:120]
-set pointsize 1.3
-set key top left
+set xrange [5.5:110]
+set xtics ({xtics})
+set key outside right top
 set grid
-plot {', '.join(lines)}
+{labels}plot {', '.join(lines)}
 """)
+
+
+def suite_rows(suite, case):
+    counters = next((suite[f"{case}/{a}"][2] for a in ALGORITHMS if f"{case}/{a}" in suite), {})
+    return f"{counters.get('nc', 0):.0f}"
 
 
 def plot_scaling(series, fixed_m, fixed_ns, out_png, tmp):
@@ -391,6 +428,70 @@ def python_section(py, march):
     return out + [""]
 
 
+def peers_section(suite, cases, context, march, command):
+    """The peers (MuJoCo; Pinocchio where the build found it) beside proxgen's solvers, all from
+    one run of proxgen_bench: time per call and ratios, per case, with MuJoCo's agreement checks."""
+    have = [p for p in PEERS if any(f"{c}/{p}" in suite for c in cases)]
+    if not have:
+        return []
+    t = lambda c, a: suite.get(f"{c}/{a}", (None,))[0]
+    counter = lambda c, k: suite.get(f"{c}/mujoco", (None, None, {}))[2].get(k)
+    version = next((counter(c, "mj_version") for c in cases if counter(c, "mj_version")), None)
+    load = ", ".join(f"{x:.1f}" for x in context.get("load_avg", [])) or "?"
+    pin = "pin_caba" in have or "pin_pv" in have
+    out = ["## Peers in the same run", "",
+           f"`{command}` ({context.get('date', '?')}, host {context.get('host_name', '?')}, load average {load} at "
+           f"the start). Processor: {cpu_description()}. proxgen's solvers compiled with "
+           f"`-O3 -DNDEBUG{' -march=' + march if march else ''}`; MuJoCo "
+           f"{'%d.%d.%d' % (version // 100, version // 10 % 10, version % 10) if version else '?'} is Debian's "
+           "`libmujoco-dev` build (x86-64 baseline: no AVX in the library). Every figure is the median over the "
+           "repetitions of the mean CPU time per call, all from one process with random interleaving, on the same "
+           "1000 random states per case. MuJoCo: `mj_forward` on the case's URDF with the layout's constraints as stiff "
+           "weld/connect equalities, contacts, limits and passive forces off (docs/benchmarks.md, \"Peers in the same "
+           "run\", for what is and is not comparable). gen/MuJoCo below 1: the generated solver is faster.",
+           "", "Checks (on 20 states of each case, in the same process, before timing): `free gap`, MuJoCo's "
+           "unconstrained qacc against proxgen's ABA; `penalty gap`, MuJoCo made a penalty method of weight mu "
+           "against proxgen's constrained ABA at K = 1, at v = 0; both relative to max(1, |qdd|), bound 1e-6. "
+           "`Newton it.`: MuJoCo's solver iterations per call, mean over the 1000 states.", ""]
+    head = "| case | nv | m | gen cABA µs | gen PV µs | generic cABA µs | MuJoCo µs | gen cABA / MuJoCo | gen PV / MuJoCo | generic cABA / MuJoCo |"
+    rule = "|---|---|---|---|---|---|---|---|---|---|"
+    if pin:
+        head += " Pinocchio cABA µs | Pinocchio PV µs | gen cABA / Pinocchio | gen PV / Pinocchio |"
+        rule += "---|---|---|---|"
+    head += " Newton it. | free gap | penalty gap |"
+    rule += "---|---|---|"
+    out += [head, rule]
+    sci = lambda x: "—" if x is None else f"{x:.1e}"
+    for c in cases:
+        counters = next((suite[f"{c}/{a}"][2] for a in ALGORITHMS if f"{c}/{a}" in suite), {})
+        mj = t(c, "mujoco")
+        row = [c, f"{counters.get('nv', 0):.0f}", f"{counters.get('nc', 0):.0f}", fmt_us(t(c, "gen_caba")),
+               fmt_us(t(c, "gen_pv")), fmt_us(t(c, "caba")), fmt_us(mj), fmt_ratio(t(c, "gen_caba"), mj),
+               fmt_ratio(t(c, "gen_pv"), mj), fmt_ratio(t(c, "caba"), mj)]
+        if pin:
+            row += [fmt_us(t(c, "pin_caba")), fmt_us(t(c, "pin_pv")), fmt_ratio(t(c, "gen_caba"), t(c, "pin_caba")),
+                    fmt_ratio(t(c, "gen_pv"), t(c, "pin_pv"))]
+        iters = counter(c, "mj_iter_mean")
+        row += ["—" if iters is None else f"{iters:.2f}", sci(counter(c, "mj_free_gap")), sci(counter(c, "mj_cons_gap"))]
+        out.append("| " + " | ".join(row) + " |")
+    if pin:
+        gaps = [suite.get(f"{c}/pin_caba", (None, None, {}))[2].get("pin_aba_gap") for c in cases]
+        gaps = [g for g in gaps if g is not None]
+        out += ["", "Pinocchio: `constrainedABA` and `pv` with `ProximalSettings(0, 1/mu, K)`, its headers compiled "
+                "in this build with proxgen's flags (bench/bench_pinocchio.cpp; Pinocchio's ABA against proxgen's "
+                f"on 20 states per case: at most {max(gaps):.1e} relative)." if gaps else ""]
+    if not pin:
+        out += ["", "Pinocchio: not in this run (CMake found no Pinocchio 3.7 install; bench/pinocchio.cmake). "
+                "The anchor figures above are the Pinocchio comparison of record."]
+    return out + ["", "![time against DoF](time_vs_dof.png)", ""]
+
+
+def plot_subtitle(context, march, suite):
+    pin = any(k.endswith("/pin_caba") or k.endswith("/pin_pv") for k in suite)
+    return (f"{cpu_description()}, {context.get('date', '?')[:10]}\\nproxgen{' and Pinocchio' if pin else ''}: -O3 -DNDEBUG"
+            f"{' -march=' + march if march else ' (x86-64 baseline)'}; MuJoCo: Debian's libmujoco-dev build (baseline)")
+
+
 def load_python(path):
     if not path or not os.path.exists(path):
         return None
@@ -452,7 +553,8 @@ def main():
     ap.add_argument("--scaling")
     ap.add_argument("--python", help="python_overhead.py's JSON")
     ap.add_argument("--out-dir")
-    ap.add_argument("--section", choices=["python"], help="print that section alone on stdout, write nothing")
+    ap.add_argument("--section", choices=["python", "peers"],
+                    help="print that section alone on stdout (peers: and write time_vs_dof.png into --out-dir, if given)")
     ap.add_argument("--no-compile", action="store_true", help="skip timing the generated solvers' compile")
     ap.add_argument("--command", default="bench/run.sh", help="the command line to quote in the report")
     ap.add_argument("--fixed-m", type=int, default=6)
@@ -463,6 +565,17 @@ def main():
         if py is None:
             ap.error("--section python needs --python FILE (an existing python_overhead.py JSON)")
         print("\n".join(python_section(py, build_march(args.build))))
+        return
+    if args.section == "peers":
+        if not args.suite:
+            ap.error("--section peers needs --suite FILE")
+        suite, context = medians(args.suite)
+        cases = [c for c in ANCHOR if any(f"{c}/{a}" in suite for a in ALGORITHMS)]
+        march = build_march(args.build)
+        if args.out_dir:
+            with tempfile.TemporaryDirectory(prefix="proxgen-plot-") as tmp:
+                plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp, plot_subtitle(context, march, suite))
+        print("\n".join(peers_section(suite, cases, context, march, args.command)))
         return
     if not args.suite or not args.out_dir:
         ap.error("--suite and --out-dir are required (unless --section)")
@@ -477,7 +590,8 @@ def main():
 
     os.makedirs(args.out_dir, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="proxgen-plot-") as tmp:
-        have_dof = plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp)
+        have_dof = plot_dof(suite, cases, os.path.join(args.out_dir, "time_vs_dof.png"), tmp,
+                            plot_subtitle(context, build_march(args.build), suite))
         have_scaling = bool(series) and plot_scaling(series, args.fixed_m, fixed_ns,
                                                      os.path.join(args.out_dir, "scaling.png"), tmp)
 
@@ -493,7 +607,9 @@ def main():
     lines += summary_table(suite, calls, cases)
     lines += minimum_table(medians(args.suite, "min")[0], cases)
     lines += case_tables(suite, calls, cases)
-    if have_dof:
+    peers = peers_section(suite, cases, context, march, args.command)
+    lines += peers
+    if have_dof and not peers:
         lines += ["![time against DoF](time_vs_dof.png)", ""]
     lines += compile_table(compile_rows, march)
     if series:

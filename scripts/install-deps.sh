@@ -5,7 +5,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config python3
   libeigen3-dev liburdfdom-dev liburdfdom-tools libtinyxml2-dev libfmt-dev libyaml-cpp-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  valgrind gnuplot-nox binutils
+  valgrind gnuplot-nox binutils libmujoco-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm
   clang libclang-rt-14-dev
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib python3-yaml

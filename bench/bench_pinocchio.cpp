@@ -1,0 +1,128 @@
+// Pinocchio (3.7 or later, where CMake finds an install: bench/pinocchio.cmake) on
+// the shared cases, timed by the suite as "pin_caba" (pinocchio::constrainedABA) and
+// "pin_pv" (pinocchio::pv), the two algorithms of the anchor figures
+// (docs/benchmarks.md, "Anchor figures", "Peers in the same run"). Per case: the
+// case's URDF through Pinocchio's own parser (a free flyer root_joint for a floating
+// base), one RigidConstraintModel per layout constraint (CONTACT_6D / CONTACT_3D on
+// the link's parent joint at the link frame times the layout offset, LOCAL, as the
+// layout's constraints are), and the case's state pool as is: proxgen's conventions
+// are Pinocchio's (docs/design.md, "Conventions"), which the constructor checks
+// joint by joint and with Pinocchio's ABA against proxgen's on the case's states.
+//
+// Settings: mu = 1/kMu (Pinocchio's mu is the inverse of proxgen's), max_iter = K =
+// kIterations and accuracy 0, so no call stops before its K-th iteration.
+// Pinocchio 3.7 marks the constraint models, pv, constrainedABA and initPvSolver
+// "unsupported" (their API may change) through its deprecation attribute, in its own
+// headers too: the warning says nothing about this use.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/contact-info.hpp>
+#include <pinocchio/algorithm/proximal.hpp>
+#include <pinocchio/algorithm/pv.hpp>
+#include <pinocchio/multibody/data.hpp>
+#include <pinocchio/multibody/model.hpp>
+#include <pinocchio/parsers/urdf.hpp>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algorithms/aba.hpp"
+#include "algorithms/data.hpp"
+#include "common.hpp"
+#include "model/error.hpp"
+
+namespace proxgen::bench {
+namespace {
+
+using ConstraintModels = PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pinocchio::RigidConstraintModel);
+using ConstraintDatas = PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pinocchio::RigidConstraintData);
+
+[[noreturn]] void pinocchioError(const std::string& caseName, const std::string& what) {
+  throw Error("pinocchio, case " + caseName + ": " + what);
+}
+
+pinocchio::SE3 toPinocchio(const SE3& x) { return pinocchio::SE3(x.R, x.p); }
+
+enum class Algorithm { Caba, Pv };
+
+class PinocchioSolver final : public Solver {
+ public:
+  PinocchioSolver(const BenchCase& c, Algorithm algorithm)
+      : states_(c.states), algorithm_(algorithm), settings_(0.0, 1.0 / kMu, kIterations) {
+    const Model& pm = c.sys.model;
+    if (pm.floatingBase)
+      pinocchio::urdf::buildModel(pm.sourcePath, pinocchio::JointModelFreeFlyer(), model_);
+    else
+      pinocchio::urdf::buildModel(pm.sourcePath, model_);
+    if (model_.nq != pm.nq || model_.nv != pm.nv) pinocchioError(c.name, "Pinocchio's nq, nv differ from proxgen's");
+    // The same joints in the same slots (joint 0 is Pinocchio's universe).
+    for (std::size_t i = 1; i < pm.bodies.size(); ++i) {
+      const Joint& j = pm.bodies[i].joint;
+      if (!model_.existJointName(j.name)) pinocchioError(c.name, "joint " + j.name + " is not in Pinocchio's model");
+      const pinocchio::JointIndex id = model_.getJointId(j.name);
+      if (model_.idx_qs[id] != j.idx_q || model_.idx_vs[id] != j.idx_v || model_.nqs[id] != j.nq ||
+          model_.nvs[id] != j.nv)
+        pinocchioError(c.name, "joint " + j.name + " has other slots in Pinocchio's model");
+    }
+    for (const Constraint& k : c.sys.constraints) {
+      if (k.kp != 0 || k.kd != 0)
+        pinocchioError(c.name, "constraint " + k.name + " has Baumgarte gains (Pinocchio's pv does not honour kp)");
+      if (!model_.existFrame(k.link, pinocchio::BODY)) pinocchioError(c.name, "no body frame " + k.link);
+      const pinocchio::Frame& f = model_.frames[model_.getFrameId(k.link, pinocchio::BODY)];
+      const pinocchio::ContactType type =
+          k.type == ConstraintType::Weld6D ? pinocchio::CONTACT_6D : pinocchio::CONTACT_3D;
+      models_.emplace_back(type, model_, f.parentJoint, f.placement * toPinocchio(k.offset), pinocchio::LOCAL);
+    }
+    for (const auto& m : models_) datas_.emplace_back(m);
+    data_ = std::make_unique<pinocchio::Data>(model_);
+    pinocchio::initPvSolver(model_, *data_, models_);
+
+    // Same dynamics model: Pinocchio's ABA against proxgen's on the first states, to
+    // round-off (both are the same recursion in double on the same numbers; 1e-9
+    // relative to max(1, |qdd|) leaves orders of margin over eps * cond(M)).
+    Data gd(c.sys);
+    double gap = 0;
+    for (std::size_t k = 0; k < std::min<std::size_t>(20, states_.size()); ++k) {
+      const State& s = states_[k];
+      const VecX& mine = aba(c.sys, gd, s.q, s.v, s.tau);
+      const Eigen::VectorXd theirs = pinocchio::aba(model_, *data_, s.q, s.v, s.tau);
+      gap = std::max(gap, (theirs - mine).lpNorm<Eigen::Infinity>() / std::max(1.0, mine.lpNorm<Eigen::Infinity>()));
+    }
+    if (!(gap <= 1e-9))
+      pinocchioError(c.name, "Pinocchio's ABA differs from proxgen's by " + std::to_string(gap) + " (relative)");
+    counters_ = {{"pin_aba_gap", gap}};
+  }
+
+  void solve(int k) override {
+    const State& s = states_[std::size_t(k)];
+    if (algorithm_ == Algorithm::Caba)
+      pinocchio::constrainedABA(model_, *data_, s.q, s.v, s.tau, models_, datas_, settings_);
+    else
+      pinocchio::pv(model_, *data_, s.q, s.v, s.tau, models_, datas_, settings_);
+  }
+  const void* output() const override { return data_->ddq.data(); }
+  std::vector<std::pair<std::string, double>> counters() const override { return counters_; }
+
+ private:
+  const std::vector<State>& states_;
+  Algorithm algorithm_;
+  pinocchio::Model model_;
+  std::unique_ptr<pinocchio::Data> data_;
+  ConstraintModels models_;
+  ConstraintDatas datas_;
+  pinocchio::ProximalSettings settings_;
+  std::vector<std::pair<std::string, double>> counters_;
+};
+
+}  // namespace
+
+std::unique_ptr<Solver> makePinocchioCaba(const BenchCase& c) {
+  return std::make_unique<PinocchioSolver>(c, Algorithm::Caba);
+}
+std::unique_ptr<Solver> makePinocchioPv(const BenchCase& c) {
+  return std::make_unique<PinocchioSolver>(c, Algorithm::Pv);
+}
+
+}  // namespace proxgen::bench
