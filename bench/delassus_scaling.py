@@ -6,8 +6,9 @@ For each (shape, n, m) of the sweeps below: the model from proxgen_bench_scaling
 build's compiler and proxgen_add_solver's options at -O3 beside bench/delassus_scaling.cpp;
 then its CPU time per call (median of REPETITIONS batches) and, with --callgrind, its
 instructions per call ((Ir(N) - Ir(0)) / N). Fits, per shape: the log-log slope of each sweep
-(all points and the three largest), and cost = a n + b m^2 + c by least squares over every
-point of the shape, with the largest relative residual (docs/benchmarks.md).
+(all points and the three largest), and cost = a n + b m^2 + c (and, to see whether the data
+want them, with m and m^3 terms too) by least squares over every point of the shape, with the
+largest relative residual (docs/benchmarks.md).
 
     delassus_scaling.py BUILD_DIR OUT.json [--quick] [--callgrind] [--repetitions R] [--calls N]
 """
@@ -63,25 +64,42 @@ def slope(xs, ys):
     return sum((x - mx) * (y - my) for x, y in zip(lx, ly)) / sxx if sxx > 0 else float("nan")
 
 
-def fit_linear_n_m2(rows, key):
-    """cost = a n + b m^2 + c, least squares weighted by 1/cost (relative errors)."""
-    A = [[r["n"] / r[key], r["m"] ** 2 / r[key], 1.0 / r[key]] for r in rows]
-    y = [1.0] * len(rows)
-    # Normal equations, 3 x 3, by Gaussian elimination.
-    N = [[sum(a[i] * a[j] for a in A) for j in range(3)] for i in range(3)]
-    b = [sum(a[i] * yy for a, yy in zip(A, y)) for i in range(3)]
-    for i in range(3):
-        for k in range(i + 1, 3):
-            f = N[k][i] / N[i][i]
-            for j in range(i, 3):
-                N[k][j] -= f * N[i][j]
-            b[k] -= f * b[i]
-    x = [0.0] * 3
-    for i in reversed(range(3)):
-        x[i] = (b[i] - sum(N[i][j] * x[j] for j in range(i + 1, 3))) / N[i][i]
-    res = [(x[0] * r["n"] + x[1] * r["m"] ** 2 + x[2]) / r[key] - 1.0 for r in rows]
-    return {"a_per_n": x[0], "b_per_m2": x[1], "c": x[2], "max_rel_residual": max(abs(e) for e in res),
-            "rms_rel_residual": math.sqrt(sum(e * e for e in res) / len(res))}
+# The models fitted: cost = sum of coefficient x term (n and m of the point).
+MODELS = {
+    "a n + b m^2 + c": [("n", lambda n, m: n), ("m^2", lambda n, m: m * m), ("1", lambda n, m: 1.0)],
+    # The terms the O(n + m^2) claim leaves out, to see whether the data want them.
+    "a n + b m + c m^2 + d m^3 + e": [("n", lambda n, m: n), ("m", lambda n, m: m), ("m^2", lambda n, m: m * m),
+                                      ("m^3", lambda n, m: m ** 3), ("1", lambda n, m: 1.0)],
+}
+
+
+def solve(N, b):
+    """N x = b by Gaussian elimination with partial pivoting (N small and square)."""
+    k = len(b)
+    A = [row[:] + [bb] for row, bb in zip(N, b)]
+    for i in range(k):
+        p = max(range(i, k), key=lambda r: abs(A[r][i]))
+        A[i], A[p] = A[p], A[i]
+        for r in range(i + 1, k):
+            f = A[r][i] / A[i][i]
+            for j in range(i, k + 1):
+                A[r][j] -= f * A[i][j]
+    x = [0.0] * k
+    for i in reversed(range(k)):
+        x[i] = (A[i][k] - sum(A[i][j] * x[j] for j in range(i + 1, k))) / A[i][i]
+    return x
+
+
+def fit(rows, key, model):
+    """Least squares of cost = sum c_t term_t(n, m), weighted by 1/cost (relative errors)."""
+    terms = MODELS[model]
+    A = [[t(r["n"], r["m"]) / r[key] for _, t in terms] for r in rows]
+    k = len(terms)
+    x = solve([[sum(a[i] * a[j] for a in A) for j in range(k)] for i in range(k)],
+              [sum(a[i] for a in A) for i in range(k)])
+    res = [sum(c * a for c, a in zip(x, row)) - 1.0 for row in A]
+    return {"model": model, "coefficients": {name: c for (name, _), c in zip(terms, x)},
+            "max_rel_residual": max(abs(e) for e in res), "rms_rel_residual": math.sqrt(sum(e * e for e in res) / len(res))}
 
 
 def main():
@@ -152,12 +170,13 @@ def main():
                              "slope_upper": slope(xs[-3:], ys[-3:])})
             # Every distinct (n, m) once (the sweeps share n = 32, m = 6 and n = 128, m = 6).
             distinct = {(r["n"], r["m"]): r for r in rows}
-            fits.append({"shape": shape, "cost": key, "model": "a n + b m^2 + c",
-                         **fit_linear_n_m2(list(distinct.values()), key)})
+            for model in MODELS:
+                fits.append({"shape": shape, "cost": key, **fit(list(distinct.values()), key, model)})
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out, "w") as f:
         json.dump({"points": results, "fits": fits}, f, indent=1)
-    for fit in fits:
-        print(json.dumps(fit))
+    for f in fits:
+        print(json.dumps(f))
 
 
 if __name__ == "__main__":

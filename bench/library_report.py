@@ -122,18 +122,18 @@ def scaling_tables(s):
         out.append(f"| {f['shape']} | {cost} | {what} | {f['range'][0]}–{f['range'][1]} | {f['slope_all']:.2f} | "
                    f"{f['slope_upper']:.2f} |")
     out.append("")
-    out.append("Least squares of cost = a n + b m^2 + c over every (n, m) of a shape, weighted by 1/cost "
-               "(relative residuals):")
+    out.append("Least squares over every (n, m) of a shape, weighted by 1/cost (relative residuals); "
+               "coefficients in the cost's unit:")
     out.append("")
-    out.append("| shape | cost | a (per joint) | b (per row^2) | c | largest relative residual | rms relative residual |")
-    out.append("|---|---|---|---|---|---|---|")
+    out.append("| shape | cost | model | coefficients | largest relative residual | rms relative residual |")
+    out.append("|---|---|---|---|---|---|")
     for f in fits:
         if "model" not in f:
             continue
-        cost, unit = ("time", "µs") if f["cost"] == "median_us" else ("Ir", "Ir")
-        g = (lambda x: f"{x:.4g} {unit}")
-        out.append(f"| {f['shape']} | {cost} | {g(f['a_per_n'])} | {g(f['b_per_m2'])} | {g(f['c'])} | "
-                   f"{100 * f['max_rel_residual']:.1f} % | {100 * f['rms_rel_residual']:.1f} % |")
+        cost = "time (µs)" if f["cost"] == "median_us" else "Ir"
+        coef = ", ".join(f"{name}: {c:.4g}" for name, c in f["coefficients"].items())
+        out.append(f"| {f['shape']} | {cost} | {f['model']} | {coef} | {100 * f['max_rel_residual']:.1f} % | "
+                   f"{100 * f['rms_rel_residual']:.1f} % |")
     out.append("")
     out.append("Points (CPU µs per call, median; Ir per call):")
     out.append("")
@@ -225,7 +225,8 @@ def main():
                  "compiled alone with the flags above (bench/delassus_scaling.py). Time: CPU time, median of the "
                  "repetitions of ~20 ms batches over 64 random configurations; Ir: callgrind, as above. "
                  "O(n + m^2) predicts a slope of 1 against n at fixed m, and against m at fixed n a slope that "
-                 "rises towards 2 as the m^2 part overtakes the n part.")
+                 "rises towards 2 as the m^2 part overtakes the n part. The times share the machine with other "
+                 "work and move by tens of percent from point to point: fit the instruction counts.")
         s.append("")
         s.extend(scaling_tables(scaling))
         s.append("")
