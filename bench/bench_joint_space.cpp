@@ -1,17 +1,37 @@
-// The generated joint-space functions against their generic twins in the same
-// run, per case: <case>/<function>/generated and <case>/<function>/generic
-// (inverse_dynamics with random qdd and lambda, nonlinear_effects,
-// mass_matrix = crba, mass_matrix_inverse). States (and qdd, lambda) are drawn
-// before any timing and cycled inside the timed loop, as bench_suite.cpp does.
+// The generated dynamics library against its generic twins in the same run,
+// per case: <case>/<function>/generated and <case>/<function>/generic for
+// inverse_dynamics (random qdd and lambda), nonlinear_effects, mass_matrix
+// (= crba), mass_matrix_inverse, constraint_placements, constraint_jacobian,
+// constraint_drift, delassus and delassus_inverse (mu = 1e4), and
+// <case>/delassus_inverse/route_mass_matrix: (J M^-1 J^T + I/mu)^-1 formed
+// from the generated mass_matrix and constraint_jacobian (Eigen's LLT of M,
+// then the LLT of G + I/mu and its inverse). States (and qdd, lambda) are
+// drawn before any timing and cycled inside the timed loop, as
+// bench_suite.cpp does. The cases are those of joint_space.cmake
+// (PROXGEN_BENCH_LIBRARY_CASES).
+//
+//   proxgen_bench_joint_space [Google Benchmark flags]
+//   proxgen_bench_joint_space --count CASE/FUNCTION/VARIANT N
+// --count makes N calls of one benchmark's body and nothing else, for
+// instructions per call under callgrind (bench/count_calls.py --library):
+// everything but the N calls is the same for every N (and for every function
+// of a case). Exit code 3: no such benchmark in this build.
 #include <benchmark/benchmark.h>
 
+#include <Eigen/Cholesky>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "algorithms/constraint_kinematics.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/data.hpp"
+#include "algorithms/delassus.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/rnea.hpp"
@@ -20,6 +40,8 @@
 #include "model/state.hpp"
 
 namespace {
+
+constexpr double kMu = 1e4;  // the benchmarks' mu (bench/common.hpp)
 
 // A case of cases.yaml with 1000 random states (a fixed seed), loaded once per
 // case for the whole run (the suite's pool size, bench/common.hpp).
@@ -70,71 +92,196 @@ std::shared_ptr<Inputs<Scalar>> inputsOf(const BenchCase& c) {
   return in;
 }
 
-template <class F>
-void loop(benchmark::State& st, int n, const F& call) {
-  int k = 0;
-  for (auto _ : st) {
-    call(k);
-    benchmark::ClobberMemory();
-    if (++k == n) k = 0;
-  }
+// Every benchmark body by name, in registration order: call(k) is one call on state k.
+struct Body {
+  std::string name;
+  int states, nv, nc;
+  std::function<void(int)> call;
+};
+std::vector<Body>& bodies() {
+  static std::vector<Body> b;
+  return b;
 }
 
-template <class Scalar, class Workspace, class Id, class Nle, class Mm, class Minv>
-void registerCase(const char* name, Id id, Nle nle, Mm mm, Minv minv) {
+// The route through the generated mass matrix: Eigen's fixed-size LLT of M
+// (what a user would write with the generated pieces), J M^-1 J^T + I/mu, its
+// LLT and inverse. The work matrices live for the whole run.
+template <class G>
+struct Route {
+  using Scalar = typename G::Scalar;
+  using MatM = Eigen::Matrix<Scalar, G::nv, G::nv, Eigen::RowMajor>;
+  using MatJ = Eigen::Matrix<Scalar, G::nc, G::nv, Eigen::RowMajor>;
+  using MatC = Eigen::Matrix<Scalar, G::nc, G::nc>;
+  MatM M;
+  MatJ J;
+  Eigen::Matrix<Scalar, G::nv, G::nc> MinvJt;
+  MatC A, Ginv;
+  Eigen::LLT<Eigen::Matrix<Scalar, G::nv, G::nv>> lltM;
+  Eigen::LLT<MatC> lltA;
+  void operator()(const Scalar* q, typename G::Workspace& w) {
+    G::mass_matrix(q, w, M.data());
+    G::constraint_jacobian(q, w, J.data());
+    lltM.compute(M);
+    MinvJt = lltM.solve(J.transpose());
+    A.noalias() = J * MinvJt;
+    A.diagonal().array() += Scalar(1.0 / kMu);
+    lltA.compute(A);
+    Ginv.setIdentity();
+    lltA.solveInPlace(Ginv);
+  }
+};
+
+template <class G>
+void registerCase(const char* name) {
+  using Scalar = typename G::Scalar;
   const BenchCase& c = *findCase(name);
   const auto in = inputsOf<Scalar>(c);
-  const auto ws = std::make_shared<Workspace>();
-  const auto out = std::make_shared<std::vector<Scalar>>(std::size_t(in->nv * in->nv + 1));
+  const auto ws = std::make_shared<typename G::Workspace>();
+  const int nv = in->nv, nc = in->nc;
+  const auto out = std::make_shared<std::vector<Scalar>>(std::size_t(std::max({nv * nv, nc * nc, 12 * G::ncons, 1})));
   const auto data = std::make_shared<proxgen::Data>(c.sys);
+  const auto settings = std::make_shared<typename G::Settings>();
+  settings->mu = Scalar(kMu);
+  const auto route = std::make_shared<Route<G>>();
   const std::string base = c.name + "/";
-  const auto reg = [&](const std::string& what, auto call) {
-    benchmark::RegisterBenchmark((base + what).c_str(), [=](benchmark::State& st) { loop(st, in->n, call); })
-        ->Unit(benchmark::kMicrosecond);
+  const auto reg = [&](const std::string& what, std::function<void(int)> call) {
+    bodies().push_back({base + what, in->n, nv, nc, std::move(call)});
   };
+  const auto q = [in](int k) { return in->at(in->q, in->nq, k); };
+  const auto v = [in](int k) { return in->at(in->v, in->nv, k); };
+  const auto s = [&c](int k) -> const proxgen::State& { return c.states[std::size_t(k)]; };
   reg("inverse_dynamics/generated", [=](int k) {
-    id(in->at(in->q, in->nq, k), in->at(in->v, in->nv, k), in->at(in->qdd, in->nv, k), in->at(in->lambda, in->nc, k), *ws,
-       out->data());
+    G::inverse_dynamics(q(k), v(k), in->at(in->qdd, nv, k), in->at(in->lambda, nc, k), *ws, out->data());
     benchmark::DoNotOptimize(out->data());
   });
   reg("inverse_dynamics/generic", [=, &c](int k) {
-    benchmark::DoNotOptimize(
-        proxgen::inverseDynamics(c.sys, *data, c.states[std::size_t(k)].q, c.states[std::size_t(k)].v,
-                                 in->qdd64[std::size_t(k)], c.sys.nc ? &in->lambda64[std::size_t(k)] : nullptr)
-            .data());
+    benchmark::DoNotOptimize(proxgen::inverseDynamics(c.sys, *data, s(k).q, s(k).v, in->qdd64[std::size_t(k)],
+                                                      nc ? &in->lambda64[std::size_t(k)] : nullptr)
+                                 .data());
   });
   reg("nonlinear_effects/generated", [=](int k) {
-    nle(in->at(in->q, in->nq, k), in->at(in->v, in->nv, k), *ws, out->data());
+    G::nonlinear_effects(q(k), v(k), *ws, out->data());
     benchmark::DoNotOptimize(out->data());
   });
   reg("nonlinear_effects/generic", [=, &c](int k) {
-    benchmark::DoNotOptimize(
-        proxgen::nonLinearEffects(c.sys, *data, c.states[std::size_t(k)].q, c.states[std::size_t(k)].v).data());
+    benchmark::DoNotOptimize(proxgen::nonLinearEffects(c.sys, *data, s(k).q, s(k).v).data());
   });
   reg("mass_matrix/generated", [=](int k) {
-    mm(in->at(in->q, in->nq, k), *ws, out->data());
+    G::mass_matrix(q(k), *ws, out->data());
     benchmark::DoNotOptimize(out->data());
   });
-  reg("mass_matrix/generic", [=, &c](int k) {
-    benchmark::DoNotOptimize(proxgen::crba(c.sys, *data, c.states[std::size_t(k)].q).data());
-  });
+  reg("mass_matrix/generic", [=, &c](int k) { benchmark::DoNotOptimize(proxgen::crba(c.sys, *data, s(k).q).data()); });
   reg("mass_matrix_inverse/generated", [=](int k) {
-    minv(in->at(in->q, in->nq, k), *ws, out->data());
+    G::mass_matrix_inverse(q(k), *ws, out->data());
     benchmark::DoNotOptimize(out->data());
   });
   reg("mass_matrix_inverse/generic", [=, &c](int k) {
-    benchmark::DoNotOptimize(proxgen::massMatrixInverse(c.sys, *data, c.states[std::size_t(k)].q).data());
+    benchmark::DoNotOptimize(proxgen::massMatrixInverse(c.sys, *data, s(k).q).data());
+  });
+  reg("constraint_placements/generated", [=](int k) {
+    G::constraint_placements(q(k), *ws, out->data());
+    benchmark::DoNotOptimize(out->data());
+  });
+  reg("constraint_placements/generic", [=, &c](int k) {
+    benchmark::DoNotOptimize(proxgen::constraintPlacements(c.sys, *data, s(k).q).data());
+  });
+  reg("constraint_jacobian/generated", [=](int k) {
+    G::constraint_jacobian(q(k), *ws, out->data());
+    benchmark::DoNotOptimize(out->data());
+  });
+  reg("constraint_jacobian/generic", [=, &c](int k) {
+    benchmark::DoNotOptimize(proxgen::constraintJacobianRows(c.sys, *data, s(k).q).data());
+  });
+  reg("constraint_drift/generated", [=](int k) {
+    G::constraint_drift(q(k), v(k), *ws, out->data());
+    benchmark::DoNotOptimize(out->data());
+  });
+  reg("constraint_drift/generic", [=, &c](int k) {
+    benchmark::DoNotOptimize(proxgen::constraintDrift(c.sys, *data, s(k).q, s(k).v).data());
+  });
+  reg("delassus/generated", [=](int k) {
+    G::delassus(q(k), *ws, out->data());
+    benchmark::DoNotOptimize(out->data());
+  });
+  reg("delassus/generic", [=, &c](int k) { benchmark::DoNotOptimize(proxgen::delassus(c.sys, *data, s(k).q).data()); });
+  reg("delassus_inverse/generated", [=](int k) {
+    G::delassus_inverse(q(k), *settings, *ws, out->data());
+    benchmark::DoNotOptimize(out->data());
+  });
+  reg("delassus_inverse/generic", [=, &c](int k) {
+    benchmark::DoNotOptimize(proxgen::delassusInverse(c.sys, *data, s(k).q, kMu).data());
+  });
+  reg("delassus_inverse/route_mass_matrix", [=](int k) {
+    (*route)(q(k), *ws);
+    benchmark::DoNotOptimize(route->Ginv.data());
   });
 }
 
-#define PROXGEN_BENCH_REGISTER(CASE, NS)                                                                            \
-  registerCase<NS::Scalar, NS::Workspace>(#CASE, NS::inverse_dynamics, NS::nonlinear_effects, NS::mass_matrix, \
-                                          NS::mass_matrix_inverse);
+void timed(benchmark::State& st, const Body* b) {
+  int k = 0;
+  for (auto _ : st) {
+    b->call(k);
+    benchmark::ClobberMemory();
+    if (++k == b->states) k = 0;
+  }
+  st.counters["nv"] = b->nv;
+  st.counters["nc"] = b->nc;
+}
 
 }  // namespace
 
+// One generated namespace's functions as a type, for registerCase.
+#define PROXGEN_BENCH_API(CASE, NS)                                                                             \
+  namespace api_##CASE {                                                                                        \
+  struct G {                                                                                                    \
+    using Scalar = NS::Scalar;                                                                                  \
+    using Workspace = NS::Workspace;                                                                            \
+    using Settings = NS::Settings;                                                                              \
+    static constexpr int nv = NS::nv, nc = NS::nc, ncons = NS::ncons;                                           \
+    static constexpr auto inverse_dynamics = &NS::inverse_dynamics;                                             \
+    static constexpr auto nonlinear_effects = &NS::nonlinear_effects;                                           \
+    static constexpr auto mass_matrix = &NS::mass_matrix;                                                       \
+    static constexpr auto mass_matrix_inverse = &NS::mass_matrix_inverse;                                       \
+    static constexpr auto constraint_placements = &NS::constraint_placements;                                   \
+    static constexpr auto constraint_jacobian = &NS::constraint_jacobian;                                       \
+    static constexpr auto constraint_drift = &NS::constraint_drift;                                             \
+    static constexpr auto delassus = &NS::delassus;                                                             \
+    static constexpr auto delassus_inverse = &NS::delassus_inverse;                                             \
+  };                                                                                                            \
+  }
+PROXGEN_BENCH_JOINT_SPACE_CASES(PROXGEN_BENCH_API)
+#undef PROXGEN_BENCH_API
+
 int main(int argc, char** argv) {
+  const bool count = argc >= 2 && std::strcmp(argv[1], "--count") == 0;
+  if (count && argc != 4) {
+    std::fprintf(stderr, "usage: %s --count CASE/FUNCTION/VARIANT N\n", argv[0]);
+    return 1;
+  }
+  // --count loads only its case: the same work whatever the function, so one
+  // run with N = 0 is the baseline of all of them.
+  const std::string only = count ? std::string(argv[2]).substr(0, std::string(argv[2]).find('/')) : "";
+#define PROXGEN_BENCH_REGISTER(CASE, NS) \
+  if (only.empty() || only == #CASE) registerCase<api_##CASE::G>(#CASE);
   PROXGEN_BENCH_JOINT_SPACE_CASES(PROXGEN_BENCH_REGISTER)
+#undef PROXGEN_BENCH_REGISTER
+  if (count) {
+    for (const Body& b : bodies()) {
+      if (b.name != argv[2]) continue;
+      const long n = std::stol(argv[3]);
+      int k = 0;
+      for (long call = 0; call < n; ++call) {
+        b.call(k);
+        benchmark::ClobberMemory();
+        if (++k == b.states) k = 0;
+      }
+      return 0;
+    }
+    std::fprintf(stderr, "proxgen_bench_joint_space: no benchmark %s in this build\n", argv[2]);
+    return 3;
+  }
+  for (const Body& b : bodies())
+    benchmark::RegisterBenchmark(b.name.c_str(), timed, &b)->Unit(benchmark::kMicrosecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -7,6 +7,11 @@ model, drawing the states and building the work space cost the same in both
 runs, so only the calls remain. Deterministic (same states, same code).
 
     count_calls.py BUILD_DIR OUT.json [--calls N] [--cases a,b] [--algorithms x,y]
+    count_calls.py BUILD_DIR OUT.json --library [--calls N] [--cases a,b] [--algorithms f/variant,...]
+
+--library counts the dynamics library's benchmarks instead (proxgen_bench_joint_space
+--count CASE/FUNCTION/VARIANT N, bench_joint_space.cpp): each generated function, its
+generic twin and the route to delassus_inverse through the generated mass_matrix.
 """
 import argparse
 import json
@@ -17,7 +22,11 @@ import sys
 import tempfile
 
 ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"]
-NOT_BUILT = 3  # proxgen_bench_calls' exit code for an algorithm this build lacks
+LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse",
+                                        "constraint_placements", "constraint_jacobian", "constraint_drift",
+                                        "delassus", "delassus_inverse"]
+           for variant in ("generated", "generic")] + ["delassus_inverse/route_mass_matrix"]
+NOT_BUILT = 3  # proxgen_bench_calls' (and --count's) exit code for what this build lacks
 
 
 def case_names(cases_yaml):
@@ -27,9 +36,11 @@ def case_names(cases_yaml):
 
 
 def instructions(driver, case, algorithm, calls, workdir):
-    """Total Ir of one run, or None when the algorithm is not built."""
-    out = os.path.join(workdir, f"callgrind.{case}.{algorithm}.{calls}")
-    cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", driver, case, algorithm, str(calls)]
+    """Total Ir of one run, or None when the algorithm is not built. driver is a list:
+    the executable, and --count for the library's."""
+    out = os.path.join(workdir, f"callgrind.{case}.{algorithm.replace('/', '.')}.{calls}")
+    what = [f"{case}/{algorithm}"] if len(driver) > 1 else [case, algorithm]
+    cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *driver, *what, str(calls)]
     run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if run.returncode == NOT_BUILT:
         return None
@@ -48,23 +59,34 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--calls", type=int, default=1000)
     ap.add_argument("--cases", help="comma-separated (default: every case of cases.yaml)")
-    ap.add_argument("--algorithms", default=",".join(ALGORITHMS))
+    ap.add_argument("--algorithms", help="comma-separated (default: every solver, or with --library every "
+                    "function/variant)")
+    ap.add_argument("--library", action="store_true", help="the dynamics library (proxgen_bench_joint_space)")
     args = ap.parse_args()
+    algorithms = args.algorithms.split(",") if args.algorithms else (LIBRARY if args.library else ALGORITHMS)
 
     with open(os.path.join(args.build_dir, "CMakeCache.txt")) as f:
         models = re.search(r"^PROXGEN_MODELS_DIR:PATH=(.*)$", f.read(), re.M).group(1)
     cases = args.cases.split(",") if args.cases else case_names(os.path.join(models, "cases.yaml"))
-    driver = os.path.join(args.build_dir, "bench", "proxgen_bench_calls")
+    if args.library:
+        driver = [os.path.join(args.build_dir, "bench", "proxgen_bench_joint_space"), "--count"]
+    else:
+        driver = [os.path.join(args.build_dir, "bench", "proxgen_bench_calls")]
 
     results = []
+    baselines = {}
     with tempfile.TemporaryDirectory(prefix="proxgen-callgrind-") as work:
         for case in cases:
-            for algorithm in args.algorithms.split(","):
+            for algorithm in algorithms:
                 full = instructions(driver, case, algorithm, args.calls, work)
                 if full is None:
                     print(f"{case:26s} {algorithm:9s} not built", flush=True)
                     continue
-                base = instructions(driver, case, algorithm, 0, work)
+                # The library driver's run without calls is the same for every function of a case.
+                key = case if args.library else (case, algorithm)
+                if key not in baselines:
+                    baselines[key] = instructions(driver, case, algorithm, 0, work)
+                base = baselines[key]
                 per_call = (full - base) / args.calls
                 results.append({"case": case, "algorithm": algorithm, "ir_per_call": per_call,
                                 "ir_total": full, "ir_baseline": base, "calls": args.calls})

@@ -13,7 +13,11 @@
 #   MARCH [native]    -march of the whole build (PROXGEN_MARCH); MARCH= for the
 #                     compiler's default (x86-64 baseline)
 #   CMAKE_ARGS []     extra configure arguments, e.g. -DPROXGEN_BENCH_GENERATED=OFF
-#   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE, SKIP_PYTHON: set to 1 to leave that part out
+#   SKIP_CALLGRIND, SKIP_SCALING, SKIP_COMPILE, SKIP_PYTHON, SKIP_LIBRARY: set to 1 to leave that part out
+# The dynamics library's section (bench_joint_space.cpp on every case,
+# count_calls.py --library, delassus_scaling.py, library_report.py) comes after
+# report.py, which rewrites RESULTS.md without it. valgrind 3.19 cannot decode
+# AVX-512: on such a machine run with MARCH= for the instruction counts.
 set -eu
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -28,7 +32,7 @@ march=${MARCH-native}
 echo "== configure and build ($build, Release)"
 # shellcheck disable=SC2086  # CMAKE_ARGS is a list of arguments
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPROXGEN_BENCH_REUSE_TEST_SOLVERS=OFF \
-  -DPROXGEN_MARCH="$march" ${CMAKE_ARGS:-} >/dev/null
+  -DPROXGEN_MARCH="$march" -DPROXGEN_BENCH_LIBRARY_CASES=ALL ${CMAKE_ARGS:-} >/dev/null
 # The Python part needs the package's build (PROXGEN_BUILD_PYTHON) and the test
 # module of the example quadruped (tests/python, PROXGEN_BUILD_TESTS).
 python_targets=""
@@ -90,3 +94,23 @@ set -- --build "$build" --suite "$results/suite.json" --out-dir "$here" \
 [ -n "$python_json" ] && set -- "$@" --python "$python_json"
 [ "${SKIP_COMPILE:-0}" = 1 ] && set -- "$@" --no-compile
 python3 "$here/report.py" "$@"
+
+if [ "${SKIP_LIBRARY:-0}" != 1 ]; then
+  echo "== the dynamics library against its generic twins"
+  load=$(cut -d' ' -f1-3 /proc/loadavg | sed 's/ /, /g')
+  # shellcheck disable=SC2086
+  "$build/bench/proxgen_bench_joint_space" $gbench_flags --benchmark_out="$results/library.json"
+  set -- --build "$build" --timings "$results/library.json" --results "$here/RESULTS.md" --load "$load" \
+    --command "bench/run.sh (REPETITIONS=$reps MIN_TIME=$min_time CALLS=${CALLS:-1000} MARCH=$march): proxgen_bench_joint_space, count_calls.py --library, delassus_scaling.py"
+  if [ "${SKIP_CALLGRIND:-0}" != 1 ] && command -v valgrind >/dev/null; then
+    python3 "$here/count_calls.py" "$build" "$results/library-calls.json" --library --calls "${CALLS:-1000}"
+    set -- "$@" --calls "$results/library-calls.json"
+  fi
+  if [ "${SKIP_SCALING:-0}" != 1 ]; then
+    cg=""
+    [ "${SKIP_CALLGRIND:-0}" != 1 ] && command -v valgrind >/dev/null && cg=--callgrind
+    python3 "$here/delassus_scaling.py" "$build" "$results/delassus-scaling.json" $cg
+    set -- "$@" --scaling "$results/delassus-scaling.json"
+  fi
+  python3 "$here/library_report.py" "$@"
+fi
