@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1130 + 316 K (= 2078 at K = 3)
-//     add/sub 482 + 139 K, mul 606 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
-//     add/sub 880 + 26 K, mul 1192 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1131 + 322 K (= 2097 at K = 3)
+//     add/sub 482 + 139 K, mul 607 + 169 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2182 + 72 K (= 2398 at K = 3)
+//     add/sub 880 + 26 K, mul 1220 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 
 #include "arm.hpp"
 
@@ -177,19 +177,20 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRI
 PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    w.U_wrist_3_link[5] = 0.0003695625 + mu;
+    const Scalar mu_c0 = mu*w.active[0];
+    w.U_wrist_3_link[5] = 0.0003695625 + mu_c0;
     w.Dinv_wrist_3_link = 1.0 / w.U_wrist_3_link[5];
     w.u_wrist_3_link[0] = -w.pA_wrist_3_link[5] - w.lambda[5] + tau[5];
     const Scalar t0 = w.U_wrist_3_link[5]*w.Dinv_wrist_3_link;
-    const Scalar Ia0 = 0.365 + mu;
-    const Scalar Ia1 = 0.035930965 + 0.0996*mu;
-    const Scalar Ia2 = -0.035930965 - 0.0996*mu;
-    const Scalar Ia3 = 0.003770528042232001 + 1.00992016*mu;
-    const Scalar pa0 = w.pA_wrist_3_link[0] + w.lambda[0] + w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
-    const Scalar pa1 = w.pA_wrist_3_link[1] + w.lambda[1] + w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
-    const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu;
-    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
-    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
+    const Scalar Ia0 = 0.365 + mu_c0;
+    const Scalar Ia1 = 0.035930965 + 0.0996*mu_c0;
+    const Scalar Ia2 = -0.035930965 - 0.0996*mu_c0;
+    const Scalar Ia3 = 0.003770528042232001 + 1.00992016*mu_c0;
+    const Scalar pa0 = w.pA_wrist_3_link[0] + w.lambda[0] + w.g_wrist_3_link[0]*mu_c0 + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
+    const Scalar pa1 = w.pA_wrist_3_link[1] + w.lambda[1] + w.g_wrist_3_link[1]*mu_c0 + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
+    const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu_c0;
+    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu_c0 + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
+    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu_c0 + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
     const Scalar pa5 = w.pA_wrist_3_link[5] + w.lambda[5] + w.u_wrist_3_link[0]*t0;
     const Scalar C20 = w.cq_wrist_3_link*w.cq_wrist_3_link - w.sq_wrist_3_link*w.sq_wrist_3_link;
     const Scalar t1 = 0.5*(Ia1 + Ia2);
@@ -672,24 +673,27 @@ PROXGEN_RT_NOINLINE void caba_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRIC
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_wrist_3_link[3];
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_wrist_3_link[4];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
@@ -887,24 +891,27 @@ PROXGEN_RT_NOINLINE void caba_reforward_wrist_3_link(Workspace& PROXGEN_RT_RESTR
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_wrist_3_link[3];
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_wrist_3_link[4];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
@@ -1497,80 +1504,98 @@ PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RES
   }
   // free row accelerations y_free = K a - k (tree order)
   {
-    w.yfree[0] = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.yfree[1] = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.yfree[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.yfree[3] = w.a_wrist_3_link[3];
-    w.yfree[4] = w.a_wrist_3_link[4];
-    w.yfree[5] = w.a_wrist_3_link[5];
+    const Scalar t7 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
+    w.yfree[0] = t7*w.active[0];
+    const Scalar t8 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
+    w.yfree[1] = w.active[0]*t8;
+    const Scalar t9 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.yfree[2] = w.active[0]*t9;
+    w.yfree[3] = w.a_wrist_3_link[3]*w.active[0];
+    w.yfree[4] = w.a_wrist_3_link[4]*w.active[0];
+    w.yfree[5] = w.a_wrist_3_link[5]*w.active[0];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_2(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_shoulder_link[0]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[0]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[5][0] + inv_mu;
-    const Scalar r0 = std::sqrt(t0);
+    const Scalar t0 = w.KSD_shoulder_link[0]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[0]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[5][0];
+    const Scalar t1 = w.active[0]*t0 + inv_mu;
+    const Scalar r0 = std::sqrt(t1);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
-    const Scalar t1 = w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][0];
-    w.L[1] = w.Linv[0]*t1;
-    const Scalar t2 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][0];
-    w.L[2] = w.Linv[0]*t2;
-    const Scalar t3 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][0];
-    w.L[3] = w.Linv[0]*t3;
-    const Scalar t4 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][0];
-    w.L[4] = w.Linv[0]*t4;
+    const Scalar t2 = w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][0];
+    const Scalar t3 = w.active[0]*t2;
+    w.L[1] = w.Linv[0]*t3;
+    const Scalar t4 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][0];
+    const Scalar t5 = w.active[0]*t4;
+    w.L[2] = w.Linv[0]*t5;
+    const Scalar t6 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][0];
+    const Scalar t7 = w.active[0]*t6;
+    w.L[3] = w.Linv[0]*t7;
+    const Scalar t8 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][0];
+    const Scalar t9 = w.active[0]*t8;
+    w.L[4] = w.Linv[0]*t9;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t5 = inv_mu + w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[1];
-    const Scalar r1 = std::sqrt(t5);
+    const Scalar t10 = w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][1];
+    const Scalar t11 = inv_mu + w.active[0]*t10 - w.L[1]*w.L[1];
+    const Scalar r1 = std::sqrt(t11);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t6 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][1] - w.L[1]*w.L[2];
-    w.L[7] = w.Linv[1]*t6;
-    const Scalar t7 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[3];
-    w.L[8] = w.Linv[1]*t7;
-    const Scalar t8 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[4];
-    w.L[9] = w.Linv[1]*t8;
+    const Scalar t12 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][1];
+    const Scalar t13 = w.active[0]*t12 - w.L[1]*w.L[2];
+    w.L[7] = w.Linv[1]*t13;
+    const Scalar t14 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][1];
+    const Scalar t15 = w.active[0]*t14 - w.L[1]*w.L[3];
+    w.L[8] = w.Linv[1]*t15;
+    const Scalar t16 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][1];
+    const Scalar t17 = w.active[0]*t16 - w.L[1]*w.L[4];
+    w.L[9] = w.Linv[1]*t17;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[2] - w.L[7]*w.L[7];
-    const Scalar r2 = std::sqrt(t9);
+    const Scalar t18 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][2];
+    const Scalar t19 = inv_mu + w.active[0]*t18 - w.L[2]*w.L[2] - w.L[7]*w.L[7];
+    const Scalar r2 = std::sqrt(t19);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    const Scalar t10 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[3] - w.L[7]*w.L[8];
-    w.L[12] = w.Linv[2]*t10;
-    const Scalar t11 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[4] - w.L[7]*w.L[9];
-    w.L[13] = w.Linv[2]*t11;
-  }
-  // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t12 = inv_mu + w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
-    const Scalar r3 = std::sqrt(t12);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[3] = inv3;
-    const Scalar t13 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
-    w.L[16] = w.Linv[3]*t13;
-  }
-  // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t14 = inv_mu + w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][4] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][4] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][4] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][4] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][4] - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
-    const Scalar r4 = std::sqrt(t14);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[4] = inv4;
+    const Scalar t20 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][2];
+    const Scalar t21 = w.active[0]*t20 - w.L[2]*w.L[3] - w.L[7]*w.L[8];
+    w.L[12] = w.Linv[2]*t21;
+    const Scalar t22 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][2];
+    const Scalar t23 = w.active[0]*t22 - w.L[2]*w.L[4] - w.L[7]*w.L[9];
+    w.L[13] = w.Linv[2]*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_5(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_3_to_column_5(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t0 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][3];
+    const Scalar t1 = w.active[0]*t0 + inv_mu - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
+    const Scalar r0 = std::sqrt(t1);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[3] = inv0;
+    const Scalar t2 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][3];
+    const Scalar t3 = w.active[0]*t2 - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
+    w.L[16] = w.Linv[3]*t3;
+  }
+  // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t4 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][4] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][4] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][4] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][4] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][4];
+    const Scalar t5 = inv_mu + w.active[0]*t4 - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
+    const Scalar r1 = std::sqrt(t5);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[4] = inv1;
+  }
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = 2705.9022492812446 + inv_mu;
-    const Scalar r0 = std::sqrt(t0);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[5] = inv0;
+    const Scalar t6 = 2705.9022492812446*w.active[0] + inv_mu;
+    const Scalar r2 = std::sqrt(t6);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[5] = inv2;
   }
 }
 
@@ -1697,12 +1722,15 @@ PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // residual rows K a - k (layout order)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.residual[3] = w.a_wrist_3_link[3];
-    w.residual[4] = w.a_wrist_3_link[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = t0*w.active[0];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
   }
 }
 
@@ -1721,15 +1749,17 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
+  w.active[0] = Scalar(s.active[0]);
   kinematics(q, v, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
+  const Scalar* const lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_wrist_3_link(tau, mu, w);
   caba_backward_wrist_2_link(tau, w);
@@ -1771,6 +1801,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 // matrix G + I/mu factored once at the root, K proximal solves, one forward sweep.
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
+  w.active[0] = Scalar(s.active[0]);
   kinematics(q, v, w);
   // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
   pv_backward_wrist_3_link_to_wrist_2_link(tau, w);
@@ -1783,16 +1814,17 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_free_wrist_3_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
-  pv_delassus_column_0_to_column_4(inv_mu, w);
-  pv_delassus_column_5(inv_mu, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  pv_delassus_column_0_to_column_2(inv_mu, w);
+  pv_delassus_column_3_to_column_5(inv_mu, w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
+  const Scalar* const lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu
