@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 1131 + 322 K (= 2097 at K = 3)
 //     add/sub 482 + 139 K, mul 607 + 169 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2182 + 72 K (= 2398 at K = 3)
-//     add/sub 880 + 26 K, mul 1220 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   prox_pv: 2166 + 72 K (= 2382 at K = 3)
+//     add/sub 880 + 26 K, mul 1204 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line

@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
 //     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16825 + 650 K (= 18775 at K = 3)
-//     add/sub 6655 + 285 K, mul 9751 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
+//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 
 #include "humanoid.hpp"
 
@@ -8111,279 +8111,228 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_2(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_3(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[0]*w.KA_l_thigh[4][0] + w.KSD_l_shank[0]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[4][0];
-    const Scalar t1 = w.active[0]*t0 + inv_mu;
-    const Scalar r0 = std::sqrt(t1);
+    const Scalar t0 = w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[0]*w.KA_l_thigh[4][0] + w.KSD_l_shank[0]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[4][0] + inv_mu;
+    const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
-    const Scalar t2 = w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][0] + w.KSD_l_shank[1]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][0];
-    const Scalar t3 = w.active[0]*t2;
-    w.L[1] = w.Linv[0]*t3;
-    const Scalar t4 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][0] + w.KSD_l_shank[2]*w.KA_l_shank[4][0];
-    const Scalar t5 = w.active[0]*t4;
-    w.L[2] = w.Linv[0]*t5;
-    const Scalar t6 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][0] + w.KSD_l_shank[3]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][0];
-    const Scalar t7 = w.active[0]*t6;
-    w.L[3] = w.Linv[0]*t7;
-    const Scalar t8 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][0] + w.KSD_l_shank[4]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][0];
-    const Scalar t9 = w.active[0]*t8;
-    w.L[4] = w.Linv[0]*t9;
-    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][0] + w.KSD_l_shank[5]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][0];
-    const Scalar t11 = w.active[0]*t10;
-    w.L[5] = w.Linv[0]*t11;
+    const Scalar t1 = w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][0] + w.KSD_l_shank[1]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][0];
+    w.L[1] = w.Linv[0]*t1;
+    const Scalar t2 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][0] + w.KSD_l_shank[2]*w.KA_l_shank[4][0];
+    w.L[2] = w.Linv[0]*t2;
+    const Scalar t3 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][0] + w.KSD_l_shank[3]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][0];
+    w.L[3] = w.Linv[0]*t3;
+    const Scalar t4 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][0] + w.KSD_l_shank[4]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][0];
+    w.L[4] = w.Linv[0]*t4;
+    const Scalar t5 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][0] + w.KSD_l_shank[5]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][0];
+    w.L[5] = w.Linv[0]*t5;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = 2.394677145741774 + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][1] + w.KSD_l_shank[1]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][1];
-    const Scalar t13 = inv_mu + w.active[0]*t12 - w.L[1]*w.L[1];
-    const Scalar r1 = std::sqrt(t13);
+    const Scalar t6 = 2.394677145741774 + inv_mu + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][1] + w.KSD_l_shank[1]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[1];
+    const Scalar r1 = std::sqrt(t6);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t14 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][1] + w.KSD_l_shank[2]*w.KA_l_shank[4][1];
-    const Scalar t15 = w.active[0]*t14 - w.L[1]*w.L[2];
-    w.L[16] = w.Linv[1]*t15;
-    const Scalar t16 = 35.0868446262531 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][1] + w.KSD_l_shank[3]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][1];
-    const Scalar t17 = w.active[0]*t16 - w.L[1]*w.L[3];
-    w.L[17] = w.Linv[1]*t17;
-    const Scalar t18 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][1] + w.KSD_l_shank[4]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][1];
-    const Scalar t19 = w.active[0]*t18 - w.L[1]*w.L[4];
-    w.L[18] = w.Linv[1]*t19;
-    const Scalar t20 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][1] + w.KSD_l_shank[5]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][1];
-    const Scalar t21 = w.active[0]*t20 - w.L[1]*w.L[5];
-    w.L[19] = w.Linv[1]*t21;
+    const Scalar t7 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][1] + w.KSD_l_shank[2]*w.KA_l_shank[4][1] - w.L[1]*w.L[2];
+    w.L[16] = w.Linv[1]*t7;
+    const Scalar t8 = 35.0868446262531 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][1] + w.KSD_l_shank[3]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[3];
+    w.L[17] = w.Linv[1]*t8;
+    const Scalar t9 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][1] + w.KSD_l_shank[4]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[4];
+    w.L[18] = w.Linv[1]*t9;
+    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][1] + w.KSD_l_shank[5]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[5];
+    w.L[19] = w.Linv[1]*t10;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t22 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][2] + w.KSD_l_shank[2]*w.KA_l_shank[4][2];
-    const Scalar t23 = inv_mu + w.active[0]*t22 - w.L[2]*w.L[2] - w.L[16]*w.L[16];
-    const Scalar r2 = std::sqrt(t23);
+    const Scalar t11 = inv_mu + w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][2] + w.KSD_l_shank[2]*w.KA_l_shank[4][2] - w.L[2]*w.L[2] - w.L[16]*w.L[16];
+    const Scalar r2 = std::sqrt(t11);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    const Scalar t24 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][2] + w.KSD_l_shank[3]*w.KA_l_shank[4][2];
-    const Scalar t25 = w.active[0]*t24 - w.L[2]*w.L[3] - w.L[16]*w.L[17];
-    w.L[30] = w.Linv[2]*t25;
-    const Scalar t26 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][2] + w.KSD_l_shank[4]*w.KA_l_shank[4][2];
-    const Scalar t27 = w.active[0]*t26 - w.L[2]*w.L[4] - w.L[16]*w.L[18];
-    w.L[31] = w.Linv[2]*t27;
-    const Scalar t28 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][2] + w.KSD_l_shank[5]*w.KA_l_shank[4][2];
-    const Scalar t29 = w.active[0]*t28 - w.L[2]*w.L[5] - w.L[16]*w.L[19];
-    w.L[32] = w.Linv[2]*t29;
+    const Scalar t12 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][2] + w.KSD_l_shank[3]*w.KA_l_shank[4][2] - w.L[2]*w.L[3] - w.L[16]*w.L[17];
+    w.L[30] = w.Linv[2]*t12;
+    const Scalar t13 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][2] + w.KSD_l_shank[4]*w.KA_l_shank[4][2] - w.L[2]*w.L[4] - w.L[16]*w.L[18];
+    w.L[31] = w.Linv[2]*t13;
+    const Scalar t14 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][2] + w.KSD_l_shank[5]*w.KA_l_shank[4][2] - w.L[2]*w.L[5] - w.L[16]*w.L[19];
+    w.L[32] = w.Linv[2]*t14;
+  }
+  // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t15 = 514.0929615568219 + inv_mu + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][3] + w.KSD_l_shank[3]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
+    const Scalar r3 = std::sqrt(t15);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[3] = inv3;
+    const Scalar t16 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][3] + w.KSD_l_shank[4]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[4] - w.L[17]*w.L[18] - w.L[30]*w.L[31];
+    w.L[43] = w.Linv[3]*t16;
+    const Scalar t17 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][3] + w.KSD_l_shank[5]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
+    w.L[44] = w.Linv[3]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_3_to_column_6(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t0 = 514.0929615568219 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][3] + w.KSD_l_shank[3]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][3];
-    const Scalar t1 = w.active[0]*t0 + inv_mu - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
-    const Scalar r0 = std::sqrt(t1);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[3] = inv0;
-    const Scalar t2 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][3] + w.KSD_l_shank[4]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][3];
-    const Scalar t3 = w.active[0]*t2 - w.L[3]*w.L[4] - w.L[17]*w.L[18] - w.L[30]*w.L[31];
-    w.L[43] = w.Linv[3]*t3;
-    const Scalar t4 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][3] + w.KSD_l_shank[5]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][3];
-    const Scalar t5 = w.active[0]*t4 - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
-    w.L[44] = w.Linv[3]*t5;
-  }
+PROXGEN_RT_NOINLINE void pv_delassus_column_4_to_column_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][4] + w.KSD_l_shank[4]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][4];
-    const Scalar t7 = inv_mu + w.active[0]*t6 - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
-    const Scalar r1 = std::sqrt(t7);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[4] = inv1;
-    const Scalar t8 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][4] + w.KSD_l_shank[5]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][4];
-    const Scalar t9 = w.active[0]*t8 - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
-    w.L[55] = w.Linv[4]*t9;
+    const Scalar t0 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][4] + w.KSD_l_shank[4]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][4] + inv_mu - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[4] = inv0;
+    const Scalar t1 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][4] + w.KSD_l_shank[5]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][4] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
+    w.L[55] = w.Linv[4]*t1;
   }
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][5] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][5] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][5] + w.KSD_l_shank[5]*w.KA_l_shank[4][5] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][5];
-    const Scalar t11 = inv_mu + w.active[0]*t10 - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
-    const Scalar r2 = std::sqrt(t11);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[5] = inv2;
+    const Scalar t2 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][5] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][5] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][5] + w.KSD_l_shank[5]*w.KA_l_shank[4][5] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][5] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
+    const Scalar r1 = std::sqrt(t2);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[5] = inv1;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[0]*w.KA_r_thigh[4][0] + w.KSD_r_shank[0]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4][0];
-    const Scalar t13 = inv_mu + w.active[1]*t12;
-    const Scalar r3 = std::sqrt(t13);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[6] = inv3;
-    const Scalar t14 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][0] + w.KSD_r_shank[1]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][0];
-    const Scalar t15 = w.active[1]*t14;
-    w.L[76] = w.Linv[6]*t15;
-    const Scalar t16 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][0] + w.KSD_r_shank[2]*w.KA_r_shank[4][0];
-    const Scalar t17 = w.active[1]*t16;
-    w.L[77] = w.Linv[6]*t17;
-    const Scalar t18 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][0] + w.KSD_r_shank[3]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][0];
-    const Scalar t19 = w.active[1]*t18;
-    w.L[78] = w.Linv[6]*t19;
-    const Scalar t20 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][0] + w.KSD_r_shank[4]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][0];
-    const Scalar t21 = w.active[1]*t20;
-    w.L[79] = w.Linv[6]*t21;
-    const Scalar t22 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][0] + w.KSD_r_shank[5]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][0];
-    const Scalar t23 = w.active[1]*t22;
-    w.L[80] = w.Linv[6]*t23;
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[0]*w.KA_r_thigh[4][0] + w.KSD_r_shank[0]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4][0];
+    const Scalar r2 = std::sqrt(t3);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[6] = inv2;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][0] + w.KSD_r_shank[1]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][0];
+    w.L[76] = w.Linv[6]*t4;
+    const Scalar t5 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][0] + w.KSD_r_shank[2]*w.KA_r_shank[4][0];
+    w.L[77] = w.Linv[6]*t5;
+    const Scalar t6 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][0] + w.KSD_r_shank[3]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][0];
+    w.L[78] = w.Linv[6]*t6;
+    const Scalar t7 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][0] + w.KSD_r_shank[4]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][0];
+    w.L[79] = w.Linv[6]*t7;
+    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][0] + w.KSD_r_shank[5]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][0];
+    w.L[80] = w.Linv[6]*t8;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_column_9(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = 2.394677145741774 + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][1] + w.KSD_r_shank[1]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][1];
-    const Scalar t1 = w.active[1]*t0 + inv_mu - w.L[76]*w.L[76];
-    const Scalar r0 = std::sqrt(t1);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[7] = inv0;
-    const Scalar t2 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][1] + w.KSD_r_shank[2]*w.KA_r_shank[4][1];
-    const Scalar t3 = w.active[1]*t2 - w.L[76]*w.L[77];
-    w.L[85] = w.Linv[7]*t3;
-    const Scalar t4 = 35.0868446262531 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][1] + w.KSD_r_shank[3]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][1];
-    const Scalar t5 = w.active[1]*t4 - w.L[76]*w.L[78];
-    w.L[86] = w.Linv[7]*t5;
-    const Scalar t6 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][1] + w.KSD_r_shank[4]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][1];
-    const Scalar t7 = w.active[1]*t6 - w.L[76]*w.L[79];
-    w.L[87] = w.Linv[7]*t7;
-    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][1] + w.KSD_r_shank[5]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][1];
-    const Scalar t9 = w.active[1]*t8 - w.L[76]*w.L[80];
-    w.L[88] = w.Linv[7]*t9;
+    const Scalar t9 = 2.394677145741774 + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][1] + w.KSD_r_shank[1]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[76];
+    const Scalar r3 = std::sqrt(t9);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[7] = inv3;
+    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][1] + w.KSD_r_shank[2]*w.KA_r_shank[4][1] - w.L[76]*w.L[77];
+    w.L[85] = w.Linv[7]*t10;
+    const Scalar t11 = 35.0868446262531 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][1] + w.KSD_r_shank[3]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[78];
+    w.L[86] = w.Linv[7]*t11;
+    const Scalar t12 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][1] + w.KSD_r_shank[4]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[79];
+    w.L[87] = w.Linv[7]*t12;
+    const Scalar t13 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][1] + w.KSD_r_shank[5]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[80];
+    w.L[88] = w.Linv[7]*t13;
   }
   // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][2] + w.KSD_r_shank[2]*w.KA_r_shank[4][2];
-    const Scalar t11 = inv_mu + w.active[1]*t10 - w.L[77]*w.L[77] - w.L[85]*w.L[85];
-    const Scalar r1 = std::sqrt(t11);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[8] = inv1;
-    const Scalar t12 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][2] + w.KSD_r_shank[3]*w.KA_r_shank[4][2];
-    const Scalar t13 = w.active[1]*t12 - w.L[77]*w.L[78] - w.L[85]*w.L[86];
-    w.L[93] = w.Linv[8]*t13;
-    const Scalar t14 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][2] + w.KSD_r_shank[4]*w.KA_r_shank[4][2];
-    const Scalar t15 = w.active[1]*t14 - w.L[77]*w.L[79] - w.L[85]*w.L[87];
-    w.L[94] = w.Linv[8]*t15;
-    const Scalar t16 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][2] + w.KSD_r_shank[5]*w.KA_r_shank[4][2];
-    const Scalar t17 = w.active[1]*t16 - w.L[77]*w.L[80] - w.L[85]*w.L[88];
+    const Scalar t14 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][2] + w.KSD_r_shank[2]*w.KA_r_shank[4][2] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
+    const Scalar r4 = std::sqrt(t14);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[8] = inv4;
+    const Scalar t15 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][2] + w.KSD_r_shank[3]*w.KA_r_shank[4][2] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
+    w.L[93] = w.Linv[8]*t15;
+    const Scalar t16 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][2] + w.KSD_r_shank[4]*w.KA_r_shank[4][2] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
+    w.L[94] = w.Linv[8]*t16;
+    const Scalar t17 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][2] + w.KSD_r_shank[5]*w.KA_r_shank[4][2] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
     w.L[95] = w.Linv[8]*t17;
-  }
-  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t18 = 514.0929615568219 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3];
-    const Scalar t19 = inv_mu + w.active[1]*t18 - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
-    const Scalar r2 = std::sqrt(t19);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[9] = inv2;
-    const Scalar t20 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][3] + w.KSD_r_shank[4]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][3];
-    const Scalar t21 = w.active[1]*t20 - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
-    w.L[100] = w.Linv[9]*t21;
-    const Scalar t22 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][3] + w.KSD_r_shank[5]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][3];
-    const Scalar t23 = w.active[1]*t22 - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
-    w.L[101] = w.Linv[9]*t23;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_10_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t0 = 514.0929615568219 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3] + inv_mu - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[9] = inv0;
+    const Scalar t1 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][3] + w.KSD_r_shank[4]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
+    w.L[100] = w.Linv[9]*t1;
+    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][3] + w.KSD_r_shank[5]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
+    w.L[101] = w.Linv[9]*t2;
+  }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][4] + w.KSD_r_shank[4]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][4];
-    const Scalar t1 = w.active[1]*t0 + inv_mu - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
-    const Scalar r0 = std::sqrt(t1);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[10] = inv0;
-    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][4] + w.KSD_r_shank[5]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][4];
-    const Scalar t3 = w.active[1]*t2 - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
-    w.L[106] = w.Linv[10]*t3;
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][4] + w.KSD_r_shank[4]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
+    const Scalar r1 = std::sqrt(t3);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[10] = inv1;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][4] + w.KSD_r_shank[5]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
+    w.L[106] = w.Linv[10]*t4;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][5] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][5] + w.KSD_r_shank[5]*w.KA_r_shank[4][5] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][5];
-    const Scalar t5 = inv_mu + w.active[1]*t4 - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
-    const Scalar r1 = std::sqrt(t5);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[11] = inv1;
+    const Scalar t5 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][5] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][5] + w.KSD_r_shank[5]*w.KA_r_shank[4][5] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][5] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
+    const Scalar r2 = std::sqrt(t5);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[11] = inv2;
   }
   // G + I/mu = L L^T, column 12 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = 3.272247652534548 + w.KSD_abdomen[0]*w.KA_abdomen[5][0] + w.KSD_chest[0]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[0]*w.KA_r_forearm[4][0];
-    const Scalar t7 = inv_mu + w.active[2]*t6;
-    const Scalar r2 = std::sqrt(t7);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[12] = inv2;
-    const Scalar t8 = w.KSD_abdomen[1]*w.KA_abdomen[5][0] + w.KSD_chest[1]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][0];
-    const Scalar t9 = w.active[2]*t8;
-    w.L[115] = w.Linv[12]*t9;
-    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[5][0] + w.KSD_chest[2]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][0];
-    const Scalar t11 = w.active[2]*t10;
-    w.L[116] = w.Linv[12]*t11;
+    const Scalar t6 = 3.272247652534548 + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5][0] + w.KSD_chest[0]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[0]*w.KA_r_forearm[4][0];
+    const Scalar r3 = std::sqrt(t6);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[12] = inv3;
+    const Scalar t7 = w.KSD_abdomen[1]*w.KA_abdomen[5][0] + w.KSD_chest[1]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][0];
+    w.L[115] = w.Linv[12]*t7;
+    const Scalar t8 = w.KSD_abdomen[2]*w.KA_abdomen[5][0] + w.KSD_chest[2]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][0];
+    w.L[116] = w.Linv[12]*t8;
   }
   // G + I/mu = L L^T, column 13 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = w.KSD_abdomen[1]*w.KA_abdomen[5][1] + w.KSD_chest[1]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][1] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[5][1] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[4][1];
-    const Scalar t13 = inv_mu + w.active[2]*t12 - w.L[115]*w.L[115];
-    const Scalar r3 = std::sqrt(t13);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[13] = inv3;
-    const Scalar t14 = w.KSD_abdomen[2]*w.KA_abdomen[5][1] + w.KSD_chest[2]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][1];
-    const Scalar t15 = w.active[2]*t14 - w.L[115]*w.L[116];
-    w.L[118] = w.Linv[13]*t15;
+    const Scalar t9 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[5][1] + w.KSD_chest[1]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][1] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[5][1] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[4][1] - w.L[115]*w.L[115];
+    const Scalar r4 = std::sqrt(t9);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[13] = inv4;
+    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[5][1] + w.KSD_chest[2]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][1] - w.L[115]*w.L[116];
+    w.L[118] = w.Linv[13]*t10;
   }
   // G + I/mu = L L^T, column 14 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t16 = w.KSD_abdomen[2]*w.KA_abdomen[5][2] + w.KSD_chest[2]*w.KA_chest[4][2] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][2] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][2] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][2] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][2];
-    const Scalar t17 = inv_mu + w.active[2]*t16 - w.L[116]*w.L[116] - w.L[118]*w.L[118];
-    const Scalar r4 = std::sqrt(t17);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[14] = inv4;
+    const Scalar t11 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[5][2] + w.KSD_chest[2]*w.KA_chest[4][2] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][2] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][2] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][2] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][2] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
+    const Scalar r5 = std::sqrt(t11);
+    const Scalar inv5 = 1.0 / r5;
+    w.Linv[14] = inv5;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t18 = w.Z_pelvis[0][0]*w.active[0];
-    const Scalar t19 = w.Linv[0]*t18;
-    const Scalar t20 = w.Z_pelvis[0][1]*w.active[0] - w.L[1]*t19;
-    const Scalar t21 = w.Linv[1]*t20;
-    const Scalar t22 = w.Z_pelvis[0][2]*w.active[0] - w.L[2]*t19 - w.L[16]*t21;
-    const Scalar t23 = w.Linv[2]*t22;
-    const Scalar t24 = w.Z_pelvis[0][3]*w.active[0] - w.L[3]*t19 - w.L[17]*t21 - w.L[30]*t23;
-    const Scalar t25 = w.Linv[3]*t24;
-    const Scalar t26 = w.Z_pelvis[0][4]*w.active[0] - w.L[4]*t19 - w.L[18]*t21 - w.L[31]*t23 - w.L[43]*t25;
-    const Scalar t27 = w.Linv[4]*t26;
-    const Scalar t28 = w.Z_pelvis[0][5]*w.active[0] - w.L[5]*t19 - w.L[19]*t21 - w.L[32]*t23 - w.L[44]*t25 - w.L[55]*t27;
-    const Scalar t29 = w.Z_pelvis[0][6]*w.active[1];
-    const Scalar t30 = w.Linv[6]*t29;
-    const Scalar t31 = w.Z_pelvis[0][7]*w.active[1] - w.L[76]*t30;
-    const Scalar t32 = w.Linv[7]*t31;
-    const Scalar t33 = w.Z_pelvis[0][8]*w.active[1] - w.L[77]*t30 - w.L[85]*t32;
-    const Scalar t34 = w.Linv[8]*t33;
-    const Scalar t35 = w.Z_pelvis[0][9]*w.active[1] - w.L[78]*t30 - w.L[86]*t32 - w.L[93]*t34;
-    const Scalar t36 = w.Linv[9]*t35;
-    const Scalar t37 = w.Z_pelvis[0][10]*w.active[1] - w.L[79]*t30 - w.L[87]*t32 - w.L[94]*t34 - w.L[100]*t36;
-    const Scalar t38 = w.Linv[10]*t37;
-    const Scalar t39 = w.Z_pelvis[0][11]*w.active[1] - w.L[80]*t30 - w.L[88]*t32 - w.L[95]*t34 - w.L[101]*t36 - w.L[106]*t38;
-    const Scalar t40 = w.Z_pelvis[0][12]*w.active[2];
-    const Scalar t41 = w.Linv[12]*t40;
-    const Scalar t42 = w.Z_pelvis[0][13]*w.active[2] - w.L[115]*t41;
-    const Scalar t43 = w.Linv[13]*t42;
-    const Scalar t44 = w.Z_pelvis[0][14]*w.active[2] - w.L[116]*t41 - w.L[118]*t43;
-    w.W[0][0] = w.Linv[0]*t18;
-    w.W[1][0] = w.Linv[1]*t20;
-    w.W[2][0] = w.Linv[2]*t22;
-    w.W[3][0] = w.Linv[3]*t24;
-    w.W[4][0] = w.Linv[4]*t26;
-    w.W[5][0] = w.Linv[5]*t28;
-    w.W[6][0] = w.Linv[6]*t29;
-    w.W[7][0] = w.Linv[7]*t31;
-    w.W[8][0] = w.Linv[8]*t33;
-    w.W[9][0] = w.Linv[9]*t35;
-    w.W[10][0] = w.Linv[10]*t37;
-    w.W[11][0] = w.Linv[11]*t39;
-    w.W[12][0] = w.Linv[12]*t40;
-    w.W[13][0] = w.Linv[13]*t42;
-    w.W[14][0] = w.Linv[14]*t44;
+    const Scalar t12 = w.Z_pelvis[0][0]*w.active[0];
+    const Scalar t13 = w.Linv[0]*t12;
+    const Scalar t14 = w.Z_pelvis[0][1]*w.active[0] - w.L[1]*t13;
+    const Scalar t15 = w.Linv[1]*t14;
+    const Scalar t16 = w.Z_pelvis[0][2]*w.active[0] - w.L[2]*t13 - w.L[16]*t15;
+    const Scalar t17 = w.Linv[2]*t16;
+    const Scalar t18 = w.Z_pelvis[0][3]*w.active[0] - w.L[3]*t13 - w.L[17]*t15 - w.L[30]*t17;
+    const Scalar t19 = w.Linv[3]*t18;
+    const Scalar t20 = w.Z_pelvis[0][4]*w.active[0] - w.L[4]*t13 - w.L[18]*t15 - w.L[31]*t17 - w.L[43]*t19;
+    const Scalar t21 = w.Linv[4]*t20;
+    const Scalar t22 = w.Z_pelvis[0][5]*w.active[0] - w.L[5]*t13 - w.L[19]*t15 - w.L[32]*t17 - w.L[44]*t19 - w.L[55]*t21;
+    const Scalar t23 = w.Z_pelvis[0][6]*w.active[1];
+    const Scalar t24 = w.Linv[6]*t23;
+    const Scalar t25 = w.Z_pelvis[0][7]*w.active[1] - w.L[76]*t24;
+    const Scalar t26 = w.Linv[7]*t25;
+    const Scalar t27 = w.Z_pelvis[0][8]*w.active[1] - w.L[77]*t24 - w.L[85]*t26;
+    const Scalar t28 = w.Linv[8]*t27;
+    const Scalar t29 = w.Z_pelvis[0][9]*w.active[1] - w.L[78]*t24 - w.L[86]*t26 - w.L[93]*t28;
+    const Scalar t30 = w.Linv[9]*t29;
+    const Scalar t31 = w.Z_pelvis[0][10]*w.active[1] - w.L[79]*t24 - w.L[87]*t26 - w.L[94]*t28 - w.L[100]*t30;
+    const Scalar t32 = w.Linv[10]*t31;
+    const Scalar t33 = w.Z_pelvis[0][11]*w.active[1] - w.L[80]*t24 - w.L[88]*t26 - w.L[95]*t28 - w.L[101]*t30 - w.L[106]*t32;
+    const Scalar t34 = w.Z_pelvis[0][12]*w.active[2];
+    const Scalar t35 = w.Linv[12]*t34;
+    const Scalar t36 = w.Z_pelvis[0][13]*w.active[2] - w.L[115]*t35;
+    const Scalar t37 = w.Linv[13]*t36;
+    const Scalar t38 = w.Z_pelvis[0][14]*w.active[2] - w.L[116]*t35 - w.L[118]*t37;
+    w.W[0][0] = w.Linv[0]*t12;
+    w.W[1][0] = w.Linv[1]*t14;
+    w.W[2][0] = w.Linv[2]*t16;
+    w.W[3][0] = w.Linv[3]*t18;
+    w.W[4][0] = w.Linv[4]*t20;
+    w.W[5][0] = w.Linv[5]*t22;
+    w.W[6][0] = w.Linv[6]*t23;
+    w.W[7][0] = w.Linv[7]*t25;
+    w.W[8][0] = w.Linv[8]*t27;
+    w.W[9][0] = w.Linv[9]*t29;
+    w.W[10][0] = w.Linv[10]*t31;
+    w.W[11][0] = w.Linv[11]*t33;
+    w.W[12][0] = w.Linv[12]*t34;
+    w.W[13][0] = w.Linv[13]*t36;
+    w.W[14][0] = w.Linv[14]*t38;
   }
 }
 
@@ -9489,10 +9438,9 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_free_r_wrist_pitch_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
-  pv_delassus_column_0_to_column_2(inv_mu, w);
-  pv_delassus_column_3_to_column_6(inv_mu, w);
-  pv_delassus_column_7_to_column_9(inv_mu, w);
-  pv_delassus_column_10_to_W_0(inv_mu, w);
+  pv_delassus_column_0_to_column_3(inv_mu, w);
+  pv_delassus_column_4_to_column_8(inv_mu, w);
+  pv_delassus_column_9_to_W_0(inv_mu, w);
   pv_delassus_W_1(w);
   pv_delassus_W_2(w);
   pv_delassus_W_3(w);

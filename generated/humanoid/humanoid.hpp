@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
 //     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16825 + 650 K (= 18775 at K = 3)
-//     add/sub 6655 + 285 K, mul 9751 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
+//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line

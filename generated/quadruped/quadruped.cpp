@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 4538 + 1216 K (= 8186 at K = 3)
 //     add/sub 1916 + 543 K, mul 2523 + 647 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8577 + 475 K (= 10002 at K = 3)
-//     add/sub 3518 + 204 K, mul 4882 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   prox_pv: 8553 + 475 K (= 9978 at K = 3)
+//     add/sub 3518 + 204 K, mul 4858 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 
 #include "quadruped.hpp"
 
@@ -4327,179 +4327,152 @@ PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRIC
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = 78.21756516587678 + w.KSD_LF_hip[0]*w.KS_LF_hip[0] + w.KSD_LF_thigh[0]*w.KA_LF_thigh[4][0];
-    const Scalar t1 = w.active[0]*t0 + inv_mu;
-    const Scalar r0 = std::sqrt(t1);
+    const Scalar t0 = 78.21756516587678 + w.KSD_LF_hip[0]*w.KS_LF_hip[0] + w.KSD_LF_thigh[0]*w.KA_LF_thigh[4][0] + inv_mu;
+    const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.Linv[0] = inv0;
-    const Scalar t2 = w.KSD_LF_hip[1]*w.KS_LF_hip[0];
-    const Scalar t3 = w.active[0]*t2;
-    w.L[1] = w.Linv[0]*t3;
-    const Scalar t4 = w.KSD_LF_hip[2]*w.KS_LF_hip[0] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][0];
-    const Scalar t5 = w.active[0]*t4;
-    w.L[2] = w.Linv[0]*t5;
+    const Scalar t1 = w.KSD_LF_hip[1]*w.KS_LF_hip[0];
+    w.L[1] = w.Linv[0]*t1;
+    const Scalar t2 = w.KSD_LF_hip[2]*w.KS_LF_hip[0] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][0];
+    w.L[2] = w.Linv[0]*t2;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = w.KSD_LF_hip[1]*w.KS_LF_hip[1];
-    const Scalar t7 = inv_mu + w.active[0]*t6 - w.L[1]*w.L[1];
-    const Scalar r1 = std::sqrt(t7);
+    const Scalar t3 = inv_mu + w.KSD_LF_hip[1]*w.KS_LF_hip[1] - w.L[1]*w.L[1];
+    const Scalar r1 = std::sqrt(t3);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t8 = w.KSD_LF_hip[2]*w.KS_LF_hip[1];
-    const Scalar t9 = w.active[0]*t8 - w.L[1]*w.L[2];
-    w.L[13] = w.Linv[1]*t9;
+    const Scalar t4 = w.KSD_LF_hip[2]*w.KS_LF_hip[1] - w.L[1]*w.L[2];
+    w.L[13] = w.Linv[1]*t4;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t10 = w.KSD_LF_hip[2]*w.KS_LF_hip[2] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][2];
-    const Scalar t11 = inv_mu + w.active[0]*t10 - w.L[2]*w.L[2] - w.L[13]*w.L[13];
-    const Scalar r2 = std::sqrt(t11);
+    const Scalar t5 = inv_mu + w.KSD_LF_hip[2]*w.KS_LF_hip[2] + w.KSD_LF_thigh[2]*w.KA_LF_thigh[4][2] - w.L[2]*w.L[2] - w.L[13]*w.L[13];
+    const Scalar r2 = std::sqrt(t5);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = 78.21756516587678 + w.KSD_LH_hip[0]*w.KS_LH_hip[0] + w.KSD_LH_thigh[0]*w.KA_LH_thigh[4][0];
-    const Scalar t13 = inv_mu + w.active[2]*t12;
-    const Scalar r3 = std::sqrt(t13);
+    const Scalar t6 = 78.21756516587678 + inv_mu + w.KSD_LH_hip[0]*w.KS_LH_hip[0] + w.KSD_LH_thigh[0]*w.KA_LH_thigh[4][0];
+    const Scalar r3 = std::sqrt(t6);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
-    const Scalar t14 = w.KSD_LH_hip[1]*w.KS_LH_hip[0];
-    const Scalar t15 = w.active[2]*t14;
-    w.L[34] = w.Linv[3]*t15;
-    const Scalar t16 = w.KSD_LH_hip[2]*w.KS_LH_hip[0] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][0];
-    const Scalar t17 = w.active[2]*t16;
-    w.L[35] = w.Linv[3]*t17;
+    const Scalar t7 = w.KSD_LH_hip[1]*w.KS_LH_hip[0];
+    w.L[34] = w.Linv[3]*t7;
+    const Scalar t8 = w.KSD_LH_hip[2]*w.KS_LH_hip[0] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][0];
+    w.L[35] = w.Linv[3]*t8;
   }
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t18 = w.KSD_LH_hip[1]*w.KS_LH_hip[1];
-    const Scalar t19 = inv_mu + w.active[2]*t18 - w.L[34]*w.L[34];
-    const Scalar r4 = std::sqrt(t19);
+    const Scalar t9 = inv_mu + w.KSD_LH_hip[1]*w.KS_LH_hip[1] - w.L[34]*w.L[34];
+    const Scalar r4 = std::sqrt(t9);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[4] = inv4;
-    const Scalar t20 = w.KSD_LH_hip[2]*w.KS_LH_hip[1];
-    const Scalar t21 = w.active[2]*t20 - w.L[34]*w.L[35];
-    w.L[43] = w.Linv[4]*t21;
+    const Scalar t10 = w.KSD_LH_hip[2]*w.KS_LH_hip[1] - w.L[34]*w.L[35];
+    w.L[43] = w.Linv[4]*t10;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_column_5_to_column_9(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_LH_hip[2]*w.KS_LH_hip[2] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][2];
-    const Scalar t1 = w.active[2]*t0 + inv_mu - w.L[35]*w.L[35] - w.L[43]*w.L[43];
-    const Scalar r0 = std::sqrt(t1);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[5] = inv0;
+    const Scalar t11 = inv_mu + w.KSD_LH_hip[2]*w.KS_LH_hip[2] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][2] - w.L[35]*w.L[35] - w.L[43]*w.L[43];
+    const Scalar r5 = std::sqrt(t11);
+    const Scalar inv5 = 1.0 / r5;
+    w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t2 = 78.21756516587678 + w.KSD_RF_hip[0]*w.KS_RF_hip[0] + w.KSD_RF_thigh[0]*w.KA_RF_thigh[4][0];
-    const Scalar t3 = inv_mu + w.active[1]*t2;
-    const Scalar r1 = std::sqrt(t3);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[6] = inv1;
-    const Scalar t4 = w.KSD_RF_hip[1]*w.KS_RF_hip[0];
-    const Scalar t5 = w.active[1]*t4;
-    w.L[58] = w.Linv[6]*t5;
-    const Scalar t6 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][0];
-    const Scalar t7 = w.active[1]*t6;
-    w.L[59] = w.Linv[6]*t7;
-  }
-  // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t8 = w.KSD_RF_hip[1]*w.KS_RF_hip[1];
-    const Scalar t9 = inv_mu + w.active[1]*t8 - w.L[58]*w.L[58];
-    const Scalar r2 = std::sqrt(t9);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[7] = inv2;
-    const Scalar t10 = w.KSD_RF_hip[2]*w.KS_RF_hip[1];
-    const Scalar t11 = w.active[1]*t10 - w.L[58]*w.L[59];
-    w.L[64] = w.Linv[7]*t11;
-  }
-  // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t12 = w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][2];
-    const Scalar t13 = inv_mu + w.active[1]*t12 - w.L[59]*w.L[59] - w.L[64]*w.L[64];
-    const Scalar r3 = std::sqrt(t13);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[8] = inv3;
-  }
-  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t14 = 78.21756516587678 + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4][0];
-    const Scalar t15 = inv_mu + w.active[3]*t14;
-    const Scalar r4 = std::sqrt(t15);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[9] = inv4;
-    const Scalar t16 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
-    const Scalar t17 = w.active[3]*t16;
-    w.L[73] = w.Linv[9]*t17;
-    const Scalar t18 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][0];
-    const Scalar t19 = w.active[3]*t18;
-    w.L[74] = w.Linv[9]*t19;
+    const Scalar t12 = 78.21756516587678 + inv_mu + w.KSD_RF_hip[0]*w.KS_RF_hip[0] + w.KSD_RF_thigh[0]*w.KA_RF_thigh[4][0];
+    const Scalar r6 = std::sqrt(t12);
+    const Scalar inv6 = 1.0 / r6;
+    w.Linv[6] = inv6;
+    const Scalar t13 = w.KSD_RF_hip[1]*w.KS_RF_hip[0];
+    w.L[58] = w.Linv[6]*t13;
+    const Scalar t14 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][0];
+    w.L[59] = w.Linv[6]*t14;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_10_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t0 = w.KSD_RF_hip[1]*w.KS_RF_hip[1] + inv_mu - w.L[58]*w.L[58];
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[7] = inv0;
+    const Scalar t1 = w.KSD_RF_hip[2]*w.KS_RF_hip[1] - w.L[58]*w.L[59];
+    w.L[64] = w.Linv[7]*t1;
+  }
+  // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t2 = inv_mu + w.KSD_RF_hip[2]*w.KS_RF_hip[2] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][2] - w.L[59]*w.L[59] - w.L[64]*w.L[64];
+    const Scalar r1 = std::sqrt(t2);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[8] = inv1;
+  }
+  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t3 = 78.21756516587678 + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4][0];
+    const Scalar r2 = std::sqrt(t3);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[9] = inv2;
+    const Scalar t4 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
+    w.L[73] = w.Linv[9]*t4;
+    const Scalar t5 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][0];
+    w.L[74] = w.Linv[9]*t5;
+  }
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_RH_hip[1]*w.KS_RH_hip[1];
-    const Scalar t1 = w.active[3]*t0 + inv_mu - w.L[73]*w.L[73];
-    const Scalar r0 = std::sqrt(t1);
-    const Scalar inv0 = 1.0 / r0;
-    w.Linv[10] = inv0;
-    const Scalar t2 = w.KSD_RH_hip[2]*w.KS_RH_hip[1];
-    const Scalar t3 = w.active[3]*t2 - w.L[73]*w.L[74];
-    w.L[76] = w.Linv[10]*t3;
+    const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
+    const Scalar r3 = std::sqrt(t6);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[10] = inv3;
+    const Scalar t7 = w.KSD_RH_hip[2]*w.KS_RH_hip[1] - w.L[73]*w.L[74];
+    w.L[76] = w.Linv[10]*t7;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t4 = w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][2];
-    const Scalar t5 = inv_mu + w.active[3]*t4 - w.L[74]*w.L[74] - w.L[76]*w.L[76];
-    const Scalar r1 = std::sqrt(t5);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[11] = inv1;
+    const Scalar t8 = inv_mu + w.KSD_RH_hip[2]*w.KS_RH_hip[2] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][2] - w.L[74]*w.L[74] - w.L[76]*w.L[76];
+    const Scalar r4 = std::sqrt(t8);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[11] = inv4;
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t6 = w.Z_trunk[0][0]*w.active[0];
-    const Scalar t7 = w.Linv[0]*t6;
-    const Scalar t8 = w.Z_trunk[0][1]*w.active[0] - w.L[1]*t7;
-    const Scalar t9 = w.Linv[1]*t8;
-    const Scalar t10 = w.Z_trunk[0][2]*w.active[0] - w.L[2]*t7 - w.L[13]*t9;
-    const Scalar t11 = w.Z_trunk[0][3]*w.active[2];
-    const Scalar t12 = w.Linv[3]*t11;
-    const Scalar t13 = w.Z_trunk[0][4]*w.active[2] - w.L[34]*t12;
-    const Scalar t14 = w.Linv[4]*t13;
-    const Scalar t15 = w.Z_trunk[0][5]*w.active[2] - w.L[35]*t12 - w.L[43]*t14;
-    const Scalar t16 = w.Z_trunk[0][6]*w.active[1];
-    const Scalar t17 = w.Linv[6]*t16;
-    const Scalar t18 = w.Z_trunk[0][7]*w.active[1] - w.L[58]*t17;
-    const Scalar t19 = w.Linv[7]*t18;
-    const Scalar t20 = w.Z_trunk[0][8]*w.active[1] - w.L[59]*t17 - w.L[64]*t19;
-    const Scalar t21 = w.Z_trunk[0][9]*w.active[3];
-    const Scalar t22 = w.Linv[9]*t21;
-    const Scalar t23 = w.Z_trunk[0][10]*w.active[3] - w.L[73]*t22;
-    const Scalar t24 = w.Linv[10]*t23;
-    const Scalar t25 = w.Z_trunk[0][11]*w.active[3] - w.L[74]*t22 - w.L[76]*t24;
-    w.W[0][0] = w.Linv[0]*t6;
-    w.W[1][0] = w.Linv[1]*t8;
-    w.W[2][0] = w.Linv[2]*t10;
-    w.W[3][0] = w.Linv[3]*t11;
-    w.W[4][0] = w.Linv[4]*t13;
-    w.W[5][0] = w.Linv[5]*t15;
-    w.W[6][0] = w.Linv[6]*t16;
-    w.W[7][0] = w.Linv[7]*t18;
-    w.W[8][0] = w.Linv[8]*t20;
-    w.W[9][0] = w.Linv[9]*t21;
-    w.W[10][0] = w.Linv[10]*t23;
-    w.W[11][0] = w.Linv[11]*t25;
+    const Scalar t9 = w.Z_trunk[0][0]*w.active[0];
+    const Scalar t10 = w.Linv[0]*t9;
+    const Scalar t11 = w.Z_trunk[0][1]*w.active[0] - w.L[1]*t10;
+    const Scalar t12 = w.Linv[1]*t11;
+    const Scalar t13 = w.Z_trunk[0][2]*w.active[0] - w.L[2]*t10 - w.L[13]*t12;
+    const Scalar t14 = w.Z_trunk[0][3]*w.active[2];
+    const Scalar t15 = w.Linv[3]*t14;
+    const Scalar t16 = w.Z_trunk[0][4]*w.active[2] - w.L[34]*t15;
+    const Scalar t17 = w.Linv[4]*t16;
+    const Scalar t18 = w.Z_trunk[0][5]*w.active[2] - w.L[35]*t15 - w.L[43]*t17;
+    const Scalar t19 = w.Z_trunk[0][6]*w.active[1];
+    const Scalar t20 = w.Linv[6]*t19;
+    const Scalar t21 = w.Z_trunk[0][7]*w.active[1] - w.L[58]*t20;
+    const Scalar t22 = w.Linv[7]*t21;
+    const Scalar t23 = w.Z_trunk[0][8]*w.active[1] - w.L[59]*t20 - w.L[64]*t22;
+    const Scalar t24 = w.Z_trunk[0][9]*w.active[3];
+    const Scalar t25 = w.Linv[9]*t24;
+    const Scalar t26 = w.Z_trunk[0][10]*w.active[3] - w.L[73]*t25;
+    const Scalar t27 = w.Linv[10]*t26;
+    const Scalar t28 = w.Z_trunk[0][11]*w.active[3] - w.L[74]*t25 - w.L[76]*t27;
+    w.W[0][0] = w.Linv[0]*t9;
+    w.W[1][0] = w.Linv[1]*t11;
+    w.W[2][0] = w.Linv[2]*t13;
+    w.W[3][0] = w.Linv[3]*t14;
+    w.W[4][0] = w.Linv[4]*t16;
+    w.W[5][0] = w.Linv[5]*t18;
+    w.W[6][0] = w.Linv[6]*t19;
+    w.W[7][0] = w.Linv[7]*t21;
+    w.W[8][0] = w.Linv[8]*t23;
+    w.W[9][0] = w.Linv[9]*t24;
+    w.W[10][0] = w.Linv[10]*t26;
+    w.W[11][0] = w.Linv[11]*t28;
   }
 }
 
@@ -5273,9 +5246,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_free_RH_thigh_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
-  pv_delassus_column_0_to_column_4(inv_mu, w);
-  pv_delassus_column_5_to_column_9(inv_mu, w);
-  pv_delassus_column_10_to_W_0(inv_mu, w);
+  pv_delassus_column_0_to_column_6(inv_mu, w);
+  pv_delassus_column_7_to_W_0(inv_mu, w);
   pv_delassus_W_1_to_W_2(w);
   pv_delassus_W_3_to_W_4(w);
   pv_delassus_W_5_to_LS(w);

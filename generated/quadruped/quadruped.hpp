@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 4538 + 1216 K (= 8186 at K = 3)
 //     add/sub 1916 + 543 K, mul 2523 + 647 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8577 + 475 K (= 10002 at K = 3)
-//     add/sub 3518 + 204 K, mul 4882 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   prox_pv: 8553 + 475 K (= 9978 at K = 3)
+//     add/sub 3518 + 204 K, mul 4858 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line

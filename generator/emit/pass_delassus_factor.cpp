@@ -85,19 +85,20 @@ int freeFlyerWithRows(const Plan& plan) {
   return -1;
 }
 
-// F G F with F = diag(activity factors) (docs/algorithms.md §4.4): an entry
-// times the factors of its two rows' constraints (one factor within a
-// constraint), so the rows of an inactive constraint are exactly 0 and its
-// diagonal of F G F + I/mu is 1/mu alone: it decouples exactly.
+// The schedule (docs/algorithms.md §4.4): an entry coupling two constraints
+// times both their activity factors, so an inactive constraint's rows meet the
+// others' through exact zeros only. Its own diagonal block stays as it is:
+// with zero coupling and a zero right-hand side (F y, lambda0 0) its rows of
+// the factor's solves are exact zeros whatever the block holds, and the other
+// rows never read it; so the limbs of one contact each pay nothing here.
 Expr scheduled(Emit& e, int t, int u, const Expr& g) {
-  if (g.isZero()) return g;
   const std::vector<int>& tree = e.plan.rootRows;
   const int kt = rowConstraint(e.plan, tree[std::size_t(t)]), ku = rowConstraint(e.plan, tree[std::size_t(u)]);
-  const Expr F = kt == ku ? activeFactor(e, kt) : e.cb().mul(activeFactor(e, kt), activeFactor(e, ku));
-  return e.cb().mul(F, e.cb().flat(g));
+  if (g.isZero() || kt == ku) return g;
+  return e.cb().mul(e.cb().mul(activeFactor(e, kt), activeFactor(e, ku)), e.cb().flat(g));
 }
 
-// F G F + I/mu = L L^T (or F A F + I/mu with a floating base), one block (and part) per column.
+// G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block (and part) per column.
 void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   const int nc = e.plan.nc;
   f.L = Sym(nc);
