@@ -22,6 +22,10 @@ static_assert(proxgen_rt::version_minor == version_minor);
 
 namespace {
 
+// nc multipliers: an array of two picks by a schedule flag, {zeros, given}
+// (docs/algorithms.md §4.4).
+using MultiplierRows = const Scalar*;
+
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
@@ -5131,7 +5135,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   kinematics(q, v, w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  const Scalar* const lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
   w.lambda[0] = lambda0_if[s.active[0]][0];
   w.lambda[1] = lambda0_if[s.active[0]][1];
   w.lambda[2] = lambda0_if[s.active[0]][2];
@@ -5253,7 +5257,7 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_delassus_W_5_to_LS(w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  const Scalar* const lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
   w.lambda[0] = lambda0_if[s.active[0]][0];
   w.lambda[1] = lambda0_if[s.active[0]][1];
   w.lambda[2] = lambda0_if[s.active[0]][2];

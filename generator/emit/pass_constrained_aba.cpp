@@ -163,7 +163,7 @@ void startMultipliers(Emit& e, Multipliers& mult) {
   CodeBuilder& cb = e.cb();
   cb.comment("---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive");
   cb.line("const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);", {}, {"s"});
-  cb.line("const Scalar* const lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};");
+  cb.line("const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};");
   for (std::size_t k = 0; k < e.plan.constraints.size(); ++k) {
     const ConstraintPlan& c = e.plan.constraints[k];
     for (int r = c.row; r < c.row + c.rows; ++r)

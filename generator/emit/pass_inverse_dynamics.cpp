@@ -89,7 +89,7 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
     host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
     // An inactive constraint's rows read the zeros (an index by its flag, no
     // branch): its lambda is never read (docs/algorithms.md §4.4).
-    host.line("const Scalar* const lambda_if[2] = {kNoMultipliers, lambda};", {}, {"lambda"});
+    host.line("const MultiplierRows lambda_if[2] = {kNoMultipliers, lambda};", {}, {"lambda"});
     host.line(fmt::format("Scalar lambda_on[{}];", plan.nc));
     for (std::size_t k = 0; k < plan.constraints.size(); ++k) {
       const ConstraintPlan& c = plan.constraints[k];
