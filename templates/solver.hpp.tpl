@@ -39,13 +39,17 @@ namespace joint {{  // position in the joint list (joint_names)
 namespace constraint {{  // position in the layout (constraint_names)
 {constraint_ids}}}  // namespace constraint
 
+// Every constraint active: the default schedule of the functions taking one.
+inline constexpr bool all_active[{active_size}] = {{{active_init}}};
+
 // Set the fields by name (later versions may add fields).
 struct Settings {{
   Scalar mu = {mu};  // augmented-Lagrangian penalty (large = stiff)
   int iterations = {iterations};  // multiplier updates K (0: the motion under the forces of lambda0)
   // Run-time contact schedule: active[k] for constraint k of the layout
   // (constraint::<name>). An inactive constraint exerts no force: its
-  // multipliers are 0 and the answer is that of the solver generated without it.{active_note}
+  // multipliers are 0 and the answer is that of the solver generated without it
+  // (to round-off; docs/algorithms.md §4.4). Change it between calls freely.{active_note}
   bool active[{active_size}] = {{{active_init}}};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead

@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1130 + 316 K (= 2078 at K = 3)
-//     add/sub 482 + 139 K, mul 606 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
-//     add/sub 880 + 26 K, mul 1192 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1131 + 322 K (= 2097 at K = 3)
+//     add/sub 482 + 139 K, mul 607 + 169 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2166 + 72 K (= 2382 at K = 3)
+//     add/sub 880 + 26 K, mul 1204 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 
 #include "arm.hpp"
 
@@ -21,6 +21,10 @@ static_assert(proxgen_rt::version_major == version_major);
 static_assert(proxgen_rt::version_minor == version_minor);
 
 namespace {
+
+// nc multipliers: an array of two picks by a schedule flag, {zeros, given}
+// (docs/algorithms.md §4.4).
+using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -177,19 +181,20 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRI
 PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    w.U_wrist_3_link[5] = 0.0003695625 + mu;
+    const Scalar mu_c0 = mu*w.active[0];
+    w.U_wrist_3_link[5] = 0.0003695625 + mu_c0;
     w.Dinv_wrist_3_link = 1.0 / w.U_wrist_3_link[5];
     w.u_wrist_3_link[0] = -w.pA_wrist_3_link[5] - w.lambda[5] + tau[5];
     const Scalar t0 = w.U_wrist_3_link[5]*w.Dinv_wrist_3_link;
-    const Scalar Ia0 = 0.365 + mu;
-    const Scalar Ia1 = 0.035930965 + 0.0996*mu;
-    const Scalar Ia2 = -0.035930965 - 0.0996*mu;
-    const Scalar Ia3 = 0.003770528042232001 + 1.00992016*mu;
-    const Scalar pa0 = w.pA_wrist_3_link[0] + w.lambda[0] + w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
-    const Scalar pa1 = w.pA_wrist_3_link[1] + w.lambda[1] + w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
-    const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu;
-    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
-    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
+    const Scalar Ia0 = 0.365 + mu_c0;
+    const Scalar Ia1 = 0.035930965 + 0.0996*mu_c0;
+    const Scalar Ia2 = -0.035930965 - 0.0996*mu_c0;
+    const Scalar Ia3 = 0.003770528042232001 + 1.00992016*mu_c0;
+    const Scalar pa0 = w.pA_wrist_3_link[0] + w.lambda[0] + w.g_wrist_3_link[0]*mu_c0 + w.c_wrist_3_link[0]*Ia0 + w.c_wrist_3_link[4]*Ia1;
+    const Scalar pa1 = w.pA_wrist_3_link[1] + w.lambda[1] + w.g_wrist_3_link[1]*mu_c0 + w.c_wrist_3_link[1]*Ia0 + w.c_wrist_3_link[3]*Ia2;
+    const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu_c0;
+    const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu_c0 + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
+    const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu_c0 + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
     const Scalar pa5 = w.pA_wrist_3_link[5] + w.lambda[5] + w.u_wrist_3_link[0]*t0;
     const Scalar C20 = w.cq_wrist_3_link*w.cq_wrist_3_link - w.sq_wrist_3_link*w.sq_wrist_3_link;
     const Scalar t1 = 0.5*(Ia1 + Ia2);
@@ -672,24 +677,27 @@ PROXGEN_RT_NOINLINE void caba_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRIC
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_wrist_3_link[3];
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_wrist_3_link[4];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
@@ -887,24 +895,27 @@ PROXGEN_RT_NOINLINE void caba_reforward_wrist_3_link(Workspace& PROXGEN_RT_RESTR
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_wrist_3_link[3];
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_wrist_3_link[4];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
   }
@@ -1497,12 +1508,15 @@ PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RES
   }
   // free row accelerations y_free = K a - k (tree order)
   {
-    w.yfree[0] = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.yfree[1] = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
-    w.yfree[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.yfree[3] = w.a_wrist_3_link[3];
-    w.yfree[4] = w.a_wrist_3_link[4];
-    w.yfree[5] = w.a_wrist_3_link[5];
+    const Scalar t7 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
+    w.yfree[0] = t7*w.active[0];
+    const Scalar t8 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
+    w.yfree[1] = w.active[0]*t8;
+    const Scalar t9 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.yfree[2] = w.active[0]*t9;
+    w.yfree[3] = w.a_wrist_3_link[3]*w.active[0];
+    w.yfree[4] = w.a_wrist_3_link[4]*w.active[0];
+    w.yfree[5] = w.a_wrist_3_link[5]*w.active[0];
   }
 }
 
@@ -1697,12 +1711,15 @@ PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // residual rows K a - k (layout order)
   {
-    w.residual[0] = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
-    w.residual[1] = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
-    w.residual[2] = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
-    w.residual[3] = w.a_wrist_3_link[3];
-    w.residual[4] = w.a_wrist_3_link[4];
-    w.residual[5] = w.a_wrist_3_link[5];
+    const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
+    w.residual[0] = t0*w.active[0];
+    const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
+    w.residual[1] = w.active[0]*t1;
+    const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
+    w.residual[2] = w.active[0]*t2;
+    w.residual[3] = w.a_wrist_3_link[3]*w.active[0];
+    w.residual[4] = w.a_wrist_3_link[4]*w.active[0];
+    w.residual[5] = w.a_wrist_3_link[5]*w.active[0];
   }
 }
 
@@ -1721,15 +1738,17 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
+  w.active[0] = Scalar(s.active[0]);
   kinematics(q, v, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_wrist_3_link(tau, mu, w);
   caba_backward_wrist_2_link(tau, w);
@@ -1771,6 +1790,7 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 // matrix G + I/mu factored once at the root, K proximal solves, one forward sweep.
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
+  w.active[0] = Scalar(s.active[0]);
   kinematics(q, v, w);
   // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
   pv_backward_wrist_3_link_to_wrist_2_link(tau, w);
@@ -1785,14 +1805,15 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   // ---- G + I/mu = L L^T, G assembled from the carried rows
   pv_delassus_column_0_to_column_4(inv_mu, w);
   pv_delassus_column_5(inv_mu, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu

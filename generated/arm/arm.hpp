@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1130 + 316 K (= 2078 at K = 3)
-//     add/sub 482 + 139 K, mul 606 + 163 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
-//     add/sub 880 + 26 K, mul 1192 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1131 + 322 K (= 2097 at K = 3)
+//     add/sub 482 + 139 K, mul 607 + 169 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2166 + 72 K (= 2382 at K = 3)
+//     add/sub 880 + 26 K, mul 1204 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -64,13 +64,17 @@ namespace constraint {  // position in the layout (constraint_names)
 inline constexpr int tool = 0;
 }  // namespace constraint
 
+// Every constraint active: the default schedule of the functions taking one.
+inline constexpr bool all_active[1] = {true};
+
 // Set the fields by name (later versions may add fields).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
   int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
   // Run-time contact schedule: active[k] for constraint k of the layout
   // (constraint::<name>). An inactive constraint exerts no force: its
-  // multipliers are 0 and the answer is that of the solver generated without it.
+  // multipliers are 0 and the answer is that of the solver generated without it
+  // (to round-off; docs/algorithms.md §4.4). Change it between calls freely.
   bool active[1] = {true};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
@@ -78,7 +82,7 @@ struct Settings {
   const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (4920 bytes): per-body quantities named
+// Everything one solve writes (4928 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar sq_shoulder_link;     // sin q, body 1
@@ -115,6 +119,7 @@ struct Workspace {
   Scalar pA_wrist_3_link[6];   // bias force, body 6
   Scalar g_wrist_3_link[3];    // gravity in body coordinates, body 6
   Scalar k_tool[6];            // constraint right-hand side, constraint 0
+  Scalar active[1];            // the schedule of the last call (Settings::active) as 0/1 factors
   Scalar lambda[6];            // multipliers (layout order)
   Scalar U_wrist_3_link[6];    // IA S, body 6
   Scalar Dinv_wrist_3_link;    // 1 / (S^T IA S), body 6
@@ -179,6 +184,10 @@ struct Workspace {
 // from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
 // round-off. From a lambda0 that already solves the constraints the update
 // adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
+// Schedule: a constraint k with !s.active[k] exerts no force: its lambda rows are
+// exactly 0, its lambda0 rows are never read, its residual rows count as 0, and
+// qdd and the other rows are those of the solver generated without it (to
+// round-off), for any combination; no branch, no allocation (4.4).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,

@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8744 + 1720 K (= 13904 at K = 3)
-//     add/sub 3521 + 743 K, mul 4990 + 931 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16657 + 650 K (= 18607 at K = 3)
-//     add/sub 6655 + 285 K, mul 9583 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
+//     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
+//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 
 #include "humanoid.hpp"
 
@@ -21,6 +21,10 @@ static_assert(proxgen_rt::version_major == version_major);
 static_assert(proxgen_rt::version_minor == version_minor);
 
 namespace {
+
+// nc multipliers: an array of two picks by a schedule flag, {zeros, given}
+// (docs/algorithms.md §4.4).
+using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1550,21 +1554,22 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROX
 PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    w.U_r_hand[1] = 0.04016628 + 0.13*mu;
-    w.U_r_hand[3] = 0.005164645770899999 + 0.016900000000000002*mu;
+    const Scalar mu_c0 = mu*w.active[2];
+    w.U_r_hand[1] = 0.04016628 + 0.13*mu_c0;
+    w.U_r_hand[3] = 0.005164645770899999 + 0.016900000000000002*mu_c0;
     w.Dinv_r_hand = 1.0 / w.U_r_hand[3];
-    w.u_r_hand[0] = -w.pA_r_hand[3] - 0.13*w.lambda[12] + 0.13*w.k_right_hand[0]*mu + tau[35];
+    w.u_r_hand[0] = -w.pA_r_hand[3] - 0.13*w.lambda[12] + 0.13*w.k_right_hand[0]*mu_c0 + tau[35];
     const Scalar t0 = w.U_r_hand[1]*w.Dinv_r_hand;
     const Scalar t1 = w.U_r_hand[3]*w.Dinv_r_hand;
-    const Scalar Ia0 = 0.42 + mu;
-    const Scalar Ia1 = -0.04016628 - 0.13*mu;
-    const Scalar Ia2 = 0.42 + mu - w.U_r_hand[1]*t0;
-    const Scalar Ia3 = 0.005164645770899999 + 0.016900000000000002*mu;
-    const Scalar pa0 = w.pA_r_hand[0] - w.lambda[13] + w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia1;
-    const Scalar pa1 = w.pA_r_hand[1] + w.lambda[12] - w.k_right_hand[0]*mu + w.u_r_hand[0]*t0 + w.c_r_hand[1]*Ia2;
-    const Scalar pa2 = w.pA_r_hand[2] + w.lambda[14] - w.k_right_hand[2]*mu + w.c_r_hand[2]*Ia0;
-    const Scalar pa3 = w.pA_r_hand[3] + 0.13*w.lambda[12] - 0.13*w.k_right_hand[0]*mu + w.u_r_hand[0]*t1;
-    const Scalar pa4 = w.pA_r_hand[4] + 0.13*w.lambda[13] - 0.13*w.k_right_hand[1]*mu + w.c_r_hand[4]*Ia3;
+    const Scalar Ia0 = 0.42 + mu_c0;
+    const Scalar Ia1 = -0.04016628 - 0.13*mu_c0;
+    const Scalar Ia2 = 0.42 + mu_c0 - w.U_r_hand[1]*t0;
+    const Scalar Ia3 = 0.005164645770899999 + 0.016900000000000002*mu_c0;
+    const Scalar pa0 = w.pA_r_hand[0] - w.lambda[13] + w.k_right_hand[1]*mu_c0 + w.c_r_hand[4]*Ia1;
+    const Scalar pa1 = w.pA_r_hand[1] + w.lambda[12] - w.k_right_hand[0]*mu_c0 + w.u_r_hand[0]*t0 + w.c_r_hand[1]*Ia2;
+    const Scalar pa2 = w.pA_r_hand[2] + w.lambda[14] - w.k_right_hand[2]*mu_c0 + w.c_r_hand[2]*Ia0;
+    const Scalar pa3 = w.pA_r_hand[3] + 0.13*w.lambda[12] - 0.13*w.k_right_hand[0]*mu_c0 + w.u_r_hand[0]*t1;
+    const Scalar pa4 = w.pA_r_hand[4] + 0.13*w.lambda[13] - 0.13*w.k_right_hand[1]*mu_c0 + w.c_r_hand[4]*Ia3;
     const Scalar pa5 = 0.000284375*w.c_r_hand[5] + w.pA_r_hand[5];
     const Scalar C20 = w.cq_r_hand*w.cq_r_hand - w.sq_r_hand*w.sq_r_hand;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
@@ -2241,23 +2246,24 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
 PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu;
-    w.U_r_foot[3] = 0.00194517348958 + 1.0046580625*mu;
+    const Scalar mu_c0 = mu*w.active[1];
+    w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu_c0;
+    w.U_r_foot[3] = 0.00194517348958 + 1.0046580625*mu_c0;
     w.Dinv_r_foot = 1.0 / w.U_r_foot[3];
-    w.u_r_foot[0] = -w.pA_r_foot[3] - 0.06825*w.lambda[7] - w.lambda[9] - 0.06825*w.g_r_foot[1]*mu + tau[17];
+    w.u_r_foot[0] = -w.pA_r_foot[3] - 0.06825*w.lambda[7] - w.lambda[9] - 0.06825*w.g_r_foot[1]*mu_c0 + tau[17];
     const Scalar t0 = w.U_r_foot[1]*w.Dinv_r_foot;
     const Scalar t1 = w.U_r_foot[3]*w.Dinv_r_foot;
-    const Scalar Ia0 = 1.015 + mu;
-    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu;
-    const Scalar Ia2 = 1.015 + mu - w.U_r_foot[1]*t0;
+    const Scalar Ia0 = 1.015 + mu_c0;
+    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu_c0;
+    const Scalar Ia2 = 1.015 + mu_c0 - w.U_r_foot[1]*t0;
     const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_r_foot[1]*w.Dinv_r_foot;
-    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu;
-    const Scalar Ia5 = 0.00860228295937 + mu - 3.1912249599999995e-06*w.Dinv_r_foot;
-    const Scalar pa0 = w.pA_r_foot[0] + w.lambda[6] + w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_r_foot[1] + w.lambda[7] + w.g_r_foot[1]*mu + w.u_r_foot[0]*t0 + w.c_r_foot[1]*Ia2 + w.c_r_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2] + w.lambda[8] + w.g_r_foot[2]*mu + w.c_r_foot[2]*Ia0;
-    const Scalar pa3 = w.pA_r_foot[3] + 0.06825*w.lambda[7] + w.lambda[9] + 0.06825*w.g_r_foot[1]*mu + w.u_r_foot[0]*t1;
-    const Scalar pa4 = -0.06495999999999999*w.c_r_foot[2] + w.pA_r_foot[4] - 0.06825*w.lambda[6] + w.lambda[10] - 0.06825*w.g_r_ankle_link[0]*mu + w.c_r_foot[4]*Ia4;
+    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu_c0;
+    const Scalar Ia5 = 0.00860228295937 + mu_c0 - 3.1912249599999995e-06*w.Dinv_r_foot;
+    const Scalar pa0 = w.pA_r_foot[0] + w.lambda[6] + w.g_r_ankle_link[0]*mu_c0 + w.c_r_foot[4]*Ia1;
+    const Scalar pa1 = w.pA_r_foot[1] + w.lambda[7] + w.g_r_foot[1]*mu_c0 + w.u_r_foot[0]*t0 + w.c_r_foot[1]*Ia2 + w.c_r_foot[5]*Ia3;
+    const Scalar pa2 = -0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2] + w.lambda[8] + w.g_r_foot[2]*mu_c0 + w.c_r_foot[2]*Ia0;
+    const Scalar pa3 = w.pA_r_foot[3] + 0.06825*w.lambda[7] + w.lambda[9] + 0.06825*w.g_r_foot[1]*mu_c0 + w.u_r_foot[0]*t1;
+    const Scalar pa4 = -0.06495999999999999*w.c_r_foot[2] + w.pA_r_foot[4] - 0.06825*w.lambda[6] + w.lambda[10] - 0.06825*w.g_r_ankle_link[0]*mu_c0 + w.c_r_foot[4]*Ia4;
     const Scalar pa5 = w.pA_r_foot[5] + w.lambda[11] + 0.0017863999999999998*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia3 + w.c_r_foot[5]*Ia5;
     const Scalar C20 = w.cq_r_foot*w.cq_r_foot - w.sq_r_foot*w.sq_r_foot;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
@@ -2755,23 +2761,24 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu;
-    w.U_l_foot[3] = 0.00194517348958 + 1.0046580625*mu;
+    const Scalar mu_c0 = mu*w.active[0];
+    w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu_c0;
+    w.U_l_foot[3] = 0.00194517348958 + 1.0046580625*mu_c0;
     w.Dinv_l_foot = 1.0 / w.U_l_foot[3];
-    w.u_l_foot[0] = -w.pA_l_foot[3] - 0.06825*w.lambda[1] - w.lambda[3] - 0.06825*w.g_l_foot[1]*mu + tau[11];
+    w.u_l_foot[0] = -w.pA_l_foot[3] - 0.06825*w.lambda[1] - w.lambda[3] - 0.06825*w.g_l_foot[1]*mu_c0 + tau[11];
     const Scalar t0 = w.U_l_foot[1]*w.Dinv_l_foot;
     const Scalar t1 = w.U_l_foot[3]*w.Dinv_l_foot;
-    const Scalar Ia0 = 1.015 + mu;
-    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu;
-    const Scalar Ia2 = 1.015 + mu - w.U_l_foot[1]*t0;
+    const Scalar Ia0 = 1.015 + mu_c0;
+    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu_c0;
+    const Scalar Ia2 = 1.015 + mu_c0 - w.U_l_foot[1]*t0;
     const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_l_foot[1]*w.Dinv_l_foot;
-    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu;
-    const Scalar Ia5 = 0.00860228295937 + mu - 3.1912249599999995e-06*w.Dinv_l_foot;
-    const Scalar pa0 = w.pA_l_foot[0] + w.lambda[0] + w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_l_foot[1] + w.lambda[1] + w.g_l_foot[1]*mu + w.u_l_foot[0]*t0 + w.c_l_foot[1]*Ia2 + w.c_l_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2] + w.lambda[2] + w.g_l_foot[2]*mu + w.c_l_foot[2]*Ia0;
-    const Scalar pa3 = w.pA_l_foot[3] + 0.06825*w.lambda[1] + w.lambda[3] + 0.06825*w.g_l_foot[1]*mu + w.u_l_foot[0]*t1;
-    const Scalar pa4 = -0.06495999999999999*w.c_l_foot[2] + w.pA_l_foot[4] - 0.06825*w.lambda[0] + w.lambda[4] - 0.06825*w.g_l_ankle_link[0]*mu + w.c_l_foot[4]*Ia4;
+    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu_c0;
+    const Scalar Ia5 = 0.00860228295937 + mu_c0 - 3.1912249599999995e-06*w.Dinv_l_foot;
+    const Scalar pa0 = w.pA_l_foot[0] + w.lambda[0] + w.g_l_ankle_link[0]*mu_c0 + w.c_l_foot[4]*Ia1;
+    const Scalar pa1 = w.pA_l_foot[1] + w.lambda[1] + w.g_l_foot[1]*mu_c0 + w.u_l_foot[0]*t0 + w.c_l_foot[1]*Ia2 + w.c_l_foot[5]*Ia3;
+    const Scalar pa2 = -0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2] + w.lambda[2] + w.g_l_foot[2]*mu_c0 + w.c_l_foot[2]*Ia0;
+    const Scalar pa3 = w.pA_l_foot[3] + 0.06825*w.lambda[1] + w.lambda[3] + 0.06825*w.g_l_foot[1]*mu_c0 + w.u_l_foot[0]*t1;
+    const Scalar pa4 = -0.06495999999999999*w.c_l_foot[2] + w.pA_l_foot[4] - 0.06825*w.lambda[0] + w.lambda[4] - 0.06825*w.g_l_ankle_link[0]*mu_c0 + w.c_l_foot[4]*Ia4;
     const Scalar pa5 = w.pA_l_foot[5] + w.lambda[5] + 0.0017863999999999998*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia3 + w.c_l_foot[5]*Ia5;
     const Scalar C20 = w.cq_l_foot*w.cq_l_foot - w.sq_l_foot*w.sq_l_foot;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
@@ -3768,51 +3775,60 @@ PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PR
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
+    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_l_foot[3];
+    w.residual[3] = w.a_l_foot[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_l_foot[4];
+    w.residual[4] = w.a_l_foot[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_l_foot[5];
+    w.residual[5] = w.a_l_foot[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.residual[6] = w.active[1]*t3;
     w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.residual[7] = w.active[1]*t4;
     w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
+    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.residual[8] = w.active[1]*t5;
     w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_r_foot[3];
+    w.residual[9] = w.a_r_foot[3]*w.active[1];
     w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_r_foot[4];
+    w.residual[10] = w.a_r_foot[4]*w.active[1];
     w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_r_foot[5];
+    w.residual[11] = w.a_r_foot[5]*w.active[1];
     w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.residual[12] = w.active[2]*t6;
     w.dlambda[12] = mu*w.residual[12];
     w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.residual[13] = w.active[2]*t7;
     w.dlambda[13] = mu*w.residual[13];
     w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
+    w.residual[14] = w.active[2]*t8;
     w.dlambda[14] = mu*w.residual[14];
     w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
@@ -4691,51 +4707,60 @@ PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& 
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
+    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_l_foot[3];
+    w.residual[3] = w.a_l_foot[3]*w.active[0];
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_l_foot[4];
+    w.residual[4] = w.a_l_foot[4]*w.active[0];
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_l_foot[5];
+    w.residual[5] = w.a_l_foot[5]*w.active[0];
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.residual[6] = w.active[1]*t3;
     w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.residual[7] = w.active[1]*t4;
     w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
+    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.residual[8] = w.active[1]*t5;
     w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_r_foot[3];
+    w.residual[9] = w.a_r_foot[3]*w.active[1];
     w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_r_foot[4];
+    w.residual[10] = w.a_r_foot[4]*w.active[1];
     w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_r_foot[5];
+    w.residual[11] = w.a_r_foot[5]*w.active[1];
     w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.residual[12] = w.active[2]*t6;
     w.dlambda[12] = mu*w.residual[12];
     w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.residual[13] = w.active[2]*t7;
     w.dlambda[13] = mu*w.residual[13];
     w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
+    w.residual[14] = w.active[2]*t8;
     w.dlambda[14] = mu*w.residual[14];
     w.lambda[14] = w.lambda[14] + w.dlambda[14];
   }
@@ -8063,21 +8088,30 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
   }
   // free row accelerations y_free = K a - k (tree order)
   {
-    w.yfree[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.yfree[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.yfree[2] = w.a_l_foot[2] + w.g_l_foot[2];
-    w.yfree[3] = w.a_l_foot[3];
-    w.yfree[4] = w.a_l_foot[4];
-    w.yfree[5] = w.a_l_foot[5];
-    w.yfree[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.yfree[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.yfree[8] = w.a_r_foot[2] + w.g_r_foot[2];
-    w.yfree[9] = w.a_r_foot[3];
-    w.yfree[10] = w.a_r_foot[4];
-    w.yfree[11] = w.a_r_foot[5];
-    w.yfree[12] = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.yfree[13] = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
-    w.yfree[14] = -w.k_right_hand[2] + w.a_r_hand[2];
+    const Scalar t10 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.yfree[0] = t10*w.active[0];
+    const Scalar t11 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.yfree[1] = w.active[0]*t11;
+    const Scalar t12 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.yfree[2] = w.active[0]*t12;
+    w.yfree[3] = w.a_l_foot[3]*w.active[0];
+    w.yfree[4] = w.a_l_foot[4]*w.active[0];
+    w.yfree[5] = w.a_l_foot[5]*w.active[0];
+    const Scalar t13 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.yfree[6] = t13*w.active[1];
+    const Scalar t14 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.yfree[7] = w.active[1]*t14;
+    const Scalar t15 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.yfree[8] = w.active[1]*t15;
+    w.yfree[9] = w.a_r_foot[3]*w.active[1];
+    w.yfree[10] = w.a_r_foot[4]*w.active[1];
+    w.yfree[11] = w.a_r_foot[5]*w.active[1];
+    const Scalar t16 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
+    w.yfree[12] = t16*w.active[2];
+    const Scalar t17 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
+    w.yfree[13] = w.active[2]*t17;
+    const Scalar t18 = -w.k_right_hand[2] + w.a_r_hand[2];
+    w.yfree[14] = w.active[2]*t18;
   }
 }
 
@@ -8261,319 +8295,346 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W_0(Scalar inv_mu, Workspace& P
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t12 = w.Z_pelvis[0][0]*w.Linv[0];
-    const Scalar t13 = w.Z_pelvis[0][1] - w.L[1]*t12;
-    const Scalar t14 = w.Linv[1]*t13;
-    const Scalar t15 = w.Z_pelvis[0][2] - w.L[2]*t12 - w.L[16]*t14;
-    const Scalar t16 = w.Linv[2]*t15;
-    const Scalar t17 = w.Z_pelvis[0][3] - w.L[3]*t12 - w.L[17]*t14 - w.L[30]*t16;
-    const Scalar t18 = w.Linv[3]*t17;
-    const Scalar t19 = w.Z_pelvis[0][4] - w.L[4]*t12 - w.L[18]*t14 - w.L[31]*t16 - w.L[43]*t18;
-    const Scalar t20 = w.Linv[4]*t19;
-    const Scalar t21 = w.Z_pelvis[0][5] - w.L[5]*t12 - w.L[19]*t14 - w.L[32]*t16 - w.L[44]*t18 - w.L[55]*t20;
-    const Scalar t22 = w.Z_pelvis[0][6]*w.Linv[6];
-    const Scalar t23 = w.Z_pelvis[0][7] - w.L[76]*t22;
-    const Scalar t24 = w.Linv[7]*t23;
-    const Scalar t25 = w.Z_pelvis[0][8] - w.L[77]*t22 - w.L[85]*t24;
-    const Scalar t26 = w.Linv[8]*t25;
-    const Scalar t27 = w.Z_pelvis[0][9] - w.L[78]*t22 - w.L[86]*t24 - w.L[93]*t26;
-    const Scalar t28 = w.Linv[9]*t27;
-    const Scalar t29 = w.Z_pelvis[0][10] - w.L[79]*t22 - w.L[87]*t24 - w.L[94]*t26 - w.L[100]*t28;
-    const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_pelvis[0][11] - w.L[80]*t22 - w.L[88]*t24 - w.L[95]*t26 - w.L[101]*t28 - w.L[106]*t30;
-    const Scalar t32 = w.Z_pelvis[0][12]*w.Linv[12];
-    const Scalar t33 = w.Z_pelvis[0][13] - w.L[115]*t32;
-    const Scalar t34 = w.Linv[13]*t33;
-    const Scalar t35 = w.Z_pelvis[0][14] - w.L[116]*t32 - w.L[118]*t34;
-    w.W[0][0] = w.Z_pelvis[0][0]*w.Linv[0];
-    w.W[1][0] = w.Linv[1]*t13;
-    w.W[2][0] = w.Linv[2]*t15;
-    w.W[3][0] = w.Linv[3]*t17;
-    w.W[4][0] = w.Linv[4]*t19;
-    w.W[5][0] = w.Linv[5]*t21;
-    w.W[6][0] = w.Z_pelvis[0][6]*w.Linv[6];
-    w.W[7][0] = w.Linv[7]*t23;
-    w.W[8][0] = w.Linv[8]*t25;
-    w.W[9][0] = w.Linv[9]*t27;
-    w.W[10][0] = w.Linv[10]*t29;
-    w.W[11][0] = w.Linv[11]*t31;
-    w.W[12][0] = w.Z_pelvis[0][12]*w.Linv[12];
-    w.W[13][0] = w.Linv[13]*t33;
-    w.W[14][0] = w.Linv[14]*t35;
+    const Scalar t12 = w.Z_pelvis[0][0]*w.active[0];
+    const Scalar t13 = w.Linv[0]*t12;
+    const Scalar t14 = w.Z_pelvis[0][1]*w.active[0] - w.L[1]*t13;
+    const Scalar t15 = w.Linv[1]*t14;
+    const Scalar t16 = w.Z_pelvis[0][2]*w.active[0] - w.L[2]*t13 - w.L[16]*t15;
+    const Scalar t17 = w.Linv[2]*t16;
+    const Scalar t18 = w.Z_pelvis[0][3]*w.active[0] - w.L[3]*t13 - w.L[17]*t15 - w.L[30]*t17;
+    const Scalar t19 = w.Linv[3]*t18;
+    const Scalar t20 = w.Z_pelvis[0][4]*w.active[0] - w.L[4]*t13 - w.L[18]*t15 - w.L[31]*t17 - w.L[43]*t19;
+    const Scalar t21 = w.Linv[4]*t20;
+    const Scalar t22 = w.Z_pelvis[0][5]*w.active[0] - w.L[5]*t13 - w.L[19]*t15 - w.L[32]*t17 - w.L[44]*t19 - w.L[55]*t21;
+    const Scalar t23 = w.Z_pelvis[0][6]*w.active[1];
+    const Scalar t24 = w.Linv[6]*t23;
+    const Scalar t25 = w.Z_pelvis[0][7]*w.active[1] - w.L[76]*t24;
+    const Scalar t26 = w.Linv[7]*t25;
+    const Scalar t27 = w.Z_pelvis[0][8]*w.active[1] - w.L[77]*t24 - w.L[85]*t26;
+    const Scalar t28 = w.Linv[8]*t27;
+    const Scalar t29 = w.Z_pelvis[0][9]*w.active[1] - w.L[78]*t24 - w.L[86]*t26 - w.L[93]*t28;
+    const Scalar t30 = w.Linv[9]*t29;
+    const Scalar t31 = w.Z_pelvis[0][10]*w.active[1] - w.L[79]*t24 - w.L[87]*t26 - w.L[94]*t28 - w.L[100]*t30;
+    const Scalar t32 = w.Linv[10]*t31;
+    const Scalar t33 = w.Z_pelvis[0][11]*w.active[1] - w.L[80]*t24 - w.L[88]*t26 - w.L[95]*t28 - w.L[101]*t30 - w.L[106]*t32;
+    const Scalar t34 = w.Z_pelvis[0][12]*w.active[2];
+    const Scalar t35 = w.Linv[12]*t34;
+    const Scalar t36 = w.Z_pelvis[0][13]*w.active[2] - w.L[115]*t35;
+    const Scalar t37 = w.Linv[13]*t36;
+    const Scalar t38 = w.Z_pelvis[0][14]*w.active[2] - w.L[116]*t35 - w.L[118]*t37;
+    w.W[0][0] = w.Linv[0]*t12;
+    w.W[1][0] = w.Linv[1]*t14;
+    w.W[2][0] = w.Linv[2]*t16;
+    w.W[3][0] = w.Linv[3]*t18;
+    w.W[4][0] = w.Linv[4]*t20;
+    w.W[5][0] = w.Linv[5]*t22;
+    w.W[6][0] = w.Linv[6]*t23;
+    w.W[7][0] = w.Linv[7]*t25;
+    w.W[8][0] = w.Linv[8]*t27;
+    w.W[9][0] = w.Linv[9]*t29;
+    w.W[10][0] = w.Linv[10]*t31;
+    w.W[11][0] = w.Linv[11]*t33;
+    w.W[12][0] = w.Linv[12]*t34;
+    w.W[13][0] = w.Linv[13]*t36;
+    w.W[14][0] = w.Linv[14]*t38;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_W_1_to_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_1(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
-    const Scalar t0 = w.Z_pelvis[1][0]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[1][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[1][2] - w.L[2]*t0 - w.L[16]*t2;
-    const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[1][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[1][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[1][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[1][6]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[1][7] - w.L[76]*t10;
-    const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[1][8] - w.L[77]*t10 - w.L[85]*t12;
-    const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[1][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[1][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[1][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[1][12]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[1][13] - w.L[115]*t20;
-    const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[1][14] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[0][1] = w.Z_pelvis[1][0]*w.Linv[0];
-    w.W[1][1] = w.Linv[1]*t1;
-    w.W[2][1] = w.Linv[2]*t3;
-    w.W[3][1] = w.Linv[3]*t5;
-    w.W[4][1] = w.Linv[4]*t7;
-    w.W[5][1] = w.Linv[5]*t9;
-    w.W[6][1] = w.Z_pelvis[1][6]*w.Linv[6];
-    w.W[7][1] = w.Linv[7]*t11;
-    w.W[8][1] = w.Linv[8]*t13;
-    w.W[9][1] = w.Linv[9]*t15;
-    w.W[10][1] = w.Linv[10]*t17;
-    w.W[11][1] = w.Linv[11]*t19;
-    w.W[12][1] = w.Z_pelvis[1][12]*w.Linv[12];
-    w.W[13][1] = w.Linv[13]*t21;
-    w.W[14][1] = w.Linv[14]*t23;
+    const Scalar t0 = w.Z_pelvis[1][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_pelvis[1][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_pelvis[1][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
+    const Scalar t5 = w.Linv[2]*t4;
+    const Scalar t6 = w.Z_pelvis[1][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
+    const Scalar t7 = w.Linv[3]*t6;
+    const Scalar t8 = w.Z_pelvis[1][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
+    const Scalar t9 = w.Linv[4]*t8;
+    const Scalar t10 = w.Z_pelvis[1][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
+    const Scalar t11 = w.Z_pelvis[1][6]*w.active[1];
+    const Scalar t12 = w.Linv[6]*t11;
+    const Scalar t13 = w.Z_pelvis[1][7]*w.active[1] - w.L[76]*t12;
+    const Scalar t14 = w.Linv[7]*t13;
+    const Scalar t15 = w.Z_pelvis[1][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
+    const Scalar t16 = w.Linv[8]*t15;
+    const Scalar t17 = w.Z_pelvis[1][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
+    const Scalar t18 = w.Linv[9]*t17;
+    const Scalar t19 = w.Z_pelvis[1][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
+    const Scalar t20 = w.Linv[10]*t19;
+    const Scalar t21 = w.Z_pelvis[1][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
+    const Scalar t22 = w.Z_pelvis[1][12]*w.active[2];
+    const Scalar t23 = w.Linv[12]*t22;
+    const Scalar t24 = w.Z_pelvis[1][13]*w.active[2] - w.L[115]*t23;
+    const Scalar t25 = w.Linv[13]*t24;
+    const Scalar t26 = w.Z_pelvis[1][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
+    w.W[0][1] = w.Linv[0]*t0;
+    w.W[1][1] = w.Linv[1]*t2;
+    w.W[2][1] = w.Linv[2]*t4;
+    w.W[3][1] = w.Linv[3]*t6;
+    w.W[4][1] = w.Linv[4]*t8;
+    w.W[5][1] = w.Linv[5]*t10;
+    w.W[6][1] = w.Linv[6]*t11;
+    w.W[7][1] = w.Linv[7]*t13;
+    w.W[8][1] = w.Linv[8]*t15;
+    w.W[9][1] = w.Linv[9]*t17;
+    w.W[10][1] = w.Linv[10]*t19;
+    w.W[11][1] = w.Linv[11]*t21;
+    w.W[12][1] = w.Linv[12]*t22;
+    w.W[13][1] = w.Linv[13]*t24;
+    w.W[14][1] = w.Linv[14]*t26;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_delassus_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 2
   {
-    const Scalar t24 = w.Z_pelvis[2][0]*w.Linv[0];
-    const Scalar t25 = w.Z_pelvis[2][1] - w.L[1]*t24;
-    const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_pelvis[2][2] - w.L[2]*t24 - w.L[16]*t26;
-    const Scalar t28 = w.Linv[2]*t27;
-    const Scalar t29 = w.Z_pelvis[2][3] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
-    const Scalar t30 = w.Linv[3]*t29;
-    const Scalar t31 = w.Z_pelvis[2][4] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
-    const Scalar t32 = w.Linv[4]*t31;
-    const Scalar t33 = w.Z_pelvis[2][5] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
-    const Scalar t34 = w.Z_pelvis[2][6]*w.Linv[6];
-    const Scalar t35 = w.Z_pelvis[2][7] - w.L[76]*t34;
-    const Scalar t36 = w.Linv[7]*t35;
-    const Scalar t37 = w.Z_pelvis[2][8] - w.L[77]*t34 - w.L[85]*t36;
-    const Scalar t38 = w.Linv[8]*t37;
-    const Scalar t39 = w.Z_pelvis[2][9] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
-    const Scalar t40 = w.Linv[9]*t39;
-    const Scalar t41 = w.Z_pelvis[2][10] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
-    const Scalar t42 = w.Linv[10]*t41;
-    const Scalar t43 = w.Z_pelvis[2][11] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
-    const Scalar t44 = w.Z_pelvis[2][12]*w.Linv[12];
-    const Scalar t45 = w.Z_pelvis[2][13] - w.L[115]*t44;
-    const Scalar t46 = w.Linv[13]*t45;
-    const Scalar t47 = w.Z_pelvis[2][14] - w.L[116]*t44 - w.L[118]*t46;
-    w.W[0][2] = w.Z_pelvis[2][0]*w.Linv[0];
-    w.W[1][2] = w.Linv[1]*t25;
-    w.W[2][2] = w.Linv[2]*t27;
-    w.W[3][2] = w.Linv[3]*t29;
-    w.W[4][2] = w.Linv[4]*t31;
-    w.W[5][2] = w.Linv[5]*t33;
-    w.W[6][2] = w.Z_pelvis[2][6]*w.Linv[6];
-    w.W[7][2] = w.Linv[7]*t35;
-    w.W[8][2] = w.Linv[8]*t37;
-    w.W[9][2] = w.Linv[9]*t39;
-    w.W[10][2] = w.Linv[10]*t41;
-    w.W[11][2] = w.Linv[11]*t43;
-    w.W[12][2] = w.Z_pelvis[2][12]*w.Linv[12];
-    w.W[13][2] = w.Linv[13]*t45;
-    w.W[14][2] = w.Linv[14]*t47;
+    const Scalar t0 = w.Z_pelvis[2][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_pelvis[2][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_pelvis[2][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
+    const Scalar t5 = w.Linv[2]*t4;
+    const Scalar t6 = w.Z_pelvis[2][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
+    const Scalar t7 = w.Linv[3]*t6;
+    const Scalar t8 = w.Z_pelvis[2][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
+    const Scalar t9 = w.Linv[4]*t8;
+    const Scalar t10 = w.Z_pelvis[2][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
+    const Scalar t11 = w.Z_pelvis[2][6]*w.active[1];
+    const Scalar t12 = w.Linv[6]*t11;
+    const Scalar t13 = w.Z_pelvis[2][7]*w.active[1] - w.L[76]*t12;
+    const Scalar t14 = w.Linv[7]*t13;
+    const Scalar t15 = w.Z_pelvis[2][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
+    const Scalar t16 = w.Linv[8]*t15;
+    const Scalar t17 = w.Z_pelvis[2][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
+    const Scalar t18 = w.Linv[9]*t17;
+    const Scalar t19 = w.Z_pelvis[2][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
+    const Scalar t20 = w.Linv[10]*t19;
+    const Scalar t21 = w.Z_pelvis[2][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
+    const Scalar t22 = w.Z_pelvis[2][12]*w.active[2];
+    const Scalar t23 = w.Linv[12]*t22;
+    const Scalar t24 = w.Z_pelvis[2][13]*w.active[2] - w.L[115]*t23;
+    const Scalar t25 = w.Linv[13]*t24;
+    const Scalar t26 = w.Z_pelvis[2][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
+    w.W[0][2] = w.Linv[0]*t0;
+    w.W[1][2] = w.Linv[1]*t2;
+    w.W[2][2] = w.Linv[2]*t4;
+    w.W[3][2] = w.Linv[3]*t6;
+    w.W[4][2] = w.Linv[4]*t8;
+    w.W[5][2] = w.Linv[5]*t10;
+    w.W[6][2] = w.Linv[6]*t11;
+    w.W[7][2] = w.Linv[7]*t13;
+    w.W[8][2] = w.Linv[8]*t15;
+    w.W[9][2] = w.Linv[9]*t17;
+    w.W[10][2] = w.Linv[10]*t19;
+    w.W[11][2] = w.Linv[11]*t21;
+    w.W[12][2] = w.Linv[12]*t22;
+    w.W[13][2] = w.Linv[13]*t24;
+    w.W[14][2] = w.Linv[14]*t26;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_W_3_to_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_3(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t0 = w.Z_pelvis[3][0]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[3][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[3][2] - w.L[2]*t0 - w.L[16]*t2;
-    const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[3][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[3][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[3][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[3][6]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[3][7] - w.L[76]*t10;
-    const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[3][8] - w.L[77]*t10 - w.L[85]*t12;
-    const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[3][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[3][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[3][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[3][12]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[3][13] - w.L[115]*t20;
-    const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[3][14] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[0][3] = w.Z_pelvis[3][0]*w.Linv[0];
-    w.W[1][3] = w.Linv[1]*t1;
-    w.W[2][3] = w.Linv[2]*t3;
-    w.W[3][3] = w.Linv[3]*t5;
-    w.W[4][3] = w.Linv[4]*t7;
-    w.W[5][3] = w.Linv[5]*t9;
-    w.W[6][3] = w.Z_pelvis[3][6]*w.Linv[6];
-    w.W[7][3] = w.Linv[7]*t11;
-    w.W[8][3] = w.Linv[8]*t13;
-    w.W[9][3] = w.Linv[9]*t15;
-    w.W[10][3] = w.Linv[10]*t17;
-    w.W[11][3] = w.Linv[11]*t19;
-    w.W[12][3] = w.Z_pelvis[3][12]*w.Linv[12];
-    w.W[13][3] = w.Linv[13]*t21;
-    w.W[14][3] = w.Linv[14]*t23;
-  }
-  // W = L^-1 Z^T, column 4
-  {
-    const Scalar t24 = w.Z_pelvis[4][0]*w.Linv[0];
-    const Scalar t25 = w.Z_pelvis[4][1] - w.L[1]*t24;
-    const Scalar t26 = w.Linv[1]*t25;
-    const Scalar t27 = w.Z_pelvis[4][2] - w.L[2]*t24 - w.L[16]*t26;
-    const Scalar t28 = w.Linv[2]*t27;
-    const Scalar t29 = w.Z_pelvis[4][3] - w.L[3]*t24 - w.L[17]*t26 - w.L[30]*t28;
-    const Scalar t30 = w.Linv[3]*t29;
-    const Scalar t31 = w.Z_pelvis[4][4] - w.L[4]*t24 - w.L[18]*t26 - w.L[31]*t28 - w.L[43]*t30;
-    const Scalar t32 = w.Linv[4]*t31;
-    const Scalar t33 = w.Z_pelvis[4][5] - w.L[5]*t24 - w.L[19]*t26 - w.L[32]*t28 - w.L[44]*t30 - w.L[55]*t32;
-    const Scalar t34 = w.Z_pelvis[4][6]*w.Linv[6];
-    const Scalar t35 = w.Z_pelvis[4][7] - w.L[76]*t34;
-    const Scalar t36 = w.Linv[7]*t35;
-    const Scalar t37 = w.Z_pelvis[4][8] - w.L[77]*t34 - w.L[85]*t36;
-    const Scalar t38 = w.Linv[8]*t37;
-    const Scalar t39 = w.Z_pelvis[4][9] - w.L[78]*t34 - w.L[86]*t36 - w.L[93]*t38;
-    const Scalar t40 = w.Linv[9]*t39;
-    const Scalar t41 = w.Z_pelvis[4][10] - w.L[79]*t34 - w.L[87]*t36 - w.L[94]*t38 - w.L[100]*t40;
-    const Scalar t42 = w.Linv[10]*t41;
-    const Scalar t43 = w.Z_pelvis[4][11] - w.L[80]*t34 - w.L[88]*t36 - w.L[95]*t38 - w.L[101]*t40 - w.L[106]*t42;
-    const Scalar t44 = w.Z_pelvis[4][12]*w.Linv[12];
-    const Scalar t45 = w.Z_pelvis[4][13] - w.L[115]*t44;
-    const Scalar t46 = w.Linv[13]*t45;
-    const Scalar t47 = w.Z_pelvis[4][14] - w.L[116]*t44 - w.L[118]*t46;
-    w.W[0][4] = w.Z_pelvis[4][0]*w.Linv[0];
-    w.W[1][4] = w.Linv[1]*t25;
-    w.W[2][4] = w.Linv[2]*t27;
-    w.W[3][4] = w.Linv[3]*t29;
-    w.W[4][4] = w.Linv[4]*t31;
-    w.W[5][4] = w.Linv[5]*t33;
-    w.W[6][4] = w.Z_pelvis[4][6]*w.Linv[6];
-    w.W[7][4] = w.Linv[7]*t35;
-    w.W[8][4] = w.Linv[8]*t37;
-    w.W[9][4] = w.Linv[9]*t39;
-    w.W[10][4] = w.Linv[10]*t41;
-    w.W[11][4] = w.Linv[11]*t43;
-    w.W[12][4] = w.Z_pelvis[4][12]*w.Linv[12];
-    w.W[13][4] = w.Linv[13]*t45;
-    w.W[14][4] = w.Linv[14]*t47;
+    const Scalar t0 = w.Z_pelvis[3][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_pelvis[3][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_pelvis[3][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
+    const Scalar t5 = w.Linv[2]*t4;
+    const Scalar t6 = w.Z_pelvis[3][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
+    const Scalar t7 = w.Linv[3]*t6;
+    const Scalar t8 = w.Z_pelvis[3][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
+    const Scalar t9 = w.Linv[4]*t8;
+    const Scalar t10 = w.Z_pelvis[3][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
+    const Scalar t11 = w.Z_pelvis[3][6]*w.active[1];
+    const Scalar t12 = w.Linv[6]*t11;
+    const Scalar t13 = w.Z_pelvis[3][7]*w.active[1] - w.L[76]*t12;
+    const Scalar t14 = w.Linv[7]*t13;
+    const Scalar t15 = w.Z_pelvis[3][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
+    const Scalar t16 = w.Linv[8]*t15;
+    const Scalar t17 = w.Z_pelvis[3][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
+    const Scalar t18 = w.Linv[9]*t17;
+    const Scalar t19 = w.Z_pelvis[3][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
+    const Scalar t20 = w.Linv[10]*t19;
+    const Scalar t21 = w.Z_pelvis[3][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
+    const Scalar t22 = w.Z_pelvis[3][12]*w.active[2];
+    const Scalar t23 = w.Linv[12]*t22;
+    const Scalar t24 = w.Z_pelvis[3][13]*w.active[2] - w.L[115]*t23;
+    const Scalar t25 = w.Linv[13]*t24;
+    const Scalar t26 = w.Z_pelvis[3][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
+    w.W[0][3] = w.Linv[0]*t0;
+    w.W[1][3] = w.Linv[1]*t2;
+    w.W[2][3] = w.Linv[2]*t4;
+    w.W[3][3] = w.Linv[3]*t6;
+    w.W[4][3] = w.Linv[4]*t8;
+    w.W[5][3] = w.Linv[5]*t10;
+    w.W[6][3] = w.Linv[6]*t11;
+    w.W[7][3] = w.Linv[7]*t13;
+    w.W[8][3] = w.Linv[8]*t15;
+    w.W[9][3] = w.Linv[9]*t17;
+    w.W[10][3] = w.Linv[10]*t19;
+    w.W[11][3] = w.Linv[11]*t21;
+    w.W[12][3] = w.Linv[12]*t22;
+    w.W[13][3] = w.Linv[13]*t24;
+    w.W[14][3] = w.Linv[14]*t26;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // W = L^-1 Z^T, column 4
+  {
+    const Scalar t0 = w.Z_pelvis[4][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_pelvis[4][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_pelvis[4][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
+    const Scalar t5 = w.Linv[2]*t4;
+    const Scalar t6 = w.Z_pelvis[4][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
+    const Scalar t7 = w.Linv[3]*t6;
+    const Scalar t8 = w.Z_pelvis[4][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
+    const Scalar t9 = w.Linv[4]*t8;
+    const Scalar t10 = w.Z_pelvis[4][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
+    const Scalar t11 = w.Z_pelvis[4][6]*w.active[1];
+    const Scalar t12 = w.Linv[6]*t11;
+    const Scalar t13 = w.Z_pelvis[4][7]*w.active[1] - w.L[76]*t12;
+    const Scalar t14 = w.Linv[7]*t13;
+    const Scalar t15 = w.Z_pelvis[4][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
+    const Scalar t16 = w.Linv[8]*t15;
+    const Scalar t17 = w.Z_pelvis[4][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
+    const Scalar t18 = w.Linv[9]*t17;
+    const Scalar t19 = w.Z_pelvis[4][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
+    const Scalar t20 = w.Linv[10]*t19;
+    const Scalar t21 = w.Z_pelvis[4][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
+    const Scalar t22 = w.Z_pelvis[4][12]*w.active[2];
+    const Scalar t23 = w.Linv[12]*t22;
+    const Scalar t24 = w.Z_pelvis[4][13]*w.active[2] - w.L[115]*t23;
+    const Scalar t25 = w.Linv[13]*t24;
+    const Scalar t26 = w.Z_pelvis[4][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
+    w.W[0][4] = w.Linv[0]*t0;
+    w.W[1][4] = w.Linv[1]*t2;
+    w.W[2][4] = w.Linv[2]*t4;
+    w.W[3][4] = w.Linv[3]*t6;
+    w.W[4][4] = w.Linv[4]*t8;
+    w.W[5][4] = w.Linv[5]*t10;
+    w.W[6][4] = w.Linv[6]*t11;
+    w.W[7][4] = w.Linv[7]*t13;
+    w.W[8][4] = w.Linv[8]*t15;
+    w.W[9][4] = w.Linv[9]*t17;
+    w.W[10][4] = w.Linv[10]*t19;
+    w.W[11][4] = w.Linv[11]*t21;
+    w.W[12][4] = w.Linv[12]*t22;
+    w.W[13][4] = w.Linv[13]*t24;
+    w.W[14][4] = w.Linv[14]*t26;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_delassus_W_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t0 = w.Z_pelvis[5][0]*w.Linv[0];
-    const Scalar t1 = w.Z_pelvis[5][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_pelvis[5][2] - w.L[2]*t0 - w.L[16]*t2;
-    const Scalar t4 = w.Linv[2]*t3;
-    const Scalar t5 = w.Z_pelvis[5][3] - w.L[3]*t0 - w.L[17]*t2 - w.L[30]*t4;
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_pelvis[5][4] - w.L[4]*t0 - w.L[18]*t2 - w.L[31]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_pelvis[5][5] - w.L[5]*t0 - w.L[19]*t2 - w.L[32]*t4 - w.L[44]*t6 - w.L[55]*t8;
-    const Scalar t10 = w.Z_pelvis[5][6]*w.Linv[6];
-    const Scalar t11 = w.Z_pelvis[5][7] - w.L[76]*t10;
-    const Scalar t12 = w.Linv[7]*t11;
-    const Scalar t13 = w.Z_pelvis[5][8] - w.L[77]*t10 - w.L[85]*t12;
-    const Scalar t14 = w.Linv[8]*t13;
-    const Scalar t15 = w.Z_pelvis[5][9] - w.L[78]*t10 - w.L[86]*t12 - w.L[93]*t14;
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_pelvis[5][10] - w.L[79]*t10 - w.L[87]*t12 - w.L[94]*t14 - w.L[100]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_pelvis[5][11] - w.L[80]*t10 - w.L[88]*t12 - w.L[95]*t14 - w.L[101]*t16 - w.L[106]*t18;
-    const Scalar t20 = w.Z_pelvis[5][12]*w.Linv[12];
-    const Scalar t21 = w.Z_pelvis[5][13] - w.L[115]*t20;
-    const Scalar t22 = w.Linv[13]*t21;
-    const Scalar t23 = w.Z_pelvis[5][14] - w.L[116]*t20 - w.L[118]*t22;
-    w.W[0][5] = w.Z_pelvis[5][0]*w.Linv[0];
-    w.W[1][5] = w.Linv[1]*t1;
-    w.W[2][5] = w.Linv[2]*t3;
-    w.W[3][5] = w.Linv[3]*t5;
-    w.W[4][5] = w.Linv[4]*t7;
-    w.W[5][5] = w.Linv[5]*t9;
-    w.W[6][5] = w.Z_pelvis[5][6]*w.Linv[6];
-    w.W[7][5] = w.Linv[7]*t11;
-    w.W[8][5] = w.Linv[8]*t13;
-    w.W[9][5] = w.Linv[9]*t15;
-    w.W[10][5] = w.Linv[10]*t17;
-    w.W[11][5] = w.Linv[11]*t19;
-    w.W[12][5] = w.Z_pelvis[5][12]*w.Linv[12];
-    w.W[13][5] = w.Linv[13]*t21;
-    w.W[14][5] = w.Linv[14]*t23;
+    const Scalar t0 = w.Z_pelvis[5][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_pelvis[5][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_pelvis[5][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
+    const Scalar t5 = w.Linv[2]*t4;
+    const Scalar t6 = w.Z_pelvis[5][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
+    const Scalar t7 = w.Linv[3]*t6;
+    const Scalar t8 = w.Z_pelvis[5][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
+    const Scalar t9 = w.Linv[4]*t8;
+    const Scalar t10 = w.Z_pelvis[5][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
+    const Scalar t11 = w.Z_pelvis[5][6]*w.active[1];
+    const Scalar t12 = w.Linv[6]*t11;
+    const Scalar t13 = w.Z_pelvis[5][7]*w.active[1] - w.L[76]*t12;
+    const Scalar t14 = w.Linv[7]*t13;
+    const Scalar t15 = w.Z_pelvis[5][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
+    const Scalar t16 = w.Linv[8]*t15;
+    const Scalar t17 = w.Z_pelvis[5][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
+    const Scalar t18 = w.Linv[9]*t17;
+    const Scalar t19 = w.Z_pelvis[5][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
+    const Scalar t20 = w.Linv[10]*t19;
+    const Scalar t21 = w.Z_pelvis[5][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
+    const Scalar t22 = w.Z_pelvis[5][12]*w.active[2];
+    const Scalar t23 = w.Linv[12]*t22;
+    const Scalar t24 = w.Z_pelvis[5][13]*w.active[2] - w.L[115]*t23;
+    const Scalar t25 = w.Linv[13]*t24;
+    const Scalar t26 = w.Z_pelvis[5][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
+    w.W[0][5] = w.Linv[0]*t0;
+    w.W[1][5] = w.Linv[1]*t2;
+    w.W[2][5] = w.Linv[2]*t4;
+    w.W[3][5] = w.Linv[3]*t6;
+    w.W[4][5] = w.Linv[4]*t8;
+    w.W[5][5] = w.Linv[5]*t10;
+    w.W[6][5] = w.Linv[6]*t11;
+    w.W[7][5] = w.Linv[7]*t13;
+    w.W[8][5] = w.Linv[8]*t15;
+    w.W[9][5] = w.Linv[9]*t17;
+    w.W[10][5] = w.Linv[10]*t19;
+    w.W[11][5] = w.Linv[11]*t21;
+    w.W[12][5] = w.Linv[12]*t22;
+    w.W[13][5] = w.Linv[13]*t24;
+    w.W[14][5] = w.Linv[14]*t26;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_delassus_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t24 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0] + w.W[12][0]*w.W[12][0] + w.W[13][0]*w.W[13][0] + w.W[14][0]*w.W[14][0];
-    const Scalar r0 = std::sqrt(t24);
+    const Scalar t0 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0] + w.W[12][0]*w.W[12][0] + w.W[13][0]*w.W[13][0] + w.W[14][0]*w.W[14][0];
+    const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t25 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1] + w.W[12][0]*w.W[12][1] + w.W[13][0]*w.W[13][1] + w.W[14][0]*w.W[14][1];
-    w.LS[1] = w.LSinv[0]*t25;
-    const Scalar t26 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2] + w.W[12][0]*w.W[12][2] + w.W[13][0]*w.W[13][2] + w.W[14][0]*w.W[14][2];
-    w.LS[2] = w.LSinv[0]*t26;
-    const Scalar t27 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3] + w.W[12][0]*w.W[12][3] + w.W[13][0]*w.W[13][3] + w.W[14][0]*w.W[14][3];
-    w.LS[3] = w.LSinv[0]*t27;
-    const Scalar t28 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4] + w.W[12][0]*w.W[12][4] + w.W[13][0]*w.W[13][4] + w.W[14][0]*w.W[14][4];
-    w.LS[4] = w.LSinv[0]*t28;
-    const Scalar t29 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5] + w.W[12][0]*w.W[12][5] + w.W[13][0]*w.W[13][5] + w.W[14][0]*w.W[14][5];
-    w.LS[5] = w.LSinv[0]*t29;
-    const Scalar t30 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] + w.W[12][1]*w.W[12][1] + w.W[13][1]*w.W[13][1] + w.W[14][1]*w.W[14][1] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t30);
+    const Scalar t1 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1] + w.W[12][0]*w.W[12][1] + w.W[13][0]*w.W[13][1] + w.W[14][0]*w.W[14][1];
+    w.LS[1] = w.LSinv[0]*t1;
+    const Scalar t2 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2] + w.W[12][0]*w.W[12][2] + w.W[13][0]*w.W[13][2] + w.W[14][0]*w.W[14][2];
+    w.LS[2] = w.LSinv[0]*t2;
+    const Scalar t3 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3] + w.W[12][0]*w.W[12][3] + w.W[13][0]*w.W[13][3] + w.W[14][0]*w.W[14][3];
+    w.LS[3] = w.LSinv[0]*t3;
+    const Scalar t4 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4] + w.W[12][0]*w.W[12][4] + w.W[13][0]*w.W[13][4] + w.W[14][0]*w.W[14][4];
+    w.LS[4] = w.LSinv[0]*t4;
+    const Scalar t5 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5] + w.W[12][0]*w.W[12][5] + w.W[13][0]*w.W[13][5] + w.W[14][0]*w.W[14][5];
+    w.LS[5] = w.LSinv[0]*t5;
+    const Scalar t6 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] + w.W[12][1]*w.W[12][1] + w.W[13][1]*w.W[13][1] + w.W[14][1]*w.W[14][1] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t6);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t31 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] + w.W[12][1]*w.W[12][2] + w.W[13][1]*w.W[13][2] + w.W[14][1]*w.W[14][2] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t31;
-    const Scalar t32 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] + w.W[12][1]*w.W[12][3] + w.W[13][1]*w.W[13][3] + w.W[14][1]*w.W[14][3] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t32;
-    const Scalar t33 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] + w.W[12][1]*w.W[12][4] + w.W[13][1]*w.W[13][4] + w.W[14][1]*w.W[14][4] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t33;
-    const Scalar t34 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] + w.W[12][1]*w.W[12][5] + w.W[13][1]*w.W[13][5] + w.W[14][1]*w.W[14][5] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t34;
-    const Scalar t35 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] + w.W[12][2]*w.W[12][2] + w.W[13][2]*w.W[13][2] + w.W[14][2]*w.W[14][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t35);
+    const Scalar t7 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] + w.W[12][1]*w.W[12][2] + w.W[13][1]*w.W[13][2] + w.W[14][1]*w.W[14][2] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t7;
+    const Scalar t8 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] + w.W[12][1]*w.W[12][3] + w.W[13][1]*w.W[13][3] + w.W[14][1]*w.W[14][3] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t8;
+    const Scalar t9 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] + w.W[12][1]*w.W[12][4] + w.W[13][1]*w.W[13][4] + w.W[14][1]*w.W[14][4] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t9;
+    const Scalar t10 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] + w.W[12][1]*w.W[12][5] + w.W[13][1]*w.W[13][5] + w.W[14][1]*w.W[14][5] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t10;
+    const Scalar t11 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] + w.W[12][2]*w.W[12][2] + w.W[13][2]*w.W[13][2] + w.W[14][2]*w.W[14][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t11);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t36 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] + w.W[12][2]*w.W[12][3] + w.W[13][2]*w.W[13][3] + w.W[14][2]*w.W[14][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t36;
-    const Scalar t37 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] + w.W[12][2]*w.W[12][4] + w.W[13][2]*w.W[13][4] + w.W[14][2]*w.W[14][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t37;
-    const Scalar t38 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] + w.W[12][2]*w.W[12][5] + w.W[13][2]*w.W[13][5] + w.W[14][2]*w.W[14][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t38;
-    const Scalar t39 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] + w.W[12][3]*w.W[12][3] + w.W[13][3]*w.W[13][3] + w.W[14][3]*w.W[14][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t39);
+    const Scalar t12 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] + w.W[12][2]*w.W[12][3] + w.W[13][2]*w.W[13][3] + w.W[14][2]*w.W[14][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t12;
+    const Scalar t13 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] + w.W[12][2]*w.W[12][4] + w.W[13][2]*w.W[13][4] + w.W[14][2]*w.W[14][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t13;
+    const Scalar t14 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] + w.W[12][2]*w.W[12][5] + w.W[13][2]*w.W[13][5] + w.W[14][2]*w.W[14][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t14;
+    const Scalar t15 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] + w.W[12][3]*w.W[12][3] + w.W[13][3]*w.W[13][3] + w.W[14][3]*w.W[14][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t15);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t40 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] + w.W[12][3]*w.W[12][4] + w.W[13][3]*w.W[13][4] + w.W[14][3]*w.W[14][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t40;
-    const Scalar t41 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] + w.W[12][3]*w.W[12][5] + w.W[13][3]*w.W[13][5] + w.W[14][3]*w.W[14][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t41;
-    const Scalar t42 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] + w.W[12][4]*w.W[12][4] + w.W[13][4]*w.W[13][4] + w.W[14][4]*w.W[14][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t42);
+    const Scalar t16 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] + w.W[12][3]*w.W[12][4] + w.W[13][3]*w.W[13][4] + w.W[14][3]*w.W[14][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t16;
+    const Scalar t17 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] + w.W[12][3]*w.W[12][5] + w.W[13][3]*w.W[13][5] + w.W[14][3]*w.W[14][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t17;
+    const Scalar t18 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] + w.W[12][4]*w.W[12][4] + w.W[13][4]*w.W[13][4] + w.W[14][4]*w.W[14][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t18);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t43 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] + w.W[12][4]*w.W[12][5] + w.W[13][4]*w.W[13][5] + w.W[14][4]*w.W[14][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t43;
-    const Scalar t44 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] + w.W[12][5]*w.W[12][5] + w.W[13][5]*w.W[13][5] + w.W[14][5]*w.W[14][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t44);
+    const Scalar t19 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] + w.W[12][4]*w.W[12][5] + w.W[13][4]*w.W[13][5] + w.W[14][4]*w.W[14][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t19;
+    const Scalar t20 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] + w.W[12][5]*w.W[12][5] + w.W[13][5]*w.W[13][5] + w.W[14][5]*w.W[14][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t20);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
@@ -9133,21 +9194,30 @@ PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROX
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // residual rows K a - k (layout order)
   {
-    w.residual[0] = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.residual[1] = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.residual[2] = w.a_l_foot[2] + w.g_l_foot[2];
-    w.residual[3] = w.a_l_foot[3];
-    w.residual[4] = w.a_l_foot[4];
-    w.residual[5] = w.a_l_foot[5];
-    w.residual[6] = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.residual[7] = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.residual[8] = w.a_r_foot[2] + w.g_r_foot[2];
-    w.residual[9] = w.a_r_foot[3];
-    w.residual[10] = w.a_r_foot[4];
-    w.residual[11] = w.a_r_foot[5];
-    w.residual[12] = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.residual[13] = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
-    w.residual[14] = w.a_r_hand[2] - w.k_right_hand[2];
+    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
+    w.residual[0] = t0*w.active[0];
+    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
+    w.residual[1] = w.active[0]*t1;
+    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
+    w.residual[2] = w.active[0]*t2;
+    w.residual[3] = w.a_l_foot[3]*w.active[0];
+    w.residual[4] = w.a_l_foot[4]*w.active[0];
+    w.residual[5] = w.a_l_foot[5]*w.active[0];
+    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
+    w.residual[6] = t3*w.active[1];
+    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
+    w.residual[7] = w.active[1]*t4;
+    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
+    w.residual[8] = w.active[1]*t5;
+    w.residual[9] = w.a_r_foot[3]*w.active[1];
+    w.residual[10] = w.a_r_foot[4]*w.active[1];
+    w.residual[11] = w.a_r_foot[5]*w.active[1];
+    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
+    w.residual[12] = t6*w.active[2];
+    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
+    w.residual[13] = w.active[2]*t7;
+    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
+    w.residual[14] = w.active[2]*t8;
   }
 }
 
@@ -9198,25 +9268,29 @@ void accelerate_free_bodies(Workspace& w) noexcept {
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
+  w.active[0] = Scalar(s.active[0]);
+  w.active[1] = Scalar(s.active[1]);
+  w.active[2] = Scalar(s.active[2]);
   kinematics(q, v, w);
   eliminate_free_bodies(tau, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
-  w.lambda[6] = lambda0[6];
-  w.lambda[7] = lambda0[7];
-  w.lambda[8] = lambda0[8];
-  w.lambda[9] = lambda0[9];
-  w.lambda[10] = lambda0[10];
-  w.lambda[11] = lambda0[11];
-  w.lambda[12] = lambda0[12];
-  w.lambda[13] = lambda0[13];
-  w.lambda[14] = lambda0[14];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
+  w.lambda[6] = lambda0_if[s.active[1]][6];
+  w.lambda[7] = lambda0_if[s.active[1]][7];
+  w.lambda[8] = lambda0_if[s.active[1]][8];
+  w.lambda[9] = lambda0_if[s.active[1]][9];
+  w.lambda[10] = lambda0_if[s.active[1]][10];
+  w.lambda[11] = lambda0_if[s.active[1]][11];
+  w.lambda[12] = lambda0_if[s.active[2]][12];
+  w.lambda[13] = lambda0_if[s.active[2]][13];
+  w.lambda[14] = lambda0_if[s.active[2]][14];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_r_hand_to_r_wrist_pitch_link(tau, mu, w);
   caba_backward_r_wrist_yaw_link(tau, w);
@@ -9330,6 +9404,9 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 // matrix G + I/mu factored once at the root, K proximal solves, one forward sweep.
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
+  w.active[0] = Scalar(s.active[0]);
+  w.active[1] = Scalar(s.active[1]);
+  w.active[2] = Scalar(s.active[2]);
   kinematics(q, v, w);
   eliminate_free_bodies(tau, w);
   // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
@@ -9368,26 +9445,30 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_delassus_column_0_to_column_3(inv_mu, w);
   pv_delassus_column_4_to_column_8(inv_mu, w);
   pv_delassus_column_9_to_W_0(inv_mu, w);
-  pv_delassus_W_1_to_W_2(w);
-  pv_delassus_W_3_to_W_4(w);
-  pv_delassus_W_5_to_LS(w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  pv_delassus_W_1(w);
+  pv_delassus_W_2(w);
+  pv_delassus_W_3(w);
+  pv_delassus_W_4(w);
+  pv_delassus_W_5(w);
+  pv_delassus_LS(w);
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
-  w.lambda[6] = lambda0[6];
-  w.lambda[7] = lambda0[7];
-  w.lambda[8] = lambda0[8];
-  w.lambda[9] = lambda0[9];
-  w.lambda[10] = lambda0[10];
-  w.lambda[11] = lambda0[11];
-  w.lambda[12] = lambda0[12];
-  w.lambda[13] = lambda0[13];
-  w.lambda[14] = lambda0[14];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[0]][3];
+  w.lambda[4] = lambda0_if[s.active[0]][4];
+  w.lambda[5] = lambda0_if[s.active[0]][5];
+  w.lambda[6] = lambda0_if[s.active[1]][6];
+  w.lambda[7] = lambda0_if[s.active[1]][7];
+  w.lambda[8] = lambda0_if[s.active[1]][8];
+  w.lambda[9] = lambda0_if[s.active[1]][9];
+  w.lambda[10] = lambda0_if[s.active[1]][10];
+  w.lambda[11] = lambda0_if[s.active[1]][11];
+  w.lambda[12] = lambda0_if[s.active[2]][12];
+  w.lambda[13] = lambda0_if[s.active[2]][13];
+  w.lambda[14] = lambda0_if[s.active[2]][14];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu

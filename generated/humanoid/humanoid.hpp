@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8744 + 1720 K (= 13904 at K = 3)
-//     add/sub 3521 + 743 K, mul 4990 + 931 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16657 + 650 K (= 18607 at K = 3)
-//     add/sub 6655 + 285 K, mul 9583 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
+//     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
+//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -118,13 +118,17 @@ inline constexpr int right_foot = 1;
 inline constexpr int right_hand = 2;
 }  // namespace constraint
 
+// Every constraint active: the default schedule of the functions taking one.
+inline constexpr bool all_active[3] = {true, true, true};
+
 // Set the fields by name (later versions may add fields).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
   int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
   // Run-time contact schedule: active[k] for constraint k of the layout
   // (constraint::<name>). An inactive constraint exerts no force: its
-  // multipliers are 0 and the answer is that of the solver generated without it.
+  // multipliers are 0 and the answer is that of the solver generated without it
+  // (to round-off; docs/algorithms.md §4.4). Change it between calls freely.
   bool active[3] = {true, true, true};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
@@ -132,7 +136,7 @@ struct Settings {
   const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (23000 bytes): per-body quantities named
+// Everything one solve writes (23024 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_pelvis[3][3];      // joint rotation, body 1
@@ -336,6 +340,7 @@ struct Workspace {
   Scalar IA_l_shoulder_pitch_link[21]; // articulated inertia (upper triangle), body 16
   Scalar Dinv_l_shoulder_pitch_link; // 1 / (S^T IA S), body 16
   Scalar u_l_shoulder_pitch_link[1]; // tau - S^T pA, body 16
+  Scalar active[3];            // the schedule of the last call (Settings::active) as 0/1 factors
   Scalar lambda[15];           // multipliers (layout order)
   Scalar U_r_hand[6];          // IA S, body 31
   Scalar Dinv_r_hand;          // 1 / (S^T IA S), body 31
@@ -516,6 +521,10 @@ struct Workspace {
 // from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
 // round-off. From a lambda0 that already solves the constraints the update
 // adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
+// Schedule: a constraint k with !s.active[k] exerts no force: its lambda rows are
+// exactly 0, its lambda0 rows are never read, its residual rows count as 0, and
+// qdd and the other rows are those of the solver generated without it (to
+// round-off), for any combination; no branch, no allocation (4.4).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,

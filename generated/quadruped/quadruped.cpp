@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4534 + 1204 K (= 8146 at K = 3)
-//     add/sub 1916 + 543 K, mul 2519 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8457 + 475 K (= 9882 at K = 3)
-//     add/sub 3518 + 204 K, mul 4762 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4538 + 1216 K (= 8186 at K = 3)
+//     add/sub 1916 + 543 K, mul 2523 + 647 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8553 + 475 K (= 9978 at K = 3)
+//     add/sub 3518 + 204 K, mul 4858 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 
 #include "quadruped.hpp"
 
@@ -21,6 +21,10 @@ static_assert(proxgen_rt::version_major == version_major);
 static_assert(proxgen_rt::version_minor == version_minor);
 
 namespace {
+
+// nc multipliers: an array of two picks by a schedule flag, {zeros, given}
+// (docs/algorithms.md §4.4).
+using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
 PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -501,38 +505,39 @@ PROXGEN_RT_NOINLINE void kinematics_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q
 PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
+    const Scalar mu_c0 = mu*w.active[3];
     const Scalar t0 = 0.195*w.k_rh_foot[1] - 0.004*w.k_rh_foot[2];
-    w.U_RH_shank[0] = -0.003904 - 0.195*mu;
-    w.U_RH_shank[4] = 0.000486144 + 0.038025*mu;
-    w.U_RH_shank[5] = -0.0007800000000000001*mu;
+    w.U_RH_shank[0] = -0.003904 - 0.195*mu_c0;
+    w.U_RH_shank[4] = 0.000486144 + 0.038025*mu_c0;
+    w.U_RH_shank[5] = -0.0007800000000000001*mu_c0;
     w.Dinv_RH_shank = 1.0 / w.U_RH_shank[4];
-    w.u_RH_shank[0] = -w.pA_RH_shank[4] + 0.195*w.lambda[9] - 0.195*w.k_rh_foot[0]*mu + tau[17];
+    w.u_RH_shank[0] = -w.pA_RH_shank[4] + 0.195*w.lambda[9] - 0.195*w.k_rh_foot[0]*mu_c0 + tau[17];
     const Scalar t1 = w.U_RH_shank[0]*w.Dinv_RH_shank;
     const Scalar t2 = w.U_RH_shank[4]*w.Dinv_RH_shank;
     const Scalar t3 = w.U_RH_shank[5]*w.Dinv_RH_shank;
-    const Scalar Ia0 = 0.064 + mu - w.U_RH_shank[0]*t1;
-    const Scalar Ia1 = 0.004*mu - w.U_RH_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu;
-    const Scalar Ia3 = 0.003904 + 0.195*mu;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_RH_shank[5]*t3;
-    const Scalar pa0 = w.pA_RH_shank[0] + w.lambda[9] - w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t1 + w.c_RH_shank[0]*Ia0 + w.c_RH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RH_shank[1] + w.lambda[10] - w.k_rh_foot[1]*mu + w.c_RH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RH_shank[2] + w.lambda[11] - w.k_rh_foot[2]*mu + w.c_RH_shank[2]*Ia2 - 0.004*w.c_RH_shank[3]*mu;
-    const Scalar pa3 = w.pA_RH_shank[3] + 0.195*w.lambda[10] - 0.004*w.lambda[11] - mu*t0 - 0.004*w.c_RH_shank[2]*mu + w.c_RH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RH_shank[4] - 0.195*w.lambda[9] + 0.195*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t2;
-    const Scalar pa5 = w.pA_RH_shank[5] + 0.004*w.lambda[9] - 0.004*w.k_rh_foot[0]*mu + w.u_RH_shank[0]*t3 + w.c_RH_shank[0]*Ia1 + w.c_RH_shank[5]*Ia5;
+    const Scalar Ia0 = 0.064 + mu_c0 - w.U_RH_shank[0]*t1;
+    const Scalar Ia1 = 0.004*mu_c0 - w.U_RH_shank[5]*t1;
+    const Scalar Ia2 = 0.064 + mu_c0;
+    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
+    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
+    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_RH_shank[5]*t3;
+    const Scalar pa0 = w.pA_RH_shank[0] + w.lambda[9] - w.k_rh_foot[0]*mu_c0 + w.u_RH_shank[0]*t1 + w.c_RH_shank[0]*Ia0 + w.c_RH_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_RH_shank[1] + w.lambda[10] - w.k_rh_foot[1]*mu_c0 + w.c_RH_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_RH_shank[2] + w.lambda[11] - w.k_rh_foot[2]*mu_c0 + w.c_RH_shank[2]*Ia2 - 0.004*w.c_RH_shank[3]*mu_c0;
+    const Scalar pa3 = w.pA_RH_shank[3] + 0.195*w.lambda[10] - 0.004*w.lambda[11] - mu_c0*t0 - 0.004*w.c_RH_shank[2]*mu_c0 + w.c_RH_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_RH_shank[4] - 0.195*w.lambda[9] + 0.195*w.k_rh_foot[0]*mu_c0 + w.u_RH_shank[0]*t2;
+    const Scalar pa5 = w.pA_RH_shank[5] + 0.004*w.lambda[9] - 0.004*w.k_rh_foot[0]*mu_c0 + w.u_RH_shank[0]*t3 + w.c_RH_shank[0]*Ia1 + w.c_RH_shank[5]*Ia5;
     const Scalar C20 = w.cq_RH_shank*w.cq_RH_shank - w.sq_RH_shank*w.sq_RH_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
     const Scalar t4 = 2.0*w.cq_RH_shank*w.sq_RH_shank;
-    const Scalar t5 = -0.002*mu + 0.5*Ia1;
+    const Scalar t5 = -0.002*mu_c0 + 0.5*Ia1;
     const Scalar h1 = 0.5*(-Ia4 + Ia5);
     const Scalar m1 = 0.5*(Ia4 + Ia5);
     const Scalar t6 = m0 - C20*h0;
     const Scalar t7 = m0 + C20*h0;
-    const Scalar t8 = 0.002*mu + 0.5*Ia1 + C20*t5;
-    const Scalar t9 = -0.002*mu - 0.5*Ia1 + C20*t5;
+    const Scalar t8 = 0.002*mu_c0 + 0.5*Ia1 + C20*t5;
+    const Scalar t9 = -0.002*mu_c0 - 0.5*Ia1 + C20*t5;
     const Scalar t10 = 0.209*Ia2 + w.cq_RH_shank*Ia3;
     const Scalar t11 = w.cq_RH_shank*pa0 + w.sq_RH_shank*pa2;
     const Scalar t12 = -w.sq_RH_shank*pa0 + w.cq_RH_shank*pa2;
@@ -770,38 +775,39 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
+    const Scalar mu_c0 = mu*w.active[1];
     const Scalar t0 = 0.195*w.k_rf_foot[1] - 0.004*w.k_rf_foot[2];
-    w.U_RF_shank[0] = -0.003904 - 0.195*mu;
-    w.U_RF_shank[4] = 0.000486144 + 0.038025*mu;
-    w.U_RF_shank[5] = -0.0007800000000000001*mu;
+    w.U_RF_shank[0] = -0.003904 - 0.195*mu_c0;
+    w.U_RF_shank[4] = 0.000486144 + 0.038025*mu_c0;
+    w.U_RF_shank[5] = -0.0007800000000000001*mu_c0;
     w.Dinv_RF_shank = 1.0 / w.U_RF_shank[4];
-    w.u_RF_shank[0] = -w.pA_RF_shank[4] + 0.195*w.lambda[3] - 0.195*w.k_rf_foot[0]*mu + tau[14];
+    w.u_RF_shank[0] = -w.pA_RF_shank[4] + 0.195*w.lambda[3] - 0.195*w.k_rf_foot[0]*mu_c0 + tau[14];
     const Scalar t1 = w.U_RF_shank[0]*w.Dinv_RF_shank;
     const Scalar t2 = w.U_RF_shank[4]*w.Dinv_RF_shank;
     const Scalar t3 = w.U_RF_shank[5]*w.Dinv_RF_shank;
-    const Scalar Ia0 = 0.064 + mu - w.U_RF_shank[0]*t1;
-    const Scalar Ia1 = 0.004*mu - w.U_RF_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu;
-    const Scalar Ia3 = 0.003904 + 0.195*mu;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_RF_shank[5]*t3;
-    const Scalar pa0 = w.pA_RF_shank[0] + w.lambda[3] - w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t1 + w.c_RF_shank[0]*Ia0 + w.c_RF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RF_shank[1] + w.lambda[4] - w.k_rf_foot[1]*mu + w.c_RF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RF_shank[2] + w.lambda[5] - w.k_rf_foot[2]*mu + w.c_RF_shank[2]*Ia2 - 0.004*w.c_RF_shank[3]*mu;
-    const Scalar pa3 = w.pA_RF_shank[3] + 0.195*w.lambda[4] - 0.004*w.lambda[5] - mu*t0 - 0.004*w.c_RF_shank[2]*mu + w.c_RF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RF_shank[4] - 0.195*w.lambda[3] + 0.195*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t2;
-    const Scalar pa5 = w.pA_RF_shank[5] + 0.004*w.lambda[3] - 0.004*w.k_rf_foot[0]*mu + w.u_RF_shank[0]*t3 + w.c_RF_shank[0]*Ia1 + w.c_RF_shank[5]*Ia5;
+    const Scalar Ia0 = 0.064 + mu_c0 - w.U_RF_shank[0]*t1;
+    const Scalar Ia1 = 0.004*mu_c0 - w.U_RF_shank[5]*t1;
+    const Scalar Ia2 = 0.064 + mu_c0;
+    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
+    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
+    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_RF_shank[5]*t3;
+    const Scalar pa0 = w.pA_RF_shank[0] + w.lambda[3] - w.k_rf_foot[0]*mu_c0 + w.u_RF_shank[0]*t1 + w.c_RF_shank[0]*Ia0 + w.c_RF_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_RF_shank[1] + w.lambda[4] - w.k_rf_foot[1]*mu_c0 + w.c_RF_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_RF_shank[2] + w.lambda[5] - w.k_rf_foot[2]*mu_c0 + w.c_RF_shank[2]*Ia2 - 0.004*w.c_RF_shank[3]*mu_c0;
+    const Scalar pa3 = w.pA_RF_shank[3] + 0.195*w.lambda[4] - 0.004*w.lambda[5] - mu_c0*t0 - 0.004*w.c_RF_shank[2]*mu_c0 + w.c_RF_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_RF_shank[4] - 0.195*w.lambda[3] + 0.195*w.k_rf_foot[0]*mu_c0 + w.u_RF_shank[0]*t2;
+    const Scalar pa5 = w.pA_RF_shank[5] + 0.004*w.lambda[3] - 0.004*w.k_rf_foot[0]*mu_c0 + w.u_RF_shank[0]*t3 + w.c_RF_shank[0]*Ia1 + w.c_RF_shank[5]*Ia5;
     const Scalar C20 = w.cq_RF_shank*w.cq_RF_shank - w.sq_RF_shank*w.sq_RF_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
     const Scalar t4 = 2.0*w.cq_RF_shank*w.sq_RF_shank;
-    const Scalar t5 = -0.002*mu + 0.5*Ia1;
+    const Scalar t5 = -0.002*mu_c0 + 0.5*Ia1;
     const Scalar h1 = 0.5*(-Ia4 + Ia5);
     const Scalar m1 = 0.5*(Ia4 + Ia5);
     const Scalar t6 = m0 - C20*h0;
     const Scalar t7 = m0 + C20*h0;
-    const Scalar t8 = 0.002*mu + 0.5*Ia1 + C20*t5;
-    const Scalar t9 = -0.002*mu - 0.5*Ia1 + C20*t5;
+    const Scalar t8 = 0.002*mu_c0 + 0.5*Ia1 + C20*t5;
+    const Scalar t9 = -0.002*mu_c0 - 0.5*Ia1 + C20*t5;
     const Scalar t10 = 0.209*Ia2 + w.cq_RF_shank*Ia3;
     const Scalar t11 = w.cq_RF_shank*pa0 + w.sq_RF_shank*pa2;
     const Scalar t12 = -w.sq_RF_shank*pa0 + w.cq_RF_shank*pa2;
@@ -1039,38 +1045,39 @@ PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
+    const Scalar mu_c0 = mu*w.active[2];
     const Scalar t0 = 0.195*w.k_lh_foot[1] + 0.004*w.k_lh_foot[2];
-    w.U_LH_shank[0] = -0.003904 - 0.195*mu;
-    w.U_LH_shank[4] = 0.000486144 + 0.038025*mu;
-    w.U_LH_shank[5] = 0.0007800000000000001*mu;
+    w.U_LH_shank[0] = -0.003904 - 0.195*mu_c0;
+    w.U_LH_shank[4] = 0.000486144 + 0.038025*mu_c0;
+    w.U_LH_shank[5] = 0.0007800000000000001*mu_c0;
     w.Dinv_LH_shank = 1.0 / w.U_LH_shank[4];
-    w.u_LH_shank[0] = -w.pA_LH_shank[4] + 0.195*w.lambda[6] - 0.195*w.k_lh_foot[0]*mu + tau[11];
+    w.u_LH_shank[0] = -w.pA_LH_shank[4] + 0.195*w.lambda[6] - 0.195*w.k_lh_foot[0]*mu_c0 + tau[11];
     const Scalar t1 = w.U_LH_shank[0]*w.Dinv_LH_shank;
     const Scalar t2 = w.U_LH_shank[4]*w.Dinv_LH_shank;
     const Scalar t3 = w.U_LH_shank[5]*w.Dinv_LH_shank;
-    const Scalar Ia0 = 0.064 + mu - w.U_LH_shank[0]*t1;
-    const Scalar Ia1 = -0.004*mu - w.U_LH_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu;
-    const Scalar Ia3 = 0.003904 + 0.195*mu;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_LH_shank[5]*t3;
-    const Scalar pa0 = w.pA_LH_shank[0] + w.lambda[6] - w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t1 + w.c_LH_shank[0]*Ia0 + w.c_LH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LH_shank[1] + w.lambda[7] - w.k_lh_foot[1]*mu + w.c_LH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LH_shank[2] + w.lambda[8] - w.k_lh_foot[2]*mu + w.c_LH_shank[2]*Ia2 + 0.004*w.c_LH_shank[3]*mu;
-    const Scalar pa3 = w.pA_LH_shank[3] + 0.195*w.lambda[7] + 0.004*w.lambda[8] - mu*t0 + 0.004*w.c_LH_shank[2]*mu + w.c_LH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LH_shank[4] - 0.195*w.lambda[6] + 0.195*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t2;
-    const Scalar pa5 = w.pA_LH_shank[5] - 0.004*w.lambda[6] + 0.004*w.k_lh_foot[0]*mu + w.u_LH_shank[0]*t3 + w.c_LH_shank[0]*Ia1 + w.c_LH_shank[5]*Ia5;
+    const Scalar Ia0 = 0.064 + mu_c0 - w.U_LH_shank[0]*t1;
+    const Scalar Ia1 = -0.004*mu_c0 - w.U_LH_shank[5]*t1;
+    const Scalar Ia2 = 0.064 + mu_c0;
+    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
+    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
+    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_LH_shank[5]*t3;
+    const Scalar pa0 = w.pA_LH_shank[0] + w.lambda[6] - w.k_lh_foot[0]*mu_c0 + w.u_LH_shank[0]*t1 + w.c_LH_shank[0]*Ia0 + w.c_LH_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_LH_shank[1] + w.lambda[7] - w.k_lh_foot[1]*mu_c0 + w.c_LH_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_LH_shank[2] + w.lambda[8] - w.k_lh_foot[2]*mu_c0 + w.c_LH_shank[2]*Ia2 + 0.004*w.c_LH_shank[3]*mu_c0;
+    const Scalar pa3 = w.pA_LH_shank[3] + 0.195*w.lambda[7] + 0.004*w.lambda[8] - mu_c0*t0 + 0.004*w.c_LH_shank[2]*mu_c0 + w.c_LH_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_LH_shank[4] - 0.195*w.lambda[6] + 0.195*w.k_lh_foot[0]*mu_c0 + w.u_LH_shank[0]*t2;
+    const Scalar pa5 = w.pA_LH_shank[5] - 0.004*w.lambda[6] + 0.004*w.k_lh_foot[0]*mu_c0 + w.u_LH_shank[0]*t3 + w.c_LH_shank[0]*Ia1 + w.c_LH_shank[5]*Ia5;
     const Scalar C20 = w.cq_LH_shank*w.cq_LH_shank - w.sq_LH_shank*w.sq_LH_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
     const Scalar t4 = 2.0*w.cq_LH_shank*w.sq_LH_shank;
-    const Scalar t5 = 0.002*mu + 0.5*Ia1;
+    const Scalar t5 = 0.002*mu_c0 + 0.5*Ia1;
     const Scalar h1 = 0.5*(-Ia4 + Ia5);
     const Scalar m1 = 0.5*(Ia4 + Ia5);
     const Scalar t6 = m0 - C20*h0;
     const Scalar t7 = m0 + C20*h0;
-    const Scalar t8 = -0.002*mu + 0.5*Ia1 + C20*t5;
-    const Scalar t9 = 0.002*mu - 0.5*Ia1 + C20*t5;
+    const Scalar t8 = -0.002*mu_c0 + 0.5*Ia1 + C20*t5;
+    const Scalar t9 = 0.002*mu_c0 - 0.5*Ia1 + C20*t5;
     const Scalar t10 = 0.209*Ia2 + w.cq_LH_shank*Ia3;
     const Scalar t11 = w.cq_LH_shank*pa0 + w.sq_LH_shank*pa2;
     const Scalar t12 = -w.sq_LH_shank*pa0 + w.cq_LH_shank*pa2;
@@ -1308,38 +1315,39 @@ PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT 
 PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
+    const Scalar mu_c0 = mu*w.active[0];
     const Scalar t0 = 0.195*w.k_lf_foot[1] + 0.004*w.k_lf_foot[2];
-    w.U_LF_shank[0] = -0.003904 - 0.195*mu;
-    w.U_LF_shank[4] = 0.000486144 + 0.038025*mu;
-    w.U_LF_shank[5] = 0.0007800000000000001*mu;
+    w.U_LF_shank[0] = -0.003904 - 0.195*mu_c0;
+    w.U_LF_shank[4] = 0.000486144 + 0.038025*mu_c0;
+    w.U_LF_shank[5] = 0.0007800000000000001*mu_c0;
     w.Dinv_LF_shank = 1.0 / w.U_LF_shank[4];
-    w.u_LF_shank[0] = -w.pA_LF_shank[4] + 0.195*w.lambda[0] - 0.195*w.k_lf_foot[0]*mu + tau[8];
+    w.u_LF_shank[0] = -w.pA_LF_shank[4] + 0.195*w.lambda[0] - 0.195*w.k_lf_foot[0]*mu_c0 + tau[8];
     const Scalar t1 = w.U_LF_shank[0]*w.Dinv_LF_shank;
     const Scalar t2 = w.U_LF_shank[4]*w.Dinv_LF_shank;
     const Scalar t3 = w.U_LF_shank[5]*w.Dinv_LF_shank;
-    const Scalar Ia0 = 0.064 + mu - w.U_LF_shank[0]*t1;
-    const Scalar Ia1 = -0.004*mu - w.U_LF_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu;
-    const Scalar Ia3 = 0.003904 + 0.195*mu;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu - w.U_LF_shank[5]*t3;
-    const Scalar pa0 = w.pA_LF_shank[0] + w.lambda[0] - w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t1 + w.c_LF_shank[0]*Ia0 + w.c_LF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LF_shank[1] + w.lambda[1] - w.k_lf_foot[1]*mu + w.c_LF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LF_shank[2] + w.lambda[2] - w.k_lf_foot[2]*mu + w.c_LF_shank[2]*Ia2 + 0.004*w.c_LF_shank[3]*mu;
-    const Scalar pa3 = w.pA_LF_shank[3] + 0.195*w.lambda[1] + 0.004*w.lambda[2] - mu*t0 + 0.004*w.c_LF_shank[2]*mu + w.c_LF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LF_shank[4] - 0.195*w.lambda[0] + 0.195*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t2;
-    const Scalar pa5 = w.pA_LF_shank[5] - 0.004*w.lambda[0] + 0.004*w.k_lf_foot[0]*mu + w.u_LF_shank[0]*t3 + w.c_LF_shank[0]*Ia1 + w.c_LF_shank[5]*Ia5;
+    const Scalar Ia0 = 0.064 + mu_c0 - w.U_LF_shank[0]*t1;
+    const Scalar Ia1 = -0.004*mu_c0 - w.U_LF_shank[5]*t1;
+    const Scalar Ia2 = 0.064 + mu_c0;
+    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
+    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
+    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_LF_shank[5]*t3;
+    const Scalar pa0 = w.pA_LF_shank[0] + w.lambda[0] - w.k_lf_foot[0]*mu_c0 + w.u_LF_shank[0]*t1 + w.c_LF_shank[0]*Ia0 + w.c_LF_shank[5]*Ia1;
+    const Scalar pa1 = w.pA_LF_shank[1] + w.lambda[1] - w.k_lf_foot[1]*mu_c0 + w.c_LF_shank[3]*Ia3;
+    const Scalar pa2 = w.pA_LF_shank[2] + w.lambda[2] - w.k_lf_foot[2]*mu_c0 + w.c_LF_shank[2]*Ia2 + 0.004*w.c_LF_shank[3]*mu_c0;
+    const Scalar pa3 = w.pA_LF_shank[3] + 0.195*w.lambda[1] + 0.004*w.lambda[2] - mu_c0*t0 + 0.004*w.c_LF_shank[2]*mu_c0 + w.c_LF_shank[3]*Ia4;
+    const Scalar pa4 = w.pA_LF_shank[4] - 0.195*w.lambda[0] + 0.195*w.k_lf_foot[0]*mu_c0 + w.u_LF_shank[0]*t2;
+    const Scalar pa5 = w.pA_LF_shank[5] - 0.004*w.lambda[0] + 0.004*w.k_lf_foot[0]*mu_c0 + w.u_LF_shank[0]*t3 + w.c_LF_shank[0]*Ia1 + w.c_LF_shank[5]*Ia5;
     const Scalar C20 = w.cq_LF_shank*w.cq_LF_shank - w.sq_LF_shank*w.sq_LF_shank;
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
     const Scalar t4 = 2.0*w.cq_LF_shank*w.sq_LF_shank;
-    const Scalar t5 = 0.002*mu + 0.5*Ia1;
+    const Scalar t5 = 0.002*mu_c0 + 0.5*Ia1;
     const Scalar h1 = 0.5*(-Ia4 + Ia5);
     const Scalar m1 = 0.5*(Ia4 + Ia5);
     const Scalar t6 = m0 - C20*h0;
     const Scalar t7 = m0 + C20*h0;
-    const Scalar t8 = -0.002*mu + 0.5*Ia1 + C20*t5;
-    const Scalar t9 = 0.002*mu - 0.5*Ia1 + C20*t5;
+    const Scalar t8 = -0.002*mu_c0 + 0.5*Ia1 + C20*t5;
+    const Scalar t9 = 0.002*mu_c0 - 0.5*Ia1 + C20*t5;
     const Scalar t10 = 0.209*Ia2 + w.cq_LF_shank*Ia3;
     const Scalar t11 = w.cq_LF_shank*pa0 + w.sq_LF_shank*pa2;
     const Scalar t12 = -w.sq_LF_shank*pa0 + w.cq_LF_shank*pa2;
@@ -1903,42 +1911,54 @@ PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.residual[3] = w.active[1]*t3;
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.residual[4] = w.active[1]*t4;
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.residual[5] = w.active[1]*t5;
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.residual[6] = w.active[2]*t6;
     w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.residual[7] = w.active[2]*t7;
     w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.residual[8] = w.active[2]*t8;
     w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.residual[9] = w.active[3]*t9;
     w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.residual[10] = w.active[3]*t10;
     w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.residual[11] = w.active[3]*t11;
     w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
   }
@@ -2461,42 +2481,54 @@ PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // multiplier update: dlambda = mu (K a - k), lambda += dlambda
+  // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
   {
-    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.residual[0] = w.active[0]*t0;
     w.dlambda[0] = mu*w.residual[0];
     w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.residual[1] = w.active[0]*t1;
     w.dlambda[1] = mu*w.residual[1];
     w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.residual[2] = w.active[0]*t2;
     w.dlambda[2] = mu*w.residual[2];
     w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.residual[3] = w.active[1]*t3;
     w.dlambda[3] = mu*w.residual[3];
     w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.residual[4] = w.active[1]*t4;
     w.dlambda[4] = mu*w.residual[4];
     w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.residual[5] = w.active[1]*t5;
     w.dlambda[5] = mu*w.residual[5];
     w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.residual[6] = w.active[2]*t6;
     w.dlambda[6] = mu*w.residual[6];
     w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.residual[7] = w.active[2]*t7;
     w.dlambda[7] = mu*w.residual[7];
     w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.residual[8] = w.active[2]*t8;
     w.dlambda[8] = mu*w.residual[8];
     w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.residual[9] = w.active[3]*t9;
     w.dlambda[9] = mu*w.residual[9];
     w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.residual[10] = w.active[3]*t10;
     w.dlambda[10] = mu*w.residual[10];
     w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.residual[11] = w.active[3]*t11;
     w.dlambda[11] = mu*w.residual[11];
     w.lambda[11] = w.lambda[11] + w.dlambda[11];
   }
@@ -4272,18 +4304,30 @@ PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRIC
   }
   // free row accelerations y_free = K a - k (tree order)
   {
-    w.yfree[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.yfree[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.yfree[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.yfree[6] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.yfree[7] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.yfree[8] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.yfree[3] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.yfree[4] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.yfree[5] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.yfree[9] = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
-    w.yfree[10] = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
-    w.yfree[11] = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
+    const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.yfree[0] = t14*w.active[0];
+    const Scalar t15 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.yfree[1] = w.active[0]*t15;
+    const Scalar t16 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.yfree[2] = w.active[0]*t16;
+    const Scalar t17 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.yfree[6] = t17*w.active[1];
+    const Scalar t18 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.yfree[7] = w.active[1]*t18;
+    const Scalar t19 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.yfree[8] = w.active[1]*t19;
+    const Scalar t20 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.yfree[3] = t20*w.active[2];
+    const Scalar t21 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.yfree[4] = w.active[2]*t21;
+    const Scalar t22 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.yfree[5] = w.active[2]*t22;
+    const Scalar t23 = -w.k_rh_foot[0] + w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5];
+    w.yfree[9] = t23*w.active[3];
+    const Scalar t24 = -w.k_rh_foot[1] + w.a_RH_shank[1] + 0.195*w.a_RH_shank[3];
+    w.yfree[10] = w.active[3]*t24;
+    const Scalar t25 = -w.k_rh_foot[2] + w.a_RH_shank[2] - 0.004*w.a_RH_shank[3];
+    w.yfree[11] = w.active[3]*t25;
   }
 }
 
@@ -4401,253 +4445,277 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& P
   }
   // W = L^-1 Z^T, column 0
   {
-    const Scalar t9 = w.Z_trunk[0][0]*w.Linv[0];
-    const Scalar t10 = w.Z_trunk[0][1] - w.L[1]*t9;
-    const Scalar t11 = w.Linv[1]*t10;
-    const Scalar t12 = w.Z_trunk[0][2] - w.L[2]*t9 - w.L[13]*t11;
-    const Scalar t13 = w.Z_trunk[0][3]*w.Linv[3];
-    const Scalar t14 = w.Z_trunk[0][4] - w.L[34]*t13;
-    const Scalar t15 = w.Linv[4]*t14;
-    const Scalar t16 = w.Z_trunk[0][5] - w.L[35]*t13 - w.L[43]*t15;
-    const Scalar t17 = w.Z_trunk[0][6]*w.Linv[6];
-    const Scalar t18 = w.Z_trunk[0][7] - w.L[58]*t17;
-    const Scalar t19 = w.Linv[7]*t18;
-    const Scalar t20 = w.Z_trunk[0][8] - w.L[59]*t17 - w.L[64]*t19;
-    const Scalar t21 = w.Z_trunk[0][9]*w.Linv[9];
-    const Scalar t22 = w.Z_trunk[0][10] - w.L[73]*t21;
-    const Scalar t23 = w.Linv[10]*t22;
-    const Scalar t24 = w.Z_trunk[0][11] - w.L[74]*t21 - w.L[76]*t23;
-    w.W[0][0] = w.Z_trunk[0][0]*w.Linv[0];
-    w.W[1][0] = w.Linv[1]*t10;
-    w.W[2][0] = w.Linv[2]*t12;
-    w.W[3][0] = w.Z_trunk[0][3]*w.Linv[3];
-    w.W[4][0] = w.Linv[4]*t14;
-    w.W[5][0] = w.Linv[5]*t16;
-    w.W[6][0] = w.Z_trunk[0][6]*w.Linv[6];
-    w.W[7][0] = w.Linv[7]*t18;
-    w.W[8][0] = w.Linv[8]*t20;
-    w.W[9][0] = w.Z_trunk[0][9]*w.Linv[9];
-    w.W[10][0] = w.Linv[10]*t22;
-    w.W[11][0] = w.Linv[11]*t24;
+    const Scalar t9 = w.Z_trunk[0][0]*w.active[0];
+    const Scalar t10 = w.Linv[0]*t9;
+    const Scalar t11 = w.Z_trunk[0][1]*w.active[0] - w.L[1]*t10;
+    const Scalar t12 = w.Linv[1]*t11;
+    const Scalar t13 = w.Z_trunk[0][2]*w.active[0] - w.L[2]*t10 - w.L[13]*t12;
+    const Scalar t14 = w.Z_trunk[0][3]*w.active[2];
+    const Scalar t15 = w.Linv[3]*t14;
+    const Scalar t16 = w.Z_trunk[0][4]*w.active[2] - w.L[34]*t15;
+    const Scalar t17 = w.Linv[4]*t16;
+    const Scalar t18 = w.Z_trunk[0][5]*w.active[2] - w.L[35]*t15 - w.L[43]*t17;
+    const Scalar t19 = w.Z_trunk[0][6]*w.active[1];
+    const Scalar t20 = w.Linv[6]*t19;
+    const Scalar t21 = w.Z_trunk[0][7]*w.active[1] - w.L[58]*t20;
+    const Scalar t22 = w.Linv[7]*t21;
+    const Scalar t23 = w.Z_trunk[0][8]*w.active[1] - w.L[59]*t20 - w.L[64]*t22;
+    const Scalar t24 = w.Z_trunk[0][9]*w.active[3];
+    const Scalar t25 = w.Linv[9]*t24;
+    const Scalar t26 = w.Z_trunk[0][10]*w.active[3] - w.L[73]*t25;
+    const Scalar t27 = w.Linv[10]*t26;
+    const Scalar t28 = w.Z_trunk[0][11]*w.active[3] - w.L[74]*t25 - w.L[76]*t27;
+    w.W[0][0] = w.Linv[0]*t9;
+    w.W[1][0] = w.Linv[1]*t11;
+    w.W[2][0] = w.Linv[2]*t13;
+    w.W[3][0] = w.Linv[3]*t14;
+    w.W[4][0] = w.Linv[4]*t16;
+    w.W[5][0] = w.Linv[5]*t18;
+    w.W[6][0] = w.Linv[6]*t19;
+    w.W[7][0] = w.Linv[7]*t21;
+    w.W[8][0] = w.Linv[8]*t23;
+    w.W[9][0] = w.Linv[9]*t24;
+    w.W[10][0] = w.Linv[10]*t26;
+    w.W[11][0] = w.Linv[11]*t28;
   }
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_W_1_to_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 1
   {
-    const Scalar t0 = w.Z_trunk[1][0]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[1][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[1][2] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[1][3]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[1][4] - w.L[34]*t4;
-    const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[1][5] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[1][6]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[1][7] - w.L[58]*t8;
-    const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[1][8] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[1][9]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[1][10] - w.L[73]*t12;
-    const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[1][11] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[0][1] = w.Z_trunk[1][0]*w.Linv[0];
-    w.W[1][1] = w.Linv[1]*t1;
-    w.W[2][1] = w.Linv[2]*t3;
-    w.W[3][1] = w.Z_trunk[1][3]*w.Linv[3];
-    w.W[4][1] = w.Linv[4]*t5;
-    w.W[5][1] = w.Linv[5]*t7;
-    w.W[6][1] = w.Z_trunk[1][6]*w.Linv[6];
-    w.W[7][1] = w.Linv[7]*t9;
-    w.W[8][1] = w.Linv[8]*t11;
-    w.W[9][1] = w.Z_trunk[1][9]*w.Linv[9];
-    w.W[10][1] = w.Linv[10]*t13;
-    w.W[11][1] = w.Linv[11]*t15;
+    const Scalar t0 = w.Z_trunk[1][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_trunk[1][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_trunk[1][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
+    const Scalar t5 = w.Z_trunk[1][3]*w.active[2];
+    const Scalar t6 = w.Linv[3]*t5;
+    const Scalar t7 = w.Z_trunk[1][4]*w.active[2] - w.L[34]*t6;
+    const Scalar t8 = w.Linv[4]*t7;
+    const Scalar t9 = w.Z_trunk[1][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
+    const Scalar t10 = w.Z_trunk[1][6]*w.active[1];
+    const Scalar t11 = w.Linv[6]*t10;
+    const Scalar t12 = w.Z_trunk[1][7]*w.active[1] - w.L[58]*t11;
+    const Scalar t13 = w.Linv[7]*t12;
+    const Scalar t14 = w.Z_trunk[1][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
+    const Scalar t15 = w.Z_trunk[1][9]*w.active[3];
+    const Scalar t16 = w.Linv[9]*t15;
+    const Scalar t17 = w.Z_trunk[1][10]*w.active[3] - w.L[73]*t16;
+    const Scalar t18 = w.Linv[10]*t17;
+    const Scalar t19 = w.Z_trunk[1][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
+    w.W[0][1] = w.Linv[0]*t0;
+    w.W[1][1] = w.Linv[1]*t2;
+    w.W[2][1] = w.Linv[2]*t4;
+    w.W[3][1] = w.Linv[3]*t5;
+    w.W[4][1] = w.Linv[4]*t7;
+    w.W[5][1] = w.Linv[5]*t9;
+    w.W[6][1] = w.Linv[6]*t10;
+    w.W[7][1] = w.Linv[7]*t12;
+    w.W[8][1] = w.Linv[8]*t14;
+    w.W[9][1] = w.Linv[9]*t15;
+    w.W[10][1] = w.Linv[10]*t17;
+    w.W[11][1] = w.Linv[11]*t19;
   }
   // W = L^-1 Z^T, column 2
   {
-    const Scalar t16 = w.Z_trunk[2][0]*w.Linv[0];
-    const Scalar t17 = w.Z_trunk[2][1] - w.L[1]*t16;
-    const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_trunk[2][2] - w.L[2]*t16 - w.L[13]*t18;
-    const Scalar t20 = w.Z_trunk[2][3]*w.Linv[3];
-    const Scalar t21 = w.Z_trunk[2][4] - w.L[34]*t20;
-    const Scalar t22 = w.Linv[4]*t21;
-    const Scalar t23 = w.Z_trunk[2][5] - w.L[35]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Z_trunk[2][6]*w.Linv[6];
-    const Scalar t25 = w.Z_trunk[2][7] - w.L[58]*t24;
-    const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_trunk[2][8] - w.L[59]*t24 - w.L[64]*t26;
-    const Scalar t28 = w.Z_trunk[2][9]*w.Linv[9];
-    const Scalar t29 = w.Z_trunk[2][10] - w.L[73]*t28;
-    const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_trunk[2][11] - w.L[74]*t28 - w.L[76]*t30;
-    w.W[0][2] = w.Z_trunk[2][0]*w.Linv[0];
-    w.W[1][2] = w.Linv[1]*t17;
-    w.W[2][2] = w.Linv[2]*t19;
-    w.W[3][2] = w.Z_trunk[2][3]*w.Linv[3];
-    w.W[4][2] = w.Linv[4]*t21;
-    w.W[5][2] = w.Linv[5]*t23;
-    w.W[6][2] = w.Z_trunk[2][6]*w.Linv[6];
-    w.W[7][2] = w.Linv[7]*t25;
-    w.W[8][2] = w.Linv[8]*t27;
-    w.W[9][2] = w.Z_trunk[2][9]*w.Linv[9];
-    w.W[10][2] = w.Linv[10]*t29;
-    w.W[11][2] = w.Linv[11]*t31;
+    const Scalar t20 = w.Z_trunk[2][0]*w.active[0];
+    const Scalar t21 = w.Linv[0]*t20;
+    const Scalar t22 = w.Z_trunk[2][1]*w.active[0] - w.L[1]*t21;
+    const Scalar t23 = w.Linv[1]*t22;
+    const Scalar t24 = w.Z_trunk[2][2]*w.active[0] - w.L[2]*t21 - w.L[13]*t23;
+    const Scalar t25 = w.Z_trunk[2][3]*w.active[2];
+    const Scalar t26 = w.Linv[3]*t25;
+    const Scalar t27 = w.Z_trunk[2][4]*w.active[2] - w.L[34]*t26;
+    const Scalar t28 = w.Linv[4]*t27;
+    const Scalar t29 = w.Z_trunk[2][5]*w.active[2] - w.L[35]*t26 - w.L[43]*t28;
+    const Scalar t30 = w.Z_trunk[2][6]*w.active[1];
+    const Scalar t31 = w.Linv[6]*t30;
+    const Scalar t32 = w.Z_trunk[2][7]*w.active[1] - w.L[58]*t31;
+    const Scalar t33 = w.Linv[7]*t32;
+    const Scalar t34 = w.Z_trunk[2][8]*w.active[1] - w.L[59]*t31 - w.L[64]*t33;
+    const Scalar t35 = w.Z_trunk[2][9]*w.active[3];
+    const Scalar t36 = w.Linv[9]*t35;
+    const Scalar t37 = w.Z_trunk[2][10]*w.active[3] - w.L[73]*t36;
+    const Scalar t38 = w.Linv[10]*t37;
+    const Scalar t39 = w.Z_trunk[2][11]*w.active[3] - w.L[74]*t36 - w.L[76]*t38;
+    w.W[0][2] = w.Linv[0]*t20;
+    w.W[1][2] = w.Linv[1]*t22;
+    w.W[2][2] = w.Linv[2]*t24;
+    w.W[3][2] = w.Linv[3]*t25;
+    w.W[4][2] = w.Linv[4]*t27;
+    w.W[5][2] = w.Linv[5]*t29;
+    w.W[6][2] = w.Linv[6]*t30;
+    w.W[7][2] = w.Linv[7]*t32;
+    w.W[8][2] = w.Linv[8]*t34;
+    w.W[9][2] = w.Linv[9]*t35;
+    w.W[10][2] = w.Linv[10]*t37;
+    w.W[11][2] = w.Linv[11]*t39;
   }
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_W_3_to_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 3
   {
-    const Scalar t0 = w.Z_trunk[3][0]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[3][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[3][2] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[3][3]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[3][4] - w.L[34]*t4;
-    const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[3][5] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[3][6]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[3][7] - w.L[58]*t8;
-    const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[3][8] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[3][9]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[3][10] - w.L[73]*t12;
-    const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[3][11] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[0][3] = w.Z_trunk[3][0]*w.Linv[0];
-    w.W[1][3] = w.Linv[1]*t1;
-    w.W[2][3] = w.Linv[2]*t3;
-    w.W[3][3] = w.Z_trunk[3][3]*w.Linv[3];
-    w.W[4][3] = w.Linv[4]*t5;
-    w.W[5][3] = w.Linv[5]*t7;
-    w.W[6][3] = w.Z_trunk[3][6]*w.Linv[6];
-    w.W[7][3] = w.Linv[7]*t9;
-    w.W[8][3] = w.Linv[8]*t11;
-    w.W[9][3] = w.Z_trunk[3][9]*w.Linv[9];
-    w.W[10][3] = w.Linv[10]*t13;
-    w.W[11][3] = w.Linv[11]*t15;
+    const Scalar t0 = w.Z_trunk[3][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_trunk[3][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_trunk[3][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
+    const Scalar t5 = w.Z_trunk[3][3]*w.active[2];
+    const Scalar t6 = w.Linv[3]*t5;
+    const Scalar t7 = w.Z_trunk[3][4]*w.active[2] - w.L[34]*t6;
+    const Scalar t8 = w.Linv[4]*t7;
+    const Scalar t9 = w.Z_trunk[3][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
+    const Scalar t10 = w.Z_trunk[3][6]*w.active[1];
+    const Scalar t11 = w.Linv[6]*t10;
+    const Scalar t12 = w.Z_trunk[3][7]*w.active[1] - w.L[58]*t11;
+    const Scalar t13 = w.Linv[7]*t12;
+    const Scalar t14 = w.Z_trunk[3][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
+    const Scalar t15 = w.Z_trunk[3][9]*w.active[3];
+    const Scalar t16 = w.Linv[9]*t15;
+    const Scalar t17 = w.Z_trunk[3][10]*w.active[3] - w.L[73]*t16;
+    const Scalar t18 = w.Linv[10]*t17;
+    const Scalar t19 = w.Z_trunk[3][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
+    w.W[0][3] = w.Linv[0]*t0;
+    w.W[1][3] = w.Linv[1]*t2;
+    w.W[2][3] = w.Linv[2]*t4;
+    w.W[3][3] = w.Linv[3]*t5;
+    w.W[4][3] = w.Linv[4]*t7;
+    w.W[5][3] = w.Linv[5]*t9;
+    w.W[6][3] = w.Linv[6]*t10;
+    w.W[7][3] = w.Linv[7]*t12;
+    w.W[8][3] = w.Linv[8]*t14;
+    w.W[9][3] = w.Linv[9]*t15;
+    w.W[10][3] = w.Linv[10]*t17;
+    w.W[11][3] = w.Linv[11]*t19;
   }
   // W = L^-1 Z^T, column 4
   {
-    const Scalar t16 = w.Z_trunk[4][0]*w.Linv[0];
-    const Scalar t17 = w.Z_trunk[4][1] - w.L[1]*t16;
-    const Scalar t18 = w.Linv[1]*t17;
-    const Scalar t19 = w.Z_trunk[4][2] - w.L[2]*t16 - w.L[13]*t18;
-    const Scalar t20 = w.Z_trunk[4][3]*w.Linv[3];
-    const Scalar t21 = w.Z_trunk[4][4] - w.L[34]*t20;
-    const Scalar t22 = w.Linv[4]*t21;
-    const Scalar t23 = w.Z_trunk[4][5] - w.L[35]*t20 - w.L[43]*t22;
-    const Scalar t24 = w.Z_trunk[4][6]*w.Linv[6];
-    const Scalar t25 = w.Z_trunk[4][7] - w.L[58]*t24;
-    const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_trunk[4][8] - w.L[59]*t24 - w.L[64]*t26;
-    const Scalar t28 = w.Z_trunk[4][9]*w.Linv[9];
-    const Scalar t29 = w.Z_trunk[4][10] - w.L[73]*t28;
-    const Scalar t30 = w.Linv[10]*t29;
-    const Scalar t31 = w.Z_trunk[4][11] - w.L[74]*t28 - w.L[76]*t30;
-    w.W[0][4] = w.Z_trunk[4][0]*w.Linv[0];
-    w.W[1][4] = w.Linv[1]*t17;
-    w.W[2][4] = w.Linv[2]*t19;
-    w.W[3][4] = w.Z_trunk[4][3]*w.Linv[3];
-    w.W[4][4] = w.Linv[4]*t21;
-    w.W[5][4] = w.Linv[5]*t23;
-    w.W[6][4] = w.Z_trunk[4][6]*w.Linv[6];
-    w.W[7][4] = w.Linv[7]*t25;
-    w.W[8][4] = w.Linv[8]*t27;
-    w.W[9][4] = w.Z_trunk[4][9]*w.Linv[9];
-    w.W[10][4] = w.Linv[10]*t29;
-    w.W[11][4] = w.Linv[11]*t31;
+    const Scalar t20 = w.Z_trunk[4][0]*w.active[0];
+    const Scalar t21 = w.Linv[0]*t20;
+    const Scalar t22 = w.Z_trunk[4][1]*w.active[0] - w.L[1]*t21;
+    const Scalar t23 = w.Linv[1]*t22;
+    const Scalar t24 = w.Z_trunk[4][2]*w.active[0] - w.L[2]*t21 - w.L[13]*t23;
+    const Scalar t25 = w.Z_trunk[4][3]*w.active[2];
+    const Scalar t26 = w.Linv[3]*t25;
+    const Scalar t27 = w.Z_trunk[4][4]*w.active[2] - w.L[34]*t26;
+    const Scalar t28 = w.Linv[4]*t27;
+    const Scalar t29 = w.Z_trunk[4][5]*w.active[2] - w.L[35]*t26 - w.L[43]*t28;
+    const Scalar t30 = w.Z_trunk[4][6]*w.active[1];
+    const Scalar t31 = w.Linv[6]*t30;
+    const Scalar t32 = w.Z_trunk[4][7]*w.active[1] - w.L[58]*t31;
+    const Scalar t33 = w.Linv[7]*t32;
+    const Scalar t34 = w.Z_trunk[4][8]*w.active[1] - w.L[59]*t31 - w.L[64]*t33;
+    const Scalar t35 = w.Z_trunk[4][9]*w.active[3];
+    const Scalar t36 = w.Linv[9]*t35;
+    const Scalar t37 = w.Z_trunk[4][10]*w.active[3] - w.L[73]*t36;
+    const Scalar t38 = w.Linv[10]*t37;
+    const Scalar t39 = w.Z_trunk[4][11]*w.active[3] - w.L[74]*t36 - w.L[76]*t38;
+    w.W[0][4] = w.Linv[0]*t20;
+    w.W[1][4] = w.Linv[1]*t22;
+    w.W[2][4] = w.Linv[2]*t24;
+    w.W[3][4] = w.Linv[3]*t25;
+    w.W[4][4] = w.Linv[4]*t27;
+    w.W[5][4] = w.Linv[5]*t29;
+    w.W[6][4] = w.Linv[6]*t30;
+    w.W[7][4] = w.Linv[7]*t32;
+    w.W[8][4] = w.Linv[8]*t34;
+    w.W[9][4] = w.Linv[9]*t35;
+    w.W[10][4] = w.Linv[10]*t37;
+    w.W[11][4] = w.Linv[11]*t39;
   }
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // W = L^-1 Z^T, column 5
   {
-    const Scalar t0 = w.Z_trunk[5][0]*w.Linv[0];
-    const Scalar t1 = w.Z_trunk[5][1] - w.L[1]*t0;
-    const Scalar t2 = w.Linv[1]*t1;
-    const Scalar t3 = w.Z_trunk[5][2] - w.L[2]*t0 - w.L[13]*t2;
-    const Scalar t4 = w.Z_trunk[5][3]*w.Linv[3];
-    const Scalar t5 = w.Z_trunk[5][4] - w.L[34]*t4;
-    const Scalar t6 = w.Linv[4]*t5;
-    const Scalar t7 = w.Z_trunk[5][5] - w.L[35]*t4 - w.L[43]*t6;
-    const Scalar t8 = w.Z_trunk[5][6]*w.Linv[6];
-    const Scalar t9 = w.Z_trunk[5][7] - w.L[58]*t8;
-    const Scalar t10 = w.Linv[7]*t9;
-    const Scalar t11 = w.Z_trunk[5][8] - w.L[59]*t8 - w.L[64]*t10;
-    const Scalar t12 = w.Z_trunk[5][9]*w.Linv[9];
-    const Scalar t13 = w.Z_trunk[5][10] - w.L[73]*t12;
-    const Scalar t14 = w.Linv[10]*t13;
-    const Scalar t15 = w.Z_trunk[5][11] - w.L[74]*t12 - w.L[76]*t14;
-    w.W[0][5] = w.Z_trunk[5][0]*w.Linv[0];
-    w.W[1][5] = w.Linv[1]*t1;
-    w.W[2][5] = w.Linv[2]*t3;
-    w.W[3][5] = w.Z_trunk[5][3]*w.Linv[3];
-    w.W[4][5] = w.Linv[4]*t5;
-    w.W[5][5] = w.Linv[5]*t7;
-    w.W[6][5] = w.Z_trunk[5][6]*w.Linv[6];
-    w.W[7][5] = w.Linv[7]*t9;
-    w.W[8][5] = w.Linv[8]*t11;
-    w.W[9][5] = w.Z_trunk[5][9]*w.Linv[9];
-    w.W[10][5] = w.Linv[10]*t13;
-    w.W[11][5] = w.Linv[11]*t15;
+    const Scalar t0 = w.Z_trunk[5][0]*w.active[0];
+    const Scalar t1 = w.Linv[0]*t0;
+    const Scalar t2 = w.Z_trunk[5][1]*w.active[0] - w.L[1]*t1;
+    const Scalar t3 = w.Linv[1]*t2;
+    const Scalar t4 = w.Z_trunk[5][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
+    const Scalar t5 = w.Z_trunk[5][3]*w.active[2];
+    const Scalar t6 = w.Linv[3]*t5;
+    const Scalar t7 = w.Z_trunk[5][4]*w.active[2] - w.L[34]*t6;
+    const Scalar t8 = w.Linv[4]*t7;
+    const Scalar t9 = w.Z_trunk[5][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
+    const Scalar t10 = w.Z_trunk[5][6]*w.active[1];
+    const Scalar t11 = w.Linv[6]*t10;
+    const Scalar t12 = w.Z_trunk[5][7]*w.active[1] - w.L[58]*t11;
+    const Scalar t13 = w.Linv[7]*t12;
+    const Scalar t14 = w.Z_trunk[5][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
+    const Scalar t15 = w.Z_trunk[5][9]*w.active[3];
+    const Scalar t16 = w.Linv[9]*t15;
+    const Scalar t17 = w.Z_trunk[5][10]*w.active[3] - w.L[73]*t16;
+    const Scalar t18 = w.Linv[10]*t17;
+    const Scalar t19 = w.Z_trunk[5][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
+    w.W[0][5] = w.Linv[0]*t0;
+    w.W[1][5] = w.Linv[1]*t2;
+    w.W[2][5] = w.Linv[2]*t4;
+    w.W[3][5] = w.Linv[3]*t5;
+    w.W[4][5] = w.Linv[4]*t7;
+    w.W[5][5] = w.Linv[5]*t9;
+    w.W[6][5] = w.Linv[6]*t10;
+    w.W[7][5] = w.Linv[7]*t12;
+    w.W[8][5] = w.Linv[8]*t14;
+    w.W[9][5] = w.Linv[9]*t15;
+    w.W[10][5] = w.Linv[10]*t17;
+    w.W[11][5] = w.Linv[11]*t19;
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t16 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0];
-    const Scalar r0 = std::sqrt(t16);
+    const Scalar t20 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0];
+    const Scalar r0 = std::sqrt(t20);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t17 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1];
-    w.LS[1] = w.LSinv[0]*t17;
-    const Scalar t18 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2];
-    w.LS[2] = w.LSinv[0]*t18;
-    const Scalar t19 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3];
-    w.LS[3] = w.LSinv[0]*t19;
-    const Scalar t20 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4];
-    w.LS[4] = w.LSinv[0]*t20;
-    const Scalar t21 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5];
-    w.LS[5] = w.LSinv[0]*t21;
-    const Scalar t22 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t22);
+    const Scalar t21 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1];
+    w.LS[1] = w.LSinv[0]*t21;
+    const Scalar t22 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2];
+    w.LS[2] = w.LSinv[0]*t22;
+    const Scalar t23 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3];
+    w.LS[3] = w.LSinv[0]*t23;
+    const Scalar t24 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4];
+    w.LS[4] = w.LSinv[0]*t24;
+    const Scalar t25 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5];
+    w.LS[5] = w.LSinv[0]*t25;
+    const Scalar t26 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t26);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t23 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t23;
-    const Scalar t24 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t24;
-    const Scalar t25 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t25;
-    const Scalar t26 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t26;
-    const Scalar t27 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t27);
+    const Scalar t27 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t27;
+    const Scalar t28 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t28;
+    const Scalar t29 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t29;
+    const Scalar t30 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t30;
+    const Scalar t31 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t31);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t28 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t28;
-    const Scalar t29 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t29;
-    const Scalar t30 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t30;
-    const Scalar t31 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t31);
+    const Scalar t32 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t32;
+    const Scalar t33 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t33;
+    const Scalar t34 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t34;
+    const Scalar t35 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t35);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t32 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t32;
-    const Scalar t33 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t33;
-    const Scalar t34 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t34);
+    const Scalar t36 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t36;
+    const Scalar t37 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t37;
+    const Scalar t38 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t38);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t35 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t35;
-    const Scalar t36 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t36);
+    const Scalar t39 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t39;
+    const Scalar t40 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t40);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
@@ -5014,18 +5082,30 @@ PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // residual rows K a - k (layout order)
   {
-    w.residual[0] = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.residual[1] = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.residual[2] = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.residual[3] = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.residual[4] = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.residual[5] = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.residual[6] = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.residual[7] = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.residual[8] = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.residual[9] = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.residual[10] = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.residual[11] = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
+    w.residual[0] = t0*w.active[0];
+    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
+    w.residual[1] = w.active[0]*t1;
+    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
+    w.residual[2] = w.active[0]*t2;
+    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    w.residual[3] = t3*w.active[1];
+    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    w.residual[4] = w.active[1]*t4;
+    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    w.residual[5] = w.active[1]*t5;
+    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
+    w.residual[6] = t6*w.active[2];
+    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
+    w.residual[7] = w.active[2]*t7;
+    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
+    w.residual[8] = w.active[2]*t8;
+    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
+    w.residual[9] = t9*w.active[3];
+    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
+    w.residual[10] = w.active[3]*t10;
+    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
+    w.residual[11] = w.active[3]*t11;
   }
 }
 
@@ -5048,21 +5128,26 @@ void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept {
   const Scalar mu = s.mu * Scalar(s.iterations > 0);
+  w.active[0] = Scalar(s.active[0]);
+  w.active[1] = Scalar(s.active[1]);
+  w.active[2] = Scalar(s.active[2]);
+  w.active[3] = Scalar(s.active[3]);
   kinematics(q, v, w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
-  w.lambda[6] = lambda0[6];
-  w.lambda[7] = lambda0[7];
-  w.lambda[8] = lambda0[8];
-  w.lambda[9] = lambda0[9];
-  w.lambda[10] = lambda0[10];
-  w.lambda[11] = lambda0[11];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[1]][3];
+  w.lambda[4] = lambda0_if[s.active[1]][4];
+  w.lambda[5] = lambda0_if[s.active[1]][5];
+  w.lambda[6] = lambda0_if[s.active[2]][6];
+  w.lambda[7] = lambda0_if[s.active[2]][7];
+  w.lambda[8] = lambda0_if[s.active[2]][8];
+  w.lambda[9] = lambda0_if[s.active[3]][9];
+  w.lambda[10] = lambda0_if[s.active[3]][10];
+  w.lambda[11] = lambda0_if[s.active[3]][11];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
   caba_backward_RH_shank(tau, mu, w);
   caba_backward_RH_thigh(tau, w);
@@ -5138,6 +5223,10 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
 // matrix G + I/mu factored once at the root, K proximal solves, one forward sweep.
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
              Scalar* qdd, Scalar* lambda) noexcept {
+  w.active[0] = Scalar(s.active[0]);
+  w.active[1] = Scalar(s.active[1]);
+  w.active[2] = Scalar(s.active[2]);
+  w.active[3] = Scalar(s.active[3]);
   kinematics(q, v, w);
   // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
   pv_backward_RH_shank(tau, w);
@@ -5166,20 +5255,21 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_delassus_W_1_to_W_2(w);
   pv_delassus_W_3_to_W_4(w);
   pv_delassus_W_5_to_LS(w);
-  // ---- warm start: lambda = s.lambda0, or 0 when it is null
+  // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
-  w.lambda[0] = lambda0[0];
-  w.lambda[1] = lambda0[1];
-  w.lambda[2] = lambda0[2];
-  w.lambda[3] = lambda0[3];
-  w.lambda[4] = lambda0[4];
-  w.lambda[5] = lambda0[5];
-  w.lambda[6] = lambda0[6];
-  w.lambda[7] = lambda0[7];
-  w.lambda[8] = lambda0[8];
-  w.lambda[9] = lambda0[9];
-  w.lambda[10] = lambda0[10];
-  w.lambda[11] = lambda0[11];
+  const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};
+  w.lambda[0] = lambda0_if[s.active[0]][0];
+  w.lambda[1] = lambda0_if[s.active[0]][1];
+  w.lambda[2] = lambda0_if[s.active[0]][2];
+  w.lambda[3] = lambda0_if[s.active[1]][3];
+  w.lambda[4] = lambda0_if[s.active[1]][4];
+  w.lambda[5] = lambda0_if[s.active[1]][5];
+  w.lambda[6] = lambda0_if[s.active[2]][6];
+  w.lambda[7] = lambda0_if[s.active[2]][7];
+  w.lambda[8] = lambda0_if[s.active[2]][8];
+  w.lambda[9] = lambda0_if[s.active[3]][9];
+  w.lambda[10] = lambda0_if[s.active[3]][10];
+  w.lambda[11] = lambda0_if[s.active[3]][11];
   // K proximal steps: (G + I/mu) lambda+ = y_free + lambda / mu (rows in tree order, stored in layout order)
   for (int k = 0; k < s.iterations; ++k) {
     // ---- proximal step: (G + I/mu) lambda = y_free + lambda / mu

@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4534 + 1204 K (= 8146 at K = 3)
-//     add/sub 1916 + 543 K, mul 2519 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8457 + 475 K (= 9882 at K = 3)
-//     add/sub 3518 + 204 K, mul 4762 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4538 + 1216 K (= 8186 at K = 3)
+//     add/sub 1916 + 543 K, mul 2523 + 647 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8553 + 475 K (= 9978 at K = 3)
+//     add/sub 3518 + 204 K, mul 4858 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -84,13 +84,17 @@ inline constexpr int lh_foot = 2;
 inline constexpr int rh_foot = 3;
 }  // namespace constraint
 
+// Every constraint active: the default schedule of the functions taking one.
+inline constexpr bool all_active[4] = {true, true, true, true};
+
 // Set the fields by name (later versions may add fields).
 struct Settings {
   Scalar mu = 10000.0;  // augmented-Lagrangian penalty (large = stiff)
   int iterations = 3;  // multiplier updates K (0: the motion under the forces of lambda0)
   // Run-time contact schedule: active[k] for constraint k of the layout
   // (constraint::<name>). An inactive constraint exerts no force: its
-  // multipliers are 0 and the answer is that of the solver generated without it.
+  // multipliers are 0 and the answer is that of the solver generated without it
+  // (to round-off; docs/algorithms.md §4.4). Change it between calls freely.
   bool active[4] = {true, true, true, true};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
@@ -98,7 +102,7 @@ struct Settings {
   const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (11256 bytes): per-body quantities named
+// Everything one solve writes (11288 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_trunk[3][3];       // joint rotation, body 1
@@ -184,6 +188,7 @@ struct Workspace {
   Scalar pA_RH_shank[6];       // bias force, body 13
   Scalar g_RH_shank[3];        // gravity in body coordinates, body 13
   Scalar k_rh_foot[3];         // constraint right-hand side, constraint 3
+  Scalar active[4];            // the schedule of the last call (Settings::active) as 0/1 factors
   Scalar lambda[12];           // multipliers (layout order)
   Scalar U_RH_shank[6];        // IA S, body 13
   Scalar Dinv_RH_shank;        // 1 / (S^T IA S), body 13
@@ -300,6 +305,10 @@ struct Workspace {
 // from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to
 // round-off. From a lambda0 that already solves the constraints the update
 // adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).
+// Schedule: a constraint k with !s.active[k] exerts no force: its lambda rows are
+// exactly 0, its lambda0 rows are never read, its residual rows count as 0, and
+// qdd and the other rows are those of the solver generated without it (to
+// round-off), for any combination; no branch, no allocation (4.4).
 void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,
                      Scalar* qdd, Scalar* lambda) noexcept;
 void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,

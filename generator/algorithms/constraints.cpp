@@ -1,5 +1,7 @@
 #include "algorithms/constraints.hpp"
 
+#include <stdexcept>
+
 #include "algorithms/kinematics.hpp"
 
 namespace proxgen {
@@ -13,6 +15,30 @@ VecN baumgarteTarget(const Constraint& c, const SE3& oMc, const Vec6& vC) {
     else aStar -= c.kp * (oMc.R.transpose() * (oMc.p - c.target.p));
   }
   return aStar;
+}
+
+System activeSubsystem(const System& sys, const std::vector<bool>& active) {
+  if (active.size() != sys.constraints.size()) throw std::invalid_argument("activeSubsystem: one flag per constraint");
+  System sub = sys;
+  sub.constraints.clear();
+  int row = 0;
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+    if (!active[k]) continue;
+    Constraint c = sys.constraints[k];
+    c.row = row;
+    row += c.rows();
+    sub.constraints.push_back(c);
+  }
+  sub.nc = row;
+  return sub;
+}
+
+std::vector<int> activeRows(const System& sys, const std::vector<bool>& active) {
+  std::vector<int> rows;
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k)
+    if (active.at(k))
+      for (int j = 0; j < sys.constraints[k].rows(); ++j) rows.push_back(sys.constraints[k].row + j);
+  return rows;
 }
 
 void computeConstraintTerms(const System& sys, Data& d) {

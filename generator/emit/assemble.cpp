@@ -82,7 +82,11 @@ const EntryPoint kEntryPoints[] = {
      "//   lambda_{k+1} = lambda_k + mu (J qdd_{k+1} + gamma - a*)\n"
      "// from lambda_0 = s.lambda0 (or 0); both algorithms give the same iterates up to\n"
      "// round-off. From a lambda0 that already solves the constraints the update\n"
-     "// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).\n",
+     "// adds nothing: lambda0 is a fixed point, at any K (docs/algorithms.md, 4.3).\n"
+     "// Schedule: a constraint k with !s.active[k] exerts no force: its lambda rows are\n"
+     "// exactly 0, its lambda0 rows are never read, its residual rows count as 0, and\n"
+     "// qdd and the other rows are those of the solver generated without it (to\n"
+     "// round-off), for any combination; no branch, no allocation (4.4).\n",
      "void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s, Workspace& w,\n"
      "                     Scalar* qdd, Scalar* lambda) noexcept",
      "// constrainedABA: the penalty mu K^T K at the constrained bodies, one full\n"
@@ -96,9 +100,11 @@ const EntryPoint kEntryPoints[] = {
      "\n// tau = M(q) qdd + h(q, v) + J(q)^T lambda (the constraint force on the robot is\n"
      "// -J^T lambda, as in the solvers): the torques that give the accelerations qdd\n"
      "// while the constraints push with multipliers lambda (rows in layout order, J's\n"
-     "// rows in the constraint frames the solvers use); lambda may be nullptr (none).\n",
+     "// rows in the constraint frames the solvers use); lambda may be nullptr (none).\n"
+     "// active (ncons flags, as Settings::active; default all): the rows of an\n"
+     "// inactive constraint are never read, as if its lambda were 0.\n",
      "void inverse_dynamics(const Scalar* q, const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
-     "                      Scalar* tau) noexcept",
+     "                      Scalar* tau, const bool* active) noexcept",
      "// Inverse dynamics (RNEA): kinematics, accelerations and forces root first,\n"
      "// with the constraint forces K^T lambda at the constrained bodies, then torques leaves first.\n"},
     {Function::NonlinearEffects,
@@ -116,22 +122,26 @@ const EntryPoint kEntryPoints[] = {
      "\n// The constraint functions: rows in layout order, in the constraint frames the\n"
      "// solvers use (6d weld: [linear; angular] of the frame, in the frame; 3d point:\n"
      "// the linear rows); the constraint force on the robot is -J^T lambda.\n"
+     "// The schedule (active: ncons flags as Settings::active, default all_active):\n"
+     "// an inactive constraint's rows (and columns of G) are exact zeros; (G + I/mu)^-1\n"
+     "// is that of the active rows alone, zeros elsewhere. The placements are geometry:\n"
+     "// they take no schedule (docs/algorithms.md, 4.4).\n"
      "// Per constraint (layout order) 12 values: its frame's rotation in the world\n"
      "// (3 x 3, row-major), then the frame's origin in the world.\n",
      "void constraint_placements(const Scalar* q, Workspace& w, Scalar* X) noexcept",
      "// The constraint frames in the world: the support bodies' placements root first.\n"},
     {Function::ConstraintJacobian, "\n// J (nc x nv, row-major): the constraint frames' velocity rows are J v.\n",
-     "void constraint_jacobian(const Scalar* q, Workspace& w, Scalar* J) noexcept",
+     "void constraint_jacobian(const Scalar* q, Workspace& w, Scalar* J, const bool* active) noexcept",
      "// J: each row's direction carried up the tree as a force; each joint reads its column.\n"},
     {Function::ConstraintDrift,
      "\n// gamma (nc): J qdd + gamma is the constraint frames' acceleration the solvers\n"
      "// hold to a* (of a point, the classical acceleration of its origin).\n",
-     "void constraint_drift(const Scalar* q, const Scalar* v, Workspace& w, Scalar* gamma) noexcept",
+     "void constraint_drift(const Scalar* q, const Scalar* v, Workspace& w, Scalar* gamma, const bool* active) noexcept",
      "// gamma: the rows' acceleration at qdd = 0 without gravity, plus w x v for a point.\n"},
     {Function::Delassus,
      "\n// G = J M^-1 J^T (nc x nc, row-major), by a recursion over the constraint\n"
      "// support: neither M nor J is formed.\n",
-     "void delassus(const Scalar* q, Workspace& w, Scalar* G) noexcept",
+     "void delassus(const Scalar* q, Workspace& w, Scalar* G, const bool* active) noexcept",
      "// G: the articulated inertias, the apparent inverse inertias Phi root first, and\n"
      "// every entry once where its two rows meet (O(n + m^2)).\n"},
     {Function::DelassusInverse,
@@ -153,6 +163,14 @@ const EntryPoint kEntryPoints[] = {
      "void constraint_wrenches(const Scalar* q, const Scalar* lambda, Workspace& w, Scalar* W) noexcept",
      "// The wrenches: the support bodies' world rotations root first, -R_C lambda at each constraint.\n"},
 };
+
+// The declaration's signature: the schedule argument defaults to every
+// constraint active (all_active), so calls without it keep compiling.
+std::string withDefaultSchedule(std::string signature) {
+  const std::string arg = "const bool* active";
+  if (const std::size_t at = signature.find(arg); at != std::string::npos) signature.insert(at + arg.size(), " = all_active");
+  return signature;
+}
 
 // The helpers the entry points call, printed only when one needs them.
 std::string helpers(const SolverTexts& texts) {
@@ -262,7 +280,7 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
     declarations += std::string(ep.f == Function::ProxPv && !texts.functions.has(Function::ConstrainedAba)
                                     ? kEntryPoints[0].header
                                     : ep.header) +
-                    ep.signature + ";\n";
+                    withDefaultSchedule(ep.signature) + ";\n";
     definitions += fmt::format("{}{} {{\n{}}}\n\n", ep.source, ep.signature, bodyOf(texts, ep.f));
   }
   // residual(w): the last solve's, so only with a solver.

@@ -14,11 +14,14 @@ namespace {
 
 std::string tauIn(int k) { return fmt::format("tau[{}]", k); }
 
-// IA_i += mu K^T K ; pA_i -= mu K^T k for every constraint on body i.
+// IA_i += mu_c K^T K ; pA_i -= mu_c K^T k for every constraint c on body i,
+// mu_c = mu times c's activity factor (docs/algorithms.md §4.4): an inactive
+// constraint adds exact zeros.
 void penalty(Emit& e, int i, const std::vector<std::vector<Expr>>& kk, Sym& IA, V6& pA) {
   CodeBuilder& cb = e.cb();
-  const Expr mu = cb.input("mu");
+  const Expr muAll = cb.input("mu");
   for (int k : e.bp(i).constraints) {
+    const Expr mu = cb.temp(cb.mul(muAll, activeFactor(e, k)), "mu_c");  // one product, not one per use
     const Constraint& c = e.sys.constraints[std::size_t(k)];
     const Mat6 X = c.placement.motionMatrixInv();
     const auto K = X.topRows(c.rows());

@@ -14,18 +14,21 @@ namespace {
 
 // lambda += mu (K a - k) for every constraint, keeping the increment for the
 // next sweep, and K a - k itself: the rows' residual J qdd + gamma - a* of the
-// accelerations just computed (residual(w) reads the last one).
+// accelerations just computed (residual(w) reads the last one). Both times the
+// constraint's activity factor: an inactive constraint's residual rows, its
+// increments and so its multipliers stay exactly 0 (docs/algorithms.md §4.4).
 void updateMultipliers(Emit& e, const Kinematics& kin, const Motion& motion, Multipliers& mult) {
   e.fn.boundary("");
   CodeBuilder& cb = e.cb();
-  cb.open("{", {"multiplier update: dlambda = mu (K a - k), lambda += dlambda"});
+  cb.open("{", {"multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)"});
   for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
     const Constraint& c = e.sys.constraints[k];
     const std::vector<Expr> Ka = e.constraintRows(int(k), c.body == 0 ? e.rootAcceleration() : motion.a[std::size_t(c.body)]);
     for (int j = 0; j < c.rows(); ++j) {
       const int row = c.row + j;
       const Expr mu = cb.input("mu");  // before the difference's temporary: see mulAdd in symbolic.cpp
-      const Expr res = cb.store(residualMember(e, row), Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+      const Expr on = activeFactor(e, int(k));
+      const Expr res = cb.store(residualMember(e, row), cb.mul(on, cb.flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)])));
       const Expr dl = cb.mul(mu, res);
       mult.dlambda[std::size_t(row)] = e.put(e.member("dlambda", e.plan.nc, row, "latest multiplier increment"), dl);
       mult.lambda[std::size_t(row)] = e.put(e.lambdaMember(row), mult.lambda[std::size_t(row)] + mult.dlambda[std::size_t(row)]);
@@ -126,16 +129,46 @@ std::string residualMember(Emit& e, int row) {
   return e.member("residual", e.plan.nc, row, "rows of J qdd + gamma - a* of the last solve (residual(w))");
 }
 
+std::string activeMember(Emit& e, int k) {
+  return e.member("active", int(e.plan.constraints.size()), k, "the schedule of the last call (Settings::active) as 0/1 factors");
+}
+
+void storeActiveFactors(Emit& e, const std::string& flags) {
+  CodeBuilder& cb = e.cb();
+  for (std::size_t k = 0; k < e.plan.constraints.size(); ++k) {
+    const std::string m = activeMember(e, int(k));
+    cb.line(fmt::format("{} = Scalar({}[{}]);", m, flags, k), {}, {flags.substr(0, flags.find('.')), m});
+  }
+}
+
+Expr activeFactor(Emit& e, int k) { return e.cb().member(activeMember(e, k)); }
+
+int rowConstraint(const Plan& plan, int row) {
+  for (std::size_t k = 0; k < plan.constraints.size(); ++k) {
+    const ConstraintPlan& c = plan.constraints[k];
+    if (row >= c.row && row < c.row + c.rows) return int(k);
+  }
+  throw std::logic_error("emitter: a row outside the layout");
+}
+
+Expr activeRowFactor(Emit& e, int row) { return activeFactor(e, rowConstraint(e.plan, row)); }
+
 // In the host, before the first sweep: lambda = lambda0 (s.lambda0, or zeros
-// when it is null: the runtime's pointer select).
+// when it is null: the runtime's pointer select); an inactive constraint's
+// rows read the zeros instead (an index by its flag, no branch), so its
+// lambda0 is never read, whatever it holds.
 void startMultipliers(Emit& e, Multipliers& mult) {
   if (e.plan.nc == 0) return;
   e.fn.endPart();
   CodeBuilder& cb = e.cb();
-  cb.comment("---- warm start: lambda = s.lambda0, or 0 when it is null");
+  cb.comment("---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive");
   cb.line("const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);", {}, {"s"});
-  for (int r = 0; r < e.plan.nc; ++r)
-    mult.lambda[std::size_t(r)] = cb.store(e.lambdaMember(r), cb.input(fmt::format("lambda0[{}]", r)));
+  cb.line("const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};");
+  for (std::size_t k = 0; k < e.plan.constraints.size(); ++k) {
+    const ConstraintPlan& c = e.plan.constraints[k];
+    for (int r = c.row; r < c.row + c.rows; ++r)
+      mult.lambda[std::size_t(r)] = cb.store(e.lambdaMember(r), cb.input(fmt::format("lambda0_if[s.active[{}]][{}]", k, r)));
+  }
 }
 
 // qdd and lambda out of the workspace.
@@ -157,6 +190,7 @@ std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const C
   e.fn.live() = Live{&kin, &art, &motion, &inc, nullptr, &mult, nullptr};
   e.fn.beginHost("caba", from);
   e.fn.setHostMu(e.cb().define("mu", "s.mu * Scalar(s.iterations > 0)", {}, {"s"}));
+  storeActiveFactors(e, "s.active");
   e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   if (!plan.offSupport.empty()) e.cb().line("eliminate_free_bodies(tau, w);", {}, {"tau", "w"});
   startMultipliers(e, mult);

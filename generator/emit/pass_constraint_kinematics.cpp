@@ -41,6 +41,18 @@ void copyOutput(Emit& e, const std::string& name, const std::vector<Expr>& out) 
     cb.line(fmt::format("{}[{}] = {};", name, k, cb.print(out[k])), {out[k]}, {name});
 }
 
+void scheduleOutput(Emit& e, std::vector<Expr>& out, int cols, bool columnsToo) {
+  e.fn.endPart();
+  CodeBuilder& cb = e.cb();
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (out[k].isZero()) continue;
+    const int r = int(k) / cols, c = int(k) % cols;
+    Expr f = activeRowFactor(e, r);
+    if (columnsToo && rowConstraint(e.plan, c) != rowConstraint(e.plan, r)) f = cb.mul(f, activeRowFactor(e, c));
+    out[k] = cb.mul(f, cb.flat(out[k]));
+  }
+}
+
 ConstraintJoints emitConstraintJoints(Emit& e, bool all) {
   ConstraintJoints j;
   const Model& m = e.model();
@@ -117,6 +129,7 @@ std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints) {
   // KA = K^T: the own rows' force directions, then each child's (below).
   for (int i : plan.support) initOwnRows(e, i, rows);
   beginFrom(e, "jacobian", joints.host, kin, out, &rows);
+  storeActiveFactors(e, "active");
   e.cb().line("constraint_joints(q, w);", {}, {"q", "w"});
   // J(row, v_j) = S_j^T X_j^T ... X_i^T K_row^T: each row's direction carried
   // up its constraint's path as a force, read by every joint on the way.
@@ -144,8 +157,9 @@ std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints) {
     }
     e.cb().close();
   }
+  scheduleOutput(e, out.out, plan.nv, false);  // an inactive constraint's rows: 0
   copyOutput(e, "J", out.out);
-  std::string text = e.fn.endHost({"q", "w", "J"});
+  std::string text = e.fn.endHost({"q", "w", "J", "active"});
   e.fn.live() = Live{};
   return text;
 }
@@ -158,6 +172,7 @@ std::string emitConstraintDrift(Emit& e, const Kinematics& kinIn, const CodeBuil
   Motion motion{std::vector<V6>(kin.b.size(), zero6()), {}};
   beginFrom(e, "drift", afterKinematics, kin, out);
   e.fn.live().motion = &motion;
+  storeActiveFactors(e, "active");
   e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   // gamma = the rows' acceleration at qdd = 0 without gravity: a_i = X_i a_p + c_i
   // from a_0 = 0, then K X_C a_i (+ w_C x v_C for a point, its classical acceleration).
@@ -184,8 +199,9 @@ std::string emitConstraintDrift(Emit& e, const Kinematics& kinIn, const CodeBuil
     }
     e.cb().close();
   }
+  scheduleOutput(e, out.out, 1, false);  // an inactive constraint's rows: 0
   copyOutput(e, "gamma", out.out);
-  std::string text = e.fn.endHost({"q", "v", "w", "gamma"});
+  std::string text = e.fn.endHost({"q", "v", "w", "gamma", "active"});
   e.fn.live() = Live{};
   return text;
 }

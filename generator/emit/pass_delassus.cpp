@@ -227,6 +227,9 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse) 
     hostMu = e.cb().define("mu", "s.mu", {}, {"s"});
     e.fn.setHostMu(hostMu);
   }
+  // The schedule: the penalty mu_c = mu times c's factor (delassus_inverse),
+  // and F out F at the end (docs/algorithms.md §4.4).
+  storeActiveFactors(e, inverse ? "s.active" : "active");
   e.cb().line("constraint_joints(q, w);", {}, {"q", "w"});
   // No penalty right-hand side: the recursion reads the inertias only.
   const std::vector<std::vector<Expr>> noRhs = [&] {
@@ -266,9 +269,10 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse) 
   if (inverse)
     for (int r = 0; r < plan.nc; ++r)
       if (st.out[std::size_t(r * plan.nc + r)].isZero()) st.out[std::size_t(r * plan.nc + r)] = hostMu;
+  scheduleOutput(e, st.out, plan.nc, true);
   copyOutput(e, inverse ? "Ginv" : "G", st.out);
   std::string text = e.fn.endHost(inverse ? std::vector<std::string>{"q", "s", "w", "Ginv"}
-                                          : std::vector<std::string>{"q", "w", "G"});
+                                          : std::vector<std::string>{"q", "w", "G", "active"});
   e.fn.live() = Live{};
   return text;
 }

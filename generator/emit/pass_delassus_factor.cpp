@@ -85,7 +85,20 @@ int freeFlyerWithRows(const Plan& plan) {
   return -1;
 }
 
-// G + I/mu = L L^T (or A + I/mu with a floating base), one block (and part) per column.
+// The schedule (docs/algorithms.md §4.4): an entry coupling two constraints
+// times both their activity factors, so an inactive constraint's rows meet the
+// others' through exact zeros only. Its own diagonal block stays as it is:
+// with zero coupling and a zero right-hand side (F y, lambda0 0) its rows of
+// the factor's solves are exact zeros whatever the block holds, and the other
+// rows never read it; so the limbs of one contact each pay nothing here.
+Expr scheduled(Emit& e, int t, int u, const Expr& g) {
+  const std::vector<int>& tree = e.plan.rootRows;
+  const int kt = rowConstraint(e.plan, tree[std::size_t(t)]), ku = rowConstraint(e.plan, tree[std::size_t(u)]);
+  if (g.isZero() || kt == ku) return g;
+  return e.cb().mul(e.cb().mul(activeFactor(e, kt), activeFactor(e, ku)), e.cb().flat(g));
+}
+
+// G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block (and part) per column.
 void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   const int nc = e.plan.nc;
   f.L = Sym(nc);
@@ -95,13 +108,13 @@ void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
     e.fn.boundary(fmt::format("column_{}", j));
     CodeBuilder& cb = e.cb();
     cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
-    Expr d = delassus(cb, a, j, j, split);  // before inv_mu: see mulAdd in symbolic.cpp
+    Expr d = scheduled(e, j, j, delassus(cb, a, j, j, split));  // before inv_mu: see mulAdd in symbolic.cpp
     d += cb.input("inv_mu");
     for (int k = 0; k < j; ++k) d -= cb.mul(f.L(j, k), f.L(j, k));
     const Expr r = cb.sqrt(d, "r");
     f.Linv[std::size_t(j)] = e.put(e.member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));
     for (int i = j + 1; i < nc; ++i) {
-      Expr x = delassus(cb, a, i, j, split);
+      Expr x = scheduled(e, i, j, delassus(cb, a, i, j, split));
       for (int k = 0; k < j; ++k) x -= cb.mul(f.L(i, k), f.L(j, k));
       f.L(i, j) = e.put(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)"),
                         cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));
@@ -120,7 +133,9 @@ void woodbury(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
     e.fn.boundary(fmt::format("W_{}", d));
     e.cb().open("{", {fmt::format("W = L^-1 Z^T, column {}", d)});
     std::vector<Expr> z(static_cast<std::size_t>(nc));
-    for (int j = 0; j < b.m(); ++j) z[std::size_t(b.rowStart + j)] = rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)];
+    for (int j = 0; j < b.m(); ++j)  // Z F: an inactive row's column of Z is 0, so is its row of W
+      z[std::size_t(b.rowStart + j)] = e.cb().mul(activeRowFactor(e, e.plan.rootRows[std::size_t(b.rowStart + j)]),
+                                                  rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)]);
     const std::vector<Expr> w = forwardSolve(e.cb(), f.L, f.Linv, z);
     for (int t = 0; t < nc; ++t)
       f.W[std::size_t(t)][std::size_t(d)] = e.put(e.ws.member("W", nc, 6, t, d, "L^-1 Z^T"), w[std::size_t(t)]);

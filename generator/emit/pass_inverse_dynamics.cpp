@@ -87,6 +87,16 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
     // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
     host.line(fmt::format("static constexpr Scalar kNoMultipliers[{}] = {{}};", plan.nc));
     host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
+    // An inactive constraint's rows read the zeros (an index by its flag, no
+    // branch): its lambda is never read (docs/algorithms.md §4.4).
+    host.line("const MultiplierRows lambda_if[2] = {kNoMultipliers, lambda};", {}, {"lambda"});
+    host.line(fmt::format("Scalar lambda_on[{}];", plan.nc));
+    for (std::size_t k = 0; k < plan.constraints.size(); ++k) {
+      const ConstraintPlan& c = plan.constraints[k];
+      for (int r = c.row; r < c.row + c.rows; ++r)
+        host.line(fmt::format("lambda_on[{}] = lambda_if[active[{}]][{}];", r, k, r), {}, {"active"});
+    }
+    host.line("lambda = lambda_on;", {}, {"lambda"});
   }
   host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   inverseDynamics(e, kin, !nonlinearEffects, withLambda, forces);
@@ -95,7 +105,7 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
   CodeBuilder& cb = e.cb();
   for (int j = 0; j < plan.nv; ++j)
     cb.line(fmt::format("{}[{}] = {};", out, j, cb.print(forces.tau[std::size_t(j)])), {forces.tau[std::size_t(j)]}, {out});
-  std::string text = nonlinearEffects ? e.fn.endHost({"q", "v", "w", "h"}) : e.fn.endHost({"q", "v", "qdd", "lambda", "w", "tau"});
+  std::string text = nonlinearEffects ? e.fn.endHost({"q", "v", "w", "h"}) : e.fn.endHost({"q", "v", "qdd", "lambda", "w", "tau", "active"});
   e.fn.live() = Live{};
   return text;
 }

@@ -216,7 +216,9 @@ void freeRowAccelerations(Emit& e, const Kinematics& kin, const Articulated& art
     const std::vector<Expr> Ka = e.constraintRows(int(k), c.body == 0 ? e.rootAcceleration() : motion.a[std::size_t(c.body)]);
     for (int j = 0; j < c.rows(); ++j) {
       const int t = e.plan.rowPosition[std::size_t(c.row + j)];
-      rows.yfree[std::size_t(t)] = e.put(e.yMember(t), Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+      // times the activity factor: an inactive row's right-hand side is exactly 0 (docs/algorithms.md §4.4)
+      rows.yfree[std::size_t(t)] =
+          e.put(e.yMember(t), e.cb().mul(activeFactor(e, int(k)), e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)])));
     }
   }
   e.cb().close();
@@ -231,7 +233,9 @@ void storeResidual(Emit& e, const Kinematics& kin, const Motion& motion) {
   for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
     const Constraint& c = e.sys.constraints[k];
     const std::vector<Expr> Ka = e.constraintRows(int(k), c.body == 0 ? e.rootAcceleration() : motion.a[std::size_t(c.body)]);
-    for (int j = 0; j < c.rows(); ++j) e.cb().store(residualMember(e, c.row + j), Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+    for (int j = 0; j < c.rows(); ++j)  // 0 for an inactive constraint
+      e.cb().store(residualMember(e, c.row + j),
+                   e.cb().mul(activeFactor(e, int(k)), e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)])));
   }
   e.cb().close();
 }
@@ -256,6 +260,7 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
   DelassusFactor del;
   e.fn.live() = Live{&kin, &art, &motion, nullptr, &rows, &mult, nullptr};
   e.fn.beginHost("pv", from);
+  storeActiveFactors(e, "s.active");
   e.cb().line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   if (!plan.offSupport.empty()) e.cb().line("eliminate_free_bodies(tau, w);", {}, {"tau", "w"});
   initRows(e, rows);

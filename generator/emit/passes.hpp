@@ -60,9 +60,19 @@ std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector
 // ---- pass_constrained_aba.cpp: the constrained_aba entry point (body text);
 // kin and art are its own copies of the state after eliminate_free_bodies,
 // whose values live in `from`.
+/// The run-time schedule (Settings::active, docs/algorithms.md §4.4): the host
+/// writes w.active[k] = Scalar(flags[k]) for every constraint k (`flags`: the
+/// raw text of the bool array, "s.active" or "active"); activeFactor reads it
+/// back as a 0/1 factor in any function after that.
+void storeActiveFactors(Emit& e, const std::string& flags);
+Expr activeFactor(Emit& e, int k);
+/// The constraint (layout order) of row `row` (layout numbering), and its factor.
+int rowConstraint(const Plan& plan, int row);
+Expr activeRowFactor(Emit& e, int row);
 /// qdd and lambda out of the workspace (the end of both entry points).
 void copyOut(Emit& e, const Motion& motion, const Multipliers& mult);
-/// The warm start in the host: lambda = s.lambda0 (or 0); and the member of
+/// The warm start in the host: lambda = s.lambda0 (or 0; 0 for the rows of an
+/// inactive constraint, whose lambda0 is never read); and the member of
 /// the rows' residual K a - k that residual(w) reads (both entry points).
 void startMultipliers(Emit& e, Multipliers& mult);
 std::string residualMember(Emit& e, int row);
@@ -108,6 +118,10 @@ ConstraintJoints emitConstraintJoints(Emit& e, bool all);
 std::string emitConstraintPlacements(Emit& e, const ConstraintJoints& joints);
 std::string emitConstraintJacobian(Emit& e, const ConstraintJoints& joints);
 std::string emitConstraintDrift(Emit& e, const Kinematics& kin, const CodeBuilder* from);
+/// Ends the open part and multiplies out[r * cols + c] (the host's values) by
+/// row r's activity factor (and, `columnsToo`, by column c's: G's rows and
+/// columns): the rows of an inactive constraint become exact zeros.
+void scheduleOutput(Emit& e, std::vector<Expr>& out, int cols, bool columnsToo);
 /// Ends the open part and copies `out` (the host's values) to the output array `name`.
 void copyOutput(Emit& e, const std::string& name, const std::vector<Expr>& out);
 

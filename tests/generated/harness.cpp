@@ -11,12 +11,16 @@
 
 #include <algorithm>
 #include <iterator>
+#include <limits>
+#include <random>
 #include <string>
 #include <type_traits>
 #include <vector>
 
 #include PROXGEN_SOLVER_HEADER
 #include "harness_lib.hpp"
+#include "model/state.hpp"
+#include "support.hpp"
 #include "proxgen/runtime.hpp"
 
 namespace {
@@ -34,8 +38,10 @@ using proxgen::test::SolverUnderTest;
 #if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
 // The generated solver on one state, results in double; lambda0 (nc values)
 // or null is Settings::lambda0. Returns residual(w).
-double runGeneratedFrom(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const VecX& vIn, const VecX& tauIn,
-                        double mu, int K, const VecX* lambda0In, VecX& qdd, VecX& lambda) {
+// active (ncons flags) or null is Settings::active (null: the default, all true).
+double runGeneratedScheduled(SolverUnderTest::Algorithm algorithm, const VecX& qIn, const VecX& vIn, const VecX& tauIn,
+                             double mu, int K, const VecX* lambda0In, const std::vector<bool>* active, VecX& qdd,
+                             VecX& lambda) {
   std::vector<gen::Scalar> q(gen::nq), v(gen::nv), tau(gen::nv), a(gen::nv), l(std::size_t(std::max(gen::nc, 1))),
       l0(std::size_t(std::max(gen::nc, 1)));
   for (int k = 0; k < gen::nq; ++k) q[std::size_t(k)] = gen::Scalar(qIn[k]);
@@ -50,6 +56,8 @@ double runGeneratedFrom(SolverUnderTest::Algorithm algorithm, const VecX& qIn, c
     for (int k = 0; k < gen::nc; ++k) l0[std::size_t(k)] = gen::Scalar((*lambda0In)[k]);
     settings.lambda0 = l0.data();
   }
+  if (active)
+    for (int k = 0; k < gen::ncons; ++k) settings.active[k] = active->at(std::size_t(k));
   static gen::Workspace w;  // tens of kB for the big robots: not on the stack
   const auto solve = algorithm == SolverUnderTest::kConstrainedAba ? gen::constrained_aba : gen::prox_pv;
   solve(q.data(), v.data(), tau.data(), settings, w, a.data(), l.data());
@@ -58,6 +66,11 @@ double runGeneratedFrom(SolverUnderTest::Algorithm algorithm, const VecX& qIn, c
   for (int k = 0; k < gen::nv; ++k) qdd[k] = double(a[std::size_t(k)]);
   for (int k = 0; k < gen::nc; ++k) lambda[k] = double(l[std::size_t(k)]);
   return double(gen::residual(w));
+}
+
+double runGeneratedFrom(SolverUnderTest::Algorithm algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu,
+                        int K, const VecX* lambda0, VecX& qdd, VecX& lambda) {
+  return runGeneratedScheduled(algorithm, q, v, tau, mu, K, lambda0, nullptr, qdd, lambda);
 }
 
 void runGenerated(SolverUnderTest::Algorithm algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu,
@@ -73,6 +86,7 @@ SolverUnderTest solverUnderTest() {
   solver.isFloat = std::is_same_v<gen::Scalar, float>;
   solver.run = runGenerated;
   solver.runFrom = runGeneratedFrom;
+  solver.runScheduled = runGeneratedScheduled;
   return solver;
 }
 #endif
@@ -183,10 +197,43 @@ TEST_F(Generated, WarmStartMayBeTheLambdaOutput) {
   }
 }
 
+// Issue 18 item 2: Settings::active, against the generic solvers on the
+// sub-layout of the active constraints (harness_lib.cpp).
+TEST_F(Generated, ScheduleIsTheSubLayout) {
+  proxgen::test::expectScheduleIsTheSubLayout(solverUnderTest(), sys_);
+}
+
 TEST_F(Generated, ResidualIsTheConstraintResidual) {
   proxgen::test::expectResidualIsTheConstraintResidual(solverUnderTest(), sys_);
 }
 
+#endif
+
+#if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS
+// inverse_dynamics' schedule (issue 18 item 2): the rows of an inactive
+// constraint are never read, so lambda with NaN there gives the bits of lambda
+// with 0 there and the default schedule (the same operations on the same
+// values; were the schedule ignored, the NaN would reach tau).
+TEST_F(Generated, InverseDynamicsIgnoresTheInactiveMultipliers) {
+  if (gen::nc == 0) GTEST_SKIP() << "no constraints";
+  std::mt19937 rng(20261207);
+  const proxgen::State st = proxgen::test::randomState(sys_.model, rng);
+  const std::vector<gen::Scalar> q = toScalar(st.q), v = toScalar(st.v), qdd = toScalar(st.tau);
+  for (const std::vector<bool>& schedule : proxgen::test::testSchedules(gen::ncons)) {
+    bool active[std::size(gen::all_active)] = {};
+    std::vector<gen::Scalar> lNan(gen::nc), lZero(gen::nc), tauNan(gen::nv), tauZero(gen::nv);
+    for (int k = 0; k < gen::ncons; ++k) {
+      active[k] = schedule[std::size_t(k)];
+      for (int r = gen::constraint_row[k]; r < gen::constraint_row[k] + gen::constraint_rows[k]; ++r) {
+        lNan[std::size_t(r)] = active[k] ? gen::Scalar(0.5 + r) : std::numeric_limits<gen::Scalar>::quiet_NaN();
+        lZero[std::size_t(r)] = active[k] ? gen::Scalar(0.5 + r) : gen::Scalar(0);
+      }
+    }
+    gen::inverse_dynamics(q.data(), v.data(), qdd.data(), lNan.data(), workspace(), tauNan.data(), active);
+    gen::inverse_dynamics(q.data(), v.data(), qdd.data(), lZero.data(), workspace(), tauZero.data());
+    EXPECT_EQ(tauNan, tauZero);
+  }
+}
 #endif
 
 #if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS || PROXGEN_SOLVER_HAS_NONLINEAR_EFFECTS || PROXGEN_SOLVER_HAS_MASS_MATRIX || \

@@ -19,12 +19,15 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
-#include <string>
+#include <iterator>
 #include <random>
+#include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
 #include PROXGEN_SOLVER_HEADER
+#include "algorithms/constraints.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/dense_reference.hpp"
 #include "harness_lib.hpp"
@@ -73,14 +76,19 @@ gen::Workspace& workspace() {
 // The number of constraints (12 placement values each), set by the fixture.
 int gConstraints = 0;
 
-// Every generated constraint function of this solver at (q, v), mu for the inverse.
-proxgen::verify::ConstraintAnswer runGenerated(const VecX& qIn, const VecX& vIn, double mu) {
+// Every generated constraint function of this solver at (q, v), mu for the
+// inverse; `active` (ncons flags) the schedule, null: the default (all).
+proxgen::verify::ConstraintAnswer runGenerated(const VecX& qIn, const VecX& vIn, double mu,
+                                               const std::vector<bool>* activeIn = nullptr) {
   proxgen::verify::ConstraintAnswer a;
   a.mu = mu;
   const std::vector<gen::Scalar> q = toScalar(qIn), v = toScalar(vIn);
   const int nc = gen::nc, nv = gen::nv, ncons = gConstraints;
   gen::Workspace& w = workspace();
+  bool active[std::size(gen::all_active)];
+  for (std::size_t k = 0; k < std::size(active); ++k) active[k] = activeIn ? bool(activeIn->at(k)) : gen::all_active[k];
   static_cast<void>(w), static_cast<void>(nv), static_cast<void>(ncons), static_cast<void>(v), static_cast<void>(nc);
+  static_cast<void>(active);
 #ifdef PROXGEN_SOLVER_HAS_CONSTRAINT_PLACEMENTS
   std::vector<gen::Scalar> X(std::size_t(12 * std::max(ncons, 1)));
   gen::constraint_placements(q.data(), w, X.data());
@@ -88,23 +96,24 @@ proxgen::verify::ConstraintAnswer runGenerated(const VecX& qIn, const VecX& vIn,
 #endif
 #ifdef PROXGEN_SOLVER_HAS_CONSTRAINT_JACOBIAN
   std::vector<gen::Scalar> J(std::size_t(std::max(nc * nv, 1)));
-  gen::constraint_jacobian(q.data(), w, J.data());
+  gen::constraint_jacobian(q.data(), w, J.data(), active);
   a.J = toDouble(J, nc * nv);
 #endif
 #ifdef PROXGEN_SOLVER_HAS_CONSTRAINT_DRIFT
   std::vector<gen::Scalar> gamma(std::size_t(std::max(nc, 1)));
-  gen::constraint_drift(q.data(), v.data(), w, gamma.data());
+  gen::constraint_drift(q.data(), v.data(), w, gamma.data(), active);
   a.gamma = toDouble(gamma, nc);
 #endif
 #ifdef PROXGEN_SOLVER_HAS_DELASSUS
   std::vector<gen::Scalar> G(std::size_t(std::max(nc * nc, 1)));
-  gen::delassus(q.data(), w, G.data());
+  gen::delassus(q.data(), w, G.data(), active);
   a.G = toDouble(G, nc * nc);
 #endif
 #ifdef PROXGEN_SOLVER_HAS_DELASSUS_INVERSE
   std::vector<gen::Scalar> Ginv(std::size_t(std::max(nc * nc, 1)));
   gen::Settings s;
   s.mu = gen::Scalar(mu);
+  for (std::size_t k = 0; k < std::size(active); ++k) s.active[k] = active[k];
   gen::delassus_inverse(q.data(), s, w, Ginv.data());
   a.Ginv = toDouble(Ginv, nc * nc);
 #endif
@@ -156,6 +165,78 @@ TEST_F(ConstraintFunctions, MatchTheGenericTwins) {
   }
   EXPECT_GT(compared, 0);
   for (const auto& [what, w] : worst) std::printf("%s: largest relErr %.1e (%.2f of the bound)\n", what.c_str(), w.first, w.second);
+}
+
+// The schedule (Settings::active, or the functions' `active` argument; issue
+// 18 item 2): for testSchedules(ncons), the rows (and columns of G, Ginv) of
+// the inactive constraints are exact zeros, the placements ignore the
+// schedule (geometry), and the active rows are the functions of the
+// sub-layout of the active constraints: compared with the generic twins on
+// activeSubsystem, with the bounds of MatchTheGenericTwins at its conditioning.
+TEST_F(ConstraintFunctions, ScheduleIsTheSubLayout) {
+  std::mt19937 rng(20261206);
+  const int ncons = int(sys_.constraints.size());
+  if (ncons == 0) GTEST_SKIP() << "no constraints";
+  double worst = 0;
+  for (const std::vector<bool>& active : proxgen::test::testSchedules(ncons)) {
+    const proxgen::System sub = proxgen::activeSubsystem(sys_, active);
+    const std::vector<int> kept = proxgen::activeRows(sys_, active);
+    const int m = int(kept.size());
+    std::vector<char> on(std::size_t(gen::nc), 0);
+    for (int r : kept) on[std::size_t(r)] = 1;
+    proxgen::Data d(sub), scratch(sub);
+    for (int n = 0; n < 4; ++n) {
+      const proxgen::State s = state(rng);
+      const proxgen::verify::Conditioning cond = proxgen::verify::conditioningAt(sub, scratch, s, kFloat);
+      for (double mu : {100.0, 1e4}) {
+        const proxgen::verify::ConstraintAnswer all = runGenerated(s.q, s.v, mu);
+        const proxgen::verify::ConstraintAnswer g = runGenerated(s.q, s.v, mu, &active);
+        proxgen::verify::ConstraintAnswer a;
+        a.mu = mu;
+        EXPECT_EQ(g.X, all.X) << "the placements take no schedule";
+        if (g.X.size()) {
+          a.X.resize(12 * Eigen::Index(sub.constraints.size()));
+          Eigen::Index at = 0;
+          for (std::size_t k = 0; k < active.size(); ++k)
+            if (active[k]) a.X.segment<12>(12 * at++) = g.X.segment<12>(12 * Eigen::Index(k));
+        }
+        if (g.J.size()) {
+          a.J.resize(Eigen::Index(m) * gen::nv);
+          for (int r = 0; r < gen::nc; ++r)
+            for (int c = 0; c < gen::nv; ++c)
+              if (!on[std::size_t(r)]) {
+                EXPECT_EQ(g.J[r * gen::nv + c], 0.0) << "J, inactive row " << r;
+              }
+          for (int i = 0; i < m; ++i) a.J.segment(Eigen::Index(i) * gen::nv, gen::nv) = g.J.segment(kept[std::size_t(i)] * gen::nv, gen::nv);
+        }
+        if (g.gamma.size()) {
+          a.gamma.resize(m);
+          for (int r = 0; r < gen::nc; ++r)
+            if (!on[std::size_t(r)]) {
+              EXPECT_EQ(g.gamma[r], 0.0) << "gamma, inactive row " << r;
+            }
+          for (int i = 0; i < m; ++i) a.gamma[i] = g.gamma[kept[std::size_t(i)]];
+        }
+        for (const auto& [full, out, what] : {std::tuple{&g.G, &a.G, "G"}, std::tuple{&g.Ginv, &a.Ginv, "Ginv"}}) {
+          if (!full->size()) continue;
+          out->resize(Eigen::Index(m) * m);
+          for (int r = 0; r < gen::nc; ++r)
+            for (int c = 0; c < gen::nc; ++c)
+              if (!on[std::size_t(r)] || !on[std::size_t(c)]) {
+                EXPECT_EQ((*full)[r * gen::nc + c], 0.0) << what << ", inactive entry " << r << ", " << c;
+              }
+          for (int i = 0; i < m; ++i)
+            for (int j = 0; j < m; ++j) (*out)[i * m + j] = (*full)[kept[std::size_t(i)] * gen::nc + kept[std::size_t(j)]];
+        }
+        for (const proxgen::verify::Compared& x : proxgen::verify::compareConstraintFunctions(sub, d, cond, s, a)) {
+          EXPECT_TRUE(x.finite) << x.what << ", state " << n;
+          EXPECT_LE(x.error, x.bound) << x.what << ", state " << n << ", mu " << mu;
+          worst = std::max(worst, x.error / x.bound);
+        }
+      }
+    }
+  }
+  std::printf("schedules: largest error / bound against the sub-layout's generic twins %.2f\n", worst);
 }
 
 #if defined(PROXGEN_SOLVER_HAS_CONSTRAINT_PLACEMENTS) && defined(PROXGEN_SOLVER_HAS_CONSTRAINT_JACOBIAN)

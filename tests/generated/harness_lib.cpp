@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <string>
 #include <random>
@@ -333,6 +334,165 @@ void expectWarmStartMatchesTheGeneric(const SolverUnderTest& gen, const System& 
       }
     }
   }
+}
+
+namespace {
+
+// J, gamma and a* at a state (constraint_kinematics.hpp; a* from the frames'
+// placements and twists J v, as constraints.cpp forms it).
+struct RowsAt {
+  MatX J;
+  VecX gamma, aStar;
+  /// ||J qdd + gamma - a*||_inf, and (scale) the size of its summands,
+  /// |J| |qdd| + |gamma| + |a*| + |g|: both sides of a residual comparison
+  /// evaluate it from the same qdd in other orders, each within c n u scale.
+  double residual(const System& sys, const VecX& qdd, double& scale) const {
+    const double Jinf = sys.nc ? J.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
+    scale = Jinf * maxAbs(qdd) + maxAbs(gamma) + maxAbs(aStar) + sys.model.gravity.norm();
+    return maxAbs(J * qdd + gamma - aStar);
+  }
+};
+RowsAt rowsAt(const System& sys, Data& d, const State& s) {
+  RowsAt out;
+  out.J = constraintJacobianRows(sys, d, s.q);
+  out.gamma = constraintDrift(sys, d, s.q, s.v);
+  const VecX placements = constraintPlacements(sys, d, s.q);
+  const VecX twist = out.J * s.v;
+  out.aStar = VecX::Zero(sys.nc);
+  for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+    const Constraint& c = sys.constraints[k];
+    SE3 oMc;
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 3; ++col) oMc.R(r, col) = placements[12 * Eigen::Index(k) + 3 * r + col];
+    oMc.p = placements.segment<3>(12 * Eigen::Index(k) + 9);
+    Vec6 vC = Vec6::Zero();
+    vC.head(c.rows()) = twist.segment(c.row, c.rows());
+    out.aStar.segment(c.row, c.rows()) = baumgarteTarget(c, oMc, vC);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::vector<bool>> testSchedules(int ncons) {
+  std::vector<std::vector<bool>> out;
+  const auto n = std::size_t(ncons);
+  if (ncons <= 4) {
+    for (unsigned mask = 0; mask < (1u << ncons); ++mask) {
+      std::vector<bool> a(n);
+      for (std::size_t k = 0; k < n; ++k) a[k] = (mask >> k) & 1u;
+      out.push_back(a);
+    }
+    return out;
+  }
+  out.push_back(std::vector<bool>(n, false));
+  out.push_back(std::vector<bool>(n, true));
+  for (std::size_t k = 0; k < n; ++k) {
+    std::vector<bool> one(n, false), allBut(n, true);
+    one[k] = true;
+    allBut[k] = false;
+    out.push_back(one);
+    out.push_back(allBut);
+  }
+  std::mt19937 rng(20261201);
+  for (int r = 0; r < 4; ++r) {
+    std::vector<bool> a(n);
+    for (std::size_t k = 0; k < n; ++k) a[k] = (rng() & 1u) != 0;
+    out.push_back(a);
+  }
+  return out;
+}
+
+void expectScheduleIsTheSubLayout(const SolverUnderTest& gen, const System& sys) {
+  const int ncons = int(sys.constraints.size());
+  if (ncons == 0) return;
+  const double eps = gen.isFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;
+  const double safety = 10.0 * (sys.model.nv + sys.nc);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // A few states per schedule: 2^4 schedules of the quadruped (or 4 n + 6 of
+  // a larger layout) times every state would cost as much as all the other
+  // tests together; what the schedule changes is structural (which rows are
+  // decoupled), so each state checks every constraint's on and off.
+  const int states = std::max(1, apiStates() / 5);
+  std::mt19937 rng(20261204);
+  Worst worst;
+  for (const std::vector<bool>& active : testSchedules(ncons)) {
+    const System sub = activeSubsystem(sys, active);
+    const std::vector<int> kept = activeRows(sys, active);
+    Data dSub(sub), denseSub(sub);
+    std::string schedule;
+    for (bool b : active) schedule += b ? '1' : '0';
+    for (int n = 0; n < states; ++n) {
+      const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
+      const verify::Conditioning cond = verify::conditioningAt(sub, denseSub, s, gen.isFloat);
+      const RowsAt rows = rowsAt(sub, dSub, s);
+      for (double mu : {100.0, 1e4}) {
+        const verify::Bounds bounds = verify::boundsAt(cond, mu);
+        for (int K : {0, 1, 3}) {
+          const std::string where =
+              "schedule " + schedule + ", state " + std::to_string(n) + ", mu " + std::to_string(mu) + ", K " + std::to_string(K);
+          verify::GeneratedAnswer answer;
+          VecX lambda[2];
+          double residual[2];
+          for (int a = 0; a < 2; ++a) {
+            VecX& qdd = a == 0 ? answer.cabaQdd : answer.pvQdd;
+            residual[a] = gen.runScheduled(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, nullptr, &active, qdd,
+                                           lambda[a]);
+            // An inactive constraint exerts no force: its multipliers are 0
+            // exactly (its penalty, its right-hand side and its rows of the
+            // Delassus matrix are multiplied by an exact 0), not small.
+            VecX& kept_ = a == 0 ? answer.cabaLambda : answer.pvLambda;
+            kept_.resize(Eigen::Index(kept.size()));
+            for (std::size_t r = 0; r < kept.size(); ++r) kept_[Eigen::Index(r)] = lambda[a][kept[r]];
+            int k = 0;
+            for (int r = 0; r < sys.nc; ++r) {
+              while (r >= sys.constraints[std::size_t(k)].row + sys.constraints[std::size_t(k)].rows()) ++k;
+              if (!active[std::size_t(k)]) {
+                EXPECT_EQ(lambda[a][r], 0.0) << "algorithm " << a << ", inactive row " << r << ", " << where;
+              }
+            }
+            // residual(w) is the sub-layout's ||J qdd + gamma - a*||_inf: the
+            // inactive rows count as 0. Same bound as expectResidualIsTheConstraintResidual.
+            double scale = 0;
+            const double expected = sub.nc ? rows.residual(sub, qdd, scale) : 0.0;
+            EXPECT_NEAR(residual[a], expected, safety * eps * scale) << "algorithm " << a << " residual, " << where;
+          }
+          // The answer is the sub-layout's: the generic solvers on it, within
+          // the bounds every generated solver meets (verify/compare.cpp) at the
+          // sub-layout's conditioning. The rows of the inactive constraints
+          // add exact zeros only; what differs from a solver generated for the
+          // sub-layout is the order of some sums (round-off, inside the bounds).
+          const verify::Comparison c = verify::compareWithGeneric(sub, dSub, cond, bounds, s, K, answer);
+          for (int q = 0; q < 4; ++q) {
+            const verify::Compared& x = c.item[q];
+            EXPECT_TRUE(x.finite) << x.what << " not finite, " << where;
+            EXPECT_LE(x.error, x.bound) << x.what << ", " << where;
+            worst.add(x.error, x.bound);
+          }
+          // A warm start whose inactive rows hold NaN: never read, so the bits
+          // of the same warm start with 0 there (0 and NaN differ in every
+          // product they enter).
+          if (K == 1) {
+            VecX l0nan = VecX::Constant(sys.nc, nan), l0zero = VecX::Zero(sys.nc);
+            for (std::size_t r = 0; r < kept.size(); ++r) {
+              const double x = 0.25 * double(r + 1);  // exact in float
+              l0nan[kept[r]] = x;
+              l0zero[kept[r]] = x;
+            }
+            for (int a = 0; a < 2; ++a) {
+              VecX qddNan, lamNan, qddZero, lamZero;
+              gen.runScheduled(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, &l0nan, &active, qddNan, lamNan);
+              gen.runScheduled(SolverUnderTest::Algorithm(a), s.q, s.v, s.tau, mu, K, &l0zero, &active, qddZero, lamZero);
+              EXPECT_EQ(qddNan, qddZero) << "algorithm " << a << ", lambda0 NaN on the inactive rows, " << where;
+              EXPECT_EQ(lamNan, lamZero) << "algorithm " << a << ", lambda0 NaN on the inactive rows, " << where;
+            }
+          }
+        }
+      }
+    }
+  }
+  std::printf("schedules: %zu, largest relErr / tolerance against the sub-layout's generic solvers %.2f\n",
+              testSchedules(ncons).size(), worst.ratio);
 }
 
 void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const System& sys) {

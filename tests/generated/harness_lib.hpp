@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include "model/model.hpp"
 
@@ -24,7 +25,16 @@ struct SolverUnderTest {
   std::function<double(Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, const VecX* lambda0,
                        VecX& qdd, VecX& lambda)>
       runFrom;
+  /// The same with Settings::active = *active (ncons flags; null: the default).
+  std::function<double(Algorithm, const VecX& q, const VecX& v, const VecX& tau, double mu, int K, const VecX* lambda0,
+                       const std::vector<bool>* active, VecX& qdd, VecX& lambda)>
+      runScheduled;
 };
+
+/// The schedules a test runs for ncons constraints: every subset when
+/// ncons <= 4, else none, each one alone, each one left out, all, and four
+/// random ones (fixed seed).
+std::vector<std::vector<bool>> testSchedules(int ncons);
 
 /// The System a solver was generated from: a case of the shared cases.yaml
 /// (caseName), or a URDF and a layout.
@@ -57,6 +67,12 @@ void expectQuaternionScaleIsIgnored(const SolverUnderTest& solver, const System&
 /// Warm starts against the generic solvers' warm starts, and K = 1 from the
 /// K-th iterate against iterate K + 1 (a converged lambda0 is a fixed point).
 void expectWarmStartMatchesTheGeneric(const SolverUnderTest& solver, const System& sys);
+/// Settings::active (issue 18 item 2) for testSchedules(ncons): the inactive
+/// rows' lambda exactly 0, qdd and the active rows' lambda against the generic
+/// solvers on activeSubsystem (the bounds of expectMatchesTheGenericSolvers, at
+/// the sub-layout's conditioning), warm starts whose inactive rows hold NaN
+/// giving the bits of lambda0 = 0 there, and residual(w) over the active rows.
+void expectScheduleIsTheSubLayout(const SolverUnderTest& solver, const System& sys);
 /// residual(w) against ||J qdd + gamma - a*||_inf from constraint_kinematics.hpp
 /// on the generated qdd, and its decrease with K.
 void expectResidualIsTheConstraintResidual(const SolverUnderTest& solver, const System& sys);
