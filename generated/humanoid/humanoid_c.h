@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8744 + 1720 K (= 13904 at K = 3)
-//     add/sub 3521 + 743 K, mul 4990 + 931 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16657 + 650 K (= 18607 at K = 3)
-//     add/sub 6655 + 285 K, mul 9583 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
+//     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
+//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 //
 // The C interface of the solver in humanoid.hpp (docs/design.md, "The C
 // interface"), for C firmware and other languages: plain arrays, a work buffer
@@ -43,7 +43,7 @@ extern "C" {
 #define humanoid_NV 36    /* velocity */
 #define humanoid_NC 15    /* constraint rows */
 #define humanoid_NCONS 3 /* constraints in the layout (each 3 or 6 rows) */
-#define humanoid_WORK_SIZE 23000
+#define humanoid_WORK_SIZE 23024
 #define humanoid_WORK_ALIGN 8
 
 /* Constraints, layout order: index (active[], W) and first row (lambda). */
