@@ -16,9 +16,10 @@ const char* const kCSourceTemplate =
 #include "../../templates/solver_c.cpp.tpl"
     ;
 
-// What a wrapper puts into the Settings it passes: none, mu and the active
-// flags (delassus_inverse), or everything a solve reads.
-enum class SettingsFrom { None, MuActive, Solve };
+// What a wrapper puts into the Settings it passes: none, the active flags alone
+// (passed on as s.active: the constraint functions), mu and the flags
+// (delassus_inverse), or everything a solve reads.
+enum class SettingsFrom { None, Active, MuActive, Solve };
 
 // One C twin: its parameters after the prefix ("{S}": the scalar), the C++
 // call ("w": the Workspace, "s": the Settings) and its comment in the header.
@@ -49,9 +50,11 @@ const CEntry kCEntries[] = {
      "const {S}* q, const {S}* v, const {S}* tau, {S} mu, int iterations,\n"
      "    const unsigned char* active, const {S}* lambda0, void* work, {S}* qdd, {S}* lambda",
      "prox_pv(q, v, tau, s, w, qdd, lambda)", SettingsFrom::Solve, ""},
-    {Function::InverseDynamics, "const {S}* q, const {S}* v, const {S}* qdd, const {S}* lambda, void* work, {S}* tau",
-     "inverse_dynamics(q, v, qdd, lambda, w, tau)", SettingsFrom::None,
-     "/* tau[NV] = M qdd + h + J^T lambda; lambda (NC) may be NULL (none). */\n"},
+    {Function::InverseDynamics,
+     "const {S}* q, const {S}* v, const {S}* qdd, const {S}* lambda, const unsigned char* active, void* work, {S}* tau",
+     "inverse_dynamics(q, v, qdd, lambda, w, tau, s.active)", SettingsFrom::Active,
+     "/* tau[NV] = M qdd + h + J^T lambda; lambda (NC) may be NULL (none); the rows\n"
+     "   of inactive constraints (active as the solvers') are not read. */\n"},
     {Function::NonlinearEffects, "const {S}* q, const {S}* v, void* work, {S}* h", "nonlinear_effects(q, v, w, h)",
      SettingsFrom::None, "/* h[NV] = inverse dynamics at qdd = 0 without constraint forces. */\n"},
     {Function::MassMatrix, "const {S}* q, void* work, {S}* M", "mass_matrix(q, w, M)", SettingsFrom::None,
@@ -62,12 +65,15 @@ const CEntry kCEntries[] = {
      SettingsFrom::None,
      "/* X[12 * NCONS]: per constraint its frame's rotation in the world (3 x 3,\n"
      "   row-major), then its origin. */\n"},
-    {Function::ConstraintJacobian, "const {S}* q, void* work, {S}* J", "constraint_jacobian(q, w, J)", SettingsFrom::None,
-     "/* J[NC * NV], row-major, in the constraint frames' rows. */\n"},
-    {Function::ConstraintDrift, "const {S}* q, const {S}* v, void* work, {S}* gamma", "constraint_drift(q, v, w, gamma)",
-     SettingsFrom::None, "/* gamma[NC]: J qdd + gamma is the rows' acceleration. */\n"},
-    {Function::Delassus, "const {S}* q, void* work, {S}* G", "delassus(q, w, G)", SettingsFrom::None,
-     "/* G[NC * NC] = J M^-1 J^T, row-major. */\n"},
+    {Function::ConstraintJacobian, "const {S}* q, const unsigned char* active, void* work, {S}* J",
+     "constraint_jacobian(q, w, J, s.active)", SettingsFrom::Active,
+     "/* J[NC * NV], row-major, in the constraint frames' rows; an inactive\n"
+     "   constraint's rows (active as the solvers') are 0. */\n"},
+    {Function::ConstraintDrift, "const {S}* q, const {S}* v, const unsigned char* active, void* work, {S}* gamma",
+     "constraint_drift(q, v, w, gamma, s.active)", SettingsFrom::Active,
+     "/* gamma[NC]: J qdd + gamma is the rows' acceleration (inactive rows 0). */\n"},
+    {Function::Delassus, "const {S}* q, const unsigned char* active, void* work, {S}* G", "delassus(q, w, G, s.active)",
+     SettingsFrom::Active, "/* G[NC * NC] = J M^-1 J^T, row-major (inactive rows and columns 0). */\n"},
     {Function::DelassusInverse, "const {S}* q, {S} mu, const unsigned char* active, void* work, {S}* Ginv",
      "delassus_inverse(q, s, w, Ginv)", SettingsFrom::MuActive,
      "/* Ginv[NC * NC] = (G + I / mu)^-1, row-major; active as the solvers'. */\n"},
@@ -135,6 +141,8 @@ CInterfaceFiles emitCInterface(const Plan& plan, const FunctionSet& functions, c
     std::string body = fmt::format("  {}::Workspace& w = workspaceIn(work);\n", name);
     if (ce.settings == SettingsFrom::Solve)
       body += fmt::format("  const {0}::Settings s = settingsOf(mu, iterations, active, lambda0);\n", name);
+    if (ce.settings == SettingsFrom::Active)
+      body += fmt::format("  const {0}::Settings s = settingsOf({0}::Settings{{}}.mu, {0}::Settings{{}}.iterations, active, nullptr);\n", name);
     if (ce.settings == SettingsFrom::MuActive)
       body += fmt::format("  const {0}::Settings s = settingsOf(mu, {0}::Settings{{}}.iterations, active, nullptr);\n", name);
     withSettings |= ce.settings != SettingsFrom::None;

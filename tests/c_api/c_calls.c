@@ -22,14 +22,14 @@ void c_call_all(const double* q, const double* v, const double* tau, const doubl
   out->caba_residual = quadruped_residual(work);
   quadruped_prox_pv(q, v, tau, mu, iterations, active, lambda0, work, out->pv_qdd, out->pv_lambda);
   out->pv_residual = quadruped_residual(work);
-  quadruped_inverse_dynamics(q, v, qdd, lambda, work, out->tau);
+  quadruped_inverse_dynamics(q, v, qdd, lambda, active, work, out->tau);
   quadruped_nonlinear_effects(q, v, work, out->h);
   quadruped_mass_matrix(q, work, out->M);
   quadruped_mass_matrix_inverse(q, work, out->Minv);
   quadruped_constraint_placements(q, work, out->X);
-  quadruped_constraint_jacobian(q, work, out->J);
-  quadruped_constraint_drift(q, v, work, out->gamma);
-  quadruped_delassus(q, work, out->G);
+  quadruped_constraint_jacobian(q, active, work, out->J);
+  quadruped_constraint_drift(q, v, active, work, out->gamma);
+  quadruped_delassus(q, active, work, out->G);
   quadruped_delassus_inverse(q, mu, active, work, out->Ginv);
   quadruped_constraint_wrenches(q, lambda, work, out->W);
 }

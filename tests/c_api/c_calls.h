@@ -24,7 +24,8 @@ size_t c_work_align(void);
 
 /* Every wrapped function once, in a buffer of quadruped_work_size() bytes:
    the solvers with (mu, iterations, active, lambda0), inverse_dynamics with
-   (qdd, lambda), constraint_wrenches with lambda, delassus_inverse with (mu, active). */
+   (qdd, lambda, active), the constraint functions with active, constraint_wrenches
+   with lambda, delassus_inverse with (mu, active). */
 void c_call_all(const double* q, const double* v, const double* tau, const double* qdd, const double* lambda, double mu,
                 int iterations, const unsigned char* active, const double* lambda0, struct c_results* out);
 

@@ -94,7 +94,7 @@ TEST(CApi, EveryFunctionGivesTheBitsOfTheCxxApi) {
       EXPECT_EQ(c.pv_residual, qp::residual(w));
 
       static double out[qp::nv * qp::nv];
-      qp::inverse_dynamics(in.q, in.v, in.qdd, in.lambda, w, out);
+      qp::inverse_dynamics(in.q, in.v, in.qdd, in.lambda, w, out, s.active);
       EXPECT_EQ(vec(c.tau), vec(out, qp::nv));
       qp::nonlinear_effects(in.q, in.v, w, out);
       EXPECT_EQ(vec(c.h), vec(out, qp::nv));
@@ -104,11 +104,11 @@ TEST(CApi, EveryFunctionGivesTheBitsOfTheCxxApi) {
       EXPECT_EQ(vec(c.Minv), vec(out, qp::nv * qp::nv));
       qp::constraint_placements(in.q, w, out);
       EXPECT_EQ(vec(c.X), vec(out, 12 * qp::ncons));
-      qp::constraint_jacobian(in.q, w, out);
+      qp::constraint_jacobian(in.q, w, out, s.active);
       EXPECT_EQ(vec(c.J), vec(out, qp::nc * qp::nv));
-      qp::constraint_drift(in.q, in.v, w, out);
+      qp::constraint_drift(in.q, in.v, w, out, s.active);
       EXPECT_EQ(vec(c.gamma), vec(out, qp::nc));
-      qp::delassus(in.q, w, out);
+      qp::delassus(in.q, w, out, s.active);
       EXPECT_EQ(vec(c.G), vec(out, qp::nc * qp::nc));
       qp::Settings sd;  // delassus_inverse reads mu (and the flags)
       sd.mu = mu;

@@ -126,19 +126,20 @@ def test_state_normalises_the_quaternion_as_eval(quadruped):
 def test_generate_in_process_writes_the_cli_files(tmp_path):
     a, b = tmp_path / "lib", tmp_path / "cli"
     written = proxgen.generate(URDF, LAYOUT, str(a), name="quadruped", python=True)
-    assert [os.path.basename(p) for p in written] == ["quadruped.hpp", "quadruped.cpp", "quadruped_python.cpp"]
+    assert [os.path.basename(p) for p in written] == ["quadruped.hpp", "quadruped.cpp", "quadruped_c.h", "quadruped_c.cpp",
+                                                      "quadruped_python.cpp"]
     p = run_proxgen("generate", URDF, "--layout", LAYOUT, "--out", str(b), "--name", "quadruped", "--python")
     assert p.returncode == 0, p.stderr
-    for name in ("quadruped.hpp", "quadruped.cpp", "quadruped_python.cpp"):
+    for name in ("quadruped.hpp", "quadruped.cpp", "quadruped_c.h", "quadruped_c.cpp", "quadruped_python.cpp"):
         assert filecmp.cmp(a / name, b / name, shallow=False), name
     assert not (tmp_path / "plain").exists()
-    assert len(proxgen.generate(URDF, LAYOUT, tmp_path / "plain")) == 2  # no python: two files
+    assert len(proxgen.generate(URDF, LAYOUT, tmp_path / "plain")) == 4  # no python: the C++ and the C files
 
 
 def test_generate_by_case(tmp_path):
     require_models()
     written = proxgen.generate(cases=CASES_FILE, case="iiwa_h3", out=str(tmp_path))
-    assert [os.path.basename(p) for p in written] == ["iiwa_h3.hpp", "iiwa_h3.cpp"]
+    assert [os.path.basename(p) for p in written] == ["iiwa_h3.hpp", "iiwa_h3.cpp", "iiwa_h3_c.h", "iiwa_h3_c.cpp"]
 
 
 def test_verify_runs_the_cli(tmp_path):
