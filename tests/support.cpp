@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "model/layout.hpp"
+
 namespace proxgen::test {
 
 std::string modelsDir() {
@@ -103,6 +105,23 @@ const std::string& TempFile::sized(std::uintmax_t bytes) const {
   std::ofstream(path_, std::ios::binary).put('x');
   std::filesystem::resize_file(path_, bytes);
   return path_;
+}
+
+std::vector<NamedSystem> sharedAndRepositorySystems() {
+  std::vector<NamedSystem> out;
+  for (const Case& c : sharedCases()) out.push_back({c.name, loadCaseSystem(c)});
+  const std::string src = sourceDir();
+  const auto add = [&](const std::string& name, const std::string& urdf, const std::string& layout) {
+    out.push_back({name, loadSystem(src + "/" + urdf, src + "/" + layout)});
+  };
+  add("example arm", "generated/arm/arm.urdf", "generated/arm/layout.yaml");
+  add("example quadruped", "generated/quadruped/quadruped.urdf", "generated/quadruped/layout.yaml");
+  add("example humanoid", "generated/humanoid/humanoid.urdf", "generated/humanoid/layout.yaml");
+  add("quadruped stand (gains)", "generated/quadruped/quadruped.urdf", "examples/python/quadruped_stand.yaml");
+  add("floating arm gains", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_gains.yaml");
+  add("floating arm two welds", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_two_welds.yaml");
+  add("box four corners", "tests/data/analytic/box.urdf", "tests/data/analytic/box_4_corners.yaml");
+  return out;
 }
 
 }  // namespace proxgen::test

@@ -50,6 +50,17 @@ bool underCi();
 
 /// The nine cases of cases.yaml (empty when the models are missing).
 std::vector<Case> sharedCases();
+/// A robot and layout under the name the tests report.
+struct NamedSystem {
+  std::string name;
+  System sys;
+};
+/// Every shared case, then the repository's robots the generic library and
+/// derivative suites also run on: the three examples, the example quadruped
+/// with Baumgarte gains (a* != 0), the analytic floating arm with gains and
+/// with two welds on one link (rank 6 of 12 rows), and four coplanar contacts
+/// on a box (12 rows on 6 dofs). Each suite appends its own.
+std::vector<NamedSystem> sharedAndRepositorySystems();
 /// Path of a file in the shared models folder.
 std::string modelPath(const std::string& file);
 

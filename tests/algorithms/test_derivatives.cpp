@@ -46,10 +46,7 @@ constexpr double kTruncationQ = 2e-8;  // h^2 |f'''| / 6 / |f| at h = 1e-5 (abov
 // Two states per robot; one under the sanitizer (-O0), which reaches every line.
 int statesPerSystem() { return test::kUnderSanitizer ? 1 : 2; }
 
-struct Named {
-  std::string name;
-  System sys;
-};
+using Named = test::NamedSystem;
 
 // Every shared case, the examples, and the robots whose features the shared
 // cases lack: Baumgarte gains (3d: the quadruped stance; 6d: the floating
@@ -57,19 +54,11 @@ struct Named {
 // 12 rows on 6 dofs), planar joints, a URDF floating joint, prismatic and
 // continuous joints.
 std::vector<Named> allSystems() {
-  std::vector<Named> out;
-  for (const Case& c : test::sharedCases()) out.push_back({c.name, loadCaseSystem(c)});
+  std::vector<Named> out = test::sharedAndRepositorySystems();
   const std::string src = test::sourceDir();
   const auto add = [&](const std::string& name, const std::string& urdf, const std::string& layout) {
     out.push_back({name, loadSystem(src + "/" + urdf, src + "/" + layout)});
   };
-  add("example arm", "generated/arm/arm.urdf", "generated/arm/layout.yaml");
-  add("example quadruped", "generated/quadruped/quadruped.urdf", "generated/quadruped/layout.yaml");
-  add("example humanoid", "generated/humanoid/humanoid.urdf", "generated/humanoid/layout.yaml");
-  add("quadruped stand (gains)", "generated/quadruped/quadruped.urdf", "examples/python/quadruped_stand.yaml");
-  add("floating arm gains", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_gains.yaml");
-  add("floating arm two welds", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_two_welds.yaml");
-  add("box four corners", "tests/data/analytic/box.urdf", "tests/data/analytic/box_4_corners.yaml");
   add("planar mobile", "tests/data/good/planar_mobile.urdf", "tests/data/good/planar_mobile.yaml");
   add("floating joint", "tests/data/good/floating_joint.urdf", "tests/data/good/floating_joint.yaml");
   const test::TempFile tip(".yaml");

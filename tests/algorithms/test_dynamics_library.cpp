@@ -34,10 +34,7 @@ using test::kEps;
 constexpr double kC = 10.0;
 constexpr int kStates = 3;
 
-struct Named {
-  std::string name;
-  System sys;
-};
+using Named = test::NamedSystem;
 
 // Every shared case, then the repository's robots: the examples, the example
 // quadruped with Baumgarte gains (a* != 0), the analytic floating arm with gains
@@ -45,19 +42,11 @@ struct Named {
 // a box, and a fixed-base arm with prismatic and continuous joints (alone, and
 // with a weld on the world and two constraints on one chain).
 std::vector<Named> allSystems() {
-  std::vector<Named> out;
-  for (const Case& c : test::sharedCases()) out.push_back({c.name, loadCaseSystem(c)});
+  std::vector<Named> out = test::sharedAndRepositorySystems();
   const std::string src = test::sourceDir();
   const auto add = [&](const std::string& name, const std::string& urdf, const std::string& layout) {
     out.push_back({name, loadSystem(src + "/" + urdf, src + "/" + layout)});
   };
-  add("example arm", "generated/arm/arm.urdf", "generated/arm/layout.yaml");
-  add("example quadruped", "generated/quadruped/quadruped.urdf", "generated/quadruped/layout.yaml");
-  add("example humanoid", "generated/humanoid/humanoid.urdf", "generated/humanoid/layout.yaml");
-  add("quadruped stand (gains)", "generated/quadruped/quadruped.urdf", "examples/python/quadruped_stand.yaml");
-  add("floating arm gains", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_gains.yaml");
-  add("floating arm two welds", "tests/data/analytic/floating_arm.urdf", "tests/data/analytic/floating_arm_two_welds.yaml");
-  add("box four corners", "tests/data/analytic/box.urdf", "tests/data/analytic/box_4_corners.yaml");
   add("arm3 prismatic+continuous", "tests/data/good/arm3.urdf", "tests/data/good/arm3_tool.yaml");
   // A weld on the world (zero rows of J: the rows of G are 0 and of Ginv mu),
   // a weld mid-chain and the tool point below it on the same chain.
