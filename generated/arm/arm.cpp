@@ -1509,7 +1509,7 @@ PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RES
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t7 = w.g_wrist_3_link[0] + w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4];
-    w.yfree[0] = t7*w.active[0];
+    w.yfree[0] = w.active[0]*t7;
     const Scalar t8 = w.g_wrist_3_link[1] + w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3];
     w.yfree[1] = w.active[0]*t8;
     const Scalar t9 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];
@@ -1712,7 +1712,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
   // residual rows K a - k (layout order)
   {
     const Scalar t0 = w.a_wrist_3_link[0] + 0.0996*w.a_wrist_3_link[4] + w.g_wrist_3_link[0];
-    w.residual[0] = t0*w.active[0];
+    w.residual[0] = w.active[0]*t0;
     const Scalar t1 = w.a_wrist_3_link[1] - 0.0996*w.a_wrist_3_link[3] + w.g_wrist_3_link[1];
     w.residual[1] = w.active[0]*t1;
     const Scalar t2 = w.g_wrist_2_link[1] + w.a_wrist_3_link[2];

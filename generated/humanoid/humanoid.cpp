@@ -8089,7 +8089,7 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t10 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.yfree[0] = t10*w.active[0];
+    w.yfree[0] = w.active[0]*t10;
     const Scalar t11 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
     w.yfree[1] = w.active[0]*t11;
     const Scalar t12 = w.a_l_foot[2] + w.g_l_foot[2];
@@ -8098,7 +8098,7 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
     w.yfree[4] = w.a_l_foot[4]*w.active[0];
     w.yfree[5] = w.a_l_foot[5]*w.active[0];
     const Scalar t13 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.yfree[6] = t13*w.active[1];
+    w.yfree[6] = w.active[1]*t13;
     const Scalar t14 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
     w.yfree[7] = w.active[1]*t14;
     const Scalar t15 = w.a_r_foot[2] + w.g_r_foot[2];
@@ -8107,7 +8107,7 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
     w.yfree[10] = w.a_r_foot[4]*w.active[1];
     w.yfree[11] = w.a_r_foot[5]*w.active[1];
     const Scalar t16 = -w.k_right_hand[0] + w.a_r_hand[1] + 0.13*w.a_r_hand[3];
-    w.yfree[12] = t16*w.active[2];
+    w.yfree[12] = w.active[2]*t16;
     const Scalar t17 = -w.k_right_hand[1] - w.a_r_hand[0] + 0.13*w.a_r_hand[4];
     w.yfree[13] = w.active[2]*t17;
     const Scalar t18 = -w.k_right_hand[2] + w.a_r_hand[2];
@@ -9195,7 +9195,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
   // residual rows K a - k (layout order)
   {
     const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.residual[0] = t0*w.active[0];
+    w.residual[0] = w.active[0]*t0;
     const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
     w.residual[1] = w.active[0]*t1;
     const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
@@ -9204,7 +9204,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
     w.residual[4] = w.a_l_foot[4]*w.active[0];
     w.residual[5] = w.a_l_foot[5]*w.active[0];
     const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.residual[6] = t3*w.active[1];
+    w.residual[6] = w.active[1]*t3;
     const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
     w.residual[7] = w.active[1]*t4;
     const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
@@ -9213,7 +9213,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
     w.residual[10] = w.a_r_foot[4]*w.active[1];
     w.residual[11] = w.a_r_foot[5]*w.active[1];
     const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.residual[12] = t6*w.active[2];
+    w.residual[12] = w.active[2]*t6;
     const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
     w.residual[13] = w.active[2]*t7;
     const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];

@@ -95,7 +95,14 @@ Expr scheduled(Emit& e, int t, int u, const Expr& g) {
   const std::vector<int>& tree = e.plan.rootRows;
   const int kt = rowConstraint(e.plan, tree[std::size_t(t)]), ku = rowConstraint(e.plan, tree[std::size_t(u)]);
   if (g.isZero() || kt == ku) return g;
-  return e.cb().mul(e.cb().mul(activeFactor(e, kt), activeFactor(e, ku)), e.cb().flat(g));
+  // One statement each, in this order: the order of C++ arguments' evaluation
+  // is the compiler's, and these calls create the expressions whose order the
+  // printed text follows (generation must not depend on the compiler).
+  const Expr at = activeFactor(e, kt);
+  const Expr au = activeFactor(e, ku);
+  const Expr both = e.cb().mul(at, au);
+  const Expr flat = e.cb().flat(g);
+  return e.cb().mul(both, flat);
 }
 
 // G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block (and part) per column.

@@ -217,8 +217,10 @@ void freeRowAccelerations(Emit& e, const Kinematics& kin, const Articulated& art
     for (int j = 0; j < c.rows(); ++j) {
       const int t = e.plan.rowPosition[std::size_t(c.row + j)];
       // times the activity factor: an inactive row's right-hand side is exactly 0 (docs/algorithms.md §4.4)
-      rows.yfree[std::size_t(t)] =
-          e.put(e.yMember(t), e.cb().mul(activeFactor(e, int(k)), e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)])));
+      // (one statement per created expression: argument order is the compiler's)
+      const Expr on = activeFactor(e, int(k));
+      const Expr y = e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+      rows.yfree[std::size_t(t)] = e.put(e.yMember(t), e.cb().mul(on, y));
     }
   }
   e.cb().close();
@@ -233,9 +235,11 @@ void storeResidual(Emit& e, const Kinematics& kin, const Motion& motion) {
   for (std::size_t k = 0; k < e.sys.constraints.size(); ++k) {
     const Constraint& c = e.sys.constraints[k];
     const std::vector<Expr> Ka = e.constraintRows(int(k), c.body == 0 ? e.rootAcceleration() : motion.a[std::size_t(c.body)]);
-    for (int j = 0; j < c.rows(); ++j)  // 0 for an inactive constraint
-      e.cb().store(residualMember(e, c.row + j),
-                   e.cb().mul(activeFactor(e, int(k)), e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)])));
+    for (int j = 0; j < c.rows(); ++j) {  // 0 for an inactive constraint
+      const Expr on = activeFactor(e, int(k));  // before the row: argument order is the compiler's
+      const Expr res = e.cb().flat(Ka[std::size_t(j)] - kin.k[k][std::size_t(j)]);
+      e.cb().store(residualMember(e, c.row + j), e.cb().mul(on, res));
+    }
   }
   e.cb().close();
 }
