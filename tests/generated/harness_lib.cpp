@@ -505,23 +505,11 @@ void expectResidualIsTheConstraintResidual(const SolverUnderTest& gen, const Sys
   double worst = 0;
   for (int n = 0; n < apiStates(); ++n) {
     const State s = verify::roundedToScalar(test::randomState(sys.model, rng), gen.isFloat);
-    // J, gamma and a* at the state (constraint_kinematics.hpp; a* from the
-    // frames' placements and twists J v, as constraints.cpp forms it).
-    const MatX J = constraintJacobianRows(sys, d, s.q);
-    const VecX gamma = constraintDrift(sys, d, s.q, s.v);
-    const VecX placements = constraintPlacements(sys, d, s.q);
-    const VecX twist = J * s.v;
-    VecX aStar = VecX::Zero(sys.nc);
-    for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
-      const Constraint& c = sys.constraints[k];
-      SE3 oMc;
-      for (int r = 0; r < 3; ++r)
-        for (int col = 0; col < 3; ++col) oMc.R(r, col) = placements[12 * Eigen::Index(k) + 3 * r + col];
-      oMc.p = placements.segment<3>(12 * Eigen::Index(k) + 9);
-      Vec6 vC = Vec6::Zero();
-      vC.head(c.rows()) = twist.segment(c.row, c.rows());
-      aStar.segment(c.row, c.rows()) = baumgarteTarget(c, oMc, vC);
-    }
+    // J, gamma and a* at the state (rowsAt above).
+    const RowsAt rows = rowsAt(sys, d, s);
+    const MatX& J = rows.J;
+    const VecX& gamma = rows.gamma;
+    const VecX& aStar = rows.aStar;
     const double Jinf = sys.nc ? J.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
     // The smallest eigenvalue of the Delassus matrix G = J M^-1 J^T: from
     // lambda = 0 the residual of iterate K is, in G's eigenbasis, y_j rho_j^K,
