@@ -23,7 +23,7 @@ static_assert(proxgen_rt::version_minor == version_minor);
 namespace {
 
 // nc multipliers: an array of two picks by a schedule flag, {zeros, given}
-// (docs/algorithms.md §4.4).
+// (docs/algorithms.md section 4.4).
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.

@@ -128,7 +128,7 @@ struct Settings {
   // Run-time contact schedule: active[k] for constraint k of the layout
   // (constraint::<name>). An inactive constraint exerts no force: its
   // multipliers are 0 and the answer is that of the solver generated without it
-  // (to round-off; docs/algorithms.md §4.4). Change it between calls freely.
+  // (to round-off; docs/algorithms.md section 4.4). Change it between calls freely.
   bool active[3] = {true, true, true};
   // Warm start: nc multipliers (layout order; e.g. the previous control step's
   // lambda), or null for lambda = 0. The K updates start from lambda0 instead
