@@ -16,6 +16,7 @@
 #include "algorithms/rnea.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"
+#include "compute_json.hpp"
 #include "support.hpp"
 
 namespace proxgen {
@@ -27,17 +28,10 @@ using test::TempFile;
 
 ProcessResult runProxgen(const std::vector<std::string>& args) { return test::runProgram(PROXGEN_BINARY_PATH, args); }
 
-struct Robot {
-  std::string urdf, layout;
-};
-// The examples: a fixed arm with a 6d weld, a floating quadruped on four 3d
-// contacts, a floating humanoid with both kinds.
-std::vector<Robot> robots() {
-  const std::string g = test::sourceDir() + "/generated/";
-  return {{g + "arm/arm.urdf", g + "arm/layout.yaml"},
-          {g + "quadruped/quadruped.urdf", g + "quadruped/layout.yaml"},
-          {g + "humanoid/humanoid.urdf", g + "humanoid/layout.yaml"}};
-}
+using test::dofNames;
+using test::expectMatrix;
+using test::Robot;
+using test::rowNames;
 
 json stateJson(const Model& m, const State& s) {
   return {{"q", configurationToJson(m, s.q)}, {"v", velocityToJson(m, s.v)}, {"tau", velocityToJson(m, s.tau)}};
@@ -58,31 +52,6 @@ void expectJoints(const Model& m, const json& j, const VecX& x, const std::strin
   }
 }
 
-std::vector<std::string> dofNames(const Model& m) {
-  std::vector<std::string> out;
-  for (int i = 1; i < m.numBodies(); ++i)
-    for (int k = 0; k < m.bodies[i].joint.nv; ++k)
-      out.push_back(m.bodies[i].joint.nv == 1 ? m.bodies[i].joint.name : m.bodies[i].joint.name + "[" + std::to_string(k) + "]");
-  return out;
-}
-std::vector<std::string> rowNames(const System& sys) {
-  std::vector<std::string> out;
-  for (const Constraint& c : sys.constraints)
-    for (int r = 0; r < c.rows(); ++r) out.push_back(c.name + "[" + std::to_string(r) + "]");
-  return out;
-}
-
-void expectMatrix(const json& j, const MatX& A, const std::vector<std::string>& rows, const std::vector<std::string>& cols,
-                  const std::string& what) {
-  EXPECT_EQ(j.at("rows").get<std::vector<std::string>>(), rows) << what;
-  EXPECT_EQ(j.at("cols").get<std::vector<std::string>>(), cols) << what;
-  ASSERT_EQ(j.at("values").size(), std::size_t(A.rows())) << what;
-  for (Eigen::Index r = 0; r < A.rows(); ++r) {
-    ASSERT_EQ(j.at("values")[r].size(), std::size_t(A.cols())) << what;
-    for (Eigen::Index c = 0; c < A.cols(); ++c) EXPECT_EQ(j.at("values")[r][c].get<double>(), A(r, c)) << what << " (" << r << ", " << c << ")";
-  }
-}
-
 json runCompute(const Robot& r, const std::string& state, const std::string& quantity, const std::vector<std::string>& extra = {}) {
   std::vector<std::string> args = {"eval", r.urdf, "--layout", r.layout, "--state", state, "--compute", quantity};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -97,7 +66,7 @@ json runCompute(const Robot& r, const std::string& state, const std::string& qua
 }
 
 TEST(Compute, EveryQuantityEqualsTheLibrary) {
-  for (const Robot& robot : robots()) {
+  for (const Robot& robot : test::exampleRobots()) {
     const System sys = loadSystem(robot.urdf, robot.layout);
     const Model& m = sys.model;
     std::mt19937 rng(41);
@@ -167,7 +136,7 @@ TEST(Compute, EveryQuantityEqualsTheLibrary) {
 // wrenches reads lambda (keyed by constraint) and prints, per constraint, the
 // force and the torque of constraintWrenches, equal as above.
 TEST(Compute, WrenchesEqualTheLibraryKeyedByConstraint) {
-  for (const Robot& robot : robots()) {
+  for (const Robot& robot : test::exampleRobots()) {
     const System sys = loadSystem(robot.urdf, robot.layout);
     std::mt19937 rng(43);
     json one = stateJson(sys.model, randomState(sys.model, rng));
@@ -203,7 +172,7 @@ TEST(Compute, WrenchesEqualTheLibraryKeyedByConstraint) {
 }
 
 TEST(Compute, LambdaIsOptionalForInverseDynamics) {
-  const Robot robot = robots()[1];
+  const Robot robot = test::exampleRobots()[1];
   const System sys = loadSystem(robot.urdf, robot.layout);
   std::mt19937 rng(42);
   json one = stateJson(sys.model, randomState(sys.model, rng));
@@ -232,7 +201,7 @@ void expectError(const std::vector<std::string>& args, const std::string& needle
 }
 
 TEST(Compute, BadInputGetsOneClearLine) {
-  const Robot robot = robots()[1];
+  const Robot robot = test::exampleRobots()[1];
   const System sys = loadSystem(robot.urdf, robot.layout);
   std::mt19937 rng(43);
   const json state = stateJson(sys.model, randomState(sys.model, rng));

@@ -14,6 +14,7 @@
 #include "algorithms/derivatives.hpp"
 #include "model/layout.hpp"
 #include "model/state.hpp"
+#include "compute_json.hpp"
 #include "support.hpp"
 
 namespace proxgen {
@@ -23,45 +24,10 @@ using nlohmann::json;
 using test::ProcessResult;
 using test::TempFile;
 
-struct Robot {
-  std::string urdf, layout;
-};
-// The examples: a fixed arm with a 6d weld, a floating quadruped on four 3d
-// contacts, a floating humanoid with both kinds.
-std::vector<Robot> robots() {
-  const std::string g = test::sourceDir() + "/generated/";
-  return {{g + "arm/arm.urdf", g + "arm/layout.yaml"},
-          {g + "quadruped/quadruped.urdf", g + "quadruped/layout.yaml"},
-          {g + "humanoid/humanoid.urdf", g + "humanoid/layout.yaml"}};
-}
-
-// "joint" for a one-dof joint, "joint[k]" for slot k of a free flyer (or a
-// planar joint); "constraint[r]" for row r of a constraint.
-std::vector<std::string> dofNames(const Model& m) {
-  std::vector<std::string> out;
-  for (int i = 1; i < m.numBodies(); ++i)
-    for (int k = 0; k < m.bodies[i].joint.nv; ++k)
-      out.push_back(m.bodies[i].joint.nv == 1 ? m.bodies[i].joint.name : m.bodies[i].joint.name + "[" + std::to_string(k) + "]");
-  return out;
-}
-std::vector<std::string> rowNames(const System& sys) {
-  std::vector<std::string> out;
-  for (const Constraint& c : sys.constraints)
-    for (int r = 0; r < c.rows(); ++r) out.push_back(c.name + "[" + std::to_string(r) + "]");
-  return out;
-}
-
-void expectMatrix(const json& j, const MatX& A, const std::vector<std::string>& rows, const std::vector<std::string>& cols,
-                  const std::string& what) {
-  EXPECT_EQ(j.at("rows").get<std::vector<std::string>>(), rows) << what;
-  EXPECT_EQ(j.at("cols").get<std::vector<std::string>>(), cols) << what;
-  ASSERT_EQ(j.at("values").size(), std::size_t(A.rows())) << what;
-  for (Eigen::Index r = 0; r < A.rows(); ++r) {
-    ASSERT_EQ(j.at("values")[r].size(), std::size_t(A.cols())) << what;
-    for (Eigen::Index c = 0; c < A.cols(); ++c)
-      EXPECT_EQ(j.at("values")[r][c].get<double>(), A(r, c)) << what << " (" << r << ", " << c << ")";
-  }
-}
+using test::dofNames;
+using test::expectMatrix;
+using test::Robot;
+using test::rowNames;
 
 ProcessResult runDerivatives(const Robot& r, const std::string& state, const std::vector<std::string>& extra) {
   std::vector<std::string> args = {"eval", r.urdf, "--layout", r.layout, "--state", state, "--compute", "derivatives"};
@@ -70,7 +36,7 @@ ProcessResult runDerivatives(const Robot& r, const std::string& state, const std
 }
 
 TEST(ComputeDerivatives, EqualsTheLibraryWithNamedRowsAndColumns) {
-  for (const Robot& robot : robots()) {
+  for (const Robot& robot : test::exampleRobots()) {
     const System sys = loadSystem(robot.urdf, robot.layout);
     const Model& m = sys.model;
     std::mt19937 rng(51);
@@ -123,7 +89,7 @@ void expectRefused(const ProcessResult& p, const std::string& needle) {
 }
 
 TEST(ComputeDerivatives, RefusesWhatDoesNotApply) {
-  const Robot arm = robots().front();
+  const Robot arm = test::exampleRobots().front();
   const System sys = loadSystem(arm.urdf, arm.layout);
   std::mt19937 rng(52);
   const State s = randomState(sys.model, rng);
