@@ -1,10 +1,12 @@
 # proxgen_add_python_module(<target> URDF <file> LAYOUT <file>
-#                           [NAME <module>] [SCALAR double|float] [OUTPUT_DIR <dir>])
+#                           [NAME <module>] [SCALAR double|float] [OUTPUT_DIR <dir>]
+#                           [FUNCTIONS <name>... | all])
 # proxgen_add_python_module(<target> CASES <cases.yaml> CASE <name> [NAME ...] ...)
 #
 # Generates a solver with `proxgen generate --python` at build time and builds
-# the importable extension module <NAME> (NAME.prox_pv, NAME.constrained_aba;
-# docs/python.md) from NAME_python.cpp and NAME.cpp. NAME defaults to <target>
+# the importable extension module <NAME> (NAME.prox_pv, NAME.constrained_aba and
+# the library functions FUNCTIONS selects, as proxgen_add_solver's FUNCTIONS or
+# the layout's `functions:`; docs/python.md) from NAME_python.cpp and NAME.cpp. NAME defaults to <target>
 # and must be a C++ identifier (it is the namespace, the file stem and the
 # Python module name). The module lands in the target's LIBRARY_OUTPUT_DIRECTORY
 # (default: OUTPUT_DIR); put that folder on PYTHONPATH, or install the target.
@@ -14,7 +16,7 @@
 # PROXGEN_RUNTIME_INCLUDE_DIR); PROXGEN_PYTHON_INCLUDE_DIR (where
 # proxgen/python_module.hpp is) defaults to PROXGEN_RUNTIME_INCLUDE_DIR, as installed.
 function(proxgen_add_python_module target)
-  cmake_parse_arguments(PARSE_ARGV 1 PPM "" "URDF;LAYOUT;CASES;CASE;SCALAR;NAME;OUTPUT_DIR" "")
+  cmake_parse_arguments(PARSE_ARGV 1 PPM "" "URDF;LAYOUT;CASES;CASE;SCALAR;NAME;OUTPUT_DIR" "FUNCTIONS")
   set(where "proxgen_add_python_module(${target})")
   if(PPM_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "${where}: unknown arguments: ${PPM_UNPARSED_ARGUMENTS}")
@@ -57,6 +59,14 @@ function(proxgen_add_python_module target)
     set(robot_args "${abs_URDF}" --layout "${abs_LAYOUT}")
   endif()
 
+  set(functions "")
+  if(DEFINED PPM_FUNCTIONS OR "FUNCTIONS" IN_LIST PPM_KEYWORDS_MISSING_VALUES)
+    if(NOT PPM_FUNCTIONS)
+      message(FATAL_ERROR "${where}: FUNCTIONS needs at least one function name")
+    endif()
+    list(JOIN PPM_FUNCTIONS "," joined)
+    set(functions --functions "${joined}")
+  endif()
   set(hpp "${PPM_OUTPUT_DIR}/${PPM_NAME}.hpp")
   set(cpp "${PPM_OUTPUT_DIR}/${PPM_NAME}.cpp")
   set(py "${PPM_OUTPUT_DIR}/${PPM_NAME}_python.cpp")
@@ -64,7 +74,7 @@ function(proxgen_add_python_module target)
   add_custom_command(
     OUTPUT "${hpp}" "${cpp}" "${py}"
     COMMAND "${PROXGEN_EXECUTABLE}" generate ${robot_args} --out "${PPM_OUTPUT_DIR}"
-            --name "${PPM_NAME}" --scalar "${PPM_SCALAR}" --python
+            --name "${PPM_NAME}" --scalar "${PPM_SCALAR}" ${functions} --python
     DEPENDS ${files} ${PROXGEN_EXECUTABLE_DEPENDS}
     COMMENT "proxgen: generating the Python module ${PPM_NAME} (${PPM_SCALAR})"
     VERBATIM)

@@ -65,9 +65,6 @@ void addGenerate(CLI::App& app) {
     System sys;
     const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
                                                         emit::parseScalar(opt->scalar), &sys, opt->functions);
-    // The Python module binds the two solvers (docs/python.md); nothing is written yet.
-    if (opt->python && !(sys.functions.has(Function::ConstrainedAba) && sys.functions.has(Function::ProxPv)))
-      throw Error("generate: --python binds constrained_aba and prox_pv: the function list must hold both");
     std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
     // The module source goes through the same atomic write as the solver's files.
     if (opt->python) outputs.push_back(emit::pythonModuleOutput(sys, files, emit::parseScalar(opt->scalar)));

@@ -29,6 +29,37 @@ const char* jointTypeText(JointClass c) {
   }
 }
 
+// The module's binding of one library function (proxgen/python_module.hpp);
+// the derivative functions are not bound yet (docs/python.md).
+std::string bindingOf(Function f, const std::string& ns) {
+  const std::string fn = "&" + ns + "::" + functionName(f);
+  const std::string b = "  proxgen::python::";
+  switch (f) {
+    case Function::ConstrainedAba:
+    case Function::ProxPv:
+      return fmt::format("{}bindSolve<Solver, {}>(m, kInfo, \"{}\");\n", b, fn, functionName(f));
+    case Function::InverseDynamics: return fmt::format("{}bindInverseDynamics<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::NonlinearEffects: return fmt::format("{}bindNonlinearEffects<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::MassMatrix:
+      return fmt::format("{}bindMatrixOfQ<Solver>(m, kInfo, \"mass_matrix\", {}, Solver::nv, Solver::nv,\n"
+                         "      \"(q) -> M (nv, nv) or (N, nv, nv): the joint-space inertia matrix.\");\n", b, fn);
+    case Function::MassMatrixInverse:
+      return fmt::format("{}bindMatrixOfQ<Solver>(m, kInfo, \"mass_matrix_inverse\", {}, Solver::nv, Solver::nv,\n"
+                         "      \"(q) -> M^-1 (nv, nv) or (N, nv, nv).\");\n", b, fn);
+    case Function::ConstraintPlacements: return fmt::format("{}bindConstraintPlacements<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::ConstraintJacobian:
+      return fmt::format("{}bindScheduledMatrixOfQ<Solver>(m, kInfo, \"constraint_jacobian\", {}, Solver::nc, Solver::nv,\n"
+                         "      \"(q, active=None) -> J (nc, nv) or (N, nc, nv): the constraint rows, layout order.\");\n", b, fn);
+    case Function::ConstraintDrift: return fmt::format("{}bindConstraintDrift<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::Delassus:
+      return fmt::format("{}bindScheduledMatrixOfQ<Solver>(m, kInfo, \"delassus\", {}, Solver::nc, Solver::nc,\n"
+                         "      \"(q, active=None) -> G = J M^-1 J^T (nc, nc) or (N, nc, nc).\");\n", b, fn);
+    case Function::DelassusInverse: return fmt::format("{}bindDelassusInverse<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::ConstraintWrenches: return fmt::format("{}bindConstraintWrenches<Solver>(m, kInfo, {});\n", b, fn);
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string cppStringLiteral(const std::string& s) {
@@ -44,7 +75,7 @@ std::string cppStringLiteral(const std::string& s) {
   return out + "\"";
 }
 
-PythonModuleFile emitPythonModule(const Plan& plan) {
+PythonModuleFile emitPythonModule(const Plan& plan, const FunctionSet& functions) {
   std::string joints, constraints;
   int quaternionAt = -1;
   for (std::size_t i = 1; i < plan.bodies.size(); ++i) {
@@ -55,19 +86,35 @@ PythonModuleFile emitPythonModule(const Plan& plan) {
   }
   for (const ConstraintPlan& c : plan.constraints)
     constraints += fmt::format("        {{{}, \"{}\", {}, {}}},\n", cppStringLiteral(c.name), c.weld ? "6d" : "3d", c.row, c.rows);
+  std::string bindings, names, list;
+  for (Function fn : allFunctions()) {
+    if (!functions.has(fn)) continue;
+    const std::string b = bindingOf(fn, plan.name);
+    if (b.empty()) continue;
+    bindings += b;
+    names += fmt::format("\n      \"{}\",", functionName(fn));
+    // The header comment's list, wrapped at 80 columns.
+    const std::string item = std::string(functionName(fn));
+    const std::size_t line = list.size() - (list.rfind('\n') == std::string::npos ? 0 : list.rfind('\n') + 1);
+    if (!list.empty()) list += line + item.size() + 5 > 80 ? ",\n// " : ", ";
+    list += item;
+  }
+  if (!names.empty()) names.pop_back();
+  bindings += fmt::format("  m.attr(\"functions\") = pybind11::make_tuple({});\n", names);
   PythonModuleFile f;
   f.name = plan.name + "_python.cpp";
   f.text = fmt::format(fmt::runtime(kPythonModuleTemplate), fmt::arg("version", PROXGEN_VERSION), fmt::arg("name", plan.name),
                        fmt::arg("scalar", plan.scalar == ScalarType::Float ? "float" : "double"),
                        fmt::arg("joints", joints), fmt::arg("constraints", constraints),
-                       fmt::arg("quaternion_at", quaternionAt));
+                       fmt::arg("quaternion_at", quaternionAt), fmt::arg("bindings", bindings),
+                       fmt::arg("function_list", list.empty() ? std::string("no function") : list));
   return f;
 }
 
 OutputFile pythonModuleOutput(const System& sys, const SolverFiles& files, ScalarType scalar) {
   // The header's stem is the plan's (already sanitised) name.
   const std::string name = fs::path(files.headerName).stem().string();
-  PythonModuleFile f = emitPythonModule(makePlan(sys, name, scalar));
+  PythonModuleFile f = emitPythonModule(makePlan(sys, name, scalar), sys.functions);
   return OutputFile{std::move(f.name), std::move(f.text)};
 }
 

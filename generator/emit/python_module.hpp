@@ -7,6 +7,7 @@
 
 #include "emit/generate.hpp"
 #include "emit/plan.hpp"
+#include "model/functions.hpp"
 
 namespace proxgen::emit {
 
@@ -14,10 +15,12 @@ struct PythonModuleFile {
   std::string name, text;  // NAME_python.cpp
 };
 
-/// The module source for a plan; joint and constraint names become C++ string
-/// literals with every byte outside printable ASCII (and quotes, backslashes,
-/// '?') as an octal escape, so no name from a URDF reaches the code raw.
-PythonModuleFile emitPythonModule(const Plan& plan);
+/// The module source for a plan, binding the solvers and library functions in
+/// `functions` (the set the solver was generated with); joint and constraint
+/// names become C++ string literals with every byte outside printable ASCII
+/// (and quotes, backslashes, '?') as an octal escape, so no name from a URDF
+/// reaches the code raw.
+PythonModuleFile emitPythonModule(const Plan& plan, const FunctionSet& functions);
 
 /// NAME_python.cpp for the solver `files` generated from `sys` (same plan name
 /// and scalar), as an output for writeFiles: it is written atomically with the

@@ -81,6 +81,24 @@ def random_state(robot, rng, exact_quaternion=True):
     return q, rng.uniform(-1, 1, robot.nv), rng.uniform(-1, 1, robot.nv)
 
 
+EPS = np.finfo(float).eps
+
+# tests/numerics.hpp's round-off model: each of these is a chain of backward-stable
+# eliminations, so its relative error is c n eps kappa_s, c = 10, kappa_s the condition
+# of the Jacobi-scaled matrix that is (in effect) factored.
+C = 10.0
+
+
+def scaled_condition(A):
+    """tests/numerics.hpp's scaledCondition: the condition number of D^-1/2 A D^-1/2,
+    D = diag(A), on its range (eigenvalues at or below n eps times the largest are zero)."""
+    d = np.diag(A)
+    s = np.where(d > 0, 1 / np.sqrt(np.where(d > 0, d, 1)), 1.0)
+    ev = np.linalg.eigvalsh(s[:, None] * A * s[None, :])
+    top = ev.max()
+    return top / ev[ev > len(A) * EPS * top].min()
+
+
 def rel_err(a, b):
     """max |a - b| / max(1, max |b|), as tests/support.hpp's relErr."""
     a, b = np.asarray(a), np.asarray(b)

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 import proxgen
-from conftest import CASES_FILE, QUADRUPED_DIR, SOURCE_DIR, random_state, require_models, run_proxgen
+from conftest import (C, CASES_FILE, EPS, QUADRUPED_DIR, SOURCE_DIR, random_state, require_models, run_proxgen,
+                      scaled_condition)
 
 URDF = os.path.join(QUADRUPED_DIR, "quadruped.urdf")
-EPS = np.finfo(float).eps
 
 # The examples (the quadruped on its four feet, and examples/python's Baumgarte layout)
 # and two shared cases (a 6d hand on a fixed arm, a floating base on two 3d feet).
@@ -91,20 +91,6 @@ def test_every_quantity_is_the_cli_bit_for_bit(name, tmp_path, rng):
         assert robot.named(tau=robot.inverse_dynamics(q, v, qdd))["tau"] == result["tau"]
 
 
-def scaled_condition(A):
-    """tests/numerics.hpp's scaledCondition: the condition number of D^-1/2 A D^-1/2,
-    D = diag(A), on its range (eigenvalues at or below n eps times the largest are zero)."""
-    d = np.diag(A)
-    s = np.where(d > 0, 1 / np.sqrt(np.where(d > 0, d, 1)), 1.0)
-    ev = np.linalg.eigvalsh(s[:, None] * A * s[None, :])
-    top = ev.max()
-    return top / ev[ev > len(A) * EPS * top].min()
-
-
-# tests/numerics.hpp's round-off model: each of these is a chain of backward-stable
-# eliminations, so its relative error is c n eps kappa_s, c = 10, kappa_s the condition
-# of the Jacobi-scaled matrix that is (in effect) factored.
-C = 10.0
 
 
 @pytest.mark.parametrize("name", SYSTEMS)

@@ -1,15 +1,19 @@
 // The body of a generated solver's Python module (NAME_python.cpp, from
 // templates/python_module.cpp.tpl): binds NAME::prox_pv and
-// NAME::constrained_aba for one state (nq,) or many (N, nq), numpy in and out.
-// Many states loop the scalar solver with the GIL released (no batched kernels
-// exist yet); one state keeps the GIL (releasing it would cost more than the
+// NAME::constrained_aba, with the run-time schedule (active) and the warm start
+// (lambda0), and every library function the solver was generated with
+// (inverse_dynamics, mass_matrix, ...: bind* below), for one state (nq,) or
+// many (N, nq), numpy in and out. Many states loop the scalar function with the
+// GIL released; one state keeps the GIL (releasing it would cost more than the
 // small solves take). Bad input: python_arrays.hpp.
 #pragma once
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <chrono>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -39,19 +43,51 @@ struct ModuleInfo {
 
 // Solver: the generated namespace seen through a struct (Scalar, Settings,
 // Workspace, nq, nv, nc, and the two solvers as static functions).
+/// active: None -> every constraint active, else one truth value per
+/// constraint of the layout (a sequence or array of bools or 0/1; the order of
+/// constraint_names), written into out[0..ncons).
+inline void readActive(py::handle active, std::size_t ncons, bool* out) {
+  for (std::size_t k = 0; k < ncons; ++k) out[k] = true;
+  if (active.is_none()) return;
+  py::array a = py::array::ensure(active);
+  if (!a || a.ndim() != 1 || std::size_t(a.shape(0)) != ncons)
+    throw py::value_error("active: expected one flag per constraint, shape (" + std::to_string(ncons) + ",), got " +
+                          (a ? shapeText(a) : std::string(py::str(py::type::handle_of(active).attr("__name__")))));
+  const char kind = a.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u')
+    throw py::type_error("active: expected bools or 0/1, got dtype " + std::string(py::str(a.dtype())));
+  auto flags = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(a);
+  for (std::size_t k = 0; k < ncons; ++k) {
+    const long long x = flags.data()[k];
+    if (x != 0 && x != 1) throw py::value_error("active[" + std::to_string(k) + "]: expected a bool or 0/1, got " + std::to_string(x));
+    out[k] = x == 1;
+  }
+}
+
+// Solver: the generated namespace seen through a struct (Scalar, Settings,
+// Workspace, nq, nv, nc, and the two solvers as static functions).
 template <class Solver, void (*Solve)(const typename Solver::Scalar*, const typename Solver::Scalar*,
                                       const typename Solver::Scalar*, const typename Solver::Settings&,
                                       typename Solver::Workspace&, typename Solver::Scalar*,
                                       typename Solver::Scalar*) noexcept>
 py::tuple solveStates(const ModuleInfo& info, py::handle q, py::handle v, py::handle tau, py::handle mu,
-                      py::handle iterations) {
+                      py::handle iterations, py::handle active, py::handle lambda0) {
   using Scalar = typename Solver::Scalar;
   constexpr int nq = Solver::nq, nv = Solver::nv, nc = Solver::nc;
   const typename Solver::Settings defaults;
   typename Solver::Settings s;
   s.mu = Scalar(readMu(mu, double(defaults.mu)));
   s.iterations = readIterations(iterations, defaults.iterations);
+  readActive(active, info.constraints.size(), s.active);
   States<Scalar> in = readStates<Scalar>(q, v, tau, nq, nv);
+  // lambda0: the warm start, one row of nc per state, or None for lambda = 0.
+  py::array_t<Scalar> lambda0Array;
+  const Scalar* lambda0In = nullptr;
+  if (!lambda0.is_none()) {
+    lambda0Array = asArray<Scalar>(lambda0, "lambda0");
+    lambda0In = checkShape(lambda0Array, nc, "lambda0", in.batch, "nc");
+    checkFinite(lambda0In, in.count() * nc, nc, "lambda0");
+  }
   py::array_t<Scalar> qdd = newOutput<Scalar>(in.batch, nv);
   py::array_t<Scalar> lambda = newOutput<Scalar>(in.batch, nc);
   Scalar* qddOut = qdd.mutable_data();
@@ -61,6 +97,7 @@ py::tuple solveStates(const ModuleInfo& info, py::handle q, py::handle v, py::ha
   Scalar qn[nq];
   if (in.batch == 0) {
     normalisedConfiguration(in.q, nq, info.quaternionAt, 0, false, qn);
+    s.lambda0 = lambda0In;
     Solve(qn, in.v, in.tau, s, w, qddOut, lambdaOut);
   } else {
     // Every state is checked before the GIL goes: errors are raised with it held.
@@ -68,6 +105,7 @@ py::tuple solveStates(const ModuleInfo& info, py::handle q, py::handle v, py::ha
     py::gil_scoped_release release;
     for (py::ssize_t k = 0; k < in.batch; ++k) {
       normalisedConfiguration(in.q + k * nq, nq, info.quaternionAt, k, true, qn);
+      s.lambda0 = lambda0In ? lambda0In + k * nc : nullptr;
       Solve(qn, in.v + k * nv, in.tau + k * nv, s, w, qddOut + k * nv, lambdaOut + k * nc);
     }
   }
@@ -97,6 +135,277 @@ double cppSecondsPerCall(const ModuleInfo& info, py::handle q, py::handle v, py:
     asm volatile("" : : "r"(qdd), "r"(lambda) : "memory");
   }
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / double(repeats);
+}
+
+// ---- The library functions (docs/dynamics.md), when the solver holds them ----
+
+/// One array argument of a library function: `width` numbers per state, the
+/// batch (one state or N) as q's (q comes first and sets it), finite.
+template <class Scalar>
+const Scalar* readInput(py::handle obj, const char* arg, py::ssize_t width, const char* sizeName, py::ssize_t& batch,
+                        py::array_t<Scalar>& keep) {
+  keep = asArray<Scalar>(obj, arg);
+  const Scalar* x = checkShape(keep, width, arg, batch, sizeName);
+  checkFinite(x, (batch == 0 ? 1 : batch) * width, width, arg);
+  return x;
+}
+
+/// A new C-contiguous array of shape `dims` (one state) or (batch, *dims).
+template <class Scalar>
+py::array_t<Scalar> newBlocks(py::ssize_t batch, std::initializer_list<py::ssize_t> dims) {
+  std::vector<py::ssize_t> shape;
+  if (batch != 0) shape.push_back(batch);
+  shape.insert(shape.end(), dims.begin(), dims.end());
+  return py::array_t<Scalar>(shape);
+}
+
+/// call(k, qn, w) for each state k with its normalised configuration qn: every
+/// quaternion is checked first (errors are raised with the GIL held), then
+/// many states run with the GIL released, one workspace per thread.
+template <class Solver, class Call>
+void forEachState(const ModuleInfo& info, const typename Solver::Scalar* q, py::ssize_t batch, Call call) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nq = Solver::nq;
+  thread_local typename Solver::Workspace w;
+  Scalar qn[nq];
+  if (batch == 0) {
+    normalisedConfiguration(q, nq, info.quaternionAt, 0, false, qn);
+    call(py::ssize_t(0), qn, w);
+    return;
+  }
+  for (py::ssize_t k = 0; k < batch; ++k) normalisedConfiguration(q + k * nq, nq, info.quaternionAt, k, true, qn);
+  py::gil_scoped_release release;
+  for (py::ssize_t k = 0; k < batch; ++k) {
+    normalisedConfiguration(q + k * nq, nq, info.quaternionAt, k, true, qn);
+    call(k, qn, w);
+  }
+}
+
+template <class Solver>
+using OfQ = void (*)(const typename Solver::Scalar*, typename Solver::Workspace&, typename Solver::Scalar*) noexcept;
+template <class Solver>
+using OfQScheduled = void (*)(const typename Solver::Scalar*, typename Solver::Workspace&, typename Solver::Scalar*,
+                              const bool*) noexcept;
+
+/// f(q) -> (rows, cols): mass_matrix, mass_matrix_inverse.
+template <class Solver>
+void bindMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name, OfQ<Solver> fn, int rows, int cols,
+                   const char* doc) {
+  using Scalar = typename Solver::Scalar;
+  const ModuleInfo* p = &info;
+  m.def(
+      name,
+      [p, fn, rows, cols](py::handle q) {
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {rows, cols});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch,
+                             [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) { fn(qn, w, o + k * rows * cols); });
+        return out;
+      },
+      py::arg("q"), doc);
+}
+
+/// f(q, active=None) -> (rows, cols): constraint_jacobian, delassus.
+template <class Solver>
+void bindScheduledMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name, OfQScheduled<Solver> fn, int rows,
+                            int cols, const char* doc) {
+  using Scalar = typename Solver::Scalar;
+  const ModuleInfo* p = &info;
+  m.def(
+      name,
+      [p, fn, rows, cols](py::handle q, py::handle active) {
+        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
+        readActive(active, p->constraints.size(), flags);
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {rows, cols});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, w, o + k * rows * cols, flags);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("active") = py::none(), doc);
+}
+
+/// nonlinear_effects(q, v) -> (nv,).
+template <class Solver>
+void bindNonlinearEffects(py::module_& m, const ModuleInfo& info,
+                          void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                     typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nv = Solver::nv;
+  const ModuleInfo* p = &info;
+  m.def(
+      "nonlinear_effects",
+      [p, fn](py::handle q, py::handle v) {
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa, va;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nv});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, vin + k * nv, w, o + k * nv);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("v"), "(q, v) -> h (nv,) or (N, nv): Coriolis, centrifugal and gravity torques.");
+}
+
+/// constraint_drift(q, v, active=None) -> (nc,).
+template <class Solver>
+void bindConstraintDrift(py::module_& m, const ModuleInfo& info,
+                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                    typename Solver::Workspace&, typename Solver::Scalar*, const bool*) noexcept) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nv = Solver::nv, nc = Solver::nc;
+  const ModuleInfo* p = &info;
+  m.def(
+      "constraint_drift",
+      [p, fn](py::handle q, py::handle v, py::handle active) {
+        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
+        readActive(active, p->constraints.size(), flags);
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa, va;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nc});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, vin + k * nv, w, o + k * nc, flags);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("v"), py::arg("active") = py::none(),
+      "(q, v, active=None) -> gamma (nc,) or (N, nc): J qdd + gamma is the constraint rows' acceleration.");
+}
+
+/// inverse_dynamics(q, v, qdd, lam=None, active=None) -> tau (nv,).
+template <class Solver>
+void bindInverseDynamics(py::module_& m, const ModuleInfo& info,
+                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                    const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                    typename Solver::Workspace&, typename Solver::Scalar*, const bool*) noexcept) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nv = Solver::nv, nc = Solver::nc;
+  const ModuleInfo* p = &info;
+  m.def(
+      "inverse_dynamics",
+      [p, fn](py::handle q, py::handle v, py::handle qdd, py::handle lam, py::handle active) {
+        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
+        readActive(active, p->constraints.size(), flags);
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa, va, aa, la;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
+        const Scalar* ain = readInput(qdd, "qdd", nv, "nv", batch, aa);
+        const Scalar* lin = lam.is_none() ? nullptr : readInput(lam, "lam", nc, "nc", batch, la);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nv});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, vin + k * nv, ain + k * nv, lin ? lin + k * nc : nullptr, w, o + k * nv, flags);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("v"), py::arg("qdd"), py::arg("lam") = py::none(), py::arg("active") = py::none(),
+      "(q, v, qdd, lam=None, active=None) -> tau (nv,) or (N, nv): M qdd + h + J^T lam (lam None: no\n"
+      "constraint forces; the rows of an inactive constraint are not read).");
+}
+
+/// constraint_placements(q) -> (ncons, 4, 4): each constraint frame's world
+/// placement [R p; 0 0 0 1], as the package's Robot.constraint_placements.
+template <class Solver>
+void bindConstraintPlacements(py::module_& m, const ModuleInfo& info, OfQ<Solver> fn) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int ncons = Solver::ncons;
+  const ModuleInfo* p = &info;
+  m.def(
+      "constraint_placements",
+      [p, fn](py::handle q) {
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {ncons, 4, 4});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          Scalar X[ncons > 0 ? 12 * ncons : 1];
+          fn(qn, w, X);
+          for (int c = 0; c < ncons; ++c) {
+            Scalar* T = o + (k * ncons + c) * 16;
+            for (int i = 0; i < 3; ++i) {
+              for (int j = 0; j < 3; ++j) T[4 * i + j] = X[12 * c + 3 * i + j];
+              T[4 * i + 3] = X[12 * c + 9 + i];
+              T[12 + i] = Scalar(0);
+            }
+            T[15] = Scalar(1);
+          }
+        });
+        return out;
+      },
+      py::arg("q"), "(q) -> (ncons, 4, 4) or (N, ncons, 4, 4): each constraint frame's world placement [R p; 0 0 0 1].");
+}
+
+/// delassus_inverse(q, mu=None, active=None) -> (G + I/mu)^-1 (nc, nc).
+template <class Solver>
+void bindDelassusInverse(py::module_& m, const ModuleInfo& info,
+                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Settings&,
+                                    typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nc = Solver::nc;
+  const ModuleInfo* p = &info;
+  m.def(
+      "delassus_inverse",
+      [p, fn](py::handle q, py::handle mu, py::handle active) {
+        const typename Solver::Settings defaults;
+        typename Solver::Settings s;
+        s.mu = Scalar(readMu(mu, double(defaults.mu)));
+        readActive(active, p->constraints.size(), s.active);
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nc, nc});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, s, w, o + k * nc * nc);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("mu") = py::none(), py::arg("active") = py::none(),
+      "(q, mu=None, active=None) -> (G + I/mu)^-1 (nc, nc) or (N, nc, nc) (mu: the layout's by default;\n"
+      "an inactive constraint's rows and columns are 0).");
+}
+
+/// constraint_wrenches(q, lam) -> (ncons, 6): each constraint's wrench on the
+/// robot in world axes, force then torque about the frame's origin.
+template <class Solver>
+void bindConstraintWrenches(py::module_& m, const ModuleInfo& info,
+                            void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                       typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
+  using Scalar = typename Solver::Scalar;
+  constexpr int nc = Solver::nc, ncons = Solver::ncons;
+  const ModuleInfo* p = &info;
+  m.def(
+      "constraint_wrenches",
+      [p, fn](py::handle q, py::handle lam) {
+        py::ssize_t batch = -1;
+        py::array_t<Scalar> qa, la;
+        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
+        const Scalar* lin = readInput(lam, "lam", nc, "nc", batch, la);
+        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {ncons, 6});
+        Scalar* o = out.mutable_data();
+        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+          fn(qn, lin + k * nc, w, o + k * ncons * 6);
+        });
+        return out;
+      },
+      py::arg("q"), py::arg("lam"),
+      "(q, lam) -> (ncons, 6) or (N, ncons, 6): each constraint's wrench on the robot in world axes\n"
+      "(force, then torque about the frame's origin); the constraint force on the robot is -J^T lam.");
 }
 
 template <class Solver>
@@ -133,32 +442,45 @@ void bindSolver(py::module_& m, const ModuleInfo& info) {
   m.attr("constraint_names") = py::tuple(constraintNames);
   m.attr("joints") = joints;
   m.attr("constraints") = constraints;
-  const char* doc =
-      "(q, v, tau, mu=None, iterations=None) -> (qdd, lam). q: (nq,) or (N, nq); v, tau: (nv,) or (N, nv);\n"
-      "float or integer arrays (others copied once); mu, iterations default to the layout's.\n"
-      "Returns new arrays (nv,), (nc,) or (N, nv), (N, nc). Bad input raises ValueError or TypeError.";
-  const ModuleInfo* p = &info;
-  m.def(
-      "prox_pv",
-      [p](py::handle q, py::handle v, py::handle tau, py::handle mu, py::handle k) {
-        return solveStates<Solver, &Solver::prox_pv>(*p, q, v, tau, mu, k);
-      },
-      py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("mu") = py::none(), py::arg("iterations") = py::none(), doc);
-  m.def(
-      "constrained_aba",
-      [p](py::handle q, py::handle v, py::handle tau, py::handle mu, py::handle k) {
-        return solveStates<Solver, &Solver::constrained_aba>(*p, q, v, tau, mu, k);
-      },
-      py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("mu") = py::none(), py::arg("iterations") = py::none(), doc);
   m.def(
       "_cpp_seconds_per_call",
-      [p](const std::string& function, py::handle q, py::handle v, py::handle tau, long repeats) {
-        if (function == "prox_pv") return cppSecondsPerCall<Solver, &Solver::prox_pv>(*p, q, v, tau, repeats);
-        if (function == "constrained_aba") return cppSecondsPerCall<Solver, &Solver::constrained_aba>(*p, q, v, tau, repeats);
-        throw py::value_error("function: expected 'prox_pv' or 'constrained_aba'");
+      // The module itself, borrowed: it outlives its functions.
+      [self = py::handle(m)](const std::string& function, py::handle q, py::handle v, py::handle tau, long repeats) {
+        const std::string timer = "_cpp_seconds_per_call_" + function;
+        if ((function != "prox_pv" && function != "constrained_aba") || !py::hasattr(self, timer.c_str()))
+          throw py::value_error("function: expected a solver this module holds ('prox_pv' or 'constrained_aba'), got '" +
+                                function + "'");
+        return self.attr(timer.c_str())(q, v, tau, repeats).template cast<double>();
       },
       py::arg("function"), py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("repeats"),
       "Benchmark helper (bench/python_overhead.py): seconds per call of the C++ solver in a loop.");
+}
+
+/// One solver (prox_pv or constrained_aba) as `name`, with its timing helper.
+template <class Solver, void (*Solve)(const typename Solver::Scalar*, const typename Solver::Scalar*,
+                                      const typename Solver::Scalar*, const typename Solver::Settings&,
+                                      typename Solver::Workspace&, typename Solver::Scalar*,
+                                      typename Solver::Scalar*) noexcept>
+void bindSolve(py::module_& m, const ModuleInfo& info, const char* name) {
+  const char* doc =
+      "(q, v, tau, mu=None, iterations=None, active=None, lambda0=None) -> (qdd, lam).\n"
+      "q: (nq,) or (N, nq); v, tau: (nv,) or (N, nv); float or integer arrays (others copied once);\n"
+      "mu, iterations default to the layout's; active: one flag per constraint (constraint_names\n"
+      "order; an inactive one exerts no force, its lam rows are 0); lambda0: the warm start, (nc,)\n"
+      "or (N, nc) as lam (None: from 0). Returns new arrays (nv,), (nc,) or (N, nv), (N, nc).\n"
+      "Bad input raises ValueError or TypeError.";
+  const ModuleInfo* p = &info;
+  m.def(
+      name,
+      [p](py::handle q, py::handle v, py::handle tau, py::handle mu, py::handle k, py::handle active, py::handle lambda0) {
+        return solveStates<Solver, Solve>(*p, q, v, tau, mu, k, active, lambda0);
+      },
+      py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("mu") = py::none(), py::arg("iterations") = py::none(),
+      py::arg("active") = py::none(), py::arg("lambda0") = py::none(), doc);
+  m.def(
+      ("_cpp_seconds_per_call_" + std::string(name)).c_str(),
+      [p](py::handle q, py::handle v, py::handle tau, long repeats) { return cppSecondsPerCall<Solver, Solve>(*p, q, v, tau, repeats); },
+      py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("repeats"));
 }
 
 }  // namespace proxgen::python

@@ -1,0 +1,144 @@
+"""The library functions and the solvers' run-time options in a generated module: the
+quadruped generated with FUNCTIONS all (module quadruped_all) against the package's
+generic twins, its many-state path against its single-state path, the schedule
+(active=) and the warm start (lambda0=), and a module that holds the mass matrix alone."""
+
+import numpy as np
+import pytest
+
+from conftest import C, EPS, module, random_state, rel_err, scaled_condition
+
+LIBRARY = ("inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse", "constraint_placements",
+           "constraint_jacobian", "constraint_drift", "delassus", "delassus_inverse", "constraint_wrenches")
+
+
+@pytest.fixture
+def m():
+    return module("quadruped_all")
+
+
+def test_the_module_holds_what_the_solver_holds(m):
+    assert m.functions == ("constrained_aba", "prox_pv") + LIBRARY
+    mass = module("quadruped_mass")
+    assert mass.functions == ("mass_matrix",)
+    assert not hasattr(mass, "prox_pv") and not hasattr(mass, "inverse_dynamics")
+    # The binding is the same compiled function over the same input: the same bits.
+    q = np.zeros(mass.nq)
+    q[6] = 1.0
+    assert np.array_equal(mass.mass_matrix(q), m.mass_matrix(q))
+
+
+def test_every_function_is_its_generic_twin(m, quadruped, rng):
+    for _ in range(5):
+        q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+        qdd, lam = quadruped.eval(q, v, tau, "pv", iterations=20)
+        M = quadruped.mass_matrix(q)
+        J = quadruped.constraint_jacobian(q)
+        # The recursions without a solve (RNEA, CRBA, the kinematics, the products of
+        # the Delassus recursion): the generated code sums the same products in another
+        # order, off by c nv eps times the size of the terms summed (the bounds of
+        # generator/verify/compare.cpp). Those sizes are |M||qdd| + |J^T||lam| + |h| for
+        # the torques (at most ~1e3 here: a 25 kg robot's gravity and unit-scale
+        # accelerations), O(1) for placements and rows: 1e3 * C nv eps = 4e-11.
+        torque_size = np.max(np.abs(M) @ np.abs(qdd) + np.abs(J.T) @ np.abs(lam)) + np.max(np.abs(tau)) + 1e2
+        sums = C * quadruped.nv * EPS * max(1.0, torque_size)
+        assert rel_err(m.inverse_dynamics(q, v, qdd, lam), quadruped.inverse_dynamics(q, v, qdd, lam)) <= sums
+        assert rel_err(m.nonlinear_effects(q, v), quadruped.nonlinear_effects(q, v)) <= sums
+        assert rel_err(m.mass_matrix(q), M) <= sums
+        assert rel_err(m.constraint_placements(q), quadruped.constraint_placements(q)) <= sums
+        assert rel_err(m.constraint_jacobian(q), J) <= sums
+        assert rel_err(m.constraint_drift(q, v), quadruped.constraint_drift(q, v)) <= sums
+        assert rel_err(m.delassus(q), quadruped.delassus(q)) <= sums
+        # The solves: c nv eps kappa_s(M) for M^-1 (relative to its largest entry), and
+        # for (G + I/mu)^-1 = mu I - mu^2 J M_mu^-1 J^T the absolute c nv eps
+        # kappa_s(M_mu) mu of test_dynamics.py's test_the_inverses_are_inverses.
+        Minv = quadruped.mass_matrix_inverse(q)
+        assert rel_err(m.mass_matrix_inverse(q), Minv) <= C * quadruped.nv * EPS * scaled_condition(M)
+        for mu in (quadruped.mu, 1.0):
+            ginv = C * quadruped.nv * EPS * scaled_condition(M + mu * J.T @ J) * mu
+            assert np.max(np.abs(m.delassus_inverse(q, mu) - quadruped.delassus_inverse(q, mu))) <= ginv
+        # The wrenches of the package's lam: -R lam_point per foot, no torque about the
+        # frame's origin (a 3d point), R the frame's rotation (docs/dynamics.md).
+        W = m.constraint_wrenches(q, lam)
+        X = quadruped.constraint_placements(q)
+        for k, name in enumerate(quadruped.constraint_names):
+            row = quadruped.constraints[name].row
+            assert rel_err(W[k, :3], -X[k, :3, :3] @ lam[row:row + 3]) <= sums
+            assert np.array_equal(W[k, 3:], np.zeros(3))
+
+
+def test_many_states_are_the_single_states(m, quadruped, rng):
+    states = [random_state(quadruped, rng, exact_quaternion=False) for _ in range(5)]
+    Q, V, T = (np.array([s[k] for s in states]) for k in range(3))
+    lam = np.array([m.prox_pv(*s)[1] for s in states])
+    calls = {
+        "inverse_dynamics": lambda k: (Q[k], V[k], T[k], lam[k]),
+        "nonlinear_effects": lambda k: (Q[k], V[k]),
+        "constraint_drift": lambda k: (Q[k], V[k]),
+        "constraint_wrenches": lambda k: (Q[k], lam[k]),
+    }
+    for name in LIBRARY:
+        args = calls.get(name, lambda k: (Q[k],))
+        many = getattr(m, name)(*(np.array([args(k)[i] for k in range(5)]) for i in range(len(args(0)))))
+        for k in range(5):
+            one = getattr(m, name)(*args(k))
+            assert many.shape == (5,) + one.shape, name
+            # The same compiled function on the same inputs (the workspace reused):
+            # identical bits, or a leftover from the previous state shows.
+            assert np.array_equal(many[k], one), name
+
+
+def test_an_inactive_constraint_exerts_no_force(m, quadruped, rng):
+    q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+    active = [True, False, True, True]
+    rows = slice(quadruped.constraints[quadruped.constraint_names[1]].row,
+                 quadruped.constraints[quadruped.constraint_names[1]].row + 3)
+    for solve in (m.prox_pv, m.constrained_aba):
+        _, lam_all = solve(q, v, tau)
+        qdd, lam = solve(q, v, tau, active=active)
+        # The schedule's promise (docs/algorithms.md, section 4.4): exactly zero, not small.
+        assert np.array_equal(lam[rows], np.zeros(3))
+        assert np.max(np.abs(lam_all[rows])) > 1e-3  # the foot pushes when it is active
+    J = m.constraint_jacobian(q, active=np.array(active))
+    assert np.array_equal(J[rows], np.zeros_like(J[rows]))
+    assert np.array_equal(np.delete(J, np.arange(rows.start, rows.stop), axis=0),
+                          np.delete(m.constraint_jacobian(q), np.arange(rows.start, rows.stop), axis=0))
+    # inverse_dynamics does not read the inactive rows: as if their lam were 0.
+    lam_zeroed = lam_all.copy()
+    lam_zeroed[rows] = 0.0
+    assert np.array_equal(m.inverse_dynamics(q, v, qdd, lam_all, active=active), m.inverse_dynamics(q, v, qdd, lam_zeroed))
+
+
+def test_the_warm_start_continues_the_iteration(m, quadruped, rng):
+    q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+    # mu = 1 makes each update count (the iteration contracts by about 1/(1 + mu g)):
+    # one update from the K-th iterate is iterate K + 1, in the same operations up to
+    # the order of the first update's sums (the K-step solve starts from an exact 0);
+    # 1e-10 relative is cond * eps with cond ~ 1e6, far below the gap between
+    # iterates that the second assertion demands.
+    _, lam3 = m.prox_pv(q, v, tau, mu=1.0, iterations=3)
+    qdd4, lam4 = m.prox_pv(q, v, tau, mu=1.0, iterations=4)
+    qdd_warm, lam_warm = m.prox_pv(q, v, tau, mu=1.0, iterations=1, lambda0=lam3)
+    assert rel_err(lam_warm, lam4) < 1e-10 and rel_err(qdd_warm, qdd4) < 1e-10
+    _, lam_cold = m.prox_pv(q, v, tau, mu=1.0, iterations=1)
+    assert rel_err(lam_cold, lam4) > 1e-6
+
+
+def test_bad_options_name_the_argument(m):
+    q = np.zeros(m.nq)
+    q[6] = 1.0
+    v = np.zeros(m.nv)
+    with pytest.raises(ValueError, match="active: expected one flag per constraint, shape \\(4,\\)"):
+        m.prox_pv(q, v, v, active=[True, False])
+    with pytest.raises(ValueError, match=r"active\[1\]: expected a bool or 0/1, got 2"):
+        m.constraint_jacobian(q, active=[1, 2, 1, 1])
+    with pytest.raises(TypeError, match="active: expected bools or 0/1"):
+        m.delassus(q, active=[0.5, 1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match=r"lambda0: expected shape \(nc,\) = \(12,\)"):
+        m.prox_pv(q, v, v, lambda0=np.zeros(3))
+    with pytest.raises(ValueError, match=r"lambda0\[2\] is not finite"):
+        m.constrained_aba(q, v, v, lambda0=np.array([0, 0, np.nan] + [0] * 9))
+    with pytest.raises(ValueError, match="lam: expected shape"):
+        m.constraint_wrenches(q, np.zeros(2))
+    with pytest.raises(ValueError, match="has zero norm"):
+        m.mass_matrix(np.zeros(m.nq))
