@@ -48,7 +48,7 @@ endfunction()
 
 # SCALAR, NAME and OUTPUT_DIR of a generated-solver target, defaulted and
 # checked alike for proxgen_add_solver and proxgen_add_python_module: a macro,
-# so <prefix>_SCALAR, <prefix>_NAME and <prefix>_OUTPUT_DIR land in the caller.
+# so <prefix>_SCALAR, <prefix>_NAME, <prefix>_OUTPUT_DIR and `functions` land in the caller.
 macro(_proxgen_solver_defaults where prefix target)
   if(NOT ${prefix}_SCALAR)
     set(${prefix}_SCALAR double)
@@ -64,6 +64,15 @@ macro(_proxgen_solver_defaults where prefix target)
   endif()
   if(NOT ${prefix}_OUTPUT_DIR)
     set(${prefix}_OUTPUT_DIR "${CMAKE_CURRENT_BINARY_DIR}/proxgen/${target}")
+  endif()
+  # FUNCTIONS a b ... -> `functions` = --functions a,b (empty when not given).
+  set(functions "")
+  if(DEFINED ${prefix}_FUNCTIONS OR "FUNCTIONS" IN_LIST ${prefix}_KEYWORDS_MISSING_VALUES)
+    if(NOT ${prefix}_FUNCTIONS)
+      message(FATAL_ERROR "${where}: FUNCTIONS needs at least one function name")
+    endif()
+    list(JOIN ${prefix}_FUNCTIONS "," joined)
+    set(functions --functions "${joined}")
   endif()
 endmacro()
 
@@ -89,14 +98,6 @@ function(proxgen_add_solver target)
     message(FATAL_ERROR "proxgen_add_solver: use find_package(proxgen) or the proxgen source tree first")
   endif()
 
-  set(functions "")
-  if(DEFINED PAS_FUNCTIONS OR "FUNCTIONS" IN_LIST PAS_KEYWORDS_MISSING_VALUES)
-    if(NOT PAS_FUNCTIONS)
-      message(FATAL_ERROR "proxgen_add_solver(${target}): FUNCTIONS needs at least one function name")
-    endif()
-    list(JOIN PAS_FUNCTIONS "," joined)
-    set(functions --functions "${joined}")
-  endif()
   set(hpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.hpp")
   set(cpp "${PAS_OUTPUT_DIR}/${PAS_NAME}.cpp")
   # The C interface (NAME_c.h, NAME_c.cpp; docs/design.md "The C interface"):

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "emit/generate.hpp"
 #include "support.hpp"
@@ -25,19 +27,24 @@ std::string firstDifference(const std::string& a, const std::string& b) {
   }
 }
 
+// The four files the current generator writes for a checked-in example, by name.
+std::vector<std::pair<std::string, std::string>> exampleFiles(const std::string& robot) {
+  const std::string dir = test::sourceDir() + "/generated/" + robot;
+  GenerateOptions g;
+  g.urdf = dir + "/" + robot + ".urdf";
+  g.layout = dir + "/layout.yaml";
+  g.name = robot;
+  const SolverFiles f = generateFiles(g);
+  return {{f.headerName, f.header}, {f.sourceName, f.source}, {f.cHeaderName, f.cHeader}, {f.cSourceName, f.cSource}};
+}
+
 TEST(GeneratedFresh, CheckedInSolversMatchTheGenerator) {
   for (const char* robot : {"arm", "quadruped", "humanoid"}) {
     const std::string dir = test::sourceDir() + "/generated/" + robot;
-    GenerateOptions g;
-    g.urdf = dir + "/" + robot + ".urdf";
-    g.layout = dir + "/layout.yaml";
-    g.name = robot;
-    const SolverFiles files = generateFiles(g);
     const std::string command = "proxgen generate generated/" + std::string(robot) + "/" + robot +
                                 ".urdf --layout generated/" + robot + "/layout.yaml --out generated/" + robot +
                                 " --name " + robot;
-    for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source},
-                                     std::pair{files.cHeaderName, files.cHeader}, std::pair{files.cSourceName, files.cSource}}) {
+    for (const auto& [name, text] : exampleFiles(robot)) {
       const std::string path = dir + "/" + name;
       const std::string checkedIn = test::slurp(path);
       EXPECT_EQ(checkedIn, text) << "generated/" << robot << "/" << name << " is stale ("
@@ -53,14 +60,7 @@ TEST(GeneratedFresh, CheckedInSolversMatchTheGenerator) {
 // three examples are generated into, templates included, in the ordinary run.
 TEST(GeneratedFresh, GeneratedTextIsPrintableAscii) {
   for (const char* robot : {"arm", "quadruped", "humanoid"}) {
-    const std::string dir = test::sourceDir() + "/generated/" + robot;
-    GenerateOptions g;
-    g.urdf = dir + "/" + robot + ".urdf";
-    g.layout = dir + "/layout.yaml";
-    g.name = robot;
-    const SolverFiles files = generateFiles(g);
-    for (const auto& [name, text] : {std::pair{files.headerName, files.header}, std::pair{files.sourceName, files.source},
-                                     std::pair{files.cHeaderName, files.cHeader}, std::pair{files.cSourceName, files.cSource}}) {
+    for (const auto& [name, text] : exampleFiles(robot)) {
       std::istringstream in(text);
       int line = 1;
       for (std::string l; std::getline(in, l); ++line)

@@ -139,95 +139,100 @@ double cppSecondsPerCall(const ModuleInfo& info, py::handle q, py::handle v, py:
 
 // ---- The library functions (docs/dynamics.md), when the solver holds them ----
 
-/// One array argument of a library function: `width` numbers per state, the
-/// batch (one state or N) as q's (q comes first and sets it), finite.
-template <class Scalar>
-const Scalar* readInput(py::handle obj, const char* arg, py::ssize_t width, const char* sizeName, py::ssize_t& batch,
-                        py::array_t<Scalar>& keep) {
-  keep = asArray<Scalar>(obj, arg);
-  const Scalar* x = checkShape(keep, width, arg, batch, sizeName);
-  checkFinite(x, (batch == 0 ? 1 : batch) * width, width, arg);
-  return x;
-}
+/// The array arguments of one call of a library function, q first (it sets
+/// the batch: one state or N), each `width` numbers per state, finite.
+template <class Solver>
+struct Inputs {
+  using Scalar = typename Solver::Scalar;
+  py::ssize_t batch = -1;
+  std::array<py::array_t<Scalar>, 4> keep;  // copies made, alive for the call
+  int count = 0;
+  const Scalar* q;
+  explicit Inputs(py::handle qObj) : q(add(qObj, "q", Solver::nq, "nq")) {}
+  const Scalar* add(py::handle obj, const char* arg, py::ssize_t width, const char* sizeName) {
+    py::array_t<Scalar>& a = keep[std::size_t(count++)];
+    a = asArray<Scalar>(obj, arg);
+    const Scalar* x = checkShape(a, width, arg, batch, sizeName);
+    checkFinite(x, (batch == 0 ? 1 : batch) * width, width, arg);
+    return x;
+  }
+};
 
-/// A new C-contiguous array of shape `dims` (one state) or (batch, *dims).
-template <class Scalar>
-py::array_t<Scalar> newBlocks(py::ssize_t batch, std::initializer_list<py::ssize_t> dims) {
-  std::vector<py::ssize_t> shape;
-  if (batch != 0) shape.push_back(batch);
-  shape.insert(shape.end(), dims.begin(), dims.end());
-  return py::array_t<Scalar>(shape);
-}
-
-/// call(k, qn, w) for each state k with its normalised configuration qn: every
-/// quaternion is checked first (errors are raised with the GIL held), then
-/// many states run with the GIL released, one workspace per thread.
+/// A new array of shape `dims` (one state) or (batch, *dims), filled by
+/// call(k, qn, w, out_k) for each state k with its normalised configuration qn
+/// and its block out_k: every quaternion is checked first (errors are raised
+/// with the GIL held), then many states run with the GIL released, one
+/// workspace per thread.
 template <class Solver, class Call>
-void forEachState(const ModuleInfo& info, const typename Solver::Scalar* q, py::ssize_t batch, Call call) {
+py::array_t<typename Solver::Scalar> eachState(const ModuleInfo& info, const Inputs<Solver>& in,
+                                               std::initializer_list<py::ssize_t> dims, Call call) {
   using Scalar = typename Solver::Scalar;
   constexpr int nq = Solver::nq;
+  std::vector<py::ssize_t> shape;
+  if (in.batch != 0) shape.push_back(in.batch);
+  py::ssize_t block = 1;
+  for (py::ssize_t d : dims) {
+    shape.push_back(d);
+    block *= d;
+  }
+  py::array_t<Scalar> out(shape);
+  Scalar* o = out.mutable_data();
   thread_local typename Solver::Workspace w;
   Scalar qn[nq];
-  if (batch == 0) {
-    normalisedConfiguration(q, nq, info.quaternionAt, 0, false, qn);
-    call(py::ssize_t(0), qn, w);
-    return;
+  if (in.batch == 0) {
+    normalisedConfiguration(in.q, nq, info.quaternionAt, 0, false, qn);
+    call(py::ssize_t(0), qn, w, o);
+    return out;
   }
-  for (py::ssize_t k = 0; k < batch; ++k) normalisedConfiguration(q + k * nq, nq, info.quaternionAt, k, true, qn);
+  for (py::ssize_t k = 0; k < in.batch; ++k) normalisedConfiguration(in.q + k * nq, nq, info.quaternionAt, k, true, qn);
   py::gil_scoped_release release;
-  for (py::ssize_t k = 0; k < batch; ++k) {
-    normalisedConfiguration(q + k * nq, nq, info.quaternionAt, k, true, qn);
-    call(k, qn, w);
+  for (py::ssize_t k = 0; k < in.batch; ++k) {
+    normalisedConfiguration(in.q + k * nq, nq, info.quaternionAt, k, true, qn);
+    call(k, qn, w, o + k * block);
   }
+  return out;
 }
 
 template <class Solver>
-using OfQ = void (*)(const typename Solver::Scalar*, typename Solver::Workspace&, typename Solver::Scalar*) noexcept;
+using Scalar_t = typename Solver::Scalar;
 template <class Solver>
-using OfQScheduled = void (*)(const typename Solver::Scalar*, typename Solver::Workspace&, typename Solver::Scalar*,
-                              const bool*) noexcept;
+using Workspace_t = typename Solver::Workspace;
+// The schedule's flags of one call (all true without `active`).
+template <class Solver>
+struct Flags {
+  bool at[Solver::ncons > 0 ? Solver::ncons : 1] = {};
+  Flags(py::handle active, const ModuleInfo& info) { readActive(active, info.constraints.size(), at); }
+};
 
 /// f(q) -> (rows, cols): mass_matrix, mass_matrix_inverse.
 template <class Solver>
-void bindMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name, OfQ<Solver> fn, int rows, int cols,
-                   const char* doc) {
-  using Scalar = typename Solver::Scalar;
+void bindMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name,
+                   void (*fn)(const Scalar_t<Solver>*, Workspace_t<Solver>&, Scalar_t<Solver>*) noexcept, int rows,
+                   int cols, const char* doc) {
   const ModuleInfo* p = &info;
   m.def(
       name,
       [p, fn, rows, cols](py::handle q) {
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {rows, cols});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch,
-                             [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) { fn(qn, w, o + k * rows * cols); });
-        return out;
+        const Inputs<Solver> in(q);
+        return eachState<Solver>(*p, in, {rows, cols}, [&](py::ssize_t, auto* qn, auto& w, auto* o) { fn(qn, w, o); });
       },
       py::arg("q"), doc);
 }
 
 /// f(q, active=None) -> (rows, cols): constraint_jacobian, delassus.
 template <class Solver>
-void bindScheduledMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name, OfQScheduled<Solver> fn, int rows,
-                            int cols, const char* doc) {
-  using Scalar = typename Solver::Scalar;
+void bindScheduledMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* name,
+                            void (*fn)(const Scalar_t<Solver>*, Workspace_t<Solver>&, Scalar_t<Solver>*,
+                                       const bool*) noexcept,
+                            int rows, int cols, const char* doc) {
   const ModuleInfo* p = &info;
   m.def(
       name,
       [p, fn, rows, cols](py::handle q, py::handle active) {
-        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
-        readActive(active, p->constraints.size(), flags);
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {rows, cols});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, w, o + k * rows * cols, flags);
-        });
-        return out;
+        const Flags<Solver> flags(active, *p);
+        const Inputs<Solver> in(q);
+        return eachState<Solver>(*p, in, {rows, cols},
+                                 [&](py::ssize_t, auto* qn, auto& w, auto* o) { fn(qn, w, o, flags.at); });
       },
       py::arg("q"), py::arg("active") = py::none(), doc);
 }
@@ -235,24 +240,16 @@ void bindScheduledMatrixOfQ(py::module_& m, const ModuleInfo& info, const char* 
 /// nonlinear_effects(q, v) -> (nv,).
 template <class Solver>
 void bindNonlinearEffects(py::module_& m, const ModuleInfo& info,
-                          void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
-                                     typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
-  using Scalar = typename Solver::Scalar;
+                          void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, Workspace_t<Solver>&,
+                                     Scalar_t<Solver>*) noexcept) {
   constexpr int nv = Solver::nv;
   const ModuleInfo* p = &info;
   m.def(
       "nonlinear_effects",
       [p, fn](py::handle q, py::handle v) {
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa, va;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nv});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, vin + k * nv, w, o + k * nv);
-        });
-        return out;
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        return eachState<Solver>(*p, in, {nv}, [&](py::ssize_t k, auto* qn, auto& w, auto* o) { fn(qn, vin + k * nv, w, o); });
       },
       py::arg("q"), py::arg("v"), "(q, v) -> h (nv,) or (N, nv): Coriolis, centrifugal and gravity torques.");
 }
@@ -260,26 +257,18 @@ void bindNonlinearEffects(py::module_& m, const ModuleInfo& info,
 /// constraint_drift(q, v, active=None) -> (nc,).
 template <class Solver>
 void bindConstraintDrift(py::module_& m, const ModuleInfo& info,
-                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
-                                    typename Solver::Workspace&, typename Solver::Scalar*, const bool*) noexcept) {
-  using Scalar = typename Solver::Scalar;
+                         void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, Workspace_t<Solver>&,
+                                    Scalar_t<Solver>*, const bool*) noexcept) {
   constexpr int nv = Solver::nv, nc = Solver::nc;
   const ModuleInfo* p = &info;
   m.def(
       "constraint_drift",
       [p, fn](py::handle q, py::handle v, py::handle active) {
-        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
-        readActive(active, p->constraints.size(), flags);
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa, va;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nc});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, vin + k * nv, w, o + k * nc, flags);
-        });
-        return out;
+        const Flags<Solver> flags(active, *p);
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        return eachState<Solver>(*p, in, {nc},
+                                 [&](py::ssize_t k, auto* qn, auto& w, auto* o) { fn(qn, vin + k * nv, w, o, flags.at); });
       },
       py::arg("q"), py::arg("v"), py::arg("active") = py::none(),
       "(q, v, active=None) -> gamma (nc,) or (N, nc): J qdd + gamma is the constraint rows' acceleration.");
@@ -288,29 +277,22 @@ void bindConstraintDrift(py::module_& m, const ModuleInfo& info,
 /// inverse_dynamics(q, v, qdd, lam=None, active=None) -> tau (nv,).
 template <class Solver>
 void bindInverseDynamics(py::module_& m, const ModuleInfo& info,
-                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
-                                    const typename Solver::Scalar*, const typename Solver::Scalar*,
-                                    typename Solver::Workspace&, typename Solver::Scalar*, const bool*) noexcept) {
-  using Scalar = typename Solver::Scalar;
+                         void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, const Scalar_t<Solver>*,
+                                    const Scalar_t<Solver>*, Workspace_t<Solver>&, Scalar_t<Solver>*,
+                                    const bool*) noexcept) {
   constexpr int nv = Solver::nv, nc = Solver::nc;
   const ModuleInfo* p = &info;
   m.def(
       "inverse_dynamics",
       [p, fn](py::handle q, py::handle v, py::handle qdd, py::handle lam, py::handle active) {
-        bool flags[Solver::ncons > 0 ? Solver::ncons : 1] = {};
-        readActive(active, p->constraints.size(), flags);
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa, va, aa, la;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        const Scalar* vin = readInput(v, "v", nv, "nv", batch, va);
-        const Scalar* ain = readInput(qdd, "qdd", nv, "nv", batch, aa);
-        const Scalar* lin = lam.is_none() ? nullptr : readInput(lam, "lam", nc, "nc", batch, la);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nv});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, vin + k * nv, ain + k * nv, lin ? lin + k * nc : nullptr, w, o + k * nv, flags);
+        const Flags<Solver> flags(active, *p);
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        const auto* ain = in.add(qdd, "qdd", nv, "nv");
+        const auto* lin = lam.is_none() ? nullptr : in.add(lam, "lam", nc, "nc");
+        return eachState<Solver>(*p, in, {nv}, [&](py::ssize_t k, auto* qn, auto& w, auto* o) {
+          fn(qn, vin + k * nv, ain + k * nv, lin ? lin + k * nc : nullptr, w, o, flags.at);
         });
-        return out;
       },
       py::arg("q"), py::arg("v"), py::arg("qdd"), py::arg("lam") = py::none(), py::arg("active") = py::none(),
       "(q, v, qdd, lam=None, active=None) -> tau (nv,) or (N, nv): M qdd + h + J^T lam (lam None: no\n"
@@ -320,23 +302,20 @@ void bindInverseDynamics(py::module_& m, const ModuleInfo& info,
 /// constraint_placements(q) -> (ncons, 4, 4): each constraint frame's world
 /// placement [R p; 0 0 0 1], as the package's Robot.constraint_placements.
 template <class Solver>
-void bindConstraintPlacements(py::module_& m, const ModuleInfo& info, OfQ<Solver> fn) {
-  using Scalar = typename Solver::Scalar;
+void bindConstraintPlacements(py::module_& m, const ModuleInfo& info,
+                              void (*fn)(const Scalar_t<Solver>*, Workspace_t<Solver>&, Scalar_t<Solver>*) noexcept) {
+  using Scalar = Scalar_t<Solver>;
   constexpr int ncons = Solver::ncons;
   const ModuleInfo* p = &info;
   m.def(
       "constraint_placements",
       [p, fn](py::handle q) {
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {ncons, 4, 4});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
+        const Inputs<Solver> in(q);
+        return eachState<Solver>(*p, in, {ncons, 4, 4}, [&](py::ssize_t, auto* qn, auto& w, Scalar* o) {
           Scalar X[ncons > 0 ? 12 * ncons : 1];
           fn(qn, w, X);
           for (int c = 0; c < ncons; ++c) {
-            Scalar* T = o + (k * ncons + c) * 16;
+            Scalar* T = o + c * 16;
             for (int i = 0; i < 3; ++i) {
               for (int j = 0; j < 3; ++j) T[4 * i + j] = X[12 * c + 3 * i + j];
               T[4 * i + 3] = X[12 * c + 9 + i];
@@ -345,7 +324,6 @@ void bindConstraintPlacements(py::module_& m, const ModuleInfo& info, OfQ<Solver
             T[15] = Scalar(1);
           }
         });
-        return out;
       },
       py::arg("q"), "(q) -> (ncons, 4, 4) or (N, ncons, 4, 4): each constraint frame's world placement [R p; 0 0 0 1].");
 }
@@ -353,9 +331,8 @@ void bindConstraintPlacements(py::module_& m, const ModuleInfo& info, OfQ<Solver
 /// delassus_inverse(q, mu=None, active=None) -> (G + I/mu)^-1 (nc, nc).
 template <class Solver>
 void bindDelassusInverse(py::module_& m, const ModuleInfo& info,
-                         void (*fn)(const typename Solver::Scalar*, const typename Solver::Settings&,
-                                    typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
-  using Scalar = typename Solver::Scalar;
+                         void (*fn)(const Scalar_t<Solver>*, const typename Solver::Settings&, Workspace_t<Solver>&,
+                                    Scalar_t<Solver>*) noexcept) {
   constexpr int nc = Solver::nc;
   const ModuleInfo* p = &info;
   m.def(
@@ -363,17 +340,10 @@ void bindDelassusInverse(py::module_& m, const ModuleInfo& info,
       [p, fn](py::handle q, py::handle mu, py::handle active) {
         const typename Solver::Settings defaults;
         typename Solver::Settings s;
-        s.mu = Scalar(readMu(mu, double(defaults.mu)));
+        s.mu = Scalar_t<Solver>(readMu(mu, double(defaults.mu)));
         readActive(active, p->constraints.size(), s.active);
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {nc, nc});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, s, w, o + k * nc * nc);
-        });
-        return out;
+        const Inputs<Solver> in(q);
+        return eachState<Solver>(*p, in, {nc, nc}, [&](py::ssize_t, auto* qn, auto& w, auto* o) { fn(qn, s, w, o); });
       },
       py::arg("q"), py::arg("mu") = py::none(), py::arg("active") = py::none(),
       "(q, mu=None, active=None) -> (G + I/mu)^-1 (nc, nc) or (N, nc, nc) (mu: the layout's by default;\n"
@@ -384,24 +354,17 @@ void bindDelassusInverse(py::module_& m, const ModuleInfo& info,
 /// robot in world axes, force then torque about the frame's origin.
 template <class Solver>
 void bindConstraintWrenches(py::module_& m, const ModuleInfo& info,
-                            void (*fn)(const typename Solver::Scalar*, const typename Solver::Scalar*,
-                                       typename Solver::Workspace&, typename Solver::Scalar*) noexcept) {
-  using Scalar = typename Solver::Scalar;
+                            void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, Workspace_t<Solver>&,
+                                       Scalar_t<Solver>*) noexcept) {
   constexpr int nc = Solver::nc, ncons = Solver::ncons;
   const ModuleInfo* p = &info;
   m.def(
       "constraint_wrenches",
       [p, fn](py::handle q, py::handle lam) {
-        py::ssize_t batch = -1;
-        py::array_t<Scalar> qa, la;
-        const Scalar* qin = readInput(q, "q", Solver::nq, "nq", batch, qa);
-        const Scalar* lin = readInput(lam, "lam", nc, "nc", batch, la);
-        py::array_t<Scalar> out = newBlocks<Scalar>(batch, {ncons, 6});
-        Scalar* o = out.mutable_data();
-        forEachState<Solver>(*p, qin, batch, [&](py::ssize_t k, const Scalar* qn, typename Solver::Workspace& w) {
-          fn(qn, lin + k * nc, w, o + k * ncons * 6);
-        });
-        return out;
+        Inputs<Solver> in(q);
+        const auto* lin = in.add(lam, "lam", nc, "nc");
+        return eachState<Solver>(*p, in, {ncons, 6},
+                                 [&](py::ssize_t k, auto* qn, auto& w, auto* o) { fn(qn, lin + k * nc, w, o); });
       },
       py::arg("q"), py::arg("lam"),
       "(q, lam) -> (ncons, 6) or (N, ncons, 6): each constraint's wrench on the robot in world axes\n"
