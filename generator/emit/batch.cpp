@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 #include <vector>
 
@@ -280,6 +281,13 @@ std::string libraryDefinitions(const std::vector<const LibraryFunction*>& held) 
 }  // namespace
 
 bool validBatchWidth(int width) { return width == 2 || width == 4 || width == 8 || width == 16; }
+
+int parseBatchWidth(const std::string& text, bool given) {
+  if (!given) return 0;
+  for (const char* valid : {"2", "4", "8", "16"})
+    if (text == valid) return std::atoi(valid);
+  fail("command line", "--batch", fmt::format("the lane width W is 2, 4, 8 or 16, got {}", quoted(text)));
+}
 
 BatchFiles batchFiles(const SolverFiles& scalar, int width) {
   if (!validBatchWidth(width)) throw Error(fmt::format("--batch: {} lanes: the width is 2, 4, 8 or 16", width));
