@@ -97,6 +97,6 @@ void prox_pv_many(int n, const Scalar* q, const Scalar* v, const Scalar* tau, co
 void residual_batch(const BatchWorkspace& w, Scalar* r) noexcept {{
   batch_lanes::residual(w.w).store(r);
 }}
-
+{library}
 }}  // namespace {name}
 )proxgen"

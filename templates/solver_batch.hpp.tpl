@@ -12,7 +12,7 @@ namespace {name} {{
 
 inline constexpr int batch_width = {width};  // states per call of the _batch functions
 using BatchScalar = proxgen_rt::lanes<Scalar, batch_width>;  // one Scalar of each of the states
-
+{out_size}
 // Everything one batched solve writes: the Workspace over lanes (batch_width
 // times its size) and the states in lanes. Caller-owned, fixed size: the
 // solvers allocate nothing; one per thread.
@@ -21,7 +21,7 @@ struct BatchWorkspace {{
 {members}  }} w;
   BatchScalar q[nq], v[nv], tau[nv], qdd[nv];  // the states in lanes
   BatchScalar lambda[{rows}], lambda0[{rows}];{rows_note}
-}};
+{out_members}}};
 
 // Lane-interleaved: element i of state l at [i * batch_width + l] (q holds
 // nq * batch_width values; v, tau and qdd nv * batch_width; lambda nc *
@@ -47,6 +47,6 @@ void prox_pv_many(int n, const Scalar* q, const Scalar* v, const Scalar* tau, co
 // residual(w) of each lane of the last batched solve with w: batch_width
 // values into r (after a _many call, those of its last batch).
 void residual_batch(const BatchWorkspace& w, Scalar* r) noexcept;
-
+{library}
 }}  // namespace {name}
 )proxgen"

@@ -41,7 +41,7 @@ void addGenerate(CLI::App& app) {
   struct Options {
     std::string urdf, layout, cases, caseName, out, name, scalar = "double", functions;
     bool python = false;
-    int batch = 0;  // 0: no batched files
+    std::string batchText;  // --batch W as given (parseBatchWidth)
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("generate", "write a flat C++ solver (NAME.hpp, NAME.cpp) and its C interface (NAME_c.h, NAME_c.cpp) for one robot and layout");
@@ -55,21 +55,23 @@ void addGenerate(CLI::App& app) {
   cmd->add_option("--functions", opt->functions,
                   "the functions the solver holds, a,b,... or all (default: the layout's functions:, else "
                   "constrained_aba,prox_pv; valid: " + functionNameList() + ")");
-  cmd->add_option("--batch", opt->batch,
-                  "also write NAME_batch.hpp and NAME_batch.cpp, the solvers over W states per call in the lanes of a "
-                  "vector register (2, 4, 8 or 16; docs/batch.md)")
-      ->check(CLI::IsMember({2, 4, 8, 16}));
+  CLI::Option* batchOption = cmd->add_option("--batch", opt->batchText,
+                  "also write NAME_batch.hpp and NAME_batch.cpp, the solvers (and the library functions held) over W "
+                  "states per call in the lanes of a vector register (2, 4, 8 or 16; docs/batch.md)")
+      ->type_name("W");
   cmd->add_flag("--python", opt->python, "also write NAME_python.cpp, a pybind11 module over the solver (docs/python.md)");
-  cmd->callback([opt] {
+  cmd->callback([opt, batchOption] {
     checkRobotOptions("generate", opt->urdf, opt->layout, opt->cases, opt->caseName);
+    // (a bad width is refused before any work)
+    const int batchWidth = emit::parseBatchWidth(opt->batchText, batchOption->count() > 0);
     System sys;
     const emit::SolverFiles files = generateSolverFiles(opt->urdf, opt->layout, opt->cases, opt->caseName, opt->name,
                                                         emit::parseScalar(opt->scalar), &sys, opt->functions);
     std::vector<emit::OutputFile> outputs = emit::solverOutputs(files);
     // The module source goes through the same atomic write as the solver's files.
     if (opt->python) outputs.push_back(emit::pythonModuleOutput(sys, files, emit::parseScalar(opt->scalar)));
-    if (opt->batch != 0) {
-      const emit::BatchFiles batch = emit::batchFiles(files, opt->batch);
+    if (batchWidth != 0) {
+      const emit::BatchFiles batch = emit::batchFiles(files, batchWidth);
       outputs.push_back({batch.headerName, batch.header});
       outputs.push_back({batch.sourceName, batch.source});
     }

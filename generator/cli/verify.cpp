@@ -54,7 +54,8 @@ struct VerifyOptions {
   unsigned seed = 1;
   double tolerance = 0;  // 0: the conditioning-aware bounds of verify/compare.hpp
   int converged = 100;
-  int batch = 0;  // --batch W (0: no batched solvers)
+  std::string batchText;  // --batch W as given (parseBatchWidth)
+  int batch = 0;          // its width (0: no batched solvers)
 };
 
 // Runs argv (no shell), stdout+stderr to `log`; returns the exit status. The
@@ -217,12 +218,14 @@ int main() {
 }
 )";
 
-// The batched solvers' driver (--batch): reads the scalar driver's input (the
-// trials; the library samples are not read), runs the trials sharing (mu, K)
-// through constrained_aba_many and prox_pv_many (a count that is in general
-// not a multiple of W), their first W states (repeated when fewer) through the
-// _batch forms, and compares every answer with the scalar solver's, bit for
-// bit (NaN for NaN). Prints "<answers compared> <answers differing>".
+// The batched solvers' driver (--batch): reads the scalar driver's input, runs
+// the trials sharing (mu, K) through constrained_aba_many and prox_pv_many (a
+// count that is in general not a multiple of W), their first W states
+// (repeated when fewer) through the _batch forms, then the library samples
+// through the _many and _batch forms of each library function the solver
+// holds (the PROXGEN_VERIFY_HAS_ lines, as the scalar driver's), and compares
+// every answer with the scalar solver's or function's, bit for bit (NaN for
+// NaN). Prints "<answers compared> <answers differing>".
 constexpr const char* kBatchDriver = R"(// proxgen verify batch driver (temporary)
 #include <cmath>
 #include <cstdio>
@@ -238,6 +241,21 @@ static long compared = 0, differ = 0;
 static void check(S batched, S scalar) {
   ++compared;
   if (!((std::isnan(batched) && std::isnan(scalar)) || std::memcmp(&batched, &scalar, sizeof batched) == 0)) ++differ;
+}
+// One library function on m samples: scalar(j, out) on sample j, batch(out) on
+// the first W samples lane-interleaved (lane l: sample l mod m), many(out) on all m.
+template <class Scalar1, class Batch, class Many>
+[[maybe_unused]] static void library(int m, int size, Scalar1 scalar, Batch batch, Many many) {
+  if (m <= 0) return;
+  std::vector<S> expect(std::size_t(size) + 1), bout(std::size_t(size * W) + 1), mout(std::size_t(size * m) + 1);
+  batch(bout.data());
+  many(mout.data());
+  for (int j = 0; j < m; ++j) {
+    scalar(j, expect.data());
+    for (int i = 0; i < size; ++i) check(mout[std::size_t(j * size + i)], expect[std::size_t(i)]);
+    for (int l = j; l < W; l += m)
+      for (int i = 0; i < size; ++i) check(bout[std::size_t(i * W + l)], expect[std::size_t(i)]);
+  }
 }
 int main() {
   int n = 0;
@@ -304,6 +322,79 @@ int main() {
       }
     }
   }
+  // The library samples (q, v, qdd, lambda).
+  int m = 0;
+  if (std::scanf("%d", &m) != 1 || m < 0) return 2;
+  std::vector<S> lq(std::size_t(m * s::nq) + 1), lv(std::size_t(m * s::nv) + 1), lqdd(std::size_t(m * s::nv) + 1),
+      ll(std::size_t(m * s::nc) + 1);
+  for (int t = 0; t < m; ++t) {
+    double x = 0;
+    for (int k = 0; k < s::nq; ++k) { if (std::scanf("%lf", &x) != 1) return 2; lq[std::size_t(t * s::nq + k)] = S(x); }
+    for (int k = 0; k < s::nv; ++k) { if (std::scanf("%lf", &x) != 1) return 2; lv[std::size_t(t * s::nv + k)] = S(x); }
+    for (int k = 0; k < s::nv; ++k) { if (std::scanf("%lf", &x) != 1) return 2; lqdd[std::size_t(t * s::nv + k)] = S(x); }
+    for (int k = 0; k < s::nc; ++k) { if (std::scanf("%lf", &x) != 1) return 2; ll[std::size_t(t * s::nc + k)] = S(x); }
+  }
+  std::vector<S> iq(std::size_t(s::nq * W)), iv(std::size_t(s::nv * W)), iqdd(std::size_t(s::nv * W)),
+      il(std::size_t(s::nc * W) + 1);
+  for (int l = 0; l < W && m > 0; ++l) {
+    const int j = l % m;
+    for (int k = 0; k < s::nq; ++k) iq[std::size_t(k * W + l)] = lq[std::size_t(j * s::nq + k)];
+    for (int k = 0; k < s::nv; ++k) iv[std::size_t(k * W + l)] = lv[std::size_t(j * s::nv + k)];
+    for (int k = 0; k < s::nv; ++k) iqdd[std::size_t(k * W + l)] = lqdd[std::size_t(j * s::nv + k)];
+    for (int k = 0; k < s::nc; ++k) il[std::size_t(k * W + l)] = ll[std::size_t(j * s::nc + k)];
+  }
+  [[maybe_unused]] const auto Q = [&](int j) { return &lq[std::size_t(j * s::nq)]; };
+  [[maybe_unused]] const auto V = [&](int j) { return &lv[std::size_t(j * s::nv)]; };
+  [[maybe_unused]] const auto A = [&](int j) { return &lqdd[std::size_t(j * s::nv)]; };
+  [[maybe_unused]] const auto L = [&](int j) { return &ll[std::size_t(j * s::nc)]; };
+#if PROXGEN_VERIFY_HAS_INVERSE_DYNAMICS
+  library(m, s::nv, [&](int j, S* o) { s::inverse_dynamics(Q(j), V(j), A(j), L(j), w, o); },
+          [&](S* o) { s::inverse_dynamics_batch(iq.data(), iv.data(), iqdd.data(), il.data(), bw, o); },
+          [&](S* o) { s::inverse_dynamics_many(m, lq.data(), lv.data(), lqdd.data(), ll.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_NONLINEAR_EFFECTS
+  library(m, s::nv, [&](int j, S* o) { s::nonlinear_effects(Q(j), V(j), w, o); },
+          [&](S* o) { s::nonlinear_effects_batch(iq.data(), iv.data(), bw, o); },
+          [&](S* o) { s::nonlinear_effects_many(m, lq.data(), lv.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_MASS_MATRIX
+  library(m, s::nv * s::nv, [&](int j, S* o) { s::mass_matrix(Q(j), w, o); },
+          [&](S* o) { s::mass_matrix_batch(iq.data(), bw, o); }, [&](S* o) { s::mass_matrix_many(m, lq.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_MASS_MATRIX_INVERSE
+  library(m, s::nv * s::nv, [&](int j, S* o) { s::mass_matrix_inverse(Q(j), w, o); },
+          [&](S* o) { s::mass_matrix_inverse_batch(iq.data(), bw, o); },
+          [&](S* o) { s::mass_matrix_inverse_many(m, lq.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_PLACEMENTS
+  library(m, 12 * s::ncons, [&](int j, S* o) { s::constraint_placements(Q(j), w, o); },
+          [&](S* o) { s::constraint_placements_batch(iq.data(), bw, o); },
+          [&](S* o) { s::constraint_placements_many(m, lq.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_JACOBIAN
+  library(m, s::nc * s::nv, [&](int j, S* o) { s::constraint_jacobian(Q(j), w, o); },
+          [&](S* o) { s::constraint_jacobian_batch(iq.data(), bw, o); },
+          [&](S* o) { s::constraint_jacobian_many(m, lq.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_DRIFT
+  library(m, s::nc, [&](int j, S* o) { s::constraint_drift(Q(j), V(j), w, o); },
+          [&](S* o) { s::constraint_drift_batch(iq.data(), iv.data(), bw, o); },
+          [&](S* o) { s::constraint_drift_many(m, lq.data(), lv.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_DELASSUS
+  library(m, s::nc * s::nc, [&](int j, S* o) { s::delassus(Q(j), w, o); },
+          [&](S* o) { s::delassus_batch(iq.data(), bw, o); }, [&](S* o) { s::delassus_many(m, lq.data(), bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_DELASSUS_INVERSE
+  library(m, s::nc * s::nc, [&](int j, S* o) { s::delassus_inverse(Q(j), s::Settings{}, w, o); },
+          [&](S* o) { s::delassus_inverse_batch(iq.data(), s::Settings{}, bw, o); },
+          [&](S* o) { s::delassus_inverse_many(m, lq.data(), s::Settings{}, bw, o); });
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINT_WRENCHES
+  library(m, 6 * s::ncons, [&](int j, S* o) { s::constraint_wrenches(Q(j), L(j), w, o); },
+          [&](S* o) { s::constraint_wrenches_batch(iq.data(), il.data(), bw, o); },
+          [&](S* o) { s::constraint_wrenches_many(m, lq.data(), ll.data(), bw, o); });
+#endif
   std::printf("%ld %ld\n", compared, differ);
   return 0;
 }
@@ -453,7 +544,7 @@ int verify(const VerifyOptions& o) {
     batchOutput = scratch.file("batch_output.txt");
     files.push_back({batch.headerName, batch.header});
     files.push_back({batch.sourceName, batch.source});
-    files.push_back({"batch_driver.cpp", kBatchDriver});
+    files.push_back({"batch_driver.cpp", driverDefines(sys.functions) + kBatchDriver});
   }
   emit::writeFiles(files, scratch.dir().string());
   const auto t1 = std::chrono::steady_clock::now();
@@ -689,12 +780,13 @@ void addVerify(CLI::App& app) {
   cmd->add_option("--keep", o->keep, "copy the generated solver, driver and logs to this folder");
   cmd->add_option("--functions", o->functions,
                   "the functions to generate and compare, a,b,... or all (default: the layout's functions:)");
-  cmd->add_option("--batch", o->batch,
+  CLI::Option* batchOption = cmd->add_option("--batch", o->batchText,
                   "also generate the batched solvers over W lanes (2, 4, 8 or 16) and compare every lane with the "
                   "scalar solver (docs/batch.md)")
-      ->check(CLI::IsMember({2, 4, 8, 16}));
-  cmd->callback([o] {
+      ->type_name("W");
+  cmd->callback([o, batchOption] {
     checkRobotOptions("verify", o->urdf, o->layout, o->cases, o->caseName);
+    o->batch = emit::parseBatchWidth(o->batchText, batchOption->count() > 0);
     const int rc = verify(*o);
     if (rc != 0) std::exit(rc);
   });

@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
+#include <vector>
 
 #include "model/error.hpp"
 
@@ -66,9 +69,225 @@ std::string laneBody(const std::string& source, const std::string& name) {
   return body;
 }
 
+// ---- The library functions over lanes (--functions; docs/batch.md) ----
+// Each selected library function gets NAME_batch (W states lane-interleaved)
+// and NAME_many (n states in the plain layout), as the two solvers do: the
+// entry point loads its inputs into the BatchWorkspace's lanes, runs the lane
+// form of the function (cut from the scalar source with the rest) and stores
+// its output from BatchWorkspace::out. The table holds each function's
+// parameters in the scalar function's order; the scalar header's declaration
+// is checked against it at generation, so a change of a signature fails here.
+
+// One parameter of a library function.
+struct Param {
+  enum Kind { In, Work, Config, Out, Active } kind;
+  const char* name;      // the scalar parameter's name
+  const char* size = "";  // In, Out: its number of values, in the header's constants
+  const char* lanes = "";  // In: the BatchWorkspace member holding it in lanes
+  bool nullable = false;  // In: may be nullptr, as the scalar function says
+};
+
+struct LibraryFunction {
+  const char* name;
+  std::vector<Param> params;
+};
+
+const std::vector<LibraryFunction>& libraryFunctions() {
+  const Param q{Param::In, "q", "nq", "q"}, v{Param::In, "v", "nv", "v"}, work{Param::Work, "w"},
+      active{Param::Active, "active"};
+  static const std::vector<LibraryFunction> table{
+      {"inverse_dynamics",
+       {q, v, {Param::In, "qdd", "nv", "qdd"}, {Param::In, "lambda", "nc", "lambda", true}, work,
+        {Param::Out, "tau", "nv"}, active}},
+      {"nonlinear_effects", {q, v, work, {Param::Out, "h", "nv"}}},
+      {"mass_matrix", {q, work, {Param::Out, "M", "nv * nv"}}},
+      {"mass_matrix_inverse", {q, work, {Param::Out, "Minv", "nv * nv"}}},
+      {"constraint_placements", {q, work, {Param::Out, "X", "12 * ncons"}}},
+      {"constraint_jacobian", {q, work, {Param::Out, "J", "nc * nv"}, active}},
+      {"constraint_drift", {q, v, work, {Param::Out, "gamma", "nc"}, active}},
+      {"delassus", {q, work, {Param::Out, "G", "nc * nc"}, active}},
+      {"delassus_inverse", {q, {Param::Config, "s"}, work, {Param::Out, "Ginv", "nc * nc"}}},
+      {"constraint_wrenches", {q, {Param::In, "lambda", "nc", "lambda"}, work, {Param::Out, "W", "6 * ncons"}}},
+  };
+  return table;
+}
+
+// The parameter as declared; `workspace` is Workspace or BatchWorkspace.
+std::string declared(const Param& p, const char* workspace) {
+  switch (p.kind) {
+    case Param::In: return fmt::format("const Scalar* {}", p.name);
+    case Param::Work: return fmt::format("{}& {}", workspace, p.name);
+    case Param::Config: return fmt::format("const Settings& {}", p.name);
+    case Param::Out: return fmt::format("Scalar* {}", p.name);
+    case Param::Active: return fmt::format("const bool* {} = all_active", p.name);
+  }
+  throw std::logic_error("batch: a parameter kind");
+}
+
+// `head(a, b, ...) noexcept`, the arguments wrapped under the parenthesis past 110 columns.
+std::string wrapped(const std::string& head, const std::vector<std::string>& args, const std::string& tail) {
+  std::string out = head + "(";
+  std::string::size_type lineStart = 0;
+  const std::string indent(head.size() + 1, ' ');
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string piece = args[i] + (i + 1 < args.size() ? "," : ")" + tail);
+    if (i > 0) {
+      if (out.size() - lineStart + 1 + piece.size() > 110) {
+        out += "\n";
+        lineStart = out.size();
+        out += indent;
+      } else {
+        out += " ";
+      }
+    }
+    out += piece;
+  }
+  return out;
+}
+
+// Whitespace runs as one space: declarations compared whatever their wrapping.
+std::string squeezed(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    const bool space = c == ' ' || c == '\n';
+    if (space && (out.empty() || out.back() == ' ')) continue;
+    out += space ? ' ' : c;
+  }
+  return out;
+}
+
+// The library functions the scalar header declares, each checked against the table.
+std::vector<const LibraryFunction*> heldFunctions(const std::string& header) {
+  std::vector<const LibraryFunction*> out;
+  for (const LibraryFunction& f : libraryFunctions()) {
+    const auto at = header.find(fmt::format("\nvoid {}(", f.name));
+    if (at == std::string::npos) continue;
+    const auto end = find(header, ") noexcept;", "header", at);
+    std::vector<std::string> args;
+    for (const Param& p : f.params) args.push_back(declared(p, "Workspace"));
+    const std::string expected = squeezed(wrapped(fmt::format("void {}", f.name), args, " noexcept;"));
+    const std::string actual = squeezed(header.substr(at + 1, end + 11 - (at + 1)));
+    if (actual != expected)
+      throw std::logic_error(fmt::format("batch: the scalar {} is not '{}' but '{}'", f.name, expected, actual));
+    out.push_back(&f);
+  }
+  return out;
+}
+
+// The header's part: the size of BatchWorkspace::out and the declarations.
+std::string libraryDeclarations(const std::vector<const LibraryFunction*>& held) {
+  std::string out =
+      "\n// The library functions over lanes (generate --functions): NAME_batch and\n"
+      "// NAME_many are NAME (the scalar function of the solver's header) on\n"
+      "// batch_width states lane-interleaved and on n states in the plain layout, as\n"
+      "// the solvers' _batch and _many: inputs and outputs as the solvers' arrays\n"
+      "// (element i of state l at [i * batch_width + l], a matrix's element i its\n"
+      "// row-major index: M[r * nv + c] of state l at [(r * nv + c) * batch_width + l];\n"
+      "// _many: state k's at + k * size, its last batch's unused lanes dropped).\n"
+      "// `active` and the Settings are shared by the states. What the scalar\n"
+      "// function says holds lane by lane; each lane's answer is its answer.\n";
+  for (const LibraryFunction* f : held) {
+    std::vector<std::string> args;
+    for (const Param& p : f->params) args.push_back(declared(p, "BatchWorkspace"));
+    out += wrapped(fmt::format("void {}_batch", f->name), args, " noexcept;") + "\n";
+    args.insert(args.begin(), "int n");
+    out += wrapped(fmt::format("void {}_many", f->name), args, " noexcept;") + "\n";
+  }
+  return out;
+}
+
+// BatchWorkspace::out: as large as the largest output of the held functions
+// (at least 1: a C++ array cannot be empty), and its size's function.
+std::string outSizeFunction(const std::vector<const LibraryFunction*>& held) {
+  std::vector<std::string> sizes;
+  for (const LibraryFunction* f : held)
+    for (const Param& p : f->params)
+      if (p.kind == Param::Out && std::find(sizes.begin(), sizes.end(), p.size) == sizes.end()) sizes.push_back(p.size);
+  std::string out =
+      "\n// The largest output of the library functions below (BatchWorkspace::out).\n"
+      "constexpr int batch_out_size() noexcept {\n"
+      "  int size = 1;\n";
+  for (const std::string& size : sizes) out += fmt::format("  if ({0} > size) size = {0};\n", size);
+  return out + "  return size;\n}\n";
+}
+const char* const kOutMember = "  BatchScalar out[batch_out_size()];  // the library functions' outputs in lanes\n";
+
+// The source's part: the lane copies and each function's two entry points.
+std::string libraryDefinitions(const std::vector<const LibraryFunction*>& held) {
+  std::string out =
+      "\n// The library functions' entry points: their inputs into lanes, the lane\n"
+      "// function, its output out of lanes.\n"
+      "namespace {\n\n"
+      "// size values of each of the batch_width states, lane-interleaved, into lanes, and back.\n"
+      "void loadLanes(const Scalar* x, int size, BatchScalar* lanes) noexcept {\n"
+      "  for (int i = 0; i < size; ++i) lanes[i] = BatchScalar::load(x + i * batch_width);\n"
+      "}\n"
+      "void storeLanes(const BatchScalar* lanes, int size, Scalar* x) noexcept {\n"
+      "  for (int i = 0; i < size; ++i) lanes[i].store(x + i * batch_width);\n"
+      "}\n\n"
+      "// States first .. first + used - 1 of the plain layout (size values each)\n"
+      "// into lanes, the unused lanes repeating state first; and the used lanes back.\n"
+      "void gatherLanes(const Scalar* x, int size, int first, int used, BatchScalar* lanes) noexcept {\n"
+      "  for (int l = 0; l < batch_width; ++l) {\n"
+      "    const std::size_t k = std::size_t(first + (l < used ? l : 0));\n"
+      "    for (int i = 0; i < size; ++i) lanes[i].set(l, x[k * std::size_t(size) + std::size_t(i)]);\n"
+      "  }\n"
+      "}\n"
+      "void scatterLanes(const BatchScalar* lanes, int size, int first, int used, Scalar* x) noexcept {\n"
+      "  for (int l = 0; l < used; ++l) {\n"
+      "    const std::size_t k = std::size_t(first + l);\n"
+      "    for (int i = 0; i < size; ++i) x[k * std::size_t(size) + std::size_t(i)] = lanes[i][l];\n"
+      "  }\n"
+      "}\n\n"
+      "}  // namespace\n";
+  for (const LibraryFunction* f : held) {
+    std::vector<std::string> args, call;
+    std::string load, gather, store, scatter;
+    for (const Param& p : f->params) {
+      args.push_back(declared(p, "BatchWorkspace"));
+      if (p.kind == Param::Active) args.back() = fmt::format("const bool* {}", p.name);  // (the default is the header's)
+      switch (p.kind) {
+        case Param::In: {
+          const std::string guard = p.nullable ? fmt::format("if ({}) ", p.name) : "";
+          load += fmt::format("  {}loadLanes({}, {}, w.{});\n", guard, p.name, p.size, p.lanes);
+          gather += fmt::format("    {}gatherLanes({}, {}, first, used, w.{});\n", guard, p.name, p.size, p.lanes);
+          call.push_back(p.nullable ? fmt::format("{} ? w.{} : nullptr", p.name, p.lanes) : fmt::format("w.{}", p.lanes));
+          break;
+        }
+        case Param::Work: call.push_back("w.w"); break;
+        case Param::Config: call.push_back(fmt::format("laneSettings({}, w)", p.name)); break;
+        case Param::Out:
+          store += fmt::format("  storeLanes(w.out, {}, {});\n", p.size, p.name);
+          scatter += fmt::format("    scatterLanes(w.out, {}, first, used, {});\n", p.size, p.name);
+          call.push_back("w.out");
+          break;
+        case Param::Active: call.push_back(p.name); break;
+      }
+    }
+    std::string joined;
+    for (const std::string& c : call) joined += (joined.empty() ? "" : ", ") + c;
+    const std::string run = fmt::format("batch_lanes::{}({});\n", f->name, joined);
+    out += "\n" + wrapped(fmt::format("void {}_batch", f->name), args, " noexcept {") + "\n" + load + "  " + run +
+           store + "}\n";
+    args.insert(args.begin(), "int n");
+    out += "\n" + wrapped(fmt::format("void {}_many", f->name), args, " noexcept {") + "\n" +
+           "  for (int first = 0; first < n; first += batch_width) {\n"
+           "    const int used = n - first < batch_width ? n - first : batch_width;\n" +
+           gather + "    " + run + scatter + "  }\n}\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 bool validBatchWidth(int width) { return width == 2 || width == 4 || width == 8 || width == 16; }
+
+int parseBatchWidth(const std::string& text, bool given) {
+  if (!given) return 0;
+  for (const char* valid : {"2", "4", "8", "16"})
+    if (text == valid) return std::atoi(valid);
+  fail("command line", "--batch", fmt::format("the lane width W is 2, 4, 8 or 16, got {}", quoted(text)));
+}
 
 BatchFiles batchFiles(const SolverFiles& scalar, int width) {
   if (!validBatchWidth(width)) throw Error(fmt::format("--batch: {} lanes: the width is 2, 4, 8 or 16", width));
@@ -92,12 +311,18 @@ BatchFiles batchFiles(const SolverFiles& scalar, int width) {
   BatchFiles out;
   out.headerName = name + "_batch.hpp";
   out.sourceName = name + "_batch.cpp";
+  // The library functions the solver holds: none gives the files of the two solvers alone.
+  const std::vector<const LibraryFunction*> held = heldFunctions(header);
   out.header = fmt::format(fmt::runtime(kBatchHeaderTemplate), fmt::arg("banner", banner), fmt::arg("name", name),
                            fmt::arg("width", width), fmt::arg("members", laneMembers(header)),
                            fmt::arg("rows", noRows ? "1" : "nc"),
-                           fmt::arg("rows_note", noRows ? "  // no constraint rows: one unused entry" : ""));
+                           fmt::arg("rows_note", noRows ? "  // no constraint rows: one unused entry" : ""),
+                           fmt::arg("out_size", held.empty() ? "" : outSizeFunction(held)),
+                           fmt::arg("out_members", held.empty() ? "" : kOutMember),
+                           fmt::arg("library", held.empty() ? "" : libraryDeclarations(held)));
   out.source = fmt::format(fmt::runtime(kBatchSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", name),
-                           fmt::arg("body", laneBody(scalar.source, name)));
+                           fmt::arg("body", laneBody(scalar.source, name)),
+                           fmt::arg("library", held.empty() ? "" : libraryDefinitions(held)));
   return out;
 }
 

@@ -15,13 +15,21 @@ namespace proxgen::emit {
 /// The lane widths --batch accepts.
 bool validBatchWidth(int width);
 
+/// --batch's value as given on the command line (not `given`: 0, no batched
+/// files); anything but 2, 4, 8 or 16, the empty text too, is refused with one
+/// line naming the option and the valid widths (proxgen::Error, "command line"
+/// as the file).
+int parseBatchWidth(const std::string& text, bool given);
+
 struct BatchFiles {
   std::string headerName, header;  // NAME_batch.hpp
   std::string sourceName, source;  // NAME_batch.cpp
 };
 
 /// The batched files of the solver `scalar` (emitSolver's NAME.hpp and
-/// NAME.cpp, holding constrained_aba and prox_pv), over `width` lanes.
+/// NAME.cpp, holding constrained_aba and prox_pv), over `width` lanes: the two
+/// solvers' _batch and _many forms, and those of each library function the
+/// solver holds (inverse_dynamics ... constraint_wrenches; docs/batch.md).
 /// Throws proxgen::Error when the solver lacks one of the two solvers or the
 /// width is not 2, 4, 8 or 16.
 BatchFiles batchFiles(const SolverFiles& scalar, int width);

@@ -3,7 +3,8 @@
 // NAME.hpp and NAME.cpp byte for byte what they are without it (the checked-in
 // examples); a width that is not 2, 4, 8 or 16, or a function list without
 // both solvers, is refused with one line and nothing written; verify --batch
-// compares every lane with the scalar solver (docs/batch.md).
+// compares every lane with the scalar solver, and the library functions'
+// batched forms with the scalar functions (docs/batch.md).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -67,13 +68,20 @@ TEST_F(BatchCli, BatchAddsTwoFilesAndLeavesTheScalarOnesAsTheyAre) {
   EXPECT_EQ(proxgen::test::slurp(out_ / "arm_batch.cpp"), source);
 }
 
+// A bad width, numeric or not, is one line naming the option and the valid
+// widths (command-line values: "command line" as the file, exit 1; docs/cli.md
+// "Errors"), for generate and verify alike, before any work: nothing written.
 TEST_F(BatchCli, AWidthOtherThan2_4_8_16IsRefusedAndNothingIsWritten) {
-  for (const char* width : {"3", "32", "0", "-4", "four"}) {
+  const std::string expected = "proxgen: error: command line: --batch: the lane width W is 2, 4, 8 or 16, got ";
+  for (const char* width : {"3", "32", "0", "-4", "four", "x", "", "4x", " 4", "04"}) {
     const ProcessResult r = runProxgen(armGenerate({"--batch", width}));
-    EXPECT_NE(r.code, 0) << width;
-    EXPECT_NE(r.err.find("--batch"), std::string::npos) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+    EXPECT_EQ(r.code, 1) << width << ": " << r.err;
+    EXPECT_EQ(r.err, expected + "'" + width + "'\n") << width;
     EXPECT_TRUE(listing(out_).empty()) << width;
+    const ProcessResult v = runProxgen({"verify", arm_ + "/arm.urdf", "--layout", arm_ + "/layout.yaml", "--batch", width});
+    EXPECT_EQ(v.code, 1) << width << ": " << v.err;
+    EXPECT_EQ(v.err, expected + "'" + width + "'\n") << width;
+    EXPECT_TRUE(v.out.empty()) << v.out;
   }
 }
 
@@ -85,14 +93,40 @@ TEST_F(BatchCli, BatchNeedsBothSolversInTheFunctionList) {
   EXPECT_TRUE(listing(out_).empty());
 }
 
+// verify --batch: every lane of the solvers and, the library functions
+// selected, of their _batch and _many forms against the scalar ones (one run:
+// each run compiles the solver twice).
 TEST_F(BatchCli, VerifyBatchComparesEveryLaneWithTheScalarSolver) {
-  const ProcessResult r = runProxgen({"verify", arm_ + "/arm.urdf", "--layout", arm_ + "/layout.yaml", "--samples", "3",
-                                      "--batch", "2"});
+  const ProcessResult r = runProxgen(
+      {"verify", arm_ + "/arm.urdf", "--layout", arm_ + "/layout.yaml", "--samples", "3", "--batch", "2", "--functions",
+       "constrained_aba,prox_pv,inverse_dynamics,nonlinear_effects,mass_matrix,mass_matrix_inverse,"
+       "constraint_placements,constraint_jacobian,constraint_drift,delassus,delassus_inverse,constraint_wrenches"});
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   // 3 states x 2 mu x 4 K = 24 trials in 8 groups of 3 (mu, K): per group and
-  // solver, 3 states through _many and 2 lanes through _batch, each nv + nc = 12 answers.
-  EXPECT_NE(r.out.find("batched (--batch 2) vs scalar, bit for bit: 960 answers, 0 differ  ok"), std::string::npos)
+  // solver, 3 states through _many and 2 lanes through _batch, each nv + nc =
+  // 12 answers: 960. Then per library function 3 samples
+  // through _many and 2 lanes through _batch, 5 x its output size: the arm has
+  // nv = 6, nc = 6, one constraint, so tau 6, h 6, M 36, Minv 36, X 12, J 36,
+  // gamma 6, G 36, Ginv 36, W 6: 216 values, 1080 answers; 2040 in all.
+  EXPECT_NE(r.out.find("batched (--batch 2) vs scalar, bit for bit: 2040 answers, 0 differ  ok"), std::string::npos)
       << r.out;
+}
+
+// The header declares the library functions' batched forms when they are
+// selected, and not otherwise (the solvers-only files are those above).
+TEST_F(BatchCli, TheLibraryFunctionsGetBatchedFormsWhenSelected) {
+  ASSERT_EQ(runProxgen(armGenerate({"--batch", "4"})).code, 0);
+  const std::string plain = proxgen::test::slurp(out_ / "arm_batch.hpp");
+  EXPECT_EQ(plain.find("_many(int n, const Scalar* q, BatchWorkspace& w, Scalar* M)"), std::string::npos);
+  EXPECT_EQ(plain.find("batch_out_size"), std::string::npos);
+  const ProcessResult r = runProxgen(armGenerate({"--batch", "4", "--functions", "constrained_aba,prox_pv,mass_matrix"}));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string header = proxgen::test::slurp(out_ / "arm_batch.hpp");
+  EXPECT_NE(header.find("void mass_matrix_batch(const Scalar* q, BatchWorkspace& w, Scalar* M) noexcept;"),
+            std::string::npos);
+  EXPECT_NE(header.find("void mass_matrix_many(int n, const Scalar* q, BatchWorkspace& w, Scalar* M) noexcept;"),
+            std::string::npos);
+  EXPECT_EQ(header.find("inverse_dynamics_batch"), std::string::npos);  // not selected
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <random>
 #include <vector>
@@ -207,5 +208,192 @@ TEST(Batch, ANaNStateStaysInItsLane) {
   }
   EXPECT_TRUE(poisoned);
 }
+
+// ---- The library functions over lanes (FUNCTIONS of the test solver) ----
+// Each NAME_batch lane and each NAME_many state against the scalar NAME on
+// the same inputs, bit for bit (the bound of the file's head: the lane forms
+// are the scalar functions' text over lanes, compiled without contraction).
+// Inputs per state: q and v of states() (the hostile ones among them), its
+// tau as qdd and its lambda0 as lambda.
+using LibraryScalar = std::function<void(const S* q, const S* v, const S* qdd, const S* lambda, g::Workspace& w, S* out)>;
+using LibraryBatch =
+    std::function<void(const S* q, const S* v, const S* qdd, const S* lambda, g::BatchWorkspace& w, S* out)>;
+using LibraryMany =
+    std::function<void(int n, const S* q, const S* v, const S* qdd, const S* lambda, g::BatchWorkspace& w, S* out)>;
+
+[[maybe_unused]] void checkLibrary(const char* what, int size, const LibraryScalar& scalar, const LibraryBatch& batch,
+                                   const LibraryMany& many) {
+  static g::Workspace w;
+  static g::BatchWorkspace bw;
+  std::vector<S> expected(std::size_t(size) + 1);
+  // W states lane-interleaved through NAME_batch.
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const std::vector<State> st = states(W, seed);
+    std::vector<S> q(std::size_t(g::nq * W)), v(std::size_t(g::nv * W)), qdd(std::size_t(g::nv * W)),
+        lambda(std::size_t(g::nc * W + 1));
+    for (int l = 0; l < W; ++l) {
+      const State& x = st[std::size_t(l)];
+      for (int i = 0; i < g::nq; ++i) q[std::size_t(i * W + l)] = x.q[std::size_t(i)];
+      for (int i = 0; i < g::nv; ++i) v[std::size_t(i * W + l)] = x.v[std::size_t(i)];
+      for (int i = 0; i < g::nv; ++i) qdd[std::size_t(i * W + l)] = x.tau[std::size_t(i)];
+      for (int r = 0; r < g::nc; ++r) lambda[std::size_t(r * W + l)] = x.lambda0[std::size_t(r)];
+    }
+    std::vector<S> out(std::size_t(size * W) + 1);
+    batch(q.data(), v.data(), qdd.data(), lambda.data(), bw, out.data());
+    for (int l = 0; l < W; ++l) {
+      const State& x = st[std::size_t(l)];
+      scalar(x.q.data(), x.v.data(), x.tau.data(), x.lambda0.data(), w, expected.data());
+      for (int i = 0; i < size; ++i)
+        EXPECT_TRUE(sameBits(out[std::size_t(i * W + l)], expected[std::size_t(i)]))
+            << what << "_batch [" << i << "] of lane " << l << " (seed " << seed << "): " << out[std::size_t(i * W + l)]
+            << " vs " << expected[std::size_t(i)];
+    }
+  }
+  // n states in the plain layout through NAME_many: n not a multiple of W
+  // among them, nothing written past state n - 1.
+  for (int n : {1, W - 1, W, 2 * W + 3}) {
+    if (n < 1) continue;
+    const std::vector<State> st = states(n, 11u + unsigned(n));
+    std::vector<S> q, v, qdd, lambda;
+    for (const State& x : st) {
+      q.insert(q.end(), x.q.begin(), x.q.end());
+      v.insert(v.end(), x.v.begin(), x.v.end());
+      qdd.insert(qdd.end(), x.tau.begin(), x.tau.end());
+      lambda.insert(lambda.end(), x.lambda0.begin(), x.lambda0.end());
+    }
+    lambda.push_back(S(0));  // (nc = 0: a valid pointer)
+    const S canary = S(-12345.5);
+    std::vector<S> out(std::size_t(size * (n + 1)) + 1, canary);
+    many(n, q.data(), v.data(), qdd.data(), lambda.data(), bw, out.data());
+    for (int k = 0; k < n; ++k) {
+      const State& x = st[std::size_t(k)];
+      scalar(x.q.data(), x.v.data(), x.tau.data(), x.lambda0.data(), w, expected.data());
+      for (int i = 0; i < size; ++i)
+        EXPECT_TRUE(sameBits(out[std::size_t(k * size + i)], expected[std::size_t(i)]))
+            << what << "_many [" << i << "] of state " << k << " of " << n;
+    }
+    for (std::size_t i = std::size_t(size * n); i < out.size(); ++i) EXPECT_EQ(out[i], canary) << what << "_many, n " << n;
+  }
+  // n = 0 and n < 0: nothing read, nothing written.
+  S untouched = S(3);
+  many(0, nullptr, nullptr, nullptr, nullptr, bw, &untouched);
+  many(-2, nullptr, nullptr, nullptr, nullptr, bw, &untouched);
+  EXPECT_EQ(untouched, S(3)) << what << "_many with n <= 0";
+}
+
+// A schedule that is not the default: every other constraint off (shared by the lanes).
+[[maybe_unused]] const bool* someInactive() {
+  static bool schedule[g::ncons > 0 ? g::ncons : 1];
+  for (int k = 0; k < g::ncons; ++k) schedule[k] = k % 2 == 1;
+  return schedule;
+}
+
+// The three forms of NAME called as (q, v, qdd, lambda, w, out), with the
+// remaining arguments ARGS... after out (nothing, or the schedule).
+#define PROXGEN_LIBRARY_FORMS(NAME, CALL)                                                                        \
+  [](const S* q, const S* v, const S* qdd, const S* lambda, g::Workspace& w, S* out) {                         \
+    auto f = [&](auto&&... a) { g::NAME(a...); };                                                              \
+    CALL;                                                                                                      \
+  },                                                                                                           \
+      [](const S* q, const S* v, const S* qdd, const S* lambda, g::BatchWorkspace& w, S* out) {                \
+        auto f = [&](auto&&... a) { g::NAME##_batch(a...); };                                                  \
+        CALL;                                                                                                  \
+      },                                                                                                       \
+      [](int n, const S* q, const S* v, const S* qdd, const S* lambda, g::BatchWorkspace& w, S* out) {         \
+        auto f = [&](auto&&... a) { g::NAME##_many(n, a...); };                                                \
+        CALL;                                                                                                  \
+      }
+
+#if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS
+TEST(BatchLibrary, InverseDynamics) {
+  checkLibrary("inverse_dynamics", g::nv, PROXGEN_LIBRARY_FORMS(inverse_dynamics, f(q, v, qdd, lambda, w, out)));
+  checkLibrary("inverse_dynamics (lambda null)", g::nv,
+               PROXGEN_LIBRARY_FORMS(inverse_dynamics, (static_cast<void>(lambda), f(q, v, qdd, nullptr, w, out))));
+  checkLibrary("inverse_dynamics (schedule)", g::nv,
+               PROXGEN_LIBRARY_FORMS(inverse_dynamics, f(q, v, qdd, lambda, w, out, someInactive())));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_NONLINEAR_EFFECTS
+TEST(BatchLibrary, NonlinearEffects) {
+  checkLibrary("nonlinear_effects", g::nv,
+               PROXGEN_LIBRARY_FORMS(nonlinear_effects, (static_cast<void>(qdd), static_cast<void>(lambda), f(q, v, w, out))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_MASS_MATRIX
+TEST(BatchLibrary, MassMatrix) {
+  checkLibrary("mass_matrix", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(mass_matrix, (static_cast<void>(v), static_cast<void>(qdd),
+                                                   static_cast<void>(lambda), f(q, w, out))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_MASS_MATRIX_INVERSE
+TEST(BatchLibrary, MassMatrixInverse) {
+  checkLibrary("mass_matrix_inverse", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(mass_matrix_inverse, (static_cast<void>(v), static_cast<void>(qdd),
+                                                           static_cast<void>(lambda), f(q, w, out))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_CONSTRAINT_PLACEMENTS
+TEST(BatchLibrary, ConstraintPlacements) {
+  checkLibrary("constraint_placements", 12 * g::ncons,
+               PROXGEN_LIBRARY_FORMS(constraint_placements, (static_cast<void>(v), static_cast<void>(qdd),
+                                                             static_cast<void>(lambda), f(q, w, out))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_CONSTRAINT_JACOBIAN
+TEST(BatchLibrary, ConstraintJacobian) {
+  checkLibrary("constraint_jacobian", g::nc * g::nv,
+               PROXGEN_LIBRARY_FORMS(constraint_jacobian, (static_cast<void>(v), static_cast<void>(qdd),
+                                                           static_cast<void>(lambda), f(q, w, out))));
+  checkLibrary("constraint_jacobian (schedule)", g::nc * g::nv,
+               PROXGEN_LIBRARY_FORMS(constraint_jacobian, (static_cast<void>(v), static_cast<void>(qdd),
+                                                           static_cast<void>(lambda), f(q, w, out, someInactive()))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_CONSTRAINT_DRIFT
+TEST(BatchLibrary, ConstraintDrift) {
+  checkLibrary("constraint_drift", g::nc,
+               PROXGEN_LIBRARY_FORMS(constraint_drift, (static_cast<void>(qdd), static_cast<void>(lambda),
+                                                        f(q, v, w, out))));
+  checkLibrary("constraint_drift (schedule)", g::nc,
+               PROXGEN_LIBRARY_FORMS(constraint_drift, (static_cast<void>(qdd), static_cast<void>(lambda),
+                                                        f(q, v, w, out, someInactive()))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_DELASSUS
+TEST(BatchLibrary, Delassus) {
+  checkLibrary("delassus", g::nc * g::nc,
+               PROXGEN_LIBRARY_FORMS(delassus, (static_cast<void>(v), static_cast<void>(qdd),
+                                                static_cast<void>(lambda), f(q, w, out))));
+  checkLibrary("delassus (schedule)", g::nc * g::nc,
+               PROXGEN_LIBRARY_FORMS(delassus, (static_cast<void>(v), static_cast<void>(qdd),
+                                                static_cast<void>(lambda), f(q, w, out, someInactive()))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_DELASSUS_INVERSE
+// The Settings are shared by the lanes: the layout's mu and schedule, and mu =
+// 100 with every other constraint off.
+g::Settings otherSettings() {
+  g::Settings s;
+  s.mu = S(100);
+  for (int k = 0; k < g::ncons; ++k) s.active[k] = someInactive()[k];
+  return s;
+}
+TEST(BatchLibrary, DelassusInverse) {
+  checkLibrary("delassus_inverse", g::nc * g::nc,
+               PROXGEN_LIBRARY_FORMS(delassus_inverse, (static_cast<void>(v), static_cast<void>(qdd),
+                                                        static_cast<void>(lambda), f(q, g::Settings{}, w, out))));
+  checkLibrary("delassus_inverse (mu 100, schedule)", g::nc * g::nc,
+               PROXGEN_LIBRARY_FORMS(delassus_inverse, (static_cast<void>(v), static_cast<void>(qdd),
+                                                        static_cast<void>(lambda), f(q, otherSettings(), w, out))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_CONSTRAINT_WRENCHES
+TEST(BatchLibrary, ConstraintWrenches) {
+  checkLibrary("constraint_wrenches", 6 * g::ncons,
+               PROXGEN_LIBRARY_FORMS(constraint_wrenches, (static_cast<void>(v), static_cast<void>(qdd),
+                                                           f(q, lambda, w, out))));
+}
+#endif
 
 }  // namespace
