@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 50eb34517e2faea3db8fdd4ba1d60ad2d61002927988ce3358e6677f52fe578e
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 1131 + 322 K (= 2097 at K = 3)
-//     add/sub 482 + 139 K, mul 607 + 169 K, div 6, neg 30 + 14 K, sqrt 0, sincos 6, log6 0
-//   prox_pv: 2166 + 72 K (= 2382 at K = 3)
-//     add/sub 880 + 26 K, mul 1204 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
+//   constrained_aba: 1134 + 303 K (= 2043 at K = 3)
+//     add/sub 486 + 129 K, mul 603 + 163 K, div 6, neg 33 + 11 K, sqrt 0, sincos 6, log6 0
+//   prox_pv: 2154 + 72 K (= 2370 at K = 3)
+//     add/sub 875 + 26 K, mul 1197 + 46 K, div 11, neg 59, sqrt 6, sincos 6, log6 0
 
 // The C interface of arm.hpp, declared in arm_c.h: each function
 // copies its scalar arguments into a Settings, makes the caller's buffer the

@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8747 + 1735 K (= 13952 at K = 3)
-//     add/sub 3521 + 743 K, mul 4993 + 946 K, div 36, neg 160 + 46 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16777 + 650 K (= 18727 at K = 3)
-//     add/sub 6655 + 285 K, mul 9703 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
+//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
+//   prox_pv: 16697 + 650 K (= 18647 at K = 3)
+//     add/sub 6625 + 285 K, mul 9653 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 //
 // The C interface of the solver in humanoid.hpp (docs/design.md, "The C
 // interface"), for C firmware and other languages: plain arrays, a work buffer

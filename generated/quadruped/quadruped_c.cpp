@@ -5,10 +5,10 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4538 + 1216 K (= 8186 at K = 3)
-//     add/sub 1916 + 543 K, mul 2523 + 647 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8553 + 475 K (= 9978 at K = 3)
-//     add/sub 3518 + 204 K, mul 4858 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
+//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8537 + 475 K (= 9962 at K = 3)
+//     add/sub 3510 + 204 K, mul 4850 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 
 // The C interface of quadruped.hpp, declared in quadruped_c.h: each function
 // copies its scalar arguments into a Settings, makes the caller's buffer the

@@ -81,12 +81,25 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   if (p.parent == 0) return;
   // Ia = IA - U D^-1 U^T (its row and column along an axis-aligned S vanish:
   // Ia S = 0) ; pa = pA + Ia c + U D^-1 u.
+  // Along an axis-aligned S (S = s e_k, s = +-1): U_k = s D, so (U D^-1)_k = s,
+  // exactly; nothing is computed for it (its products were IA_kk / IA_kk).
+  const int along = axisComponent(p);
   V6 UD;
-  for (int r = 0; r < 6; ++r) UD[std::size_t(r)] = cb.flat(cb.mul(b.U[0][std::size_t(r)], b.Dinv), "UD");
+  for (int r = 0; r < 6; ++r)
+    UD[std::size_t(r)] = r == along ? Expr(p.axisSign) : cb.flat(cb.mul(b.U[0][std::size_t(r)], b.Dinv), "UD");
+  // U_r D^-1 U_c with the product that is already a temporary: a constant U_r
+  // makes (U D^-1)_r = U_r * D^-1 a scaled atom, and U_r * (U D^-1)_c reuses
+  // the temporary of column c (one multiplication instead of two).
+  auto udu = [&](int r, int col) {
+    const Expr& Ur = b.U[0][std::size_t(r)];
+    const Expr& Uc = b.U[0][std::size_t(col)];
+    if (Ur.isConstant() && !Uc.isConstant()) return cb.mul(Ur, UD[std::size_t(col)]);
+    return cb.mul(UD[std::size_t(r)], Uc);
+  };
   Sym Ia(6);
   for (int r = 0; r < 6; ++r)
-    for (int col = r; col < 6; ++col) Ia(r, col) = IA(r, col) - cb.mul(UD[std::size_t(r)], b.U[0][std::size_t(col)]);
-  if (const int along = axisComponent(p); along >= 0)
+    for (int col = r; col < 6; ++col) Ia(r, col) = IA(r, col) - udu(r, col);
+  if (along >= 0)
     for (int k = 0; k < 6; ++k) Ia(along, k) = Expr();
   flatten(cb, Ia, "Ia");
   if (!bias) {  // the articulated inertia only (the Delassus functions)
@@ -95,6 +108,12 @@ void eliminateOneDof(Emit& e, const Kinematics& kin, int i, const std::vector<st
   }
   V6 pa;
   for (int r = 0; r < 6; ++r) {
+    if (r == along) {
+      // S^T pa = S^T pA + u = tau (Ia S = 0): pa_k = s tau, exactly, where
+      // pA_k + s (tau - s pA_k) would cancel in floating point.
+      pa[std::size_t(r)] = p.axisSign * cb.input(tauIn(p.idx_v));
+      continue;
+    }
     Expr x = pA[std::size_t(r)] + cb.mul(UD[std::size_t(r)], b.u[0]);
     for (int k = 0; k < 6; ++k) x += cb.mul(Ia(r, k), kb.c[std::size_t(k)]);
     pa[std::size_t(r)] = x;

@@ -86,6 +86,9 @@ void reducedSweep(Emit& e, const Kinematics& kin, const Multipliers& mult, Artic
         const Expr x = cb.flat(cb.mul(b.Dinv, du), "x");
         V6 t;
         for (int r = 0; r < 6; ++r) t[std::size_t(r)] = dp[std::size_t(r)] + cb.mul(b.U[0][std::size_t(r)], x);
+        // S^T t = S^T dp + D D^-1 du = 0: along an axis-aligned S the component is
+        // exactly 0 (the products cancelled only to round-off), and so are its moves.
+        if (const int along = axisComponent(p); along >= 0) t[std::size_t(along)] = Expr();
         const V6 f = e.forceToParent(kb, t);
         V6& par = inc.dp[std::size_t(p.parent)];
         for (int r = 0; r < 6; ++r)

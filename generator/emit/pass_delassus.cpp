@@ -115,6 +115,8 @@ V6 throughJoint(Emit& e, const Kinematics& kin, const Articulated& art, int ch, 
   const Expr ks = cb.flat(dot(cb, kb.S[0], x), "ks");
   V6 f;
   for (int r = 0; r < 6; ++r) f[std::size_t(r)] = x[std::size_t(r)] - cb.mul(cb.mul(ab.U[0][std::size_t(r)], ab.Dinv), ks);
+  // S^T f = 0: along an axis-aligned S the component is exactly 0.
+  if (const int along = axisComponent(e.bp(ch)); along >= 0) f[std::size_t(along)] = Expr();
   return e.forceToParent(kb, f);
 }
 

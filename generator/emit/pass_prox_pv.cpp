@@ -88,8 +88,12 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
     out.ksdStored = !plain(ksd);
     out.ksd = out.ksdStored ? cb.store(at(kKSD), ksd) : ksd;
     if (!passes) return out;
+    // U (D^-1 KS) when D^-1 KS is stored: one product per entry, where
+    // (U D^-1) KS costs two for an entry of U that is a constant.
     V6 col;
-    for (int r = 0; r < 6; ++r) col[std::size_t(r)] = ka[std::size_t(r)] - cb.mul(UD[std::size_t(r)], out.ks);
+    for (int r = 0; r < 6; ++r)
+      col[std::size_t(r)] = ka[std::size_t(r)] - (out.ksdStored ? cb.mul(ab.U[0][std::size_t(r)], out.ksd)
+                                                                : cb.mul(UD[std::size_t(r)], out.ks));
     if (along >= 0) col[std::size_t(along)] = Expr();  // S^T (KA - U D^-1 KS) = 0
     out.f = e.forceToParent(kb, col);
     return out;
