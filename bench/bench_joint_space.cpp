@@ -8,7 +8,14 @@
 // then the LLT of G + I/mu and its inverse). States (and qdd, lambda) are
 // drawn before any timing and cycled inside the timed loop, as
 // bench_suite.cpp does. The cases are those of joint_space.cmake
-// (PROXGEN_BENCH_LIBRARY_CASES).
+// (PROXGEN_BENCH_LIBRARY_CASES). Where CMake finds Pinocchio (bench/pinocchio.cmake),
+// also <case>/<function>/pinocchio for inverse_dynamics (rnea, no constraint
+// forces: the generated function does J^T lambda besides), nonlinear_effects,
+// mass_matrix (crba, its upper triangle copied to the lower one, as the
+// generated function returns the full matrix) and mass_matrix_inverse
+// (computeMinverse, the same copy), and <case>/<function>/pinocchio_upper for
+// the last two without the copy (crba in Pinocchio 3.7's default LOCAL
+// convention; bench_pinocchio.cpp, pinocchioJointSpace), on the same states and qdd.
 //
 //   proxgen_bench_joint_space [Google Benchmark flags]
 //   proxgen_bench_joint_space --count CASE/FUNCTION/VARIANT N
@@ -38,6 +45,15 @@
 #include "cases/cases.hpp"
 #include "joint_space_solvers.hpp"
 #include "model/state.hpp"
+
+#ifdef PROXGEN_BENCH_PINOCCHIO
+namespace proxgen::bench {
+// bench_pinocchio.cpp: one call of Pinocchio's `function` on state k (checked against the generic twin first).
+std::function<void(int)> pinocchioJointSpace(const std::string& caseName, const System& sys,
+                                             const std::vector<State>& states, const std::vector<VecX>& qdd,
+                                             const std::string& function);
+}  // namespace proxgen::bench
+#endif
 
 namespace {
 
@@ -215,6 +231,14 @@ void registerCase(const char* name) {
     (*route)(q(k), *ws);
     benchmark::DoNotOptimize(route->Ginv.data());
   });
+#ifdef PROXGEN_BENCH_PINOCCHIO
+  // The same states and qdd (in double: the inputs the generic twins read).
+  for (const char* fn : {"inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"})
+    reg(std::string(fn) + "/pinocchio", proxgen::bench::pinocchioJointSpace(c.name, c.sys, c.states, in->qdd64, fn));
+  for (const char* fn : {"mass_matrix", "mass_matrix_inverse"})
+    reg(std::string(fn) + "/pinocchio_upper",
+        proxgen::bench::pinocchioJointSpace(c.name, c.sys, c.states, in->qdd64, std::string(fn) + "_upper"));
+#endif
 }
 
 void timed(benchmark::State& st, const Body* b) {

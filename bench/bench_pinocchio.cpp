@@ -9,6 +9,13 @@
 // are Pinocchio's (docs/design.md, "Conventions"), which the constructor checks
 // joint by joint and with Pinocchio's ABA against proxgen's on the case's states.
 //
+// pinocchioJointSpace: Pinocchio's rnea, nonLinearEffects, crba and
+// computeMinverse on bench_joint_space.cpp's states, as the "pinocchio" variants
+// beside the generated joint-space functions (docs/benchmarks.md, "The dynamics
+// library"). crba and computeMinverse fill only the upper triangle; the
+// "pinocchio" variant also copies it to the lower one (what the generated
+// functions return: the full matrix), "pinocchio_upper" is the call alone.
+//
 // Settings: mu = 1/kMu (Pinocchio's mu is the inverse of proxgen's), max_iter = K =
 // kIterations and accuracy 0, so no call stops before its K-th iteration.
 // Pinocchio 3.7 marks the constraint models, pv, constrainedABA and initPvSolver
@@ -17,19 +24,25 @@
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/contact-info.hpp>
+#include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/proximal.hpp>
 #include <pinocchio/algorithm/pv.hpp>
+#include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody/data.hpp>
 #include <pinocchio/multibody/model.hpp>
 #include <pinocchio/parsers/urdf.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "algorithms/aba.hpp"
+#include "algorithms/crba.hpp"
 #include "algorithms/data.hpp"
+#include "algorithms/mass_matrix_inverse.hpp"
+#include "algorithms/rnea.hpp"
 #include "common.hpp"
 #include "model/error.hpp"
 
@@ -47,25 +60,29 @@ pinocchio::SE3 toPinocchio(const SE3& x) { return pinocchio::SE3(x.R, x.p); }
 
 enum class Algorithm { Caba, Pv };
 
+// The case's URDF through Pinocchio's parser, checked joint by joint against proxgen's slots.
+void buildPinocchioModel(const std::string& caseName, const Model& pm, pinocchio::Model& model) {
+  if (pm.floatingBase)
+    pinocchio::urdf::buildModel(pm.sourcePath, pinocchio::JointModelFreeFlyer(), model);
+  else
+    pinocchio::urdf::buildModel(pm.sourcePath, model);
+  if (model.nq != pm.nq || model.nv != pm.nv) pinocchioError(caseName, "Pinocchio's nq, nv differ from proxgen's");
+  // The same joints in the same slots (joint 0 is Pinocchio's universe).
+  for (std::size_t i = 1; i < pm.bodies.size(); ++i) {
+    const Joint& j = pm.bodies[i].joint;
+    if (!model.existJointName(j.name)) pinocchioError(caseName, "joint " + j.name + " is not in Pinocchio's model");
+    const pinocchio::JointIndex id = model.getJointId(j.name);
+    if (model.idx_qs[id] != j.idx_q || model.idx_vs[id] != j.idx_v || model.nqs[id] != j.nq ||
+        model.nvs[id] != j.nv)
+      pinocchioError(caseName, "joint " + j.name + " has other slots in Pinocchio's model");
+  }
+}
+
 class PinocchioSolver final : public Solver {
  public:
   PinocchioSolver(const BenchCase& c, Algorithm algorithm)
       : states_(c.states), algorithm_(algorithm), settings_(0.0, 1.0 / kMu, kIterations) {
-    const Model& pm = c.sys.model;
-    if (pm.floatingBase)
-      pinocchio::urdf::buildModel(pm.sourcePath, pinocchio::JointModelFreeFlyer(), model_);
-    else
-      pinocchio::urdf::buildModel(pm.sourcePath, model_);
-    if (model_.nq != pm.nq || model_.nv != pm.nv) pinocchioError(c.name, "Pinocchio's nq, nv differ from proxgen's");
-    // The same joints in the same slots (joint 0 is Pinocchio's universe).
-    for (std::size_t i = 1; i < pm.bodies.size(); ++i) {
-      const Joint& j = pm.bodies[i].joint;
-      if (!model_.existJointName(j.name)) pinocchioError(c.name, "joint " + j.name + " is not in Pinocchio's model");
-      const pinocchio::JointIndex id = model_.getJointId(j.name);
-      if (model_.idx_qs[id] != j.idx_q || model_.idx_vs[id] != j.idx_v || model_.nqs[id] != j.nq ||
-          model_.nvs[id] != j.nv)
-        pinocchioError(c.name, "joint " + j.name + " has other slots in Pinocchio's model");
-    }
+    buildPinocchioModel(c.name, c.sys.model, model_);
     for (const Constraint& k : c.sys.constraints) {
       if (k.kp != 0 || k.kd != 0)
         pinocchioError(c.name, "constraint " + k.name + " has Baumgarte gains (Pinocchio's pv does not honour kp)");
@@ -123,6 +140,108 @@ std::unique_ptr<Solver> makePinocchioCaba(const BenchCase& c) {
 }
 std::unique_ptr<Solver> makePinocchioPv(const BenchCase& c) {
   return std::make_unique<PinocchioSolver>(c, Algorithm::Pv);
+}
+
+namespace {
+
+// One case's Pinocchio model and data for the joint-space functions.
+struct JointSpaceModel {
+  pinocchio::Model model;
+  std::unique_ptr<pinocchio::Data> data;
+};
+
+// The largest |a - b| / max(1, |b|) over the first states, between Pinocchio's
+// function and proxgen's generic one (both in double on the same inputs).
+template <class Theirs, class Mine>
+double gapOver(const std::vector<State>& states, Theirs theirs, Mine mine) {
+  double gap = 0;
+  for (std::size_t k = 0; k < std::min<std::size_t>(20, states.size()); ++k) {
+    const MatX a = theirs(k), b = mine(k);
+    gap = std::max(gap, (a - b).lpNorm<Eigen::Infinity>() / std::max(1.0, b.lpNorm<Eigen::Infinity>()));
+  }
+  return gap;
+}
+
+// The lower triangle from the upper one (Pinocchio's idiom, no aliasing: each side reads only the other).
+template <class M>
+void symmetrize(M& upper) {
+  upper.template triangularView<Eigen::StrictlyLower>() =
+      upper.transpose().template triangularView<Eigen::StrictlyLower>();
+}
+
+}  // namespace
+
+std::function<void(int)> pinocchioJointSpace(const std::string& caseName, const System& sys,
+                                             const std::vector<State>& states, const std::vector<VecX>& qdd,
+                                             const std::string& function) {
+  const auto js = std::make_shared<JointSpaceModel>();
+  buildPinocchioModel(caseName, sys.model, js->model);
+  js->data = std::make_unique<pinocchio::Data>(js->model);
+  pinocchio::Model& model = js->model;
+  pinocchio::Data& data = *js->data;
+  Data gd(sys);
+  // Same function on the same inputs before any timing: Pinocchio's against the
+  // generic twin, to round-off: 1e-9 relative to max(1, |ours|), as the suite's ABA
+  // check (both are the same recursions in double on the same numbers; the
+  // constructor throws if a case misses it, and none of the shared cases does).
+  double gap = 0;
+  std::function<void(int)> call;
+  if (function == "inverse_dynamics") {
+    gap = gapOver(
+        states, [&](std::size_t k) -> MatX { return pinocchio::rnea(model, data, states[k].q, states[k].v, qdd[k]); },
+        [&](std::size_t k) -> MatX { return rnea(sys, gd, states[k].q, states[k].v, qdd[k]); });
+    call = [js, &states, &qdd](int k) {
+      const State& s = states[std::size_t(k)];
+      pinocchio::rnea(js->model, *js->data, s.q, s.v, qdd[std::size_t(k)]);
+    };
+  } else if (function == "nonlinear_effects") {
+    gap = gapOver(
+        states,
+        [&](std::size_t k) -> MatX { return pinocchio::nonLinearEffects(model, data, states[k].q, states[k].v); },
+        [&](std::size_t k) -> MatX { return nonLinearEffects(sys, gd, states[k].q, states[k].v); });
+    call = [js, &states](int k) {
+      const State& s = states[std::size_t(k)];
+      pinocchio::nonLinearEffects(js->model, *js->data, s.q, s.v);
+    };
+  } else if (function == "mass_matrix" || function == "mass_matrix_upper") {
+    gap = gapOver(
+        states,
+        [&](std::size_t k) -> MatX {
+          MatX M = pinocchio::crba(model, data, states[k].q);
+          symmetrize(M);
+          return M;
+        },
+        [&](std::size_t k) -> MatX { return crba(sys, gd, states[k].q); });
+    if (function == "mass_matrix")
+      call = [js, &states](int k) {
+        pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q);
+        symmetrize(js->data->M);
+      };
+    else
+      call = [js, &states](int k) { pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q); };
+  } else if (function == "mass_matrix_inverse" || function == "mass_matrix_inverse_upper") {
+    gap = gapOver(
+        states,
+        [&](std::size_t k) -> MatX {
+          MatX Minv = pinocchio::computeMinverse(model, data, states[k].q);
+          symmetrize(Minv);
+          return Minv;
+        },
+        [&](std::size_t k) -> MatX { return massMatrixInverse(sys, gd, states[k].q); });
+    if (function == "mass_matrix_inverse")
+      call = [js, &states](int k) {
+        pinocchio::computeMinverse(js->model, *js->data, states[std::size_t(k)].q);
+        symmetrize(js->data->Minv);
+      };
+    else
+      call = [js, &states](int k) { pinocchio::computeMinverse(js->model, *js->data, states[std::size_t(k)].q); };
+  } else {
+    pinocchioError(caseName, "no joint-space function " + function);
+  }
+  if (!(gap <= 1e-9))
+    pinocchioError(caseName, function + ": Pinocchio differs from proxgen's generic twin by " + std::to_string(gap) +
+                                 " (relative)");
+  return call;
 }
 
 }  // namespace proxgen::bench

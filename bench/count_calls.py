@@ -11,7 +11,8 @@ runs, so only the calls remain. Deterministic (same states, same code).
 
 --library counts the dynamics library's benchmarks instead (proxgen_bench_joint_space
 --count CASE/FUNCTION/VARIANT N, bench_joint_space.cpp): each generated function, its
-generic twin and the route to delassus_inverse through the generated mass_matrix.
+generic twin, the route to delassus_inverse through the generated mass_matrix, and
+Pinocchio's rnea, nonLinearEffects, crba and computeMinverse where the build has them.
 """
 import argparse
 import json
@@ -25,7 +26,10 @@ ALGORITHMS = ["aba", "caba", "pv", "ltl", "ltls", "gen_caba", "gen_pv"]
 LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse",
                                         "constraint_placements", "constraint_jacobian", "constraint_drift",
                                         "delassus", "delassus_inverse"]
-           for variant in ("generated", "generic")] + ["delassus_inverse/route_mass_matrix"]
+           for variant in ("generated", "generic")] + ["delassus_inverse/route_mass_matrix"] + [
+    # Pinocchio's, where the build found it (bench_pinocchio.cpp, pinocchioJointSpace); exit 3 otherwise.
+    f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
+    "mass_matrix/pinocchio_upper", "mass_matrix_inverse/pinocchio_upper"]
 NOT_BUILT = 3  # proxgen_bench_calls' (and --count's) exit code for what this build lacks
 
 

@@ -31,22 +31,25 @@ GENERIC = {"inverse_dynamics": "inverseDynamics (RNEA + J^T lambda)", "nonlinear
            "constraint_placements": "constraintPlacements", "constraint_jacobian": "constraintJacobianRows",
            "constraint_drift": "constraintDrift", "delassus": "delassus", "delassus_inverse": "delassusInverse"}
 
-# Pinocchio 3.7 on this machine kind (AMD EPYC, 2 vCPUs), 2026-12-01, g++ -O3: median µs per
-# call over 200 random states x 30 repetitions. rnea, crba (WORLD), computeMinverse and
-# computeDampedDelassusMatrixInverse at mu = 1e4 (Pinocchio's 1e-4). Not measured in this run.
-PINOCCHIO = {
-    # case: (rnea, crba, Minv, damped Delassus inverse)
-    "iiwa_h3": (0.70, 0.55, 1.04, 1.25),
-    "iiwa_h6": (0.70, 0.55, 1.02, 1.48),
-    "solo_f3x2": (1.35, 1.15, 2.60, 2.98),
-    "solo_f3x4": (1.33, 1.15, 2.59, 3.82),
-    "talos_f6x2": (4.65, 3.87, 10.2, 7.85),
-    "talos_f6x2_h6x2": (4.60, 3.85, 10.3, 9.53),
-    "atlas_shadow_f6x2": (8.34, 7.18, 23.0, 12.7),
-    "atlas_shadow_f6x2_t3x5": (8.32, 7.22, 23.1, 17.2),
-    "atlas_shadow_f6x2_t3x10": (8.55, 7.36, 23.6, 21.5),
+# Pinocchio's damped Delassus inverse (computeDampedDelassusMatrixInverse at mu = 1e4, Pinocchio's
+# 1e-4), measured on this machine kind on 2026-12-01 at -O3 (median µs per call over 200 random states
+# x 30 repetitions), NOT in the run: bench_joint_space.cpp does not time it. rnea, nonLinearEffects,
+# crba and computeMinverse are timed in the run itself (<case>/<function>/pinocchio).
+PINOCCHIO_DELASSUS_INVERSE = {
+    "iiwa_h3": 1.25, "iiwa_h6": 1.48, "solo_f3x2": 2.98, "solo_f3x4": 3.82, "talos_f6x2": 7.85,
+    "talos_f6x2_h6x2": 9.53, "atlas_shadow_f6x2": 12.7, "atlas_shadow_f6x2_t3x5": 17.2,
+    "atlas_shadow_f6x2_t3x10": 21.5,
 }
-CASE_ORDER = list(PINOCCHIO)
+CASE_ORDER = list(PINOCCHIO_DELASSUS_INVERSE)
+# (generated function, Pinocchio variant, Pinocchio's name) of the same-run table.
+PINOCCHIO_PAIRS = [
+    ("inverse_dynamics", "pinocchio", "rnea"),
+    ("nonlinear_effects", "pinocchio", "nonLinearEffects"),
+    ("mass_matrix", "pinocchio", "crba + lower copy"),
+    ("mass_matrix", "pinocchio_upper", "crba alone"),
+    ("mass_matrix_inverse", "pinocchio", "computeMinverse + lower copy"),
+    ("mass_matrix_inverse", "pinocchio_upper", "computeMinverse alone"),
+]
 TARGET = 1.0 / 3.0  # issue 14: generated inverse_dynamics and mass_matrix at most a third of rnea and crba
 
 
@@ -78,21 +81,32 @@ def timing_tables(t, calls, cases):
     return out
 
 
-def target_table(t, cases):
-    out = ["| case | inverse_dynamics µs | Pinocchio rnea µs | ratio | ≤ 1/3? | mass_matrix µs | Pinocchio crba µs | "
-           "ratio | ≤ 1/3? | mass_matrix_inverse µs | Pinocchio Minv µs | ratio | delassus_inverse µs | "
-           "Pinocchio damped Delassus inverse µs | ratio |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+def target_table(t, calls, cases):
+    """Generated against Pinocchio, same run: one row per (case, function, Pinocchio variant)."""
+    out = ["| case | generated function | Pinocchio | generated µs | Pinocchio µs | time ratio | ≤ 1/3? | "
+           "generated Ir | Pinocchio Ir | Ir ratio |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
     for c in cases:
-        if c not in PINOCCHIO:
-            continue
-        rnea, crba, minv, dinv = PINOCCHIO[c]
-        idt, mmt = t.get(f"{c}/inverse_dynamics/generated"), t.get(f"{c}/mass_matrix/generated")
-        mit, dit = t.get(f"{c}/mass_matrix_inverse/generated"), t.get(f"{c}/delassus_inverse/generated")
-        met = lambda x, p: "—" if x is None else ("yes" if x / p <= TARGET else "no")
-        out.append(f"| {c} | {fmt_us(idt)} | {rnea} | {fmt_ratio(idt, rnea)} | {met(idt, rnea)} | {fmt_us(mmt)} | "
-                   f"{crba} | {fmt_ratio(mmt, crba)} | {met(mmt, crba)} | {fmt_us(mit)} | {minv} | "
-                   f"{fmt_ratio(mit, minv)} | {fmt_us(dit)} | {dinv} | {fmt_ratio(dit, dinv)} |")
+        for fn, variant, pin_name in PINOCCHIO_PAIRS:
+            g, p = t.get(f"{c}/{fn}/generated"), t.get(f"{c}/{fn}/{variant}")
+            if p is None:
+                continue
+            gi, pi = calls.get((c, f"{fn}/generated")), calls.get((c, f"{fn}/{variant}"))
+            met = "—" if g is None else ("yes" if g / p <= TARGET else "no")
+            out.append(f"| {c} | `{fn}` | `{pin_name}` | {fmt_us(g)} | {fmt_us(p)} | {fmt_ratio(g, p)} | {met} | "
+                       f"{fmt_ir(gi)} | {fmt_ir(pi)} | {fmt_ratio(gi, pi)} |")
+    return out
+
+
+def delassus_anchor_table(t, cases):
+    if not any(t.get(f"{c}/delassus_inverse/generated") is not None for c in cases):
+        return []  # a run without delassus_inverse (--benchmark_filter): nothing to set beside the figures
+    out = ["| case | delassus_inverse µs (this run) | Pinocchio damped Delassus inverse µs (2026-12-01, not this run) | "
+           "ratio |", "|---|---|---|---|"]
+    for c in cases:
+        d, p = t.get(f"{c}/delassus_inverse/generated"), PINOCCHIO_DELASSUS_INVERSE.get(c)
+        if p is not None:
+            out.append(f"| {c} | {fmt_us(d)} | {p} | {fmt_ratio(d, p)} |")
     return out
 
 
@@ -149,6 +163,35 @@ def scaling_tables(s):
     return out
 
 
+def pinocchio_subsection(t, calls, cases, run=None):
+    """The same-run comparison with Pinocchio; `run`: lines saying which run, when it is not the section's."""
+    s = []
+    s.append("### Against Pinocchio 3.7 in the same run (issue 14's target)")
+    s.append("")
+    s.append("Pinocchio 3.7 (an install outside the repository, found by CMake: bench/pinocchio.cmake) in the same "
+             "process on the same states and qdd (bench_pinocchio.cpp, `pinocchioJointSpace`, interleaved with the "
+             "generated functions by the random interleaving), each checked against the generic twin before any "
+             "timing. `rnea` has no constraint forces; the generated `inverse_dynamics` adds `J^T lambda` for the "
+             "case's constraints (more work, not less). `crba` and `computeMinverse` fill the upper triangle only: "
+             "\"+ lower copy\" copies it to the lower one (the full matrix, what the generated functions return: "
+             "the fair comparison), \"alone\" is Pinocchio's call by itself. `crba` runs in Pinocchio 3.7's default "
+             "LOCAL convention (the anchor figures of 2026-12-01 used WORLD). The target: generated "
+             "`inverse_dynamics` and `mass_matrix` at most a third of `rnea` and `crba`. Ratio = generated / "
+             "Pinocchio; Ir from callgrind on the same build.")
+    s.append("")
+    s.extend(run or [])
+    s.extend(target_table(t, calls, cases))
+    s.append("")
+    anchor = delassus_anchor_table(t, cases)
+    if anchor:
+        s.append("`delassus_inverse` against Pinocchio's damped Delassus inverse, which this run does not time (the "
+                 "figures measured on 2026-12-01 on this machine kind):")
+        s.append("")
+        s.extend(anchor)
+        s.append("")
+    return s
+
+
 SIZES = {}
 
 
@@ -161,6 +204,9 @@ def main():
     ap.add_argument("--results", required=True)
     ap.add_argument("--command", required=True, help="the commands that produced the inputs, for the text")
     ap.add_argument("--load", default="", help="load average at the start of the timed run")
+    ap.add_argument("--pinocchio-only", action="store_true",
+                    help="replace only the subsection against Pinocchio (from its heading to the next ###) in the "
+                         "existing section, with this run's context and commands")
     args = ap.parse_args()
 
     t_all, context = medians(args.timings)
@@ -176,6 +222,29 @@ def main():
     version, config = compiler(args.build)
     flags = " ".join(["-O3 -DNDEBUG"] + ([f"-march={config['march']}"] if config["march"] else []))
     date = context.get("date", datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"))
+
+    if args.pinocchio_only:
+        run = [f"From its own run ({date}, host {platform.node() or '?'}, {context.get('num_cpus', '?')} CPUs"
+               f"{', load average ' + args.load + ' at the start' if args.load else ''}; the machine shared with "
+               f"other work), compiled with `{flags}` (the generated sources also with "
+               f"`{' '.join(config['solver_options'])}`), {version}, the x86-64 baseline. Commands:", "", "```sh",
+               *args.command.split(" ;; "), "```", "",
+               "Ir: a \"—\" where the case was not counted. `mass_matrix` and `mass_matrix_inverse` are the same "
+               "code for every layout of a robot (they do not read the constraints), so one case per robot gives "
+               "their instructions. The time ratio at the target is the one of this run's load; the Ir ratio is "
+               "deterministic. Below, mass_matrix_inverse's \"<= 1/3?\" is only for reading: the issue sets no "
+               "target for it.", ""]
+        sub = "\n".join(pinocchio_subsection(t, calls, cases, run)).rstrip() + "\n\n"
+        text = open(args.results).read()
+        start = text.find("### Against Pinocchio 3.7")
+        if start < 0 or text.find(HEADING) < 0:
+            sys.exit(f"library_report: no subsection against Pinocchio in {args.results} to replace")
+        nxt = re.search(r"^##+ ", text[start + 4:], re.M)
+        end = start + 4 + nxt.start() if nxt else len(text)
+        with open(args.results, "w") as f:
+            f.write(text[:start] + sub + text[end:])
+        print(f"library_report: replaced the subsection against Pinocchio in {args.results}")
+        return
 
     s = [HEADING, ""]
     s.append(f"Written by `bench/library_report.py` from one run ({date}, host {platform.node() or '?'}, "
@@ -198,15 +267,7 @@ def main():
              "same states for both sides). Ir: instructions per call under callgrind, "
              "(run with N calls - run with none) / N, deterministic.")
     s.append("")
-    s.append("### Against Pinocchio 3.7 (issue 14's target)")
-    s.append("")
-    s.append("Pinocchio 3.7, measured on this machine on 2026-12-01 at -O3, not in this run (median µs per call, "
-             "200 random states x 30 repetitions; `rnea`, `crba`, `computeMinverse`, "
-             "`computeDampedDelassusMatrixInverse` at mu = 1e4). The target: generated `inverse_dynamics` and "
-             "`mass_matrix` at most a third of `rnea` and `crba`. Ratio = generated / Pinocchio.")
-    s.append("")
-    s.extend(target_table(t, cases))
-    s.append("")
+    s.extend(pinocchio_subsection(t, calls, cases))
     s.append("### `delassus_inverse` against the route through `mass_matrix`")
     s.append("")
     s.append("The route: the generated `mass_matrix` and `constraint_jacobian`, Eigen's fixed-size LLT of M, "
