@@ -162,6 +162,31 @@ const EntryPoint kEntryPoints[] = {
      "// values (a solver's output), none of them inside w.\n",
      "void constraint_wrenches(const Scalar* q, const Scalar* lambda, Workspace& w, Scalar* W) noexcept",
      "// The wrenches: the support bodies' world rotations root first, -R_C lambda at each constraint.\n"},
+    {Function::InverseDynamicsDerivatives,
+     "\n// The derivatives of the dynamics (docs/derivatives.md). Every matrix is dense and\n"
+     "// row-major: row = output component, column = input component (M[r * cols + c]).\n"
+     "// Tangent convention of every d/dq: column k is the derivative along q (+) t e_k,\n"
+     "// t -> 0, where q (+) dq is q + dq for revolute, continuous and prismatic joints,\n"
+     "// and for a free flyer the placement M(q) Exp(dq), dq = [linear; angular] in the\n"
+     "// base frame (the right perturbation of Pinocchio's integrate); likewise\n"
+     "// M(q) Exp([dx dy 0 0 0 dyaw]) in the joint frame for a planar joint. So d/dq has\n"
+     "// nv columns, like d/dv.\n"
+     "// inverse_dynamics_derivatives: dtau_dq, dtau_dv (nv x nv each) of\n"
+     "// tau = M(q) qdd + h(q, v) + J(q)^T lambda (as inverse_dynamics) at fixed qdd and\n"
+     "// lambda; lambda may be nullptr (no constraint forces). Every constraint counts\n"
+     "// as active. None of the arrays may be inside w.\n",
+     "void inverse_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* qdd, const Scalar* lambda,\n"
+     "                                  Workspace& w, Scalar* dtau_dq, Scalar* dtau_dv) noexcept",
+     "// The tangent sweep of RNEA along every q and v direction, the path's columns only.\n"},
+    {Function::ForwardDynamicsDerivatives,
+     "\n// forward_dynamics_derivatives (no constraint forces: the free motion):\n"
+     "// qdd = M^-1 (tau - h) (ABA's answer, to round-off), and at (q, v, qdd)\n"
+     "// dqdd_dq = -M^-1 dtau_dq, dqdd_dv = -M^-1 dtau_dv, dqdd_dtau = M^-1 (nv x nv each).\n"
+     "// It calls nonlinear_effects, mass_matrix_inverse and inverse_dynamics_derivatives\n"
+     "// (held with it). None of the arrays may be inside w.\n",
+     "void forward_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, Workspace& w, Scalar* qdd,\n"
+     "                                  Scalar* dqdd_dq, Scalar* dqdd_dv, Scalar* dqdd_dtau) noexcept",
+     "// M^-1 by ABA on the unit torques, qdd = M^-1 (tau - h), the tangent sweep at qdd, two dense products.\n"},
 };
 
 // The declaration's signature: the schedule argument defaults to every
@@ -186,6 +211,18 @@ std::string helpers(const SolverTexts& texts) {
         "// The joint transforms alone, for the functions without a velocity.\n"
         "void joint_transforms(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
         texts.jointTransforms);
+  if (texts.functions.has(Function::ForwardDynamicsDerivatives))
+    out += "// C = s A B, A n x m, B m x p, C n x p, all row-major (the derivatives' dense\n"
+           "// products: fixed bounds, no branch on the data; C may not overlap A or B).\n"
+           "template <int n, int m, int p>\n"
+           "void dense_product(const Scalar* A, const Scalar* B, Scalar s, Scalar* C) noexcept {\n"
+           "  for (int r = 0; r < n; ++r)\n"
+           "    for (int c = 0; c < p; ++c) {\n"
+           "      Scalar sum = 0;\n"
+           "      for (int k = 0; k < m; ++k) sum += A[r * m + k] * B[k * p + c];\n"
+           "      C[r * p + c] = s * sum;\n"
+           "    }\n"
+           "}\n\n";
   if (!texts.constraintJoints.empty())
     out += fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
                        "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",

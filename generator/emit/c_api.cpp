@@ -83,6 +83,18 @@ const CEntry kCEntries[] = {
      "   ON THE ROBOT in world axes, force then torque about the constraint\n"
      "   frame's origin: -R [lambda_lin; lambda_ang] (a 3d point: [-R lambda; 0]),\n"
      "   the solvers' sign; the robot pushes its contact with minus these. */\n"},
+    {Function::InverseDynamicsDerivatives,
+     "const {S}* q, const {S}* v, const {S}* qdd, const {S}* lambda, void* work, {S}* dtau_dq, {S}* dtau_dv",
+     "inverse_dynamics_derivatives(q, v, qdd, lambda, w, dtau_dq, dtau_dv)", SettingsFrom::None,
+     "/* dtau_dq[NV * NV], dtau_dv[NV * NV], row-major, of tau = M qdd + h + J^T lambda at\n"
+     "   fixed qdd, lambda (NULL: none); column k of d/dq is along q (+) t e_k (the\n"
+     "   header's tangent convention). */\n"},
+    {Function::ForwardDynamicsDerivatives,
+     "const {S}* q, const {S}* v, const {S}* tau, void* work, {S}* qdd, {S}* dqdd_dq, {S}* dqdd_dv,\n"
+     "    {S}* dqdd_dtau",
+     "forward_dynamics_derivatives(q, v, tau, w, qdd, dqdd_dq, dqdd_dv, dqdd_dtau)", SettingsFrom::None,
+     "/* qdd[NV] of the unconstrained dynamics and dqdd_dq, dqdd_dv, dqdd_dtau\n"
+     "   (NV * NV each, row-major). */\n"},
 };
 
 // Every C name a prefix makes that does not depend on the function list.

@@ -41,11 +41,15 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;
-  const FunctionSet& want = sys.functions;
+  // A derivative function calls the functions it is made of: the file holds them too.
+  FunctionSet want = sys.functions;
+  if (want.has(Function::ForwardDynamicsDerivatives))
+    for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
+      want.add(f);
   texts.functions = want;
   const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
   texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects) ||
-                         want.has(Function::ConstraintDrift);
+                         want.has(Function::ConstraintDrift) || want.has(Function::InverseDynamicsDerivatives);
   texts.withJointTransforms = want.has(Function::MassMatrix) || want.has(Function::MassMatrixInverse);
 
   // kinematics(q, v, w): shared by the entry points with a velocity.
@@ -89,6 +93,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     texts.library[Function::InverseDynamics] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, false);
   if (want.has(Function::NonlinearEffects))
     texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, true);
+  if (want.has(Function::InverseDynamicsDerivatives))
+    texts.library[Function::InverseDynamicsDerivatives] =
+        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics);
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);
     Kinematics transforms = emitJointTransforms(e);
@@ -101,6 +108,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     if (want.has(Function::MassMatrixInverse))
       texts.library[Function::MassMatrixInverse] = emitMassMatrixInverse(e, transforms, afterTransforms);
   }
+
+  if (want.has(Function::ForwardDynamicsDerivatives))
+    texts.library[Function::ForwardDynamicsDerivatives] = emitForwardDynamicsDerivatives(e);
 
   // The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp).
   emitConstraintFunctions(e, afterKinematicsState, afterKinematics, texts);
@@ -128,11 +138,19 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
                  {Function::ConstraintDrift, "drift", "kinematics"},
                  {Function::Delassus, "delassus", "joints"},
                  {Function::DelassusInverse, "dinv", "joints"},
-                 {Function::ConstraintWrenches, "wrenches", "joints"}};
+                 {Function::ConstraintWrenches, "wrenches", "joints"},
+                 {Function::InverseDynamicsDerivatives, "rnead", "kinematics"}};
   for (const auto& l : library) {
     OpCount ops = fn.hostOps(l.host);
     ops += fn.hostOps(l.helper);
     texts.libraryOps[l.f] = ops;
+  }
+  // The derivatives: their host (the dense products included) and the functions it calls.
+  if (want.has(Function::ForwardDynamicsDerivatives)) {
+    OpCount ops = fn.hostOps("fdd");
+    for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
+      ops += texts.libraryOps[f];
+    texts.libraryOps[Function::ForwardDynamicsDerivatives] = ops;
   }
 
   if (stats) {

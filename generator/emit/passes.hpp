@@ -133,4 +133,14 @@ std::string emitConstraintWrenches(Emit& e, const ConstraintJoints& joints);
 // delassus_inverse ((G + I/mu)^-1 by Woodbury on the penalised recursion).
 std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);
 
+// ---- pass_inverse_dynamics_derivatives.cpp: d tau / dq and d tau / dv of
+// tau = RNEA(q, v, qdd) + J^T lambda at fixed qdd, lambda (the tangent sweep of
+// docs/derivatives.md section 2), from its copy of the state after kinematics.
+std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics);
+/// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
+/// and inverse_dynamics_derivatives (held with it) and the dense products
+/// (dense_product<n, m, p>, printed by assemble.cpp). denseProductOps: their arithmetic.
+std::string emitForwardDynamicsDerivatives(Emit& e);
+Ops denseProductOps(int n, int m, int p);
+
 }  // namespace proxgen::emit

@@ -12,7 +12,8 @@ struct Named {
 };
 
 // allFunctions() order: the solvers, the joint-space quantities, the
-// constraint kinematics, the Delassus operator, the constraints' world wrenches.
+// constraint kinematics, the Delassus operator, the constraints' world wrenches,
+// the derivatives of the dynamics (docs/derivatives.md).
 constexpr Named kFunctions[] = {
     {Function::ConstrainedAba, "constrained_aba"},
     {Function::ProxPv, "prox_pv"},
@@ -26,6 +27,8 @@ constexpr Named kFunctions[] = {
     {Function::Delassus, "delassus"},
     {Function::DelassusInverse, "delassus_inverse"},
     {Function::ConstraintWrenches, "constraint_wrenches"},
+    {Function::InverseDynamicsDerivatives, "inverse_dynamics_derivatives"},
+    {Function::ForwardDynamicsDerivatives, "forward_dynamics_derivatives"},
 };
 
 }  // namespace

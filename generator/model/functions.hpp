@@ -23,6 +23,8 @@ enum class Function {
   Delassus,
   DelassusInverse,
   ConstraintWrenches,
+  InverseDynamicsDerivatives,
+  ForwardDynamicsDerivatives,
 };
 
 /// Every function, in the order the header declares them.
