@@ -56,6 +56,8 @@ std::string bindingOf(Function f, const std::string& ns) {
                          "      \"(q, active=None) -> G = J M^-1 J^T (nc, nc) or (N, nc, nc).\");\n", b, fn);
     case Function::DelassusInverse: return fmt::format("{}bindDelassusInverse<Solver>(m, kInfo, {});\n", b, fn);
     case Function::ConstraintWrenches: return fmt::format("{}bindConstraintWrenches<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::InverseDynamicsDerivatives:
+    case Function::ForwardDynamicsDerivatives: return "";  // not bound yet (docs/python.md)
   }
   return "";
 }
