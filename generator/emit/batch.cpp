@@ -108,6 +108,12 @@ const std::vector<LibraryFunction>& libraryFunctions() {
       {"delassus", {q, work, {Param::Out, "G", "nc * nc"}, active}},
       {"delassus_inverse", {q, {Param::Config, "s"}, work, {Param::Out, "Ginv", "nc * nc"}}},
       {"constraint_wrenches", {q, {Param::In, "lambda", "nc", "lambda"}, work, {Param::Out, "W", "6 * ncons"}}},
+      {"inverse_dynamics_derivatives",
+       {q, v, {Param::In, "qdd", "nv", "qdd"}, {Param::In, "lambda", "nc", "lambda", true}, work,
+        {Param::Out, "dtau_dq", "nv * nv"}, {Param::Out, "dtau_dv", "nv * nv"}}},
+      {"forward_dynamics_derivatives",
+       {q, v, {Param::In, "tau", "nv", "tau"}, work, {Param::Out, "qdd", "nv"}, {Param::Out, "dqdd_dq", "nv * nv"},
+        {Param::Out, "dqdd_dv", "nv * nv"}, {Param::Out, "dqdd_dtau", "nv * nv"}}},
   };
   return table;
 }
@@ -196,13 +202,29 @@ std::string libraryDeclarations(const std::vector<const LibraryFunction*>& held)
   return out;
 }
 
-// BatchWorkspace::out: as large as the largest output of the held functions
-// (at least 1: a C++ array cannot be empty), and its size's function.
+// The outputs of one function, one after another in BatchWorkspace::out: the
+// offset of each (a sum of the earlier sizes, "" for the first) and the total.
+std::vector<std::string> outOffsets(const LibraryFunction& f, std::string* total = nullptr) {
+  std::vector<std::string> offsets;
+  std::string sum;
+  for (const Param& p : f.params) {
+    if (p.kind != Param::Out) continue;
+    offsets.push_back(sum);
+    sum += (sum.empty() ? "" : " + ") + fmt::format("({})", p.size);
+  }
+  if (total) *total = sum;
+  return offsets;
+}
+
+// BatchWorkspace::out: as large as the largest sum of one held function's
+// outputs (at least 1: a C++ array cannot be empty), and its size's function.
 std::string outSizeFunction(const std::vector<const LibraryFunction*>& held) {
   std::vector<std::string> sizes;
-  for (const LibraryFunction* f : held)
-    for (const Param& p : f->params)
-      if (p.kind == Param::Out && std::find(sizes.begin(), sizes.end(), p.size) == sizes.end()) sizes.push_back(p.size);
+  for (const LibraryFunction* f : held) {
+    std::string total;
+    outOffsets(*f, &total);
+    if (std::find(sizes.begin(), sizes.end(), total) == sizes.end()) sizes.push_back(total);
+  }
   std::string out =
       "\n// The largest output of the library functions below (BatchWorkspace::out).\n"
       "constexpr int batch_out_size() noexcept {\n"
@@ -243,6 +265,8 @@ std::string libraryDefinitions(const std::vector<const LibraryFunction*>& held) 
   for (const LibraryFunction* f : held) {
     std::vector<std::string> args, call;
     std::string load, gather, store, scatter;
+    const std::vector<std::string> offsets = outOffsets(*f);
+    std::size_t outs = 0;
     for (const Param& p : f->params) {
       args.push_back(declared(p, "BatchWorkspace"));
       if (p.kind == Param::Active) args.back() = fmt::format("const bool* {}", p.name);  // (the default is the header's)
@@ -256,11 +280,15 @@ std::string libraryDefinitions(const std::vector<const LibraryFunction*>& held) 
         }
         case Param::Work: call.push_back("w.w"); break;
         case Param::Config: call.push_back(fmt::format("laneSettings({}, w)", p.name)); break;
-        case Param::Out:
-          store += fmt::format("  storeLanes(w.out, {}, {});\n", p.size, p.name);
-          scatter += fmt::format("    scatterLanes(w.out, {}, first, used, {});\n", p.size, p.name);
-          call.push_back("w.out");
+        case Param::Out: {
+          // Several outputs (the derivatives) lie one after another in w.out.
+          const std::string& offset = offsets[outs++];
+          const std::string lanes = offset.empty() ? "w.out" : fmt::format("w.out + {}", offset);
+          store += fmt::format("  storeLanes({}, {}, {});\n", lanes, p.size, p.name);
+          scatter += fmt::format("    scatterLanes({}, {}, first, used, {});\n", lanes, p.size, p.name);
+          call.push_back(lanes);
           break;
+        }
         case Param::Active: call.push_back(p.name); break;
       }
     }

@@ -396,4 +396,43 @@ TEST(BatchLibrary, ConstraintWrenches) {
 }
 #endif
 
+// The derivative functions write several outputs: each is checked in turn
+// through `out`, the others go to scratch(k), each large enough for the
+// _many calls' 2 W + 3 states of an nv x nv matrix.
+[[maybe_unused]] S* scratch(int k) {
+  static std::vector<S> buffers[3];
+  std::vector<S>& b = buffers[k];
+  if (b.empty()) b.resize(std::size_t(g::nv * g::nv * (2 * W + 4)) + 1);
+  return b.data();
+}
+
+#if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS_DERIVATIVES
+TEST(BatchLibrary, InverseDynamicsDerivatives) {
+  checkLibrary("inverse_dynamics_derivatives dtau_dq", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(inverse_dynamics_derivatives, f(q, v, qdd, lambda, w, out, scratch(0))));
+  checkLibrary("inverse_dynamics_derivatives dtau_dv", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(inverse_dynamics_derivatives, f(q, v, qdd, lambda, w, scratch(0), out)));
+  checkLibrary("inverse_dynamics_derivatives (lambda null)", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(inverse_dynamics_derivatives,
+                                     (static_cast<void>(lambda), f(q, v, qdd, nullptr, w, out, scratch(0)))));
+}
+#endif
+#if PROXGEN_SOLVER_HAS_FORWARD_DYNAMICS_DERIVATIVES
+// qdd's slot (the third input) carries tau here.
+TEST(BatchLibrary, ForwardDynamicsDerivatives) {
+  checkLibrary("forward_dynamics_derivatives qdd", g::nv,
+               PROXGEN_LIBRARY_FORMS(forward_dynamics_derivatives,
+                                     (static_cast<void>(lambda), f(q, v, qdd, w, out, scratch(0), scratch(1), scratch(2)))));
+  checkLibrary("forward_dynamics_derivatives dqdd_dq", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(forward_dynamics_derivatives,
+                                     (static_cast<void>(lambda), f(q, v, qdd, w, scratch(0), out, scratch(1), scratch(2)))));
+  checkLibrary("forward_dynamics_derivatives dqdd_dv", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(forward_dynamics_derivatives,
+                                     (static_cast<void>(lambda), f(q, v, qdd, w, scratch(0), scratch(1), out, scratch(2)))));
+  checkLibrary("forward_dynamics_derivatives dqdd_dtau", g::nv * g::nv,
+               PROXGEN_LIBRARY_FORMS(forward_dynamics_derivatives,
+                                     (static_cast<void>(lambda), f(q, v, qdd, w, scratch(0), scratch(1), scratch(2), out))));
+}
+#endif
+
 }  // namespace
