@@ -29,8 +29,7 @@ const char* jointTypeText(JointClass c) {
   }
 }
 
-// The module's binding of one library function (proxgen/python_module.hpp);
-// the derivative functions are not bound yet (docs/python.md).
+// The module's binding of one library function (proxgen/python_module.hpp).
 std::string bindingOf(Function f, const std::string& ns) {
   const std::string fn = "&" + ns + "::" + functionName(f);
   const std::string b = "  proxgen::python::";
@@ -57,7 +56,9 @@ std::string bindingOf(Function f, const std::string& ns) {
     case Function::DelassusInverse: return fmt::format("{}bindDelassusInverse<Solver>(m, kInfo, {});\n", b, fn);
     case Function::ConstraintWrenches: return fmt::format("{}bindConstraintWrenches<Solver>(m, kInfo, {});\n", b, fn);
     case Function::InverseDynamicsDerivatives:
-    case Function::ForwardDynamicsDerivatives: return "";  // not bound yet (docs/python.md)
+      return fmt::format("{}bindInverseDynamicsDerivatives<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::ForwardDynamicsDerivatives:
+      return fmt::format("{}bindForwardDynamicsDerivatives<Solver>(m, kInfo, {});\n", b, fn);
   }
   return "";
 }

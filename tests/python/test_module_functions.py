@@ -9,7 +9,8 @@ import pytest
 from conftest import C, EPS, module, random_state, rel_err, scaled_condition
 
 LIBRARY = ("inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse", "constraint_placements",
-           "constraint_jacobian", "constraint_drift", "delassus", "delassus_inverse", "constraint_wrenches")
+           "constraint_jacobian", "constraint_drift", "delassus", "delassus_inverse", "constraint_wrenches",
+           "inverse_dynamics_derivatives", "forward_dynamics_derivatives")
 
 
 @pytest.fixture
@@ -76,16 +77,66 @@ def test_many_states_are_the_single_states(m, quadruped, rng):
         "nonlinear_effects": lambda k: (Q[k], V[k]),
         "constraint_drift": lambda k: (Q[k], V[k]),
         "constraint_wrenches": lambda k: (Q[k], lam[k]),
+        "inverse_dynamics_derivatives": lambda k: (Q[k], V[k], T[k], lam[k]),
+        "forward_dynamics_derivatives": lambda k: (Q[k], V[k], T[k]),
     }
     for name in LIBRARY:
         args = calls.get(name, lambda k: (Q[k],))
         many = getattr(m, name)(*(np.array([args(k)[i] for k in range(5)]) for i in range(len(args(0)))))
         for k in range(5):
             one = getattr(m, name)(*args(k))
-            assert many.shape == (5,) + one.shape, name
-            # The same compiled function on the same inputs (the workspace reused):
-            # identical bits, or a leftover from the previous state shows.
-            assert np.array_equal(many[k], one), name
+            # The derivatives return several arrays: each is compared alike.
+            for many_part, one_part in (zip(many, one) if isinstance(one, tuple) else [(many, one)]):
+                assert many_part.shape == (5,) + one_part.shape, name
+                # The same compiled function on the same inputs (the workspace reused):
+                # identical bits, or a leftover from the previous state shows.
+                assert np.array_equal(many_part[k], one_part), name
+
+
+def test_the_derivatives_are_derivatives(m, quadruped, rng):
+    nv = quadruped.nv
+    for _ in range(3):
+        q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+        qdd, lam = m.prox_pv(q, v, tau)
+        dq, dv = m.inverse_dynamics_derivatives(q, v, qdd, lam)
+        size = np.max(np.abs(m.inverse_dynamics(q, v, qdd, lam))) + 1e2  # the torques' terms, as above
+        # tau is quadratic in v: its central difference is exact for any step, up to
+        # the round-off of the two evaluations, c nv eps size / h (times 10 for the
+        # terms of both calls and the difference).
+        h = 0.5
+        roundoff = 10 * C * nv * EPS * size / h
+        for k in range(nv):
+            e = np.zeros(nv)
+            e[k] = h
+            fd = (m.inverse_dynamics(q, v + e, qdd, lam) - m.inverse_dynamics(q, v - e, qdd, lam)) / (2 * h)
+            assert np.max(np.abs(dv[:, k] - fd)) <= roundoff, k
+        # The joint angles (velocity slot k >= 6 is configuration slot k + 1, after the
+        # quaternion; q (+) dq is q + dq there): central differences at h, whose
+        # truncation (h^2 times the third derivative over 6) is measured as
+        # |D(2h) - D(h)| / 3 (D(2h) carries four times D(h)'s); a margin of 3 on it,
+        # plus the round-off at this step.
+        def D(step, k):
+            e = np.zeros(quadruped.nq)
+            e[k + 1] = step
+            return (m.inverse_dynamics(q + e, v, qdd, lam) - m.inverse_dynamics(q - e, v, qdd, lam)) / (2 * step)
+        h = 1e-4
+        for k in range(6, nv):
+            d1, d2 = D(h, k), D(2 * h, k)
+            bound = np.max(np.abs(d2 - d1)) + 10 * C * nv * EPS * size / h
+            assert np.max(np.abs(dq[:, k] - d1)) <= bound, k
+        # The free motion: dqdd/dtau is M^-1 written by the same generated function (the
+        # same bits); qdd solves M qdd + h = tau (c nv eps kappa_s(M) |M^-1| |tau - h|);
+        # dqdd_dq = -M^-1 dtau_dq at that qdd, numpy's product of the same factors off
+        # by c nv eps times |M^-1| |dtau_dq| (the order of the sums).
+        fqdd, fdq, fdv, fdtau = m.forward_dynamics_derivatives(q, v, tau)
+        Minv = m.mass_matrix_inverse(q)
+        assert np.array_equal(fdtau, Minv)
+        M, hv = m.mass_matrix(q), m.nonlinear_effects(q, v)
+        assert rel_err(fqdd, np.linalg.solve(M, tau - hv)) <= (
+            C * nv * EPS * scaled_condition(M) * np.max(np.abs(Minv)) * max(1.0, np.max(np.abs(tau - hv))))
+        tq, tv = m.inverse_dynamics_derivatives(q, v, fqdd)
+        for got, t in ((fdq, tq), (fdv, tv)):
+            assert np.max(np.abs(got + Minv @ t)) <= C * nv * EPS * np.max(np.abs(Minv) @ np.abs(t))
 
 
 def test_an_inactive_constraint_exerts_no_force(m, quadruped, rng):

@@ -158,39 +158,57 @@ struct Inputs {
   }
 };
 
-/// A new array of shape `dims` (one state) or (batch, *dims), filled by
-/// call(k, qn, w, out_k) for each state k with its normalised configuration qn
-/// and its block out_k: every quaternion is checked first (errors are raised
-/// with the GIL held), then many states run with the GIL released, one
-/// workspace per thread.
-template <class Solver, class Call>
-py::array_t<typename Solver::Scalar> eachState(const ModuleInfo& info, const Inputs<Solver>& in,
-                                               std::initializer_list<py::ssize_t> dims, Call call) {
+/// N new arrays, output j of shape dims[j] (one state) or (batch, *dims[j]),
+/// filled by call(k, qn, w, outs_k) for each state k with its normalised
+/// configuration qn and outs_k[j] its block of output j: every quaternion is
+/// checked first (errors are raised with the GIL held), then many states run
+/// with the GIL released, one workspace per thread.
+template <class Solver, std::size_t N, class Call>
+std::array<py::array_t<typename Solver::Scalar>, N> eachStateOutputs(const ModuleInfo& info, const Inputs<Solver>& in,
+                                                                     const std::array<std::vector<py::ssize_t>, N>& dims,
+                                                                     Call call) {
   using Scalar = typename Solver::Scalar;
   constexpr int nq = Solver::nq;
-  std::vector<py::ssize_t> shape;
-  if (in.batch != 0) shape.push_back(in.batch);
-  py::ssize_t block = 1;
-  for (py::ssize_t d : dims) {
-    shape.push_back(d);
-    block *= d;
+  std::array<py::array_t<Scalar>, N> out;
+  std::array<Scalar*, N> at{};
+  std::array<py::ssize_t, N> block{};
+  for (std::size_t j = 0; j < N; ++j) {
+    std::vector<py::ssize_t> shape;
+    if (in.batch != 0) shape.push_back(in.batch);
+    block[j] = 1;
+    for (py::ssize_t d : dims[j]) {
+      shape.push_back(d);
+      block[j] *= d;
+    }
+    out[j] = py::array_t<Scalar>(shape);
+    at[j] = out[j].mutable_data();
   }
-  py::array_t<Scalar> out(shape);
-  Scalar* o = out.mutable_data();
   thread_local typename Solver::Workspace w;
   Scalar qn[nq];
   if (in.batch == 0) {
     normalisedConfiguration(in.q, nq, info.quaternionAt, 0, false, qn);
-    call(py::ssize_t(0), qn, w, o);
+    call(py::ssize_t(0), qn, w, at);
     return out;
   }
   for (py::ssize_t k = 0; k < in.batch; ++k) normalisedConfiguration(in.q + k * nq, nq, info.quaternionAt, k, true, qn);
   py::gil_scoped_release release;
   for (py::ssize_t k = 0; k < in.batch; ++k) {
     normalisedConfiguration(in.q + k * nq, nq, info.quaternionAt, k, true, qn);
-    call(k, qn, w, o + k * block);
+    std::array<Scalar*, N> mine;
+    for (std::size_t j = 0; j < N; ++j) mine[j] = at[j] + k * block[j];
+    call(k, qn, w, mine);
   }
   return out;
+}
+
+/// One output: eachStateOutputs with call(k, qn, w, out_k).
+template <class Solver, class Call>
+py::array_t<typename Solver::Scalar> eachState(const ModuleInfo& info, const Inputs<Solver>& in,
+                                               std::initializer_list<py::ssize_t> dims, Call call) {
+  const std::array<std::vector<py::ssize_t>, 1> shape{std::vector<py::ssize_t>(dims)};
+  return eachStateOutputs<Solver, 1>(info, in, shape, [&](py::ssize_t k, auto* qn, auto& w, auto& outs) {
+    call(k, qn, w, outs[0]);
+  })[0];
 }
 
 template <class Solver>
@@ -369,6 +387,58 @@ void bindConstraintWrenches(py::module_& m, const ModuleInfo& info,
       py::arg("q"), py::arg("lam"),
       "(q, lam) -> (ncons, 6) or (N, ncons, 6): each constraint's wrench on the robot in world axes\n"
       "(force, then torque about the frame's origin); the constraint force on the robot is -J^T lam.");
+}
+
+/// inverse_dynamics_derivatives(q, v, qdd, lam=None) -> (dtau_dq, dtau_dv), (nv, nv) each.
+template <class Solver>
+void bindInverseDynamicsDerivatives(py::module_& m, const ModuleInfo& info,
+                                    void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, const Scalar_t<Solver>*,
+                                               const Scalar_t<Solver>*, Workspace_t<Solver>&, Scalar_t<Solver>*,
+                                               Scalar_t<Solver>*) noexcept) {
+  constexpr int nv = Solver::nv, nc = Solver::nc;
+  const ModuleInfo* p = &info;
+  m.def(
+      "inverse_dynamics_derivatives",
+      [p, fn](py::handle q, py::handle v, py::handle qdd, py::handle lam) {
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        const auto* ain = in.add(qdd, "qdd", nv, "nv");
+        const auto* lin = lam.is_none() ? nullptr : in.add(lam, "lam", nc, "nc");
+        const std::array<std::vector<py::ssize_t>, 2> dims{std::vector<py::ssize_t>{nv, nv}, std::vector<py::ssize_t>{nv, nv}};
+        auto out = eachStateOutputs<Solver, 2>(*p, in, dims, [&](py::ssize_t k, auto* qn, auto& w, auto& o) {
+          fn(qn, vin + k * nv, ain + k * nv, lin ? lin + k * nc : nullptr, w, o[0], o[1]);
+        });
+        return py::make_tuple(std::move(out[0]), std::move(out[1]));
+      },
+      py::arg("q"), py::arg("v"), py::arg("qdd"), py::arg("lam") = py::none(),
+      "(q, v, qdd, lam=None) -> (dtau_dq, dtau_dv), (nv, nv) each or (N, nv, nv): the derivatives of\n"
+      "inverse_dynamics at fixed qdd and lam; column k of d/dq is along q (+) t e_k (docs/derivatives.md).");
+}
+
+/// forward_dynamics_derivatives(q, v, tau) -> (qdd, dqdd_dq, dqdd_dv, dqdd_dtau).
+template <class Solver>
+void bindForwardDynamicsDerivatives(py::module_& m, const ModuleInfo& info,
+                                    void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, const Scalar_t<Solver>*,
+                                               Workspace_t<Solver>&, Scalar_t<Solver>*, Scalar_t<Solver>*,
+                                               Scalar_t<Solver>*, Scalar_t<Solver>*) noexcept) {
+  constexpr int nv = Solver::nv;
+  const ModuleInfo* p = &info;
+  m.def(
+      "forward_dynamics_derivatives",
+      [p, fn](py::handle q, py::handle v, py::handle tau) {
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        const auto* tin = in.add(tau, "tau", nv, "nv");
+        const std::vector<py::ssize_t> square{nv, nv};
+        const std::array<std::vector<py::ssize_t>, 4> dims{std::vector<py::ssize_t>{nv}, square, square, square};
+        auto out = eachStateOutputs<Solver, 4>(*p, in, dims, [&](py::ssize_t k, auto* qn, auto& w, auto& o) {
+          fn(qn, vin + k * nv, tin + k * nv, w, o[0], o[1], o[2], o[3]);
+        });
+        return py::make_tuple(std::move(out[0]), std::move(out[1]), std::move(out[2]), std::move(out[3]));
+      },
+      py::arg("q"), py::arg("v"), py::arg("tau"),
+      "(q, v, tau) -> (qdd, dqdd_dq, dqdd_dv, dqdd_dtau) of the free motion (no constraint forces),\n"
+      "(nv,) and (nv, nv), or with a leading N; column k of d/dq is along q (+) t e_k (docs/derivatives.md).");
 }
 
 template <class Solver>
