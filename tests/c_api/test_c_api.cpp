@@ -139,7 +139,7 @@ TEST(CApi, NullFlagsAreAllInForceAndLambda0IsRead) {
 // README-CPP-BEGIN
 namespace qp = quadruped;
 
-qp::Workspace w;                  // once, e.g. static: caller-owned, ~34 kB with every function
+qp::Workspace w;                  // once, e.g. static: caller-owned, ~95 kB with every function
 qp::Scalar lambda[qp::nc] = {};   // kept between steps: the next step's warm start
 qp::Settings s;
 
