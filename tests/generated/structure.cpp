@@ -1,8 +1,10 @@
 // The shape of every generated solver built by tests/generated:
 // - its .cpp has no loop or branch but the iteration loops over K (exact text
-//   allow-listed) and proxPV's loops over a run of constraint columns (a
-//   literal trip count, `for (int j = 0; j < 30; ++j) {`): no loop over
-//   bodies, no branch on joint type;
+//   allow-listed), proxPV's loops over a run of constraint columns (a
+//   literal trip count, `for (int j = 0; j < 30; ++j) {`) and the derivatives'
+//   fixed-bound loops (one assignment per element over a literal count, the
+//   dense product over its template bounds): no loop over bodies, no branch on
+//   joint type;
 // - it has no empty function (a body of nothing but static_cast<void>
 //   of unused parameters): a pass that folds away prints no function;
 // - its object references no heap (malloc, operator new, ...) and no exception
@@ -59,14 +61,29 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
   static const std::vector<std::string> allowed = {"for (int k = 2; k <= s.iterations; ++k) {",
                                                    "for (int k = 0; k < s.iterations; ++k) {"};
   static const std::regex columns(R"(for \(int j = 0; j < [1-9][0-9]*; \+\+j\) \{)");
+  static const std::regex fixedLoop(
+      R"( *(for \(int k = 0; k < [1-9][0-9]*; \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
+      R"(|for \(int r = 0; r < n; \+\+r\)|for \(int c = 0; c < p; \+\+c\) \{)"
+      R"(|for \(int k = 0; k < m; \+\+k\) sum \+= A\[r \* m \+ k\] \* B\[k \* p \+ c\];))");
   static const std::vector<std::string> keywords = {"for", "while", "do", "if", "else", "switch", "case", "goto"};
   std::vector<std::string> found;
   for (std::size_t k = 0; k < code.size(); ++k) {
-    // inverse_dynamics' lambda == nullptr: a pointer select before any
-    // arithmetic (docs/dynamics.md), the one conditional allowed.
-    const std::size_t lineStart = code.rfind('\n', k) == std::string::npos ? 0 : code.rfind('\n', k) + 1;
-    if (code.compare(lineStart, code.find('\n', k) - lineStart, "  lambda = lambda != nullptr ? lambda : kNoMultipliers;") == 0)
-      continue;
+    // Lines allowed whole, checked at their first character (the regex once
+    // per line, not per character: the big sources are megabytes).
+    if (k == 0 || code[k - 1] == '\n') {
+      const std::size_t nl = code.find('\n', k);
+      const std::string line = code.substr(k, nl == std::string::npos ? std::string::npos : nl - k);
+      // inverse_dynamics' lambda == nullptr: a pointer select before any
+      // arithmetic (docs/dynamics.md), the one conditional allowed; and the
+      // derivatives' fixed-bound loops (docs/derivatives.md): the dense
+      // product template, whose bounds are its template arguments, and one
+      // element-wise assignment over a literal count. No data decides a trip.
+      if (line == "  lambda = lambda != nullptr ? lambda : kNoMultipliers;" || std::regex_match(line, fixedLoop)) {
+        if (nl == std::string::npos) break;
+        k = nl;
+        continue;
+      }
+    }
     if (code[k] == '?' || code.compare(k, 2, "&&") == 0 || code.compare(k, 2, "||") == 0 || code[k] == '"' ||
         code[k] == '\'' || code[k] == '#') {
       found.push_back(code.substr(k, code.find('\n', k) - k));
@@ -99,6 +116,11 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_TRUE(forbiddenControlFlow("  lambda = lambda != nullptr ? lambda : kNoMultipliers;\n").empty());
   EXPECT_EQ(forbiddenControlFlow("  lambda = lambda != nullptr ? lambda : other;\n").size(), 1u);
   EXPECT_EQ(forbiddenControlFlow("while (x) {}").size(), 1u);
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 324; ++k) dtau_dq[k] = Scalar(0);\n").empty());
+  EXPECT_EQ(forbiddenControlFlow("  for (int k = 0; k < n; ++k) dtau_dq[k] = Scalar(0);\n").size(), 1u);
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.fdd_h[k] = tau[k] - w.fdd_h[k];\n").empty());
+  EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.h[k] = c ? a : b;\n").size(), 1u);
+  EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) { w.h[k] = 0; }\n").size(), 1u);
   EXPECT_EQ(forbiddenControlFlow("switch (t) { case 1: {} }").size(), 2u);
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < s.iterations; ++k) {\n    w.x = iff + format;\n  }").empty());
   EXPECT_TRUE(forbiddenControlFlow(stripComments("// if (a) for (;;)\nx = 1;")).empty());
