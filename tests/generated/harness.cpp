@@ -29,12 +29,6 @@ namespace gen = PROXGEN_SOLVER_NAMESPACE;
 using proxgen::VecX;
 using proxgen::test::SolverUnderTest;
 
-#ifdef PROXGEN_SOLVER_CASE
-#define PROXGEN_SOLVER_INPUTS PROXGEN_SOLVER_CASE, nullptr, nullptr
-#else
-#define PROXGEN_SOLVER_INPUTS nullptr, PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT
-#endif
-
 #if PROXGEN_SOLVER_HAS_CONSTRAINED_ABA && PROXGEN_SOLVER_HAS_PROX_PV
 // The generated solver on one state, results in double; lambda0 (nc values)
 // or null is Settings::lambda0. Returns residual(w).

@@ -41,12 +41,6 @@ namespace gen = PROXGEN_SOLVER_NAMESPACE;
 using proxgen::MatX;
 using proxgen::VecX;
 
-#ifdef PROXGEN_SOLVER_CASE
-#define PROXGEN_SOLVER_INPUTS PROXGEN_SOLVER_CASE, nullptr, nullptr
-#else
-#define PROXGEN_SOLVER_INPUTS nullptr, PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT
-#endif
-
 constexpr bool kFloat = std::is_same_v<gen::Scalar, float>;
 constexpr int kStates = 20;
 

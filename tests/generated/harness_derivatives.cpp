@@ -32,12 +32,6 @@ namespace gen = PROXGEN_SOLVER_NAMESPACE;
 using proxgen::MatX;
 using proxgen::VecX;
 
-#ifdef PROXGEN_SOLVER_CASE
-#define PROXGEN_SOLVER_INPUTS PROXGEN_SOLVER_CASE, nullptr, nullptr
-#else
-#define PROXGEN_SOLVER_INPUTS nullptr, PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT
-#endif
-
 constexpr bool kFloat = std::is_same_v<gen::Scalar, float>;
 constexpr double kEps = kFloat ? 5.9604644775390625e-08 : 1.1102230246251565e-16;  // unit round-off, 2^-24 / 2^-53
 constexpr double kFloor = kFloat ? 64 * kEps : 1e-12;  // verify/compare.cpp's floor

@@ -8,6 +8,15 @@
 
 #include "model/model.hpp"
 
+// The harness's robot, as the per-solver files pass it on (a shared case, or a
+// URDF and a layout: the compile definitions of tests/generated/CMakeLists.txt).
+// Expanded only in the per-solver files, which have those definitions.
+#ifdef PROXGEN_SOLVER_CASE
+#define PROXGEN_SOLVER_INPUTS PROXGEN_SOLVER_CASE, nullptr, nullptr
+#else
+#define PROXGEN_SOLVER_INPUTS nullptr, PROXGEN_SOLVER_URDF, PROXGEN_SOLVER_LAYOUT
+#endif
+
 namespace proxgen::test {
 
 /// One generated solver, seen through double-precision vectors.
