@@ -150,7 +150,7 @@ struct Inputs {
   const Scalar* q;
   explicit Inputs(py::handle qObj) : q(add(qObj, "q", Solver::nq, "nq")) {}
   const Scalar* add(py::handle obj, const char* arg, py::ssize_t width, const char* sizeName) {
-    py::array_t<Scalar>& a = keep[std::size_t(count++)];
+    py::array_t<Scalar>& a = keep.at(std::size_t(count++));  // (a binding with a fifth array is a bug: throws)
     a = asArray<Scalar>(obj, arg);
     const Scalar* x = checkShape(a, width, arg, batch, sizeName);
     checkFinite(x, (batch == 0 ? 1 : batch) * width, width, arg);
