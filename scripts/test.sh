@@ -33,7 +33,8 @@ fi
 
 # Hardening: one clang build with ASan + UBSan (and libFuzzer's coverage
 # instrumentation) runs the test suite, then each fuzz target from the same
-# build for FUZZ_SECONDS (default here 30: five targets, each first replaying its
+# build for FUZZ_SECONDS (default here 30: five targets, two at a time on two
+# cores, each first replaying its
 # seed corpus, whose findings are the regressions that matter; CI's 35-minute
 # budget has no room for more; tests/fuzz/run.sh alone defaults to 60).
 if [ "${PROXGEN_HARDENING:-1}" = 1 ]; then
