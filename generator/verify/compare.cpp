@@ -244,15 +244,21 @@ std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, con
 //    tangents, times the lever 1 + |p| of a transform to the parent);
 //  - forward dqdd (M^-1 times the sweep's result): c n u kappa(M) m nv (|dtau| + T),
 //    m = max(1, |M^-1|); dqdd/dtau = M^-1: c n u kappa(M); qdd: c n u kappa m nv (|tau| + |h| + |g|);
-//  - constrained: C = J M^-1 R1 - R2 has eC = c n u (kappa m nv |J| (|R1| + T) + |R2| + R)
-//    (R: the rows' terms, motion tangents times 1 + |v| and the gains); the K
-//    proximal steps on the tangents, L_K = sum_{k<K} mu^-k (G + I/mu)^-(k+1) C,
-//    multiply a perturbation by at most A = max over G's eigenvalues g of
-//    (1 - (1 + mu g)^-K) / g (K mu on null(G)), so eL = A (eC + c n u (|G| + 1/mu) nc |L|)
-//    (G's product with L and the factor's solves at every step);
-//    X = M^-1 (R1 - J^T L): eX = c n u kappa m nv (|R1| + T + |J| |L|) + m nv |J| eL;
-//    qdd and lambda (prox_pv's solve, the same steps on y): eLam = A c n u (y + (|G| + 1/mu) nc |lambda|),
-//    y = |J| m nv (|tau| + |h|) + |da*| + R; eQdd = c n u kappa m nv (|tau| + |h| + |J| |lambda|) + m nv |J| eLam.
+//  - constrained: X0 = M^-1 R1 (R1 = [-dtau_dq, -dtau_dv, I]) is a solve with
+//    M: eX0 = c n u (kappa |X0| + m nv T) (its own error, and the sweep's
+//    through M^-1); C = J X0 - R2: eC = |J| nv eX0 + c n u (|J| nv |X0| + |R2| + R
+//    + (|G| + 1/mu) nc |L|) (R: the rows' terms, motion tangents times 1 + |v|
+//    and the gains; the last: G's product with L and the factor's solves at
+//    every step). The K proximal steps on the tangents,
+//    L_K = sum_{k<K} mu^-k (G + I/mu)^-(k+1) C, are one symmetric operator
+//    S_K = V diag(s(g)) V^T over G's eigenvalues g, s(g) = (1 - (1 + mu g)^-K) / g
+//    (K mu on null(G)): eL = |S_K| eC (|.| of an operator: its largest row sum);
+//    X = X0 - M^-1 J^T L: eX = eX0 + |M^-1 J^T S_K| eC + c n u kappa |M^-1 J^T| nc |L|
+//    (J^T annihilates what S_K amplifies along null(J^T), K mu: the
+//    multipliers carry it, qdd does not);
+//    qdd and lambda (prox_pv's solve, the same steps on y = J qfree + gamma - a*,
+//    qfree = M^-1 (tau - h)): ey = c n u (kappa (|J| nv |qfree| + |da*| + R) + (|G| + 1/mu) nc |lambda|),
+//    eLam = |S_K| ey, eQdd = c n u kappa (|qfree| + |M^-1 J^T| nc |lambda|) + |M^-1 J^T S_K| ey.
 // A dropped term (the gravity tangent of the rows' true acceleration, Jr(e)^-1,
 // a velocity product) moves entries by O(1) of the rows' size, far above these
 // at well-conditioned states (tests/generated/harness_derivatives.cpp; tried by hand).
@@ -275,16 +281,22 @@ double derivativeTerms(const System& sys, const Data& d, const DerivativeData& d
   return T;
 }
 
-double proximalAmplification(const MatX& G, double mu, int K) {
-  if (G.rows() == 0) return 0.0;
-  const Eigen::SelfAdjointEigenSolver<MatX> eig(G, Eigen::EigenvaluesOnly);
-  double amp = 0.0;
-  for (Eigen::Index k = 0; k < eig.eigenvalues().size(); ++k) {
+// The K proximal steps on the tangents as one operator, L_K = S_K C:
+// S_K = sum_{k<K} mu^-k (G + I/mu)^-(k+1) = V diag(s(g)) V^T over G's
+// eigenvalues g, s(g) = (1 - (1 + mu g)^-K) / g (K mu on null(G)).
+MatX proximalOperator(const MatX& G, double mu, int K) {
+  if (G.rows() == 0) return G;
+  const Eigen::SelfAdjointEigenSolver<MatX> eig(G);
+  VecX s(G.rows());
+  for (Eigen::Index k = 0; k < s.size(); ++k) {
     const double g = std::max(0.0, eig.eigenvalues()[k]);
-    amp = std::max(amp, g * mu > 1e-12 ? (1.0 - std::pow(1.0 + mu * g, -K)) / g : K * mu);
+    s[k] = g * mu > 1e-12 ? (1.0 - std::pow(1.0 + mu * g, -K)) / g : K * mu;
   }
-  return amp;
+  return eig.eigenvectors() * s.asDiagonal() * eig.eigenvectors().transpose();
 }
+
+// max_r sum_c |A(r, c)|: the factor a perturbation of size e per entry of x grows by in A x.
+double rowSum(const MatX& A) { return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0; }
 
 }  // namespace
 
@@ -331,17 +343,23 @@ std::vector<Compared> compareDerivatives(const System& sys, Data& d, const Condi
     double gains = 1.0;
     for (const Constraint& con : sys.constraints) gains = std::max({gains, con.kp, con.kd});
     const MatX G = dd.J * Minv * dd.J.transpose();
-    const double A = proximalAmplification(G, gen.mu, gen.K);
-    const double R1 = std::max({maxAbsM(dd.dtau_dq), maxAbsM(dd.dtau_dv), 1.0});
+    const MatX S = proximalOperator(G, gen.mu, gen.K);
+    const MatX MinvJt = Minv * dd.J.transpose();
+    const double A = rowSum(S), P = rowSum(MinvJt * S);  // |S_K|, |M^-1 J^T S_K|
+    // X0 = M^-1 R1, R1 = [-dtau_dq, -dtau_dv, I]: its entries' size.
+    const double X0 = std::max({maxAbsM(Minv * dd.dtau_dq), maxAbsM(Minv * dd.dtau_dv), maxAbsM(Minv)});
     const double R2 = std::max(maxAbsM(dd.dastar_dq - dd.dalpha_dq), maxAbsM(dd.dastar_dv - dd.dalpha_dv));
     const double J = maxAbsM(dd.J), R = gains * motion;
     const double Ls = std::max({maxAbsM(dd.dlambda_dq), maxAbsM(dd.dlambda_dv), maxAbsM(dd.dlambda_dtau)});
-    const double eC = u * (c.kappaM * m * nv * J * (R1 + T) + R2 + R);
-    const double eL = A * (eC + u * (maxAbsM(G) + 1.0 / gen.mu) * nc * Ls);
-    const double eX = u * c.kappaM * m * nv * (R1 + T + J * Ls) + m * nv * J * eL;
-    const double y = J * m * nv * (maxAbsM(gen.tau) + maxAbsM(h)) + maxAbsM(dd.dastar_dq) + R;
-    const double eLam = A * u * (y + (maxAbsM(G) + 1.0 / gen.mu) * nc * maxAbsM(dd.lambda));
-    const double eQdd = u * c.kappaM * m * nv * (maxAbsM(gen.tau) + maxAbsM(h) + J * maxAbsM(dd.lambda)) + m * nv * J * eLam;
+    const double eX0 = u * (c.kappaM * X0 + m * nv * T);
+    const double eC = J * nv * eX0 + u * (J * nv * X0 + R2 + R + (maxAbsM(G) + 1.0 / gen.mu) * nc * Ls);
+    const double eL = A * eC;
+    const double eX = eX0 + P * eC + u * c.kappaM * maxAbsM(MinvJt) * nc * Ls;
+    const VecX qfree = Minv * (gen.tau - h);
+    const double y = J * nv * maxAbsM(qfree) + maxAbsM(dd.dastar_dq) + R;
+    const double ey = u * (c.kappaM * y + (maxAbsM(G) + 1.0 / gen.mu) * nc * maxAbsM(dd.lambda));
+    const double eLam = A * ey;
+    const double eQdd = u * c.kappaM * (maxAbsM(qfree) + maxAbsM(MinvJt) * nc * maxAbsM(dd.lambda)) + P * ey;
     add("constrained_dynamics_derivatives qdd", gen.cQdd, dd.qdd, eQdd);
     add("constrained_dynamics_derivatives lambda", gen.cLambda, dd.lambda, eLam);
     add("constrained_dynamics_derivatives dqdd_dq", gen.cDq, dd.dqdd_dq, eX);
