@@ -79,6 +79,7 @@ def test_many_states_are_the_single_states(m, quadruped, rng):
         "constraint_wrenches": lambda k: (Q[k], lam[k]),
         "inverse_dynamics_derivatives": lambda k: (Q[k], V[k], T[k], lam[k]),
         "forward_dynamics_derivatives": lambda k: (Q[k], V[k], T[k]),
+        "constrained_dynamics_derivatives": lambda k: (Q[k], V[k], T[k]),
     }
     for name in LIBRARY:
         args = calls.get(name, lambda k: (Q[k],))
