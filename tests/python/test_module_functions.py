@@ -222,3 +222,31 @@ def test_constrained_dynamics_derivatives_along_v_and_tau_are_the_solve_s(m, qua
                 minus = m.prox_pv(q, v - e, tau) if x == 0 else m.prox_pv(q, v, tau - e)
                 assert np.max(np.abs(got_qdd[:, k] - (plus[0] - minus[0]) / (2 * h))) <= delta / h, (x, k)
                 assert np.max(np.abs(got_lam[:, k] - (plus[1] - minus[1]) / (2 * h))) <= delta / h, (x, k)
+
+
+def test_constrained_dynamics_derivatives_follow_the_schedule(m, quadruped, rng):
+    """An inactive constraint counts as absent: its multiplier rows and their tangents are
+    exactly zero, and the others are the derivatives of prox_pv with that schedule (checked
+    along tau, where central differences of the K-step solve are exact, as above)."""
+    nv, nc = m.nv, m.nc
+    active = [True, False, True, True]
+    name = quadruped.constraint_names[1]
+    rows = slice(quadruped.constraints[name].row, quadruped.constraints[name].row + 3)
+    q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+    qdd, lam, dq, dv, dtau, lq, lv, ltau = m.constrained_dynamics_derivatives(q, v, tau, active=active)
+    qdd0, lam0 = m.prox_pv(q, v, tau, active=active)
+    assert np.array_equal(qdd, qdd0) and np.array_equal(lam, lam0)
+    for L in (lq, lv, ltau):
+        assert np.array_equal(L[rows], np.zeros((3, nv)))
+    M, J = m.mass_matrix(q), m.constraint_jacobian(q)
+    G = J @ np.linalg.solve(M, J.T) + np.eye(nc) / m.mu
+    delta = C * (nv + nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+    h = 1e-2
+    for k in range(nv):
+        e = np.zeros(nv)
+        e[k] = h
+        plus, minus = m.prox_pv(q, v, tau + e, active=active), m.prox_pv(q, v, tau - e, active=active)
+        assert np.max(np.abs(dtau[:, k] - (plus[0] - minus[0]) / (2 * h))) <= delta / h, k
+        assert np.max(np.abs(ltau[:, k] - (plus[1] - minus[1]) / (2 * h))) <= delta / h, k
+    # The schedule changes the answer: with every foot the tangents differ.
+    assert np.max(np.abs(m.constrained_dynamics_derivatives(q, v, tau)[4] - dtau)) > 1e-6
