@@ -16,7 +16,7 @@ namespace {{
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-{parts}{helpers}{free_bodies}}}  // namespace
+{part_helpers}{parts}{helpers}{free_bodies}}}  // namespace
 
 {definitions}}}  // namespace {name}
 )proxgen"

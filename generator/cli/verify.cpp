@@ -213,6 +213,27 @@ int main() {
     s::constraint_wrenches(q, lambda, w, out);  // the sample's lambda
     printAll(out, 6 * s::ncons);
 #endif
+    // The derivatives; forward and constrained take the sample's qdd as tau.
+    static s::Scalar d[6][(s::nv > s::nc ? s::nv : s::nc) * s::nv], r[2][s::nv + s::nc + 1];
+    static_cast<void>(d);
+    static_cast<void>(r);
+#if PROXGEN_VERIFY_HAS_INVERSE_DYNAMICS_DERIVATIVES
+    s::inverse_dynamics_derivatives(q, v, qdd, lambda, w, d[0], d[1]);
+    printAll(d[0], s::nv * s::nv);
+    printAll(d[1], s::nv * s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_FORWARD_DYNAMICS_DERIVATIVES
+    s::forward_dynamics_derivatives(q, v, qdd, w, r[0], d[0], d[1], d[2]);
+    printAll(r[0], s::nv);
+    for (int k = 0; k < 3; ++k) printAll(d[k], s::nv * s::nv);
+#endif
+#if PROXGEN_VERIFY_HAS_CONSTRAINED_DYNAMICS_DERIVATIVES
+    s::constrained_dynamics_derivatives(q, v, qdd, s::Settings{}, w, r[0], r[1], d[0], d[1], d[2], d[3], d[4], d[5]);
+    printAll(r[0], s::nv);
+    printAll(r[1], s::nc);
+    for (int k = 0; k < 3; ++k) printAll(d[k], s::nv * s::nv);
+    for (int k = 3; k < 6; ++k) printAll(d[k], s::nc * s::nv);
+#endif
   }
   return 0;
 }
@@ -721,8 +742,43 @@ int verify(const VerifyOptions& o) {
     if (sys.functions.has(Function::ConstraintWrenches)) cons.W = read(6 * ncons, "constraint_wrenches", at);
     cons.lambda = libraryIn[s].lambda;
     cons.mu = sys.mu;
+    // The derivatives (docs/derivatives.md), forward and constrained at tau = the sample's qdd.
+    verify::DerivativeAnswer der;
+    der.qdd = der.tau = libraryIn[s].qdd;
+    der.lambda = libraryIn[s].lambda;
+    der.mu = sys.mu;
+    der.K = sys.iterations;
+    const auto matrix = [&](int rows, const char* what) {
+      const VecX x = read(rows * m.nv, what, at);
+      MatX A(rows, m.nv);
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < m.nv; ++c) A(r, c) = x[r * m.nv + c];  // row-major
+      return A;
+    };
+    if (sys.functions.has(Function::InverseDynamicsDerivatives)) {
+      der.dtau_dq = matrix(m.nv, "inverse_dynamics_derivatives dtau_dq");
+      der.dtau_dv = matrix(m.nv, "inverse_dynamics_derivatives dtau_dv");
+    }
+    if (sys.functions.has(Function::ForwardDynamicsDerivatives)) {
+      der.fQdd = read(m.nv, "forward_dynamics_derivatives qdd", at);
+      der.fDq = matrix(m.nv, "forward_dynamics_derivatives dqdd_dq");
+      der.fDv = matrix(m.nv, "forward_dynamics_derivatives dqdd_dv");
+      der.fDtau = matrix(m.nv, "forward_dynamics_derivatives dqdd_dtau");
+    }
+    if (sys.functions.has(Function::ConstrainedDynamicsDerivatives)) {
+      der.cQdd = read(m.nv, "constrained_dynamics_derivatives qdd", at);
+      der.cLambda = read(sys.nc, "constrained_dynamics_derivatives lambda", at);
+      der.cDq = matrix(m.nv, "constrained_dynamics_derivatives dqdd_dq");
+      der.cDv = matrix(m.nv, "constrained_dynamics_derivatives dqdd_dv");
+      der.cDtau = matrix(m.nv, "constrained_dynamics_derivatives dqdd_dtau");
+      der.cLq = matrix(sys.nc, "constrained_dynamics_derivatives dlambda_dq");
+      der.cLv = matrix(sys.nc, "constrained_dynamics_derivatives dlambda_dv");
+      der.cLtau = matrix(sys.nc, "constrained_dynamics_derivatives dlambda_dtau");
+    }
     std::vector<verify::Compared> items = verify::compareLibraryWithGeneric(sys, d, conditioning[s], states[s], gen);
     for (const verify::Compared& x : verify::compareConstraintFunctions(sys, d, conditioning[s], states[s], cons))
+      items.push_back(x);
+    for (const verify::Compared& x : verify::compareDerivatives(sys, d, conditioning[s], states[s], der))
       items.push_back(x);
     for (const verify::Compared& x : items) {
       if (!x.finite) throw Error(fmt::format("verify: the generic {} is not finite at sample {}", x.what, s));

@@ -187,6 +187,23 @@ const EntryPoint kEntryPoints[] = {
      "void forward_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, Workspace& w, Scalar* qdd,\n"
      "                                  Scalar* dqdd_dq, Scalar* dqdd_dv, Scalar* dqdd_dtau) noexcept",
      "// M^-1 by ABA on the unit torques, qdd = M^-1 (tau - h), the tangent sweep at qdd, two dense products.\n"},
+    {Function::ConstrainedDynamicsDerivatives,
+     "\n// constrained_dynamics_derivatives: qdd and lambda as prox_pv(q, v, tau, s) returns\n"
+     "// them, and the derivatives of the solution prox_pv and constrained_aba converge\n"
+     "// to with these Settings (the proximal limit: the minimum-norm multipliers where\n"
+     "// J is rank-deficient) with respect to q (the tangent convention above), v and\n"
+     "// tau: dqdd_* nv x nv, dlambda_* nc x nv. By the implicit function theorem on\n"
+     "// M qdd + h + J^T lambda = tau, J qdd + gamma = a*, the multipliers' tangents by\n"
+     "// s.iterations proximal steps with s.mu (as the solve: at K steps they are off\n"
+     "// by what the K-th iterate is). A constraint with !s.active[k] counts as absent\n"
+     "// (its rows are 0). It calls mass_matrix_inverse, prox_pv and\n"
+     "// inverse_dynamics_derivatives (held with it). None of the arrays may be inside w.\n",
+     "void constrained_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s,\n"
+     "                                      Workspace& w, Scalar* qdd, Scalar* lambda, Scalar* dqdd_dq,\n"
+     "                                      Scalar* dqdd_dv, Scalar* dqdd_dtau, Scalar* dlambda_dq,\n"
+     "                                      Scalar* dlambda_dv, Scalar* dlambda_dtau) noexcept",
+     "// prox_pv, M^-1, the tangent sweep at (qdd, lambda), the constraint rows' derivatives\n"
+     "// straight-line, then the dense algebra of the implicit function theorem.\n"},
 };
 
 // The declaration's signature: the schedule argument defaults to every
@@ -195,6 +212,130 @@ std::string withDefaultSchedule(std::string signature) {
   const std::string arg = "const bool* active";
   if (const std::size_t at = signature.find(arg); at != std::string::npos) signature.insert(at + arg.size(), " = all_active");
   return signature;
+}
+
+// constrained_dynamics_derivatives' dense algebra (docs/derivatives.md section
+// 5): fixed bounds (template arguments), no branch on the data, no heap.
+constexpr const char* kConstrainedDerivativeHelpers =
+    "// C += s A B (as dense_product).\n"
+    "template <int n, int m, int p>\n"
+    "void dense_product_add(const Scalar* A, const Scalar* B, Scalar s, Scalar* C) noexcept {\n"
+    "  for (int r = 0; r < n; ++r)\n"
+    "    for (int c = 0; c < p; ++c) {\n"
+    "      Scalar sum = 0;\n"
+    "      for (int k = 0; k < m; ++k) sum += A[r * m + k] * B[k * p + c];\n"
+    "      C[r * p + c] += s * sum;\n"
+    "    }\n"
+    "}\n\n"
+    "// A + shift I = L L^T (A n x n symmetric, row-major, its lower triangle read): L\n"
+    "// lower triangular, its diagonal holding 1 / L_jj (what the solves multiply by),\n"
+    "// its upper triangle zero. Not positive definite gives NaN, not a branch.\n"
+    "template <int n>\n"
+    "void dense_cholesky(const Scalar* A, Scalar shift, Scalar* L) noexcept {\n"
+    "  for (int j = 0; j < n; ++j) {\n"
+    "    Scalar d = A[j * n + j] + shift;\n"
+    "    for (int k = 0; k < j; ++k) {\n"
+    "      d -= L[j * n + k] * L[j * n + k];\n"
+    "    }\n"
+    "    const Scalar inv = Scalar(1) / std::sqrt(d);\n"
+    "    L[j * n + j] = inv;\n"
+    "    for (int i = j + 1; i < n; ++i) {\n"
+    "      Scalar sum = A[i * n + j];\n"
+    "      for (int k = 0; k < j; ++k) {\n"
+    "        sum -= L[i * n + k] * L[j * n + k];\n"
+    "      }\n"
+    "      L[i * n + j] = sum * inv;\n"
+    "      L[j * n + i] = Scalar(0);\n"
+    "    }\n"
+    "  }\n"
+    "}\n\n"
+    "// Lam := (L L^T)^-1 (C + Lam / mu), n x p: one proximal step on the multipliers'\n"
+    "// tangents, L from dense_cholesky; column by column, forward then backward.\n"
+    "template <int n, int p>\n"
+    "void proximal_step(const Scalar* L, const Scalar* C, Scalar inv_mu, Scalar* Lam) noexcept {\n"
+    "  for (int c = 0; c < p; ++c) {\n"
+    "    for (int i = 0; i < n; ++i) {\n"
+    "      Scalar sum = C[i * p + c] + Lam[i * p + c] * inv_mu;\n"
+    "      for (int k = 0; k < i; ++k) {\n"
+    "        sum -= L[i * n + k] * Lam[k * p + c];\n"
+    "      }\n"
+    "      Lam[i * p + c] = sum * L[i * n + i];\n"
+    "    }\n"
+    "    for (int i = n - 1; i >= 0; --i) {\n"
+    "      Scalar sum = Lam[i * p + c];\n"
+    "      for (int k = i + 1; k < n; ++k) {\n"
+    "        sum -= L[k * n + i] * Lam[k * p + c];\n"
+    "      }\n"
+    "      Lam[i * p + c] = sum * L[i * n + i];\n"
+    "    }\n"
+    "  }\n"
+    "}\n\n";
+
+// Jr(e)^-1 for the 6d welds' Baumgarte position term (docs/derivatives.md section 2).
+constexpr const char* kRightJacobianInverse =
+    "// Jr(e)^-1 (6 x 6, row-major) of the SE(3) exponential at e = [linear; angular]:\n"
+    "// log(Exp(e) Exp(x)) = e + Jr(e)^-1 x + O(x^2). Jr = sum_k (-ad_e)^k / (k + 1)!,\n"
+    "// -ad_e = [[P, Q], [0, P]] (P = -[w]x, Q = -[rho]x), summed to a fixed 40 terms\n"
+    "// (the remainder is below |ad_e|^41 / 42!, 1e-20 at |ad_e| = 6: round-off for\n"
+    "// errors of metres and radians), then inverted by its block form:\n"
+    "// [[A, B], [0, A]]^-1 = [[A^-1, -A^-1 B A^-1], [0, A^-1]]; A = Jr of SO(3) is\n"
+    "// invertible for rotation errors below 2 pi.\n"
+    "void se3_right_jacobian_inverse(const Scalar* e, Scalar* out) noexcept {\n"
+    "  const Scalar P[9] = {0, e[5], -e[4], -e[5], 0, e[3], e[4], -e[3], 0};\n"
+    "  const Scalar Q[9] = {0, e[2], -e[1], -e[2], 0, e[0], e[1], -e[0], 0};\n"
+    "  Scalar Pk[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Ck[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};\n"
+    "  Scalar A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};\n"
+    "  Scalar f = 1;\n"
+    "  for (int t = 1; t < 41; ++t) {\n"
+    "    f = f / Scalar(t + 1);\n"
+    "    Scalar nP[9], nC[9];\n"
+    "    for (int i = 0; i < 3; ++i) {\n"
+    "      for (int j = 0; j < 3; ++j) {\n"
+    "        Scalar sp = 0, sc = 0;\n"
+    "        for (int k = 0; k < 3; ++k) {\n"
+    "          sp += P[3 * i + k] * Pk[3 * k + j];\n"
+    "          sc += P[3 * i + k] * Ck[3 * k + j] + Q[3 * i + k] * Pk[3 * k + j];\n"
+    "        }\n"
+    "        nP[3 * i + j] = sp;\n"
+    "        nC[3 * i + j] = sc;\n"
+    "      }\n"
+    "    }\n"
+    "    for (int i = 0; i < 9; ++i) {\n"
+    "      Pk[i] = nP[i];\n"
+    "      Ck[i] = nC[i];\n"
+    "      A[i] += f * Pk[i];\n"
+    "      B[i] += f * Ck[i];\n"
+    "    }\n"
+    "  }\n"
+    "  const Scalar c0 = A[4] * A[8] - A[5] * A[7], c1 = A[5] * A[6] - A[3] * A[8], c2 = A[3] * A[7] - A[4] * A[6];\n"
+    "  const Scalar inv_det = Scalar(1) / (A[0] * c0 + A[1] * c1 + A[2] * c2);\n"
+    "  const Scalar adj[9] = {c0, A[2] * A[7] - A[1] * A[8], A[1] * A[5] - A[2] * A[4],\n"
+    "                        c1, A[0] * A[8] - A[2] * A[6], A[2] * A[3] - A[0] * A[5],\n"
+    "                        c2, A[1] * A[6] - A[0] * A[7], A[0] * A[4] - A[1] * A[3]};\n"
+    "  Scalar Ai[9], T[9];\n"
+    "  for (int i = 0; i < 9; ++i) {\n"
+    "    Ai[i] = adj[i] * inv_det;\n"
+    "  }\n"
+    "  for (int i = 0; i < 3; ++i) {\n"
+    "    for (int j = 0; j < 3; ++j) {\n"
+    "      T[3 * i + j] = B[3 * i] * Ai[j] + B[3 * i + 1] * Ai[3 + j] + B[3 * i + 2] * Ai[6 + j];\n"
+    "    }\n"
+    "  }\n"
+    "  for (int i = 0; i < 3; ++i) {\n"
+    "    for (int j = 0; j < 3; ++j) {\n"
+    "      out[6 * i + j] = Ai[3 * i + j];\n"
+    "      out[6 * (i + 3) + j + 3] = Ai[3 * i + j];\n"
+    "      out[6 * (i + 3) + j] = Scalar(0);\n"
+    "      out[6 * i + j + 3] = -(Ai[3 * i] * T[j] + Ai[3 * i + 1] * T[3 + j] + Ai[3 * i + 2] * T[6 + j]);\n"
+    "    }\n"
+    "  }\n"
+    "}\n\n";
+
+// The helpers the part functions call (before them), printed only when one needs them.
+std::string partHelpers(const System& sys, const SolverTexts& texts) {
+  bool gains6 = false;
+  for (const Constraint& c : sys.constraints) gains6 |= c.type == ConstraintType::Weld6D && c.kp != 0;
+  return texts.functions.has(Function::ConstrainedDynamicsDerivatives) && gains6 ? kRightJacobianInverse : "";
 }
 
 // The helpers the entry points call, printed only when one needs them.
@@ -211,7 +352,8 @@ std::string helpers(const SolverTexts& texts) {
         "// The joint transforms alone, for the functions without a velocity.\n"
         "void joint_transforms(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
         texts.jointTransforms);
-  if (texts.functions.has(Function::ForwardDynamicsDerivatives))
+  const bool cdd = texts.functions.has(Function::ConstrainedDynamicsDerivatives);
+  if (texts.functions.has(Function::ForwardDynamicsDerivatives) || cdd)
     out += "// C = s A B, A n x m, B m x p, C n x p, all row-major (the derivatives' dense\n"
            "// products: fixed bounds, no branch on the data; C may not overlap A or B).\n"
            "template <int n, int m, int p>\n"
@@ -223,6 +365,8 @@ std::string helpers(const SolverTexts& texts) {
            "      C[r * p + c] = s * sum;\n"
            "    }\n"
            "}\n\n";
+  if (cdd)
+    out += kConstrainedDerivativeHelpers;
   if (!texts.constraintJoints.empty())
     out += fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
                        "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
@@ -361,7 +505,7 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("active_init", activeInit(plan)),
       fmt::arg("active_note", plan.constraints.empty() ? "\n  // No constraints: one placeholder entry, never read." : ""));
   files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
-                             fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)),
+                             fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)), fmt::arg("part_helpers", partHelpers(sys, texts)),
                              fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));
   CInterfaceFiles c = emitCInterface(plan, texts.functions, banner, ws.scalars() * scalarBytes);
   files.cHeaderName = std::move(c.headerName), files.cHeader = std::move(c.header);

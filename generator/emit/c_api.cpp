@@ -95,6 +95,17 @@ const CEntry kCEntries[] = {
      "forward_dynamics_derivatives(q, v, tau, w, qdd, dqdd_dq, dqdd_dv, dqdd_dtau)", SettingsFrom::None,
      "/* qdd[NV] of the unconstrained dynamics and dqdd_dq, dqdd_dv, dqdd_dtau\n"
      "   (NV * NV each, row-major). */\n"},
+    {Function::ConstrainedDynamicsDerivatives,
+     "const {S}* q, const {S}* v, const {S}* tau, {S} mu, int iterations,\n"
+     "    const unsigned char* active, const {S}* lambda0, void* work, {S}* qdd, {S}* lambda, {S}* dqdd_dq,\n"
+     "    {S}* dqdd_dv, {S}* dqdd_dtau, {S}* dlambda_dq, {S}* dlambda_dv, {S}* dlambda_dtau",
+     "constrained_dynamics_derivatives(q, v, tau, s, w, qdd, lambda, dqdd_dq, dqdd_dv, dqdd_dtau, dlambda_dq, "
+     "dlambda_dv, dlambda_dtau)",
+     SettingsFrom::Solve,
+     "/* qdd[NV], lambda[NC] as {P}_prox_pv with these settings, and the derivatives\n"
+     "   of the solution it converges to: dqdd_dq, dqdd_dv, dqdd_dtau (NV * NV each)\n"
+     "   and dlambda_dq, dlambda_dv, dlambda_dtau (NC * NV each), row-major; column k\n"
+     "   of d/dq is along q (+) t e_k (the header's tangent convention). */\n"},
 };
 
 // Every C name a prefix makes that does not depend on the function list.

@@ -46,6 +46,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   if (want.has(Function::ForwardDynamicsDerivatives))
     for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
       want.add(f);
+  if (want.has(Function::ConstrainedDynamicsDerivatives))
+    for (Function f : {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}) want.add(f);
   texts.functions = want;
   const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
   texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects) ||
@@ -93,9 +95,13 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     texts.library[Function::InverseDynamics] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, false);
   if (want.has(Function::NonlinearEffects))
     texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, true);
+  // With constrained_dynamics_derivatives the sweep also keeps the constrained
+  // bodies' motion tangents, which its constraint rows read.
+  const bool cdd = want.has(Function::ConstrainedDynamicsDerivatives);
+  BodyTangents tangents;
   if (want.has(Function::InverseDynamicsDerivatives))
     texts.library[Function::InverseDynamicsDerivatives] =
-        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics);
+        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, cdd ? &tangents : nullptr);
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);
     Kinematics transforms = emitJointTransforms(e);
@@ -111,6 +117,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
 
   if (want.has(Function::ForwardDynamicsDerivatives))
     texts.library[Function::ForwardDynamicsDerivatives] = emitForwardDynamicsDerivatives(e);
+  if (cdd)
+    texts.library[Function::ConstrainedDynamicsDerivatives] =
+        emitConstrainedDynamicsDerivatives(e, afterKinematicsState, afterKinematics, tangents);
 
   // The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp).
   emitConstraintFunctions(e, afterKinematicsState, afterKinematics, texts);
@@ -151,6 +160,12 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
       ops += texts.libraryOps[f];
     texts.libraryOps[Function::ForwardDynamicsDerivatives] = ops;
+  }
+  if (cdd) {
+    OpCount ops = fn.hostOps("cdd");
+    ops += texts.pvOps;
+    for (Function f : {Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}) ops += texts.libraryOps[f];
+    texts.libraryOps[Function::ConstrainedDynamicsDerivatives] = ops;
   }
 
   if (stats) {

@@ -30,20 +30,9 @@ constexpr Quantity kDvq{"dvq", "d v / dq (6 x nv, path columns)"}, kDvv{"dvv", "
     kDaq{"daq", "d a / dq at fixed qdd (6 x nv, path columns)"}, kDav{"dav", "d a / dv at fixed qdd (6 x nv, path columns)"},
     kDfq{"dfq", "d f / dq, subtree force (6 x nv)"}, kDfv{"dfv", "d f / dv, subtree force (6 x nv)"};
 
-// One entry of a tangent as the next part function reads it: a generation-time
-// constant, or the member it was stored to.
-struct Slot {
-  Expr value;
-  std::string name;  // empty: `value` is the constant
-};
-using Col = std::array<Slot, 6>;
-using Cols = std::map<int, Col>;  // column -> the 6 entries (absent: zero)
-
-V6 load(CodeBuilder& cb, const Col& s) {
-  V6 x;
-  for (std::size_t r = 0; r < 6; ++r) x[r] = s[r].name.empty() ? s[r].value : cb.member(s[r].name);
-  return x;
-}
+using Slot = TangentSlot;
+using Col = TangentCol;
+using Cols = TangentCols;
 
 Col save(Emit& e, const Quantity& qy, int body, int col, const V6& x) {
   Col s;
@@ -116,14 +105,16 @@ void finishColumn(Emit& e, const Kinematics::Body& kb, int i, int k, const V6& v
   s.dfv[b][k] = save(e, kDfv, i, k, fv);
 }
 
-void forward(Emit& e, const Kinematics& kin, bool withLambda, Forces& fs, Sweep& s) {
+void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrained, Forces& fs, Sweep& s) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
   e.fn.beginPass("forward", "forward: a, f, and their tangents along the path's q and v directions");
   for (int i = 1; i < N; ++i) {
     const Kinematics::Body& kb = kin.b[std::size_t(i)];
     const BodyPlan& p = e.bp(i);
-    const bool store = !p.children.empty();  // the motion tangents are read by the children only
+    // The motion tangents are read by the children, and with keepConstrained by
+    // constrained_dynamics_derivatives' constraint rows.
+    const bool store = !p.children.empty() || (keepConstrained && !p.constraints.empty());
     // The primal RNEA values and the body's own columns.
     e.fn.boundary(i);
     e.openBody(i, "forward");
@@ -258,7 +249,14 @@ void copyOut(Emit& e, const std::map<std::pair<int, int>, Slot>& entries, const 
 
 }  // namespace
 
-std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics) {
+V6 load(CodeBuilder& cb, const TangentCol& s) {
+  V6 x;
+  for (std::size_t r = 0; r < 6; ++r) x[r] = s[r].name.empty() ? s[r].value : cb.member(s[r].name);
+  return x;
+}
+
+std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
+                                           BodyTangents* keep) {
   const Plan& plan = e.plan;
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
@@ -278,7 +276,8 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
     host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
   }
   host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
-  forward(e, kin, withLambda, forces, s);
+  forward(e, kin, withLambda, keep != nullptr, forces, s);
+  if (keep != nullptr) *keep = BodyTangents{s.dvq, s.dvv, s.daq, s.dav};
   backward(e, kin, forces, s, out);
   e.fn.endPart();
   copyOut(e, out.dq, "dtau_dq");

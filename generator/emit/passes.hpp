@@ -6,6 +6,8 @@
 // functions of a solver. docs/emitter.md: how to add one.
 #pragma once
 
+#include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -136,11 +138,39 @@ std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);
 // ---- pass_inverse_dynamics_derivatives.cpp: d tau / dq and d tau / dv of
 // tau = RNEA(q, v, qdd) + J^T lambda at fixed qdd, lambda (the tangent sweep of
 // docs/derivatives.md section 2), from its copy of the state after kinematics.
-std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics);
+/// One entry of a tangent as a later function reads it: a generation-time
+/// constant, or the workspace member it was stored to.
+struct TangentSlot {
+  Expr value;
+  std::string name;  // empty: `value` is the constant
+};
+using TangentCol = std::array<TangentSlot, 6>;
+using TangentCols = std::map<int, TangentCol>;  // column -> the 6 entries (absent: zero)
+/// The motion tangents per body (columns of its path) the sweep left in the workspace.
+struct BodyTangents {
+  std::vector<TangentCols> dvq, dvv, daq, dav;
+};
+V6 load(CodeBuilder& cb, const TangentCol& s);
+/// With `keep`, the constrained bodies' motion tangents are stored too, and
+/// their slots returned (constrained_dynamics_derivatives reads them).
+std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
+                                           BodyTangents* keep = nullptr);
 /// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
 /// and inverse_dynamics_derivatives (held with it) and the dense products
 /// (dense_product<n, m, p>, printed by assemble.cpp). denseProductOps: their arithmetic.
 std::string emitForwardDynamicsDerivatives(Emit& e);
 Ops denseProductOps(int n, int m, int p);
+
+// ---- pass_constrained_dynamics_derivatives.cpp: constrained_dynamics_derivatives
+// (docs/derivatives.md section 3): prox_pv, the sweep at its solution, the
+// constraint rows' derivatives (straight-line, from `t`), the dense algebra of
+// the implicit function theorem (fixed-bound loops printed by assemble.cpp).
+std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kin, const CodeBuilder* afterKinematics,
+                                               const BodyTangents& t);
+/// What assemble.cpp's dense helpers compute, for the banner.
+Ops denseProductAddOps(int n, int m, int p);
+Ops denseCholeskyOps(int n);
+Ops choleskySolveOps(int n, int p);
+Ops se3RightJacobianInverseOps();
 
 }  // namespace proxgen::emit

@@ -59,6 +59,8 @@ std::string bindingOf(Function f, const std::string& ns) {
       return fmt::format("{}bindInverseDynamicsDerivatives<Solver>(m, kInfo, {});\n", b, fn);
     case Function::ForwardDynamicsDerivatives:
       return fmt::format("{}bindForwardDynamicsDerivatives<Solver>(m, kInfo, {});\n", b, fn);
+    case Function::ConstrainedDynamicsDerivatives:
+      return fmt::format("{}bindConstrainedDynamicsDerivatives<Solver>(m, kInfo, {});\n", b, fn);
   }
   return "";
 }

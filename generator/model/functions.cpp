@@ -29,6 +29,7 @@ constexpr Named kFunctions[] = {
     {Function::ConstraintWrenches, "constraint_wrenches"},
     {Function::InverseDynamicsDerivatives, "inverse_dynamics_derivatives"},
     {Function::ForwardDynamicsDerivatives, "forward_dynamics_derivatives"},
+    {Function::ConstrainedDynamicsDerivatives, "constrained_dynamics_derivatives"},
 };
 
 }  // namespace

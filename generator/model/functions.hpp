@@ -25,6 +25,7 @@ enum class Function {
   ConstraintWrenches,
   InverseDynamicsDerivatives,
   ForwardDynamicsDerivatives,
+  ConstrainedDynamicsDerivatives,
 };
 
 /// Every function, in the order the header declares them.

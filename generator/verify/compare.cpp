@@ -38,6 +38,7 @@
 #include "algorithms/constrained_aba.hpp"
 #include "algorithms/constraint_kinematics.hpp"
 #include "algorithms/delassus.hpp"
+#include "algorithms/derivatives.hpp"
 #include "algorithms/crba.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
@@ -229,6 +230,144 @@ std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, con
   if (gen.W.size()) {
     const VecX ref = constraintWrenches(sys, d, s.q, gen.lambda);
     add("constraint_wrenches", gen.W, ref, std::max(c.floor, 3 * c.safety * c.eps * maxAbs1(gen.lambda) / maxAbs1(ref)));
+  }
+  return out;
+}
+
+// ---- The derivative functions. Both sides run the same sweep and the same
+// solves with the sums in another order and other factors (ABA's M^-1 against
+// CRBA + Cholesky, a dense factor of G + I/mu against Eigen's), so each entry
+// differs by c n u times the size of the terms summed, not of the result (u,
+// c n = safety as above; sizes |.| = max |entry|; relative to max(1, |generic|)):
+//  - dtau (the sweep): c n u T, T the size of the sweep's terms (derivativeTerms:
+//    the body force tangents, the forces, the inertia times the motion
+//    tangents, times the lever 1 + |p| of a transform to the parent);
+//  - forward dqdd (M^-1 times the sweep's result): c n u kappa(M) m nv (|dtau| + T),
+//    m = max(1, |M^-1|); dqdd/dtau = M^-1: c n u kappa(M); qdd: c n u kappa m nv (|tau| + |h| + |g|);
+//  - constrained: X0 = M^-1 R1 (R1 = [-dtau_dq, -dtau_dv, I]) is a solve with
+//    M: eX0 = c n u (kappa |X0| + m nv T) (its own error, and the sweep's
+//    through M^-1); C = J X0 - R2: eC = |J| nv eX0 + c n u (|J| nv |X0| + |R2| + R
+//    + (|G| + 1/mu) nc |L|) (R: the rows' terms, motion tangents times 1 + |v|
+//    and the gains; the last: G's product with L and the factor's solves at
+//    every step). The K proximal steps on the tangents,
+//    L_K = sum_{k<K} mu^-k (G + I/mu)^-(k+1) C, are one symmetric operator
+//    S_K = V diag(s(g)) V^T over G's eigenvalues g, s(g) = (1 - (1 + mu g)^-K) / g
+//    (K mu on null(G)): eL = |S_K| eC (|.| of an operator: its largest row sum);
+//    X = X0 - M^-1 J^T L: eX = eX0 + |M^-1 J^T S_K| eC + c n u kappa |M^-1 J^T| nc |L|
+//    (J^T annihilates what S_K amplifies along null(J^T), K mu: the
+//    multipliers carry it, qdd does not);
+//    qdd and lambda (prox_pv's solve, the same steps on y = J qfree + gamma - a*,
+//    qfree = M^-1 (tau - h)): ey = c n u (kappa (|J| nv |qfree| + |da*| + R) + (|G| + 1/mu) nc |lambda|),
+//    eLam = |S_K| ey, eQdd = c n u kappa (|qfree| + |M^-1 J^T| nc |lambda|) + |M^-1 J^T S_K| ey.
+// A dropped term (the gravity tangent of the rows' true acceleration, Jr(e)^-1,
+// a velocity product) moves entries by O(1) of the rows' size, far above these
+// at well-conditioned states (tests/generated/harness_derivatives.cpp; tried by hand).
+namespace {
+
+double maxAbsM(const MatX& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
+
+double derivativeTerms(const System& sys, const Data& d, const DerivativeData& dd) {
+  double T = 0.0;
+  for (int i = 1; i < sys.model.numBodies(); ++i) {
+    const std::size_t b = std::size_t(i);
+    const double lever = 1.0 + d.liMi[b].p.norm();
+    const double I = sys.model.bodies[b].inertia.matrix().cwiseAbs().maxCoeff();
+    const double vi = d.v[b].cwiseAbs().maxCoeff();
+    const double motion = std::max({maxAbsM(dd.da_dq[b]), maxAbsM(dd.da_dv[b]), dd.a[b].cwiseAbs().maxCoeff()}) +
+                          2.0 * vi * std::max(maxAbsM(dd.dv_dq[b]), maxAbsM(dd.dv_dv[b]));
+    T = std::max({T, lever * maxAbsM(dd.df_dq[b]), lever * maxAbsM(dd.df_dv[b]), lever * dd.f[b].cwiseAbs().maxCoeff(),
+                  lever * 6.0 * I * motion});
+  }
+  return T;
+}
+
+// The K proximal steps on the tangents as one operator, L_K = S_K C:
+// S_K = sum_{k<K} mu^-k (G + I/mu)^-(k+1) = V diag(s(g)) V^T over G's
+// eigenvalues g, s(g) = (1 - (1 + mu g)^-K) / g (K mu on null(G)).
+MatX proximalOperator(const MatX& G, double mu, int K) {
+  if (G.rows() == 0) return G;
+  const Eigen::SelfAdjointEigenSolver<MatX> eig(G);
+  VecX s(G.rows());
+  for (Eigen::Index k = 0; k < s.size(); ++k) {
+    const double g = std::max(0.0, eig.eigenvalues()[k]);
+    s[k] = g * mu > 1e-12 ? (1.0 - std::pow(1.0 + mu * g, -K)) / g : K * mu;
+  }
+  return eig.eigenvectors() * s.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// max_r sum_c |A(r, c)|: the factor a perturbation of size e per entry of x grows by in A x.
+double rowSum(const MatX& A) { return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0; }
+
+}  // namespace
+
+std::vector<Compared> compareDerivatives(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                         const DerivativeAnswer& gen) {
+  std::vector<Compared> out;
+  const int nv = sys.model.nv, nc = sys.nc;
+  const double u = c.safety * c.eps;
+  DerivativeData dd(sys);
+  const auto add = [&](const char* what, const MatX& g, const MatX& ref, double absBound) {
+    const bool finite = (g.size() == 0 || g.allFinite()) && (ref.size() == 0 || ref.allFinite());
+    out.push_back({what, relErr(g, ref), std::max(c.floor, absBound / std::max(1.0, maxAbsM(ref))), finite});
+  };
+  const MatX Minv = c.M.llt().solve(MatX::Identity(nv, nv));
+  const double m = std::max(1.0, maxAbsM(Minv));
+  const VecX h = nonLinearEffects(sys, d, s.q, s.v);
+  if (gen.dtau_dq.size()) {
+    inverseDynamicsDerivatives(sys, d, dd, s.q, s.v, gen.qdd, nc > 0 ? &gen.lambda : nullptr);
+    const double T = derivativeTerms(sys, d, dd);
+    add("inverse_dynamics_derivatives dtau_dq", gen.dtau_dq, dd.dtau_dq, u * T);
+    add("inverse_dynamics_derivatives dtau_dv", gen.dtau_dv, dd.dtau_dv, u * T);
+  }
+  if (gen.fDq.size()) {
+    forwardDynamicsDerivatives(sys, d, dd, s.q, s.v, gen.tau);
+    const double T = derivativeTerms(sys, d, dd);
+    const VecX g = nonLinearEffects(sys, d, s.q, d.zeroV);
+    const double k = u * c.kappaM * m * nv;
+    const double rhs = maxAbsM(gen.tau) + maxAbsM(h) + maxAbsM(g);
+    add("forward_dynamics_derivatives qdd", gen.fQdd, dd.qdd, k * rhs);
+    add("forward_dynamics_derivatives dqdd_dq", gen.fDq, dd.dqdd_dq, k * (maxAbsM(dd.dtau_dq) + T));
+    add("forward_dynamics_derivatives dqdd_dv", gen.fDv, dd.dqdd_dv, k * (maxAbsM(dd.dtau_dv) + T));
+    add("forward_dynamics_derivatives dqdd_dtau", gen.fDtau, dd.dqdd_dtau, u * c.kappaM * m);
+  }
+  if (gen.cDq.size()) {
+    constrainedDynamicsDerivatives(sys, d, dd, s.q, s.v, gen.tau, gen.mu, gen.K);
+    const double T = derivativeTerms(sys, d, dd);
+    double motion = 0.0;  // the rows' terms: motion tangents, times 1 + |v| in the velocity products
+    for (int i = 1; i < sys.model.numBodies(); ++i) {
+      const std::size_t b = std::size_t(i);
+      const double vi = 1.0 + d.v[b].cwiseAbs().maxCoeff();
+      motion = std::max({motion, vi * maxAbsM(dd.dv_dq[b]), vi * maxAbsM(dd.dv_dv[b]), maxAbsM(dd.da_dq[b]),
+                         maxAbsM(dd.da_dv[b]), maxAbsM(dd.dg_dq[b])});
+    }
+    double gains = 1.0;
+    for (const Constraint& con : sys.constraints) gains = std::max({gains, con.kp, con.kd});
+    const MatX G = dd.J * Minv * dd.J.transpose();
+    const MatX S = proximalOperator(G, gen.mu, gen.K);
+    const MatX MinvJt = Minv * dd.J.transpose();
+    const double A = rowSum(S), P = rowSum(MinvJt * S);  // |S_K|, |M^-1 J^T S_K|
+    // X0 = M^-1 R1, R1 = [-dtau_dq, -dtau_dv, I]: its entries' size.
+    const double X0 = std::max({maxAbsM(Minv * dd.dtau_dq), maxAbsM(Minv * dd.dtau_dv), maxAbsM(Minv)});
+    const double R2 = std::max(maxAbsM(dd.dastar_dq - dd.dalpha_dq), maxAbsM(dd.dastar_dv - dd.dalpha_dv));
+    const double J = maxAbsM(dd.J), R = gains * motion;
+    const double Ls = std::max({maxAbsM(dd.dlambda_dq), maxAbsM(dd.dlambda_dv), maxAbsM(dd.dlambda_dtau)});
+    const double eX0 = u * (c.kappaM * X0 + m * nv * T);
+    const double eC = J * nv * eX0 + u * (J * nv * X0 + R2 + R + (maxAbsM(G) + 1.0 / gen.mu) * nc * Ls);
+    const double eL = A * eC;
+    const double eX = eX0 + P * eC + u * c.kappaM * maxAbsM(MinvJt) * nc * Ls;
+    const VecX qfree = Minv * (gen.tau - h);
+    const double y = J * nv * maxAbsM(qfree) + maxAbsM(dd.dastar_dq) + R;
+    const double ey = u * (c.kappaM * y + (maxAbsM(G) + 1.0 / gen.mu) * nc * maxAbsM(dd.lambda));
+    const double eLam = A * ey;
+    const double eQdd = u * c.kappaM * (maxAbsM(qfree) + maxAbsM(MinvJt) * nc * maxAbsM(dd.lambda)) + P * ey;
+    add("constrained_dynamics_derivatives qdd", gen.cQdd, dd.qdd, eQdd);
+    add("constrained_dynamics_derivatives lambda", gen.cLambda, dd.lambda, eLam);
+    add("constrained_dynamics_derivatives dqdd_dq", gen.cDq, dd.dqdd_dq, eX);
+    add("constrained_dynamics_derivatives dqdd_dv", gen.cDv, dd.dqdd_dv, eX);
+    add("constrained_dynamics_derivatives dqdd_dtau", gen.cDtau, dd.dqdd_dtau, eX);
+    add("constrained_dynamics_derivatives dlambda_dq", gen.cLq, dd.dlambda_dq, eL);
+    add("constrained_dynamics_derivatives dlambda_dv", gen.cLv, dd.dlambda_dv, eL);
+    add("constrained_dynamics_derivatives dlambda_dtau", gen.cLtau, dd.dlambda_dtau, eL);
   }
   return out;
 }

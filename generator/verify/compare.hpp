@@ -107,4 +107,21 @@ struct ConstraintAnswer {
 std::vector<Compared> compareConstraintFunctions(const System& sys, Data& d, const Conditioning& c, const State& s,
                                                  const ConstraintAnswer& gen);
 
+// ---- The derivative functions (docs/derivatives.md) against
+// algorithms/derivatives.cpp; bounds argued in compare.cpp. Row-major results
+// as nv x nv / nc x nv matrices; an empty matrix: not generated.
+struct DerivativeAnswer {
+  VecX qdd, lambda, tau;  // the inputs: inverse_dynamics_derivatives' (qdd, lambda), the others' tau
+  MatX dtau_dq, dtau_dv;  // inverse_dynamics_derivatives(q, v, qdd, lambda)
+  VecX fQdd;              // forward_dynamics_derivatives(q, v, tau)
+  MatX fDq, fDv, fDtau;
+  VecX cQdd, cLambda;     // constrained_dynamics_derivatives(q, v, tau, Settings{mu, K})
+  MatX cDq, cDv, cDtau, cLq, cLv, cLtau;
+  double mu = 0;
+  int K = 0;
+};
+/// One Compared per result present in `gen`.
+std::vector<Compared> compareDerivatives(const System& sys, Data& d, const Conditioning& c, const State& s,
+                                         const DerivativeAnswer& gen);
+
 }  // namespace proxgen::verify

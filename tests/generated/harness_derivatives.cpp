@@ -6,7 +6,8 @@
 // Compiled into every harness executable (tests/generated/CMakeLists.txt);
 // each test exists only when its solver holds the function
 // (PROXGEN_SOLVER_HAS_<NAME>, from proxgen_test_solver's FUNCTIONS).
-#if defined(PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS_DERIVATIVES) || defined(PROXGEN_SOLVER_HAS_FORWARD_DYNAMICS_DERIVATIVES)
+#if defined(PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS_DERIVATIVES) || defined(PROXGEN_SOLVER_HAS_FORWARD_DYNAMICS_DERIVATIVES) || \
+    defined(PROXGEN_SOLVER_HAS_CONSTRAINED_DYNAMICS_DERIVATIVES)
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -25,6 +26,7 @@
 #include "algorithms/rnea.hpp"
 #include "harness_lib.hpp"
 #include "support.hpp"
+#include "verify/compare.hpp"
 
 namespace {
 
@@ -198,6 +200,46 @@ TEST_F(GeneratedDerivatives, ForwardDynamicsDerivativesMatchTheGeneric) {
     }
   }
   std::printf("forward_dynamics_derivatives: largest error %.2g of the bound\n", worst);
+}
+#endif
+
+
+#if PROXGEN_SOLVER_HAS_CONSTRAINED_DYNAMICS_DERIVATIVES
+// constrained_dynamics_derivatives against constrainedDynamicsDerivatives at
+// the layout's mu and K (both return the K-step iterates on the tangents, so
+// they answer the same question also where K has not converged), with the
+// bounds `proxgen verify` applies (verify::compareDerivatives, argued in
+// verify/compare.cpp: c n u times the sizes of the terms, kappa(M) for the
+// solves with M, and the K proximal steps' amplification of a perturbation of
+// their right-hand side, read from G's eigenvalues at each state).
+TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGeneric) {
+  const int nv = gen::nv, nc = gen::nc;
+  const gen::Settings settings;  // the layout's mu and K
+  double worst = 0.0;
+  for (const Sample& s : samples(sys_, 20261204)) {
+    const std::size_t n = std::size_t(nv), m = std::size_t(std::max(nc, 1)), n2 = n * n, mn = m * n;
+    std::vector<gen::Scalar> qdd(n), lambda(m), xq(n2), xv(n2), xt(n2), lq(mn), lv(mn), lt(mn);
+    gen::constrained_dynamics_derivatives(toScalar(s.q).data(), toScalar(s.v).data(), toScalar(s.tau).data(), settings,
+                                          workspace(), qdd.data(), lambda.data(), xq.data(), xv.data(), xt.data(),
+                                          lq.data(), lv.data(), lt.data());
+    proxgen::verify::DerivativeAnswer a;
+    a.tau = s.tau;
+    a.mu = double(settings.mu);
+    a.K = settings.iterations;
+    a.cQdd = rowMajor(qdd, nv, 1);
+    a.cLambda = rowMajor(lambda, nc, 1);
+    a.cDq = rowMajor(xq, nv, nv), a.cDv = rowMajor(xv, nv, nv), a.cDtau = rowMajor(xt, nv, nv);
+    a.cLq = rowMajor(lq, nc, nv), a.cLv = rowMajor(lv, nc, nv), a.cLtau = rowMajor(lt, nc, nv);
+    proxgen::State st;
+    st.q = s.q, st.v = s.v, st.tau = s.tau;
+    const proxgen::verify::Conditioning c = proxgen::verify::conditioningAt(sys_, d_, st, kFloat);
+    for (const proxgen::verify::Compared& x : proxgen::verify::compareDerivatives(sys_, d_, c, st, a)) {
+      ASSERT_TRUE(x.finite) << x.what;
+      EXPECT_LE(x.error, x.bound) << x.what;
+      worst = std::max(worst, x.error / x.bound);
+    }
+  }
+  std::printf("constrained_dynamics_derivatives: largest error %.2g of the bound\n", worst);
 }
 #endif
 

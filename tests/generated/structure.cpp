@@ -64,7 +64,11 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
   static const std::regex fixedLoop(
       R"( *(for \(int k = 0; k < [1-9][0-9]*; \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
       R"(|for \(int r = 0; r < n; \+\+r\)|for \(int c = 0; c < p; \+\+c\) \{)"
-      R"(|for \(int k = 0; k < m; \+\+k\) sum \+= A\[r \* m \+ k\] \* B\[k \* p \+ c\];))");
+      R"(|for \(int k = 0; k < m; \+\+k\) sum \+= A\[r \* m \+ k\] \* B\[k \* p \+ c\];)"
+      // constrained_dynamics_derivatives' helpers (Cholesky, proximal step, the
+      // SE(3) Jacobian's series): a head alone, bounds a template argument, an
+      // outer index or a literal.
+      R"(|for \(int ([a-z]) = (0|1|[a-z] \+ 1|n - 1); \2 (<|>=) ([a-z]|0|[1-9][0-9]*); (\+\+|--)\2\) \{))");
   static const std::vector<std::string> keywords = {"for", "while", "do", "if", "else", "switch", "case", "goto"};
   std::vector<std::string> found;
   for (std::size_t k = 0; k < code.size(); ++k) {
@@ -119,6 +123,10 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 324; ++k) dtau_dq[k] = Scalar(0);\n").empty());
   EXPECT_EQ(forbiddenControlFlow("  for (int k = 0; k < n; ++k) dtau_dq[k] = Scalar(0);\n").size(), 1u);
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.fdd_h[k] = tau[k] - w.fdd_h[k];\n").empty());
+  EXPECT_TRUE(forbiddenControlFlow("    for (int i = n - 1; i >= 0; --i) {\n    }\n").empty());
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = i + 1; k < n; ++k) {\n  }\n").empty());
+  EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < w.n; ++k) {\n  }\n").size(), 1u);
+  EXPECT_GE(forbiddenControlFlow("  for (int i = 0; i < n; ++i) { x(); }\n").size(), 1u);
   EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.h[k] = c ? a : b;\n").size(), 1u);
   EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) { w.h[k] = 0; }\n").size(), 1u);
   EXPECT_EQ(forbiddenControlFlow("switch (t) { case 1: {} }").size(), 2u);

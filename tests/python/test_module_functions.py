@@ -10,7 +10,7 @@ from conftest import C, EPS, module, random_state, rel_err, scaled_condition
 
 LIBRARY = ("inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse", "constraint_placements",
            "constraint_jacobian", "constraint_drift", "delassus", "delassus_inverse", "constraint_wrenches",
-           "inverse_dynamics_derivatives", "forward_dynamics_derivatives")
+           "inverse_dynamics_derivatives", "forward_dynamics_derivatives", "constrained_dynamics_derivatives")
 
 
 @pytest.fixture
@@ -79,6 +79,7 @@ def test_many_states_are_the_single_states(m, quadruped, rng):
         "constraint_wrenches": lambda k: (Q[k], lam[k]),
         "inverse_dynamics_derivatives": lambda k: (Q[k], V[k], T[k], lam[k]),
         "forward_dynamics_derivatives": lambda k: (Q[k], V[k], T[k]),
+        "constrained_dynamics_derivatives": lambda k: (Q[k], V[k], T[k]),
     }
     for name in LIBRARY:
         args = calls.get(name, lambda k: (Q[k],))
@@ -193,3 +194,59 @@ def test_bad_options_name_the_argument(m):
         m.constraint_wrenches(q, np.zeros(2))
     with pytest.raises(ValueError, match="has zero norm"):
         m.mass_matrix(np.zeros(m.nq))
+
+
+def test_constrained_dynamics_derivatives_along_v_and_tau_are_the_solve_s(m, quadruped, rng):
+    """Along v and tau, G does not move, so the tangents' K proximal steps are exactly the
+    derivative of prox_pv's K steps: central differences of m.prox_pv check them with no
+    truncation error (the K-step solution is linear in tau and quadratic in v)."""
+    nv, nc = m.nv, m.nc
+    for _ in range(3):
+        q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+        qdd, lam, dq, dv, dtau, lq, lv, ltau = m.constrained_dynamics_derivatives(q, v, tau)
+        assert dq.shape == (nv, nv) and lq.shape == (nc, nv)
+        # The same prox_pv call inside: the same bits.
+        qdd0, lam0 = m.prox_pv(q, v, tau)
+        assert np.array_equal(qdd, qdd0) and np.array_equal(lam, lam0)
+        # Each solve is off by at most delta = C n eps kappa(M) kappa(G + I/mu) times the
+        # size of its answer; a central difference of two of them by delta / h.
+        M, J = m.mass_matrix(q), m.constraint_jacobian(q)
+        G = J @ np.linalg.solve(M, J.T) + np.eye(nc) / m.mu
+        delta = C * (nv + nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+        h = 1e-2
+        for k in range(nv):
+            e = np.zeros(nv)
+            e[k] = h
+            for x, got_qdd, got_lam in ((0, dv, lv), (1, dtau, ltau)):
+                plus = m.prox_pv(q, v + e, tau) if x == 0 else m.prox_pv(q, v, tau + e)
+                minus = m.prox_pv(q, v - e, tau) if x == 0 else m.prox_pv(q, v, tau - e)
+                assert np.max(np.abs(got_qdd[:, k] - (plus[0] - minus[0]) / (2 * h))) <= delta / h, (x, k)
+                assert np.max(np.abs(got_lam[:, k] - (plus[1] - minus[1]) / (2 * h))) <= delta / h, (x, k)
+
+
+def test_constrained_dynamics_derivatives_follow_the_schedule(m, quadruped, rng):
+    """An inactive constraint counts as absent: its multiplier rows and their tangents are
+    exactly zero, and the others are the derivatives of prox_pv with that schedule (checked
+    along tau, where central differences of the K-step solve are exact, as above)."""
+    nv, nc = m.nv, m.nc
+    active = [True, False, True, True]
+    name = quadruped.constraint_names[1]
+    rows = slice(quadruped.constraints[name].row, quadruped.constraints[name].row + 3)
+    q, v, tau = random_state(quadruped, rng, exact_quaternion=False)
+    qdd, lam, dq, dv, dtau, lq, lv, ltau = m.constrained_dynamics_derivatives(q, v, tau, active=active)
+    qdd0, lam0 = m.prox_pv(q, v, tau, active=active)
+    assert np.array_equal(qdd, qdd0) and np.array_equal(lam, lam0)
+    for L in (lq, lv, ltau):
+        assert np.array_equal(L[rows], np.zeros((3, nv)))
+    M, J = m.mass_matrix(q), m.constraint_jacobian(q)
+    G = J @ np.linalg.solve(M, J.T) + np.eye(nc) / m.mu
+    delta = C * (nv + nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+    h = 1e-2
+    for k in range(nv):
+        e = np.zeros(nv)
+        e[k] = h
+        plus, minus = m.prox_pv(q, v, tau + e, active=active), m.prox_pv(q, v, tau - e, active=active)
+        assert np.max(np.abs(dtau[:, k] - (plus[0] - minus[0]) / (2 * h))) <= delta / h, k
+        assert np.max(np.abs(ltau[:, k] - (plus[1] - minus[1]) / (2 * h))) <= delta / h, k
+    # The schedule changes the answer: with every foot the tangents differ.
+    assert np.max(np.abs(m.constrained_dynamics_derivatives(q, v, tau)[4] - dtau)) > 1e-6

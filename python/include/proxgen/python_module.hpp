@@ -441,6 +441,44 @@ void bindForwardDynamicsDerivatives(py::module_& m, const ModuleInfo& info,
       "(nv,) and (nv, nv), or with a leading N; column k of d/dq is along q (+) t e_k (docs/derivatives.md).");
 }
 
+/// constrained_dynamics_derivatives(q, v, tau, mu=None, iterations=None, active=None)
+/// -> (qdd, lam, dqdd_dq, dqdd_dv, dqdd_dtau, dlam_dq, dlam_dv, dlam_dtau).
+template <class Solver>
+void bindConstrainedDynamicsDerivatives(
+    py::module_& m, const ModuleInfo& info,
+    void (*fn)(const Scalar_t<Solver>*, const Scalar_t<Solver>*, const Scalar_t<Solver>*,
+               const typename Solver::Settings&, Workspace_t<Solver>&, Scalar_t<Solver>*, Scalar_t<Solver>*,
+               Scalar_t<Solver>*, Scalar_t<Solver>*, Scalar_t<Solver>*, Scalar_t<Solver>*, Scalar_t<Solver>*,
+               Scalar_t<Solver>*) noexcept) {
+  constexpr int nv = Solver::nv, nc = Solver::nc;
+  const ModuleInfo* p = &info;
+  m.def(
+      "constrained_dynamics_derivatives",
+      [p, fn](py::handle q, py::handle v, py::handle tau, py::handle mu, py::handle iterations, py::handle active) {
+        const typename Solver::Settings defaults;
+        typename Solver::Settings s;
+        s.mu = Scalar_t<Solver>(readMu(mu, double(defaults.mu)));
+        s.iterations = readIterations(iterations, defaults.iterations);
+        readActive(active, p->constraints.size(), s.active);
+        Inputs<Solver> in(q);
+        const auto* vin = in.add(v, "v", nv, "nv");
+        const auto* tin = in.add(tau, "tau", nv, "nv");
+        const std::vector<py::ssize_t> square{nv, nv}, rows{nc, nv};
+        const std::array<std::vector<py::ssize_t>, 8> dims{std::vector<py::ssize_t>{nv}, std::vector<py::ssize_t>{nc},
+                                                           square, square, square, rows, rows, rows};
+        auto out = eachStateOutputs<Solver, 8>(*p, in, dims, [&](py::ssize_t k, auto* qn, auto& w, auto& o) {
+          fn(qn, vin + k * nv, tin + k * nv, s, w, o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7]);
+        });
+        return py::make_tuple(std::move(out[0]), std::move(out[1]), std::move(out[2]), std::move(out[3]),
+                              std::move(out[4]), std::move(out[5]), std::move(out[6]), std::move(out[7]));
+      },
+      py::arg("q"), py::arg("v"), py::arg("tau"), py::arg("mu") = py::none(), py::arg("iterations") = py::none(),
+      py::arg("active") = py::none(),
+      "(q, v, tau, mu=None, iterations=None, active=None) -> (qdd, lam, dqdd_dq, dqdd_dv, dqdd_dtau,\n"
+      "dlam_dq, dlam_dv, dlam_dtau): prox_pv's solution and its derivatives ((nv, nv) and (nc, nv),\n"
+      "or with a leading N); column k of d/dq is along q (+) t e_k (docs/derivatives.md).");
+}
+
 template <class Solver>
 void bindSolver(py::module_& m, const ModuleInfo& info) {
   m.attr("name") = info.name;

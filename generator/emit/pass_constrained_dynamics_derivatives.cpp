@@ -1,0 +1,304 @@
+// constrained_dynamics_derivatives (docs/derivatives.md section 3): the
+// derivatives of the solution prox_pv converges to, by the implicit function
+// theorem on M qdd + h + J^T lambda = tau, J qdd + gamma = a*:
+//   M X + J^T L = R1 = [-dtau/dq, -dtau/dv, I],   J X = R2 = d a*/dx - d alpha/dx  (x = q, v; 0 for tau),
+// L by the Settings' K proximal steps (G + I/mu) L+ = C + L/mu from 0,
+// C = J M^-1 R1 - R2, and X = M^-1 (R1 - J^T L). The host calls
+// mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
+// it); the constraint rows (J, R2) are printed straight-line from the sweep's
+// motion tangents of the constrained bodies, the path's columns only; the
+// dense algebra (O(nv^2 nc + nc^2 nv + K nc^2 nv)) is fixed-bound loops
+// printed once by assemble.cpp. The generic counterpart:
+// algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
+#include <fmt/format.h>
+
+#include "emit/identifiers.hpp"
+#include "emit/passes.hpp"
+#include "model/error.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+std::string rowsComment(const Emit& e, int k) {
+  const ConstraintPlan& c = e.plan.constraints[std::size_t(k)];
+  return fmt::format("constraint '{}' ({}) on link '{}': rows {}..{}", escapeComment(c.name), c.weld ? "6d" : "3d",
+                     escapeComment(c.link), c.row, c.row + c.rows - 1);
+}
+
+// Jr(e)^-1 of a weld's placement error e = log6(T^-1 oMc) (6 x 6, as inputs of
+// the block): log6 as the kinematics pass computes it, then the helper.
+std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& kb) {
+  const Constraint& c = e.sys.constraints[std::size_t(k)];
+  const std::string id = e.plan.constraints[std::size_t(k)].ident;
+  CodeBuilder& cb = e.cb();
+  const XSym oMc = compose(cb, kb.oM, constant(c.placement));
+  const XSym E = compose(cb, constant(c.target.inverse()), oMc);
+  std::vector<Expr> R, p;
+  std::string Rs, ps;
+  for (int j = 0; j < 9; ++j) {
+    R.push_back(cb.flat(E.R[std::size_t(j)]));
+    Rs += (j ? ", " : "") + cb.print(R.back());
+  }
+  for (int j = 0; j < 3; ++j) {
+    p.push_back(cb.flat(E.p[std::size_t(j)]));
+    ps += (j ? ", " : "") + cb.print(p.back());
+  }
+  cb.line(fmt::format("const Scalar jrR_{}[9] = {{{}}};", id, Rs), R);
+  cb.line(fmt::format("const Scalar jrp_{}[3] = {{{}}};", id, ps), p);
+  cb.line(fmt::format("Scalar jre_{0}[6], jri_{0}[36];", id));
+  OpCount ops;
+  ops.once.log6 = 1;
+  cb.line(fmt::format("proxgen_rt::log6(jrR_{0}, jrp_{0}, jre_{0});", id), {}, {}, ops);
+  ops = OpCount{};
+  ops.once = se3RightJacobianInverseOps();
+  cb.line(fmt::format("se3_right_jacobian_inverse(jre_{0}, jri_{0});", id), {}, {}, ops);
+  std::vector<Expr> out;
+  for (int j = 0; j < 36; ++j) out.push_back(cb.input(fmt::format("jri_{}[{}]", id, j)));
+  return out;
+}
+
+struct RowMembers {
+  std::string J, R2q, R2v;  // nc x nv each, flat
+};
+
+// entry = f * x into member[idx], skipping exact zeros (the host zeroed the arrays).
+void storeRow(Emit& e, const std::string& base, int idx, const Expr& f, const Expr& x) {
+  if (x.isZero()) return;
+  CodeBuilder& cb = e.cb();
+  const Expr flat = cb.flat(x);
+  const Expr y = cb.mul(f, flat);
+  cb.store(e.ws.member(base, e.plan.nc * e.plan.nv, idx, "constrained_dynamics_derivatives"), y);
+}
+
+// One constraint's rows: J, and R2 = d a*/dx - d alpha/dx for x = q, v at
+// fixed qdd (alpha = J qdd + gamma: the frame's acceleration in C, 6d; the
+// classical acceleration a_lin + w x v_lin of its origin, 3d), per column of
+// the body's path. The sweep's a is gravity-shifted (a_0 = -a_g): the true
+// acceleration's q tangent adds R^T g x w back (w the Jacobian column's
+// angular part: the body turns by w, its gravity by -w x R^T g).
+void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangents& t, const RowMembers& m) {
+  const Constraint& c = e.sys.constraints[std::size_t(k)];
+  const int i = c.body, r = c.rows(), nv = e.plan.nv;
+  const bool weld = c.type == ConstraintType::Weld6D;
+  CodeBuilder& cb = e.cb();
+  cb.comment(rowsComment(e, k));
+  const XSym P = constant(c.placement);
+  const Expr f = activeFactor(e, k);
+  const V6 vC = actInvMotion(cb, P, kb.v);
+  std::vector<Expr> jri;
+  if (weld && c.kp != 0) jri = rightJacobianInverse(e, k, kb);
+  V3 err = zero3();
+  if (!weld && c.kp != 0) {
+    const XSym oMc = compose(cb, kb.oM, constant(c.placement));
+    V3 d;
+    for (int j = 0; j < 3; ++j) d[std::size_t(j)] = oMc.p[std::size_t(j)] - c.target.p[j];
+    err = rotateT(cb, oMc.R, d);
+    for (Expr& x : err) x = cb.flat(x, "e");
+  }
+  const std::size_t b = std::size_t(i);
+  for (const auto& [col, slots] : t.dvv[b]) {
+    const V6 dvv = load(cb, slots);
+    const V6 dvq = load(cb, t.dvq[b].at(col));
+    const V6 daq0 = load(cb, t.daq[b].at(col));
+    const V6 dav = load(cb, t.dav[b].at(col));
+    const V3 gw = cross(cb, kb.g, ang(dvv));
+    V6 daq = daq0;
+    for (int j = 0; j < 3; ++j) daq[std::size_t(j)] += gw[std::size_t(j)];
+    const V6 J6 = actInvMotion(cb, P, dvv);
+    const V6 vq = actInvMotion(cb, P, dvq);
+    const V6 aq = actInvMotion(cb, P, daq);
+    const V6 av = actInvMotion(cb, P, dav);
+    std::vector<Expr> Aq(aq.begin(), aq.begin() + r), Av(av.begin(), av.begin() + r);
+    if (!weld) {  // d(w x v) = dw x v + w x dv
+      const V3 t1 = cross(cb, ang(vq), lin(vC));
+      const V3 t2 = cross(cb, ang(vC), lin(vq));
+      const V3 t3 = cross(cb, ang(J6), lin(vC));
+      const V3 t4 = cross(cb, ang(vC), lin(J6));
+      for (std::size_t j = 0; j < 3; ++j) {
+        Aq[j] += t1[j] + t2[j];
+        Av[j] += t3[j] + t4[j];
+      }
+    }
+    std::vector<Expr> Sq(static_cast<std::size_t>(r)), Sv(static_cast<std::size_t>(r));
+    for (std::size_t j = 0; j < std::size_t(r); ++j) {
+      Sq[j] = -c.kd * vq[j];
+      Sv[j] = -c.kd * J6[j];
+    }
+    if (c.kp != 0 && weld) {  // de = Jr(e)^-1 J6 dq
+      std::vector<Expr> J6f;
+      for (const Expr& x : J6) J6f.push_back(cb.flat(x));
+      for (std::size_t j = 0; j < 6; ++j) {
+        Expr s;
+        for (std::size_t l = 0; l < 6; ++l) {
+          if (J6f[l].isZero()) continue;
+          const Expr p = cb.mul(jri[6 * j + l], J6f[l]);
+          s += p;
+        }
+        Sq[j] -= c.kp * s;
+      }
+    } else if (c.kp != 0) {  // de = J6_lin dq + e x J6_ang dq
+      const V3 ex = cross(cb, err, ang(J6));
+      for (std::size_t j = 0; j < 3; ++j) Sq[j] -= c.kp * (J6[j] + ex[j]);
+    }
+    for (int j = 0; j < r; ++j) {
+      const int idx = (c.row + j) * nv + col;
+      storeRow(e, m.J, idx, f, J6[std::size_t(j)]);
+      storeRow(e, m.R2q, idx, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]);
+      storeRow(e, m.R2v, idx, f, Sv[std::size_t(j)] - Av[std::size_t(j)]);
+    }
+  }
+}
+
+}  // namespace
+
+// The helpers' arithmetic (assemble.cpp prints them; counted as they are written).
+Ops denseProductAddOps(int n, int m, int p) {
+  Ops o = denseProductOps(n, m, p);
+  o.add += long(n) * p;
+  return o;
+}
+
+Ops denseCholeskyOps(int n) {
+  Ops o;
+  for (long j = 0; j < n; ++j) {
+    o.mul += j + (n - 1 - j) * (j + 1);
+    o.add += j + (n - 1 - j) * j;
+  }
+  o.add += n;  // the shift
+  o.sqrt = n;
+  o.div = n;
+  return o;
+}
+
+Ops choleskySolveOps(int n, int p) {
+  Ops o;
+  o.mul = long(p) * (long(n) * (n - 1) + 2L * n);
+  o.add = long(p) * long(n) * (n - 1);
+  return o;
+}
+
+Ops se3RightJacobianInverseOps() {
+  Ops o;
+  // 40 terms: 1 division, P^(k+1) and C_(k+1) (81 products, 81 sums), the 18 scaled sums.
+  o.div = 40;
+  o.add = 40L * (81 + 18);
+  o.mul = 40L * (81 + 18);
+  // The 3 x 3 inverse by cofactors (18 products, 9 differences, det 3 + 2, 1
+  // division, 9 scalings), the corner -A^-1 B A^-1 (two 3 x 3 products), 9 negations.
+  o.mul += 18 + 3 + 9 + 54;
+  o.add += 9 + 2 + 36;
+  o.div += 1;
+  o.neg += 9;
+  return o;
+}
+
+std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn, const CodeBuilder* afterKinematics,
+                                               const BodyTangents& t) {
+  const Plan& plan = e.plan;
+  const int nv = plan.nv, nc = plan.nc;
+  if (nv == 0)
+    fail("layout", "functions", "'constrained_dynamics_derivatives' is not generated for a robot without joints (nv = 0)");
+  const auto array = [&](const std::string& base, int size, const std::string& comment) {
+    e.ws.member(base, size, 0, comment);
+    return "w." + base;
+  };
+  const std::string minv = array("cdd_Minv", nv * nv, "M^-1 (constrained_dynamics_derivatives)");
+  const std::string dq = array("cdd_dtau_dq", nv * nv, "d tau / dq at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
+  const std::string dv = array("cdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
+  RowMembers rows;
+  std::string jminv, minvjt, G, Lf, C;
+  if (nc > 0) {
+    rows.J = "cdd_J", rows.R2q = "cdd_R2q", rows.R2v = "cdd_R2v";
+    array(rows.J, nc * nv, "J (nc x nv; constrained_dynamics_derivatives)");
+    array(rows.R2q, nc * nv, "d a*/dq - d alpha/dq (constrained_dynamics_derivatives)");
+    array(rows.R2v, nc * nv, "d a*/dv - d alpha/dv (constrained_dynamics_derivatives)");
+    jminv = array("cdd_JMinv", nc * nv, "J M^-1 (constrained_dynamics_derivatives)");
+    minvjt = array("cdd_MinvJt", nv * nc, "M^-1 J^T (constrained_dynamics_derivatives)");
+    G = array("cdd_G", nc * nc, "G = J M^-1 J^T (constrained_dynamics_derivatives)");
+    Lf = array("cdd_Lf", nc * nc, "G + I/mu = L L^T, 1/L_jj on the diagonal (constrained_dynamics_derivatives)");
+    C = array("cdd_C", nc * nv, "J M^-1 R1 - R2, one input's columns (constrained_dynamics_derivatives)");
+  }
+  Kinematics kin = kinIn;
+  e.fn.live() = Live{};
+  e.fn.live().kin = &kin;
+  e.fn.beginHost("cdd", afterKinematics);
+  const std::vector<std::string> names = {"q", "v", "tau", "s", "w", "qdd", "lambda", "dqdd_dq", "dqdd_dv",
+                                          "dqdd_dtau", "dlambda_dq", "dlambda_dv", "dlambda_dtau"};
+  CodeBuilder& host = e.cb();
+  // M^-1 first: its joint transforms are the same q's, and the sweep's
+  // members (read by the rows below) are written after it.
+  host.line(fmt::format("mass_matrix_inverse(q, w, {});", minv), {}, names);
+  host.line("prox_pv(q, v, tau, s, w, qdd, lambda);", {}, names);
+  host.line(fmt::format("inverse_dynamics_derivatives(q, v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
+  OpCount ops;
+  if (nc > 0) {
+    // The rows of an inactive constraint are zeros: its lambda is 0 and its
+    // tangents too, the derivatives of the solver generated without it.
+    storeActiveFactors(e, "s.active");
+    for (const std::string& a : {rows.J, rows.R2q, rows.R2v})
+      host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, a), {}, names);
+    e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's tangents");
+    for (int i : plan.support)
+      for (int k : e.bp(i).constraints) {
+        e.fn.boundary(i);
+        e.openBody(i, "constraint rows:");
+        constraintRows(e, k, kin.b[std::size_t(i)], t, rows);
+        e.cb().close();
+      }
+    e.fn.endPart();
+  }
+  CodeBuilder& cb = e.cb();
+  // The unconstrained tangents M^-1 R1: X_q = -M^-1 dtau_dq, X_v = -M^-1 dtau_dv, X_tau = M^-1.
+  ops.once = denseProductOps(nv, nv, nv);
+  cb.line(fmt::format("dense_product<{0}, {0}, {0}>({1}, {2}, Scalar(-1), dqdd_dq);", nv, minv, dq), {}, names, ops);
+  cb.line(fmt::format("dense_product<{0}, {0}, {0}>({1}, {2}, Scalar(-1), dqdd_dv);", nv, minv, dv), {}, names, ops);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_dtau[k] = {}[k];", nv * nv, minv), {}, names);
+  if (nc == 0) {
+    for (const char* p : {"dlambda_dq", "dlambda_dv", "dlambda_dtau"})
+      cb.line(fmt::format("static_cast<void>({});", p), {}, names);
+    return e.fn.endHost(names);
+  }
+  ops.once = denseProductOps(nc, nv, nv);
+  cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, rows.J, minv, jminv), {}, names, ops);
+  // M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k % {}) * {} + k / {}];", nv * nc, minvjt, jminv, nc, nv, nc),
+          {}, names);
+  ops.once = denseProductOps(nc, nv, nc);
+  cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nc, rows.J, minvjt, G), {}, names, ops);
+  ops.once = Ops::divisions(1);
+  cb.line("const Scalar inv_mu = Scalar(1) / s.mu;", {}, names, ops);
+  ops.once = denseCholeskyOps(nc);
+  cb.line(fmt::format("dense_cholesky<{}>({}, inv_mu, {});", nc, G, Lf), {}, names, ops);
+  // One input at a time: C = J X - R2, L by the K proximal steps, X -= M^-1 J^T L.
+  const struct {
+    const char *X, *L;
+    std::string R2;
+  } blocks[] = {{"dqdd_dq", "dlambda_dq", rows.R2q}, {"dqdd_dv", "dlambda_dv", rows.R2v}, {"dqdd_dtau", "dlambda_dtau", ""}};
+  for (const auto& bl : blocks) {
+    cb.comment(fmt::format("{} and {}", bl.X, bl.L));
+    if (bl.R2.empty()) {
+      cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k];", nc * nv, C, jminv), {}, names);
+    } else {
+      ops.once = denseProductOps(nc, nv, nv);
+      cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, rows.J, bl.X, C), {}, names, ops);
+      ops.once = Ops{};
+      ops.once.add = long(nc) * nv;
+      cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", nc * nv, C, C, bl.R2), {}, names, ops);
+    }
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nv, bl.L), {}, names);
+    cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
+    ops.once = choleskySolveOps(nc, nv);
+    ops.once.add += long(nc) * nv;
+    ops.once.mul += long(nc) * nv;
+    cb.line(fmt::format("proximal_step<{}, {}>({}, {}, inv_mu, {});", nc, nv, Lf, C, bl.L), {}, names, ops);
+    cb.close();
+    ops.once = denseProductAddOps(nv, nc, nv);
+    cb.line(fmt::format("dense_product_add<{}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, minvjt, bl.L, bl.X), {}, names,
+            ops);
+  }
+  std::string text = e.fn.endHost(names);
+  e.fn.live() = Live{};
+  return text;
+}
+
+}  // namespace proxgen::emit
