@@ -2,7 +2,9 @@
 // carried up the support (G(t, u) = sum of KSD_i KS_i over the bodies whose
 // subtree holds both rows), and the solves with that factor. With a floating
 // base, G = A + Z^T Z: L factors A (zeros between limbs fold away) and the
-// rank-6 part goes through Woodbury. The generic counterpart:
+// rank-6 part goes through Woodbury. Where the rows of two or more limbs meet
+// through a few joints only (a branch: two hands below a torso), the blocks
+// between them stay in low rank, never formed (LowRank). The generic counterpart:
 // algorithms/prox_pv.cpp (Eigen's LLT of the assembled G).
 #include <fmt/format.h>
 
