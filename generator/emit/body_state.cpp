@@ -58,6 +58,7 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
     vec(s.del->Linv), vec(s.del->LSinv);
     sym(s.del->L), sym(s.del->LS);
     for (V6& x : s.del->W) v6(x);
+    vec(s.del->lowRank);
   }
   if (s.cons) {
     for (Sym& m : s.cons->Phi) sym(m);

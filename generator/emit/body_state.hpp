@@ -78,6 +78,15 @@ struct DelassusFactor {
   std::vector<V6> W;      // floating base: L^-1 Z^T (row t: 6 values)
   Sym LS{6};              // floating base: factor of I + W^T W
   std::vector<Expr> LSinv;
+  /// A branch of the rows whose blocks meet in low rank (pass_delassus_factor.cpp):
+  /// L(i, j) between two of its blocks is (g M_l)[i] . Y[j], not stored in L.
+  struct Branch {
+    std::vector<int> blocks;  // first row of each block (tree order), then the end
+    int rank = 0;
+    int y = 0, gm = 0;        // offsets in lowRank of Y[t][p] and (g M_l)[l][t][p]
+  };
+  std::vector<Branch> branches;
+  std::vector<Expr> lowRank;  // the branches' stored terms
 };
 
 /// Inverse dynamics (pass_inverse_dynamics.cpp): per body its acceleration

@@ -2,7 +2,9 @@
 // carried up the support (G(t, u) = sum of KSD_i KS_i over the bodies whose
 // subtree holds both rows), and the solves with that factor. With a floating
 // base, G = A + Z^T Z: L factors A (zeros between limbs fold away) and the
-// rank-6 part goes through Woodbury. The generic counterpart:
+// rank-6 part goes through Woodbury. Where the rows of two or more limbs meet
+// through a few joints only (a branch: two hands below a torso), the blocks
+// between them stay in low rank, never formed (LowRank). The generic counterpart:
 // algorithms/prox_pv.cpp (Eigen's LLT of the assembled G).
 #include <fmt/format.h>
 
@@ -105,29 +107,338 @@ Expr scheduled(Emit& e, int t, int u, const Expr& g) {
   return e.cb().mul(both, flat);
 }
 
-// G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block (and part) per column.
+// A branch of the rows: a support body with no rows of its own whose
+// children hold two or more blocks of rows, and whose path up to the split (or
+// the world) is one-dof bodies that see no other rows. Two rows of different
+// blocks then meet only at that path: G(t, u) = sum_p KS_p[t] Dinv_p KS_p[u],
+// a block of rank r = |path| (the Atlas's two Shadow hands: 15 rows each, r = 3
+// torso joints), and rows outside the branch meet its rows only at the split.
+struct Branch {
+  int at = 0;
+  std::vector<int> blocks;  // first row (tree order) of each child's block, then the end
+  std::vector<int> path;    // `at` and its ancestors below the split
+  int rank() const { return int(path.size()); }
+  int count() const { return int(blocks.size()) - 1; }
+  int size(int l) const { return blocks[std::size_t(l + 1)] - blocks[std::size_t(l)]; }
+  int rows() const { return blocks.back() - blocks.front(); }
+};
+
+// Multiply-adds of what the two schemes do differently, for a factor
+// followed by `solves` triangular solves (Woodbury's six and two per proximal
+// step). Dense: every cross-block entry of G assembled (r each) and of L
+// summed over the earlier columns; a block's own entries summed over the
+// earlier blocks' columns; each solve touches every cross-block entry of L.
+// Low rank: Y_l = L_ll^-1 g_l (r columns), g M_l, the r x r updates, g P_l
+// and its r terms per own entry; each solve r per row and block (docs/emitter.md,
+// "Low-rank blocks of the Delassus factor").
+long denseCost(const Branch& b, int solves) {
+  const long r = b.rank();
+  long c = 0, prefix = 0;
+  for (int l = 0; l < b.count(); ++l) {
+    const long n = b.size(l), rest = b.blocks.back() - b.blocks[std::size_t(l + 1)];
+    c += rest * (n * (r + prefix) + n * (n - 1) / 2) + n * (n + 1) / 2 * prefix + solves * n * rest;
+    prefix += n;
+  }
+  return c;
+}
+
+long lowRankCost(const Branch& b, int solves) {
+  const long r = b.rank();
+  long c = 0;
+  for (int l = 0; l < b.count(); ++l) {
+    const long n = b.size(l), rest = b.blocks.back() - b.blocks[std::size_t(l + 1)];
+    c += n * r;  // the activity factors
+    if (l + 1 < b.count())
+      c += n * (n - 1) / 2 * r + rest * r * r + n * r * (r + 1) / 2 + 2 * r * r * r + solves * (n + rest) * r;
+    if (l > 0) c += n * r * r + n * (n + 1) / 2 * r;
+  }
+  return c;
+}
+
+// The branches whose low-rank factor costs fewer multiply-adds than the dense one.
+std::vector<Branch> lowRankBranches(const Plan& plan, int split) {
+  const int solves = 2 * plan.iterations + (split >= 0 ? 6 : 0);
+  auto bp = [&](int i) -> const BodyPlan& { return plan.bodies[std::size_t(i)]; };
+  std::vector<Branch> out;
+  for (int i : plan.support) {
+    const BodyPlan& b = bp(i);
+    if (i == split || !b.constraints.empty()) continue;
+    Branch br;
+    br.at = i;
+    int next = b.rowStart;
+    bool ok = true;
+    for (int c : b.children) {
+      if (bp(c).m() == 0) continue;
+      ok = ok && bp(c).rowStart == next;
+      br.blocks.push_back(next);
+      next += bp(c).m();
+    }
+    br.blocks.push_back(next);
+    if (!ok || br.count() < 2 || next != b.rowStart + b.m()) continue;
+    for (int a = i; a != 0 && a != split; a = bp(a).parent) {
+      ok = ok && bp(a).m() == b.m() && pickedComponents(bp(a).jointClass).empty();
+      br.path.push_back(a);
+    }
+    if (ok && lowRankCost(br, solves) < denseCost(br, solves)) out.push_back(br);
+  }
+  return out;
+}
+
+// Where one branch's terms sit in DelassusFactor::lowRank (that vector is
+// visited at every part boundary: its expressions move with the factor).
+struct LowRankSlots {
+  int g = -1;   // g[t][p] = a_t KS_p[t] (activity factor a), rows of the branch
+  int y = -1;   // Y[t][p] = (L_ll^-1 g_l)[t][p] for t in block l
+  int gm = -1;  // (g M_l)[t][p] for t after block l (current l)
+  int gp = -1;  // (g P_l)[t][p] for t in block l (current l)
+  int mb = -1, pm = -1;  // M_l and P_l (r x r, current l)
+};
+
+class LowRank {
+ public:
+  LowRank(Emit& e, DelassusFactor& f, const Branch& br, int index) : e_(e), f_(f), br_(br), index_(index) {}
+
+  // Before block l's first column: the terms its columns and the later blocks' read.
+  void startBlock(int l) {
+    const int r = br_.rank(), n = br_.rows(), s = br_.blocks.front();
+    e_.fn.boundary(fmt::format("low_rank_{}", br_.blocks[std::size_t(l)]));
+    CodeBuilder& cb = e_.cb();
+    cb.open("{", {fmt::format("rows {} to {}, block {} of {}: the blocks meet through {} joints (low rank)", s,
+                              br_.blocks.back() - 1, l, br_.count(), r)});
+    const ProxRows& rows = *e_.fn.live().rows;
+    const Articulated& art = *e_.fn.live().art;
+    if (l == 0) {
+      s_.g = slots(n * r), s_.y = slots(n * r), s_.gm = slots(br_.count() * n * r), s_.gp = slots(n * r);
+      s_.mb = slots(r * r), s_.pm = slots(r * r);
+      f_.branches.push_back(DelassusFactor::Branch{br_.blocks, r, s_.y, s_.gm});
+      for (int t = s; t < s + n; ++t)
+        for (int p = 0; p < r; ++p) {
+          const int body = br_.path[std::size_t(p)];
+          const Expr on = activeRowFactor(e_, e_.plan.rootRows[std::size_t(t)]);
+          const Expr ks = rows.b[std::size_t(body)].KS[std::size_t(t - e_.plan.bodies[std::size_t(body)].rowStart)][0];
+          at(s_.g, t - s, p) = e_.put(member("g", n * r, (t - s) * r + p, "activity times KS at the path"), cb.mul(on, ks));
+        }
+      for (int p = 0; p < r; ++p)
+        for (int q = 0; q < r; ++q) {
+          at(s_.mb, p, q) = p == q ? art.b[std::size_t(br_.path[std::size_t(p)])].Dinv : Expr();
+          at(s_.pm, p, q) = Expr();
+        }
+    } else {
+      // C = Y^T Y over block l - 1, then M_l = M - M C M and P_l = P + M C M.
+      std::vector<Expr> C(std::size_t(r * r)), MC(std::size_t(r * r));
+      for (int p = 0; p < r; ++p)
+        for (int q = p; q < r; ++q) {
+          Expr x;
+          for (int t = br_.blocks[std::size_t(l - 1)]; t < br_.blocks[std::size_t(l)]; ++t)
+            x += cb.mul(at(s_.y, t - s, p), at(s_.y, t - s, q));
+          C[std::size_t(p * r + q)] = C[std::size_t(q * r + p)] = cb.flat(x, "C");
+        }
+      for (int p = 0; p < r; ++p)
+        for (int q = 0; q < r; ++q) {
+          Expr x;
+          for (int k = 0; k < r; ++k) x += cb.mul(at(s_.mb, p, k), C[std::size_t(k * r + q)]);
+          MC[std::size_t(p * r + q)] = cb.flat(x, "MC");
+        }
+      for (int p = 0; p < r; ++p)
+        for (int q = p; q < r; ++q) {
+          Expr x;
+          for (int k = 0; k < r; ++k) x += cb.mul(MC[std::size_t(p * r + k)], at(s_.mb, k, q));
+          const Expr mcm = cb.flat(x, "MCM");
+          const int pq = (l * r + p) * r + q;
+          const Expr pnew = at(s_.pm, p, q) + mcm;
+          const Expr mnew = at(s_.mb, p, q) - mcm;
+          at(s_.pm, p, q) = at(s_.pm, q, p) = e_.put(member("P", br_.count() * r * r, pq, "low-rank Schur update P_l"), pnew);
+          if (!last(l))  // M_l reaches only the later blocks
+            at(s_.mb, p, q) = at(s_.mb, q, p) = e_.put(member("M", br_.count() * r * r, pq, "low-rank coupling M_l"), mnew);
+        }
+      for (int t = br_.blocks[std::size_t(l)]; t < br_.blocks[std::size_t(l + 1)]; ++t)
+        for (int p = 0; p < r; ++p)
+          at(s_.gp, t - s, p) = e_.put(member("gP", n * r, (t - s) * r + p, "g P_l, block l"), times(s_.pm, t - s, p));
+    }
+    for (int t = br_.blocks[std::size_t(l + 1)]; t < br_.blocks.back(); ++t)
+      for (int p = 0; p < r; ++p)
+        at(s_.gm, l * n + t - s, p) = e_.put(member("gM", br_.count() * n * r, (l * n + t - s) * r + p, "g M_l, rows after block l"),
+                                     times(s_.mb, t - s, p));
+    cb.close();
+  }
+
+  int blockOf(int t) const {
+    for (int l = 0; l < br_.count(); ++l)
+      if (t < br_.blocks[std::size_t(l + 1)]) return t >= br_.blocks[std::size_t(l)] ? l : -1;
+    return -1;
+  }
+  int blockStart(int t) const { return br_.blocks[std::size_t(blockOf(t))]; }
+  int first() const { return br_.blocks.front(); }
+  bool last(int l) const { return l + 1 == br_.count(); }
+
+  // Column j's row of Y: (g[j] - sum over the block's earlier columns L(j, k) Y[k]) / L(j, j).
+  void solveRow(int j, const DelassusFactor& f) {
+    CodeBuilder& cb = e_.cb();
+    const int r = br_.rank(), s = first(), n = br_.rows();
+    for (int p = 0; p < r; ++p) {
+      Expr x = at(s_.g, j - s, p);
+      for (int k = blockStart(j); k < j; ++k) x -= cb.mul(f.L(j, k), at(s_.y, k - s, p));
+      const Expr y = cb.mul(cb.flat(x), f.Linv[std::size_t(j)]);
+      at(s_.y, j - s, p) = e_.put(member("Y", n * r, (j - s) * r + p, "L_ll^-1 g, block l"), y);
+    }
+  }
+  // The earlier blocks' share of entry (i, j) of one block: (g P_l)[i] . g[j].
+  Expr update(int i, int j) {
+    Expr x;
+    if (blockOf(j) == 0) return x;
+    for (int p = 0; p < br_.rank(); ++p) x += e_.cb().mul(at(s_.gp, i - first(), p), at(s_.g, j - first(), p));
+    return x;
+  }
+
+ private:
+  int slots(int n) {
+    const int at = int(f_.lowRank.size());
+    f_.lowRank.resize(f_.lowRank.size() + std::size_t(n));
+    return at;
+  }
+  Expr& at(int base, int t, int p) { return f_.lowRank[std::size_t(base + t * br_.rank() + p)]; }
+  Expr times(int mat, int t, int p) {
+    Expr x;
+    for (int q = 0; q < br_.rank(); ++q) x += e_.cb().mul(at(s_.g, t, q), at(mat, q, p));
+    return x;
+  }
+  std::string member(const std::string& what, int size, int idx, const std::string& comment) {
+    return e_.member(fmt::format("lr{}_{}", index_, what), size, idx, comment);
+  }
+
+  Emit& e_;
+  DelassusFactor& f_;
+  const Branch& br_;
+  int index_;
+  LowRankSlots s_;
+};
+
+// G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block
+// (and part) per column; the blocks of a branch meet through its low-rank terms.
 void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   const int nc = e.plan.nc;
   f.L = Sym(nc);
   f.Linv.assign(std::size_t(nc), Expr());
   const int split = freeFlyerWithRows(e.plan);
+  const std::vector<Branch> branches = lowRankBranches(e.plan, split);
+  std::vector<LowRank> lr;
+  lr.reserve(branches.size());
+  for (std::size_t b = 0; b < branches.size(); ++b) lr.emplace_back(e, f, branches[b], int(b));
+  std::vector<int> branchOf(std::size_t(nc), -1);
+  for (std::size_t b = 0; b < branches.size(); ++b)
+    for (int t = branches[b].blocks.front(); t < branches[b].blocks.back(); ++t) branchOf[std::size_t(t)] = int(b);
   for (int j = 0; j < nc; ++j) {
+    LowRank* lj = branchOf[std::size_t(j)] >= 0 ? &lr[std::size_t(branchOf[std::size_t(j)])] : nullptr;
+    const int lb = lj ? lj->blockOf(j) : -1;
+    if (lj && j == lj->blockStart(j)) lj->startBlock(lb);
+    // Column k of row t is summed over unless both are in one branch, in different blocks (low rank).
+    auto summed = [&](int t, int k) { return !lj || branchOf[std::size_t(t)] != branchOf[std::size_t(j)] || k < lj->first() || k >= lj->blockStart(j); };
     e.fn.boundary(fmt::format("column_{}", j));
     CodeBuilder& cb = e.cb();
     cb.open("{", {fmt::format("G + I/mu = L L^T, column {} (Cholesky, unrolled for the fixed row count)", j)});
     Expr d = scheduled(e, j, j, delassus(cb, a, j, j, split));  // before inv_mu: see mulAdd in symbolic.cpp
     d += cb.input("inv_mu");
-    for (int k = 0; k < j; ++k) d -= cb.mul(f.L(j, k), f.L(j, k));
+    if (lj) d -= lj->update(j, j);
+    for (int k = 0; k < j; ++k)
+      if (summed(j, k)) d -= cb.mul(f.L(j, k), f.L(j, k));
     const Expr r = cb.sqrt(d, "r");
     f.Linv[std::size_t(j)] = e.put(e.member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));
+    if (lj && !lj->last(lb)) lj->solveRow(j, f);
     for (int i = j + 1; i < nc; ++i) {
+      const std::string name = e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)");
+      // between two blocks of a branch: (g M_l)[i] . Y[j], never formed (lowRankForward, lowRankBackward)
+      if (lj && branchOf[std::size_t(i)] == branchOf[std::size_t(j)] && lj->blockOf(i) > lb) continue;
       Expr x = scheduled(e, i, j, delassus(cb, a, i, j, split));
-      for (int k = 0; k < j; ++k) x -= cb.mul(f.L(i, k), f.L(j, k));
-      f.L(i, j) = e.put(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)"),
-                        cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));
+      if (lj && branchOf[std::size_t(i)] == branchOf[std::size_t(j)]) x -= lj->update(i, j);
+      for (int k = 0; k < j; ++k)
+        if (summed(i, k)) x -= cb.mul(f.L(i, k), f.L(j, k));
+      f.L(i, j) = e.put(name, cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));
     }
     cb.close();
   }
+}
+
+// The branch and block of tree row t, or {-1, -1}.
+std::pair<int, int> branchBlock(const DelassusFactor& f, int t) {
+  for (std::size_t b = 0; b < f.branches.size(); ++b) {
+    const std::vector<int>& bl = f.branches[b].blocks;
+    if (t < bl.front() || t >= bl.back()) continue;
+    for (std::size_t l = 0; l + 1 < bl.size(); ++l)
+      if (t < bl[l + 1]) return {int(b), int(l)};
+  }
+  return {-1, -1};
+}
+
+// L(i, k) is an entry of L unless i and k are in different blocks of one branch.
+bool inL(const DelassusFactor& f, int i, int k) {
+  const auto bi = branchBlock(f, i), bk = branchBlock(f, k);
+  return bi.first < 0 || bi.first != bk.first || bi.second == bk.second;
+}
+
+// L y = b with L's cross-block parts in low rank: once block l is solved,
+// w_l = Y_l^T y_l (r values), and a later row i subtracts (g M_l)[i] . w_l.
+std::vector<Expr> lowRankForward(CodeBuilder& cb, const DelassusFactor& f, const std::vector<Expr>& b) {
+  if (f.branches.empty()) return forwardSolve(cb, f.L, f.Linv, b);
+  const int n = f.L.size();
+  std::vector<Expr> y(static_cast<std::size_t>(n));
+  std::vector<std::vector<Expr>> w(f.branches.size());  // per branch: w_l[p], l * rank + p
+  for (int i = 0; i < n; ++i) {
+    Expr x = b[std::size_t(i)];
+    for (int k = 0; k < i; ++k)
+      if (inL(f, i, k)) x -= cb.mul(f.L(i, k), y[std::size_t(k)]);
+    const auto [bi, l] = branchBlock(f, i);
+    if (bi >= 0) {
+      const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+      const int r = br.rank, s = br.blocks.front(), m = br.blocks.back() - s;
+      for (int k = 0; k < l; ++k)
+        for (int p = 0; p < r; ++p)
+          x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s) * r + p))], w[std::size_t(bi)][std::size_t(k * r + p)]);
+    }
+    y[std::size_t(i)] = cb.flat(cb.mul(cb.flat(x), f.Linv[std::size_t(i)]), "y");
+    if (bi >= 0) {
+      const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+      const int r = br.rank, s = br.blocks.front();
+      if (i + 1 == br.blocks[std::size_t(l + 1)] && l + 2 < int(br.blocks.size()))  // block l solved, not the last
+        for (int p = 0; p < r; ++p) {
+          Expr x;
+          for (int t = br.blocks[std::size_t(l)]; t <= i; ++t)
+            x += cb.mul(f.lowRank[std::size_t(br.y + (t - s) * r + p)], y[std::size_t(t)]);
+          w[std::size_t(bi)].push_back(cb.flat(x, "w"));
+        }
+    }
+  }
+  return y;
+}
+
+// L^T x = y: before block l's rows (from the bottom), v_l = sum over the later
+// blocks' rows t of (g M_l)[t] x[t], and a row j of block l subtracts Y[j] . v_l.
+std::vector<Expr> lowRankBackward(CodeBuilder& cb, const DelassusFactor& f, const std::vector<Expr>& y) {
+  if (f.branches.empty()) return backwardSolve(cb, f.L, f.Linv, y);
+  const int n = f.L.size();
+  std::vector<Expr> x(static_cast<std::size_t>(n));
+  std::vector<Expr> v;  // v_l of the current block
+  for (int i = n - 1; i >= 0; --i) {
+    const auto [bi, l] = branchBlock(f, i);
+    const DelassusFactor::Branch* br = bi >= 0 ? &f.branches[std::size_t(bi)] : nullptr;
+    if (br && i + 1 == br->blocks[std::size_t(l + 1)]) {  // the block's last row: v_l from the rows after it
+      const int r = br->rank, s = br->blocks.front(), m = br->blocks.back() - s;
+      v.assign(std::size_t(r), Expr());
+      for (int p = 0; p < r; ++p) {
+        Expr z;
+        for (int t = br->blocks[std::size_t(l + 1)]; t < br->blocks.back(); ++t)
+          z += cb.mul(f.lowRank[std::size_t(br->gm + ((l * m + t - s) * r + p))], x[std::size_t(t)]);
+        v[std::size_t(p)] = cb.flat(z, "v");
+      }
+    }
+    Expr z = y[std::size_t(i)];
+    for (int k = i + 1; k < n; ++k)
+      if (inL(f, k, i)) z -= cb.mul(f.L(k, i), x[std::size_t(k)]);
+    if (br && l + 2 < int(br->blocks.size()))
+      for (int p = 0; p < br->rank; ++p)
+        z -= cb.mul(f.lowRank[std::size_t(br->y + (i - br->blocks.front()) * br->rank + p)], v[std::size_t(p)]);
+    x[std::size_t(i)] = cb.flat(cb.mul(cb.flat(z), f.Linv[std::size_t(i)]), "x");
+  }
+  return x;
 }
 
 // (A + Z^T Z)^-1 = L^-T (I - W S^-1 W^T) L^-1 with W = L^-1 Z^T, S = I + W^T W
@@ -143,7 +454,7 @@ void woodbury(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
     for (int j = 0; j < b.m(); ++j)  // Z F: an inactive row's column of Z is 0, so is its row of W
       z[std::size_t(b.rowStart + j)] = e.cb().mul(activeRowFactor(e, e.plan.rootRows[std::size_t(b.rowStart + j)]),
                                                   rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)]);
-    const std::vector<Expr> w = forwardSolve(e.cb(), f.L, f.Linv, z);
+    const std::vector<Expr> w = lowRankForward(e.cb(), f, z);
     for (int t = 0; t < nc; ++t)
       f.W[std::size_t(t)][std::size_t(d)] = e.put(e.ws.member("W", nc, 6, t, d, "L^-1 Z^T"), w[std::size_t(t)]);
     e.cb().close();
@@ -179,7 +490,7 @@ DelassusFactor factorDelassus(Emit& e, const ProxRows& rows) {
 
 std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vector<Expr>& rhs) {
   CodeBuilder& cb = e.cb();
-  std::vector<Expr> z = forwardSolve(cb, f.L, f.Linv, rhs);
+  std::vector<Expr> z = lowRankForward(cb, f, rhs);
   if (!f.W.empty()) {
     std::vector<Expr> v(6);
     for (int d = 0; d < 6; ++d)
@@ -190,7 +501,7 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
       z[t] = cb.flat(z[t], "z");
     }
   }
-  return backwardSolve(cb, f.L, f.Linv, z);
+  return lowRankBackward(cb, f, z);
 }
 
 }  // namespace proxgen::emit
