@@ -32,24 +32,9 @@ std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& k
   const std::string id = e.plan.constraints[std::size_t(k)].ident;
   CodeBuilder& cb = e.cb();
   const XSym oMc = compose(cb, kb.oM, constant(c.placement));
-  const XSym E = compose(cb, constant(c.target.inverse()), oMc);
-  std::vector<Expr> R, p;
-  std::string Rs, ps;
-  for (int j = 0; j < 9; ++j) {
-    R.push_back(cb.flat(E.R[std::size_t(j)]));
-    Rs += (j ? ", " : "") + cb.print(R.back());
-  }
-  for (int j = 0; j < 3; ++j) {
-    p.push_back(cb.flat(E.p[std::size_t(j)]));
-    ps += (j ? ", " : "") + cb.print(p.back());
-  }
-  cb.line(fmt::format("const Scalar jrR_{}[9] = {{{}}};", id, Rs), R);
-  cb.line(fmt::format("const Scalar jrp_{}[3] = {{{}}};", id, ps), p);
-  cb.line(fmt::format("Scalar jre_{0}[6], jri_{0}[36];", id));
+  weldError(cb, oMc, c, "jr", id);
+  cb.line(fmt::format("Scalar jri_{}[36];", id));
   OpCount ops;
-  ops.once.log6 = 1;
-  cb.line(fmt::format("proxgen_rt::log6(jrR_{0}, jrp_{0}, jre_{0});", id), {}, {}, ops);
-  ops = OpCount{};
   ops.once = se3RightJacobianInverseOps();
   cb.line(fmt::format("se3_right_jacobian_inverse(jre_{0}, jri_{0});", id), {}, {}, ops);
   std::vector<Expr> out;

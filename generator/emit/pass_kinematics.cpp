@@ -97,6 +97,31 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
     }
 }
 
+std::vector<Expr> weldError(CodeBuilder& cb, const XSym& oMc, const Constraint& c, const std::string& prefix,
+                            const std::string& id) {
+  const XSym E = compose(cb, constant(c.target.inverse()), oMc);
+  std::vector<Expr> R, p;
+  std::string Rs, ps;
+  for (int j = 0; j < 9; ++j) {
+    R.push_back(cb.flat(E.R[std::size_t(j)]));
+    Rs += (j ? ", " : "") + cb.print(R.back());
+  }
+  for (int j = 0; j < 3; ++j) {
+    p.push_back(cb.flat(E.p[std::size_t(j)]));
+    ps += (j ? ", " : "") + cb.print(p.back());
+  }
+  // Each line's uses are what it prints (the operation count reads them).
+  cb.line(fmt::format("const Scalar {}R_{}[9] = {{{}}};", prefix, id, Rs), R);
+  cb.line(fmt::format("const Scalar {}p_{}[3] = {{{}}};", prefix, id, ps), p);
+  cb.line(fmt::format("Scalar {}e_{}[6];", prefix, id));
+  OpCount log6;
+  log6.once.log6 = 1;
+  cb.line(fmt::format("proxgen_rt::log6({0}R_{1}, {0}p_{1}, {0}e_{1});", prefix, id), {}, {}, log6);
+  std::vector<Expr> e;
+  for (int j = 0; j < 6; ++j) e.push_back(cb.input(fmt::format("{}e_{}[{}]", prefix, id, j)));
+  return e;
+}
+
 namespace {
 
 void velocity(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {
@@ -145,27 +170,7 @@ std::vector<Expr> constraintTerms(Emit& e, int k, const Kinematics::Body& b) {
     const XSym oMc = compose(cb, b.oM, constant(c.placement));
     std::vector<Expr> err(static_cast<std::size_t>(r));
     if (cp.weld) {
-      // log6(target^-1 oMc) through the runtime.
-      const XSym E = compose(cb, constant(c.target.inverse()), oMc);
-      std::vector<Expr> R, p;
-      std::string Rs, ps;
-      for (int j = 0; j < 9; ++j) {
-        R.push_back(cb.flat(E.R[std::size_t(j)]));
-        Rs += (j ? ", " : "") + cb.print(R.back());
-      }
-      for (int j = 0; j < 3; ++j) {
-        p.push_back(cb.flat(E.p[std::size_t(j)]));
-        ps += (j ? ", " : "") + cb.print(p.back());
-      }
-      const std::string id = cp.ident;
-      // Each line's uses are what it prints (the operation count reads them).
-      cb.line(fmt::format("const Scalar kpR_{}[9] = {{{}}};", id, Rs), R);
-      cb.line(fmt::format("const Scalar kpp_{}[3] = {{{}}};", id, ps), p);
-      cb.line(fmt::format("Scalar kpe_{}[6];", id));
-      OpCount log6;
-      log6.once.log6 = 1;
-      cb.line(fmt::format("proxgen_rt::log6(kpR_{0}, kpp_{0}, kpe_{0});", id), {}, {}, log6);
-      for (int j = 0; j < 6; ++j) err[std::size_t(j)] = cb.input(fmt::format("kpe_{}[{}]", id, j));
+      err = weldError(cb, oMc, c, "kp", cp.ident);
     } else {
       V3 d;
       for (int j = 0; j < 3; ++j) d[std::size_t(j)] = oMc.p[std::size_t(j)] - c.target.p[j];

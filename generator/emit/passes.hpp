@@ -20,6 +20,12 @@ namespace proxgen::emit {
 Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
+// A weld's placement error e = log6(target^-1 oMc) through the runtime's log6,
+// printed as `<prefix>R_<id>[9]`, `<prefix>p_<id>[3]` -> `<prefix>e_<id>[6]`;
+// returns the six entries of e (the kinematics pass's Baumgarte term and the
+// constrained derivatives' right Jacobian read it).
+std::vector<Expr> weldError(CodeBuilder& cb, const XSym& oMc, const Constraint& c, const std::string& prefix,
+                            const std::string& id);
 
 // ---- pass_aba_eliminate.cpp: the articulated-body elimination.
 /// The elimination's starting point: every body's own inertia and bias.
