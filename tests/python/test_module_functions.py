@@ -196,6 +196,14 @@ def test_bad_options_name_the_argument(m):
         m.mass_matrix(np.zeros(m.nq))
 
 
+def solve_roundoff(m, q, lam):
+    """What one prox_pv solve is off by: C n eps kappa(M) kappa(G + I/mu) times the size of
+    its answer (n = nv + nc)."""
+    M, J = m.mass_matrix(q), m.constraint_jacobian(q)
+    G = J @ np.linalg.solve(M, J.T) + np.eye(m.nc) / m.mu
+    return C * (m.nv + m.nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+
+
 def test_constrained_dynamics_derivatives_along_v_and_tau_are_the_solve_s(m, quadruped, rng):
     """Along v and tau, G does not move, so the tangents' K proximal steps are exactly the
     derivative of prox_pv's K steps: central differences of m.prox_pv check them with no
@@ -208,11 +216,8 @@ def test_constrained_dynamics_derivatives_along_v_and_tau_are_the_solve_s(m, qua
         # The same prox_pv call inside: the same bits.
         qdd0, lam0 = m.prox_pv(q, v, tau)
         assert np.array_equal(qdd, qdd0) and np.array_equal(lam, lam0)
-        # Each solve is off by at most delta = C n eps kappa(M) kappa(G + I/mu) times the
-        # size of its answer; a central difference of two of them by delta / h.
-        M, J = m.mass_matrix(q), m.constraint_jacobian(q)
-        G = J @ np.linalg.solve(M, J.T) + np.eye(nc) / m.mu
-        delta = C * (nv + nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+        # A central difference of two solves is off by solve_roundoff / h.
+        delta = solve_roundoff(m, q, lam)
         h = 1e-2
         for k in range(nv):
             e = np.zeros(nv)
@@ -238,9 +243,7 @@ def test_constrained_dynamics_derivatives_follow_the_schedule(m, quadruped, rng)
     assert np.array_equal(qdd, qdd0) and np.array_equal(lam, lam0)
     for L in (lq, lv, ltau):
         assert np.array_equal(L[rows], np.zeros((3, nv)))
-    M, J = m.mass_matrix(q), m.constraint_jacobian(q)
-    G = J @ np.linalg.solve(M, J.T) + np.eye(nc) / m.mu
-    delta = C * (nv + nc) * EPS * scaled_condition(M) * scaled_condition(G) * max(1.0, np.max(np.abs(lam)))
+    delta = solve_roundoff(m, q, lam)
     h = 1e-2
     for k in range(nv):
         e = np.zeros(nv)
