@@ -41,13 +41,22 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;
-  // A derivative function calls the functions it is made of: the file holds them too.
+  // A derivative function calls the functions it is made of (its host, named
+  // here, counts their operations too): the file holds them as well.
+  struct Composite {
+    Function f;
+    const char* host;
+    std::vector<Function> calls;
+  };
+  const Composite composites[] = {
+      {Function::ForwardDynamicsDerivatives, "fdd",
+       {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}},
+      {Function::ConstrainedDynamicsDerivatives, "cdd",
+       {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}}};
   FunctionSet want = sys.functions;
-  if (want.has(Function::ForwardDynamicsDerivatives))
-    for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
-      want.add(f);
-  if (want.has(Function::ConstrainedDynamicsDerivatives))
-    for (Function f : {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}) want.add(f);
+  for (const Composite& c : composites)
+    if (want.has(c.f))
+      for (Function f : c.calls) want.add(f);
   texts.functions = want;
   const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
   texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects) ||
@@ -155,17 +164,11 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     texts.libraryOps[l.f] = ops;
   }
   // The derivatives: their host (the dense products included) and the functions it calls.
-  if (want.has(Function::ForwardDynamicsDerivatives)) {
-    OpCount ops = fn.hostOps("fdd");
-    for (Function f : {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives})
-      ops += texts.libraryOps[f];
-    texts.libraryOps[Function::ForwardDynamicsDerivatives] = ops;
-  }
-  if (cdd) {
-    OpCount ops = fn.hostOps("cdd");
-    ops += texts.pvOps;
-    for (Function f : {Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}) ops += texts.libraryOps[f];
-    texts.libraryOps[Function::ConstrainedDynamicsDerivatives] = ops;
+  for (const Composite& c : composites) {
+    if (!want.has(c.f)) continue;
+    OpCount ops = fn.hostOps(c.host);
+    for (Function f : c.calls) ops += f == Function::ProxPv ? texts.pvOps : texts.libraryOps[f];
+    texts.libraryOps[c.f] = ops;
   }
 
   if (stats) {
