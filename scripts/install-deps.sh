@@ -7,7 +7,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   valgrind gnuplot-nox binutils libmujoco-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev lld
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib python3-yaml
   locales
 )

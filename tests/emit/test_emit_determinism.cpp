@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "emit/generate.hpp"
 #include "emit/hash.hpp"
@@ -27,8 +28,13 @@ GenerateOptions example(const std::string& robot, ScalarType scalar) {
 }
 
 TEST(Determinism, TwoGenerationsAreByteIdentical) {
+  // Under the sanitizer, double alone: its allocator places every object
+  // elsewhere, which is what could show an order taken from addresses; the
+  // float files print the same plan with other literals.
+  std::vector<ScalarType> scalars = {ScalarType::Double};
+  if (!test::kUnderSanitizer) scalars.push_back(ScalarType::Float);
   for (const char* robot : {"arm", "quadruped", "humanoid"})
-    for (ScalarType t : {ScalarType::Double, ScalarType::Float}) {
+    for (ScalarType t : scalars) {
       const SolverFiles a = generateFiles(example(robot, t)), b = generateFiles(example(robot, t));
       EXPECT_EQ(a.header, b.header) << robot;
       EXPECT_EQ(a.source, b.source) << robot;
