@@ -7,8 +7,9 @@
 // mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
 // it); the constraint rows (J, R2) are printed straight-line from the sweep's
 // motion tangents of the constrained bodies, the path's columns only; the
-// dense algebra (O(nv^2 nc + nc^2 nv + K nc^2 nv)) is fixed-bound loops
-// printed once by assemble.cpp. The generic counterpart:
+// dense algebra (O(nv^3 + nv^2 nc + nc^2 nv), plus K nc^3 for the proximal
+// operator S_K or K nc^2 nv for stepping C) is fixed-bound loops printed once
+// by assemble.cpp. The generic counterpart:
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
 
@@ -43,16 +44,17 @@ std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& k
 }
 
 struct RowMembers {
-  std::string J, R2q, R2v;  // nc x nv each, flat
+  std::string J;   // nc x nv
+  std::string R2;  // nc x 3 nv: the q, v and tau columns side by side (tau's are 0)
 };
 
-// entry = f * x into member[idx], skipping exact zeros (the host zeroed the arrays).
-void storeRow(Emit& e, const std::string& base, int idx, const Expr& f, const Expr& x) {
+// entry = f * x into member[idx] (of `size` entries), skipping exact zeros (the host zeroed the arrays).
+void storeRow(Emit& e, const std::string& base, int size, int idx, const Expr& f, const Expr& x) {
   if (x.isZero()) return;
   CodeBuilder& cb = e.cb();
   const Expr flat = cb.flat(x);
   const Expr y = cb.mul(f, flat);
-  cb.store(e.ws.member(base, e.plan.nc * e.plan.nv, idx, "constrained_dynamics_derivatives"), y);
+  cb.store(e.ws.member(base, size, idx, "constrained_dynamics_derivatives"), y);
 }
 
 // One constraint's rows: J, and R2 = d a*/dx - d alpha/dx for x = q, v at
@@ -126,10 +128,10 @@ void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangen
       for (std::size_t j = 0; j < 3; ++j) Sq[j] -= c.kp * (J6[j] + ex[j]);
     }
     for (int j = 0; j < r; ++j) {
-      const int idx = (c.row + j) * nv + col;
-      storeRow(e, m.J, idx, f, J6[std::size_t(j)]);
-      storeRow(e, m.R2q, idx, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]);
-      storeRow(e, m.R2v, idx, f, Sv[std::size_t(j)] - Av[std::size_t(j)]);
+      const int nc = e.plan.nc, row = c.row + j;
+      storeRow(e, m.J, nc * nv, row * nv + col, f, J6[std::size_t(j)]);
+      storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + col, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]);
+      storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + nv + col, f, Sv[std::size_t(j)] - Av[std::size_t(j)]);
     }
   }
 }
@@ -137,11 +139,7 @@ void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangen
 }  // namespace
 
 // The helpers' arithmetic (assemble.cpp prints them; counted as they are written).
-Ops denseProductAddOps(int n, int m, int p) {
-  Ops o = denseProductOps(n, m, p);
-  o.add += long(n) * p;
-  return o;
-}
+Ops denseProductAddOps(int n, int m, int p) { return denseProductOps(n, m, p); }  // the same loops, into C
 
 Ops denseCholeskyOps(int n) {
   Ops o;
@@ -191,17 +189,16 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const std::string dq = array("cdd_dtau_dq", nv * nv, "d tau / dq at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
   const std::string dv = array("cdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
   RowMembers rows;
-  std::string jminv, minvjt, G, Lf, C;
+  std::string minvjt, G, Lf, C, L;
   if (nc > 0) {
-    rows.J = "cdd_J", rows.R2q = "cdd_R2q", rows.R2v = "cdd_R2v";
+    rows.J = "cdd_J", rows.R2 = "cdd_R2";
     array(rows.J, nc * nv, "J (nc x nv; constrained_dynamics_derivatives)");
-    array(rows.R2q, nc * nv, "d a*/dq - d alpha/dq (constrained_dynamics_derivatives)");
-    array(rows.R2v, nc * nv, "d a*/dv - d alpha/dv (constrained_dynamics_derivatives)");
-    jminv = array("cdd_JMinv", nc * nv, "J M^-1 (constrained_dynamics_derivatives)");
+    array(rows.R2, 3 * nc * nv, "d a*/dx - d alpha/dx, x = q, v, tau side by side (constrained_dynamics_derivatives)");
     minvjt = array("cdd_MinvJt", nv * nc, "M^-1 J^T (constrained_dynamics_derivatives)");
     G = array("cdd_G", nc * nc, "G = J M^-1 J^T (constrained_dynamics_derivatives)");
     Lf = array("cdd_Lf", nc * nc, "G + I/mu = L L^T, 1/L_jj on the diagonal (constrained_dynamics_derivatives)");
-    C = array("cdd_C", nc * nv, "J M^-1 R1 - R2, one input's columns (constrained_dynamics_derivatives)");
+    C = array("cdd_C", 3 * nc * nv, "C = J M^-1 R1 - R2, the three inputs side by side (constrained_dynamics_derivatives)");
+    L = array("cdd_L", 3 * nc * nv, "the multipliers' tangents, the three inputs side by side (constrained_dynamics_derivatives)");
   }
   Kinematics kin = kinIn;
   e.fn.live() = Live{};
@@ -220,8 +217,8 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
     // The rows of an inactive constraint are zeros: its lambda is 0 and its
     // tangents too, the derivatives of the solver generated without it.
     storeActiveFactors(e, "s.active");
-    for (const std::string& a : {rows.J, rows.R2q, rows.R2v})
-      host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, a), {}, names);
+    host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, rows.J), {}, names);
+    host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", 3 * nc * nv, rows.R2), {}, names);
     e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's tangents");
     for (int i : plan.support)
       for (int k : e.bp(i).constraints) {
@@ -243,43 +240,69 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
       cb.line(fmt::format("static_cast<void>({});", p), {}, names);
     return e.fn.endHost(names);
   }
+  // The three inputs side by side (nc x 3 nv, q | v | tau), so each step below
+  // is one product over rows of 3 nv: C = J [X_q X_v M^-1] - R2 (R2's tau block
+  // is 0, so C's is J M^-1 exactly), the multipliers' tangents L from C, then
+  // per input X -= M^-1 J^T L and the copy of L's block out.
+  const int w3 = 3 * nv;
+  const std::string Xs[] = {"dqdd_dq", "dqdd_dv", "dqdd_dtau"}, Ls[] = {"dlambda_dq", "dlambda_dv", "dlambda_dtau"};
+  const auto block = [&](const std::string& a, int b) { return b == 0 ? a : fmt::format("{} + {}", a, b * nv); };
   ops.once = denseProductOps(nc, nv, nv);
-  cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, rows.J, minv, jminv), {}, names, ops);
+  for (int b = 0; b < 3; ++b)
+    cb.line(fmt::format("dense_product<{}, {}, {}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, nv, w3, rows.J, Xs[b],
+                        block(C, b)),
+            {}, names, ops);
   // M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k % {}) * {} + k / {}];", nv * nc, minvjt, jminv, nc, nv, nc),
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k % {}) * {} + {} + k / {}];", nv * nc, minvjt, C, nc, w3,
+                      2 * nv, nc),
           {}, names);
+  ops.once = Ops{};
+  ops.once.add = 3L * nc * nv;
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", 3 * nc * nv, C, C, rows.R2), {}, names, ops);
   ops.once = denseProductOps(nc, nv, nc);
   cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nc, rows.J, minvjt, G), {}, names, ops);
   ops.once = Ops::divisions(1);
   cb.line("const Scalar inv_mu = Scalar(1) / s.mu;", {}, names, ops);
   ops.once = denseCholeskyOps(nc);
   cb.line(fmt::format("dense_cholesky<{}>({}, inv_mu, {});", nc, G, Lf), {}, names, ops);
-  // One input at a time: C = J X - R2, L by the K proximal steps, X -= M^-1 J^T L.
-  const struct {
-    const char *X, *L;
-    std::string R2;
-  } blocks[] = {{"dqdd_dq", "dlambda_dq", rows.R2q}, {"dqdd_dv", "dlambda_dv", rows.R2v}, {"dqdd_dtau", "dlambda_dtau", ""}};
-  for (const auto& bl : blocks) {
-    cb.comment(fmt::format("{} and {}", bl.X, bl.L));
-    if (bl.R2.empty()) {
-      cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k];", nc * nv, C, jminv), {}, names);
-    } else {
-      ops.once = denseProductOps(nc, nv, nv);
-      cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, rows.J, bl.X, C), {}, names, ops);
-      ops.once = Ops{};
-      ops.once.add = long(nc) * nv;
-      cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", nc * nv, C, C, bl.R2), {}, names, ops);
-    }
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nv, bl.L), {}, names);
+  // The K proximal steps on the tangents are linear in C: L = S_K C with
+  // S_K = sum_j mu^(1-j) (G + I/mu)^-j (j = 1..K), itself K steps from C = I.
+  // Forming S_K (K nc^3) and applying it (3 nc^2 nv) beats stepping C
+  // (3 K nc^2 nv) unless there are many rows on few dofs; the layout's K
+  // decides, as it does the banner's count.
+  const long K = plan.iterations;
+  if (K * nc + 3L * nv < 3L * K * nv) {
+    const std::string id = array("cdd_Id", nc * nc, "the nc x nc identity (constrained_dynamics_derivatives)");
+    const std::string S = array("cdd_S", nc * nc, "S_K, the K proximal steps as one operator (constrained_dynamics_derivatives)");
+    cb.comment("S_K: the K proximal steps from C = I");
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, id), {}, names);
+    for (int r = 0; r < nc; ++r) cb.line(fmt::format("{}[{}] = Scalar(1);", id, r * (nc + 1)), {}, names);
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, S), {}, names);
     cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
-    ops.once = choleskySolveOps(nc, nv);
-    ops.once.add += long(nc) * nv;
-    ops.once.mul += long(nc) * nv;
-    cb.line(fmt::format("proximal_step<{}, {}>({}, {}, inv_mu, {});", nc, nv, Lf, C, bl.L), {}, names, ops);
+    ops.once = choleskySolveOps(nc, nc);
+    ops.once.add += long(nc) * nc;
+    ops.once.mul += long(nc) * nc;
+    cb.line(fmt::format("proximal_step<{0}, {0}>({1}, {2}, inv_mu, {3});", nc, Lf, id, S), {}, names, ops);
     cb.close();
+    ops.once = denseProductOps(nc, nc, w3);
+    cb.line(fmt::format("dense_product<{}, {}, {}>({}, {}, Scalar(1), {});", nc, nc, w3, S, C, L), {}, names, ops);
+  } else {
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", 3 * nc * nv, L), {}, names);
+    cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
+    ops.once = choleskySolveOps(nc, w3);
+    ops.once.add += 3L * nc * nv;
+    ops.once.mul += 3L * nc * nv;
+    cb.line(fmt::format("proximal_step<{}, {}>({}, {}, inv_mu, {});", nc, w3, Lf, C, L), {}, names, ops);
+    cb.close();
+  }
+  for (int b = 0; b < 3; ++b) {
     ops.once = denseProductAddOps(nv, nc, nv);
-    cb.line(fmt::format("dense_product_add<{}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, minvjt, bl.L, bl.X), {}, names,
-            ops);
+    cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, w3, nv, minvjt,
+                        block(L, b), Xs[b]),
+            {}, names, ops);
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k / {}) * {} + {}];", nc * nv, Ls[b], L, nv, w3,
+                        block(fmt::format("k % {}", nv), b)),
+            {}, names);
   }
   std::string text = e.fn.endHost(names);
   e.fn.live() = Live{};

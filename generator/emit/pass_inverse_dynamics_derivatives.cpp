@@ -290,9 +290,9 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
 // The arithmetic of dense_product<n, m, p> (assemble.cpp prints it): per
 // entry m multiplications and m additions into the sum, one scaling.
 Ops denseProductOps(int n, int m, int p) {
-  Ops o;
-  o.mul = long(n) * p * (m + 1);
-  o.add = long(n) * p * m;
+  Ops o;  // per row and k: s A_rk, then p multiply-adds
+  o.mul = long(n) * m * (p + 1);
+  o.add = long(n) * m * p;
   return o;
 }
 
