@@ -11,6 +11,10 @@
 //   3b.   the same at constrained_aba's answer (float: at mu = 100, see kMuPrimal)
 //   4. (G + I/mu) Ginv = I           delassus, delassus_inverse
 //   5. G = J Minv J^T                delassus, constraint_jacobian, mass_matrix_inverse
+//   6. M dqdd/dx + J^T dlambda/dx = R1 (x = q, v, tau; R1 = -dtau/dq, -dtau/dv, I: the implicit
+//      function theorem's first row)  constrained_dynamics_derivatives, inverse_dynamics_derivatives
+//   7. J dqdd/dtau = (I + mu G)^-K J Minv ~ 0 (the contacts' acceleration does not move with
+//      tau; double only, see there)  constrained_dynamics_derivatives, delassus_inverse
 //
 // Every identity has a bound argued below from u (the unit roundoff of the scalar: 2^-53 on the
 // M7, 2^-24 on the M4F) and a condition number computed here from the library's own outputs
@@ -66,6 +70,8 @@ Scalar g_M[nv * nv], g_Minv[nv * nv], g_J[nc * nv], g_G[nc * nc], g_Ginv[nc * nc
 Scalar g_h[nv], g_id[nv], g_tau[nv], g_qdd[nv], g_lambda[nc], g_gamma[nc];
 Scalar g_X[12 * gen::ncons];
 Scalar g_d[nv];  // sqrt(diag M): the Jacobi scaling
+Scalar g_dX[3][nv * nv], g_dL[3][nc * nv], g_dtau_dq[nv * nv], g_dtau_dv[nv * nv];  // 6 and 7
+Scalar g_cqdd[nv], g_clambda[nc];
 
 Scalar max_of(Scalar a, Scalar b) { return a < b ? b : a; }  // callers map NaN to infinity first
 
@@ -102,9 +108,12 @@ struct Check {
   const char* name;
   Scalar err = 0, bound = 0, worst = 0;  // at the state of the worst ratio
 };
-Check g_checks[6] = {{"M Minv = I"}, {"h = ID(q, v, 0)"}, {"ID(q, v, qdd, lambda) = tau (prox_pv)"},
+Check g_checks[8] = {{"M Minv = I"}, {"h = ID(q, v, 0)"}, {"ID(q, v, qdd, lambda) = tau (prox_pv)"},
                      {"(G + I/mu) Ginv = I"}, {"G = J Minv J^T"},
-                     {"ID(q, v, qdd, lambda) = tau (constrained_aba)"}};
+                     {"ID(q, v, qdd, lambda) = tau (constrained_aba)"},
+                     {"M dqdd/dx + J^T dlambda/dx = R1 (derivatives)"},
+                     {"J dqdd/dtau = (I + mu G)^-K J Minv (derivatives)"}};
+constexpr int kChecks = 8;
 
 void record(int k, Scalar err, Scalar bound) {
   Check& c = g_checks[k];
@@ -126,7 +135,8 @@ void run_state(int s) {
 
   // Region order: mass_matrix, mass_matrix_inverse, nonlinear_effects, inverse_dynamics,
   // prox_pv, inverse_dynamics, constraint_jacobian, delassus, delassus_inverse,
-  // constrained_aba, inverse_dynamics, constraint_placements, constraint_drift.
+  // constrained_aba, inverse_dynamics, constrained_dynamics_derivatives,
+  // inverse_dynamics_derivatives, constraint_placements, constraint_drift.
   if (trace) fw::trace_begin();
   gen::mass_matrix(q, g_w, g_M);
   if (trace) fw::trace_end();
@@ -311,6 +321,75 @@ void run_state(int s) {
     record(5, err, kC * kN * kU);
   }
 
+  // ---- 6. constrained_dynamics_derivatives (the layout's mu and K) against the implicit
+  // function theorem's first row, M X + J^T L = R1 with R1 = -dtau/dq, -dtau/dv, I for
+  // x = q, v, tau (dtau/dx from inverse_dynamics_derivatives at its (qdd, lambda)). The
+  // function computes X = Minv (R1 - J^T L) with its own Minv, so for ANY L the identity holds
+  // up to Minv's error and the products' round-off: with Y = R1 - J^T L, the Jacobi-scaled
+  // residual column D^-1 (M X - Y) e_j = Ms Es (D^-1 Y e_j), where Ms Es is the scaled
+  // residual of the inverse, within (c + 1) n u kappa(Ms) as in 1; the products X = Minv Y,
+  // J^T L and M X add c n u kappa(Ms) more. Error: max_j ||D^-1 R e_j||_inf / ||D^-1 Y e_j||_inf;
+  // bound: (2 c + 1) n u kappa(Ms). (It does not test L: 7 does.)
+  if (trace) fw::trace_begin();
+  gen::constrained_dynamics_derivatives(q, v, tau, settings, g_w, g_cqdd, g_clambda, g_dX[0], g_dX[1], g_dX[2],
+                                        g_dL[0], g_dL[1], g_dL[2]);
+  if (trace) fw::trace_end();
+  if (trace) fw::trace_begin();
+  gen::inverse_dynamics_derivatives(q, v, g_cqdd, g_clambda, g_w, g_dtau_dq, g_dtau_dv);
+  if (trace) fw::trace_end();
+  {
+    Scalar err = 0;
+    for (int b = 0; b < 3; ++b)
+      for (int j = 0; j < nv; ++j) {
+        Scalar res = 0, ys = 0;
+        for (int i = 0; i < nv; ++i) {
+          Scalar y = b == 2 ? (i == j ? Scalar(1) : Scalar(0)) : -(b == 0 ? g_dtau_dq : g_dtau_dv)[i * nv + j];
+          for (int r = 0; r < nc; ++r) y -= g_J[r * nv + i] * g_dL[b][r * nv + j];
+          Scalar mx = 0;
+          for (int k = 0; k < nv; ++k) mx += g_M[i * nv + k] * g_dX[b][k * nv + j];
+          const Scalar e = std::fabs(mx - y) / g_d[i];
+          res = max_of(res, std::isfinite(e) ? e : std::numeric_limits<Scalar>::infinity());
+          ys = max_of(ys, std::fabs(y) / g_d[i]);
+        }
+        err = max_of(err, res / ys);
+      }
+    record(6, err, (2 * kC + 1) * kN * kU * kappa_M);
+  }
+
+  // ---- 7. J X_tau, X_tau = dqdd/dtau: with S_K the K proximal steps as one operator,
+  // X_tau = Minv - Minv J^T S_K J Minv and G S_K = I - (I + mu G)^-K (the steps telescope), so
+  // J X_tau = (I + mu G)^-K J Minv: zero but for the proximal truncation, whose factor is below
+  // rho^K, rho = ||(I + mu G)^-1||_2 <= ||(G + I/mu)^-1||_inf / mu (delassus_inverse at the
+  // layout's mu, 4). This is what tests L: a wrong L leaves J Minv, O(1). Round-off: J X_tau is
+  // the difference J Minv - G L, whose terms are of the size of J Minv; L comes from solves with
+  // A = G + I/mu (error u kappa(A) relative, kappa(A) <= 1 + mu ||G||_inf since A >= I/mu), and
+  // G A^-1 <= I keeps that error at the size of J Minv; Minv's error adds c n u kappa(Ms).
+  // Error: max |J X_tau| / max |J Minv|; bound: c n u (kappa(A) + kappa(Ms)) + nc rho^K (nc:
+  // the 2-norm against the entries). In float at mu = 1e4, kappa(A) ~ 1e5 makes the bound
+  // exceed 1 (nothing could fail): float skips 7 (6 still runs).
+  if constexpr (!kFloat) {
+    Scalar jx = 0, jm = 0;
+    for (int r = 0; r < nc; ++r)
+      for (int j = 0; j < nv; ++j) {
+        Scalar a = 0, b = 0;
+        for (int k = 0; k < nv; ++k) {
+          a += g_J[r * nv + k] * g_dX[2][k * nv + j];
+          b += g_J[r * nv + k] * g_Minv[k * nv + j];
+        }
+        jx = max_of(jx, std::isfinite(a) ? std::fabs(a) : std::numeric_limits<Scalar>::infinity());
+        jm = max_of(jm, std::fabs(b));
+      }
+    // rho reads Ginv of 4, computed at kMuInverse: in double that is the layout's mu (else
+    // the check fails: an infinite error).
+    const Scalar mu = settings.mu;
+    const Scalar rho = mu == kMuInverse ? norm_inf(g_Ginv, nc, nullptr, false) / mu
+                                        : std::numeric_limits<Scalar>::infinity();
+    Scalar trunc = 1;
+    for (int k = 0; k < settings.iterations; ++k) trunc *= rho;
+    const Scalar kappa_A = 1 + mu * norm_inf(g_G, nc, nullptr, false);
+    record(7, jx / jm, kC * kN * kU * (kappa_A + kappa_M) + Scalar(nc) * trunc);
+  }
+
   // The two constraint functions without an identity here: run, finite.
   if (trace) fw::trace_begin();
   gen::constraint_placements(q, g_w, g_X);
@@ -362,7 +441,9 @@ int main() {
       ++failures;
     }
   }
-  for (const Check& c : g_checks) {
+  for (int k = 0; k < kChecks; ++k) {
+    const Check& c = g_checks[k];
+    if (kFloat && k == 7) continue;  // not run in float (see 7)
     fw::print("max ");
     fw::print(c.name);
     fw::print(": error ");
