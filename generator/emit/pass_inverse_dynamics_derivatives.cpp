@@ -287,10 +287,10 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
   return text;
 }
 
-// The arithmetic of dense_product<n, m, p> (assemble.cpp prints it): per
-// entry m multiplications and m additions into the sum, one scaling.
+// The arithmetic of dense_product<n, m, p> (assemble.cpp prints it): per row
+// r and k, the scaling s A_rk, then p multiply-adds into C's row.
 Ops denseProductOps(int n, int m, int p) {
-  Ops o;  // per row and k: s A_rk, then p multiply-adds
+  Ops o;
   o.mul = long(n) * m * (p + 1);
   o.add = long(n) * m * p;
   return o;
