@@ -307,7 +307,9 @@ ConstrainedDerivatives genericDifferences(const proxgen::System& sys, const prox
 // bound of proxPV at the state, c n u (kappa(M) + kappa(G + I/mu)), c = 10, the
 // same bound `proxgen verify` holds prox_pv to), so one column differs by at
 // most 2 delta max(1, |f|) / (2 h), and 10 times that is allowed (the bound, not
-// an estimate, as test_derivatives.cpp's allowance). Relative to max(1, |twin|).
+// an estimate, as test_derivatives.cpp's allowance); |f| is the larger of |qdd|
+// and |lambda| for both outputs, as qdd's round-off carries the multipliers'
+// (test::multiplierRoundoff). Relative to max(1, |twin|).
 // Returns the largest error / bound; err gets the largest |FD_gen - twin|
 // relative to max(1, |twin|) per block, the differences' own accuracy.
 template <class G>
@@ -374,8 +376,8 @@ std::vector<std::pair<std::string, double>> pinocchioCheck(const BenchCase& c,
     // compareDerivatives' order: qdd, lambda, then the six blocks as kBlocks.
     for (std::size_t b = 0; b < 8 && b < cmp.size(); ++b) {
       if (!cmp[b].finite) checkFailed(c.name + "/cdd/pinocchio: " + cmp[b].what + " is not finite");
-      const MatX& x = b == 0 ? r.qdd : b == 1 ? r.lambda : r.*kBlocks[b - 2];
-      const MatX& y = b == 0 ? conv.qdd : b == 1 ? conv.lambda : conv.*kBlocks[b - 2];
+      const MatX x = b == 0 ? MatX(r.qdd) : b == 1 ? MatX(r.lambda) : r.*kBlocks[b - 2];
+      const MatX y = b == 0 ? MatX(conv.qdd) : b == 1 ? MatX(conv.lambda) : conv.*kBlocks[b - 2];
       eK[b] = std::max(eK[b], cmp[b].error);
       eConv[b] = std::max(eConv[b], relErr(x, y));
       bound[b] = std::max(bound[b], cmp[b].bound);
