@@ -18,7 +18,12 @@
 //
 // makePinocchioConstraintDerivatives: pinocchio::constraintDynamics followed by
 // computeConstraintDynamicsDerivatives with the same constraint models, for
-// bench_derivatives.cpp (bench_pinocchio.hpp), on that executable's states.
+// bench_derivatives.cpp (bench_pinocchio.hpp), on that executable's states;
+// compiled only with PROXGEN_BENCH_PINOCCHIO_DERIVATIVES (bench/derivatives.cmake
+// defines it for proxgen_bench_derivatives alone): with the derivative templates
+// this file took 524 s to compile (GCC 12, -O3, wall, load ~2.5 on 2 cores; without
+// them its -fsyntax-only alone takes 166 s), a difference the suite's and the
+// library's builds, which do not call them, need not pay.
 //
 // Settings: mu = 1/kMu (Pinocchio's mu is the inverse of proxgen's), max_iter = K =
 // kIterations and accuracy 0, so no call stops before its K-th iteration.
@@ -27,8 +32,10 @@
 // headers too: the warning says nothing about this use.
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #include <pinocchio/algorithm/aba.hpp>
+#ifdef PROXGEN_BENCH_PINOCCHIO_DERIVATIVES
 #include <pinocchio/algorithm/constrained-dynamics-derivatives.hpp>
 #include <pinocchio/algorithm/constrained-dynamics.hpp>
+#endif
 #include <pinocchio/algorithm/contact-info.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/proximal.hpp>
@@ -145,6 +152,7 @@ class PinocchioSolver final : public Solver {
   std::vector<std::pair<std::string, double>> counters_;
 };
 
+#ifdef PROXGEN_BENCH_PINOCCHIO_DERIVATIVES
 // constraintDynamics + computeConstraintDynamicsDerivatives (bench_pinocchio.hpp).
 // Pinocchio's multipliers are the forces on the robot, M qdd + h = tau + J^T
 // lambda_pin (its KKT solve returns -lambda_pin): lambda = -lambda_pin in
@@ -191,6 +199,9 @@ std::unique_ptr<PinocchioConstraintDerivatives> makePinocchioConstraintDerivativ
                                                                                    double mu, int K) {
   return std::make_unique<PinocchioDerivatives>(caseName, sys, states, mu, K);
 }
+#else
+}  // namespace
+#endif
 
 std::unique_ptr<Solver> makePinocchioCaba(const BenchCase& c) {
   return std::make_unique<PinocchioSolver>(c, Algorithm::Caba);

@@ -54,7 +54,7 @@ ${dd_includes}
     # bring the suite's nine generated solvers into this target's build).
     target_sources(proxgen_bench_derivatives PRIVATE bench_pinocchio.cpp)
     target_link_libraries(proxgen_bench_derivatives PRIVATE pinocchio::pinocchio)
-    target_compile_definitions(proxgen_bench_derivatives PRIVATE PROXGEN_BENCH_PINOCCHIO)
+    target_compile_definitions(proxgen_bench_derivatives PRIVATE PROXGEN_BENCH_PINOCCHIO PROXGEN_BENCH_PINOCCHIO_DERIVATIVES)
   endif()
   add_dependencies(proxgen_bench_all proxgen_bench_derivatives)
   if(dd_case_list)
