@@ -16,6 +16,15 @@
 // "pinocchio" variant also copies it to the lower one (what the generated
 // functions return: the full matrix), "pinocchio_upper" is the call alone.
 //
+// makePinocchioConstraintDerivatives: pinocchio::constraintDynamics followed by
+// computeConstraintDynamicsDerivatives with the same constraint models, for
+// bench_derivatives.cpp (bench_pinocchio.hpp), on that executable's states;
+// compiled only with PROXGEN_BENCH_PINOCCHIO_DERIVATIVES (bench/derivatives.cmake
+// defines it for proxgen_bench_derivatives alone): with the derivative templates
+// this file took 524 s to compile (GCC 12, -O3, wall, load ~2.5 on 2 cores; without
+// them its -fsyntax-only alone takes 166 s), a difference the suite's and the
+// library's builds, which do not call them, need not pay.
+//
 // Settings: mu = 1/kMu (Pinocchio's mu is the inverse of proxgen's), max_iter = K =
 // kIterations and accuracy 0, so no call stops before its K-th iteration.
 // Pinocchio 3.7 marks the constraint models, pv, constrainedABA and initPvSolver
@@ -23,6 +32,10 @@
 // headers too: the warning says nothing about this use.
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #include <pinocchio/algorithm/aba.hpp>
+#ifdef PROXGEN_BENCH_PINOCCHIO_DERIVATIVES
+#include <pinocchio/algorithm/constrained-dynamics-derivatives.hpp>
+#include <pinocchio/algorithm/constrained-dynamics.hpp>
+#endif
 #include <pinocchio/algorithm/contact-info.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/proximal.hpp>
@@ -43,6 +56,7 @@
 #include "algorithms/data.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/rnea.hpp"
+#include "bench_pinocchio.hpp"
 #include "common.hpp"
 #include "model/error.hpp"
 
@@ -78,21 +92,26 @@ void buildPinocchioModel(const std::string& caseName, const Model& pm, pinocchio
   }
 }
 
+// One RigidConstraintModel per layout constraint (and its data), in layout order.
+void buildConstraintModels(const std::string& caseName, const System& sys, const pinocchio::Model& model,
+                           ConstraintModels& models, ConstraintDatas& datas) {
+  for (const Constraint& k : sys.constraints) {
+    if (k.kp != 0 || k.kd != 0)
+      pinocchioError(caseName, "constraint " + k.name + " has Baumgarte gains (Pinocchio's pv does not honour kp)");
+    if (!model.existFrame(k.link, pinocchio::BODY)) pinocchioError(caseName, "no body frame " + k.link);
+    const pinocchio::Frame& f = model.frames[model.getFrameId(k.link, pinocchio::BODY)];
+    const pinocchio::ContactType type = k.type == ConstraintType::Weld6D ? pinocchio::CONTACT_6D : pinocchio::CONTACT_3D;
+    models.emplace_back(type, model, f.parentJoint, f.placement * toPinocchio(k.offset), pinocchio::LOCAL);
+  }
+  for (const auto& m : models) datas.emplace_back(m);
+}
+
 class PinocchioSolver final : public Solver {
  public:
   PinocchioSolver(const BenchCase& c, Algorithm algorithm)
       : states_(c.states), algorithm_(algorithm), settings_(0.0, 1.0 / kMu, kIterations) {
     buildPinocchioModel(c.name, c.sys.model, model_);
-    for (const Constraint& k : c.sys.constraints) {
-      if (k.kp != 0 || k.kd != 0)
-        pinocchioError(c.name, "constraint " + k.name + " has Baumgarte gains (Pinocchio's pv does not honour kp)");
-      if (!model_.existFrame(k.link, pinocchio::BODY)) pinocchioError(c.name, "no body frame " + k.link);
-      const pinocchio::Frame& f = model_.frames[model_.getFrameId(k.link, pinocchio::BODY)];
-      const pinocchio::ContactType type =
-          k.type == ConstraintType::Weld6D ? pinocchio::CONTACT_6D : pinocchio::CONTACT_3D;
-      models_.emplace_back(type, model_, f.parentJoint, f.placement * toPinocchio(k.offset), pinocchio::LOCAL);
-    }
-    for (const auto& m : models_) datas_.emplace_back(m);
+    buildConstraintModels(c.name, c.sys, model_, models_, datas_);
     data_ = std::make_unique<pinocchio::Data>(model_);
     pinocchio::initPvSolver(model_, *data_, models_);
 
@@ -133,7 +152,56 @@ class PinocchioSolver final : public Solver {
   std::vector<std::pair<std::string, double>> counters_;
 };
 
+#ifdef PROXGEN_BENCH_PINOCCHIO_DERIVATIVES
+// constraintDynamics + computeConstraintDynamicsDerivatives (bench_pinocchio.hpp).
+// Pinocchio's multipliers are the forces on the robot, M qdd + h = tau + J^T
+// lambda_pin (its KKT solve returns -lambda_pin): lambda = -lambda_pin in
+// proxgen's convention, and so for their tangents. settings_ is one object for
+// both calls: constraintDynamics writes settings.iter, the derivatives run that
+// many proximal steps on the tangents.
+class PinocchioDerivatives final : public PinocchioConstraintDerivatives {
+ public:
+  PinocchioDerivatives(const std::string& caseName, const System& sys, const std::vector<State>& states, double mu,
+                       int K)
+      : states_(states), settings_(0.0, 1.0 / mu, K) {
+    buildPinocchioModel(caseName, sys.model, model_);
+    buildConstraintModels(caseName, sys, model_, models_, datas_);
+    data_ = std::make_unique<pinocchio::Data>(model_);
+    pinocchio::initConstraintDynamics(model_, *data_, models_);
+  }
+  void call(int k) override {
+    const State& s = states_[std::size_t(k)];
+    pinocchio::constraintDynamics(model_, *data_, s.q, s.v, s.tau, models_, datas_, settings_);
+    pinocchio::computeConstraintDynamicsDerivatives(model_, *data_, models_, datas_, settings_);
+  }
+  void read(ConstrainedDerivatives& out) const override {
+    out.qdd = data_->ddq;
+    out.lambda = -data_->lambda_c;
+    out.dqdd_dq = data_->ddq_dq, out.dqdd_dv = data_->ddq_dv, out.dqdd_dtau = data_->ddq_dtau;
+    out.dlambda_dq = -data_->dlambda_dq, out.dlambda_dv = -data_->dlambda_dv, out.dlambda_dtau = -data_->dlambda_dtau;
+  }
+  int iterations() const override { return settings_.iter; }
+
+ private:
+  const std::vector<State>& states_;
+  pinocchio::Model model_;
+  std::unique_ptr<pinocchio::Data> data_;
+  ConstraintModels models_;
+  ConstraintDatas datas_;
+  pinocchio::ProximalSettings settings_;
+};
+
 }  // namespace
+
+std::unique_ptr<PinocchioConstraintDerivatives> makePinocchioConstraintDerivatives(const std::string& caseName,
+                                                                                   const System& sys,
+                                                                                   const std::vector<State>& states,
+                                                                                   double mu, int K) {
+  return std::make_unique<PinocchioDerivatives>(caseName, sys, states, mu, K);
+}
+#else
+}  // namespace
+#endif
 
 std::unique_ptr<Solver> makePinocchioCaba(const BenchCase& c) {
   return std::make_unique<PinocchioSolver>(c, Algorithm::Caba);

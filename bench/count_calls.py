@@ -9,10 +9,17 @@ runs, so only the calls remain. Deterministic (same states, same code).
     count_calls.py BUILD_DIR OUT.json [--calls N] [--cases a,b] [--algorithms x,y]
     count_calls.py BUILD_DIR OUT.json --library [--calls N] [--cases a,b] [--algorithms f/variant,...]
 
+    count_calls.py BUILD_DIR OUT.json --derivatives [--calls N] [--cases a,b] [--algorithms variant,...]
+
 --library counts the dynamics library's benchmarks instead (proxgen_bench_joint_space
 --count CASE/FUNCTION/VARIANT N, bench_joint_space.cpp): each generated function, its
 generic twin, the route to delassus_inverse through the generated mass_matrix, and
 Pinocchio's rnea, nonLinearEffects, crba and computeMinverse where the build has them.
+--derivatives counts the derivative benchmarks (proxgen_bench_derivatives --count
+CASE/VARIANT N, bench_derivatives.cpp): the generated constrained_dynamics_derivatives,
+the central differences of prox_pv, their integrations alone, and Pinocchio's
+constraintDynamics + computeConstraintDynamicsDerivatives where the build has it. Its
+set-up checks the one variant it runs, so each (case, variant) has its own N = 0 run.
 """
 import argparse
 import json
@@ -30,6 +37,14 @@ LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "
     # Pinocchio's, where the build found it (bench_pinocchio.cpp, pinocchioJointSpace); exit 3 otherwise.
     f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
     "mass_matrix/pinocchio_upper", "mass_matrix_inverse/pinocchio_upper"]
+DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio"]
+# The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, the
+# default list of what to count, and whether one N = 0 run serves every item of a case.
+DRIVERS = {
+    "calls": ("proxgen_bench_calls", False, ALGORITHMS, False),
+    "library": ("proxgen_bench_joint_space", True, LIBRARY, True),
+    "derivatives": ("proxgen_bench_derivatives", True, DERIVATIVES, False),
+}
 NOT_BUILT = 3  # proxgen_bench_calls' (and --count's) exit code for what this build lacks
 
 
@@ -65,17 +80,18 @@ def main():
     ap.add_argument("--cases", help="comma-separated (default: every case of cases.yaml)")
     ap.add_argument("--algorithms", help="comma-separated (default: every solver, or with --library every "
                     "function/variant)")
-    ap.add_argument("--library", action="store_true", help="the dynamics library (proxgen_bench_joint_space)")
+    which = ap.add_mutually_exclusive_group()
+    which.add_argument("--library", action="store_true", help="the dynamics library (proxgen_bench_joint_space)")
+    which.add_argument("--derivatives", action="store_true", help="the derivatives (proxgen_bench_derivatives)")
     args = ap.parse_args()
-    algorithms = args.algorithms.split(",") if args.algorithms else (LIBRARY if args.library else ALGORITHMS)
+    exe, count_flag, default_list, shared_baseline = DRIVERS[
+        "library" if args.library else "derivatives" if args.derivatives else "calls"]
+    algorithms = args.algorithms.split(",") if args.algorithms else default_list
 
     with open(os.path.join(args.build_dir, "CMakeCache.txt")) as f:
         models = re.search(r"^PROXGEN_MODELS_DIR:PATH=(.*)$", f.read(), re.M).group(1)
     cases = args.cases.split(",") if args.cases else case_names(os.path.join(models, "cases.yaml"))
-    if args.library:
-        driver = [os.path.join(args.build_dir, "bench", "proxgen_bench_joint_space"), "--count"]
-    else:
-        driver = [os.path.join(args.build_dir, "bench", "proxgen_bench_calls")]
+    driver = [os.path.join(args.build_dir, "bench", exe)] + (["--count"] if count_flag else [])
 
     results = []
     baselines = {}
@@ -84,17 +100,17 @@ def main():
             for algorithm in algorithms:
                 full = instructions(driver, case, algorithm, args.calls, work)
                 if full is None:
-                    print(f"{case:26s} {algorithm:9s} not built", flush=True)
+                    print(f"{case:26s} {algorithm:20s} not built", flush=True)
                     continue
                 # The library driver's run without calls is the same for every function of a case.
-                key = case if args.library else (case, algorithm)
+                key = case if shared_baseline else (case, algorithm)
                 if key not in baselines:
                     baselines[key] = instructions(driver, case, algorithm, 0, work)
                 base = baselines[key]
                 per_call = (full - base) / args.calls
                 results.append({"case": case, "algorithm": algorithm, "ir_per_call": per_call,
                                 "ir_total": full, "ir_baseline": base, "calls": args.calls})
-                print(f"{case:26s} {algorithm:9s} {per_call:12,.0f} Ir/call", flush=True)
+                print(f"{case:26s} {algorithm:20s} {per_call:14,.0f} Ir/call", flush=True)
     with open(args.out, "w") as f:
         json.dump(results, f, indent=1)
 
