@@ -55,6 +55,7 @@
 #include "algorithms/derivatives.hpp"
 #include "algorithms/prox_pv.hpp"
 #include "bench_pinocchio.hpp"
+#include "bodies.hpp"
 #include "cases/cases.hpp"
 #include "derivative_solvers.hpp"
 #include "model/error.hpp"
@@ -63,6 +64,8 @@
 #include "verify/compare.hpp"
 
 namespace {
+
+using proxgen::bench::bodies;
 
 using proxgen::MatX;
 using proxgen::VecX;
@@ -91,18 +94,6 @@ std::unique_ptr<BenchCase> loadBenchCase(const std::string& name) {
   std::mt19937 rng(1);
   for (int k = 0; k < kStates; ++k) c->states.push_back(proxgen::randomState(c->sys.model, rng));
   return c;
-}
-
-// Every benchmark body by name, in registration order: call(k) is one call on state k.
-struct Body {
-  std::string name;
-  int states, nv, nc;
-  std::function<void(int)> call;
-  std::vector<std::pair<std::string, double>> counters;  // the check's figures
-};
-std::vector<Body>& bodies() {
-  static std::vector<Body> b;
-  return b;
 }
 
 double maxAbs(const MatX& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
@@ -406,7 +397,7 @@ void registerCase(const char* name, const std::function<bool(const std::string&)
   const auto g = std::make_shared<Generated<G>>(c);
   const int nv = G::nv, nc = G::nc;
   const std::string base = c.name + "/";
-  const std::vector<std::pair<std::string, double>> sizes{{"nv", nv}, {"nc", nc}, {"K", kK}};
+  const std::vector<std::pair<std::string, double>> sizes{{"K", kK}};  // nv, nc: timedBody
   const auto reg = [&](const std::string& variant, std::function<void(int)> call,
                        std::vector<std::pair<std::string, double>> counters) {
     counters.insert(counters.begin(), sizes.begin(), sizes.end());
@@ -438,16 +429,6 @@ void registerCase(const char* name, const std::function<bool(const std::string&)
     reg("cdd/pinocchio", [p](int k) { p->call(k); }, counters);
   }
 #endif
-}
-
-void timed(benchmark::State& st, const Body* b) {
-  int k = 0;
-  for (auto _ : st) {
-    b->call(k);
-    benchmark::ClobberMemory();
-    if (++k == b->states) k = 0;
-  }
-  for (const auto& [key, value] : b->counters) st.counters[key] = value;
 }
 
 }  // namespace
@@ -487,26 +468,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "proxgen_bench_derivatives: %s\n", e.what());
     return 2;
   }
-  if (count) {
-    for (const Body& b : bodies()) {
-      if (b.name != what) continue;
-      const long n = std::stol(argv[3]);
-      int k = 0;
-      for (long call = 0; call < n; ++call) {
-        b.call(k);
-        benchmark::ClobberMemory();
-        if (++k == b.states) k = 0;
-      }
-      return 0;
-    }
-    std::fprintf(stderr, "proxgen_bench_derivatives: no benchmark %s in this build\n", what.c_str());
-    return 3;
-  }
-  for (const Body& b : bodies())
-    benchmark::RegisterBenchmark(b.name.c_str(), timed, &b)->Unit(benchmark::kMicrosecond);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  if (count) return proxgen::bench::countBody("proxgen_bench_derivatives", argv[2], std::stol(argv[3]));
+  return proxgen::bench::runBodies(argc, argv);
 }

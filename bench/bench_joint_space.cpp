@@ -42,6 +42,7 @@
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/mass_matrix_inverse.hpp"
 #include "algorithms/rnea.hpp"
+#include "bodies.hpp"
 #include "cases/cases.hpp"
 #include "joint_space_solvers.hpp"
 #include "model/state.hpp"
@@ -56,6 +57,8 @@ std::function<void(int)> pinocchioJointSpace(const std::string& caseName, const 
 #endif
 
 namespace {
+
+using proxgen::bench::bodies;
 
 constexpr double kMu = 1e4;  // the benchmarks' mu (bench/common.hpp)
 
@@ -108,17 +111,6 @@ std::shared_ptr<Inputs<Scalar>> inputsOf(const BenchCase& c) {
   return in;
 }
 
-// Every benchmark body by name, in registration order: call(k) is one call on state k.
-struct Body {
-  std::string name;
-  int states, nv, nc;
-  std::function<void(int)> call;
-};
-std::vector<Body>& bodies() {
-  static std::vector<Body> b;
-  return b;
-}
-
 // The route through the generated mass matrix: Eigen's fixed-size LLT of M
 // (what a user would write with the generated pieces), J M^-1 J^T + I/mu, its
 // LLT and inverse. The work matrices live for the whole run.
@@ -161,7 +153,7 @@ void registerCase(const char* name) {
   const auto route = std::make_shared<Route<G>>();
   const std::string base = c.name + "/";
   const auto reg = [&](const std::string& what, std::function<void(int)> call) {
-    bodies().push_back({base + what, in->n, nv, nc, std::move(call)});
+    bodies().push_back({base + what, in->n, nv, nc, std::move(call), {}});
   };
   const auto q = [in](int k) { return in->at(in->q, in->nq, k); };
   const auto v = [in](int k) { return in->at(in->v, in->nv, k); };
@@ -241,17 +233,6 @@ void registerCase(const char* name) {
 #endif
 }
 
-void timed(benchmark::State& st, const Body* b) {
-  int k = 0;
-  for (auto _ : st) {
-    b->call(k);
-    benchmark::ClobberMemory();
-    if (++k == b->states) k = 0;
-  }
-  st.counters["nv"] = b->nv;
-  st.counters["nc"] = b->nc;
-}
-
 }  // namespace
 
 // One generated namespace's functions as a type, for registerCase.
@@ -291,26 +272,6 @@ int main(int argc, char** argv) {
   if (only.empty() || only == #CASE) registerCase<api_##CASE::G>(#CASE);
   PROXGEN_BENCH_JOINT_SPACE_CASES(PROXGEN_BENCH_REGISTER)
 #undef PROXGEN_BENCH_REGISTER
-  if (count) {
-    for (const Body& b : bodies()) {
-      if (b.name != argv[2]) continue;
-      const long n = std::stol(argv[3]);
-      int k = 0;
-      for (long call = 0; call < n; ++call) {
-        b.call(k);
-        benchmark::ClobberMemory();
-        if (++k == b.states) k = 0;
-      }
-      return 0;
-    }
-    std::fprintf(stderr, "proxgen_bench_joint_space: no benchmark %s in this build\n", argv[2]);
-    return 3;
-  }
-  for (const Body& b : bodies())
-    benchmark::RegisterBenchmark(b.name.c_str(), timed, &b)->Unit(benchmark::kMicrosecond);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  if (count) return proxgen::bench::countBody("proxgen_bench_joint_space", argv[2], std::stol(argv[3]));
+  return proxgen::bench::runBodies(argc, argv);
 }
