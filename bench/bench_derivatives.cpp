@@ -97,8 +97,7 @@ std::unique_ptr<BenchCase> loadBenchCase(const std::string& name) {
 }
 
 double maxAbs(const MatX& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
-// max |a - b| / max(1, max |b|), as verify::relErr.
-double relErr(const MatX& a, const MatX& b) { return a.size() ? maxAbs(a - b) / std::max(1.0, maxAbs(b)) : 0.0; }
+using proxgen::verify::relErr;  // max |a - b| / max(1, max |b|)
 
 template <class Scalar>
 MatX rowMajor(const std::vector<Scalar>& x, int rows, int cols) {
