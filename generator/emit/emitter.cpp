@@ -106,11 +106,12 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, true);
   // With constrained_dynamics_derivatives the sweep also keeps the constrained
   // bodies' motion tangents, which its constraint rows read.
+  // Both derivative functions that call the sweep read dtau's pattern.
   const bool cdd = want.has(Function::ConstrainedDynamicsDerivatives);
   BodyTangents tangents;
   if (want.has(Function::InverseDynamicsDerivatives))
     texts.library[Function::InverseDynamicsDerivatives] =
-        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, cdd ? &tangents : nullptr);
+        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);
     Kinematics transforms = emitJointTransforms(e);
@@ -125,7 +126,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   }
 
   if (want.has(Function::ForwardDynamicsDerivatives))
-    texts.library[Function::ForwardDynamicsDerivatives] = emitForwardDynamicsDerivatives(e);
+    texts.library[Function::ForwardDynamicsDerivatives] = emitForwardDynamicsDerivatives(e, tangents);
   if (cdd)
     texts.library[Function::ConstrainedDynamicsDerivatives] =
         emitConstrainedDynamicsDerivatives(e, afterKinematicsState, afterKinematics, tangents);

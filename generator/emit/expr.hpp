@@ -146,6 +146,10 @@ class CodeBuilder {
   /// become stale: printing an expression that still holds one is an error
   /// (it would read the new value where the old one was meant).
   Expr store(const std::string& member, const Expr& e);
+  /// The member was written by a statement under another name (a loop's
+  /// slot "w.x[r][c0 + j]" writes "w.x[r][c]"): its earlier values become
+  /// stale as after store(); returns its new value.
+  Expr refresh(const std::string& member);
   /// member = rhs; with a raw right-hand side (a function call).
   Expr storeRaw(const std::string& member, const std::string& rhs, const std::vector<Expr>& uses, const Ops& extra = {});
   /// A raw statement that writes several members (a call with output
@@ -224,7 +228,6 @@ class CodeBuilder {
   };
 
   int newAtom(Atom a);
-  Expr refresh(const std::string& member);
   int& current(int name);
   std::string key(const Expr& e) const;
   void collectUses(const Expr& e, std::vector<int>& uses) const;

@@ -7,11 +7,14 @@
 // mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
 // it); the constraint rows (J, R2) are printed straight-line from the sweep's
 // motion tangents of the constrained bodies, the path's columns only; the
-// dense algebra (O(nv^3 + nv^2 nc + nc^2 nv), plus K nc^3 for the proximal
-// operator S_K or K nc^2 nv for stepping C) is fixed-bound loops printed once
-// by assemble.cpp. The generic counterpart:
+// matrix algebra (O(nv nnz(dtau) + nv^2 nc + nc^2 nv), plus K nc^3 for the
+// proximal operator S_K or K nc^2 nv for stepping C) is fixed-bound loops
+// printed once by assemble.cpp, the products with dtau and J over their
+// nonzero patterns (constant tables of column ranges). The generic counterpart:
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
+
+#include <set>
 
 #include "emit/identifiers.hpp"
 #include "emit/passes.hpp"
@@ -46,15 +49,18 @@ std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& k
 struct RowMembers {
   std::string J;   // nc x nv
   std::string R2;  // nc x 3 nv: the q, v and tau columns side by side (tau's are 0)
+  std::set<std::pair<int, int>> Jnz;  // J's entries written (row, column): its pattern
 };
 
-// entry = f * x into member[idx] (of `size` entries), skipping exact zeros (the host zeroed the arrays).
-void storeRow(Emit& e, const std::string& base, int size, int idx, const Expr& f, const Expr& x) {
-  if (x.isZero()) return;
+// entry = f * x into member[idx] (of `size` entries), skipping exact zeros
+// (the host zeroed the arrays); false for a zero.
+bool storeRow(Emit& e, const std::string& base, int size, int idx, const Expr& f, const Expr& x) {
+  if (x.isZero()) return false;
   CodeBuilder& cb = e.cb();
   const Expr flat = cb.flat(x);
   const Expr y = cb.mul(f, flat);
   cb.store(e.ws.member(base, size, idx, "constrained_dynamics_derivatives"), y);
+  return true;
 }
 
 // One constraint's rows: J, and R2 = d a*/dx - d alpha/dx for x = q, v at
@@ -63,7 +69,7 @@ void storeRow(Emit& e, const std::string& base, int size, int idx, const Expr& f
 // the body's path. The sweep's a is gravity-shifted (a_0 = -a_g): the true
 // acceleration's q tangent adds R^T g x w back (w the Jacobian column's
 // angular part: the body turns by w, its gravity by -w x R^T g).
-void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangents& t, const RowMembers& m) {
+void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangents& t, RowMembers& m) {
   const Constraint& c = e.sys.constraints[std::size_t(k)];
   const int i = c.body, r = c.rows(), nv = e.plan.nv;
   const bool weld = c.type == ConstraintType::Weld6D;
@@ -129,7 +135,7 @@ void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangen
     }
     for (int j = 0; j < r; ++j) {
       const int nc = e.plan.nc, row = c.row + j;
-      storeRow(e, m.J, nc * nv, row * nv + col, f, J6[std::size_t(j)]);
+      if (storeRow(e, m.J, nc * nv, row * nv + col, f, J6[std::size_t(j)])) m.Jnz.insert({row, col});
       storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + col, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]);
       storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + nv + col, f, Sv[std::size_t(j)] - Av[std::size_t(j)]);
     }
@@ -188,6 +194,7 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const std::string minv = array("cdd_Minv", nv * nv, "M^-1 (constrained_dynamics_derivatives)");
   const std::string dq = array("cdd_dtau_dq", nv * nv, "d tau / dq at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
   const std::string dv = array("cdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
+  const std::string xt = array("cdd_Xt", nv * nv, "d qdd / dq or d qdd / dv unconstrained, transposed (constrained_dynamics_derivatives)");
   RowMembers rows;
   std::string minvjt, G, Lf, C, L;
   if (nc > 0) {
@@ -230,10 +237,9 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
     e.fn.endPart();
   }
   CodeBuilder& cb = e.cb();
-  // The unconstrained tangents M^-1 R1: X_q = -M^-1 dtau_dq, X_v = -M^-1 dtau_dv, X_tau = M^-1.
-  ops.once = denseProductOps(nv, nv, nv);
-  cb.line(fmt::format("dense_product<{0}, {0}, {0}>({1}, {2}, Scalar(-1), dqdd_dq);", nv, minv, dq), {}, names, ops);
-  cb.line(fmt::format("dense_product<{0}, {0}, {0}>({1}, {2}, Scalar(-1), dqdd_dv);", nv, minv, dv), {}, names, ops);
+  // The unconstrained tangents M^-1 R1: X_q = -M^-1 dtau_dq, X_v = -M^-1
+  // dtau_dv over dtau's nonzero entries, X_tau = M^-1.
+  minvTimesDtau(e, t, minv, dq, dv, xt, names);
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_dtau[k] = {}[k];", nv * nv, minv), {}, names);
   if (nc == 0) {
     for (const char* p : {"dlambda_dq", "dlambda_dv", "dlambda_dtau"})
@@ -247,10 +253,15 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const int w3 = 3 * nv;
   const std::string Xs[] = {"dqdd_dq", "dqdd_dv", "dqdd_dtau"}, Ls[] = {"dlambda_dq", "dlambda_dv", "dlambda_dtau"};
   const auto block = [&](const std::string& a, int b) { return b == 0 ? a : fmt::format("{} + {}", a, b * nv); };
-  ops.once = denseProductOps(nc, nv, nv);
+  // J's rows are nonzero only on the constrained body's path: the products
+  // with J on the left read its pattern (C starts at 0 for them).
+  const RowSpans jSpans = rowSpans(nc, rows.Jnz);
+  printSpans(cb, "J_nz", jSpans);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", 3 * nc * nv, C), {}, names);
+  ops.once = sparseLeftProductOps(jSpans, nv);
   for (int b = 0; b < 3; ++b)
-    cb.line(fmt::format("dense_product<{}, {}, {}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nv, nv, w3, rows.J, Xs[b],
-                        block(C, b)),
+    cb.line(fmt::format("sparse_left_product_add<{}, {}, {}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});",
+                        nc, nv, nv, nv, w3, rows.J, Xs[b], block(C, b)),
             {}, names, ops);
   // M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k % {}) * {} + {} + k / {}];", nv * nc, minvjt, C, nc, w3,
@@ -259,8 +270,11 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   ops.once = Ops{};
   ops.once.add = 3L * nc * nv;
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", 3 * nc * nv, C, C, rows.R2), {}, names, ops);
-  ops.once = denseProductOps(nc, nv, nc);
-  cb.line(fmt::format("dense_product<{}, {}, {}>(w.{}, {}, Scalar(1), {});", nc, nv, nc, rows.J, minvjt, G), {}, names, ops);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, G), {}, names);
+  ops.once = sparseLeftProductOps(jSpans, nc);
+  cb.line(fmt::format("sparse_left_product_add<{}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});", nc, nv, nc,
+                      rows.J, minvjt, G),
+          {}, names, ops);
   ops.once = Ops::divisions(1);
   cb.line("const Scalar inv_mu = Scalar(1) / s.mu;", {}, names, ops);
   ops.once = denseCholeskyOps(nc);

@@ -13,9 +13,12 @@
 // A column outside a body's path (forward) or path and subtree (backward) is
 // zero and never printed. The tangents move between the part functions in
 // workspace members (6 x nv per body, only the path's columns written); the
-// host copies the nonzero entries out and writes the zeros.
+// host copies the nonzero entries out and writes the zeros. A run of adjacent
+// columns of one shape is one loop over j instead of a block per column
+// (below, "Column loops"; docs/derivatives.md).
 // The generic counterpart: algorithms/derivatives.cpp (tangentSweep).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <map>
@@ -34,18 +37,60 @@ using Slot = TangentSlot;
 using Col = TangentCol;
 using Cols = TangentCols;
 
-Col save(Emit& e, const Quantity& qy, int body, int col, const V6& x) {
+// Stores x's non-constant entries as column `col` of the body's 6 x nv
+// member; in a loop over a run of columns (`loop`), as column col + j.
+Col save(Emit& e, const Quantity& qy, int body, int col, const V6& x, bool loop = false) {
   Col s;
   for (int r = 0; r < 6; ++r) {
     const Expr& v = x[std::size_t(r)];
     if (v.isConstant()) {
       s[std::size_t(r)].value = v;
     } else {
-      s[std::size_t(r)].name = e.member(qy, body, 6, e.plan.nv, r, col);
+      s[std::size_t(r)].name =
+          loop ? e.loopSlot(qy, body, 6, e.plan.nv, r, col) : e.member(qy, body, 6, e.plan.nv, r, col);
       e.cb().store(s[std::size_t(r)].name, v);
     }
   }
   return s;
+}
+
+// Column loops. The columns of a body's tangents go through the same
+// arithmetic with the same coefficients (the body's transform, inertia and
+// velocity); only which members they read differs. A run of adjacent columns
+// whose inputs have the same shape (each entry a stored member in all of
+// them, or the same constant in all) is one loop over j, the members indexed
+// [c0 + j], instead of a copy of the code per column: the sweep's code shrinks
+// by the depth of the tree, and the compiler vectorises the loop across
+// columns. Runs shorter than this stay unrolled (docs/derivatives.md, "Column
+// loops").
+constexpr int kLoopColumns = 2;
+
+bool sameShape(const Col& a, const Col& b) {
+  for (std::size_t r = 0; r < 6; ++r) {
+    if (a[r].name.empty() != b[r].name.empty()) return false;
+    if (a[r].name.empty() && a[r].value.constant() != b[r].value.constant()) return false;
+  }
+  return true;
+}
+
+// `c`'s stored entries read as the loop's column c0 + j (c: column c0's slots).
+Col loopColumn(Emit& e, const Quantity& qy, int body, const Col& c, int c0) {
+  Col out = c;
+  for (int r = 0; r < 6; ++r)
+    if (!c[std::size_t(r)].name.empty()) out[std::size_t(r)].name = e.loopSlot(qy, body, 6, e.plan.nv, r, c0);
+  return out;
+}
+
+// After the loop: column k's slots, with the shape the loop gave them; the
+// members the loop wrote under its own names are new values from here on.
+Col columnAfterLoop(Emit& e, const Quantity& qy, int body, const Col& looped, int k) {
+  Col out = looped;
+  for (int r = 0; r < 6; ++r)
+    if (!looped[std::size_t(r)].name.empty()) {
+      out[std::size_t(r)].name = e.member(qy, body, 6, e.plan.nv, r, k);
+      e.cb().refresh(out[std::size_t(r)].name);
+    }
+  return out;
 }
 
 std::string vIn(int k) { return fmt::format("v[{}]", k); }
@@ -82,7 +127,7 @@ V6 forceTangent(Emit& e, const Kinematics::Body& kb, const V6& da, const V6& dv)
 // tangents before the velocity-product term; stores what the children and the
 // backward sweep read.
 void finishColumn(Emit& e, const Kinematics::Body& kb, int i, int k, const V6& vJ, const V6& dvq, const V6& dvv,
-                  const V6& daq0, const V6& dav0, bool store, Sweep& s) {
+                  const V6& daq0, const V6& dav0, bool store, Sweep& s, bool loop = false) {
   CodeBuilder& cb = e.cb();
   V6 dq = dvq, dv = dvv;
   flatten(cb, dq, "dv");
@@ -94,15 +139,15 @@ void finishColumn(Emit& e, const Kinematics::Body& kb, int i, int k, const V6& v
   flatten(cb, dav, "da");
   const std::size_t b = std::size_t(i);
   if (store) {
-    s.dvq[b][k] = save(e, kDvq, i, k, dq);
-    s.dvv[b][k] = save(e, kDvv, i, k, dv);
-    s.daq[b][k] = save(e, kDaq, i, k, daq);
-    s.dav[b][k] = save(e, kDav, i, k, dav);
+    s.dvq[b][k] = save(e, kDvq, i, k, dq, loop);
+    s.dvv[b][k] = save(e, kDvv, i, k, dv, loop);
+    s.daq[b][k] = save(e, kDaq, i, k, daq, loop);
+    s.dav[b][k] = save(e, kDav, i, k, dav, loop);
   }
   const V6 fq = forceTangent(e, kb, daq, dq);
-  s.dfq[b][k] = save(e, kDfq, i, k, fq);
+  s.dfq[b][k] = save(e, kDfq, i, k, fq, loop);
   const V6 fv = forceTangent(e, kb, dav, dv);
-  s.dfv[b][k] = save(e, kDfv, i, k, fv);
+  s.dfv[b][k] = save(e, kDfv, i, k, fv, loop);
 }
 
 void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrained, Forces& fs, Sweep& s) {
@@ -153,24 +198,55 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
       }
     }
     e.cb().close();
-    // The ancestors' columns, carried from the parent: one block each.
+    // The ancestors' columns, carried from the parent: a loop per run of
+    // columns of one shape, a block per column elsewhere.
     if (p.parent <= 0) continue;
     const std::size_t par = std::size_t(p.parent);
-    for (const auto& [k, unused] : s.dvq[par]) {
-      static_cast<void>(unused);
-      e.fn.boundary(fmt::format("{}_c{}", p.ident, k));
-      e.cb().open("{", {fmt::format("body {} '{}', column {}", i, p.ident, k)});
+    std::vector<int> carried;
+    for (const auto& kv : s.dvq[par]) carried.push_back(kv.first);
+    const auto shapeOf = [&](int k, int k0) {
+      return sameShape(s.dvq[par].at(k), s.dvq[par].at(k0)) &&
+             sameShape(s.dvv[par].at(k), s.dvv[par].at(k0)) && sameShape(s.daq[par].at(k), s.daq[par].at(k0)) &&
+             sameShape(s.dav[par].at(k), s.dav[par].at(k0));
+    };
+    for (std::size_t n = 0; n < carried.size();) {
+      const int k0 = carried[n];
+      std::size_t len = 1;
+      while (n + len < carried.size() && carried[n + len] == k0 + int(len) && shapeOf(carried[n + len], k0)) ++len;
+      const bool loop = int(len) >= kLoopColumns;
+      if (!loop) len = 1;
+      e.fn.boundary(fmt::format("{}_c{}", p.ident, k0));
+      if (loop)
+        e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
+                    {fmt::format("body {} '{}', columns {} to {}", i, p.ident, k0, k0 + int(len) - 1)});
+      else
+        e.cb().open("{", {fmt::format("body {} '{}', column {}", i, p.ident, k0)});
+      const auto in = [&](const Quantity& qy, const Cols& c) {
+        return loop ? loopColumn(e, qy, p.parent, c.at(k0), k0) : c.at(k0);
+      };
       const V6 vJ = jointVelocity(e, kb, p);
-      const V6 pq = load(e.cb(), s.dvq[par].at(k));
+      const V6 pq = load(e.cb(), in(kDvq, s.dvq[par]));
       const V6 dvq = e.motionToChild(kb, pq);
-      const V6 pv = load(e.cb(), s.dvv[par].at(k));
+      const V6 pv = load(e.cb(), in(kDvv, s.dvv[par]));
       const V6 dvv = e.motionToChild(kb, pv);
-      const V6 paq = load(e.cb(), s.daq[par].at(k));
+      const V6 paq = load(e.cb(), in(kDaq, s.daq[par]));
       const V6 daq = e.motionToChild(kb, paq);
-      const V6 pav = load(e.cb(), s.dav[par].at(k));
+      const V6 pav = load(e.cb(), in(kDav, s.dav[par]));
       const V6 dav = e.motionToChild(kb, pav);
-      finishColumn(e, kb, i, k, vJ, dvq, dvv, daq, dav, store, s);
+      finishColumn(e, kb, i, k0, vJ, dvq, dvv, daq, dav, store, s, loop);
       e.cb().close();
+      if (loop) {
+        const std::size_t b = std::size_t(i);
+        const std::pair<const Quantity*, std::vector<Cols>*> stored[] = {
+            {&kDvq, &s.dvq}, {&kDvv, &s.dvv}, {&kDaq, &s.daq}, {&kDav, &s.dav}, {&kDfq, &s.dfq}, {&kDfv, &s.dfv}};
+        for (const auto& [qy, cols] : stored) {
+          Cols& c = (*cols)[b];
+          if (c.count(k0) == 0) continue;  // not stored (a leaf's motion tangents)
+          const Col looped = c.at(k0);
+          for (int k = k0; k < k0 + int(len); ++k) c[k] = columnAfterLoop(e, *qy, i, looped, k);
+        }
+      }
+      n += len;
     }
   }
 }
@@ -189,38 +265,78 @@ void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out
     const std::size_t b = std::size_t(i), par = std::size_t(std::max(p.parent, 0));
     for (int pass = 0; pass < 2; ++pass) {
       Cols& cols = pass == 0 ? s.dfq[b] : s.dfv[b];
-      for (const auto& [k, col] : cols) {
-        e.fn.boundary(fmt::format("{}_c{}", p.ident, k));
-        e.cb().open("{", {fmt::format("body {} '{}', {} column {}", i, p.ident, pass == 0 ? "q" : "v", k)});
+      const Quantity& qy = pass == 0 ? kDfq : kDfv;
+      Cols& pc = pass == 0 ? s.dfq[par] : s.dfv[par];
+      const char* dtau = pass == 0 ? "dtau_dq" : "dtau_dv";
+      const auto own = [&](int k) { return pass == 0 && k >= p.idx_v && k < p.idx_v + p.nv; };  // + X (S_k x* f)
+      // A run: adjacent columns of one shape, none of the joint's own q
+      // columns, each met or not met before in the parent, in one shape.
+      const auto runs = [&](int k, int k0) {
+        if (own(k) || own(k0) || !sameShape(cols.at(k), cols.at(k0))) return false;
+        if (p.parent <= 0) return true;
+        const auto a = pc.find(k), a0 = pc.find(k0);
+        if ((a == pc.end()) != (a0 == pc.end())) return false;
+        return a == pc.end() || sameShape(a->second, a0->second);
+      };
+      std::vector<int> ks;
+      for (const auto& kv : cols) ks.push_back(kv.first);
+      for (std::size_t n = 0; n < ks.size();) {
+        const int k0 = ks[n];
+        std::size_t len = 1;
+        while (n + len < ks.size() && ks[n + len] == k0 + int(len) && runs(ks[n + len], k0)) ++len;
+        const bool loop = int(len) >= kLoopColumns;
+        if (!loop) len = 1;
+        e.fn.boundary(fmt::format("{}_c{}", p.ident, k0));
+        if (loop)
+          e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
+                      {fmt::format("body {} '{}', {} columns {} to {}", i, p.ident, pass == 0 ? "q" : "v", k0,
+                                   k0 + int(len) - 1)});
+        else
+          e.cb().open("{", {fmt::format("body {} '{}', {} column {}", i, p.ident, pass == 0 ? "q" : "v", k0)});
         CodeBuilder& cb = e.cb();
-        V6 df = load(cb, col);
+        V6 df = load(cb, loop ? loopColumn(e, qy, i, cols.at(k0), k0) : cols.at(k0));
+        std::vector<Slot> rows(std::size_t(p.nv));
         for (int d = 0; d < p.nv; ++d) {
           const int row = p.idx_v + d;
           const Expr t = dot(cb, kb.S[std::size_t(d)], df);
-          Slot slot;
+          Slot& slot = rows[std::size_t(d)];
           if (t.isConstant()) {
             slot.value = t;
           } else {
-            slot.name = e.ws.member(pass == 0 ? "dtau_dq" : "dtau_dv", nv, nv, row, k, "d tau / dq or d tau / dv (row-major)");
+            const std::string what = "d tau / dq or d tau / dv (row-major)";
+            slot.name = loop ? e.ws.loopSlot(dtau, nv, nv, row, k0, what) : e.ws.member(dtau, nv, nv, row, k0, what);
             cb.store(slot.name, t);
           }
-          (pass == 0 ? out.dq : out.dv)[{row, k}] = slot;
         }
+        Col parentCol;
+        bool toParent = false;
         if (p.parent > 0) {
-          if (pass == 0 && k >= p.idx_v && k < p.idx_v + p.nv) {
-            const V6 carried = crossForce(cb, kb.S[std::size_t(k - p.idx_v)], fs.f[b]);
+          if (own(k0)) {
+            const V6 carried = crossForce(cb, kb.S[std::size_t(k0 - p.idx_v)], fs.f[b]);
             df = add(df, carried);
           }
           const V6 dp = e.forceToParent(kb, df);
-          Cols& pc = pass == 0 ? s.dfq[par] : s.dfv[par];
           V6 sum = dp;
-          if (const auto it = pc.find(k); it != pc.end()) {
-            const V6 old = load(cb, it->second);
+          if (const auto it = pc.find(k0); it != pc.end()) {
+            const V6 old = load(cb, loop ? loopColumn(e, qy, p.parent, it->second, k0) : it->second);
             sum = add(old, dp);
           }
-          pc[k] = save(e, pass == 0 ? kDfq : kDfv, p.parent, k, sum);
+          parentCol = save(e, qy, p.parent, k0, sum, loop);
+          toParent = true;
         }
         cb.close();
+        for (int k = k0; k < k0 + int(len); ++k) {
+          for (int d = 0; d < p.nv; ++d) {
+            Slot slot = rows[std::size_t(d)];
+            if (loop && !slot.name.empty()) {
+              slot.name = e.ws.member(dtau, nv, nv, p.idx_v + d, k, "d tau / dq or d tau / dv (row-major)");
+              cb.refresh(slot.name);
+            }
+            (pass == 0 ? out.dq : out.dv)[{p.idx_v + d, k}] = slot;
+          }
+          if (toParent) pc[k] = loop ? columnAfterLoop(e, qy, p.parent, parentCol, k) : parentCol;
+        }
+        n += len;
       }
     }
     if (p.parent > 0) {
@@ -235,16 +351,20 @@ void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out
   }
 }
 
-// out[r * nv + c] for every entry: zeros by a loop, then the nonzero ones.
-void copyOut(Emit& e, const std::map<std::pair<int, int>, Slot>& entries, const char* out) {
+// out[r * nv + c] for every entry: zeros by a loop, then the nonzero ones;
+// returns the nonzero entries.
+std::set<std::pair<int, int>> copyOut(Emit& e, const std::map<std::pair<int, int>, Slot>& entries, const char* out) {
   CodeBuilder& cb = e.cb();
   const int nv = e.plan.nv;
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
+  std::set<std::pair<int, int>> nonzero;
   for (const auto& [rc, slot] : entries) {
     const Expr x = slot.name.empty() ? slot.value : cb.member(slot.name);
     if (x.isZero()) continue;
     cb.line(fmt::format("{}[{}] = {};", out, rc.first * nv + rc.second, cb.print(x)), {x}, {out});
+    nonzero.insert(rc);
   }
+  return nonzero;
 }
 
 }  // namespace
@@ -256,7 +376,7 @@ V6 load(CodeBuilder& cb, const TangentCol& s) {
 }
 
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                           BodyTangents* keep) {
+                                           BodyTangents* keep, bool keepConstrained) {
   const Plan& plan = e.plan;
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
@@ -276,15 +396,81 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
     host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
   }
   host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
-  forward(e, kin, withLambda, keep != nullptr, forces, s);
-  if (keep != nullptr) *keep = BodyTangents{s.dvq, s.dvv, s.daq, s.dav};
+  forward(e, kin, withLambda, keepConstrained, forces, s);
+  if (keep != nullptr) *keep = BodyTangents{s.dvq, s.dvv, s.daq, s.dav, {}, {}};
   backward(e, kin, forces, s, out);
   e.fn.endPart();
-  copyOut(e, out.dq, "dtau_dq");
-  copyOut(e, out.dv, "dtau_dv");
+  std::set<std::pair<int, int>> dq = copyOut(e, out.dq, "dtau_dq");
+  std::set<std::pair<int, int>> dv = copyOut(e, out.dv, "dtau_dv");
+  if (keep != nullptr) {
+    keep->dtauDq = std::move(dq);
+    keep->dtauDv = std::move(dv);
+  }
   std::string text = e.fn.endHost({"q", "v", "qdd", "lambda", "w", "dtau_dq", "dtau_dv"});
   e.fn.live() = Live{};
   return text;
+}
+
+RowSpans rowSpans(int rows, const std::set<std::pair<int, int>>& entries) {
+  RowSpans out(static_cast<std::size_t>(rows));
+  for (const auto& [r, c] : entries) {
+    auto& spans = out.at(std::size_t(r));
+    if (!spans.empty() && spans.back().second == c)
+      ++spans.back().second;  // the set is sorted: c extends the last range or opens one
+    else
+      spans.push_back({c, c + 1});
+  }
+  return out;
+}
+
+void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans) {
+  std::vector<int> start{0}, span;
+  for (const auto& row : spans) {
+    for (const auto& [lo, hi] : row) span.insert(span.end(), {lo, hi});
+    start.push_back(int(span.size() / 2));
+  }
+  if (span.empty()) span = {0, 0};  // no entry: a range nothing reads (no zero-length array)
+  cb.line(fmt::format("static constexpr int {}_start[{}] = {{{}}};", name, start.size(), fmt::join(start, ", ")));
+  cb.line(fmt::format("static constexpr int {}_span[{}] = {{{}}};", name, span.size(), fmt::join(span, ", ")));
+}
+
+// sparse_left_product_add<n, m, p> and sparse_transposed_product<n, m, p>:
+// per entry of the left factor, its scaling and p multiply-adds.
+Ops sparseLeftProductOps(const RowSpans& a, int p) {
+  long nnz = 0;
+  for (const auto& row : a)
+    for (const auto& [lo, hi] : row) nnz += hi - lo;
+  Ops o;
+  o.mul = nnz * (p + 1);
+  o.add = nnz * p;
+  return o;
+}
+
+// M^-1 is symmetric, so X = -M^-1 dtau is X^T = -dtau^T M^-1: each row of X^T
+// sums full rows of M^-1 over one column of dtau's nonzero entries (the inner
+// loop of fixed length, as in the dense product), then X^T is copied out
+// transposed.
+void minvTimesDtau(Emit& e, const BodyTangents& t, const std::string& minv, const std::string& dq,
+                   const std::string& dv, const std::string& scratch, const std::vector<std::string>& names) {
+  CodeBuilder& cb = e.cb();
+  const int nv = e.plan.nv;
+  const std::pair<const std::set<std::pair<int, int>>*, std::string> products[] = {{&t.dtauDq, "dq"},
+                                                                                   {&t.dtauDv, "dv"}};
+  for (const auto& [entries, x] : products) {
+    std::set<std::pair<int, int>> transposed;
+    for (const auto& [r, c] : *entries) transposed.insert({c, r});
+    const RowSpans spans = rowSpans(nv, transposed);
+    const std::string table = "dtau_" + x + "_t";
+    printSpans(cb, table, spans);
+    OpCount ops;
+    ops.once = sparseLeftProductOps(spans, nv);
+    cb.line(fmt::format("sparse_transposed_product<{0}, {0}, {0}>({1}, {2}_start, {2}_span, {3}, Scalar(-1), {4});", nv,
+                        x == "dq" ? dq : dv, table, minv, scratch),
+            {}, names, ops);
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_{}[k] = {}[(k % {}) * {} + k / {}];", nv * nv, x, scratch, nv,
+                        nv, nv),
+            {}, names);
+  }
 }
 
 // The arithmetic of dense_product<n, m, p> (assemble.cpp prints it): per row
@@ -296,7 +482,7 @@ Ops denseProductOps(int n, int m, int p) {
   return o;
 }
 
-std::string emitForwardDynamicsDerivatives(Emit& e) {
+std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
   const Plan& plan = e.plan;
   const int nv = plan.nv;
   if (nv == 0) fail("layout", "functions", "'forward_dynamics_derivatives' is not generated for a robot without joints (nv = 0)");
@@ -307,6 +493,7 @@ std::string emitForwardDynamicsDerivatives(Emit& e) {
   const std::string h = array("fdd_h", nv, "h(q, v) (forward_dynamics_derivatives)");
   const std::string dq = array("fdd_dtau_dq", nv * nv, "d tau / dq at (q, v, qdd) (forward_dynamics_derivatives)");
   const std::string dv = array("fdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd) (forward_dynamics_derivatives)");
+  const std::string xt = array("fdd_Xt", nv * nv, "d qdd / dq or d qdd / dv, transposed (forward_dynamics_derivatives)");
   e.fn.live() = Live{};
   e.fn.beginHost("fdd", nullptr);
   CodeBuilder& cb = e.cb();
@@ -321,9 +508,8 @@ std::string emitForwardDynamicsDerivatives(Emit& e) {
   ops.once = denseProductOps(nv, nv, 1);
   cb.line(fmt::format("dense_product<{0}, {0}, 1>(dqdd_dtau, {1}, Scalar(1), qdd);", nv, h), {}, names, ops);
   cb.line(fmt::format("inverse_dynamics_derivatives(q, v, qdd, nullptr, w, {}, {});", dq, dv), {}, names);
-  ops.once = denseProductOps(nv, nv, nv);
-  cb.line(fmt::format("dense_product<{0}, {0}, {0}>(dqdd_dtau, {1}, Scalar(-1), dqdd_dq);", nv, dq), {}, names, ops);
-  cb.line(fmt::format("dense_product<{0}, {0}, {0}>(dqdd_dtau, {1}, Scalar(-1), dqdd_dv);", nv, dv), {}, names, ops);
+  // dqdd_dx = -M^-1 dtau_dx over dtau's nonzero entries (the tree's pattern).
+  minvTimesDtau(e, t, "dqdd_dtau", dq, dv, xt, names);
   return e.fn.endHost(names);
 }
 

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -152,19 +153,43 @@ struct TangentSlot {
 };
 using TangentCol = std::array<TangentSlot, 6>;
 using TangentCols = std::map<int, TangentCol>;  // column -> the 6 entries (absent: zero)
-/// The motion tangents per body (columns of its path) the sweep left in the workspace.
+/// Which entries of a matrix can be nonzero: per row, its [lo, hi) column
+/// ranges (the entries the emitter printed). The sparse products of
+/// assemble.cpp (sparse_left_product_add, sparse_transposed_product) read only these.
+using RowSpans = std::vector<std::vector<std::pair<int, int>>>;
+/// The ranges of `rows` rows from the (row, column) entries that can be nonzero.
+RowSpans rowSpans(int rows, const std::set<std::pair<int, int>>& entries);
+/// Prints the tables the sparse products read, `<name>_start[rows + 1]` and
+/// `<name>_span[2 ranges]`, as static constants of the function being written.
+void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans);
+/// The arithmetic of sparse_left_product_add<n, m, p> and of
+/// sparse_transposed_product<n, m, p> over the left factor's spans.
+Ops sparseLeftProductOps(const RowSpans& a, int p);
+
+/// What the tangent sweep hands to the functions that call it: the motion
+/// tangents per body (columns of its path) it left in the workspace, and
+/// d tau / dq's and d tau / dv's nonzero pattern (the tree's: a joint's torque
+/// moves with its ancestors, itself and its subtree).
 struct BodyTangents {
   std::vector<TangentCols> dvq, dvv, daq, dav;
+  std::set<std::pair<int, int>> dtauDq, dtauDv;  // (row, column) entries that can be nonzero
 };
 V6 load(CodeBuilder& cb, const TangentCol& s);
-/// With `keep`, the constrained bodies' motion tangents are stored too, and
-/// their slots returned (constrained_dynamics_derivatives reads them).
+/// With `keep`, the tangents' slots and dtau's pattern are returned; with
+/// `keepConstrained` too, the constrained bodies' motion tangents are stored
+/// (constrained_dynamics_derivatives reads them).
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                           BodyTangents* keep = nullptr);
+                                           BodyTangents* keep = nullptr, bool keepConstrained = false);
 /// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
-/// and inverse_dynamics_derivatives (held with it) and the dense products
-/// (dense_product<n, m, p>, printed by assemble.cpp). denseProductOps: their arithmetic.
-std::string emitForwardDynamicsDerivatives(Emit& e);
+/// and inverse_dynamics_derivatives (held with it) and the products with M^-1
+/// (dense_product<n, m, p>, and sparse_transposed_product over dtau's pattern
+/// in `t`, printed by assemble.cpp). denseProductOps: their arithmetic.
+std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t);
+/// dqdd_dq = -M^-1 dtau_dq and dqdd_dv = -M^-1 dtau_dv (the callers' outputs)
+/// over dtau's pattern in `t`: M^-1 in `minv`, the tangents in `dq`, `dv`,
+/// the transposed product in the nv x nv member `scratch`; `names`: the host's parameters.
+void minvTimesDtau(Emit& e, const BodyTangents& t, const std::string& minv, const std::string& dq,
+                   const std::string& dv, const std::string& scratch, const std::vector<std::string>& names);
 Ops denseProductOps(int n, int m, int p);
 
 // ---- pass_constrained_dynamics_derivatives.cpp: constrained_dynamics_derivatives
