@@ -93,6 +93,33 @@ Col columnAfterLoop(Emit& e, const Quantity& qy, int body, const Col& looped, in
   return out;
 }
 
+// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
+// holds with the run's first, as (first, length); runs shorter than
+// kLoopColumns are split into single columns.
+template <class Joins>
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const Joins& joins) {
+  std::vector<std::pair<int, int>> runs;
+  for (std::size_t n = 0; n < ks.size();) {
+    const int k0 = ks[n];
+    std::size_t len = 1;
+    while (n + len < ks.size() && ks[n + len] == k0 + int(len) && joins(ks[n + len], k0)) ++len;
+    if (int(len) < kLoopColumns) len = 1;
+    runs.push_back({k0, int(len)});
+    n += len;
+  }
+  return runs;
+}
+
+// Opens a run's block: a loop over its columns, or a plain block for one.
+void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label) {
+  e.fn.boundary(fmt::format("{}_c{}", ident, k0));
+  if (len > 1)
+    e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
+                {fmt::format("{} columns {} to {}", label, k0, k0 + len - 1)});
+  else
+    e.cb().open("{", {fmt::format("{} column {}", label, k0)});
+}
+
 std::string vIn(int k) { return fmt::format("v[{}]", k); }
 std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
 std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
@@ -209,18 +236,10 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
              sameShape(s.dvv[par].at(k), s.dvv[par].at(k0)) && sameShape(s.daq[par].at(k), s.daq[par].at(k0)) &&
              sameShape(s.dav[par].at(k), s.dav[par].at(k0));
     };
-    for (std::size_t n = 0; n < carried.size();) {
-      const int k0 = carried[n];
-      std::size_t len = 1;
-      while (n + len < carried.size() && carried[n + len] == k0 + int(len) && shapeOf(carried[n + len], k0)) ++len;
-      const bool loop = int(len) >= kLoopColumns;
-      if (!loop) len = 1;
-      e.fn.boundary(fmt::format("{}_c{}", p.ident, k0));
-      if (loop)
-        e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
-                    {fmt::format("body {} '{}', columns {} to {}", i, p.ident, k0, k0 + int(len) - 1)});
-      else
-        e.cb().open("{", {fmt::format("body {} '{}', column {}", i, p.ident, k0)});
+    for (const auto& run : columnRuns(carried, shapeOf)) {
+      const int k0 = run.first, len = run.second;  // named: the lambdas below capture them
+      const bool loop = len > 1;
+      openColumns(e, p.ident, k0, len, fmt::format("body {} '{}',", i, p.ident));
       const auto in = [&](const Quantity& qy, const Cols& c) {
         return loop ? loopColumn(e, qy, p.parent, c.at(k0), k0) : c.at(k0);
       };
@@ -243,10 +262,9 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
           Cols& c = (*cols)[b];
           if (c.count(k0) == 0) continue;  // not stored (a leaf's motion tangents)
           const Col looped = c.at(k0);
-          for (int k = k0; k < k0 + int(len); ++k) c[k] = columnAfterLoop(e, *qy, i, looped, k);
+          for (int k = k0; k < k0 + len; ++k) c[k] = columnAfterLoop(e, *qy, i, looped, k);
         }
       }
-      n += len;
     }
   }
 }
@@ -280,19 +298,10 @@ void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out
       };
       std::vector<int> ks;
       for (const auto& kv : cols) ks.push_back(kv.first);
-      for (std::size_t n = 0; n < ks.size();) {
-        const int k0 = ks[n];
-        std::size_t len = 1;
-        while (n + len < ks.size() && ks[n + len] == k0 + int(len) && runs(ks[n + len], k0)) ++len;
-        const bool loop = int(len) >= kLoopColumns;
-        if (!loop) len = 1;
-        e.fn.boundary(fmt::format("{}_c{}", p.ident, k0));
-        if (loop)
-          e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
-                      {fmt::format("body {} '{}', {} columns {} to {}", i, p.ident, pass == 0 ? "q" : "v", k0,
-                                   k0 + int(len) - 1)});
-        else
-          e.cb().open("{", {fmt::format("body {} '{}', {} column {}", i, p.ident, pass == 0 ? "q" : "v", k0)});
+      for (const auto& run : columnRuns(ks, runs)) {
+        const int k0 = run.first, len = run.second;
+        const bool loop = len > 1;
+        openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', {}", i, p.ident, pass == 0 ? "q" : "v"));
         CodeBuilder& cb = e.cb();
         V6 df = load(cb, loop ? loopColumn(e, qy, i, cols.at(k0), k0) : cols.at(k0));
         std::vector<Slot> rows(std::size_t(p.nv));
@@ -325,7 +334,7 @@ void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out
           toParent = true;
         }
         cb.close();
-        for (int k = k0; k < k0 + int(len); ++k) {
+        for (int k = k0; k < k0 + len; ++k) {
           for (int d = 0; d < p.nv; ++d) {
             Slot slot = rows[std::size_t(d)];
             if (loop && !slot.name.empty()) {
@@ -336,7 +345,6 @@ void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out
           }
           if (toParent) pc[k] = loop ? columnAfterLoop(e, qy, p.parent, parentCol, k) : parentCol;
         }
-        n += len;
       }
     }
     if (p.parent > 0) {
