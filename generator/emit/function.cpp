@@ -117,6 +117,11 @@ void FunctionWriter::endPart() {
     params.push_back("Workspace& PROXGEN_RT_RESTRICT w");
     args.push_back("w");
   }
+  for (const char* p : {"M"})  // an output written where it is computed (mass_matrix)
+    if (needs(accessed, p)) {
+      params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
+      args.push_back(p);
+    }
   std::string sig, call;
   for (std::size_t k = 0; k < params.size(); ++k) {
     sig += (k ? ", " : "") + params[k];

@@ -1,10 +1,15 @@
 // The joint-space inertia M(q) by the composite-rigid-body algorithm, leaves
 // first: F = Ic_i S_i, M_ii = S_i^T F, then F carried to each ancestor j
 // (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i. A leaf's Ic is its
-// own inertia, a constant, so its diagonal entry folds. Also the q-only joint
+// own inertia, a constant, so its diagonal entry folds. Each entry is written
+// once, where it is computed, into both halves of the output M (no workspace
+// copy); the constant ones after the pass. Also the q-only joint
 // transforms (joint_transforms(q, w)) that the joint-space functions without a
 // velocity start from. The generic counterpart: algorithms/crba.cpp.
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <vector>
 
 #include "emit/passes.hpp"
 
@@ -28,13 +33,55 @@ Kinematics emitJointTransforms(Emit& e) {
 
 namespace {
 
-std::string massMember(Emit& e, int r, int c) {
+// M_rc (r <= c) straight into the output, both triangles from the one value:
+// a copy through the workspace after the pass was a load and two stores per
+// entry, and a third of the function's code. Constant entries (zeros between
+// branches, the base's mass) stay in js.upper for finishMassMatrix.
+void putMass(Emit& e, JointSpace& js, std::vector<char>& written, int r, int c, const Expr& value) {
   const int nv = e.plan.nv;
-  return e.member("mass", nv * (nv + 1) / 2, Sym::index(nv, r, c), "joint-space inertia M (upper triangle, by rows)");
+  if (value.isConstant()) {
+    js.upper(r, c) = value;
+    return;
+  }
+  CodeBuilder& cb = e.cb();
+  const Expr t = cb.flat(value, "m");
+  cb.line(fmt::format("M[{}] = {};", r * nv + c, cb.print(t)), {t}, {"M"});
+  if (r != c) cb.line(fmt::format("M[{}] = {};", c * nv + r, cb.print(t)), {t}, {"M"});
+  written[std::size_t(Sym::index(nv, r, c))] = 1;
+}
+
+// The entries the pass left constant: runs of zeros as loops (a branch's
+// entries against another branch's: 70% of a humanoid's M), the others (a
+// leaf's own inertia, the base's mass) one by one. One fill of the whole
+// matrix before the pass was no faster and is a memset: `rep stosb` on
+// glibc, which callgrind counts by the byte (docs/benchmarks.md).
+void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& written) {
+  e.fn.endPart();
+  CodeBuilder& cb = e.cb();
+  const int nv = e.plan.nv;
+  auto constantAt = [&](int k) {
+    return !written[std::size_t(Sym::index(nv, std::min(k / nv, k % nv), std::max(k / nv, k % nv)))];
+  };
+  auto value = [&](int k) { return js.upper(std::min(k / nv, k % nv), std::max(k / nv, k % nv)); };
+  for (int k = 0; k < nv * nv;) {
+    if (!constantAt(k)) {
+      ++k;
+      continue;
+    }
+    const Expr x = value(k);
+    int end = k + 1;
+    if (x.isZero())
+      while (end < nv * nv && constantAt(end) && value(end).isZero()) ++end;
+    if (end - k > 2)
+      cb.line(fmt::format("for (int k = {}; k < {}; ++k) M[k] = {};", k, end, cb.print(x)), {}, {"M"});
+    else
+      for (int j = k; j < end; ++j) cb.line(fmt::format("M[{}] = {};", j, cb.print(x)), {}, {"M"});
+    k = end;
+  }
 }
 
 // Fills js (in the caller's Live).
-void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js) {
+void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
@@ -51,8 +98,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js) {
     }
     for (int r = 0; r < p.nv; ++r)
       for (int c = r; c < p.nv; ++c)
-        js.upper(p.idx_v + r, p.idx_v + c) =
-            e.put(massMember(e, p.idx_v + r, p.idx_v + c), dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
+        putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
     for (int j = i; e.bp(j).parent > 0; j = e.bp(j).parent) {
       const BodyPlan& pj = e.bp(e.bp(j).parent);
       const Kinematics::Body& kj = kin.b[std::size_t(j)];
@@ -61,8 +107,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js) {
         F[std::size_t(d)] = e.forceToParent(kj, F[std::size_t(d)]);
         flatten(cb, F[std::size_t(d)], "F");
         for (int r = 0; r < pj.nv; ++r)  // an ancestor's dofs come first: the upper triangle
-          js.upper(pj.idx_v + r, p.idx_v + d) =
-              e.put(massMember(e, pj.idx_v + r, p.idx_v + d), dot(cb, kp.S[std::size_t(r)], F[std::size_t(d)]));
+          putMass(e, js, written, pj.idx_v + r, p.idx_v + d, dot(cb, kp.S[std::size_t(r)], F[std::size_t(d)]));
       }
     }
     if (p.parent > 0) {
@@ -95,8 +140,9 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
   e.fn.live().js = &js;
   e.fn.beginHost("crba", afterTransforms);
   e.cb().line("joint_transforms(q, w);", {}, {"q", "w"});
-  compositeInertias(e, kin, js);
-  copyOutSymmetric(e, js.upper, "M");
+  std::vector<char> written(std::size_t(e.plan.nv * (e.plan.nv + 1) / 2), 0);
+  compositeInertias(e, kin, js, written);
+  finishMassMatrix(e, js, written);
   std::string text = e.fn.endHost({"q", "w", "M"});
   e.fn.live() = Live{};
   return text;

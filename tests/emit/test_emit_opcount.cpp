@@ -150,10 +150,13 @@ Poly countLine(Source& src, const std::string& line) {
 }
 
 // A function body: blocks nest by their braces; `for (int k = A; k < N; ++k) {`
-// (or <=) multiplies its body by N - A (+1), N a literal or s.iterations = K.
+// (or <=) multiplies its body by N - A (+1), N a literal or s.iterations = K;
+// `for (int k = A; k < N; ++k) statement;` (mass_matrix's runs of zeros)
+// multiplies the statement by N - A.
 Poly count(Source& src, const std::string& fn) {
   if (src.memo.count(fn)) return src.memo[fn];
   static const std::regex loop(R"(^for \(int (\w+) = (\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{$)");
+  static const std::regex oneLine(R"(^for \(int k = (\d+); k < (\d+); \+\+k\) ([^{}]+;)$)");
   struct Frame {
     Poly p;
     long trips = 1;
@@ -192,6 +195,11 @@ Poly count(Source& src, const std::string& fn) {
         EXPECT_EQ(line, "{") << "a block the count cannot read";
       }
       stack.push_back(f);
+      continue;
+    }
+    std::smatch one;
+    if (std::regex_match(line, one, oneLine)) {  // a fill over literal bounds: its statement N - A times
+      addTo(stack.back().p, countLine(src, one[3].str()), std::stol(one[2].str()) - std::stol(one[1].str()));
       continue;
     }
     addTo(stack.back().p, countLine(src, line));

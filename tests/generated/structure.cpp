@@ -62,7 +62,7 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
                                                    "for (int k = 0; k < s.iterations; ++k) {"};
   static const std::regex columns(R"(for \(int j = 0; j < [1-9][0-9]*; \+\+j\) \{)");
   static const std::regex fixedLoop(
-      R"( *(for \(int k = 0; k < [1-9][0-9]*; \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
+      R"( *(for \(int k = (?:0|[1-9][0-9]*); k < [1-9][0-9]*; \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
       R"(|for \(int r = 0; r < n; \+\+r\)|for \(int c = 0; c < p; \+\+c\) \{)"
       R"(|for \(int k = 0; k < m; \+\+k\) sum \+= A\[r \* m \+ k\] \* B\[k \* p \+ c\];)"
       // constrained_dynamics_derivatives' helpers (Cholesky, proximal step, the
@@ -84,7 +84,8 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
       // arithmetic (docs/dynamics.md), the one conditional allowed; and the
       // derivatives' fixed-bound loops (docs/derivatives.md): the dense
       // product template, whose bounds are its template arguments, and one
-      // element-wise assignment over a literal count. No data decides a trip.
+      // element-wise assignment over literal bounds (also mass_matrix's runs
+      // of zeros, docs/dynamics.md). No data decides a trip.
       if (line == "  lambda = lambda != nullptr ? lambda : kNoMultipliers;" || std::regex_match(line, fixedLoop)) {
         if (nl == std::string::npos) break;
         k = nl;
@@ -125,6 +126,8 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_EQ(forbiddenControlFlow("while (x) {}").size(), 1u);
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 324; ++k) dtau_dq[k] = Scalar(0);\n").empty());
   EXPECT_EQ(forbiddenControlFlow("  for (int k = 0; k < n; ++k) dtau_dq[k] = Scalar(0);\n").size(), 1u);
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = 117; k < 126; ++k) M[k] = 0.0;\n").empty());  // mass_matrix's zeros
+  EXPECT_EQ(forbiddenControlFlow("  for (int k = a; k < 126; ++k) M[k] = 0.0;\n").size(), 1u);
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.fdd_h[k] = tau[k] - w.fdd_h[k];\n").empty());
   EXPECT_TRUE(forbiddenControlFlow("    for (int i = n - 1; i >= 0; --i) {\n    }\n").empty());
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = i + 1; k < n; ++k) {\n  }\n").empty());
