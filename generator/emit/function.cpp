@@ -117,7 +117,7 @@ void FunctionWriter::endPart() {
     params.push_back("Workspace& PROXGEN_RT_RESTRICT w");
     args.push_back("w");
   }
-  for (const char* p : {"M"})  // an output written where it is computed (mass_matrix)
+  for (const char* p : {"M", "Minv"})  // an output written where it is computed (mass_matrix, mass_matrix_inverse)
     if (needs(accessed, p)) {
       params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
       args.push_back(p);

@@ -61,9 +61,8 @@ Col save(Emit& e, const Quantity& qy, int body, int col, const V6& x, bool loop 
 // them, or the same constant in all) is one loop over j, the members indexed
 // [c0 + j], instead of a copy of the code per column: the sweep's code shrinks
 // by the depth of the tree, and the compiler vectorises the loop across
-// columns. Runs shorter than this stay unrolled (docs/derivatives.md, "Column
-// loops").
-constexpr int kLoopColumns = 2;
+// columns (columnRuns and openColumns: column_loops.cpp; docs/derivatives.md,
+// "Column loops").
 
 bool sameShape(const Col& a, const Col& b) {
   for (std::size_t r = 0; r < 6; ++r) {
@@ -91,33 +90,6 @@ Col columnAfterLoop(Emit& e, const Quantity& qy, int body, const Col& looped, in
       e.cb().refresh(out[std::size_t(r)].name);
     }
   return out;
-}
-
-// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
-// holds with the run's first, as (first, length); runs shorter than
-// kLoopColumns are split into single columns.
-template <class Joins>
-std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const Joins& joins) {
-  std::vector<std::pair<int, int>> runs;
-  for (std::size_t n = 0; n < ks.size();) {
-    const int k0 = ks[n];
-    std::size_t len = 1;
-    while (n + len < ks.size() && ks[n + len] == k0 + int(len) && joins(ks[n + len], k0)) ++len;
-    if (int(len) < kLoopColumns) len = 1;
-    runs.push_back({k0, int(len)});
-    n += len;
-  }
-  return runs;
-}
-
-// Opens a run's block: a loop over its columns, or a plain block for one.
-void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label) {
-  e.fn.boundary(fmt::format("{}_c{}", ident, k0));
-  if (len > 1)
-    e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
-                {fmt::format("{} columns {} to {}", label, k0, k0 + len - 1)});
-  else
-    e.cb().open("{", {fmt::format("{} column {}", label, k0)});
 }
 
 std::string vIn(int k) { return fmt::format("v[{}]", k); }

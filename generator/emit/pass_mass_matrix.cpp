@@ -122,15 +122,6 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
 
 }  // namespace
 
-void copyOutSymmetric(Emit& e, const Sym& upper, const char* out) {
-  e.fn.endPart();
-  CodeBuilder& cb = e.cb();
-  const int nv = e.plan.nv;
-  for (int r = 0; r < nv; ++r)
-    for (int c = 0; c < nv; ++c)
-      cb.line(fmt::format("{}[{}] = {};", out, r * nv + c, cb.print(upper(r, c))), {upper(r, c)}, {out});
-}
-
 std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms) {
   JointSpace js;
   js.upper = Sym(e.plan.nv);

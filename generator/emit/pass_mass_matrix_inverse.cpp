@@ -7,21 +7,36 @@
 // Forward, root first, for every column j >= s (the upper triangle):
 //   a' = X A_p[:, j]; Minv(s, j) -= D^-1 U^T a'; A_i[:, j] = a' + S Minv(s, j).
 // F_i and A_i share the member FA_<body> (the forces are last read before the
-// accelerations are written), and the lower triangle is the mirror. The free
-// flyer (always the root) uses the Cholesky factor of its 6 x 6 IA for D^-1.
-// The generic counterpart: algorithms/mass_matrix_inverse.cpp.
+// accelerations are written). The forward pass writes each final Minv(s, j)
+// into both triangles of the output; the rows that are final after the
+// backward pass (the free flyer's, a child of the world's) are written from
+// the members. The free flyer (always the root) uses the Cholesky factor of
+// its 6 x 6 IA for D^-1. Each body's columns go in loops over runs of one
+// shape ("Column loops" below). The generic counterpart:
+// algorithms/mass_matrix_inverse.cpp.
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <regex>
+#include <utility>
 
 #include "emit/passes.hpp"
 
 namespace proxgen::emit {
 namespace {
 
+// Minv(r, c), r <= c, between the passes (the output is written by the forward pass).
 std::string minvMember(Emit& e, int r, int c) {
   const int nv = e.plan.nv;
   return e.member("minv", nv * (nv + 1) / 2, Sym::index(nv, r, c), "M^-1 (upper triangle, by rows)");
+}
+// Its slot in a loop over the columns c + j of row r.
+std::string minvLoopSlot(Emit& e, int r, int c) {
+  const int nv = e.plan.nv;
+  return e.ws.loopSlot("minv", nv * (nv + 1) / 2, Sym::index(nv, r, c), "M^-1 (upper triangle, by rows)");
 }
 
 // IA_p += X^T (IA - U D^-1 U^T) X for a one-dof body (v = 0: no bias).
@@ -43,51 +58,193 @@ void passInertia(Emit& e, const Kinematics& kin, int i, Articulated& art) {
     if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
 }
 
-void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated& art, JointSpace& js) {
+// Column loops. Body i treats every column j with the same coefficients (its
+// transform, U, D^-1): only which members it reads and writes differ. An input
+// entry is a constant or +-(a member slot) whose index advances by one per
+// column (FA_p[r][j], minv[idx(s, j)]); a run of adjacent columns whose
+// entries have one shape becomes one loop over j (column_loops.cpp), so each
+// pass is O(n) code instead of O(n^2) (forward) or O(n depth) (backward), and
+// the compiler vectorises across columns (docs/dynamics.md, "mass_matrix_inverse").
+struct Slot {
+  Expr value;          // a constant (prefix empty), or the sign of the member
+  std::string prefix;  // "w.FA_x[2]" of "w.FA_x[2][17]", "w.minv" of "w.minv[40]"
+  int index = -1;
+  bool opaque = false;  // anything else: its column stays unrolled
+};
+
+Slot slotOf(const CodeBuilder& cb, const Expr& x) {
+  Slot s;
+  if (x.isConstant()) {
+    s.value = x;
+    return s;
+  }
+  static const std::regex member(R"(^(-?)(w\.\w+(?:\[\d+\])?)\[(\d+)\]$)");
+  const std::string text = cb.describe(x);
+  std::smatch m;
+  if (!x.isScaledAtom() || std::abs(x.terms()[0].coeff) != 1.0 || !std::regex_match(text, m, member)) {
+    s.opaque = true;
+    return s;
+  }
+  s.value = Expr(m[1].str().empty() ? 1.0 : -1.0);
+  s.prefix = m[2].str();
+  s.index = std::stoi(m[3].str());
+  return s;
+}
+
+std::vector<Slot> slotsOf(const CodeBuilder& cb, const std::vector<Expr>& xs) {
+  std::vector<Slot> out;
+  for (const Expr& x : xs) out.push_back(slotOf(cb, x));
+  return out;
+}
+
+// Entry a of column k joins entry b of column k0 in one loop.
+bool joins(const Slot& a, int k, const Slot& b, int k0) {
+  if (a.opaque || b.opaque || a.prefix != b.prefix || a.value.constant() != b.value.constant()) return false;
+  return a.prefix.empty() || a.index - b.index == k - k0;
+}
+
+// Columns k and k0 have entries of one shape (inputs(k): a column's entries).
+bool oneShape(const CodeBuilder& cb, const std::function<std::vector<Expr>(int)>& inputs, int k, int k0) {
+  const std::vector<Slot> a = slotsOf(cb, inputs(k)), b = slotsOf(cb, inputs(k0));
+  for (std::size_t r = 0; r < a.size(); ++r)
+    if (!joins(a[r], k, b[r], k0)) return false;
+  return true;
+}
+
+// The loop's reading of slot `first` (column k0's): "prefix[idx + j]".
+Expr loopRead(CodeBuilder& cb, const Slot& first) {
+  if (first.prefix.empty()) return first.value;
+  const std::string text = first.index == 0 ? fmt::format("{}[j]", first.prefix)
+                                            : fmt::format("{}[{} + j]", first.prefix, first.index);
+  return first.value.constant() * cb.member(text);
+}
+
+// The loop's reading of a column's entries: column k0's, indexed [idx + j].
+std::vector<Expr> loopReads(CodeBuilder& cb, const std::vector<Expr>& first) {
+  std::vector<Expr> out;
+  for (const Slot& s : slotsOf(cb, first)) out.push_back(loopRead(cb, s));
+  return out;
+}
+
+std::vector<Expr> entries(const V6& x) { return {x.begin(), x.end()}; }
+V6 toV6(const std::vector<Expr>& x, std::size_t from = 0) {
+  V6 v;
+  for (std::size_t r = 0; r < 6; ++r) v[r] = x[from + r];
+  return v;
+}
+
+// Column j (s < j < end) of a one-dof body: Minv(s, j) = -D^-1 S^T F_i[:, j],
+// and F_p[:, j] += X^T (F_i[:, j] + U Minv(s, j)) (Fp: F_p[:, j] before). Stores
+// into minvOut and fpOut(r) (in a loop, column j's slots); returns Minv(s, j)
+// and F_p[:, j] with the rows it wrote.
+struct Accumulated {
+  V6 value;
+  std::array<bool, 6> stored{};
+};
+std::pair<Expr, Accumulated> eliminateColumn(Emit& e, const Kinematics::Body& kb, const Articulated::Body& b,
+                                             bool toParent, const V6& F, const V6& Fp, bool loop,
+                                             const std::string& minvOut,
+                                             const std::function<std::string(int)>& fpOut) {
   CodeBuilder& cb = e.cb();
+  const Expr x = e.put(minvOut, -cb.mul(b.Dinv, cb.flat(dot(cb, kb.S[0], F))));
+  Accumulated out{Fp, {}};
+  if (!toParent) return {x, out};
+  V6 f;
+  for (int r = 0; r < 6; ++r) f[std::size_t(r)] = F[std::size_t(r)] + cb.mul(b.U[0][std::size_t(r)], x);
+  flatten(cb, f, "f");
+  const V6 dp = e.forceToParent(kb, f);
+  for (int r = 0; r < 6; ++r)
+    if (!dp[std::size_t(r)].isZero()) {
+      const Expr sum = Fp[std::size_t(r)] + dp[std::size_t(r)];
+      out.value[std::size_t(r)] = loop ? e.put(fpOut(r), sum) : e.keep(fpOut(r), sum);
+      out.stored[std::size_t(r)] = true;
+    }
+  return {x, out};
+}
+
+void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated& art, JointSpace& js) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
   const BodyPlan& p = e.bp(i);
-  const int s = p.idx_v;
-  const V6& S = kb.S[0];
-  V6 U = mul(cb, b.IA, S);
-  b.U.assign(1, V6{});
-  for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
-  const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
-  if (D.isConstant()) {  // folded as in pass_aba_eliminate.cpp: correctly rounded in the solver's Scalar
-    b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
-  } else {
-    b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
-  }
+  const int s = p.idx_v, nv = e.plan.nv;
+  const bool toParent = p.parent != 0;  // else nothing passes on: the forward pass reads only Minv
   std::vector<V6>& F = js.FA[std::size_t(i)];
-  js.upper(s, s) = b.Dinv;
-  for (int j = s + 1; j < end; ++j)
-    js.upper(s, j) = e.put(minvMember(e, s, j), -cb.mul(b.Dinv, cb.flat(dot(cb, S, F[std::size_t(j)]))));
-  if (p.parent == 0) return;  // nothing passes on: the forward pass reads only Minv
-  std::vector<V6>& Fp = js.FA[std::size_t(p.parent)];
-  for (int j = s; j < end; ++j) {
-    V6 f;
-    for (int r = 0; r < 6; ++r)
-      f[std::size_t(r)] = F[std::size_t(j)][std::size_t(r)] + cb.mul(b.U[0][std::size_t(r)], js.upper(s, j));
-    flatten(cb, f, "f");
-    const V6 dp = e.forceToParent(kb, f);
-    for (int r = 0; r < 6; ++r)
-      if (!dp[std::size_t(r)].isZero())
-        Fp[std::size_t(j)][std::size_t(r)] = e.keepQ(kFA, p.parent, 6, e.plan.nv, r, j, Fp[std::size_t(j)][std::size_t(r)] + dp[std::size_t(r)]);
+  std::vector<V6>& Fp = js.FA[std::size_t(std::max(p.parent, 0))];
+  e.fn.boundary(i);
+  e.openBody(i, "eliminate");
+  {
+    CodeBuilder& cb = e.cb();
+    const V6& S = kb.S[0];
+    V6 U = mul(cb, b.IA, S);
+    b.U.assign(1, V6{});
+    for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
+    const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
+    if (D.isConstant()) {  // folded as in pass_aba_eliminate.cpp: correctly rounded in the solver's Scalar
+      b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
+    } else {
+      b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
+    }
+    js.upper(s, s) = b.Dinv;
+    if (toParent) {  // the body's own column: F_i[:, s] = 0, Minv(s, s) = D^-1
+      const V6 dp = e.forceToParent(kb, scale(cb, b.Dinv, b.U[0]));
+      for (int r = 0; r < 6; ++r)
+        if (!dp[std::size_t(r)].isZero())
+          Fp[std::size_t(s)][std::size_t(r)] =
+              e.keepQ(kFA, p.parent, 6, nv, r, s, Fp[std::size_t(s)][std::size_t(r)] + dp[std::size_t(r)]);
+      passInertia(e, kin, i, art);
+    }
   }
-  passInertia(e, kin, i, art);
+  e.cb().close();
+  // The subtree's columns: F_i[:, j], then F_p[:, j] (it accumulates).
+  const auto inputs = [&](int j) {
+    std::vector<Expr> in = entries(F[std::size_t(j)]);
+    if (toParent)
+      for (const Expr& x : Fp[std::size_t(j)]) in.push_back(x);
+    return in;
+  };
+  std::vector<int> cols;
+  for (int j = s + 1; j < end; ++j) cols.push_back(j);
+  const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+    openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', unit-torque forces,", i, p.ident));
+    CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
+    if (len == 1) {
+      const auto [x, fp] = eliminateColumn(e, kb, b, toParent, F[std::size_t(k0)], Fp[std::size_t(k0)], false,
+                                           minvMember(e, s, k0),
+                                           [&](int r) { return e.member(kFA, p.parent, 6, nv, r, k0); });
+      js.upper(s, k0) = x;
+      Fp[std::size_t(k0)] = fp.value;
+      e.cb().close();
+      continue;
+    }
+    const std::vector<Expr> in = loopReads(cb, inputs(k0));
+    const std::string minvLoop = minvLoopSlot(e, s, k0);
+    const auto [x, fp] = eliminateColumn(e, kb, b, toParent, toV6(in), toParent ? toV6(in, 6) : zero6(), true, minvLoop,
+                                         [&](int r) { return e.loopSlot(kFA, p.parent, 6, nv, r, k0); });
+    e.cb().close();
+    // After the loop each column's slots hold new values: read them by their own names.
+    for (int k = k0; k < k0 + len; ++k) {
+      js.upper(s, k) = x.isConstant() ? x : cb.refresh(minvMember(e, s, k));
+      for (int r = 0; r < 6; ++r)
+        if (toParent && fp.stored[std::size_t(r)])
+          Fp[std::size_t(k)][std::size_t(r)] = fp.value[std::size_t(r)].isConstant()
+                                                    ? fp.value[std::size_t(r)]
+                                                    : cb.refresh(e.member(kFA, p.parent, 6, nv, r, k));
+    }
+  }
 }
 
 // The free flyer at the root: D^-1 = IA^-1 through its Cholesky factor.
 void backwardFreeFlyer(Emit& e, int i, int end, Articulated& art, JointSpace& js) {
-  CodeBuilder& cb = e.cb();
   Articulated::Body& b = art.b[std::size_t(i)];
   const int s = e.bp(i).idx_v;
-  const Cholesky ch = cholesky(
-      e, b.IA, Expr(), [&](int r, int c) { return e.member(kL, i, 21, Sym::index(6, r, c)); },
-      [&](int r) { return e.member(kLinv, i, 6, r); });
+  const auto Lname = [&](int r, int c) { return e.member(kL, i, 21, Sym::index(6, r, c)); };
+  const auto invName = [&](int r) { return e.member(kLinv, i, 6, r); };
+  e.fn.boundary(i);
+  e.openBody(i, "eliminate");
+  Cholesky ch = cholesky(e, b.IA, Expr(), Lname, invName);
   const auto solve = [&](const std::vector<Expr>& rhs) {
-    return backwardSolve(cb, ch.L, ch.inv, forwardSolve(cb, ch.L, ch.inv, rhs));
+    return backwardSolve(e.cb(), ch.L, ch.inv, forwardSolve(e.cb(), ch.L, ch.inv, rhs));
   };
   for (int c = 0; c < 6; ++c) {
     std::vector<Expr> unit(6);
@@ -95,37 +252,136 @@ void backwardFreeFlyer(Emit& e, int i, int end, Articulated& art, JointSpace& js
     const std::vector<Expr> x = solve(unit);
     for (int r = 0; r <= c; ++r) js.upper(s + r, s + c) = e.put(minvMember(e, s + r, s + c), x[std::size_t(r)]);
   }
-  for (int j = s + 6; j < end; ++j) {
-    const V6& F = js.FA[std::size_t(i)][std::size_t(j)];
-    const std::vector<Expr> x = solve(std::vector<Expr>(F.begin(), F.end()));
-    for (int r = 0; r < 6; ++r) js.upper(s + r, j) = e.put(minvMember(e, s + r, j), -x[std::size_t(r)]);
+  e.cb().close();
+  // The subtree's columns, Minv(s.., j) = -IA^-1 F[:, j], a loop per run of one shape.
+  const std::vector<V6>& F = js.FA[std::size_t(i)];
+  const auto inputs = [&](int j) { return entries(F[std::size_t(j)]); };
+  std::vector<int> cols;
+  for (int j = s + 6; j < end; ++j) cols.push_back(j);
+  const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+    openColumns(e, e.bp(i).ident, k0, len, fmt::format("body {} '{}', unit-torque forces,", i, e.bp(i).ident));
+    CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
+    // The factor is in members: read them in this part (a local Cholesky is not in the Live state).
+    for (int r = 0; r < 6; ++r) {
+      if (!ch.inv[std::size_t(r)].isConstant()) ch.inv[std::size_t(r)] = cb.member(invName(r));
+      for (int c = 0; c <= r; ++c)
+        if (!ch.L(r, c).isConstant()) ch.L(r, c) = cb.member(Lname(r, c));
+    }
+    const bool loop = len > 1;
+    const std::vector<Expr> x = solve(loop ? loopReads(cb, inputs(k0)) : inputs(k0));
+    std::array<Expr, 6> stored;
+    for (int r = 0; r < 6; ++r) {
+      const std::string slot = loop ? minvLoopSlot(e, s + r, k0) : minvMember(e, s + r, k0);
+      stored[std::size_t(r)] = e.put(slot, -x[std::size_t(r)]);
+    }
+    e.cb().close();
+    for (int k = k0; k < k0 + len; ++k)
+      for (int r = 0; r < 6; ++r) {
+        const Expr& v = stored[std::size_t(r)];
+        js.upper(s + r, k) = !loop || v.isConstant() ? v : cb.refresh(minvMember(e, s + r, k));
+      }
   }
 }
 
-void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, JointSpace& js) {
+// Minv(row, j) = Minv(j, row) = x in the output, for column k0, or in a loop
+// (`loop`) for column k0 + j.
+void writeOut(Emit& e, int row, int k0, bool loop, const Expr& value) {
   CodeBuilder& cb = e.cb();
+  const int nv = e.plan.nv;
+  const Expr x = cb.flat(value, "m");
+  const std::string v = cb.print(x);
+  if (loop) {
+    cb.line(fmt::format("Minv[{} + j] = {};", row * nv + k0, v), {x}, {"Minv"});
+    cb.line(fmt::format("Minv[{} + {} * j] = {};", k0 * nv + row, nv, v), {x}, {"Minv"});
+    return;
+  }
+  cb.line(fmt::format("Minv[{}] = {};", row * nv + k0, v), {x}, {"Minv"});
+  if (k0 != row) cb.line(fmt::format("Minv[{}] = {};", k0 * nv + row, v), {x}, {"Minv"});
+}
+
+// A row whose entries Minv(row, j), j >= from, are final in js (the free
+// flyer's after the backward pass, a child of the world's), into the output.
+void writeRow(Emit& e, int i, int row, int from, const JointSpace& js) {
+  const int nv = e.plan.nv;
+  const auto inputs = [&](int j) { return std::vector<Expr>{js.upper(row, j)}; };
+  std::vector<int> cols;
+  for (int j = from; j < nv; ++j) cols.push_back(j);
+  const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+    openColumns(e, fmt::format("{}_r{}", e.bp(i).ident, row), k0, len,
+                fmt::format("body {} '{}', M^-1 row {},", i, e.bp(i).ident, row));
+    const bool loop = len > 1;
+    writeOut(e, row, k0, loop, loop ? loopReads(e.cb(), inputs(k0))[0] : inputs(k0)[0]);
+    e.cb().close();
+  }
+}
+
+// x = Minv(s, j) - D^-1 U^T a' with a' = X A_p[:, j], into the output
+// (nothing reads it after this pass); A_i[:, j] = a' + S x, stored into
+// `aOut(r)` (in a loop, column j's slots) unless constant, and outside a loop
+// unless +-(a member) already.
+V6 accelerateColumn(Emit& e, const Kinematics::Body& kb, const Articulated::Body& b, int s, int k0, const V6& Ap,
+                    const Expr& minv, bool store, bool loop, const std::function<std::string(int)>& aOut) {
+  CodeBuilder& cb = e.cb();
+  V6 a = e.motionToChild(kb, Ap);
+  flatten(cb, a, "t");
+  const Expr x = cb.flat(minv - cb.mul(b.Dinv, cb.flat(dot(cb, b.U[0], a))), "m");
+  writeOut(e, s, k0, loop, x);
+  V6 A = zero6();
+  if (!store) return A;
+  const V6 Aj = add(a, scale(cb, x, kb.S[0]));
+  for (int r = 0; r < 6; ++r)
+    A[std::size_t(r)] = loop ? e.put(aOut(r), Aj[std::size_t(r)]) : e.keep(aOut(r), Aj[std::size_t(r)]);
+  return A;
+}
+
+void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, JointSpace& js) {
   const BodyPlan& p = e.bp(i);
   const int s = p.idx_v, nv = e.plan.nv;
   const bool store = !p.children.empty();  // A_i is read by the children only
   std::vector<V6>& A = js.FA[std::size_t(i)];
   if (p.jointClass == JointClass::FreeFlyer) {  // the root: a' = 0, A = S Minv(s.., j) with S = I
+    for (int r = 0; r < 6; ++r) writeRow(e, i, s + r, s + r, js);
     for (int j = s; j < nv; ++j)
       for (int r = 0; r < 6; ++r) A[std::size_t(j)][std::size_t(r)] = store ? js.upper(s + r, j) : Expr();
     return;
   }
-  const Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
-  for (int j = s; j < nv; ++j) {
-    V6 a = zero6();
-    if (p.parent > 0) {
-      a = e.motionToChild(kb, js.FA[std::size_t(p.parent)][std::size_t(j)]);
-      flatten(cb, a, "t");
-      const Expr x = js.upper(s, j) - cb.mul(b.Dinv, cb.flat(dot(cb, b.U[0], a)));
-      js.upper(s, j) = e.put(minvMember(e, s, j), x);
+  if (p.parent == 0) {  // a' = 0: Minv(s, j) is final, A = S Minv(s, j)
+    writeRow(e, i, s, s, js);
+    for (int j = s; j < nv && store; ++j) {
+      const V6 Aj = scale(e.cb(), js.upper(s, j), kb.S[0]);  // +-(a member): no statement
+      for (int r = 0; r < 6; ++r) A[std::size_t(j)][std::size_t(r)] = e.keepQ(kFA, i, 6, nv, r, j, Aj[std::size_t(r)]);
     }
-    if (!store) continue;
-    const V6 Aj = add(a, scale(cb, js.upper(s, j), kb.S[0]));
-    for (int r = 0; r < 6; ++r) A[std::size_t(j)][std::size_t(r)] = e.keepQ(kFA, i, 6, nv, r, j, Aj[std::size_t(r)]);
+    return;
+  }
+  const Articulated::Body& b = art.b[std::size_t(i)];
+  const std::vector<V6>& Ap = js.FA[std::size_t(p.parent)];
+  // Column j's inputs: A_p[:, j], then Minv(s, j) from the backward pass.
+  const auto inputs = [&](int j) {
+    std::vector<Expr> in = entries(Ap[std::size_t(j)]);
+    in.push_back(js.upper(s, j));
+    return in;
+  };
+  std::vector<int> cols;
+  for (int j = s; j < nv; ++j) cols.push_back(j);
+  const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+    openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', accelerations,", i, p.ident));
+    CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
+    const bool loop = len > 1;
+    const std::vector<Expr> in = loop ? loopReads(cb, inputs(k0)) : inputs(k0);
+    const V6 Aj = accelerateColumn(e, kb, b, s, k0, toV6(in), in[6], store, loop, [&](int r) {
+      return loop ? e.loopSlot(kFA, i, 6, nv, r, k0) : e.member(kFA, i, 6, nv, r, k0);
+    });
+    e.cb().close();
+    // After a loop each column's slots hold new values: read them by their own names.
+    for (int k = k0; k < k0 + len; ++k)
+      for (int r = 0; r < 6; ++r)
+        A[std::size_t(k)][std::size_t(r)] = !loop || !store || Aj[std::size_t(r)].isConstant()
+                                                ? Aj[std::size_t(r)]
+                                                : cb.refresh(e.member(kFA, i, 6, nv, r, k));
   }
 }
 
@@ -153,20 +409,11 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
   e.cb().line("joint_transforms(q, w);", {}, {"q", "w"});
   e.fn.beginPass("backward", "backward: D^-1 and the unit-torque forces, leaves first");
   for (int i = N - 1; i >= 1; --i) {
-    e.fn.boundary(i);
-    e.openBody(i, "eliminate");
     if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, end[std::size_t(i)], art, js);
     else backwardOneDof(e, kin, i, end[std::size_t(i)], art, js);
-    e.cb().close();
   }
   e.fn.beginPass("forward", "forward: the unit-torque accelerations, the upper triangle of M^-1");
-  for (int i = 1; i < N; ++i) {
-    e.fn.boundary(i);
-    e.openBody(i, "accelerate");
-    forwardBody(e, kin, i, art, js);
-    e.cb().close();
-  }
-  copyOutSymmetric(e, js.upper, "Minv");
+  for (int i = 1; i < N; ++i) forwardBody(e, kin, i, art, js);
   std::string text = e.fn.endHost({"q", "w", "Minv"});
   e.fn.live() = Live{};
   return text;

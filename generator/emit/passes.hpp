@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -103,11 +104,17 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
 /// copy of the state after kinematics, whose values live in `afterKinematics`.
 std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects);
 
+// ---- column_loops.cpp: a run of adjacent columns of one shape as one loop over j.
+/// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
+/// holds with the run's first, as (first, length); runs too short to pay for a
+/// loop are split into single columns.
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins);
+/// Starts a part and opens a run's block: `for (int j = 0; j < len; ++j) {`, or a plain block for one column.
+void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label);
+
 // ---- pass_mass_matrix.cpp: the joint transforms alone, and CRBA.
 /// joint_transforms(q, w): X_J and the bodies' own inertias, for the functions without v.
 Kinematics emitJointTransforms(Emit& e);
-/// out[r * nv + c] = the symmetric matrix whose upper triangle is `upper` (in the host).
-void copyOutSymmetric(Emit& e, const Sym& upper, const char* out);
 std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
 
 // ---- pass_mass_matrix_inverse.cpp: M^-1 in O(n^2) (ABA on the unit torques).

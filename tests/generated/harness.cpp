@@ -235,9 +235,12 @@ TEST_F(Generated, InverseDynamicsIgnoresTheInactiveMultipliers) {
 TEST_F(Generated, JointSpaceFunctionsMatchTheGeneric) {
   proxgen::test::LibraryUnderTest lib;
   lib.isFloat = std::is_same_v<gen::Scalar, float>;
+  // The outputs start as NaN: an entry the function does not write (mass_matrix
+  // and mass_matrix_inverse write theirs piecemeal, the zeros apart) fails the comparison.
+  static constexpr gen::Scalar kUnwritten = std::numeric_limits<gen::Scalar>::quiet_NaN();
 #if PROXGEN_SOLVER_HAS_INVERSE_DYNAMICS
   lib.inverseDynamics = [](const VecX& q, const VecX& v, const VecX& qdd, const VecX* lambda, VecX& tau) {
-    std::vector<gen::Scalar> out(gen::nv);
+    std::vector<gen::Scalar> out(gen::nv, kUnwritten);
     const std::vector<gen::Scalar> l = lambda ? toScalar(*lambda) : std::vector<gen::Scalar>();
     gen::inverse_dynamics(toScalar(q).data(), toScalar(v).data(), toScalar(qdd).data(), lambda ? l.data() : nullptr,
                           workspace(), out.data());
@@ -246,21 +249,21 @@ TEST_F(Generated, JointSpaceFunctionsMatchTheGeneric) {
 #endif
 #if PROXGEN_SOLVER_HAS_NONLINEAR_EFFECTS
   lib.nonlinearEffects = [](const VecX& q, const VecX& v, VecX& h) {
-    std::vector<gen::Scalar> out(gen::nv);
+    std::vector<gen::Scalar> out(gen::nv, kUnwritten);
     gen::nonlinear_effects(toScalar(q).data(), toScalar(v).data(), workspace(), out.data());
     h = toDouble(out, gen::nv);
   };
 #endif
 #if PROXGEN_SOLVER_HAS_MASS_MATRIX
   lib.massMatrix = [](const VecX& q, proxgen::MatX& M) {
-    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv));
+    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv), kUnwritten);
     gen::mass_matrix(toScalar(q).data(), workspace(), out.data());
     M = squareToDouble(out);
   };
 #endif
 #if PROXGEN_SOLVER_HAS_MASS_MATRIX_INVERSE
   lib.massMatrixInverse = [](const VecX& q, proxgen::MatX& Minv) {
-    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv));
+    std::vector<gen::Scalar> out(std::size_t(gen::nv * gen::nv), kUnwritten);
     gen::mass_matrix_inverse(toScalar(q).data(), workspace(), out.data());
     Minv = squareToDouble(out);
   };
