@@ -15,7 +15,8 @@
 // generated function returns the full matrix) and mass_matrix_inverse
 // (computeMinverse, the same copy), and <case>/<function>/pinocchio_upper for
 // the last two without the copy (crba in Pinocchio 3.7's default LOCAL
-// convention; bench_pinocchio.cpp, pinocchioJointSpace), on the same states and qdd.
+// convention), and mass_matrix/pinocchio_world for crba in its WORLD convention
+// with the copy (bench_pinocchio.cpp, pinocchioJointSpace), on the same states and qdd.
 //
 //   proxgen_bench_joint_space [Google Benchmark flags]
 //   proxgen_bench_joint_space --count CASE/FUNCTION/VARIANT N
@@ -230,6 +231,8 @@ void registerCase(const char* name) {
   for (const char* fn : {"mass_matrix", "mass_matrix_inverse"})
     reg(std::string(fn) + "/pinocchio_upper",
         proxgen::bench::pinocchioJointSpace(c.name, c.sys, c.states, in->qdd64, std::string(fn) + "_upper"));
+  reg("mass_matrix/pinocchio_world",
+      proxgen::bench::pinocchioJointSpace(c.name, c.sys, c.states, in->qdd64, "mass_matrix_world"));
 #endif
 }
 

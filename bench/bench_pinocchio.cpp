@@ -271,22 +271,28 @@ std::function<void(int)> pinocchioJointSpace(const std::string& caseName, const 
       const State& s = states[std::size_t(k)];
       pinocchio::nonLinearEffects(js->model, *js->data, s.q, s.v);
     };
-  } else if (function == "mass_matrix" || function == "mass_matrix_upper") {
+  } else if (function == "mass_matrix" || function == "mass_matrix_upper" || function == "mass_matrix_world") {
+    // Pinocchio 3.7's crba has two conventions: LOCAL (its default, Featherstone's
+    // recursion in the joint frames) and WORLD (the columns of M from world-frame
+    // Jacobians and composite inertias). Both are timed so that the comparison is
+    // against Pinocchio's faster one: measured here, LOCAL (docs/benchmarks.md).
+    const pinocchio::Convention convention =
+        function == "mass_matrix_world" ? pinocchio::Convention::WORLD : pinocchio::Convention::LOCAL;
     gap = gapOver(
         states,
         [&](std::size_t k) -> MatX {
-          MatX M = pinocchio::crba(model, data, states[k].q);
+          MatX M = pinocchio::crba(model, data, states[k].q, convention);
           symmetrize(M);
           return M;
         },
         [&](std::size_t k) -> MatX { return crba(sys, gd, states[k].q); });
-    if (function == "mass_matrix")
-      call = [js, &states](int k) {
-        pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q);
+    if (function == "mass_matrix_upper")
+      call = [js, &states](int k) { pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q); };
+    else
+      call = [js, &states, convention](int k) {
+        pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q, convention);
         symmetrize(js->data->M);
       };
-    else
-      call = [js, &states](int k) { pinocchio::crba(js->model, *js->data, states[std::size_t(k)].q); };
   } else if (function == "mass_matrix_inverse" || function == "mass_matrix_inverse_upper") {
     gap = gapOver(
         states,

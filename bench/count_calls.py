@@ -36,7 +36,7 @@ LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "
            for variant in ("generated", "generic")] + ["delassus_inverse/route_mass_matrix"] + [
     # Pinocchio's, where the build found it (bench_pinocchio.cpp, pinocchioJointSpace); exit 3 otherwise.
     f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
-    "mass_matrix/pinocchio_upper", "mass_matrix_inverse/pinocchio_upper"]
+    "mass_matrix/pinocchio_upper", "mass_matrix/pinocchio_world", "mass_matrix_inverse/pinocchio_upper"]
 DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio"]
 # The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, the
 # default list of what to count, and whether one N = 0 run serves every item of a case.
