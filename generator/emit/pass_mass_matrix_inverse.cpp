@@ -205,7 +205,8 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated&
   std::vector<int> cols;
   for (int j = s + 1; j < end; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
-  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+  for (const auto& run : columnRuns(cols, sameShape)) {
+    const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
     openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', unit-torque forces,", i, p.ident));
     CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
     if (len == 1) {
@@ -259,7 +260,8 @@ void backwardFreeFlyer(Emit& e, int i, int end, Articulated& art, JointSpace& js
   std::vector<int> cols;
   for (int j = s + 6; j < end; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
-  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+  for (const auto& run : columnRuns(cols, sameShape)) {
+    const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
     openColumns(e, e.bp(i).ident, k0, len, fmt::format("body {} '{}', unit-torque forces,", i, e.bp(i).ident));
     CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
     // The factor is in members: read them in this part (a local Cholesky is not in the Live state).
@@ -308,7 +310,8 @@ void writeRow(Emit& e, int i, int row, int from, const JointSpace& js) {
   std::vector<int> cols;
   for (int j = from; j < nv; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
-  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+  for (const auto& run : columnRuns(cols, sameShape)) {
+    const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
     openColumns(e, fmt::format("{}_r{}", e.bp(i).ident, row), k0, len,
                 fmt::format("body {} '{}', M^-1 row {},", i, e.bp(i).ident, row));
     const bool loop = len > 1;
@@ -367,7 +370,8 @@ void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, 
   std::vector<int> cols;
   for (int j = s; j < nv; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
-  for (const auto& [k0, len] : columnRuns(cols, sameShape)) {
+  for (const auto& run : columnRuns(cols, sameShape)) {
+    const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
     openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', accelerations,", i, p.ident));
     CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
     const bool loop = len > 1;
