@@ -7,6 +7,7 @@
 // kind of statement, a part function, a loop or a sign fails here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <map>
@@ -312,6 +313,27 @@ TEST(OperationCount, TheJointSpaceFunctionsCountWhatTheyCompute) {
     g.functions = "constrained_aba,prox_pv,inverse_dynamics,nonlinear_effects,mass_matrix,mass_matrix_inverse";
     expectCountsMatch(generateFiles(g), robot, 3, entries);
   }
+}
+
+TEST(OperationCount, MassMatrixInverseCodeGrowsLinearly) {
+  // Its passes loop over runs of columns (docs/dynamics.md, "Column loops"):
+  // twice the chain, about twice the code. Unrolled per column, the forward
+  // pass alone is n^2 / 2 column blocks: 4x the code for 2x the chain.
+  std::vector<std::size_t> lines;
+  for (int links : {12, 24}) {
+    const test::TempFile urdf(".urdf"), layout(".yaml");
+    urdf.write(test::syntheticTreeUrdf(links, 1));
+    layout.write("base: fixed\nconstraints: []\n");
+    GenerateOptions g;
+    g.urdf = urdf.path();
+    g.layout = layout.path();
+    g.name = "chain";
+    g.functions = "mass_matrix_inverse";
+    const SolverFiles f = generateFiles(g);
+    lines.push_back(std::size_t(std::count(f.source.begin(), f.source.end(), '\n')));
+    EXPECT_NE(f.source.find("for (int j = 0; j < "), std::string::npos) << links << " links: no column loop";
+  }
+  EXPECT_LT(double(lines[1]) / double(lines[0]), 2.5) << lines[0] << " -> " << lines[1] << " lines";
 }
 
 TEST(OperationCount, SharedCases) {
