@@ -59,8 +59,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
       for (Function f : c.calls) want.add(f);
   texts.functions = want;
   const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
-  texts.withKinematics =
-      solvers || want.has(Function::ConstraintDrift) || want.has(Function::InverseDynamicsDerivatives);
+  texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects) ||
+                         want.has(Function::ConstraintDrift) || want.has(Function::InverseDynamicsDerivatives);
   texts.withJointTransforms = want.has(Function::MassMatrix) || want.has(Function::MassMatrixInverse);
 
   // kinematics(q, v, w): shared by the entry points with a velocity.
@@ -100,8 +100,10 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
 
   // The dynamics library (docs/dynamics.md), after the solvers: their members
   // come first in the Workspace, so a solver without these is what it was.
-  if (want.has(Function::InverseDynamics)) texts.library[Function::InverseDynamics] = emitInverseDynamics(e, false);
-  if (want.has(Function::NonlinearEffects)) texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, true);
+  if (want.has(Function::InverseDynamics))
+    texts.library[Function::InverseDynamics] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, false);
+  if (want.has(Function::NonlinearEffects))
+    texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, true);
   // With constrained_dynamics_derivatives the sweep also keeps the constrained
   // bodies' motion tangents, which its constraint rows read.
   // Both derivative functions that call the sweep read dtau's pattern.
@@ -146,8 +148,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     Function f;
     const char* host;
     const char* helper;
-  } library[] = {{Function::InverseDynamics, "rnea", nullptr},
-                 {Function::NonlinearEffects, "nle", nullptr},
+  } library[] = {{Function::InverseDynamics, "rnea", "kinematics"},
+                 {Function::NonlinearEffects, "nle", "kinematics"},
                  {Function::MassMatrix, "crba", "joint_transforms"},
                  {Function::MassMatrixInverse, "minv", "joint_transforms"},
                  {Function::ConstraintPlacements, "placements", "joints"},
@@ -159,7 +161,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
                  {Function::InverseDynamicsDerivatives, "rnead", "kinematics"}};
   for (const auto& l : library) {
     OpCount ops = fn.hostOps(l.host);
-    if (l.helper) ops += fn.hostOps(l.helper);
+    ops += fn.hostOps(l.helper);
     texts.libraryOps[l.f] = ops;
   }
   // The derivatives: their host (the dense products included) and the functions it calls.

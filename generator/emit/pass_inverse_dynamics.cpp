@@ -1,9 +1,13 @@
 // Inverse dynamics (RNEA) with the constraint forces, root first then leaves
 // first: a_i = X_i a_p + S qdd_i + c_i (a_0 = -g), f_i = I_i a_i + v_i x* I_i v_i
-// (+ K_c^T lambda_c for each constraint c on body i), tau_i = S^T f_i,
-// f_p += X_i^T f_i. EXPERIMENT: the forward sweep computes its own joint
-// transforms and velocities (v_i = X_i v_p + S qd_i, c_i = v_i x S qd_i) in the
-// same block as a_i and f_i, instead of calling kinematics(q, v, w).
+// (+ K_c^T lambda_c for each constraint c on body i: its rows applied as a
+// wrench at its frame, [linear; angular] for a weld, linear for a point, the
+// rows the solvers use), tau_i = S^T f_i, f_p += X_i^T f_i. So
+// tau = M qdd + h + J^T lambda (the constraint force on the robot is -J^T lambda).
+// The constraint forces enter the same backward sweep as the inertial ones
+// (the generic code adds them in a second one): the sum is the same, in
+// another order. The generic counterpart: algorithms/inverse_dynamics.cpp and
+// algorithms/rnea.cpp (docs/dynamics.md).
 #include <fmt/format.h>
 
 #include "emit/passes.hpp"
@@ -13,42 +17,26 @@ namespace {
 
 std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
 std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
-std::string vIn(int k) { return fmt::format("v[{}]", k); }
 
-// Fills `kin` (joint transforms, the velocities of bodies with children) and
-// `out` (in scope: the caller's Live holds both).
-void inverseDynamics(Emit& e, Kinematics& kin, bool withQdd, bool withLambda, Forces& out) {
+// Fills `out` (in scope: the caller's Live holds it).
+void inverseDynamics(Emit& e, const Kinematics& kin, bool withQdd, bool withLambda, Forces& out) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
-  e.fn.beginPass("forward", std::string("forward: v = X v_parent + S qd, a = X a_parent + ") + (withQdd ? "S qdd + " : "") +
-                                "v x S qd, f = I a + v x* I v" + (withLambda ? " + K^T lambda" : ""));
+  e.fn.beginPass("forward", std::string("forward: a = X a_parent + ") + (withQdd ? "S qdd + " : "") + "c, f = I a + v x* I v" +
+                                (withLambda ? " + K^T lambda" : ""));
   for (int i = 1; i < N; ++i) {
     e.fn.boundary(i);
     e.openBody(i, "forward");
     CodeBuilder& cb = e.cb();
-    Kinematics::Body& kb = kin.b[std::size_t(i)];
+    const Kinematics::Body& kb = kin.b[std::size_t(i)];
     const BodyPlan& p = e.bp(i);
-    const bool parentOfAny = !p.children.empty();
-    jointTransform(e, i, kb);
-    kb.IA = constant(e.model().bodies[std::size_t(i)].inertia.matrix());
-    V6 vJ = zero6();
-    for (int d = 0; d < p.nv; ++d) vJ = add(vJ, scale(cb, cb.input(vIn(p.idx_v + d)), kb.S[std::size_t(d)]));
-    V6 v = add(e.motionToChild(kb, kin.b[std::size_t(p.parent)].v), vJ);
-    if (parentOfAny)
-      for (int k = 0; k < 6; ++k) v[std::size_t(k)] = e.keepQ(kV, i, 6, k, v[std::size_t(k)]);
-    else
-      flatten(cb, v, "v");
-    kb.v = v;
-    V6 a = add(e.motionToChild(kb, p.parent == 0 ? e.rootAcceleration() : out.a[std::size_t(p.parent)]),
-               crossMotion(cb, v, vJ));
+    V6 a = add(e.motionToChild(kb, p.parent == 0 ? e.rootAcceleration() : out.a[std::size_t(p.parent)]), kb.c);
     if (withQdd)
       for (int d = 0; d < p.nv; ++d) a = add(a, scale(cb, cb.input(qddIn(p.idx_v + d)), kb.S[std::size_t(d)]));
     flatten(cb, a, "t");  // used in I a and by the children
-    if (parentOfAny)
+    if (!p.children.empty())
       for (int k = 0; k < 6; ++k) out.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
-    V6 h = mul(cb, kb.IA, v);
-    flatten(cb, h, "h");
-    V6 f = add(mul(cb, kb.IA, a), crossForce(cb, v, h));
+    V6 f = add(mul(cb, kb.IA, a), kb.pA);
     if (withLambda)
       for (int k : p.constraints) {
         const Constraint& c = e.sys.constraints[std::size_t(k)];
@@ -84,10 +72,8 @@ void inverseDynamics(Emit& e, Kinematics& kin, bool withQdd, bool withLambda, Fo
 
 }  // namespace
 
-std::string emitInverseDynamics(Emit& e, bool nonlinearEffects) {
+std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects) {
   const Plan& plan = e.plan;
-  Kinematics kin;
-  kin.b.resize(plan.bodies.size());
   const bool withLambda = !nonlinearEffects && plan.nc > 0;
   const int N = int(plan.bodies.size());
   Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
@@ -95,7 +81,7 @@ std::string emitInverseDynamics(Emit& e, bool nonlinearEffects) {
   e.fn.live() = Live{};
   e.fn.live().kin = &kin;
   e.fn.live().forces = &forces;
-  e.fn.beginHost(nonlinearEffects ? "nle" : "rnea", nullptr);
+  e.fn.beginHost(nonlinearEffects ? "nle" : "rnea", afterKinematics);
   CodeBuilder& host = e.cb();
   if (withLambda) {
     // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
@@ -112,6 +98,7 @@ std::string emitInverseDynamics(Emit& e, bool nonlinearEffects) {
     }
     host.line("lambda = lambda_on;", {}, {"lambda"});
   }
+  host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   inverseDynamics(e, kin, !nonlinearEffects, withLambda, forces);
   e.fn.endPart();
   const char* out = nonlinearEffects ? "h" : "tau";

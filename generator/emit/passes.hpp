@@ -102,7 +102,7 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
 // ---- pass_inverse_dynamics.cpp: RNEA with the constraint forces J^T lambda.
 /// The inverse_dynamics host (nonlinear_effects: qdd = 0, no lambda), from its
 /// copy of the state after kinematics, whose values live in `afterKinematics`.
-std::string emitInverseDynamics(Emit& e, bool nonlinearEffects);
+std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects);
 
 // ---- column_loops.cpp: a run of adjacent columns of one shape as one loop over j.
 /// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
