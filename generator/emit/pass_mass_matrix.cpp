@@ -80,85 +80,43 @@ void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& wr
   }
 }
 
-// The walk of body i's columns up its path: F = Ic_i S_i (M_ii), then F
-// carried to each ancestor j (M_ji = S_j^T F), one step per call of next().
-struct Walk {
-  int i = 0, j = 0;  // the body, and the body F is expressed in
-  std::vector<V6> F;
-};
-
-void startWalk(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written, Walk& w) {
-  CodeBuilder& cb = e.cb();
-  const BodyPlan& p = e.bp(w.i);
-  const Kinematics::Body& kb = kin.b[std::size_t(w.i)];
-  w.j = w.i;
-  w.F.assign(std::size_t(p.nv), zero6());
-  for (int d = 0; d < p.nv; ++d) {
-    w.F[std::size_t(d)] = mul(cb, js.Ic[std::size_t(w.i)], kb.S[std::size_t(d)]);
-    flatten(cb, w.F[std::size_t(d)], "F");
-  }
-  for (int r = 0; r < p.nv; ++r)
-    for (int c = r; c < p.nv; ++c)
-      putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], w.F[std::size_t(c)]));
-}
-
-// One step up: false when F has reached the root body.
-bool stepWalk(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written, Walk& w) {
-  if (e.bp(w.j).parent <= 0) return false;
-  CodeBuilder& cb = e.cb();
-  const BodyPlan& p = e.bp(w.i);
-  const BodyPlan& pj = e.bp(e.bp(w.j).parent);
-  const Kinematics::Body& kj = kin.b[std::size_t(w.j)];
-  const Kinematics::Body& kp = kin.b[std::size_t(pj.index)];
-  for (int d = 0; d < p.nv; ++d) {
-    w.F[std::size_t(d)] = e.forceToParent(kj, w.F[std::size_t(d)]);
-    flatten(cb, w.F[std::size_t(d)], "F");
-    for (int r = 0; r < pj.nv; ++r)  // an ancestor's dofs come first: the upper triangle
-      putMass(e, js, written, pj.idx_v + r, p.idx_v + d, dot(cb, kp.S[std::size_t(r)], w.F[std::size_t(d)]));
-  }
-  w.j = pj.index;
-  return true;
-}
-
-// Bodies whose walks are printed side by side, step by step: each walk is a
-// chain of dependent transforms, and interleaving independent chains lets the
-// processor overlap them.
-constexpr int kInterleave = 2;
-
-// Fills js (in the caller's Live). Leaves first, in groups of kInterleave
-// bodies: first each body's composite inertia into its parent's
-// (Ic_p += X^T Ic_i X, in the same order as one body at a time), then the
-// group's walks interleaved. A walk reads only its body's Ic, final once the
-// group's own updates are done (its children come before it).
+// Fills js (in the caller's Live).
 void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
-  for (int hi = N - 1; hi >= 1; hi -= kInterleave) {
-    const int lo = std::max(1, hi - kInterleave + 1);
-    e.fn.boundary(hi);
-    std::vector<std::string> comments;
-    for (int i = hi; i >= lo; --i)
-      for (const std::string& c : e.bodyComments(i, "composite")) comments.push_back(c);
-    e.cb().open("{", comments);
-    for (int i = hi; i >= lo; --i) {
-      const BodyPlan& p = e.bp(i);
-      if (p.parent <= 0) continue;
-      const Sym dI = e.inertiaToParent(kin.b[std::size_t(i)], js.Ic[std::size_t(i)]);
+  for (int i = N - 1; i >= 1; --i) {
+    e.fn.boundary(i);
+    e.openBody(i, "composite");
+    CodeBuilder& cb = e.cb();
+    const BodyPlan& p = e.bp(i);
+    const Kinematics::Body& kb = kin.b[std::size_t(i)];
+    std::vector<V6> F(std::size_t(p.nv));
+    for (int d = 0; d < p.nv; ++d) {
+      F[std::size_t(d)] = mul(cb, js.Ic[std::size_t(i)], kb.S[std::size_t(d)]);
+      flatten(cb, F[std::size_t(d)], "F");
+    }
+    for (int r = 0; r < p.nv; ++r)
+      for (int c = r; c < p.nv; ++c)
+        putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
+    for (int j = i; e.bp(j).parent > 0; j = e.bp(j).parent) {
+      const BodyPlan& pj = e.bp(e.bp(j).parent);
+      const Kinematics::Body& kj = kin.b[std::size_t(j)];
+      const Kinematics::Body& kp = kin.b[std::size_t(pj.index)];
+      for (int d = 0; d < p.nv; ++d) {
+        F[std::size_t(d)] = e.forceToParent(kj, F[std::size_t(d)]);
+        flatten(cb, F[std::size_t(d)], "F");
+        for (int r = 0; r < pj.nv; ++r)  // an ancestor's dofs come first: the upper triangle
+          putMass(e, js, written, pj.idx_v + r, p.idx_v + d, dot(cb, kp.S[std::size_t(r)], F[std::size_t(d)]));
+      }
+    }
+    if (p.parent > 0) {
+      const Sym dI = e.inertiaToParent(kb, js.Ic[std::size_t(i)]);
       Sym& par = js.Ic[std::size_t(p.parent)];
       for (int k = 0; k < 21; ++k)
         if (!dI.packed(k).isZero()) par.packed(k) = e.putQ(kIc, p.parent, 21, k, par.packed(k) + dI.packed(k));
     }
-    std::vector<Walk> walks;
-    for (int i = hi; i >= lo; --i) {
-      walks.push_back(Walk{i, i, {}});
-      startWalk(e, kin, js, written, walks.back());
-    }
-    for (bool any = true; any;) {
-      any = false;
-      for (Walk& w : walks) any |= stepWalk(e, kin, js, written, w);
-    }
-    e.cb().close();
+    cb.close();
   }
 }
 
