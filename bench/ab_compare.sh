@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# A/B comparison of one generated function (docs/benchmarks.md, "Comparing two
+# versions of the emitter"): generates CASE with two proxgen executables (or one,
+# compiled twice with other flags), links the two sources side by side into
+# bench/ab_compare.cpp and prints, for A and B: the object's text bytes, the
+# instructions per call (callgrind, (Ir(N) - Ir(0)) / N), whether the outputs
+# agree bit for bit on 1000 random states, and the time of both in one process,
+# alternating (21 repetitions, medians and fastest).
+#
+#   bench/ab_compare.sh PROXGEN_A PROXGEN_B CASE FUNCTION [CALLS]
+#
+# FUNCTION: constrained_aba, prox_pv, inverse_dynamics, nonlinear_effects,
+# mass_matrix, mass_matrix_inverse, inverse_dynamics_derivatives,
+# constrained_dynamics_derivatives. CALLS: calls per timed repetition (default
+# 20000). Environment: CXX (default g++), A_FLAGS and B_FLAGS (default
+# "-O3 -DNDEBUG -fno-tree-slp-vectorize", the bench's flags for generated code,
+# at the x86-64 baseline so that callgrind can run it), PROXGEN_MODELS_DIR
+# (default ../shared/models beside the repository), AB_DIR (default a new
+# temporary folder, kept and printed).
+set -euo pipefail
+[[ $# -ge 4 ]] || { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+pa=$1 pb=$2 case=$3 fn=$4 calls=${5:-20000}
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/.." && pwd)
+models=${PROXGEN_MODELS_DIR:-$root/../shared/models}
+cxx=${CXX:-g++}
+default_flags="-O3 -DNDEBUG -fno-tree-slp-vectorize"
+read -r -a aflags <<< "${A_FLAGS:-$default_flags}"
+read -r -a bflags <<< "${B_FLAGS:-$default_flags}"
+case $fn in
+  constrained_aba | prox_pv) call="$fn(q, v, a, s, w, o[0], o[1])" ;;
+  inverse_dynamics) call="inverse_dynamics(q, v, a, lam, w, o[0])" ;;
+  nonlinear_effects) call="nonlinear_effects(q, v, w, o[0])" ;;
+  mass_matrix | mass_matrix_inverse) call="$fn(q, w, o[0])" ;;
+  inverse_dynamics_derivatives) call="inverse_dynamics_derivatives(q, v, a, lam, w, o[0], o[1])" ;;
+  constrained_dynamics_derivatives)
+    call="constrained_dynamics_derivatives(q, v, a, s, w, o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7])" ;;
+  *) echo "ab_compare.sh: no call for function '$fn'" >&2; exit 2 ;;
+esac
+dir=${AB_DIR:-$(mktemp -d)}
+mkdir -p "$dir"
+for side in A B; do
+  exe=$pa; [[ $side == B ]] && exe=$pb
+  "$exe" generate --cases "$models/cases.yaml" --case "$case" --functions "$fn" --name "$side" --out "$dir" > /dev/null
+done
+"$cxx" -std=c++17 "${aflags[@]}" -fno-exceptions -fno-rtti -I "$root/runtime" -c "$dir/A.cpp" -o "$dir/A.o" &
+"$cxx" -std=c++17 "${bflags[@]}" -fno-exceptions -fno-rtti -I "$root/runtime" -c "$dir/B.cpp" -o "$dir/B.o" &
+wait
+"$cxx" -std=c++17 -O2 -I "$root/runtime" -I "$dir" "-DCALL=$call" "$here/ab_compare.cpp" "$dir/A.o" "$dir/B.o" \
+  -o "$dir/ab_compare"
+ir() {  # instructions of N calls of one side
+  valgrind --tool=callgrind --callgrind-out-file=/dev/null "$dir/ab_compare" count "$1" "$2" 2>&1 |
+    sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
+}
+n=20
+echo "case $case, function $fn, folder $dir"
+for side in A B; do
+  bytes=$(size "$dir/$side.o" | awk 'NR == 2 {print $1}')
+  per_call=$(( ($(ir "$side" "$n") - $(ir "$side" 0)) / n ))
+  echo "$side: text $bytes bytes, $per_call instructions per call"
+done
+"$dir/ab_compare" check
+"$dir/ab_compare" time "$calls"
