@@ -11,14 +11,15 @@
 #
 # FUNCTION: constrained_aba, prox_pv, inverse_dynamics, nonlinear_effects,
 # mass_matrix, mass_matrix_inverse, inverse_dynamics_derivatives,
-# constrained_dynamics_derivatives. CALLS: calls per timed repetition (default
-# 20000). Environment: CXX (default g++), A_FLAGS and B_FLAGS (default
+# forward_dynamics_derivatives, constrained_dynamics_derivatives. CALLS: calls
+# per timed repetition (default 20000). Environment: CXX (default g++), A_FLAGS
+# and B_FLAGS (default
 # "-O3 -DNDEBUG -fno-tree-slp-vectorize", the bench's flags for generated code,
 # at the x86-64 baseline so that callgrind can run it), PROXGEN_MODELS_DIR
 # (default ../shared/models beside the repository), AB_DIR (default a new
 # temporary folder, kept and printed).
 set -euo pipefail
-[[ $# -ge 4 ]] || { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[[ $# -ge 4 ]] || { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 pa=$1 pb=$2 case=$3 fn=$4 calls=${5:-20000}
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
@@ -33,6 +34,7 @@ case $fn in
   nonlinear_effects) call="nonlinear_effects(q, v, w, o[0])" ;;
   mass_matrix | mass_matrix_inverse) call="$fn(q, w, o[0])" ;;
   inverse_dynamics_derivatives) call="inverse_dynamics_derivatives(q, v, a, lam, w, o[0], o[1])" ;;
+  forward_dynamics_derivatives) call="forward_dynamics_derivatives(q, v, a, w, o[0], o[1], o[2], o[3])" ;;
   constrained_dynamics_derivatives)
     call="constrained_dynamics_derivatives(q, v, a, s, w, o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7])" ;;
   *) echo "ab_compare.sh: no call for function '$fn'" >&2; exit 2 ;;

@@ -182,8 +182,8 @@ const EntryPoint kEntryPoints[] = {
      "\n// forward_dynamics_derivatives (no constraint forces: the free motion):\n"
      "// qdd = M^-1 (tau - h) (ABA's answer, to round-off), and at (q, v, qdd)\n"
      "// dqdd_dq = -M^-1 dtau_dq, dqdd_dv = -M^-1 dtau_dv, dqdd_dtau = M^-1 (nv x nv each).\n"
-     "// It calls nonlinear_effects, mass_matrix_inverse and inverse_dynamics_derivatives\n"
-     "// (held with it). None of the arrays may be inside w.\n",
+     "// It calls nonlinear_effects, mass_matrix_inverse and the tangent sweep of\n"
+     "// inverse_dynamics_derivatives (held with it). None of the arrays may be inside w.\n",
      "void forward_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, Workspace& w, Scalar* qdd,\n"
      "                                  Scalar* dqdd_dq, Scalar* dqdd_dv, Scalar* dqdd_dtau) noexcept",
      "// M^-1 by ABA on the unit torques, qdd = M^-1 (tau - h), the tangent sweep at qdd, two dense products.\n"},
@@ -196,7 +196,7 @@ const EntryPoint kEntryPoints[] = {
      "// M qdd + h + J^T lambda = tau, J qdd + gamma = a*, the multipliers' tangents by\n"
      "// s.iterations proximal steps with s.mu (as the solve: at K steps they are off\n"
      "// by what the K-th iterate is). A constraint with !s.active[k] counts as absent\n"
-     "// (its rows are 0). It calls mass_matrix_inverse, prox_pv and\n"
+     "// (its rows are 0). It calls mass_matrix_inverse, prox_pv and the tangent sweep of\n"
      "// inverse_dynamics_derivatives (held with it). None of the arrays may be inside w.\n",
      "void constrained_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s,\n"
      "                                      Workspace& w, Scalar* qdd, Scalar* lambda, Scalar* dqdd_dq,\n"
@@ -436,6 +436,19 @@ std::string helpers(const SolverTexts& texts) {
            "}\n\n";
   if (cdd)
     out += kConstrainedDerivativeHelpers;
+  if (!texts.tangentSweep.empty())
+    out += fmt::format(
+        "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) and its\n"
+        "// tangents along every q and v direction; reads the kinematics state in w.\n"
+        "void tangent_sweep(const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
+        "                   Scalar* dtau_dq, Scalar* dtau_dv) noexcept {{\n{}}}\n\n",
+        texts.tangentSweep);
+  if (!texts.biasForces.empty())
+    out += fmt::format(
+        "// pA = v x* I v again for the bodies with children: the elimination of prox_pv\n"
+        "// leaves their articulated bias in those members, and the tangent sweep reads pA.\n"
+        "void bias_forces(const Scalar* v, Workspace& w) noexcept {{\n{}}}\n\n",
+        texts.biasForces);
   if (!texts.constraintJoints.empty())
     out += fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
                        "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",

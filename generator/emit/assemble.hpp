@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "emit/emitter.hpp"
 #include "emit/expr.hpp"
@@ -25,6 +26,9 @@ struct SolverTexts {
   std::map<Function, std::string> library;
   std::map<Function, OpCount> libraryOps;
   std::string jointTransforms;
+  // inverse_dynamics_derivatives' sweep after the kinematics pass, and the bias
+  // forces that constrained_dynamics_derivatives restores before it ("" when not held).
+  std::string tangentSweep, biasForces;
   bool withKinematics = false, withJointTransforms = false;
   // The helper of the constraint functions of q alone ("" when none is held).
   std::string constraintJoints;

@@ -43,16 +43,22 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   SolverTexts texts;
   // A derivative function calls the functions it is made of (its host, named
   // here, counts their operations too): the file holds them as well.
+  // Both call the tangent sweep of inverse_dynamics_derivatives without its
+  // kinematics pass (hosts: the sweep, "rnead", and cdd's "bias"), after a
+  // function that left the kinematics state of the same (q, v) in the workspace.
   struct Composite {
     Function f;
     const char* host;
     std::vector<Function> calls;
+    std::vector<const char*> hosts;
   };
   const Composite composites[] = {
       {Function::ForwardDynamicsDerivatives, "fdd",
-       {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}},
+       {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
+       {"rnead"}},
       {Function::ConstrainedDynamicsDerivatives, "cdd",
-       {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives}}};
+       {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
+       {"rnead", "bias"}}};
   FunctionSet want = sys.functions;
   for (const Composite& c : composites)
     if (want.has(c.f))
@@ -109,9 +115,12 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   // Both derivative functions that call the sweep read dtau's pattern.
   const bool cdd = want.has(Function::ConstrainedDynamicsDerivatives);
   BodyTangents tangents;
-  if (want.has(Function::InverseDynamicsDerivatives))
+  if (want.has(Function::InverseDynamicsDerivatives)) {
+    texts.tangentSweep = emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
     texts.library[Function::InverseDynamicsDerivatives] =
-        emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
+        "  kinematics(q, v, w);\n  tangent_sweep(v, qdd, lambda, w, dtau_dq, dtau_dv);\n";
+  }
+  if (cdd) texts.biasForces = emitBiasForces(e, afterKinematicsState, afterKinematics);
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);
     Kinematics transforms = emitJointTransforms(e);
@@ -168,7 +177,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   for (const Composite& c : composites) {
     if (!want.has(c.f)) continue;
     OpCount ops = fn.hostOps(c.host);
-    for (Function f : c.calls) ops += f == Function::ProxPv ? texts.pvOps : texts.libraryOps[f];
+    for (Function f : c.calls)
+      if (f != Function::InverseDynamicsDerivatives) ops += f == Function::ProxPv ? texts.pvOps : texts.libraryOps[f];
+    for (const char* h : c.hosts) ops += fn.hostOps(h);
     texts.libraryOps[c.f] = ops;
   }
 

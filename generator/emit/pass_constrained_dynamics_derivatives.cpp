@@ -218,7 +218,10 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   // members (read by the rows below) are written after it.
   host.line(fmt::format("mass_matrix_inverse(q, w, {});", minv), {}, names);
   host.line("prox_pv(q, v, tau, s, w, qdd, lambda);", {}, names);
-  host.line(fmt::format("inverse_dynamics_derivatives(q, v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
+  // The sweep at the solution reads prox_pv's kinematics state (same q, v), less
+  // the bias forces its elimination overwrote: bias_forces restores those.
+  host.line("bias_forces(v, w);", {}, names);
+  host.line(fmt::format("tangent_sweep(v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
   OpCount ops;
   if (nc > 0) {
     // The rows of an inactive constraint are zeros: its lambda is 0 and its

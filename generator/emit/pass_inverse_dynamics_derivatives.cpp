@@ -375,7 +375,6 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
     host.line(fmt::format("static constexpr Scalar kNoMultipliers[{}] = {{}};", plan.nc));
     host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
   }
-  host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
   forward(e, kin, withLambda, keepConstrained, forces, s);
   if (keep != nullptr) *keep = BodyTangents{s.dvq, s.dvv, s.daq, s.dav, {}, {}};
   backward(e, kin, forces, s, out);
@@ -386,7 +385,24 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
     keep->dtauDq = std::move(dq);
     keep->dtauDv = std::move(dv);
   }
-  std::string text = e.fn.endHost({"q", "v", "qdd", "lambda", "w", "dtau_dq", "dtau_dv"});
+  std::string text = e.fn.endHost({"v", "qdd", "lambda", "w", "dtau_dq", "dtau_dv"});
+  e.fn.live() = Live{};
+  return text;
+}
+
+std::string emitBiasForces(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics) {
+  e.fn.live() = Live{};
+  e.fn.live().kin = &kin;
+  e.fn.beginHost("bias", afterKinematics);
+  e.fn.beginPass("", "pA = v x* I v of the bodies with children (the elimination's articulated bias in their members)");
+  for (int i = 1; i < int(e.plan.bodies.size()); ++i) {
+    if (e.bp(i).children.empty()) continue;  // a leaf's member still holds its own pA
+    e.fn.boundary(i);
+    e.openBody(i, "bias");
+    storeBiasForce(e, i, kin.b[std::size_t(i)]);
+    e.cb().close();
+  }
+  std::string text = e.fn.endHost({"v", "w"});  // v: a velocity equal to an input is read from it
   e.fn.live() = Live{};
   return text;
 }
@@ -487,7 +503,9 @@ std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = tau[k] - {}[k];", nv, h, h), {}, names, ops);
   ops.once = denseProductOps(nv, nv, 1);
   cb.line(fmt::format("dense_product<{0}, {0}, 1>(dqdd_dtau, {1}, Scalar(1), qdd);", nv, h), {}, names, ops);
-  cb.line(fmt::format("inverse_dynamics_derivatives(q, v, qdd, nullptr, w, {}, {});", dq, dv), {}, names);
+  // The sweep reads the kinematics state nonlinear_effects left for the same (q, v):
+  // neither RNEA nor mass_matrix_inverse writes v, c or pA (no second kinematics pass).
+  cb.line(fmt::format("tangent_sweep(v, qdd, nullptr, w, {}, {});", dq, dv), {}, names);
   // dqdd_dx = -M^-1 dtau_dx over dtau's nonzero entries (the tree's pattern).
   minvTimesDtau(e, t, "dqdd_dtau", dq, dv, xt, names);
   return e.fn.endHost(names);

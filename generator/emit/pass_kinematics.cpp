@@ -122,6 +122,14 @@ std::vector<Expr> weldError(CodeBuilder& cb, const XSym& oMc, const Constraint& 
   return e;
 }
 
+void storeBiasForce(Emit& e, int i, Kinematics::Body& b) {
+  CodeBuilder& cb = e.cb();
+  V6 h = mul(cb, b.IA, b.v);
+  flatten(cb, h, "h");
+  const V6 pA = crossForce(cb, b.v, h);
+  for (int k = 0; k < 6; ++k) b.pA[std::size_t(k)] = e.putQ(kPA, i, 6, k, pA[std::size_t(k)]);
+}
+
 namespace {
 
 void velocity(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {
@@ -135,10 +143,7 @@ void velocity(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& 
   for (int k = 0; k < 6; ++k) b.c[std::size_t(k)] = e.keepQ(kC, i, 6, k, c[std::size_t(k)]);
   // pA = v x* (I v); IA starts as the body's own inertia (a constant).
   b.IA = constant(e.model().bodies[std::size_t(i)].inertia.matrix());
-  V6 h = mul(cb, b.IA, b.v);
-  flatten(cb, h, "h");
-  const V6 pA = crossForce(cb, b.v, h);
-  for (int k = 0; k < 6; ++k) b.pA[std::size_t(k)] = e.putQ(kPA, i, 6, k, pA[std::size_t(k)]);
+  storeBiasForce(e, i, b);
 }
 
 void gravityAndPlacement(Emit& e, int i, const Kinematics::Body& parent, Kinematics::Body& b) {

@@ -22,6 +22,9 @@ namespace proxgen::emit {
 Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
+/// pA = v x* (I v) of body i from b.v and b.IA, into its member (the kinematics
+/// pass, and bias_forces for constrained_dynamics_derivatives).
+void storeBiasForce(Emit& e, int i, Kinematics::Body& b);
 // A weld's placement error e = log6(target^-1 oMc) through the runtime's log6,
 // printed as `<prefix>R_<id>[9]`, `<prefix>p_<id>[3]` -> `<prefix>e_<id>[6]`;
 // returns the six entries of e (the kinematics pass's Baumgarte term and the
@@ -182,11 +185,19 @@ struct BodyTangents {
   std::set<std::pair<int, int>> dtauDq, dtauDv;  // (row, column) entries that can be nonzero
 };
 V6 load(CodeBuilder& cb, const TangentCol& s);
+/// The sweep's body, `tangent_sweep(v, qdd, lambda, w, dtau_dq, dtau_dv)`, which
+/// reads the kinematics state in the workspace: inverse_dynamics_derivatives is
+/// kinematics(q, v, w) and this; the derivative functions that have just run a
+/// solver or RNEA on the same (q, v) call it without a second kinematics pass.
 /// With `keep`, the tangents' slots and dtau's pattern are returned; with
 /// `keepConstrained` too, the constrained bodies' motion tangents are stored
 /// (constrained_dynamics_derivatives reads them).
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
                                            BodyTangents* keep = nullptr, bool keepConstrained = false);
+/// The body of bias_forces(v, w): pA = v x* I v again for every body with children,
+/// whose member the solvers' elimination overwrites with the articulated bias
+/// (constrained_dynamics_derivatives calls it between prox_pv and the sweep).
+std::string emitBiasForces(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics);
 /// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
 /// and inverse_dynamics_derivatives (held with it) and the products with M^-1
 /// (dense_product<n, m, p>, and sparse_transposed_product over dtau's pattern
