@@ -515,6 +515,19 @@ std::pair<int, int> versionNumbers() {
 
 }  // namespace
 
+const std::vector<std::string>& fileFunctionNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out = {"kinematics", "joint_transforms", "constraint_joints", "eliminate_free_bodies",
+                                    "accelerate_free_bodies", "tangent_sweep", "bias_forces", "residual",
+                                    "dense_product", "dense_product_add", "sparse_left_product_add",
+                                    "sparse_transposed_product", "dense_cholesky", "proximal_step",
+                                    "se3_right_jacobian_inverse"};
+    for (Function f : allFunctions()) out.push_back(functionName(f));
+    return out;
+  }();
+  return names;
+}
+
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
                           const SolverTexts& texts) {
   const Model& m = sys.model;

@@ -34,6 +34,12 @@ struct SolverTexts {
   std::string constraintJoints;
 };
 
+/// Every function the source defines besides the part functions (the entry
+/// points, the helpers above and the dense templates): a part function is named
+/// after its host and its first body, and may take none of these names (a link
+/// called "bodies" would otherwise make a part eliminate_free_bodies).
+const std::vector<std::string>& fileFunctionNames();
+
 SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInputs& in, const Members& ws,
                           const SolverTexts& texts);
 

@@ -38,6 +38,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   std::vector<std::string> bodyNames;
   for (const BodyPlan& b : plan.bodies) bodyNames.push_back(b.ident);
   FunctionWriter fn(plan.scalar, bodyNames);
+  for (const std::string& name : fileFunctionNames()) fn.reserveName(name);
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;

@@ -62,6 +62,9 @@ class FunctionWriter {
   /// hosts it calls by a raw line: kinematics(...), ...); zero if none closed.
   OpCount hostOps(const std::string& name) const;
 
+  /// A name a part function may not take (a function of the file besides the
+  /// parts): a part that would is suffixed _2, as when two parts collide.
+  void reserveName(const std::string& name) { partNames_.insert(name); }
   /// Every part function printed so far.
   const std::string& parts() const { return partsText_; }
   const CodeBuilder::Stats& stats() const { return stats_; }
