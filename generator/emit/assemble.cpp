@@ -182,8 +182,9 @@ const EntryPoint kEntryPoints[] = {
      "\n// forward_dynamics_derivatives (no constraint forces: the free motion):\n"
      "// qdd = M^-1 (tau - h) (ABA's answer, to round-off), and at (q, v, qdd)\n"
      "// dqdd_dq = -M^-1 dtau_dq, dqdd_dv = -M^-1 dtau_dv, dqdd_dtau = M^-1 (nv x nv each).\n"
-     "// It calls nonlinear_effects, mass_matrix_inverse and the tangent sweep of\n"
-     "// inverse_dynamics_derivatives (held with it). None of the arrays may be inside w.\n",
+     "// It calls nonlinear_effects, then the passes of mass_matrix_inverse and the tangent\n"
+     "// sweep of inverse_dynamics_derivatives (held with it) on the kinematics it left in w.\n"
+     "// None of the arrays may be inside w.\n",
      "void forward_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, Workspace& w, Scalar* qdd,\n"
      "                                  Scalar* dqdd_dq, Scalar* dqdd_dv, Scalar* dqdd_dtau) noexcept",
      "// M^-1 by ABA on the unit torques, qdd = M^-1 (tau - h), the tangent sweep at qdd, two dense products.\n"},
@@ -196,8 +197,9 @@ const EntryPoint kEntryPoints[] = {
      "// M qdd + h + J^T lambda = tau, J qdd + gamma = a*, the multipliers' tangents by\n"
      "// s.iterations proximal steps with s.mu (as the solve: at K steps they are off\n"
      "// by what the K-th iterate is). A constraint with !s.active[k] counts as absent\n"
-     "// (its rows are 0). It calls mass_matrix_inverse, prox_pv and the tangent sweep of\n"
-     "// inverse_dynamics_derivatives (held with it). None of the arrays may be inside w.\n",
+     "// (its rows are 0). It calls prox_pv, then the passes of mass_matrix_inverse and the\n"
+     "// tangent sweep of inverse_dynamics_derivatives (held with it) on the kinematics\n"
+     "// prox_pv left in w. None of the arrays may be inside w.\n",
      "void constrained_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings& s,\n"
      "                                      Workspace& w, Scalar* qdd, Scalar* lambda, Scalar* dqdd_dq,\n"
      "                                      Scalar* dqdd_dv, Scalar* dqdd_dtau, Scalar* dlambda_dq,\n"
@@ -436,6 +438,12 @@ std::string helpers(const SolverTexts& texts) {
            "}\n\n";
   if (cdd)
     out += kConstrainedDerivativeHelpers;
+  if (!texts.minvPasses.empty())
+    out += fmt::format(
+        "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
+        "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n"
+        "void mass_matrix_inverse_passes(const Scalar* q, Workspace& w, Scalar* Minv) noexcept {{\n{}}}\n\n",
+        texts.minvPasses);
   if (!texts.tangentSweep.empty())
     out += fmt::format(
         "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) and its\n"
@@ -518,7 +526,8 @@ std::pair<int, int> versionNumbers() {
 const std::vector<std::string>& fileFunctionNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out = {"kinematics", "joint_transforms", "constraint_joints", "eliminate_free_bodies",
-                                    "accelerate_free_bodies", "tangent_sweep", "bias_forces", "residual",
+                                    "accelerate_free_bodies", "tangent_sweep", "bias_forces", "mass_matrix_inverse_passes",
+                                    "residual",
                                     "dense_product", "dense_product_add", "sparse_left_product_add",
                                     "sparse_transposed_product", "dense_cholesky", "proximal_step",
                                     "se3_right_jacobian_inverse"};

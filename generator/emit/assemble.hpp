@@ -29,6 +29,8 @@ struct SolverTexts {
   // inverse_dynamics_derivatives' sweep after the kinematics pass, and the bias
   // forces that constrained_dynamics_derivatives restores before it ("" when not held).
   std::string tangentSweep, biasForces;
+  // mass_matrix_inverse's passes after the joint transforms ("" when not held).
+  std::string minvPasses;
   bool withKinematics = false, withJointTransforms = false;
   // The helper of the constraint functions of q alone ("" when none is held).
   std::string constraintJoints;

@@ -44,9 +44,10 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   SolverTexts texts;
   // A derivative function calls the functions it is made of (its host, named
   // here, counts their operations too): the file holds them as well.
-  // Both call the tangent sweep of inverse_dynamics_derivatives without its
-  // kinematics pass (hosts: the sweep, "rnead", and cdd's "bias"), after a
-  // function that left the kinematics state of the same (q, v) in the workspace.
+  // Both call mass_matrix_inverse's passes and inverse_dynamics_derivatives'
+  // tangent sweep without their transforms and kinematics (hosts "minv",
+  // "rnead", and cdd's "bias"), after a function that left the kinematics
+  // state of the same (q, v) in the workspace.
   struct Composite {
     Function f;
     const char* host;
@@ -56,10 +57,10 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   const Composite composites[] = {
       {Function::ForwardDynamicsDerivatives, "fdd",
        {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
-       {"rnead"}},
+       {"minv", "rnead"}},
       {Function::ConstrainedDynamicsDerivatives, "cdd",
        {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
-       {"rnead", "bias"}}};
+       {"minv", "rnead", "bias"}}};
   FunctionSet want = sys.functions;
   for (const Composite& c : composites)
     if (want.has(c.f))
@@ -131,8 +132,11 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     const CodeBuilder* afterTransforms = fn.lastHost();
     if (want.has(Function::MassMatrix))
       texts.library[Function::MassMatrix] = emitMassMatrix(e, transforms, afterTransforms);
-    if (want.has(Function::MassMatrixInverse))
-      texts.library[Function::MassMatrixInverse] = emitMassMatrixInverse(e, transforms, afterTransforms);
+    if (want.has(Function::MassMatrixInverse)) {
+      texts.minvPasses = emitMassMatrixInverse(e, transforms, afterTransforms);
+      texts.library[Function::MassMatrixInverse] =
+          "  joint_transforms(q, w);\n  mass_matrix_inverse_passes(q, w, Minv);\n";
+    }
   }
 
   if (want.has(Function::ForwardDynamicsDerivatives))
@@ -179,7 +183,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     if (!want.has(c.f)) continue;
     OpCount ops = fn.hostOps(c.host);
     for (Function f : c.calls)
-      if (f != Function::InverseDynamicsDerivatives) ops += f == Function::ProxPv ? texts.pvOps : texts.libraryOps[f];
+      if (f == Function::ProxPv) ops += texts.pvOps;
+      else if (f == Function::NonlinearEffects) ops += texts.libraryOps[f];  // the others: their hosts, below
     for (const char* h : c.hosts) ops += fn.hostOps(h);
     texts.libraryOps[c.f] = ops;
   }

@@ -214,10 +214,10 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const std::vector<std::string> names = {"q", "v", "tau", "s", "w", "qdd", "lambda", "dqdd_dq", "dqdd_dv",
                                           "dqdd_dtau", "dlambda_dq", "dlambda_dv", "dlambda_dtau"};
   CodeBuilder& host = e.cb();
-  // M^-1 first: its joint transforms are the same q's, and the sweep's
-  // members (read by the rows below) are written after it.
-  host.line(fmt::format("mass_matrix_inverse(q, w, {});", minv), {}, names);
+  // prox_pv's kinematics pass writes the joint transforms M^-1 reads (no
+  // second transforms pass); M^-1's members (IA, U, D^-1, ...) are not read after it.
   host.line("prox_pv(q, v, tau, s, w, qdd, lambda);", {}, names);
+  host.line(fmt::format("mass_matrix_inverse_passes(q, w, {});", minv), {}, names);
   // The sweep at the solution reads prox_pv's kinematics state (same q, v), less
   // the bias forces its elimination overwrote: bias_forces restores those.
   host.line("bias_forces(v, w);", {}, names);

@@ -496,7 +496,8 @@ std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
   const std::vector<std::string> names = {"q", "v", "tau", "w", "qdd", "dqdd_dq", "dqdd_dv", "dqdd_dtau"};
   OpCount ops;
   cb.line(fmt::format("nonlinear_effects(q, v, w, {});", h), {}, names);
-  cb.line("mass_matrix_inverse(q, w, dqdd_dtau);", {}, names);
+  // nonlinear_effects' kinematics pass wrote the joint transforms of this q.
+  cb.line("mass_matrix_inverse_passes(q, w, dqdd_dtau);", {}, names);
   // h := tau - h, then qdd = M^-1 (tau - h): ABA's answer to round-off.
   ops.once = Ops{};
   ops.once.add = nv;

@@ -410,7 +410,6 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
   e.fn.live().art = &art;
   e.fn.live().js = &js;
   e.fn.beginHost("minv", afterTransforms);
-  e.cb().line("joint_transforms(q, w);", {}, {"q", "w"});
   e.fn.beginPass("backward", "backward: D^-1 and the unit-torque forces, leaves first");
   for (int i = N - 1; i >= 1; --i) {
     if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, end[std::size_t(i)], art, js);

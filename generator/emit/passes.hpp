@@ -121,6 +121,10 @@ Kinematics emitJointTransforms(Emit& e);
 std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
 
 // ---- pass_mass_matrix_inverse.cpp: M^-1 in O(n^2) (ABA on the unit torques).
+/// The body of mass_matrix_inverse_passes(q, w, Minv), which reads the joint
+/// transforms in the workspace: mass_matrix_inverse is joint_transforms(q, w)
+/// and this; the derivative functions call it after a kinematics pass of the
+/// same q, which writes the same transforms.
 std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
 
 // ---- pass_constraint_kinematics.cpp: constraint_placements, constraint_jacobian,
