@@ -349,17 +349,16 @@ std::string partHelpers(const System& sys, const SolverTexts& texts) {
 // The helpers the entry points call, printed only when one needs them.
 std::string helpers(const SolverTexts& texts) {
   std::string out;
-  if (texts.withKinematics)
-    out += fmt::format(
-        "// Joint transforms, body velocities v, velocity-product accelerations c, bias\n"
-        "// forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.\n"
-        "void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {{\n{}}}\n\n",
-        texts.kinematics);
-  if (texts.withJointTransforms)
-    out += fmt::format(
-        "// The joint transforms alone, for the functions without a velocity.\n"
-        "void joint_transforms(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
-        texts.jointTransforms);
+  // "<comment lines>void <signature> noexcept {<body>}", where `wanted`.
+  const auto helper = [&](bool wanted, const char* comment, const char* signature, const std::string& body) {
+    if (wanted) out += fmt::format("{}void {} noexcept {{\n{}}}\n\n", comment, signature, body);
+  };
+  helper(texts.withKinematics,
+         "// Joint transforms, body velocities v, velocity-product accelerations c, bias\n"
+         "// forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.\n",
+         "kinematics(const Scalar* q, const Scalar* v, Workspace& w)", texts.kinematics);
+  helper(texts.withJointTransforms, "// The joint transforms alone, for the functions without a velocity.\n",
+         "joint_transforms(const Scalar* q, Workspace& w)", texts.jointTransforms);
   const bool cdd = texts.functions.has(Function::ConstrainedDynamicsDerivatives);
   if (texts.functions.has(Function::ForwardDynamicsDerivatives) || cdd)
     out += "// C += s A B, A n x m, B m x p, C n x p, all row-major (the derivatives' dense\n"
@@ -438,29 +437,22 @@ std::string helpers(const SolverTexts& texts) {
            "}\n\n";
   if (cdd)
     out += kConstrainedDerivativeHelpers;
-  if (!texts.minvPasses.empty())
-    out += fmt::format(
-        "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
-        "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n"
-        "void mass_matrix_inverse_passes(const Scalar* q, Workspace& w, Scalar* Minv) noexcept {{\n{}}}\n\n",
-        texts.minvPasses);
-  if (!texts.tangentSweep.empty())
-    out += fmt::format(
-        "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) and its\n"
-        "// tangents along every q and v direction; reads the kinematics state in w.\n"
-        "void tangent_sweep(const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
-        "                   Scalar* dtau_dq, Scalar* dtau_dv) noexcept {{\n{}}}\n\n",
-        texts.tangentSweep);
-  if (!texts.biasForces.empty())
-    out += fmt::format(
-        "// pA = v x* I v again for the bodies with children: the elimination of prox_pv\n"
-        "// leaves their articulated bias in those members, and the tangent sweep reads pA.\n"
-        "void bias_forces(const Scalar* v, Workspace& w) noexcept {{\n{}}}\n\n",
-        texts.biasForces);
-  if (!texts.constraintJoints.empty())
-    out += fmt::format("// Joint transforms, for the constraint functions of q alone.\n"
-                       "void constraint_joints(const Scalar* q, Workspace& w) noexcept {{\n{}}}\n\n",
-                       texts.constraintJoints);
+  helper(!texts.minvPasses.empty(),
+         "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
+         "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n",
+         "mass_matrix_inverse_passes(const Scalar* q, Workspace& w, Scalar* Minv)", texts.minvPasses);
+  helper(!texts.tangentSweep.empty(),
+         "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) and its\n"
+         "// tangents along every q and v direction; reads the kinematics state in w.\n",
+         "tangent_sweep(const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
+         "                   Scalar* dtau_dq, Scalar* dtau_dv)",
+         texts.tangentSweep);
+  helper(!texts.biasForces.empty(),
+         "// pA = v x* I v again for the bodies with children: the elimination of prox_pv\n"
+         "// leaves their articulated bias in those members, and the tangent sweep reads pA.\n",
+         "bias_forces(const Scalar* v, Workspace& w)", texts.biasForces);
+  helper(!texts.constraintJoints.empty(), "// Joint transforms, for the constraint functions of q alone.\n",
+         "constraint_joints(const Scalar* q, Workspace& w)", texts.constraintJoints);
   return out;
 }
 
