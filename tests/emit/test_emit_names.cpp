@@ -7,10 +7,13 @@
 // compares the arrays with the Model byte for byte.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
 
+#include "emit/assemble.hpp"
 #include "emit/generate.hpp"
 #include "emit/identifiers.hpp"
 #include "model/layout.hpp"
@@ -97,6 +100,45 @@ TEST(HeaderNames, StringLiteralsHoldExactlyTheBytes) {
     EXPECT_EQ(lit.find("/*"), std::string::npos) << lit;
     EXPECT_EQ(lit.find("*/"), std::string::npos) << lit;
   }
+}
+
+
+// A part function is named after its host and its first body, so a link may
+// spell another function of the file ("bodies" off the support made
+// eliminate_free_bodies twice: a source that did not compile). The emitter
+// reserves fileFunctionNames() for the parts; here, on helper_names.urdf with
+// every function held, every function the source defines is defined once, and
+// each one that is not a part (PROXGEN_RT_NOINLINE) is in that list, so a helper
+// added to the file without its name there fails this test.
+TEST(FileFunctions, EachNameIsDefinedOnceAndEveryHelperIsReserved) {
+  const std::string dir = test::sourceDir() + "/tests/data/hostile";
+  GenerateOptions g;
+  g.urdf = dir + "/helper_names.urdf";
+  g.layout = dir + "/helper_names.yaml";
+  g.name = "helper_names";
+  g.functions = "all";
+  const std::string source = generateFiles(g).source;
+  // A definition starts a line: a part, a helper or entry point, or a template's
+  // function on the line after its template head.
+  static const std::regex definition(
+      R"((?:^|\n)(PROXGEN_RT_NOINLINE )?(?:void|Scalar|bool|int) (\w+)\([^;{]*\)\s*(?:const\s*)?noexcept\s*\{)");
+  std::map<std::string, int> defined;
+  const std::vector<std::string>& reserved = fileFunctionNames();
+  for (auto it = std::sregex_iterator(source.begin(), source.end(), definition); it != std::sregex_iterator(); ++it) {
+    const std::string name = (*it)[2].str();
+    ++defined[name];
+    if ((*it)[1].matched) continue;  // a part
+    EXPECT_NE(std::find(reserved.begin(), reserved.end(), name), reserved.end())
+        << name << " is defined by the file but not in fileFunctionNames()";
+  }
+  for (const auto& [name, count] : defined) EXPECT_EQ(count, 1) << name;
+  // The links of helper_names.urdf do collide: the parts took the suffix.
+  EXPECT_EQ(defined.count("eliminate_free_bodies_2"), 1u);
+  EXPECT_EQ(defined.count("accelerate_free_bodies_2"), 1u);
+  // The check sees the helpers at all (a regex that matched nothing would pass).
+  for (const char* helper : {"kinematics", "tangent_sweep", "bias_forces", "mass_matrix_inverse_passes",
+                             "dense_product_add", "residual", "constrained_dynamics_derivatives"})
+    EXPECT_EQ(defined.count(helper), 1u) << helper;
 }
 
 }  // namespace
