@@ -42,23 +42,24 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
   SolverTexts texts;
-  // A derivative function calls the functions it is made of (its host, named
-  // here, counts their operations too): the file holds them as well.
-  // Both call mass_matrix_inverse's passes and inverse_dynamics_derivatives'
-  // tangent sweep without their transforms and kinematics (hosts "minv",
-  // "rnead", and cdd's "bias"), after a function that left the kinematics
-  // state of the same (q, v) in the workspace.
+  // A derivative function calls the functions it is made of: the file holds
+  // them as well (`calls`). Its operations per call are its host's, the whole
+  // of `first` (the function that leaves the kinematics state of its (q, v) in
+  // the workspace) and the hosts it calls after it without their transforms
+  // and kinematics: mass_matrix_inverse's passes ("minv"), the tangent sweep
+  // of inverse_dynamics_derivatives ("rnead") and, for cdd, "bias".
   struct Composite {
     Function f;
     const char* host;
+    Function first;
     std::vector<Function> calls;
     std::vector<const char*> hosts;
   };
   const Composite composites[] = {
-      {Function::ForwardDynamicsDerivatives, "fdd",
+      {Function::ForwardDynamicsDerivatives, "fdd", Function::NonlinearEffects,
        {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
        {"minv", "rnead"}},
-      {Function::ConstrainedDynamicsDerivatives, "cdd",
+      {Function::ConstrainedDynamicsDerivatives, "cdd", Function::ProxPv,
        {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
        {"minv", "rnead", "bias"}}};
   FunctionSet want = sys.functions;
@@ -182,9 +183,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   for (const Composite& c : composites) {
     if (!want.has(c.f)) continue;
     OpCount ops = fn.hostOps(c.host);
-    for (Function f : c.calls)
-      if (f == Function::ProxPv) ops += texts.pvOps;
-      else if (f == Function::NonlinearEffects) ops += texts.libraryOps[f];  // the others: their hosts, below
+    ops += c.first == Function::ProxPv ? texts.pvOps : texts.libraryOps[c.first];
     for (const char* h : c.hosts) ops += fn.hostOps(h);
     texts.libraryOps[c.f] = ops;
   }
