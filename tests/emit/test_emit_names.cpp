@@ -60,12 +60,18 @@ std::string decode(const std::string& literal) {
   return out;
 }
 
-TEST(HeaderNames, IndicesAreTheSanitisedUniqueNames) {
+// Generation options for a fixture of tests/data/hostile: STEM.urdf and STEM.yaml.
+GenerateOptions hostile(const std::string& stem, const std::string& name) {
   const std::string dir = test::sourceDir() + "/tests/data/hostile";
   GenerateOptions g;
-  g.urdf = dir + "/names.urdf";
-  g.layout = dir + "/names.yaml";
-  g.name = "hostile";
+  g.urdf = dir + "/" + stem + ".urdf";
+  g.layout = dir + "/" + stem + ".yaml";
+  g.name = name;
+  return g;
+}
+
+TEST(HeaderNames, IndicesAreTheSanitisedUniqueNames) {
+  const GenerateOptions g = hostile("names", "hostile");
   System sys;
   const SolverFiles files = generateFiles(g, nullptr, &sys);
   // The rule: sanitizeIdentifier, and a name taken already gets "_<position>".
@@ -111,11 +117,7 @@ TEST(HeaderNames, StringLiteralsHoldExactlyTheBytes) {
 // each one that is not a part (PROXGEN_RT_NOINLINE) is in that list, so a helper
 // added to the file without its name there fails this test.
 TEST(FileFunctions, EachNameIsDefinedOnceAndEveryHelperIsReserved) {
-  const std::string dir = test::sourceDir() + "/tests/data/hostile";
-  GenerateOptions g;
-  g.urdf = dir + "/helper_names.urdf";
-  g.layout = dir + "/helper_names.yaml";
-  g.name = "helper_names";
+  GenerateOptions g = hostile("helper_names", "helper_names");
   g.functions = "all";
   const std::string source = generateFiles(g).source;
   // A definition starts a line: a part, a helper or entry point, or a template's
