@@ -59,79 +59,11 @@ void passInertia(Emit& e, const Kinematics& kin, int i, Articulated& art) {
 }
 
 // Column loops. Body i treats every column j with the same coefficients (its
-// transform, U, D^-1): only which members it reads and writes differ. An input
-// entry is a constant or +-(a member slot) whose index advances by one per
-// column (FA_p[r][j], minv[idx(s, j)]); a run of adjacent columns whose
-// entries have one shape becomes one loop over j (column_loops.cpp), so each
-// pass is O(n) code instead of O(n^2) (forward) or O(n depth) (backward), and
-// the compiler vectorises across columns (docs/dynamics.md, "mass_matrix_inverse").
-struct Slot {
-  Expr value;          // a constant (prefix empty), or the sign of the member
-  std::string prefix;  // "w.FA_x[2]" of "w.FA_x[2][17]", "w.minv" of "w.minv[40]"
-  int index = -1;
-  bool opaque = false;  // anything else: its column stays unrolled
-};
-
-Slot slotOf(const CodeBuilder& cb, const Expr& x) {
-  Slot s;
-  if (x.isConstant()) {
-    s.value = x;
-    return s;
-  }
-  static const std::regex member(R"(^(-?)(w\.\w+(?:\[\d+\])?)\[(\d+)\]$)");
-  const std::string text = cb.describe(x);
-  std::smatch m;
-  if (!x.isScaledAtom() || std::abs(x.terms()[0].coeff) != 1.0 || !std::regex_match(text, m, member)) {
-    s.opaque = true;
-    return s;
-  }
-  s.value = Expr(m[1].str().empty() ? 1.0 : -1.0);
-  s.prefix = m[2].str();
-  s.index = std::stoi(m[3].str());
-  return s;
-}
-
-std::vector<Slot> slotsOf(const CodeBuilder& cb, const std::vector<Expr>& xs) {
-  std::vector<Slot> out;
-  for (const Expr& x : xs) out.push_back(slotOf(cb, x));
-  return out;
-}
-
-// Entry a of column k joins entry b of column k0 in one loop.
-bool joins(const Slot& a, int k, const Slot& b, int k0) {
-  if (a.opaque || b.opaque || a.prefix != b.prefix || a.value.constant() != b.value.constant()) return false;
-  return a.prefix.empty() || a.index - b.index == k - k0;
-}
-
-// Columns k and k0 have entries of one shape (inputs(k): a column's entries).
-bool oneShape(const CodeBuilder& cb, const std::function<std::vector<Expr>(int)>& inputs, int k, int k0) {
-  const std::vector<Slot> a = slotsOf(cb, inputs(k)), b = slotsOf(cb, inputs(k0));
-  for (std::size_t r = 0; r < a.size(); ++r)
-    if (!joins(a[r], k, b[r], k0)) return false;
-  return true;
-}
-
-// The loop's reading of slot `first` (column k0's): "prefix[idx + j]".
-Expr loopRead(CodeBuilder& cb, const Slot& first) {
-  if (first.prefix.empty()) return first.value;
-  const std::string text = first.index == 0 ? fmt::format("{}[j]", first.prefix)
-                                            : fmt::format("{}[{} + j]", first.prefix, first.index);
-  return first.value.constant() * cb.member(text);
-}
-
-// The loop's reading of a column's entries: column k0's, indexed [idx + j].
-std::vector<Expr> loopReads(CodeBuilder& cb, const std::vector<Expr>& first) {
-  std::vector<Expr> out;
-  for (const Slot& s : slotsOf(cb, first)) out.push_back(loopRead(cb, s));
-  return out;
-}
-
-std::vector<Expr> entries(const V6& x) { return {x.begin(), x.end()}; }
-V6 toV6(const std::vector<Expr>& x, std::size_t from = 0) {
-  V6 v;
-  for (std::size_t r = 0; r < 6; ++r) v[r] = x[from + r];
-  return v;
-}
+// transform, U, D^-1): only which members it reads and writes differ, so a run
+// of adjacent columns whose entries have one shape is one loop over j
+// (column_loops.cpp), and each pass is O(n) code instead of O(n^2) (forward) or
+// O(n depth) (backward); the compiler vectorises across columns
+// (docs/dynamics.md, "mass_matrix_inverse").
 
 // Column j (s < j < end) of a one-dof body: Minv(s, j) = -D^-1 S^T F_i[:, j],
 // and F_p[:, j] += X^T (F_i[:, j] + U Minv(s, j)) (Fp: F_p[:, j] before). Stores

@@ -114,6 +114,14 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
 std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins);
 /// Starts a part and opens a run's block: `for (int j = 0; j < len; ++j) {`, or a plain block for one column.
 void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label);
+/// Columns k and k0 have entries of one shape (inputs(k): column k's entries):
+/// each entry the same constant in both, or +-(a member slot) whose index
+/// advances by one per column (FA_p[r][j], minv[idx(s, j)]).
+bool oneShape(const CodeBuilder& cb, const std::function<std::vector<Expr>(int)>& inputs, int k, int k0);
+/// A loop's reading of a column's entries: column k0's, indexed [idx + j].
+std::vector<Expr> loopReads(CodeBuilder& cb, const std::vector<Expr>& first);
+std::vector<Expr> entries(const V6& x);
+V6 toV6(const std::vector<Expr>& x, std::size_t from = 0);
 
 // ---- pass_mass_matrix.cpp: the joint transforms alone, and CRBA.
 /// joint_transforms(q, w): X_J and the bodies' own inertias, for the functions without v.
