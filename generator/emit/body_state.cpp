@@ -53,7 +53,10 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
   if (s.mult) vec(s.mult->lambda), vec(s.mult->dlambda);
   if (s.rows) vec(s.rows->yfree);
   if (s.forces) vec(s.forces->tau);
-  if (s.js) sym(s.js->upper);
+  if (s.js) {
+    for (V6& x : s.js->carried) v6(x);
+    sym(s.js->upper);
+  }
   if (s.del) {
     vec(s.del->Linv), vec(s.del->LSinv);
     sym(s.del->L), sym(s.del->LS);

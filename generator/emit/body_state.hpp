@@ -102,6 +102,7 @@ struct Forces {
 struct JointSpace {
   std::vector<Sym> Ic;
   std::vector<std::vector<V6>> FA;
+  std::vector<V6> carried;  // CRBA: column k in the frame of the body being visited
   Sym upper;
 };
 

@@ -12,18 +12,14 @@
 
 namespace proxgen::emit {
 
-namespace {
-// Runs shorter than this stay unrolled: a loop of one column is only overhead.
-constexpr int kLoopColumns = 2;
-}  // namespace
-
-std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins) {
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins,
+                                            int shortest) {
   std::vector<std::pair<int, int>> runs;
   for (std::size_t n = 0; n < ks.size();) {
     const int k0 = ks[n];
     std::size_t len = 1;
     while (n + len < ks.size() && ks[n + len] == k0 + int(len) && joins(ks[n + len], k0)) ++len;
-    if (int(len) < kLoopColumns) len = 1;
+    if (int(len) < shortest) len = 1;
     runs.push_back({k0, int(len)});
     n += len;
   }

@@ -1,6 +1,8 @@
 // The joint-space inertia M(q) by the composite-rigid-body algorithm, leaves
 // first: F = Ic_i S_i, M_ii = S_i^T F, then F carried to each ancestor j
-// (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i. A leaf's Ic is its
+// (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i. The carrying goes
+// ancestor by ancestor (every column of a subtree one step up at its root's
+// turn), so a body's descendants' columns are one loop. A leaf's Ic is its
 // own inertia, a constant, so its diagonal entry folds. Each entry is written
 // once, where it is computed, into both halves of the output M (no workspace
 // copy); the constant ones after the pass. Also the q-only joint
@@ -80,10 +82,74 @@ void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& wr
   }
 }
 
-// Fills js (in the caller's Live).
+// The CRBA columns carried up the tree (column k: the composite force of a unit
+// acceleration of dof k, F = X^T ... Ic_k S_k) live in one of two 6 x nv
+// members by the depth of the body whose frame they are in, so carrying them
+// to the parent reads one and writes the other (in place, a column's entries
+// would overwrite each other when X permutes them).
+std::string columnSlot(Emit& e, int depth, int r, int k, bool loop) {
+  const std::string base = depth % 2 == 0 ? "Fcol0" : "Fcol1";
+  const std::string what = depth % 2 == 0 ? "CRBA columns in the frame of a body at even depth"
+                                          : "CRBA columns in the frame of a body at odd depth";
+  return loop ? e.ws.loopSlot(base, 6, e.plan.nv, r, k, what) : e.ws.member(base, 6, e.plan.nv, r, k, what);
+}
+
+// M(row, k + j) for the j of a loop over columns k..k + len - 1, into both
+// triangles; a constant is the same in every column of the run (one shape).
+void putMassColumns(Emit& e, JointSpace& js, std::vector<char>& written, int row, int k0, int len, const Expr& value) {
+  if (len == 1 || value.isConstant()) {
+    for (int k = k0; k < k0 + len; ++k) putMass(e, js, written, row, k, value);
+    return;
+  }
+  const int nv = e.plan.nv;
+  CodeBuilder& cb = e.cb();
+  const Expr t = cb.flat(value, "m");
+  cb.line(fmt::format("M[{} + j] = {};", row * nv + k0, cb.print(t)), {t}, {"M"});
+  cb.line(fmt::format("M[{} + {} * j] = {};", k0 * nv + row, nv, cb.print(t)), {t}, {"M"});
+  for (int k = k0; k < k0 + len; ++k) written[std::size_t(Sym::index(nv, row, k))] = 1;
+}
+
+// Column k0 (or, in a loop, columns k0 + j) of body i's subtree, F in i's frame:
+// F = X_i^T F into the parent's frame, M(parent's dofs, k) = S_p^T F, and F
+// kept for the grandparent (returned: the stored values, zero when not kept).
+V6 carryColumn(Emit& e, const Kinematics& kin, const std::vector<int>& depth, int i, int k0, int len, const V6& F,
+               JointSpace& js, std::vector<char>& written) {
+  CodeBuilder& cb = e.cb();
+  const BodyPlan& p = e.bp(i);
+  const BodyPlan& pp = e.bp(p.parent);
+  V6 G = e.forceToParent(kin.b[std::size_t(i)], F);
+  flatten(cb, G, "F");
+  const Kinematics::Body& kp = kin.b[std::size_t(p.parent)];
+  for (int r = 0; r < pp.nv; ++r)  // an ancestor's dofs come first: the upper triangle
+    putMassColumns(e, js, written, pp.idx_v + r, k0, len, dot(cb, kp.S[std::size_t(r)], G));
+  V6 out = zero6();
+  if (pp.parent > 0)
+    for (int r = 0; r < 6; ++r)
+      out[std::size_t(r)] = e.put(columnSlot(e, depth[std::size_t(p.parent)], r, k0, len > 1), G[std::size_t(r)]);
+  return out;
+}
+
+// Fills js (in the caller's Live). Body i, leaves first: its own columns F =
+// Ic_i S_i (M_ii = S_i^T F), Ic_p += X^T Ic_i X; then every column of its
+// subtree goes one step up, to the parent's frame, where the parent's dofs
+// read their entries. A body's descendants' columns all go through the same
+// transform, so runs of them of one shape are one loop (column_loops.cpp):
+// the walk is O(n) code instead of O(n depth).
 void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
-  const int N = int(plan.bodies.size());
+  const int N = int(plan.bodies.size()), nv = plan.nv;
+  // Depth below the world's children, and subtree dof ends (depth-first order
+  // makes a subtree's dofs contiguous).
+  std::vector<int> depth(std::size_t(N), 0), end(std::size_t(N), 0);
+  for (int i = 1; i < N; ++i)
+    if (e.bp(i).parent > 0) depth[std::size_t(i)] = depth[std::size_t(e.bp(i).parent)] + 1;
+  for (int i = N - 1; i >= 1; --i) {
+    const BodyPlan& p = e.bp(i);
+    end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
+    if (p.parent > 0) end[std::size_t(p.parent)] = std::max(end[std::size_t(p.parent)], end[std::size_t(i)]);
+  }
+  std::vector<V6>& cols = js.carried;
+  cols.assign(std::size_t(nv), zero6());
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
   for (int i = N - 1; i >= 1; --i) {
     e.fn.boundary(i);
@@ -99,17 +165,9 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
     for (int r = 0; r < p.nv; ++r)
       for (int c = r; c < p.nv; ++c)
         putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
-    for (int j = i; e.bp(j).parent > 0; j = e.bp(j).parent) {
-      const BodyPlan& pj = e.bp(e.bp(j).parent);
-      const Kinematics::Body& kj = kin.b[std::size_t(j)];
-      const Kinematics::Body& kp = kin.b[std::size_t(pj.index)];
-      for (int d = 0; d < p.nv; ++d) {
-        F[std::size_t(d)] = e.forceToParent(kj, F[std::size_t(d)]);
-        flatten(cb, F[std::size_t(d)], "F");
-        for (int r = 0; r < pj.nv; ++r)  // an ancestor's dofs come first: the upper triangle
-          putMass(e, js, written, pj.idx_v + r, p.idx_v + d, dot(cb, kp.S[std::size_t(r)], F[std::size_t(d)]));
-      }
-    }
+    if (p.parent > 0)
+      for (int d = 0; d < p.nv; ++d)
+        cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, depth, i, p.idx_v + d, 1, F[std::size_t(d)], js, written);
     if (p.parent > 0) {
       const Sym dI = e.inertiaToParent(kb, js.Ic[std::size_t(i)]);
       Sym& par = js.Ic[std::size_t(p.parent)];
@@ -117,6 +175,26 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
         if (!dI.packed(k).isZero()) par.packed(k) = e.putQ(kIc, p.parent, 21, k, par.packed(k) + dI.packed(k));
     }
     cb.close();
+    if (p.parent == 0) continue;
+    // The descendants' columns, in i's frame since its children's turns.
+    std::vector<int> ks;
+    for (int k = p.idx_v + p.nv; k < end[std::size_t(i)]; ++k) ks.push_back(k);
+    const auto inputs = [&](int k) { return entries(cols[std::size_t(k)]); };
+    const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+    for (const auto& run : columnRuns(ks, sameShape)) {
+      const int k0 = run.first, len = run.second;
+      openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', subtree columns to the parent,", i, p.ident));
+      CodeBuilder& lb = e.cb();  // after openColumns: it may have started a new part
+      const V6 in = len > 1 ? toV6(loopReads(lb, inputs(k0))) : cols[std::size_t(k0)];
+      const V6 out = carryColumn(e, kin, depth, i, k0, len, in, js, written);
+      lb.close();
+      // After a loop each column's slots hold new values: read them by their own names.
+      for (int k = k0; k < k0 + len; ++k)
+        for (int r = 0; r < 6; ++r)
+          cols[std::size_t(k)][std::size_t(r)] = len == 1 || out[std::size_t(r)].isConstant()
+                                                     ? out[std::size_t(r)]
+                                                     : lb.refresh(columnSlot(e, depth[std::size_t(p.parent)], r, k, false));
+    }
   }
 }
 

@@ -109,9 +109,10 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
 
 // ---- column_loops.cpp: a run of adjacent columns of one shape as one loop over j.
 /// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
-/// holds with the run's first, as (first, length); runs too short to pay for a
-/// loop are split into single columns.
-std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins);
+/// holds with the run's first, as (first, length); runs shorter than `shortest`
+/// are split into single columns (a loop of one column is only overhead).
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins,
+                                            int shortest = 2);
 /// Starts a part and opens a run's block: `for (int j = 0; j < len; ++j) {`, or a plain block for one column.
 void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label);
 /// Columns k and k0 have entries of one shape (inputs(k): column k's entries):
