@@ -27,7 +27,7 @@ namespace {
 int rowStride(int m) { return m + 1; }
 /// Runs of at least this many constraint columns that go through the same
 /// arithmetic are printed as a loop (README, "The generated solver").
-constexpr int kLoopColumns = 4;
+constexpr int kLoopColumns = 2;
 
 // How many columns from c0 on hold exactly the members KA_i[r][c]
 // (each entry stored, none folded): a loop over them reads the same slots.
