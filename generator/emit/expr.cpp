@@ -248,6 +248,16 @@ std::string CodeBuilder::freshName(const std::string& hint) { return fmt::format
 Expr CodeBuilder::temp(const Expr& e, const std::string& hint) {
   if (e.isConstant()) return e;
   if (e.isScaledAtom() && e.terms()[0].coeff == 1.0 && atoms_[e.terms()[0].atom].f1 < 0) return e;
+  return newTemp(e, hint);
+}
+
+Expr CodeBuilder::snapshot(const Expr& e, const std::string& hint) {
+  if (e.isConstant()) return e;
+  if (e.isScaledAtom() && atoms_[e.terms()[0].atom].temp) return e;  // a temporary is never overwritten
+  return newTemp(e, hint);
+}
+
+Expr CodeBuilder::newTemp(const Expr& e, const std::string& hint) {
   const std::string k = key(e);
   for (auto b = stack_.rbegin(); b != stack_.rend(); ++b) {
     auto it = blocks_[*b].memo.find(k);

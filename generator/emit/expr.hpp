@@ -120,6 +120,10 @@ class CodeBuilder {
   Expr mul(const Expr& a, const Expr& b);
   /// e as a plain atom: itself when it is one already, else a temporary.
   Expr temp(const Expr& e, const std::string& hint = "t");
+  /// e's current value in a temporary even when e is +-(a member) or a
+  /// product of members, so that it can be read after a store overwrites
+  /// them; e itself when it is a constant or a multiple of a temporary.
+  Expr snapshot(const Expr& e, const std::string& hint = "t");
   /// A temporary when e is more than coeff * atom (before use in many products).
   Expr flat(const Expr& e, const std::string& hint = "t") { return e.size() > 1 || (e.size() == 1 && !e.isScaledAtom()) ? temp(e, hint) : e; }
   Expr recip(const Expr& e, const std::string& hint = "inv");
@@ -228,6 +232,7 @@ class CodeBuilder {
   };
 
   int newAtom(Atom a);
+  Expr newTemp(const Expr& e, const std::string& hint);  // temp() and snapshot() after their checks
   int& current(int name);
   std::string key(const Expr& e) const;
   void collectUses(const Expr& e, std::vector<int>& uses) const;

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <vector>
 
 #include "emit/passes.hpp"
@@ -83,15 +84,12 @@ void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& wr
 }
 
 // The CRBA columns carried up the tree (column k: the composite force of a unit
-// acceleration of dof k, F = X^T ... Ic_k S_k) live in one of two 6 x nv
-// members by the depth of the body whose frame they are in, so carrying them
-// to the parent reads one and writes the other (in place, a column's entries
-// would overwrite each other when X permutes them).
-std::string columnSlot(Emit& e, int depth, int r, int k, bool loop) {
-  const std::string base = depth % 2 == 0 ? "Fcol0" : "Fcol1";
-  const std::string what = depth % 2 == 0 ? "CRBA columns in the frame of a body at even depth"
-                                          : "CRBA columns in the frame of a body at odd depth";
-  return loop ? e.ws.loopSlot(base, 6, e.plan.nv, r, k, what) : e.ws.member(base, 6, e.plan.nv, r, k, what);
+// acceleration of dof k, F = X^T ... Ic_k S_k), in one 6 x nv member, each
+// column in the frame of the body whose turn it is; carrying a column to the
+// parent overwrites it in place.
+std::string columnSlot(Emit& e, int r, int k, bool loop) {
+  const char* what = "CRBA columns, each in the frame of the body being visited";
+  return loop ? e.ws.loopSlot("Fcol", 6, e.plan.nv, r, k, what) : e.ws.member("Fcol", 6, e.plan.nv, r, k, what);
 }
 
 // M(row, k + j) for the j of a loop over columns k..k + len - 1, into both
@@ -111,9 +109,17 @@ void putMassColumns(Emit& e, JointSpace& js, std::vector<char>& written, int row
 
 // Column k0 (or, in a loop, columns k0 + j) of body i's subtree, F in i's frame:
 // F = X_i^T F into the parent's frame, M(parent's dofs, k) = S_p^T F, and F
-// kept for the grandparent (returned: the stored values, zero when not kept).
-V6 carryColumn(Emit& e, const Kinematics& kin, const std::vector<int>& depth, int i, int k0, int len, const V6& F,
-               JointSpace& js, std::vector<char>& written) {
+// kept in its slot for the grandparent. In place: an entry the transform
+// leaves as it was is not stored again (a rotation about x keeps two of the
+// six), and one that is a multiple of another entry or a product with one (X
+// permutes and scales them; flatten leaves those as they are) is read into a
+// temporary before any store can overwrite that entry.
+struct Carried {
+  V6 value = zero6();                   // the slots' values after the step (zero when not kept)
+  std::array<bool, 6> stored{};         // entries written by this step
+};
+Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, const V6& F, JointSpace& js,
+                    std::vector<char>& written) {
   CodeBuilder& cb = e.cb();
   const BodyPlan& p = e.bp(i);
   const BodyPlan& pp = e.bp(p.parent);
@@ -122,10 +128,20 @@ V6 carryColumn(Emit& e, const Kinematics& kin, const std::vector<int>& depth, in
   const Kinematics::Body& kp = kin.b[std::size_t(p.parent)];
   for (int r = 0; r < pp.nv; ++r)  // an ancestor's dofs come first: the upper triangle
     putMassColumns(e, js, written, pp.idx_v + r, k0, len, dot(cb, kp.S[std::size_t(r)], G));
-  V6 out = zero6();
-  if (pp.parent > 0)
-    for (int r = 0; r < 6; ++r)
-      out[std::size_t(r)] = e.put(columnSlot(e, depth[std::size_t(p.parent)], r, k0, len > 1), G[std::size_t(r)]);
+  Carried out;
+  if (pp.parent == 0) return out;  // the parent is a child of the world: nothing reads the column
+  const bool loop = len > 1;
+  std::array<bool, 6> unchanged{};
+  for (int r = 0; r < 6; ++r) {
+    Expr& g = G[std::size_t(r)];
+    unchanged[std::size_t(r)] = !g.isConstant() && cb.describe(g) == columnSlot(e, r, k0, loop);
+    if (!unchanged[std::size_t(r)] && g.isScaledAtom()) g = cb.snapshot(g, "F");
+  }
+  for (int r = 0; r < 6; ++r) {
+    const std::size_t u = std::size_t(r);
+    out.stored[u] = !unchanged[u] && !G[u].isConstant();
+    out.value[u] = out.stored[u] ? cb.store(columnSlot(e, r, k0, loop), G[u]) : G[u];
+  }
   return out;
 }
 
@@ -138,11 +154,8 @@ V6 carryColumn(Emit& e, const Kinematics& kin, const std::vector<int>& depth, in
 void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size()), nv = plan.nv;
-  // Depth below the world's children, and subtree dof ends (depth-first order
-  // makes a subtree's dofs contiguous).
-  std::vector<int> depth(std::size_t(N), 0), end(std::size_t(N), 0);
-  for (int i = 1; i < N; ++i)
-    if (e.bp(i).parent > 0) depth[std::size_t(i)] = depth[std::size_t(e.bp(i).parent)] + 1;
+  // Subtree dof ends (depth-first order makes a subtree's dofs contiguous).
+  std::vector<int> end(std::size_t(N), 0);
   for (int i = N - 1; i >= 1; --i) {
     const BodyPlan& p = e.bp(i);
     end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
@@ -167,7 +180,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
         putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
     if (p.parent > 0)
       for (int d = 0; d < p.nv; ++d)
-        cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, depth, i, p.idx_v + d, 1, F[std::size_t(d)], js, written);
+        cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, i, p.idx_v + d, 1, F[std::size_t(d)], js, written).value;
     if (p.parent > 0) {
       const Sym dI = e.inertiaToParent(kb, js.Ic[std::size_t(i)]);
       Sym& par = js.Ic[std::size_t(p.parent)];
@@ -186,14 +199,20 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
       openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', subtree columns to the parent,", i, p.ident));
       CodeBuilder& lb = e.cb();  // after openColumns: it may have started a new part
       const V6 in = len > 1 ? toV6(loopReads(lb, inputs(k0))) : cols[std::size_t(k0)];
-      const V6 out = carryColumn(e, kin, depth, i, k0, len, in, js, written);
+      const Carried out = carryColumn(e, kin, i, k0, len, in, js, written);
       lb.close();
-      // After a loop each column's slots hold new values: read them by their own names.
+      if (len == 1) {
+        cols[std::size_t(k0)] = out.value;
+        continue;
+      }
+      // After a loop the slots it wrote hold new values: read them by their own
+      // names; the others hold what they held (or the constant they all share).
       for (int k = k0; k < k0 + len; ++k)
-        for (int r = 0; r < 6; ++r)
-          cols[std::size_t(k)][std::size_t(r)] = len == 1 || out[std::size_t(r)].isConstant()
-                                                     ? out[std::size_t(r)]
-                                                     : lb.refresh(columnSlot(e, depth[std::size_t(p.parent)], r, k, false));
+        for (int r = 0; r < 6; ++r) {
+          Expr& c = cols[std::size_t(k)][std::size_t(r)];
+          if (out.stored[std::size_t(r)]) c = lb.refresh(columnSlot(e, r, k, false));
+          else if (out.value[std::size_t(r)].isConstant()) c = out.value[std::size_t(r)];
+        }
     }
   }
 }

@@ -95,6 +95,26 @@ TEST(Expr, StaleAndOutOfScopeValuesAreCaught) {
   EXPECT_THROW(cb.print(t), std::logic_error);
 }
 
+// A swap of two members in place (what a transform that permutes a column's
+// entries does): the entry read after the first store is snapshot() into a
+// temporary before it, so both stores read the old values; a product of
+// members is copied too, a multiple of a temporary is left as it is.
+TEST(Expr, SnapshotsKeepValuesAcrossStores) {
+  CodeBuilder cb(ScalarType::Double);
+  const Expr a = cb.member("w.f[0]"), b = cb.member("w.f[1]");
+  const Expr oldA = cb.snapshot(-1.0 * a, "s");
+  const Expr oldB = cb.snapshot(b, "s");
+  EXPECT_NE(cb.print(oldB), "w.f[1]");
+  cb.store("w.f[0]", oldB);
+  cb.store("w.f[1]", oldA);
+  EXPECT_EQ(cb.render(0), "const Scalar s0 = -w.f[0];\nconst Scalar s1 = w.f[1];\nw.f[0] = s1;\nw.f[1] = s0;\n");
+  EXPECT_THROW(cb.print(a), std::logic_error);  // without the snapshot: the new value
+  const Expr t = cb.temp(cb.mul(cb.input("x"), cb.input("y")), "t");
+  EXPECT_EQ(cb.print(cb.snapshot(2.0 * t)), "2.0*t0");
+  const Expr prod = cb.mul(cb.member("w.f[0]"), cb.member("w.f[1]"));
+  EXPECT_EQ(cb.print(cb.snapshot(prod, "p")), "p0");
+}
+
 TEST(Expr, FloatCodeHasOnlyFloatLiterals) {
   CodeBuilder cb(ScalarType::Float);
   const Expr x = cb.input("x");
