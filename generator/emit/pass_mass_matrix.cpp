@@ -110,13 +110,13 @@ void putMassColumns(Emit& e, JointSpace& js, std::vector<char>& written, int row
 // Column k0 (or, in a loop, columns k0 + j) of body i's subtree, F in i's frame:
 // F = X_i^T F into the parent's frame, M(parent's dofs, k) = S_p^T F, and F
 // kept in its slot for the grandparent. In place: an entry the transform
-// leaves as it was is not stored again (a rotation about x keeps two of the
-// six), and one that is a multiple of another entry or a product with one (X
+// leaves as it was is not stored again (a rotation about x can keep two of
+// the six), and one that is a multiple of another entry or a product with one (X
 // permutes and scales them; flatten leaves those as they are) is read into a
 // temporary before any store can overwrite that entry.
 struct Carried {
-  V6 value = zero6();                   // the slots' values after the step (zero when not kept)
-  std::array<bool, 6> stored{};         // entries written by this step
+  V6 value = zero6();            // the slots' values after the step (zero when not kept)
+  std::array<bool, 6> stored{};  // entries written by this step
 };
 Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, const V6& F, JointSpace& js,
                     std::vector<char>& written) {
