@@ -44,22 +44,21 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   SolverTexts texts;
   // A derivative function calls the functions it is made of: the file holds
   // them as well (`calls`). Its operations per call are its host's, the whole
-  // of `first` (the function that leaves the kinematics state of its (q, v) in
-  // the workspace) and the hosts it calls after it without their transforms
-  // and kinematics: mass_matrix_inverse's passes ("minv"), the tangent sweep
-  // of inverse_dynamics_derivatives ("rnead") and, for cdd, "bias".
+  // of calls.front() (the function that leaves the kinematics state of its
+  // (q, v) in the workspace) and the hosts it calls after it without their
+  // transforms and kinematics: mass_matrix_inverse's passes ("minv"), the
+  // tangent sweep of inverse_dynamics_derivatives ("rnead") and, for cdd, "bias".
   struct Composite {
     Function f;
     const char* host;
-    Function first;
     std::vector<Function> calls;
     std::vector<const char*> hosts;
   };
   const Composite composites[] = {
-      {Function::ForwardDynamicsDerivatives, "fdd", Function::NonlinearEffects,
+      {Function::ForwardDynamicsDerivatives, "fdd",
        {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
        {"minv", "rnead"}},
-      {Function::ConstrainedDynamicsDerivatives, "cdd", Function::ProxPv,
+      {Function::ConstrainedDynamicsDerivatives, "cdd",
        {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
        {"minv", "rnead", "bias"}}};
   FunctionSet want = sys.functions;
@@ -183,7 +182,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   for (const Composite& c : composites) {
     if (!want.has(c.f)) continue;
     OpCount ops = fn.hostOps(c.host);
-    ops += c.first == Function::ProxPv ? texts.pvOps : texts.libraryOps[c.first];
+    const Function first = c.calls.front();
+    ops += first == Function::ProxPv ? texts.pvOps : texts.libraryOps[first];
     for (const char* h : c.hosts) ops += fn.hostOps(h);
     texts.libraryOps[c.f] = ops;
   }

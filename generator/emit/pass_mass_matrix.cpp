@@ -178,10 +178,9 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
     for (int r = 0; r < p.nv; ++r)
       for (int c = r; c < p.nv; ++c)
         putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
-    if (p.parent > 0)
+    if (p.parent > 0) {
       for (int d = 0; d < p.nv; ++d)
         cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, i, p.idx_v + d, 1, F[std::size_t(d)], js, written).value;
-    if (p.parent > 0) {
       const Sym dI = e.inertiaToParent(kb, js.Ic[std::size_t(i)]);
       Sym& par = js.Ic[std::size_t(p.parent)];
       for (int k = 0; k < 21; ++k)

@@ -18,9 +18,7 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <functional>
-#include <regex>
 #include <utility>
 
 #include "emit/passes.hpp"
