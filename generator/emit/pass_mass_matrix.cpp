@@ -5,7 +5,8 @@
 // turn), so a body's descendants' columns are one loop. A leaf's Ic is its
 // own inertia, a constant, so its diagonal entry folds. Each entry is written
 // once, where it is computed, into both halves of the output M (no workspace
-// copy); the constant ones after the pass. Also the q-only joint
+// copy); the zeros between branches by one fill before the pass, the other
+// constant ones after it. Also the q-only joint
 // transforms (joint_transforms(q, w)) that the joint-space functions without a
 // velocity start from. The generic counterpart: algorithms/crba.cpp.
 #include <fmt/format.h>
@@ -53,28 +54,67 @@ void putMass(Emit& e, JointSpace& js, std::vector<char>& written, int r, int c, 
   written[std::size_t(Sym::index(nv, r, c))] = 1;
 }
 
-// The entries the pass left constant: runs of zeros as loops (a branch's
-// entries against another branch's: 70% of a humanoid's M), the others (a
-// leaf's own inertia, the base's mass) one by one. One fill of the whole
-// matrix before the pass was no faster and is a memset: `rep stosb` on
-// glibc, which callgrind counts by the byte (docs/benchmarks.md).
-void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& written) {
+// Per body, one past the last dof of its subtree (depth-first order makes a
+// subtree's dofs contiguous, from the body's own).
+std::vector<int> subtreeEnds(Emit& e) {
+  const int N = int(e.plan.bodies.size());
+  std::vector<int> end(std::size_t(N), 0);
+  for (int i = N - 1; i >= 1; --i) {
+    const BodyPlan& p = e.bp(i);
+    end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
+    if (p.parent > 0) end[std::size_t(p.parent)] = std::max(end[std::size_t(p.parent)], end[std::size_t(i)]);
+  }
+  return end;
+}
+
+// Whether the host zeroes all of M in one fill before the pass rather than
+// the runs of zeros after it. The zeros are the entries of two dofs on
+// different branches (neither body an ancestor of the other): 70 % of a
+// humanoid's M. GCC writes a loop over 16 or more of them as an inlined
+// `rep stosq`, whose start-up (some 25 cycles) dominates a run of a row's
+// length; the fill is one start-up and nv^2 8 bytes at some 32 bytes a cycle.
+// Talos: 94 runs, 0.77 of 3.1 us, against 0.1 us for the fill (the time
+// 0.78 of before); Solo's runs are short (stores, no `rep`) and a fill was
+// 1.06 of their time (docs/benchmarks.md).
+bool fillFirst(Emit& e, const std::vector<int>& end) {
+  const int nv = e.plan.nv;
+  std::vector<int> body(std::size_t(nv), 0);
+  for (int i = 1; i < int(e.plan.bodies.size()); ++i)
+    for (int d = 0; d < e.bp(i).nv; ++d) body[std::size_t(e.bp(i).idx_v + d)] = i;
+  auto zero = [&](int k) {
+    const int lo = std::min(k / nv, k % nv), hi = std::max(k / nv, k % nv);
+    return hi >= end[std::size_t(body[std::size_t(lo)])];
+  };
+  int longRuns = 0;
+  for (int k = 0; k < nv * nv;) {
+    int run = 0;
+    while (k < nv * nv && zero(k)) ++run, ++k;
+    if (run >= 16) ++longRuns;
+    if (run == 0) ++k;
+  }
+  return 25 * longRuns > 25 + nv * nv / 4;
+}
+
+// The entries the pass left constant and the fill did not set: a leaf's own
+// inertia, the base's mass, and without a fill the zeros, runs of them as loops.
+void finishMassMatrix(Emit& e, const JointSpace& js, const std::vector<char>& written, bool filled) {
   e.fn.endPart();
   CodeBuilder& cb = e.cb();
   const int nv = e.plan.nv;
-  auto constantAt = [&](int k) {
-    return !written[std::size_t(Sym::index(nv, std::min(k / nv, k % nv), std::max(k / nv, k % nv)))];
-  };
   auto value = [&](int k) { return js.upper(std::min(k / nv, k % nv), std::max(k / nv, k % nv)); };
+  auto pending = [&](int k) {
+    return !written[std::size_t(Sym::index(nv, std::min(k / nv, k % nv), std::max(k / nv, k % nv)))] &&
+           !(filled && value(k).isZero());
+  };
   for (int k = 0; k < nv * nv;) {
-    if (!constantAt(k)) {
+    if (!pending(k)) {
       ++k;
       continue;
     }
     const Expr x = value(k);
     int end = k + 1;
     if (x.isZero())
-      while (end < nv * nv && constantAt(end) && value(end).isZero()) ++end;
+      while (end < nv * nv && pending(end) && value(end).isZero()) ++end;
     if (end - k > 2)
       cb.line(fmt::format("for (int k = {}; k < {}; ++k) M[k] = {};", k, end, cb.print(x)), {}, {"M"});
     else
@@ -151,16 +191,10 @@ Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, cons
 // read their entries. A body's descendants' columns all go through the same
 // transform, so runs of them of one shape are one loop (column_loops.cpp):
 // the walk is O(n) code instead of O(n depth).
-void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
+void compositeInertias(Emit& e, const Kinematics& kin, const std::vector<int>& end, JointSpace& js,
+                       std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size()), nv = plan.nv;
-  // Subtree dof ends (depth-first order makes a subtree's dofs contiguous).
-  std::vector<int> end(std::size_t(N), 0);
-  for (int i = N - 1; i >= 1; --i) {
-    const BodyPlan& p = e.bp(i);
-    end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
-    if (p.parent > 0) end[std::size_t(p.parent)] = std::max(end[std::size_t(p.parent)], end[std::size_t(i)]);
-  }
   std::vector<V6>& cols = js.carried;
   cols.assign(std::size_t(nv), zero6());
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
@@ -226,10 +260,14 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
   e.fn.live().kin = &kin;
   e.fn.live().js = &js;
   e.fn.beginHost("crba", afterTransforms);
+  const std::vector<int> end = subtreeEnds(e);
+  const bool fill = fillFirst(e, end);
+  if (fill)
+    e.cb().line(fmt::format("for (int k = 0; k < {}; ++k) M[k] = Scalar(0);", e.plan.nv * e.plan.nv), {}, {"M"});
   e.cb().line("joint_transforms(q, w);", {}, {"q", "w"});
   std::vector<char> written(std::size_t(e.plan.nv * (e.plan.nv + 1) / 2), 0);
-  compositeInertias(e, kin, js, written);
-  finishMassMatrix(e, js, written);
+  compositeInertias(e, kin, end, js, written);
+  finishMassMatrix(e, js, written, fill);
   std::string text = e.fn.endHost({"q", "w", "M"});
   e.fn.live() = Live{};
   return text;
