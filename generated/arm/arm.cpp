@@ -1101,7 +1101,7 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq_wrist_1_link*pa3 + w.cq_wrist_1_link*pa4;
     w.pA_forearm_link[5] = w.pA_forearm_link[5] + tau[3] - 0.3922*t24;
     // columns 0 to 1
-    for (int j = 0; j < 2; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
       w.KSD_wrist_1_link[j] = w.Dinv_wrist_1_link*w.KA_wrist_1_link[5][j];
       const Scalar t25 = w.KA_wrist_1_link[0][j] - w.IA_wrist_1_link[5]*w.KSD_wrist_1_link[j];
       const Scalar t26 = w.KA_wrist_1_link[1][j] - w.IA_wrist_1_link[10]*w.KSD_wrist_1_link[j];
@@ -1250,7 +1250,7 @@ PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTR
     w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq_forearm_link*pa3 + w.cq_forearm_link*pa4;
     w.pA_upper_arm_link[5] = w.pA_upper_arm_link[5] + tau[2] - 0.425*t21;
     // columns 0 to 4
-    for (int j = 0; j < 5; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
       w.KSD_forearm_link[j] = w.Dinv_forearm_link*w.KA_forearm_link[5][j];
       const Scalar t22 = w.KA_forearm_link[0][j] - w.IA_forearm_link[5]*w.KSD_forearm_link[j];
       const Scalar t23 = w.KA_forearm_link[1][j] - w.IA_forearm_link[10]*w.KSD_forearm_link[j];
@@ -1357,7 +1357,7 @@ PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RES
     w.pA_shoulder_link[4] = -tau[1] + 0.1625*t20;
     w.pA_shoulder_link[5] = w.sq_upper_arm_link*pa3 + w.cq_upper_arm_link*pa4;
     // columns 0 to 4
-    for (int j = 0; j < 5; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
       w.KSD_upper_arm_link[j] = w.Dinv_upper_arm_link*w.KA_upper_arm_link[5][j];
       const Scalar t22 = w.KA_upper_arm_link[0][j] - w.IA_upper_arm_link[5]*w.KSD_upper_arm_link[j];
       const Scalar t23 = w.KA_upper_arm_link[1][j] - w.IA_upper_arm_link[10]*w.KSD_upper_arm_link[j];
@@ -1382,7 +1382,7 @@ PROXGEN_RT_NOINLINE void pv_backward_shoulder_link(const Scalar* PROXGEN_RT_REST
     w.Dinv_shoulder_link = 1.0 / w.IA_shoulder_link[20];
     w.u_shoulder_link[0] = -w.pA_shoulder_link[5] + tau[0];
     // columns 0 to 4
-    for (int j = 0; j < 5; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
       w.KSD_shoulder_link[j] = w.Dinv_shoulder_link*w.KA_shoulder_link[5][j];
     }
   }

@@ -5208,7 +5208,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRI
     w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
     w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + tau[31];
     // columns 0 to 2
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_r_upper_arm[j] = w.Dinv_r_upper_arm*w.KA_r_upper_arm[5][j];
       const Scalar t7 = w.KA_r_upper_arm[0][j] - w.IA_r_upper_arm[5]*w.KSD_r_upper_arm[j];
       const Scalar t8 = w.KA_r_upper_arm[1][j] - w.IA_r_upper_arm[10]*w.KSD_r_upper_arm[j];
@@ -5281,7 +5281,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
     w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa3 - w.sq_r_shoulder_roll_link*pa4;
     w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa3 + w.cq_r_shoulder_roll_link*pa4;
     // columns 0 to 2
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_r_shoulder_roll_link[j] = w.Dinv_r_shoulder_roll_link*w.KA_r_shoulder_roll_link[3][j];
       const Scalar t5 = w.KA_r_shoulder_roll_link[0][j] - w.IA_r_shoulder_roll_link[3]*w.KSD_r_shoulder_roll_link[j];
       const Scalar t6 = w.KA_r_shoulder_roll_link[1][j] - w.IA_r_shoulder_roll_link[8]*w.KSD_r_shoulder_roll_link[j];
@@ -5408,7 +5408,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
     w.pA_chest[4] = w.pA_chest[4] + 0.9659256678396477*tau[29] + 0.2588196364430848*t50 + 0.254*t51;
     w.pA_chest[5] = w.pA_chest[5] - 0.2548890642384102*tau[29] + 0.17361575258114187*t49 + 0.9512566085906322*t50 + 0.19*t51;
     // columns 0 to 2
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_r_shoulder_pitch_link[j] = w.Dinv_r_shoulder_pitch_link*w.KA_r_shoulder_pitch_link[4][j];
       const Scalar t54 = w.KA_r_shoulder_pitch_link[0][j] - w.IA_r_shoulder_pitch_link[4]*w.KSD_r_shoulder_pitch_link[j];
       const Scalar t55 = w.KA_r_shoulder_pitch_link[1][j] - w.IA_r_shoulder_pitch_link[9]*w.KSD_r_shoulder_pitch_link[j];
@@ -5519,7 +5519,7 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
     w.pA_abdomen[4] = w.pA_abdomen[4] + tau[19] + 0.15*t20;
     w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq_chest*pa3 + w.cq_chest*pa4;
     // columns 0 to 2
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_chest[j] = w.Dinv_chest*w.KA_chest[4][j];
       const Scalar t22 = w.KA_chest[0][j] - w.IA_chest[4]*w.KSD_chest[j];
       const Scalar t23 = w.KA_chest[1][j] - w.IA_chest[9]*w.KSD_chest[j];
@@ -5623,7 +5623,7 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq_abdomen*pa3 + w.cq_abdomen*pa4 + 0.1*t23;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[18];
     // columns 0 to 2
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_abdomen[j] = w.Dinv_abdomen*w.KA_abdomen[5][j];
       const Scalar t25 = w.KA_abdomen[0][j] - w.IA_abdomen[5]*w.KSD_abdomen[j];
       const Scalar t26 = w.KA_abdomen[1][j] - w.IA_abdomen[10]*w.KSD_abdomen[j];
@@ -5975,7 +5975,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_r_thigh[4] = w.pA_r_thigh[4] + tau[15] - 0.42875*t42;
     w.pA_r_thigh[5] = w.pA_r_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
     // columns 0 to 1
-    for (int j = 0; j < 2; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
       w.KSD_r_shank[j] = w.Dinv_r_shank*w.KA_r_shank[4][j];
       const Scalar t44 = w.KA_r_shank[0][j] - w.IA_r_shank[4]*w.KSD_r_shank[j];
       const Scalar t45 = w.KA_r_shank[1][j] - w.IA_r_shank[9]*w.KSD_r_shank[j];
@@ -6014,7 +6014,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT t
     w.KA_r_thigh[4][2] = -0.42875*t64;
     w.KA_r_thigh[5][2] = -0.19866933079506124*t62 + 0.9800665778412416*t63;
     // columns 3 to 5
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_r_shank[3 + j] = w.Dinv_r_shank*w.KA_r_shank[4][3 + j];
       const Scalar t66 = w.KA_r_shank[0][3 + j] - w.IA_r_shank[4]*w.KSD_r_shank[3 + j];
       const Scalar t67 = w.KA_r_shank[1][3 + j] - w.IA_r_shank[9]*w.KSD_r_shank[3 + j];
@@ -6125,7 +6125,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_r_hip_roll_link[4] = w.pA_r_hip_roll_link[4] + tau[14];
     w.pA_r_hip_roll_link[5] = w.pA_r_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_r_thigh[j] = w.Dinv_r_thigh*w.KA_r_thigh[4][j];
       const Scalar t29 = w.KA_r_thigh[0][j] - w.IA_r_thigh[4]*w.KSD_r_thigh[j];
       const Scalar t30 = w.KA_r_thigh[1][j] - w.IA_r_thigh[9]*w.KSD_r_thigh[j];
@@ -6202,7 +6202,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RE
     w.pA_r_hip_yaw_link[4] = w.pA_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*pa3 - w.sq_r_hip_roll_link*pa4;
     w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa3 + w.cq_r_hip_roll_link*pa4;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_r_hip_roll_link[j] = w.Dinv_r_hip_roll_link*w.KA_r_hip_roll_link[3][j];
       const Scalar t5 = w.KA_r_hip_roll_link[0][j] - w.IA_r_hip_roll_link[3]*w.KSD_r_hip_roll_link[j];
       const Scalar t6 = w.KA_r_hip_roll_link[1][j] - w.IA_r_hip_roll_link[8]*w.KSD_r_hip_roll_link[j];
@@ -6313,7 +6313,7 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     w.pA_pelvis[4] = w.pA_pelvis[4] - 0.08718915247898762*t36 + 0.9961917745544759*t37;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[12] + 0.0875*t38;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_r_hip_yaw_link[j] = w.Dinv_r_hip_yaw_link*w.KA_r_hip_yaw_link[5][j];
       const Scalar t40 = w.KA_r_hip_yaw_link[0][j] - w.IA_r_hip_yaw_link[5]*w.KSD_r_hip_yaw_link[j];
       const Scalar t41 = w.KA_r_hip_yaw_link[1][j] - w.IA_r_hip_yaw_link[10]*w.KSD_r_hip_yaw_link[j];
@@ -6668,7 +6668,7 @@ PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_l_thigh[4] = w.pA_l_thigh[4] + tau[9] - 0.42875*t42;
     w.pA_l_thigh[5] = w.pA_l_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
     // columns 0 to 1
-    for (int j = 0; j < 2; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
       w.KSD_l_shank[j] = w.Dinv_l_shank*w.KA_l_shank[4][j];
       const Scalar t44 = w.KA_l_shank[0][j] - w.IA_l_shank[4]*w.KSD_l_shank[j];
       const Scalar t45 = w.KA_l_shank[1][j] - w.IA_l_shank[9]*w.KSD_l_shank[j];
@@ -6707,7 +6707,7 @@ PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT t
     w.KA_l_thigh[4][2] = -0.42875*t64;
     w.KA_l_thigh[5][2] = -0.19866933079506124*t62 + 0.9800665778412416*t63;
     // columns 3 to 5
-    for (int j = 0; j < 3; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_l_shank[3 + j] = w.Dinv_l_shank*w.KA_l_shank[4][3 + j];
       const Scalar t66 = w.KA_l_shank[0][3 + j] - w.IA_l_shank[4]*w.KSD_l_shank[3 + j];
       const Scalar t67 = w.KA_l_shank[1][3 + j] - w.IA_l_shank[9]*w.KSD_l_shank[3 + j];
@@ -6818,7 +6818,7 @@ PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_l_hip_roll_link[4] = w.pA_l_hip_roll_link[4] + tau[8];
     w.pA_l_hip_roll_link[5] = w.pA_l_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_l_thigh[j] = w.Dinv_l_thigh*w.KA_l_thigh[4][j];
       const Scalar t29 = w.KA_l_thigh[0][j] - w.IA_l_thigh[4]*w.KSD_l_thigh[j];
       const Scalar t30 = w.KA_l_thigh[1][j] - w.IA_l_thigh[9]*w.KSD_l_thigh[j];
@@ -6895,7 +6895,7 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RE
     w.pA_l_hip_yaw_link[4] = w.pA_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*pa3 - w.sq_l_hip_roll_link*pa4;
     w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa3 + w.cq_l_hip_roll_link*pa4;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_l_hip_roll_link[j] = w.Dinv_l_hip_roll_link*w.KA_l_hip_roll_link[3][j];
       const Scalar t5 = w.KA_l_hip_roll_link[0][j] - w.IA_l_hip_roll_link[3]*w.KSD_l_hip_roll_link[j];
       const Scalar t6 = w.KA_l_hip_roll_link[1][j] - w.IA_l_hip_roll_link[8]*w.KSD_l_hip_roll_link[j];
@@ -7006,7 +7006,7 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t36 + 0.9961917745544759*t37;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[6] - 0.0875*t38;
     // columns 0 to 5
-    for (int j = 0; j < 6; ++j) {
+    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_l_hip_yaw_link[j] = w.Dinv_l_hip_yaw_link*w.KA_l_hip_yaw_link[5][j];
       const Scalar t40 = w.KA_l_hip_yaw_link[0][j] - w.IA_l_hip_yaw_link[5]*w.KSD_l_hip_yaw_link[j];
       const Scalar t41 = w.KA_l_hip_yaw_link[1][j] - w.IA_l_hip_yaw_link[10]*w.KSD_l_hip_yaw_link[j];

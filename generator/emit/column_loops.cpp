@@ -28,8 +28,8 @@ std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const st
 
 void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label) {
   e.fn.boundary(fmt::format("{}_c{}", ident, k0));
-  if (len > 1)
-    e.cb().open(fmt::format("for (int j = 0; j < {}; ++j) {{", len),
+  if (len > 1)  // kept a loop by the compiler too (runtime.hpp, PROXGEN_RT_NO_UNROLL)
+    e.cb().open(fmt::format("PROXGEN_RT_NO_UNROLL for (int j = 0; j < {}; ++j) {{", len),
                 {fmt::format("{} columns {} to {}", label, k0, k0 + len - 1)});
   else
     e.cb().open("{", {fmt::format("{} column {}", label, k0)});

@@ -472,10 +472,12 @@ void CodeBuilder::open(const std::string& head, const std::vector<std::string>& 
   b.head = head;
   b.names = names;
   b.comments = comments;
-  if (head.rfind("for", 0) == 0) {
+  if (head.rfind("for", 0) == 0 || head.rfind("PROXGEN_RT_NO_UNROLL for", 0) == 0) {
     // The trip count, for opCount(): the passes print loops of one shape,
-    // for (int k = A; k < N; ++k) or k <= N, N a literal or s.iterations (K).
-    static const std::regex loop(R"(for \(int (\w+) = (-?\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{)");
+    // for (int k = A; k < N; ++k) or k <= N, N a literal or s.iterations (K),
+    // the column loops after the runtime's pragma that keeps them loops.
+    static const std::regex loop(
+        R"((?:PROXGEN_RT_NO_UNROLL )?for \(int (\w+) = (-?\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{)");
     std::smatch m;
     if (!std::regex_match(head, m, loop)) throw std::logic_error("emitter: no trip count for the loop " + head);
     const long from = std::stol(m[2].str()), inclusive = m[3].str() == "<=" ? 1 : 0;

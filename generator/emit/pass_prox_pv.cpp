@@ -105,7 +105,9 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
     if (len >= kLoopColumns) {
       // Columns c0 .. c0 + len - 1 go through identical arithmetic: one loop
       // (vectorised by the compiler) instead of len copies of the code.
-      cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
+      // Not unrolled by the compiler either (runtime.hpp, PROXGEN_RT_NO_UNROLL).
+      cb.open(fmt::format("PROXGEN_RT_NO_UNROLL for (int j = 0; j < {}; ++j) {{", len),
+              {fmt::format("columns {} to {}", c0, c0 + len - 1)});
       V6 ka;
       for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
       const auto out = column(ka, [&](const Quantity& qy) { return e.loopSlot(qy, i, m, c0); });

@@ -151,12 +151,14 @@ Poly countLine(Source& src, const std::string& line) {
 }
 
 // A function body: blocks nest by their braces; `for (int k = A; k < N; ++k) {`
-// (or <=) multiplies its body by N - A (+1), N a literal or s.iterations = K;
+// (or <=; after PROXGEN_RT_NO_UNROLL, the column loops) multiplies its body by
+// N - A (+1), N a literal or s.iterations = K;
 // `for (int k = A; k < N; ++k) statement;` (mass_matrix's runs of zeros)
 // multiplies the statement by N - A.
 Poly count(Source& src, const std::string& fn) {
   if (src.memo.count(fn)) return src.memo[fn];
-  static const std::regex loop(R"(^for \(int (\w+) = (\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{$)");
+  static const std::regex loop(
+      R"(^(?:PROXGEN_RT_NO_UNROLL )?for \(int (\w+) = (\d+); \1 (<=?) (\d+|s\.iterations); \+\+\1\) \{$)");
   static const std::regex oneLine(R"(^for \(int k = (\d+); k < (\d+); \+\+k\) ([^{}]+;)$)");
   struct Frame {
     Poly p;
@@ -185,7 +187,7 @@ Poly count(Source& src, const std::string& fn) {
     if (line.back() == '{') {
       Frame f;
       std::smatch m;
-      if (line.rfind("for", 0) == 0) {
+      if (line.rfind("for", 0) == 0 || line.rfind("PROXGEN_RT_NO_UNROLL", 0) == 0) {
         if (!std::regex_match(line, m, loop)) {
           ADD_FAILURE() << "a loop the count cannot read: " << line;
         } else {
