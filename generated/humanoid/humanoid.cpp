@@ -68,7 +68,7 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
   }
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos(q[7], w.sq_l_hip_yaw_link, w.cq_l_hip_yaw_link);
+    proxgen_rt::sincos_noinline(q[7], w.sq_l_hip_yaw_link, w.cq_l_hip_yaw_link);
     const Scalar t1 = v[0] - 0.0875*v[5];
     const Scalar t2 = v[2] + 0.0875*v[3];
     const Scalar t3 = 0.08718915247898762*v[1] + 0.9961917745544759*t1;
@@ -105,7 +105,7 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
 PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
-    proxgen_rt::sincos(q[8], w.sq_l_hip_roll_link, w.cq_l_hip_roll_link);
+    proxgen_rt::sincos_noinline(q[8], w.sq_l_hip_roll_link, w.cq_l_hip_roll_link);
     w.v_l_hip_roll_link[1] = w.v_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
     w.v_l_hip_roll_link[2] = -w.v_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
     w.v_l_hip_roll_link[3] = w.v_l_hip_yaw_link[3] + v[7];
@@ -130,7 +130,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PRO
   }
   // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
   {
-    proxgen_rt::sincos(q[9], w.sq_l_thigh, w.cq_l_thigh);
+    proxgen_rt::sincos_noinline(q[9], w.sq_l_thigh, w.cq_l_thigh);
     const Scalar t0 = 0.9950041652780258*w.v_l_hip_yaw_link[0] + 0.09983341664682815*w.v_l_hip_roll_link[2];
     const Scalar t1 = -0.09983341664682815*w.v_l_hip_yaw_link[0] + 0.9950041652780258*w.v_l_hip_roll_link[2];
     const Scalar t2 = 0.9950041652780258*w.v_l_hip_roll_link[3] + 0.09983341664682815*w.v_l_hip_roll_link[5];
@@ -164,7 +164,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PRO
 PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
   {
-    proxgen_rt::sincos(q[10], w.sq_l_shank, w.cq_l_shank);
+    proxgen_rt::sincos_noinline(q[10], w.sq_l_shank, w.cq_l_shank);
     const Scalar t0 = w.v_l_thigh[0] - 0.42875*w.v_l_thigh[4];
     const Scalar t1 = w.v_l_hip_roll_link[1] + 0.42875*w.v_l_thigh[3];
     const Scalar t2 = -0.19866933079506124*w.v_l_thigh[2] + 0.9800665778412416*t0;
@@ -198,7 +198,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGE
   }
   // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
-    proxgen_rt::sincos(q[11], w.sq_l_ankle_link, w.cq_l_ankle_link);
+    proxgen_rt::sincos_noinline(q[11], w.sq_l_ankle_link, w.cq_l_ankle_link);
     const Scalar t8 = w.v_l_shank[0] - 0.4305*w.v_l_shank[4];
     const Scalar t9 = w.v_l_shank[1] + 0.4305*w.v_l_shank[3];
     const Scalar t10 = 0.09983341664682815*w.v_l_shank[2] + 0.9950041652780258*t8;
@@ -228,7 +228,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGE
 PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
   {
-    proxgen_rt::sincos(q[12], w.sq_l_foot, w.cq_l_foot);
+    proxgen_rt::sincos_noinline(q[12], w.sq_l_foot, w.cq_l_foot);
     w.v_l_foot[1] = w.v_l_ankle_link[1]*w.cq_l_foot + w.v_l_ankle_link[2]*w.sq_l_foot;
     w.v_l_foot[2] = -w.v_l_ankle_link[1]*w.sq_l_foot + w.v_l_ankle_link[2]*w.cq_l_foot;
     w.v_l_foot[3] = w.v_l_ankle_link[3] + v[11];
@@ -256,7 +256,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
   }
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
+    proxgen_rt::sincos_noinline(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
     const Scalar t0 = v[0] + 0.0875*v[5];
     const Scalar t1 = v[2] - 0.0875*v[3];
     const Scalar t2 = -0.08718915247898762*v[1] + 0.9961917745544759*t0;
@@ -293,7 +293,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
 PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   {
-    proxgen_rt::sincos(q[14], w.sq_r_hip_roll_link, w.cq_r_hip_roll_link);
+    proxgen_rt::sincos_noinline(q[14], w.sq_r_hip_roll_link, w.cq_r_hip_roll_link);
     w.v_r_hip_roll_link[1] = w.v_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
     w.v_r_hip_roll_link[2] = -w.v_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
     w.v_r_hip_roll_link[3] = w.v_r_hip_yaw_link[3] + v[13];
@@ -318,7 +318,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PRO
   }
   // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
   {
-    proxgen_rt::sincos(q[15], w.sq_r_thigh, w.cq_r_thigh);
+    proxgen_rt::sincos_noinline(q[15], w.sq_r_thigh, w.cq_r_thigh);
     const Scalar t0 = 0.9950041652780258*w.v_r_hip_yaw_link[0] + 0.09983341664682815*w.v_r_hip_roll_link[2];
     const Scalar t1 = -0.09983341664682815*w.v_r_hip_yaw_link[0] + 0.9950041652780258*w.v_r_hip_roll_link[2];
     const Scalar t2 = 0.9950041652780258*w.v_r_hip_roll_link[3] + 0.09983341664682815*w.v_r_hip_roll_link[5];
@@ -352,7 +352,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PRO
 PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
-    proxgen_rt::sincos(q[16], w.sq_r_shank, w.cq_r_shank);
+    proxgen_rt::sincos_noinline(q[16], w.sq_r_shank, w.cq_r_shank);
     const Scalar t0 = w.v_r_thigh[0] - 0.42875*w.v_r_thigh[4];
     const Scalar t1 = w.v_r_hip_roll_link[1] + 0.42875*w.v_r_thigh[3];
     const Scalar t2 = -0.19866933079506124*w.v_r_thigh[2] + 0.9800665778412416*t0;
@@ -386,7 +386,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGE
   }
   // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
   {
-    proxgen_rt::sincos(q[17], w.sq_r_ankle_link, w.cq_r_ankle_link);
+    proxgen_rt::sincos_noinline(q[17], w.sq_r_ankle_link, w.cq_r_ankle_link);
     const Scalar t8 = w.v_r_shank[0] - 0.4305*w.v_r_shank[4];
     const Scalar t9 = w.v_r_shank[1] + 0.4305*w.v_r_shank[3];
     const Scalar t10 = 0.09983341664682815*w.v_r_shank[2] + 0.9950041652780258*t8;
@@ -416,7 +416,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGE
 PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
   {
-    proxgen_rt::sincos(q[18], w.sq_r_foot, w.cq_r_foot);
+    proxgen_rt::sincos_noinline(q[18], w.sq_r_foot, w.cq_r_foot);
     w.v_r_foot[1] = w.v_r_ankle_link[1]*w.cq_r_foot + w.v_r_ankle_link[2]*w.sq_r_foot;
     w.v_r_foot[2] = -w.v_r_ankle_link[1]*w.sq_r_foot + w.v_r_ankle_link[2]*w.cq_r_foot;
     w.v_r_foot[3] = w.v_r_ankle_link[3] + v[17];
@@ -444,7 +444,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
   }
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos(q[19], w.sq_abdomen, w.cq_abdomen);
+    proxgen_rt::sincos_noinline(q[19], w.sq_abdomen, w.cq_abdomen);
     const Scalar t0 = v[0] + 0.1*v[4];
     const Scalar t1 = v[1] - 0.1*v[3];
     w.v_abdomen[0] = w.cq_abdomen*t0 + w.sq_abdomen*t1;
@@ -474,7 +474,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    proxgen_rt::sincos(q[20], w.sq_chest, w.cq_chest);
+    proxgen_rt::sincos_noinline(q[20], w.sq_chest, w.cq_chest);
     const Scalar t0 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
     const Scalar t1 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
     w.v_chest[0] = w.cq_chest*t0 - v[2]*w.sq_chest;
@@ -502,7 +502,7 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
   }
   // body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
-    proxgen_rt::sincos(q[21], w.sq_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link);
+    proxgen_rt::sincos_noinline(q[21], w.sq_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link);
     const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
     const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
@@ -538,7 +538,7 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
 PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
-    proxgen_rt::sincos(q[22], w.sq_l_shoulder_roll_link, w.cq_l_shoulder_roll_link);
+    proxgen_rt::sincos_noinline(q[22], w.sq_l_shoulder_roll_link, w.cq_l_shoulder_roll_link);
     w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.sq_l_shoulder_roll_link;
     w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.cq_l_shoulder_roll_link;
     w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
@@ -561,7 +561,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
   }
   // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    proxgen_rt::sincos(q[23], w.sq_l_upper_arm, w.cq_l_upper_arm);
+    proxgen_rt::sincos_noinline(q[23], w.sq_l_upper_arm, w.cq_l_upper_arm);
     w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.sq_l_upper_arm;
     w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.cq_l_upper_arm;
     w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[4]*w.sq_l_upper_arm;
@@ -587,7 +587,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
 PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
-    proxgen_rt::sincos(q[24], w.sq_l_forearm, w.cq_l_forearm);
+    proxgen_rt::sincos_noinline(q[24], w.sq_l_forearm, w.cq_l_forearm);
     const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
     const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -617,7 +617,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* 
   }
   // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
   {
-    proxgen_rt::sincos(q[25], w.sq_l_wrist_yaw_link, w.cq_l_wrist_yaw_link);
+    proxgen_rt::sincos_noinline(q[25], w.sq_l_wrist_yaw_link, w.cq_l_wrist_yaw_link);
     const Scalar t6 = w.v_l_forearm[0] - 0.2555*w.v_l_forearm[4];
     const Scalar t7 = w.v_l_forearm[1] + 0.2555*w.v_l_forearm[3];
     w.v_l_wrist_yaw_link[0] = w.cq_l_wrist_yaw_link*t6 + w.sq_l_wrist_yaw_link*t7;
@@ -645,7 +645,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* 
 PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    proxgen_rt::sincos(q[26], w.sq_l_wrist_pitch_link, w.cq_l_wrist_pitch_link);
+    proxgen_rt::sincos_noinline(q[26], w.sq_l_wrist_pitch_link, w.cq_l_wrist_pitch_link);
     w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq_l_wrist_pitch_link - w.v_l_forearm[2]*w.sq_l_wrist_pitch_link;
     w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq_l_wrist_pitch_link + w.v_l_forearm[2]*w.cq_l_wrist_pitch_link;
     w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq_l_wrist_pitch_link - w.v_l_wrist_yaw_link[5]*w.sq_l_wrist_pitch_link;
@@ -668,7 +668,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
   }
   // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    proxgen_rt::sincos(q[27], w.sq_l_hand, w.cq_l_hand);
+    proxgen_rt::sincos_noinline(q[27], w.sq_l_hand, w.cq_l_hand);
     w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq_l_hand + w.v_l_wrist_pitch_link[2]*w.sq_l_hand;
     w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq_l_hand + w.v_l_wrist_pitch_link[2]*w.cq_l_hand;
     w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
@@ -694,7 +694,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
 PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
-    proxgen_rt::sincos(q[28], w.sq_neck_link, w.cq_neck_link);
+    proxgen_rt::sincos_noinline(q[28], w.sq_neck_link, w.cq_neck_link);
     const Scalar t0 = w.v_chest[0] + 0.29*w.v_chest[4];
     const Scalar t1 = w.v_chest[1] - 0.29*w.v_chest[3];
     w.v_neck_link[0] = w.cq_neck_link*t0 + w.sq_neck_link*t1;
@@ -719,7 +719,7 @@ PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_R
   }
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    proxgen_rt::sincos(q[29], w.sq_head, w.cq_head);
+    proxgen_rt::sincos_noinline(q[29], w.sq_head, w.cq_head);
     const Scalar t2 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
     const Scalar t3 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
     w.v_head[0] = w.cq_head*t2 - w.v_chest[2]*w.sq_head;
@@ -748,7 +748,7 @@ PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    proxgen_rt::sincos(q[30], w.sq_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link);
+    proxgen_rt::sincos_noinline(q[30], w.sq_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link);
     const Scalar t0 = w.v_chest[0] + 0.254*w.v_chest[4] + 0.19*w.v_chest[5];
     const Scalar t1 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t2 = w.v_chest[2] - 0.19*w.v_chest[3];
@@ -787,7 +787,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
   }
   // body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    proxgen_rt::sincos(q[31], w.sq_r_shoulder_roll_link, w.cq_r_shoulder_roll_link);
+    proxgen_rt::sincos_noinline(q[31], w.sq_r_shoulder_roll_link, w.cq_r_shoulder_roll_link);
     w.v_r_shoulder_roll_link[1] = w.v_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
     w.v_r_shoulder_roll_link[2] = -w.v_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
     w.v_r_shoulder_roll_link[3] = w.v_r_shoulder_pitch_link[3] + v[30];
@@ -815,7 +815,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
 PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    proxgen_rt::sincos(q[32], w.sq_r_upper_arm, w.cq_r_upper_arm);
+    proxgen_rt::sincos_noinline(q[32], w.sq_r_upper_arm, w.cq_r_upper_arm);
     w.v_r_upper_arm[0] = w.v_r_shoulder_pitch_link[0]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
     w.v_r_upper_arm[1] = -w.v_r_shoulder_pitch_link[0]*w.sq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
     w.v_r_upper_arm[3] = w.v_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
@@ -840,7 +840,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
   }
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    proxgen_rt::sincos(q[33], w.sq_r_forearm, w.cq_r_forearm);
+    proxgen_rt::sincos_noinline(q[33], w.sq_r_forearm, w.cq_r_forearm);
     const Scalar t0 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
     const Scalar t1 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -877,7 +877,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
 PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    proxgen_rt::sincos(q[34], w.sq_r_wrist_yaw_link, w.cq_r_wrist_yaw_link);
+    proxgen_rt::sincos_noinline(q[34], w.sq_r_wrist_yaw_link, w.cq_r_wrist_yaw_link);
     const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
     const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
     w.v_r_wrist_yaw_link[0] = w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
@@ -904,7 +904,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
   }
   // body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    proxgen_rt::sincos(q[35], w.sq_r_wrist_pitch_link, w.cq_r_wrist_pitch_link);
+    proxgen_rt::sincos_noinline(q[35], w.sq_r_wrist_pitch_link, w.cq_r_wrist_pitch_link);
     w.v_r_wrist_pitch_link[0] = w.v_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.v_r_forearm[2]*w.sq_r_wrist_pitch_link;
     w.v_r_wrist_pitch_link[2] = w.v_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.v_r_forearm[2]*w.cq_r_wrist_pitch_link;
     w.v_r_wrist_pitch_link[3] = w.v_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.v_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
@@ -932,7 +932,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
 PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    proxgen_rt::sincos(q[36], w.sq_r_hand, w.cq_r_hand);
+    proxgen_rt::sincos_noinline(q[36], w.sq_r_hand, w.cq_r_hand);
     w.v_r_hand[1] = w.v_r_wrist_yaw_link[1]*w.cq_r_hand + w.v_r_wrist_pitch_link[2]*w.sq_r_hand;
     w.v_r_hand[2] = -w.v_r_wrist_yaw_link[1]*w.sq_r_hand + w.v_r_wrist_pitch_link[2]*w.cq_r_hand;
     w.v_r_hand[3] = w.v_r_wrist_pitch_link[3] + v[35];

@@ -132,6 +132,28 @@ inline void sincos<double>(double x, double& s, double& c) noexcept {
   c = v[(k + 1) & 1] * sign[((k + 1) & 2) >> 1];
 }
 
+/// sincos called rather than inlined, for the generated code of a robot with
+/// many revolute joints: one copy of the kernel instead of one per joint (17 %
+/// less code on Talos), where the code's size costs more than the call
+/// (docs/benchmarks.md, "sincos called on the larger robots"). The pair comes
+/// back by value, in two registers on the common ABIs, not through memory.
+template <class S>
+struct SinCos {
+  S s, c;
+};
+template <class S>
+PROXGEN_RT_NOINLINE SinCos<S> sincos_pair(S x) noexcept {
+  SinCos<S> r;
+  sincos(x, r.s, r.c);
+  return r;
+}
+template <class S>
+inline void sincos_noinline(S x, S& s, S& c) noexcept {
+  const SinCos<S> r = sincos_pair(x);
+  s = r.s;
+  c = r.c;
+}
+
 /// Angle and unit axis of a rotation matrix R (row-major), as Eigen's
 /// AngleAxis(Quaternion(R)) computes them: the quaternion by Shepperd's method
 /// (largest diagonal pivot), then angle = 2 atan2(|vec|, |w|) in [0, pi].

@@ -4,8 +4,10 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "proxgen/runtime.hpp"
 
@@ -85,6 +87,31 @@ TEST(Runtime, SinCosExactValuesAndTheFallback) {
     proxgen_rt::sincos(x, s, c);
     EXPECT_TRUE(std::isnan(s) && std::isnan(c)) << x;
   }
+}
+
+// The called form (the generated code of the larger robots calls it,
+// pass_kinematics.cpp) is the inline one bit for bit: the same kernel, its
+// pair returned by value. Angles over the joint range, the quadrant
+// boundaries, the fallback past 1e5, NaN; double and float.
+template <class S>
+void expectCalledIsInline(const std::vector<S>& xs) {
+  for (S x : xs) {
+    S s = 0, c = 0, sc = 0, cc = 0;
+    proxgen_rt::sincos(x, s, c);
+    proxgen_rt::sincos_noinline(x, sc, cc);
+    EXPECT_EQ(std::memcmp(&s, &sc, sizeof(S)), 0) << x;
+    EXPECT_EQ(std::memcmp(&c, &cc, sizeof(S)), 0) << x;
+  }
+}
+
+TEST(Runtime, SinCosCalledIsTheInlineOne) {
+  std::vector<double> xs = {0.0, -0.0, 1e-300, 3e5, -1e9, std::numeric_limits<double>::quiet_NaN()};
+  for (int k = -8; k <= 8; ++k) xs.push_back(k * 0.7853981633974483);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-10, 10);
+  for (int i = 0; i < 1000; ++i) xs.push_back(u(rng));
+  expectCalledIsInline(xs);
+  expectCalledIsInline(std::vector<float>{0.3f, -2.5f, 1000.0f, 1e6f});
 }
 
 TEST(Runtime, SinCosOfFloatIsTheCLibrarys) {
