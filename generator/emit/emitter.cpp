@@ -67,8 +67,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
       for (Function f : c.calls) want.add(f);
   texts.functions = want;
   const bool solvers = want.has(Function::ConstrainedAba) || want.has(Function::ProxPv);
-  texts.withKinematics = solvers || want.has(Function::InverseDynamics) || want.has(Function::NonlinearEffects) ||
-                         want.has(Function::ConstraintDrift) || want.has(Function::InverseDynamicsDerivatives);
+  // (inverse_dynamics has its own forward sweep: pass_inverse_dynamics.cpp.)
+  texts.withKinematics = solvers || want.has(Function::NonlinearEffects) || want.has(Function::ConstraintDrift) ||
+                         want.has(Function::InverseDynamicsDerivatives);
   texts.withJointTransforms = want.has(Function::MassMatrix) || want.has(Function::MassMatrixInverse);
 
   // kinematics(q, v, w): shared by the entry points with a velocity.
@@ -161,8 +162,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   const struct {
     Function f;
     const char* host;
-    const char* helper;
-  } library[] = {{Function::InverseDynamics, "rnea", "kinematics"},
+    const char* helper;  // the helper it calls, or none
+  } library[] = {{Function::InverseDynamics, "rnea", nullptr},  // its own forward sweep
                  {Function::NonlinearEffects, "nle", "kinematics"},
                  {Function::MassMatrix, "crba", "joint_transforms"},
                  {Function::MassMatrixInverse, "minv", "joint_transforms"},
@@ -175,7 +176,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
                  {Function::InverseDynamicsDerivatives, "rnead", "kinematics"}};
   for (const auto& l : library) {
     OpCount ops = fn.hostOps(l.host);
-    ops += fn.hostOps(l.helper);
+    if (l.helper) ops += fn.hostOps(l.helper);
     texts.libraryOps[l.f] = ops;
   }
   // The derivatives: their host (the dense products included) and the functions it calls.

@@ -16,14 +16,27 @@ namespace proxgen::emit {
 namespace {
 
 std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
+std::string vIn(int k) { return fmt::format("v[{}]", k); }
 std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
 
-// Fills `out` (in scope: the caller's Live holds it).
-void inverseDynamics(Emit& e, const Kinematics& kin, bool withQdd, bool withLambda, Forces& out) {
-  const Plan& plan = e.plan;
-  const int N = int(plan.bodies.size());
-  e.fn.beginPass("forward", std::string("forward: a = X a_parent + ") + (withQdd ? "S qdd + " : "") + "c, f = I a + v x* I v" +
-                                (withLambda ? " + K^T lambda" : ""));
+// f_i += K_c^T lambda_c for each constraint c on body i: its rows as a wrench at its frame.
+void addConstraintForces(Emit& e, int i, V6& f) {
+  CodeBuilder& cb = e.cb();
+  for (int k : e.bp(i).constraints) {
+    const Constraint& c = e.sys.constraints[std::size_t(k)];
+    const Mat6 X = c.placement.motionMatrixInv();  // rows K_c: body motion -> constraint frame
+    for (int r = 0; r < 6; ++r)
+      for (int j = 0; j < c.rows(); ++j)
+        if (X(j, r) != 0) f[std::size_t(r)] += X(j, r) * cb.input(lambdaIn(c.row + j));
+  }
+}
+
+// The forward sweep from the kinematics pass's state (nonlinear_effects:
+// forward_dynamics_derivatives reads the state that pass leaves). Fills `out`
+// (in scope: the caller's Live holds it).
+void forwardFromKinematics(Emit& e, const Kinematics& kin, Forces& out) {
+  const int N = int(e.plan.bodies.size());
+  e.fn.beginPass("forward", "forward: a = X a_parent + c, f = I a + v x* I v");
   for (int i = 1; i < N; ++i) {
     e.fn.boundary(i);
     e.openBody(i, "forward");
@@ -31,23 +44,82 @@ void inverseDynamics(Emit& e, const Kinematics& kin, bool withQdd, bool withLamb
     const Kinematics::Body& kb = kin.b[std::size_t(i)];
     const BodyPlan& p = e.bp(i);
     V6 a = add(e.motionToChild(kb, p.parent == 0 ? e.rootAcceleration() : out.a[std::size_t(p.parent)]), kb.c);
-    if (withQdd)
-      for (int d = 0; d < p.nv; ++d) a = add(a, scale(cb, cb.input(qddIn(p.idx_v + d)), kb.S[std::size_t(d)]));
     flatten(cb, a, "t");  // used in I a and by the children
     if (!p.children.empty())
       for (int k = 0; k < 6; ++k) out.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
-    V6 f = add(mul(cb, kb.IA, a), kb.pA);
-    if (withLambda)
-      for (int k : p.constraints) {
-        const Constraint& c = e.sys.constraints[std::size_t(k)];
-        const Mat6 X = c.placement.motionMatrixInv();  // rows K_c: body motion -> constraint frame
-        for (int r = 0; r < 6; ++r)
-          for (int j = 0; j < c.rows(); ++j)
-            if (X(j, r) != 0) f[std::size_t(r)] += X(j, r) * cb.input(lambdaIn(c.row + j));
-      }
+    const V6 f = add(mul(cb, kb.IA, a), kb.pA);
     for (int k = 0; k < 6; ++k) out.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
     cb.close();
   }
+}
+
+// The forward sweep of inverse_dynamics, from q, v and qdd alone: per body its
+// joint transform, v = X v_p + S qd, c = v x S qd, a = X a_p + S qdd + c and
+// f = I a + v x* I v. The solvers' kinematics pass, which this replaced here,
+// also stores c and v x* I v for a later function, gravity in every support
+// body and the constraints' right-hand sides, none of which RNEA reads; here c
+// and the bias stay in registers, and v and a are stored only for bodies with
+// children. Where sincos is inlined (sincosCalled), the joint transforms come
+// first, a pass of their own; where it is called (the larger robots), each in
+// its body's step. Measured both ways (docs/dynamics.md, "inverse_dynamics'
+// own forward sweep"): first, the iiwa and Solo take 0.73-0.76 of the time of
+// the kinematics pass and the forward sweep, but Talos and the Atlas 1.04-1.12;
+// in each step, the iiwa and Solo 1.13-1.18, Talos 0.99 and the Atlas 0.94.
+// Fills `kin` (the joint transforms the backward sweep reads) and `out`, both
+// in the caller's Live.
+void forwardFused(Emit& e, bool withLambda, Kinematics& kin, Forces& out) {
+  const int N = int(e.plan.bodies.size());
+  const bool transformsFirst = !sincosCalled(e.plan);
+  if (transformsFirst) {
+    e.fn.beginPass("transforms", "joint transforms X_J(q)");
+    for (int i = 1; i < N; ++i) {
+      e.fn.boundary(i);
+      e.openBody(i, "");
+      jointTransform(e, i, kin.b[std::size_t(i)]);
+      e.cb().close();
+    }
+  }
+  e.fn.beginPass("forward", std::string("forward: ") + (transformsFirst ? "" : "X_J(q), ") +
+                                "v = X v_parent + S qd, a = X a_parent + S qdd + v x S qd, f = I a + v x* I v" +
+                                (withLambda ? " + K^T lambda" : ""));
+  for (int i = 1; i < N; ++i) {
+    e.fn.boundary(i);
+    e.openBody(i, "forward");
+    CodeBuilder& cb = e.cb();
+    Kinematics::Body& b = kin.b[std::size_t(i)];
+    const BodyPlan& p = e.bp(i);
+    const bool parentOfSome = !p.children.empty();
+    if (!transformsFirst) jointTransform(e, i, b);
+    V6 vJ = zero6(), aJ = zero6();
+    for (int d = 0; d < p.nv; ++d) {
+      vJ = add(vJ, scale(cb, cb.input(vIn(p.idx_v + d)), b.S[std::size_t(d)]));
+      aJ = add(aJ, scale(cb, cb.input(qddIn(p.idx_v + d)), b.S[std::size_t(d)]));
+    }
+    V6 v = add(e.motionToChild(b, kin.b[std::size_t(p.parent)].v), vJ);
+    if (parentOfSome)
+      for (int k = 0; k < 6; ++k) v[std::size_t(k)] = e.keepQ(kV, i, 6, k, v[std::size_t(k)]);
+    else
+      flatten(cb, v, "v");
+    b.v = v;
+    const V6 c = crossMotion(cb, v, vJ);
+    V6 a = add(add(e.motionToChild(b, p.parent == 0 ? e.rootAcceleration() : out.a[std::size_t(p.parent)]), aJ), c);
+    flatten(cb, a, "t");  // used in I a and by the children
+    if (parentOfSome)
+      for (int k = 0; k < 6; ++k) out.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
+    b.IA = constant(e.model().bodies[std::size_t(i)].inertia.matrix());
+    V6 h = mul(cb, b.IA, v);
+    flatten(cb, h, "h");
+    V6 f = add(mul(cb, b.IA, a), crossForce(cb, v, h));
+    if (withLambda) addConstraintForces(e, i, f);
+    for (int k = 0; k < 6; ++k) out.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
+    cb.close();
+  }
+}
+
+// tau = S^T f, leaves first, each f passed to the parent.
+void backward(Emit& e, const Kinematics& kin, Forces& out) {
+  const Plan& plan = e.plan;
+  const int N = int(plan.bodies.size());
   e.fn.beginPass("backward", "backward: tau = S^T f, f_parent += X^T f");
   for (int i = N - 1; i >= 1; --i) {
     e.fn.boundary(i);
@@ -78,10 +150,16 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
   const int N = int(plan.bodies.size());
   Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
                 std::vector<Expr>(std::size_t(plan.nv))};
+  // inverse_dynamics sweeps from q, v and qdd itself; nonlinear_effects
+  // calls kinematics(q, v, w) and starts from its state.
+  if (!nonlinearEffects) {
+    kin = Kinematics{};
+    kin.b.resize(std::size_t(N));
+  }
   e.fn.live() = Live{};
   e.fn.live().kin = &kin;
   e.fn.live().forces = &forces;
-  e.fn.beginHost(nonlinearEffects ? "nle" : "rnea", afterKinematics);
+  e.fn.beginHost(nonlinearEffects ? "nle" : "rnea", nonlinearEffects ? afterKinematics : nullptr);
   CodeBuilder& host = e.cb();
   if (withLambda) {
     // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
@@ -98,8 +176,13 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
     }
     host.line("lambda = lambda_on;", {}, {"lambda"});
   }
-  host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
-  inverseDynamics(e, kin, !nonlinearEffects, withLambda, forces);
+  if (nonlinearEffects) {
+    host.line("kinematics(q, v, w);", {}, {"q", "v", "w"});
+    forwardFromKinematics(e, kin, forces);
+  } else {
+    forwardFused(e, withLambda, kin, forces);
+  }
+  backward(e, kin, forces);
   e.fn.endPart();
   const char* out = nonlinearEffects ? "h" : "tau";
   CodeBuilder& cb = e.cb();

@@ -19,15 +19,9 @@ Ops sincos() {
   return o;
 }
 
-// The runtime's sincos inlined at each revolute joint, or called (one copy of
-// its kernel, some 400 bytes at -O3) on a robot with more than 16 revolute
-// joints. Measured with bench/ab_compare.sh (docs/benchmarks.md, "sincos
-// called on the larger robots"): called, Talos' solvers take 0.95 of the time
-// and its inverse_dynamics 0.89, for 0.8 % more instructions (the spills
-// around the calls); Solo's (12 joints) solvers 0.95 too, but for 0.7 % more
-// instructions, past the ones of the issue's baseline on solo_f3x4, so Solo
-// and smaller keep it inline; on the iiwa (7) a call is 1-4 % slower.
-const char* sincosFunction(const Plan& plan) {
+}  // namespace
+
+bool sincosCalled(const Plan& plan) {
   int revolute = 0;
   for (std::size_t i = 1; i < plan.bodies.size(); ++i) {  // bodies[0] is the world
     const BodyPlan& b = plan.bodies[i];
@@ -35,10 +29,8 @@ const char* sincosFunction(const Plan& plan) {
         b.jointClass == JointClass::RevoluteZ || b.jointClass == JointClass::RevoluteAxis)
       ++revolute;
   }
-  return revolute > 16 ? "sincos_noinline" : "sincos";
+  return revolute > 16;
 }
-
-}  // namespace
 
 void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   const Body& body = e.model().bodies[std::size_t(i)];
@@ -105,7 +97,7 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   // Revolute: R = c I + s [a]x + (1 - c) a a^T; an axis along +-x/y/z folds to picks of c and s.
   const std::string sm = e.member(kSin, i, 0, 0), cm = e.member(kCos, i, 0, 0);
   const std::vector<Expr> sc = cb.storeByCall(
-      fmt::format("proxgen_rt::{}({}, {}, {});", sincosFunction(e.plan), q(j.idx_q), sm, cm), {sm, cm},
+      fmt::format("proxgen_rt::{}({}, {}, {});", sincosCalled(e.plan) ? "sincos_noinline" : "sincos", q(j.idx_q), sm, cm), {sm, cm},
       {cb.input(q(j.idx_q))}, sincos());
   const Expr &s = sc[0], &c = sc[1];
   const Mat3 K = skew(a), A = a * a.transpose();

@@ -22,6 +22,14 @@ namespace proxgen::emit {
 Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
+/// Whether jointTransform calls the runtime's sincos (sincos_noinline) rather
+/// than inlining it: on a robot of more than 16 revolute joints. Measured with
+/// bench/ab_compare.sh (docs/benchmarks.md, "sincos called on the larger
+/// robots"): called, Talos' solvers take 0.95 of the time for 0.8 % more
+/// instructions (the spills around the calls); Solo's (12 joints) solvers 0.95
+/// too, but for 0.7 % more instructions, past solo_f3x4's count when issue 20
+/// was filed, so Solo and smaller keep it inline; the iiwa (7) is 1-4 % slower called.
+bool sincosCalled(const Plan& plan);
 /// pA = v x* (I v) of body i from b.v and b.IA, into its member (the kinematics
 /// pass, and bias_forces for constrained_dynamics_derivatives).
 void storeBiasForce(Emit& e, int i, Kinematics::Body& b);

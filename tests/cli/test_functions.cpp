@@ -47,14 +47,22 @@ TEST(FunctionSelection, OnlyMassMatrixPrintsNothingElse) {
   EXPECT_FALSE(has(f.header, "//   constrained_aba: "));
 }
 
-TEST(FunctionSelection, InverseDynamicsCallsKinematicsNotTheSolvers) {
+// inverse_dynamics sweeps from (q, v, qdd) itself (pass_inverse_dynamics.cpp):
+// alone it prints neither the solvers' kinematics helper nor the solvers;
+// nonlinear_effects calls kinematics (forward_dynamics_derivatives reads its state).
+TEST(FunctionSelection, InverseDynamicsHasItsOwnSweepNotTheSolvers) {
   const SolverFiles f = arm("inverse_dynamics");
   EXPECT_TRUE(has(f.header, "tau = M(q) qdd + h(q, v) + J(q)^T lambda"));  // the sign, in the header
-  EXPECT_TRUE(has(f.source, "void kinematics("));
+  EXPECT_FALSE(has(f.source, "void kinematics("));
+  EXPECT_FALSE(has(f.source, "kinematics(q, v, w);"));
+  EXPECT_TRUE(has(f.source, "rnea_forward_"));
   EXPECT_FALSE(has(f.source, "void joint_transforms("));
   EXPECT_FALSE(has(f.source, "eliminate_free_bodies"));
   EXPECT_FALSE(has(f.header, "prox_pv("));
   EXPECT_TRUE(has(f.header, "--functions inverse_dynamics"));  // recorded in the banner's command
+  const SolverFiles h = arm("nonlinear_effects");
+  EXPECT_TRUE(has(h.source, "void kinematics("));
+  EXPECT_TRUE(has(h.source, "  kinematics(q, v, w);"));
 }
 
 TEST(FunctionSelection, TheTwoSolversNamedArePrintedAsTheDefault) {
