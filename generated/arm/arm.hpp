@@ -87,33 +87,33 @@ struct Settings {
 struct Workspace {
   Scalar sq_shoulder_link;     // sin q, body 1
   Scalar cq_shoulder_link;     // cos q, body 1
-  Scalar pA_shoulder_link[6];  // bias force, body 1
   Scalar sq_upper_arm_link;    // sin q, body 2
   Scalar cq_upper_arm_link;    // cos q, body 2
+  Scalar sq_forearm_link;      // sin q, body 3
+  Scalar cq_forearm_link;      // cos q, body 3
+  Scalar sq_wrist_1_link;      // sin q, body 4
+  Scalar cq_wrist_1_link;      // cos q, body 4
+  Scalar sq_wrist_2_link;      // sin q, body 5
+  Scalar cq_wrist_2_link;      // cos q, body 5
+  Scalar sq_wrist_3_link;      // sin q, body 6
+  Scalar cq_wrist_3_link;      // cos q, body 6
+  Scalar pA_shoulder_link[6];  // bias force, body 1
   Scalar v_upper_arm_link[6];  // velocity, body 2
   Scalar c_upper_arm_link[6];  // velocity-product acceleration, body 2
   Scalar pA_upper_arm_link[6]; // bias force, body 2
   Scalar g_upper_arm_link[3];  // gravity in body coordinates, body 2
-  Scalar sq_forearm_link;      // sin q, body 3
-  Scalar cq_forearm_link;      // cos q, body 3
   Scalar v_forearm_link[6];    // velocity, body 3
   Scalar c_forearm_link[6];    // velocity-product acceleration, body 3
   Scalar pA_forearm_link[6];   // bias force, body 3
   Scalar g_forearm_link[3];    // gravity in body coordinates, body 3
-  Scalar sq_wrist_1_link;      // sin q, body 4
-  Scalar cq_wrist_1_link;      // cos q, body 4
   Scalar v_wrist_1_link[6];    // velocity, body 4
   Scalar c_wrist_1_link[6];    // velocity-product acceleration, body 4
   Scalar pA_wrist_1_link[6];   // bias force, body 4
   Scalar g_wrist_1_link[3];    // gravity in body coordinates, body 4
-  Scalar sq_wrist_2_link;      // sin q, body 5
-  Scalar cq_wrist_2_link;      // cos q, body 5
   Scalar v_wrist_2_link[6];    // velocity, body 5
   Scalar c_wrist_2_link[6];    // velocity-product acceleration, body 5
   Scalar pA_wrist_2_link[6];   // bias force, body 5
   Scalar g_wrist_2_link[3];    // gravity in body coordinates, body 5
-  Scalar sq_wrist_3_link;      // sin q, body 6
-  Scalar cq_wrist_3_link;      // cos q, body 6
   Scalar v_wrist_3_link[6];    // velocity, body 6
   Scalar c_wrist_3_link[6];    // velocity-product acceleration, body 6
   Scalar pA_wrist_3_link[6];   // bias force, body 6

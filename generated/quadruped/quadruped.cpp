@@ -27,7 +27,7 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
@@ -52,15 +52,6 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.RJ_trunk[2][0] = 2.0*(qu0*qu2 - qu1*qu3);
     w.RJ_trunk[2][1] = 2.0*(qu1*qu2 + qu0*qu3);
     w.RJ_trunk[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
-    w.pA_trunk[0] = 3.5200000000000005*(v[2]*v[4] - v[1]*v[5]);
-    w.pA_trunk[1] = 3.5200000000000005*(v[0]*v[5] - v[2]*v[3]);
-    w.pA_trunk[2] = 3.5200000000000005*(v[1]*v[3] - v[0]*v[4]);
-    w.pA_trunk[3] = 0.0069982199999999994*v[4]*v[5];
-    w.pA_trunk[4] = -0.03473749999999999*v[3]*v[5];
-    w.pA_trunk[5] = 0.02773927999999999*v[3]*v[4];
-    w.g_trunk[0] = -9.81*w.RJ_trunk[2][0];
-    w.g_trunk[1] = -9.81*w.RJ_trunk[2][1];
-    w.g_trunk[2] = -9.81*w.RJ_trunk[2][2];
   }
   // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
@@ -73,15 +64,104 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.RJ_LF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_LF_hip;
     w.RJ_LF_hip[2][1] = 0.9950371902099893*w.sq_LF_hip;
     w.RJ_LF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_LF_hip;
-    const Scalar t1 = v[0] - 0.049*v[5];
-    const Scalar t2 = v[1] + 0.19*v[5];
-    const Scalar t3 = v[2] + 0.049*v[3] - 0.19*v[4];
-    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t1 + w.RJ_LF_hip[1][0]*t2 + w.RJ_LF_hip[2][0]*t3;
-    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t1 + w.cq_LF_hip*t2 + w.RJ_LF_hip[2][1]*t3;
-    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t1 + w.RJ_LF_hip[1][2]*t2 + w.RJ_LF_hip[2][2]*t3;
-    w.v_LF_hip[3] = 0.9950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][0] + v[4]*w.RJ_LF_hip[1][0] + v[5]*w.RJ_LF_hip[2][0];
-    w.v_LF_hip[4] = v[3]*w.RJ_LF_hip[0][1] + v[4]*w.cq_LF_hip + v[5]*w.RJ_LF_hip[2][1];
-    w.v_LF_hip[5] = 0.09950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][2] + v[4]*w.RJ_LF_hip[1][2] + v[5]*w.RJ_LF_hip[2][2];
+  }
+  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  {
+    proxgen_rt::sincos(q[8], w.sq_LF_thigh, w.cq_LF_thigh);
+  }
+  // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  {
+    proxgen_rt::sincos(q[9], w.sq_LF_shank, w.cq_LF_shank);
+  }
+  // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    proxgen_rt::sincos(q[10], w.sq_LH_hip, w.cq_LH_hip);
+    w.RJ_LH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_LH_hip;
+    w.RJ_LH_hip[0][1] = 0.09950371902099892*w.sq_LH_hip;
+    w.RJ_LH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
+    w.RJ_LH_hip[1][0] = -0.09950371902099892*w.sq_LH_hip;
+    w.RJ_LH_hip[1][2] = -0.9950371902099892*w.sq_LH_hip;
+    w.RJ_LH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
+    w.RJ_LH_hip[2][1] = 0.9950371902099892*w.sq_LH_hip;
+    w.RJ_LH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_LH_hip;
+  }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_transforms_LH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  {
+    proxgen_rt::sincos(q[11], w.sq_LH_thigh, w.cq_LH_thigh);
+  }
+  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  {
+    proxgen_rt::sincos(q[12], w.sq_LH_shank, w.cq_LH_shank);
+  }
+  // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    proxgen_rt::sincos(q[13], w.sq_RF_hip, w.cq_RF_hip);
+    w.RJ_RF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq_RF_hip;
+    w.RJ_RF_hip[0][1] = -0.09950371902099893*w.sq_RF_hip;
+    w.RJ_RF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
+    w.RJ_RF_hip[1][0] = 0.09950371902099893*w.sq_RF_hip;
+    w.RJ_RF_hip[1][2] = -0.9950371902099893*w.sq_RF_hip;
+    w.RJ_RF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
+    w.RJ_RF_hip[2][1] = 0.9950371902099893*w.sq_RF_hip;
+    w.RJ_RF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_RF_hip;
+  }
+  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  {
+    proxgen_rt::sincos(q[14], w.sq_RF_thigh, w.cq_RF_thigh);
+  }
+  // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  {
+    proxgen_rt::sincos(q[15], w.sq_RF_shank, w.cq_RF_shank);
+  }
+  // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    proxgen_rt::sincos(q[16], w.sq_RH_hip, w.cq_RH_hip);
+    w.RJ_RH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_RH_hip;
+    w.RJ_RH_hip[0][1] = 0.09950371902099892*w.sq_RH_hip;
+    w.RJ_RH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
+    w.RJ_RH_hip[1][0] = -0.09950371902099892*w.sq_RH_hip;
+    w.RJ_RH_hip[1][2] = -0.9950371902099892*w.sq_RH_hip;
+    w.RJ_RH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
+    w.RJ_RH_hip[2][1] = 0.9950371902099892*w.sq_RH_hip;
+    w.RJ_RH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_RH_hip;
+  }
+  // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+  {
+    proxgen_rt::sincos(q[17], w.sq_RH_thigh, w.cq_RH_thigh);
+  }
+  // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
+  {
+    proxgen_rt::sincos(q[18], w.sq_RH_shank, w.cq_RH_shank);
+  }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
+  {
+    w.pA_trunk[0] = 3.5200000000000005*(v[2]*v[4] - v[1]*v[5]);
+    w.pA_trunk[1] = 3.5200000000000005*(v[0]*v[5] - v[2]*v[3]);
+    w.pA_trunk[2] = 3.5200000000000005*(v[1]*v[3] - v[0]*v[4]);
+    w.pA_trunk[3] = 0.0069982199999999994*v[4]*v[5];
+    w.pA_trunk[4] = -0.03473749999999999*v[3]*v[5];
+    w.pA_trunk[5] = 0.02773927999999999*v[3]*v[4];
+    w.g_trunk[0] = -9.81*w.RJ_trunk[2][0];
+    w.g_trunk[1] = -9.81*w.RJ_trunk[2][1];
+    w.g_trunk[2] = -9.81*w.RJ_trunk[2][2];
+  }
+  // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
+  {
+    const Scalar t0 = v[0] - 0.049*v[5];
+    const Scalar t1 = v[1] + 0.19*v[5];
+    const Scalar t2 = v[2] + 0.049*v[3] - 0.19*v[4];
+    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t0 + w.RJ_LF_hip[1][0]*t1 + w.RJ_LF_hip[2][0]*t2;
+    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[2][1]*t2;
+    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t0 + w.RJ_LF_hip[1][2]*t1 + w.RJ_LF_hip[2][2]*t2;
+    w.v_LF_hip[3] = 0.9950371902099893*v[6] + w.RJ_LF_hip[0][0]*v[3] + w.RJ_LF_hip[1][0]*v[4] + w.RJ_LF_hip[2][0]*v[5];
+    w.v_LF_hip[4] = w.RJ_LF_hip[0][1]*v[3] + w.cq_LF_hip*v[4] + w.RJ_LF_hip[2][1]*v[5];
+    w.v_LF_hip[5] = 0.09950371902099893*v[6] + w.RJ_LF_hip[0][2]*v[3] + w.RJ_LF_hip[1][2]*v[4] + w.RJ_LF_hip[2][2]*v[5];
     w.c_LF_hip[0] = 0.09950371902099893*v[6]*w.v_LF_hip[1];
     w.c_LF_hip[1] = 0.9950371902099893*v[6]*w.v_LF_hip[2] - 0.09950371902099893*v[6]*w.v_LF_hip[0];
     w.c_LF_hip[2] = -0.9950371902099893*v[6]*w.v_LF_hip[1];
@@ -99,50 +179,48 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.pA_LF_hip[3] = w.v_LF_hip[4]*h4 - w.v_LF_hip[5]*h3 + w.v_LF_hip[1]*h1 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[2];
     w.pA_LF_hip[4] = w.v_LF_hip[5]*h2 - w.v_LF_hip[3]*h4 + w.v_LF_hip[2]*h0 - w.v_LF_hip[0]*h1;
     w.pA_LF_hip[5] = w.v_LF_hip[3]*h3 - w.v_LF_hip[4]*h2 + 0.5950000000000001*w.v_LF_hip[0]*w.v_LF_hip[1] - w.v_LF_hip[1]*h0;
-    w.g_LF_hip[0] = w.g_trunk[0]*w.RJ_LF_hip[0][0] + w.g_trunk[1]*w.RJ_LF_hip[1][0] + w.g_trunk[2]*w.RJ_LF_hip[2][0];
-    w.g_LF_hip[1] = w.g_trunk[0]*w.RJ_LF_hip[0][1] + w.g_trunk[1]*w.cq_LF_hip + w.g_trunk[2]*w.RJ_LF_hip[2][1];
-    w.g_LF_hip[2] = w.g_trunk[0]*w.RJ_LF_hip[0][2] + w.g_trunk[1]*w.RJ_LF_hip[1][2] + w.g_trunk[2]*w.RJ_LF_hip[2][2];
+    w.g_LF_hip[0] = w.RJ_LF_hip[0][0]*w.g_trunk[0] + w.RJ_LF_hip[1][0]*w.g_trunk[1] + w.RJ_LF_hip[2][0]*w.g_trunk[2];
+    w.g_LF_hip[1] = w.RJ_LF_hip[0][1]*w.g_trunk[0] + w.cq_LF_hip*w.g_trunk[1] + w.RJ_LF_hip[2][1]*w.g_trunk[2];
+    w.g_LF_hip[2] = w.RJ_LF_hip[0][2]*w.g_trunk[0] + w.RJ_LF_hip[1][2]*w.g_trunk[1] + w.RJ_LF_hip[2][2]*w.g_trunk[2];
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   {
-    proxgen_rt::sincos(q[8], w.sq_LF_thigh, w.cq_LF_thigh);
-    const Scalar t0 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
-    const Scalar t1 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
-    w.v_LF_thigh[0] = w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
-    w.v_LF_thigh[2] = w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
-    w.v_LF_thigh[3] = w.v_LF_hip[3]*w.cq_LF_thigh - w.v_LF_hip[5]*w.sq_LF_thigh;
+    const Scalar t3 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
+    const Scalar t4 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
+    w.v_LF_thigh[0] = w.cq_LF_thigh*t3 - w.sq_LF_thigh*t4;
+    w.v_LF_thigh[2] = w.sq_LF_thigh*t3 + w.cq_LF_thigh*t4;
+    w.v_LF_thigh[3] = w.cq_LF_thigh*w.v_LF_hip[3] - w.sq_LF_thigh*w.v_LF_hip[5];
     w.v_LF_thigh[4] = w.v_LF_hip[4] + v[7];
-    w.v_LF_thigh[5] = w.v_LF_hip[3]*w.sq_LF_thigh + w.v_LF_hip[5]*w.cq_LF_thigh;
+    w.v_LF_thigh[5] = w.sq_LF_thigh*w.v_LF_hip[3] + w.cq_LF_thigh*w.v_LF_hip[5];
     w.c_LF_thigh[0] = -v[7]*w.v_LF_thigh[2];
     w.c_LF_thigh[2] = v[7]*w.v_LF_thigh[0];
     w.c_LF_thigh[3] = -v[7]*w.v_LF_thigh[5];
     w.c_LF_thigh[5] = v[7]*w.v_LF_thigh[3];
-    const Scalar h0 = 0.6890000000000001*w.v_LF_thigh[0] - 0.01268*w.v_LF_thigh[4] + 0.010144*w.v_LF_thigh[5];
-    const Scalar h1 = 0.6890000000000001*w.v_LF_hip[1] + 0.01268*w.v_LF_thigh[3];
-    const Scalar h2 = 0.6890000000000001*w.v_LF_thigh[2] - 0.010144*w.v_LF_thigh[3];
-    const Scalar h3 = 0.01268*w.v_LF_hip[1] - 0.010144*w.v_LF_thigh[2] + 0.002431904*w.v_LF_thigh[3];
-    const Scalar h4 = -0.01268*w.v_LF_thigh[0] + 0.0024196*w.v_LF_thigh[4] - 0.00020288*w.v_LF_thigh[5];
-    const Scalar h5 = 0.010144*w.v_LF_thigh[0] - 0.00020288*w.v_LF_thigh[4] + 0.0006033039999999999*w.v_LF_thigh[5];
-    w.pA_LF_thigh[0] = w.v_LF_thigh[4]*h2 - w.v_LF_thigh[5]*h1;
-    w.pA_LF_thigh[1] = w.v_LF_thigh[5]*h0 - w.v_LF_thigh[3]*h2;
-    w.pA_LF_thigh[2] = w.v_LF_thigh[3]*h1 - w.v_LF_thigh[4]*h0;
-    w.pA_LF_thigh[3] = w.v_LF_thigh[4]*h5 - w.v_LF_thigh[5]*h4 + w.v_LF_hip[1]*h2 - w.v_LF_thigh[2]*h1;
-    w.pA_LF_thigh[4] = w.v_LF_thigh[5]*h3 - w.v_LF_thigh[3]*h5 + w.v_LF_thigh[2]*h0 - w.v_LF_thigh[0]*h2;
-    w.pA_LF_thigh[5] = w.v_LF_thigh[3]*h4 - w.v_LF_thigh[4]*h3 + w.v_LF_thigh[0]*h1 - w.v_LF_hip[1]*h0;
-    w.g_LF_thigh[0] = w.g_LF_hip[0]*w.cq_LF_thigh - w.g_LF_hip[2]*w.sq_LF_thigh;
-    w.g_LF_thigh[2] = w.g_LF_hip[0]*w.sq_LF_thigh + w.g_LF_hip[2]*w.cq_LF_thigh;
+    const Scalar h5 = 0.6890000000000001*w.v_LF_thigh[0] - 0.01268*w.v_LF_thigh[4] + 0.010144*w.v_LF_thigh[5];
+    const Scalar h6 = 0.6890000000000001*w.v_LF_hip[1] + 0.01268*w.v_LF_thigh[3];
+    const Scalar h7 = 0.6890000000000001*w.v_LF_thigh[2] - 0.010144*w.v_LF_thigh[3];
+    const Scalar h8 = 0.01268*w.v_LF_hip[1] - 0.010144*w.v_LF_thigh[2] + 0.002431904*w.v_LF_thigh[3];
+    const Scalar h9 = -0.01268*w.v_LF_thigh[0] + 0.0024196*w.v_LF_thigh[4] - 0.00020288*w.v_LF_thigh[5];
+    const Scalar h10 = 0.010144*w.v_LF_thigh[0] - 0.00020288*w.v_LF_thigh[4] + 0.0006033039999999999*w.v_LF_thigh[5];
+    w.pA_LF_thigh[0] = w.v_LF_thigh[4]*h7 - w.v_LF_thigh[5]*h6;
+    w.pA_LF_thigh[1] = w.v_LF_thigh[5]*h5 - w.v_LF_thigh[3]*h7;
+    w.pA_LF_thigh[2] = w.v_LF_thigh[3]*h6 - w.v_LF_thigh[4]*h5;
+    w.pA_LF_thigh[3] = w.v_LF_thigh[4]*h10 - w.v_LF_thigh[5]*h9 + w.v_LF_hip[1]*h7 - w.v_LF_thigh[2]*h6;
+    w.pA_LF_thigh[4] = w.v_LF_thigh[5]*h8 - w.v_LF_thigh[3]*h10 + w.v_LF_thigh[2]*h5 - w.v_LF_thigh[0]*h7;
+    w.pA_LF_thigh[5] = w.v_LF_thigh[3]*h9 - w.v_LF_thigh[4]*h8 + w.v_LF_thigh[0]*h6 - w.v_LF_hip[1]*h5;
+    w.g_LF_thigh[0] = w.cq_LF_thigh*w.g_LF_hip[0] - w.sq_LF_thigh*w.g_LF_hip[2];
+    w.g_LF_thigh[2] = w.sq_LF_thigh*w.g_LF_hip[0] + w.cq_LF_thigh*w.g_LF_hip[2];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
   {
-    proxgen_rt::sincos(q[9], w.sq_LF_shank, w.cq_LF_shank);
-    const Scalar t2 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
-    const Scalar t3 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
-    w.v_LF_shank[0] = w.cq_LF_shank*t2 - w.v_LF_thigh[2]*w.sq_LF_shank;
-    w.v_LF_shank[1] = t3;
-    w.v_LF_shank[2] = w.sq_LF_shank*t2 + w.v_LF_thigh[2]*w.cq_LF_shank;
+    const Scalar t0 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
+    const Scalar t1 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
+    w.v_LF_shank[0] = w.cq_LF_shank*t0 - w.v_LF_thigh[2]*w.sq_LF_shank;
+    w.v_LF_shank[1] = t1;
+    w.v_LF_shank[2] = w.sq_LF_shank*t0 + w.v_LF_thigh[2]*w.cq_LF_shank;
     w.v_LF_shank[3] = w.v_LF_thigh[3]*w.cq_LF_shank - w.v_LF_thigh[5]*w.sq_LF_shank;
     w.v_LF_shank[4] = w.v_LF_thigh[4] + v[8];
     w.v_LF_shank[5] = w.v_LF_thigh[3]*w.sq_LF_shank + w.v_LF_thigh[5]*w.cq_LF_shank;
@@ -150,46 +228,34 @@ PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LF_shank(const Scalar* PROXGEN_R
     w.c_LF_shank[2] = v[8]*w.v_LF_shank[0];
     w.c_LF_shank[3] = -v[8]*w.v_LF_shank[5];
     w.c_LF_shank[5] = v[8]*w.v_LF_shank[3];
-    const Scalar h6 = 0.064*w.v_LF_shank[0] - 0.003904*w.v_LF_shank[4];
-    const Scalar h7 = 0.064*w.v_LF_shank[1] + 0.003904*w.v_LF_shank[3];
-    const Scalar h8 = 0.003904*w.v_LF_shank[1] + 0.000483144*w.v_LF_shank[3];
-    const Scalar h9 = -0.003904*w.v_LF_shank[0] + 0.000486144*w.v_LF_shank[4];
-    w.pA_LF_shank[0] = 0.064*w.v_LF_shank[2]*w.v_LF_shank[4] - w.v_LF_shank[5]*h7;
-    w.pA_LF_shank[1] = w.v_LF_shank[5]*h6 - 0.064*w.v_LF_shank[2]*w.v_LF_shank[3];
-    w.pA_LF_shank[2] = w.v_LF_shank[3]*h7 - w.v_LF_shank[4]*h6;
-    w.pA_LF_shank[3] = 6e-06*w.v_LF_shank[4]*w.v_LF_shank[5] - w.v_LF_shank[5]*h9 + 0.064*w.v_LF_shank[1]*w.v_LF_shank[2] - w.v_LF_shank[2]*h7;
-    w.pA_LF_shank[4] = w.v_LF_shank[5]*h8 - 6e-06*w.v_LF_shank[3]*w.v_LF_shank[5] + w.v_LF_shank[2]*h6 - 0.064*w.v_LF_shank[0]*w.v_LF_shank[2];
-    w.pA_LF_shank[5] = w.v_LF_shank[3]*h9 - w.v_LF_shank[4]*h8 + w.v_LF_shank[0]*h7 - w.v_LF_shank[1]*h6;
+    const Scalar h0 = 0.064*w.v_LF_shank[0] - 0.003904*w.v_LF_shank[4];
+    const Scalar h1 = 0.064*w.v_LF_shank[1] + 0.003904*w.v_LF_shank[3];
+    const Scalar h2 = 0.003904*w.v_LF_shank[1] + 0.000483144*w.v_LF_shank[3];
+    const Scalar h3 = -0.003904*w.v_LF_shank[0] + 0.000486144*w.v_LF_shank[4];
+    w.pA_LF_shank[0] = 0.064*w.v_LF_shank[2]*w.v_LF_shank[4] - w.v_LF_shank[5]*h1;
+    w.pA_LF_shank[1] = w.v_LF_shank[5]*h0 - 0.064*w.v_LF_shank[2]*w.v_LF_shank[3];
+    w.pA_LF_shank[2] = w.v_LF_shank[3]*h1 - w.v_LF_shank[4]*h0;
+    w.pA_LF_shank[3] = 6e-06*w.v_LF_shank[4]*w.v_LF_shank[5] - w.v_LF_shank[5]*h3 + 0.064*w.v_LF_shank[1]*w.v_LF_shank[2] - w.v_LF_shank[2]*h1;
+    w.pA_LF_shank[4] = w.v_LF_shank[5]*h2 - 6e-06*w.v_LF_shank[3]*w.v_LF_shank[5] + w.v_LF_shank[2]*h0 - 0.064*w.v_LF_shank[0]*w.v_LF_shank[2];
+    w.pA_LF_shank[5] = w.v_LF_shank[3]*h3 - w.v_LF_shank[4]*h2 + w.v_LF_shank[0]*h1 - w.v_LF_shank[1]*h0;
     w.g_LF_shank[0] = w.g_LF_thigh[0]*w.cq_LF_shank - w.g_LF_thigh[2]*w.sq_LF_shank;
     w.g_LF_shank[2] = w.g_LF_thigh[0]*w.sq_LF_shank + w.g_LF_thigh[2]*w.cq_LF_shank;
     // constraint 'lf_foot' (3d) on link 'LF_foot': rows 0..2
-    const Scalar t4 = w.v_LF_shank[2] + 0.004*w.v_LF_shank[3];
-    const Scalar t5 = w.v_LF_shank[1] + 0.195*w.v_LF_shank[3];
-    const Scalar t6 = w.v_LF_shank[0] - 0.195*w.v_LF_shank[4] - 0.004*w.v_LF_shank[5];
-    w.k_lf_foot[0] = -w.g_LF_shank[0] - w.v_LF_shank[4]*t4 + w.v_LF_shank[5]*t5;
-    w.k_lf_foot[1] = -w.g_LF_hip[1] - w.v_LF_shank[5]*t6 + w.v_LF_shank[3]*t4;
-    w.k_lf_foot[2] = -w.g_LF_shank[2] - w.v_LF_shank[3]*t5 + w.v_LF_shank[4]*t6;
+    const Scalar t2 = w.v_LF_shank[2] + 0.004*w.v_LF_shank[3];
+    const Scalar t3 = w.v_LF_shank[1] + 0.195*w.v_LF_shank[3];
+    const Scalar t4 = w.v_LF_shank[0] - 0.195*w.v_LF_shank[4] - 0.004*w.v_LF_shank[5];
+    w.k_lf_foot[0] = -w.g_LF_shank[0] - w.v_LF_shank[4]*t2 + w.v_LF_shank[5]*t3;
+    w.k_lf_foot[1] = -w.g_LF_hip[1] - w.v_LF_shank[5]*t4 + w.v_LF_shank[3]*t2;
+    w.k_lf_foot[2] = -w.g_LF_shank[2] - w.v_LF_shank[3]*t3 + w.v_LF_shank[4]*t4;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    proxgen_rt::sincos(q[10], w.sq_LH_hip, w.cq_LH_hip);
-    w.RJ_LH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_LH_hip;
-    w.RJ_LH_hip[0][1] = 0.09950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
-    w.RJ_LH_hip[1][0] = -0.09950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[1][2] = -0.9950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
-    w.RJ_LH_hip[2][1] = 0.9950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_LH_hip;
-    const Scalar t0 = v[0] - 0.049*v[5];
-    const Scalar t1 = v[1] - 0.19*v[5];
-    const Scalar t2 = v[2] + 0.049*v[3] + 0.19*v[4];
-    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t0 + w.RJ_LH_hip[1][0]*t1 + w.RJ_LH_hip[2][0]*t2;
-    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t0 + w.cq_LH_hip*t1 + w.RJ_LH_hip[2][1]*t2;
-    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t0 + w.RJ_LH_hip[1][2]*t1 + w.RJ_LH_hip[2][2]*t2;
+    const Scalar t5 = v[0] - 0.049*v[5];
+    const Scalar t6 = v[1] - 0.19*v[5];
+    const Scalar t7 = v[2] + 0.049*v[3] + 0.19*v[4];
+    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t5 + w.RJ_LH_hip[1][0]*t6 + w.RJ_LH_hip[2][0]*t7;
+    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t5 + w.cq_LH_hip*t6 + w.RJ_LH_hip[2][1]*t7;
+    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t5 + w.RJ_LH_hip[1][2]*t6 + w.RJ_LH_hip[2][2]*t7;
     w.v_LH_hip[3] = 0.9950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][0] + v[4]*w.RJ_LH_hip[1][0] + v[5]*w.RJ_LH_hip[2][0];
     w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[0][1] + v[4]*w.cq_LH_hip + v[5]*w.RJ_LH_hip[2][1];
     w.v_LH_hip[5] = -0.09950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][2] + v[4]*w.RJ_LH_hip[1][2] + v[5]*w.RJ_LH_hip[2][2];
@@ -199,28 +265,30 @@ PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_
     w.c_LH_hip[3] = -0.09950371902099892*v[9]*w.v_LH_hip[4];
     w.c_LH_hip[4] = 0.9950371902099892*v[9]*w.v_LH_hip[5] + 0.09950371902099892*v[9]*w.v_LH_hip[3];
     w.c_LH_hip[5] = -0.9950371902099892*v[9]*w.v_LH_hip[4];
-    const Scalar h0 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
-    const Scalar h1 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
-    const Scalar h2 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
-    const Scalar h3 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
-    const Scalar h4 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
-    w.pA_LH_hip[0] = w.v_LH_hip[4]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
-    w.pA_LH_hip[1] = w.v_LH_hip[5]*h0 - w.v_LH_hip[3]*h1;
-    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h0;
-    w.pA_LH_hip[3] = w.v_LH_hip[4]*h4 - w.v_LH_hip[5]*h3 + w.v_LH_hip[1]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
-    w.pA_LH_hip[4] = w.v_LH_hip[5]*h2 - w.v_LH_hip[3]*h4 + w.v_LH_hip[2]*h0 - w.v_LH_hip[0]*h1;
-    w.pA_LH_hip[5] = w.v_LH_hip[3]*h3 - w.v_LH_hip[4]*h2 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h0;
+    const Scalar h4 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
+    const Scalar h5 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
+    const Scalar h6 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
+    const Scalar h7 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
+    const Scalar h8 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
+    w.pA_LH_hip[0] = w.v_LH_hip[4]*h5 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
+    w.pA_LH_hip[1] = w.v_LH_hip[5]*h4 - w.v_LH_hip[3]*h5;
+    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h4;
+    w.pA_LH_hip[3] = w.v_LH_hip[4]*h8 - w.v_LH_hip[5]*h7 + w.v_LH_hip[1]*h5 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
+    w.pA_LH_hip[4] = w.v_LH_hip[5]*h6 - w.v_LH_hip[3]*h8 + w.v_LH_hip[2]*h4 - w.v_LH_hip[0]*h5;
+    w.pA_LH_hip[5] = w.v_LH_hip[3]*h7 - w.v_LH_hip[4]*h6 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h4;
     w.g_LH_hip[0] = w.g_trunk[0]*w.RJ_LH_hip[0][0] + w.g_trunk[1]*w.RJ_LH_hip[1][0] + w.g_trunk[2]*w.RJ_LH_hip[2][0];
     w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[0][1] + w.g_trunk[1]*w.cq_LH_hip + w.g_trunk[2]*w.RJ_LH_hip[2][1];
     w.g_LH_hip[2] = w.g_trunk[0]*w.RJ_LH_hip[0][2] + w.g_trunk[1]*w.RJ_LH_hip[1][2] + w.g_trunk[2]*w.RJ_LH_hip[2][2];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_LH_thigh_to_LH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   {
-    proxgen_rt::sincos(q[11], w.sq_LH_thigh, w.cq_LH_thigh);
-    const Scalar t3 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
-    const Scalar t4 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
-    w.v_LH_thigh[0] = w.cq_LH_thigh*t3 - w.sq_LH_thigh*t4;
-    w.v_LH_thigh[2] = w.sq_LH_thigh*t3 + w.cq_LH_thigh*t4;
+    const Scalar t0 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
+    const Scalar t1 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
+    w.v_LH_thigh[0] = w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
+    w.v_LH_thigh[2] = w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
     w.v_LH_thigh[3] = w.v_LH_hip[3]*w.cq_LH_thigh - w.v_LH_hip[5]*w.sq_LH_thigh;
     w.v_LH_thigh[4] = w.v_LH_hip[4] + v[10];
     w.v_LH_thigh[5] = w.v_LH_hip[3]*w.sq_LH_thigh + w.v_LH_hip[5]*w.cq_LH_thigh;
@@ -228,76 +296,66 @@ PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_
     w.c_LH_thigh[2] = v[10]*w.v_LH_thigh[0];
     w.c_LH_thigh[3] = -v[10]*w.v_LH_thigh[5];
     w.c_LH_thigh[5] = v[10]*w.v_LH_thigh[3];
-    const Scalar h5 = 0.6890000000000001*w.v_LH_thigh[0] - 0.01268*w.v_LH_thigh[4] + 0.010144*w.v_LH_thigh[5];
-    const Scalar h6 = 0.6890000000000001*w.v_LH_hip[1] + 0.01268*w.v_LH_thigh[3];
-    const Scalar h7 = 0.6890000000000001*w.v_LH_thigh[2] - 0.010144*w.v_LH_thigh[3];
-    const Scalar h8 = 0.01268*w.v_LH_hip[1] - 0.010144*w.v_LH_thigh[2] + 0.002431904*w.v_LH_thigh[3];
-    const Scalar h9 = -0.01268*w.v_LH_thigh[0] + 0.0024196*w.v_LH_thigh[4] - 0.00020288*w.v_LH_thigh[5];
-    const Scalar h10 = 0.010144*w.v_LH_thigh[0] - 0.00020288*w.v_LH_thigh[4] + 0.0006033039999999999*w.v_LH_thigh[5];
-    w.pA_LH_thigh[0] = w.v_LH_thigh[4]*h7 - w.v_LH_thigh[5]*h6;
-    w.pA_LH_thigh[1] = w.v_LH_thigh[5]*h5 - w.v_LH_thigh[3]*h7;
-    w.pA_LH_thigh[2] = w.v_LH_thigh[3]*h6 - w.v_LH_thigh[4]*h5;
-    w.pA_LH_thigh[3] = w.v_LH_thigh[4]*h10 - w.v_LH_thigh[5]*h9 + w.v_LH_hip[1]*h7 - w.v_LH_thigh[2]*h6;
-    w.pA_LH_thigh[4] = w.v_LH_thigh[5]*h8 - w.v_LH_thigh[3]*h10 + w.v_LH_thigh[2]*h5 - w.v_LH_thigh[0]*h7;
-    w.pA_LH_thigh[5] = w.v_LH_thigh[3]*h9 - w.v_LH_thigh[4]*h8 + w.v_LH_thigh[0]*h6 - w.v_LH_hip[1]*h5;
+    const Scalar h0 = 0.6890000000000001*w.v_LH_thigh[0] - 0.01268*w.v_LH_thigh[4] + 0.010144*w.v_LH_thigh[5];
+    const Scalar h1 = 0.6890000000000001*w.v_LH_hip[1] + 0.01268*w.v_LH_thigh[3];
+    const Scalar h2 = 0.6890000000000001*w.v_LH_thigh[2] - 0.010144*w.v_LH_thigh[3];
+    const Scalar h3 = 0.01268*w.v_LH_hip[1] - 0.010144*w.v_LH_thigh[2] + 0.002431904*w.v_LH_thigh[3];
+    const Scalar h4 = -0.01268*w.v_LH_thigh[0] + 0.0024196*w.v_LH_thigh[4] - 0.00020288*w.v_LH_thigh[5];
+    const Scalar h5 = 0.010144*w.v_LH_thigh[0] - 0.00020288*w.v_LH_thigh[4] + 0.0006033039999999999*w.v_LH_thigh[5];
+    w.pA_LH_thigh[0] = w.v_LH_thigh[4]*h2 - w.v_LH_thigh[5]*h1;
+    w.pA_LH_thigh[1] = w.v_LH_thigh[5]*h0 - w.v_LH_thigh[3]*h2;
+    w.pA_LH_thigh[2] = w.v_LH_thigh[3]*h1 - w.v_LH_thigh[4]*h0;
+    w.pA_LH_thigh[3] = w.v_LH_thigh[4]*h5 - w.v_LH_thigh[5]*h4 + w.v_LH_hip[1]*h2 - w.v_LH_thigh[2]*h1;
+    w.pA_LH_thigh[4] = w.v_LH_thigh[5]*h3 - w.v_LH_thigh[3]*h5 + w.v_LH_thigh[2]*h0 - w.v_LH_thigh[0]*h2;
+    w.pA_LH_thigh[5] = w.v_LH_thigh[3]*h4 - w.v_LH_thigh[4]*h3 + w.v_LH_thigh[0]*h1 - w.v_LH_hip[1]*h0;
     w.g_LH_thigh[0] = w.g_LH_hip[0]*w.cq_LH_thigh - w.g_LH_hip[2]*w.sq_LH_thigh;
     w.g_LH_thigh[2] = w.g_LH_hip[0]*w.sq_LH_thigh + w.g_LH_hip[2]*w.cq_LH_thigh;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
   {
-    proxgen_rt::sincos(q[12], w.sq_LH_shank, w.cq_LH_shank);
-    const Scalar t0 = w.v_LH_thigh[0] - 0.209*w.v_LH_thigh[4];
-    const Scalar t1 = w.v_LH_hip[1] + 0.209*w.v_LH_thigh[3];
-    w.v_LH_shank[0] = w.cq_LH_shank*t0 - w.v_LH_thigh[2]*w.sq_LH_shank;
-    w.v_LH_shank[1] = t1;
-    w.v_LH_shank[2] = w.sq_LH_shank*t0 + w.v_LH_thigh[2]*w.cq_LH_shank;
-    w.v_LH_shank[3] = w.v_LH_thigh[3]*w.cq_LH_shank - w.v_LH_thigh[5]*w.sq_LH_shank;
+    const Scalar t2 = w.v_LH_thigh[0] - 0.209*w.v_LH_thigh[4];
+    const Scalar t3 = w.v_LH_hip[1] + 0.209*w.v_LH_thigh[3];
+    w.v_LH_shank[0] = w.cq_LH_shank*t2 - w.sq_LH_shank*w.v_LH_thigh[2];
+    w.v_LH_shank[1] = t3;
+    w.v_LH_shank[2] = w.sq_LH_shank*t2 + w.cq_LH_shank*w.v_LH_thigh[2];
+    w.v_LH_shank[3] = w.cq_LH_shank*w.v_LH_thigh[3] - w.sq_LH_shank*w.v_LH_thigh[5];
     w.v_LH_shank[4] = w.v_LH_thigh[4] + v[11];
-    w.v_LH_shank[5] = w.v_LH_thigh[3]*w.sq_LH_shank + w.v_LH_thigh[5]*w.cq_LH_shank;
+    w.v_LH_shank[5] = w.sq_LH_shank*w.v_LH_thigh[3] + w.cq_LH_shank*w.v_LH_thigh[5];
     w.c_LH_shank[0] = -v[11]*w.v_LH_shank[2];
     w.c_LH_shank[2] = v[11]*w.v_LH_shank[0];
     w.c_LH_shank[3] = -v[11]*w.v_LH_shank[5];
     w.c_LH_shank[5] = v[11]*w.v_LH_shank[3];
-    const Scalar h0 = 0.064*w.v_LH_shank[0] - 0.003904*w.v_LH_shank[4];
-    const Scalar h1 = 0.064*w.v_LH_shank[1] + 0.003904*w.v_LH_shank[3];
-    const Scalar h2 = 0.003904*w.v_LH_shank[1] + 0.000483144*w.v_LH_shank[3];
-    const Scalar h3 = -0.003904*w.v_LH_shank[0] + 0.000486144*w.v_LH_shank[4];
-    w.pA_LH_shank[0] = 0.064*w.v_LH_shank[2]*w.v_LH_shank[4] - w.v_LH_shank[5]*h1;
-    w.pA_LH_shank[1] = w.v_LH_shank[5]*h0 - 0.064*w.v_LH_shank[2]*w.v_LH_shank[3];
-    w.pA_LH_shank[2] = w.v_LH_shank[3]*h1 - w.v_LH_shank[4]*h0;
-    w.pA_LH_shank[3] = 6e-06*w.v_LH_shank[4]*w.v_LH_shank[5] - w.v_LH_shank[5]*h3 + 0.064*w.v_LH_shank[1]*w.v_LH_shank[2] - w.v_LH_shank[2]*h1;
-    w.pA_LH_shank[4] = w.v_LH_shank[5]*h2 - 6e-06*w.v_LH_shank[3]*w.v_LH_shank[5] + w.v_LH_shank[2]*h0 - 0.064*w.v_LH_shank[0]*w.v_LH_shank[2];
-    w.pA_LH_shank[5] = w.v_LH_shank[3]*h3 - w.v_LH_shank[4]*h2 + w.v_LH_shank[0]*h1 - w.v_LH_shank[1]*h0;
-    w.g_LH_shank[0] = w.g_LH_thigh[0]*w.cq_LH_shank - w.g_LH_thigh[2]*w.sq_LH_shank;
-    w.g_LH_shank[2] = w.g_LH_thigh[0]*w.sq_LH_shank + w.g_LH_thigh[2]*w.cq_LH_shank;
+    const Scalar h6 = 0.064*w.v_LH_shank[0] - 0.003904*w.v_LH_shank[4];
+    const Scalar h7 = 0.064*w.v_LH_shank[1] + 0.003904*w.v_LH_shank[3];
+    const Scalar h8 = 0.003904*w.v_LH_shank[1] + 0.000483144*w.v_LH_shank[3];
+    const Scalar h9 = -0.003904*w.v_LH_shank[0] + 0.000486144*w.v_LH_shank[4];
+    w.pA_LH_shank[0] = 0.064*w.v_LH_shank[2]*w.v_LH_shank[4] - w.v_LH_shank[5]*h7;
+    w.pA_LH_shank[1] = w.v_LH_shank[5]*h6 - 0.064*w.v_LH_shank[2]*w.v_LH_shank[3];
+    w.pA_LH_shank[2] = w.v_LH_shank[3]*h7 - w.v_LH_shank[4]*h6;
+    w.pA_LH_shank[3] = 6e-06*w.v_LH_shank[4]*w.v_LH_shank[5] - w.v_LH_shank[5]*h9 + 0.064*w.v_LH_shank[1]*w.v_LH_shank[2] - w.v_LH_shank[2]*h7;
+    w.pA_LH_shank[4] = w.v_LH_shank[5]*h8 - 6e-06*w.v_LH_shank[3]*w.v_LH_shank[5] + w.v_LH_shank[2]*h6 - 0.064*w.v_LH_shank[0]*w.v_LH_shank[2];
+    w.pA_LH_shank[5] = w.v_LH_shank[3]*h9 - w.v_LH_shank[4]*h8 + w.v_LH_shank[0]*h7 - w.v_LH_shank[1]*h6;
+    w.g_LH_shank[0] = w.cq_LH_shank*w.g_LH_thigh[0] - w.sq_LH_shank*w.g_LH_thigh[2];
+    w.g_LH_shank[2] = w.sq_LH_shank*w.g_LH_thigh[0] + w.cq_LH_shank*w.g_LH_thigh[2];
     // constraint 'lh_foot' (3d) on link 'LH_foot': rows 6..8
-    const Scalar t2 = w.v_LH_shank[2] + 0.004*w.v_LH_shank[3];
-    const Scalar t3 = w.v_LH_shank[1] + 0.195*w.v_LH_shank[3];
-    const Scalar t4 = w.v_LH_shank[0] - 0.195*w.v_LH_shank[4] - 0.004*w.v_LH_shank[5];
-    w.k_lh_foot[0] = -w.g_LH_shank[0] - w.v_LH_shank[4]*t2 + w.v_LH_shank[5]*t3;
-    w.k_lh_foot[1] = -w.g_LH_hip[1] - w.v_LH_shank[5]*t4 + w.v_LH_shank[3]*t2;
-    w.k_lh_foot[2] = -w.g_LH_shank[2] - w.v_LH_shank[3]*t3 + w.v_LH_shank[4]*t4;
+    const Scalar t4 = w.v_LH_shank[2] + 0.004*w.v_LH_shank[3];
+    const Scalar t5 = w.v_LH_shank[1] + 0.195*w.v_LH_shank[3];
+    const Scalar t6 = w.v_LH_shank[0] - 0.195*w.v_LH_shank[4] - 0.004*w.v_LH_shank[5];
+    w.k_lh_foot[0] = -w.g_LH_shank[0] - w.v_LH_shank[4]*t4 + w.v_LH_shank[5]*t5;
+    w.k_lh_foot[1] = -w.g_LH_hip[1] - w.v_LH_shank[5]*t6 + w.v_LH_shank[3]*t4;
+    w.k_lh_foot[2] = -w.g_LH_shank[2] - w.v_LH_shank[3]*t5 + w.v_LH_shank[4]*t6;
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    proxgen_rt::sincos(q[13], w.sq_RF_hip, w.cq_RF_hip);
-    w.RJ_RF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq_RF_hip;
-    w.RJ_RF_hip[0][1] = -0.09950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
-    w.RJ_RF_hip[1][0] = 0.09950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[1][2] = -0.9950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
-    w.RJ_RF_hip[2][1] = 0.9950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_RF_hip;
-    const Scalar t5 = v[0] + 0.049*v[5];
-    const Scalar t6 = v[1] + 0.19*v[5];
-    const Scalar t7 = v[2] - 0.049*v[3] - 0.19*v[4];
-    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t5 + w.RJ_RF_hip[1][0]*t6 + w.RJ_RF_hip[2][0]*t7;
-    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t5 + w.cq_RF_hip*t6 + w.RJ_RF_hip[2][1]*t7;
-    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t5 + w.RJ_RF_hip[1][2]*t6 + w.RJ_RF_hip[2][2]*t7;
+    const Scalar t0 = v[0] + 0.049*v[5];
+    const Scalar t1 = v[1] + 0.19*v[5];
+    const Scalar t2 = v[2] - 0.049*v[3] - 0.19*v[4];
+    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t0 + w.RJ_RF_hip[1][0]*t1 + w.RJ_RF_hip[2][0]*t2;
+    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[2][1]*t2;
+    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t0 + w.RJ_RF_hip[1][2]*t1 + w.RJ_RF_hip[2][2]*t2;
     w.v_RF_hip[3] = 0.9950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][0] + v[4]*w.RJ_RF_hip[1][0] + v[5]*w.RJ_RF_hip[2][0];
     w.v_RF_hip[4] = v[3]*w.RJ_RF_hip[0][1] + v[4]*w.cq_RF_hip + v[5]*w.RJ_RF_hip[2][1];
     w.v_RF_hip[5] = 0.09950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][2] + v[4]*w.RJ_RF_hip[1][2] + v[5]*w.RJ_RF_hip[2][2];
@@ -307,61 +365,59 @@ PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_
     w.c_RF_hip[3] = 0.09950371902099893*v[12]*w.v_RF_hip[4];
     w.c_RF_hip[4] = 0.9950371902099893*v[12]*w.v_RF_hip[5] - 0.09950371902099893*v[12]*w.v_RF_hip[3];
     w.c_RF_hip[5] = -0.9950371902099893*v[12]*w.v_RF_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
-    const Scalar h6 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
-    const Scalar h7 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
-    const Scalar h8 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
-    w.pA_RF_hip[0] = w.v_RF_hip[4]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
-    w.pA_RF_hip[1] = w.v_RF_hip[5]*h4 - w.v_RF_hip[3]*h5;
-    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h4;
-    w.pA_RF_hip[3] = w.v_RF_hip[4]*h8 - w.v_RF_hip[5]*h7 + w.v_RF_hip[1]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
-    w.pA_RF_hip[4] = w.v_RF_hip[5]*h6 - w.v_RF_hip[3]*h8 + w.v_RF_hip[2]*h4 - w.v_RF_hip[0]*h5;
-    w.pA_RF_hip[5] = w.v_RF_hip[3]*h7 - w.v_RF_hip[4]*h6 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h4;
+    const Scalar h0 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
+    const Scalar h2 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
+    const Scalar h3 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
+    const Scalar h4 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
+    w.pA_RF_hip[0] = w.v_RF_hip[4]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
+    w.pA_RF_hip[1] = w.v_RF_hip[5]*h0 - w.v_RF_hip[3]*h1;
+    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h0;
+    w.pA_RF_hip[3] = w.v_RF_hip[4]*h4 - w.v_RF_hip[5]*h3 + w.v_RF_hip[1]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
+    w.pA_RF_hip[4] = w.v_RF_hip[5]*h2 - w.v_RF_hip[3]*h4 + w.v_RF_hip[2]*h0 - w.v_RF_hip[0]*h1;
+    w.pA_RF_hip[5] = w.v_RF_hip[3]*h3 - w.v_RF_hip[4]*h2 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h0;
     w.g_RF_hip[0] = w.g_trunk[0]*w.RJ_RF_hip[0][0] + w.g_trunk[1]*w.RJ_RF_hip[1][0] + w.g_trunk[2]*w.RJ_RF_hip[2][0];
     w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[0][1] + w.g_trunk[1]*w.cq_RF_hip + w.g_trunk[2]*w.RJ_RF_hip[2][1];
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[0][2] + w.g_trunk[1]*w.RJ_RF_hip[1][2] + w.g_trunk[2]*w.RJ_RF_hip[2][2];
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   {
-    proxgen_rt::sincos(q[14], w.sq_RF_thigh, w.cq_RF_thigh);
-    const Scalar t0 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
-    const Scalar t1 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
-    w.v_RF_thigh[0] = w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
-    w.v_RF_thigh[2] = w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
-    w.v_RF_thigh[3] = w.v_RF_hip[3]*w.cq_RF_thigh - w.v_RF_hip[5]*w.sq_RF_thigh;
+    const Scalar t3 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
+    const Scalar t4 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
+    w.v_RF_thigh[0] = w.cq_RF_thigh*t3 - w.sq_RF_thigh*t4;
+    w.v_RF_thigh[2] = w.sq_RF_thigh*t3 + w.cq_RF_thigh*t4;
+    w.v_RF_thigh[3] = w.cq_RF_thigh*w.v_RF_hip[3] - w.sq_RF_thigh*w.v_RF_hip[5];
     w.v_RF_thigh[4] = w.v_RF_hip[4] + v[13];
-    w.v_RF_thigh[5] = w.v_RF_hip[3]*w.sq_RF_thigh + w.v_RF_hip[5]*w.cq_RF_thigh;
+    w.v_RF_thigh[5] = w.sq_RF_thigh*w.v_RF_hip[3] + w.cq_RF_thigh*w.v_RF_hip[5];
     w.c_RF_thigh[0] = -v[13]*w.v_RF_thigh[2];
     w.c_RF_thigh[2] = v[13]*w.v_RF_thigh[0];
     w.c_RF_thigh[3] = -v[13]*w.v_RF_thigh[5];
     w.c_RF_thigh[5] = v[13]*w.v_RF_thigh[3];
-    const Scalar h0 = 0.6890000000000001*w.v_RF_thigh[0] - 0.01268*w.v_RF_thigh[4] - 0.010144*w.v_RF_thigh[5];
-    const Scalar h1 = 0.6890000000000001*w.v_RF_hip[1] + 0.01268*w.v_RF_thigh[3];
-    const Scalar h2 = 0.6890000000000001*w.v_RF_thigh[2] + 0.010144*w.v_RF_thigh[3];
-    const Scalar h3 = 0.01268*w.v_RF_hip[1] + 0.010144*w.v_RF_thigh[2] + 0.002431904*w.v_RF_thigh[3];
-    const Scalar h4 = -0.01268*w.v_RF_thigh[0] + 0.0024196*w.v_RF_thigh[4] + 0.00020288*w.v_RF_thigh[5];
-    const Scalar h5 = -0.010144*w.v_RF_thigh[0] + 0.00020288*w.v_RF_thigh[4] + 0.0006033039999999999*w.v_RF_thigh[5];
-    w.pA_RF_thigh[0] = w.v_RF_thigh[4]*h2 - w.v_RF_thigh[5]*h1;
-    w.pA_RF_thigh[1] = w.v_RF_thigh[5]*h0 - w.v_RF_thigh[3]*h2;
-    w.pA_RF_thigh[2] = w.v_RF_thigh[3]*h1 - w.v_RF_thigh[4]*h0;
-    w.pA_RF_thigh[3] = w.v_RF_thigh[4]*h5 - w.v_RF_thigh[5]*h4 + w.v_RF_hip[1]*h2 - w.v_RF_thigh[2]*h1;
-    w.pA_RF_thigh[4] = w.v_RF_thigh[5]*h3 - w.v_RF_thigh[3]*h5 + w.v_RF_thigh[2]*h0 - w.v_RF_thigh[0]*h2;
-    w.pA_RF_thigh[5] = w.v_RF_thigh[3]*h4 - w.v_RF_thigh[4]*h3 + w.v_RF_thigh[0]*h1 - w.v_RF_hip[1]*h0;
-    w.g_RF_thigh[0] = w.g_RF_hip[0]*w.cq_RF_thigh - w.g_RF_hip[2]*w.sq_RF_thigh;
-    w.g_RF_thigh[2] = w.g_RF_hip[0]*w.sq_RF_thigh + w.g_RF_hip[2]*w.cq_RF_thigh;
+    const Scalar h5 = 0.6890000000000001*w.v_RF_thigh[0] - 0.01268*w.v_RF_thigh[4] - 0.010144*w.v_RF_thigh[5];
+    const Scalar h6 = 0.6890000000000001*w.v_RF_hip[1] + 0.01268*w.v_RF_thigh[3];
+    const Scalar h7 = 0.6890000000000001*w.v_RF_thigh[2] + 0.010144*w.v_RF_thigh[3];
+    const Scalar h8 = 0.01268*w.v_RF_hip[1] + 0.010144*w.v_RF_thigh[2] + 0.002431904*w.v_RF_thigh[3];
+    const Scalar h9 = -0.01268*w.v_RF_thigh[0] + 0.0024196*w.v_RF_thigh[4] + 0.00020288*w.v_RF_thigh[5];
+    const Scalar h10 = -0.010144*w.v_RF_thigh[0] + 0.00020288*w.v_RF_thigh[4] + 0.0006033039999999999*w.v_RF_thigh[5];
+    w.pA_RF_thigh[0] = w.v_RF_thigh[4]*h7 - w.v_RF_thigh[5]*h6;
+    w.pA_RF_thigh[1] = w.v_RF_thigh[5]*h5 - w.v_RF_thigh[3]*h7;
+    w.pA_RF_thigh[2] = w.v_RF_thigh[3]*h6 - w.v_RF_thigh[4]*h5;
+    w.pA_RF_thigh[3] = w.v_RF_thigh[4]*h10 - w.v_RF_thigh[5]*h9 + w.v_RF_hip[1]*h7 - w.v_RF_thigh[2]*h6;
+    w.pA_RF_thigh[4] = w.v_RF_thigh[5]*h8 - w.v_RF_thigh[3]*h10 + w.v_RF_thigh[2]*h5 - w.v_RF_thigh[0]*h7;
+    w.pA_RF_thigh[5] = w.v_RF_thigh[3]*h9 - w.v_RF_thigh[4]*h8 + w.v_RF_thigh[0]*h6 - w.v_RF_hip[1]*h5;
+    w.g_RF_thigh[0] = w.cq_RF_thigh*w.g_RF_hip[0] - w.sq_RF_thigh*w.g_RF_hip[2];
+    w.g_RF_thigh[2] = w.sq_RF_thigh*w.g_RF_hip[0] + w.cq_RF_thigh*w.g_RF_hip[2];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   {
-    proxgen_rt::sincos(q[15], w.sq_RF_shank, w.cq_RF_shank);
-    const Scalar t2 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
-    const Scalar t3 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
-    w.v_RF_shank[0] = w.cq_RF_shank*t2 - w.v_RF_thigh[2]*w.sq_RF_shank;
-    w.v_RF_shank[1] = t3;
-    w.v_RF_shank[2] = w.sq_RF_shank*t2 + w.v_RF_thigh[2]*w.cq_RF_shank;
+    const Scalar t0 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
+    const Scalar t1 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
+    w.v_RF_shank[0] = w.cq_RF_shank*t0 - w.v_RF_thigh[2]*w.sq_RF_shank;
+    w.v_RF_shank[1] = t1;
+    w.v_RF_shank[2] = w.sq_RF_shank*t0 + w.v_RF_thigh[2]*w.cq_RF_shank;
     w.v_RF_shank[3] = w.v_RF_thigh[3]*w.cq_RF_shank - w.v_RF_thigh[5]*w.sq_RF_shank;
     w.v_RF_shank[4] = w.v_RF_thigh[4] + v[14];
     w.v_RF_shank[5] = w.v_RF_thigh[3]*w.sq_RF_shank + w.v_RF_thigh[5]*w.cq_RF_shank;
@@ -369,46 +425,34 @@ PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RF_shank(const Scalar* PROXGEN_R
     w.c_RF_shank[2] = v[14]*w.v_RF_shank[0];
     w.c_RF_shank[3] = -v[14]*w.v_RF_shank[5];
     w.c_RF_shank[5] = v[14]*w.v_RF_shank[3];
-    const Scalar h6 = 0.064*w.v_RF_shank[0] - 0.003904*w.v_RF_shank[4];
-    const Scalar h7 = 0.064*w.v_RF_shank[1] + 0.003904*w.v_RF_shank[3];
-    const Scalar h8 = 0.003904*w.v_RF_shank[1] + 0.000483144*w.v_RF_shank[3];
-    const Scalar h9 = -0.003904*w.v_RF_shank[0] + 0.000486144*w.v_RF_shank[4];
-    w.pA_RF_shank[0] = 0.064*w.v_RF_shank[2]*w.v_RF_shank[4] - w.v_RF_shank[5]*h7;
-    w.pA_RF_shank[1] = w.v_RF_shank[5]*h6 - 0.064*w.v_RF_shank[2]*w.v_RF_shank[3];
-    w.pA_RF_shank[2] = w.v_RF_shank[3]*h7 - w.v_RF_shank[4]*h6;
-    w.pA_RF_shank[3] = 6e-06*w.v_RF_shank[4]*w.v_RF_shank[5] - w.v_RF_shank[5]*h9 + 0.064*w.v_RF_shank[1]*w.v_RF_shank[2] - w.v_RF_shank[2]*h7;
-    w.pA_RF_shank[4] = w.v_RF_shank[5]*h8 - 6e-06*w.v_RF_shank[3]*w.v_RF_shank[5] + w.v_RF_shank[2]*h6 - 0.064*w.v_RF_shank[0]*w.v_RF_shank[2];
-    w.pA_RF_shank[5] = w.v_RF_shank[3]*h9 - w.v_RF_shank[4]*h8 + w.v_RF_shank[0]*h7 - w.v_RF_shank[1]*h6;
+    const Scalar h0 = 0.064*w.v_RF_shank[0] - 0.003904*w.v_RF_shank[4];
+    const Scalar h1 = 0.064*w.v_RF_shank[1] + 0.003904*w.v_RF_shank[3];
+    const Scalar h2 = 0.003904*w.v_RF_shank[1] + 0.000483144*w.v_RF_shank[3];
+    const Scalar h3 = -0.003904*w.v_RF_shank[0] + 0.000486144*w.v_RF_shank[4];
+    w.pA_RF_shank[0] = 0.064*w.v_RF_shank[2]*w.v_RF_shank[4] - w.v_RF_shank[5]*h1;
+    w.pA_RF_shank[1] = w.v_RF_shank[5]*h0 - 0.064*w.v_RF_shank[2]*w.v_RF_shank[3];
+    w.pA_RF_shank[2] = w.v_RF_shank[3]*h1 - w.v_RF_shank[4]*h0;
+    w.pA_RF_shank[3] = 6e-06*w.v_RF_shank[4]*w.v_RF_shank[5] - w.v_RF_shank[5]*h3 + 0.064*w.v_RF_shank[1]*w.v_RF_shank[2] - w.v_RF_shank[2]*h1;
+    w.pA_RF_shank[4] = w.v_RF_shank[5]*h2 - 6e-06*w.v_RF_shank[3]*w.v_RF_shank[5] + w.v_RF_shank[2]*h0 - 0.064*w.v_RF_shank[0]*w.v_RF_shank[2];
+    w.pA_RF_shank[5] = w.v_RF_shank[3]*h3 - w.v_RF_shank[4]*h2 + w.v_RF_shank[0]*h1 - w.v_RF_shank[1]*h0;
     w.g_RF_shank[0] = w.g_RF_thigh[0]*w.cq_RF_shank - w.g_RF_thigh[2]*w.sq_RF_shank;
     w.g_RF_shank[2] = w.g_RF_thigh[0]*w.sq_RF_shank + w.g_RF_thigh[2]*w.cq_RF_shank;
     // constraint 'rf_foot' (3d) on link 'RF_foot': rows 3..5
-    const Scalar t4 = w.v_RF_shank[2] - 0.004*w.v_RF_shank[3];
-    const Scalar t5 = w.v_RF_shank[1] + 0.195*w.v_RF_shank[3];
-    const Scalar t6 = w.v_RF_shank[0] - 0.195*w.v_RF_shank[4] + 0.004*w.v_RF_shank[5];
-    w.k_rf_foot[0] = -w.g_RF_shank[0] - w.v_RF_shank[4]*t4 + w.v_RF_shank[5]*t5;
-    w.k_rf_foot[1] = -w.g_RF_hip[1] - w.v_RF_shank[5]*t6 + w.v_RF_shank[3]*t4;
-    w.k_rf_foot[2] = -w.g_RF_shank[2] - w.v_RF_shank[3]*t5 + w.v_RF_shank[4]*t6;
+    const Scalar t2 = w.v_RF_shank[2] - 0.004*w.v_RF_shank[3];
+    const Scalar t3 = w.v_RF_shank[1] + 0.195*w.v_RF_shank[3];
+    const Scalar t4 = w.v_RF_shank[0] - 0.195*w.v_RF_shank[4] + 0.004*w.v_RF_shank[5];
+    w.k_rf_foot[0] = -w.g_RF_shank[0] - w.v_RF_shank[4]*t2 + w.v_RF_shank[5]*t3;
+    w.k_rf_foot[1] = -w.g_RF_hip[1] - w.v_RF_shank[5]*t4 + w.v_RF_shank[3]*t2;
+    w.k_rf_foot[2] = -w.g_RF_shank[2] - w.v_RF_shank[3]*t3 + w.v_RF_shank[4]*t4;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    proxgen_rt::sincos(q[16], w.sq_RH_hip, w.cq_RH_hip);
-    w.RJ_RH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_RH_hip;
-    w.RJ_RH_hip[0][1] = 0.09950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
-    w.RJ_RH_hip[1][0] = -0.09950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[1][2] = -0.9950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
-    w.RJ_RH_hip[2][1] = 0.9950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_RH_hip;
-    const Scalar t0 = v[0] + 0.049*v[5];
-    const Scalar t1 = v[1] - 0.19*v[5];
-    const Scalar t2 = v[2] - 0.049*v[3] + 0.19*v[4];
-    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t0 + w.RJ_RH_hip[1][0]*t1 + w.RJ_RH_hip[2][0]*t2;
-    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t0 + w.cq_RH_hip*t1 + w.RJ_RH_hip[2][1]*t2;
-    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t0 + w.RJ_RH_hip[1][2]*t1 + w.RJ_RH_hip[2][2]*t2;
+    const Scalar t5 = v[0] + 0.049*v[5];
+    const Scalar t6 = v[1] - 0.19*v[5];
+    const Scalar t7 = v[2] - 0.049*v[3] + 0.19*v[4];
+    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t5 + w.RJ_RH_hip[1][0]*t6 + w.RJ_RH_hip[2][0]*t7;
+    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t5 + w.cq_RH_hip*t6 + w.RJ_RH_hip[2][1]*t7;
+    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t5 + w.RJ_RH_hip[1][2]*t6 + w.RJ_RH_hip[2][2]*t7;
     w.v_RH_hip[3] = 0.9950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][0] + v[4]*w.RJ_RH_hip[1][0] + v[5]*w.RJ_RH_hip[2][0];
     w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[0][1] + v[4]*w.cq_RH_hip + v[5]*w.RJ_RH_hip[2][1];
     w.v_RH_hip[5] = -0.09950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][2] + v[4]*w.RJ_RH_hip[1][2] + v[5]*w.RJ_RH_hip[2][2];
@@ -418,28 +462,30 @@ PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_
     w.c_RH_hip[3] = -0.09950371902099892*v[15]*w.v_RH_hip[4];
     w.c_RH_hip[4] = 0.9950371902099892*v[15]*w.v_RH_hip[5] + 0.09950371902099892*v[15]*w.v_RH_hip[3];
     w.c_RH_hip[5] = -0.9950371902099892*v[15]*w.v_RH_hip[4];
-    const Scalar h0 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
-    const Scalar h1 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
-    const Scalar h2 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
-    const Scalar h3 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
-    const Scalar h4 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
-    w.pA_RH_hip[0] = w.v_RH_hip[4]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
-    w.pA_RH_hip[1] = w.v_RH_hip[5]*h0 - w.v_RH_hip[3]*h1;
-    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h0;
-    w.pA_RH_hip[3] = w.v_RH_hip[4]*h4 - w.v_RH_hip[5]*h3 + w.v_RH_hip[1]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
-    w.pA_RH_hip[4] = w.v_RH_hip[5]*h2 - w.v_RH_hip[3]*h4 + w.v_RH_hip[2]*h0 - w.v_RH_hip[0]*h1;
-    w.pA_RH_hip[5] = w.v_RH_hip[3]*h3 - w.v_RH_hip[4]*h2 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h0;
+    const Scalar h4 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
+    const Scalar h5 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
+    const Scalar h6 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
+    const Scalar h7 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
+    const Scalar h8 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
+    w.pA_RH_hip[0] = w.v_RH_hip[4]*h5 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
+    w.pA_RH_hip[1] = w.v_RH_hip[5]*h4 - w.v_RH_hip[3]*h5;
+    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h4;
+    w.pA_RH_hip[3] = w.v_RH_hip[4]*h8 - w.v_RH_hip[5]*h7 + w.v_RH_hip[1]*h5 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
+    w.pA_RH_hip[4] = w.v_RH_hip[5]*h6 - w.v_RH_hip[3]*h8 + w.v_RH_hip[2]*h4 - w.v_RH_hip[0]*h5;
+    w.pA_RH_hip[5] = w.v_RH_hip[3]*h7 - w.v_RH_hip[4]*h6 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h4;
     w.g_RH_hip[0] = w.g_trunk[0]*w.RJ_RH_hip[0][0] + w.g_trunk[1]*w.RJ_RH_hip[1][0] + w.g_trunk[2]*w.RJ_RH_hip[2][0];
     w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[0][1] + w.g_trunk[1]*w.cq_RH_hip + w.g_trunk[2]*w.RJ_RH_hip[2][1];
     w.g_RH_hip[2] = w.g_trunk[0]*w.RJ_RH_hip[0][2] + w.g_trunk[1]*w.RJ_RH_hip[1][2] + w.g_trunk[2]*w.RJ_RH_hip[2][2];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   {
-    proxgen_rt::sincos(q[17], w.sq_RH_thigh, w.cq_RH_thigh);
-    const Scalar t3 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
-    const Scalar t4 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
-    w.v_RH_thigh[0] = w.cq_RH_thigh*t3 - w.sq_RH_thigh*t4;
-    w.v_RH_thigh[2] = w.sq_RH_thigh*t3 + w.cq_RH_thigh*t4;
+    const Scalar t0 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
+    const Scalar t1 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
+    w.v_RH_thigh[0] = w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
+    w.v_RH_thigh[2] = w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
     w.v_RH_thigh[3] = w.v_RH_hip[3]*w.cq_RH_thigh - w.v_RH_hip[5]*w.sq_RH_thigh;
     w.v_RH_thigh[4] = w.v_RH_hip[4] + v[16];
     w.v_RH_thigh[5] = w.v_RH_hip[3]*w.sq_RH_thigh + w.v_RH_hip[5]*w.cq_RH_thigh;
@@ -447,58 +493,54 @@ PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_
     w.c_RH_thigh[2] = v[16]*w.v_RH_thigh[0];
     w.c_RH_thigh[3] = -v[16]*w.v_RH_thigh[5];
     w.c_RH_thigh[5] = v[16]*w.v_RH_thigh[3];
-    const Scalar h5 = 0.6890000000000001*w.v_RH_thigh[0] - 0.01268*w.v_RH_thigh[4] - 0.010144*w.v_RH_thigh[5];
-    const Scalar h6 = 0.6890000000000001*w.v_RH_hip[1] + 0.01268*w.v_RH_thigh[3];
-    const Scalar h7 = 0.6890000000000001*w.v_RH_thigh[2] + 0.010144*w.v_RH_thigh[3];
-    const Scalar h8 = 0.01268*w.v_RH_hip[1] + 0.010144*w.v_RH_thigh[2] + 0.002431904*w.v_RH_thigh[3];
-    const Scalar h9 = -0.01268*w.v_RH_thigh[0] + 0.0024196*w.v_RH_thigh[4] + 0.00020288*w.v_RH_thigh[5];
-    const Scalar h10 = -0.010144*w.v_RH_thigh[0] + 0.00020288*w.v_RH_thigh[4] + 0.0006033039999999999*w.v_RH_thigh[5];
-    w.pA_RH_thigh[0] = w.v_RH_thigh[4]*h7 - w.v_RH_thigh[5]*h6;
-    w.pA_RH_thigh[1] = w.v_RH_thigh[5]*h5 - w.v_RH_thigh[3]*h7;
-    w.pA_RH_thigh[2] = w.v_RH_thigh[3]*h6 - w.v_RH_thigh[4]*h5;
-    w.pA_RH_thigh[3] = w.v_RH_thigh[4]*h10 - w.v_RH_thigh[5]*h9 + w.v_RH_hip[1]*h7 - w.v_RH_thigh[2]*h6;
-    w.pA_RH_thigh[4] = w.v_RH_thigh[5]*h8 - w.v_RH_thigh[3]*h10 + w.v_RH_thigh[2]*h5 - w.v_RH_thigh[0]*h7;
-    w.pA_RH_thigh[5] = w.v_RH_thigh[3]*h9 - w.v_RH_thigh[4]*h8 + w.v_RH_thigh[0]*h6 - w.v_RH_hip[1]*h5;
+    const Scalar h0 = 0.6890000000000001*w.v_RH_thigh[0] - 0.01268*w.v_RH_thigh[4] - 0.010144*w.v_RH_thigh[5];
+    const Scalar h1 = 0.6890000000000001*w.v_RH_hip[1] + 0.01268*w.v_RH_thigh[3];
+    const Scalar h2 = 0.6890000000000001*w.v_RH_thigh[2] + 0.010144*w.v_RH_thigh[3];
+    const Scalar h3 = 0.01268*w.v_RH_hip[1] + 0.010144*w.v_RH_thigh[2] + 0.002431904*w.v_RH_thigh[3];
+    const Scalar h4 = -0.01268*w.v_RH_thigh[0] + 0.0024196*w.v_RH_thigh[4] + 0.00020288*w.v_RH_thigh[5];
+    const Scalar h5 = -0.010144*w.v_RH_thigh[0] + 0.00020288*w.v_RH_thigh[4] + 0.0006033039999999999*w.v_RH_thigh[5];
+    w.pA_RH_thigh[0] = w.v_RH_thigh[4]*h2 - w.v_RH_thigh[5]*h1;
+    w.pA_RH_thigh[1] = w.v_RH_thigh[5]*h0 - w.v_RH_thigh[3]*h2;
+    w.pA_RH_thigh[2] = w.v_RH_thigh[3]*h1 - w.v_RH_thigh[4]*h0;
+    w.pA_RH_thigh[3] = w.v_RH_thigh[4]*h5 - w.v_RH_thigh[5]*h4 + w.v_RH_hip[1]*h2 - w.v_RH_thigh[2]*h1;
+    w.pA_RH_thigh[4] = w.v_RH_thigh[5]*h3 - w.v_RH_thigh[3]*h5 + w.v_RH_thigh[2]*h0 - w.v_RH_thigh[0]*h2;
+    w.pA_RH_thigh[5] = w.v_RH_thigh[3]*h4 - w.v_RH_thigh[4]*h3 + w.v_RH_thigh[0]*h1 - w.v_RH_hip[1]*h0;
     w.g_RH_thigh[0] = w.g_RH_hip[0]*w.cq_RH_thigh - w.g_RH_hip[2]*w.sq_RH_thigh;
     w.g_RH_thigh[2] = w.g_RH_hip[0]*w.sq_RH_thigh + w.g_RH_hip[2]*w.cq_RH_thigh;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
   {
-    proxgen_rt::sincos(q[18], w.sq_RH_shank, w.cq_RH_shank);
-    const Scalar t0 = w.v_RH_thigh[0] - 0.209*w.v_RH_thigh[4];
-    const Scalar t1 = w.v_RH_hip[1] + 0.209*w.v_RH_thigh[3];
-    w.v_RH_shank[0] = w.cq_RH_shank*t0 - w.v_RH_thigh[2]*w.sq_RH_shank;
-    w.v_RH_shank[1] = t1;
-    w.v_RH_shank[2] = w.sq_RH_shank*t0 + w.v_RH_thigh[2]*w.cq_RH_shank;
-    w.v_RH_shank[3] = w.v_RH_thigh[3]*w.cq_RH_shank - w.v_RH_thigh[5]*w.sq_RH_shank;
+    const Scalar t2 = w.v_RH_thigh[0] - 0.209*w.v_RH_thigh[4];
+    const Scalar t3 = w.v_RH_hip[1] + 0.209*w.v_RH_thigh[3];
+    w.v_RH_shank[0] = w.cq_RH_shank*t2 - w.sq_RH_shank*w.v_RH_thigh[2];
+    w.v_RH_shank[1] = t3;
+    w.v_RH_shank[2] = w.sq_RH_shank*t2 + w.cq_RH_shank*w.v_RH_thigh[2];
+    w.v_RH_shank[3] = w.cq_RH_shank*w.v_RH_thigh[3] - w.sq_RH_shank*w.v_RH_thigh[5];
     w.v_RH_shank[4] = w.v_RH_thigh[4] + v[17];
-    w.v_RH_shank[5] = w.v_RH_thigh[3]*w.sq_RH_shank + w.v_RH_thigh[5]*w.cq_RH_shank;
+    w.v_RH_shank[5] = w.sq_RH_shank*w.v_RH_thigh[3] + w.cq_RH_shank*w.v_RH_thigh[5];
     w.c_RH_shank[0] = -v[17]*w.v_RH_shank[2];
     w.c_RH_shank[2] = v[17]*w.v_RH_shank[0];
     w.c_RH_shank[3] = -v[17]*w.v_RH_shank[5];
     w.c_RH_shank[5] = v[17]*w.v_RH_shank[3];
-    const Scalar h0 = 0.064*w.v_RH_shank[0] - 0.003904*w.v_RH_shank[4];
-    const Scalar h1 = 0.064*w.v_RH_shank[1] + 0.003904*w.v_RH_shank[3];
-    const Scalar h2 = 0.003904*w.v_RH_shank[1] + 0.000483144*w.v_RH_shank[3];
-    const Scalar h3 = -0.003904*w.v_RH_shank[0] + 0.000486144*w.v_RH_shank[4];
-    w.pA_RH_shank[0] = 0.064*w.v_RH_shank[2]*w.v_RH_shank[4] - w.v_RH_shank[5]*h1;
-    w.pA_RH_shank[1] = w.v_RH_shank[5]*h0 - 0.064*w.v_RH_shank[2]*w.v_RH_shank[3];
-    w.pA_RH_shank[2] = w.v_RH_shank[3]*h1 - w.v_RH_shank[4]*h0;
-    w.pA_RH_shank[3] = 6e-06*w.v_RH_shank[4]*w.v_RH_shank[5] - w.v_RH_shank[5]*h3 + 0.064*w.v_RH_shank[1]*w.v_RH_shank[2] - w.v_RH_shank[2]*h1;
-    w.pA_RH_shank[4] = w.v_RH_shank[5]*h2 - 6e-06*w.v_RH_shank[3]*w.v_RH_shank[5] + w.v_RH_shank[2]*h0 - 0.064*w.v_RH_shank[0]*w.v_RH_shank[2];
-    w.pA_RH_shank[5] = w.v_RH_shank[3]*h3 - w.v_RH_shank[4]*h2 + w.v_RH_shank[0]*h1 - w.v_RH_shank[1]*h0;
-    w.g_RH_shank[0] = w.g_RH_thigh[0]*w.cq_RH_shank - w.g_RH_thigh[2]*w.sq_RH_shank;
-    w.g_RH_shank[2] = w.g_RH_thigh[0]*w.sq_RH_shank + w.g_RH_thigh[2]*w.cq_RH_shank;
+    const Scalar h6 = 0.064*w.v_RH_shank[0] - 0.003904*w.v_RH_shank[4];
+    const Scalar h7 = 0.064*w.v_RH_shank[1] + 0.003904*w.v_RH_shank[3];
+    const Scalar h8 = 0.003904*w.v_RH_shank[1] + 0.000483144*w.v_RH_shank[3];
+    const Scalar h9 = -0.003904*w.v_RH_shank[0] + 0.000486144*w.v_RH_shank[4];
+    w.pA_RH_shank[0] = 0.064*w.v_RH_shank[2]*w.v_RH_shank[4] - w.v_RH_shank[5]*h7;
+    w.pA_RH_shank[1] = w.v_RH_shank[5]*h6 - 0.064*w.v_RH_shank[2]*w.v_RH_shank[3];
+    w.pA_RH_shank[2] = w.v_RH_shank[3]*h7 - w.v_RH_shank[4]*h6;
+    w.pA_RH_shank[3] = 6e-06*w.v_RH_shank[4]*w.v_RH_shank[5] - w.v_RH_shank[5]*h9 + 0.064*w.v_RH_shank[1]*w.v_RH_shank[2] - w.v_RH_shank[2]*h7;
+    w.pA_RH_shank[4] = w.v_RH_shank[5]*h8 - 6e-06*w.v_RH_shank[3]*w.v_RH_shank[5] + w.v_RH_shank[2]*h6 - 0.064*w.v_RH_shank[0]*w.v_RH_shank[2];
+    w.pA_RH_shank[5] = w.v_RH_shank[3]*h9 - w.v_RH_shank[4]*h8 + w.v_RH_shank[0]*h7 - w.v_RH_shank[1]*h6;
+    w.g_RH_shank[0] = w.cq_RH_shank*w.g_RH_thigh[0] - w.sq_RH_shank*w.g_RH_thigh[2];
+    w.g_RH_shank[2] = w.sq_RH_shank*w.g_RH_thigh[0] + w.cq_RH_shank*w.g_RH_thigh[2];
     // constraint 'rh_foot' (3d) on link 'RH_foot': rows 9..11
-    const Scalar t2 = w.v_RH_shank[2] - 0.004*w.v_RH_shank[3];
-    const Scalar t3 = w.v_RH_shank[1] + 0.195*w.v_RH_shank[3];
-    const Scalar t4 = w.v_RH_shank[0] - 0.195*w.v_RH_shank[4] + 0.004*w.v_RH_shank[5];
-    w.k_rh_foot[0] = -w.g_RH_shank[0] - w.v_RH_shank[4]*t2 + w.v_RH_shank[5]*t3;
-    w.k_rh_foot[1] = -w.g_RH_hip[1] - w.v_RH_shank[5]*t4 + w.v_RH_shank[3]*t2;
-    w.k_rh_foot[2] = -w.g_RH_shank[2] - w.v_RH_shank[3]*t3 + w.v_RH_shank[4]*t4;
+    const Scalar t4 = w.v_RH_shank[2] - 0.004*w.v_RH_shank[3];
+    const Scalar t5 = w.v_RH_shank[1] + 0.195*w.v_RH_shank[3];
+    const Scalar t6 = w.v_RH_shank[0] - 0.195*w.v_RH_shank[4] + 0.004*w.v_RH_shank[5];
+    w.k_rh_foot[0] = -w.g_RH_shank[0] - w.v_RH_shank[4]*t4 + w.v_RH_shank[5]*t5;
+    w.k_rh_foot[1] = -w.g_RH_hip[1] - w.v_RH_shank[5]*t6 + w.v_RH_shank[3]*t4;
+    w.k_rh_foot[2] = -w.g_RH_shank[2] - w.v_RH_shank[3]*t5 + w.v_RH_shank[4]*t6;
   }
 }
 
@@ -5060,13 +5102,16 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  kinematics_trunk_to_LF_hip(q, v, w);
-  kinematics_LF_thigh_to_LF_shank(q, v, w);
-  kinematics_LH_hip_to_LH_thigh(q, v, w);
-  kinematics_LH_shank_to_RF_hip(q, v, w);
-  kinematics_RF_thigh_to_RF_shank(q, v, w);
-  kinematics_RH_hip_to_RH_thigh(q, v, w);
-  kinematics_RH_shank(q, v, w);
+  // ---- joint transforms X_J(q)
+  kinematics_transforms_trunk_to_LH_hip(q, w);
+  kinematics_transforms_LH_thigh_to_RH_shank(q, w);
+  // ---- velocities, bias forces, gravity, placements, constraint terms
+  kinematics_trunk_to_LF_thigh(v, w);
+  kinematics_LF_shank_to_LH_hip(v, w);
+  kinematics_LH_thigh_to_LH_shank(v, w);
+  kinematics_RF_hip_to_RF_thigh(v, w);
+  kinematics_RF_shank_to_RH_hip(v, w);
+  kinematics_RH_thigh_to_RH_shank(v, w);
 }
 
 }  // namespace

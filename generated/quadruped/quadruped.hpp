@@ -106,83 +106,83 @@ struct Settings {
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar RJ_trunk[3][3];       // joint rotation, body 1
-  Scalar pA_trunk[6];          // bias force, body 1
-  Scalar g_trunk[3];           // gravity in body coordinates, body 1
   Scalar sq_LF_hip;            // sin q, body 2
   Scalar cq_LF_hip;            // cos q, body 2
   Scalar RJ_LF_hip[3][3];      // joint rotation, body 2
+  Scalar sq_LF_thigh;          // sin q, body 3
+  Scalar cq_LF_thigh;          // cos q, body 3
+  Scalar sq_LF_shank;          // sin q, body 4
+  Scalar cq_LF_shank;          // cos q, body 4
+  Scalar sq_LH_hip;            // sin q, body 5
+  Scalar cq_LH_hip;            // cos q, body 5
+  Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
+  Scalar sq_LH_thigh;          // sin q, body 6
+  Scalar cq_LH_thigh;          // cos q, body 6
+  Scalar sq_LH_shank;          // sin q, body 7
+  Scalar cq_LH_shank;          // cos q, body 7
+  Scalar sq_RF_hip;            // sin q, body 8
+  Scalar cq_RF_hip;            // cos q, body 8
+  Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
+  Scalar sq_RF_thigh;          // sin q, body 9
+  Scalar cq_RF_thigh;          // cos q, body 9
+  Scalar sq_RF_shank;          // sin q, body 10
+  Scalar cq_RF_shank;          // cos q, body 10
+  Scalar sq_RH_hip;            // sin q, body 11
+  Scalar cq_RH_hip;            // cos q, body 11
+  Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
+  Scalar sq_RH_thigh;          // sin q, body 12
+  Scalar cq_RH_thigh;          // cos q, body 12
+  Scalar sq_RH_shank;          // sin q, body 13
+  Scalar cq_RH_shank;          // cos q, body 13
+  Scalar pA_trunk[6];          // bias force, body 1
+  Scalar g_trunk[3];           // gravity in body coordinates, body 1
   Scalar v_LF_hip[6];          // velocity, body 2
   Scalar c_LF_hip[6];          // velocity-product acceleration, body 2
   Scalar pA_LF_hip[6];         // bias force, body 2
   Scalar g_LF_hip[3];          // gravity in body coordinates, body 2
-  Scalar sq_LF_thigh;          // sin q, body 3
-  Scalar cq_LF_thigh;          // cos q, body 3
   Scalar v_LF_thigh[6];        // velocity, body 3
   Scalar c_LF_thigh[6];        // velocity-product acceleration, body 3
   Scalar pA_LF_thigh[6];       // bias force, body 3
   Scalar g_LF_thigh[3];        // gravity in body coordinates, body 3
-  Scalar sq_LF_shank;          // sin q, body 4
-  Scalar cq_LF_shank;          // cos q, body 4
   Scalar v_LF_shank[6];        // velocity, body 4
   Scalar c_LF_shank[6];        // velocity-product acceleration, body 4
   Scalar pA_LF_shank[6];       // bias force, body 4
   Scalar g_LF_shank[3];        // gravity in body coordinates, body 4
   Scalar k_lf_foot[3];         // constraint right-hand side, constraint 0
-  Scalar sq_LH_hip;            // sin q, body 5
-  Scalar cq_LH_hip;            // cos q, body 5
-  Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
   Scalar v_LH_hip[6];          // velocity, body 5
   Scalar c_LH_hip[6];          // velocity-product acceleration, body 5
   Scalar pA_LH_hip[6];         // bias force, body 5
   Scalar g_LH_hip[3];          // gravity in body coordinates, body 5
-  Scalar sq_LH_thigh;          // sin q, body 6
-  Scalar cq_LH_thigh;          // cos q, body 6
   Scalar v_LH_thigh[6];        // velocity, body 6
   Scalar c_LH_thigh[6];        // velocity-product acceleration, body 6
   Scalar pA_LH_thigh[6];       // bias force, body 6
   Scalar g_LH_thigh[3];        // gravity in body coordinates, body 6
-  Scalar sq_LH_shank;          // sin q, body 7
-  Scalar cq_LH_shank;          // cos q, body 7
   Scalar v_LH_shank[6];        // velocity, body 7
   Scalar c_LH_shank[6];        // velocity-product acceleration, body 7
   Scalar pA_LH_shank[6];       // bias force, body 7
   Scalar g_LH_shank[3];        // gravity in body coordinates, body 7
   Scalar k_lh_foot[3];         // constraint right-hand side, constraint 2
-  Scalar sq_RF_hip;            // sin q, body 8
-  Scalar cq_RF_hip;            // cos q, body 8
-  Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
   Scalar v_RF_hip[6];          // velocity, body 8
   Scalar c_RF_hip[6];          // velocity-product acceleration, body 8
   Scalar pA_RF_hip[6];         // bias force, body 8
   Scalar g_RF_hip[3];          // gravity in body coordinates, body 8
-  Scalar sq_RF_thigh;          // sin q, body 9
-  Scalar cq_RF_thigh;          // cos q, body 9
   Scalar v_RF_thigh[6];        // velocity, body 9
   Scalar c_RF_thigh[6];        // velocity-product acceleration, body 9
   Scalar pA_RF_thigh[6];       // bias force, body 9
   Scalar g_RF_thigh[3];        // gravity in body coordinates, body 9
-  Scalar sq_RF_shank;          // sin q, body 10
-  Scalar cq_RF_shank;          // cos q, body 10
   Scalar v_RF_shank[6];        // velocity, body 10
   Scalar c_RF_shank[6];        // velocity-product acceleration, body 10
   Scalar pA_RF_shank[6];       // bias force, body 10
   Scalar g_RF_shank[3];        // gravity in body coordinates, body 10
   Scalar k_rf_foot[3];         // constraint right-hand side, constraint 1
-  Scalar sq_RH_hip;            // sin q, body 11
-  Scalar cq_RH_hip;            // cos q, body 11
-  Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
   Scalar v_RH_hip[6];          // velocity, body 11
   Scalar c_RH_hip[6];          // velocity-product acceleration, body 11
   Scalar pA_RH_hip[6];         // bias force, body 11
   Scalar g_RH_hip[3];          // gravity in body coordinates, body 11
-  Scalar sq_RH_thigh;          // sin q, body 12
-  Scalar cq_RH_thigh;          // cos q, body 12
   Scalar v_RH_thigh[6];        // velocity, body 12
   Scalar c_RH_thigh[6];        // velocity-product acceleration, body 12
   Scalar pA_RH_thigh[6];       // bias force, body 12
   Scalar g_RH_thigh[3];        // gravity in body coordinates, body 12
-  Scalar sq_RH_shank;          // sin q, body 13
-  Scalar cq_RH_shank;          // cos q, body 13
   Scalar v_RH_shank[6];        // velocity, body 13
   Scalar c_RH_shank[6];        // velocity-product acceleration, body 13
   Scalar pA_RH_shank[6];       // bias force, body 13

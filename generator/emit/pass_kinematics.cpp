@@ -1,7 +1,10 @@
 // The kinematics pass: per body its joint transform, velocity, velocity-product
 // acceleration, bias force v x* I v, gravity in body coordinates (support) and
 // world placement (under a kp constraint); per constraint its right-hand side
-// k (docs/algorithms.md §2). The generic counterpart: algorithms/kinematics.cpp,
+// k (docs/algorithms.md §2). Where sincos is inlined (sincosCalled), all the
+// joint transforms come first, a pass of their own: the iiwa's solvers take
+// 0.90-0.93 of the time so, nonlinear_effects 0.74-0.81 on the iiwa and Solo
+// (docs/benchmarks.md). The generic counterpart: algorithms/kinematics.cpp,
 // algorithms/constraints.cpp.
 #include <fmt/format.h>
 
@@ -216,12 +219,23 @@ Kinematics emitKinematics(Emit& e) {
   // World: at rest, gravity as given, at the origin.
   kin.b[0].g = constant(m.gravity);
   kin.b[0].oM = constant(SE3::Identity());
+  const bool transformsFirst = !sincosCalled(e.plan);
+  if (transformsFirst) {
+    e.fn.beginPass("transforms", "joint transforms X_J(q)");
+    for (int i = 1; i < m.numBodies(); ++i) {
+      e.fn.boundary(i);
+      e.openBody(i, "");
+      jointTransform(e, i, kin.b[std::size_t(i)]);
+      e.cb().close();
+    }
+    e.fn.beginPass("", "velocities, bias forces, gravity, placements, constraint terms");
+  }
   for (int i = 1; i < m.numBodies(); ++i) {
     e.fn.boundary(i);
     e.openBody(i, "");
     Kinematics::Body& b = kin.b[std::size_t(i)];
     const Kinematics::Body& parent = kin.b[std::size_t(e.bp(i).parent)];
-    jointTransform(e, i, b);
+    if (!transformsFirst) jointTransform(e, i, b);
     velocity(e, i, parent, b);
     gravityAndPlacement(e, i, parent, b);
     for (int k : e.bp(i).constraints) kin.k[std::size_t(k)] = constraintTerms(e, k, b);
