@@ -57,6 +57,7 @@ std::string laneMembers(const std::string& header) {
 // (an anonymous namespace) and the entry points, over Scalar and Workspace.
 // The one call that does not resolve by overloading, std::sqrt, becomes the
 // runtime's lane-wise sqrt; any other std:: function would have no lane form.
+// sincos is inlined whatever the scalar code does (below).
 std::string laneBody(const std::string& source, const std::string& name) {
   const std::string open = "\nnamespace {\n";
   const auto begin = find(source, open, "source") + open.size();
@@ -64,6 +65,11 @@ std::string laneBody(const std::string& source, const std::string& name) {
   const auto end = source.rfind(close);
   if (end == std::string::npos || end < begin) throw std::logic_error("batch: the scalar source has no '" + close + "'");
   std::string body = replaceAll(source.substr(begin, end - begin), "std::sqrt(", "proxgen_rt::sqrt(");
+  // The lane kernel of sincos stays inline where the scalar code calls it
+  // (sincosCalled, pass_kinematics.cpp): Talos' prox_pv_many at W = 8 took
+  // 1.02-1.04 of the time with the call (its pair of vectors comes back
+  // through memory), docs/batch.md.
+  body = replaceAll(body, "proxgen_rt::sincos_noinline(", "proxgen_rt::sincos(");
   if (body.find("std::") != std::string::npos)
     throw std::logic_error("batch: the scalar source calls a std:: function without a lane form");
   return body;
