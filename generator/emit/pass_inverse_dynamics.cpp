@@ -69,16 +69,7 @@ void forwardFromKinematics(Emit& e, const Kinematics& kin, Forces& out) {
 // in the caller's Live.
 void forwardFused(Emit& e, bool withLambda, Kinematics& kin, Forces& out) {
   const int N = int(e.plan.bodies.size());
-  const bool transformsFirst = !sincosCalled(e.plan);
-  if (transformsFirst) {
-    e.fn.beginPass("transforms", "joint transforms X_J(q)");
-    for (int i = 1; i < N; ++i) {
-      e.fn.boundary(i);
-      e.openBody(i, "");
-      jointTransform(e, i, kin.b[std::size_t(i)]);
-      e.cb().close();
-    }
-  }
+  const bool transformsFirst = jointTransformsFirst(e, kin);
   e.fn.beginPass("forward", std::string("forward: ") + (transformsFirst ? "" : "X_J(q), ") +
                                 "v = X v_parent + S qd, a = X a_parent + S qdd + v x S qd, f = I a + v x* I v" +
                                 (withLambda ? " + K^T lambda" : ""));

@@ -35,6 +35,18 @@ bool sincosCalled(const Plan& plan) {
   return revolute > 16;
 }
 
+bool jointTransformsFirst(Emit& e, Kinematics& kin) {
+  if (sincosCalled(e.plan)) return false;
+  e.fn.beginPass("transforms", "joint transforms X_J(q)");
+  for (int i = 1; i < e.model().numBodies(); ++i) {
+    e.fn.boundary(i);
+    e.openBody(i, "");
+    jointTransform(e, i, kin.b[std::size_t(i)]);
+    e.cb().close();
+  }
+  return true;
+}
+
 void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   const Body& body = e.model().bodies[std::size_t(i)];
   const Joint& j = body.joint;
@@ -219,17 +231,8 @@ Kinematics emitKinematics(Emit& e) {
   // World: at rest, gravity as given, at the origin.
   kin.b[0].g = constant(m.gravity);
   kin.b[0].oM = constant(SE3::Identity());
-  const bool transformsFirst = !sincosCalled(e.plan);
-  if (transformsFirst) {
-    e.fn.beginPass("transforms", "joint transforms X_J(q)");
-    for (int i = 1; i < m.numBodies(); ++i) {
-      e.fn.boundary(i);
-      e.openBody(i, "");
-      jointTransform(e, i, kin.b[std::size_t(i)]);
-      e.cb().close();
-    }
-    e.fn.beginPass("", "velocities, bias forces, gravity, placements, constraint terms");
-  }
+  const bool transformsFirst = jointTransformsFirst(e, kin);
+  if (transformsFirst) e.fn.beginPass("", "velocities, bias forces, gravity, placements, constraint terms");
   for (int i = 1; i < m.numBodies(); ++i) {
     e.fn.boundary(i);
     e.openBody(i, "");

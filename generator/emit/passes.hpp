@@ -30,6 +30,10 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b);
 /// too, but for 0.7 % more instructions, past solo_f3x4's count when issue 20
 /// was filed, so Solo and smaller keep it inline; the iiwa (7) is 1-4 % slower called.
 bool sincosCalled(const Plan& plan);
+/// Where sincos is inlined, a pass of every body's joint transform into kin
+/// (true), which the sweep that follows then reads; else nothing (false) and
+/// each body's step computes its own (docs/benchmarks.md: the faster way for each).
+bool jointTransformsFirst(Emit& e, Kinematics& kin);
 /// pA = v x* (I v) of body i from b.v and b.IA, into its member (the kinematics
 /// pass, and bias_forces for constrained_dynamics_derivatives).
 void storeBiasForce(Emit& e, int i, Kinematics::Body& b);
