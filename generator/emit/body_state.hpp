@@ -94,6 +94,7 @@ struct DelassusFactor {
 struct Forces {
   std::vector<V6> a, f;
   std::vector<Expr> tau;
+  std::vector<V6> Iv;  // the derivatives' tangent sweep: each body's I v, read by all its columns (else empty)
 };
 
 /// The joint-space matrices (pass_mass_matrix.cpp, pass_mass_matrix_inverse.cpp):
