@@ -19,7 +19,8 @@ std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
 std::string vIn(int k) { return fmt::format("v[{}]", k); }
 std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
 
-// f_i += K_c^T lambda_c for each constraint c on body i: its rows as a wrench at its frame.
+}  // namespace
+
 void addConstraintForces(Emit& e, int i, V6& f) {
   CodeBuilder& cb = e.cb();
   for (int k : e.bp(i).constraints) {
@@ -30,6 +31,8 @@ void addConstraintForces(Emit& e, int i, V6& f) {
         if (X(j, r) != 0) f[std::size_t(r)] += X(j, r) * cb.input(lambdaIn(c.row + j));
   }
 }
+
+namespace {
 
 // The forward sweep from the kinematics pass's state (nonlinear_effects:
 // forward_dynamics_derivatives reads the state that pass leaves). Fills `out`
@@ -61,10 +64,10 @@ void forwardFromKinematics(Emit& e, const Kinematics& kin, Forces& out) {
 // and the bias stay in registers, and v and a are stored only for bodies with
 // children. Where sincos is inlined (sincosCalled), the joint transforms come
 // first, a pass of their own; where it is called (the larger robots), each in
-// its body's step. Measured both ways (docs/dynamics.md, "inverse_dynamics'
-// own forward sweep"): first, the iiwa and Solo take 0.73-0.76 of the time of
+// its body's step. Measured both ways (docs/benchmarks.md, "Revisited and kept
+// for inverse_dynamics"): first, the iiwa and Solo take 0.73-0.77 of the time of
 // the kinematics pass and the forward sweep, but Talos and the Atlas 1.04-1.12;
-// in each step, the iiwa and Solo 1.13-1.18, Talos 0.99 and the Atlas 0.94.
+// in each step, the iiwa and Solo 1.13-1.18, Talos 0.99 and the Atlas 0.92-0.94.
 // Fills `kin` (the joint transforms the backward sweep reads) and `out`, both
 // in the caller's Live.
 void forwardFused(Emit& e, bool withLambda, Kinematics& kin, Forces& out) {

@@ -94,7 +94,6 @@ Col columnAfterLoop(Emit& e, const Quantity& qy, int body, const Col& looped, in
 
 std::string vIn(int k) { return fmt::format("v[{}]", k); }
 std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
-std::string lambdaIn(int k) { return fmt::format("lambda[{}]", k); }
 
 struct Sweep {
   std::vector<Cols> dvq, dvv, daq, dav, dfq, dfv;  // per body
@@ -177,14 +176,7 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
         for (int k = 0; k < 6; ++k) fs.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
       const V6 Ia = mul(cb, kb.IA, a);
       V6 f = add(Ia, kb.pA);
-      if (withLambda)
-        for (int k : p.constraints) {
-          const Constraint& c = e.sys.constraints[std::size_t(k)];
-          const Mat6 X = c.placement.motionMatrixInv();  // rows K_c: body motion -> constraint frame
-          for (int r = 0; r < 6; ++r)
-            for (int j = 0; j < c.rows(); ++j)
-              if (X(j, r) != 0) f[std::size_t(r)] += X(j, r) * cb.input(lambdaIn(c.row + j));
-        }
+      if (withLambda) addConstraintForces(e, i, f);
       for (int k = 0; k < 6; ++k) fs.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
       // I v once per body: every column's force tangent reads it, and the
       // carried columns are parts of their own (stored if it has any).

@@ -118,6 +118,9 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
 /// The inverse_dynamics host (nonlinear_effects: qdd = 0, no lambda), from its
 /// copy of the state after kinematics, whose values live in `afterKinematics`.
 std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics, bool nonlinearEffects);
+/// f += K_c^T lambda_c for each constraint c on body i: its rows (lambda[row])
+/// as a wrench at its frame (also the derivatives' sweep).
+void addConstraintForces(Emit& e, int i, V6& f);
 
 // ---- column_loops.cpp: a run of adjacent columns of one shape as one loop over j.
 /// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
