@@ -12,14 +12,19 @@
 
 namespace proxgen::emit {
 
-std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins,
-                                            int shortest) {
+std::string columnLoopHead(int len) {
+  // Kept a loop by the compiler too (runtime.hpp, PROXGEN_RT_NO_UNROLL); the
+  // operation count reads the trip count after the pragma (CodeBuilder::open).
+  return fmt::format("PROXGEN_RT_NO_UNROLL for (int j = 0; j < {}; ++j) {{", len);
+}
+
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins) {
   std::vector<std::pair<int, int>> runs;
   for (std::size_t n = 0; n < ks.size();) {
     const int k0 = ks[n];
     std::size_t len = 1;
     while (n + len < ks.size() && ks[n + len] == k0 + int(len) && joins(ks[n + len], k0)) ++len;
-    if (int(len) < shortest) len = 1;
+    if (int(len) < kShortestColumnLoop) len = 1;
     runs.push_back({k0, int(len)});
     n += len;
   }
@@ -28,9 +33,8 @@ std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const st
 
 void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label) {
   e.fn.boundary(fmt::format("{}_c{}", ident, k0));
-  if (len > 1)  // kept a loop by the compiler too (runtime.hpp, PROXGEN_RT_NO_UNROLL)
-    e.cb().open(fmt::format("PROXGEN_RT_NO_UNROLL for (int j = 0; j < {}; ++j) {{", len),
-                {fmt::format("{} columns {} to {}", label, k0, k0 + len - 1)});
+  if (len > 1)
+    e.cb().open(columnLoopHead(len), {fmt::format("{} columns {} to {}", label, k0, k0 + len - 1)});
   else
     e.cb().open("{", {fmt::format("{} column {}", label, k0)});
 }

@@ -54,19 +54,6 @@ void putMass(Emit& e, JointSpace& js, std::vector<char>& written, int r, int c, 
   written[std::size_t(Sym::index(nv, r, c))] = 1;
 }
 
-// Per body, one past the last dof of its subtree (depth-first order makes a
-// subtree's dofs contiguous, from the body's own).
-std::vector<int> subtreeEnds(Emit& e) {
-  const int N = int(e.plan.bodies.size());
-  std::vector<int> end(std::size_t(N), 0);
-  for (int i = N - 1; i >= 1; --i) {
-    const BodyPlan& p = e.bp(i);
-    end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
-    if (p.parent > 0) end[std::size_t(p.parent)] = std::max(end[std::size_t(p.parent)], end[std::size_t(i)]);
-  }
-  return end;
-}
-
 // Whether the host zeroes all of M in one fill before the pass rather than
 // the runs of zeros after it. The zeros are the entries of two dofs on
 // different branches (neither body an ancestor of the other): 70 % of a
@@ -76,14 +63,14 @@ std::vector<int> subtreeEnds(Emit& e) {
 // Talos: 94 runs, 0.77 of 3.1 us, against 0.1 us for the fill (the time
 // 0.78 of before); Solo's runs are short (stores, no `rep`) and a fill was
 // 1.06 of their time (docs/benchmarks.md).
-bool fillFirst(Emit& e, const std::vector<int>& end) {
+bool fillFirst(Emit& e) {
   const int nv = e.plan.nv;
   std::vector<int> body(std::size_t(nv), 0);
   for (int i = 1; i < int(e.plan.bodies.size()); ++i)
     for (int d = 0; d < e.bp(i).nv; ++d) body[std::size_t(e.bp(i).idx_v + d)] = i;
   auto zero = [&](int k) {
     const int lo = std::min(k / nv, k % nv), hi = std::max(k / nv, k % nv);
-    return hi >= end[std::size_t(body[std::size_t(lo)])];
+    return hi >= e.bp(body[std::size_t(lo)]).dofEnd;
   };
   int longRuns = 0;
   for (int k = 0; k < nv * nv;) {
@@ -191,8 +178,7 @@ Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, cons
 // read their entries. A body's descendants' columns all go through the same
 // transform, so runs of them of one shape are one loop (column_loops.cpp):
 // the walk is O(n) code instead of O(n depth).
-void compositeInertias(Emit& e, const Kinematics& kin, const std::vector<int>& end, JointSpace& js,
-                       std::vector<char>& written) {
+void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size()), nv = plan.nv;
   std::vector<V6>& cols = js.carried;
@@ -224,7 +210,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, const std::vector<int>& e
     if (p.parent == 0) continue;
     // The descendants' columns, in i's frame since its children's turns.
     std::vector<int> ks;
-    for (int k = p.idx_v + p.nv; k < end[std::size_t(i)]; ++k) ks.push_back(k);
+    for (int k = p.idx_v + p.nv; k < p.dofEnd; ++k) ks.push_back(k);
     const auto inputs = [&](int k) { return entries(cols[std::size_t(k)]); };
     const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
     for (const auto& run : columnRuns(ks, sameShape)) {
@@ -260,13 +246,12 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
   e.fn.live().kin = &kin;
   e.fn.live().js = &js;
   e.fn.beginHost("crba", afterTransforms);
-  const std::vector<int> end = subtreeEnds(e);
-  const bool fill = fillFirst(e, end);
+  const bool fill = fillFirst(e);
   if (fill)
     e.cb().line(fmt::format("for (int k = 0; k < {}; ++k) M[k] = Scalar(0);", e.plan.nv * e.plan.nv), {}, {"M"});
   e.cb().line("joint_transforms(q, w);", {}, {"q", "w"});
   std::vector<char> written(std::size_t(e.plan.nv * (e.plan.nv + 1) / 2), 0);
-  compositeInertias(e, kin, end, js, written);
+  compositeInertias(e, kin, js, written);
   finishMassMatrix(e, js, written, fill);
   std::string text = e.fn.endHost({"q", "w", "M"});
   e.fn.live() = Live{};

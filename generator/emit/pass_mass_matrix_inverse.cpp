@@ -63,10 +63,10 @@ void passInertia(Emit& e, const Kinematics& kin, int i, Articulated& art) {
 // O(n depth) (backward); the compiler vectorises across columns
 // (docs/dynamics.md, "mass_matrix_inverse").
 
-// Column j (s < j < end) of a one-dof body: Minv(s, j) = -D^-1 S^T F_i[:, j],
-// and F_p[:, j] += X^T (F_i[:, j] + U Minv(s, j)) (Fp: F_p[:, j] before). Stores
-// into minvOut and fpOut(r) (in a loop, column j's slots); returns Minv(s, j)
-// and F_p[:, j] with the rows it wrote.
+// Column j (s < j < dofEnd, the subtree's) of a one-dof body: Minv(s, j) =
+// -D^-1 S^T F_i[:, j], and F_p[:, j] += X^T (F_i[:, j] + U Minv(s, j)) (Fp:
+// F_p[:, j] before). Stores into minvOut and fpOut(r) (in a loop, column j's
+// slots); returns Minv(s, j) and F_p[:, j] with the rows it wrote.
 struct Accumulated {
   V6 value;
   std::array<bool, 6> stored{};
@@ -92,7 +92,7 @@ std::pair<Expr, Accumulated> eliminateColumn(Emit& e, const Kinematics::Body& kb
   return {x, out};
 }
 
-void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated& art, JointSpace& js) {
+void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
   const BodyPlan& p = e.bp(i);
@@ -133,7 +133,7 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated&
     return in;
   };
   std::vector<int> cols;
-  for (int j = s + 1; j < end; ++j) cols.push_back(j);
+  for (int j = s + 1; j < e.bp(i).dofEnd; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
   for (const auto& run : columnRuns(cols, sameShape)) {
     const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
@@ -166,7 +166,7 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, int end, Articulated&
 }
 
 // The free flyer at the root: D^-1 = IA^-1 through its Cholesky factor.
-void backwardFreeFlyer(Emit& e, int i, int end, Articulated& art, JointSpace& js) {
+void backwardFreeFlyer(Emit& e, int i, Articulated& art, JointSpace& js) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const int s = e.bp(i).idx_v;
   const auto Lname = [&](int r, int c) { return e.member(kL, i, 21, Sym::index(6, r, c)); };
@@ -188,7 +188,7 @@ void backwardFreeFlyer(Emit& e, int i, int end, Articulated& art, JointSpace& js
   const std::vector<V6>& F = js.FA[std::size_t(i)];
   const auto inputs = [&](int j) { return entries(F[std::size_t(j)]); };
   std::vector<int> cols;
-  for (int j = s + 6; j < end; ++j) cols.push_back(j);
+  for (int j = s + 6; j < e.bp(i).dofEnd; ++j) cols.push_back(j);
   const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
   for (const auto& run : columnRuns(cols, sameShape)) {
     const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
@@ -324,13 +324,6 @@ void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, 
 std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
-  // Subtree dof ends: depth-first order makes a subtree's dofs contiguous.
-  std::vector<int> end(std::size_t(N), 0);
-  for (int i = N - 1; i >= 1; --i) {
-    const BodyPlan& p = e.bp(i);
-    end[std::size_t(i)] = std::max(end[std::size_t(i)], p.idx_v + p.nv);
-    if (p.parent > 0) end[std::size_t(p.parent)] = std::max(end[std::size_t(p.parent)], end[std::size_t(i)]);
-  }
   Articulated art = startElimination(kin);  // IA = I, pA = 0 (the transforms pass sets no bias)
   JointSpace js;
   js.upper = Sym(plan.nv);
@@ -342,8 +335,8 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
   e.fn.beginHost("minv", afterTransforms);
   e.fn.beginPass("backward", "backward: D^-1 and the unit-torque forces, leaves first");
   for (int i = N - 1; i >= 1; --i) {
-    if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, end[std::size_t(i)], art, js);
-    else backwardOneDof(e, kin, i, end[std::size_t(i)], art, js);
+    if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, art, js);
+    else backwardOneDof(e, kin, i, art, js);
   }
   e.fn.beginPass("forward", "forward: the unit-torque accelerations, the upper triangle of M^-1");
   for (int i = 1; i < N; ++i) forwardBody(e, kin, i, art, js);

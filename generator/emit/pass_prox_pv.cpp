@@ -25,9 +25,6 @@ namespace {
 
 /// Slots per row of the row-major KA and Z: m columns and one unused slot.
 int rowStride(int m) { return m + 1; }
-/// Runs of at least this many constraint columns that go through the same
-/// arithmetic are printed as a loop (README, "The generated solver").
-constexpr int kLoopColumns = 2;
 
 // How many columns from c0 on hold exactly the members KA_i[r][c]
 // (each entry stored, none folded): a loop over them reads the same slots.
@@ -102,12 +99,10 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
   ProxRows::Body& par = rows.b[std::size_t(p.parent)];
   for (int c0 = 0; c0 < m;) {
     const int len = loopableColumns(e, b, i, c0);
-    if (len >= kLoopColumns) {
+    if (len >= kShortestColumnLoop) {
       // Columns c0 .. c0 + len - 1 go through identical arithmetic: one loop
       // (vectorised by the compiler) instead of len copies of the code.
-      // Not unrolled by the compiler either (runtime.hpp, PROXGEN_RT_NO_UNROLL).
-      cb.open(fmt::format("PROXGEN_RT_NO_UNROLL for (int j = 0; j < {}; ++j) {{", len),
-              {fmt::format("columns {} to {}", c0, c0 + len - 1)});
+      cb.open(columnLoopHead(len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
       V6 ka;
       for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
       const auto out = column(ka, [&](const Quantity& qy) { return e.loopSlot(qy, i, m, c0); });

@@ -123,11 +123,15 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
 void addConstraintForces(Emit& e, int i, V6& f);
 
 // ---- column_loops.cpp: a run of adjacent columns of one shape as one loop over j.
+/// Runs of fewer columns than this stay unrolled: a loop of one column is only
+/// overhead (proxPV's carried columns use the same threshold).
+inline constexpr int kShortestColumnLoop = 2;
+/// `PROXGEN_RT_NO_UNROLL for (int j = 0; j < len; ++j) {`: the head of every column loop.
+std::string columnLoopHead(int len);
 /// The runs of `ks` (sorted columns): adjacent columns for which `joins(k, k0)`
-/// holds with the run's first, as (first, length); runs shorter than `shortest`
-/// are split into single columns (a loop of one column is only overhead).
-std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins,
-                                            int shortest = 2);
+/// holds with the run's first, as (first, length); runs shorter than
+/// kShortestColumnLoop are split into single columns.
+std::vector<std::pair<int, int>> columnRuns(const std::vector<int>& ks, const std::function<bool(int, int)>& joins);
 /// Starts a part and opens a run's block: `for (int j = 0; j < len; ++j) {`, or a plain block for one column.
 void openColumns(Emit& e, const std::string& ident, int k0, int len, const std::string& label);
 /// Columns k and k0 have entries of one shape (inputs(k): column k's entries):

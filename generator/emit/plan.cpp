@@ -120,6 +120,14 @@ Plan makePlan(const System& sys, const std::string& name, ScalarType scalar) {
     b.needsGravity = b.onSupport;
     if (!b.onSupport) plan.offSupport.push_back(i);
   }
+  for (int i = N - 1; i >= 0; --i) {  // children after their parent: leaves first
+    BodyPlan& b = plan.bodies[std::size_t(i)];
+    b.dofEnd = std::max(b.dofEnd, b.idx_v + b.nv);
+    if (i > 0) {
+      BodyPlan& parent = plan.bodies[std::size_t(b.parent)];
+      parent.dofEnd = std::max(parent.dofEnd, b.dofEnd);
+    }
+  }
   for (int i = 0; i < N; ++i) {
     BodyPlan& b = plan.bodies[std::size_t(i)];
     b.subtreeRows = tree.subtreeRows[std::size_t(i)];

@@ -36,6 +36,9 @@ struct BodyPlan {
   int axis = -1;             // 0/1/2 for an axis along x/y/z, else -1
   double axisSign = 1.0;     // +1 or -1 for such an axis
   int idx_q = 0, nq = 0, idx_v = 0, nv = 0;
+  /// One past the last dof of the subtree: its dofs are [idx_v, dofEnd)
+  /// (depth-first order makes them contiguous; the world's: all nv).
+  int dofEnd = 0;
   std::vector<int> children;
   bool onSupport = false;
   std::vector<int> constraints;  // constraints on this body (indices, layout order)

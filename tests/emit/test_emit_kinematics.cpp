@@ -1,9 +1,10 @@
 // The kinematics pass's choice of sine and cosine (emit/pass_kinematics.cpp,
-// sincosFunction): the runtime's sincos inlined at each revolute joint, or its
+// sincosCalled): the runtime's sincos inlined at each revolute joint, or its
 // called form on a robot of more than 16 revolute joints, where one copy of
 // the kernel beats one per joint (docs/benchmarks.md, "sincos called on the
 // larger robots"). The two give the same bits (tests/runtime); this checks
-// which one the generated source uses, and that every joint uses it.
+// which one the generated source uses, that every joint uses it, and where
+// the joint transforms go with each.
 #include <gtest/gtest.h>
 #include <fmt/format.h>
 
@@ -21,8 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The generated source for a fixed-base chain of `links` links (links - 1 revolute joints).
-std::string chainSource(int links) {
+// The generated source for a fixed-base chain of `links` links (links - 1
+// revolute joints), holding `functions` (empty: the two solvers).
+std::string chainSource(int links, const std::string& functions = "") {
   const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_kinematics_{}_{}", getpid(), links);
   fs::create_directories(dir);
   std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(links, 1);
@@ -31,6 +33,7 @@ std::string chainSource(int links) {
   g.urdf = (dir / "chain.urdf").string();
   g.layout = (dir / "fixed.yaml").string();
   g.name = "chain";
+  g.functions = functions;
   const std::string source = generateFiles(g).source;
   fs::remove_all(dir);
   return source;
@@ -48,6 +51,19 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_noinline("), 0);
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_noinline(q["), 17);
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos("), 0);
+}
+
+// Where sincos is inlined, the kinematics pass and inverse_dynamics' sweep
+// compute every joint transform first, in a pass of their own (part functions
+// named <host>_transforms_...); where it is called, each body's step computes
+// its own (jointTransformsFirst: the faster way for each, docs/benchmarks.md).
+TEST(KinematicsCode, TheJointTransformsComeFirstWhereSinCosIsInlined) {
+  const std::string functions = "constrained_aba,prox_pv,inverse_dynamics";
+  const std::string inlined = chainSource(17, functions), called = chainSource(18, functions);
+  EXPECT_GT(count(inlined, "void kinematics_transforms_"), 0);
+  EXPECT_GT(count(inlined, "void rnea_transforms_"), 0);
+  EXPECT_EQ(count(called, "void kinematics_transforms_"), 0);
+  EXPECT_EQ(count(called, "void rnea_transforms_"), 0);
 }
 
 }  // namespace

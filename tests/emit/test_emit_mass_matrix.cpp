@@ -22,9 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Lines of the generated source of mass_matrix alone for a serial chain of n
-// links on a fixed base (depth n: the walk is n (n - 1) / 2 column steps).
-long massMatrixLines(int n) {
+// The generated source of mass_matrix alone for a serial chain of n links on
+// a fixed base (depth n: the walk is n (n - 1) / 2 column steps).
+std::string massMatrixSource(int n) {
   const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_mass_matrix_{}_{}", getpid(), n);
   fs::create_directories(dir);
   std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(n + 1, 1);
@@ -36,7 +36,18 @@ long massMatrixLines(int n) {
   g.functions = "mass_matrix";
   const std::string source = generateFiles(g).source;
   fs::remove_all(dir);
+  return source;
+}
+
+long massMatrixLines(int n) {
+  const std::string source = massMatrixSource(n);
   return long(std::count(source.begin(), source.end(), '\n'));
+}
+
+long count(const std::string& text, const std::string& what) {
+  long n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
 }
 
 // From 16 to 64 links, code linear in n grows 4 times, and the fixed part of
@@ -50,6 +61,17 @@ TEST(MassMatrixCode, TheWalkIsLinearInTheDepth) {
   const long small = massMatrixLines(16), large = massMatrixLines(64);
   ASSERT_GT(small, 0);
   EXPECT_LT(double(large) / double(small), 6.0) << small << " lines at 16 links, " << large << " at 64";
+}
+
+// Every column loop is printed after PROXGEN_RT_NO_UNROLL (column_loops.cpp,
+// columnLoopHead): GCC would otherwise peel the short ones completely, code
+// that a large robot runs once per call (docs/benchmarks.md, "The column loops
+// kept loops by the compiler").
+TEST(MassMatrixCode, ColumnLoopsAreKeptLoops) {
+  const std::string source = massMatrixSource(16);
+  const long loops = count(source, "for (int j = 0; j < ");
+  EXPECT_GT(loops, 0);
+  EXPECT_EQ(count(source, "PROXGEN_RT_NO_UNROLL for (int j = 0; j < "), loops);
 }
 
 }  // namespace

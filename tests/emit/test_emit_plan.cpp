@@ -100,6 +100,15 @@ TEST(Plan, TreeFactsAgreeWithAnIndependentDerivation) {
     }
     std::set<int> distinct(plan.rootRows.begin(), plan.rootRows.end());
     EXPECT_EQ(int(distinct.size()), nc) << "every row once";
+    // A subtree's dofs are [idx_v, dofEnd): exactly the dofs of the bodies in it.
+    for (int i = 0; i < N; ++i) {
+      const BodyPlan& b = plan.bodies[std::size_t(i)];
+      for (int j = 1; j < N; ++j) {
+        const Joint& jt = m.bodies[std::size_t(j)].joint;
+        for (int d = jt.idx_v; d < jt.idx_v + jt.nv; ++d)
+          EXPECT_EQ(d >= b.idx_v && d < b.dofEnd, inSubtree(m, j, i)) << "body " << i << ", dof " << d;
+      }
+    }
   }
 }
 
