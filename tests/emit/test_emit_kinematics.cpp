@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "emit/batch.hpp"
 #include "emit/generate.hpp"
 #include "support.hpp"
 
@@ -22,9 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The generated source for a fixed-base chain of `links` links (links - 1
+// The generated files for a fixed-base chain of `links` links (links - 1
 // revolute joints), holding `functions` (empty: the two solvers).
-std::string chainSource(int links, const std::string& functions = "") {
+SolverFiles chainFiles(int links, const std::string& functions = "") {
   const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_kinematics_{}_{}", getpid(), links);
   fs::create_directories(dir);
   std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(links, 1);
@@ -34,10 +35,12 @@ std::string chainSource(int links, const std::string& functions = "") {
   g.layout = (dir / "fixed.yaml").string();
   g.name = "chain";
   g.functions = functions;
-  const std::string source = generateFiles(g).source;
+  SolverFiles files = generateFiles(g);
   fs::remove_all(dir);
-  return source;
+  return files;
 }
+
+std::string chainSource(int links, const std::string& functions = "") { return chainFiles(links, functions).source; }
 
 long count(const std::string& text, const std::string& what) {
   long n = 0;
@@ -51,6 +54,10 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_noinline("), 0);
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_noinline(q["), 17);
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos("), 0);
+  // The lane code inlines the kernel again (batch.cpp: the call was slower there).
+  const std::string lanes = batchFiles(chainFiles(18), 4).source;
+  EXPECT_EQ(count(lanes, "sincos_noinline"), 0);
+  EXPECT_EQ(count(lanes, "proxgen_rt::sincos(q["), 17);
 }
 
 // Where sincos is inlined, the kinematics pass and inverse_dynamics' sweep
