@@ -1,0 +1,56 @@
+// The shape of the derivatives' tangent sweep (emit/pass_inverse_dynamics_derivatives.cpp):
+// a body's momentum I v, which every column's force tangent dv x* I v reads,
+// is computed once in the body's own block and stored for its carried columns,
+// whose parts used to compute it again each (docs/derivatives.md). The values
+// are the harness's business (tests/generated: harness_derivatives.cpp).
+#include <gtest/gtest.h>
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <string>
+
+#include <unistd.h>
+
+#include "emit/generate.hpp"
+#include "support.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(DerivativesCode, EachBodysMomentumIsStoredOnce) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_derivatives_{}", getpid());
+  fs::create_directories(dir);
+  std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(8, 1);  // 7 revolute joints in a chain
+  std::ofstream(dir / "fixed.yaml") << "base: fixed\n";
+  GenerateOptions g;
+  g.urdf = (dir / "chain.urdf").string();
+  g.layout = (dir / "fixed.yaml").string();
+  g.name = "chain";
+  g.functions = "inverse_dynamics_derivatives";
+  const std::string source = generateFiles(g).source;
+  fs::remove_all(dir);
+  // Stores `w.Iv_<body>[r] = ...`, counted per (body, r).
+  std::map<std::string, int> stores;
+  const std::regex store(R"(w\.(Iv_\w+\[\d\]) = )");
+  for (auto it = std::sregex_iterator(source.begin(), source.end(), store); it != std::sregex_iterator(); ++it)
+    ++stores[(*it)[1].str()];
+  // The bodies below the first carry their ancestors' columns: 6 bodies.
+  std::map<std::string, int> bodies;
+  for (const auto& [slot, n] : stores) {
+    EXPECT_EQ(n, 1) << slot << " stored more than once";
+    ++bodies[slot.substr(0, slot.find('['))];
+  }
+  EXPECT_EQ(bodies.size(), 6u);
+  // And read back, not recomputed, by the carried columns' parts: more uses than stores.
+  long uses = 0;
+  for (auto at = source.find("w.Iv_"); at != std::string::npos; at = source.find("w.Iv_", at + 1)) ++uses;
+  EXPECT_GT(uses, long(stores.size()));
+}
+
+}  // namespace
+}  // namespace proxgen::emit
