@@ -9,6 +9,58 @@
 //     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
 //   prox_pv: 16721 + 650 K (= 18671 at K = 3)
 //     add/sub 6643 + 285 K, mul 9659 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
+// same code up to their constants, over a table of each one's constants:
+//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_1: 2 blocks of l_thigh, r_thigh
+//   shared_2: 2 blocks of l_shank, r_shank
+//   shared_3: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_4: 2 blocks of l_foot, r_foot
+//   shared_5: 2 blocks of l_wrist_yaw_link, neck_link
+//   shared_6: 2 blocks of l_wrist_yaw_link, r_wrist_yaw_link
+//   shared_7: 2 blocks of l_forearm, r_forearm
+//   shared_8: 2 blocks of l_upper_arm, r_upper_arm
+//   shared_9: 2 blocks of l_shoulder_roll_link, r_shoulder_roll_link
+//   shared_10: 2 blocks of r_foot, l_foot
+//   shared_11: 2 blocks of r_ankle_link, l_ankle_link
+//   shared_12: 2 blocks of r_shank, l_shank
+//   shared_13: 2 blocks of r_thigh, l_thigh
+//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_15: 2 blocks of pelvis
+//   shared_16: 2 blocks of l_hip_yaw_link
+//   shared_17: 4 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_18: 4 blocks of l_thigh, r_thigh
+//   shared_19: 4 blocks of l_shank, r_shank
+//   shared_20: 4 blocks of l_ankle_link, r_ankle_link
+//   shared_21: 4 blocks of l_foot, r_foot
+//   shared_22: 2 blocks of r_hip_yaw_link
+//   shared_23: 2 blocks of abdomen
+//   shared_24: 2 blocks of chest
+//   shared_25: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
+//   shared_26: 3 blocks of r_shoulder_roll_link, l_shoulder_roll_link
+//   shared_27: 2 blocks of r_upper_arm
+//   shared_28: 2 blocks of r_forearm
+//   shared_29: 3 blocks of r_wrist_yaw_link, l_wrist_yaw_link
+//   shared_30: 2 blocks of r_wrist_pitch_link
+//   shared_31: 2 blocks of r_hand
+//   shared_32: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_33: 2 blocks of r_foot, l_foot
+//   shared_34: 2 blocks of r_thigh, l_thigh
+//   shared_35: 2 blocks of r_foot, l_foot
+//   shared_36: 2 blocks of r_ankle_link, l_ankle_link
+//   shared_37: 2 blocks of r_shank, l_shank
+//   shared_38: 2 blocks of r_thigh, l_thigh
+//   shared_39: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_40: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_41: 2 blocks of l_thigh, r_thigh
+//   shared_42: 2 blocks of l_shank, r_shank
+//   shared_43: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_44: 2 blocks of l_foot, r_foot
+//   shared_45: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_46: 2 blocks of l_thigh, r_thigh
+//   shared_47: 2 blocks of l_shank, r_shank
+//   shared_48: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_49: 2 blocks of l_foot, r_foot
 
 #include "humanoid.hpp"
 
@@ -27,6 +79,2150 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
+// The first: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+constexpr Scalar shared_0_k0[14] = {0.5, -0.015, 0.5, 0.015, 0.015, 0.00095, -0.015, 0.00095, 0.5, -0.5, 0.0005, 0.5, -0.0005, -0.5};
+PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
+  v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
+  v_m2[2] = v_m3[3] + v[0];
+  v_m2[3] = v_m3[4]*cq_m1[0] + v_m3[5]*sq_m0[0];
+  v_m2[4] = -v_m3[4]*sq_m0[0] + v_m3[5]*cq_m1[0];
+  c_m4[0] = v[0]*v_m2[1];
+  c_m4[1] = -v[0]*v_m2[0];
+  c_m4[3] = v[0]*v_m2[4];
+  c_m4[4] = -v[0]*v_m2[3];
+  const Scalar x0 = k[0]*v_m3[0] + k[1]*v_m2[3];
+  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m2[2];
+  const Scalar x2 = k[4]*v_m2[0] + k[5]*v_m2[2];
+  const Scalar x3 = k[6]*v_m3[0] + k[7]*v_m2[3];
+  pA_m5[0] = k[8]*v_m2[1]*v_m2[3] - v_m2[4]*x1;
+  pA_m5[1] = v_m2[4]*x0 + k[9]*v_m2[1]*v_m2[2];
+  pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
+  pA_m5[3] = k[10]*v_m2[3]*v_m2[4] - v_m2[4]*x3 + k[11]*v_m2[0]*v_m2[1] - v_m2[1]*x1;
+  pA_m5[4] = v_m2[4]*x2 + k[12]*v_m2[2]*v_m2[4] + v_m2[1]*x0 + k[13]*v_m3[0]*v_m2[1];
+  pA_m5[5] = v_m2[2]*x3 - v_m2[3]*x2 + v_m3[0]*x1 - v_m2[0]*x0;
+  g_m6[0] = g_m7[0]*cq_m1[0] + g_m8[0]*sq_m0[0];
+  g_m6[1] = -g_m7[0]*sq_m0[0] + g_m8[0]*cq_m1[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
+// The first: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+constexpr Scalar shared_1_k0[26] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 7.0, -1.29954125, 7.0, 1.29954125, 1.29954125, 0.3755072987089375, -1.29954125, 0.3755072987089375, 7.0, -7.0, 0.0196875, 7.0, -0.0196875, -7.0, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = k[0]*v_m2[0] + k[1]*v_m3[1];
+  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m3[1];
+  const Scalar x2 = k[4]*v_m3[2] + k[5]*v_m3[4];
+  const Scalar x3 = k[6]*v_m3[2] + k[7]*v_m3[4];
+  v_m4[0] = cq_m1[0]*x0 - sq_m0[0]*x1;
+  v_m4[2] = sq_m0[0]*x0 + cq_m1[0]*x1;
+  v_m4[3] = cq_m1[0]*x2 - sq_m0[0]*x3;
+  v_m4[4] = v_m3[3] + v[0];
+  v_m4[5] = sq_m0[0]*x2 + cq_m1[0]*x3;
+  c_m5[0] = -v[0]*v_m4[2];
+  c_m5[2] = v[0]*v_m4[0];
+  c_m5[3] = -v[0]*v_m4[5];
+  c_m5[5] = v[0]*v_m4[3];
+  const Scalar x4 = k[8]*v_m4[0] + k[9]*v_m4[4];
+  const Scalar x5 = k[10]*v_m3[0] + k[11]*v_m4[3];
+  const Scalar x6 = k[12]*v_m3[0] + k[13]*v_m4[3];
+  const Scalar x7 = k[14]*v_m4[0] + k[15]*v_m4[4];
+  pA_m6[0] = k[16]*v_m4[2]*v_m4[4] - v_m4[5]*x5;
+  pA_m6[1] = v_m4[5]*x4 + k[17]*v_m4[2]*v_m4[3];
+  pA_m6[2] = v_m4[3]*x5 - v_m4[4]*x4;
+  pA_m6[3] = k[18]*v_m4[4]*v_m4[5] - v_m4[5]*x7 + k[19]*v_m3[0]*v_m4[2] - v_m4[2]*x5;
+  pA_m6[4] = v_m4[5]*x6 + k[20]*v_m4[3]*v_m4[5] + v_m4[2]*x4 + k[21]*v_m4[0]*v_m4[2];
+  pA_m6[5] = v_m4[3]*x7 - v_m4[4]*x6 + v_m4[0]*x5 - v_m3[0]*x4;
+  const Scalar x8 = k[22]*g_m7[0] + k[23]*g_m8[0];
+  const Scalar x9 = k[24]*g_m7[0] + k[25]*g_m8[0];
+  g_m9[0] = cq_m1[0]*x8 - sq_m0[0]*x9;
+  g_m9[2] = sq_m0[0]*x8 + cq_m1[0]*x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+constexpr Scalar shared_2_k0[28] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 3.055, -0.5694718575000001, 3.055, 0.5694718575000001, 0.5694718575000001, 0.15779149347477375, -0.5694718575000001, 0.15779149347477375, 3.055, -3.055, 0.00381875, 3.055, -0.00381875, -3.055, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
+  const Scalar x1 = v_m3[0] + k[1]*v_m2[3];
+  const Scalar x2 = k[2]*v_m2[2] + k[3]*x0;
+  const Scalar x3 = k[4]*v_m2[2] + k[5]*x0;
+  const Scalar x4 = k[6]*v_m2[3] + k[7]*v_m2[5];
+  const Scalar x5 = k[8]*v_m2[3] + k[9]*v_m2[5];
+  v_m4[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
+  v_m4[1] = x1;
+  v_m4[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
+  v_m4[3] = cq_m1[0]*x4 - sq_m0[0]*x5;
+  v_m4[4] = v_m2[4] + v[0];
+  v_m4[5] = sq_m0[0]*x4 + cq_m1[0]*x5;
+  c_m5[0] = -v[0]*v_m4[2];
+  c_m5[2] = v[0]*v_m4[0];
+  c_m5[3] = -v[0]*v_m4[5];
+  c_m5[5] = v[0]*v_m4[3];
+  const Scalar x6 = k[10]*v_m4[0] + k[11]*v_m4[4];
+  const Scalar x7 = k[12]*v_m4[1] + k[13]*v_m4[3];
+  const Scalar x8 = k[14]*v_m4[1] + k[15]*v_m4[3];
+  const Scalar x9 = k[16]*v_m4[0] + k[17]*v_m4[4];
+  pA_m6[0] = k[18]*v_m4[2]*v_m4[4] - v_m4[5]*x7;
+  pA_m6[1] = v_m4[5]*x6 + k[19]*v_m4[2]*v_m4[3];
+  pA_m6[2] = v_m4[3]*x7 - v_m4[4]*x6;
+  pA_m6[3] = k[20]*v_m4[4]*v_m4[5] - v_m4[5]*x9 + k[21]*v_m4[1]*v_m4[2] - v_m4[2]*x7;
+  pA_m6[4] = v_m4[5]*x8 + k[22]*v_m4[3]*v_m4[5] + v_m4[2]*x6 + k[23]*v_m4[0]*v_m4[2];
+  pA_m6[5] = v_m4[3]*x9 - v_m4[4]*x8 + v_m4[0]*x7 - v_m4[1]*x6;
+  const Scalar x10 = k[24]*g_m7[0] + k[25]*g_m7[2];
+  const Scalar x11 = k[26]*g_m7[0] + k[27]*g_m7[2];
+  g_m8[0] = cq_m1[0]*x10 - sq_m0[0]*x11;
+  g_m8[2] = sq_m0[0]*x10 + cq_m1[0]*x11;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+constexpr Scalar shared_3_k0[17] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.2, 0.2, 0.2, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
+  const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
+  const Scalar x2 = k[2]*v_m2[2] + k[3]*x0;
+  const Scalar x3 = k[4]*v_m2[2] + k[5]*x0;
+  const Scalar x4 = k[6]*v_m2[3] + k[7]*v_m2[5];
+  const Scalar x5 = k[8]*v_m2[3] + k[9]*v_m2[5];
+  v_m3[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
+  v_m3[1] = x1;
+  v_m3[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
+  v_m3[3] = cq_m1[0]*x4 - sq_m0[0]*x5;
+  v_m3[4] = v_m2[4] + v[0];
+  v_m3[5] = sq_m0[0]*x4 + cq_m1[0]*x5;
+  c_m4[0] = -v[0]*v_m3[2];
+  c_m4[2] = v[0]*v_m3[0];
+  c_m4[3] = -v[0]*v_m3[5];
+  c_m4[5] = v[0]*v_m3[3];
+  pA_m5[0] = k[10]*(v_m3[2]*v_m3[4] - v_m3[1]*v_m3[5]);
+  pA_m5[1] = k[11]*(v_m3[0]*v_m3[5] - v_m3[2]*v_m3[3]);
+  pA_m5[2] = k[12]*(v_m3[1]*v_m3[3] - v_m3[0]*v_m3[4]);
+  const Scalar x6 = k[13]*g_m6[0] + k[14]*g_m6[2];
+  const Scalar x7 = k[15]*g_m6[0] + k[16]*g_m6[2];
+  g_m7[0] = cq_m1[0]*x6 - sq_m0[0]*x7;
+  g_m7[2] = sq_m0[0]*x6 + cq_m1[0]*x7;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+constexpr Scalar shared_4_k0[16] = {1.015, -0.027912499999999996, 1.015, 0.027912499999999996, 0.06495999999999999, 1.015, -0.06495999999999999, 0.027912499999999996, 0.00194517348958, 0.0017863999999999998, -0.027912499999999996, -0.06495999999999999, 0.00936987670937, 0.06495999999999999, 0.0017863999999999998, 0.00860228295937};
+PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
+  v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
+  v_m2[2] = v_m3[3] + v[0];
+  v_m2[3] = v_m3[4]*cq_m1[0] + v_m3[5]*sq_m0[0];
+  v_m2[4] = -v_m3[4]*sq_m0[0] + v_m3[5]*cq_m1[0];
+  c_m4[0] = v[0]*v_m2[1];
+  c_m4[1] = -v[0]*v_m2[0];
+  c_m4[3] = v[0]*v_m2[4];
+  c_m4[4] = -v[0]*v_m2[3];
+  const Scalar x0 = k[0]*v_m3[0] + k[1]*v_m2[3];
+  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m2[2] + k[4]*v_m2[4];
+  const Scalar x2 = k[5]*v_m2[1] + k[6]*v_m2[3];
+  const Scalar x3 = k[7]*v_m2[0] + k[8]*v_m2[2] + k[9]*v_m2[4];
+  const Scalar x4 = k[10]*v_m3[0] + k[11]*v_m2[1] + k[12]*v_m2[3];
+  const Scalar x5 = k[13]*v_m2[0] + k[14]*v_m2[2] + k[15]*v_m2[4];
+  pA_m5[0] = v_m2[3]*x2 - v_m2[4]*x1;
+  pA_m5[1] = v_m2[4]*x0 - v_m2[2]*x2;
+  pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
+  pA_m5[3] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x2 - v_m2[1]*x1;
+  pA_m5[4] = v_m2[4]*x3 - v_m2[2]*x5 + v_m2[1]*x0 - v_m3[0]*x2;
+  pA_m5[5] = v_m2[2]*x4 - v_m2[3]*x3 + v_m3[0]*x1 - v_m2[0]*x0;
+  g_m6[0] = g_m7[0]*cq_m1[0] + g_m8[0]*sq_m0[0];
+  g_m6[1] = -g_m7[0]*sq_m0[0] + g_m8[0]*cq_m1[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, neck_link.
+// The first: body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
+constexpr Scalar shared_5_k0[16] = {-0.2555, 0.2555, 0.1, 0.001, 0.1, -0.001, -0.001, 3.5000000000000004e-05, 0.001, 3.5000000000000004e-05, 0.1, -0.1, 2.5e-05, 0.1, -2.5e-05, -0.1};
+constexpr Scalar shared_5_k1[16] = {0.29, -0.29, 0.5, 0.015, 0.5, -0.015, -0.015, 0.0007700000000000001, 0.015, 0.0007700000000000001, 0.5, -0.5, 0.00032, 0.5, -0.00032, -0.5};
+PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5) noexcept {
+  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
+  const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
+  v_m3[0] = cq_m1[0]*x0 + sq_m0[0]*x1;
+  v_m3[1] = -sq_m0[0]*x0 + cq_m1[0]*x1;
+  v_m3[3] = v_m2[3]*cq_m1[0] + v_m2[4]*sq_m0[0];
+  v_m3[4] = -v_m2[3]*sq_m0[0] + v_m2[4]*cq_m1[0];
+  v_m3[5] = v_m2[5] + v[0];
+  c_m4[0] = v[0]*v_m3[1];
+  c_m4[1] = -v[0]*v_m3[0];
+  c_m4[3] = v[0]*v_m3[4];
+  c_m4[4] = -v[0]*v_m3[3];
+  const Scalar x2 = k[2]*v_m3[0] + k[3]*v_m3[4];
+  const Scalar x3 = k[4]*v_m3[1] + k[5]*v_m3[3];
+  const Scalar x4 = k[6]*v_m3[1] + k[7]*v_m3[3];
+  const Scalar x5 = k[8]*v_m3[0] + k[9]*v_m3[4];
+  pA_m5[0] = k[10]*v_m2[2]*v_m3[4] - v_m3[5]*x3;
+  pA_m5[1] = v_m3[5]*x2 + k[11]*v_m2[2]*v_m3[3];
+  pA_m5[2] = v_m3[3]*x3 - v_m3[4]*x2;
+  pA_m5[3] = k[12]*v_m3[4]*v_m3[5] - v_m3[5]*x5 + k[13]*v_m2[2]*v_m3[1] - v_m2[2]*x3;
+  pA_m5[4] = v_m3[5]*x4 + k[14]*v_m3[3]*v_m3[5] + v_m2[2]*x2 + k[15]*v_m2[2]*v_m3[0];
+  pA_m5[5] = v_m3[3]*x5 - v_m3[4]*x4 + v_m3[0]*x3 - v_m3[1]*x2;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, r_wrist_yaw_link.
+// The first: eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
+constexpr Scalar shared_6_k0[42] = {1.0, 0.001, 0.001, 3.5000000000000004e-05, 0.5, 0.5, 2.0, 0.0005, 0.5, 0.5, 0.5, -1.7500000000000002e-05, 0.5, 1.7500000000000002e-05, 0.5, 0.5, 0.0005, -0.5, -0.0005, 0.5, 0.5, 0.2555, -0.2555, 0.2555, -0.2555, 0.2555, -0.2555, 0.92, -0.10107580000000001, 0.92, 0.10107580000000001, 0.92, 0.01661854208147, 0.2555, 0.2555, -0.2555, 0.2555, 0.01661854208147, -0.2555, -0.2555, 0.2555, -0.2555};
+PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[20];
+  u_m2[0] = -pA_m3[5] + tau[0];
+  const Scalar x0 = IA_m1[5]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[10]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[14]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[5]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[10]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[14]*x0;
+  const Scalar x7 = IA_m1[3] - IA_m1[17]*x0;
+  const Scalar x8 = IA_m1[6] - IA_m1[10]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[14]*x1;
+  const Scalar x10 = IA_m1[8] - IA_m1[17]*x1;
+  const Scalar x11 = IA_m1[11] - IA_m1[14]*x2;
+  const Scalar x12 = IA_m1[12] - IA_m1[17]*x2;
+  const Scalar x13 = IA_m1[15] - IA_m1[17]*x3;
+  const Scalar x14 = k[1]*c_m4[4] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[1]*x5 + c_m4[3]*x7;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[1]*x8 + c_m4[3]*x10;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[1]*x9 + c_m4[3]*x12;
+  const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[1]*x10 + c_m4[3]*x13;
+  const Scalar x18 = k[2]*c_m4[0] + k[3]*c_m4[4] + pA_m3[4];
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[4]*(x4 - x8);
+  const Scalar x21 = k[5]*(x4 + x8);
+  const Scalar x22 = k[6]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x5*x22;
+  const Scalar x24 = x20*x22 + x5*x19;
+  const Scalar x25 = k[7] + k[8]*x10;
+  const Scalar x26 = k[9]*x7*x19 - x22*x25;
+  const Scalar x27 = k[10]*x7*x22 + x19*x25;
+  const Scalar x28 = k[11] + k[12]*x13;
+  const Scalar x29 = k[13] + k[14]*x13;
+  const Scalar x30 = x21 + x23;
+  const Scalar x31 = cq_m5*x6 - sq_m6*x9;
+  const Scalar x32 = x21 - x23;
+  const Scalar x33 = sq_m6*x6 + cq_m5*x9;
+  const Scalar x34 = k[15]*x7 + x26;
+  const Scalar x35 = k[16] + k[17]*x10 + x27;
+  const Scalar x36 = k[18] + k[19]*x10 + x27;
+  const Scalar x37 = k[20]*x7 - x26;
+  const Scalar x38 = k[21]*x24 + x34;
+  const Scalar x39 = k[22]*x30 + x35;
+  const Scalar x40 = k[23]*x32 + x36;
+  const Scalar x41 = k[24]*x24 + x37;
+  const Scalar x42 = cq_m5*x12 + k[25]*x33;
+  const Scalar x43 = sq_m6*x12 + k[26]*x31;
+  const Scalar x44 = cq_m5*x14 - sq_m6*x15;
+  const Scalar x45 = sq_m6*x14 + cq_m5*x15;
+  IA_m7[0] = k[27] + x30;
+  IA_m7[1] = x24;
+  IA_m7[2] = x31;
+  IA_m7[3] = x38;
+  IA_m7[4] = k[28] + x39;
+  IA_m7[6] = k[29] + x32;
+  IA_m7[7] = x33;
+  IA_m7[8] = k[30] + x40;
+  IA_m7[9] = x41;
+  IA_m7[11] = k[31] + x11;
+  IA_m7[12] = x42;
+  IA_m7[13] = x43;
+  IA_m7[15] = k[32] + x29 + x19*x28 + k[33]*x36 + k[34]*x40;
+  IA_m7[16] = x22*x28 + k[35]*x34 + k[36]*x41;
+  IA_m7[18] = k[37] + x29 - x19*x28 + k[38]*x35 + k[39]*x39;
+  pA_m8[0] = pA_m8[0] + x44;
+  pA_m8[1] = pA_m8[1] + x45;
+  pA_m8[2] = pA_m8[2] + x16;
+  pA_m8[3] = pA_m8[3] + cq_m5*x17 - sq_m6*x18 + k[40]*x45;
+  pA_m8[4] = pA_m8[4] + sq_m6*x17 + cq_m5*x18 + k[41]*x44;
+  pA_m8[5] = pA_m8[5] + tau[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_forearm, r_forearm.
+// The first: eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
+constexpr Scalar shared_7_k0[112] = {1.0, 0.0005635, 0.5, 0.5, 2.0, 0.5, 0.5, 0.00028175, -0.5, 0.00028175, 0.5, 0.955336489125606, -0.955336489125606, -0.29552020666133966, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.955336489125606, 0.955336489125606, 0.29552020666133966, 0.477668244562803, -0.14776010333066983, -0.955336489125606, -0.29552020666133966, -0.14776010333066983, -0.477668244562803, -0.29552020666133966, 0.955336489125606, 0.14776010333066983, 0.477668244562803, -0.29552020666133966, 0.955336489125606, 0.477668244562803, -0.14776010333066983, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.955336489125606, -0.29552020666133966, -0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.955336489125606, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.3255, 0.3255, 0.3255, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 1.96, -0.27815927999999995, -0.3255, 1.96, 0.27815927999999995, -0.3255, 1.96, -0.3255, 0.061007086312239986, 0.955336489125606, -0.29552020666133966, 0.3255, 0.3255, -0.10595025000000001, -0.3255, 0.29552020666133966, 0.955336489125606, 0.3255, 0.061007086312239986, 0.10595025000000001, -0.3255, 0.0019845, 0.29552020666133966, 0.955336489125606, 0.3255, 0.955336489125606, -0.29552020666133966, -0.3255, 0.29552020666133966, 0.955336489125606};
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[9]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x7 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x8 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x10 = IA_m1[8] - IA_m1[16]*x1;
+  const Scalar x11 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x12 = IA_m1[12] - IA_m1[16]*x2;
+  const Scalar x13 = IA_m1[15] - IA_m1[16]*x3;
+  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x6 + c_m4[3]*x7;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[2]*x9 + c_m4[3]*x10;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12;
+  const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x12 + c_m4[3]*x13;
+  const Scalar x18 = k[1]*c_m4[5] + pA_m3[5];
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[2]*(-x4 + x11);
+  const Scalar x21 = k[3]*(x4 + x11);
+  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x6*x22;
+  const Scalar x24 = x20*x22 + x6*x19;
+  const Scalar x25 = k[5]*(-x7*x19 - x12*x22);
+  const Scalar x26 = k[6]*(-x7*x22 + x12*x19);
+  const Scalar x27 = k[7] + k[8]*x13;
+  const Scalar x28 = k[9] + k[10]*x13;
+  const Scalar x29 = k[11]*x21 + k[12]*x23 + k[13]*x24;
+  const Scalar x30 = k[14]*cq_m5*x9 + k[15]*sq_m6*x5 + k[16]*sq_m6*x9 + k[17]*cq_m5*x5;
+  const Scalar x31 = k[18]*x21 + k[19]*x23 + k[20]*x24;
+  const Scalar x32 = sq_m6*x9 + cq_m5*x5;
+  const Scalar x33 = cq_m5*x9 - sq_m6*x5;
+  const Scalar x34 = k[21]*x21 + k[22]*x23 + k[23]*x24;
+  const Scalar x35 = k[24]*x21 + k[25]*x23 + k[26]*x24;
+  const Scalar x36 = k[27]*x7 + k[28]*x12 + k[29]*x25 + k[30]*x26;
+  const Scalar x37 = k[31]*x7 + k[32]*x12 + k[33]*x25 + k[34]*x26;
+  const Scalar x38 = k[35]*x7 + k[36]*x12 + k[37]*x25 + k[38]*x26;
+  const Scalar x39 = k[39]*x7 + k[40]*x12 + k[41]*x25 + k[42]*x26;
+  const Scalar x40 = k[43]*x28 + k[44]*x19*x27 + k[45]*x22*x27;
+  const Scalar x41 = k[46]*x28 + k[47]*x19*x27 + k[48]*x22*x27;
+  const Scalar x42 = k[49]*x28 + k[50]*x19*x27 + k[51]*x22*x27;
+  const Scalar x43 = k[52]*x28 + k[53]*x19*x27 + k[54]*x22*x27;
+  const Scalar x44 = k[55]*x29 + k[56]*x31;
+  const Scalar x45 = k[57]*x29 + k[58]*x31;
+  const Scalar x46 = k[59]*x32 + k[60]*x33;
+  const Scalar x47 = k[61]*x34 + k[62]*x35;
+  const Scalar x48 = k[63]*x36 + k[64]*x37;
+  const Scalar x49 = k[65]*x36 + k[66]*x37;
+  const Scalar x50 = k[67]*sq_m6*x10 + k[68]*cq_m5*x10;
+  const Scalar x51 = k[69]*sq_m6*x10 + k[70]*cq_m5*x10;
+  const Scalar x52 = k[71]*x38 + k[72]*x39;
+  const Scalar x53 = k[73]*x38 + k[74]*x39;
+  const Scalar x54 = k[75]*x30 + x48;
+  const Scalar x55 = k[76]*x8 + x50;
+  const Scalar x56 = k[77]*x46 + x52;
+  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
+  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
+  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
+  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x61 = k[78]*x57 + k[79]*x58;
+  const Scalar x62 = k[80]*x57 + k[81]*x58;
+  IA_m7[0] = k[82] + x44;
+  IA_m7[1] = x30;
+  IA_m7[2] = x45;
+  IA_m7[3] = x54;
+  IA_m7[4] = k[83] + k[84]*x44;
+  IA_m7[5] = x49;
+  IA_m7[6] = k[85] + x8;
+  IA_m7[7] = x46;
+  IA_m7[8] = k[86] + x55;
+  IA_m7[9] = k[87]*x30;
+  IA_m7[10] = x51;
+  IA_m7[11] = k[88] + x47;
+  IA_m7[12] = x56;
+  IA_m7[13] = k[89]*x45;
+  IA_m7[14] = x53;
+  IA_m7[15] = k[90] + k[91]*x40 + k[92]*x41 + k[93]*x50 + k[94]*x55;
+  IA_m7[16] = k[95]*x30 + k[96]*x48;
+  IA_m7[17] = k[97]*x40 + k[98]*x41 + k[99]*x51;
+  IA_m7[18] = k[100] + k[101]*x44;
+  IA_m7[19] = k[102]*x49;
+  IA_m7[20] = k[103] + k[104]*x42 + k[105]*x43;
+  pA_m8[0] = pA_m8[0] + x61;
+  pA_m8[1] = pA_m8[1] + x15;
+  pA_m8[2] = pA_m8[2] + x62;
+  pA_m8[3] = pA_m8[3] + k[106]*x15 + k[107]*x59 + k[108]*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] + k[109]*x61;
+  pA_m8[5] = pA_m8[5] + k[110]*x59 + k[111]*x60;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_upper_arm, r_upper_arm.
+// The first: eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
+constexpr Scalar shared_8_k0[20] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.3, -0.009, 0.5, -0.5, 0.3, 0.009, -0.5, 0.5, 0.3, 0.00046199999999999995, 0.00046199999999999995};
+PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[20];
+  u_m2[0] = -pA_m3[5] + tau[0];
+  const Scalar x0 = IA_m1[5]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[10]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[14]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[0] - IA_m1[5]*x0;
+  const Scalar x6 = IA_m1[1] - IA_m1[10]*x0;
+  const Scalar x7 = IA_m1[2] - IA_m1[14]*x0;
+  const Scalar x8 = IA_m1[3] - IA_m1[17]*x0;
+  const Scalar x9 = IA_m1[4] - IA_m1[19]*x0;
+  const Scalar x10 = IA_m1[6] - IA_m1[10]*x1;
+  const Scalar x11 = IA_m1[7] - IA_m1[14]*x1;
+  const Scalar x12 = IA_m1[8] - IA_m1[17]*x1;
+  const Scalar x13 = IA_m1[9] - IA_m1[19]*x1;
+  const Scalar x14 = IA_m1[11] - IA_m1[14]*x2;
+  const Scalar x15 = IA_m1[12] - IA_m1[17]*x2;
+  const Scalar x16 = IA_m1[13] - IA_m1[19]*x2;
+  const Scalar x17 = IA_m1[15] - IA_m1[17]*x3;
+  const Scalar x18 = IA_m1[16] - IA_m1[19]*x3;
+  const Scalar x19 = IA_m1[18] - IA_m1[19]*x4;
+  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[3]*x8 + c_m4[4]*x9;
+  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[1]*x10 + c_m4[3]*x12 + c_m4[4]*x13;
+  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[1]*x11 + c_m4[3]*x15 + c_m4[4]*x16;
+  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[1]*x12 + c_m4[3]*x17 + c_m4[4]*x18;
+  const Scalar x24 = pA_m3[4] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[1]*x13 + c_m4[3]*x18 + c_m4[4]*x19;
+  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x26 = k[1]*(x5 - x10);
+  const Scalar x27 = k[2]*(x5 + x10);
+  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x29 = x25*x26 - x6*x28;
+  const Scalar x30 = x26*x28 + x6*x25;
+  const Scalar x31 = k[4]*(x8 - x13);
+  const Scalar x32 = k[5]*(x8 + x13);
+  const Scalar x33 = k[6]*(x9 + x12);
+  const Scalar x34 = x25*x31 - x28*x33;
+  const Scalar x35 = x28*x31 + x25*x33;
+  const Scalar x36 = k[7]*(x17 - x19);
+  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x38 = x25*x36 - x18*x28;
+  const Scalar x39 = x28*x36 + x18*x25;
+  IA_m7[0] = k[9] + x27 + x29;
+  IA_m7[1] = x30;
+  IA_m7[2] = cq_m5*x7 - sq_m6*x11;
+  IA_m7[3] = x32 + x34;
+  IA_m7[4] = k[10] + k[11]*x9 + k[12]*x12 + x35;
+  IA_m7[6] = k[13] + x27 - x29;
+  IA_m7[7] = sq_m6*x7 + cq_m5*x11;
+  IA_m7[8] = k[14] + k[15]*x9 + k[16]*x12 + x35;
+  IA_m7[9] = x32 - x34;
+  IA_m7[11] = k[17] + x14;
+  IA_m7[12] = cq_m5*x15 - sq_m6*x16;
+  IA_m7[13] = sq_m6*x15 + cq_m5*x16;
+  IA_m7[15] = k[18] + x37 + x38;
+  IA_m7[16] = x39;
+  IA_m7[18] = k[19] + x37 - x38;
+  pA_m8[0] = pA_m8[0] + cq_m5*x20 - sq_m6*x21;
+  pA_m8[1] = pA_m8[1] + sq_m6*x20 + cq_m5*x21;
+  pA_m8[2] = pA_m8[2] + x22;
+  pA_m8[3] = pA_m8[3] + cq_m5*x23 - sq_m6*x24;
+  pA_m8[4] = pA_m8[4] + sq_m6*x23 + cq_m5*x24;
+  pA_m8[5] = pA_m8[5] + tau[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_shoulder_roll_link, r_shoulder_roll_link.
+// The first: eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
+constexpr Scalar shared_9_k0[21] = {1.0, 0.000192, 0.5, 0.5, 2.0, 0.5, 0.5, -9.6e-05, 0.5, 9.6e-05, 0.5, 0.3, -0.009, 0.3, 0.5, -0.5, 0.3, 0.5, 0.5, 0.000192, 0.00046199999999999995};
+constexpr Scalar shared_9_k1[21] = {1.0, 0.000192, 0.5, 0.5, 2.0, 0.5, 0.5, -9.6e-05, 0.5, 9.6e-05, 0.5, 0.3, 0.009, 0.3, 0.5, -0.5, 0.3, 0.5, 0.5, 0.000192, 0.00046199999999999995};
+PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[15];
+  u_m2[0] = -pA_m3[3] + tau[0];
+  const Scalar x0 = IA_m1[3]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[8]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[12]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[3]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[8]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[12]*x0;
+  const Scalar x7 = IA_m1[4] - IA_m1[16]*x0;
+  const Scalar x8 = IA_m1[6] - IA_m1[8]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[12]*x1;
+  const Scalar x10 = IA_m1[9] - IA_m1[16]*x1;
+  const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
+  const Scalar x12 = IA_m1[13] - IA_m1[16]*x2;
+  const Scalar x13 = IA_m1[18] - IA_m1[16]*x3;
+  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[3]*x7;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[3]*x10;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[3]*x12;
+  const Scalar x17 = pA_m3[4] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[3]*x13;
+  const Scalar x18 = k[1]*c_m4[4] + pA_m3[5];
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[2]*(x8 - x11);
+  const Scalar x21 = k[3]*(x8 + x11);
+  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x9*x22;
+  const Scalar x24 = x20*x22 + x9*x19;
+  const Scalar x25 = k[5]*(x10*x19 - x12*x22);
+  const Scalar x26 = k[6]*(x10*x22 + x12*x19);
+  const Scalar x27 = k[7] + k[8]*x13;
+  const Scalar x28 = k[9] + k[10]*x13;
+  IA_m7[0] = k[11] + x4;
+  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
+  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
+  IA_m7[4] = cq_m5*x7;
+  IA_m7[5] = k[12] + sq_m6*x7;
+  IA_m7[6] = k[13] + x21 + x23;
+  IA_m7[7] = x24;
+  IA_m7[9] = k[14]*x10 + x25;
+  IA_m7[10] = k[15]*x12 + x26;
+  IA_m7[11] = k[16] + x21 - x23;
+  IA_m7[13] = k[17]*x12 + x26;
+  IA_m7[14] = k[18]*x10 - x25;
+  IA_m7[18] = k[19] + x28 + x19*x27;
+  IA_m7[19] = x22*x27;
+  IA_m7[20] = k[20] + x28 - x19*x27;
+  pA_m8[0] = pA_m8[0] + x14;
+  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[3] = pA_m8[3] + tau[0];
+  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
+// The first: eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+constexpr Scalar shared_10_k0[38] = {0.027912499999999996, 0.06825, 0.00194517348958, 1.0046580625, 1.0, -0.06825, -0.06825, 1.015, -0.027912499999999996, -0.06825, 1.015, 0.06495999999999999, -0.0017863999999999998, 0.00936987670937, 1.0046580625, 0.00860228295937, -3.1912249599999995e-06, -0.06495999999999999, -0.06495999999999999, -0.06825, -0.06825, 0.0017863999999999998, 0.5, 0.5, 2.0, -0.032479999999999995, 0.5, 0.5, 0.5, 0.2, 0.2, 0.032479999999999995, 0.5, 0.2, -0.032479999999999995, -0.5, 7.2e-05, 7.2e-05};
+PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar cq_m9, Scalar sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
+  const Scalar x0 = mu*active_m0[0];
+  U_m1[0] = k[0] + k[1]*x0;
+  U_m1[2] = k[2] + k[3]*x0;
+  Dinv_m2[0] = k[4] / U_m1[2];
+  u_m3[0] = -pA_m4[3] + k[5]*lambda_m5[1] - lambda_m5[3] + k[6]*g_m6[0]*x0 + tau[0];
+  const Scalar x1 = U_m1[0]*Dinv_m2[0];
+  const Scalar x2 = k[7] + x0;
+  const Scalar x3 = k[8] + k[9]*x0;
+  const Scalar x4 = k[10] + x0 - U_m1[0]*x1;
+  const Scalar x5 = k[11] + k[12]*U_m1[0]*Dinv_m2[0];
+  const Scalar x6 = k[13] + k[14]*x0;
+  const Scalar x7 = k[15] + x0 + k[16]*Dinv_m2[0];
+  const Scalar x8 = pA_m4[0] + lambda_m5[0] + g_m7[0]*x0 + c_m8[3]*x3;
+  const Scalar x9 = pA_m4[1] + lambda_m5[1] + g_m6[0]*x0 + u_m3[0]*x1 + c_m8[0]*x4 + c_m8[4]*x5;
+  const Scalar x10 = k[17]*c_m8[3] + pA_m4[2] + lambda_m5[2] + g_m6[1]*x0 + c_m8[1]*x2;
+  const Scalar x11 = k[18]*c_m8[1] + pA_m4[4] + k[19]*lambda_m5[0] + lambda_m5[4] + k[20]*g_m7[0]*x0 + c_m8[3]*x6;
+  const Scalar x12 = pA_m4[5] + lambda_m5[5] + k[21]*Dinv_m2[0]*u_m3[0] + c_m8[0]*x5 + c_m8[4]*x7;
+  const Scalar x13 = cq_m9*cq_m9 - sq_m10*sq_m10;
+  const Scalar x14 = k[22]*(-x2 + x4);
+  const Scalar x15 = k[23]*(x2 + x4);
+  const Scalar x16 = k[24]*cq_m9*sq_m10;
+  const Scalar x17 = k[25] + k[26]*x5;
+  const Scalar x18 = k[27]*(x6 - x7);
+  const Scalar x19 = k[28]*(x6 + x7);
+  IA_m11[0] = k[29] + x2;
+  IA_m11[4] = cq_m9*x3;
+  IA_m11[5] = sq_m10*x3;
+  IA_m11[6] = k[30] + x15 + x13*x14;
+  IA_m11[7] = x14*x16;
+  IA_m11[9] = -x16*x17;
+  IA_m11[10] = k[31] + k[32]*x5 + x13*x17;
+  IA_m11[11] = k[33] + x15 - x13*x14;
+  IA_m11[13] = k[34] + k[35]*x5 + x13*x17;
+  IA_m11[14] = x16*x17;
+  IA_m11[18] = k[36] + x19 + x13*x18;
+  IA_m11[19] = x16*x18;
+  IA_m11[20] = k[37] + x19 - x13*x18;
+  pA_m12[0] = pA_m12[0] + x8;
+  pA_m12[1] = pA_m12[1] + cq_m9*x9 - sq_m10*x10;
+  pA_m12[2] = pA_m12[2] + sq_m10*x9 + cq_m9*x10;
+  pA_m12[3] = tau[0];
+  pA_m12[4] = cq_m9*x11 - sq_m10*x12;
+  pA_m12[5] = sq_m10*x11 + cq_m9*x12;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
+// The first: eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+constexpr Scalar shared_11_k0[112] = {1.0, 7.2e-05, 0.5, 0.5, 2.0, 0.5, 0.5, -3.6e-05, 0.5, 3.6e-05, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, 0.4975020826390129, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.04991670832341408, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.04991670832341408, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, 0.4975020826390129, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 3.055, -0.5694718575000001, -0.4305, 3.055, 0.5694718575000001, -0.4305, 3.055, -0.4305, 0.15779149347477375, 0.9950041652780258, -0.09983341664682815, 0.4305, 0.4305, -0.18533025, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.15779149347477375, 0.18533025, -0.4305, 0.00381875, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x5 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x6 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x7 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x8 = IA_m1[10] - IA_m1[19]*x1;
+  const Scalar x9 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x10 = IA_m1[14] - IA_m1[19]*x2;
+  const Scalar x11 = IA_m1[20] - IA_m1[19]*x3;
+  const Scalar x12 = -IA_m1[13]*x0;
+  const Scalar x13 = -IA_m1[9]*x0;
+  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
+  const Scalar x17 = k[1]*c_m4[3] + pA_m3[3];
+  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[2]*(-x4 + x9);
+  const Scalar x21 = k[3]*(x4 + x9);
+  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x12*x22;
+  const Scalar x24 = x20*x22 + x12*x19;
+  const Scalar x25 = k[5]*(x10*x19 - x5*x22);
+  const Scalar x26 = k[6]*(x10*x22 + x5*x19);
+  const Scalar x27 = k[7] + k[8]*x11;
+  const Scalar x28 = k[9] + k[10]*x11;
+  const Scalar x29 = k[11]*x21 + k[12]*x23 + k[13]*x24;
+  const Scalar x30 = k[14]*cq_m5*x7 + k[15]*sq_m6*x13 + k[16]*sq_m6*x7 + k[17]*cq_m5*x13;
+  const Scalar x31 = k[18]*x21 + k[19]*x23 + k[20]*x24;
+  const Scalar x32 = sq_m6*x7 + cq_m5*x13;
+  const Scalar x33 = cq_m5*x7 - sq_m6*x13;
+  const Scalar x34 = k[21]*x21 + k[22]*x23 + k[23]*x24;
+  const Scalar x35 = k[24]*x21 + k[25]*x23 + k[26]*x24;
+  const Scalar x36 = k[27]*x5 + k[28]*x10 + k[29]*x25 + k[30]*x26;
+  const Scalar x37 = k[31]*x5 + k[32]*x10 + k[33]*x25 + k[34]*x26;
+  const Scalar x38 = k[35]*x5 + k[36]*x10 + k[37]*x25 + k[38]*x26;
+  const Scalar x39 = k[39]*x5 + k[40]*x10 + k[41]*x25 + k[42]*x26;
+  const Scalar x40 = k[43]*x28 + k[44]*x19*x27 + k[45]*x22*x27;
+  const Scalar x41 = k[46]*x28 + k[47]*x19*x27 + k[48]*x22*x27;
+  const Scalar x42 = k[49]*x28 + k[50]*x19*x27 + k[51]*x22*x27;
+  const Scalar x43 = k[52]*x28 + k[53]*x19*x27 + k[54]*x22*x27;
+  const Scalar x44 = k[55]*x29 + k[56]*x31;
+  const Scalar x45 = k[57]*x29 + k[58]*x31;
+  const Scalar x46 = k[59]*x32 + k[60]*x33;
+  const Scalar x47 = k[61]*x34 + k[62]*x35;
+  const Scalar x48 = k[63]*x36 + k[64]*x37;
+  const Scalar x49 = k[65]*x36 + k[66]*x37;
+  const Scalar x50 = k[67]*cq_m5*x8 + k[68]*sq_m6*x8;
+  const Scalar x51 = k[69]*cq_m5*x8 + k[70]*sq_m6*x8;
+  const Scalar x52 = k[71]*x38 + k[72]*x39;
+  const Scalar x53 = k[73]*x38 + k[74]*x39;
+  const Scalar x54 = k[75]*x30 + x48;
+  const Scalar x55 = k[76]*x6 + x50;
+  const Scalar x56 = k[77]*x46 + x52;
+  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
+  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
+  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
+  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x61 = k[78]*x57 + k[79]*x58;
+  const Scalar x62 = k[80]*x57 + k[81]*x58;
+  IA_m7[0] = k[82] + x44;
+  IA_m7[1] = x30;
+  IA_m7[2] = x45;
+  IA_m7[3] = x54;
+  IA_m7[4] = k[83] + k[84]*x44;
+  IA_m7[5] = x49;
+  IA_m7[6] = k[85] + x6;
+  IA_m7[7] = x46;
+  IA_m7[8] = k[86] + x55;
+  IA_m7[9] = k[87]*x30;
+  IA_m7[10] = x51;
+  IA_m7[11] = k[88] + x47;
+  IA_m7[12] = x56;
+  IA_m7[13] = k[89]*x45;
+  IA_m7[14] = x53;
+  IA_m7[15] = k[90] + k[91]*x40 + k[92]*x41 + k[93]*x50 + k[94]*x55;
+  IA_m7[16] = k[95]*x30 + k[96]*x48;
+  IA_m7[17] = k[97]*x40 + k[98]*x41 + k[99]*x51;
+  IA_m7[18] = k[100] + k[101]*x44;
+  IA_m7[19] = k[102]*x49;
+  IA_m7[20] = k[103] + k[104]*x42 + k[105]*x43;
+  pA_m8[0] = pA_m8[0] + x61;
+  pA_m8[1] = pA_m8[1] + x15;
+  pA_m8[2] = pA_m8[2] + x62;
+  pA_m8[3] = pA_m8[3] + k[106]*x15 + k[107]*x59 + k[108]*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] + k[109]*x61;
+  pA_m8[5] = pA_m8[5] + k[110]*x59 + k[111]*x60;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
+// The first: eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+constexpr Scalar shared_12_k0[114] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.4900332889206208, 0.4900332889206208, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 7.0, -1.29954125, -0.42875, 7.0, 1.29954125, -0.42875, 7.0, -0.42875, 0.3755072987089375, 0.9800665778412416, 0.19866933079506124, 0.42875, 0.42875, -0.1838265625, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.3755072987089375, 0.1838265625, -0.42875, 0.0196875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
+  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
+  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
+  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
+  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
+  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
+  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
+  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
+  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
+  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
+  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
+  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
+  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
+  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x26 = k[1]*(-x5 + x14);
+  const Scalar x27 = k[2]*(x5 + x14);
+  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x29 = x25*x26 - x7*x28;
+  const Scalar x30 = x26*x28 + x7*x25;
+  const Scalar x31 = k[4]*(-x8 + x16);
+  const Scalar x32 = k[5]*(x8 + x16);
+  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x34 = x25*x31 - x28*x33;
+  const Scalar x35 = x28*x31 + x25*x33;
+  const Scalar x36 = k[7]*(-x17 + x19);
+  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x38 = x25*x36 - x18*x28;
+  const Scalar x39 = x28*x36 + x18*x25;
+  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
+  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
+  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
+  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
+  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
+  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
+  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
+  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
+  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
+  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
+  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
+  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
+  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x57 = k[57]*x40 + k[58]*x42;
+  const Scalar x58 = k[59]*x40 + k[60]*x42;
+  const Scalar x59 = k[61]*x43 + k[62]*x44;
+  const Scalar x60 = k[63]*x45 + k[64]*x46;
+  const Scalar x61 = k[65]*x47 + k[66]*x48;
+  const Scalar x62 = k[67]*x47 + k[68]*x48;
+  const Scalar x63 = k[69]*x49 + k[70]*x50;
+  const Scalar x64 = k[71]*x49 + k[72]*x50;
+  const Scalar x65 = k[73]*x51 + k[74]*x52;
+  const Scalar x66 = k[75]*x51 + k[76]*x52;
+  const Scalar x67 = k[77]*x41 + x61;
+  const Scalar x68 = k[78]*x10 + x63;
+  const Scalar x69 = k[79]*x59 + x65;
+  const Scalar x70 = cq_m5*x20 + sq_m6*x22;
+  const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
+  const Scalar x72 = cq_m5*x23 + sq_m6*x24;
+  const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x74 = k[80]*x70 + k[81]*x71;
+  const Scalar x75 = k[82]*x70 + k[83]*x71;
+  IA_m7[0] = k[84] + x57;
+  IA_m7[1] = x41;
+  IA_m7[2] = x58;
+  IA_m7[3] = x67;
+  IA_m7[4] = k[85] + k[86]*x57;
+  IA_m7[5] = x62;
+  IA_m7[6] = k[87] + x10;
+  IA_m7[7] = x59;
+  IA_m7[8] = k[88] + x68;
+  IA_m7[9] = k[89]*x41;
+  IA_m7[10] = x64;
+  IA_m7[11] = k[90] + x60;
+  IA_m7[12] = x69;
+  IA_m7[13] = k[91]*x58;
+  IA_m7[14] = x66;
+  IA_m7[15] = k[92] + k[93]*x53 + k[94]*x54 + k[95]*x63 + k[96]*x68;
+  IA_m7[16] = k[97]*x41 + k[98]*x61;
+  IA_m7[17] = k[99]*x53 + k[100]*x54 + k[101]*x64;
+  IA_m7[18] = k[102] + k[103]*x57;
+  IA_m7[19] = k[104]*x62;
+  IA_m7[20] = k[105] + k[106]*x55 + k[107]*x56;
+  pA_m8[0] = pA_m8[0] + x74;
+  pA_m8[1] = pA_m8[1] + x21;
+  pA_m8[2] = pA_m8[2] + x75;
+  pA_m8[3] = pA_m8[3] + k[108]*x21 + k[109]*x72 + k[110]*x73;
+  pA_m8[4] = pA_m8[4] + tau[0] + k[111]*x74;
+  pA_m8[5] = pA_m8[5] + k[112]*x72 + k[113]*x73;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
+// The first: eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+constexpr Scalar shared_13_k0[97] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.4975020826390129, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.5, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.015, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.00095, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.0005, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
+  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
+  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
+  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
+  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
+  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
+  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
+  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
+  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
+  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
+  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
+  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
+  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
+  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x26 = k[1]*(-x5 + x14);
+  const Scalar x27 = k[2]*(x5 + x14);
+  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x29 = x25*x26 - x7*x28;
+  const Scalar x30 = x26*x28 + x7*x25;
+  const Scalar x31 = k[4]*(-x8 + x16);
+  const Scalar x32 = k[5]*(x8 + x16);
+  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x34 = x25*x31 - x28*x33;
+  const Scalar x35 = x28*x31 + x25*x33;
+  const Scalar x36 = k[7]*(-x17 + x19);
+  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x38 = x25*x36 - x18*x28;
+  const Scalar x39 = x28*x36 + x18*x25;
+  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
+  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
+  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
+  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
+  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
+  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
+  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
+  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
+  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
+  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
+  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
+  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
+  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x57 = cq_m5*x20 + sq_m6*x22;
+  const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
+  const Scalar x59 = cq_m5*x23 + sq_m6*x24;
+  const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
+  IA_m7[0] = k[57] + k[58]*x40 + k[59]*x42;
+  IA_m7[1] = x41;
+  IA_m7[2] = k[60]*x40 + k[61]*x42;
+  IA_m7[3] = k[62]*x47 + k[63]*x48;
+  IA_m7[5] = k[64]*x47 + k[65]*x48;
+  IA_m7[6] = k[66] + x10;
+  IA_m7[7] = k[67]*x43 + k[68]*x44;
+  IA_m7[8] = k[69] + k[70]*x49 + k[71]*x50;
+  IA_m7[10] = k[72]*x49 + k[73]*x50;
+  IA_m7[11] = k[74] + k[75]*x45 + k[76]*x46;
+  IA_m7[12] = k[77]*x51 + k[78]*x52;
+  IA_m7[14] = k[79]*x51 + k[80]*x52;
+  IA_m7[15] = k[81] + k[82]*x53 + k[83]*x54;
+  IA_m7[17] = k[84]*x53 + k[85]*x54;
+  IA_m7[20] = k[86] + k[87]*x55 + k[88]*x56;
+  pA_m8[0] = pA_m8[0] + k[89]*x57 + k[90]*x58;
+  pA_m8[1] = pA_m8[1] + x21;
+  pA_m8[2] = pA_m8[2] + k[91]*x57 + k[92]*x58;
+  pA_m8[3] = pA_m8[3] + k[93]*x59 + k[94]*x60;
+  pA_m8[4] = pA_m8[4] + tau[0];
+  pA_m8[5] = pA_m8[5] + k[95]*x59 + k[96]*x60;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
+// The first: eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+constexpr Scalar shared_14_k0[24] = {1.0, -0.015, 0.00095, 0.5, 0.5, 2.0, 0.5, 0.5, 0.000475, -0.5, 0.000475, 0.5, 0.5, 0.02, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, -0.5, 0.5, 0.0013, 0.0005};
+PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[15];
+  u_m2[0] = -pA_m3[3] + tau[0];
+  const Scalar x0 = IA_m1[3]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[8]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[12]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[3]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[8]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[12]*x0;
+  const Scalar x7 = IA_m1[5] - IA_m1[17]*x0;
+  const Scalar x8 = IA_m1[6] - IA_m1[8]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[12]*x1;
+  const Scalar x10 = IA_m1[10] - IA_m1[17]*x1;
+  const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
+  const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
+  const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
+  const Scalar x14 = k[1]*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
+  const Scalar x17 = k[2]*c_m4[3] + pA_m3[4];
+  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[3]*(x8 - x11);
+  const Scalar x21 = k[4]*(x8 + x11);
+  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x9*x22;
+  const Scalar x24 = x20*x22 + x9*x19;
+  const Scalar x25 = k[6]*(-x12*x19 - x10*x22);
+  const Scalar x26 = k[7]*(-x12*x22 + x10*x19);
+  const Scalar x27 = k[8] + k[9]*x13;
+  const Scalar x28 = k[10] + k[11]*x13;
+  IA_m7[0] = k[12] + x4;
+  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
+  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
+  IA_m7[4] = k[13] + k[14]*cq_m5 - sq_m6*x7;
+  IA_m7[5] = k[15]*sq_m6 + cq_m5*x7;
+  IA_m7[6] = k[16] + x21 + x23;
+  IA_m7[7] = x24;
+  IA_m7[9] = k[17]*x12 + x25;
+  IA_m7[10] = k[18]*x10 + x26;
+  IA_m7[11] = k[19] + x21 - x23;
+  IA_m7[13] = k[20]*x10 + x26;
+  IA_m7[14] = k[21]*x12 - x25;
+  IA_m7[18] = k[22] + x28 + x19*x27;
+  IA_m7[19] = x22*x27;
+  IA_m7[20] = k[23] + x28 - x19*x27;
+  pA_m8[0] = pA_m8[0] + x14;
+  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[3] = pA_m8[3] + tau[0];
+  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: pelvis.
+// The first: accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
+constexpr Scalar shared_15_k0[21] = {-9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, 9.81, 9.81, 9.81};
+PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
+  const Scalar x0 = u_m0[0] + k[0]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] + k[1]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] + k[2]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
+  const Scalar x1 = Linv_m3[0]*x0;
+  const Scalar x2 = u_m0[1] + k[3]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] + k[4]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] + k[5]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
+  const Scalar x3 = Linv_m3[1]*x2;
+  const Scalar x4 = u_m0[2] + k[6]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] + k[7]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] + k[8]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
+  const Scalar x5 = Linv_m3[2]*x4;
+  const Scalar x6 = u_m0[3] + k[9]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] + k[10]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] + k[11]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
+  const Scalar x7 = Linv_m3[3]*x6;
+  const Scalar x8 = u_m0[4] + k[12]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] + k[13]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] + k[14]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
+  const Scalar x9 = Linv_m3[4]*x8;
+  const Scalar x10 = u_m0[5] + k[15]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] + k[16]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] + k[17]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
+  const Scalar x11 = Linv_m3[5]*x10;
+  const Scalar x12 = Linv_m3[5]*x11;
+  const Scalar x13 = Linv_m3[4]*x8 - L_m4[18]*x12;
+  const Scalar x14 = Linv_m3[4]*x13;
+  const Scalar x15 = Linv_m3[3]*x6 - L_m4[15]*x14 - L_m4[16]*x12;
+  const Scalar x16 = Linv_m3[3]*x15;
+  const Scalar x17 = Linv_m3[2]*x4 - L_m4[11]*x16 - L_m4[12]*x14 - L_m4[13]*x12;
+  const Scalar x18 = Linv_m3[2]*x17;
+  const Scalar x19 = Linv_m3[1]*x2 - L_m4[6]*x18 - L_m4[7]*x16 - L_m4[8]*x14 - L_m4[9]*x12;
+  const Scalar x20 = Linv_m3[1]*x19;
+  const Scalar x21 = Linv_m3[0]*x0 - L_m4[0]*x20 - L_m4[1]*x18 - L_m4[2]*x16 - L_m4[3]*x14 - L_m4[4]*x12;
+  qdd_m5[0] = Linv_m3[0]*x21;
+  qdd_m5[1] = Linv_m3[1]*x19;
+  qdd_m5[2] = Linv_m3[2]*x17;
+  qdd_m5[3] = Linv_m3[3]*x15;
+  qdd_m5[4] = Linv_m3[4]*x13;
+  qdd_m5[5] = Linv_m3[5]*x11;
+  a_m6[0] = k[18]*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
+  a_m6[1] = k[19]*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
+  a_m6[2] = k[20]*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
+  a_m6[3] = qdd_m5[3];
+  a_m6[4] = qdd_m5[4];
+  a_m6[5] = qdd_m5[5];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link.
+// The first: accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
+constexpr Scalar shared_16_k0[10] = {-0.0875, 0.0875, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759, -0.08718915247898762, 0.9961917745544759, 0.08718915247898762, -0.08718915247898762, 0.9961917745544759};
+PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[1] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[1] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[4];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[4];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
+  const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
+  const Scalar x9 = c_m1[4] - sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - IA_m5[15]*a_m0[5];
+  qdd_m6[0] = Dinv_m7*x10;
+  a_m8[0] = x6;
+  a_m8[1] = x7;
+  a_m8[2] = x1;
+  a_m8[3] = x8;
+  a_m8[4] = x9;
+  a_m8[5] = a_m0[5] + qdd_m6[0];
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
+// The first: accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+  const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = a_m1[0];
+  a_m8[1] = x0;
+  a_m8[2] = x1;
+  a_m8[3] = a_m1[3] + qdd_m6[0];
+  a_m8[4] = x2;
+  a_m8[5] = x3;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
+// The first: accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+constexpr Scalar shared_18_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
+  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
+  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
+  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
+  qdd_m6[0] = Dinv_m7*x8;
+  a_m8[0] = x4;
+  a_m8[1] = a_m0[1];
+  a_m8[2] = x5;
+  a_m8[3] = x6;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x7;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+constexpr Scalar shared_19_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
+  qdd_m6[0] = Dinv_m7*x10;
+  a_m8[0] = x6;
+  a_m8[1] = x1;
+  a_m8[2] = x7;
+  a_m8[3] = x8;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x9;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+constexpr Scalar shared_20_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
+  qdd_m6[0] = Dinv_m7*x10;
+  a_m8[0] = x6;
+  a_m8[1] = x1;
+  a_m8[2] = x7;
+  a_m8[3] = x8;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x9;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+constexpr Scalar shared_21_k0[1] = {-0.0017863999999999998};
+PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+  const Scalar x4 = u_m4[0] + k[0]*x3 - U_m5[0]*x0 - U_m5[2]*a_m2[3];
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = a_m2[0];
+  a_m8[1] = x0;
+  a_m8[2] = x1;
+  a_m8[3] = a_m2[3] + qdd_m6[0];
+  a_m8[4] = x2;
+  a_m8[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_hip_yaw_link.
+// The first: accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
+constexpr Scalar shared_22_k0[10] = {0.0875, -0.0875, -0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.08718915247898762, 0.9961917745544759, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759};
+PROXGEN_RT_NOINLINE void shared_22(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[1] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[1] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[4];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[4];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
+  const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
+  const Scalar x9 = c_m1[4] - sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - a_m0[5]*IA_m5[15];
+  qdd_m6[0] = Dinv_m7*x10;
+  a_m8[0] = x6;
+  a_m8[1] = x7;
+  a_m8[2] = x1;
+  a_m8[3] = x8;
+  a_m8[4] = x9;
+  a_m8[5] = a_m0[5] + qdd_m6[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: abdomen.
+// The first: accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
+constexpr Scalar shared_23_k0[2] = {0.1, -0.1};
+PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
+  const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 + a_m0[4]*sq_m3;
+  const Scalar x5 = c_m1[4] - a_m0[3]*sq_m3 + a_m0[4]*cq_m2;
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - a_m0[2]*IA_m5[9] - IA_m5[12]*x4 - IA_m5[14]*x5 - a_m0[5]*IA_m5[15];
+  qdd_m6[0] = Dinv_m7*x6;
+  a_m8[0] = x2;
+  a_m8[1] = x3;
+  a_m8[2] = a_m0[2];
+  a_m8[3] = x4;
+  a_m8[4] = x5;
+  a_m8[5] = a_m0[5] + qdd_m6[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: chest.
+// The first: accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
+constexpr Scalar shared_24_k0[2] = {0.15, -0.15};
+PROXGEN_RT_NOINLINE void shared_24(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - a_m0[2]*sq_m3;
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + a_m0[2]*cq_m2;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x1 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
+  qdd_m6[0] = Dinv_m7*x6;
+  a_m8[0] = x2;
+  a_m8[1] = x1;
+  a_m8[2] = x3;
+  a_m8[3] = x4;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x5;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: r_shoulder_pitch_link, l_shoulder_pitch_link.
+// The first: accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+constexpr Scalar shared_25_k0[20] = {0.254, 0.19, -0.254, -0.19, 0.9848134698792882, 0.17361575258114187, 0.04493516596384369, 0.9659256678396477, -0.2548890642384102, -0.1676999117594225, 0.2588196364430848, 0.9512566085906322, 0.9848134698792882, 0.17361575258114187, 0.04493516596384369, 0.9659256678396477, -0.2548890642384102, -0.1676999117594225, 0.2588196364430848, 0.9512566085906322};
+constexpr Scalar shared_25_k1[20] = {0.254, -0.19, -0.254, 0.19, 0.9848134698792882, 0.17361575258114187, -0.04493516596384369, 0.9659256678396477, 0.2548890642384102, -0.1676999117594225, -0.2588196364430848, 0.9512566085906322, 0.9848134698792882, 0.17361575258114187, -0.04493516596384369, 0.9659256678396477, 0.2548890642384102, -0.1676999117594225, -0.2588196364430848, 0.9512566085906322};
+PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4] + k[1]*a_m0[5];
+  const Scalar x1 = a_m0[1] + k[2]*a_m0[3];
+  const Scalar x2 = a_m0[2] + k[3]*a_m0[3];
+  const Scalar x3 = k[4]*x0 + k[5]*x2;
+  const Scalar x4 = k[6]*x0 + k[7]*x1 + k[8]*x2;
+  const Scalar x5 = k[9]*x0 + k[10]*x1 + k[11]*x2;
+  const Scalar x6 = k[12]*a_m0[3] + k[13]*a_m0[5];
+  const Scalar x7 = k[14]*a_m0[3] + k[15]*a_m0[4] + k[16]*a_m0[5];
+  const Scalar x8 = k[17]*a_m0[3] + k[18]*a_m0[4] + k[19]*a_m0[5];
+  const Scalar x9 = c_m1[0] + cq_m2*x3 - sq_m3*x5;
+  const Scalar x10 = c_m1[2] + sq_m3*x3 + cq_m2*x5;
+  const Scalar x11 = c_m1[3] + cq_m2*x6 - sq_m3*x8;
+  const Scalar x12 = c_m1[5] + sq_m3*x6 + cq_m2*x8;
+  const Scalar x13 = u_m4[0] - IA_m5[0]*x9 - IA_m5[5]*x4 - IA_m5[9]*x10 - IA_m5[14]*x7 - IA_m5[15]*x12;
+  qdd_m6[0] = Dinv_m7*x13;
+  a_m8[0] = x9;
+  a_m8[1] = x4;
+  a_m8[2] = x10;
+  a_m8[3] = x11;
+  a_m8[4] = x7 + qdd_m6[0];
+  a_m8[5] = x12;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: r_shoulder_roll_link, l_shoulder_roll_link.
+// The first: accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+  const Scalar x4 = u_m4[0] - IA_m5[0]*a_m2[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - IA_m5[12]*a_m2[3] - IA_m5[13]*x2;
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = a_m2[0];
+  a_m8[1] = x0;
+  a_m8[2] = x1;
+  a_m8[3] = a_m2[3] + qdd_m6[0];
+  a_m8[4] = x2;
+  a_m8[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_upper_arm.
+// The first: accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
+PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2 + a_m1[1]*sq_m3;
+  const Scalar x1 = c_m0[1] - a_m1[0]*sq_m3 + a_m1[1]*cq_m2;
+  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2 + a_m1[4]*sq_m3;
+  const Scalar x3 = c_m0[4] - a_m1[3]*sq_m3 + a_m1[4]*cq_m2;
+  const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - IA_m5[5]*x1 - a_m1[2]*IA_m5[9] - IA_m5[12]*x2 - IA_m5[14]*x3 - a_m1[5]*IA_m5[15];
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = x0;
+  a_m8[1] = x1;
+  a_m8[2] = a_m1[2];
+  a_m8[3] = x2;
+  a_m8[4] = x3;
+  a_m8[5] = a_m1[5] + qdd_m6[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_forearm.
+// The first: accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
+constexpr Scalar shared_28_k0[10] = {-0.3255, 0.3255, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606};
+PROXGEN_RT_NOINLINE void shared_28(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4];
+  qdd_m6[0] = Dinv_m7*x10;
+  a_m8[0] = x6;
+  a_m8[1] = x1;
+  a_m8[2] = x7;
+  a_m8[3] = x8;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x9;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: r_wrist_yaw_link, l_wrist_yaw_link.
+// The first: accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+constexpr Scalar shared_29_k0[2] = {-0.2555, 0.2555};
+PROXGEN_RT_NOINLINE void shared_29(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
+  const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
+  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] + sq_m3*a_m0[4];
+  const Scalar x5 = c_m1[4] - sq_m3*a_m0[3] + cq_m2*a_m0[4];
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - IA_m5[9]*a_m0[2] - IA_m5[12]*x4 - IA_m5[15]*a_m0[5];
+  qdd_m6[0] = Dinv_m7*x6;
+  a_m8[0] = x2;
+  a_m8[1] = x3;
+  a_m8[2] = a_m0[2];
+  a_m8[3] = x4;
+  a_m8[4] = x5;
+  a_m8[5] = a_m0[5] + qdd_m6[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_wrist_pitch_link.
+// The first: accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
+PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2 - a_m1[2]*sq_m3;
+  const Scalar x1 = c_m0[2] + a_m1[0]*sq_m3 + a_m1[2]*cq_m2;
+  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2 - a_m1[5]*sq_m3;
+  const Scalar x3 = c_m0[5] + a_m1[3]*sq_m3 + a_m1[5]*cq_m2;
+  const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - a_m1[4]*IA_m5[14] - IA_m5[15]*x3;
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = x0;
+  a_m8[1] = a_m1[1];
+  a_m8[2] = x1;
+  a_m8[3] = x2;
+  a_m8[4] = a_m1[4] + qdd_m6[0];
+  a_m8[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_hand.
+// The first: accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
+PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+  const Scalar x4 = u_m4[0] - U_m5[0]*x0 - U_m5[2]*a_m2[3];
+  qdd_m6[0] = Dinv_m7*x4;
+  a_m8[0] = a_m2[0];
+  a_m8[1] = x0;
+  a_m8[2] = x1;
+  a_m8[3] = a_m2[3] + qdd_m6[0];
+  a_m8[4] = x2;
+  a_m8[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
+// The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+constexpr Scalar shared_32_k0[6] = {-0.06825, 0.06825, -0.06825, 0.06825, 0.13, 0.13};
+PROXGEN_RT_NOINLINE void shared_32(const Scalar* PROXGEN_RT_RESTRICT k, Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+  const Scalar x0 = g_m0[0] + a_m1[0] + k[0]*a_m1[4];
+  residual_m2[0] = active_m3[0]*x0;
+  dlambda_m4[0] = mu*residual_m2[0];
+  lambda_m5[0] = lambda_m5[0] + dlambda_m4[0];
+  const Scalar x1 = a_m1[1] + k[1]*a_m1[3] + g_m6[0];
+  residual_m2[1] = active_m3[0]*x1;
+  dlambda_m4[1] = mu*residual_m2[1];
+  lambda_m5[1] = lambda_m5[1] + dlambda_m4[1];
+  const Scalar x2 = a_m1[2] + g_m6[1];
+  residual_m2[2] = active_m3[0]*x2;
+  dlambda_m4[2] = mu*residual_m2[2];
+  lambda_m5[2] = lambda_m5[2] + dlambda_m4[2];
+  residual_m2[3] = a_m1[3]*active_m3[0];
+  dlambda_m4[3] = mu*residual_m2[3];
+  lambda_m5[3] = lambda_m5[3] + dlambda_m4[3];
+  residual_m2[4] = a_m1[4]*active_m3[0];
+  dlambda_m4[4] = mu*residual_m2[4];
+  lambda_m5[4] = lambda_m5[4] + dlambda_m4[4];
+  residual_m2[5] = a_m1[5]*active_m3[0];
+  dlambda_m4[5] = mu*residual_m2[5];
+  lambda_m5[5] = lambda_m5[5] + dlambda_m4[5];
+  const Scalar x3 = g_m7[0] + a_m8[0] + k[2]*a_m8[4];
+  residual_m2[6] = active_m3[1]*x3;
+  dlambda_m4[6] = mu*residual_m2[6];
+  lambda_m5[6] = lambda_m5[6] + dlambda_m4[6];
+  const Scalar x4 = a_m8[1] + k[3]*a_m8[3] + g_m9[0];
+  residual_m2[7] = active_m3[1]*x4;
+  dlambda_m4[7] = mu*residual_m2[7];
+  lambda_m5[7] = lambda_m5[7] + dlambda_m4[7];
+  const Scalar x5 = a_m8[2] + g_m9[1];
+  residual_m2[8] = active_m3[1]*x5;
+  dlambda_m4[8] = mu*residual_m2[8];
+  lambda_m5[8] = lambda_m5[8] + dlambda_m4[8];
+  residual_m2[9] = a_m8[3]*active_m3[1];
+  dlambda_m4[9] = mu*residual_m2[9];
+  lambda_m5[9] = lambda_m5[9] + dlambda_m4[9];
+  residual_m2[10] = a_m8[4]*active_m3[1];
+  dlambda_m4[10] = mu*residual_m2[10];
+  lambda_m5[10] = lambda_m5[10] + dlambda_m4[10];
+  residual_m2[11] = a_m8[5]*active_m3[1];
+  dlambda_m4[11] = mu*residual_m2[11];
+  lambda_m5[11] = lambda_m5[11] + dlambda_m4[11];
+  const Scalar x6 = a_m10[1] + k[4]*a_m10[3] - k_m11[0];
+  residual_m2[12] = active_m3[2]*x6;
+  dlambda_m4[12] = mu*residual_m2[12];
+  lambda_m5[12] = lambda_m5[12] + dlambda_m4[12];
+  const Scalar x7 = -a_m10[0] + k[5]*a_m10[4] - k_m11[1];
+  residual_m2[13] = active_m3[2]*x7;
+  dlambda_m4[13] = mu*residual_m2[13];
+  lambda_m5[13] = lambda_m5[13] + dlambda_m4[13];
+  const Scalar x8 = a_m10[2] - k_m11[2];
+  residual_m2[14] = active_m3[2]*x8;
+  dlambda_m4[14] = mu*residual_m2[14];
+  lambda_m5[14] = lambda_m5[14] + dlambda_m4[14];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
+// The first: reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+constexpr Scalar shared_33_k0[3] = {-0.06825, -0.06825, 0.0017863999999999998};
+PROXGEN_RT_NOINLINE void shared_33(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar cq_m5, Scalar sq_m6) noexcept {
+  const Scalar x0 = k[0]*dlambda_m0[1] - dlambda_m0[3];
+  u_m1[0] = u_m1[0] + x0;
+  const Scalar x1 = Dinv_m2*x0;
+  const Scalar x2 = dlambda_m0[1] + U_m3[0]*x1;
+  const Scalar x3 = k[1]*dlambda_m0[0] + dlambda_m0[4];
+  const Scalar x4 = dlambda_m0[5] + k[2]*Dinv_m2*x0;
+  dp_m4[0] = dlambda_m0[0];
+  dp_m4[1] = cq_m5*x2 - sq_m6*dlambda_m0[2];
+  dp_m4[2] = sq_m6*x2 + cq_m5*dlambda_m0[2];
+  dp_m4[4] = cq_m5*x3 - sq_m6*x4;
+  dp_m4[5] = sq_m6*x3 + cq_m5*x4;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
+// The first: reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+constexpr Scalar shared_34_k0[8] = {0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_34(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+  u_m0[0] = u_m0[0] - dp_m1[4];
+  const Scalar x0 = -Dinv_m2*dp_m1[4];
+  const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
+  const Scalar x2 = dp_m1[1] + IA_m3[5]*x0;
+  const Scalar x3 = dp_m1[2] + IA_m3[9]*x0;
+  const Scalar x4 = dp_m1[3] + IA_m3[12]*x0;
+  const Scalar x5 = dp_m1[5] + IA_m3[15]*x0;
+  const Scalar x6 = cq_m4*x1 + sq_m5*x3;
+  const Scalar x7 = -sq_m5*x1 + cq_m4*x3;
+  const Scalar x8 = cq_m4*x4 + sq_m5*x5;
+  const Scalar x9 = -sq_m5*x4 + cq_m4*x5;
+  dp_m6[0] = k[0]*x6 + k[1]*x7;
+  dp_m6[1] = x2;
+  dp_m6[2] = k[2]*x6 + k[3]*x7;
+  dp_m6[3] = k[4]*x8 + k[5]*x9;
+  dp_m6[5] = k[6]*x8 + k[7]*x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
+// The first: eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+constexpr Scalar shared_35_k0[39] = {-0.027912499999999996, 0.614466237626843, 0.039325839208117955, 14.34961978945479, 1.015, -0.06495999999999999, -0.06495999999999999, 0.00936987670937, 0.039325839208117955, 0.006961696668689549, 0.9183756665251066, -0.027912499999999996, -0.027912499999999996, 1.0147331188134214, -0.20026688118657843, -0.40053376237315685, 0.025634160791882035, 0.05214291960405897, -0.012817080395941018, 1.0147331188134214, 0.20026688118657843, -0.05214291960405897, -0.012817080395941018, -0.025634160791882035, 0.008237786689029773, 0.0012040900203402253, 0.0024081800406804505, 0.008237786689029773, -0.0012040900203402253, -0.06825, -0.06825, 0.020638449369710488, 0.020638449369710488, 0.06267913924033854, -0.06267913924033854, -14.34961978945479, -14.34961978945479, 0.9183756665251066, -0.9183756665251066};
+PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
+  u_m0[0] = -pA_m1[3] + tau[0];
+  const Scalar x0 = k[0]*c_m2[3] + pA_m1[0];
+  const Scalar x1 = k[1]*c_m2[0] + k[2]*c_m2[4] + pA_m1[1] + k[3]*u_m0[0];
+  const Scalar x2 = k[4]*c_m2[1] + k[5]*c_m2[3] + pA_m1[2];
+  const Scalar x3 = k[6]*c_m2[1] + k[7]*c_m2[3] + pA_m1[4];
+  const Scalar x4 = k[8]*c_m2[0] + k[9]*c_m2[4] + pA_m1[5] + k[10]*u_m0[0];
+  const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
+  IA_m5[0] = k[11]*cq_m3;
+  IA_m5[1] = k[12]*sq_m4;
+  IA_m5[2] = k[13] + k[14]*x5;
+  IA_m5[3] = k[15]*cq_m3*sq_m4;
+  IA_m5[5] = k[16]*cq_m3*sq_m4;
+  IA_m5[6] = k[17] + k[18]*x5;
+  IA_m5[7] = k[19] + k[20]*x5;
+  IA_m5[9] = k[21] + k[22]*x5;
+  IA_m5[10] = k[23]*cq_m3*sq_m4;
+  IA_m5[14] = k[24] + k[25]*x5;
+  IA_m5[15] = k[26]*cq_m3*sq_m4;
+  IA_m5[16] = k[27] + k[28]*x5;
+  pA_m6[0] = pA_m6[0] + x0;
+  pA_m6[1] = pA_m6[1] + cq_m3*x1 - sq_m4*x2;
+  pA_m6[2] = pA_m6[2] + sq_m4*x1 + cq_m3*x2;
+  pA_m6[3] = tau[0];
+  pA_m6[4] = cq_m3*x3 - sq_m4*x4;
+  pA_m6[5] = sq_m4*x3 + cq_m3*x4;
+  KA_m7[4][KA_m7_col + 0] = k[29]*cq_m3;
+  KA_m7[5][KA_m7_col + 0] = k[30]*sq_m4;
+  KA_m7[1][KA_m7_col + 1] = k[31]*cq_m3;
+  KA_m7[2][KA_m7_col + 1] = k[32]*sq_m4;
+  KA_m7[4][KA_m7_col + 1] = k[33]*sq_m4;
+  KA_m7[5][KA_m7_col + 1] = k[34]*cq_m3;
+  KA_m7[1][KA_m7_col + 2] = -sq_m4;
+  KA_m7[2][KA_m7_col + 2] = cq_m3;
+  KA_m7[1][KA_m7_col + 3] = k[35]*cq_m3;
+  KA_m7[2][KA_m7_col + 3] = k[36]*sq_m4;
+  KA_m7[4][KA_m7_col + 3] = k[37]*sq_m4;
+  KA_m7[5][KA_m7_col + 3] = k[38]*cq_m3;
+  KA_m7[4][KA_m7_col + 4] = cq_m3;
+  KA_m7[5][KA_m7_col + 4] = sq_m4;
+  KA_m7[4][KA_m7_col + 5] = -sq_m4;
+  KA_m7[5][KA_m7_col + 5] = cq_m3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
+// The first: eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+constexpr Scalar shared_36_k0[170] = {1.0, 1.2149999999999999, 7.2e-05, 0.5, 0.5, 2.0, 0.5, 0.5, -3.6e-05, 0.5, 3.6e-05, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, 0.4975020826390129, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.04991670832341408, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.04991670832341408, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, 0.4975020826390129, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 3.055, -0.5694718575000001, -0.4305, 3.055, 0.5694718575000001, -0.4305, 3.055, -0.4305, 0.15779149347477375, 0.9950041652780258, -0.09983341664682815, 0.4305, 0.4305, -0.18533025, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.15779149347477375, 0.18533025, -0.4305, 0.00381875, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 1.0, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, -0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[14];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[0]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[5]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[15]*Dinv_m0[0];
+  const Scalar x4 = k[1] - IA_m1[0]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[15]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[5]*x1;
+  const Scalar x7 = IA_m1[3] - IA_m1[9]*x1;
+  const Scalar x8 = IA_m1[6] - IA_m1[15]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[9]*x2;
+  const Scalar x10 = IA_m1[10] - IA_m1[15]*x2;
+  const Scalar x11 = IA_m1[16] - IA_m1[15]*x3;
+  const Scalar x12 = -IA_m1[9]*x0;
+  const Scalar x13 = -IA_m1[5]*x0;
+  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
+  const Scalar x17 = k[2]*c_m4[3] + pA_m3[3];
+  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[3]*(-x4 + x9);
+  const Scalar x21 = k[4]*(x4 + x9);
+  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x12*x22;
+  const Scalar x24 = x20*x22 + x12*x19;
+  const Scalar x25 = k[6]*(x10*x19 - x5*x22);
+  const Scalar x26 = k[7]*(x10*x22 + x5*x19);
+  const Scalar x27 = k[8] + k[9]*x11;
+  const Scalar x28 = k[10] + k[11]*x11;
+  const Scalar x29 = k[12]*x21 + k[13]*x23 + k[14]*x24;
+  const Scalar x30 = k[15]*cq_m5*x7 + k[16]*sq_m6*x13 + k[17]*sq_m6*x7 + k[18]*cq_m5*x13;
+  const Scalar x31 = k[19]*x21 + k[20]*x23 + k[21]*x24;
+  const Scalar x32 = sq_m6*x7 + cq_m5*x13;
+  const Scalar x33 = cq_m5*x7 - sq_m6*x13;
+  const Scalar x34 = k[22]*x21 + k[23]*x23 + k[24]*x24;
+  const Scalar x35 = k[25]*x21 + k[26]*x23 + k[27]*x24;
+  const Scalar x36 = k[28]*x5 + k[29]*x10 + k[30]*x25 + k[31]*x26;
+  const Scalar x37 = k[32]*x5 + k[33]*x10 + k[34]*x25 + k[35]*x26;
+  const Scalar x38 = k[36]*x5 + k[37]*x10 + k[38]*x25 + k[39]*x26;
+  const Scalar x39 = k[40]*x5 + k[41]*x10 + k[42]*x25 + k[43]*x26;
+  const Scalar x40 = k[44]*x28 + k[45]*x19*x27 + k[46]*x22*x27;
+  const Scalar x41 = k[47]*x28 + k[48]*x19*x27 + k[49]*x22*x27;
+  const Scalar x42 = k[50]*x28 + k[51]*x19*x27 + k[52]*x22*x27;
+  const Scalar x43 = k[53]*x28 + k[54]*x19*x27 + k[55]*x22*x27;
+  const Scalar x44 = k[56]*x29 + k[57]*x31;
+  const Scalar x45 = k[58]*x29 + k[59]*x31;
+  const Scalar x46 = k[60]*x32 + k[61]*x33;
+  const Scalar x47 = k[62]*x34 + k[63]*x35;
+  const Scalar x48 = k[64]*x36 + k[65]*x37;
+  const Scalar x49 = k[66]*x36 + k[67]*x37;
+  const Scalar x50 = k[68]*cq_m5*x8 + k[69]*sq_m6*x8;
+  const Scalar x51 = k[70]*cq_m5*x8 + k[71]*sq_m6*x8;
+  const Scalar x52 = k[72]*x38 + k[73]*x39;
+  const Scalar x53 = k[74]*x38 + k[75]*x39;
+  const Scalar x54 = k[76]*x30 + x48;
+  const Scalar x55 = k[77]*x6 + x50;
+  const Scalar x56 = k[78]*x46 + x52;
+  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
+  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
+  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
+  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x61 = k[79]*x57 + k[80]*x58;
+  const Scalar x62 = k[81]*x57 + k[82]*x58;
+  IA_m7[0] = k[83] + x44;
+  IA_m7[1] = x30;
+  IA_m7[2] = x45;
+  IA_m7[3] = x54;
+  IA_m7[4] = k[84] + k[85]*x44;
+  IA_m7[5] = x49;
+  IA_m7[6] = k[86] + x6;
+  IA_m7[7] = x46;
+  IA_m7[8] = k[87] + x55;
+  IA_m7[9] = k[88]*x30;
+  IA_m7[10] = x51;
+  IA_m7[11] = k[89] + x47;
+  IA_m7[12] = x56;
+  IA_m7[13] = k[90]*x45;
+  IA_m7[14] = x53;
+  IA_m7[15] = k[91] + k[92]*x40 + k[93]*x41 + k[94]*x50 + k[95]*x55;
+  IA_m7[16] = k[96]*x30 + k[97]*x48;
+  IA_m7[17] = k[98]*x40 + k[99]*x41 + k[100]*x51;
+  IA_m7[18] = k[101] + k[102]*x44;
+  IA_m7[19] = k[103]*x49;
+  IA_m7[20] = k[104] + k[105]*x42 + k[106]*x43;
+  pA_m8[0] = pA_m8[0] + x61;
+  pA_m8[1] = pA_m8[1] + x15;
+  pA_m8[2] = pA_m8[2] + x62;
+  pA_m8[3] = pA_m8[3] + k[107]*x15 + k[108]*x59 + k[109]*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] + k[110]*x61;
+  pA_m8[5] = pA_m8[5] + k[111]*x59 + k[112]*x60;
+  KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
+  const Scalar x63 = k[113] - IA_m1[0]*KSD_m9[0];
+  const Scalar x64 = -IA_m1[9]*KSD_m9[0];
+  const Scalar x65 = KA_m10[5][KA_m10_col + 0] - IA_m1[15]*KSD_m9[0];
+  const Scalar x66 = cq_m5*x63 + sq_m6*x64;
+  const Scalar x67 = -sq_m6*x63 + cq_m5*x64;
+  const Scalar x68 = k[114]*x66 + k[115]*x67;
+  const Scalar x69 = k[116]*x66 + k[117]*x67;
+  KA_m11[0][KA_m11_col + 0] = x68;
+  KA_m11[1][KA_m11_col + 0] = -IA_m1[5]*KSD_m9[0];
+  KA_m11[2][KA_m11_col + 0] = x69;
+  KA_m11[3][KA_m11_col + 0] = k[118]*IA_m1[5]*KSD_m9[0] + k[119]*sq_m6*x65 + k[120]*cq_m5*x65;
+  KA_m11[4][KA_m11_col + 0] = k[121]*x68;
+  KA_m11[5][KA_m11_col + 0] = k[122]*sq_m6*x65 + k[123]*cq_m5*x65;
+  KSD_m9[1] = KA_m10[4][KA_m10_col + 1]*Dinv_m0[0];
+  const Scalar x70 = KA_m10[1][KA_m10_col + 1] - IA_m1[5]*KSD_m9[1];
+  const Scalar x71 = KA_m10[2][KA_m10_col + 1] - IA_m1[9]*KSD_m9[1];
+  const Scalar x72 = -IA_m1[0]*KSD_m9[1];
+  const Scalar x73 = KA_m10[5][KA_m10_col + 1] - IA_m1[15]*KSD_m9[1];
+  const Scalar x74 = cq_m5*x72 + sq_m6*x71;
+  const Scalar x75 = -sq_m6*x72 + cq_m5*x71;
+  const Scalar x76 = k[124]*x74 + k[125]*x75;
+  const Scalar x77 = k[126]*x74 + k[127]*x75;
+  KA_m11[0][KA_m11_col + 1] = x76;
+  KA_m11[1][KA_m11_col + 1] = x70;
+  KA_m11[2][KA_m11_col + 1] = x77;
+  KA_m11[3][KA_m11_col + 1] = k[128]*x70 + k[129]*sq_m6*x73 + k[130]*cq_m5*x73;
+  KA_m11[4][KA_m11_col + 1] = k[131]*x76;
+  KA_m11[5][KA_m11_col + 1] = k[132]*sq_m6*x73 + k[133]*cq_m5*x73;
+  const Scalar x78 = k[134]*sq_m6*KA_m10[2][KA_m10_col + 2] + k[135]*cq_m5*KA_m10[2][KA_m10_col + 2];
+  const Scalar x79 = k[136]*sq_m6*KA_m10[2][KA_m10_col + 2] + k[137]*cq_m5*KA_m10[2][KA_m10_col + 2];
+  KA_m11[0][KA_m11_col + 2] = x78;
+  KA_m11[1][KA_m11_col + 2] = KA_m10[1][KA_m10_col + 2];
+  KA_m11[2][KA_m11_col + 2] = x79;
+  KA_m11[3][KA_m11_col + 2] = k[138]*KA_m10[1][KA_m10_col + 2];
+  KA_m11[4][KA_m11_col + 2] = k[139]*x78;
+  KSD_m9[3] = KA_m10[4][KA_m10_col + 3]*Dinv_m0[0];
+  const Scalar x80 = KA_m10[1][KA_m10_col + 3] - IA_m1[5]*KSD_m9[3];
+  const Scalar x81 = KA_m10[2][KA_m10_col + 3] - IA_m1[9]*KSD_m9[3];
+  const Scalar x82 = -IA_m1[0]*KSD_m9[3];
+  const Scalar x83 = KA_m10[5][KA_m10_col + 3] - IA_m1[15]*KSD_m9[3];
+  const Scalar x84 = cq_m5*x82 + sq_m6*x81;
+  const Scalar x85 = -sq_m6*x82 + cq_m5*x81;
+  const Scalar x86 = k[140]*x84 + k[141]*x85;
+  const Scalar x87 = k[142]*x84 + k[143]*x85;
+  KA_m11[0][KA_m11_col + 3] = x86;
+  KA_m11[1][KA_m11_col + 3] = x80;
+  KA_m11[2][KA_m11_col + 3] = x87;
+  KA_m11[3][KA_m11_col + 3] = k[144]*x80 + k[145]*sq_m6*x83 + k[146]*cq_m5*x83;
+  KA_m11[4][KA_m11_col + 3] = k[147]*x86;
+  KA_m11[5][KA_m11_col + 3] = k[148]*sq_m6*x83 + k[149]*cq_m5*x83;
+  KSD_m9[4] = KA_m10[4][KA_m10_col + 4]*Dinv_m0[0];
+  const Scalar x88 = -IA_m1[0]*KSD_m9[4];
+  const Scalar x89 = -IA_m1[9]*KSD_m9[4];
+  const Scalar x90 = KA_m10[5][KA_m10_col + 4] - IA_m1[15]*KSD_m9[4];
+  const Scalar x91 = cq_m5*x88 + sq_m6*x89;
+  const Scalar x92 = -sq_m6*x88 + cq_m5*x89;
+  const Scalar x93 = k[150]*x91 + k[151]*x92;
+  const Scalar x94 = k[152]*x91 + k[153]*x92;
+  KA_m11[0][KA_m11_col + 4] = x93;
+  KA_m11[1][KA_m11_col + 4] = -IA_m1[5]*KSD_m9[4];
+  KA_m11[2][KA_m11_col + 4] = x94;
+  KA_m11[3][KA_m11_col + 4] = k[154]*IA_m1[5]*KSD_m9[4] + k[155]*sq_m6*x90 + k[156]*cq_m5*x90;
+  KA_m11[4][KA_m11_col + 4] = k[157]*x93;
+  KA_m11[5][KA_m11_col + 4] = k[158]*sq_m6*x90 + k[159]*cq_m5*x90;
+  KSD_m9[5] = KA_m10[4][KA_m10_col + 5]*Dinv_m0[0];
+  const Scalar x95 = -IA_m1[0]*KSD_m9[5];
+  const Scalar x96 = -IA_m1[9]*KSD_m9[5];
+  const Scalar x97 = KA_m10[5][KA_m10_col + 5] - IA_m1[15]*KSD_m9[5];
+  const Scalar x98 = cq_m5*x95 + sq_m6*x96;
+  const Scalar x99 = -sq_m6*x95 + cq_m5*x96;
+  const Scalar x100 = k[160]*x98 + k[161]*x99;
+  const Scalar x101 = k[162]*x98 + k[163]*x99;
+  KA_m11[0][KA_m11_col + 5] = x100;
+  KA_m11[1][KA_m11_col + 5] = -IA_m1[5]*KSD_m9[5];
+  KA_m11[2][KA_m11_col + 5] = x101;
+  KA_m11[3][KA_m11_col + 5] = k[164]*IA_m1[5]*KSD_m9[5] + k[165]*sq_m6*x97 + k[166]*cq_m5*x97;
+  KA_m11[4][KA_m11_col + 5] = k[167]*x100;
+  KA_m11[5][KA_m11_col + 5] = k[168]*sq_m6*x97 + k[169]*cq_m5*x97;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
+// The first: eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+constexpr Scalar shared_37_k0[144] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.4900332889206208, 0.4900332889206208, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 7.0, -1.29954125, -0.42875, 7.0, 1.29954125, -0.42875, 7.0, -0.42875, 0.3755072987089375, 0.9800665778412416, 0.19866933079506124, 0.42875, 0.42875, -0.1838265625, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.3755072987089375, 0.1838265625, -0.42875, 0.0196875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
+  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
+  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
+  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
+  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
+  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
+  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
+  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
+  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
+  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
+  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
+  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
+  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
+  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x26 = k[1]*(-x5 + x14);
+  const Scalar x27 = k[2]*(x5 + x14);
+  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x29 = x25*x26 - x7*x28;
+  const Scalar x30 = x26*x28 + x7*x25;
+  const Scalar x31 = k[4]*(-x8 + x16);
+  const Scalar x32 = k[5]*(x8 + x16);
+  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x34 = x25*x31 - x28*x33;
+  const Scalar x35 = x28*x31 + x25*x33;
+  const Scalar x36 = k[7]*(-x17 + x19);
+  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x38 = x25*x36 - x18*x28;
+  const Scalar x39 = x28*x36 + x18*x25;
+  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
+  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
+  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
+  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
+  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
+  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
+  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
+  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
+  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
+  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
+  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
+  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
+  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x57 = k[57]*x40 + k[58]*x42;
+  const Scalar x58 = k[59]*x40 + k[60]*x42;
+  const Scalar x59 = k[61]*x43 + k[62]*x44;
+  const Scalar x60 = k[63]*x45 + k[64]*x46;
+  const Scalar x61 = k[65]*x47 + k[66]*x48;
+  const Scalar x62 = k[67]*x47 + k[68]*x48;
+  const Scalar x63 = k[69]*x49 + k[70]*x50;
+  const Scalar x64 = k[71]*x49 + k[72]*x50;
+  const Scalar x65 = k[73]*x51 + k[74]*x52;
+  const Scalar x66 = k[75]*x51 + k[76]*x52;
+  const Scalar x67 = k[77]*x41 + x61;
+  const Scalar x68 = k[78]*x10 + x63;
+  const Scalar x69 = k[79]*x59 + x65;
+  const Scalar x70 = cq_m5*x20 + sq_m6*x22;
+  const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
+  const Scalar x72 = cq_m5*x23 + sq_m6*x24;
+  const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x74 = k[80]*x70 + k[81]*x71;
+  const Scalar x75 = k[82]*x70 + k[83]*x71;
+  IA_m7[0] = k[84] + x57;
+  IA_m7[1] = x41;
+  IA_m7[2] = x58;
+  IA_m7[3] = x67;
+  IA_m7[4] = k[85] + k[86]*x57;
+  IA_m7[5] = x62;
+  IA_m7[6] = k[87] + x10;
+  IA_m7[7] = x59;
+  IA_m7[8] = k[88] + x68;
+  IA_m7[9] = k[89]*x41;
+  IA_m7[10] = x64;
+  IA_m7[11] = k[90] + x60;
+  IA_m7[12] = x69;
+  IA_m7[13] = k[91]*x58;
+  IA_m7[14] = x66;
+  IA_m7[15] = k[92] + k[93]*x53 + k[94]*x54 + k[95]*x63 + k[96]*x68;
+  IA_m7[16] = k[97]*x41 + k[98]*x61;
+  IA_m7[17] = k[99]*x53 + k[100]*x54 + k[101]*x64;
+  IA_m7[18] = k[102] + k[103]*x57;
+  IA_m7[19] = k[104]*x62;
+  IA_m7[20] = k[105] + k[106]*x55 + k[107]*x56;
+  pA_m8[0] = pA_m8[0] + x74;
+  pA_m8[1] = pA_m8[1] + x21;
+  pA_m8[2] = pA_m8[2] + x75;
+  pA_m8[3] = pA_m8[3] + k[108]*x21 + k[109]*x72 + k[110]*x73;
+  pA_m8[4] = pA_m8[4] + tau[0] + k[111]*x74;
+  pA_m8[5] = pA_m8[5] + k[112]*x72 + k[113]*x73;
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
+    KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
+    const Scalar x76 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
+    const Scalar x77 = KA_m10[1][j] - IA_m1[9]*KSD_m9[j];
+    const Scalar x78 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
+    const Scalar x79 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
+    const Scalar x80 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
+    const Scalar x81 = cq_m5*x76 + sq_m6*x78;
+    const Scalar x82 = -sq_m6*x76 + cq_m5*x78;
+    const Scalar x83 = cq_m5*x79 + sq_m6*x80;
+    const Scalar x84 = -sq_m6*x79 + cq_m5*x80;
+    const Scalar x85 = k[114]*x81 + k[115]*x82;
+    const Scalar x86 = k[116]*x81 + k[117]*x82;
+    KA_m11[0][j] = x85;
+    KA_m11[1][j] = x77;
+    KA_m11[2][j] = x86;
+    KA_m11[3][j] = k[118]*x77 + k[119]*x83 + k[120]*x84;
+    KA_m11[4][j] = k[121]*x85;
+    KA_m11[5][j] = k[122]*x83 + k[123]*x84;
+  }
+  KSD_m9[2] = KA_m10[4][2]*Dinv_m0[0];
+  const Scalar x87 = KA_m10[0][2] - IA_m1[4]*KSD_m9[2];
+  const Scalar x88 = KA_m10[1][2] - IA_m1[9]*KSD_m9[2];
+  const Scalar x89 = KA_m10[2][2] - IA_m1[13]*KSD_m9[2];
+  const Scalar x90 = KA_m10[3][2] - IA_m1[16]*KSD_m9[2];
+  const Scalar x91 = -IA_m1[19]*KSD_m9[2];
+  const Scalar x92 = cq_m5*x87 + sq_m6*x89;
+  const Scalar x93 = -sq_m6*x87 + cq_m5*x89;
+  const Scalar x94 = cq_m5*x90 + sq_m6*x91;
+  const Scalar x95 = -sq_m6*x90 + cq_m5*x91;
+  const Scalar x96 = k[124]*x92 + k[125]*x93;
+  const Scalar x97 = k[126]*x92 + k[127]*x93;
+  KA_m11[0][2] = x96;
+  KA_m11[1][2] = x88;
+  KA_m11[2][2] = x97;
+  KA_m11[3][2] = k[128]*x88 + k[129]*x94 + k[130]*x95;
+  KA_m11[4][2] = k[131]*x96;
+  KA_m11[5][2] = k[132]*x94 + k[133]*x95;
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
+    KSD_m9[3 + j] = Dinv_m0[0]*KA_m10[4][3 + j];
+    const Scalar x98 = KA_m10[0][3 + j] - IA_m1[4]*KSD_m9[3 + j];
+    const Scalar x99 = KA_m10[1][3 + j] - IA_m1[9]*KSD_m9[3 + j];
+    const Scalar x100 = KA_m10[2][3 + j] - IA_m1[13]*KSD_m9[3 + j];
+    const Scalar x101 = KA_m10[3][3 + j] - IA_m1[16]*KSD_m9[3 + j];
+    const Scalar x102 = KA_m10[5][3 + j] - IA_m1[19]*KSD_m9[3 + j];
+    const Scalar x103 = cq_m5*x98 + sq_m6*x100;
+    const Scalar x104 = -sq_m6*x98 + cq_m5*x100;
+    const Scalar x105 = cq_m5*x101 + sq_m6*x102;
+    const Scalar x106 = -sq_m6*x101 + cq_m5*x102;
+    const Scalar x107 = k[134]*x103 + k[135]*x104;
+    const Scalar x108 = k[136]*x103 + k[137]*x104;
+    KA_m11[0][3 + j] = x107;
+    KA_m11[1][3 + j] = x99;
+    KA_m11[2][3 + j] = x108;
+    KA_m11[3][3 + j] = k[138]*x99 + k[139]*x105 + k[140]*x106;
+    KA_m11[4][3 + j] = k[141]*x107;
+    KA_m11[5][3 + j] = k[142]*x105 + k[143]*x106;
+  }
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
+// The first: eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+constexpr Scalar shared_38_k0[106] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.4975020826390129, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.5, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.015, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.00095, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.0005, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.0, 0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
+  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
+  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
+  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
+  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
+  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
+  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
+  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
+  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
+  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
+  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
+  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
+  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
+  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
+  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
+  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
+  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x26 = k[1]*(-x5 + x14);
+  const Scalar x27 = k[2]*(x5 + x14);
+  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x29 = x25*x26 - x7*x28;
+  const Scalar x30 = x26*x28 + x7*x25;
+  const Scalar x31 = k[4]*(-x8 + x16);
+  const Scalar x32 = k[5]*(x8 + x16);
+  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x34 = x25*x31 - x28*x33;
+  const Scalar x35 = x28*x31 + x25*x33;
+  const Scalar x36 = k[7]*(-x17 + x19);
+  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x38 = x25*x36 - x18*x28;
+  const Scalar x39 = x28*x36 + x18*x25;
+  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
+  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
+  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
+  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
+  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
+  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
+  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
+  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
+  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
+  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
+  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
+  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
+  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x57 = cq_m5*x20 + sq_m6*x22;
+  const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
+  const Scalar x59 = cq_m5*x23 + sq_m6*x24;
+  const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
+  IA_m7[0] = k[57] + k[58]*x40 + k[59]*x42;
+  IA_m7[1] = x41;
+  IA_m7[2] = k[60]*x40 + k[61]*x42;
+  IA_m7[3] = k[62]*x47 + k[63]*x48;
+  IA_m7[5] = k[64]*x47 + k[65]*x48;
+  IA_m7[6] = k[66] + x10;
+  IA_m7[7] = k[67]*x43 + k[68]*x44;
+  IA_m7[8] = k[69] + k[70]*x49 + k[71]*x50;
+  IA_m7[10] = k[72]*x49 + k[73]*x50;
+  IA_m7[11] = k[74] + k[75]*x45 + k[76]*x46;
+  IA_m7[12] = k[77]*x51 + k[78]*x52;
+  IA_m7[14] = k[79]*x51 + k[80]*x52;
+  IA_m7[15] = k[81] + k[82]*x53 + k[83]*x54;
+  IA_m7[17] = k[84]*x53 + k[85]*x54;
+  IA_m7[20] = k[86] + k[87]*x55 + k[88]*x56;
+  pA_m8[0] = pA_m8[0] + k[89]*x57 + k[90]*x58;
+  pA_m8[1] = pA_m8[1] + x21;
+  pA_m8[2] = pA_m8[2] + k[91]*x57 + k[92]*x58;
+  pA_m8[3] = pA_m8[3] + k[93]*x59 + k[94]*x60;
+  pA_m8[4] = pA_m8[4] + tau[0];
+  pA_m8[5] = pA_m8[5] + k[95]*x59 + k[96]*x60;
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
+    const Scalar x61 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
+    const Scalar x62 = KA_m10[1][j] - IA_m1[9]*KSD_m9[j];
+    const Scalar x63 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
+    const Scalar x64 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
+    const Scalar x65 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
+    const Scalar x66 = cq_m5*x61 + sq_m6*x63;
+    const Scalar x67 = -sq_m6*x61 + cq_m5*x63;
+    const Scalar x68 = cq_m5*x64 + sq_m6*x65;
+    const Scalar x69 = -sq_m6*x64 + cq_m5*x65;
+    KA_m11[0][j] = k[97]*x66 + k[98]*x67;
+    KA_m11[1][j] = x62;
+    KA_m11[2][j] = k[99]*x66 + k[100]*x67;
+    KA_m11[3][j] = k[101]*x68 + k[102]*x69;
+    KA_m11[4][j] = k[103];
+    KA_m11[5][j] = k[104]*x68 + k[105]*x69;
+  }
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
+// The first: eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+constexpr Scalar shared_39_k0[25] = {1.0, -0.015, 0.00095, 0.5, 0.5, 2.0, 0.5, 0.5, 0.000475, -0.5, 0.000475, 0.5, 0.5, 0.02, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, -0.5, 0.5, 0.0013, 0.0005, 0.0};
+PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[15];
+  u_m2[0] = -pA_m3[3] + tau[0];
+  const Scalar x0 = IA_m1[3]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[8]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[12]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[3]*x0;
+  const Scalar x5 = IA_m1[1] - IA_m1[8]*x0;
+  const Scalar x6 = IA_m1[2] - IA_m1[12]*x0;
+  const Scalar x7 = IA_m1[5] - IA_m1[17]*x0;
+  const Scalar x8 = IA_m1[6] - IA_m1[8]*x1;
+  const Scalar x9 = IA_m1[7] - IA_m1[12]*x1;
+  const Scalar x10 = IA_m1[10] - IA_m1[17]*x1;
+  const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
+  const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
+  const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
+  const Scalar x14 = k[1]*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
+  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
+  const Scalar x17 = k[2]*c_m4[3] + pA_m3[4];
+  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[3]*(x8 - x11);
+  const Scalar x21 = k[4]*(x8 + x11);
+  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x9*x22;
+  const Scalar x24 = x20*x22 + x9*x19;
+  const Scalar x25 = k[6]*(-x12*x19 - x10*x22);
+  const Scalar x26 = k[7]*(-x12*x22 + x10*x19);
+  const Scalar x27 = k[8] + k[9]*x13;
+  const Scalar x28 = k[10] + k[11]*x13;
+  IA_m7[0] = k[12] + x4;
+  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
+  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
+  IA_m7[4] = k[13] + k[14]*cq_m5 - sq_m6*x7;
+  IA_m7[5] = k[15]*sq_m6 + cq_m5*x7;
+  IA_m7[6] = k[16] + x21 + x23;
+  IA_m7[7] = x24;
+  IA_m7[9] = k[17]*x12 + x25;
+  IA_m7[10] = k[18]*x10 + x26;
+  IA_m7[11] = k[19] + x21 - x23;
+  IA_m7[13] = k[20]*x10 + x26;
+  IA_m7[14] = k[21]*x12 - x25;
+  IA_m7[18] = k[22] + x28 + x19*x27;
+  IA_m7[19] = x22*x27;
+  IA_m7[20] = k[23] + x28 - x19*x27;
+  pA_m8[0] = pA_m8[0] + x14;
+  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[3] = pA_m8[3] + tau[0];
+  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    KSD_m9[j] = Dinv_m0[0]*KA_m10[3][j];
+    const Scalar x29 = KA_m10[0][j] - IA_m1[3]*KSD_m9[j];
+    const Scalar x30 = KA_m10[1][j] - IA_m1[8]*KSD_m9[j];
+    const Scalar x31 = KA_m10[2][j] - IA_m1[12]*KSD_m9[j];
+    const Scalar x32 = KA_m10[5][j] - IA_m1[17]*KSD_m9[j];
+    KA_m11[0][j] = x29;
+    KA_m11[1][j] = cq_m5*x30 - sq_m6*x31;
+    KA_m11[2][j] = sq_m6*x30 + cq_m5*x31;
+    KA_m11[3][j] = k[24];
+    KA_m11[4][j] = cq_m5*KA_m10[4][j] - sq_m6*x32;
+    KA_m11[5][j] = sq_m6*KA_m10[4][j] + cq_m5*x32;
+  }
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
+// The first: free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+  const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
+  a_m6[0] = a_m1[0];
+  a_m6[1] = x0;
+  a_m6[2] = x1;
+  a_m6[3] = a_m1[3] + Dinv_m7*x4;
+  a_m6[4] = x2;
+  a_m6[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
+// The first: free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+constexpr Scalar shared_41_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_41(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
+  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
+  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
+  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
+  a_m6[0] = x4;
+  a_m6[1] = a_m0[1];
+  a_m6[2] = x5;
+  a_m6[3] = x6;
+  a_m6[4] = a_m0[4] + Dinv_m7*x8;
+  a_m6[5] = x7;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+constexpr Scalar shared_42_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_42(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
+  a_m6[0] = x6;
+  a_m6[1] = x1;
+  a_m6[2] = x7;
+  a_m6[3] = x8;
+  a_m6[4] = a_m0[4] + Dinv_m7*x10;
+  a_m6[5] = x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+constexpr Scalar shared_43_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_43(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
+  a_m6[0] = x6;
+  a_m6[1] = x1;
+  a_m6[2] = x7;
+  a_m6[3] = x8;
+  a_m6[4] = a_m0[4] + Dinv_m7*x10;
+  a_m6[5] = x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+constexpr Scalar shared_44_k0[4] = {-0.00194517348958, -0.027912499999999996, -0.0017863999999999998, 514.0929615568219};
+PROXGEN_RT_NOINLINE void shared_44(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+  const Scalar x4 = u_m4[0] + k[0]*a_m2[3] + k[1]*x0 + k[2]*x3;
+  a_m5[0] = a_m2[0];
+  a_m5[1] = x0;
+  a_m5[2] = x1;
+  a_m5[3] = a_m2[3] + k[3]*x4;
+  a_m5[4] = x2;
+  a_m5[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
+// The first: accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+  const Scalar x4 = u_m4[0] - KA_m5[3][KA_m5_col + 0]*lambda_m6[0] - KA_m5[3][KA_m5_col + 1]*lambda_m6[1] - KA_m5[3][KA_m5_col + 2]*lambda_m6[2] - KA_m5[3][KA_m5_col + 3]*lambda_m6[3] - KA_m5[3][KA_m5_col + 4]*lambda_m6[4] - KA_m5[3][KA_m5_col + 5]*lambda_m6[5] - a_m1[0]*IA_m7[0] - IA_m7[5]*x0 - IA_m7[9]*x1 - a_m1[3]*IA_m7[12] - IA_m7[14]*x3;
+  qdd_m8[0] = Dinv_m9*x4;
+  a_m10[0] = a_m1[0];
+  a_m10[1] = x0;
+  a_m10[2] = x1;
+  a_m10[3] = a_m1[3] + qdd_m8[0];
+  a_m10[4] = x2;
+  a_m10[5] = x3;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
+// The first: accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+constexpr Scalar shared_46_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_46(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
+  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
+  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
+  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x4 - IA_m7[5]*a_m0[1] - IA_m7[9]*x5 - IA_m7[12]*x6 - IA_m7[14]*a_m0[4] - IA_m7[15]*x7;
+  qdd_m8[0] = Dinv_m9*x8;
+  a_m10[0] = x4;
+  a_m10[1] = a_m0[1];
+  a_m10[2] = x5;
+  a_m10[3] = x6;
+  a_m10[4] = a_m0[4] + qdd_m8[0];
+  a_m10[5] = x7;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+constexpr Scalar shared_47_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_47(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - IA_m7[12]*x8 - IA_m7[14]*a_m0[4] - IA_m7[15]*x9;
+  qdd_m8[0] = Dinv_m9*x10;
+  a_m10[0] = x6;
+  a_m10[1] = x1;
+  a_m10[2] = x7;
+  a_m10[3] = x8;
+  a_m10[4] = a_m0[4] + qdd_m8[0];
+  a_m10[5] = x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+constexpr Scalar shared_48_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_48(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
+  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
+  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
+  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
+  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
+  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - a_m0[4]*IA_m7[14] - IA_m7[15]*x9;
+  qdd_m8[0] = Dinv_m9*x10;
+  a_m10[0] = x6;
+  a_m10[1] = x1;
+  a_m10[2] = x7;
+  a_m10[3] = x8;
+  a_m10[4] = a_m0[4] + qdd_m8[0];
+  a_m10[5] = x9;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+constexpr Scalar shared_49_k0[5] = {-0.06825, -0.00194517348958, -0.027912499999999996, -0.0017863999999999998, 514.0929615568219};
+PROXGEN_RT_NOINLINE void shared_49(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+  const Scalar x4 = u_m4[0] + k[0]*lambda_m5[0] - lambda_m5[2] + k[1]*a_m2[3] + k[2]*x0 + k[3]*x3;
+  qdd_m6[0] = k[4]*x4;
+  a_m7[0] = a_m2[0];
+  a_m7[1] = x0;
+  a_m7[2] = x1;
+  a_m7[3] = a_m2[3] + qdd_m6[0];
+  a_m7[4] = x2;
+  a_m7[5] = x3;
+}
+
 PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
@@ -104,156 +2300,21 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
 
 PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    proxgen_rt::sincos_noinline(q[8], w.sq_l_hip_roll_link, w.cq_l_hip_roll_link);
-    w.v_l_hip_roll_link[1] = w.v_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
-    w.v_l_hip_roll_link[2] = -w.v_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.v_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
-    w.v_l_hip_roll_link[3] = w.v_l_hip_yaw_link[3] + v[7];
-    w.v_l_hip_roll_link[4] = w.v_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.v_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
-    w.v_l_hip_roll_link[5] = -w.v_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.v_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    w.c_l_hip_roll_link[1] = v[7]*w.v_l_hip_roll_link[2];
-    w.c_l_hip_roll_link[2] = -v[7]*w.v_l_hip_roll_link[1];
-    w.c_l_hip_roll_link[4] = v[7]*w.v_l_hip_roll_link[5];
-    w.c_l_hip_roll_link[5] = -v[7]*w.v_l_hip_roll_link[4];
-    const Scalar h0 = 0.5*w.v_l_hip_yaw_link[0] - 0.015*w.v_l_hip_roll_link[4];
-    const Scalar h1 = 0.5*w.v_l_hip_roll_link[1] + 0.015*w.v_l_hip_roll_link[3];
-    const Scalar h2 = 0.015*w.v_l_hip_roll_link[1] + 0.00095*w.v_l_hip_roll_link[3];
-    const Scalar h3 = -0.015*w.v_l_hip_yaw_link[0] + 0.00095*w.v_l_hip_roll_link[4];
-    w.pA_l_hip_roll_link[0] = 0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[4] - w.v_l_hip_roll_link[5]*h1;
-    w.pA_l_hip_roll_link[1] = w.v_l_hip_roll_link[5]*h0 - 0.5*w.v_l_hip_roll_link[2]*w.v_l_hip_roll_link[3];
-    w.pA_l_hip_roll_link[2] = w.v_l_hip_roll_link[3]*h1 - w.v_l_hip_roll_link[4]*h0;
-    w.pA_l_hip_roll_link[3] = 0.0005*w.v_l_hip_roll_link[4]*w.v_l_hip_roll_link[5] - w.v_l_hip_roll_link[5]*h3 + 0.5*w.v_l_hip_roll_link[1]*w.v_l_hip_roll_link[2] - w.v_l_hip_roll_link[2]*h1;
-    w.pA_l_hip_roll_link[4] = w.v_l_hip_roll_link[5]*h2 - 0.0005*w.v_l_hip_roll_link[3]*w.v_l_hip_roll_link[5] + w.v_l_hip_roll_link[2]*h0 - 0.5*w.v_l_hip_yaw_link[0]*w.v_l_hip_roll_link[2];
-    w.pA_l_hip_roll_link[5] = w.v_l_hip_roll_link[3]*h3 - w.v_l_hip_roll_link[4]*h2 + w.v_l_hip_yaw_link[0]*h1 - w.v_l_hip_roll_link[1]*h0;
-    w.g_l_hip_roll_link[1] = w.g_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.g_pelvis[2]*w.sq_l_hip_roll_link;
-    w.g_l_hip_roll_link[2] = -w.g_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.g_pelvis[2]*w.cq_l_hip_roll_link;
-  }
+  shared_0(shared_0_k0, &q[8], &v[7], &w.sq_l_hip_roll_link, &w.cq_l_hip_roll_link, &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    proxgen_rt::sincos_noinline(q[9], w.sq_l_thigh, w.cq_l_thigh);
-    const Scalar t0 = 0.9950041652780258*w.v_l_hip_yaw_link[0] + 0.09983341664682815*w.v_l_hip_roll_link[2];
-    const Scalar t1 = -0.09983341664682815*w.v_l_hip_yaw_link[0] + 0.9950041652780258*w.v_l_hip_roll_link[2];
-    const Scalar t2 = 0.9950041652780258*w.v_l_hip_roll_link[3] + 0.09983341664682815*w.v_l_hip_roll_link[5];
-    const Scalar t3 = -0.09983341664682815*w.v_l_hip_roll_link[3] + 0.9950041652780258*w.v_l_hip_roll_link[5];
-    w.v_l_thigh[0] = w.cq_l_thigh*t0 - w.sq_l_thigh*t1;
-    w.v_l_thigh[2] = w.sq_l_thigh*t0 + w.cq_l_thigh*t1;
-    w.v_l_thigh[3] = w.cq_l_thigh*t2 - w.sq_l_thigh*t3;
-    w.v_l_thigh[4] = w.v_l_hip_roll_link[4] + v[8];
-    w.v_l_thigh[5] = w.sq_l_thigh*t2 + w.cq_l_thigh*t3;
-    w.c_l_thigh[0] = -v[8]*w.v_l_thigh[2];
-    w.c_l_thigh[2] = v[8]*w.v_l_thigh[0];
-    w.c_l_thigh[3] = -v[8]*w.v_l_thigh[5];
-    w.c_l_thigh[5] = v[8]*w.v_l_thigh[3];
-    const Scalar h4 = 7.0*w.v_l_thigh[0] - 1.29954125*w.v_l_thigh[4];
-    const Scalar h5 = 7.0*w.v_l_hip_roll_link[1] + 1.29954125*w.v_l_thigh[3];
-    const Scalar h6 = 1.29954125*w.v_l_hip_roll_link[1] + 0.3755072987089375*w.v_l_thigh[3];
-    const Scalar h7 = -1.29954125*w.v_l_thigh[0] + 0.3755072987089375*w.v_l_thigh[4];
-    w.pA_l_thigh[0] = 7.0*w.v_l_thigh[2]*w.v_l_thigh[4] - w.v_l_thigh[5]*h5;
-    w.pA_l_thigh[1] = w.v_l_thigh[5]*h4 - 7.0*w.v_l_thigh[2]*w.v_l_thigh[3];
-    w.pA_l_thigh[2] = w.v_l_thigh[3]*h5 - w.v_l_thigh[4]*h4;
-    w.pA_l_thigh[3] = 0.0196875*w.v_l_thigh[4]*w.v_l_thigh[5] - w.v_l_thigh[5]*h7 + 7.0*w.v_l_hip_roll_link[1]*w.v_l_thigh[2] - w.v_l_thigh[2]*h5;
-    w.pA_l_thigh[4] = w.v_l_thigh[5]*h6 - 0.0196875*w.v_l_thigh[3]*w.v_l_thigh[5] + w.v_l_thigh[2]*h4 - 7.0*w.v_l_thigh[0]*w.v_l_thigh[2];
-    w.pA_l_thigh[5] = w.v_l_thigh[3]*h7 - w.v_l_thigh[4]*h6 + w.v_l_thigh[0]*h5 - w.v_l_hip_roll_link[1]*h4;
-    const Scalar t4 = 0.9950041652780258*w.g_l_hip_yaw_link[0] + 0.09983341664682815*w.g_l_hip_roll_link[2];
-    const Scalar t5 = -0.09983341664682815*w.g_l_hip_yaw_link[0] + 0.9950041652780258*w.g_l_hip_roll_link[2];
-    w.g_l_thigh[0] = w.cq_l_thigh*t4 - w.sq_l_thigh*t5;
-    w.g_l_thigh[2] = w.sq_l_thigh*t4 + w.cq_l_thigh*t5;
-  }
+  shared_1(shared_1_k0, &q[9], &v[8], &w.sq_l_thigh, &w.cq_l_thigh, w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    proxgen_rt::sincos_noinline(q[10], w.sq_l_shank, w.cq_l_shank);
-    const Scalar t0 = w.v_l_thigh[0] - 0.42875*w.v_l_thigh[4];
-    const Scalar t1 = w.v_l_hip_roll_link[1] + 0.42875*w.v_l_thigh[3];
-    const Scalar t2 = -0.19866933079506124*w.v_l_thigh[2] + 0.9800665778412416*t0;
-    const Scalar t3 = 0.9800665778412416*w.v_l_thigh[2] + 0.19866933079506124*t0;
-    const Scalar t4 = 0.9800665778412416*w.v_l_thigh[3] - 0.19866933079506124*w.v_l_thigh[5];
-    const Scalar t5 = 0.19866933079506124*w.v_l_thigh[3] + 0.9800665778412416*w.v_l_thigh[5];
-    w.v_l_shank[0] = w.cq_l_shank*t2 - w.sq_l_shank*t3;
-    w.v_l_shank[1] = t1;
-    w.v_l_shank[2] = w.sq_l_shank*t2 + w.cq_l_shank*t3;
-    w.v_l_shank[3] = w.cq_l_shank*t4 - w.sq_l_shank*t5;
-    w.v_l_shank[4] = w.v_l_thigh[4] + v[9];
-    w.v_l_shank[5] = w.sq_l_shank*t4 + w.cq_l_shank*t5;
-    w.c_l_shank[0] = -v[9]*w.v_l_shank[2];
-    w.c_l_shank[2] = v[9]*w.v_l_shank[0];
-    w.c_l_shank[3] = -v[9]*w.v_l_shank[5];
-    w.c_l_shank[5] = v[9]*w.v_l_shank[3];
-    const Scalar h0 = 3.055*w.v_l_shank[0] - 0.5694718575000001*w.v_l_shank[4];
-    const Scalar h1 = 3.055*w.v_l_shank[1] + 0.5694718575000001*w.v_l_shank[3];
-    const Scalar h2 = 0.5694718575000001*w.v_l_shank[1] + 0.15779149347477375*w.v_l_shank[3];
-    const Scalar h3 = -0.5694718575000001*w.v_l_shank[0] + 0.15779149347477375*w.v_l_shank[4];
-    w.pA_l_shank[0] = 3.055*w.v_l_shank[2]*w.v_l_shank[4] - w.v_l_shank[5]*h1;
-    w.pA_l_shank[1] = w.v_l_shank[5]*h0 - 3.055*w.v_l_shank[2]*w.v_l_shank[3];
-    w.pA_l_shank[2] = w.v_l_shank[3]*h1 - w.v_l_shank[4]*h0;
-    w.pA_l_shank[3] = 0.00381875*w.v_l_shank[4]*w.v_l_shank[5] - w.v_l_shank[5]*h3 + 3.055*w.v_l_shank[1]*w.v_l_shank[2] - w.v_l_shank[2]*h1;
-    w.pA_l_shank[4] = w.v_l_shank[5]*h2 - 0.00381875*w.v_l_shank[3]*w.v_l_shank[5] + w.v_l_shank[2]*h0 - 3.055*w.v_l_shank[0]*w.v_l_shank[2];
-    w.pA_l_shank[5] = w.v_l_shank[3]*h3 - w.v_l_shank[4]*h2 + w.v_l_shank[0]*h1 - w.v_l_shank[1]*h0;
-    const Scalar t6 = 0.9800665778412416*w.g_l_thigh[0] - 0.19866933079506124*w.g_l_thigh[2];
-    const Scalar t7 = 0.19866933079506124*w.g_l_thigh[0] + 0.9800665778412416*w.g_l_thigh[2];
-    w.g_l_shank[0] = w.cq_l_shank*t6 - w.sq_l_shank*t7;
-    w.g_l_shank[2] = w.sq_l_shank*t6 + w.cq_l_shank*t7;
-  }
+  shared_2(shared_2_k0, &q[10], &v[9], &w.sq_l_shank, &w.cq_l_shank, w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
   // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    proxgen_rt::sincos_noinline(q[11], w.sq_l_ankle_link, w.cq_l_ankle_link);
-    const Scalar t8 = w.v_l_shank[0] - 0.4305*w.v_l_shank[4];
-    const Scalar t9 = w.v_l_shank[1] + 0.4305*w.v_l_shank[3];
-    const Scalar t10 = 0.09983341664682815*w.v_l_shank[2] + 0.9950041652780258*t8;
-    const Scalar t11 = 0.9950041652780258*w.v_l_shank[2] - 0.09983341664682815*t8;
-    const Scalar t12 = 0.9950041652780258*w.v_l_shank[3] + 0.09983341664682815*w.v_l_shank[5];
-    const Scalar t13 = -0.09983341664682815*w.v_l_shank[3] + 0.9950041652780258*w.v_l_shank[5];
-    w.v_l_ankle_link[0] = w.cq_l_ankle_link*t10 - w.sq_l_ankle_link*t11;
-    w.v_l_ankle_link[1] = t9;
-    w.v_l_ankle_link[2] = w.sq_l_ankle_link*t10 + w.cq_l_ankle_link*t11;
-    w.v_l_ankle_link[3] = w.cq_l_ankle_link*t12 - w.sq_l_ankle_link*t13;
-    w.v_l_ankle_link[4] = w.v_l_shank[4] + v[10];
-    w.v_l_ankle_link[5] = w.sq_l_ankle_link*t12 + w.cq_l_ankle_link*t13;
-    w.c_l_ankle_link[0] = -v[10]*w.v_l_ankle_link[2];
-    w.c_l_ankle_link[2] = v[10]*w.v_l_ankle_link[0];
-    w.c_l_ankle_link[3] = -v[10]*w.v_l_ankle_link[5];
-    w.c_l_ankle_link[5] = v[10]*w.v_l_ankle_link[3];
-    w.pA_l_ankle_link[0] = 0.2*(w.v_l_ankle_link[2]*w.v_l_ankle_link[4] - w.v_l_ankle_link[1]*w.v_l_ankle_link[5]);
-    w.pA_l_ankle_link[1] = 0.2*(w.v_l_ankle_link[0]*w.v_l_ankle_link[5] - w.v_l_ankle_link[2]*w.v_l_ankle_link[3]);
-    w.pA_l_ankle_link[2] = 0.2*(w.v_l_ankle_link[1]*w.v_l_ankle_link[3] - w.v_l_ankle_link[0]*w.v_l_ankle_link[4]);
-    const Scalar t14 = 0.9950041652780258*w.g_l_shank[0] + 0.09983341664682815*w.g_l_shank[2];
-    const Scalar t15 = -0.09983341664682815*w.g_l_shank[0] + 0.9950041652780258*w.g_l_shank[2];
-    w.g_l_ankle_link[0] = w.cq_l_ankle_link*t14 - w.sq_l_ankle_link*t15;
-    w.g_l_ankle_link[2] = w.sq_l_ankle_link*t14 + w.cq_l_ankle_link*t15;
-  }
+  shared_3(shared_3_k0, &q[11], &v[10], &w.sq_l_ankle_link, &w.cq_l_ankle_link, w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    proxgen_rt::sincos_noinline(q[12], w.sq_l_foot, w.cq_l_foot);
-    w.v_l_foot[1] = w.v_l_ankle_link[1]*w.cq_l_foot + w.v_l_ankle_link[2]*w.sq_l_foot;
-    w.v_l_foot[2] = -w.v_l_ankle_link[1]*w.sq_l_foot + w.v_l_ankle_link[2]*w.cq_l_foot;
-    w.v_l_foot[3] = w.v_l_ankle_link[3] + v[11];
-    w.v_l_foot[4] = w.v_l_ankle_link[4]*w.cq_l_foot + w.v_l_ankle_link[5]*w.sq_l_foot;
-    w.v_l_foot[5] = -w.v_l_ankle_link[4]*w.sq_l_foot + w.v_l_ankle_link[5]*w.cq_l_foot;
-    w.c_l_foot[1] = v[11]*w.v_l_foot[2];
-    w.c_l_foot[2] = -v[11]*w.v_l_foot[1];
-    w.c_l_foot[4] = v[11]*w.v_l_foot[5];
-    w.c_l_foot[5] = -v[11]*w.v_l_foot[4];
-    const Scalar h0 = 1.015*w.v_l_ankle_link[0] - 0.027912499999999996*w.v_l_foot[4];
-    const Scalar h1 = 1.015*w.v_l_foot[1] + 0.027912499999999996*w.v_l_foot[3] + 0.06495999999999999*w.v_l_foot[5];
-    const Scalar h2 = 1.015*w.v_l_foot[2] - 0.06495999999999999*w.v_l_foot[4];
-    const Scalar h3 = 0.027912499999999996*w.v_l_foot[1] + 0.00194517348958*w.v_l_foot[3] + 0.0017863999999999998*w.v_l_foot[5];
-    const Scalar h4 = -0.027912499999999996*w.v_l_ankle_link[0] - 0.06495999999999999*w.v_l_foot[2] + 0.00936987670937*w.v_l_foot[4];
-    const Scalar h5 = 0.06495999999999999*w.v_l_foot[1] + 0.0017863999999999998*w.v_l_foot[3] + 0.00860228295937*w.v_l_foot[5];
-    w.pA_l_foot[0] = w.v_l_foot[4]*h2 - w.v_l_foot[5]*h1;
-    w.pA_l_foot[1] = w.v_l_foot[5]*h0 - w.v_l_foot[3]*h2;
-    w.pA_l_foot[2] = w.v_l_foot[3]*h1 - w.v_l_foot[4]*h0;
-    w.pA_l_foot[3] = w.v_l_foot[4]*h5 - w.v_l_foot[5]*h4 + w.v_l_foot[1]*h2 - w.v_l_foot[2]*h1;
-    w.pA_l_foot[4] = w.v_l_foot[5]*h3 - w.v_l_foot[3]*h5 + w.v_l_foot[2]*h0 - w.v_l_ankle_link[0]*h2;
-    w.pA_l_foot[5] = w.v_l_foot[3]*h4 - w.v_l_foot[4]*h3 + w.v_l_ankle_link[0]*h1 - w.v_l_foot[1]*h0;
-    w.g_l_foot[1] = w.g_l_hip_roll_link[1]*w.cq_l_foot + w.g_l_ankle_link[2]*w.sq_l_foot;
-    w.g_l_foot[2] = -w.g_l_hip_roll_link[1]*w.sq_l_foot + w.g_l_ankle_link[2]*w.cq_l_foot;
-    // constraint 'left_foot' (6d) on link 'l_sole': rows 0..5
-  }
+  shared_4(shared_4_k0, &q[12], &v[11], &w.sq_l_foot, &w.cq_l_foot, &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_noinline(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
@@ -292,156 +2353,21 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
 
 PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    proxgen_rt::sincos_noinline(q[14], w.sq_r_hip_roll_link, w.cq_r_hip_roll_link);
-    w.v_r_hip_roll_link[1] = w.v_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
-    w.v_r_hip_roll_link[2] = -w.v_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.v_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
-    w.v_r_hip_roll_link[3] = w.v_r_hip_yaw_link[3] + v[13];
-    w.v_r_hip_roll_link[4] = w.v_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.v_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
-    w.v_r_hip_roll_link[5] = -w.v_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.v_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    w.c_r_hip_roll_link[1] = v[13]*w.v_r_hip_roll_link[2];
-    w.c_r_hip_roll_link[2] = -v[13]*w.v_r_hip_roll_link[1];
-    w.c_r_hip_roll_link[4] = v[13]*w.v_r_hip_roll_link[5];
-    w.c_r_hip_roll_link[5] = -v[13]*w.v_r_hip_roll_link[4];
-    const Scalar h0 = 0.5*w.v_r_hip_yaw_link[0] - 0.015*w.v_r_hip_roll_link[4];
-    const Scalar h1 = 0.5*w.v_r_hip_roll_link[1] + 0.015*w.v_r_hip_roll_link[3];
-    const Scalar h2 = 0.015*w.v_r_hip_roll_link[1] + 0.00095*w.v_r_hip_roll_link[3];
-    const Scalar h3 = -0.015*w.v_r_hip_yaw_link[0] + 0.00095*w.v_r_hip_roll_link[4];
-    w.pA_r_hip_roll_link[0] = 0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[4] - w.v_r_hip_roll_link[5]*h1;
-    w.pA_r_hip_roll_link[1] = w.v_r_hip_roll_link[5]*h0 - 0.5*w.v_r_hip_roll_link[2]*w.v_r_hip_roll_link[3];
-    w.pA_r_hip_roll_link[2] = w.v_r_hip_roll_link[3]*h1 - w.v_r_hip_roll_link[4]*h0;
-    w.pA_r_hip_roll_link[3] = 0.0005*w.v_r_hip_roll_link[4]*w.v_r_hip_roll_link[5] - w.v_r_hip_roll_link[5]*h3 + 0.5*w.v_r_hip_roll_link[1]*w.v_r_hip_roll_link[2] - w.v_r_hip_roll_link[2]*h1;
-    w.pA_r_hip_roll_link[4] = w.v_r_hip_roll_link[5]*h2 - 0.0005*w.v_r_hip_roll_link[3]*w.v_r_hip_roll_link[5] + w.v_r_hip_roll_link[2]*h0 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_roll_link[2];
-    w.pA_r_hip_roll_link[5] = w.v_r_hip_roll_link[3]*h3 - w.v_r_hip_roll_link[4]*h2 + w.v_r_hip_yaw_link[0]*h1 - w.v_r_hip_roll_link[1]*h0;
-    w.g_r_hip_roll_link[1] = w.g_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.g_pelvis[2]*w.sq_r_hip_roll_link;
-    w.g_r_hip_roll_link[2] = -w.g_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.g_pelvis[2]*w.cq_r_hip_roll_link;
-  }
+  shared_0(shared_0_k0, &q[14], &v[13], &w.sq_r_hip_roll_link, &w.cq_r_hip_roll_link, &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    proxgen_rt::sincos_noinline(q[15], w.sq_r_thigh, w.cq_r_thigh);
-    const Scalar t0 = 0.9950041652780258*w.v_r_hip_yaw_link[0] + 0.09983341664682815*w.v_r_hip_roll_link[2];
-    const Scalar t1 = -0.09983341664682815*w.v_r_hip_yaw_link[0] + 0.9950041652780258*w.v_r_hip_roll_link[2];
-    const Scalar t2 = 0.9950041652780258*w.v_r_hip_roll_link[3] + 0.09983341664682815*w.v_r_hip_roll_link[5];
-    const Scalar t3 = -0.09983341664682815*w.v_r_hip_roll_link[3] + 0.9950041652780258*w.v_r_hip_roll_link[5];
-    w.v_r_thigh[0] = w.cq_r_thigh*t0 - w.sq_r_thigh*t1;
-    w.v_r_thigh[2] = w.sq_r_thigh*t0 + w.cq_r_thigh*t1;
-    w.v_r_thigh[3] = w.cq_r_thigh*t2 - w.sq_r_thigh*t3;
-    w.v_r_thigh[4] = w.v_r_hip_roll_link[4] + v[14];
-    w.v_r_thigh[5] = w.sq_r_thigh*t2 + w.cq_r_thigh*t3;
-    w.c_r_thigh[0] = -v[14]*w.v_r_thigh[2];
-    w.c_r_thigh[2] = v[14]*w.v_r_thigh[0];
-    w.c_r_thigh[3] = -v[14]*w.v_r_thigh[5];
-    w.c_r_thigh[5] = v[14]*w.v_r_thigh[3];
-    const Scalar h4 = 7.0*w.v_r_thigh[0] - 1.29954125*w.v_r_thigh[4];
-    const Scalar h5 = 7.0*w.v_r_hip_roll_link[1] + 1.29954125*w.v_r_thigh[3];
-    const Scalar h6 = 1.29954125*w.v_r_hip_roll_link[1] + 0.3755072987089375*w.v_r_thigh[3];
-    const Scalar h7 = -1.29954125*w.v_r_thigh[0] + 0.3755072987089375*w.v_r_thigh[4];
-    w.pA_r_thigh[0] = 7.0*w.v_r_thigh[2]*w.v_r_thigh[4] - w.v_r_thigh[5]*h5;
-    w.pA_r_thigh[1] = w.v_r_thigh[5]*h4 - 7.0*w.v_r_thigh[2]*w.v_r_thigh[3];
-    w.pA_r_thigh[2] = w.v_r_thigh[3]*h5 - w.v_r_thigh[4]*h4;
-    w.pA_r_thigh[3] = 0.0196875*w.v_r_thigh[4]*w.v_r_thigh[5] - w.v_r_thigh[5]*h7 + 7.0*w.v_r_hip_roll_link[1]*w.v_r_thigh[2] - w.v_r_thigh[2]*h5;
-    w.pA_r_thigh[4] = w.v_r_thigh[5]*h6 - 0.0196875*w.v_r_thigh[3]*w.v_r_thigh[5] + w.v_r_thigh[2]*h4 - 7.0*w.v_r_thigh[0]*w.v_r_thigh[2];
-    w.pA_r_thigh[5] = w.v_r_thigh[3]*h7 - w.v_r_thigh[4]*h6 + w.v_r_thigh[0]*h5 - w.v_r_hip_roll_link[1]*h4;
-    const Scalar t4 = 0.9950041652780258*w.g_r_hip_yaw_link[0] + 0.09983341664682815*w.g_r_hip_roll_link[2];
-    const Scalar t5 = -0.09983341664682815*w.g_r_hip_yaw_link[0] + 0.9950041652780258*w.g_r_hip_roll_link[2];
-    w.g_r_thigh[0] = w.cq_r_thigh*t4 - w.sq_r_thigh*t5;
-    w.g_r_thigh[2] = w.sq_r_thigh*t4 + w.cq_r_thigh*t5;
-  }
+  shared_1(shared_1_k0, &q[15], &v[14], &w.sq_r_thigh, &w.cq_r_thigh, w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    proxgen_rt::sincos_noinline(q[16], w.sq_r_shank, w.cq_r_shank);
-    const Scalar t0 = w.v_r_thigh[0] - 0.42875*w.v_r_thigh[4];
-    const Scalar t1 = w.v_r_hip_roll_link[1] + 0.42875*w.v_r_thigh[3];
-    const Scalar t2 = -0.19866933079506124*w.v_r_thigh[2] + 0.9800665778412416*t0;
-    const Scalar t3 = 0.9800665778412416*w.v_r_thigh[2] + 0.19866933079506124*t0;
-    const Scalar t4 = 0.9800665778412416*w.v_r_thigh[3] - 0.19866933079506124*w.v_r_thigh[5];
-    const Scalar t5 = 0.19866933079506124*w.v_r_thigh[3] + 0.9800665778412416*w.v_r_thigh[5];
-    w.v_r_shank[0] = w.cq_r_shank*t2 - w.sq_r_shank*t3;
-    w.v_r_shank[1] = t1;
-    w.v_r_shank[2] = w.sq_r_shank*t2 + w.cq_r_shank*t3;
-    w.v_r_shank[3] = w.cq_r_shank*t4 - w.sq_r_shank*t5;
-    w.v_r_shank[4] = w.v_r_thigh[4] + v[15];
-    w.v_r_shank[5] = w.sq_r_shank*t4 + w.cq_r_shank*t5;
-    w.c_r_shank[0] = -v[15]*w.v_r_shank[2];
-    w.c_r_shank[2] = v[15]*w.v_r_shank[0];
-    w.c_r_shank[3] = -v[15]*w.v_r_shank[5];
-    w.c_r_shank[5] = v[15]*w.v_r_shank[3];
-    const Scalar h0 = 3.055*w.v_r_shank[0] - 0.5694718575000001*w.v_r_shank[4];
-    const Scalar h1 = 3.055*w.v_r_shank[1] + 0.5694718575000001*w.v_r_shank[3];
-    const Scalar h2 = 0.5694718575000001*w.v_r_shank[1] + 0.15779149347477375*w.v_r_shank[3];
-    const Scalar h3 = -0.5694718575000001*w.v_r_shank[0] + 0.15779149347477375*w.v_r_shank[4];
-    w.pA_r_shank[0] = 3.055*w.v_r_shank[2]*w.v_r_shank[4] - w.v_r_shank[5]*h1;
-    w.pA_r_shank[1] = w.v_r_shank[5]*h0 - 3.055*w.v_r_shank[2]*w.v_r_shank[3];
-    w.pA_r_shank[2] = w.v_r_shank[3]*h1 - w.v_r_shank[4]*h0;
-    w.pA_r_shank[3] = 0.00381875*w.v_r_shank[4]*w.v_r_shank[5] - w.v_r_shank[5]*h3 + 3.055*w.v_r_shank[1]*w.v_r_shank[2] - w.v_r_shank[2]*h1;
-    w.pA_r_shank[4] = w.v_r_shank[5]*h2 - 0.00381875*w.v_r_shank[3]*w.v_r_shank[5] + w.v_r_shank[2]*h0 - 3.055*w.v_r_shank[0]*w.v_r_shank[2];
-    w.pA_r_shank[5] = w.v_r_shank[3]*h3 - w.v_r_shank[4]*h2 + w.v_r_shank[0]*h1 - w.v_r_shank[1]*h0;
-    const Scalar t6 = 0.9800665778412416*w.g_r_thigh[0] - 0.19866933079506124*w.g_r_thigh[2];
-    const Scalar t7 = 0.19866933079506124*w.g_r_thigh[0] + 0.9800665778412416*w.g_r_thigh[2];
-    w.g_r_shank[0] = w.cq_r_shank*t6 - w.sq_r_shank*t7;
-    w.g_r_shank[2] = w.sq_r_shank*t6 + w.cq_r_shank*t7;
-  }
+  shared_2(shared_2_k0, &q[16], &v[15], &w.sq_r_shank, &w.cq_r_shank, w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
   // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    proxgen_rt::sincos_noinline(q[17], w.sq_r_ankle_link, w.cq_r_ankle_link);
-    const Scalar t8 = w.v_r_shank[0] - 0.4305*w.v_r_shank[4];
-    const Scalar t9 = w.v_r_shank[1] + 0.4305*w.v_r_shank[3];
-    const Scalar t10 = 0.09983341664682815*w.v_r_shank[2] + 0.9950041652780258*t8;
-    const Scalar t11 = 0.9950041652780258*w.v_r_shank[2] - 0.09983341664682815*t8;
-    const Scalar t12 = 0.9950041652780258*w.v_r_shank[3] + 0.09983341664682815*w.v_r_shank[5];
-    const Scalar t13 = -0.09983341664682815*w.v_r_shank[3] + 0.9950041652780258*w.v_r_shank[5];
-    w.v_r_ankle_link[0] = w.cq_r_ankle_link*t10 - w.sq_r_ankle_link*t11;
-    w.v_r_ankle_link[1] = t9;
-    w.v_r_ankle_link[2] = w.sq_r_ankle_link*t10 + w.cq_r_ankle_link*t11;
-    w.v_r_ankle_link[3] = w.cq_r_ankle_link*t12 - w.sq_r_ankle_link*t13;
-    w.v_r_ankle_link[4] = w.v_r_shank[4] + v[16];
-    w.v_r_ankle_link[5] = w.sq_r_ankle_link*t12 + w.cq_r_ankle_link*t13;
-    w.c_r_ankle_link[0] = -v[16]*w.v_r_ankle_link[2];
-    w.c_r_ankle_link[2] = v[16]*w.v_r_ankle_link[0];
-    w.c_r_ankle_link[3] = -v[16]*w.v_r_ankle_link[5];
-    w.c_r_ankle_link[5] = v[16]*w.v_r_ankle_link[3];
-    w.pA_r_ankle_link[0] = 0.2*(w.v_r_ankle_link[2]*w.v_r_ankle_link[4] - w.v_r_ankle_link[1]*w.v_r_ankle_link[5]);
-    w.pA_r_ankle_link[1] = 0.2*(w.v_r_ankle_link[0]*w.v_r_ankle_link[5] - w.v_r_ankle_link[2]*w.v_r_ankle_link[3]);
-    w.pA_r_ankle_link[2] = 0.2*(w.v_r_ankle_link[1]*w.v_r_ankle_link[3] - w.v_r_ankle_link[0]*w.v_r_ankle_link[4]);
-    const Scalar t14 = 0.9950041652780258*w.g_r_shank[0] + 0.09983341664682815*w.g_r_shank[2];
-    const Scalar t15 = -0.09983341664682815*w.g_r_shank[0] + 0.9950041652780258*w.g_r_shank[2];
-    w.g_r_ankle_link[0] = w.cq_r_ankle_link*t14 - w.sq_r_ankle_link*t15;
-    w.g_r_ankle_link[2] = w.sq_r_ankle_link*t14 + w.cq_r_ankle_link*t15;
-  }
+  shared_3(shared_3_k0, &q[17], &v[16], &w.sq_r_ankle_link, &w.cq_r_ankle_link, w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    proxgen_rt::sincos_noinline(q[18], w.sq_r_foot, w.cq_r_foot);
-    w.v_r_foot[1] = w.v_r_ankle_link[1]*w.cq_r_foot + w.v_r_ankle_link[2]*w.sq_r_foot;
-    w.v_r_foot[2] = -w.v_r_ankle_link[1]*w.sq_r_foot + w.v_r_ankle_link[2]*w.cq_r_foot;
-    w.v_r_foot[3] = w.v_r_ankle_link[3] + v[17];
-    w.v_r_foot[4] = w.v_r_ankle_link[4]*w.cq_r_foot + w.v_r_ankle_link[5]*w.sq_r_foot;
-    w.v_r_foot[5] = -w.v_r_ankle_link[4]*w.sq_r_foot + w.v_r_ankle_link[5]*w.cq_r_foot;
-    w.c_r_foot[1] = v[17]*w.v_r_foot[2];
-    w.c_r_foot[2] = -v[17]*w.v_r_foot[1];
-    w.c_r_foot[4] = v[17]*w.v_r_foot[5];
-    w.c_r_foot[5] = -v[17]*w.v_r_foot[4];
-    const Scalar h0 = 1.015*w.v_r_ankle_link[0] - 0.027912499999999996*w.v_r_foot[4];
-    const Scalar h1 = 1.015*w.v_r_foot[1] + 0.027912499999999996*w.v_r_foot[3] + 0.06495999999999999*w.v_r_foot[5];
-    const Scalar h2 = 1.015*w.v_r_foot[2] - 0.06495999999999999*w.v_r_foot[4];
-    const Scalar h3 = 0.027912499999999996*w.v_r_foot[1] + 0.00194517348958*w.v_r_foot[3] + 0.0017863999999999998*w.v_r_foot[5];
-    const Scalar h4 = -0.027912499999999996*w.v_r_ankle_link[0] - 0.06495999999999999*w.v_r_foot[2] + 0.00936987670937*w.v_r_foot[4];
-    const Scalar h5 = 0.06495999999999999*w.v_r_foot[1] + 0.0017863999999999998*w.v_r_foot[3] + 0.00860228295937*w.v_r_foot[5];
-    w.pA_r_foot[0] = w.v_r_foot[4]*h2 - w.v_r_foot[5]*h1;
-    w.pA_r_foot[1] = w.v_r_foot[5]*h0 - w.v_r_foot[3]*h2;
-    w.pA_r_foot[2] = w.v_r_foot[3]*h1 - w.v_r_foot[4]*h0;
-    w.pA_r_foot[3] = w.v_r_foot[4]*h5 - w.v_r_foot[5]*h4 + w.v_r_foot[1]*h2 - w.v_r_foot[2]*h1;
-    w.pA_r_foot[4] = w.v_r_foot[5]*h3 - w.v_r_foot[3]*h5 + w.v_r_foot[2]*h0 - w.v_r_ankle_link[0]*h2;
-    w.pA_r_foot[5] = w.v_r_foot[3]*h4 - w.v_r_foot[4]*h3 + w.v_r_ankle_link[0]*h1 - w.v_r_foot[1]*h0;
-    w.g_r_foot[1] = w.g_r_hip_roll_link[1]*w.cq_r_foot + w.g_r_ankle_link[2]*w.sq_r_foot;
-    w.g_r_foot[2] = -w.g_r_hip_roll_link[1]*w.sq_r_foot + w.g_r_ankle_link[2]*w.cq_r_foot;
-    // constraint 'right_foot' (6d) on link 'r_sole': rows 6..11
-  }
+  shared_4(shared_4_k0, &q[18], &v[17], &w.sq_r_foot, &w.cq_r_foot, &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_noinline(q[19], w.sq_abdomen, w.cq_abdomen);
@@ -616,30 +2542,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* 
     w.pA_l_forearm[5] = w.v_l_forearm[3]*h3 - w.v_l_forearm[4]*h2 + w.v_l_forearm[0]*h1 - w.v_l_forearm[1]*h0;
   }
   // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  {
-    proxgen_rt::sincos_noinline(q[25], w.sq_l_wrist_yaw_link, w.cq_l_wrist_yaw_link);
-    const Scalar t6 = w.v_l_forearm[0] - 0.2555*w.v_l_forearm[4];
-    const Scalar t7 = w.v_l_forearm[1] + 0.2555*w.v_l_forearm[3];
-    w.v_l_wrist_yaw_link[0] = w.cq_l_wrist_yaw_link*t6 + w.sq_l_wrist_yaw_link*t7;
-    w.v_l_wrist_yaw_link[1] = -w.sq_l_wrist_yaw_link*t6 + w.cq_l_wrist_yaw_link*t7;
-    w.v_l_wrist_yaw_link[3] = w.v_l_forearm[3]*w.cq_l_wrist_yaw_link + w.v_l_forearm[4]*w.sq_l_wrist_yaw_link;
-    w.v_l_wrist_yaw_link[4] = -w.v_l_forearm[3]*w.sq_l_wrist_yaw_link + w.v_l_forearm[4]*w.cq_l_wrist_yaw_link;
-    w.v_l_wrist_yaw_link[5] = w.v_l_forearm[5] + v[24];
-    w.c_l_wrist_yaw_link[0] = v[24]*w.v_l_wrist_yaw_link[1];
-    w.c_l_wrist_yaw_link[1] = -v[24]*w.v_l_wrist_yaw_link[0];
-    w.c_l_wrist_yaw_link[3] = v[24]*w.v_l_wrist_yaw_link[4];
-    w.c_l_wrist_yaw_link[4] = -v[24]*w.v_l_wrist_yaw_link[3];
-    const Scalar h4 = 0.1*w.v_l_wrist_yaw_link[0] + 0.001*w.v_l_wrist_yaw_link[4];
-    const Scalar h5 = 0.1*w.v_l_wrist_yaw_link[1] - 0.001*w.v_l_wrist_yaw_link[3];
-    const Scalar h6 = -0.001*w.v_l_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[3];
-    const Scalar h7 = 0.001*w.v_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_l_wrist_yaw_link[4];
-    w.pA_l_wrist_yaw_link[0] = 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[4] - w.v_l_wrist_yaw_link[5]*h5;
-    w.pA_l_wrist_yaw_link[1] = w.v_l_wrist_yaw_link[5]*h4 - 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[3];
-    w.pA_l_wrist_yaw_link[2] = w.v_l_wrist_yaw_link[3]*h5 - w.v_l_wrist_yaw_link[4]*h4;
-    w.pA_l_wrist_yaw_link[3] = 2.5e-05*w.v_l_wrist_yaw_link[4]*w.v_l_wrist_yaw_link[5] - w.v_l_wrist_yaw_link[5]*h7 + 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[1] - w.v_l_forearm[2]*h5;
-    w.pA_l_wrist_yaw_link[4] = w.v_l_wrist_yaw_link[5]*h6 - 2.5e-05*w.v_l_wrist_yaw_link[3]*w.v_l_wrist_yaw_link[5] + w.v_l_forearm[2]*h4 - 0.1*w.v_l_forearm[2]*w.v_l_wrist_yaw_link[0];
-    w.pA_l_wrist_yaw_link[5] = w.v_l_wrist_yaw_link[3]*h7 - w.v_l_wrist_yaw_link[4]*h6 + w.v_l_wrist_yaw_link[0]*h5 - w.v_l_wrist_yaw_link[1]*h4;
-  }
+  shared_5(shared_5_k0, &q[25], &v[24], &w.sq_l_wrist_yaw_link, &w.cq_l_wrist_yaw_link, w.v_l_forearm, w.v_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.pA_l_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -693,30 +2596,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
 
 PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
-  {
-    proxgen_rt::sincos_noinline(q[28], w.sq_neck_link, w.cq_neck_link);
-    const Scalar t0 = w.v_chest[0] + 0.29*w.v_chest[4];
-    const Scalar t1 = w.v_chest[1] - 0.29*w.v_chest[3];
-    w.v_neck_link[0] = w.cq_neck_link*t0 + w.sq_neck_link*t1;
-    w.v_neck_link[1] = -w.sq_neck_link*t0 + w.cq_neck_link*t1;
-    w.v_neck_link[3] = w.v_chest[3]*w.cq_neck_link + w.v_chest[4]*w.sq_neck_link;
-    w.v_neck_link[4] = -w.v_chest[3]*w.sq_neck_link + w.v_chest[4]*w.cq_neck_link;
-    w.v_neck_link[5] = w.v_chest[5] + v[27];
-    w.c_neck_link[0] = v[27]*w.v_neck_link[1];
-    w.c_neck_link[1] = -v[27]*w.v_neck_link[0];
-    w.c_neck_link[3] = v[27]*w.v_neck_link[4];
-    w.c_neck_link[4] = -v[27]*w.v_neck_link[3];
-    const Scalar h0 = 0.5*w.v_neck_link[0] + 0.015*w.v_neck_link[4];
-    const Scalar h1 = 0.5*w.v_neck_link[1] - 0.015*w.v_neck_link[3];
-    const Scalar h2 = -0.015*w.v_neck_link[1] + 0.0007700000000000001*w.v_neck_link[3];
-    const Scalar h3 = 0.015*w.v_neck_link[0] + 0.0007700000000000001*w.v_neck_link[4];
-    w.pA_neck_link[0] = 0.5*w.v_chest[2]*w.v_neck_link[4] - w.v_neck_link[5]*h1;
-    w.pA_neck_link[1] = w.v_neck_link[5]*h0 - 0.5*w.v_chest[2]*w.v_neck_link[3];
-    w.pA_neck_link[2] = w.v_neck_link[3]*h1 - w.v_neck_link[4]*h0;
-    w.pA_neck_link[3] = 0.00032*w.v_neck_link[4]*w.v_neck_link[5] - w.v_neck_link[5]*h3 + 0.5*w.v_chest[2]*w.v_neck_link[1] - w.v_chest[2]*h1;
-    w.pA_neck_link[4] = w.v_neck_link[5]*h2 - 0.00032*w.v_neck_link[3]*w.v_neck_link[5] + w.v_chest[2]*h0 - 0.5*w.v_chest[2]*w.v_neck_link[0];
-    w.pA_neck_link[5] = w.v_neck_link[3]*h3 - w.v_neck_link[4]*h2 + w.v_neck_link[0]*h1 - w.v_neck_link[1]*h0;
-  }
+  shared_5(shared_5_k1, &q[28], &v[27], &w.sq_neck_link, &w.cq_neck_link, w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
     proxgen_rt::sincos_noinline(q[29], w.sq_head, w.cq_head);
@@ -1124,302 +3004,22 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_hand_to_l_wrist_pitch_link(const Scala
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  {
-    w.Dinv_l_wrist_yaw_link = 1.0 / w.IA_l_wrist_yaw_link[20];
-    w.u_l_wrist_yaw_link[0] = -w.pA_l_wrist_yaw_link[5] + tau[24];
-    const Scalar t0 = w.IA_l_wrist_yaw_link[5]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t1 = w.IA_l_wrist_yaw_link[10]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t2 = w.IA_l_wrist_yaw_link[14]*w.Dinv_l_wrist_yaw_link;
-    const Scalar t3 = w.IA_l_wrist_yaw_link[17]*w.Dinv_l_wrist_yaw_link;
-    const Scalar Ia0 = w.IA_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t0;
-    const Scalar Ia1 = w.IA_l_wrist_yaw_link[1] - w.IA_l_wrist_yaw_link[10]*t0;
-    const Scalar Ia2 = w.IA_l_wrist_yaw_link[2] - w.IA_l_wrist_yaw_link[14]*t0;
-    const Scalar Ia3 = w.IA_l_wrist_yaw_link[3] - w.IA_l_wrist_yaw_link[17]*t0;
-    const Scalar Ia4 = w.IA_l_wrist_yaw_link[6] - w.IA_l_wrist_yaw_link[10]*t1;
-    const Scalar Ia5 = w.IA_l_wrist_yaw_link[7] - w.IA_l_wrist_yaw_link[14]*t1;
-    const Scalar Ia6 = w.IA_l_wrist_yaw_link[8] - w.IA_l_wrist_yaw_link[17]*t1;
-    const Scalar Ia7 = w.IA_l_wrist_yaw_link[11] - w.IA_l_wrist_yaw_link[14]*t2;
-    const Scalar Ia8 = w.IA_l_wrist_yaw_link[12] - w.IA_l_wrist_yaw_link[17]*t2;
-    const Scalar Ia9 = w.IA_l_wrist_yaw_link[15] - w.IA_l_wrist_yaw_link[17]*t3;
-    const Scalar pa0 = 0.001*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[0] + w.u_l_wrist_yaw_link[0]*t0 + w.c_l_wrist_yaw_link[0]*Ia0 + w.c_l_wrist_yaw_link[1]*Ia1 + w.c_l_wrist_yaw_link[3]*Ia3;
-    const Scalar pa1 = w.pA_l_wrist_yaw_link[1] + w.u_l_wrist_yaw_link[0]*t1 + w.c_l_wrist_yaw_link[0]*Ia1 + w.c_l_wrist_yaw_link[1]*Ia4 + w.c_l_wrist_yaw_link[3]*Ia6;
-    const Scalar pa2 = w.pA_l_wrist_yaw_link[2] + w.u_l_wrist_yaw_link[0]*t2 + w.c_l_wrist_yaw_link[0]*Ia2 + w.c_l_wrist_yaw_link[1]*Ia5 + w.c_l_wrist_yaw_link[3]*Ia8;
-    const Scalar pa3 = w.pA_l_wrist_yaw_link[3] + w.u_l_wrist_yaw_link[0]*t3 + w.c_l_wrist_yaw_link[0]*Ia3 + w.c_l_wrist_yaw_link[1]*Ia6 + w.c_l_wrist_yaw_link[3]*Ia9;
-    const Scalar pa4 = 0.001*w.c_l_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_l_wrist_yaw_link[4] + w.pA_l_wrist_yaw_link[4];
-    const Scalar C20 = w.cq_l_wrist_yaw_link*w.cq_l_wrist_yaw_link - w.sq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link;
-    const Scalar h0 = 0.5*(Ia0 - Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_l_wrist_yaw_link*w.sq_l_wrist_yaw_link;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar t5 = 0.0005 + 0.5*Ia6;
-    const Scalar d1 = 0.5*Ia3*C20 - t4*t5;
-    const Scalar qq1 = 0.5*Ia3*t4 + C20*t5;
-    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia9;
-    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia9;
-    const Scalar t6 = m0 + d0;
-    const Scalar t7 = w.cq_l_wrist_yaw_link*Ia2 - w.sq_l_wrist_yaw_link*Ia5;
-    const Scalar t8 = m0 - d0;
-    const Scalar t9 = w.sq_l_wrist_yaw_link*Ia2 + w.cq_l_wrist_yaw_link*Ia5;
-    const Scalar t10 = 0.5*Ia3 + d1;
-    const Scalar t11 = 0.0005 - 0.5*Ia6 + qq1;
-    const Scalar t12 = -0.0005 + 0.5*Ia6 + qq1;
-    const Scalar t13 = 0.5*Ia3 - d1;
-    const Scalar t14 = 0.2555*qq0 + t10;
-    const Scalar t15 = -0.2555*t6 + t11;
-    const Scalar t16 = 0.2555*t8 + t12;
-    const Scalar t17 = -0.2555*qq0 + t13;
-    const Scalar t18 = w.cq_l_wrist_yaw_link*Ia8 + 0.2555*t9;
-    const Scalar t19 = w.sq_l_wrist_yaw_link*Ia8 - 0.2555*t7;
-    const Scalar t20 = w.cq_l_wrist_yaw_link*pa0 - w.sq_l_wrist_yaw_link*pa1;
-    const Scalar t21 = w.sq_l_wrist_yaw_link*pa0 + w.cq_l_wrist_yaw_link*pa1;
-    w.IA_l_forearm[0] = 0.92 + t6;
-    w.IA_l_forearm[1] = qq0;
-    w.IA_l_forearm[2] = t7;
-    w.IA_l_forearm[3] = t14;
-    w.IA_l_forearm[4] = -0.10107580000000001 + t15;
-    w.IA_l_forearm[6] = 0.92 + t8;
-    w.IA_l_forearm[7] = t9;
-    w.IA_l_forearm[8] = 0.10107580000000001 + t16;
-    w.IA_l_forearm[9] = t17;
-    w.IA_l_forearm[11] = 0.92 + Ia7;
-    w.IA_l_forearm[12] = t18;
-    w.IA_l_forearm[13] = t19;
-    w.IA_l_forearm[15] = 0.01661854208147 + m1 + C20*h1 + 0.2555*t12 + 0.2555*t16;
-    w.IA_l_forearm[16] = t4*h1 - 0.2555*t10 + 0.2555*t17;
-    w.IA_l_forearm[18] = 0.01661854208147 + m1 - C20*h1 - 0.2555*t11 - 0.2555*t15;
-    w.pA_l_forearm[0] = w.pA_l_forearm[0] + t20;
-    w.pA_l_forearm[1] = w.pA_l_forearm[1] + t21;
-    w.pA_l_forearm[2] = w.pA_l_forearm[2] + pa2;
-    w.pA_l_forearm[3] = w.pA_l_forearm[3] + w.cq_l_wrist_yaw_link*pa3 - w.sq_l_wrist_yaw_link*pa4 + 0.2555*t21;
-    w.pA_l_forearm[4] = w.pA_l_forearm[4] + w.sq_l_wrist_yaw_link*pa3 + w.cq_l_wrist_yaw_link*pa4 - 0.2555*t20;
-    w.pA_l_forearm[5] = w.pA_l_forearm[5] + tau[24];
-  }
+  shared_6(shared_6_k0, &tau[24], &w.Dinv_l_wrist_yaw_link, w.IA_l_wrist_yaw_link, w.u_l_wrist_yaw_link, w.pA_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.IA_l_forearm, w.pA_l_forearm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-  {
-    w.Dinv_l_forearm = 1.0 / w.IA_l_forearm[18];
-    w.u_l_forearm[0] = -w.pA_l_forearm[4] + tau[23];
-    const Scalar t0 = w.IA_l_forearm[4]*w.Dinv_l_forearm;
-    const Scalar t1 = w.IA_l_forearm[9]*w.Dinv_l_forearm;
-    const Scalar t2 = w.IA_l_forearm[13]*w.Dinv_l_forearm;
-    const Scalar t3 = w.IA_l_forearm[16]*w.Dinv_l_forearm;
-    const Scalar Ia0 = w.IA_l_forearm[0] - w.IA_l_forearm[4]*t0;
-    const Scalar Ia1 = w.IA_l_forearm[1] - w.IA_l_forearm[9]*t0;
-    const Scalar Ia2 = w.IA_l_forearm[2] - w.IA_l_forearm[13]*t0;
-    const Scalar Ia3 = w.IA_l_forearm[3] - w.IA_l_forearm[16]*t0;
-    const Scalar Ia4 = w.IA_l_forearm[6] - w.IA_l_forearm[9]*t1;
-    const Scalar Ia5 = w.IA_l_forearm[7] - w.IA_l_forearm[13]*t1;
-    const Scalar Ia6 = w.IA_l_forearm[8] - w.IA_l_forearm[16]*t1;
-    const Scalar Ia7 = w.IA_l_forearm[11] - w.IA_l_forearm[13]*t2;
-    const Scalar Ia8 = w.IA_l_forearm[12] - w.IA_l_forearm[16]*t2;
-    const Scalar Ia9 = w.IA_l_forearm[15] - w.IA_l_forearm[16]*t3;
-    const Scalar pa0 = w.pA_l_forearm[0] + w.u_l_forearm[0]*t0 + w.c_l_forearm[0]*Ia0 + w.c_l_forearm[2]*Ia2 + w.c_l_forearm[3]*Ia3;
-    const Scalar pa1 = w.pA_l_forearm[1] + w.u_l_forearm[0]*t1 + w.c_l_forearm[0]*Ia1 + w.c_l_forearm[2]*Ia5 + w.c_l_forearm[3]*Ia6;
-    const Scalar pa2 = w.pA_l_forearm[2] + w.u_l_forearm[0]*t2 + w.c_l_forearm[0]*Ia2 + w.c_l_forearm[2]*Ia7 + w.c_l_forearm[3]*Ia8;
-    const Scalar pa3 = w.pA_l_forearm[3] + w.u_l_forearm[0]*t3 + w.c_l_forearm[0]*Ia3 + w.c_l_forearm[2]*Ia8 + w.c_l_forearm[3]*Ia9;
-    const Scalar pa4 = 0.0005635*w.c_l_forearm[5] + w.pA_l_forearm[5];
-    const Scalar C20 = w.cq_l_forearm*w.cq_l_forearm - w.sq_l_forearm*w.sq_l_forearm;
-    const Scalar h0 = 0.5*(-Ia0 + Ia7);
-    const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_l_forearm*w.sq_l_forearm;
-    const Scalar d0 = C20*h0 - Ia2*t4;
-    const Scalar qq0 = h0*t4 + Ia2*C20;
-    const Scalar d1 = 0.5*(-Ia3*C20 - Ia8*t4);
-    const Scalar qq1 = 0.5*(-Ia3*t4 + Ia8*C20);
-    const Scalar h1 = 0.00028175 - 0.5*Ia9;
-    const Scalar m1 = 0.00028175 + 0.5*Ia9;
-    const Scalar t5 = 0.955336489125606*m0 - 0.955336489125606*d0 - 0.29552020666133966*qq0;
-    const Scalar t6 = -0.29552020666133966*w.cq_l_forearm*Ia5 + 0.29552020666133966*w.sq_l_forearm*Ia1 + 0.955336489125606*w.sq_l_forearm*Ia5 + 0.955336489125606*w.cq_l_forearm*Ia1;
-    const Scalar t7 = -0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
-    const Scalar t8 = w.sq_l_forearm*Ia5 + w.cq_l_forearm*Ia1;
-    const Scalar t9 = w.cq_l_forearm*Ia5 - w.sq_l_forearm*Ia1;
-    const Scalar t10 = 0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
-    const Scalar t12 = 0.955336489125606*m0 + 0.955336489125606*d0 + 0.29552020666133966*qq0;
-    const Scalar t13 = 0.477668244562803*Ia3 - 0.14776010333066983*Ia8 - 0.955336489125606*d1 - 0.29552020666133966*qq1;
-    const Scalar t14 = -0.14776010333066983*Ia3 - 0.477668244562803*Ia8 - 0.29552020666133966*d1 + 0.955336489125606*qq1;
-    const Scalar t15 = 0.14776010333066983*Ia3 + 0.477668244562803*Ia8 - 0.29552020666133966*d1 + 0.955336489125606*qq1;
-    const Scalar t16 = 0.477668244562803*Ia3 - 0.14776010333066983*Ia8 + 0.955336489125606*d1 + 0.29552020666133966*qq1;
-    const Scalar t17 = 0.955336489125606*m1 - 0.955336489125606*C20*h1 - 0.29552020666133966*t4*h1;
-    const Scalar t18 = -0.29552020666133966*m1 - 0.29552020666133966*C20*h1 + 0.955336489125606*t4*h1;
-    const Scalar t19 = 0.29552020666133966*m1 - 0.29552020666133966*C20*h1 + 0.955336489125606*t4*h1;
-    const Scalar t20 = 0.955336489125606*m1 + 0.955336489125606*C20*h1 + 0.29552020666133966*t4*h1;
-    const Scalar t21 = 0.955336489125606*t5 - 0.29552020666133966*t7;
-    const Scalar t22 = 0.29552020666133966*t5 + 0.955336489125606*t7;
-    const Scalar t23 = 0.29552020666133966*t8 + 0.955336489125606*t9;
-    const Scalar t24 = 0.29552020666133966*t10 + 0.955336489125606*t12;
-    const Scalar t25 = 0.955336489125606*t13 - 0.29552020666133966*t14;
-    const Scalar t26 = 0.29552020666133966*t13 + 0.955336489125606*t14;
-    const Scalar t27 = 0.29552020666133966*w.sq_l_forearm*Ia6 + 0.955336489125606*w.cq_l_forearm*Ia6;
-    const Scalar t28 = -0.955336489125606*w.sq_l_forearm*Ia6 + 0.29552020666133966*w.cq_l_forearm*Ia6;
-    const Scalar t29 = 0.955336489125606*t15 - 0.29552020666133966*t16;
-    const Scalar t30 = 0.29552020666133966*t15 + 0.955336489125606*t16;
-    const Scalar t31 = 0.3255*t6 + t25;
-    const Scalar t32 = 0.3255*Ia4 + t27;
-    const Scalar t33 = 0.3255*t23 + t29;
-    const Scalar t34 = w.cq_l_forearm*pa0 + w.sq_l_forearm*pa2;
-    const Scalar t35 = -w.sq_l_forearm*pa0 + w.cq_l_forearm*pa2;
-    const Scalar t36 = w.cq_l_forearm*pa3 + w.sq_l_forearm*pa4;
-    const Scalar t37 = -w.sq_l_forearm*pa3 + w.cq_l_forearm*pa4;
-    const Scalar t38 = 0.955336489125606*t34 - 0.29552020666133966*t35;
-    const Scalar t39 = 0.29552020666133966*t34 + 0.955336489125606*t35;
-    w.IA_l_upper_arm[0] = 1.96 + t21;
-    w.IA_l_upper_arm[1] = t6;
-    w.IA_l_upper_arm[2] = t22;
-    w.IA_l_upper_arm[3] = t31;
-    w.IA_l_upper_arm[4] = -0.27815927999999995 - 0.3255*t21;
-    w.IA_l_upper_arm[5] = t26;
-    w.IA_l_upper_arm[6] = 1.96 + Ia4;
-    w.IA_l_upper_arm[7] = t23;
-    w.IA_l_upper_arm[8] = 0.27815927999999995 + t32;
-    w.IA_l_upper_arm[9] = -0.3255*t6;
-    w.IA_l_upper_arm[10] = t28;
-    w.IA_l_upper_arm[11] = 1.96 + t24;
-    w.IA_l_upper_arm[12] = t33;
-    w.IA_l_upper_arm[13] = -0.3255*t22;
-    w.IA_l_upper_arm[14] = t30;
-    w.IA_l_upper_arm[15] = 0.061007086312239986 + 0.955336489125606*t17 - 0.29552020666133966*t18 + 0.3255*t27 + 0.3255*t32;
-    w.IA_l_upper_arm[16] = -0.10595025000000001*t6 - 0.3255*t25;
-    w.IA_l_upper_arm[17] = 0.29552020666133966*t17 + 0.955336489125606*t18 + 0.3255*t28;
-    w.IA_l_upper_arm[18] = 0.061007086312239986 + 0.10595025000000001*t21;
-    w.IA_l_upper_arm[19] = -0.3255*t26;
-    w.IA_l_upper_arm[20] = 0.0019845 + 0.29552020666133966*t19 + 0.955336489125606*t20;
-    w.pA_l_upper_arm[0] = w.pA_l_upper_arm[0] + t38;
-    w.pA_l_upper_arm[1] = w.pA_l_upper_arm[1] + pa1;
-    w.pA_l_upper_arm[2] = w.pA_l_upper_arm[2] + t39;
-    w.pA_l_upper_arm[3] = w.pA_l_upper_arm[3] + 0.3255*pa1 + 0.955336489125606*t36 - 0.29552020666133966*t37;
-    w.pA_l_upper_arm[4] = w.pA_l_upper_arm[4] + tau[23] - 0.3255*t38;
-    w.pA_l_upper_arm[5] = w.pA_l_upper_arm[5] + 0.29552020666133966*t36 + 0.955336489125606*t37;
-  }
+  shared_7(shared_7_k0, &tau[23], &w.Dinv_l_forearm, w.IA_l_forearm, w.u_l_forearm, w.pA_l_forearm, w.c_l_forearm, w.cq_l_forearm, w.sq_l_forearm, w.IA_l_upper_arm, w.pA_l_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-  {
-    w.Dinv_l_upper_arm = 1.0 / w.IA_l_upper_arm[20];
-    w.u_l_upper_arm[0] = -w.pA_l_upper_arm[5] + tau[22];
-    const Scalar t0 = w.IA_l_upper_arm[5]*w.Dinv_l_upper_arm;
-    const Scalar t1 = w.IA_l_upper_arm[10]*w.Dinv_l_upper_arm;
-    const Scalar t2 = w.IA_l_upper_arm[14]*w.Dinv_l_upper_arm;
-    const Scalar t3 = w.IA_l_upper_arm[17]*w.Dinv_l_upper_arm;
-    const Scalar t4 = w.IA_l_upper_arm[19]*w.Dinv_l_upper_arm;
-    const Scalar Ia0 = w.IA_l_upper_arm[0] - w.IA_l_upper_arm[5]*t0;
-    const Scalar Ia1 = w.IA_l_upper_arm[1] - w.IA_l_upper_arm[10]*t0;
-    const Scalar Ia2 = w.IA_l_upper_arm[2] - w.IA_l_upper_arm[14]*t0;
-    const Scalar Ia3 = w.IA_l_upper_arm[3] - w.IA_l_upper_arm[17]*t0;
-    const Scalar Ia4 = w.IA_l_upper_arm[4] - w.IA_l_upper_arm[19]*t0;
-    const Scalar Ia5 = w.IA_l_upper_arm[6] - w.IA_l_upper_arm[10]*t1;
-    const Scalar Ia6 = w.IA_l_upper_arm[7] - w.IA_l_upper_arm[14]*t1;
-    const Scalar Ia7 = w.IA_l_upper_arm[8] - w.IA_l_upper_arm[17]*t1;
-    const Scalar Ia8 = w.IA_l_upper_arm[9] - w.IA_l_upper_arm[19]*t1;
-    const Scalar Ia9 = w.IA_l_upper_arm[11] - w.IA_l_upper_arm[14]*t2;
-    const Scalar Ia10 = w.IA_l_upper_arm[12] - w.IA_l_upper_arm[17]*t2;
-    const Scalar Ia11 = w.IA_l_upper_arm[13] - w.IA_l_upper_arm[19]*t2;
-    const Scalar Ia12 = w.IA_l_upper_arm[15] - w.IA_l_upper_arm[17]*t3;
-    const Scalar Ia13 = w.IA_l_upper_arm[16] - w.IA_l_upper_arm[19]*t3;
-    const Scalar Ia14 = w.IA_l_upper_arm[18] - w.IA_l_upper_arm[19]*t4;
-    const Scalar pa0 = w.pA_l_upper_arm[0] + w.u_l_upper_arm[0]*t0 + w.c_l_upper_arm[0]*Ia0 + w.c_l_upper_arm[1]*Ia1 + w.c_l_upper_arm[3]*Ia3 + w.c_l_upper_arm[4]*Ia4;
-    const Scalar pa1 = w.pA_l_upper_arm[1] + w.u_l_upper_arm[0]*t1 + w.c_l_upper_arm[0]*Ia1 + w.c_l_upper_arm[1]*Ia5 + w.c_l_upper_arm[3]*Ia7 + w.c_l_upper_arm[4]*Ia8;
-    const Scalar pa2 = w.pA_l_upper_arm[2] + w.u_l_upper_arm[0]*t2 + w.c_l_upper_arm[0]*Ia2 + w.c_l_upper_arm[1]*Ia6 + w.c_l_upper_arm[3]*Ia10 + w.c_l_upper_arm[4]*Ia11;
-    const Scalar pa3 = w.pA_l_upper_arm[3] + w.u_l_upper_arm[0]*t3 + w.c_l_upper_arm[0]*Ia3 + w.c_l_upper_arm[1]*Ia7 + w.c_l_upper_arm[3]*Ia12 + w.c_l_upper_arm[4]*Ia13;
-    const Scalar pa4 = w.pA_l_upper_arm[4] + w.u_l_upper_arm[0]*t4 + w.c_l_upper_arm[0]*Ia4 + w.c_l_upper_arm[1]*Ia8 + w.c_l_upper_arm[3]*Ia13 + w.c_l_upper_arm[4]*Ia14;
-    const Scalar C20 = w.cq_l_upper_arm*w.cq_l_upper_arm - w.sq_l_upper_arm*w.sq_l_upper_arm;
-    const Scalar h0 = 0.5*(Ia0 - Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_l_upper_arm*w.sq_l_upper_arm;
-    const Scalar d0 = C20*h0 - Ia1*t5;
-    const Scalar qq0 = h0*t5 + Ia1*C20;
-    const Scalar h1 = 0.5*(Ia3 - Ia8);
-    const Scalar m1 = 0.5*(Ia3 + Ia8);
-    const Scalar t6 = 0.5*(Ia4 + Ia7);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(Ia12 - Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    w.IA_l_shoulder_roll_link[0] = 0.3 + m0 + d0;
-    w.IA_l_shoulder_roll_link[1] = qq0;
-    w.IA_l_shoulder_roll_link[2] = w.cq_l_upper_arm*Ia2 - w.sq_l_upper_arm*Ia6;
-    w.IA_l_shoulder_roll_link[3] = m1 + d1;
-    w.IA_l_shoulder_roll_link[4] = -0.009 + 0.5*Ia4 - 0.5*Ia7 + qq1;
-    w.IA_l_shoulder_roll_link[6] = 0.3 + m0 - d0;
-    w.IA_l_shoulder_roll_link[7] = w.sq_l_upper_arm*Ia2 + w.cq_l_upper_arm*Ia6;
-    w.IA_l_shoulder_roll_link[8] = 0.009 - 0.5*Ia4 + 0.5*Ia7 + qq1;
-    w.IA_l_shoulder_roll_link[9] = m1 - d1;
-    w.IA_l_shoulder_roll_link[11] = 0.3 + Ia9;
-    w.IA_l_shoulder_roll_link[12] = w.cq_l_upper_arm*Ia10 - w.sq_l_upper_arm*Ia11;
-    w.IA_l_shoulder_roll_link[13] = w.sq_l_upper_arm*Ia10 + w.cq_l_upper_arm*Ia11;
-    w.IA_l_shoulder_roll_link[15] = 0.00046199999999999995 + m2 + d2;
-    w.IA_l_shoulder_roll_link[16] = qq2;
-    w.IA_l_shoulder_roll_link[18] = 0.00046199999999999995 + m2 - d2;
-    w.pA_l_shoulder_roll_link[0] = w.pA_l_shoulder_roll_link[0] + w.cq_l_upper_arm*pa0 - w.sq_l_upper_arm*pa1;
-    w.pA_l_shoulder_roll_link[1] = w.pA_l_shoulder_roll_link[1] + w.sq_l_upper_arm*pa0 + w.cq_l_upper_arm*pa1;
-    w.pA_l_shoulder_roll_link[2] = w.pA_l_shoulder_roll_link[2] + pa2;
-    w.pA_l_shoulder_roll_link[3] = w.pA_l_shoulder_roll_link[3] + w.cq_l_upper_arm*pa3 - w.sq_l_upper_arm*pa4;
-    w.pA_l_shoulder_roll_link[4] = w.pA_l_shoulder_roll_link[4] + w.sq_l_upper_arm*pa3 + w.cq_l_upper_arm*pa4;
-    w.pA_l_shoulder_roll_link[5] = w.pA_l_shoulder_roll_link[5] + tau[22];
-  }
+  shared_8(shared_8_k0, &tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, w.cq_l_upper_arm, w.sq_l_upper_arm, w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  {
-    w.Dinv_l_shoulder_roll_link = 1.0 / w.IA_l_shoulder_roll_link[15];
-    w.u_l_shoulder_roll_link[0] = -w.pA_l_shoulder_roll_link[3] + tau[21];
-    const Scalar t0 = w.IA_l_shoulder_roll_link[3]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t1 = w.IA_l_shoulder_roll_link[8]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t2 = w.IA_l_shoulder_roll_link[12]*w.Dinv_l_shoulder_roll_link;
-    const Scalar t3 = w.IA_l_shoulder_roll_link[16]*w.Dinv_l_shoulder_roll_link;
-    const Scalar Ia0 = w.IA_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_l_shoulder_roll_link[1] - w.IA_l_shoulder_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_l_shoulder_roll_link[2] - w.IA_l_shoulder_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_l_shoulder_roll_link[4] - w.IA_l_shoulder_roll_link[16]*t0;
-    const Scalar Ia4 = w.IA_l_shoulder_roll_link[6] - w.IA_l_shoulder_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_l_shoulder_roll_link[7] - w.IA_l_shoulder_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_l_shoulder_roll_link[9] - w.IA_l_shoulder_roll_link[16]*t1;
-    const Scalar Ia7 = w.IA_l_shoulder_roll_link[11] - w.IA_l_shoulder_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_l_shoulder_roll_link[13] - w.IA_l_shoulder_roll_link[16]*t2;
-    const Scalar Ia9 = w.IA_l_shoulder_roll_link[18] - w.IA_l_shoulder_roll_link[16]*t3;
-    const Scalar pa0 = w.pA_l_shoulder_roll_link[0] + w.u_l_shoulder_roll_link[0]*t0 + w.c_l_shoulder_roll_link[1]*Ia1 + w.c_l_shoulder_roll_link[2]*Ia2 + w.c_l_shoulder_roll_link[4]*Ia3;
-    const Scalar pa1 = w.pA_l_shoulder_roll_link[1] + w.u_l_shoulder_roll_link[0]*t1 + w.c_l_shoulder_roll_link[1]*Ia4 + w.c_l_shoulder_roll_link[2]*Ia5 + w.c_l_shoulder_roll_link[4]*Ia6;
-    const Scalar pa2 = w.pA_l_shoulder_roll_link[2] + w.u_l_shoulder_roll_link[0]*t2 + w.c_l_shoulder_roll_link[1]*Ia5 + w.c_l_shoulder_roll_link[2]*Ia7 + w.c_l_shoulder_roll_link[4]*Ia8;
-    const Scalar pa3 = w.pA_l_shoulder_roll_link[4] + w.u_l_shoulder_roll_link[0]*t3 + w.c_l_shoulder_roll_link[1]*Ia6 + w.c_l_shoulder_roll_link[2]*Ia8 + w.c_l_shoulder_roll_link[4]*Ia9;
-    const Scalar pa4 = 0.000192*w.c_l_shoulder_roll_link[5] + w.pA_l_shoulder_roll_link[5];
-    const Scalar C20 = w.cq_l_shoulder_roll_link*w.cq_l_shoulder_roll_link - w.sq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_l_shoulder_roll_link*w.sq_l_shoulder_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia8*t4);
-    const Scalar qq1 = 0.5*(Ia6*t4 + Ia8*C20);
-    const Scalar h1 = -9.6e-05 + 0.5*Ia9;
-    const Scalar m1 = 9.6e-05 + 0.5*Ia9;
-    w.IA_l_shoulder_pitch_link[0] = 0.3 + Ia0;
-    w.IA_l_shoulder_pitch_link[1] = w.cq_l_shoulder_roll_link*Ia1 - w.sq_l_shoulder_roll_link*Ia2;
-    w.IA_l_shoulder_pitch_link[2] = w.sq_l_shoulder_roll_link*Ia1 + w.cq_l_shoulder_roll_link*Ia2;
-    w.IA_l_shoulder_pitch_link[4] = w.cq_l_shoulder_roll_link*Ia3;
-    w.IA_l_shoulder_pitch_link[5] = -0.009 + w.sq_l_shoulder_roll_link*Ia3;
-    w.IA_l_shoulder_pitch_link[6] = 0.3 + m0 + d0;
-    w.IA_l_shoulder_pitch_link[7] = qq0;
-    w.IA_l_shoulder_pitch_link[9] = 0.5*Ia6 + d1;
-    w.IA_l_shoulder_pitch_link[10] = -0.5*Ia8 + qq1;
-    w.IA_l_shoulder_pitch_link[11] = 0.3 + m0 - d0;
-    w.IA_l_shoulder_pitch_link[13] = 0.5*Ia8 + qq1;
-    w.IA_l_shoulder_pitch_link[14] = 0.5*Ia6 - d1;
-    w.IA_l_shoulder_pitch_link[18] = 0.000192 + m1 + C20*h1;
-    w.IA_l_shoulder_pitch_link[19] = t4*h1;
-    w.IA_l_shoulder_pitch_link[20] = 0.00046199999999999995 + m1 - C20*h1;
-    w.pA_l_shoulder_pitch_link[0] = w.pA_l_shoulder_pitch_link[0] + pa0;
-    w.pA_l_shoulder_pitch_link[1] = w.pA_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*pa1 - w.sq_l_shoulder_roll_link*pa2;
-    w.pA_l_shoulder_pitch_link[2] = w.pA_l_shoulder_pitch_link[2] + w.sq_l_shoulder_roll_link*pa1 + w.cq_l_shoulder_roll_link*pa2;
-    w.pA_l_shoulder_pitch_link[3] = w.pA_l_shoulder_pitch_link[3] + tau[21];
-    w.pA_l_shoulder_pitch_link[4] = w.pA_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*pa3 - w.sq_l_shoulder_roll_link*pa4;
-    w.pA_l_shoulder_pitch_link[5] = w.pA_l_shoulder_pitch_link[5] + w.sq_l_shoulder_roll_link*pa3 + w.cq_l_shoulder_roll_link*pa4;
-  }
+  shared_9(shared_9_k0, &tau[21], &w.Dinv_l_shoulder_roll_link, w.IA_l_shoulder_roll_link, w.u_l_shoulder_roll_link, w.pA_l_shoulder_roll_link, &w.c_l_shoulder_roll_link[1], w.cq_l_shoulder_roll_link, w.sq_l_shoulder_roll_link, w.IA_l_shoulder_pitch_link, w.pA_l_shoulder_pitch_link);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1621,302 +3221,22 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
 
 PROXGEN_RT_NOINLINE void caba_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    w.Dinv_r_wrist_yaw_link = 1.0 / w.IA_r_wrist_yaw_link[20];
-    w.u_r_wrist_yaw_link[0] = -w.pA_r_wrist_yaw_link[5] + tau[33];
-    const Scalar t0 = w.IA_r_wrist_yaw_link[5]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t1 = w.IA_r_wrist_yaw_link[10]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t2 = w.IA_r_wrist_yaw_link[14]*w.Dinv_r_wrist_yaw_link;
-    const Scalar t3 = w.IA_r_wrist_yaw_link[17]*w.Dinv_r_wrist_yaw_link;
-    const Scalar Ia0 = w.IA_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t0;
-    const Scalar Ia1 = w.IA_r_wrist_yaw_link[1] - w.IA_r_wrist_yaw_link[10]*t0;
-    const Scalar Ia2 = w.IA_r_wrist_yaw_link[2] - w.IA_r_wrist_yaw_link[14]*t0;
-    const Scalar Ia3 = w.IA_r_wrist_yaw_link[3] - w.IA_r_wrist_yaw_link[17]*t0;
-    const Scalar Ia4 = w.IA_r_wrist_yaw_link[6] - w.IA_r_wrist_yaw_link[10]*t1;
-    const Scalar Ia5 = w.IA_r_wrist_yaw_link[7] - w.IA_r_wrist_yaw_link[14]*t1;
-    const Scalar Ia6 = w.IA_r_wrist_yaw_link[8] - w.IA_r_wrist_yaw_link[17]*t1;
-    const Scalar Ia7 = w.IA_r_wrist_yaw_link[11] - w.IA_r_wrist_yaw_link[14]*t2;
-    const Scalar Ia8 = w.IA_r_wrist_yaw_link[12] - w.IA_r_wrist_yaw_link[17]*t2;
-    const Scalar Ia9 = w.IA_r_wrist_yaw_link[15] - w.IA_r_wrist_yaw_link[17]*t3;
-    const Scalar pa0 = 0.001*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[0] + w.u_r_wrist_yaw_link[0]*t0 + w.c_r_wrist_yaw_link[0]*Ia0 + w.c_r_wrist_yaw_link[1]*Ia1 + w.c_r_wrist_yaw_link[3]*Ia3;
-    const Scalar pa1 = w.pA_r_wrist_yaw_link[1] + w.u_r_wrist_yaw_link[0]*t1 + w.c_r_wrist_yaw_link[0]*Ia1 + w.c_r_wrist_yaw_link[1]*Ia4 + w.c_r_wrist_yaw_link[3]*Ia6;
-    const Scalar pa2 = w.pA_r_wrist_yaw_link[2] + w.u_r_wrist_yaw_link[0]*t2 + w.c_r_wrist_yaw_link[0]*Ia2 + w.c_r_wrist_yaw_link[1]*Ia5 + w.c_r_wrist_yaw_link[3]*Ia8;
-    const Scalar pa3 = w.pA_r_wrist_yaw_link[3] + w.u_r_wrist_yaw_link[0]*t3 + w.c_r_wrist_yaw_link[0]*Ia3 + w.c_r_wrist_yaw_link[1]*Ia6 + w.c_r_wrist_yaw_link[3]*Ia9;
-    const Scalar pa4 = 0.001*w.c_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[4];
-    const Scalar C20 = w.cq_r_wrist_yaw_link*w.cq_r_wrist_yaw_link - w.sq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
-    const Scalar h0 = 0.5*(Ia0 - Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar t5 = 0.0005 + 0.5*Ia6;
-    const Scalar d1 = 0.5*Ia3*C20 - t4*t5;
-    const Scalar qq1 = 0.5*Ia3*t4 + C20*t5;
-    const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia9;
-    const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia9;
-    const Scalar t6 = m0 + d0;
-    const Scalar t7 = w.cq_r_wrist_yaw_link*Ia2 - w.sq_r_wrist_yaw_link*Ia5;
-    const Scalar t8 = m0 - d0;
-    const Scalar t9 = w.sq_r_wrist_yaw_link*Ia2 + w.cq_r_wrist_yaw_link*Ia5;
-    const Scalar t10 = 0.5*Ia3 + d1;
-    const Scalar t11 = 0.0005 - 0.5*Ia6 + qq1;
-    const Scalar t12 = -0.0005 + 0.5*Ia6 + qq1;
-    const Scalar t13 = 0.5*Ia3 - d1;
-    const Scalar t14 = 0.2555*qq0 + t10;
-    const Scalar t15 = -0.2555*t6 + t11;
-    const Scalar t16 = 0.2555*t8 + t12;
-    const Scalar t17 = -0.2555*qq0 + t13;
-    const Scalar t18 = w.cq_r_wrist_yaw_link*Ia8 + 0.2555*t9;
-    const Scalar t19 = w.sq_r_wrist_yaw_link*Ia8 - 0.2555*t7;
-    const Scalar t20 = w.cq_r_wrist_yaw_link*pa0 - w.sq_r_wrist_yaw_link*pa1;
-    const Scalar t21 = w.sq_r_wrist_yaw_link*pa0 + w.cq_r_wrist_yaw_link*pa1;
-    w.IA_r_forearm[0] = 0.92 + t6;
-    w.IA_r_forearm[1] = qq0;
-    w.IA_r_forearm[2] = t7;
-    w.IA_r_forearm[3] = t14;
-    w.IA_r_forearm[4] = -0.10107580000000001 + t15;
-    w.IA_r_forearm[6] = 0.92 + t8;
-    w.IA_r_forearm[7] = t9;
-    w.IA_r_forearm[8] = 0.10107580000000001 + t16;
-    w.IA_r_forearm[9] = t17;
-    w.IA_r_forearm[11] = 0.92 + Ia7;
-    w.IA_r_forearm[12] = t18;
-    w.IA_r_forearm[13] = t19;
-    w.IA_r_forearm[15] = 0.01661854208147 + m1 + C20*h1 + 0.2555*t12 + 0.2555*t16;
-    w.IA_r_forearm[16] = t4*h1 - 0.2555*t10 + 0.2555*t17;
-    w.IA_r_forearm[18] = 0.01661854208147 + m1 - C20*h1 - 0.2555*t11 - 0.2555*t15;
-    w.pA_r_forearm[0] = w.pA_r_forearm[0] + t20;
-    w.pA_r_forearm[1] = w.pA_r_forearm[1] + t21;
-    w.pA_r_forearm[2] = w.pA_r_forearm[2] + pa2;
-    w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa3 - w.sq_r_wrist_yaw_link*pa4 + 0.2555*t21;
-    w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa3 + w.cq_r_wrist_yaw_link*pa4 - 0.2555*t20;
-    w.pA_r_forearm[5] = w.pA_r_forearm[5] + tau[33];
-  }
+  shared_6(shared_6_k0, &tau[33], &w.Dinv_r_wrist_yaw_link, w.IA_r_wrist_yaw_link, w.u_r_wrist_yaw_link, w.pA_r_wrist_yaw_link, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.IA_r_forearm, w.pA_r_forearm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  {
-    w.Dinv_r_forearm = 1.0 / w.IA_r_forearm[18];
-    w.u_r_forearm[0] = -w.pA_r_forearm[4] + tau[32];
-    const Scalar t0 = w.IA_r_forearm[4]*w.Dinv_r_forearm;
-    const Scalar t1 = w.IA_r_forearm[9]*w.Dinv_r_forearm;
-    const Scalar t2 = w.IA_r_forearm[13]*w.Dinv_r_forearm;
-    const Scalar t3 = w.IA_r_forearm[16]*w.Dinv_r_forearm;
-    const Scalar Ia0 = w.IA_r_forearm[0] - w.IA_r_forearm[4]*t0;
-    const Scalar Ia1 = w.IA_r_forearm[1] - w.IA_r_forearm[9]*t0;
-    const Scalar Ia2 = w.IA_r_forearm[2] - w.IA_r_forearm[13]*t0;
-    const Scalar Ia3 = w.IA_r_forearm[3] - w.IA_r_forearm[16]*t0;
-    const Scalar Ia4 = w.IA_r_forearm[6] - w.IA_r_forearm[9]*t1;
-    const Scalar Ia5 = w.IA_r_forearm[7] - w.IA_r_forearm[13]*t1;
-    const Scalar Ia6 = w.IA_r_forearm[8] - w.IA_r_forearm[16]*t1;
-    const Scalar Ia7 = w.IA_r_forearm[11] - w.IA_r_forearm[13]*t2;
-    const Scalar Ia8 = w.IA_r_forearm[12] - w.IA_r_forearm[16]*t2;
-    const Scalar Ia9 = w.IA_r_forearm[15] - w.IA_r_forearm[16]*t3;
-    const Scalar pa0 = w.pA_r_forearm[0] + w.u_r_forearm[0]*t0 + w.c_r_forearm[0]*Ia0 + w.c_r_forearm[2]*Ia2 + w.c_r_forearm[3]*Ia3;
-    const Scalar pa1 = w.pA_r_forearm[1] + w.u_r_forearm[0]*t1 + w.c_r_forearm[0]*Ia1 + w.c_r_forearm[2]*Ia5 + w.c_r_forearm[3]*Ia6;
-    const Scalar pa2 = w.pA_r_forearm[2] + w.u_r_forearm[0]*t2 + w.c_r_forearm[0]*Ia2 + w.c_r_forearm[2]*Ia7 + w.c_r_forearm[3]*Ia8;
-    const Scalar pa3 = w.pA_r_forearm[3] + w.u_r_forearm[0]*t3 + w.c_r_forearm[0]*Ia3 + w.c_r_forearm[2]*Ia8 + w.c_r_forearm[3]*Ia9;
-    const Scalar pa4 = 0.0005635*w.c_r_forearm[5] + w.pA_r_forearm[5];
-    const Scalar C20 = w.cq_r_forearm*w.cq_r_forearm - w.sq_r_forearm*w.sq_r_forearm;
-    const Scalar h0 = 0.5*(-Ia0 + Ia7);
-    const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_forearm*w.sq_r_forearm;
-    const Scalar d0 = C20*h0 - Ia2*t4;
-    const Scalar qq0 = h0*t4 + Ia2*C20;
-    const Scalar d1 = 0.5*(-Ia3*C20 - Ia8*t4);
-    const Scalar qq1 = 0.5*(-Ia3*t4 + Ia8*C20);
-    const Scalar h1 = 0.00028175 - 0.5*Ia9;
-    const Scalar m1 = 0.00028175 + 0.5*Ia9;
-    const Scalar t5 = 0.955336489125606*m0 - 0.955336489125606*d0 - 0.29552020666133966*qq0;
-    const Scalar t6 = -0.29552020666133966*w.cq_r_forearm*Ia5 + 0.29552020666133966*w.sq_r_forearm*Ia1 + 0.955336489125606*w.sq_r_forearm*Ia5 + 0.955336489125606*w.cq_r_forearm*Ia1;
-    const Scalar t7 = -0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
-    const Scalar t8 = w.sq_r_forearm*Ia5 + w.cq_r_forearm*Ia1;
-    const Scalar t9 = w.cq_r_forearm*Ia5 - w.sq_r_forearm*Ia1;
-    const Scalar t10 = 0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
-    const Scalar t12 = 0.955336489125606*m0 + 0.955336489125606*d0 + 0.29552020666133966*qq0;
-    const Scalar t13 = 0.477668244562803*Ia3 - 0.14776010333066983*Ia8 - 0.955336489125606*d1 - 0.29552020666133966*qq1;
-    const Scalar t14 = -0.14776010333066983*Ia3 - 0.477668244562803*Ia8 - 0.29552020666133966*d1 + 0.955336489125606*qq1;
-    const Scalar t15 = 0.14776010333066983*Ia3 + 0.477668244562803*Ia8 - 0.29552020666133966*d1 + 0.955336489125606*qq1;
-    const Scalar t16 = 0.477668244562803*Ia3 - 0.14776010333066983*Ia8 + 0.955336489125606*d1 + 0.29552020666133966*qq1;
-    const Scalar t17 = 0.955336489125606*m1 - 0.955336489125606*C20*h1 - 0.29552020666133966*t4*h1;
-    const Scalar t18 = -0.29552020666133966*m1 - 0.29552020666133966*C20*h1 + 0.955336489125606*t4*h1;
-    const Scalar t19 = 0.29552020666133966*m1 - 0.29552020666133966*C20*h1 + 0.955336489125606*t4*h1;
-    const Scalar t20 = 0.955336489125606*m1 + 0.955336489125606*C20*h1 + 0.29552020666133966*t4*h1;
-    const Scalar t21 = 0.955336489125606*t5 - 0.29552020666133966*t7;
-    const Scalar t22 = 0.29552020666133966*t5 + 0.955336489125606*t7;
-    const Scalar t23 = 0.29552020666133966*t8 + 0.955336489125606*t9;
-    const Scalar t24 = 0.29552020666133966*t10 + 0.955336489125606*t12;
-    const Scalar t25 = 0.955336489125606*t13 - 0.29552020666133966*t14;
-    const Scalar t26 = 0.29552020666133966*t13 + 0.955336489125606*t14;
-    const Scalar t27 = 0.29552020666133966*w.sq_r_forearm*Ia6 + 0.955336489125606*w.cq_r_forearm*Ia6;
-    const Scalar t28 = -0.955336489125606*w.sq_r_forearm*Ia6 + 0.29552020666133966*w.cq_r_forearm*Ia6;
-    const Scalar t29 = 0.955336489125606*t15 - 0.29552020666133966*t16;
-    const Scalar t30 = 0.29552020666133966*t15 + 0.955336489125606*t16;
-    const Scalar t31 = 0.3255*t6 + t25;
-    const Scalar t32 = 0.3255*Ia4 + t27;
-    const Scalar t33 = 0.3255*t23 + t29;
-    const Scalar t34 = w.cq_r_forearm*pa0 + w.sq_r_forearm*pa2;
-    const Scalar t35 = -w.sq_r_forearm*pa0 + w.cq_r_forearm*pa2;
-    const Scalar t36 = w.cq_r_forearm*pa3 + w.sq_r_forearm*pa4;
-    const Scalar t37 = -w.sq_r_forearm*pa3 + w.cq_r_forearm*pa4;
-    const Scalar t38 = 0.955336489125606*t34 - 0.29552020666133966*t35;
-    const Scalar t39 = 0.29552020666133966*t34 + 0.955336489125606*t35;
-    w.IA_r_upper_arm[0] = 1.96 + t21;
-    w.IA_r_upper_arm[1] = t6;
-    w.IA_r_upper_arm[2] = t22;
-    w.IA_r_upper_arm[3] = t31;
-    w.IA_r_upper_arm[4] = -0.27815927999999995 - 0.3255*t21;
-    w.IA_r_upper_arm[5] = t26;
-    w.IA_r_upper_arm[6] = 1.96 + Ia4;
-    w.IA_r_upper_arm[7] = t23;
-    w.IA_r_upper_arm[8] = 0.27815927999999995 + t32;
-    w.IA_r_upper_arm[9] = -0.3255*t6;
-    w.IA_r_upper_arm[10] = t28;
-    w.IA_r_upper_arm[11] = 1.96 + t24;
-    w.IA_r_upper_arm[12] = t33;
-    w.IA_r_upper_arm[13] = -0.3255*t22;
-    w.IA_r_upper_arm[14] = t30;
-    w.IA_r_upper_arm[15] = 0.061007086312239986 + 0.955336489125606*t17 - 0.29552020666133966*t18 + 0.3255*t27 + 0.3255*t32;
-    w.IA_r_upper_arm[16] = -0.10595025000000001*t6 - 0.3255*t25;
-    w.IA_r_upper_arm[17] = 0.29552020666133966*t17 + 0.955336489125606*t18 + 0.3255*t28;
-    w.IA_r_upper_arm[18] = 0.061007086312239986 + 0.10595025000000001*t21;
-    w.IA_r_upper_arm[19] = -0.3255*t26;
-    w.IA_r_upper_arm[20] = 0.0019845 + 0.29552020666133966*t19 + 0.955336489125606*t20;
-    w.pA_r_upper_arm[0] = w.pA_r_upper_arm[0] + t38;
-    w.pA_r_upper_arm[1] = w.pA_r_upper_arm[1] + pa1;
-    w.pA_r_upper_arm[2] = w.pA_r_upper_arm[2] + t39;
-    w.pA_r_upper_arm[3] = w.pA_r_upper_arm[3] + 0.3255*pa1 + 0.955336489125606*t36 - 0.29552020666133966*t37;
-    w.pA_r_upper_arm[4] = w.pA_r_upper_arm[4] + tau[32] - 0.3255*t38;
-    w.pA_r_upper_arm[5] = w.pA_r_upper_arm[5] + 0.29552020666133966*t36 + 0.955336489125606*t37;
-  }
+  shared_7(shared_7_k0, &tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.IA_r_upper_arm, w.pA_r_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  {
-    w.Dinv_r_upper_arm = 1.0 / w.IA_r_upper_arm[20];
-    w.u_r_upper_arm[0] = -w.pA_r_upper_arm[5] + tau[31];
-    const Scalar t0 = w.IA_r_upper_arm[5]*w.Dinv_r_upper_arm;
-    const Scalar t1 = w.IA_r_upper_arm[10]*w.Dinv_r_upper_arm;
-    const Scalar t2 = w.IA_r_upper_arm[14]*w.Dinv_r_upper_arm;
-    const Scalar t3 = w.IA_r_upper_arm[17]*w.Dinv_r_upper_arm;
-    const Scalar t4 = w.IA_r_upper_arm[19]*w.Dinv_r_upper_arm;
-    const Scalar Ia0 = w.IA_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0;
-    const Scalar Ia1 = w.IA_r_upper_arm[1] - w.IA_r_upper_arm[10]*t0;
-    const Scalar Ia2 = w.IA_r_upper_arm[2] - w.IA_r_upper_arm[14]*t0;
-    const Scalar Ia3 = w.IA_r_upper_arm[3] - w.IA_r_upper_arm[17]*t0;
-    const Scalar Ia4 = w.IA_r_upper_arm[4] - w.IA_r_upper_arm[19]*t0;
-    const Scalar Ia5 = w.IA_r_upper_arm[6] - w.IA_r_upper_arm[10]*t1;
-    const Scalar Ia6 = w.IA_r_upper_arm[7] - w.IA_r_upper_arm[14]*t1;
-    const Scalar Ia7 = w.IA_r_upper_arm[8] - w.IA_r_upper_arm[17]*t1;
-    const Scalar Ia8 = w.IA_r_upper_arm[9] - w.IA_r_upper_arm[19]*t1;
-    const Scalar Ia9 = w.IA_r_upper_arm[11] - w.IA_r_upper_arm[14]*t2;
-    const Scalar Ia10 = w.IA_r_upper_arm[12] - w.IA_r_upper_arm[17]*t2;
-    const Scalar Ia11 = w.IA_r_upper_arm[13] - w.IA_r_upper_arm[19]*t2;
-    const Scalar Ia12 = w.IA_r_upper_arm[15] - w.IA_r_upper_arm[17]*t3;
-    const Scalar Ia13 = w.IA_r_upper_arm[16] - w.IA_r_upper_arm[19]*t3;
-    const Scalar Ia14 = w.IA_r_upper_arm[18] - w.IA_r_upper_arm[19]*t4;
-    const Scalar pa0 = w.pA_r_upper_arm[0] + w.u_r_upper_arm[0]*t0 + w.c_r_upper_arm[0]*Ia0 + w.c_r_upper_arm[1]*Ia1 + w.c_r_upper_arm[3]*Ia3 + w.c_r_upper_arm[4]*Ia4;
-    const Scalar pa1 = w.pA_r_upper_arm[1] + w.u_r_upper_arm[0]*t1 + w.c_r_upper_arm[0]*Ia1 + w.c_r_upper_arm[1]*Ia5 + w.c_r_upper_arm[3]*Ia7 + w.c_r_upper_arm[4]*Ia8;
-    const Scalar pa2 = w.pA_r_upper_arm[2] + w.u_r_upper_arm[0]*t2 + w.c_r_upper_arm[0]*Ia2 + w.c_r_upper_arm[1]*Ia6 + w.c_r_upper_arm[3]*Ia10 + w.c_r_upper_arm[4]*Ia11;
-    const Scalar pa3 = w.pA_r_upper_arm[3] + w.u_r_upper_arm[0]*t3 + w.c_r_upper_arm[0]*Ia3 + w.c_r_upper_arm[1]*Ia7 + w.c_r_upper_arm[3]*Ia12 + w.c_r_upper_arm[4]*Ia13;
-    const Scalar pa4 = w.pA_r_upper_arm[4] + w.u_r_upper_arm[0]*t4 + w.c_r_upper_arm[0]*Ia4 + w.c_r_upper_arm[1]*Ia8 + w.c_r_upper_arm[3]*Ia13 + w.c_r_upper_arm[4]*Ia14;
-    const Scalar C20 = w.cq_r_upper_arm*w.cq_r_upper_arm - w.sq_r_upper_arm*w.sq_r_upper_arm;
-    const Scalar h0 = 0.5*(Ia0 - Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_r_upper_arm*w.sq_r_upper_arm;
-    const Scalar d0 = C20*h0 - Ia1*t5;
-    const Scalar qq0 = h0*t5 + Ia1*C20;
-    const Scalar h1 = 0.5*(Ia3 - Ia8);
-    const Scalar m1 = 0.5*(Ia3 + Ia8);
-    const Scalar t6 = 0.5*(Ia4 + Ia7);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(Ia12 - Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    w.IA_r_shoulder_roll_link[0] = 0.3 + m0 + d0;
-    w.IA_r_shoulder_roll_link[1] = qq0;
-    w.IA_r_shoulder_roll_link[2] = w.cq_r_upper_arm*Ia2 - w.sq_r_upper_arm*Ia6;
-    w.IA_r_shoulder_roll_link[3] = m1 + d1;
-    w.IA_r_shoulder_roll_link[4] = -0.009 + 0.5*Ia4 - 0.5*Ia7 + qq1;
-    w.IA_r_shoulder_roll_link[6] = 0.3 + m0 - d0;
-    w.IA_r_shoulder_roll_link[7] = w.sq_r_upper_arm*Ia2 + w.cq_r_upper_arm*Ia6;
-    w.IA_r_shoulder_roll_link[8] = 0.009 - 0.5*Ia4 + 0.5*Ia7 + qq1;
-    w.IA_r_shoulder_roll_link[9] = m1 - d1;
-    w.IA_r_shoulder_roll_link[11] = 0.3 + Ia9;
-    w.IA_r_shoulder_roll_link[12] = w.cq_r_upper_arm*Ia10 - w.sq_r_upper_arm*Ia11;
-    w.IA_r_shoulder_roll_link[13] = w.sq_r_upper_arm*Ia10 + w.cq_r_upper_arm*Ia11;
-    w.IA_r_shoulder_roll_link[15] = 0.00046199999999999995 + m2 + d2;
-    w.IA_r_shoulder_roll_link[16] = qq2;
-    w.IA_r_shoulder_roll_link[18] = 0.00046199999999999995 + m2 - d2;
-    w.pA_r_shoulder_roll_link[0] = w.pA_r_shoulder_roll_link[0] + w.cq_r_upper_arm*pa0 - w.sq_r_upper_arm*pa1;
-    w.pA_r_shoulder_roll_link[1] = w.pA_r_shoulder_roll_link[1] + w.sq_r_upper_arm*pa0 + w.cq_r_upper_arm*pa1;
-    w.pA_r_shoulder_roll_link[2] = w.pA_r_shoulder_roll_link[2] + pa2;
-    w.pA_r_shoulder_roll_link[3] = w.pA_r_shoulder_roll_link[3] + w.cq_r_upper_arm*pa3 - w.sq_r_upper_arm*pa4;
-    w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
-    w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + tau[31];
-  }
+  shared_8(shared_8_k0, &tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, w.cq_r_upper_arm, w.sq_r_upper_arm, w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    w.Dinv_r_shoulder_roll_link = 1.0 / w.IA_r_shoulder_roll_link[15];
-    w.u_r_shoulder_roll_link[0] = -w.pA_r_shoulder_roll_link[3] + tau[30];
-    const Scalar t0 = w.IA_r_shoulder_roll_link[3]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t1 = w.IA_r_shoulder_roll_link[8]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t2 = w.IA_r_shoulder_roll_link[12]*w.Dinv_r_shoulder_roll_link;
-    const Scalar t3 = w.IA_r_shoulder_roll_link[16]*w.Dinv_r_shoulder_roll_link;
-    const Scalar Ia0 = w.IA_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_r_shoulder_roll_link[1] - w.IA_r_shoulder_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_r_shoulder_roll_link[2] - w.IA_r_shoulder_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_r_shoulder_roll_link[4] - w.IA_r_shoulder_roll_link[16]*t0;
-    const Scalar Ia4 = w.IA_r_shoulder_roll_link[6] - w.IA_r_shoulder_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_r_shoulder_roll_link[7] - w.IA_r_shoulder_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_r_shoulder_roll_link[9] - w.IA_r_shoulder_roll_link[16]*t1;
-    const Scalar Ia7 = w.IA_r_shoulder_roll_link[11] - w.IA_r_shoulder_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_r_shoulder_roll_link[13] - w.IA_r_shoulder_roll_link[16]*t2;
-    const Scalar Ia9 = w.IA_r_shoulder_roll_link[18] - w.IA_r_shoulder_roll_link[16]*t3;
-    const Scalar pa0 = w.pA_r_shoulder_roll_link[0] + w.u_r_shoulder_roll_link[0]*t0 + w.c_r_shoulder_roll_link[1]*Ia1 + w.c_r_shoulder_roll_link[2]*Ia2 + w.c_r_shoulder_roll_link[4]*Ia3;
-    const Scalar pa1 = w.pA_r_shoulder_roll_link[1] + w.u_r_shoulder_roll_link[0]*t1 + w.c_r_shoulder_roll_link[1]*Ia4 + w.c_r_shoulder_roll_link[2]*Ia5 + w.c_r_shoulder_roll_link[4]*Ia6;
-    const Scalar pa2 = w.pA_r_shoulder_roll_link[2] + w.u_r_shoulder_roll_link[0]*t2 + w.c_r_shoulder_roll_link[1]*Ia5 + w.c_r_shoulder_roll_link[2]*Ia7 + w.c_r_shoulder_roll_link[4]*Ia8;
-    const Scalar pa3 = w.pA_r_shoulder_roll_link[4] + w.u_r_shoulder_roll_link[0]*t3 + w.c_r_shoulder_roll_link[1]*Ia6 + w.c_r_shoulder_roll_link[2]*Ia8 + w.c_r_shoulder_roll_link[4]*Ia9;
-    const Scalar pa4 = 0.000192*w.c_r_shoulder_roll_link[5] + w.pA_r_shoulder_roll_link[5];
-    const Scalar C20 = w.cq_r_shoulder_roll_link*w.cq_r_shoulder_roll_link - w.sq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia8*t4);
-    const Scalar qq1 = 0.5*(Ia6*t4 + Ia8*C20);
-    const Scalar h1 = -9.6e-05 + 0.5*Ia9;
-    const Scalar m1 = 9.6e-05 + 0.5*Ia9;
-    w.IA_r_shoulder_pitch_link[0] = 0.3 + Ia0;
-    w.IA_r_shoulder_pitch_link[1] = w.cq_r_shoulder_roll_link*Ia1 - w.sq_r_shoulder_roll_link*Ia2;
-    w.IA_r_shoulder_pitch_link[2] = w.sq_r_shoulder_roll_link*Ia1 + w.cq_r_shoulder_roll_link*Ia2;
-    w.IA_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*Ia3;
-    w.IA_r_shoulder_pitch_link[5] = 0.009 + w.sq_r_shoulder_roll_link*Ia3;
-    w.IA_r_shoulder_pitch_link[6] = 0.3 + m0 + d0;
-    w.IA_r_shoulder_pitch_link[7] = qq0;
-    w.IA_r_shoulder_pitch_link[9] = 0.5*Ia6 + d1;
-    w.IA_r_shoulder_pitch_link[10] = -0.5*Ia8 + qq1;
-    w.IA_r_shoulder_pitch_link[11] = 0.3 + m0 - d0;
-    w.IA_r_shoulder_pitch_link[13] = 0.5*Ia8 + qq1;
-    w.IA_r_shoulder_pitch_link[14] = 0.5*Ia6 - d1;
-    w.IA_r_shoulder_pitch_link[18] = 0.000192 + m1 + C20*h1;
-    w.IA_r_shoulder_pitch_link[19] = t4*h1;
-    w.IA_r_shoulder_pitch_link[20] = 0.00046199999999999995 + m1 - C20*h1;
-    w.pA_r_shoulder_pitch_link[0] = w.pA_r_shoulder_pitch_link[0] + pa0;
-    w.pA_r_shoulder_pitch_link[1] = w.pA_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*pa1 - w.sq_r_shoulder_roll_link*pa2;
-    w.pA_r_shoulder_pitch_link[2] = w.pA_r_shoulder_pitch_link[2] + w.sq_r_shoulder_roll_link*pa1 + w.cq_r_shoulder_roll_link*pa2;
-    w.pA_r_shoulder_pitch_link[3] = w.pA_r_shoulder_pitch_link[3] + tau[30];
-    w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa3 - w.sq_r_shoulder_roll_link*pa4;
-    w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa3 + w.cq_r_shoulder_roll_link*pa4;
-  }
+  shared_9(shared_9_k1, &tau[30], &w.Dinv_r_shoulder_roll_link, w.IA_r_shoulder_roll_link, w.u_r_shoulder_roll_link, w.pA_r_shoulder_roll_link, &w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.sq_r_shoulder_roll_link, w.IA_r_shoulder_pitch_link, w.pA_r_shoulder_pitch_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2211,408 +3531,27 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
 
 PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar mu_c0 = mu*w.active[1];
-    w.U_r_foot[1] = 0.027912499999999996 + 0.06825*mu_c0;
-    w.U_r_foot[3] = 0.00194517348958 + 1.0046580625*mu_c0;
-    w.Dinv_r_foot = 1.0 / w.U_r_foot[3];
-    w.u_r_foot[0] = -w.pA_r_foot[3] - 0.06825*w.lambda[7] - w.lambda[9] - 0.06825*w.g_r_foot[1]*mu_c0 + tau[17];
-    const Scalar t0 = w.U_r_foot[1]*w.Dinv_r_foot;
-    const Scalar Ia0 = 1.015 + mu_c0;
-    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu_c0;
-    const Scalar Ia2 = 1.015 + mu_c0 - w.U_r_foot[1]*t0;
-    const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_r_foot[1]*w.Dinv_r_foot;
-    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu_c0;
-    const Scalar Ia5 = 0.00860228295937 + mu_c0 - 3.1912249599999995e-06*w.Dinv_r_foot;
-    const Scalar pa0 = w.pA_r_foot[0] + w.lambda[6] + w.g_r_ankle_link[0]*mu_c0 + w.c_r_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_r_foot[1] + w.lambda[7] + w.g_r_foot[1]*mu_c0 + w.u_r_foot[0]*t0 + w.c_r_foot[1]*Ia2 + w.c_r_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2] + w.lambda[8] + w.g_r_foot[2]*mu_c0 + w.c_r_foot[2]*Ia0;
-    const Scalar pa3 = -0.06495999999999999*w.c_r_foot[2] + w.pA_r_foot[4] - 0.06825*w.lambda[6] + w.lambda[10] - 0.06825*w.g_r_ankle_link[0]*mu_c0 + w.c_r_foot[4]*Ia4;
-    const Scalar pa4 = w.pA_r_foot[5] + w.lambda[11] + 0.0017863999999999998*w.Dinv_r_foot*w.u_r_foot[0] + w.c_r_foot[1]*Ia3 + w.c_r_foot[5]*Ia5;
-    const Scalar C20 = w.cq_r_foot*w.cq_r_foot - w.sq_r_foot*w.sq_r_foot;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t1 = 2.0*w.cq_r_foot*w.sq_r_foot;
-    const Scalar t2 = -0.032479999999999995 + 0.5*Ia3;
-    const Scalar h1 = 0.5*(Ia4 - Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    w.IA_r_ankle_link[0] = 0.2 + Ia0;
-    w.IA_r_ankle_link[4] = w.cq_r_foot*Ia1;
-    w.IA_r_ankle_link[5] = w.sq_r_foot*Ia1;
-    w.IA_r_ankle_link[6] = 0.2 + m0 + C20*h0;
-    w.IA_r_ankle_link[7] = h0*t1;
-    w.IA_r_ankle_link[9] = -t1*t2;
-    w.IA_r_ankle_link[10] = 0.032479999999999995 + 0.5*Ia3 + C20*t2;
-    w.IA_r_ankle_link[11] = 0.2 + m0 - C20*h0;
-    w.IA_r_ankle_link[13] = -0.032479999999999995 - 0.5*Ia3 + C20*t2;
-    w.IA_r_ankle_link[14] = t1*t2;
-    w.IA_r_ankle_link[18] = 7.2e-05 + m1 + C20*h1;
-    w.IA_r_ankle_link[19] = t1*h1;
-    w.IA_r_ankle_link[20] = 7.2e-05 + m1 - C20*h1;
-    w.pA_r_ankle_link[0] = w.pA_r_ankle_link[0] + pa0;
-    w.pA_r_ankle_link[1] = w.pA_r_ankle_link[1] + w.cq_r_foot*pa1 - w.sq_r_foot*pa2;
-    w.pA_r_ankle_link[2] = w.pA_r_ankle_link[2] + w.sq_r_foot*pa1 + w.cq_r_foot*pa2;
-    w.pA_r_ankle_link[3] = tau[17];
-    w.pA_r_ankle_link[4] = w.cq_r_foot*pa3 - w.sq_r_foot*pa4;
-    w.pA_r_ankle_link[5] = w.sq_r_foot*pa3 + w.cq_r_foot*pa4;
-  }
+  shared_10(shared_10_k0, &tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, w.IA_r_ankle_link, w.pA_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
-    w.u_r_ankle_link[0] = -w.pA_r_ankle_link[4] + tau[16];
-    const Scalar t0 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
-    const Scalar t1 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
-    const Scalar t2 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
-    const Scalar t3 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
-    const Scalar Ia0 = w.IA_r_ankle_link[0] - w.IA_r_ankle_link[4]*t0;
-    const Scalar Ia1 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t0;
-    const Scalar Ia2 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t1;
-    const Scalar Ia3 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t1;
-    const Scalar Ia4 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t1;
-    const Scalar Ia5 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t2;
-    const Scalar Ia6 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t2;
-    const Scalar Ia7 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t3;
-    const Scalar t4 = -w.IA_r_ankle_link[13]*t0;
-    const Scalar t5 = -w.IA_r_ankle_link[9]*t0;
-    const Scalar pa0 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t0 + w.c_r_ankle_link[0]*Ia0 + w.c_r_ankle_link[2]*t4 + w.c_r_ankle_link[5]*Ia1;
-    const Scalar pa1 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t1 + w.c_r_ankle_link[0]*t5 + w.c_r_ankle_link[2]*Ia3 + w.c_r_ankle_link[5]*Ia4;
-    const Scalar pa2 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t2 + w.c_r_ankle_link[0]*t4 + w.c_r_ankle_link[2]*Ia5 + w.c_r_ankle_link[5]*Ia6;
-    const Scalar pa3 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
-    const Scalar pa4 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t3 + w.c_r_ankle_link[0]*Ia1 + w.c_r_ankle_link[2]*Ia6 + w.c_r_ankle_link[5]*Ia7;
-    const Scalar C20 = w.cq_r_ankle_link*w.cq_r_ankle_link - w.sq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar h0 = 0.5*(-Ia0 + Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t6 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar d0 = C20*h0 - t4*t6;
-    const Scalar qq0 = h0*t6 + t4*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia1*t6);
-    const Scalar qq1 = 0.5*(Ia6*t6 + Ia1*C20);
-    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
-    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_r_ankle_link*Ia3 + 0.09983341664682815*w.sq_r_ankle_link*t5 + 0.9950041652780258*w.sq_r_ankle_link*Ia3 + 0.9950041652780258*w.cq_r_ankle_link*t5;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_r_ankle_link*Ia3 + w.cq_r_ankle_link*t5;
-    const Scalar t11 = w.cq_r_ankle_link*Ia3 - w.sq_r_ankle_link*t5;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t18 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t19 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t6*h1;
-    const Scalar t20 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t21 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t22 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t6*h1;
-    const Scalar t23 = 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    const Scalar t24 = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    const Scalar t25 = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    const Scalar t26 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t27 = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    const Scalar t28 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t29 = -0.09983341664682815*w.cq_r_ankle_link*Ia4 + 0.9950041652780258*w.sq_r_ankle_link*Ia4;
-    const Scalar t30 = 0.9950041652780258*w.cq_r_ankle_link*Ia4 + 0.09983341664682815*w.sq_r_ankle_link*Ia4;
-    const Scalar t31 = 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    const Scalar t32 = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    const Scalar t33 = 0.4305*t8 + t27;
-    const Scalar t34 = 0.4305*Ia2 + t29;
-    const Scalar t35 = 0.4305*t25 + t31;
-    const Scalar t36 = w.cq_r_ankle_link*pa0 + w.sq_r_ankle_link*pa2;
-    const Scalar t37 = -w.sq_r_ankle_link*pa0 + w.cq_r_ankle_link*pa2;
-    const Scalar t38 = w.cq_r_ankle_link*pa3 + w.sq_r_ankle_link*pa4;
-    const Scalar t39 = -w.sq_r_ankle_link*pa3 + w.cq_r_ankle_link*pa4;
-    const Scalar t40 = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-    const Scalar t41 = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    w.IA_r_shank[0] = 3.055 + t23;
-    w.IA_r_shank[1] = t8;
-    w.IA_r_shank[2] = t24;
-    w.IA_r_shank[3] = t33;
-    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t23;
-    w.IA_r_shank[5] = t28;
-    w.IA_r_shank[6] = 3.055 + Ia2;
-    w.IA_r_shank[7] = t25;
-    w.IA_r_shank[8] = 0.5694718575000001 + t34;
-    w.IA_r_shank[9] = -0.4305*t8;
-    w.IA_r_shank[10] = t30;
-    w.IA_r_shank[11] = 3.055 + t26;
-    w.IA_r_shank[12] = t35;
-    w.IA_r_shank[13] = -0.4305*t24;
-    w.IA_r_shank[14] = t32;
-    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t19 - 0.09983341664682815*t20 + 0.4305*t29 + 0.4305*t34;
-    w.IA_r_shank[16] = -0.18533025*t8 - 0.4305*t27;
-    w.IA_r_shank[17] = 0.09983341664682815*t19 + 0.9950041652780258*t20 + 0.4305*t30;
-    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t23;
-    w.IA_r_shank[19] = -0.4305*t28;
-    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.pA_r_shank[0] = w.pA_r_shank[0] + t40;
-    w.pA_r_shank[1] = w.pA_r_shank[1] + pa1;
-    w.pA_r_shank[2] = w.pA_r_shank[2] + t41;
-    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa1 + 0.9950041652780258*t38 - 0.09983341664682815*t39;
-    w.pA_r_shank[4] = w.pA_r_shank[4] + tau[16] - 0.4305*t40;
-    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t38 + 0.9950041652780258*t39;
-  }
+  shared_11(shared_11_k0, &tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
-    w.u_r_shank[0] = -w.pA_r_shank[4] + tau[15];
-    const Scalar t0 = w.IA_r_shank[4]*w.Dinv_r_shank;
-    const Scalar t1 = w.IA_r_shank[9]*w.Dinv_r_shank;
-    const Scalar t2 = w.IA_r_shank[13]*w.Dinv_r_shank;
-    const Scalar t3 = w.IA_r_shank[16]*w.Dinv_r_shank;
-    const Scalar t4 = w.IA_r_shank[19]*w.Dinv_r_shank;
-    const Scalar Ia0 = w.IA_r_shank[0] - w.IA_r_shank[4]*t0;
-    const Scalar Ia1 = w.IA_r_shank[1] - w.IA_r_shank[9]*t0;
-    const Scalar Ia2 = w.IA_r_shank[2] - w.IA_r_shank[13]*t0;
-    const Scalar Ia3 = w.IA_r_shank[3] - w.IA_r_shank[16]*t0;
-    const Scalar Ia4 = w.IA_r_shank[5] - w.IA_r_shank[19]*t0;
-    const Scalar Ia5 = w.IA_r_shank[6] - w.IA_r_shank[9]*t1;
-    const Scalar Ia6 = w.IA_r_shank[7] - w.IA_r_shank[13]*t1;
-    const Scalar Ia7 = w.IA_r_shank[8] - w.IA_r_shank[16]*t1;
-    const Scalar Ia8 = w.IA_r_shank[10] - w.IA_r_shank[19]*t1;
-    const Scalar Ia9 = w.IA_r_shank[11] - w.IA_r_shank[13]*t2;
-    const Scalar Ia10 = w.IA_r_shank[12] - w.IA_r_shank[16]*t2;
-    const Scalar Ia11 = w.IA_r_shank[14] - w.IA_r_shank[19]*t2;
-    const Scalar Ia12 = w.IA_r_shank[15] - w.IA_r_shank[16]*t3;
-    const Scalar Ia13 = w.IA_r_shank[17] - w.IA_r_shank[19]*t3;
-    const Scalar Ia14 = w.IA_r_shank[20] - w.IA_r_shank[19]*t4;
-    const Scalar pa0 = w.pA_r_shank[0] + w.u_r_shank[0]*t0 + w.c_r_shank[0]*Ia0 + w.c_r_shank[2]*Ia2 + w.c_r_shank[3]*Ia3 + w.c_r_shank[5]*Ia4;
-    const Scalar pa1 = w.pA_r_shank[1] + w.u_r_shank[0]*t1 + w.c_r_shank[0]*Ia1 + w.c_r_shank[2]*Ia6 + w.c_r_shank[3]*Ia7 + w.c_r_shank[5]*Ia8;
-    const Scalar pa2 = w.pA_r_shank[2] + w.u_r_shank[0]*t2 + w.c_r_shank[0]*Ia2 + w.c_r_shank[2]*Ia9 + w.c_r_shank[3]*Ia10 + w.c_r_shank[5]*Ia11;
-    const Scalar pa3 = w.pA_r_shank[3] + w.u_r_shank[0]*t3 + w.c_r_shank[0]*Ia3 + w.c_r_shank[2]*Ia10 + w.c_r_shank[3]*Ia12 + w.c_r_shank[5]*Ia13;
-    const Scalar pa4 = w.pA_r_shank[5] + w.u_r_shank[0]*t4 + w.c_r_shank[0]*Ia4 + w.c_r_shank[2]*Ia11 + w.c_r_shank[3]*Ia13 + w.c_r_shank[5]*Ia14;
-    const Scalar C20 = w.cq_r_shank*w.cq_r_shank - w.sq_r_shank*w.sq_r_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_r_shank*w.sq_r_shank;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9800665778412416*m0 - 0.9800665778412416*d0 + 0.19866933079506124*qq0;
-    const Scalar t8 = 0.19866933079506124*w.cq_r_shank*Ia6 - 0.19866933079506124*w.sq_r_shank*Ia1 + 0.9800665778412416*w.sq_r_shank*Ia6 + 0.9800665778412416*w.cq_r_shank*Ia1;
-    const Scalar t9 = 0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t10 = w.sq_r_shank*Ia6 + w.cq_r_shank*Ia1;
-    const Scalar t11 = w.cq_r_shank*Ia6 - w.sq_r_shank*Ia1;
-    const Scalar t12 = -0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t14 = 0.9800665778412416*m0 + 0.9800665778412416*d0 - 0.19866933079506124*qq0;
-    const Scalar t15 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 - 0.9800665778412416*d1 + 0.19866933079506124*qq1;
-    const Scalar t16 = 0.4900332889206208*Ia4 - 0.4900332889206208*Ia10 + 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t17 = w.sq_r_shank*Ia8 + w.cq_r_shank*Ia7;
-    const Scalar t18 = w.cq_r_shank*Ia8 - w.sq_r_shank*Ia7;
-    const Scalar t19 = -0.4900332889206208*Ia4 + 0.4900332889206208*Ia10 - 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t20 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 + 0.9800665778412416*d1 - 0.19866933079506124*qq1;
-    const Scalar t21 = 0.9800665778412416*m2 - 0.9800665778412416*d2 + 0.19866933079506124*qq2;
-    const Scalar t22 = 0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t23 = -0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t24 = 0.9800665778412416*m2 + 0.9800665778412416*d2 - 0.19866933079506124*qq2;
-    const Scalar t25 = 0.9800665778412416*t7 + 0.19866933079506124*t9;
-    const Scalar t26 = -0.19866933079506124*t7 + 0.9800665778412416*t9;
-    const Scalar t27 = -0.19866933079506124*t10 + 0.9800665778412416*t11;
-    const Scalar t28 = -0.19866933079506124*t12 + 0.9800665778412416*t14;
-    const Scalar t29 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
-    const Scalar t30 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
-    const Scalar t31 = 0.9800665778412416*t17 + 0.19866933079506124*t18;
-    const Scalar t32 = -0.19866933079506124*t17 + 0.9800665778412416*t18;
-    const Scalar t33 = 0.9800665778412416*t19 + 0.19866933079506124*t20;
-    const Scalar t34 = -0.19866933079506124*t19 + 0.9800665778412416*t20;
-    const Scalar t35 = 0.42875*t8 + t29;
-    const Scalar t36 = 0.42875*Ia5 + t31;
-    const Scalar t37 = 0.42875*t27 + t33;
-    const Scalar t38 = w.cq_r_shank*pa0 + w.sq_r_shank*pa2;
-    const Scalar t39 = -w.sq_r_shank*pa0 + w.cq_r_shank*pa2;
-    const Scalar t40 = w.cq_r_shank*pa3 + w.sq_r_shank*pa4;
-    const Scalar t41 = -w.sq_r_shank*pa3 + w.cq_r_shank*pa4;
-    const Scalar t42 = 0.9800665778412416*t38 + 0.19866933079506124*t39;
-    const Scalar t43 = -0.19866933079506124*t38 + 0.9800665778412416*t39;
-    w.IA_r_thigh[0] = 7.0 + t25;
-    w.IA_r_thigh[1] = t8;
-    w.IA_r_thigh[2] = t26;
-    w.IA_r_thigh[3] = t35;
-    w.IA_r_thigh[4] = -1.29954125 - 0.42875*t25;
-    w.IA_r_thigh[5] = t30;
-    w.IA_r_thigh[6] = 7.0 + Ia5;
-    w.IA_r_thigh[7] = t27;
-    w.IA_r_thigh[8] = 1.29954125 + t36;
-    w.IA_r_thigh[9] = -0.42875*t8;
-    w.IA_r_thigh[10] = t32;
-    w.IA_r_thigh[11] = 7.0 + t28;
-    w.IA_r_thigh[12] = t37;
-    w.IA_r_thigh[13] = -0.42875*t26;
-    w.IA_r_thigh[14] = t34;
-    w.IA_r_thigh[15] = 0.3755072987089375 + 0.9800665778412416*t21 + 0.19866933079506124*t22 + 0.42875*t31 + 0.42875*t36;
-    w.IA_r_thigh[16] = -0.1838265625*t8 - 0.42875*t29;
-    w.IA_r_thigh[17] = -0.19866933079506124*t21 + 0.9800665778412416*t22 + 0.42875*t32;
-    w.IA_r_thigh[18] = 0.3755072987089375 + 0.1838265625*t25;
-    w.IA_r_thigh[19] = -0.42875*t30;
-    w.IA_r_thigh[20] = 0.0196875 - 0.19866933079506124*t23 + 0.9800665778412416*t24;
-    w.pA_r_thigh[0] = w.pA_r_thigh[0] + t42;
-    w.pA_r_thigh[1] = w.pA_r_thigh[1] + pa1;
-    w.pA_r_thigh[2] = w.pA_r_thigh[2] + t43;
-    w.pA_r_thigh[3] = w.pA_r_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t40 + 0.19866933079506124*t41;
-    w.pA_r_thigh[4] = w.pA_r_thigh[4] + tau[15] - 0.42875*t42;
-    w.pA_r_thigh[5] = w.pA_r_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
-  }
+  shared_12(shared_12_k0, &tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
-    w.u_r_thigh[0] = -w.pA_r_thigh[4] + tau[14];
-    const Scalar t0 = w.IA_r_thigh[4]*w.Dinv_r_thigh;
-    const Scalar t1 = w.IA_r_thigh[9]*w.Dinv_r_thigh;
-    const Scalar t2 = w.IA_r_thigh[13]*w.Dinv_r_thigh;
-    const Scalar t3 = w.IA_r_thigh[16]*w.Dinv_r_thigh;
-    const Scalar t4 = w.IA_r_thigh[19]*w.Dinv_r_thigh;
-    const Scalar Ia0 = w.IA_r_thigh[0] - w.IA_r_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_r_thigh[1] - w.IA_r_thigh[9]*t0;
-    const Scalar Ia2 = w.IA_r_thigh[2] - w.IA_r_thigh[13]*t0;
-    const Scalar Ia3 = w.IA_r_thigh[3] - w.IA_r_thigh[16]*t0;
-    const Scalar Ia4 = w.IA_r_thigh[5] - w.IA_r_thigh[19]*t0;
-    const Scalar Ia5 = w.IA_r_thigh[6] - w.IA_r_thigh[9]*t1;
-    const Scalar Ia6 = w.IA_r_thigh[7] - w.IA_r_thigh[13]*t1;
-    const Scalar Ia7 = w.IA_r_thigh[8] - w.IA_r_thigh[16]*t1;
-    const Scalar Ia8 = w.IA_r_thigh[10] - w.IA_r_thigh[19]*t1;
-    const Scalar Ia9 = w.IA_r_thigh[11] - w.IA_r_thigh[13]*t2;
-    const Scalar Ia10 = w.IA_r_thigh[12] - w.IA_r_thigh[16]*t2;
-    const Scalar Ia11 = w.IA_r_thigh[14] - w.IA_r_thigh[19]*t2;
-    const Scalar Ia12 = w.IA_r_thigh[15] - w.IA_r_thigh[16]*t3;
-    const Scalar Ia13 = w.IA_r_thigh[17] - w.IA_r_thigh[19]*t3;
-    const Scalar Ia14 = w.IA_r_thigh[20] - w.IA_r_thigh[19]*t4;
-    const Scalar pa0 = w.pA_r_thigh[0] + w.u_r_thigh[0]*t0 + w.c_r_thigh[0]*Ia0 + w.c_r_thigh[2]*Ia2 + w.c_r_thigh[3]*Ia3 + w.c_r_thigh[5]*Ia4;
-    const Scalar pa1 = w.pA_r_thigh[1] + w.u_r_thigh[0]*t1 + w.c_r_thigh[0]*Ia1 + w.c_r_thigh[2]*Ia6 + w.c_r_thigh[3]*Ia7 + w.c_r_thigh[5]*Ia8;
-    const Scalar pa2 = w.pA_r_thigh[2] + w.u_r_thigh[0]*t2 + w.c_r_thigh[0]*Ia2 + w.c_r_thigh[2]*Ia9 + w.c_r_thigh[3]*Ia10 + w.c_r_thigh[5]*Ia11;
-    const Scalar pa3 = w.pA_r_thigh[3] + w.u_r_thigh[0]*t3 + w.c_r_thigh[0]*Ia3 + w.c_r_thigh[2]*Ia10 + w.c_r_thigh[3]*Ia12 + w.c_r_thigh[5]*Ia13;
-    const Scalar pa4 = w.pA_r_thigh[5] + w.u_r_thigh[0]*t4 + w.c_r_thigh[0]*Ia4 + w.c_r_thigh[2]*Ia11 + w.c_r_thigh[3]*Ia13 + w.c_r_thigh[5]*Ia14;
-    const Scalar C20 = w.cq_r_thigh*w.cq_r_thigh - w.sq_r_thigh*w.sq_r_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_r_thigh*w.sq_r_thigh;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_r_thigh*Ia6 + 0.09983341664682815*w.sq_r_thigh*Ia1 + 0.9950041652780258*w.sq_r_thigh*Ia6 + 0.9950041652780258*w.cq_r_thigh*Ia1;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_r_thigh*Ia6 + w.cq_r_thigh*Ia1;
-    const Scalar t11 = w.cq_r_thigh*Ia6 - w.sq_r_thigh*Ia1;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia4 - 0.4975020826390129*Ia10 - 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = w.sq_r_thigh*Ia8 + w.cq_r_thigh*Ia7;
-    const Scalar t18 = w.cq_r_thigh*Ia8 - w.sq_r_thigh*Ia7;
-    const Scalar t19 = -0.4975020826390129*Ia4 + 0.4975020826390129*Ia10 + 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t20 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t21 = 0.9950041652780258*m2 - 0.9950041652780258*d2 - 0.09983341664682815*qq2;
-    const Scalar t22 = -0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t23 = 0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t24 = 0.9950041652780258*m2 + 0.9950041652780258*d2 + 0.09983341664682815*qq2;
-    const Scalar t25 = w.cq_r_thigh*pa0 + w.sq_r_thigh*pa2;
-    const Scalar t26 = -w.sq_r_thigh*pa0 + w.cq_r_thigh*pa2;
-    const Scalar t27 = w.cq_r_thigh*pa3 + w.sq_r_thigh*pa4;
-    const Scalar t28 = -w.sq_r_thigh*pa3 + w.cq_r_thigh*pa4;
-    w.IA_r_hip_roll_link[0] = 0.5 + 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    w.IA_r_hip_roll_link[1] = t8;
-    w.IA_r_hip_roll_link[2] = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    w.IA_r_hip_roll_link[3] = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    w.IA_r_hip_roll_link[5] = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    w.IA_r_hip_roll_link[6] = 0.5 + Ia5;
-    w.IA_r_hip_roll_link[7] = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    w.IA_r_hip_roll_link[8] = 0.015 + 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    w.IA_r_hip_roll_link[10] = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    w.IA_r_hip_roll_link[11] = 0.5 + 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    w.IA_r_hip_roll_link[12] = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    w.IA_r_hip_roll_link[14] = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    w.IA_r_hip_roll_link[15] = 0.00095 + 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    w.IA_r_hip_roll_link[17] = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.IA_r_hip_roll_link[20] = 0.0005 + 0.09983341664682815*t23 + 0.9950041652780258*t24;
-    w.pA_r_hip_roll_link[0] = w.pA_r_hip_roll_link[0] + 0.9950041652780258*t25 - 0.09983341664682815*t26;
-    w.pA_r_hip_roll_link[1] = w.pA_r_hip_roll_link[1] + pa1;
-    w.pA_r_hip_roll_link[2] = w.pA_r_hip_roll_link[2] + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_r_hip_roll_link[3] = w.pA_r_hip_roll_link[3] + 0.9950041652780258*t27 - 0.09983341664682815*t28;
-    w.pA_r_hip_roll_link[4] = w.pA_r_hip_roll_link[4] + tau[14];
-    w.pA_r_hip_roll_link[5] = w.pA_r_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
-  }
+  shared_13(shared_13_k0, &tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
-    w.u_r_hip_roll_link[0] = -w.pA_r_hip_roll_link[3] + tau[13];
-    const Scalar t0 = w.IA_r_hip_roll_link[3]*w.Dinv_r_hip_roll_link;
-    const Scalar t1 = w.IA_r_hip_roll_link[8]*w.Dinv_r_hip_roll_link;
-    const Scalar t2 = w.IA_r_hip_roll_link[12]*w.Dinv_r_hip_roll_link;
-    const Scalar t3 = w.IA_r_hip_roll_link[17]*w.Dinv_r_hip_roll_link;
-    const Scalar Ia0 = w.IA_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_r_hip_roll_link[1] - w.IA_r_hip_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_r_hip_roll_link[2] - w.IA_r_hip_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_r_hip_roll_link[5] - w.IA_r_hip_roll_link[17]*t0;
-    const Scalar Ia4 = w.IA_r_hip_roll_link[6] - w.IA_r_hip_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_r_hip_roll_link[7] - w.IA_r_hip_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_r_hip_roll_link[10] - w.IA_r_hip_roll_link[17]*t1;
-    const Scalar Ia7 = w.IA_r_hip_roll_link[11] - w.IA_r_hip_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_r_hip_roll_link[14] - w.IA_r_hip_roll_link[17]*t2;
-    const Scalar Ia9 = w.IA_r_hip_roll_link[20] - w.IA_r_hip_roll_link[17]*t3;
-    const Scalar pa0 = -0.015*w.c_r_hip_roll_link[4] + w.pA_r_hip_roll_link[0] + w.u_r_hip_roll_link[0]*t0 + w.c_r_hip_roll_link[1]*Ia1 + w.c_r_hip_roll_link[2]*Ia2 + w.c_r_hip_roll_link[5]*Ia3;
-    const Scalar pa1 = w.pA_r_hip_roll_link[1] + w.u_r_hip_roll_link[0]*t1 + w.c_r_hip_roll_link[1]*Ia4 + w.c_r_hip_roll_link[2]*Ia5 + w.c_r_hip_roll_link[5]*Ia6;
-    const Scalar pa2 = w.pA_r_hip_roll_link[2] + w.u_r_hip_roll_link[0]*t2 + w.c_r_hip_roll_link[1]*Ia5 + w.c_r_hip_roll_link[2]*Ia7 + w.c_r_hip_roll_link[5]*Ia8;
-    const Scalar pa3 = 0.00095*w.c_r_hip_roll_link[4] + w.pA_r_hip_roll_link[4];
-    const Scalar pa4 = w.pA_r_hip_roll_link[5] + w.u_r_hip_roll_link[0]*t3 + w.c_r_hip_roll_link[1]*Ia6 + w.c_r_hip_roll_link[2]*Ia8 + w.c_r_hip_roll_link[5]*Ia9;
-    const Scalar C20 = w.cq_r_hip_roll_link*w.cq_r_hip_roll_link - w.sq_r_hip_roll_link*w.sq_r_hip_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_hip_roll_link*w.sq_r_hip_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(-Ia8*C20 - Ia6*t4);
-    const Scalar qq1 = 0.5*(-Ia8*t4 + Ia6*C20);
-    const Scalar h1 = 0.000475 - 0.5*Ia9;
-    const Scalar m1 = 0.000475 + 0.5*Ia9;
-    w.IA_r_hip_yaw_link[0] = 0.5 + Ia0;
-    w.IA_r_hip_yaw_link[1] = w.cq_r_hip_roll_link*Ia1 - w.sq_r_hip_roll_link*Ia2;
-    w.IA_r_hip_yaw_link[2] = w.sq_r_hip_roll_link*Ia1 + w.cq_r_hip_roll_link*Ia2;
-    w.IA_r_hip_yaw_link[4] = 0.02 - 0.015*w.cq_r_hip_roll_link - w.sq_r_hip_roll_link*Ia3;
-    w.IA_r_hip_yaw_link[5] = -0.015*w.sq_r_hip_roll_link + w.cq_r_hip_roll_link*Ia3;
-    w.IA_r_hip_yaw_link[6] = 0.5 + m0 + d0;
-    w.IA_r_hip_yaw_link[7] = qq0;
-    w.IA_r_hip_yaw_link[9] = 0.5*Ia8 + d1;
-    w.IA_r_hip_yaw_link[10] = 0.5*Ia6 + qq1;
-    w.IA_r_hip_yaw_link[11] = 0.5 + m0 - d0;
-    w.IA_r_hip_yaw_link[13] = -0.5*Ia6 + qq1;
-    w.IA_r_hip_yaw_link[14] = 0.5*Ia8 - d1;
-    w.IA_r_hip_yaw_link[18] = 0.0013 + m1 + C20*h1;
-    w.IA_r_hip_yaw_link[19] = t4*h1;
-    w.IA_r_hip_yaw_link[20] = 0.0005 + m1 - C20*h1;
-    w.pA_r_hip_yaw_link[0] = w.pA_r_hip_yaw_link[0] + pa0;
-    w.pA_r_hip_yaw_link[1] = w.pA_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*pa1 - w.sq_r_hip_roll_link*pa2;
-    w.pA_r_hip_yaw_link[2] = w.pA_r_hip_yaw_link[2] + w.sq_r_hip_roll_link*pa1 + w.cq_r_hip_roll_link*pa2;
-    w.pA_r_hip_yaw_link[3] = w.pA_r_hip_yaw_link[3] + tau[13];
-    w.pA_r_hip_yaw_link[4] = w.pA_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*pa3 - w.sq_r_hip_roll_link*pa4;
-    w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa3 + w.cq_r_hip_roll_link*pa4;
-  }
+  shared_14(shared_14_k0, &tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2714,408 +3653,27 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
 
 PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar mu_c0 = mu*w.active[0];
-    w.U_l_foot[1] = 0.027912499999999996 + 0.06825*mu_c0;
-    w.U_l_foot[3] = 0.00194517348958 + 1.0046580625*mu_c0;
-    w.Dinv_l_foot = 1.0 / w.U_l_foot[3];
-    w.u_l_foot[0] = -w.pA_l_foot[3] - 0.06825*w.lambda[1] - w.lambda[3] - 0.06825*w.g_l_foot[1]*mu_c0 + tau[11];
-    const Scalar t0 = w.U_l_foot[1]*w.Dinv_l_foot;
-    const Scalar Ia0 = 1.015 + mu_c0;
-    const Scalar Ia1 = -0.027912499999999996 - 0.06825*mu_c0;
-    const Scalar Ia2 = 1.015 + mu_c0 - w.U_l_foot[1]*t0;
-    const Scalar Ia3 = 0.06495999999999999 - 0.0017863999999999998*w.U_l_foot[1]*w.Dinv_l_foot;
-    const Scalar Ia4 = 0.00936987670937 + 1.0046580625*mu_c0;
-    const Scalar Ia5 = 0.00860228295937 + mu_c0 - 3.1912249599999995e-06*w.Dinv_l_foot;
-    const Scalar pa0 = w.pA_l_foot[0] + w.lambda[0] + w.g_l_ankle_link[0]*mu_c0 + w.c_l_foot[4]*Ia1;
-    const Scalar pa1 = w.pA_l_foot[1] + w.lambda[1] + w.g_l_foot[1]*mu_c0 + w.u_l_foot[0]*t0 + w.c_l_foot[1]*Ia2 + w.c_l_foot[5]*Ia3;
-    const Scalar pa2 = -0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2] + w.lambda[2] + w.g_l_foot[2]*mu_c0 + w.c_l_foot[2]*Ia0;
-    const Scalar pa3 = -0.06495999999999999*w.c_l_foot[2] + w.pA_l_foot[4] - 0.06825*w.lambda[0] + w.lambda[4] - 0.06825*w.g_l_ankle_link[0]*mu_c0 + w.c_l_foot[4]*Ia4;
-    const Scalar pa4 = w.pA_l_foot[5] + w.lambda[5] + 0.0017863999999999998*w.Dinv_l_foot*w.u_l_foot[0] + w.c_l_foot[1]*Ia3 + w.c_l_foot[5]*Ia5;
-    const Scalar C20 = w.cq_l_foot*w.cq_l_foot - w.sq_l_foot*w.sq_l_foot;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t1 = 2.0*w.cq_l_foot*w.sq_l_foot;
-    const Scalar t2 = -0.032479999999999995 + 0.5*Ia3;
-    const Scalar h1 = 0.5*(Ia4 - Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    w.IA_l_ankle_link[0] = 0.2 + Ia0;
-    w.IA_l_ankle_link[4] = w.cq_l_foot*Ia1;
-    w.IA_l_ankle_link[5] = w.sq_l_foot*Ia1;
-    w.IA_l_ankle_link[6] = 0.2 + m0 + C20*h0;
-    w.IA_l_ankle_link[7] = h0*t1;
-    w.IA_l_ankle_link[9] = -t1*t2;
-    w.IA_l_ankle_link[10] = 0.032479999999999995 + 0.5*Ia3 + C20*t2;
-    w.IA_l_ankle_link[11] = 0.2 + m0 - C20*h0;
-    w.IA_l_ankle_link[13] = -0.032479999999999995 - 0.5*Ia3 + C20*t2;
-    w.IA_l_ankle_link[14] = t1*t2;
-    w.IA_l_ankle_link[18] = 7.2e-05 + m1 + C20*h1;
-    w.IA_l_ankle_link[19] = t1*h1;
-    w.IA_l_ankle_link[20] = 7.2e-05 + m1 - C20*h1;
-    w.pA_l_ankle_link[0] = w.pA_l_ankle_link[0] + pa0;
-    w.pA_l_ankle_link[1] = w.pA_l_ankle_link[1] + w.cq_l_foot*pa1 - w.sq_l_foot*pa2;
-    w.pA_l_ankle_link[2] = w.pA_l_ankle_link[2] + w.sq_l_foot*pa1 + w.cq_l_foot*pa2;
-    w.pA_l_ankle_link[3] = tau[11];
-    w.pA_l_ankle_link[4] = w.cq_l_foot*pa3 - w.sq_l_foot*pa4;
-    w.pA_l_ankle_link[5] = w.sq_l_foot*pa3 + w.cq_l_foot*pa4;
-  }
+  shared_10(shared_10_k0, &tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, w.IA_l_ankle_link, w.pA_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
-    w.u_l_ankle_link[0] = -w.pA_l_ankle_link[4] + tau[10];
-    const Scalar t0 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
-    const Scalar t1 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
-    const Scalar t2 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
-    const Scalar t3 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
-    const Scalar Ia0 = w.IA_l_ankle_link[0] - w.IA_l_ankle_link[4]*t0;
-    const Scalar Ia1 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t0;
-    const Scalar Ia2 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t1;
-    const Scalar Ia3 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t1;
-    const Scalar Ia4 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t1;
-    const Scalar Ia5 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t2;
-    const Scalar Ia6 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t2;
-    const Scalar Ia7 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t3;
-    const Scalar t4 = -w.IA_l_ankle_link[13]*t0;
-    const Scalar t5 = -w.IA_l_ankle_link[9]*t0;
-    const Scalar pa0 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t0 + w.c_l_ankle_link[0]*Ia0 + w.c_l_ankle_link[2]*t4 + w.c_l_ankle_link[5]*Ia1;
-    const Scalar pa1 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t1 + w.c_l_ankle_link[0]*t5 + w.c_l_ankle_link[2]*Ia3 + w.c_l_ankle_link[5]*Ia4;
-    const Scalar pa2 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t2 + w.c_l_ankle_link[0]*t4 + w.c_l_ankle_link[2]*Ia5 + w.c_l_ankle_link[5]*Ia6;
-    const Scalar pa3 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
-    const Scalar pa4 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t3 + w.c_l_ankle_link[0]*Ia1 + w.c_l_ankle_link[2]*Ia6 + w.c_l_ankle_link[5]*Ia7;
-    const Scalar C20 = w.cq_l_ankle_link*w.cq_l_ankle_link - w.sq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar h0 = 0.5*(-Ia0 + Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t6 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar d0 = C20*h0 - t4*t6;
-    const Scalar qq0 = h0*t6 + t4*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia1*t6);
-    const Scalar qq1 = 0.5*(Ia6*t6 + Ia1*C20);
-    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
-    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_l_ankle_link*Ia3 + 0.09983341664682815*w.sq_l_ankle_link*t5 + 0.9950041652780258*w.sq_l_ankle_link*Ia3 + 0.9950041652780258*w.cq_l_ankle_link*t5;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_l_ankle_link*Ia3 + w.cq_l_ankle_link*t5;
-    const Scalar t11 = w.cq_l_ankle_link*Ia3 - w.sq_l_ankle_link*t5;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t18 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t19 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t6*h1;
-    const Scalar t20 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t21 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t22 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t6*h1;
-    const Scalar t23 = 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    const Scalar t24 = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    const Scalar t25 = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    const Scalar t26 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t27 = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    const Scalar t28 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t29 = -0.09983341664682815*w.cq_l_ankle_link*Ia4 + 0.9950041652780258*w.sq_l_ankle_link*Ia4;
-    const Scalar t30 = 0.9950041652780258*w.cq_l_ankle_link*Ia4 + 0.09983341664682815*w.sq_l_ankle_link*Ia4;
-    const Scalar t31 = 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    const Scalar t32 = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    const Scalar t33 = 0.4305*t8 + t27;
-    const Scalar t34 = 0.4305*Ia2 + t29;
-    const Scalar t35 = 0.4305*t25 + t31;
-    const Scalar t36 = w.cq_l_ankle_link*pa0 + w.sq_l_ankle_link*pa2;
-    const Scalar t37 = -w.sq_l_ankle_link*pa0 + w.cq_l_ankle_link*pa2;
-    const Scalar t38 = w.cq_l_ankle_link*pa3 + w.sq_l_ankle_link*pa4;
-    const Scalar t39 = -w.sq_l_ankle_link*pa3 + w.cq_l_ankle_link*pa4;
-    const Scalar t40 = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-    const Scalar t41 = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    w.IA_l_shank[0] = 3.055 + t23;
-    w.IA_l_shank[1] = t8;
-    w.IA_l_shank[2] = t24;
-    w.IA_l_shank[3] = t33;
-    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t23;
-    w.IA_l_shank[5] = t28;
-    w.IA_l_shank[6] = 3.055 + Ia2;
-    w.IA_l_shank[7] = t25;
-    w.IA_l_shank[8] = 0.5694718575000001 + t34;
-    w.IA_l_shank[9] = -0.4305*t8;
-    w.IA_l_shank[10] = t30;
-    w.IA_l_shank[11] = 3.055 + t26;
-    w.IA_l_shank[12] = t35;
-    w.IA_l_shank[13] = -0.4305*t24;
-    w.IA_l_shank[14] = t32;
-    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t19 - 0.09983341664682815*t20 + 0.4305*t29 + 0.4305*t34;
-    w.IA_l_shank[16] = -0.18533025*t8 - 0.4305*t27;
-    w.IA_l_shank[17] = 0.09983341664682815*t19 + 0.9950041652780258*t20 + 0.4305*t30;
-    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t23;
-    w.IA_l_shank[19] = -0.4305*t28;
-    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.pA_l_shank[0] = w.pA_l_shank[0] + t40;
-    w.pA_l_shank[1] = w.pA_l_shank[1] + pa1;
-    w.pA_l_shank[2] = w.pA_l_shank[2] + t41;
-    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa1 + 0.9950041652780258*t38 - 0.09983341664682815*t39;
-    w.pA_l_shank[4] = w.pA_l_shank[4] + tau[10] - 0.4305*t40;
-    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t38 + 0.9950041652780258*t39;
-  }
+  shared_11(shared_11_k0, &tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
-    w.u_l_shank[0] = -w.pA_l_shank[4] + tau[9];
-    const Scalar t0 = w.IA_l_shank[4]*w.Dinv_l_shank;
-    const Scalar t1 = w.IA_l_shank[9]*w.Dinv_l_shank;
-    const Scalar t2 = w.IA_l_shank[13]*w.Dinv_l_shank;
-    const Scalar t3 = w.IA_l_shank[16]*w.Dinv_l_shank;
-    const Scalar t4 = w.IA_l_shank[19]*w.Dinv_l_shank;
-    const Scalar Ia0 = w.IA_l_shank[0] - w.IA_l_shank[4]*t0;
-    const Scalar Ia1 = w.IA_l_shank[1] - w.IA_l_shank[9]*t0;
-    const Scalar Ia2 = w.IA_l_shank[2] - w.IA_l_shank[13]*t0;
-    const Scalar Ia3 = w.IA_l_shank[3] - w.IA_l_shank[16]*t0;
-    const Scalar Ia4 = w.IA_l_shank[5] - w.IA_l_shank[19]*t0;
-    const Scalar Ia5 = w.IA_l_shank[6] - w.IA_l_shank[9]*t1;
-    const Scalar Ia6 = w.IA_l_shank[7] - w.IA_l_shank[13]*t1;
-    const Scalar Ia7 = w.IA_l_shank[8] - w.IA_l_shank[16]*t1;
-    const Scalar Ia8 = w.IA_l_shank[10] - w.IA_l_shank[19]*t1;
-    const Scalar Ia9 = w.IA_l_shank[11] - w.IA_l_shank[13]*t2;
-    const Scalar Ia10 = w.IA_l_shank[12] - w.IA_l_shank[16]*t2;
-    const Scalar Ia11 = w.IA_l_shank[14] - w.IA_l_shank[19]*t2;
-    const Scalar Ia12 = w.IA_l_shank[15] - w.IA_l_shank[16]*t3;
-    const Scalar Ia13 = w.IA_l_shank[17] - w.IA_l_shank[19]*t3;
-    const Scalar Ia14 = w.IA_l_shank[20] - w.IA_l_shank[19]*t4;
-    const Scalar pa0 = w.pA_l_shank[0] + w.u_l_shank[0]*t0 + w.c_l_shank[0]*Ia0 + w.c_l_shank[2]*Ia2 + w.c_l_shank[3]*Ia3 + w.c_l_shank[5]*Ia4;
-    const Scalar pa1 = w.pA_l_shank[1] + w.u_l_shank[0]*t1 + w.c_l_shank[0]*Ia1 + w.c_l_shank[2]*Ia6 + w.c_l_shank[3]*Ia7 + w.c_l_shank[5]*Ia8;
-    const Scalar pa2 = w.pA_l_shank[2] + w.u_l_shank[0]*t2 + w.c_l_shank[0]*Ia2 + w.c_l_shank[2]*Ia9 + w.c_l_shank[3]*Ia10 + w.c_l_shank[5]*Ia11;
-    const Scalar pa3 = w.pA_l_shank[3] + w.u_l_shank[0]*t3 + w.c_l_shank[0]*Ia3 + w.c_l_shank[2]*Ia10 + w.c_l_shank[3]*Ia12 + w.c_l_shank[5]*Ia13;
-    const Scalar pa4 = w.pA_l_shank[5] + w.u_l_shank[0]*t4 + w.c_l_shank[0]*Ia4 + w.c_l_shank[2]*Ia11 + w.c_l_shank[3]*Ia13 + w.c_l_shank[5]*Ia14;
-    const Scalar C20 = w.cq_l_shank*w.cq_l_shank - w.sq_l_shank*w.sq_l_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_l_shank*w.sq_l_shank;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9800665778412416*m0 - 0.9800665778412416*d0 + 0.19866933079506124*qq0;
-    const Scalar t8 = 0.19866933079506124*w.cq_l_shank*Ia6 - 0.19866933079506124*w.sq_l_shank*Ia1 + 0.9800665778412416*w.sq_l_shank*Ia6 + 0.9800665778412416*w.cq_l_shank*Ia1;
-    const Scalar t9 = 0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t10 = w.sq_l_shank*Ia6 + w.cq_l_shank*Ia1;
-    const Scalar t11 = w.cq_l_shank*Ia6 - w.sq_l_shank*Ia1;
-    const Scalar t12 = -0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t14 = 0.9800665778412416*m0 + 0.9800665778412416*d0 - 0.19866933079506124*qq0;
-    const Scalar t15 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 - 0.9800665778412416*d1 + 0.19866933079506124*qq1;
-    const Scalar t16 = 0.4900332889206208*Ia4 - 0.4900332889206208*Ia10 + 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t17 = w.sq_l_shank*Ia8 + w.cq_l_shank*Ia7;
-    const Scalar t18 = w.cq_l_shank*Ia8 - w.sq_l_shank*Ia7;
-    const Scalar t19 = -0.4900332889206208*Ia4 + 0.4900332889206208*Ia10 - 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t20 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 + 0.9800665778412416*d1 - 0.19866933079506124*qq1;
-    const Scalar t21 = 0.9800665778412416*m2 - 0.9800665778412416*d2 + 0.19866933079506124*qq2;
-    const Scalar t22 = 0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t23 = -0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t24 = 0.9800665778412416*m2 + 0.9800665778412416*d2 - 0.19866933079506124*qq2;
-    const Scalar t25 = 0.9800665778412416*t7 + 0.19866933079506124*t9;
-    const Scalar t26 = -0.19866933079506124*t7 + 0.9800665778412416*t9;
-    const Scalar t27 = -0.19866933079506124*t10 + 0.9800665778412416*t11;
-    const Scalar t28 = -0.19866933079506124*t12 + 0.9800665778412416*t14;
-    const Scalar t29 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
-    const Scalar t30 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
-    const Scalar t31 = 0.9800665778412416*t17 + 0.19866933079506124*t18;
-    const Scalar t32 = -0.19866933079506124*t17 + 0.9800665778412416*t18;
-    const Scalar t33 = 0.9800665778412416*t19 + 0.19866933079506124*t20;
-    const Scalar t34 = -0.19866933079506124*t19 + 0.9800665778412416*t20;
-    const Scalar t35 = 0.42875*t8 + t29;
-    const Scalar t36 = 0.42875*Ia5 + t31;
-    const Scalar t37 = 0.42875*t27 + t33;
-    const Scalar t38 = w.cq_l_shank*pa0 + w.sq_l_shank*pa2;
-    const Scalar t39 = -w.sq_l_shank*pa0 + w.cq_l_shank*pa2;
-    const Scalar t40 = w.cq_l_shank*pa3 + w.sq_l_shank*pa4;
-    const Scalar t41 = -w.sq_l_shank*pa3 + w.cq_l_shank*pa4;
-    const Scalar t42 = 0.9800665778412416*t38 + 0.19866933079506124*t39;
-    const Scalar t43 = -0.19866933079506124*t38 + 0.9800665778412416*t39;
-    w.IA_l_thigh[0] = 7.0 + t25;
-    w.IA_l_thigh[1] = t8;
-    w.IA_l_thigh[2] = t26;
-    w.IA_l_thigh[3] = t35;
-    w.IA_l_thigh[4] = -1.29954125 - 0.42875*t25;
-    w.IA_l_thigh[5] = t30;
-    w.IA_l_thigh[6] = 7.0 + Ia5;
-    w.IA_l_thigh[7] = t27;
-    w.IA_l_thigh[8] = 1.29954125 + t36;
-    w.IA_l_thigh[9] = -0.42875*t8;
-    w.IA_l_thigh[10] = t32;
-    w.IA_l_thigh[11] = 7.0 + t28;
-    w.IA_l_thigh[12] = t37;
-    w.IA_l_thigh[13] = -0.42875*t26;
-    w.IA_l_thigh[14] = t34;
-    w.IA_l_thigh[15] = 0.3755072987089375 + 0.9800665778412416*t21 + 0.19866933079506124*t22 + 0.42875*t31 + 0.42875*t36;
-    w.IA_l_thigh[16] = -0.1838265625*t8 - 0.42875*t29;
-    w.IA_l_thigh[17] = -0.19866933079506124*t21 + 0.9800665778412416*t22 + 0.42875*t32;
-    w.IA_l_thigh[18] = 0.3755072987089375 + 0.1838265625*t25;
-    w.IA_l_thigh[19] = -0.42875*t30;
-    w.IA_l_thigh[20] = 0.0196875 - 0.19866933079506124*t23 + 0.9800665778412416*t24;
-    w.pA_l_thigh[0] = w.pA_l_thigh[0] + t42;
-    w.pA_l_thigh[1] = w.pA_l_thigh[1] + pa1;
-    w.pA_l_thigh[2] = w.pA_l_thigh[2] + t43;
-    w.pA_l_thigh[3] = w.pA_l_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t40 + 0.19866933079506124*t41;
-    w.pA_l_thigh[4] = w.pA_l_thigh[4] + tau[9] - 0.42875*t42;
-    w.pA_l_thigh[5] = w.pA_l_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
-  }
+  shared_12(shared_12_k0, &tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
-    w.u_l_thigh[0] = -w.pA_l_thigh[4] + tau[8];
-    const Scalar t0 = w.IA_l_thigh[4]*w.Dinv_l_thigh;
-    const Scalar t1 = w.IA_l_thigh[9]*w.Dinv_l_thigh;
-    const Scalar t2 = w.IA_l_thigh[13]*w.Dinv_l_thigh;
-    const Scalar t3 = w.IA_l_thigh[16]*w.Dinv_l_thigh;
-    const Scalar t4 = w.IA_l_thigh[19]*w.Dinv_l_thigh;
-    const Scalar Ia0 = w.IA_l_thigh[0] - w.IA_l_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_l_thigh[1] - w.IA_l_thigh[9]*t0;
-    const Scalar Ia2 = w.IA_l_thigh[2] - w.IA_l_thigh[13]*t0;
-    const Scalar Ia3 = w.IA_l_thigh[3] - w.IA_l_thigh[16]*t0;
-    const Scalar Ia4 = w.IA_l_thigh[5] - w.IA_l_thigh[19]*t0;
-    const Scalar Ia5 = w.IA_l_thigh[6] - w.IA_l_thigh[9]*t1;
-    const Scalar Ia6 = w.IA_l_thigh[7] - w.IA_l_thigh[13]*t1;
-    const Scalar Ia7 = w.IA_l_thigh[8] - w.IA_l_thigh[16]*t1;
-    const Scalar Ia8 = w.IA_l_thigh[10] - w.IA_l_thigh[19]*t1;
-    const Scalar Ia9 = w.IA_l_thigh[11] - w.IA_l_thigh[13]*t2;
-    const Scalar Ia10 = w.IA_l_thigh[12] - w.IA_l_thigh[16]*t2;
-    const Scalar Ia11 = w.IA_l_thigh[14] - w.IA_l_thigh[19]*t2;
-    const Scalar Ia12 = w.IA_l_thigh[15] - w.IA_l_thigh[16]*t3;
-    const Scalar Ia13 = w.IA_l_thigh[17] - w.IA_l_thigh[19]*t3;
-    const Scalar Ia14 = w.IA_l_thigh[20] - w.IA_l_thigh[19]*t4;
-    const Scalar pa0 = w.pA_l_thigh[0] + w.u_l_thigh[0]*t0 + w.c_l_thigh[0]*Ia0 + w.c_l_thigh[2]*Ia2 + w.c_l_thigh[3]*Ia3 + w.c_l_thigh[5]*Ia4;
-    const Scalar pa1 = w.pA_l_thigh[1] + w.u_l_thigh[0]*t1 + w.c_l_thigh[0]*Ia1 + w.c_l_thigh[2]*Ia6 + w.c_l_thigh[3]*Ia7 + w.c_l_thigh[5]*Ia8;
-    const Scalar pa2 = w.pA_l_thigh[2] + w.u_l_thigh[0]*t2 + w.c_l_thigh[0]*Ia2 + w.c_l_thigh[2]*Ia9 + w.c_l_thigh[3]*Ia10 + w.c_l_thigh[5]*Ia11;
-    const Scalar pa3 = w.pA_l_thigh[3] + w.u_l_thigh[0]*t3 + w.c_l_thigh[0]*Ia3 + w.c_l_thigh[2]*Ia10 + w.c_l_thigh[3]*Ia12 + w.c_l_thigh[5]*Ia13;
-    const Scalar pa4 = w.pA_l_thigh[5] + w.u_l_thigh[0]*t4 + w.c_l_thigh[0]*Ia4 + w.c_l_thigh[2]*Ia11 + w.c_l_thigh[3]*Ia13 + w.c_l_thigh[5]*Ia14;
-    const Scalar C20 = w.cq_l_thigh*w.cq_l_thigh - w.sq_l_thigh*w.sq_l_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_l_thigh*w.sq_l_thigh;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_l_thigh*Ia6 + 0.09983341664682815*w.sq_l_thigh*Ia1 + 0.9950041652780258*w.sq_l_thigh*Ia6 + 0.9950041652780258*w.cq_l_thigh*Ia1;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_l_thigh*Ia6 + w.cq_l_thigh*Ia1;
-    const Scalar t11 = w.cq_l_thigh*Ia6 - w.sq_l_thigh*Ia1;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia4 - 0.4975020826390129*Ia10 - 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = w.sq_l_thigh*Ia8 + w.cq_l_thigh*Ia7;
-    const Scalar t18 = w.cq_l_thigh*Ia8 - w.sq_l_thigh*Ia7;
-    const Scalar t19 = -0.4975020826390129*Ia4 + 0.4975020826390129*Ia10 + 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t20 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t21 = 0.9950041652780258*m2 - 0.9950041652780258*d2 - 0.09983341664682815*qq2;
-    const Scalar t22 = -0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t23 = 0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t24 = 0.9950041652780258*m2 + 0.9950041652780258*d2 + 0.09983341664682815*qq2;
-    const Scalar t25 = w.cq_l_thigh*pa0 + w.sq_l_thigh*pa2;
-    const Scalar t26 = -w.sq_l_thigh*pa0 + w.cq_l_thigh*pa2;
-    const Scalar t27 = w.cq_l_thigh*pa3 + w.sq_l_thigh*pa4;
-    const Scalar t28 = -w.sq_l_thigh*pa3 + w.cq_l_thigh*pa4;
-    w.IA_l_hip_roll_link[0] = 0.5 + 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    w.IA_l_hip_roll_link[1] = t8;
-    w.IA_l_hip_roll_link[2] = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    w.IA_l_hip_roll_link[3] = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    w.IA_l_hip_roll_link[5] = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    w.IA_l_hip_roll_link[6] = 0.5 + Ia5;
-    w.IA_l_hip_roll_link[7] = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    w.IA_l_hip_roll_link[8] = 0.015 + 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    w.IA_l_hip_roll_link[10] = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    w.IA_l_hip_roll_link[11] = 0.5 + 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    w.IA_l_hip_roll_link[12] = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    w.IA_l_hip_roll_link[14] = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    w.IA_l_hip_roll_link[15] = 0.00095 + 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    w.IA_l_hip_roll_link[17] = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.IA_l_hip_roll_link[20] = 0.0005 + 0.09983341664682815*t23 + 0.9950041652780258*t24;
-    w.pA_l_hip_roll_link[0] = w.pA_l_hip_roll_link[0] + 0.9950041652780258*t25 - 0.09983341664682815*t26;
-    w.pA_l_hip_roll_link[1] = w.pA_l_hip_roll_link[1] + pa1;
-    w.pA_l_hip_roll_link[2] = w.pA_l_hip_roll_link[2] + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_l_hip_roll_link[3] = w.pA_l_hip_roll_link[3] + 0.9950041652780258*t27 - 0.09983341664682815*t28;
-    w.pA_l_hip_roll_link[4] = w.pA_l_hip_roll_link[4] + tau[8];
-    w.pA_l_hip_roll_link[5] = w.pA_l_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
-  }
+  shared_13(shared_13_k0, &tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
-    w.u_l_hip_roll_link[0] = -w.pA_l_hip_roll_link[3] + tau[7];
-    const Scalar t0 = w.IA_l_hip_roll_link[3]*w.Dinv_l_hip_roll_link;
-    const Scalar t1 = w.IA_l_hip_roll_link[8]*w.Dinv_l_hip_roll_link;
-    const Scalar t2 = w.IA_l_hip_roll_link[12]*w.Dinv_l_hip_roll_link;
-    const Scalar t3 = w.IA_l_hip_roll_link[17]*w.Dinv_l_hip_roll_link;
-    const Scalar Ia0 = w.IA_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_l_hip_roll_link[1] - w.IA_l_hip_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_l_hip_roll_link[2] - w.IA_l_hip_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_l_hip_roll_link[5] - w.IA_l_hip_roll_link[17]*t0;
-    const Scalar Ia4 = w.IA_l_hip_roll_link[6] - w.IA_l_hip_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_l_hip_roll_link[7] - w.IA_l_hip_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_l_hip_roll_link[10] - w.IA_l_hip_roll_link[17]*t1;
-    const Scalar Ia7 = w.IA_l_hip_roll_link[11] - w.IA_l_hip_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_l_hip_roll_link[14] - w.IA_l_hip_roll_link[17]*t2;
-    const Scalar Ia9 = w.IA_l_hip_roll_link[20] - w.IA_l_hip_roll_link[17]*t3;
-    const Scalar pa0 = -0.015*w.c_l_hip_roll_link[4] + w.pA_l_hip_roll_link[0] + w.u_l_hip_roll_link[0]*t0 + w.c_l_hip_roll_link[1]*Ia1 + w.c_l_hip_roll_link[2]*Ia2 + w.c_l_hip_roll_link[5]*Ia3;
-    const Scalar pa1 = w.pA_l_hip_roll_link[1] + w.u_l_hip_roll_link[0]*t1 + w.c_l_hip_roll_link[1]*Ia4 + w.c_l_hip_roll_link[2]*Ia5 + w.c_l_hip_roll_link[5]*Ia6;
-    const Scalar pa2 = w.pA_l_hip_roll_link[2] + w.u_l_hip_roll_link[0]*t2 + w.c_l_hip_roll_link[1]*Ia5 + w.c_l_hip_roll_link[2]*Ia7 + w.c_l_hip_roll_link[5]*Ia8;
-    const Scalar pa3 = 0.00095*w.c_l_hip_roll_link[4] + w.pA_l_hip_roll_link[4];
-    const Scalar pa4 = w.pA_l_hip_roll_link[5] + w.u_l_hip_roll_link[0]*t3 + w.c_l_hip_roll_link[1]*Ia6 + w.c_l_hip_roll_link[2]*Ia8 + w.c_l_hip_roll_link[5]*Ia9;
-    const Scalar C20 = w.cq_l_hip_roll_link*w.cq_l_hip_roll_link - w.sq_l_hip_roll_link*w.sq_l_hip_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_l_hip_roll_link*w.sq_l_hip_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(-Ia8*C20 - Ia6*t4);
-    const Scalar qq1 = 0.5*(-Ia8*t4 + Ia6*C20);
-    const Scalar h1 = 0.000475 - 0.5*Ia9;
-    const Scalar m1 = 0.000475 + 0.5*Ia9;
-    w.IA_l_hip_yaw_link[0] = 0.5 + Ia0;
-    w.IA_l_hip_yaw_link[1] = w.cq_l_hip_roll_link*Ia1 - w.sq_l_hip_roll_link*Ia2;
-    w.IA_l_hip_yaw_link[2] = w.sq_l_hip_roll_link*Ia1 + w.cq_l_hip_roll_link*Ia2;
-    w.IA_l_hip_yaw_link[4] = 0.02 - 0.015*w.cq_l_hip_roll_link - w.sq_l_hip_roll_link*Ia3;
-    w.IA_l_hip_yaw_link[5] = -0.015*w.sq_l_hip_roll_link + w.cq_l_hip_roll_link*Ia3;
-    w.IA_l_hip_yaw_link[6] = 0.5 + m0 + d0;
-    w.IA_l_hip_yaw_link[7] = qq0;
-    w.IA_l_hip_yaw_link[9] = 0.5*Ia8 + d1;
-    w.IA_l_hip_yaw_link[10] = 0.5*Ia6 + qq1;
-    w.IA_l_hip_yaw_link[11] = 0.5 + m0 - d0;
-    w.IA_l_hip_yaw_link[13] = -0.5*Ia6 + qq1;
-    w.IA_l_hip_yaw_link[14] = 0.5*Ia8 - d1;
-    w.IA_l_hip_yaw_link[18] = 0.0013 + m1 + C20*h1;
-    w.IA_l_hip_yaw_link[19] = t4*h1;
-    w.IA_l_hip_yaw_link[20] = 0.0005 + m1 - C20*h1;
-    w.pA_l_hip_yaw_link[0] = w.pA_l_hip_yaw_link[0] + pa0;
-    w.pA_l_hip_yaw_link[1] = w.pA_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*pa1 - w.sq_l_hip_roll_link*pa2;
-    w.pA_l_hip_yaw_link[2] = w.pA_l_hip_yaw_link[2] + w.sq_l_hip_roll_link*pa1 + w.cq_l_hip_roll_link*pa2;
-    w.pA_l_hip_yaw_link[3] = w.pA_l_hip_yaw_link[3] + tau[7];
-    w.pA_l_hip_yaw_link[4] = w.pA_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*pa3 - w.sq_l_hip_roll_link*pa4;
-    w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa3 + w.cq_l_hip_roll_link*pa4;
-  }
+  shared_14(shared_14_k0, &tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3277,503 +3835,75 @@ PROXGEN_RT_NOINLINE void caba_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
-  {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
-    const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
-    const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
-    const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
-    const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
-    const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
-    const Scalar t11 = w.Linv_pelvis[5]*t10;
-    const Scalar t12 = w.Linv_pelvis[5]*t11;
-    const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
-    const Scalar t14 = w.Linv_pelvis[4]*t13;
-    const Scalar t15 = w.Linv_pelvis[3]*t6 - w.L_pelvis[16]*t14 - w.L_pelvis[17]*t12;
-    const Scalar t16 = w.Linv_pelvis[3]*t15;
-    const Scalar t17 = w.Linv_pelvis[2]*t4 - w.L_pelvis[12]*t16 - w.L_pelvis[13]*t14 - w.L_pelvis[14]*t12;
-    const Scalar t18 = w.Linv_pelvis[2]*t17;
-    const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
-    const Scalar t20 = w.Linv_pelvis[1]*t19;
-    const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
-    w.qdd[0] = w.Linv_pelvis[0]*t21;
-    w.qdd[1] = w.Linv_pelvis[1]*t19;
-    w.qdd[2] = w.Linv_pelvis[2]*t17;
-    w.qdd[3] = w.Linv_pelvis[3]*t15;
-    w.qdd[4] = w.Linv_pelvis[4]*t13;
-    w.qdd[5] = w.Linv_pelvis[5]*t11;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.qdd[0];
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.qdd[1];
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.qdd[2];
-    w.a_pelvis[3] = w.qdd[3];
-    w.a_pelvis[4] = w.qdd[4];
-    w.a_pelvis[5] = w.qdd[5];
-  }
+  shared_15(shared_15_k0, w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t24 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
-    const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
-    const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
-    w.a_l_hip_yaw_link[0] = t28;
-    w.a_l_hip_yaw_link[1] = t29;
-    w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = t30;
-    w.a_l_hip_yaw_link[4] = t31;
-    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
-  }
+  shared_16(shared_16_k0, w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
-    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
-    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
-    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = t0;
-    w.a_l_hip_roll_link[2] = t1;
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = t2;
-    w.a_l_hip_roll_link[5] = t3;
-  }
+  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
-    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
-    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
-    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
-    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
-    w.qdd[8] = w.Dinv_l_thigh*t13;
-    w.a_l_thigh[0] = t9;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = t10;
-    w.a_l_thigh[3] = t11;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = t12;
-  }
+  shared_18(shared_18_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
-    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
-    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
-    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
-    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
-    w.qdd[9] = w.Dinv_l_shank*t24;
-    w.a_l_shank[0] = t20;
-    w.a_l_shank[1] = t15;
-    w.a_l_shank[2] = t21;
-    w.a_l_shank[3] = t22;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = t23;
-  }
+  shared_19(shared_19_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
-    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
-    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
-    w.qdd[10] = w.Dinv_l_ankle_link*t10;
-    w.a_l_ankle_link[0] = t6;
-    w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = t7;
-    w.a_l_ankle_link[3] = t8;
-    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = t9;
-  }
+  shared_20(shared_20_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t15 = w.u_l_foot[0] - 0.0017863999999999998*t14 - w.U_l_foot[1]*t11 - w.U_l_foot[3]*w.a_l_ankle_link[3];
-    w.qdd[11] = w.Dinv_l_foot*t15;
-    w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = t11;
-    w.a_l_foot[2] = t12;
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = t13;
-    w.a_l_foot[5] = t14;
-  }
+  shared_21(shared_21_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t18 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
-    const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
-    const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
-    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
-    w.a_r_hip_yaw_link[0] = t22;
-    w.a_r_hip_yaw_link[1] = t23;
-    w.a_r_hip_yaw_link[2] = t17;
-    w.a_r_hip_yaw_link[3] = t24;
-    w.a_r_hip_yaw_link[4] = t25;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
+  shared_22(shared_22_k0, w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
-    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
-    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
-    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = t0;
-    w.a_r_hip_roll_link[2] = t1;
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = t2;
-    w.a_r_hip_roll_link[5] = t3;
-  }
+  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
-    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
-    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
-    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
-    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
-    w.qdd[14] = w.Dinv_r_thigh*t13;
-    w.a_r_thigh[0] = t9;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = t10;
-    w.a_r_thigh[3] = t11;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = t12;
-  }
+  shared_18(shared_18_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
-    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
-    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
-    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
-    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
-    w.qdd[15] = w.Dinv_r_shank*t24;
-    w.a_r_shank[0] = t20;
-    w.a_r_shank[1] = t15;
-    w.a_r_shank[2] = t21;
-    w.a_r_shank[3] = t22;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = t23;
-  }
+  shared_19(shared_19_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
-    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
-    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
-    w.qdd[16] = w.Dinv_r_ankle_link*t10;
-    w.a_r_ankle_link[0] = t6;
-    w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = t7;
-    w.a_r_ankle_link[3] = t8;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = t9;
-  }
+  shared_20(shared_20_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t15 = w.u_r_foot[0] - 0.0017863999999999998*t14 - w.U_r_foot[1]*t11 - w.U_r_foot[3]*w.a_r_ankle_link[3];
-    w.qdd[17] = w.Dinv_r_foot*t15;
-    w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = t11;
-    w.a_r_foot[2] = t12;
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = t13;
-    w.a_r_foot[5] = t14;
-  }
+  shared_21(shared_21_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t22;
-    w.a_abdomen[0] = t18;
-    w.a_abdomen[1] = t19;
-    w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = t20;
-    w.a_abdomen[4] = t21;
-    w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
-  }
+  shared_23(shared_23_k0, w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  {
-    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
-    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
-    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
-    w.qdd[19] = w.Dinv_chest*t6;
-    w.a_chest[0] = t2;
-    w.a_chest[1] = t1;
-    w.a_chest[2] = t3;
-    w.a_chest[3] = t4;
-    w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = t5;
-  }
+  shared_24(shared_24_k0, w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t10 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
-    const Scalar t11 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
-    const Scalar t12 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
-    const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
-    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
-    w.a_r_shoulder_pitch_link[0] = t16;
-    w.a_r_shoulder_pitch_link[1] = t11;
-    w.a_r_shoulder_pitch_link[2] = t17;
-    w.a_r_shoulder_pitch_link[3] = t18;
-    w.a_r_shoulder_pitch_link[4] = t14 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = t19;
-  }
+  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = t21;
-    w.a_r_shoulder_roll_link[2] = t22;
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = t23;
-    w.a_r_shoulder_roll_link[5] = t24;
-  }
+  shared_26(&w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.a_r_shoulder_pitch_link, w.sq_r_shoulder_roll_link, w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
-    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
-    w.qdd[31] = w.Dinv_r_upper_arm*t4;
-    w.a_r_upper_arm[0] = t0;
-    w.a_r_upper_arm[1] = t1;
-    w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = t2;
-    w.a_r_upper_arm[4] = t3;
-    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
-  }
+  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  {
-    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t7 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
-    const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
-    const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
-    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t15;
-    w.a_r_forearm[0] = t11;
-    w.a_r_forearm[1] = t6;
-    w.a_r_forearm[2] = t12;
-    w.a_r_forearm[3] = t13;
-    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = t14;
-  }
+  shared_28(shared_28_k0, w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
-    w.a_r_wrist_yaw_link[0] = t18;
-    w.a_r_wrist_yaw_link[1] = t19;
-    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = t20;
-    w.a_r_wrist_yaw_link[4] = t21;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
-  }
+  shared_29(shared_29_k0, w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  {
-    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
-    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
-    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
-    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
-    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
-    w.a_r_wrist_pitch_link[0] = t0;
-    w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = t1;
-    w.a_r_wrist_pitch_link[3] = t2;
-    w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = t3;
-  }
+  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, w.cq_r_wrist_pitch_link, w.sq_r_wrist_pitch_link, w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  {
-    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t9 = w.u_r_hand[0] - w.U_r_hand[1]*t5 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
-    w.qdd[35] = w.Dinv_r_hand*t9;
-    w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = t5;
-    w.a_r_hand[2] = t6;
-    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = t7;
-    w.a_r_hand[5] = t8;
-  }
+  shared_31(&w.c_r_hand[1], w.cq_r_hand, w.a_r_wrist_pitch_link, w.sq_r_hand, w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  {
-    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.residual[0] = w.active[0]*t0;
-    w.dlambda[0] = mu*w.residual[0];
-    w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.residual[1] = w.active[0]*t1;
-    w.dlambda[1] = mu*w.residual[1];
-    w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.residual[2] = w.active[0]*t2;
-    w.dlambda[2] = mu*w.residual[2];
-    w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_l_foot[3]*w.active[0];
-    w.dlambda[3] = mu*w.residual[3];
-    w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_l_foot[4]*w.active[0];
-    w.dlambda[4] = mu*w.residual[4];
-    w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_l_foot[5]*w.active[0];
-    w.dlambda[5] = mu*w.residual[5];
-    w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.residual[6] = w.active[1]*t3;
-    w.dlambda[6] = mu*w.residual[6];
-    w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.residual[7] = w.active[1]*t4;
-    w.dlambda[7] = mu*w.residual[7];
-    w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.residual[8] = w.active[1]*t5;
-    w.dlambda[8] = mu*w.residual[8];
-    w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_r_foot[3]*w.active[1];
-    w.dlambda[9] = mu*w.residual[9];
-    w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_r_foot[4]*w.active[1];
-    w.dlambda[10] = mu*w.residual[10];
-    w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_r_foot[5]*w.active[1];
-    w.dlambda[11] = mu*w.residual[11];
-    w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.residual[12] = w.active[2]*t6;
-    w.dlambda[12] = mu*w.residual[12];
-    w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
-    w.residual[13] = w.active[2]*t7;
-    w.dlambda[13] = mu*w.residual[13];
-    w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
-    w.residual[14] = w.active[2]*t8;
-    w.dlambda[14] = mu*w.residual[14];
-    w.lambda[14] = w.lambda[14] + w.dlambda[14];
-  }
+  shared_32(shared_32_k0, mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3926,19 +4056,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_REST
     w.dp_pelvis[4] = w.sq_abdomen*t12 + w.cq_abdomen*t13 + 0.1*t14;
   }
   // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar du0 = -0.06825*w.dlambda[7] - w.dlambda[9];
-    w.u_r_foot[0] = w.u_r_foot[0] + du0;
-    const Scalar t16 = w.Dinv_r_foot*du0;
-    const Scalar t17 = w.dlambda[7] + w.U_r_foot[1]*t16;
-    const Scalar t18 = -0.06825*w.dlambda[6] + w.dlambda[10];
-    const Scalar t19 = w.dlambda[11] + 0.0017863999999999998*w.Dinv_r_foot*du0;
-    w.dp_r_ankle_link[0] = w.dlambda[6];
-    w.dp_r_ankle_link[1] = w.cq_r_foot*t17 - w.sq_r_foot*w.dlambda[8];
-    w.dp_r_ankle_link[2] = w.sq_r_foot*t17 + w.cq_r_foot*w.dlambda[8];
-    w.dp_r_ankle_link[4] = w.cq_r_foot*t18 - w.sq_r_foot*t19;
-    w.dp_r_ankle_link[5] = w.sq_r_foot*t18 + w.cq_r_foot*t19;
-  }
+  shared_33(shared_33_k0, &w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, w.cq_r_foot, w.sq_r_foot);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3984,24 +4102,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN
     w.dp_r_thigh[5] = -0.19866933079506124*t17 + 0.9800665778412416*t18;
   }
   // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    w.u_r_thigh[0] = w.u_r_thigh[0] - w.dp_r_thigh[4];
-    const Scalar t21 = -w.Dinv_r_thigh*w.dp_r_thigh[4];
-    const Scalar t22 = w.dp_r_thigh[0] + w.IA_r_thigh[4]*t21;
-    const Scalar t23 = w.dp_r_thigh[1] + w.IA_r_thigh[9]*t21;
-    const Scalar t24 = w.dp_r_thigh[2] + w.IA_r_thigh[13]*t21;
-    const Scalar t25 = w.dp_r_thigh[3] + w.IA_r_thigh[16]*t21;
-    const Scalar t26 = w.dp_r_thigh[5] + w.IA_r_thigh[19]*t21;
-    const Scalar t27 = w.cq_r_thigh*t22 + w.sq_r_thigh*t24;
-    const Scalar t28 = -w.sq_r_thigh*t22 + w.cq_r_thigh*t24;
-    const Scalar t29 = w.cq_r_thigh*t25 + w.sq_r_thigh*t26;
-    const Scalar t30 = -w.sq_r_thigh*t25 + w.cq_r_thigh*t26;
-    w.dp_r_hip_roll_link[0] = 0.9950041652780258*t27 - 0.09983341664682815*t28;
-    w.dp_r_hip_roll_link[1] = t23;
-    w.dp_r_hip_roll_link[2] = 0.09983341664682815*t27 + 0.9950041652780258*t28;
-    w.dp_r_hip_roll_link[3] = 0.9950041652780258*t29 - 0.09983341664682815*t30;
-    w.dp_r_hip_roll_link[5] = 0.09983341664682815*t29 + 0.9950041652780258*t30;
-  }
+  shared_34(shared_34_k0, w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], w.cq_r_thigh, w.sq_r_thigh, w.dp_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4039,19 +4140,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace&
     w.dp_pelvis[5] = 0.0875*t12;
   }
   // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar du0 = -0.06825*w.dlambda[1] - w.dlambda[3];
-    w.u_l_foot[0] = w.u_l_foot[0] + du0;
-    const Scalar t14 = w.Dinv_l_foot*du0;
-    const Scalar t15 = w.dlambda[1] + w.U_l_foot[1]*t14;
-    const Scalar t16 = -0.06825*w.dlambda[0] + w.dlambda[4];
-    const Scalar t17 = w.dlambda[5] + 0.0017863999999999998*w.Dinv_l_foot*du0;
-    w.dp_l_ankle_link[0] = w.dlambda[0];
-    w.dp_l_ankle_link[1] = w.cq_l_foot*t15 - w.sq_l_foot*w.dlambda[2];
-    w.dp_l_ankle_link[2] = w.sq_l_foot*t15 + w.cq_l_foot*w.dlambda[2];
-    w.dp_l_ankle_link[4] = w.cq_l_foot*t16 - w.sq_l_foot*t17;
-    w.dp_l_ankle_link[5] = w.sq_l_foot*t16 + w.cq_l_foot*t17;
-  }
+  shared_33(shared_33_k0, w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, w.cq_l_foot, w.sq_l_foot);
   // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.u_l_ankle_link[0] = w.u_l_ankle_link[0] - w.dp_l_ankle_link[4];
@@ -4097,24 +4186,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROX
     w.dp_l_thigh[5] = -0.19866933079506124*t8 + 0.9800665778412416*t9;
   }
   // reduced sweep: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    w.u_l_thigh[0] = w.u_l_thigh[0] - w.dp_l_thigh[4];
-    const Scalar t12 = -w.Dinv_l_thigh*w.dp_l_thigh[4];
-    const Scalar t13 = w.dp_l_thigh[0] + w.IA_l_thigh[4]*t12;
-    const Scalar t14 = w.dp_l_thigh[1] + w.IA_l_thigh[9]*t12;
-    const Scalar t15 = w.dp_l_thigh[2] + w.IA_l_thigh[13]*t12;
-    const Scalar t16 = w.dp_l_thigh[3] + w.IA_l_thigh[16]*t12;
-    const Scalar t17 = w.dp_l_thigh[5] + w.IA_l_thigh[19]*t12;
-    const Scalar t18 = w.cq_l_thigh*t13 + w.sq_l_thigh*t15;
-    const Scalar t19 = -w.sq_l_thigh*t13 + w.cq_l_thigh*t15;
-    const Scalar t20 = w.cq_l_thigh*t16 + w.sq_l_thigh*t17;
-    const Scalar t21 = -w.sq_l_thigh*t16 + w.cq_l_thigh*t17;
-    w.dp_l_hip_roll_link[0] = 0.9950041652780258*t18 - 0.09983341664682815*t19;
-    w.dp_l_hip_roll_link[1] = t14;
-    w.dp_l_hip_roll_link[2] = 0.09983341664682815*t18 + 0.9950041652780258*t19;
-    w.dp_l_hip_roll_link[3] = 0.9950041652780258*t20 - 0.09983341664682815*t21;
-    w.dp_l_hip_roll_link[5] = 0.09983341664682815*t20 + 0.9950041652780258*t21;
-  }
+  shared_34(shared_34_k0, w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], w.cq_l_thigh, w.sq_l_thigh, w.dp_l_hip_roll_link);
   // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.u_l_hip_roll_link[0] = w.u_l_hip_roll_link[0] - w.dp_l_hip_roll_link[3];
@@ -4164,545 +4236,82 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_hip_yaw_link_to_pelvis(Workspace& PROXGE
 
 PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
-  {
-    const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
-    const Scalar t1 = w.Linv_pelvis[0]*t0;
-    const Scalar t2 = w.u_pelvis[1] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[6] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[7] - w.L_pelvis[1]*t1;
-    const Scalar t3 = w.Linv_pelvis[1]*t2;
-    const Scalar t4 = w.u_pelvis[2] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[2] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[7] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[11] - w.L_pelvis[2]*t1 - w.L_pelvis[7]*t3;
-    const Scalar t5 = w.Linv_pelvis[2]*t4;
-    const Scalar t6 = w.u_pelvis[3] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[3] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[8] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[12] - w.L_pelvis[3]*t1 - w.L_pelvis[8]*t3 - w.L_pelvis[12]*t5;
-    const Scalar t7 = w.Linv_pelvis[3]*t6;
-    const Scalar t8 = w.u_pelvis[4] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[4] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[9] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[13] - w.L_pelvis[4]*t1 - w.L_pelvis[9]*t3 - w.L_pelvis[13]*t5 - w.L_pelvis[16]*t7;
-    const Scalar t9 = w.Linv_pelvis[4]*t8;
-    const Scalar t10 = w.u_pelvis[5] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[5] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[10] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[14] - w.L_pelvis[5]*t1 - w.L_pelvis[10]*t3 - w.L_pelvis[14]*t5 - w.L_pelvis[17]*t7 - w.L_pelvis[19]*t9;
-    const Scalar t11 = w.Linv_pelvis[5]*t10;
-    const Scalar t12 = w.Linv_pelvis[5]*t11;
-    const Scalar t13 = w.Linv_pelvis[4]*t8 - w.L_pelvis[19]*t12;
-    const Scalar t14 = w.Linv_pelvis[4]*t13;
-    const Scalar t15 = w.Linv_pelvis[3]*t6 - w.L_pelvis[16]*t14 - w.L_pelvis[17]*t12;
-    const Scalar t16 = w.Linv_pelvis[3]*t15;
-    const Scalar t17 = w.Linv_pelvis[2]*t4 - w.L_pelvis[12]*t16 - w.L_pelvis[13]*t14 - w.L_pelvis[14]*t12;
-    const Scalar t18 = w.Linv_pelvis[2]*t17;
-    const Scalar t19 = w.Linv_pelvis[1]*t2 - w.L_pelvis[7]*t18 - w.L_pelvis[8]*t16 - w.L_pelvis[9]*t14 - w.L_pelvis[10]*t12;
-    const Scalar t20 = w.Linv_pelvis[1]*t19;
-    const Scalar t21 = w.Linv_pelvis[0]*t0 - w.L_pelvis[1]*t20 - w.L_pelvis[2]*t18 - w.L_pelvis[3]*t16 - w.L_pelvis[4]*t14 - w.L_pelvis[5]*t12;
-    w.qdd[0] = w.Linv_pelvis[0]*t21;
-    w.qdd[1] = w.Linv_pelvis[1]*t19;
-    w.qdd[2] = w.Linv_pelvis[2]*t17;
-    w.qdd[3] = w.Linv_pelvis[3]*t15;
-    w.qdd[4] = w.Linv_pelvis[4]*t13;
-    w.qdd[5] = w.Linv_pelvis[5]*t11;
-    w.a_pelvis[0] = 9.81*w.RJ_pelvis[2][0] + w.qdd[0];
-    w.a_pelvis[1] = 9.81*w.RJ_pelvis[2][1] + w.qdd[1];
-    w.a_pelvis[2] = 9.81*w.RJ_pelvis[2][2] + w.qdd[2];
-    w.a_pelvis[3] = w.qdd[3];
-    w.a_pelvis[4] = w.qdd[4];
-    w.a_pelvis[5] = w.qdd[5];
-  }
+  shared_15(shared_15_k0, w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t24 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
-    const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
-    const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
-    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
-    w.a_l_hip_yaw_link[0] = t28;
-    w.a_l_hip_yaw_link[1] = t29;
-    w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = t30;
-    w.a_l_hip_yaw_link[4] = t31;
-    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
-  }
+  shared_16(shared_16_k0, w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
-    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
-    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
-    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = t0;
-    w.a_l_hip_roll_link[2] = t1;
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = t2;
-    w.a_l_hip_roll_link[5] = t3;
-  }
+  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
-    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
-    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
-    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
-    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
-    w.qdd[8] = w.Dinv_l_thigh*t13;
-    w.a_l_thigh[0] = t9;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = t10;
-    w.a_l_thigh[3] = t11;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = t12;
-  }
+  shared_18(shared_18_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
-    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
-    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
-    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
-    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
-    w.qdd[9] = w.Dinv_l_shank*t24;
-    w.a_l_shank[0] = t20;
-    w.a_l_shank[1] = t15;
-    w.a_l_shank[2] = t21;
-    w.a_l_shank[3] = t22;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = t23;
-  }
+  shared_19(shared_19_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
-    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
-    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
-    w.qdd[10] = w.Dinv_l_ankle_link*t10;
-    w.a_l_ankle_link[0] = t6;
-    w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = t7;
-    w.a_l_ankle_link[3] = t8;
-    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = t9;
-  }
+  shared_20(shared_20_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t15 = w.u_l_foot[0] - 0.0017863999999999998*t14 - w.U_l_foot[1]*t11 - w.U_l_foot[3]*w.a_l_ankle_link[3];
-    w.qdd[11] = w.Dinv_l_foot*t15;
-    w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = t11;
-    w.a_l_foot[2] = t12;
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = t13;
-    w.a_l_foot[5] = t14;
-  }
+  shared_21(shared_21_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t18 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
-    const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
-    const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
-    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
-    w.a_r_hip_yaw_link[0] = t22;
-    w.a_r_hip_yaw_link[1] = t23;
-    w.a_r_hip_yaw_link[2] = t17;
-    w.a_r_hip_yaw_link[3] = t24;
-    w.a_r_hip_yaw_link[4] = t25;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
+  shared_22(shared_22_k0, w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
-    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
-    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
-    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = t0;
-    w.a_r_hip_roll_link[2] = t1;
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = t2;
-    w.a_r_hip_roll_link[5] = t3;
-  }
+  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
-    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
-    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
-    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
-    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
-    w.qdd[14] = w.Dinv_r_thigh*t13;
-    w.a_r_thigh[0] = t9;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = t10;
-    w.a_r_thigh[3] = t11;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = t12;
-  }
+  shared_18(shared_18_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
-    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
-    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
-    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
-    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
-    w.qdd[15] = w.Dinv_r_shank*t24;
-    w.a_r_shank[0] = t20;
-    w.a_r_shank[1] = t15;
-    w.a_r_shank[2] = t21;
-    w.a_r_shank[3] = t22;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = t23;
-  }
+  shared_19(shared_19_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
-    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
-    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
-    w.qdd[16] = w.Dinv_r_ankle_link*t10;
-    w.a_r_ankle_link[0] = t6;
-    w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = t7;
-    w.a_r_ankle_link[3] = t8;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = t9;
-  }
+  shared_20(shared_20_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t15 = w.u_r_foot[0] - 0.0017863999999999998*t14 - w.U_r_foot[1]*t11 - w.U_r_foot[3]*w.a_r_ankle_link[3];
-    w.qdd[17] = w.Dinv_r_foot*t15;
-    w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = t11;
-    w.a_r_foot[2] = t12;
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = t13;
-    w.a_r_foot[5] = t14;
-  }
+  shared_21(shared_21_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
-    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t22;
-    w.a_abdomen[0] = t18;
-    w.a_abdomen[1] = t19;
-    w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = t20;
-    w.a_abdomen[4] = t21;
-    w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
-  }
+  shared_23(shared_23_k0, w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  {
-    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
-    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
-    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
-    w.qdd[19] = w.Dinv_chest*t6;
-    w.a_chest[0] = t2;
-    w.a_chest[1] = t1;
-    w.a_chest[2] = t3;
-    w.a_chest[3] = t4;
-    w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = t5;
-  }
+  shared_24(shared_24_k0, w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t10 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
-    const Scalar t11 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
-    const Scalar t12 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
-    const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
-    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
-    w.a_r_shoulder_pitch_link[0] = t16;
-    w.a_r_shoulder_pitch_link[1] = t11;
-    w.a_r_shoulder_pitch_link[2] = t17;
-    w.a_r_shoulder_pitch_link[3] = t18;
-    w.a_r_shoulder_pitch_link[4] = t14 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = t19;
-  }
+  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = t21;
-    w.a_r_shoulder_roll_link[2] = t22;
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = t23;
-    w.a_r_shoulder_roll_link[5] = t24;
-  }
+  shared_26(&w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.a_r_shoulder_pitch_link, w.sq_r_shoulder_roll_link, w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
-    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
-    w.qdd[31] = w.Dinv_r_upper_arm*t4;
-    w.a_r_upper_arm[0] = t0;
-    w.a_r_upper_arm[1] = t1;
-    w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = t2;
-    w.a_r_upper_arm[4] = t3;
-    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
-  }
+  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  {
-    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t7 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
-    const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
-    const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
-    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t15;
-    w.a_r_forearm[0] = t11;
-    w.a_r_forearm[1] = t6;
-    w.a_r_forearm[2] = t12;
-    w.a_r_forearm[3] = t13;
-    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = t14;
-  }
+  shared_28(shared_28_k0, w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
-    w.a_r_wrist_yaw_link[0] = t18;
-    w.a_r_wrist_yaw_link[1] = t19;
-    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = t20;
-    w.a_r_wrist_yaw_link[4] = t21;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
-  }
+  shared_29(shared_29_k0, w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  {
-    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
-    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
-    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
-    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
-    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
-    w.a_r_wrist_pitch_link[0] = t0;
-    w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = t1;
-    w.a_r_wrist_pitch_link[3] = t2;
-    w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = t3;
-  }
+  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, w.cq_r_wrist_pitch_link, w.sq_r_wrist_pitch_link, w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  {
-    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t9 = w.u_r_hand[0] - w.U_r_hand[1]*t5 - w.U_r_hand[3]*w.a_r_wrist_pitch_link[3];
-    w.qdd[35] = w.Dinv_r_hand*t9;
-    w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = t5;
-    w.a_r_hand[2] = t6;
-    w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = t7;
-    w.a_r_hand[5] = t8;
-  }
+  shared_31(&w.c_r_hand[1], w.cq_r_hand, w.a_r_wrist_pitch_link, w.sq_r_hand, w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  {
-    const Scalar t0 = w.g_l_ankle_link[0] + w.a_l_foot[0] - 0.06825*w.a_l_foot[4];
-    w.residual[0] = w.active[0]*t0;
-    w.dlambda[0] = mu*w.residual[0];
-    w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_l_foot[1] + 0.06825*w.a_l_foot[3] + w.g_l_foot[1];
-    w.residual[1] = w.active[0]*t1;
-    w.dlambda[1] = mu*w.residual[1];
-    w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_l_foot[2] + w.g_l_foot[2];
-    w.residual[2] = w.active[0]*t2;
-    w.dlambda[2] = mu*w.residual[2];
-    w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    w.residual[3] = w.a_l_foot[3]*w.active[0];
-    w.dlambda[3] = mu*w.residual[3];
-    w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    w.residual[4] = w.a_l_foot[4]*w.active[0];
-    w.dlambda[4] = mu*w.residual[4];
-    w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    w.residual[5] = w.a_l_foot[5]*w.active[0];
-    w.dlambda[5] = mu*w.residual[5];
-    w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t3 = w.g_r_ankle_link[0] + w.a_r_foot[0] - 0.06825*w.a_r_foot[4];
-    w.residual[6] = w.active[1]*t3;
-    w.dlambda[6] = mu*w.residual[6];
-    w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t4 = w.a_r_foot[1] + 0.06825*w.a_r_foot[3] + w.g_r_foot[1];
-    w.residual[7] = w.active[1]*t4;
-    w.dlambda[7] = mu*w.residual[7];
-    w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t5 = w.a_r_foot[2] + w.g_r_foot[2];
-    w.residual[8] = w.active[1]*t5;
-    w.dlambda[8] = mu*w.residual[8];
-    w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    w.residual[9] = w.a_r_foot[3]*w.active[1];
-    w.dlambda[9] = mu*w.residual[9];
-    w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    w.residual[10] = w.a_r_foot[4]*w.active[1];
-    w.dlambda[10] = mu*w.residual[10];
-    w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    w.residual[11] = w.a_r_foot[5]*w.active[1];
-    w.dlambda[11] = mu*w.residual[11];
-    w.lambda[11] = w.lambda[11] + w.dlambda[11];
-    const Scalar t6 = w.a_r_hand[1] + 0.13*w.a_r_hand[3] - w.k_right_hand[0];
-    w.residual[12] = w.active[2]*t6;
-    w.dlambda[12] = mu*w.residual[12];
-    w.lambda[12] = w.lambda[12] + w.dlambda[12];
-    const Scalar t7 = -w.a_r_hand[0] + 0.13*w.a_r_hand[4] - w.k_right_hand[1];
-    w.residual[13] = w.active[2]*t7;
-    w.dlambda[13] = mu*w.residual[13];
-    w.lambda[13] = w.lambda[13] + w.dlambda[13];
-    const Scalar t8 = w.a_r_hand[2] - w.k_right_hand[2];
-    w.residual[14] = w.active[2]*t8;
-    w.dlambda[14] = mu*w.residual[14];
-    w.lambda[14] = w.lambda[14] + w.dlambda[14];
-  }
+  shared_32(shared_32_k0, mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
 PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
-  {
-    const Scalar t0 = w.a_chest[0] + 0.254*w.a_chest[4] - 0.19*w.a_chest[5];
-    const Scalar t1 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t2 = w.a_chest[2] + 0.19*w.a_chest[3];
-    const Scalar t3 = 0.9848134698792882*t0 + 0.17361575258114187*t2;
-    const Scalar t4 = -0.04493516596384369*t0 + 0.9659256678396477*t1 + 0.2548890642384102*t2;
-    const Scalar t5 = -0.1676999117594225*t0 - 0.2588196364430848*t1 + 0.9512566085906322*t2;
-    const Scalar t6 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t7 = -0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] + 0.2548890642384102*w.a_chest[5];
-    const Scalar t8 = -0.1676999117594225*w.a_chest[3] - 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t9 = w.c_l_shoulder_pitch_link[0] + w.cq_l_shoulder_pitch_link*t3 - w.sq_l_shoulder_pitch_link*t5;
-    const Scalar t10 = w.c_l_shoulder_pitch_link[2] + w.sq_l_shoulder_pitch_link*t3 + w.cq_l_shoulder_pitch_link*t5;
-    const Scalar t11 = w.c_l_shoulder_pitch_link[3] + w.cq_l_shoulder_pitch_link*t6 - w.sq_l_shoulder_pitch_link*t8;
-    const Scalar t12 = w.c_l_shoulder_pitch_link[5] + w.sq_l_shoulder_pitch_link*t6 + w.cq_l_shoulder_pitch_link*t8;
-    const Scalar t13 = w.u_l_shoulder_pitch_link[0] - w.IA_l_shoulder_pitch_link[4]*t9 - w.IA_l_shoulder_pitch_link[9]*t4 - w.IA_l_shoulder_pitch_link[13]*t10 - w.IA_l_shoulder_pitch_link[18]*t7 - w.IA_l_shoulder_pitch_link[19]*t12;
-    w.qdd[20] = w.Dinv_l_shoulder_pitch_link*t13;
-    w.a_l_shoulder_pitch_link[0] = t9;
-    w.a_l_shoulder_pitch_link[1] = t4;
-    w.a_l_shoulder_pitch_link[2] = t10;
-    w.a_l_shoulder_pitch_link[3] = t11;
-    w.a_l_shoulder_pitch_link[4] = t7 + w.qdd[20];
-    w.a_l_shoulder_pitch_link[5] = t12;
-  }
+  shared_25(shared_25_k1, w.a_chest, w.c_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link, w.sq_l_shoulder_pitch_link, w.u_l_shoulder_pitch_link, &w.IA_l_shoulder_pitch_link[4], &w.qdd[20], w.Dinv_l_shoulder_pitch_link, w.a_l_shoulder_pitch_link);
   // accelerate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  {
-    const Scalar t14 = w.c_l_shoulder_roll_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
-    const Scalar t15 = w.c_l_shoulder_roll_link[2] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[1] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[2];
-    const Scalar t16 = w.c_l_shoulder_roll_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
-    const Scalar t17 = w.c_l_shoulder_roll_link[5] - w.sq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[4] + w.cq_l_shoulder_roll_link*w.a_l_shoulder_pitch_link[5];
-    const Scalar t18 = w.u_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*w.a_l_shoulder_pitch_link[0] - w.IA_l_shoulder_roll_link[8]*t14 - w.IA_l_shoulder_roll_link[12]*t15 - w.IA_l_shoulder_roll_link[15]*w.a_l_shoulder_pitch_link[3] - w.IA_l_shoulder_roll_link[16]*t16;
-    w.qdd[21] = w.Dinv_l_shoulder_roll_link*t18;
-    w.a_l_shoulder_roll_link[0] = w.a_l_shoulder_pitch_link[0];
-    w.a_l_shoulder_roll_link[1] = t14;
-    w.a_l_shoulder_roll_link[2] = t15;
-    w.a_l_shoulder_roll_link[3] = w.a_l_shoulder_pitch_link[3] + w.qdd[21];
-    w.a_l_shoulder_roll_link[4] = t16;
-    w.a_l_shoulder_roll_link[5] = t17;
-  }
+  shared_26(&w.c_l_shoulder_roll_link[1], w.cq_l_shoulder_roll_link, w.a_l_shoulder_pitch_link, w.sq_l_shoulder_roll_link, w.u_l_shoulder_roll_link, &w.IA_l_shoulder_roll_link[3], &w.qdd[21], w.Dinv_l_shoulder_roll_link, w.a_l_shoulder_roll_link);
   // accelerate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
     const Scalar t19 = w.c_l_upper_arm[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[1];
@@ -4743,22 +4352,7 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspa
     w.a_l_forearm[5] = t9;
   }
   // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  {
-    const Scalar t11 = w.a_l_forearm[0] - 0.2555*w.a_l_forearm[4];
-    const Scalar t12 = w.a_l_forearm[1] + 0.2555*w.a_l_forearm[3];
-    const Scalar t13 = w.c_l_wrist_yaw_link[0] + w.cq_l_wrist_yaw_link*t11 + w.sq_l_wrist_yaw_link*t12;
-    const Scalar t14 = w.c_l_wrist_yaw_link[1] - w.sq_l_wrist_yaw_link*t11 + w.cq_l_wrist_yaw_link*t12;
-    const Scalar t15 = w.c_l_wrist_yaw_link[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[3] + w.sq_l_wrist_yaw_link*w.a_l_forearm[4];
-    const Scalar t16 = w.c_l_wrist_yaw_link[4] - w.sq_l_wrist_yaw_link*w.a_l_forearm[3] + w.cq_l_wrist_yaw_link*w.a_l_forearm[4];
-    const Scalar t17 = w.u_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t13 - w.IA_l_wrist_yaw_link[10]*t14 - w.IA_l_wrist_yaw_link[14]*w.a_l_forearm[2] - w.IA_l_wrist_yaw_link[17]*t15 - w.IA_l_wrist_yaw_link[20]*w.a_l_forearm[5];
-    w.qdd[24] = w.Dinv_l_wrist_yaw_link*t17;
-    w.a_l_wrist_yaw_link[0] = t13;
-    w.a_l_wrist_yaw_link[1] = t14;
-    w.a_l_wrist_yaw_link[2] = w.a_l_forearm[2];
-    w.a_l_wrist_yaw_link[3] = t15;
-    w.a_l_wrist_yaw_link[4] = t16;
-    w.a_l_wrist_yaw_link[5] = w.a_l_forearm[5] + w.qdd[24];
-  }
+  shared_29(shared_29_k0, w.a_l_forearm, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
   // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
     const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
@@ -5644,578 +5238,27 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void pv_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    w.u_r_foot[0] = -w.pA_r_foot[3] + tau[17];
-    const Scalar pa0 = -0.027912499999999996*w.c_r_foot[4] + w.pA_r_foot[0];
-    const Scalar pa1 = 0.614466237626843*w.c_r_foot[1] + 0.039325839208117955*w.c_r_foot[5] + w.pA_r_foot[1] + 14.34961978945479*w.u_r_foot[0];
-    const Scalar pa2 = 1.015*w.c_r_foot[2] - 0.06495999999999999*w.c_r_foot[4] + w.pA_r_foot[2];
-    const Scalar pa3 = -0.06495999999999999*w.c_r_foot[2] + 0.00936987670937*w.c_r_foot[4] + w.pA_r_foot[4];
-    const Scalar pa4 = 0.039325839208117955*w.c_r_foot[1] + 0.006961696668689549*w.c_r_foot[5] + w.pA_r_foot[5] + 0.9183756665251066*w.u_r_foot[0];
-    const Scalar C20 = w.cq_r_foot*w.cq_r_foot - w.sq_r_foot*w.sq_r_foot;
-    w.IA_r_ankle_link[4] = -0.027912499999999996*w.cq_r_foot;
-    w.IA_r_ankle_link[5] = -0.027912499999999996*w.sq_r_foot;
-    w.IA_r_ankle_link[6] = 1.0147331188134214 - 0.20026688118657843*C20;
-    w.IA_r_ankle_link[7] = -0.40053376237315685*w.cq_r_foot*w.sq_r_foot;
-    w.IA_r_ankle_link[9] = 0.025634160791882035*w.cq_r_foot*w.sq_r_foot;
-    w.IA_r_ankle_link[10] = 0.05214291960405897 - 0.012817080395941018*C20;
-    w.IA_r_ankle_link[11] = 1.0147331188134214 + 0.20026688118657843*C20;
-    w.IA_r_ankle_link[13] = -0.05214291960405897 - 0.012817080395941018*C20;
-    w.IA_r_ankle_link[14] = -0.025634160791882035*w.cq_r_foot*w.sq_r_foot;
-    w.IA_r_ankle_link[18] = 0.008237786689029773 + 0.0012040900203402253*C20;
-    w.IA_r_ankle_link[19] = 0.0024081800406804505*w.cq_r_foot*w.sq_r_foot;
-    w.IA_r_ankle_link[20] = 0.008237786689029773 - 0.0012040900203402253*C20;
-    w.pA_r_ankle_link[0] = w.pA_r_ankle_link[0] + pa0;
-    w.pA_r_ankle_link[1] = w.pA_r_ankle_link[1] + w.cq_r_foot*pa1 - w.sq_r_foot*pa2;
-    w.pA_r_ankle_link[2] = w.pA_r_ankle_link[2] + w.sq_r_foot*pa1 + w.cq_r_foot*pa2;
-    w.pA_r_ankle_link[3] = tau[17];
-    w.pA_r_ankle_link[4] = w.cq_r_foot*pa3 - w.sq_r_foot*pa4;
-    w.pA_r_ankle_link[5] = w.sq_r_foot*pa3 + w.cq_r_foot*pa4;
-    w.KA_r_ankle_link[4][0] = -0.06825*w.cq_r_foot;
-    w.KA_r_ankle_link[5][0] = -0.06825*w.sq_r_foot;
-    w.KA_r_ankle_link[1][1] = 0.020638449369710488*w.cq_r_foot;
-    w.KA_r_ankle_link[2][1] = 0.020638449369710488*w.sq_r_foot;
-    w.KA_r_ankle_link[4][1] = 0.06267913924033854*w.sq_r_foot;
-    w.KA_r_ankle_link[5][1] = -0.06267913924033854*w.cq_r_foot;
-    w.KA_r_ankle_link[1][2] = -w.sq_r_foot;
-    w.KA_r_ankle_link[2][2] = w.cq_r_foot;
-    w.KA_r_ankle_link[1][3] = -14.34961978945479*w.cq_r_foot;
-    w.KA_r_ankle_link[2][3] = -14.34961978945479*w.sq_r_foot;
-    w.KA_r_ankle_link[4][3] = 0.9183756665251066*w.sq_r_foot;
-    w.KA_r_ankle_link[5][3] = -0.9183756665251066*w.cq_r_foot;
-    w.KA_r_ankle_link[4][4] = w.cq_r_foot;
-    w.KA_r_ankle_link[5][4] = w.sq_r_foot;
-    w.KA_r_ankle_link[4][5] = -w.sq_r_foot;
-    w.KA_r_ankle_link[5][5] = w.cq_r_foot;
-  }
+  shared_35(shared_35_k0, &tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    w.Dinv_r_ankle_link = 1.0 / w.IA_r_ankle_link[18];
-    w.u_r_ankle_link[0] = -w.pA_r_ankle_link[4] + tau[16];
-    const Scalar t0 = w.IA_r_ankle_link[4]*w.Dinv_r_ankle_link;
-    const Scalar t1 = w.IA_r_ankle_link[9]*w.Dinv_r_ankle_link;
-    const Scalar t2 = w.IA_r_ankle_link[13]*w.Dinv_r_ankle_link;
-    const Scalar t3 = w.IA_r_ankle_link[19]*w.Dinv_r_ankle_link;
-    const Scalar Ia0 = 1.2149999999999999 - w.IA_r_ankle_link[4]*t0;
-    const Scalar Ia1 = w.IA_r_ankle_link[5] - w.IA_r_ankle_link[19]*t0;
-    const Scalar Ia2 = w.IA_r_ankle_link[6] - w.IA_r_ankle_link[9]*t1;
-    const Scalar Ia3 = w.IA_r_ankle_link[7] - w.IA_r_ankle_link[13]*t1;
-    const Scalar Ia4 = w.IA_r_ankle_link[10] - w.IA_r_ankle_link[19]*t1;
-    const Scalar Ia5 = w.IA_r_ankle_link[11] - w.IA_r_ankle_link[13]*t2;
-    const Scalar Ia6 = w.IA_r_ankle_link[14] - w.IA_r_ankle_link[19]*t2;
-    const Scalar Ia7 = w.IA_r_ankle_link[20] - w.IA_r_ankle_link[19]*t3;
-    const Scalar t4 = -w.IA_r_ankle_link[13]*t0;
-    const Scalar t5 = -w.IA_r_ankle_link[9]*t0;
-    const Scalar pa0 = w.pA_r_ankle_link[0] + w.u_r_ankle_link[0]*t0 + w.c_r_ankle_link[0]*Ia0 + w.c_r_ankle_link[2]*t4 + w.c_r_ankle_link[5]*Ia1;
-    const Scalar pa1 = w.pA_r_ankle_link[1] + w.u_r_ankle_link[0]*t1 + w.c_r_ankle_link[0]*t5 + w.c_r_ankle_link[2]*Ia3 + w.c_r_ankle_link[5]*Ia4;
-    const Scalar pa2 = w.pA_r_ankle_link[2] + w.u_r_ankle_link[0]*t2 + w.c_r_ankle_link[0]*t4 + w.c_r_ankle_link[2]*Ia5 + w.c_r_ankle_link[5]*Ia6;
-    const Scalar pa3 = 7.2e-05*w.c_r_ankle_link[3] + w.pA_r_ankle_link[3];
-    const Scalar pa4 = w.pA_r_ankle_link[5] + w.u_r_ankle_link[0]*t3 + w.c_r_ankle_link[0]*Ia1 + w.c_r_ankle_link[2]*Ia6 + w.c_r_ankle_link[5]*Ia7;
-    const Scalar C20 = w.cq_r_ankle_link*w.cq_r_ankle_link - w.sq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar h0 = 0.5*(-Ia0 + Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t6 = 2.0*w.cq_r_ankle_link*w.sq_r_ankle_link;
-    const Scalar d0 = C20*h0 - t4*t6;
-    const Scalar qq0 = h0*t6 + t4*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia1*t6);
-    const Scalar qq1 = 0.5*(Ia6*t6 + Ia1*C20);
-    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
-    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_r_ankle_link*Ia3 + 0.09983341664682815*w.sq_r_ankle_link*t5 + 0.9950041652780258*w.sq_r_ankle_link*Ia3 + 0.9950041652780258*w.cq_r_ankle_link*t5;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_r_ankle_link*Ia3 + w.cq_r_ankle_link*t5;
-    const Scalar t11 = w.cq_r_ankle_link*Ia3 - w.sq_r_ankle_link*t5;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t18 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t19 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t6*h1;
-    const Scalar t20 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t21 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t22 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t6*h1;
-    const Scalar t23 = 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    const Scalar t24 = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    const Scalar t25 = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    const Scalar t26 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t27 = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    const Scalar t28 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t29 = -0.09983341664682815*w.cq_r_ankle_link*Ia4 + 0.9950041652780258*w.sq_r_ankle_link*Ia4;
-    const Scalar t30 = 0.9950041652780258*w.cq_r_ankle_link*Ia4 + 0.09983341664682815*w.sq_r_ankle_link*Ia4;
-    const Scalar t31 = 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    const Scalar t32 = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    const Scalar t33 = 0.4305*t8 + t27;
-    const Scalar t34 = 0.4305*Ia2 + t29;
-    const Scalar t35 = 0.4305*t25 + t31;
-    const Scalar t36 = w.cq_r_ankle_link*pa0 + w.sq_r_ankle_link*pa2;
-    const Scalar t37 = -w.sq_r_ankle_link*pa0 + w.cq_r_ankle_link*pa2;
-    const Scalar t38 = w.cq_r_ankle_link*pa3 + w.sq_r_ankle_link*pa4;
-    const Scalar t39 = -w.sq_r_ankle_link*pa3 + w.cq_r_ankle_link*pa4;
-    const Scalar t40 = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-    const Scalar t41 = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    w.IA_r_shank[0] = 3.055 + t23;
-    w.IA_r_shank[1] = t8;
-    w.IA_r_shank[2] = t24;
-    w.IA_r_shank[3] = t33;
-    w.IA_r_shank[4] = -0.5694718575000001 - 0.4305*t23;
-    w.IA_r_shank[5] = t28;
-    w.IA_r_shank[6] = 3.055 + Ia2;
-    w.IA_r_shank[7] = t25;
-    w.IA_r_shank[8] = 0.5694718575000001 + t34;
-    w.IA_r_shank[9] = -0.4305*t8;
-    w.IA_r_shank[10] = t30;
-    w.IA_r_shank[11] = 3.055 + t26;
-    w.IA_r_shank[12] = t35;
-    w.IA_r_shank[13] = -0.4305*t24;
-    w.IA_r_shank[14] = t32;
-    w.IA_r_shank[15] = 0.15779149347477375 + 0.9950041652780258*t19 - 0.09983341664682815*t20 + 0.4305*t29 + 0.4305*t34;
-    w.IA_r_shank[16] = -0.18533025*t8 - 0.4305*t27;
-    w.IA_r_shank[17] = 0.09983341664682815*t19 + 0.9950041652780258*t20 + 0.4305*t30;
-    w.IA_r_shank[18] = 0.15779149347477375 + 0.18533025*t23;
-    w.IA_r_shank[19] = -0.4305*t28;
-    w.IA_r_shank[20] = 0.00381875 + 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.pA_r_shank[0] = w.pA_r_shank[0] + t40;
-    w.pA_r_shank[1] = w.pA_r_shank[1] + pa1;
-    w.pA_r_shank[2] = w.pA_r_shank[2] + t41;
-    w.pA_r_shank[3] = w.pA_r_shank[3] + 0.4305*pa1 + 0.9950041652780258*t38 - 0.09983341664682815*t39;
-    w.pA_r_shank[4] = w.pA_r_shank[4] + tau[16] - 0.4305*t40;
-    w.pA_r_shank[5] = w.pA_r_shank[5] + 0.09983341664682815*t38 + 0.9950041652780258*t39;
-    w.KSD_r_ankle_link[0] = w.KA_r_ankle_link[4][0]*w.Dinv_r_ankle_link;
-    const Scalar t42 = 1.0 - w.IA_r_ankle_link[4]*w.KSD_r_ankle_link[0];
-    const Scalar t43 = -w.IA_r_ankle_link[13]*w.KSD_r_ankle_link[0];
-    const Scalar t44 = w.KA_r_ankle_link[5][0] - w.IA_r_ankle_link[19]*w.KSD_r_ankle_link[0];
-    const Scalar t45 = w.cq_r_ankle_link*t42 + w.sq_r_ankle_link*t43;
-    const Scalar t46 = -w.sq_r_ankle_link*t42 + w.cq_r_ankle_link*t43;
-    const Scalar t47 = 0.9950041652780258*t45 - 0.09983341664682815*t46;
-    const Scalar t48 = 0.09983341664682815*t45 + 0.9950041652780258*t46;
-    w.KA_r_shank[0][0] = t47;
-    w.KA_r_shank[1][0] = -w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[0];
-    w.KA_r_shank[2][0] = t48;
-    w.KA_r_shank[3][0] = -0.4305*w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[0] + 0.9950041652780258*w.sq_r_ankle_link*t44 - 0.09983341664682815*w.cq_r_ankle_link*t44;
-    w.KA_r_shank[4][0] = -0.4305*t47;
-    w.KA_r_shank[5][0] = 0.09983341664682815*w.sq_r_ankle_link*t44 + 0.9950041652780258*w.cq_r_ankle_link*t44;
-    w.KSD_r_ankle_link[1] = w.KA_r_ankle_link[4][1]*w.Dinv_r_ankle_link;
-    const Scalar t49 = w.KA_r_ankle_link[1][1] - w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[1];
-    const Scalar t50 = w.KA_r_ankle_link[2][1] - w.IA_r_ankle_link[13]*w.KSD_r_ankle_link[1];
-    const Scalar t51 = -w.IA_r_ankle_link[4]*w.KSD_r_ankle_link[1];
-    const Scalar t52 = w.KA_r_ankle_link[5][1] - w.IA_r_ankle_link[19]*w.KSD_r_ankle_link[1];
-    const Scalar t53 = w.cq_r_ankle_link*t51 + w.sq_r_ankle_link*t50;
-    const Scalar t54 = -w.sq_r_ankle_link*t51 + w.cq_r_ankle_link*t50;
-    const Scalar t55 = 0.9950041652780258*t53 - 0.09983341664682815*t54;
-    const Scalar t56 = 0.09983341664682815*t53 + 0.9950041652780258*t54;
-    w.KA_r_shank[0][1] = t55;
-    w.KA_r_shank[1][1] = t49;
-    w.KA_r_shank[2][1] = t56;
-    w.KA_r_shank[3][1] = 0.4305*t49 + 0.9950041652780258*w.sq_r_ankle_link*t52 - 0.09983341664682815*w.cq_r_ankle_link*t52;
-    w.KA_r_shank[4][1] = -0.4305*t55;
-    w.KA_r_shank[5][1] = 0.09983341664682815*w.sq_r_ankle_link*t52 + 0.9950041652780258*w.cq_r_ankle_link*t52;
-    const Scalar t57 = 0.9950041652780258*w.sq_r_ankle_link*w.KA_r_ankle_link[2][2] - 0.09983341664682815*w.cq_r_ankle_link*w.KA_r_ankle_link[2][2];
-    const Scalar t58 = 0.09983341664682815*w.sq_r_ankle_link*w.KA_r_ankle_link[2][2] + 0.9950041652780258*w.cq_r_ankle_link*w.KA_r_ankle_link[2][2];
-    w.KA_r_shank[0][2] = t57;
-    w.KA_r_shank[1][2] = w.KA_r_ankle_link[1][2];
-    w.KA_r_shank[2][2] = t58;
-    w.KA_r_shank[3][2] = 0.4305*w.KA_r_ankle_link[1][2];
-    w.KA_r_shank[4][2] = -0.4305*t57;
-    w.KSD_r_ankle_link[3] = w.KA_r_ankle_link[4][3]*w.Dinv_r_ankle_link;
-    const Scalar t59 = w.KA_r_ankle_link[1][3] - w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[3];
-    const Scalar t60 = w.KA_r_ankle_link[2][3] - w.IA_r_ankle_link[13]*w.KSD_r_ankle_link[3];
-    const Scalar t61 = -w.IA_r_ankle_link[4]*w.KSD_r_ankle_link[3];
-    const Scalar t62 = w.KA_r_ankle_link[5][3] - w.IA_r_ankle_link[19]*w.KSD_r_ankle_link[3];
-    const Scalar t63 = w.cq_r_ankle_link*t61 + w.sq_r_ankle_link*t60;
-    const Scalar t64 = -w.sq_r_ankle_link*t61 + w.cq_r_ankle_link*t60;
-    const Scalar t65 = 0.9950041652780258*t63 - 0.09983341664682815*t64;
-    const Scalar t66 = 0.09983341664682815*t63 + 0.9950041652780258*t64;
-    w.KA_r_shank[0][3] = t65;
-    w.KA_r_shank[1][3] = t59;
-    w.KA_r_shank[2][3] = t66;
-    w.KA_r_shank[3][3] = 0.4305*t59 + 0.9950041652780258*w.sq_r_ankle_link*t62 - 0.09983341664682815*w.cq_r_ankle_link*t62;
-    w.KA_r_shank[4][3] = -0.4305*t65;
-    w.KA_r_shank[5][3] = 0.09983341664682815*w.sq_r_ankle_link*t62 + 0.9950041652780258*w.cq_r_ankle_link*t62;
-    w.KSD_r_ankle_link[4] = w.KA_r_ankle_link[4][4]*w.Dinv_r_ankle_link;
-    const Scalar t67 = -w.IA_r_ankle_link[4]*w.KSD_r_ankle_link[4];
-    const Scalar t68 = -w.IA_r_ankle_link[13]*w.KSD_r_ankle_link[4];
-    const Scalar t69 = w.KA_r_ankle_link[5][4] - w.IA_r_ankle_link[19]*w.KSD_r_ankle_link[4];
-    const Scalar t70 = w.cq_r_ankle_link*t67 + w.sq_r_ankle_link*t68;
-    const Scalar t71 = -w.sq_r_ankle_link*t67 + w.cq_r_ankle_link*t68;
-    const Scalar t72 = 0.9950041652780258*t70 - 0.09983341664682815*t71;
-    const Scalar t73 = 0.09983341664682815*t70 + 0.9950041652780258*t71;
-    w.KA_r_shank[0][4] = t72;
-    w.KA_r_shank[1][4] = -w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[4];
-    w.KA_r_shank[2][4] = t73;
-    w.KA_r_shank[3][4] = -0.4305*w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[4] + 0.9950041652780258*w.sq_r_ankle_link*t69 - 0.09983341664682815*w.cq_r_ankle_link*t69;
-    w.KA_r_shank[4][4] = -0.4305*t72;
-    w.KA_r_shank[5][4] = 0.09983341664682815*w.sq_r_ankle_link*t69 + 0.9950041652780258*w.cq_r_ankle_link*t69;
-    w.KSD_r_ankle_link[5] = w.KA_r_ankle_link[4][5]*w.Dinv_r_ankle_link;
-    const Scalar t74 = -w.IA_r_ankle_link[4]*w.KSD_r_ankle_link[5];
-    const Scalar t75 = -w.IA_r_ankle_link[13]*w.KSD_r_ankle_link[5];
-    const Scalar t76 = w.KA_r_ankle_link[5][5] - w.IA_r_ankle_link[19]*w.KSD_r_ankle_link[5];
-    const Scalar t77 = w.cq_r_ankle_link*t74 + w.sq_r_ankle_link*t75;
-    const Scalar t78 = -w.sq_r_ankle_link*t74 + w.cq_r_ankle_link*t75;
-    const Scalar t79 = 0.9950041652780258*t77 - 0.09983341664682815*t78;
-    const Scalar t80 = 0.09983341664682815*t77 + 0.9950041652780258*t78;
-    w.KA_r_shank[0][5] = t79;
-    w.KA_r_shank[1][5] = -w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[5];
-    w.KA_r_shank[2][5] = t80;
-    w.KA_r_shank[3][5] = -0.4305*w.IA_r_ankle_link[9]*w.KSD_r_ankle_link[5] + 0.9950041652780258*w.sq_r_ankle_link*t76 - 0.09983341664682815*w.cq_r_ankle_link*t76;
-    w.KA_r_shank[4][5] = -0.4305*t79;
-    w.KA_r_shank[5][5] = 0.09983341664682815*w.sq_r_ankle_link*t76 + 0.9950041652780258*w.cq_r_ankle_link*t76;
-  }
+  shared_36(shared_36_k0, &tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    w.Dinv_r_shank = 1.0 / w.IA_r_shank[18];
-    w.u_r_shank[0] = -w.pA_r_shank[4] + tau[15];
-    const Scalar t0 = w.IA_r_shank[4]*w.Dinv_r_shank;
-    const Scalar t1 = w.IA_r_shank[9]*w.Dinv_r_shank;
-    const Scalar t2 = w.IA_r_shank[13]*w.Dinv_r_shank;
-    const Scalar t3 = w.IA_r_shank[16]*w.Dinv_r_shank;
-    const Scalar t4 = w.IA_r_shank[19]*w.Dinv_r_shank;
-    const Scalar Ia0 = w.IA_r_shank[0] - w.IA_r_shank[4]*t0;
-    const Scalar Ia1 = w.IA_r_shank[1] - w.IA_r_shank[9]*t0;
-    const Scalar Ia2 = w.IA_r_shank[2] - w.IA_r_shank[13]*t0;
-    const Scalar Ia3 = w.IA_r_shank[3] - w.IA_r_shank[16]*t0;
-    const Scalar Ia4 = w.IA_r_shank[5] - w.IA_r_shank[19]*t0;
-    const Scalar Ia5 = w.IA_r_shank[6] - w.IA_r_shank[9]*t1;
-    const Scalar Ia6 = w.IA_r_shank[7] - w.IA_r_shank[13]*t1;
-    const Scalar Ia7 = w.IA_r_shank[8] - w.IA_r_shank[16]*t1;
-    const Scalar Ia8 = w.IA_r_shank[10] - w.IA_r_shank[19]*t1;
-    const Scalar Ia9 = w.IA_r_shank[11] - w.IA_r_shank[13]*t2;
-    const Scalar Ia10 = w.IA_r_shank[12] - w.IA_r_shank[16]*t2;
-    const Scalar Ia11 = w.IA_r_shank[14] - w.IA_r_shank[19]*t2;
-    const Scalar Ia12 = w.IA_r_shank[15] - w.IA_r_shank[16]*t3;
-    const Scalar Ia13 = w.IA_r_shank[17] - w.IA_r_shank[19]*t3;
-    const Scalar Ia14 = w.IA_r_shank[20] - w.IA_r_shank[19]*t4;
-    const Scalar pa0 = w.pA_r_shank[0] + w.u_r_shank[0]*t0 + w.c_r_shank[0]*Ia0 + w.c_r_shank[2]*Ia2 + w.c_r_shank[3]*Ia3 + w.c_r_shank[5]*Ia4;
-    const Scalar pa1 = w.pA_r_shank[1] + w.u_r_shank[0]*t1 + w.c_r_shank[0]*Ia1 + w.c_r_shank[2]*Ia6 + w.c_r_shank[3]*Ia7 + w.c_r_shank[5]*Ia8;
-    const Scalar pa2 = w.pA_r_shank[2] + w.u_r_shank[0]*t2 + w.c_r_shank[0]*Ia2 + w.c_r_shank[2]*Ia9 + w.c_r_shank[3]*Ia10 + w.c_r_shank[5]*Ia11;
-    const Scalar pa3 = w.pA_r_shank[3] + w.u_r_shank[0]*t3 + w.c_r_shank[0]*Ia3 + w.c_r_shank[2]*Ia10 + w.c_r_shank[3]*Ia12 + w.c_r_shank[5]*Ia13;
-    const Scalar pa4 = w.pA_r_shank[5] + w.u_r_shank[0]*t4 + w.c_r_shank[0]*Ia4 + w.c_r_shank[2]*Ia11 + w.c_r_shank[3]*Ia13 + w.c_r_shank[5]*Ia14;
-    const Scalar C20 = w.cq_r_shank*w.cq_r_shank - w.sq_r_shank*w.sq_r_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_r_shank*w.sq_r_shank;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9800665778412416*m0 - 0.9800665778412416*d0 + 0.19866933079506124*qq0;
-    const Scalar t8 = 0.19866933079506124*w.cq_r_shank*Ia6 - 0.19866933079506124*w.sq_r_shank*Ia1 + 0.9800665778412416*w.sq_r_shank*Ia6 + 0.9800665778412416*w.cq_r_shank*Ia1;
-    const Scalar t9 = 0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t10 = w.sq_r_shank*Ia6 + w.cq_r_shank*Ia1;
-    const Scalar t11 = w.cq_r_shank*Ia6 - w.sq_r_shank*Ia1;
-    const Scalar t12 = -0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t14 = 0.9800665778412416*m0 + 0.9800665778412416*d0 - 0.19866933079506124*qq0;
-    const Scalar t15 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 - 0.9800665778412416*d1 + 0.19866933079506124*qq1;
-    const Scalar t16 = 0.4900332889206208*Ia4 - 0.4900332889206208*Ia10 + 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t17 = w.sq_r_shank*Ia8 + w.cq_r_shank*Ia7;
-    const Scalar t18 = w.cq_r_shank*Ia8 - w.sq_r_shank*Ia7;
-    const Scalar t19 = -0.4900332889206208*Ia4 + 0.4900332889206208*Ia10 - 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t20 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 + 0.9800665778412416*d1 - 0.19866933079506124*qq1;
-    const Scalar t21 = 0.9800665778412416*m2 - 0.9800665778412416*d2 + 0.19866933079506124*qq2;
-    const Scalar t22 = 0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t23 = -0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t24 = 0.9800665778412416*m2 + 0.9800665778412416*d2 - 0.19866933079506124*qq2;
-    const Scalar t25 = 0.9800665778412416*t7 + 0.19866933079506124*t9;
-    const Scalar t26 = -0.19866933079506124*t7 + 0.9800665778412416*t9;
-    const Scalar t27 = -0.19866933079506124*t10 + 0.9800665778412416*t11;
-    const Scalar t28 = -0.19866933079506124*t12 + 0.9800665778412416*t14;
-    const Scalar t29 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
-    const Scalar t30 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
-    const Scalar t31 = 0.9800665778412416*t17 + 0.19866933079506124*t18;
-    const Scalar t32 = -0.19866933079506124*t17 + 0.9800665778412416*t18;
-    const Scalar t33 = 0.9800665778412416*t19 + 0.19866933079506124*t20;
-    const Scalar t34 = -0.19866933079506124*t19 + 0.9800665778412416*t20;
-    const Scalar t35 = 0.42875*t8 + t29;
-    const Scalar t36 = 0.42875*Ia5 + t31;
-    const Scalar t37 = 0.42875*t27 + t33;
-    const Scalar t38 = w.cq_r_shank*pa0 + w.sq_r_shank*pa2;
-    const Scalar t39 = -w.sq_r_shank*pa0 + w.cq_r_shank*pa2;
-    const Scalar t40 = w.cq_r_shank*pa3 + w.sq_r_shank*pa4;
-    const Scalar t41 = -w.sq_r_shank*pa3 + w.cq_r_shank*pa4;
-    const Scalar t42 = 0.9800665778412416*t38 + 0.19866933079506124*t39;
-    const Scalar t43 = -0.19866933079506124*t38 + 0.9800665778412416*t39;
-    w.IA_r_thigh[0] = 7.0 + t25;
-    w.IA_r_thigh[1] = t8;
-    w.IA_r_thigh[2] = t26;
-    w.IA_r_thigh[3] = t35;
-    w.IA_r_thigh[4] = -1.29954125 - 0.42875*t25;
-    w.IA_r_thigh[5] = t30;
-    w.IA_r_thigh[6] = 7.0 + Ia5;
-    w.IA_r_thigh[7] = t27;
-    w.IA_r_thigh[8] = 1.29954125 + t36;
-    w.IA_r_thigh[9] = -0.42875*t8;
-    w.IA_r_thigh[10] = t32;
-    w.IA_r_thigh[11] = 7.0 + t28;
-    w.IA_r_thigh[12] = t37;
-    w.IA_r_thigh[13] = -0.42875*t26;
-    w.IA_r_thigh[14] = t34;
-    w.IA_r_thigh[15] = 0.3755072987089375 + 0.9800665778412416*t21 + 0.19866933079506124*t22 + 0.42875*t31 + 0.42875*t36;
-    w.IA_r_thigh[16] = -0.1838265625*t8 - 0.42875*t29;
-    w.IA_r_thigh[17] = -0.19866933079506124*t21 + 0.9800665778412416*t22 + 0.42875*t32;
-    w.IA_r_thigh[18] = 0.3755072987089375 + 0.1838265625*t25;
-    w.IA_r_thigh[19] = -0.42875*t30;
-    w.IA_r_thigh[20] = 0.0196875 - 0.19866933079506124*t23 + 0.9800665778412416*t24;
-    w.pA_r_thigh[0] = w.pA_r_thigh[0] + t42;
-    w.pA_r_thigh[1] = w.pA_r_thigh[1] + pa1;
-    w.pA_r_thigh[2] = w.pA_r_thigh[2] + t43;
-    w.pA_r_thigh[3] = w.pA_r_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t40 + 0.19866933079506124*t41;
-    w.pA_r_thigh[4] = w.pA_r_thigh[4] + tau[15] - 0.42875*t42;
-    w.pA_r_thigh[5] = w.pA_r_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
-    // columns 0 to 1
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      w.KSD_r_shank[j] = w.Dinv_r_shank*w.KA_r_shank[4][j];
-      const Scalar t44 = w.KA_r_shank[0][j] - w.IA_r_shank[4]*w.KSD_r_shank[j];
-      const Scalar t45 = w.KA_r_shank[1][j] - w.IA_r_shank[9]*w.KSD_r_shank[j];
-      const Scalar t46 = w.KA_r_shank[2][j] - w.IA_r_shank[13]*w.KSD_r_shank[j];
-      const Scalar t47 = w.KA_r_shank[3][j] - w.IA_r_shank[16]*w.KSD_r_shank[j];
-      const Scalar t48 = w.KA_r_shank[5][j] - w.IA_r_shank[19]*w.KSD_r_shank[j];
-      const Scalar t49 = w.cq_r_shank*t44 + w.sq_r_shank*t46;
-      const Scalar t50 = -w.sq_r_shank*t44 + w.cq_r_shank*t46;
-      const Scalar t51 = w.cq_r_shank*t47 + w.sq_r_shank*t48;
-      const Scalar t52 = -w.sq_r_shank*t47 + w.cq_r_shank*t48;
-      const Scalar t53 = 0.9800665778412416*t49 + 0.19866933079506124*t50;
-      const Scalar t54 = -0.19866933079506124*t49 + 0.9800665778412416*t50;
-      w.KA_r_thigh[0][j] = t53;
-      w.KA_r_thigh[1][j] = t45;
-      w.KA_r_thigh[2][j] = t54;
-      w.KA_r_thigh[3][j] = 0.42875*t45 + 0.9800665778412416*t51 + 0.19866933079506124*t52;
-      w.KA_r_thigh[4][j] = -0.42875*t53;
-      w.KA_r_thigh[5][j] = -0.19866933079506124*t51 + 0.9800665778412416*t52;
-    }
-    w.KSD_r_shank[2] = w.KA_r_shank[4][2]*w.Dinv_r_shank;
-    const Scalar t55 = w.KA_r_shank[0][2] - w.IA_r_shank[4]*w.KSD_r_shank[2];
-    const Scalar t56 = w.KA_r_shank[1][2] - w.IA_r_shank[9]*w.KSD_r_shank[2];
-    const Scalar t57 = w.KA_r_shank[2][2] - w.IA_r_shank[13]*w.KSD_r_shank[2];
-    const Scalar t58 = w.KA_r_shank[3][2] - w.IA_r_shank[16]*w.KSD_r_shank[2];
-    const Scalar t59 = -w.IA_r_shank[19]*w.KSD_r_shank[2];
-    const Scalar t60 = w.cq_r_shank*t55 + w.sq_r_shank*t57;
-    const Scalar t61 = -w.sq_r_shank*t55 + w.cq_r_shank*t57;
-    const Scalar t62 = w.cq_r_shank*t58 + w.sq_r_shank*t59;
-    const Scalar t63 = -w.sq_r_shank*t58 + w.cq_r_shank*t59;
-    const Scalar t64 = 0.9800665778412416*t60 + 0.19866933079506124*t61;
-    const Scalar t65 = -0.19866933079506124*t60 + 0.9800665778412416*t61;
-    w.KA_r_thigh[0][2] = t64;
-    w.KA_r_thigh[1][2] = t56;
-    w.KA_r_thigh[2][2] = t65;
-    w.KA_r_thigh[3][2] = 0.42875*t56 + 0.9800665778412416*t62 + 0.19866933079506124*t63;
-    w.KA_r_thigh[4][2] = -0.42875*t64;
-    w.KA_r_thigh[5][2] = -0.19866933079506124*t62 + 0.9800665778412416*t63;
-    // columns 3 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
-      w.KSD_r_shank[3 + j] = w.Dinv_r_shank*w.KA_r_shank[4][3 + j];
-      const Scalar t66 = w.KA_r_shank[0][3 + j] - w.IA_r_shank[4]*w.KSD_r_shank[3 + j];
-      const Scalar t67 = w.KA_r_shank[1][3 + j] - w.IA_r_shank[9]*w.KSD_r_shank[3 + j];
-      const Scalar t68 = w.KA_r_shank[2][3 + j] - w.IA_r_shank[13]*w.KSD_r_shank[3 + j];
-      const Scalar t69 = w.KA_r_shank[3][3 + j] - w.IA_r_shank[16]*w.KSD_r_shank[3 + j];
-      const Scalar t70 = w.KA_r_shank[5][3 + j] - w.IA_r_shank[19]*w.KSD_r_shank[3 + j];
-      const Scalar t71 = w.cq_r_shank*t66 + w.sq_r_shank*t68;
-      const Scalar t72 = -w.sq_r_shank*t66 + w.cq_r_shank*t68;
-      const Scalar t73 = w.cq_r_shank*t69 + w.sq_r_shank*t70;
-      const Scalar t74 = -w.sq_r_shank*t69 + w.cq_r_shank*t70;
-      const Scalar t75 = 0.9800665778412416*t71 + 0.19866933079506124*t72;
-      const Scalar t76 = -0.19866933079506124*t71 + 0.9800665778412416*t72;
-      w.KA_r_thigh[0][3 + j] = t75;
-      w.KA_r_thigh[1][3 + j] = t67;
-      w.KA_r_thigh[2][3 + j] = t76;
-      w.KA_r_thigh[3][3 + j] = 0.42875*t67 + 0.9800665778412416*t73 + 0.19866933079506124*t74;
-      w.KA_r_thigh[4][3 + j] = -0.42875*t75;
-      w.KA_r_thigh[5][3 + j] = -0.19866933079506124*t73 + 0.9800665778412416*t74;
-    }
-  }
+  shared_37(shared_37_k0, &tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    w.Dinv_r_thigh = 1.0 / w.IA_r_thigh[18];
-    w.u_r_thigh[0] = -w.pA_r_thigh[4] + tau[14];
-    const Scalar t0 = w.IA_r_thigh[4]*w.Dinv_r_thigh;
-    const Scalar t1 = w.IA_r_thigh[9]*w.Dinv_r_thigh;
-    const Scalar t2 = w.IA_r_thigh[13]*w.Dinv_r_thigh;
-    const Scalar t3 = w.IA_r_thigh[16]*w.Dinv_r_thigh;
-    const Scalar t4 = w.IA_r_thigh[19]*w.Dinv_r_thigh;
-    const Scalar Ia0 = w.IA_r_thigh[0] - w.IA_r_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_r_thigh[1] - w.IA_r_thigh[9]*t0;
-    const Scalar Ia2 = w.IA_r_thigh[2] - w.IA_r_thigh[13]*t0;
-    const Scalar Ia3 = w.IA_r_thigh[3] - w.IA_r_thigh[16]*t0;
-    const Scalar Ia4 = w.IA_r_thigh[5] - w.IA_r_thigh[19]*t0;
-    const Scalar Ia5 = w.IA_r_thigh[6] - w.IA_r_thigh[9]*t1;
-    const Scalar Ia6 = w.IA_r_thigh[7] - w.IA_r_thigh[13]*t1;
-    const Scalar Ia7 = w.IA_r_thigh[8] - w.IA_r_thigh[16]*t1;
-    const Scalar Ia8 = w.IA_r_thigh[10] - w.IA_r_thigh[19]*t1;
-    const Scalar Ia9 = w.IA_r_thigh[11] - w.IA_r_thigh[13]*t2;
-    const Scalar Ia10 = w.IA_r_thigh[12] - w.IA_r_thigh[16]*t2;
-    const Scalar Ia11 = w.IA_r_thigh[14] - w.IA_r_thigh[19]*t2;
-    const Scalar Ia12 = w.IA_r_thigh[15] - w.IA_r_thigh[16]*t3;
-    const Scalar Ia13 = w.IA_r_thigh[17] - w.IA_r_thigh[19]*t3;
-    const Scalar Ia14 = w.IA_r_thigh[20] - w.IA_r_thigh[19]*t4;
-    const Scalar pa0 = w.pA_r_thigh[0] + w.u_r_thigh[0]*t0 + w.c_r_thigh[0]*Ia0 + w.c_r_thigh[2]*Ia2 + w.c_r_thigh[3]*Ia3 + w.c_r_thigh[5]*Ia4;
-    const Scalar pa1 = w.pA_r_thigh[1] + w.u_r_thigh[0]*t1 + w.c_r_thigh[0]*Ia1 + w.c_r_thigh[2]*Ia6 + w.c_r_thigh[3]*Ia7 + w.c_r_thigh[5]*Ia8;
-    const Scalar pa2 = w.pA_r_thigh[2] + w.u_r_thigh[0]*t2 + w.c_r_thigh[0]*Ia2 + w.c_r_thigh[2]*Ia9 + w.c_r_thigh[3]*Ia10 + w.c_r_thigh[5]*Ia11;
-    const Scalar pa3 = w.pA_r_thigh[3] + w.u_r_thigh[0]*t3 + w.c_r_thigh[0]*Ia3 + w.c_r_thigh[2]*Ia10 + w.c_r_thigh[3]*Ia12 + w.c_r_thigh[5]*Ia13;
-    const Scalar pa4 = w.pA_r_thigh[5] + w.u_r_thigh[0]*t4 + w.c_r_thigh[0]*Ia4 + w.c_r_thigh[2]*Ia11 + w.c_r_thigh[3]*Ia13 + w.c_r_thigh[5]*Ia14;
-    const Scalar C20 = w.cq_r_thigh*w.cq_r_thigh - w.sq_r_thigh*w.sq_r_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_r_thigh*w.sq_r_thigh;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_r_thigh*Ia6 + 0.09983341664682815*w.sq_r_thigh*Ia1 + 0.9950041652780258*w.sq_r_thigh*Ia6 + 0.9950041652780258*w.cq_r_thigh*Ia1;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_r_thigh*Ia6 + w.cq_r_thigh*Ia1;
-    const Scalar t11 = w.cq_r_thigh*Ia6 - w.sq_r_thigh*Ia1;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia4 - 0.4975020826390129*Ia10 - 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = w.sq_r_thigh*Ia8 + w.cq_r_thigh*Ia7;
-    const Scalar t18 = w.cq_r_thigh*Ia8 - w.sq_r_thigh*Ia7;
-    const Scalar t19 = -0.4975020826390129*Ia4 + 0.4975020826390129*Ia10 + 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t20 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t21 = 0.9950041652780258*m2 - 0.9950041652780258*d2 - 0.09983341664682815*qq2;
-    const Scalar t22 = -0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t23 = 0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t24 = 0.9950041652780258*m2 + 0.9950041652780258*d2 + 0.09983341664682815*qq2;
-    const Scalar t25 = w.cq_r_thigh*pa0 + w.sq_r_thigh*pa2;
-    const Scalar t26 = -w.sq_r_thigh*pa0 + w.cq_r_thigh*pa2;
-    const Scalar t27 = w.cq_r_thigh*pa3 + w.sq_r_thigh*pa4;
-    const Scalar t28 = -w.sq_r_thigh*pa3 + w.cq_r_thigh*pa4;
-    w.IA_r_hip_roll_link[0] = 0.5 + 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    w.IA_r_hip_roll_link[1] = t8;
-    w.IA_r_hip_roll_link[2] = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    w.IA_r_hip_roll_link[3] = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    w.IA_r_hip_roll_link[5] = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    w.IA_r_hip_roll_link[6] = 0.5 + Ia5;
-    w.IA_r_hip_roll_link[7] = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    w.IA_r_hip_roll_link[8] = 0.015 + 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    w.IA_r_hip_roll_link[10] = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    w.IA_r_hip_roll_link[11] = 0.5 + 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    w.IA_r_hip_roll_link[12] = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    w.IA_r_hip_roll_link[14] = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    w.IA_r_hip_roll_link[15] = 0.00095 + 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    w.IA_r_hip_roll_link[17] = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.IA_r_hip_roll_link[20] = 0.0005 + 0.09983341664682815*t23 + 0.9950041652780258*t24;
-    w.pA_r_hip_roll_link[0] = w.pA_r_hip_roll_link[0] + 0.9950041652780258*t25 - 0.09983341664682815*t26;
-    w.pA_r_hip_roll_link[1] = w.pA_r_hip_roll_link[1] + pa1;
-    w.pA_r_hip_roll_link[2] = w.pA_r_hip_roll_link[2] + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_r_hip_roll_link[3] = w.pA_r_hip_roll_link[3] + 0.9950041652780258*t27 - 0.09983341664682815*t28;
-    w.pA_r_hip_roll_link[4] = w.pA_r_hip_roll_link[4] + tau[14];
-    w.pA_r_hip_roll_link[5] = w.pA_r_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
-    // columns 0 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-      w.KSD_r_thigh[j] = w.Dinv_r_thigh*w.KA_r_thigh[4][j];
-      const Scalar t29 = w.KA_r_thigh[0][j] - w.IA_r_thigh[4]*w.KSD_r_thigh[j];
-      const Scalar t30 = w.KA_r_thigh[1][j] - w.IA_r_thigh[9]*w.KSD_r_thigh[j];
-      const Scalar t31 = w.KA_r_thigh[2][j] - w.IA_r_thigh[13]*w.KSD_r_thigh[j];
-      const Scalar t32 = w.KA_r_thigh[3][j] - w.IA_r_thigh[16]*w.KSD_r_thigh[j];
-      const Scalar t33 = w.KA_r_thigh[5][j] - w.IA_r_thigh[19]*w.KSD_r_thigh[j];
-      const Scalar t34 = w.cq_r_thigh*t29 + w.sq_r_thigh*t31;
-      const Scalar t35 = -w.sq_r_thigh*t29 + w.cq_r_thigh*t31;
-      const Scalar t36 = w.cq_r_thigh*t32 + w.sq_r_thigh*t33;
-      const Scalar t37 = -w.sq_r_thigh*t32 + w.cq_r_thigh*t33;
-      w.KA_r_hip_roll_link[0][j] = 0.9950041652780258*t34 - 0.09983341664682815*t35;
-      w.KA_r_hip_roll_link[1][j] = t30;
-      w.KA_r_hip_roll_link[2][j] = 0.09983341664682815*t34 + 0.9950041652780258*t35;
-      w.KA_r_hip_roll_link[3][j] = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-      w.KA_r_hip_roll_link[4][j] = 0.0;
-      w.KA_r_hip_roll_link[5][j] = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    }
-  }
+  shared_38(shared_38_k0, &tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    w.Dinv_r_hip_roll_link = 1.0 / w.IA_r_hip_roll_link[15];
-    w.u_r_hip_roll_link[0] = -w.pA_r_hip_roll_link[3] + tau[13];
-    const Scalar t0 = w.IA_r_hip_roll_link[3]*w.Dinv_r_hip_roll_link;
-    const Scalar t1 = w.IA_r_hip_roll_link[8]*w.Dinv_r_hip_roll_link;
-    const Scalar t2 = w.IA_r_hip_roll_link[12]*w.Dinv_r_hip_roll_link;
-    const Scalar t3 = w.IA_r_hip_roll_link[17]*w.Dinv_r_hip_roll_link;
-    const Scalar Ia0 = w.IA_r_hip_roll_link[0] - w.IA_r_hip_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_r_hip_roll_link[1] - w.IA_r_hip_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_r_hip_roll_link[2] - w.IA_r_hip_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_r_hip_roll_link[5] - w.IA_r_hip_roll_link[17]*t0;
-    const Scalar Ia4 = w.IA_r_hip_roll_link[6] - w.IA_r_hip_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_r_hip_roll_link[7] - w.IA_r_hip_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_r_hip_roll_link[10] - w.IA_r_hip_roll_link[17]*t1;
-    const Scalar Ia7 = w.IA_r_hip_roll_link[11] - w.IA_r_hip_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_r_hip_roll_link[14] - w.IA_r_hip_roll_link[17]*t2;
-    const Scalar Ia9 = w.IA_r_hip_roll_link[20] - w.IA_r_hip_roll_link[17]*t3;
-    const Scalar pa0 = -0.015*w.c_r_hip_roll_link[4] + w.pA_r_hip_roll_link[0] + w.u_r_hip_roll_link[0]*t0 + w.c_r_hip_roll_link[1]*Ia1 + w.c_r_hip_roll_link[2]*Ia2 + w.c_r_hip_roll_link[5]*Ia3;
-    const Scalar pa1 = w.pA_r_hip_roll_link[1] + w.u_r_hip_roll_link[0]*t1 + w.c_r_hip_roll_link[1]*Ia4 + w.c_r_hip_roll_link[2]*Ia5 + w.c_r_hip_roll_link[5]*Ia6;
-    const Scalar pa2 = w.pA_r_hip_roll_link[2] + w.u_r_hip_roll_link[0]*t2 + w.c_r_hip_roll_link[1]*Ia5 + w.c_r_hip_roll_link[2]*Ia7 + w.c_r_hip_roll_link[5]*Ia8;
-    const Scalar pa3 = 0.00095*w.c_r_hip_roll_link[4] + w.pA_r_hip_roll_link[4];
-    const Scalar pa4 = w.pA_r_hip_roll_link[5] + w.u_r_hip_roll_link[0]*t3 + w.c_r_hip_roll_link[1]*Ia6 + w.c_r_hip_roll_link[2]*Ia8 + w.c_r_hip_roll_link[5]*Ia9;
-    const Scalar C20 = w.cq_r_hip_roll_link*w.cq_r_hip_roll_link - w.sq_r_hip_roll_link*w.sq_r_hip_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_hip_roll_link*w.sq_r_hip_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(-Ia8*C20 - Ia6*t4);
-    const Scalar qq1 = 0.5*(-Ia8*t4 + Ia6*C20);
-    const Scalar h1 = 0.000475 - 0.5*Ia9;
-    const Scalar m1 = 0.000475 + 0.5*Ia9;
-    w.IA_r_hip_yaw_link[0] = 0.5 + Ia0;
-    w.IA_r_hip_yaw_link[1] = w.cq_r_hip_roll_link*Ia1 - w.sq_r_hip_roll_link*Ia2;
-    w.IA_r_hip_yaw_link[2] = w.sq_r_hip_roll_link*Ia1 + w.cq_r_hip_roll_link*Ia2;
-    w.IA_r_hip_yaw_link[4] = 0.02 - 0.015*w.cq_r_hip_roll_link - w.sq_r_hip_roll_link*Ia3;
-    w.IA_r_hip_yaw_link[5] = -0.015*w.sq_r_hip_roll_link + w.cq_r_hip_roll_link*Ia3;
-    w.IA_r_hip_yaw_link[6] = 0.5 + m0 + d0;
-    w.IA_r_hip_yaw_link[7] = qq0;
-    w.IA_r_hip_yaw_link[9] = 0.5*Ia8 + d1;
-    w.IA_r_hip_yaw_link[10] = 0.5*Ia6 + qq1;
-    w.IA_r_hip_yaw_link[11] = 0.5 + m0 - d0;
-    w.IA_r_hip_yaw_link[13] = -0.5*Ia6 + qq1;
-    w.IA_r_hip_yaw_link[14] = 0.5*Ia8 - d1;
-    w.IA_r_hip_yaw_link[18] = 0.0013 + m1 + C20*h1;
-    w.IA_r_hip_yaw_link[19] = t4*h1;
-    w.IA_r_hip_yaw_link[20] = 0.0005 + m1 - C20*h1;
-    w.pA_r_hip_yaw_link[0] = w.pA_r_hip_yaw_link[0] + pa0;
-    w.pA_r_hip_yaw_link[1] = w.pA_r_hip_yaw_link[1] + w.cq_r_hip_roll_link*pa1 - w.sq_r_hip_roll_link*pa2;
-    w.pA_r_hip_yaw_link[2] = w.pA_r_hip_yaw_link[2] + w.sq_r_hip_roll_link*pa1 + w.cq_r_hip_roll_link*pa2;
-    w.pA_r_hip_yaw_link[3] = w.pA_r_hip_yaw_link[3] + tau[13];
-    w.pA_r_hip_yaw_link[4] = w.pA_r_hip_yaw_link[4] + w.cq_r_hip_roll_link*pa3 - w.sq_r_hip_roll_link*pa4;
-    w.pA_r_hip_yaw_link[5] = w.pA_r_hip_yaw_link[5] + w.sq_r_hip_roll_link*pa3 + w.cq_r_hip_roll_link*pa4;
-    // columns 0 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-      w.KSD_r_hip_roll_link[j] = w.Dinv_r_hip_roll_link*w.KA_r_hip_roll_link[3][j];
-      const Scalar t5 = w.KA_r_hip_roll_link[0][j] - w.IA_r_hip_roll_link[3]*w.KSD_r_hip_roll_link[j];
-      const Scalar t6 = w.KA_r_hip_roll_link[1][j] - w.IA_r_hip_roll_link[8]*w.KSD_r_hip_roll_link[j];
-      const Scalar t7 = w.KA_r_hip_roll_link[2][j] - w.IA_r_hip_roll_link[12]*w.KSD_r_hip_roll_link[j];
-      const Scalar t8 = w.KA_r_hip_roll_link[5][j] - w.IA_r_hip_roll_link[17]*w.KSD_r_hip_roll_link[j];
-      w.KA_r_hip_yaw_link[0][j] = t5;
-      w.KA_r_hip_yaw_link[1][j] = w.cq_r_hip_roll_link*t6 - w.sq_r_hip_roll_link*t7;
-      w.KA_r_hip_yaw_link[2][j] = w.sq_r_hip_roll_link*t6 + w.cq_r_hip_roll_link*t7;
-      w.KA_r_hip_yaw_link[3][j] = 0.0;
-      w.KA_r_hip_yaw_link[4][j] = w.cq_r_hip_roll_link*w.KA_r_hip_roll_link[4][j] - w.sq_r_hip_roll_link*t8;
-      w.KA_r_hip_yaw_link[5][j] = w.sq_r_hip_roll_link*w.KA_r_hip_roll_link[4][j] + w.cq_r_hip_roll_link*t8;
-    }
-  }
+  shared_39(shared_39_k0, &tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -6337,578 +5380,27 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
 
 PROXGEN_RT_NOINLINE void pv_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    w.u_l_foot[0] = -w.pA_l_foot[3] + tau[11];
-    const Scalar pa0 = -0.027912499999999996*w.c_l_foot[4] + w.pA_l_foot[0];
-    const Scalar pa1 = 0.614466237626843*w.c_l_foot[1] + 0.039325839208117955*w.c_l_foot[5] + w.pA_l_foot[1] + 14.34961978945479*w.u_l_foot[0];
-    const Scalar pa2 = 1.015*w.c_l_foot[2] - 0.06495999999999999*w.c_l_foot[4] + w.pA_l_foot[2];
-    const Scalar pa3 = -0.06495999999999999*w.c_l_foot[2] + 0.00936987670937*w.c_l_foot[4] + w.pA_l_foot[4];
-    const Scalar pa4 = 0.039325839208117955*w.c_l_foot[1] + 0.006961696668689549*w.c_l_foot[5] + w.pA_l_foot[5] + 0.9183756665251066*w.u_l_foot[0];
-    const Scalar C20 = w.cq_l_foot*w.cq_l_foot - w.sq_l_foot*w.sq_l_foot;
-    w.IA_l_ankle_link[4] = -0.027912499999999996*w.cq_l_foot;
-    w.IA_l_ankle_link[5] = -0.027912499999999996*w.sq_l_foot;
-    w.IA_l_ankle_link[6] = 1.0147331188134214 - 0.20026688118657843*C20;
-    w.IA_l_ankle_link[7] = -0.40053376237315685*w.cq_l_foot*w.sq_l_foot;
-    w.IA_l_ankle_link[9] = 0.025634160791882035*w.cq_l_foot*w.sq_l_foot;
-    w.IA_l_ankle_link[10] = 0.05214291960405897 - 0.012817080395941018*C20;
-    w.IA_l_ankle_link[11] = 1.0147331188134214 + 0.20026688118657843*C20;
-    w.IA_l_ankle_link[13] = -0.05214291960405897 - 0.012817080395941018*C20;
-    w.IA_l_ankle_link[14] = -0.025634160791882035*w.cq_l_foot*w.sq_l_foot;
-    w.IA_l_ankle_link[18] = 0.008237786689029773 + 0.0012040900203402253*C20;
-    w.IA_l_ankle_link[19] = 0.0024081800406804505*w.cq_l_foot*w.sq_l_foot;
-    w.IA_l_ankle_link[20] = 0.008237786689029773 - 0.0012040900203402253*C20;
-    w.pA_l_ankle_link[0] = w.pA_l_ankle_link[0] + pa0;
-    w.pA_l_ankle_link[1] = w.pA_l_ankle_link[1] + w.cq_l_foot*pa1 - w.sq_l_foot*pa2;
-    w.pA_l_ankle_link[2] = w.pA_l_ankle_link[2] + w.sq_l_foot*pa1 + w.cq_l_foot*pa2;
-    w.pA_l_ankle_link[3] = tau[11];
-    w.pA_l_ankle_link[4] = w.cq_l_foot*pa3 - w.sq_l_foot*pa4;
-    w.pA_l_ankle_link[5] = w.sq_l_foot*pa3 + w.cq_l_foot*pa4;
-    w.KA_l_ankle_link[4][0] = -0.06825*w.cq_l_foot;
-    w.KA_l_ankle_link[5][0] = -0.06825*w.sq_l_foot;
-    w.KA_l_ankle_link[1][1] = 0.020638449369710488*w.cq_l_foot;
-    w.KA_l_ankle_link[2][1] = 0.020638449369710488*w.sq_l_foot;
-    w.KA_l_ankle_link[4][1] = 0.06267913924033854*w.sq_l_foot;
-    w.KA_l_ankle_link[5][1] = -0.06267913924033854*w.cq_l_foot;
-    w.KA_l_ankle_link[1][2] = -w.sq_l_foot;
-    w.KA_l_ankle_link[2][2] = w.cq_l_foot;
-    w.KA_l_ankle_link[1][3] = -14.34961978945479*w.cq_l_foot;
-    w.KA_l_ankle_link[2][3] = -14.34961978945479*w.sq_l_foot;
-    w.KA_l_ankle_link[4][3] = 0.9183756665251066*w.sq_l_foot;
-    w.KA_l_ankle_link[5][3] = -0.9183756665251066*w.cq_l_foot;
-    w.KA_l_ankle_link[4][4] = w.cq_l_foot;
-    w.KA_l_ankle_link[5][4] = w.sq_l_foot;
-    w.KA_l_ankle_link[4][5] = -w.sq_l_foot;
-    w.KA_l_ankle_link[5][5] = w.cq_l_foot;
-  }
+  shared_35(shared_35_k0, &tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    w.Dinv_l_ankle_link = 1.0 / w.IA_l_ankle_link[18];
-    w.u_l_ankle_link[0] = -w.pA_l_ankle_link[4] + tau[10];
-    const Scalar t0 = w.IA_l_ankle_link[4]*w.Dinv_l_ankle_link;
-    const Scalar t1 = w.IA_l_ankle_link[9]*w.Dinv_l_ankle_link;
-    const Scalar t2 = w.IA_l_ankle_link[13]*w.Dinv_l_ankle_link;
-    const Scalar t3 = w.IA_l_ankle_link[19]*w.Dinv_l_ankle_link;
-    const Scalar Ia0 = 1.2149999999999999 - w.IA_l_ankle_link[4]*t0;
-    const Scalar Ia1 = w.IA_l_ankle_link[5] - w.IA_l_ankle_link[19]*t0;
-    const Scalar Ia2 = w.IA_l_ankle_link[6] - w.IA_l_ankle_link[9]*t1;
-    const Scalar Ia3 = w.IA_l_ankle_link[7] - w.IA_l_ankle_link[13]*t1;
-    const Scalar Ia4 = w.IA_l_ankle_link[10] - w.IA_l_ankle_link[19]*t1;
-    const Scalar Ia5 = w.IA_l_ankle_link[11] - w.IA_l_ankle_link[13]*t2;
-    const Scalar Ia6 = w.IA_l_ankle_link[14] - w.IA_l_ankle_link[19]*t2;
-    const Scalar Ia7 = w.IA_l_ankle_link[20] - w.IA_l_ankle_link[19]*t3;
-    const Scalar t4 = -w.IA_l_ankle_link[13]*t0;
-    const Scalar t5 = -w.IA_l_ankle_link[9]*t0;
-    const Scalar pa0 = w.pA_l_ankle_link[0] + w.u_l_ankle_link[0]*t0 + w.c_l_ankle_link[0]*Ia0 + w.c_l_ankle_link[2]*t4 + w.c_l_ankle_link[5]*Ia1;
-    const Scalar pa1 = w.pA_l_ankle_link[1] + w.u_l_ankle_link[0]*t1 + w.c_l_ankle_link[0]*t5 + w.c_l_ankle_link[2]*Ia3 + w.c_l_ankle_link[5]*Ia4;
-    const Scalar pa2 = w.pA_l_ankle_link[2] + w.u_l_ankle_link[0]*t2 + w.c_l_ankle_link[0]*t4 + w.c_l_ankle_link[2]*Ia5 + w.c_l_ankle_link[5]*Ia6;
-    const Scalar pa3 = 7.2e-05*w.c_l_ankle_link[3] + w.pA_l_ankle_link[3];
-    const Scalar pa4 = w.pA_l_ankle_link[5] + w.u_l_ankle_link[0]*t3 + w.c_l_ankle_link[0]*Ia1 + w.c_l_ankle_link[2]*Ia6 + w.c_l_ankle_link[5]*Ia7;
-    const Scalar C20 = w.cq_l_ankle_link*w.cq_l_ankle_link - w.sq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar h0 = 0.5*(-Ia0 + Ia5);
-    const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t6 = 2.0*w.cq_l_ankle_link*w.sq_l_ankle_link;
-    const Scalar d0 = C20*h0 - t4*t6;
-    const Scalar qq0 = h0*t6 + t4*C20;
-    const Scalar d1 = 0.5*(Ia6*C20 - Ia1*t6);
-    const Scalar qq1 = 0.5*(Ia6*t6 + Ia1*C20);
-    const Scalar h1 = -3.6e-05 + 0.5*Ia7;
-    const Scalar m1 = 3.6e-05 + 0.5*Ia7;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_l_ankle_link*Ia3 + 0.09983341664682815*w.sq_l_ankle_link*t5 + 0.9950041652780258*w.sq_l_ankle_link*Ia3 + 0.9950041652780258*w.cq_l_ankle_link*t5;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_l_ankle_link*Ia3 + w.cq_l_ankle_link*t5;
-    const Scalar t11 = w.cq_l_ankle_link*Ia3 - w.sq_l_ankle_link*t5;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia1 - 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = -0.4975020826390129*Ia1 + 0.04991670832341408*Ia6 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t18 = 0.04991670832341408*Ia1 + 0.4975020826390129*Ia6 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t19 = 0.9950041652780258*m1 - 0.9950041652780258*C20*h1 - 0.09983341664682815*t6*h1;
-    const Scalar t20 = -0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t21 = 0.09983341664682815*m1 - 0.09983341664682815*C20*h1 + 0.9950041652780258*t6*h1;
-    const Scalar t22 = 0.9950041652780258*m1 + 0.9950041652780258*C20*h1 + 0.09983341664682815*t6*h1;
-    const Scalar t23 = 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    const Scalar t24 = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    const Scalar t25 = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    const Scalar t26 = 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    const Scalar t27 = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    const Scalar t28 = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    const Scalar t29 = -0.09983341664682815*w.cq_l_ankle_link*Ia4 + 0.9950041652780258*w.sq_l_ankle_link*Ia4;
-    const Scalar t30 = 0.9950041652780258*w.cq_l_ankle_link*Ia4 + 0.09983341664682815*w.sq_l_ankle_link*Ia4;
-    const Scalar t31 = 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    const Scalar t32 = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    const Scalar t33 = 0.4305*t8 + t27;
-    const Scalar t34 = 0.4305*Ia2 + t29;
-    const Scalar t35 = 0.4305*t25 + t31;
-    const Scalar t36 = w.cq_l_ankle_link*pa0 + w.sq_l_ankle_link*pa2;
-    const Scalar t37 = -w.sq_l_ankle_link*pa0 + w.cq_l_ankle_link*pa2;
-    const Scalar t38 = w.cq_l_ankle_link*pa3 + w.sq_l_ankle_link*pa4;
-    const Scalar t39 = -w.sq_l_ankle_link*pa3 + w.cq_l_ankle_link*pa4;
-    const Scalar t40 = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-    const Scalar t41 = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    w.IA_l_shank[0] = 3.055 + t23;
-    w.IA_l_shank[1] = t8;
-    w.IA_l_shank[2] = t24;
-    w.IA_l_shank[3] = t33;
-    w.IA_l_shank[4] = -0.5694718575000001 - 0.4305*t23;
-    w.IA_l_shank[5] = t28;
-    w.IA_l_shank[6] = 3.055 + Ia2;
-    w.IA_l_shank[7] = t25;
-    w.IA_l_shank[8] = 0.5694718575000001 + t34;
-    w.IA_l_shank[9] = -0.4305*t8;
-    w.IA_l_shank[10] = t30;
-    w.IA_l_shank[11] = 3.055 + t26;
-    w.IA_l_shank[12] = t35;
-    w.IA_l_shank[13] = -0.4305*t24;
-    w.IA_l_shank[14] = t32;
-    w.IA_l_shank[15] = 0.15779149347477375 + 0.9950041652780258*t19 - 0.09983341664682815*t20 + 0.4305*t29 + 0.4305*t34;
-    w.IA_l_shank[16] = -0.18533025*t8 - 0.4305*t27;
-    w.IA_l_shank[17] = 0.09983341664682815*t19 + 0.9950041652780258*t20 + 0.4305*t30;
-    w.IA_l_shank[18] = 0.15779149347477375 + 0.18533025*t23;
-    w.IA_l_shank[19] = -0.4305*t28;
-    w.IA_l_shank[20] = 0.00381875 + 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.pA_l_shank[0] = w.pA_l_shank[0] + t40;
-    w.pA_l_shank[1] = w.pA_l_shank[1] + pa1;
-    w.pA_l_shank[2] = w.pA_l_shank[2] + t41;
-    w.pA_l_shank[3] = w.pA_l_shank[3] + 0.4305*pa1 + 0.9950041652780258*t38 - 0.09983341664682815*t39;
-    w.pA_l_shank[4] = w.pA_l_shank[4] + tau[10] - 0.4305*t40;
-    w.pA_l_shank[5] = w.pA_l_shank[5] + 0.09983341664682815*t38 + 0.9950041652780258*t39;
-    w.KSD_l_ankle_link[0] = w.KA_l_ankle_link[4][0]*w.Dinv_l_ankle_link;
-    const Scalar t42 = 1.0 - w.IA_l_ankle_link[4]*w.KSD_l_ankle_link[0];
-    const Scalar t43 = -w.IA_l_ankle_link[13]*w.KSD_l_ankle_link[0];
-    const Scalar t44 = w.KA_l_ankle_link[5][0] - w.IA_l_ankle_link[19]*w.KSD_l_ankle_link[0];
-    const Scalar t45 = w.cq_l_ankle_link*t42 + w.sq_l_ankle_link*t43;
-    const Scalar t46 = -w.sq_l_ankle_link*t42 + w.cq_l_ankle_link*t43;
-    const Scalar t47 = 0.9950041652780258*t45 - 0.09983341664682815*t46;
-    const Scalar t48 = 0.09983341664682815*t45 + 0.9950041652780258*t46;
-    w.KA_l_shank[0][0] = t47;
-    w.KA_l_shank[1][0] = -w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[0];
-    w.KA_l_shank[2][0] = t48;
-    w.KA_l_shank[3][0] = -0.4305*w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[0] + 0.9950041652780258*w.sq_l_ankle_link*t44 - 0.09983341664682815*w.cq_l_ankle_link*t44;
-    w.KA_l_shank[4][0] = -0.4305*t47;
-    w.KA_l_shank[5][0] = 0.09983341664682815*w.sq_l_ankle_link*t44 + 0.9950041652780258*w.cq_l_ankle_link*t44;
-    w.KSD_l_ankle_link[1] = w.KA_l_ankle_link[4][1]*w.Dinv_l_ankle_link;
-    const Scalar t49 = w.KA_l_ankle_link[1][1] - w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[1];
-    const Scalar t50 = w.KA_l_ankle_link[2][1] - w.IA_l_ankle_link[13]*w.KSD_l_ankle_link[1];
-    const Scalar t51 = -w.IA_l_ankle_link[4]*w.KSD_l_ankle_link[1];
-    const Scalar t52 = w.KA_l_ankle_link[5][1] - w.IA_l_ankle_link[19]*w.KSD_l_ankle_link[1];
-    const Scalar t53 = w.cq_l_ankle_link*t51 + w.sq_l_ankle_link*t50;
-    const Scalar t54 = -w.sq_l_ankle_link*t51 + w.cq_l_ankle_link*t50;
-    const Scalar t55 = 0.9950041652780258*t53 - 0.09983341664682815*t54;
-    const Scalar t56 = 0.09983341664682815*t53 + 0.9950041652780258*t54;
-    w.KA_l_shank[0][1] = t55;
-    w.KA_l_shank[1][1] = t49;
-    w.KA_l_shank[2][1] = t56;
-    w.KA_l_shank[3][1] = 0.4305*t49 + 0.9950041652780258*w.sq_l_ankle_link*t52 - 0.09983341664682815*w.cq_l_ankle_link*t52;
-    w.KA_l_shank[4][1] = -0.4305*t55;
-    w.KA_l_shank[5][1] = 0.09983341664682815*w.sq_l_ankle_link*t52 + 0.9950041652780258*w.cq_l_ankle_link*t52;
-    const Scalar t57 = 0.9950041652780258*w.sq_l_ankle_link*w.KA_l_ankle_link[2][2] - 0.09983341664682815*w.cq_l_ankle_link*w.KA_l_ankle_link[2][2];
-    const Scalar t58 = 0.09983341664682815*w.sq_l_ankle_link*w.KA_l_ankle_link[2][2] + 0.9950041652780258*w.cq_l_ankle_link*w.KA_l_ankle_link[2][2];
-    w.KA_l_shank[0][2] = t57;
-    w.KA_l_shank[1][2] = w.KA_l_ankle_link[1][2];
-    w.KA_l_shank[2][2] = t58;
-    w.KA_l_shank[3][2] = 0.4305*w.KA_l_ankle_link[1][2];
-    w.KA_l_shank[4][2] = -0.4305*t57;
-    w.KSD_l_ankle_link[3] = w.KA_l_ankle_link[4][3]*w.Dinv_l_ankle_link;
-    const Scalar t59 = w.KA_l_ankle_link[1][3] - w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[3];
-    const Scalar t60 = w.KA_l_ankle_link[2][3] - w.IA_l_ankle_link[13]*w.KSD_l_ankle_link[3];
-    const Scalar t61 = -w.IA_l_ankle_link[4]*w.KSD_l_ankle_link[3];
-    const Scalar t62 = w.KA_l_ankle_link[5][3] - w.IA_l_ankle_link[19]*w.KSD_l_ankle_link[3];
-    const Scalar t63 = w.cq_l_ankle_link*t61 + w.sq_l_ankle_link*t60;
-    const Scalar t64 = -w.sq_l_ankle_link*t61 + w.cq_l_ankle_link*t60;
-    const Scalar t65 = 0.9950041652780258*t63 - 0.09983341664682815*t64;
-    const Scalar t66 = 0.09983341664682815*t63 + 0.9950041652780258*t64;
-    w.KA_l_shank[0][3] = t65;
-    w.KA_l_shank[1][3] = t59;
-    w.KA_l_shank[2][3] = t66;
-    w.KA_l_shank[3][3] = 0.4305*t59 + 0.9950041652780258*w.sq_l_ankle_link*t62 - 0.09983341664682815*w.cq_l_ankle_link*t62;
-    w.KA_l_shank[4][3] = -0.4305*t65;
-    w.KA_l_shank[5][3] = 0.09983341664682815*w.sq_l_ankle_link*t62 + 0.9950041652780258*w.cq_l_ankle_link*t62;
-    w.KSD_l_ankle_link[4] = w.KA_l_ankle_link[4][4]*w.Dinv_l_ankle_link;
-    const Scalar t67 = -w.IA_l_ankle_link[4]*w.KSD_l_ankle_link[4];
-    const Scalar t68 = -w.IA_l_ankle_link[13]*w.KSD_l_ankle_link[4];
-    const Scalar t69 = w.KA_l_ankle_link[5][4] - w.IA_l_ankle_link[19]*w.KSD_l_ankle_link[4];
-    const Scalar t70 = w.cq_l_ankle_link*t67 + w.sq_l_ankle_link*t68;
-    const Scalar t71 = -w.sq_l_ankle_link*t67 + w.cq_l_ankle_link*t68;
-    const Scalar t72 = 0.9950041652780258*t70 - 0.09983341664682815*t71;
-    const Scalar t73 = 0.09983341664682815*t70 + 0.9950041652780258*t71;
-    w.KA_l_shank[0][4] = t72;
-    w.KA_l_shank[1][4] = -w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[4];
-    w.KA_l_shank[2][4] = t73;
-    w.KA_l_shank[3][4] = -0.4305*w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[4] + 0.9950041652780258*w.sq_l_ankle_link*t69 - 0.09983341664682815*w.cq_l_ankle_link*t69;
-    w.KA_l_shank[4][4] = -0.4305*t72;
-    w.KA_l_shank[5][4] = 0.09983341664682815*w.sq_l_ankle_link*t69 + 0.9950041652780258*w.cq_l_ankle_link*t69;
-    w.KSD_l_ankle_link[5] = w.KA_l_ankle_link[4][5]*w.Dinv_l_ankle_link;
-    const Scalar t74 = -w.IA_l_ankle_link[4]*w.KSD_l_ankle_link[5];
-    const Scalar t75 = -w.IA_l_ankle_link[13]*w.KSD_l_ankle_link[5];
-    const Scalar t76 = w.KA_l_ankle_link[5][5] - w.IA_l_ankle_link[19]*w.KSD_l_ankle_link[5];
-    const Scalar t77 = w.cq_l_ankle_link*t74 + w.sq_l_ankle_link*t75;
-    const Scalar t78 = -w.sq_l_ankle_link*t74 + w.cq_l_ankle_link*t75;
-    const Scalar t79 = 0.9950041652780258*t77 - 0.09983341664682815*t78;
-    const Scalar t80 = 0.09983341664682815*t77 + 0.9950041652780258*t78;
-    w.KA_l_shank[0][5] = t79;
-    w.KA_l_shank[1][5] = -w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[5];
-    w.KA_l_shank[2][5] = t80;
-    w.KA_l_shank[3][5] = -0.4305*w.IA_l_ankle_link[9]*w.KSD_l_ankle_link[5] + 0.9950041652780258*w.sq_l_ankle_link*t76 - 0.09983341664682815*w.cq_l_ankle_link*t76;
-    w.KA_l_shank[4][5] = -0.4305*t79;
-    w.KA_l_shank[5][5] = 0.09983341664682815*w.sq_l_ankle_link*t76 + 0.9950041652780258*w.cq_l_ankle_link*t76;
-  }
+  shared_36(shared_36_k0, &tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    w.Dinv_l_shank = 1.0 / w.IA_l_shank[18];
-    w.u_l_shank[0] = -w.pA_l_shank[4] + tau[9];
-    const Scalar t0 = w.IA_l_shank[4]*w.Dinv_l_shank;
-    const Scalar t1 = w.IA_l_shank[9]*w.Dinv_l_shank;
-    const Scalar t2 = w.IA_l_shank[13]*w.Dinv_l_shank;
-    const Scalar t3 = w.IA_l_shank[16]*w.Dinv_l_shank;
-    const Scalar t4 = w.IA_l_shank[19]*w.Dinv_l_shank;
-    const Scalar Ia0 = w.IA_l_shank[0] - w.IA_l_shank[4]*t0;
-    const Scalar Ia1 = w.IA_l_shank[1] - w.IA_l_shank[9]*t0;
-    const Scalar Ia2 = w.IA_l_shank[2] - w.IA_l_shank[13]*t0;
-    const Scalar Ia3 = w.IA_l_shank[3] - w.IA_l_shank[16]*t0;
-    const Scalar Ia4 = w.IA_l_shank[5] - w.IA_l_shank[19]*t0;
-    const Scalar Ia5 = w.IA_l_shank[6] - w.IA_l_shank[9]*t1;
-    const Scalar Ia6 = w.IA_l_shank[7] - w.IA_l_shank[13]*t1;
-    const Scalar Ia7 = w.IA_l_shank[8] - w.IA_l_shank[16]*t1;
-    const Scalar Ia8 = w.IA_l_shank[10] - w.IA_l_shank[19]*t1;
-    const Scalar Ia9 = w.IA_l_shank[11] - w.IA_l_shank[13]*t2;
-    const Scalar Ia10 = w.IA_l_shank[12] - w.IA_l_shank[16]*t2;
-    const Scalar Ia11 = w.IA_l_shank[14] - w.IA_l_shank[19]*t2;
-    const Scalar Ia12 = w.IA_l_shank[15] - w.IA_l_shank[16]*t3;
-    const Scalar Ia13 = w.IA_l_shank[17] - w.IA_l_shank[19]*t3;
-    const Scalar Ia14 = w.IA_l_shank[20] - w.IA_l_shank[19]*t4;
-    const Scalar pa0 = w.pA_l_shank[0] + w.u_l_shank[0]*t0 + w.c_l_shank[0]*Ia0 + w.c_l_shank[2]*Ia2 + w.c_l_shank[3]*Ia3 + w.c_l_shank[5]*Ia4;
-    const Scalar pa1 = w.pA_l_shank[1] + w.u_l_shank[0]*t1 + w.c_l_shank[0]*Ia1 + w.c_l_shank[2]*Ia6 + w.c_l_shank[3]*Ia7 + w.c_l_shank[5]*Ia8;
-    const Scalar pa2 = w.pA_l_shank[2] + w.u_l_shank[0]*t2 + w.c_l_shank[0]*Ia2 + w.c_l_shank[2]*Ia9 + w.c_l_shank[3]*Ia10 + w.c_l_shank[5]*Ia11;
-    const Scalar pa3 = w.pA_l_shank[3] + w.u_l_shank[0]*t3 + w.c_l_shank[0]*Ia3 + w.c_l_shank[2]*Ia10 + w.c_l_shank[3]*Ia12 + w.c_l_shank[5]*Ia13;
-    const Scalar pa4 = w.pA_l_shank[5] + w.u_l_shank[0]*t4 + w.c_l_shank[0]*Ia4 + w.c_l_shank[2]*Ia11 + w.c_l_shank[3]*Ia13 + w.c_l_shank[5]*Ia14;
-    const Scalar C20 = w.cq_l_shank*w.cq_l_shank - w.sq_l_shank*w.sq_l_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_l_shank*w.sq_l_shank;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9800665778412416*m0 - 0.9800665778412416*d0 + 0.19866933079506124*qq0;
-    const Scalar t8 = 0.19866933079506124*w.cq_l_shank*Ia6 - 0.19866933079506124*w.sq_l_shank*Ia1 + 0.9800665778412416*w.sq_l_shank*Ia6 + 0.9800665778412416*w.cq_l_shank*Ia1;
-    const Scalar t9 = 0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t10 = w.sq_l_shank*Ia6 + w.cq_l_shank*Ia1;
-    const Scalar t11 = w.cq_l_shank*Ia6 - w.sq_l_shank*Ia1;
-    const Scalar t12 = -0.19866933079506124*m0 + 0.19866933079506124*d0 + 0.9800665778412416*qq0;
-    const Scalar t14 = 0.9800665778412416*m0 + 0.9800665778412416*d0 - 0.19866933079506124*qq0;
-    const Scalar t15 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 - 0.9800665778412416*d1 + 0.19866933079506124*qq1;
-    const Scalar t16 = 0.4900332889206208*Ia4 - 0.4900332889206208*Ia10 + 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t17 = w.sq_l_shank*Ia8 + w.cq_l_shank*Ia7;
-    const Scalar t18 = w.cq_l_shank*Ia8 - w.sq_l_shank*Ia7;
-    const Scalar t19 = -0.4900332889206208*Ia4 + 0.4900332889206208*Ia10 - 0.19866933079506124*m1 + 0.19866933079506124*d1 + 0.9800665778412416*qq1;
-    const Scalar t20 = -0.09933466539753062*Ia4 + 0.09933466539753062*Ia10 + 0.9800665778412416*m1 + 0.9800665778412416*d1 - 0.19866933079506124*qq1;
-    const Scalar t21 = 0.9800665778412416*m2 - 0.9800665778412416*d2 + 0.19866933079506124*qq2;
-    const Scalar t22 = 0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t23 = -0.19866933079506124*m2 + 0.19866933079506124*d2 + 0.9800665778412416*qq2;
-    const Scalar t24 = 0.9800665778412416*m2 + 0.9800665778412416*d2 - 0.19866933079506124*qq2;
-    const Scalar t25 = 0.9800665778412416*t7 + 0.19866933079506124*t9;
-    const Scalar t26 = -0.19866933079506124*t7 + 0.9800665778412416*t9;
-    const Scalar t27 = -0.19866933079506124*t10 + 0.9800665778412416*t11;
-    const Scalar t28 = -0.19866933079506124*t12 + 0.9800665778412416*t14;
-    const Scalar t29 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
-    const Scalar t30 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
-    const Scalar t31 = 0.9800665778412416*t17 + 0.19866933079506124*t18;
-    const Scalar t32 = -0.19866933079506124*t17 + 0.9800665778412416*t18;
-    const Scalar t33 = 0.9800665778412416*t19 + 0.19866933079506124*t20;
-    const Scalar t34 = -0.19866933079506124*t19 + 0.9800665778412416*t20;
-    const Scalar t35 = 0.42875*t8 + t29;
-    const Scalar t36 = 0.42875*Ia5 + t31;
-    const Scalar t37 = 0.42875*t27 + t33;
-    const Scalar t38 = w.cq_l_shank*pa0 + w.sq_l_shank*pa2;
-    const Scalar t39 = -w.sq_l_shank*pa0 + w.cq_l_shank*pa2;
-    const Scalar t40 = w.cq_l_shank*pa3 + w.sq_l_shank*pa4;
-    const Scalar t41 = -w.sq_l_shank*pa3 + w.cq_l_shank*pa4;
-    const Scalar t42 = 0.9800665778412416*t38 + 0.19866933079506124*t39;
-    const Scalar t43 = -0.19866933079506124*t38 + 0.9800665778412416*t39;
-    w.IA_l_thigh[0] = 7.0 + t25;
-    w.IA_l_thigh[1] = t8;
-    w.IA_l_thigh[2] = t26;
-    w.IA_l_thigh[3] = t35;
-    w.IA_l_thigh[4] = -1.29954125 - 0.42875*t25;
-    w.IA_l_thigh[5] = t30;
-    w.IA_l_thigh[6] = 7.0 + Ia5;
-    w.IA_l_thigh[7] = t27;
-    w.IA_l_thigh[8] = 1.29954125 + t36;
-    w.IA_l_thigh[9] = -0.42875*t8;
-    w.IA_l_thigh[10] = t32;
-    w.IA_l_thigh[11] = 7.0 + t28;
-    w.IA_l_thigh[12] = t37;
-    w.IA_l_thigh[13] = -0.42875*t26;
-    w.IA_l_thigh[14] = t34;
-    w.IA_l_thigh[15] = 0.3755072987089375 + 0.9800665778412416*t21 + 0.19866933079506124*t22 + 0.42875*t31 + 0.42875*t36;
-    w.IA_l_thigh[16] = -0.1838265625*t8 - 0.42875*t29;
-    w.IA_l_thigh[17] = -0.19866933079506124*t21 + 0.9800665778412416*t22 + 0.42875*t32;
-    w.IA_l_thigh[18] = 0.3755072987089375 + 0.1838265625*t25;
-    w.IA_l_thigh[19] = -0.42875*t30;
-    w.IA_l_thigh[20] = 0.0196875 - 0.19866933079506124*t23 + 0.9800665778412416*t24;
-    w.pA_l_thigh[0] = w.pA_l_thigh[0] + t42;
-    w.pA_l_thigh[1] = w.pA_l_thigh[1] + pa1;
-    w.pA_l_thigh[2] = w.pA_l_thigh[2] + t43;
-    w.pA_l_thigh[3] = w.pA_l_thigh[3] + 0.42875*pa1 + 0.9800665778412416*t40 + 0.19866933079506124*t41;
-    w.pA_l_thigh[4] = w.pA_l_thigh[4] + tau[9] - 0.42875*t42;
-    w.pA_l_thigh[5] = w.pA_l_thigh[5] - 0.19866933079506124*t40 + 0.9800665778412416*t41;
-    // columns 0 to 1
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      w.KSD_l_shank[j] = w.Dinv_l_shank*w.KA_l_shank[4][j];
-      const Scalar t44 = w.KA_l_shank[0][j] - w.IA_l_shank[4]*w.KSD_l_shank[j];
-      const Scalar t45 = w.KA_l_shank[1][j] - w.IA_l_shank[9]*w.KSD_l_shank[j];
-      const Scalar t46 = w.KA_l_shank[2][j] - w.IA_l_shank[13]*w.KSD_l_shank[j];
-      const Scalar t47 = w.KA_l_shank[3][j] - w.IA_l_shank[16]*w.KSD_l_shank[j];
-      const Scalar t48 = w.KA_l_shank[5][j] - w.IA_l_shank[19]*w.KSD_l_shank[j];
-      const Scalar t49 = w.cq_l_shank*t44 + w.sq_l_shank*t46;
-      const Scalar t50 = -w.sq_l_shank*t44 + w.cq_l_shank*t46;
-      const Scalar t51 = w.cq_l_shank*t47 + w.sq_l_shank*t48;
-      const Scalar t52 = -w.sq_l_shank*t47 + w.cq_l_shank*t48;
-      const Scalar t53 = 0.9800665778412416*t49 + 0.19866933079506124*t50;
-      const Scalar t54 = -0.19866933079506124*t49 + 0.9800665778412416*t50;
-      w.KA_l_thigh[0][j] = t53;
-      w.KA_l_thigh[1][j] = t45;
-      w.KA_l_thigh[2][j] = t54;
-      w.KA_l_thigh[3][j] = 0.42875*t45 + 0.9800665778412416*t51 + 0.19866933079506124*t52;
-      w.KA_l_thigh[4][j] = -0.42875*t53;
-      w.KA_l_thigh[5][j] = -0.19866933079506124*t51 + 0.9800665778412416*t52;
-    }
-    w.KSD_l_shank[2] = w.KA_l_shank[4][2]*w.Dinv_l_shank;
-    const Scalar t55 = w.KA_l_shank[0][2] - w.IA_l_shank[4]*w.KSD_l_shank[2];
-    const Scalar t56 = w.KA_l_shank[1][2] - w.IA_l_shank[9]*w.KSD_l_shank[2];
-    const Scalar t57 = w.KA_l_shank[2][2] - w.IA_l_shank[13]*w.KSD_l_shank[2];
-    const Scalar t58 = w.KA_l_shank[3][2] - w.IA_l_shank[16]*w.KSD_l_shank[2];
-    const Scalar t59 = -w.IA_l_shank[19]*w.KSD_l_shank[2];
-    const Scalar t60 = w.cq_l_shank*t55 + w.sq_l_shank*t57;
-    const Scalar t61 = -w.sq_l_shank*t55 + w.cq_l_shank*t57;
-    const Scalar t62 = w.cq_l_shank*t58 + w.sq_l_shank*t59;
-    const Scalar t63 = -w.sq_l_shank*t58 + w.cq_l_shank*t59;
-    const Scalar t64 = 0.9800665778412416*t60 + 0.19866933079506124*t61;
-    const Scalar t65 = -0.19866933079506124*t60 + 0.9800665778412416*t61;
-    w.KA_l_thigh[0][2] = t64;
-    w.KA_l_thigh[1][2] = t56;
-    w.KA_l_thigh[2][2] = t65;
-    w.KA_l_thigh[3][2] = 0.42875*t56 + 0.9800665778412416*t62 + 0.19866933079506124*t63;
-    w.KA_l_thigh[4][2] = -0.42875*t64;
-    w.KA_l_thigh[5][2] = -0.19866933079506124*t62 + 0.9800665778412416*t63;
-    // columns 3 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
-      w.KSD_l_shank[3 + j] = w.Dinv_l_shank*w.KA_l_shank[4][3 + j];
-      const Scalar t66 = w.KA_l_shank[0][3 + j] - w.IA_l_shank[4]*w.KSD_l_shank[3 + j];
-      const Scalar t67 = w.KA_l_shank[1][3 + j] - w.IA_l_shank[9]*w.KSD_l_shank[3 + j];
-      const Scalar t68 = w.KA_l_shank[2][3 + j] - w.IA_l_shank[13]*w.KSD_l_shank[3 + j];
-      const Scalar t69 = w.KA_l_shank[3][3 + j] - w.IA_l_shank[16]*w.KSD_l_shank[3 + j];
-      const Scalar t70 = w.KA_l_shank[5][3 + j] - w.IA_l_shank[19]*w.KSD_l_shank[3 + j];
-      const Scalar t71 = w.cq_l_shank*t66 + w.sq_l_shank*t68;
-      const Scalar t72 = -w.sq_l_shank*t66 + w.cq_l_shank*t68;
-      const Scalar t73 = w.cq_l_shank*t69 + w.sq_l_shank*t70;
-      const Scalar t74 = -w.sq_l_shank*t69 + w.cq_l_shank*t70;
-      const Scalar t75 = 0.9800665778412416*t71 + 0.19866933079506124*t72;
-      const Scalar t76 = -0.19866933079506124*t71 + 0.9800665778412416*t72;
-      w.KA_l_thigh[0][3 + j] = t75;
-      w.KA_l_thigh[1][3 + j] = t67;
-      w.KA_l_thigh[2][3 + j] = t76;
-      w.KA_l_thigh[3][3 + j] = 0.42875*t67 + 0.9800665778412416*t73 + 0.19866933079506124*t74;
-      w.KA_l_thigh[4][3 + j] = -0.42875*t75;
-      w.KA_l_thigh[5][3 + j] = -0.19866933079506124*t73 + 0.9800665778412416*t74;
-    }
-  }
+  shared_37(shared_37_k0, &tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    w.Dinv_l_thigh = 1.0 / w.IA_l_thigh[18];
-    w.u_l_thigh[0] = -w.pA_l_thigh[4] + tau[8];
-    const Scalar t0 = w.IA_l_thigh[4]*w.Dinv_l_thigh;
-    const Scalar t1 = w.IA_l_thigh[9]*w.Dinv_l_thigh;
-    const Scalar t2 = w.IA_l_thigh[13]*w.Dinv_l_thigh;
-    const Scalar t3 = w.IA_l_thigh[16]*w.Dinv_l_thigh;
-    const Scalar t4 = w.IA_l_thigh[19]*w.Dinv_l_thigh;
-    const Scalar Ia0 = w.IA_l_thigh[0] - w.IA_l_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_l_thigh[1] - w.IA_l_thigh[9]*t0;
-    const Scalar Ia2 = w.IA_l_thigh[2] - w.IA_l_thigh[13]*t0;
-    const Scalar Ia3 = w.IA_l_thigh[3] - w.IA_l_thigh[16]*t0;
-    const Scalar Ia4 = w.IA_l_thigh[5] - w.IA_l_thigh[19]*t0;
-    const Scalar Ia5 = w.IA_l_thigh[6] - w.IA_l_thigh[9]*t1;
-    const Scalar Ia6 = w.IA_l_thigh[7] - w.IA_l_thigh[13]*t1;
-    const Scalar Ia7 = w.IA_l_thigh[8] - w.IA_l_thigh[16]*t1;
-    const Scalar Ia8 = w.IA_l_thigh[10] - w.IA_l_thigh[19]*t1;
-    const Scalar Ia9 = w.IA_l_thigh[11] - w.IA_l_thigh[13]*t2;
-    const Scalar Ia10 = w.IA_l_thigh[12] - w.IA_l_thigh[16]*t2;
-    const Scalar Ia11 = w.IA_l_thigh[14] - w.IA_l_thigh[19]*t2;
-    const Scalar Ia12 = w.IA_l_thigh[15] - w.IA_l_thigh[16]*t3;
-    const Scalar Ia13 = w.IA_l_thigh[17] - w.IA_l_thigh[19]*t3;
-    const Scalar Ia14 = w.IA_l_thigh[20] - w.IA_l_thigh[19]*t4;
-    const Scalar pa0 = w.pA_l_thigh[0] + w.u_l_thigh[0]*t0 + w.c_l_thigh[0]*Ia0 + w.c_l_thigh[2]*Ia2 + w.c_l_thigh[3]*Ia3 + w.c_l_thigh[5]*Ia4;
-    const Scalar pa1 = w.pA_l_thigh[1] + w.u_l_thigh[0]*t1 + w.c_l_thigh[0]*Ia1 + w.c_l_thigh[2]*Ia6 + w.c_l_thigh[3]*Ia7 + w.c_l_thigh[5]*Ia8;
-    const Scalar pa2 = w.pA_l_thigh[2] + w.u_l_thigh[0]*t2 + w.c_l_thigh[0]*Ia2 + w.c_l_thigh[2]*Ia9 + w.c_l_thigh[3]*Ia10 + w.c_l_thigh[5]*Ia11;
-    const Scalar pa3 = w.pA_l_thigh[3] + w.u_l_thigh[0]*t3 + w.c_l_thigh[0]*Ia3 + w.c_l_thigh[2]*Ia10 + w.c_l_thigh[3]*Ia12 + w.c_l_thigh[5]*Ia13;
-    const Scalar pa4 = w.pA_l_thigh[5] + w.u_l_thigh[0]*t4 + w.c_l_thigh[0]*Ia4 + w.c_l_thigh[2]*Ia11 + w.c_l_thigh[3]*Ia13 + w.c_l_thigh[5]*Ia14;
-    const Scalar C20 = w.cq_l_thigh*w.cq_l_thigh - w.sq_l_thigh*w.sq_l_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia9);
-    const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_l_thigh*w.sq_l_thigh;
-    const Scalar d0 = C20*h0 - Ia2*t5;
-    const Scalar qq0 = h0*t5 + Ia2*C20;
-    const Scalar h1 = 0.5*(-Ia3 + Ia11);
-    const Scalar m1 = 0.5*(Ia3 + Ia11);
-    const Scalar t6 = 0.5*(Ia4 + Ia10);
-    const Scalar d1 = C20*h1 - t5*t6;
-    const Scalar qq1 = t5*h1 + C20*t6;
-    const Scalar h2 = 0.5*(-Ia12 + Ia14);
-    const Scalar m2 = 0.5*(Ia12 + Ia14);
-    const Scalar d2 = C20*h2 - Ia13*t5;
-    const Scalar qq2 = t5*h2 + Ia13*C20;
-    const Scalar t7 = 0.9950041652780258*m0 - 0.9950041652780258*d0 - 0.09983341664682815*qq0;
-    const Scalar t8 = -0.09983341664682815*w.cq_l_thigh*Ia6 + 0.09983341664682815*w.sq_l_thigh*Ia1 + 0.9950041652780258*w.sq_l_thigh*Ia6 + 0.9950041652780258*w.cq_l_thigh*Ia1;
-    const Scalar t9 = -0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t10 = w.sq_l_thigh*Ia6 + w.cq_l_thigh*Ia1;
-    const Scalar t11 = w.cq_l_thigh*Ia6 - w.sq_l_thigh*Ia1;
-    const Scalar t12 = 0.09983341664682815*m0 - 0.09983341664682815*d0 + 0.9950041652780258*qq0;
-    const Scalar t14 = 0.9950041652780258*m0 + 0.9950041652780258*d0 + 0.09983341664682815*qq0;
-    const Scalar t15 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 - 0.9950041652780258*d1 - 0.09983341664682815*qq1;
-    const Scalar t16 = 0.4975020826390129*Ia4 - 0.4975020826390129*Ia10 - 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t17 = w.sq_l_thigh*Ia8 + w.cq_l_thigh*Ia7;
-    const Scalar t18 = w.cq_l_thigh*Ia8 - w.sq_l_thigh*Ia7;
-    const Scalar t19 = -0.4975020826390129*Ia4 + 0.4975020826390129*Ia10 + 0.09983341664682815*m1 - 0.09983341664682815*d1 + 0.9950041652780258*qq1;
-    const Scalar t20 = 0.04991670832341408*Ia4 - 0.04991670832341408*Ia10 + 0.9950041652780258*m1 + 0.9950041652780258*d1 + 0.09983341664682815*qq1;
-    const Scalar t21 = 0.9950041652780258*m2 - 0.9950041652780258*d2 - 0.09983341664682815*qq2;
-    const Scalar t22 = -0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t23 = 0.09983341664682815*m2 - 0.09983341664682815*d2 + 0.9950041652780258*qq2;
-    const Scalar t24 = 0.9950041652780258*m2 + 0.9950041652780258*d2 + 0.09983341664682815*qq2;
-    const Scalar t25 = w.cq_l_thigh*pa0 + w.sq_l_thigh*pa2;
-    const Scalar t26 = -w.sq_l_thigh*pa0 + w.cq_l_thigh*pa2;
-    const Scalar t27 = w.cq_l_thigh*pa3 + w.sq_l_thigh*pa4;
-    const Scalar t28 = -w.sq_l_thigh*pa3 + w.cq_l_thigh*pa4;
-    w.IA_l_hip_roll_link[0] = 0.5 + 0.9950041652780258*t7 - 0.09983341664682815*t9;
-    w.IA_l_hip_roll_link[1] = t8;
-    w.IA_l_hip_roll_link[2] = 0.09983341664682815*t7 + 0.9950041652780258*t9;
-    w.IA_l_hip_roll_link[3] = 0.9950041652780258*t15 - 0.09983341664682815*t16;
-    w.IA_l_hip_roll_link[5] = 0.09983341664682815*t15 + 0.9950041652780258*t16;
-    w.IA_l_hip_roll_link[6] = 0.5 + Ia5;
-    w.IA_l_hip_roll_link[7] = 0.09983341664682815*t10 + 0.9950041652780258*t11;
-    w.IA_l_hip_roll_link[8] = 0.015 + 0.9950041652780258*t17 - 0.09983341664682815*t18;
-    w.IA_l_hip_roll_link[10] = 0.09983341664682815*t17 + 0.9950041652780258*t18;
-    w.IA_l_hip_roll_link[11] = 0.5 + 0.09983341664682815*t12 + 0.9950041652780258*t14;
-    w.IA_l_hip_roll_link[12] = 0.9950041652780258*t19 - 0.09983341664682815*t20;
-    w.IA_l_hip_roll_link[14] = 0.09983341664682815*t19 + 0.9950041652780258*t20;
-    w.IA_l_hip_roll_link[15] = 0.00095 + 0.9950041652780258*t21 - 0.09983341664682815*t22;
-    w.IA_l_hip_roll_link[17] = 0.09983341664682815*t21 + 0.9950041652780258*t22;
-    w.IA_l_hip_roll_link[20] = 0.0005 + 0.09983341664682815*t23 + 0.9950041652780258*t24;
-    w.pA_l_hip_roll_link[0] = w.pA_l_hip_roll_link[0] + 0.9950041652780258*t25 - 0.09983341664682815*t26;
-    w.pA_l_hip_roll_link[1] = w.pA_l_hip_roll_link[1] + pa1;
-    w.pA_l_hip_roll_link[2] = w.pA_l_hip_roll_link[2] + 0.09983341664682815*t25 + 0.9950041652780258*t26;
-    w.pA_l_hip_roll_link[3] = w.pA_l_hip_roll_link[3] + 0.9950041652780258*t27 - 0.09983341664682815*t28;
-    w.pA_l_hip_roll_link[4] = w.pA_l_hip_roll_link[4] + tau[8];
-    w.pA_l_hip_roll_link[5] = w.pA_l_hip_roll_link[5] + 0.09983341664682815*t27 + 0.9950041652780258*t28;
-    // columns 0 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-      w.KSD_l_thigh[j] = w.Dinv_l_thigh*w.KA_l_thigh[4][j];
-      const Scalar t29 = w.KA_l_thigh[0][j] - w.IA_l_thigh[4]*w.KSD_l_thigh[j];
-      const Scalar t30 = w.KA_l_thigh[1][j] - w.IA_l_thigh[9]*w.KSD_l_thigh[j];
-      const Scalar t31 = w.KA_l_thigh[2][j] - w.IA_l_thigh[13]*w.KSD_l_thigh[j];
-      const Scalar t32 = w.KA_l_thigh[3][j] - w.IA_l_thigh[16]*w.KSD_l_thigh[j];
-      const Scalar t33 = w.KA_l_thigh[5][j] - w.IA_l_thigh[19]*w.KSD_l_thigh[j];
-      const Scalar t34 = w.cq_l_thigh*t29 + w.sq_l_thigh*t31;
-      const Scalar t35 = -w.sq_l_thigh*t29 + w.cq_l_thigh*t31;
-      const Scalar t36 = w.cq_l_thigh*t32 + w.sq_l_thigh*t33;
-      const Scalar t37 = -w.sq_l_thigh*t32 + w.cq_l_thigh*t33;
-      w.KA_l_hip_roll_link[0][j] = 0.9950041652780258*t34 - 0.09983341664682815*t35;
-      w.KA_l_hip_roll_link[1][j] = t30;
-      w.KA_l_hip_roll_link[2][j] = 0.09983341664682815*t34 + 0.9950041652780258*t35;
-      w.KA_l_hip_roll_link[3][j] = 0.9950041652780258*t36 - 0.09983341664682815*t37;
-      w.KA_l_hip_roll_link[4][j] = 0.0;
-      w.KA_l_hip_roll_link[5][j] = 0.09983341664682815*t36 + 0.9950041652780258*t37;
-    }
-  }
+  shared_38(shared_38_k0, &tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    w.Dinv_l_hip_roll_link = 1.0 / w.IA_l_hip_roll_link[15];
-    w.u_l_hip_roll_link[0] = -w.pA_l_hip_roll_link[3] + tau[7];
-    const Scalar t0 = w.IA_l_hip_roll_link[3]*w.Dinv_l_hip_roll_link;
-    const Scalar t1 = w.IA_l_hip_roll_link[8]*w.Dinv_l_hip_roll_link;
-    const Scalar t2 = w.IA_l_hip_roll_link[12]*w.Dinv_l_hip_roll_link;
-    const Scalar t3 = w.IA_l_hip_roll_link[17]*w.Dinv_l_hip_roll_link;
-    const Scalar Ia0 = w.IA_l_hip_roll_link[0] - w.IA_l_hip_roll_link[3]*t0;
-    const Scalar Ia1 = w.IA_l_hip_roll_link[1] - w.IA_l_hip_roll_link[8]*t0;
-    const Scalar Ia2 = w.IA_l_hip_roll_link[2] - w.IA_l_hip_roll_link[12]*t0;
-    const Scalar Ia3 = w.IA_l_hip_roll_link[5] - w.IA_l_hip_roll_link[17]*t0;
-    const Scalar Ia4 = w.IA_l_hip_roll_link[6] - w.IA_l_hip_roll_link[8]*t1;
-    const Scalar Ia5 = w.IA_l_hip_roll_link[7] - w.IA_l_hip_roll_link[12]*t1;
-    const Scalar Ia6 = w.IA_l_hip_roll_link[10] - w.IA_l_hip_roll_link[17]*t1;
-    const Scalar Ia7 = w.IA_l_hip_roll_link[11] - w.IA_l_hip_roll_link[12]*t2;
-    const Scalar Ia8 = w.IA_l_hip_roll_link[14] - w.IA_l_hip_roll_link[17]*t2;
-    const Scalar Ia9 = w.IA_l_hip_roll_link[20] - w.IA_l_hip_roll_link[17]*t3;
-    const Scalar pa0 = -0.015*w.c_l_hip_roll_link[4] + w.pA_l_hip_roll_link[0] + w.u_l_hip_roll_link[0]*t0 + w.c_l_hip_roll_link[1]*Ia1 + w.c_l_hip_roll_link[2]*Ia2 + w.c_l_hip_roll_link[5]*Ia3;
-    const Scalar pa1 = w.pA_l_hip_roll_link[1] + w.u_l_hip_roll_link[0]*t1 + w.c_l_hip_roll_link[1]*Ia4 + w.c_l_hip_roll_link[2]*Ia5 + w.c_l_hip_roll_link[5]*Ia6;
-    const Scalar pa2 = w.pA_l_hip_roll_link[2] + w.u_l_hip_roll_link[0]*t2 + w.c_l_hip_roll_link[1]*Ia5 + w.c_l_hip_roll_link[2]*Ia7 + w.c_l_hip_roll_link[5]*Ia8;
-    const Scalar pa3 = 0.00095*w.c_l_hip_roll_link[4] + w.pA_l_hip_roll_link[4];
-    const Scalar pa4 = w.pA_l_hip_roll_link[5] + w.u_l_hip_roll_link[0]*t3 + w.c_l_hip_roll_link[1]*Ia6 + w.c_l_hip_roll_link[2]*Ia8 + w.c_l_hip_roll_link[5]*Ia9;
-    const Scalar C20 = w.cq_l_hip_roll_link*w.cq_l_hip_roll_link - w.sq_l_hip_roll_link*w.sq_l_hip_roll_link;
-    const Scalar h0 = 0.5*(Ia4 - Ia7);
-    const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_l_hip_roll_link*w.sq_l_hip_roll_link;
-    const Scalar d0 = C20*h0 - Ia5*t4;
-    const Scalar qq0 = h0*t4 + Ia5*C20;
-    const Scalar d1 = 0.5*(-Ia8*C20 - Ia6*t4);
-    const Scalar qq1 = 0.5*(-Ia8*t4 + Ia6*C20);
-    const Scalar h1 = 0.000475 - 0.5*Ia9;
-    const Scalar m1 = 0.000475 + 0.5*Ia9;
-    w.IA_l_hip_yaw_link[0] = 0.5 + Ia0;
-    w.IA_l_hip_yaw_link[1] = w.cq_l_hip_roll_link*Ia1 - w.sq_l_hip_roll_link*Ia2;
-    w.IA_l_hip_yaw_link[2] = w.sq_l_hip_roll_link*Ia1 + w.cq_l_hip_roll_link*Ia2;
-    w.IA_l_hip_yaw_link[4] = 0.02 - 0.015*w.cq_l_hip_roll_link - w.sq_l_hip_roll_link*Ia3;
-    w.IA_l_hip_yaw_link[5] = -0.015*w.sq_l_hip_roll_link + w.cq_l_hip_roll_link*Ia3;
-    w.IA_l_hip_yaw_link[6] = 0.5 + m0 + d0;
-    w.IA_l_hip_yaw_link[7] = qq0;
-    w.IA_l_hip_yaw_link[9] = 0.5*Ia8 + d1;
-    w.IA_l_hip_yaw_link[10] = 0.5*Ia6 + qq1;
-    w.IA_l_hip_yaw_link[11] = 0.5 + m0 - d0;
-    w.IA_l_hip_yaw_link[13] = -0.5*Ia6 + qq1;
-    w.IA_l_hip_yaw_link[14] = 0.5*Ia8 - d1;
-    w.IA_l_hip_yaw_link[18] = 0.0013 + m1 + C20*h1;
-    w.IA_l_hip_yaw_link[19] = t4*h1;
-    w.IA_l_hip_yaw_link[20] = 0.0005 + m1 - C20*h1;
-    w.pA_l_hip_yaw_link[0] = w.pA_l_hip_yaw_link[0] + pa0;
-    w.pA_l_hip_yaw_link[1] = w.pA_l_hip_yaw_link[1] + w.cq_l_hip_roll_link*pa1 - w.sq_l_hip_roll_link*pa2;
-    w.pA_l_hip_yaw_link[2] = w.pA_l_hip_yaw_link[2] + w.sq_l_hip_roll_link*pa1 + w.cq_l_hip_roll_link*pa2;
-    w.pA_l_hip_yaw_link[3] = w.pA_l_hip_yaw_link[3] + tau[7];
-    w.pA_l_hip_yaw_link[4] = w.pA_l_hip_yaw_link[4] + w.cq_l_hip_roll_link*pa3 - w.sq_l_hip_roll_link*pa4;
-    w.pA_l_hip_yaw_link[5] = w.pA_l_hip_yaw_link[5] + w.sq_l_hip_roll_link*pa3 + w.cq_l_hip_roll_link*pa4;
-    // columns 0 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-      w.KSD_l_hip_roll_link[j] = w.Dinv_l_hip_roll_link*w.KA_l_hip_roll_link[3][j];
-      const Scalar t5 = w.KA_l_hip_roll_link[0][j] - w.IA_l_hip_roll_link[3]*w.KSD_l_hip_roll_link[j];
-      const Scalar t6 = w.KA_l_hip_roll_link[1][j] - w.IA_l_hip_roll_link[8]*w.KSD_l_hip_roll_link[j];
-      const Scalar t7 = w.KA_l_hip_roll_link[2][j] - w.IA_l_hip_roll_link[12]*w.KSD_l_hip_roll_link[j];
-      const Scalar t8 = w.KA_l_hip_roll_link[5][j] - w.IA_l_hip_roll_link[17]*w.KSD_l_hip_roll_link[j];
-      w.KA_l_hip_yaw_link[0][j] = t5;
-      w.KA_l_hip_yaw_link[1][j] = w.cq_l_hip_roll_link*t6 - w.sq_l_hip_roll_link*t7;
-      w.KA_l_hip_yaw_link[2][j] = w.sq_l_hip_roll_link*t6 + w.cq_l_hip_roll_link*t7;
-      w.KA_l_hip_yaw_link[3][j] = 0.0;
-      w.KA_l_hip_yaw_link[4][j] = w.cq_l_hip_roll_link*w.KA_l_hip_roll_link[4][j] - w.sq_l_hip_roll_link*t8;
-      w.KA_l_hip_yaw_link[5][j] = w.sq_l_hip_roll_link*w.KA_l_hip_roll_link[4][j] + w.cq_l_hip_roll_link*t8;
-    }
-  }
+  shared_39(shared_39_k0, &tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -7384,94 +5876,18 @@ PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_
 
 PROXGEN_RT_NOINLINE void pv_free_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
-    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
-    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
-    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    const Scalar t4 = w.u_l_hip_roll_link[0] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = t0;
-    w.a_l_hip_roll_link[2] = t1;
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.Dinv_l_hip_roll_link*t4;
-    w.a_l_hip_roll_link[4] = t2;
-    w.a_l_hip_roll_link[5] = t3;
-  }
+  shared_40(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], w.a_l_hip_roll_link, w.Dinv_l_hip_roll_link);
   // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
-    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
-    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
-    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
-    const Scalar t13 = w.u_l_thigh[0] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
-    w.a_l_thigh[0] = t9;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = t10;
-    w.a_l_thigh[3] = t11;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.Dinv_l_thigh*t13;
-    w.a_l_thigh[5] = t12;
-  }
+  shared_41(shared_41_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
   // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
-    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
-    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
-    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
-    const Scalar t24 = w.u_l_shank[0] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
-    w.a_l_shank[0] = t20;
-    w.a_l_shank[1] = t15;
-    w.a_l_shank[2] = t21;
-    w.a_l_shank[3] = t22;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.Dinv_l_shank*t24;
-    w.a_l_shank[5] = t23;
-  }
+  shared_42(shared_42_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
-    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
-    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t10 = w.u_l_ankle_link[0] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
-    w.a_l_ankle_link[0] = t6;
-    w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = t7;
-    w.a_l_ankle_link[3] = t8;
-    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.Dinv_l_ankle_link*t10;
-    w.a_l_ankle_link[5] = t9;
-  }
+  shared_43(shared_43_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
   // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t15 = w.u_l_foot[0] - 0.00194517348958*w.a_l_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = t11;
-    w.a_l_foot[2] = t12;
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + 514.0929615568219*t15;
-    w.a_l_foot[4] = t13;
-    w.a_l_foot[5] = t14;
-  }
+  shared_44(shared_44_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, w.a_l_foot);
   // free acceleration (lambda = 0): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -7496,94 +5912,18 @@ PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXG
 
 PROXGEN_RT_NOINLINE void pv_free_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
-    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
-    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
-    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    const Scalar t4 = w.u_r_hip_roll_link[0] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = t0;
-    w.a_r_hip_roll_link[2] = t1;
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.Dinv_r_hip_roll_link*t4;
-    w.a_r_hip_roll_link[4] = t2;
-    w.a_r_hip_roll_link[5] = t3;
-  }
+  shared_40(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], w.a_r_hip_roll_link, w.Dinv_r_hip_roll_link);
   // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
-    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
-    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
-    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
-    const Scalar t13 = w.u_r_thigh[0] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
-    w.a_r_thigh[0] = t9;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = t10;
-    w.a_r_thigh[3] = t11;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.Dinv_r_thigh*t13;
-    w.a_r_thigh[5] = t12;
-  }
+  shared_41(shared_41_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
   // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
-    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
-    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
-    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
-    const Scalar t24 = w.u_r_shank[0] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
-    w.a_r_shank[0] = t20;
-    w.a_r_shank[1] = t15;
-    w.a_r_shank[2] = t21;
-    w.a_r_shank[3] = t22;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.Dinv_r_shank*t24;
-    w.a_r_shank[5] = t23;
-  }
+  shared_42(shared_42_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
-    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
-    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t10 = w.u_r_ankle_link[0] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
-    w.a_r_ankle_link[0] = t6;
-    w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = t7;
-    w.a_r_ankle_link[3] = t8;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.Dinv_r_ankle_link*t10;
-    w.a_r_ankle_link[5] = t9;
-  }
+  shared_43(shared_43_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
   // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t15 = w.u_r_foot[0] - 0.00194517348958*w.a_r_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = t11;
-    w.a_r_foot[2] = t12;
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + 514.0929615568219*t15;
-    w.a_r_foot[4] = t13;
-    w.a_r_foot[5] = t14;
-  }
+  shared_44(shared_44_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, w.a_r_foot);
   // free acceleration (lambda = 0): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
@@ -8467,99 +6807,18 @@ PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_
 
 PROXGEN_RT_NOINLINE void pv_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_l_hip_roll_link[1] + w.a_l_hip_yaw_link[1]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.sq_l_hip_roll_link;
-    const Scalar t1 = w.c_l_hip_roll_link[2] - w.a_l_hip_yaw_link[1]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[2]*w.cq_l_hip_roll_link;
-    const Scalar t2 = w.c_l_hip_roll_link[4] + w.a_l_hip_yaw_link[4]*w.cq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.sq_l_hip_roll_link;
-    const Scalar t3 = w.c_l_hip_roll_link[5] - w.a_l_hip_yaw_link[4]*w.sq_l_hip_roll_link + w.a_l_hip_yaw_link[5]*w.cq_l_hip_roll_link;
-    const Scalar t4 = w.u_l_hip_roll_link[0] - w.KA_l_hip_roll_link[3][0]*w.lambda[0] - w.KA_l_hip_roll_link[3][1]*w.lambda[1] - w.KA_l_hip_roll_link[3][2]*w.lambda[2] - w.KA_l_hip_roll_link[3][3]*w.lambda[3] - w.KA_l_hip_roll_link[3][4]*w.lambda[4] - w.KA_l_hip_roll_link[3][5]*w.lambda[5] - w.a_l_hip_yaw_link[0]*w.IA_l_hip_roll_link[3] - w.IA_l_hip_roll_link[8]*t0 - w.IA_l_hip_roll_link[12]*t1 - w.a_l_hip_yaw_link[3]*w.IA_l_hip_roll_link[15] - w.IA_l_hip_roll_link[17]*t3;
-    w.qdd[7] = w.Dinv_l_hip_roll_link*t4;
-    w.a_l_hip_roll_link[0] = w.a_l_hip_yaw_link[0];
-    w.a_l_hip_roll_link[1] = t0;
-    w.a_l_hip_roll_link[2] = t1;
-    w.a_l_hip_roll_link[3] = w.a_l_hip_yaw_link[3] + w.qdd[7];
-    w.a_l_hip_roll_link[4] = t2;
-    w.a_l_hip_roll_link[5] = t3;
-  }
+  shared_45(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, w.KA_l_hip_roll_link, 0, w.lambda, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_l_hip_roll_link[0] + 0.09983341664682815*w.a_l_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_l_hip_roll_link[0] + 0.9950041652780258*w.a_l_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_l_hip_roll_link[3] + 0.09983341664682815*w.a_l_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_l_hip_roll_link[3] + 0.9950041652780258*w.a_l_hip_roll_link[5];
-    const Scalar t9 = w.c_l_thigh[0] + w.cq_l_thigh*t5 - w.sq_l_thigh*t6;
-    const Scalar t10 = w.c_l_thigh[2] + w.sq_l_thigh*t5 + w.cq_l_thigh*t6;
-    const Scalar t11 = w.c_l_thigh[3] + w.cq_l_thigh*t7 - w.sq_l_thigh*t8;
-    const Scalar t12 = w.c_l_thigh[5] + w.sq_l_thigh*t7 + w.cq_l_thigh*t8;
-    const Scalar t13 = w.u_l_thigh[0] - w.KA_l_thigh[4][0]*w.lambda[0] - w.KA_l_thigh[4][1]*w.lambda[1] - w.KA_l_thigh[4][2]*w.lambda[2] - w.KA_l_thigh[4][3]*w.lambda[3] - w.KA_l_thigh[4][4]*w.lambda[4] - w.KA_l_thigh[4][5]*w.lambda[5] - w.IA_l_thigh[4]*t9 - w.IA_l_thigh[9]*w.a_l_hip_roll_link[1] - w.IA_l_thigh[13]*t10 - w.IA_l_thigh[16]*t11 - w.IA_l_thigh[18]*w.a_l_hip_roll_link[4] - w.IA_l_thigh[19]*t12;
-    w.qdd[8] = w.Dinv_l_thigh*t13;
-    w.a_l_thigh[0] = t9;
-    w.a_l_thigh[1] = w.a_l_hip_roll_link[1];
-    w.a_l_thigh[2] = t10;
-    w.a_l_thigh[3] = t11;
-    w.a_l_thigh[4] = w.a_l_hip_roll_link[4] + w.qdd[8];
-    w.a_l_thigh[5] = t12;
-  }
+  shared_46(shared_46_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    const Scalar t14 = w.a_l_thigh[0] - 0.42875*w.a_l_thigh[4];
-    const Scalar t15 = w.a_l_thigh[1] + 0.42875*w.a_l_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_l_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_l_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_l_thigh[3] - 0.19866933079506124*w.a_l_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_l_thigh[3] + 0.9800665778412416*w.a_l_thigh[5];
-    const Scalar t20 = w.c_l_shank[0] + w.cq_l_shank*t16 - w.sq_l_shank*t17;
-    const Scalar t21 = w.c_l_shank[2] + w.sq_l_shank*t16 + w.cq_l_shank*t17;
-    const Scalar t22 = w.c_l_shank[3] + w.cq_l_shank*t18 - w.sq_l_shank*t19;
-    const Scalar t23 = w.c_l_shank[5] + w.sq_l_shank*t18 + w.cq_l_shank*t19;
-    const Scalar t24 = w.u_l_shank[0] - w.KA_l_shank[4][0]*w.lambda[0] - w.KA_l_shank[4][1]*w.lambda[1] - w.KA_l_shank[4][2]*w.lambda[2] - w.KA_l_shank[4][3]*w.lambda[3] - w.KA_l_shank[4][4]*w.lambda[4] - w.KA_l_shank[4][5]*w.lambda[5] - w.IA_l_shank[4]*t20 - w.IA_l_shank[9]*t15 - w.IA_l_shank[13]*t21 - w.IA_l_shank[16]*t22 - w.IA_l_shank[18]*w.a_l_thigh[4] - w.IA_l_shank[19]*t23;
-    w.qdd[9] = w.Dinv_l_shank*t24;
-    w.a_l_shank[0] = t20;
-    w.a_l_shank[1] = t15;
-    w.a_l_shank[2] = t21;
-    w.a_l_shank[3] = t22;
-    w.a_l_shank[4] = w.a_l_thigh[4] + w.qdd[9];
-    w.a_l_shank[5] = t23;
-  }
+  shared_47(shared_47_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    const Scalar t0 = w.a_l_shank[0] - 0.4305*w.a_l_shank[4];
-    const Scalar t1 = w.a_l_shank[1] + 0.4305*w.a_l_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_l_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_l_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_l_shank[3] + 0.09983341664682815*w.a_l_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_l_shank[3] + 0.9950041652780258*w.a_l_shank[5];
-    const Scalar t6 = w.c_l_ankle_link[0] + w.cq_l_ankle_link*t2 - w.sq_l_ankle_link*t3;
-    const Scalar t7 = w.c_l_ankle_link[2] + w.sq_l_ankle_link*t2 + w.cq_l_ankle_link*t3;
-    const Scalar t8 = w.c_l_ankle_link[3] + w.cq_l_ankle_link*t4 - w.sq_l_ankle_link*t5;
-    const Scalar t9 = w.c_l_ankle_link[5] + w.sq_l_ankle_link*t4 + w.cq_l_ankle_link*t5;
-    const Scalar t10 = w.u_l_ankle_link[0] - w.KA_l_ankle_link[4][0]*w.lambda[0] - w.KA_l_ankle_link[4][1]*w.lambda[1] - w.KA_l_ankle_link[4][3]*w.lambda[3] - w.KA_l_ankle_link[4][4]*w.lambda[4] - w.KA_l_ankle_link[4][5]*w.lambda[5] - w.IA_l_ankle_link[4]*t6 - w.IA_l_ankle_link[9]*t1 - w.IA_l_ankle_link[13]*t7 - w.a_l_shank[4]*w.IA_l_ankle_link[18] - w.IA_l_ankle_link[19]*t9;
-    w.qdd[10] = w.Dinv_l_ankle_link*t10;
-    w.a_l_ankle_link[0] = t6;
-    w.a_l_ankle_link[1] = t1;
-    w.a_l_ankle_link[2] = t7;
-    w.a_l_ankle_link[3] = t8;
-    w.a_l_ankle_link[4] = w.a_l_shank[4] + w.qdd[10];
-    w.a_l_ankle_link[5] = t9;
-  }
+  shared_48(shared_48_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  {
-    const Scalar t11 = w.c_l_foot[1] + w.cq_l_foot*w.a_l_ankle_link[1] + w.sq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t12 = w.c_l_foot[2] - w.sq_l_foot*w.a_l_ankle_link[1] + w.cq_l_foot*w.a_l_ankle_link[2];
-    const Scalar t13 = w.c_l_foot[4] + w.cq_l_foot*w.a_l_ankle_link[4] + w.sq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t14 = w.c_l_foot[5] - w.sq_l_foot*w.a_l_ankle_link[4] + w.cq_l_foot*w.a_l_ankle_link[5];
-    const Scalar t15 = w.u_l_foot[0] - 0.06825*w.lambda[1] - w.lambda[3] - 0.00194517348958*w.a_l_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.qdd[11] = 514.0929615568219*t15;
-    w.a_l_foot[0] = w.a_l_ankle_link[0];
-    w.a_l_foot[1] = t11;
-    w.a_l_foot[2] = t12;
-    w.a_l_foot[3] = w.a_l_ankle_link[3] + w.qdd[11];
-    w.a_l_foot[4] = t13;
-    w.a_l_foot[5] = t14;
-  }
+  shared_49(shared_49_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
   // accelerate, with the multipliers of the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -8585,99 +6844,18 @@ PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PR
 
 PROXGEN_RT_NOINLINE void pv_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    const Scalar t0 = w.c_r_hip_roll_link[1] + w.a_r_hip_yaw_link[1]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.sq_r_hip_roll_link;
-    const Scalar t1 = w.c_r_hip_roll_link[2] - w.a_r_hip_yaw_link[1]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[2]*w.cq_r_hip_roll_link;
-    const Scalar t2 = w.c_r_hip_roll_link[4] + w.a_r_hip_yaw_link[4]*w.cq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.sq_r_hip_roll_link;
-    const Scalar t3 = w.c_r_hip_roll_link[5] - w.a_r_hip_yaw_link[4]*w.sq_r_hip_roll_link + w.a_r_hip_yaw_link[5]*w.cq_r_hip_roll_link;
-    const Scalar t4 = w.u_r_hip_roll_link[0] - w.KA_r_hip_roll_link[3][0]*w.lambda[6] - w.KA_r_hip_roll_link[3][1]*w.lambda[7] - w.KA_r_hip_roll_link[3][2]*w.lambda[8] - w.KA_r_hip_roll_link[3][3]*w.lambda[9] - w.KA_r_hip_roll_link[3][4]*w.lambda[10] - w.KA_r_hip_roll_link[3][5]*w.lambda[11] - w.a_r_hip_yaw_link[0]*w.IA_r_hip_roll_link[3] - w.IA_r_hip_roll_link[8]*t0 - w.IA_r_hip_roll_link[12]*t1 - w.a_r_hip_yaw_link[3]*w.IA_r_hip_roll_link[15] - w.IA_r_hip_roll_link[17]*t3;
-    w.qdd[13] = w.Dinv_r_hip_roll_link*t4;
-    w.a_r_hip_roll_link[0] = w.a_r_hip_yaw_link[0];
-    w.a_r_hip_roll_link[1] = t0;
-    w.a_r_hip_roll_link[2] = t1;
-    w.a_r_hip_roll_link[3] = w.a_r_hip_yaw_link[3] + w.qdd[13];
-    w.a_r_hip_roll_link[4] = t2;
-    w.a_r_hip_roll_link[5] = t3;
-  }
+  shared_45(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, w.KA_r_hip_roll_link, 0, &w.lambda[6], &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  {
-    const Scalar t5 = 0.9950041652780258*w.a_r_hip_roll_link[0] + 0.09983341664682815*w.a_r_hip_roll_link[2];
-    const Scalar t6 = -0.09983341664682815*w.a_r_hip_roll_link[0] + 0.9950041652780258*w.a_r_hip_roll_link[2];
-    const Scalar t7 = 0.9950041652780258*w.a_r_hip_roll_link[3] + 0.09983341664682815*w.a_r_hip_roll_link[5];
-    const Scalar t8 = -0.09983341664682815*w.a_r_hip_roll_link[3] + 0.9950041652780258*w.a_r_hip_roll_link[5];
-    const Scalar t9 = w.c_r_thigh[0] + w.cq_r_thigh*t5 - w.sq_r_thigh*t6;
-    const Scalar t10 = w.c_r_thigh[2] + w.sq_r_thigh*t5 + w.cq_r_thigh*t6;
-    const Scalar t11 = w.c_r_thigh[3] + w.cq_r_thigh*t7 - w.sq_r_thigh*t8;
-    const Scalar t12 = w.c_r_thigh[5] + w.sq_r_thigh*t7 + w.cq_r_thigh*t8;
-    const Scalar t13 = w.u_r_thigh[0] - w.KA_r_thigh[4][0]*w.lambda[6] - w.KA_r_thigh[4][1]*w.lambda[7] - w.KA_r_thigh[4][2]*w.lambda[8] - w.KA_r_thigh[4][3]*w.lambda[9] - w.KA_r_thigh[4][4]*w.lambda[10] - w.KA_r_thigh[4][5]*w.lambda[11] - w.IA_r_thigh[4]*t9 - w.IA_r_thigh[9]*w.a_r_hip_roll_link[1] - w.IA_r_thigh[13]*t10 - w.IA_r_thigh[16]*t11 - w.IA_r_thigh[18]*w.a_r_hip_roll_link[4] - w.IA_r_thigh[19]*t12;
-    w.qdd[14] = w.Dinv_r_thigh*t13;
-    w.a_r_thigh[0] = t9;
-    w.a_r_thigh[1] = w.a_r_hip_roll_link[1];
-    w.a_r_thigh[2] = t10;
-    w.a_r_thigh[3] = t11;
-    w.a_r_thigh[4] = w.a_r_hip_roll_link[4] + w.qdd[14];
-    w.a_r_thigh[5] = t12;
-  }
+  shared_46(shared_46_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    const Scalar t14 = w.a_r_thigh[0] - 0.42875*w.a_r_thigh[4];
-    const Scalar t15 = w.a_r_thigh[1] + 0.42875*w.a_r_thigh[3];
-    const Scalar t16 = -0.19866933079506124*w.a_r_thigh[2] + 0.9800665778412416*t14;
-    const Scalar t17 = 0.9800665778412416*w.a_r_thigh[2] + 0.19866933079506124*t14;
-    const Scalar t18 = 0.9800665778412416*w.a_r_thigh[3] - 0.19866933079506124*w.a_r_thigh[5];
-    const Scalar t19 = 0.19866933079506124*w.a_r_thigh[3] + 0.9800665778412416*w.a_r_thigh[5];
-    const Scalar t20 = w.c_r_shank[0] + w.cq_r_shank*t16 - w.sq_r_shank*t17;
-    const Scalar t21 = w.c_r_shank[2] + w.sq_r_shank*t16 + w.cq_r_shank*t17;
-    const Scalar t22 = w.c_r_shank[3] + w.cq_r_shank*t18 - w.sq_r_shank*t19;
-    const Scalar t23 = w.c_r_shank[5] + w.sq_r_shank*t18 + w.cq_r_shank*t19;
-    const Scalar t24 = w.u_r_shank[0] - w.KA_r_shank[4][0]*w.lambda[6] - w.KA_r_shank[4][1]*w.lambda[7] - w.KA_r_shank[4][2]*w.lambda[8] - w.KA_r_shank[4][3]*w.lambda[9] - w.KA_r_shank[4][4]*w.lambda[10] - w.KA_r_shank[4][5]*w.lambda[11] - w.IA_r_shank[4]*t20 - w.IA_r_shank[9]*t15 - w.IA_r_shank[13]*t21 - w.IA_r_shank[16]*t22 - w.IA_r_shank[18]*w.a_r_thigh[4] - w.IA_r_shank[19]*t23;
-    w.qdd[15] = w.Dinv_r_shank*t24;
-    w.a_r_shank[0] = t20;
-    w.a_r_shank[1] = t15;
-    w.a_r_shank[2] = t21;
-    w.a_r_shank[3] = t22;
-    w.a_r_shank[4] = w.a_r_thigh[4] + w.qdd[15];
-    w.a_r_shank[5] = t23;
-  }
+  shared_47(shared_47_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    const Scalar t0 = w.a_r_shank[0] - 0.4305*w.a_r_shank[4];
-    const Scalar t1 = w.a_r_shank[1] + 0.4305*w.a_r_shank[3];
-    const Scalar t2 = 0.09983341664682815*w.a_r_shank[2] + 0.9950041652780258*t0;
-    const Scalar t3 = 0.9950041652780258*w.a_r_shank[2] - 0.09983341664682815*t0;
-    const Scalar t4 = 0.9950041652780258*w.a_r_shank[3] + 0.09983341664682815*w.a_r_shank[5];
-    const Scalar t5 = -0.09983341664682815*w.a_r_shank[3] + 0.9950041652780258*w.a_r_shank[5];
-    const Scalar t6 = w.c_r_ankle_link[0] + w.cq_r_ankle_link*t2 - w.sq_r_ankle_link*t3;
-    const Scalar t7 = w.c_r_ankle_link[2] + w.sq_r_ankle_link*t2 + w.cq_r_ankle_link*t3;
-    const Scalar t8 = w.c_r_ankle_link[3] + w.cq_r_ankle_link*t4 - w.sq_r_ankle_link*t5;
-    const Scalar t9 = w.c_r_ankle_link[5] + w.sq_r_ankle_link*t4 + w.cq_r_ankle_link*t5;
-    const Scalar t10 = w.u_r_ankle_link[0] - w.KA_r_ankle_link[4][0]*w.lambda[6] - w.KA_r_ankle_link[4][1]*w.lambda[7] - w.KA_r_ankle_link[4][3]*w.lambda[9] - w.KA_r_ankle_link[4][4]*w.lambda[10] - w.KA_r_ankle_link[4][5]*w.lambda[11] - w.IA_r_ankle_link[4]*t6 - w.IA_r_ankle_link[9]*t1 - w.IA_r_ankle_link[13]*t7 - w.a_r_shank[4]*w.IA_r_ankle_link[18] - w.IA_r_ankle_link[19]*t9;
-    w.qdd[16] = w.Dinv_r_ankle_link*t10;
-    w.a_r_ankle_link[0] = t6;
-    w.a_r_ankle_link[1] = t1;
-    w.a_r_ankle_link[2] = t7;
-    w.a_r_ankle_link[3] = t8;
-    w.a_r_ankle_link[4] = w.a_r_shank[4] + w.qdd[16];
-    w.a_r_ankle_link[5] = t9;
-  }
+  shared_48(shared_48_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  {
-    const Scalar t11 = w.c_r_foot[1] + w.cq_r_foot*w.a_r_ankle_link[1] + w.sq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t12 = w.c_r_foot[2] - w.sq_r_foot*w.a_r_ankle_link[1] + w.cq_r_foot*w.a_r_ankle_link[2];
-    const Scalar t13 = w.c_r_foot[4] + w.cq_r_foot*w.a_r_ankle_link[4] + w.sq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t14 = w.c_r_foot[5] - w.sq_r_foot*w.a_r_ankle_link[4] + w.cq_r_foot*w.a_r_ankle_link[5];
-    const Scalar t15 = w.u_r_foot[0] - 0.06825*w.lambda[7] - w.lambda[9] - 0.00194517348958*w.a_r_ankle_link[3] - 0.027912499999999996*t11 - 0.0017863999999999998*t14;
-    w.qdd[17] = 514.0929615568219*t15;
-    w.a_r_foot[0] = w.a_r_ankle_link[0];
-    w.a_r_foot[1] = t11;
-    w.a_r_foot[2] = t12;
-    w.a_r_foot[3] = w.a_r_ankle_link[3] + w.qdd[17];
-    w.a_r_foot[4] = t13;
-    w.a_r_foot[5] = t14;
-  }
+  shared_49(shared_49_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
   // accelerate, with the multipliers of the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];

@@ -9,6 +9,58 @@
 //     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
 //   prox_pv: 16721 + 650 K (= 18671 at K = 3)
 //     add/sub 6643 + 285 K, mul 9659 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
+// same code up to their constants, over a table of each one's constants:
+//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_1: 2 blocks of l_thigh, r_thigh
+//   shared_2: 2 blocks of l_shank, r_shank
+//   shared_3: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_4: 2 blocks of l_foot, r_foot
+//   shared_5: 2 blocks of l_wrist_yaw_link, neck_link
+//   shared_6: 2 blocks of l_wrist_yaw_link, r_wrist_yaw_link
+//   shared_7: 2 blocks of l_forearm, r_forearm
+//   shared_8: 2 blocks of l_upper_arm, r_upper_arm
+//   shared_9: 2 blocks of l_shoulder_roll_link, r_shoulder_roll_link
+//   shared_10: 2 blocks of r_foot, l_foot
+//   shared_11: 2 blocks of r_ankle_link, l_ankle_link
+//   shared_12: 2 blocks of r_shank, l_shank
+//   shared_13: 2 blocks of r_thigh, l_thigh
+//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_15: 2 blocks of pelvis
+//   shared_16: 2 blocks of l_hip_yaw_link
+//   shared_17: 4 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_18: 4 blocks of l_thigh, r_thigh
+//   shared_19: 4 blocks of l_shank, r_shank
+//   shared_20: 4 blocks of l_ankle_link, r_ankle_link
+//   shared_21: 4 blocks of l_foot, r_foot
+//   shared_22: 2 blocks of r_hip_yaw_link
+//   shared_23: 2 blocks of abdomen
+//   shared_24: 2 blocks of chest
+//   shared_25: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
+//   shared_26: 3 blocks of r_shoulder_roll_link, l_shoulder_roll_link
+//   shared_27: 2 blocks of r_upper_arm
+//   shared_28: 2 blocks of r_forearm
+//   shared_29: 3 blocks of r_wrist_yaw_link, l_wrist_yaw_link
+//   shared_30: 2 blocks of r_wrist_pitch_link
+//   shared_31: 2 blocks of r_hand
+//   shared_32: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_33: 2 blocks of r_foot, l_foot
+//   shared_34: 2 blocks of r_thigh, l_thigh
+//   shared_35: 2 blocks of r_foot, l_foot
+//   shared_36: 2 blocks of r_ankle_link, l_ankle_link
+//   shared_37: 2 blocks of r_shank, l_shank
+//   shared_38: 2 blocks of r_thigh, l_thigh
+//   shared_39: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_40: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_41: 2 blocks of l_thigh, r_thigh
+//   shared_42: 2 blocks of l_shank, r_shank
+//   shared_43: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_44: 2 blocks of l_foot, r_foot
+//   shared_45: 2 blocks of l_hip_roll_link, r_hip_roll_link
+//   shared_46: 2 blocks of l_thigh, r_thigh
+//   shared_47: 2 blocks of l_shank, r_shank
+//   shared_48: 2 blocks of l_ankle_link, r_ankle_link
+//   shared_49: 2 blocks of l_foot, r_foot
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line

@@ -9,6 +9,36 @@
 //     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
 //   prox_pv: 8537 + 475 K (= 9962 at K = 3)
 //     add/sub 3510 + 204 K, mul 4850 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
+// same code up to their constants, over a table of each one's constants:
+//   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
+//   shared_1: 8 blocks of LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank
+//   shared_2: 2 blocks of LF_thigh, RF_thigh
+//   shared_3: 2 blocks of LF_shank, RF_shank
+//   shared_4: 2 blocks of LH_thigh, RH_thigh
+//   shared_5: 2 blocks of LH_shank, RH_shank
+//   shared_6: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_7: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_8: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_9: 2 blocks of trunk
+//   shared_10: 2 blocks of LF_hip
+//   shared_11: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_12: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_13: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_14: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_15: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_16: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_17: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_18: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_19: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_20: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_24: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+//   shared_25: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_26: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_27: 3 blocks of LH_hip, RF_hip, RH_hip
 
 #include "quadruped.hpp"
 
@@ -27,6 +57,1143 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
+// 4 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip, RF_hip, RH_hip.
+// The first: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_0_k0[12] = {0.9900990099009903, 0.009900990099009688, -0.09950371902099893, 0.09900990099009904, -0.09900990099009904, 0.09950371902099893, -0.9950371902099893, 0.09900990099009904, -0.09900990099009904, 0.9950371902099893, 0.009900990099009905, 0.9900990099009901};
+constexpr Scalar shared_0_k1[12] = {0.9900990099009901, 0.00990099009900991, 0.09950371902099892, -0.09900990099009901, 0.09900990099009901, -0.09950371902099892, -0.9950371902099892, -0.09900990099009901, 0.09900990099009901, 0.9950371902099892, 0.009900990099009901, 0.9900990099009901};
+PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col) noexcept {
+  proxgen_rt::sincos(q[0], sq_m0[0], cq_m1[0]);
+  RJ_m2[0][RJ_m2_col + 0] = k[0] + k[1]*cq_m1[0];
+  RJ_m2[0][RJ_m2_col + 1] = k[2]*sq_m0[0];
+  RJ_m2[0][RJ_m2_col + 2] = k[3] + k[4]*cq_m1[0];
+  RJ_m2[1][RJ_m2_col + 0] = k[5]*sq_m0[0];
+  RJ_m2[1][RJ_m2_col + 2] = k[6]*sq_m0[0];
+  RJ_m2[2][RJ_m2_col + 0] = k[7] + k[8]*cq_m1[0];
+  RJ_m2[2][RJ_m2_col + 1] = k[9]*sq_m0[0];
+  RJ_m2[2][RJ_m2_col + 2] = k[10] + k[11]*cq_m1[0];
+}
+
+// 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank.
+// The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1) noexcept {
+  proxgen_rt::sincos(q[0], sq_m0[0], cq_m1[0]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: LF_thigh, RF_thigh.
+// The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+constexpr Scalar shared_2_k0[18] = {-0.062, 0.062, 0.6890000000000001, -0.01268, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, 0.01268, -0.010144, 0.002431904, -0.01268, 0.0024196, -0.00020288, 0.010144, -0.00020288, 0.0006033039999999999};
+constexpr Scalar shared_2_k1[18] = {0.062, -0.062, 0.6890000000000001, -0.01268, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, 0.01268, 0.010144, 0.002431904, -0.01268, 0.0024196, 0.00020288, -0.010144, 0.00020288, 0.0006033039999999999};
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+  const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
+  const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
+  v_m1[0] = cq_m2*x0 - sq_m3*x1;
+  v_m1[2] = sq_m3*x0 + cq_m2*x1;
+  v_m1[3] = cq_m2*v_m0[3] - sq_m3*v_m0[5];
+  v_m1[4] = v_m0[4] + v[0];
+  v_m1[5] = sq_m3*v_m0[3] + cq_m2*v_m0[5];
+  c_m4[0] = -v[0]*v_m1[2];
+  c_m4[2] = v[0]*v_m1[0];
+  c_m4[3] = -v[0]*v_m1[5];
+  c_m4[5] = v[0]*v_m1[3];
+  const Scalar x2 = k[2]*v_m1[0] + k[3]*v_m1[4] + k[4]*v_m1[5];
+  const Scalar x3 = k[5]*v_m0[1] + k[6]*v_m1[3];
+  const Scalar x4 = k[7]*v_m1[2] + k[8]*v_m1[3];
+  const Scalar x5 = k[9]*v_m0[1] + k[10]*v_m1[2] + k[11]*v_m1[3];
+  const Scalar x6 = k[12]*v_m1[0] + k[13]*v_m1[4] + k[14]*v_m1[5];
+  const Scalar x7 = k[15]*v_m1[0] + k[16]*v_m1[4] + k[17]*v_m1[5];
+  pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
+  pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
+  pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
+  pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
+  pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
+  pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
+  g_m6[0] = cq_m2*g_m7[0] - sq_m3*g_m7[2];
+  g_m6[2] = sq_m3*g_m7[0] + cq_m2*g_m7[2];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: LF_shank, RF_shank.
+// The first: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+constexpr Scalar shared_3_k0[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, 0.004, 0.195, -0.195, -0.004};
+constexpr Scalar shared_3_k1[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, -0.004, 0.195, -0.195, 0.004};
+PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
+  const Scalar x0 = v_m0[0] + k[0]*v_m0[4];
+  const Scalar x1 = v_m1[0] + k[1]*v_m0[3];
+  v_m2[0] = cq_m3*x0 - v_m0[2]*sq_m4;
+  v_m2[1] = x1;
+  v_m2[2] = sq_m4*x0 + v_m0[2]*cq_m3;
+  v_m2[3] = v_m0[3]*cq_m3 - v_m0[5]*sq_m4;
+  v_m2[4] = v_m0[4] + v[0];
+  v_m2[5] = v_m0[3]*sq_m4 + v_m0[5]*cq_m3;
+  c_m5[0] = -v[0]*v_m2[2];
+  c_m5[2] = v[0]*v_m2[0];
+  c_m5[3] = -v[0]*v_m2[5];
+  c_m5[5] = v[0]*v_m2[3];
+  const Scalar x2 = k[2]*v_m2[0] + k[3]*v_m2[4];
+  const Scalar x3 = k[4]*v_m2[1] + k[5]*v_m2[3];
+  const Scalar x4 = k[6]*v_m2[1] + k[7]*v_m2[3];
+  const Scalar x5 = k[8]*v_m2[0] + k[9]*v_m2[4];
+  pA_m6[0] = k[10]*v_m2[2]*v_m2[4] - v_m2[5]*x3;
+  pA_m6[1] = v_m2[5]*x2 + k[11]*v_m2[2]*v_m2[3];
+  pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
+  pA_m6[3] = k[12]*v_m2[4]*v_m2[5] - v_m2[5]*x5 + k[13]*v_m2[1]*v_m2[2] - v_m2[2]*x3;
+  pA_m6[4] = v_m2[5]*x4 + k[14]*v_m2[3]*v_m2[5] + v_m2[2]*x2 + k[15]*v_m2[0]*v_m2[2];
+  pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
+  g_m7[0] = g_m8[0]*cq_m3 - g_m8[2]*sq_m4;
+  g_m7[2] = g_m8[0]*sq_m4 + g_m8[2]*cq_m3;
+  const Scalar x6 = v_m2[2] + k[16]*v_m2[3];
+  const Scalar x7 = v_m2[1] + k[17]*v_m2[3];
+  const Scalar x8 = v_m2[0] + k[18]*v_m2[4] + k[19]*v_m2[5];
+  k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
+  k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
+  k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: LH_thigh, RH_thigh.
+// The first: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+constexpr Scalar shared_4_k0[18] = {-0.062, 0.062, 0.6890000000000001, -0.01268, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, 0.01268, -0.010144, 0.002431904, -0.01268, 0.0024196, -0.00020288, 0.010144, -0.00020288, 0.0006033039999999999};
+constexpr Scalar shared_4_k1[18] = {0.062, -0.062, 0.6890000000000001, -0.01268, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, 0.01268, 0.010144, 0.002431904, -0.01268, 0.0024196, 0.00020288, -0.010144, 0.00020288, 0.0006033039999999999};
+PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+  const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
+  const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
+  v_m1[0] = cq_m2*x0 - sq_m3*x1;
+  v_m1[2] = sq_m3*x0 + cq_m2*x1;
+  v_m1[3] = v_m0[3]*cq_m2 - v_m0[5]*sq_m3;
+  v_m1[4] = v_m0[4] + v[0];
+  v_m1[5] = v_m0[3]*sq_m3 + v_m0[5]*cq_m2;
+  c_m4[0] = -v[0]*v_m1[2];
+  c_m4[2] = v[0]*v_m1[0];
+  c_m4[3] = -v[0]*v_m1[5];
+  c_m4[5] = v[0]*v_m1[3];
+  const Scalar x2 = k[2]*v_m1[0] + k[3]*v_m1[4] + k[4]*v_m1[5];
+  const Scalar x3 = k[5]*v_m0[1] + k[6]*v_m1[3];
+  const Scalar x4 = k[7]*v_m1[2] + k[8]*v_m1[3];
+  const Scalar x5 = k[9]*v_m0[1] + k[10]*v_m1[2] + k[11]*v_m1[3];
+  const Scalar x6 = k[12]*v_m1[0] + k[13]*v_m1[4] + k[14]*v_m1[5];
+  const Scalar x7 = k[15]*v_m1[0] + k[16]*v_m1[4] + k[17]*v_m1[5];
+  pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
+  pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
+  pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
+  pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
+  pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
+  pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
+  g_m6[0] = g_m7[0]*cq_m2 - g_m7[2]*sq_m3;
+  g_m6[2] = g_m7[0]*sq_m3 + g_m7[2]*cq_m2;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: LH_shank, RH_shank.
+// The first: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+constexpr Scalar shared_5_k0[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, 0.004, 0.195, -0.195, -0.004};
+constexpr Scalar shared_5_k1[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, -0.004, 0.195, -0.195, 0.004};
+PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
+  const Scalar x0 = v_m0[0] + k[0]*v_m0[4];
+  const Scalar x1 = v_m1[0] + k[1]*v_m0[3];
+  v_m2[0] = cq_m3*x0 - sq_m4*v_m0[2];
+  v_m2[1] = x1;
+  v_m2[2] = sq_m4*x0 + cq_m3*v_m0[2];
+  v_m2[3] = cq_m3*v_m0[3] - sq_m4*v_m0[5];
+  v_m2[4] = v_m0[4] + v[0];
+  v_m2[5] = sq_m4*v_m0[3] + cq_m3*v_m0[5];
+  c_m5[0] = -v[0]*v_m2[2];
+  c_m5[2] = v[0]*v_m2[0];
+  c_m5[3] = -v[0]*v_m2[5];
+  c_m5[5] = v[0]*v_m2[3];
+  const Scalar x2 = k[2]*v_m2[0] + k[3]*v_m2[4];
+  const Scalar x3 = k[4]*v_m2[1] + k[5]*v_m2[3];
+  const Scalar x4 = k[6]*v_m2[1] + k[7]*v_m2[3];
+  const Scalar x5 = k[8]*v_m2[0] + k[9]*v_m2[4];
+  pA_m6[0] = k[10]*v_m2[2]*v_m2[4] - v_m2[5]*x3;
+  pA_m6[1] = v_m2[5]*x2 + k[11]*v_m2[2]*v_m2[3];
+  pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
+  pA_m6[3] = k[12]*v_m2[4]*v_m2[5] - v_m2[5]*x5 + k[13]*v_m2[1]*v_m2[2] - v_m2[2]*x3;
+  pA_m6[4] = v_m2[5]*x4 + k[14]*v_m2[3]*v_m2[5] + v_m2[2]*x2 + k[15]*v_m2[0]*v_m2[2];
+  pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
+  g_m7[0] = cq_m3*g_m8[0] - sq_m4*g_m8[2];
+  g_m7[2] = sq_m4*g_m8[0] + cq_m3*g_m8[2];
+  const Scalar x6 = v_m2[2] + k[16]*v_m2[3];
+  const Scalar x7 = v_m2[1] + k[17]*v_m2[3];
+  const Scalar x8 = v_m2[0] + k[18]*v_m2[4] + k[19]*v_m2[5];
+  k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
+  k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
+  k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
+// The first: eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
+constexpr Scalar shared_6_k0[58] = {0.195, -0.004, -0.003904, -0.195, 0.000486144, 0.038025, -0.0007800000000000001, 1.0, 0.195, -0.195, 0.064, 0.004, 0.064, 0.003904, 0.195, 0.000483144, 0.038041000000000005, 6e-06, 1.6e-05, -0.004, 0.195, -0.004, -0.004, 0.004, -0.004, 0.5, 0.5, 2.0, -0.002, 0.5, 0.5, 0.5, 0.002, 0.5, -0.002, -0.5, 0.209, 0.6890000000000001, -0.01268, -0.209, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, -0.209, 0.002431904, 0.209, 0.209, -0.209, -0.209, 0.0024196, 0.043681, 0.00020288, -0.209, 0.0006033039999999999, 0.209, -0.209};
+constexpr Scalar shared_6_k1[58] = {0.195, 0.004, -0.003904, -0.195, 0.000486144, 0.038025, 0.0007800000000000001, 1.0, 0.195, -0.195, 0.064, -0.004, 0.064, 0.003904, 0.195, 0.000483144, 0.038041000000000005, 6e-06, 1.6e-05, 0.004, 0.195, 0.004, 0.004, -0.004, 0.004, 0.5, 0.5, 2.0, 0.002, 0.5, 0.5, 0.5, -0.002, 0.5, 0.002, -0.5, 0.209, 0.6890000000000001, -0.01268, -0.209, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, -0.209, 0.002431904, 0.209, 0.209, -0.209, -0.209, 0.0024196, 0.043681, -0.00020288, -0.209, 0.0006033039999999999, 0.209, -0.209};
+PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar cq_m8, Scalar sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
+  const Scalar x0 = mu*active_m0[0];
+  const Scalar x1 = k[0]*k_m1[1] + k[1]*k_m1[2];
+  U_m2[0] = k[2] + k[3]*x0;
+  U_m2[4] = k[4] + k[5]*x0;
+  U_m2[5] = k[6]*x0;
+  Dinv_m3[0] = k[7] / U_m2[4];
+  u_m4[0] = -pA_m5[4] + k[8]*lambda_m6[0] + k[9]*k_m1[0]*x0 + tau[0];
+  const Scalar x2 = U_m2[0]*Dinv_m3[0];
+  const Scalar x3 = U_m2[5]*Dinv_m3[0];
+  const Scalar x4 = k[10] + x0 - U_m2[0]*x2;
+  const Scalar x5 = k[11]*x0 - U_m2[5]*x2;
+  const Scalar x6 = k[12] + x0;
+  const Scalar x7 = k[13] + k[14]*x0;
+  const Scalar x8 = k[15] + k[16]*x0;
+  const Scalar x9 = k[17] + k[18]*x0 - U_m2[5]*x3;
+  const Scalar x10 = pA_m5[0] + lambda_m6[0] - k_m1[0]*x0 + u_m4[0]*x2 + c_m7[0]*x4 + c_m7[5]*x5;
+  const Scalar x11 = pA_m5[1] + lambda_m6[1] - k_m1[1]*x0 + c_m7[3]*x7;
+  const Scalar x12 = pA_m5[2] + lambda_m6[2] - k_m1[2]*x0 + c_m7[2]*x6 + k[19]*c_m7[3]*x0;
+  const Scalar x13 = pA_m5[3] + k[20]*lambda_m6[1] + k[21]*lambda_m6[2] - x0*x1 + k[22]*c_m7[2]*x0 + c_m7[3]*x8;
+  const Scalar x14 = pA_m5[5] + k[23]*lambda_m6[0] + k[24]*k_m1[0]*x0 + u_m4[0]*x3 + c_m7[0]*x5 + c_m7[5]*x9;
+  const Scalar x15 = cq_m8*cq_m8 - sq_m9*sq_m9;
+  const Scalar x16 = k[25]*(-x4 + x6);
+  const Scalar x17 = k[26]*(x4 + x6);
+  const Scalar x18 = k[27]*cq_m8*sq_m9;
+  const Scalar x19 = k[28]*x0 + k[29]*x5;
+  const Scalar x20 = k[30]*(-x8 + x9);
+  const Scalar x21 = k[31]*(x8 + x9);
+  const Scalar x22 = x17 - x15*x16;
+  const Scalar x23 = x17 + x15*x16;
+  const Scalar x24 = k[32]*x0 + k[33]*x5 + x15*x19;
+  const Scalar x25 = k[34]*x0 + k[35]*x5 + x15*x19;
+  const Scalar x26 = k[36]*x6 + cq_m8*x7;
+  const Scalar x27 = cq_m8*x10 + sq_m9*x12;
+  const Scalar x28 = -sq_m9*x10 + cq_m8*x12;
+  IA_m10[0] = k[37] + x22;
+  IA_m10[2] = x16*x18;
+  IA_m10[3] = x18*x19;
+  IA_m10[4] = k[38] + k[39]*x22;
+  IA_m10[5] = k[40] + x24;
+  IA_m10[6] = k[41] + x6;
+  IA_m10[8] = k[42] + x26;
+  IA_m10[10] = -sq_m9*x7;
+  IA_m10[11] = k[43] + x23;
+  IA_m10[12] = k[44] + x25;
+  IA_m10[13] = k[45]*x16*x18;
+  IA_m10[14] = -x18*x19;
+  IA_m10[15] = k[46] + k[47]*cq_m8*x7 + x21 - x15*x20 + k[48]*x26;
+  IA_m10[16] = k[49]*x18*x19;
+  IA_m10[17] = k[50]*sq_m9*x7 + x18*x20;
+  IA_m10[18] = k[51] + k[52]*x22;
+  IA_m10[19] = k[53] + k[54]*x24;
+  IA_m10[20] = k[55] + x21 + x15*x20;
+  pA_m11[0] = pA_m11[0] + x27;
+  pA_m11[1] = pA_m11[1] + x11;
+  pA_m11[2] = pA_m11[2] + x28;
+  pA_m11[3] = pA_m11[3] + k[56]*x11 + cq_m8*x13 + sq_m9*x14;
+  pA_m11[4] = pA_m11[4] + tau[0] + k[57]*x27;
+  pA_m11[5] = pA_m11[5] - sq_m9*x13 + cq_m8*x14;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
+// The first: eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+constexpr Scalar shared_7_k0[33] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, -0.062, 0.062, -0.062, 0.062, 0.5950000000000001, 0.02164, 0.5950000000000001, 0.5950000000000001, -0.02164, 0.0012018399999999998, -0.062, -0.062, 4.5e-07, 0.062, -0.062, 0.00126484, 0.062, 0.062, -0.062, 0.062};
+constexpr Scalar shared_7_k1[33] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, 0.062, -0.062, 0.062, -0.062, 0.5950000000000001, -0.02164, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.0012018399999999998, 0.062, 0.062, 4.5e-07, -0.062, 0.062, 0.00126484, -0.062, -0.062, 0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[16]*Dinv_m0[0];
+  const Scalar x3 = IA_m1[19]*Dinv_m0[0];
+  const Scalar x4 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x5 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x6 = IA_m1[3] - IA_m1[16]*x0;
+  const Scalar x7 = IA_m1[5] - IA_m1[19]*x0;
+  const Scalar x8 = IA_m1[11] - IA_m1[13]*x1;
+  const Scalar x9 = IA_m1[12] - IA_m1[16]*x1;
+  const Scalar x10 = IA_m1[14] - IA_m1[19]*x1;
+  const Scalar x11 = IA_m1[15] - IA_m1[16]*x2;
+  const Scalar x12 = IA_m1[17] - IA_m1[19]*x2;
+  const Scalar x13 = IA_m1[20] - IA_m1[19]*x3;
+  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x5 + c_m4[3]*x6 + c_m4[5]*x7;
+  const Scalar x15 = pA_m3[1] + c_m4[3]*IA_m1[8] + c_m4[5]*IA_m1[10];
+  const Scalar x16 = pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[2]*x8 + c_m4[3]*x9 + c_m4[5]*x10;
+  const Scalar x17 = pA_m3[3] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x9 + c_m4[3]*x11 + c_m4[5]*x12;
+  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x10 + c_m4[3]*x12 + c_m4[5]*x13;
+  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x20 = k[1]*(-x4 + x8);
+  const Scalar x21 = k[2]*(x4 + x8);
+  const Scalar x22 = k[3]*cq_m5*sq_m6;
+  const Scalar x23 = x19*x20 - x5*x22;
+  const Scalar x24 = x20*x22 + x5*x19;
+  const Scalar x25 = k[4]*(-x6 + x10);
+  const Scalar x26 = k[5]*(x6 + x10);
+  const Scalar x27 = k[6]*(x7 + x9);
+  const Scalar x28 = x19*x25 - x22*x27;
+  const Scalar x29 = x22*x25 + x19*x27;
+  const Scalar x30 = k[7]*(-x11 + x13);
+  const Scalar x31 = k[8]*(x11 + x13);
+  const Scalar x32 = x19*x30 - x12*x22;
+  const Scalar x33 = x22*x30 + x12*x19;
+  const Scalar x34 = x21 - x23;
+  const Scalar x35 = x21 + x23;
+  const Scalar x36 = x26 - x28;
+  const Scalar x37 = k[9]*x7 + k[10]*x9 + x29;
+  const Scalar x38 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
+  const Scalar x39 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
+  const Scalar x40 = k[11]*x7 + k[12]*x9 + x29;
+  const Scalar x41 = x26 + x28;
+  const Scalar x42 = k[13]*x24 + x36;
+  const Scalar x43 = k[14]*x34 + x37;
+  const Scalar x44 = k[15]*x35 + x40;
+  const Scalar x45 = k[16]*x24 + x41;
+  const Scalar x46 = cq_m5*x14 + sq_m6*x16;
+  const Scalar x47 = -sq_m6*x14 + cq_m5*x16;
+  IA_m7[0] = k[17] + x34;
+  IA_m7[2] = x24;
+  IA_m7[3] = x42;
+  IA_m7[5] = k[18] + x43;
+  IA_m7[6] = k[19] + IA_m1[6];
+  IA_m7[8] = x38;
+  IA_m7[10] = x39;
+  IA_m7[11] = k[20] + x35;
+  IA_m7[12] = k[21] + x44;
+  IA_m7[14] = x45;
+  IA_m7[15] = k[22] + x31 - x32 + k[23]*x40 + k[24]*x44;
+  IA_m7[17] = k[25] + x33 + k[26]*x36 + k[27]*x45;
+  IA_m7[20] = k[28] + x31 + x32 + k[29]*x37 + k[30]*x43;
+  pA_m8[0] = pA_m8[0] + x46;
+  pA_m8[1] = pA_m8[1] + x15;
+  pA_m8[2] = pA_m8[2] + x47;
+  pA_m8[3] = pA_m8[3] + cq_m5*x17 + sq_m6*x18 + k[31]*x47;
+  pA_m8[4] = pA_m8[4] + tau[0];
+  pA_m8[5] = pA_m8[5] - sq_m6*x17 + cq_m5*x18 + k[32]*x46;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
+// The first: eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_8_k0[57] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, 0.000623, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
+constexpr Scalar shared_8_k1[57] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 1.0, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, 0.000623, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
+constexpr Scalar shared_8_k2[57] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, 0.000623, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
+  U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
+  U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
+  U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
+  U_m0[3] = k[6]*IA_m1[15] + k[7]*IA_m1[17];
+  U_m0[5] = k[8]*IA_m1[17] + k[9]*IA_m1[20];
+  const Scalar x0 = k[10]*U_m0[3] + k[11]*U_m0[5];
+  Dinv_m2[0] = k[12] / x0;
+  u_m3[0] = k[13]*pA_m4[3] + k[14]*pA_m4[5] + tau[0];
+  const Scalar x1 = U_m0[0]*Dinv_m2[0];
+  const Scalar x2 = U_m0[1]*Dinv_m2[0];
+  const Scalar x3 = U_m0[2]*Dinv_m2[0];
+  const Scalar x4 = U_m0[3]*Dinv_m2[0];
+  const Scalar x5 = U_m0[5]*Dinv_m2[0];
+  const Scalar x6 = IA_m1[0] - U_m0[0]*x1;
+  const Scalar x7 = IA_m1[2] - U_m0[2]*x1;
+  const Scalar x8 = IA_m1[3] - U_m0[3]*x1;
+  const Scalar x9 = IA_m1[5] - U_m0[5]*x1;
+  const Scalar x10 = IA_m1[6] - U_m0[1]*x2;
+  const Scalar x11 = IA_m1[8] - U_m0[3]*x2;
+  const Scalar x12 = IA_m1[10] - U_m0[5]*x2;
+  const Scalar x13 = IA_m1[11] - U_m0[2]*x3;
+  const Scalar x14 = IA_m1[12] - U_m0[3]*x3;
+  const Scalar x15 = IA_m1[14] - U_m0[5]*x3;
+  const Scalar x16 = IA_m1[15] - U_m0[3]*x4;
+  const Scalar x17 = k[15] + k[16]*U_m0[3]*Dinv_m2[0];
+  const Scalar x18 = IA_m1[17] - U_m0[5]*x4;
+  const Scalar x19 = k[17] + k[18]*Dinv_m2[0];
+  const Scalar x20 = k[19] + k[20]*U_m0[5]*Dinv_m2[0];
+  const Scalar x21 = IA_m1[20] - U_m0[5]*x5;
+  const Scalar x22 = -U_m0[1]*x1;
+  const Scalar x23 = k[21]*U_m0[0]*Dinv_m2[0];
+  const Scalar x24 = -U_m0[2]*x2;
+  const Scalar x25 = k[22]*U_m0[1]*Dinv_m2[0];
+  const Scalar x26 = k[23]*U_m0[2]*Dinv_m2[0];
+  const Scalar x27 = pA_m4[0] + u_m3[0]*x1 + c_m5[0]*x6 + c_m5[1]*x22 + c_m5[2]*x7 + c_m5[3]*x8 + c_m5[4]*x23 + c_m5[5]*x9;
+  const Scalar x28 = pA_m4[1] + u_m3[0]*x2 + c_m5[0]*x22 + c_m5[1]*x10 + c_m5[2]*x24 + c_m5[3]*x11 + c_m5[4]*x25 + c_m5[5]*x12;
+  const Scalar x29 = pA_m4[2] + u_m3[0]*x3 + c_m5[0]*x7 + c_m5[1]*x24 + c_m5[2]*x13 + c_m5[3]*x14 + c_m5[4]*x26 + c_m5[5]*x15;
+  const Scalar x30 = pA_m4[3] + u_m3[0]*x4 + c_m5[0]*x8 + c_m5[1]*x11 + c_m5[2]*x14 + c_m5[3]*x16 + c_m5[4]*x17 + c_m5[5]*x18;
+  const Scalar x31 = pA_m4[4] + k[24]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
+  const Scalar x32 = pA_m4[5] + u_m3[0]*x5 + c_m5[0]*x9 + c_m5[1]*x12 + c_m5[2]*x15 + c_m5[3]*x18 + c_m5[4]*x20 + c_m5[5]*x21;
+  const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
+  const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
+  const Scalar x35 = RJ_m6[0][RJ_m6_col + 0]*x7 + RJ_m6[0][RJ_m6_col + 1]*x24 + RJ_m6[0][RJ_m6_col + 2]*x13;
+  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
+  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
+  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
+  const Scalar x39 = RJ_m6[2][RJ_m6_col + 0]*x6 + RJ_m6[2][RJ_m6_col + 1]*x22 + RJ_m6[2][RJ_m6_col + 2]*x7;
+  const Scalar x40 = RJ_m6[2][RJ_m6_col + 0]*x22 + RJ_m6[2][RJ_m6_col + 1]*x10 + RJ_m6[2][RJ_m6_col + 2]*x24;
+  const Scalar x41 = RJ_m6[2][RJ_m6_col + 0]*x7 + RJ_m6[2][RJ_m6_col + 1]*x24 + RJ_m6[2][RJ_m6_col + 2]*x13;
+  const Scalar x42 = RJ_m6[0][RJ_m6_col + 0]*x8 + RJ_m6[0][RJ_m6_col + 1]*x11 + RJ_m6[0][RJ_m6_col + 2]*x14;
+  const Scalar x43 = RJ_m6[0][RJ_m6_col + 0]*x23 + RJ_m6[0][RJ_m6_col + 1]*x25 + RJ_m6[0][RJ_m6_col + 2]*x26;
+  const Scalar x44 = RJ_m6[0][RJ_m6_col + 0]*x9 + RJ_m6[0][RJ_m6_col + 1]*x12 + RJ_m6[0][RJ_m6_col + 2]*x15;
+  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
+  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
+  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
+  const Scalar x48 = RJ_m6[2][RJ_m6_col + 0]*x8 + RJ_m6[2][RJ_m6_col + 1]*x11 + RJ_m6[2][RJ_m6_col + 2]*x14;
+  const Scalar x49 = RJ_m6[2][RJ_m6_col + 0]*x23 + RJ_m6[2][RJ_m6_col + 1]*x25 + RJ_m6[2][RJ_m6_col + 2]*x26;
+  const Scalar x50 = RJ_m6[2][RJ_m6_col + 0]*x9 + RJ_m6[2][RJ_m6_col + 1]*x12 + RJ_m6[2][RJ_m6_col + 2]*x15;
+  const Scalar x51 = RJ_m6[0][RJ_m6_col + 0]*x16 + RJ_m6[0][RJ_m6_col + 1]*x17 + RJ_m6[0][RJ_m6_col + 2]*x18;
+  const Scalar x52 = RJ_m6[0][RJ_m6_col + 0]*x17 + RJ_m6[0][RJ_m6_col + 1]*x19 + RJ_m6[0][RJ_m6_col + 2]*x20;
+  const Scalar x53 = RJ_m6[0][RJ_m6_col + 0]*x18 + RJ_m6[0][RJ_m6_col + 1]*x20 + RJ_m6[0][RJ_m6_col + 2]*x21;
+  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
+  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
+  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
+  const Scalar x57 = RJ_m6[2][RJ_m6_col + 0]*x16 + RJ_m6[2][RJ_m6_col + 1]*x17 + RJ_m6[2][RJ_m6_col + 2]*x18;
+  const Scalar x58 = RJ_m6[2][RJ_m6_col + 0]*x17 + RJ_m6[2][RJ_m6_col + 1]*x19 + RJ_m6[2][RJ_m6_col + 2]*x20;
+  const Scalar x59 = RJ_m6[2][RJ_m6_col + 0]*x18 + RJ_m6[2][RJ_m6_col + 1]*x20 + RJ_m6[2][RJ_m6_col + 2]*x21;
+  const Scalar x60 = RJ_m6[0][RJ_m6_col + 0]*x33 + RJ_m6[0][RJ_m6_col + 1]*x34 + RJ_m6[0][RJ_m6_col + 2]*x35;
+  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
+  const Scalar x62 = RJ_m6[2][RJ_m6_col + 0]*x33 + RJ_m6[2][RJ_m6_col + 1]*x34 + RJ_m6[2][RJ_m6_col + 2]*x35;
+  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
+  const Scalar x64 = RJ_m6[2][RJ_m6_col + 0]*x36 + RJ_m6[2][RJ_m6_col + 1]*x37 + RJ_m6[2][RJ_m6_col + 2]*x38;
+  const Scalar x65 = RJ_m6[2][RJ_m6_col + 0]*x39 + RJ_m6[2][RJ_m6_col + 1]*x40 + RJ_m6[2][RJ_m6_col + 2]*x41;
+  const Scalar x66 = RJ_m6[0][RJ_m6_col + 0]*x42 + RJ_m6[0][RJ_m6_col + 1]*x43 + RJ_m6[0][RJ_m6_col + 2]*x44;
+  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
+  const Scalar x68 = RJ_m6[2][RJ_m6_col + 0]*x42 + RJ_m6[2][RJ_m6_col + 1]*x43 + RJ_m6[2][RJ_m6_col + 2]*x44;
+  const Scalar x69 = RJ_m6[0][RJ_m6_col + 0]*x45 + RJ_m6[0][RJ_m6_col + 1]*x46 + RJ_m6[0][RJ_m6_col + 2]*x47;
+  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
+  const Scalar x71 = RJ_m6[2][RJ_m6_col + 0]*x45 + RJ_m6[2][RJ_m6_col + 1]*x46 + RJ_m6[2][RJ_m6_col + 2]*x47;
+  const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
+  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
+  const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
+  const Scalar x75 = k[25]*x62 + x66;
+  const Scalar x76 = k[26]*x62 + x67;
+  const Scalar x77 = k[27]*x60 + k[28]*x61 + x68;
+  const Scalar x78 = k[29]*x64 + x69;
+  const Scalar x79 = k[30]*x64 + x70;
+  const Scalar x80 = k[31]*x61 + k[32]*x63 + x71;
+  const Scalar x81 = k[33]*x65 + x72;
+  const Scalar x82 = k[34]*x65 + x73;
+  const Scalar x83 = k[35]*x62 + k[36]*x64 + x74;
+  const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
+  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
+  const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
+  IA_m8[0] = IA_m8[0] + x60;
+  IA_m8[1] = IA_m8[1] + x61;
+  IA_m8[2] = IA_m8[2] + x62;
+  IA_m8[3] = IA_m8[3] + x75;
+  IA_m8[4] = IA_m8[4] + x76;
+  IA_m8[5] = IA_m8[5] + x77;
+  IA_m8[6] = IA_m8[6] + x63;
+  IA_m8[7] = IA_m8[7] + x64;
+  IA_m8[8] = IA_m8[8] + x78;
+  IA_m8[9] = IA_m8[9] + x79;
+  IA_m8[10] = IA_m8[10] + x80;
+  IA_m8[11] = IA_m8[11] + x65;
+  IA_m8[12] = IA_m8[12] + x81;
+  IA_m8[13] = IA_m8[13] + x82;
+  IA_m8[14] = IA_m8[14] + x83;
+  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x81;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[39]*x72 + k[40]*x82;
+  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[41]*x66 + k[42]*x69 + k[43]*x83;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[44]*x73 + k[45]*x82;
+  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[46]*x67 + k[47]*x70 + k[48]*x83;
+  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[49]*x68 + k[50]*x71 + k[51]*x77 + k[52]*x80;
+  pA_m9[0] = pA_m9[0] + x84;
+  pA_m9[1] = pA_m9[1] + x85;
+  pA_m9[2] = pA_m9[2] + x86;
+  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[53]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[54]*x86;
+  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[55]*x84 + k[56]*x85;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: trunk.
+// The first: accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
+constexpr Scalar shared_9_k0[21] = {-9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, 9.81, 9.81, 9.81};
+PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
+  const Scalar x0 = u_m0[0] + k[0]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] + k[1]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] + k[2]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
+  const Scalar x1 = Linv_m3[0]*x0;
+  const Scalar x2 = u_m0[1] + k[3]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] + k[4]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] + k[5]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
+  const Scalar x3 = Linv_m3[1]*x2;
+  const Scalar x4 = u_m0[2] + k[6]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] + k[7]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] + k[8]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
+  const Scalar x5 = Linv_m3[2]*x4;
+  const Scalar x6 = u_m0[3] + k[9]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] + k[10]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] + k[11]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
+  const Scalar x7 = Linv_m3[3]*x6;
+  const Scalar x8 = u_m0[4] + k[12]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] + k[13]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] + k[14]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
+  const Scalar x9 = Linv_m3[4]*x8;
+  const Scalar x10 = u_m0[5] + k[15]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] + k[16]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] + k[17]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
+  const Scalar x11 = Linv_m3[5]*x10;
+  const Scalar x12 = Linv_m3[5]*x11;
+  const Scalar x13 = Linv_m3[4]*x8 - L_m4[18]*x12;
+  const Scalar x14 = Linv_m3[4]*x13;
+  const Scalar x15 = Linv_m3[3]*x6 - L_m4[15]*x14 - L_m4[16]*x12;
+  const Scalar x16 = Linv_m3[3]*x15;
+  const Scalar x17 = Linv_m3[2]*x4 - L_m4[11]*x16 - L_m4[12]*x14 - L_m4[13]*x12;
+  const Scalar x18 = Linv_m3[2]*x17;
+  const Scalar x19 = Linv_m3[1]*x2 - L_m4[6]*x18 - L_m4[7]*x16 - L_m4[8]*x14 - L_m4[9]*x12;
+  const Scalar x20 = Linv_m3[1]*x19;
+  const Scalar x21 = Linv_m3[0]*x0 - L_m4[0]*x20 - L_m4[1]*x18 - L_m4[2]*x16 - L_m4[3]*x14 - L_m4[4]*x12;
+  qdd_m5[0] = Linv_m3[0]*x21;
+  qdd_m5[1] = Linv_m3[1]*x19;
+  qdd_m5[2] = Linv_m3[2]*x17;
+  qdd_m5[3] = Linv_m3[3]*x15;
+  qdd_m5[4] = Linv_m3[4]*x13;
+  qdd_m5[5] = Linv_m3[5]*x11;
+  a_m6[0] = k[18]*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
+  a_m6[1] = k[19]*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
+  a_m6[2] = k[20]*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
+  a_m6[3] = qdd_m5[3];
+  a_m6[4] = qdd_m5[4];
+  a_m6[5] = qdd_m5[5];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: LF_hip.
+// The first: accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_10_k0[7] = {-0.049, 0.19, 0.049, -0.19, -5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
+  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
+  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
+  const Scalar x6 = c_m1[3] + RJ_m2[0][RJ_m2_col + 0]*a_m0[3] + RJ_m2[1][RJ_m2_col + 0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 0]*a_m0[5];
+  const Scalar x7 = c_m1[4] + RJ_m2[0][RJ_m2_col + 1]*a_m0[3] + cq_m3*a_m0[4] + RJ_m2[2][RJ_m2_col + 1]*a_m0[5];
+  const Scalar x8 = c_m1[5] + RJ_m2[0][RJ_m2_col + 2]*a_m0[3] + RJ_m2[1][RJ_m2_col + 2]*a_m0[4] + RJ_m2[2][RJ_m2_col + 2]*a_m0[5];
+  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
+  qdd_m6[0] = Dinv_m7*x9;
+  a_m8[0] = x3;
+  a_m8[1] = x4;
+  a_m8[2] = x5;
+  a_m8[3] = x6 + k[5]*qdd_m6[0];
+  a_m8[4] = x7;
+  a_m8[5] = x8 + k[6]*qdd_m6[0];
+}
+
+// 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
+// The first: accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+constexpr Scalar shared_11_k0[2] = {-0.062, 0.062};
+constexpr Scalar shared_11_k1[2] = {0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
+  qdd_m6[0] = Dinv_m7*x6;
+  a_m8[0] = x2;
+  a_m8[1] = a_m0[1];
+  a_m8[2] = x3;
+  a_m8[3] = x4;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x5;
+}
+
+// 8 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
+// The first: accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+constexpr Scalar shared_12_k0[2] = {-0.209, 0.209};
+PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x6 = u_m4[0] - U_m5[0]*x2 - U_m5[4]*a_m0[4] - U_m5[5]*x5;
+  qdd_m6[0] = Dinv_m7*x6;
+  a_m8[0] = x2;
+  a_m8[1] = x1;
+  a_m8[2] = x3;
+  a_m8[3] = x4;
+  a_m8[4] = a_m0[4] + qdd_m6[0];
+  a_m8[5] = x5;
+}
+
+// 6 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
+// The first: accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_13_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_13_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_13_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
+  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
+  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
+  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
+  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
+  qdd_m6[0] = Dinv_m7*x9;
+  a_m8[0] = x3;
+  a_m8[1] = x4;
+  a_m8[2] = x5;
+  a_m8[3] = x6 + k[5]*qdd_m6[0];
+  a_m8[4] = x7;
+  a_m8[5] = x8 + k[6]*qdd_m6[0];
+}
+
+// 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
+// The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+constexpr Scalar shared_14_k0[16] = {-0.195, -0.004, 0.195, 0.004, -0.195, 0.004, 0.195, -0.004, -0.195, -0.004, 0.195, 0.004, -0.195, 0.004, 0.195, -0.004};
+PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4] + k[1]*a_m0[5] - k_m1[0];
+  residual_m2[0] = active_m3[0]*x0;
+  dlambda_m4[0] = mu*residual_m2[0];
+  lambda_m5[0] = lambda_m5[0] + dlambda_m4[0];
+  const Scalar x1 = a_m0[1] + k[2]*a_m0[3] - k_m1[1];
+  residual_m2[1] = active_m3[0]*x1;
+  dlambda_m4[1] = mu*residual_m2[1];
+  lambda_m5[1] = lambda_m5[1] + dlambda_m4[1];
+  const Scalar x2 = a_m0[2] + k[3]*a_m0[3] - k_m1[2];
+  residual_m2[2] = active_m3[0]*x2;
+  dlambda_m4[2] = mu*residual_m2[2];
+  lambda_m5[2] = lambda_m5[2] + dlambda_m4[2];
+  const Scalar x3 = a_m6[0] + k[4]*a_m6[4] + k[5]*a_m6[5] - k_m7[0];
+  residual_m2[3] = active_m3[1]*x3;
+  dlambda_m4[3] = mu*residual_m2[3];
+  lambda_m5[3] = lambda_m5[3] + dlambda_m4[3];
+  const Scalar x4 = a_m6[1] + k[6]*a_m6[3] - k_m7[1];
+  residual_m2[4] = active_m3[1]*x4;
+  dlambda_m4[4] = mu*residual_m2[4];
+  lambda_m5[4] = lambda_m5[4] + dlambda_m4[4];
+  const Scalar x5 = a_m6[2] + k[7]*a_m6[3] - k_m7[2];
+  residual_m2[5] = active_m3[1]*x5;
+  dlambda_m4[5] = mu*residual_m2[5];
+  lambda_m5[5] = lambda_m5[5] + dlambda_m4[5];
+  const Scalar x6 = a_m8[0] + k[8]*a_m8[4] + k[9]*a_m8[5] - k_m9[0];
+  residual_m2[6] = active_m3[2]*x6;
+  dlambda_m4[6] = mu*residual_m2[6];
+  lambda_m5[6] = lambda_m5[6] + dlambda_m4[6];
+  const Scalar x7 = a_m8[1] + k[10]*a_m8[3] - k_m9[1];
+  residual_m2[7] = active_m3[2]*x7;
+  dlambda_m4[7] = mu*residual_m2[7];
+  lambda_m5[7] = lambda_m5[7] + dlambda_m4[7];
+  const Scalar x8 = a_m8[2] + k[11]*a_m8[3] - k_m9[2];
+  residual_m2[8] = active_m3[2]*x8;
+  dlambda_m4[8] = mu*residual_m2[8];
+  lambda_m5[8] = lambda_m5[8] + dlambda_m4[8];
+  const Scalar x9 = a_m10[0] + k[12]*a_m10[4] + k[13]*a_m10[5] - k_m11[0];
+  residual_m2[9] = active_m3[3]*x9;
+  dlambda_m4[9] = mu*residual_m2[9];
+  lambda_m5[9] = lambda_m5[9] + dlambda_m4[9];
+  const Scalar x10 = a_m10[1] + k[14]*a_m10[3] - k_m11[1];
+  residual_m2[10] = active_m3[3]*x10;
+  dlambda_m4[10] = mu*residual_m2[10];
+  lambda_m5[10] = lambda_m5[10] + dlambda_m4[10];
+  const Scalar x11 = a_m10[2] + k[15]*a_m10[3] - k_m11[2];
+  residual_m2[11] = active_m3[3]*x11;
+  dlambda_m4[11] = mu*residual_m2[11];
+  lambda_m5[11] = lambda_m5[11] + dlambda_m4[11];
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
+// The first: reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
+constexpr Scalar shared_15_k0[7] = {0.195, 0.195, 0.195, -0.004, 0.004, 0.209, -0.209};
+constexpr Scalar shared_15_k1[7] = {0.195, 0.195, 0.195, 0.004, -0.004, 0.209, -0.209};
+PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+  u_m0[0] = u_m0[0] + k[0]*dlambda_m1[0];
+  const Scalar x0 = k[1]*Dinv_m2*dlambda_m1[0];
+  const Scalar x1 = dlambda_m1[0] + U_m3[0]*x0;
+  const Scalar x2 = k[2]*dlambda_m1[1] + k[3]*dlambda_m1[2];
+  const Scalar x3 = k[4]*dlambda_m1[0] + U_m3[5]*x0;
+  const Scalar x4 = cq_m4*x1 + sq_m5*dlambda_m1[2];
+  const Scalar x5 = -sq_m5*x1 + cq_m4*dlambda_m1[2];
+  dp_m6[0] = x4;
+  dp_m6[1] = dlambda_m1[1];
+  dp_m6[2] = x5;
+  dp_m6[3] = k[5]*dlambda_m1[1] + cq_m4*x2 + sq_m5*x3;
+  dp_m6[4] = k[6]*x4;
+  dp_m6[5] = -sq_m5*x2 + cq_m4*x3;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
+// The first: reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+constexpr Scalar shared_16_k0[2] = {-0.062, 0.062};
+constexpr Scalar shared_16_k1[2] = {0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+  u_m0[0] = u_m0[0] - dp_m1[4];
+  const Scalar x0 = -Dinv_m2*dp_m1[4];
+  const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
+  const Scalar x2 = dp_m1[2] + IA_m3[9]*x0;
+  const Scalar x3 = dp_m1[3] + IA_m3[12]*x0;
+  const Scalar x4 = dp_m1[5] + IA_m3[15]*x0;
+  const Scalar x5 = cq_m4*x1 + sq_m5*x2;
+  const Scalar x6 = -sq_m5*x1 + cq_m4*x2;
+  dp_m6[0] = x5;
+  dp_m6[1] = dp_m1[1];
+  dp_m6[2] = x6;
+  dp_m6[3] = cq_m4*x3 + sq_m5*x4 + k[0]*x6;
+  dp_m6[5] = -sq_m5*x3 + cq_m4*x4 + k[1]*x5;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
+// The first: reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_17_k0[7] = {-0.9950371902099893, -0.09950371902099893, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19};
+constexpr Scalar shared_17_k1[7] = {-0.9950371902099892, 0.09950371902099892, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19};
+constexpr Scalar shared_17_k2[7] = {-0.9950371902099893, -0.09950371902099893, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dp_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar (*PROXGEN_RT_RESTRICT RJ_m4)[3], int RJ_m4_col, Scalar cq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+  const Scalar x0 = k[0]*dp_m0[3] + k[1]*dp_m0[5];
+  u_m1[0] = u_m1[0] + x0;
+  const Scalar x1 = Dinv_m2*x0;
+  const Scalar x2 = dp_m0[0] + U_m3[0]*x1;
+  const Scalar x3 = dp_m0[1] + U_m3[1]*x1;
+  const Scalar x4 = dp_m0[2] + U_m3[2]*x1;
+  const Scalar x5 = dp_m0[3] + U_m3[3]*x1;
+  const Scalar x6 = dp_m0[5] + U_m3[5]*x1;
+  const Scalar x7 = k[2]*Dinv_m2*x0;
+  const Scalar x8 = RJ_m4[0][RJ_m4_col + 0]*x2 + RJ_m4[0][RJ_m4_col + 1]*x3 + RJ_m4[0][RJ_m4_col + 2]*x4;
+  const Scalar x9 = RJ_m4[1][RJ_m4_col + 0]*x2 + cq_m5*x3 + RJ_m4[1][RJ_m4_col + 2]*x4;
+  const Scalar x10 = RJ_m4[2][RJ_m4_col + 0]*x2 + RJ_m4[2][RJ_m4_col + 1]*x3 + RJ_m4[2][RJ_m4_col + 2]*x4;
+  dp_m6[0] = dp_m6[0] + x8;
+  dp_m6[1] = dp_m6[1] + x9;
+  dp_m6[2] = dp_m6[2] + x10;
+  dp_m6[3] = dp_m6[3] + RJ_m4[0][RJ_m4_col + 0]*x5 + RJ_m4[0][RJ_m4_col + 1]*x7 + RJ_m4[0][RJ_m4_col + 2]*x6 + k[3]*x10;
+  dp_m6[4] = dp_m6[4] + RJ_m4[1][RJ_m4_col + 0]*x5 + cq_m5*x7 + RJ_m4[1][RJ_m4_col + 2]*x6 + k[4]*x10;
+  dp_m6[5] = dp_m6[5] + RJ_m4[2][RJ_m4_col + 0]*x5 + RJ_m4[2][RJ_m4_col + 1]*x7 + RJ_m4[2][RJ_m4_col + 2]*x6 + k[5]*x8 + k[6]*x9;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
+// The first: eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
+constexpr Scalar shared_18_k0[43] = {0.03264876250658241, -8.030542390731965, 0.003904, 0.064, 0.000483144, 6e-06, 0.04832438125329121, -0.015675618746708794, 0.04832438125329121, 0.015675618746708794, 0.013375999999999999, 0.003904, 0.6890000000000001, 0.03135123749341759, -0.01268, -0.209, 0.01268, -0.003904, 0.6890000000000001, -0.006552408636124276, 0.002676476, 0.000815936, 0.00023857200000000002, 0.209, -0.000815936, -0.00047714400000000004, 0.0024196, 0.043681, 0.000847876, -0.00023857200000000002, 0.209, -0.209, -0.5659557661927332, 0.5659557661927332, 0.004, 0.11828475513428124, 0.004, 0.209, 0.195, -0.195, -0.004, -0.209, 0.004};
+constexpr Scalar shared_18_k1[43] = {0.03264876250658241, -8.030542390731965, 0.003904, 0.064, 0.000483144, 6e-06, 0.04832438125329121, -0.015675618746708794, 0.04832438125329121, 0.015675618746708794, 0.013375999999999999, 0.003904, 0.6890000000000001, 0.03135123749341759, -0.01268, -0.209, 0.01268, -0.003904, 0.6890000000000001, -0.006552408636124276, 0.002676476, 0.000815936, 0.00023857200000000002, 0.209, -0.000815936, -0.00047714400000000004, 0.0024196, 0.043681, 0.000847876, -0.00023857200000000002, 0.209, -0.209, -0.5659557661927332, 0.5659557661927332, -0.004, 0.11828475513428124, -0.004, 0.209, 0.195, -0.195, 0.004, -0.209, -0.004};
+PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
+  u_m0[0] = -pA_m1[4] + tau[0];
+  const Scalar x0 = k[0]*c_m2[0] + pA_m1[0] + k[1]*u_m0[0];
+  const Scalar x1 = k[2]*c_m2[3] + pA_m1[1];
+  const Scalar x2 = k[3]*c_m2[2] + pA_m1[2];
+  const Scalar x3 = k[4]*c_m2[3] + pA_m1[3];
+  const Scalar x4 = k[5]*c_m2[5] + pA_m1[5];
+  const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
+  const Scalar x6 = k[6] + k[7]*x5;
+  const Scalar x7 = k[8] + k[9]*x5;
+  const Scalar x8 = k[10] + k[11]*cq_m3;
+  const Scalar x9 = cq_m3*x0 + sq_m4*x2;
+  const Scalar x10 = -sq_m4*x0 + cq_m3*x2;
+  IA_m5[0] = k[12] + x6;
+  IA_m5[2] = k[13]*cq_m3*sq_m4;
+  IA_m5[4] = k[14] + k[15]*x6;
+  IA_m5[8] = k[16] + x8;
+  IA_m5[10] = k[17]*sq_m4;
+  IA_m5[11] = k[18] + x7;
+  IA_m5[13] = k[19]*cq_m3*sq_m4;
+  IA_m5[15] = k[20] + k[21]*cq_m3 + k[22]*x5 + k[23]*x8;
+  IA_m5[17] = k[24]*sq_m4 + k[25]*cq_m3*sq_m4;
+  IA_m5[18] = k[26] + k[27]*x6;
+  IA_m5[20] = k[28] + k[29]*x5;
+  pA_m6[0] = pA_m6[0] + x9;
+  pA_m6[1] = pA_m6[1] + x1;
+  pA_m6[2] = pA_m6[2] + x10;
+  pA_m6[3] = pA_m6[3] + k[30]*x1 + cq_m3*x3 + sq_m4*x4;
+  pA_m6[4] = pA_m6[4] + tau[0] + k[31]*x9;
+  pA_m6[5] = pA_m6[5] - sq_m4*x3 + cq_m3*x4;
+  KA_m7[0][KA_m7_col + 0] = k[32]*cq_m3;
+  KA_m7[2][KA_m7_col + 0] = k[33]*sq_m4;
+  KA_m7[3][KA_m7_col + 0] = k[34]*sq_m4;
+  KA_m7[4][KA_m7_col + 0] = k[35]*cq_m3;
+  KA_m7[5][KA_m7_col + 0] = k[36]*cq_m3;
+  KA_m7[3][KA_m7_col + 1] = k[37] + k[38]*cq_m3;
+  KA_m7[5][KA_m7_col + 1] = k[39]*sq_m4;
+  KA_m7[0][KA_m7_col + 2] = sq_m4;
+  KA_m7[2][KA_m7_col + 2] = cq_m3;
+  KA_m7[3][KA_m7_col + 2] = k[40]*cq_m3;
+  KA_m7[4][KA_m7_col + 2] = k[41]*sq_m4;
+  KA_m7[5][KA_m7_col + 2] = k[42]*sq_m4;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
+// The first: eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+constexpr Scalar shared_19_k0[47] = {1.0, -0.010144, -0.00020288, -4.11602944e-08, -0.00020288, 0.010144, 0.010144, 0.00020288, 0.5, 0.5, 2.0, -0.00010144, 0.005072, 0.5, 0.5, 0.5, -0.00010144, -0.005072, 0.5, 0.005072, -0.5, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.5950000000000001, 0.02164, 0.5950000000000001, -0.02164, 0.0012018399999999998, -0.062, -0.062, 4.5e-07, 0.062, -0.062, 0.00126484, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
+constexpr Scalar shared_19_k1[47] = {1.0, 0.010144, 0.00020288, -4.11602944e-08, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.5, 0.5, 2.0, 0.00010144, -0.005072, 0.5, 0.5, 0.5, 0.00010144, 0.005072, 0.5, -0.005072, -0.5, 0.00010144, 0.062, -0.062, 0.062, -0.062, 0.5950000000000001, -0.02164, 0.5950000000000001, 0.02164, 0.0012018399999999998, 0.062, 0.062, 4.5e-07, -0.062, 0.062, 0.00126484, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
+  Dinv_m0[0] = k[0] / IA_m1[18];
+  u_m2[0] = -pA_m3[4] + tau[0];
+  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
+  const Scalar x1 = IA_m1[13]*Dinv_m0[0];
+  const Scalar x2 = IA_m1[0] - IA_m1[4]*x0;
+  const Scalar x3 = IA_m1[2] - IA_m1[13]*x0;
+  const Scalar x4 = k[1] + k[2]*IA_m1[4]*Dinv_m0[0];
+  const Scalar x5 = IA_m1[11] - IA_m1[13]*x1;
+  const Scalar x6 = IA_m1[20] + k[3]*Dinv_m0[0];
+  const Scalar x7 = k[4]*IA_m1[13]*Dinv_m0[0];
+  const Scalar x8 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x2 + c_m4[2]*x3 + c_m4[5]*x4;
+  const Scalar x9 = pA_m3[1] + c_m4[3]*IA_m1[8] + c_m4[5]*IA_m1[10];
+  const Scalar x10 = k[5]*c_m4[3] + pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x3 + c_m4[2]*x5 + c_m4[5]*x7;
+  const Scalar x11 = k[6]*c_m4[2] + pA_m3[3] + c_m4[3]*IA_m1[15] + c_m4[5]*IA_m1[17];
+  const Scalar x12 = pA_m3[5] + k[7]*Dinv_m0[0]*u_m2[0] + c_m4[0]*x4 + c_m4[2]*x7 + c_m4[3]*IA_m1[17] + c_m4[5]*x6;
+  const Scalar x13 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x14 = k[8]*(-x2 + x5);
+  const Scalar x15 = k[9]*(x2 + x5);
+  const Scalar x16 = k[10]*cq_m5*sq_m6;
+  const Scalar x17 = x13*x14 - x3*x16;
+  const Scalar x18 = x14*x16 + x3*x13;
+  const Scalar x19 = k[11]*IA_m1[13]*Dinv_m0[0];
+  const Scalar x20 = k[12] + k[13]*x4;
+  const Scalar x21 = x13*x19 - x16*x20;
+  const Scalar x22 = x16*x19 + x13*x20;
+  const Scalar x23 = k[14]*(-IA_m1[15] + x6);
+  const Scalar x24 = k[15]*(IA_m1[15] + x6);
+  const Scalar x25 = x13*x23 - IA_m1[17]*x16;
+  const Scalar x26 = x16*x23 + IA_m1[17]*x13;
+  const Scalar x27 = x15 - x17;
+  const Scalar x28 = x15 + x17;
+  const Scalar x29 = k[16]*IA_m1[13]*Dinv_m0[0] - x21;
+  const Scalar x30 = k[17] + k[18]*x4 + x22;
+  const Scalar x31 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
+  const Scalar x32 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
+  const Scalar x33 = k[19] + k[20]*x4 + x22;
+  const Scalar x34 = k[21]*IA_m1[13]*Dinv_m0[0] + x21;
+  const Scalar x35 = k[22]*x18 + x29;
+  const Scalar x36 = k[23]*x27 + x30;
+  const Scalar x37 = k[24]*x28 + x33;
+  const Scalar x38 = k[25]*x18 + x34;
+  const Scalar x39 = cq_m5*x8 + sq_m6*x10;
+  const Scalar x40 = -sq_m6*x8 + cq_m5*x10;
+  IA_m7[0] = k[26] + x27;
+  IA_m7[2] = x18;
+  IA_m7[3] = x35;
+  IA_m7[5] = k[27] + x36;
+  IA_m7[8] = x31;
+  IA_m7[10] = x32;
+  IA_m7[11] = k[28] + x28;
+  IA_m7[12] = k[29] + x37;
+  IA_m7[14] = x38;
+  IA_m7[15] = k[30] + x24 - x25 + k[31]*x33 + k[32]*x37;
+  IA_m7[17] = k[33] + x26 + k[34]*x29 + k[35]*x38;
+  IA_m7[20] = k[36] + x24 + x25 + k[37]*x30 + k[38]*x36;
+  pA_m8[0] = pA_m8[0] + x39;
+  pA_m8[1] = pA_m8[1] + x9;
+  pA_m8[2] = pA_m8[2] + x40;
+  pA_m8[3] = pA_m8[3] + cq_m5*x11 + sq_m6*x12 + k[39]*x40;
+  pA_m8[4] = pA_m8[4] + tau[0];
+  pA_m8[5] = pA_m8[5] - sq_m6*x11 + cq_m5*x12 + k[40]*x39;
+  KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
+  const Scalar x41 = KA_m10[0][KA_m10_col + 0] - IA_m1[4]*KSD_m9[0];
+  const Scalar x42 = KA_m10[2][KA_m10_col + 0] - IA_m1[13]*KSD_m9[0];
+  const Scalar x43 = KA_m10[5][KA_m10_col + 0] + k[41]*KSD_m9[0];
+  const Scalar x44 = cq_m5*x41 + sq_m6*x42;
+  const Scalar x45 = -sq_m6*x41 + cq_m5*x42;
+  KA_m11[0][KA_m11_col + 0] = x44;
+  KA_m11[2][KA_m11_col + 0] = x45;
+  KA_m11[3][KA_m11_col + 0] = cq_m5*KA_m10[3][KA_m10_col + 0] + sq_m6*x43 + k[42]*x45;
+  KA_m11[5][KA_m11_col + 0] = -sq_m6*KA_m10[3][KA_m10_col + 0] + cq_m5*x43 + k[43]*x44;
+  KA_m11[3][KA_m11_col + 1] = cq_m5*KA_m10[3][KA_m10_col + 1] + sq_m6*KA_m10[5][KA_m10_col + 1];
+  KA_m11[5][KA_m11_col + 1] = -sq_m6*KA_m10[3][KA_m10_col + 1] + cq_m5*KA_m10[5][KA_m10_col + 1];
+  KSD_m9[2] = KA_m10[4][KA_m10_col + 2]*Dinv_m0[0];
+  const Scalar x46 = KA_m10[0][KA_m10_col + 2] - IA_m1[4]*KSD_m9[2];
+  const Scalar x47 = KA_m10[2][KA_m10_col + 2] - IA_m1[13]*KSD_m9[2];
+  const Scalar x48 = KA_m10[5][KA_m10_col + 2] + k[44]*KSD_m9[2];
+  const Scalar x49 = cq_m5*x46 + sq_m6*x47;
+  const Scalar x50 = -sq_m6*x46 + cq_m5*x47;
+  KA_m11[0][KA_m11_col + 2] = x49;
+  KA_m11[2][KA_m11_col + 2] = x50;
+  KA_m11[3][KA_m11_col + 2] = cq_m5*KA_m10[3][KA_m10_col + 2] + sq_m6*x48 + k[45]*x50;
+  KA_m11[5][KA_m11_col + 2] = -sq_m6*KA_m10[3][KA_m10_col + 2] + cq_m5*x48 + k[46]*x49;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
+// The first: eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_20_k0[86] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 1.3480000000000003, -5.8e-05, 5.780668556524933e-05, 0.000623, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 1.0, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
+constexpr Scalar shared_20_k1[86] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 1.0, -0.9950371902099892, 0.09950371902099892, 1.3480000000000003, 5.8e-05, -5.7617628499109426e-05, 0.000623, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, 1.0, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
+constexpr Scalar shared_20_k2[86] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 1.3480000000000003, 5.8e-05, -5.780668556524933e-05, 0.000623, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 1.0, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
+  U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
+  U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
+  U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
+  U_m0[3] = k[6]*IA_m1[15] + k[7]*IA_m1[17];
+  U_m0[5] = k[8]*IA_m1[17] + k[9]*IA_m1[20];
+  const Scalar x0 = k[10]*U_m0[3] + k[11]*U_m0[5];
+  Dinv_m2[0] = k[12] / x0;
+  u_m3[0] = k[13]*pA_m4[3] + k[14]*pA_m4[5] + tau[0];
+  const Scalar x1 = U_m0[0]*Dinv_m2[0];
+  const Scalar x2 = U_m0[1]*Dinv_m2[0];
+  const Scalar x3 = U_m0[2]*Dinv_m2[0];
+  const Scalar x4 = U_m0[3]*Dinv_m2[0];
+  const Scalar x5 = U_m0[5]*Dinv_m2[0];
+  const Scalar x6 = IA_m1[0] - U_m0[0]*x1;
+  const Scalar x7 = IA_m1[2] - U_m0[2]*x1;
+  const Scalar x8 = IA_m1[3] - U_m0[3]*x1;
+  const Scalar x9 = IA_m1[5] - U_m0[5]*x1;
+  const Scalar x10 = k[15] - U_m0[1]*x2;
+  const Scalar x11 = IA_m1[8] - U_m0[3]*x2;
+  const Scalar x12 = IA_m1[10] - U_m0[5]*x2;
+  const Scalar x13 = IA_m1[11] - U_m0[2]*x3;
+  const Scalar x14 = IA_m1[12] - U_m0[3]*x3;
+  const Scalar x15 = IA_m1[14] - U_m0[5]*x3;
+  const Scalar x16 = IA_m1[15] - U_m0[3]*x4;
+  const Scalar x17 = k[16] + k[17]*U_m0[3]*Dinv_m2[0];
+  const Scalar x18 = IA_m1[17] - U_m0[5]*x4;
+  const Scalar x19 = k[18] + k[19]*Dinv_m2[0];
+  const Scalar x20 = k[20] + k[21]*U_m0[5]*Dinv_m2[0];
+  const Scalar x21 = IA_m1[20] - U_m0[5]*x5;
+  const Scalar x22 = -U_m0[1]*x1;
+  const Scalar x23 = k[22]*U_m0[0]*Dinv_m2[0];
+  const Scalar x24 = -U_m0[2]*x2;
+  const Scalar x25 = k[23]*U_m0[1]*Dinv_m2[0];
+  const Scalar x26 = k[24]*U_m0[2]*Dinv_m2[0];
+  const Scalar x27 = pA_m4[0] + u_m3[0]*x1 + c_m5[0]*x6 + c_m5[1]*x22 + c_m5[2]*x7 + c_m5[3]*x8 + c_m5[4]*x23 + c_m5[5]*x9;
+  const Scalar x28 = pA_m4[1] + u_m3[0]*x2 + c_m5[0]*x22 + c_m5[1]*x10 + c_m5[2]*x24 + c_m5[3]*x11 + c_m5[4]*x25 + c_m5[5]*x12;
+  const Scalar x29 = pA_m4[2] + u_m3[0]*x3 + c_m5[0]*x7 + c_m5[1]*x24 + c_m5[2]*x13 + c_m5[3]*x14 + c_m5[4]*x26 + c_m5[5]*x15;
+  const Scalar x30 = pA_m4[3] + u_m3[0]*x4 + c_m5[0]*x8 + c_m5[1]*x11 + c_m5[2]*x14 + c_m5[3]*x16 + c_m5[4]*x17 + c_m5[5]*x18;
+  const Scalar x31 = pA_m4[4] + k[25]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
+  const Scalar x32 = pA_m4[5] + u_m3[0]*x5 + c_m5[0]*x9 + c_m5[1]*x12 + c_m5[2]*x15 + c_m5[3]*x18 + c_m5[4]*x20 + c_m5[5]*x21;
+  const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
+  const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
+  const Scalar x35 = RJ_m6[0][RJ_m6_col + 0]*x7 + RJ_m6[0][RJ_m6_col + 1]*x24 + RJ_m6[0][RJ_m6_col + 2]*x13;
+  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
+  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
+  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
+  const Scalar x39 = RJ_m6[2][RJ_m6_col + 0]*x6 + RJ_m6[2][RJ_m6_col + 1]*x22 + RJ_m6[2][RJ_m6_col + 2]*x7;
+  const Scalar x40 = RJ_m6[2][RJ_m6_col + 0]*x22 + RJ_m6[2][RJ_m6_col + 1]*x10 + RJ_m6[2][RJ_m6_col + 2]*x24;
+  const Scalar x41 = RJ_m6[2][RJ_m6_col + 0]*x7 + RJ_m6[2][RJ_m6_col + 1]*x24 + RJ_m6[2][RJ_m6_col + 2]*x13;
+  const Scalar x42 = RJ_m6[0][RJ_m6_col + 0]*x8 + RJ_m6[0][RJ_m6_col + 1]*x11 + RJ_m6[0][RJ_m6_col + 2]*x14;
+  const Scalar x43 = RJ_m6[0][RJ_m6_col + 0]*x23 + RJ_m6[0][RJ_m6_col + 1]*x25 + RJ_m6[0][RJ_m6_col + 2]*x26;
+  const Scalar x44 = RJ_m6[0][RJ_m6_col + 0]*x9 + RJ_m6[0][RJ_m6_col + 1]*x12 + RJ_m6[0][RJ_m6_col + 2]*x15;
+  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
+  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
+  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
+  const Scalar x48 = RJ_m6[2][RJ_m6_col + 0]*x8 + RJ_m6[2][RJ_m6_col + 1]*x11 + RJ_m6[2][RJ_m6_col + 2]*x14;
+  const Scalar x49 = RJ_m6[2][RJ_m6_col + 0]*x23 + RJ_m6[2][RJ_m6_col + 1]*x25 + RJ_m6[2][RJ_m6_col + 2]*x26;
+  const Scalar x50 = RJ_m6[2][RJ_m6_col + 0]*x9 + RJ_m6[2][RJ_m6_col + 1]*x12 + RJ_m6[2][RJ_m6_col + 2]*x15;
+  const Scalar x51 = RJ_m6[0][RJ_m6_col + 0]*x16 + RJ_m6[0][RJ_m6_col + 1]*x17 + RJ_m6[0][RJ_m6_col + 2]*x18;
+  const Scalar x52 = RJ_m6[0][RJ_m6_col + 0]*x17 + RJ_m6[0][RJ_m6_col + 1]*x19 + RJ_m6[0][RJ_m6_col + 2]*x20;
+  const Scalar x53 = RJ_m6[0][RJ_m6_col + 0]*x18 + RJ_m6[0][RJ_m6_col + 1]*x20 + RJ_m6[0][RJ_m6_col + 2]*x21;
+  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
+  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
+  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
+  const Scalar x57 = RJ_m6[2][RJ_m6_col + 0]*x16 + RJ_m6[2][RJ_m6_col + 1]*x17 + RJ_m6[2][RJ_m6_col + 2]*x18;
+  const Scalar x58 = RJ_m6[2][RJ_m6_col + 0]*x17 + RJ_m6[2][RJ_m6_col + 1]*x19 + RJ_m6[2][RJ_m6_col + 2]*x20;
+  const Scalar x59 = RJ_m6[2][RJ_m6_col + 0]*x18 + RJ_m6[2][RJ_m6_col + 1]*x20 + RJ_m6[2][RJ_m6_col + 2]*x21;
+  const Scalar x60 = RJ_m6[0][RJ_m6_col + 0]*x33 + RJ_m6[0][RJ_m6_col + 1]*x34 + RJ_m6[0][RJ_m6_col + 2]*x35;
+  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
+  const Scalar x62 = RJ_m6[2][RJ_m6_col + 0]*x33 + RJ_m6[2][RJ_m6_col + 1]*x34 + RJ_m6[2][RJ_m6_col + 2]*x35;
+  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
+  const Scalar x64 = RJ_m6[2][RJ_m6_col + 0]*x36 + RJ_m6[2][RJ_m6_col + 1]*x37 + RJ_m6[2][RJ_m6_col + 2]*x38;
+  const Scalar x65 = RJ_m6[2][RJ_m6_col + 0]*x39 + RJ_m6[2][RJ_m6_col + 1]*x40 + RJ_m6[2][RJ_m6_col + 2]*x41;
+  const Scalar x66 = RJ_m6[0][RJ_m6_col + 0]*x42 + RJ_m6[0][RJ_m6_col + 1]*x43 + RJ_m6[0][RJ_m6_col + 2]*x44;
+  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
+  const Scalar x68 = RJ_m6[2][RJ_m6_col + 0]*x42 + RJ_m6[2][RJ_m6_col + 1]*x43 + RJ_m6[2][RJ_m6_col + 2]*x44;
+  const Scalar x69 = RJ_m6[0][RJ_m6_col + 0]*x45 + RJ_m6[0][RJ_m6_col + 1]*x46 + RJ_m6[0][RJ_m6_col + 2]*x47;
+  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
+  const Scalar x71 = RJ_m6[2][RJ_m6_col + 0]*x45 + RJ_m6[2][RJ_m6_col + 1]*x46 + RJ_m6[2][RJ_m6_col + 2]*x47;
+  const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
+  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
+  const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
+  const Scalar x75 = k[26]*x62 + x66;
+  const Scalar x76 = k[27]*x62 + x67;
+  const Scalar x77 = k[28]*x60 + k[29]*x61 + x68;
+  const Scalar x78 = k[30]*x64 + x69;
+  const Scalar x79 = k[31]*x64 + x70;
+  const Scalar x80 = k[32]*x61 + k[33]*x63 + x71;
+  const Scalar x81 = k[34]*x65 + x72;
+  const Scalar x82 = k[35]*x65 + x73;
+  const Scalar x83 = k[36]*x62 + k[37]*x64 + x74;
+  const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
+  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
+  const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
+  IA_m8[0] = IA_m8[0] + x60;
+  IA_m8[1] = IA_m8[1] + x61;
+  IA_m8[2] = IA_m8[2] + x62;
+  IA_m8[3] = IA_m8[3] + x75;
+  IA_m8[4] = IA_m8[4] + x76;
+  IA_m8[5] = IA_m8[5] + x77;
+  IA_m8[6] = IA_m8[6] + x63;
+  IA_m8[7] = IA_m8[7] + x64;
+  IA_m8[8] = IA_m8[8] + x78;
+  IA_m8[9] = IA_m8[9] + x79;
+  IA_m8[10] = IA_m8[10] + x80;
+  IA_m8[11] = IA_m8[11] + x65;
+  IA_m8[12] = IA_m8[12] + x81;
+  IA_m8[13] = IA_m8[13] + x82;
+  IA_m8[14] = IA_m8[14] + x83;
+  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[38]*x72 + k[39]*x81;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[40]*x72 + k[41]*x82;
+  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[42]*x66 + k[43]*x69 + k[44]*x83;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[45]*x73 + k[46]*x82;
+  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[47]*x67 + k[48]*x70 + k[49]*x83;
+  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[50]*x68 + k[51]*x71 + k[52]*x77 + k[53]*x80;
+  pA_m9[0] = pA_m9[0] + x84;
+  pA_m9[1] = pA_m9[1] + x85;
+  pA_m9[2] = pA_m9[2] + x86;
+  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[54]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[55]*x86;
+  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[56]*x84 + k[57]*x85;
+  KS_m10[0] = k[58]*KA_m11[3][KA_m11_col + 0] + k[59]*KA_m11[5][KA_m11_col + 0];
+  KSD_m12[0] = Dinv_m2[0]*KS_m10[0];
+  const Scalar x87 = KA_m11[0][KA_m11_col + 0] - U_m0[0]*KSD_m12[0];
+  const Scalar x88 = KA_m11[2][KA_m11_col + 0] - U_m0[2]*KSD_m12[0];
+  const Scalar x89 = -U_m0[1]*KSD_m12[0];
+  const Scalar x90 = KA_m11[3][KA_m11_col + 0] - U_m0[3]*KSD_m12[0];
+  const Scalar x91 = KA_m11[5][KA_m11_col + 0] - U_m0[5]*KSD_m12[0];
+  const Scalar x92 = RJ_m6[0][RJ_m6_col + 0]*x87 + RJ_m6[0][RJ_m6_col + 1]*x89 + RJ_m6[0][RJ_m6_col + 2]*x88;
+  const Scalar x93 = RJ_m6[1][RJ_m6_col + 0]*x87 + cq_m7*x89 + RJ_m6[1][RJ_m6_col + 2]*x88;
+  const Scalar x94 = RJ_m6[2][RJ_m6_col + 0]*x87 + RJ_m6[2][RJ_m6_col + 1]*x89 + RJ_m6[2][RJ_m6_col + 2]*x88;
+  KA_m13[0][KA_m13_col + 0] = x92;
+  KA_m13[1][KA_m13_col + 0] = x93;
+  KA_m13[2][KA_m13_col + 0] = x94;
+  KA_m13[3][KA_m13_col + 0] = RJ_m6[0][RJ_m6_col + 0]*x90 + k[60]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[0][RJ_m6_col + 2]*x91 + k[61]*x94;
+  KA_m13[4][KA_m13_col + 0] = RJ_m6[1][RJ_m6_col + 0]*x90 + k[62]*cq_m7*KSD_m12[0] + RJ_m6[1][RJ_m6_col + 2]*x91 + k[63]*x94;
+  KA_m13[5][KA_m13_col + 0] = RJ_m6[2][RJ_m6_col + 0]*x90 + k[64]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[2][RJ_m6_col + 2]*x91 + k[65]*x92 + k[66]*x93;
+  KS_m10[1] = k[67]*KA_m11[3][KA_m11_col + 1] + k[68]*KA_m11[5][KA_m11_col + 1];
+  KSD_m12[1] = Dinv_m2[0]*KS_m10[1];
+  const Scalar x95 = k[69] - U_m0[1]*KSD_m12[1];
+  const Scalar x96 = -U_m0[0]*KSD_m12[1];
+  const Scalar x97 = -U_m0[2]*KSD_m12[1];
+  const Scalar x98 = KA_m11[3][KA_m11_col + 1] - U_m0[3]*KSD_m12[1];
+  const Scalar x99 = KA_m11[5][KA_m11_col + 1] - U_m0[5]*KSD_m12[1];
+  const Scalar x100 = RJ_m6[0][RJ_m6_col + 0]*x96 + RJ_m6[0][RJ_m6_col + 1]*x95 + RJ_m6[0][RJ_m6_col + 2]*x97;
+  const Scalar x101 = RJ_m6[1][RJ_m6_col + 0]*x96 + cq_m7*x95 + RJ_m6[1][RJ_m6_col + 2]*x97;
+  const Scalar x102 = RJ_m6[2][RJ_m6_col + 0]*x96 + RJ_m6[2][RJ_m6_col + 1]*x95 + RJ_m6[2][RJ_m6_col + 2]*x97;
+  KA_m13[0][KA_m13_col + 1] = x100;
+  KA_m13[1][KA_m13_col + 1] = x101;
+  KA_m13[2][KA_m13_col + 1] = x102;
+  KA_m13[3][KA_m13_col + 1] = RJ_m6[0][RJ_m6_col + 0]*x98 + k[70]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[0][RJ_m6_col + 2]*x99 + k[71]*x102;
+  KA_m13[4][KA_m13_col + 1] = RJ_m6[1][RJ_m6_col + 0]*x98 + k[72]*cq_m7*KSD_m12[1] + RJ_m6[1][RJ_m6_col + 2]*x99 + k[73]*x102;
+  KA_m13[5][KA_m13_col + 1] = RJ_m6[2][RJ_m6_col + 0]*x98 + k[74]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[2][RJ_m6_col + 2]*x99 + k[75]*x100 + k[76]*x101;
+  KS_m10[2] = k[77]*KA_m11[3][KA_m11_col + 2] + k[78]*KA_m11[5][KA_m11_col + 2];
+  KSD_m12[2] = Dinv_m2[0]*KS_m10[2];
+  const Scalar x103 = KA_m11[0][KA_m11_col + 2] - U_m0[0]*KSD_m12[2];
+  const Scalar x104 = KA_m11[2][KA_m11_col + 2] - U_m0[2]*KSD_m12[2];
+  const Scalar x105 = -U_m0[1]*KSD_m12[2];
+  const Scalar x106 = KA_m11[3][KA_m11_col + 2] - U_m0[3]*KSD_m12[2];
+  const Scalar x107 = KA_m11[5][KA_m11_col + 2] - U_m0[5]*KSD_m12[2];
+  const Scalar x108 = RJ_m6[0][RJ_m6_col + 0]*x103 + RJ_m6[0][RJ_m6_col + 1]*x105 + RJ_m6[0][RJ_m6_col + 2]*x104;
+  const Scalar x109 = RJ_m6[1][RJ_m6_col + 0]*x103 + cq_m7*x105 + RJ_m6[1][RJ_m6_col + 2]*x104;
+  const Scalar x110 = RJ_m6[2][RJ_m6_col + 0]*x103 + RJ_m6[2][RJ_m6_col + 1]*x105 + RJ_m6[2][RJ_m6_col + 2]*x104;
+  KA_m13[0][KA_m13_col + 2] = x108;
+  KA_m13[1][KA_m13_col + 2] = x109;
+  KA_m13[2][KA_m13_col + 2] = x110;
+  KA_m13[3][KA_m13_col + 2] = RJ_m6[0][RJ_m6_col + 0]*x106 + k[79]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[0][RJ_m6_col + 2]*x107 + k[80]*x110;
+  KA_m13[4][KA_m13_col + 2] = RJ_m6[1][RJ_m6_col + 0]*x106 + k[81]*cq_m7*KSD_m12[2] + RJ_m6[1][RJ_m6_col + 2]*x107 + k[82]*x110;
+  KA_m13[5][KA_m13_col + 2] = RJ_m6[2][RJ_m6_col + 0]*x106 + k[83]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[2][RJ_m6_col + 2]*x107 + k[84]*x108 + k[85]*x109;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
+// The first: free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+constexpr Scalar shared_21_k0[3] = {-0.062, 0.062, 0.00020288};
+constexpr Scalar shared_21_k1[3] = {0.062, -0.062, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x6 = u_m4[0] + k[2]*x5 - IA_m5[0]*x2 - IA_m5[9]*x3 - a_m0[4]*IA_m5[14];
+  a_m6[0] = x2;
+  a_m6[1] = a_m0[1];
+  a_m6[2] = x3;
+  a_m6[3] = x4;
+  a_m6[4] = a_m0[4] + Dinv_m7*x6;
+  a_m6[5] = x5;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
+// The first: free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+constexpr Scalar shared_22_k0[5] = {-0.209, 0.209, -0.000486144, 0.003904, 2057.0036861506055};
+PROXGEN_RT_NOINLINE void shared_22(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x6 = u_m4[0] + k[2]*a_m0[4] + k[3]*x2;
+  a_m5[0] = x2;
+  a_m5[1] = x1;
+  a_m5[2] = x3;
+  a_m5[3] = x4;
+  a_m5[4] = a_m0[4] + k[4]*x6;
+  a_m5[5] = x5;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
+// The first: free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_23_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_23_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_23_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
+  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
+  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
+  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
+  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
+  a_m6[0] = x3;
+  a_m6[1] = x4;
+  a_m6[2] = x5;
+  a_m6[3] = x6 + k[5]*Dinv_m7*x9;
+  a_m6[4] = x7;
+  a_m6[5] = x8 + k[6]*Dinv_m7*x9;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members:   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
+// The first: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
+constexpr Scalar shared_24_k0[2] = {78.21756516587678, 1.0};
+PROXGEN_RT_NOINLINE void shared_24(const Scalar* PROXGEN_RT_RESTRICT k, Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
+  const Scalar x0 = k[0] + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];
+  const Scalar x1 = std::sqrt(x0);
+  const Scalar x2 = k[1] / x1;
+  Linv_m4[0] = x2;
+  const Scalar x3 = KSD_m0[1]*KS_m1[0];
+  L_m5[0] = Linv_m4[0]*x3;
+  const Scalar x4 = KSD_m0[2]*KS_m1[0] + KSD_m2[2]*KA_m3[4][KA_m3_col + 0];
+  L_m5[1] = Linv_m4[0]*x4;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
+// The first: accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+constexpr Scalar shared_25_k0[3] = {-0.062, 0.062, 0.00020288};
+constexpr Scalar shared_25_k1[3] = {0.062, -0.062, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x6 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] + k[2]*x5 - IA_m7[0]*x2 - IA_m7[9]*x3 - a_m0[4]*IA_m7[14];
+  qdd_m8[0] = Dinv_m9*x6;
+  a_m10[0] = x2;
+  a_m10[1] = a_m0[1];
+  a_m10[2] = x3;
+  a_m10[3] = x4;
+  a_m10[4] = a_m0[4] + qdd_m8[0];
+  a_m10[5] = x5;
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
+// The first: accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+constexpr Scalar shared_26_k0[6] = {-0.209, 0.209, 0.195, -0.000486144, 0.003904, 2057.0036861506055};
+PROXGEN_RT_NOINLINE void shared_26(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x6 = u_m4[0] + k[2]*lambda_m5[0] + k[3]*a_m0[4] + k[4]*x2;
+  qdd_m6[0] = k[5]*x6;
+  a_m7[0] = x2;
+  a_m7[1] = x1;
+  a_m7[2] = x3;
+  a_m7[3] = x4;
+  a_m7[4] = a_m0[4] + qdd_m6[0];
+  a_m7[5] = x5;
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
+// The first: accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
+constexpr Scalar shared_27_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_27_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_27_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_27(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
+  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
+  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
+  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
+  const Scalar x9 = u_m4[0] - KS_m5[0]*lambda_m6[0] - KS_m5[1]*lambda_m6[1] - KS_m5[2]*lambda_m6[2] + k[4]*x7 - U_m7[0]*x3 - U_m7[1]*x4 - U_m7[2]*x5 - U_m7[3]*x6 - U_m7[5]*x8;
+  qdd_m8[0] = Dinv_m9*x9;
+  a_m10[0] = x3;
+  a_m10[1] = x4;
+  a_m10[2] = x5;
+  a_m10[3] = x6 + k[5]*qdd_m8[0];
+  a_m10[4] = x7;
+  a_m10[5] = x8 + k[6]*qdd_m8[0];
+}
+
 PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
@@ -54,88 +1221,32 @@ PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PRO
     w.RJ_trunk[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
   }
   // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    proxgen_rt::sincos(q[7], w.sq_LF_hip, w.cq_LF_hip);
-    w.RJ_LF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq_LF_hip;
-    w.RJ_LF_hip[0][1] = -0.09950371902099893*w.sq_LF_hip;
-    w.RJ_LF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq_LF_hip;
-    w.RJ_LF_hip[1][0] = 0.09950371902099893*w.sq_LF_hip;
-    w.RJ_LF_hip[1][2] = -0.9950371902099893*w.sq_LF_hip;
-    w.RJ_LF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_LF_hip;
-    w.RJ_LF_hip[2][1] = 0.9950371902099893*w.sq_LF_hip;
-    w.RJ_LF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_LF_hip;
-  }
+  shared_0(shared_0_k0, &q[7], &w.sq_LF_hip, &w.cq_LF_hip, w.RJ_LF_hip, 0);
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    proxgen_rt::sincos(q[8], w.sq_LF_thigh, w.cq_LF_thigh);
-  }
+  shared_1(&q[8], &w.sq_LF_thigh, &w.cq_LF_thigh);
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    proxgen_rt::sincos(q[9], w.sq_LF_shank, w.cq_LF_shank);
-  }
+  shared_1(&q[9], &w.sq_LF_shank, &w.cq_LF_shank);
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    proxgen_rt::sincos(q[10], w.sq_LH_hip, w.cq_LH_hip);
-    w.RJ_LH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_LH_hip;
-    w.RJ_LH_hip[0][1] = 0.09950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
-    w.RJ_LH_hip[1][0] = -0.09950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[1][2] = -0.9950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_LH_hip;
-    w.RJ_LH_hip[2][1] = 0.9950371902099892*w.sq_LH_hip;
-    w.RJ_LH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_LH_hip;
-  }
+  shared_0(shared_0_k1, &q[10], &w.sq_LH_hip, &w.cq_LH_hip, w.RJ_LH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_transforms_LH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    proxgen_rt::sincos(q[11], w.sq_LH_thigh, w.cq_LH_thigh);
-  }
+  shared_1(&q[11], &w.sq_LH_thigh, &w.cq_LH_thigh);
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    proxgen_rt::sincos(q[12], w.sq_LH_shank, w.cq_LH_shank);
-  }
+  shared_1(&q[12], &w.sq_LH_shank, &w.cq_LH_shank);
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    proxgen_rt::sincos(q[13], w.sq_RF_hip, w.cq_RF_hip);
-    w.RJ_RF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq_RF_hip;
-    w.RJ_RF_hip[0][1] = -0.09950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
-    w.RJ_RF_hip[1][0] = 0.09950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[1][2] = -0.9950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq_RF_hip;
-    w.RJ_RF_hip[2][1] = 0.9950371902099893*w.sq_RF_hip;
-    w.RJ_RF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq_RF_hip;
-  }
+  shared_0(shared_0_k0, &q[13], &w.sq_RF_hip, &w.cq_RF_hip, w.RJ_RF_hip, 0);
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    proxgen_rt::sincos(q[14], w.sq_RF_thigh, w.cq_RF_thigh);
-  }
+  shared_1(&q[14], &w.sq_RF_thigh, &w.cq_RF_thigh);
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    proxgen_rt::sincos(q[15], w.sq_RF_shank, w.cq_RF_shank);
-  }
+  shared_1(&q[15], &w.sq_RF_shank, &w.cq_RF_shank);
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    proxgen_rt::sincos(q[16], w.sq_RH_hip, w.cq_RH_hip);
-    w.RJ_RH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq_RH_hip;
-    w.RJ_RH_hip[0][1] = 0.09950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
-    w.RJ_RH_hip[1][0] = -0.09950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[1][2] = -0.9950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq_RH_hip;
-    w.RJ_RH_hip[2][1] = 0.9950371902099892*w.sq_RH_hip;
-    w.RJ_RH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq_RH_hip;
-  }
+  shared_0(shared_0_k1, &q[16], &w.sq_RH_hip, &w.cq_RH_hip, w.RJ_RH_hip, 0);
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    proxgen_rt::sincos(q[17], w.sq_RH_thigh, w.cq_RH_thigh);
-  }
+  shared_1(&q[17], &w.sq_RH_thigh, &w.cq_RH_thigh);
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    proxgen_rt::sincos(q[18], w.sq_RH_shank, w.cq_RH_shank);
-  }
+  shared_1(&q[18], &w.sq_RH_shank, &w.cq_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -184,70 +1295,12 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_R
     w.g_LF_hip[2] = w.RJ_LF_hip[0][2]*w.g_trunk[0] + w.RJ_LF_hip[1][2]*w.g_trunk[1] + w.RJ_LF_hip[2][2]*w.g_trunk[2];
   }
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t3 = w.v_LF_hip[0] - 0.062*w.v_LF_hip[5];
-    const Scalar t4 = w.v_LF_hip[2] + 0.062*w.v_LF_hip[3];
-    w.v_LF_thigh[0] = w.cq_LF_thigh*t3 - w.sq_LF_thigh*t4;
-    w.v_LF_thigh[2] = w.sq_LF_thigh*t3 + w.cq_LF_thigh*t4;
-    w.v_LF_thigh[3] = w.cq_LF_thigh*w.v_LF_hip[3] - w.sq_LF_thigh*w.v_LF_hip[5];
-    w.v_LF_thigh[4] = w.v_LF_hip[4] + v[7];
-    w.v_LF_thigh[5] = w.sq_LF_thigh*w.v_LF_hip[3] + w.cq_LF_thigh*w.v_LF_hip[5];
-    w.c_LF_thigh[0] = -v[7]*w.v_LF_thigh[2];
-    w.c_LF_thigh[2] = v[7]*w.v_LF_thigh[0];
-    w.c_LF_thigh[3] = -v[7]*w.v_LF_thigh[5];
-    w.c_LF_thigh[5] = v[7]*w.v_LF_thigh[3];
-    const Scalar h5 = 0.6890000000000001*w.v_LF_thigh[0] - 0.01268*w.v_LF_thigh[4] + 0.010144*w.v_LF_thigh[5];
-    const Scalar h6 = 0.6890000000000001*w.v_LF_hip[1] + 0.01268*w.v_LF_thigh[3];
-    const Scalar h7 = 0.6890000000000001*w.v_LF_thigh[2] - 0.010144*w.v_LF_thigh[3];
-    const Scalar h8 = 0.01268*w.v_LF_hip[1] - 0.010144*w.v_LF_thigh[2] + 0.002431904*w.v_LF_thigh[3];
-    const Scalar h9 = -0.01268*w.v_LF_thigh[0] + 0.0024196*w.v_LF_thigh[4] - 0.00020288*w.v_LF_thigh[5];
-    const Scalar h10 = 0.010144*w.v_LF_thigh[0] - 0.00020288*w.v_LF_thigh[4] + 0.0006033039999999999*w.v_LF_thigh[5];
-    w.pA_LF_thigh[0] = w.v_LF_thigh[4]*h7 - w.v_LF_thigh[5]*h6;
-    w.pA_LF_thigh[1] = w.v_LF_thigh[5]*h5 - w.v_LF_thigh[3]*h7;
-    w.pA_LF_thigh[2] = w.v_LF_thigh[3]*h6 - w.v_LF_thigh[4]*h5;
-    w.pA_LF_thigh[3] = w.v_LF_thigh[4]*h10 - w.v_LF_thigh[5]*h9 + w.v_LF_hip[1]*h7 - w.v_LF_thigh[2]*h6;
-    w.pA_LF_thigh[4] = w.v_LF_thigh[5]*h8 - w.v_LF_thigh[3]*h10 + w.v_LF_thigh[2]*h5 - w.v_LF_thigh[0]*h7;
-    w.pA_LF_thigh[5] = w.v_LF_thigh[3]*h9 - w.v_LF_thigh[4]*h8 + w.v_LF_thigh[0]*h6 - w.v_LF_hip[1]*h5;
-    w.g_LF_thigh[0] = w.cq_LF_thigh*w.g_LF_hip[0] - w.sq_LF_thigh*w.g_LF_hip[2];
-    w.g_LF_thigh[2] = w.sq_LF_thigh*w.g_LF_hip[0] + w.cq_LF_thigh*w.g_LF_hip[2];
-  }
+  shared_2(shared_2_k0, &v[7], w.v_LF_hip, w.v_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t0 = w.v_LF_thigh[0] - 0.209*w.v_LF_thigh[4];
-    const Scalar t1 = w.v_LF_hip[1] + 0.209*w.v_LF_thigh[3];
-    w.v_LF_shank[0] = w.cq_LF_shank*t0 - w.v_LF_thigh[2]*w.sq_LF_shank;
-    w.v_LF_shank[1] = t1;
-    w.v_LF_shank[2] = w.sq_LF_shank*t0 + w.v_LF_thigh[2]*w.cq_LF_shank;
-    w.v_LF_shank[3] = w.v_LF_thigh[3]*w.cq_LF_shank - w.v_LF_thigh[5]*w.sq_LF_shank;
-    w.v_LF_shank[4] = w.v_LF_thigh[4] + v[8];
-    w.v_LF_shank[5] = w.v_LF_thigh[3]*w.sq_LF_shank + w.v_LF_thigh[5]*w.cq_LF_shank;
-    w.c_LF_shank[0] = -v[8]*w.v_LF_shank[2];
-    w.c_LF_shank[2] = v[8]*w.v_LF_shank[0];
-    w.c_LF_shank[3] = -v[8]*w.v_LF_shank[5];
-    w.c_LF_shank[5] = v[8]*w.v_LF_shank[3];
-    const Scalar h0 = 0.064*w.v_LF_shank[0] - 0.003904*w.v_LF_shank[4];
-    const Scalar h1 = 0.064*w.v_LF_shank[1] + 0.003904*w.v_LF_shank[3];
-    const Scalar h2 = 0.003904*w.v_LF_shank[1] + 0.000483144*w.v_LF_shank[3];
-    const Scalar h3 = -0.003904*w.v_LF_shank[0] + 0.000486144*w.v_LF_shank[4];
-    w.pA_LF_shank[0] = 0.064*w.v_LF_shank[2]*w.v_LF_shank[4] - w.v_LF_shank[5]*h1;
-    w.pA_LF_shank[1] = w.v_LF_shank[5]*h0 - 0.064*w.v_LF_shank[2]*w.v_LF_shank[3];
-    w.pA_LF_shank[2] = w.v_LF_shank[3]*h1 - w.v_LF_shank[4]*h0;
-    w.pA_LF_shank[3] = 6e-06*w.v_LF_shank[4]*w.v_LF_shank[5] - w.v_LF_shank[5]*h3 + 0.064*w.v_LF_shank[1]*w.v_LF_shank[2] - w.v_LF_shank[2]*h1;
-    w.pA_LF_shank[4] = w.v_LF_shank[5]*h2 - 6e-06*w.v_LF_shank[3]*w.v_LF_shank[5] + w.v_LF_shank[2]*h0 - 0.064*w.v_LF_shank[0]*w.v_LF_shank[2];
-    w.pA_LF_shank[5] = w.v_LF_shank[3]*h3 - w.v_LF_shank[4]*h2 + w.v_LF_shank[0]*h1 - w.v_LF_shank[1]*h0;
-    w.g_LF_shank[0] = w.g_LF_thigh[0]*w.cq_LF_shank - w.g_LF_thigh[2]*w.sq_LF_shank;
-    w.g_LF_shank[2] = w.g_LF_thigh[0]*w.sq_LF_shank + w.g_LF_thigh[2]*w.cq_LF_shank;
-    // constraint 'lf_foot' (3d) on link 'LF_foot': rows 0..2
-    const Scalar t2 = w.v_LF_shank[2] + 0.004*w.v_LF_shank[3];
-    const Scalar t3 = w.v_LF_shank[1] + 0.195*w.v_LF_shank[3];
-    const Scalar t4 = w.v_LF_shank[0] - 0.195*w.v_LF_shank[4] - 0.004*w.v_LF_shank[5];
-    w.k_lf_foot[0] = -w.g_LF_shank[0] - w.v_LF_shank[4]*t2 + w.v_LF_shank[5]*t3;
-    w.k_lf_foot[1] = -w.g_LF_hip[1] - w.v_LF_shank[5]*t4 + w.v_LF_shank[3]*t2;
-    w.k_lf_foot[2] = -w.g_LF_shank[2] - w.v_LF_shank[3]*t3 + w.v_LF_shank[4]*t4;
-  }
+  shared_3(shared_3_k0, &v[8], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t5 = v[0] - 0.049*v[5];
@@ -284,67 +1337,9 @@ PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_
 
 PROXGEN_RT_NOINLINE void kinematics_LH_thigh_to_LH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t0 = w.v_LH_hip[0] - 0.062*w.v_LH_hip[5];
-    const Scalar t1 = w.v_LH_hip[2] + 0.062*w.v_LH_hip[3];
-    w.v_LH_thigh[0] = w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
-    w.v_LH_thigh[2] = w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    w.v_LH_thigh[3] = w.v_LH_hip[3]*w.cq_LH_thigh - w.v_LH_hip[5]*w.sq_LH_thigh;
-    w.v_LH_thigh[4] = w.v_LH_hip[4] + v[10];
-    w.v_LH_thigh[5] = w.v_LH_hip[3]*w.sq_LH_thigh + w.v_LH_hip[5]*w.cq_LH_thigh;
-    w.c_LH_thigh[0] = -v[10]*w.v_LH_thigh[2];
-    w.c_LH_thigh[2] = v[10]*w.v_LH_thigh[0];
-    w.c_LH_thigh[3] = -v[10]*w.v_LH_thigh[5];
-    w.c_LH_thigh[5] = v[10]*w.v_LH_thigh[3];
-    const Scalar h0 = 0.6890000000000001*w.v_LH_thigh[0] - 0.01268*w.v_LH_thigh[4] + 0.010144*w.v_LH_thigh[5];
-    const Scalar h1 = 0.6890000000000001*w.v_LH_hip[1] + 0.01268*w.v_LH_thigh[3];
-    const Scalar h2 = 0.6890000000000001*w.v_LH_thigh[2] - 0.010144*w.v_LH_thigh[3];
-    const Scalar h3 = 0.01268*w.v_LH_hip[1] - 0.010144*w.v_LH_thigh[2] + 0.002431904*w.v_LH_thigh[3];
-    const Scalar h4 = -0.01268*w.v_LH_thigh[0] + 0.0024196*w.v_LH_thigh[4] - 0.00020288*w.v_LH_thigh[5];
-    const Scalar h5 = 0.010144*w.v_LH_thigh[0] - 0.00020288*w.v_LH_thigh[4] + 0.0006033039999999999*w.v_LH_thigh[5];
-    w.pA_LH_thigh[0] = w.v_LH_thigh[4]*h2 - w.v_LH_thigh[5]*h1;
-    w.pA_LH_thigh[1] = w.v_LH_thigh[5]*h0 - w.v_LH_thigh[3]*h2;
-    w.pA_LH_thigh[2] = w.v_LH_thigh[3]*h1 - w.v_LH_thigh[4]*h0;
-    w.pA_LH_thigh[3] = w.v_LH_thigh[4]*h5 - w.v_LH_thigh[5]*h4 + w.v_LH_hip[1]*h2 - w.v_LH_thigh[2]*h1;
-    w.pA_LH_thigh[4] = w.v_LH_thigh[5]*h3 - w.v_LH_thigh[3]*h5 + w.v_LH_thigh[2]*h0 - w.v_LH_thigh[0]*h2;
-    w.pA_LH_thigh[5] = w.v_LH_thigh[3]*h4 - w.v_LH_thigh[4]*h3 + w.v_LH_thigh[0]*h1 - w.v_LH_hip[1]*h0;
-    w.g_LH_thigh[0] = w.g_LH_hip[0]*w.cq_LH_thigh - w.g_LH_hip[2]*w.sq_LH_thigh;
-    w.g_LH_thigh[2] = w.g_LH_hip[0]*w.sq_LH_thigh + w.g_LH_hip[2]*w.cq_LH_thigh;
-  }
+  shared_4(shared_4_k0, &v[10], w.v_LH_hip, w.v_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar t2 = w.v_LH_thigh[0] - 0.209*w.v_LH_thigh[4];
-    const Scalar t3 = w.v_LH_hip[1] + 0.209*w.v_LH_thigh[3];
-    w.v_LH_shank[0] = w.cq_LH_shank*t2 - w.sq_LH_shank*w.v_LH_thigh[2];
-    w.v_LH_shank[1] = t3;
-    w.v_LH_shank[2] = w.sq_LH_shank*t2 + w.cq_LH_shank*w.v_LH_thigh[2];
-    w.v_LH_shank[3] = w.cq_LH_shank*w.v_LH_thigh[3] - w.sq_LH_shank*w.v_LH_thigh[5];
-    w.v_LH_shank[4] = w.v_LH_thigh[4] + v[11];
-    w.v_LH_shank[5] = w.sq_LH_shank*w.v_LH_thigh[3] + w.cq_LH_shank*w.v_LH_thigh[5];
-    w.c_LH_shank[0] = -v[11]*w.v_LH_shank[2];
-    w.c_LH_shank[2] = v[11]*w.v_LH_shank[0];
-    w.c_LH_shank[3] = -v[11]*w.v_LH_shank[5];
-    w.c_LH_shank[5] = v[11]*w.v_LH_shank[3];
-    const Scalar h6 = 0.064*w.v_LH_shank[0] - 0.003904*w.v_LH_shank[4];
-    const Scalar h7 = 0.064*w.v_LH_shank[1] + 0.003904*w.v_LH_shank[3];
-    const Scalar h8 = 0.003904*w.v_LH_shank[1] + 0.000483144*w.v_LH_shank[3];
-    const Scalar h9 = -0.003904*w.v_LH_shank[0] + 0.000486144*w.v_LH_shank[4];
-    w.pA_LH_shank[0] = 0.064*w.v_LH_shank[2]*w.v_LH_shank[4] - w.v_LH_shank[5]*h7;
-    w.pA_LH_shank[1] = w.v_LH_shank[5]*h6 - 0.064*w.v_LH_shank[2]*w.v_LH_shank[3];
-    w.pA_LH_shank[2] = w.v_LH_shank[3]*h7 - w.v_LH_shank[4]*h6;
-    w.pA_LH_shank[3] = 6e-06*w.v_LH_shank[4]*w.v_LH_shank[5] - w.v_LH_shank[5]*h9 + 0.064*w.v_LH_shank[1]*w.v_LH_shank[2] - w.v_LH_shank[2]*h7;
-    w.pA_LH_shank[4] = w.v_LH_shank[5]*h8 - 6e-06*w.v_LH_shank[3]*w.v_LH_shank[5] + w.v_LH_shank[2]*h6 - 0.064*w.v_LH_shank[0]*w.v_LH_shank[2];
-    w.pA_LH_shank[5] = w.v_LH_shank[3]*h9 - w.v_LH_shank[4]*h8 + w.v_LH_shank[0]*h7 - w.v_LH_shank[1]*h6;
-    w.g_LH_shank[0] = w.cq_LH_shank*w.g_LH_thigh[0] - w.sq_LH_shank*w.g_LH_thigh[2];
-    w.g_LH_shank[2] = w.sq_LH_shank*w.g_LH_thigh[0] + w.cq_LH_shank*w.g_LH_thigh[2];
-    // constraint 'lh_foot' (3d) on link 'LH_foot': rows 6..8
-    const Scalar t4 = w.v_LH_shank[2] + 0.004*w.v_LH_shank[3];
-    const Scalar t5 = w.v_LH_shank[1] + 0.195*w.v_LH_shank[3];
-    const Scalar t6 = w.v_LH_shank[0] - 0.195*w.v_LH_shank[4] - 0.004*w.v_LH_shank[5];
-    w.k_lh_foot[0] = -w.g_LH_shank[0] - w.v_LH_shank[4]*t4 + w.v_LH_shank[5]*t5;
-    w.k_lh_foot[1] = -w.g_LH_hip[1] - w.v_LH_shank[5]*t6 + w.v_LH_shank[3]*t4;
-    w.k_lh_foot[2] = -w.g_LH_shank[2] - w.v_LH_shank[3]*t5 + w.v_LH_shank[4]*t6;
-  }
+  shared_5(shared_5_k0, &v[11], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -381,70 +1376,12 @@ PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[0][2] + w.g_trunk[1]*w.RJ_RF_hip[1][2] + w.g_trunk[2]*w.RJ_RF_hip[2][2];
   }
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t3 = w.v_RF_hip[0] + 0.062*w.v_RF_hip[5];
-    const Scalar t4 = w.v_RF_hip[2] - 0.062*w.v_RF_hip[3];
-    w.v_RF_thigh[0] = w.cq_RF_thigh*t3 - w.sq_RF_thigh*t4;
-    w.v_RF_thigh[2] = w.sq_RF_thigh*t3 + w.cq_RF_thigh*t4;
-    w.v_RF_thigh[3] = w.cq_RF_thigh*w.v_RF_hip[3] - w.sq_RF_thigh*w.v_RF_hip[5];
-    w.v_RF_thigh[4] = w.v_RF_hip[4] + v[13];
-    w.v_RF_thigh[5] = w.sq_RF_thigh*w.v_RF_hip[3] + w.cq_RF_thigh*w.v_RF_hip[5];
-    w.c_RF_thigh[0] = -v[13]*w.v_RF_thigh[2];
-    w.c_RF_thigh[2] = v[13]*w.v_RF_thigh[0];
-    w.c_RF_thigh[3] = -v[13]*w.v_RF_thigh[5];
-    w.c_RF_thigh[5] = v[13]*w.v_RF_thigh[3];
-    const Scalar h5 = 0.6890000000000001*w.v_RF_thigh[0] - 0.01268*w.v_RF_thigh[4] - 0.010144*w.v_RF_thigh[5];
-    const Scalar h6 = 0.6890000000000001*w.v_RF_hip[1] + 0.01268*w.v_RF_thigh[3];
-    const Scalar h7 = 0.6890000000000001*w.v_RF_thigh[2] + 0.010144*w.v_RF_thigh[3];
-    const Scalar h8 = 0.01268*w.v_RF_hip[1] + 0.010144*w.v_RF_thigh[2] + 0.002431904*w.v_RF_thigh[3];
-    const Scalar h9 = -0.01268*w.v_RF_thigh[0] + 0.0024196*w.v_RF_thigh[4] + 0.00020288*w.v_RF_thigh[5];
-    const Scalar h10 = -0.010144*w.v_RF_thigh[0] + 0.00020288*w.v_RF_thigh[4] + 0.0006033039999999999*w.v_RF_thigh[5];
-    w.pA_RF_thigh[0] = w.v_RF_thigh[4]*h7 - w.v_RF_thigh[5]*h6;
-    w.pA_RF_thigh[1] = w.v_RF_thigh[5]*h5 - w.v_RF_thigh[3]*h7;
-    w.pA_RF_thigh[2] = w.v_RF_thigh[3]*h6 - w.v_RF_thigh[4]*h5;
-    w.pA_RF_thigh[3] = w.v_RF_thigh[4]*h10 - w.v_RF_thigh[5]*h9 + w.v_RF_hip[1]*h7 - w.v_RF_thigh[2]*h6;
-    w.pA_RF_thigh[4] = w.v_RF_thigh[5]*h8 - w.v_RF_thigh[3]*h10 + w.v_RF_thigh[2]*h5 - w.v_RF_thigh[0]*h7;
-    w.pA_RF_thigh[5] = w.v_RF_thigh[3]*h9 - w.v_RF_thigh[4]*h8 + w.v_RF_thigh[0]*h6 - w.v_RF_hip[1]*h5;
-    w.g_RF_thigh[0] = w.cq_RF_thigh*w.g_RF_hip[0] - w.sq_RF_thigh*w.g_RF_hip[2];
-    w.g_RF_thigh[2] = w.sq_RF_thigh*w.g_RF_hip[0] + w.cq_RF_thigh*w.g_RF_hip[2];
-  }
+  shared_2(shared_2_k1, &v[13], w.v_RF_hip, w.v_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t0 = w.v_RF_thigh[0] - 0.209*w.v_RF_thigh[4];
-    const Scalar t1 = w.v_RF_hip[1] + 0.209*w.v_RF_thigh[3];
-    w.v_RF_shank[0] = w.cq_RF_shank*t0 - w.v_RF_thigh[2]*w.sq_RF_shank;
-    w.v_RF_shank[1] = t1;
-    w.v_RF_shank[2] = w.sq_RF_shank*t0 + w.v_RF_thigh[2]*w.cq_RF_shank;
-    w.v_RF_shank[3] = w.v_RF_thigh[3]*w.cq_RF_shank - w.v_RF_thigh[5]*w.sq_RF_shank;
-    w.v_RF_shank[4] = w.v_RF_thigh[4] + v[14];
-    w.v_RF_shank[5] = w.v_RF_thigh[3]*w.sq_RF_shank + w.v_RF_thigh[5]*w.cq_RF_shank;
-    w.c_RF_shank[0] = -v[14]*w.v_RF_shank[2];
-    w.c_RF_shank[2] = v[14]*w.v_RF_shank[0];
-    w.c_RF_shank[3] = -v[14]*w.v_RF_shank[5];
-    w.c_RF_shank[5] = v[14]*w.v_RF_shank[3];
-    const Scalar h0 = 0.064*w.v_RF_shank[0] - 0.003904*w.v_RF_shank[4];
-    const Scalar h1 = 0.064*w.v_RF_shank[1] + 0.003904*w.v_RF_shank[3];
-    const Scalar h2 = 0.003904*w.v_RF_shank[1] + 0.000483144*w.v_RF_shank[3];
-    const Scalar h3 = -0.003904*w.v_RF_shank[0] + 0.000486144*w.v_RF_shank[4];
-    w.pA_RF_shank[0] = 0.064*w.v_RF_shank[2]*w.v_RF_shank[4] - w.v_RF_shank[5]*h1;
-    w.pA_RF_shank[1] = w.v_RF_shank[5]*h0 - 0.064*w.v_RF_shank[2]*w.v_RF_shank[3];
-    w.pA_RF_shank[2] = w.v_RF_shank[3]*h1 - w.v_RF_shank[4]*h0;
-    w.pA_RF_shank[3] = 6e-06*w.v_RF_shank[4]*w.v_RF_shank[5] - w.v_RF_shank[5]*h3 + 0.064*w.v_RF_shank[1]*w.v_RF_shank[2] - w.v_RF_shank[2]*h1;
-    w.pA_RF_shank[4] = w.v_RF_shank[5]*h2 - 6e-06*w.v_RF_shank[3]*w.v_RF_shank[5] + w.v_RF_shank[2]*h0 - 0.064*w.v_RF_shank[0]*w.v_RF_shank[2];
-    w.pA_RF_shank[5] = w.v_RF_shank[3]*h3 - w.v_RF_shank[4]*h2 + w.v_RF_shank[0]*h1 - w.v_RF_shank[1]*h0;
-    w.g_RF_shank[0] = w.g_RF_thigh[0]*w.cq_RF_shank - w.g_RF_thigh[2]*w.sq_RF_shank;
-    w.g_RF_shank[2] = w.g_RF_thigh[0]*w.sq_RF_shank + w.g_RF_thigh[2]*w.cq_RF_shank;
-    // constraint 'rf_foot' (3d) on link 'RF_foot': rows 3..5
-    const Scalar t2 = w.v_RF_shank[2] - 0.004*w.v_RF_shank[3];
-    const Scalar t3 = w.v_RF_shank[1] + 0.195*w.v_RF_shank[3];
-    const Scalar t4 = w.v_RF_shank[0] - 0.195*w.v_RF_shank[4] + 0.004*w.v_RF_shank[5];
-    w.k_rf_foot[0] = -w.g_RF_shank[0] - w.v_RF_shank[4]*t2 + w.v_RF_shank[5]*t3;
-    w.k_rf_foot[1] = -w.g_RF_hip[1] - w.v_RF_shank[5]*t4 + w.v_RF_shank[3]*t2;
-    w.k_rf_foot[2] = -w.g_RF_shank[2] - w.v_RF_shank[3]*t3 + w.v_RF_shank[4]*t4;
-  }
+  shared_3(shared_3_k1, &v[14], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t5 = v[0] + 0.049*v[5];
@@ -481,206 +1418,19 @@ PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_
 
 PROXGEN_RT_NOINLINE void kinematics_RH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t0 = w.v_RH_hip[0] + 0.062*w.v_RH_hip[5];
-    const Scalar t1 = w.v_RH_hip[2] - 0.062*w.v_RH_hip[3];
-    w.v_RH_thigh[0] = w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
-    w.v_RH_thigh[2] = w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
-    w.v_RH_thigh[3] = w.v_RH_hip[3]*w.cq_RH_thigh - w.v_RH_hip[5]*w.sq_RH_thigh;
-    w.v_RH_thigh[4] = w.v_RH_hip[4] + v[16];
-    w.v_RH_thigh[5] = w.v_RH_hip[3]*w.sq_RH_thigh + w.v_RH_hip[5]*w.cq_RH_thigh;
-    w.c_RH_thigh[0] = -v[16]*w.v_RH_thigh[2];
-    w.c_RH_thigh[2] = v[16]*w.v_RH_thigh[0];
-    w.c_RH_thigh[3] = -v[16]*w.v_RH_thigh[5];
-    w.c_RH_thigh[5] = v[16]*w.v_RH_thigh[3];
-    const Scalar h0 = 0.6890000000000001*w.v_RH_thigh[0] - 0.01268*w.v_RH_thigh[4] - 0.010144*w.v_RH_thigh[5];
-    const Scalar h1 = 0.6890000000000001*w.v_RH_hip[1] + 0.01268*w.v_RH_thigh[3];
-    const Scalar h2 = 0.6890000000000001*w.v_RH_thigh[2] + 0.010144*w.v_RH_thigh[3];
-    const Scalar h3 = 0.01268*w.v_RH_hip[1] + 0.010144*w.v_RH_thigh[2] + 0.002431904*w.v_RH_thigh[3];
-    const Scalar h4 = -0.01268*w.v_RH_thigh[0] + 0.0024196*w.v_RH_thigh[4] + 0.00020288*w.v_RH_thigh[5];
-    const Scalar h5 = -0.010144*w.v_RH_thigh[0] + 0.00020288*w.v_RH_thigh[4] + 0.0006033039999999999*w.v_RH_thigh[5];
-    w.pA_RH_thigh[0] = w.v_RH_thigh[4]*h2 - w.v_RH_thigh[5]*h1;
-    w.pA_RH_thigh[1] = w.v_RH_thigh[5]*h0 - w.v_RH_thigh[3]*h2;
-    w.pA_RH_thigh[2] = w.v_RH_thigh[3]*h1 - w.v_RH_thigh[4]*h0;
-    w.pA_RH_thigh[3] = w.v_RH_thigh[4]*h5 - w.v_RH_thigh[5]*h4 + w.v_RH_hip[1]*h2 - w.v_RH_thigh[2]*h1;
-    w.pA_RH_thigh[4] = w.v_RH_thigh[5]*h3 - w.v_RH_thigh[3]*h5 + w.v_RH_thigh[2]*h0 - w.v_RH_thigh[0]*h2;
-    w.pA_RH_thigh[5] = w.v_RH_thigh[3]*h4 - w.v_RH_thigh[4]*h3 + w.v_RH_thigh[0]*h1 - w.v_RH_hip[1]*h0;
-    w.g_RH_thigh[0] = w.g_RH_hip[0]*w.cq_RH_thigh - w.g_RH_hip[2]*w.sq_RH_thigh;
-    w.g_RH_thigh[2] = w.g_RH_hip[0]*w.sq_RH_thigh + w.g_RH_hip[2]*w.cq_RH_thigh;
-  }
+  shared_4(shared_4_k1, &v[16], w.v_RH_hip, w.v_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t2 = w.v_RH_thigh[0] - 0.209*w.v_RH_thigh[4];
-    const Scalar t3 = w.v_RH_hip[1] + 0.209*w.v_RH_thigh[3];
-    w.v_RH_shank[0] = w.cq_RH_shank*t2 - w.sq_RH_shank*w.v_RH_thigh[2];
-    w.v_RH_shank[1] = t3;
-    w.v_RH_shank[2] = w.sq_RH_shank*t2 + w.cq_RH_shank*w.v_RH_thigh[2];
-    w.v_RH_shank[3] = w.cq_RH_shank*w.v_RH_thigh[3] - w.sq_RH_shank*w.v_RH_thigh[5];
-    w.v_RH_shank[4] = w.v_RH_thigh[4] + v[17];
-    w.v_RH_shank[5] = w.sq_RH_shank*w.v_RH_thigh[3] + w.cq_RH_shank*w.v_RH_thigh[5];
-    w.c_RH_shank[0] = -v[17]*w.v_RH_shank[2];
-    w.c_RH_shank[2] = v[17]*w.v_RH_shank[0];
-    w.c_RH_shank[3] = -v[17]*w.v_RH_shank[5];
-    w.c_RH_shank[5] = v[17]*w.v_RH_shank[3];
-    const Scalar h6 = 0.064*w.v_RH_shank[0] - 0.003904*w.v_RH_shank[4];
-    const Scalar h7 = 0.064*w.v_RH_shank[1] + 0.003904*w.v_RH_shank[3];
-    const Scalar h8 = 0.003904*w.v_RH_shank[1] + 0.000483144*w.v_RH_shank[3];
-    const Scalar h9 = -0.003904*w.v_RH_shank[0] + 0.000486144*w.v_RH_shank[4];
-    w.pA_RH_shank[0] = 0.064*w.v_RH_shank[2]*w.v_RH_shank[4] - w.v_RH_shank[5]*h7;
-    w.pA_RH_shank[1] = w.v_RH_shank[5]*h6 - 0.064*w.v_RH_shank[2]*w.v_RH_shank[3];
-    w.pA_RH_shank[2] = w.v_RH_shank[3]*h7 - w.v_RH_shank[4]*h6;
-    w.pA_RH_shank[3] = 6e-06*w.v_RH_shank[4]*w.v_RH_shank[5] - w.v_RH_shank[5]*h9 + 0.064*w.v_RH_shank[1]*w.v_RH_shank[2] - w.v_RH_shank[2]*h7;
-    w.pA_RH_shank[4] = w.v_RH_shank[5]*h8 - 6e-06*w.v_RH_shank[3]*w.v_RH_shank[5] + w.v_RH_shank[2]*h6 - 0.064*w.v_RH_shank[0]*w.v_RH_shank[2];
-    w.pA_RH_shank[5] = w.v_RH_shank[3]*h9 - w.v_RH_shank[4]*h8 + w.v_RH_shank[0]*h7 - w.v_RH_shank[1]*h6;
-    w.g_RH_shank[0] = w.cq_RH_shank*w.g_RH_thigh[0] - w.sq_RH_shank*w.g_RH_thigh[2];
-    w.g_RH_shank[2] = w.sq_RH_shank*w.g_RH_thigh[0] + w.cq_RH_shank*w.g_RH_thigh[2];
-    // constraint 'rh_foot' (3d) on link 'RH_foot': rows 9..11
-    const Scalar t4 = w.v_RH_shank[2] - 0.004*w.v_RH_shank[3];
-    const Scalar t5 = w.v_RH_shank[1] + 0.195*w.v_RH_shank[3];
-    const Scalar t6 = w.v_RH_shank[0] - 0.195*w.v_RH_shank[4] + 0.004*w.v_RH_shank[5];
-    w.k_rh_foot[0] = -w.g_RH_shank[0] - w.v_RH_shank[4]*t4 + w.v_RH_shank[5]*t5;
-    w.k_rh_foot[1] = -w.g_RH_hip[1] - w.v_RH_shank[5]*t6 + w.v_RH_shank[3]*t4;
-    w.k_rh_foot[2] = -w.g_RH_shank[2] - w.v_RH_shank[3]*t5 + w.v_RH_shank[4]*t6;
-  }
+  shared_5(shared_5_k1, &v[17], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar mu_c0 = mu*w.active[3];
-    const Scalar t0 = 0.195*w.k_rh_foot[1] - 0.004*w.k_rh_foot[2];
-    w.U_RH_shank[0] = -0.003904 - 0.195*mu_c0;
-    w.U_RH_shank[4] = 0.000486144 + 0.038025*mu_c0;
-    w.U_RH_shank[5] = -0.0007800000000000001*mu_c0;
-    w.Dinv_RH_shank = 1.0 / w.U_RH_shank[4];
-    w.u_RH_shank[0] = -w.pA_RH_shank[4] + 0.195*w.lambda[9] - 0.195*w.k_rh_foot[0]*mu_c0 + tau[17];
-    const Scalar t1 = w.U_RH_shank[0]*w.Dinv_RH_shank;
-    const Scalar t2 = w.U_RH_shank[5]*w.Dinv_RH_shank;
-    const Scalar Ia0 = 0.064 + mu_c0 - w.U_RH_shank[0]*t1;
-    const Scalar Ia1 = 0.004*mu_c0 - w.U_RH_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu_c0;
-    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_RH_shank[5]*t2;
-    const Scalar pa0 = w.pA_RH_shank[0] + w.lambda[9] - w.k_rh_foot[0]*mu_c0 + w.u_RH_shank[0]*t1 + w.c_RH_shank[0]*Ia0 + w.c_RH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RH_shank[1] + w.lambda[10] - w.k_rh_foot[1]*mu_c0 + w.c_RH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RH_shank[2] + w.lambda[11] - w.k_rh_foot[2]*mu_c0 + w.c_RH_shank[2]*Ia2 - 0.004*w.c_RH_shank[3]*mu_c0;
-    const Scalar pa3 = w.pA_RH_shank[3] + 0.195*w.lambda[10] - 0.004*w.lambda[11] - mu_c0*t0 - 0.004*w.c_RH_shank[2]*mu_c0 + w.c_RH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RH_shank[5] + 0.004*w.lambda[9] - 0.004*w.k_rh_foot[0]*mu_c0 + w.u_RH_shank[0]*t2 + w.c_RH_shank[0]*Ia1 + w.c_RH_shank[5]*Ia5;
-    const Scalar C20 = w.cq_RH_shank*w.cq_RH_shank - w.sq_RH_shank*w.sq_RH_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t3 = 2.0*w.cq_RH_shank*w.sq_RH_shank;
-    const Scalar t4 = -0.002*mu_c0 + 0.5*Ia1;
-    const Scalar h1 = 0.5*(-Ia4 + Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    const Scalar t5 = m0 - C20*h0;
-    const Scalar t6 = m0 + C20*h0;
-    const Scalar t7 = 0.002*mu_c0 + 0.5*Ia1 + C20*t4;
-    const Scalar t8 = -0.002*mu_c0 - 0.5*Ia1 + C20*t4;
-    const Scalar t9 = 0.209*Ia2 + w.cq_RH_shank*Ia3;
-    const Scalar t10 = w.cq_RH_shank*pa0 + w.sq_RH_shank*pa2;
-    const Scalar t11 = -w.sq_RH_shank*pa0 + w.cq_RH_shank*pa2;
-    w.IA_RH_thigh[0] = 0.6890000000000001 + t5;
-    w.IA_RH_thigh[2] = h0*t3;
-    w.IA_RH_thigh[3] = t3*t4;
-    w.IA_RH_thigh[4] = -0.01268 - 0.209*t5;
-    w.IA_RH_thigh[5] = -0.010144 + t7;
-    w.IA_RH_thigh[6] = 0.6890000000000001 + Ia2;
-    w.IA_RH_thigh[8] = 0.01268 + t9;
-    w.IA_RH_thigh[10] = -w.sq_RH_shank*Ia3;
-    w.IA_RH_thigh[11] = 0.6890000000000001 + t6;
-    w.IA_RH_thigh[12] = 0.010144 + t8;
-    w.IA_RH_thigh[13] = -0.209*h0*t3;
-    w.IA_RH_thigh[14] = -t3*t4;
-    w.IA_RH_thigh[15] = 0.002431904 + 0.209*w.cq_RH_shank*Ia3 + m1 - C20*h1 + 0.209*t9;
-    w.IA_RH_thigh[16] = -0.209*t3*t4;
-    w.IA_RH_thigh[17] = -0.209*w.sq_RH_shank*Ia3 + t3*h1;
-    w.IA_RH_thigh[18] = 0.0024196 + 0.043681*t5;
-    w.IA_RH_thigh[19] = 0.00020288 - 0.209*t7;
-    w.IA_RH_thigh[20] = 0.0006033039999999999 + m1 + C20*h1;
-    w.pA_RH_thigh[0] = w.pA_RH_thigh[0] + t10;
-    w.pA_RH_thigh[1] = w.pA_RH_thigh[1] + pa1;
-    w.pA_RH_thigh[2] = w.pA_RH_thigh[2] + t11;
-    w.pA_RH_thigh[3] = w.pA_RH_thigh[3] + 0.209*pa1 + w.cq_RH_shank*pa3 + w.sq_RH_shank*pa4;
-    w.pA_RH_thigh[4] = w.pA_RH_thigh[4] + tau[17] - 0.209*t10;
-    w.pA_RH_thigh[5] = w.pA_RH_thigh[5] - w.sq_RH_shank*pa3 + w.cq_RH_shank*pa4;
-  }
+  shared_6(shared_6_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.IA_RH_thigh, w.pA_RH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
-    w.u_RH_thigh[0] = -w.pA_RH_thigh[4] + tau[16];
-    const Scalar t0 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar t1 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar t2 = w.IA_RH_thigh[16]*w.Dinv_RH_thigh;
-    const Scalar t3 = w.IA_RH_thigh[19]*w.Dinv_RH_thigh;
-    const Scalar Ia0 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t0;
-    const Scalar Ia2 = w.IA_RH_thigh[3] - w.IA_RH_thigh[16]*t0;
-    const Scalar Ia3 = w.IA_RH_thigh[5] - w.IA_RH_thigh[19]*t0;
-    const Scalar Ia4 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t1;
-    const Scalar Ia5 = w.IA_RH_thigh[12] - w.IA_RH_thigh[16]*t1;
-    const Scalar Ia6 = w.IA_RH_thigh[14] - w.IA_RH_thigh[19]*t1;
-    const Scalar Ia7 = w.IA_RH_thigh[15] - w.IA_RH_thigh[16]*t2;
-    const Scalar Ia8 = w.IA_RH_thigh[17] - w.IA_RH_thigh[19]*t2;
-    const Scalar Ia9 = w.IA_RH_thigh[20] - w.IA_RH_thigh[19]*t3;
-    const Scalar pa0 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t0 + w.c_RH_thigh[0]*Ia0 + w.c_RH_thigh[2]*Ia1 + w.c_RH_thigh[3]*Ia2 + w.c_RH_thigh[5]*Ia3;
-    const Scalar pa1 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
-    const Scalar pa2 = w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t1 + w.c_RH_thigh[0]*Ia1 + w.c_RH_thigh[2]*Ia4 + w.c_RH_thigh[3]*Ia5 + w.c_RH_thigh[5]*Ia6;
-    const Scalar pa3 = w.pA_RH_thigh[3] + w.u_RH_thigh[0]*t2 + w.c_RH_thigh[0]*Ia2 + w.c_RH_thigh[2]*Ia5 + w.c_RH_thigh[3]*Ia7 + w.c_RH_thigh[5]*Ia8;
-    const Scalar pa4 = w.pA_RH_thigh[5] + w.u_RH_thigh[0]*t3 + w.c_RH_thigh[0]*Ia3 + w.c_RH_thigh[2]*Ia6 + w.c_RH_thigh[3]*Ia8 + w.c_RH_thigh[5]*Ia9;
-    const Scalar C20 = w.cq_RH_thigh*w.cq_RH_thigh - w.sq_RH_thigh*w.sq_RH_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar h1 = 0.5*(-Ia2 + Ia6);
-    const Scalar m1 = 0.5*(Ia2 + Ia6);
-    const Scalar t5 = 0.5*(Ia3 + Ia5);
-    const Scalar d1 = C20*h1 - t4*t5;
-    const Scalar qq1 = t4*h1 + C20*t5;
-    const Scalar h2 = 0.5*(-Ia7 + Ia9);
-    const Scalar m2 = 0.5*(Ia7 + Ia9);
-    const Scalar d2 = C20*h2 - Ia8*t4;
-    const Scalar qq2 = t4*h2 + Ia8*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = m1 - d1;
-    const Scalar t9 = 0.5*Ia3 - 0.5*Ia5 + qq1;
-    const Scalar t10 = w.sq_RH_thigh*w.IA_RH_thigh[10] + w.cq_RH_thigh*w.IA_RH_thigh[8];
-    const Scalar t11 = w.cq_RH_thigh*w.IA_RH_thigh[10] - w.sq_RH_thigh*w.IA_RH_thigh[8];
-    const Scalar t12 = -0.5*Ia3 + 0.5*Ia5 + qq1;
-    const Scalar t13 = m1 + d1;
-    const Scalar t14 = -0.062*qq0 + t8;
-    const Scalar t15 = 0.062*t6 + t9;
-    const Scalar t16 = -0.062*t7 + t12;
-    const Scalar t17 = 0.062*qq0 + t13;
-    const Scalar t18 = w.cq_RH_thigh*pa0 + w.sq_RH_thigh*pa2;
-    const Scalar t19 = -w.sq_RH_thigh*pa0 + w.cq_RH_thigh*pa2;
-    w.IA_RH_hip[0] = 0.5950000000000001 + t6;
-    w.IA_RH_hip[2] = qq0;
-    w.IA_RH_hip[3] = t14;
-    w.IA_RH_hip[5] = 0.02164 + t15;
-    w.IA_RH_hip[6] = 0.5950000000000001 + w.IA_RH_thigh[6];
-    w.IA_RH_hip[8] = t10;
-    w.IA_RH_hip[10] = t11;
-    w.IA_RH_hip[11] = 0.5950000000000001 + t7;
-    w.IA_RH_hip[12] = -0.02164 + t16;
-    w.IA_RH_hip[14] = t17;
-    w.IA_RH_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t12 - 0.062*t16;
-    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t8 - 0.062*t17;
-    w.IA_RH_hip[20] = 0.00126484 + m2 + d2 + 0.062*t9 + 0.062*t15;
-    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t18;
-    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa1;
-    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t19;
-    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa3 + w.sq_RH_thigh*pa4 - 0.062*t19;
-    w.pA_RH_hip[4] = w.pA_RH_hip[4] + tau[16];
-    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa4 + 0.062*t18;
-  }
+  shared_7(shared_7_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.IA_RH_hip, w.pA_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -812,800 +1562,47 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar mu_c0 = mu*w.active[1];
-    const Scalar t0 = 0.195*w.k_rf_foot[1] - 0.004*w.k_rf_foot[2];
-    w.U_RF_shank[0] = -0.003904 - 0.195*mu_c0;
-    w.U_RF_shank[4] = 0.000486144 + 0.038025*mu_c0;
-    w.U_RF_shank[5] = -0.0007800000000000001*mu_c0;
-    w.Dinv_RF_shank = 1.0 / w.U_RF_shank[4];
-    w.u_RF_shank[0] = -w.pA_RF_shank[4] + 0.195*w.lambda[3] - 0.195*w.k_rf_foot[0]*mu_c0 + tau[14];
-    const Scalar t1 = w.U_RF_shank[0]*w.Dinv_RF_shank;
-    const Scalar t2 = w.U_RF_shank[5]*w.Dinv_RF_shank;
-    const Scalar Ia0 = 0.064 + mu_c0 - w.U_RF_shank[0]*t1;
-    const Scalar Ia1 = 0.004*mu_c0 - w.U_RF_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu_c0;
-    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_RF_shank[5]*t2;
-    const Scalar pa0 = w.pA_RF_shank[0] + w.lambda[3] - w.k_rf_foot[0]*mu_c0 + w.u_RF_shank[0]*t1 + w.c_RF_shank[0]*Ia0 + w.c_RF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_RF_shank[1] + w.lambda[4] - w.k_rf_foot[1]*mu_c0 + w.c_RF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_RF_shank[2] + w.lambda[5] - w.k_rf_foot[2]*mu_c0 + w.c_RF_shank[2]*Ia2 - 0.004*w.c_RF_shank[3]*mu_c0;
-    const Scalar pa3 = w.pA_RF_shank[3] + 0.195*w.lambda[4] - 0.004*w.lambda[5] - mu_c0*t0 - 0.004*w.c_RF_shank[2]*mu_c0 + w.c_RF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_RF_shank[5] + 0.004*w.lambda[3] - 0.004*w.k_rf_foot[0]*mu_c0 + w.u_RF_shank[0]*t2 + w.c_RF_shank[0]*Ia1 + w.c_RF_shank[5]*Ia5;
-    const Scalar C20 = w.cq_RF_shank*w.cq_RF_shank - w.sq_RF_shank*w.sq_RF_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t3 = 2.0*w.cq_RF_shank*w.sq_RF_shank;
-    const Scalar t4 = -0.002*mu_c0 + 0.5*Ia1;
-    const Scalar h1 = 0.5*(-Ia4 + Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    const Scalar t5 = m0 - C20*h0;
-    const Scalar t6 = m0 + C20*h0;
-    const Scalar t7 = 0.002*mu_c0 + 0.5*Ia1 + C20*t4;
-    const Scalar t8 = -0.002*mu_c0 - 0.5*Ia1 + C20*t4;
-    const Scalar t9 = 0.209*Ia2 + w.cq_RF_shank*Ia3;
-    const Scalar t10 = w.cq_RF_shank*pa0 + w.sq_RF_shank*pa2;
-    const Scalar t11 = -w.sq_RF_shank*pa0 + w.cq_RF_shank*pa2;
-    w.IA_RF_thigh[0] = 0.6890000000000001 + t5;
-    w.IA_RF_thigh[2] = h0*t3;
-    w.IA_RF_thigh[3] = t3*t4;
-    w.IA_RF_thigh[4] = -0.01268 - 0.209*t5;
-    w.IA_RF_thigh[5] = -0.010144 + t7;
-    w.IA_RF_thigh[6] = 0.6890000000000001 + Ia2;
-    w.IA_RF_thigh[8] = 0.01268 + t9;
-    w.IA_RF_thigh[10] = -w.sq_RF_shank*Ia3;
-    w.IA_RF_thigh[11] = 0.6890000000000001 + t6;
-    w.IA_RF_thigh[12] = 0.010144 + t8;
-    w.IA_RF_thigh[13] = -0.209*h0*t3;
-    w.IA_RF_thigh[14] = -t3*t4;
-    w.IA_RF_thigh[15] = 0.002431904 + 0.209*w.cq_RF_shank*Ia3 + m1 - C20*h1 + 0.209*t9;
-    w.IA_RF_thigh[16] = -0.209*t3*t4;
-    w.IA_RF_thigh[17] = -0.209*w.sq_RF_shank*Ia3 + t3*h1;
-    w.IA_RF_thigh[18] = 0.0024196 + 0.043681*t5;
-    w.IA_RF_thigh[19] = 0.00020288 - 0.209*t7;
-    w.IA_RF_thigh[20] = 0.0006033039999999999 + m1 + C20*h1;
-    w.pA_RF_thigh[0] = w.pA_RF_thigh[0] + t10;
-    w.pA_RF_thigh[1] = w.pA_RF_thigh[1] + pa1;
-    w.pA_RF_thigh[2] = w.pA_RF_thigh[2] + t11;
-    w.pA_RF_thigh[3] = w.pA_RF_thigh[3] + 0.209*pa1 + w.cq_RF_shank*pa3 + w.sq_RF_shank*pa4;
-    w.pA_RF_thigh[4] = w.pA_RF_thigh[4] + tau[14] - 0.209*t10;
-    w.pA_RF_thigh[5] = w.pA_RF_thigh[5] - w.sq_RF_shank*pa3 + w.cq_RF_shank*pa4;
-  }
+  shared_6(shared_6_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.IA_RF_thigh, w.pA_RF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
-    w.u_RF_thigh[0] = -w.pA_RF_thigh[4] + tau[13];
-    const Scalar t0 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar t1 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar t2 = w.IA_RF_thigh[16]*w.Dinv_RF_thigh;
-    const Scalar t3 = w.IA_RF_thigh[19]*w.Dinv_RF_thigh;
-    const Scalar Ia0 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t0;
-    const Scalar Ia2 = w.IA_RF_thigh[3] - w.IA_RF_thigh[16]*t0;
-    const Scalar Ia3 = w.IA_RF_thigh[5] - w.IA_RF_thigh[19]*t0;
-    const Scalar Ia4 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t1;
-    const Scalar Ia5 = w.IA_RF_thigh[12] - w.IA_RF_thigh[16]*t1;
-    const Scalar Ia6 = w.IA_RF_thigh[14] - w.IA_RF_thigh[19]*t1;
-    const Scalar Ia7 = w.IA_RF_thigh[15] - w.IA_RF_thigh[16]*t2;
-    const Scalar Ia8 = w.IA_RF_thigh[17] - w.IA_RF_thigh[19]*t2;
-    const Scalar Ia9 = w.IA_RF_thigh[20] - w.IA_RF_thigh[19]*t3;
-    const Scalar pa0 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t0 + w.c_RF_thigh[0]*Ia0 + w.c_RF_thigh[2]*Ia1 + w.c_RF_thigh[3]*Ia2 + w.c_RF_thigh[5]*Ia3;
-    const Scalar pa1 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
-    const Scalar pa2 = w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t1 + w.c_RF_thigh[0]*Ia1 + w.c_RF_thigh[2]*Ia4 + w.c_RF_thigh[3]*Ia5 + w.c_RF_thigh[5]*Ia6;
-    const Scalar pa3 = w.pA_RF_thigh[3] + w.u_RF_thigh[0]*t2 + w.c_RF_thigh[0]*Ia2 + w.c_RF_thigh[2]*Ia5 + w.c_RF_thigh[3]*Ia7 + w.c_RF_thigh[5]*Ia8;
-    const Scalar pa4 = w.pA_RF_thigh[5] + w.u_RF_thigh[0]*t3 + w.c_RF_thigh[0]*Ia3 + w.c_RF_thigh[2]*Ia6 + w.c_RF_thigh[3]*Ia8 + w.c_RF_thigh[5]*Ia9;
-    const Scalar C20 = w.cq_RF_thigh*w.cq_RF_thigh - w.sq_RF_thigh*w.sq_RF_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar h1 = 0.5*(-Ia2 + Ia6);
-    const Scalar m1 = 0.5*(Ia2 + Ia6);
-    const Scalar t5 = 0.5*(Ia3 + Ia5);
-    const Scalar d1 = C20*h1 - t4*t5;
-    const Scalar qq1 = t4*h1 + C20*t5;
-    const Scalar h2 = 0.5*(-Ia7 + Ia9);
-    const Scalar m2 = 0.5*(Ia7 + Ia9);
-    const Scalar d2 = C20*h2 - Ia8*t4;
-    const Scalar qq2 = t4*h2 + Ia8*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = m1 - d1;
-    const Scalar t9 = 0.5*Ia3 - 0.5*Ia5 + qq1;
-    const Scalar t10 = w.sq_RF_thigh*w.IA_RF_thigh[10] + w.cq_RF_thigh*w.IA_RF_thigh[8];
-    const Scalar t11 = w.cq_RF_thigh*w.IA_RF_thigh[10] - w.sq_RF_thigh*w.IA_RF_thigh[8];
-    const Scalar t12 = -0.5*Ia3 + 0.5*Ia5 + qq1;
-    const Scalar t13 = m1 + d1;
-    const Scalar t14 = -0.062*qq0 + t8;
-    const Scalar t15 = 0.062*t6 + t9;
-    const Scalar t16 = -0.062*t7 + t12;
-    const Scalar t17 = 0.062*qq0 + t13;
-    const Scalar t18 = w.cq_RF_thigh*pa0 + w.sq_RF_thigh*pa2;
-    const Scalar t19 = -w.sq_RF_thigh*pa0 + w.cq_RF_thigh*pa2;
-    w.IA_RF_hip[0] = 0.5950000000000001 + t6;
-    w.IA_RF_hip[2] = qq0;
-    w.IA_RF_hip[3] = t14;
-    w.IA_RF_hip[5] = 0.02164 + t15;
-    w.IA_RF_hip[6] = 0.5950000000000001 + w.IA_RF_thigh[6];
-    w.IA_RF_hip[8] = t10;
-    w.IA_RF_hip[10] = t11;
-    w.IA_RF_hip[11] = 0.5950000000000001 + t7;
-    w.IA_RF_hip[12] = -0.02164 + t16;
-    w.IA_RF_hip[14] = t17;
-    w.IA_RF_hip[15] = 0.0012018399999999998 + m2 - d2 - 0.062*t12 - 0.062*t16;
-    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t8 - 0.062*t17;
-    w.IA_RF_hip[20] = 0.00126484 + m2 + d2 + 0.062*t9 + 0.062*t15;
-    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t18;
-    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa1;
-    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t19;
-    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa3 + w.sq_RF_thigh*pa4 - 0.062*t19;
-    w.pA_RF_hip[4] = w.pA_RF_hip[4] + tau[13];
-    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa4 + 0.062*t18;
-  }
+  shared_7(shared_7_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.IA_RF_hip, w.pA_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
-    w.U_RF_hip[1] = 0.9950371902099893*w.IA_RF_hip[8] + 0.09950371902099893*w.IA_RF_hip[10];
-    w.U_RF_hip[2] = 0.9950371902099893*w.IA_RF_hip[12] + 0.09950371902099893*w.IA_RF_hip[14];
-    w.U_RF_hip[3] = 0.9950371902099893*w.IA_RF_hip[15] + 0.09950371902099893*w.IA_RF_hip[17];
-    w.U_RF_hip[5] = 0.9950371902099893*w.IA_RF_hip[17] + 0.09950371902099893*w.IA_RF_hip[20];
-    const Scalar D0 = 0.9950371902099893*w.U_RF_hip[3] + 0.09950371902099893*w.U_RF_hip[5];
-    w.Dinv_RF_hip = 1.0 / D0;
-    w.u_RF_hip[0] = -0.9950371902099893*w.pA_RF_hip[3] - 0.09950371902099893*w.pA_RF_hip[5] + tau[12];
-    const Scalar t0 = w.U_RF_hip[0]*w.Dinv_RF_hip;
-    const Scalar t1 = w.U_RF_hip[1]*w.Dinv_RF_hip;
-    const Scalar t2 = w.U_RF_hip[2]*w.Dinv_RF_hip;
-    const Scalar t3 = w.U_RF_hip[3]*w.Dinv_RF_hip;
-    const Scalar t4 = w.U_RF_hip[5]*w.Dinv_RF_hip;
-    const Scalar Ia0 = w.IA_RF_hip[0] - w.U_RF_hip[0]*t0;
-    const Scalar Ia1 = w.IA_RF_hip[2] - w.U_RF_hip[2]*t0;
-    const Scalar Ia2 = w.IA_RF_hip[3] - w.U_RF_hip[3]*t0;
-    const Scalar Ia3 = w.IA_RF_hip[5] - w.U_RF_hip[5]*t0;
-    const Scalar Ia4 = w.IA_RF_hip[6] - w.U_RF_hip[1]*t1;
-    const Scalar Ia5 = w.IA_RF_hip[8] - w.U_RF_hip[3]*t1;
-    const Scalar Ia6 = w.IA_RF_hip[10] - w.U_RF_hip[5]*t1;
-    const Scalar Ia7 = w.IA_RF_hip[11] - w.U_RF_hip[2]*t2;
-    const Scalar Ia8 = w.IA_RF_hip[12] - w.U_RF_hip[3]*t2;
-    const Scalar Ia9 = w.IA_RF_hip[14] - w.U_RF_hip[5]*t2;
-    const Scalar Ia10 = w.IA_RF_hip[15] - w.U_RF_hip[3]*t3;
-    const Scalar Ia11 = -5.8e-05 + 5.780668556524933e-05*w.U_RF_hip[3]*w.Dinv_RF_hip;
-    const Scalar Ia12 = w.IA_RF_hip[17] - w.U_RF_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.341612896039605e-09*w.Dinv_RF_hip;
-    const Scalar Ia14 = -9.5e-07 + 5.780668556524933e-05*w.U_RF_hip[5]*w.Dinv_RF_hip;
-    const Scalar Ia15 = w.IA_RF_hip[20] - w.U_RF_hip[5]*t4;
-    const Scalar t5 = -w.U_RF_hip[1]*t0;
-    const Scalar t6 = 5.780668556524933e-05*w.U_RF_hip[0]*w.Dinv_RF_hip;
-    const Scalar t7 = -w.U_RF_hip[2]*t1;
-    const Scalar t8 = 5.780668556524933e-05*w.U_RF_hip[1]*w.Dinv_RF_hip;
-    const Scalar t9 = 5.780668556524933e-05*w.U_RF_hip[2]*w.Dinv_RF_hip;
-    const Scalar pa0 = w.pA_RF_hip[0] + w.u_RF_hip[0]*t0 + w.c_RF_hip[0]*Ia0 + w.c_RF_hip[1]*t5 + w.c_RF_hip[2]*Ia1 + w.c_RF_hip[3]*Ia2 + w.c_RF_hip[4]*t6 + w.c_RF_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_RF_hip[1] + w.u_RF_hip[0]*t1 + w.c_RF_hip[0]*t5 + w.c_RF_hip[1]*Ia4 + w.c_RF_hip[2]*t7 + w.c_RF_hip[3]*Ia5 + w.c_RF_hip[4]*t8 + w.c_RF_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_RF_hip[2] + w.u_RF_hip[0]*t2 + w.c_RF_hip[0]*Ia1 + w.c_RF_hip[1]*t7 + w.c_RF_hip[2]*Ia7 + w.c_RF_hip[3]*Ia8 + w.c_RF_hip[4]*t9 + w.c_RF_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_RF_hip[3] + w.u_RF_hip[0]*t3 + w.c_RF_hip[0]*Ia2 + w.c_RF_hip[1]*Ia5 + w.c_RF_hip[2]*Ia8 + w.c_RF_hip[3]*Ia10 + w.c_RF_hip[4]*Ia11 + w.c_RF_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_RF_hip[4] - 5.780668556524933e-05*w.Dinv_RF_hip*w.u_RF_hip[0] + w.c_RF_hip[0]*t6 + w.c_RF_hip[1]*t8 + w.c_RF_hip[2]*t9 + w.c_RF_hip[3]*Ia11 + w.c_RF_hip[4]*Ia13 + w.c_RF_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_RF_hip[5] + w.u_RF_hip[0]*t4 + w.c_RF_hip[0]*Ia3 + w.c_RF_hip[1]*Ia6 + w.c_RF_hip[2]*Ia9 + w.c_RF_hip[3]*Ia12 + w.c_RF_hip[4]*Ia14 + w.c_RF_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_RF_hip[0][0]*Ia0 + w.RJ_RF_hip[0][1]*t5 + w.RJ_RF_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_RF_hip[0][0]*t5 + w.RJ_RF_hip[0][1]*Ia4 + w.RJ_RF_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_RF_hip[0][0]*Ia1 + w.RJ_RF_hip[0][1]*t7 + w.RJ_RF_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_RF_hip[1][0]*Ia0 + w.cq_RF_hip*t5 + w.RJ_RF_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_RF_hip[1][0]*t5 + w.cq_RF_hip*Ia4 + w.RJ_RF_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_RF_hip[1][0]*Ia1 + w.cq_RF_hip*t7 + w.RJ_RF_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_RF_hip[2][0]*Ia0 + w.RJ_RF_hip[2][1]*t5 + w.RJ_RF_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_RF_hip[2][0]*t5 + w.RJ_RF_hip[2][1]*Ia4 + w.RJ_RF_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_RF_hip[2][0]*Ia1 + w.RJ_RF_hip[2][1]*t7 + w.RJ_RF_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_RF_hip[0][0]*Ia2 + w.RJ_RF_hip[0][1]*Ia5 + w.RJ_RF_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_RF_hip[0][0]*t6 + w.RJ_RF_hip[0][1]*t8 + w.RJ_RF_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_RF_hip[0][0]*Ia3 + w.RJ_RF_hip[0][1]*Ia6 + w.RJ_RF_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_RF_hip[1][0]*Ia2 + w.cq_RF_hip*Ia5 + w.RJ_RF_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_RF_hip[1][0]*t6 + w.cq_RF_hip*t8 + w.RJ_RF_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_RF_hip[1][0]*Ia3 + w.cq_RF_hip*Ia6 + w.RJ_RF_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_RF_hip[2][0]*Ia2 + w.RJ_RF_hip[2][1]*Ia5 + w.RJ_RF_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_RF_hip[2][0]*t6 + w.RJ_RF_hip[2][1]*t8 + w.RJ_RF_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_RF_hip[2][0]*Ia3 + w.RJ_RF_hip[2][1]*Ia6 + w.RJ_RF_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_RF_hip[0][0]*Ia10 + w.RJ_RF_hip[0][1]*Ia11 + w.RJ_RF_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_RF_hip[0][0]*Ia11 + w.RJ_RF_hip[0][1]*Ia13 + w.RJ_RF_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_RF_hip[0][0]*Ia12 + w.RJ_RF_hip[0][1]*Ia14 + w.RJ_RF_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_RF_hip[1][0]*Ia10 + w.cq_RF_hip*Ia11 + w.RJ_RF_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_RF_hip[1][0]*Ia11 + w.cq_RF_hip*Ia13 + w.RJ_RF_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_RF_hip[1][0]*Ia12 + w.cq_RF_hip*Ia14 + w.RJ_RF_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_RF_hip[2][0]*Ia10 + w.RJ_RF_hip[2][1]*Ia11 + w.RJ_RF_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_RF_hip[2][0]*Ia11 + w.RJ_RF_hip[2][1]*Ia13 + w.RJ_RF_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_RF_hip[2][0]*Ia12 + w.RJ_RF_hip[2][1]*Ia14 + w.RJ_RF_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_RF_hip[0][0]*t10 + w.RJ_RF_hip[0][1]*t11 + w.RJ_RF_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_RF_hip[1][0]*t10 + w.cq_RF_hip*t11 + w.RJ_RF_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_RF_hip[2][0]*t10 + w.RJ_RF_hip[2][1]*t11 + w.RJ_RF_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_RF_hip[1][0]*t13 + w.cq_RF_hip*t14 + w.RJ_RF_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_RF_hip[2][0]*t13 + w.RJ_RF_hip[2][1]*t14 + w.RJ_RF_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_RF_hip[2][0]*t16 + w.RJ_RF_hip[2][1]*t17 + w.RJ_RF_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_RF_hip[0][0]*t19 + w.RJ_RF_hip[0][1]*t20 + w.RJ_RF_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_RF_hip[1][0]*t19 + w.cq_RF_hip*t20 + w.RJ_RF_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_RF_hip[2][0]*t19 + w.RJ_RF_hip[2][1]*t20 + w.RJ_RF_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_RF_hip[0][0]*t22 + w.RJ_RF_hip[0][1]*t23 + w.RJ_RF_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_RF_hip[1][0]*t22 + w.cq_RF_hip*t23 + w.RJ_RF_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_RF_hip[2][0]*t22 + w.RJ_RF_hip[2][1]*t23 + w.RJ_RF_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_RF_hip[0][0]*t25 + w.RJ_RF_hip[0][1]*t26 + w.RJ_RF_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_RF_hip[1][0]*t25 + w.cq_RF_hip*t26 + w.RJ_RF_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_RF_hip[2][0]*t25 + w.RJ_RF_hip[2][1]*t26 + w.RJ_RF_hip[2][2]*t27;
-    const Scalar t52 = -0.049*t39 + t43;
-    const Scalar t53 = -0.19*t39 + t44;
-    const Scalar t54 = 0.049*t37 + 0.19*t38 + t45;
-    const Scalar t55 = -0.049*t41 + t46;
-    const Scalar t56 = -0.19*t41 + t47;
-    const Scalar t57 = 0.049*t38 + 0.19*t40 + t48;
-    const Scalar t58 = -0.049*t42 + t49;
-    const Scalar t59 = -0.19*t42 + t50;
-    const Scalar t60 = 0.049*t39 + 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_RF_hip[0][0]*pa0 + w.RJ_RF_hip[0][1]*pa1 + w.RJ_RF_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_RF_hip[1][0]*pa0 + w.cq_RF_hip*pa1 + w.RJ_RF_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_RF_hip[2][0]*pa0 + w.RJ_RF_hip[2][1]*pa1 + w.RJ_RF_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_RF_hip[0][0]*t28 + w.RJ_RF_hip[0][1]*t29 + w.RJ_RF_hip[0][2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_RF_hip[1][0]*t28 + w.cq_RF_hip*t29 + w.RJ_RF_hip[1][2]*t30 - 0.19*t49 - 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_RF_hip[2][0]*t28 + w.RJ_RF_hip[2][1]*t29 + w.RJ_RF_hip[2][2]*t30 + 0.049*t43 + 0.19*t46 - 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_RF_hip[1][0]*t31 + w.cq_RF_hip*t32 + w.RJ_RF_hip[1][2]*t33 - 0.19*t50 - 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_RF_hip[2][0]*t31 + w.RJ_RF_hip[2][1]*t32 + w.RJ_RF_hip[2][2]*t33 + 0.049*t44 + 0.19*t47 - 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_RF_hip[2][0]*t34 + w.RJ_RF_hip[2][1]*t35 + w.RJ_RF_hip[2][2]*t36 + 0.049*t45 + 0.19*t48 + 0.049*t54 + 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RF_hip[0][0]*pa3 + w.RJ_RF_hip[0][1]*pa4 + w.RJ_RF_hip[0][2]*pa5 - 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RF_hip[1][0]*pa3 + w.cq_RF_hip*pa4 + w.RJ_RF_hip[1][2]*pa5 - 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RF_hip[2][0]*pa3 + w.RJ_RF_hip[2][1]*pa4 + w.RJ_RF_hip[2][2]*pa5 + 0.049*t61 + 0.19*t62;
-  }
+  shared_8(shared_8_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar mu_c0 = mu*w.active[2];
-    const Scalar t0 = 0.195*w.k_lh_foot[1] + 0.004*w.k_lh_foot[2];
-    w.U_LH_shank[0] = -0.003904 - 0.195*mu_c0;
-    w.U_LH_shank[4] = 0.000486144 + 0.038025*mu_c0;
-    w.U_LH_shank[5] = 0.0007800000000000001*mu_c0;
-    w.Dinv_LH_shank = 1.0 / w.U_LH_shank[4];
-    w.u_LH_shank[0] = -w.pA_LH_shank[4] + 0.195*w.lambda[6] - 0.195*w.k_lh_foot[0]*mu_c0 + tau[11];
-    const Scalar t1 = w.U_LH_shank[0]*w.Dinv_LH_shank;
-    const Scalar t2 = w.U_LH_shank[5]*w.Dinv_LH_shank;
-    const Scalar Ia0 = 0.064 + mu_c0 - w.U_LH_shank[0]*t1;
-    const Scalar Ia1 = -0.004*mu_c0 - w.U_LH_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu_c0;
-    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_LH_shank[5]*t2;
-    const Scalar pa0 = w.pA_LH_shank[0] + w.lambda[6] - w.k_lh_foot[0]*mu_c0 + w.u_LH_shank[0]*t1 + w.c_LH_shank[0]*Ia0 + w.c_LH_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LH_shank[1] + w.lambda[7] - w.k_lh_foot[1]*mu_c0 + w.c_LH_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LH_shank[2] + w.lambda[8] - w.k_lh_foot[2]*mu_c0 + w.c_LH_shank[2]*Ia2 + 0.004*w.c_LH_shank[3]*mu_c0;
-    const Scalar pa3 = w.pA_LH_shank[3] + 0.195*w.lambda[7] + 0.004*w.lambda[8] - mu_c0*t0 + 0.004*w.c_LH_shank[2]*mu_c0 + w.c_LH_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LH_shank[5] - 0.004*w.lambda[6] + 0.004*w.k_lh_foot[0]*mu_c0 + w.u_LH_shank[0]*t2 + w.c_LH_shank[0]*Ia1 + w.c_LH_shank[5]*Ia5;
-    const Scalar C20 = w.cq_LH_shank*w.cq_LH_shank - w.sq_LH_shank*w.sq_LH_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t3 = 2.0*w.cq_LH_shank*w.sq_LH_shank;
-    const Scalar t4 = 0.002*mu_c0 + 0.5*Ia1;
-    const Scalar h1 = 0.5*(-Ia4 + Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    const Scalar t5 = m0 - C20*h0;
-    const Scalar t6 = m0 + C20*h0;
-    const Scalar t7 = -0.002*mu_c0 + 0.5*Ia1 + C20*t4;
-    const Scalar t8 = 0.002*mu_c0 - 0.5*Ia1 + C20*t4;
-    const Scalar t9 = 0.209*Ia2 + w.cq_LH_shank*Ia3;
-    const Scalar t10 = w.cq_LH_shank*pa0 + w.sq_LH_shank*pa2;
-    const Scalar t11 = -w.sq_LH_shank*pa0 + w.cq_LH_shank*pa2;
-    w.IA_LH_thigh[0] = 0.6890000000000001 + t5;
-    w.IA_LH_thigh[2] = h0*t3;
-    w.IA_LH_thigh[3] = t3*t4;
-    w.IA_LH_thigh[4] = -0.01268 - 0.209*t5;
-    w.IA_LH_thigh[5] = 0.010144 + t7;
-    w.IA_LH_thigh[6] = 0.6890000000000001 + Ia2;
-    w.IA_LH_thigh[8] = 0.01268 + t9;
-    w.IA_LH_thigh[10] = -w.sq_LH_shank*Ia3;
-    w.IA_LH_thigh[11] = 0.6890000000000001 + t6;
-    w.IA_LH_thigh[12] = -0.010144 + t8;
-    w.IA_LH_thigh[13] = -0.209*h0*t3;
-    w.IA_LH_thigh[14] = -t3*t4;
-    w.IA_LH_thigh[15] = 0.002431904 + 0.209*w.cq_LH_shank*Ia3 + m1 - C20*h1 + 0.209*t9;
-    w.IA_LH_thigh[16] = -0.209*t3*t4;
-    w.IA_LH_thigh[17] = -0.209*w.sq_LH_shank*Ia3 + t3*h1;
-    w.IA_LH_thigh[18] = 0.0024196 + 0.043681*t5;
-    w.IA_LH_thigh[19] = -0.00020288 - 0.209*t7;
-    w.IA_LH_thigh[20] = 0.0006033039999999999 + m1 + C20*h1;
-    w.pA_LH_thigh[0] = w.pA_LH_thigh[0] + t10;
-    w.pA_LH_thigh[1] = w.pA_LH_thigh[1] + pa1;
-    w.pA_LH_thigh[2] = w.pA_LH_thigh[2] + t11;
-    w.pA_LH_thigh[3] = w.pA_LH_thigh[3] + 0.209*pa1 + w.cq_LH_shank*pa3 + w.sq_LH_shank*pa4;
-    w.pA_LH_thigh[4] = w.pA_LH_thigh[4] + tau[11] - 0.209*t10;
-    w.pA_LH_thigh[5] = w.pA_LH_thigh[5] - w.sq_LH_shank*pa3 + w.cq_LH_shank*pa4;
-  }
+  shared_6(shared_6_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.IA_LH_thigh, w.pA_LH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
-    w.u_LH_thigh[0] = -w.pA_LH_thigh[4] + tau[10];
-    const Scalar t0 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar t1 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar t2 = w.IA_LH_thigh[16]*w.Dinv_LH_thigh;
-    const Scalar t3 = w.IA_LH_thigh[19]*w.Dinv_LH_thigh;
-    const Scalar Ia0 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t0;
-    const Scalar Ia2 = w.IA_LH_thigh[3] - w.IA_LH_thigh[16]*t0;
-    const Scalar Ia3 = w.IA_LH_thigh[5] - w.IA_LH_thigh[19]*t0;
-    const Scalar Ia4 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t1;
-    const Scalar Ia5 = w.IA_LH_thigh[12] - w.IA_LH_thigh[16]*t1;
-    const Scalar Ia6 = w.IA_LH_thigh[14] - w.IA_LH_thigh[19]*t1;
-    const Scalar Ia7 = w.IA_LH_thigh[15] - w.IA_LH_thigh[16]*t2;
-    const Scalar Ia8 = w.IA_LH_thigh[17] - w.IA_LH_thigh[19]*t2;
-    const Scalar Ia9 = w.IA_LH_thigh[20] - w.IA_LH_thigh[19]*t3;
-    const Scalar pa0 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t0 + w.c_LH_thigh[0]*Ia0 + w.c_LH_thigh[2]*Ia1 + w.c_LH_thigh[3]*Ia2 + w.c_LH_thigh[5]*Ia3;
-    const Scalar pa1 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
-    const Scalar pa2 = w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t1 + w.c_LH_thigh[0]*Ia1 + w.c_LH_thigh[2]*Ia4 + w.c_LH_thigh[3]*Ia5 + w.c_LH_thigh[5]*Ia6;
-    const Scalar pa3 = w.pA_LH_thigh[3] + w.u_LH_thigh[0]*t2 + w.c_LH_thigh[0]*Ia2 + w.c_LH_thigh[2]*Ia5 + w.c_LH_thigh[3]*Ia7 + w.c_LH_thigh[5]*Ia8;
-    const Scalar pa4 = w.pA_LH_thigh[5] + w.u_LH_thigh[0]*t3 + w.c_LH_thigh[0]*Ia3 + w.c_LH_thigh[2]*Ia6 + w.c_LH_thigh[3]*Ia8 + w.c_LH_thigh[5]*Ia9;
-    const Scalar C20 = w.cq_LH_thigh*w.cq_LH_thigh - w.sq_LH_thigh*w.sq_LH_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar h1 = 0.5*(-Ia2 + Ia6);
-    const Scalar m1 = 0.5*(Ia2 + Ia6);
-    const Scalar t5 = 0.5*(Ia3 + Ia5);
-    const Scalar d1 = C20*h1 - t4*t5;
-    const Scalar qq1 = t4*h1 + C20*t5;
-    const Scalar h2 = 0.5*(-Ia7 + Ia9);
-    const Scalar m2 = 0.5*(Ia7 + Ia9);
-    const Scalar d2 = C20*h2 - Ia8*t4;
-    const Scalar qq2 = t4*h2 + Ia8*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = m1 - d1;
-    const Scalar t9 = 0.5*Ia3 - 0.5*Ia5 + qq1;
-    const Scalar t10 = w.sq_LH_thigh*w.IA_LH_thigh[10] + w.cq_LH_thigh*w.IA_LH_thigh[8];
-    const Scalar t11 = w.cq_LH_thigh*w.IA_LH_thigh[10] - w.sq_LH_thigh*w.IA_LH_thigh[8];
-    const Scalar t12 = -0.5*Ia3 + 0.5*Ia5 + qq1;
-    const Scalar t13 = m1 + d1;
-    const Scalar t14 = 0.062*qq0 + t8;
-    const Scalar t15 = -0.062*t6 + t9;
-    const Scalar t16 = 0.062*t7 + t12;
-    const Scalar t17 = -0.062*qq0 + t13;
-    const Scalar t18 = w.cq_LH_thigh*pa0 + w.sq_LH_thigh*pa2;
-    const Scalar t19 = -w.sq_LH_thigh*pa0 + w.cq_LH_thigh*pa2;
-    w.IA_LH_hip[0] = 0.5950000000000001 + t6;
-    w.IA_LH_hip[2] = qq0;
-    w.IA_LH_hip[3] = t14;
-    w.IA_LH_hip[5] = -0.02164 + t15;
-    w.IA_LH_hip[6] = 0.5950000000000001 + w.IA_LH_thigh[6];
-    w.IA_LH_hip[8] = t10;
-    w.IA_LH_hip[10] = t11;
-    w.IA_LH_hip[11] = 0.5950000000000001 + t7;
-    w.IA_LH_hip[12] = 0.02164 + t16;
-    w.IA_LH_hip[14] = t17;
-    w.IA_LH_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t12 + 0.062*t16;
-    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t8 + 0.062*t17;
-    w.IA_LH_hip[20] = 0.00126484 + m2 + d2 - 0.062*t9 - 0.062*t15;
-    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t18;
-    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa1;
-    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t19;
-    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa3 + w.sq_LH_thigh*pa4 + 0.062*t19;
-    w.pA_LH_hip[4] = w.pA_LH_hip[4] + tau[10];
-    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa4 - 0.062*t18;
-  }
+  shared_7(shared_7_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.IA_LH_hip, w.pA_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
-    w.U_LH_hip[1] = 0.9950371902099892*w.IA_LH_hip[8] - 0.09950371902099892*w.IA_LH_hip[10];
-    w.U_LH_hip[2] = 0.9950371902099892*w.IA_LH_hip[12] - 0.09950371902099892*w.IA_LH_hip[14];
-    w.U_LH_hip[3] = 0.9950371902099892*w.IA_LH_hip[15] - 0.09950371902099892*w.IA_LH_hip[17];
-    w.U_LH_hip[5] = 0.9950371902099892*w.IA_LH_hip[17] - 0.09950371902099892*w.IA_LH_hip[20];
-    const Scalar D0 = 0.9950371902099892*w.U_LH_hip[3] - 0.09950371902099892*w.U_LH_hip[5];
-    w.Dinv_LH_hip = 1.0 / D0;
-    w.u_LH_hip[0] = -0.9950371902099892*w.pA_LH_hip[3] + 0.09950371902099892*w.pA_LH_hip[5] + tau[9];
-    const Scalar t0 = w.U_LH_hip[0]*w.Dinv_LH_hip;
-    const Scalar t1 = w.U_LH_hip[1]*w.Dinv_LH_hip;
-    const Scalar t2 = w.U_LH_hip[2]*w.Dinv_LH_hip;
-    const Scalar t3 = w.U_LH_hip[3]*w.Dinv_LH_hip;
-    const Scalar t4 = w.U_LH_hip[5]*w.Dinv_LH_hip;
-    const Scalar Ia0 = w.IA_LH_hip[0] - w.U_LH_hip[0]*t0;
-    const Scalar Ia1 = w.IA_LH_hip[2] - w.U_LH_hip[2]*t0;
-    const Scalar Ia2 = w.IA_LH_hip[3] - w.U_LH_hip[3]*t0;
-    const Scalar Ia3 = w.IA_LH_hip[5] - w.U_LH_hip[5]*t0;
-    const Scalar Ia4 = w.IA_LH_hip[6] - w.U_LH_hip[1]*t1;
-    const Scalar Ia5 = w.IA_LH_hip[8] - w.U_LH_hip[3]*t1;
-    const Scalar Ia6 = w.IA_LH_hip[10] - w.U_LH_hip[5]*t1;
-    const Scalar Ia7 = w.IA_LH_hip[11] - w.U_LH_hip[2]*t2;
-    const Scalar Ia8 = w.IA_LH_hip[12] - w.U_LH_hip[3]*t2;
-    const Scalar Ia9 = w.IA_LH_hip[14] - w.U_LH_hip[5]*t2;
-    const Scalar Ia10 = w.IA_LH_hip[15] - w.U_LH_hip[3]*t3;
-    const Scalar Ia11 = 5.8e-05 - 5.7617628499109426e-05*w.U_LH_hip[3]*w.Dinv_LH_hip;
-    const Scalar Ia12 = w.IA_LH_hip[17] - w.U_LH_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.3197911138613866e-09*w.Dinv_LH_hip;
-    const Scalar Ia14 = 9.5e-07 - 5.7617628499109426e-05*w.U_LH_hip[5]*w.Dinv_LH_hip;
-    const Scalar Ia15 = w.IA_LH_hip[20] - w.U_LH_hip[5]*t4;
-    const Scalar t5 = -w.U_LH_hip[1]*t0;
-    const Scalar t6 = -5.7617628499109426e-05*w.U_LH_hip[0]*w.Dinv_LH_hip;
-    const Scalar t7 = -w.U_LH_hip[2]*t1;
-    const Scalar t8 = -5.7617628499109426e-05*w.U_LH_hip[1]*w.Dinv_LH_hip;
-    const Scalar t9 = -5.7617628499109426e-05*w.U_LH_hip[2]*w.Dinv_LH_hip;
-    const Scalar pa0 = w.pA_LH_hip[0] + w.u_LH_hip[0]*t0 + w.c_LH_hip[0]*Ia0 + w.c_LH_hip[1]*t5 + w.c_LH_hip[2]*Ia1 + w.c_LH_hip[3]*Ia2 + w.c_LH_hip[4]*t6 + w.c_LH_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_LH_hip[1] + w.u_LH_hip[0]*t1 + w.c_LH_hip[0]*t5 + w.c_LH_hip[1]*Ia4 + w.c_LH_hip[2]*t7 + w.c_LH_hip[3]*Ia5 + w.c_LH_hip[4]*t8 + w.c_LH_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_LH_hip[2] + w.u_LH_hip[0]*t2 + w.c_LH_hip[0]*Ia1 + w.c_LH_hip[1]*t7 + w.c_LH_hip[2]*Ia7 + w.c_LH_hip[3]*Ia8 + w.c_LH_hip[4]*t9 + w.c_LH_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_LH_hip[3] + w.u_LH_hip[0]*t3 + w.c_LH_hip[0]*Ia2 + w.c_LH_hip[1]*Ia5 + w.c_LH_hip[2]*Ia8 + w.c_LH_hip[3]*Ia10 + w.c_LH_hip[4]*Ia11 + w.c_LH_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_LH_hip[4] + 5.7617628499109426e-05*w.Dinv_LH_hip*w.u_LH_hip[0] + w.c_LH_hip[0]*t6 + w.c_LH_hip[1]*t8 + w.c_LH_hip[2]*t9 + w.c_LH_hip[3]*Ia11 + w.c_LH_hip[4]*Ia13 + w.c_LH_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_LH_hip[5] + w.u_LH_hip[0]*t4 + w.c_LH_hip[0]*Ia3 + w.c_LH_hip[1]*Ia6 + w.c_LH_hip[2]*Ia9 + w.c_LH_hip[3]*Ia12 + w.c_LH_hip[4]*Ia14 + w.c_LH_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_LH_hip[0][0]*Ia0 + w.RJ_LH_hip[0][1]*t5 + w.RJ_LH_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_LH_hip[0][0]*t5 + w.RJ_LH_hip[0][1]*Ia4 + w.RJ_LH_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_LH_hip[0][0]*Ia1 + w.RJ_LH_hip[0][1]*t7 + w.RJ_LH_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_LH_hip[1][0]*Ia0 + w.cq_LH_hip*t5 + w.RJ_LH_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_LH_hip[1][0]*t5 + w.cq_LH_hip*Ia4 + w.RJ_LH_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_LH_hip[1][0]*Ia1 + w.cq_LH_hip*t7 + w.RJ_LH_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_LH_hip[2][0]*Ia0 + w.RJ_LH_hip[2][1]*t5 + w.RJ_LH_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_LH_hip[2][0]*t5 + w.RJ_LH_hip[2][1]*Ia4 + w.RJ_LH_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_LH_hip[2][0]*Ia1 + w.RJ_LH_hip[2][1]*t7 + w.RJ_LH_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_LH_hip[0][0]*Ia2 + w.RJ_LH_hip[0][1]*Ia5 + w.RJ_LH_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_LH_hip[0][0]*t6 + w.RJ_LH_hip[0][1]*t8 + w.RJ_LH_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_LH_hip[0][0]*Ia3 + w.RJ_LH_hip[0][1]*Ia6 + w.RJ_LH_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_LH_hip[1][0]*Ia2 + w.cq_LH_hip*Ia5 + w.RJ_LH_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_LH_hip[1][0]*t6 + w.cq_LH_hip*t8 + w.RJ_LH_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_LH_hip[1][0]*Ia3 + w.cq_LH_hip*Ia6 + w.RJ_LH_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_LH_hip[2][0]*Ia2 + w.RJ_LH_hip[2][1]*Ia5 + w.RJ_LH_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_LH_hip[2][0]*t6 + w.RJ_LH_hip[2][1]*t8 + w.RJ_LH_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_LH_hip[2][0]*Ia3 + w.RJ_LH_hip[2][1]*Ia6 + w.RJ_LH_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_LH_hip[0][0]*Ia10 + w.RJ_LH_hip[0][1]*Ia11 + w.RJ_LH_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_LH_hip[0][0]*Ia11 + w.RJ_LH_hip[0][1]*Ia13 + w.RJ_LH_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_LH_hip[0][0]*Ia12 + w.RJ_LH_hip[0][1]*Ia14 + w.RJ_LH_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_LH_hip[1][0]*Ia10 + w.cq_LH_hip*Ia11 + w.RJ_LH_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_LH_hip[1][0]*Ia11 + w.cq_LH_hip*Ia13 + w.RJ_LH_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_LH_hip[1][0]*Ia12 + w.cq_LH_hip*Ia14 + w.RJ_LH_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_LH_hip[2][0]*Ia10 + w.RJ_LH_hip[2][1]*Ia11 + w.RJ_LH_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_LH_hip[2][0]*Ia11 + w.RJ_LH_hip[2][1]*Ia13 + w.RJ_LH_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_LH_hip[2][0]*Ia12 + w.RJ_LH_hip[2][1]*Ia14 + w.RJ_LH_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_LH_hip[0][0]*t10 + w.RJ_LH_hip[0][1]*t11 + w.RJ_LH_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_LH_hip[1][0]*t10 + w.cq_LH_hip*t11 + w.RJ_LH_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_LH_hip[2][0]*t10 + w.RJ_LH_hip[2][1]*t11 + w.RJ_LH_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_LH_hip[1][0]*t13 + w.cq_LH_hip*t14 + w.RJ_LH_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_LH_hip[2][0]*t13 + w.RJ_LH_hip[2][1]*t14 + w.RJ_LH_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_LH_hip[2][0]*t16 + w.RJ_LH_hip[2][1]*t17 + w.RJ_LH_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_LH_hip[0][0]*t19 + w.RJ_LH_hip[0][1]*t20 + w.RJ_LH_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_LH_hip[1][0]*t19 + w.cq_LH_hip*t20 + w.RJ_LH_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_LH_hip[2][0]*t19 + w.RJ_LH_hip[2][1]*t20 + w.RJ_LH_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_LH_hip[0][0]*t22 + w.RJ_LH_hip[0][1]*t23 + w.RJ_LH_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_LH_hip[1][0]*t22 + w.cq_LH_hip*t23 + w.RJ_LH_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_LH_hip[2][0]*t22 + w.RJ_LH_hip[2][1]*t23 + w.RJ_LH_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_LH_hip[0][0]*t25 + w.RJ_LH_hip[0][1]*t26 + w.RJ_LH_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_LH_hip[1][0]*t25 + w.cq_LH_hip*t26 + w.RJ_LH_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_LH_hip[2][0]*t25 + w.RJ_LH_hip[2][1]*t26 + w.RJ_LH_hip[2][2]*t27;
-    const Scalar t52 = 0.049*t39 + t43;
-    const Scalar t53 = 0.19*t39 + t44;
-    const Scalar t54 = -0.049*t37 - 0.19*t38 + t45;
-    const Scalar t55 = 0.049*t41 + t46;
-    const Scalar t56 = 0.19*t41 + t47;
-    const Scalar t57 = -0.049*t38 - 0.19*t40 + t48;
-    const Scalar t58 = 0.049*t42 + t49;
-    const Scalar t59 = 0.19*t42 + t50;
-    const Scalar t60 = -0.049*t39 - 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_LH_hip[0][0]*pa0 + w.RJ_LH_hip[0][1]*pa1 + w.RJ_LH_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_LH_hip[1][0]*pa0 + w.cq_LH_hip*pa1 + w.RJ_LH_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_LH_hip[2][0]*pa0 + w.RJ_LH_hip[2][1]*pa1 + w.RJ_LH_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_LH_hip[0][0]*t28 + w.RJ_LH_hip[0][1]*t29 + w.RJ_LH_hip[0][2]*t30 + 0.049*t49 + 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_LH_hip[1][0]*t28 + w.cq_LH_hip*t29 + w.RJ_LH_hip[1][2]*t30 + 0.19*t49 + 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_LH_hip[2][0]*t28 + w.RJ_LH_hip[2][1]*t29 + w.RJ_LH_hip[2][2]*t30 - 0.049*t43 - 0.19*t46 + 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_LH_hip[1][0]*t31 + w.cq_LH_hip*t32 + w.RJ_LH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_LH_hip[2][0]*t31 + w.RJ_LH_hip[2][1]*t32 + w.RJ_LH_hip[2][2]*t33 - 0.049*t44 - 0.19*t47 + 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_LH_hip[2][0]*t34 + w.RJ_LH_hip[2][1]*t35 + w.RJ_LH_hip[2][2]*t36 - 0.049*t45 - 0.19*t48 - 0.049*t54 - 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LH_hip[0][0]*pa3 + w.RJ_LH_hip[0][1]*pa4 + w.RJ_LH_hip[0][2]*pa5 + 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LH_hip[1][0]*pa3 + w.cq_LH_hip*pa4 + w.RJ_LH_hip[1][2]*pa5 + 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LH_hip[2][0]*pa3 + w.RJ_LH_hip[2][1]*pa4 + w.RJ_LH_hip[2][2]*pa5 - 0.049*t61 - 0.19*t62;
-  }
+  shared_8(shared_8_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar mu_c0 = mu*w.active[0];
-    const Scalar t0 = 0.195*w.k_lf_foot[1] + 0.004*w.k_lf_foot[2];
-    w.U_LF_shank[0] = -0.003904 - 0.195*mu_c0;
-    w.U_LF_shank[4] = 0.000486144 + 0.038025*mu_c0;
-    w.U_LF_shank[5] = 0.0007800000000000001*mu_c0;
-    w.Dinv_LF_shank = 1.0 / w.U_LF_shank[4];
-    w.u_LF_shank[0] = -w.pA_LF_shank[4] + 0.195*w.lambda[0] - 0.195*w.k_lf_foot[0]*mu_c0 + tau[8];
-    const Scalar t1 = w.U_LF_shank[0]*w.Dinv_LF_shank;
-    const Scalar t2 = w.U_LF_shank[5]*w.Dinv_LF_shank;
-    const Scalar Ia0 = 0.064 + mu_c0 - w.U_LF_shank[0]*t1;
-    const Scalar Ia1 = -0.004*mu_c0 - w.U_LF_shank[5]*t1;
-    const Scalar Ia2 = 0.064 + mu_c0;
-    const Scalar Ia3 = 0.003904 + 0.195*mu_c0;
-    const Scalar Ia4 = 0.000483144 + 0.038041000000000005*mu_c0;
-    const Scalar Ia5 = 6e-06 + 1.6e-05*mu_c0 - w.U_LF_shank[5]*t2;
-    const Scalar pa0 = w.pA_LF_shank[0] + w.lambda[0] - w.k_lf_foot[0]*mu_c0 + w.u_LF_shank[0]*t1 + w.c_LF_shank[0]*Ia0 + w.c_LF_shank[5]*Ia1;
-    const Scalar pa1 = w.pA_LF_shank[1] + w.lambda[1] - w.k_lf_foot[1]*mu_c0 + w.c_LF_shank[3]*Ia3;
-    const Scalar pa2 = w.pA_LF_shank[2] + w.lambda[2] - w.k_lf_foot[2]*mu_c0 + w.c_LF_shank[2]*Ia2 + 0.004*w.c_LF_shank[3]*mu_c0;
-    const Scalar pa3 = w.pA_LF_shank[3] + 0.195*w.lambda[1] + 0.004*w.lambda[2] - mu_c0*t0 + 0.004*w.c_LF_shank[2]*mu_c0 + w.c_LF_shank[3]*Ia4;
-    const Scalar pa4 = w.pA_LF_shank[5] - 0.004*w.lambda[0] + 0.004*w.k_lf_foot[0]*mu_c0 + w.u_LF_shank[0]*t2 + w.c_LF_shank[0]*Ia1 + w.c_LF_shank[5]*Ia5;
-    const Scalar C20 = w.cq_LF_shank*w.cq_LF_shank - w.sq_LF_shank*w.sq_LF_shank;
-    const Scalar h0 = 0.5*(-Ia0 + Ia2);
-    const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t3 = 2.0*w.cq_LF_shank*w.sq_LF_shank;
-    const Scalar t4 = 0.002*mu_c0 + 0.5*Ia1;
-    const Scalar h1 = 0.5*(-Ia4 + Ia5);
-    const Scalar m1 = 0.5*(Ia4 + Ia5);
-    const Scalar t5 = m0 - C20*h0;
-    const Scalar t6 = m0 + C20*h0;
-    const Scalar t7 = -0.002*mu_c0 + 0.5*Ia1 + C20*t4;
-    const Scalar t8 = 0.002*mu_c0 - 0.5*Ia1 + C20*t4;
-    const Scalar t9 = 0.209*Ia2 + w.cq_LF_shank*Ia3;
-    const Scalar t10 = w.cq_LF_shank*pa0 + w.sq_LF_shank*pa2;
-    const Scalar t11 = -w.sq_LF_shank*pa0 + w.cq_LF_shank*pa2;
-    w.IA_LF_thigh[0] = 0.6890000000000001 + t5;
-    w.IA_LF_thigh[2] = h0*t3;
-    w.IA_LF_thigh[3] = t3*t4;
-    w.IA_LF_thigh[4] = -0.01268 - 0.209*t5;
-    w.IA_LF_thigh[5] = 0.010144 + t7;
-    w.IA_LF_thigh[6] = 0.6890000000000001 + Ia2;
-    w.IA_LF_thigh[8] = 0.01268 + t9;
-    w.IA_LF_thigh[10] = -w.sq_LF_shank*Ia3;
-    w.IA_LF_thigh[11] = 0.6890000000000001 + t6;
-    w.IA_LF_thigh[12] = -0.010144 + t8;
-    w.IA_LF_thigh[13] = -0.209*h0*t3;
-    w.IA_LF_thigh[14] = -t3*t4;
-    w.IA_LF_thigh[15] = 0.002431904 + 0.209*w.cq_LF_shank*Ia3 + m1 - C20*h1 + 0.209*t9;
-    w.IA_LF_thigh[16] = -0.209*t3*t4;
-    w.IA_LF_thigh[17] = -0.209*w.sq_LF_shank*Ia3 + t3*h1;
-    w.IA_LF_thigh[18] = 0.0024196 + 0.043681*t5;
-    w.IA_LF_thigh[19] = -0.00020288 - 0.209*t7;
-    w.IA_LF_thigh[20] = 0.0006033039999999999 + m1 + C20*h1;
-    w.pA_LF_thigh[0] = w.pA_LF_thigh[0] + t10;
-    w.pA_LF_thigh[1] = w.pA_LF_thigh[1] + pa1;
-    w.pA_LF_thigh[2] = w.pA_LF_thigh[2] + t11;
-    w.pA_LF_thigh[3] = w.pA_LF_thigh[3] + 0.209*pa1 + w.cq_LF_shank*pa3 + w.sq_LF_shank*pa4;
-    w.pA_LF_thigh[4] = w.pA_LF_thigh[4] + tau[8] - 0.209*t10;
-    w.pA_LF_thigh[5] = w.pA_LF_thigh[5] - w.sq_LF_shank*pa3 + w.cq_LF_shank*pa4;
-  }
+  shared_6(shared_6_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.IA_LF_thigh, w.pA_LF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
-    w.u_LF_thigh[0] = -w.pA_LF_thigh[4] + tau[7];
-    const Scalar t0 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar t1 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar t2 = w.IA_LF_thigh[16]*w.Dinv_LF_thigh;
-    const Scalar t3 = w.IA_LF_thigh[19]*w.Dinv_LF_thigh;
-    const Scalar Ia0 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t0;
-    const Scalar Ia2 = w.IA_LF_thigh[3] - w.IA_LF_thigh[16]*t0;
-    const Scalar Ia3 = w.IA_LF_thigh[5] - w.IA_LF_thigh[19]*t0;
-    const Scalar Ia4 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t1;
-    const Scalar Ia5 = w.IA_LF_thigh[12] - w.IA_LF_thigh[16]*t1;
-    const Scalar Ia6 = w.IA_LF_thigh[14] - w.IA_LF_thigh[19]*t1;
-    const Scalar Ia7 = w.IA_LF_thigh[15] - w.IA_LF_thigh[16]*t2;
-    const Scalar Ia8 = w.IA_LF_thigh[17] - w.IA_LF_thigh[19]*t2;
-    const Scalar Ia9 = w.IA_LF_thigh[20] - w.IA_LF_thigh[19]*t3;
-    const Scalar pa0 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t0 + w.c_LF_thigh[0]*Ia0 + w.c_LF_thigh[2]*Ia1 + w.c_LF_thigh[3]*Ia2 + w.c_LF_thigh[5]*Ia3;
-    const Scalar pa1 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
-    const Scalar pa2 = w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t1 + w.c_LF_thigh[0]*Ia1 + w.c_LF_thigh[2]*Ia4 + w.c_LF_thigh[3]*Ia5 + w.c_LF_thigh[5]*Ia6;
-    const Scalar pa3 = w.pA_LF_thigh[3] + w.u_LF_thigh[0]*t2 + w.c_LF_thigh[0]*Ia2 + w.c_LF_thigh[2]*Ia5 + w.c_LF_thigh[3]*Ia7 + w.c_LF_thigh[5]*Ia8;
-    const Scalar pa4 = w.pA_LF_thigh[5] + w.u_LF_thigh[0]*t3 + w.c_LF_thigh[0]*Ia3 + w.c_LF_thigh[2]*Ia6 + w.c_LF_thigh[3]*Ia8 + w.c_LF_thigh[5]*Ia9;
-    const Scalar C20 = w.cq_LF_thigh*w.cq_LF_thigh - w.sq_LF_thigh*w.sq_LF_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar h1 = 0.5*(-Ia2 + Ia6);
-    const Scalar m1 = 0.5*(Ia2 + Ia6);
-    const Scalar t5 = 0.5*(Ia3 + Ia5);
-    const Scalar d1 = C20*h1 - t4*t5;
-    const Scalar qq1 = t4*h1 + C20*t5;
-    const Scalar h2 = 0.5*(-Ia7 + Ia9);
-    const Scalar m2 = 0.5*(Ia7 + Ia9);
-    const Scalar d2 = C20*h2 - Ia8*t4;
-    const Scalar qq2 = t4*h2 + Ia8*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = m1 - d1;
-    const Scalar t9 = 0.5*Ia3 - 0.5*Ia5 + qq1;
-    const Scalar t10 = w.sq_LF_thigh*w.IA_LF_thigh[10] + w.cq_LF_thigh*w.IA_LF_thigh[8];
-    const Scalar t11 = w.cq_LF_thigh*w.IA_LF_thigh[10] - w.sq_LF_thigh*w.IA_LF_thigh[8];
-    const Scalar t12 = -0.5*Ia3 + 0.5*Ia5 + qq1;
-    const Scalar t13 = m1 + d1;
-    const Scalar t14 = 0.062*qq0 + t8;
-    const Scalar t15 = -0.062*t6 + t9;
-    const Scalar t16 = 0.062*t7 + t12;
-    const Scalar t17 = -0.062*qq0 + t13;
-    const Scalar t18 = w.cq_LF_thigh*pa0 + w.sq_LF_thigh*pa2;
-    const Scalar t19 = -w.sq_LF_thigh*pa0 + w.cq_LF_thigh*pa2;
-    w.IA_LF_hip[0] = 0.5950000000000001 + t6;
-    w.IA_LF_hip[2] = qq0;
-    w.IA_LF_hip[3] = t14;
-    w.IA_LF_hip[5] = -0.02164 + t15;
-    w.IA_LF_hip[6] = 0.5950000000000001 + w.IA_LF_thigh[6];
-    w.IA_LF_hip[8] = t10;
-    w.IA_LF_hip[10] = t11;
-    w.IA_LF_hip[11] = 0.5950000000000001 + t7;
-    w.IA_LF_hip[12] = 0.02164 + t16;
-    w.IA_LF_hip[14] = t17;
-    w.IA_LF_hip[15] = 0.0012018399999999998 + m2 - d2 + 0.062*t12 + 0.062*t16;
-    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t8 + 0.062*t17;
-    w.IA_LF_hip[20] = 0.00126484 + m2 + d2 - 0.062*t9 - 0.062*t15;
-    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t18;
-    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa1;
-    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t19;
-    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa3 + w.sq_LF_thigh*pa4 + 0.062*t19;
-    w.pA_LF_hip[4] = w.pA_LF_hip[4] + tau[7];
-    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa4 - 0.062*t18;
-  }
+  shared_7(shared_7_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.IA_LF_hip, w.pA_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
-    w.U_LF_hip[1] = 0.9950371902099893*w.IA_LF_hip[8] + 0.09950371902099893*w.IA_LF_hip[10];
-    w.U_LF_hip[2] = 0.9950371902099893*w.IA_LF_hip[12] + 0.09950371902099893*w.IA_LF_hip[14];
-    w.U_LF_hip[3] = 0.9950371902099893*w.IA_LF_hip[15] + 0.09950371902099893*w.IA_LF_hip[17];
-    w.U_LF_hip[5] = 0.9950371902099893*w.IA_LF_hip[17] + 0.09950371902099893*w.IA_LF_hip[20];
-    const Scalar D0 = 0.9950371902099893*w.U_LF_hip[3] + 0.09950371902099893*w.U_LF_hip[5];
-    w.Dinv_LF_hip = 1.0 / D0;
-    w.u_LF_hip[0] = -0.9950371902099893*w.pA_LF_hip[3] - 0.09950371902099893*w.pA_LF_hip[5] + tau[6];
-    const Scalar t0 = w.U_LF_hip[0]*w.Dinv_LF_hip;
-    const Scalar t1 = w.U_LF_hip[1]*w.Dinv_LF_hip;
-    const Scalar t2 = w.U_LF_hip[2]*w.Dinv_LF_hip;
-    const Scalar t3 = w.U_LF_hip[3]*w.Dinv_LF_hip;
-    const Scalar t4 = w.U_LF_hip[5]*w.Dinv_LF_hip;
-    const Scalar Ia0 = w.IA_LF_hip[0] - w.U_LF_hip[0]*t0;
-    const Scalar Ia1 = w.IA_LF_hip[2] - w.U_LF_hip[2]*t0;
-    const Scalar Ia2 = w.IA_LF_hip[3] - w.U_LF_hip[3]*t0;
-    const Scalar Ia3 = w.IA_LF_hip[5] - w.U_LF_hip[5]*t0;
-    const Scalar Ia4 = w.IA_LF_hip[6] - w.U_LF_hip[1]*t1;
-    const Scalar Ia5 = w.IA_LF_hip[8] - w.U_LF_hip[3]*t1;
-    const Scalar Ia6 = w.IA_LF_hip[10] - w.U_LF_hip[5]*t1;
-    const Scalar Ia7 = w.IA_LF_hip[11] - w.U_LF_hip[2]*t2;
-    const Scalar Ia8 = w.IA_LF_hip[12] - w.U_LF_hip[3]*t2;
-    const Scalar Ia9 = w.IA_LF_hip[14] - w.U_LF_hip[5]*t2;
-    const Scalar Ia10 = w.IA_LF_hip[15] - w.U_LF_hip[3]*t3;
-    const Scalar Ia11 = 5.8e-05 - 5.780668556524933e-05*w.U_LF_hip[3]*w.Dinv_LF_hip;
-    const Scalar Ia12 = w.IA_LF_hip[17] - w.U_LF_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.341612896039605e-09*w.Dinv_LF_hip;
-    const Scalar Ia14 = 9.5e-07 - 5.780668556524933e-05*w.U_LF_hip[5]*w.Dinv_LF_hip;
-    const Scalar Ia15 = w.IA_LF_hip[20] - w.U_LF_hip[5]*t4;
-    const Scalar t5 = -w.U_LF_hip[1]*t0;
-    const Scalar t6 = -5.780668556524933e-05*w.U_LF_hip[0]*w.Dinv_LF_hip;
-    const Scalar t7 = -w.U_LF_hip[2]*t1;
-    const Scalar t8 = -5.780668556524933e-05*w.U_LF_hip[1]*w.Dinv_LF_hip;
-    const Scalar t9 = -5.780668556524933e-05*w.U_LF_hip[2]*w.Dinv_LF_hip;
-    const Scalar pa0 = w.pA_LF_hip[0] + w.u_LF_hip[0]*t0 + w.c_LF_hip[0]*Ia0 + w.c_LF_hip[1]*t5 + w.c_LF_hip[2]*Ia1 + w.c_LF_hip[3]*Ia2 + w.c_LF_hip[4]*t6 + w.c_LF_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_LF_hip[1] + w.u_LF_hip[0]*t1 + w.c_LF_hip[0]*t5 + w.c_LF_hip[1]*Ia4 + w.c_LF_hip[2]*t7 + w.c_LF_hip[3]*Ia5 + w.c_LF_hip[4]*t8 + w.c_LF_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_LF_hip[2] + w.u_LF_hip[0]*t2 + w.c_LF_hip[0]*Ia1 + w.c_LF_hip[1]*t7 + w.c_LF_hip[2]*Ia7 + w.c_LF_hip[3]*Ia8 + w.c_LF_hip[4]*t9 + w.c_LF_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_LF_hip[3] + w.u_LF_hip[0]*t3 + w.c_LF_hip[0]*Ia2 + w.c_LF_hip[1]*Ia5 + w.c_LF_hip[2]*Ia8 + w.c_LF_hip[3]*Ia10 + w.c_LF_hip[4]*Ia11 + w.c_LF_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_LF_hip[4] + 5.780668556524933e-05*w.Dinv_LF_hip*w.u_LF_hip[0] + w.c_LF_hip[0]*t6 + w.c_LF_hip[1]*t8 + w.c_LF_hip[2]*t9 + w.c_LF_hip[3]*Ia11 + w.c_LF_hip[4]*Ia13 + w.c_LF_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_LF_hip[5] + w.u_LF_hip[0]*t4 + w.c_LF_hip[0]*Ia3 + w.c_LF_hip[1]*Ia6 + w.c_LF_hip[2]*Ia9 + w.c_LF_hip[3]*Ia12 + w.c_LF_hip[4]*Ia14 + w.c_LF_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_LF_hip[0][0]*Ia0 + w.RJ_LF_hip[0][1]*t5 + w.RJ_LF_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_LF_hip[0][0]*t5 + w.RJ_LF_hip[0][1]*Ia4 + w.RJ_LF_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_LF_hip[0][0]*Ia1 + w.RJ_LF_hip[0][1]*t7 + w.RJ_LF_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_LF_hip[1][0]*Ia0 + w.cq_LF_hip*t5 + w.RJ_LF_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_LF_hip[1][0]*t5 + w.cq_LF_hip*Ia4 + w.RJ_LF_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_LF_hip[1][0]*Ia1 + w.cq_LF_hip*t7 + w.RJ_LF_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_LF_hip[2][0]*Ia0 + w.RJ_LF_hip[2][1]*t5 + w.RJ_LF_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_LF_hip[2][0]*t5 + w.RJ_LF_hip[2][1]*Ia4 + w.RJ_LF_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_LF_hip[2][0]*Ia1 + w.RJ_LF_hip[2][1]*t7 + w.RJ_LF_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_LF_hip[0][0]*Ia2 + w.RJ_LF_hip[0][1]*Ia5 + w.RJ_LF_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_LF_hip[0][0]*t6 + w.RJ_LF_hip[0][1]*t8 + w.RJ_LF_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_LF_hip[0][0]*Ia3 + w.RJ_LF_hip[0][1]*Ia6 + w.RJ_LF_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_LF_hip[1][0]*Ia2 + w.cq_LF_hip*Ia5 + w.RJ_LF_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_LF_hip[1][0]*t6 + w.cq_LF_hip*t8 + w.RJ_LF_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_LF_hip[1][0]*Ia3 + w.cq_LF_hip*Ia6 + w.RJ_LF_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_LF_hip[2][0]*Ia2 + w.RJ_LF_hip[2][1]*Ia5 + w.RJ_LF_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_LF_hip[2][0]*t6 + w.RJ_LF_hip[2][1]*t8 + w.RJ_LF_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_LF_hip[2][0]*Ia3 + w.RJ_LF_hip[2][1]*Ia6 + w.RJ_LF_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_LF_hip[0][0]*Ia10 + w.RJ_LF_hip[0][1]*Ia11 + w.RJ_LF_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_LF_hip[0][0]*Ia11 + w.RJ_LF_hip[0][1]*Ia13 + w.RJ_LF_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_LF_hip[0][0]*Ia12 + w.RJ_LF_hip[0][1]*Ia14 + w.RJ_LF_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_LF_hip[1][0]*Ia10 + w.cq_LF_hip*Ia11 + w.RJ_LF_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_LF_hip[1][0]*Ia11 + w.cq_LF_hip*Ia13 + w.RJ_LF_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_LF_hip[1][0]*Ia12 + w.cq_LF_hip*Ia14 + w.RJ_LF_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_LF_hip[2][0]*Ia10 + w.RJ_LF_hip[2][1]*Ia11 + w.RJ_LF_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_LF_hip[2][0]*Ia11 + w.RJ_LF_hip[2][1]*Ia13 + w.RJ_LF_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_LF_hip[2][0]*Ia12 + w.RJ_LF_hip[2][1]*Ia14 + w.RJ_LF_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_LF_hip[0][0]*t10 + w.RJ_LF_hip[0][1]*t11 + w.RJ_LF_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_LF_hip[1][0]*t10 + w.cq_LF_hip*t11 + w.RJ_LF_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_LF_hip[2][0]*t10 + w.RJ_LF_hip[2][1]*t11 + w.RJ_LF_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_LF_hip[1][0]*t13 + w.cq_LF_hip*t14 + w.RJ_LF_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_LF_hip[2][0]*t13 + w.RJ_LF_hip[2][1]*t14 + w.RJ_LF_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_LF_hip[2][0]*t16 + w.RJ_LF_hip[2][1]*t17 + w.RJ_LF_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_LF_hip[0][0]*t19 + w.RJ_LF_hip[0][1]*t20 + w.RJ_LF_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_LF_hip[1][0]*t19 + w.cq_LF_hip*t20 + w.RJ_LF_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_LF_hip[2][0]*t19 + w.RJ_LF_hip[2][1]*t20 + w.RJ_LF_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[0][1]*t23 + w.RJ_LF_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_LF_hip[1][0]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_LF_hip[2][0]*t22 + w.RJ_LF_hip[2][1]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_LF_hip[0][0]*t25 + w.RJ_LF_hip[0][1]*t26 + w.RJ_LF_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_LF_hip[1][0]*t25 + w.cq_LF_hip*t26 + w.RJ_LF_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_LF_hip[2][0]*t25 + w.RJ_LF_hip[2][1]*t26 + w.RJ_LF_hip[2][2]*t27;
-    const Scalar t52 = 0.049*t39 + t43;
-    const Scalar t53 = -0.19*t39 + t44;
-    const Scalar t54 = -0.049*t37 + 0.19*t38 + t45;
-    const Scalar t55 = 0.049*t41 + t46;
-    const Scalar t56 = -0.19*t41 + t47;
-    const Scalar t57 = -0.049*t38 + 0.19*t40 + t48;
-    const Scalar t58 = 0.049*t42 + t49;
-    const Scalar t59 = -0.19*t42 + t50;
-    const Scalar t60 = -0.049*t39 + 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_LF_hip[0][0]*pa0 + w.RJ_LF_hip[0][1]*pa1 + w.RJ_LF_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_LF_hip[1][0]*pa0 + w.cq_LF_hip*pa1 + w.RJ_LF_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_LF_hip[2][0]*pa0 + w.RJ_LF_hip[2][1]*pa1 + w.RJ_LF_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_LF_hip[0][0]*t28 + w.RJ_LF_hip[0][1]*t29 + w.RJ_LF_hip[0][2]*t30 + 0.049*t49 + 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_LF_hip[1][0]*t28 + w.cq_LF_hip*t29 + w.RJ_LF_hip[1][2]*t30 - 0.19*t49 + 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_LF_hip[2][0]*t28 + w.RJ_LF_hip[2][1]*t29 + w.RJ_LF_hip[2][2]*t30 - 0.049*t43 + 0.19*t46 + 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_LF_hip[1][0]*t31 + w.cq_LF_hip*t32 + w.RJ_LF_hip[1][2]*t33 - 0.19*t50 - 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_LF_hip[2][0]*t31 + w.RJ_LF_hip[2][1]*t32 + w.RJ_LF_hip[2][2]*t33 - 0.049*t44 + 0.19*t47 - 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_LF_hip[2][0]*t34 + w.RJ_LF_hip[2][1]*t35 + w.RJ_LF_hip[2][2]*t36 - 0.049*t45 + 0.19*t48 - 0.049*t54 + 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LF_hip[0][0]*pa3 + w.RJ_LF_hip[0][1]*pa4 + w.RJ_LF_hip[0][2]*pa5 + 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LF_hip[1][0]*pa3 + w.cq_LF_hip*pa4 + w.RJ_LF_hip[1][2]*pa5 - 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LF_hip[2][0]*pa3 + w.RJ_LF_hip[2][1]*pa4 + w.RJ_LF_hip[2][2]*pa5 - 0.049*t61 + 0.19*t62;
-  }
+  shared_8(shared_8_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1670,359 +1667,55 @@ PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  {
-    const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[0] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[2];
-    const Scalar t1 = w.Linv_trunk[0]*t0;
-    const Scalar t2 = w.u_trunk[1] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[6] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[7] - w.L_trunk[1]*t1;
-    const Scalar t3 = w.Linv_trunk[1]*t2;
-    const Scalar t4 = w.u_trunk[2] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[2] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[7] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[11] - w.L_trunk[2]*t1 - w.L_trunk[7]*t3;
-    const Scalar t5 = w.Linv_trunk[2]*t4;
-    const Scalar t6 = w.u_trunk[3] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[3] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[8] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[12] - w.L_trunk[3]*t1 - w.L_trunk[8]*t3 - w.L_trunk[12]*t5;
-    const Scalar t7 = w.Linv_trunk[3]*t6;
-    const Scalar t8 = w.u_trunk[4] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[4] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[9] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[13] - w.L_trunk[4]*t1 - w.L_trunk[9]*t3 - w.L_trunk[13]*t5 - w.L_trunk[16]*t7;
-    const Scalar t9 = w.Linv_trunk[4]*t8;
-    const Scalar t10 = w.u_trunk[5] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[5] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[10] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[14] - w.L_trunk[5]*t1 - w.L_trunk[10]*t3 - w.L_trunk[14]*t5 - w.L_trunk[17]*t7 - w.L_trunk[19]*t9;
-    const Scalar t11 = w.Linv_trunk[5]*t10;
-    const Scalar t12 = w.Linv_trunk[5]*t11;
-    const Scalar t13 = w.Linv_trunk[4]*t8 - w.L_trunk[19]*t12;
-    const Scalar t14 = w.Linv_trunk[4]*t13;
-    const Scalar t15 = w.Linv_trunk[3]*t6 - w.L_trunk[16]*t14 - w.L_trunk[17]*t12;
-    const Scalar t16 = w.Linv_trunk[3]*t15;
-    const Scalar t17 = w.Linv_trunk[2]*t4 - w.L_trunk[12]*t16 - w.L_trunk[13]*t14 - w.L_trunk[14]*t12;
-    const Scalar t18 = w.Linv_trunk[2]*t17;
-    const Scalar t19 = w.Linv_trunk[1]*t2 - w.L_trunk[7]*t18 - w.L_trunk[8]*t16 - w.L_trunk[9]*t14 - w.L_trunk[10]*t12;
-    const Scalar t20 = w.Linv_trunk[1]*t19;
-    const Scalar t21 = w.Linv_trunk[0]*t0 - w.L_trunk[1]*t20 - w.L_trunk[2]*t18 - w.L_trunk[3]*t16 - w.L_trunk[4]*t14 - w.L_trunk[5]*t12;
-    w.qdd[0] = w.Linv_trunk[0]*t21;
-    w.qdd[1] = w.Linv_trunk[1]*t19;
-    w.qdd[2] = w.Linv_trunk[2]*t17;
-    w.qdd[3] = w.Linv_trunk[3]*t15;
-    w.qdd[4] = w.Linv_trunk[4]*t13;
-    w.qdd[5] = w.Linv_trunk[5]*t11;
-    w.a_trunk[0] = 9.81*w.RJ_trunk[2][0] + w.qdd[0];
-    w.a_trunk[1] = 9.81*w.RJ_trunk[2][1] + w.qdd[1];
-    w.a_trunk[2] = 9.81*w.RJ_trunk[2][2] + w.qdd[2];
-    w.a_trunk[3] = w.qdd[3];
-    w.a_trunk[4] = w.qdd[4];
-    w.a_trunk[5] = w.qdd[5];
-  }
+  shared_9(shared_9_k0, w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[2][1]*t24;
-    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
-    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
-    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
-    w.qdd[6] = w.Dinv_LF_hip*t31;
-    w.a_LF_hip[0] = t25;
-    w.a_LF_hip[1] = t26;
-    w.a_LF_hip[2] = t27;
-    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = t29;
-    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
-  }
+  shared_10(shared_10_k0, w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
-    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
-    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
-    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
-    const Scalar t6 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.IA_LF_thigh[16]*t4 - w.a_LF_hip[4]*w.IA_LF_thigh[18] - w.IA_LF_thigh[19]*t5;
-    w.qdd[7] = w.Dinv_LF_thigh*t6;
-    w.a_LF_thigh[0] = t2;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = t3;
-    w.a_LF_thigh[3] = t4;
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = t5;
-  }
+  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t13 = w.u_LF_shank[0] - w.U_LF_shank[0]*t9 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t12;
-    w.qdd[8] = w.Dinv_LF_shank*t13;
-    w.a_LF_shank[0] = t9;
-    w.a_LF_shank[1] = t8;
-    w.a_LF_shank[2] = t10;
-    w.a_LF_shank[3] = t11;
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0][0]*t14 + w.RJ_LH_hip[1][0]*t15 + w.RJ_LH_hip[2][0]*t16;
-    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[0][1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[2][1]*t16;
-    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[0][2]*t14 + w.RJ_LH_hip[1][2]*t15 + w.RJ_LH_hip[2][2]*t16;
-    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0][0] + w.a_trunk[4]*w.RJ_LH_hip[1][0] + w.a_trunk[5]*w.RJ_LH_hip[2][0];
-    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[0][1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[2][1];
-    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[0][2] + w.a_trunk[4]*w.RJ_LH_hip[1][2] + w.a_trunk[5]*w.RJ_LH_hip[2][2];
-    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
-    w.qdd[9] = w.Dinv_LH_hip*t23;
-    w.a_LH_hip[0] = t17;
-    w.a_LH_hip[1] = t18;
-    w.a_LH_hip[2] = t19;
-    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = t21;
-    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
-  }
+  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
-    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
-    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
-    const Scalar t6 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.IA_LH_thigh[16]*t4 - w.a_LH_hip[4]*w.IA_LH_thigh[18] - w.IA_LH_thigh[19]*t5;
-    w.qdd[10] = w.Dinv_LH_thigh*t6;
-    w.a_LH_thigh[0] = t2;
-    w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = t3;
-    w.a_LH_thigh[3] = t4;
-    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = t5;
-  }
+  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t13 = w.u_LH_shank[0] - w.U_LH_shank[0]*t9 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t12;
-    w.qdd[11] = w.Dinv_LH_shank*t13;
-    w.a_LH_shank[0] = t9;
-    w.a_LH_shank[1] = t8;
-    w.a_LH_shank[2] = t10;
-    w.a_LH_shank[3] = t11;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0][0]*t14 + w.RJ_RF_hip[1][0]*t15 + w.RJ_RF_hip[2][0]*t16;
-    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[0][1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[2][1]*t16;
-    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[0][2]*t14 + w.RJ_RF_hip[1][2]*t15 + w.RJ_RF_hip[2][2]*t16;
-    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0][0] + w.a_trunk[4]*w.RJ_RF_hip[1][0] + w.a_trunk[5]*w.RJ_RF_hip[2][0];
-    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[0][1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[2][1];
-    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[0][2] + w.a_trunk[4]*w.RJ_RF_hip[1][2] + w.a_trunk[5]*w.RJ_RF_hip[2][2];
-    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
-    w.qdd[12] = w.Dinv_RF_hip*t23;
-    w.a_RF_hip[0] = t17;
-    w.a_RF_hip[1] = t18;
-    w.a_RF_hip[2] = t19;
-    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = t21;
-    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
-  }
+  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
-    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
-    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
-    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
-    const Scalar t6 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.IA_RF_thigh[16]*t4 - w.a_RF_hip[4]*w.IA_RF_thigh[18] - w.IA_RF_thigh[19]*t5;
-    w.qdd[13] = w.Dinv_RF_thigh*t6;
-    w.a_RF_thigh[0] = t2;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = t3;
-    w.a_RF_thigh[3] = t4;
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = t5;
-  }
+  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t13 = w.u_RF_shank[0] - w.U_RF_shank[0]*t9 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t12;
-    w.qdd[14] = w.Dinv_RF_shank*t13;
-    w.a_RF_shank[0] = t9;
-    w.a_RF_shank[1] = t8;
-    w.a_RF_shank[2] = t10;
-    w.a_RF_shank[3] = t11;
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[1][0]*t15 + w.RJ_RH_hip[2][0]*t16;
-    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[0][1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[2][1]*t16;
-    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[0][2]*t14 + w.RJ_RH_hip[1][2]*t15 + w.RJ_RH_hip[2][2]*t16;
-    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0][0] + w.a_trunk[4]*w.RJ_RH_hip[1][0] + w.a_trunk[5]*w.RJ_RH_hip[2][0];
-    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[0][1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[2][1];
-    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[0][2] + w.a_trunk[4]*w.RJ_RH_hip[1][2] + w.a_trunk[5]*w.RJ_RH_hip[2][2];
-    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
-    w.qdd[15] = w.Dinv_RH_hip*t23;
-    w.a_RH_hip[0] = t17;
-    w.a_RH_hip[1] = t18;
-    w.a_RH_hip[2] = t19;
-    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = t21;
-    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
-  }
+  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
-    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
-    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
-    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
-    const Scalar t6 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.IA_RH_thigh[16]*t4 - w.a_RH_hip[4]*w.IA_RH_thigh[18] - w.IA_RH_thigh[19]*t5;
-    w.qdd[16] = w.Dinv_RH_thigh*t6;
-    w.a_RH_thigh[0] = t2;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = t3;
-    w.a_RH_thigh[3] = t4;
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = t5;
-  }
+  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t13 = w.u_RH_shank[0] - w.U_RH_shank[0]*t9 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t12;
-    w.qdd[17] = w.Dinv_RH_shank*t13;
-    w.a_RH_shank[0] = t9;
-    w.a_RH_shank[1] = t8;
-    w.a_RH_shank[2] = t10;
-    w.a_RH_shank[3] = t11;
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  {
-    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.residual[0] = w.active[0]*t0;
-    w.dlambda[0] = mu*w.residual[0];
-    w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.residual[1] = w.active[0]*t1;
-    w.dlambda[1] = mu*w.residual[1];
-    w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.residual[2] = w.active[0]*t2;
-    w.dlambda[2] = mu*w.residual[2];
-    w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.residual[3] = w.active[1]*t3;
-    w.dlambda[3] = mu*w.residual[3];
-    w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.residual[4] = w.active[1]*t4;
-    w.dlambda[4] = mu*w.residual[4];
-    w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.residual[5] = w.active[1]*t5;
-    w.dlambda[5] = mu*w.residual[5];
-    w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.residual[6] = w.active[2]*t6;
-    w.dlambda[6] = mu*w.residual[6];
-    w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.residual[7] = w.active[2]*t7;
-    w.dlambda[7] = mu*w.residual[7];
-    w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.residual[8] = w.active[2]*t8;
-    w.dlambda[8] = mu*w.residual[8];
-    w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.residual[9] = w.active[3]*t9;
-    w.dlambda[9] = mu*w.residual[9];
-    w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.residual[10] = w.active[3]*t10;
-    w.dlambda[10] = mu*w.residual[10];
-    w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
-    w.residual[11] = w.active[3]*t11;
-    w.dlambda[11] = mu*w.residual[11];
-    w.lambda[11] = w.lambda[11] + w.dlambda[11];
-  }
+  shared_14(shared_14_k0, mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    w.u_RH_shank[0] = w.u_RH_shank[0] + 0.195*w.dlambda[9];
-    const Scalar t0 = 0.195*w.Dinv_RH_shank*w.dlambda[9];
-    const Scalar t1 = w.dlambda[9] + w.U_RH_shank[0]*t0;
-    const Scalar t2 = 0.195*w.dlambda[10] - 0.004*w.dlambda[11];
-    const Scalar t3 = 0.004*w.dlambda[9] + w.U_RH_shank[5]*t0;
-    const Scalar t4 = w.cq_RH_shank*t1 + w.sq_RH_shank*w.dlambda[11];
-    const Scalar t5 = -w.sq_RH_shank*t1 + w.cq_RH_shank*w.dlambda[11];
-    w.dp_RH_thigh[0] = t4;
-    w.dp_RH_thigh[1] = w.dlambda[10];
-    w.dp_RH_thigh[2] = t5;
-    w.dp_RH_thigh[3] = 0.209*w.dlambda[10] + w.cq_RH_shank*t2 + w.sq_RH_shank*t3;
-    w.dp_RH_thigh[4] = -0.209*t4;
-    w.dp_RH_thigh[5] = -w.sq_RH_shank*t2 + w.cq_RH_shank*t3;
-  }
+  shared_15(shared_15_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.dp_RH_thigh);
   // reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    w.u_RH_thigh[0] = w.u_RH_thigh[0] - w.dp_RH_thigh[4];
-    const Scalar t6 = -w.Dinv_RH_thigh*w.dp_RH_thigh[4];
-    const Scalar t7 = w.dp_RH_thigh[0] + w.IA_RH_thigh[4]*t6;
-    const Scalar t8 = w.dp_RH_thigh[2] + w.IA_RH_thigh[13]*t6;
-    const Scalar t9 = w.dp_RH_thigh[3] + w.IA_RH_thigh[16]*t6;
-    const Scalar t10 = w.dp_RH_thigh[5] + w.IA_RH_thigh[19]*t6;
-    const Scalar t11 = w.cq_RH_thigh*t7 + w.sq_RH_thigh*t8;
-    const Scalar t12 = -w.sq_RH_thigh*t7 + w.cq_RH_thigh*t8;
-    w.dp_RH_hip[0] = t11;
-    w.dp_RH_hip[1] = w.dp_RH_thigh[1];
-    w.dp_RH_hip[2] = t12;
-    w.dp_RH_hip[3] = w.cq_RH_thigh*t9 + w.sq_RH_thigh*t10 - 0.062*t12;
-    w.dp_RH_hip[5] = -w.sq_RH_thigh*t9 + w.cq_RH_thigh*t10 + 0.062*t11;
-  }
+  shared_16(shared_16_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], w.cq_RH_thigh, w.sq_RH_thigh, w.dp_RH_hip);
   // reduced sweep: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar du0 = -0.9950371902099892*w.dp_RH_hip[3] + 0.09950371902099892*w.dp_RH_hip[5];
@@ -2048,170 +1741,29 @@ PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_R
 
 PROXGEN_RT_NOINLINE void caba_reduced_RF_shank_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    w.u_RF_shank[0] = w.u_RF_shank[0] + 0.195*w.dlambda[3];
-    const Scalar t0 = 0.195*w.Dinv_RF_shank*w.dlambda[3];
-    const Scalar t1 = w.dlambda[3] + w.U_RF_shank[0]*t0;
-    const Scalar t2 = 0.195*w.dlambda[4] - 0.004*w.dlambda[5];
-    const Scalar t3 = 0.004*w.dlambda[3] + w.U_RF_shank[5]*t0;
-    const Scalar t4 = w.cq_RF_shank*t1 + w.sq_RF_shank*w.dlambda[5];
-    const Scalar t5 = -w.sq_RF_shank*t1 + w.cq_RF_shank*w.dlambda[5];
-    w.dp_RF_thigh[0] = t4;
-    w.dp_RF_thigh[1] = w.dlambda[4];
-    w.dp_RF_thigh[2] = t5;
-    w.dp_RF_thigh[3] = 0.209*w.dlambda[4] + w.cq_RF_shank*t2 + w.sq_RF_shank*t3;
-    w.dp_RF_thigh[4] = -0.209*t4;
-    w.dp_RF_thigh[5] = -w.sq_RF_shank*t2 + w.cq_RF_shank*t3;
-  }
+  shared_15(shared_15_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.dp_RF_thigh);
   // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    w.u_RF_thigh[0] = w.u_RF_thigh[0] - w.dp_RF_thigh[4];
-    const Scalar t6 = -w.Dinv_RF_thigh*w.dp_RF_thigh[4];
-    const Scalar t7 = w.dp_RF_thigh[0] + w.IA_RF_thigh[4]*t6;
-    const Scalar t8 = w.dp_RF_thigh[2] + w.IA_RF_thigh[13]*t6;
-    const Scalar t9 = w.dp_RF_thigh[3] + w.IA_RF_thigh[16]*t6;
-    const Scalar t10 = w.dp_RF_thigh[5] + w.IA_RF_thigh[19]*t6;
-    const Scalar t11 = w.cq_RF_thigh*t7 + w.sq_RF_thigh*t8;
-    const Scalar t12 = -w.sq_RF_thigh*t7 + w.cq_RF_thigh*t8;
-    w.dp_RF_hip[0] = t11;
-    w.dp_RF_hip[1] = w.dp_RF_thigh[1];
-    w.dp_RF_hip[2] = t12;
-    w.dp_RF_hip[3] = w.cq_RF_thigh*t9 + w.sq_RF_thigh*t10 - 0.062*t12;
-    w.dp_RF_hip[5] = -w.sq_RF_thigh*t9 + w.cq_RF_thigh*t10 + 0.062*t11;
-  }
+  shared_16(shared_16_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], w.cq_RF_thigh, w.sq_RF_thigh, w.dp_RF_hip);
   // reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar du0 = -0.9950371902099893*w.dp_RF_hip[3] - 0.09950371902099893*w.dp_RF_hip[5];
-    w.u_RF_hip[0] = w.u_RF_hip[0] + du0;
-    const Scalar t13 = w.Dinv_RF_hip*du0;
-    const Scalar t14 = w.dp_RF_hip[0] + w.U_RF_hip[0]*t13;
-    const Scalar t15 = w.dp_RF_hip[1] + w.U_RF_hip[1]*t13;
-    const Scalar t16 = w.dp_RF_hip[2] + w.U_RF_hip[2]*t13;
-    const Scalar t17 = w.dp_RF_hip[3] + w.U_RF_hip[3]*t13;
-    const Scalar t18 = w.dp_RF_hip[5] + w.U_RF_hip[5]*t13;
-    const Scalar t19 = -5.780668556524933e-05*w.Dinv_RF_hip*du0;
-    const Scalar t20 = w.RJ_RF_hip[0][0]*t14 + w.RJ_RF_hip[0][1]*t15 + w.RJ_RF_hip[0][2]*t16;
-    const Scalar t21 = w.RJ_RF_hip[1][0]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[1][2]*t16;
-    const Scalar t22 = w.RJ_RF_hip[2][0]*t14 + w.RJ_RF_hip[2][1]*t15 + w.RJ_RF_hip[2][2]*t16;
-    w.dp_trunk[0] = w.dp_trunk[0] + t20;
-    w.dp_trunk[1] = w.dp_trunk[1] + t21;
-    w.dp_trunk[2] = w.dp_trunk[2] + t22;
-    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_RF_hip[0][0]*t17 + w.RJ_RF_hip[0][1]*t19 + w.RJ_RF_hip[0][2]*t18 - 0.049*t22;
-    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_RF_hip[1][0]*t17 + w.cq_RF_hip*t19 + w.RJ_RF_hip[1][2]*t18 - 0.19*t22;
-    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_RF_hip[2][0]*t17 + w.RJ_RF_hip[2][1]*t19 + w.RJ_RF_hip[2][2]*t18 + 0.049*t20 + 0.19*t21;
-  }
+  shared_17(shared_17_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LH_shank_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    w.u_LH_shank[0] = w.u_LH_shank[0] + 0.195*w.dlambda[6];
-    const Scalar t0 = 0.195*w.Dinv_LH_shank*w.dlambda[6];
-    const Scalar t1 = w.dlambda[6] + w.U_LH_shank[0]*t0;
-    const Scalar t2 = 0.195*w.dlambda[7] + 0.004*w.dlambda[8];
-    const Scalar t3 = -0.004*w.dlambda[6] + w.U_LH_shank[5]*t0;
-    const Scalar t4 = w.cq_LH_shank*t1 + w.sq_LH_shank*w.dlambda[8];
-    const Scalar t5 = -w.sq_LH_shank*t1 + w.cq_LH_shank*w.dlambda[8];
-    w.dp_LH_thigh[0] = t4;
-    w.dp_LH_thigh[1] = w.dlambda[7];
-    w.dp_LH_thigh[2] = t5;
-    w.dp_LH_thigh[3] = 0.209*w.dlambda[7] + w.cq_LH_shank*t2 + w.sq_LH_shank*t3;
-    w.dp_LH_thigh[4] = -0.209*t4;
-    w.dp_LH_thigh[5] = -w.sq_LH_shank*t2 + w.cq_LH_shank*t3;
-  }
+  shared_15(shared_15_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.dp_LH_thigh);
   // reduced sweep: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    w.u_LH_thigh[0] = w.u_LH_thigh[0] - w.dp_LH_thigh[4];
-    const Scalar t6 = -w.Dinv_LH_thigh*w.dp_LH_thigh[4];
-    const Scalar t7 = w.dp_LH_thigh[0] + w.IA_LH_thigh[4]*t6;
-    const Scalar t8 = w.dp_LH_thigh[2] + w.IA_LH_thigh[13]*t6;
-    const Scalar t9 = w.dp_LH_thigh[3] + w.IA_LH_thigh[16]*t6;
-    const Scalar t10 = w.dp_LH_thigh[5] + w.IA_LH_thigh[19]*t6;
-    const Scalar t11 = w.cq_LH_thigh*t7 + w.sq_LH_thigh*t8;
-    const Scalar t12 = -w.sq_LH_thigh*t7 + w.cq_LH_thigh*t8;
-    w.dp_LH_hip[0] = t11;
-    w.dp_LH_hip[1] = w.dp_LH_thigh[1];
-    w.dp_LH_hip[2] = t12;
-    w.dp_LH_hip[3] = w.cq_LH_thigh*t9 + w.sq_LH_thigh*t10 + 0.062*t12;
-    w.dp_LH_hip[5] = -w.sq_LH_thigh*t9 + w.cq_LH_thigh*t10 - 0.062*t11;
-  }
+  shared_16(shared_16_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], w.cq_LH_thigh, w.sq_LH_thigh, w.dp_LH_hip);
   // reduced sweep: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar du0 = -0.9950371902099892*w.dp_LH_hip[3] + 0.09950371902099892*w.dp_LH_hip[5];
-    w.u_LH_hip[0] = w.u_LH_hip[0] + du0;
-    const Scalar t13 = w.Dinv_LH_hip*du0;
-    const Scalar t14 = w.dp_LH_hip[0] + w.U_LH_hip[0]*t13;
-    const Scalar t15 = w.dp_LH_hip[1] + w.U_LH_hip[1]*t13;
-    const Scalar t16 = w.dp_LH_hip[2] + w.U_LH_hip[2]*t13;
-    const Scalar t17 = w.dp_LH_hip[3] + w.U_LH_hip[3]*t13;
-    const Scalar t18 = w.dp_LH_hip[5] + w.U_LH_hip[5]*t13;
-    const Scalar t19 = 5.7617628499109426e-05*w.Dinv_LH_hip*du0;
-    const Scalar t20 = w.RJ_LH_hip[0][0]*t14 + w.RJ_LH_hip[0][1]*t15 + w.RJ_LH_hip[0][2]*t16;
-    const Scalar t21 = w.RJ_LH_hip[1][0]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[1][2]*t16;
-    const Scalar t22 = w.RJ_LH_hip[2][0]*t14 + w.RJ_LH_hip[2][1]*t15 + w.RJ_LH_hip[2][2]*t16;
-    w.dp_trunk[0] = w.dp_trunk[0] + t20;
-    w.dp_trunk[1] = w.dp_trunk[1] + t21;
-    w.dp_trunk[2] = w.dp_trunk[2] + t22;
-    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_LH_hip[0][0]*t17 + w.RJ_LH_hip[0][1]*t19 + w.RJ_LH_hip[0][2]*t18 + 0.049*t22;
-    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_LH_hip[1][0]*t17 + w.cq_LH_hip*t19 + w.RJ_LH_hip[1][2]*t18 + 0.19*t22;
-    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_LH_hip[2][0]*t17 + w.RJ_LH_hip[2][1]*t19 + w.RJ_LH_hip[2][2]*t18 - 0.049*t20 - 0.19*t21;
-  }
+  shared_17(shared_17_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LF_shank_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    w.u_LF_shank[0] = w.u_LF_shank[0] + 0.195*w.dlambda[0];
-    const Scalar t0 = 0.195*w.Dinv_LF_shank*w.dlambda[0];
-    const Scalar t1 = w.dlambda[0] + w.U_LF_shank[0]*t0;
-    const Scalar t2 = 0.195*w.dlambda[1] + 0.004*w.dlambda[2];
-    const Scalar t3 = -0.004*w.dlambda[0] + w.U_LF_shank[5]*t0;
-    const Scalar t4 = w.cq_LF_shank*t1 + w.sq_LF_shank*w.dlambda[2];
-    const Scalar t5 = -w.sq_LF_shank*t1 + w.cq_LF_shank*w.dlambda[2];
-    w.dp_LF_thigh[0] = t4;
-    w.dp_LF_thigh[1] = w.dlambda[1];
-    w.dp_LF_thigh[2] = t5;
-    w.dp_LF_thigh[3] = 0.209*w.dlambda[1] + w.cq_LF_shank*t2 + w.sq_LF_shank*t3;
-    w.dp_LF_thigh[4] = -0.209*t4;
-    w.dp_LF_thigh[5] = -w.sq_LF_shank*t2 + w.cq_LF_shank*t3;
-  }
+  shared_15(shared_15_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.dp_LF_thigh);
   // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    w.u_LF_thigh[0] = w.u_LF_thigh[0] - w.dp_LF_thigh[4];
-    const Scalar t6 = -w.Dinv_LF_thigh*w.dp_LF_thigh[4];
-    const Scalar t7 = w.dp_LF_thigh[0] + w.IA_LF_thigh[4]*t6;
-    const Scalar t8 = w.dp_LF_thigh[2] + w.IA_LF_thigh[13]*t6;
-    const Scalar t9 = w.dp_LF_thigh[3] + w.IA_LF_thigh[16]*t6;
-    const Scalar t10 = w.dp_LF_thigh[5] + w.IA_LF_thigh[19]*t6;
-    const Scalar t11 = w.cq_LF_thigh*t7 + w.sq_LF_thigh*t8;
-    const Scalar t12 = -w.sq_LF_thigh*t7 + w.cq_LF_thigh*t8;
-    w.dp_LF_hip[0] = t11;
-    w.dp_LF_hip[1] = w.dp_LF_thigh[1];
-    w.dp_LF_hip[2] = t12;
-    w.dp_LF_hip[3] = w.cq_LF_thigh*t9 + w.sq_LF_thigh*t10 + 0.062*t12;
-    w.dp_LF_hip[5] = -w.sq_LF_thigh*t9 + w.cq_LF_thigh*t10 - 0.062*t11;
-  }
+  shared_16(shared_16_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], w.cq_LF_thigh, w.sq_LF_thigh, w.dp_LF_hip);
   // reduced sweep: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar du0 = -0.9950371902099893*w.dp_LF_hip[3] - 0.09950371902099893*w.dp_LF_hip[5];
-    w.u_LF_hip[0] = w.u_LF_hip[0] + du0;
-    const Scalar t13 = w.Dinv_LF_hip*du0;
-    const Scalar t14 = w.dp_LF_hip[0] + w.U_LF_hip[0]*t13;
-    const Scalar t15 = w.dp_LF_hip[1] + w.U_LF_hip[1]*t13;
-    const Scalar t16 = w.dp_LF_hip[2] + w.U_LF_hip[2]*t13;
-    const Scalar t17 = w.dp_LF_hip[3] + w.U_LF_hip[3]*t13;
-    const Scalar t18 = w.dp_LF_hip[5] + w.U_LF_hip[5]*t13;
-    const Scalar t19 = 5.780668556524933e-05*w.Dinv_LF_hip*du0;
-    const Scalar t20 = w.RJ_LF_hip[0][0]*t14 + w.RJ_LF_hip[0][1]*t15 + w.RJ_LF_hip[0][2]*t16;
-    const Scalar t21 = w.RJ_LF_hip[1][0]*t14 + w.cq_LF_hip*t15 + w.RJ_LF_hip[1][2]*t16;
-    const Scalar t22 = w.RJ_LF_hip[2][0]*t14 + w.RJ_LF_hip[2][1]*t15 + w.RJ_LF_hip[2][2]*t16;
-    w.dp_trunk[0] = w.dp_trunk[0] + t20;
-    w.dp_trunk[1] = w.dp_trunk[1] + t21;
-    w.dp_trunk[2] = w.dp_trunk[2] + t22;
-    w.dp_trunk[3] = w.dp_trunk[3] + w.RJ_LF_hip[0][0]*t17 + w.RJ_LF_hip[0][1]*t19 + w.RJ_LF_hip[0][2]*t18 + 0.049*t22;
-    w.dp_trunk[4] = w.dp_trunk[4] + w.RJ_LF_hip[1][0]*t17 + w.cq_LF_hip*t19 + w.RJ_LF_hip[1][2]*t18 - 0.19*t22;
-    w.dp_trunk[5] = w.dp_trunk[5] + w.RJ_LF_hip[2][0]*t17 + w.RJ_LF_hip[2][1]*t19 + w.RJ_LF_hip[2][2]*t18 - 0.049*t20 + 0.19*t21;
-  }
+  shared_17(shared_17_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2228,460 +1780,58 @@ PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) no
 
 PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  {
-    const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[0] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[2];
-    const Scalar t1 = w.Linv_trunk[0]*t0;
-    const Scalar t2 = w.u_trunk[1] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[6] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[7] - w.L_trunk[1]*t1;
-    const Scalar t3 = w.Linv_trunk[1]*t2;
-    const Scalar t4 = w.u_trunk[2] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[2] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[7] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[11] - w.L_trunk[2]*t1 - w.L_trunk[7]*t3;
-    const Scalar t5 = w.Linv_trunk[2]*t4;
-    const Scalar t6 = w.u_trunk[3] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[3] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[8] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[12] - w.L_trunk[3]*t1 - w.L_trunk[8]*t3 - w.L_trunk[12]*t5;
-    const Scalar t7 = w.Linv_trunk[3]*t6;
-    const Scalar t8 = w.u_trunk[4] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[4] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[9] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[13] - w.L_trunk[4]*t1 - w.L_trunk[9]*t3 - w.L_trunk[13]*t5 - w.L_trunk[16]*t7;
-    const Scalar t9 = w.Linv_trunk[4]*t8;
-    const Scalar t10 = w.u_trunk[5] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[5] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[10] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[14] - w.L_trunk[5]*t1 - w.L_trunk[10]*t3 - w.L_trunk[14]*t5 - w.L_trunk[17]*t7 - w.L_trunk[19]*t9;
-    const Scalar t11 = w.Linv_trunk[5]*t10;
-    const Scalar t12 = w.Linv_trunk[5]*t11;
-    const Scalar t13 = w.Linv_trunk[4]*t8 - w.L_trunk[19]*t12;
-    const Scalar t14 = w.Linv_trunk[4]*t13;
-    const Scalar t15 = w.Linv_trunk[3]*t6 - w.L_trunk[16]*t14 - w.L_trunk[17]*t12;
-    const Scalar t16 = w.Linv_trunk[3]*t15;
-    const Scalar t17 = w.Linv_trunk[2]*t4 - w.L_trunk[12]*t16 - w.L_trunk[13]*t14 - w.L_trunk[14]*t12;
-    const Scalar t18 = w.Linv_trunk[2]*t17;
-    const Scalar t19 = w.Linv_trunk[1]*t2 - w.L_trunk[7]*t18 - w.L_trunk[8]*t16 - w.L_trunk[9]*t14 - w.L_trunk[10]*t12;
-    const Scalar t20 = w.Linv_trunk[1]*t19;
-    const Scalar t21 = w.Linv_trunk[0]*t0 - w.L_trunk[1]*t20 - w.L_trunk[2]*t18 - w.L_trunk[3]*t16 - w.L_trunk[4]*t14 - w.L_trunk[5]*t12;
-    w.qdd[0] = w.Linv_trunk[0]*t21;
-    w.qdd[1] = w.Linv_trunk[1]*t19;
-    w.qdd[2] = w.Linv_trunk[2]*t17;
-    w.qdd[3] = w.Linv_trunk[3]*t15;
-    w.qdd[4] = w.Linv_trunk[4]*t13;
-    w.qdd[5] = w.Linv_trunk[5]*t11;
-    w.a_trunk[0] = 9.81*w.RJ_trunk[2][0] + w.qdd[0];
-    w.a_trunk[1] = 9.81*w.RJ_trunk[2][1] + w.qdd[1];
-    w.a_trunk[2] = 9.81*w.RJ_trunk[2][2] + w.qdd[2];
-    w.a_trunk[3] = w.qdd[3];
-    w.a_trunk[4] = w.qdd[4];
-    w.a_trunk[5] = w.qdd[5];
-  }
+  shared_9(shared_9_k0, w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[2][1]*t24;
-    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
-    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
-    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
-    w.qdd[6] = w.Dinv_LF_hip*t31;
-    w.a_LF_hip[0] = t25;
-    w.a_LF_hip[1] = t26;
-    w.a_LF_hip[2] = t27;
-    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = t29;
-    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
-  }
+  shared_10(shared_10_k0, w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
-    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
-    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
-    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
-    const Scalar t6 = w.u_LF_thigh[0] - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.IA_LF_thigh[16]*t4 - w.a_LF_hip[4]*w.IA_LF_thigh[18] - w.IA_LF_thigh[19]*t5;
-    w.qdd[7] = w.Dinv_LF_thigh*t6;
-    w.a_LF_thigh[0] = t2;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = t3;
-    w.a_LF_thigh[3] = t4;
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = t5;
-  }
+  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t13 = w.u_LF_shank[0] - w.U_LF_shank[0]*t9 - w.U_LF_shank[4]*w.a_LF_thigh[4] - w.U_LF_shank[5]*t12;
-    w.qdd[8] = w.Dinv_LF_shank*t13;
-    w.a_LF_shank[0] = t9;
-    w.a_LF_shank[1] = t8;
-    w.a_LF_shank[2] = t10;
-    w.a_LF_shank[3] = t11;
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0][0]*t14 + w.RJ_LH_hip[1][0]*t15 + w.RJ_LH_hip[2][0]*t16;
-    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[0][1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[2][1]*t16;
-    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[0][2]*t14 + w.RJ_LH_hip[1][2]*t15 + w.RJ_LH_hip[2][2]*t16;
-    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0][0] + w.a_trunk[4]*w.RJ_LH_hip[1][0] + w.a_trunk[5]*w.RJ_LH_hip[2][0];
-    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[0][1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[2][1];
-    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[0][2] + w.a_trunk[4]*w.RJ_LH_hip[1][2] + w.a_trunk[5]*w.RJ_LH_hip[2][2];
-    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
-    w.qdd[9] = w.Dinv_LH_hip*t23;
-    w.a_LH_hip[0] = t17;
-    w.a_LH_hip[1] = t18;
-    w.a_LH_hip[2] = t19;
-    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = t21;
-    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
-  }
+  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
-    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
-    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
-    const Scalar t6 = w.u_LH_thigh[0] - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.IA_LH_thigh[16]*t4 - w.a_LH_hip[4]*w.IA_LH_thigh[18] - w.IA_LH_thigh[19]*t5;
-    w.qdd[10] = w.Dinv_LH_thigh*t6;
-    w.a_LH_thigh[0] = t2;
-    w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = t3;
-    w.a_LH_thigh[3] = t4;
-    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = t5;
-  }
+  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t13 = w.u_LH_shank[0] - w.U_LH_shank[0]*t9 - w.U_LH_shank[4]*w.a_LH_thigh[4] - w.U_LH_shank[5]*t12;
-    w.qdd[11] = w.Dinv_LH_shank*t13;
-    w.a_LH_shank[0] = t9;
-    w.a_LH_shank[1] = t8;
-    w.a_LH_shank[2] = t10;
-    w.a_LH_shank[3] = t11;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0][0]*t14 + w.RJ_RF_hip[1][0]*t15 + w.RJ_RF_hip[2][0]*t16;
-    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[0][1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[2][1]*t16;
-    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[0][2]*t14 + w.RJ_RF_hip[1][2]*t15 + w.RJ_RF_hip[2][2]*t16;
-    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0][0] + w.a_trunk[4]*w.RJ_RF_hip[1][0] + w.a_trunk[5]*w.RJ_RF_hip[2][0];
-    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[0][1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[2][1];
-    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[0][2] + w.a_trunk[4]*w.RJ_RF_hip[1][2] + w.a_trunk[5]*w.RJ_RF_hip[2][2];
-    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
-    w.qdd[12] = w.Dinv_RF_hip*t23;
-    w.a_RF_hip[0] = t17;
-    w.a_RF_hip[1] = t18;
-    w.a_RF_hip[2] = t19;
-    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = t21;
-    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
-  }
+  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
-    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
-    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
-    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
-    const Scalar t6 = w.u_RF_thigh[0] - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.IA_RF_thigh[16]*t4 - w.a_RF_hip[4]*w.IA_RF_thigh[18] - w.IA_RF_thigh[19]*t5;
-    w.qdd[13] = w.Dinv_RF_thigh*t6;
-    w.a_RF_thigh[0] = t2;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = t3;
-    w.a_RF_thigh[3] = t4;
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = t5;
-  }
+  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t13 = w.u_RF_shank[0] - w.U_RF_shank[0]*t9 - w.U_RF_shank[4]*w.a_RF_thigh[4] - w.U_RF_shank[5]*t12;
-    w.qdd[14] = w.Dinv_RF_shank*t13;
-    w.a_RF_shank[0] = t9;
-    w.a_RF_shank[1] = t8;
-    w.a_RF_shank[2] = t10;
-    w.a_RF_shank[3] = t11;
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[1][0]*t15 + w.RJ_RH_hip[2][0]*t16;
-    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[0][1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[2][1]*t16;
-    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[0][2]*t14 + w.RJ_RH_hip[1][2]*t15 + w.RJ_RH_hip[2][2]*t16;
-    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0][0] + w.a_trunk[4]*w.RJ_RH_hip[1][0] + w.a_trunk[5]*w.RJ_RH_hip[2][0];
-    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[0][1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[2][1];
-    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[0][2] + w.a_trunk[4]*w.RJ_RH_hip[1][2] + w.a_trunk[5]*w.RJ_RH_hip[2][2];
-    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
-    w.qdd[15] = w.Dinv_RH_hip*t23;
-    w.a_RH_hip[0] = t17;
-    w.a_RH_hip[1] = t18;
-    w.a_RH_hip[2] = t19;
-    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = t21;
-    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
-  }
+  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
-    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
-    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
-    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
-    const Scalar t6 = w.u_RH_thigh[0] - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.IA_RH_thigh[16]*t4 - w.a_RH_hip[4]*w.IA_RH_thigh[18] - w.IA_RH_thigh[19]*t5;
-    w.qdd[16] = w.Dinv_RH_thigh*t6;
-    w.a_RH_thigh[0] = t2;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = t3;
-    w.a_RH_thigh[3] = t4;
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = t5;
-  }
+  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t13 = w.u_RH_shank[0] - w.U_RH_shank[0]*t9 - w.U_RH_shank[4]*w.a_RH_thigh[4] - w.U_RH_shank[5]*t12;
-    w.qdd[17] = w.Dinv_RH_shank*t13;
-    w.a_RH_shank[0] = t9;
-    w.a_RH_shank[1] = t8;
-    w.a_RH_shank[2] = t10;
-    w.a_RH_shank[3] = t11;
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = t12;
-  }
+  shared_12(shared_12_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  {
-    const Scalar t0 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
-    w.residual[0] = w.active[0]*t0;
-    w.dlambda[0] = mu*w.residual[0];
-    w.lambda[0] = w.lambda[0] + w.dlambda[0];
-    const Scalar t1 = w.a_LF_shank[1] + 0.195*w.a_LF_shank[3] - w.k_lf_foot[1];
-    w.residual[1] = w.active[0]*t1;
-    w.dlambda[1] = mu*w.residual[1];
-    w.lambda[1] = w.lambda[1] + w.dlambda[1];
-    const Scalar t2 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
-    w.residual[2] = w.active[0]*t2;
-    w.dlambda[2] = mu*w.residual[2];
-    w.lambda[2] = w.lambda[2] + w.dlambda[2];
-    const Scalar t3 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
-    w.residual[3] = w.active[1]*t3;
-    w.dlambda[3] = mu*w.residual[3];
-    w.lambda[3] = w.lambda[3] + w.dlambda[3];
-    const Scalar t4 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
-    w.residual[4] = w.active[1]*t4;
-    w.dlambda[4] = mu*w.residual[4];
-    w.lambda[4] = w.lambda[4] + w.dlambda[4];
-    const Scalar t5 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
-    w.residual[5] = w.active[1]*t5;
-    w.dlambda[5] = mu*w.residual[5];
-    w.lambda[5] = w.lambda[5] + w.dlambda[5];
-    const Scalar t6 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
-    w.residual[6] = w.active[2]*t6;
-    w.dlambda[6] = mu*w.residual[6];
-    w.lambda[6] = w.lambda[6] + w.dlambda[6];
-    const Scalar t7 = w.a_LH_shank[1] + 0.195*w.a_LH_shank[3] - w.k_lh_foot[1];
-    w.residual[7] = w.active[2]*t7;
-    w.dlambda[7] = mu*w.residual[7];
-    w.lambda[7] = w.lambda[7] + w.dlambda[7];
-    const Scalar t8 = w.a_LH_shank[2] + 0.004*w.a_LH_shank[3] - w.k_lh_foot[2];
-    w.residual[8] = w.active[2]*t8;
-    w.dlambda[8] = mu*w.residual[8];
-    w.lambda[8] = w.lambda[8] + w.dlambda[8];
-    const Scalar t9 = w.a_RH_shank[0] - 0.195*w.a_RH_shank[4] + 0.004*w.a_RH_shank[5] - w.k_rh_foot[0];
-    w.residual[9] = w.active[3]*t9;
-    w.dlambda[9] = mu*w.residual[9];
-    w.lambda[9] = w.lambda[9] + w.dlambda[9];
-    const Scalar t10 = w.a_RH_shank[1] + 0.195*w.a_RH_shank[3] - w.k_rh_foot[1];
-    w.residual[10] = w.active[3]*t10;
-    w.dlambda[10] = mu*w.residual[10];
-    w.lambda[10] = w.lambda[10] + w.dlambda[10];
-    const Scalar t11 = w.a_RH_shank[2] - 0.004*w.a_RH_shank[3] - w.k_rh_foot[2];
-    w.residual[11] = w.active[3]*t11;
-    w.dlambda[11] = mu*w.residual[11];
-    w.lambda[11] = w.lambda[11] + w.dlambda[11];
-  }
+  shared_14(shared_14_k0, mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    w.u_RH_shank[0] = -w.pA_RH_shank[4] + tau[17];
-    const Scalar pa0 = 0.03264876250658241*w.c_RH_shank[0] + w.pA_RH_shank[0] - 8.030542390731965*w.u_RH_shank[0];
-    const Scalar pa1 = 0.003904*w.c_RH_shank[3] + w.pA_RH_shank[1];
-    const Scalar pa2 = 0.064*w.c_RH_shank[2] + w.pA_RH_shank[2];
-    const Scalar pa3 = 0.000483144*w.c_RH_shank[3] + w.pA_RH_shank[3];
-    const Scalar pa4 = 6e-06*w.c_RH_shank[5] + w.pA_RH_shank[5];
-    const Scalar C20 = w.cq_RH_shank*w.cq_RH_shank - w.sq_RH_shank*w.sq_RH_shank;
-    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
-    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
-    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_RH_shank;
-    const Scalar t3 = w.cq_RH_shank*pa0 + w.sq_RH_shank*pa2;
-    const Scalar t4 = -w.sq_RH_shank*pa0 + w.cq_RH_shank*pa2;
-    w.IA_RH_thigh[0] = 0.6890000000000001 + t0;
-    w.IA_RH_thigh[2] = 0.03135123749341759*w.cq_RH_shank*w.sq_RH_shank;
-    w.IA_RH_thigh[4] = -0.01268 - 0.209*t0;
-    w.IA_RH_thigh[8] = 0.01268 + t2;
-    w.IA_RH_thigh[10] = -0.003904*w.sq_RH_shank;
-    w.IA_RH_thigh[11] = 0.6890000000000001 + t1;
-    w.IA_RH_thigh[13] = -0.006552408636124276*w.cq_RH_shank*w.sq_RH_shank;
-    w.IA_RH_thigh[15] = 0.002676476 + 0.000815936*w.cq_RH_shank + 0.00023857200000000002*C20 + 0.209*t2;
-    w.IA_RH_thigh[17] = -0.000815936*w.sq_RH_shank - 0.00047714400000000004*w.cq_RH_shank*w.sq_RH_shank;
-    w.IA_RH_thigh[18] = 0.0024196 + 0.043681*t0;
-    w.IA_RH_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_RH_thigh[0] = w.pA_RH_thigh[0] + t3;
-    w.pA_RH_thigh[1] = w.pA_RH_thigh[1] + pa1;
-    w.pA_RH_thigh[2] = w.pA_RH_thigh[2] + t4;
-    w.pA_RH_thigh[3] = w.pA_RH_thigh[3] + 0.209*pa1 + w.cq_RH_shank*pa3 + w.sq_RH_shank*pa4;
-    w.pA_RH_thigh[4] = w.pA_RH_thigh[4] + tau[17] - 0.209*t3;
-    w.pA_RH_thigh[5] = w.pA_RH_thigh[5] - w.sq_RH_shank*pa3 + w.cq_RH_shank*pa4;
-    w.KA_RH_thigh[0][0] = -0.5659557661927332*w.cq_RH_shank;
-    w.KA_RH_thigh[2][0] = 0.5659557661927332*w.sq_RH_shank;
-    w.KA_RH_thigh[3][0] = 0.004*w.sq_RH_shank;
-    w.KA_RH_thigh[4][0] = 0.11828475513428124*w.cq_RH_shank;
-    w.KA_RH_thigh[5][0] = 0.004*w.cq_RH_shank;
-    w.KA_RH_thigh[3][1] = 0.209 + 0.195*w.cq_RH_shank;
-    w.KA_RH_thigh[5][1] = -0.195*w.sq_RH_shank;
-    w.KA_RH_thigh[0][2] = w.sq_RH_shank;
-    w.KA_RH_thigh[2][2] = w.cq_RH_shank;
-    w.KA_RH_thigh[3][2] = -0.004*w.cq_RH_shank;
-    w.KA_RH_thigh[4][2] = -0.209*w.sq_RH_shank;
-    w.KA_RH_thigh[5][2] = 0.004*w.sq_RH_shank;
-  }
+  shared_18(shared_18_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    w.Dinv_RH_thigh = 1.0 / w.IA_RH_thigh[18];
-    w.u_RH_thigh[0] = -w.pA_RH_thigh[4] + tau[16];
-    const Scalar t0 = w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar t1 = w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar Ia0 = w.IA_RH_thigh[0] - w.IA_RH_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_RH_thigh[2] - w.IA_RH_thigh[13]*t0;
-    const Scalar Ia2 = -0.010144 - 0.00020288*w.IA_RH_thigh[4]*w.Dinv_RH_thigh;
-    const Scalar Ia3 = w.IA_RH_thigh[11] - w.IA_RH_thigh[13]*t1;
-    const Scalar Ia4 = w.IA_RH_thigh[20] - 4.11602944e-08*w.Dinv_RH_thigh;
-    const Scalar t2 = -0.00020288*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar pa0 = w.pA_RH_thigh[0] + w.u_RH_thigh[0]*t0 + w.c_RH_thigh[0]*Ia0 + w.c_RH_thigh[2]*Ia1 + w.c_RH_thigh[5]*Ia2;
-    const Scalar pa1 = w.pA_RH_thigh[1] + w.c_RH_thigh[3]*w.IA_RH_thigh[8] + w.c_RH_thigh[5]*w.IA_RH_thigh[10];
-    const Scalar pa2 = 0.010144*w.c_RH_thigh[3] + w.pA_RH_thigh[2] + w.u_RH_thigh[0]*t1 + w.c_RH_thigh[0]*Ia1 + w.c_RH_thigh[2]*Ia3 + w.c_RH_thigh[5]*t2;
-    const Scalar pa3 = 0.010144*w.c_RH_thigh[2] + w.pA_RH_thigh[3] + w.c_RH_thigh[3]*w.IA_RH_thigh[15] + w.c_RH_thigh[5]*w.IA_RH_thigh[17];
-    const Scalar pa4 = w.pA_RH_thigh[5] + 0.00020288*w.Dinv_RH_thigh*w.u_RH_thigh[0] + w.c_RH_thigh[0]*Ia2 + w.c_RH_thigh[2]*t2 + w.c_RH_thigh[3]*w.IA_RH_thigh[17] + w.c_RH_thigh[5]*Ia4;
-    const Scalar C20 = w.cq_RH_thigh*w.cq_RH_thigh - w.sq_RH_thigh*w.sq_RH_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia3);
-    const Scalar m0 = 0.5*(Ia0 + Ia3);
-    const Scalar t3 = 2.0*w.cq_RH_thigh*w.sq_RH_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t3;
-    const Scalar qq0 = h0*t3 + Ia1*C20;
-    const Scalar t4 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh;
-    const Scalar t5 = 0.005072 + 0.5*Ia2;
-    const Scalar d1 = C20*t4 - t3*t5;
-    const Scalar qq1 = t3*t4 + C20*t5;
-    const Scalar h1 = 0.5*(-w.IA_RH_thigh[15] + Ia4);
-    const Scalar m1 = 0.5*(w.IA_RH_thigh[15] + Ia4);
-    const Scalar d2 = C20*h1 - w.IA_RH_thigh[17]*t3;
-    const Scalar qq2 = t3*h1 + w.IA_RH_thigh[17]*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh - d1;
-    const Scalar t9 = -0.005072 + 0.5*Ia2 + qq1;
-    const Scalar t10 = w.sq_RH_thigh*w.IA_RH_thigh[10] + w.cq_RH_thigh*w.IA_RH_thigh[8];
-    const Scalar t11 = w.cq_RH_thigh*w.IA_RH_thigh[10] - w.sq_RH_thigh*w.IA_RH_thigh[8];
-    const Scalar t12 = 0.005072 - 0.5*Ia2 + qq1;
-    const Scalar t13 = -0.00010144*w.IA_RH_thigh[13]*w.Dinv_RH_thigh + d1;
-    const Scalar t14 = -0.062*qq0 + t8;
-    const Scalar t15 = 0.062*t6 + t9;
-    const Scalar t16 = -0.062*t7 + t12;
-    const Scalar t17 = 0.062*qq0 + t13;
-    const Scalar t18 = w.cq_RH_thigh*pa0 + w.sq_RH_thigh*pa2;
-    const Scalar t19 = -w.sq_RH_thigh*pa0 + w.cq_RH_thigh*pa2;
-    w.IA_RH_hip[0] = 0.5950000000000001 + t6;
-    w.IA_RH_hip[2] = qq0;
-    w.IA_RH_hip[3] = t14;
-    w.IA_RH_hip[5] = 0.02164 + t15;
-    w.IA_RH_hip[8] = t10;
-    w.IA_RH_hip[10] = t11;
-    w.IA_RH_hip[11] = 0.5950000000000001 + t7;
-    w.IA_RH_hip[12] = -0.02164 + t16;
-    w.IA_RH_hip[14] = t17;
-    w.IA_RH_hip[15] = 0.0012018399999999998 + m1 - d2 - 0.062*t12 - 0.062*t16;
-    w.IA_RH_hip[17] = 4.5e-07 + qq2 + 0.062*t8 - 0.062*t17;
-    w.IA_RH_hip[20] = 0.00126484 + m1 + d2 + 0.062*t9 + 0.062*t15;
-    w.pA_RH_hip[0] = w.pA_RH_hip[0] + t18;
-    w.pA_RH_hip[1] = w.pA_RH_hip[1] + pa1;
-    w.pA_RH_hip[2] = w.pA_RH_hip[2] + t19;
-    w.pA_RH_hip[3] = w.pA_RH_hip[3] + w.cq_RH_thigh*pa3 + w.sq_RH_thigh*pa4 - 0.062*t19;
-    w.pA_RH_hip[4] = w.pA_RH_hip[4] + tau[16];
-    w.pA_RH_hip[5] = w.pA_RH_hip[5] - w.sq_RH_thigh*pa3 + w.cq_RH_thigh*pa4 + 0.062*t18;
-    w.KSD_RH_thigh[0] = w.KA_RH_thigh[4][0]*w.Dinv_RH_thigh;
-    const Scalar t20 = w.KA_RH_thigh[0][0] - w.IA_RH_thigh[4]*w.KSD_RH_thigh[0];
-    const Scalar t21 = w.KA_RH_thigh[2][0] - w.IA_RH_thigh[13]*w.KSD_RH_thigh[0];
-    const Scalar t22 = w.KA_RH_thigh[5][0] - 0.00020288*w.KSD_RH_thigh[0];
-    const Scalar t23 = w.cq_RH_thigh*t20 + w.sq_RH_thigh*t21;
-    const Scalar t24 = -w.sq_RH_thigh*t20 + w.cq_RH_thigh*t21;
-    w.KA_RH_hip[0][0] = t23;
-    w.KA_RH_hip[2][0] = t24;
-    w.KA_RH_hip[3][0] = w.cq_RH_thigh*w.KA_RH_thigh[3][0] + w.sq_RH_thigh*t22 - 0.062*t24;
-    w.KA_RH_hip[5][0] = -w.sq_RH_thigh*w.KA_RH_thigh[3][0] + w.cq_RH_thigh*t22 + 0.062*t23;
-    w.KA_RH_hip[3][1] = w.cq_RH_thigh*w.KA_RH_thigh[3][1] + w.sq_RH_thigh*w.KA_RH_thigh[5][1];
-    w.KA_RH_hip[5][1] = -w.sq_RH_thigh*w.KA_RH_thigh[3][1] + w.cq_RH_thigh*w.KA_RH_thigh[5][1];
-    w.KSD_RH_thigh[2] = w.KA_RH_thigh[4][2]*w.Dinv_RH_thigh;
-    const Scalar t25 = w.KA_RH_thigh[0][2] - w.IA_RH_thigh[4]*w.KSD_RH_thigh[2];
-    const Scalar t26 = w.KA_RH_thigh[2][2] - w.IA_RH_thigh[13]*w.KSD_RH_thigh[2];
-    const Scalar t27 = w.KA_RH_thigh[5][2] - 0.00020288*w.KSD_RH_thigh[2];
-    const Scalar t28 = w.cq_RH_thigh*t25 + w.sq_RH_thigh*t26;
-    const Scalar t29 = -w.sq_RH_thigh*t25 + w.cq_RH_thigh*t26;
-    w.KA_RH_hip[0][2] = t28;
-    w.KA_RH_hip[2][2] = t29;
-    w.KA_RH_hip[3][2] = w.cq_RH_thigh*w.KA_RH_thigh[3][2] + w.sq_RH_thigh*t27 - 0.062*t29;
-    w.KA_RH_hip[5][2] = -w.sq_RH_thigh*w.KA_RH_thigh[3][2] + w.cq_RH_thigh*t27 + 0.062*t28;
-  }
+  shared_19(shared_19_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2861,935 +2011,47 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    w.u_RF_shank[0] = -w.pA_RF_shank[4] + tau[14];
-    const Scalar pa0 = 0.03264876250658241*w.c_RF_shank[0] + w.pA_RF_shank[0] - 8.030542390731965*w.u_RF_shank[0];
-    const Scalar pa1 = 0.003904*w.c_RF_shank[3] + w.pA_RF_shank[1];
-    const Scalar pa2 = 0.064*w.c_RF_shank[2] + w.pA_RF_shank[2];
-    const Scalar pa3 = 0.000483144*w.c_RF_shank[3] + w.pA_RF_shank[3];
-    const Scalar pa4 = 6e-06*w.c_RF_shank[5] + w.pA_RF_shank[5];
-    const Scalar C20 = w.cq_RF_shank*w.cq_RF_shank - w.sq_RF_shank*w.sq_RF_shank;
-    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
-    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
-    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_RF_shank;
-    const Scalar t3 = w.cq_RF_shank*pa0 + w.sq_RF_shank*pa2;
-    const Scalar t4 = -w.sq_RF_shank*pa0 + w.cq_RF_shank*pa2;
-    w.IA_RF_thigh[0] = 0.6890000000000001 + t0;
-    w.IA_RF_thigh[2] = 0.03135123749341759*w.cq_RF_shank*w.sq_RF_shank;
-    w.IA_RF_thigh[4] = -0.01268 - 0.209*t0;
-    w.IA_RF_thigh[8] = 0.01268 + t2;
-    w.IA_RF_thigh[10] = -0.003904*w.sq_RF_shank;
-    w.IA_RF_thigh[11] = 0.6890000000000001 + t1;
-    w.IA_RF_thigh[13] = -0.006552408636124276*w.cq_RF_shank*w.sq_RF_shank;
-    w.IA_RF_thigh[15] = 0.002676476 + 0.000815936*w.cq_RF_shank + 0.00023857200000000002*C20 + 0.209*t2;
-    w.IA_RF_thigh[17] = -0.000815936*w.sq_RF_shank - 0.00047714400000000004*w.cq_RF_shank*w.sq_RF_shank;
-    w.IA_RF_thigh[18] = 0.0024196 + 0.043681*t0;
-    w.IA_RF_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_RF_thigh[0] = w.pA_RF_thigh[0] + t3;
-    w.pA_RF_thigh[1] = w.pA_RF_thigh[1] + pa1;
-    w.pA_RF_thigh[2] = w.pA_RF_thigh[2] + t4;
-    w.pA_RF_thigh[3] = w.pA_RF_thigh[3] + 0.209*pa1 + w.cq_RF_shank*pa3 + w.sq_RF_shank*pa4;
-    w.pA_RF_thigh[4] = w.pA_RF_thigh[4] + tau[14] - 0.209*t3;
-    w.pA_RF_thigh[5] = w.pA_RF_thigh[5] - w.sq_RF_shank*pa3 + w.cq_RF_shank*pa4;
-    w.KA_RF_thigh[0][0] = -0.5659557661927332*w.cq_RF_shank;
-    w.KA_RF_thigh[2][0] = 0.5659557661927332*w.sq_RF_shank;
-    w.KA_RF_thigh[3][0] = 0.004*w.sq_RF_shank;
-    w.KA_RF_thigh[4][0] = 0.11828475513428124*w.cq_RF_shank;
-    w.KA_RF_thigh[5][0] = 0.004*w.cq_RF_shank;
-    w.KA_RF_thigh[3][1] = 0.209 + 0.195*w.cq_RF_shank;
-    w.KA_RF_thigh[5][1] = -0.195*w.sq_RF_shank;
-    w.KA_RF_thigh[0][2] = w.sq_RF_shank;
-    w.KA_RF_thigh[2][2] = w.cq_RF_shank;
-    w.KA_RF_thigh[3][2] = -0.004*w.cq_RF_shank;
-    w.KA_RF_thigh[4][2] = -0.209*w.sq_RF_shank;
-    w.KA_RF_thigh[5][2] = 0.004*w.sq_RF_shank;
-  }
+  shared_18(shared_18_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    w.Dinv_RF_thigh = 1.0 / w.IA_RF_thigh[18];
-    w.u_RF_thigh[0] = -w.pA_RF_thigh[4] + tau[13];
-    const Scalar t0 = w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar t1 = w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar Ia0 = w.IA_RF_thigh[0] - w.IA_RF_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_RF_thigh[2] - w.IA_RF_thigh[13]*t0;
-    const Scalar Ia2 = -0.010144 - 0.00020288*w.IA_RF_thigh[4]*w.Dinv_RF_thigh;
-    const Scalar Ia3 = w.IA_RF_thigh[11] - w.IA_RF_thigh[13]*t1;
-    const Scalar Ia4 = w.IA_RF_thigh[20] - 4.11602944e-08*w.Dinv_RF_thigh;
-    const Scalar t2 = -0.00020288*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar pa0 = w.pA_RF_thigh[0] + w.u_RF_thigh[0]*t0 + w.c_RF_thigh[0]*Ia0 + w.c_RF_thigh[2]*Ia1 + w.c_RF_thigh[5]*Ia2;
-    const Scalar pa1 = w.pA_RF_thigh[1] + w.c_RF_thigh[3]*w.IA_RF_thigh[8] + w.c_RF_thigh[5]*w.IA_RF_thigh[10];
-    const Scalar pa2 = 0.010144*w.c_RF_thigh[3] + w.pA_RF_thigh[2] + w.u_RF_thigh[0]*t1 + w.c_RF_thigh[0]*Ia1 + w.c_RF_thigh[2]*Ia3 + w.c_RF_thigh[5]*t2;
-    const Scalar pa3 = 0.010144*w.c_RF_thigh[2] + w.pA_RF_thigh[3] + w.c_RF_thigh[3]*w.IA_RF_thigh[15] + w.c_RF_thigh[5]*w.IA_RF_thigh[17];
-    const Scalar pa4 = w.pA_RF_thigh[5] + 0.00020288*w.Dinv_RF_thigh*w.u_RF_thigh[0] + w.c_RF_thigh[0]*Ia2 + w.c_RF_thigh[2]*t2 + w.c_RF_thigh[3]*w.IA_RF_thigh[17] + w.c_RF_thigh[5]*Ia4;
-    const Scalar C20 = w.cq_RF_thigh*w.cq_RF_thigh - w.sq_RF_thigh*w.sq_RF_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia3);
-    const Scalar m0 = 0.5*(Ia0 + Ia3);
-    const Scalar t3 = 2.0*w.cq_RF_thigh*w.sq_RF_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t3;
-    const Scalar qq0 = h0*t3 + Ia1*C20;
-    const Scalar t4 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh;
-    const Scalar t5 = 0.005072 + 0.5*Ia2;
-    const Scalar d1 = C20*t4 - t3*t5;
-    const Scalar qq1 = t3*t4 + C20*t5;
-    const Scalar h1 = 0.5*(-w.IA_RF_thigh[15] + Ia4);
-    const Scalar m1 = 0.5*(w.IA_RF_thigh[15] + Ia4);
-    const Scalar d2 = C20*h1 - w.IA_RF_thigh[17]*t3;
-    const Scalar qq2 = t3*h1 + w.IA_RF_thigh[17]*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh - d1;
-    const Scalar t9 = -0.005072 + 0.5*Ia2 + qq1;
-    const Scalar t10 = w.sq_RF_thigh*w.IA_RF_thigh[10] + w.cq_RF_thigh*w.IA_RF_thigh[8];
-    const Scalar t11 = w.cq_RF_thigh*w.IA_RF_thigh[10] - w.sq_RF_thigh*w.IA_RF_thigh[8];
-    const Scalar t12 = 0.005072 - 0.5*Ia2 + qq1;
-    const Scalar t13 = -0.00010144*w.IA_RF_thigh[13]*w.Dinv_RF_thigh + d1;
-    const Scalar t14 = -0.062*qq0 + t8;
-    const Scalar t15 = 0.062*t6 + t9;
-    const Scalar t16 = -0.062*t7 + t12;
-    const Scalar t17 = 0.062*qq0 + t13;
-    const Scalar t18 = w.cq_RF_thigh*pa0 + w.sq_RF_thigh*pa2;
-    const Scalar t19 = -w.sq_RF_thigh*pa0 + w.cq_RF_thigh*pa2;
-    w.IA_RF_hip[0] = 0.5950000000000001 + t6;
-    w.IA_RF_hip[2] = qq0;
-    w.IA_RF_hip[3] = t14;
-    w.IA_RF_hip[5] = 0.02164 + t15;
-    w.IA_RF_hip[8] = t10;
-    w.IA_RF_hip[10] = t11;
-    w.IA_RF_hip[11] = 0.5950000000000001 + t7;
-    w.IA_RF_hip[12] = -0.02164 + t16;
-    w.IA_RF_hip[14] = t17;
-    w.IA_RF_hip[15] = 0.0012018399999999998 + m1 - d2 - 0.062*t12 - 0.062*t16;
-    w.IA_RF_hip[17] = 4.5e-07 + qq2 + 0.062*t8 - 0.062*t17;
-    w.IA_RF_hip[20] = 0.00126484 + m1 + d2 + 0.062*t9 + 0.062*t15;
-    w.pA_RF_hip[0] = w.pA_RF_hip[0] + t18;
-    w.pA_RF_hip[1] = w.pA_RF_hip[1] + pa1;
-    w.pA_RF_hip[2] = w.pA_RF_hip[2] + t19;
-    w.pA_RF_hip[3] = w.pA_RF_hip[3] + w.cq_RF_thigh*pa3 + w.sq_RF_thigh*pa4 - 0.062*t19;
-    w.pA_RF_hip[4] = w.pA_RF_hip[4] + tau[13];
-    w.pA_RF_hip[5] = w.pA_RF_hip[5] - w.sq_RF_thigh*pa3 + w.cq_RF_thigh*pa4 + 0.062*t18;
-    w.KSD_RF_thigh[0] = w.KA_RF_thigh[4][0]*w.Dinv_RF_thigh;
-    const Scalar t20 = w.KA_RF_thigh[0][0] - w.IA_RF_thigh[4]*w.KSD_RF_thigh[0];
-    const Scalar t21 = w.KA_RF_thigh[2][0] - w.IA_RF_thigh[13]*w.KSD_RF_thigh[0];
-    const Scalar t22 = w.KA_RF_thigh[5][0] - 0.00020288*w.KSD_RF_thigh[0];
-    const Scalar t23 = w.cq_RF_thigh*t20 + w.sq_RF_thigh*t21;
-    const Scalar t24 = -w.sq_RF_thigh*t20 + w.cq_RF_thigh*t21;
-    w.KA_RF_hip[0][0] = t23;
-    w.KA_RF_hip[2][0] = t24;
-    w.KA_RF_hip[3][0] = w.cq_RF_thigh*w.KA_RF_thigh[3][0] + w.sq_RF_thigh*t22 - 0.062*t24;
-    w.KA_RF_hip[5][0] = -w.sq_RF_thigh*w.KA_RF_thigh[3][0] + w.cq_RF_thigh*t22 + 0.062*t23;
-    w.KA_RF_hip[3][1] = w.cq_RF_thigh*w.KA_RF_thigh[3][1] + w.sq_RF_thigh*w.KA_RF_thigh[5][1];
-    w.KA_RF_hip[5][1] = -w.sq_RF_thigh*w.KA_RF_thigh[3][1] + w.cq_RF_thigh*w.KA_RF_thigh[5][1];
-    w.KSD_RF_thigh[2] = w.KA_RF_thigh[4][2]*w.Dinv_RF_thigh;
-    const Scalar t25 = w.KA_RF_thigh[0][2] - w.IA_RF_thigh[4]*w.KSD_RF_thigh[2];
-    const Scalar t26 = w.KA_RF_thigh[2][2] - w.IA_RF_thigh[13]*w.KSD_RF_thigh[2];
-    const Scalar t27 = w.KA_RF_thigh[5][2] - 0.00020288*w.KSD_RF_thigh[2];
-    const Scalar t28 = w.cq_RF_thigh*t25 + w.sq_RF_thigh*t26;
-    const Scalar t29 = -w.sq_RF_thigh*t25 + w.cq_RF_thigh*t26;
-    w.KA_RF_hip[0][2] = t28;
-    w.KA_RF_hip[2][2] = t29;
-    w.KA_RF_hip[3][2] = w.cq_RF_thigh*w.KA_RF_thigh[3][2] + w.sq_RF_thigh*t27 - 0.062*t29;
-    w.KA_RF_hip[5][2] = -w.sq_RF_thigh*w.KA_RF_thigh[3][2] + w.cq_RF_thigh*t27 + 0.062*t28;
-  }
+  shared_19(shared_19_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_RF_hip[0] = 0.9950371902099893*w.IA_RF_hip[3] + 0.09950371902099893*w.IA_RF_hip[5];
-    w.U_RF_hip[1] = 0.9950371902099893*w.IA_RF_hip[8] + 0.09950371902099893*w.IA_RF_hip[10];
-    w.U_RF_hip[2] = 0.9950371902099893*w.IA_RF_hip[12] + 0.09950371902099893*w.IA_RF_hip[14];
-    w.U_RF_hip[3] = 0.9950371902099893*w.IA_RF_hip[15] + 0.09950371902099893*w.IA_RF_hip[17];
-    w.U_RF_hip[5] = 0.9950371902099893*w.IA_RF_hip[17] + 0.09950371902099893*w.IA_RF_hip[20];
-    const Scalar D0 = 0.9950371902099893*w.U_RF_hip[3] + 0.09950371902099893*w.U_RF_hip[5];
-    w.Dinv_RF_hip = 1.0 / D0;
-    w.u_RF_hip[0] = -0.9950371902099893*w.pA_RF_hip[3] - 0.09950371902099893*w.pA_RF_hip[5] + tau[12];
-    const Scalar t0 = w.U_RF_hip[0]*w.Dinv_RF_hip;
-    const Scalar t1 = w.U_RF_hip[1]*w.Dinv_RF_hip;
-    const Scalar t2 = w.U_RF_hip[2]*w.Dinv_RF_hip;
-    const Scalar t3 = w.U_RF_hip[3]*w.Dinv_RF_hip;
-    const Scalar t4 = w.U_RF_hip[5]*w.Dinv_RF_hip;
-    const Scalar Ia0 = w.IA_RF_hip[0] - w.U_RF_hip[0]*t0;
-    const Scalar Ia1 = w.IA_RF_hip[2] - w.U_RF_hip[2]*t0;
-    const Scalar Ia2 = w.IA_RF_hip[3] - w.U_RF_hip[3]*t0;
-    const Scalar Ia3 = w.IA_RF_hip[5] - w.U_RF_hip[5]*t0;
-    const Scalar Ia4 = 1.3480000000000003 - w.U_RF_hip[1]*t1;
-    const Scalar Ia5 = w.IA_RF_hip[8] - w.U_RF_hip[3]*t1;
-    const Scalar Ia6 = w.IA_RF_hip[10] - w.U_RF_hip[5]*t1;
-    const Scalar Ia7 = w.IA_RF_hip[11] - w.U_RF_hip[2]*t2;
-    const Scalar Ia8 = w.IA_RF_hip[12] - w.U_RF_hip[3]*t2;
-    const Scalar Ia9 = w.IA_RF_hip[14] - w.U_RF_hip[5]*t2;
-    const Scalar Ia10 = w.IA_RF_hip[15] - w.U_RF_hip[3]*t3;
-    const Scalar Ia11 = -5.8e-05 + 5.780668556524933e-05*w.U_RF_hip[3]*w.Dinv_RF_hip;
-    const Scalar Ia12 = w.IA_RF_hip[17] - w.U_RF_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.341612896039605e-09*w.Dinv_RF_hip;
-    const Scalar Ia14 = -9.5e-07 + 5.780668556524933e-05*w.U_RF_hip[5]*w.Dinv_RF_hip;
-    const Scalar Ia15 = w.IA_RF_hip[20] - w.U_RF_hip[5]*t4;
-    const Scalar t5 = -w.U_RF_hip[1]*t0;
-    const Scalar t6 = 5.780668556524933e-05*w.U_RF_hip[0]*w.Dinv_RF_hip;
-    const Scalar t7 = -w.U_RF_hip[2]*t1;
-    const Scalar t8 = 5.780668556524933e-05*w.U_RF_hip[1]*w.Dinv_RF_hip;
-    const Scalar t9 = 5.780668556524933e-05*w.U_RF_hip[2]*w.Dinv_RF_hip;
-    const Scalar pa0 = w.pA_RF_hip[0] + w.u_RF_hip[0]*t0 + w.c_RF_hip[0]*Ia0 + w.c_RF_hip[1]*t5 + w.c_RF_hip[2]*Ia1 + w.c_RF_hip[3]*Ia2 + w.c_RF_hip[4]*t6 + w.c_RF_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_RF_hip[1] + w.u_RF_hip[0]*t1 + w.c_RF_hip[0]*t5 + w.c_RF_hip[1]*Ia4 + w.c_RF_hip[2]*t7 + w.c_RF_hip[3]*Ia5 + w.c_RF_hip[4]*t8 + w.c_RF_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_RF_hip[2] + w.u_RF_hip[0]*t2 + w.c_RF_hip[0]*Ia1 + w.c_RF_hip[1]*t7 + w.c_RF_hip[2]*Ia7 + w.c_RF_hip[3]*Ia8 + w.c_RF_hip[4]*t9 + w.c_RF_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_RF_hip[3] + w.u_RF_hip[0]*t3 + w.c_RF_hip[0]*Ia2 + w.c_RF_hip[1]*Ia5 + w.c_RF_hip[2]*Ia8 + w.c_RF_hip[3]*Ia10 + w.c_RF_hip[4]*Ia11 + w.c_RF_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_RF_hip[4] - 5.780668556524933e-05*w.Dinv_RF_hip*w.u_RF_hip[0] + w.c_RF_hip[0]*t6 + w.c_RF_hip[1]*t8 + w.c_RF_hip[2]*t9 + w.c_RF_hip[3]*Ia11 + w.c_RF_hip[4]*Ia13 + w.c_RF_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_RF_hip[5] + w.u_RF_hip[0]*t4 + w.c_RF_hip[0]*Ia3 + w.c_RF_hip[1]*Ia6 + w.c_RF_hip[2]*Ia9 + w.c_RF_hip[3]*Ia12 + w.c_RF_hip[4]*Ia14 + w.c_RF_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_RF_hip[0][0]*Ia0 + w.RJ_RF_hip[0][1]*t5 + w.RJ_RF_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_RF_hip[0][0]*t5 + w.RJ_RF_hip[0][1]*Ia4 + w.RJ_RF_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_RF_hip[0][0]*Ia1 + w.RJ_RF_hip[0][1]*t7 + w.RJ_RF_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_RF_hip[1][0]*Ia0 + w.cq_RF_hip*t5 + w.RJ_RF_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_RF_hip[1][0]*t5 + w.cq_RF_hip*Ia4 + w.RJ_RF_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_RF_hip[1][0]*Ia1 + w.cq_RF_hip*t7 + w.RJ_RF_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_RF_hip[2][0]*Ia0 + w.RJ_RF_hip[2][1]*t5 + w.RJ_RF_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_RF_hip[2][0]*t5 + w.RJ_RF_hip[2][1]*Ia4 + w.RJ_RF_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_RF_hip[2][0]*Ia1 + w.RJ_RF_hip[2][1]*t7 + w.RJ_RF_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_RF_hip[0][0]*Ia2 + w.RJ_RF_hip[0][1]*Ia5 + w.RJ_RF_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_RF_hip[0][0]*t6 + w.RJ_RF_hip[0][1]*t8 + w.RJ_RF_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_RF_hip[0][0]*Ia3 + w.RJ_RF_hip[0][1]*Ia6 + w.RJ_RF_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_RF_hip[1][0]*Ia2 + w.cq_RF_hip*Ia5 + w.RJ_RF_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_RF_hip[1][0]*t6 + w.cq_RF_hip*t8 + w.RJ_RF_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_RF_hip[1][0]*Ia3 + w.cq_RF_hip*Ia6 + w.RJ_RF_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_RF_hip[2][0]*Ia2 + w.RJ_RF_hip[2][1]*Ia5 + w.RJ_RF_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_RF_hip[2][0]*t6 + w.RJ_RF_hip[2][1]*t8 + w.RJ_RF_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_RF_hip[2][0]*Ia3 + w.RJ_RF_hip[2][1]*Ia6 + w.RJ_RF_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_RF_hip[0][0]*Ia10 + w.RJ_RF_hip[0][1]*Ia11 + w.RJ_RF_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_RF_hip[0][0]*Ia11 + w.RJ_RF_hip[0][1]*Ia13 + w.RJ_RF_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_RF_hip[0][0]*Ia12 + w.RJ_RF_hip[0][1]*Ia14 + w.RJ_RF_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_RF_hip[1][0]*Ia10 + w.cq_RF_hip*Ia11 + w.RJ_RF_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_RF_hip[1][0]*Ia11 + w.cq_RF_hip*Ia13 + w.RJ_RF_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_RF_hip[1][0]*Ia12 + w.cq_RF_hip*Ia14 + w.RJ_RF_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_RF_hip[2][0]*Ia10 + w.RJ_RF_hip[2][1]*Ia11 + w.RJ_RF_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_RF_hip[2][0]*Ia11 + w.RJ_RF_hip[2][1]*Ia13 + w.RJ_RF_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_RF_hip[2][0]*Ia12 + w.RJ_RF_hip[2][1]*Ia14 + w.RJ_RF_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_RF_hip[0][0]*t10 + w.RJ_RF_hip[0][1]*t11 + w.RJ_RF_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_RF_hip[1][0]*t10 + w.cq_RF_hip*t11 + w.RJ_RF_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_RF_hip[2][0]*t10 + w.RJ_RF_hip[2][1]*t11 + w.RJ_RF_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_RF_hip[1][0]*t13 + w.cq_RF_hip*t14 + w.RJ_RF_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_RF_hip[2][0]*t13 + w.RJ_RF_hip[2][1]*t14 + w.RJ_RF_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_RF_hip[2][0]*t16 + w.RJ_RF_hip[2][1]*t17 + w.RJ_RF_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_RF_hip[0][0]*t19 + w.RJ_RF_hip[0][1]*t20 + w.RJ_RF_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_RF_hip[1][0]*t19 + w.cq_RF_hip*t20 + w.RJ_RF_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_RF_hip[2][0]*t19 + w.RJ_RF_hip[2][1]*t20 + w.RJ_RF_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_RF_hip[0][0]*t22 + w.RJ_RF_hip[0][1]*t23 + w.RJ_RF_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_RF_hip[1][0]*t22 + w.cq_RF_hip*t23 + w.RJ_RF_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_RF_hip[2][0]*t22 + w.RJ_RF_hip[2][1]*t23 + w.RJ_RF_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_RF_hip[0][0]*t25 + w.RJ_RF_hip[0][1]*t26 + w.RJ_RF_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_RF_hip[1][0]*t25 + w.cq_RF_hip*t26 + w.RJ_RF_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_RF_hip[2][0]*t25 + w.RJ_RF_hip[2][1]*t26 + w.RJ_RF_hip[2][2]*t27;
-    const Scalar t52 = -0.049*t39 + t43;
-    const Scalar t53 = -0.19*t39 + t44;
-    const Scalar t54 = 0.049*t37 + 0.19*t38 + t45;
-    const Scalar t55 = -0.049*t41 + t46;
-    const Scalar t56 = -0.19*t41 + t47;
-    const Scalar t57 = 0.049*t38 + 0.19*t40 + t48;
-    const Scalar t58 = -0.049*t42 + t49;
-    const Scalar t59 = -0.19*t42 + t50;
-    const Scalar t60 = 0.049*t39 + 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_RF_hip[0][0]*pa0 + w.RJ_RF_hip[0][1]*pa1 + w.RJ_RF_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_RF_hip[1][0]*pa0 + w.cq_RF_hip*pa1 + w.RJ_RF_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_RF_hip[2][0]*pa0 + w.RJ_RF_hip[2][1]*pa1 + w.RJ_RF_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_RF_hip[0][0]*t28 + w.RJ_RF_hip[0][1]*t29 + w.RJ_RF_hip[0][2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_RF_hip[1][0]*t28 + w.cq_RF_hip*t29 + w.RJ_RF_hip[1][2]*t30 - 0.19*t49 - 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_RF_hip[2][0]*t28 + w.RJ_RF_hip[2][1]*t29 + w.RJ_RF_hip[2][2]*t30 + 0.049*t43 + 0.19*t46 - 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_RF_hip[1][0]*t31 + w.cq_RF_hip*t32 + w.RJ_RF_hip[1][2]*t33 - 0.19*t50 - 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_RF_hip[2][0]*t31 + w.RJ_RF_hip[2][1]*t32 + w.RJ_RF_hip[2][2]*t33 + 0.049*t44 + 0.19*t47 - 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_RF_hip[2][0]*t34 + w.RJ_RF_hip[2][1]*t35 + w.RJ_RF_hip[2][2]*t36 + 0.049*t45 + 0.19*t48 + 0.049*t54 + 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RF_hip[0][0]*pa3 + w.RJ_RF_hip[0][1]*pa4 + w.RJ_RF_hip[0][2]*pa5 - 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RF_hip[1][0]*pa3 + w.cq_RF_hip*pa4 + w.RJ_RF_hip[1][2]*pa5 - 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RF_hip[2][0]*pa3 + w.RJ_RF_hip[2][1]*pa4 + w.RJ_RF_hip[2][2]*pa5 + 0.049*t61 + 0.19*t62;
-    w.KS_RF_hip[0] = 0.9950371902099893*w.KA_RF_hip[3][0] + 0.09950371902099893*w.KA_RF_hip[5][0];
-    w.KSD_RF_hip[0] = w.Dinv_RF_hip*w.KS_RF_hip[0];
-    const Scalar t64 = w.KA_RF_hip[0][0] - w.U_RF_hip[0]*w.KSD_RF_hip[0];
-    const Scalar t65 = w.KA_RF_hip[2][0] - w.U_RF_hip[2]*w.KSD_RF_hip[0];
-    const Scalar t66 = -w.U_RF_hip[1]*w.KSD_RF_hip[0];
-    const Scalar t67 = w.KA_RF_hip[3][0] - w.U_RF_hip[3]*w.KSD_RF_hip[0];
-    const Scalar t68 = w.KA_RF_hip[5][0] - w.U_RF_hip[5]*w.KSD_RF_hip[0];
-    const Scalar t69 = w.RJ_RF_hip[0][0]*t64 + w.RJ_RF_hip[0][1]*t66 + w.RJ_RF_hip[0][2]*t65;
-    const Scalar t70 = w.RJ_RF_hip[1][0]*t64 + w.cq_RF_hip*t66 + w.RJ_RF_hip[1][2]*t65;
-    const Scalar t71 = w.RJ_RF_hip[2][0]*t64 + w.RJ_RF_hip[2][1]*t66 + w.RJ_RF_hip[2][2]*t65;
-    w.KA_trunk[0][6] = t69;
-    w.KA_trunk[1][6] = t70;
-    w.KA_trunk[2][6] = t71;
-    w.KA_trunk[3][6] = w.RJ_RF_hip[0][0]*t67 + 5.780668556524933e-05*w.RJ_RF_hip[0][1]*w.KSD_RF_hip[0] + w.RJ_RF_hip[0][2]*t68 - 0.049*t71;
-    w.KA_trunk[4][6] = w.RJ_RF_hip[1][0]*t67 + 5.780668556524933e-05*w.cq_RF_hip*w.KSD_RF_hip[0] + w.RJ_RF_hip[1][2]*t68 - 0.19*t71;
-    w.KA_trunk[5][6] = w.RJ_RF_hip[2][0]*t67 + 5.780668556524933e-05*w.RJ_RF_hip[2][1]*w.KSD_RF_hip[0] + w.RJ_RF_hip[2][2]*t68 + 0.049*t69 + 0.19*t70;
-    w.KS_RF_hip[1] = 0.9950371902099893*w.KA_RF_hip[3][1] + 0.09950371902099893*w.KA_RF_hip[5][1];
-    w.KSD_RF_hip[1] = w.Dinv_RF_hip*w.KS_RF_hip[1];
-    const Scalar t72 = 1.0 - w.U_RF_hip[1]*w.KSD_RF_hip[1];
-    const Scalar t73 = -w.U_RF_hip[0]*w.KSD_RF_hip[1];
-    const Scalar t74 = -w.U_RF_hip[2]*w.KSD_RF_hip[1];
-    const Scalar t75 = w.KA_RF_hip[3][1] - w.U_RF_hip[3]*w.KSD_RF_hip[1];
-    const Scalar t76 = w.KA_RF_hip[5][1] - w.U_RF_hip[5]*w.KSD_RF_hip[1];
-    const Scalar t77 = w.RJ_RF_hip[0][0]*t73 + w.RJ_RF_hip[0][1]*t72 + w.RJ_RF_hip[0][2]*t74;
-    const Scalar t78 = w.RJ_RF_hip[1][0]*t73 + w.cq_RF_hip*t72 + w.RJ_RF_hip[1][2]*t74;
-    const Scalar t79 = w.RJ_RF_hip[2][0]*t73 + w.RJ_RF_hip[2][1]*t72 + w.RJ_RF_hip[2][2]*t74;
-    w.KA_trunk[0][7] = t77;
-    w.KA_trunk[1][7] = t78;
-    w.KA_trunk[2][7] = t79;
-    w.KA_trunk[3][7] = w.RJ_RF_hip[0][0]*t75 + 5.780668556524933e-05*w.RJ_RF_hip[0][1]*w.KSD_RF_hip[1] + w.RJ_RF_hip[0][2]*t76 - 0.049*t79;
-    w.KA_trunk[4][7] = w.RJ_RF_hip[1][0]*t75 + 5.780668556524933e-05*w.cq_RF_hip*w.KSD_RF_hip[1] + w.RJ_RF_hip[1][2]*t76 - 0.19*t79;
-    w.KA_trunk[5][7] = w.RJ_RF_hip[2][0]*t75 + 5.780668556524933e-05*w.RJ_RF_hip[2][1]*w.KSD_RF_hip[1] + w.RJ_RF_hip[2][2]*t76 + 0.049*t77 + 0.19*t78;
-    w.KS_RF_hip[2] = 0.9950371902099893*w.KA_RF_hip[3][2] + 0.09950371902099893*w.KA_RF_hip[5][2];
-    w.KSD_RF_hip[2] = w.Dinv_RF_hip*w.KS_RF_hip[2];
-    const Scalar t80 = w.KA_RF_hip[0][2] - w.U_RF_hip[0]*w.KSD_RF_hip[2];
-    const Scalar t81 = w.KA_RF_hip[2][2] - w.U_RF_hip[2]*w.KSD_RF_hip[2];
-    const Scalar t82 = -w.U_RF_hip[1]*w.KSD_RF_hip[2];
-    const Scalar t83 = w.KA_RF_hip[3][2] - w.U_RF_hip[3]*w.KSD_RF_hip[2];
-    const Scalar t84 = w.KA_RF_hip[5][2] - w.U_RF_hip[5]*w.KSD_RF_hip[2];
-    const Scalar t85 = w.RJ_RF_hip[0][0]*t80 + w.RJ_RF_hip[0][1]*t82 + w.RJ_RF_hip[0][2]*t81;
-    const Scalar t86 = w.RJ_RF_hip[1][0]*t80 + w.cq_RF_hip*t82 + w.RJ_RF_hip[1][2]*t81;
-    const Scalar t87 = w.RJ_RF_hip[2][0]*t80 + w.RJ_RF_hip[2][1]*t82 + w.RJ_RF_hip[2][2]*t81;
-    w.KA_trunk[0][8] = t85;
-    w.KA_trunk[1][8] = t86;
-    w.KA_trunk[2][8] = t87;
-    w.KA_trunk[3][8] = w.RJ_RF_hip[0][0]*t83 + 5.780668556524933e-05*w.RJ_RF_hip[0][1]*w.KSD_RF_hip[2] + w.RJ_RF_hip[0][2]*t84 - 0.049*t87;
-    w.KA_trunk[4][8] = w.RJ_RF_hip[1][0]*t83 + 5.780668556524933e-05*w.cq_RF_hip*w.KSD_RF_hip[2] + w.RJ_RF_hip[1][2]*t84 - 0.19*t87;
-    w.KA_trunk[5][8] = w.RJ_RF_hip[2][0]*t83 + 5.780668556524933e-05*w.RJ_RF_hip[2][1]*w.KSD_RF_hip[2] + w.RJ_RF_hip[2][2]*t84 + 0.049*t85 + 0.19*t86;
-  }
+  shared_20(shared_20_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    w.u_LH_shank[0] = -w.pA_LH_shank[4] + tau[11];
-    const Scalar pa0 = 0.03264876250658241*w.c_LH_shank[0] + w.pA_LH_shank[0] - 8.030542390731965*w.u_LH_shank[0];
-    const Scalar pa1 = 0.003904*w.c_LH_shank[3] + w.pA_LH_shank[1];
-    const Scalar pa2 = 0.064*w.c_LH_shank[2] + w.pA_LH_shank[2];
-    const Scalar pa3 = 0.000483144*w.c_LH_shank[3] + w.pA_LH_shank[3];
-    const Scalar pa4 = 6e-06*w.c_LH_shank[5] + w.pA_LH_shank[5];
-    const Scalar C20 = w.cq_LH_shank*w.cq_LH_shank - w.sq_LH_shank*w.sq_LH_shank;
-    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
-    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
-    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_LH_shank;
-    const Scalar t3 = w.cq_LH_shank*pa0 + w.sq_LH_shank*pa2;
-    const Scalar t4 = -w.sq_LH_shank*pa0 + w.cq_LH_shank*pa2;
-    w.IA_LH_thigh[0] = 0.6890000000000001 + t0;
-    w.IA_LH_thigh[2] = 0.03135123749341759*w.cq_LH_shank*w.sq_LH_shank;
-    w.IA_LH_thigh[4] = -0.01268 - 0.209*t0;
-    w.IA_LH_thigh[8] = 0.01268 + t2;
-    w.IA_LH_thigh[10] = -0.003904*w.sq_LH_shank;
-    w.IA_LH_thigh[11] = 0.6890000000000001 + t1;
-    w.IA_LH_thigh[13] = -0.006552408636124276*w.cq_LH_shank*w.sq_LH_shank;
-    w.IA_LH_thigh[15] = 0.002676476 + 0.000815936*w.cq_LH_shank + 0.00023857200000000002*C20 + 0.209*t2;
-    w.IA_LH_thigh[17] = -0.000815936*w.sq_LH_shank - 0.00047714400000000004*w.cq_LH_shank*w.sq_LH_shank;
-    w.IA_LH_thigh[18] = 0.0024196 + 0.043681*t0;
-    w.IA_LH_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_LH_thigh[0] = w.pA_LH_thigh[0] + t3;
-    w.pA_LH_thigh[1] = w.pA_LH_thigh[1] + pa1;
-    w.pA_LH_thigh[2] = w.pA_LH_thigh[2] + t4;
-    w.pA_LH_thigh[3] = w.pA_LH_thigh[3] + 0.209*pa1 + w.cq_LH_shank*pa3 + w.sq_LH_shank*pa4;
-    w.pA_LH_thigh[4] = w.pA_LH_thigh[4] + tau[11] - 0.209*t3;
-    w.pA_LH_thigh[5] = w.pA_LH_thigh[5] - w.sq_LH_shank*pa3 + w.cq_LH_shank*pa4;
-    w.KA_LH_thigh[0][0] = -0.5659557661927332*w.cq_LH_shank;
-    w.KA_LH_thigh[2][0] = 0.5659557661927332*w.sq_LH_shank;
-    w.KA_LH_thigh[3][0] = -0.004*w.sq_LH_shank;
-    w.KA_LH_thigh[4][0] = 0.11828475513428124*w.cq_LH_shank;
-    w.KA_LH_thigh[5][0] = -0.004*w.cq_LH_shank;
-    w.KA_LH_thigh[3][1] = 0.209 + 0.195*w.cq_LH_shank;
-    w.KA_LH_thigh[5][1] = -0.195*w.sq_LH_shank;
-    w.KA_LH_thigh[0][2] = w.sq_LH_shank;
-    w.KA_LH_thigh[2][2] = w.cq_LH_shank;
-    w.KA_LH_thigh[3][2] = 0.004*w.cq_LH_shank;
-    w.KA_LH_thigh[4][2] = -0.209*w.sq_LH_shank;
-    w.KA_LH_thigh[5][2] = -0.004*w.sq_LH_shank;
-  }
+  shared_18(shared_18_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    w.Dinv_LH_thigh = 1.0 / w.IA_LH_thigh[18];
-    w.u_LH_thigh[0] = -w.pA_LH_thigh[4] + tau[10];
-    const Scalar t0 = w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar t1 = w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar Ia0 = w.IA_LH_thigh[0] - w.IA_LH_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_LH_thigh[2] - w.IA_LH_thigh[13]*t0;
-    const Scalar Ia2 = 0.010144 + 0.00020288*w.IA_LH_thigh[4]*w.Dinv_LH_thigh;
-    const Scalar Ia3 = w.IA_LH_thigh[11] - w.IA_LH_thigh[13]*t1;
-    const Scalar Ia4 = w.IA_LH_thigh[20] - 4.11602944e-08*w.Dinv_LH_thigh;
-    const Scalar t2 = 0.00020288*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar pa0 = w.pA_LH_thigh[0] + w.u_LH_thigh[0]*t0 + w.c_LH_thigh[0]*Ia0 + w.c_LH_thigh[2]*Ia1 + w.c_LH_thigh[5]*Ia2;
-    const Scalar pa1 = w.pA_LH_thigh[1] + w.c_LH_thigh[3]*w.IA_LH_thigh[8] + w.c_LH_thigh[5]*w.IA_LH_thigh[10];
-    const Scalar pa2 = -0.010144*w.c_LH_thigh[3] + w.pA_LH_thigh[2] + w.u_LH_thigh[0]*t1 + w.c_LH_thigh[0]*Ia1 + w.c_LH_thigh[2]*Ia3 + w.c_LH_thigh[5]*t2;
-    const Scalar pa3 = -0.010144*w.c_LH_thigh[2] + w.pA_LH_thigh[3] + w.c_LH_thigh[3]*w.IA_LH_thigh[15] + w.c_LH_thigh[5]*w.IA_LH_thigh[17];
-    const Scalar pa4 = w.pA_LH_thigh[5] - 0.00020288*w.Dinv_LH_thigh*w.u_LH_thigh[0] + w.c_LH_thigh[0]*Ia2 + w.c_LH_thigh[2]*t2 + w.c_LH_thigh[3]*w.IA_LH_thigh[17] + w.c_LH_thigh[5]*Ia4;
-    const Scalar C20 = w.cq_LH_thigh*w.cq_LH_thigh - w.sq_LH_thigh*w.sq_LH_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia3);
-    const Scalar m0 = 0.5*(Ia0 + Ia3);
-    const Scalar t3 = 2.0*w.cq_LH_thigh*w.sq_LH_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t3;
-    const Scalar qq0 = h0*t3 + Ia1*C20;
-    const Scalar t4 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh;
-    const Scalar t5 = -0.005072 + 0.5*Ia2;
-    const Scalar d1 = C20*t4 - t3*t5;
-    const Scalar qq1 = t3*t4 + C20*t5;
-    const Scalar h1 = 0.5*(-w.IA_LH_thigh[15] + Ia4);
-    const Scalar m1 = 0.5*(w.IA_LH_thigh[15] + Ia4);
-    const Scalar d2 = C20*h1 - w.IA_LH_thigh[17]*t3;
-    const Scalar qq2 = t3*h1 + w.IA_LH_thigh[17]*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh - d1;
-    const Scalar t9 = 0.005072 + 0.5*Ia2 + qq1;
-    const Scalar t10 = w.sq_LH_thigh*w.IA_LH_thigh[10] + w.cq_LH_thigh*w.IA_LH_thigh[8];
-    const Scalar t11 = w.cq_LH_thigh*w.IA_LH_thigh[10] - w.sq_LH_thigh*w.IA_LH_thigh[8];
-    const Scalar t12 = -0.005072 - 0.5*Ia2 + qq1;
-    const Scalar t13 = 0.00010144*w.IA_LH_thigh[13]*w.Dinv_LH_thigh + d1;
-    const Scalar t14 = 0.062*qq0 + t8;
-    const Scalar t15 = -0.062*t6 + t9;
-    const Scalar t16 = 0.062*t7 + t12;
-    const Scalar t17 = -0.062*qq0 + t13;
-    const Scalar t18 = w.cq_LH_thigh*pa0 + w.sq_LH_thigh*pa2;
-    const Scalar t19 = -w.sq_LH_thigh*pa0 + w.cq_LH_thigh*pa2;
-    w.IA_LH_hip[0] = 0.5950000000000001 + t6;
-    w.IA_LH_hip[2] = qq0;
-    w.IA_LH_hip[3] = t14;
-    w.IA_LH_hip[5] = -0.02164 + t15;
-    w.IA_LH_hip[8] = t10;
-    w.IA_LH_hip[10] = t11;
-    w.IA_LH_hip[11] = 0.5950000000000001 + t7;
-    w.IA_LH_hip[12] = 0.02164 + t16;
-    w.IA_LH_hip[14] = t17;
-    w.IA_LH_hip[15] = 0.0012018399999999998 + m1 - d2 + 0.062*t12 + 0.062*t16;
-    w.IA_LH_hip[17] = 4.5e-07 + qq2 - 0.062*t8 + 0.062*t17;
-    w.IA_LH_hip[20] = 0.00126484 + m1 + d2 - 0.062*t9 - 0.062*t15;
-    w.pA_LH_hip[0] = w.pA_LH_hip[0] + t18;
-    w.pA_LH_hip[1] = w.pA_LH_hip[1] + pa1;
-    w.pA_LH_hip[2] = w.pA_LH_hip[2] + t19;
-    w.pA_LH_hip[3] = w.pA_LH_hip[3] + w.cq_LH_thigh*pa3 + w.sq_LH_thigh*pa4 + 0.062*t19;
-    w.pA_LH_hip[4] = w.pA_LH_hip[4] + tau[10];
-    w.pA_LH_hip[5] = w.pA_LH_hip[5] - w.sq_LH_thigh*pa3 + w.cq_LH_thigh*pa4 - 0.062*t18;
-    w.KSD_LH_thigh[0] = w.KA_LH_thigh[4][0]*w.Dinv_LH_thigh;
-    const Scalar t20 = w.KA_LH_thigh[0][0] - w.IA_LH_thigh[4]*w.KSD_LH_thigh[0];
-    const Scalar t21 = w.KA_LH_thigh[2][0] - w.IA_LH_thigh[13]*w.KSD_LH_thigh[0];
-    const Scalar t22 = w.KA_LH_thigh[5][0] + 0.00020288*w.KSD_LH_thigh[0];
-    const Scalar t23 = w.cq_LH_thigh*t20 + w.sq_LH_thigh*t21;
-    const Scalar t24 = -w.sq_LH_thigh*t20 + w.cq_LH_thigh*t21;
-    w.KA_LH_hip[0][0] = t23;
-    w.KA_LH_hip[2][0] = t24;
-    w.KA_LH_hip[3][0] = w.cq_LH_thigh*w.KA_LH_thigh[3][0] + w.sq_LH_thigh*t22 + 0.062*t24;
-    w.KA_LH_hip[5][0] = -w.sq_LH_thigh*w.KA_LH_thigh[3][0] + w.cq_LH_thigh*t22 - 0.062*t23;
-    w.KA_LH_hip[3][1] = w.cq_LH_thigh*w.KA_LH_thigh[3][1] + w.sq_LH_thigh*w.KA_LH_thigh[5][1];
-    w.KA_LH_hip[5][1] = -w.sq_LH_thigh*w.KA_LH_thigh[3][1] + w.cq_LH_thigh*w.KA_LH_thigh[5][1];
-    w.KSD_LH_thigh[2] = w.KA_LH_thigh[4][2]*w.Dinv_LH_thigh;
-    const Scalar t25 = w.KA_LH_thigh[0][2] - w.IA_LH_thigh[4]*w.KSD_LH_thigh[2];
-    const Scalar t26 = w.KA_LH_thigh[2][2] - w.IA_LH_thigh[13]*w.KSD_LH_thigh[2];
-    const Scalar t27 = w.KA_LH_thigh[5][2] + 0.00020288*w.KSD_LH_thigh[2];
-    const Scalar t28 = w.cq_LH_thigh*t25 + w.sq_LH_thigh*t26;
-    const Scalar t29 = -w.sq_LH_thigh*t25 + w.cq_LH_thigh*t26;
-    w.KA_LH_hip[0][2] = t28;
-    w.KA_LH_hip[2][2] = t29;
-    w.KA_LH_hip[3][2] = w.cq_LH_thigh*w.KA_LH_thigh[3][2] + w.sq_LH_thigh*t27 + 0.062*t29;
-    w.KA_LH_hip[5][2] = -w.sq_LH_thigh*w.KA_LH_thigh[3][2] + w.cq_LH_thigh*t27 - 0.062*t28;
-  }
+  shared_19(shared_19_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_LH_hip[0] = 0.9950371902099892*w.IA_LH_hip[3] - 0.09950371902099892*w.IA_LH_hip[5];
-    w.U_LH_hip[1] = 0.9950371902099892*w.IA_LH_hip[8] - 0.09950371902099892*w.IA_LH_hip[10];
-    w.U_LH_hip[2] = 0.9950371902099892*w.IA_LH_hip[12] - 0.09950371902099892*w.IA_LH_hip[14];
-    w.U_LH_hip[3] = 0.9950371902099892*w.IA_LH_hip[15] - 0.09950371902099892*w.IA_LH_hip[17];
-    w.U_LH_hip[5] = 0.9950371902099892*w.IA_LH_hip[17] - 0.09950371902099892*w.IA_LH_hip[20];
-    const Scalar D0 = 0.9950371902099892*w.U_LH_hip[3] - 0.09950371902099892*w.U_LH_hip[5];
-    w.Dinv_LH_hip = 1.0 / D0;
-    w.u_LH_hip[0] = -0.9950371902099892*w.pA_LH_hip[3] + 0.09950371902099892*w.pA_LH_hip[5] + tau[9];
-    const Scalar t0 = w.U_LH_hip[0]*w.Dinv_LH_hip;
-    const Scalar t1 = w.U_LH_hip[1]*w.Dinv_LH_hip;
-    const Scalar t2 = w.U_LH_hip[2]*w.Dinv_LH_hip;
-    const Scalar t3 = w.U_LH_hip[3]*w.Dinv_LH_hip;
-    const Scalar t4 = w.U_LH_hip[5]*w.Dinv_LH_hip;
-    const Scalar Ia0 = w.IA_LH_hip[0] - w.U_LH_hip[0]*t0;
-    const Scalar Ia1 = w.IA_LH_hip[2] - w.U_LH_hip[2]*t0;
-    const Scalar Ia2 = w.IA_LH_hip[3] - w.U_LH_hip[3]*t0;
-    const Scalar Ia3 = w.IA_LH_hip[5] - w.U_LH_hip[5]*t0;
-    const Scalar Ia4 = 1.3480000000000003 - w.U_LH_hip[1]*t1;
-    const Scalar Ia5 = w.IA_LH_hip[8] - w.U_LH_hip[3]*t1;
-    const Scalar Ia6 = w.IA_LH_hip[10] - w.U_LH_hip[5]*t1;
-    const Scalar Ia7 = w.IA_LH_hip[11] - w.U_LH_hip[2]*t2;
-    const Scalar Ia8 = w.IA_LH_hip[12] - w.U_LH_hip[3]*t2;
-    const Scalar Ia9 = w.IA_LH_hip[14] - w.U_LH_hip[5]*t2;
-    const Scalar Ia10 = w.IA_LH_hip[15] - w.U_LH_hip[3]*t3;
-    const Scalar Ia11 = 5.8e-05 - 5.7617628499109426e-05*w.U_LH_hip[3]*w.Dinv_LH_hip;
-    const Scalar Ia12 = w.IA_LH_hip[17] - w.U_LH_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.3197911138613866e-09*w.Dinv_LH_hip;
-    const Scalar Ia14 = 9.5e-07 - 5.7617628499109426e-05*w.U_LH_hip[5]*w.Dinv_LH_hip;
-    const Scalar Ia15 = w.IA_LH_hip[20] - w.U_LH_hip[5]*t4;
-    const Scalar t5 = -w.U_LH_hip[1]*t0;
-    const Scalar t6 = -5.7617628499109426e-05*w.U_LH_hip[0]*w.Dinv_LH_hip;
-    const Scalar t7 = -w.U_LH_hip[2]*t1;
-    const Scalar t8 = -5.7617628499109426e-05*w.U_LH_hip[1]*w.Dinv_LH_hip;
-    const Scalar t9 = -5.7617628499109426e-05*w.U_LH_hip[2]*w.Dinv_LH_hip;
-    const Scalar pa0 = w.pA_LH_hip[0] + w.u_LH_hip[0]*t0 + w.c_LH_hip[0]*Ia0 + w.c_LH_hip[1]*t5 + w.c_LH_hip[2]*Ia1 + w.c_LH_hip[3]*Ia2 + w.c_LH_hip[4]*t6 + w.c_LH_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_LH_hip[1] + w.u_LH_hip[0]*t1 + w.c_LH_hip[0]*t5 + w.c_LH_hip[1]*Ia4 + w.c_LH_hip[2]*t7 + w.c_LH_hip[3]*Ia5 + w.c_LH_hip[4]*t8 + w.c_LH_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_LH_hip[2] + w.u_LH_hip[0]*t2 + w.c_LH_hip[0]*Ia1 + w.c_LH_hip[1]*t7 + w.c_LH_hip[2]*Ia7 + w.c_LH_hip[3]*Ia8 + w.c_LH_hip[4]*t9 + w.c_LH_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_LH_hip[3] + w.u_LH_hip[0]*t3 + w.c_LH_hip[0]*Ia2 + w.c_LH_hip[1]*Ia5 + w.c_LH_hip[2]*Ia8 + w.c_LH_hip[3]*Ia10 + w.c_LH_hip[4]*Ia11 + w.c_LH_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_LH_hip[4] + 5.7617628499109426e-05*w.Dinv_LH_hip*w.u_LH_hip[0] + w.c_LH_hip[0]*t6 + w.c_LH_hip[1]*t8 + w.c_LH_hip[2]*t9 + w.c_LH_hip[3]*Ia11 + w.c_LH_hip[4]*Ia13 + w.c_LH_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_LH_hip[5] + w.u_LH_hip[0]*t4 + w.c_LH_hip[0]*Ia3 + w.c_LH_hip[1]*Ia6 + w.c_LH_hip[2]*Ia9 + w.c_LH_hip[3]*Ia12 + w.c_LH_hip[4]*Ia14 + w.c_LH_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_LH_hip[0][0]*Ia0 + w.RJ_LH_hip[0][1]*t5 + w.RJ_LH_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_LH_hip[0][0]*t5 + w.RJ_LH_hip[0][1]*Ia4 + w.RJ_LH_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_LH_hip[0][0]*Ia1 + w.RJ_LH_hip[0][1]*t7 + w.RJ_LH_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_LH_hip[1][0]*Ia0 + w.cq_LH_hip*t5 + w.RJ_LH_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_LH_hip[1][0]*t5 + w.cq_LH_hip*Ia4 + w.RJ_LH_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_LH_hip[1][0]*Ia1 + w.cq_LH_hip*t7 + w.RJ_LH_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_LH_hip[2][0]*Ia0 + w.RJ_LH_hip[2][1]*t5 + w.RJ_LH_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_LH_hip[2][0]*t5 + w.RJ_LH_hip[2][1]*Ia4 + w.RJ_LH_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_LH_hip[2][0]*Ia1 + w.RJ_LH_hip[2][1]*t7 + w.RJ_LH_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_LH_hip[0][0]*Ia2 + w.RJ_LH_hip[0][1]*Ia5 + w.RJ_LH_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_LH_hip[0][0]*t6 + w.RJ_LH_hip[0][1]*t8 + w.RJ_LH_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_LH_hip[0][0]*Ia3 + w.RJ_LH_hip[0][1]*Ia6 + w.RJ_LH_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_LH_hip[1][0]*Ia2 + w.cq_LH_hip*Ia5 + w.RJ_LH_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_LH_hip[1][0]*t6 + w.cq_LH_hip*t8 + w.RJ_LH_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_LH_hip[1][0]*Ia3 + w.cq_LH_hip*Ia6 + w.RJ_LH_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_LH_hip[2][0]*Ia2 + w.RJ_LH_hip[2][1]*Ia5 + w.RJ_LH_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_LH_hip[2][0]*t6 + w.RJ_LH_hip[2][1]*t8 + w.RJ_LH_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_LH_hip[2][0]*Ia3 + w.RJ_LH_hip[2][1]*Ia6 + w.RJ_LH_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_LH_hip[0][0]*Ia10 + w.RJ_LH_hip[0][1]*Ia11 + w.RJ_LH_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_LH_hip[0][0]*Ia11 + w.RJ_LH_hip[0][1]*Ia13 + w.RJ_LH_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_LH_hip[0][0]*Ia12 + w.RJ_LH_hip[0][1]*Ia14 + w.RJ_LH_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_LH_hip[1][0]*Ia10 + w.cq_LH_hip*Ia11 + w.RJ_LH_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_LH_hip[1][0]*Ia11 + w.cq_LH_hip*Ia13 + w.RJ_LH_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_LH_hip[1][0]*Ia12 + w.cq_LH_hip*Ia14 + w.RJ_LH_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_LH_hip[2][0]*Ia10 + w.RJ_LH_hip[2][1]*Ia11 + w.RJ_LH_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_LH_hip[2][0]*Ia11 + w.RJ_LH_hip[2][1]*Ia13 + w.RJ_LH_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_LH_hip[2][0]*Ia12 + w.RJ_LH_hip[2][1]*Ia14 + w.RJ_LH_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_LH_hip[0][0]*t10 + w.RJ_LH_hip[0][1]*t11 + w.RJ_LH_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_LH_hip[1][0]*t10 + w.cq_LH_hip*t11 + w.RJ_LH_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_LH_hip[2][0]*t10 + w.RJ_LH_hip[2][1]*t11 + w.RJ_LH_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_LH_hip[1][0]*t13 + w.cq_LH_hip*t14 + w.RJ_LH_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_LH_hip[2][0]*t13 + w.RJ_LH_hip[2][1]*t14 + w.RJ_LH_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_LH_hip[2][0]*t16 + w.RJ_LH_hip[2][1]*t17 + w.RJ_LH_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_LH_hip[0][0]*t19 + w.RJ_LH_hip[0][1]*t20 + w.RJ_LH_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_LH_hip[1][0]*t19 + w.cq_LH_hip*t20 + w.RJ_LH_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_LH_hip[2][0]*t19 + w.RJ_LH_hip[2][1]*t20 + w.RJ_LH_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_LH_hip[0][0]*t22 + w.RJ_LH_hip[0][1]*t23 + w.RJ_LH_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_LH_hip[1][0]*t22 + w.cq_LH_hip*t23 + w.RJ_LH_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_LH_hip[2][0]*t22 + w.RJ_LH_hip[2][1]*t23 + w.RJ_LH_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_LH_hip[0][0]*t25 + w.RJ_LH_hip[0][1]*t26 + w.RJ_LH_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_LH_hip[1][0]*t25 + w.cq_LH_hip*t26 + w.RJ_LH_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_LH_hip[2][0]*t25 + w.RJ_LH_hip[2][1]*t26 + w.RJ_LH_hip[2][2]*t27;
-    const Scalar t52 = 0.049*t39 + t43;
-    const Scalar t53 = 0.19*t39 + t44;
-    const Scalar t54 = -0.049*t37 - 0.19*t38 + t45;
-    const Scalar t55 = 0.049*t41 + t46;
-    const Scalar t56 = 0.19*t41 + t47;
-    const Scalar t57 = -0.049*t38 - 0.19*t40 + t48;
-    const Scalar t58 = 0.049*t42 + t49;
-    const Scalar t59 = 0.19*t42 + t50;
-    const Scalar t60 = -0.049*t39 - 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_LH_hip[0][0]*pa0 + w.RJ_LH_hip[0][1]*pa1 + w.RJ_LH_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_LH_hip[1][0]*pa0 + w.cq_LH_hip*pa1 + w.RJ_LH_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_LH_hip[2][0]*pa0 + w.RJ_LH_hip[2][1]*pa1 + w.RJ_LH_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_LH_hip[0][0]*t28 + w.RJ_LH_hip[0][1]*t29 + w.RJ_LH_hip[0][2]*t30 + 0.049*t49 + 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_LH_hip[1][0]*t28 + w.cq_LH_hip*t29 + w.RJ_LH_hip[1][2]*t30 + 0.19*t49 + 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_LH_hip[2][0]*t28 + w.RJ_LH_hip[2][1]*t29 + w.RJ_LH_hip[2][2]*t30 - 0.049*t43 - 0.19*t46 + 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_LH_hip[1][0]*t31 + w.cq_LH_hip*t32 + w.RJ_LH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_LH_hip[2][0]*t31 + w.RJ_LH_hip[2][1]*t32 + w.RJ_LH_hip[2][2]*t33 - 0.049*t44 - 0.19*t47 + 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_LH_hip[2][0]*t34 + w.RJ_LH_hip[2][1]*t35 + w.RJ_LH_hip[2][2]*t36 - 0.049*t45 - 0.19*t48 - 0.049*t54 - 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LH_hip[0][0]*pa3 + w.RJ_LH_hip[0][1]*pa4 + w.RJ_LH_hip[0][2]*pa5 + 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LH_hip[1][0]*pa3 + w.cq_LH_hip*pa4 + w.RJ_LH_hip[1][2]*pa5 + 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LH_hip[2][0]*pa3 + w.RJ_LH_hip[2][1]*pa4 + w.RJ_LH_hip[2][2]*pa5 - 0.049*t61 - 0.19*t62;
-    w.KS_LH_hip[0] = 0.9950371902099892*w.KA_LH_hip[3][0] - 0.09950371902099892*w.KA_LH_hip[5][0];
-    w.KSD_LH_hip[0] = w.Dinv_LH_hip*w.KS_LH_hip[0];
-    const Scalar t64 = w.KA_LH_hip[0][0] - w.U_LH_hip[0]*w.KSD_LH_hip[0];
-    const Scalar t65 = w.KA_LH_hip[2][0] - w.U_LH_hip[2]*w.KSD_LH_hip[0];
-    const Scalar t66 = -w.U_LH_hip[1]*w.KSD_LH_hip[0];
-    const Scalar t67 = w.KA_LH_hip[3][0] - w.U_LH_hip[3]*w.KSD_LH_hip[0];
-    const Scalar t68 = w.KA_LH_hip[5][0] - w.U_LH_hip[5]*w.KSD_LH_hip[0];
-    const Scalar t69 = w.RJ_LH_hip[0][0]*t64 + w.RJ_LH_hip[0][1]*t66 + w.RJ_LH_hip[0][2]*t65;
-    const Scalar t70 = w.RJ_LH_hip[1][0]*t64 + w.cq_LH_hip*t66 + w.RJ_LH_hip[1][2]*t65;
-    const Scalar t71 = w.RJ_LH_hip[2][0]*t64 + w.RJ_LH_hip[2][1]*t66 + w.RJ_LH_hip[2][2]*t65;
-    w.KA_trunk[0][3] = t69;
-    w.KA_trunk[1][3] = t70;
-    w.KA_trunk[2][3] = t71;
-    w.KA_trunk[3][3] = w.RJ_LH_hip[0][0]*t67 - 5.7617628499109426e-05*w.RJ_LH_hip[0][1]*w.KSD_LH_hip[0] + w.RJ_LH_hip[0][2]*t68 + 0.049*t71;
-    w.KA_trunk[4][3] = w.RJ_LH_hip[1][0]*t67 - 5.7617628499109426e-05*w.cq_LH_hip*w.KSD_LH_hip[0] + w.RJ_LH_hip[1][2]*t68 + 0.19*t71;
-    w.KA_trunk[5][3] = w.RJ_LH_hip[2][0]*t67 - 5.7617628499109426e-05*w.RJ_LH_hip[2][1]*w.KSD_LH_hip[0] + w.RJ_LH_hip[2][2]*t68 - 0.049*t69 - 0.19*t70;
-    w.KS_LH_hip[1] = 0.9950371902099892*w.KA_LH_hip[3][1] - 0.09950371902099892*w.KA_LH_hip[5][1];
-    w.KSD_LH_hip[1] = w.Dinv_LH_hip*w.KS_LH_hip[1];
-    const Scalar t72 = 1.0 - w.U_LH_hip[1]*w.KSD_LH_hip[1];
-    const Scalar t73 = -w.U_LH_hip[0]*w.KSD_LH_hip[1];
-    const Scalar t74 = -w.U_LH_hip[2]*w.KSD_LH_hip[1];
-    const Scalar t75 = w.KA_LH_hip[3][1] - w.U_LH_hip[3]*w.KSD_LH_hip[1];
-    const Scalar t76 = w.KA_LH_hip[5][1] - w.U_LH_hip[5]*w.KSD_LH_hip[1];
-    const Scalar t77 = w.RJ_LH_hip[0][0]*t73 + w.RJ_LH_hip[0][1]*t72 + w.RJ_LH_hip[0][2]*t74;
-    const Scalar t78 = w.RJ_LH_hip[1][0]*t73 + w.cq_LH_hip*t72 + w.RJ_LH_hip[1][2]*t74;
-    const Scalar t79 = w.RJ_LH_hip[2][0]*t73 + w.RJ_LH_hip[2][1]*t72 + w.RJ_LH_hip[2][2]*t74;
-    w.KA_trunk[0][4] = t77;
-    w.KA_trunk[1][4] = t78;
-    w.KA_trunk[2][4] = t79;
-    w.KA_trunk[3][4] = w.RJ_LH_hip[0][0]*t75 - 5.7617628499109426e-05*w.RJ_LH_hip[0][1]*w.KSD_LH_hip[1] + w.RJ_LH_hip[0][2]*t76 + 0.049*t79;
-    w.KA_trunk[4][4] = w.RJ_LH_hip[1][0]*t75 - 5.7617628499109426e-05*w.cq_LH_hip*w.KSD_LH_hip[1] + w.RJ_LH_hip[1][2]*t76 + 0.19*t79;
-    w.KA_trunk[5][4] = w.RJ_LH_hip[2][0]*t75 - 5.7617628499109426e-05*w.RJ_LH_hip[2][1]*w.KSD_LH_hip[1] + w.RJ_LH_hip[2][2]*t76 - 0.049*t77 - 0.19*t78;
-    w.KS_LH_hip[2] = 0.9950371902099892*w.KA_LH_hip[3][2] - 0.09950371902099892*w.KA_LH_hip[5][2];
-    w.KSD_LH_hip[2] = w.Dinv_LH_hip*w.KS_LH_hip[2];
-    const Scalar t80 = w.KA_LH_hip[0][2] - w.U_LH_hip[0]*w.KSD_LH_hip[2];
-    const Scalar t81 = w.KA_LH_hip[2][2] - w.U_LH_hip[2]*w.KSD_LH_hip[2];
-    const Scalar t82 = -w.U_LH_hip[1]*w.KSD_LH_hip[2];
-    const Scalar t83 = w.KA_LH_hip[3][2] - w.U_LH_hip[3]*w.KSD_LH_hip[2];
-    const Scalar t84 = w.KA_LH_hip[5][2] - w.U_LH_hip[5]*w.KSD_LH_hip[2];
-    const Scalar t85 = w.RJ_LH_hip[0][0]*t80 + w.RJ_LH_hip[0][1]*t82 + w.RJ_LH_hip[0][2]*t81;
-    const Scalar t86 = w.RJ_LH_hip[1][0]*t80 + w.cq_LH_hip*t82 + w.RJ_LH_hip[1][2]*t81;
-    const Scalar t87 = w.RJ_LH_hip[2][0]*t80 + w.RJ_LH_hip[2][1]*t82 + w.RJ_LH_hip[2][2]*t81;
-    w.KA_trunk[0][5] = t85;
-    w.KA_trunk[1][5] = t86;
-    w.KA_trunk[2][5] = t87;
-    w.KA_trunk[3][5] = w.RJ_LH_hip[0][0]*t83 - 5.7617628499109426e-05*w.RJ_LH_hip[0][1]*w.KSD_LH_hip[2] + w.RJ_LH_hip[0][2]*t84 + 0.049*t87;
-    w.KA_trunk[4][5] = w.RJ_LH_hip[1][0]*t83 - 5.7617628499109426e-05*w.cq_LH_hip*w.KSD_LH_hip[2] + w.RJ_LH_hip[1][2]*t84 + 0.19*t87;
-    w.KA_trunk[5][5] = w.RJ_LH_hip[2][0]*t83 - 5.7617628499109426e-05*w.RJ_LH_hip[2][1]*w.KSD_LH_hip[2] + w.RJ_LH_hip[2][2]*t84 - 0.049*t85 - 0.19*t86;
-  }
+  shared_20(shared_20_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    w.u_LF_shank[0] = -w.pA_LF_shank[4] + tau[8];
-    const Scalar pa0 = 0.03264876250658241*w.c_LF_shank[0] + w.pA_LF_shank[0] - 8.030542390731965*w.u_LF_shank[0];
-    const Scalar pa1 = 0.003904*w.c_LF_shank[3] + w.pA_LF_shank[1];
-    const Scalar pa2 = 0.064*w.c_LF_shank[2] + w.pA_LF_shank[2];
-    const Scalar pa3 = 0.000483144*w.c_LF_shank[3] + w.pA_LF_shank[3];
-    const Scalar pa4 = 6e-06*w.c_LF_shank[5] + w.pA_LF_shank[5];
-    const Scalar C20 = w.cq_LF_shank*w.cq_LF_shank - w.sq_LF_shank*w.sq_LF_shank;
-    const Scalar t0 = 0.04832438125329121 - 0.015675618746708794*C20;
-    const Scalar t1 = 0.04832438125329121 + 0.015675618746708794*C20;
-    const Scalar t2 = 0.013375999999999999 + 0.003904*w.cq_LF_shank;
-    const Scalar t3 = w.cq_LF_shank*pa0 + w.sq_LF_shank*pa2;
-    const Scalar t4 = -w.sq_LF_shank*pa0 + w.cq_LF_shank*pa2;
-    w.IA_LF_thigh[0] = 0.6890000000000001 + t0;
-    w.IA_LF_thigh[2] = 0.03135123749341759*w.cq_LF_shank*w.sq_LF_shank;
-    w.IA_LF_thigh[4] = -0.01268 - 0.209*t0;
-    w.IA_LF_thigh[8] = 0.01268 + t2;
-    w.IA_LF_thigh[10] = -0.003904*w.sq_LF_shank;
-    w.IA_LF_thigh[11] = 0.6890000000000001 + t1;
-    w.IA_LF_thigh[13] = -0.006552408636124276*w.cq_LF_shank*w.sq_LF_shank;
-    w.IA_LF_thigh[15] = 0.002676476 + 0.000815936*w.cq_LF_shank + 0.00023857200000000002*C20 + 0.209*t2;
-    w.IA_LF_thigh[17] = -0.000815936*w.sq_LF_shank - 0.00047714400000000004*w.cq_LF_shank*w.sq_LF_shank;
-    w.IA_LF_thigh[18] = 0.0024196 + 0.043681*t0;
-    w.IA_LF_thigh[20] = 0.000847876 - 0.00023857200000000002*C20;
-    w.pA_LF_thigh[0] = w.pA_LF_thigh[0] + t3;
-    w.pA_LF_thigh[1] = w.pA_LF_thigh[1] + pa1;
-    w.pA_LF_thigh[2] = w.pA_LF_thigh[2] + t4;
-    w.pA_LF_thigh[3] = w.pA_LF_thigh[3] + 0.209*pa1 + w.cq_LF_shank*pa3 + w.sq_LF_shank*pa4;
-    w.pA_LF_thigh[4] = w.pA_LF_thigh[4] + tau[8] - 0.209*t3;
-    w.pA_LF_thigh[5] = w.pA_LF_thigh[5] - w.sq_LF_shank*pa3 + w.cq_LF_shank*pa4;
-    w.KA_LF_thigh[0][0] = -0.5659557661927332*w.cq_LF_shank;
-    w.KA_LF_thigh[2][0] = 0.5659557661927332*w.sq_LF_shank;
-    w.KA_LF_thigh[3][0] = -0.004*w.sq_LF_shank;
-    w.KA_LF_thigh[4][0] = 0.11828475513428124*w.cq_LF_shank;
-    w.KA_LF_thigh[5][0] = -0.004*w.cq_LF_shank;
-    w.KA_LF_thigh[3][1] = 0.209 + 0.195*w.cq_LF_shank;
-    w.KA_LF_thigh[5][1] = -0.195*w.sq_LF_shank;
-    w.KA_LF_thigh[0][2] = w.sq_LF_shank;
-    w.KA_LF_thigh[2][2] = w.cq_LF_shank;
-    w.KA_LF_thigh[3][2] = 0.004*w.cq_LF_shank;
-    w.KA_LF_thigh[4][2] = -0.209*w.sq_LF_shank;
-    w.KA_LF_thigh[5][2] = -0.004*w.sq_LF_shank;
-  }
+  shared_18(shared_18_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    w.Dinv_LF_thigh = 1.0 / w.IA_LF_thigh[18];
-    w.u_LF_thigh[0] = -w.pA_LF_thigh[4] + tau[7];
-    const Scalar t0 = w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar t1 = w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar Ia0 = w.IA_LF_thigh[0] - w.IA_LF_thigh[4]*t0;
-    const Scalar Ia1 = w.IA_LF_thigh[2] - w.IA_LF_thigh[13]*t0;
-    const Scalar Ia2 = 0.010144 + 0.00020288*w.IA_LF_thigh[4]*w.Dinv_LF_thigh;
-    const Scalar Ia3 = w.IA_LF_thigh[11] - w.IA_LF_thigh[13]*t1;
-    const Scalar Ia4 = w.IA_LF_thigh[20] - 4.11602944e-08*w.Dinv_LF_thigh;
-    const Scalar t2 = 0.00020288*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar pa0 = w.pA_LF_thigh[0] + w.u_LF_thigh[0]*t0 + w.c_LF_thigh[0]*Ia0 + w.c_LF_thigh[2]*Ia1 + w.c_LF_thigh[5]*Ia2;
-    const Scalar pa1 = w.pA_LF_thigh[1] + w.c_LF_thigh[3]*w.IA_LF_thigh[8] + w.c_LF_thigh[5]*w.IA_LF_thigh[10];
-    const Scalar pa2 = -0.010144*w.c_LF_thigh[3] + w.pA_LF_thigh[2] + w.u_LF_thigh[0]*t1 + w.c_LF_thigh[0]*Ia1 + w.c_LF_thigh[2]*Ia3 + w.c_LF_thigh[5]*t2;
-    const Scalar pa3 = -0.010144*w.c_LF_thigh[2] + w.pA_LF_thigh[3] + w.c_LF_thigh[3]*w.IA_LF_thigh[15] + w.c_LF_thigh[5]*w.IA_LF_thigh[17];
-    const Scalar pa4 = w.pA_LF_thigh[5] - 0.00020288*w.Dinv_LF_thigh*w.u_LF_thigh[0] + w.c_LF_thigh[0]*Ia2 + w.c_LF_thigh[2]*t2 + w.c_LF_thigh[3]*w.IA_LF_thigh[17] + w.c_LF_thigh[5]*Ia4;
-    const Scalar C20 = w.cq_LF_thigh*w.cq_LF_thigh - w.sq_LF_thigh*w.sq_LF_thigh;
-    const Scalar h0 = 0.5*(-Ia0 + Ia3);
-    const Scalar m0 = 0.5*(Ia0 + Ia3);
-    const Scalar t3 = 2.0*w.cq_LF_thigh*w.sq_LF_thigh;
-    const Scalar d0 = C20*h0 - Ia1*t3;
-    const Scalar qq0 = h0*t3 + Ia1*C20;
-    const Scalar t4 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh;
-    const Scalar t5 = -0.005072 + 0.5*Ia2;
-    const Scalar d1 = C20*t4 - t3*t5;
-    const Scalar qq1 = t3*t4 + C20*t5;
-    const Scalar h1 = 0.5*(-w.IA_LF_thigh[15] + Ia4);
-    const Scalar m1 = 0.5*(w.IA_LF_thigh[15] + Ia4);
-    const Scalar d2 = C20*h1 - w.IA_LF_thigh[17]*t3;
-    const Scalar qq2 = t3*h1 + w.IA_LF_thigh[17]*C20;
-    const Scalar t6 = m0 - d0;
-    const Scalar t7 = m0 + d0;
-    const Scalar t8 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh - d1;
-    const Scalar t9 = 0.005072 + 0.5*Ia2 + qq1;
-    const Scalar t10 = w.sq_LF_thigh*w.IA_LF_thigh[10] + w.cq_LF_thigh*w.IA_LF_thigh[8];
-    const Scalar t11 = w.cq_LF_thigh*w.IA_LF_thigh[10] - w.sq_LF_thigh*w.IA_LF_thigh[8];
-    const Scalar t12 = -0.005072 - 0.5*Ia2 + qq1;
-    const Scalar t13 = 0.00010144*w.IA_LF_thigh[13]*w.Dinv_LF_thigh + d1;
-    const Scalar t14 = 0.062*qq0 + t8;
-    const Scalar t15 = -0.062*t6 + t9;
-    const Scalar t16 = 0.062*t7 + t12;
-    const Scalar t17 = -0.062*qq0 + t13;
-    const Scalar t18 = w.cq_LF_thigh*pa0 + w.sq_LF_thigh*pa2;
-    const Scalar t19 = -w.sq_LF_thigh*pa0 + w.cq_LF_thigh*pa2;
-    w.IA_LF_hip[0] = 0.5950000000000001 + t6;
-    w.IA_LF_hip[2] = qq0;
-    w.IA_LF_hip[3] = t14;
-    w.IA_LF_hip[5] = -0.02164 + t15;
-    w.IA_LF_hip[8] = t10;
-    w.IA_LF_hip[10] = t11;
-    w.IA_LF_hip[11] = 0.5950000000000001 + t7;
-    w.IA_LF_hip[12] = 0.02164 + t16;
-    w.IA_LF_hip[14] = t17;
-    w.IA_LF_hip[15] = 0.0012018399999999998 + m1 - d2 + 0.062*t12 + 0.062*t16;
-    w.IA_LF_hip[17] = 4.5e-07 + qq2 - 0.062*t8 + 0.062*t17;
-    w.IA_LF_hip[20] = 0.00126484 + m1 + d2 - 0.062*t9 - 0.062*t15;
-    w.pA_LF_hip[0] = w.pA_LF_hip[0] + t18;
-    w.pA_LF_hip[1] = w.pA_LF_hip[1] + pa1;
-    w.pA_LF_hip[2] = w.pA_LF_hip[2] + t19;
-    w.pA_LF_hip[3] = w.pA_LF_hip[3] + w.cq_LF_thigh*pa3 + w.sq_LF_thigh*pa4 + 0.062*t19;
-    w.pA_LF_hip[4] = w.pA_LF_hip[4] + tau[7];
-    w.pA_LF_hip[5] = w.pA_LF_hip[5] - w.sq_LF_thigh*pa3 + w.cq_LF_thigh*pa4 - 0.062*t18;
-    w.KSD_LF_thigh[0] = w.KA_LF_thigh[4][0]*w.Dinv_LF_thigh;
-    const Scalar t20 = w.KA_LF_thigh[0][0] - w.IA_LF_thigh[4]*w.KSD_LF_thigh[0];
-    const Scalar t21 = w.KA_LF_thigh[2][0] - w.IA_LF_thigh[13]*w.KSD_LF_thigh[0];
-    const Scalar t22 = w.KA_LF_thigh[5][0] + 0.00020288*w.KSD_LF_thigh[0];
-    const Scalar t23 = w.cq_LF_thigh*t20 + w.sq_LF_thigh*t21;
-    const Scalar t24 = -w.sq_LF_thigh*t20 + w.cq_LF_thigh*t21;
-    w.KA_LF_hip[0][0] = t23;
-    w.KA_LF_hip[2][0] = t24;
-    w.KA_LF_hip[3][0] = w.cq_LF_thigh*w.KA_LF_thigh[3][0] + w.sq_LF_thigh*t22 + 0.062*t24;
-    w.KA_LF_hip[5][0] = -w.sq_LF_thigh*w.KA_LF_thigh[3][0] + w.cq_LF_thigh*t22 - 0.062*t23;
-    w.KA_LF_hip[3][1] = w.cq_LF_thigh*w.KA_LF_thigh[3][1] + w.sq_LF_thigh*w.KA_LF_thigh[5][1];
-    w.KA_LF_hip[5][1] = -w.sq_LF_thigh*w.KA_LF_thigh[3][1] + w.cq_LF_thigh*w.KA_LF_thigh[5][1];
-    w.KSD_LF_thigh[2] = w.KA_LF_thigh[4][2]*w.Dinv_LF_thigh;
-    const Scalar t25 = w.KA_LF_thigh[0][2] - w.IA_LF_thigh[4]*w.KSD_LF_thigh[2];
-    const Scalar t26 = w.KA_LF_thigh[2][2] - w.IA_LF_thigh[13]*w.KSD_LF_thigh[2];
-    const Scalar t27 = w.KA_LF_thigh[5][2] + 0.00020288*w.KSD_LF_thigh[2];
-    const Scalar t28 = w.cq_LF_thigh*t25 + w.sq_LF_thigh*t26;
-    const Scalar t29 = -w.sq_LF_thigh*t25 + w.cq_LF_thigh*t26;
-    w.KA_LF_hip[0][2] = t28;
-    w.KA_LF_hip[2][2] = t29;
-    w.KA_LF_hip[3][2] = w.cq_LF_thigh*w.KA_LF_thigh[3][2] + w.sq_LF_thigh*t27 + 0.062*t29;
-    w.KA_LF_hip[5][2] = -w.sq_LF_thigh*w.KA_LF_thigh[3][2] + w.cq_LF_thigh*t27 - 0.062*t28;
-  }
+  shared_19(shared_19_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    w.U_LF_hip[0] = 0.9950371902099893*w.IA_LF_hip[3] + 0.09950371902099893*w.IA_LF_hip[5];
-    w.U_LF_hip[1] = 0.9950371902099893*w.IA_LF_hip[8] + 0.09950371902099893*w.IA_LF_hip[10];
-    w.U_LF_hip[2] = 0.9950371902099893*w.IA_LF_hip[12] + 0.09950371902099893*w.IA_LF_hip[14];
-    w.U_LF_hip[3] = 0.9950371902099893*w.IA_LF_hip[15] + 0.09950371902099893*w.IA_LF_hip[17];
-    w.U_LF_hip[5] = 0.9950371902099893*w.IA_LF_hip[17] + 0.09950371902099893*w.IA_LF_hip[20];
-    const Scalar D0 = 0.9950371902099893*w.U_LF_hip[3] + 0.09950371902099893*w.U_LF_hip[5];
-    w.Dinv_LF_hip = 1.0 / D0;
-    w.u_LF_hip[0] = -0.9950371902099893*w.pA_LF_hip[3] - 0.09950371902099893*w.pA_LF_hip[5] + tau[6];
-    const Scalar t0 = w.U_LF_hip[0]*w.Dinv_LF_hip;
-    const Scalar t1 = w.U_LF_hip[1]*w.Dinv_LF_hip;
-    const Scalar t2 = w.U_LF_hip[2]*w.Dinv_LF_hip;
-    const Scalar t3 = w.U_LF_hip[3]*w.Dinv_LF_hip;
-    const Scalar t4 = w.U_LF_hip[5]*w.Dinv_LF_hip;
-    const Scalar Ia0 = w.IA_LF_hip[0] - w.U_LF_hip[0]*t0;
-    const Scalar Ia1 = w.IA_LF_hip[2] - w.U_LF_hip[2]*t0;
-    const Scalar Ia2 = w.IA_LF_hip[3] - w.U_LF_hip[3]*t0;
-    const Scalar Ia3 = w.IA_LF_hip[5] - w.U_LF_hip[5]*t0;
-    const Scalar Ia4 = 1.3480000000000003 - w.U_LF_hip[1]*t1;
-    const Scalar Ia5 = w.IA_LF_hip[8] - w.U_LF_hip[3]*t1;
-    const Scalar Ia6 = w.IA_LF_hip[10] - w.U_LF_hip[5]*t1;
-    const Scalar Ia7 = w.IA_LF_hip[11] - w.U_LF_hip[2]*t2;
-    const Scalar Ia8 = w.IA_LF_hip[12] - w.U_LF_hip[3]*t2;
-    const Scalar Ia9 = w.IA_LF_hip[14] - w.U_LF_hip[5]*t2;
-    const Scalar Ia10 = w.IA_LF_hip[15] - w.U_LF_hip[3]*t3;
-    const Scalar Ia11 = 5.8e-05 - 5.780668556524933e-05*w.U_LF_hip[3]*w.Dinv_LF_hip;
-    const Scalar Ia12 = w.IA_LF_hip[17] - w.U_LF_hip[5]*t3;
-    const Scalar Ia13 = 0.000623 - 3.341612896039605e-09*w.Dinv_LF_hip;
-    const Scalar Ia14 = 9.5e-07 - 5.780668556524933e-05*w.U_LF_hip[5]*w.Dinv_LF_hip;
-    const Scalar Ia15 = w.IA_LF_hip[20] - w.U_LF_hip[5]*t4;
-    const Scalar t5 = -w.U_LF_hip[1]*t0;
-    const Scalar t6 = -5.780668556524933e-05*w.U_LF_hip[0]*w.Dinv_LF_hip;
-    const Scalar t7 = -w.U_LF_hip[2]*t1;
-    const Scalar t8 = -5.780668556524933e-05*w.U_LF_hip[1]*w.Dinv_LF_hip;
-    const Scalar t9 = -5.780668556524933e-05*w.U_LF_hip[2]*w.Dinv_LF_hip;
-    const Scalar pa0 = w.pA_LF_hip[0] + w.u_LF_hip[0]*t0 + w.c_LF_hip[0]*Ia0 + w.c_LF_hip[1]*t5 + w.c_LF_hip[2]*Ia1 + w.c_LF_hip[3]*Ia2 + w.c_LF_hip[4]*t6 + w.c_LF_hip[5]*Ia3;
-    const Scalar pa1 = w.pA_LF_hip[1] + w.u_LF_hip[0]*t1 + w.c_LF_hip[0]*t5 + w.c_LF_hip[1]*Ia4 + w.c_LF_hip[2]*t7 + w.c_LF_hip[3]*Ia5 + w.c_LF_hip[4]*t8 + w.c_LF_hip[5]*Ia6;
-    const Scalar pa2 = w.pA_LF_hip[2] + w.u_LF_hip[0]*t2 + w.c_LF_hip[0]*Ia1 + w.c_LF_hip[1]*t7 + w.c_LF_hip[2]*Ia7 + w.c_LF_hip[3]*Ia8 + w.c_LF_hip[4]*t9 + w.c_LF_hip[5]*Ia9;
-    const Scalar pa3 = w.pA_LF_hip[3] + w.u_LF_hip[0]*t3 + w.c_LF_hip[0]*Ia2 + w.c_LF_hip[1]*Ia5 + w.c_LF_hip[2]*Ia8 + w.c_LF_hip[3]*Ia10 + w.c_LF_hip[4]*Ia11 + w.c_LF_hip[5]*Ia12;
-    const Scalar pa4 = w.pA_LF_hip[4] + 5.780668556524933e-05*w.Dinv_LF_hip*w.u_LF_hip[0] + w.c_LF_hip[0]*t6 + w.c_LF_hip[1]*t8 + w.c_LF_hip[2]*t9 + w.c_LF_hip[3]*Ia11 + w.c_LF_hip[4]*Ia13 + w.c_LF_hip[5]*Ia14;
-    const Scalar pa5 = w.pA_LF_hip[5] + w.u_LF_hip[0]*t4 + w.c_LF_hip[0]*Ia3 + w.c_LF_hip[1]*Ia6 + w.c_LF_hip[2]*Ia9 + w.c_LF_hip[3]*Ia12 + w.c_LF_hip[4]*Ia14 + w.c_LF_hip[5]*Ia15;
-    const Scalar t10 = w.RJ_LF_hip[0][0]*Ia0 + w.RJ_LF_hip[0][1]*t5 + w.RJ_LF_hip[0][2]*Ia1;
-    const Scalar t11 = w.RJ_LF_hip[0][0]*t5 + w.RJ_LF_hip[0][1]*Ia4 + w.RJ_LF_hip[0][2]*t7;
-    const Scalar t12 = w.RJ_LF_hip[0][0]*Ia1 + w.RJ_LF_hip[0][1]*t7 + w.RJ_LF_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_LF_hip[1][0]*Ia0 + w.cq_LF_hip*t5 + w.RJ_LF_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_LF_hip[1][0]*t5 + w.cq_LF_hip*Ia4 + w.RJ_LF_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_LF_hip[1][0]*Ia1 + w.cq_LF_hip*t7 + w.RJ_LF_hip[1][2]*Ia7;
-    const Scalar t16 = w.RJ_LF_hip[2][0]*Ia0 + w.RJ_LF_hip[2][1]*t5 + w.RJ_LF_hip[2][2]*Ia1;
-    const Scalar t17 = w.RJ_LF_hip[2][0]*t5 + w.RJ_LF_hip[2][1]*Ia4 + w.RJ_LF_hip[2][2]*t7;
-    const Scalar t18 = w.RJ_LF_hip[2][0]*Ia1 + w.RJ_LF_hip[2][1]*t7 + w.RJ_LF_hip[2][2]*Ia7;
-    const Scalar t19 = w.RJ_LF_hip[0][0]*Ia2 + w.RJ_LF_hip[0][1]*Ia5 + w.RJ_LF_hip[0][2]*Ia8;
-    const Scalar t20 = w.RJ_LF_hip[0][0]*t6 + w.RJ_LF_hip[0][1]*t8 + w.RJ_LF_hip[0][2]*t9;
-    const Scalar t21 = w.RJ_LF_hip[0][0]*Ia3 + w.RJ_LF_hip[0][1]*Ia6 + w.RJ_LF_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_LF_hip[1][0]*Ia2 + w.cq_LF_hip*Ia5 + w.RJ_LF_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_LF_hip[1][0]*t6 + w.cq_LF_hip*t8 + w.RJ_LF_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_LF_hip[1][0]*Ia3 + w.cq_LF_hip*Ia6 + w.RJ_LF_hip[1][2]*Ia9;
-    const Scalar t25 = w.RJ_LF_hip[2][0]*Ia2 + w.RJ_LF_hip[2][1]*Ia5 + w.RJ_LF_hip[2][2]*Ia8;
-    const Scalar t26 = w.RJ_LF_hip[2][0]*t6 + w.RJ_LF_hip[2][1]*t8 + w.RJ_LF_hip[2][2]*t9;
-    const Scalar t27 = w.RJ_LF_hip[2][0]*Ia3 + w.RJ_LF_hip[2][1]*Ia6 + w.RJ_LF_hip[2][2]*Ia9;
-    const Scalar t28 = w.RJ_LF_hip[0][0]*Ia10 + w.RJ_LF_hip[0][1]*Ia11 + w.RJ_LF_hip[0][2]*Ia12;
-    const Scalar t29 = w.RJ_LF_hip[0][0]*Ia11 + w.RJ_LF_hip[0][1]*Ia13 + w.RJ_LF_hip[0][2]*Ia14;
-    const Scalar t30 = w.RJ_LF_hip[0][0]*Ia12 + w.RJ_LF_hip[0][1]*Ia14 + w.RJ_LF_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_LF_hip[1][0]*Ia10 + w.cq_LF_hip*Ia11 + w.RJ_LF_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_LF_hip[1][0]*Ia11 + w.cq_LF_hip*Ia13 + w.RJ_LF_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_LF_hip[1][0]*Ia12 + w.cq_LF_hip*Ia14 + w.RJ_LF_hip[1][2]*Ia15;
-    const Scalar t34 = w.RJ_LF_hip[2][0]*Ia10 + w.RJ_LF_hip[2][1]*Ia11 + w.RJ_LF_hip[2][2]*Ia12;
-    const Scalar t35 = w.RJ_LF_hip[2][0]*Ia11 + w.RJ_LF_hip[2][1]*Ia13 + w.RJ_LF_hip[2][2]*Ia14;
-    const Scalar t36 = w.RJ_LF_hip[2][0]*Ia12 + w.RJ_LF_hip[2][1]*Ia14 + w.RJ_LF_hip[2][2]*Ia15;
-    const Scalar t37 = w.RJ_LF_hip[0][0]*t10 + w.RJ_LF_hip[0][1]*t11 + w.RJ_LF_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_LF_hip[1][0]*t10 + w.cq_LF_hip*t11 + w.RJ_LF_hip[1][2]*t12;
-    const Scalar t39 = w.RJ_LF_hip[2][0]*t10 + w.RJ_LF_hip[2][1]*t11 + w.RJ_LF_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_LF_hip[1][0]*t13 + w.cq_LF_hip*t14 + w.RJ_LF_hip[1][2]*t15;
-    const Scalar t41 = w.RJ_LF_hip[2][0]*t13 + w.RJ_LF_hip[2][1]*t14 + w.RJ_LF_hip[2][2]*t15;
-    const Scalar t42 = w.RJ_LF_hip[2][0]*t16 + w.RJ_LF_hip[2][1]*t17 + w.RJ_LF_hip[2][2]*t18;
-    const Scalar t43 = w.RJ_LF_hip[0][0]*t19 + w.RJ_LF_hip[0][1]*t20 + w.RJ_LF_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_LF_hip[1][0]*t19 + w.cq_LF_hip*t20 + w.RJ_LF_hip[1][2]*t21;
-    const Scalar t45 = w.RJ_LF_hip[2][0]*t19 + w.RJ_LF_hip[2][1]*t20 + w.RJ_LF_hip[2][2]*t21;
-    const Scalar t46 = w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[0][1]*t23 + w.RJ_LF_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_LF_hip[1][0]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[1][2]*t24;
-    const Scalar t48 = w.RJ_LF_hip[2][0]*t22 + w.RJ_LF_hip[2][1]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t49 = w.RJ_LF_hip[0][0]*t25 + w.RJ_LF_hip[0][1]*t26 + w.RJ_LF_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_LF_hip[1][0]*t25 + w.cq_LF_hip*t26 + w.RJ_LF_hip[1][2]*t27;
-    const Scalar t51 = w.RJ_LF_hip[2][0]*t25 + w.RJ_LF_hip[2][1]*t26 + w.RJ_LF_hip[2][2]*t27;
-    const Scalar t52 = 0.049*t39 + t43;
-    const Scalar t53 = -0.19*t39 + t44;
-    const Scalar t54 = -0.049*t37 + 0.19*t38 + t45;
-    const Scalar t55 = 0.049*t41 + t46;
-    const Scalar t56 = -0.19*t41 + t47;
-    const Scalar t57 = -0.049*t38 + 0.19*t40 + t48;
-    const Scalar t58 = 0.049*t42 + t49;
-    const Scalar t59 = -0.19*t42 + t50;
-    const Scalar t60 = -0.049*t39 + 0.19*t41 + t51;
-    const Scalar t61 = w.RJ_LF_hip[0][0]*pa0 + w.RJ_LF_hip[0][1]*pa1 + w.RJ_LF_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_LF_hip[1][0]*pa0 + w.cq_LF_hip*pa1 + w.RJ_LF_hip[1][2]*pa2;
-    const Scalar t63 = w.RJ_LF_hip[2][0]*pa0 + w.RJ_LF_hip[2][1]*pa1 + w.RJ_LF_hip[2][2]*pa2;
-    w.IA_trunk[0] = w.IA_trunk[0] + t37;
-    w.IA_trunk[1] = w.IA_trunk[1] + t38;
-    w.IA_trunk[2] = w.IA_trunk[2] + t39;
-    w.IA_trunk[3] = w.IA_trunk[3] + t52;
-    w.IA_trunk[4] = w.IA_trunk[4] + t53;
-    w.IA_trunk[5] = w.IA_trunk[5] + t54;
-    w.IA_trunk[6] = w.IA_trunk[6] + t40;
-    w.IA_trunk[7] = w.IA_trunk[7] + t41;
-    w.IA_trunk[8] = w.IA_trunk[8] + t55;
-    w.IA_trunk[9] = w.IA_trunk[9] + t56;
-    w.IA_trunk[10] = w.IA_trunk[10] + t57;
-    w.IA_trunk[11] = w.IA_trunk[11] + t42;
-    w.IA_trunk[12] = w.IA_trunk[12] + t58;
-    w.IA_trunk[13] = w.IA_trunk[13] + t59;
-    w.IA_trunk[14] = w.IA_trunk[14] + t60;
-    w.IA_trunk[15] = w.IA_trunk[15] + w.RJ_LF_hip[0][0]*t28 + w.RJ_LF_hip[0][1]*t29 + w.RJ_LF_hip[0][2]*t30 + 0.049*t49 + 0.049*t58;
-    w.IA_trunk[16] = w.IA_trunk[16] + w.RJ_LF_hip[1][0]*t28 + w.cq_LF_hip*t29 + w.RJ_LF_hip[1][2]*t30 - 0.19*t49 + 0.049*t59;
-    w.IA_trunk[17] = w.IA_trunk[17] + w.RJ_LF_hip[2][0]*t28 + w.RJ_LF_hip[2][1]*t29 + w.RJ_LF_hip[2][2]*t30 - 0.049*t43 + 0.19*t46 + 0.049*t60;
-    w.IA_trunk[18] = w.IA_trunk[18] + w.RJ_LF_hip[1][0]*t31 + w.cq_LF_hip*t32 + w.RJ_LF_hip[1][2]*t33 - 0.19*t50 - 0.19*t59;
-    w.IA_trunk[19] = w.IA_trunk[19] + w.RJ_LF_hip[2][0]*t31 + w.RJ_LF_hip[2][1]*t32 + w.RJ_LF_hip[2][2]*t33 - 0.049*t44 + 0.19*t47 - 0.19*t60;
-    w.IA_trunk[20] = w.IA_trunk[20] + w.RJ_LF_hip[2][0]*t34 + w.RJ_LF_hip[2][1]*t35 + w.RJ_LF_hip[2][2]*t36 - 0.049*t45 + 0.19*t48 - 0.049*t54 + 0.19*t57;
-    w.pA_trunk[0] = w.pA_trunk[0] + t61;
-    w.pA_trunk[1] = w.pA_trunk[1] + t62;
-    w.pA_trunk[2] = w.pA_trunk[2] + t63;
-    w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_LF_hip[0][0]*pa3 + w.RJ_LF_hip[0][1]*pa4 + w.RJ_LF_hip[0][2]*pa5 + 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_LF_hip[1][0]*pa3 + w.cq_LF_hip*pa4 + w.RJ_LF_hip[1][2]*pa5 - 0.19*t63;
-    w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_LF_hip[2][0]*pa3 + w.RJ_LF_hip[2][1]*pa4 + w.RJ_LF_hip[2][2]*pa5 - 0.049*t61 + 0.19*t62;
-    w.KS_LF_hip[0] = 0.9950371902099893*w.KA_LF_hip[3][0] + 0.09950371902099893*w.KA_LF_hip[5][0];
-    w.KSD_LF_hip[0] = w.Dinv_LF_hip*w.KS_LF_hip[0];
-    const Scalar t64 = w.KA_LF_hip[0][0] - w.U_LF_hip[0]*w.KSD_LF_hip[0];
-    const Scalar t65 = w.KA_LF_hip[2][0] - w.U_LF_hip[2]*w.KSD_LF_hip[0];
-    const Scalar t66 = -w.U_LF_hip[1]*w.KSD_LF_hip[0];
-    const Scalar t67 = w.KA_LF_hip[3][0] - w.U_LF_hip[3]*w.KSD_LF_hip[0];
-    const Scalar t68 = w.KA_LF_hip[5][0] - w.U_LF_hip[5]*w.KSD_LF_hip[0];
-    const Scalar t69 = w.RJ_LF_hip[0][0]*t64 + w.RJ_LF_hip[0][1]*t66 + w.RJ_LF_hip[0][2]*t65;
-    const Scalar t70 = w.RJ_LF_hip[1][0]*t64 + w.cq_LF_hip*t66 + w.RJ_LF_hip[1][2]*t65;
-    const Scalar t71 = w.RJ_LF_hip[2][0]*t64 + w.RJ_LF_hip[2][1]*t66 + w.RJ_LF_hip[2][2]*t65;
-    w.KA_trunk[0][0] = t69;
-    w.KA_trunk[1][0] = t70;
-    w.KA_trunk[2][0] = t71;
-    w.KA_trunk[3][0] = w.RJ_LF_hip[0][0]*t67 - 5.780668556524933e-05*w.RJ_LF_hip[0][1]*w.KSD_LF_hip[0] + w.RJ_LF_hip[0][2]*t68 + 0.049*t71;
-    w.KA_trunk[4][0] = w.RJ_LF_hip[1][0]*t67 - 5.780668556524933e-05*w.cq_LF_hip*w.KSD_LF_hip[0] + w.RJ_LF_hip[1][2]*t68 - 0.19*t71;
-    w.KA_trunk[5][0] = w.RJ_LF_hip[2][0]*t67 - 5.780668556524933e-05*w.RJ_LF_hip[2][1]*w.KSD_LF_hip[0] + w.RJ_LF_hip[2][2]*t68 - 0.049*t69 + 0.19*t70;
-    w.KS_LF_hip[1] = 0.9950371902099893*w.KA_LF_hip[3][1] + 0.09950371902099893*w.KA_LF_hip[5][1];
-    w.KSD_LF_hip[1] = w.Dinv_LF_hip*w.KS_LF_hip[1];
-    const Scalar t72 = 1.0 - w.U_LF_hip[1]*w.KSD_LF_hip[1];
-    const Scalar t73 = -w.U_LF_hip[0]*w.KSD_LF_hip[1];
-    const Scalar t74 = -w.U_LF_hip[2]*w.KSD_LF_hip[1];
-    const Scalar t75 = w.KA_LF_hip[3][1] - w.U_LF_hip[3]*w.KSD_LF_hip[1];
-    const Scalar t76 = w.KA_LF_hip[5][1] - w.U_LF_hip[5]*w.KSD_LF_hip[1];
-    const Scalar t77 = w.RJ_LF_hip[0][0]*t73 + w.RJ_LF_hip[0][1]*t72 + w.RJ_LF_hip[0][2]*t74;
-    const Scalar t78 = w.RJ_LF_hip[1][0]*t73 + w.cq_LF_hip*t72 + w.RJ_LF_hip[1][2]*t74;
-    const Scalar t79 = w.RJ_LF_hip[2][0]*t73 + w.RJ_LF_hip[2][1]*t72 + w.RJ_LF_hip[2][2]*t74;
-    w.KA_trunk[0][1] = t77;
-    w.KA_trunk[1][1] = t78;
-    w.KA_trunk[2][1] = t79;
-    w.KA_trunk[3][1] = w.RJ_LF_hip[0][0]*t75 - 5.780668556524933e-05*w.RJ_LF_hip[0][1]*w.KSD_LF_hip[1] + w.RJ_LF_hip[0][2]*t76 + 0.049*t79;
-    w.KA_trunk[4][1] = w.RJ_LF_hip[1][0]*t75 - 5.780668556524933e-05*w.cq_LF_hip*w.KSD_LF_hip[1] + w.RJ_LF_hip[1][2]*t76 - 0.19*t79;
-    w.KA_trunk[5][1] = w.RJ_LF_hip[2][0]*t75 - 5.780668556524933e-05*w.RJ_LF_hip[2][1]*w.KSD_LF_hip[1] + w.RJ_LF_hip[2][2]*t76 - 0.049*t77 + 0.19*t78;
-    w.KS_LF_hip[2] = 0.9950371902099893*w.KA_LF_hip[3][2] + 0.09950371902099893*w.KA_LF_hip[5][2];
-    w.KSD_LF_hip[2] = w.Dinv_LF_hip*w.KS_LF_hip[2];
-    const Scalar t80 = w.KA_LF_hip[0][2] - w.U_LF_hip[0]*w.KSD_LF_hip[2];
-    const Scalar t81 = w.KA_LF_hip[2][2] - w.U_LF_hip[2]*w.KSD_LF_hip[2];
-    const Scalar t82 = -w.U_LF_hip[1]*w.KSD_LF_hip[2];
-    const Scalar t83 = w.KA_LF_hip[3][2] - w.U_LF_hip[3]*w.KSD_LF_hip[2];
-    const Scalar t84 = w.KA_LF_hip[5][2] - w.U_LF_hip[5]*w.KSD_LF_hip[2];
-    const Scalar t85 = w.RJ_LF_hip[0][0]*t80 + w.RJ_LF_hip[0][1]*t82 + w.RJ_LF_hip[0][2]*t81;
-    const Scalar t86 = w.RJ_LF_hip[1][0]*t80 + w.cq_LF_hip*t82 + w.RJ_LF_hip[1][2]*t81;
-    const Scalar t87 = w.RJ_LF_hip[2][0]*t80 + w.RJ_LF_hip[2][1]*t82 + w.RJ_LF_hip[2][2]*t81;
-    w.KA_trunk[0][2] = t85;
-    w.KA_trunk[1][2] = t86;
-    w.KA_trunk[2][2] = t87;
-    w.KA_trunk[3][2] = w.RJ_LF_hip[0][0]*t83 - 5.780668556524933e-05*w.RJ_LF_hip[0][1]*w.KSD_LF_hip[2] + w.RJ_LF_hip[0][2]*t84 + 0.049*t87;
-    w.KA_trunk[4][2] = w.RJ_LF_hip[1][0]*t83 - 5.780668556524933e-05*w.cq_LF_hip*w.KSD_LF_hip[2] + w.RJ_LF_hip[1][2]*t84 - 0.19*t87;
-    w.KA_trunk[5][2] = w.RJ_LF_hip[2][0]*t83 - 5.780668556524933e-05*w.RJ_LF_hip[2][1]*w.KSD_LF_hip[2] + w.RJ_LF_hip[2][2]*t84 - 0.049*t85 + 0.19*t86;
-  }
+  shared_20(shared_20_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4099,199 +2361,36 @@ PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
-    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
-    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
-    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
-    const Scalar t6 = w.u_LF_thigh[0] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
-    w.a_LF_thigh[0] = t2;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = t3;
-    w.a_LF_thigh[3] = t4;
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.Dinv_LF_thigh*t6;
-    w.a_LF_thigh[5] = t5;
-  }
+  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
   // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t13 = w.u_LF_shank[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*t9;
-    w.a_LF_shank[0] = t9;
-    w.a_LF_shank[1] = t8;
-    w.a_LF_shank[2] = t10;
-    w.a_LF_shank[3] = t11;
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + 2057.0036861506055*t13;
-    w.a_LF_shank[5] = t12;
-  }
+  shared_22(shared_22_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.a_LF_shank);
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0][0]*t14 + w.RJ_LH_hip[1][0]*t15 + w.RJ_LH_hip[2][0]*t16;
-    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[0][1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[2][1]*t16;
-    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[0][2]*t14 + w.RJ_LH_hip[1][2]*t15 + w.RJ_LH_hip[2][2]*t16;
-    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0][0] + w.a_trunk[4]*w.RJ_LH_hip[1][0] + w.a_trunk[5]*w.RJ_LH_hip[2][0];
-    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[0][1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[2][1];
-    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[0][2] + w.a_trunk[4]*w.RJ_LH_hip[1][2] + w.a_trunk[5]*w.RJ_LH_hip[2][2];
-    const Scalar t23 = w.u_LH_hip[0] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
-    w.a_LH_hip[0] = t17;
-    w.a_LH_hip[1] = t18;
-    w.a_LH_hip[2] = t19;
-    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.Dinv_LH_hip*t23;
-    w.a_LH_hip[4] = t21;
-    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.Dinv_LH_hip*t23;
-  }
+  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
-    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
-    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
-    const Scalar t6 = w.u_LH_thigh[0] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
-    w.a_LH_thigh[0] = t2;
-    w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = t3;
-    w.a_LH_thigh[3] = t4;
-    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.Dinv_LH_thigh*t6;
-    w.a_LH_thigh[5] = t5;
-  }
+  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
   // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t13 = w.u_LH_shank[0] - 0.000486144*w.a_LH_thigh[4] + 0.003904*t9;
-    w.a_LH_shank[0] = t9;
-    w.a_LH_shank[1] = t8;
-    w.a_LH_shank[2] = t10;
-    w.a_LH_shank[3] = t11;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + 2057.0036861506055*t13;
-    w.a_LH_shank[5] = t12;
-  }
+  shared_22(shared_22_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.a_LH_shank);
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0][0]*t14 + w.RJ_RF_hip[1][0]*t15 + w.RJ_RF_hip[2][0]*t16;
-    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[0][1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[2][1]*t16;
-    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[0][2]*t14 + w.RJ_RF_hip[1][2]*t15 + w.RJ_RF_hip[2][2]*t16;
-    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0][0] + w.a_trunk[4]*w.RJ_RF_hip[1][0] + w.a_trunk[5]*w.RJ_RF_hip[2][0];
-    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[0][1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[2][1];
-    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[0][2] + w.a_trunk[4]*w.RJ_RF_hip[1][2] + w.a_trunk[5]*w.RJ_RF_hip[2][2];
-    const Scalar t23 = w.u_RF_hip[0] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
-    w.a_RF_hip[0] = t17;
-    w.a_RF_hip[1] = t18;
-    w.a_RF_hip[2] = t19;
-    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.Dinv_RF_hip*t23;
-    w.a_RF_hip[4] = t21;
-    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.Dinv_RF_hip*t23;
-  }
+  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
-    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
-    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
-    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
-    const Scalar t6 = w.u_RF_thigh[0] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
-    w.a_RF_thigh[0] = t2;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = t3;
-    w.a_RF_thigh[3] = t4;
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.Dinv_RF_thigh*t6;
-    w.a_RF_thigh[5] = t5;
-  }
+  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
   // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t13 = w.u_RF_shank[0] - 0.000486144*w.a_RF_thigh[4] + 0.003904*t9;
-    w.a_RF_shank[0] = t9;
-    w.a_RF_shank[1] = t8;
-    w.a_RF_shank[2] = t10;
-    w.a_RF_shank[3] = t11;
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + 2057.0036861506055*t13;
-    w.a_RF_shank[5] = t12;
-  }
+  shared_22(shared_22_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.a_RF_shank);
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[1][0]*t15 + w.RJ_RH_hip[2][0]*t16;
-    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[0][1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[2][1]*t16;
-    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[0][2]*t14 + w.RJ_RH_hip[1][2]*t15 + w.RJ_RH_hip[2][2]*t16;
-    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0][0] + w.a_trunk[4]*w.RJ_RH_hip[1][0] + w.a_trunk[5]*w.RJ_RH_hip[2][0];
-    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[0][1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[2][1];
-    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[0][2] + w.a_trunk[4]*w.RJ_RH_hip[1][2] + w.a_trunk[5]*w.RJ_RH_hip[2][2];
-    const Scalar t23 = w.u_RH_hip[0] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
-    w.a_RH_hip[0] = t17;
-    w.a_RH_hip[1] = t18;
-    w.a_RH_hip[2] = t19;
-    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.Dinv_RH_hip*t23;
-    w.a_RH_hip[4] = t21;
-    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.Dinv_RH_hip*t23;
-  }
+  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
-    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
-    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
-    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
-    const Scalar t6 = w.u_RH_thigh[0] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
-    w.a_RH_thigh[0] = t2;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = t3;
-    w.a_RH_thigh[3] = t4;
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.Dinv_RH_thigh*t6;
-    w.a_RH_thigh[5] = t5;
-  }
+  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t13 = w.u_RH_shank[0] - 0.000486144*w.a_RH_thigh[4] + 0.003904*t9;
-    w.a_RH_shank[0] = t9;
-    w.a_RH_shank[1] = t8;
-    w.a_RH_shank[2] = t10;
-    w.a_RH_shank[3] = t11;
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + 2057.0036861506055*t13;
-    w.a_RH_shank[5] = t12;
-  }
+  shared_22(shared_22_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.a_RH_shank);
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -4350,16 +2449,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t6 = 78.21756516587678 + inv_mu + w.KSD_LH_hip[0]*w.KS_LH_hip[0] + w.KSD_LH_thigh[0]*w.KA_LH_thigh[4][0];
-    const Scalar r3 = std::sqrt(t6);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[3] = inv3;
-    const Scalar t7 = w.KSD_LH_hip[1]*w.KS_LH_hip[0];
-    w.L[34] = w.Linv[3]*t7;
-    const Scalar t8 = w.KSD_LH_hip[2]*w.KS_LH_hip[0] + w.KSD_LH_thigh[2]*w.KA_LH_thigh[4][0];
-    w.L[35] = w.Linv[3]*t8;
-  }
+  shared_24(shared_24_k0, inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t9 = inv_mu + w.KSD_LH_hip[1]*w.KS_LH_hip[1] - w.L[34]*w.L[34];
@@ -4377,16 +2467,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t12 = 78.21756516587678 + inv_mu + w.KSD_RF_hip[0]*w.KS_RF_hip[0] + w.KSD_RF_thigh[0]*w.KA_RF_thigh[4][0];
-    const Scalar r6 = std::sqrt(t12);
-    const Scalar inv6 = 1.0 / r6;
-    w.Linv[6] = inv6;
-    const Scalar t13 = w.KSD_RF_hip[1]*w.KS_RF_hip[0];
-    w.L[58] = w.Linv[6]*t13;
-    const Scalar t14 = w.KSD_RF_hip[2]*w.KS_RF_hip[0] + w.KSD_RF_thigh[2]*w.KA_RF_thigh[4][0];
-    w.L[59] = w.Linv[6]*t14;
-  }
+  shared_24(shared_24_k0, inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4407,16 +2488,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& P
     w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t3 = 78.21756516587678 + inv_mu + w.KSD_RH_hip[0]*w.KS_RH_hip[0] + w.KSD_RH_thigh[0]*w.KA_RH_thigh[4][0];
-    const Scalar r2 = std::sqrt(t3);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[9] = inv2;
-    const Scalar t4 = w.KSD_RH_hip[1]*w.KS_RH_hip[0];
-    w.L[73] = w.Linv[9]*t4;
-    const Scalar t5 = w.KSD_RH_hip[2]*w.KS_RH_hip[0] + w.KSD_RH_thigh[2]*w.KA_RH_thigh[4][0];
-    w.L[74] = w.Linv[9]*t5;
-  }
+  shared_24(shared_24_k0, inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
@@ -4863,210 +2935,36 @@ PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRI
 
 PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  {
-    const Scalar t0 = w.a_LF_hip[0] - 0.062*w.a_LF_hip[5];
-    const Scalar t1 = w.a_LF_hip[2] + 0.062*w.a_LF_hip[3];
-    const Scalar t2 = w.c_LF_thigh[0] + w.cq_LF_thigh*t0 - w.sq_LF_thigh*t1;
-    const Scalar t3 = w.c_LF_thigh[2] + w.sq_LF_thigh*t0 + w.cq_LF_thigh*t1;
-    const Scalar t4 = w.c_LF_thigh[3] + w.a_LF_hip[3]*w.cq_LF_thigh - w.a_LF_hip[5]*w.sq_LF_thigh;
-    const Scalar t5 = w.c_LF_thigh[5] + w.a_LF_hip[3]*w.sq_LF_thigh + w.a_LF_hip[5]*w.cq_LF_thigh;
-    const Scalar t6 = w.u_LF_thigh[0] - w.KA_LF_thigh[4][0]*w.lambda[0] - w.KA_LF_thigh[4][2]*w.lambda[2] + 0.00020288*t5 - w.IA_LF_thigh[4]*t2 - w.IA_LF_thigh[13]*t3 - w.a_LF_hip[4]*w.IA_LF_thigh[18];
-    w.qdd[7] = w.Dinv_LF_thigh*t6;
-    w.a_LF_thigh[0] = t2;
-    w.a_LF_thigh[1] = w.a_LF_hip[1];
-    w.a_LF_thigh[2] = t3;
-    w.a_LF_thigh[3] = t4;
-    w.a_LF_thigh[4] = w.a_LF_hip[4] + w.qdd[7];
-    w.a_LF_thigh[5] = t5;
-  }
+  shared_25(shared_25_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  {
-    const Scalar t7 = w.a_LF_thigh[0] - 0.209*w.a_LF_thigh[4];
-    const Scalar t8 = w.a_LF_thigh[1] + 0.209*w.a_LF_thigh[3];
-    const Scalar t9 = w.c_LF_shank[0] + w.cq_LF_shank*t7 - w.sq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t10 = w.c_LF_shank[2] + w.sq_LF_shank*t7 + w.cq_LF_shank*w.a_LF_thigh[2];
-    const Scalar t11 = w.c_LF_shank[3] + w.cq_LF_shank*w.a_LF_thigh[3] - w.sq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t12 = w.c_LF_shank[5] + w.sq_LF_shank*w.a_LF_thigh[3] + w.cq_LF_shank*w.a_LF_thigh[5];
-    const Scalar t13 = w.u_LF_shank[0] + 0.195*w.lambda[0] - 0.000486144*w.a_LF_thigh[4] + 0.003904*t9;
-    w.qdd[8] = 2057.0036861506055*t13;
-    w.a_LF_shank[0] = t9;
-    w.a_LF_shank[1] = t8;
-    w.a_LF_shank[2] = t10;
-    w.a_LF_shank[3] = t11;
-    w.a_LF_shank[4] = w.a_LF_thigh[4] + w.qdd[8];
-    w.a_LF_shank[5] = t12;
-  }
+  shared_26(shared_26_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
   // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] + 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_LH_hip[0] + w.RJ_LH_hip[0][0]*t14 + w.RJ_LH_hip[1][0]*t15 + w.RJ_LH_hip[2][0]*t16;
-    const Scalar t18 = w.c_LH_hip[1] + w.RJ_LH_hip[0][1]*t14 + w.cq_LH_hip*t15 + w.RJ_LH_hip[2][1]*t16;
-    const Scalar t19 = w.c_LH_hip[2] + w.RJ_LH_hip[0][2]*t14 + w.RJ_LH_hip[1][2]*t15 + w.RJ_LH_hip[2][2]*t16;
-    const Scalar t20 = w.c_LH_hip[3] + w.a_trunk[3]*w.RJ_LH_hip[0][0] + w.a_trunk[4]*w.RJ_LH_hip[1][0] + w.a_trunk[5]*w.RJ_LH_hip[2][0];
-    const Scalar t21 = w.c_LH_hip[4] + w.a_trunk[3]*w.RJ_LH_hip[0][1] + w.a_trunk[4]*w.cq_LH_hip + w.a_trunk[5]*w.RJ_LH_hip[2][1];
-    const Scalar t22 = w.c_LH_hip[5] + w.a_trunk[3]*w.RJ_LH_hip[0][2] + w.a_trunk[4]*w.RJ_LH_hip[1][2] + w.a_trunk[5]*w.RJ_LH_hip[2][2];
-    const Scalar t23 = w.u_LH_hip[0] - w.KS_LH_hip[0]*w.lambda[6] - w.KS_LH_hip[1]*w.lambda[7] - w.KS_LH_hip[2]*w.lambda[8] - 5.7617628499109426e-05*t21 - w.U_LH_hip[0]*t17 - w.U_LH_hip[1]*t18 - w.U_LH_hip[2]*t19 - w.U_LH_hip[3]*t20 - w.U_LH_hip[5]*t22;
-    w.qdd[9] = w.Dinv_LH_hip*t23;
-    w.a_LH_hip[0] = t17;
-    w.a_LH_hip[1] = t18;
-    w.a_LH_hip[2] = t19;
-    w.a_LH_hip[3] = t20 + 0.9950371902099892*w.qdd[9];
-    w.a_LH_hip[4] = t21;
-    w.a_LH_hip[5] = t22 - 0.09950371902099892*w.qdd[9];
-  }
+  shared_27(shared_27_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  {
-    const Scalar t0 = w.a_LH_hip[0] - 0.062*w.a_LH_hip[5];
-    const Scalar t1 = w.a_LH_hip[2] + 0.062*w.a_LH_hip[3];
-    const Scalar t2 = w.c_LH_thigh[0] + w.cq_LH_thigh*t0 - w.sq_LH_thigh*t1;
-    const Scalar t3 = w.c_LH_thigh[2] + w.sq_LH_thigh*t0 + w.cq_LH_thigh*t1;
-    const Scalar t4 = w.c_LH_thigh[3] + w.a_LH_hip[3]*w.cq_LH_thigh - w.a_LH_hip[5]*w.sq_LH_thigh;
-    const Scalar t5 = w.c_LH_thigh[5] + w.a_LH_hip[3]*w.sq_LH_thigh + w.a_LH_hip[5]*w.cq_LH_thigh;
-    const Scalar t6 = w.u_LH_thigh[0] - w.KA_LH_thigh[4][0]*w.lambda[6] - w.KA_LH_thigh[4][2]*w.lambda[8] + 0.00020288*t5 - w.IA_LH_thigh[4]*t2 - w.IA_LH_thigh[13]*t3 - w.a_LH_hip[4]*w.IA_LH_thigh[18];
-    w.qdd[10] = w.Dinv_LH_thigh*t6;
-    w.a_LH_thigh[0] = t2;
-    w.a_LH_thigh[1] = w.a_LH_hip[1];
-    w.a_LH_thigh[2] = t3;
-    w.a_LH_thigh[3] = t4;
-    w.a_LH_thigh[4] = w.a_LH_hip[4] + w.qdd[10];
-    w.a_LH_thigh[5] = t5;
-  }
+  shared_25(shared_25_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  {
-    const Scalar t7 = w.a_LH_thigh[0] - 0.209*w.a_LH_thigh[4];
-    const Scalar t8 = w.a_LH_thigh[1] + 0.209*w.a_LH_thigh[3];
-    const Scalar t9 = w.c_LH_shank[0] + w.cq_LH_shank*t7 - w.sq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t10 = w.c_LH_shank[2] + w.sq_LH_shank*t7 + w.cq_LH_shank*w.a_LH_thigh[2];
-    const Scalar t11 = w.c_LH_shank[3] + w.cq_LH_shank*w.a_LH_thigh[3] - w.sq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t12 = w.c_LH_shank[5] + w.sq_LH_shank*w.a_LH_thigh[3] + w.cq_LH_shank*w.a_LH_thigh[5];
-    const Scalar t13 = w.u_LH_shank[0] + 0.195*w.lambda[6] - 0.000486144*w.a_LH_thigh[4] + 0.003904*t9;
-    w.qdd[11] = 2057.0036861506055*t13;
-    w.a_LH_shank[0] = t9;
-    w.a_LH_shank[1] = t8;
-    w.a_LH_shank[2] = t10;
-    w.a_LH_shank[3] = t11;
-    w.a_LH_shank[4] = w.a_LH_thigh[4] + w.qdd[11];
-    w.a_LH_shank[5] = t12;
-  }
+  shared_26(shared_26_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RF_hip[0] + w.RJ_RF_hip[0][0]*t14 + w.RJ_RF_hip[1][0]*t15 + w.RJ_RF_hip[2][0]*t16;
-    const Scalar t18 = w.c_RF_hip[1] + w.RJ_RF_hip[0][1]*t14 + w.cq_RF_hip*t15 + w.RJ_RF_hip[2][1]*t16;
-    const Scalar t19 = w.c_RF_hip[2] + w.RJ_RF_hip[0][2]*t14 + w.RJ_RF_hip[1][2]*t15 + w.RJ_RF_hip[2][2]*t16;
-    const Scalar t20 = w.c_RF_hip[3] + w.a_trunk[3]*w.RJ_RF_hip[0][0] + w.a_trunk[4]*w.RJ_RF_hip[1][0] + w.a_trunk[5]*w.RJ_RF_hip[2][0];
-    const Scalar t21 = w.c_RF_hip[4] + w.a_trunk[3]*w.RJ_RF_hip[0][1] + w.a_trunk[4]*w.cq_RF_hip + w.a_trunk[5]*w.RJ_RF_hip[2][1];
-    const Scalar t22 = w.c_RF_hip[5] + w.a_trunk[3]*w.RJ_RF_hip[0][2] + w.a_trunk[4]*w.RJ_RF_hip[1][2] + w.a_trunk[5]*w.RJ_RF_hip[2][2];
-    const Scalar t23 = w.u_RF_hip[0] - w.KS_RF_hip[0]*w.lambda[3] - w.KS_RF_hip[1]*w.lambda[4] - w.KS_RF_hip[2]*w.lambda[5] + 5.780668556524933e-05*t21 - w.U_RF_hip[0]*t17 - w.U_RF_hip[1]*t18 - w.U_RF_hip[2]*t19 - w.U_RF_hip[3]*t20 - w.U_RF_hip[5]*t22;
-    w.qdd[12] = w.Dinv_RF_hip*t23;
-    w.a_RF_hip[0] = t17;
-    w.a_RF_hip[1] = t18;
-    w.a_RF_hip[2] = t19;
-    w.a_RF_hip[3] = t20 + 0.9950371902099893*w.qdd[12];
-    w.a_RF_hip[4] = t21;
-    w.a_RF_hip[5] = t22 + 0.09950371902099893*w.qdd[12];
-  }
+  shared_27(shared_27_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  {
-    const Scalar t0 = w.a_RF_hip[0] + 0.062*w.a_RF_hip[5];
-    const Scalar t1 = w.a_RF_hip[2] - 0.062*w.a_RF_hip[3];
-    const Scalar t2 = w.c_RF_thigh[0] + w.cq_RF_thigh*t0 - w.sq_RF_thigh*t1;
-    const Scalar t3 = w.c_RF_thigh[2] + w.sq_RF_thigh*t0 + w.cq_RF_thigh*t1;
-    const Scalar t4 = w.c_RF_thigh[3] + w.a_RF_hip[3]*w.cq_RF_thigh - w.a_RF_hip[5]*w.sq_RF_thigh;
-    const Scalar t5 = w.c_RF_thigh[5] + w.a_RF_hip[3]*w.sq_RF_thigh + w.a_RF_hip[5]*w.cq_RF_thigh;
-    const Scalar t6 = w.u_RF_thigh[0] - w.KA_RF_thigh[4][0]*w.lambda[3] - w.KA_RF_thigh[4][2]*w.lambda[5] - 0.00020288*t5 - w.IA_RF_thigh[4]*t2 - w.IA_RF_thigh[13]*t3 - w.a_RF_hip[4]*w.IA_RF_thigh[18];
-    w.qdd[13] = w.Dinv_RF_thigh*t6;
-    w.a_RF_thigh[0] = t2;
-    w.a_RF_thigh[1] = w.a_RF_hip[1];
-    w.a_RF_thigh[2] = t3;
-    w.a_RF_thigh[3] = t4;
-    w.a_RF_thigh[4] = w.a_RF_hip[4] + w.qdd[13];
-    w.a_RF_thigh[5] = t5;
-  }
+  shared_25(shared_25_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  {
-    const Scalar t7 = w.a_RF_thigh[0] - 0.209*w.a_RF_thigh[4];
-    const Scalar t8 = w.a_RF_thigh[1] + 0.209*w.a_RF_thigh[3];
-    const Scalar t9 = w.c_RF_shank[0] + w.cq_RF_shank*t7 - w.sq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t10 = w.c_RF_shank[2] + w.sq_RF_shank*t7 + w.cq_RF_shank*w.a_RF_thigh[2];
-    const Scalar t11 = w.c_RF_shank[3] + w.cq_RF_shank*w.a_RF_thigh[3] - w.sq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t12 = w.c_RF_shank[5] + w.sq_RF_shank*w.a_RF_thigh[3] + w.cq_RF_shank*w.a_RF_thigh[5];
-    const Scalar t13 = w.u_RF_shank[0] + 0.195*w.lambda[3] - 0.000486144*w.a_RF_thigh[4] + 0.003904*t9;
-    w.qdd[14] = 2057.0036861506055*t13;
-    w.a_RF_shank[0] = t9;
-    w.a_RF_shank[1] = t8;
-    w.a_RF_shank[2] = t10;
-    w.a_RF_shank[3] = t11;
-    w.a_RF_shank[4] = w.a_RF_thigh[4] + w.qdd[14];
-    w.a_RF_shank[5] = t12;
-  }
+  shared_26(shared_26_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
   // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t14 = w.a_trunk[0] + 0.049*w.a_trunk[5];
-    const Scalar t15 = w.a_trunk[1] - 0.19*w.a_trunk[5];
-    const Scalar t16 = w.a_trunk[2] - 0.049*w.a_trunk[3] + 0.19*w.a_trunk[4];
-    const Scalar t17 = w.c_RH_hip[0] + w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[1][0]*t15 + w.RJ_RH_hip[2][0]*t16;
-    const Scalar t18 = w.c_RH_hip[1] + w.RJ_RH_hip[0][1]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[2][1]*t16;
-    const Scalar t19 = w.c_RH_hip[2] + w.RJ_RH_hip[0][2]*t14 + w.RJ_RH_hip[1][2]*t15 + w.RJ_RH_hip[2][2]*t16;
-    const Scalar t20 = w.c_RH_hip[3] + w.a_trunk[3]*w.RJ_RH_hip[0][0] + w.a_trunk[4]*w.RJ_RH_hip[1][0] + w.a_trunk[5]*w.RJ_RH_hip[2][0];
-    const Scalar t21 = w.c_RH_hip[4] + w.a_trunk[3]*w.RJ_RH_hip[0][1] + w.a_trunk[4]*w.cq_RH_hip + w.a_trunk[5]*w.RJ_RH_hip[2][1];
-    const Scalar t22 = w.c_RH_hip[5] + w.a_trunk[3]*w.RJ_RH_hip[0][2] + w.a_trunk[4]*w.RJ_RH_hip[1][2] + w.a_trunk[5]*w.RJ_RH_hip[2][2];
-    const Scalar t23 = w.u_RH_hip[0] - w.KS_RH_hip[0]*w.lambda[9] - w.KS_RH_hip[1]*w.lambda[10] - w.KS_RH_hip[2]*w.lambda[11] + 5.7617628499109426e-05*t21 - w.U_RH_hip[0]*t17 - w.U_RH_hip[1]*t18 - w.U_RH_hip[2]*t19 - w.U_RH_hip[3]*t20 - w.U_RH_hip[5]*t22;
-    w.qdd[15] = w.Dinv_RH_hip*t23;
-    w.a_RH_hip[0] = t17;
-    w.a_RH_hip[1] = t18;
-    w.a_RH_hip[2] = t19;
-    w.a_RH_hip[3] = t20 + 0.9950371902099892*w.qdd[15];
-    w.a_RH_hip[4] = t21;
-    w.a_RH_hip[5] = t22 - 0.09950371902099892*w.qdd[15];
-  }
+  shared_27(shared_27_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  {
-    const Scalar t0 = w.a_RH_hip[0] + 0.062*w.a_RH_hip[5];
-    const Scalar t1 = w.a_RH_hip[2] - 0.062*w.a_RH_hip[3];
-    const Scalar t2 = w.c_RH_thigh[0] + w.cq_RH_thigh*t0 - w.sq_RH_thigh*t1;
-    const Scalar t3 = w.c_RH_thigh[2] + w.sq_RH_thigh*t0 + w.cq_RH_thigh*t1;
-    const Scalar t4 = w.c_RH_thigh[3] + w.a_RH_hip[3]*w.cq_RH_thigh - w.a_RH_hip[5]*w.sq_RH_thigh;
-    const Scalar t5 = w.c_RH_thigh[5] + w.a_RH_hip[3]*w.sq_RH_thigh + w.a_RH_hip[5]*w.cq_RH_thigh;
-    const Scalar t6 = w.u_RH_thigh[0] - w.KA_RH_thigh[4][0]*w.lambda[9] - w.KA_RH_thigh[4][2]*w.lambda[11] - 0.00020288*t5 - w.IA_RH_thigh[4]*t2 - w.IA_RH_thigh[13]*t3 - w.a_RH_hip[4]*w.IA_RH_thigh[18];
-    w.qdd[16] = w.Dinv_RH_thigh*t6;
-    w.a_RH_thigh[0] = t2;
-    w.a_RH_thigh[1] = w.a_RH_hip[1];
-    w.a_RH_thigh[2] = t3;
-    w.a_RH_thigh[3] = t4;
-    w.a_RH_thigh[4] = w.a_RH_hip[4] + w.qdd[16];
-    w.a_RH_thigh[5] = t5;
-  }
+  shared_25(shared_25_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  {
-    const Scalar t7 = w.a_RH_thigh[0] - 0.209*w.a_RH_thigh[4];
-    const Scalar t8 = w.a_RH_thigh[1] + 0.209*w.a_RH_thigh[3];
-    const Scalar t9 = w.c_RH_shank[0] + w.cq_RH_shank*t7 - w.sq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t10 = w.c_RH_shank[2] + w.sq_RH_shank*t7 + w.cq_RH_shank*w.a_RH_thigh[2];
-    const Scalar t11 = w.c_RH_shank[3] + w.cq_RH_shank*w.a_RH_thigh[3] - w.sq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t12 = w.c_RH_shank[5] + w.sq_RH_shank*w.a_RH_thigh[3] + w.cq_RH_shank*w.a_RH_thigh[5];
-    const Scalar t13 = w.u_RH_shank[0] + 0.195*w.lambda[9] - 0.000486144*w.a_RH_thigh[4] + 0.003904*t9;
-    w.qdd[17] = 2057.0036861506055*t13;
-    w.a_RH_shank[0] = t9;
-    w.a_RH_shank[1] = t8;
-    w.a_RH_shank[2] = t10;
-    w.a_RH_shank[3] = t11;
-    w.a_RH_shank[4] = w.a_RH_thigh[4] + w.qdd[17];
-    w.a_RH_shank[5] = t12;
-  }
+  shared_26(shared_26_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {

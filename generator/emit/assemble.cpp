@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -573,11 +574,30 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
                                plan.nc > 0 ? "  return proxgen_rt::largest_magnitude_of<nc>(w.residual);\n"
                                            : "  static_cast<void>(w);\n  return Scalar(0);\n");
   }
-  const std::string banner = fmt::format(
-      fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION), fmt::arg("urdf", escapeComment(in.urdfName)),
-      fmt::arg("layout", escapeComment(in.layoutName)), fmt::arg("command", escapeComment(in.command)),
-      fmt::arg("robot", escapeComment(m.name)), fmt::arg("urdf_sha", in.urdfSha256), fmt::arg("layout_sha", in.layoutSha256),
-      fmt::arg("operations", operations));
+  // Which blocks were shared (issue 20: say which subtrees share their code).
+  std::string shared;
+  if (!texts.sharedKernels.empty()) {
+    shared = "// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the\n"
+             "// same code up to their constants, over a table of each one's constants:\n";
+    for (const SharedKernel& k : texts.sharedKernels) {
+      std::string bodies;
+      std::set<std::string> seen;
+      for (const std::string& b : k.blocks) {
+        const std::size_t a = b.find('\''), z = a == std::string::npos ? a : b.find('\'', a + 1);
+        const std::string name = z == std::string::npos ? b : b.substr(a + 1, z - a - 1);
+        if (seen.insert(name).second) bodies += (bodies.empty() ? "" : ", ") + name;
+      }
+      shared += fmt::format("//   {}: {} blocks of {}\n", k.name, k.blocks.size(), bodies);
+    }
+  }
+  auto bannerWith = [&](const std::string& sharedLines) {
+    return fmt::format(fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION),
+                       fmt::arg("urdf", escapeComment(in.urdfName)), fmt::arg("layout", escapeComment(in.layoutName)),
+                       fmt::arg("command", escapeComment(in.command)), fmt::arg("robot", escapeComment(m.name)),
+                       fmt::arg("urdf_sha", in.urdfSha256), fmt::arg("layout_sha", in.layoutSha256),
+                       fmt::arg("operations", operations + sharedLines));
+  };
+  const std::string banner = bannerWith(shared);
 
   SolverFiles files;
   files.headerName = plan.name + ".hpp";
@@ -600,9 +620,14 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
       fmt::arg("constraint_ids", n.consIds), fmt::arg("active_size", std::max<std::size_t>(plan.constraints.size(), 1)),
       fmt::arg("active_init", activeInit(plan)),
       fmt::arg("active_note", plan.constraints.empty() ? "\n  // No constraints: one placeholder entry, never read." : ""));
-  files.source = fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", plan.name),
-                             fmt::arg("parts", texts.parts), fmt::arg("helpers", helpers(texts)), fmt::arg("part_helpers", partHelpers(sys, texts)),
-                             fmt::arg("free_bodies", freeBodies(texts)), fmt::arg("definitions", definitions));
+  auto source = [&](const std::string& parts, const std::string& sourceBanner) {
+    return fmt::format(fmt::runtime(kSourceTemplate), fmt::arg("banner", sourceBanner), fmt::arg("name", plan.name),
+                       fmt::arg("parts", parts), fmt::arg("helpers", helpers(texts)),
+                       fmt::arg("part_helpers", partHelpers(sys, texts)), fmt::arg("free_bodies", freeBodies(texts)),
+                       fmt::arg("definitions", definitions));
+  };
+  files.source = source(texts.parts, banner);
+  files.unsharedSource = texts.sharedKernels.empty() ? files.source : source(texts.unsharedParts, bannerWith(""));
   CInterfaceFiles c = emitCInterface(plan, texts.functions, banner, ws.scalars() * scalarBytes);
   files.cHeaderName = std::move(c.headerName), files.cHeader = std::move(c.header);
   files.cSourceName = std::move(c.sourceName), files.cSource = std::move(c.source);

@@ -11,12 +11,15 @@
 #include "emit/emitter.hpp"
 #include "emit/expr.hpp"
 #include "emit/members.hpp"
+#include "emit/shared_blocks.hpp"
 
 namespace proxgen::emit {
 
 /// The printed bodies of the functions of templates/solver.cpp.tpl.
 struct SolverTexts {
-  std::string parts;  // every part function
+  std::string parts;  // every part function, after shareBlocks
+  std::string unsharedParts;  // the same before it (the lane code's: batch.cpp)
+  std::vector<SharedKernel> sharedKernels;
   std::string kinematics, eliminateFree, accelerateFree, caba, pv;
   OpCount cabaOps, pvOps;  // per call of each entry point, everything it calls included
   // What the solver holds (System::functions); the library's entry points

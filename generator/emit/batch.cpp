@@ -336,7 +336,8 @@ BatchFiles batchFiles(const SolverFiles& scalar, int width) {
 
   // The scalar files' banner (inputs, hashes, operations per call: each lane
   // runs those), and what these files add.
-  const std::string banner = scalar.source.substr(0, find(scalar.source, "\n#include \"", "source")) +
+  const std::string& unshared = scalar.unsharedSource.empty() ? scalar.source : scalar.unsharedSource;
+  const std::string banner = unshared.substr(0, find(unshared, "\n#include \"", "source")) +
                              fmt::format("// Batched over {} lanes: the command above with --batch {} ({}.hpp and\n"
                                          "// {}.cpp are the same with and without it).\n",
                                          width, width, name, name);
@@ -355,7 +356,7 @@ BatchFiles batchFiles(const SolverFiles& scalar, int width) {
                            fmt::arg("out_members", held.empty() ? "" : kOutMember),
                            fmt::arg("library", held.empty() ? "" : libraryDeclarations(held)));
   out.source = fmt::format(fmt::runtime(kBatchSourceTemplate), fmt::arg("banner", banner), fmt::arg("name", name),
-                           fmt::arg("body", laneBody(scalar.source, name)),
+                           fmt::arg("body", laneBody(unshared, name)),
                            fmt::arg("library", held.empty() ? "" : libraryDefinitions(held)));
   return out;
 }

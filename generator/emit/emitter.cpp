@@ -5,8 +5,12 @@
 // joint_transforms, the off-support bodies' functions) only when one needs it.
 #include "emit/emitter.hpp"
 
+#include <algorithm>
+#include <map>
+
 #include "emit/assemble.hpp"
 #include "emit/passes.hpp"
+#include "emit/shared_blocks.hpp"
 
 namespace proxgen::emit {
 namespace {
@@ -150,15 +154,19 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   emitConstraintFunctions(e, afterKinematicsState, afterKinematics, texts);
   texts.parts = fn.parts();
 
-  // Operations per call: each entry point calls kinematics and the two
-  // functions of the off-support bodies once (raw lines, not parts).
-  OpCount shared = fn.hostOps("kinematics");
-  shared += fn.hostOps("eliminate_free");
-  shared += fn.hostOps("accelerate_free");
-  texts.cabaOps = fn.hostOps("caba");
-  texts.cabaOps += shared;
-  texts.pvOps = fn.hostOps("pv");
-  texts.pvOps += shared;
+  // Operations per call, and the hosts each entry point runs (for the shared
+  // blocks below): each entry point calls kinematics and the two functions of
+  // the off-support bodies once (raw lines, not parts).
+  std::map<Function, std::vector<std::string>> reach;
+  auto sum = [&](const std::vector<std::string>& hosts) {
+    OpCount ops;
+    for (const std::string& h : hosts) ops += fn.hostOps(h);
+    return ops;
+  };
+  reach[Function::ConstrainedAba] = {"caba", "kinematics", "eliminate_free", "accelerate_free"};
+  reach[Function::ProxPv] = {"pv", "kinematics", "eliminate_free", "accelerate_free"};
+  texts.cabaOps = sum(reach[Function::ConstrainedAba]);
+  texts.pvOps = sum(reach[Function::ProxPv]);
   const struct {
     Function f;
     const char* host;
@@ -175,19 +183,39 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
                  {Function::ConstraintWrenches, "wrenches", "joints"},
                  {Function::InverseDynamicsDerivatives, "rnead", "kinematics"}};
   for (const auto& l : library) {
-    OpCount ops = fn.hostOps(l.host);
-    if (l.helper) ops += fn.hostOps(l.helper);
-    texts.libraryOps[l.f] = ops;
+    reach[l.f] = {l.host};
+    if (l.helper) reach[l.f].push_back(l.helper);
+    texts.libraryOps[l.f] = sum(reach[l.f]);
   }
   // The derivatives: their host (the dense products included) and the functions it calls.
   for (const Composite& c : composites) {
     if (!want.has(c.f)) continue;
-    OpCount ops = fn.hostOps(c.host);
-    const Function first = c.calls.front();
-    ops += first == Function::ProxPv ? texts.pvOps : texts.libraryOps[first];
-    for (const char* h : c.hosts) ops += fn.hostOps(h);
-    texts.libraryOps[c.f] = ops;
+    std::vector<std::string> hosts = reach[c.calls.front()];
+    hosts.push_back(c.host);
+    for (const char* h : c.hosts) hosts.push_back(h);
+    reach[c.f] = hosts;
+    texts.libraryOps[c.f] = sum(hosts);
   }
+
+  // Shared blocks (shared_blocks.hpp): the parts of a host whose every entry
+  // point in the file has code of kSharedBlocksMinOps operations or more.
+  std::map<std::string, long> smallest;  // host -> the smallest code of an entry point that runs it
+  for (const auto& [f, hosts] : reach) {
+    if (!want.has(f)) continue;
+    const OpCount ops = sum(hosts);
+    const long size = ops.once.total() + ops.perK.total();
+    for (const std::string& h : hosts) {
+      auto [it, inserted] = smallest.emplace(h, size);
+      if (!inserted) it->second = std::min(it->second, size);
+    }
+  }
+  texts.unsharedParts = texts.parts;
+  SharedParts shared = shareBlocks(texts.parts, ws, [&](const std::string& part) {
+    const auto it = smallest.find(fn.hostOf(part));
+    return it != smallest.end() && it->second >= kSharedBlocksMinOps;
+  });
+  texts.parts = std::move(shared.parts);
+  texts.sharedKernels = std::move(shared.kernels);
 
   if (stats) {
     stats->statements = fn.stats().statements;

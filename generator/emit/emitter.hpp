@@ -27,6 +27,10 @@ struct SolverInputs {
 struct SolverFiles {
   std::string headerName, header;  // NAME.hpp
   std::string sourceName, source;  // NAME.cpp
+  // NAME.cpp as the passes printed it, without shared blocks
+  // (emit/shared_blocks.hpp): what the batched files are cut from (their lanes
+  // keep every block inline); the same text as `source` where nothing is shared.
+  std::string unsharedSource;
   // The C interface (emit/c_api.hpp): NAME_c.h, NAME_c.cpp.
   std::string cHeaderName, cHeader, cSourceName, cSource;
 };

@@ -133,6 +133,7 @@ void FunctionWriter::endPart() {
   if (body.find_first_not_of(" \n") == std::string::npos) return;  // everything folded to constants: no function
   const std::string name = partName(host);
   partsText_ += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", name, sig, body);
+  partHost_[name] = host.name;
   if (!host.banner.empty()) {
     cb_->comment("---- " + host.banner);
     host.banner.clear();

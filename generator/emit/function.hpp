@@ -67,6 +67,11 @@ class FunctionWriter {
   void reserveName(const std::string& name) { partNames_.insert(name); }
   /// Every part function printed so far.
   const std::string& parts() const { return partsText_; }
+  /// The host a part function was printed for ("" if none of that name).
+  std::string hostOf(const std::string& part) const {
+    const auto it = partHost_.find(part);
+    return it == partHost_.end() ? std::string() : it->second;
+  }
   const CodeBuilder::Stats& stats() const { return stats_; }
   const std::shared_ptr<NameTable>& names() const { return names_; }
 
@@ -98,6 +103,7 @@ class FunctionWriter {
   std::set<std::string> partNames_;
   std::map<std::string, OpCount> hostOps_;
   std::string partsText_;
+  std::map<std::string, std::string> partHost_;
   CodeBuilder::Stats stats_;
 };
 

@@ -40,7 +40,12 @@ SolverFiles chainFiles(int links, const std::string& functions = "") {
   return files;
 }
 
-std::string chainSource(int links, const std::string& functions = "") { return chainFiles(links, functions).source; }
+// The source as the passes printed it, before blocks equal up to their
+// constants become shared kernels (emit/shared_blocks.hpp), which would print
+// the one joint's statements once for all the joints it runs.
+std::string chainSource(int links, const std::string& functions = "") {
+  return chainFiles(links, functions).unsharedSource;
+}
 
 long count(const std::string& text, const std::string& what) {
   long n = 0;

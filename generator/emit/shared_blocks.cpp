@@ -1,0 +1,536 @@
+// Shared blocks: the body blocks of the part functions, each rewritten into a
+// canonical form (its literals -> k[i], its members -> <prefix>_m<i>, its temporaries
+// -> x<i>, the integer subscripts of members and inputs relative to the
+// smallest one), grouped by that form; each group of two or more becomes one
+// kernel (the canonical form as a function) and a call per block with the
+// block's constants, member pointers and input offsets.
+#include "emit/shared_blocks.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <climits>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+namespace proxgen::emit {
+namespace {
+
+bool identStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool identChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// A part function as printed: its name, parameter list and body lines.
+struct Part {
+  std::string name, params;
+  std::vector<std::string> lines;
+};
+
+// One body's block in a part: the comment line before "  {", the lines inside.
+struct Block {
+  std::size_t part = 0, comment = 0, end = 0;  // comment: index of its comment line; end: of "  }"
+};
+
+// A subscript `[N]`, `[N + rest]` or anything else (loose: kept as printed).
+struct Subscript {
+  bool numeric = false;
+  long lead = 0;
+  std::string rest;  // " + j", " + 50 * j" after the leading integer
+  std::string text;  // as printed, without the brackets
+};
+
+Subscript parseSubscript(const std::string& s) {
+  Subscript r;
+  r.text = s;
+  std::size_t i = 0;
+  while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
+  if (i == 0 || i > 9) return r;
+  if (i == s.size() || s.compare(i, 3, " + ") == 0) {
+    r.numeric = true;
+    r.lead = std::stol(s.substr(0, i));
+    r.rest = s.substr(i);
+  }
+  return r;
+}
+
+// Reads `[...][...]` at `at` (brackets do not nest in the printed code).
+std::vector<std::string> readSubscripts(const std::string& line, std::size_t& at) {
+  std::vector<std::string> out;
+  while (at < line.size() && line[at] == '[') {
+    const std::size_t close = line.find(']', at);
+    if (close == std::string::npos) break;
+    out.push_back(line.substr(at + 1, close - at - 1));
+    at = close + 1;
+  }
+  return out;
+}
+
+// The length of a floating literal at `at` (digits with a '.' or an exponent,
+// an optional 'f'), 0 if there is none; integers are not literals here.
+std::size_t literalLength(const std::string& s, std::size_t at) {
+  std::size_t i = at;
+  bool point = false, exponent = false;
+  while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
+  if (i == at) return 0;
+  if (i < s.size() && s[i] == '.') {
+    point = true;
+    ++i;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
+  }
+  if (i < s.size() && s[i] == 'e') {
+    std::size_t j = i + 1;
+    if (j < s.size() && (s[j] == '-' || s[j] == '+')) ++j;
+    const std::size_t digits = j;
+    while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
+    if (j > digits) exponent = true, i = j;
+  }
+  if (!point && !exponent) return 0;
+  if (i < s.size() && s[i] == 'f') ++i;
+  if (i < s.size() && identChar(s[i])) return 0;
+  return i - at;
+}
+
+// What a kernel parameter is: an input or output array of the part, a scalar
+// of the part (mu), or a workspace member.
+struct MemberUse {
+  std::string name;
+  int rows = 0, cols = 0;  // cols > 0: a matrix member; rows == 0 && cols == 0: a scalar
+  bool array = false;
+  bool loose = false;      // a subscript that is not N or N + ...: no rebasing
+  long base = LONG_MAX;    // the smallest leading index of its last subscript
+  bool written = false;    // a scalar the block stores or passes to a call (by pointer; else by value)
+};
+
+struct PointerUse {
+  std::string name, type;
+  bool loose = false;
+  long base = LONG_MAX;
+};
+
+struct Canonical {
+  std::string key;    // the kernel's text and parameter kinds
+  std::string body;   // the kernel's body lines
+  std::string signature;
+  std::vector<std::string> constants;  // literal texts, signed
+  std::vector<std::string> args;       // besides the table: the call's arguments
+};
+
+// The names a block may use besides its temporaries, members and parameters.
+const std::set<std::string>& knownNames() {
+  static const std::set<std::string> names{"Scalar", "const", "int", "for", "PROXGEN_RT_NO_UNROLL", "proxgen_rt",
+                                           "std"};
+  return names;
+}
+
+class Canonicalizer {
+ public:
+  Canonicalizer(const Part& part, const std::map<std::string, const Members::Member*>& members)
+      : members_(members) {
+    // "const Scalar* PROXGEN_RT_RESTRICT q, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w"
+    std::size_t at = 0;
+    while (at < part.params.size()) {
+      std::size_t comma = part.params.find(", ", at);
+      if (comma == std::string::npos) comma = part.params.size();
+      const std::string p = part.params.substr(at, comma - at);
+      const std::size_t name = p.find_last_of(' ') + 1;
+      const std::string n = p.substr(name), type = p.substr(0, name - 1);
+      if (n == "w") {
+      } else if (type.find('*') != std::string::npos) {
+        pointers_[n] = type;
+      } else {
+        scalars_[n] = type;
+      }
+      at = comma + 2;
+    }
+  }
+
+  // False when the block reads something the kernel could not (a part-level temporary).
+  bool run(const std::vector<std::string>& lines, Canonical& out) {
+    // Its temporaries (renamed x0, x1, ...) and loop variables (kept: the
+    // loop heads are the ones tests/generated/structure.cpp admits).
+    std::set<std::string> temps;
+    for (const std::string& l : lines) {
+      for (const char* decl : {"const Scalar ", "for (int "}) {
+        const std::size_t d = l.find(decl);
+        if (d == std::string::npos) continue;
+        std::size_t i = d + std::string(decl).size(), j = i;
+        while (j < l.size() && identChar(l[j])) ++j;
+        (decl[0] == 'f' ? loopVars_ : temps).insert(l.substr(i, j - i));
+      }
+    }
+    // First pass: the members and pointers used, their smallest leading index.
+    std::vector<std::string> code;
+    for (const std::string& l : lines) {
+      const std::size_t first = l.find_first_not_of(' ');
+      if (first != std::string::npos && l.compare(first, 2, "//") == 0) continue;  // comments name one block
+      if (l.find("//") != std::string::npos) return false;
+      code.push_back(l);
+    }
+    for (const std::string& l : code)
+      if (!scan(l, temps, nullptr)) return false;
+    // Second pass: the text.
+    std::string body;
+    for (const std::string& l : code) {
+      std::string o;
+      if (!scan(l, temps, &o)) return false;
+      body += (o.compare(0, 2, "  ") == 0 ? o.substr(2) : o) + "\n";  // the block's indent, less the braces'
+
+    }
+    // The table of constants, when the block has any.
+    std::vector<std::string> params;
+    if (!constants_.empty()) params.push_back("const Scalar* PROXGEN_RT_RESTRICT k");
+    std::string kinds;
+    for (const auto& [n, p] : usedPointers_) {
+      const PointerUse& u = pointerUse_.at(n);
+      params.push_back(fmt::format("{} {}", p, n));
+      out.args.push_back(u.loose || u.base == 0 ? n : fmt::format("&{}[{}]", n, u.base));
+      kinds += "p:" + n + p + (u.loose ? "L" : "") + ";";
+    }
+    for (const std::string& n : usedScalars_) {
+      params.push_back(fmt::format("{} {}", scalars_.at(n), n));
+      out.args.push_back(n);
+      kinds += "s:" + n + ";";
+    }
+    for (std::size_t i = 0; i < memberUse_.size(); ++i) {
+      const MemberUse& u = memberUse_[i];
+      const long base = u.loose || u.base == LONG_MAX ? 0 : u.base;
+      const std::string p = paramName(i);
+      if (!u.array && !u.written) {
+        params.push_back(fmt::format("Scalar {}", p));
+        out.args.push_back("w." + u.name);
+        kinds += "v" + p + ";";
+      } else if (!u.array) {
+        params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
+        out.args.push_back("&w." + u.name);
+        kinds += "m" + p + ";";
+      } else if (u.cols == 0) {
+        params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
+        out.args.push_back(base == 0 ? "w." + u.name : fmt::format("&w.{}[{}]", u.name, base));
+        kinds += "a" + p + ";";
+      } else {
+        params.push_back(fmt::format("Scalar (*PROXGEN_RT_RESTRICT {})[{}]", p, u.cols));
+        out.args.push_back("w." + u.name);
+        kinds += fmt::format("x{}{};", p, u.cols);
+        if (!u.loose) {
+          params.push_back(fmt::format("int {}_col", p));
+          out.args.push_back(fmt::format("{}", base));
+          kinds += "o;";
+        }
+      }
+    }
+    for (std::size_t i = 0; i < params.size(); ++i) out.signature += (i ? ", " : "") + params[i];
+    out.body = std::move(body);
+    out.constants = std::move(constants_);
+    out.key = kinds + "\n" + out.body;
+    return true;
+  }
+
+ private:
+  // One line: checks it (o == nullptr: records the uses) or prints it into *o.
+  bool scan(const std::string& l, const std::set<std::string>& temps, std::string* o) {
+    std::size_t i = 0;
+    while (i < l.size()) {
+      const char c = l[i];
+      if (identStart(c) && (i == 0 || (!identChar(l[i - 1]) && l[i - 1] != '.'))) {
+        std::size_t j = i;
+        while (j < l.size() && identChar(l[j])) ++j;
+        const std::string id = l.substr(i, j - i);
+        if (id == "w" && j < l.size() && l[j] == '.') {
+          std::size_t e = j + 1;
+          while (e < l.size() && identChar(l[e])) ++e;
+          const std::string name = l.substr(j + 1, e - j - 1);
+          std::vector<std::string> subs = readSubscripts(l, e);
+          const bool stored = l.find_first_not_of(' ') == i && l.compare(e, 3, " = ") == 0;
+          if (!member(name, subs, stored || insideCall(l, i), o)) return false;
+          i = e;
+          continue;
+        }
+        if (pointers_.count(id) && j < l.size() && l[j] == '[') {
+          std::size_t e = j;
+          std::vector<std::string> subs = readSubscripts(l, e);
+          pointer(id, subs, o);
+          i = e;
+          continue;
+        }
+        const bool qualified = i >= 2 && l.compare(i - 2, 2, "::") == 0;
+        const bool call = j < l.size() && l[j] == '(';
+        if (temps.count(id)) {
+          if (o) *o += tempName(id);
+        } else if (scalars_.count(id)) {
+          if (o) {
+            if (std::find(usedScalars_.begin(), usedScalars_.end(), id) == usedScalars_.end()) usedScalars_.push_back(id);
+            *o += id;
+          } else if (std::find(usedScalars_.begin(), usedScalars_.end(), id) == usedScalars_.end()) {
+            usedScalars_.push_back(id);
+          }
+        } else if (qualified || call || knownNames().count(id) || loopVars_.count(id)) {
+          if (o) *o += id;
+        } else {
+          return false;  // a name the kernel would not have
+        }
+        i = j;
+        continue;
+      }
+      if (std::isdigit(static_cast<unsigned char>(c)) && (i == 0 || !identChar(l[i - 1])) &&
+          (i == 0 || l[i - 1] != '.')) {
+        const std::size_t n = literalLength(l, i);
+        if (n > 0) {
+          if (o) {
+            // A sign before the literal goes into the table: "a - 0.5*x" is
+            // "a + k*x" with k = -0.5, the same value bit for bit.
+            std::string sign;
+            std::size_t back = o->find_last_not_of(' ');
+            if (back != std::string::npos && ((*o)[back] == '-' || (*o)[back] == '+')) {
+              sign = (*o)[back] == '-' ? "-" : "";
+              o->erase(back);
+              while (!o->empty() && o->back() == ' ') o->pop_back();
+              const char before = o->empty() ? '(' : o->back();
+              *o += (before == '(' || before == '=' || before == ',') ? " " : " + ";
+            } else if (back != std::string::npos && (*o)[back] != '(' && (*o)[back] != '=' && (*o)[back] != ',' &&
+                       (*o)[back] != '*' && (*o)[back] != '/') {
+              return false;  // not a place the printer puts a literal
+            }
+            *o += fmt::format("k[{}]", constants_.size());
+            constants_.push_back(sign + l.substr(i, n));
+          }
+          i += n;
+          continue;
+        }
+        std::size_t j = i;
+        while (j < l.size() && identChar(l[j])) ++j;
+        if (o) *o += l.substr(i, j - i);
+        i = j;
+        continue;
+      }
+      if (o) *o += c;
+      ++i;
+    }
+    return true;
+  }
+
+  // A member's parameter: its quantity's prefix (v, pA, IA: members.hpp) and
+  // its place in the block ("v_m0" the first member read, ...).
+  std::string paramName(std::size_t i) const {
+    const std::string& n = memberUse_[i].name;
+    const std::size_t u = n.find('_');
+    return fmt::format("{}_m{}", u == std::string::npos ? n : n.substr(0, u), i);
+  }
+
+  std::string tempName(const std::string& id) {
+    auto [it, inserted] = tempNames_.emplace(id, "");
+    if (inserted) it->second = fmt::format("x{}", tempNames_.size() - 1);
+    return it->second;
+  }
+
+  // Whether position `at` of `l` is inside a call's parentheses (`f(..., here)`).
+  static bool insideCall(const std::string& l, std::size_t at) {
+    int depth = 0;
+    for (std::size_t i = at; i-- > 0;) {
+      if (l[i] == ')') ++depth;
+      if (l[i] == '(' && depth-- == 0) return i > 0 && identChar(l[i - 1]);
+    }
+    return false;
+  }
+
+  bool member(const std::string& name, const std::vector<std::string>& subs, bool written, std::string* o) {
+    const auto m = members_.find(name);
+    if (m == members_.end()) return false;
+    const Members::Member& decl = *m->second;
+    auto at = memberIndex_.find(name);
+    if (at == memberIndex_.end()) {
+      MemberUse u;
+      u.name = name;
+      u.array = decl.size > 0;
+      u.cols = decl.columns;
+      at = memberIndex_.emplace(name, memberUse_.size()).first;
+      memberUse_.push_back(u);
+    }
+    MemberUse& u = memberUse_[at->second];
+    if (u.array != !subs.empty() || (u.cols > 0 && subs.size() != 2) || (u.array && u.cols == 0 && subs.size() != 1))
+      return false;
+    if (!o) {
+      u.written = u.written || written;
+      if (!subs.empty()) {
+        const Subscript s = parseSubscript(subs.back());
+        if (!s.numeric) u.loose = true;
+        else u.base = std::min(u.base, s.lead);
+      }
+      return true;
+    }
+    const std::string p = paramName(at->second);
+    if (subs.empty()) {
+      *o += u.written ? p + "[0]" : p;
+      return true;
+    }
+    *o += p;
+    for (std::size_t k = 0; k + 1 < subs.size(); ++k) *o += "[" + subs[k] + "]";
+    const Subscript s = parseSubscript(subs.back());
+    if (u.loose) *o += "[" + s.text + "]";
+    else if (u.cols > 0) *o += fmt::format("[{}_col + {}{}]", p, s.lead - u.base, s.rest);
+    else *o += fmt::format("[{}{}]", s.lead - u.base, s.rest);
+    return true;
+  }
+
+  void pointer(const std::string& name, const std::vector<std::string>& subs, std::string* o) {
+    if (usedPointers_.count(name) == 0) usedPointers_[name] = pointers_.at(name);
+    PointerUse& u = pointerUse_[name];
+    const Subscript s = parseSubscript(subs.empty() ? std::string() : subs.back());
+    if (!o) {
+      if (subs.size() != 1 || !s.numeric) u.loose = true;
+      else u.base = std::min(u.base, s.lead);
+      return;
+    }
+    *o += name;
+    for (std::size_t k = 0; k + 1 < subs.size(); ++k) *o += "[" + subs[k] + "]";
+    if (u.loose) *o += "[" + s.text + "]";
+    else *o += fmt::format("[{}{}]", s.lead - u.base, s.rest);
+  }
+
+  const std::map<std::string, const Members::Member*>& members_;
+  std::map<std::string, std::string> pointers_, scalars_;
+  std::map<std::string, std::string> usedPointers_;  // in name order: a deterministic signature
+  std::map<std::string, PointerUse> pointerUse_;
+  std::vector<std::string> usedScalars_;
+  std::vector<MemberUse> memberUse_;
+  std::map<std::string, std::size_t> memberIndex_;
+  std::map<std::string, std::string> tempNames_;
+  std::set<std::string> loopVars_;
+  std::vector<std::string> constants_;
+};
+
+std::vector<Part> splitParts(const std::string& text, std::string& unparsed) {
+  std::vector<Part> parts;
+  const std::string head = "PROXGEN_RT_NOINLINE void ";
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t eol = text.find('\n', at);
+    const std::string line = text.substr(at, eol == std::string::npos ? std::string::npos : eol - at);
+    at = eol == std::string::npos ? text.size() : eol + 1;
+    if (line.rfind(head, 0) == 0) {
+      Part p;
+      const std::size_t open = line.find('(');
+      const std::size_t close = line.rfind(") noexcept {");
+      p.name = line.substr(head.size(), open - head.size());
+      p.params = line.substr(open + 1, close - open - 1);
+      parts.push_back(std::move(p));
+      continue;
+    }
+    if (line == "}") {
+      parts.back().lines.push_back("}");
+      continue;
+    }
+    if (parts.empty()) {
+      unparsed += line + "\n";
+      continue;
+    }
+    parts.back().lines.push_back(line);
+  }
+  return parts;
+}
+
+// "// eliminate body 20 'arm_left_5_link': ..." -> "arm_left_5_link"
+std::string blockBody(const std::string& comment) {
+  const std::size_t a = comment.find('\'');
+  const std::size_t b = a == std::string::npos ? a : comment.find('\'', a + 1);
+  return b == std::string::npos ? comment : comment.substr(a + 1, b - a - 1);
+}
+
+}  // namespace
+
+SharedParts shareBlocks(const std::string& text, const Members& ws,
+                        const std::function<bool(const std::string&)>& eligible) {
+  std::map<std::string, const Members::Member*> members;
+  for (const Members::Member& m : ws.all()) members[m.name] = &m;
+  std::string before;
+  std::vector<Part> parts = splitParts(text, before);
+
+  struct Found {
+    Block where;
+    Canonical canon;
+  };
+  std::vector<Found> found;
+  std::unordered_map<std::string, std::vector<std::size_t>> groups;
+  std::vector<std::string> order;  // keys in order of first appearance
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (!eligible(parts[p].name)) continue;
+    const std::vector<std::string>& lines = parts[p].lines;
+    for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
+      if (lines[i].rfind("  // ", 0) != 0 || lines[i + 1] != "  {") continue;
+      std::size_t end = i + 2;
+      while (end < lines.size() && lines[end] != "  }") ++end;
+      if (end == lines.size()) break;
+      Canonicalizer c(parts[p], members);
+      Found f;
+      f.where = {p, i, end};
+      if (c.run({lines.begin() + long(i) + 2, lines.begin() + long(end)}, f.canon)) {
+        auto [it, inserted] = groups.emplace(f.canon.key, std::vector<std::size_t>{});
+        if (inserted) order.push_back(f.canon.key);
+        it->second.push_back(found.size());
+        found.push_back(std::move(f));
+      }
+      i = end;
+    }
+  }
+
+  SharedParts out;
+  std::string kernels;
+  // Per part, the replaced blocks: comment line index -> (end, call line).
+  std::map<std::size_t, std::map<std::size_t, std::pair<std::size_t, std::string>>> calls;
+  for (const std::string& key : order) {
+    const std::vector<std::size_t>& g = groups.at(key);
+    if (g.size() < 2) continue;
+    SharedKernel k;
+    k.name = fmt::format("shared_{}", out.kernels.size());
+    const Canonical& first = found[g.front()].canon;
+    k.bytes = long(first.body.size());
+    std::string tables;
+    std::set<std::string> bodies;
+    std::string bodyList;
+    std::map<std::string, std::string> tableOf;  // values -> table: blocks with the same constants share one
+    for (std::size_t n = 0; n < g.size(); ++n) {
+      const Found& f = found[g[n]];
+      const std::string comment = parts[f.where.part].lines[f.where.comment];
+      k.blocks.push_back(comment.substr(5));
+      if (bodies.insert(blockBody(comment)).second) bodyList += (bodyList.empty() ? "" : ", ") + blockBody(comment);
+      std::string values;
+      for (std::size_t c = 0; c < f.canon.constants.size(); ++c) values += (c ? ", " : "") + f.canon.constants[c];
+      std::string args;
+      if (!f.canon.constants.empty()) {
+        auto [t, fresh] = tableOf.emplace(values, fmt::format("{}_k{}", k.name, tableOf.size()));
+        if (fresh)
+          tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, f.canon.constants.size(), values);
+        args = t->second;
+      }
+      for (const std::string& a : f.canon.args) args += (args.empty() ? "" : ", ") + a;
+      calls[f.where.part][f.where.comment] = {f.where.end, fmt::format("  {}({});", k.name, args)};
+    }
+    kernels += fmt::format("// {} blocks of the same code, each over its constants (k) and members: {}.\n// The first: {}\n",
+                           g.size(), bodyList, parts[found[g.front()].where.part].lines[found[g.front()].where.comment].substr(5));
+    kernels += tables;
+    kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, first.signature,
+                           first.body);
+    out.kernels.push_back(std::move(k));
+  }
+  if (out.kernels.empty()) {
+    out.parts = text;
+    return out;
+  }
+  out.parts = before + kernels;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const Part& part = parts[p];
+    out.parts += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n", part.name, part.params);
+    const auto c = calls.find(p);
+    for (std::size_t i = 0; i < part.lines.size(); ++i) {
+      out.parts += part.lines[i] + "\n";
+      if (c == calls.end()) continue;
+      const auto at = c->second.find(i);
+      if (at == c->second.end()) continue;
+      out.parts += at->second.second + "\n";
+      i = at->second.first;
+    }
+  }
+  return out;
+}
+
+}  // namespace proxgen::emit

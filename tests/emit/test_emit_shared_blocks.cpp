@@ -1,0 +1,143 @@
+// Shared blocks (emit/shared_blocks.hpp): body blocks that are the same code up
+// to their constants, members and input offsets become one kernel called with
+// each block's table; anything else stays as printed. That the shared code
+// computes what the blocks did is the generated suites' job (tests/generated:
+// every solver against its generic twin, Solo, Talos and the Atlas with shared
+// blocks); this checks the rewriting itself and which solvers share.
+#include <gtest/gtest.h>
+#include <fmt/format.h>
+
+#include <string>
+
+#include "cases/cases.hpp"
+#include "emit/shared_blocks.hpp"
+#include "support.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+long count(const std::string& text, const std::string& what) {
+  long n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+
+// A part with one block for body `b` (dof `d`): the same statements for every
+// body, `c` its constant, `sign` the sign the printer put before it.
+std::string part(const std::string& name, const std::string& b, int d, const std::string& c, char sign = '+') {
+  return fmt::format(
+      "PROXGEN_RT_NOINLINE void {0}(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {{\n"
+      "  // body {2} '{1}': joint '{1}_joint' (revolute about z), parent 'base'\n"
+      "  {{\n"
+      "    const Scalar t{2} = w.IA_{1}[3] {4} {3}*w.Dinv_{1};\n"
+      "    w.u_{1}[0] = -w.pA_{1}[5] + tau[{2}];\n"
+      "    w.IA_base[{2}] = w.IA_base[{2}] + t{2}*w.u_{1}[0] - 1.5e-05*tau[{5}];\n"
+      "  }}\n"
+      "}}\n\n",
+      name, b, d, c, sign, d + 1);
+}
+
+Members members(const std::vector<std::string>& bodies) {
+  Members ws;
+  for (const std::string& b : bodies) {
+    ws.member("IA_" + b, 21, 0, "articulated inertia");
+    ws.member("Dinv_" + b, 0, 0, "1 / D");
+    ws.member("u_" + b, 1, 0, "tau - S^T pA");
+    ws.member("pA_" + b, 6, 0, "bias force");
+  }
+  ws.member("IA_base", 21, 0, "articulated inertia");
+  return ws;
+}
+
+const auto all = [](const std::string&) { return true; };
+
+TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
+  const std::string text = part("caba_left", "left", 2, "0.25") + part("caba_right", "right", 4, "0.5", '-');
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  ASSERT_EQ(s.kernels.size(), 1u);
+  EXPECT_EQ(s.kernels[0].name, "shared_0");
+  ASSERT_EQ(s.kernels[0].blocks.size(), 2u);
+  // One kernel body over k[], each block's constants in its own table; the
+  // sign before a literal goes into the table (a - 0.5*x == a + (-0.5)*x).
+  EXPECT_EQ(count(s.parts, "PROXGEN_RT_NOINLINE void shared_0("), 1);
+  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k0[2] = {0.25, -1.5e-05};"), std::string::npos) << s.parts;
+  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k1[2] = {-0.5, -1.5e-05};"), std::string::npos) << s.parts;
+  // A scalar member the block only reads comes by value, arrays as pointers.
+  EXPECT_NE(s.parts.find("const Scalar x0 = IA_m0[0] + k[0]*Dinv_m1;"), std::string::npos) << s.parts;
+  // Inputs and members rebased at their smallest index, so one text serves both.
+  EXPECT_NE(s.parts.find("IA_m4[0] = IA_m4[0] + x0*u_m2[0] + k[1]*tau[1];"), std::string::npos) << s.parts;
+  EXPECT_NE(s.parts.find("  shared_0(shared_0_k0, &tau[2], &w.IA_left[3], w.Dinv_left, w.u_left, &w.pA_left[5], "
+                         "&w.IA_base[2]);"),
+            std::string::npos)
+      << s.parts;
+  EXPECT_NE(s.parts.find("  shared_0(shared_0_k1, &tau[4], &w.IA_right[3], w.Dinv_right, w.u_right, &w.pA_right[5], "
+                         "&w.IA_base[4]);"),
+            std::string::npos)
+      << s.parts;
+  // The blocks' statements are gone from the parts, their comment lines stay.
+  EXPECT_EQ(count(s.parts, "w.Dinv_"), 2);
+  EXPECT_EQ(count(s.parts, "// body 2 'left'"), 1);
+}
+
+TEST(SharedBlocks, BlocksWithTheSameConstantsShareATable) {
+  const std::string text = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25");
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  ASSERT_EQ(s.kernels.size(), 1u);
+  EXPECT_EQ(count(s.parts, "constexpr Scalar shared_0_k"), 1);
+  EXPECT_EQ(count(s.parts, "shared_0(shared_0_k0, "), 2);
+}
+
+TEST(SharedBlocks, OtherCodeAndIneligiblePartsStayAsPrinted) {
+  // A third body whose block multiplies where the others add: no kernel of its own.
+  std::string odd = part("caba_odd", "odd", 6, "0.5");
+  odd.replace(odd.find("t6*w.u_odd[0]"), 13, "t6/w.u_odd[0]");
+  const std::string text = part("caba_left", "left", 2, "0.25") + part("caba_right", "right", 4, "0.5") + odd;
+  const Members ws = members({"left", "right", "odd"});
+  const SharedParts s = shareBlocks(text, ws, all);
+  ASSERT_EQ(s.kernels.size(), 1u);
+  EXPECT_EQ(s.kernels[0].blocks.size(), 2u);
+  EXPECT_NE(s.parts.find("t6/w.u_odd[0]"), std::string::npos);
+  // Nothing eligible, or nothing to share: the text comes back byte for byte.
+  const SharedParts none = shareBlocks(text, ws, [](const std::string&) { return false; });
+  EXPECT_TRUE(none.kernels.empty());
+  EXPECT_EQ(none.parts, text);
+  EXPECT_EQ(shareBlocks(odd, ws, all).parts, odd);
+  // Only the eligible part's block would be shared: one block is no group.
+  const SharedParts one = shareBlocks(text, ws, [](const std::string& p) { return p == "caba_left"; });
+  EXPECT_EQ(one.parts, text);
+}
+
+TEST(SharedBlocks, ABlockReadingWhatAKernelCouldNotIsLeftAlone) {
+  // t_part: a temporary of the part, outside the block (the kernel has no such parameter).
+  auto reading = [](const std::string& name, const std::string& b, int d) {
+    std::string p = part(name, b, d, "0.25");
+    p.replace(p.find("-w.pA_"), 1, "t_part - ");
+    return p;
+  };
+  const std::string text = reading("a", "left", 2) + reading("b", "right", 4);
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  EXPECT_TRUE(s.kernels.empty());
+  EXPECT_EQ(s.parts, text);
+}
+
+// Which solvers share: the ones whose entry points' code is above the first-level
+// instruction cache (kSharedBlocksMinOps): Solo's legs, not the iiwa (no group
+// would pay there: measured 1.01-1.06 of the time, docs/benchmarks.md).
+TEST(SharedBlocks, SoloSharesItsLegsTheIiwaNothing) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  const SolverFiles solo = generateCase(cases, "solo_f3x4", "", ScalarType::Double);
+  const SolverFiles iiwa = generateCase(cases, "iiwa_h3", "", ScalarType::Double);
+  EXPECT_EQ(count(iiwa.source, "shared_"), 0);
+  EXPECT_EQ(iiwa.unsharedSource, iiwa.source);
+  EXPECT_GT(count(solo.source, "PROXGEN_RT_NOINLINE void shared_"), 4);
+  // The banner says which blocks share a kernel; the four legs' lower links do.
+  EXPECT_NE(solo.source.find("// Shared blocks"), std::string::npos);
+  EXPECT_NE(solo.source.find("blocks of FL_LOWER_LEG, FR_LOWER_LEG, HL_LOWER_LEG, HR_LOWER_LEG"), std::string::npos);
+  // The lane code is cut from the source without them.
+  EXPECT_EQ(count(solo.unsharedSource, "shared_"), 0);
+  EXPECT_NE(solo.unsharedSource, solo.source);
+}
+
+}  // namespace
+}  // namespace proxgen::emit
