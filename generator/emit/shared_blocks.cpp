@@ -159,6 +159,7 @@ class Canonicalizer {
         (decl[0] == 'f' ? loopVars_ : temps).insert(l.substr(i, j - i));
       }
     }
+    if (loopVars_.count("k")) return false;  // the table's name in the kernel
     // First pass: the members and pointers used, their smallest leading index.
     std::vector<std::string> code;
     for (const std::string& l : lines) {
@@ -175,7 +176,6 @@ class Canonicalizer {
       std::string o;
       if (!scan(l, temps, &o)) return false;
       body += (o.compare(0, 2, "  ") == 0 ? o.substr(2) : o) + "\n";  // the block's indent, less the braces'
-
     }
     // The table of constants, when the block has any.
     std::vector<std::string> params;
