@@ -81,8 +81,7 @@ using MultiplierRows = const Scalar*;
 // The parts the functions below call in order: each holds a few bodies' blocks.
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-constexpr Scalar shared_0_k0[14] = {0.5, -0.015, 0.5, 0.015, 0.015, 0.00095, -0.015, 0.00095, 0.5, -0.5, 0.0005, 0.5, -0.0005, -0.5};
-PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
   proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
@@ -93,15 +92,15 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m4[1] = -v[0]*v_m2[0];
   c_m4[3] = v[0]*v_m2[4];
   c_m4[4] = -v[0]*v_m2[3];
-  const Scalar x0 = k[0]*v_m3[0] + k[1]*v_m2[3];
-  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m2[2];
-  const Scalar x2 = k[4]*v_m2[0] + k[5]*v_m2[2];
-  const Scalar x3 = k[6]*v_m3[0] + k[7]*v_m2[3];
-  pA_m5[0] = k[8]*v_m2[1]*v_m2[3] - v_m2[4]*x1;
-  pA_m5[1] = v_m2[4]*x0 + k[9]*v_m2[1]*v_m2[2];
+  const Scalar x0 = 0.5*v_m3[0] - 0.015*v_m2[3];
+  const Scalar x1 = 0.5*v_m2[0] + 0.015*v_m2[2];
+  const Scalar x2 = 0.015*v_m2[0] + 0.00095*v_m2[2];
+  const Scalar x3 = -0.015*v_m3[0] + 0.00095*v_m2[3];
+  pA_m5[0] = 0.5*v_m2[1]*v_m2[3] - v_m2[4]*x1;
+  pA_m5[1] = v_m2[4]*x0 - 0.5*v_m2[1]*v_m2[2];
   pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
-  pA_m5[3] = k[10]*v_m2[3]*v_m2[4] - v_m2[4]*x3 + k[11]*v_m2[0]*v_m2[1] - v_m2[1]*x1;
-  pA_m5[4] = v_m2[4]*x2 + k[12]*v_m2[2]*v_m2[4] + v_m2[1]*x0 + k[13]*v_m3[0]*v_m2[1];
+  pA_m5[3] = 0.0005*v_m2[3]*v_m2[4] - v_m2[4]*x3 + 0.5*v_m2[0]*v_m2[1] - v_m2[1]*x1;
+  pA_m5[4] = v_m2[4]*x2 - 0.0005*v_m2[2]*v_m2[4] + v_m2[1]*x0 - 0.5*v_m3[0]*v_m2[1];
   pA_m5[5] = v_m2[2]*x3 - v_m2[3]*x2 + v_m3[0]*x1 - v_m2[0]*x0;
   g_m6[0] = g_m7[0]*cq_m1[0] + g_m8[0]*sq_m0[0];
   g_m6[1] = -g_m7[0]*sq_m0[0] + g_m8[0]*cq_m1[0];
@@ -109,13 +108,12 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-constexpr Scalar shared_1_k0[26] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 7.0, -1.29954125, 7.0, 1.29954125, 1.29954125, 0.3755072987089375, -1.29954125, 0.3755072987089375, 7.0, -7.0, 0.0196875, 7.0, -0.0196875, -7.0, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
+PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
   proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = k[0]*v_m2[0] + k[1]*v_m3[1];
-  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m3[1];
-  const Scalar x2 = k[4]*v_m3[2] + k[5]*v_m3[4];
-  const Scalar x3 = k[6]*v_m3[2] + k[7]*v_m3[4];
+  const Scalar x0 = 0.9950041652780258*v_m2[0] + 0.09983341664682815*v_m3[1];
+  const Scalar x1 = -0.09983341664682815*v_m2[0] + 0.9950041652780258*v_m3[1];
+  const Scalar x2 = 0.9950041652780258*v_m3[2] + 0.09983341664682815*v_m3[4];
+  const Scalar x3 = -0.09983341664682815*v_m3[2] + 0.9950041652780258*v_m3[4];
   v_m4[0] = cq_m1[0]*x0 - sq_m0[0]*x1;
   v_m4[2] = sq_m0[0]*x0 + cq_m1[0]*x1;
   v_m4[3] = cq_m1[0]*x2 - sq_m0[0]*x3;
@@ -125,33 +123,32 @@ PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m5[2] = v[0]*v_m4[0];
   c_m5[3] = -v[0]*v_m4[5];
   c_m5[5] = v[0]*v_m4[3];
-  const Scalar x4 = k[8]*v_m4[0] + k[9]*v_m4[4];
-  const Scalar x5 = k[10]*v_m3[0] + k[11]*v_m4[3];
-  const Scalar x6 = k[12]*v_m3[0] + k[13]*v_m4[3];
-  const Scalar x7 = k[14]*v_m4[0] + k[15]*v_m4[4];
-  pA_m6[0] = k[16]*v_m4[2]*v_m4[4] - v_m4[5]*x5;
-  pA_m6[1] = v_m4[5]*x4 + k[17]*v_m4[2]*v_m4[3];
+  const Scalar x4 = 7.0*v_m4[0] - 1.29954125*v_m4[4];
+  const Scalar x5 = 7.0*v_m3[0] + 1.29954125*v_m4[3];
+  const Scalar x6 = 1.29954125*v_m3[0] + 0.3755072987089375*v_m4[3];
+  const Scalar x7 = -1.29954125*v_m4[0] + 0.3755072987089375*v_m4[4];
+  pA_m6[0] = 7.0*v_m4[2]*v_m4[4] - v_m4[5]*x5;
+  pA_m6[1] = v_m4[5]*x4 - 7.0*v_m4[2]*v_m4[3];
   pA_m6[2] = v_m4[3]*x5 - v_m4[4]*x4;
-  pA_m6[3] = k[18]*v_m4[4]*v_m4[5] - v_m4[5]*x7 + k[19]*v_m3[0]*v_m4[2] - v_m4[2]*x5;
-  pA_m6[4] = v_m4[5]*x6 + k[20]*v_m4[3]*v_m4[5] + v_m4[2]*x4 + k[21]*v_m4[0]*v_m4[2];
+  pA_m6[3] = 0.0196875*v_m4[4]*v_m4[5] - v_m4[5]*x7 + 7.0*v_m3[0]*v_m4[2] - v_m4[2]*x5;
+  pA_m6[4] = v_m4[5]*x6 - 0.0196875*v_m4[3]*v_m4[5] + v_m4[2]*x4 - 7.0*v_m4[0]*v_m4[2];
   pA_m6[5] = v_m4[3]*x7 - v_m4[4]*x6 + v_m4[0]*x5 - v_m3[0]*x4;
-  const Scalar x8 = k[22]*g_m7[0] + k[23]*g_m8[0];
-  const Scalar x9 = k[24]*g_m7[0] + k[25]*g_m8[0];
+  const Scalar x8 = 0.9950041652780258*g_m7[0] + 0.09983341664682815*g_m8[0];
+  const Scalar x9 = -0.09983341664682815*g_m7[0] + 0.9950041652780258*g_m8[0];
   g_m9[0] = cq_m1[0]*x8 - sq_m0[0]*x9;
   g_m9[2] = sq_m0[0]*x8 + cq_m1[0]*x9;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-constexpr Scalar shared_2_k0[28] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 3.055, -0.5694718575000001, 3.055, 0.5694718575000001, 0.5694718575000001, 0.15779149347477375, -0.5694718575000001, 0.15779149347477375, 3.055, -3.055, 0.00381875, 3.055, -0.00381875, -3.055, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
   proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
-  const Scalar x1 = v_m3[0] + k[1]*v_m2[3];
-  const Scalar x2 = k[2]*v_m2[2] + k[3]*x0;
-  const Scalar x3 = k[4]*v_m2[2] + k[5]*x0;
-  const Scalar x4 = k[6]*v_m2[3] + k[7]*v_m2[5];
-  const Scalar x5 = k[8]*v_m2[3] + k[9]*v_m2[5];
+  const Scalar x0 = v_m2[0] - 0.42875*v_m2[4];
+  const Scalar x1 = v_m3[0] + 0.42875*v_m2[3];
+  const Scalar x2 = -0.19866933079506124*v_m2[2] + 0.9800665778412416*x0;
+  const Scalar x3 = 0.9800665778412416*v_m2[2] + 0.19866933079506124*x0;
+  const Scalar x4 = 0.9800665778412416*v_m2[3] - 0.19866933079506124*v_m2[5];
+  const Scalar x5 = 0.19866933079506124*v_m2[3] + 0.9800665778412416*v_m2[5];
   v_m4[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
   v_m4[1] = x1;
   v_m4[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
@@ -162,33 +159,32 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m5[2] = v[0]*v_m4[0];
   c_m5[3] = -v[0]*v_m4[5];
   c_m5[5] = v[0]*v_m4[3];
-  const Scalar x6 = k[10]*v_m4[0] + k[11]*v_m4[4];
-  const Scalar x7 = k[12]*v_m4[1] + k[13]*v_m4[3];
-  const Scalar x8 = k[14]*v_m4[1] + k[15]*v_m4[3];
-  const Scalar x9 = k[16]*v_m4[0] + k[17]*v_m4[4];
-  pA_m6[0] = k[18]*v_m4[2]*v_m4[4] - v_m4[5]*x7;
-  pA_m6[1] = v_m4[5]*x6 + k[19]*v_m4[2]*v_m4[3];
+  const Scalar x6 = 3.055*v_m4[0] - 0.5694718575000001*v_m4[4];
+  const Scalar x7 = 3.055*v_m4[1] + 0.5694718575000001*v_m4[3];
+  const Scalar x8 = 0.5694718575000001*v_m4[1] + 0.15779149347477375*v_m4[3];
+  const Scalar x9 = -0.5694718575000001*v_m4[0] + 0.15779149347477375*v_m4[4];
+  pA_m6[0] = 3.055*v_m4[2]*v_m4[4] - v_m4[5]*x7;
+  pA_m6[1] = v_m4[5]*x6 - 3.055*v_m4[2]*v_m4[3];
   pA_m6[2] = v_m4[3]*x7 - v_m4[4]*x6;
-  pA_m6[3] = k[20]*v_m4[4]*v_m4[5] - v_m4[5]*x9 + k[21]*v_m4[1]*v_m4[2] - v_m4[2]*x7;
-  pA_m6[4] = v_m4[5]*x8 + k[22]*v_m4[3]*v_m4[5] + v_m4[2]*x6 + k[23]*v_m4[0]*v_m4[2];
+  pA_m6[3] = 0.00381875*v_m4[4]*v_m4[5] - v_m4[5]*x9 + 3.055*v_m4[1]*v_m4[2] - v_m4[2]*x7;
+  pA_m6[4] = v_m4[5]*x8 - 0.00381875*v_m4[3]*v_m4[5] + v_m4[2]*x6 - 3.055*v_m4[0]*v_m4[2];
   pA_m6[5] = v_m4[3]*x9 - v_m4[4]*x8 + v_m4[0]*x7 - v_m4[1]*x6;
-  const Scalar x10 = k[24]*g_m7[0] + k[25]*g_m7[2];
-  const Scalar x11 = k[26]*g_m7[0] + k[27]*g_m7[2];
+  const Scalar x10 = 0.9800665778412416*g_m7[0] - 0.19866933079506124*g_m7[2];
+  const Scalar x11 = 0.19866933079506124*g_m7[0] + 0.9800665778412416*g_m7[2];
   g_m8[0] = cq_m1[0]*x10 - sq_m0[0]*x11;
   g_m8[2] = sq_m0[0]*x10 + cq_m1[0]*x11;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-constexpr Scalar shared_3_k0[17] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.2, 0.2, 0.2, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
   proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
-  const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
-  const Scalar x2 = k[2]*v_m2[2] + k[3]*x0;
-  const Scalar x3 = k[4]*v_m2[2] + k[5]*x0;
-  const Scalar x4 = k[6]*v_m2[3] + k[7]*v_m2[5];
-  const Scalar x5 = k[8]*v_m2[3] + k[9]*v_m2[5];
+  const Scalar x0 = v_m2[0] - 0.4305*v_m2[4];
+  const Scalar x1 = v_m2[1] + 0.4305*v_m2[3];
+  const Scalar x2 = 0.09983341664682815*v_m2[2] + 0.9950041652780258*x0;
+  const Scalar x3 = 0.9950041652780258*v_m2[2] - 0.09983341664682815*x0;
+  const Scalar x4 = 0.9950041652780258*v_m2[3] + 0.09983341664682815*v_m2[5];
+  const Scalar x5 = -0.09983341664682815*v_m2[3] + 0.9950041652780258*v_m2[5];
   v_m3[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
   v_m3[1] = x1;
   v_m3[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
@@ -199,19 +195,18 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m4[2] = v[0]*v_m3[0];
   c_m4[3] = -v[0]*v_m3[5];
   c_m4[5] = v[0]*v_m3[3];
-  pA_m5[0] = k[10]*(v_m3[2]*v_m3[4] - v_m3[1]*v_m3[5]);
-  pA_m5[1] = k[11]*(v_m3[0]*v_m3[5] - v_m3[2]*v_m3[3]);
-  pA_m5[2] = k[12]*(v_m3[1]*v_m3[3] - v_m3[0]*v_m3[4]);
-  const Scalar x6 = k[13]*g_m6[0] + k[14]*g_m6[2];
-  const Scalar x7 = k[15]*g_m6[0] + k[16]*g_m6[2];
+  pA_m5[0] = 0.2*(v_m3[2]*v_m3[4] - v_m3[1]*v_m3[5]);
+  pA_m5[1] = 0.2*(v_m3[0]*v_m3[5] - v_m3[2]*v_m3[3]);
+  pA_m5[2] = 0.2*(v_m3[1]*v_m3[3] - v_m3[0]*v_m3[4]);
+  const Scalar x6 = 0.9950041652780258*g_m6[0] + 0.09983341664682815*g_m6[2];
+  const Scalar x7 = -0.09983341664682815*g_m6[0] + 0.9950041652780258*g_m6[2];
   g_m7[0] = cq_m1[0]*x6 - sq_m0[0]*x7;
   g_m7[2] = sq_m0[0]*x6 + cq_m1[0]*x7;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-constexpr Scalar shared_4_k0[16] = {1.015, -0.027912499999999996, 1.015, 0.027912499999999996, 0.06495999999999999, 1.015, -0.06495999999999999, 0.027912499999999996, 0.00194517348958, 0.0017863999999999998, -0.027912499999999996, -0.06495999999999999, 0.00936987670937, 0.06495999999999999, 0.0017863999999999998, 0.00860228295937};
-PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
   proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
@@ -222,12 +217,12 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m4[1] = -v[0]*v_m2[0];
   c_m4[3] = v[0]*v_m2[4];
   c_m4[4] = -v[0]*v_m2[3];
-  const Scalar x0 = k[0]*v_m3[0] + k[1]*v_m2[3];
-  const Scalar x1 = k[2]*v_m2[0] + k[3]*v_m2[2] + k[4]*v_m2[4];
-  const Scalar x2 = k[5]*v_m2[1] + k[6]*v_m2[3];
-  const Scalar x3 = k[7]*v_m2[0] + k[8]*v_m2[2] + k[9]*v_m2[4];
-  const Scalar x4 = k[10]*v_m3[0] + k[11]*v_m2[1] + k[12]*v_m2[3];
-  const Scalar x5 = k[13]*v_m2[0] + k[14]*v_m2[2] + k[15]*v_m2[4];
+  const Scalar x0 = 1.015*v_m3[0] - 0.027912499999999996*v_m2[3];
+  const Scalar x1 = 1.015*v_m2[0] + 0.027912499999999996*v_m2[2] + 0.06495999999999999*v_m2[4];
+  const Scalar x2 = 1.015*v_m2[1] - 0.06495999999999999*v_m2[3];
+  const Scalar x3 = 0.027912499999999996*v_m2[0] + 0.00194517348958*v_m2[2] + 0.0017863999999999998*v_m2[4];
+  const Scalar x4 = -0.027912499999999996*v_m3[0] - 0.06495999999999999*v_m2[1] + 0.00936987670937*v_m2[3];
+  const Scalar x5 = 0.06495999999999999*v_m2[0] + 0.0017863999999999998*v_m2[2] + 0.00860228295937*v_m2[4];
   pA_m5[0] = v_m2[3]*x2 - v_m2[4]*x1;
   pA_m5[1] = v_m2[4]*x0 - v_m2[2]*x2;
   pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
@@ -269,9 +264,8 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, r_wrist_yaw_link.
 // The first: eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-constexpr Scalar shared_6_k0[42] = {1.0, 0.001, 0.001, 3.5000000000000004e-05, 0.5, 0.5, 2.0, 0.0005, 0.5, 0.5, 0.5, -1.7500000000000002e-05, 0.5, 1.7500000000000002e-05, 0.5, 0.5, 0.0005, -0.5, -0.0005, 0.5, 0.5, 0.2555, -0.2555, 0.2555, -0.2555, 0.2555, -0.2555, 0.92, -0.10107580000000001, 0.92, 0.10107580000000001, 0.92, 0.01661854208147, 0.2555, 0.2555, -0.2555, 0.2555, 0.01661854208147, -0.2555, -0.2555, 0.2555, -0.2555};
-PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[20];
+PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[20];
   u_m2[0] = -pA_m3[5] + tau[0];
   const Scalar x0 = IA_m1[5]*Dinv_m0[0];
   const Scalar x1 = IA_m1[10]*Dinv_m0[0];
@@ -287,66 +281,65 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x11 = IA_m1[11] - IA_m1[14]*x2;
   const Scalar x12 = IA_m1[12] - IA_m1[17]*x2;
   const Scalar x13 = IA_m1[15] - IA_m1[17]*x3;
-  const Scalar x14 = k[1]*c_m4[4] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[1]*x5 + c_m4[3]*x7;
+  const Scalar x14 = 0.001*c_m4[4] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[1]*x5 + c_m4[3]*x7;
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[1]*x8 + c_m4[3]*x10;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[1]*x9 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[1]*x10 + c_m4[3]*x13;
-  const Scalar x18 = k[2]*c_m4[0] + k[3]*c_m4[4] + pA_m3[4];
+  const Scalar x18 = 0.001*c_m4[0] + 3.5000000000000004e-05*c_m4[4] + pA_m3[4];
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[4]*(x4 - x8);
-  const Scalar x21 = k[5]*(x4 + x8);
-  const Scalar x22 = k[6]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(x4 - x8);
+  const Scalar x21 = 0.5*(x4 + x8);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x5*x22;
   const Scalar x24 = x20*x22 + x5*x19;
-  const Scalar x25 = k[7] + k[8]*x10;
-  const Scalar x26 = k[9]*x7*x19 - x22*x25;
-  const Scalar x27 = k[10]*x7*x22 + x19*x25;
-  const Scalar x28 = k[11] + k[12]*x13;
-  const Scalar x29 = k[13] + k[14]*x13;
+  const Scalar x25 = 0.0005 + 0.5*x10;
+  const Scalar x26 = 0.5*x7*x19 - x22*x25;
+  const Scalar x27 = 0.5*x7*x22 + x19*x25;
+  const Scalar x28 = -1.7500000000000002e-05 + 0.5*x13;
+  const Scalar x29 = 1.7500000000000002e-05 + 0.5*x13;
   const Scalar x30 = x21 + x23;
   const Scalar x31 = cq_m5*x6 - sq_m6*x9;
   const Scalar x32 = x21 - x23;
   const Scalar x33 = sq_m6*x6 + cq_m5*x9;
-  const Scalar x34 = k[15]*x7 + x26;
-  const Scalar x35 = k[16] + k[17]*x10 + x27;
-  const Scalar x36 = k[18] + k[19]*x10 + x27;
-  const Scalar x37 = k[20]*x7 - x26;
-  const Scalar x38 = k[21]*x24 + x34;
-  const Scalar x39 = k[22]*x30 + x35;
-  const Scalar x40 = k[23]*x32 + x36;
-  const Scalar x41 = k[24]*x24 + x37;
-  const Scalar x42 = cq_m5*x12 + k[25]*x33;
-  const Scalar x43 = sq_m6*x12 + k[26]*x31;
+  const Scalar x34 = 0.5*x7 + x26;
+  const Scalar x35 = 0.0005 - 0.5*x10 + x27;
+  const Scalar x36 = -0.0005 + 0.5*x10 + x27;
+  const Scalar x37 = 0.5*x7 - x26;
+  const Scalar x38 = 0.2555*x24 + x34;
+  const Scalar x39 = -0.2555*x30 + x35;
+  const Scalar x40 = 0.2555*x32 + x36;
+  const Scalar x41 = -0.2555*x24 + x37;
+  const Scalar x42 = cq_m5*x12 + 0.2555*x33;
+  const Scalar x43 = sq_m6*x12 - 0.2555*x31;
   const Scalar x44 = cq_m5*x14 - sq_m6*x15;
   const Scalar x45 = sq_m6*x14 + cq_m5*x15;
-  IA_m7[0] = k[27] + x30;
+  IA_m7[0] = 0.92 + x30;
   IA_m7[1] = x24;
   IA_m7[2] = x31;
   IA_m7[3] = x38;
-  IA_m7[4] = k[28] + x39;
-  IA_m7[6] = k[29] + x32;
+  IA_m7[4] = -0.10107580000000001 + x39;
+  IA_m7[6] = 0.92 + x32;
   IA_m7[7] = x33;
-  IA_m7[8] = k[30] + x40;
+  IA_m7[8] = 0.10107580000000001 + x40;
   IA_m7[9] = x41;
-  IA_m7[11] = k[31] + x11;
+  IA_m7[11] = 0.92 + x11;
   IA_m7[12] = x42;
   IA_m7[13] = x43;
-  IA_m7[15] = k[32] + x29 + x19*x28 + k[33]*x36 + k[34]*x40;
-  IA_m7[16] = x22*x28 + k[35]*x34 + k[36]*x41;
-  IA_m7[18] = k[37] + x29 - x19*x28 + k[38]*x35 + k[39]*x39;
+  IA_m7[15] = 0.01661854208147 + x29 + x19*x28 + 0.2555*x36 + 0.2555*x40;
+  IA_m7[16] = x22*x28 - 0.2555*x34 + 0.2555*x41;
+  IA_m7[18] = 0.01661854208147 + x29 - x19*x28 - 0.2555*x35 - 0.2555*x39;
   pA_m8[0] = pA_m8[0] + x44;
   pA_m8[1] = pA_m8[1] + x45;
   pA_m8[2] = pA_m8[2] + x16;
-  pA_m8[3] = pA_m8[3] + cq_m5*x17 - sq_m6*x18 + k[40]*x45;
-  pA_m8[4] = pA_m8[4] + sq_m6*x17 + cq_m5*x18 + k[41]*x44;
+  pA_m8[3] = pA_m8[3] + cq_m5*x17 - sq_m6*x18 + 0.2555*x45;
+  pA_m8[4] = pA_m8[4] + sq_m6*x17 + cq_m5*x18 - 0.2555*x44;
   pA_m8[5] = pA_m8[5] + tau[0];
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_forearm, r_forearm.
 // The first: eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-constexpr Scalar shared_7_k0[112] = {1.0, 0.0005635, 0.5, 0.5, 2.0, 0.5, 0.5, 0.00028175, -0.5, 0.00028175, 0.5, 0.955336489125606, -0.955336489125606, -0.29552020666133966, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.955336489125606, 0.955336489125606, 0.29552020666133966, 0.477668244562803, -0.14776010333066983, -0.955336489125606, -0.29552020666133966, -0.14776010333066983, -0.477668244562803, -0.29552020666133966, 0.955336489125606, 0.14776010333066983, 0.477668244562803, -0.29552020666133966, 0.955336489125606, 0.477668244562803, -0.14776010333066983, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.955336489125606, -0.29552020666133966, -0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606, 0.955336489125606, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.955336489125606, 0.29552020666133966, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 0.3255, 0.3255, 0.3255, 0.955336489125606, -0.29552020666133966, 0.29552020666133966, 0.955336489125606, 1.96, -0.27815927999999995, -0.3255, 1.96, 0.27815927999999995, -0.3255, 1.96, -0.3255, 0.061007086312239986, 0.955336489125606, -0.29552020666133966, 0.3255, 0.3255, -0.10595025000000001, -0.3255, 0.29552020666133966, 0.955336489125606, 0.3255, 0.061007086312239986, 0.10595025000000001, -0.3255, 0.0019845, 0.29552020666133966, 0.955336489125606, 0.3255, 0.955336489125606, -0.29552020666133966, -0.3255, 0.29552020666133966, 0.955336489125606};
-PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -366,85 +359,84 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[2]*x9 + c_m4[3]*x10;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x12 + c_m4[3]*x13;
-  const Scalar x18 = k[1]*c_m4[5] + pA_m3[5];
+  const Scalar x18 = 0.0005635*c_m4[5] + pA_m3[5];
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[2]*(-x4 + x11);
-  const Scalar x21 = k[3]*(x4 + x11);
-  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(-x4 + x11);
+  const Scalar x21 = 0.5*(x4 + x11);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x6*x22;
   const Scalar x24 = x20*x22 + x6*x19;
-  const Scalar x25 = k[5]*(-x7*x19 - x12*x22);
-  const Scalar x26 = k[6]*(-x7*x22 + x12*x19);
-  const Scalar x27 = k[7] + k[8]*x13;
-  const Scalar x28 = k[9] + k[10]*x13;
-  const Scalar x29 = k[11]*x21 + k[12]*x23 + k[13]*x24;
-  const Scalar x30 = k[14]*cq_m5*x9 + k[15]*sq_m6*x5 + k[16]*sq_m6*x9 + k[17]*cq_m5*x5;
-  const Scalar x31 = k[18]*x21 + k[19]*x23 + k[20]*x24;
+  const Scalar x25 = 0.5*(-x7*x19 - x12*x22);
+  const Scalar x26 = 0.5*(-x7*x22 + x12*x19);
+  const Scalar x27 = 0.00028175 - 0.5*x13;
+  const Scalar x28 = 0.00028175 + 0.5*x13;
+  const Scalar x29 = 0.955336489125606*x21 - 0.955336489125606*x23 - 0.29552020666133966*x24;
+  const Scalar x30 = -0.29552020666133966*cq_m5*x9 + 0.29552020666133966*sq_m6*x5 + 0.955336489125606*sq_m6*x9 + 0.955336489125606*cq_m5*x5;
+  const Scalar x31 = -0.29552020666133966*x21 - 0.29552020666133966*x23 + 0.955336489125606*x24;
   const Scalar x32 = sq_m6*x9 + cq_m5*x5;
   const Scalar x33 = cq_m5*x9 - sq_m6*x5;
-  const Scalar x34 = k[21]*x21 + k[22]*x23 + k[23]*x24;
-  const Scalar x35 = k[24]*x21 + k[25]*x23 + k[26]*x24;
-  const Scalar x36 = k[27]*x7 + k[28]*x12 + k[29]*x25 + k[30]*x26;
-  const Scalar x37 = k[31]*x7 + k[32]*x12 + k[33]*x25 + k[34]*x26;
-  const Scalar x38 = k[35]*x7 + k[36]*x12 + k[37]*x25 + k[38]*x26;
-  const Scalar x39 = k[39]*x7 + k[40]*x12 + k[41]*x25 + k[42]*x26;
-  const Scalar x40 = k[43]*x28 + k[44]*x19*x27 + k[45]*x22*x27;
-  const Scalar x41 = k[46]*x28 + k[47]*x19*x27 + k[48]*x22*x27;
-  const Scalar x42 = k[49]*x28 + k[50]*x19*x27 + k[51]*x22*x27;
-  const Scalar x43 = k[52]*x28 + k[53]*x19*x27 + k[54]*x22*x27;
-  const Scalar x44 = k[55]*x29 + k[56]*x31;
-  const Scalar x45 = k[57]*x29 + k[58]*x31;
-  const Scalar x46 = k[59]*x32 + k[60]*x33;
-  const Scalar x47 = k[61]*x34 + k[62]*x35;
-  const Scalar x48 = k[63]*x36 + k[64]*x37;
-  const Scalar x49 = k[65]*x36 + k[66]*x37;
-  const Scalar x50 = k[67]*sq_m6*x10 + k[68]*cq_m5*x10;
-  const Scalar x51 = k[69]*sq_m6*x10 + k[70]*cq_m5*x10;
-  const Scalar x52 = k[71]*x38 + k[72]*x39;
-  const Scalar x53 = k[73]*x38 + k[74]*x39;
-  const Scalar x54 = k[75]*x30 + x48;
-  const Scalar x55 = k[76]*x8 + x50;
-  const Scalar x56 = k[77]*x46 + x52;
+  const Scalar x34 = 0.29552020666133966*x21 - 0.29552020666133966*x23 + 0.955336489125606*x24;
+  const Scalar x35 = 0.955336489125606*x21 + 0.955336489125606*x23 + 0.29552020666133966*x24;
+  const Scalar x36 = 0.477668244562803*x7 - 0.14776010333066983*x12 - 0.955336489125606*x25 - 0.29552020666133966*x26;
+  const Scalar x37 = -0.14776010333066983*x7 - 0.477668244562803*x12 - 0.29552020666133966*x25 + 0.955336489125606*x26;
+  const Scalar x38 = 0.14776010333066983*x7 + 0.477668244562803*x12 - 0.29552020666133966*x25 + 0.955336489125606*x26;
+  const Scalar x39 = 0.477668244562803*x7 - 0.14776010333066983*x12 + 0.955336489125606*x25 + 0.29552020666133966*x26;
+  const Scalar x40 = 0.955336489125606*x28 - 0.955336489125606*x19*x27 - 0.29552020666133966*x22*x27;
+  const Scalar x41 = -0.29552020666133966*x28 - 0.29552020666133966*x19*x27 + 0.955336489125606*x22*x27;
+  const Scalar x42 = 0.29552020666133966*x28 - 0.29552020666133966*x19*x27 + 0.955336489125606*x22*x27;
+  const Scalar x43 = 0.955336489125606*x28 + 0.955336489125606*x19*x27 + 0.29552020666133966*x22*x27;
+  const Scalar x44 = 0.955336489125606*x29 - 0.29552020666133966*x31;
+  const Scalar x45 = 0.29552020666133966*x29 + 0.955336489125606*x31;
+  const Scalar x46 = 0.29552020666133966*x32 + 0.955336489125606*x33;
+  const Scalar x47 = 0.29552020666133966*x34 + 0.955336489125606*x35;
+  const Scalar x48 = 0.955336489125606*x36 - 0.29552020666133966*x37;
+  const Scalar x49 = 0.29552020666133966*x36 + 0.955336489125606*x37;
+  const Scalar x50 = 0.29552020666133966*sq_m6*x10 + 0.955336489125606*cq_m5*x10;
+  const Scalar x51 = -0.955336489125606*sq_m6*x10 + 0.29552020666133966*cq_m5*x10;
+  const Scalar x52 = 0.955336489125606*x38 - 0.29552020666133966*x39;
+  const Scalar x53 = 0.29552020666133966*x38 + 0.955336489125606*x39;
+  const Scalar x54 = 0.3255*x30 + x48;
+  const Scalar x55 = 0.3255*x8 + x50;
+  const Scalar x56 = 0.3255*x46 + x52;
   const Scalar x57 = cq_m5*x14 + sq_m6*x16;
   const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
   const Scalar x59 = cq_m5*x17 + sq_m6*x18;
   const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
-  const Scalar x61 = k[78]*x57 + k[79]*x58;
-  const Scalar x62 = k[80]*x57 + k[81]*x58;
-  IA_m7[0] = k[82] + x44;
+  const Scalar x61 = 0.955336489125606*x57 - 0.29552020666133966*x58;
+  const Scalar x62 = 0.29552020666133966*x57 + 0.955336489125606*x58;
+  IA_m7[0] = 1.96 + x44;
   IA_m7[1] = x30;
   IA_m7[2] = x45;
   IA_m7[3] = x54;
-  IA_m7[4] = k[83] + k[84]*x44;
+  IA_m7[4] = -0.27815927999999995 - 0.3255*x44;
   IA_m7[5] = x49;
-  IA_m7[6] = k[85] + x8;
+  IA_m7[6] = 1.96 + x8;
   IA_m7[7] = x46;
-  IA_m7[8] = k[86] + x55;
-  IA_m7[9] = k[87]*x30;
+  IA_m7[8] = 0.27815927999999995 + x55;
+  IA_m7[9] = -0.3255*x30;
   IA_m7[10] = x51;
-  IA_m7[11] = k[88] + x47;
+  IA_m7[11] = 1.96 + x47;
   IA_m7[12] = x56;
-  IA_m7[13] = k[89]*x45;
+  IA_m7[13] = -0.3255*x45;
   IA_m7[14] = x53;
-  IA_m7[15] = k[90] + k[91]*x40 + k[92]*x41 + k[93]*x50 + k[94]*x55;
-  IA_m7[16] = k[95]*x30 + k[96]*x48;
-  IA_m7[17] = k[97]*x40 + k[98]*x41 + k[99]*x51;
-  IA_m7[18] = k[100] + k[101]*x44;
-  IA_m7[19] = k[102]*x49;
-  IA_m7[20] = k[103] + k[104]*x42 + k[105]*x43;
+  IA_m7[15] = 0.061007086312239986 + 0.955336489125606*x40 - 0.29552020666133966*x41 + 0.3255*x50 + 0.3255*x55;
+  IA_m7[16] = -0.10595025000000001*x30 - 0.3255*x48;
+  IA_m7[17] = 0.29552020666133966*x40 + 0.955336489125606*x41 + 0.3255*x51;
+  IA_m7[18] = 0.061007086312239986 + 0.10595025000000001*x44;
+  IA_m7[19] = -0.3255*x49;
+  IA_m7[20] = 0.0019845 + 0.29552020666133966*x42 + 0.955336489125606*x43;
   pA_m8[0] = pA_m8[0] + x61;
   pA_m8[1] = pA_m8[1] + x15;
   pA_m8[2] = pA_m8[2] + x62;
-  pA_m8[3] = pA_m8[3] + k[106]*x15 + k[107]*x59 + k[108]*x60;
-  pA_m8[4] = pA_m8[4] + tau[0] + k[109]*x61;
-  pA_m8[5] = pA_m8[5] + k[110]*x59 + k[111]*x60;
+  pA_m8[3] = pA_m8[3] + 0.3255*x15 + 0.955336489125606*x59 - 0.29552020666133966*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] - 0.3255*x61;
+  pA_m8[5] = pA_m8[5] + 0.29552020666133966*x59 + 0.955336489125606*x60;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_upper_arm, r_upper_arm.
 // The first: eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-constexpr Scalar shared_8_k0[20] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.3, -0.009, 0.5, -0.5, 0.3, 0.009, -0.5, 0.5, 0.3, 0.00046199999999999995, 0.00046199999999999995};
-PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[20];
+PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[20];
   u_m2[0] = -pA_m3[5] + tau[0];
   const Scalar x0 = IA_m1[5]*Dinv_m0[0];
   const Scalar x1 = IA_m1[10]*Dinv_m0[0];
@@ -472,35 +464,35 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[1]*x12 + c_m4[3]*x17 + c_m4[4]*x18;
   const Scalar x24 = pA_m3[4] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[1]*x13 + c_m4[3]*x18 + c_m4[4]*x19;
   const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x26 = k[1]*(x5 - x10);
-  const Scalar x27 = k[2]*(x5 + x10);
-  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x26 = 0.5*(x5 - x10);
+  const Scalar x27 = 0.5*(x5 + x10);
+  const Scalar x28 = 2.0*cq_m5*sq_m6;
   const Scalar x29 = x25*x26 - x6*x28;
   const Scalar x30 = x26*x28 + x6*x25;
-  const Scalar x31 = k[4]*(x8 - x13);
-  const Scalar x32 = k[5]*(x8 + x13);
-  const Scalar x33 = k[6]*(x9 + x12);
+  const Scalar x31 = 0.5*(x8 - x13);
+  const Scalar x32 = 0.5*(x8 + x13);
+  const Scalar x33 = 0.5*(x9 + x12);
   const Scalar x34 = x25*x31 - x28*x33;
   const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = k[7]*(x17 - x19);
-  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x36 = 0.5*(x17 - x19);
+  const Scalar x37 = 0.5*(x17 + x19);
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
-  IA_m7[0] = k[9] + x27 + x29;
+  IA_m7[0] = 0.3 + x27 + x29;
   IA_m7[1] = x30;
   IA_m7[2] = cq_m5*x7 - sq_m6*x11;
   IA_m7[3] = x32 + x34;
-  IA_m7[4] = k[10] + k[11]*x9 + k[12]*x12 + x35;
-  IA_m7[6] = k[13] + x27 - x29;
+  IA_m7[4] = -0.009 + 0.5*x9 - 0.5*x12 + x35;
+  IA_m7[6] = 0.3 + x27 - x29;
   IA_m7[7] = sq_m6*x7 + cq_m5*x11;
-  IA_m7[8] = k[14] + k[15]*x9 + k[16]*x12 + x35;
+  IA_m7[8] = 0.009 - 0.5*x9 + 0.5*x12 + x35;
   IA_m7[9] = x32 - x34;
-  IA_m7[11] = k[17] + x14;
+  IA_m7[11] = 0.3 + x14;
   IA_m7[12] = cq_m5*x15 - sq_m6*x16;
   IA_m7[13] = sq_m6*x15 + cq_m5*x16;
-  IA_m7[15] = k[18] + x37 + x38;
+  IA_m7[15] = 0.00046199999999999995 + x37 + x38;
   IA_m7[16] = x39;
-  IA_m7[18] = k[19] + x37 - x38;
+  IA_m7[18] = 0.00046199999999999995 + x37 - x38;
   pA_m8[0] = pA_m8[0] + cq_m5*x20 - sq_m6*x21;
   pA_m8[1] = pA_m8[1] + sq_m6*x20 + cq_m5*x21;
   pA_m8[2] = pA_m8[2] + x22;
@@ -511,10 +503,10 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shoulder_roll_link, r_shoulder_roll_link.
 // The first: eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-constexpr Scalar shared_9_k0[21] = {1.0, 0.000192, 0.5, 0.5, 2.0, 0.5, 0.5, -9.6e-05, 0.5, 9.6e-05, 0.5, 0.3, -0.009, 0.3, 0.5, -0.5, 0.3, 0.5, 0.5, 0.000192, 0.00046199999999999995};
-constexpr Scalar shared_9_k1[21] = {1.0, 0.000192, 0.5, 0.5, 2.0, 0.5, 0.5, -9.6e-05, 0.5, 9.6e-05, 0.5, 0.3, 0.009, 0.3, 0.5, -0.5, 0.3, 0.5, 0.5, 0.000192, 0.00046199999999999995};
+constexpr Scalar shared_9_k0[1] = {-0.009};
+constexpr Scalar shared_9_k1[1] = {0.009};
 PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[15];
+  Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
   const Scalar x1 = IA_m1[8]*Dinv_m0[0];
@@ -534,32 +526,32 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[3]*x10;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[4] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[3]*x13;
-  const Scalar x18 = k[1]*c_m4[4] + pA_m3[5];
+  const Scalar x18 = 0.000192*c_m4[4] + pA_m3[5];
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[2]*(x8 - x11);
-  const Scalar x21 = k[3]*(x8 + x11);
-  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(x8 - x11);
+  const Scalar x21 = 0.5*(x8 + x11);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
-  const Scalar x25 = k[5]*(x10*x19 - x12*x22);
-  const Scalar x26 = k[6]*(x10*x22 + x12*x19);
-  const Scalar x27 = k[7] + k[8]*x13;
-  const Scalar x28 = k[9] + k[10]*x13;
-  IA_m7[0] = k[11] + x4;
+  const Scalar x25 = 0.5*(x10*x19 - x12*x22);
+  const Scalar x26 = 0.5*(x10*x22 + x12*x19);
+  const Scalar x27 = -9.6e-05 + 0.5*x13;
+  const Scalar x28 = 9.6e-05 + 0.5*x13;
+  IA_m7[0] = 0.3 + x4;
   IA_m7[1] = cq_m5*x5 - sq_m6*x6;
   IA_m7[2] = sq_m6*x5 + cq_m5*x6;
   IA_m7[4] = cq_m5*x7;
-  IA_m7[5] = k[12] + sq_m6*x7;
-  IA_m7[6] = k[13] + x21 + x23;
+  IA_m7[5] = k[0] + sq_m6*x7;
+  IA_m7[6] = 0.3 + x21 + x23;
   IA_m7[7] = x24;
-  IA_m7[9] = k[14]*x10 + x25;
-  IA_m7[10] = k[15]*x12 + x26;
-  IA_m7[11] = k[16] + x21 - x23;
-  IA_m7[13] = k[17]*x12 + x26;
-  IA_m7[14] = k[18]*x10 - x25;
-  IA_m7[18] = k[19] + x28 + x19*x27;
+  IA_m7[9] = 0.5*x10 + x25;
+  IA_m7[10] = -0.5*x12 + x26;
+  IA_m7[11] = 0.3 + x21 - x23;
+  IA_m7[13] = 0.5*x12 + x26;
+  IA_m7[14] = 0.5*x10 - x25;
+  IA_m7[18] = 0.000192 + x28 + x19*x27;
   IA_m7[19] = x22*x27;
-  IA_m7[20] = k[20] + x28 - x19*x27;
+  IA_m7[20] = 0.00046199999999999995 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
   pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
   pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
@@ -570,45 +562,44 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-constexpr Scalar shared_10_k0[38] = {0.027912499999999996, 0.06825, 0.00194517348958, 1.0046580625, 1.0, -0.06825, -0.06825, 1.015, -0.027912499999999996, -0.06825, 1.015, 0.06495999999999999, -0.0017863999999999998, 0.00936987670937, 1.0046580625, 0.00860228295937, -3.1912249599999995e-06, -0.06495999999999999, -0.06495999999999999, -0.06825, -0.06825, 0.0017863999999999998, 0.5, 0.5, 2.0, -0.032479999999999995, 0.5, 0.5, 0.5, 0.2, 0.2, 0.032479999999999995, 0.5, 0.2, -0.032479999999999995, -0.5, 7.2e-05, 7.2e-05};
-PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar cq_m9, Scalar sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
+PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar cq_m9, Scalar sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
   const Scalar x0 = mu*active_m0[0];
-  U_m1[0] = k[0] + k[1]*x0;
-  U_m1[2] = k[2] + k[3]*x0;
-  Dinv_m2[0] = k[4] / U_m1[2];
-  u_m3[0] = -pA_m4[3] + k[5]*lambda_m5[1] - lambda_m5[3] + k[6]*g_m6[0]*x0 + tau[0];
+  U_m1[0] = 0.027912499999999996 + 0.06825*x0;
+  U_m1[2] = 0.00194517348958 + 1.0046580625*x0;
+  Dinv_m2[0] = 1.0 / U_m1[2];
+  u_m3[0] = -pA_m4[3] - 0.06825*lambda_m5[1] - lambda_m5[3] - 0.06825*g_m6[0]*x0 + tau[0];
   const Scalar x1 = U_m1[0]*Dinv_m2[0];
-  const Scalar x2 = k[7] + x0;
-  const Scalar x3 = k[8] + k[9]*x0;
-  const Scalar x4 = k[10] + x0 - U_m1[0]*x1;
-  const Scalar x5 = k[11] + k[12]*U_m1[0]*Dinv_m2[0];
-  const Scalar x6 = k[13] + k[14]*x0;
-  const Scalar x7 = k[15] + x0 + k[16]*Dinv_m2[0];
+  const Scalar x2 = 1.015 + x0;
+  const Scalar x3 = -0.027912499999999996 - 0.06825*x0;
+  const Scalar x4 = 1.015 + x0 - U_m1[0]*x1;
+  const Scalar x5 = 0.06495999999999999 - 0.0017863999999999998*U_m1[0]*Dinv_m2[0];
+  const Scalar x6 = 0.00936987670937 + 1.0046580625*x0;
+  const Scalar x7 = 0.00860228295937 + x0 - 3.1912249599999995e-06*Dinv_m2[0];
   const Scalar x8 = pA_m4[0] + lambda_m5[0] + g_m7[0]*x0 + c_m8[3]*x3;
   const Scalar x9 = pA_m4[1] + lambda_m5[1] + g_m6[0]*x0 + u_m3[0]*x1 + c_m8[0]*x4 + c_m8[4]*x5;
-  const Scalar x10 = k[17]*c_m8[3] + pA_m4[2] + lambda_m5[2] + g_m6[1]*x0 + c_m8[1]*x2;
-  const Scalar x11 = k[18]*c_m8[1] + pA_m4[4] + k[19]*lambda_m5[0] + lambda_m5[4] + k[20]*g_m7[0]*x0 + c_m8[3]*x6;
-  const Scalar x12 = pA_m4[5] + lambda_m5[5] + k[21]*Dinv_m2[0]*u_m3[0] + c_m8[0]*x5 + c_m8[4]*x7;
+  const Scalar x10 = -0.06495999999999999*c_m8[3] + pA_m4[2] + lambda_m5[2] + g_m6[1]*x0 + c_m8[1]*x2;
+  const Scalar x11 = -0.06495999999999999*c_m8[1] + pA_m4[4] - 0.06825*lambda_m5[0] + lambda_m5[4] - 0.06825*g_m7[0]*x0 + c_m8[3]*x6;
+  const Scalar x12 = pA_m4[5] + lambda_m5[5] + 0.0017863999999999998*Dinv_m2[0]*u_m3[0] + c_m8[0]*x5 + c_m8[4]*x7;
   const Scalar x13 = cq_m9*cq_m9 - sq_m10*sq_m10;
-  const Scalar x14 = k[22]*(-x2 + x4);
-  const Scalar x15 = k[23]*(x2 + x4);
-  const Scalar x16 = k[24]*cq_m9*sq_m10;
-  const Scalar x17 = k[25] + k[26]*x5;
-  const Scalar x18 = k[27]*(x6 - x7);
-  const Scalar x19 = k[28]*(x6 + x7);
-  IA_m11[0] = k[29] + x2;
+  const Scalar x14 = 0.5*(-x2 + x4);
+  const Scalar x15 = 0.5*(x2 + x4);
+  const Scalar x16 = 2.0*cq_m9*sq_m10;
+  const Scalar x17 = -0.032479999999999995 + 0.5*x5;
+  const Scalar x18 = 0.5*(x6 - x7);
+  const Scalar x19 = 0.5*(x6 + x7);
+  IA_m11[0] = 0.2 + x2;
   IA_m11[4] = cq_m9*x3;
   IA_m11[5] = sq_m10*x3;
-  IA_m11[6] = k[30] + x15 + x13*x14;
+  IA_m11[6] = 0.2 + x15 + x13*x14;
   IA_m11[7] = x14*x16;
   IA_m11[9] = -x16*x17;
-  IA_m11[10] = k[31] + k[32]*x5 + x13*x17;
-  IA_m11[11] = k[33] + x15 - x13*x14;
-  IA_m11[13] = k[34] + k[35]*x5 + x13*x17;
+  IA_m11[10] = 0.032479999999999995 + 0.5*x5 + x13*x17;
+  IA_m11[11] = 0.2 + x15 - x13*x14;
+  IA_m11[13] = -0.032479999999999995 - 0.5*x5 + x13*x17;
   IA_m11[14] = x16*x17;
-  IA_m11[18] = k[36] + x19 + x13*x18;
+  IA_m11[18] = 7.2e-05 + x19 + x13*x18;
   IA_m11[19] = x16*x18;
-  IA_m11[20] = k[37] + x19 - x13*x18;
+  IA_m11[20] = 7.2e-05 + x19 - x13*x18;
   pA_m12[0] = pA_m12[0] + x8;
   pA_m12[1] = pA_m12[1] + cq_m9*x9 - sq_m10*x10;
   pA_m12[2] = pA_m12[2] + sq_m10*x9 + cq_m9*x10;
@@ -619,9 +610,8 @@ PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-constexpr Scalar shared_11_k0[112] = {1.0, 7.2e-05, 0.5, 0.5, 2.0, 0.5, 0.5, -3.6e-05, 0.5, 3.6e-05, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, 0.4975020826390129, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.04991670832341408, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.04991670832341408, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, 0.4975020826390129, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 3.055, -0.5694718575000001, -0.4305, 3.055, 0.5694718575000001, -0.4305, 3.055, -0.4305, 0.15779149347477375, 0.9950041652780258, -0.09983341664682815, 0.4305, 0.4305, -0.18533025, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.15779149347477375, 0.18533025, -0.4305, 0.00381875, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -640,86 +630,85 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
-  const Scalar x17 = k[1]*c_m4[3] + pA_m3[3];
+  const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[2]*(-x4 + x9);
-  const Scalar x21 = k[3]*(x4 + x9);
-  const Scalar x22 = k[4]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(-x4 + x9);
+  const Scalar x21 = 0.5*(x4 + x9);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x12*x22;
   const Scalar x24 = x20*x22 + x12*x19;
-  const Scalar x25 = k[5]*(x10*x19 - x5*x22);
-  const Scalar x26 = k[6]*(x10*x22 + x5*x19);
-  const Scalar x27 = k[7] + k[8]*x11;
-  const Scalar x28 = k[9] + k[10]*x11;
-  const Scalar x29 = k[11]*x21 + k[12]*x23 + k[13]*x24;
-  const Scalar x30 = k[14]*cq_m5*x7 + k[15]*sq_m6*x13 + k[16]*sq_m6*x7 + k[17]*cq_m5*x13;
-  const Scalar x31 = k[18]*x21 + k[19]*x23 + k[20]*x24;
+  const Scalar x25 = 0.5*(x10*x19 - x5*x22);
+  const Scalar x26 = 0.5*(x10*x22 + x5*x19);
+  const Scalar x27 = -3.6e-05 + 0.5*x11;
+  const Scalar x28 = 3.6e-05 + 0.5*x11;
+  const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
+  const Scalar x30 = -0.09983341664682815*cq_m5*x7 + 0.09983341664682815*sq_m6*x13 + 0.9950041652780258*sq_m6*x7 + 0.9950041652780258*cq_m5*x13;
+  const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
   const Scalar x32 = sq_m6*x7 + cq_m5*x13;
   const Scalar x33 = cq_m5*x7 - sq_m6*x13;
-  const Scalar x34 = k[21]*x21 + k[22]*x23 + k[23]*x24;
-  const Scalar x35 = k[24]*x21 + k[25]*x23 + k[26]*x24;
-  const Scalar x36 = k[27]*x5 + k[28]*x10 + k[29]*x25 + k[30]*x26;
-  const Scalar x37 = k[31]*x5 + k[32]*x10 + k[33]*x25 + k[34]*x26;
-  const Scalar x38 = k[35]*x5 + k[36]*x10 + k[37]*x25 + k[38]*x26;
-  const Scalar x39 = k[39]*x5 + k[40]*x10 + k[41]*x25 + k[42]*x26;
-  const Scalar x40 = k[43]*x28 + k[44]*x19*x27 + k[45]*x22*x27;
-  const Scalar x41 = k[46]*x28 + k[47]*x19*x27 + k[48]*x22*x27;
-  const Scalar x42 = k[49]*x28 + k[50]*x19*x27 + k[51]*x22*x27;
-  const Scalar x43 = k[52]*x28 + k[53]*x19*x27 + k[54]*x22*x27;
-  const Scalar x44 = k[55]*x29 + k[56]*x31;
-  const Scalar x45 = k[57]*x29 + k[58]*x31;
-  const Scalar x46 = k[59]*x32 + k[60]*x33;
-  const Scalar x47 = k[61]*x34 + k[62]*x35;
-  const Scalar x48 = k[63]*x36 + k[64]*x37;
-  const Scalar x49 = k[65]*x36 + k[66]*x37;
-  const Scalar x50 = k[67]*cq_m5*x8 + k[68]*sq_m6*x8;
-  const Scalar x51 = k[69]*cq_m5*x8 + k[70]*sq_m6*x8;
-  const Scalar x52 = k[71]*x38 + k[72]*x39;
-  const Scalar x53 = k[73]*x38 + k[74]*x39;
-  const Scalar x54 = k[75]*x30 + x48;
-  const Scalar x55 = k[76]*x6 + x50;
-  const Scalar x56 = k[77]*x46 + x52;
+  const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
+  const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
+  const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
+  const Scalar x37 = 0.4975020826390129*x5 - 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
+  const Scalar x38 = -0.4975020826390129*x5 + 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
+  const Scalar x39 = 0.04991670832341408*x5 + 0.4975020826390129*x10 + 0.9950041652780258*x25 + 0.09983341664682815*x26;
+  const Scalar x40 = 0.9950041652780258*x28 - 0.9950041652780258*x19*x27 - 0.09983341664682815*x22*x27;
+  const Scalar x41 = -0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
+  const Scalar x42 = 0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
+  const Scalar x43 = 0.9950041652780258*x28 + 0.9950041652780258*x19*x27 + 0.09983341664682815*x22*x27;
+  const Scalar x44 = 0.9950041652780258*x29 - 0.09983341664682815*x31;
+  const Scalar x45 = 0.09983341664682815*x29 + 0.9950041652780258*x31;
+  const Scalar x46 = 0.09983341664682815*x32 + 0.9950041652780258*x33;
+  const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
+  const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
+  const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
+  const Scalar x50 = -0.09983341664682815*cq_m5*x8 + 0.9950041652780258*sq_m6*x8;
+  const Scalar x51 = 0.9950041652780258*cq_m5*x8 + 0.09983341664682815*sq_m6*x8;
+  const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
+  const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x54 = 0.4305*x30 + x48;
+  const Scalar x55 = 0.4305*x6 + x50;
+  const Scalar x56 = 0.4305*x46 + x52;
   const Scalar x57 = cq_m5*x14 + sq_m6*x16;
   const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
   const Scalar x59 = cq_m5*x17 + sq_m6*x18;
   const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
-  const Scalar x61 = k[78]*x57 + k[79]*x58;
-  const Scalar x62 = k[80]*x57 + k[81]*x58;
-  IA_m7[0] = k[82] + x44;
+  const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
+  const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
+  IA_m7[0] = 3.055 + x44;
   IA_m7[1] = x30;
   IA_m7[2] = x45;
   IA_m7[3] = x54;
-  IA_m7[4] = k[83] + k[84]*x44;
+  IA_m7[4] = -0.5694718575000001 - 0.4305*x44;
   IA_m7[5] = x49;
-  IA_m7[6] = k[85] + x6;
+  IA_m7[6] = 3.055 + x6;
   IA_m7[7] = x46;
-  IA_m7[8] = k[86] + x55;
-  IA_m7[9] = k[87]*x30;
+  IA_m7[8] = 0.5694718575000001 + x55;
+  IA_m7[9] = -0.4305*x30;
   IA_m7[10] = x51;
-  IA_m7[11] = k[88] + x47;
+  IA_m7[11] = 3.055 + x47;
   IA_m7[12] = x56;
-  IA_m7[13] = k[89]*x45;
+  IA_m7[13] = -0.4305*x45;
   IA_m7[14] = x53;
-  IA_m7[15] = k[90] + k[91]*x40 + k[92]*x41 + k[93]*x50 + k[94]*x55;
-  IA_m7[16] = k[95]*x30 + k[96]*x48;
-  IA_m7[17] = k[97]*x40 + k[98]*x41 + k[99]*x51;
-  IA_m7[18] = k[100] + k[101]*x44;
-  IA_m7[19] = k[102]*x49;
-  IA_m7[20] = k[103] + k[104]*x42 + k[105]*x43;
+  IA_m7[15] = 0.15779149347477375 + 0.9950041652780258*x40 - 0.09983341664682815*x41 + 0.4305*x50 + 0.4305*x55;
+  IA_m7[16] = -0.18533025*x30 - 0.4305*x48;
+  IA_m7[17] = 0.09983341664682815*x40 + 0.9950041652780258*x41 + 0.4305*x51;
+  IA_m7[18] = 0.15779149347477375 + 0.18533025*x44;
+  IA_m7[19] = -0.4305*x49;
+  IA_m7[20] = 0.00381875 + 0.09983341664682815*x42 + 0.9950041652780258*x43;
   pA_m8[0] = pA_m8[0] + x61;
   pA_m8[1] = pA_m8[1] + x15;
   pA_m8[2] = pA_m8[2] + x62;
-  pA_m8[3] = pA_m8[3] + k[106]*x15 + k[107]*x59 + k[108]*x60;
-  pA_m8[4] = pA_m8[4] + tau[0] + k[109]*x61;
-  pA_m8[5] = pA_m8[5] + k[110]*x59 + k[111]*x60;
+  pA_m8[3] = pA_m8[3] + 0.4305*x15 + 0.9950041652780258*x59 - 0.09983341664682815*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] - 0.4305*x61;
+  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-constexpr Scalar shared_12_k0[114] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.4900332889206208, 0.4900332889206208, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 7.0, -1.29954125, -0.42875, 7.0, 1.29954125, -0.42875, 7.0, -0.42875, 0.3755072987089375, 0.9800665778412416, 0.19866933079506124, 0.42875, 0.42875, -0.1838265625, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.3755072987089375, 0.1838265625, -0.42875, 0.0196875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -747,90 +736,89 @@ PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
   const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x26 = k[1]*(-x5 + x14);
-  const Scalar x27 = k[2]*(x5 + x14);
-  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x26 = 0.5*(-x5 + x14);
+  const Scalar x27 = 0.5*(x5 + x14);
+  const Scalar x28 = 2.0*cq_m5*sq_m6;
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = k[4]*(-x8 + x16);
-  const Scalar x32 = k[5]*(x8 + x16);
-  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x31 = 0.5*(-x8 + x16);
+  const Scalar x32 = 0.5*(x8 + x16);
+  const Scalar x33 = 0.5*(x9 + x15);
   const Scalar x34 = x25*x31 - x28*x33;
   const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = k[7]*(-x17 + x19);
-  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x36 = 0.5*(-x17 + x19);
+  const Scalar x37 = 0.5*(x17 + x19);
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
-  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
-  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
+  const Scalar x41 = 0.19866933079506124*cq_m5*x11 - 0.19866933079506124*sq_m6*x6 + 0.9800665778412416*sq_m6*x11 + 0.9800665778412416*cq_m5*x6;
+  const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
   const Scalar x43 = sq_m6*x11 + cq_m5*x6;
   const Scalar x44 = cq_m5*x11 - sq_m6*x6;
-  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
-  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
-  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
-  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
+  const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
+  const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
+  const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
   const Scalar x49 = sq_m6*x13 + cq_m5*x12;
   const Scalar x50 = cq_m5*x13 - sq_m6*x12;
-  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
-  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
-  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
-  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
-  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
-  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
-  const Scalar x57 = k[57]*x40 + k[58]*x42;
-  const Scalar x58 = k[59]*x40 + k[60]*x42;
-  const Scalar x59 = k[61]*x43 + k[62]*x44;
-  const Scalar x60 = k[63]*x45 + k[64]*x46;
-  const Scalar x61 = k[65]*x47 + k[66]*x48;
-  const Scalar x62 = k[67]*x47 + k[68]*x48;
-  const Scalar x63 = k[69]*x49 + k[70]*x50;
-  const Scalar x64 = k[71]*x49 + k[72]*x50;
-  const Scalar x65 = k[73]*x51 + k[74]*x52;
-  const Scalar x66 = k[75]*x51 + k[76]*x52;
-  const Scalar x67 = k[77]*x41 + x61;
-  const Scalar x68 = k[78]*x10 + x63;
-  const Scalar x69 = k[79]*x59 + x65;
+  const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
+  const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
+  const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
+  const Scalar x54 = 0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
+  const Scalar x55 = -0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
+  const Scalar x56 = 0.9800665778412416*x37 + 0.9800665778412416*x38 - 0.19866933079506124*x39;
+  const Scalar x57 = 0.9800665778412416*x40 + 0.19866933079506124*x42;
+  const Scalar x58 = -0.19866933079506124*x40 + 0.9800665778412416*x42;
+  const Scalar x59 = -0.19866933079506124*x43 + 0.9800665778412416*x44;
+  const Scalar x60 = -0.19866933079506124*x45 + 0.9800665778412416*x46;
+  const Scalar x61 = 0.9800665778412416*x47 + 0.19866933079506124*x48;
+  const Scalar x62 = -0.19866933079506124*x47 + 0.9800665778412416*x48;
+  const Scalar x63 = 0.9800665778412416*x49 + 0.19866933079506124*x50;
+  const Scalar x64 = -0.19866933079506124*x49 + 0.9800665778412416*x50;
+  const Scalar x65 = 0.9800665778412416*x51 + 0.19866933079506124*x52;
+  const Scalar x66 = -0.19866933079506124*x51 + 0.9800665778412416*x52;
+  const Scalar x67 = 0.42875*x41 + x61;
+  const Scalar x68 = 0.42875*x10 + x63;
+  const Scalar x69 = 0.42875*x59 + x65;
   const Scalar x70 = cq_m5*x20 + sq_m6*x22;
   const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
   const Scalar x72 = cq_m5*x23 + sq_m6*x24;
   const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
-  const Scalar x74 = k[80]*x70 + k[81]*x71;
-  const Scalar x75 = k[82]*x70 + k[83]*x71;
-  IA_m7[0] = k[84] + x57;
+  const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
+  const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
+  IA_m7[0] = 7.0 + x57;
   IA_m7[1] = x41;
   IA_m7[2] = x58;
   IA_m7[3] = x67;
-  IA_m7[4] = k[85] + k[86]*x57;
+  IA_m7[4] = -1.29954125 - 0.42875*x57;
   IA_m7[5] = x62;
-  IA_m7[6] = k[87] + x10;
+  IA_m7[6] = 7.0 + x10;
   IA_m7[7] = x59;
-  IA_m7[8] = k[88] + x68;
-  IA_m7[9] = k[89]*x41;
+  IA_m7[8] = 1.29954125 + x68;
+  IA_m7[9] = -0.42875*x41;
   IA_m7[10] = x64;
-  IA_m7[11] = k[90] + x60;
+  IA_m7[11] = 7.0 + x60;
   IA_m7[12] = x69;
-  IA_m7[13] = k[91]*x58;
+  IA_m7[13] = -0.42875*x58;
   IA_m7[14] = x66;
-  IA_m7[15] = k[92] + k[93]*x53 + k[94]*x54 + k[95]*x63 + k[96]*x68;
-  IA_m7[16] = k[97]*x41 + k[98]*x61;
-  IA_m7[17] = k[99]*x53 + k[100]*x54 + k[101]*x64;
-  IA_m7[18] = k[102] + k[103]*x57;
-  IA_m7[19] = k[104]*x62;
-  IA_m7[20] = k[105] + k[106]*x55 + k[107]*x56;
+  IA_m7[15] = 0.3755072987089375 + 0.9800665778412416*x53 + 0.19866933079506124*x54 + 0.42875*x63 + 0.42875*x68;
+  IA_m7[16] = -0.1838265625*x41 - 0.42875*x61;
+  IA_m7[17] = -0.19866933079506124*x53 + 0.9800665778412416*x54 + 0.42875*x64;
+  IA_m7[18] = 0.3755072987089375 + 0.1838265625*x57;
+  IA_m7[19] = -0.42875*x62;
+  IA_m7[20] = 0.0196875 - 0.19866933079506124*x55 + 0.9800665778412416*x56;
   pA_m8[0] = pA_m8[0] + x74;
   pA_m8[1] = pA_m8[1] + x21;
   pA_m8[2] = pA_m8[2] + x75;
-  pA_m8[3] = pA_m8[3] + k[108]*x21 + k[109]*x72 + k[110]*x73;
-  pA_m8[4] = pA_m8[4] + tau[0] + k[111]*x74;
-  pA_m8[5] = pA_m8[5] + k[112]*x72 + k[113]*x73;
+  pA_m8[3] = pA_m8[3] + 0.42875*x21 + 0.9800665778412416*x72 + 0.19866933079506124*x73;
+  pA_m8[4] = pA_m8[4] + tau[0] - 0.42875*x74;
+  pA_m8[5] = pA_m8[5] - 0.19866933079506124*x72 + 0.9800665778412416*x73;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-constexpr Scalar shared_13_k0[97] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.4975020826390129, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.5, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.015, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.00095, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.0005, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -858,69 +846,68 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
   const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x26 = k[1]*(-x5 + x14);
-  const Scalar x27 = k[2]*(x5 + x14);
-  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x26 = 0.5*(-x5 + x14);
+  const Scalar x27 = 0.5*(x5 + x14);
+  const Scalar x28 = 2.0*cq_m5*sq_m6;
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = k[4]*(-x8 + x16);
-  const Scalar x32 = k[5]*(x8 + x16);
-  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x31 = 0.5*(-x8 + x16);
+  const Scalar x32 = 0.5*(x8 + x16);
+  const Scalar x33 = 0.5*(x9 + x15);
   const Scalar x34 = x25*x31 - x28*x33;
   const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = k[7]*(-x17 + x19);
-  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x36 = 0.5*(-x17 + x19);
+  const Scalar x37 = 0.5*(x17 + x19);
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
-  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
-  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
+  const Scalar x41 = -0.09983341664682815*cq_m5*x11 + 0.09983341664682815*sq_m6*x6 + 0.9950041652780258*sq_m6*x11 + 0.9950041652780258*cq_m5*x6;
+  const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
   const Scalar x43 = sq_m6*x11 + cq_m5*x6;
   const Scalar x44 = cq_m5*x11 - sq_m6*x6;
-  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
-  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
-  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
-  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
+  const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
+  const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
+  const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x49 = sq_m6*x13 + cq_m5*x12;
   const Scalar x50 = cq_m5*x13 - sq_m6*x12;
-  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
-  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
-  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
-  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
-  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
-  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
+  const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
+  const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
+  const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
   const Scalar x57 = cq_m5*x20 + sq_m6*x22;
   const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
   const Scalar x59 = cq_m5*x23 + sq_m6*x24;
   const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
-  IA_m7[0] = k[57] + k[58]*x40 + k[59]*x42;
+  IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
   IA_m7[1] = x41;
-  IA_m7[2] = k[60]*x40 + k[61]*x42;
-  IA_m7[3] = k[62]*x47 + k[63]*x48;
-  IA_m7[5] = k[64]*x47 + k[65]*x48;
-  IA_m7[6] = k[66] + x10;
-  IA_m7[7] = k[67]*x43 + k[68]*x44;
-  IA_m7[8] = k[69] + k[70]*x49 + k[71]*x50;
-  IA_m7[10] = k[72]*x49 + k[73]*x50;
-  IA_m7[11] = k[74] + k[75]*x45 + k[76]*x46;
-  IA_m7[12] = k[77]*x51 + k[78]*x52;
-  IA_m7[14] = k[79]*x51 + k[80]*x52;
-  IA_m7[15] = k[81] + k[82]*x53 + k[83]*x54;
-  IA_m7[17] = k[84]*x53 + k[85]*x54;
-  IA_m7[20] = k[86] + k[87]*x55 + k[88]*x56;
-  pA_m8[0] = pA_m8[0] + k[89]*x57 + k[90]*x58;
+  IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
+  IA_m7[3] = 0.9950041652780258*x47 - 0.09983341664682815*x48;
+  IA_m7[5] = 0.09983341664682815*x47 + 0.9950041652780258*x48;
+  IA_m7[6] = 0.5 + x10;
+  IA_m7[7] = 0.09983341664682815*x43 + 0.9950041652780258*x44;
+  IA_m7[8] = 0.015 + 0.9950041652780258*x49 - 0.09983341664682815*x50;
+  IA_m7[10] = 0.09983341664682815*x49 + 0.9950041652780258*x50;
+  IA_m7[11] = 0.5 + 0.09983341664682815*x45 + 0.9950041652780258*x46;
+  IA_m7[12] = 0.9950041652780258*x51 - 0.09983341664682815*x52;
+  IA_m7[14] = 0.09983341664682815*x51 + 0.9950041652780258*x52;
+  IA_m7[15] = 0.00095 + 0.9950041652780258*x53 - 0.09983341664682815*x54;
+  IA_m7[17] = 0.09983341664682815*x53 + 0.9950041652780258*x54;
+  IA_m7[20] = 0.0005 + 0.09983341664682815*x55 + 0.9950041652780258*x56;
+  pA_m8[0] = pA_m8[0] + 0.9950041652780258*x57 - 0.09983341664682815*x58;
   pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + k[91]*x57 + k[92]*x58;
-  pA_m8[3] = pA_m8[3] + k[93]*x59 + k[94]*x60;
+  pA_m8[2] = pA_m8[2] + 0.09983341664682815*x57 + 0.9950041652780258*x58;
+  pA_m8[3] = pA_m8[3] + 0.9950041652780258*x59 - 0.09983341664682815*x60;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] + k[95]*x59 + k[96]*x60;
+  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-constexpr Scalar shared_14_k0[24] = {1.0, -0.015, 0.00095, 0.5, 0.5, 2.0, 0.5, 0.5, 0.000475, -0.5, 0.000475, 0.5, 0.5, 0.02, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, -0.5, 0.5, 0.0013, 0.0005};
-PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[15];
+PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
   const Scalar x1 = IA_m1[8]*Dinv_m0[0];
@@ -936,36 +923,36 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
   const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
   const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
-  const Scalar x14 = k[1]*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
+  const Scalar x14 = -0.015*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
-  const Scalar x17 = k[2]*c_m4[3] + pA_m3[4];
+  const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[3]*(x8 - x11);
-  const Scalar x21 = k[4]*(x8 + x11);
-  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(x8 - x11);
+  const Scalar x21 = 0.5*(x8 + x11);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
-  const Scalar x25 = k[6]*(-x12*x19 - x10*x22);
-  const Scalar x26 = k[7]*(-x12*x22 + x10*x19);
-  const Scalar x27 = k[8] + k[9]*x13;
-  const Scalar x28 = k[10] + k[11]*x13;
-  IA_m7[0] = k[12] + x4;
+  const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
+  const Scalar x26 = 0.5*(-x12*x22 + x10*x19);
+  const Scalar x27 = 0.000475 - 0.5*x13;
+  const Scalar x28 = 0.000475 + 0.5*x13;
+  IA_m7[0] = 0.5 + x4;
   IA_m7[1] = cq_m5*x5 - sq_m6*x6;
   IA_m7[2] = sq_m6*x5 + cq_m5*x6;
-  IA_m7[4] = k[13] + k[14]*cq_m5 - sq_m6*x7;
-  IA_m7[5] = k[15]*sq_m6 + cq_m5*x7;
-  IA_m7[6] = k[16] + x21 + x23;
+  IA_m7[4] = 0.02 - 0.015*cq_m5 - sq_m6*x7;
+  IA_m7[5] = -0.015*sq_m6 + cq_m5*x7;
+  IA_m7[6] = 0.5 + x21 + x23;
   IA_m7[7] = x24;
-  IA_m7[9] = k[17]*x12 + x25;
-  IA_m7[10] = k[18]*x10 + x26;
-  IA_m7[11] = k[19] + x21 - x23;
-  IA_m7[13] = k[20]*x10 + x26;
-  IA_m7[14] = k[21]*x12 - x25;
-  IA_m7[18] = k[22] + x28 + x19*x27;
+  IA_m7[9] = 0.5*x12 + x25;
+  IA_m7[10] = 0.5*x10 + x26;
+  IA_m7[11] = 0.5 + x21 - x23;
+  IA_m7[13] = -0.5*x10 + x26;
+  IA_m7[14] = 0.5*x12 - x25;
+  IA_m7[18] = 0.0013 + x28 + x19*x27;
   IA_m7[19] = x22*x27;
-  IA_m7[20] = k[23] + x28 - x19*x27;
+  IA_m7[20] = 0.0005 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
   pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
   pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
@@ -976,19 +963,18 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 2 blocks of the same code, each over its constants (k) and members: pelvis.
 // The first: accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
-constexpr Scalar shared_15_k0[21] = {-9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, 9.81, 9.81, 9.81};
-PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
-  const Scalar x0 = u_m0[0] + k[0]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] + k[1]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] + k[2]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
+PROXGEN_RT_NOINLINE void shared_15(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
+  const Scalar x0 = u_m0[0] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
   const Scalar x1 = Linv_m3[0]*x0;
-  const Scalar x2 = u_m0[1] + k[3]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] + k[4]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] + k[5]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
+  const Scalar x2 = u_m0[1] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
   const Scalar x3 = Linv_m3[1]*x2;
-  const Scalar x4 = u_m0[2] + k[6]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] + k[7]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] + k[8]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
+  const Scalar x4 = u_m0[2] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
   const Scalar x5 = Linv_m3[2]*x4;
-  const Scalar x6 = u_m0[3] + k[9]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] + k[10]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] + k[11]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
+  const Scalar x6 = u_m0[3] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
   const Scalar x7 = Linv_m3[3]*x6;
-  const Scalar x8 = u_m0[4] + k[12]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] + k[13]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] + k[14]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
+  const Scalar x8 = u_m0[4] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
   const Scalar x9 = Linv_m3[4]*x8;
-  const Scalar x10 = u_m0[5] + k[15]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] + k[16]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] + k[17]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
+  const Scalar x10 = u_m0[5] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
   const Scalar x11 = Linv_m3[5]*x10;
   const Scalar x12 = Linv_m3[5]*x11;
   const Scalar x13 = Linv_m3[4]*x8 - L_m4[18]*x12;
@@ -1006,9 +992,9 @@ PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   qdd_m5[3] = Linv_m3[3]*x15;
   qdd_m5[4] = Linv_m3[4]*x13;
   qdd_m5[5] = Linv_m3[5]*x11;
-  a_m6[0] = k[18]*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
-  a_m6[1] = k[19]*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
-  a_m6[2] = k[20]*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
+  a_m6[0] = 9.81*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
+  a_m6[1] = 9.81*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
+  a_m6[2] = 9.81*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
   a_m6[3] = qdd_m5[3];
   a_m6[4] = qdd_m5[4];
   a_m6[5] = qdd_m5[5];
@@ -1016,14 +1002,13 @@ PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link.
 // The first: accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-constexpr Scalar shared_16_k0[10] = {-0.0875, 0.0875, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759, -0.08718915247898762, 0.9961917745544759, 0.08718915247898762, -0.08718915247898762, 0.9961917745544759};
-PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[1] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[1] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[4];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[4];
+PROXGEN_RT_NOINLINE void shared_16(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.0875*a_m0[5];
+  const Scalar x1 = a_m0[2] + 0.0875*a_m0[3];
+  const Scalar x2 = 0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
+  const Scalar x3 = 0.9961917745544759*a_m0[1] - 0.08718915247898762*x0;
+  const Scalar x4 = 0.9961917745544759*a_m0[3] + 0.08718915247898762*a_m0[4];
+  const Scalar x5 = -0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
   const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
   const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
@@ -1057,12 +1042,11 @@ PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-constexpr Scalar shared_18_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
-  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
-  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
-  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
+  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
+  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
   const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
   const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
@@ -1079,14 +1063,13 @@ PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-constexpr Scalar shared_19_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
+  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
+  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
+  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
+  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -1103,14 +1086,13 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-constexpr Scalar shared_20_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_20(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
+  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
+  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
+  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -1127,13 +1109,12 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-constexpr Scalar shared_21_k0[1] = {-0.0017863999999999998};
-PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_21(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
   const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
   const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
   const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
-  const Scalar x4 = u_m4[0] + k[0]*x3 - U_m5[0]*x0 - U_m5[2]*a_m2[3];
+  const Scalar x4 = u_m4[0] - 0.0017863999999999998*x3 - U_m5[0]*x0 - U_m5[2]*a_m2[3];
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = a_m2[0];
   a_m8[1] = x0;
@@ -1145,14 +1126,13 @@ PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_yaw_link.
 // The first: accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-constexpr Scalar shared_22_k0[10] = {0.0875, -0.0875, -0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.08718915247898762, 0.9961917745544759, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759};
-PROXGEN_RT_NOINLINE void shared_22(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[1] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[1] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[4];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[4];
+PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + 0.0875*a_m0[5];
+  const Scalar x1 = a_m0[2] - 0.0875*a_m0[3];
+  const Scalar x2 = -0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
+  const Scalar x3 = 0.9961917745544759*a_m0[1] + 0.08718915247898762*x0;
+  const Scalar x4 = 0.9961917745544759*a_m0[3] - 0.08718915247898762*a_m0[4];
+  const Scalar x5 = 0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
   const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
   const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
@@ -1169,10 +1149,9 @@ PROXGEN_RT_NOINLINE void shared_22(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: abdomen.
 // The first: accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-constexpr Scalar shared_23_k0[2] = {0.1, -0.1};
-PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + 0.1*a_m0[4];
+  const Scalar x1 = a_m0[1] - 0.1*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
   const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
   const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 + a_m0[4]*sq_m3;
@@ -1189,10 +1168,9 @@ PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: chest.
 // The first: accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-constexpr Scalar shared_24_k0[2] = {0.15, -0.15};
-PROXGEN_RT_NOINLINE void shared_24(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] + 0.15*a_m0[4];
+  const Scalar x1 = a_m0[1] - 0.15*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 - a_m0[2]*sq_m3;
   const Scalar x3 = c_m1[2] + sq_m3*x0 + a_m0[2]*cq_m2;
   const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
@@ -1209,18 +1187,18 @@ PROXGEN_RT_NOINLINE void shared_24(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members: r_shoulder_pitch_link, l_shoulder_pitch_link.
 // The first: accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-constexpr Scalar shared_25_k0[20] = {0.254, 0.19, -0.254, -0.19, 0.9848134698792882, 0.17361575258114187, 0.04493516596384369, 0.9659256678396477, -0.2548890642384102, -0.1676999117594225, 0.2588196364430848, 0.9512566085906322, 0.9848134698792882, 0.17361575258114187, 0.04493516596384369, 0.9659256678396477, -0.2548890642384102, -0.1676999117594225, 0.2588196364430848, 0.9512566085906322};
-constexpr Scalar shared_25_k1[20] = {0.254, -0.19, -0.254, 0.19, 0.9848134698792882, 0.17361575258114187, -0.04493516596384369, 0.9659256678396477, 0.2548890642384102, -0.1676999117594225, -0.2588196364430848, 0.9512566085906322, 0.9848134698792882, 0.17361575258114187, -0.04493516596384369, 0.9659256678396477, 0.2548890642384102, -0.1676999117594225, -0.2588196364430848, 0.9512566085906322};
+constexpr Scalar shared_25_k0[8] = {0.19, -0.19, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848};
+constexpr Scalar shared_25_k1[8] = {-0.19, 0.19, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848};
 PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4] + k[1]*a_m0[5];
-  const Scalar x1 = a_m0[1] + k[2]*a_m0[3];
-  const Scalar x2 = a_m0[2] + k[3]*a_m0[3];
-  const Scalar x3 = k[4]*x0 + k[5]*x2;
-  const Scalar x4 = k[6]*x0 + k[7]*x1 + k[8]*x2;
-  const Scalar x5 = k[9]*x0 + k[10]*x1 + k[11]*x2;
-  const Scalar x6 = k[12]*a_m0[3] + k[13]*a_m0[5];
-  const Scalar x7 = k[14]*a_m0[3] + k[15]*a_m0[4] + k[16]*a_m0[5];
-  const Scalar x8 = k[17]*a_m0[3] + k[18]*a_m0[4] + k[19]*a_m0[5];
+  const Scalar x0 = a_m0[0] + 0.254*a_m0[4] + k[0]*a_m0[5];
+  const Scalar x1 = a_m0[1] - 0.254*a_m0[3];
+  const Scalar x2 = a_m0[2] + k[1]*a_m0[3];
+  const Scalar x3 = 0.9848134698792882*x0 + 0.17361575258114187*x2;
+  const Scalar x4 = k[2]*x0 + 0.9659256678396477*x1 + k[3]*x2;
+  const Scalar x5 = -0.1676999117594225*x0 + k[4]*x1 + 0.9512566085906322*x2;
+  const Scalar x6 = 0.9848134698792882*a_m0[3] + 0.17361575258114187*a_m0[5];
+  const Scalar x7 = k[5]*a_m0[3] + 0.9659256678396477*a_m0[4] + k[6]*a_m0[5];
+  const Scalar x8 = -0.1676999117594225*a_m0[3] + k[7]*a_m0[4] + 0.9512566085906322*a_m0[5];
   const Scalar x9 = c_m1[0] + cq_m2*x3 - sq_m3*x5;
   const Scalar x10 = c_m1[2] + sq_m3*x3 + cq_m2*x5;
   const Scalar x11 = c_m1[3] + cq_m2*x6 - sq_m3*x8;
@@ -1271,14 +1249,13 @@ PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_forearm.
 // The first: accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-constexpr Scalar shared_28_k0[10] = {-0.3255, 0.3255, 0.29552020666133966, 0.955336489125606, 0.955336489125606, -0.29552020666133966, 0.955336489125606, 0.29552020666133966, -0.29552020666133966, 0.955336489125606};
-PROXGEN_RT_NOINLINE void shared_28(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.3255*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.3255*a_m0[3];
+  const Scalar x2 = 0.29552020666133966*a_m0[2] + 0.955336489125606*x0;
+  const Scalar x3 = 0.955336489125606*a_m0[2] - 0.29552020666133966*x0;
+  const Scalar x4 = 0.955336489125606*a_m0[3] + 0.29552020666133966*a_m0[5];
+  const Scalar x5 = -0.29552020666133966*a_m0[3] + 0.955336489125606*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -1295,10 +1272,9 @@ PROXGEN_RT_NOINLINE void shared_28(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members: r_wrist_yaw_link, l_wrist_yaw_link.
 // The first: accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-constexpr Scalar shared_29_k0[2] = {-0.2555, 0.2555};
-PROXGEN_RT_NOINLINE void shared_29(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.2555*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.2555*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
   const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
   const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] + sq_m3*a_m0[4];
@@ -1349,13 +1325,12 @@ PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m
 
 // 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-constexpr Scalar shared_32_k0[6] = {-0.06825, 0.06825, -0.06825, 0.06825, 0.13, 0.13};
-PROXGEN_RT_NOINLINE void shared_32(const Scalar* PROXGEN_RT_RESTRICT k, Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
-  const Scalar x0 = g_m0[0] + a_m1[0] + k[0]*a_m1[4];
+PROXGEN_RT_NOINLINE void shared_32(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+  const Scalar x0 = g_m0[0] + a_m1[0] - 0.06825*a_m1[4];
   residual_m2[0] = active_m3[0]*x0;
   dlambda_m4[0] = mu*residual_m2[0];
   lambda_m5[0] = lambda_m5[0] + dlambda_m4[0];
-  const Scalar x1 = a_m1[1] + k[1]*a_m1[3] + g_m6[0];
+  const Scalar x1 = a_m1[1] + 0.06825*a_m1[3] + g_m6[0];
   residual_m2[1] = active_m3[0]*x1;
   dlambda_m4[1] = mu*residual_m2[1];
   lambda_m5[1] = lambda_m5[1] + dlambda_m4[1];
@@ -1372,11 +1347,11 @@ PROXGEN_RT_NOINLINE void shared_32(const Scalar* PROXGEN_RT_RESTRICT k, Scalar m
   residual_m2[5] = a_m1[5]*active_m3[0];
   dlambda_m4[5] = mu*residual_m2[5];
   lambda_m5[5] = lambda_m5[5] + dlambda_m4[5];
-  const Scalar x3 = g_m7[0] + a_m8[0] + k[2]*a_m8[4];
+  const Scalar x3 = g_m7[0] + a_m8[0] - 0.06825*a_m8[4];
   residual_m2[6] = active_m3[1]*x3;
   dlambda_m4[6] = mu*residual_m2[6];
   lambda_m5[6] = lambda_m5[6] + dlambda_m4[6];
-  const Scalar x4 = a_m8[1] + k[3]*a_m8[3] + g_m9[0];
+  const Scalar x4 = a_m8[1] + 0.06825*a_m8[3] + g_m9[0];
   residual_m2[7] = active_m3[1]*x4;
   dlambda_m4[7] = mu*residual_m2[7];
   lambda_m5[7] = lambda_m5[7] + dlambda_m4[7];
@@ -1393,11 +1368,11 @@ PROXGEN_RT_NOINLINE void shared_32(const Scalar* PROXGEN_RT_RESTRICT k, Scalar m
   residual_m2[11] = a_m8[5]*active_m3[1];
   dlambda_m4[11] = mu*residual_m2[11];
   lambda_m5[11] = lambda_m5[11] + dlambda_m4[11];
-  const Scalar x6 = a_m10[1] + k[4]*a_m10[3] - k_m11[0];
+  const Scalar x6 = a_m10[1] + 0.13*a_m10[3] - k_m11[0];
   residual_m2[12] = active_m3[2]*x6;
   dlambda_m4[12] = mu*residual_m2[12];
   lambda_m5[12] = lambda_m5[12] + dlambda_m4[12];
-  const Scalar x7 = -a_m10[0] + k[5]*a_m10[4] - k_m11[1];
+  const Scalar x7 = -a_m10[0] + 0.13*a_m10[4] - k_m11[1];
   residual_m2[13] = active_m3[2]*x7;
   dlambda_m4[13] = mu*residual_m2[13];
   lambda_m5[13] = lambda_m5[13] + dlambda_m4[13];
@@ -1409,14 +1384,13 @@ PROXGEN_RT_NOINLINE void shared_32(const Scalar* PROXGEN_RT_RESTRICT k, Scalar m
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-constexpr Scalar shared_33_k0[3] = {-0.06825, -0.06825, 0.0017863999999999998};
-PROXGEN_RT_NOINLINE void shared_33(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar cq_m5, Scalar sq_m6) noexcept {
-  const Scalar x0 = k[0]*dlambda_m0[1] - dlambda_m0[3];
+PROXGEN_RT_NOINLINE void shared_33(Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar cq_m5, Scalar sq_m6) noexcept {
+  const Scalar x0 = -0.06825*dlambda_m0[1] - dlambda_m0[3];
   u_m1[0] = u_m1[0] + x0;
   const Scalar x1 = Dinv_m2*x0;
   const Scalar x2 = dlambda_m0[1] + U_m3[0]*x1;
-  const Scalar x3 = k[1]*dlambda_m0[0] + dlambda_m0[4];
-  const Scalar x4 = dlambda_m0[5] + k[2]*Dinv_m2*x0;
+  const Scalar x3 = -0.06825*dlambda_m0[0] + dlambda_m0[4];
+  const Scalar x4 = dlambda_m0[5] + 0.0017863999999999998*Dinv_m2*x0;
   dp_m4[0] = dlambda_m0[0];
   dp_m4[1] = cq_m5*x2 - sq_m6*dlambda_m0[2];
   dp_m4[2] = sq_m6*x2 + cq_m5*dlambda_m0[2];
@@ -1426,8 +1400,7 @@ PROXGEN_RT_NOINLINE void shared_33(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-constexpr Scalar shared_34_k0[8] = {0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_34(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] - dp_m1[4];
   const Scalar x0 = -Dinv_m2*dp_m1[4];
   const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
@@ -1439,54 +1412,53 @@ PROXGEN_RT_NOINLINE void shared_34(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   const Scalar x7 = -sq_m5*x1 + cq_m4*x3;
   const Scalar x8 = cq_m4*x4 + sq_m5*x5;
   const Scalar x9 = -sq_m5*x4 + cq_m4*x5;
-  dp_m6[0] = k[0]*x6 + k[1]*x7;
+  dp_m6[0] = 0.9950041652780258*x6 - 0.09983341664682815*x7;
   dp_m6[1] = x2;
-  dp_m6[2] = k[2]*x6 + k[3]*x7;
-  dp_m6[3] = k[4]*x8 + k[5]*x9;
-  dp_m6[5] = k[6]*x8 + k[7]*x9;
+  dp_m6[2] = 0.09983341664682815*x6 + 0.9950041652780258*x7;
+  dp_m6[3] = 0.9950041652780258*x8 - 0.09983341664682815*x9;
+  dp_m6[5] = 0.09983341664682815*x8 + 0.9950041652780258*x9;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-constexpr Scalar shared_35_k0[39] = {-0.027912499999999996, 0.614466237626843, 0.039325839208117955, 14.34961978945479, 1.015, -0.06495999999999999, -0.06495999999999999, 0.00936987670937, 0.039325839208117955, 0.006961696668689549, 0.9183756665251066, -0.027912499999999996, -0.027912499999999996, 1.0147331188134214, -0.20026688118657843, -0.40053376237315685, 0.025634160791882035, 0.05214291960405897, -0.012817080395941018, 1.0147331188134214, 0.20026688118657843, -0.05214291960405897, -0.012817080395941018, -0.025634160791882035, 0.008237786689029773, 0.0012040900203402253, 0.0024081800406804505, 0.008237786689029773, -0.0012040900203402253, -0.06825, -0.06825, 0.020638449369710488, 0.020638449369710488, 0.06267913924033854, -0.06267913924033854, -14.34961978945479, -14.34961978945479, 0.9183756665251066, -0.9183756665251066};
-PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
   u_m0[0] = -pA_m1[3] + tau[0];
-  const Scalar x0 = k[0]*c_m2[3] + pA_m1[0];
-  const Scalar x1 = k[1]*c_m2[0] + k[2]*c_m2[4] + pA_m1[1] + k[3]*u_m0[0];
-  const Scalar x2 = k[4]*c_m2[1] + k[5]*c_m2[3] + pA_m1[2];
-  const Scalar x3 = k[6]*c_m2[1] + k[7]*c_m2[3] + pA_m1[4];
-  const Scalar x4 = k[8]*c_m2[0] + k[9]*c_m2[4] + pA_m1[5] + k[10]*u_m0[0];
+  const Scalar x0 = -0.027912499999999996*c_m2[3] + pA_m1[0];
+  const Scalar x1 = 0.614466237626843*c_m2[0] + 0.039325839208117955*c_m2[4] + pA_m1[1] + 14.34961978945479*u_m0[0];
+  const Scalar x2 = 1.015*c_m2[1] - 0.06495999999999999*c_m2[3] + pA_m1[2];
+  const Scalar x3 = -0.06495999999999999*c_m2[1] + 0.00936987670937*c_m2[3] + pA_m1[4];
+  const Scalar x4 = 0.039325839208117955*c_m2[0] + 0.006961696668689549*c_m2[4] + pA_m1[5] + 0.9183756665251066*u_m0[0];
   const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
-  IA_m5[0] = k[11]*cq_m3;
-  IA_m5[1] = k[12]*sq_m4;
-  IA_m5[2] = k[13] + k[14]*x5;
-  IA_m5[3] = k[15]*cq_m3*sq_m4;
-  IA_m5[5] = k[16]*cq_m3*sq_m4;
-  IA_m5[6] = k[17] + k[18]*x5;
-  IA_m5[7] = k[19] + k[20]*x5;
-  IA_m5[9] = k[21] + k[22]*x5;
-  IA_m5[10] = k[23]*cq_m3*sq_m4;
-  IA_m5[14] = k[24] + k[25]*x5;
-  IA_m5[15] = k[26]*cq_m3*sq_m4;
-  IA_m5[16] = k[27] + k[28]*x5;
+  IA_m5[0] = -0.027912499999999996*cq_m3;
+  IA_m5[1] = -0.027912499999999996*sq_m4;
+  IA_m5[2] = 1.0147331188134214 - 0.20026688118657843*x5;
+  IA_m5[3] = -0.40053376237315685*cq_m3*sq_m4;
+  IA_m5[5] = 0.025634160791882035*cq_m3*sq_m4;
+  IA_m5[6] = 0.05214291960405897 - 0.012817080395941018*x5;
+  IA_m5[7] = 1.0147331188134214 + 0.20026688118657843*x5;
+  IA_m5[9] = -0.05214291960405897 - 0.012817080395941018*x5;
+  IA_m5[10] = -0.025634160791882035*cq_m3*sq_m4;
+  IA_m5[14] = 0.008237786689029773 + 0.0012040900203402253*x5;
+  IA_m5[15] = 0.0024081800406804505*cq_m3*sq_m4;
+  IA_m5[16] = 0.008237786689029773 - 0.0012040900203402253*x5;
   pA_m6[0] = pA_m6[0] + x0;
   pA_m6[1] = pA_m6[1] + cq_m3*x1 - sq_m4*x2;
   pA_m6[2] = pA_m6[2] + sq_m4*x1 + cq_m3*x2;
   pA_m6[3] = tau[0];
   pA_m6[4] = cq_m3*x3 - sq_m4*x4;
   pA_m6[5] = sq_m4*x3 + cq_m3*x4;
-  KA_m7[4][KA_m7_col + 0] = k[29]*cq_m3;
-  KA_m7[5][KA_m7_col + 0] = k[30]*sq_m4;
-  KA_m7[1][KA_m7_col + 1] = k[31]*cq_m3;
-  KA_m7[2][KA_m7_col + 1] = k[32]*sq_m4;
-  KA_m7[4][KA_m7_col + 1] = k[33]*sq_m4;
-  KA_m7[5][KA_m7_col + 1] = k[34]*cq_m3;
+  KA_m7[4][KA_m7_col + 0] = -0.06825*cq_m3;
+  KA_m7[5][KA_m7_col + 0] = -0.06825*sq_m4;
+  KA_m7[1][KA_m7_col + 1] = 0.020638449369710488*cq_m3;
+  KA_m7[2][KA_m7_col + 1] = 0.020638449369710488*sq_m4;
+  KA_m7[4][KA_m7_col + 1] = 0.06267913924033854*sq_m4;
+  KA_m7[5][KA_m7_col + 1] = -0.06267913924033854*cq_m3;
   KA_m7[1][KA_m7_col + 2] = -sq_m4;
   KA_m7[2][KA_m7_col + 2] = cq_m3;
-  KA_m7[1][KA_m7_col + 3] = k[35]*cq_m3;
-  KA_m7[2][KA_m7_col + 3] = k[36]*sq_m4;
-  KA_m7[4][KA_m7_col + 3] = k[37]*sq_m4;
-  KA_m7[5][KA_m7_col + 3] = k[38]*cq_m3;
+  KA_m7[1][KA_m7_col + 3] = -14.34961978945479*cq_m3;
+  KA_m7[2][KA_m7_col + 3] = -14.34961978945479*sq_m4;
+  KA_m7[4][KA_m7_col + 3] = 0.9183756665251066*sq_m4;
+  KA_m7[5][KA_m7_col + 3] = -0.9183756665251066*cq_m3;
   KA_m7[4][KA_m7_col + 4] = cq_m3;
   KA_m7[5][KA_m7_col + 4] = sq_m4;
   KA_m7[4][KA_m7_col + 5] = -sq_m4;
@@ -1495,15 +1467,14 @@ PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-constexpr Scalar shared_36_k0[170] = {1.0, 1.2149999999999999, 7.2e-05, 0.5, 0.5, 2.0, 0.5, 0.5, -3.6e-05, 0.5, 3.6e-05, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, 0.4975020826390129, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.04991670832341408, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.04991670832341408, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, 0.4975020826390129, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 3.055, -0.5694718575000001, -0.4305, 3.055, 0.5694718575000001, -0.4305, 3.055, -0.4305, 0.15779149347477375, 0.9950041652780258, -0.09983341664682815, 0.4305, 0.4305, -0.18533025, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.15779149347477375, 0.18533025, -0.4305, 0.00381875, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 1.0, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, -0.4305, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, -0.4305, 0.9950041652780258, -0.09983341664682815, -0.4305, 0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[14];
+PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[14];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[0]*Dinv_m0[0];
   const Scalar x1 = IA_m1[5]*Dinv_m0[0];
   const Scalar x2 = IA_m1[9]*Dinv_m0[0];
   const Scalar x3 = IA_m1[15]*Dinv_m0[0];
-  const Scalar x4 = k[1] - IA_m1[0]*x0;
+  const Scalar x4 = 1.2149999999999999 - IA_m1[0]*x0;
   const Scalar x5 = IA_m1[1] - IA_m1[15]*x0;
   const Scalar x6 = IA_m1[2] - IA_m1[5]*x1;
   const Scalar x7 = IA_m1[3] - IA_m1[9]*x1;
@@ -1516,93 +1487,93 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
-  const Scalar x17 = k[2]*c_m4[3] + pA_m3[3];
+  const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[3]*(-x4 + x9);
-  const Scalar x21 = k[4]*(x4 + x9);
-  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(-x4 + x9);
+  const Scalar x21 = 0.5*(x4 + x9);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x12*x22;
   const Scalar x24 = x20*x22 + x12*x19;
-  const Scalar x25 = k[6]*(x10*x19 - x5*x22);
-  const Scalar x26 = k[7]*(x10*x22 + x5*x19);
-  const Scalar x27 = k[8] + k[9]*x11;
-  const Scalar x28 = k[10] + k[11]*x11;
-  const Scalar x29 = k[12]*x21 + k[13]*x23 + k[14]*x24;
-  const Scalar x30 = k[15]*cq_m5*x7 + k[16]*sq_m6*x13 + k[17]*sq_m6*x7 + k[18]*cq_m5*x13;
-  const Scalar x31 = k[19]*x21 + k[20]*x23 + k[21]*x24;
+  const Scalar x25 = 0.5*(x10*x19 - x5*x22);
+  const Scalar x26 = 0.5*(x10*x22 + x5*x19);
+  const Scalar x27 = -3.6e-05 + 0.5*x11;
+  const Scalar x28 = 3.6e-05 + 0.5*x11;
+  const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
+  const Scalar x30 = -0.09983341664682815*cq_m5*x7 + 0.09983341664682815*sq_m6*x13 + 0.9950041652780258*sq_m6*x7 + 0.9950041652780258*cq_m5*x13;
+  const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
   const Scalar x32 = sq_m6*x7 + cq_m5*x13;
   const Scalar x33 = cq_m5*x7 - sq_m6*x13;
-  const Scalar x34 = k[22]*x21 + k[23]*x23 + k[24]*x24;
-  const Scalar x35 = k[25]*x21 + k[26]*x23 + k[27]*x24;
-  const Scalar x36 = k[28]*x5 + k[29]*x10 + k[30]*x25 + k[31]*x26;
-  const Scalar x37 = k[32]*x5 + k[33]*x10 + k[34]*x25 + k[35]*x26;
-  const Scalar x38 = k[36]*x5 + k[37]*x10 + k[38]*x25 + k[39]*x26;
-  const Scalar x39 = k[40]*x5 + k[41]*x10 + k[42]*x25 + k[43]*x26;
-  const Scalar x40 = k[44]*x28 + k[45]*x19*x27 + k[46]*x22*x27;
-  const Scalar x41 = k[47]*x28 + k[48]*x19*x27 + k[49]*x22*x27;
-  const Scalar x42 = k[50]*x28 + k[51]*x19*x27 + k[52]*x22*x27;
-  const Scalar x43 = k[53]*x28 + k[54]*x19*x27 + k[55]*x22*x27;
-  const Scalar x44 = k[56]*x29 + k[57]*x31;
-  const Scalar x45 = k[58]*x29 + k[59]*x31;
-  const Scalar x46 = k[60]*x32 + k[61]*x33;
-  const Scalar x47 = k[62]*x34 + k[63]*x35;
-  const Scalar x48 = k[64]*x36 + k[65]*x37;
-  const Scalar x49 = k[66]*x36 + k[67]*x37;
-  const Scalar x50 = k[68]*cq_m5*x8 + k[69]*sq_m6*x8;
-  const Scalar x51 = k[70]*cq_m5*x8 + k[71]*sq_m6*x8;
-  const Scalar x52 = k[72]*x38 + k[73]*x39;
-  const Scalar x53 = k[74]*x38 + k[75]*x39;
-  const Scalar x54 = k[76]*x30 + x48;
-  const Scalar x55 = k[77]*x6 + x50;
-  const Scalar x56 = k[78]*x46 + x52;
+  const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
+  const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
+  const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
+  const Scalar x37 = 0.4975020826390129*x5 - 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
+  const Scalar x38 = -0.4975020826390129*x5 + 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
+  const Scalar x39 = 0.04991670832341408*x5 + 0.4975020826390129*x10 + 0.9950041652780258*x25 + 0.09983341664682815*x26;
+  const Scalar x40 = 0.9950041652780258*x28 - 0.9950041652780258*x19*x27 - 0.09983341664682815*x22*x27;
+  const Scalar x41 = -0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
+  const Scalar x42 = 0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
+  const Scalar x43 = 0.9950041652780258*x28 + 0.9950041652780258*x19*x27 + 0.09983341664682815*x22*x27;
+  const Scalar x44 = 0.9950041652780258*x29 - 0.09983341664682815*x31;
+  const Scalar x45 = 0.09983341664682815*x29 + 0.9950041652780258*x31;
+  const Scalar x46 = 0.09983341664682815*x32 + 0.9950041652780258*x33;
+  const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
+  const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
+  const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
+  const Scalar x50 = -0.09983341664682815*cq_m5*x8 + 0.9950041652780258*sq_m6*x8;
+  const Scalar x51 = 0.9950041652780258*cq_m5*x8 + 0.09983341664682815*sq_m6*x8;
+  const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
+  const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x54 = 0.4305*x30 + x48;
+  const Scalar x55 = 0.4305*x6 + x50;
+  const Scalar x56 = 0.4305*x46 + x52;
   const Scalar x57 = cq_m5*x14 + sq_m6*x16;
   const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
   const Scalar x59 = cq_m5*x17 + sq_m6*x18;
   const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
-  const Scalar x61 = k[79]*x57 + k[80]*x58;
-  const Scalar x62 = k[81]*x57 + k[82]*x58;
-  IA_m7[0] = k[83] + x44;
+  const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
+  const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
+  IA_m7[0] = 3.055 + x44;
   IA_m7[1] = x30;
   IA_m7[2] = x45;
   IA_m7[3] = x54;
-  IA_m7[4] = k[84] + k[85]*x44;
+  IA_m7[4] = -0.5694718575000001 - 0.4305*x44;
   IA_m7[5] = x49;
-  IA_m7[6] = k[86] + x6;
+  IA_m7[6] = 3.055 + x6;
   IA_m7[7] = x46;
-  IA_m7[8] = k[87] + x55;
-  IA_m7[9] = k[88]*x30;
+  IA_m7[8] = 0.5694718575000001 + x55;
+  IA_m7[9] = -0.4305*x30;
   IA_m7[10] = x51;
-  IA_m7[11] = k[89] + x47;
+  IA_m7[11] = 3.055 + x47;
   IA_m7[12] = x56;
-  IA_m7[13] = k[90]*x45;
+  IA_m7[13] = -0.4305*x45;
   IA_m7[14] = x53;
-  IA_m7[15] = k[91] + k[92]*x40 + k[93]*x41 + k[94]*x50 + k[95]*x55;
-  IA_m7[16] = k[96]*x30 + k[97]*x48;
-  IA_m7[17] = k[98]*x40 + k[99]*x41 + k[100]*x51;
-  IA_m7[18] = k[101] + k[102]*x44;
-  IA_m7[19] = k[103]*x49;
-  IA_m7[20] = k[104] + k[105]*x42 + k[106]*x43;
+  IA_m7[15] = 0.15779149347477375 + 0.9950041652780258*x40 - 0.09983341664682815*x41 + 0.4305*x50 + 0.4305*x55;
+  IA_m7[16] = -0.18533025*x30 - 0.4305*x48;
+  IA_m7[17] = 0.09983341664682815*x40 + 0.9950041652780258*x41 + 0.4305*x51;
+  IA_m7[18] = 0.15779149347477375 + 0.18533025*x44;
+  IA_m7[19] = -0.4305*x49;
+  IA_m7[20] = 0.00381875 + 0.09983341664682815*x42 + 0.9950041652780258*x43;
   pA_m8[0] = pA_m8[0] + x61;
   pA_m8[1] = pA_m8[1] + x15;
   pA_m8[2] = pA_m8[2] + x62;
-  pA_m8[3] = pA_m8[3] + k[107]*x15 + k[108]*x59 + k[109]*x60;
-  pA_m8[4] = pA_m8[4] + tau[0] + k[110]*x61;
-  pA_m8[5] = pA_m8[5] + k[111]*x59 + k[112]*x60;
+  pA_m8[3] = pA_m8[3] + 0.4305*x15 + 0.9950041652780258*x59 - 0.09983341664682815*x60;
+  pA_m8[4] = pA_m8[4] + tau[0] - 0.4305*x61;
+  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
   KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
-  const Scalar x63 = k[113] - IA_m1[0]*KSD_m9[0];
+  const Scalar x63 = 1.0 - IA_m1[0]*KSD_m9[0];
   const Scalar x64 = -IA_m1[9]*KSD_m9[0];
   const Scalar x65 = KA_m10[5][KA_m10_col + 0] - IA_m1[15]*KSD_m9[0];
   const Scalar x66 = cq_m5*x63 + sq_m6*x64;
   const Scalar x67 = -sq_m6*x63 + cq_m5*x64;
-  const Scalar x68 = k[114]*x66 + k[115]*x67;
-  const Scalar x69 = k[116]*x66 + k[117]*x67;
+  const Scalar x68 = 0.9950041652780258*x66 - 0.09983341664682815*x67;
+  const Scalar x69 = 0.09983341664682815*x66 + 0.9950041652780258*x67;
   KA_m11[0][KA_m11_col + 0] = x68;
   KA_m11[1][KA_m11_col + 0] = -IA_m1[5]*KSD_m9[0];
   KA_m11[2][KA_m11_col + 0] = x69;
-  KA_m11[3][KA_m11_col + 0] = k[118]*IA_m1[5]*KSD_m9[0] + k[119]*sq_m6*x65 + k[120]*cq_m5*x65;
-  KA_m11[4][KA_m11_col + 0] = k[121]*x68;
-  KA_m11[5][KA_m11_col + 0] = k[122]*sq_m6*x65 + k[123]*cq_m5*x65;
+  KA_m11[3][KA_m11_col + 0] = -0.4305*IA_m1[5]*KSD_m9[0] + 0.9950041652780258*sq_m6*x65 - 0.09983341664682815*cq_m5*x65;
+  KA_m11[4][KA_m11_col + 0] = -0.4305*x68;
+  KA_m11[5][KA_m11_col + 0] = 0.09983341664682815*sq_m6*x65 + 0.9950041652780258*cq_m5*x65;
   KSD_m9[1] = KA_m10[4][KA_m10_col + 1]*Dinv_m0[0];
   const Scalar x70 = KA_m10[1][KA_m10_col + 1] - IA_m1[5]*KSD_m9[1];
   const Scalar x71 = KA_m10[2][KA_m10_col + 1] - IA_m1[9]*KSD_m9[1];
@@ -1610,21 +1581,21 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x73 = KA_m10[5][KA_m10_col + 1] - IA_m1[15]*KSD_m9[1];
   const Scalar x74 = cq_m5*x72 + sq_m6*x71;
   const Scalar x75 = -sq_m6*x72 + cq_m5*x71;
-  const Scalar x76 = k[124]*x74 + k[125]*x75;
-  const Scalar x77 = k[126]*x74 + k[127]*x75;
+  const Scalar x76 = 0.9950041652780258*x74 - 0.09983341664682815*x75;
+  const Scalar x77 = 0.09983341664682815*x74 + 0.9950041652780258*x75;
   KA_m11[0][KA_m11_col + 1] = x76;
   KA_m11[1][KA_m11_col + 1] = x70;
   KA_m11[2][KA_m11_col + 1] = x77;
-  KA_m11[3][KA_m11_col + 1] = k[128]*x70 + k[129]*sq_m6*x73 + k[130]*cq_m5*x73;
-  KA_m11[4][KA_m11_col + 1] = k[131]*x76;
-  KA_m11[5][KA_m11_col + 1] = k[132]*sq_m6*x73 + k[133]*cq_m5*x73;
-  const Scalar x78 = k[134]*sq_m6*KA_m10[2][KA_m10_col + 2] + k[135]*cq_m5*KA_m10[2][KA_m10_col + 2];
-  const Scalar x79 = k[136]*sq_m6*KA_m10[2][KA_m10_col + 2] + k[137]*cq_m5*KA_m10[2][KA_m10_col + 2];
+  KA_m11[3][KA_m11_col + 1] = 0.4305*x70 + 0.9950041652780258*sq_m6*x73 - 0.09983341664682815*cq_m5*x73;
+  KA_m11[4][KA_m11_col + 1] = -0.4305*x76;
+  KA_m11[5][KA_m11_col + 1] = 0.09983341664682815*sq_m6*x73 + 0.9950041652780258*cq_m5*x73;
+  const Scalar x78 = 0.9950041652780258*sq_m6*KA_m10[2][KA_m10_col + 2] - 0.09983341664682815*cq_m5*KA_m10[2][KA_m10_col + 2];
+  const Scalar x79 = 0.09983341664682815*sq_m6*KA_m10[2][KA_m10_col + 2] + 0.9950041652780258*cq_m5*KA_m10[2][KA_m10_col + 2];
   KA_m11[0][KA_m11_col + 2] = x78;
   KA_m11[1][KA_m11_col + 2] = KA_m10[1][KA_m10_col + 2];
   KA_m11[2][KA_m11_col + 2] = x79;
-  KA_m11[3][KA_m11_col + 2] = k[138]*KA_m10[1][KA_m10_col + 2];
-  KA_m11[4][KA_m11_col + 2] = k[139]*x78;
+  KA_m11[3][KA_m11_col + 2] = 0.4305*KA_m10[1][KA_m10_col + 2];
+  KA_m11[4][KA_m11_col + 2] = -0.4305*x78;
   KSD_m9[3] = KA_m10[4][KA_m10_col + 3]*Dinv_m0[0];
   const Scalar x80 = KA_m10[1][KA_m10_col + 3] - IA_m1[5]*KSD_m9[3];
   const Scalar x81 = KA_m10[2][KA_m10_col + 3] - IA_m1[9]*KSD_m9[3];
@@ -1632,49 +1603,48 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x83 = KA_m10[5][KA_m10_col + 3] - IA_m1[15]*KSD_m9[3];
   const Scalar x84 = cq_m5*x82 + sq_m6*x81;
   const Scalar x85 = -sq_m6*x82 + cq_m5*x81;
-  const Scalar x86 = k[140]*x84 + k[141]*x85;
-  const Scalar x87 = k[142]*x84 + k[143]*x85;
+  const Scalar x86 = 0.9950041652780258*x84 - 0.09983341664682815*x85;
+  const Scalar x87 = 0.09983341664682815*x84 + 0.9950041652780258*x85;
   KA_m11[0][KA_m11_col + 3] = x86;
   KA_m11[1][KA_m11_col + 3] = x80;
   KA_m11[2][KA_m11_col + 3] = x87;
-  KA_m11[3][KA_m11_col + 3] = k[144]*x80 + k[145]*sq_m6*x83 + k[146]*cq_m5*x83;
-  KA_m11[4][KA_m11_col + 3] = k[147]*x86;
-  KA_m11[5][KA_m11_col + 3] = k[148]*sq_m6*x83 + k[149]*cq_m5*x83;
+  KA_m11[3][KA_m11_col + 3] = 0.4305*x80 + 0.9950041652780258*sq_m6*x83 - 0.09983341664682815*cq_m5*x83;
+  KA_m11[4][KA_m11_col + 3] = -0.4305*x86;
+  KA_m11[5][KA_m11_col + 3] = 0.09983341664682815*sq_m6*x83 + 0.9950041652780258*cq_m5*x83;
   KSD_m9[4] = KA_m10[4][KA_m10_col + 4]*Dinv_m0[0];
   const Scalar x88 = -IA_m1[0]*KSD_m9[4];
   const Scalar x89 = -IA_m1[9]*KSD_m9[4];
   const Scalar x90 = KA_m10[5][KA_m10_col + 4] - IA_m1[15]*KSD_m9[4];
   const Scalar x91 = cq_m5*x88 + sq_m6*x89;
   const Scalar x92 = -sq_m6*x88 + cq_m5*x89;
-  const Scalar x93 = k[150]*x91 + k[151]*x92;
-  const Scalar x94 = k[152]*x91 + k[153]*x92;
+  const Scalar x93 = 0.9950041652780258*x91 - 0.09983341664682815*x92;
+  const Scalar x94 = 0.09983341664682815*x91 + 0.9950041652780258*x92;
   KA_m11[0][KA_m11_col + 4] = x93;
   KA_m11[1][KA_m11_col + 4] = -IA_m1[5]*KSD_m9[4];
   KA_m11[2][KA_m11_col + 4] = x94;
-  KA_m11[3][KA_m11_col + 4] = k[154]*IA_m1[5]*KSD_m9[4] + k[155]*sq_m6*x90 + k[156]*cq_m5*x90;
-  KA_m11[4][KA_m11_col + 4] = k[157]*x93;
-  KA_m11[5][KA_m11_col + 4] = k[158]*sq_m6*x90 + k[159]*cq_m5*x90;
+  KA_m11[3][KA_m11_col + 4] = -0.4305*IA_m1[5]*KSD_m9[4] + 0.9950041652780258*sq_m6*x90 - 0.09983341664682815*cq_m5*x90;
+  KA_m11[4][KA_m11_col + 4] = -0.4305*x93;
+  KA_m11[5][KA_m11_col + 4] = 0.09983341664682815*sq_m6*x90 + 0.9950041652780258*cq_m5*x90;
   KSD_m9[5] = KA_m10[4][KA_m10_col + 5]*Dinv_m0[0];
   const Scalar x95 = -IA_m1[0]*KSD_m9[5];
   const Scalar x96 = -IA_m1[9]*KSD_m9[5];
   const Scalar x97 = KA_m10[5][KA_m10_col + 5] - IA_m1[15]*KSD_m9[5];
   const Scalar x98 = cq_m5*x95 + sq_m6*x96;
   const Scalar x99 = -sq_m6*x95 + cq_m5*x96;
-  const Scalar x100 = k[160]*x98 + k[161]*x99;
-  const Scalar x101 = k[162]*x98 + k[163]*x99;
+  const Scalar x100 = 0.9950041652780258*x98 - 0.09983341664682815*x99;
+  const Scalar x101 = 0.09983341664682815*x98 + 0.9950041652780258*x99;
   KA_m11[0][KA_m11_col + 5] = x100;
   KA_m11[1][KA_m11_col + 5] = -IA_m1[5]*KSD_m9[5];
   KA_m11[2][KA_m11_col + 5] = x101;
-  KA_m11[3][KA_m11_col + 5] = k[164]*IA_m1[5]*KSD_m9[5] + k[165]*sq_m6*x97 + k[166]*cq_m5*x97;
-  KA_m11[4][KA_m11_col + 5] = k[167]*x100;
-  KA_m11[5][KA_m11_col + 5] = k[168]*sq_m6*x97 + k[169]*cq_m5*x97;
+  KA_m11[3][KA_m11_col + 5] = -0.4305*IA_m1[5]*KSD_m9[5] + 0.9950041652780258*sq_m6*x97 - 0.09983341664682815*cq_m5*x97;
+  KA_m11[4][KA_m11_col + 5] = -0.4305*x100;
+  KA_m11[5][KA_m11_col + 5] = 0.09983341664682815*sq_m6*x97 + 0.9950041652780258*cq_m5*x97;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-constexpr Scalar shared_37_k0[144] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.4900332889206208, 0.4900332889206208, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 7.0, -1.29954125, -0.42875, 7.0, 1.29954125, -0.42875, 7.0, -0.42875, 0.3755072987089375, 0.9800665778412416, 0.19866933079506124, 0.42875, 0.42875, -0.1838265625, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.3755072987089375, 0.1838265625, -0.42875, 0.0196875, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.42875, 0.9800665778412416, 0.19866933079506124, -0.42875, -0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -1702,83 +1672,83 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
   const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x26 = k[1]*(-x5 + x14);
-  const Scalar x27 = k[2]*(x5 + x14);
-  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x26 = 0.5*(-x5 + x14);
+  const Scalar x27 = 0.5*(x5 + x14);
+  const Scalar x28 = 2.0*cq_m5*sq_m6;
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = k[4]*(-x8 + x16);
-  const Scalar x32 = k[5]*(x8 + x16);
-  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x31 = 0.5*(-x8 + x16);
+  const Scalar x32 = 0.5*(x8 + x16);
+  const Scalar x33 = 0.5*(x9 + x15);
   const Scalar x34 = x25*x31 - x28*x33;
   const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = k[7]*(-x17 + x19);
-  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x36 = 0.5*(-x17 + x19);
+  const Scalar x37 = 0.5*(x17 + x19);
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
-  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
-  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
+  const Scalar x41 = 0.19866933079506124*cq_m5*x11 - 0.19866933079506124*sq_m6*x6 + 0.9800665778412416*sq_m6*x11 + 0.9800665778412416*cq_m5*x6;
+  const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
   const Scalar x43 = sq_m6*x11 + cq_m5*x6;
   const Scalar x44 = cq_m5*x11 - sq_m6*x6;
-  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
-  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
-  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
-  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
+  const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
+  const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
+  const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
   const Scalar x49 = sq_m6*x13 + cq_m5*x12;
   const Scalar x50 = cq_m5*x13 - sq_m6*x12;
-  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
-  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
-  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
-  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
-  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
-  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
-  const Scalar x57 = k[57]*x40 + k[58]*x42;
-  const Scalar x58 = k[59]*x40 + k[60]*x42;
-  const Scalar x59 = k[61]*x43 + k[62]*x44;
-  const Scalar x60 = k[63]*x45 + k[64]*x46;
-  const Scalar x61 = k[65]*x47 + k[66]*x48;
-  const Scalar x62 = k[67]*x47 + k[68]*x48;
-  const Scalar x63 = k[69]*x49 + k[70]*x50;
-  const Scalar x64 = k[71]*x49 + k[72]*x50;
-  const Scalar x65 = k[73]*x51 + k[74]*x52;
-  const Scalar x66 = k[75]*x51 + k[76]*x52;
-  const Scalar x67 = k[77]*x41 + x61;
-  const Scalar x68 = k[78]*x10 + x63;
-  const Scalar x69 = k[79]*x59 + x65;
+  const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
+  const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
+  const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
+  const Scalar x54 = 0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
+  const Scalar x55 = -0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
+  const Scalar x56 = 0.9800665778412416*x37 + 0.9800665778412416*x38 - 0.19866933079506124*x39;
+  const Scalar x57 = 0.9800665778412416*x40 + 0.19866933079506124*x42;
+  const Scalar x58 = -0.19866933079506124*x40 + 0.9800665778412416*x42;
+  const Scalar x59 = -0.19866933079506124*x43 + 0.9800665778412416*x44;
+  const Scalar x60 = -0.19866933079506124*x45 + 0.9800665778412416*x46;
+  const Scalar x61 = 0.9800665778412416*x47 + 0.19866933079506124*x48;
+  const Scalar x62 = -0.19866933079506124*x47 + 0.9800665778412416*x48;
+  const Scalar x63 = 0.9800665778412416*x49 + 0.19866933079506124*x50;
+  const Scalar x64 = -0.19866933079506124*x49 + 0.9800665778412416*x50;
+  const Scalar x65 = 0.9800665778412416*x51 + 0.19866933079506124*x52;
+  const Scalar x66 = -0.19866933079506124*x51 + 0.9800665778412416*x52;
+  const Scalar x67 = 0.42875*x41 + x61;
+  const Scalar x68 = 0.42875*x10 + x63;
+  const Scalar x69 = 0.42875*x59 + x65;
   const Scalar x70 = cq_m5*x20 + sq_m6*x22;
   const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
   const Scalar x72 = cq_m5*x23 + sq_m6*x24;
   const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
-  const Scalar x74 = k[80]*x70 + k[81]*x71;
-  const Scalar x75 = k[82]*x70 + k[83]*x71;
-  IA_m7[0] = k[84] + x57;
+  const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
+  const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
+  IA_m7[0] = 7.0 + x57;
   IA_m7[1] = x41;
   IA_m7[2] = x58;
   IA_m7[3] = x67;
-  IA_m7[4] = k[85] + k[86]*x57;
+  IA_m7[4] = -1.29954125 - 0.42875*x57;
   IA_m7[5] = x62;
-  IA_m7[6] = k[87] + x10;
+  IA_m7[6] = 7.0 + x10;
   IA_m7[7] = x59;
-  IA_m7[8] = k[88] + x68;
-  IA_m7[9] = k[89]*x41;
+  IA_m7[8] = 1.29954125 + x68;
+  IA_m7[9] = -0.42875*x41;
   IA_m7[10] = x64;
-  IA_m7[11] = k[90] + x60;
+  IA_m7[11] = 7.0 + x60;
   IA_m7[12] = x69;
-  IA_m7[13] = k[91]*x58;
+  IA_m7[13] = -0.42875*x58;
   IA_m7[14] = x66;
-  IA_m7[15] = k[92] + k[93]*x53 + k[94]*x54 + k[95]*x63 + k[96]*x68;
-  IA_m7[16] = k[97]*x41 + k[98]*x61;
-  IA_m7[17] = k[99]*x53 + k[100]*x54 + k[101]*x64;
-  IA_m7[18] = k[102] + k[103]*x57;
-  IA_m7[19] = k[104]*x62;
-  IA_m7[20] = k[105] + k[106]*x55 + k[107]*x56;
+  IA_m7[15] = 0.3755072987089375 + 0.9800665778412416*x53 + 0.19866933079506124*x54 + 0.42875*x63 + 0.42875*x68;
+  IA_m7[16] = -0.1838265625*x41 - 0.42875*x61;
+  IA_m7[17] = -0.19866933079506124*x53 + 0.9800665778412416*x54 + 0.42875*x64;
+  IA_m7[18] = 0.3755072987089375 + 0.1838265625*x57;
+  IA_m7[19] = -0.42875*x62;
+  IA_m7[20] = 0.0196875 - 0.19866933079506124*x55 + 0.9800665778412416*x56;
   pA_m8[0] = pA_m8[0] + x74;
   pA_m8[1] = pA_m8[1] + x21;
   pA_m8[2] = pA_m8[2] + x75;
-  pA_m8[3] = pA_m8[3] + k[108]*x21 + k[109]*x72 + k[110]*x73;
-  pA_m8[4] = pA_m8[4] + tau[0] + k[111]*x74;
-  pA_m8[5] = pA_m8[5] + k[112]*x72 + k[113]*x73;
+  pA_m8[3] = pA_m8[3] + 0.42875*x21 + 0.9800665778412416*x72 + 0.19866933079506124*x73;
+  pA_m8[4] = pA_m8[4] + tau[0] - 0.42875*x74;
+  pA_m8[5] = pA_m8[5] - 0.19866933079506124*x72 + 0.9800665778412416*x73;
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
     KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
     const Scalar x76 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
@@ -1790,14 +1760,14 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
     const Scalar x82 = -sq_m6*x76 + cq_m5*x78;
     const Scalar x83 = cq_m5*x79 + sq_m6*x80;
     const Scalar x84 = -sq_m6*x79 + cq_m5*x80;
-    const Scalar x85 = k[114]*x81 + k[115]*x82;
-    const Scalar x86 = k[116]*x81 + k[117]*x82;
+    const Scalar x85 = 0.9800665778412416*x81 + 0.19866933079506124*x82;
+    const Scalar x86 = -0.19866933079506124*x81 + 0.9800665778412416*x82;
     KA_m11[0][j] = x85;
     KA_m11[1][j] = x77;
     KA_m11[2][j] = x86;
-    KA_m11[3][j] = k[118]*x77 + k[119]*x83 + k[120]*x84;
-    KA_m11[4][j] = k[121]*x85;
-    KA_m11[5][j] = k[122]*x83 + k[123]*x84;
+    KA_m11[3][j] = 0.42875*x77 + 0.9800665778412416*x83 + 0.19866933079506124*x84;
+    KA_m11[4][j] = -0.42875*x85;
+    KA_m11[5][j] = -0.19866933079506124*x83 + 0.9800665778412416*x84;
   }
   KSD_m9[2] = KA_m10[4][2]*Dinv_m0[0];
   const Scalar x87 = KA_m10[0][2] - IA_m1[4]*KSD_m9[2];
@@ -1809,14 +1779,14 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x93 = -sq_m6*x87 + cq_m5*x89;
   const Scalar x94 = cq_m5*x90 + sq_m6*x91;
   const Scalar x95 = -sq_m6*x90 + cq_m5*x91;
-  const Scalar x96 = k[124]*x92 + k[125]*x93;
-  const Scalar x97 = k[126]*x92 + k[127]*x93;
+  const Scalar x96 = 0.9800665778412416*x92 + 0.19866933079506124*x93;
+  const Scalar x97 = -0.19866933079506124*x92 + 0.9800665778412416*x93;
   KA_m11[0][2] = x96;
   KA_m11[1][2] = x88;
   KA_m11[2][2] = x97;
-  KA_m11[3][2] = k[128]*x88 + k[129]*x94 + k[130]*x95;
-  KA_m11[4][2] = k[131]*x96;
-  KA_m11[5][2] = k[132]*x94 + k[133]*x95;
+  KA_m11[3][2] = 0.42875*x88 + 0.9800665778412416*x94 + 0.19866933079506124*x95;
+  KA_m11[4][2] = -0.42875*x96;
+  KA_m11[5][2] = -0.19866933079506124*x94 + 0.9800665778412416*x95;
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
     KSD_m9[3 + j] = Dinv_m0[0]*KA_m10[4][3 + j];
     const Scalar x98 = KA_m10[0][3 + j] - IA_m1[4]*KSD_m9[3 + j];
@@ -1828,22 +1798,21 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
     const Scalar x104 = -sq_m6*x98 + cq_m5*x100;
     const Scalar x105 = cq_m5*x101 + sq_m6*x102;
     const Scalar x106 = -sq_m6*x101 + cq_m5*x102;
-    const Scalar x107 = k[134]*x103 + k[135]*x104;
-    const Scalar x108 = k[136]*x103 + k[137]*x104;
+    const Scalar x107 = 0.9800665778412416*x103 + 0.19866933079506124*x104;
+    const Scalar x108 = -0.19866933079506124*x103 + 0.9800665778412416*x104;
     KA_m11[0][3 + j] = x107;
     KA_m11[1][3 + j] = x99;
     KA_m11[2][3 + j] = x108;
-    KA_m11[3][3 + j] = k[138]*x99 + k[139]*x105 + k[140]*x106;
-    KA_m11[4][3 + j] = k[141]*x107;
-    KA_m11[5][3 + j] = k[142]*x105 + k[143]*x106;
+    KA_m11[3][3 + j] = 0.42875*x99 + 0.9800665778412416*x105 + 0.19866933079506124*x106;
+    KA_m11[4][3 + j] = -0.42875*x107;
+    KA_m11[5][3 + j] = -0.19866933079506124*x105 + 0.9800665778412416*x106;
   }
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-constexpr Scalar shared_38_k0[106] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, 0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, -0.4975020826390129, 0.4975020826390129, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.5, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.015, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.5, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.00095, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.0005, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.0, 0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[9]*Dinv_m0[0];
@@ -1871,62 +1840,62 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
   const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x26 = k[1]*(-x5 + x14);
-  const Scalar x27 = k[2]*(x5 + x14);
-  const Scalar x28 = k[3]*cq_m5*sq_m6;
+  const Scalar x26 = 0.5*(-x5 + x14);
+  const Scalar x27 = 0.5*(x5 + x14);
+  const Scalar x28 = 2.0*cq_m5*sq_m6;
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = k[4]*(-x8 + x16);
-  const Scalar x32 = k[5]*(x8 + x16);
-  const Scalar x33 = k[6]*(x9 + x15);
+  const Scalar x31 = 0.5*(-x8 + x16);
+  const Scalar x32 = 0.5*(x8 + x16);
+  const Scalar x33 = 0.5*(x9 + x15);
   const Scalar x34 = x25*x31 - x28*x33;
   const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = k[7]*(-x17 + x19);
-  const Scalar x37 = k[8]*(x17 + x19);
+  const Scalar x36 = 0.5*(-x17 + x19);
+  const Scalar x37 = 0.5*(x17 + x19);
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = k[9]*x27 + k[10]*x29 + k[11]*x30;
-  const Scalar x41 = k[12]*cq_m5*x11 + k[13]*sq_m6*x6 + k[14]*sq_m6*x11 + k[15]*cq_m5*x6;
-  const Scalar x42 = k[16]*x27 + k[17]*x29 + k[18]*x30;
+  const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
+  const Scalar x41 = -0.09983341664682815*cq_m5*x11 + 0.09983341664682815*sq_m6*x6 + 0.9950041652780258*sq_m6*x11 + 0.9950041652780258*cq_m5*x6;
+  const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
   const Scalar x43 = sq_m6*x11 + cq_m5*x6;
   const Scalar x44 = cq_m5*x11 - sq_m6*x6;
-  const Scalar x45 = k[19]*x27 + k[20]*x29 + k[21]*x30;
-  const Scalar x46 = k[22]*x27 + k[23]*x29 + k[24]*x30;
-  const Scalar x47 = k[25]*x9 + k[26]*x15 + k[27]*x32 + k[28]*x34 + k[29]*x35;
-  const Scalar x48 = k[30]*x9 + k[31]*x15 + k[32]*x32 + k[33]*x34 + k[34]*x35;
+  const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
+  const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
+  const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
+  const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x49 = sq_m6*x13 + cq_m5*x12;
   const Scalar x50 = cq_m5*x13 - sq_m6*x12;
-  const Scalar x51 = k[35]*x9 + k[36]*x15 + k[37]*x32 + k[38]*x34 + k[39]*x35;
-  const Scalar x52 = k[40]*x9 + k[41]*x15 + k[42]*x32 + k[43]*x34 + k[44]*x35;
-  const Scalar x53 = k[45]*x37 + k[46]*x38 + k[47]*x39;
-  const Scalar x54 = k[48]*x37 + k[49]*x38 + k[50]*x39;
-  const Scalar x55 = k[51]*x37 + k[52]*x38 + k[53]*x39;
-  const Scalar x56 = k[54]*x37 + k[55]*x38 + k[56]*x39;
+  const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
+  const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
+  const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
+  const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
+  const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
   const Scalar x57 = cq_m5*x20 + sq_m6*x22;
   const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
   const Scalar x59 = cq_m5*x23 + sq_m6*x24;
   const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
-  IA_m7[0] = k[57] + k[58]*x40 + k[59]*x42;
+  IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
   IA_m7[1] = x41;
-  IA_m7[2] = k[60]*x40 + k[61]*x42;
-  IA_m7[3] = k[62]*x47 + k[63]*x48;
-  IA_m7[5] = k[64]*x47 + k[65]*x48;
-  IA_m7[6] = k[66] + x10;
-  IA_m7[7] = k[67]*x43 + k[68]*x44;
-  IA_m7[8] = k[69] + k[70]*x49 + k[71]*x50;
-  IA_m7[10] = k[72]*x49 + k[73]*x50;
-  IA_m7[11] = k[74] + k[75]*x45 + k[76]*x46;
-  IA_m7[12] = k[77]*x51 + k[78]*x52;
-  IA_m7[14] = k[79]*x51 + k[80]*x52;
-  IA_m7[15] = k[81] + k[82]*x53 + k[83]*x54;
-  IA_m7[17] = k[84]*x53 + k[85]*x54;
-  IA_m7[20] = k[86] + k[87]*x55 + k[88]*x56;
-  pA_m8[0] = pA_m8[0] + k[89]*x57 + k[90]*x58;
+  IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
+  IA_m7[3] = 0.9950041652780258*x47 - 0.09983341664682815*x48;
+  IA_m7[5] = 0.09983341664682815*x47 + 0.9950041652780258*x48;
+  IA_m7[6] = 0.5 + x10;
+  IA_m7[7] = 0.09983341664682815*x43 + 0.9950041652780258*x44;
+  IA_m7[8] = 0.015 + 0.9950041652780258*x49 - 0.09983341664682815*x50;
+  IA_m7[10] = 0.09983341664682815*x49 + 0.9950041652780258*x50;
+  IA_m7[11] = 0.5 + 0.09983341664682815*x45 + 0.9950041652780258*x46;
+  IA_m7[12] = 0.9950041652780258*x51 - 0.09983341664682815*x52;
+  IA_m7[14] = 0.09983341664682815*x51 + 0.9950041652780258*x52;
+  IA_m7[15] = 0.00095 + 0.9950041652780258*x53 - 0.09983341664682815*x54;
+  IA_m7[17] = 0.09983341664682815*x53 + 0.9950041652780258*x54;
+  IA_m7[20] = 0.0005 + 0.09983341664682815*x55 + 0.9950041652780258*x56;
+  pA_m8[0] = pA_m8[0] + 0.9950041652780258*x57 - 0.09983341664682815*x58;
   pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + k[91]*x57 + k[92]*x58;
-  pA_m8[3] = pA_m8[3] + k[93]*x59 + k[94]*x60;
+  pA_m8[2] = pA_m8[2] + 0.09983341664682815*x57 + 0.9950041652780258*x58;
+  pA_m8[3] = pA_m8[3] + 0.9950041652780258*x59 - 0.09983341664682815*x60;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] + k[95]*x59 + k[96]*x60;
+  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
     KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
     const Scalar x61 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
@@ -1938,20 +1907,19 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
     const Scalar x67 = -sq_m6*x61 + cq_m5*x63;
     const Scalar x68 = cq_m5*x64 + sq_m6*x65;
     const Scalar x69 = -sq_m6*x64 + cq_m5*x65;
-    KA_m11[0][j] = k[97]*x66 + k[98]*x67;
+    KA_m11[0][j] = 0.9950041652780258*x66 - 0.09983341664682815*x67;
     KA_m11[1][j] = x62;
-    KA_m11[2][j] = k[99]*x66 + k[100]*x67;
-    KA_m11[3][j] = k[101]*x68 + k[102]*x69;
-    KA_m11[4][j] = k[103];
-    KA_m11[5][j] = k[104]*x68 + k[105]*x69;
+    KA_m11[2][j] = 0.09983341664682815*x66 + 0.9950041652780258*x67;
+    KA_m11[3][j] = 0.9950041652780258*x68 - 0.09983341664682815*x69;
+    KA_m11[4][j] = 0.0;
+    KA_m11[5][j] = 0.09983341664682815*x68 + 0.9950041652780258*x69;
   }
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-constexpr Scalar shared_39_k0[25] = {1.0, -0.015, 0.00095, 0.5, 0.5, 2.0, 0.5, 0.5, 0.000475, -0.5, 0.000475, 0.5, 0.5, 0.02, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, -0.5, 0.5, 0.0013, 0.0005, 0.0};
-PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[15];
+PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+  Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
   const Scalar x1 = IA_m1[8]*Dinv_m0[0];
@@ -1967,36 +1935,36 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
   const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
   const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
-  const Scalar x14 = k[1]*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
+  const Scalar x14 = -0.015*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
   const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
-  const Scalar x17 = k[2]*c_m4[3] + pA_m3[4];
+  const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[3]*(x8 - x11);
-  const Scalar x21 = k[4]*(x8 + x11);
-  const Scalar x22 = k[5]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(x8 - x11);
+  const Scalar x21 = 0.5*(x8 + x11);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
-  const Scalar x25 = k[6]*(-x12*x19 - x10*x22);
-  const Scalar x26 = k[7]*(-x12*x22 + x10*x19);
-  const Scalar x27 = k[8] + k[9]*x13;
-  const Scalar x28 = k[10] + k[11]*x13;
-  IA_m7[0] = k[12] + x4;
+  const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
+  const Scalar x26 = 0.5*(-x12*x22 + x10*x19);
+  const Scalar x27 = 0.000475 - 0.5*x13;
+  const Scalar x28 = 0.000475 + 0.5*x13;
+  IA_m7[0] = 0.5 + x4;
   IA_m7[1] = cq_m5*x5 - sq_m6*x6;
   IA_m7[2] = sq_m6*x5 + cq_m5*x6;
-  IA_m7[4] = k[13] + k[14]*cq_m5 - sq_m6*x7;
-  IA_m7[5] = k[15]*sq_m6 + cq_m5*x7;
-  IA_m7[6] = k[16] + x21 + x23;
+  IA_m7[4] = 0.02 - 0.015*cq_m5 - sq_m6*x7;
+  IA_m7[5] = -0.015*sq_m6 + cq_m5*x7;
+  IA_m7[6] = 0.5 + x21 + x23;
   IA_m7[7] = x24;
-  IA_m7[9] = k[17]*x12 + x25;
-  IA_m7[10] = k[18]*x10 + x26;
-  IA_m7[11] = k[19] + x21 - x23;
-  IA_m7[13] = k[20]*x10 + x26;
-  IA_m7[14] = k[21]*x12 - x25;
-  IA_m7[18] = k[22] + x28 + x19*x27;
+  IA_m7[9] = 0.5*x12 + x25;
+  IA_m7[10] = 0.5*x10 + x26;
+  IA_m7[11] = 0.5 + x21 - x23;
+  IA_m7[13] = -0.5*x10 + x26;
+  IA_m7[14] = 0.5*x12 - x25;
+  IA_m7[18] = 0.0013 + x28 + x19*x27;
   IA_m7[19] = x22*x27;
-  IA_m7[20] = k[23] + x28 - x19*x27;
+  IA_m7[20] = 0.0005 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
   pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
   pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
@@ -2012,7 +1980,7 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
     KA_m11[0][j] = x29;
     KA_m11[1][j] = cq_m5*x30 - sq_m6*x31;
     KA_m11[2][j] = sq_m6*x30 + cq_m5*x31;
-    KA_m11[3][j] = k[24];
+    KA_m11[3][j] = 0.0;
     KA_m11[4][j] = cq_m5*KA_m10[4][j] - sq_m6*x32;
     KA_m11[5][j] = sq_m6*KA_m10[4][j] + cq_m5*x32;
   }
@@ -2036,12 +2004,11 @@ PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-constexpr Scalar shared_41_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_41(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
-  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
-  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
-  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_41(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
+  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
+  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
   const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
   const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
@@ -2057,14 +2024,13 @@ PROXGEN_RT_NOINLINE void shared_41(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-constexpr Scalar shared_42_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_42(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_42(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
+  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
+  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
+  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
+  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -2080,14 +2046,13 @@ PROXGEN_RT_NOINLINE void shared_42(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-constexpr Scalar shared_43_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_43(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_43(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
+  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
+  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
+  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -2103,17 +2068,16 @@ PROXGEN_RT_NOINLINE void shared_43(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-constexpr Scalar shared_44_k0[4] = {-0.00194517348958, -0.027912499999999996, -0.0017863999999999998, 514.0929615568219};
-PROXGEN_RT_NOINLINE void shared_44(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+PROXGEN_RT_NOINLINE void shared_44(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
   const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
   const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
   const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
   const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
-  const Scalar x4 = u_m4[0] + k[0]*a_m2[3] + k[1]*x0 + k[2]*x3;
+  const Scalar x4 = u_m4[0] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
   a_m5[0] = a_m2[0];
   a_m5[1] = x0;
   a_m5[2] = x1;
-  a_m5[3] = a_m2[3] + k[3]*x4;
+  a_m5[3] = a_m2[3] + 514.0929615568219*x4;
   a_m5[4] = x2;
   a_m5[5] = x3;
 }
@@ -2137,12 +2101,11 @@ PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-constexpr Scalar shared_46_k0[8] = {0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_46(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = k[0]*a_m0[0] + k[1]*a_m0[2];
-  const Scalar x1 = k[2]*a_m0[0] + k[3]*a_m0[2];
-  const Scalar x2 = k[4]*a_m0[3] + k[5]*a_m0[5];
-  const Scalar x3 = k[6]*a_m0[3] + k[7]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_46(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
+  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
+  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
   const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
   const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
@@ -2159,14 +2122,13 @@ PROXGEN_RT_NOINLINE void shared_46(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-constexpr Scalar shared_47_k0[10] = {-0.42875, 0.42875, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.9800665778412416, -0.19866933079506124, 0.19866933079506124, 0.9800665778412416};
-PROXGEN_RT_NOINLINE void shared_47(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_47(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
+  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
+  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
+  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
+  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -2183,14 +2145,13 @@ PROXGEN_RT_NOINLINE void shared_47(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-constexpr Scalar shared_48_k0[10] = {-0.4305, 0.4305, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, 0.9950041652780258, 0.09983341664682815, -0.09983341664682815, 0.9950041652780258};
-PROXGEN_RT_NOINLINE void shared_48(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
-  const Scalar x2 = k[2]*a_m0[2] + k[3]*x0;
-  const Scalar x3 = k[4]*a_m0[2] + k[5]*x0;
-  const Scalar x4 = k[6]*a_m0[3] + k[7]*a_m0[5];
-  const Scalar x5 = k[8]*a_m0[3] + k[9]*a_m0[5];
+PROXGEN_RT_NOINLINE void shared_48(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
+  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
+  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
+  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
+  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
   const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
   const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
   const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
@@ -2207,14 +2168,13 @@ PROXGEN_RT_NOINLINE void shared_48(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-constexpr Scalar shared_49_k0[5] = {-0.06825, -0.00194517348958, -0.027912499999999996, -0.0017863999999999998, 514.0929615568219};
-PROXGEN_RT_NOINLINE void shared_49(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_49(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
   const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
   const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
   const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
   const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
-  const Scalar x4 = u_m4[0] + k[0]*lambda_m5[0] - lambda_m5[2] + k[1]*a_m2[3] + k[2]*x0 + k[3]*x3;
-  qdd_m6[0] = k[4]*x4;
+  const Scalar x4 = u_m4[0] - 0.06825*lambda_m5[0] - lambda_m5[2] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
+  qdd_m6[0] = 514.0929615568219*x4;
   a_m7[0] = a_m2[0];
   a_m7[1] = x0;
   a_m7[2] = x1;
@@ -2300,21 +2260,21 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
 
 PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_0(shared_0_k0, &q[8], &v[7], &w.sq_l_hip_roll_link, &w.cq_l_hip_roll_link, &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
+  shared_0(&q[8], &v[7], &w.sq_l_hip_roll_link, &w.cq_l_hip_roll_link, &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_1(shared_1_k0, &q[9], &v[8], &w.sq_l_thigh, &w.cq_l_thigh, w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
+  shared_1(&q[9], &v[8], &w.sq_l_thigh, &w.cq_l_thigh, w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_2(shared_2_k0, &q[10], &v[9], &w.sq_l_shank, &w.cq_l_shank, w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
+  shared_2(&q[10], &v[9], &w.sq_l_shank, &w.cq_l_shank, w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
   // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_3(shared_3_k0, &q[11], &v[10], &w.sq_l_ankle_link, &w.cq_l_ankle_link, w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
+  shared_3(&q[11], &v[10], &w.sq_l_ankle_link, &w.cq_l_ankle_link, w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_4(shared_4_k0, &q[12], &v[11], &w.sq_l_foot, &w.cq_l_foot, &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
+  shared_4(&q[12], &v[11], &w.sq_l_foot, &w.cq_l_foot, &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_noinline(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
@@ -2353,21 +2313,21 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
 
 PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_0(shared_0_k0, &q[14], &v[13], &w.sq_r_hip_roll_link, &w.cq_r_hip_roll_link, &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
+  shared_0(&q[14], &v[13], &w.sq_r_hip_roll_link, &w.cq_r_hip_roll_link, &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_1(shared_1_k0, &q[15], &v[14], &w.sq_r_thigh, &w.cq_r_thigh, w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
+  shared_1(&q[15], &v[14], &w.sq_r_thigh, &w.cq_r_thigh, w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_2(shared_2_k0, &q[16], &v[15], &w.sq_r_shank, &w.cq_r_shank, w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
+  shared_2(&q[16], &v[15], &w.sq_r_shank, &w.cq_r_shank, w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
   // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_3(shared_3_k0, &q[17], &v[16], &w.sq_r_ankle_link, &w.cq_r_ankle_link, w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
+  shared_3(&q[17], &v[16], &w.sq_r_ankle_link, &w.cq_r_ankle_link, w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_4(shared_4_k0, &q[18], &v[17], &w.sq_r_foot, &w.cq_r_foot, &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
+  shared_4(&q[18], &v[17], &w.sq_r_foot, &w.cq_r_foot, &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_noinline(q[19], w.sq_abdomen, w.cq_abdomen);
@@ -3004,17 +2964,17 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_hand_to_l_wrist_pitch_link(const Scala
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_6(shared_6_k0, &tau[24], &w.Dinv_l_wrist_yaw_link, w.IA_l_wrist_yaw_link, w.u_l_wrist_yaw_link, w.pA_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.IA_l_forearm, w.pA_l_forearm);
+  shared_6(&tau[24], &w.Dinv_l_wrist_yaw_link, w.IA_l_wrist_yaw_link, w.u_l_wrist_yaw_link, w.pA_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.IA_l_forearm, w.pA_l_forearm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-  shared_7(shared_7_k0, &tau[23], &w.Dinv_l_forearm, w.IA_l_forearm, w.u_l_forearm, w.pA_l_forearm, w.c_l_forearm, w.cq_l_forearm, w.sq_l_forearm, w.IA_l_upper_arm, w.pA_l_upper_arm);
+  shared_7(&tau[23], &w.Dinv_l_forearm, w.IA_l_forearm, w.u_l_forearm, w.pA_l_forearm, w.c_l_forearm, w.cq_l_forearm, w.sq_l_forearm, w.IA_l_upper_arm, w.pA_l_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-  shared_8(shared_8_k0, &tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, w.cq_l_upper_arm, w.sq_l_upper_arm, w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
+  shared_8(&tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, w.cq_l_upper_arm, w.sq_l_upper_arm, w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3221,17 +3181,17 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
 
 PROXGEN_RT_NOINLINE void caba_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_6(shared_6_k0, &tau[33], &w.Dinv_r_wrist_yaw_link, w.IA_r_wrist_yaw_link, w.u_r_wrist_yaw_link, w.pA_r_wrist_yaw_link, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.IA_r_forearm, w.pA_r_forearm);
+  shared_6(&tau[33], &w.Dinv_r_wrist_yaw_link, w.IA_r_wrist_yaw_link, w.u_r_wrist_yaw_link, w.pA_r_wrist_yaw_link, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.IA_r_forearm, w.pA_r_forearm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_7(shared_7_k0, &tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.IA_r_upper_arm, w.pA_r_upper_arm);
+  shared_7(&tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.IA_r_upper_arm, w.pA_r_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_8(shared_8_k0, &tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, w.cq_r_upper_arm, w.sq_r_upper_arm, w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
+  shared_8(&tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, w.cq_r_upper_arm, w.sq_r_upper_arm, w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3531,27 +3491,27 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
 
 PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_10(shared_10_k0, &tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, w.IA_r_ankle_link, w.pA_r_ankle_link);
+  shared_10(&tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, w.IA_r_ankle_link, w.pA_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_11(shared_11_k0, &tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank);
+  shared_11(&tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_12(shared_12_k0, &tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh);
+  shared_12(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_13(shared_13_k0, &tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
+  shared_13(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_14(shared_14_k0, &tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
+  shared_14(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3653,27 +3613,27 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
 
 PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_10(shared_10_k0, &tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, w.IA_l_ankle_link, w.pA_l_ankle_link);
+  shared_10(&tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, w.IA_l_ankle_link, w.pA_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_11(shared_11_k0, &tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank);
+  shared_11(&tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_12(shared_12_k0, &tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh);
+  shared_12(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_13(shared_13_k0, &tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
+  shared_13(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_14(shared_14_k0, &tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
+  shared_14(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3835,50 +3795,50 @@ PROXGEN_RT_NOINLINE void caba_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
-  shared_15(shared_15_k0, w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
+  shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(shared_16_k0, w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
+  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(shared_18_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(shared_19_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_19(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(shared_20_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_20(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(shared_21_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
+  shared_21(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(shared_22_k0, w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(shared_18_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(shared_19_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_19(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(shared_20_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_20(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(shared_21_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+  shared_21(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(shared_23_k0, w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  shared_23(w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(shared_24_k0, w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_24(w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
@@ -3889,9 +3849,9 @@ PROXGEN_RT_NOINLINE void caba_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace&
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(shared_28_k0, w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+  shared_28(w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(shared_29_k0, w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3903,7 +3863,7 @@ PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PR
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_32(shared_32_k0, mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
+  shared_32(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4056,7 +4016,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_REST
     w.dp_pelvis[4] = w.sq_abdomen*t12 + w.cq_abdomen*t13 + 0.1*t14;
   }
   // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_33(shared_33_k0, &w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, w.cq_r_foot, w.sq_r_foot);
+  shared_33(&w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, w.cq_r_foot, w.sq_r_foot);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4102,7 +4062,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN
     w.dp_r_thigh[5] = -0.19866933079506124*t17 + 0.9800665778412416*t18;
   }
   // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_34(shared_34_k0, w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], w.cq_r_thigh, w.sq_r_thigh, w.dp_r_hip_roll_link);
+  shared_34(w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], w.cq_r_thigh, w.sq_r_thigh, w.dp_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4140,7 +4100,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace&
     w.dp_pelvis[5] = 0.0875*t12;
   }
   // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_33(shared_33_k0, w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, w.cq_l_foot, w.sq_l_foot);
+  shared_33(w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, w.cq_l_foot, w.sq_l_foot);
   // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.u_l_ankle_link[0] = w.u_l_ankle_link[0] - w.dp_l_ankle_link[4];
@@ -4186,7 +4146,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROX
     w.dp_l_thigh[5] = -0.19866933079506124*t8 + 0.9800665778412416*t9;
   }
   // reduced sweep: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_34(shared_34_k0, w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], w.cq_l_thigh, w.sq_l_thigh, w.dp_l_hip_roll_link);
+  shared_34(w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], w.cq_l_thigh, w.sq_l_thigh, w.dp_l_hip_roll_link);
   // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.u_l_hip_roll_link[0] = w.u_l_hip_roll_link[0] - w.dp_l_hip_roll_link[3];
@@ -4236,50 +4196,50 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_hip_yaw_link_to_pelvis(Workspace& PROXGE
 
 PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
-  shared_15(shared_15_k0, w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
+  shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(shared_16_k0, w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
+  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(shared_18_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(shared_19_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_19(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(shared_20_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_20(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(shared_21_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
+  shared_21(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(shared_22_k0, w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(shared_18_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(shared_19_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_19(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(shared_20_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_20(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(shared_21_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+  shared_21(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(shared_23_k0, w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  shared_23(w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(shared_24_k0, w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_24(w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
@@ -4290,9 +4250,9 @@ PROXGEN_RT_NOINLINE void caba_reforward_r_upper_arm_to_r_wrist_yaw_link(Workspac
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(shared_28_k0, w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+  shared_28(w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(shared_29_k0, w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4304,7 +4264,7 @@ PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& 
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_32(shared_32_k0, mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
+  shared_32(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
 PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4352,7 +4312,7 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspa
     w.a_l_forearm[5] = t9;
   }
   // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_29(shared_29_k0, w.a_l_forearm, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
+  shared_29(w.a_l_forearm, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
   // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
     const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
@@ -5238,27 +5198,27 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void pv_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_35(shared_35_k0, &tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
+  shared_35(&tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_36(shared_36_k0, &tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
+  shared_36(&tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_37(shared_37_k0, &tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
+  shared_37(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_38(shared_38_k0, &tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
+  shared_38(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_39(shared_39_k0, &tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
+  shared_39(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -5380,27 +5340,27 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
 
 PROXGEN_RT_NOINLINE void pv_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_35(shared_35_k0, &tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
+  shared_35(&tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_36(shared_36_k0, &tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
+  shared_36(&tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_37(shared_37_k0, &tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
+  shared_37(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_38(shared_38_k0, &tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
+  shared_38(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_39(shared_39_k0, &tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
+  shared_39(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -5878,16 +5838,16 @@ PROXGEN_RT_NOINLINE void pv_free_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_R
   // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   shared_40(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], w.a_l_hip_roll_link, w.Dinv_l_hip_roll_link);
   // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_41(shared_41_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
+  shared_41(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
   // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_42(shared_42_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
+  shared_42(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_43(shared_43_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
+  shared_43(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
   // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_44(shared_44_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, w.a_l_foot);
+  shared_44(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, w.a_l_foot);
   // free acceleration (lambda = 0): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -5914,16 +5874,16 @@ PROXGEN_RT_NOINLINE void pv_free_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_R
   // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   shared_40(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], w.a_r_hip_roll_link, w.Dinv_r_hip_roll_link);
   // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_41(shared_41_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
+  shared_41(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
   // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_42(shared_42_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
+  shared_42(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_43(shared_43_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
+  shared_43(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
   // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_44(shared_44_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, w.a_r_foot);
+  shared_44(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, w.a_r_foot);
   // free acceleration (lambda = 0): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
@@ -6809,16 +6769,16 @@ PROXGEN_RT_NOINLINE void pv_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGE
   // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   shared_45(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, w.KA_l_hip_roll_link, 0, w.lambda, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_46(shared_46_k0, w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_46(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_47(shared_47_k0, w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_47(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_48(shared_48_k0, w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_48(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_49(shared_49_k0, &w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
+  shared_49(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
   // accelerate, with the multipliers of the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -6846,16 +6806,16 @@ PROXGEN_RT_NOINLINE void pv_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGE
   // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
   shared_45(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, w.KA_r_hip_roll_link, 0, &w.lambda[6], &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_46(shared_46_k0, w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_46(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_47(shared_47_k0, w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_47(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_48(shared_48_k0, w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_48(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_49(shared_49_k0, &w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
+  shared_49(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
   // accelerate, with the multipliers of the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];

@@ -59,8 +59,8 @@ using MultiplierRows = const Scalar*;
 // The parts the functions below call in order: each holds a few bodies' blocks.
 // 4 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip, RF_hip, RH_hip.
 // The first: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_0_k0[12] = {0.9900990099009903, 0.009900990099009688, -0.09950371902099893, 0.09900990099009904, -0.09900990099009904, 0.09950371902099893, -0.9950371902099893, 0.09900990099009904, -0.09900990099009904, 0.9950371902099893, 0.009900990099009905, 0.9900990099009901};
-constexpr Scalar shared_0_k1[12] = {0.9900990099009901, 0.00990099009900991, 0.09950371902099892, -0.09900990099009901, 0.09900990099009901, -0.09950371902099892, -0.9950371902099892, -0.09900990099009901, 0.09900990099009901, 0.9950371902099892, 0.009900990099009901, 0.9900990099009901};
+constexpr Scalar shared_0_k0[11] = {0.9900990099009903, 0.009900990099009688, -0.09950371902099893, 0.09900990099009904, -0.09900990099009904, 0.09950371902099893, -0.9950371902099893, 0.09900990099009904, -0.09900990099009904, 0.9950371902099893, 0.009900990099009905};
+constexpr Scalar shared_0_k1[11] = {0.9900990099009901, 0.00990099009900991, 0.09950371902099892, -0.09900990099009901, 0.09900990099009901, -0.09950371902099892, -0.9950371902099892, -0.09900990099009901, 0.09900990099009901, 0.9950371902099892, 0.009900990099009901};
 PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col) noexcept {
   proxgen_rt::sincos(q[0], sq_m0[0], cq_m1[0]);
   RJ_m2[0][RJ_m2_col + 0] = k[0] + k[1]*cq_m1[0];
@@ -70,7 +70,7 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   RJ_m2[1][RJ_m2_col + 2] = k[6]*sq_m0[0];
   RJ_m2[2][RJ_m2_col + 0] = k[7] + k[8]*cq_m1[0];
   RJ_m2[2][RJ_m2_col + 1] = k[9]*sq_m0[0];
-  RJ_m2[2][RJ_m2_col + 2] = k[10] + k[11]*cq_m1[0];
+  RJ_m2[2][RJ_m2_col + 2] = k[10] + 0.9900990099009901*cq_m1[0];
 }
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank.
@@ -81,8 +81,8 @@ PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, Scalar* P
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_thigh, RF_thigh.
 // The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_2_k0[18] = {-0.062, 0.062, 0.6890000000000001, -0.01268, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, 0.01268, -0.010144, 0.002431904, -0.01268, 0.0024196, -0.00020288, 0.010144, -0.00020288, 0.0006033039999999999};
-constexpr Scalar shared_2_k1[18] = {0.062, -0.062, 0.6890000000000001, -0.01268, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, 0.01268, 0.010144, 0.002431904, -0.01268, 0.0024196, 0.00020288, -0.010144, 0.00020288, 0.0006033039999999999};
+constexpr Scalar shared_2_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
+constexpr Scalar shared_2_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
 PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
   const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
   const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
@@ -95,12 +95,12 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m4[2] = v[0]*v_m1[0];
   c_m4[3] = -v[0]*v_m1[5];
   c_m4[5] = v[0]*v_m1[3];
-  const Scalar x2 = k[2]*v_m1[0] + k[3]*v_m1[4] + k[4]*v_m1[5];
-  const Scalar x3 = k[5]*v_m0[1] + k[6]*v_m1[3];
-  const Scalar x4 = k[7]*v_m1[2] + k[8]*v_m1[3];
-  const Scalar x5 = k[9]*v_m0[1] + k[10]*v_m1[2] + k[11]*v_m1[3];
-  const Scalar x6 = k[12]*v_m1[0] + k[13]*v_m1[4] + k[14]*v_m1[5];
-  const Scalar x7 = k[15]*v_m1[0] + k[16]*v_m1[4] + k[17]*v_m1[5];
+  const Scalar x2 = 0.6890000000000001*v_m1[0] - 0.01268*v_m1[4] + k[2]*v_m1[5];
+  const Scalar x3 = 0.6890000000000001*v_m0[1] + 0.01268*v_m1[3];
+  const Scalar x4 = 0.6890000000000001*v_m1[2] + k[3]*v_m1[3];
+  const Scalar x5 = 0.01268*v_m0[1] + k[4]*v_m1[2] + 0.002431904*v_m1[3];
+  const Scalar x6 = -0.01268*v_m1[0] + 0.0024196*v_m1[4] + k[5]*v_m1[5];
+  const Scalar x7 = k[6]*v_m1[0] + k[7]*v_m1[4] + 0.0006033039999999999*v_m1[5];
   pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
   pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
   pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
@@ -113,11 +113,11 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_shank, RF_shank.
 // The first: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_3_k0[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, 0.004, 0.195, -0.195, -0.004};
-constexpr Scalar shared_3_k1[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, -0.004, 0.195, -0.195, 0.004};
+constexpr Scalar shared_3_k0[2] = {0.004, -0.004};
+constexpr Scalar shared_3_k1[2] = {-0.004, 0.004};
 PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
-  const Scalar x0 = v_m0[0] + k[0]*v_m0[4];
-  const Scalar x1 = v_m1[0] + k[1]*v_m0[3];
+  const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
+  const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
   v_m2[0] = cq_m3*x0 - v_m0[2]*sq_m4;
   v_m2[1] = x1;
   v_m2[2] = sq_m4*x0 + v_m0[2]*cq_m3;
@@ -128,21 +128,21 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m5[2] = v[0]*v_m2[0];
   c_m5[3] = -v[0]*v_m2[5];
   c_m5[5] = v[0]*v_m2[3];
-  const Scalar x2 = k[2]*v_m2[0] + k[3]*v_m2[4];
-  const Scalar x3 = k[4]*v_m2[1] + k[5]*v_m2[3];
-  const Scalar x4 = k[6]*v_m2[1] + k[7]*v_m2[3];
-  const Scalar x5 = k[8]*v_m2[0] + k[9]*v_m2[4];
-  pA_m6[0] = k[10]*v_m2[2]*v_m2[4] - v_m2[5]*x3;
-  pA_m6[1] = v_m2[5]*x2 + k[11]*v_m2[2]*v_m2[3];
+  const Scalar x2 = 0.064*v_m2[0] - 0.003904*v_m2[4];
+  const Scalar x3 = 0.064*v_m2[1] + 0.003904*v_m2[3];
+  const Scalar x4 = 0.003904*v_m2[1] + 0.000483144*v_m2[3];
+  const Scalar x5 = -0.003904*v_m2[0] + 0.000486144*v_m2[4];
+  pA_m6[0] = 0.064*v_m2[2]*v_m2[4] - v_m2[5]*x3;
+  pA_m6[1] = v_m2[5]*x2 - 0.064*v_m2[2]*v_m2[3];
   pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
-  pA_m6[3] = k[12]*v_m2[4]*v_m2[5] - v_m2[5]*x5 + k[13]*v_m2[1]*v_m2[2] - v_m2[2]*x3;
-  pA_m6[4] = v_m2[5]*x4 + k[14]*v_m2[3]*v_m2[5] + v_m2[2]*x2 + k[15]*v_m2[0]*v_m2[2];
+  pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
+  pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
   pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
   g_m7[0] = g_m8[0]*cq_m3 - g_m8[2]*sq_m4;
   g_m7[2] = g_m8[0]*sq_m4 + g_m8[2]*cq_m3;
-  const Scalar x6 = v_m2[2] + k[16]*v_m2[3];
-  const Scalar x7 = v_m2[1] + k[17]*v_m2[3];
-  const Scalar x8 = v_m2[0] + k[18]*v_m2[4] + k[19]*v_m2[5];
+  const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
+  const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
+  const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
   k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
   k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
   k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
@@ -150,8 +150,8 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: LH_thigh, RH_thigh.
 // The first: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-constexpr Scalar shared_4_k0[18] = {-0.062, 0.062, 0.6890000000000001, -0.01268, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, 0.01268, -0.010144, 0.002431904, -0.01268, 0.0024196, -0.00020288, 0.010144, -0.00020288, 0.0006033039999999999};
-constexpr Scalar shared_4_k1[18] = {0.062, -0.062, 0.6890000000000001, -0.01268, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, 0.01268, 0.010144, 0.002431904, -0.01268, 0.0024196, 0.00020288, -0.010144, 0.00020288, 0.0006033039999999999};
+constexpr Scalar shared_4_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
+constexpr Scalar shared_4_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
 PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
   const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
   const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
@@ -164,12 +164,12 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m4[2] = v[0]*v_m1[0];
   c_m4[3] = -v[0]*v_m1[5];
   c_m4[5] = v[0]*v_m1[3];
-  const Scalar x2 = k[2]*v_m1[0] + k[3]*v_m1[4] + k[4]*v_m1[5];
-  const Scalar x3 = k[5]*v_m0[1] + k[6]*v_m1[3];
-  const Scalar x4 = k[7]*v_m1[2] + k[8]*v_m1[3];
-  const Scalar x5 = k[9]*v_m0[1] + k[10]*v_m1[2] + k[11]*v_m1[3];
-  const Scalar x6 = k[12]*v_m1[0] + k[13]*v_m1[4] + k[14]*v_m1[5];
-  const Scalar x7 = k[15]*v_m1[0] + k[16]*v_m1[4] + k[17]*v_m1[5];
+  const Scalar x2 = 0.6890000000000001*v_m1[0] - 0.01268*v_m1[4] + k[2]*v_m1[5];
+  const Scalar x3 = 0.6890000000000001*v_m0[1] + 0.01268*v_m1[3];
+  const Scalar x4 = 0.6890000000000001*v_m1[2] + k[3]*v_m1[3];
+  const Scalar x5 = 0.01268*v_m0[1] + k[4]*v_m1[2] + 0.002431904*v_m1[3];
+  const Scalar x6 = -0.01268*v_m1[0] + 0.0024196*v_m1[4] + k[5]*v_m1[5];
+  const Scalar x7 = k[6]*v_m1[0] + k[7]*v_m1[4] + 0.0006033039999999999*v_m1[5];
   pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
   pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
   pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
@@ -182,11 +182,11 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: LH_shank, RH_shank.
 // The first: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-constexpr Scalar shared_5_k0[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, 0.004, 0.195, -0.195, -0.004};
-constexpr Scalar shared_5_k1[20] = {-0.209, 0.209, 0.064, -0.003904, 0.064, 0.003904, 0.003904, 0.000483144, -0.003904, 0.000486144, 0.064, -0.064, 6e-06, 0.064, -6e-06, -0.064, -0.004, 0.195, -0.195, 0.004};
+constexpr Scalar shared_5_k0[2] = {0.004, -0.004};
+constexpr Scalar shared_5_k1[2] = {-0.004, 0.004};
 PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
-  const Scalar x0 = v_m0[0] + k[0]*v_m0[4];
-  const Scalar x1 = v_m1[0] + k[1]*v_m0[3];
+  const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
+  const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
   v_m2[0] = cq_m3*x0 - sq_m4*v_m0[2];
   v_m2[1] = x1;
   v_m2[2] = sq_m4*x0 + cq_m3*v_m0[2];
@@ -197,21 +197,21 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   c_m5[2] = v[0]*v_m2[0];
   c_m5[3] = -v[0]*v_m2[5];
   c_m5[5] = v[0]*v_m2[3];
-  const Scalar x2 = k[2]*v_m2[0] + k[3]*v_m2[4];
-  const Scalar x3 = k[4]*v_m2[1] + k[5]*v_m2[3];
-  const Scalar x4 = k[6]*v_m2[1] + k[7]*v_m2[3];
-  const Scalar x5 = k[8]*v_m2[0] + k[9]*v_m2[4];
-  pA_m6[0] = k[10]*v_m2[2]*v_m2[4] - v_m2[5]*x3;
-  pA_m6[1] = v_m2[5]*x2 + k[11]*v_m2[2]*v_m2[3];
+  const Scalar x2 = 0.064*v_m2[0] - 0.003904*v_m2[4];
+  const Scalar x3 = 0.064*v_m2[1] + 0.003904*v_m2[3];
+  const Scalar x4 = 0.003904*v_m2[1] + 0.000483144*v_m2[3];
+  const Scalar x5 = -0.003904*v_m2[0] + 0.000486144*v_m2[4];
+  pA_m6[0] = 0.064*v_m2[2]*v_m2[4] - v_m2[5]*x3;
+  pA_m6[1] = v_m2[5]*x2 - 0.064*v_m2[2]*v_m2[3];
   pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
-  pA_m6[3] = k[12]*v_m2[4]*v_m2[5] - v_m2[5]*x5 + k[13]*v_m2[1]*v_m2[2] - v_m2[2]*x3;
-  pA_m6[4] = v_m2[5]*x4 + k[14]*v_m2[3]*v_m2[5] + v_m2[2]*x2 + k[15]*v_m2[0]*v_m2[2];
+  pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
+  pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
   pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
   g_m7[0] = cq_m3*g_m8[0] - sq_m4*g_m8[2];
   g_m7[2] = sq_m4*g_m8[0] + cq_m3*g_m8[2];
-  const Scalar x6 = v_m2[2] + k[16]*v_m2[3];
-  const Scalar x7 = v_m2[1] + k[17]*v_m2[3];
-  const Scalar x8 = v_m2[0] + k[18]*v_m2[4] + k[19]*v_m2[5];
+  const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
+  const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
+  const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
   k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
   k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
   k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
@@ -219,75 +219,75 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_6_k0[58] = {0.195, -0.004, -0.003904, -0.195, 0.000486144, 0.038025, -0.0007800000000000001, 1.0, 0.195, -0.195, 0.064, 0.004, 0.064, 0.003904, 0.195, 0.000483144, 0.038041000000000005, 6e-06, 1.6e-05, -0.004, 0.195, -0.004, -0.004, 0.004, -0.004, 0.5, 0.5, 2.0, -0.002, 0.5, 0.5, 0.5, 0.002, 0.5, -0.002, -0.5, 0.209, 0.6890000000000001, -0.01268, -0.209, -0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, 0.010144, -0.209, 0.002431904, 0.209, 0.209, -0.209, -0.209, 0.0024196, 0.043681, 0.00020288, -0.209, 0.0006033039999999999, 0.209, -0.209};
-constexpr Scalar shared_6_k1[58] = {0.195, 0.004, -0.003904, -0.195, 0.000486144, 0.038025, 0.0007800000000000001, 1.0, 0.195, -0.195, 0.064, -0.004, 0.064, 0.003904, 0.195, 0.000483144, 0.038041000000000005, 6e-06, 1.6e-05, 0.004, 0.195, 0.004, 0.004, -0.004, 0.004, 0.5, 0.5, 2.0, 0.002, 0.5, 0.5, 0.5, -0.002, 0.5, 0.002, -0.5, 0.209, 0.6890000000000001, -0.01268, -0.209, 0.010144, 0.6890000000000001, 0.01268, 0.6890000000000001, -0.010144, -0.209, 0.002431904, 0.209, 0.209, -0.209, -0.209, 0.0024196, 0.043681, -0.00020288, -0.209, 0.0006033039999999999, 0.209, -0.209};
+constexpr Scalar shared_6_k0[14] = {-0.004, -0.0007800000000000001, 0.004, -0.004, -0.004, -0.004, 0.004, -0.004, -0.002, 0.002, -0.002, -0.010144, 0.010144, 0.00020288};
+constexpr Scalar shared_6_k1[14] = {0.004, 0.0007800000000000001, -0.004, 0.004, 0.004, 0.004, -0.004, 0.004, 0.002, -0.002, 0.002, 0.010144, -0.010144, -0.00020288};
 PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar cq_m8, Scalar sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
   const Scalar x0 = mu*active_m0[0];
-  const Scalar x1 = k[0]*k_m1[1] + k[1]*k_m1[2];
-  U_m2[0] = k[2] + k[3]*x0;
-  U_m2[4] = k[4] + k[5]*x0;
-  U_m2[5] = k[6]*x0;
-  Dinv_m3[0] = k[7] / U_m2[4];
-  u_m4[0] = -pA_m5[4] + k[8]*lambda_m6[0] + k[9]*k_m1[0]*x0 + tau[0];
+  const Scalar x1 = 0.195*k_m1[1] + k[0]*k_m1[2];
+  U_m2[0] = -0.003904 - 0.195*x0;
+  U_m2[4] = 0.000486144 + 0.038025*x0;
+  U_m2[5] = k[1]*x0;
+  Dinv_m3[0] = 1.0 / U_m2[4];
+  u_m4[0] = -pA_m5[4] + 0.195*lambda_m6[0] - 0.195*k_m1[0]*x0 + tau[0];
   const Scalar x2 = U_m2[0]*Dinv_m3[0];
   const Scalar x3 = U_m2[5]*Dinv_m3[0];
-  const Scalar x4 = k[10] + x0 - U_m2[0]*x2;
-  const Scalar x5 = k[11]*x0 - U_m2[5]*x2;
-  const Scalar x6 = k[12] + x0;
-  const Scalar x7 = k[13] + k[14]*x0;
-  const Scalar x8 = k[15] + k[16]*x0;
-  const Scalar x9 = k[17] + k[18]*x0 - U_m2[5]*x3;
+  const Scalar x4 = 0.064 + x0 - U_m2[0]*x2;
+  const Scalar x5 = k[2]*x0 - U_m2[5]*x2;
+  const Scalar x6 = 0.064 + x0;
+  const Scalar x7 = 0.003904 + 0.195*x0;
+  const Scalar x8 = 0.000483144 + 0.038041000000000005*x0;
+  const Scalar x9 = 6e-06 + 1.6e-05*x0 - U_m2[5]*x3;
   const Scalar x10 = pA_m5[0] + lambda_m6[0] - k_m1[0]*x0 + u_m4[0]*x2 + c_m7[0]*x4 + c_m7[5]*x5;
   const Scalar x11 = pA_m5[1] + lambda_m6[1] - k_m1[1]*x0 + c_m7[3]*x7;
-  const Scalar x12 = pA_m5[2] + lambda_m6[2] - k_m1[2]*x0 + c_m7[2]*x6 + k[19]*c_m7[3]*x0;
-  const Scalar x13 = pA_m5[3] + k[20]*lambda_m6[1] + k[21]*lambda_m6[2] - x0*x1 + k[22]*c_m7[2]*x0 + c_m7[3]*x8;
-  const Scalar x14 = pA_m5[5] + k[23]*lambda_m6[0] + k[24]*k_m1[0]*x0 + u_m4[0]*x3 + c_m7[0]*x5 + c_m7[5]*x9;
+  const Scalar x12 = pA_m5[2] + lambda_m6[2] - k_m1[2]*x0 + c_m7[2]*x6 + k[3]*c_m7[3]*x0;
+  const Scalar x13 = pA_m5[3] + 0.195*lambda_m6[1] + k[4]*lambda_m6[2] - x0*x1 + k[5]*c_m7[2]*x0 + c_m7[3]*x8;
+  const Scalar x14 = pA_m5[5] + k[6]*lambda_m6[0] + k[7]*k_m1[0]*x0 + u_m4[0]*x3 + c_m7[0]*x5 + c_m7[5]*x9;
   const Scalar x15 = cq_m8*cq_m8 - sq_m9*sq_m9;
-  const Scalar x16 = k[25]*(-x4 + x6);
-  const Scalar x17 = k[26]*(x4 + x6);
-  const Scalar x18 = k[27]*cq_m8*sq_m9;
-  const Scalar x19 = k[28]*x0 + k[29]*x5;
-  const Scalar x20 = k[30]*(-x8 + x9);
-  const Scalar x21 = k[31]*(x8 + x9);
+  const Scalar x16 = 0.5*(-x4 + x6);
+  const Scalar x17 = 0.5*(x4 + x6);
+  const Scalar x18 = 2.0*cq_m8*sq_m9;
+  const Scalar x19 = k[8]*x0 + 0.5*x5;
+  const Scalar x20 = 0.5*(-x8 + x9);
+  const Scalar x21 = 0.5*(x8 + x9);
   const Scalar x22 = x17 - x15*x16;
   const Scalar x23 = x17 + x15*x16;
-  const Scalar x24 = k[32]*x0 + k[33]*x5 + x15*x19;
-  const Scalar x25 = k[34]*x0 + k[35]*x5 + x15*x19;
-  const Scalar x26 = k[36]*x6 + cq_m8*x7;
+  const Scalar x24 = k[9]*x0 + 0.5*x5 + x15*x19;
+  const Scalar x25 = k[10]*x0 - 0.5*x5 + x15*x19;
+  const Scalar x26 = 0.209*x6 + cq_m8*x7;
   const Scalar x27 = cq_m8*x10 + sq_m9*x12;
   const Scalar x28 = -sq_m9*x10 + cq_m8*x12;
-  IA_m10[0] = k[37] + x22;
+  IA_m10[0] = 0.6890000000000001 + x22;
   IA_m10[2] = x16*x18;
   IA_m10[3] = x18*x19;
-  IA_m10[4] = k[38] + k[39]*x22;
-  IA_m10[5] = k[40] + x24;
-  IA_m10[6] = k[41] + x6;
-  IA_m10[8] = k[42] + x26;
+  IA_m10[4] = -0.01268 - 0.209*x22;
+  IA_m10[5] = k[11] + x24;
+  IA_m10[6] = 0.6890000000000001 + x6;
+  IA_m10[8] = 0.01268 + x26;
   IA_m10[10] = -sq_m9*x7;
-  IA_m10[11] = k[43] + x23;
-  IA_m10[12] = k[44] + x25;
-  IA_m10[13] = k[45]*x16*x18;
+  IA_m10[11] = 0.6890000000000001 + x23;
+  IA_m10[12] = k[12] + x25;
+  IA_m10[13] = -0.209*x16*x18;
   IA_m10[14] = -x18*x19;
-  IA_m10[15] = k[46] + k[47]*cq_m8*x7 + x21 - x15*x20 + k[48]*x26;
-  IA_m10[16] = k[49]*x18*x19;
-  IA_m10[17] = k[50]*sq_m9*x7 + x18*x20;
-  IA_m10[18] = k[51] + k[52]*x22;
-  IA_m10[19] = k[53] + k[54]*x24;
-  IA_m10[20] = k[55] + x21 + x15*x20;
+  IA_m10[15] = 0.002431904 + 0.209*cq_m8*x7 + x21 - x15*x20 + 0.209*x26;
+  IA_m10[16] = -0.209*x18*x19;
+  IA_m10[17] = -0.209*sq_m9*x7 + x18*x20;
+  IA_m10[18] = 0.0024196 + 0.043681*x22;
+  IA_m10[19] = k[13] - 0.209*x24;
+  IA_m10[20] = 0.0006033039999999999 + x21 + x15*x20;
   pA_m11[0] = pA_m11[0] + x27;
   pA_m11[1] = pA_m11[1] + x11;
   pA_m11[2] = pA_m11[2] + x28;
-  pA_m11[3] = pA_m11[3] + k[56]*x11 + cq_m8*x13 + sq_m9*x14;
-  pA_m11[4] = pA_m11[4] + tau[0] + k[57]*x27;
+  pA_m11[3] = pA_m11[3] + 0.209*x11 + cq_m8*x13 + sq_m9*x14;
+  pA_m11[4] = pA_m11[4] + tau[0] - 0.209*x27;
   pA_m11[5] = pA_m11[5] - sq_m9*x13 + cq_m8*x14;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_7_k0[33] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, -0.062, 0.062, -0.062, 0.062, 0.5950000000000001, 0.02164, 0.5950000000000001, 0.5950000000000001, -0.02164, 0.0012018399999999998, -0.062, -0.062, 4.5e-07, 0.062, -0.062, 0.00126484, 0.062, 0.062, -0.062, 0.062};
-constexpr Scalar shared_7_k1[33] = {1.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, 0.062, -0.062, 0.062, -0.062, 0.5950000000000001, -0.02164, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.0012018399999999998, 0.062, 0.062, 4.5e-07, -0.062, 0.062, 0.00126484, -0.062, -0.062, 0.062, -0.062};
+constexpr Scalar shared_7_k0[14] = {-0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062};
+constexpr Scalar shared_7_k1[14] = {0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062};
 PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[13]*Dinv_m0[0];
@@ -309,60 +309,60 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x17 = pA_m3[3] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x9 + c_m4[3]*x11 + c_m4[5]*x12;
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x10 + c_m4[3]*x12 + c_m4[5]*x13;
   const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x20 = k[1]*(-x4 + x8);
-  const Scalar x21 = k[2]*(x4 + x8);
-  const Scalar x22 = k[3]*cq_m5*sq_m6;
+  const Scalar x20 = 0.5*(-x4 + x8);
+  const Scalar x21 = 0.5*(x4 + x8);
+  const Scalar x22 = 2.0*cq_m5*sq_m6;
   const Scalar x23 = x19*x20 - x5*x22;
   const Scalar x24 = x20*x22 + x5*x19;
-  const Scalar x25 = k[4]*(-x6 + x10);
-  const Scalar x26 = k[5]*(x6 + x10);
-  const Scalar x27 = k[6]*(x7 + x9);
+  const Scalar x25 = 0.5*(-x6 + x10);
+  const Scalar x26 = 0.5*(x6 + x10);
+  const Scalar x27 = 0.5*(x7 + x9);
   const Scalar x28 = x19*x25 - x22*x27;
   const Scalar x29 = x22*x25 + x19*x27;
-  const Scalar x30 = k[7]*(-x11 + x13);
-  const Scalar x31 = k[8]*(x11 + x13);
+  const Scalar x30 = 0.5*(-x11 + x13);
+  const Scalar x31 = 0.5*(x11 + x13);
   const Scalar x32 = x19*x30 - x12*x22;
   const Scalar x33 = x22*x30 + x12*x19;
   const Scalar x34 = x21 - x23;
   const Scalar x35 = x21 + x23;
   const Scalar x36 = x26 - x28;
-  const Scalar x37 = k[9]*x7 + k[10]*x9 + x29;
+  const Scalar x37 = 0.5*x7 - 0.5*x9 + x29;
   const Scalar x38 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
   const Scalar x39 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
-  const Scalar x40 = k[11]*x7 + k[12]*x9 + x29;
+  const Scalar x40 = -0.5*x7 + 0.5*x9 + x29;
   const Scalar x41 = x26 + x28;
-  const Scalar x42 = k[13]*x24 + x36;
-  const Scalar x43 = k[14]*x34 + x37;
-  const Scalar x44 = k[15]*x35 + x40;
-  const Scalar x45 = k[16]*x24 + x41;
+  const Scalar x42 = k[0]*x24 + x36;
+  const Scalar x43 = k[1]*x34 + x37;
+  const Scalar x44 = k[2]*x35 + x40;
+  const Scalar x45 = k[3]*x24 + x41;
   const Scalar x46 = cq_m5*x14 + sq_m6*x16;
   const Scalar x47 = -sq_m6*x14 + cq_m5*x16;
-  IA_m7[0] = k[17] + x34;
+  IA_m7[0] = 0.5950000000000001 + x34;
   IA_m7[2] = x24;
   IA_m7[3] = x42;
-  IA_m7[5] = k[18] + x43;
-  IA_m7[6] = k[19] + IA_m1[6];
+  IA_m7[5] = k[4] + x43;
+  IA_m7[6] = 0.5950000000000001 + IA_m1[6];
   IA_m7[8] = x38;
   IA_m7[10] = x39;
-  IA_m7[11] = k[20] + x35;
-  IA_m7[12] = k[21] + x44;
+  IA_m7[11] = 0.5950000000000001 + x35;
+  IA_m7[12] = k[5] + x44;
   IA_m7[14] = x45;
-  IA_m7[15] = k[22] + x31 - x32 + k[23]*x40 + k[24]*x44;
-  IA_m7[17] = k[25] + x33 + k[26]*x36 + k[27]*x45;
-  IA_m7[20] = k[28] + x31 + x32 + k[29]*x37 + k[30]*x43;
+  IA_m7[15] = 0.0012018399999999998 + x31 - x32 + k[6]*x40 + k[7]*x44;
+  IA_m7[17] = 4.5e-07 + x33 + k[8]*x36 + k[9]*x45;
+  IA_m7[20] = 0.00126484 + x31 + x32 + k[10]*x37 + k[11]*x43;
   pA_m8[0] = pA_m8[0] + x46;
   pA_m8[1] = pA_m8[1] + x15;
   pA_m8[2] = pA_m8[2] + x47;
-  pA_m8[3] = pA_m8[3] + cq_m5*x17 + sq_m6*x18 + k[31]*x47;
+  pA_m8[3] = pA_m8[3] + cq_m5*x17 + sq_m6*x18 + k[12]*x47;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6*x17 + cq_m5*x18 + k[32]*x46;
+  pA_m8[5] = pA_m8[5] - sq_m6*x17 + cq_m5*x18 + k[13]*x46;
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
 // The first: eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_8_k0[57] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, 0.000623, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
-constexpr Scalar shared_8_k1[57] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 1.0, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, 0.000623, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
-constexpr Scalar shared_8_k2[57] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, 0.000623, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
+constexpr Scalar shared_8_k0[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
+constexpr Scalar shared_8_k1[55] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
+constexpr Scalar shared_8_k2[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
 PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
@@ -370,8 +370,8 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   U_m0[3] = k[6]*IA_m1[15] + k[7]*IA_m1[17];
   U_m0[5] = k[8]*IA_m1[17] + k[9]*IA_m1[20];
   const Scalar x0 = k[10]*U_m0[3] + k[11]*U_m0[5];
-  Dinv_m2[0] = k[12] / x0;
-  u_m3[0] = k[13]*pA_m4[3] + k[14]*pA_m4[5] + tau[0];
+  Dinv_m2[0] = 1.0 / x0;
+  u_m3[0] = k[12]*pA_m4[3] + k[13]*pA_m4[5] + tau[0];
   const Scalar x1 = U_m0[0]*Dinv_m2[0];
   const Scalar x2 = U_m0[1]*Dinv_m2[0];
   const Scalar x3 = U_m0[2]*Dinv_m2[0];
@@ -388,21 +388,21 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x14 = IA_m1[12] - U_m0[3]*x3;
   const Scalar x15 = IA_m1[14] - U_m0[5]*x3;
   const Scalar x16 = IA_m1[15] - U_m0[3]*x4;
-  const Scalar x17 = k[15] + k[16]*U_m0[3]*Dinv_m2[0];
+  const Scalar x17 = k[14] + k[15]*U_m0[3]*Dinv_m2[0];
   const Scalar x18 = IA_m1[17] - U_m0[5]*x4;
-  const Scalar x19 = k[17] + k[18]*Dinv_m2[0];
-  const Scalar x20 = k[19] + k[20]*U_m0[5]*Dinv_m2[0];
+  const Scalar x19 = 0.000623 + k[16]*Dinv_m2[0];
+  const Scalar x20 = k[17] + k[18]*U_m0[5]*Dinv_m2[0];
   const Scalar x21 = IA_m1[20] - U_m0[5]*x5;
   const Scalar x22 = -U_m0[1]*x1;
-  const Scalar x23 = k[21]*U_m0[0]*Dinv_m2[0];
+  const Scalar x23 = k[19]*U_m0[0]*Dinv_m2[0];
   const Scalar x24 = -U_m0[2]*x2;
-  const Scalar x25 = k[22]*U_m0[1]*Dinv_m2[0];
-  const Scalar x26 = k[23]*U_m0[2]*Dinv_m2[0];
+  const Scalar x25 = k[20]*U_m0[1]*Dinv_m2[0];
+  const Scalar x26 = k[21]*U_m0[2]*Dinv_m2[0];
   const Scalar x27 = pA_m4[0] + u_m3[0]*x1 + c_m5[0]*x6 + c_m5[1]*x22 + c_m5[2]*x7 + c_m5[3]*x8 + c_m5[4]*x23 + c_m5[5]*x9;
   const Scalar x28 = pA_m4[1] + u_m3[0]*x2 + c_m5[0]*x22 + c_m5[1]*x10 + c_m5[2]*x24 + c_m5[3]*x11 + c_m5[4]*x25 + c_m5[5]*x12;
   const Scalar x29 = pA_m4[2] + u_m3[0]*x3 + c_m5[0]*x7 + c_m5[1]*x24 + c_m5[2]*x13 + c_m5[3]*x14 + c_m5[4]*x26 + c_m5[5]*x15;
   const Scalar x30 = pA_m4[3] + u_m3[0]*x4 + c_m5[0]*x8 + c_m5[1]*x11 + c_m5[2]*x14 + c_m5[3]*x16 + c_m5[4]*x17 + c_m5[5]*x18;
-  const Scalar x31 = pA_m4[4] + k[24]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
+  const Scalar x31 = pA_m4[4] + k[22]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
   const Scalar x32 = pA_m4[5] + u_m3[0]*x5 + c_m5[0]*x9 + c_m5[1]*x12 + c_m5[2]*x15 + c_m5[3]*x18 + c_m5[4]*x20 + c_m5[5]*x21;
   const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
   const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
@@ -446,15 +446,15 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
   const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
   const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
-  const Scalar x75 = k[25]*x62 + x66;
-  const Scalar x76 = k[26]*x62 + x67;
-  const Scalar x77 = k[27]*x60 + k[28]*x61 + x68;
-  const Scalar x78 = k[29]*x64 + x69;
-  const Scalar x79 = k[30]*x64 + x70;
-  const Scalar x80 = k[31]*x61 + k[32]*x63 + x71;
-  const Scalar x81 = k[33]*x65 + x72;
-  const Scalar x82 = k[34]*x65 + x73;
-  const Scalar x83 = k[35]*x62 + k[36]*x64 + x74;
+  const Scalar x75 = k[23]*x62 + x66;
+  const Scalar x76 = k[24]*x62 + x67;
+  const Scalar x77 = k[25]*x60 + k[26]*x61 + x68;
+  const Scalar x78 = k[27]*x64 + x69;
+  const Scalar x79 = k[28]*x64 + x70;
+  const Scalar x80 = k[29]*x61 + k[30]*x63 + x71;
+  const Scalar x81 = k[31]*x65 + x72;
+  const Scalar x82 = k[32]*x65 + x73;
+  const Scalar x83 = k[33]*x62 + k[34]*x64 + x74;
   const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
   const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
   const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
@@ -473,35 +473,34 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   IA_m8[12] = IA_m8[12] + x81;
   IA_m8[13] = IA_m8[13] + x82;
   IA_m8[14] = IA_m8[14] + x83;
-  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x81;
-  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[39]*x72 + k[40]*x82;
-  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[41]*x66 + k[42]*x69 + k[43]*x83;
-  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[44]*x73 + k[45]*x82;
-  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[46]*x67 + k[47]*x70 + k[48]*x83;
-  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[49]*x68 + k[50]*x71 + k[51]*x77 + k[52]*x80;
+  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[35]*x72 + k[36]*x81;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
+  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[39]*x66 + k[40]*x69 + k[41]*x83;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
+  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[44]*x67 + k[45]*x70 + k[46]*x83;
+  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[47]*x68 + k[48]*x71 + k[49]*x77 + k[50]*x80;
   pA_m9[0] = pA_m9[0] + x84;
   pA_m9[1] = pA_m9[1] + x85;
   pA_m9[2] = pA_m9[2] + x86;
-  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[53]*x86;
-  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[54]*x86;
-  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[55]*x84 + k[56]*x85;
+  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[51]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
+  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[53]*x84 + k[54]*x85;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: trunk.
 // The first: accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-constexpr Scalar shared_9_k0[21] = {-9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, -9.81, 9.81, 9.81, 9.81};
-PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
-  const Scalar x0 = u_m0[0] + k[0]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] + k[1]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] + k[2]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
+PROXGEN_RT_NOINLINE void shared_9(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
+  const Scalar x0 = u_m0[0] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
   const Scalar x1 = Linv_m3[0]*x0;
-  const Scalar x2 = u_m0[1] + k[3]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] + k[4]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] + k[5]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
+  const Scalar x2 = u_m0[1] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
   const Scalar x3 = Linv_m3[1]*x2;
-  const Scalar x4 = u_m0[2] + k[6]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] + k[7]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] + k[8]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
+  const Scalar x4 = u_m0[2] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[2] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[7] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[11] - L_m4[1]*x1 - L_m4[6]*x3;
   const Scalar x5 = Linv_m3[2]*x4;
-  const Scalar x6 = u_m0[3] + k[9]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] + k[10]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] + k[11]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
+  const Scalar x6 = u_m0[3] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[3] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[8] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[12] - L_m4[2]*x1 - L_m4[7]*x3 - L_m4[11]*x5;
   const Scalar x7 = Linv_m3[3]*x6;
-  const Scalar x8 = u_m0[4] + k[12]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] + k[13]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] + k[14]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
+  const Scalar x8 = u_m0[4] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[4] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[9] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[13] - L_m4[3]*x1 - L_m4[8]*x3 - L_m4[12]*x5 - L_m4[15]*x7;
   const Scalar x9 = Linv_m3[4]*x8;
-  const Scalar x10 = u_m0[5] + k[15]*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] + k[16]*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] + k[17]*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
+  const Scalar x10 = u_m0[5] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[5] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[10] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[14] - L_m4[4]*x1 - L_m4[9]*x3 - L_m4[13]*x5 - L_m4[16]*x7 - L_m4[18]*x9;
   const Scalar x11 = Linv_m3[5]*x10;
   const Scalar x12 = Linv_m3[5]*x11;
   const Scalar x13 = Linv_m3[4]*x8 - L_m4[18]*x12;
@@ -519,9 +518,9 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* P
   qdd_m5[3] = Linv_m3[3]*x15;
   qdd_m5[4] = Linv_m3[4]*x13;
   qdd_m5[5] = Linv_m3[5]*x11;
-  a_m6[0] = k[18]*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
-  a_m6[1] = k[19]*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
-  a_m6[2] = k[20]*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
+  a_m6[0] = 9.81*RJ_m1[2][RJ_m1_col + 0] + qdd_m5[0];
+  a_m6[1] = 9.81*RJ_m1[2][RJ_m1_col + 1] + qdd_m5[1];
+  a_m6[2] = 9.81*RJ_m1[2][RJ_m1_col + 2] + qdd_m5[2];
   a_m6[3] = qdd_m5[3];
   a_m6[4] = qdd_m5[4];
   a_m6[5] = qdd_m5[5];
@@ -529,25 +528,24 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* P
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_hip.
 // The first: accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_10_k0[7] = {-0.049, 0.19, 0.049, -0.19, -5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
-  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
+PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.049*a_m0[5];
+  const Scalar x1 = a_m0[1] + 0.19*a_m0[5];
+  const Scalar x2 = a_m0[2] + 0.049*a_m0[3] - 0.19*a_m0[4];
   const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
   const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
   const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
   const Scalar x6 = c_m1[3] + RJ_m2[0][RJ_m2_col + 0]*a_m0[3] + RJ_m2[1][RJ_m2_col + 0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 0]*a_m0[5];
   const Scalar x7 = c_m1[4] + RJ_m2[0][RJ_m2_col + 1]*a_m0[3] + cq_m3*a_m0[4] + RJ_m2[2][RJ_m2_col + 1]*a_m0[5];
   const Scalar x8 = c_m1[5] + RJ_m2[0][RJ_m2_col + 2]*a_m0[3] + RJ_m2[1][RJ_m2_col + 2]*a_m0[4] + RJ_m2[2][RJ_m2_col + 2]*a_m0[5];
-  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
+  const Scalar x9 = u_m4[0] - 5.780668556524933e-05*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
   qdd_m6[0] = Dinv_m7*x9;
   a_m8[0] = x3;
   a_m8[1] = x4;
   a_m8[2] = x5;
-  a_m8[3] = x6 + k[5]*qdd_m6[0];
+  a_m8[3] = x6 + 0.9950371902099893*qdd_m6[0];
   a_m8[4] = x7;
-  a_m8[5] = x8 + k[6]*qdd_m6[0];
+  a_m8[5] = x8 + 0.09950371902099893*qdd_m6[0];
 }
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
@@ -573,10 +571,9 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_12_k0[2] = {-0.209, 0.209};
-PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
   const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
   const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
@@ -618,53 +615,52 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-constexpr Scalar shared_14_k0[16] = {-0.195, -0.004, 0.195, 0.004, -0.195, 0.004, 0.195, -0.004, -0.195, -0.004, 0.195, 0.004, -0.195, 0.004, 0.195, -0.004};
-PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4] + k[1]*a_m0[5] - k_m1[0];
+PROXGEN_RT_NOINLINE void shared_14(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+  const Scalar x0 = a_m0[0] - 0.195*a_m0[4] - 0.004*a_m0[5] - k_m1[0];
   residual_m2[0] = active_m3[0]*x0;
   dlambda_m4[0] = mu*residual_m2[0];
   lambda_m5[0] = lambda_m5[0] + dlambda_m4[0];
-  const Scalar x1 = a_m0[1] + k[2]*a_m0[3] - k_m1[1];
+  const Scalar x1 = a_m0[1] + 0.195*a_m0[3] - k_m1[1];
   residual_m2[1] = active_m3[0]*x1;
   dlambda_m4[1] = mu*residual_m2[1];
   lambda_m5[1] = lambda_m5[1] + dlambda_m4[1];
-  const Scalar x2 = a_m0[2] + k[3]*a_m0[3] - k_m1[2];
+  const Scalar x2 = a_m0[2] + 0.004*a_m0[3] - k_m1[2];
   residual_m2[2] = active_m3[0]*x2;
   dlambda_m4[2] = mu*residual_m2[2];
   lambda_m5[2] = lambda_m5[2] + dlambda_m4[2];
-  const Scalar x3 = a_m6[0] + k[4]*a_m6[4] + k[5]*a_m6[5] - k_m7[0];
+  const Scalar x3 = a_m6[0] - 0.195*a_m6[4] + 0.004*a_m6[5] - k_m7[0];
   residual_m2[3] = active_m3[1]*x3;
   dlambda_m4[3] = mu*residual_m2[3];
   lambda_m5[3] = lambda_m5[3] + dlambda_m4[3];
-  const Scalar x4 = a_m6[1] + k[6]*a_m6[3] - k_m7[1];
+  const Scalar x4 = a_m6[1] + 0.195*a_m6[3] - k_m7[1];
   residual_m2[4] = active_m3[1]*x4;
   dlambda_m4[4] = mu*residual_m2[4];
   lambda_m5[4] = lambda_m5[4] + dlambda_m4[4];
-  const Scalar x5 = a_m6[2] + k[7]*a_m6[3] - k_m7[2];
+  const Scalar x5 = a_m6[2] - 0.004*a_m6[3] - k_m7[2];
   residual_m2[5] = active_m3[1]*x5;
   dlambda_m4[5] = mu*residual_m2[5];
   lambda_m5[5] = lambda_m5[5] + dlambda_m4[5];
-  const Scalar x6 = a_m8[0] + k[8]*a_m8[4] + k[9]*a_m8[5] - k_m9[0];
+  const Scalar x6 = a_m8[0] - 0.195*a_m8[4] - 0.004*a_m8[5] - k_m9[0];
   residual_m2[6] = active_m3[2]*x6;
   dlambda_m4[6] = mu*residual_m2[6];
   lambda_m5[6] = lambda_m5[6] + dlambda_m4[6];
-  const Scalar x7 = a_m8[1] + k[10]*a_m8[3] - k_m9[1];
+  const Scalar x7 = a_m8[1] + 0.195*a_m8[3] - k_m9[1];
   residual_m2[7] = active_m3[2]*x7;
   dlambda_m4[7] = mu*residual_m2[7];
   lambda_m5[7] = lambda_m5[7] + dlambda_m4[7];
-  const Scalar x8 = a_m8[2] + k[11]*a_m8[3] - k_m9[2];
+  const Scalar x8 = a_m8[2] + 0.004*a_m8[3] - k_m9[2];
   residual_m2[8] = active_m3[2]*x8;
   dlambda_m4[8] = mu*residual_m2[8];
   lambda_m5[8] = lambda_m5[8] + dlambda_m4[8];
-  const Scalar x9 = a_m10[0] + k[12]*a_m10[4] + k[13]*a_m10[5] - k_m11[0];
+  const Scalar x9 = a_m10[0] - 0.195*a_m10[4] + 0.004*a_m10[5] - k_m11[0];
   residual_m2[9] = active_m3[3]*x9;
   dlambda_m4[9] = mu*residual_m2[9];
   lambda_m5[9] = lambda_m5[9] + dlambda_m4[9];
-  const Scalar x10 = a_m10[1] + k[14]*a_m10[3] - k_m11[1];
+  const Scalar x10 = a_m10[1] + 0.195*a_m10[3] - k_m11[1];
   residual_m2[10] = active_m3[3]*x10;
   dlambda_m4[10] = mu*residual_m2[10];
   lambda_m5[10] = lambda_m5[10] + dlambda_m4[10];
-  const Scalar x11 = a_m10[2] + k[15]*a_m10[3] - k_m11[2];
+  const Scalar x11 = a_m10[2] - 0.004*a_m10[3] - k_m11[2];
   residual_m2[11] = active_m3[3]*x11;
   dlambda_m4[11] = mu*residual_m2[11];
   lambda_m5[11] = lambda_m5[11] + dlambda_m4[11];
@@ -672,21 +668,21 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, Scalar m
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_15_k0[7] = {0.195, 0.195, 0.195, -0.004, 0.004, 0.209, -0.209};
-constexpr Scalar shared_15_k1[7] = {0.195, 0.195, 0.195, 0.004, -0.004, 0.209, -0.209};
+constexpr Scalar shared_15_k0[2] = {-0.004, 0.004};
+constexpr Scalar shared_15_k1[2] = {0.004, -0.004};
 PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
-  u_m0[0] = u_m0[0] + k[0]*dlambda_m1[0];
-  const Scalar x0 = k[1]*Dinv_m2*dlambda_m1[0];
+  u_m0[0] = u_m0[0] + 0.195*dlambda_m1[0];
+  const Scalar x0 = 0.195*Dinv_m2*dlambda_m1[0];
   const Scalar x1 = dlambda_m1[0] + U_m3[0]*x0;
-  const Scalar x2 = k[2]*dlambda_m1[1] + k[3]*dlambda_m1[2];
-  const Scalar x3 = k[4]*dlambda_m1[0] + U_m3[5]*x0;
+  const Scalar x2 = 0.195*dlambda_m1[1] + k[0]*dlambda_m1[2];
+  const Scalar x3 = k[1]*dlambda_m1[0] + U_m3[5]*x0;
   const Scalar x4 = cq_m4*x1 + sq_m5*dlambda_m1[2];
   const Scalar x5 = -sq_m5*x1 + cq_m4*dlambda_m1[2];
   dp_m6[0] = x4;
   dp_m6[1] = dlambda_m1[1];
   dp_m6[2] = x5;
-  dp_m6[3] = k[5]*dlambda_m1[1] + cq_m4*x2 + sq_m5*x3;
-  dp_m6[4] = k[6]*x4;
+  dp_m6[3] = 0.209*dlambda_m1[1] + cq_m4*x2 + sq_m5*x3;
+  dp_m6[4] = -0.209*x4;
   dp_m6[5] = -sq_m5*x2 + cq_m4*x3;
 }
 
@@ -738,147 +734,147 @@ PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_18_k0[43] = {0.03264876250658241, -8.030542390731965, 0.003904, 0.064, 0.000483144, 6e-06, 0.04832438125329121, -0.015675618746708794, 0.04832438125329121, 0.015675618746708794, 0.013375999999999999, 0.003904, 0.6890000000000001, 0.03135123749341759, -0.01268, -0.209, 0.01268, -0.003904, 0.6890000000000001, -0.006552408636124276, 0.002676476, 0.000815936, 0.00023857200000000002, 0.209, -0.000815936, -0.00047714400000000004, 0.0024196, 0.043681, 0.000847876, -0.00023857200000000002, 0.209, -0.209, -0.5659557661927332, 0.5659557661927332, 0.004, 0.11828475513428124, 0.004, 0.209, 0.195, -0.195, -0.004, -0.209, 0.004};
-constexpr Scalar shared_18_k1[43] = {0.03264876250658241, -8.030542390731965, 0.003904, 0.064, 0.000483144, 6e-06, 0.04832438125329121, -0.015675618746708794, 0.04832438125329121, 0.015675618746708794, 0.013375999999999999, 0.003904, 0.6890000000000001, 0.03135123749341759, -0.01268, -0.209, 0.01268, -0.003904, 0.6890000000000001, -0.006552408636124276, 0.002676476, 0.000815936, 0.00023857200000000002, 0.209, -0.000815936, -0.00047714400000000004, 0.0024196, 0.043681, 0.000847876, -0.00023857200000000002, 0.209, -0.209, -0.5659557661927332, 0.5659557661927332, -0.004, 0.11828475513428124, -0.004, 0.209, 0.195, -0.195, 0.004, -0.209, -0.004};
+constexpr Scalar shared_18_k0[4] = {0.004, 0.004, -0.004, 0.004};
+constexpr Scalar shared_18_k1[4] = {-0.004, -0.004, 0.004, -0.004};
 PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
   u_m0[0] = -pA_m1[4] + tau[0];
-  const Scalar x0 = k[0]*c_m2[0] + pA_m1[0] + k[1]*u_m0[0];
-  const Scalar x1 = k[2]*c_m2[3] + pA_m1[1];
-  const Scalar x2 = k[3]*c_m2[2] + pA_m1[2];
-  const Scalar x3 = k[4]*c_m2[3] + pA_m1[3];
-  const Scalar x4 = k[5]*c_m2[5] + pA_m1[5];
+  const Scalar x0 = 0.03264876250658241*c_m2[0] + pA_m1[0] - 8.030542390731965*u_m0[0];
+  const Scalar x1 = 0.003904*c_m2[3] + pA_m1[1];
+  const Scalar x2 = 0.064*c_m2[2] + pA_m1[2];
+  const Scalar x3 = 0.000483144*c_m2[3] + pA_m1[3];
+  const Scalar x4 = 6e-06*c_m2[5] + pA_m1[5];
   const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
-  const Scalar x6 = k[6] + k[7]*x5;
-  const Scalar x7 = k[8] + k[9]*x5;
-  const Scalar x8 = k[10] + k[11]*cq_m3;
+  const Scalar x6 = 0.04832438125329121 - 0.015675618746708794*x5;
+  const Scalar x7 = 0.04832438125329121 + 0.015675618746708794*x5;
+  const Scalar x8 = 0.013375999999999999 + 0.003904*cq_m3;
   const Scalar x9 = cq_m3*x0 + sq_m4*x2;
   const Scalar x10 = -sq_m4*x0 + cq_m3*x2;
-  IA_m5[0] = k[12] + x6;
-  IA_m5[2] = k[13]*cq_m3*sq_m4;
-  IA_m5[4] = k[14] + k[15]*x6;
-  IA_m5[8] = k[16] + x8;
-  IA_m5[10] = k[17]*sq_m4;
-  IA_m5[11] = k[18] + x7;
-  IA_m5[13] = k[19]*cq_m3*sq_m4;
-  IA_m5[15] = k[20] + k[21]*cq_m3 + k[22]*x5 + k[23]*x8;
-  IA_m5[17] = k[24]*sq_m4 + k[25]*cq_m3*sq_m4;
-  IA_m5[18] = k[26] + k[27]*x6;
-  IA_m5[20] = k[28] + k[29]*x5;
+  IA_m5[0] = 0.6890000000000001 + x6;
+  IA_m5[2] = 0.03135123749341759*cq_m3*sq_m4;
+  IA_m5[4] = -0.01268 - 0.209*x6;
+  IA_m5[8] = 0.01268 + x8;
+  IA_m5[10] = -0.003904*sq_m4;
+  IA_m5[11] = 0.6890000000000001 + x7;
+  IA_m5[13] = -0.006552408636124276*cq_m3*sq_m4;
+  IA_m5[15] = 0.002676476 + 0.000815936*cq_m3 + 0.00023857200000000002*x5 + 0.209*x8;
+  IA_m5[17] = -0.000815936*sq_m4 - 0.00047714400000000004*cq_m3*sq_m4;
+  IA_m5[18] = 0.0024196 + 0.043681*x6;
+  IA_m5[20] = 0.000847876 - 0.00023857200000000002*x5;
   pA_m6[0] = pA_m6[0] + x9;
   pA_m6[1] = pA_m6[1] + x1;
   pA_m6[2] = pA_m6[2] + x10;
-  pA_m6[3] = pA_m6[3] + k[30]*x1 + cq_m3*x3 + sq_m4*x4;
-  pA_m6[4] = pA_m6[4] + tau[0] + k[31]*x9;
+  pA_m6[3] = pA_m6[3] + 0.209*x1 + cq_m3*x3 + sq_m4*x4;
+  pA_m6[4] = pA_m6[4] + tau[0] - 0.209*x9;
   pA_m6[5] = pA_m6[5] - sq_m4*x3 + cq_m3*x4;
-  KA_m7[0][KA_m7_col + 0] = k[32]*cq_m3;
-  KA_m7[2][KA_m7_col + 0] = k[33]*sq_m4;
-  KA_m7[3][KA_m7_col + 0] = k[34]*sq_m4;
-  KA_m7[4][KA_m7_col + 0] = k[35]*cq_m3;
-  KA_m7[5][KA_m7_col + 0] = k[36]*cq_m3;
-  KA_m7[3][KA_m7_col + 1] = k[37] + k[38]*cq_m3;
-  KA_m7[5][KA_m7_col + 1] = k[39]*sq_m4;
+  KA_m7[0][KA_m7_col + 0] = -0.5659557661927332*cq_m3;
+  KA_m7[2][KA_m7_col + 0] = 0.5659557661927332*sq_m4;
+  KA_m7[3][KA_m7_col + 0] = k[0]*sq_m4;
+  KA_m7[4][KA_m7_col + 0] = 0.11828475513428124*cq_m3;
+  KA_m7[5][KA_m7_col + 0] = k[1]*cq_m3;
+  KA_m7[3][KA_m7_col + 1] = 0.209 + 0.195*cq_m3;
+  KA_m7[5][KA_m7_col + 1] = -0.195*sq_m4;
   KA_m7[0][KA_m7_col + 2] = sq_m4;
   KA_m7[2][KA_m7_col + 2] = cq_m3;
-  KA_m7[3][KA_m7_col + 2] = k[40]*cq_m3;
-  KA_m7[4][KA_m7_col + 2] = k[41]*sq_m4;
-  KA_m7[5][KA_m7_col + 2] = k[42]*sq_m4;
+  KA_m7[3][KA_m7_col + 2] = k[2]*cq_m3;
+  KA_m7[4][KA_m7_col + 2] = -0.209*sq_m4;
+  KA_m7[5][KA_m7_col + 2] = k[3]*sq_m4;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_19_k0[47] = {1.0, -0.010144, -0.00020288, -4.11602944e-08, -0.00020288, 0.010144, 0.010144, 0.00020288, 0.5, 0.5, 2.0, -0.00010144, 0.005072, 0.5, 0.5, 0.5, -0.00010144, -0.005072, 0.5, 0.005072, -0.5, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.5950000000000001, 0.02164, 0.5950000000000001, -0.02164, 0.0012018399999999998, -0.062, -0.062, 4.5e-07, 0.062, -0.062, 0.00126484, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
-constexpr Scalar shared_19_k1[47] = {1.0, 0.010144, 0.00020288, -4.11602944e-08, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.5, 0.5, 2.0, 0.00010144, -0.005072, 0.5, 0.5, 0.5, 0.00010144, 0.005072, 0.5, -0.005072, -0.5, 0.00010144, 0.062, -0.062, 0.062, -0.062, 0.5950000000000001, -0.02164, 0.5950000000000001, 0.02164, 0.0012018399999999998, 0.062, 0.062, 4.5e-07, -0.062, 0.062, 0.00126484, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
+constexpr Scalar shared_19_k0[32] = {-0.010144, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.00020288, -0.00010144, 0.005072, -0.00010144, -0.005072, 0.005072, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
+constexpr Scalar shared_19_k1[32] = {0.010144, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.00010144, -0.005072, 0.00010144, 0.005072, -0.005072, 0.00010144, 0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
 PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
-  Dinv_m0[0] = k[0] / IA_m1[18];
+  Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
   const Scalar x1 = IA_m1[13]*Dinv_m0[0];
   const Scalar x2 = IA_m1[0] - IA_m1[4]*x0;
   const Scalar x3 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x4 = k[1] + k[2]*IA_m1[4]*Dinv_m0[0];
+  const Scalar x4 = k[0] + k[1]*IA_m1[4]*Dinv_m0[0];
   const Scalar x5 = IA_m1[11] - IA_m1[13]*x1;
-  const Scalar x6 = IA_m1[20] + k[3]*Dinv_m0[0];
-  const Scalar x7 = k[4]*IA_m1[13]*Dinv_m0[0];
+  const Scalar x6 = IA_m1[20] - 4.11602944e-08*Dinv_m0[0];
+  const Scalar x7 = k[2]*IA_m1[13]*Dinv_m0[0];
   const Scalar x8 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x2 + c_m4[2]*x3 + c_m4[5]*x4;
   const Scalar x9 = pA_m3[1] + c_m4[3]*IA_m1[8] + c_m4[5]*IA_m1[10];
-  const Scalar x10 = k[5]*c_m4[3] + pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x3 + c_m4[2]*x5 + c_m4[5]*x7;
-  const Scalar x11 = k[6]*c_m4[2] + pA_m3[3] + c_m4[3]*IA_m1[15] + c_m4[5]*IA_m1[17];
-  const Scalar x12 = pA_m3[5] + k[7]*Dinv_m0[0]*u_m2[0] + c_m4[0]*x4 + c_m4[2]*x7 + c_m4[3]*IA_m1[17] + c_m4[5]*x6;
+  const Scalar x10 = k[3]*c_m4[3] + pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x3 + c_m4[2]*x5 + c_m4[5]*x7;
+  const Scalar x11 = k[4]*c_m4[2] + pA_m3[3] + c_m4[3]*IA_m1[15] + c_m4[5]*IA_m1[17];
+  const Scalar x12 = pA_m3[5] + k[5]*Dinv_m0[0]*u_m2[0] + c_m4[0]*x4 + c_m4[2]*x7 + c_m4[3]*IA_m1[17] + c_m4[5]*x6;
   const Scalar x13 = cq_m5*cq_m5 - sq_m6*sq_m6;
-  const Scalar x14 = k[8]*(-x2 + x5);
-  const Scalar x15 = k[9]*(x2 + x5);
-  const Scalar x16 = k[10]*cq_m5*sq_m6;
+  const Scalar x14 = 0.5*(-x2 + x5);
+  const Scalar x15 = 0.5*(x2 + x5);
+  const Scalar x16 = 2.0*cq_m5*sq_m6;
   const Scalar x17 = x13*x14 - x3*x16;
   const Scalar x18 = x14*x16 + x3*x13;
-  const Scalar x19 = k[11]*IA_m1[13]*Dinv_m0[0];
-  const Scalar x20 = k[12] + k[13]*x4;
+  const Scalar x19 = k[6]*IA_m1[13]*Dinv_m0[0];
+  const Scalar x20 = k[7] + 0.5*x4;
   const Scalar x21 = x13*x19 - x16*x20;
   const Scalar x22 = x16*x19 + x13*x20;
-  const Scalar x23 = k[14]*(-IA_m1[15] + x6);
-  const Scalar x24 = k[15]*(IA_m1[15] + x6);
+  const Scalar x23 = 0.5*(-IA_m1[15] + x6);
+  const Scalar x24 = 0.5*(IA_m1[15] + x6);
   const Scalar x25 = x13*x23 - IA_m1[17]*x16;
   const Scalar x26 = x16*x23 + IA_m1[17]*x13;
   const Scalar x27 = x15 - x17;
   const Scalar x28 = x15 + x17;
-  const Scalar x29 = k[16]*IA_m1[13]*Dinv_m0[0] - x21;
-  const Scalar x30 = k[17] + k[18]*x4 + x22;
+  const Scalar x29 = k[8]*IA_m1[13]*Dinv_m0[0] - x21;
+  const Scalar x30 = k[9] + 0.5*x4 + x22;
   const Scalar x31 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
   const Scalar x32 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
-  const Scalar x33 = k[19] + k[20]*x4 + x22;
-  const Scalar x34 = k[21]*IA_m1[13]*Dinv_m0[0] + x21;
-  const Scalar x35 = k[22]*x18 + x29;
-  const Scalar x36 = k[23]*x27 + x30;
-  const Scalar x37 = k[24]*x28 + x33;
-  const Scalar x38 = k[25]*x18 + x34;
+  const Scalar x33 = k[10] - 0.5*x4 + x22;
+  const Scalar x34 = k[11]*IA_m1[13]*Dinv_m0[0] + x21;
+  const Scalar x35 = k[12]*x18 + x29;
+  const Scalar x36 = k[13]*x27 + x30;
+  const Scalar x37 = k[14]*x28 + x33;
+  const Scalar x38 = k[15]*x18 + x34;
   const Scalar x39 = cq_m5*x8 + sq_m6*x10;
   const Scalar x40 = -sq_m6*x8 + cq_m5*x10;
-  IA_m7[0] = k[26] + x27;
+  IA_m7[0] = 0.5950000000000001 + x27;
   IA_m7[2] = x18;
   IA_m7[3] = x35;
-  IA_m7[5] = k[27] + x36;
+  IA_m7[5] = k[16] + x36;
   IA_m7[8] = x31;
   IA_m7[10] = x32;
-  IA_m7[11] = k[28] + x28;
-  IA_m7[12] = k[29] + x37;
+  IA_m7[11] = 0.5950000000000001 + x28;
+  IA_m7[12] = k[17] + x37;
   IA_m7[14] = x38;
-  IA_m7[15] = k[30] + x24 - x25 + k[31]*x33 + k[32]*x37;
-  IA_m7[17] = k[33] + x26 + k[34]*x29 + k[35]*x38;
-  IA_m7[20] = k[36] + x24 + x25 + k[37]*x30 + k[38]*x36;
+  IA_m7[15] = 0.0012018399999999998 + x24 - x25 + k[18]*x33 + k[19]*x37;
+  IA_m7[17] = 4.5e-07 + x26 + k[20]*x29 + k[21]*x38;
+  IA_m7[20] = 0.00126484 + x24 + x25 + k[22]*x30 + k[23]*x36;
   pA_m8[0] = pA_m8[0] + x39;
   pA_m8[1] = pA_m8[1] + x9;
   pA_m8[2] = pA_m8[2] + x40;
-  pA_m8[3] = pA_m8[3] + cq_m5*x11 + sq_m6*x12 + k[39]*x40;
+  pA_m8[3] = pA_m8[3] + cq_m5*x11 + sq_m6*x12 + k[24]*x40;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6*x11 + cq_m5*x12 + k[40]*x39;
+  pA_m8[5] = pA_m8[5] - sq_m6*x11 + cq_m5*x12 + k[25]*x39;
   KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
   const Scalar x41 = KA_m10[0][KA_m10_col + 0] - IA_m1[4]*KSD_m9[0];
   const Scalar x42 = KA_m10[2][KA_m10_col + 0] - IA_m1[13]*KSD_m9[0];
-  const Scalar x43 = KA_m10[5][KA_m10_col + 0] + k[41]*KSD_m9[0];
+  const Scalar x43 = KA_m10[5][KA_m10_col + 0] + k[26]*KSD_m9[0];
   const Scalar x44 = cq_m5*x41 + sq_m6*x42;
   const Scalar x45 = -sq_m6*x41 + cq_m5*x42;
   KA_m11[0][KA_m11_col + 0] = x44;
   KA_m11[2][KA_m11_col + 0] = x45;
-  KA_m11[3][KA_m11_col + 0] = cq_m5*KA_m10[3][KA_m10_col + 0] + sq_m6*x43 + k[42]*x45;
-  KA_m11[5][KA_m11_col + 0] = -sq_m6*KA_m10[3][KA_m10_col + 0] + cq_m5*x43 + k[43]*x44;
+  KA_m11[3][KA_m11_col + 0] = cq_m5*KA_m10[3][KA_m10_col + 0] + sq_m6*x43 + k[27]*x45;
+  KA_m11[5][KA_m11_col + 0] = -sq_m6*KA_m10[3][KA_m10_col + 0] + cq_m5*x43 + k[28]*x44;
   KA_m11[3][KA_m11_col + 1] = cq_m5*KA_m10[3][KA_m10_col + 1] + sq_m6*KA_m10[5][KA_m10_col + 1];
   KA_m11[5][KA_m11_col + 1] = -sq_m6*KA_m10[3][KA_m10_col + 1] + cq_m5*KA_m10[5][KA_m10_col + 1];
   KSD_m9[2] = KA_m10[4][KA_m10_col + 2]*Dinv_m0[0];
   const Scalar x46 = KA_m10[0][KA_m10_col + 2] - IA_m1[4]*KSD_m9[2];
   const Scalar x47 = KA_m10[2][KA_m10_col + 2] - IA_m1[13]*KSD_m9[2];
-  const Scalar x48 = KA_m10[5][KA_m10_col + 2] + k[44]*KSD_m9[2];
+  const Scalar x48 = KA_m10[5][KA_m10_col + 2] + k[29]*KSD_m9[2];
   const Scalar x49 = cq_m5*x46 + sq_m6*x47;
   const Scalar x50 = -sq_m6*x46 + cq_m5*x47;
   KA_m11[0][KA_m11_col + 2] = x49;
   KA_m11[2][KA_m11_col + 2] = x50;
-  KA_m11[3][KA_m11_col + 2] = cq_m5*KA_m10[3][KA_m10_col + 2] + sq_m6*x48 + k[45]*x50;
-  KA_m11[5][KA_m11_col + 2] = -sq_m6*KA_m10[3][KA_m10_col + 2] + cq_m5*x48 + k[46]*x49;
+  KA_m11[3][KA_m11_col + 2] = cq_m5*KA_m10[3][KA_m10_col + 2] + sq_m6*x48 + k[30]*x50;
+  KA_m11[5][KA_m11_col + 2] = -sq_m6*KA_m10[3][KA_m10_col + 2] + cq_m5*x48 + k[31]*x49;
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
 // The first: eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_20_k0[86] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 1.3480000000000003, -5.8e-05, 5.780668556524933e-05, 0.000623, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 1.0, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
-constexpr Scalar shared_20_k1[86] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 1.0, -0.9950371902099892, 0.09950371902099892, 1.3480000000000003, 5.8e-05, -5.7617628499109426e-05, 0.000623, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, 1.0, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
-constexpr Scalar shared_20_k2[86] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 1.0, -0.9950371902099893, -0.09950371902099893, 1.3480000000000003, 5.8e-05, -5.780668556524933e-05, 0.000623, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 1.0, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
+constexpr Scalar shared_20_k0[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
+constexpr Scalar shared_20_k1[82] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
+constexpr Scalar shared_20_k2[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
 PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
@@ -886,8 +882,8 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   U_m0[3] = k[6]*IA_m1[15] + k[7]*IA_m1[17];
   U_m0[5] = k[8]*IA_m1[17] + k[9]*IA_m1[20];
   const Scalar x0 = k[10]*U_m0[3] + k[11]*U_m0[5];
-  Dinv_m2[0] = k[12] / x0;
-  u_m3[0] = k[13]*pA_m4[3] + k[14]*pA_m4[5] + tau[0];
+  Dinv_m2[0] = 1.0 / x0;
+  u_m3[0] = k[12]*pA_m4[3] + k[13]*pA_m4[5] + tau[0];
   const Scalar x1 = U_m0[0]*Dinv_m2[0];
   const Scalar x2 = U_m0[1]*Dinv_m2[0];
   const Scalar x3 = U_m0[2]*Dinv_m2[0];
@@ -897,28 +893,28 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x7 = IA_m1[2] - U_m0[2]*x1;
   const Scalar x8 = IA_m1[3] - U_m0[3]*x1;
   const Scalar x9 = IA_m1[5] - U_m0[5]*x1;
-  const Scalar x10 = k[15] - U_m0[1]*x2;
+  const Scalar x10 = 1.3480000000000003 - U_m0[1]*x2;
   const Scalar x11 = IA_m1[8] - U_m0[3]*x2;
   const Scalar x12 = IA_m1[10] - U_m0[5]*x2;
   const Scalar x13 = IA_m1[11] - U_m0[2]*x3;
   const Scalar x14 = IA_m1[12] - U_m0[3]*x3;
   const Scalar x15 = IA_m1[14] - U_m0[5]*x3;
   const Scalar x16 = IA_m1[15] - U_m0[3]*x4;
-  const Scalar x17 = k[16] + k[17]*U_m0[3]*Dinv_m2[0];
+  const Scalar x17 = k[14] + k[15]*U_m0[3]*Dinv_m2[0];
   const Scalar x18 = IA_m1[17] - U_m0[5]*x4;
-  const Scalar x19 = k[18] + k[19]*Dinv_m2[0];
-  const Scalar x20 = k[20] + k[21]*U_m0[5]*Dinv_m2[0];
+  const Scalar x19 = 0.000623 + k[16]*Dinv_m2[0];
+  const Scalar x20 = k[17] + k[18]*U_m0[5]*Dinv_m2[0];
   const Scalar x21 = IA_m1[20] - U_m0[5]*x5;
   const Scalar x22 = -U_m0[1]*x1;
-  const Scalar x23 = k[22]*U_m0[0]*Dinv_m2[0];
+  const Scalar x23 = k[19]*U_m0[0]*Dinv_m2[0];
   const Scalar x24 = -U_m0[2]*x2;
-  const Scalar x25 = k[23]*U_m0[1]*Dinv_m2[0];
-  const Scalar x26 = k[24]*U_m0[2]*Dinv_m2[0];
+  const Scalar x25 = k[20]*U_m0[1]*Dinv_m2[0];
+  const Scalar x26 = k[21]*U_m0[2]*Dinv_m2[0];
   const Scalar x27 = pA_m4[0] + u_m3[0]*x1 + c_m5[0]*x6 + c_m5[1]*x22 + c_m5[2]*x7 + c_m5[3]*x8 + c_m5[4]*x23 + c_m5[5]*x9;
   const Scalar x28 = pA_m4[1] + u_m3[0]*x2 + c_m5[0]*x22 + c_m5[1]*x10 + c_m5[2]*x24 + c_m5[3]*x11 + c_m5[4]*x25 + c_m5[5]*x12;
   const Scalar x29 = pA_m4[2] + u_m3[0]*x3 + c_m5[0]*x7 + c_m5[1]*x24 + c_m5[2]*x13 + c_m5[3]*x14 + c_m5[4]*x26 + c_m5[5]*x15;
   const Scalar x30 = pA_m4[3] + u_m3[0]*x4 + c_m5[0]*x8 + c_m5[1]*x11 + c_m5[2]*x14 + c_m5[3]*x16 + c_m5[4]*x17 + c_m5[5]*x18;
-  const Scalar x31 = pA_m4[4] + k[25]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
+  const Scalar x31 = pA_m4[4] + k[22]*Dinv_m2[0]*u_m3[0] + c_m5[0]*x23 + c_m5[1]*x25 + c_m5[2]*x26 + c_m5[3]*x17 + c_m5[4]*x19 + c_m5[5]*x20;
   const Scalar x32 = pA_m4[5] + u_m3[0]*x5 + c_m5[0]*x9 + c_m5[1]*x12 + c_m5[2]*x15 + c_m5[3]*x18 + c_m5[4]*x20 + c_m5[5]*x21;
   const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
   const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
@@ -962,15 +958,15 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
   const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
   const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
-  const Scalar x75 = k[26]*x62 + x66;
-  const Scalar x76 = k[27]*x62 + x67;
-  const Scalar x77 = k[28]*x60 + k[29]*x61 + x68;
-  const Scalar x78 = k[30]*x64 + x69;
-  const Scalar x79 = k[31]*x64 + x70;
-  const Scalar x80 = k[32]*x61 + k[33]*x63 + x71;
-  const Scalar x81 = k[34]*x65 + x72;
-  const Scalar x82 = k[35]*x65 + x73;
-  const Scalar x83 = k[36]*x62 + k[37]*x64 + x74;
+  const Scalar x75 = k[23]*x62 + x66;
+  const Scalar x76 = k[24]*x62 + x67;
+  const Scalar x77 = k[25]*x60 + k[26]*x61 + x68;
+  const Scalar x78 = k[27]*x64 + x69;
+  const Scalar x79 = k[28]*x64 + x70;
+  const Scalar x80 = k[29]*x61 + k[30]*x63 + x71;
+  const Scalar x81 = k[31]*x65 + x72;
+  const Scalar x82 = k[32]*x65 + x73;
+  const Scalar x83 = k[33]*x62 + k[34]*x64 + x74;
   const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
   const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
   const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
@@ -989,19 +985,19 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   IA_m8[12] = IA_m8[12] + x81;
   IA_m8[13] = IA_m8[13] + x82;
   IA_m8[14] = IA_m8[14] + x83;
-  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[38]*x72 + k[39]*x81;
-  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[40]*x72 + k[41]*x82;
-  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[42]*x66 + k[43]*x69 + k[44]*x83;
-  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[45]*x73 + k[46]*x82;
-  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[47]*x67 + k[48]*x70 + k[49]*x83;
-  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[50]*x68 + k[51]*x71 + k[52]*x77 + k[53]*x80;
+  IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[35]*x72 + k[36]*x81;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
+  IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[39]*x66 + k[40]*x69 + k[41]*x83;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
+  IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[44]*x67 + k[45]*x70 + k[46]*x83;
+  IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[47]*x68 + k[48]*x71 + k[49]*x77 + k[50]*x80;
   pA_m9[0] = pA_m9[0] + x84;
   pA_m9[1] = pA_m9[1] + x85;
   pA_m9[2] = pA_m9[2] + x86;
-  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[54]*x86;
-  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[55]*x86;
-  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[56]*x84 + k[57]*x85;
-  KS_m10[0] = k[58]*KA_m11[3][KA_m11_col + 0] + k[59]*KA_m11[5][KA_m11_col + 0];
+  pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[51]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
+  pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[53]*x84 + k[54]*x85;
+  KS_m10[0] = k[55]*KA_m11[3][KA_m11_col + 0] + k[56]*KA_m11[5][KA_m11_col + 0];
   KSD_m12[0] = Dinv_m2[0]*KS_m10[0];
   const Scalar x87 = KA_m11[0][KA_m11_col + 0] - U_m0[0]*KSD_m12[0];
   const Scalar x88 = KA_m11[2][KA_m11_col + 0] - U_m0[2]*KSD_m12[0];
@@ -1014,12 +1010,12 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   KA_m13[0][KA_m13_col + 0] = x92;
   KA_m13[1][KA_m13_col + 0] = x93;
   KA_m13[2][KA_m13_col + 0] = x94;
-  KA_m13[3][KA_m13_col + 0] = RJ_m6[0][RJ_m6_col + 0]*x90 + k[60]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[0][RJ_m6_col + 2]*x91 + k[61]*x94;
-  KA_m13[4][KA_m13_col + 0] = RJ_m6[1][RJ_m6_col + 0]*x90 + k[62]*cq_m7*KSD_m12[0] + RJ_m6[1][RJ_m6_col + 2]*x91 + k[63]*x94;
-  KA_m13[5][KA_m13_col + 0] = RJ_m6[2][RJ_m6_col + 0]*x90 + k[64]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[2][RJ_m6_col + 2]*x91 + k[65]*x92 + k[66]*x93;
-  KS_m10[1] = k[67]*KA_m11[3][KA_m11_col + 1] + k[68]*KA_m11[5][KA_m11_col + 1];
+  KA_m13[3][KA_m13_col + 0] = RJ_m6[0][RJ_m6_col + 0]*x90 + k[57]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[0][RJ_m6_col + 2]*x91 + k[58]*x94;
+  KA_m13[4][KA_m13_col + 0] = RJ_m6[1][RJ_m6_col + 0]*x90 + k[59]*cq_m7*KSD_m12[0] + RJ_m6[1][RJ_m6_col + 2]*x91 + k[60]*x94;
+  KA_m13[5][KA_m13_col + 0] = RJ_m6[2][RJ_m6_col + 0]*x90 + k[61]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[2][RJ_m6_col + 2]*x91 + k[62]*x92 + k[63]*x93;
+  KS_m10[1] = k[64]*KA_m11[3][KA_m11_col + 1] + k[65]*KA_m11[5][KA_m11_col + 1];
   KSD_m12[1] = Dinv_m2[0]*KS_m10[1];
-  const Scalar x95 = k[69] - U_m0[1]*KSD_m12[1];
+  const Scalar x95 = 1.0 - U_m0[1]*KSD_m12[1];
   const Scalar x96 = -U_m0[0]*KSD_m12[1];
   const Scalar x97 = -U_m0[2]*KSD_m12[1];
   const Scalar x98 = KA_m11[3][KA_m11_col + 1] - U_m0[3]*KSD_m12[1];
@@ -1030,10 +1026,10 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   KA_m13[0][KA_m13_col + 1] = x100;
   KA_m13[1][KA_m13_col + 1] = x101;
   KA_m13[2][KA_m13_col + 1] = x102;
-  KA_m13[3][KA_m13_col + 1] = RJ_m6[0][RJ_m6_col + 0]*x98 + k[70]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[0][RJ_m6_col + 2]*x99 + k[71]*x102;
-  KA_m13[4][KA_m13_col + 1] = RJ_m6[1][RJ_m6_col + 0]*x98 + k[72]*cq_m7*KSD_m12[1] + RJ_m6[1][RJ_m6_col + 2]*x99 + k[73]*x102;
-  KA_m13[5][KA_m13_col + 1] = RJ_m6[2][RJ_m6_col + 0]*x98 + k[74]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[2][RJ_m6_col + 2]*x99 + k[75]*x100 + k[76]*x101;
-  KS_m10[2] = k[77]*KA_m11[3][KA_m11_col + 2] + k[78]*KA_m11[5][KA_m11_col + 2];
+  KA_m13[3][KA_m13_col + 1] = RJ_m6[0][RJ_m6_col + 0]*x98 + k[66]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[0][RJ_m6_col + 2]*x99 + k[67]*x102;
+  KA_m13[4][KA_m13_col + 1] = RJ_m6[1][RJ_m6_col + 0]*x98 + k[68]*cq_m7*KSD_m12[1] + RJ_m6[1][RJ_m6_col + 2]*x99 + k[69]*x102;
+  KA_m13[5][KA_m13_col + 1] = RJ_m6[2][RJ_m6_col + 0]*x98 + k[70]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[2][RJ_m6_col + 2]*x99 + k[71]*x100 + k[72]*x101;
+  KS_m10[2] = k[73]*KA_m11[3][KA_m11_col + 2] + k[74]*KA_m11[5][KA_m11_col + 2];
   KSD_m12[2] = Dinv_m2[0]*KS_m10[2];
   const Scalar x103 = KA_m11[0][KA_m11_col + 2] - U_m0[0]*KSD_m12[2];
   const Scalar x104 = KA_m11[2][KA_m11_col + 2] - U_m0[2]*KSD_m12[2];
@@ -1046,9 +1042,9 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   KA_m13[0][KA_m13_col + 2] = x108;
   KA_m13[1][KA_m13_col + 2] = x109;
   KA_m13[2][KA_m13_col + 2] = x110;
-  KA_m13[3][KA_m13_col + 2] = RJ_m6[0][RJ_m6_col + 0]*x106 + k[79]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[0][RJ_m6_col + 2]*x107 + k[80]*x110;
-  KA_m13[4][KA_m13_col + 2] = RJ_m6[1][RJ_m6_col + 0]*x106 + k[81]*cq_m7*KSD_m12[2] + RJ_m6[1][RJ_m6_col + 2]*x107 + k[82]*x110;
-  KA_m13[5][KA_m13_col + 2] = RJ_m6[2][RJ_m6_col + 0]*x106 + k[83]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[2][RJ_m6_col + 2]*x107 + k[84]*x108 + k[85]*x109;
+  KA_m13[3][KA_m13_col + 2] = RJ_m6[0][RJ_m6_col + 0]*x106 + k[75]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[0][RJ_m6_col + 2]*x107 + k[76]*x110;
+  KA_m13[4][KA_m13_col + 2] = RJ_m6[1][RJ_m6_col + 0]*x106 + k[77]*cq_m7*KSD_m12[2] + RJ_m6[1][RJ_m6_col + 2]*x107 + k[78]*x110;
+  KA_m13[5][KA_m13_col + 2] = RJ_m6[2][RJ_m6_col + 0]*x106 + k[79]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[2][RJ_m6_col + 2]*x107 + k[80]*x108 + k[81]*x109;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
@@ -1073,20 +1069,19 @@ PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_22_k0[5] = {-0.209, 0.209, -0.000486144, 0.003904, 2057.0036861506055};
-PROXGEN_RT_NOINLINE void shared_22(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
   const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
   const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
   const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
-  const Scalar x6 = u_m4[0] + k[2]*a_m0[4] + k[3]*x2;
+  const Scalar x6 = u_m4[0] - 0.000486144*a_m0[4] + 0.003904*x2;
   a_m5[0] = x2;
   a_m5[1] = x1;
   a_m5[2] = x3;
   a_m5[3] = x4;
-  a_m5[4] = a_m0[4] + k[4]*x6;
+  a_m5[4] = a_m0[4] + 2057.0036861506055*x6;
   a_m5[5] = x5;
 }
 
@@ -1116,11 +1111,10 @@ PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members:   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
 // The first: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-constexpr Scalar shared_24_k0[2] = {78.21756516587678, 1.0};
-PROXGEN_RT_NOINLINE void shared_24(const Scalar* PROXGEN_RT_RESTRICT k, Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
-  const Scalar x0 = k[0] + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];
+PROXGEN_RT_NOINLINE void shared_24(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
+  const Scalar x0 = 78.21756516587678 + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];
   const Scalar x1 = std::sqrt(x0);
-  const Scalar x2 = k[1] / x1;
+  const Scalar x2 = 1.0 / x1;
   Linv_m4[0] = x2;
   const Scalar x3 = KSD_m0[1]*KS_m1[0];
   L_m5[0] = Linv_m4[0]*x3;
@@ -1151,16 +1145,15 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_26_k0[6] = {-0.209, 0.209, 0.195, -0.000486144, 0.003904, 2057.0036861506055};
-PROXGEN_RT_NOINLINE void shared_26(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[4];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[3];
+PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
+  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
   const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
   const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
   const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
-  const Scalar x6 = u_m4[0] + k[2]*lambda_m5[0] + k[3]*a_m0[4] + k[4]*x2;
-  qdd_m6[0] = k[5]*x6;
+  const Scalar x6 = u_m4[0] + 0.195*lambda_m5[0] - 0.000486144*a_m0[4] + 0.003904*x2;
+  qdd_m6[0] = 2057.0036861506055*x6;
   a_m7[0] = x2;
   a_m7[1] = x1;
   a_m7[2] = x3;
@@ -1667,16 +1660,16 @@ PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  shared_9(shared_9_k0, w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
+  shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(shared_10_k0, w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(shared_12_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_12(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
@@ -1685,7 +1678,7 @@ PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_R
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(shared_12_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_12(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
@@ -1694,7 +1687,7 @@ PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_R
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(shared_12_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_12(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
@@ -1703,12 +1696,12 @@ PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(shared_12_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_12(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_14(shared_14_k0, mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
+  shared_14(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1780,16 +1773,16 @@ PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) no
 
 PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  shared_9(shared_9_k0, w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
+  shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(shared_10_k0, w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(shared_12_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_12(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
@@ -1798,7 +1791,7 @@ PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(shared_12_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_12(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
@@ -1807,7 +1800,7 @@ PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(shared_12_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_12(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
@@ -1816,12 +1809,12 @@ PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(shared_12_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_12(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_14(shared_14_k0, mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
+  shared_14(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2363,7 +2356,7 @@ PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRI
   // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
   // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_22(shared_22_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.a_LF_shank);
+  shared_22(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.a_LF_shank);
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
 }
@@ -2372,7 +2365,7 @@ PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRI
   // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
   // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_22(shared_22_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.a_LH_shank);
+  shared_22(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.a_LH_shank);
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
 }
@@ -2381,7 +2374,7 @@ PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRI
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
   // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_22(shared_22_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.a_RF_shank);
+  shared_22(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.a_RF_shank);
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
 }
@@ -2390,7 +2383,7 @@ PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRIC
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_22(shared_22_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.a_RH_shank);
+  shared_22(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.a_RH_shank);
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -2449,7 +2442,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  shared_24(shared_24_k0, inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
+  shared_24(inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t9 = inv_mu + w.KSD_LH_hip[1]*w.KS_LH_hip[1] - w.L[34]*w.L[34];
@@ -2467,7 +2460,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
-  shared_24(shared_24_k0, inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
+  shared_24(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2488,7 +2481,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& P
     w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  shared_24(shared_24_k0, inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
+  shared_24(inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
@@ -2937,7 +2930,7 @@ PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RES
   // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
   shared_25(shared_25_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_26(shared_26_k0, w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
+  shared_26(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
   // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_27(shared_27_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
@@ -2946,7 +2939,7 @@ PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RES
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
   shared_25(shared_25_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_26(shared_26_k0, w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
+  shared_26(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_27(shared_27_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
@@ -2955,7 +2948,7 @@ PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RES
   // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   shared_25(shared_25_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_26(shared_26_k0, w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
+  shared_26(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
   // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   shared_27(shared_27_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
@@ -2964,7 +2957,7 @@ PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_R
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
   shared_25(shared_25_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_26(shared_26_k0, w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
+  shared_26(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {

@@ -436,6 +436,34 @@ std::string blockBody(const std::string& comment) {
   return b == std::string::npos ? comment : comment.substr(a + 1, b - a - 1);
 }
 
+// The kernel's text with the constants common to its blocks printed back as
+// the literals they were (" + k[3]" with k[3] = -0.5 is " - 0.5", as the
+// printer wrote it) and the others as k[slot].
+std::string withCommonLiterals(const std::string& body, const std::vector<std::string>& constants,
+                               const std::vector<char>& common, const std::vector<std::size_t>& slot) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < body.size()) {
+    if (body.compare(i, 2, "k[") == 0 && (i == 0 || !identChar(body[i - 1]))) {
+      const std::size_t close = body.find(']', i);
+      const std::size_t c = std::stoul(body.substr(i + 2, close - i - 2));
+      if (!common[c]) {
+        out += fmt::format("k[{}]", slot[c]);
+      } else if (out.size() >= 3 && out.compare(out.size() - 3, 3, " + ") == 0) {
+        const std::string& v = constants[c];
+        out.erase(out.size() - 3);
+        out += v[0] == '-' ? " - " + v.substr(1) : " + " + v;
+      } else {
+        out += constants[c];
+      }
+      i = close + 1;
+      continue;
+    }
+    out += body[i++];
+  }
+  return out;
+}
+
 }  // namespace
 
 SharedParts shareBlocks(const std::string& text, const Members& ws,
@@ -483,7 +511,23 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     SharedKernel k;
     k.name = fmt::format("shared_{}", out.kernels.size());
     const Canonical& first = found[g.front()].canon;
-    k.bytes = long(first.body.size());
+    // A constant that is the same in every block of the group stays a literal
+    // of the kernel (1.0 in 1.0 / D, the 0.5 of a rotation's half angle); the
+    // table holds the others, renumbered.
+    const std::size_t nk = first.constants.size();
+    std::vector<char> common(nk, 1);
+    for (std::size_t c = 0; c < nk; ++c)
+      for (std::size_t n : g) common[c] = common[c] && found[n].canon.constants[c] == first.constants[c];
+    std::vector<std::size_t> slot(nk, 0);
+    std::size_t varying = 0;
+    for (std::size_t c = 0; c < nk; ++c)
+      if (!common[c]) slot[c] = varying++;
+    const std::string body = withCommonLiterals(first.body, first.constants, common, slot);
+    std::string signature = first.signature;
+    const std::string tableParam = "const Scalar* PROXGEN_RT_RESTRICT k";
+    if (nk > 0 && varying == 0)
+      signature = signature.size() > tableParam.size() ? signature.substr(tableParam.size() + 2) : "";
+    k.bytes = long(body.size());
     std::string tables;
     std::set<std::string> bodies;
     std::string bodyList;
@@ -494,12 +538,12 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       k.blocks.push_back(comment.substr(5));
       if (bodies.insert(blockBody(comment)).second) bodyList += (bodyList.empty() ? "" : ", ") + blockBody(comment);
       std::string values;
-      for (std::size_t c = 0; c < f.canon.constants.size(); ++c) values += (c ? ", " : "") + f.canon.constants[c];
+      for (std::size_t c = 0; c < nk; ++c)
+        if (!common[c]) values += (values.empty() ? "" : ", ") + f.canon.constants[c];
       std::string args;
-      if (!f.canon.constants.empty()) {
+      if (varying > 0) {
         auto [t, fresh] = tableOf.emplace(values, fmt::format("{}_k{}", k.name, tableOf.size()));
-        if (fresh)
-          tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, f.canon.constants.size(), values);
+        if (fresh) tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, varying, values);
         args = t->second;
       }
       for (const std::string& a : f.canon.args) args += (args.empty() ? "" : ", ") + a;
@@ -508,8 +552,7 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     kernels += fmt::format("// {} blocks of the same code, each over its constants (k) and members: {}.\n// The first: {}\n",
                            g.size(), bodyList, parts[found[g.front()].where.part].lines[found[g.front()].where.comment].substr(5));
     kernels += tables;
-    kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, first.signature,
-                           first.body);
+    kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, signature, body);
     out.kernels.push_back(std::move(k));
   }
   if (out.kernels.empty()) {

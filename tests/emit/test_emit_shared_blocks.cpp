@@ -59,13 +59,14 @@ TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
   ASSERT_EQ(s.kernels[0].blocks.size(), 2u);
   // One kernel body over k[], each block's constants in its own table; the
   // sign before a literal goes into the table (a - 0.5*x == a + (-0.5)*x).
+  // A constant the blocks have in common (1.5e-05) stays a literal.
   EXPECT_EQ(count(s.parts, "PROXGEN_RT_NOINLINE void shared_0("), 1);
-  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k0[2] = {0.25, -1.5e-05};"), std::string::npos) << s.parts;
-  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k1[2] = {-0.5, -1.5e-05};"), std::string::npos) << s.parts;
+  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k0[1] = {0.25};"), std::string::npos) << s.parts;
+  EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k1[1] = {-0.5};"), std::string::npos) << s.parts;
   // A scalar member the block only reads comes by value, arrays as pointers.
   EXPECT_NE(s.parts.find("const Scalar x0 = IA_m0[0] + k[0]*Dinv_m1;"), std::string::npos) << s.parts;
   // Inputs and members rebased at their smallest index, so one text serves both.
-  EXPECT_NE(s.parts.find("IA_m4[0] = IA_m4[0] + x0*u_m2[0] + k[1]*tau[1];"), std::string::npos) << s.parts;
+  EXPECT_NE(s.parts.find("IA_m4[0] = IA_m4[0] + x0*u_m2[0] - 1.5e-05*tau[1];"), std::string::npos) << s.parts;
   EXPECT_NE(s.parts.find("  shared_0(shared_0_k0, &tau[2], &w.IA_left[3], w.Dinv_left, w.u_left, &w.pA_left[5], "
                          "&w.IA_base[2]);"),
             std::string::npos)
@@ -79,12 +80,18 @@ TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
   EXPECT_EQ(count(s.parts, "// body 2 'left'"), 1);
 }
 
-TEST(SharedBlocks, BlocksWithTheSameConstantsShareATable) {
-  const std::string text = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25");
+TEST(SharedBlocks, BlocksWithTheSameConstantsNeedNoTable) {
+  const std::string text = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25", '-');
   const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
   ASSERT_EQ(s.kernels.size(), 1u);
-  EXPECT_EQ(count(s.parts, "constexpr Scalar shared_0_k"), 1);
-  EXPECT_EQ(count(s.parts, "shared_0(shared_0_k0, "), 2);
+  EXPECT_EQ(count(s.parts, "constexpr Scalar shared_0_k"), 2);  // 0.25 and -0.25 differ: a table each
+  EXPECT_NE(s.parts.find("- 1.5e-05*tau[1];"), std::string::npos) << s.parts;
+  const std::string same = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25");
+  const SharedParts t = shareBlocks(same, members({"left", "right"}), all);
+  ASSERT_EQ(t.kernels.size(), 1u);
+  EXPECT_EQ(count(t.parts, "constexpr Scalar"), 0);
+  EXPECT_NE(t.parts.find("const Scalar x0 = IA_m0[0] + 0.25*Dinv_m1;"), std::string::npos) << t.parts;
+  EXPECT_NE(t.parts.find("  shared_0(&tau[2], &w.IA_left[3], w.Dinv_left"), std::string::npos) << t.parts;
 }
 
 TEST(SharedBlocks, OtherCodeAndIneligiblePartsStayAsPrinted) {
