@@ -91,19 +91,18 @@ std::size_t literalLength(const std::string& s, std::size_t at) {
   return i - at;
 }
 
-// What a kernel parameter is: an input or output array of the part, a scalar
-// of the part (mu), or a workspace member.
+// How a block uses a workspace member (a kernel parameter each).
 struct MemberUse {
   std::string name;
-  int rows = 0, cols = 0;  // cols > 0: a matrix member; rows == 0 && cols == 0: a scalar
-  bool array = false;
+  int cols = 0;            // > 0: a matrix member (rows x cols)
+  bool array = false;      // false: a scalar
   bool loose = false;      // a subscript that is not N or N + ...: no rebasing
   long base = LONG_MAX;    // the smallest leading index of its last subscript
   bool written = false;    // a scalar the block stores or passes to a call (by pointer; else by value)
 };
 
+// How a block uses an input or output array of its part (q, tau, M, ...).
 struct PointerUse {
-  std::string name, type;
   bool loose = false;
   long base = LONG_MAX;
 };
