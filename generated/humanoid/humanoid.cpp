@@ -1323,7 +1323,7 @@ PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m
   a_m8[5] = x3;
 }
 
-// 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
+// 2 blocks of the same code, each over its constants (k) and members: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
 PROXGEN_RT_NOINLINE void shared_32(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
   const Scalar x0 = g_m0[0] + a_m1[0] - 0.06825*a_m1[4];

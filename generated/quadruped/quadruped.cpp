@@ -613,7 +613,7 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   a_m8[5] = x8 + k[6]*qdd_m6[0];
 }
 
-// 2 blocks of the same code, each over its constants (k) and members:   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
+// 2 blocks of the same code, each over its constants (k) and members: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
 PROXGEN_RT_NOINLINE void shared_14(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
   const Scalar x0 = a_m0[0] - 0.195*a_m0[4] - 0.004*a_m0[5] - k_m1[0];
@@ -1109,7 +1109,7 @@ PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   a_m6[5] = x8 + k[6]*Dinv_m7*x9;
 }
 
-// 3 blocks of the same code, each over its constants (k) and members:   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count),   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
+// 3 blocks of the same code, each over its constants (k) and members: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
 // The first: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
 PROXGEN_RT_NOINLINE void shared_24(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
   const Scalar x0 = 78.21756516587678 + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];

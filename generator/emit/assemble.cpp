@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cstdio>
-#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -579,16 +579,8 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   if (!texts.sharedKernels.empty()) {
     shared = "// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the\n"
              "// same code up to their constants, over a table of each one's constants:\n";
-    for (const SharedKernel& k : texts.sharedKernels) {
-      std::string bodies;
-      std::set<std::string> seen;
-      for (const std::string& b : k.blocks) {
-        const std::size_t a = b.find('\''), z = a == std::string::npos ? a : b.find('\'', a + 1);
-        const std::string name = z == std::string::npos ? b : b.substr(a + 1, z - a - 1);
-        if (seen.insert(name).second) bodies += (bodies.empty() ? "" : ", ") + name;
-      }
-      shared += fmt::format("//   {}: {} blocks of {}\n", k.name, k.blocks.size(), bodies);
-    }
+    for (const SharedKernel& k : texts.sharedKernels)
+      shared += fmt::format("//   {}: {} blocks of {}\n", k.name, k.blocks.size(), fmt::join(k.bodies, ", "));
   }
   auto bannerWith = [&](const std::string& sharedLines) {
     return fmt::format(fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION),

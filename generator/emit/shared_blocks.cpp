@@ -428,7 +428,8 @@ std::vector<Part> splitParts(const std::string& text, std::string& unparsed) {
   return parts;
 }
 
-// "// eliminate body 20 'arm_left_5_link': ..." -> "arm_left_5_link"
+// "eliminate body 20 'arm_left_5_link': ..." -> "arm_left_5_link"; a block
+// that is not a body's ("multiplier update: ...") is named by its whole comment.
 std::string blockBody(const std::string& comment) {
   const std::size_t a = comment.find('\'');
   const std::size_t b = a == std::string::npos ? a : comment.find('\'', a + 1);
@@ -535,7 +536,11 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       const Found& f = found[g[n]];
       const std::string comment = parts[f.where.part].lines[f.where.comment];
       k.blocks.push_back(comment.substr(5));
-      if (bodies.insert(blockBody(comment)).second) bodyList += (bodyList.empty() ? "" : ", ") + blockBody(comment);
+      const std::string bodyName = blockBody(comment.substr(5));
+      if (bodies.insert(bodyName).second) {
+        bodyList += (bodyList.empty() ? "" : ", ") + bodyName;
+        k.bodies.push_back(bodyName);
+      }
       std::string values;
       for (std::size_t c = 0; c < nk; ++c)
         if (!common[c]) values += (values.empty() ? "" : ", ") + f.canon.constants[c];
