@@ -40,6 +40,14 @@ struct Subscript {
   std::string text;  // as printed, without the brackets
 };
 
+// The subscript as the kernel prints it: relative to `base` (the smallest
+// leading index of the block), after `offset` (a matrix member's first
+// column); as printed when the block's uses are loose.
+std::string rebased(const Subscript& s, bool loose, long base, const std::string& offset = "") {
+  if (loose) return "[" + s.text + "]";
+  return fmt::format("[{}{}{}]", offset, s.lead - base, s.rest);
+}
+
 Subscript parseSubscript(const std::string& s) {
   Subscript r;
   r.text = s;
@@ -180,8 +188,8 @@ class Canonicalizer {
     std::vector<std::string> params;
     if (!constants_.empty()) params.push_back("const Scalar* PROXGEN_RT_RESTRICT k");
     std::string kinds;
-    for (const auto& [n, p] : usedPointers_) {
-      const PointerUse& u = pointerUse_.at(n);
+    for (const auto& [n, u] : pointerUse_) {  // in name order: a deterministic signature
+      const std::string& p = pointers_.at(n);
       params.push_back(fmt::format("{} {}", p, n));
       out.args.push_back(u.loose || u.base == 0 ? n : fmt::format("&{}[{}]", n, u.base));
       kinds += "p:" + n + p + (u.loose ? "L" : "") + ";";
@@ -257,12 +265,8 @@ class Canonicalizer {
         if (temps.count(id)) {
           if (o) *o += tempName(id);
         } else if (scalars_.count(id)) {
-          if (o) {
-            if (std::find(usedScalars_.begin(), usedScalars_.end(), id) == usedScalars_.end()) usedScalars_.push_back(id);
-            *o += id;
-          } else if (std::find(usedScalars_.begin(), usedScalars_.end(), id) == usedScalars_.end()) {
-            usedScalars_.push_back(id);
-          }
+          if (std::find(usedScalars_.begin(), usedScalars_.end(), id) == usedScalars_.end()) usedScalars_.push_back(id);
+          if (o) *o += id;
         } else if (qualified || call || knownNames().count(id) || loopVars_.count(id)) {
           if (o) *o += id;
         } else {
@@ -364,15 +368,11 @@ class Canonicalizer {
     }
     *o += p;
     for (std::size_t k = 0; k + 1 < subs.size(); ++k) *o += "[" + subs[k] + "]";
-    const Subscript s = parseSubscript(subs.back());
-    if (u.loose) *o += "[" + s.text + "]";
-    else if (u.cols > 0) *o += fmt::format("[{}_col + {}{}]", p, s.lead - u.base, s.rest);
-    else *o += fmt::format("[{}{}]", s.lead - u.base, s.rest);
+    *o += rebased(parseSubscript(subs.back()), u.loose, u.base, u.cols > 0 ? p + "_col + " : "");
     return true;
   }
 
   void pointer(const std::string& name, const std::vector<std::string>& subs, std::string* o) {
-    if (usedPointers_.count(name) == 0) usedPointers_[name] = pointers_.at(name);
     PointerUse& u = pointerUse_[name];
     const Subscript s = parseSubscript(subs.empty() ? std::string() : subs.back());
     if (!o) {
@@ -382,13 +382,11 @@ class Canonicalizer {
     }
     *o += name;
     for (std::size_t k = 0; k + 1 < subs.size(); ++k) *o += "[" + subs[k] + "]";
-    if (u.loose) *o += "[" + s.text + "]";
-    else *o += fmt::format("[{}{}]", s.lead - u.base, s.rest);
+    *o += rebased(s, u.loose, u.base);
   }
 
   const std::map<std::string, const Members::Member*>& members_;
   std::map<std::string, std::string> pointers_, scalars_;
-  std::map<std::string, std::string> usedPointers_;  // in name order: a deterministic signature
   std::map<std::string, PointerUse> pointerUse_;
   std::vector<std::string> usedScalars_;
   std::vector<MemberUse> memberUse_;
@@ -527,7 +525,6 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     const std::string tableParam = "const Scalar* PROXGEN_RT_RESTRICT k";
     if (nk > 0 && varying == 0)
       signature = signature.size() > tableParam.size() ? signature.substr(tableParam.size() + 2) : "";
-    k.bytes = long(body.size());
     std::string tables;
     std::set<std::string> bodies;
     std::string bodyList;

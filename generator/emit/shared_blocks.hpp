@@ -23,7 +23,6 @@ struct SharedKernel {
   std::string name;                  // shared_<k>
   std::vector<std::string> blocks;   // each block's comment line (its body), in order of the file
   std::vector<std::string> bodies;   // the bodies of those blocks, each once, in that order
-  long bytes = 0;                    // the kernel body's source characters
 };
 
 struct SharedParts {
