@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "emit/generate.hpp"
 #include "model/layout.hpp"
 
 namespace proxgen::test {
@@ -55,6 +56,18 @@ std::string syntheticTreeUrdf(int links, int branching, const std::string& pad) 
     xml += link(i);
   }
   return xml + pad + "</robot>\n";
+}
+
+emit::SolverFiles syntheticChainFiles(int links, const std::string& functions) {
+  const TempFile urdf("chain.urdf"), layout("fixed.yaml");
+  urdf.write(syntheticTreeUrdf(links, 1));
+  layout.write("base: fixed\n");
+  emit::GenerateOptions g;
+  g.urdf = urdf.path();
+  g.layout = layout.path();
+  g.name = "chain";
+  g.functions = functions;
+  return emit::generateFiles(g);
 }
 
 double relErr(const VecX& a, const VecX& b) {

@@ -80,6 +80,11 @@ std::string sourceDir();
 /// robots as tests/data/hostile/make_big_urdf.py writes to files.
 std::string syntheticTreeUrdf(int links, int branching, const std::string& pad = "");
 
+/// The generated files of syntheticTreeUrdf(links, 1) on a fixed base (a chain
+/// of links - 1 revolute joints), named "chain", holding `functions` (--functions;
+/// "" = the two solvers).
+emit::SolverFiles syntheticChainFiles(int links, const std::string& functions = "");
+
 // --- files and child processes (the tests that run the `proxgen` binary) -----
 
 /// The whole file as bytes ("" when it cannot be read).

@@ -4,37 +4,20 @@
 // whose parts used to compute it again each (docs/derivatives.md). The values
 // are the harness's business (tests/generated: harness_derivatives.cpp).
 #include <gtest/gtest.h>
-#include <fmt/format.h>
 
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <regex>
 #include <string>
 
-#include <unistd.h>
-
-#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
 namespace {
 
-namespace fs = std::filesystem;
-
 TEST(DerivativesCode, EachBodysMomentumIsStoredOnce) {
-  const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_derivatives_{}", getpid());
-  fs::create_directories(dir);
-  std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(8, 1);  // 7 revolute joints in a chain
-  std::ofstream(dir / "fixed.yaml") << "base: fixed\n";
-  GenerateOptions g;
-  g.urdf = (dir / "chain.urdf").string();
-  g.layout = (dir / "fixed.yaml").string();
-  g.name = "chain";
-  g.functions = "inverse_dynamics_derivatives";
-  // As the passes printed it (shared blocks would print a store once for several bodies).
-  const std::string source = generateFiles(g).unsharedSource;
-  fs::remove_all(dir);
+  // 7 revolute joints in a chain, the source as the passes printed it (shared
+  // blocks would print a store once for several bodies).
+  const std::string source = test::syntheticChainFiles(8, "inverse_dynamics_derivatives").unsharedSource;
   // Stores `w.Iv_<body>[r] = ...`, counted per (body, r).
   std::map<std::string, int> stores;
   const std::regex store(R"(w\.(Iv_\w+\[\d\]) = )");

@@ -6,45 +6,20 @@
 // which one the generated source uses, that every joint uses it, and where
 // the joint transforms go with each.
 #include <gtest/gtest.h>
-#include <fmt/format.h>
 
-#include <filesystem>
-#include <fstream>
 #include <string>
 
-#include <unistd.h>
-
 #include "emit/batch.hpp"
-#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
 namespace {
 
-namespace fs = std::filesystem;
-
-// The generated files for a fixed-base chain of `links` links (links - 1
-// revolute joints), holding `functions` (empty: the two solvers).
-SolverFiles chainFiles(int links, const std::string& functions = "") {
-  const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_kinematics_{}_{}", getpid(), links);
-  fs::create_directories(dir);
-  std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(links, 1);
-  std::ofstream(dir / "fixed.yaml") << "base: fixed\n";
-  GenerateOptions g;
-  g.urdf = (dir / "chain.urdf").string();
-  g.layout = (dir / "fixed.yaml").string();
-  g.name = "chain";
-  g.functions = functions;
-  SolverFiles files = generateFiles(g);
-  fs::remove_all(dir);
-  return files;
-}
-
 // The source as the passes printed it, before blocks equal up to their
 // constants become shared kernels (emit/shared_blocks.hpp), which would print
 // the one joint's statements once for all the joints it runs.
 std::string chainSource(int links, const std::string& functions = "") {
-  return chainFiles(links, functions).unsharedSource;
+  return test::syntheticChainFiles(links, functions).unsharedSource;
 }
 
 long count(const std::string& text, const std::string& what) {
@@ -60,7 +35,7 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_noinline(q["), 17);
   EXPECT_EQ(count(seventeen, "proxgen_rt::sincos("), 0);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
-  const std::string lanes = batchFiles(chainFiles(18), 4).source;
+  const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
   EXPECT_EQ(count(lanes, "sincos_noinline"), 0);
   EXPECT_EQ(count(lanes, "proxgen_rt::sincos(q["), 17);
 }

@@ -5,39 +5,18 @@
 // the harness's business (tests/generated: every solver holding mass_matrix
 // against the generic crba); this checks that the code stays O(n).
 #include <gtest/gtest.h>
-#include <fmt/format.h>
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
 #include <string>
 
-#include <unistd.h>
-
-#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
 namespace {
 
-namespace fs = std::filesystem;
-
 // The generated source of mass_matrix alone for a serial chain of n links on
 // a fixed base (depth n: the walk is n (n - 1) / 2 column steps).
-std::string massMatrixSource(int n) {
-  const fs::path dir = fs::temp_directory_path() / fmt::format("proxgen_emit_mass_matrix_{}_{}", getpid(), n);
-  fs::create_directories(dir);
-  std::ofstream(dir / "chain.urdf") << test::syntheticTreeUrdf(n + 1, 1);
-  std::ofstream(dir / "fixed.yaml") << "base: fixed\n";
-  GenerateOptions g;
-  g.urdf = (dir / "chain.urdf").string();
-  g.layout = (dir / "fixed.yaml").string();
-  g.name = "chain";
-  g.functions = "mass_matrix";
-  const std::string source = generateFiles(g).source;
-  fs::remove_all(dir);
-  return source;
-}
+std::string massMatrixSource(int n) { return test::syntheticChainFiles(n + 1, "mass_matrix").source; }
 
 long massMatrixLines(int n) {
   const std::string source = massMatrixSource(n);
