@@ -1,7 +1,7 @@
 R"proxgen({banner}
 #include "{name}.hpp"
 
-#include "proxgen/runtime.hpp"
+#include "proxgen/lanes.hpp"  // the runtime, and the lanes of sincos_run
 
 namespace {name} {{
 

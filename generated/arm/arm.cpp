@@ -12,7 +12,7 @@
 
 #include "arm.hpp"
 
-#include "proxgen/runtime.hpp"
+#include "proxgen/lanes.hpp"  // the runtime, and the lanes of sincos_run
 
 namespace arm {
 
@@ -30,27 +30,27 @@ using MultiplierRows = const Scalar*;
 PROXGEN_RT_NOINLINE void kinematics_transforms_shoulder_link_to_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    proxgen_rt::sincos(q[0], w.sq_shoulder_link, w.cq_shoulder_link);
+    proxgen_rt::sincos_joint(q[0], w.sq[0], w.cq[0]);
   }
   // body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    proxgen_rt::sincos(q[1], w.sq_upper_arm_link, w.cq_upper_arm_link);
+    proxgen_rt::sincos_joint(q[1], w.sq[1], w.cq[1]);
   }
   // body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    proxgen_rt::sincos(q[2], w.sq_forearm_link, w.cq_forearm_link);
+    proxgen_rt::sincos_joint(q[2], w.sq[2], w.cq[2]);
   }
   // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
-    proxgen_rt::sincos(q[3], w.sq_wrist_1_link, w.cq_wrist_1_link);
+    proxgen_rt::sincos_joint(q[3], w.sq[3], w.cq[3]);
   }
   // body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
-    proxgen_rt::sincos(q[4], w.sq_wrist_2_link, w.cq_wrist_2_link);
+    proxgen_rt::sincos_joint(q[4], w.sq[4], w.cq[4]);
   }
   // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
-    proxgen_rt::sincos(q[5], w.sq_wrist_3_link, w.cq_wrist_3_link);
+    proxgen_rt::sincos_joint(q[5], w.sq[5], w.cq[5]);
   }
 }
 
@@ -62,8 +62,8 @@ PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* 
   }
   // body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    w.v_upper_arm_link[3] = w.sq_upper_arm_link*v[0];
-    w.v_upper_arm_link[4] = w.cq_upper_arm_link*v[0];
+    w.v_upper_arm_link[3] = w.sq[1]*v[0];
+    w.v_upper_arm_link[4] = w.cq[1]*v[0];
     w.c_upper_arm_link[3] = v[1]*w.v_upper_arm_link[4];
     w.c_upper_arm_link[4] = -v[1]*w.v_upper_arm_link[3];
     const Scalar h0 = -1.7123249999999999*v[1] - 0.91345488*w.v_upper_arm_link[3];
@@ -75,16 +75,16 @@ PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* 
     w.pA_upper_arm_link[3] = -0.5945822771967999*v[1]*w.v_upper_arm_link[4] + w.v_upper_arm_link[4]*h2;
     w.pA_upper_arm_link[4] = v[1]*h1 - w.v_upper_arm_link[3]*h2;
     w.pA_upper_arm_link[5] = 0.5945822771967999*w.v_upper_arm_link[3]*w.v_upper_arm_link[4] - w.v_upper_arm_link[4]*h1;
-    w.g_upper_arm_link[0] = -9.81*w.sq_upper_arm_link;
-    w.g_upper_arm_link[1] = -9.81*w.cq_upper_arm_link;
+    w.g_upper_arm_link[0] = -9.81*w.sq[1];
+    w.g_upper_arm_link[1] = -9.81*w.cq[1];
   }
   // body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    w.v_forearm_link[0] = -0.425*w.sq_forearm_link*v[1];
-    w.v_forearm_link[1] = -0.425*w.cq_forearm_link*v[1];
+    w.v_forearm_link[0] = -0.425*w.sq[2]*v[1];
+    w.v_forearm_link[1] = -0.425*w.cq[2]*v[1];
     w.v_forearm_link[2] = 0.425*w.v_upper_arm_link[4];
-    w.v_forearm_link[3] = w.cq_forearm_link*w.v_upper_arm_link[3] + w.sq_forearm_link*w.v_upper_arm_link[4];
-    w.v_forearm_link[4] = -w.sq_forearm_link*w.v_upper_arm_link[3] + w.cq_forearm_link*w.v_upper_arm_link[4];
+    w.v_forearm_link[3] = w.cq[2]*w.v_upper_arm_link[3] + w.sq[2]*w.v_upper_arm_link[4];
+    w.v_forearm_link[4] = -w.sq[2]*w.v_upper_arm_link[3] + w.cq[2]*w.v_upper_arm_link[4];
     w.v_forearm_link[5] = v[1] + v[2];
     w.c_forearm_link[0] = v[2]*w.v_forearm_link[1];
     w.c_forearm_link[1] = -v[2]*w.v_forearm_link[0];
@@ -102,8 +102,8 @@ PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* 
     w.pA_forearm_link[3] = w.v_forearm_link[4]*h8 - w.v_forearm_link[5]*h7 + w.v_forearm_link[1]*h5 - w.v_forearm_link[2]*h4;
     w.pA_forearm_link[4] = w.v_forearm_link[5]*h6 - w.v_forearm_link[3]*h8 + w.v_forearm_link[2]*h3 - w.v_forearm_link[0]*h5;
     w.pA_forearm_link[5] = w.v_forearm_link[3]*h7 - w.v_forearm_link[4]*h6 + w.v_forearm_link[0]*h4 - w.v_forearm_link[1]*h3;
-    w.g_forearm_link[0] = w.cq_forearm_link*w.g_upper_arm_link[0] + w.sq_forearm_link*w.g_upper_arm_link[1];
-    w.g_forearm_link[1] = -w.sq_forearm_link*w.g_upper_arm_link[0] + w.cq_forearm_link*w.g_upper_arm_link[1];
+    w.g_forearm_link[0] = w.cq[2]*w.g_upper_arm_link[0] + w.sq[2]*w.g_upper_arm_link[1];
+    w.g_forearm_link[1] = -w.sq[2]*w.g_upper_arm_link[0] + w.cq[2]*w.g_upper_arm_link[1];
   }
 }
 
@@ -112,11 +112,11 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* P
   {
     const Scalar t0 = w.v_forearm_link[1] - 0.3922*w.v_forearm_link[5];
     const Scalar t1 = w.v_forearm_link[2] + 0.3922*w.v_forearm_link[4];
-    w.v_wrist_1_link[0] = w.v_forearm_link[0]*w.cq_wrist_1_link + w.sq_wrist_1_link*t0;
-    w.v_wrist_1_link[1] = -w.v_forearm_link[0]*w.sq_wrist_1_link + w.cq_wrist_1_link*t0;
+    w.v_wrist_1_link[0] = w.v_forearm_link[0]*w.cq[3] + w.sq[3]*t0;
+    w.v_wrist_1_link[1] = -w.v_forearm_link[0]*w.sq[3] + w.cq[3]*t0;
     w.v_wrist_1_link[2] = t1;
-    w.v_wrist_1_link[3] = w.v_forearm_link[3]*w.cq_wrist_1_link + w.v_forearm_link[4]*w.sq_wrist_1_link;
-    w.v_wrist_1_link[4] = -w.v_forearm_link[3]*w.sq_wrist_1_link + w.v_forearm_link[4]*w.cq_wrist_1_link;
+    w.v_wrist_1_link[3] = w.v_forearm_link[3]*w.cq[3] + w.v_forearm_link[4]*w.sq[3];
+    w.v_wrist_1_link[4] = -w.v_forearm_link[3]*w.sq[3] + w.v_forearm_link[4]*w.cq[3];
     w.v_wrist_1_link[5] = w.v_forearm_link[5] + v[3];
     w.c_wrist_1_link[0] = v[3]*w.v_wrist_1_link[1];
     w.c_wrist_1_link[1] = -v[3]*w.v_wrist_1_link[0];
@@ -134,18 +134,18 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* P
     w.pA_wrist_1_link[3] = w.v_wrist_1_link[4]*h5 - w.v_wrist_1_link[5]*h4 + w.v_wrist_1_link[1]*h2 - w.v_wrist_1_link[2]*h1;
     w.pA_wrist_1_link[4] = w.v_wrist_1_link[5]*h3 - w.v_wrist_1_link[3]*h5 + w.v_wrist_1_link[2]*h0 - w.v_wrist_1_link[0]*h2;
     w.pA_wrist_1_link[5] = w.v_wrist_1_link[3]*h4 - w.v_wrist_1_link[4]*h3 + w.v_wrist_1_link[0]*h1 - w.v_wrist_1_link[1]*h0;
-    w.g_wrist_1_link[0] = w.g_forearm_link[0]*w.cq_wrist_1_link + w.g_forearm_link[1]*w.sq_wrist_1_link;
-    w.g_wrist_1_link[1] = -w.g_forearm_link[0]*w.sq_wrist_1_link + w.g_forearm_link[1]*w.cq_wrist_1_link;
+    w.g_wrist_1_link[0] = w.g_forearm_link[0]*w.cq[3] + w.g_forearm_link[1]*w.sq[3];
+    w.g_wrist_1_link[1] = -w.g_forearm_link[0]*w.sq[3] + w.g_forearm_link[1]*w.cq[3];
   }
   // body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
     const Scalar t2 = w.v_wrist_1_link[0] + 0.1333*w.v_wrist_1_link[4];
     const Scalar t3 = -w.v_wrist_1_link[1] + 0.1333*w.v_wrist_1_link[3];
-    w.v_wrist_2_link[0] = w.cq_wrist_2_link*t2 + w.sq_wrist_2_link*w.v_wrist_1_link[2];
-    w.v_wrist_2_link[1] = -w.sq_wrist_2_link*t2 + w.cq_wrist_2_link*w.v_wrist_1_link[2];
+    w.v_wrist_2_link[0] = w.cq[4]*t2 + w.sq[4]*w.v_wrist_1_link[2];
+    w.v_wrist_2_link[1] = -w.sq[4]*t2 + w.cq[4]*w.v_wrist_1_link[2];
     w.v_wrist_2_link[2] = t3;
-    w.v_wrist_2_link[3] = w.cq_wrist_2_link*w.v_wrist_1_link[3] + w.sq_wrist_2_link*w.v_wrist_1_link[5];
-    w.v_wrist_2_link[4] = -w.sq_wrist_2_link*w.v_wrist_1_link[3] + w.cq_wrist_2_link*w.v_wrist_1_link[5];
+    w.v_wrist_2_link[3] = w.cq[4]*w.v_wrist_1_link[3] + w.sq[4]*w.v_wrist_1_link[5];
+    w.v_wrist_2_link[4] = -w.sq[4]*w.v_wrist_1_link[3] + w.cq[4]*w.v_wrist_1_link[5];
     w.v_wrist_2_link[5] = -w.v_wrist_1_link[4] + v[4];
     w.c_wrist_2_link[0] = v[4]*w.v_wrist_2_link[1];
     w.c_wrist_2_link[1] = -v[4]*w.v_wrist_2_link[0];
@@ -163,8 +163,8 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* P
     w.pA_wrist_2_link[3] = w.v_wrist_2_link[4]*h11 - w.v_wrist_2_link[5]*h10 + w.v_wrist_2_link[1]*h8 - w.v_wrist_2_link[2]*h7;
     w.pA_wrist_2_link[4] = w.v_wrist_2_link[5]*h9 - w.v_wrist_2_link[3]*h11 + w.v_wrist_2_link[2]*h6 - w.v_wrist_2_link[0]*h8;
     w.pA_wrist_2_link[5] = w.v_wrist_2_link[3]*h10 - w.v_wrist_2_link[4]*h9 + w.v_wrist_2_link[0]*h7 - w.v_wrist_2_link[1]*h6;
-    w.g_wrist_2_link[0] = w.cq_wrist_2_link*w.g_wrist_1_link[0];
-    w.g_wrist_2_link[1] = -w.sq_wrist_2_link*w.g_wrist_1_link[0];
+    w.g_wrist_2_link[0] = w.cq[4]*w.g_wrist_1_link[0];
+    w.g_wrist_2_link[1] = -w.sq[4]*w.g_wrist_1_link[0];
   }
 }
 
@@ -173,11 +173,11 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRI
   {
     const Scalar t0 = w.v_wrist_2_link[0] + 0.0997*w.v_wrist_2_link[4];
     const Scalar t1 = w.v_wrist_2_link[1] - 0.0997*w.v_wrist_2_link[3];
-    w.v_wrist_3_link[0] = w.cq_wrist_3_link*t0 - w.v_wrist_2_link[2]*w.sq_wrist_3_link;
-    w.v_wrist_3_link[1] = -w.sq_wrist_3_link*t0 - w.v_wrist_2_link[2]*w.cq_wrist_3_link;
+    w.v_wrist_3_link[0] = w.cq[5]*t0 - w.v_wrist_2_link[2]*w.sq[5];
+    w.v_wrist_3_link[1] = -w.sq[5]*t0 - w.v_wrist_2_link[2]*w.cq[5];
     w.v_wrist_3_link[2] = t1;
-    w.v_wrist_3_link[3] = w.v_wrist_2_link[3]*w.cq_wrist_3_link - w.v_wrist_2_link[5]*w.sq_wrist_3_link;
-    w.v_wrist_3_link[4] = -w.v_wrist_2_link[3]*w.sq_wrist_3_link - w.v_wrist_2_link[5]*w.cq_wrist_3_link;
+    w.v_wrist_3_link[3] = w.v_wrist_2_link[3]*w.cq[5] - w.v_wrist_2_link[5]*w.sq[5];
+    w.v_wrist_3_link[4] = -w.v_wrist_2_link[3]*w.sq[5] - w.v_wrist_2_link[5]*w.cq[5];
     w.v_wrist_3_link[5] = w.v_wrist_2_link[4] + v[5];
     w.c_wrist_3_link[0] = v[5]*w.v_wrist_3_link[1];
     w.c_wrist_3_link[1] = -v[5]*w.v_wrist_3_link[0];
@@ -193,8 +193,8 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRI
     w.pA_wrist_3_link[3] = 0.0003695625*w.v_wrist_3_link[4]*w.v_wrist_3_link[5] - w.v_wrist_3_link[5]*h3 + 0.365*w.v_wrist_3_link[1]*w.v_wrist_3_link[2] - w.v_wrist_3_link[2]*h1;
     w.pA_wrist_3_link[4] = w.v_wrist_3_link[5]*h2 - 0.0003695625*w.v_wrist_3_link[3]*w.v_wrist_3_link[5] + w.v_wrist_3_link[2]*h0 - 0.365*w.v_wrist_3_link[0]*w.v_wrist_3_link[2];
     w.pA_wrist_3_link[5] = w.v_wrist_3_link[3]*h3 - w.v_wrist_3_link[4]*h2 + w.v_wrist_3_link[0]*h1 - w.v_wrist_3_link[1]*h0;
-    w.g_wrist_3_link[0] = w.g_wrist_2_link[0]*w.cq_wrist_3_link + w.g_wrist_1_link[1]*w.sq_wrist_3_link;
-    w.g_wrist_3_link[1] = -w.g_wrist_2_link[0]*w.sq_wrist_3_link + w.g_wrist_1_link[1]*w.cq_wrist_3_link;
+    w.g_wrist_3_link[0] = w.g_wrist_2_link[0]*w.cq[5] + w.g_wrist_1_link[1]*w.sq[5];
+    w.g_wrist_3_link[1] = -w.g_wrist_2_link[0]*w.sq[5] + w.g_wrist_1_link[1]*w.cq[5];
     // constraint 'tool' (6d) on link 'tool0': rows 0..5
   }
 }
@@ -215,13 +215,13 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_wrist_3_link[2] + w.lambda[2] + w.g_wrist_2_link[1]*mu_c0;
     const Scalar pa3 = w.pA_wrist_3_link[3] - 0.0996*w.lambda[1] + w.lambda[3] - 0.0996*w.g_wrist_3_link[1]*mu_c0 + w.c_wrist_3_link[1]*Ia2 + w.c_wrist_3_link[3]*Ia3;
     const Scalar pa4 = w.pA_wrist_3_link[4] + 0.0996*w.lambda[0] + w.lambda[4] + 0.0996*w.g_wrist_3_link[0]*mu_c0 + w.c_wrist_3_link[0]*Ia1 + w.c_wrist_3_link[4]*Ia3;
-    const Scalar C20 = w.cq_wrist_3_link*w.cq_wrist_3_link - w.sq_wrist_3_link*w.sq_wrist_3_link;
+    const Scalar C20 = w.cq[5]*w.cq[5] - w.sq[5]*w.sq[5];
     const Scalar t0 = 0.5*(Ia1 + Ia2);
-    const Scalar t1 = 2.0*w.cq_wrist_3_link*w.sq_wrist_3_link;
+    const Scalar t1 = 2.0*w.cq[5]*w.sq[5];
     const Scalar t2 = -0.5*Ia1 + 0.5*Ia2 - C20*t0;
     const Scalar t3 = 0.5*Ia1 - 0.5*Ia2 - C20*t0;
-    const Scalar t4 = w.cq_wrist_3_link*pa0 - w.sq_wrist_3_link*pa1;
-    const Scalar t5 = -w.sq_wrist_3_link*pa0 - w.cq_wrist_3_link*pa1;
+    const Scalar t4 = w.cq[5]*pa0 - w.sq[5]*pa1;
+    const Scalar t5 = -w.sq[5]*pa0 - w.cq[5]*pa1;
     w.IA_wrist_2_link[0] = 1.3 + Ia0;
     w.IA_wrist_2_link[3] = -t0*t1;
     w.IA_wrist_2_link[4] = 0.12727 + 0.0997*Ia0;
@@ -239,9 +239,9 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_3_link(const Scalar* PROXGEN_RT_RES
     w.pA_wrist_2_link[0] = w.pA_wrist_2_link[0] + t4;
     w.pA_wrist_2_link[1] = w.pA_wrist_2_link[1] + pa2;
     w.pA_wrist_2_link[2] = w.pA_wrist_2_link[2] + t5;
-    w.pA_wrist_2_link[3] = w.pA_wrist_2_link[3] - 0.0997*pa2 + w.cq_wrist_3_link*pa3 - w.sq_wrist_3_link*pa4;
+    w.pA_wrist_2_link[3] = w.pA_wrist_2_link[3] - 0.0997*pa2 + w.cq[5]*pa3 - w.sq[5]*pa4;
     w.pA_wrist_2_link[4] = w.pA_wrist_2_link[4] + tau[5] + 0.0997*t4;
-    w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq_wrist_3_link*pa3 - w.cq_wrist_3_link*pa4;
+    w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq[5]*pa3 - w.cq[5]*pa4;
   }
 }
 
@@ -264,10 +264,10 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_2_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_wrist_2_link[2] + w.u_wrist_2_link[0]*t1 + w.c_wrist_2_link[0]*t3 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[12] + w.c_wrist_2_link[4]*t4;
     const Scalar pa3 = w.pA_wrist_2_link[3] + w.c_wrist_2_link[0]*w.IA_wrist_2_link[3] + w.c_wrist_2_link[1]*w.IA_wrist_2_link[8] + w.c_wrist_2_link[3]*w.IA_wrist_2_link[15] + w.c_wrist_2_link[4]*w.IA_wrist_2_link[16];
     const Scalar pa4 = w.pA_wrist_2_link[4] + w.u_wrist_2_link[0]*t2 + w.c_wrist_2_link[0]*Ia1 + w.c_wrist_2_link[3]*w.IA_wrist_2_link[16] + w.c_wrist_2_link[4]*Ia3;
-    const Scalar C20 = w.cq_wrist_2_link*w.cq_wrist_2_link - w.sq_wrist_2_link*w.sq_wrist_2_link;
+    const Scalar C20 = w.cq[4]*w.cq[4] - w.sq[4]*w.sq[4];
     const Scalar h0 = 0.5*(-w.IA_wrist_2_link[6] + Ia0);
     const Scalar m0 = 0.5*(w.IA_wrist_2_link[6] + Ia0);
-    const Scalar t5 = 2.0*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    const Scalar t5 = 2.0*w.cq[4]*w.sq[4];
     const Scalar t6 = 0.5*(w.IA_wrist_2_link[8] + Ia1);
     const Scalar d0 = 0.5*w.IA_wrist_2_link[3]*C20 - t5*t6;
     const Scalar qq0 = 0.5*w.IA_wrist_2_link[3]*t5 + C20*t6;
@@ -279,32 +279,32 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_2_link(const Scalar* PROXGEN_RT_RES
     const Scalar t8 = m0 - C20*h0;
     const Scalar t9 = 0.5*w.IA_wrist_2_link[3] + d0;
     const Scalar t10 = -0.5*w.IA_wrist_2_link[8] + 0.5*Ia1 + qq0;
-    const Scalar t11 = -w.cq_wrist_2_link*w.IA_wrist_2_link[12] + w.sq_wrist_2_link*t4;
-    const Scalar t12 = -w.sq_wrist_2_link*w.IA_wrist_2_link[12] - w.cq_wrist_2_link*t4;
+    const Scalar t11 = -w.cq[4]*w.IA_wrist_2_link[12] + w.sq[4]*t4;
+    const Scalar t12 = -w.sq[4]*w.IA_wrist_2_link[12] - w.cq[4]*t4;
     const Scalar t13 = 0.5*w.IA_wrist_2_link[8] - 0.5*Ia1 + qq0;
     const Scalar t14 = 0.5*w.IA_wrist_2_link[3] - d0;
-    const Scalar t15 = 0.1333*w.cq_wrist_2_link*t3 + t9;
+    const Scalar t15 = 0.1333*w.cq[4]*t3 + t9;
     const Scalar t16 = -0.1333*Ia2 + t11;
-    const Scalar t17 = 0.1333*w.sq_wrist_2_link*t3 + t13;
-    const Scalar t18 = w.cq_wrist_2_link*pa0 - w.sq_wrist_2_link*pa1;
-    const Scalar t19 = w.sq_wrist_2_link*pa0 + w.cq_wrist_2_link*pa1;
+    const Scalar t17 = 0.1333*w.sq[4]*t3 + t13;
+    const Scalar t18 = w.cq[4]*pa0 - w.sq[4]*pa1;
+    const Scalar t19 = w.sq[4]*pa0 + w.cq[4]*pa1;
     w.IA_wrist_1_link[0] = 1.37 + t7;
-    w.IA_wrist_1_link[1] = -w.cq_wrist_2_link*t3;
+    w.IA_wrist_1_link[1] = -w.cq[4]*t3;
     w.IA_wrist_1_link[2] = h0*t5;
     w.IA_wrist_1_link[3] = t15;
     w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t7;
     w.IA_wrist_1_link[5] = 0.0223858 + t10;
     w.IA_wrist_1_link[6] = 1.37 + Ia2;
-    w.IA_wrist_1_link[7] = -w.sq_wrist_2_link*t3;
+    w.IA_wrist_1_link[7] = -w.sq[4]*t3;
     w.IA_wrist_1_link[8] = -0.180155 + t16;
-    w.IA_wrist_1_link[9] = -0.1333*w.cq_wrist_2_link*t3;
+    w.IA_wrist_1_link[9] = -0.1333*w.cq[4]*t3;
     w.IA_wrist_1_link[10] = t12;
     w.IA_wrist_1_link[11] = 1.37 + t8;
     w.IA_wrist_1_link[12] = -0.0223858 + t17;
     w.IA_wrist_1_link[13] = 0.1333*h0*t5;
     w.IA_wrist_1_link[14] = t14;
     w.IA_wrist_1_link[15] = 0.026393728972000003 + m1 + d1 - 0.1333*t11 - 0.1333*t16;
-    w.IA_wrist_1_link[16] = 0.01776889*w.cq_wrist_2_link*t3 + 0.1333*t9;
+    w.IA_wrist_1_link[16] = 0.01776889*w.cq[4]*t3 + 0.1333*t9;
     w.IA_wrist_1_link[17] = qq1 - 0.1333*t12;
     w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t7;
     w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t10;
@@ -312,9 +312,9 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_2_link(const Scalar* PROXGEN_RT_RES
     w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t18;
     w.pA_wrist_1_link[1] = w.pA_wrist_1_link[1] - pa2;
     w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t19;
-    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa2 + w.cq_wrist_2_link*pa3 - w.sq_wrist_2_link*pa4;
+    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa2 + w.cq[4]*pa3 - w.sq[4]*pa4;
     w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - tau[4] + 0.1333*t18;
-    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa3 + w.cq_wrist_2_link*pa4;
+    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq[4]*pa3 + w.cq[4]*pa4;
   }
 }
 
@@ -348,10 +348,10 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_1_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_wrist_1_link[2] + w.u_wrist_1_link[0]*t2 + w.c_wrist_1_link[0]*Ia2 + w.c_wrist_1_link[1]*Ia6 + w.c_wrist_1_link[3]*Ia10 + w.c_wrist_1_link[4]*Ia11;
     const Scalar pa3 = w.pA_wrist_1_link[3] + w.u_wrist_1_link[0]*t3 + w.c_wrist_1_link[0]*Ia3 + w.c_wrist_1_link[1]*Ia7 + w.c_wrist_1_link[3]*Ia12 + w.c_wrist_1_link[4]*Ia13;
     const Scalar pa4 = w.pA_wrist_1_link[4] + w.u_wrist_1_link[0]*t4 + w.c_wrist_1_link[0]*Ia4 + w.c_wrist_1_link[1]*Ia8 + w.c_wrist_1_link[3]*Ia13 + w.c_wrist_1_link[4]*Ia14;
-    const Scalar C20 = w.cq_wrist_1_link*w.cq_wrist_1_link - w.sq_wrist_1_link*w.sq_wrist_1_link;
+    const Scalar C20 = w.cq[3]*w.cq[3] - w.sq[3]*w.sq[3];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_wrist_1_link*w.sq_wrist_1_link;
+    const Scalar t5 = 2.0*w.cq[3]*w.sq[3];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -364,20 +364,20 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_1_link(const Scalar* PROXGEN_RT_RES
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = w.cq_wrist_1_link*Ia2 - w.sq_wrist_1_link*Ia6;
+    const Scalar t8 = w.cq[3]*Ia2 - w.sq[3]*Ia6;
     const Scalar t9 = m0 - d0;
-    const Scalar t10 = w.sq_wrist_1_link*Ia2 + w.cq_wrist_1_link*Ia6;
+    const Scalar t10 = w.sq[3]*Ia2 + w.cq[3]*Ia6;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
     const Scalar t13 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t14 = m1 - d1;
-    const Scalar t15 = w.cq_wrist_1_link*Ia10 - w.sq_wrist_1_link*Ia11;
-    const Scalar t16 = w.sq_wrist_1_link*Ia10 + w.cq_wrist_1_link*Ia11;
+    const Scalar t15 = w.cq[3]*Ia10 - w.sq[3]*Ia11;
+    const Scalar t16 = w.sq[3]*Ia10 + w.cq[3]*Ia11;
     const Scalar t17 = 0.3922*t8 + t12;
     const Scalar t18 = 0.3922*t10 + t14;
     const Scalar t19 = 0.3922*Ia9 + t16;
-    const Scalar t20 = w.cq_wrist_1_link*pa0 - w.sq_wrist_1_link*pa1;
-    const Scalar t21 = w.sq_wrist_1_link*pa0 + w.cq_wrist_1_link*pa1;
+    const Scalar t20 = w.cq[3]*pa0 - w.sq[3]*pa1;
+    const Scalar t21 = w.sq[3]*pa0 + w.cq[3]*pa1;
     w.IA_forearm_link[0] = 2.846 + t7;
     w.IA_forearm_link[1] = qq0;
     w.IA_forearm_link[2] = t8;
@@ -402,8 +402,8 @@ PROXGEN_RT_NOINLINE void caba_backward_wrist_1_link(const Scalar* PROXGEN_RT_RES
     w.pA_forearm_link[0] = w.pA_forearm_link[0] + t20;
     w.pA_forearm_link[1] = w.pA_forearm_link[1] + t21;
     w.pA_forearm_link[2] = w.pA_forearm_link[2] + pa2;
-    w.pA_forearm_link[3] = w.pA_forearm_link[3] + w.cq_wrist_1_link*pa3 - w.sq_wrist_1_link*pa4;
-    w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq_wrist_1_link*pa3 + w.cq_wrist_1_link*pa4;
+    w.pA_forearm_link[3] = w.pA_forearm_link[3] + w.cq[3]*pa3 - w.sq[3]*pa4;
+    w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq[3]*pa3 + w.cq[3]*pa4;
     w.pA_forearm_link[5] = w.pA_forearm_link[5] + tau[3] - 0.3922*t21;
   }
 }
@@ -438,10 +438,10 @@ PROXGEN_RT_NOINLINE void caba_backward_forearm_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_forearm_link[2] + w.u_forearm_link[0]*t2 + w.c_forearm_link[0]*Ia2 + w.c_forearm_link[1]*Ia6 + w.c_forearm_link[3]*Ia10 + w.c_forearm_link[4]*Ia11;
     const Scalar pa3 = w.pA_forearm_link[3] + w.u_forearm_link[0]*t3 + w.c_forearm_link[0]*Ia3 + w.c_forearm_link[1]*Ia7 + w.c_forearm_link[3]*Ia12 + w.c_forearm_link[4]*Ia13;
     const Scalar pa4 = w.pA_forearm_link[4] + w.u_forearm_link[0]*t4 + w.c_forearm_link[0]*Ia4 + w.c_forearm_link[1]*Ia8 + w.c_forearm_link[3]*Ia13 + w.c_forearm_link[4]*Ia14;
-    const Scalar C20 = w.cq_forearm_link*w.cq_forearm_link - w.sq_forearm_link*w.sq_forearm_link;
+    const Scalar C20 = w.cq[2]*w.cq[2] - w.sq[2]*w.sq[2];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_forearm_link*w.sq_forearm_link;
+    const Scalar t5 = 2.0*w.cq[2]*w.sq[2];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -454,20 +454,20 @@ PROXGEN_RT_NOINLINE void caba_backward_forearm_link(const Scalar* PROXGEN_RT_RES
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = w.cq_forearm_link*Ia2 - w.sq_forearm_link*Ia6;
+    const Scalar t8 = w.cq[2]*Ia2 - w.sq[2]*Ia6;
     const Scalar t9 = m0 - d0;
-    const Scalar t10 = w.sq_forearm_link*Ia2 + w.cq_forearm_link*Ia6;
+    const Scalar t10 = w.sq[2]*Ia2 + w.cq[2]*Ia6;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
     const Scalar t13 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t14 = m1 - d1;
-    const Scalar t15 = w.cq_forearm_link*Ia10 - w.sq_forearm_link*Ia11;
-    const Scalar t16 = w.sq_forearm_link*Ia10 + w.cq_forearm_link*Ia11;
+    const Scalar t15 = w.cq[2]*Ia10 - w.sq[2]*Ia11;
+    const Scalar t16 = w.sq[2]*Ia10 + w.cq[2]*Ia11;
     const Scalar t17 = 0.425*t8 + t12;
     const Scalar t18 = 0.425*t10 + t14;
     const Scalar t19 = 0.425*Ia9 + t16;
-    const Scalar t20 = w.cq_forearm_link*pa0 - w.sq_forearm_link*pa1;
-    const Scalar t21 = w.sq_forearm_link*pa0 + w.cq_forearm_link*pa1;
+    const Scalar t20 = w.cq[2]*pa0 - w.sq[2]*pa1;
+    const Scalar t21 = w.sq[2]*pa0 + w.cq[2]*pa1;
     w.IA_upper_arm_link[0] = 8.058 + t7;
     w.IA_upper_arm_link[1] = qq0;
     w.IA_upper_arm_link[2] = t8;
@@ -492,8 +492,8 @@ PROXGEN_RT_NOINLINE void caba_backward_forearm_link(const Scalar* PROXGEN_RT_RES
     w.pA_upper_arm_link[0] = w.pA_upper_arm_link[0] + t20;
     w.pA_upper_arm_link[1] = w.pA_upper_arm_link[1] + t21;
     w.pA_upper_arm_link[2] = w.pA_upper_arm_link[2] + pa2;
-    w.pA_upper_arm_link[3] = w.pA_upper_arm_link[3] + w.cq_forearm_link*pa3 - w.sq_forearm_link*pa4;
-    w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq_forearm_link*pa3 + w.cq_forearm_link*pa4;
+    w.pA_upper_arm_link[3] = w.pA_upper_arm_link[3] + w.cq[2]*pa3 - w.sq[2]*pa4;
+    w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq[2]*pa3 + w.cq[2]*pa4;
     w.pA_upper_arm_link[5] = w.pA_upper_arm_link[5] + tau[2] - 0.425*t21;
   }
 }
@@ -528,10 +528,10 @@ PROXGEN_RT_NOINLINE void caba_backward_upper_arm_link(const Scalar* PROXGEN_RT_R
     const Scalar pa2 = w.pA_upper_arm_link[2] + w.u_upper_arm_link[0]*t2 + w.c_upper_arm_link[3]*Ia10 + w.c_upper_arm_link[4]*Ia11;
     const Scalar pa3 = w.pA_upper_arm_link[3] + w.u_upper_arm_link[0]*t3 + w.c_upper_arm_link[3]*Ia12 + w.c_upper_arm_link[4]*Ia13;
     const Scalar pa4 = w.pA_upper_arm_link[4] + w.u_upper_arm_link[0]*t4 + w.c_upper_arm_link[3]*Ia13 + w.c_upper_arm_link[4]*Ia14;
-    const Scalar C20 = w.cq_upper_arm_link*w.cq_upper_arm_link - w.sq_upper_arm_link*w.sq_upper_arm_link;
+    const Scalar C20 = w.cq[1]*w.cq[1] - w.sq[1]*w.sq[1];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_upper_arm_link*w.sq_upper_arm_link;
+    const Scalar t5 = 2.0*w.cq[1]*w.sq[1];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -544,20 +544,20 @@ PROXGEN_RT_NOINLINE void caba_backward_upper_arm_link(const Scalar* PROXGEN_RT_R
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = -w.cq_upper_arm_link*Ia2 + w.sq_upper_arm_link*Ia6;
-    const Scalar t9 = -w.sq_upper_arm_link*Ia2 - w.cq_upper_arm_link*Ia6;
+    const Scalar t8 = -w.cq[1]*Ia2 + w.sq[1]*Ia6;
+    const Scalar t9 = -w.sq[1]*Ia2 - w.cq[1]*Ia6;
     const Scalar t10 = m0 - d0;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
-    const Scalar t13 = -w.cq_upper_arm_link*Ia10 + w.sq_upper_arm_link*Ia11;
-    const Scalar t14 = -w.sq_upper_arm_link*Ia10 - w.cq_upper_arm_link*Ia11;
+    const Scalar t13 = -w.cq[1]*Ia10 + w.sq[1]*Ia11;
+    const Scalar t14 = -w.sq[1]*Ia10 - w.cq[1]*Ia11;
     const Scalar t15 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t16 = m1 - d1;
     const Scalar t17 = -0.1625*t8 + t11;
     const Scalar t18 = -0.1625*Ia9 + t13;
     const Scalar t19 = -0.1625*t9 + t15;
-    const Scalar t20 = w.cq_upper_arm_link*pa0 - w.sq_upper_arm_link*pa1;
-    const Scalar t21 = w.sq_upper_arm_link*pa0 + w.cq_upper_arm_link*pa1;
+    const Scalar t20 = w.cq[1]*pa0 - w.sq[1]*pa1;
+    const Scalar t21 = w.sq[1]*pa0 + w.cq[1]*pa1;
     w.IA_shoulder_link[0] = 3.761 + t7;
     w.IA_shoulder_link[1] = t8;
     w.IA_shoulder_link[2] = qq0;
@@ -582,9 +582,9 @@ PROXGEN_RT_NOINLINE void caba_backward_upper_arm_link(const Scalar* PROXGEN_RT_R
     w.pA_shoulder_link[0] = t20;
     w.pA_shoulder_link[1] = w.pA_shoulder_link[1] - pa2;
     w.pA_shoulder_link[2] = t21;
-    w.pA_shoulder_link[3] = w.pA_shoulder_link[3] + 0.1625*pa2 + w.cq_upper_arm_link*pa3 - w.sq_upper_arm_link*pa4;
+    w.pA_shoulder_link[3] = w.pA_shoulder_link[3] + 0.1625*pa2 + w.cq[1]*pa3 - w.sq[1]*pa4;
     w.pA_shoulder_link[4] = -tau[1] + 0.1625*t20;
-    w.pA_shoulder_link[5] = w.sq_upper_arm_link*pa3 + w.cq_upper_arm_link*pa4;
+    w.pA_shoulder_link[5] = w.sq[1]*pa3 + w.cq[1]*pa4;
   }
 }
 
@@ -605,12 +605,12 @@ PROXGEN_RT_NOINLINE void caba_forward_shoulder_link_to_wrist_2_link(Workspace& P
   }
   // accelerate body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    const Scalar t1 = w.c_upper_arm_link[3] + w.sq[1]*w.a_shoulder_link[5];
+    const Scalar t2 = w.c_upper_arm_link[4] + w.cq[1]*w.a_shoulder_link[5];
+    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq[1]*w.IA_upper_arm_link[5] - 9.81*w.cq[1]*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
-    w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
-    w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
+    w.a_upper_arm_link[0] = 9.81*w.sq[1];
+    w.a_upper_arm_link[1] = 9.81*w.cq[1];
     w.a_upper_arm_link[3] = t1;
     w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
@@ -618,10 +618,10 @@ PROXGEN_RT_NOINLINE void caba_forward_shoulder_link_to_wrist_2_link(Workspace& P
   // accelerate body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     const Scalar t4 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
-    const Scalar t5 = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
-    const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t5 = w.c_forearm_link[0] + w.cq[2]*w.a_upper_arm_link[0] + w.sq[2]*t4;
+    const Scalar t6 = w.c_forearm_link[1] - w.sq[2]*w.a_upper_arm_link[0] + w.cq[2]*t4;
+    const Scalar t7 = w.c_forearm_link[3] + w.cq[2]*w.a_upper_arm_link[3] + w.sq[2]*w.a_upper_arm_link[4];
+    const Scalar t8 = w.c_forearm_link[4] - w.sq[2]*w.a_upper_arm_link[3] + w.cq[2]*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
     w.a_forearm_link[0] = t5;
@@ -635,10 +635,10 @@ PROXGEN_RT_NOINLINE void caba_forward_shoulder_link_to_wrist_2_link(Workspace& P
   {
     const Scalar t10 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
     const Scalar t11 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
-    const Scalar t12 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
-    const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t12 = w.c_wrist_1_link[0] + w.cq[3]*w.a_forearm_link[0] + w.sq[3]*t10;
+    const Scalar t13 = w.c_wrist_1_link[1] - w.sq[3]*w.a_forearm_link[0] + w.cq[3]*t10;
+    const Scalar t14 = w.c_wrist_1_link[3] + w.cq[3]*w.a_forearm_link[3] + w.sq[3]*w.a_forearm_link[4];
+    const Scalar t15 = w.c_wrist_1_link[4] - w.sq[3]*w.a_forearm_link[3] + w.cq[3]*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
     w.a_wrist_1_link[0] = t12;
@@ -652,10 +652,10 @@ PROXGEN_RT_NOINLINE void caba_forward_shoulder_link_to_wrist_2_link(Workspace& P
   {
     const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq[4]*t17 + w.sq[4]*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq[4]*t17 + w.cq[4]*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq[4]*w.a_wrist_1_link[3] + w.sq[4]*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq[4]*w.a_wrist_1_link[3] + w.cq[4]*w.a_wrist_1_link[5];
     const Scalar t23 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t19 - w.IA_wrist_2_link[14]*t18 - w.IA_wrist_2_link[19]*t22 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
     w.qdd[4] = w.Dinv_wrist_2_link*t23;
     w.a_wrist_2_link[0] = t19;
@@ -672,10 +672,10 @@ PROXGEN_RT_NOINLINE void caba_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRIC
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
     const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
-    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
-    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
-    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq[5]*t0 - w.a_wrist_2_link[2]*w.sq[5];
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq[5]*t0 - w.a_wrist_2_link[2]*w.cq[5];
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq[5] - w.a_wrist_2_link[5]*w.sq[5];
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq[5] - w.a_wrist_2_link[5]*w.cq[5];
     const Scalar t6 = w.u_wrist_3_link[0] - w.a_wrist_2_link[4]*w.U_wrist_3_link[5];
     w.qdd[5] = w.Dinv_wrist_3_link*t6;
     w.a_wrist_3_link[0] = t2;
@@ -720,14 +720,14 @@ PROXGEN_RT_NOINLINE void caba_reduced_wrist_3_link_to_wrist_1_link(Workspace& PR
     w.u_wrist_3_link[0] = w.u_wrist_3_link[0] - w.dlambda[5];
     const Scalar t1 = -0.0996*w.dlambda[1] + w.dlambda[3];
     const Scalar t2 = 0.0996*w.dlambda[0] + w.dlambda[4];
-    const Scalar t3 = w.cq_wrist_3_link*w.dlambda[0] - w.sq_wrist_3_link*w.dlambda[1];
-    const Scalar t4 = -w.sq_wrist_3_link*w.dlambda[0] - w.cq_wrist_3_link*w.dlambda[1];
+    const Scalar t3 = w.cq[5]*w.dlambda[0] - w.sq[5]*w.dlambda[1];
+    const Scalar t4 = -w.sq[5]*w.dlambda[0] - w.cq[5]*w.dlambda[1];
     w.dp_wrist_2_link[0] = t3;
     w.dp_wrist_2_link[1] = w.dlambda[2];
     w.dp_wrist_2_link[2] = t4;
-    w.dp_wrist_2_link[3] = -0.0997*w.dlambda[2] + w.cq_wrist_3_link*t1 - w.sq_wrist_3_link*t2;
+    w.dp_wrist_2_link[3] = -0.0997*w.dlambda[2] + w.cq[5]*t1 - w.sq[5]*t2;
     w.dp_wrist_2_link[4] = 0.0997*t3;
-    w.dp_wrist_2_link[5] = -w.sq_wrist_3_link*t1 - w.cq_wrist_3_link*t2;
+    w.dp_wrist_2_link[5] = -w.sq[5]*t1 - w.cq[5]*t2;
   }
   // reduced sweep: body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
@@ -736,14 +736,14 @@ PROXGEN_RT_NOINLINE void caba_reduced_wrist_3_link_to_wrist_1_link(Workspace& PR
     const Scalar t6 = w.dp_wrist_2_link[0] + w.IA_wrist_2_link[5]*t5;
     const Scalar t7 = w.dp_wrist_2_link[2] + w.IA_wrist_2_link[14]*t5;
     const Scalar t8 = w.dp_wrist_2_link[4] + w.IA_wrist_2_link[19]*t5;
-    const Scalar t9 = w.cq_wrist_2_link*t6 - w.sq_wrist_2_link*w.dp_wrist_2_link[1];
-    const Scalar t10 = w.sq_wrist_2_link*t6 + w.cq_wrist_2_link*w.dp_wrist_2_link[1];
+    const Scalar t9 = w.cq[4]*t6 - w.sq[4]*w.dp_wrist_2_link[1];
+    const Scalar t10 = w.sq[4]*t6 + w.cq[4]*w.dp_wrist_2_link[1];
     w.dp_wrist_1_link[0] = t9;
     w.dp_wrist_1_link[1] = -t7;
     w.dp_wrist_1_link[2] = t10;
-    w.dp_wrist_1_link[3] = 0.1333*t7 + w.cq_wrist_2_link*w.dp_wrist_2_link[3] - w.sq_wrist_2_link*t8;
+    w.dp_wrist_1_link[3] = 0.1333*t7 + w.cq[4]*w.dp_wrist_2_link[3] - w.sq[4]*t8;
     w.dp_wrist_1_link[4] = 0.1333*t9;
-    w.dp_wrist_1_link[5] = w.sq_wrist_2_link*w.dp_wrist_2_link[3] + w.cq_wrist_2_link*t8;
+    w.dp_wrist_1_link[5] = w.sq[4]*w.dp_wrist_2_link[3] + w.cq[4]*t8;
   }
   // reduced sweep: body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
@@ -754,13 +754,13 @@ PROXGEN_RT_NOINLINE void caba_reduced_wrist_3_link_to_wrist_1_link(Workspace& PR
     const Scalar t14 = w.dp_wrist_1_link[2] + w.IA_wrist_1_link[14]*t11;
     const Scalar t15 = w.dp_wrist_1_link[3] + w.IA_wrist_1_link[17]*t11;
     const Scalar t16 = w.dp_wrist_1_link[4] + w.IA_wrist_1_link[19]*t11;
-    const Scalar t17 = w.cq_wrist_1_link*t12 - w.sq_wrist_1_link*t13;
-    const Scalar t18 = w.sq_wrist_1_link*t12 + w.cq_wrist_1_link*t13;
+    const Scalar t17 = w.cq[3]*t12 - w.sq[3]*t13;
+    const Scalar t18 = w.sq[3]*t12 + w.cq[3]*t13;
     w.dp_forearm_link[0] = t17;
     w.dp_forearm_link[1] = t18;
     w.dp_forearm_link[2] = t14;
-    w.dp_forearm_link[3] = w.cq_wrist_1_link*t15 - w.sq_wrist_1_link*t16;
-    w.dp_forearm_link[4] = 0.3922*t14 + w.sq_wrist_1_link*t15 + w.cq_wrist_1_link*t16;
+    w.dp_forearm_link[3] = w.cq[3]*t15 - w.sq[3]*t16;
+    w.dp_forearm_link[4] = 0.3922*t14 + w.sq[3]*t15 + w.cq[3]*t16;
     w.dp_forearm_link[5] = -0.3922*t18;
   }
 }
@@ -775,13 +775,13 @@ PROXGEN_RT_NOINLINE void caba_reduced_forearm_link_to_shoulder_link(Workspace& P
     const Scalar t3 = w.dp_forearm_link[2] + w.IA_forearm_link[14]*t0;
     const Scalar t4 = w.dp_forearm_link[3] + w.IA_forearm_link[17]*t0;
     const Scalar t5 = w.dp_forearm_link[4] + w.IA_forearm_link[19]*t0;
-    const Scalar t6 = w.cq_forearm_link*t1 - w.sq_forearm_link*t2;
-    const Scalar t7 = w.sq_forearm_link*t1 + w.cq_forearm_link*t2;
+    const Scalar t6 = w.cq[2]*t1 - w.sq[2]*t2;
+    const Scalar t7 = w.sq[2]*t1 + w.cq[2]*t2;
     w.dp_upper_arm_link[0] = t6;
     w.dp_upper_arm_link[1] = t7;
     w.dp_upper_arm_link[2] = t3;
-    w.dp_upper_arm_link[3] = w.cq_forearm_link*t4 - w.sq_forearm_link*t5;
-    w.dp_upper_arm_link[4] = 0.425*t3 + w.sq_forearm_link*t4 + w.cq_forearm_link*t5;
+    w.dp_upper_arm_link[3] = w.cq[2]*t4 - w.sq[2]*t5;
+    w.dp_upper_arm_link[4] = 0.425*t3 + w.sq[2]*t4 + w.cq[2]*t5;
     w.dp_upper_arm_link[5] = -0.425*t7;
   }
   // reduced sweep: body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
@@ -793,14 +793,14 @@ PROXGEN_RT_NOINLINE void caba_reduced_forearm_link_to_shoulder_link(Workspace& P
     const Scalar t11 = w.dp_upper_arm_link[2] + w.IA_upper_arm_link[14]*t8;
     const Scalar t12 = w.dp_upper_arm_link[3] + w.IA_upper_arm_link[17]*t8;
     const Scalar t13 = w.dp_upper_arm_link[4] + w.IA_upper_arm_link[19]*t8;
-    const Scalar t14 = w.cq_upper_arm_link*t9 - w.sq_upper_arm_link*t10;
-    const Scalar t15 = w.sq_upper_arm_link*t9 + w.cq_upper_arm_link*t10;
+    const Scalar t14 = w.cq[1]*t9 - w.sq[1]*t10;
+    const Scalar t15 = w.sq[1]*t9 + w.cq[1]*t10;
     w.dp_shoulder_link[0] = t14;
     w.dp_shoulder_link[1] = -t11;
     w.dp_shoulder_link[2] = t15;
-    w.dp_shoulder_link[3] = 0.1625*t11 + w.cq_upper_arm_link*t12 - w.sq_upper_arm_link*t13;
+    w.dp_shoulder_link[3] = 0.1625*t11 + w.cq[1]*t12 - w.sq[1]*t13;
     w.dp_shoulder_link[4] = 0.1625*t14;
-    w.dp_shoulder_link[5] = w.sq_upper_arm_link*t12 + w.cq_upper_arm_link*t13;
+    w.dp_shoulder_link[5] = w.sq[1]*t12 + w.cq[1]*t13;
   }
   // reduced sweep: body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
@@ -817,12 +817,12 @@ PROXGEN_RT_NOINLINE void caba_reforward_shoulder_link_to_wrist_2_link(Workspace&
   }
   // accelerate body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    const Scalar t1 = w.c_upper_arm_link[3] + w.sq[1]*w.a_shoulder_link[5];
+    const Scalar t2 = w.c_upper_arm_link[4] + w.cq[1]*w.a_shoulder_link[5];
+    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq[1]*w.IA_upper_arm_link[5] - 9.81*w.cq[1]*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
-    w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
-    w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
+    w.a_upper_arm_link[0] = 9.81*w.sq[1];
+    w.a_upper_arm_link[1] = 9.81*w.cq[1];
     w.a_upper_arm_link[3] = t1;
     w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
@@ -830,10 +830,10 @@ PROXGEN_RT_NOINLINE void caba_reforward_shoulder_link_to_wrist_2_link(Workspace&
   // accelerate body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     const Scalar t4 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
-    const Scalar t5 = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
-    const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t5 = w.c_forearm_link[0] + w.cq[2]*w.a_upper_arm_link[0] + w.sq[2]*t4;
+    const Scalar t6 = w.c_forearm_link[1] - w.sq[2]*w.a_upper_arm_link[0] + w.cq[2]*t4;
+    const Scalar t7 = w.c_forearm_link[3] + w.cq[2]*w.a_upper_arm_link[3] + w.sq[2]*w.a_upper_arm_link[4];
+    const Scalar t8 = w.c_forearm_link[4] - w.sq[2]*w.a_upper_arm_link[3] + w.cq[2]*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
     w.a_forearm_link[0] = t5;
@@ -847,10 +847,10 @@ PROXGEN_RT_NOINLINE void caba_reforward_shoulder_link_to_wrist_2_link(Workspace&
   {
     const Scalar t10 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
     const Scalar t11 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
-    const Scalar t12 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
-    const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t12 = w.c_wrist_1_link[0] + w.cq[3]*w.a_forearm_link[0] + w.sq[3]*t10;
+    const Scalar t13 = w.c_wrist_1_link[1] - w.sq[3]*w.a_forearm_link[0] + w.cq[3]*t10;
+    const Scalar t14 = w.c_wrist_1_link[3] + w.cq[3]*w.a_forearm_link[3] + w.sq[3]*w.a_forearm_link[4];
+    const Scalar t15 = w.c_wrist_1_link[4] - w.sq[3]*w.a_forearm_link[3] + w.cq[3]*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
     w.a_wrist_1_link[0] = t12;
@@ -864,10 +864,10 @@ PROXGEN_RT_NOINLINE void caba_reforward_shoulder_link_to_wrist_2_link(Workspace&
   {
     const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq[4]*t17 + w.sq[4]*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq[4]*t17 + w.cq[4]*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq[4]*w.a_wrist_1_link[3] + w.sq[4]*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq[4]*w.a_wrist_1_link[3] + w.cq[4]*w.a_wrist_1_link[5];
     const Scalar t23 = w.u_wrist_2_link[0] - w.IA_wrist_2_link[5]*t19 - w.IA_wrist_2_link[14]*t18 - w.IA_wrist_2_link[19]*t22 + w.IA_wrist_2_link[20]*w.a_wrist_1_link[4];
     w.qdd[4] = w.Dinv_wrist_2_link*t23;
     w.a_wrist_2_link[0] = t19;
@@ -884,10 +884,10 @@ PROXGEN_RT_NOINLINE void caba_reforward_wrist_3_link(Workspace& PROXGEN_RT_RESTR
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
     const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
-    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
-    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
-    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq[5]*t0 - w.a_wrist_2_link[2]*w.sq[5];
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq[5]*t0 - w.a_wrist_2_link[2]*w.cq[5];
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq[5] - w.a_wrist_2_link[5]*w.sq[5];
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq[5] - w.a_wrist_2_link[5]*w.cq[5];
     const Scalar t6 = w.u_wrist_3_link[0] - w.a_wrist_2_link[4]*w.U_wrist_3_link[5];
     w.qdd[5] = w.Dinv_wrist_3_link*t6;
     w.a_wrist_3_link[0] = t2;
@@ -934,28 +934,28 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_3_link_to_wrist_2_link(const Scalar* 
     const Scalar pa1 = 0.365*w.c_wrist_3_link[1] - 0.035930965*w.c_wrist_3_link[3] + w.pA_wrist_3_link[1];
     const Scalar pa2 = -0.035930965*w.c_wrist_3_link[1] + 0.003770528042232001*w.c_wrist_3_link[3] + w.pA_wrist_3_link[3];
     const Scalar pa3 = 0.035930965*w.c_wrist_3_link[0] + 0.003770528042232001*w.c_wrist_3_link[4] + w.pA_wrist_3_link[4];
-    const Scalar t0 = w.cq_wrist_3_link*pa0 - w.sq_wrist_3_link*pa1;
-    const Scalar t1 = -w.sq_wrist_3_link*pa0 - w.cq_wrist_3_link*pa1;
+    const Scalar t0 = w.cq[5]*pa0 - w.sq[5]*pa1;
+    const Scalar t1 = -w.sq[5]*pa0 - w.cq[5]*pa1;
     w.pA_wrist_2_link[0] = w.pA_wrist_2_link[0] + t0;
     w.pA_wrist_2_link[1] = w.pA_wrist_2_link[1] + w.pA_wrist_3_link[2];
     w.pA_wrist_2_link[2] = w.pA_wrist_2_link[2] + t1;
-    w.pA_wrist_2_link[3] = w.pA_wrist_2_link[3] - 0.0997*w.pA_wrist_3_link[2] + w.cq_wrist_3_link*pa2 - w.sq_wrist_3_link*pa3;
+    w.pA_wrist_2_link[3] = w.pA_wrist_2_link[3] - 0.0997*w.pA_wrist_3_link[2] + w.cq[5]*pa2 - w.sq[5]*pa3;
     w.pA_wrist_2_link[4] = w.pA_wrist_2_link[4] + tau[5] + 0.0997*t0;
-    w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq_wrist_3_link*pa2 - w.cq_wrist_3_link*pa3;
-    w.KA_wrist_2_link[0][0] = w.cq_wrist_3_link;
-    w.KA_wrist_2_link[2][0] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[3][0] = -0.0996*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[4][0] = 0.0997*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[5][0] = -0.0996*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[0][1] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[2][1] = -w.cq_wrist_3_link;
-    w.KA_wrist_2_link[3][1] = -0.0996*w.cq_wrist_3_link;
-    w.KA_wrist_2_link[4][1] = -0.0997*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[5][1] = 0.0996*w.sq_wrist_3_link;
-    w.KA_wrist_2_link[3][3] = w.cq_wrist_3_link;
-    w.KA_wrist_2_link[5][3] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[3][4] = -w.sq_wrist_3_link;
-    w.KA_wrist_2_link[5][4] = -w.cq_wrist_3_link;
+    w.pA_wrist_2_link[5] = w.pA_wrist_2_link[5] - w.sq[5]*pa2 - w.cq[5]*pa3;
+    w.KA_wrist_2_link[0][0] = w.cq[5];
+    w.KA_wrist_2_link[2][0] = -w.sq[5];
+    w.KA_wrist_2_link[3][0] = -0.0996*w.sq[5];
+    w.KA_wrist_2_link[4][0] = 0.0997*w.cq[5];
+    w.KA_wrist_2_link[5][0] = -0.0996*w.cq[5];
+    w.KA_wrist_2_link[0][1] = -w.sq[5];
+    w.KA_wrist_2_link[2][1] = -w.cq[5];
+    w.KA_wrist_2_link[3][1] = -0.0996*w.cq[5];
+    w.KA_wrist_2_link[4][1] = -0.0997*w.sq[5];
+    w.KA_wrist_2_link[5][1] = 0.0996*w.sq[5];
+    w.KA_wrist_2_link[3][3] = w.cq[5];
+    w.KA_wrist_2_link[5][3] = -w.sq[5];
+    w.KA_wrist_2_link[3][4] = -w.sq[5];
+    w.KA_wrist_2_link[5][4] = -w.cq[5];
   }
   // eliminate, carrying the subtree rows: body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
@@ -965,72 +965,72 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_3_link_to_wrist_2_link(const Scalar* 
     const Scalar pa6 = 0.057172965000000006*w.c_wrist_2_link[3] + w.pA_wrist_2_link[2];
     const Scalar pa7 = -0.1636605*w.c_wrist_2_link[1] + 0.022423613172231998*w.c_wrist_2_link[3] + w.pA_wrist_2_link[3];
     const Scalar pa8 = 0.10408822695153502*w.c_wrist_2_link[0] + 0.012406475413830647*w.c_wrist_2_link[4] + w.pA_wrist_2_link[4] - 1.041965779603436*w.u_wrist_2_link[0];
-    const Scalar C21 = w.cq_wrist_2_link*w.cq_wrist_2_link - w.sq_wrist_2_link*w.sq_wrist_2_link;
+    const Scalar C21 = w.cq[4]*w.cq[4] - w.sq[4]*w.sq[4];
     const Scalar t2 = 1.3642248130750554 - 0.30077518692494465*C21;
     const Scalar t3 = 1.3642248130750554 + 0.30077518692494465*C21;
     const Scalar t4 = 0.1338743634757675 - 0.02978613652423248*C21;
     const Scalar t5 = -0.1338743634757675 - 0.02978613652423248*C21;
-    const Scalar t6 = -0.22194450000000002 - 0.057172965000000006*w.cq_wrist_2_link;
-    const Scalar t7 = w.cq_wrist_2_link*pa4 - w.sq_wrist_2_link*pa5;
-    const Scalar t8 = w.sq_wrist_2_link*pa4 + w.cq_wrist_2_link*pa5;
+    const Scalar t6 = -0.22194450000000002 - 0.057172965000000006*w.cq[4];
+    const Scalar t7 = w.cq[4]*pa4 - w.sq[4]*pa5;
+    const Scalar t8 = w.sq[4]*pa4 + w.cq[4]*pa5;
     w.IA_wrist_1_link[0] = 1.37 + t2;
-    w.IA_wrist_1_link[2] = -0.6015503738498893*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    w.IA_wrist_1_link[3] = 0.05957227304846496*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[2] = -0.6015503738498893*w.cq[4]*w.sq[4];
+    w.IA_wrist_1_link[3] = 0.05957227304846496*w.cq[4]*w.sq[4];
     w.IA_wrist_1_link[4] = 0.180155 + 0.1333*t2;
     w.IA_wrist_1_link[5] = 0.0223858 + t4;
     w.IA_wrist_1_link[8] = -0.180155 + t6;
-    w.IA_wrist_1_link[10] = -0.057172965000000006*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[10] = -0.057172965000000006*w.sq[4];
     w.IA_wrist_1_link[11] = 1.37 + t3;
     w.IA_wrist_1_link[12] = -0.0223858 + t5;
-    w.IA_wrist_1_link[13] = -0.08018666483419025*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    w.IA_wrist_1_link[14] = -0.05957227304846496*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    w.IA_wrist_1_link[15] = 0.043808773265031326 + 0.007621156234500001*w.cq_wrist_2_link + 0.0050085688792006755*C21 - 0.1333*t6;
-    w.IA_wrist_1_link[16] = 0.00794098399736038*w.cq_wrist_2_link*w.sq_wrist_2_link;
-    w.IA_wrist_1_link[17] = 0.007621156234500001*w.sq_wrist_2_link + 0.010017137758401351*w.cq_wrist_2_link*w.sq_wrist_2_link;
+    w.IA_wrist_1_link[13] = -0.08018666483419025*w.cq[4]*w.sq[4];
+    w.IA_wrist_1_link[14] = -0.05957227304846496*w.cq[4]*w.sq[4];
+    w.IA_wrist_1_link[15] = 0.043808773265031326 + 0.007621156234500001*w.cq[4] + 0.0050085688792006755*C21 - 0.1333*t6;
+    w.IA_wrist_1_link[16] = 0.00794098399736038*w.cq[4]*w.sq[4];
+    w.IA_wrist_1_link[17] = 0.007621156234500001*w.sq[4] + 0.010017137758401351*w.cq[4]*w.sq[4];
     w.IA_wrist_1_link[18] = 0.026027945000000004 + 0.01776889*t2;
     w.IA_wrist_1_link[19] = 0.0029437327000000004 + 0.1333*t4;
     w.IA_wrist_1_link[20] = 0.01916795326503132 - 0.0050085688792006755*C21;
     w.pA_wrist_1_link[0] = w.pA_wrist_1_link[0] + t7;
     w.pA_wrist_1_link[1] = w.pA_wrist_1_link[1] - pa6;
     w.pA_wrist_1_link[2] = w.pA_wrist_1_link[2] + t8;
-    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa6 + w.cq_wrist_2_link*pa7 - w.sq_wrist_2_link*pa8;
+    w.pA_wrist_1_link[3] = w.pA_wrist_1_link[3] + 0.1333*pa6 + w.cq[4]*pa7 - w.sq[4]*pa8;
     w.pA_wrist_1_link[4] = w.pA_wrist_1_link[4] - tau[4] + 0.1333*t7;
-    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq_wrist_2_link*pa7 + w.cq_wrist_2_link*pa8;
+    w.pA_wrist_1_link[5] = w.pA_wrist_1_link[5] + w.sq[4]*pa7 + w.cq[4]*pa8;
     w.KSD_wrist_2_link[0] = 184.03082382127872*w.KA_wrist_2_link[5][0];
     const Scalar t9 = w.KA_wrist_2_link[0][0] + 0.057172965000000006*w.KSD_wrist_2_link[0];
     const Scalar t10 = w.KA_wrist_2_link[4][0] + 0.0056619090105*w.KSD_wrist_2_link[0];
-    w.KA_wrist_1_link[0][0] = w.cq_wrist_2_link*t9;
+    w.KA_wrist_1_link[0][0] = w.cq[4]*t9;
     w.KA_wrist_1_link[1][0] = -w.KA_wrist_2_link[2][0];
-    w.KA_wrist_1_link[2][0] = w.sq_wrist_2_link*t9;
-    w.KA_wrist_1_link[3][0] = 0.1333*w.KA_wrist_2_link[2][0] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][0] - w.sq_wrist_2_link*t10;
-    w.KA_wrist_1_link[4][0] = 0.1333*w.cq_wrist_2_link*t9;
-    w.KA_wrist_1_link[5][0] = w.sq_wrist_2_link*w.KA_wrist_2_link[3][0] + w.cq_wrist_2_link*t10;
+    w.KA_wrist_1_link[2][0] = w.sq[4]*t9;
+    w.KA_wrist_1_link[3][0] = 0.1333*w.KA_wrist_2_link[2][0] + w.cq[4]*w.KA_wrist_2_link[3][0] - w.sq[4]*t10;
+    w.KA_wrist_1_link[4][0] = 0.1333*w.cq[4]*t9;
+    w.KA_wrist_1_link[5][0] = w.sq[4]*w.KA_wrist_2_link[3][0] + w.cq[4]*t10;
     w.KSD_wrist_2_link[1] = 184.03082382127872*w.KA_wrist_2_link[5][1];
     const Scalar t11 = w.KA_wrist_2_link[0][1] + 0.057172965000000006*w.KSD_wrist_2_link[1];
     const Scalar t12 = w.KA_wrist_2_link[4][1] + 0.0056619090105*w.KSD_wrist_2_link[1];
-    w.KA_wrist_1_link[0][1] = w.cq_wrist_2_link*t11;
+    w.KA_wrist_1_link[0][1] = w.cq[4]*t11;
     w.KA_wrist_1_link[1][1] = -w.KA_wrist_2_link[2][1];
-    w.KA_wrist_1_link[2][1] = w.sq_wrist_2_link*t11;
-    w.KA_wrist_1_link[3][1] = 0.1333*w.KA_wrist_2_link[2][1] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][1] - w.sq_wrist_2_link*t12;
-    w.KA_wrist_1_link[4][1] = 0.1333*w.cq_wrist_2_link*t11;
-    w.KA_wrist_1_link[5][1] = w.sq_wrist_2_link*w.KA_wrist_2_link[3][1] + w.cq_wrist_2_link*t12;
-    w.KA_wrist_1_link[0][2] = -w.sq_wrist_2_link;
-    w.KA_wrist_1_link[2][2] = w.cq_wrist_2_link;
-    w.KA_wrist_1_link[3][2] = -0.0997*w.cq_wrist_2_link;
-    w.KA_wrist_1_link[4][2] = -0.1333*w.sq_wrist_2_link;
-    w.KA_wrist_1_link[5][2] = -0.0997*w.sq_wrist_2_link;
+    w.KA_wrist_1_link[2][1] = w.sq[4]*t11;
+    w.KA_wrist_1_link[3][1] = 0.1333*w.KA_wrist_2_link[2][1] + w.cq[4]*w.KA_wrist_2_link[3][1] - w.sq[4]*t12;
+    w.KA_wrist_1_link[4][1] = 0.1333*w.cq[4]*t11;
+    w.KA_wrist_1_link[5][1] = w.sq[4]*w.KA_wrist_2_link[3][1] + w.cq[4]*t12;
+    w.KA_wrist_1_link[0][2] = -w.sq[4];
+    w.KA_wrist_1_link[2][2] = w.cq[4];
+    w.KA_wrist_1_link[3][2] = -0.0997*w.cq[4];
+    w.KA_wrist_1_link[4][2] = -0.1333*w.sq[4];
+    w.KA_wrist_1_link[5][2] = -0.0997*w.sq[4];
     w.KSD_wrist_2_link[3] = 184.03082382127872*w.KA_wrist_2_link[5][3];
-    w.KA_wrist_1_link[0][3] = 0.057172965000000006*w.cq_wrist_2_link*w.KSD_wrist_2_link[3];
-    w.KA_wrist_1_link[2][3] = 0.057172965000000006*w.sq_wrist_2_link*w.KSD_wrist_2_link[3];
-    w.KA_wrist_1_link[3][3] = -0.0056619090105*w.sq_wrist_2_link*w.KSD_wrist_2_link[3] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][3];
-    w.KA_wrist_1_link[4][3] = 0.007621156234500001*w.cq_wrist_2_link*w.KSD_wrist_2_link[3];
-    w.KA_wrist_1_link[5][3] = 0.0056619090105*w.cq_wrist_2_link*w.KSD_wrist_2_link[3] + w.sq_wrist_2_link*w.KA_wrist_2_link[3][3];
+    w.KA_wrist_1_link[0][3] = 0.057172965000000006*w.cq[4]*w.KSD_wrist_2_link[3];
+    w.KA_wrist_1_link[2][3] = 0.057172965000000006*w.sq[4]*w.KSD_wrist_2_link[3];
+    w.KA_wrist_1_link[3][3] = -0.0056619090105*w.sq[4]*w.KSD_wrist_2_link[3] + w.cq[4]*w.KA_wrist_2_link[3][3];
+    w.KA_wrist_1_link[4][3] = 0.007621156234500001*w.cq[4]*w.KSD_wrist_2_link[3];
+    w.KA_wrist_1_link[5][3] = 0.0056619090105*w.cq[4]*w.KSD_wrist_2_link[3] + w.sq[4]*w.KA_wrist_2_link[3][3];
     w.KSD_wrist_2_link[4] = 184.03082382127872*w.KA_wrist_2_link[5][4];
-    w.KA_wrist_1_link[0][4] = 0.057172965000000006*w.cq_wrist_2_link*w.KSD_wrist_2_link[4];
-    w.KA_wrist_1_link[2][4] = 0.057172965000000006*w.sq_wrist_2_link*w.KSD_wrist_2_link[4];
-    w.KA_wrist_1_link[3][4] = -0.0056619090105*w.sq_wrist_2_link*w.KSD_wrist_2_link[4] + w.cq_wrist_2_link*w.KA_wrist_2_link[3][4];
-    w.KA_wrist_1_link[4][4] = 0.007621156234500001*w.cq_wrist_2_link*w.KSD_wrist_2_link[4];
-    w.KA_wrist_1_link[5][4] = 0.0056619090105*w.cq_wrist_2_link*w.KSD_wrist_2_link[4] + w.sq_wrist_2_link*w.KA_wrist_2_link[3][4];
+    w.KA_wrist_1_link[0][4] = 0.057172965000000006*w.cq[4]*w.KSD_wrist_2_link[4];
+    w.KA_wrist_1_link[2][4] = 0.057172965000000006*w.sq[4]*w.KSD_wrist_2_link[4];
+    w.KA_wrist_1_link[3][4] = -0.0056619090105*w.sq[4]*w.KSD_wrist_2_link[4] + w.cq[4]*w.KA_wrist_2_link[3][4];
+    w.KA_wrist_1_link[4][4] = 0.007621156234500001*w.cq[4]*w.KSD_wrist_2_link[4];
+    w.KA_wrist_1_link[5][4] = 0.0056619090105*w.cq[4]*w.KSD_wrist_2_link[4] + w.sq[4]*w.KA_wrist_2_link[3][4];
   }
 }
 
@@ -1064,10 +1064,10 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar pa2 = w.pA_wrist_1_link[2] + w.u_wrist_1_link[0]*t2 + w.c_wrist_1_link[0]*Ia1 + w.c_wrist_1_link[1]*t7 + w.c_wrist_1_link[3]*Ia7 + w.c_wrist_1_link[4]*Ia8;
     const Scalar pa3 = w.pA_wrist_1_link[3] + w.u_wrist_1_link[0]*t3 + w.c_wrist_1_link[0]*Ia2 + w.c_wrist_1_link[1]*Ia5 + w.c_wrist_1_link[3]*Ia9 + w.c_wrist_1_link[4]*Ia10;
     const Scalar pa4 = w.pA_wrist_1_link[4] + w.u_wrist_1_link[0]*t4 + w.c_wrist_1_link[0]*Ia3 + w.c_wrist_1_link[1]*t6 + w.c_wrist_1_link[3]*Ia10 + w.c_wrist_1_link[4]*Ia11;
-    const Scalar C20 = w.cq_wrist_1_link*w.cq_wrist_1_link - w.sq_wrist_1_link*w.sq_wrist_1_link;
+    const Scalar C20 = w.cq[3]*w.cq[3] - w.sq[3]*w.sq[3];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t8 = 2.0*w.cq_wrist_1_link*w.sq_wrist_1_link;
+    const Scalar t8 = 2.0*w.cq[3]*w.sq[3];
     const Scalar d0 = C20*h0 - t5*t8;
     const Scalar qq0 = h0*t8 + t5*C20;
     const Scalar h1 = 0.5*(w.IA_wrist_1_link[19]*t1 + Ia2);
@@ -1080,20 +1080,20 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar d2 = C20*h2 - Ia10*t8;
     const Scalar qq2 = t8*h2 + Ia10*C20;
     const Scalar t10 = m0 + d0;
-    const Scalar t11 = w.cq_wrist_1_link*Ia1 - w.sq_wrist_1_link*t7;
+    const Scalar t11 = w.cq[3]*Ia1 - w.sq[3]*t7;
     const Scalar t12 = m0 - d0;
-    const Scalar t13 = w.sq_wrist_1_link*Ia1 + w.cq_wrist_1_link*t7;
+    const Scalar t13 = w.sq[3]*Ia1 + w.cq[3]*t7;
     const Scalar t14 = m1 + d1;
     const Scalar t15 = 0.5*Ia3 - 0.5*Ia5 + qq1;
     const Scalar t16 = -0.5*Ia3 + 0.5*Ia5 + qq1;
     const Scalar t17 = m1 - d1;
-    const Scalar t18 = w.cq_wrist_1_link*Ia7 - w.sq_wrist_1_link*Ia8;
-    const Scalar t19 = w.sq_wrist_1_link*Ia7 + w.cq_wrist_1_link*Ia8;
+    const Scalar t18 = w.cq[3]*Ia7 - w.sq[3]*Ia8;
+    const Scalar t19 = w.sq[3]*Ia7 + w.cq[3]*Ia8;
     const Scalar t20 = 0.3922*t11 + t15;
     const Scalar t21 = 0.3922*t13 + t17;
     const Scalar t22 = 0.3922*Ia6 + t19;
-    const Scalar t23 = w.cq_wrist_1_link*pa0 - w.sq_wrist_1_link*pa1;
-    const Scalar t24 = w.sq_wrist_1_link*pa0 + w.cq_wrist_1_link*pa1;
+    const Scalar t23 = w.cq[3]*pa0 - w.sq[3]*pa1;
+    const Scalar t24 = w.sq[3]*pa0 + w.cq[3]*pa1;
     w.IA_forearm_link[0] = 2.846 + t10;
     w.IA_forearm_link[1] = qq0;
     w.IA_forearm_link[2] = t11;
@@ -1118,8 +1118,8 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     w.pA_forearm_link[0] = w.pA_forearm_link[0] + t23;
     w.pA_forearm_link[1] = w.pA_forearm_link[1] + t24;
     w.pA_forearm_link[2] = w.pA_forearm_link[2] + pa2;
-    w.pA_forearm_link[3] = w.pA_forearm_link[3] + w.cq_wrist_1_link*pa3 - w.sq_wrist_1_link*pa4;
-    w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq_wrist_1_link*pa3 + w.cq_wrist_1_link*pa4;
+    w.pA_forearm_link[3] = w.pA_forearm_link[3] + w.cq[3]*pa3 - w.sq[3]*pa4;
+    w.pA_forearm_link[4] = w.pA_forearm_link[4] + 0.3922*pa2 + w.sq[3]*pa3 + w.cq[3]*pa4;
     w.pA_forearm_link[5] = w.pA_forearm_link[5] + tau[3] - 0.3922*t24;
     // columns 0 to 1
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
@@ -1129,13 +1129,13 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
       const Scalar t27 = w.KA_wrist_1_link[2][j] - w.IA_wrist_1_link[14]*w.KSD_wrist_1_link[j];
       const Scalar t28 = w.KA_wrist_1_link[3][j] - w.IA_wrist_1_link[17]*w.KSD_wrist_1_link[j];
       const Scalar t29 = w.KA_wrist_1_link[4][j] - w.IA_wrist_1_link[19]*w.KSD_wrist_1_link[j];
-      const Scalar t30 = w.cq_wrist_1_link*t25 - w.sq_wrist_1_link*t26;
-      const Scalar t31 = w.sq_wrist_1_link*t25 + w.cq_wrist_1_link*t26;
+      const Scalar t30 = w.cq[3]*t25 - w.sq[3]*t26;
+      const Scalar t31 = w.sq[3]*t25 + w.cq[3]*t26;
       w.KA_forearm_link[0][j] = t30;
       w.KA_forearm_link[1][j] = t31;
       w.KA_forearm_link[2][j] = t27;
-      w.KA_forearm_link[3][j] = w.cq_wrist_1_link*t28 - w.sq_wrist_1_link*t29;
-      w.KA_forearm_link[4][j] = 0.3922*t27 + w.sq_wrist_1_link*t28 + w.cq_wrist_1_link*t29;
+      w.KA_forearm_link[3][j] = w.cq[3]*t28 - w.sq[3]*t29;
+      w.KA_forearm_link[4][j] = 0.3922*t27 + w.sq[3]*t28 + w.cq[3]*t29;
       w.KA_forearm_link[5][j] = -0.3922*t31;
     }
     w.KSD_wrist_1_link[2] = w.KA_wrist_1_link[5][2]*w.Dinv_wrist_1_link;
@@ -1144,13 +1144,13 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar t34 = -w.IA_wrist_1_link[10]*w.KSD_wrist_1_link[2];
     const Scalar t35 = w.KA_wrist_1_link[3][2] - w.IA_wrist_1_link[17]*w.KSD_wrist_1_link[2];
     const Scalar t36 = w.KA_wrist_1_link[4][2] - w.IA_wrist_1_link[19]*w.KSD_wrist_1_link[2];
-    const Scalar t37 = w.cq_wrist_1_link*t32 - w.sq_wrist_1_link*t34;
-    const Scalar t38 = w.sq_wrist_1_link*t32 + w.cq_wrist_1_link*t34;
+    const Scalar t37 = w.cq[3]*t32 - w.sq[3]*t34;
+    const Scalar t38 = w.sq[3]*t32 + w.cq[3]*t34;
     w.KA_forearm_link[0][2] = t37;
     w.KA_forearm_link[1][2] = t38;
     w.KA_forearm_link[2][2] = t33;
-    w.KA_forearm_link[3][2] = w.cq_wrist_1_link*t35 - w.sq_wrist_1_link*t36;
-    w.KA_forearm_link[4][2] = 0.3922*t33 + w.sq_wrist_1_link*t35 + w.cq_wrist_1_link*t36;
+    w.KA_forearm_link[3][2] = w.cq[3]*t35 - w.sq[3]*t36;
+    w.KA_forearm_link[4][2] = 0.3922*t33 + w.sq[3]*t35 + w.cq[3]*t36;
     w.KA_forearm_link[5][2] = -0.3922*t38;
     w.KSD_wrist_1_link[3] = w.KA_wrist_1_link[5][3]*w.Dinv_wrist_1_link;
     const Scalar t39 = w.KA_wrist_1_link[0][3] - w.IA_wrist_1_link[5]*w.KSD_wrist_1_link[3];
@@ -1158,13 +1158,13 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar t41 = -w.IA_wrist_1_link[10]*w.KSD_wrist_1_link[3];
     const Scalar t42 = w.KA_wrist_1_link[3][3] - w.IA_wrist_1_link[17]*w.KSD_wrist_1_link[3];
     const Scalar t43 = w.KA_wrist_1_link[4][3] - w.IA_wrist_1_link[19]*w.KSD_wrist_1_link[3];
-    const Scalar t44 = w.cq_wrist_1_link*t39 - w.sq_wrist_1_link*t41;
-    const Scalar t45 = w.sq_wrist_1_link*t39 + w.cq_wrist_1_link*t41;
+    const Scalar t44 = w.cq[3]*t39 - w.sq[3]*t41;
+    const Scalar t45 = w.sq[3]*t39 + w.cq[3]*t41;
     w.KA_forearm_link[0][3] = t44;
     w.KA_forearm_link[1][3] = t45;
     w.KA_forearm_link[2][3] = t40;
-    w.KA_forearm_link[3][3] = w.cq_wrist_1_link*t42 - w.sq_wrist_1_link*t43;
-    w.KA_forearm_link[4][3] = 0.3922*t40 + w.sq_wrist_1_link*t42 + w.cq_wrist_1_link*t43;
+    w.KA_forearm_link[3][3] = w.cq[3]*t42 - w.sq[3]*t43;
+    w.KA_forearm_link[4][3] = 0.3922*t40 + w.sq[3]*t42 + w.cq[3]*t43;
     w.KA_forearm_link[5][3] = -0.3922*t45;
     w.KSD_wrist_1_link[4] = w.KA_wrist_1_link[5][4]*w.Dinv_wrist_1_link;
     const Scalar t46 = w.KA_wrist_1_link[0][4] - w.IA_wrist_1_link[5]*w.KSD_wrist_1_link[4];
@@ -1172,13 +1172,13 @@ PROXGEN_RT_NOINLINE void pv_backward_wrist_1_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar t48 = -w.IA_wrist_1_link[10]*w.KSD_wrist_1_link[4];
     const Scalar t49 = w.KA_wrist_1_link[3][4] - w.IA_wrist_1_link[17]*w.KSD_wrist_1_link[4];
     const Scalar t50 = w.KA_wrist_1_link[4][4] - w.IA_wrist_1_link[19]*w.KSD_wrist_1_link[4];
-    const Scalar t51 = w.cq_wrist_1_link*t46 - w.sq_wrist_1_link*t48;
-    const Scalar t52 = w.sq_wrist_1_link*t46 + w.cq_wrist_1_link*t48;
+    const Scalar t51 = w.cq[3]*t46 - w.sq[3]*t48;
+    const Scalar t52 = w.sq[3]*t46 + w.cq[3]*t48;
     w.KA_forearm_link[0][4] = t51;
     w.KA_forearm_link[1][4] = t52;
     w.KA_forearm_link[2][4] = t47;
-    w.KA_forearm_link[3][4] = w.cq_wrist_1_link*t49 - w.sq_wrist_1_link*t50;
-    w.KA_forearm_link[4][4] = 0.3922*t47 + w.sq_wrist_1_link*t49 + w.cq_wrist_1_link*t50;
+    w.KA_forearm_link[3][4] = w.cq[3]*t49 - w.sq[3]*t50;
+    w.KA_forearm_link[4][4] = 0.3922*t47 + w.sq[3]*t49 + w.cq[3]*t50;
     w.KA_forearm_link[5][4] = -0.3922*t52;
   }
 }
@@ -1213,10 +1213,10 @@ PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar pa2 = w.pA_forearm_link[2] + w.u_forearm_link[0]*t2 + w.c_forearm_link[0]*Ia2 + w.c_forearm_link[1]*Ia6 + w.c_forearm_link[3]*Ia10 + w.c_forearm_link[4]*Ia11;
     const Scalar pa3 = w.pA_forearm_link[3] + w.u_forearm_link[0]*t3 + w.c_forearm_link[0]*Ia3 + w.c_forearm_link[1]*Ia7 + w.c_forearm_link[3]*Ia12 + w.c_forearm_link[4]*Ia13;
     const Scalar pa4 = w.pA_forearm_link[4] + w.u_forearm_link[0]*t4 + w.c_forearm_link[0]*Ia4 + w.c_forearm_link[1]*Ia8 + w.c_forearm_link[3]*Ia13 + w.c_forearm_link[4]*Ia14;
-    const Scalar C20 = w.cq_forearm_link*w.cq_forearm_link - w.sq_forearm_link*w.sq_forearm_link;
+    const Scalar C20 = w.cq[2]*w.cq[2] - w.sq[2]*w.sq[2];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_forearm_link*w.sq_forearm_link;
+    const Scalar t5 = 2.0*w.cq[2]*w.sq[2];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -1229,20 +1229,20 @@ PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTR
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = w.cq_forearm_link*Ia2 - w.sq_forearm_link*Ia6;
+    const Scalar t8 = w.cq[2]*Ia2 - w.sq[2]*Ia6;
     const Scalar t9 = m0 - d0;
-    const Scalar t10 = w.sq_forearm_link*Ia2 + w.cq_forearm_link*Ia6;
+    const Scalar t10 = w.sq[2]*Ia2 + w.cq[2]*Ia6;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
     const Scalar t13 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t14 = m1 - d1;
-    const Scalar t15 = w.cq_forearm_link*Ia10 - w.sq_forearm_link*Ia11;
-    const Scalar t16 = w.sq_forearm_link*Ia10 + w.cq_forearm_link*Ia11;
+    const Scalar t15 = w.cq[2]*Ia10 - w.sq[2]*Ia11;
+    const Scalar t16 = w.sq[2]*Ia10 + w.cq[2]*Ia11;
     const Scalar t17 = 0.425*t8 + t12;
     const Scalar t18 = 0.425*t10 + t14;
     const Scalar t19 = 0.425*Ia9 + t16;
-    const Scalar t20 = w.cq_forearm_link*pa0 - w.sq_forearm_link*pa1;
-    const Scalar t21 = w.sq_forearm_link*pa0 + w.cq_forearm_link*pa1;
+    const Scalar t20 = w.cq[2]*pa0 - w.sq[2]*pa1;
+    const Scalar t21 = w.sq[2]*pa0 + w.cq[2]*pa1;
     w.IA_upper_arm_link[0] = 8.058 + t7;
     w.IA_upper_arm_link[1] = qq0;
     w.IA_upper_arm_link[2] = t8;
@@ -1267,8 +1267,8 @@ PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTR
     w.pA_upper_arm_link[0] = w.pA_upper_arm_link[0] + t20;
     w.pA_upper_arm_link[1] = w.pA_upper_arm_link[1] + t21;
     w.pA_upper_arm_link[2] = w.pA_upper_arm_link[2] + pa2;
-    w.pA_upper_arm_link[3] = w.pA_upper_arm_link[3] + w.cq_forearm_link*pa3 - w.sq_forearm_link*pa4;
-    w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq_forearm_link*pa3 + w.cq_forearm_link*pa4;
+    w.pA_upper_arm_link[3] = w.pA_upper_arm_link[3] + w.cq[2]*pa3 - w.sq[2]*pa4;
+    w.pA_upper_arm_link[4] = w.pA_upper_arm_link[4] + 0.425*pa2 + w.sq[2]*pa3 + w.cq[2]*pa4;
     w.pA_upper_arm_link[5] = w.pA_upper_arm_link[5] + tau[2] - 0.425*t21;
     // columns 0 to 4
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
@@ -1278,13 +1278,13 @@ PROXGEN_RT_NOINLINE void pv_backward_forearm_link(const Scalar* PROXGEN_RT_RESTR
       const Scalar t24 = w.KA_forearm_link[2][j] - w.IA_forearm_link[14]*w.KSD_forearm_link[j];
       const Scalar t25 = w.KA_forearm_link[3][j] - w.IA_forearm_link[17]*w.KSD_forearm_link[j];
       const Scalar t26 = w.KA_forearm_link[4][j] - w.IA_forearm_link[19]*w.KSD_forearm_link[j];
-      const Scalar t27 = w.cq_forearm_link*t22 - w.sq_forearm_link*t23;
-      const Scalar t28 = w.sq_forearm_link*t22 + w.cq_forearm_link*t23;
+      const Scalar t27 = w.cq[2]*t22 - w.sq[2]*t23;
+      const Scalar t28 = w.sq[2]*t22 + w.cq[2]*t23;
       w.KA_upper_arm_link[0][j] = t27;
       w.KA_upper_arm_link[1][j] = t28;
       w.KA_upper_arm_link[2][j] = t24;
-      w.KA_upper_arm_link[3][j] = w.cq_forearm_link*t25 - w.sq_forearm_link*t26;
-      w.KA_upper_arm_link[4][j] = 0.425*t24 + w.sq_forearm_link*t25 + w.cq_forearm_link*t26;
+      w.KA_upper_arm_link[3][j] = w.cq[2]*t25 - w.sq[2]*t26;
+      w.KA_upper_arm_link[4][j] = 0.425*t24 + w.sq[2]*t25 + w.cq[2]*t26;
       w.KA_upper_arm_link[5][j] = -0.425*t28;
     }
   }
@@ -1320,10 +1320,10 @@ PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_upper_arm_link[2] + w.u_upper_arm_link[0]*t2 + w.c_upper_arm_link[3]*Ia10 + w.c_upper_arm_link[4]*Ia11;
     const Scalar pa3 = w.pA_upper_arm_link[3] + w.u_upper_arm_link[0]*t3 + w.c_upper_arm_link[3]*Ia12 + w.c_upper_arm_link[4]*Ia13;
     const Scalar pa4 = w.pA_upper_arm_link[4] + w.u_upper_arm_link[0]*t4 + w.c_upper_arm_link[3]*Ia13 + w.c_upper_arm_link[4]*Ia14;
-    const Scalar C20 = w.cq_upper_arm_link*w.cq_upper_arm_link - w.sq_upper_arm_link*w.sq_upper_arm_link;
+    const Scalar C20 = w.cq[1]*w.cq[1] - w.sq[1]*w.sq[1];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_upper_arm_link*w.sq_upper_arm_link;
+    const Scalar t5 = 2.0*w.cq[1]*w.sq[1];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -1336,20 +1336,20 @@ PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RES
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = -w.cq_upper_arm_link*Ia2 + w.sq_upper_arm_link*Ia6;
-    const Scalar t9 = -w.sq_upper_arm_link*Ia2 - w.cq_upper_arm_link*Ia6;
+    const Scalar t8 = -w.cq[1]*Ia2 + w.sq[1]*Ia6;
+    const Scalar t9 = -w.sq[1]*Ia2 - w.cq[1]*Ia6;
     const Scalar t10 = m0 - d0;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
-    const Scalar t13 = -w.cq_upper_arm_link*Ia10 + w.sq_upper_arm_link*Ia11;
-    const Scalar t14 = -w.sq_upper_arm_link*Ia10 - w.cq_upper_arm_link*Ia11;
+    const Scalar t13 = -w.cq[1]*Ia10 + w.sq[1]*Ia11;
+    const Scalar t14 = -w.sq[1]*Ia10 - w.cq[1]*Ia11;
     const Scalar t15 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t16 = m1 - d1;
     const Scalar t17 = -0.1625*t8 + t11;
     const Scalar t18 = -0.1625*Ia9 + t13;
     const Scalar t19 = -0.1625*t9 + t15;
-    const Scalar t20 = w.cq_upper_arm_link*pa0 - w.sq_upper_arm_link*pa1;
-    const Scalar t21 = w.sq_upper_arm_link*pa0 + w.cq_upper_arm_link*pa1;
+    const Scalar t20 = w.cq[1]*pa0 - w.sq[1]*pa1;
+    const Scalar t21 = w.sq[1]*pa0 + w.cq[1]*pa1;
     w.IA_shoulder_link[0] = 3.761 + t7;
     w.IA_shoulder_link[1] = t8;
     w.IA_shoulder_link[2] = qq0;
@@ -1374,9 +1374,9 @@ PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RES
     w.pA_shoulder_link[0] = t20;
     w.pA_shoulder_link[1] = w.pA_shoulder_link[1] - pa2;
     w.pA_shoulder_link[2] = t21;
-    w.pA_shoulder_link[3] = w.pA_shoulder_link[3] + 0.1625*pa2 + w.cq_upper_arm_link*pa3 - w.sq_upper_arm_link*pa4;
+    w.pA_shoulder_link[3] = w.pA_shoulder_link[3] + 0.1625*pa2 + w.cq[1]*pa3 - w.sq[1]*pa4;
     w.pA_shoulder_link[4] = -tau[1] + 0.1625*t20;
-    w.pA_shoulder_link[5] = w.sq_upper_arm_link*pa3 + w.cq_upper_arm_link*pa4;
+    w.pA_shoulder_link[5] = w.sq[1]*pa3 + w.cq[1]*pa4;
     // columns 0 to 4
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
       w.KSD_upper_arm_link[j] = w.Dinv_upper_arm_link*w.KA_upper_arm_link[5][j];
@@ -1385,14 +1385,14 @@ PROXGEN_RT_NOINLINE void pv_backward_upper_arm_link(const Scalar* PROXGEN_RT_RES
       const Scalar t24 = w.KA_upper_arm_link[2][j] - w.IA_upper_arm_link[14]*w.KSD_upper_arm_link[j];
       const Scalar t25 = w.KA_upper_arm_link[3][j] - w.IA_upper_arm_link[17]*w.KSD_upper_arm_link[j];
       const Scalar t26 = w.KA_upper_arm_link[4][j] - w.IA_upper_arm_link[19]*w.KSD_upper_arm_link[j];
-      const Scalar t27 = w.cq_upper_arm_link*t22 - w.sq_upper_arm_link*t23;
-      const Scalar t28 = w.sq_upper_arm_link*t22 + w.cq_upper_arm_link*t23;
+      const Scalar t27 = w.cq[1]*t22 - w.sq[1]*t23;
+      const Scalar t28 = w.sq[1]*t22 + w.cq[1]*t23;
       w.KA_shoulder_link[0][j] = t27;
       w.KA_shoulder_link[1][j] = -t24;
       w.KA_shoulder_link[2][j] = t28;
-      w.KA_shoulder_link[3][j] = 0.1625*t24 + w.cq_upper_arm_link*t25 - w.sq_upper_arm_link*t26;
+      w.KA_shoulder_link[3][j] = 0.1625*t24 + w.cq[1]*t25 - w.sq[1]*t26;
       w.KA_shoulder_link[4][j] = 0.1625*t27;
-      w.KA_shoulder_link[5][j] = w.sq_upper_arm_link*t25 + w.cq_upper_arm_link*t26;
+      w.KA_shoulder_link[5][j] = w.sq[1]*t25 + w.cq[1]*t26;
     }
   }
 }
@@ -1417,11 +1417,11 @@ PROXGEN_RT_NOINLINE void pv_free_shoulder_link_to_wrist_2_link(Workspace& PROXGE
   }
   // free acceleration (lambda = 0): body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
-    w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
-    w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
+    const Scalar t1 = w.c_upper_arm_link[3] + w.sq[1]*w.a_shoulder_link[5];
+    const Scalar t2 = w.c_upper_arm_link[4] + w.cq[1]*w.a_shoulder_link[5];
+    const Scalar t3 = w.u_upper_arm_link[0] - 9.81*w.sq[1]*w.IA_upper_arm_link[5] - 9.81*w.cq[1]*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    w.a_upper_arm_link[0] = 9.81*w.sq[1];
+    w.a_upper_arm_link[1] = 9.81*w.cq[1];
     w.a_upper_arm_link[3] = t1;
     w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.Dinv_upper_arm_link*t3;
@@ -1429,10 +1429,10 @@ PROXGEN_RT_NOINLINE void pv_free_shoulder_link_to_wrist_2_link(Workspace& PROXGE
   // free acceleration (lambda = 0): body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     const Scalar t4 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
-    const Scalar t5 = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
-    const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t5 = w.c_forearm_link[0] + w.cq[2]*w.a_upper_arm_link[0] + w.sq[2]*t4;
+    const Scalar t6 = w.c_forearm_link[1] - w.sq[2]*w.a_upper_arm_link[0] + w.cq[2]*t4;
+    const Scalar t7 = w.c_forearm_link[3] + w.cq[2]*w.a_upper_arm_link[3] + w.sq[2]*w.a_upper_arm_link[4];
+    const Scalar t8 = w.c_forearm_link[4] - w.sq[2]*w.a_upper_arm_link[3] + w.cq[2]*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.a_forearm_link[0] = t5;
     w.a_forearm_link[1] = t6;
@@ -1445,10 +1445,10 @@ PROXGEN_RT_NOINLINE void pv_free_shoulder_link_to_wrist_2_link(Workspace& PROXGE
   {
     const Scalar t10 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
     const Scalar t11 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
-    const Scalar t12 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
-    const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t12 = w.c_wrist_1_link[0] + w.cq[3]*w.a_forearm_link[0] + w.sq[3]*t10;
+    const Scalar t13 = w.c_wrist_1_link[1] - w.sq[3]*w.a_forearm_link[0] + w.cq[3]*t10;
+    const Scalar t14 = w.c_wrist_1_link[3] + w.cq[3]*w.a_forearm_link[3] + w.sq[3]*w.a_forearm_link[4];
+    const Scalar t15 = w.c_wrist_1_link[4] - w.sq[3]*w.a_forearm_link[3] + w.cq[3]*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.a_wrist_1_link[0] = t12;
     w.a_wrist_1_link[1] = t13;
@@ -1461,10 +1461,10 @@ PROXGEN_RT_NOINLINE void pv_free_shoulder_link_to_wrist_2_link(Workspace& PROXGE
   {
     const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq[4]*t17 + w.sq[4]*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq[4]*t17 + w.cq[4]*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq[4]*w.a_wrist_1_link[3] + w.sq[4]*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq[4]*w.a_wrist_1_link[3] + w.cq[4]*w.a_wrist_1_link[5];
     const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
     w.a_wrist_2_link[0] = t19;
     w.a_wrist_2_link[1] = t20;
@@ -1480,10 +1480,10 @@ PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RES
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
     const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
-    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
-    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
-    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq[5]*t0 - w.a_wrist_2_link[2]*w.sq[5];
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq[5]*t0 - w.a_wrist_2_link[2]*w.cq[5];
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq[5] - w.a_wrist_2_link[5]*w.sq[5];
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq[5] - w.a_wrist_2_link[5]*w.cq[5];
     const Scalar t6 = -0.0003695625*w.a_wrist_2_link[4] + w.u_wrist_3_link[0];
     w.a_wrist_3_link[0] = t2;
     w.a_wrist_3_link[1] = t3;
@@ -1612,12 +1612,12 @@ PROXGEN_RT_NOINLINE void pv_forward_shoulder_link_to_wrist_2_link(Workspace& PRO
   }
   // accelerate, with the multipliers of the subtree rows: body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    const Scalar t1 = w.c_upper_arm_link[3] + w.sq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t2 = w.c_upper_arm_link[4] + w.cq_upper_arm_link*w.a_shoulder_link[5];
-    const Scalar t3 = w.u_upper_arm_link[0] - w.KA_upper_arm_link[5][0]*w.lambda[0] - w.KA_upper_arm_link[5][1]*w.lambda[1] - w.KA_upper_arm_link[5][2]*w.lambda[2] - w.KA_upper_arm_link[5][3]*w.lambda[3] - w.KA_upper_arm_link[5][4]*w.lambda[4] - 9.81*w.sq_upper_arm_link*w.IA_upper_arm_link[5] - 9.81*w.cq_upper_arm_link*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
+    const Scalar t1 = w.c_upper_arm_link[3] + w.sq[1]*w.a_shoulder_link[5];
+    const Scalar t2 = w.c_upper_arm_link[4] + w.cq[1]*w.a_shoulder_link[5];
+    const Scalar t3 = w.u_upper_arm_link[0] - w.KA_upper_arm_link[5][0]*w.lambda[0] - w.KA_upper_arm_link[5][1]*w.lambda[1] - w.KA_upper_arm_link[5][2]*w.lambda[2] - w.KA_upper_arm_link[5][3]*w.lambda[3] - w.KA_upper_arm_link[5][4]*w.lambda[4] - 9.81*w.sq[1]*w.IA_upper_arm_link[5] - 9.81*w.cq[1]*w.IA_upper_arm_link[10] - w.IA_upper_arm_link[17]*t1 - w.IA_upper_arm_link[19]*t2;
     w.qdd[1] = w.Dinv_upper_arm_link*t3;
-    w.a_upper_arm_link[0] = 9.81*w.sq_upper_arm_link;
-    w.a_upper_arm_link[1] = 9.81*w.cq_upper_arm_link;
+    w.a_upper_arm_link[0] = 9.81*w.sq[1];
+    w.a_upper_arm_link[1] = 9.81*w.cq[1];
     w.a_upper_arm_link[3] = t1;
     w.a_upper_arm_link[4] = t2;
     w.a_upper_arm_link[5] = w.qdd[1];
@@ -1625,10 +1625,10 @@ PROXGEN_RT_NOINLINE void pv_forward_shoulder_link_to_wrist_2_link(Workspace& PRO
   // accelerate, with the multipliers of the subtree rows: body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
     const Scalar t4 = w.a_upper_arm_link[1] - 0.425*w.a_upper_arm_link[5];
-    const Scalar t5 = w.c_forearm_link[0] + w.cq_forearm_link*w.a_upper_arm_link[0] + w.sq_forearm_link*t4;
-    const Scalar t6 = w.c_forearm_link[1] - w.sq_forearm_link*w.a_upper_arm_link[0] + w.cq_forearm_link*t4;
-    const Scalar t7 = w.c_forearm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[3] + w.sq_forearm_link*w.a_upper_arm_link[4];
-    const Scalar t8 = w.c_forearm_link[4] - w.sq_forearm_link*w.a_upper_arm_link[3] + w.cq_forearm_link*w.a_upper_arm_link[4];
+    const Scalar t5 = w.c_forearm_link[0] + w.cq[2]*w.a_upper_arm_link[0] + w.sq[2]*t4;
+    const Scalar t6 = w.c_forearm_link[1] - w.sq[2]*w.a_upper_arm_link[0] + w.cq[2]*t4;
+    const Scalar t7 = w.c_forearm_link[3] + w.cq[2]*w.a_upper_arm_link[3] + w.sq[2]*w.a_upper_arm_link[4];
+    const Scalar t8 = w.c_forearm_link[4] - w.sq[2]*w.a_upper_arm_link[3] + w.cq[2]*w.a_upper_arm_link[4];
     const Scalar t9 = w.u_forearm_link[0] - w.KA_forearm_link[5][0]*w.lambda[0] - w.KA_forearm_link[5][1]*w.lambda[1] - w.KA_forearm_link[5][2]*w.lambda[2] - w.KA_forearm_link[5][3]*w.lambda[3] - w.KA_forearm_link[5][4]*w.lambda[4] - w.IA_forearm_link[5]*t5 - w.IA_forearm_link[10]*t6 - 0.425*w.IA_forearm_link[14]*w.a_upper_arm_link[4] - w.IA_forearm_link[17]*t7 - w.IA_forearm_link[19]*t8 - w.IA_forearm_link[20]*w.a_upper_arm_link[5];
     w.qdd[2] = w.Dinv_forearm_link*t9;
     w.a_forearm_link[0] = t5;
@@ -1642,10 +1642,10 @@ PROXGEN_RT_NOINLINE void pv_forward_shoulder_link_to_wrist_2_link(Workspace& PRO
   {
     const Scalar t10 = w.a_forearm_link[1] - 0.3922*w.a_forearm_link[5];
     const Scalar t11 = w.a_forearm_link[2] + 0.3922*w.a_forearm_link[4];
-    const Scalar t12 = w.c_wrist_1_link[0] + w.cq_wrist_1_link*w.a_forearm_link[0] + w.sq_wrist_1_link*t10;
-    const Scalar t13 = w.c_wrist_1_link[1] - w.sq_wrist_1_link*w.a_forearm_link[0] + w.cq_wrist_1_link*t10;
-    const Scalar t14 = w.c_wrist_1_link[3] + w.cq_wrist_1_link*w.a_forearm_link[3] + w.sq_wrist_1_link*w.a_forearm_link[4];
-    const Scalar t15 = w.c_wrist_1_link[4] - w.sq_wrist_1_link*w.a_forearm_link[3] + w.cq_wrist_1_link*w.a_forearm_link[4];
+    const Scalar t12 = w.c_wrist_1_link[0] + w.cq[3]*w.a_forearm_link[0] + w.sq[3]*t10;
+    const Scalar t13 = w.c_wrist_1_link[1] - w.sq[3]*w.a_forearm_link[0] + w.cq[3]*t10;
+    const Scalar t14 = w.c_wrist_1_link[3] + w.cq[3]*w.a_forearm_link[3] + w.sq[3]*w.a_forearm_link[4];
+    const Scalar t15 = w.c_wrist_1_link[4] - w.sq[3]*w.a_forearm_link[3] + w.cq[3]*w.a_forearm_link[4];
     const Scalar t16 = w.u_wrist_1_link[0] - w.KA_wrist_1_link[5][0]*w.lambda[0] - w.KA_wrist_1_link[5][1]*w.lambda[1] - w.KA_wrist_1_link[5][2]*w.lambda[2] - w.KA_wrist_1_link[5][3]*w.lambda[3] - w.KA_wrist_1_link[5][4]*w.lambda[4] - w.IA_wrist_1_link[5]*t12 - w.IA_wrist_1_link[10]*t13 - w.IA_wrist_1_link[14]*t11 - w.IA_wrist_1_link[17]*t14 - w.IA_wrist_1_link[19]*t15 - w.IA_wrist_1_link[20]*w.a_forearm_link[5];
     w.qdd[3] = w.Dinv_wrist_1_link*t16;
     w.a_wrist_1_link[0] = t12;
@@ -1659,10 +1659,10 @@ PROXGEN_RT_NOINLINE void pv_forward_shoulder_link_to_wrist_2_link(Workspace& PRO
   {
     const Scalar t17 = w.a_wrist_1_link[0] + 0.1333*w.a_wrist_1_link[4];
     const Scalar t18 = -w.a_wrist_1_link[1] + 0.1333*w.a_wrist_1_link[3];
-    const Scalar t19 = w.c_wrist_2_link[0] + w.cq_wrist_2_link*t17 + w.sq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t20 = w.c_wrist_2_link[1] - w.sq_wrist_2_link*t17 + w.cq_wrist_2_link*w.a_wrist_1_link[2];
-    const Scalar t21 = w.c_wrist_2_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[3] + w.sq_wrist_2_link*w.a_wrist_1_link[5];
-    const Scalar t22 = w.c_wrist_2_link[4] - w.sq_wrist_2_link*w.a_wrist_1_link[3] + w.cq_wrist_2_link*w.a_wrist_1_link[5];
+    const Scalar t19 = w.c_wrist_2_link[0] + w.cq[4]*t17 + w.sq[4]*w.a_wrist_1_link[2];
+    const Scalar t20 = w.c_wrist_2_link[1] - w.sq[4]*t17 + w.cq[4]*w.a_wrist_1_link[2];
+    const Scalar t21 = w.c_wrist_2_link[3] + w.cq[4]*w.a_wrist_1_link[3] + w.sq[4]*w.a_wrist_1_link[5];
+    const Scalar t22 = w.c_wrist_2_link[4] - w.sq[4]*w.a_wrist_1_link[3] + w.cq[4]*w.a_wrist_1_link[5];
     const Scalar t23 = w.u_wrist_2_link[0] + 0.005433872322232001*w.a_wrist_1_link[4] - w.KA_wrist_2_link[5][0]*w.lambda[0] - w.KA_wrist_2_link[5][1]*w.lambda[1] - w.KA_wrist_2_link[5][3]*w.lambda[3] - w.KA_wrist_2_link[5][4]*w.lambda[4] + 0.057172965000000006*t19 + 0.0056619090105*t22;
     w.qdd[4] = 184.03082382127872*t23;
     w.a_wrist_2_link[0] = t19;
@@ -1679,10 +1679,10 @@ PROXGEN_RT_NOINLINE void pv_forward_wrist_3_link(Workspace& PROXGEN_RT_RESTRICT 
   {
     const Scalar t0 = w.a_wrist_2_link[0] + 0.0997*w.a_wrist_2_link[4];
     const Scalar t1 = w.a_wrist_2_link[1] - 0.0997*w.a_wrist_2_link[3];
-    const Scalar t2 = w.c_wrist_3_link[0] + w.cq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.sq_wrist_3_link;
-    const Scalar t3 = w.c_wrist_3_link[1] - w.sq_wrist_3_link*t0 - w.a_wrist_2_link[2]*w.cq_wrist_3_link;
-    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq_wrist_3_link - w.a_wrist_2_link[5]*w.sq_wrist_3_link;
-    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq_wrist_3_link - w.a_wrist_2_link[5]*w.cq_wrist_3_link;
+    const Scalar t2 = w.c_wrist_3_link[0] + w.cq[5]*t0 - w.a_wrist_2_link[2]*w.sq[5];
+    const Scalar t3 = w.c_wrist_3_link[1] - w.sq[5]*t0 - w.a_wrist_2_link[2]*w.cq[5];
+    const Scalar t4 = w.c_wrist_3_link[3] + w.a_wrist_2_link[3]*w.cq[5] - w.a_wrist_2_link[5]*w.sq[5];
+    const Scalar t5 = w.c_wrist_3_link[4] - w.a_wrist_2_link[3]*w.sq[5] - w.a_wrist_2_link[5]*w.cq[5];
     const Scalar t6 = -0.0003695625*w.a_wrist_2_link[4] + w.u_wrist_3_link[0] - w.lambda[5];
     w.qdd[5] = 2705.9022492812446*t6;
     w.a_wrist_3_link[0] = t2;
@@ -1712,6 +1712,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+  proxgen_rt::sincos_run<6>(&q[0], &w.sq[0], &w.cq[0]);
   // ---- joint transforms X_J(q)
   kinematics_transforms_shoulder_link_to_wrist_3_link(q, w);
   // ---- velocities, bias forces, gravity, placements, constraint terms

@@ -85,18 +85,8 @@ struct Settings {
 // Everything one solve writes (4928 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
-  Scalar sq_shoulder_link;     // sin q, body 1
-  Scalar cq_shoulder_link;     // cos q, body 1
-  Scalar sq_upper_arm_link;    // sin q, body 2
-  Scalar cq_upper_arm_link;    // cos q, body 2
-  Scalar sq_forearm_link;      // sin q, body 3
-  Scalar cq_forearm_link;      // cos q, body 3
-  Scalar sq_wrist_1_link;      // sin q, body 4
-  Scalar cq_wrist_1_link;      // cos q, body 4
-  Scalar sq_wrist_2_link;      // sin q, body 5
-  Scalar cq_wrist_2_link;      // cos q, body 5
-  Scalar sq_wrist_3_link;      // sin q, body 6
-  Scalar cq_wrist_3_link;      // cos q, body 6
+  Scalar sq[6];                // sin q of the revolute joints (q order)
+  Scalar cq[6];                // cos q of the revolute joints (q order)
   Scalar pA_shoulder_link[6];  // bias force, body 1
   Scalar v_upper_arm_link[6];  // velocity, body 2
   Scalar c_upper_arm_link[6];  // velocity-product acceleration, body 2

@@ -64,7 +64,7 @@
 
 #include "humanoid.hpp"
 
-#include "proxgen/runtime.hpp"
+#include "proxgen/lanes.hpp"  // the runtime, and the lanes of sincos_run
 
 namespace humanoid {
 
@@ -82,7 +82,7 @@ using MultiplierRows = const Scalar*;
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
 PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
   v_m2[2] = v_m3[3] + v[0];
@@ -109,7 +109,7 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
 PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = 0.9950041652780258*v_m2[0] + 0.09983341664682815*v_m3[1];
   const Scalar x1 = -0.09983341664682815*v_m2[0] + 0.9950041652780258*v_m3[1];
   const Scalar x2 = 0.9950041652780258*v_m3[2] + 0.09983341664682815*v_m3[4];
@@ -142,7 +142,7 @@ PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
 PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] - 0.42875*v_m2[4];
   const Scalar x1 = v_m3[0] + 0.42875*v_m2[3];
   const Scalar x2 = -0.19866933079506124*v_m2[2] + 0.9800665778412416*x0;
@@ -178,7 +178,7 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
 PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] - 0.4305*v_m2[4];
   const Scalar x1 = v_m2[1] + 0.4305*v_m2[3];
   const Scalar x2 = 0.09983341664682815*v_m2[2] + 0.9950041652780258*x0;
@@ -207,7 +207,7 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
 PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
   v_m2[2] = v_m3[3] + v[0];
@@ -238,7 +238,7 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 constexpr Scalar shared_5_k0[16] = {-0.2555, 0.2555, 0.1, 0.001, 0.1, -0.001, -0.001, 3.5000000000000004e-05, 0.001, 3.5000000000000004e-05, 0.1, -0.1, 2.5e-05, 0.1, -2.5e-05, -0.1};
 constexpr Scalar shared_5_k1[16] = {0.29, -0.29, 0.5, 0.015, 0.5, -0.015, -0.015, 0.0007700000000000001, 0.015, 0.0007700000000000001, 0.5, -0.5, 0.00032, 0.5, -0.00032, -0.5};
 PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5) noexcept {
-  proxgen_rt::sincos_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
   const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
   v_m3[0] = cq_m1[0]*x0 + sq_m0[0]*x1;
@@ -264,7 +264,7 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, r_wrist_yaw_link.
 // The first: eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[20];
   u_m2[0] = -pA_m3[5] + tau[0];
   const Scalar x0 = IA_m1[5]*Dinv_m0[0];
@@ -286,10 +286,10 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[1]*x9 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[1]*x10 + c_m4[3]*x13;
   const Scalar x18 = 0.001*c_m4[0] + 3.5000000000000004e-05*c_m4[4] + pA_m3[4];
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(x4 - x8);
   const Scalar x21 = 0.5*(x4 + x8);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x5*x22;
   const Scalar x24 = x20*x22 + x5*x19;
   const Scalar x25 = 0.0005 + 0.5*x10;
@@ -298,9 +298,9 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x28 = -1.7500000000000002e-05 + 0.5*x13;
   const Scalar x29 = 1.7500000000000002e-05 + 0.5*x13;
   const Scalar x30 = x21 + x23;
-  const Scalar x31 = cq_m5*x6 - sq_m6*x9;
+  const Scalar x31 = cq_m5[0]*x6 - sq_m6[0]*x9;
   const Scalar x32 = x21 - x23;
-  const Scalar x33 = sq_m6*x6 + cq_m5*x9;
+  const Scalar x33 = sq_m6[0]*x6 + cq_m5[0]*x9;
   const Scalar x34 = 0.5*x7 + x26;
   const Scalar x35 = 0.0005 - 0.5*x10 + x27;
   const Scalar x36 = -0.0005 + 0.5*x10 + x27;
@@ -309,10 +309,10 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x39 = -0.2555*x30 + x35;
   const Scalar x40 = 0.2555*x32 + x36;
   const Scalar x41 = -0.2555*x24 + x37;
-  const Scalar x42 = cq_m5*x12 + 0.2555*x33;
-  const Scalar x43 = sq_m6*x12 - 0.2555*x31;
-  const Scalar x44 = cq_m5*x14 - sq_m6*x15;
-  const Scalar x45 = sq_m6*x14 + cq_m5*x15;
+  const Scalar x42 = cq_m5[0]*x12 + 0.2555*x33;
+  const Scalar x43 = sq_m6[0]*x12 - 0.2555*x31;
+  const Scalar x44 = cq_m5[0]*x14 - sq_m6[0]*x15;
+  const Scalar x45 = sq_m6[0]*x14 + cq_m5[0]*x15;
   IA_m7[0] = 0.92 + x30;
   IA_m7[1] = x24;
   IA_m7[2] = x31;
@@ -331,14 +331,14 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   pA_m8[0] = pA_m8[0] + x44;
   pA_m8[1] = pA_m8[1] + x45;
   pA_m8[2] = pA_m8[2] + x16;
-  pA_m8[3] = pA_m8[3] + cq_m5*x17 - sq_m6*x18 + 0.2555*x45;
-  pA_m8[4] = pA_m8[4] + sq_m6*x17 + cq_m5*x18 - 0.2555*x44;
+  pA_m8[3] = pA_m8[3] + cq_m5[0]*x17 - sq_m6[0]*x18 + 0.2555*x45;
+  pA_m8[4] = pA_m8[4] + sq_m6[0]*x17 + cq_m5[0]*x18 - 0.2555*x44;
   pA_m8[5] = pA_m8[5] + tau[0];
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_forearm, r_forearm.
 // The first: eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -360,10 +360,10 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x12 + c_m4[3]*x13;
   const Scalar x18 = 0.0005635*c_m4[5] + pA_m3[5];
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(-x4 + x11);
   const Scalar x21 = 0.5*(x4 + x11);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x6*x22;
   const Scalar x24 = x20*x22 + x6*x19;
   const Scalar x25 = 0.5*(-x7*x19 - x12*x22);
@@ -371,10 +371,10 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x27 = 0.00028175 - 0.5*x13;
   const Scalar x28 = 0.00028175 + 0.5*x13;
   const Scalar x29 = 0.955336489125606*x21 - 0.955336489125606*x23 - 0.29552020666133966*x24;
-  const Scalar x30 = -0.29552020666133966*cq_m5*x9 + 0.29552020666133966*sq_m6*x5 + 0.955336489125606*sq_m6*x9 + 0.955336489125606*cq_m5*x5;
+  const Scalar x30 = -0.29552020666133966*cq_m5[0]*x9 + 0.29552020666133966*sq_m6[0]*x5 + 0.955336489125606*sq_m6[0]*x9 + 0.955336489125606*cq_m5[0]*x5;
   const Scalar x31 = -0.29552020666133966*x21 - 0.29552020666133966*x23 + 0.955336489125606*x24;
-  const Scalar x32 = sq_m6*x9 + cq_m5*x5;
-  const Scalar x33 = cq_m5*x9 - sq_m6*x5;
+  const Scalar x32 = sq_m6[0]*x9 + cq_m5[0]*x5;
+  const Scalar x33 = cq_m5[0]*x9 - sq_m6[0]*x5;
   const Scalar x34 = 0.29552020666133966*x21 - 0.29552020666133966*x23 + 0.955336489125606*x24;
   const Scalar x35 = 0.955336489125606*x21 + 0.955336489125606*x23 + 0.29552020666133966*x24;
   const Scalar x36 = 0.477668244562803*x7 - 0.14776010333066983*x12 - 0.955336489125606*x25 - 0.29552020666133966*x26;
@@ -391,17 +391,17 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x47 = 0.29552020666133966*x34 + 0.955336489125606*x35;
   const Scalar x48 = 0.955336489125606*x36 - 0.29552020666133966*x37;
   const Scalar x49 = 0.29552020666133966*x36 + 0.955336489125606*x37;
-  const Scalar x50 = 0.29552020666133966*sq_m6*x10 + 0.955336489125606*cq_m5*x10;
-  const Scalar x51 = -0.955336489125606*sq_m6*x10 + 0.29552020666133966*cq_m5*x10;
+  const Scalar x50 = 0.29552020666133966*sq_m6[0]*x10 + 0.955336489125606*cq_m5[0]*x10;
+  const Scalar x51 = -0.955336489125606*sq_m6[0]*x10 + 0.29552020666133966*cq_m5[0]*x10;
   const Scalar x52 = 0.955336489125606*x38 - 0.29552020666133966*x39;
   const Scalar x53 = 0.29552020666133966*x38 + 0.955336489125606*x39;
   const Scalar x54 = 0.3255*x30 + x48;
   const Scalar x55 = 0.3255*x8 + x50;
   const Scalar x56 = 0.3255*x46 + x52;
-  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
-  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
-  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
-  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x57 = cq_m5[0]*x14 + sq_m6[0]*x16;
+  const Scalar x58 = -sq_m6[0]*x14 + cq_m5[0]*x16;
+  const Scalar x59 = cq_m5[0]*x17 + sq_m6[0]*x18;
+  const Scalar x60 = -sq_m6[0]*x17 + cq_m5[0]*x18;
   const Scalar x61 = 0.955336489125606*x57 - 0.29552020666133966*x58;
   const Scalar x62 = 0.29552020666133966*x57 + 0.955336489125606*x58;
   IA_m7[0] = 1.96 + x44;
@@ -435,7 +435,7 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
 
 // 2 blocks of the same code, each over its constants (k) and members: l_upper_arm, r_upper_arm.
 // The first: eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[20];
   u_m2[0] = -pA_m3[5] + tau[0];
   const Scalar x0 = IA_m1[5]*Dinv_m0[0];
@@ -463,10 +463,10 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[1]*x11 + c_m4[3]*x15 + c_m4[4]*x16;
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[1]*x12 + c_m4[3]*x17 + c_m4[4]*x18;
   const Scalar x24 = pA_m3[4] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[1]*x13 + c_m4[3]*x18 + c_m4[4]*x19;
-  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x26 = 0.5*(x5 - x10);
   const Scalar x27 = 0.5*(x5 + x10);
-  const Scalar x28 = 2.0*cq_m5*sq_m6;
+  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x29 = x25*x26 - x6*x28;
   const Scalar x30 = x26*x28 + x6*x25;
   const Scalar x31 = 0.5*(x8 - x13);
@@ -480,24 +480,24 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
   const Scalar x39 = x28*x36 + x18*x25;
   IA_m7[0] = 0.3 + x27 + x29;
   IA_m7[1] = x30;
-  IA_m7[2] = cq_m5*x7 - sq_m6*x11;
+  IA_m7[2] = cq_m5[0]*x7 - sq_m6[0]*x11;
   IA_m7[3] = x32 + x34;
   IA_m7[4] = -0.009 + 0.5*x9 - 0.5*x12 + x35;
   IA_m7[6] = 0.3 + x27 - x29;
-  IA_m7[7] = sq_m6*x7 + cq_m5*x11;
+  IA_m7[7] = sq_m6[0]*x7 + cq_m5[0]*x11;
   IA_m7[8] = 0.009 - 0.5*x9 + 0.5*x12 + x35;
   IA_m7[9] = x32 - x34;
   IA_m7[11] = 0.3 + x14;
-  IA_m7[12] = cq_m5*x15 - sq_m6*x16;
-  IA_m7[13] = sq_m6*x15 + cq_m5*x16;
+  IA_m7[12] = cq_m5[0]*x15 - sq_m6[0]*x16;
+  IA_m7[13] = sq_m6[0]*x15 + cq_m5[0]*x16;
   IA_m7[15] = 0.00046199999999999995 + x37 + x38;
   IA_m7[16] = x39;
   IA_m7[18] = 0.00046199999999999995 + x37 - x38;
-  pA_m8[0] = pA_m8[0] + cq_m5*x20 - sq_m6*x21;
-  pA_m8[1] = pA_m8[1] + sq_m6*x20 + cq_m5*x21;
+  pA_m8[0] = pA_m8[0] + cq_m5[0]*x20 - sq_m6[0]*x21;
+  pA_m8[1] = pA_m8[1] + sq_m6[0]*x20 + cq_m5[0]*x21;
   pA_m8[2] = pA_m8[2] + x22;
-  pA_m8[3] = pA_m8[3] + cq_m5*x23 - sq_m6*x24;
-  pA_m8[4] = pA_m8[4] + sq_m6*x23 + cq_m5*x24;
+  pA_m8[3] = pA_m8[3] + cq_m5[0]*x23 - sq_m6[0]*x24;
+  pA_m8[4] = pA_m8[4] + sq_m6[0]*x23 + cq_m5[0]*x24;
   pA_m8[5] = pA_m8[5] + tau[0];
 }
 
@@ -505,7 +505,7 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar*
 // The first: eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
 constexpr Scalar shared_9_k0[1] = {-0.009};
 constexpr Scalar shared_9_k1[1] = {0.009};
-PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
@@ -527,10 +527,10 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[3]*x12;
   const Scalar x17 = pA_m3[4] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[3]*x13;
   const Scalar x18 = 0.000192*c_m4[4] + pA_m3[5];
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(x8 - x11);
   const Scalar x21 = 0.5*(x8 + x11);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
   const Scalar x25 = 0.5*(x10*x19 - x12*x22);
@@ -538,10 +538,10 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x27 = -9.6e-05 + 0.5*x13;
   const Scalar x28 = 9.6e-05 + 0.5*x13;
   IA_m7[0] = 0.3 + x4;
-  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
-  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
-  IA_m7[4] = cq_m5*x7;
-  IA_m7[5] = k[0] + sq_m6*x7;
+  IA_m7[1] = cq_m5[0]*x5 - sq_m6[0]*x6;
+  IA_m7[2] = sq_m6[0]*x5 + cq_m5[0]*x6;
+  IA_m7[4] = cq_m5[0]*x7;
+  IA_m7[5] = k[0] + sq_m6[0]*x7;
   IA_m7[6] = 0.3 + x21 + x23;
   IA_m7[7] = x24;
   IA_m7[9] = 0.5*x10 + x25;
@@ -553,16 +553,16 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   IA_m7[19] = x22*x27;
   IA_m7[20] = 0.00046199999999999995 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
-  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
-  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[1] = pA_m8[1] + cq_m5[0]*x15 - sq_m6[0]*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6[0]*x15 + cq_m5[0]*x16;
   pA_m8[3] = pA_m8[3] + tau[0];
-  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
-  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+  pA_m8[4] = pA_m8[4] + cq_m5[0]*x17 - sq_m6[0]*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6[0]*x17 + cq_m5[0]*x18;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar cq_m9, Scalar sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
+PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar* PROXGEN_RT_RESTRICT cq_m9, Scalar* PROXGEN_RT_RESTRICT sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
   const Scalar x0 = mu*active_m0[0];
   U_m1[0] = 0.027912499999999996 + 0.06825*x0;
   U_m1[2] = 0.00194517348958 + 1.0046580625*x0;
@@ -580,16 +580,16 @@ PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x10 = -0.06495999999999999*c_m8[3] + pA_m4[2] + lambda_m5[2] + g_m6[1]*x0 + c_m8[1]*x2;
   const Scalar x11 = -0.06495999999999999*c_m8[1] + pA_m4[4] - 0.06825*lambda_m5[0] + lambda_m5[4] - 0.06825*g_m7[0]*x0 + c_m8[3]*x6;
   const Scalar x12 = pA_m4[5] + lambda_m5[5] + 0.0017863999999999998*Dinv_m2[0]*u_m3[0] + c_m8[0]*x5 + c_m8[4]*x7;
-  const Scalar x13 = cq_m9*cq_m9 - sq_m10*sq_m10;
+  const Scalar x13 = cq_m9[0]*cq_m9[0] - sq_m10[0]*sq_m10[0];
   const Scalar x14 = 0.5*(-x2 + x4);
   const Scalar x15 = 0.5*(x2 + x4);
-  const Scalar x16 = 2.0*cq_m9*sq_m10;
+  const Scalar x16 = 2.0*cq_m9[0]*sq_m10[0];
   const Scalar x17 = -0.032479999999999995 + 0.5*x5;
   const Scalar x18 = 0.5*(x6 - x7);
   const Scalar x19 = 0.5*(x6 + x7);
   IA_m11[0] = 0.2 + x2;
-  IA_m11[4] = cq_m9*x3;
-  IA_m11[5] = sq_m10*x3;
+  IA_m11[4] = cq_m9[0]*x3;
+  IA_m11[5] = sq_m10[0]*x3;
   IA_m11[6] = 0.2 + x15 + x13*x14;
   IA_m11[7] = x14*x16;
   IA_m11[9] = -x16*x17;
@@ -601,16 +601,16 @@ PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   IA_m11[19] = x16*x18;
   IA_m11[20] = 7.2e-05 + x19 - x13*x18;
   pA_m12[0] = pA_m12[0] + x8;
-  pA_m12[1] = pA_m12[1] + cq_m9*x9 - sq_m10*x10;
-  pA_m12[2] = pA_m12[2] + sq_m10*x9 + cq_m9*x10;
+  pA_m12[1] = pA_m12[1] + cq_m9[0]*x9 - sq_m10[0]*x10;
+  pA_m12[2] = pA_m12[2] + sq_m10[0]*x9 + cq_m9[0]*x10;
   pA_m12[3] = tau[0];
-  pA_m12[4] = cq_m9*x11 - sq_m10*x12;
-  pA_m12[5] = sq_m10*x11 + cq_m9*x12;
+  pA_m12[4] = cq_m9[0]*x11 - sq_m10[0]*x12;
+  pA_m12[5] = sq_m10[0]*x11 + cq_m9[0]*x12;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -632,10 +632,10 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
   const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(-x4 + x9);
   const Scalar x21 = 0.5*(x4 + x9);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x12*x22;
   const Scalar x24 = x20*x22 + x12*x19;
   const Scalar x25 = 0.5*(x10*x19 - x5*x22);
@@ -643,10 +643,10 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x27 = -3.6e-05 + 0.5*x11;
   const Scalar x28 = 3.6e-05 + 0.5*x11;
   const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
-  const Scalar x30 = -0.09983341664682815*cq_m5*x7 + 0.09983341664682815*sq_m6*x13 + 0.9950041652780258*sq_m6*x7 + 0.9950041652780258*cq_m5*x13;
+  const Scalar x30 = -0.09983341664682815*cq_m5[0]*x7 + 0.09983341664682815*sq_m6[0]*x13 + 0.9950041652780258*sq_m6[0]*x7 + 0.9950041652780258*cq_m5[0]*x13;
   const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x32 = sq_m6*x7 + cq_m5*x13;
-  const Scalar x33 = cq_m5*x7 - sq_m6*x13;
+  const Scalar x32 = sq_m6[0]*x7 + cq_m5[0]*x13;
+  const Scalar x33 = cq_m5[0]*x7 - sq_m6[0]*x13;
   const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
   const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
   const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
@@ -663,17 +663,17 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
   const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
-  const Scalar x50 = -0.09983341664682815*cq_m5*x8 + 0.9950041652780258*sq_m6*x8;
-  const Scalar x51 = 0.9950041652780258*cq_m5*x8 + 0.09983341664682815*sq_m6*x8;
+  const Scalar x50 = -0.09983341664682815*cq_m5[0]*x8 + 0.9950041652780258*sq_m6[0]*x8;
+  const Scalar x51 = 0.9950041652780258*cq_m5[0]*x8 + 0.09983341664682815*sq_m6[0]*x8;
   const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
   const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x54 = 0.4305*x30 + x48;
   const Scalar x55 = 0.4305*x6 + x50;
   const Scalar x56 = 0.4305*x46 + x52;
-  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
-  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
-  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
-  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x57 = cq_m5[0]*x14 + sq_m6[0]*x16;
+  const Scalar x58 = -sq_m6[0]*x14 + cq_m5[0]*x16;
+  const Scalar x59 = cq_m5[0]*x17 + sq_m6[0]*x18;
+  const Scalar x60 = -sq_m6[0]*x17 + cq_m5[0]*x18;
   const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
   const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
   IA_m7[0] = 3.055 + x44;
@@ -707,7 +707,7 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -735,10 +735,10 @@ PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x26 = 0.5*(-x5 + x14);
   const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5*sq_m6;
+  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
   const Scalar x31 = 0.5*(-x8 + x16);
@@ -751,16 +751,16 @@ PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
   const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
-  const Scalar x41 = 0.19866933079506124*cq_m5*x11 - 0.19866933079506124*sq_m6*x6 + 0.9800665778412416*sq_m6*x11 + 0.9800665778412416*cq_m5*x6;
+  const Scalar x41 = 0.19866933079506124*cq_m5[0]*x11 - 0.19866933079506124*sq_m6[0]*x6 + 0.9800665778412416*sq_m6[0]*x11 + 0.9800665778412416*cq_m5[0]*x6;
   const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
-  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
+  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
   const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
   const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
   const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
   const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
-  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
+  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
   const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
   const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
   const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
@@ -780,10 +780,10 @@ PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x67 = 0.42875*x41 + x61;
   const Scalar x68 = 0.42875*x10 + x63;
   const Scalar x69 = 0.42875*x59 + x65;
-  const Scalar x70 = cq_m5*x20 + sq_m6*x22;
-  const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
-  const Scalar x72 = cq_m5*x23 + sq_m6*x24;
-  const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x70 = cq_m5[0]*x20 + sq_m6[0]*x22;
+  const Scalar x71 = -sq_m6[0]*x20 + cq_m5[0]*x22;
+  const Scalar x72 = cq_m5[0]*x23 + sq_m6[0]*x24;
+  const Scalar x73 = -sq_m6[0]*x23 + cq_m5[0]*x24;
   const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
   const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
   IA_m7[0] = 7.0 + x57;
@@ -817,7 +817,7 @@ PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -845,10 +845,10 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x26 = 0.5*(-x5 + x14);
   const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5*sq_m6;
+  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
   const Scalar x31 = 0.5*(-x8 + x16);
@@ -861,26 +861,26 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
   const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
-  const Scalar x41 = -0.09983341664682815*cq_m5*x11 + 0.09983341664682815*sq_m6*x6 + 0.9950041652780258*sq_m6*x11 + 0.9950041652780258*cq_m5*x6;
+  const Scalar x41 = -0.09983341664682815*cq_m5[0]*x11 + 0.09983341664682815*sq_m6[0]*x6 + 0.9950041652780258*sq_m6[0]*x11 + 0.9950041652780258*cq_m5[0]*x6;
   const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
-  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
+  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
   const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
   const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
   const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
   const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
-  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
+  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
   const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
   const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
   const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
-  const Scalar x57 = cq_m5*x20 + sq_m6*x22;
-  const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
-  const Scalar x59 = cq_m5*x23 + sq_m6*x24;
-  const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x57 = cq_m5[0]*x20 + sq_m6[0]*x22;
+  const Scalar x58 = -sq_m6[0]*x20 + cq_m5[0]*x22;
+  const Scalar x59 = cq_m5[0]*x23 + sq_m6[0]*x24;
+  const Scalar x60 = -sq_m6[0]*x23 + cq_m5[0]*x24;
   IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
   IA_m7[1] = x41;
   IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
@@ -906,7 +906,7 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
@@ -928,10 +928,10 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
   const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(x8 - x11);
   const Scalar x21 = 0.5*(x8 + x11);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
   const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
@@ -939,10 +939,10 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x27 = 0.000475 - 0.5*x13;
   const Scalar x28 = 0.000475 + 0.5*x13;
   IA_m7[0] = 0.5 + x4;
-  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
-  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
-  IA_m7[4] = 0.02 - 0.015*cq_m5 - sq_m6*x7;
-  IA_m7[5] = -0.015*sq_m6 + cq_m5*x7;
+  IA_m7[1] = cq_m5[0]*x5 - sq_m6[0]*x6;
+  IA_m7[2] = sq_m6[0]*x5 + cq_m5[0]*x6;
+  IA_m7[4] = 0.02 - 0.015*cq_m5[0] - sq_m6[0]*x7;
+  IA_m7[5] = -0.015*sq_m6[0] + cq_m5[0]*x7;
   IA_m7[6] = 0.5 + x21 + x23;
   IA_m7[7] = x24;
   IA_m7[9] = 0.5*x12 + x25;
@@ -954,11 +954,11 @@ PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   IA_m7[19] = x22*x27;
   IA_m7[20] = 0.0005 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
-  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
-  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[1] = pA_m8[1] + cq_m5[0]*x15 - sq_m6[0]*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6[0]*x15 + cq_m5[0]*x16;
   pA_m8[3] = pA_m8[3] + tau[0];
-  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
-  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+  pA_m8[4] = pA_m8[4] + cq_m5[0]*x17 - sq_m6[0]*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6[0]*x17 + cq_m5[0]*x18;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: pelvis.
@@ -1002,17 +1002,17 @@ PROXGEN_RT_NOINLINE void shared_15(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PR
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link.
 // The first: accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_16(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_16(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.0875*a_m0[5];
   const Scalar x1 = a_m0[2] + 0.0875*a_m0[3];
   const Scalar x2 = 0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
   const Scalar x3 = 0.9961917745544759*a_m0[1] - 0.08718915247898762*x0;
   const Scalar x4 = 0.9961917745544759*a_m0[3] + 0.08718915247898762*a_m0[4];
   const Scalar x5 = -0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
-  const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
-  const Scalar x9 = c_m1[4] - sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 + sq_m3[0]*x3;
+  const Scalar x7 = c_m1[1] - sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 + sq_m3[0]*x5;
+  const Scalar x9 = c_m1[4] - sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - IA_m5[15]*a_m0[5];
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
@@ -1025,11 +1025,11 @@ PROXGEN_RT_NOINLINE void shared_16(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
   const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = a_m1[0];
@@ -1042,15 +1042,15 @@ PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
   const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
   const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
   const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
   qdd_m6[0] = Dinv_m7*x8;
   a_m8[0] = x4;
@@ -1063,17 +1063,17 @@ PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
   const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
   const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
   const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
   const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
@@ -1086,17 +1086,17 @@ PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_20(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_20(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
   const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
   const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
   const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
@@ -1109,11 +1109,11 @@ PROXGEN_RT_NOINLINE void shared_20(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 4 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_21(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+PROXGEN_RT_NOINLINE void shared_21(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
   const Scalar x4 = u_m4[0] - 0.0017863999999999998*x3 - U_m5[0]*x0 - U_m5[2]*a_m2[3];
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = a_m2[0];
@@ -1126,17 +1126,17 @@ PROXGEN_RT_NOINLINE void shared_21(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_yaw_link.
 // The first: accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.0875*a_m0[5];
   const Scalar x1 = a_m0[2] - 0.0875*a_m0[3];
   const Scalar x2 = -0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
   const Scalar x3 = 0.9961917745544759*a_m0[1] + 0.08718915247898762*x0;
   const Scalar x4 = 0.9961917745544759*a_m0[3] - 0.08718915247898762*a_m0[4];
   const Scalar x5 = 0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 + sq_m3*x3;
-  const Scalar x7 = c_m1[1] - sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 + sq_m3*x5;
-  const Scalar x9 = c_m1[4] - sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 + sq_m3[0]*x3;
+  const Scalar x7 = c_m1[1] - sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 + sq_m3[0]*x5;
+  const Scalar x9 = c_m1[4] - sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - a_m0[5]*IA_m5[15];
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
@@ -1149,13 +1149,13 @@ PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: abdomen.
 // The first: accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.1*a_m0[4];
   const Scalar x1 = a_m0[1] - 0.1*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
-  const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 + a_m0[4]*sq_m3;
-  const Scalar x5 = c_m1[4] - a_m0[3]*sq_m3 + a_m0[4]*cq_m2;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 + sq_m3[0]*x1;
+  const Scalar x3 = c_m1[1] - sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] + a_m0[4]*sq_m3[0];
+  const Scalar x5 = c_m1[4] - a_m0[3]*sq_m3[0] + a_m0[4]*cq_m2[0];
   const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - a_m0[2]*IA_m5[9] - IA_m5[12]*x4 - IA_m5[14]*x5 - a_m0[5]*IA_m5[15];
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
@@ -1168,13 +1168,13 @@ PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: chest.
 // The first: accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.15*a_m0[4];
   const Scalar x1 = a_m0[1] - 0.15*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - a_m0[2]*sq_m3;
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + a_m0[2]*cq_m2;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - a_m0[2]*sq_m3[0];
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + a_m0[2]*cq_m2[0];
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
   const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x1 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
@@ -1189,7 +1189,7 @@ PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 // The first: accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
 constexpr Scalar shared_25_k0[8] = {0.19, -0.19, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848};
 constexpr Scalar shared_25_k1[8] = {-0.19, 0.19, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848};
-PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.254*a_m0[4] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] - 0.254*a_m0[3];
   const Scalar x2 = a_m0[2] + k[1]*a_m0[3];
@@ -1199,10 +1199,10 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   const Scalar x6 = 0.9848134698792882*a_m0[3] + 0.17361575258114187*a_m0[5];
   const Scalar x7 = k[5]*a_m0[3] + 0.9659256678396477*a_m0[4] + k[6]*a_m0[5];
   const Scalar x8 = -0.1676999117594225*a_m0[3] + k[7]*a_m0[4] + 0.9512566085906322*a_m0[5];
-  const Scalar x9 = c_m1[0] + cq_m2*x3 - sq_m3*x5;
-  const Scalar x10 = c_m1[2] + sq_m3*x3 + cq_m2*x5;
-  const Scalar x11 = c_m1[3] + cq_m2*x6 - sq_m3*x8;
-  const Scalar x12 = c_m1[5] + sq_m3*x6 + cq_m2*x8;
+  const Scalar x9 = c_m1[0] + cq_m2[0]*x3 - sq_m3[0]*x5;
+  const Scalar x10 = c_m1[2] + sq_m3[0]*x3 + cq_m2[0]*x5;
+  const Scalar x11 = c_m1[3] + cq_m2[0]*x6 - sq_m3[0]*x8;
+  const Scalar x12 = c_m1[5] + sq_m3[0]*x6 + cq_m2[0]*x8;
   const Scalar x13 = u_m4[0] - IA_m5[0]*x9 - IA_m5[5]*x4 - IA_m5[9]*x10 - IA_m5[14]*x7 - IA_m5[15]*x12;
   qdd_m6[0] = Dinv_m7*x13;
   a_m8[0] = x9;
@@ -1215,11 +1215,11 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members: r_shoulder_roll_link, l_shoulder_roll_link.
 // The first: accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
   const Scalar x4 = u_m4[0] - IA_m5[0]*a_m2[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - IA_m5[12]*a_m2[3] - IA_m5[13]*x2;
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = a_m2[0];
@@ -1232,11 +1232,11 @@ PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m
 
 // 2 blocks of the same code, each over its constants (k) and members: r_upper_arm.
 // The first: accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2 + a_m1[1]*sq_m3;
-  const Scalar x1 = c_m0[1] - a_m1[0]*sq_m3 + a_m1[1]*cq_m2;
-  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2 + a_m1[4]*sq_m3;
-  const Scalar x3 = c_m0[4] - a_m1[3]*sq_m3 + a_m1[4]*cq_m2;
+PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2[0] + a_m1[1]*sq_m3[0];
+  const Scalar x1 = c_m0[1] - a_m1[0]*sq_m3[0] + a_m1[1]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2[0] + a_m1[4]*sq_m3[0];
+  const Scalar x3 = c_m0[4] - a_m1[3]*sq_m3[0] + a_m1[4]*cq_m2[0];
   const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - IA_m5[5]*x1 - a_m1[2]*IA_m5[9] - IA_m5[12]*x2 - IA_m5[14]*x3 - a_m1[5]*IA_m5[15];
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = x0;
@@ -1249,17 +1249,17 @@ PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_forearm.
 // The first: accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.3255*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.3255*a_m0[3];
   const Scalar x2 = 0.29552020666133966*a_m0[2] + 0.955336489125606*x0;
   const Scalar x3 = 0.955336489125606*a_m0[2] - 0.29552020666133966*x0;
   const Scalar x4 = 0.955336489125606*a_m0[3] + 0.29552020666133966*a_m0[5];
   const Scalar x5 = -0.29552020666133966*a_m0[3] + 0.955336489125606*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4];
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
@@ -1272,13 +1272,13 @@ PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 3 blocks of the same code, each over its constants (k) and members: r_wrist_yaw_link, l_wrist_yaw_link.
 // The first: accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.2555*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.2555*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 + sq_m3*x1;
-  const Scalar x3 = c_m1[1] - sq_m3*x0 + cq_m2*x1;
-  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] + sq_m3*a_m0[4];
-  const Scalar x5 = c_m1[4] - sq_m3*a_m0[3] + cq_m2*a_m0[4];
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 + sq_m3[0]*x1;
+  const Scalar x3 = c_m1[1] - sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] + sq_m3[0]*a_m0[4];
+  const Scalar x5 = c_m1[4] - sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[4];
   const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - IA_m5[9]*a_m0[2] - IA_m5[12]*x4 - IA_m5[15]*a_m0[5];
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
@@ -1291,11 +1291,11 @@ PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_wrist_pitch_link.
 // The first: accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2 - a_m1[2]*sq_m3;
-  const Scalar x1 = c_m0[2] + a_m1[0]*sq_m3 + a_m1[2]*cq_m2;
-  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2 - a_m1[5]*sq_m3;
-  const Scalar x3 = c_m0[5] + a_m1[3]*sq_m3 + a_m1[5]*cq_m2;
+PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2[0] - a_m1[2]*sq_m3[0];
+  const Scalar x1 = c_m0[2] + a_m1[0]*sq_m3[0] + a_m1[2]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2[0] - a_m1[5]*sq_m3[0];
+  const Scalar x3 = c_m0[5] + a_m1[3]*sq_m3[0] + a_m1[5]*cq_m2[0];
   const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - a_m1[4]*IA_m5[14] - IA_m5[15]*x3;
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = x0;
@@ -1308,11 +1308,11 @@ PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hand.
 // The first: accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
   const Scalar x4 = u_m4[0] - U_m5[0]*x0 - U_m5[2]*a_m2[3];
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = a_m2[0];
@@ -1384,7 +1384,7 @@ PROXGEN_RT_NOINLINE void shared_32(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, 
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_33(Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar cq_m5, Scalar sq_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_33(Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6) noexcept {
   const Scalar x0 = -0.06825*dlambda_m0[1] - dlambda_m0[3];
   u_m1[0] = u_m1[0] + x0;
   const Scalar x1 = Dinv_m2*x0;
@@ -1392,15 +1392,15 @@ PROXGEN_RT_NOINLINE void shared_33(Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scala
   const Scalar x3 = -0.06825*dlambda_m0[0] + dlambda_m0[4];
   const Scalar x4 = dlambda_m0[5] + 0.0017863999999999998*Dinv_m2*x0;
   dp_m4[0] = dlambda_m0[0];
-  dp_m4[1] = cq_m5*x2 - sq_m6*dlambda_m0[2];
-  dp_m4[2] = sq_m6*x2 + cq_m5*dlambda_m0[2];
-  dp_m4[4] = cq_m5*x3 - sq_m6*x4;
-  dp_m4[5] = sq_m6*x3 + cq_m5*x4;
+  dp_m4[1] = cq_m5[0]*x2 - sq_m6[0]*dlambda_m0[2];
+  dp_m4[2] = sq_m6[0]*x2 + cq_m5[0]*dlambda_m0[2];
+  dp_m4[4] = cq_m5[0]*x3 - sq_m6[0]*x4;
+  dp_m4[5] = sq_m6[0]*x3 + cq_m5[0]*x4;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] - dp_m1[4];
   const Scalar x0 = -Dinv_m2*dp_m1[4];
   const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
@@ -1408,10 +1408,10 @@ PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PRO
   const Scalar x3 = dp_m1[2] + IA_m3[9]*x0;
   const Scalar x4 = dp_m1[3] + IA_m3[12]*x0;
   const Scalar x5 = dp_m1[5] + IA_m3[15]*x0;
-  const Scalar x6 = cq_m4*x1 + sq_m5*x3;
-  const Scalar x7 = -sq_m5*x1 + cq_m4*x3;
-  const Scalar x8 = cq_m4*x4 + sq_m5*x5;
-  const Scalar x9 = -sq_m5*x4 + cq_m4*x5;
+  const Scalar x6 = cq_m4[0]*x1 + sq_m5[0]*x3;
+  const Scalar x7 = -sq_m5[0]*x1 + cq_m4[0]*x3;
+  const Scalar x8 = cq_m4[0]*x4 + sq_m5[0]*x5;
+  const Scalar x9 = -sq_m5[0]*x4 + cq_m4[0]*x5;
   dp_m6[0] = 0.9950041652780258*x6 - 0.09983341664682815*x7;
   dp_m6[1] = x2;
   dp_m6[2] = 0.09983341664682815*x6 + 0.9950041652780258*x7;
@@ -1421,53 +1421,53 @@ PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
   u_m0[0] = -pA_m1[3] + tau[0];
   const Scalar x0 = -0.027912499999999996*c_m2[3] + pA_m1[0];
   const Scalar x1 = 0.614466237626843*c_m2[0] + 0.039325839208117955*c_m2[4] + pA_m1[1] + 14.34961978945479*u_m0[0];
   const Scalar x2 = 1.015*c_m2[1] - 0.06495999999999999*c_m2[3] + pA_m1[2];
   const Scalar x3 = -0.06495999999999999*c_m2[1] + 0.00936987670937*c_m2[3] + pA_m1[4];
   const Scalar x4 = 0.039325839208117955*c_m2[0] + 0.006961696668689549*c_m2[4] + pA_m1[5] + 0.9183756665251066*u_m0[0];
-  const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
-  IA_m5[0] = -0.027912499999999996*cq_m3;
-  IA_m5[1] = -0.027912499999999996*sq_m4;
+  const Scalar x5 = cq_m3[0]*cq_m3[0] - sq_m4[0]*sq_m4[0];
+  IA_m5[0] = -0.027912499999999996*cq_m3[0];
+  IA_m5[1] = -0.027912499999999996*sq_m4[0];
   IA_m5[2] = 1.0147331188134214 - 0.20026688118657843*x5;
-  IA_m5[3] = -0.40053376237315685*cq_m3*sq_m4;
-  IA_m5[5] = 0.025634160791882035*cq_m3*sq_m4;
+  IA_m5[3] = -0.40053376237315685*cq_m3[0]*sq_m4[0];
+  IA_m5[5] = 0.025634160791882035*cq_m3[0]*sq_m4[0];
   IA_m5[6] = 0.05214291960405897 - 0.012817080395941018*x5;
   IA_m5[7] = 1.0147331188134214 + 0.20026688118657843*x5;
   IA_m5[9] = -0.05214291960405897 - 0.012817080395941018*x5;
-  IA_m5[10] = -0.025634160791882035*cq_m3*sq_m4;
+  IA_m5[10] = -0.025634160791882035*cq_m3[0]*sq_m4[0];
   IA_m5[14] = 0.008237786689029773 + 0.0012040900203402253*x5;
-  IA_m5[15] = 0.0024081800406804505*cq_m3*sq_m4;
+  IA_m5[15] = 0.0024081800406804505*cq_m3[0]*sq_m4[0];
   IA_m5[16] = 0.008237786689029773 - 0.0012040900203402253*x5;
   pA_m6[0] = pA_m6[0] + x0;
-  pA_m6[1] = pA_m6[1] + cq_m3*x1 - sq_m4*x2;
-  pA_m6[2] = pA_m6[2] + sq_m4*x1 + cq_m3*x2;
+  pA_m6[1] = pA_m6[1] + cq_m3[0]*x1 - sq_m4[0]*x2;
+  pA_m6[2] = pA_m6[2] + sq_m4[0]*x1 + cq_m3[0]*x2;
   pA_m6[3] = tau[0];
-  pA_m6[4] = cq_m3*x3 - sq_m4*x4;
-  pA_m6[5] = sq_m4*x3 + cq_m3*x4;
-  KA_m7[4][KA_m7_col + 0] = -0.06825*cq_m3;
-  KA_m7[5][KA_m7_col + 0] = -0.06825*sq_m4;
-  KA_m7[1][KA_m7_col + 1] = 0.020638449369710488*cq_m3;
-  KA_m7[2][KA_m7_col + 1] = 0.020638449369710488*sq_m4;
-  KA_m7[4][KA_m7_col + 1] = 0.06267913924033854*sq_m4;
-  KA_m7[5][KA_m7_col + 1] = -0.06267913924033854*cq_m3;
-  KA_m7[1][KA_m7_col + 2] = -sq_m4;
-  KA_m7[2][KA_m7_col + 2] = cq_m3;
-  KA_m7[1][KA_m7_col + 3] = -14.34961978945479*cq_m3;
-  KA_m7[2][KA_m7_col + 3] = -14.34961978945479*sq_m4;
-  KA_m7[4][KA_m7_col + 3] = 0.9183756665251066*sq_m4;
-  KA_m7[5][KA_m7_col + 3] = -0.9183756665251066*cq_m3;
-  KA_m7[4][KA_m7_col + 4] = cq_m3;
-  KA_m7[5][KA_m7_col + 4] = sq_m4;
-  KA_m7[4][KA_m7_col + 5] = -sq_m4;
-  KA_m7[5][KA_m7_col + 5] = cq_m3;
+  pA_m6[4] = cq_m3[0]*x3 - sq_m4[0]*x4;
+  pA_m6[5] = sq_m4[0]*x3 + cq_m3[0]*x4;
+  KA_m7[4][KA_m7_col + 0] = -0.06825*cq_m3[0];
+  KA_m7[5][KA_m7_col + 0] = -0.06825*sq_m4[0];
+  KA_m7[1][KA_m7_col + 1] = 0.020638449369710488*cq_m3[0];
+  KA_m7[2][KA_m7_col + 1] = 0.020638449369710488*sq_m4[0];
+  KA_m7[4][KA_m7_col + 1] = 0.06267913924033854*sq_m4[0];
+  KA_m7[5][KA_m7_col + 1] = -0.06267913924033854*cq_m3[0];
+  KA_m7[1][KA_m7_col + 2] = -sq_m4[0];
+  KA_m7[2][KA_m7_col + 2] = cq_m3[0];
+  KA_m7[1][KA_m7_col + 3] = -14.34961978945479*cq_m3[0];
+  KA_m7[2][KA_m7_col + 3] = -14.34961978945479*sq_m4[0];
+  KA_m7[4][KA_m7_col + 3] = 0.9183756665251066*sq_m4[0];
+  KA_m7[5][KA_m7_col + 3] = -0.9183756665251066*cq_m3[0];
+  KA_m7[4][KA_m7_col + 4] = cq_m3[0];
+  KA_m7[5][KA_m7_col + 4] = sq_m4[0];
+  KA_m7[4][KA_m7_col + 5] = -sq_m4[0];
+  KA_m7[5][KA_m7_col + 5] = cq_m3[0];
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[14];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[0]*Dinv_m0[0];
@@ -1489,10 +1489,10 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
   const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(-x4 + x9);
   const Scalar x21 = 0.5*(x4 + x9);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x12*x22;
   const Scalar x24 = x20*x22 + x12*x19;
   const Scalar x25 = 0.5*(x10*x19 - x5*x22);
@@ -1500,10 +1500,10 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x27 = -3.6e-05 + 0.5*x11;
   const Scalar x28 = 3.6e-05 + 0.5*x11;
   const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
-  const Scalar x30 = -0.09983341664682815*cq_m5*x7 + 0.09983341664682815*sq_m6*x13 + 0.9950041652780258*sq_m6*x7 + 0.9950041652780258*cq_m5*x13;
+  const Scalar x30 = -0.09983341664682815*cq_m5[0]*x7 + 0.09983341664682815*sq_m6[0]*x13 + 0.9950041652780258*sq_m6[0]*x7 + 0.9950041652780258*cq_m5[0]*x13;
   const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x32 = sq_m6*x7 + cq_m5*x13;
-  const Scalar x33 = cq_m5*x7 - sq_m6*x13;
+  const Scalar x32 = sq_m6[0]*x7 + cq_m5[0]*x13;
+  const Scalar x33 = cq_m5[0]*x7 - sq_m6[0]*x13;
   const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
   const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
   const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
@@ -1520,17 +1520,17 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
   const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
-  const Scalar x50 = -0.09983341664682815*cq_m5*x8 + 0.9950041652780258*sq_m6*x8;
-  const Scalar x51 = 0.9950041652780258*cq_m5*x8 + 0.09983341664682815*sq_m6*x8;
+  const Scalar x50 = -0.09983341664682815*cq_m5[0]*x8 + 0.9950041652780258*sq_m6[0]*x8;
+  const Scalar x51 = 0.9950041652780258*cq_m5[0]*x8 + 0.09983341664682815*sq_m6[0]*x8;
   const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
   const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x54 = 0.4305*x30 + x48;
   const Scalar x55 = 0.4305*x6 + x50;
   const Scalar x56 = 0.4305*x46 + x52;
-  const Scalar x57 = cq_m5*x14 + sq_m6*x16;
-  const Scalar x58 = -sq_m6*x14 + cq_m5*x16;
-  const Scalar x59 = cq_m5*x17 + sq_m6*x18;
-  const Scalar x60 = -sq_m6*x17 + cq_m5*x18;
+  const Scalar x57 = cq_m5[0]*x14 + sq_m6[0]*x16;
+  const Scalar x58 = -sq_m6[0]*x14 + cq_m5[0]*x16;
+  const Scalar x59 = cq_m5[0]*x17 + sq_m6[0]*x18;
+  const Scalar x60 = -sq_m6[0]*x17 + cq_m5[0]*x18;
   const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
   const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
   IA_m7[0] = 3.055 + x44;
@@ -1564,33 +1564,33 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x63 = 1.0 - IA_m1[0]*KSD_m9[0];
   const Scalar x64 = -IA_m1[9]*KSD_m9[0];
   const Scalar x65 = KA_m10[5][KA_m10_col + 0] - IA_m1[15]*KSD_m9[0];
-  const Scalar x66 = cq_m5*x63 + sq_m6*x64;
-  const Scalar x67 = -sq_m6*x63 + cq_m5*x64;
+  const Scalar x66 = cq_m5[0]*x63 + sq_m6[0]*x64;
+  const Scalar x67 = -sq_m6[0]*x63 + cq_m5[0]*x64;
   const Scalar x68 = 0.9950041652780258*x66 - 0.09983341664682815*x67;
   const Scalar x69 = 0.09983341664682815*x66 + 0.9950041652780258*x67;
   KA_m11[0][KA_m11_col + 0] = x68;
   KA_m11[1][KA_m11_col + 0] = -IA_m1[5]*KSD_m9[0];
   KA_m11[2][KA_m11_col + 0] = x69;
-  KA_m11[3][KA_m11_col + 0] = -0.4305*IA_m1[5]*KSD_m9[0] + 0.9950041652780258*sq_m6*x65 - 0.09983341664682815*cq_m5*x65;
+  KA_m11[3][KA_m11_col + 0] = -0.4305*IA_m1[5]*KSD_m9[0] + 0.9950041652780258*sq_m6[0]*x65 - 0.09983341664682815*cq_m5[0]*x65;
   KA_m11[4][KA_m11_col + 0] = -0.4305*x68;
-  KA_m11[5][KA_m11_col + 0] = 0.09983341664682815*sq_m6*x65 + 0.9950041652780258*cq_m5*x65;
+  KA_m11[5][KA_m11_col + 0] = 0.09983341664682815*sq_m6[0]*x65 + 0.9950041652780258*cq_m5[0]*x65;
   KSD_m9[1] = KA_m10[4][KA_m10_col + 1]*Dinv_m0[0];
   const Scalar x70 = KA_m10[1][KA_m10_col + 1] - IA_m1[5]*KSD_m9[1];
   const Scalar x71 = KA_m10[2][KA_m10_col + 1] - IA_m1[9]*KSD_m9[1];
   const Scalar x72 = -IA_m1[0]*KSD_m9[1];
   const Scalar x73 = KA_m10[5][KA_m10_col + 1] - IA_m1[15]*KSD_m9[1];
-  const Scalar x74 = cq_m5*x72 + sq_m6*x71;
-  const Scalar x75 = -sq_m6*x72 + cq_m5*x71;
+  const Scalar x74 = cq_m5[0]*x72 + sq_m6[0]*x71;
+  const Scalar x75 = -sq_m6[0]*x72 + cq_m5[0]*x71;
   const Scalar x76 = 0.9950041652780258*x74 - 0.09983341664682815*x75;
   const Scalar x77 = 0.09983341664682815*x74 + 0.9950041652780258*x75;
   KA_m11[0][KA_m11_col + 1] = x76;
   KA_m11[1][KA_m11_col + 1] = x70;
   KA_m11[2][KA_m11_col + 1] = x77;
-  KA_m11[3][KA_m11_col + 1] = 0.4305*x70 + 0.9950041652780258*sq_m6*x73 - 0.09983341664682815*cq_m5*x73;
+  KA_m11[3][KA_m11_col + 1] = 0.4305*x70 + 0.9950041652780258*sq_m6[0]*x73 - 0.09983341664682815*cq_m5[0]*x73;
   KA_m11[4][KA_m11_col + 1] = -0.4305*x76;
-  KA_m11[5][KA_m11_col + 1] = 0.09983341664682815*sq_m6*x73 + 0.9950041652780258*cq_m5*x73;
-  const Scalar x78 = 0.9950041652780258*sq_m6*KA_m10[2][KA_m10_col + 2] - 0.09983341664682815*cq_m5*KA_m10[2][KA_m10_col + 2];
-  const Scalar x79 = 0.09983341664682815*sq_m6*KA_m10[2][KA_m10_col + 2] + 0.9950041652780258*cq_m5*KA_m10[2][KA_m10_col + 2];
+  KA_m11[5][KA_m11_col + 1] = 0.09983341664682815*sq_m6[0]*x73 + 0.9950041652780258*cq_m5[0]*x73;
+  const Scalar x78 = 0.9950041652780258*sq_m6[0]*KA_m10[2][KA_m10_col + 2] - 0.09983341664682815*cq_m5[0]*KA_m10[2][KA_m10_col + 2];
+  const Scalar x79 = 0.09983341664682815*sq_m6[0]*KA_m10[2][KA_m10_col + 2] + 0.9950041652780258*cq_m5[0]*KA_m10[2][KA_m10_col + 2];
   KA_m11[0][KA_m11_col + 2] = x78;
   KA_m11[1][KA_m11_col + 2] = KA_m10[1][KA_m10_col + 2];
   KA_m11[2][KA_m11_col + 2] = x79;
@@ -1601,49 +1601,49 @@ PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x81 = KA_m10[2][KA_m10_col + 3] - IA_m1[9]*KSD_m9[3];
   const Scalar x82 = -IA_m1[0]*KSD_m9[3];
   const Scalar x83 = KA_m10[5][KA_m10_col + 3] - IA_m1[15]*KSD_m9[3];
-  const Scalar x84 = cq_m5*x82 + sq_m6*x81;
-  const Scalar x85 = -sq_m6*x82 + cq_m5*x81;
+  const Scalar x84 = cq_m5[0]*x82 + sq_m6[0]*x81;
+  const Scalar x85 = -sq_m6[0]*x82 + cq_m5[0]*x81;
   const Scalar x86 = 0.9950041652780258*x84 - 0.09983341664682815*x85;
   const Scalar x87 = 0.09983341664682815*x84 + 0.9950041652780258*x85;
   KA_m11[0][KA_m11_col + 3] = x86;
   KA_m11[1][KA_m11_col + 3] = x80;
   KA_m11[2][KA_m11_col + 3] = x87;
-  KA_m11[3][KA_m11_col + 3] = 0.4305*x80 + 0.9950041652780258*sq_m6*x83 - 0.09983341664682815*cq_m5*x83;
+  KA_m11[3][KA_m11_col + 3] = 0.4305*x80 + 0.9950041652780258*sq_m6[0]*x83 - 0.09983341664682815*cq_m5[0]*x83;
   KA_m11[4][KA_m11_col + 3] = -0.4305*x86;
-  KA_m11[5][KA_m11_col + 3] = 0.09983341664682815*sq_m6*x83 + 0.9950041652780258*cq_m5*x83;
+  KA_m11[5][KA_m11_col + 3] = 0.09983341664682815*sq_m6[0]*x83 + 0.9950041652780258*cq_m5[0]*x83;
   KSD_m9[4] = KA_m10[4][KA_m10_col + 4]*Dinv_m0[0];
   const Scalar x88 = -IA_m1[0]*KSD_m9[4];
   const Scalar x89 = -IA_m1[9]*KSD_m9[4];
   const Scalar x90 = KA_m10[5][KA_m10_col + 4] - IA_m1[15]*KSD_m9[4];
-  const Scalar x91 = cq_m5*x88 + sq_m6*x89;
-  const Scalar x92 = -sq_m6*x88 + cq_m5*x89;
+  const Scalar x91 = cq_m5[0]*x88 + sq_m6[0]*x89;
+  const Scalar x92 = -sq_m6[0]*x88 + cq_m5[0]*x89;
   const Scalar x93 = 0.9950041652780258*x91 - 0.09983341664682815*x92;
   const Scalar x94 = 0.09983341664682815*x91 + 0.9950041652780258*x92;
   KA_m11[0][KA_m11_col + 4] = x93;
   KA_m11[1][KA_m11_col + 4] = -IA_m1[5]*KSD_m9[4];
   KA_m11[2][KA_m11_col + 4] = x94;
-  KA_m11[3][KA_m11_col + 4] = -0.4305*IA_m1[5]*KSD_m9[4] + 0.9950041652780258*sq_m6*x90 - 0.09983341664682815*cq_m5*x90;
+  KA_m11[3][KA_m11_col + 4] = -0.4305*IA_m1[5]*KSD_m9[4] + 0.9950041652780258*sq_m6[0]*x90 - 0.09983341664682815*cq_m5[0]*x90;
   KA_m11[4][KA_m11_col + 4] = -0.4305*x93;
-  KA_m11[5][KA_m11_col + 4] = 0.09983341664682815*sq_m6*x90 + 0.9950041652780258*cq_m5*x90;
+  KA_m11[5][KA_m11_col + 4] = 0.09983341664682815*sq_m6[0]*x90 + 0.9950041652780258*cq_m5[0]*x90;
   KSD_m9[5] = KA_m10[4][KA_m10_col + 5]*Dinv_m0[0];
   const Scalar x95 = -IA_m1[0]*KSD_m9[5];
   const Scalar x96 = -IA_m1[9]*KSD_m9[5];
   const Scalar x97 = KA_m10[5][KA_m10_col + 5] - IA_m1[15]*KSD_m9[5];
-  const Scalar x98 = cq_m5*x95 + sq_m6*x96;
-  const Scalar x99 = -sq_m6*x95 + cq_m5*x96;
+  const Scalar x98 = cq_m5[0]*x95 + sq_m6[0]*x96;
+  const Scalar x99 = -sq_m6[0]*x95 + cq_m5[0]*x96;
   const Scalar x100 = 0.9950041652780258*x98 - 0.09983341664682815*x99;
   const Scalar x101 = 0.09983341664682815*x98 + 0.9950041652780258*x99;
   KA_m11[0][KA_m11_col + 5] = x100;
   KA_m11[1][KA_m11_col + 5] = -IA_m1[5]*KSD_m9[5];
   KA_m11[2][KA_m11_col + 5] = x101;
-  KA_m11[3][KA_m11_col + 5] = -0.4305*IA_m1[5]*KSD_m9[5] + 0.9950041652780258*sq_m6*x97 - 0.09983341664682815*cq_m5*x97;
+  KA_m11[3][KA_m11_col + 5] = -0.4305*IA_m1[5]*KSD_m9[5] + 0.9950041652780258*sq_m6[0]*x97 - 0.09983341664682815*cq_m5[0]*x97;
   KA_m11[4][KA_m11_col + 5] = -0.4305*x100;
-  KA_m11[5][KA_m11_col + 5] = 0.09983341664682815*sq_m6*x97 + 0.9950041652780258*cq_m5*x97;
+  KA_m11[5][KA_m11_col + 5] = 0.09983341664682815*sq_m6[0]*x97 + 0.9950041652780258*cq_m5[0]*x97;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -1671,10 +1671,10 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x26 = 0.5*(-x5 + x14);
   const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5*sq_m6;
+  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
   const Scalar x31 = 0.5*(-x8 + x16);
@@ -1687,16 +1687,16 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
   const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
-  const Scalar x41 = 0.19866933079506124*cq_m5*x11 - 0.19866933079506124*sq_m6*x6 + 0.9800665778412416*sq_m6*x11 + 0.9800665778412416*cq_m5*x6;
+  const Scalar x41 = 0.19866933079506124*cq_m5[0]*x11 - 0.19866933079506124*sq_m6[0]*x6 + 0.9800665778412416*sq_m6[0]*x11 + 0.9800665778412416*cq_m5[0]*x6;
   const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
-  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
+  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
   const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
   const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
   const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
   const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
-  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
+  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
   const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
   const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
   const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
@@ -1716,10 +1716,10 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x67 = 0.42875*x41 + x61;
   const Scalar x68 = 0.42875*x10 + x63;
   const Scalar x69 = 0.42875*x59 + x65;
-  const Scalar x70 = cq_m5*x20 + sq_m6*x22;
-  const Scalar x71 = -sq_m6*x20 + cq_m5*x22;
-  const Scalar x72 = cq_m5*x23 + sq_m6*x24;
-  const Scalar x73 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x70 = cq_m5[0]*x20 + sq_m6[0]*x22;
+  const Scalar x71 = -sq_m6[0]*x20 + cq_m5[0]*x22;
+  const Scalar x72 = cq_m5[0]*x23 + sq_m6[0]*x24;
+  const Scalar x73 = -sq_m6[0]*x23 + cq_m5[0]*x24;
   const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
   const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
   IA_m7[0] = 7.0 + x57;
@@ -1756,10 +1756,10 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
     const Scalar x78 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
     const Scalar x79 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
     const Scalar x80 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
-    const Scalar x81 = cq_m5*x76 + sq_m6*x78;
-    const Scalar x82 = -sq_m6*x76 + cq_m5*x78;
-    const Scalar x83 = cq_m5*x79 + sq_m6*x80;
-    const Scalar x84 = -sq_m6*x79 + cq_m5*x80;
+    const Scalar x81 = cq_m5[0]*x76 + sq_m6[0]*x78;
+    const Scalar x82 = -sq_m6[0]*x76 + cq_m5[0]*x78;
+    const Scalar x83 = cq_m5[0]*x79 + sq_m6[0]*x80;
+    const Scalar x84 = -sq_m6[0]*x79 + cq_m5[0]*x80;
     const Scalar x85 = 0.9800665778412416*x81 + 0.19866933079506124*x82;
     const Scalar x86 = -0.19866933079506124*x81 + 0.9800665778412416*x82;
     KA_m11[0][j] = x85;
@@ -1775,10 +1775,10 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x89 = KA_m10[2][2] - IA_m1[13]*KSD_m9[2];
   const Scalar x90 = KA_m10[3][2] - IA_m1[16]*KSD_m9[2];
   const Scalar x91 = -IA_m1[19]*KSD_m9[2];
-  const Scalar x92 = cq_m5*x87 + sq_m6*x89;
-  const Scalar x93 = -sq_m6*x87 + cq_m5*x89;
-  const Scalar x94 = cq_m5*x90 + sq_m6*x91;
-  const Scalar x95 = -sq_m6*x90 + cq_m5*x91;
+  const Scalar x92 = cq_m5[0]*x87 + sq_m6[0]*x89;
+  const Scalar x93 = -sq_m6[0]*x87 + cq_m5[0]*x89;
+  const Scalar x94 = cq_m5[0]*x90 + sq_m6[0]*x91;
+  const Scalar x95 = -sq_m6[0]*x90 + cq_m5[0]*x91;
   const Scalar x96 = 0.9800665778412416*x92 + 0.19866933079506124*x93;
   const Scalar x97 = -0.19866933079506124*x92 + 0.9800665778412416*x93;
   KA_m11[0][2] = x96;
@@ -1794,10 +1794,10 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
     const Scalar x100 = KA_m10[2][3 + j] - IA_m1[13]*KSD_m9[3 + j];
     const Scalar x101 = KA_m10[3][3 + j] - IA_m1[16]*KSD_m9[3 + j];
     const Scalar x102 = KA_m10[5][3 + j] - IA_m1[19]*KSD_m9[3 + j];
-    const Scalar x103 = cq_m5*x98 + sq_m6*x100;
-    const Scalar x104 = -sq_m6*x98 + cq_m5*x100;
-    const Scalar x105 = cq_m5*x101 + sq_m6*x102;
-    const Scalar x106 = -sq_m6*x101 + cq_m5*x102;
+    const Scalar x103 = cq_m5[0]*x98 + sq_m6[0]*x100;
+    const Scalar x104 = -sq_m6[0]*x98 + cq_m5[0]*x100;
+    const Scalar x105 = cq_m5[0]*x101 + sq_m6[0]*x102;
+    const Scalar x106 = -sq_m6[0]*x101 + cq_m5[0]*x102;
     const Scalar x107 = 0.9800665778412416*x103 + 0.19866933079506124*x104;
     const Scalar x108 = -0.19866933079506124*x103 + 0.9800665778412416*x104;
     KA_m11[0][3 + j] = x107;
@@ -1811,7 +1811,7 @@ PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -1839,10 +1839,10 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
   const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
   const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x26 = 0.5*(-x5 + x14);
   const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5*sq_m6;
+  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x29 = x25*x26 - x7*x28;
   const Scalar x30 = x26*x28 + x7*x25;
   const Scalar x31 = 0.5*(-x8 + x16);
@@ -1855,26 +1855,26 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x38 = x25*x36 - x18*x28;
   const Scalar x39 = x28*x36 + x18*x25;
   const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
-  const Scalar x41 = -0.09983341664682815*cq_m5*x11 + 0.09983341664682815*sq_m6*x6 + 0.9950041652780258*sq_m6*x11 + 0.9950041652780258*cq_m5*x6;
+  const Scalar x41 = -0.09983341664682815*cq_m5[0]*x11 + 0.09983341664682815*sq_m6[0]*x6 + 0.9950041652780258*sq_m6[0]*x11 + 0.9950041652780258*cq_m5[0]*x6;
   const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x43 = sq_m6*x11 + cq_m5*x6;
-  const Scalar x44 = cq_m5*x11 - sq_m6*x6;
+  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
+  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
   const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
   const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
   const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
   const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x49 = sq_m6*x13 + cq_m5*x12;
-  const Scalar x50 = cq_m5*x13 - sq_m6*x12;
+  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
+  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
   const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
   const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
   const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
   const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
   const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
-  const Scalar x57 = cq_m5*x20 + sq_m6*x22;
-  const Scalar x58 = -sq_m6*x20 + cq_m5*x22;
-  const Scalar x59 = cq_m5*x23 + sq_m6*x24;
-  const Scalar x60 = -sq_m6*x23 + cq_m5*x24;
+  const Scalar x57 = cq_m5[0]*x20 + sq_m6[0]*x22;
+  const Scalar x58 = -sq_m6[0]*x20 + cq_m5[0]*x22;
+  const Scalar x59 = cq_m5[0]*x23 + sq_m6[0]*x24;
+  const Scalar x60 = -sq_m6[0]*x23 + cq_m5[0]*x24;
   IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
   IA_m7[1] = x41;
   IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
@@ -1903,10 +1903,10 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
     const Scalar x63 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
     const Scalar x64 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
     const Scalar x65 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
-    const Scalar x66 = cq_m5*x61 + sq_m6*x63;
-    const Scalar x67 = -sq_m6*x61 + cq_m5*x63;
-    const Scalar x68 = cq_m5*x64 + sq_m6*x65;
-    const Scalar x69 = -sq_m6*x64 + cq_m5*x65;
+    const Scalar x66 = cq_m5[0]*x61 + sq_m6[0]*x63;
+    const Scalar x67 = -sq_m6[0]*x61 + cq_m5[0]*x63;
+    const Scalar x68 = cq_m5[0]*x64 + sq_m6[0]*x65;
+    const Scalar x69 = -sq_m6[0]*x64 + cq_m5[0]*x65;
     KA_m11[0][j] = 0.9950041652780258*x66 - 0.09983341664682815*x67;
     KA_m11[1][j] = x62;
     KA_m11[2][j] = 0.09983341664682815*x66 + 0.9950041652780258*x67;
@@ -1918,7 +1918,7 @@ PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
+PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[15];
   u_m2[0] = -pA_m3[3] + tau[0];
   const Scalar x0 = IA_m1[3]*Dinv_m0[0];
@@ -1940,10 +1940,10 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
   const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(x8 - x11);
   const Scalar x21 = 0.5*(x8 + x11);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x9*x22;
   const Scalar x24 = x20*x22 + x9*x19;
   const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
@@ -1951,10 +1951,10 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   const Scalar x27 = 0.000475 - 0.5*x13;
   const Scalar x28 = 0.000475 + 0.5*x13;
   IA_m7[0] = 0.5 + x4;
-  IA_m7[1] = cq_m5*x5 - sq_m6*x6;
-  IA_m7[2] = sq_m6*x5 + cq_m5*x6;
-  IA_m7[4] = 0.02 - 0.015*cq_m5 - sq_m6*x7;
-  IA_m7[5] = -0.015*sq_m6 + cq_m5*x7;
+  IA_m7[1] = cq_m5[0]*x5 - sq_m6[0]*x6;
+  IA_m7[2] = sq_m6[0]*x5 + cq_m5[0]*x6;
+  IA_m7[4] = 0.02 - 0.015*cq_m5[0] - sq_m6[0]*x7;
+  IA_m7[5] = -0.015*sq_m6[0] + cq_m5[0]*x7;
   IA_m7[6] = 0.5 + x21 + x23;
   IA_m7[7] = x24;
   IA_m7[9] = 0.5*x12 + x25;
@@ -1966,11 +1966,11 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
   IA_m7[19] = x22*x27;
   IA_m7[20] = 0.0005 + x28 - x19*x27;
   pA_m8[0] = pA_m8[0] + x14;
-  pA_m8[1] = pA_m8[1] + cq_m5*x15 - sq_m6*x16;
-  pA_m8[2] = pA_m8[2] + sq_m6*x15 + cq_m5*x16;
+  pA_m8[1] = pA_m8[1] + cq_m5[0]*x15 - sq_m6[0]*x16;
+  pA_m8[2] = pA_m8[2] + sq_m6[0]*x15 + cq_m5[0]*x16;
   pA_m8[3] = pA_m8[3] + tau[0];
-  pA_m8[4] = pA_m8[4] + cq_m5*x17 - sq_m6*x18;
-  pA_m8[5] = pA_m8[5] + sq_m6*x17 + cq_m5*x18;
+  pA_m8[4] = pA_m8[4] + cq_m5[0]*x17 - sq_m6[0]*x18;
+  pA_m8[5] = pA_m8[5] + sq_m6[0]*x17 + cq_m5[0]*x18;
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
     KSD_m9[j] = Dinv_m0[0]*KA_m10[3][j];
     const Scalar x29 = KA_m10[0][j] - IA_m1[3]*KSD_m9[j];
@@ -1978,21 +1978,21 @@ PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar
     const Scalar x31 = KA_m10[2][j] - IA_m1[12]*KSD_m9[j];
     const Scalar x32 = KA_m10[5][j] - IA_m1[17]*KSD_m9[j];
     KA_m11[0][j] = x29;
-    KA_m11[1][j] = cq_m5*x30 - sq_m6*x31;
-    KA_m11[2][j] = sq_m6*x30 + cq_m5*x31;
+    KA_m11[1][j] = cq_m5[0]*x30 - sq_m6[0]*x31;
+    KA_m11[2][j] = sq_m6[0]*x30 + cq_m5[0]*x31;
     KA_m11[3][j] = 0.0;
-    KA_m11[4][j] = cq_m5*KA_m10[4][j] - sq_m6*x32;
-    KA_m11[5][j] = sq_m6*KA_m10[4][j] + cq_m5*x32;
+    KA_m11[4][j] = cq_m5[0]*KA_m10[4][j] - sq_m6[0]*x32;
+    KA_m11[5][j] = sq_m6[0]*KA_m10[4][j] + cq_m5[0]*x32;
   }
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
   const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
   a_m6[0] = a_m1[0];
   a_m6[1] = x0;
@@ -2004,15 +2004,15 @@ PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_41(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_41(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
   const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
   const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
   const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
   a_m6[0] = x4;
   a_m6[1] = a_m0[1];
@@ -2024,17 +2024,17 @@ PROXGEN_RT_NOINLINE void shared_41(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_42(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_42(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
   const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
   const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
   const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
   const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
   a_m6[0] = x6;
   a_m6[1] = x1;
@@ -2046,17 +2046,17 @@ PROXGEN_RT_NOINLINE void shared_42(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_43(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_43(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
   const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
   const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
   const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
   a_m6[0] = x6;
   a_m6[1] = x1;
@@ -2068,11 +2068,11 @@ PROXGEN_RT_NOINLINE void shared_43(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_44(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+PROXGEN_RT_NOINLINE void shared_44(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
   const Scalar x4 = u_m4[0] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
   a_m5[0] = a_m2[0];
   a_m5[1] = x0;
@@ -2084,11 +2084,11 @@ PROXGEN_RT_NOINLINE void shared_44(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2 + a_m1[2]*sq_m3;
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3 + a_m1[2]*cq_m2;
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2 + a_m1[5]*sq_m3;
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3 + a_m1[5]*cq_m2;
+PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
   const Scalar x4 = u_m4[0] - KA_m5[3][KA_m5_col + 0]*lambda_m6[0] - KA_m5[3][KA_m5_col + 1]*lambda_m6[1] - KA_m5[3][KA_m5_col + 2]*lambda_m6[2] - KA_m5[3][KA_m5_col + 3]*lambda_m6[3] - KA_m5[3][KA_m5_col + 4]*lambda_m6[4] - KA_m5[3][KA_m5_col + 5]*lambda_m6[5] - a_m1[0]*IA_m7[0] - IA_m7[5]*x0 - IA_m7[9]*x1 - a_m1[3]*IA_m7[12] - IA_m7[14]*x3;
   qdd_m8[0] = Dinv_m9*x4;
   a_m10[0] = a_m1[0];
@@ -2101,15 +2101,15 @@ PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_46(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_46(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
   const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
   const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x5 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x6 = c_m1[3] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[5] + sq_m3*x2 + cq_m2*x3;
+  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
   const Scalar x8 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x4 - IA_m7[5]*a_m0[1] - IA_m7[9]*x5 - IA_m7[12]*x6 - IA_m7[14]*a_m0[4] - IA_m7[15]*x7;
   qdd_m8[0] = Dinv_m9*x8;
   a_m10[0] = x4;
@@ -2122,17 +2122,17 @@ PROXGEN_RT_NOINLINE void shared_46(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_47(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_47(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
   const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
   const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
   const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
   const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - IA_m7[12]*x8 - IA_m7[14]*a_m0[4] - IA_m7[15]*x9;
   qdd_m8[0] = Dinv_m9*x10;
   a_m10[0] = x6;
@@ -2145,17 +2145,17 @@ PROXGEN_RT_NOINLINE void shared_47(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_48(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_48(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
   const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
   const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
   const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
   const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2*x2 - sq_m3*x3;
-  const Scalar x7 = c_m1[2] + sq_m3*x2 + cq_m2*x3;
-  const Scalar x8 = c_m1[3] + cq_m2*x4 - sq_m3*x5;
-  const Scalar x9 = c_m1[5] + sq_m3*x4 + cq_m2*x5;
+  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
+  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
+  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
+  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
   const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - a_m0[4]*IA_m7[14] - IA_m7[15]*x9;
   qdd_m8[0] = Dinv_m9*x10;
   a_m10[0] = x6;
@@ -2168,11 +2168,11 @@ PROXGEN_RT_NOINLINE void shared_48(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_49(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1*a_m2[1] + sq_m3*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3*a_m2[1] + cq_m1*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1*a_m2[4] + sq_m3*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3*a_m2[4] + cq_m1*a_m2[5];
+PROXGEN_RT_NOINLINE void shared_49(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
   const Scalar x4 = u_m4[0] - 0.06825*lambda_m5[0] - lambda_m5[2] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
   qdd_m6[0] = 514.0929615568219*x4;
   a_m7[0] = a_m2[0];
@@ -2224,18 +2224,18 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
   }
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_noinline(q[7], w.sq_l_hip_yaw_link, w.cq_l_hip_yaw_link);
+    proxgen_rt::sincos_joint_noinline(q[7], w.sq[0], w.cq[0]);
     const Scalar t1 = v[0] - 0.0875*v[5];
     const Scalar t2 = v[2] + 0.0875*v[3];
     const Scalar t3 = 0.08718915247898762*v[1] + 0.9961917745544759*t1;
     const Scalar t4 = 0.9961917745544759*v[1] - 0.08718915247898762*t1;
     const Scalar t5 = 0.9961917745544759*v[3] + 0.08718915247898762*v[4];
     const Scalar t6 = -0.08718915247898762*v[3] + 0.9961917745544759*v[4];
-    w.v_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t3 + w.sq_l_hip_yaw_link*t4;
-    w.v_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t3 + w.cq_l_hip_yaw_link*t4;
+    w.v_l_hip_yaw_link[0] = w.cq[0]*t3 + w.sq[0]*t4;
+    w.v_l_hip_yaw_link[1] = -w.sq[0]*t3 + w.cq[0]*t4;
     w.v_l_hip_yaw_link[2] = t2;
-    w.v_l_hip_yaw_link[3] = w.cq_l_hip_yaw_link*t5 + w.sq_l_hip_yaw_link*t6;
-    w.v_l_hip_yaw_link[4] = -w.sq_l_hip_yaw_link*t5 + w.cq_l_hip_yaw_link*t6;
+    w.v_l_hip_yaw_link[3] = w.cq[0]*t5 + w.sq[0]*t6;
+    w.v_l_hip_yaw_link[4] = -w.sq[0]*t5 + w.cq[0]*t6;
     w.v_l_hip_yaw_link[5] = v[5] + v[6];
     w.c_l_hip_yaw_link[0] = v[6]*w.v_l_hip_yaw_link[1];
     w.c_l_hip_yaw_link[1] = -v[6]*w.v_l_hip_yaw_link[0];
@@ -2253,42 +2253,42 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
     w.pA_l_hip_yaw_link[5] = w.v_l_hip_yaw_link[3]*h7 - w.v_l_hip_yaw_link[4]*h6 + w.v_l_hip_yaw_link[0]*h5 - w.v_l_hip_yaw_link[1]*h4;
     const Scalar t7 = 0.9961917745544759*w.g_pelvis[0] + 0.08718915247898762*w.g_pelvis[1];
     const Scalar t8 = -0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
-    w.g_l_hip_yaw_link[0] = w.cq_l_hip_yaw_link*t7 + w.sq_l_hip_yaw_link*t8;
-    w.g_l_hip_yaw_link[1] = -w.sq_l_hip_yaw_link*t7 + w.cq_l_hip_yaw_link*t8;
+    w.g_l_hip_yaw_link[0] = w.cq[0]*t7 + w.sq[0]*t8;
+    w.g_l_hip_yaw_link[1] = -w.sq[0]*t7 + w.cq[0]*t8;
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_0(&q[8], &v[7], &w.sq_l_hip_roll_link, &w.cq_l_hip_roll_link, &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
+  shared_0(&q[8], &v[7], &w.sq[1], &w.cq[1], &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_1(&q[9], &v[8], &w.sq_l_thigh, &w.cq_l_thigh, w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
+  shared_1(&q[9], &v[8], &w.sq[2], &w.cq[2], w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_2(&q[10], &v[9], &w.sq_l_shank, &w.cq_l_shank, w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
+  shared_2(&q[10], &v[9], &w.sq[3], &w.cq[3], w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
   // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_3(&q[11], &v[10], &w.sq_l_ankle_link, &w.cq_l_ankle_link, w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
+  shared_3(&q[11], &v[10], &w.sq[4], &w.cq[4], w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_4(&q[12], &v[11], &w.sq_l_foot, &w.cq_l_foot, &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
+  shared_4(&q[12], &v[11], &w.sq[5], &w.cq[5], &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_noinline(q[13], w.sq_r_hip_yaw_link, w.cq_r_hip_yaw_link);
+    proxgen_rt::sincos_joint_noinline(q[13], w.sq[6], w.cq[6]);
     const Scalar t0 = v[0] + 0.0875*v[5];
     const Scalar t1 = v[2] - 0.0875*v[3];
     const Scalar t2 = -0.08718915247898762*v[1] + 0.9961917745544759*t0;
     const Scalar t3 = 0.9961917745544759*v[1] + 0.08718915247898762*t0;
     const Scalar t4 = 0.9961917745544759*v[3] - 0.08718915247898762*v[4];
     const Scalar t5 = 0.08718915247898762*v[3] + 0.9961917745544759*v[4];
-    w.v_r_hip_yaw_link[0] = w.cq_r_hip_yaw_link*t2 + w.sq_r_hip_yaw_link*t3;
-    w.v_r_hip_yaw_link[1] = -w.sq_r_hip_yaw_link*t2 + w.cq_r_hip_yaw_link*t3;
+    w.v_r_hip_yaw_link[0] = w.cq[6]*t2 + w.sq[6]*t3;
+    w.v_r_hip_yaw_link[1] = -w.sq[6]*t2 + w.cq[6]*t3;
     w.v_r_hip_yaw_link[2] = t1;
-    w.v_r_hip_yaw_link[3] = w.cq_r_hip_yaw_link*t4 + w.sq_r_hip_yaw_link*t5;
-    w.v_r_hip_yaw_link[4] = -w.sq_r_hip_yaw_link*t4 + w.cq_r_hip_yaw_link*t5;
+    w.v_r_hip_yaw_link[3] = w.cq[6]*t4 + w.sq[6]*t5;
+    w.v_r_hip_yaw_link[4] = -w.sq[6]*t4 + w.cq[6]*t5;
     w.v_r_hip_yaw_link[5] = v[5] + v[12];
     w.c_r_hip_yaw_link[0] = v[12]*w.v_r_hip_yaw_link[1];
     w.c_r_hip_yaw_link[1] = -v[12]*w.v_r_hip_yaw_link[0];
@@ -2306,37 +2306,37 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
     w.pA_r_hip_yaw_link[5] = w.v_r_hip_yaw_link[3]*h9 - w.v_r_hip_yaw_link[4]*h8 + w.v_r_hip_yaw_link[0]*h7 - w.v_r_hip_yaw_link[1]*h6;
     const Scalar t6 = 0.9961917745544759*w.g_pelvis[0] - 0.08718915247898762*w.g_pelvis[1];
     const Scalar t7 = 0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
-    w.g_r_hip_yaw_link[0] = w.cq_r_hip_yaw_link*t6 + w.sq_r_hip_yaw_link*t7;
-    w.g_r_hip_yaw_link[1] = -w.sq_r_hip_yaw_link*t6 + w.cq_r_hip_yaw_link*t7;
+    w.g_r_hip_yaw_link[0] = w.cq[6]*t6 + w.sq[6]*t7;
+    w.g_r_hip_yaw_link[1] = -w.sq[6]*t6 + w.cq[6]*t7;
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_0(&q[14], &v[13], &w.sq_r_hip_roll_link, &w.cq_r_hip_roll_link, &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
+  shared_0(&q[14], &v[13], &w.sq[7], &w.cq[7], &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
   // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_1(&q[15], &v[14], &w.sq_r_thigh, &w.cq_r_thigh, w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
+  shared_1(&q[15], &v[14], &w.sq[8], &w.cq[8], w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_2(&q[16], &v[15], &w.sq_r_shank, &w.cq_r_shank, w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
+  shared_2(&q[16], &v[15], &w.sq[9], &w.cq[9], w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
   // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_3(&q[17], &v[16], &w.sq_r_ankle_link, &w.cq_r_ankle_link, w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
+  shared_3(&q[17], &v[16], &w.sq[10], &w.cq[10], w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_4(&q[18], &v[17], &w.sq_r_foot, &w.cq_r_foot, &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
+  shared_4(&q[18], &v[17], &w.sq[11], &w.cq[11], &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_noinline(q[19], w.sq_abdomen, w.cq_abdomen);
+    proxgen_rt::sincos_joint_noinline(q[19], w.sq[12], w.cq[12]);
     const Scalar t0 = v[0] + 0.1*v[4];
     const Scalar t1 = v[1] - 0.1*v[3];
-    w.v_abdomen[0] = w.cq_abdomen*t0 + w.sq_abdomen*t1;
-    w.v_abdomen[1] = -w.sq_abdomen*t0 + w.cq_abdomen*t1;
-    w.v_abdomen[3] = v[3]*w.cq_abdomen + v[4]*w.sq_abdomen;
-    w.v_abdomen[4] = -v[3]*w.sq_abdomen + v[4]*w.cq_abdomen;
+    w.v_abdomen[0] = w.cq[12]*t0 + w.sq[12]*t1;
+    w.v_abdomen[1] = -w.sq[12]*t0 + w.cq[12]*t1;
+    w.v_abdomen[3] = v[3]*w.cq[12] + v[4]*w.sq[12];
+    w.v_abdomen[4] = -v[3]*w.sq[12] + v[4]*w.cq[12];
     w.v_abdomen[5] = v[5] + v[18];
     w.c_abdomen[0] = v[18]*w.v_abdomen[1];
     w.c_abdomen[1] = -v[18]*w.v_abdomen[0];
@@ -2352,23 +2352,23 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
     w.pA_abdomen[3] = 0.105408333333*w.v_abdomen[4]*w.v_abdomen[5] - w.v_abdomen[5]*h9 + 9.73*v[2]*w.v_abdomen[1] - v[2]*h7;
     w.pA_abdomen[4] = w.v_abdomen[5]*h8 - 0.105408333333*w.v_abdomen[3]*w.v_abdomen[5] + v[2]*h6 - 9.73*v[2]*w.v_abdomen[0];
     w.pA_abdomen[5] = w.v_abdomen[3]*h9 - w.v_abdomen[4]*h8 + w.v_abdomen[0]*h7 - w.v_abdomen[1]*h6;
-    w.g_abdomen[0] = w.g_pelvis[0]*w.cq_abdomen + w.g_pelvis[1]*w.sq_abdomen;
-    w.g_abdomen[1] = -w.g_pelvis[0]*w.sq_abdomen + w.g_pelvis[1]*w.cq_abdomen;
+    w.g_abdomen[0] = w.g_pelvis[0]*w.cq[12] + w.g_pelvis[1]*w.sq[12];
+    w.g_abdomen[1] = -w.g_pelvis[0]*w.sq[12] + w.g_pelvis[1]*w.cq[12];
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    proxgen_rt::sincos_noinline(q[20], w.sq_chest, w.cq_chest);
+    proxgen_rt::sincos_joint_noinline(q[20], w.sq[13], w.cq[13]);
     const Scalar t0 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
     const Scalar t1 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
-    w.v_chest[0] = w.cq_chest*t0 - v[2]*w.sq_chest;
+    w.v_chest[0] = w.cq[13]*t0 - v[2]*w.sq[13];
     w.v_chest[1] = t1;
-    w.v_chest[2] = w.sq_chest*t0 + v[2]*w.cq_chest;
-    w.v_chest[3] = w.v_abdomen[3]*w.cq_chest - w.v_abdomen[5]*w.sq_chest;
+    w.v_chest[2] = w.sq[13]*t0 + v[2]*w.cq[13];
+    w.v_chest[3] = w.v_abdomen[3]*w.cq[13] - w.v_abdomen[5]*w.sq[13];
     w.v_chest[4] = w.v_abdomen[4] + v[19];
-    w.v_chest[5] = w.v_abdomen[3]*w.sq_chest + w.v_abdomen[5]*w.cq_chest;
+    w.v_chest[5] = w.v_abdomen[3]*w.sq[13] + w.v_abdomen[5]*w.cq[13];
     w.c_chest[0] = -v[19]*w.v_chest[2];
     w.c_chest[2] = v[19]*w.v_chest[0];
     w.c_chest[3] = -v[19]*w.v_chest[5];
@@ -2383,12 +2383,12 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
     w.pA_chest[3] = 0.198244*w.v_chest[4]*w.v_chest[5] - w.v_chest[5]*h3 + 13.92*w.v_chest[1]*w.v_chest[2] - w.v_chest[2]*h1;
     w.pA_chest[4] = w.v_chest[5]*h2 - 0.198244*w.v_chest[3]*w.v_chest[5] + w.v_chest[2]*h0 - 13.92*w.v_chest[0]*w.v_chest[2];
     w.pA_chest[5] = w.v_chest[3]*h3 - w.v_chest[4]*h2 + w.v_chest[0]*h1 - w.v_chest[1]*h0;
-    w.g_chest[0] = w.g_abdomen[0]*w.cq_chest - w.g_pelvis[2]*w.sq_chest;
-    w.g_chest[2] = w.g_abdomen[0]*w.sq_chest + w.g_pelvis[2]*w.cq_chest;
+    w.g_chest[0] = w.g_abdomen[0]*w.cq[13] - w.g_pelvis[2]*w.sq[13];
+    w.g_chest[2] = w.g_abdomen[0]*w.sq[13] + w.g_pelvis[2]*w.cq[13];
   }
   // body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
-    proxgen_rt::sincos_noinline(q[21], w.sq_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link);
+    proxgen_rt::sincos_joint_noinline(q[21], w.sq[14], w.cq[14]);
     const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
     const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
@@ -2398,12 +2398,12 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
     const Scalar t8 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
     const Scalar t9 = -0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] + 0.2548890642384102*w.v_chest[5];
     const Scalar t10 = -0.1676999117594225*w.v_chest[3] - 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
-    w.v_l_shoulder_pitch_link[0] = w.cq_l_shoulder_pitch_link*t5 - w.sq_l_shoulder_pitch_link*t7;
+    w.v_l_shoulder_pitch_link[0] = w.cq[14]*t5 - w.sq[14]*t7;
     w.v_l_shoulder_pitch_link[1] = t6;
-    w.v_l_shoulder_pitch_link[2] = w.sq_l_shoulder_pitch_link*t5 + w.cq_l_shoulder_pitch_link*t7;
-    w.v_l_shoulder_pitch_link[3] = w.cq_l_shoulder_pitch_link*t8 - w.sq_l_shoulder_pitch_link*t10;
+    w.v_l_shoulder_pitch_link[2] = w.sq[14]*t5 + w.cq[14]*t7;
+    w.v_l_shoulder_pitch_link[3] = w.cq[14]*t8 - w.sq[14]*t10;
     w.v_l_shoulder_pitch_link[4] = v[20] + t9;
-    w.v_l_shoulder_pitch_link[5] = w.sq_l_shoulder_pitch_link*t8 + w.cq_l_shoulder_pitch_link*t10;
+    w.v_l_shoulder_pitch_link[5] = w.sq[14]*t8 + w.cq[14]*t10;
     w.c_l_shoulder_pitch_link[0] = -v[20]*w.v_l_shoulder_pitch_link[2];
     w.c_l_shoulder_pitch_link[2] = v[20]*w.v_l_shoulder_pitch_link[0];
     w.c_l_shoulder_pitch_link[3] = -v[20]*w.v_l_shoulder_pitch_link[5];
@@ -2424,12 +2424,12 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
 PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
-    proxgen_rt::sincos_noinline(q[22], w.sq_l_shoulder_roll_link, w.cq_l_shoulder_roll_link);
-    w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.sq_l_shoulder_roll_link;
-    w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[2]*w.cq_l_shoulder_roll_link;
+    proxgen_rt::sincos_joint_noinline(q[22], w.sq[15], w.cq[15]);
+    w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq[15] + w.v_l_shoulder_pitch_link[2]*w.sq[15];
+    w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq[15] + w.v_l_shoulder_pitch_link[2]*w.cq[15];
     w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
-    w.v_l_shoulder_roll_link[4] = w.v_l_shoulder_pitch_link[4]*w.cq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[5]*w.sq_l_shoulder_roll_link;
-    w.v_l_shoulder_roll_link[5] = -w.v_l_shoulder_pitch_link[4]*w.sq_l_shoulder_roll_link + w.v_l_shoulder_pitch_link[5]*w.cq_l_shoulder_roll_link;
+    w.v_l_shoulder_roll_link[4] = w.v_l_shoulder_pitch_link[4]*w.cq[15] + w.v_l_shoulder_pitch_link[5]*w.sq[15];
+    w.v_l_shoulder_roll_link[5] = -w.v_l_shoulder_pitch_link[4]*w.sq[15] + w.v_l_shoulder_pitch_link[5]*w.cq[15];
     w.c_l_shoulder_roll_link[1] = v[21]*w.v_l_shoulder_roll_link[2];
     w.c_l_shoulder_roll_link[2] = -v[21]*w.v_l_shoulder_roll_link[1];
     w.c_l_shoulder_roll_link[4] = v[21]*w.v_l_shoulder_roll_link[5];
@@ -2447,11 +2447,11 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
   }
   // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    proxgen_rt::sincos_noinline(q[23], w.sq_l_upper_arm, w.cq_l_upper_arm);
-    w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.sq_l_upper_arm;
-    w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq_l_upper_arm + w.v_l_shoulder_roll_link[1]*w.cq_l_upper_arm;
-    w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq_l_upper_arm + w.v_l_shoulder_roll_link[4]*w.sq_l_upper_arm;
-    w.v_l_upper_arm[4] = -w.v_l_shoulder_roll_link[3]*w.sq_l_upper_arm + w.v_l_shoulder_roll_link[4]*w.cq_l_upper_arm;
+    proxgen_rt::sincos_joint_noinline(q[23], w.sq[16], w.cq[16]);
+    w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq[16] + w.v_l_shoulder_roll_link[1]*w.sq[16];
+    w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq[16] + w.v_l_shoulder_roll_link[1]*w.cq[16];
+    w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq[16] + w.v_l_shoulder_roll_link[4]*w.sq[16];
+    w.v_l_upper_arm[4] = -w.v_l_shoulder_roll_link[3]*w.sq[16] + w.v_l_shoulder_roll_link[4]*w.cq[16];
     w.v_l_upper_arm[5] = w.v_l_shoulder_roll_link[5] + v[22];
     w.c_l_upper_arm[0] = v[22]*w.v_l_upper_arm[1];
     w.c_l_upper_arm[1] = -v[22]*w.v_l_upper_arm[0];
@@ -2473,19 +2473,19 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
 PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
-    proxgen_rt::sincos_noinline(q[24], w.sq_l_forearm, w.cq_l_forearm);
+    proxgen_rt::sincos_joint_noinline(q[24], w.sq[17], w.cq[17]);
     const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
     const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
     const Scalar t3 = 0.955336489125606*w.v_l_shoulder_roll_link[2] - 0.29552020666133966*t0;
     const Scalar t4 = 0.955336489125606*w.v_l_upper_arm[3] + 0.29552020666133966*w.v_l_upper_arm[5];
     const Scalar t5 = -0.29552020666133966*w.v_l_upper_arm[3] + 0.955336489125606*w.v_l_upper_arm[5];
-    w.v_l_forearm[0] = w.cq_l_forearm*t2 - w.sq_l_forearm*t3;
+    w.v_l_forearm[0] = w.cq[17]*t2 - w.sq[17]*t3;
     w.v_l_forearm[1] = t1;
-    w.v_l_forearm[2] = w.sq_l_forearm*t2 + w.cq_l_forearm*t3;
-    w.v_l_forearm[3] = w.cq_l_forearm*t4 - w.sq_l_forearm*t5;
+    w.v_l_forearm[2] = w.sq[17]*t2 + w.cq[17]*t3;
+    w.v_l_forearm[3] = w.cq[17]*t4 - w.sq[17]*t5;
     w.v_l_forearm[4] = w.v_l_upper_arm[4] + v[23];
-    w.v_l_forearm[5] = w.sq_l_forearm*t4 + w.cq_l_forearm*t5;
+    w.v_l_forearm[5] = w.sq[17]*t4 + w.cq[17]*t5;
     w.c_l_forearm[0] = -v[23]*w.v_l_forearm[2];
     w.c_l_forearm[2] = v[23]*w.v_l_forearm[0];
     w.c_l_forearm[3] = -v[23]*w.v_l_forearm[5];
@@ -2502,18 +2502,18 @@ PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* 
     w.pA_l_forearm[5] = w.v_l_forearm[3]*h3 - w.v_l_forearm[4]*h2 + w.v_l_forearm[0]*h1 - w.v_l_forearm[1]*h0;
   }
   // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_5(shared_5_k0, &q[25], &v[24], &w.sq_l_wrist_yaw_link, &w.cq_l_wrist_yaw_link, w.v_l_forearm, w.v_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.pA_l_wrist_yaw_link);
+  shared_5(shared_5_k0, &q[25], &v[24], &w.sq[18], &w.cq[18], w.v_l_forearm, w.v_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.pA_l_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    proxgen_rt::sincos_noinline(q[26], w.sq_l_wrist_pitch_link, w.cq_l_wrist_pitch_link);
-    w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq_l_wrist_pitch_link - w.v_l_forearm[2]*w.sq_l_wrist_pitch_link;
-    w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq_l_wrist_pitch_link + w.v_l_forearm[2]*w.cq_l_wrist_pitch_link;
-    w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq_l_wrist_pitch_link - w.v_l_wrist_yaw_link[5]*w.sq_l_wrist_pitch_link;
+    proxgen_rt::sincos_joint_noinline(q[26], w.sq[19], w.cq[19]);
+    w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq[19] - w.v_l_forearm[2]*w.sq[19];
+    w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq[19] + w.v_l_forearm[2]*w.cq[19];
+    w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq[19] - w.v_l_wrist_yaw_link[5]*w.sq[19];
     w.v_l_wrist_pitch_link[4] = w.v_l_wrist_yaw_link[4] + v[25];
-    w.v_l_wrist_pitch_link[5] = w.v_l_wrist_yaw_link[3]*w.sq_l_wrist_pitch_link + w.v_l_wrist_yaw_link[5]*w.cq_l_wrist_pitch_link;
+    w.v_l_wrist_pitch_link[5] = w.v_l_wrist_yaw_link[3]*w.sq[19] + w.v_l_wrist_yaw_link[5]*w.cq[19];
     w.c_l_wrist_pitch_link[0] = -v[25]*w.v_l_wrist_pitch_link[2];
     w.c_l_wrist_pitch_link[2] = v[25]*w.v_l_wrist_pitch_link[0];
     w.c_l_wrist_pitch_link[3] = -v[25]*w.v_l_wrist_pitch_link[5];
@@ -2531,12 +2531,12 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
   }
   // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    proxgen_rt::sincos_noinline(q[27], w.sq_l_hand, w.cq_l_hand);
-    w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq_l_hand + w.v_l_wrist_pitch_link[2]*w.sq_l_hand;
-    w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq_l_hand + w.v_l_wrist_pitch_link[2]*w.cq_l_hand;
+    proxgen_rt::sincos_joint_noinline(q[27], w.sq[20], w.cq[20]);
+    w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq[20] + w.v_l_wrist_pitch_link[2]*w.sq[20];
+    w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq[20] + w.v_l_wrist_pitch_link[2]*w.cq[20];
     w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
-    w.v_l_hand[4] = w.v_l_wrist_pitch_link[4]*w.cq_l_hand + w.v_l_wrist_pitch_link[5]*w.sq_l_hand;
-    w.v_l_hand[5] = -w.v_l_wrist_pitch_link[4]*w.sq_l_hand + w.v_l_wrist_pitch_link[5]*w.cq_l_hand;
+    w.v_l_hand[4] = w.v_l_wrist_pitch_link[4]*w.cq[20] + w.v_l_wrist_pitch_link[5]*w.sq[20];
+    w.v_l_hand[5] = -w.v_l_wrist_pitch_link[4]*w.sq[20] + w.v_l_wrist_pitch_link[5]*w.cq[20];
     w.c_l_hand[1] = v[26]*w.v_l_hand[2];
     w.c_l_hand[2] = -v[26]*w.v_l_hand[1];
     w.c_l_hand[4] = v[26]*w.v_l_hand[5];
@@ -2556,18 +2556,18 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
 
 PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
-  shared_5(shared_5_k1, &q[28], &v[27], &w.sq_neck_link, &w.cq_neck_link, w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
+  shared_5(shared_5_k1, &q[28], &v[27], &w.sq[21], &w.cq[21], w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    proxgen_rt::sincos_noinline(q[29], w.sq_head, w.cq_head);
+    proxgen_rt::sincos_joint_noinline(q[29], w.sq[22], w.cq[22]);
     const Scalar t2 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
     const Scalar t3 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
-    w.v_head[0] = w.cq_head*t2 - w.v_chest[2]*w.sq_head;
+    w.v_head[0] = w.cq[22]*t2 - w.v_chest[2]*w.sq[22];
     w.v_head[1] = t3;
-    w.v_head[2] = w.sq_head*t2 + w.v_chest[2]*w.cq_head;
-    w.v_head[3] = w.v_neck_link[3]*w.cq_head - w.v_neck_link[5]*w.sq_head;
+    w.v_head[2] = w.sq[22]*t2 + w.v_chest[2]*w.cq[22];
+    w.v_head[3] = w.v_neck_link[3]*w.cq[22] - w.v_neck_link[5]*w.sq[22];
     w.v_head[4] = w.v_neck_link[4] + v[28];
-    w.v_head[5] = w.v_neck_link[3]*w.sq_head + w.v_neck_link[5]*w.cq_head;
+    w.v_head[5] = w.v_neck_link[3]*w.sq[22] + w.v_neck_link[5]*w.cq[22];
     w.c_head[0] = -v[28]*w.v_head[2];
     w.c_head[2] = v[28]*w.v_head[0];
     w.c_head[3] = -v[28]*w.v_head[5];
@@ -2588,7 +2588,7 @@ PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    proxgen_rt::sincos_noinline(q[30], w.sq_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link);
+    proxgen_rt::sincos_joint_noinline(q[30], w.sq[23], w.cq[23]);
     const Scalar t0 = w.v_chest[0] + 0.254*w.v_chest[4] + 0.19*w.v_chest[5];
     const Scalar t1 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t2 = w.v_chest[2] - 0.19*w.v_chest[3];
@@ -2598,12 +2598,12 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
     const Scalar t6 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
     const Scalar t7 = 0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] - 0.2548890642384102*w.v_chest[5];
     const Scalar t8 = -0.1676999117594225*w.v_chest[3] + 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
-    w.v_r_shoulder_pitch_link[0] = w.cq_r_shoulder_pitch_link*t3 - w.sq_r_shoulder_pitch_link*t5;
+    w.v_r_shoulder_pitch_link[0] = w.cq[23]*t3 - w.sq[23]*t5;
     w.v_r_shoulder_pitch_link[1] = t4;
-    w.v_r_shoulder_pitch_link[2] = w.sq_r_shoulder_pitch_link*t3 + w.cq_r_shoulder_pitch_link*t5;
-    w.v_r_shoulder_pitch_link[3] = w.cq_r_shoulder_pitch_link*t6 - w.sq_r_shoulder_pitch_link*t8;
+    w.v_r_shoulder_pitch_link[2] = w.sq[23]*t3 + w.cq[23]*t5;
+    w.v_r_shoulder_pitch_link[3] = w.cq[23]*t6 - w.sq[23]*t8;
     w.v_r_shoulder_pitch_link[4] = v[29] + t7;
-    w.v_r_shoulder_pitch_link[5] = w.sq_r_shoulder_pitch_link*t6 + w.cq_r_shoulder_pitch_link*t8;
+    w.v_r_shoulder_pitch_link[5] = w.sq[23]*t6 + w.cq[23]*t8;
     w.c_r_shoulder_pitch_link[0] = -v[29]*w.v_r_shoulder_pitch_link[2];
     w.c_r_shoulder_pitch_link[2] = v[29]*w.v_r_shoulder_pitch_link[0];
     w.c_r_shoulder_pitch_link[3] = -v[29]*w.v_r_shoulder_pitch_link[5];
@@ -2621,18 +2621,18 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
     const Scalar t9 = 0.9848134698792882*w.g_chest[0] + 0.17361575258114187*w.g_chest[2];
     const Scalar t10 = 0.9659256678396477*w.g_abdomen[1] + 0.04493516596384369*w.g_chest[0] - 0.2548890642384102*w.g_chest[2];
     const Scalar t11 = 0.2588196364430848*w.g_abdomen[1] - 0.1676999117594225*w.g_chest[0] + 0.9512566085906322*w.g_chest[2];
-    w.g_r_shoulder_pitch_link[0] = w.cq_r_shoulder_pitch_link*t9 - w.sq_r_shoulder_pitch_link*t11;
+    w.g_r_shoulder_pitch_link[0] = w.cq[23]*t9 - w.sq[23]*t11;
     w.g_r_shoulder_pitch_link[1] = t10;
-    w.g_r_shoulder_pitch_link[2] = w.sq_r_shoulder_pitch_link*t9 + w.cq_r_shoulder_pitch_link*t11;
+    w.g_r_shoulder_pitch_link[2] = w.sq[23]*t9 + w.cq[23]*t11;
   }
   // body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    proxgen_rt::sincos_noinline(q[31], w.sq_r_shoulder_roll_link, w.cq_r_shoulder_roll_link);
-    w.v_r_shoulder_roll_link[1] = w.v_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
-    w.v_r_shoulder_roll_link[2] = -w.v_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
+    proxgen_rt::sincos_joint_noinline(q[31], w.sq[24], w.cq[24]);
+    w.v_r_shoulder_roll_link[1] = w.v_r_shoulder_pitch_link[1]*w.cq[24] + w.v_r_shoulder_pitch_link[2]*w.sq[24];
+    w.v_r_shoulder_roll_link[2] = -w.v_r_shoulder_pitch_link[1]*w.sq[24] + w.v_r_shoulder_pitch_link[2]*w.cq[24];
     w.v_r_shoulder_roll_link[3] = w.v_r_shoulder_pitch_link[3] + v[30];
-    w.v_r_shoulder_roll_link[4] = w.v_r_shoulder_pitch_link[4]*w.cq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[5]*w.sq_r_shoulder_roll_link;
-    w.v_r_shoulder_roll_link[5] = -w.v_r_shoulder_pitch_link[4]*w.sq_r_shoulder_roll_link + w.v_r_shoulder_pitch_link[5]*w.cq_r_shoulder_roll_link;
+    w.v_r_shoulder_roll_link[4] = w.v_r_shoulder_pitch_link[4]*w.cq[24] + w.v_r_shoulder_pitch_link[5]*w.sq[24];
+    w.v_r_shoulder_roll_link[5] = -w.v_r_shoulder_pitch_link[4]*w.sq[24] + w.v_r_shoulder_pitch_link[5]*w.cq[24];
     w.c_r_shoulder_roll_link[1] = v[30]*w.v_r_shoulder_roll_link[2];
     w.c_r_shoulder_roll_link[2] = -v[30]*w.v_r_shoulder_roll_link[1];
     w.c_r_shoulder_roll_link[4] = v[30]*w.v_r_shoulder_roll_link[5];
@@ -2647,19 +2647,19 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
     w.pA_r_shoulder_roll_link[3] = 0.000192*w.v_r_shoulder_roll_link[4]*w.v_r_shoulder_roll_link[5] - w.v_r_shoulder_roll_link[5]*h7 + 0.3*w.v_r_shoulder_roll_link[1]*w.v_r_shoulder_roll_link[2] - w.v_r_shoulder_roll_link[2]*h5;
     w.pA_r_shoulder_roll_link[4] = w.v_r_shoulder_roll_link[5]*h6 - 0.000192*w.v_r_shoulder_roll_link[3]*w.v_r_shoulder_roll_link[5] + w.v_r_shoulder_roll_link[2]*h4 - 0.3*w.v_r_shoulder_pitch_link[0]*w.v_r_shoulder_roll_link[2];
     w.pA_r_shoulder_roll_link[5] = w.v_r_shoulder_roll_link[3]*h7 - w.v_r_shoulder_roll_link[4]*h6 + w.v_r_shoulder_pitch_link[0]*h5 - w.v_r_shoulder_roll_link[1]*h4;
-    w.g_r_shoulder_roll_link[1] = w.g_r_shoulder_pitch_link[1]*w.cq_r_shoulder_roll_link + w.g_r_shoulder_pitch_link[2]*w.sq_r_shoulder_roll_link;
-    w.g_r_shoulder_roll_link[2] = -w.g_r_shoulder_pitch_link[1]*w.sq_r_shoulder_roll_link + w.g_r_shoulder_pitch_link[2]*w.cq_r_shoulder_roll_link;
+    w.g_r_shoulder_roll_link[1] = w.g_r_shoulder_pitch_link[1]*w.cq[24] + w.g_r_shoulder_pitch_link[2]*w.sq[24];
+    w.g_r_shoulder_roll_link[2] = -w.g_r_shoulder_pitch_link[1]*w.sq[24] + w.g_r_shoulder_pitch_link[2]*w.cq[24];
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    proxgen_rt::sincos_noinline(q[32], w.sq_r_upper_arm, w.cq_r_upper_arm);
-    w.v_r_upper_arm[0] = w.v_r_shoulder_pitch_link[0]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    w.v_r_upper_arm[1] = -w.v_r_shoulder_pitch_link[0]*w.sq_r_upper_arm + w.v_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
-    w.v_r_upper_arm[3] = w.v_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.v_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    w.v_r_upper_arm[4] = -w.v_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.v_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    proxgen_rt::sincos_joint_noinline(q[32], w.sq[25], w.cq[25]);
+    w.v_r_upper_arm[0] = w.v_r_shoulder_pitch_link[0]*w.cq[25] + w.v_r_shoulder_roll_link[1]*w.sq[25];
+    w.v_r_upper_arm[1] = -w.v_r_shoulder_pitch_link[0]*w.sq[25] + w.v_r_shoulder_roll_link[1]*w.cq[25];
+    w.v_r_upper_arm[3] = w.v_r_shoulder_roll_link[3]*w.cq[25] + w.v_r_shoulder_roll_link[4]*w.sq[25];
+    w.v_r_upper_arm[4] = -w.v_r_shoulder_roll_link[3]*w.sq[25] + w.v_r_shoulder_roll_link[4]*w.cq[25];
     w.v_r_upper_arm[5] = w.v_r_shoulder_roll_link[5] + v[31];
     w.c_r_upper_arm[0] = v[31]*w.v_r_upper_arm[1];
     w.c_r_upper_arm[1] = -v[31]*w.v_r_upper_arm[0];
@@ -2675,24 +2675,24 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
     w.pA_r_upper_arm[3] = 0.0019845*w.v_r_upper_arm[4]*w.v_r_upper_arm[5] - w.v_r_upper_arm[5]*h3 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[1] - w.v_r_shoulder_roll_link[2]*h1;
     w.pA_r_upper_arm[4] = w.v_r_upper_arm[5]*h2 - 0.0019845*w.v_r_upper_arm[3]*w.v_r_upper_arm[5] + w.v_r_shoulder_roll_link[2]*h0 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[0];
     w.pA_r_upper_arm[5] = w.v_r_upper_arm[3]*h3 - w.v_r_upper_arm[4]*h2 + w.v_r_upper_arm[0]*h1 - w.v_r_upper_arm[1]*h0;
-    w.g_r_upper_arm[0] = w.g_r_shoulder_pitch_link[0]*w.cq_r_upper_arm + w.g_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    w.g_r_upper_arm[1] = -w.g_r_shoulder_pitch_link[0]*w.sq_r_upper_arm + w.g_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
+    w.g_r_upper_arm[0] = w.g_r_shoulder_pitch_link[0]*w.cq[25] + w.g_r_shoulder_roll_link[1]*w.sq[25];
+    w.g_r_upper_arm[1] = -w.g_r_shoulder_pitch_link[0]*w.sq[25] + w.g_r_shoulder_roll_link[1]*w.cq[25];
   }
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    proxgen_rt::sincos_noinline(q[33], w.sq_r_forearm, w.cq_r_forearm);
+    proxgen_rt::sincos_joint_noinline(q[33], w.sq[26], w.cq[26]);
     const Scalar t0 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
     const Scalar t1 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t0;
     const Scalar t3 = 0.955336489125606*w.v_r_shoulder_roll_link[2] - 0.29552020666133966*t0;
     const Scalar t4 = 0.955336489125606*w.v_r_upper_arm[3] + 0.29552020666133966*w.v_r_upper_arm[5];
     const Scalar t5 = -0.29552020666133966*w.v_r_upper_arm[3] + 0.955336489125606*w.v_r_upper_arm[5];
-    w.v_r_forearm[0] = w.cq_r_forearm*t2 - w.sq_r_forearm*t3;
+    w.v_r_forearm[0] = w.cq[26]*t2 - w.sq[26]*t3;
     w.v_r_forearm[1] = t1;
-    w.v_r_forearm[2] = w.sq_r_forearm*t2 + w.cq_r_forearm*t3;
-    w.v_r_forearm[3] = w.cq_r_forearm*t4 - w.sq_r_forearm*t5;
+    w.v_r_forearm[2] = w.sq[26]*t2 + w.cq[26]*t3;
+    w.v_r_forearm[3] = w.cq[26]*t4 - w.sq[26]*t5;
     w.v_r_forearm[4] = w.v_r_upper_arm[4] + v[32];
-    w.v_r_forearm[5] = w.sq_r_forearm*t4 + w.cq_r_forearm*t5;
+    w.v_r_forearm[5] = w.sq[26]*t4 + w.cq[26]*t5;
     w.c_r_forearm[0] = -v[32]*w.v_r_forearm[2];
     w.c_r_forearm[2] = v[32]*w.v_r_forearm[0];
     w.c_r_forearm[3] = -v[32]*w.v_r_forearm[5];
@@ -2709,21 +2709,21 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
     w.pA_r_forearm[5] = w.v_r_forearm[3]*h7 - w.v_r_forearm[4]*h6 + w.v_r_forearm[0]*h5 - w.v_r_forearm[1]*h4;
     const Scalar t6 = 0.29552020666133966*w.g_r_shoulder_roll_link[2] + 0.955336489125606*w.g_r_upper_arm[0];
     const Scalar t7 = 0.955336489125606*w.g_r_shoulder_roll_link[2] - 0.29552020666133966*w.g_r_upper_arm[0];
-    w.g_r_forearm[0] = w.cq_r_forearm*t6 - w.sq_r_forearm*t7;
-    w.g_r_forearm[2] = w.sq_r_forearm*t6 + w.cq_r_forearm*t7;
+    w.g_r_forearm[0] = w.cq[26]*t6 - w.sq[26]*t7;
+    w.g_r_forearm[2] = w.sq[26]*t6 + w.cq[26]*t7;
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    proxgen_rt::sincos_noinline(q[34], w.sq_r_wrist_yaw_link, w.cq_r_wrist_yaw_link);
+    proxgen_rt::sincos_joint_noinline(q[34], w.sq[27], w.cq[27]);
     const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
     const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
-    w.v_r_wrist_yaw_link[0] = w.cq_r_wrist_yaw_link*t0 + w.sq_r_wrist_yaw_link*t1;
-    w.v_r_wrist_yaw_link[1] = -w.sq_r_wrist_yaw_link*t0 + w.cq_r_wrist_yaw_link*t1;
-    w.v_r_wrist_yaw_link[3] = w.v_r_forearm[3]*w.cq_r_wrist_yaw_link + w.v_r_forearm[4]*w.sq_r_wrist_yaw_link;
-    w.v_r_wrist_yaw_link[4] = -w.v_r_forearm[3]*w.sq_r_wrist_yaw_link + w.v_r_forearm[4]*w.cq_r_wrist_yaw_link;
+    w.v_r_wrist_yaw_link[0] = w.cq[27]*t0 + w.sq[27]*t1;
+    w.v_r_wrist_yaw_link[1] = -w.sq[27]*t0 + w.cq[27]*t1;
+    w.v_r_wrist_yaw_link[3] = w.v_r_forearm[3]*w.cq[27] + w.v_r_forearm[4]*w.sq[27];
+    w.v_r_wrist_yaw_link[4] = -w.v_r_forearm[3]*w.sq[27] + w.v_r_forearm[4]*w.cq[27];
     w.v_r_wrist_yaw_link[5] = w.v_r_forearm[5] + v[33];
     w.c_r_wrist_yaw_link[0] = v[33]*w.v_r_wrist_yaw_link[1];
     w.c_r_wrist_yaw_link[1] = -v[33]*w.v_r_wrist_yaw_link[0];
@@ -2739,17 +2739,17 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
     w.pA_r_wrist_yaw_link[3] = 2.5e-05*w.v_r_wrist_yaw_link[4]*w.v_r_wrist_yaw_link[5] - w.v_r_wrist_yaw_link[5]*h3 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[1] - w.v_r_forearm[2]*h1;
     w.pA_r_wrist_yaw_link[4] = w.v_r_wrist_yaw_link[5]*h2 - 2.5e-05*w.v_r_wrist_yaw_link[3]*w.v_r_wrist_yaw_link[5] + w.v_r_forearm[2]*h0 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[0];
     w.pA_r_wrist_yaw_link[5] = w.v_r_wrist_yaw_link[3]*h3 - w.v_r_wrist_yaw_link[4]*h2 + w.v_r_wrist_yaw_link[0]*h1 - w.v_r_wrist_yaw_link[1]*h0;
-    w.g_r_wrist_yaw_link[0] = w.g_r_forearm[0]*w.cq_r_wrist_yaw_link + w.g_r_upper_arm[1]*w.sq_r_wrist_yaw_link;
-    w.g_r_wrist_yaw_link[1] = -w.g_r_forearm[0]*w.sq_r_wrist_yaw_link + w.g_r_upper_arm[1]*w.cq_r_wrist_yaw_link;
+    w.g_r_wrist_yaw_link[0] = w.g_r_forearm[0]*w.cq[27] + w.g_r_upper_arm[1]*w.sq[27];
+    w.g_r_wrist_yaw_link[1] = -w.g_r_forearm[0]*w.sq[27] + w.g_r_upper_arm[1]*w.cq[27];
   }
   // body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    proxgen_rt::sincos_noinline(q[35], w.sq_r_wrist_pitch_link, w.cq_r_wrist_pitch_link);
-    w.v_r_wrist_pitch_link[0] = w.v_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.v_r_forearm[2]*w.sq_r_wrist_pitch_link;
-    w.v_r_wrist_pitch_link[2] = w.v_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.v_r_forearm[2]*w.cq_r_wrist_pitch_link;
-    w.v_r_wrist_pitch_link[3] = w.v_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.v_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
+    proxgen_rt::sincos_joint_noinline(q[35], w.sq[28], w.cq[28]);
+    w.v_r_wrist_pitch_link[0] = w.v_r_wrist_yaw_link[0]*w.cq[28] - w.v_r_forearm[2]*w.sq[28];
+    w.v_r_wrist_pitch_link[2] = w.v_r_wrist_yaw_link[0]*w.sq[28] + w.v_r_forearm[2]*w.cq[28];
+    w.v_r_wrist_pitch_link[3] = w.v_r_wrist_yaw_link[3]*w.cq[28] - w.v_r_wrist_yaw_link[5]*w.sq[28];
     w.v_r_wrist_pitch_link[4] = w.v_r_wrist_yaw_link[4] + v[34];
-    w.v_r_wrist_pitch_link[5] = w.v_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.v_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    w.v_r_wrist_pitch_link[5] = w.v_r_wrist_yaw_link[3]*w.sq[28] + w.v_r_wrist_yaw_link[5]*w.cq[28];
     w.c_r_wrist_pitch_link[0] = -v[34]*w.v_r_wrist_pitch_link[2];
     w.c_r_wrist_pitch_link[2] = v[34]*w.v_r_wrist_pitch_link[0];
     w.c_r_wrist_pitch_link[3] = -v[34]*w.v_r_wrist_pitch_link[5];
@@ -2764,20 +2764,20 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
     w.pA_r_wrist_pitch_link[3] = 2.5e-05*w.v_r_wrist_pitch_link[4]*w.v_r_wrist_pitch_link[5] - w.v_r_wrist_pitch_link[5]*h7 + 0.1*w.v_r_wrist_yaw_link[1]*w.v_r_wrist_pitch_link[2] - w.v_r_wrist_pitch_link[2]*h5;
     w.pA_r_wrist_pitch_link[4] = w.v_r_wrist_pitch_link[5]*h6 - 2.5e-05*w.v_r_wrist_pitch_link[3]*w.v_r_wrist_pitch_link[5] + w.v_r_wrist_pitch_link[2]*h4 - 0.1*w.v_r_wrist_pitch_link[0]*w.v_r_wrist_pitch_link[2];
     w.pA_r_wrist_pitch_link[5] = w.v_r_wrist_pitch_link[3]*h7 - w.v_r_wrist_pitch_link[4]*h6 + w.v_r_wrist_pitch_link[0]*h5 - w.v_r_wrist_yaw_link[1]*h4;
-    w.g_r_wrist_pitch_link[0] = w.g_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.g_r_forearm[2]*w.sq_r_wrist_pitch_link;
-    w.g_r_wrist_pitch_link[2] = w.g_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.g_r_forearm[2]*w.cq_r_wrist_pitch_link;
+    w.g_r_wrist_pitch_link[0] = w.g_r_wrist_yaw_link[0]*w.cq[28] - w.g_r_forearm[2]*w.sq[28];
+    w.g_r_wrist_pitch_link[2] = w.g_r_wrist_yaw_link[0]*w.sq[28] + w.g_r_forearm[2]*w.cq[28];
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    proxgen_rt::sincos_noinline(q[36], w.sq_r_hand, w.cq_r_hand);
-    w.v_r_hand[1] = w.v_r_wrist_yaw_link[1]*w.cq_r_hand + w.v_r_wrist_pitch_link[2]*w.sq_r_hand;
-    w.v_r_hand[2] = -w.v_r_wrist_yaw_link[1]*w.sq_r_hand + w.v_r_wrist_pitch_link[2]*w.cq_r_hand;
+    proxgen_rt::sincos_joint_noinline(q[36], w.sq[29], w.cq[29]);
+    w.v_r_hand[1] = w.v_r_wrist_yaw_link[1]*w.cq[29] + w.v_r_wrist_pitch_link[2]*w.sq[29];
+    w.v_r_hand[2] = -w.v_r_wrist_yaw_link[1]*w.sq[29] + w.v_r_wrist_pitch_link[2]*w.cq[29];
     w.v_r_hand[3] = w.v_r_wrist_pitch_link[3] + v[35];
-    w.v_r_hand[4] = w.v_r_wrist_pitch_link[4]*w.cq_r_hand + w.v_r_wrist_pitch_link[5]*w.sq_r_hand;
-    w.v_r_hand[5] = -w.v_r_wrist_pitch_link[4]*w.sq_r_hand + w.v_r_wrist_pitch_link[5]*w.cq_r_hand;
+    w.v_r_hand[4] = w.v_r_wrist_pitch_link[4]*w.cq[29] + w.v_r_wrist_pitch_link[5]*w.sq[29];
+    w.v_r_hand[5] = -w.v_r_wrist_pitch_link[4]*w.sq[29] + w.v_r_wrist_pitch_link[5]*w.cq[29];
     w.c_r_hand[1] = v[35]*w.v_r_hand[2];
     w.c_r_hand[2] = -v[35]*w.v_r_hand[1];
     w.c_r_hand[4] = v[35]*w.v_r_hand[5];
@@ -2792,8 +2792,8 @@ PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, 
     w.pA_r_hand[3] = 0.000284375*w.v_r_hand[4]*w.v_r_hand[5] - w.v_r_hand[5]*h3 + 0.42*w.v_r_hand[1]*w.v_r_hand[2] - w.v_r_hand[2]*h1;
     w.pA_r_hand[4] = w.v_r_hand[5]*h2 - 0.000284375*w.v_r_hand[3]*w.v_r_hand[5] + w.v_r_hand[2]*h0 - 0.42*w.v_r_wrist_pitch_link[0]*w.v_r_hand[2];
     w.pA_r_hand[5] = w.v_r_hand[3]*h3 - w.v_r_hand[4]*h2 + w.v_r_wrist_pitch_link[0]*h1 - w.v_r_hand[1]*h0;
-    w.g_r_hand[1] = w.g_r_wrist_yaw_link[1]*w.cq_r_hand + w.g_r_wrist_pitch_link[2]*w.sq_r_hand;
-    w.g_r_hand[2] = -w.g_r_wrist_yaw_link[1]*w.sq_r_hand + w.g_r_wrist_pitch_link[2]*w.cq_r_hand;
+    w.g_r_hand[1] = w.g_r_wrist_yaw_link[1]*w.cq[29] + w.g_r_wrist_pitch_link[2]*w.sq[29];
+    w.g_r_hand[2] = -w.g_r_wrist_yaw_link[1]*w.sq[29] + w.g_r_wrist_pitch_link[2]*w.cq[29];
     // constraint 'right_hand' (3d) on link 'r_hand_frame': rows 12..14
     const Scalar t0 = -w.v_r_wrist_pitch_link[0] + 0.13*w.v_r_hand[4];
     const Scalar t1 = w.v_r_hand[1] + 0.13*w.v_r_hand[3];
@@ -2812,29 +2812,29 @@ PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_
     const Scalar pa2 = 5.17*w.c_head[2] + w.pA_head[2];
     const Scalar pa3 = 0.07202788281129999*w.c_head[3] + w.pA_head[3];
     const Scalar pa4 = 0.0167508*w.c_head[5] + w.pA_head[5];
-    const Scalar C20 = w.cq_head*w.cq_head - w.sq_head*w.sq_head;
+    const Scalar C20 = w.cq[22]*w.cq[22] - w.sq[22]*w.sq[22];
     const Scalar t0 = 3.6250437433423075 - 1.5449562566576927*C20;
     const Scalar t1 = 3.6250437433423075 + 1.5449562566576927*C20;
-    const Scalar t2 = -0.3102 - 0.4717625*w.cq_head;
-    const Scalar t3 = w.cq_head*pa0 + w.sq_head*pa2;
-    const Scalar t4 = -w.sq_head*pa0 + w.cq_head*pa2;
+    const Scalar t2 = -0.3102 - 0.4717625*w.cq[22];
+    const Scalar t3 = w.cq[22]*pa0 + w.sq[22]*pa2;
+    const Scalar t4 = -w.sq[22]*pa0 + w.cq[22]*pa2;
     w.IA_neck_link[0] = 0.5 + t0;
-    w.IA_neck_link[2] = 3.0899125133153853*w.cq_head*w.sq_head;
+    w.IA_neck_link[2] = 3.0899125133153853*w.cq[22]*w.sq[22];
     w.IA_neck_link[4] = 0.015 + 0.06*t0;
     w.IA_neck_link[8] = -0.015 + t2;
-    w.IA_neck_link[10] = 0.4717625*w.sq_head;
+    w.IA_neck_link[10] = 0.4717625*w.sq[22];
     w.IA_neck_link[11] = 0.5 + t1;
-    w.IA_neck_link[13] = 0.18539475079892312*w.cq_head*w.sq_head;
-    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq_head + 0.027638541405649995*C20 - 0.06*t2;
-    w.IA_neck_link[17] = -0.028305749999999998*w.sq_head - 0.05527708281129999*w.cq_head*w.sq_head;
+    w.IA_neck_link[13] = 0.18539475079892312*w.cq[22]*w.sq[22];
+    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq[22] + 0.027638541405649995*C20 - 0.06*t2;
+    w.IA_neck_link[17] = -0.028305749999999998*w.sq[22] - 0.05527708281129999*w.cq[22]*w.sq[22];
     w.IA_neck_link[18] = 0.0007700000000000001 + 0.0036*t0;
     w.IA_neck_link[20] = 0.04470934140564999 - 0.027638541405649995*C20;
     w.pA_neck_link[0] = w.pA_neck_link[0] + t3;
     w.pA_neck_link[1] = w.pA_neck_link[1] + pa1;
     w.pA_neck_link[2] = w.pA_neck_link[2] + t4;
-    w.pA_neck_link[3] = w.pA_neck_link[3] - 0.06*pa1 + w.cq_head*pa3 + w.sq_head*pa4;
+    w.pA_neck_link[3] = w.pA_neck_link[3] - 0.06*pa1 + w.cq[22]*pa3 + w.sq[22]*pa4;
     w.pA_neck_link[4] = w.pA_neck_link[4] + tau[28] + 0.06*t3;
-    w.pA_neck_link[5] = w.pA_neck_link[5] - w.sq_head*pa3 + w.cq_head*pa4;
+    w.pA_neck_link[5] = w.pA_neck_link[5] - w.sq[22]*pa3 + w.cq[22]*pa4;
   }
   // eliminate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
@@ -2850,10 +2850,10 @@ PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_
     const Scalar pa7 = w.pA_neck_link[2] + w.c_neck_link[0]*w.IA_neck_link[2] + w.c_neck_link[4]*w.IA_neck_link[13];
     const Scalar pa8 = w.pA_neck_link[3] + w.u_neck_link[0]*t6 + w.c_neck_link[1]*Ia1 + w.c_neck_link[3]*Ia2;
     const Scalar pa9 = w.pA_neck_link[4] + w.c_neck_link[0]*w.IA_neck_link[4] + w.c_neck_link[4]*w.IA_neck_link[18];
-    const Scalar C21 = w.cq_neck_link*w.cq_neck_link - w.sq_neck_link*w.sq_neck_link;
+    const Scalar C21 = w.cq[21]*w.cq[21] - w.sq[21]*w.sq[21];
     const Scalar h0 = 0.5*(w.IA_neck_link[0] - Ia0);
     const Scalar m0 = 0.5*(w.IA_neck_link[0] + Ia0);
-    const Scalar t7 = 2.0*w.cq_neck_link*w.sq_neck_link;
+    const Scalar t7 = 2.0*w.cq[21]*w.sq[21];
     const Scalar t8 = 0.5*(w.IA_neck_link[4] + Ia1);
     const Scalar h1 = 0.5*(-w.IA_neck_link[18] + Ia2);
     const Scalar m1 = 0.5*(w.IA_neck_link[18] + Ia2);
@@ -2865,17 +2865,17 @@ PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_
     const Scalar t14 = 0.29*t9 + t11;
     const Scalar t15 = -0.29*t10 + t12;
     const Scalar t16 = 0.29*h0*t7 + t7*t8;
-    const Scalar t17 = -0.29*w.sq_neck_link*w.IA_neck_link[2] - w.sq_neck_link*w.IA_neck_link[13];
-    const Scalar t18 = 0.29*w.cq_neck_link*w.IA_neck_link[2] + w.cq_neck_link*w.IA_neck_link[13];
-    const Scalar t19 = w.cq_neck_link*pa5 - w.sq_neck_link*pa6;
-    const Scalar t20 = w.sq_neck_link*pa5 + w.cq_neck_link*pa6;
+    const Scalar t17 = -0.29*w.sq[21]*w.IA_neck_link[2] - w.sq[21]*w.IA_neck_link[13];
+    const Scalar t18 = 0.29*w.cq[21]*w.IA_neck_link[2] + w.cq[21]*w.IA_neck_link[13];
+    const Scalar t19 = w.cq[21]*pa5 - w.sq[21]*pa6;
+    const Scalar t20 = w.sq[21]*pa5 + w.cq[21]*pa6;
     w.IA_chest[0] = 13.92 + t9;
     w.IA_chest[1] = h0*t7;
-    w.IA_chest[2] = w.cq_neck_link*w.IA_neck_link[2];
+    w.IA_chest[2] = w.cq[21]*w.IA_neck_link[2];
     w.IA_chest[3] = t13;
     w.IA_chest[4] = 0.726624 + t14;
     w.IA_chest[6] = 13.92 + t10;
-    w.IA_chest[7] = w.sq_neck_link*w.IA_neck_link[2];
+    w.IA_chest[7] = w.sq[21]*w.IA_neck_link[2];
     w.IA_chest[8] = -0.726624 + t15;
     w.IA_chest[9] = t16;
     w.IA_chest[11] = 13.92 + w.IA_neck_link[11];
@@ -2887,8 +2887,8 @@ PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_
     w.pA_chest[0] = w.pA_chest[0] + t19;
     w.pA_chest[1] = w.pA_chest[1] + t20;
     w.pA_chest[2] = w.pA_chest[2] + pa7;
-    w.pA_chest[3] = w.pA_chest[3] + w.cq_neck_link*pa8 - w.sq_neck_link*pa9 - 0.29*t20;
-    w.pA_chest[4] = w.pA_chest[4] + w.sq_neck_link*pa8 + w.cq_neck_link*pa9 + 0.29*t19;
+    w.pA_chest[3] = w.pA_chest[3] + w.cq[21]*pa8 - w.sq[21]*pa9 - 0.29*t20;
+    w.pA_chest[4] = w.pA_chest[4] + w.sq[21]*pa8 + w.cq[21]*pa9 + 0.29*t19;
     w.pA_chest[5] = w.pA_chest[5] + tau[27];
   }
 }
@@ -2902,21 +2902,21 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_hand_to_l_wrist_pitch_link(const Scala
     const Scalar pa2 = 0.42*w.c_l_hand[2] + w.pA_l_hand[2];
     const Scalar pa3 = 0.005164645770899999*w.c_l_hand[4] + w.pA_l_hand[4];
     const Scalar pa4 = 0.000284375*w.c_l_hand[5] + w.pA_l_hand[5];
-    const Scalar C20 = w.cq_l_hand*w.cq_l_hand - w.sq_l_hand*w.sq_l_hand;
-    w.IA_l_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq_l_hand;
-    w.IA_l_wrist_pitch_link[5] = -0.04016628*w.sq_l_hand;
+    const Scalar C20 = w.cq[20]*w.cq[20] - w.sq[20]*w.sq[20];
+    w.IA_l_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq[20];
+    w.IA_l_wrist_pitch_link[5] = -0.04016628*w.sq[20];
     w.IA_l_wrist_pitch_link[6] = 0.3638101933216168 - 0.15618980667838314*C20;
-    w.IA_l_wrist_pitch_link[7] = -0.3123796133567663*w.cq_l_hand*w.sq_l_hand;
+    w.IA_l_wrist_pitch_link[7] = -0.3123796133567663*w.cq[20]*w.sq[20];
     w.IA_l_wrist_pitch_link[11] = 0.3638101933216168 + 0.15618980667838314*C20;
     w.IA_l_wrist_pitch_link[18] = 0.0027595103854499993 + 0.0024401353854499996*C20;
-    w.IA_l_wrist_pitch_link[19] = 0.004880270770899999*w.cq_l_hand*w.sq_l_hand;
+    w.IA_l_wrist_pitch_link[19] = 0.004880270770899999*w.cq[20]*w.sq[20];
     w.IA_l_wrist_pitch_link[20] = 0.0027495103854499993 - 0.0024401353854499996*C20;
     w.pA_l_wrist_pitch_link[0] = w.pA_l_wrist_pitch_link[0] + pa0;
-    w.pA_l_wrist_pitch_link[1] = w.pA_l_wrist_pitch_link[1] + w.cq_l_hand*pa1 - w.sq_l_hand*pa2;
-    w.pA_l_wrist_pitch_link[2] = w.pA_l_wrist_pitch_link[2] + w.sq_l_hand*pa1 + w.cq_l_hand*pa2;
+    w.pA_l_wrist_pitch_link[1] = w.pA_l_wrist_pitch_link[1] + w.cq[20]*pa1 - w.sq[20]*pa2;
+    w.pA_l_wrist_pitch_link[2] = w.pA_l_wrist_pitch_link[2] + w.sq[20]*pa1 + w.cq[20]*pa2;
     w.pA_l_wrist_pitch_link[3] = w.pA_l_wrist_pitch_link[3] + tau[26];
-    w.pA_l_wrist_pitch_link[4] = w.pA_l_wrist_pitch_link[4] + w.cq_l_hand*pa3 - w.sq_l_hand*pa4;
-    w.pA_l_wrist_pitch_link[5] = w.pA_l_wrist_pitch_link[5] + w.sq_l_hand*pa3 + w.cq_l_hand*pa4;
+    w.pA_l_wrist_pitch_link[4] = w.pA_l_wrist_pitch_link[4] + w.cq[20]*pa3 - w.sq[20]*pa4;
+    w.pA_l_wrist_pitch_link[5] = w.pA_l_wrist_pitch_link[5] + w.sq[20]*pa3 + w.cq[20]*pa4;
   }
   // eliminate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
@@ -2932,54 +2932,54 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_hand_to_l_wrist_pitch_link(const Scala
     const Scalar pa7 = w.pA_l_wrist_pitch_link[2] + w.c_l_wrist_pitch_link[2]*w.IA_l_wrist_pitch_link[11];
     const Scalar pa8 = 3.5000000000000004e-05*w.c_l_wrist_pitch_link[3] + w.pA_l_wrist_pitch_link[3];
     const Scalar pa9 = w.pA_l_wrist_pitch_link[5] + w.u_l_wrist_pitch_link[0]*t1 + w.c_l_wrist_pitch_link[0]*Ia1 + w.c_l_wrist_pitch_link[5]*Ia2;
-    const Scalar C21 = w.cq_l_wrist_pitch_link*w.cq_l_wrist_pitch_link - w.sq_l_wrist_pitch_link*w.sq_l_wrist_pitch_link;
+    const Scalar C21 = w.cq[19]*w.cq[19] - w.sq[19]*w.sq[19];
     const Scalar h0 = 0.5*(w.IA_l_wrist_pitch_link[11] - Ia0);
     const Scalar m0 = 0.5*(w.IA_l_wrist_pitch_link[11] + Ia0);
-    const Scalar t2 = 2.0*w.cq_l_wrist_pitch_link*w.sq_l_wrist_pitch_link;
+    const Scalar t2 = 2.0*w.cq[19]*w.sq[19];
     const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia2;
     const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia2;
     w.IA_l_wrist_yaw_link[0] = 0.1 + m0 - C21*h0;
-    w.IA_l_wrist_yaw_link[1] = w.sq_l_wrist_pitch_link*w.IA_l_wrist_pitch_link[7];
+    w.IA_l_wrist_yaw_link[1] = w.sq[19]*w.IA_l_wrist_pitch_link[7];
     w.IA_l_wrist_yaw_link[2] = h0*t2;
     w.IA_l_wrist_yaw_link[3] = 0.5*Ia1*t2;
     w.IA_l_wrist_yaw_link[5] = 0.5*(Ia1 + Ia1*C21);
     w.IA_l_wrist_yaw_link[6] = 0.1 + w.IA_l_wrist_pitch_link[6];
-    w.IA_l_wrist_yaw_link[7] = w.cq_l_wrist_pitch_link*w.IA_l_wrist_pitch_link[7];
-    w.IA_l_wrist_yaw_link[8] = -0.001 + 0.001*w.cq_l_wrist_pitch_link;
-    w.IA_l_wrist_yaw_link[10] = -0.001*w.sq_l_wrist_pitch_link;
+    w.IA_l_wrist_yaw_link[7] = w.cq[19]*w.IA_l_wrist_pitch_link[7];
+    w.IA_l_wrist_yaw_link[8] = -0.001 + 0.001*w.cq[19];
+    w.IA_l_wrist_yaw_link[10] = -0.001*w.sq[19];
     w.IA_l_wrist_yaw_link[11] = 0.1 + m0 + C21*h0;
     w.IA_l_wrist_yaw_link[12] = 0.5*(-Ia1 + Ia1*C21);
     w.IA_l_wrist_yaw_link[14] = -0.5*Ia1*t2;
     w.IA_l_wrist_yaw_link[15] = 3.5000000000000004e-05 + m1 - C21*h1;
     w.IA_l_wrist_yaw_link[17] = t2*h1;
     w.IA_l_wrist_yaw_link[20] = 2.5e-05 + m1 + C21*h1;
-    w.pA_l_wrist_yaw_link[0] = w.pA_l_wrist_yaw_link[0] + w.cq_l_wrist_pitch_link*pa5 + w.sq_l_wrist_pitch_link*pa7;
+    w.pA_l_wrist_yaw_link[0] = w.pA_l_wrist_yaw_link[0] + w.cq[19]*pa5 + w.sq[19]*pa7;
     w.pA_l_wrist_yaw_link[1] = w.pA_l_wrist_yaw_link[1] + pa6;
-    w.pA_l_wrist_yaw_link[2] = w.pA_l_wrist_yaw_link[2] - w.sq_l_wrist_pitch_link*pa5 + w.cq_l_wrist_pitch_link*pa7;
-    w.pA_l_wrist_yaw_link[3] = w.pA_l_wrist_yaw_link[3] + w.cq_l_wrist_pitch_link*pa8 + w.sq_l_wrist_pitch_link*pa9;
+    w.pA_l_wrist_yaw_link[2] = w.pA_l_wrist_yaw_link[2] - w.sq[19]*pa5 + w.cq[19]*pa7;
+    w.pA_l_wrist_yaw_link[3] = w.pA_l_wrist_yaw_link[3] + w.cq[19]*pa8 + w.sq[19]*pa9;
     w.pA_l_wrist_yaw_link[4] = w.pA_l_wrist_yaw_link[4] + tau[25];
-    w.pA_l_wrist_yaw_link[5] = w.pA_l_wrist_yaw_link[5] - w.sq_l_wrist_pitch_link*pa8 + w.cq_l_wrist_pitch_link*pa9;
+    w.pA_l_wrist_yaw_link[5] = w.pA_l_wrist_yaw_link[5] - w.sq[19]*pa8 + w.cq[19]*pa9;
   }
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_6(&tau[24], &w.Dinv_l_wrist_yaw_link, w.IA_l_wrist_yaw_link, w.u_l_wrist_yaw_link, w.pA_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.IA_l_forearm, w.pA_l_forearm);
+  shared_6(&tau[24], &w.Dinv_l_wrist_yaw_link, w.IA_l_wrist_yaw_link, w.u_l_wrist_yaw_link, w.pA_l_wrist_yaw_link, w.c_l_wrist_yaw_link, &w.cq[18], &w.sq[18], w.IA_l_forearm, w.pA_l_forearm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-  shared_7(&tau[23], &w.Dinv_l_forearm, w.IA_l_forearm, w.u_l_forearm, w.pA_l_forearm, w.c_l_forearm, w.cq_l_forearm, w.sq_l_forearm, w.IA_l_upper_arm, w.pA_l_upper_arm);
+  shared_7(&tau[23], &w.Dinv_l_forearm, w.IA_l_forearm, w.u_l_forearm, w.pA_l_forearm, w.c_l_forearm, &w.cq[17], &w.sq[17], w.IA_l_upper_arm, w.pA_l_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-  shared_8(&tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, w.cq_l_upper_arm, w.sq_l_upper_arm, w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
+  shared_8(&tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, &w.cq[16], &w.sq[16], w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  shared_9(shared_9_k0, &tau[21], &w.Dinv_l_shoulder_roll_link, w.IA_l_shoulder_roll_link, w.u_l_shoulder_roll_link, w.pA_l_shoulder_roll_link, &w.c_l_shoulder_roll_link[1], w.cq_l_shoulder_roll_link, w.sq_l_shoulder_roll_link, w.IA_l_shoulder_pitch_link, w.pA_l_shoulder_pitch_link);
+  shared_9(shared_9_k0, &tau[21], &w.Dinv_l_shoulder_roll_link, w.IA_l_shoulder_roll_link, w.u_l_shoulder_roll_link, w.pA_l_shoulder_roll_link, &w.c_l_shoulder_roll_link[1], &w.cq[15], &w.sq[15], w.IA_l_shoulder_pitch_link, w.pA_l_shoulder_pitch_link);
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3006,10 +3006,10 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROX
     const Scalar pa2 = 0.009*w.c_l_shoulder_pitch_link[3] + w.pA_l_shoulder_pitch_link[2] + w.u_l_shoulder_pitch_link[0]*t2 + w.c_l_shoulder_pitch_link[0]*Ia2 + w.c_l_shoulder_pitch_link[2]*Ia7 + w.c_l_shoulder_pitch_link[5]*Ia8;
     const Scalar pa3 = 0.009*w.c_l_shoulder_pitch_link[2] + 0.00046199999999999995*w.c_l_shoulder_pitch_link[3] + w.pA_l_shoulder_pitch_link[3];
     const Scalar pa4 = w.pA_l_shoulder_pitch_link[5] + w.u_l_shoulder_pitch_link[0]*t3 + w.c_l_shoulder_pitch_link[0]*Ia3 + w.c_l_shoulder_pitch_link[2]*Ia8 + w.c_l_shoulder_pitch_link[5]*Ia9;
-    const Scalar C20 = w.cq_l_shoulder_pitch_link*w.cq_l_shoulder_pitch_link - w.sq_l_shoulder_pitch_link*w.sq_l_shoulder_pitch_link;
+    const Scalar C20 = w.cq[14]*w.cq[14] - w.sq[14]*w.sq[14];
     const Scalar h0 = 0.5*(-Ia0 + Ia7);
     const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_l_shoulder_pitch_link*w.sq_l_shoulder_pitch_link;
+    const Scalar t4 = 2.0*w.cq[14]*w.sq[14];
     const Scalar d0 = C20*h0 - Ia2*t4;
     const Scalar qq0 = h0*t4 + Ia2*C20;
     const Scalar t5 = 0.0045 + 0.5*Ia3;
@@ -3017,21 +3017,21 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROX
     const Scalar qq1 = 0.5*Ia8*t4 + C20*t5;
     const Scalar h1 = -0.00023099999999999998 + 0.5*Ia9;
     const Scalar m1 = 0.00023099999999999998 + 0.5*Ia9;
-    const Scalar t6 = -0.04493516596384369*w.sq_l_shoulder_pitch_link*Ia5 - 0.04493516596384369*w.cq_l_shoulder_pitch_link*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
-    const Scalar t7 = -0.04493516596384369*Ia4 - 0.1676999117594225*w.cq_l_shoulder_pitch_link*Ia5 + 0.1676999117594225*w.sq_l_shoulder_pitch_link*Ia1 + 0.9848134698792882*w.sq_l_shoulder_pitch_link*Ia5 + 0.9848134698792882*w.cq_l_shoulder_pitch_link*Ia1;
-    const Scalar t8 = -0.04493516596384369*w.cq_l_shoulder_pitch_link*Ia5 + 0.04493516596384369*w.sq_l_shoulder_pitch_link*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
-    const Scalar t9 = 0.9659256678396477*w.sq_l_shoulder_pitch_link*Ia5 + 0.9659256678396477*w.cq_l_shoulder_pitch_link*Ia1 - 0.2588196364430848*qq0;
-    const Scalar t10 = 0.9659256678396477*Ia4 - 0.2588196364430848*w.cq_l_shoulder_pitch_link*Ia5 + 0.2588196364430848*w.sq_l_shoulder_pitch_link*Ia1;
-    const Scalar t11 = 0.9659256678396477*w.cq_l_shoulder_pitch_link*Ia5 - 0.9659256678396477*w.sq_l_shoulder_pitch_link*Ia1 - 0.2588196364430848*m0 - 0.2588196364430848*d0;
-    const Scalar t12 = 0.2548890642384102*w.sq_l_shoulder_pitch_link*Ia5 + 0.2548890642384102*w.cq_l_shoulder_pitch_link*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
-    const Scalar t13 = 0.2548890642384102*Ia4 + 0.9512566085906322*w.cq_l_shoulder_pitch_link*Ia5 - 0.9512566085906322*w.sq_l_shoulder_pitch_link*Ia1 + 0.17361575258114187*w.sq_l_shoulder_pitch_link*Ia5 + 0.17361575258114187*w.cq_l_shoulder_pitch_link*Ia1;
-    const Scalar t14 = 0.2548890642384102*w.cq_l_shoulder_pitch_link*Ia5 - 0.2548890642384102*w.sq_l_shoulder_pitch_link*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
-    const Scalar t15 = -0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 - 0.04493516596384369*w.sq_l_shoulder_pitch_link*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
-    const Scalar t16 = -0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 - 0.04493516596384369*w.cq_l_shoulder_pitch_link*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
-    const Scalar t17 = -0.0011646883639938816 + 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq_l_shoulder_pitch_link*Ia6 - 0.2588196364430848*qq1;
-    const Scalar t18 = -0.1294098182215424*Ia8 + 0.9659256678396477*w.cq_l_shoulder_pitch_link*Ia6 - 0.2588196364430848*d1;
-    const Scalar t19 = 0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 + 0.2548890642384102*w.sq_l_shoulder_pitch_link*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
-    const Scalar t20 = -0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 + 0.2548890642384102*w.cq_l_shoulder_pitch_link*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
+    const Scalar t6 = -0.04493516596384369*w.sq[14]*Ia5 - 0.04493516596384369*w.cq[14]*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
+    const Scalar t7 = -0.04493516596384369*Ia4 - 0.1676999117594225*w.cq[14]*Ia5 + 0.1676999117594225*w.sq[14]*Ia1 + 0.9848134698792882*w.sq[14]*Ia5 + 0.9848134698792882*w.cq[14]*Ia1;
+    const Scalar t8 = -0.04493516596384369*w.cq[14]*Ia5 + 0.04493516596384369*w.sq[14]*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
+    const Scalar t9 = 0.9659256678396477*w.sq[14]*Ia5 + 0.9659256678396477*w.cq[14]*Ia1 - 0.2588196364430848*qq0;
+    const Scalar t10 = 0.9659256678396477*Ia4 - 0.2588196364430848*w.cq[14]*Ia5 + 0.2588196364430848*w.sq[14]*Ia1;
+    const Scalar t11 = 0.9659256678396477*w.cq[14]*Ia5 - 0.9659256678396477*w.sq[14]*Ia1 - 0.2588196364430848*m0 - 0.2588196364430848*d0;
+    const Scalar t12 = 0.2548890642384102*w.sq[14]*Ia5 + 0.2548890642384102*w.cq[14]*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
+    const Scalar t13 = 0.2548890642384102*Ia4 + 0.9512566085906322*w.cq[14]*Ia5 - 0.9512566085906322*w.sq[14]*Ia1 + 0.17361575258114187*w.sq[14]*Ia5 + 0.17361575258114187*w.cq[14]*Ia1;
+    const Scalar t14 = 0.2548890642384102*w.cq[14]*Ia5 - 0.2548890642384102*w.sq[14]*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
+    const Scalar t15 = -0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 - 0.04493516596384369*w.sq[14]*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
+    const Scalar t16 = -0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 - 0.04493516596384369*w.cq[14]*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
+    const Scalar t17 = -0.0011646883639938816 + 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq[14]*Ia6 - 0.2588196364430848*qq1;
+    const Scalar t18 = -0.1294098182215424*Ia8 + 0.9659256678396477*w.cq[14]*Ia6 - 0.2588196364430848*d1;
+    const Scalar t19 = 0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 + 0.2548890642384102*w.sq[14]*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
+    const Scalar t20 = -0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 + 0.2548890642384102*w.cq[14]*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
     const Scalar t21 = 0.9848134698792882*m1 - 0.9848134698792882*C20*h1 - 0.1676999117594225*t4*h1;
     const Scalar t22 = -0.1676999117594225*m1 - 0.1676999117594225*C20*h1 + 0.9848134698792882*t4*h1;
     const Scalar t23 = 0.2588196364430848*(-m1 - C20*h1);
@@ -3058,10 +3058,10 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROX
     const Scalar t44 = -0.254*t30 + 0.19*t31 + t36;
     const Scalar t45 = -0.2588196364430848*t20 + 0.254*t28;
     const Scalar t46 = -0.19*t28 + t37;
-    const Scalar t47 = w.cq_l_shoulder_pitch_link*pa0 + w.sq_l_shoulder_pitch_link*pa2;
-    const Scalar t48 = -w.sq_l_shoulder_pitch_link*pa0 + w.cq_l_shoulder_pitch_link*pa2;
-    const Scalar t49 = w.cq_l_shoulder_pitch_link*pa3 + w.sq_l_shoulder_pitch_link*pa4;
-    const Scalar t50 = -w.sq_l_shoulder_pitch_link*pa3 + w.cq_l_shoulder_pitch_link*pa4;
+    const Scalar t47 = w.cq[14]*pa0 + w.sq[14]*pa2;
+    const Scalar t48 = -w.sq[14]*pa0 + w.cq[14]*pa2;
+    const Scalar t49 = w.cq[14]*pa3 + w.sq[14]*pa4;
+    const Scalar t50 = -w.sq[14]*pa3 + w.cq[14]*pa4;
     const Scalar t51 = -0.04493516596384369*pa1 + 0.9848134698792882*t47 - 0.1676999117594225*t48;
     const Scalar t52 = 0.9659256678396477*pa1 - 0.2588196364430848*t48;
     const Scalar t53 = 0.2548890642384102*pa1 + 0.17361575258114187*t47 + 0.9512566085906322*t48;
@@ -3113,15 +3113,15 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
     const Scalar pa2 = w.pA_r_hand[2] + w.lambda[14] - w.k_right_hand[2]*mu_c0 + w.c_r_hand[2]*Ia0;
     const Scalar pa3 = w.pA_r_hand[4] + 0.13*w.lambda[13] - 0.13*w.k_right_hand[1]*mu_c0 + w.c_r_hand[4]*Ia3;
     const Scalar pa4 = 0.000284375*w.c_r_hand[5] + w.pA_r_hand[5];
-    const Scalar C20 = w.cq_r_hand*w.cq_r_hand - w.sq_r_hand*w.sq_r_hand;
+    const Scalar C20 = w.cq[29]*w.cq[29] - w.sq[29]*w.sq[29];
     const Scalar h0 = 0.5*(-Ia0 + Ia2);
     const Scalar m0 = 0.5*(Ia0 + Ia2);
-    const Scalar t1 = 2.0*w.cq_r_hand*w.sq_r_hand;
+    const Scalar t1 = 2.0*w.cq[29]*w.sq[29];
     const Scalar h1 = -0.0001421875 + 0.5*Ia3;
     const Scalar m1 = 0.0001421875 + 0.5*Ia3;
     w.IA_r_wrist_pitch_link[0] = 0.1 + Ia0;
-    w.IA_r_wrist_pitch_link[4] = -0.001 + w.cq_r_hand*Ia1;
-    w.IA_r_wrist_pitch_link[5] = w.sq_r_hand*Ia1;
+    w.IA_r_wrist_pitch_link[4] = -0.001 + w.cq[29]*Ia1;
+    w.IA_r_wrist_pitch_link[5] = w.sq[29]*Ia1;
     w.IA_r_wrist_pitch_link[6] = 0.1 + m0 + C20*h0;
     w.IA_r_wrist_pitch_link[7] = h0*t1;
     w.IA_r_wrist_pitch_link[11] = 0.1 + m0 - C20*h0;
@@ -3129,11 +3129,11 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
     w.IA_r_wrist_pitch_link[19] = t1*h1;
     w.IA_r_wrist_pitch_link[20] = 2.5e-05 + m1 - C20*h1;
     w.pA_r_wrist_pitch_link[0] = w.pA_r_wrist_pitch_link[0] + pa0;
-    w.pA_r_wrist_pitch_link[1] = w.pA_r_wrist_pitch_link[1] + w.cq_r_hand*pa1 - w.sq_r_hand*pa2;
-    w.pA_r_wrist_pitch_link[2] = w.pA_r_wrist_pitch_link[2] + w.sq_r_hand*pa1 + w.cq_r_hand*pa2;
+    w.pA_r_wrist_pitch_link[1] = w.pA_r_wrist_pitch_link[1] + w.cq[29]*pa1 - w.sq[29]*pa2;
+    w.pA_r_wrist_pitch_link[2] = w.pA_r_wrist_pitch_link[2] + w.sq[29]*pa1 + w.cq[29]*pa2;
     w.pA_r_wrist_pitch_link[3] = w.pA_r_wrist_pitch_link[3] + tau[35];
-    w.pA_r_wrist_pitch_link[4] = w.pA_r_wrist_pitch_link[4] + w.cq_r_hand*pa3 - w.sq_r_hand*pa4;
-    w.pA_r_wrist_pitch_link[5] = w.pA_r_wrist_pitch_link[5] + w.sq_r_hand*pa3 + w.cq_r_hand*pa4;
+    w.pA_r_wrist_pitch_link[4] = w.pA_r_wrist_pitch_link[4] + w.cq[29]*pa3 - w.sq[29]*pa4;
+    w.pA_r_wrist_pitch_link[5] = w.pA_r_wrist_pitch_link[5] + w.sq[29]*pa3 + w.cq[29]*pa4;
   }
   // eliminate (penalty at the constraints): body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
@@ -3149,54 +3149,54 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hand_to_r_wrist_pitch_link(const Scalar
     const Scalar pa7 = w.pA_r_wrist_pitch_link[2] + w.c_r_wrist_pitch_link[2]*w.IA_r_wrist_pitch_link[11];
     const Scalar pa8 = 3.5000000000000004e-05*w.c_r_wrist_pitch_link[3] + w.pA_r_wrist_pitch_link[3];
     const Scalar pa9 = w.pA_r_wrist_pitch_link[5] + w.u_r_wrist_pitch_link[0]*t3 + w.c_r_wrist_pitch_link[0]*Ia5 + w.c_r_wrist_pitch_link[5]*Ia6;
-    const Scalar C21 = w.cq_r_wrist_pitch_link*w.cq_r_wrist_pitch_link - w.sq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
+    const Scalar C21 = w.cq[28]*w.cq[28] - w.sq[28]*w.sq[28];
     const Scalar h2 = 0.5*(w.IA_r_wrist_pitch_link[11] - Ia4);
     const Scalar m2 = 0.5*(w.IA_r_wrist_pitch_link[11] + Ia4);
-    const Scalar t4 = 2.0*w.cq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
+    const Scalar t4 = 2.0*w.cq[28]*w.sq[28];
     const Scalar h3 = -1.7500000000000002e-05 + 0.5*Ia6;
     const Scalar m3 = 1.7500000000000002e-05 + 0.5*Ia6;
     w.IA_r_wrist_yaw_link[0] = 0.1 + m2 - C21*h2;
-    w.IA_r_wrist_yaw_link[1] = w.sq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
+    w.IA_r_wrist_yaw_link[1] = w.sq[28]*w.IA_r_wrist_pitch_link[7];
     w.IA_r_wrist_yaw_link[2] = h2*t4;
     w.IA_r_wrist_yaw_link[3] = 0.5*Ia5*t4;
     w.IA_r_wrist_yaw_link[5] = 0.5*(Ia5 + Ia5*C21);
     w.IA_r_wrist_yaw_link[6] = 0.1 + w.IA_r_wrist_pitch_link[6];
-    w.IA_r_wrist_yaw_link[7] = w.cq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
-    w.IA_r_wrist_yaw_link[8] = -0.001 + 0.001*w.cq_r_wrist_pitch_link;
-    w.IA_r_wrist_yaw_link[10] = -0.001*w.sq_r_wrist_pitch_link;
+    w.IA_r_wrist_yaw_link[7] = w.cq[28]*w.IA_r_wrist_pitch_link[7];
+    w.IA_r_wrist_yaw_link[8] = -0.001 + 0.001*w.cq[28];
+    w.IA_r_wrist_yaw_link[10] = -0.001*w.sq[28];
     w.IA_r_wrist_yaw_link[11] = 0.1 + m2 + C21*h2;
     w.IA_r_wrist_yaw_link[12] = 0.5*(-Ia5 + Ia5*C21);
     w.IA_r_wrist_yaw_link[14] = -0.5*Ia5*t4;
     w.IA_r_wrist_yaw_link[15] = 3.5000000000000004e-05 + m3 - C21*h3;
     w.IA_r_wrist_yaw_link[17] = t4*h3;
     w.IA_r_wrist_yaw_link[20] = 2.5e-05 + m3 + C21*h3;
-    w.pA_r_wrist_yaw_link[0] = w.pA_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*pa5 + w.sq_r_wrist_pitch_link*pa7;
+    w.pA_r_wrist_yaw_link[0] = w.pA_r_wrist_yaw_link[0] + w.cq[28]*pa5 + w.sq[28]*pa7;
     w.pA_r_wrist_yaw_link[1] = w.pA_r_wrist_yaw_link[1] + pa6;
-    w.pA_r_wrist_yaw_link[2] = w.pA_r_wrist_yaw_link[2] - w.sq_r_wrist_pitch_link*pa5 + w.cq_r_wrist_pitch_link*pa7;
-    w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*pa8 + w.sq_r_wrist_pitch_link*pa9;
+    w.pA_r_wrist_yaw_link[2] = w.pA_r_wrist_yaw_link[2] - w.sq[28]*pa5 + w.cq[28]*pa7;
+    w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq[28]*pa8 + w.sq[28]*pa9;
     w.pA_r_wrist_yaw_link[4] = w.pA_r_wrist_yaw_link[4] + tau[34];
-    w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq_r_wrist_pitch_link*pa8 + w.cq_r_wrist_pitch_link*pa9;
+    w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq[28]*pa8 + w.cq[28]*pa9;
   }
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_6(&tau[33], &w.Dinv_r_wrist_yaw_link, w.IA_r_wrist_yaw_link, w.u_r_wrist_yaw_link, w.pA_r_wrist_yaw_link, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.IA_r_forearm, w.pA_r_forearm);
+  shared_6(&tau[33], &w.Dinv_r_wrist_yaw_link, w.IA_r_wrist_yaw_link, w.u_r_wrist_yaw_link, w.pA_r_wrist_yaw_link, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.IA_r_forearm, w.pA_r_forearm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_7(&tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.IA_r_upper_arm, w.pA_r_upper_arm);
+  shared_7(&tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.IA_r_upper_arm, w.pA_r_upper_arm);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_8(&tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, w.cq_r_upper_arm, w.sq_r_upper_arm, w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
+  shared_8(&tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, &w.cq[25], &w.sq[25], w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  shared_9(shared_9_k1, &tau[30], &w.Dinv_r_shoulder_roll_link, w.IA_r_shoulder_roll_link, w.u_r_shoulder_roll_link, w.pA_r_shoulder_roll_link, &w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.sq_r_shoulder_roll_link, w.IA_r_shoulder_pitch_link, w.pA_r_shoulder_pitch_link);
+  shared_9(shared_9_k1, &tau[30], &w.Dinv_r_shoulder_roll_link, w.IA_r_shoulder_roll_link, w.u_r_shoulder_roll_link, w.pA_r_shoulder_roll_link, &w.c_r_shoulder_roll_link[1], &w.cq[24], &w.sq[24], w.IA_r_shoulder_pitch_link, w.pA_r_shoulder_pitch_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3223,10 +3223,10 @@ PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXG
     const Scalar pa2 = -0.009*w.c_r_shoulder_pitch_link[3] + w.pA_r_shoulder_pitch_link[2] + w.u_r_shoulder_pitch_link[0]*t2 + w.c_r_shoulder_pitch_link[0]*Ia2 + w.c_r_shoulder_pitch_link[2]*Ia7 + w.c_r_shoulder_pitch_link[5]*Ia8;
     const Scalar pa3 = -0.009*w.c_r_shoulder_pitch_link[2] + 0.00046199999999999995*w.c_r_shoulder_pitch_link[3] + w.pA_r_shoulder_pitch_link[3];
     const Scalar pa4 = w.pA_r_shoulder_pitch_link[5] + w.u_r_shoulder_pitch_link[0]*t3 + w.c_r_shoulder_pitch_link[0]*Ia3 + w.c_r_shoulder_pitch_link[2]*Ia8 + w.c_r_shoulder_pitch_link[5]*Ia9;
-    const Scalar C20 = w.cq_r_shoulder_pitch_link*w.cq_r_shoulder_pitch_link - w.sq_r_shoulder_pitch_link*w.sq_r_shoulder_pitch_link;
+    const Scalar C20 = w.cq[23]*w.cq[23] - w.sq[23]*w.sq[23];
     const Scalar h0 = 0.5*(-Ia0 + Ia7);
     const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_shoulder_pitch_link*w.sq_r_shoulder_pitch_link;
+    const Scalar t4 = 2.0*w.cq[23]*w.sq[23];
     const Scalar d0 = C20*h0 - Ia2*t4;
     const Scalar qq0 = h0*t4 + Ia2*C20;
     const Scalar t5 = -0.0045 + 0.5*Ia3;
@@ -3234,21 +3234,21 @@ PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXG
     const Scalar qq1 = 0.5*Ia8*t4 + C20*t5;
     const Scalar h1 = -0.00023099999999999998 + 0.5*Ia9;
     const Scalar m1 = 0.00023099999999999998 + 0.5*Ia9;
-    const Scalar t6 = 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia5 + 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
-    const Scalar t7 = 0.04493516596384369*Ia4 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*Ia5 + 0.1676999117594225*w.sq_r_shoulder_pitch_link*Ia1 + 0.9848134698792882*w.sq_r_shoulder_pitch_link*Ia5 + 0.9848134698792882*w.cq_r_shoulder_pitch_link*Ia1;
-    const Scalar t8 = 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia5 - 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
-    const Scalar t9 = 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia5 + 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia1 + 0.2588196364430848*qq0;
-    const Scalar t10 = 0.9659256678396477*Ia4 + 0.2588196364430848*w.cq_r_shoulder_pitch_link*Ia5 - 0.2588196364430848*w.sq_r_shoulder_pitch_link*Ia1;
-    const Scalar t11 = 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia5 - 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia1 + 0.2588196364430848*m0 + 0.2588196364430848*d0;
-    const Scalar t12 = -0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia5 - 0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
-    const Scalar t13 = -0.2548890642384102*Ia4 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*Ia5 - 0.9512566085906322*w.sq_r_shoulder_pitch_link*Ia1 + 0.17361575258114187*w.sq_r_shoulder_pitch_link*Ia5 + 0.17361575258114187*w.cq_r_shoulder_pitch_link*Ia1;
-    const Scalar t14 = -0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia5 + 0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
-    const Scalar t15 = 0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 + 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
-    const Scalar t16 = 0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 + 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
-    const Scalar t17 = -0.0011646883639938816 - 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia6 + 0.2588196364430848*qq1;
-    const Scalar t18 = 0.1294098182215424*Ia8 + 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia6 + 0.2588196364430848*d1;
-    const Scalar t19 = -0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 - 0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
-    const Scalar t20 = 0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 - 0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
+    const Scalar t6 = 0.04493516596384369*w.sq[23]*Ia5 + 0.04493516596384369*w.cq[23]*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
+    const Scalar t7 = 0.04493516596384369*Ia4 - 0.1676999117594225*w.cq[23]*Ia5 + 0.1676999117594225*w.sq[23]*Ia1 + 0.9848134698792882*w.sq[23]*Ia5 + 0.9848134698792882*w.cq[23]*Ia1;
+    const Scalar t8 = 0.04493516596384369*w.cq[23]*Ia5 - 0.04493516596384369*w.sq[23]*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
+    const Scalar t9 = 0.9659256678396477*w.sq[23]*Ia5 + 0.9659256678396477*w.cq[23]*Ia1 + 0.2588196364430848*qq0;
+    const Scalar t10 = 0.9659256678396477*Ia4 + 0.2588196364430848*w.cq[23]*Ia5 - 0.2588196364430848*w.sq[23]*Ia1;
+    const Scalar t11 = 0.9659256678396477*w.cq[23]*Ia5 - 0.9659256678396477*w.sq[23]*Ia1 + 0.2588196364430848*m0 + 0.2588196364430848*d0;
+    const Scalar t12 = -0.2548890642384102*w.sq[23]*Ia5 - 0.2548890642384102*w.cq[23]*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
+    const Scalar t13 = -0.2548890642384102*Ia4 + 0.9512566085906322*w.cq[23]*Ia5 - 0.9512566085906322*w.sq[23]*Ia1 + 0.17361575258114187*w.sq[23]*Ia5 + 0.17361575258114187*w.cq[23]*Ia1;
+    const Scalar t14 = -0.2548890642384102*w.cq[23]*Ia5 + 0.2548890642384102*w.sq[23]*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
+    const Scalar t15 = 0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 + 0.04493516596384369*w.sq[23]*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
+    const Scalar t16 = 0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 + 0.04493516596384369*w.cq[23]*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
+    const Scalar t17 = -0.0011646883639938816 - 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq[23]*Ia6 + 0.2588196364430848*qq1;
+    const Scalar t18 = 0.1294098182215424*Ia8 + 0.9659256678396477*w.cq[23]*Ia6 + 0.2588196364430848*d1;
+    const Scalar t19 = -0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 - 0.2548890642384102*w.sq[23]*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
+    const Scalar t20 = 0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 - 0.2548890642384102*w.cq[23]*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
     const Scalar t21 = 0.9848134698792882*m1 - 0.9848134698792882*C20*h1 - 0.1676999117594225*t4*h1;
     const Scalar t22 = -0.1676999117594225*m1 - 0.1676999117594225*C20*h1 + 0.9848134698792882*t4*h1;
     const Scalar t23 = 0.2588196364430848*(m1 + C20*h1);
@@ -3275,10 +3275,10 @@ PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXG
     const Scalar t44 = -0.254*t30 - 0.19*t31 + t36;
     const Scalar t45 = 0.2588196364430848*t20 + 0.254*t28;
     const Scalar t46 = 0.19*t28 + t37;
-    const Scalar t47 = w.cq_r_shoulder_pitch_link*pa0 + w.sq_r_shoulder_pitch_link*pa2;
-    const Scalar t48 = -w.sq_r_shoulder_pitch_link*pa0 + w.cq_r_shoulder_pitch_link*pa2;
-    const Scalar t49 = w.cq_r_shoulder_pitch_link*pa3 + w.sq_r_shoulder_pitch_link*pa4;
-    const Scalar t50 = -w.sq_r_shoulder_pitch_link*pa3 + w.cq_r_shoulder_pitch_link*pa4;
+    const Scalar t47 = w.cq[23]*pa0 + w.sq[23]*pa2;
+    const Scalar t48 = -w.sq[23]*pa0 + w.cq[23]*pa2;
+    const Scalar t49 = w.cq[23]*pa3 + w.sq[23]*pa4;
+    const Scalar t50 = -w.sq[23]*pa3 + w.cq[23]*pa4;
     const Scalar t51 = 0.04493516596384369*pa1 + 0.9848134698792882*t47 - 0.1676999117594225*t48;
     const Scalar t52 = 0.9659256678396477*pa1 + 0.2588196364430848*t48;
     const Scalar t53 = -0.2548890642384102*pa1 + 0.17361575258114187*t47 + 0.9512566085906322*t48;
@@ -3342,10 +3342,10 @@ PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT t
     const Scalar pa2 = w.pA_chest[2] + w.u_chest[0]*t2 + w.c_chest[0]*Ia2 + w.c_chest[2]*Ia9 + w.c_chest[3]*Ia10 + w.c_chest[5]*Ia11;
     const Scalar pa3 = w.pA_chest[3] + w.u_chest[0]*t3 + w.c_chest[0]*Ia3 + w.c_chest[2]*Ia10 + w.c_chest[3]*Ia12 + w.c_chest[5]*Ia13;
     const Scalar pa4 = w.pA_chest[5] + w.u_chest[0]*t4 + w.c_chest[0]*Ia4 + w.c_chest[2]*Ia11 + w.c_chest[3]*Ia13 + w.c_chest[5]*Ia14;
-    const Scalar C20 = w.cq_chest*w.cq_chest - w.sq_chest*w.sq_chest;
+    const Scalar C20 = w.cq[13]*w.cq[13] - w.sq[13]*w.sq[13];
     const Scalar h0 = 0.5*(-Ia0 + Ia9);
     const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_chest*w.sq_chest;
+    const Scalar t5 = 2.0*w.cq[13]*w.sq[13];
     const Scalar d0 = C20*h0 - Ia2*t5;
     const Scalar qq0 = h0*t5 + Ia2*C20;
     const Scalar h1 = 0.5*(-Ia3 + Ia11);
@@ -3358,20 +3358,20 @@ PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT t
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 - d0;
-    const Scalar t8 = w.sq_chest*Ia6 + w.cq_chest*Ia1;
-    const Scalar t9 = w.cq_chest*Ia6 - w.sq_chest*Ia1;
+    const Scalar t8 = w.sq[13]*Ia6 + w.cq[13]*Ia1;
+    const Scalar t9 = w.cq[13]*Ia6 - w.sq[13]*Ia1;
     const Scalar t10 = m0 + d0;
     const Scalar t11 = m1 - d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia10 + qq1;
-    const Scalar t13 = w.sq_chest*Ia8 + w.cq_chest*Ia7;
-    const Scalar t14 = w.cq_chest*Ia8 - w.sq_chest*Ia7;
+    const Scalar t13 = w.sq[13]*Ia8 + w.cq[13]*Ia7;
+    const Scalar t14 = w.cq[13]*Ia8 - w.sq[13]*Ia7;
     const Scalar t15 = -0.5*Ia4 + 0.5*Ia10 + qq1;
     const Scalar t16 = m1 + d1;
     const Scalar t17 = -0.15*t8 + t11;
     const Scalar t18 = -0.15*Ia5 + t13;
     const Scalar t19 = -0.15*t9 + t15;
-    const Scalar t20 = w.cq_chest*pa0 + w.sq_chest*pa2;
-    const Scalar t21 = -w.sq_chest*pa0 + w.cq_chest*pa2;
+    const Scalar t20 = w.cq[13]*pa0 + w.sq[13]*pa2;
+    const Scalar t21 = -w.sq[13]*pa0 + w.cq[13]*pa2;
     w.IA_abdomen[0] = 9.73 + t7;
     w.IA_abdomen[1] = t8;
     w.IA_abdomen[2] = qq0;
@@ -3396,9 +3396,9 @@ PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_abdomen[0] = w.pA_abdomen[0] + t20;
     w.pA_abdomen[1] = w.pA_abdomen[1] + pa1;
     w.pA_abdomen[2] = w.pA_abdomen[2] + t21;
-    w.pA_abdomen[3] = w.pA_abdomen[3] - 0.15*pa1 + w.cq_chest*pa3 + w.sq_chest*pa4;
+    w.pA_abdomen[3] = w.pA_abdomen[3] - 0.15*pa1 + w.cq[13]*pa3 + w.sq[13]*pa4;
     w.pA_abdomen[4] = w.pA_abdomen[4] + tau[19] + 0.15*t20;
-    w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq_chest*pa3 + w.cq_chest*pa4;
+    w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq[13]*pa3 + w.cq[13]*pa4;
   }
 }
 
@@ -3432,10 +3432,10 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar pa2 = w.pA_abdomen[2] + w.u_abdomen[0]*t2 + w.c_abdomen[0]*Ia2 + w.c_abdomen[1]*Ia6 + w.c_abdomen[3]*Ia10 + w.c_abdomen[4]*Ia11;
     const Scalar pa3 = w.pA_abdomen[3] + w.u_abdomen[0]*t3 + w.c_abdomen[0]*Ia3 + w.c_abdomen[1]*Ia7 + w.c_abdomen[3]*Ia12 + w.c_abdomen[4]*Ia13;
     const Scalar pa4 = w.pA_abdomen[4] + w.u_abdomen[0]*t4 + w.c_abdomen[0]*Ia4 + w.c_abdomen[1]*Ia8 + w.c_abdomen[3]*Ia13 + w.c_abdomen[4]*Ia14;
-    const Scalar C20 = w.cq_abdomen*w.cq_abdomen - w.sq_abdomen*w.sq_abdomen;
+    const Scalar C20 = w.cq[12]*w.cq[12] - w.sq[12]*w.sq[12];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_abdomen*w.sq_abdomen;
+    const Scalar t5 = 2.0*w.cq[12]*w.sq[12];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -3448,23 +3448,23 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = w.cq_abdomen*Ia2 - w.sq_abdomen*Ia6;
+    const Scalar t8 = w.cq[12]*Ia2 - w.sq[12]*Ia6;
     const Scalar t9 = m0 - d0;
-    const Scalar t10 = w.sq_abdomen*Ia2 + w.cq_abdomen*Ia6;
+    const Scalar t10 = w.sq[12]*Ia2 + w.cq[12]*Ia6;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
     const Scalar t13 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t14 = m1 - d1;
-    const Scalar t15 = w.cq_abdomen*Ia10 - w.sq_abdomen*Ia11;
-    const Scalar t16 = w.sq_abdomen*Ia10 + w.cq_abdomen*Ia11;
+    const Scalar t15 = w.cq[12]*Ia10 - w.sq[12]*Ia11;
+    const Scalar t16 = w.sq[12]*Ia10 + w.cq[12]*Ia11;
     const Scalar t17 = -0.1*qq0 + t11;
     const Scalar t18 = 0.1*t7 + t12;
     const Scalar t19 = -0.1*t9 + t13;
     const Scalar t20 = 0.1*qq0 + t14;
     const Scalar t21 = -0.1*t10 + t15;
     const Scalar t22 = 0.1*t8 + t16;
-    const Scalar t23 = w.cq_abdomen*pa0 - w.sq_abdomen*pa1;
-    const Scalar t24 = w.sq_abdomen*pa0 + w.cq_abdomen*pa1;
+    const Scalar t23 = w.cq[12]*pa0 - w.sq[12]*pa1;
+    const Scalar t24 = w.sq[12]*pa0 + w.cq[12]*pa1;
     w.IA_pelvis[0] = 7.94 + t7;
     w.IA_pelvis[1] = qq0;
     w.IA_pelvis[2] = t8;
@@ -3483,35 +3483,35 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
     w.pA_pelvis[0] = w.pA_pelvis[0] + t23;
     w.pA_pelvis[1] = w.pA_pelvis[1] + t24;
     w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
-    w.pA_pelvis[3] = w.pA_pelvis[3] + w.cq_abdomen*pa3 - w.sq_abdomen*pa4 - 0.1*t24;
-    w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq_abdomen*pa3 + w.cq_abdomen*pa4 + 0.1*t23;
+    w.pA_pelvis[3] = w.pA_pelvis[3] + w.cq[12]*pa3 - w.sq[12]*pa4 - 0.1*t24;
+    w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq[12]*pa3 + w.cq[12]*pa4 + 0.1*t23;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[18];
   }
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_10(&tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, w.IA_r_ankle_link, w.pA_r_ankle_link);
+  shared_10(&tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], &w.cq[11], &w.sq[11], w.IA_r_ankle_link, w.pA_r_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_11(&tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank);
+  shared_11(&tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.IA_r_shank, w.pA_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_12(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh);
+  shared_12(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, &w.cq[9], &w.sq[9], w.IA_r_thigh, w.pA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_13(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
+  shared_13(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, &w.cq[8], &w.sq[8], w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_14(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
+  shared_14(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], &w.cq[7], &w.sq[7], w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3538,10 +3538,10 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar pa2 = w.pA_r_hip_yaw_link[2] + w.u_r_hip_yaw_link[0]*t2 + w.c_r_hip_yaw_link[0]*Ia2 + w.c_r_hip_yaw_link[1]*Ia5 + w.c_r_hip_yaw_link[4]*Ia8;
     const Scalar pa3 = -0.02*w.c_r_hip_yaw_link[1] + 0.0013*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[3];
     const Scalar pa4 = w.pA_r_hip_yaw_link[4] + w.u_r_hip_yaw_link[0]*t3 + w.c_r_hip_yaw_link[0]*Ia3 + w.c_r_hip_yaw_link[1]*Ia6 + w.c_r_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq_r_hip_yaw_link*w.cq_r_hip_yaw_link - w.sq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
+    const Scalar C20 = w.cq[6]*w.cq[6] - w.sq[6]*w.sq[6];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
+    const Scalar t4 = 2.0*w.cq[6]*w.sq[6];
     const Scalar d0 = C20*h0 - Ia1*t4;
     const Scalar qq0 = h0*t4 + Ia1*C20;
     const Scalar t5 = -0.01 + 0.5*Ia3;
@@ -3551,10 +3551,10 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar m1 = 0.00065 + 0.5*Ia9;
     const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 + 0.08718915247898762*qq0;
     const Scalar t7 = 0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq_r_hip_yaw_link*Ia2 - 0.9961917745544759*w.sq_r_hip_yaw_link*Ia5 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia2 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia5;
+    const Scalar t8 = 0.9961917745544759*w.cq[6]*Ia2 - 0.9961917745544759*w.sq[6]*Ia5 + 0.08718915247898762*w.sq[6]*Ia2 + 0.08718915247898762*w.cq[6]*Ia5;
     const Scalar t9 = -0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
     const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 - 0.08718915247898762*qq0;
-    const Scalar t11 = -0.08718915247898762*w.cq_r_hip_yaw_link*Ia2 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_r_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia5;
+    const Scalar t11 = -0.08718915247898762*w.cq[6]*Ia2 + 0.08718915247898762*w.sq[6]*Ia5 + 0.9961917745544759*w.sq[6]*Ia2 + 0.9961917745544759*w.cq[6]*Ia5;
     const Scalar t14 = -0.0008718915247898762 - 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 + 0.08718915247898762*qq1;
     const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
     const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
@@ -3570,15 +3570,15 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar t26 = -0.08718915247898762*t14 + 0.9961917745544759*t15;
     const Scalar t27 = 0.9961917745544759*t16 + 0.08718915247898762*t17;
     const Scalar t28 = -0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia8 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia8;
-    const Scalar t30 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia8;
+    const Scalar t29 = -0.9961917745544759*w.sq[6]*Ia8 + 0.08718915247898762*w.cq[6]*Ia8;
+    const Scalar t30 = 0.08718915247898762*w.sq[6]*Ia8 + 0.9961917745544759*w.cq[6]*Ia8;
     const Scalar t31 = -0.0875*t8 + t25;
     const Scalar t32 = -0.0875*t11 + t27;
     const Scalar t33 = -0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq_r_hip_yaw_link*pa0 - w.sq_r_hip_yaw_link*pa1;
-    const Scalar t35 = w.sq_r_hip_yaw_link*pa0 + w.cq_r_hip_yaw_link*pa1;
-    const Scalar t36 = w.cq_r_hip_yaw_link*pa3 - w.sq_r_hip_yaw_link*pa4;
-    const Scalar t37 = w.sq_r_hip_yaw_link*pa3 + w.cq_r_hip_yaw_link*pa4;
+    const Scalar t34 = w.cq[6]*pa0 - w.sq[6]*pa1;
+    const Scalar t35 = w.sq[6]*pa0 + w.cq[6]*pa1;
+    const Scalar t36 = w.cq[6]*pa3 - w.sq[6]*pa4;
+    const Scalar t37 = w.sq[6]*pa3 + w.cq[6]*pa4;
     const Scalar t38 = 0.9961917745544759*t34 + 0.08718915247898762*t35;
     const Scalar t39 = -0.08718915247898762*t34 + 0.9961917745544759*t35;
     w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
@@ -3613,27 +3613,27 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
 
 PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_10(&tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, w.IA_l_ankle_link, w.pA_l_ankle_link);
+  shared_10(&tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], &w.cq[5], &w.sq[5], w.IA_l_ankle_link, w.pA_l_ankle_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_11(&tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank);
+  shared_11(&tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.IA_l_shank, w.pA_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_12(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh);
+  shared_12(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, &w.cq[3], &w.sq[3], w.IA_l_thigh, w.pA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_13(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
+  shared_13(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, &w.cq[2], &w.sq[2], w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_14(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
+  shared_14(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], &w.cq[1], &w.sq[1], w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3660,10 +3660,10 @@ PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar pa2 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t2 + w.c_l_hip_yaw_link[0]*Ia2 + w.c_l_hip_yaw_link[1]*Ia5 + w.c_l_hip_yaw_link[4]*Ia8;
     const Scalar pa3 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
     const Scalar pa4 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t3 + w.c_l_hip_yaw_link[0]*Ia3 + w.c_l_hip_yaw_link[1]*Ia6 + w.c_l_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq_l_hip_yaw_link*w.cq_l_hip_yaw_link - w.sq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
+    const Scalar C20 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
+    const Scalar t4 = 2.0*w.cq[0]*w.sq[0];
     const Scalar d0 = C20*h0 - Ia1*t4;
     const Scalar qq0 = h0*t4 + Ia1*C20;
     const Scalar t5 = -0.01 + 0.5*Ia3;
@@ -3673,10 +3673,10 @@ PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar m1 = 0.00065 + 0.5*Ia9;
     const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 - 0.08718915247898762*qq0;
     const Scalar t7 = -0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq_l_hip_yaw_link*Ia2 - 0.9961917745544759*w.sq_l_hip_yaw_link*Ia5 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia2 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia5;
+    const Scalar t8 = 0.9961917745544759*w.cq[0]*Ia2 - 0.9961917745544759*w.sq[0]*Ia5 - 0.08718915247898762*w.sq[0]*Ia2 - 0.08718915247898762*w.cq[0]*Ia5;
     const Scalar t9 = 0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
     const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 + 0.08718915247898762*qq0;
-    const Scalar t11 = 0.08718915247898762*w.cq_l_hip_yaw_link*Ia2 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_l_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia5;
+    const Scalar t11 = 0.08718915247898762*w.cq[0]*Ia2 - 0.08718915247898762*w.sq[0]*Ia5 + 0.9961917745544759*w.sq[0]*Ia2 + 0.9961917745544759*w.cq[0]*Ia5;
     const Scalar t14 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 - 0.08718915247898762*qq1;
     const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
     const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
@@ -3692,15 +3692,15 @@ PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar t26 = 0.08718915247898762*t14 + 0.9961917745544759*t15;
     const Scalar t27 = 0.9961917745544759*t16 - 0.08718915247898762*t17;
     const Scalar t28 = 0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia8 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia8;
-    const Scalar t30 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia8;
+    const Scalar t29 = -0.9961917745544759*w.sq[0]*Ia8 - 0.08718915247898762*w.cq[0]*Ia8;
+    const Scalar t30 = -0.08718915247898762*w.sq[0]*Ia8 + 0.9961917745544759*w.cq[0]*Ia8;
     const Scalar t31 = 0.0875*t8 + t25;
     const Scalar t32 = 0.0875*t11 + t27;
     const Scalar t33 = 0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq_l_hip_yaw_link*pa0 - w.sq_l_hip_yaw_link*pa1;
-    const Scalar t35 = w.sq_l_hip_yaw_link*pa0 + w.cq_l_hip_yaw_link*pa1;
-    const Scalar t36 = w.cq_l_hip_yaw_link*pa3 - w.sq_l_hip_yaw_link*pa4;
-    const Scalar t37 = w.sq_l_hip_yaw_link*pa3 + w.cq_l_hip_yaw_link*pa4;
+    const Scalar t34 = w.cq[0]*pa0 - w.sq[0]*pa1;
+    const Scalar t35 = w.sq[0]*pa0 + w.cq[0]*pa1;
+    const Scalar t36 = w.cq[0]*pa3 - w.sq[0]*pa4;
+    const Scalar t37 = w.sq[0]*pa3 + w.cq[0]*pa4;
     const Scalar t38 = 0.9961917745544759*t34 - 0.08718915247898762*t35;
     const Scalar t39 = 0.08718915247898762*t34 + 0.9961917745544759*t35;
     w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
@@ -3797,68 +3797,68 @@ PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGE
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
+  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq, w.sq, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
+  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_19(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_20(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
+  shared_21(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, &w.cq[6], &w.sq[6], w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
+  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_19(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_20(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+  shared_21(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  shared_23(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_24(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  shared_26(&w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.a_r_shoulder_pitch_link, w.sq_r_shoulder_roll_link, w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
+  shared_26(&w.c_r_shoulder_roll_link[1], &w.cq[24], w.a_r_shoulder_pitch_link, &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
+  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+  shared_28(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, w.cq_r_wrist_pitch_link, w.sq_r_wrist_pitch_link, w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
+  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, &w.cq[28], &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  shared_31(&w.c_r_hand[1], w.cq_r_hand, w.a_r_wrist_pitch_link, w.sq_r_hand, w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
+  shared_31(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3873,10 +3873,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_
     const Scalar t0 = -0.13*w.Dinv_r_hand*w.dlambda[12];
     const Scalar t1 = w.dlambda[12] + w.U_r_hand[1]*t0;
     w.dp_r_wrist_pitch_link[0] = -w.dlambda[13];
-    w.dp_r_wrist_pitch_link[1] = w.cq_r_hand*t1 - w.sq_r_hand*w.dlambda[14];
-    w.dp_r_wrist_pitch_link[2] = w.sq_r_hand*t1 + w.cq_r_hand*w.dlambda[14];
-    w.dp_r_wrist_pitch_link[4] = 0.13*w.cq_r_hand*w.dlambda[13];
-    w.dp_r_wrist_pitch_link[5] = 0.13*w.sq_r_hand*w.dlambda[13];
+    w.dp_r_wrist_pitch_link[1] = w.cq[29]*t1 - w.sq[29]*w.dlambda[14];
+    w.dp_r_wrist_pitch_link[2] = w.sq[29]*t1 + w.cq[29]*w.dlambda[14];
+    w.dp_r_wrist_pitch_link[4] = 0.13*w.cq[29]*w.dlambda[13];
+    w.dp_r_wrist_pitch_link[5] = 0.13*w.sq[29]*w.dlambda[13];
   }
   // reduced sweep: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
@@ -3884,11 +3884,11 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_
     const Scalar t2 = -w.Dinv_r_wrist_pitch_link*w.dp_r_wrist_pitch_link[4];
     const Scalar t3 = w.dp_r_wrist_pitch_link[0] + w.IA_r_wrist_pitch_link[4]*t2;
     const Scalar t4 = w.dp_r_wrist_pitch_link[5] + w.IA_r_wrist_pitch_link[19]*t2;
-    w.dp_r_wrist_yaw_link[0] = w.cq_r_wrist_pitch_link*t3 + w.sq_r_wrist_pitch_link*w.dp_r_wrist_pitch_link[2];
+    w.dp_r_wrist_yaw_link[0] = w.cq[28]*t3 + w.sq[28]*w.dp_r_wrist_pitch_link[2];
     w.dp_r_wrist_yaw_link[1] = w.dp_r_wrist_pitch_link[1];
-    w.dp_r_wrist_yaw_link[2] = -w.sq_r_wrist_pitch_link*t3 + w.cq_r_wrist_pitch_link*w.dp_r_wrist_pitch_link[2];
-    w.dp_r_wrist_yaw_link[3] = w.sq_r_wrist_pitch_link*t4;
-    w.dp_r_wrist_yaw_link[5] = w.cq_r_wrist_pitch_link*t4;
+    w.dp_r_wrist_yaw_link[2] = -w.sq[28]*t3 + w.cq[28]*w.dp_r_wrist_pitch_link[2];
+    w.dp_r_wrist_yaw_link[3] = w.sq[28]*t4;
+    w.dp_r_wrist_yaw_link[5] = w.cq[28]*t4;
   }
   // reduced sweep: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
@@ -3898,13 +3898,13 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_
     const Scalar t7 = w.dp_r_wrist_yaw_link[1] + w.IA_r_wrist_yaw_link[10]*t5;
     const Scalar t8 = w.dp_r_wrist_yaw_link[2] + w.IA_r_wrist_yaw_link[14]*t5;
     const Scalar t9 = w.dp_r_wrist_yaw_link[3] + w.IA_r_wrist_yaw_link[17]*t5;
-    const Scalar t10 = w.cq_r_wrist_yaw_link*t6 - w.sq_r_wrist_yaw_link*t7;
-    const Scalar t11 = w.sq_r_wrist_yaw_link*t6 + w.cq_r_wrist_yaw_link*t7;
+    const Scalar t10 = w.cq[27]*t6 - w.sq[27]*t7;
+    const Scalar t11 = w.sq[27]*t6 + w.cq[27]*t7;
     w.dp_r_forearm[0] = t10;
     w.dp_r_forearm[1] = t11;
     w.dp_r_forearm[2] = t8;
-    w.dp_r_forearm[3] = w.cq_r_wrist_yaw_link*t9 + 0.2555*t11;
-    w.dp_r_forearm[4] = w.sq_r_wrist_yaw_link*t9 - 0.2555*t10;
+    w.dp_r_forearm[3] = w.cq[27]*t9 + 0.2555*t11;
+    w.dp_r_forearm[4] = w.sq[27]*t9 - 0.2555*t10;
   }
   // reduced sweep: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
@@ -3914,16 +3914,16 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_
     const Scalar t14 = w.dp_r_forearm[1] + w.IA_r_forearm[9]*t12;
     const Scalar t15 = w.dp_r_forearm[2] + w.IA_r_forearm[13]*t12;
     const Scalar t16 = w.dp_r_forearm[3] + w.IA_r_forearm[16]*t12;
-    const Scalar t17 = w.cq_r_forearm*t13 + w.sq_r_forearm*t15;
-    const Scalar t18 = -w.sq_r_forearm*t13 + w.cq_r_forearm*t15;
+    const Scalar t17 = w.cq[26]*t13 + w.sq[26]*t15;
+    const Scalar t18 = -w.sq[26]*t13 + w.cq[26]*t15;
     const Scalar t19 = 0.955336489125606*t17 - 0.29552020666133966*t18;
     const Scalar t20 = 0.29552020666133966*t17 + 0.955336489125606*t18;
     w.dp_r_upper_arm[0] = t19;
     w.dp_r_upper_arm[1] = t14;
     w.dp_r_upper_arm[2] = t20;
-    w.dp_r_upper_arm[3] = 0.3255*t14 + 0.955336489125606*w.cq_r_forearm*t16 + 0.29552020666133966*w.sq_r_forearm*t16;
+    w.dp_r_upper_arm[3] = 0.3255*t14 + 0.955336489125606*w.cq[26]*t16 + 0.29552020666133966*w.sq[26]*t16;
     w.dp_r_upper_arm[4] = -0.3255*t19;
-    w.dp_r_upper_arm[5] = 0.29552020666133966*w.cq_r_forearm*t16 - 0.955336489125606*w.sq_r_forearm*t16;
+    w.dp_r_upper_arm[5] = 0.29552020666133966*w.cq[26]*t16 - 0.955336489125606*w.sq[26]*t16;
   }
 }
 
@@ -3937,11 +3937,11 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(Works
     const Scalar t3 = w.dp_r_upper_arm[2] + w.IA_r_upper_arm[14]*t0;
     const Scalar t4 = w.dp_r_upper_arm[3] + w.IA_r_upper_arm[17]*t0;
     const Scalar t5 = w.dp_r_upper_arm[4] + w.IA_r_upper_arm[19]*t0;
-    w.dp_r_shoulder_roll_link[0] = w.cq_r_upper_arm*t1 - w.sq_r_upper_arm*t2;
-    w.dp_r_shoulder_roll_link[1] = w.sq_r_upper_arm*t1 + w.cq_r_upper_arm*t2;
+    w.dp_r_shoulder_roll_link[0] = w.cq[25]*t1 - w.sq[25]*t2;
+    w.dp_r_shoulder_roll_link[1] = w.sq[25]*t1 + w.cq[25]*t2;
     w.dp_r_shoulder_roll_link[2] = t3;
-    w.dp_r_shoulder_roll_link[3] = w.cq_r_upper_arm*t4 - w.sq_r_upper_arm*t5;
-    w.dp_r_shoulder_roll_link[4] = w.sq_r_upper_arm*t4 + w.cq_r_upper_arm*t5;
+    w.dp_r_shoulder_roll_link[3] = w.cq[25]*t4 - w.sq[25]*t5;
+    w.dp_r_shoulder_roll_link[4] = w.sq[25]*t4 + w.cq[25]*t5;
   }
   // reduced sweep: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
@@ -3952,10 +3952,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(Works
     const Scalar t9 = w.dp_r_shoulder_roll_link[2] + w.IA_r_shoulder_roll_link[12]*t6;
     const Scalar t10 = w.dp_r_shoulder_roll_link[4] + w.IA_r_shoulder_roll_link[16]*t6;
     w.dp_r_shoulder_pitch_link[0] = t7;
-    w.dp_r_shoulder_pitch_link[1] = w.cq_r_shoulder_roll_link*t8 - w.sq_r_shoulder_roll_link*t9;
-    w.dp_r_shoulder_pitch_link[2] = w.sq_r_shoulder_roll_link*t8 + w.cq_r_shoulder_roll_link*t9;
-    w.dp_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*t10;
-    w.dp_r_shoulder_pitch_link[5] = w.sq_r_shoulder_roll_link*t10;
+    w.dp_r_shoulder_pitch_link[1] = w.cq[24]*t8 - w.sq[24]*t9;
+    w.dp_r_shoulder_pitch_link[2] = w.sq[24]*t8 + w.cq[24]*t9;
+    w.dp_r_shoulder_pitch_link[4] = w.cq[24]*t10;
+    w.dp_r_shoulder_pitch_link[5] = w.sq[24]*t10;
   }
   // reduced sweep: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
@@ -3965,17 +3965,17 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(Works
     const Scalar t13 = w.dp_r_shoulder_pitch_link[1] + w.IA_r_shoulder_pitch_link[9]*t11;
     const Scalar t14 = w.dp_r_shoulder_pitch_link[2] + w.IA_r_shoulder_pitch_link[13]*t11;
     const Scalar t15 = w.dp_r_shoulder_pitch_link[5] + w.IA_r_shoulder_pitch_link[19]*t11;
-    const Scalar t16 = w.cq_r_shoulder_pitch_link*t12 + w.sq_r_shoulder_pitch_link*t14;
-    const Scalar t17 = -w.sq_r_shoulder_pitch_link*t12 + w.cq_r_shoulder_pitch_link*t14;
+    const Scalar t16 = w.cq[23]*t12 + w.sq[23]*t14;
+    const Scalar t17 = -w.sq[23]*t12 + w.cq[23]*t14;
     const Scalar t18 = 0.04493516596384369*t13 + 0.9848134698792882*t16 - 0.1676999117594225*t17;
     const Scalar t19 = 0.9659256678396477*t13 + 0.2588196364430848*t17;
     const Scalar t20 = -0.2548890642384102*t13 + 0.17361575258114187*t16 + 0.9512566085906322*t17;
     w.dp_chest[0] = t18;
     w.dp_chest[1] = t19;
     w.dp_chest[2] = t20;
-    w.dp_chest[3] = 0.9848134698792882*w.sq_r_shoulder_pitch_link*t15 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*t15 - 0.254*t19 - 0.19*t20;
-    w.dp_chest[4] = 0.2588196364430848*w.cq_r_shoulder_pitch_link*t15 + 0.254*t18;
-    w.dp_chest[5] = 0.17361575258114187*w.sq_r_shoulder_pitch_link*t15 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*t15 + 0.19*t18;
+    w.dp_chest[3] = 0.9848134698792882*w.sq[23]*t15 - 0.1676999117594225*w.cq[23]*t15 - 0.254*t19 - 0.19*t20;
+    w.dp_chest[4] = 0.2588196364430848*w.cq[23]*t15 + 0.254*t18;
+    w.dp_chest[5] = 0.17361575258114187*w.sq[23]*t15 + 0.9512566085906322*w.cq[23]*t15 + 0.19*t18;
   }
 }
 
@@ -3989,14 +3989,14 @@ PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_REST
     const Scalar t3 = w.dp_chest[2] + w.IA_chest[13]*t0;
     const Scalar t4 = w.dp_chest[3] + w.IA_chest[16]*t0;
     const Scalar t5 = w.dp_chest[5] + w.IA_chest[19]*t0;
-    const Scalar t6 = w.cq_chest*t1 + w.sq_chest*t3;
-    const Scalar t7 = -w.sq_chest*t1 + w.cq_chest*t3;
+    const Scalar t6 = w.cq[13]*t1 + w.sq[13]*t3;
+    const Scalar t7 = -w.sq[13]*t1 + w.cq[13]*t3;
     w.dp_abdomen[0] = t6;
     w.dp_abdomen[1] = t2;
     w.dp_abdomen[2] = t7;
-    w.dp_abdomen[3] = -0.15*t2 + w.cq_chest*t4 + w.sq_chest*t5;
+    w.dp_abdomen[3] = -0.15*t2 + w.cq[13]*t4 + w.sq[13]*t5;
     w.dp_abdomen[4] = 0.15*t6;
-    w.dp_abdomen[5] = -w.sq_chest*t4 + w.cq_chest*t5;
+    w.dp_abdomen[5] = -w.sq[13]*t4 + w.cq[13]*t5;
   }
   // reduced sweep: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
@@ -4007,16 +4007,16 @@ PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_REST
     const Scalar t11 = w.dp_abdomen[2] + w.IA_abdomen[14]*t8;
     const Scalar t12 = w.dp_abdomen[3] + w.IA_abdomen[17]*t8;
     const Scalar t13 = w.dp_abdomen[4] + w.IA_abdomen[19]*t8;
-    const Scalar t14 = w.cq_abdomen*t9 - w.sq_abdomen*t10;
-    const Scalar t15 = w.sq_abdomen*t9 + w.cq_abdomen*t10;
+    const Scalar t14 = w.cq[12]*t9 - w.sq[12]*t10;
+    const Scalar t15 = w.sq[12]*t9 + w.cq[12]*t10;
     w.dp_pelvis[0] = t14;
     w.dp_pelvis[1] = t15;
     w.dp_pelvis[2] = t11;
-    w.dp_pelvis[3] = w.cq_abdomen*t12 - w.sq_abdomen*t13 - 0.1*t15;
-    w.dp_pelvis[4] = w.sq_abdomen*t12 + w.cq_abdomen*t13 + 0.1*t14;
+    w.dp_pelvis[3] = w.cq[12]*t12 - w.sq[12]*t13 - 0.1*t15;
+    w.dp_pelvis[4] = w.sq[12]*t12 + w.cq[12]*t13 + 0.1*t14;
   }
   // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_33(&w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, w.cq_r_foot, w.sq_r_foot);
+  shared_33(&w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, &w.cq[11], &w.sq[11]);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4028,16 +4028,16 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN
     const Scalar t2 = w.dp_r_ankle_link[1] + w.IA_r_ankle_link[9]*t0;
     const Scalar t3 = w.dp_r_ankle_link[2] + w.IA_r_ankle_link[13]*t0;
     const Scalar t4 = w.dp_r_ankle_link[5] + w.IA_r_ankle_link[19]*t0;
-    const Scalar t5 = w.cq_r_ankle_link*t1 + w.sq_r_ankle_link*t3;
-    const Scalar t6 = -w.sq_r_ankle_link*t1 + w.cq_r_ankle_link*t3;
+    const Scalar t5 = w.cq[10]*t1 + w.sq[10]*t3;
+    const Scalar t6 = -w.sq[10]*t1 + w.cq[10]*t3;
     const Scalar t7 = 0.9950041652780258*t5 - 0.09983341664682815*t6;
     const Scalar t8 = 0.09983341664682815*t5 + 0.9950041652780258*t6;
     w.dp_r_shank[0] = t7;
     w.dp_r_shank[1] = t2;
     w.dp_r_shank[2] = t8;
-    w.dp_r_shank[3] = 0.4305*t2 + 0.9950041652780258*w.sq_r_ankle_link*t4 - 0.09983341664682815*w.cq_r_ankle_link*t4;
+    w.dp_r_shank[3] = 0.4305*t2 + 0.9950041652780258*w.sq[10]*t4 - 0.09983341664682815*w.cq[10]*t4;
     w.dp_r_shank[4] = -0.4305*t7;
-    w.dp_r_shank[5] = 0.09983341664682815*w.sq_r_ankle_link*t4 + 0.9950041652780258*w.cq_r_ankle_link*t4;
+    w.dp_r_shank[5] = 0.09983341664682815*w.sq[10]*t4 + 0.9950041652780258*w.cq[10]*t4;
   }
   // reduced sweep: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
   {
@@ -4048,10 +4048,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN
     const Scalar t12 = w.dp_r_shank[2] + w.IA_r_shank[13]*t9;
     const Scalar t13 = w.dp_r_shank[3] + w.IA_r_shank[16]*t9;
     const Scalar t14 = w.dp_r_shank[5] + w.IA_r_shank[19]*t9;
-    const Scalar t15 = w.cq_r_shank*t10 + w.sq_r_shank*t12;
-    const Scalar t16 = -w.sq_r_shank*t10 + w.cq_r_shank*t12;
-    const Scalar t17 = w.cq_r_shank*t13 + w.sq_r_shank*t14;
-    const Scalar t18 = -w.sq_r_shank*t13 + w.cq_r_shank*t14;
+    const Scalar t15 = w.cq[9]*t10 + w.sq[9]*t12;
+    const Scalar t16 = -w.sq[9]*t10 + w.cq[9]*t12;
+    const Scalar t17 = w.cq[9]*t13 + w.sq[9]*t14;
+    const Scalar t18 = -w.sq[9]*t13 + w.cq[9]*t14;
     const Scalar t19 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
     const Scalar t20 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
     w.dp_r_thigh[0] = t19;
@@ -4062,7 +4062,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN
     w.dp_r_thigh[5] = -0.19866933079506124*t17 + 0.9800665778412416*t18;
   }
   // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_34(w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], w.cq_r_thigh, w.sq_r_thigh, w.dp_r_hip_roll_link);
+  shared_34(w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], &w.cq[8], &w.sq[8], w.dp_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4075,10 +4075,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace&
     const Scalar t3 = w.dp_r_hip_roll_link[2] + w.IA_r_hip_roll_link[12]*t0;
     const Scalar t4 = w.dp_r_hip_roll_link[5] + w.IA_r_hip_roll_link[17]*t0;
     w.dp_r_hip_yaw_link[0] = t1;
-    w.dp_r_hip_yaw_link[1] = w.cq_r_hip_roll_link*t2 - w.sq_r_hip_roll_link*t3;
-    w.dp_r_hip_yaw_link[2] = w.sq_r_hip_roll_link*t2 + w.cq_r_hip_roll_link*t3;
-    w.dp_r_hip_yaw_link[4] = -w.sq_r_hip_roll_link*t4;
-    w.dp_r_hip_yaw_link[5] = w.cq_r_hip_roll_link*t4;
+    w.dp_r_hip_yaw_link[1] = w.cq[7]*t2 - w.sq[7]*t3;
+    w.dp_r_hip_yaw_link[2] = w.sq[7]*t2 + w.cq[7]*t3;
+    w.dp_r_hip_yaw_link[4] = -w.sq[7]*t4;
+    w.dp_r_hip_yaw_link[5] = w.cq[7]*t4;
   }
   // reduced sweep: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
@@ -4088,19 +4088,19 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace&
     const Scalar t7 = w.dp_r_hip_yaw_link[1] + w.IA_r_hip_yaw_link[10]*t5;
     const Scalar t8 = w.dp_r_hip_yaw_link[2] + w.IA_r_hip_yaw_link[14]*t5;
     const Scalar t9 = w.dp_r_hip_yaw_link[4] + w.IA_r_hip_yaw_link[19]*t5;
-    const Scalar t10 = w.cq_r_hip_yaw_link*t6 - w.sq_r_hip_yaw_link*t7;
-    const Scalar t11 = w.sq_r_hip_yaw_link*t6 + w.cq_r_hip_yaw_link*t7;
+    const Scalar t10 = w.cq[6]*t6 - w.sq[6]*t7;
+    const Scalar t11 = w.sq[6]*t6 + w.cq[6]*t7;
     const Scalar t12 = 0.9961917745544759*t10 + 0.08718915247898762*t11;
     const Scalar t13 = -0.08718915247898762*t10 + 0.9961917745544759*t11;
     w.dp_pelvis[0] = w.dp_pelvis[0] + t12;
     w.dp_pelvis[1] = w.dp_pelvis[1] + t13;
     w.dp_pelvis[2] = w.dp_pelvis[2] + t8;
-    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t8 - 0.9961917745544759*w.sq_r_hip_yaw_link*t9 + 0.08718915247898762*w.cq_r_hip_yaw_link*t9;
-    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*w.sq_r_hip_yaw_link*t9 + 0.9961917745544759*w.cq_r_hip_yaw_link*t9;
+    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t8 - 0.9961917745544759*w.sq[6]*t9 + 0.08718915247898762*w.cq[6]*t9;
+    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*w.sq[6]*t9 + 0.9961917745544759*w.cq[6]*t9;
     w.dp_pelvis[5] = 0.0875*t12;
   }
   // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_33(w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, w.cq_l_foot, w.sq_l_foot);
+  shared_33(w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, &w.cq[5], &w.sq[5]);
   // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
   {
     w.u_l_ankle_link[0] = w.u_l_ankle_link[0] - w.dp_l_ankle_link[4];
@@ -4109,16 +4109,16 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace&
     const Scalar t20 = w.dp_l_ankle_link[1] + w.IA_l_ankle_link[9]*t18;
     const Scalar t21 = w.dp_l_ankle_link[2] + w.IA_l_ankle_link[13]*t18;
     const Scalar t22 = w.dp_l_ankle_link[5] + w.IA_l_ankle_link[19]*t18;
-    const Scalar t23 = w.cq_l_ankle_link*t19 + w.sq_l_ankle_link*t21;
-    const Scalar t24 = -w.sq_l_ankle_link*t19 + w.cq_l_ankle_link*t21;
+    const Scalar t23 = w.cq[4]*t19 + w.sq[4]*t21;
+    const Scalar t24 = -w.sq[4]*t19 + w.cq[4]*t21;
     const Scalar t25 = 0.9950041652780258*t23 - 0.09983341664682815*t24;
     const Scalar t26 = 0.09983341664682815*t23 + 0.9950041652780258*t24;
     w.dp_l_shank[0] = t25;
     w.dp_l_shank[1] = t20;
     w.dp_l_shank[2] = t26;
-    w.dp_l_shank[3] = 0.4305*t20 + 0.9950041652780258*w.sq_l_ankle_link*t22 - 0.09983341664682815*w.cq_l_ankle_link*t22;
+    w.dp_l_shank[3] = 0.4305*t20 + 0.9950041652780258*w.sq[4]*t22 - 0.09983341664682815*w.cq[4]*t22;
     w.dp_l_shank[4] = -0.4305*t25;
-    w.dp_l_shank[5] = 0.09983341664682815*w.sq_l_ankle_link*t22 + 0.9950041652780258*w.cq_l_ankle_link*t22;
+    w.dp_l_shank[5] = 0.09983341664682815*w.sq[4]*t22 + 0.9950041652780258*w.cq[4]*t22;
   }
 }
 
@@ -4132,10 +4132,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROX
     const Scalar t3 = w.dp_l_shank[2] + w.IA_l_shank[13]*t0;
     const Scalar t4 = w.dp_l_shank[3] + w.IA_l_shank[16]*t0;
     const Scalar t5 = w.dp_l_shank[5] + w.IA_l_shank[19]*t0;
-    const Scalar t6 = w.cq_l_shank*t1 + w.sq_l_shank*t3;
-    const Scalar t7 = -w.sq_l_shank*t1 + w.cq_l_shank*t3;
-    const Scalar t8 = w.cq_l_shank*t4 + w.sq_l_shank*t5;
-    const Scalar t9 = -w.sq_l_shank*t4 + w.cq_l_shank*t5;
+    const Scalar t6 = w.cq[3]*t1 + w.sq[3]*t3;
+    const Scalar t7 = -w.sq[3]*t1 + w.cq[3]*t3;
+    const Scalar t8 = w.cq[3]*t4 + w.sq[3]*t5;
+    const Scalar t9 = -w.sq[3]*t4 + w.cq[3]*t5;
     const Scalar t10 = 0.9800665778412416*t6 + 0.19866933079506124*t7;
     const Scalar t11 = -0.19866933079506124*t6 + 0.9800665778412416*t7;
     w.dp_l_thigh[0] = t10;
@@ -4146,7 +4146,7 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROX
     w.dp_l_thigh[5] = -0.19866933079506124*t8 + 0.9800665778412416*t9;
   }
   // reduced sweep: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_34(w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], w.cq_l_thigh, w.sq_l_thigh, w.dp_l_hip_roll_link);
+  shared_34(w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], &w.cq[2], &w.sq[2], w.dp_l_hip_roll_link);
   // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
   {
     w.u_l_hip_roll_link[0] = w.u_l_hip_roll_link[0] - w.dp_l_hip_roll_link[3];
@@ -4156,10 +4156,10 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROX
     const Scalar t25 = w.dp_l_hip_roll_link[2] + w.IA_l_hip_roll_link[12]*t22;
     const Scalar t26 = w.dp_l_hip_roll_link[5] + w.IA_l_hip_roll_link[17]*t22;
     w.dp_l_hip_yaw_link[0] = t23;
-    w.dp_l_hip_yaw_link[1] = w.cq_l_hip_roll_link*t24 - w.sq_l_hip_roll_link*t25;
-    w.dp_l_hip_yaw_link[2] = w.sq_l_hip_roll_link*t24 + w.cq_l_hip_roll_link*t25;
-    w.dp_l_hip_yaw_link[4] = -w.sq_l_hip_roll_link*t26;
-    w.dp_l_hip_yaw_link[5] = w.cq_l_hip_roll_link*t26;
+    w.dp_l_hip_yaw_link[1] = w.cq[1]*t24 - w.sq[1]*t25;
+    w.dp_l_hip_yaw_link[2] = w.sq[1]*t24 + w.cq[1]*t25;
+    w.dp_l_hip_yaw_link[4] = -w.sq[1]*t26;
+    w.dp_l_hip_yaw_link[5] = w.cq[1]*t26;
   }
 }
 
@@ -4172,15 +4172,15 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_hip_yaw_link_to_pelvis(Workspace& PROXGE
     const Scalar t2 = w.dp_l_hip_yaw_link[1] + w.IA_l_hip_yaw_link[10]*t0;
     const Scalar t3 = w.dp_l_hip_yaw_link[2] + w.IA_l_hip_yaw_link[14]*t0;
     const Scalar t4 = w.dp_l_hip_yaw_link[4] + w.IA_l_hip_yaw_link[19]*t0;
-    const Scalar t5 = w.cq_l_hip_yaw_link*t1 - w.sq_l_hip_yaw_link*t2;
-    const Scalar t6 = w.sq_l_hip_yaw_link*t1 + w.cq_l_hip_yaw_link*t2;
+    const Scalar t5 = w.cq[0]*t1 - w.sq[0]*t2;
+    const Scalar t6 = w.sq[0]*t1 + w.cq[0]*t2;
     const Scalar t7 = 0.9961917745544759*t5 - 0.08718915247898762*t6;
     const Scalar t8 = 0.08718915247898762*t5 + 0.9961917745544759*t6;
     w.dp_pelvis[0] = w.dp_pelvis[0] + t7;
     w.dp_pelvis[1] = w.dp_pelvis[1] + t8;
     w.dp_pelvis[2] = w.dp_pelvis[2] + t3;
-    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t3 - 0.9961917745544759*w.sq_l_hip_yaw_link*t4 - 0.08718915247898762*w.cq_l_hip_yaw_link*t4;
-    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*w.sq_l_hip_yaw_link*t4 + 0.9961917745544759*w.cq_l_hip_yaw_link*t4;
+    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t3 - 0.9961917745544759*w.sq[0]*t4 - 0.08718915247898762*w.cq[0]*t4;
+    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*w.sq[0]*t4 + 0.9961917745544759*w.cq[0]*t4;
     w.dp_pelvis[5] = w.dp_pelvis[5] - 0.0875*t7;
   }
   // reduced sweep: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
@@ -4198,68 +4198,68 @@ PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROX
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq_l_hip_yaw_link, w.sq_l_hip_yaw_link, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
+  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq, w.sq, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
+  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_19(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_20(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
+  shared_21(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, w.cq_r_hip_yaw_link, w.sq_r_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, &w.cq[6], &w.sq[6], w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
+  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_19(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_20(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+  shared_21(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(w.a_pelvis, w.c_abdomen, w.cq_abdomen, w.sq_abdomen, w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  shared_23(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(w.a_abdomen, w.c_chest, w.cq_chest, w.sq_chest, w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_24(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, w.cq_r_shoulder_pitch_link, w.sq_r_shoulder_pitch_link, w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  shared_26(&w.c_r_shoulder_roll_link[1], w.cq_r_shoulder_roll_link, w.a_r_shoulder_pitch_link, w.sq_r_shoulder_roll_link, w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
+  shared_26(&w.c_r_shoulder_roll_link[1], &w.cq[24], w.a_r_shoulder_pitch_link, &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, w.cq_r_upper_arm, w.sq_r_upper_arm, w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
+  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
   // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(w.a_r_upper_arm, w.c_r_forearm, w.cq_r_forearm, w.sq_r_forearm, w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+  shared_28(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
   // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, w.cq_r_wrist_yaw_link, w.sq_r_wrist_yaw_link, w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, w.cq_r_wrist_pitch_link, w.sq_r_wrist_pitch_link, w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
+  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, &w.cq[28], &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  shared_31(&w.c_r_hand[1], w.cq_r_hand, w.a_r_wrist_pitch_link, w.sq_r_hand, w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
+  shared_31(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4269,15 +4269,15 @@ PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w
 
 PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
-  shared_25(shared_25_k1, w.a_chest, w.c_l_shoulder_pitch_link, w.cq_l_shoulder_pitch_link, w.sq_l_shoulder_pitch_link, w.u_l_shoulder_pitch_link, &w.IA_l_shoulder_pitch_link[4], &w.qdd[20], w.Dinv_l_shoulder_pitch_link, w.a_l_shoulder_pitch_link);
+  shared_25(shared_25_k1, w.a_chest, w.c_l_shoulder_pitch_link, &w.cq[14], &w.sq[14], w.u_l_shoulder_pitch_link, &w.IA_l_shoulder_pitch_link[4], &w.qdd[20], w.Dinv_l_shoulder_pitch_link, w.a_l_shoulder_pitch_link);
   // accelerate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  shared_26(&w.c_l_shoulder_roll_link[1], w.cq_l_shoulder_roll_link, w.a_l_shoulder_pitch_link, w.sq_l_shoulder_roll_link, w.u_l_shoulder_roll_link, &w.IA_l_shoulder_roll_link[3], &w.qdd[21], w.Dinv_l_shoulder_roll_link, w.a_l_shoulder_roll_link);
+  shared_26(&w.c_l_shoulder_roll_link[1], &w.cq[15], w.a_l_shoulder_pitch_link, &w.sq[15], w.u_l_shoulder_roll_link, &w.IA_l_shoulder_roll_link[3], &w.qdd[21], w.Dinv_l_shoulder_roll_link, w.a_l_shoulder_roll_link);
   // accelerate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    const Scalar t19 = w.c_l_upper_arm[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[1];
-    const Scalar t20 = w.c_l_upper_arm[1] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[0] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[1];
-    const Scalar t21 = w.c_l_upper_arm[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.sq_l_upper_arm*w.a_l_shoulder_roll_link[4];
-    const Scalar t22 = w.c_l_upper_arm[4] - w.sq_l_upper_arm*w.a_l_shoulder_roll_link[3] + w.cq_l_upper_arm*w.a_l_shoulder_roll_link[4];
+    const Scalar t19 = w.c_l_upper_arm[0] + w.cq[16]*w.a_l_shoulder_roll_link[0] + w.sq[16]*w.a_l_shoulder_roll_link[1];
+    const Scalar t20 = w.c_l_upper_arm[1] - w.sq[16]*w.a_l_shoulder_roll_link[0] + w.cq[16]*w.a_l_shoulder_roll_link[1];
+    const Scalar t21 = w.c_l_upper_arm[3] + w.cq[16]*w.a_l_shoulder_roll_link[3] + w.sq[16]*w.a_l_shoulder_roll_link[4];
+    const Scalar t22 = w.c_l_upper_arm[4] - w.sq[16]*w.a_l_shoulder_roll_link[3] + w.cq[16]*w.a_l_shoulder_roll_link[4];
     const Scalar t23 = w.u_l_upper_arm[0] - w.IA_l_upper_arm[5]*t19 - w.IA_l_upper_arm[10]*t20 - w.IA_l_upper_arm[14]*w.a_l_shoulder_roll_link[2] - w.IA_l_upper_arm[17]*t21 - w.IA_l_upper_arm[19]*t22 - w.IA_l_upper_arm[20]*w.a_l_shoulder_roll_link[5];
     w.qdd[22] = w.Dinv_l_upper_arm*t23;
     w.a_l_upper_arm[0] = t19;
@@ -4298,10 +4298,10 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspa
     const Scalar t3 = 0.955336489125606*w.a_l_upper_arm[2] - 0.29552020666133966*t0;
     const Scalar t4 = 0.955336489125606*w.a_l_upper_arm[3] + 0.29552020666133966*w.a_l_upper_arm[5];
     const Scalar t5 = -0.29552020666133966*w.a_l_upper_arm[3] + 0.955336489125606*w.a_l_upper_arm[5];
-    const Scalar t6 = w.c_l_forearm[0] + w.cq_l_forearm*t2 - w.sq_l_forearm*t3;
-    const Scalar t7 = w.c_l_forearm[2] + w.sq_l_forearm*t2 + w.cq_l_forearm*t3;
-    const Scalar t8 = w.c_l_forearm[3] + w.cq_l_forearm*t4 - w.sq_l_forearm*t5;
-    const Scalar t9 = w.c_l_forearm[5] + w.sq_l_forearm*t4 + w.cq_l_forearm*t5;
+    const Scalar t6 = w.c_l_forearm[0] + w.cq[17]*t2 - w.sq[17]*t3;
+    const Scalar t7 = w.c_l_forearm[2] + w.sq[17]*t2 + w.cq[17]*t3;
+    const Scalar t8 = w.c_l_forearm[3] + w.cq[17]*t4 - w.sq[17]*t5;
+    const Scalar t9 = w.c_l_forearm[5] + w.sq[17]*t4 + w.cq[17]*t5;
     const Scalar t10 = w.u_l_forearm[0] - w.IA_l_forearm[4]*t6 - w.IA_l_forearm[9]*t1 - w.IA_l_forearm[13]*t7 - w.IA_l_forearm[16]*t8 - w.a_l_upper_arm[4]*w.IA_l_forearm[18];
     w.qdd[23] = w.Dinv_l_forearm*t10;
     w.a_l_forearm[0] = t6;
@@ -4312,13 +4312,13 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspa
     w.a_l_forearm[5] = t9;
   }
   // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_29(w.a_l_forearm, w.c_l_wrist_yaw_link, w.cq_l_wrist_yaw_link, w.sq_l_wrist_yaw_link, w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
+  shared_29(w.a_l_forearm, w.c_l_wrist_yaw_link, &w.cq[18], &w.sq[18], w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
   // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
-    const Scalar t19 = w.c_l_wrist_pitch_link[2] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[0] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[2];
-    const Scalar t20 = w.c_l_wrist_pitch_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] - w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
-    const Scalar t21 = w.c_l_wrist_pitch_link[5] + w.sq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[3] + w.cq_l_wrist_pitch_link*w.a_l_wrist_yaw_link[5];
+    const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq[19]*w.a_l_wrist_yaw_link[0] - w.sq[19]*w.a_l_wrist_yaw_link[2];
+    const Scalar t19 = w.c_l_wrist_pitch_link[2] + w.sq[19]*w.a_l_wrist_yaw_link[0] + w.cq[19]*w.a_l_wrist_yaw_link[2];
+    const Scalar t20 = w.c_l_wrist_pitch_link[3] + w.cq[19]*w.a_l_wrist_yaw_link[3] - w.sq[19]*w.a_l_wrist_yaw_link[5];
+    const Scalar t21 = w.c_l_wrist_pitch_link[5] + w.sq[19]*w.a_l_wrist_yaw_link[3] + w.cq[19]*w.a_l_wrist_yaw_link[5];
     const Scalar t22 = w.u_l_wrist_pitch_link[0] - w.IA_l_wrist_pitch_link[4]*t18 - w.IA_l_wrist_pitch_link[18]*w.a_l_wrist_yaw_link[4] - w.IA_l_wrist_pitch_link[19]*t21;
     w.qdd[25] = w.Dinv_l_wrist_pitch_link*t22;
     w.a_l_wrist_pitch_link[0] = t18;
@@ -4333,7 +4333,7 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspa
 PROXGEN_RT_NOINLINE void accelerate_free_l_hand_to_head(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    const Scalar t0 = w.c_l_hand[1] + w.a_l_wrist_pitch_link[1]*w.cq_l_hand + w.a_l_wrist_pitch_link[2]*w.sq_l_hand;
+    const Scalar t0 = w.c_l_hand[1] + w.a_l_wrist_pitch_link[1]*w.cq[20] + w.a_l_wrist_pitch_link[2]*w.sq[20];
     const Scalar t4 = -0.005164645770899999*w.a_l_wrist_pitch_link[3] + w.u_l_hand[0] - 0.04016628*t0;
     w.qdd[26] = 193.62412145174838*t4;
   }
@@ -4341,10 +4341,10 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_hand_to_head(Workspace& PROXGEN_RT_RE
   {
     const Scalar t5 = w.a_chest[0] + 0.29*w.a_chest[4];
     const Scalar t6 = w.a_chest[1] - 0.29*w.a_chest[3];
-    const Scalar t7 = w.c_neck_link[0] + w.cq_neck_link*t5 + w.sq_neck_link*t6;
-    const Scalar t8 = w.c_neck_link[1] - w.sq_neck_link*t5 + w.cq_neck_link*t6;
-    const Scalar t9 = w.c_neck_link[3] + w.a_chest[3]*w.cq_neck_link + w.a_chest[4]*w.sq_neck_link;
-    const Scalar t10 = w.c_neck_link[4] - w.a_chest[3]*w.sq_neck_link + w.a_chest[4]*w.cq_neck_link;
+    const Scalar t7 = w.c_neck_link[0] + w.cq[21]*t5 + w.sq[21]*t6;
+    const Scalar t8 = w.c_neck_link[1] - w.sq[21]*t5 + w.cq[21]*t6;
+    const Scalar t9 = w.c_neck_link[3] + w.a_chest[3]*w.cq[21] + w.a_chest[4]*w.sq[21];
+    const Scalar t10 = w.c_neck_link[4] - w.a_chest[3]*w.sq[21] + w.a_chest[4]*w.cq[21];
     const Scalar t11 = w.u_neck_link[0] - w.IA_neck_link[10]*t8 - w.IA_neck_link[17]*t9 - w.a_chest[5]*w.IA_neck_link[20];
     w.qdd[27] = w.Dinv_neck_link*t11;
     w.a_neck_link[0] = t7;
@@ -4357,7 +4357,7 @@ PROXGEN_RT_NOINLINE void accelerate_free_l_hand_to_head(Workspace& PROXGEN_RT_RE
   // accelerate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
     const Scalar t12 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
-    const Scalar t14 = w.c_head[0] + w.cq_head*t12 - w.sq_head*w.a_neck_link[2];
+    const Scalar t14 = w.c_head[0] + w.cq[22]*t12 - w.sq[22]*w.a_neck_link[2];
     const Scalar t18 = w.u_head[0] - 0.07202788281129999*w.a_neck_link[4] - 0.4717625*t14;
     w.qdd[28] = 13.88351234229415*t18;
   }
@@ -4372,27 +4372,27 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hand_to_r_wrist_pitch_link(const Scalar* 
     const Scalar pa2 = 0.42*w.c_r_hand[2] + w.pA_r_hand[2];
     const Scalar pa3 = 0.005164645770899999*w.c_r_hand[4] + w.pA_r_hand[4];
     const Scalar pa4 = 0.000284375*w.c_r_hand[5] + w.pA_r_hand[5];
-    const Scalar C20 = w.cq_r_hand*w.cq_r_hand - w.sq_r_hand*w.sq_r_hand;
-    w.IA_r_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq_r_hand;
-    w.IA_r_wrist_pitch_link[5] = -0.04016628*w.sq_r_hand;
+    const Scalar C20 = w.cq[29]*w.cq[29] - w.sq[29]*w.sq[29];
+    w.IA_r_wrist_pitch_link[4] = -0.001 - 0.04016628*w.cq[29];
+    w.IA_r_wrist_pitch_link[5] = -0.04016628*w.sq[29];
     w.IA_r_wrist_pitch_link[6] = 0.3638101933216168 - 0.15618980667838314*C20;
-    w.IA_r_wrist_pitch_link[7] = -0.3123796133567663*w.cq_r_hand*w.sq_r_hand;
+    w.IA_r_wrist_pitch_link[7] = -0.3123796133567663*w.cq[29]*w.sq[29];
     w.IA_r_wrist_pitch_link[11] = 0.3638101933216168 + 0.15618980667838314*C20;
     w.IA_r_wrist_pitch_link[18] = 0.0027595103854499993 + 0.0024401353854499996*C20;
-    w.IA_r_wrist_pitch_link[19] = 0.004880270770899999*w.cq_r_hand*w.sq_r_hand;
+    w.IA_r_wrist_pitch_link[19] = 0.004880270770899999*w.cq[29]*w.sq[29];
     w.IA_r_wrist_pitch_link[20] = 0.0027495103854499993 - 0.0024401353854499996*C20;
     w.pA_r_wrist_pitch_link[0] = w.pA_r_wrist_pitch_link[0] + pa0;
-    w.pA_r_wrist_pitch_link[1] = w.pA_r_wrist_pitch_link[1] + w.cq_r_hand*pa1 - w.sq_r_hand*pa2;
-    w.pA_r_wrist_pitch_link[2] = w.pA_r_wrist_pitch_link[2] + w.sq_r_hand*pa1 + w.cq_r_hand*pa2;
+    w.pA_r_wrist_pitch_link[1] = w.pA_r_wrist_pitch_link[1] + w.cq[29]*pa1 - w.sq[29]*pa2;
+    w.pA_r_wrist_pitch_link[2] = w.pA_r_wrist_pitch_link[2] + w.sq[29]*pa1 + w.cq[29]*pa2;
     w.pA_r_wrist_pitch_link[3] = w.pA_r_wrist_pitch_link[3] + tau[35];
-    w.pA_r_wrist_pitch_link[4] = w.pA_r_wrist_pitch_link[4] + w.cq_r_hand*pa3 - w.sq_r_hand*pa4;
-    w.pA_r_wrist_pitch_link[5] = w.pA_r_wrist_pitch_link[5] + w.sq_r_hand*pa3 + w.cq_r_hand*pa4;
-    w.KA_r_wrist_pitch_link[1][0] = -0.011030888008041195*w.cq_r_hand;
-    w.KA_r_wrist_pitch_link[2][0] = -0.011030888008041195*w.sq_r_hand;
-    w.KA_r_wrist_pitch_link[4][1] = 0.13*w.cq_r_hand;
-    w.KA_r_wrist_pitch_link[5][1] = 0.13*w.sq_r_hand;
-    w.KA_r_wrist_pitch_link[1][2] = -w.sq_r_hand;
-    w.KA_r_wrist_pitch_link[2][2] = w.cq_r_hand;
+    w.pA_r_wrist_pitch_link[4] = w.pA_r_wrist_pitch_link[4] + w.cq[29]*pa3 - w.sq[29]*pa4;
+    w.pA_r_wrist_pitch_link[5] = w.pA_r_wrist_pitch_link[5] + w.sq[29]*pa3 + w.cq[29]*pa4;
+    w.KA_r_wrist_pitch_link[1][0] = -0.011030888008041195*w.cq[29];
+    w.KA_r_wrist_pitch_link[2][0] = -0.011030888008041195*w.sq[29];
+    w.KA_r_wrist_pitch_link[4][1] = 0.13*w.cq[29];
+    w.KA_r_wrist_pitch_link[5][1] = 0.13*w.sq[29];
+    w.KA_r_wrist_pitch_link[1][2] = -w.sq[29];
+    w.KA_r_wrist_pitch_link[2][2] = w.cq[29];
   }
   // eliminate, carrying the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
@@ -4408,46 +4408,46 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hand_to_r_wrist_pitch_link(const Scalar* 
     const Scalar pa7 = w.pA_r_wrist_pitch_link[2] + w.c_r_wrist_pitch_link[2]*w.IA_r_wrist_pitch_link[11];
     const Scalar pa8 = 3.5000000000000004e-05*w.c_r_wrist_pitch_link[3] + w.pA_r_wrist_pitch_link[3];
     const Scalar pa9 = w.pA_r_wrist_pitch_link[5] + w.u_r_wrist_pitch_link[0]*t1 + w.c_r_wrist_pitch_link[0]*Ia1 + w.c_r_wrist_pitch_link[5]*Ia2;
-    const Scalar C21 = w.cq_r_wrist_pitch_link*w.cq_r_wrist_pitch_link - w.sq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
+    const Scalar C21 = w.cq[28]*w.cq[28] - w.sq[28]*w.sq[28];
     const Scalar h0 = 0.5*(w.IA_r_wrist_pitch_link[11] - Ia0);
     const Scalar m0 = 0.5*(w.IA_r_wrist_pitch_link[11] + Ia0);
-    const Scalar t2 = 2.0*w.cq_r_wrist_pitch_link*w.sq_r_wrist_pitch_link;
+    const Scalar t2 = 2.0*w.cq[28]*w.sq[28];
     const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia2;
     const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia2;
     w.IA_r_wrist_yaw_link[0] = 0.1 + m0 - C21*h0;
-    w.IA_r_wrist_yaw_link[1] = w.sq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
+    w.IA_r_wrist_yaw_link[1] = w.sq[28]*w.IA_r_wrist_pitch_link[7];
     w.IA_r_wrist_yaw_link[2] = h0*t2;
     w.IA_r_wrist_yaw_link[3] = 0.5*Ia1*t2;
     w.IA_r_wrist_yaw_link[5] = 0.5*(Ia1 + Ia1*C21);
     w.IA_r_wrist_yaw_link[6] = 0.1 + w.IA_r_wrist_pitch_link[6];
-    w.IA_r_wrist_yaw_link[7] = w.cq_r_wrist_pitch_link*w.IA_r_wrist_pitch_link[7];
-    w.IA_r_wrist_yaw_link[8] = -0.001 + 0.001*w.cq_r_wrist_pitch_link;
-    w.IA_r_wrist_yaw_link[10] = -0.001*w.sq_r_wrist_pitch_link;
+    w.IA_r_wrist_yaw_link[7] = w.cq[28]*w.IA_r_wrist_pitch_link[7];
+    w.IA_r_wrist_yaw_link[8] = -0.001 + 0.001*w.cq[28];
+    w.IA_r_wrist_yaw_link[10] = -0.001*w.sq[28];
     w.IA_r_wrist_yaw_link[11] = 0.1 + m0 + C21*h0;
     w.IA_r_wrist_yaw_link[12] = 0.5*(-Ia1 + Ia1*C21);
     w.IA_r_wrist_yaw_link[14] = -0.5*Ia1*t2;
     w.IA_r_wrist_yaw_link[15] = 3.5000000000000004e-05 + m1 - C21*h1;
     w.IA_r_wrist_yaw_link[17] = t2*h1;
     w.IA_r_wrist_yaw_link[20] = 2.5e-05 + m1 + C21*h1;
-    w.pA_r_wrist_yaw_link[0] = w.pA_r_wrist_yaw_link[0] + w.cq_r_wrist_pitch_link*pa5 + w.sq_r_wrist_pitch_link*pa7;
+    w.pA_r_wrist_yaw_link[0] = w.pA_r_wrist_yaw_link[0] + w.cq[28]*pa5 + w.sq[28]*pa7;
     w.pA_r_wrist_yaw_link[1] = w.pA_r_wrist_yaw_link[1] + pa6;
-    w.pA_r_wrist_yaw_link[2] = w.pA_r_wrist_yaw_link[2] - w.sq_r_wrist_pitch_link*pa5 + w.cq_r_wrist_pitch_link*pa7;
-    w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq_r_wrist_pitch_link*pa8 + w.sq_r_wrist_pitch_link*pa9;
+    w.pA_r_wrist_yaw_link[2] = w.pA_r_wrist_yaw_link[2] - w.sq[28]*pa5 + w.cq[28]*pa7;
+    w.pA_r_wrist_yaw_link[3] = w.pA_r_wrist_yaw_link[3] + w.cq[28]*pa8 + w.sq[28]*pa9;
     w.pA_r_wrist_yaw_link[4] = w.pA_r_wrist_yaw_link[4] + tau[34];
-    w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq_r_wrist_pitch_link*pa8 + w.cq_r_wrist_pitch_link*pa9;
-    w.KA_r_wrist_yaw_link[0][0] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][0];
+    w.pA_r_wrist_yaw_link[5] = w.pA_r_wrist_yaw_link[5] - w.sq[28]*pa8 + w.cq[28]*pa9;
+    w.KA_r_wrist_yaw_link[0][0] = w.sq[28]*w.KA_r_wrist_pitch_link[2][0];
     w.KA_r_wrist_yaw_link[1][0] = w.KA_r_wrist_pitch_link[1][0];
-    w.KA_r_wrist_yaw_link[2][0] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][0];
+    w.KA_r_wrist_yaw_link[2][0] = w.cq[28]*w.KA_r_wrist_pitch_link[2][0];
     w.KSD_r_wrist_pitch_link[1] = w.KA_r_wrist_pitch_link[4][1]*w.Dinv_r_wrist_pitch_link;
     const Scalar t3 = -1.0 - w.IA_r_wrist_pitch_link[4]*w.KSD_r_wrist_pitch_link[1];
     const Scalar t4 = w.KA_r_wrist_pitch_link[5][1] - w.IA_r_wrist_pitch_link[19]*w.KSD_r_wrist_pitch_link[1];
-    w.KA_r_wrist_yaw_link[0][1] = w.cq_r_wrist_pitch_link*t3;
-    w.KA_r_wrist_yaw_link[2][1] = -w.sq_r_wrist_pitch_link*t3;
-    w.KA_r_wrist_yaw_link[3][1] = w.sq_r_wrist_pitch_link*t4;
-    w.KA_r_wrist_yaw_link[5][1] = w.cq_r_wrist_pitch_link*t4;
-    w.KA_r_wrist_yaw_link[0][2] = w.sq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][2];
+    w.KA_r_wrist_yaw_link[0][1] = w.cq[28]*t3;
+    w.KA_r_wrist_yaw_link[2][1] = -w.sq[28]*t3;
+    w.KA_r_wrist_yaw_link[3][1] = w.sq[28]*t4;
+    w.KA_r_wrist_yaw_link[5][1] = w.cq[28]*t4;
+    w.KA_r_wrist_yaw_link[0][2] = w.sq[28]*w.KA_r_wrist_pitch_link[2][2];
     w.KA_r_wrist_yaw_link[1][2] = w.KA_r_wrist_pitch_link[1][2];
-    w.KA_r_wrist_yaw_link[2][2] = w.cq_r_wrist_pitch_link*w.KA_r_wrist_pitch_link[2][2];
+    w.KA_r_wrist_yaw_link[2][2] = w.cq[28]*w.KA_r_wrist_pitch_link[2][2];
   }
 }
 
@@ -4475,10 +4475,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar pa2 = w.pA_r_wrist_yaw_link[2] + w.u_r_wrist_yaw_link[0]*t2 + w.c_r_wrist_yaw_link[0]*Ia2 + w.c_r_wrist_yaw_link[1]*Ia5 + w.c_r_wrist_yaw_link[3]*Ia8;
     const Scalar pa3 = w.pA_r_wrist_yaw_link[3] + w.u_r_wrist_yaw_link[0]*t3 + w.c_r_wrist_yaw_link[0]*Ia3 + w.c_r_wrist_yaw_link[1]*Ia6 + w.c_r_wrist_yaw_link[3]*Ia9;
     const Scalar pa4 = 0.001*w.c_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.c_r_wrist_yaw_link[4] + w.pA_r_wrist_yaw_link[4];
-    const Scalar C20 = w.cq_r_wrist_yaw_link*w.cq_r_wrist_yaw_link - w.sq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
+    const Scalar C20 = w.cq[27]*w.cq[27] - w.sq[27]*w.sq[27];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_r_wrist_yaw_link*w.sq_r_wrist_yaw_link;
+    const Scalar t4 = 2.0*w.cq[27]*w.sq[27];
     const Scalar d0 = C20*h0 - Ia1*t4;
     const Scalar qq0 = h0*t4 + Ia1*C20;
     const Scalar t5 = 0.0005 + 0.5*Ia6;
@@ -4487,9 +4487,9 @@ PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar h1 = -1.7500000000000002e-05 + 0.5*Ia9;
     const Scalar m1 = 1.7500000000000002e-05 + 0.5*Ia9;
     const Scalar t6 = m0 + d0;
-    const Scalar t7 = w.cq_r_wrist_yaw_link*Ia2 - w.sq_r_wrist_yaw_link*Ia5;
+    const Scalar t7 = w.cq[27]*Ia2 - w.sq[27]*Ia5;
     const Scalar t8 = m0 - d0;
-    const Scalar t9 = w.sq_r_wrist_yaw_link*Ia2 + w.cq_r_wrist_yaw_link*Ia5;
+    const Scalar t9 = w.sq[27]*Ia2 + w.cq[27]*Ia5;
     const Scalar t10 = 0.5*Ia3 + d1;
     const Scalar t11 = 0.0005 - 0.5*Ia6 + qq1;
     const Scalar t12 = -0.0005 + 0.5*Ia6 + qq1;
@@ -4498,10 +4498,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar t15 = -0.2555*t6 + t11;
     const Scalar t16 = 0.2555*t8 + t12;
     const Scalar t17 = -0.2555*qq0 + t13;
-    const Scalar t18 = w.cq_r_wrist_yaw_link*Ia8 + 0.2555*t9;
-    const Scalar t19 = w.sq_r_wrist_yaw_link*Ia8 - 0.2555*t7;
-    const Scalar t20 = w.cq_r_wrist_yaw_link*pa0 - w.sq_r_wrist_yaw_link*pa1;
-    const Scalar t21 = w.sq_r_wrist_yaw_link*pa0 + w.cq_r_wrist_yaw_link*pa1;
+    const Scalar t18 = w.cq[27]*Ia8 + 0.2555*t9;
+    const Scalar t19 = w.sq[27]*Ia8 - 0.2555*t7;
+    const Scalar t20 = w.cq[27]*pa0 - w.sq[27]*pa1;
+    const Scalar t21 = w.sq[27]*pa0 + w.cq[27]*pa1;
     w.IA_r_forearm[0] = 0.92 + t6;
     w.IA_r_forearm[1] = qq0;
     w.IA_r_forearm[2] = t7;
@@ -4520,11 +4520,11 @@ PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_R
     w.pA_r_forearm[0] = w.pA_r_forearm[0] + t20;
     w.pA_r_forearm[1] = w.pA_r_forearm[1] + t21;
     w.pA_r_forearm[2] = w.pA_r_forearm[2] + pa2;
-    w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq_r_wrist_yaw_link*pa3 - w.sq_r_wrist_yaw_link*pa4 + 0.2555*t21;
-    w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq_r_wrist_yaw_link*pa3 + w.cq_r_wrist_yaw_link*pa4 - 0.2555*t20;
+    w.pA_r_forearm[3] = w.pA_r_forearm[3] + w.cq[27]*pa3 - w.sq[27]*pa4 + 0.2555*t21;
+    w.pA_r_forearm[4] = w.pA_r_forearm[4] + w.sq[27]*pa3 + w.cq[27]*pa4 - 0.2555*t20;
     w.pA_r_forearm[5] = w.pA_r_forearm[5] + tau[33];
-    const Scalar t22 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][0] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][0];
-    const Scalar t23 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][0] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][0];
+    const Scalar t22 = w.cq[27]*w.KA_r_wrist_yaw_link[0][0] - w.sq[27]*w.KA_r_wrist_yaw_link[1][0];
+    const Scalar t23 = w.sq[27]*w.KA_r_wrist_yaw_link[0][0] + w.cq[27]*w.KA_r_wrist_yaw_link[1][0];
     w.KA_r_forearm[0][0] = t22;
     w.KA_r_forearm[1][0] = t23;
     w.KA_r_forearm[2][0] = w.KA_r_wrist_yaw_link[2][0];
@@ -4535,15 +4535,15 @@ PROXGEN_RT_NOINLINE void pv_backward_r_wrist_yaw_link(const Scalar* PROXGEN_RT_R
     const Scalar t25 = w.KA_r_wrist_yaw_link[2][1] - w.IA_r_wrist_yaw_link[14]*w.KSD_r_wrist_yaw_link[1];
     const Scalar t26 = -w.IA_r_wrist_yaw_link[10]*w.KSD_r_wrist_yaw_link[1];
     const Scalar t27 = w.KA_r_wrist_yaw_link[3][1] - w.IA_r_wrist_yaw_link[17]*w.KSD_r_wrist_yaw_link[1];
-    const Scalar t28 = w.cq_r_wrist_yaw_link*t24 - w.sq_r_wrist_yaw_link*t26;
-    const Scalar t29 = w.sq_r_wrist_yaw_link*t24 + w.cq_r_wrist_yaw_link*t26;
+    const Scalar t28 = w.cq[27]*t24 - w.sq[27]*t26;
+    const Scalar t29 = w.sq[27]*t24 + w.cq[27]*t26;
     w.KA_r_forearm[0][1] = t28;
     w.KA_r_forearm[1][1] = t29;
     w.KA_r_forearm[2][1] = t25;
-    w.KA_r_forearm[3][1] = w.cq_r_wrist_yaw_link*t27 + 0.2555*t29;
-    w.KA_r_forearm[4][1] = w.sq_r_wrist_yaw_link*t27 - 0.2555*t28;
-    const Scalar t30 = w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][2] - w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][2];
-    const Scalar t31 = w.sq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[0][2] + w.cq_r_wrist_yaw_link*w.KA_r_wrist_yaw_link[1][2];
+    w.KA_r_forearm[3][1] = w.cq[27]*t27 + 0.2555*t29;
+    w.KA_r_forearm[4][1] = w.sq[27]*t27 - 0.2555*t28;
+    const Scalar t30 = w.cq[27]*w.KA_r_wrist_yaw_link[0][2] - w.sq[27]*w.KA_r_wrist_yaw_link[1][2];
+    const Scalar t31 = w.sq[27]*w.KA_r_wrist_yaw_link[0][2] + w.cq[27]*w.KA_r_wrist_yaw_link[1][2];
     w.KA_r_forearm[0][2] = t30;
     w.KA_r_forearm[1][2] = t31;
     w.KA_r_forearm[2][2] = w.KA_r_wrist_yaw_link[2][2];
@@ -4576,10 +4576,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar pa2 = w.pA_r_forearm[2] + w.u_r_forearm[0]*t2 + w.c_r_forearm[0]*Ia2 + w.c_r_forearm[2]*Ia7 + w.c_r_forearm[3]*Ia8;
     const Scalar pa3 = w.pA_r_forearm[3] + w.u_r_forearm[0]*t3 + w.c_r_forearm[0]*Ia3 + w.c_r_forearm[2]*Ia8 + w.c_r_forearm[3]*Ia9;
     const Scalar pa4 = 0.0005635*w.c_r_forearm[5] + w.pA_r_forearm[5];
-    const Scalar C20 = w.cq_r_forearm*w.cq_r_forearm - w.sq_r_forearm*w.sq_r_forearm;
+    const Scalar C20 = w.cq[26]*w.cq[26] - w.sq[26]*w.sq[26];
     const Scalar h0 = 0.5*(-Ia0 + Ia7);
     const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_forearm*w.sq_r_forearm;
+    const Scalar t4 = 2.0*w.cq[26]*w.sq[26];
     const Scalar d0 = C20*h0 - Ia2*t4;
     const Scalar qq0 = h0*t4 + Ia2*C20;
     const Scalar d1 = 0.5*(-Ia3*C20 - Ia8*t4);
@@ -4587,10 +4587,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar h1 = 0.00028175 - 0.5*Ia9;
     const Scalar m1 = 0.00028175 + 0.5*Ia9;
     const Scalar t5 = 0.955336489125606*m0 - 0.955336489125606*d0 - 0.29552020666133966*qq0;
-    const Scalar t6 = -0.29552020666133966*w.cq_r_forearm*Ia5 + 0.29552020666133966*w.sq_r_forearm*Ia1 + 0.955336489125606*w.sq_r_forearm*Ia5 + 0.955336489125606*w.cq_r_forearm*Ia1;
+    const Scalar t6 = -0.29552020666133966*w.cq[26]*Ia5 + 0.29552020666133966*w.sq[26]*Ia1 + 0.955336489125606*w.sq[26]*Ia5 + 0.955336489125606*w.cq[26]*Ia1;
     const Scalar t7 = -0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
-    const Scalar t8 = w.sq_r_forearm*Ia5 + w.cq_r_forearm*Ia1;
-    const Scalar t9 = w.cq_r_forearm*Ia5 - w.sq_r_forearm*Ia1;
+    const Scalar t8 = w.sq[26]*Ia5 + w.cq[26]*Ia1;
+    const Scalar t9 = w.cq[26]*Ia5 - w.sq[26]*Ia1;
     const Scalar t10 = 0.29552020666133966*m0 - 0.29552020666133966*d0 + 0.955336489125606*qq0;
     const Scalar t12 = 0.955336489125606*m0 + 0.955336489125606*d0 + 0.29552020666133966*qq0;
     const Scalar t13 = 0.477668244562803*Ia3 - 0.14776010333066983*Ia8 - 0.955336489125606*d1 - 0.29552020666133966*qq1;
@@ -4607,17 +4607,17 @@ PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar t24 = 0.29552020666133966*t10 + 0.955336489125606*t12;
     const Scalar t25 = 0.955336489125606*t13 - 0.29552020666133966*t14;
     const Scalar t26 = 0.29552020666133966*t13 + 0.955336489125606*t14;
-    const Scalar t27 = 0.29552020666133966*w.sq_r_forearm*Ia6 + 0.955336489125606*w.cq_r_forearm*Ia6;
-    const Scalar t28 = -0.955336489125606*w.sq_r_forearm*Ia6 + 0.29552020666133966*w.cq_r_forearm*Ia6;
+    const Scalar t27 = 0.29552020666133966*w.sq[26]*Ia6 + 0.955336489125606*w.cq[26]*Ia6;
+    const Scalar t28 = -0.955336489125606*w.sq[26]*Ia6 + 0.29552020666133966*w.cq[26]*Ia6;
     const Scalar t29 = 0.955336489125606*t15 - 0.29552020666133966*t16;
     const Scalar t30 = 0.29552020666133966*t15 + 0.955336489125606*t16;
     const Scalar t31 = 0.3255*t6 + t25;
     const Scalar t32 = 0.3255*Ia4 + t27;
     const Scalar t33 = 0.3255*t23 + t29;
-    const Scalar t34 = w.cq_r_forearm*pa0 + w.sq_r_forearm*pa2;
-    const Scalar t35 = -w.sq_r_forearm*pa0 + w.cq_r_forearm*pa2;
-    const Scalar t36 = w.cq_r_forearm*pa3 + w.sq_r_forearm*pa4;
-    const Scalar t37 = -w.sq_r_forearm*pa3 + w.cq_r_forearm*pa4;
+    const Scalar t34 = w.cq[26]*pa0 + w.sq[26]*pa2;
+    const Scalar t35 = -w.sq[26]*pa0 + w.cq[26]*pa2;
+    const Scalar t36 = w.cq[26]*pa3 + w.sq[26]*pa4;
+    const Scalar t37 = -w.sq[26]*pa3 + w.cq[26]*pa4;
     const Scalar t38 = 0.955336489125606*t34 - 0.29552020666133966*t35;
     const Scalar t39 = 0.29552020666133966*t34 + 0.955336489125606*t35;
     w.IA_r_upper_arm[0] = 1.96 + t21;
@@ -4652,46 +4652,46 @@ PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT
     const Scalar t41 = w.KA_r_forearm[1][0] - w.IA_r_forearm[9]*w.KSD_r_forearm[0];
     const Scalar t42 = w.KA_r_forearm[2][0] - w.IA_r_forearm[13]*w.KSD_r_forearm[0];
     const Scalar t43 = w.KA_r_forearm[3][0] - w.IA_r_forearm[16]*w.KSD_r_forearm[0];
-    const Scalar t44 = w.cq_r_forearm*t40 + w.sq_r_forearm*t42;
-    const Scalar t45 = -w.sq_r_forearm*t40 + w.cq_r_forearm*t42;
+    const Scalar t44 = w.cq[26]*t40 + w.sq[26]*t42;
+    const Scalar t45 = -w.sq[26]*t40 + w.cq[26]*t42;
     const Scalar t46 = 0.955336489125606*t44 - 0.29552020666133966*t45;
     const Scalar t47 = 0.29552020666133966*t44 + 0.955336489125606*t45;
     w.KA_r_upper_arm[0][0] = t46;
     w.KA_r_upper_arm[1][0] = t41;
     w.KA_r_upper_arm[2][0] = t47;
-    w.KA_r_upper_arm[3][0] = 0.3255*t41 + 0.955336489125606*w.cq_r_forearm*t43 + 0.29552020666133966*w.sq_r_forearm*t43;
+    w.KA_r_upper_arm[3][0] = 0.3255*t41 + 0.955336489125606*w.cq[26]*t43 + 0.29552020666133966*w.sq[26]*t43;
     w.KA_r_upper_arm[4][0] = -0.3255*t46;
-    w.KA_r_upper_arm[5][0] = 0.29552020666133966*w.cq_r_forearm*t43 - 0.955336489125606*w.sq_r_forearm*t43;
+    w.KA_r_upper_arm[5][0] = 0.29552020666133966*w.cq[26]*t43 - 0.955336489125606*w.sq[26]*t43;
     w.KSD_r_forearm[1] = w.KA_r_forearm[4][1]*w.Dinv_r_forearm;
     const Scalar t48 = w.KA_r_forearm[0][1] - w.IA_r_forearm[4]*w.KSD_r_forearm[1];
     const Scalar t49 = w.KA_r_forearm[1][1] - w.IA_r_forearm[9]*w.KSD_r_forearm[1];
     const Scalar t50 = w.KA_r_forearm[2][1] - w.IA_r_forearm[13]*w.KSD_r_forearm[1];
     const Scalar t51 = w.KA_r_forearm[3][1] - w.IA_r_forearm[16]*w.KSD_r_forearm[1];
-    const Scalar t52 = w.cq_r_forearm*t48 + w.sq_r_forearm*t50;
-    const Scalar t53 = -w.sq_r_forearm*t48 + w.cq_r_forearm*t50;
+    const Scalar t52 = w.cq[26]*t48 + w.sq[26]*t50;
+    const Scalar t53 = -w.sq[26]*t48 + w.cq[26]*t50;
     const Scalar t54 = 0.955336489125606*t52 - 0.29552020666133966*t53;
     const Scalar t55 = 0.29552020666133966*t52 + 0.955336489125606*t53;
     w.KA_r_upper_arm[0][1] = t54;
     w.KA_r_upper_arm[1][1] = t49;
     w.KA_r_upper_arm[2][1] = t55;
-    w.KA_r_upper_arm[3][1] = 0.3255*t49 + 0.955336489125606*w.cq_r_forearm*t51 + 0.29552020666133966*w.sq_r_forearm*t51;
+    w.KA_r_upper_arm[3][1] = 0.3255*t49 + 0.955336489125606*w.cq[26]*t51 + 0.29552020666133966*w.sq[26]*t51;
     w.KA_r_upper_arm[4][1] = -0.3255*t54;
-    w.KA_r_upper_arm[5][1] = 0.29552020666133966*w.cq_r_forearm*t51 - 0.955336489125606*w.sq_r_forearm*t51;
+    w.KA_r_upper_arm[5][1] = 0.29552020666133966*w.cq[26]*t51 - 0.955336489125606*w.sq[26]*t51;
     w.KSD_r_forearm[2] = w.KA_r_forearm[4][2]*w.Dinv_r_forearm;
     const Scalar t56 = w.KA_r_forearm[0][2] - w.IA_r_forearm[4]*w.KSD_r_forearm[2];
     const Scalar t57 = w.KA_r_forearm[1][2] - w.IA_r_forearm[9]*w.KSD_r_forearm[2];
     const Scalar t58 = w.KA_r_forearm[2][2] - w.IA_r_forearm[13]*w.KSD_r_forearm[2];
     const Scalar t59 = w.KA_r_forearm[3][2] - w.IA_r_forearm[16]*w.KSD_r_forearm[2];
-    const Scalar t60 = w.cq_r_forearm*t56 + w.sq_r_forearm*t58;
-    const Scalar t61 = -w.sq_r_forearm*t56 + w.cq_r_forearm*t58;
+    const Scalar t60 = w.cq[26]*t56 + w.sq[26]*t58;
+    const Scalar t61 = -w.sq[26]*t56 + w.cq[26]*t58;
     const Scalar t62 = 0.955336489125606*t60 - 0.29552020666133966*t61;
     const Scalar t63 = 0.29552020666133966*t60 + 0.955336489125606*t61;
     w.KA_r_upper_arm[0][2] = t62;
     w.KA_r_upper_arm[1][2] = t57;
     w.KA_r_upper_arm[2][2] = t63;
-    w.KA_r_upper_arm[3][2] = 0.3255*t57 + 0.955336489125606*w.cq_r_forearm*t59 + 0.29552020666133966*w.sq_r_forearm*t59;
+    w.KA_r_upper_arm[3][2] = 0.3255*t57 + 0.955336489125606*w.cq[26]*t59 + 0.29552020666133966*w.sq[26]*t59;
     w.KA_r_upper_arm[4][2] = -0.3255*t62;
-    w.KA_r_upper_arm[5][2] = 0.29552020666133966*w.cq_r_forearm*t59 - 0.955336489125606*w.sq_r_forearm*t59;
+    w.KA_r_upper_arm[5][2] = 0.29552020666133966*w.cq[26]*t59 - 0.955336489125606*w.sq[26]*t59;
   }
 }
 
@@ -4725,10 +4725,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRI
     const Scalar pa2 = w.pA_r_upper_arm[2] + w.u_r_upper_arm[0]*t2 + w.c_r_upper_arm[0]*Ia2 + w.c_r_upper_arm[1]*Ia6 + w.c_r_upper_arm[3]*Ia10 + w.c_r_upper_arm[4]*Ia11;
     const Scalar pa3 = w.pA_r_upper_arm[3] + w.u_r_upper_arm[0]*t3 + w.c_r_upper_arm[0]*Ia3 + w.c_r_upper_arm[1]*Ia7 + w.c_r_upper_arm[3]*Ia12 + w.c_r_upper_arm[4]*Ia13;
     const Scalar pa4 = w.pA_r_upper_arm[4] + w.u_r_upper_arm[0]*t4 + w.c_r_upper_arm[0]*Ia4 + w.c_r_upper_arm[1]*Ia8 + w.c_r_upper_arm[3]*Ia13 + w.c_r_upper_arm[4]*Ia14;
-    const Scalar C20 = w.cq_r_upper_arm*w.cq_r_upper_arm - w.sq_r_upper_arm*w.sq_r_upper_arm;
+    const Scalar C20 = w.cq[25]*w.cq[25] - w.sq[25]*w.sq[25];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_r_upper_arm*w.sq_r_upper_arm;
+    const Scalar t5 = 2.0*w.cq[25]*w.sq[25];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -4742,24 +4742,24 @@ PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRI
     const Scalar qq2 = t5*h2 + Ia13*C20;
     w.IA_r_shoulder_roll_link[0] = 0.3 + m0 + d0;
     w.IA_r_shoulder_roll_link[1] = qq0;
-    w.IA_r_shoulder_roll_link[2] = w.cq_r_upper_arm*Ia2 - w.sq_r_upper_arm*Ia6;
+    w.IA_r_shoulder_roll_link[2] = w.cq[25]*Ia2 - w.sq[25]*Ia6;
     w.IA_r_shoulder_roll_link[3] = m1 + d1;
     w.IA_r_shoulder_roll_link[4] = -0.009 + 0.5*Ia4 - 0.5*Ia7 + qq1;
     w.IA_r_shoulder_roll_link[6] = 0.3 + m0 - d0;
-    w.IA_r_shoulder_roll_link[7] = w.sq_r_upper_arm*Ia2 + w.cq_r_upper_arm*Ia6;
+    w.IA_r_shoulder_roll_link[7] = w.sq[25]*Ia2 + w.cq[25]*Ia6;
     w.IA_r_shoulder_roll_link[8] = 0.009 - 0.5*Ia4 + 0.5*Ia7 + qq1;
     w.IA_r_shoulder_roll_link[9] = m1 - d1;
     w.IA_r_shoulder_roll_link[11] = 0.3 + Ia9;
-    w.IA_r_shoulder_roll_link[12] = w.cq_r_upper_arm*Ia10 - w.sq_r_upper_arm*Ia11;
-    w.IA_r_shoulder_roll_link[13] = w.sq_r_upper_arm*Ia10 + w.cq_r_upper_arm*Ia11;
+    w.IA_r_shoulder_roll_link[12] = w.cq[25]*Ia10 - w.sq[25]*Ia11;
+    w.IA_r_shoulder_roll_link[13] = w.sq[25]*Ia10 + w.cq[25]*Ia11;
     w.IA_r_shoulder_roll_link[15] = 0.00046199999999999995 + m2 + d2;
     w.IA_r_shoulder_roll_link[16] = qq2;
     w.IA_r_shoulder_roll_link[18] = 0.00046199999999999995 + m2 - d2;
-    w.pA_r_shoulder_roll_link[0] = w.pA_r_shoulder_roll_link[0] + w.cq_r_upper_arm*pa0 - w.sq_r_upper_arm*pa1;
-    w.pA_r_shoulder_roll_link[1] = w.pA_r_shoulder_roll_link[1] + w.sq_r_upper_arm*pa0 + w.cq_r_upper_arm*pa1;
+    w.pA_r_shoulder_roll_link[0] = w.pA_r_shoulder_roll_link[0] + w.cq[25]*pa0 - w.sq[25]*pa1;
+    w.pA_r_shoulder_roll_link[1] = w.pA_r_shoulder_roll_link[1] + w.sq[25]*pa0 + w.cq[25]*pa1;
     w.pA_r_shoulder_roll_link[2] = w.pA_r_shoulder_roll_link[2] + pa2;
-    w.pA_r_shoulder_roll_link[3] = w.pA_r_shoulder_roll_link[3] + w.cq_r_upper_arm*pa3 - w.sq_r_upper_arm*pa4;
-    w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq_r_upper_arm*pa3 + w.cq_r_upper_arm*pa4;
+    w.pA_r_shoulder_roll_link[3] = w.pA_r_shoulder_roll_link[3] + w.cq[25]*pa3 - w.sq[25]*pa4;
+    w.pA_r_shoulder_roll_link[4] = w.pA_r_shoulder_roll_link[4] + w.sq[25]*pa3 + w.cq[25]*pa4;
     w.pA_r_shoulder_roll_link[5] = w.pA_r_shoulder_roll_link[5] + tau[31];
     // columns 0 to 2
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
@@ -4769,11 +4769,11 @@ PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRI
       const Scalar t9 = w.KA_r_upper_arm[2][j] - w.IA_r_upper_arm[14]*w.KSD_r_upper_arm[j];
       const Scalar t10 = w.KA_r_upper_arm[3][j] - w.IA_r_upper_arm[17]*w.KSD_r_upper_arm[j];
       const Scalar t11 = w.KA_r_upper_arm[4][j] - w.IA_r_upper_arm[19]*w.KSD_r_upper_arm[j];
-      w.KA_r_shoulder_roll_link[0][j] = w.cq_r_upper_arm*t7 - w.sq_r_upper_arm*t8;
-      w.KA_r_shoulder_roll_link[1][j] = w.sq_r_upper_arm*t7 + w.cq_r_upper_arm*t8;
+      w.KA_r_shoulder_roll_link[0][j] = w.cq[25]*t7 - w.sq[25]*t8;
+      w.KA_r_shoulder_roll_link[1][j] = w.sq[25]*t7 + w.cq[25]*t8;
       w.KA_r_shoulder_roll_link[2][j] = t9;
-      w.KA_r_shoulder_roll_link[3][j] = w.cq_r_upper_arm*t10 - w.sq_r_upper_arm*t11;
-      w.KA_r_shoulder_roll_link[4][j] = w.sq_r_upper_arm*t10 + w.cq_r_upper_arm*t11;
+      w.KA_r_shoulder_roll_link[3][j] = w.cq[25]*t10 - w.sq[25]*t11;
+      w.KA_r_shoulder_roll_link[4][j] = w.sq[25]*t10 + w.cq[25]*t11;
       w.KA_r_shoulder_roll_link[5][j] = 0.0;
     }
   }
@@ -4803,10 +4803,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
     const Scalar pa2 = w.pA_r_shoulder_roll_link[2] + w.u_r_shoulder_roll_link[0]*t2 + w.c_r_shoulder_roll_link[1]*Ia5 + w.c_r_shoulder_roll_link[2]*Ia7 + w.c_r_shoulder_roll_link[4]*Ia8;
     const Scalar pa3 = w.pA_r_shoulder_roll_link[4] + w.u_r_shoulder_roll_link[0]*t3 + w.c_r_shoulder_roll_link[1]*Ia6 + w.c_r_shoulder_roll_link[2]*Ia8 + w.c_r_shoulder_roll_link[4]*Ia9;
     const Scalar pa4 = 0.000192*w.c_r_shoulder_roll_link[5] + w.pA_r_shoulder_roll_link[5];
-    const Scalar C20 = w.cq_r_shoulder_roll_link*w.cq_r_shoulder_roll_link - w.sq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
+    const Scalar C20 = w.cq[24]*w.cq[24] - w.sq[24]*w.sq[24];
     const Scalar h0 = 0.5*(Ia4 - Ia7);
     const Scalar m0 = 0.5*(Ia4 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_shoulder_roll_link*w.sq_r_shoulder_roll_link;
+    const Scalar t4 = 2.0*w.cq[24]*w.sq[24];
     const Scalar d0 = C20*h0 - Ia5*t4;
     const Scalar qq0 = h0*t4 + Ia5*C20;
     const Scalar d1 = 0.5*(Ia6*C20 - Ia8*t4);
@@ -4814,10 +4814,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
     const Scalar h1 = -9.6e-05 + 0.5*Ia9;
     const Scalar m1 = 9.6e-05 + 0.5*Ia9;
     w.IA_r_shoulder_pitch_link[0] = 0.3 + Ia0;
-    w.IA_r_shoulder_pitch_link[1] = w.cq_r_shoulder_roll_link*Ia1 - w.sq_r_shoulder_roll_link*Ia2;
-    w.IA_r_shoulder_pitch_link[2] = w.sq_r_shoulder_roll_link*Ia1 + w.cq_r_shoulder_roll_link*Ia2;
-    w.IA_r_shoulder_pitch_link[4] = w.cq_r_shoulder_roll_link*Ia3;
-    w.IA_r_shoulder_pitch_link[5] = 0.009 + w.sq_r_shoulder_roll_link*Ia3;
+    w.IA_r_shoulder_pitch_link[1] = w.cq[24]*Ia1 - w.sq[24]*Ia2;
+    w.IA_r_shoulder_pitch_link[2] = w.sq[24]*Ia1 + w.cq[24]*Ia2;
+    w.IA_r_shoulder_pitch_link[4] = w.cq[24]*Ia3;
+    w.IA_r_shoulder_pitch_link[5] = 0.009 + w.sq[24]*Ia3;
     w.IA_r_shoulder_pitch_link[6] = 0.3 + m0 + d0;
     w.IA_r_shoulder_pitch_link[7] = qq0;
     w.IA_r_shoulder_pitch_link[9] = 0.5*Ia6 + d1;
@@ -4829,11 +4829,11 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
     w.IA_r_shoulder_pitch_link[19] = t4*h1;
     w.IA_r_shoulder_pitch_link[20] = 0.00046199999999999995 + m1 - C20*h1;
     w.pA_r_shoulder_pitch_link[0] = w.pA_r_shoulder_pitch_link[0] + pa0;
-    w.pA_r_shoulder_pitch_link[1] = w.pA_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*pa1 - w.sq_r_shoulder_roll_link*pa2;
-    w.pA_r_shoulder_pitch_link[2] = w.pA_r_shoulder_pitch_link[2] + w.sq_r_shoulder_roll_link*pa1 + w.cq_r_shoulder_roll_link*pa2;
+    w.pA_r_shoulder_pitch_link[1] = w.pA_r_shoulder_pitch_link[1] + w.cq[24]*pa1 - w.sq[24]*pa2;
+    w.pA_r_shoulder_pitch_link[2] = w.pA_r_shoulder_pitch_link[2] + w.sq[24]*pa1 + w.cq[24]*pa2;
     w.pA_r_shoulder_pitch_link[3] = w.pA_r_shoulder_pitch_link[3] + tau[30];
-    w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*pa3 - w.sq_r_shoulder_roll_link*pa4;
-    w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq_r_shoulder_roll_link*pa3 + w.cq_r_shoulder_roll_link*pa4;
+    w.pA_r_shoulder_pitch_link[4] = w.pA_r_shoulder_pitch_link[4] + w.cq[24]*pa3 - w.sq[24]*pa4;
+    w.pA_r_shoulder_pitch_link[5] = w.pA_r_shoulder_pitch_link[5] + w.sq[24]*pa3 + w.cq[24]*pa4;
     // columns 0 to 2
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_r_shoulder_roll_link[j] = w.Dinv_r_shoulder_roll_link*w.KA_r_shoulder_roll_link[3][j];
@@ -4842,11 +4842,11 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
       const Scalar t7 = w.KA_r_shoulder_roll_link[2][j] - w.IA_r_shoulder_roll_link[12]*w.KSD_r_shoulder_roll_link[j];
       const Scalar t8 = w.KA_r_shoulder_roll_link[4][j] - w.IA_r_shoulder_roll_link[16]*w.KSD_r_shoulder_roll_link[j];
       w.KA_r_shoulder_pitch_link[0][j] = t5;
-      w.KA_r_shoulder_pitch_link[1][j] = w.cq_r_shoulder_roll_link*t6 - w.sq_r_shoulder_roll_link*t7;
-      w.KA_r_shoulder_pitch_link[2][j] = w.sq_r_shoulder_roll_link*t6 + w.cq_r_shoulder_roll_link*t7;
+      w.KA_r_shoulder_pitch_link[1][j] = w.cq[24]*t6 - w.sq[24]*t7;
+      w.KA_r_shoulder_pitch_link[2][j] = w.sq[24]*t6 + w.cq[24]*t7;
       w.KA_r_shoulder_pitch_link[3][j] = 0.0;
-      w.KA_r_shoulder_pitch_link[4][j] = w.cq_r_shoulder_roll_link*t8 - w.sq_r_shoulder_roll_link*w.KA_r_shoulder_roll_link[5][j];
-      w.KA_r_shoulder_pitch_link[5][j] = w.sq_r_shoulder_roll_link*t8 + w.cq_r_shoulder_roll_link*w.KA_r_shoulder_roll_link[5][j];
+      w.KA_r_shoulder_pitch_link[4][j] = w.cq[24]*t8 - w.sq[24]*w.KA_r_shoulder_roll_link[5][j];
+      w.KA_r_shoulder_pitch_link[5][j] = w.sq[24]*t8 + w.cq[24]*w.KA_r_shoulder_roll_link[5][j];
     }
   }
 }
@@ -4875,10 +4875,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
     const Scalar pa2 = -0.009*w.c_r_shoulder_pitch_link[3] + w.pA_r_shoulder_pitch_link[2] + w.u_r_shoulder_pitch_link[0]*t2 + w.c_r_shoulder_pitch_link[0]*Ia2 + w.c_r_shoulder_pitch_link[2]*Ia7 + w.c_r_shoulder_pitch_link[5]*Ia8;
     const Scalar pa3 = -0.009*w.c_r_shoulder_pitch_link[2] + 0.00046199999999999995*w.c_r_shoulder_pitch_link[3] + w.pA_r_shoulder_pitch_link[3];
     const Scalar pa4 = w.pA_r_shoulder_pitch_link[5] + w.u_r_shoulder_pitch_link[0]*t3 + w.c_r_shoulder_pitch_link[0]*Ia3 + w.c_r_shoulder_pitch_link[2]*Ia8 + w.c_r_shoulder_pitch_link[5]*Ia9;
-    const Scalar C20 = w.cq_r_shoulder_pitch_link*w.cq_r_shoulder_pitch_link - w.sq_r_shoulder_pitch_link*w.sq_r_shoulder_pitch_link;
+    const Scalar C20 = w.cq[23]*w.cq[23] - w.sq[23]*w.sq[23];
     const Scalar h0 = 0.5*(-Ia0 + Ia7);
     const Scalar m0 = 0.5*(Ia0 + Ia7);
-    const Scalar t4 = 2.0*w.cq_r_shoulder_pitch_link*w.sq_r_shoulder_pitch_link;
+    const Scalar t4 = 2.0*w.cq[23]*w.sq[23];
     const Scalar d0 = C20*h0 - Ia2*t4;
     const Scalar qq0 = h0*t4 + Ia2*C20;
     const Scalar t5 = -0.0045 + 0.5*Ia3;
@@ -4886,21 +4886,21 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
     const Scalar qq1 = 0.5*Ia8*t4 + C20*t5;
     const Scalar h1 = -0.00023099999999999998 + 0.5*Ia9;
     const Scalar m1 = 0.00023099999999999998 + 0.5*Ia9;
-    const Scalar t6 = 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia5 + 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
-    const Scalar t7 = 0.04493516596384369*Ia4 - 0.1676999117594225*w.cq_r_shoulder_pitch_link*Ia5 + 0.1676999117594225*w.sq_r_shoulder_pitch_link*Ia1 + 0.9848134698792882*w.sq_r_shoulder_pitch_link*Ia5 + 0.9848134698792882*w.cq_r_shoulder_pitch_link*Ia1;
-    const Scalar t8 = 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia5 - 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
-    const Scalar t9 = 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia5 + 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia1 + 0.2588196364430848*qq0;
-    const Scalar t10 = 0.9659256678396477*Ia4 + 0.2588196364430848*w.cq_r_shoulder_pitch_link*Ia5 - 0.2588196364430848*w.sq_r_shoulder_pitch_link*Ia1;
-    const Scalar t11 = 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia5 - 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia1 + 0.2588196364430848*m0 + 0.2588196364430848*d0;
-    const Scalar t12 = -0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia5 - 0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
-    const Scalar t13 = -0.2548890642384102*Ia4 + 0.9512566085906322*w.cq_r_shoulder_pitch_link*Ia5 - 0.9512566085906322*w.sq_r_shoulder_pitch_link*Ia1 + 0.17361575258114187*w.sq_r_shoulder_pitch_link*Ia5 + 0.17361575258114187*w.cq_r_shoulder_pitch_link*Ia1;
-    const Scalar t14 = -0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia5 + 0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
-    const Scalar t15 = 0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 + 0.04493516596384369*w.sq_r_shoulder_pitch_link*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
-    const Scalar t16 = 0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 + 0.04493516596384369*w.cq_r_shoulder_pitch_link*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
-    const Scalar t17 = -0.0011646883639938816 - 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq_r_shoulder_pitch_link*Ia6 + 0.2588196364430848*qq1;
-    const Scalar t18 = 0.1294098182215424*Ia8 + 0.9659256678396477*w.cq_r_shoulder_pitch_link*Ia6 + 0.2588196364430848*d1;
-    const Scalar t19 = -0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 - 0.2548890642384102*w.sq_r_shoulder_pitch_link*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
-    const Scalar t20 = 0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 - 0.2548890642384102*w.cq_r_shoulder_pitch_link*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
+    const Scalar t6 = 0.04493516596384369*w.sq[23]*Ia5 + 0.04493516596384369*w.cq[23]*Ia1 + 0.9848134698792882*m0 - 0.9848134698792882*d0 - 0.1676999117594225*qq0;
+    const Scalar t7 = 0.04493516596384369*Ia4 - 0.1676999117594225*w.cq[23]*Ia5 + 0.1676999117594225*w.sq[23]*Ia1 + 0.9848134698792882*w.sq[23]*Ia5 + 0.9848134698792882*w.cq[23]*Ia1;
+    const Scalar t8 = 0.04493516596384369*w.cq[23]*Ia5 - 0.04493516596384369*w.sq[23]*Ia1 - 0.1676999117594225*m0 - 0.1676999117594225*d0 + 0.9848134698792882*qq0;
+    const Scalar t9 = 0.9659256678396477*w.sq[23]*Ia5 + 0.9659256678396477*w.cq[23]*Ia1 + 0.2588196364430848*qq0;
+    const Scalar t10 = 0.9659256678396477*Ia4 + 0.2588196364430848*w.cq[23]*Ia5 - 0.2588196364430848*w.sq[23]*Ia1;
+    const Scalar t11 = 0.9659256678396477*w.cq[23]*Ia5 - 0.9659256678396477*w.sq[23]*Ia1 + 0.2588196364430848*m0 + 0.2588196364430848*d0;
+    const Scalar t12 = -0.2548890642384102*w.sq[23]*Ia5 - 0.2548890642384102*w.cq[23]*Ia1 + 0.17361575258114187*m0 - 0.17361575258114187*d0 + 0.9512566085906322*qq0;
+    const Scalar t13 = -0.2548890642384102*Ia4 + 0.9512566085906322*w.cq[23]*Ia5 - 0.9512566085906322*w.sq[23]*Ia1 + 0.17361575258114187*w.sq[23]*Ia5 + 0.17361575258114187*w.cq[23]*Ia1;
+    const Scalar t14 = -0.2548890642384102*w.cq[23]*Ia5 + 0.2548890642384102*w.sq[23]*Ia1 + 0.9512566085906322*m0 + 0.9512566085906322*d0 + 0.17361575258114187*qq0;
+    const Scalar t15 = 0.0007546496029174013 + 0.08384995587971125*Ia3 + 0.4924067349396441*Ia8 + 0.04493516596384369*w.sq[23]*Ia6 - 0.9848134698792882*d1 - 0.1676999117594225*qq1;
+    const Scalar t16 = 0.004431660614456797 + 0.4924067349396441*Ia3 - 0.08384995587971125*Ia8 + 0.04493516596384369*w.cq[23]*Ia6 - 0.1676999117594225*d1 + 0.9848134698792882*qq1;
+    const Scalar t17 = -0.0011646883639938816 - 0.1294098182215424*Ia3 + 0.9659256678396477*w.sq[23]*Ia6 + 0.2588196364430848*qq1;
+    const Scalar t18 = 0.1294098182215424*Ia8 + 0.9659256678396477*w.cq[23]*Ia6 + 0.2588196364430848*d1;
+    const Scalar t19 = -0.004280654738657845 - 0.4756283042953161*Ia3 + 0.08680787629057093*Ia8 - 0.2548890642384102*w.sq[23]*Ia6 - 0.17361575258114187*d1 + 0.9512566085906322*qq1;
+    const Scalar t20 = 0.0007812708866151383 + 0.08680787629057093*Ia3 + 0.4756283042953161*Ia8 - 0.2548890642384102*w.cq[23]*Ia6 + 0.9512566085906322*d1 + 0.17361575258114187*qq1;
     const Scalar t21 = 0.9848134698792882*m1 - 0.9848134698792882*C20*h1 - 0.1676999117594225*t4*h1;
     const Scalar t22 = -0.1676999117594225*m1 - 0.1676999117594225*C20*h1 + 0.9848134698792882*t4*h1;
     const Scalar t23 = 0.2588196364430848*(m1 + C20*h1);
@@ -4927,10 +4927,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
     const Scalar t44 = -0.254*t30 - 0.19*t31 + t36;
     const Scalar t45 = 0.2588196364430848*t20 + 0.254*t28;
     const Scalar t46 = 0.19*t28 + t37;
-    const Scalar t47 = w.cq_r_shoulder_pitch_link*pa0 + w.sq_r_shoulder_pitch_link*pa2;
-    const Scalar t48 = -w.sq_r_shoulder_pitch_link*pa0 + w.cq_r_shoulder_pitch_link*pa2;
-    const Scalar t49 = w.cq_r_shoulder_pitch_link*pa3 + w.sq_r_shoulder_pitch_link*pa4;
-    const Scalar t50 = -w.sq_r_shoulder_pitch_link*pa3 + w.cq_r_shoulder_pitch_link*pa4;
+    const Scalar t47 = w.cq[23]*pa0 + w.sq[23]*pa2;
+    const Scalar t48 = -w.sq[23]*pa0 + w.cq[23]*pa2;
+    const Scalar t49 = w.cq[23]*pa3 + w.sq[23]*pa4;
+    const Scalar t50 = -w.sq[23]*pa3 + w.cq[23]*pa4;
     const Scalar t51 = 0.04493516596384369*pa1 + 0.9848134698792882*t47 - 0.1676999117594225*t48;
     const Scalar t52 = 0.9659256678396477*pa1 + 0.2588196364430848*t48;
     const Scalar t53 = -0.2548890642384102*pa1 + 0.17361575258114187*t47 + 0.9512566085906322*t48;
@@ -4968,10 +4968,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
       const Scalar t55 = w.KA_r_shoulder_pitch_link[1][j] - w.IA_r_shoulder_pitch_link[9]*w.KSD_r_shoulder_pitch_link[j];
       const Scalar t56 = w.KA_r_shoulder_pitch_link[2][j] - w.IA_r_shoulder_pitch_link[13]*w.KSD_r_shoulder_pitch_link[j];
       const Scalar t57 = w.KA_r_shoulder_pitch_link[5][j] - w.IA_r_shoulder_pitch_link[19]*w.KSD_r_shoulder_pitch_link[j];
-      const Scalar t58 = w.cq_r_shoulder_pitch_link*t54 + w.sq_r_shoulder_pitch_link*t56;
-      const Scalar t59 = -w.sq_r_shoulder_pitch_link*t54 + w.cq_r_shoulder_pitch_link*t56;
-      const Scalar t60 = w.cq_r_shoulder_pitch_link*w.KA_r_shoulder_pitch_link[3][j] + w.sq_r_shoulder_pitch_link*t57;
-      const Scalar t61 = -w.sq_r_shoulder_pitch_link*w.KA_r_shoulder_pitch_link[3][j] + w.cq_r_shoulder_pitch_link*t57;
+      const Scalar t58 = w.cq[23]*t54 + w.sq[23]*t56;
+      const Scalar t59 = -w.sq[23]*t54 + w.cq[23]*t56;
+      const Scalar t60 = w.cq[23]*w.KA_r_shoulder_pitch_link[3][j] + w.sq[23]*t57;
+      const Scalar t61 = -w.sq[23]*w.KA_r_shoulder_pitch_link[3][j] + w.cq[23]*t57;
       const Scalar t62 = 0.04493516596384369*t55 + 0.9848134698792882*t58 - 0.1676999117594225*t59;
       const Scalar t63 = 0.9659256678396477*t55 + 0.2588196364430848*t59;
       const Scalar t64 = -0.2548890642384102*t55 + 0.17361575258114187*t58 + 0.9512566085906322*t59;
@@ -5015,10 +5015,10 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
     const Scalar pa2 = w.pA_chest[2] + w.u_chest[0]*t2 + w.c_chest[0]*Ia2 + w.c_chest[2]*Ia9 + w.c_chest[3]*Ia10 + w.c_chest[5]*Ia11;
     const Scalar pa3 = w.pA_chest[3] + w.u_chest[0]*t3 + w.c_chest[0]*Ia3 + w.c_chest[2]*Ia10 + w.c_chest[3]*Ia12 + w.c_chest[5]*Ia13;
     const Scalar pa4 = w.pA_chest[5] + w.u_chest[0]*t4 + w.c_chest[0]*Ia4 + w.c_chest[2]*Ia11 + w.c_chest[3]*Ia13 + w.c_chest[5]*Ia14;
-    const Scalar C20 = w.cq_chest*w.cq_chest - w.sq_chest*w.sq_chest;
+    const Scalar C20 = w.cq[13]*w.cq[13] - w.sq[13]*w.sq[13];
     const Scalar h0 = 0.5*(-Ia0 + Ia9);
     const Scalar m0 = 0.5*(Ia0 + Ia9);
-    const Scalar t5 = 2.0*w.cq_chest*w.sq_chest;
+    const Scalar t5 = 2.0*w.cq[13]*w.sq[13];
     const Scalar d0 = C20*h0 - Ia2*t5;
     const Scalar qq0 = h0*t5 + Ia2*C20;
     const Scalar h1 = 0.5*(-Ia3 + Ia11);
@@ -5031,20 +5031,20 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 - d0;
-    const Scalar t8 = w.sq_chest*Ia6 + w.cq_chest*Ia1;
-    const Scalar t9 = w.cq_chest*Ia6 - w.sq_chest*Ia1;
+    const Scalar t8 = w.sq[13]*Ia6 + w.cq[13]*Ia1;
+    const Scalar t9 = w.cq[13]*Ia6 - w.sq[13]*Ia1;
     const Scalar t10 = m0 + d0;
     const Scalar t11 = m1 - d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia10 + qq1;
-    const Scalar t13 = w.sq_chest*Ia8 + w.cq_chest*Ia7;
-    const Scalar t14 = w.cq_chest*Ia8 - w.sq_chest*Ia7;
+    const Scalar t13 = w.sq[13]*Ia8 + w.cq[13]*Ia7;
+    const Scalar t14 = w.cq[13]*Ia8 - w.sq[13]*Ia7;
     const Scalar t15 = -0.5*Ia4 + 0.5*Ia10 + qq1;
     const Scalar t16 = m1 + d1;
     const Scalar t17 = -0.15*t8 + t11;
     const Scalar t18 = -0.15*Ia5 + t13;
     const Scalar t19 = -0.15*t9 + t15;
-    const Scalar t20 = w.cq_chest*pa0 + w.sq_chest*pa2;
-    const Scalar t21 = -w.sq_chest*pa0 + w.cq_chest*pa2;
+    const Scalar t20 = w.cq[13]*pa0 + w.sq[13]*pa2;
+    const Scalar t21 = -w.sq[13]*pa0 + w.cq[13]*pa2;
     w.IA_abdomen[0] = 9.73 + t7;
     w.IA_abdomen[1] = t8;
     w.IA_abdomen[2] = qq0;
@@ -5069,9 +5069,9 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
     w.pA_abdomen[0] = w.pA_abdomen[0] + t20;
     w.pA_abdomen[1] = w.pA_abdomen[1] + pa1;
     w.pA_abdomen[2] = w.pA_abdomen[2] + t21;
-    w.pA_abdomen[3] = w.pA_abdomen[3] - 0.15*pa1 + w.cq_chest*pa3 + w.sq_chest*pa4;
+    w.pA_abdomen[3] = w.pA_abdomen[3] - 0.15*pa1 + w.cq[13]*pa3 + w.sq[13]*pa4;
     w.pA_abdomen[4] = w.pA_abdomen[4] + tau[19] + 0.15*t20;
-    w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq_chest*pa3 + w.cq_chest*pa4;
+    w.pA_abdomen[5] = w.pA_abdomen[5] - w.sq[13]*pa3 + w.cq[13]*pa4;
     // columns 0 to 2
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
       w.KSD_chest[j] = w.Dinv_chest*w.KA_chest[4][j];
@@ -5080,14 +5080,14 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
       const Scalar t24 = w.KA_chest[2][j] - w.IA_chest[13]*w.KSD_chest[j];
       const Scalar t25 = w.KA_chest[3][j] - w.IA_chest[16]*w.KSD_chest[j];
       const Scalar t26 = w.KA_chest[5][j] - w.IA_chest[19]*w.KSD_chest[j];
-      const Scalar t27 = w.cq_chest*t22 + w.sq_chest*t24;
-      const Scalar t28 = -w.sq_chest*t22 + w.cq_chest*t24;
+      const Scalar t27 = w.cq[13]*t22 + w.sq[13]*t24;
+      const Scalar t28 = -w.sq[13]*t22 + w.cq[13]*t24;
       w.KA_abdomen[0][j] = t27;
       w.KA_abdomen[1][j] = t23;
       w.KA_abdomen[2][j] = t28;
-      w.KA_abdomen[3][j] = -0.15*t23 + w.cq_chest*t25 + w.sq_chest*t26;
+      w.KA_abdomen[3][j] = -0.15*t23 + w.cq[13]*t25 + w.sq[13]*t26;
       w.KA_abdomen[4][j] = 0.15*t27;
-      w.KA_abdomen[5][j] = -w.sq_chest*t25 + w.cq_chest*t26;
+      w.KA_abdomen[5][j] = -w.sq[13]*t25 + w.cq[13]*t26;
     }
   }
 }
@@ -5122,10 +5122,10 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
     const Scalar pa2 = w.pA_abdomen[2] + w.u_abdomen[0]*t2 + w.c_abdomen[0]*Ia2 + w.c_abdomen[1]*Ia6 + w.c_abdomen[3]*Ia10 + w.c_abdomen[4]*Ia11;
     const Scalar pa3 = w.pA_abdomen[3] + w.u_abdomen[0]*t3 + w.c_abdomen[0]*Ia3 + w.c_abdomen[1]*Ia7 + w.c_abdomen[3]*Ia12 + w.c_abdomen[4]*Ia13;
     const Scalar pa4 = w.pA_abdomen[4] + w.u_abdomen[0]*t4 + w.c_abdomen[0]*Ia4 + w.c_abdomen[1]*Ia8 + w.c_abdomen[3]*Ia13 + w.c_abdomen[4]*Ia14;
-    const Scalar C20 = w.cq_abdomen*w.cq_abdomen - w.sq_abdomen*w.sq_abdomen;
+    const Scalar C20 = w.cq[12]*w.cq[12] - w.sq[12]*w.sq[12];
     const Scalar h0 = 0.5*(Ia0 - Ia5);
     const Scalar m0 = 0.5*(Ia0 + Ia5);
-    const Scalar t5 = 2.0*w.cq_abdomen*w.sq_abdomen;
+    const Scalar t5 = 2.0*w.cq[12]*w.sq[12];
     const Scalar d0 = C20*h0 - Ia1*t5;
     const Scalar qq0 = h0*t5 + Ia1*C20;
     const Scalar h1 = 0.5*(Ia3 - Ia8);
@@ -5138,23 +5138,23 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
     const Scalar d2 = C20*h2 - Ia13*t5;
     const Scalar qq2 = t5*h2 + Ia13*C20;
     const Scalar t7 = m0 + d0;
-    const Scalar t8 = w.cq_abdomen*Ia2 - w.sq_abdomen*Ia6;
+    const Scalar t8 = w.cq[12]*Ia2 - w.sq[12]*Ia6;
     const Scalar t9 = m0 - d0;
-    const Scalar t10 = w.sq_abdomen*Ia2 + w.cq_abdomen*Ia6;
+    const Scalar t10 = w.sq[12]*Ia2 + w.cq[12]*Ia6;
     const Scalar t11 = m1 + d1;
     const Scalar t12 = 0.5*Ia4 - 0.5*Ia7 + qq1;
     const Scalar t13 = -0.5*Ia4 + 0.5*Ia7 + qq1;
     const Scalar t14 = m1 - d1;
-    const Scalar t15 = w.cq_abdomen*Ia10 - w.sq_abdomen*Ia11;
-    const Scalar t16 = w.sq_abdomen*Ia10 + w.cq_abdomen*Ia11;
+    const Scalar t15 = w.cq[12]*Ia10 - w.sq[12]*Ia11;
+    const Scalar t16 = w.sq[12]*Ia10 + w.cq[12]*Ia11;
     const Scalar t17 = -0.1*qq0 + t11;
     const Scalar t18 = 0.1*t7 + t12;
     const Scalar t19 = -0.1*t9 + t13;
     const Scalar t20 = 0.1*qq0 + t14;
     const Scalar t21 = -0.1*t10 + t15;
     const Scalar t22 = 0.1*t8 + t16;
-    const Scalar t23 = w.cq_abdomen*pa0 - w.sq_abdomen*pa1;
-    const Scalar t24 = w.sq_abdomen*pa0 + w.cq_abdomen*pa1;
+    const Scalar t23 = w.cq[12]*pa0 - w.sq[12]*pa1;
+    const Scalar t24 = w.sq[12]*pa0 + w.cq[12]*pa1;
     w.IA_pelvis[0] = 7.94 + t7;
     w.IA_pelvis[1] = qq0;
     w.IA_pelvis[2] = t8;
@@ -5173,8 +5173,8 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
     w.pA_pelvis[0] = w.pA_pelvis[0] + t23;
     w.pA_pelvis[1] = w.pA_pelvis[1] + t24;
     w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
-    w.pA_pelvis[3] = w.pA_pelvis[3] + w.cq_abdomen*pa3 - w.sq_abdomen*pa4 - 0.1*t24;
-    w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq_abdomen*pa3 + w.cq_abdomen*pa4 + 0.1*t23;
+    w.pA_pelvis[3] = w.pA_pelvis[3] + w.cq[12]*pa3 - w.sq[12]*pa4 - 0.1*t24;
+    w.pA_pelvis[4] = w.pA_pelvis[4] + w.sq[12]*pa3 + w.cq[12]*pa4 + 0.1*t23;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[18];
     // columns 0 to 2
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
@@ -5184,13 +5184,13 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
       const Scalar t27 = w.KA_abdomen[2][j] - w.IA_abdomen[14]*w.KSD_abdomen[j];
       const Scalar t28 = w.KA_abdomen[3][j] - w.IA_abdomen[17]*w.KSD_abdomen[j];
       const Scalar t29 = w.KA_abdomen[4][j] - w.IA_abdomen[19]*w.KSD_abdomen[j];
-      const Scalar t30 = w.cq_abdomen*t25 - w.sq_abdomen*t26;
-      const Scalar t31 = w.sq_abdomen*t25 + w.cq_abdomen*t26;
+      const Scalar t30 = w.cq[12]*t25 - w.sq[12]*t26;
+      const Scalar t31 = w.sq[12]*t25 + w.cq[12]*t26;
       w.KA_pelvis[0][12 + j] = t30;
       w.KA_pelvis[1][12 + j] = t31;
       w.KA_pelvis[2][12 + j] = t27;
-      w.KA_pelvis[3][12 + j] = w.cq_abdomen*t28 - w.sq_abdomen*t29 - 0.1*t31;
-      w.KA_pelvis[4][12 + j] = w.sq_abdomen*t28 + w.cq_abdomen*t29 + 0.1*t30;
+      w.KA_pelvis[3][12 + j] = w.cq[12]*t28 - w.sq[12]*t29 - 0.1*t31;
+      w.KA_pelvis[4][12 + j] = w.sq[12]*t28 + w.cq[12]*t29 + 0.1*t30;
       w.KA_pelvis[5][12 + j] = 0.0;
     }
   }
@@ -5198,27 +5198,27 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void pv_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_35(&tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], w.cq_r_foot, w.sq_r_foot, &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
+  shared_35(&tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], &w.cq[11], &w.sq[11], &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_36(&tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
+  shared_36(&tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_37(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
+  shared_37(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, &w.cq[9], &w.sq[9], w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_38(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
+  shared_38(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, &w.cq[8], &w.sq[8], w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_39(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
+  shared_39(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], &w.cq[7], &w.sq[7], w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -5245,10 +5245,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_r_hip_yaw_link[2] + w.u_r_hip_yaw_link[0]*t2 + w.c_r_hip_yaw_link[0]*Ia2 + w.c_r_hip_yaw_link[1]*Ia5 + w.c_r_hip_yaw_link[4]*Ia8;
     const Scalar pa3 = -0.02*w.c_r_hip_yaw_link[1] + 0.0013*w.c_r_hip_yaw_link[3] + w.pA_r_hip_yaw_link[3];
     const Scalar pa4 = w.pA_r_hip_yaw_link[4] + w.u_r_hip_yaw_link[0]*t3 + w.c_r_hip_yaw_link[0]*Ia3 + w.c_r_hip_yaw_link[1]*Ia6 + w.c_r_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq_r_hip_yaw_link*w.cq_r_hip_yaw_link - w.sq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
+    const Scalar C20 = w.cq[6]*w.cq[6] - w.sq[6]*w.sq[6];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_r_hip_yaw_link*w.sq_r_hip_yaw_link;
+    const Scalar t4 = 2.0*w.cq[6]*w.sq[6];
     const Scalar d0 = C20*h0 - Ia1*t4;
     const Scalar qq0 = h0*t4 + Ia1*C20;
     const Scalar t5 = -0.01 + 0.5*Ia3;
@@ -5258,10 +5258,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar m1 = 0.00065 + 0.5*Ia9;
     const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 + 0.08718915247898762*qq0;
     const Scalar t7 = 0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq_r_hip_yaw_link*Ia2 - 0.9961917745544759*w.sq_r_hip_yaw_link*Ia5 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia2 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia5;
+    const Scalar t8 = 0.9961917745544759*w.cq[6]*Ia2 - 0.9961917745544759*w.sq[6]*Ia5 + 0.08718915247898762*w.sq[6]*Ia2 + 0.08718915247898762*w.cq[6]*Ia5;
     const Scalar t9 = -0.08718915247898762*m0 - 0.08718915247898762*d0 + 0.9961917745544759*qq0;
     const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 - 0.08718915247898762*qq0;
-    const Scalar t11 = -0.08718915247898762*w.cq_r_hip_yaw_link*Ia2 + 0.08718915247898762*w.sq_r_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_r_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia5;
+    const Scalar t11 = -0.08718915247898762*w.cq[6]*Ia2 + 0.08718915247898762*w.sq[6]*Ia5 + 0.9961917745544759*w.sq[6]*Ia2 + 0.9961917745544759*w.cq[6]*Ia5;
     const Scalar t14 = -0.0008718915247898762 - 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 + 0.08718915247898762*qq1;
     const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
     const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 - 0.08718915247898762*d1 + 0.9961917745544759*qq1;
@@ -5277,15 +5277,15 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar t26 = -0.08718915247898762*t14 + 0.9961917745544759*t15;
     const Scalar t27 = 0.9961917745544759*t16 + 0.08718915247898762*t17;
     const Scalar t28 = -0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq_r_hip_yaw_link*Ia8 + 0.08718915247898762*w.cq_r_hip_yaw_link*Ia8;
-    const Scalar t30 = 0.08718915247898762*w.sq_r_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_r_hip_yaw_link*Ia8;
+    const Scalar t29 = -0.9961917745544759*w.sq[6]*Ia8 + 0.08718915247898762*w.cq[6]*Ia8;
+    const Scalar t30 = 0.08718915247898762*w.sq[6]*Ia8 + 0.9961917745544759*w.cq[6]*Ia8;
     const Scalar t31 = -0.0875*t8 + t25;
     const Scalar t32 = -0.0875*t11 + t27;
     const Scalar t33 = -0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq_r_hip_yaw_link*pa0 - w.sq_r_hip_yaw_link*pa1;
-    const Scalar t35 = w.sq_r_hip_yaw_link*pa0 + w.cq_r_hip_yaw_link*pa1;
-    const Scalar t36 = w.cq_r_hip_yaw_link*pa3 - w.sq_r_hip_yaw_link*pa4;
-    const Scalar t37 = w.sq_r_hip_yaw_link*pa3 + w.cq_r_hip_yaw_link*pa4;
+    const Scalar t34 = w.cq[6]*pa0 - w.sq[6]*pa1;
+    const Scalar t35 = w.sq[6]*pa0 + w.cq[6]*pa1;
+    const Scalar t36 = w.cq[6]*pa3 - w.sq[6]*pa4;
+    const Scalar t37 = w.sq[6]*pa3 + w.cq[6]*pa4;
     const Scalar t38 = 0.9961917745544759*t34 + 0.08718915247898762*t35;
     const Scalar t39 = -0.08718915247898762*t34 + 0.9961917745544759*t35;
     w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
@@ -5322,10 +5322,10 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
       const Scalar t41 = w.KA_r_hip_yaw_link[1][j] - w.IA_r_hip_yaw_link[10]*w.KSD_r_hip_yaw_link[j];
       const Scalar t42 = w.KA_r_hip_yaw_link[2][j] - w.IA_r_hip_yaw_link[14]*w.KSD_r_hip_yaw_link[j];
       const Scalar t43 = w.KA_r_hip_yaw_link[4][j] - w.IA_r_hip_yaw_link[19]*w.KSD_r_hip_yaw_link[j];
-      const Scalar t44 = w.cq_r_hip_yaw_link*t40 - w.sq_r_hip_yaw_link*t41;
-      const Scalar t45 = w.sq_r_hip_yaw_link*t40 + w.cq_r_hip_yaw_link*t41;
-      const Scalar t46 = w.cq_r_hip_yaw_link*w.KA_r_hip_yaw_link[3][j] - w.sq_r_hip_yaw_link*t43;
-      const Scalar t47 = w.sq_r_hip_yaw_link*w.KA_r_hip_yaw_link[3][j] + w.cq_r_hip_yaw_link*t43;
+      const Scalar t44 = w.cq[6]*t40 - w.sq[6]*t41;
+      const Scalar t45 = w.sq[6]*t40 + w.cq[6]*t41;
+      const Scalar t46 = w.cq[6]*w.KA_r_hip_yaw_link[3][j] - w.sq[6]*t43;
+      const Scalar t47 = w.sq[6]*w.KA_r_hip_yaw_link[3][j] + w.cq[6]*t43;
       const Scalar t48 = 0.9961917745544759*t44 + 0.08718915247898762*t45;
       const Scalar t49 = -0.08718915247898762*t44 + 0.9961917745544759*t45;
       w.KA_pelvis[0][6 + j] = t48;
@@ -5340,27 +5340,27 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
 
 PROXGEN_RT_NOINLINE void pv_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_35(&tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], w.cq_l_foot, w.sq_l_foot, &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
+  shared_35(&tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], &w.cq[5], &w.sq[5], &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_36(&tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
+  shared_36(&tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_37(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
+  shared_37(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, &w.cq[3], &w.sq[3], w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_38(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
+  shared_38(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, &w.cq[2], &w.sq[2], w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_39(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
+  shared_39(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], &w.cq[1], &w.sq[1], w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -5387,10 +5387,10 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar pa2 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t2 + w.c_l_hip_yaw_link[0]*Ia2 + w.c_l_hip_yaw_link[1]*Ia5 + w.c_l_hip_yaw_link[4]*Ia8;
     const Scalar pa3 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
     const Scalar pa4 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t3 + w.c_l_hip_yaw_link[0]*Ia3 + w.c_l_hip_yaw_link[1]*Ia6 + w.c_l_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq_l_hip_yaw_link*w.cq_l_hip_yaw_link - w.sq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
+    const Scalar C20 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
     const Scalar h0 = 0.5*(Ia0 - Ia4);
     const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq_l_hip_yaw_link*w.sq_l_hip_yaw_link;
+    const Scalar t4 = 2.0*w.cq[0]*w.sq[0];
     const Scalar d0 = C20*h0 - Ia1*t4;
     const Scalar qq0 = h0*t4 + Ia1*C20;
     const Scalar t5 = -0.01 + 0.5*Ia3;
@@ -5400,10 +5400,10 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar m1 = 0.00065 + 0.5*Ia9;
     const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 - 0.08718915247898762*qq0;
     const Scalar t7 = -0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq_l_hip_yaw_link*Ia2 - 0.9961917745544759*w.sq_l_hip_yaw_link*Ia5 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia2 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia5;
+    const Scalar t8 = 0.9961917745544759*w.cq[0]*Ia2 - 0.9961917745544759*w.sq[0]*Ia5 - 0.08718915247898762*w.sq[0]*Ia2 - 0.08718915247898762*w.cq[0]*Ia5;
     const Scalar t9 = 0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
     const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 + 0.08718915247898762*qq0;
-    const Scalar t11 = 0.08718915247898762*w.cq_l_hip_yaw_link*Ia2 - 0.08718915247898762*w.sq_l_hip_yaw_link*Ia5 + 0.9961917745544759*w.sq_l_hip_yaw_link*Ia2 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia5;
+    const Scalar t11 = 0.08718915247898762*w.cq[0]*Ia2 - 0.08718915247898762*w.sq[0]*Ia5 + 0.9961917745544759*w.sq[0]*Ia2 + 0.9961917745544759*w.cq[0]*Ia5;
     const Scalar t14 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 - 0.08718915247898762*qq1;
     const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
     const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
@@ -5419,15 +5419,15 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RES
     const Scalar t26 = 0.08718915247898762*t14 + 0.9961917745544759*t15;
     const Scalar t27 = 0.9961917745544759*t16 - 0.08718915247898762*t17;
     const Scalar t28 = 0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq_l_hip_yaw_link*Ia8 - 0.08718915247898762*w.cq_l_hip_yaw_link*Ia8;
-    const Scalar t30 = -0.08718915247898762*w.sq_l_hip_yaw_link*Ia8 + 0.9961917745544759*w.cq_l_hip_yaw_link*Ia8;
+    const Scalar t29 = -0.9961917745544759*w.sq[0]*Ia8 - 0.08718915247898762*w.cq[0]*Ia8;
+    const Scalar t30 = -0.08718915247898762*w.sq[0]*Ia8 + 0.9961917745544759*w.cq[0]*Ia8;
     const Scalar t31 = 0.0875*t8 + t25;
     const Scalar t32 = 0.0875*t11 + t27;
     const Scalar t33 = 0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq_l_hip_yaw_link*pa0 - w.sq_l_hip_yaw_link*pa1;
-    const Scalar t35 = w.sq_l_hip_yaw_link*pa0 + w.cq_l_hip_yaw_link*pa1;
-    const Scalar t36 = w.cq_l_hip_yaw_link*pa3 - w.sq_l_hip_yaw_link*pa4;
-    const Scalar t37 = w.sq_l_hip_yaw_link*pa3 + w.cq_l_hip_yaw_link*pa4;
+    const Scalar t34 = w.cq[0]*pa0 - w.sq[0]*pa1;
+    const Scalar t35 = w.sq[0]*pa0 + w.cq[0]*pa1;
+    const Scalar t36 = w.cq[0]*pa3 - w.sq[0]*pa4;
+    const Scalar t37 = w.sq[0]*pa3 + w.cq[0]*pa4;
     const Scalar t38 = 0.9961917745544759*t34 - 0.08718915247898762*t35;
     const Scalar t39 = 0.08718915247898762*t34 + 0.9961917745544759*t35;
     w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
@@ -5464,10 +5464,10 @@ PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RES
       const Scalar t41 = w.KA_l_hip_yaw_link[1][j] - w.IA_l_hip_yaw_link[10]*w.KSD_l_hip_yaw_link[j];
       const Scalar t42 = w.KA_l_hip_yaw_link[2][j] - w.IA_l_hip_yaw_link[14]*w.KSD_l_hip_yaw_link[j];
       const Scalar t43 = w.KA_l_hip_yaw_link[4][j] - w.IA_l_hip_yaw_link[19]*w.KSD_l_hip_yaw_link[j];
-      const Scalar t44 = w.cq_l_hip_yaw_link*t40 - w.sq_l_hip_yaw_link*t41;
-      const Scalar t45 = w.sq_l_hip_yaw_link*t40 + w.cq_l_hip_yaw_link*t41;
-      const Scalar t46 = w.cq_l_hip_yaw_link*w.KA_l_hip_yaw_link[3][j] - w.sq_l_hip_yaw_link*t43;
-      const Scalar t47 = w.sq_l_hip_yaw_link*w.KA_l_hip_yaw_link[3][j] + w.cq_l_hip_yaw_link*t43;
+      const Scalar t44 = w.cq[0]*t40 - w.sq[0]*t41;
+      const Scalar t45 = w.sq[0]*t40 + w.cq[0]*t41;
+      const Scalar t46 = w.cq[0]*w.KA_l_hip_yaw_link[3][j] - w.sq[0]*t43;
+      const Scalar t47 = w.sq[0]*w.KA_l_hip_yaw_link[3][j] + w.cq[0]*t43;
       const Scalar t48 = 0.9961917745544759*t44 - 0.08718915247898762*t45;
       const Scalar t49 = 0.08718915247898762*t44 + 0.9961917745544759*t45;
       w.KA_pelvis[0][j] = t48;
@@ -5820,10 +5820,10 @@ PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_
     const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
     const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
     const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq[0]*t24 + w.sq[0]*t25;
+    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq[0]*t24 + w.cq[0]*t25;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq[0]*t26 + w.sq[0]*t27;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq[0]*t26 + w.cq[0]*t27;
     const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
     w.a_l_hip_yaw_link[0] = t28;
     w.a_l_hip_yaw_link[1] = t29;
@@ -5836,18 +5836,18 @@ PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_
 
 PROXGEN_RT_NOINLINE void pv_free_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_40(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], w.a_l_hip_roll_link, w.Dinv_l_hip_roll_link);
+  shared_40(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], w.a_l_hip_roll_link, w.Dinv_l_hip_roll_link);
   // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_41(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
+  shared_41(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
   // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_42(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
+  shared_42(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_43(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
+  shared_43(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
   // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_44(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, w.a_l_foot);
+  shared_44(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, w.a_l_foot);
   // free acceleration (lambda = 0): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -5856,10 +5856,10 @@ PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXG
     const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
     const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
     const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq[6]*t18 + w.sq[6]*t19;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq[6]*t18 + w.cq[6]*t19;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq[6]*t20 + w.sq[6]*t21;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq[6]*t20 + w.cq[6]*t21;
     const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
     w.a_r_hip_yaw_link[0] = t22;
     w.a_r_hip_yaw_link[1] = t23;
@@ -5872,26 +5872,26 @@ PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXG
 
 PROXGEN_RT_NOINLINE void pv_free_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_40(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], w.a_r_hip_roll_link, w.Dinv_r_hip_roll_link);
+  shared_40(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], w.a_r_hip_roll_link, w.Dinv_r_hip_roll_link);
   // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_41(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
+  shared_41(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
   // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_42(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
+  shared_42(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_43(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
+  shared_43(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
   // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_44(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, w.a_r_foot);
+  shared_44(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, w.a_r_foot);
   // free acceleration (lambda = 0): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
     const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t18 = w.c_abdomen[0] + w.cq[12]*t16 + w.sq[12]*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq[12]*t16 + w.cq[12]*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
     const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
     w.a_abdomen[0] = t18;
     w.a_abdomen[1] = t19;
@@ -5907,10 +5907,10 @@ PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGE
   {
     const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
     const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
-    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t2 = w.c_chest[0] + w.cq[13]*t0 - w.a_abdomen[2]*w.sq[13];
+    const Scalar t3 = w.c_chest[2] + w.sq[13]*t0 + w.a_abdomen[2]*w.cq[13];
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq[13] - w.a_abdomen[5]*w.sq[13];
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq[13] + w.a_abdomen[5]*w.cq[13];
     const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
     w.a_chest[0] = t2;
     w.a_chest[1] = t1;
@@ -5930,10 +5930,10 @@ PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGE
     const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
     const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
     const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t10 - w.sq[23]*t12;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t10 + w.cq[23]*t12;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t13 - w.sq[23]*t15;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t13 + w.cq[23]*t15;
     const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
     w.a_r_shoulder_pitch_link[0] = t16;
     w.a_r_shoulder_pitch_link[1] = t11;
@@ -5944,10 +5944,10 @@ PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGE
   }
   // free acceleration (lambda = 0): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[1] + w.sq[24]*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq[24]*w.a_r_shoulder_pitch_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[4] + w.sq[24]*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq[24]*w.a_r_shoulder_pitch_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[5];
     const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
     w.a_r_shoulder_roll_link[1] = t21;
@@ -5961,10 +5961,10 @@ PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGE
 PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
+    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
+    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
+    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
     const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
     w.a_r_upper_arm[0] = t0;
     w.a_r_upper_arm[1] = t1;
@@ -5981,10 +5981,10 @@ PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROX
     const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
     const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
     const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
+    const Scalar t11 = w.c_r_forearm[0] + w.cq[26]*t7 - w.sq[26]*t8;
+    const Scalar t12 = w.c_r_forearm[2] + w.sq[26]*t7 + w.cq[26]*t8;
+    const Scalar t13 = w.c_r_forearm[3] + w.cq[26]*t9 - w.sq[26]*t10;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq[26]*t9 + w.cq[26]*t10;
     const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
     w.a_r_forearm[0] = t11;
     w.a_r_forearm[1] = t6;
@@ -5997,10 +5997,10 @@ PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROX
   {
     const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
     const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t16 + w.sq[27]*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t16 + w.cq[27]*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq[27]*w.a_r_forearm[3] + w.sq[27]*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq[27]*w.a_r_forearm[3] + w.cq[27]*w.a_r_forearm[4];
     const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
     w.a_r_wrist_yaw_link[0] = t18;
     w.a_r_wrist_yaw_link[1] = t19;
@@ -6014,10 +6014,10 @@ PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROX
 PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
-    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
-    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
-    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq[28] - w.a_r_wrist_yaw_link[2]*w.sq[28];
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq[28] + w.a_r_wrist_yaw_link[2]*w.cq[28];
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq[28] - w.a_r_wrist_yaw_link[5]*w.sq[28];
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq[28] + w.a_r_wrist_yaw_link[5]*w.cq[28];
     const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
     w.a_r_wrist_pitch_link[0] = t0;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
@@ -6028,10 +6028,10 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
   }
   // free acceleration (lambda = 0): body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t5 = w.c_r_hand[1] + w.cq[29]*w.a_r_wrist_pitch_link[1] + w.sq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq[29]*w.a_r_wrist_pitch_link[1] + w.cq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq[29]*w.a_r_wrist_pitch_link[4] + w.sq[29]*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq[29]*w.a_r_wrist_pitch_link[4] + w.cq[29]*w.a_r_wrist_pitch_link[5];
     const Scalar t9 = w.u_r_hand[0] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
     w.a_r_hand[1] = t5;
@@ -6750,10 +6750,10 @@ PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_
     const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
     const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
     const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq_l_hip_yaw_link*t24 + w.sq_l_hip_yaw_link*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq_l_hip_yaw_link*t24 + w.cq_l_hip_yaw_link*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq_l_hip_yaw_link*t26 + w.sq_l_hip_yaw_link*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq_l_hip_yaw_link*t26 + w.cq_l_hip_yaw_link*t27;
+    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq[0]*t24 + w.sq[0]*t25;
+    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq[0]*t24 + w.cq[0]*t25;
+    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq[0]*t26 + w.sq[0]*t27;
+    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq[0]*t26 + w.cq[0]*t27;
     const Scalar t32 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[5][0]*w.lambda[0] - w.KA_l_hip_yaw_link[5][1]*w.lambda[1] - w.KA_l_hip_yaw_link[5][2]*w.lambda[2] - w.KA_l_hip_yaw_link[5][3]*w.lambda[3] - w.KA_l_hip_yaw_link[5][4]*w.lambda[4] - w.KA_l_hip_yaw_link[5][5]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
     w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
     w.a_l_hip_yaw_link[0] = t28;
@@ -6767,18 +6767,18 @@ PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_
 
 PROXGEN_RT_NOINLINE void pv_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_45(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, w.cq_l_hip_roll_link, w.sq_l_hip_roll_link, w.u_l_hip_roll_link, w.KA_l_hip_roll_link, 0, w.lambda, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
+  shared_45(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, w.KA_l_hip_roll_link, 0, w.lambda, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_46(w.a_l_hip_roll_link, w.c_l_thigh, w.cq_l_thigh, w.sq_l_thigh, w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
+  shared_46(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
   // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_47(w.a_l_thigh, w.c_l_shank, w.cq_l_shank, w.sq_l_shank, w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
+  shared_47(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_48(w.a_l_shank, w.c_l_ankle_link, w.cq_l_ankle_link, w.sq_l_ankle_link, w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
+  shared_48(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_49(&w.c_l_foot[1], w.cq_l_foot, w.a_l_ankle_link, w.sq_l_foot, w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
+  shared_49(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
   // accelerate, with the multipliers of the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
@@ -6787,10 +6787,10 @@ PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PR
     const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
     const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
     const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq_r_hip_yaw_link*t18 + w.sq_r_hip_yaw_link*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq_r_hip_yaw_link*t18 + w.cq_r_hip_yaw_link*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq_r_hip_yaw_link*t20 + w.sq_r_hip_yaw_link*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq_r_hip_yaw_link*t20 + w.cq_r_hip_yaw_link*t21;
+    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq[6]*t18 + w.sq[6]*t19;
+    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq[6]*t18 + w.cq[6]*t19;
+    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq[6]*t20 + w.sq[6]*t21;
+    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq[6]*t20 + w.cq[6]*t21;
     const Scalar t26 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[5][0]*w.lambda[6] - w.KA_r_hip_yaw_link[5][1]*w.lambda[7] - w.KA_r_hip_yaw_link[5][2]*w.lambda[8] - w.KA_r_hip_yaw_link[5][3]*w.lambda[9] - w.KA_r_hip_yaw_link[5][4]*w.lambda[10] - w.KA_r_hip_yaw_link[5][5]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
     w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
     w.a_r_hip_yaw_link[0] = t22;
@@ -6804,26 +6804,26 @@ PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PR
 
 PROXGEN_RT_NOINLINE void pv_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_45(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, w.cq_r_hip_roll_link, w.sq_r_hip_roll_link, w.u_r_hip_roll_link, w.KA_r_hip_roll_link, 0, &w.lambda[6], &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
+  shared_45(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, w.KA_r_hip_roll_link, 0, &w.lambda[6], &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_46(w.a_r_hip_roll_link, w.c_r_thigh, w.cq_r_thigh, w.sq_r_thigh, w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
+  shared_46(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
   // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_47(w.a_r_thigh, w.c_r_shank, w.cq_r_shank, w.sq_r_shank, w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
+  shared_47(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_48(w.a_r_shank, w.c_r_ankle_link, w.cq_r_ankle_link, w.sq_r_ankle_link, w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
+  shared_48(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_49(&w.c_r_foot[1], w.cq_r_foot, w.a_r_ankle_link, w.sq_r_foot, w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
+  shared_49(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
   // accelerate, with the multipliers of the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
     const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq_abdomen*t16 + w.sq_abdomen*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq_abdomen*t16 + w.cq_abdomen*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq_abdomen + w.a_pelvis[4]*w.sq_abdomen;
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq_abdomen + w.a_pelvis[4]*w.cq_abdomen;
+    const Scalar t18 = w.c_abdomen[0] + w.cq[12]*t16 + w.sq[12]*t17;
+    const Scalar t19 = w.c_abdomen[1] - w.sq[12]*t16 + w.cq[12]*t17;
+    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
+    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
     const Scalar t22 = w.u_abdomen[0] - w.KA_abdomen[5][0]*w.lambda[12] - w.KA_abdomen[5][1]*w.lambda[13] - w.KA_abdomen[5][2]*w.lambda[14] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
     w.qdd[18] = w.Dinv_abdomen*t22;
     w.a_abdomen[0] = t18;
@@ -6840,10 +6840,10 @@ PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PRO
   {
     const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
     const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq_chest*t0 - w.a_abdomen[2]*w.sq_chest;
-    const Scalar t3 = w.c_chest[2] + w.sq_chest*t0 + w.a_abdomen[2]*w.cq_chest;
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq_chest - w.a_abdomen[5]*w.sq_chest;
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq_chest + w.a_abdomen[5]*w.cq_chest;
+    const Scalar t2 = w.c_chest[0] + w.cq[13]*t0 - w.a_abdomen[2]*w.sq[13];
+    const Scalar t3 = w.c_chest[2] + w.sq[13]*t0 + w.a_abdomen[2]*w.cq[13];
+    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq[13] - w.a_abdomen[5]*w.sq[13];
+    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq[13] + w.a_abdomen[5]*w.cq[13];
     const Scalar t6 = w.u_chest[0] - w.KA_chest[4][0]*w.lambda[12] - w.KA_chest[4][1]*w.lambda[13] - w.KA_chest[4][2]*w.lambda[14] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
     w.qdd[19] = w.Dinv_chest*t6;
     w.a_chest[0] = t2;
@@ -6864,10 +6864,10 @@ PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PRO
     const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
     const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
     const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq_r_shoulder_pitch_link*t10 - w.sq_r_shoulder_pitch_link*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq_r_shoulder_pitch_link*t10 + w.cq_r_shoulder_pitch_link*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq_r_shoulder_pitch_link*t13 - w.sq_r_shoulder_pitch_link*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq_r_shoulder_pitch_link*t13 + w.cq_r_shoulder_pitch_link*t15;
+    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t10 - w.sq[23]*t12;
+    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t10 + w.cq[23]*t12;
+    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t13 - w.sq[23]*t15;
+    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t13 + w.cq[23]*t15;
     const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4][0]*w.lambda[12] - w.KA_r_shoulder_pitch_link[4][1]*w.lambda[13] - w.KA_r_shoulder_pitch_link[4][2]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
     w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
     w.a_r_shoulder_pitch_link[0] = t16;
@@ -6879,10 +6879,10 @@ PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PRO
   }
   // accelerate, with the multipliers of the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[1] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[4] + w.cq_r_shoulder_roll_link*w.a_r_shoulder_pitch_link[5];
+    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[1] + w.sq[24]*w.a_r_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq[24]*w.a_r_shoulder_pitch_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[4] + w.sq[24]*w.a_r_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq[24]*w.a_r_shoulder_pitch_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[5];
     const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3][0]*w.lambda[12] - w.KA_r_shoulder_roll_link[3][1]*w.lambda[13] - w.KA_r_shoulder_roll_link[3][2]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
     w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
@@ -6897,10 +6897,10 @@ PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PRO
 PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.sq_r_upper_arm;
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[1]*w.cq_r_upper_arm;
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.sq_r_upper_arm;
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq_r_upper_arm + w.a_r_shoulder_roll_link[4]*w.cq_r_upper_arm;
+    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
+    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
+    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
+    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
     const Scalar t4 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[5][0]*w.lambda[12] - w.KA_r_upper_arm[5][1]*w.lambda[13] - w.KA_r_upper_arm[5][2]*w.lambda[14] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
     w.qdd[31] = w.Dinv_r_upper_arm*t4;
     w.a_r_upper_arm[0] = t0;
@@ -6918,10 +6918,10 @@ PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& P
     const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
     const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
     const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq_r_forearm*t7 - w.sq_r_forearm*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq_r_forearm*t7 + w.cq_r_forearm*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq_r_forearm*t9 - w.sq_r_forearm*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq_r_forearm*t9 + w.cq_r_forearm*t10;
+    const Scalar t11 = w.c_r_forearm[0] + w.cq[26]*t7 - w.sq[26]*t8;
+    const Scalar t12 = w.c_r_forearm[2] + w.sq[26]*t7 + w.cq[26]*t8;
+    const Scalar t13 = w.c_r_forearm[3] + w.cq[26]*t9 - w.sq[26]*t10;
+    const Scalar t14 = w.c_r_forearm[5] + w.sq[26]*t9 + w.cq[26]*t10;
     const Scalar t15 = w.u_r_forearm[0] - w.KA_r_forearm[4][0]*w.lambda[12] - w.KA_r_forearm[4][1]*w.lambda[13] - w.KA_r_forearm[4][2]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
     w.qdd[32] = w.Dinv_r_forearm*t15;
     w.a_r_forearm[0] = t11;
@@ -6935,10 +6935,10 @@ PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& P
   {
     const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
     const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq_r_wrist_yaw_link*t16 + w.sq_r_wrist_yaw_link*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq_r_wrist_yaw_link*t16 + w.cq_r_wrist_yaw_link*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[3] + w.sq_r_wrist_yaw_link*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq_r_wrist_yaw_link*w.a_r_forearm[3] + w.cq_r_wrist_yaw_link*w.a_r_forearm[4];
+    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t16 + w.sq[27]*t17;
+    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t16 + w.cq[27]*t17;
+    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq[27]*w.a_r_forearm[3] + w.sq[27]*w.a_r_forearm[4];
+    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq[27]*w.a_r_forearm[3] + w.cq[27]*w.a_r_forearm[4];
     const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[5][1]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
     w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
     w.a_r_wrist_yaw_link[0] = t18;
@@ -6953,10 +6953,10 @@ PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& P
 PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[2]*w.sq_r_wrist_pitch_link;
-    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[2]*w.cq_r_wrist_pitch_link;
-    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq_r_wrist_pitch_link - w.a_r_wrist_yaw_link[5]*w.sq_r_wrist_pitch_link;
-    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq_r_wrist_pitch_link + w.a_r_wrist_yaw_link[5]*w.cq_r_wrist_pitch_link;
+    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq[28] - w.a_r_wrist_yaw_link[2]*w.sq[28];
+    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq[28] + w.a_r_wrist_yaw_link[2]*w.cq[28];
+    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq[28] - w.a_r_wrist_yaw_link[5]*w.sq[28];
+    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq[28] + w.a_r_wrist_yaw_link[5]*w.cq[28];
     const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[4][1]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
     w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
     w.a_r_wrist_pitch_link[0] = t0;
@@ -6968,10 +6968,10 @@ PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROX
   }
   // accelerate, with the multipliers of the subtree rows: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t5 = w.c_r_hand[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[1] + w.sq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t6 = w.c_r_hand[2] - w.sq_r_hand*w.a_r_wrist_pitch_link[1] + w.cq_r_hand*w.a_r_wrist_pitch_link[2];
-    const Scalar t7 = w.c_r_hand[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[4] + w.sq_r_hand*w.a_r_wrist_pitch_link[5];
-    const Scalar t8 = w.c_r_hand[5] - w.sq_r_hand*w.a_r_wrist_pitch_link[4] + w.cq_r_hand*w.a_r_wrist_pitch_link[5];
+    const Scalar t5 = w.c_r_hand[1] + w.cq[29]*w.a_r_wrist_pitch_link[1] + w.sq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t6 = w.c_r_hand[2] - w.sq[29]*w.a_r_wrist_pitch_link[1] + w.cq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t7 = w.c_r_hand[4] + w.cq[29]*w.a_r_wrist_pitch_link[4] + w.sq[29]*w.a_r_wrist_pitch_link[5];
+    const Scalar t8 = w.c_r_hand[5] - w.sq[29]*w.a_r_wrist_pitch_link[4] + w.cq[29]*w.a_r_wrist_pitch_link[5];
     const Scalar t9 = w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
     w.qdd[35] = 193.62412145174838*t9;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
@@ -7016,6 +7016,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+  proxgen_rt::sincos_run<30>(&q[7], &w.sq[0], &w.cq[0]);
   kinematics_pelvis_to_l_hip_yaw_link(q, v, w);
   kinematics_l_hip_roll_link_to_l_thigh(q, v, w);
   kinematics_l_shank_to_l_ankle_link(q, v, w);

@@ -191,178 +191,120 @@ struct Settings {
 // Everything one solve writes (23024 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
+  Scalar sq[30];               // sin q of the revolute joints (q order)
+  Scalar cq[30];               // cos q of the revolute joints (q order)
   Scalar RJ_pelvis[3][3];      // joint rotation, body 1
   Scalar pA_pelvis[6];         // bias force, body 1
   Scalar g_pelvis[3];          // gravity in body coordinates, body 1
-  Scalar sq_l_hip_yaw_link;    // sin q, body 2
-  Scalar cq_l_hip_yaw_link;    // cos q, body 2
   Scalar v_l_hip_yaw_link[6];  // velocity, body 2
   Scalar c_l_hip_yaw_link[6];  // velocity-product acceleration, body 2
   Scalar pA_l_hip_yaw_link[6]; // bias force, body 2
   Scalar g_l_hip_yaw_link[3];  // gravity in body coordinates, body 2
-  Scalar sq_l_hip_roll_link;   // sin q, body 3
-  Scalar cq_l_hip_roll_link;   // cos q, body 3
   Scalar v_l_hip_roll_link[6]; // velocity, body 3
   Scalar c_l_hip_roll_link[6]; // velocity-product acceleration, body 3
   Scalar pA_l_hip_roll_link[6]; // bias force, body 3
   Scalar g_l_hip_roll_link[3]; // gravity in body coordinates, body 3
-  Scalar sq_l_thigh;           // sin q, body 4
-  Scalar cq_l_thigh;           // cos q, body 4
   Scalar v_l_thigh[6];         // velocity, body 4
   Scalar c_l_thigh[6];         // velocity-product acceleration, body 4
   Scalar pA_l_thigh[6];        // bias force, body 4
   Scalar g_l_thigh[3];         // gravity in body coordinates, body 4
-  Scalar sq_l_shank;           // sin q, body 5
-  Scalar cq_l_shank;           // cos q, body 5
   Scalar v_l_shank[6];         // velocity, body 5
   Scalar c_l_shank[6];         // velocity-product acceleration, body 5
   Scalar pA_l_shank[6];        // bias force, body 5
   Scalar g_l_shank[3];         // gravity in body coordinates, body 5
-  Scalar sq_l_ankle_link;      // sin q, body 6
-  Scalar cq_l_ankle_link;      // cos q, body 6
   Scalar v_l_ankle_link[6];    // velocity, body 6
   Scalar c_l_ankle_link[6];    // velocity-product acceleration, body 6
   Scalar pA_l_ankle_link[6];   // bias force, body 6
   Scalar g_l_ankle_link[3];    // gravity in body coordinates, body 6
-  Scalar sq_l_foot;            // sin q, body 7
-  Scalar cq_l_foot;            // cos q, body 7
   Scalar v_l_foot[6];          // velocity, body 7
   Scalar c_l_foot[6];          // velocity-product acceleration, body 7
   Scalar pA_l_foot[6];         // bias force, body 7
   Scalar g_l_foot[3];          // gravity in body coordinates, body 7
   Scalar k_left_foot[6];       // constraint right-hand side, constraint 0
-  Scalar sq_r_hip_yaw_link;    // sin q, body 8
-  Scalar cq_r_hip_yaw_link;    // cos q, body 8
   Scalar v_r_hip_yaw_link[6];  // velocity, body 8
   Scalar c_r_hip_yaw_link[6];  // velocity-product acceleration, body 8
   Scalar pA_r_hip_yaw_link[6]; // bias force, body 8
   Scalar g_r_hip_yaw_link[3];  // gravity in body coordinates, body 8
-  Scalar sq_r_hip_roll_link;   // sin q, body 9
-  Scalar cq_r_hip_roll_link;   // cos q, body 9
   Scalar v_r_hip_roll_link[6]; // velocity, body 9
   Scalar c_r_hip_roll_link[6]; // velocity-product acceleration, body 9
   Scalar pA_r_hip_roll_link[6]; // bias force, body 9
   Scalar g_r_hip_roll_link[3]; // gravity in body coordinates, body 9
-  Scalar sq_r_thigh;           // sin q, body 10
-  Scalar cq_r_thigh;           // cos q, body 10
   Scalar v_r_thigh[6];         // velocity, body 10
   Scalar c_r_thigh[6];         // velocity-product acceleration, body 10
   Scalar pA_r_thigh[6];        // bias force, body 10
   Scalar g_r_thigh[3];         // gravity in body coordinates, body 10
-  Scalar sq_r_shank;           // sin q, body 11
-  Scalar cq_r_shank;           // cos q, body 11
   Scalar v_r_shank[6];         // velocity, body 11
   Scalar c_r_shank[6];         // velocity-product acceleration, body 11
   Scalar pA_r_shank[6];        // bias force, body 11
   Scalar g_r_shank[3];         // gravity in body coordinates, body 11
-  Scalar sq_r_ankle_link;      // sin q, body 12
-  Scalar cq_r_ankle_link;      // cos q, body 12
   Scalar v_r_ankle_link[6];    // velocity, body 12
   Scalar c_r_ankle_link[6];    // velocity-product acceleration, body 12
   Scalar pA_r_ankle_link[6];   // bias force, body 12
   Scalar g_r_ankle_link[3];    // gravity in body coordinates, body 12
-  Scalar sq_r_foot;            // sin q, body 13
-  Scalar cq_r_foot;            // cos q, body 13
   Scalar v_r_foot[6];          // velocity, body 13
   Scalar c_r_foot[6];          // velocity-product acceleration, body 13
   Scalar pA_r_foot[6];         // bias force, body 13
   Scalar g_r_foot[3];          // gravity in body coordinates, body 13
   Scalar k_right_foot[6];      // constraint right-hand side, constraint 1
-  Scalar sq_abdomen;           // sin q, body 14
-  Scalar cq_abdomen;           // cos q, body 14
   Scalar v_abdomen[6];         // velocity, body 14
   Scalar c_abdomen[6];         // velocity-product acceleration, body 14
   Scalar pA_abdomen[6];        // bias force, body 14
   Scalar g_abdomen[3];         // gravity in body coordinates, body 14
-  Scalar sq_chest;             // sin q, body 15
-  Scalar cq_chest;             // cos q, body 15
   Scalar v_chest[6];           // velocity, body 15
   Scalar c_chest[6];           // velocity-product acceleration, body 15
   Scalar pA_chest[6];          // bias force, body 15
   Scalar g_chest[3];           // gravity in body coordinates, body 15
-  Scalar sq_l_shoulder_pitch_link; // sin q, body 16
-  Scalar cq_l_shoulder_pitch_link; // cos q, body 16
   Scalar v_l_shoulder_pitch_link[6]; // velocity, body 16
   Scalar c_l_shoulder_pitch_link[6]; // velocity-product acceleration, body 16
   Scalar pA_l_shoulder_pitch_link[6]; // bias force, body 16
-  Scalar sq_l_shoulder_roll_link; // sin q, body 17
-  Scalar cq_l_shoulder_roll_link; // cos q, body 17
   Scalar v_l_shoulder_roll_link[6]; // velocity, body 17
   Scalar c_l_shoulder_roll_link[6]; // velocity-product acceleration, body 17
   Scalar pA_l_shoulder_roll_link[6]; // bias force, body 17
-  Scalar sq_l_upper_arm;       // sin q, body 18
-  Scalar cq_l_upper_arm;       // cos q, body 18
   Scalar v_l_upper_arm[6];     // velocity, body 18
   Scalar c_l_upper_arm[6];     // velocity-product acceleration, body 18
   Scalar pA_l_upper_arm[6];    // bias force, body 18
-  Scalar sq_l_forearm;         // sin q, body 19
-  Scalar cq_l_forearm;         // cos q, body 19
   Scalar v_l_forearm[6];       // velocity, body 19
   Scalar c_l_forearm[6];       // velocity-product acceleration, body 19
   Scalar pA_l_forearm[6];      // bias force, body 19
-  Scalar sq_l_wrist_yaw_link;  // sin q, body 20
-  Scalar cq_l_wrist_yaw_link;  // cos q, body 20
   Scalar v_l_wrist_yaw_link[6]; // velocity, body 20
   Scalar c_l_wrist_yaw_link[6]; // velocity-product acceleration, body 20
   Scalar pA_l_wrist_yaw_link[6]; // bias force, body 20
-  Scalar sq_l_wrist_pitch_link; // sin q, body 21
-  Scalar cq_l_wrist_pitch_link; // cos q, body 21
   Scalar v_l_wrist_pitch_link[6]; // velocity, body 21
   Scalar c_l_wrist_pitch_link[6]; // velocity-product acceleration, body 21
   Scalar pA_l_wrist_pitch_link[6]; // bias force, body 21
-  Scalar sq_l_hand;            // sin q, body 22
-  Scalar cq_l_hand;            // cos q, body 22
   Scalar v_l_hand[6];          // velocity, body 22
   Scalar c_l_hand[6];          // velocity-product acceleration, body 22
   Scalar pA_l_hand[6];         // bias force, body 22
-  Scalar sq_neck_link;         // sin q, body 23
-  Scalar cq_neck_link;         // cos q, body 23
   Scalar v_neck_link[6];       // velocity, body 23
   Scalar c_neck_link[6];       // velocity-product acceleration, body 23
   Scalar pA_neck_link[6];      // bias force, body 23
-  Scalar sq_head;              // sin q, body 24
-  Scalar cq_head;              // cos q, body 24
   Scalar v_head[6];            // velocity, body 24
   Scalar c_head[6];            // velocity-product acceleration, body 24
   Scalar pA_head[6];           // bias force, body 24
-  Scalar sq_r_shoulder_pitch_link; // sin q, body 25
-  Scalar cq_r_shoulder_pitch_link; // cos q, body 25
   Scalar v_r_shoulder_pitch_link[6]; // velocity, body 25
   Scalar c_r_shoulder_pitch_link[6]; // velocity-product acceleration, body 25
   Scalar pA_r_shoulder_pitch_link[6]; // bias force, body 25
   Scalar g_r_shoulder_pitch_link[3]; // gravity in body coordinates, body 25
-  Scalar sq_r_shoulder_roll_link; // sin q, body 26
-  Scalar cq_r_shoulder_roll_link; // cos q, body 26
   Scalar v_r_shoulder_roll_link[6]; // velocity, body 26
   Scalar c_r_shoulder_roll_link[6]; // velocity-product acceleration, body 26
   Scalar pA_r_shoulder_roll_link[6]; // bias force, body 26
   Scalar g_r_shoulder_roll_link[3]; // gravity in body coordinates, body 26
-  Scalar sq_r_upper_arm;       // sin q, body 27
-  Scalar cq_r_upper_arm;       // cos q, body 27
   Scalar v_r_upper_arm[6];     // velocity, body 27
   Scalar c_r_upper_arm[6];     // velocity-product acceleration, body 27
   Scalar pA_r_upper_arm[6];    // bias force, body 27
   Scalar g_r_upper_arm[3];     // gravity in body coordinates, body 27
-  Scalar sq_r_forearm;         // sin q, body 28
-  Scalar cq_r_forearm;         // cos q, body 28
   Scalar v_r_forearm[6];       // velocity, body 28
   Scalar c_r_forearm[6];       // velocity-product acceleration, body 28
   Scalar pA_r_forearm[6];      // bias force, body 28
   Scalar g_r_forearm[3];       // gravity in body coordinates, body 28
-  Scalar sq_r_wrist_yaw_link;  // sin q, body 29
-  Scalar cq_r_wrist_yaw_link;  // cos q, body 29
   Scalar v_r_wrist_yaw_link[6]; // velocity, body 29
   Scalar c_r_wrist_yaw_link[6]; // velocity-product acceleration, body 29
   Scalar pA_r_wrist_yaw_link[6]; // bias force, body 29
   Scalar g_r_wrist_yaw_link[3]; // gravity in body coordinates, body 29
-  Scalar sq_r_wrist_pitch_link; // sin q, body 30
-  Scalar cq_r_wrist_pitch_link; // cos q, body 30
   Scalar v_r_wrist_pitch_link[6]; // velocity, body 30
   Scalar c_r_wrist_pitch_link[6]; // velocity-product acceleration, body 30
   Scalar pA_r_wrist_pitch_link[6]; // bias force, body 30
   Scalar g_r_wrist_pitch_link[3]; // gravity in body coordinates, body 30
-  Scalar sq_r_hand;            // sin q, body 31
-  Scalar cq_r_hand;            // cos q, body 31
   Scalar v_r_hand[6];          // velocity, body 31
   Scalar c_r_hand[6];          // velocity-product acceleration, body 31
   Scalar pA_r_hand[6];         // bias force, body 31

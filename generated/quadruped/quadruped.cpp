@@ -42,7 +42,7 @@
 
 #include "quadruped.hpp"
 
-#include "proxgen/runtime.hpp"
+#include "proxgen/lanes.hpp"  // the runtime, and the lanes of sincos_run
 
 namespace quadruped {
 
@@ -62,7 +62,7 @@ using MultiplierRows = const Scalar*;
 constexpr Scalar shared_0_k0[11] = {0.9900990099009903, 0.009900990099009688, -0.09950371902099893, 0.09900990099009904, -0.09900990099009904, 0.09950371902099893, -0.9950371902099893, 0.09900990099009904, -0.09900990099009904, 0.9950371902099893, 0.009900990099009905};
 constexpr Scalar shared_0_k1[11] = {0.9900990099009901, 0.00990099009900991, 0.09950371902099892, -0.09900990099009901, 0.09900990099009901, -0.09950371902099892, -0.9950371902099892, -0.09900990099009901, 0.09900990099009901, 0.9950371902099892, 0.009900990099009901};
 PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col) noexcept {
-  proxgen_rt::sincos(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint(q[0], sq_m0[0], cq_m1[0]);
   RJ_m2[0][RJ_m2_col + 0] = k[0] + k[1]*cq_m1[0];
   RJ_m2[0][RJ_m2_col + 1] = k[2]*sq_m0[0];
   RJ_m2[0][RJ_m2_col + 2] = k[3] + k[4]*cq_m1[0];
@@ -76,21 +76,21 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 // 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank.
 // The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
 PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1) noexcept {
-  proxgen_rt::sincos(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint(q[0], sq_m0[0], cq_m1[0]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_thigh, RF_thigh.
 // The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
 constexpr Scalar shared_2_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
 constexpr Scalar shared_2_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
-PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
   const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
   const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
-  v_m1[0] = cq_m2*x0 - sq_m3*x1;
-  v_m1[2] = sq_m3*x0 + cq_m2*x1;
-  v_m1[3] = cq_m2*v_m0[3] - sq_m3*v_m0[5];
+  v_m1[0] = cq_m2[0]*x0 - sq_m3[0]*x1;
+  v_m1[2] = sq_m3[0]*x0 + cq_m2[0]*x1;
+  v_m1[3] = cq_m2[0]*v_m0[3] - sq_m3[0]*v_m0[5];
   v_m1[4] = v_m0[4] + v[0];
-  v_m1[5] = sq_m3*v_m0[3] + cq_m2*v_m0[5];
+  v_m1[5] = sq_m3[0]*v_m0[3] + cq_m2[0]*v_m0[5];
   c_m4[0] = -v[0]*v_m1[2];
   c_m4[2] = v[0]*v_m1[0];
   c_m4[3] = -v[0]*v_m1[5];
@@ -107,23 +107,23 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
   pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
   pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
-  g_m6[0] = cq_m2*g_m7[0] - sq_m3*g_m7[2];
-  g_m6[2] = sq_m3*g_m7[0] + cq_m2*g_m7[2];
+  g_m6[0] = cq_m2[0]*g_m7[0] - sq_m3[0]*g_m7[2];
+  g_m6[2] = sq_m3[0]*g_m7[0] + cq_m2[0]*g_m7[2];
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_shank, RF_shank.
 // The first: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
 constexpr Scalar shared_3_k0[2] = {0.004, -0.004};
 constexpr Scalar shared_3_k1[2] = {-0.004, 0.004};
-PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
   const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
   const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
-  v_m2[0] = cq_m3*x0 - v_m0[2]*sq_m4;
+  v_m2[0] = cq_m3[0]*x0 - v_m0[2]*sq_m4[0];
   v_m2[1] = x1;
-  v_m2[2] = sq_m4*x0 + v_m0[2]*cq_m3;
-  v_m2[3] = v_m0[3]*cq_m3 - v_m0[5]*sq_m4;
+  v_m2[2] = sq_m4[0]*x0 + v_m0[2]*cq_m3[0];
+  v_m2[3] = v_m0[3]*cq_m3[0] - v_m0[5]*sq_m4[0];
   v_m2[4] = v_m0[4] + v[0];
-  v_m2[5] = v_m0[3]*sq_m4 + v_m0[5]*cq_m3;
+  v_m2[5] = v_m0[3]*sq_m4[0] + v_m0[5]*cq_m3[0];
   c_m5[0] = -v[0]*v_m2[2];
   c_m5[2] = v[0]*v_m2[0];
   c_m5[3] = -v[0]*v_m2[5];
@@ -138,8 +138,8 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
   pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
   pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
-  g_m7[0] = g_m8[0]*cq_m3 - g_m8[2]*sq_m4;
-  g_m7[2] = g_m8[0]*sq_m4 + g_m8[2]*cq_m3;
+  g_m7[0] = g_m8[0]*cq_m3[0] - g_m8[2]*sq_m4[0];
+  g_m7[2] = g_m8[0]*sq_m4[0] + g_m8[2]*cq_m3[0];
   const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
   const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
   const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
@@ -152,14 +152,14 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 // The first: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
 constexpr Scalar shared_4_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
 constexpr Scalar shared_4_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
-PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
   const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
   const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
-  v_m1[0] = cq_m2*x0 - sq_m3*x1;
-  v_m1[2] = sq_m3*x0 + cq_m2*x1;
-  v_m1[3] = v_m0[3]*cq_m2 - v_m0[5]*sq_m3;
+  v_m1[0] = cq_m2[0]*x0 - sq_m3[0]*x1;
+  v_m1[2] = sq_m3[0]*x0 + cq_m2[0]*x1;
+  v_m1[3] = v_m0[3]*cq_m2[0] - v_m0[5]*sq_m3[0];
   v_m1[4] = v_m0[4] + v[0];
-  v_m1[5] = v_m0[3]*sq_m3 + v_m0[5]*cq_m2;
+  v_m1[5] = v_m0[3]*sq_m3[0] + v_m0[5]*cq_m2[0];
   c_m4[0] = -v[0]*v_m1[2];
   c_m4[2] = v[0]*v_m1[0];
   c_m4[3] = -v[0]*v_m1[5];
@@ -176,23 +176,23 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
   pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
   pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
-  g_m6[0] = g_m7[0]*cq_m2 - g_m7[2]*sq_m3;
-  g_m6[2] = g_m7[0]*sq_m3 + g_m7[2]*cq_m2;
+  g_m6[0] = g_m7[0]*cq_m2[0] - g_m7[2]*sq_m3[0];
+  g_m6[2] = g_m7[0]*sq_m3[0] + g_m7[2]*cq_m2[0];
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: LH_shank, RH_shank.
 // The first: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
 constexpr Scalar shared_5_k0[2] = {0.004, -0.004};
 constexpr Scalar shared_5_k1[2] = {-0.004, 0.004};
-PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
   const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
   const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
-  v_m2[0] = cq_m3*x0 - sq_m4*v_m0[2];
+  v_m2[0] = cq_m3[0]*x0 - sq_m4[0]*v_m0[2];
   v_m2[1] = x1;
-  v_m2[2] = sq_m4*x0 + cq_m3*v_m0[2];
-  v_m2[3] = cq_m3*v_m0[3] - sq_m4*v_m0[5];
+  v_m2[2] = sq_m4[0]*x0 + cq_m3[0]*v_m0[2];
+  v_m2[3] = cq_m3[0]*v_m0[3] - sq_m4[0]*v_m0[5];
   v_m2[4] = v_m0[4] + v[0];
-  v_m2[5] = sq_m4*v_m0[3] + cq_m3*v_m0[5];
+  v_m2[5] = sq_m4[0]*v_m0[3] + cq_m3[0]*v_m0[5];
   c_m5[0] = -v[0]*v_m2[2];
   c_m5[2] = v[0]*v_m2[0];
   c_m5[3] = -v[0]*v_m2[5];
@@ -207,8 +207,8 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
   pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
   pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
-  g_m7[0] = cq_m3*g_m8[0] - sq_m4*g_m8[2];
-  g_m7[2] = sq_m4*g_m8[0] + cq_m3*g_m8[2];
+  g_m7[0] = cq_m3[0]*g_m8[0] - sq_m4[0]*g_m8[2];
+  g_m7[2] = sq_m4[0]*g_m8[0] + cq_m3[0]*g_m8[2];
   const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
   const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
   const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
@@ -221,7 +221,7 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 // The first: eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
 constexpr Scalar shared_6_k0[14] = {-0.004, -0.0007800000000000001, 0.004, -0.004, -0.004, -0.004, 0.004, -0.004, -0.002, 0.002, -0.002, -0.010144, 0.010144, 0.00020288};
 constexpr Scalar shared_6_k1[14] = {0.004, 0.0007800000000000001, -0.004, 0.004, 0.004, 0.004, -0.004, 0.004, 0.002, -0.002, 0.002, 0.010144, -0.010144, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar cq_m8, Scalar sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
+PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar* PROXGEN_RT_RESTRICT cq_m8, Scalar* PROXGEN_RT_RESTRICT sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
   const Scalar x0 = mu*active_m0[0];
   const Scalar x1 = 0.195*k_m1[1] + k[0]*k_m1[2];
   U_m2[0] = -0.003904 - 0.195*x0;
@@ -242,10 +242,10 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x12 = pA_m5[2] + lambda_m6[2] - k_m1[2]*x0 + c_m7[2]*x6 + k[3]*c_m7[3]*x0;
   const Scalar x13 = pA_m5[3] + 0.195*lambda_m6[1] + k[4]*lambda_m6[2] - x0*x1 + k[5]*c_m7[2]*x0 + c_m7[3]*x8;
   const Scalar x14 = pA_m5[5] + k[6]*lambda_m6[0] + k[7]*k_m1[0]*x0 + u_m4[0]*x3 + c_m7[0]*x5 + c_m7[5]*x9;
-  const Scalar x15 = cq_m8*cq_m8 - sq_m9*sq_m9;
+  const Scalar x15 = cq_m8[0]*cq_m8[0] - sq_m9[0]*sq_m9[0];
   const Scalar x16 = 0.5*(-x4 + x6);
   const Scalar x17 = 0.5*(x4 + x6);
-  const Scalar x18 = 2.0*cq_m8*sq_m9;
+  const Scalar x18 = 2.0*cq_m8[0]*sq_m9[0];
   const Scalar x19 = k[8]*x0 + 0.5*x5;
   const Scalar x20 = 0.5*(-x8 + x9);
   const Scalar x21 = 0.5*(x8 + x9);
@@ -253,9 +253,9 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x23 = x17 + x15*x16;
   const Scalar x24 = k[9]*x0 + 0.5*x5 + x15*x19;
   const Scalar x25 = k[10]*x0 - 0.5*x5 + x15*x19;
-  const Scalar x26 = 0.209*x6 + cq_m8*x7;
-  const Scalar x27 = cq_m8*x10 + sq_m9*x12;
-  const Scalar x28 = -sq_m9*x10 + cq_m8*x12;
+  const Scalar x26 = 0.209*x6 + cq_m8[0]*x7;
+  const Scalar x27 = cq_m8[0]*x10 + sq_m9[0]*x12;
+  const Scalar x28 = -sq_m9[0]*x10 + cq_m8[0]*x12;
   IA_m10[0] = 0.6890000000000001 + x22;
   IA_m10[2] = x16*x18;
   IA_m10[3] = x18*x19;
@@ -263,30 +263,30 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   IA_m10[5] = k[11] + x24;
   IA_m10[6] = 0.6890000000000001 + x6;
   IA_m10[8] = 0.01268 + x26;
-  IA_m10[10] = -sq_m9*x7;
+  IA_m10[10] = -sq_m9[0]*x7;
   IA_m10[11] = 0.6890000000000001 + x23;
   IA_m10[12] = k[12] + x25;
   IA_m10[13] = -0.209*x16*x18;
   IA_m10[14] = -x18*x19;
-  IA_m10[15] = 0.002431904 + 0.209*cq_m8*x7 + x21 - x15*x20 + 0.209*x26;
+  IA_m10[15] = 0.002431904 + 0.209*cq_m8[0]*x7 + x21 - x15*x20 + 0.209*x26;
   IA_m10[16] = -0.209*x18*x19;
-  IA_m10[17] = -0.209*sq_m9*x7 + x18*x20;
+  IA_m10[17] = -0.209*sq_m9[0]*x7 + x18*x20;
   IA_m10[18] = 0.0024196 + 0.043681*x22;
   IA_m10[19] = k[13] - 0.209*x24;
   IA_m10[20] = 0.0006033039999999999 + x21 + x15*x20;
   pA_m11[0] = pA_m11[0] + x27;
   pA_m11[1] = pA_m11[1] + x11;
   pA_m11[2] = pA_m11[2] + x28;
-  pA_m11[3] = pA_m11[3] + 0.209*x11 + cq_m8*x13 + sq_m9*x14;
+  pA_m11[3] = pA_m11[3] + 0.209*x11 + cq_m8[0]*x13 + sq_m9[0]*x14;
   pA_m11[4] = pA_m11[4] + tau[0] - 0.209*x27;
-  pA_m11[5] = pA_m11[5] - sq_m9*x13 + cq_m8*x14;
+  pA_m11[5] = pA_m11[5] - sq_m9[0]*x13 + cq_m8[0]*x14;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
 constexpr Scalar shared_7_k0[14] = {-0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062};
 constexpr Scalar shared_7_k1[14] = {0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -308,10 +308,10 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x16 = pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[2]*x8 + c_m4[3]*x9 + c_m4[5]*x10;
   const Scalar x17 = pA_m3[3] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x9 + c_m4[3]*x11 + c_m4[5]*x12;
   const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x10 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x19 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x20 = 0.5*(-x4 + x8);
   const Scalar x21 = 0.5*(x4 + x8);
-  const Scalar x22 = 2.0*cq_m5*sq_m6;
+  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x23 = x19*x20 - x5*x22;
   const Scalar x24 = x20*x22 + x5*x19;
   const Scalar x25 = 0.5*(-x6 + x10);
@@ -327,16 +327,16 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x35 = x21 + x23;
   const Scalar x36 = x26 - x28;
   const Scalar x37 = 0.5*x7 - 0.5*x9 + x29;
-  const Scalar x38 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
-  const Scalar x39 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
+  const Scalar x38 = sq_m6[0]*IA_m1[10] + cq_m5[0]*IA_m1[8];
+  const Scalar x39 = cq_m5[0]*IA_m1[10] - sq_m6[0]*IA_m1[8];
   const Scalar x40 = -0.5*x7 + 0.5*x9 + x29;
   const Scalar x41 = x26 + x28;
   const Scalar x42 = k[0]*x24 + x36;
   const Scalar x43 = k[1]*x34 + x37;
   const Scalar x44 = k[2]*x35 + x40;
   const Scalar x45 = k[3]*x24 + x41;
-  const Scalar x46 = cq_m5*x14 + sq_m6*x16;
-  const Scalar x47 = -sq_m6*x14 + cq_m5*x16;
+  const Scalar x46 = cq_m5[0]*x14 + sq_m6[0]*x16;
+  const Scalar x47 = -sq_m6[0]*x14 + cq_m5[0]*x16;
   IA_m7[0] = 0.5950000000000001 + x34;
   IA_m7[2] = x24;
   IA_m7[3] = x42;
@@ -353,9 +353,9 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m8[0] = pA_m8[0] + x46;
   pA_m8[1] = pA_m8[1] + x15;
   pA_m8[2] = pA_m8[2] + x47;
-  pA_m8[3] = pA_m8[3] + cq_m5*x17 + sq_m6*x18 + k[12]*x47;
+  pA_m8[3] = pA_m8[3] + cq_m5[0]*x17 + sq_m6[0]*x18 + k[12]*x47;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6*x17 + cq_m5*x18 + k[13]*x46;
+  pA_m8[5] = pA_m8[5] - sq_m6[0]*x17 + cq_m5[0]*x18 + k[13]*x46;
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -363,7 +363,7 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 constexpr Scalar shared_8_k0[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
 constexpr Scalar shared_8_k1[55] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
 constexpr Scalar shared_8_k2[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
+PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
   U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
@@ -407,44 +407,44 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
   const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
   const Scalar x35 = RJ_m6[0][RJ_m6_col + 0]*x7 + RJ_m6[0][RJ_m6_col + 1]*x24 + RJ_m6[0][RJ_m6_col + 2]*x13;
-  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
-  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
-  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
+  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7[0]*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
+  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7[0]*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
+  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7[0]*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
   const Scalar x39 = RJ_m6[2][RJ_m6_col + 0]*x6 + RJ_m6[2][RJ_m6_col + 1]*x22 + RJ_m6[2][RJ_m6_col + 2]*x7;
   const Scalar x40 = RJ_m6[2][RJ_m6_col + 0]*x22 + RJ_m6[2][RJ_m6_col + 1]*x10 + RJ_m6[2][RJ_m6_col + 2]*x24;
   const Scalar x41 = RJ_m6[2][RJ_m6_col + 0]*x7 + RJ_m6[2][RJ_m6_col + 1]*x24 + RJ_m6[2][RJ_m6_col + 2]*x13;
   const Scalar x42 = RJ_m6[0][RJ_m6_col + 0]*x8 + RJ_m6[0][RJ_m6_col + 1]*x11 + RJ_m6[0][RJ_m6_col + 2]*x14;
   const Scalar x43 = RJ_m6[0][RJ_m6_col + 0]*x23 + RJ_m6[0][RJ_m6_col + 1]*x25 + RJ_m6[0][RJ_m6_col + 2]*x26;
   const Scalar x44 = RJ_m6[0][RJ_m6_col + 0]*x9 + RJ_m6[0][RJ_m6_col + 1]*x12 + RJ_m6[0][RJ_m6_col + 2]*x15;
-  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
-  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
-  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
+  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7[0]*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
+  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7[0]*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
+  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7[0]*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
   const Scalar x48 = RJ_m6[2][RJ_m6_col + 0]*x8 + RJ_m6[2][RJ_m6_col + 1]*x11 + RJ_m6[2][RJ_m6_col + 2]*x14;
   const Scalar x49 = RJ_m6[2][RJ_m6_col + 0]*x23 + RJ_m6[2][RJ_m6_col + 1]*x25 + RJ_m6[2][RJ_m6_col + 2]*x26;
   const Scalar x50 = RJ_m6[2][RJ_m6_col + 0]*x9 + RJ_m6[2][RJ_m6_col + 1]*x12 + RJ_m6[2][RJ_m6_col + 2]*x15;
   const Scalar x51 = RJ_m6[0][RJ_m6_col + 0]*x16 + RJ_m6[0][RJ_m6_col + 1]*x17 + RJ_m6[0][RJ_m6_col + 2]*x18;
   const Scalar x52 = RJ_m6[0][RJ_m6_col + 0]*x17 + RJ_m6[0][RJ_m6_col + 1]*x19 + RJ_m6[0][RJ_m6_col + 2]*x20;
   const Scalar x53 = RJ_m6[0][RJ_m6_col + 0]*x18 + RJ_m6[0][RJ_m6_col + 1]*x20 + RJ_m6[0][RJ_m6_col + 2]*x21;
-  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
-  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
-  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
+  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7[0]*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
+  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7[0]*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
+  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7[0]*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
   const Scalar x57 = RJ_m6[2][RJ_m6_col + 0]*x16 + RJ_m6[2][RJ_m6_col + 1]*x17 + RJ_m6[2][RJ_m6_col + 2]*x18;
   const Scalar x58 = RJ_m6[2][RJ_m6_col + 0]*x17 + RJ_m6[2][RJ_m6_col + 1]*x19 + RJ_m6[2][RJ_m6_col + 2]*x20;
   const Scalar x59 = RJ_m6[2][RJ_m6_col + 0]*x18 + RJ_m6[2][RJ_m6_col + 1]*x20 + RJ_m6[2][RJ_m6_col + 2]*x21;
   const Scalar x60 = RJ_m6[0][RJ_m6_col + 0]*x33 + RJ_m6[0][RJ_m6_col + 1]*x34 + RJ_m6[0][RJ_m6_col + 2]*x35;
-  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
+  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7[0]*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
   const Scalar x62 = RJ_m6[2][RJ_m6_col + 0]*x33 + RJ_m6[2][RJ_m6_col + 1]*x34 + RJ_m6[2][RJ_m6_col + 2]*x35;
-  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
+  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7[0]*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
   const Scalar x64 = RJ_m6[2][RJ_m6_col + 0]*x36 + RJ_m6[2][RJ_m6_col + 1]*x37 + RJ_m6[2][RJ_m6_col + 2]*x38;
   const Scalar x65 = RJ_m6[2][RJ_m6_col + 0]*x39 + RJ_m6[2][RJ_m6_col + 1]*x40 + RJ_m6[2][RJ_m6_col + 2]*x41;
   const Scalar x66 = RJ_m6[0][RJ_m6_col + 0]*x42 + RJ_m6[0][RJ_m6_col + 1]*x43 + RJ_m6[0][RJ_m6_col + 2]*x44;
-  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
+  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7[0]*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
   const Scalar x68 = RJ_m6[2][RJ_m6_col + 0]*x42 + RJ_m6[2][RJ_m6_col + 1]*x43 + RJ_m6[2][RJ_m6_col + 2]*x44;
   const Scalar x69 = RJ_m6[0][RJ_m6_col + 0]*x45 + RJ_m6[0][RJ_m6_col + 1]*x46 + RJ_m6[0][RJ_m6_col + 2]*x47;
-  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
+  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7[0]*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
   const Scalar x71 = RJ_m6[2][RJ_m6_col + 0]*x45 + RJ_m6[2][RJ_m6_col + 1]*x46 + RJ_m6[2][RJ_m6_col + 2]*x47;
   const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
-  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
+  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7[0]*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
   const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
   const Scalar x75 = k[23]*x62 + x66;
   const Scalar x76 = k[24]*x62 + x67;
@@ -456,7 +456,7 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   const Scalar x82 = k[32]*x65 + x73;
   const Scalar x83 = k[33]*x62 + k[34]*x64 + x74;
   const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
-  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
+  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7[0]*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
   const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
   IA_m8[0] = IA_m8[0] + x60;
   IA_m8[1] = IA_m8[1] + x61;
@@ -474,16 +474,16 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   IA_m8[13] = IA_m8[13] + x82;
   IA_m8[14] = IA_m8[14] + x83;
   IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[35]*x72 + k[36]*x81;
-  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7[0]*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
   IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[39]*x66 + k[40]*x69 + k[41]*x83;
-  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7[0]*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
   IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[44]*x67 + k[45]*x70 + k[46]*x83;
   IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[47]*x68 + k[48]*x71 + k[49]*x77 + k[50]*x80;
   pA_m9[0] = pA_m9[0] + x84;
   pA_m9[1] = pA_m9[1] + x85;
   pA_m9[2] = pA_m9[2] + x86;
   pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[51]*x86;
-  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7[0]*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
   pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[53]*x84 + k[54]*x85;
 }
 
@@ -528,15 +528,15 @@ PROXGEN_RT_NOINLINE void shared_9(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_hip.
 // The first: accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.049*a_m0[5];
   const Scalar x1 = a_m0[1] + 0.19*a_m0[5];
   const Scalar x2 = a_m0[2] + 0.049*a_m0[3] - 0.19*a_m0[4];
   const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
   const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
   const Scalar x6 = c_m1[3] + RJ_m2[0][RJ_m2_col + 0]*a_m0[3] + RJ_m2[1][RJ_m2_col + 0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 0]*a_m0[5];
-  const Scalar x7 = c_m1[4] + RJ_m2[0][RJ_m2_col + 1]*a_m0[3] + cq_m3*a_m0[4] + RJ_m2[2][RJ_m2_col + 1]*a_m0[5];
+  const Scalar x7 = c_m1[4] + RJ_m2[0][RJ_m2_col + 1]*a_m0[3] + cq_m3[0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 1]*a_m0[5];
   const Scalar x8 = c_m1[5] + RJ_m2[0][RJ_m2_col + 2]*a_m0[3] + RJ_m2[1][RJ_m2_col + 2]*a_m0[4] + RJ_m2[2][RJ_m2_col + 2]*a_m0[5];
   const Scalar x9 = u_m4[0] - 5.780668556524933e-05*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
   qdd_m6[0] = Dinv_m7*x9;
@@ -552,13 +552,13 @@ PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 // The first: accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
 constexpr Scalar shared_11_k0[2] = {-0.062, 0.062};
 constexpr Scalar shared_11_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
   const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
@@ -571,13 +571,13 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
   const Scalar x6 = u_m4[0] - U_m5[0]*x2 - U_m5[4]*a_m0[4] - U_m5[5]*x5;
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
@@ -593,15 +593,15 @@ PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 constexpr Scalar shared_13_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
 constexpr Scalar shared_13_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
 constexpr Scalar shared_13_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
   const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
   const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
   const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
   const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
   const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
   qdd_m6[0] = Dinv_m7*x9;
@@ -670,40 +670,40 @@ PROXGEN_RT_NOINLINE void shared_14(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, 
 // The first: reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
 constexpr Scalar shared_15_k0[2] = {-0.004, 0.004};
 constexpr Scalar shared_15_k1[2] = {0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] + 0.195*dlambda_m1[0];
   const Scalar x0 = 0.195*Dinv_m2*dlambda_m1[0];
   const Scalar x1 = dlambda_m1[0] + U_m3[0]*x0;
   const Scalar x2 = 0.195*dlambda_m1[1] + k[0]*dlambda_m1[2];
   const Scalar x3 = k[1]*dlambda_m1[0] + U_m3[5]*x0;
-  const Scalar x4 = cq_m4*x1 + sq_m5*dlambda_m1[2];
-  const Scalar x5 = -sq_m5*x1 + cq_m4*dlambda_m1[2];
+  const Scalar x4 = cq_m4[0]*x1 + sq_m5[0]*dlambda_m1[2];
+  const Scalar x5 = -sq_m5[0]*x1 + cq_m4[0]*dlambda_m1[2];
   dp_m6[0] = x4;
   dp_m6[1] = dlambda_m1[1];
   dp_m6[2] = x5;
-  dp_m6[3] = 0.209*dlambda_m1[1] + cq_m4*x2 + sq_m5*x3;
+  dp_m6[3] = 0.209*dlambda_m1[1] + cq_m4[0]*x2 + sq_m5[0]*x3;
   dp_m6[4] = -0.209*x4;
-  dp_m6[5] = -sq_m5*x2 + cq_m4*x3;
+  dp_m6[5] = -sq_m5[0]*x2 + cq_m4[0]*x3;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
 constexpr Scalar shared_16_k0[2] = {-0.062, 0.062};
 constexpr Scalar shared_16_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar cq_m4, Scalar sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] - dp_m1[4];
   const Scalar x0 = -Dinv_m2*dp_m1[4];
   const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
   const Scalar x2 = dp_m1[2] + IA_m3[9]*x0;
   const Scalar x3 = dp_m1[3] + IA_m3[12]*x0;
   const Scalar x4 = dp_m1[5] + IA_m3[15]*x0;
-  const Scalar x5 = cq_m4*x1 + sq_m5*x2;
-  const Scalar x6 = -sq_m5*x1 + cq_m4*x2;
+  const Scalar x5 = cq_m4[0]*x1 + sq_m5[0]*x2;
+  const Scalar x6 = -sq_m5[0]*x1 + cq_m4[0]*x2;
   dp_m6[0] = x5;
   dp_m6[1] = dp_m1[1];
   dp_m6[2] = x6;
-  dp_m6[3] = cq_m4*x3 + sq_m5*x4 + k[0]*x6;
-  dp_m6[5] = -sq_m5*x3 + cq_m4*x4 + k[1]*x5;
+  dp_m6[3] = cq_m4[0]*x3 + sq_m5[0]*x4 + k[0]*x6;
+  dp_m6[5] = -sq_m5[0]*x3 + cq_m4[0]*x4 + k[1]*x5;
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -711,7 +711,7 @@ PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 constexpr Scalar shared_17_k0[7] = {-0.9950371902099893, -0.09950371902099893, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19};
 constexpr Scalar shared_17_k1[7] = {-0.9950371902099892, 0.09950371902099892, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19};
 constexpr Scalar shared_17_k2[7] = {-0.9950371902099893, -0.09950371902099893, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dp_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar (*PROXGEN_RT_RESTRICT RJ_m4)[3], int RJ_m4_col, Scalar cq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dp_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar (*PROXGEN_RT_RESTRICT RJ_m4)[3], int RJ_m4_col, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   const Scalar x0 = k[0]*dp_m0[3] + k[1]*dp_m0[5];
   u_m1[0] = u_m1[0] + x0;
   const Scalar x1 = Dinv_m2*x0;
@@ -722,13 +722,13 @@ PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   const Scalar x6 = dp_m0[5] + U_m3[5]*x1;
   const Scalar x7 = k[2]*Dinv_m2*x0;
   const Scalar x8 = RJ_m4[0][RJ_m4_col + 0]*x2 + RJ_m4[0][RJ_m4_col + 1]*x3 + RJ_m4[0][RJ_m4_col + 2]*x4;
-  const Scalar x9 = RJ_m4[1][RJ_m4_col + 0]*x2 + cq_m5*x3 + RJ_m4[1][RJ_m4_col + 2]*x4;
+  const Scalar x9 = RJ_m4[1][RJ_m4_col + 0]*x2 + cq_m5[0]*x3 + RJ_m4[1][RJ_m4_col + 2]*x4;
   const Scalar x10 = RJ_m4[2][RJ_m4_col + 0]*x2 + RJ_m4[2][RJ_m4_col + 1]*x3 + RJ_m4[2][RJ_m4_col + 2]*x4;
   dp_m6[0] = dp_m6[0] + x8;
   dp_m6[1] = dp_m6[1] + x9;
   dp_m6[2] = dp_m6[2] + x10;
   dp_m6[3] = dp_m6[3] + RJ_m4[0][RJ_m4_col + 0]*x5 + RJ_m4[0][RJ_m4_col + 1]*x7 + RJ_m4[0][RJ_m4_col + 2]*x6 + k[3]*x10;
-  dp_m6[4] = dp_m6[4] + RJ_m4[1][RJ_m4_col + 0]*x5 + cq_m5*x7 + RJ_m4[1][RJ_m4_col + 2]*x6 + k[4]*x10;
+  dp_m6[4] = dp_m6[4] + RJ_m4[1][RJ_m4_col + 0]*x5 + cq_m5[0]*x7 + RJ_m4[1][RJ_m4_col + 2]*x6 + k[4]*x10;
   dp_m6[5] = dp_m6[5] + RJ_m4[2][RJ_m4_col + 0]*x5 + RJ_m4[2][RJ_m4_col + 1]*x7 + RJ_m4[2][RJ_m4_col + 2]*x6 + k[5]*x8 + k[6]*x9;
 }
 
@@ -736,55 +736,55 @@ PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 // The first: eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
 constexpr Scalar shared_18_k0[4] = {0.004, 0.004, -0.004, 0.004};
 constexpr Scalar shared_18_k1[4] = {-0.004, -0.004, 0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar cq_m3, Scalar sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
   u_m0[0] = -pA_m1[4] + tau[0];
   const Scalar x0 = 0.03264876250658241*c_m2[0] + pA_m1[0] - 8.030542390731965*u_m0[0];
   const Scalar x1 = 0.003904*c_m2[3] + pA_m1[1];
   const Scalar x2 = 0.064*c_m2[2] + pA_m1[2];
   const Scalar x3 = 0.000483144*c_m2[3] + pA_m1[3];
   const Scalar x4 = 6e-06*c_m2[5] + pA_m1[5];
-  const Scalar x5 = cq_m3*cq_m3 - sq_m4*sq_m4;
+  const Scalar x5 = cq_m3[0]*cq_m3[0] - sq_m4[0]*sq_m4[0];
   const Scalar x6 = 0.04832438125329121 - 0.015675618746708794*x5;
   const Scalar x7 = 0.04832438125329121 + 0.015675618746708794*x5;
-  const Scalar x8 = 0.013375999999999999 + 0.003904*cq_m3;
-  const Scalar x9 = cq_m3*x0 + sq_m4*x2;
-  const Scalar x10 = -sq_m4*x0 + cq_m3*x2;
+  const Scalar x8 = 0.013375999999999999 + 0.003904*cq_m3[0];
+  const Scalar x9 = cq_m3[0]*x0 + sq_m4[0]*x2;
+  const Scalar x10 = -sq_m4[0]*x0 + cq_m3[0]*x2;
   IA_m5[0] = 0.6890000000000001 + x6;
-  IA_m5[2] = 0.03135123749341759*cq_m3*sq_m4;
+  IA_m5[2] = 0.03135123749341759*cq_m3[0]*sq_m4[0];
   IA_m5[4] = -0.01268 - 0.209*x6;
   IA_m5[8] = 0.01268 + x8;
-  IA_m5[10] = -0.003904*sq_m4;
+  IA_m5[10] = -0.003904*sq_m4[0];
   IA_m5[11] = 0.6890000000000001 + x7;
-  IA_m5[13] = -0.006552408636124276*cq_m3*sq_m4;
-  IA_m5[15] = 0.002676476 + 0.000815936*cq_m3 + 0.00023857200000000002*x5 + 0.209*x8;
-  IA_m5[17] = -0.000815936*sq_m4 - 0.00047714400000000004*cq_m3*sq_m4;
+  IA_m5[13] = -0.006552408636124276*cq_m3[0]*sq_m4[0];
+  IA_m5[15] = 0.002676476 + 0.000815936*cq_m3[0] + 0.00023857200000000002*x5 + 0.209*x8;
+  IA_m5[17] = -0.000815936*sq_m4[0] - 0.00047714400000000004*cq_m3[0]*sq_m4[0];
   IA_m5[18] = 0.0024196 + 0.043681*x6;
   IA_m5[20] = 0.000847876 - 0.00023857200000000002*x5;
   pA_m6[0] = pA_m6[0] + x9;
   pA_m6[1] = pA_m6[1] + x1;
   pA_m6[2] = pA_m6[2] + x10;
-  pA_m6[3] = pA_m6[3] + 0.209*x1 + cq_m3*x3 + sq_m4*x4;
+  pA_m6[3] = pA_m6[3] + 0.209*x1 + cq_m3[0]*x3 + sq_m4[0]*x4;
   pA_m6[4] = pA_m6[4] + tau[0] - 0.209*x9;
-  pA_m6[5] = pA_m6[5] - sq_m4*x3 + cq_m3*x4;
-  KA_m7[0][KA_m7_col + 0] = -0.5659557661927332*cq_m3;
-  KA_m7[2][KA_m7_col + 0] = 0.5659557661927332*sq_m4;
-  KA_m7[3][KA_m7_col + 0] = k[0]*sq_m4;
-  KA_m7[4][KA_m7_col + 0] = 0.11828475513428124*cq_m3;
-  KA_m7[5][KA_m7_col + 0] = k[1]*cq_m3;
-  KA_m7[3][KA_m7_col + 1] = 0.209 + 0.195*cq_m3;
-  KA_m7[5][KA_m7_col + 1] = -0.195*sq_m4;
-  KA_m7[0][KA_m7_col + 2] = sq_m4;
-  KA_m7[2][KA_m7_col + 2] = cq_m3;
-  KA_m7[3][KA_m7_col + 2] = k[2]*cq_m3;
-  KA_m7[4][KA_m7_col + 2] = -0.209*sq_m4;
-  KA_m7[5][KA_m7_col + 2] = k[3]*sq_m4;
+  pA_m6[5] = pA_m6[5] - sq_m4[0]*x3 + cq_m3[0]*x4;
+  KA_m7[0][KA_m7_col + 0] = -0.5659557661927332*cq_m3[0];
+  KA_m7[2][KA_m7_col + 0] = 0.5659557661927332*sq_m4[0];
+  KA_m7[3][KA_m7_col + 0] = k[0]*sq_m4[0];
+  KA_m7[4][KA_m7_col + 0] = 0.11828475513428124*cq_m3[0];
+  KA_m7[5][KA_m7_col + 0] = k[1]*cq_m3[0];
+  KA_m7[3][KA_m7_col + 1] = 0.209 + 0.195*cq_m3[0];
+  KA_m7[5][KA_m7_col + 1] = -0.195*sq_m4[0];
+  KA_m7[0][KA_m7_col + 2] = sq_m4[0];
+  KA_m7[2][KA_m7_col + 2] = cq_m3[0];
+  KA_m7[3][KA_m7_col + 2] = k[2]*cq_m3[0];
+  KA_m7[4][KA_m7_col + 2] = -0.209*sq_m4[0];
+  KA_m7[5][KA_m7_col + 2] = k[3]*sq_m4[0];
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
 constexpr Scalar shared_19_k0[32] = {-0.010144, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.00020288, -0.00010144, 0.005072, -0.00010144, -0.005072, 0.005072, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
 constexpr Scalar shared_19_k1[32] = {0.010144, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.00010144, -0.005072, 0.00010144, 0.005072, -0.005072, 0.00010144, 0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar cq_m5, Scalar sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -800,10 +800,10 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x10 = k[3]*c_m4[3] + pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x3 + c_m4[2]*x5 + c_m4[5]*x7;
   const Scalar x11 = k[4]*c_m4[2] + pA_m3[3] + c_m4[3]*IA_m1[15] + c_m4[5]*IA_m1[17];
   const Scalar x12 = pA_m3[5] + k[5]*Dinv_m0[0]*u_m2[0] + c_m4[0]*x4 + c_m4[2]*x7 + c_m4[3]*IA_m1[17] + c_m4[5]*x6;
-  const Scalar x13 = cq_m5*cq_m5 - sq_m6*sq_m6;
+  const Scalar x13 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
   const Scalar x14 = 0.5*(-x2 + x5);
   const Scalar x15 = 0.5*(x2 + x5);
-  const Scalar x16 = 2.0*cq_m5*sq_m6;
+  const Scalar x16 = 2.0*cq_m5[0]*sq_m6[0];
   const Scalar x17 = x13*x14 - x3*x16;
   const Scalar x18 = x14*x16 + x3*x13;
   const Scalar x19 = k[6]*IA_m1[13]*Dinv_m0[0];
@@ -818,16 +818,16 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x28 = x15 + x17;
   const Scalar x29 = k[8]*IA_m1[13]*Dinv_m0[0] - x21;
   const Scalar x30 = k[9] + 0.5*x4 + x22;
-  const Scalar x31 = sq_m6*IA_m1[10] + cq_m5*IA_m1[8];
-  const Scalar x32 = cq_m5*IA_m1[10] - sq_m6*IA_m1[8];
+  const Scalar x31 = sq_m6[0]*IA_m1[10] + cq_m5[0]*IA_m1[8];
+  const Scalar x32 = cq_m5[0]*IA_m1[10] - sq_m6[0]*IA_m1[8];
   const Scalar x33 = k[10] - 0.5*x4 + x22;
   const Scalar x34 = k[11]*IA_m1[13]*Dinv_m0[0] + x21;
   const Scalar x35 = k[12]*x18 + x29;
   const Scalar x36 = k[13]*x27 + x30;
   const Scalar x37 = k[14]*x28 + x33;
   const Scalar x38 = k[15]*x18 + x34;
-  const Scalar x39 = cq_m5*x8 + sq_m6*x10;
-  const Scalar x40 = -sq_m6*x8 + cq_m5*x10;
+  const Scalar x39 = cq_m5[0]*x8 + sq_m6[0]*x10;
+  const Scalar x40 = -sq_m6[0]*x8 + cq_m5[0]*x10;
   IA_m7[0] = 0.5950000000000001 + x27;
   IA_m7[2] = x18;
   IA_m7[3] = x35;
@@ -843,31 +843,31 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   pA_m8[0] = pA_m8[0] + x39;
   pA_m8[1] = pA_m8[1] + x9;
   pA_m8[2] = pA_m8[2] + x40;
-  pA_m8[3] = pA_m8[3] + cq_m5*x11 + sq_m6*x12 + k[24]*x40;
+  pA_m8[3] = pA_m8[3] + cq_m5[0]*x11 + sq_m6[0]*x12 + k[24]*x40;
   pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6*x11 + cq_m5*x12 + k[25]*x39;
+  pA_m8[5] = pA_m8[5] - sq_m6[0]*x11 + cq_m5[0]*x12 + k[25]*x39;
   KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
   const Scalar x41 = KA_m10[0][KA_m10_col + 0] - IA_m1[4]*KSD_m9[0];
   const Scalar x42 = KA_m10[2][KA_m10_col + 0] - IA_m1[13]*KSD_m9[0];
   const Scalar x43 = KA_m10[5][KA_m10_col + 0] + k[26]*KSD_m9[0];
-  const Scalar x44 = cq_m5*x41 + sq_m6*x42;
-  const Scalar x45 = -sq_m6*x41 + cq_m5*x42;
+  const Scalar x44 = cq_m5[0]*x41 + sq_m6[0]*x42;
+  const Scalar x45 = -sq_m6[0]*x41 + cq_m5[0]*x42;
   KA_m11[0][KA_m11_col + 0] = x44;
   KA_m11[2][KA_m11_col + 0] = x45;
-  KA_m11[3][KA_m11_col + 0] = cq_m5*KA_m10[3][KA_m10_col + 0] + sq_m6*x43 + k[27]*x45;
-  KA_m11[5][KA_m11_col + 0] = -sq_m6*KA_m10[3][KA_m10_col + 0] + cq_m5*x43 + k[28]*x44;
-  KA_m11[3][KA_m11_col + 1] = cq_m5*KA_m10[3][KA_m10_col + 1] + sq_m6*KA_m10[5][KA_m10_col + 1];
-  KA_m11[5][KA_m11_col + 1] = -sq_m6*KA_m10[3][KA_m10_col + 1] + cq_m5*KA_m10[5][KA_m10_col + 1];
+  KA_m11[3][KA_m11_col + 0] = cq_m5[0]*KA_m10[3][KA_m10_col + 0] + sq_m6[0]*x43 + k[27]*x45;
+  KA_m11[5][KA_m11_col + 0] = -sq_m6[0]*KA_m10[3][KA_m10_col + 0] + cq_m5[0]*x43 + k[28]*x44;
+  KA_m11[3][KA_m11_col + 1] = cq_m5[0]*KA_m10[3][KA_m10_col + 1] + sq_m6[0]*KA_m10[5][KA_m10_col + 1];
+  KA_m11[5][KA_m11_col + 1] = -sq_m6[0]*KA_m10[3][KA_m10_col + 1] + cq_m5[0]*KA_m10[5][KA_m10_col + 1];
   KSD_m9[2] = KA_m10[4][KA_m10_col + 2]*Dinv_m0[0];
   const Scalar x46 = KA_m10[0][KA_m10_col + 2] - IA_m1[4]*KSD_m9[2];
   const Scalar x47 = KA_m10[2][KA_m10_col + 2] - IA_m1[13]*KSD_m9[2];
   const Scalar x48 = KA_m10[5][KA_m10_col + 2] + k[29]*KSD_m9[2];
-  const Scalar x49 = cq_m5*x46 + sq_m6*x47;
-  const Scalar x50 = -sq_m6*x46 + cq_m5*x47;
+  const Scalar x49 = cq_m5[0]*x46 + sq_m6[0]*x47;
+  const Scalar x50 = -sq_m6[0]*x46 + cq_m5[0]*x47;
   KA_m11[0][KA_m11_col + 2] = x49;
   KA_m11[2][KA_m11_col + 2] = x50;
-  KA_m11[3][KA_m11_col + 2] = cq_m5*KA_m10[3][KA_m10_col + 2] + sq_m6*x48 + k[30]*x50;
-  KA_m11[5][KA_m11_col + 2] = -sq_m6*KA_m10[3][KA_m10_col + 2] + cq_m5*x48 + k[31]*x49;
+  KA_m11[3][KA_m11_col + 2] = cq_m5[0]*KA_m10[3][KA_m10_col + 2] + sq_m6[0]*x48 + k[30]*x50;
+  KA_m11[5][KA_m11_col + 2] = -sq_m6[0]*KA_m10[3][KA_m10_col + 2] + cq_m5[0]*x48 + k[31]*x49;
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -875,7 +875,7 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 constexpr Scalar shared_20_k0[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
 constexpr Scalar shared_20_k1[82] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
 constexpr Scalar shared_20_k2[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
+PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
   U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
@@ -919,44 +919,44 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x33 = RJ_m6[0][RJ_m6_col + 0]*x6 + RJ_m6[0][RJ_m6_col + 1]*x22 + RJ_m6[0][RJ_m6_col + 2]*x7;
   const Scalar x34 = RJ_m6[0][RJ_m6_col + 0]*x22 + RJ_m6[0][RJ_m6_col + 1]*x10 + RJ_m6[0][RJ_m6_col + 2]*x24;
   const Scalar x35 = RJ_m6[0][RJ_m6_col + 0]*x7 + RJ_m6[0][RJ_m6_col + 1]*x24 + RJ_m6[0][RJ_m6_col + 2]*x13;
-  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
-  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
-  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
+  const Scalar x36 = RJ_m6[1][RJ_m6_col + 0]*x6 + cq_m7[0]*x22 + RJ_m6[1][RJ_m6_col + 2]*x7;
+  const Scalar x37 = RJ_m6[1][RJ_m6_col + 0]*x22 + cq_m7[0]*x10 + RJ_m6[1][RJ_m6_col + 2]*x24;
+  const Scalar x38 = RJ_m6[1][RJ_m6_col + 0]*x7 + cq_m7[0]*x24 + RJ_m6[1][RJ_m6_col + 2]*x13;
   const Scalar x39 = RJ_m6[2][RJ_m6_col + 0]*x6 + RJ_m6[2][RJ_m6_col + 1]*x22 + RJ_m6[2][RJ_m6_col + 2]*x7;
   const Scalar x40 = RJ_m6[2][RJ_m6_col + 0]*x22 + RJ_m6[2][RJ_m6_col + 1]*x10 + RJ_m6[2][RJ_m6_col + 2]*x24;
   const Scalar x41 = RJ_m6[2][RJ_m6_col + 0]*x7 + RJ_m6[2][RJ_m6_col + 1]*x24 + RJ_m6[2][RJ_m6_col + 2]*x13;
   const Scalar x42 = RJ_m6[0][RJ_m6_col + 0]*x8 + RJ_m6[0][RJ_m6_col + 1]*x11 + RJ_m6[0][RJ_m6_col + 2]*x14;
   const Scalar x43 = RJ_m6[0][RJ_m6_col + 0]*x23 + RJ_m6[0][RJ_m6_col + 1]*x25 + RJ_m6[0][RJ_m6_col + 2]*x26;
   const Scalar x44 = RJ_m6[0][RJ_m6_col + 0]*x9 + RJ_m6[0][RJ_m6_col + 1]*x12 + RJ_m6[0][RJ_m6_col + 2]*x15;
-  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
-  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
-  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
+  const Scalar x45 = RJ_m6[1][RJ_m6_col + 0]*x8 + cq_m7[0]*x11 + RJ_m6[1][RJ_m6_col + 2]*x14;
+  const Scalar x46 = RJ_m6[1][RJ_m6_col + 0]*x23 + cq_m7[0]*x25 + RJ_m6[1][RJ_m6_col + 2]*x26;
+  const Scalar x47 = RJ_m6[1][RJ_m6_col + 0]*x9 + cq_m7[0]*x12 + RJ_m6[1][RJ_m6_col + 2]*x15;
   const Scalar x48 = RJ_m6[2][RJ_m6_col + 0]*x8 + RJ_m6[2][RJ_m6_col + 1]*x11 + RJ_m6[2][RJ_m6_col + 2]*x14;
   const Scalar x49 = RJ_m6[2][RJ_m6_col + 0]*x23 + RJ_m6[2][RJ_m6_col + 1]*x25 + RJ_m6[2][RJ_m6_col + 2]*x26;
   const Scalar x50 = RJ_m6[2][RJ_m6_col + 0]*x9 + RJ_m6[2][RJ_m6_col + 1]*x12 + RJ_m6[2][RJ_m6_col + 2]*x15;
   const Scalar x51 = RJ_m6[0][RJ_m6_col + 0]*x16 + RJ_m6[0][RJ_m6_col + 1]*x17 + RJ_m6[0][RJ_m6_col + 2]*x18;
   const Scalar x52 = RJ_m6[0][RJ_m6_col + 0]*x17 + RJ_m6[0][RJ_m6_col + 1]*x19 + RJ_m6[0][RJ_m6_col + 2]*x20;
   const Scalar x53 = RJ_m6[0][RJ_m6_col + 0]*x18 + RJ_m6[0][RJ_m6_col + 1]*x20 + RJ_m6[0][RJ_m6_col + 2]*x21;
-  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
-  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
-  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
+  const Scalar x54 = RJ_m6[1][RJ_m6_col + 0]*x16 + cq_m7[0]*x17 + RJ_m6[1][RJ_m6_col + 2]*x18;
+  const Scalar x55 = RJ_m6[1][RJ_m6_col + 0]*x17 + cq_m7[0]*x19 + RJ_m6[1][RJ_m6_col + 2]*x20;
+  const Scalar x56 = RJ_m6[1][RJ_m6_col + 0]*x18 + cq_m7[0]*x20 + RJ_m6[1][RJ_m6_col + 2]*x21;
   const Scalar x57 = RJ_m6[2][RJ_m6_col + 0]*x16 + RJ_m6[2][RJ_m6_col + 1]*x17 + RJ_m6[2][RJ_m6_col + 2]*x18;
   const Scalar x58 = RJ_m6[2][RJ_m6_col + 0]*x17 + RJ_m6[2][RJ_m6_col + 1]*x19 + RJ_m6[2][RJ_m6_col + 2]*x20;
   const Scalar x59 = RJ_m6[2][RJ_m6_col + 0]*x18 + RJ_m6[2][RJ_m6_col + 1]*x20 + RJ_m6[2][RJ_m6_col + 2]*x21;
   const Scalar x60 = RJ_m6[0][RJ_m6_col + 0]*x33 + RJ_m6[0][RJ_m6_col + 1]*x34 + RJ_m6[0][RJ_m6_col + 2]*x35;
-  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
+  const Scalar x61 = RJ_m6[1][RJ_m6_col + 0]*x33 + cq_m7[0]*x34 + RJ_m6[1][RJ_m6_col + 2]*x35;
   const Scalar x62 = RJ_m6[2][RJ_m6_col + 0]*x33 + RJ_m6[2][RJ_m6_col + 1]*x34 + RJ_m6[2][RJ_m6_col + 2]*x35;
-  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
+  const Scalar x63 = RJ_m6[1][RJ_m6_col + 0]*x36 + cq_m7[0]*x37 + RJ_m6[1][RJ_m6_col + 2]*x38;
   const Scalar x64 = RJ_m6[2][RJ_m6_col + 0]*x36 + RJ_m6[2][RJ_m6_col + 1]*x37 + RJ_m6[2][RJ_m6_col + 2]*x38;
   const Scalar x65 = RJ_m6[2][RJ_m6_col + 0]*x39 + RJ_m6[2][RJ_m6_col + 1]*x40 + RJ_m6[2][RJ_m6_col + 2]*x41;
   const Scalar x66 = RJ_m6[0][RJ_m6_col + 0]*x42 + RJ_m6[0][RJ_m6_col + 1]*x43 + RJ_m6[0][RJ_m6_col + 2]*x44;
-  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
+  const Scalar x67 = RJ_m6[1][RJ_m6_col + 0]*x42 + cq_m7[0]*x43 + RJ_m6[1][RJ_m6_col + 2]*x44;
   const Scalar x68 = RJ_m6[2][RJ_m6_col + 0]*x42 + RJ_m6[2][RJ_m6_col + 1]*x43 + RJ_m6[2][RJ_m6_col + 2]*x44;
   const Scalar x69 = RJ_m6[0][RJ_m6_col + 0]*x45 + RJ_m6[0][RJ_m6_col + 1]*x46 + RJ_m6[0][RJ_m6_col + 2]*x47;
-  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
+  const Scalar x70 = RJ_m6[1][RJ_m6_col + 0]*x45 + cq_m7[0]*x46 + RJ_m6[1][RJ_m6_col + 2]*x47;
   const Scalar x71 = RJ_m6[2][RJ_m6_col + 0]*x45 + RJ_m6[2][RJ_m6_col + 1]*x46 + RJ_m6[2][RJ_m6_col + 2]*x47;
   const Scalar x72 = RJ_m6[0][RJ_m6_col + 0]*x48 + RJ_m6[0][RJ_m6_col + 1]*x49 + RJ_m6[0][RJ_m6_col + 2]*x50;
-  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
+  const Scalar x73 = RJ_m6[1][RJ_m6_col + 0]*x48 + cq_m7[0]*x49 + RJ_m6[1][RJ_m6_col + 2]*x50;
   const Scalar x74 = RJ_m6[2][RJ_m6_col + 0]*x48 + RJ_m6[2][RJ_m6_col + 1]*x49 + RJ_m6[2][RJ_m6_col + 2]*x50;
   const Scalar x75 = k[23]*x62 + x66;
   const Scalar x76 = k[24]*x62 + x67;
@@ -968,7 +968,7 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x82 = k[32]*x65 + x73;
   const Scalar x83 = k[33]*x62 + k[34]*x64 + x74;
   const Scalar x84 = RJ_m6[0][RJ_m6_col + 0]*x27 + RJ_m6[0][RJ_m6_col + 1]*x28 + RJ_m6[0][RJ_m6_col + 2]*x29;
-  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
+  const Scalar x85 = RJ_m6[1][RJ_m6_col + 0]*x27 + cq_m7[0]*x28 + RJ_m6[1][RJ_m6_col + 2]*x29;
   const Scalar x86 = RJ_m6[2][RJ_m6_col + 0]*x27 + RJ_m6[2][RJ_m6_col + 1]*x28 + RJ_m6[2][RJ_m6_col + 2]*x29;
   IA_m8[0] = IA_m8[0] + x60;
   IA_m8[1] = IA_m8[1] + x61;
@@ -986,16 +986,16 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   IA_m8[13] = IA_m8[13] + x82;
   IA_m8[14] = IA_m8[14] + x83;
   IA_m8[15] = IA_m8[15] + RJ_m6[0][RJ_m6_col + 0]*x51 + RJ_m6[0][RJ_m6_col + 1]*x52 + RJ_m6[0][RJ_m6_col + 2]*x53 + k[35]*x72 + k[36]*x81;
-  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
+  IA_m8[16] = IA_m8[16] + RJ_m6[1][RJ_m6_col + 0]*x51 + cq_m7[0]*x52 + RJ_m6[1][RJ_m6_col + 2]*x53 + k[37]*x72 + k[38]*x82;
   IA_m8[17] = IA_m8[17] + RJ_m6[2][RJ_m6_col + 0]*x51 + RJ_m6[2][RJ_m6_col + 1]*x52 + RJ_m6[2][RJ_m6_col + 2]*x53 + k[39]*x66 + k[40]*x69 + k[41]*x83;
-  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
+  IA_m8[18] = IA_m8[18] + RJ_m6[1][RJ_m6_col + 0]*x54 + cq_m7[0]*x55 + RJ_m6[1][RJ_m6_col + 2]*x56 + k[42]*x73 + k[43]*x82;
   IA_m8[19] = IA_m8[19] + RJ_m6[2][RJ_m6_col + 0]*x54 + RJ_m6[2][RJ_m6_col + 1]*x55 + RJ_m6[2][RJ_m6_col + 2]*x56 + k[44]*x67 + k[45]*x70 + k[46]*x83;
   IA_m8[20] = IA_m8[20] + RJ_m6[2][RJ_m6_col + 0]*x57 + RJ_m6[2][RJ_m6_col + 1]*x58 + RJ_m6[2][RJ_m6_col + 2]*x59 + k[47]*x68 + k[48]*x71 + k[49]*x77 + k[50]*x80;
   pA_m9[0] = pA_m9[0] + x84;
   pA_m9[1] = pA_m9[1] + x85;
   pA_m9[2] = pA_m9[2] + x86;
   pA_m9[3] = pA_m9[3] + RJ_m6[0][RJ_m6_col + 0]*x30 + RJ_m6[0][RJ_m6_col + 1]*x31 + RJ_m6[0][RJ_m6_col + 2]*x32 + k[51]*x86;
-  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
+  pA_m9[4] = pA_m9[4] + RJ_m6[1][RJ_m6_col + 0]*x30 + cq_m7[0]*x31 + RJ_m6[1][RJ_m6_col + 2]*x32 + k[52]*x86;
   pA_m9[5] = pA_m9[5] + RJ_m6[2][RJ_m6_col + 0]*x30 + RJ_m6[2][RJ_m6_col + 1]*x31 + RJ_m6[2][RJ_m6_col + 2]*x32 + k[53]*x84 + k[54]*x85;
   KS_m10[0] = k[55]*KA_m11[3][KA_m11_col + 0] + k[56]*KA_m11[5][KA_m11_col + 0];
   KSD_m12[0] = Dinv_m2[0]*KS_m10[0];
@@ -1005,13 +1005,13 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x90 = KA_m11[3][KA_m11_col + 0] - U_m0[3]*KSD_m12[0];
   const Scalar x91 = KA_m11[5][KA_m11_col + 0] - U_m0[5]*KSD_m12[0];
   const Scalar x92 = RJ_m6[0][RJ_m6_col + 0]*x87 + RJ_m6[0][RJ_m6_col + 1]*x89 + RJ_m6[0][RJ_m6_col + 2]*x88;
-  const Scalar x93 = RJ_m6[1][RJ_m6_col + 0]*x87 + cq_m7*x89 + RJ_m6[1][RJ_m6_col + 2]*x88;
+  const Scalar x93 = RJ_m6[1][RJ_m6_col + 0]*x87 + cq_m7[0]*x89 + RJ_m6[1][RJ_m6_col + 2]*x88;
   const Scalar x94 = RJ_m6[2][RJ_m6_col + 0]*x87 + RJ_m6[2][RJ_m6_col + 1]*x89 + RJ_m6[2][RJ_m6_col + 2]*x88;
   KA_m13[0][KA_m13_col + 0] = x92;
   KA_m13[1][KA_m13_col + 0] = x93;
   KA_m13[2][KA_m13_col + 0] = x94;
   KA_m13[3][KA_m13_col + 0] = RJ_m6[0][RJ_m6_col + 0]*x90 + k[57]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[0][RJ_m6_col + 2]*x91 + k[58]*x94;
-  KA_m13[4][KA_m13_col + 0] = RJ_m6[1][RJ_m6_col + 0]*x90 + k[59]*cq_m7*KSD_m12[0] + RJ_m6[1][RJ_m6_col + 2]*x91 + k[60]*x94;
+  KA_m13[4][KA_m13_col + 0] = RJ_m6[1][RJ_m6_col + 0]*x90 + k[59]*cq_m7[0]*KSD_m12[0] + RJ_m6[1][RJ_m6_col + 2]*x91 + k[60]*x94;
   KA_m13[5][KA_m13_col + 0] = RJ_m6[2][RJ_m6_col + 0]*x90 + k[61]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[0] + RJ_m6[2][RJ_m6_col + 2]*x91 + k[62]*x92 + k[63]*x93;
   KS_m10[1] = k[64]*KA_m11[3][KA_m11_col + 1] + k[65]*KA_m11[5][KA_m11_col + 1];
   KSD_m12[1] = Dinv_m2[0]*KS_m10[1];
@@ -1021,13 +1021,13 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x98 = KA_m11[3][KA_m11_col + 1] - U_m0[3]*KSD_m12[1];
   const Scalar x99 = KA_m11[5][KA_m11_col + 1] - U_m0[5]*KSD_m12[1];
   const Scalar x100 = RJ_m6[0][RJ_m6_col + 0]*x96 + RJ_m6[0][RJ_m6_col + 1]*x95 + RJ_m6[0][RJ_m6_col + 2]*x97;
-  const Scalar x101 = RJ_m6[1][RJ_m6_col + 0]*x96 + cq_m7*x95 + RJ_m6[1][RJ_m6_col + 2]*x97;
+  const Scalar x101 = RJ_m6[1][RJ_m6_col + 0]*x96 + cq_m7[0]*x95 + RJ_m6[1][RJ_m6_col + 2]*x97;
   const Scalar x102 = RJ_m6[2][RJ_m6_col + 0]*x96 + RJ_m6[2][RJ_m6_col + 1]*x95 + RJ_m6[2][RJ_m6_col + 2]*x97;
   KA_m13[0][KA_m13_col + 1] = x100;
   KA_m13[1][KA_m13_col + 1] = x101;
   KA_m13[2][KA_m13_col + 1] = x102;
   KA_m13[3][KA_m13_col + 1] = RJ_m6[0][RJ_m6_col + 0]*x98 + k[66]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[0][RJ_m6_col + 2]*x99 + k[67]*x102;
-  KA_m13[4][KA_m13_col + 1] = RJ_m6[1][RJ_m6_col + 0]*x98 + k[68]*cq_m7*KSD_m12[1] + RJ_m6[1][RJ_m6_col + 2]*x99 + k[69]*x102;
+  KA_m13[4][KA_m13_col + 1] = RJ_m6[1][RJ_m6_col + 0]*x98 + k[68]*cq_m7[0]*KSD_m12[1] + RJ_m6[1][RJ_m6_col + 2]*x99 + k[69]*x102;
   KA_m13[5][KA_m13_col + 1] = RJ_m6[2][RJ_m6_col + 0]*x98 + k[70]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[1] + RJ_m6[2][RJ_m6_col + 2]*x99 + k[71]*x100 + k[72]*x101;
   KS_m10[2] = k[73]*KA_m11[3][KA_m11_col + 2] + k[74]*KA_m11[5][KA_m11_col + 2];
   KSD_m12[2] = Dinv_m2[0]*KS_m10[2];
@@ -1037,13 +1037,13 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   const Scalar x106 = KA_m11[3][KA_m11_col + 2] - U_m0[3]*KSD_m12[2];
   const Scalar x107 = KA_m11[5][KA_m11_col + 2] - U_m0[5]*KSD_m12[2];
   const Scalar x108 = RJ_m6[0][RJ_m6_col + 0]*x103 + RJ_m6[0][RJ_m6_col + 1]*x105 + RJ_m6[0][RJ_m6_col + 2]*x104;
-  const Scalar x109 = RJ_m6[1][RJ_m6_col + 0]*x103 + cq_m7*x105 + RJ_m6[1][RJ_m6_col + 2]*x104;
+  const Scalar x109 = RJ_m6[1][RJ_m6_col + 0]*x103 + cq_m7[0]*x105 + RJ_m6[1][RJ_m6_col + 2]*x104;
   const Scalar x110 = RJ_m6[2][RJ_m6_col + 0]*x103 + RJ_m6[2][RJ_m6_col + 1]*x105 + RJ_m6[2][RJ_m6_col + 2]*x104;
   KA_m13[0][KA_m13_col + 2] = x108;
   KA_m13[1][KA_m13_col + 2] = x109;
   KA_m13[2][KA_m13_col + 2] = x110;
   KA_m13[3][KA_m13_col + 2] = RJ_m6[0][RJ_m6_col + 0]*x106 + k[75]*RJ_m6[0][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[0][RJ_m6_col + 2]*x107 + k[76]*x110;
-  KA_m13[4][KA_m13_col + 2] = RJ_m6[1][RJ_m6_col + 0]*x106 + k[77]*cq_m7*KSD_m12[2] + RJ_m6[1][RJ_m6_col + 2]*x107 + k[78]*x110;
+  KA_m13[4][KA_m13_col + 2] = RJ_m6[1][RJ_m6_col + 0]*x106 + k[77]*cq_m7[0]*KSD_m12[2] + RJ_m6[1][RJ_m6_col + 2]*x107 + k[78]*x110;
   KA_m13[5][KA_m13_col + 2] = RJ_m6[2][RJ_m6_col + 0]*x106 + k[79]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[2][RJ_m6_col + 2]*x107 + k[80]*x108 + k[81]*x109;
 }
 
@@ -1051,13 +1051,13 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 // The first: free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
 constexpr Scalar shared_21_k0[3] = {-0.062, 0.062, 0.00020288};
 constexpr Scalar shared_21_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
   const Scalar x6 = u_m4[0] + k[2]*x5 - IA_m5[0]*x2 - IA_m5[9]*x3 - a_m0[4]*IA_m5[14];
   a_m6[0] = x2;
   a_m6[1] = a_m0[1];
@@ -1069,13 +1069,13 @@ PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
   const Scalar x6 = u_m4[0] - 0.000486144*a_m0[4] + 0.003904*x2;
   a_m5[0] = x2;
   a_m5[1] = x1;
@@ -1090,15 +1090,15 @@ PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 constexpr Scalar shared_23_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
 constexpr Scalar shared_23_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
 constexpr Scalar shared_23_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
   const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
   const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
   const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
   const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
   const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
   a_m6[0] = x3;
@@ -1126,13 +1126,13 @@ PROXGEN_RT_NOINLINE void shared_24(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KS
 // The first: accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
 constexpr Scalar shared_25_k0[3] = {-0.062, 0.062, 0.00020288};
 constexpr Scalar shared_25_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*x1;
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2 - a_m0[5]*sq_m3;
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3 + a_m0[5]*cq_m2;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
+  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
   const Scalar x6 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] + k[2]*x5 - IA_m7[0]*x2 - IA_m7[9]*x3 - a_m0[4]*IA_m7[14];
   qdd_m8[0] = Dinv_m9*x6;
   a_m10[0] = x2;
@@ -1145,13 +1145,13 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar cq_m2, Scalar sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2*x0 - sq_m3*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3*x0 + cq_m2*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2*a_m0[3] - sq_m3*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3*a_m0[3] + cq_m2*a_m0[5];
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
   const Scalar x6 = u_m4[0] + 0.195*lambda_m5[0] - 0.000486144*a_m0[4] + 0.003904*x2;
   qdd_m6[0] = 2057.0036861506055*x6;
   a_m7[0] = x2;
@@ -1167,15 +1167,15 @@ PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 constexpr Scalar shared_27_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
 constexpr Scalar shared_27_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
 constexpr Scalar shared_27_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_27(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+PROXGEN_RT_NOINLINE void shared_27(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
   const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
+  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
   const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
   const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3 + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
+  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
   const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
   const Scalar x9 = u_m4[0] - KS_m5[0]*lambda_m6[0] - KS_m5[1]*lambda_m6[1] - KS_m5[2]*lambda_m6[2] + k[4]*x7 - U_m7[0]*x3 - U_m7[1]*x4 - U_m7[2]*x5 - U_m7[3]*x6 - U_m7[5]*x8;
   qdd_m8[0] = Dinv_m9*x9;
@@ -1214,32 +1214,32 @@ PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PRO
     w.RJ_trunk[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
   }
   // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k0, &q[7], &w.sq_LF_hip, &w.cq_LF_hip, w.RJ_LF_hip, 0);
+  shared_0(shared_0_k0, &q[7], w.sq, w.cq, w.RJ_LF_hip, 0);
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_1(&q[8], &w.sq_LF_thigh, &w.cq_LF_thigh);
+  shared_1(&q[8], &w.sq[1], &w.cq[1]);
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_1(&q[9], &w.sq_LF_shank, &w.cq_LF_shank);
+  shared_1(&q[9], &w.sq[2], &w.cq[2]);
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k1, &q[10], &w.sq_LH_hip, &w.cq_LH_hip, w.RJ_LH_hip, 0);
+  shared_0(shared_0_k1, &q[10], &w.sq[3], &w.cq[3], w.RJ_LH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_transforms_LH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_1(&q[11], &w.sq_LH_thigh, &w.cq_LH_thigh);
+  shared_1(&q[11], &w.sq[4], &w.cq[4]);
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_1(&q[12], &w.sq_LH_shank, &w.cq_LH_shank);
+  shared_1(&q[12], &w.sq[5], &w.cq[5]);
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k0, &q[13], &w.sq_RF_hip, &w.cq_RF_hip, w.RJ_RF_hip, 0);
+  shared_0(shared_0_k0, &q[13], &w.sq[6], &w.cq[6], w.RJ_RF_hip, 0);
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_1(&q[14], &w.sq_RF_thigh, &w.cq_RF_thigh);
+  shared_1(&q[14], &w.sq[7], &w.cq[7]);
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_1(&q[15], &w.sq_RF_shank, &w.cq_RF_shank);
+  shared_1(&q[15], &w.sq[8], &w.cq[8]);
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k1, &q[16], &w.sq_RH_hip, &w.cq_RH_hip, w.RJ_RH_hip, 0);
+  shared_0(shared_0_k1, &q[16], &w.sq[9], &w.cq[9], w.RJ_RH_hip, 0);
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_1(&q[17], &w.sq_RH_thigh, &w.cq_RH_thigh);
+  shared_1(&q[17], &w.sq[10], &w.cq[10]);
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_1(&q[18], &w.sq_RH_shank, &w.cq_RH_shank);
+  shared_1(&q[18], &w.sq[11], &w.cq[11]);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1261,10 +1261,10 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_R
     const Scalar t1 = v[1] + 0.19*v[5];
     const Scalar t2 = v[2] + 0.049*v[3] - 0.19*v[4];
     w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t0 + w.RJ_LF_hip[1][0]*t1 + w.RJ_LF_hip[2][0]*t2;
-    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t0 + w.cq_LF_hip*t1 + w.RJ_LF_hip[2][1]*t2;
+    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t0 + w.cq[0]*t1 + w.RJ_LF_hip[2][1]*t2;
     w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t0 + w.RJ_LF_hip[1][2]*t1 + w.RJ_LF_hip[2][2]*t2;
     w.v_LF_hip[3] = 0.9950371902099893*v[6] + w.RJ_LF_hip[0][0]*v[3] + w.RJ_LF_hip[1][0]*v[4] + w.RJ_LF_hip[2][0]*v[5];
-    w.v_LF_hip[4] = w.RJ_LF_hip[0][1]*v[3] + w.cq_LF_hip*v[4] + w.RJ_LF_hip[2][1]*v[5];
+    w.v_LF_hip[4] = w.RJ_LF_hip[0][1]*v[3] + w.cq[0]*v[4] + w.RJ_LF_hip[2][1]*v[5];
     w.v_LF_hip[5] = 0.09950371902099893*v[6] + w.RJ_LF_hip[0][2]*v[3] + w.RJ_LF_hip[1][2]*v[4] + w.RJ_LF_hip[2][2]*v[5];
     w.c_LF_hip[0] = 0.09950371902099893*v[6]*w.v_LF_hip[1];
     w.c_LF_hip[1] = 0.9950371902099893*v[6]*w.v_LF_hip[2] - 0.09950371902099893*v[6]*w.v_LF_hip[0];
@@ -1284,26 +1284,26 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_R
     w.pA_LF_hip[4] = w.v_LF_hip[5]*h2 - w.v_LF_hip[3]*h4 + w.v_LF_hip[2]*h0 - w.v_LF_hip[0]*h1;
     w.pA_LF_hip[5] = w.v_LF_hip[3]*h3 - w.v_LF_hip[4]*h2 + 0.5950000000000001*w.v_LF_hip[0]*w.v_LF_hip[1] - w.v_LF_hip[1]*h0;
     w.g_LF_hip[0] = w.RJ_LF_hip[0][0]*w.g_trunk[0] + w.RJ_LF_hip[1][0]*w.g_trunk[1] + w.RJ_LF_hip[2][0]*w.g_trunk[2];
-    w.g_LF_hip[1] = w.RJ_LF_hip[0][1]*w.g_trunk[0] + w.cq_LF_hip*w.g_trunk[1] + w.RJ_LF_hip[2][1]*w.g_trunk[2];
+    w.g_LF_hip[1] = w.RJ_LF_hip[0][1]*w.g_trunk[0] + w.cq[0]*w.g_trunk[1] + w.RJ_LF_hip[2][1]*w.g_trunk[2];
     w.g_LF_hip[2] = w.RJ_LF_hip[0][2]*w.g_trunk[0] + w.RJ_LF_hip[1][2]*w.g_trunk[1] + w.RJ_LF_hip[2][2]*w.g_trunk[2];
   }
   // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_2(shared_2_k0, &v[7], w.v_LF_hip, w.v_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
+  shared_2(shared_2_k0, &v[7], w.v_LF_hip, w.v_LF_thigh, &w.cq[1], &w.sq[1], w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_3(shared_3_k0, &v[8], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
+  shared_3(shared_3_k0, &v[8], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, &w.cq[2], &w.sq[2], w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t5 = v[0] - 0.049*v[5];
     const Scalar t6 = v[1] - 0.19*v[5];
     const Scalar t7 = v[2] + 0.049*v[3] + 0.19*v[4];
     w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t5 + w.RJ_LH_hip[1][0]*t6 + w.RJ_LH_hip[2][0]*t7;
-    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t5 + w.cq_LH_hip*t6 + w.RJ_LH_hip[2][1]*t7;
+    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t5 + w.cq[3]*t6 + w.RJ_LH_hip[2][1]*t7;
     w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t5 + w.RJ_LH_hip[1][2]*t6 + w.RJ_LH_hip[2][2]*t7;
     w.v_LH_hip[3] = 0.9950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][0] + v[4]*w.RJ_LH_hip[1][0] + v[5]*w.RJ_LH_hip[2][0];
-    w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[0][1] + v[4]*w.cq_LH_hip + v[5]*w.RJ_LH_hip[2][1];
+    w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[0][1] + v[4]*w.cq[3] + v[5]*w.RJ_LH_hip[2][1];
     w.v_LH_hip[5] = -0.09950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][2] + v[4]*w.RJ_LH_hip[1][2] + v[5]*w.RJ_LH_hip[2][2];
     w.c_LH_hip[0] = -0.09950371902099892*v[9]*w.v_LH_hip[1];
     w.c_LH_hip[1] = 0.9950371902099892*v[9]*w.v_LH_hip[2] + 0.09950371902099892*v[9]*w.v_LH_hip[0];
@@ -1323,16 +1323,16 @@ PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_
     w.pA_LH_hip[4] = w.v_LH_hip[5]*h6 - w.v_LH_hip[3]*h8 + w.v_LH_hip[2]*h4 - w.v_LH_hip[0]*h5;
     w.pA_LH_hip[5] = w.v_LH_hip[3]*h7 - w.v_LH_hip[4]*h6 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h4;
     w.g_LH_hip[0] = w.g_trunk[0]*w.RJ_LH_hip[0][0] + w.g_trunk[1]*w.RJ_LH_hip[1][0] + w.g_trunk[2]*w.RJ_LH_hip[2][0];
-    w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[0][1] + w.g_trunk[1]*w.cq_LH_hip + w.g_trunk[2]*w.RJ_LH_hip[2][1];
+    w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[0][1] + w.g_trunk[1]*w.cq[3] + w.g_trunk[2]*w.RJ_LH_hip[2][1];
     w.g_LH_hip[2] = w.g_trunk[0]*w.RJ_LH_hip[0][2] + w.g_trunk[1]*w.RJ_LH_hip[1][2] + w.g_trunk[2]*w.RJ_LH_hip[2][2];
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_LH_thigh_to_LH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_4(shared_4_k0, &v[10], w.v_LH_hip, w.v_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
+  shared_4(shared_4_k0, &v[10], w.v_LH_hip, w.v_LH_thigh, &w.cq[4], &w.sq[4], w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
   // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_5(shared_5_k0, &v[11], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
+  shared_5(shared_5_k0, &v[11], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, &w.cq[5], &w.sq[5], w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1342,10 +1342,10 @@ PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_
     const Scalar t1 = v[1] + 0.19*v[5];
     const Scalar t2 = v[2] - 0.049*v[3] - 0.19*v[4];
     w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t0 + w.RJ_RF_hip[1][0]*t1 + w.RJ_RF_hip[2][0]*t2;
-    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t0 + w.cq_RF_hip*t1 + w.RJ_RF_hip[2][1]*t2;
+    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t0 + w.cq[6]*t1 + w.RJ_RF_hip[2][1]*t2;
     w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t0 + w.RJ_RF_hip[1][2]*t1 + w.RJ_RF_hip[2][2]*t2;
     w.v_RF_hip[3] = 0.9950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][0] + v[4]*w.RJ_RF_hip[1][0] + v[5]*w.RJ_RF_hip[2][0];
-    w.v_RF_hip[4] = v[3]*w.RJ_RF_hip[0][1] + v[4]*w.cq_RF_hip + v[5]*w.RJ_RF_hip[2][1];
+    w.v_RF_hip[4] = v[3]*w.RJ_RF_hip[0][1] + v[4]*w.cq[6] + v[5]*w.RJ_RF_hip[2][1];
     w.v_RF_hip[5] = 0.09950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][2] + v[4]*w.RJ_RF_hip[1][2] + v[5]*w.RJ_RF_hip[2][2];
     w.c_RF_hip[0] = 0.09950371902099893*v[12]*w.v_RF_hip[1];
     w.c_RF_hip[1] = 0.9950371902099893*v[12]*w.v_RF_hip[2] - 0.09950371902099893*v[12]*w.v_RF_hip[0];
@@ -1365,26 +1365,26 @@ PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_
     w.pA_RF_hip[4] = w.v_RF_hip[5]*h2 - w.v_RF_hip[3]*h4 + w.v_RF_hip[2]*h0 - w.v_RF_hip[0]*h1;
     w.pA_RF_hip[5] = w.v_RF_hip[3]*h3 - w.v_RF_hip[4]*h2 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h0;
     w.g_RF_hip[0] = w.g_trunk[0]*w.RJ_RF_hip[0][0] + w.g_trunk[1]*w.RJ_RF_hip[1][0] + w.g_trunk[2]*w.RJ_RF_hip[2][0];
-    w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[0][1] + w.g_trunk[1]*w.cq_RF_hip + w.g_trunk[2]*w.RJ_RF_hip[2][1];
+    w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[0][1] + w.g_trunk[1]*w.cq[6] + w.g_trunk[2]*w.RJ_RF_hip[2][1];
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[0][2] + w.g_trunk[1]*w.RJ_RF_hip[1][2] + w.g_trunk[2]*w.RJ_RF_hip[2][2];
   }
   // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_2(shared_2_k1, &v[13], w.v_RF_hip, w.v_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
+  shared_2(shared_2_k1, &v[13], w.v_RF_hip, w.v_RF_thigh, &w.cq[7], &w.sq[7], w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_3(shared_3_k1, &v[14], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
+  shared_3(shared_3_k1, &v[14], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, &w.cq[8], &w.sq[8], w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar t5 = v[0] + 0.049*v[5];
     const Scalar t6 = v[1] - 0.19*v[5];
     const Scalar t7 = v[2] - 0.049*v[3] + 0.19*v[4];
     w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t5 + w.RJ_RH_hip[1][0]*t6 + w.RJ_RH_hip[2][0]*t7;
-    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t5 + w.cq_RH_hip*t6 + w.RJ_RH_hip[2][1]*t7;
+    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t5 + w.cq[9]*t6 + w.RJ_RH_hip[2][1]*t7;
     w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t5 + w.RJ_RH_hip[1][2]*t6 + w.RJ_RH_hip[2][2]*t7;
     w.v_RH_hip[3] = 0.9950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][0] + v[4]*w.RJ_RH_hip[1][0] + v[5]*w.RJ_RH_hip[2][0];
-    w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[0][1] + v[4]*w.cq_RH_hip + v[5]*w.RJ_RH_hip[2][1];
+    w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[0][1] + v[4]*w.cq[9] + v[5]*w.RJ_RH_hip[2][1];
     w.v_RH_hip[5] = -0.09950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][2] + v[4]*w.RJ_RH_hip[1][2] + v[5]*w.RJ_RH_hip[2][2];
     w.c_RH_hip[0] = -0.09950371902099892*v[15]*w.v_RH_hip[1];
     w.c_RH_hip[1] = 0.9950371902099892*v[15]*w.v_RH_hip[2] + 0.09950371902099892*v[15]*w.v_RH_hip[0];
@@ -1404,26 +1404,26 @@ PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_
     w.pA_RH_hip[4] = w.v_RH_hip[5]*h6 - w.v_RH_hip[3]*h8 + w.v_RH_hip[2]*h4 - w.v_RH_hip[0]*h5;
     w.pA_RH_hip[5] = w.v_RH_hip[3]*h7 - w.v_RH_hip[4]*h6 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h4;
     w.g_RH_hip[0] = w.g_trunk[0]*w.RJ_RH_hip[0][0] + w.g_trunk[1]*w.RJ_RH_hip[1][0] + w.g_trunk[2]*w.RJ_RH_hip[2][0];
-    w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[0][1] + w.g_trunk[1]*w.cq_RH_hip + w.g_trunk[2]*w.RJ_RH_hip[2][1];
+    w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[0][1] + w.g_trunk[1]*w.cq[9] + w.g_trunk[2]*w.RJ_RH_hip[2][1];
     w.g_RH_hip[2] = w.g_trunk[0]*w.RJ_RH_hip[0][2] + w.g_trunk[1]*w.RJ_RH_hip[1][2] + w.g_trunk[2]*w.RJ_RH_hip[2][2];
   }
 }
 
 PROXGEN_RT_NOINLINE void kinematics_RH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_4(shared_4_k1, &v[16], w.v_RH_hip, w.v_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
+  shared_4(shared_4_k1, &v[16], w.v_RH_hip, w.v_RH_thigh, &w.cq[10], &w.sq[10], w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_5(shared_5_k1, &v[17], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
+  shared_5(shared_5_k1, &v[17], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, &w.cq[11], &w.sq[11], w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_6(shared_6_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.IA_RH_thigh, w.pA_RH_thigh);
+  shared_6(shared_6_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_7(shared_7_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.IA_RH_hip, w.pA_RH_hip);
+  shared_7(shared_7_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1472,44 +1472,44 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
     const Scalar t10 = w.RJ_RH_hip[0][0]*Ia0 + w.RJ_RH_hip[0][1]*t5 + w.RJ_RH_hip[0][2]*Ia1;
     const Scalar t11 = w.RJ_RH_hip[0][0]*t5 + w.RJ_RH_hip[0][1]*Ia4 + w.RJ_RH_hip[0][2]*t7;
     const Scalar t12 = w.RJ_RH_hip[0][0]*Ia1 + w.RJ_RH_hip[0][1]*t7 + w.RJ_RH_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_RH_hip[1][0]*Ia0 + w.cq_RH_hip*t5 + w.RJ_RH_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_RH_hip[1][0]*t5 + w.cq_RH_hip*Ia4 + w.RJ_RH_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_RH_hip[1][0]*Ia1 + w.cq_RH_hip*t7 + w.RJ_RH_hip[1][2]*Ia7;
+    const Scalar t13 = w.RJ_RH_hip[1][0]*Ia0 + w.cq[9]*t5 + w.RJ_RH_hip[1][2]*Ia1;
+    const Scalar t14 = w.RJ_RH_hip[1][0]*t5 + w.cq[9]*Ia4 + w.RJ_RH_hip[1][2]*t7;
+    const Scalar t15 = w.RJ_RH_hip[1][0]*Ia1 + w.cq[9]*t7 + w.RJ_RH_hip[1][2]*Ia7;
     const Scalar t16 = w.RJ_RH_hip[2][0]*Ia0 + w.RJ_RH_hip[2][1]*t5 + w.RJ_RH_hip[2][2]*Ia1;
     const Scalar t17 = w.RJ_RH_hip[2][0]*t5 + w.RJ_RH_hip[2][1]*Ia4 + w.RJ_RH_hip[2][2]*t7;
     const Scalar t18 = w.RJ_RH_hip[2][0]*Ia1 + w.RJ_RH_hip[2][1]*t7 + w.RJ_RH_hip[2][2]*Ia7;
     const Scalar t19 = w.RJ_RH_hip[0][0]*Ia2 + w.RJ_RH_hip[0][1]*Ia5 + w.RJ_RH_hip[0][2]*Ia8;
     const Scalar t20 = w.RJ_RH_hip[0][0]*t6 + w.RJ_RH_hip[0][1]*t8 + w.RJ_RH_hip[0][2]*t9;
     const Scalar t21 = w.RJ_RH_hip[0][0]*Ia3 + w.RJ_RH_hip[0][1]*Ia6 + w.RJ_RH_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_RH_hip[1][0]*Ia2 + w.cq_RH_hip*Ia5 + w.RJ_RH_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_RH_hip[1][0]*t6 + w.cq_RH_hip*t8 + w.RJ_RH_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_RH_hip[1][0]*Ia3 + w.cq_RH_hip*Ia6 + w.RJ_RH_hip[1][2]*Ia9;
+    const Scalar t22 = w.RJ_RH_hip[1][0]*Ia2 + w.cq[9]*Ia5 + w.RJ_RH_hip[1][2]*Ia8;
+    const Scalar t23 = w.RJ_RH_hip[1][0]*t6 + w.cq[9]*t8 + w.RJ_RH_hip[1][2]*t9;
+    const Scalar t24 = w.RJ_RH_hip[1][0]*Ia3 + w.cq[9]*Ia6 + w.RJ_RH_hip[1][2]*Ia9;
     const Scalar t25 = w.RJ_RH_hip[2][0]*Ia2 + w.RJ_RH_hip[2][1]*Ia5 + w.RJ_RH_hip[2][2]*Ia8;
     const Scalar t26 = w.RJ_RH_hip[2][0]*t6 + w.RJ_RH_hip[2][1]*t8 + w.RJ_RH_hip[2][2]*t9;
     const Scalar t27 = w.RJ_RH_hip[2][0]*Ia3 + w.RJ_RH_hip[2][1]*Ia6 + w.RJ_RH_hip[2][2]*Ia9;
     const Scalar t28 = w.RJ_RH_hip[0][0]*Ia10 + w.RJ_RH_hip[0][1]*Ia11 + w.RJ_RH_hip[0][2]*Ia12;
     const Scalar t29 = w.RJ_RH_hip[0][0]*Ia11 + w.RJ_RH_hip[0][1]*Ia13 + w.RJ_RH_hip[0][2]*Ia14;
     const Scalar t30 = w.RJ_RH_hip[0][0]*Ia12 + w.RJ_RH_hip[0][1]*Ia14 + w.RJ_RH_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_RH_hip[1][0]*Ia10 + w.cq_RH_hip*Ia11 + w.RJ_RH_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_RH_hip[1][0]*Ia11 + w.cq_RH_hip*Ia13 + w.RJ_RH_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_RH_hip[1][0]*Ia12 + w.cq_RH_hip*Ia14 + w.RJ_RH_hip[1][2]*Ia15;
+    const Scalar t31 = w.RJ_RH_hip[1][0]*Ia10 + w.cq[9]*Ia11 + w.RJ_RH_hip[1][2]*Ia12;
+    const Scalar t32 = w.RJ_RH_hip[1][0]*Ia11 + w.cq[9]*Ia13 + w.RJ_RH_hip[1][2]*Ia14;
+    const Scalar t33 = w.RJ_RH_hip[1][0]*Ia12 + w.cq[9]*Ia14 + w.RJ_RH_hip[1][2]*Ia15;
     const Scalar t34 = w.RJ_RH_hip[2][0]*Ia10 + w.RJ_RH_hip[2][1]*Ia11 + w.RJ_RH_hip[2][2]*Ia12;
     const Scalar t35 = w.RJ_RH_hip[2][0]*Ia11 + w.RJ_RH_hip[2][1]*Ia13 + w.RJ_RH_hip[2][2]*Ia14;
     const Scalar t36 = w.RJ_RH_hip[2][0]*Ia12 + w.RJ_RH_hip[2][1]*Ia14 + w.RJ_RH_hip[2][2]*Ia15;
     const Scalar t37 = w.RJ_RH_hip[0][0]*t10 + w.RJ_RH_hip[0][1]*t11 + w.RJ_RH_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_RH_hip[1][0]*t10 + w.cq_RH_hip*t11 + w.RJ_RH_hip[1][2]*t12;
+    const Scalar t38 = w.RJ_RH_hip[1][0]*t10 + w.cq[9]*t11 + w.RJ_RH_hip[1][2]*t12;
     const Scalar t39 = w.RJ_RH_hip[2][0]*t10 + w.RJ_RH_hip[2][1]*t11 + w.RJ_RH_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_RH_hip[1][0]*t13 + w.cq_RH_hip*t14 + w.RJ_RH_hip[1][2]*t15;
+    const Scalar t40 = w.RJ_RH_hip[1][0]*t13 + w.cq[9]*t14 + w.RJ_RH_hip[1][2]*t15;
     const Scalar t41 = w.RJ_RH_hip[2][0]*t13 + w.RJ_RH_hip[2][1]*t14 + w.RJ_RH_hip[2][2]*t15;
     const Scalar t42 = w.RJ_RH_hip[2][0]*t16 + w.RJ_RH_hip[2][1]*t17 + w.RJ_RH_hip[2][2]*t18;
     const Scalar t43 = w.RJ_RH_hip[0][0]*t19 + w.RJ_RH_hip[0][1]*t20 + w.RJ_RH_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_RH_hip[1][0]*t19 + w.cq_RH_hip*t20 + w.RJ_RH_hip[1][2]*t21;
+    const Scalar t44 = w.RJ_RH_hip[1][0]*t19 + w.cq[9]*t20 + w.RJ_RH_hip[1][2]*t21;
     const Scalar t45 = w.RJ_RH_hip[2][0]*t19 + w.RJ_RH_hip[2][1]*t20 + w.RJ_RH_hip[2][2]*t21;
     const Scalar t46 = w.RJ_RH_hip[0][0]*t22 + w.RJ_RH_hip[0][1]*t23 + w.RJ_RH_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_RH_hip[1][0]*t22 + w.cq_RH_hip*t23 + w.RJ_RH_hip[1][2]*t24;
+    const Scalar t47 = w.RJ_RH_hip[1][0]*t22 + w.cq[9]*t23 + w.RJ_RH_hip[1][2]*t24;
     const Scalar t48 = w.RJ_RH_hip[2][0]*t22 + w.RJ_RH_hip[2][1]*t23 + w.RJ_RH_hip[2][2]*t24;
     const Scalar t49 = w.RJ_RH_hip[0][0]*t25 + w.RJ_RH_hip[0][1]*t26 + w.RJ_RH_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_RH_hip[1][0]*t25 + w.cq_RH_hip*t26 + w.RJ_RH_hip[1][2]*t27;
+    const Scalar t50 = w.RJ_RH_hip[1][0]*t25 + w.cq[9]*t26 + w.RJ_RH_hip[1][2]*t27;
     const Scalar t51 = w.RJ_RH_hip[2][0]*t25 + w.RJ_RH_hip[2][1]*t26 + w.RJ_RH_hip[2][2]*t27;
     const Scalar t52 = -0.049*t39 + t43;
     const Scalar t53 = 0.19*t39 + t44;
@@ -1521,7 +1521,7 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
     const Scalar t59 = 0.19*t42 + t50;
     const Scalar t60 = 0.049*t39 - 0.19*t41 + t51;
     const Scalar t61 = w.RJ_RH_hip[0][0]*pa0 + w.RJ_RH_hip[0][1]*pa1 + w.RJ_RH_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_RH_hip[1][0]*pa0 + w.cq_RH_hip*pa1 + w.RJ_RH_hip[1][2]*pa2;
+    const Scalar t62 = w.RJ_RH_hip[1][0]*pa0 + w.cq[9]*pa1 + w.RJ_RH_hip[1][2]*pa2;
     const Scalar t63 = w.RJ_RH_hip[2][0]*pa0 + w.RJ_RH_hip[2][1]*pa1 + w.RJ_RH_hip[2][2]*pa2;
     w.IA_trunk[0] = 3.5200000000000005 + t37;
     w.IA_trunk[1] = t38;
@@ -1539,63 +1539,63 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
     w.IA_trunk[13] = t59;
     w.IA_trunk[14] = t60;
     w.IA_trunk[15] = 0.012033220000000006 + w.RJ_RH_hip[0][0]*t28 + w.RJ_RH_hip[0][1]*t29 + w.RJ_RH_hip[0][2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = w.RJ_RH_hip[1][0]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[1][2]*t30 + 0.19*t49 - 0.049*t59;
+    w.IA_trunk[16] = w.RJ_RH_hip[1][0]*t28 + w.cq[9]*t29 + w.RJ_RH_hip[1][2]*t30 + 0.19*t49 - 0.049*t59;
     w.IA_trunk[17] = w.RJ_RH_hip[2][0]*t28 + w.RJ_RH_hip[2][1]*t29 + w.RJ_RH_hip[2][2]*t30 + 0.049*t43 - 0.19*t46 - 0.049*t60;
-    w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[1][0]*t31 + w.cq_RH_hip*t32 + w.RJ_RH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
+    w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[1][0]*t31 + w.cq[9]*t32 + w.RJ_RH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
     w.IA_trunk[19] = w.RJ_RH_hip[2][0]*t31 + w.RJ_RH_hip[2][1]*t32 + w.RJ_RH_hip[2][2]*t33 + 0.049*t44 - 0.19*t47 + 0.19*t60;
     w.IA_trunk[20] = 0.046770719999999995 + w.RJ_RH_hip[2][0]*t34 + w.RJ_RH_hip[2][1]*t35 + w.RJ_RH_hip[2][2]*t36 + 0.049*t45 - 0.19*t48 + 0.049*t54 - 0.19*t57;
     w.pA_trunk[0] = w.pA_trunk[0] + t61;
     w.pA_trunk[1] = w.pA_trunk[1] + t62;
     w.pA_trunk[2] = w.pA_trunk[2] + t63;
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RH_hip[0][0]*pa3 + w.RJ_RH_hip[0][1]*pa4 + w.RJ_RH_hip[0][2]*pa5 - 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[1][0]*pa3 + w.cq_RH_hip*pa4 + w.RJ_RH_hip[1][2]*pa5 + 0.19*t63;
+    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[1][0]*pa3 + w.cq[9]*pa4 + w.RJ_RH_hip[1][2]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RH_hip[2][0]*pa3 + w.RJ_RH_hip[2][1]*pa4 + w.RJ_RH_hip[2][2]*pa5 + 0.049*t61 - 0.19*t62;
   }
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_6(shared_6_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.IA_RF_thigh, w.pA_RF_thigh);
+  shared_6(shared_6_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_7(shared_7_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.IA_RF_hip, w.pA_RF_hip);
+  shared_7(shared_7_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.IA_trunk, w.pA_trunk);
+  shared_8(shared_8_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_6(shared_6_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.IA_LH_thigh, w.pA_LH_thigh);
+  shared_6(shared_6_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_7(shared_7_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.IA_LH_hip, w.pA_LH_hip);
+  shared_7(shared_7_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.IA_trunk, w.pA_trunk);
+  shared_8(shared_8_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_6(shared_6_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.IA_LF_thigh, w.pA_LF_thigh);
+  shared_6(shared_6_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_7(shared_7_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.IA_LF_hip, w.pA_LF_hip);
+  shared_7(shared_7_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.IA_trunk, w.pA_trunk);
+  shared_8(shared_8_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1662,41 +1662,41 @@ PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_REST
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_12(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_12(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_12(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_12(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1706,9 +1706,9 @@ PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTR
 
 PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_15(shared_15_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.dp_RH_thigh);
+  shared_15(shared_15_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, &w.cq[11], &w.sq[11], w.dp_RH_thigh);
   // reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_16(shared_16_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], w.cq_RH_thigh, w.sq_RH_thigh, w.dp_RH_hip);
+  shared_16(shared_16_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], &w.cq[10], &w.sq[10], w.dp_RH_hip);
   // reduced sweep: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar du0 = -0.9950371902099892*w.dp_RH_hip[3] + 0.09950371902099892*w.dp_RH_hip[5];
@@ -1721,42 +1721,42 @@ PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_R
     const Scalar t18 = w.dp_RH_hip[5] + w.U_RH_hip[5]*t13;
     const Scalar t19 = -5.7617628499109426e-05*w.Dinv_RH_hip*du0;
     const Scalar t20 = w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[0][1]*t15 + w.RJ_RH_hip[0][2]*t16;
-    const Scalar t21 = w.RJ_RH_hip[1][0]*t14 + w.cq_RH_hip*t15 + w.RJ_RH_hip[1][2]*t16;
+    const Scalar t21 = w.RJ_RH_hip[1][0]*t14 + w.cq[9]*t15 + w.RJ_RH_hip[1][2]*t16;
     const Scalar t22 = w.RJ_RH_hip[2][0]*t14 + w.RJ_RH_hip[2][1]*t15 + w.RJ_RH_hip[2][2]*t16;
     w.dp_trunk[0] = t20;
     w.dp_trunk[1] = t21;
     w.dp_trunk[2] = t22;
     w.dp_trunk[3] = w.RJ_RH_hip[0][0]*t17 + w.RJ_RH_hip[0][1]*t19 + w.RJ_RH_hip[0][2]*t18 - 0.049*t22;
-    w.dp_trunk[4] = w.RJ_RH_hip[1][0]*t17 + w.cq_RH_hip*t19 + w.RJ_RH_hip[1][2]*t18 + 0.19*t22;
+    w.dp_trunk[4] = w.RJ_RH_hip[1][0]*t17 + w.cq[9]*t19 + w.RJ_RH_hip[1][2]*t18 + 0.19*t22;
     w.dp_trunk[5] = w.RJ_RH_hip[2][0]*t17 + w.RJ_RH_hip[2][1]*t19 + w.RJ_RH_hip[2][2]*t18 + 0.049*t20 - 0.19*t21;
   }
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_RF_shank_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_15(shared_15_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.dp_RF_thigh);
+  shared_15(shared_15_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, &w.cq[8], &w.sq[8], w.dp_RF_thigh);
   // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_16(shared_16_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], w.cq_RF_thigh, w.sq_RF_thigh, w.dp_RF_hip);
+  shared_16(shared_16_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], &w.cq[7], &w.sq[7], w.dp_RF_hip);
   // reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.dp_trunk);
+  shared_17(shared_17_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LH_shank_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_15(shared_15_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.dp_LH_thigh);
+  shared_15(shared_15_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, &w.cq[5], &w.sq[5], w.dp_LH_thigh);
   // reduced sweep: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_16(shared_16_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], w.cq_LH_thigh, w.sq_LH_thigh, w.dp_LH_hip);
+  shared_16(shared_16_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], &w.cq[4], &w.sq[4], w.dp_LH_hip);
   // reduced sweep: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.dp_trunk);
+  shared_17(shared_17_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LF_shank_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_15(shared_15_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.dp_LF_thigh);
+  shared_15(shared_15_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, &w.cq[2], &w.sq[2], w.dp_LF_thigh);
   // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_16(shared_16_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], w.cq_LF_thigh, w.sq_LF_thigh, w.dp_LF_hip);
+  shared_16(shared_16_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], &w.cq[1], &w.sq[1], w.dp_LF_hip);
   // reduced sweep: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.dp_trunk);
+  shared_17(shared_17_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq, w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1775,41 +1775,41 @@ PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RE
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_12(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_12(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_12(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_12(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1819,12 +1819,12 @@ PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_18(shared_18_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
+  shared_18(shared_18_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_19(shared_19_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
+  shared_19(shared_19_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1873,44 +1873,44 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     const Scalar t10 = w.RJ_RH_hip[0][0]*Ia0 + w.RJ_RH_hip[0][1]*t5 + w.RJ_RH_hip[0][2]*Ia1;
     const Scalar t11 = w.RJ_RH_hip[0][0]*t5 + w.RJ_RH_hip[0][1]*Ia4 + w.RJ_RH_hip[0][2]*t7;
     const Scalar t12 = w.RJ_RH_hip[0][0]*Ia1 + w.RJ_RH_hip[0][1]*t7 + w.RJ_RH_hip[0][2]*Ia7;
-    const Scalar t13 = w.RJ_RH_hip[1][0]*Ia0 + w.cq_RH_hip*t5 + w.RJ_RH_hip[1][2]*Ia1;
-    const Scalar t14 = w.RJ_RH_hip[1][0]*t5 + w.cq_RH_hip*Ia4 + w.RJ_RH_hip[1][2]*t7;
-    const Scalar t15 = w.RJ_RH_hip[1][0]*Ia1 + w.cq_RH_hip*t7 + w.RJ_RH_hip[1][2]*Ia7;
+    const Scalar t13 = w.RJ_RH_hip[1][0]*Ia0 + w.cq[9]*t5 + w.RJ_RH_hip[1][2]*Ia1;
+    const Scalar t14 = w.RJ_RH_hip[1][0]*t5 + w.cq[9]*Ia4 + w.RJ_RH_hip[1][2]*t7;
+    const Scalar t15 = w.RJ_RH_hip[1][0]*Ia1 + w.cq[9]*t7 + w.RJ_RH_hip[1][2]*Ia7;
     const Scalar t16 = w.RJ_RH_hip[2][0]*Ia0 + w.RJ_RH_hip[2][1]*t5 + w.RJ_RH_hip[2][2]*Ia1;
     const Scalar t17 = w.RJ_RH_hip[2][0]*t5 + w.RJ_RH_hip[2][1]*Ia4 + w.RJ_RH_hip[2][2]*t7;
     const Scalar t18 = w.RJ_RH_hip[2][0]*Ia1 + w.RJ_RH_hip[2][1]*t7 + w.RJ_RH_hip[2][2]*Ia7;
     const Scalar t19 = w.RJ_RH_hip[0][0]*Ia2 + w.RJ_RH_hip[0][1]*Ia5 + w.RJ_RH_hip[0][2]*Ia8;
     const Scalar t20 = w.RJ_RH_hip[0][0]*t6 + w.RJ_RH_hip[0][1]*t8 + w.RJ_RH_hip[0][2]*t9;
     const Scalar t21 = w.RJ_RH_hip[0][0]*Ia3 + w.RJ_RH_hip[0][1]*Ia6 + w.RJ_RH_hip[0][2]*Ia9;
-    const Scalar t22 = w.RJ_RH_hip[1][0]*Ia2 + w.cq_RH_hip*Ia5 + w.RJ_RH_hip[1][2]*Ia8;
-    const Scalar t23 = w.RJ_RH_hip[1][0]*t6 + w.cq_RH_hip*t8 + w.RJ_RH_hip[1][2]*t9;
-    const Scalar t24 = w.RJ_RH_hip[1][0]*Ia3 + w.cq_RH_hip*Ia6 + w.RJ_RH_hip[1][2]*Ia9;
+    const Scalar t22 = w.RJ_RH_hip[1][0]*Ia2 + w.cq[9]*Ia5 + w.RJ_RH_hip[1][2]*Ia8;
+    const Scalar t23 = w.RJ_RH_hip[1][0]*t6 + w.cq[9]*t8 + w.RJ_RH_hip[1][2]*t9;
+    const Scalar t24 = w.RJ_RH_hip[1][0]*Ia3 + w.cq[9]*Ia6 + w.RJ_RH_hip[1][2]*Ia9;
     const Scalar t25 = w.RJ_RH_hip[2][0]*Ia2 + w.RJ_RH_hip[2][1]*Ia5 + w.RJ_RH_hip[2][2]*Ia8;
     const Scalar t26 = w.RJ_RH_hip[2][0]*t6 + w.RJ_RH_hip[2][1]*t8 + w.RJ_RH_hip[2][2]*t9;
     const Scalar t27 = w.RJ_RH_hip[2][0]*Ia3 + w.RJ_RH_hip[2][1]*Ia6 + w.RJ_RH_hip[2][2]*Ia9;
     const Scalar t28 = w.RJ_RH_hip[0][0]*Ia10 + w.RJ_RH_hip[0][1]*Ia11 + w.RJ_RH_hip[0][2]*Ia12;
     const Scalar t29 = w.RJ_RH_hip[0][0]*Ia11 + w.RJ_RH_hip[0][1]*Ia13 + w.RJ_RH_hip[0][2]*Ia14;
     const Scalar t30 = w.RJ_RH_hip[0][0]*Ia12 + w.RJ_RH_hip[0][1]*Ia14 + w.RJ_RH_hip[0][2]*Ia15;
-    const Scalar t31 = w.RJ_RH_hip[1][0]*Ia10 + w.cq_RH_hip*Ia11 + w.RJ_RH_hip[1][2]*Ia12;
-    const Scalar t32 = w.RJ_RH_hip[1][0]*Ia11 + w.cq_RH_hip*Ia13 + w.RJ_RH_hip[1][2]*Ia14;
-    const Scalar t33 = w.RJ_RH_hip[1][0]*Ia12 + w.cq_RH_hip*Ia14 + w.RJ_RH_hip[1][2]*Ia15;
+    const Scalar t31 = w.RJ_RH_hip[1][0]*Ia10 + w.cq[9]*Ia11 + w.RJ_RH_hip[1][2]*Ia12;
+    const Scalar t32 = w.RJ_RH_hip[1][0]*Ia11 + w.cq[9]*Ia13 + w.RJ_RH_hip[1][2]*Ia14;
+    const Scalar t33 = w.RJ_RH_hip[1][0]*Ia12 + w.cq[9]*Ia14 + w.RJ_RH_hip[1][2]*Ia15;
     const Scalar t34 = w.RJ_RH_hip[2][0]*Ia10 + w.RJ_RH_hip[2][1]*Ia11 + w.RJ_RH_hip[2][2]*Ia12;
     const Scalar t35 = w.RJ_RH_hip[2][0]*Ia11 + w.RJ_RH_hip[2][1]*Ia13 + w.RJ_RH_hip[2][2]*Ia14;
     const Scalar t36 = w.RJ_RH_hip[2][0]*Ia12 + w.RJ_RH_hip[2][1]*Ia14 + w.RJ_RH_hip[2][2]*Ia15;
     const Scalar t37 = w.RJ_RH_hip[0][0]*t10 + w.RJ_RH_hip[0][1]*t11 + w.RJ_RH_hip[0][2]*t12;
-    const Scalar t38 = w.RJ_RH_hip[1][0]*t10 + w.cq_RH_hip*t11 + w.RJ_RH_hip[1][2]*t12;
+    const Scalar t38 = w.RJ_RH_hip[1][0]*t10 + w.cq[9]*t11 + w.RJ_RH_hip[1][2]*t12;
     const Scalar t39 = w.RJ_RH_hip[2][0]*t10 + w.RJ_RH_hip[2][1]*t11 + w.RJ_RH_hip[2][2]*t12;
-    const Scalar t40 = w.RJ_RH_hip[1][0]*t13 + w.cq_RH_hip*t14 + w.RJ_RH_hip[1][2]*t15;
+    const Scalar t40 = w.RJ_RH_hip[1][0]*t13 + w.cq[9]*t14 + w.RJ_RH_hip[1][2]*t15;
     const Scalar t41 = w.RJ_RH_hip[2][0]*t13 + w.RJ_RH_hip[2][1]*t14 + w.RJ_RH_hip[2][2]*t15;
     const Scalar t42 = w.RJ_RH_hip[2][0]*t16 + w.RJ_RH_hip[2][1]*t17 + w.RJ_RH_hip[2][2]*t18;
     const Scalar t43 = w.RJ_RH_hip[0][0]*t19 + w.RJ_RH_hip[0][1]*t20 + w.RJ_RH_hip[0][2]*t21;
-    const Scalar t44 = w.RJ_RH_hip[1][0]*t19 + w.cq_RH_hip*t20 + w.RJ_RH_hip[1][2]*t21;
+    const Scalar t44 = w.RJ_RH_hip[1][0]*t19 + w.cq[9]*t20 + w.RJ_RH_hip[1][2]*t21;
     const Scalar t45 = w.RJ_RH_hip[2][0]*t19 + w.RJ_RH_hip[2][1]*t20 + w.RJ_RH_hip[2][2]*t21;
     const Scalar t46 = w.RJ_RH_hip[0][0]*t22 + w.RJ_RH_hip[0][1]*t23 + w.RJ_RH_hip[0][2]*t24;
-    const Scalar t47 = w.RJ_RH_hip[1][0]*t22 + w.cq_RH_hip*t23 + w.RJ_RH_hip[1][2]*t24;
+    const Scalar t47 = w.RJ_RH_hip[1][0]*t22 + w.cq[9]*t23 + w.RJ_RH_hip[1][2]*t24;
     const Scalar t48 = w.RJ_RH_hip[2][0]*t22 + w.RJ_RH_hip[2][1]*t23 + w.RJ_RH_hip[2][2]*t24;
     const Scalar t49 = w.RJ_RH_hip[0][0]*t25 + w.RJ_RH_hip[0][1]*t26 + w.RJ_RH_hip[0][2]*t27;
-    const Scalar t50 = w.RJ_RH_hip[1][0]*t25 + w.cq_RH_hip*t26 + w.RJ_RH_hip[1][2]*t27;
+    const Scalar t50 = w.RJ_RH_hip[1][0]*t25 + w.cq[9]*t26 + w.RJ_RH_hip[1][2]*t27;
     const Scalar t51 = w.RJ_RH_hip[2][0]*t25 + w.RJ_RH_hip[2][1]*t26 + w.RJ_RH_hip[2][2]*t27;
     const Scalar t52 = -0.049*t39 + t43;
     const Scalar t53 = 0.19*t39 + t44;
@@ -1922,7 +1922,7 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     const Scalar t59 = 0.19*t42 + t50;
     const Scalar t60 = 0.049*t39 - 0.19*t41 + t51;
     const Scalar t61 = w.RJ_RH_hip[0][0]*pa0 + w.RJ_RH_hip[0][1]*pa1 + w.RJ_RH_hip[0][2]*pa2;
-    const Scalar t62 = w.RJ_RH_hip[1][0]*pa0 + w.cq_RH_hip*pa1 + w.RJ_RH_hip[1][2]*pa2;
+    const Scalar t62 = w.RJ_RH_hip[1][0]*pa0 + w.cq[9]*pa1 + w.RJ_RH_hip[1][2]*pa2;
     const Scalar t63 = w.RJ_RH_hip[2][0]*pa0 + w.RJ_RH_hip[2][1]*pa1 + w.RJ_RH_hip[2][2]*pa2;
     w.IA_trunk[0] = 3.5200000000000005 + t37;
     w.IA_trunk[1] = t38;
@@ -1940,16 +1940,16 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     w.IA_trunk[13] = t59;
     w.IA_trunk[14] = t60;
     w.IA_trunk[15] = 0.012033220000000006 + w.RJ_RH_hip[0][0]*t28 + w.RJ_RH_hip[0][1]*t29 + w.RJ_RH_hip[0][2]*t30 - 0.049*t49 - 0.049*t58;
-    w.IA_trunk[16] = w.RJ_RH_hip[1][0]*t28 + w.cq_RH_hip*t29 + w.RJ_RH_hip[1][2]*t30 + 0.19*t49 - 0.049*t59;
+    w.IA_trunk[16] = w.RJ_RH_hip[1][0]*t28 + w.cq[9]*t29 + w.RJ_RH_hip[1][2]*t30 + 0.19*t49 - 0.049*t59;
     w.IA_trunk[17] = w.RJ_RH_hip[2][0]*t28 + w.RJ_RH_hip[2][1]*t29 + w.RJ_RH_hip[2][2]*t30 + 0.049*t43 - 0.19*t46 - 0.049*t60;
-    w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[1][0]*t31 + w.cq_RH_hip*t32 + w.RJ_RH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
+    w.IA_trunk[18] = 0.039772499999999995 + w.RJ_RH_hip[1][0]*t31 + w.cq[9]*t32 + w.RJ_RH_hip[1][2]*t33 + 0.19*t50 + 0.19*t59;
     w.IA_trunk[19] = w.RJ_RH_hip[2][0]*t31 + w.RJ_RH_hip[2][1]*t32 + w.RJ_RH_hip[2][2]*t33 + 0.049*t44 - 0.19*t47 + 0.19*t60;
     w.IA_trunk[20] = 0.046770719999999995 + w.RJ_RH_hip[2][0]*t34 + w.RJ_RH_hip[2][1]*t35 + w.RJ_RH_hip[2][2]*t36 + 0.049*t45 - 0.19*t48 + 0.049*t54 - 0.19*t57;
     w.pA_trunk[0] = w.pA_trunk[0] + t61;
     w.pA_trunk[1] = w.pA_trunk[1] + t62;
     w.pA_trunk[2] = w.pA_trunk[2] + t63;
     w.pA_trunk[3] = w.pA_trunk[3] + w.RJ_RH_hip[0][0]*pa3 + w.RJ_RH_hip[0][1]*pa4 + w.RJ_RH_hip[0][2]*pa5 - 0.049*t63;
-    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[1][0]*pa3 + w.cq_RH_hip*pa4 + w.RJ_RH_hip[1][2]*pa5 + 0.19*t63;
+    w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[1][0]*pa3 + w.cq[9]*pa4 + w.RJ_RH_hip[1][2]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RH_hip[2][0]*pa3 + w.RJ_RH_hip[2][1]*pa4 + w.RJ_RH_hip[2][2]*pa5 + 0.049*t61 - 0.19*t62;
     w.KS_RH_hip[0] = 0.9950371902099892*w.KA_RH_hip[3][0] - 0.09950371902099892*w.KA_RH_hip[5][0];
     w.KSD_RH_hip[0] = w.Dinv_RH_hip*w.KS_RH_hip[0];
@@ -1959,13 +1959,13 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     const Scalar t67 = w.KA_RH_hip[3][0] - w.U_RH_hip[3]*w.KSD_RH_hip[0];
     const Scalar t68 = w.KA_RH_hip[5][0] - w.U_RH_hip[5]*w.KSD_RH_hip[0];
     const Scalar t69 = w.RJ_RH_hip[0][0]*t64 + w.RJ_RH_hip[0][1]*t66 + w.RJ_RH_hip[0][2]*t65;
-    const Scalar t70 = w.RJ_RH_hip[1][0]*t64 + w.cq_RH_hip*t66 + w.RJ_RH_hip[1][2]*t65;
+    const Scalar t70 = w.RJ_RH_hip[1][0]*t64 + w.cq[9]*t66 + w.RJ_RH_hip[1][2]*t65;
     const Scalar t71 = w.RJ_RH_hip[2][0]*t64 + w.RJ_RH_hip[2][1]*t66 + w.RJ_RH_hip[2][2]*t65;
     w.KA_trunk[0][9] = t69;
     w.KA_trunk[1][9] = t70;
     w.KA_trunk[2][9] = t71;
     w.KA_trunk[3][9] = w.RJ_RH_hip[0][0]*t67 + 5.7617628499109426e-05*w.RJ_RH_hip[0][1]*w.KSD_RH_hip[0] + w.RJ_RH_hip[0][2]*t68 - 0.049*t71;
-    w.KA_trunk[4][9] = w.RJ_RH_hip[1][0]*t67 + 5.7617628499109426e-05*w.cq_RH_hip*w.KSD_RH_hip[0] + w.RJ_RH_hip[1][2]*t68 + 0.19*t71;
+    w.KA_trunk[4][9] = w.RJ_RH_hip[1][0]*t67 + 5.7617628499109426e-05*w.cq[9]*w.KSD_RH_hip[0] + w.RJ_RH_hip[1][2]*t68 + 0.19*t71;
     w.KA_trunk[5][9] = w.RJ_RH_hip[2][0]*t67 + 5.7617628499109426e-05*w.RJ_RH_hip[2][1]*w.KSD_RH_hip[0] + w.RJ_RH_hip[2][2]*t68 + 0.049*t69 - 0.19*t70;
     w.KS_RH_hip[1] = 0.9950371902099892*w.KA_RH_hip[3][1] - 0.09950371902099892*w.KA_RH_hip[5][1];
     w.KSD_RH_hip[1] = w.Dinv_RH_hip*w.KS_RH_hip[1];
@@ -1975,13 +1975,13 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     const Scalar t75 = w.KA_RH_hip[3][1] - w.U_RH_hip[3]*w.KSD_RH_hip[1];
     const Scalar t76 = w.KA_RH_hip[5][1] - w.U_RH_hip[5]*w.KSD_RH_hip[1];
     const Scalar t77 = w.RJ_RH_hip[0][0]*t73 + w.RJ_RH_hip[0][1]*t72 + w.RJ_RH_hip[0][2]*t74;
-    const Scalar t78 = w.RJ_RH_hip[1][0]*t73 + w.cq_RH_hip*t72 + w.RJ_RH_hip[1][2]*t74;
+    const Scalar t78 = w.RJ_RH_hip[1][0]*t73 + w.cq[9]*t72 + w.RJ_RH_hip[1][2]*t74;
     const Scalar t79 = w.RJ_RH_hip[2][0]*t73 + w.RJ_RH_hip[2][1]*t72 + w.RJ_RH_hip[2][2]*t74;
     w.KA_trunk[0][10] = t77;
     w.KA_trunk[1][10] = t78;
     w.KA_trunk[2][10] = t79;
     w.KA_trunk[3][10] = w.RJ_RH_hip[0][0]*t75 + 5.7617628499109426e-05*w.RJ_RH_hip[0][1]*w.KSD_RH_hip[1] + w.RJ_RH_hip[0][2]*t76 - 0.049*t79;
-    w.KA_trunk[4][10] = w.RJ_RH_hip[1][0]*t75 + 5.7617628499109426e-05*w.cq_RH_hip*w.KSD_RH_hip[1] + w.RJ_RH_hip[1][2]*t76 + 0.19*t79;
+    w.KA_trunk[4][10] = w.RJ_RH_hip[1][0]*t75 + 5.7617628499109426e-05*w.cq[9]*w.KSD_RH_hip[1] + w.RJ_RH_hip[1][2]*t76 + 0.19*t79;
     w.KA_trunk[5][10] = w.RJ_RH_hip[2][0]*t75 + 5.7617628499109426e-05*w.RJ_RH_hip[2][1]*w.KSD_RH_hip[1] + w.RJ_RH_hip[2][2]*t76 + 0.049*t77 - 0.19*t78;
     w.KS_RH_hip[2] = 0.9950371902099892*w.KA_RH_hip[3][2] - 0.09950371902099892*w.KA_RH_hip[5][2];
     w.KSD_RH_hip[2] = w.Dinv_RH_hip*w.KS_RH_hip[2];
@@ -1991,60 +1991,60 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     const Scalar t83 = w.KA_RH_hip[3][2] - w.U_RH_hip[3]*w.KSD_RH_hip[2];
     const Scalar t84 = w.KA_RH_hip[5][2] - w.U_RH_hip[5]*w.KSD_RH_hip[2];
     const Scalar t85 = w.RJ_RH_hip[0][0]*t80 + w.RJ_RH_hip[0][1]*t82 + w.RJ_RH_hip[0][2]*t81;
-    const Scalar t86 = w.RJ_RH_hip[1][0]*t80 + w.cq_RH_hip*t82 + w.RJ_RH_hip[1][2]*t81;
+    const Scalar t86 = w.RJ_RH_hip[1][0]*t80 + w.cq[9]*t82 + w.RJ_RH_hip[1][2]*t81;
     const Scalar t87 = w.RJ_RH_hip[2][0]*t80 + w.RJ_RH_hip[2][1]*t82 + w.RJ_RH_hip[2][2]*t81;
     w.KA_trunk[0][11] = t85;
     w.KA_trunk[1][11] = t86;
     w.KA_trunk[2][11] = t87;
     w.KA_trunk[3][11] = w.RJ_RH_hip[0][0]*t83 + 5.7617628499109426e-05*w.RJ_RH_hip[0][1]*w.KSD_RH_hip[2] + w.RJ_RH_hip[0][2]*t84 - 0.049*t87;
-    w.KA_trunk[4][11] = w.RJ_RH_hip[1][0]*t83 + 5.7617628499109426e-05*w.cq_RH_hip*w.KSD_RH_hip[2] + w.RJ_RH_hip[1][2]*t84 + 0.19*t87;
+    w.KA_trunk[4][11] = w.RJ_RH_hip[1][0]*t83 + 5.7617628499109426e-05*w.cq[9]*w.KSD_RH_hip[2] + w.RJ_RH_hip[1][2]*t84 + 0.19*t87;
     w.KA_trunk[5][11] = w.RJ_RH_hip[2][0]*t83 + 5.7617628499109426e-05*w.RJ_RH_hip[2][1]*w.KSD_RH_hip[2] + w.RJ_RH_hip[2][2]*t84 + 0.049*t85 - 0.19*t86;
   }
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_18(shared_18_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
+  shared_18(shared_18_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_19(shared_19_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
+  shared_19(shared_19_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
+  shared_20(shared_20_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_18(shared_18_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
+  shared_18(shared_18_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_19(shared_19_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
+  shared_19(shared_19_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
+  shared_20(shared_20_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_18(shared_18_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
+  shared_18(shared_18_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_19(shared_19_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
+  shared_19(shared_19_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq_LF_hip, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
+  shared_20(shared_20_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2337,10 +2337,10 @@ PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT 
     const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
     const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
     const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[2][1]*t24;
+    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq[0]*t23 + w.RJ_LF_hip[2][1]*t24;
     const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
     const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq[0]*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
     const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
     const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
     w.a_LF_hip[0] = t25;
@@ -2354,36 +2354,36 @@ PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
+  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
   // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_22(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.a_LF_shank);
+  shared_22(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.a_LF_shank);
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
+  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
+  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
   // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_22(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, w.a_LH_shank);
+  shared_22(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.a_LH_shank);
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
+  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
+  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
   // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_22(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, w.a_RF_shank);
+  shared_22(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.a_RF_shank);
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
+  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
+  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_22(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, w.a_RH_shank);
+  shared_22(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.a_RH_shank);
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -2910,10 +2910,10 @@ PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRI
     const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
     const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
     const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq_LF_hip*t23 + w.RJ_LF_hip[2][1]*t24;
+    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq[0]*t23 + w.RJ_LF_hip[2][1]*t24;
     const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
     const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq_LF_hip*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
+    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq[0]*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
     const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
     const Scalar t31 = w.u_LF_hip[0] - w.KS_LF_hip[0]*w.lambda[0] - w.KS_LF_hip[1]*w.lambda[1] - w.KS_LF_hip[2]*w.lambda[2] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
     w.qdd[6] = w.Dinv_LF_hip*t31;
@@ -2928,36 +2928,36 @@ PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRI
 
 PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_25(shared_25_k0, w.a_LF_hip, w.c_LF_thigh, w.cq_LF_thigh, w.sq_LF_thigh, w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_25(shared_25_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_26(w.a_LF_thigh, w.c_LF_shank, w.cq_LF_shank, w.sq_LF_shank, w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
+  shared_26(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
   // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, w.cq_LH_hip, w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_27(shared_27_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_25(shared_25_k0, w.a_LH_hip, w.c_LH_thigh, w.cq_LH_thigh, w.sq_LH_thigh, w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_25(shared_25_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_26(w.a_LH_thigh, w.c_LH_shank, w.cq_LH_shank, w.sq_LH_shank, w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
+  shared_26(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, w.cq_RF_hip, w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_27(shared_27_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_25(shared_25_k1, w.a_RF_hip, w.c_RF_thigh, w.cq_RF_thigh, w.sq_RF_thigh, w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_25(shared_25_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_26(w.a_RF_thigh, w.c_RF_shank, w.cq_RF_shank, w.sq_RF_shank, w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
+  shared_26(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
   // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, w.cq_RH_hip, w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_27(shared_27_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_25(shared_25_k1, w.a_RH_hip, w.c_RH_thigh, w.cq_RH_thigh, w.sq_RH_thigh, w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_25(shared_25_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_26(w.a_RH_thigh, w.c_RH_shank, w.cq_RH_shank, w.sq_RH_shank, w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
+  shared_26(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2993,6 +2993,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
+  proxgen_rt::sincos_run<12>(&q[7], &w.sq[0], &w.cq[0]);
   // ---- joint transforms X_J(q)
   kinematics_transforms_trunk_to_LH_hip(q, w);
   kinematics_transforms_LH_thigh_to_RH_shank(q, w);

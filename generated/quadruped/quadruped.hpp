@@ -135,35 +135,13 @@ struct Settings {
 // Everything one solve writes (11288 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
+  Scalar sq[12];               // sin q of the revolute joints (q order)
+  Scalar cq[12];               // cos q of the revolute joints (q order)
   Scalar RJ_trunk[3][3];       // joint rotation, body 1
-  Scalar sq_LF_hip;            // sin q, body 2
-  Scalar cq_LF_hip;            // cos q, body 2
   Scalar RJ_LF_hip[3][3];      // joint rotation, body 2
-  Scalar sq_LF_thigh;          // sin q, body 3
-  Scalar cq_LF_thigh;          // cos q, body 3
-  Scalar sq_LF_shank;          // sin q, body 4
-  Scalar cq_LF_shank;          // cos q, body 4
-  Scalar sq_LH_hip;            // sin q, body 5
-  Scalar cq_LH_hip;            // cos q, body 5
   Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
-  Scalar sq_LH_thigh;          // sin q, body 6
-  Scalar cq_LH_thigh;          // cos q, body 6
-  Scalar sq_LH_shank;          // sin q, body 7
-  Scalar cq_LH_shank;          // cos q, body 7
-  Scalar sq_RF_hip;            // sin q, body 8
-  Scalar cq_RF_hip;            // cos q, body 8
   Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
-  Scalar sq_RF_thigh;          // sin q, body 9
-  Scalar cq_RF_thigh;          // cos q, body 9
-  Scalar sq_RF_shank;          // sin q, body 10
-  Scalar cq_RF_shank;          // cos q, body 10
-  Scalar sq_RH_hip;            // sin q, body 11
-  Scalar cq_RH_hip;            // cos q, body 11
   Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
-  Scalar sq_RH_thigh;          // sin q, body 12
-  Scalar cq_RH_thigh;          // cos q, body 12
-  Scalar sq_RH_shank;          // sin q, body 13
-  Scalar cq_RH_shank;          // cos q, body 13
   Scalar pA_trunk[6];          // bias force, body 1
   Scalar g_trunk[3];           // gravity in body coordinates, body 1
   Scalar v_LF_hip[6];          // velocity, body 2

@@ -14,7 +14,7 @@ struct Quantity {
   const char* prefix;
   const char* what;
 };
-inline constexpr Quantity kQ{"q", "joint offset q"}, kSin{"sq", "sin q"}, kCos{"cq", "cos q"},
+inline constexpr Quantity kQ{"q", "joint offset q"},
     kRJ{"RJ", "joint rotation"}, kV{"v", "velocity"}, kC{"c", "velocity-product acceleration"},
     kPA{"pA", "bias force"}, kIA{"IA", "articulated inertia (upper triangle)"}, kG{"g", "gravity in body coordinates"},
     kOR{"oR", "world rotation"}, kOP{"op", "world position"}, kU{"U", "IA S"}, kDinv{"Dinv", "1 / (S^T IA S)"},

@@ -60,8 +60,11 @@ ConstraintJoints emitConstraintJoints(Emit& e, bool all) {
   e.fn.live() = Live{};
   e.fn.live().kin = &j.kin;
   e.fn.beginHost("joints", nullptr);
-  for (int i = 1; i < m.numBodies(); ++i) {
-    if (!all && !e.bp(i).onSupport) continue;
+  std::vector<int> bodies;
+  for (int i = 1; i < m.numBodies(); ++i)
+    if (all || e.bp(i).onSupport) bodies.push_back(i);
+  sincosRuns(e, bodies);
+  for (int i : bodies) {
     e.fn.boundary(i);
     e.openBody(i, "joint transform:");
     jointTransform(e, i, j.kin.b[std::size_t(i)]);

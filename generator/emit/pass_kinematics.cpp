@@ -8,6 +8,8 @@
 // algorithms/constraints.cpp.
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "emit/identifiers.hpp"
 #include "emit/passes.hpp"
 
@@ -22,20 +24,65 @@ Ops sincos() {
   return o;
 }
 
+bool revolute(const BodyPlan& b) {
+  return b.jointClass == JointClass::RevoluteX || b.jointClass == JointClass::RevoluteY ||
+         b.jointClass == JointClass::RevoluteZ || b.jointClass == JointClass::RevoluteAxis;
+}
+
+// The revolute joints' bodies in q order: slot j of w.sq and w.cq is the j-th.
+std::vector<int> revoluteBodies(const Plan& plan) {
+  std::vector<int> out;
+  for (std::size_t i = 1; i < plan.bodies.size(); ++i)  // bodies[0] is the world
+    if (revolute(plan.bodies[i])) out.push_back(int(i));
+  std::sort(out.begin(), out.end(),
+            [&](int a, int b) { return plan.bodies[std::size_t(a)].idx_q < plan.bodies[std::size_t(b)].idx_q; });
+  return out;
+}
+
+// The members holding joint j's sine and cosine.
+std::pair<std::string, std::string> sincosMembers(Emit& e, int slot, int slots) {
+  return {e.member("sq", slots, slot, "sin q of the revolute joints (q order)"),
+          e.member("cq", slots, slot, "cos q of the revolute joints (q order)")};
+}
+
 }  // namespace
 
-bool sincosCalled(const Plan& plan) {
-  int revolute = 0;
-  for (std::size_t i = 1; i < plan.bodies.size(); ++i) {  // bodies[0] is the world
-    const BodyPlan& b = plan.bodies[i];
-    if (b.jointClass == JointClass::RevoluteX || b.jointClass == JointClass::RevoluteY ||
-        b.jointClass == JointClass::RevoluteZ || b.jointClass == JointClass::RevoluteAxis)
-      ++revolute;
+bool sincosCalled(const Plan& plan) { return revoluteBodies(plan).size() > 16; }
+
+void sincosRuns(Emit& e, const std::vector<int>& bodies) {
+  const std::vector<int> all = revoluteBodies(e.plan);
+  std::vector<char> wanted(e.plan.bodies.size(), 0);
+  for (int i : bodies) wanted[std::size_t(i)] = 1;
+  CodeBuilder& cb = e.cb();
+  for (std::size_t a = 0; a < all.size();) {
+    if (!wanted[std::size_t(all[a])]) {
+      ++a;
+      continue;
+    }
+    // The run: consecutive slots whose angles are consecutive in q.
+    std::size_t b = a + 1;
+    while (b < all.size() && wanted[std::size_t(all[b])] &&
+           e.bp(all[b]).idx_q == e.bp(all[b - 1]).idx_q + 1)
+      ++b;
+    std::vector<std::string> written;
+    std::vector<Expr> angles;
+    for (std::size_t j = a; j < b; ++j) {
+      const auto [sm, cm] = sincosMembers(e, int(j), int(all.size()));
+      written.push_back(sm);
+      written.push_back(cm);
+      angles.push_back(cb.input(q(e.bp(all[j]).idx_q)));
+    }
+    const std::string s0 = written[0], c0 = written[1];
+    cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}>(&{}, &{}, &{});", b - a, q(e.bp(all[a]).idx_q), s0, c0),
+                   written, angles);
+    a = b;
   }
-  return revolute > 16;
 }
 
 bool jointTransformsFirst(Emit& e, Kinematics& kin) {
+  std::vector<int> bodies;
+  for (int i = 1; i < e.model().numBodies(); ++i) bodies.push_back(i);
+  sincosRuns(e, bodies);
   if (sincosCalled(e.plan)) return false;
   e.fn.beginPass("transforms", "joint transforms X_J(q)");
   for (int i = 1; i < e.model().numBodies(); ++i) {
@@ -110,10 +157,15 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
     return;
   }
   // Revolute: R = c I + s [a]x + (1 - c) a a^T; an axis along +-x/y/z folds to picks of c and s.
-  const std::string sm = e.member(kSin, i, 0, 0), cm = e.member(kCos, i, 0, 0);
+  // Its sine and cosine: computed here, or (a target with wide enough vector
+  // registers) by the run before the pass, sincosRuns (lanes.hpp, sincos_run).
+  const std::vector<int> slots = revoluteBodies(e.plan);
+  const int slot = int(std::find(slots.begin(), slots.end(), i) - slots.begin());
+  const auto [sm, cm] = sincosMembers(e, slot, int(slots.size()));
   const std::vector<Expr> sc = cb.storeByCall(
-      fmt::format("proxgen_rt::{}({}, {}, {});", sincosCalled(e.plan) ? "sincos_noinline" : "sincos", q(j.idx_q), sm, cm), {sm, cm},
-      {cb.input(q(j.idx_q))}, sincos());
+      fmt::format("proxgen_rt::{}({}, {}, {});", sincosCalled(e.plan) ? "sincos_joint_noinline" : "sincos_joint",
+                  q(j.idx_q), sm, cm),
+      {sm, cm}, {cb.input(q(j.idx_q))}, sincos());
   const Expr &s = sc[0], &c = sc[1];
   const Mat3 K = skew(a), A = a * a.transpose();
   for (int r = 0; r < 3; ++r)

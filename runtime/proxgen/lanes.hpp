@@ -1,7 +1,9 @@
 // W values of one Scalar in the lanes of a vector register, for the batched
 // solvers (`proxgen generate --batch W`, docs/batch.md): the solver's
 // straight-line code is the same for every state, so it runs on W states at
-// once. Header-only, fixed size, no heap, no intrinsics headers.
+// once; and for the scalar solvers' sincos_run (below), the joint angles of
+// one state many at a time. Header-only, fixed size, no heap, no intrinsics
+// headers. Every generated NAME.cpp includes it (and runtime.hpp through it).
 //
 // With GCC or Clang the lanes are the compilers' vector extension
 // (__attribute__((vector_size))): the compiler maps them to SSE2, AVX2,
@@ -20,6 +22,7 @@
 #pragma once
 
 #include <cstring>
+#include <type_traits>
 
 #include "runtime.hpp"  // beside this file
 
@@ -333,6 +336,104 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
   }
 }
 #endif
+
+// ---- The joint angles' sines and cosines of a scalar solver, many per call.
+//
+// A scalar solver computes each revolute joint's sine and cosine where its
+// body's step needs them (sincos_joint). On a target with four or more
+// double lanes (AVX: 4, AVX-512: 8) one call before the kinematics computes
+// a run of consecutive joint angles in the lanes instead (sincos_run), and
+// each joint's call is empty: Talos' inverse_dynamics takes 0.88 of the time
+// with AVX-512, 0.95-0.98 with AVX2 (docs/benchmarks.md, "sincos in the
+// lanes"). With two lanes (SSE2, NEON) the run was slower than the joints'
+// calls (1.12: their latency hides behind the bodies' arithmetic, the run's
+// does not), so there, and for float and lanes Scalars, the run is empty.
+// Either way every value is the scalar kernel's, bit for bit (see sincos
+// above). Define PROXGEN_RT_SINCOS_RUN to 0 to keep the joints' calls.
+//
+// The mode is part of the functions' names (an inline namespace), so
+// translation units compiled for different targets and linked together never
+// pick one another's definitions.
+#ifndef PROXGEN_RT_SINCOS_RUN
+#if PROXGEN_RT_LANES_VECTOR && (defined(__AVX__) || defined(__AVX512F__))
+#define PROXGEN_RT_SINCOS_RUN 1
+#else
+#define PROXGEN_RT_SINCOS_RUN 0
+#endif
+#endif
+
+#if PROXGEN_RT_SINCOS_RUN && defined(__AVX512F__)
+#define PROXGEN_RT_SINCOS_RUN_NS sincos_lanes8
+#define PROXGEN_RT_SINCOS_RUN_WIDTH 8
+#elif PROXGEN_RT_SINCOS_RUN
+#define PROXGEN_RT_SINCOS_RUN_NS sincos_lanes4
+#define PROXGEN_RT_SINCOS_RUN_WIDTH 4
+#else
+#define PROXGEN_RT_SINCOS_RUN_NS sincos_per_joint
+#define PROXGEN_RT_SINCOS_RUN_WIDTH 1
+#endif
+
+inline namespace PROXGEN_RT_SINCOS_RUN_NS {
+
+/// Whether sincos_run computes Scalar S's sines and cosines (else sincos_joint does).
+template <class S>
+constexpr bool sincos_in_run() noexcept {
+  return PROXGEN_RT_SINCOS_RUN_WIDTH > 1 && std::is_same<S, double>::value;
+}
+
+namespace sincos_run_detail {
+// The widest lane count of the run that N values fill: 8, 4 or 2 (1: none).
+template <int N>
+constexpr int width() noexcept {
+  int w = PROXGEN_RT_SINCOS_RUN_WIDTH;
+  while (w > N) w /= 2;
+  return w;
+}
+template <int W>
+inline void window(const double* x, double* s, double* c) noexcept {
+  lanes<double, W> sl, cl;
+  sincos(lanes<double, W>::load(x), sl, cl);
+  sl.store(s);
+  cl.store(c);
+}
+}  // namespace sincos_run_detail
+
+/// s[i] = sin x[i], c[i] = cos x[i] for i < N where sincos_in_run<S>(), in
+/// windows of W lanes (W = PROXGEN_RT_SINCOS_RUN_WIDTH, halved while it
+/// exceeds N), the last window ending at N (it may overlap the one before:
+/// the same values again, never a read past x[N - 1]); else nothing.
+template <int N, class S>
+PROXGEN_RT_NOINLINE void sincos_run(const S* x, S* s, S* c) noexcept {
+#if PROXGEN_RT_SINCOS_RUN_WIDTH > 1
+  if constexpr (sincos_in_run<S>()) {
+    constexpr int W = sincos_run_detail::width<N>();
+    if constexpr (W == 1) {
+      sincos(x[0], s[0], c[0]);
+    } else {
+      for (int i = 0; i + W <= N; i += W) sincos_run_detail::window<W>(x + i, s + i, c + i);
+      if constexpr (N % W != 0) sincos_run_detail::window<W>(x + N - W, s + N - W, c + N - W);
+    }
+    return;
+  }
+#endif
+  static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
+}
+
+/// One joint's s = sin x, c = cos x, inline, unless sincos_run computed them.
+template <class S>
+inline void sincos_joint(S x, S& s, S& c) noexcept {
+  if constexpr (!sincos_in_run<S>()) sincos(x, s, c);
+  static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
+}
+
+/// The same through a call of the runtime's kernel (sincos_noinline).
+template <class S>
+inline void sincos_joint_noinline(S x, S& s, S& c) noexcept {
+  if constexpr (!sincos_in_run<S>()) sincos_noinline(x, s, c);
+  static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
+}
+
+}  // inline namespace PROXGEN_RT_SINCOS_RUN_NS
 
 /// angle_axis (runtime.hpp) per lane: it branches on the pivot, so each lane
 /// runs the scalar function.

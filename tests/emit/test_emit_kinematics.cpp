@@ -2,9 +2,11 @@
 // sincosCalled): the runtime's sincos inlined at each revolute joint, or its
 // called form on a robot of more than 16 revolute joints, where one copy of
 // the kernel beats one per joint (docs/benchmarks.md, "sincos called on the
-// larger robots"). The two give the same bits (tests/runtime); this checks
-// which one the generated source uses, that every joint uses it, and where
-// the joint transforms go with each.
+// larger robots"); and before each pass of joint transforms the run of every
+// joint in the lanes of a wide vector target (sincosRuns, lanes.hpp's
+// sincos_run). They give the same bits (tests/runtime); this checks which one
+// the generated source uses, that every joint uses it, and where the joint
+// transforms go with each.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -30,14 +32,29 @@ long count(const std::string& text, const std::string& what) {
 
 TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   const std::string sixteen = chainSource(17), seventeen = chainSource(18);
-  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos(q["), 16);
-  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_noinline("), 0);
-  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_noinline(q["), 17);
-  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos("), 0);
+  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_joint(q["), 16);
+  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_joint_noinline("), 0);
+  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_joint_noinline(q["), 17);
+  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_joint("), 0);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
   const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
-  EXPECT_EQ(count(lanes, "sincos_noinline"), 0);
-  EXPECT_EQ(count(lanes, "proxgen_rt::sincos(q["), 17);
+  EXPECT_EQ(count(lanes, "sincos_joint_noinline"), 0);
+  EXPECT_EQ(count(lanes, "proxgen_rt::sincos_joint(q["), 17);
+}
+
+// The chain's angles are q[0..n): one run of all of them before the kinematics
+// (slots 0..n of w.sq and w.cq), which the joints' calls then read.
+TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
+  const std::string src = chainSource(18);
+  EXPECT_EQ(count(src, "proxgen_rt::sincos_run<"), 1);
+  const auto run = src.find("proxgen_rt::sincos_run<17>(&q[0], &w.sq[0], &w.cq[0]);");
+  ASSERT_NE(run, std::string::npos);
+  EXPECT_LT(run, src.find("kinematics_", src.rfind("void kinematics(")));
+  for (int j = 0; j < 17; ++j)
+    EXPECT_EQ(count(src, "proxgen_rt::sincos_joint_noinline(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
+                             "], w.cq[" + std::to_string(j) + "]);"),
+              1)
+        << "joint " << j;
 }
 
 // Where sincos is inlined, the kinematics pass and inverse_dynamics' sweep
