@@ -343,11 +343,12 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 // body's step needs them (sincos_joint). On a target with four or more
 // double lanes (AVX: 4, AVX-512: 8) one call before the kinematics computes
 // a run of consecutive joint angles in the lanes instead (sincos_run), and
-// each joint's call is empty: Talos' inverse_dynamics takes 0.88 of the time
-// with AVX-512, 0.95-0.98 with AVX2 (docs/benchmarks.md, "sincos in the
-// lanes"). With two lanes (SSE2, NEON) the run was slower than the joints'
-// calls (1.12: their latency hides behind the bodies' arithmetic, the run's
-// does not), so there, and for float and lanes Scalars, the run is empty.
+// each joint's call is empty: with AVX-512 Talos' solvers take 0.88-0.92 of
+// the time and its inverse_dynamics 0.68, with AVX2 (a first version)
+// inverse_dynamics 0.95-0.98 (docs/benchmarks.md, "sincos in the lanes").
+// With two lanes (SSE2, NEON) the run was slower than the joints' calls
+// (1.12: their latency hides behind the bodies' arithmetic, the run's does
+// not), so there, and for float and lanes Scalars, the run is empty.
 // Either way every value is the scalar kernel's, bit for bit (see sincos
 // above). Define PROXGEN_RT_SINCOS_RUN to 0 to keep the joints' calls.
 //
@@ -396,25 +397,31 @@ inline void window(const double* x, double* s, double* c) noexcept {
   sl.store(s);
   cl.store(c);
 }
+
+#if PROXGEN_RT_SINCOS_RUN_WIDTH > 1
+// The run's kernel, called: one copy per N.
+template <int N>
+PROXGEN_RT_NOINLINE void run(const double* x, double* s, double* c) noexcept {
+  constexpr int W = width<N>();
+  if constexpr (W == 1) {
+    sincos(x[0], s[0], c[0]);
+  } else {
+    for (int i = 0; i + W <= N; i += W) window<W>(x + i, s + i, c + i);
+    if constexpr (N % W != 0) window<W>(x + N - W, s + N - W, c + N - W);
+  }
+}
+#endif
 }  // namespace sincos_run_detail
 
 /// s[i] = sin x[i], c[i] = cos x[i] for i < N where sincos_in_run<S>(), in
 /// windows of W lanes (W = PROXGEN_RT_SINCOS_RUN_WIDTH, halved while it
 /// exceeds N), the last window ending at N (it may overlap the one before:
-/// the same values again, never a read past x[N - 1]); else nothing.
+/// the same values again, never a read past x[N - 1]); else nothing (inline:
+/// no call either).
 template <int N, class S>
-PROXGEN_RT_NOINLINE void sincos_run(const S* x, S* s, S* c) noexcept {
+inline void sincos_run(const S* x, S* s, S* c) noexcept {
 #if PROXGEN_RT_SINCOS_RUN_WIDTH > 1
-  if constexpr (sincos_in_run<S>()) {
-    constexpr int W = sincos_run_detail::width<N>();
-    if constexpr (W == 1) {
-      sincos(x[0], s[0], c[0]);
-    } else {
-      for (int i = 0; i + W <= N; i += W) sincos_run_detail::window<W>(x + i, s + i, c + i);
-      if constexpr (N % W != 0) sincos_run_detail::window<W>(x + N - W, s + N - W, c + N - W);
-    }
-    return;
-  }
+  if constexpr (sincos_in_run<S>()) sincos_run_detail::run<N>(x, s, c);
 #endif
   static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
 }

@@ -33,7 +33,12 @@ const char* const kMarker = "\n---8<---\n";
 
 proxgen::emit::SolverFiles emit(const proxgen::System& sys) {
   const proxgen::emit::Plan plan = proxgen::emit::makePlan(sys, "fuzz", proxgen::emit::ScalarType::Double);
-  return proxgen::emit::emitSolver(sys, plan, {"fuzz.urdf", "0", "fuzz.yaml", "0"});
+  proxgen::emit::SolverInputs inputs;
+  inputs.urdfName = "fuzz.urdf";
+  inputs.urdfSha256 = "0";
+  inputs.layoutName = "fuzz.yaml";
+  inputs.layoutSha256 = "0";
+  return proxgen::emit::emitSolver(sys, plan, inputs);
 }
 
 std::set<std::string> preprocessorLines(const std::string& text) {
