@@ -22,7 +22,7 @@ namespace proxgen::emit {
 Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
-/// Whether jointTransform calls the runtime's sincos (sincos_noinline) rather
+/// Whether jointTransform calls the runtime's sincos (sincos_joint_noinline) rather
 /// than inlining it: on a robot of more than 16 revolute joints. Measured with
 /// bench/ab_compare.sh (docs/benchmarks.md, "sincos called on the larger
 /// robots"): called, Talos' solvers take 0.95 of the time for 0.8 % more
