@@ -60,11 +60,9 @@ ConstraintJoints emitConstraintJoints(Emit& e, bool all) {
   e.fn.live() = Live{};
   e.fn.live().kin = &j.kin;
   e.fn.beginHost("joints", nullptr);
-  std::vector<int> bodies;
-  for (int i = 1; i < m.numBodies(); ++i)
-    if (all || e.bp(i).onSupport) bodies.push_back(i);
-  sincosRuns(e, bodies);
-  for (int i : bodies) {
+  sincosRuns(e, !all);
+  for (int i = 1; i < m.numBodies(); ++i) {
+    if (!all && !e.bp(i).onSupport) continue;
     e.fn.boundary(i);
     e.openBody(i, "joint transform:");
     jointTransform(e, i, j.kin.b[std::size_t(i)]);

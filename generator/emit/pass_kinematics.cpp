@@ -49,20 +49,18 @@ std::pair<std::string, std::string> sincosMembers(Emit& e, int slot, int slots) 
 
 bool sincosCalled(const Plan& plan) { return revoluteBodies(plan).size() > 16; }
 
-void sincosRuns(Emit& e, const std::vector<int>& bodies) {
+void sincosRuns(Emit& e, bool supportOnly) {
   const std::vector<int> all = revoluteBodies(e.plan);
-  std::vector<char> wanted(e.plan.bodies.size(), 0);
-  for (int i : bodies) wanted[std::size_t(i)] = 1;
+  auto wanted = [&](std::size_t j) { return !supportOnly || e.bp(all[j]).onSupport; };
   CodeBuilder& cb = e.cb();
   for (std::size_t a = 0; a < all.size();) {
-    if (!wanted[std::size_t(all[a])]) {
+    if (!wanted(a)) {
       ++a;
       continue;
     }
     // The run: consecutive slots whose angles are consecutive in q.
     std::size_t b = a + 1;
-    while (b < all.size() && wanted[std::size_t(all[b])] &&
-           e.bp(all[b]).idx_q == e.bp(all[b - 1]).idx_q + 1)
+    while (b < all.size() && wanted(b) && e.bp(all[b]).idx_q == e.bp(all[b - 1]).idx_q + 1)
       ++b;
     std::vector<std::string> written;
     std::vector<Expr> angles;
@@ -72,17 +70,15 @@ void sincosRuns(Emit& e, const std::vector<int>& bodies) {
       written.push_back(cm);
       angles.push_back(cb.input(q(e.bp(all[j]).idx_q)));
     }
-    const std::string s0 = written[0], c0 = written[1];
-    cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}>(&{}, &{}, &{});", b - a, q(e.bp(all[a]).idx_q), s0, c0),
+    cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}>(&{}, &{}, &{});", b - a, q(e.bp(all[a]).idx_q), written[0],
+                               written[1]),
                    written, angles);
     a = b;
   }
 }
 
 bool jointTransformsFirst(Emit& e, Kinematics& kin) {
-  std::vector<int> bodies;
-  for (int i = 1; i < e.model().numBodies(); ++i) bodies.push_back(i);
-  sincosRuns(e, bodies);
+  sincosRuns(e);
   if (sincosCalled(e.plan)) return false;
   e.fn.beginPass("transforms", "joint transforms X_J(q)");
   for (int i = 1; i < e.model().numBodies(); ++i) {

@@ -24,9 +24,7 @@ Kinematics emitJointTransforms(Emit& e) {
   Kinematics kin;
   kin.b.resize(std::size_t(m.numBodies()));
   const InScope<Kinematics> scope(e.fn.live().kin, &kin);
-  std::vector<int> bodies;
-  for (int i = 1; i < m.numBodies(); ++i) bodies.push_back(i);
-  sincosRuns(e, bodies);
+  sincosRuns(e);
   for (int i = 1; i < m.numBodies(); ++i) {
     e.fn.boundary(i);
     e.openBody(i, "");

@@ -30,13 +30,14 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b);
 /// too, but for 0.7 % more instructions, past solo_f3x4's count when issue 20
 /// was filed, so Solo and smaller keep it inline; the iiwa (7) is 1-4 % slower called.
 bool sincosCalled(const Plan& plan);
-/// Before the joint transforms of `bodies`: their revolute joints' sines and
+/// Before the joint transforms of every body (`supportOnly`: of the bodies on
+/// the constraints' support): their revolute joints' sines and
 /// cosines, one proxgen_rt::sincos_run per run of consecutive angles in q
 /// (w.sq and w.cq, slot j for the j-th revolute joint in q order). It computes
 /// them where the target has 4 or more double lanes; elsewhere it is empty and
 /// each joint's sincos_joint computes its own (lanes.hpp). Every pass that calls
 /// jointTransform calls this first (jointTransformsFirst does).
-void sincosRuns(Emit& e, const std::vector<int>& bodies);
+void sincosRuns(Emit& e, bool supportOnly = false);
 /// The sincos runs of every body (sincosRuns), then, where sincos is inlined,
 /// a pass of every body's joint transform into kin
 /// (true), which the sweep that follows then reads; else nothing (false) and

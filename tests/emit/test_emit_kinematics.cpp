@@ -49,7 +49,9 @@ TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
   EXPECT_EQ(count(src, "proxgen_rt::sincos_run<"), 1);
   const auto run = src.find("proxgen_rt::sincos_run<17>(&q[0], &w.sq[0], &w.cq[0]);");
   ASSERT_NE(run, std::string::npos);
-  EXPECT_LT(run, src.find("kinematics_", src.rfind("void kinematics(")));
+  const auto host = src.rfind("void kinematics(");  // the host, after its parts
+  EXPECT_GT(run, host);
+  EXPECT_LT(run, src.find("kinematics_", host));  // before its first part's call
   for (int j = 0; j < 17; ++j)
     EXPECT_EQ(count(src, "proxgen_rt::sincos_joint_noinline(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
                              "], w.cq[" + std::to_string(j) + "]);"),
