@@ -101,7 +101,7 @@ struct Forces {
 /// per body the composite inertia (CRBA) or the 6 x nv columns of unit-torque
 /// forces, then accelerations (M^-1); the upper triangle of M or M^-1 (packed by rows).
 struct JointSpace {
-  std::vector<Sym> Ic;
+  std::vector<Rigid> Ic;  // composite inertias (CRBA)
   std::vector<std::vector<V6>> FA;
   std::vector<V6> carried;  // CRBA: column k in the frame of the body being visited
   Sym upper;

@@ -54,6 +54,10 @@ Sym Emit::inertiaToParent(const Kinematics::Body& b, const Sym& M) {
   return congruence(cb(), b.XT, congruence(cb(), b.XJ, M));
 }
 
+Rigid Emit::inertiaToParent(const Kinematics::Body& b, const Rigid& r) {
+  return rigidToParent(cb(), b.XT, rigidToParent(cb(), b.XJ, r));
+}
+
 std::vector<Expr> Emit::constraintRows(int k, const V6& x) {
   const Constraint& c = sys.constraints[std::size_t(k)];
   const V6 y = actInvMotion(cb(), constant(c.placement), x);

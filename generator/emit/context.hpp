@@ -64,6 +64,7 @@ struct Emit {
   V6 motionToChild(const Kinematics::Body& b, const V6& m);
   V6 forceToParent(const Kinematics::Body& b, const V6& f);
   Sym inertiaToParent(const Kinematics::Body& b, const Sym& M);
+  Rigid inertiaToParent(const Kinematics::Body& b, const Rigid& r);
   /// K x (K = the first rows of cXi) for constraint k.
   std::vector<Expr> constraintRows(int k, const V6& x);
 };

@@ -1,6 +1,7 @@
 // The joint-space inertia M(q) by the composite-rigid-body algorithm, leaves
 // first: F = Ic_i S_i, M_ii = S_i^T F, then F carried to each ancestor j
-// (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i. The carrying goes
+// (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i, the composite
+// inertias by their ten parameters (symbolic.hpp, Rigid). The carrying goes
 // ancestor by ancestor (every column of a subtree one step up at its root's
 // turn), so a body's descendants' columns are one loop. A leaf's Ic is its
 // own inertia, a constant, so its diagonal entry folds. Each entry is written
@@ -173,6 +174,19 @@ Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, cons
   return out;
 }
 
+// Ic_p += the child's composite inertia dI, already in p's frame: the mass
+// folds; h and I, those of the 9 entries that vary, in member Ic_p (h, then
+// I's upper triangle by rows).
+void addToParent(Emit& e, int parent, const Rigid& dI, Rigid& par) {
+  par.m = par.m + dI.m;
+  for (int k = 0; k < 3; ++k) {
+    Expr& x = par.h[std::size_t(k)];
+    if (!dI.h[std::size_t(k)].isZero()) x = e.putQ(kIc, parent, 9, k, x + dI.h[std::size_t(k)]);
+  }
+  for (int k = 0; k < 6; ++k)
+    if (!dI.I.packed(k).isZero()) par.I.packed(k) = e.putQ(kIc, parent, 9, 3 + k, par.I.packed(k) + dI.I.packed(k));
+}
+
 // Fills js (in the caller's Live). Body i, leaves first: its own columns F =
 // Ic_i S_i (M_ii = S_i^T F), Ic_p += X^T Ic_i X; then every column of its
 // subtree goes one step up, to the parent's frame, where the parent's dofs
@@ -193,7 +207,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
     const Kinematics::Body& kb = kin.b[std::size_t(i)];
     std::vector<V6> F(std::size_t(p.nv));
     for (int d = 0; d < p.nv; ++d) {
-      F[std::size_t(d)] = mul(cb, js.Ic[std::size_t(i)], kb.S[std::size_t(d)]);
+      F[std::size_t(d)] = mul(cb, spatial(js.Ic[std::size_t(i)]), kb.S[std::size_t(d)]);
       flatten(cb, F[std::size_t(d)], "F");
     }
     for (int r = 0; r < p.nv; ++r)
@@ -202,10 +216,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
     if (p.parent > 0) {
       for (int d = 0; d < p.nv; ++d)
         cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, i, p.idx_v + d, 1, F[std::size_t(d)], js, written).value;
-      const Sym dI = e.inertiaToParent(kb, js.Ic[std::size_t(i)]);
-      Sym& par = js.Ic[std::size_t(p.parent)];
-      for (int k = 0; k < 21; ++k)
-        if (!dI.packed(k).isZero()) par.packed(k) = e.putQ(kIc, p.parent, 21, k, par.packed(k) + dI.packed(k));
+      addToParent(e, p.parent, e.inertiaToParent(kb, js.Ic[std::size_t(i)]), js.Ic[std::size_t(p.parent)]);
     }
     cb.close();
     if (p.parent == 0) continue;
@@ -242,7 +253,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
 std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms) {
   JointSpace js;
   js.upper = Sym(e.plan.nv);
-  for (const Kinematics::Body& b : kin.b) js.Ic.push_back(b.IA);
+  for (const Kinematics::Body& b : kin.b) js.Ic.push_back(rigidOf(b.IA));
   e.fn.live() = Live{};
   e.fn.live().kin = &kin;
   e.fn.live().js = &js;

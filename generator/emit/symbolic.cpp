@@ -314,6 +314,67 @@ Sym congruence(CodeBuilder& cb, const XSym& X, const Sym& M) {
   return out;
 }
 
+Rigid rigidOf(const Sym& M) {
+  Rigid r;
+  r.m = M(0, 0);
+  r.h = {M(1, 5), M(2, 3), M(0, 4)};  // the coupling block M(i, 3 + j) is -[h]x
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) r.I(i, j) = M(3 + i, 3 + j);
+  return r;
+}
+
+Sym spatial(const Rigid& r) {
+  Sym M(6);
+  for (int i = 0; i < 3; ++i) {
+    M(i, i) = r.m;
+    for (int j = i; j < 3; ++j) M(3 + i, 3 + j) = r.I(i, j);
+  }
+  const G3 H = skewOf(r.h);  // [h]x; the coupling block is its transpose, -[h]x
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) M(i, 3 + j) = -g(H, i, j);
+  return M;
+}
+
+Rigid rigidToParent(CodeBuilder& cb, const XSym& X, const Rigid& r) {
+  Rigid out;
+  out.m = r.m;
+  V3 h = r.h;
+  G3 I;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) I[std::size_t(3 * i + j)] = r.I(i, j);
+  if (!isIdentity(X.R)) {
+    h = rotate(cb, X.R, h);
+    I = rotateBlock(cb, X.R, I, true);
+  }
+  if (isZero(X.p)) {
+    out.h = h;
+  } else {
+    // With a = R h and p the shift: h' = a + m p and, from
+    // I' = R I R^T - [a]x[p]x - [p]x[a]x - m [p]x^2 ([u]x[w]x = w u^T - (u.w) 1),
+    // I'_ij = I_ij - a_i p_j - p_i a_j - m p_i p_j (i != j) and
+    // I'_ii = I_ii + sum over k != i of (2 p_k a_k + m p_k^2).
+    for (Expr& e : h) e = cb.flat(e);
+    const V3& p = X.p;
+    for (std::size_t i = 0; i < 3; ++i) out.h[i] = h[i] + cb.mul(r.m, p[i]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) {
+        Expr e = g(I, i, j);
+        const std::size_t u = std::size_t(i), w = std::size_t(j);
+        if (i == j) {
+          for (std::size_t k = 0; k < 3; ++k)
+            if (k != u) e += 2.0 * cb.mul(p[k], h[k]) + cb.mul(r.m, cb.mul(p[k], p[k]));
+        } else {
+          e -= cb.mul(h[u], p[w]) + cb.mul(p[u], h[w]) + cb.mul(r.m, cb.mul(p[u], p[w]));
+        }
+        out.I(i, j) = e;
+      }
+    return out;
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) out.I(i, j) = g(I, i, j);
+  return out;
+}
+
 void flatten(CodeBuilder& cb, V6& x, const std::string& hint) {
   for (Expr& e : x) e = cb.flat(e, hint);
 }

@@ -84,6 +84,28 @@ Expr dot(CodeBuilder& cb, const V6& a, const V6& b);
 /// articulated inertia seen from the parent. Rotation first, then the shift.
 Sym congruence(CodeBuilder& cb, const XSym& X, const Sym& M);
 
+/// A rigid-body inertia (one body's, or a composite of bodies') by its ten
+/// parameters in the body frame: the mass m (a constant: a sum of the model's
+/// masses), the first moment h = m c (c the centre of mass) and the rotational
+/// inertia I about the frame's origin. As a 6 x 6 in [linear; angular] it is
+/// [m 1, -[h]x; [h]x, I]: CRBA carries composite inertias in this form, 9
+/// entries that vary with q where the general symmetric 6 x 6 of an
+/// articulated inertia has 21 (its mass block is m 1, its coupling block
+/// skew; the symbolic algebra cannot see either through a rotation).
+struct Rigid {
+  Expr m;
+  V3 h = zero3();
+  Sym I{3};
+};
+/// The parameters of M, which must have that form (a body's own inertia).
+Rigid rigidOf(const Sym& M);
+/// The 6 x 6 of r.
+Sym spatial(const Rigid& r);
+/// r seen from the parent (X maps child to parent coordinates): m, R h + m p,
+/// and R I R^T shifted by the parallel-axis terms of p; the same inertia as
+/// congruence(X, spatial(r)) without its structural zeros and repeats.
+Rigid rigidToParent(CodeBuilder& cb, const XSym& X, const Rigid& r);
+
 /// Every non-trivial entry as a temporary (before it enters many products).
 void flatten(CodeBuilder& cb, V6& x, const std::string& hint);
 void flatten(CodeBuilder& cb, Sym& M, const std::string& hint);
