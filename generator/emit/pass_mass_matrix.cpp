@@ -3,7 +3,8 @@
 // (F = X^T F) gives M_ji = S_j^T F; Ic_p += X_i^T Ic_i X_i, the composite
 // inertias by their ten parameters (symbolic.hpp, Rigid). The carrying goes
 // ancestor by ancestor (every column of a subtree one step up at its root's
-// turn), so a body's descendants' columns are one loop. A leaf's Ic is its
+// turn), so a body's descendants' columns are one loop, through up to three
+// bodies where a parent has a single child. A leaf's Ic is its
 // own inertia, a constant, so its diagonal entry folds. Each entry is written
 // once, where it is computed, into both halves of the output M (no workspace
 // copy); the zeros between branches by one fill before the pass, the other
@@ -147,18 +148,28 @@ struct Carried {
   V6 value = zero6();            // the slots' values after the step (zero when not kept)
   std::array<bool, 6> stored{};  // entries written by this step
 };
-Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, const V6& F, JointSpace& js,
-                    std::vector<char>& written) {
+
+// One step of a column: G = X_b^T F into the frame of b's parent, whose dofs
+// read their entries M(parent's dofs, k) = S^T G.
+V6 stepColumn(Emit& e, const Kinematics& kin, int b, int k0, int len, const V6& F, JointSpace& js,
+              std::vector<char>& written) {
   CodeBuilder& cb = e.cb();
-  const BodyPlan& p = e.bp(i);
-  const BodyPlan& pp = e.bp(p.parent);
-  V6 G = e.forceToParent(kin.b[std::size_t(i)], F);
+  const BodyPlan& pp = e.bp(e.bp(b).parent);
+  V6 G = e.forceToParent(kin.b[std::size_t(b)], F);
   flatten(cb, G, "F");
-  const Kinematics::Body& kp = kin.b[std::size_t(p.parent)];
+  const Kinematics::Body& kp = kin.b[std::size_t(e.bp(b).parent)];
   for (int r = 0; r < pp.nv; ++r)  // an ancestor's dofs come first: the upper triangle
     putMassColumns(e, js, written, pp.idx_v + r, k0, len, dot(cb, kp.S[std::size_t(r)], G));
+  return G;
+}
+
+// The column, in the frame of b's parent after the step through b, kept in
+// its slot for the grandparent, unless b's parent is a child of the world
+// (then nothing reads it again).
+Carried keepColumn(Emit& e, int b, int k0, int len, V6 G) {
+  CodeBuilder& cb = e.cb();
   Carried out;
-  if (pp.parent == 0) return out;  // the parent is a child of the world: nothing reads the column
+  if (e.bp(e.bp(b).parent).parent == 0) return out;
   const bool loop = len > 1;
   std::array<bool, 6> unchanged{};
   for (int r = 0; r < 6; ++r) {
@@ -173,6 +184,21 @@ Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, cons
   }
   return out;
 }
+
+Carried carryColumn(Emit& e, const Kinematics& kin, int i, int k0, int len, const V6& F, JointSpace& js,
+                    std::vector<char>& written) {
+  return keepColumn(e, i, k0, len, stepColumn(e, kin, i, k0, len, F, js, written));
+}
+
+// Columns go up a chain of single children in one loop: at a body whose
+// parent has no other child, its descendants' columns wait, and at the
+// parent's turn they go through both transforms with no store of Fcol
+// between them. At most this many bodies per loop: a chain body's own column
+// joins the walk later than the columns below it and goes through its steps
+// alone, so longer loops cost more single columns than they save. Measured
+// (docs/benchmarks.md, "CRBA's columns up single-child chains"): 2, 3, 4 and
+// 6 on Talos and the Atlas; 3 was the fastest.
+constexpr int kChainSteps = 3;
 
 // Ic_p += the child's composite inertia dI, already in p's frame: the mass
 // folds; h and I, those of the 9 entries that vary, in member Ic_p (h, then
@@ -198,6 +224,9 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
   const int N = int(plan.bodies.size()), nv = plan.nv;
   std::vector<V6>& cols = js.carried;
   cols.assign(std::size_t(nv), zero6());
+  std::vector<int> frameOf(std::size_t(nv), 0);  // the body in whose frame column k is
+  std::vector<int> children(std::size_t(N), 0);
+  for (int i = 1; i < N; ++i) ++children[std::size_t(e.bp(i).parent)];
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
   for (int i = N - 1; i >= 1; --i) {
     e.fn.boundary(i);
@@ -214,24 +243,47 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
       for (int c = r; c < p.nv; ++c)
         putMass(e, js, written, p.idx_v + r, p.idx_v + c, dot(cb, kb.S[std::size_t(r)], F[std::size_t(c)]));
     if (p.parent > 0) {
-      for (int d = 0; d < p.nv; ++d)
+      for (int d = 0; d < p.nv; ++d) {
         cols[std::size_t(p.idx_v + d)] = carryColumn(e, kin, i, p.idx_v + d, 1, F[std::size_t(d)], js, written).value;
+        frameOf[std::size_t(p.idx_v + d)] = p.parent;
+      }
       addToParent(e, p.parent, e.inertiaToParent(kb, js.Ic[std::size_t(i)]), js.Ic[std::size_t(p.parent)]);
     }
     cb.close();
     if (p.parent == 0) continue;
-    // The descendants' columns, in i's frame since its children's turns.
+    // The descendants' columns, each in the frame of the body frameOf[k]
+    // (i, or below i where they waited: kChainSteps), up to i's parent.
     std::vector<int> ks;
     for (int k = p.idx_v + p.nv; k < p.dofEnd; ++k) ks.push_back(k);
+    auto steps = [&](int k) {  // the bodies from frameOf[k] up to i
+      std::vector<int> path;
+      for (int b = frameOf[std::size_t(k)]; b != p.parent; b = e.bp(b).parent) path.push_back(b);
+      return path;
+    };
+    const int par = p.parent;
+    int longest = 0;
+    for (int k : ks) longest = std::max(longest, int(steps(k).size()));
+    if (!ks.empty() && children[std::size_t(par)] == 1 && e.bp(par).parent > 0 && longest < kChainSteps)
+      continue;  // they go on with the parent's own step
     const auto inputs = [&](int k) { return entries(cols[std::size_t(k)]); };
-    const auto sameShape = [&](int k, int k0) { return oneShape(e.cb(), inputs, k, k0); };
+    const auto sameShape = [&](int k, int k0) {
+      return frameOf[std::size_t(k)] == frameOf[std::size_t(k0)] && oneShape(e.cb(), inputs, k, k0);
+    };
     for (const auto& run : columnRuns(ks, sameShape)) {
       const int k0 = run.first, len = run.second;
-      openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', subtree columns to the parent,", i, p.ident));
+      const std::vector<int> path = steps(k0);
+      const std::string label =
+          path.size() == 1
+              ? fmt::format("body {} '{}', subtree columns to the parent,", i, p.ident)
+              : fmt::format("bodies {} to {} ('{}' to '{}'), subtree columns to the parent,", path.front(), i,
+                            e.bp(path.front()).ident, p.ident);
+      openColumns(e, p.ident, k0, len, label);
       CodeBuilder& lb = e.cb();  // after openColumns: it may have started a new part
-      const V6 in = len > 1 ? toV6(loopReads(lb, inputs(k0))) : cols[std::size_t(k0)];
-      const Carried out = carryColumn(e, kin, i, k0, len, in, js, written);
+      V6 G = len > 1 ? toV6(loopReads(lb, inputs(k0))) : cols[std::size_t(k0)];
+      for (int b : path) G = stepColumn(e, kin, b, k0, len, G, js, written);
+      const Carried out = keepColumn(e, i, k0, len, G);
       lb.close();
+      for (int k = k0; k < k0 + len; ++k) frameOf[std::size_t(k)] = par;
       if (len == 1) {
         cols[std::size_t(k0)] = out.value;
         continue;

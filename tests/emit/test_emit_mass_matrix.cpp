@@ -57,6 +57,26 @@ TEST(MassMatrixCode, ColumnLoopsAreKeptLoops) {
   EXPECT_EQ(count(source, "PROXGEN_RT_NO_UNROLL for (int j = 0; j < "), loops);
 }
 
+// In a serial chain every body but the root's child has a single-child
+// parent, so the descendants' columns wait and go up kChainSteps (3) bodies per
+// loop, with no store of Fcol between the steps (pass_mass_matrix.cpp; the
+// walk by ancestor before it printed one loop per body, its label "body i
+// 'name'"). Every loop's label names the bodies it goes through.
+TEST(MassMatrixCode, ColumnsGoUpSingleChildChainsInOneLoop) {
+  const std::string source = massMatrixSource(16);
+  long loops = 0, chained = 0;
+  std::size_t at = 0;
+  for (std::string line; at < source.size(); at += line.size() + 1) {
+    line = source.substr(at, source.find('\n', at) - at);
+    if (line.find("subtree columns to the parent, columns") == std::string::npos) continue;
+    ++loops;
+    if (line.find("// bodies ") != std::string::npos) ++chained;
+  }
+  ASSERT_GT(loops, 0);
+  EXPECT_EQ(chained, loops) << "column loops through one body only";
+  EXPECT_LE(loops, 16 / 3 + 1) << "one loop per three bodies of the chain";
+}
+
 // rigidToParent (symbolic.hpp) against the general congruence F M F^T of the
 // same inertia's 6 x 6, on constant inputs (every entry folds to a number):
 // random bodies (mass, centre of mass, a positive definite inertia) under
