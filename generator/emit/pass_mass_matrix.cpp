@@ -215,10 +215,11 @@ void addToParent(Emit& e, int parent, const Rigid& dI, Rigid& par) {
 
 // Fills js (in the caller's Live). Body i, leaves first: its own columns F =
 // Ic_i S_i (M_ii = S_i^T F), Ic_p += X^T Ic_i X; then every column of its
-// subtree goes one step up, to the parent's frame, where the parent's dofs
-// read their entries. A body's descendants' columns all go through the same
-// transform, so runs of them of one shape are one loop (column_loops.cpp):
-// the walk is O(n) code instead of O(n depth).
+// subtree goes up to the parent's frame, where the parent's dofs read their
+// entries: one step, or, for columns that waited below i (kChainSteps), the
+// steps from the body whose frame they are in. A body's descendants' columns
+// all go through the same transforms, so runs of them of one shape are one
+// loop (column_loops.cpp): the walk is O(n) code instead of O(n depth).
 void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vector<char>& written) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size()), nv = plan.nv;

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <random>
 #include <string>
 
@@ -81,8 +80,10 @@ TEST(MassMatrixCode, ColumnsGoUpSingleChildChainsInOneLoop) {
 // same inertia's 6 x 6, on constant inputs (every entry folds to a number):
 // random bodies (mass, centre of mass, a positive definite inertia) under
 // random placements. The two sum the same products in other orders, so they
-// agree to round-off: entries are O(m |p|^2 + |I|) <= about 20 here, and a
-// few dozen operations at 1.1e-16 each bound the difference by 1e-13.
+// agree to round-off: every term of an entry is at most the scale
+// S = |Ic| + m (|c| + |p|)^2 (the parallel-axis terms of the shifted centre),
+// each entry is a sum of fewer than 32 rounded terms, so the two differ by
+// less than 64 u S (u = 2^-53), whatever cancellation the entry itself has.
 TEST(MassMatrixCode, CompositeInertiaToTheParentIsTheCongruence) {
   std::mt19937 gen(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -102,10 +103,13 @@ TEST(MassMatrixCode, CompositeInertiaToTheParentIsTheCongruence) {
     const Sym M = constant(body.matrix());
     const Sym viaCongruence = congruence(cb, constant(X), M);
     const Sym viaRigid = spatial(rigidToParent(cb, constant(X), rigidOf(M)));
+    const double reach = body.com.norm() + X.p.norm();
+    const double scale = body.Ic.cwiseAbs().maxCoeff() + body.mass * reach * reach;
+    const double bound = 64.0 * 0x1p-53 * scale;
     for (int i = 0; i < 6; ++i)
       for (int j = i; j < 6; ++j) {
         ASSERT_TRUE(viaCongruence(i, j).isConstant() && viaRigid(i, j).isConstant()) << i << ", " << j;
-        EXPECT_NEAR(viaRigid(i, j).constant(), viaCongruence(i, j).constant(), 1e-13)
+        EXPECT_NEAR(viaRigid(i, j).constant(), viaCongruence(i, j).constant(), bound)
             << "trial " << trial << ", entry (" << i << ", " << j << ")";
       }
   }
