@@ -148,21 +148,11 @@ void eliminateFreeFlyer(Emit& e, int i, const std::vector<std::vector<Expr>>* kk
     b.u[std::size_t(d)] = e.putQ(kUu, i, 6, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(d)]);
 }
 
-// A planar joint: S picks the components sel (linear x, linear y, angular z),
-// so U = IA S is three columns of IA, D = S^T IA S their 3 x 3 block (LL^T)
-// and u = tau - pA[sel]. Below a moving parent Ia = IA - U D^-1 U^T (whose
-// rows and columns sel vanish: Ia S = 0) and pa = pA + Ia c + U D^-1 u pass on.
-void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art,
-                     bool bias) {
-  CodeBuilder& cb = e.cb();
-  Articulated::Body& b = art.b[std::size_t(i)];
-  const Kinematics::Body& kb = kin.b[std::size_t(i)];
-  const BodyPlan& p = e.bp(i);
-  const std::vector<int> sel = pickedComponents(p.jointClass);
+}  // namespace
+
+void factorPicked(Emit& e, int i, const Sym& IA, Articulated::Body& b) {
+  const std::vector<int> sel = pickedComponents(e.bp(i).jointClass);
   const int n = int(sel.size());
-  Sym IA = b.IA;
-  V6 pA = b.pA;
-  if (kk) penalty(e, i, *kk, IA, pA);
   b.U.assign(std::size_t(n), V6{});
   for (int d = 0; d < n; ++d)
     for (int r = 0; r < 6; ++r)
@@ -175,13 +165,10 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
       [&](int r) { return e.member(kLinv, i, n, r); });
   b.L = ch.L;
   b.Linv = ch.inv;
-  if (bias) {
-    b.u.resize(std::size_t(n));
-    for (int d = 0; d < n; ++d)
-      b.u[std::size_t(d)] =
-          e.putQ(kUu, i, n, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(sel[std::size_t(d)])]);
-  }
-  if (p.parent == 0) return;
+}
+
+Sym reducedPicked(CodeBuilder& cb, const Sym& IA, const Articulated::Body& b, const std::vector<int>& sel) {
+  const int n = int(sel.size());
   // Y = L^-1 U^T (one solve per row of U), so U D^-1 U^T = Y^T Y.
   std::vector<std::vector<Expr>> Y(6);
   for (int r = 0; r < 6; ++r) {
@@ -199,6 +186,35 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
   for (int k : sel)
     for (int c = 0; c < 6; ++c) Ia(k, c) = Expr();
   flatten(cb, Ia, "Ia");
+  return Ia;
+}
+
+namespace {
+
+// A planar joint: S picks the components sel (linear x, linear y, angular z),
+// so U = IA S is three columns of IA, D = S^T IA S their 3 x 3 block (LL^T)
+// and u = tau - pA[sel]. Below a moving parent Ia = IA - U D^-1 U^T (whose
+// rows and columns sel vanish: Ia S = 0) and pa = pA + Ia c + U D^-1 u pass on.
+void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* kk, Articulated& art,
+                     bool bias) {
+  CodeBuilder& cb = e.cb();
+  Articulated::Body& b = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const int n = int(sel.size());
+  Sym IA = b.IA;
+  V6 pA = b.pA;
+  if (kk) penalty(e, i, *kk, IA, pA);
+  factorPicked(e, i, IA, b);
+  if (bias) {
+    b.u.resize(std::size_t(n));
+    for (int d = 0; d < n; ++d)
+      b.u[std::size_t(d)] =
+          e.putQ(kUu, i, n, d, cb.input(tauIn(p.idx_v + d)) - pA[std::size_t(sel[std::size_t(d)])]);
+  }
+  if (p.parent == 0) return;
+  const Sym Ia = reducedPicked(cb, IA, b, sel);
   if (!bias) {  // the articulated inertia only (the Delassus functions)
     passToParent(e, kb, p.parent, Ia, nullptr, art);
     return;

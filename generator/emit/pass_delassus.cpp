@@ -7,7 +7,8 @@
 //    the inverse;
 //  - forward over the support, the apparent inverse inertia
 //    Phi_i = S D^-1 S^T + P^T (iXp Phi_p iXp^T) P, P = 1 - U D^-1 S^T
-//    (at a free flyer, IA^-1 = L^-T L^-1 from its Cholesky factor);
+//    (at a free flyer, IA^-1 = L^-T L^-1 from its Cholesky factor; at a
+//    planar joint S D^-1 S^T and P through its 3 x 3 D's factor);
 //  - backward over the support, each row's force direction carried up
 //    (B = X^T P per joint; along an unbranched link with more than
 //    kMapColumns columns, the 6 x 6 product of the B's instead, so columns
@@ -57,10 +58,68 @@ Sym toChild(Emit& e, int i, const Kinematics::Body& b, const Sym& Phi) {
   return swapHalves(B);
 }
 
+// A planar joint (S picks the components sel; D = S^T IA S = L L^T from
+// eliminatePicked): D^-1 S^T x, by the factor.
+std::vector<Expr> pickedSolve(CodeBuilder& cb, const Articulated::Body& ab, const std::vector<int>& sel, const V6& x) {
+  std::vector<Expr> rhs;
+  for (int k : sel) rhs.push_back(x[std::size_t(k)]);
+  return backwardSolve(cb, ab.L, ab.Linv, forwardSolve(cb, ab.L, ab.Linv, rhs));
+}
+
+// Phi_i at a planar joint: S D^-1 S^T + P^T Phi' P, P = 1 - UD S^T with UD = U D^-1
+// (6 x n): P^T Phi' P = Phi' - S Yd^T - Yd S^T + S (UD^T Yd) S^T, Yd = Phi' UD.
+Sym apparentInverseInertiaPicked(Emit& e, const Kinematics& kin, const Articulated& art, const ConstraintOutputs& st,
+                                 int i) {
+  CodeBuilder& cb = e.cb();
+  const BodyPlan& p = e.bp(i);
+  const Articulated::Body& ab = art.b[std::size_t(i)];
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const std::size_t n = sel.size();
+  std::vector<std::vector<Expr>> Dinv(n);  // column c of D^-1
+  for (std::size_t c = 0; c < n; ++c) {
+    std::vector<Expr> unit(n);
+    unit[c] = Expr(1.0);
+    Dinv[c] = backwardSolve(cb, ab.L, ab.Linv, forwardSolve(cb, ab.L, ab.Linv, unit));
+    for (Expr& x : Dinv[c]) x = cb.flat(x, "Di");
+  }
+  Sym Phi(6);
+  std::vector<Expr> SAS(n * n);  // the n x n block that S ... S^T places at (sel, sel)
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) SAS[a * n + b] = Dinv[b][a];
+  if (p.parent != 0) {
+    const Sym Pp = toChild(e, i, kin.b[std::size_t(i)], st.Phi[std::size_t(p.parent)]);
+    std::vector<V6> UD(n), Yd(n);
+    for (std::size_t c = 0; c < n; ++c) {
+      V6 u = zero6();
+      for (std::size_t d = 0; d < n; ++d) u = add(u, scale(cb, Dinv[c][d], ab.U[d]));
+      flatten(cb, u, "UD");
+      UD[c] = u;
+      Yd[c] = mul(cb, Pp, u);
+      flatten(cb, Yd[c], "yd");
+    }
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = 0; b < n; ++b) SAS[a * n + b] += cb.flat(dot(cb, UD[a], Yd[b]), "alpha");
+    for (int r = 0; r < 6; ++r)
+      for (int c = r; c < 6; ++c) {
+        Expr x = Pp(r, c);
+        for (std::size_t a = 0; a < n; ++a) {
+          if (sel[a] == r) x -= Yd[a][std::size_t(c)];
+          if (sel[a] == c) x -= Yd[a][std::size_t(r)];
+        }
+        Phi(r, c) = x;
+      }
+  }
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b)
+      if (sel[a] <= sel[b]) Phi(sel[a], sel[b]) += SAS[a * n + b];
+  return Phi;
+}
+
 Sym apparentInverseInertia(Emit& e, const Kinematics& kin, const Articulated& art, const ConstraintOutputs& st, int i) {
   CodeBuilder& cb = e.cb();
   const BodyPlan& p = e.bp(i);
   const Articulated::Body& ab = art.b[std::size_t(i)];
+  if (p.jointClass == JointClass::Planar) return apparentInverseInertiaPicked(e, kin, art, st, i);
   Sym Phi(6);
   if (p.jointClass == JointClass::FreeFlyer) {
     // IA^-1 = N^T N, N = L^-1 (column c: L^-1 e_c).
@@ -112,6 +171,14 @@ V6 throughJoint(Emit& e, const Kinematics& kin, const Articulated& art, int ch, 
   CodeBuilder& cb = e.cb();
   const Articulated::Body& ab = art.b[std::size_t(ch)];
   const Kinematics::Body& kb = kin.b[std::size_t(ch)];
+  if (e.bp(ch).jointClass == JointClass::Planar) {  // x - U D^-1 S^T x, its components sel exactly 0
+    const std::vector<int> sel = pickedComponents(e.bp(ch).jointClass);
+    const std::vector<Expr> y = pickedSolve(cb, ab, sel, x);
+    V6 f = x;
+    for (std::size_t d = 0; d < sel.size(); ++d) f = sub(f, scale(cb, y[d], ab.U[d]));
+    for (int k : sel) f[std::size_t(k)] = Expr();
+    return e.forceToParent(kb, f);
+  }
   const Expr ks = cb.flat(dot(cb, kb.S[0], x), "ks");
   V6 f;
   for (int r = 0; r < 6; ++r) f[std::size_t(r)] = x[std::size_t(r)] - cb.mul(cb.mul(ab.U[0][std::size_t(r)], ab.Dinv), ks);

@@ -11,8 +11,9 @@
 // into both triangles of the output; the rows that are final after the
 // backward pass (the free flyer's, a child of the world's) are written from
 // the members. The free flyer (always the root) uses the Cholesky factor of
-// its 6 x 6 IA for D^-1. Each body's columns go in loops over runs of one
-// shape ("Column loops" below). The generic counterpart:
+// its 6 x 6 IA for D^-1, a planar joint (anywhere) that of its 3 x 3 D
+// (backwardPicked, forwardPicked). Each one-dof body's columns go in loops
+// over runs of one shape ("Column loops" below). The generic counterpart:
 // algorithms/mass_matrix_inverse.cpp.
 #include <fmt/format.h>
 
@@ -232,6 +233,121 @@ void writeOut(Emit& e, int row, int k0, bool loop, const Expr& value) {
   if (k0 != row) cb.line(fmt::format("Minv[{}] = {};", k0 * nv + row, v), {x}, {"Minv"});
 }
 
+// A planar joint (pass_aba_eliminate.cpp, eliminatePicked): S picks the
+// components sel, U = IA S is three columns of IA and D = S^T U their 3 x 3
+// block, factored (L L^T). Minv(s.., s..) = D^-1, Minv(s.., j) = -D^-1 S^T
+// F_i[:, j] for the subtree's columns, F_p[:, j] += X^T (F_i[:, j] + U
+// Minv(s.., j)) and IA_p += X^T (IA - U D^-1 U^T) X. A planar joint is rare
+// (a mobile base, once per robot): its columns are printed one by one.
+struct Picked {
+  std::vector<int> sel;
+  Cholesky ch;
+  std::vector<Expr> solve(CodeBuilder& cb, const std::vector<Expr>& rhs) const {  // D^-1 rhs
+    return backwardSolve(cb, ch.L, ch.inv, forwardSolve(cb, ch.L, ch.inv, rhs));
+  }
+};
+Picked pickedFactor(Emit& e, int i, Articulated& art) {
+  Articulated::Body& b = art.b[std::size_t(i)];
+  factorPicked(e, i, b.IA, b);
+  return {pickedComponents(e.bp(i).jointClass), {b.L, b.Linv}};
+}
+
+void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js) {
+  Articulated::Body& b = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const BodyPlan& p = e.bp(i);
+  const int s = p.idx_v, nv = e.plan.nv;
+  const bool toParent = p.parent != 0;
+  std::vector<V6>& F = js.FA[std::size_t(i)];
+  std::vector<V6>& Fp = js.FA[std::size_t(std::max(p.parent, 0))];
+  e.fn.boundary(i);
+  e.openBody(i, "eliminate");
+  CodeBuilder& cb = e.cb();
+  const Picked pk = pickedFactor(e, i, art);
+  const int n = int(pk.sel.size());
+  // Passes one column f of the subtree's forces on to the parent: F_p[:, j] += X^T f.
+  const auto passOn = [&](int j, V6 f) {
+    flatten(cb, f, "f");
+    const V6 dp = e.forceToParent(kb, f);
+    for (int r = 0; r < 6; ++r)
+      if (!dp[std::size_t(r)].isZero())
+        Fp[std::size_t(j)][std::size_t(r)] =
+            e.keepQ(kFA, p.parent, 6, nv, r, j, Fp[std::size_t(j)][std::size_t(r)] + dp[std::size_t(r)]);
+  };
+  // Columns s + c of D^-1: the block Minv(s.., s..), and (its own columns' F_i = 0) U D^-1 e_c on.
+  for (int c = 0; c < n; ++c) {
+    std::vector<Expr> unit(static_cast<std::size_t>(n));
+    unit[std::size_t(c)] = Expr(1.0);
+    std::vector<Expr> x = pk.solve(cb, unit);
+    for (Expr& v : x) v = cb.flat(v, "m");
+    for (int r = 0; r <= c; ++r) js.upper(s + r, s + c) = e.put(minvMember(e, s + r, s + c), x[std::size_t(r)]);
+    if (!toParent) continue;
+    V6 f = zero6();
+    for (int d = 0; d < n; ++d) f = add(f, scale(cb, x[std::size_t(d)], b.U[std::size_t(d)]));
+    passOn(s + c, f);
+  }
+  if (toParent) {  // IA_p += X^T (IA - U D^-1 U^T) X
+    const Sym dI = e.inertiaToParent(kb, reducedPicked(cb, b.IA, b, pk.sel));
+    Articulated::Body& par = art.b[std::size_t(p.parent)];
+    for (int k = 0; k < 21; ++k)
+      if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
+  }
+  // The subtree's columns: Minv(s.., j) = -D^-1 S^T F_i[:, j], then F_i[:, j] + U Minv(s.., j) on.
+  for (int j = s + n; j < p.dofEnd; ++j) {
+    std::vector<Expr> rhs(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d) rhs[std::size_t(d)] = F[std::size_t(j)][std::size_t(pk.sel[std::size_t(d)])];
+    std::vector<Expr> x = pk.solve(cb, rhs);
+    for (int d = 0; d < n; ++d) {
+      x[std::size_t(d)] = e.put(minvMember(e, s + d, j), -x[std::size_t(d)]);
+      js.upper(s + d, j) = x[std::size_t(d)];
+    }
+    if (!toParent) continue;
+    V6 f = F[std::size_t(j)];
+    for (int d = 0; d < n; ++d) f = add(f, scale(cb, x[std::size_t(d)], b.U[std::size_t(d)]));
+    passOn(j, f);
+  }
+  cb.close();
+}
+
+// Forward, a planar joint: for every column j >= s, a' = X A_p[:, j] (zero at
+// the root), x = Minv(s.., j) - D^-1 U^T a', Minv(s + d, j) = x_d written out
+// for s + d <= j, and A_i[:, j] = a' + S x.
+void forwardPicked(Emit& e, const Kinematics& kin, int i, const Articulated& art, JointSpace& js) {
+  const BodyPlan& p = e.bp(i);
+  const int s = p.idx_v, nv = e.plan.nv;
+  const bool store = !p.children.empty();
+  const Articulated::Body& b = art.b[std::size_t(i)];
+  const Kinematics::Body& kb = kin.b[std::size_t(i)];
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const int n = int(sel.size());
+  std::vector<V6>& A = js.FA[std::size_t(i)];
+  e.fn.boundary(i);
+  e.openBody(i, "accelerate");
+  CodeBuilder& cb = e.cb();
+  Cholesky ch;
+  ch.L = b.L;
+  ch.inv = b.Linv;
+  for (int j = s; j < nv; ++j) {
+    std::vector<Expr> x(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d) x[std::size_t(d)] = js.upper(s + d, j);
+    V6 a = zero6();
+    if (p.parent != 0) {
+      a = e.motionToChild(kb, js.FA[std::size_t(p.parent)][std::size_t(j)]);
+      flatten(cb, a, "t");
+      std::vector<Expr> Ua(static_cast<std::size_t>(n));
+      for (int d = 0; d < n; ++d) Ua[std::size_t(d)] = cb.flat(dot(cb, b.U[std::size_t(d)], a));
+      const std::vector<Expr> y = backwardSolve(cb, ch.L, ch.inv, forwardSolve(cb, ch.L, ch.inv, Ua));
+      for (int d = 0; d < n; ++d) x[std::size_t(d)] = cb.flat(x[std::size_t(d)] - y[std::size_t(d)], "m");
+    }
+    for (int d = 0; d < n && s + d <= j; ++d) writeOut(e, s + d, j, false, x[std::size_t(d)]);
+    if (!store) continue;
+    V6 Aj = a;
+    for (int d = 0; d < n; ++d) Aj[std::size_t(sel[std::size_t(d)])] = Aj[std::size_t(sel[std::size_t(d)])] + x[std::size_t(d)];
+    for (int r = 0; r < 6; ++r) A[std::size_t(j)][std::size_t(r)] = e.keepQ(kFA, i, 6, nv, r, j, Aj[std::size_t(r)]);
+  }
+  cb.close();
+}
+
 // A row whose entries Minv(row, j), j >= from, are final in js (the free
 // flyer's after the backward pass, a child of the world's), into the output.
 void writeRow(Emit& e, int i, int row, int from, const JointSpace& js) {
@@ -336,10 +452,14 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
   e.fn.beginPass("backward", "backward: D^-1 and the unit-torque forces, leaves first");
   for (int i = N - 1; i >= 1; --i) {
     if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, art, js);
+    else if (e.bp(i).jointClass == JointClass::Planar) backwardPicked(e, kin, i, art, js);
     else backwardOneDof(e, kin, i, art, js);
   }
   e.fn.beginPass("forward", "forward: the unit-torque accelerations, the upper triangle of M^-1");
-  for (int i = 1; i < N; ++i) forwardBody(e, kin, i, art, js);
+  for (int i = 1; i < N; ++i) {
+    if (e.bp(i).jointClass == JointClass::Planar) forwardPicked(e, kin, i, art, js);
+    else forwardBody(e, kin, i, art, js);
+  }
   std::string text = e.fn.endHost({"q", "w", "Minv"});
   e.fn.live() = Live{};
   return text;

@@ -61,6 +61,12 @@ Articulated startElimination(const Kinematics& kin);
 /// Without `bias`, IA, U and D only (no tau, u, pA: the Delassus functions).
 void eliminateBody(Emit& e, const Kinematics& kin, int i, const std::vector<std::vector<Expr>>* k, Articulated& art,
                    bool bias = true);
+/// A planar joint's U = IA S (the three columns of IA that pickedComponents
+/// picks) and the factor of D = S^T U = L L^T, into body i's members and b.
+void factorPicked(Emit& e, int i, const Sym& IA, Articulated::Body& b);
+/// IA - U D^-1 U^T for that joint (b's U and factor), its rows and columns sel
+/// exactly zero (Ia S = 0), flattened: what passes on to the parent.
+Sym reducedPicked(CodeBuilder& cb, const Sym& IA, const Articulated::Body& b, const std::vector<int>& sel);
 /// The bodies off the constraint support, leaves first (the same in both algorithms).
 Articulated eliminateFreeBodies(Emit& e, const Kinematics& kin);
 
