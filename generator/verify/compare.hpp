@@ -40,8 +40,12 @@ struct Bounds {
   double primal = 0, dual = 0;
   double kappaC = 1;  // condition number of M + mu J^T J
   double mu = 0;
+  double contraction = 0;  // 1 / (1 + mu g_min): how much of a step's error the next proximal step keeps
 };
 Bounds boundsAt(const Conditioning& c, double mu);
+/// How many proximal steps' round-off K steps of proxPV carry at most:
+/// (1 - rho^K) / (1 - rho), rho = b.contraction (K when rho = 1).
+double proximalAccumulation(const Bounds& b, int K);
 /// constrainedABA's lambda = mu (K a - k) multiplies the error of J qdd by mu.
 double cabaLambdaBound(const System& sys, const Conditioning& c, const Bounds& b, const VecX& genericQdd,
                        const VecX& genericLambda);
