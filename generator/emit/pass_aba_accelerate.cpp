@@ -23,7 +23,7 @@ void accelerateBody(Emit& e, const Kinematics& kin, const Articulated& art, int 
   for (int d = 0; d < n; ++d) r[std::size_t(d)] = uEff[std::size_t(d)] - dot(cb, b.U[std::size_t(d)], ap);
   std::vector<Expr> qdd(static_cast<std::size_t>(n));
   if (n == 1) qdd[0] = cb.mul(b.Dinv, cb.flat(r[0]));
-  else qdd = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, r));
+  else qdd = choleskySolve(cb, b.L, b.Linv, r);
   V6 a = ap;
   for (int d = 0; d < n; ++d) {
     if (storeQdd)

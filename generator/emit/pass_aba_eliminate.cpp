@@ -219,7 +219,7 @@ void eliminatePicked(Emit& e, const Kinematics& kin, int i, const std::vector<st
     passToParent(e, kb, p.parent, Ia, nullptr, art);
     return;
   }
-  const std::vector<Expr> Du = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, b.u));  // D^-1 u
+  const std::vector<Expr> Du = choleskySolve(cb, b.L, b.Linv, b.u);  // D^-1 u
   V6 pa;
   for (int r = 0; r < 6; ++r) {
     Expr x = pA[std::size_t(r)];

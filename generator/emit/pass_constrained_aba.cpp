@@ -68,7 +68,7 @@ void reducedSweep(Emit& e, const Kinematics& kin, const Multipliers& mult, Artic
         b.u[std::size_t(d)] = cb.store(e.member(kUu, i, n, d), b.u[std::size_t(d)] + du[std::size_t(d)]);
       }
       if (p.parent != 0) {
-        const std::vector<Expr> x = backwardSolve(cb, b.L, b.Linv, forwardSolve(cb, b.L, b.Linv, du));
+        const std::vector<Expr> x = choleskySolve(cb, b.L, b.Linv, du);
         V6 t;
         for (int r = 0; r < 6; ++r) {
           t[std::size_t(r)] = dp[std::size_t(r)];

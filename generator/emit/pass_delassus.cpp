@@ -58,14 +58,6 @@ Sym toChild(Emit& e, int i, const Kinematics::Body& b, const Sym& Phi) {
   return swapHalves(B);
 }
 
-// A planar joint (S picks the components sel; D = S^T IA S = L L^T from
-// eliminatePicked): D^-1 S^T x, by the factor.
-std::vector<Expr> pickedSolve(CodeBuilder& cb, const Articulated::Body& ab, const std::vector<int>& sel, const V6& x) {
-  std::vector<Expr> rhs;
-  for (int k : sel) rhs.push_back(x[std::size_t(k)]);
-  return backwardSolve(cb, ab.L, ab.Linv, forwardSolve(cb, ab.L, ab.Linv, rhs));
-}
-
 // Phi_i at a planar joint: S D^-1 S^T + P^T Phi' P, P = 1 - UD S^T with UD = U D^-1
 // (6 x n): P^T Phi' P = Phi' - S Yd^T - Yd S^T + S (UD^T Yd) S^T, Yd = Phi' UD.
 Sym apparentInverseInertiaPicked(Emit& e, const Kinematics& kin, const Articulated& art, const ConstraintOutputs& st,
@@ -79,7 +71,7 @@ Sym apparentInverseInertiaPicked(Emit& e, const Kinematics& kin, const Articulat
   for (std::size_t c = 0; c < n; ++c) {
     std::vector<Expr> unit(n);
     unit[c] = Expr(1.0);
-    Dinv[c] = backwardSolve(cb, ab.L, ab.Linv, forwardSolve(cb, ab.L, ab.Linv, unit));
+    Dinv[c] = choleskySolve(cb, ab.L, ab.Linv, unit);
     for (Expr& x : Dinv[c]) x = cb.flat(x, "Di");
   }
   Sym Phi(6);
@@ -173,7 +165,9 @@ V6 throughJoint(Emit& e, const Kinematics& kin, const Articulated& art, int ch, 
   const Kinematics::Body& kb = kin.b[std::size_t(ch)];
   if (e.bp(ch).jointClass == JointClass::Planar) {  // x - U D^-1 S^T x, its components sel exactly 0
     const std::vector<int> sel = pickedComponents(e.bp(ch).jointClass);
-    const std::vector<Expr> y = pickedSolve(cb, ab, sel, x);
+    std::vector<Expr> rhs;  // S^T x
+    for (int k : sel) rhs.push_back(x[std::size_t(k)]);
+    const std::vector<Expr> y = choleskySolve(cb, ab.L, ab.Linv, rhs);  // D^-1 S^T x
     V6 f = x;
     for (std::size_t d = 0; d < sel.size(); ++d) f = sub(f, scale(cb, y[d], ab.U[d]));
     for (int k : sel) f[std::size_t(k)] = Expr();

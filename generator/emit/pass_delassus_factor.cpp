@@ -495,7 +495,7 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
     std::vector<Expr> v(6);
     for (int d = 0; d < 6; ++d)
       for (std::size_t t = 0; t < z.size(); ++t) v[std::size_t(d)] += cb.mul(f.W[t][std::size_t(d)], z[t]);
-    const std::vector<Expr> x = backwardSolve(cb, f.LS, f.LSinv, forwardSolve(cb, f.LS, f.LSinv, v));
+    const std::vector<Expr> x = choleskySolve(cb, f.LS, f.LSinv, v);
     for (std::size_t t = 0; t < z.size(); ++t) {
       for (int d = 0; d < 6; ++d) z[t] -= cb.mul(f.W[t][std::size_t(d)], x[std::size_t(d)]);
       z[t] = cb.flat(z[t], "z");

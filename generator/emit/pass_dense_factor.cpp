@@ -46,4 +46,8 @@ std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector
   return x;
 }
 
+std::vector<Expr> choleskySolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& b) {
+  return backwardSolve(cb, L, inv, forwardSolve(cb, L, inv, b));
+}
+
 }  // namespace proxgen::emit

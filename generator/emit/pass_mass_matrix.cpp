@@ -226,8 +226,6 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
   std::vector<V6>& cols = js.carried;
   cols.assign(std::size_t(nv), zero6());
   std::vector<int> frameOf(std::size_t(nv), 0);  // the body in whose frame column k is
-  std::vector<int> children(std::size_t(N), 0);
-  for (int i = 1; i < N; ++i) ++children[std::size_t(e.bp(i).parent)];
   e.fn.beginPass("", "composite inertias, leaves first: M_ji = S_j^T X^T ... Ic_i S_i");
   for (int i = N - 1; i >= 1; --i) {
     e.fn.boundary(i);
@@ -264,7 +262,7 @@ void compositeInertias(Emit& e, const Kinematics& kin, JointSpace& js, std::vect
     const int par = p.parent;
     int longest = 0;
     for (int k : ks) longest = std::max(longest, int(steps(k).size()));
-    if (!ks.empty() && children[std::size_t(par)] == 1 && e.bp(par).parent > 0 && longest < kChainSteps)
+    if (!ks.empty() && e.bp(par).children.size() == 1 && e.bp(par).parent > 0 && longest < kChainSteps)
       continue;  // they go on with the parent's own step
     const auto inputs = [&](int k) { return entries(cols[std::size_t(k)]); };
     const auto sameShape = [&](int k, int k0) {

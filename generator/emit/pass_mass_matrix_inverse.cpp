@@ -176,7 +176,7 @@ void backwardFreeFlyer(Emit& e, int i, Articulated& art, JointSpace& js) {
   e.openBody(i, "eliminate");
   Cholesky ch = cholesky(e, b.IA, Expr(), Lname, invName);
   const auto solve = [&](const std::vector<Expr>& rhs) {
-    return backwardSolve(e.cb(), ch.L, ch.inv, forwardSolve(e.cb(), ch.L, ch.inv, rhs));
+    return choleskySolve(e.cb(), ch.L, ch.inv, rhs);
   };
   for (int c = 0; c < 6; ++c) {
     std::vector<Expr> unit(6);
@@ -239,19 +239,6 @@ void writeOut(Emit& e, int row, int k0, bool loop, const Expr& value) {
 // F_i[:, j] for the subtree's columns, F_p[:, j] += X^T (F_i[:, j] + U
 // Minv(s.., j)) and IA_p += X^T (IA - U D^-1 U^T) X. A planar joint is rare
 // (a mobile base, once per robot): its columns are printed one by one.
-struct Picked {
-  std::vector<int> sel;
-  Cholesky ch;
-  std::vector<Expr> solve(CodeBuilder& cb, const std::vector<Expr>& rhs) const {  // D^-1 rhs
-    return backwardSolve(cb, ch.L, ch.inv, forwardSolve(cb, ch.L, ch.inv, rhs));
-  }
-};
-Picked pickedFactor(Emit& e, int i, Articulated& art) {
-  Articulated::Body& b = art.b[std::size_t(i)];
-  factorPicked(e, i, b.IA, b);
-  return {pickedComponents(e.bp(i).jointClass), {b.L, b.Linv}};
-}
-
 void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
@@ -263,8 +250,10 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   e.fn.boundary(i);
   e.openBody(i, "eliminate");
   CodeBuilder& cb = e.cb();
-  const Picked pk = pickedFactor(e, i, art);
-  const int n = int(pk.sel.size());
+  factorPicked(e, i, b.IA, b);
+  const std::vector<int> sel = pickedComponents(p.jointClass);
+  const int n = int(sel.size());
+  const auto solve = [&](const std::vector<Expr>& rhs) { return choleskySolve(cb, b.L, b.Linv, rhs); };  // D^-1 rhs
   // Passes one column f of the subtree's forces on to the parent: F_p[:, j] += X^T f.
   const auto passOn = [&](int j, V6 f) {
     flatten(cb, f, "f");
@@ -278,7 +267,7 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   for (int c = 0; c < n; ++c) {
     std::vector<Expr> unit(static_cast<std::size_t>(n));
     unit[std::size_t(c)] = Expr(1.0);
-    std::vector<Expr> x = pk.solve(cb, unit);
+    std::vector<Expr> x = solve(unit);
     for (Expr& v : x) v = cb.flat(v, "m");
     for (int r = 0; r <= c; ++r) js.upper(s + r, s + c) = e.put(minvMember(e, s + r, s + c), x[std::size_t(r)]);
     if (!toParent) continue;
@@ -287,7 +276,7 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
     passOn(s + c, f);
   }
   if (toParent) {  // IA_p += X^T (IA - U D^-1 U^T) X
-    const Sym dI = e.inertiaToParent(kb, reducedPicked(cb, b.IA, b, pk.sel));
+    const Sym dI = e.inertiaToParent(kb, reducedPicked(cb, b.IA, b, sel));
     Articulated::Body& par = art.b[std::size_t(p.parent)];
     for (int k = 0; k < 21; ++k)
       if (!dI.packed(k).isZero()) par.IA.packed(k) = e.putQ(kIA, p.parent, 21, k, par.IA.packed(k) + dI.packed(k));
@@ -295,8 +284,8 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   // The subtree's columns: Minv(s.., j) = -D^-1 S^T F_i[:, j], then F_i[:, j] + U Minv(s.., j) on.
   for (int j = s + n; j < p.dofEnd; ++j) {
     std::vector<Expr> rhs(static_cast<std::size_t>(n));
-    for (int d = 0; d < n; ++d) rhs[std::size_t(d)] = F[std::size_t(j)][std::size_t(pk.sel[std::size_t(d)])];
-    std::vector<Expr> x = pk.solve(cb, rhs);
+    for (int d = 0; d < n; ++d) rhs[std::size_t(d)] = F[std::size_t(j)][std::size_t(sel[std::size_t(d)])];
+    std::vector<Expr> x = solve(rhs);
     for (int d = 0; d < n; ++d) {
       x[std::size_t(d)] = e.put(minvMember(e, s + d, j), -x[std::size_t(d)]);
       js.upper(s + d, j) = x[std::size_t(d)];
@@ -324,9 +313,6 @@ void forwardPicked(Emit& e, const Kinematics& kin, int i, const Articulated& art
   e.fn.boundary(i);
   e.openBody(i, "accelerate");
   CodeBuilder& cb = e.cb();
-  Cholesky ch;
-  ch.L = b.L;
-  ch.inv = b.Linv;
   for (int j = s; j < nv; ++j) {
     std::vector<Expr> x(static_cast<std::size_t>(n));
     for (int d = 0; d < n; ++d) x[std::size_t(d)] = js.upper(s + d, j);
@@ -336,7 +322,7 @@ void forwardPicked(Emit& e, const Kinematics& kin, int i, const Articulated& art
       flatten(cb, a, "t");
       std::vector<Expr> Ua(static_cast<std::size_t>(n));
       for (int d = 0; d < n; ++d) Ua[std::size_t(d)] = cb.flat(dot(cb, b.U[std::size_t(d)], a));
-      const std::vector<Expr> y = backwardSolve(cb, ch.L, ch.inv, forwardSolve(cb, ch.L, ch.inv, Ua));
+      const std::vector<Expr> y = choleskySolve(cb, b.L, b.Linv, Ua);
       for (int d = 0; d < n; ++d) x[std::size_t(d)] = cb.flat(x[std::size_t(d)] - y[std::size_t(d)], "m");
     }
     for (int d = 0; d < n && s + d <= j; ++d) writeOut(e, s + d, j, false, x[std::size_t(d)]);

@@ -96,6 +96,8 @@ Cholesky cholesky(Emit& e, const Sym& A, const Expr& shift, const std::function<
                   const std::function<std::string(int)>& invName);
 std::vector<Expr> forwardSolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& b);
 std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& y);
+/// (L L^T)^-1 b: the two solves.
+std::vector<Expr> choleskySolve(CodeBuilder& cb, const Sym& L, const std::vector<Expr>& inv, const std::vector<Expr>& b);
 
 // ---- pass_constrained_aba.cpp: the constrained_aba entry point (body text);
 // kin and art are its own copies of the state after eliminate_free_bodies,
