@@ -128,6 +128,42 @@ TEST(UrdfLoad, FixedJointMergesFrameAndInertiaAsDerivedByHand) {
   EXPECT_EQ(m.bodies[1].inertia.mass, 1.0);
 }
 
+// Quarter turns written to 11-12 digits (1.57079632679: 4.9e-12 from pi/2,
+// 3.14159265359: 2.1e-12 from pi; Talos' file) leave entries of 1e-12 in the
+// rotation, which the generated code carried as live terms. A rotation within
+// 1e-10 of a signed permutation is that permutation (model/urdf.cpp,
+// snapRotation); a quarter turn of fewer digits (1.5708: 3.7e-6 off) is the
+// file's number, not round-off, and a rotation mixing a quarter turn with
+// another angle keeps its entries.
+TEST(UrdfLoad, QuarterTurnsOfElevenDigitsAreExact) {
+  const char* urdf = R"(<?xml version="1.0"?>
+<robot name="turns">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="f1" type="fixed"><parent link="base"/><child link="talos"/><origin xyz="0 0 0" rpy="3.14159265359 0 1.57079632679"/></joint>
+  <link name="talos"/>
+  <joint name="f2" type="fixed"><parent link="base"/><child link="short"/><origin xyz="0 0 0" rpy="0 0 1.5708"/></joint>
+  <link name="short"/>
+  <joint name="f3" type="fixed"><parent link="base"/><child link="mixed"/><origin xyz="0 0 0" rpy="1.57079632679 0 0.5"/></joint>
+  <link name="mixed"/>
+</robot>
+)";
+  const Model m = parseUrdf(urdf, "turns.urdf", false);
+  // Rz(pi/2) Rx(pi) = [[0,-1,0],[1,0,0],[0,0,1]] diag(1,-1,-1), exactly.
+  Mat3 P;
+  P << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  EXPECT_EQ(m.frames[m.findFrame("talos")].placement.R, P);
+  // cos(1.5708) = -3.7e-6 is kept: the file says 1.5708.
+  const Mat3& S = m.frames[m.findFrame("short")].placement.R;
+  EXPECT_NEAR(S(0, 0), std::cos(1.5708), 1e-15);
+  EXPECT_NE(S(0, 0), 0.0);
+  // The mixed turn: Rz(0.5) Rx(1.57079632679); its (2, 1) entry -sin(1.57079632679) and (2, 2)
+  // entry cos(1.57079632679) = 4.9e-12 stay as computed, and the matrix a rotation to round-off.
+  const Mat3& X = m.frames[m.findFrame("mixed")].placement.R;
+  EXPECT_NEAR(X(2, 2), std::cos(1.57079632679), 1e-15);
+  EXPECT_GT(X(2, 2), 1e-12);
+  EXPECT_LE((X * X.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+}
+
 TEST(UrdfLoad, FloatingBaseAddsAFreeFlyerRoot) {
   const Model m = parseUrdf(kRobot, "merge.urdf", true);
   ASSERT_EQ(m.numBodies(), 5);
