@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
 //     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16721 + 650 K (= 18671 at K = 3)
-//     add/sub 6643 + 285 K, mul 9659 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   prox_pv: 16649 + 650 K (= 18599 at K = 3)
+//     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
@@ -6192,7 +6192,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_4_to_column_8(Scalar inv_mu, Workspa
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = 514.0929615568219 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3] + inv_mu - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
@@ -6247,348 +6247,157 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W_0(Scalar inv_mu, Workspace& P
     const Scalar inv5 = 1.0 / r5;
     w.Linv[14] = inv5;
   }
-  // W = L^-1 Z^T, column 0
-  {
-    const Scalar t12 = w.Z_pelvis[0][0]*w.active[0];
-    const Scalar t13 = w.Linv[0]*t12;
-    const Scalar t14 = w.Z_pelvis[0][1]*w.active[0] - w.L[1]*t13;
-    const Scalar t15 = w.Linv[1]*t14;
-    const Scalar t16 = w.Z_pelvis[0][2]*w.active[0] - w.L[2]*t13 - w.L[16]*t15;
-    const Scalar t17 = w.Linv[2]*t16;
-    const Scalar t18 = w.Z_pelvis[0][3]*w.active[0] - w.L[3]*t13 - w.L[17]*t15 - w.L[30]*t17;
-    const Scalar t19 = w.Linv[3]*t18;
-    const Scalar t20 = w.Z_pelvis[0][4]*w.active[0] - w.L[4]*t13 - w.L[18]*t15 - w.L[31]*t17 - w.L[43]*t19;
-    const Scalar t21 = w.Linv[4]*t20;
-    const Scalar t22 = w.Z_pelvis[0][5]*w.active[0] - w.L[5]*t13 - w.L[19]*t15 - w.L[32]*t17 - w.L[44]*t19 - w.L[55]*t21;
-    const Scalar t23 = w.Z_pelvis[0][6]*w.active[1];
-    const Scalar t24 = w.Linv[6]*t23;
-    const Scalar t25 = w.Z_pelvis[0][7]*w.active[1] - w.L[76]*t24;
-    const Scalar t26 = w.Linv[7]*t25;
-    const Scalar t27 = w.Z_pelvis[0][8]*w.active[1] - w.L[77]*t24 - w.L[85]*t26;
-    const Scalar t28 = w.Linv[8]*t27;
-    const Scalar t29 = w.Z_pelvis[0][9]*w.active[1] - w.L[78]*t24 - w.L[86]*t26 - w.L[93]*t28;
-    const Scalar t30 = w.Linv[9]*t29;
-    const Scalar t31 = w.Z_pelvis[0][10]*w.active[1] - w.L[79]*t24 - w.L[87]*t26 - w.L[94]*t28 - w.L[100]*t30;
-    const Scalar t32 = w.Linv[10]*t31;
-    const Scalar t33 = w.Z_pelvis[0][11]*w.active[1] - w.L[80]*t24 - w.L[88]*t26 - w.L[95]*t28 - w.L[101]*t30 - w.L[106]*t32;
-    const Scalar t34 = w.Z_pelvis[0][12]*w.active[2];
-    const Scalar t35 = w.Linv[12]*t34;
-    const Scalar t36 = w.Z_pelvis[0][13]*w.active[2] - w.L[115]*t35;
-    const Scalar t37 = w.Linv[13]*t36;
-    const Scalar t38 = w.Z_pelvis[0][14]*w.active[2] - w.L[116]*t35 - w.L[118]*t37;
-    w.W[0][0] = w.Linv[0]*t12;
-    w.W[1][0] = w.Linv[1]*t14;
-    w.W[2][0] = w.Linv[2]*t16;
-    w.W[3][0] = w.Linv[3]*t18;
-    w.W[4][0] = w.Linv[4]*t20;
-    w.W[5][0] = w.Linv[5]*t22;
-    w.W[6][0] = w.Linv[6]*t23;
-    w.W[7][0] = w.Linv[7]*t25;
-    w.W[8][0] = w.Linv[8]*t27;
-    w.W[9][0] = w.Linv[9]*t29;
-    w.W[10][0] = w.Linv[10]*t31;
-    w.W[11][0] = w.Linv[11]*t33;
-    w.W[12][0] = w.Linv[12]*t34;
-    w.W[13][0] = w.Linv[13]*t36;
-    w.W[14][0] = w.Linv[14]*t38;
+  // W = L^-1 Z^T, row 0, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t12 = w.Z_pelvis[j][0]*w.active[0];
+    w.W[0][j] = w.Linv[0]*t12;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_1(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 1
-  {
-    const Scalar t0 = w.Z_pelvis[1][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_pelvis[1][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_pelvis[1][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
-    const Scalar t5 = w.Linv[2]*t4;
-    const Scalar t6 = w.Z_pelvis[1][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
-    const Scalar t7 = w.Linv[3]*t6;
-    const Scalar t8 = w.Z_pelvis[1][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
-    const Scalar t9 = w.Linv[4]*t8;
-    const Scalar t10 = w.Z_pelvis[1][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
-    const Scalar t11 = w.Z_pelvis[1][6]*w.active[1];
-    const Scalar t12 = w.Linv[6]*t11;
-    const Scalar t13 = w.Z_pelvis[1][7]*w.active[1] - w.L[76]*t12;
-    const Scalar t14 = w.Linv[7]*t13;
-    const Scalar t15 = w.Z_pelvis[1][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
-    const Scalar t16 = w.Linv[8]*t15;
-    const Scalar t17 = w.Z_pelvis[1][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
-    const Scalar t18 = w.Linv[9]*t17;
-    const Scalar t19 = w.Z_pelvis[1][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
-    const Scalar t20 = w.Linv[10]*t19;
-    const Scalar t21 = w.Z_pelvis[1][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
-    const Scalar t22 = w.Z_pelvis[1][12]*w.active[2];
-    const Scalar t23 = w.Linv[12]*t22;
-    const Scalar t24 = w.Z_pelvis[1][13]*w.active[2] - w.L[115]*t23;
-    const Scalar t25 = w.Linv[13]*t24;
-    const Scalar t26 = w.Z_pelvis[1][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
-    w.W[0][1] = w.Linv[0]*t0;
-    w.W[1][1] = w.Linv[1]*t2;
-    w.W[2][1] = w.Linv[2]*t4;
-    w.W[3][1] = w.Linv[3]*t6;
-    w.W[4][1] = w.Linv[4]*t8;
-    w.W[5][1] = w.Linv[5]*t10;
-    w.W[6][1] = w.Linv[6]*t11;
-    w.W[7][1] = w.Linv[7]*t13;
-    w.W[8][1] = w.Linv[8]*t15;
-    w.W[9][1] = w.Linv[9]*t17;
-    w.W[10][1] = w.Linv[10]*t19;
-    w.W[11][1] = w.Linv[11]*t21;
-    w.W[12][1] = w.Linv[12]*t22;
-    w.W[13][1] = w.Linv[13]*t24;
-    w.W[14][1] = w.Linv[14]*t26;
+  // W = L^-1 Z^T, row 1, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t13 = w.active[0]*w.Z_pelvis[j][1] - w.L[1]*w.W[0][j];
+    w.W[1][j] = w.Linv[1]*t13;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 2
-  {
-    const Scalar t0 = w.Z_pelvis[2][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_pelvis[2][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_pelvis[2][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
-    const Scalar t5 = w.Linv[2]*t4;
-    const Scalar t6 = w.Z_pelvis[2][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
-    const Scalar t7 = w.Linv[3]*t6;
-    const Scalar t8 = w.Z_pelvis[2][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
-    const Scalar t9 = w.Linv[4]*t8;
-    const Scalar t10 = w.Z_pelvis[2][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
-    const Scalar t11 = w.Z_pelvis[2][6]*w.active[1];
-    const Scalar t12 = w.Linv[6]*t11;
-    const Scalar t13 = w.Z_pelvis[2][7]*w.active[1] - w.L[76]*t12;
-    const Scalar t14 = w.Linv[7]*t13;
-    const Scalar t15 = w.Z_pelvis[2][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
-    const Scalar t16 = w.Linv[8]*t15;
-    const Scalar t17 = w.Z_pelvis[2][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
-    const Scalar t18 = w.Linv[9]*t17;
-    const Scalar t19 = w.Z_pelvis[2][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
-    const Scalar t20 = w.Linv[10]*t19;
-    const Scalar t21 = w.Z_pelvis[2][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
-    const Scalar t22 = w.Z_pelvis[2][12]*w.active[2];
-    const Scalar t23 = w.Linv[12]*t22;
-    const Scalar t24 = w.Z_pelvis[2][13]*w.active[2] - w.L[115]*t23;
-    const Scalar t25 = w.Linv[13]*t24;
-    const Scalar t26 = w.Z_pelvis[2][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
-    w.W[0][2] = w.Linv[0]*t0;
-    w.W[1][2] = w.Linv[1]*t2;
-    w.W[2][2] = w.Linv[2]*t4;
-    w.W[3][2] = w.Linv[3]*t6;
-    w.W[4][2] = w.Linv[4]*t8;
-    w.W[5][2] = w.Linv[5]*t10;
-    w.W[6][2] = w.Linv[6]*t11;
-    w.W[7][2] = w.Linv[7]*t13;
-    w.W[8][2] = w.Linv[8]*t15;
-    w.W[9][2] = w.Linv[9]*t17;
-    w.W[10][2] = w.Linv[10]*t19;
-    w.W[11][2] = w.Linv[11]*t21;
-    w.W[12][2] = w.Linv[12]*t22;
-    w.W[13][2] = w.Linv[13]*t24;
-    w.W[14][2] = w.Linv[14]*t26;
+  // W = L^-1 Z^T, row 2, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t14 = w.active[0]*w.Z_pelvis[j][2] - w.L[2]*w.W[0][j] - w.L[16]*w.W[1][j];
+    w.W[2][j] = w.Linv[2]*t14;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_3(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 3
-  {
-    const Scalar t0 = w.Z_pelvis[3][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_pelvis[3][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_pelvis[3][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
-    const Scalar t5 = w.Linv[2]*t4;
-    const Scalar t6 = w.Z_pelvis[3][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
-    const Scalar t7 = w.Linv[3]*t6;
-    const Scalar t8 = w.Z_pelvis[3][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
-    const Scalar t9 = w.Linv[4]*t8;
-    const Scalar t10 = w.Z_pelvis[3][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
-    const Scalar t11 = w.Z_pelvis[3][6]*w.active[1];
-    const Scalar t12 = w.Linv[6]*t11;
-    const Scalar t13 = w.Z_pelvis[3][7]*w.active[1] - w.L[76]*t12;
-    const Scalar t14 = w.Linv[7]*t13;
-    const Scalar t15 = w.Z_pelvis[3][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
-    const Scalar t16 = w.Linv[8]*t15;
-    const Scalar t17 = w.Z_pelvis[3][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
-    const Scalar t18 = w.Linv[9]*t17;
-    const Scalar t19 = w.Z_pelvis[3][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
-    const Scalar t20 = w.Linv[10]*t19;
-    const Scalar t21 = w.Z_pelvis[3][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
-    const Scalar t22 = w.Z_pelvis[3][12]*w.active[2];
-    const Scalar t23 = w.Linv[12]*t22;
-    const Scalar t24 = w.Z_pelvis[3][13]*w.active[2] - w.L[115]*t23;
-    const Scalar t25 = w.Linv[13]*t24;
-    const Scalar t26 = w.Z_pelvis[3][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
-    w.W[0][3] = w.Linv[0]*t0;
-    w.W[1][3] = w.Linv[1]*t2;
-    w.W[2][3] = w.Linv[2]*t4;
-    w.W[3][3] = w.Linv[3]*t6;
-    w.W[4][3] = w.Linv[4]*t8;
-    w.W[5][3] = w.Linv[5]*t10;
-    w.W[6][3] = w.Linv[6]*t11;
-    w.W[7][3] = w.Linv[7]*t13;
-    w.W[8][3] = w.Linv[8]*t15;
-    w.W[9][3] = w.Linv[9]*t17;
-    w.W[10][3] = w.Linv[10]*t19;
-    w.W[11][3] = w.Linv[11]*t21;
-    w.W[12][3] = w.Linv[12]*t22;
-    w.W[13][3] = w.Linv[13]*t24;
-    w.W[14][3] = w.Linv[14]*t26;
+  // W = L^-1 Z^T, row 3, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t15 = w.active[0]*w.Z_pelvis[j][3] - w.L[3]*w.W[0][j] - w.L[17]*w.W[1][j] - w.L[30]*w.W[2][j];
+    w.W[3][j] = w.Linv[3]*t15;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 4
-  {
-    const Scalar t0 = w.Z_pelvis[4][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_pelvis[4][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_pelvis[4][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
-    const Scalar t5 = w.Linv[2]*t4;
-    const Scalar t6 = w.Z_pelvis[4][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
-    const Scalar t7 = w.Linv[3]*t6;
-    const Scalar t8 = w.Z_pelvis[4][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
-    const Scalar t9 = w.Linv[4]*t8;
-    const Scalar t10 = w.Z_pelvis[4][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
-    const Scalar t11 = w.Z_pelvis[4][6]*w.active[1];
-    const Scalar t12 = w.Linv[6]*t11;
-    const Scalar t13 = w.Z_pelvis[4][7]*w.active[1] - w.L[76]*t12;
-    const Scalar t14 = w.Linv[7]*t13;
-    const Scalar t15 = w.Z_pelvis[4][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
-    const Scalar t16 = w.Linv[8]*t15;
-    const Scalar t17 = w.Z_pelvis[4][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
-    const Scalar t18 = w.Linv[9]*t17;
-    const Scalar t19 = w.Z_pelvis[4][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
-    const Scalar t20 = w.Linv[10]*t19;
-    const Scalar t21 = w.Z_pelvis[4][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
-    const Scalar t22 = w.Z_pelvis[4][12]*w.active[2];
-    const Scalar t23 = w.Linv[12]*t22;
-    const Scalar t24 = w.Z_pelvis[4][13]*w.active[2] - w.L[115]*t23;
-    const Scalar t25 = w.Linv[13]*t24;
-    const Scalar t26 = w.Z_pelvis[4][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
-    w.W[0][4] = w.Linv[0]*t0;
-    w.W[1][4] = w.Linv[1]*t2;
-    w.W[2][4] = w.Linv[2]*t4;
-    w.W[3][4] = w.Linv[3]*t6;
-    w.W[4][4] = w.Linv[4]*t8;
-    w.W[5][4] = w.Linv[5]*t10;
-    w.W[6][4] = w.Linv[6]*t11;
-    w.W[7][4] = w.Linv[7]*t13;
-    w.W[8][4] = w.Linv[8]*t15;
-    w.W[9][4] = w.Linv[9]*t17;
-    w.W[10][4] = w.Linv[10]*t19;
-    w.W[11][4] = w.Linv[11]*t21;
-    w.W[12][4] = w.Linv[12]*t22;
-    w.W[13][4] = w.Linv[13]*t24;
-    w.W[14][4] = w.Linv[14]*t26;
+  // W = L^-1 Z^T, row 4, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t16 = w.active[0]*w.Z_pelvis[j][4] - w.L[4]*w.W[0][j] - w.L[18]*w.W[1][j] - w.L[31]*w.W[2][j] - w.L[43]*w.W[3][j];
+    w.W[4][j] = w.Linv[4]*t16;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_5(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 5
-  {
-    const Scalar t0 = w.Z_pelvis[5][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_pelvis[5][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_pelvis[5][2]*w.active[0] - w.L[2]*t1 - w.L[16]*t3;
-    const Scalar t5 = w.Linv[2]*t4;
-    const Scalar t6 = w.Z_pelvis[5][3]*w.active[0] - w.L[3]*t1 - w.L[17]*t3 - w.L[30]*t5;
-    const Scalar t7 = w.Linv[3]*t6;
-    const Scalar t8 = w.Z_pelvis[5][4]*w.active[0] - w.L[4]*t1 - w.L[18]*t3 - w.L[31]*t5 - w.L[43]*t7;
-    const Scalar t9 = w.Linv[4]*t8;
-    const Scalar t10 = w.Z_pelvis[5][5]*w.active[0] - w.L[5]*t1 - w.L[19]*t3 - w.L[32]*t5 - w.L[44]*t7 - w.L[55]*t9;
-    const Scalar t11 = w.Z_pelvis[5][6]*w.active[1];
-    const Scalar t12 = w.Linv[6]*t11;
-    const Scalar t13 = w.Z_pelvis[5][7]*w.active[1] - w.L[76]*t12;
-    const Scalar t14 = w.Linv[7]*t13;
-    const Scalar t15 = w.Z_pelvis[5][8]*w.active[1] - w.L[77]*t12 - w.L[85]*t14;
-    const Scalar t16 = w.Linv[8]*t15;
-    const Scalar t17 = w.Z_pelvis[5][9]*w.active[1] - w.L[78]*t12 - w.L[86]*t14 - w.L[93]*t16;
-    const Scalar t18 = w.Linv[9]*t17;
-    const Scalar t19 = w.Z_pelvis[5][10]*w.active[1] - w.L[79]*t12 - w.L[87]*t14 - w.L[94]*t16 - w.L[100]*t18;
-    const Scalar t20 = w.Linv[10]*t19;
-    const Scalar t21 = w.Z_pelvis[5][11]*w.active[1] - w.L[80]*t12 - w.L[88]*t14 - w.L[95]*t16 - w.L[101]*t18 - w.L[106]*t20;
-    const Scalar t22 = w.Z_pelvis[5][12]*w.active[2];
-    const Scalar t23 = w.Linv[12]*t22;
-    const Scalar t24 = w.Z_pelvis[5][13]*w.active[2] - w.L[115]*t23;
-    const Scalar t25 = w.Linv[13]*t24;
-    const Scalar t26 = w.Z_pelvis[5][14]*w.active[2] - w.L[116]*t23 - w.L[118]*t25;
-    w.W[0][5] = w.Linv[0]*t0;
-    w.W[1][5] = w.Linv[1]*t2;
-    w.W[2][5] = w.Linv[2]*t4;
-    w.W[3][5] = w.Linv[3]*t6;
-    w.W[4][5] = w.Linv[4]*t8;
-    w.W[5][5] = w.Linv[5]*t10;
-    w.W[6][5] = w.Linv[6]*t11;
-    w.W[7][5] = w.Linv[7]*t13;
-    w.W[8][5] = w.Linv[8]*t15;
-    w.W[9][5] = w.Linv[9]*t17;
-    w.W[10][5] = w.Linv[10]*t19;
-    w.W[11][5] = w.Linv[11]*t21;
-    w.W[12][5] = w.Linv[12]*t22;
-    w.W[13][5] = w.Linv[13]*t24;
-    w.W[14][5] = w.Linv[14]*t26;
+  // W = L^-1 Z^T, row 5, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t17 = w.active[0]*w.Z_pelvis[j][5] - w.L[5]*w.W[0][j] - w.L[19]*w.W[1][j] - w.L[32]*w.W[2][j] - w.L[44]*w.W[3][j] - w.L[55]*w.W[4][j];
+    w.W[5][j] = w.Linv[5]*t17;
+  }
+  // W = L^-1 Z^T, row 6, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t18 = w.Z_pelvis[j][6]*w.active[1];
+    w.W[6][j] = w.Linv[6]*t18;
+  }
+  // W = L^-1 Z^T, row 7, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t19 = w.active[1]*w.Z_pelvis[j][7] - w.L[76]*w.W[6][j];
+    w.W[7][j] = w.Linv[7]*t19;
+  }
+  // W = L^-1 Z^T, row 8, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t20 = w.active[1]*w.Z_pelvis[j][8] - w.L[77]*w.W[6][j] - w.L[85]*w.W[7][j];
+    w.W[8][j] = w.Linv[8]*t20;
+  }
+  // W = L^-1 Z^T, row 9, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t21 = w.active[1]*w.Z_pelvis[j][9] - w.L[78]*w.W[6][j] - w.L[86]*w.W[7][j] - w.L[93]*w.W[8][j];
+    w.W[9][j] = w.Linv[9]*t21;
+  }
+  // W = L^-1 Z^T, row 10, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t22 = w.active[1]*w.Z_pelvis[j][10] - w.L[79]*w.W[6][j] - w.L[87]*w.W[7][j] - w.L[94]*w.W[8][j] - w.L[100]*w.W[9][j];
+    w.W[10][j] = w.Linv[10]*t22;
+  }
+  // W = L^-1 Z^T, row 11, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t23 = w.active[1]*w.Z_pelvis[j][11] - w.L[80]*w.W[6][j] - w.L[88]*w.W[7][j] - w.L[95]*w.W[8][j] - w.L[101]*w.W[9][j] - w.L[106]*w.W[10][j];
+    w.W[11][j] = w.Linv[11]*t23;
+  }
+  // W = L^-1 Z^T, row 12, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t24 = w.Z_pelvis[j][12]*w.active[2];
+    w.W[12][j] = w.Linv[12]*t24;
+  }
+  // W = L^-1 Z^T, row 13, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t25 = w.active[2]*w.Z_pelvis[j][13] - w.L[115]*w.W[12][j];
+    w.W[13][j] = w.Linv[13]*t25;
+  }
+  // W = L^-1 Z^T, row 14, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t26 = w.active[2]*w.Z_pelvis[j][14] - w.L[116]*w.W[12][j] - w.L[118]*w.W[13][j];
+    w.W[14][j] = w.Linv[14]*t26;
   }
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // W^T W, row 0, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    w.WtW[0][j] = w.W[0][0]*w.W[0][j] + w.W[1][0]*w.W[1][j] + w.W[2][0]*w.W[2][j] + w.W[3][0]*w.W[3][j] + w.W[4][0]*w.W[4][j] + w.W[5][0]*w.W[5][j] + w.W[6][0]*w.W[6][j] + w.W[7][0]*w.W[7][j] + w.W[8][0]*w.W[8][j] + w.W[9][0]*w.W[9][j] + w.W[10][0]*w.W[10][j] + w.W[11][0]*w.W[11][j] + w.W[12][0]*w.W[12][j] + w.W[13][0]*w.W[13][j] + w.W[14][0]*w.W[14][j];
+  }
+  // W^T W, row 1, columns 1 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
+    w.WtW[1][1 + j] = w.W[0][1]*w.W[0][1 + j] + w.W[1][1]*w.W[1][1 + j] + w.W[2][1]*w.W[2][1 + j] + w.W[3][1]*w.W[3][1 + j] + w.W[4][1]*w.W[4][1 + j] + w.W[5][1]*w.W[5][1 + j] + w.W[6][1]*w.W[6][1 + j] + w.W[7][1]*w.W[7][1 + j] + w.W[8][1]*w.W[8][1 + j] + w.W[9][1]*w.W[9][1 + j] + w.W[10][1]*w.W[10][1 + j] + w.W[11][1]*w.W[11][1 + j] + w.W[12][1]*w.W[12][1 + j] + w.W[13][1]*w.W[13][1 + j] + w.W[14][1]*w.W[14][1 + j];
+  }
+  // W^T W, row 2, columns 2 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 4; ++j) {
+    w.WtW[2][2 + j] = w.W[0][2]*w.W[0][2 + j] + w.W[1][2]*w.W[1][2 + j] + w.W[2][2]*w.W[2][2 + j] + w.W[3][2]*w.W[3][2 + j] + w.W[4][2]*w.W[4][2 + j] + w.W[5][2]*w.W[5][2 + j] + w.W[6][2]*w.W[6][2 + j] + w.W[7][2]*w.W[7][2 + j] + w.W[8][2]*w.W[8][2 + j] + w.W[9][2]*w.W[9][2 + j] + w.W[10][2]*w.W[10][2 + j] + w.W[11][2]*w.W[11][2 + j] + w.W[12][2]*w.W[12][2 + j] + w.W[13][2]*w.W[13][2 + j] + w.W[14][2]*w.W[14][2 + j];
+  }
+  // W^T W, row 3, columns 3 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
+    w.WtW[3][3 + j] = w.W[0][3]*w.W[0][3 + j] + w.W[1][3]*w.W[1][3 + j] + w.W[2][3]*w.W[2][3 + j] + w.W[3][3]*w.W[3][3 + j] + w.W[4][3]*w.W[4][3 + j] + w.W[5][3]*w.W[5][3 + j] + w.W[6][3]*w.W[6][3 + j] + w.W[7][3]*w.W[7][3 + j] + w.W[8][3]*w.W[8][3 + j] + w.W[9][3]*w.W[9][3 + j] + w.W[10][3]*w.W[10][3 + j] + w.W[11][3]*w.W[11][3 + j] + w.W[12][3]*w.W[12][3 + j] + w.W[13][3]*w.W[13][3 + j] + w.W[14][3]*w.W[14][3 + j];
+  }
+  // W^T W, row 4, columns 4 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
+    w.WtW[4][4 + j] = w.W[0][4]*w.W[0][4 + j] + w.W[1][4]*w.W[1][4 + j] + w.W[2][4]*w.W[2][4 + j] + w.W[3][4]*w.W[3][4 + j] + w.W[4][4]*w.W[4][4 + j] + w.W[5][4]*w.W[5][4 + j] + w.W[6][4]*w.W[6][4 + j] + w.W[7][4]*w.W[7][4 + j] + w.W[8][4]*w.W[8][4 + j] + w.W[9][4]*w.W[9][4 + j] + w.W[10][4]*w.W[10][4 + j] + w.W[11][4]*w.W[11][4 + j] + w.W[12][4]*w.W[12][4 + j] + w.W[13][4]*w.W[13][4 + j] + w.W[14][4]*w.W[14][4 + j];
+  }
+  // W^T W, row 5, columns 5 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 1; ++j) {
+    w.WtW[5][5 + j] = w.W[0][5]*w.W[0][5 + j] + w.W[1][5]*w.W[1][5 + j] + w.W[2][5]*w.W[2][5 + j] + w.W[3][5]*w.W[3][5 + j] + w.W[4][5]*w.W[4][5 + j] + w.W[5][5]*w.W[5][5 + j] + w.W[6][5]*w.W[6][5 + j] + w.W[7][5]*w.W[7][5 + j] + w.W[8][5]*w.W[8][5 + j] + w.W[9][5]*w.W[9][5 + j] + w.W[10][5]*w.W[10][5 + j] + w.W[11][5]*w.W[11][5 + j] + w.W[12][5]*w.W[12][5 + j] + w.W[13][5]*w.W[13][5 + j] + w.W[14][5]*w.W[14][5 + j];
+  }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t0 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0] + w.W[12][0]*w.W[12][0] + w.W[13][0]*w.W[13][0] + w.W[14][0]*w.W[14][0];
+    const Scalar t0 = 1.0 + w.WtW[0][0];
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t1 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1] + w.W[12][0]*w.W[12][1] + w.W[13][0]*w.W[13][1] + w.W[14][0]*w.W[14][1];
-    w.LS[1] = w.LSinv[0]*t1;
-    const Scalar t2 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2] + w.W[12][0]*w.W[12][2] + w.W[13][0]*w.W[13][2] + w.W[14][0]*w.W[14][2];
-    w.LS[2] = w.LSinv[0]*t2;
-    const Scalar t3 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3] + w.W[12][0]*w.W[12][3] + w.W[13][0]*w.W[13][3] + w.W[14][0]*w.W[14][3];
-    w.LS[3] = w.LSinv[0]*t3;
-    const Scalar t4 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4] + w.W[12][0]*w.W[12][4] + w.W[13][0]*w.W[13][4] + w.W[14][0]*w.W[14][4];
-    w.LS[4] = w.LSinv[0]*t4;
-    const Scalar t5 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5] + w.W[12][0]*w.W[12][5] + w.W[13][0]*w.W[13][5] + w.W[14][0]*w.W[14][5];
-    w.LS[5] = w.LSinv[0]*t5;
-    const Scalar t6 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] + w.W[12][1]*w.W[12][1] + w.W[13][1]*w.W[13][1] + w.W[14][1]*w.W[14][1] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t6);
+    w.LS[1] = w.WtW[0][1]*w.LSinv[0];
+    w.LS[2] = w.WtW[0][2]*w.LSinv[0];
+    w.LS[3] = w.WtW[0][3]*w.LSinv[0];
+    w.LS[4] = w.WtW[0][4]*w.LSinv[0];
+    w.LS[5] = w.WtW[0][5]*w.LSinv[0];
+    const Scalar t1 = 1.0 + w.WtW[1][1] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t1);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t7 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] + w.W[12][1]*w.W[12][2] + w.W[13][1]*w.W[13][2] + w.W[14][1]*w.W[14][2] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t7;
-    const Scalar t8 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] + w.W[12][1]*w.W[12][3] + w.W[13][1]*w.W[13][3] + w.W[14][1]*w.W[14][3] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t8;
-    const Scalar t9 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] + w.W[12][1]*w.W[12][4] + w.W[13][1]*w.W[13][4] + w.W[14][1]*w.W[14][4] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t9;
-    const Scalar t10 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] + w.W[12][1]*w.W[12][5] + w.W[13][1]*w.W[13][5] + w.W[14][1]*w.W[14][5] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t10;
-    const Scalar t11 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] + w.W[12][2]*w.W[12][2] + w.W[13][2]*w.W[13][2] + w.W[14][2]*w.W[14][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t11);
+    const Scalar t2 = w.WtW[1][2] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t2;
+    const Scalar t3 = w.WtW[1][3] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t3;
+    const Scalar t4 = w.WtW[1][4] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t4;
+    const Scalar t5 = w.WtW[1][5] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t5;
+    const Scalar t6 = 1.0 + w.WtW[2][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t6);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t12 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] + w.W[12][2]*w.W[12][3] + w.W[13][2]*w.W[13][3] + w.W[14][2]*w.W[14][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t12;
-    const Scalar t13 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] + w.W[12][2]*w.W[12][4] + w.W[13][2]*w.W[13][4] + w.W[14][2]*w.W[14][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t13;
-    const Scalar t14 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] + w.W[12][2]*w.W[12][5] + w.W[13][2]*w.W[13][5] + w.W[14][2]*w.W[14][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t14;
-    const Scalar t15 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] + w.W[12][3]*w.W[12][3] + w.W[13][3]*w.W[13][3] + w.W[14][3]*w.W[14][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t15);
+    const Scalar t7 = w.WtW[2][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t7;
+    const Scalar t8 = w.WtW[2][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t8;
+    const Scalar t9 = w.WtW[2][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t9;
+    const Scalar t10 = 1.0 + w.WtW[3][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t10);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t16 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] + w.W[12][3]*w.W[12][4] + w.W[13][3]*w.W[13][4] + w.W[14][3]*w.W[14][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t16;
-    const Scalar t17 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] + w.W[12][3]*w.W[12][5] + w.W[13][3]*w.W[13][5] + w.W[14][3]*w.W[14][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t17;
-    const Scalar t18 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] + w.W[12][4]*w.W[12][4] + w.W[13][4]*w.W[13][4] + w.W[14][4]*w.W[14][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t18);
+    const Scalar t11 = w.WtW[3][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t11;
+    const Scalar t12 = w.WtW[3][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t12;
+    const Scalar t13 = 1.0 + w.WtW[4][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t13);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t19 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] + w.W[12][4]*w.W[12][5] + w.W[13][4]*w.W[13][5] + w.W[14][4]*w.W[14][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t19;
-    const Scalar t20 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] + w.W[12][5]*w.W[12][5] + w.W[13][5]*w.W[13][5] + w.W[14][5]*w.W[14][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t20);
+    const Scalar t14 = w.WtW[4][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t14;
+    const Scalar t15 = 1.0 + w.WtW[5][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t15);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
@@ -7237,12 +7046,7 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   // ---- G + I/mu = L L^T, G assembled from the carried rows
   pv_delassus_column_0_to_column_3(inv_mu, w);
   pv_delassus_column_4_to_column_8(inv_mu, w);
-  pv_delassus_column_9_to_W_0(inv_mu, w);
-  pv_delassus_W_1(w);
-  pv_delassus_W_2(w);
-  pv_delassus_W_3(w);
-  pv_delassus_W_4(w);
-  pv_delassus_W_5(w);
+  pv_delassus_column_9_to_W(inv_mu, w);
   pv_delassus_LS(w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);

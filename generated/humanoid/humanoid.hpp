@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
 //     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16721 + 650 K (= 18671 at K = 3)
-//     add/sub 6643 + 285 K, mul 9659 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   prox_pv: 16649 + 650 K (= 18599 at K = 3)
+//     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
@@ -188,7 +188,7 @@ struct Settings {
   const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (23024 bytes): per-body quantities named
+// Everything one solve writes (23312 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar sq[30];               // sin q of the revolute joints (q order)
@@ -495,6 +495,7 @@ struct Workspace {
   Scalar Linv[15];             // 1 / diag(L)
   Scalar L[120];               // Cholesky factor of G + I/mu (lower, packed)
   Scalar W[15][6];             // L^-1 Z^T
+  Scalar WtW[6][6];            // W^T W (row a, column j)
   Scalar LSinv[6];             // 1 / diag(LS)
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };

@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
 //     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
-//   prox_pv: 16721 + 650 K (= 18671 at K = 3)
-//     add/sub 6643 + 285 K, mul 9659 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
+//   prox_pv: 16649 + 650 K (= 18599 at K = 3)
+//     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link

@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
 //     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8537 + 475 K (= 9962 at K = 3)
-//     add/sub 3510 + 204 K, mul 4850 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
@@ -2463,7 +2463,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
   shared_24(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = w.KSD_RF_hip[1]*w.KS_RF_hip[1] + inv_mu - w.L[58]*w.L[58];
@@ -2498,279 +2498,142 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W_0(Scalar inv_mu, Workspace& P
     const Scalar inv4 = 1.0 / r4;
     w.Linv[11] = inv4;
   }
-  // W = L^-1 Z^T, column 0
-  {
-    const Scalar t9 = w.Z_trunk[0][0]*w.active[0];
-    const Scalar t10 = w.Linv[0]*t9;
-    const Scalar t11 = w.Z_trunk[0][1]*w.active[0] - w.L[1]*t10;
-    const Scalar t12 = w.Linv[1]*t11;
-    const Scalar t13 = w.Z_trunk[0][2]*w.active[0] - w.L[2]*t10 - w.L[13]*t12;
-    const Scalar t14 = w.Z_trunk[0][3]*w.active[2];
-    const Scalar t15 = w.Linv[3]*t14;
-    const Scalar t16 = w.Z_trunk[0][4]*w.active[2] - w.L[34]*t15;
-    const Scalar t17 = w.Linv[4]*t16;
-    const Scalar t18 = w.Z_trunk[0][5]*w.active[2] - w.L[35]*t15 - w.L[43]*t17;
-    const Scalar t19 = w.Z_trunk[0][6]*w.active[1];
-    const Scalar t20 = w.Linv[6]*t19;
-    const Scalar t21 = w.Z_trunk[0][7]*w.active[1] - w.L[58]*t20;
-    const Scalar t22 = w.Linv[7]*t21;
-    const Scalar t23 = w.Z_trunk[0][8]*w.active[1] - w.L[59]*t20 - w.L[64]*t22;
-    const Scalar t24 = w.Z_trunk[0][9]*w.active[3];
-    const Scalar t25 = w.Linv[9]*t24;
-    const Scalar t26 = w.Z_trunk[0][10]*w.active[3] - w.L[73]*t25;
-    const Scalar t27 = w.Linv[10]*t26;
-    const Scalar t28 = w.Z_trunk[0][11]*w.active[3] - w.L[74]*t25 - w.L[76]*t27;
-    w.W[0][0] = w.Linv[0]*t9;
-    w.W[1][0] = w.Linv[1]*t11;
-    w.W[2][0] = w.Linv[2]*t13;
-    w.W[3][0] = w.Linv[3]*t14;
-    w.W[4][0] = w.Linv[4]*t16;
-    w.W[5][0] = w.Linv[5]*t18;
-    w.W[6][0] = w.Linv[6]*t19;
-    w.W[7][0] = w.Linv[7]*t21;
-    w.W[8][0] = w.Linv[8]*t23;
-    w.W[9][0] = w.Linv[9]*t24;
-    w.W[10][0] = w.Linv[10]*t26;
-    w.W[11][0] = w.Linv[11]*t28;
+  // W = L^-1 Z^T, row 0, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t9 = w.Z_trunk[j][0]*w.active[0];
+    w.W[0][j] = w.Linv[0]*t9;
+  }
+  // W = L^-1 Z^T, row 1, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t10 = w.active[0]*w.Z_trunk[j][1] - w.L[1]*w.W[0][j];
+    w.W[1][j] = w.Linv[1]*t10;
+  }
+  // W = L^-1 Z^T, row 2, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t11 = w.active[0]*w.Z_trunk[j][2] - w.L[2]*w.W[0][j] - w.L[13]*w.W[1][j];
+    w.W[2][j] = w.Linv[2]*t11;
+  }
+  // W = L^-1 Z^T, row 3, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t12 = w.Z_trunk[j][3]*w.active[2];
+    w.W[3][j] = w.Linv[3]*t12;
+  }
+  // W = L^-1 Z^T, row 4, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t13 = w.active[2]*w.Z_trunk[j][4] - w.L[34]*w.W[3][j];
+    w.W[4][j] = w.Linv[4]*t13;
+  }
+  // W = L^-1 Z^T, row 5, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t14 = w.active[2]*w.Z_trunk[j][5] - w.L[35]*w.W[3][j] - w.L[43]*w.W[4][j];
+    w.W[5][j] = w.Linv[5]*t14;
+  }
+  // W = L^-1 Z^T, row 6, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t15 = w.Z_trunk[j][6]*w.active[1];
+    w.W[6][j] = w.Linv[6]*t15;
+  }
+  // W = L^-1 Z^T, row 7, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t16 = w.active[1]*w.Z_trunk[j][7] - w.L[58]*w.W[6][j];
+    w.W[7][j] = w.Linv[7]*t16;
+  }
+  // W = L^-1 Z^T, row 8, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t17 = w.active[1]*w.Z_trunk[j][8] - w.L[59]*w.W[6][j] - w.L[64]*w.W[7][j];
+    w.W[8][j] = w.Linv[8]*t17;
+  }
+  // W = L^-1 Z^T, row 9, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t18 = w.Z_trunk[j][9]*w.active[3];
+    w.W[9][j] = w.Linv[9]*t18;
+  }
+  // W = L^-1 Z^T, row 10, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t19 = w.active[3]*w.Z_trunk[j][10] - w.L[73]*w.W[9][j];
+    w.W[10][j] = w.Linv[10]*t19;
+  }
+  // W = L^-1 Z^T, row 11, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    const Scalar t20 = w.active[3]*w.Z_trunk[j][11] - w.L[74]*w.W[9][j] - w.L[76]*w.W[10][j];
+    w.W[11][j] = w.Linv[11]*t20;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_W_1_to_W_2(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 1
-  {
-    const Scalar t0 = w.Z_trunk[1][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_trunk[1][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_trunk[1][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
-    const Scalar t5 = w.Z_trunk[1][3]*w.active[2];
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_trunk[1][4]*w.active[2] - w.L[34]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_trunk[1][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
-    const Scalar t10 = w.Z_trunk[1][6]*w.active[1];
-    const Scalar t11 = w.Linv[6]*t10;
-    const Scalar t12 = w.Z_trunk[1][7]*w.active[1] - w.L[58]*t11;
-    const Scalar t13 = w.Linv[7]*t12;
-    const Scalar t14 = w.Z_trunk[1][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
-    const Scalar t15 = w.Z_trunk[1][9]*w.active[3];
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_trunk[1][10]*w.active[3] - w.L[73]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_trunk[1][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
-    w.W[0][1] = w.Linv[0]*t0;
-    w.W[1][1] = w.Linv[1]*t2;
-    w.W[2][1] = w.Linv[2]*t4;
-    w.W[3][1] = w.Linv[3]*t5;
-    w.W[4][1] = w.Linv[4]*t7;
-    w.W[5][1] = w.Linv[5]*t9;
-    w.W[6][1] = w.Linv[6]*t10;
-    w.W[7][1] = w.Linv[7]*t12;
-    w.W[8][1] = w.Linv[8]*t14;
-    w.W[9][1] = w.Linv[9]*t15;
-    w.W[10][1] = w.Linv[10]*t17;
-    w.W[11][1] = w.Linv[11]*t19;
+PROXGEN_RT_NOINLINE void pv_delassus_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // W^T W, row 0, columns 0 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
+    w.WtW[0][j] = w.W[0][0]*w.W[0][j] + w.W[1][0]*w.W[1][j] + w.W[2][0]*w.W[2][j] + w.W[3][0]*w.W[3][j] + w.W[4][0]*w.W[4][j] + w.W[5][0]*w.W[5][j] + w.W[6][0]*w.W[6][j] + w.W[7][0]*w.W[7][j] + w.W[8][0]*w.W[8][j] + w.W[9][0]*w.W[9][j] + w.W[10][0]*w.W[10][j] + w.W[11][0]*w.W[11][j];
   }
-  // W = L^-1 Z^T, column 2
-  {
-    const Scalar t20 = w.Z_trunk[2][0]*w.active[0];
-    const Scalar t21 = w.Linv[0]*t20;
-    const Scalar t22 = w.Z_trunk[2][1]*w.active[0] - w.L[1]*t21;
-    const Scalar t23 = w.Linv[1]*t22;
-    const Scalar t24 = w.Z_trunk[2][2]*w.active[0] - w.L[2]*t21 - w.L[13]*t23;
-    const Scalar t25 = w.Z_trunk[2][3]*w.active[2];
-    const Scalar t26 = w.Linv[3]*t25;
-    const Scalar t27 = w.Z_trunk[2][4]*w.active[2] - w.L[34]*t26;
-    const Scalar t28 = w.Linv[4]*t27;
-    const Scalar t29 = w.Z_trunk[2][5]*w.active[2] - w.L[35]*t26 - w.L[43]*t28;
-    const Scalar t30 = w.Z_trunk[2][6]*w.active[1];
-    const Scalar t31 = w.Linv[6]*t30;
-    const Scalar t32 = w.Z_trunk[2][7]*w.active[1] - w.L[58]*t31;
-    const Scalar t33 = w.Linv[7]*t32;
-    const Scalar t34 = w.Z_trunk[2][8]*w.active[1] - w.L[59]*t31 - w.L[64]*t33;
-    const Scalar t35 = w.Z_trunk[2][9]*w.active[3];
-    const Scalar t36 = w.Linv[9]*t35;
-    const Scalar t37 = w.Z_trunk[2][10]*w.active[3] - w.L[73]*t36;
-    const Scalar t38 = w.Linv[10]*t37;
-    const Scalar t39 = w.Z_trunk[2][11]*w.active[3] - w.L[74]*t36 - w.L[76]*t38;
-    w.W[0][2] = w.Linv[0]*t20;
-    w.W[1][2] = w.Linv[1]*t22;
-    w.W[2][2] = w.Linv[2]*t24;
-    w.W[3][2] = w.Linv[3]*t25;
-    w.W[4][2] = w.Linv[4]*t27;
-    w.W[5][2] = w.Linv[5]*t29;
-    w.W[6][2] = w.Linv[6]*t30;
-    w.W[7][2] = w.Linv[7]*t32;
-    w.W[8][2] = w.Linv[8]*t34;
-    w.W[9][2] = w.Linv[9]*t35;
-    w.W[10][2] = w.Linv[10]*t37;
-    w.W[11][2] = w.Linv[11]*t39;
+  // W^T W, row 1, columns 1 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 5; ++j) {
+    w.WtW[1][1 + j] = w.W[0][1]*w.W[0][1 + j] + w.W[1][1]*w.W[1][1 + j] + w.W[2][1]*w.W[2][1 + j] + w.W[3][1]*w.W[3][1 + j] + w.W[4][1]*w.W[4][1 + j] + w.W[5][1]*w.W[5][1 + j] + w.W[6][1]*w.W[6][1 + j] + w.W[7][1]*w.W[7][1 + j] + w.W[8][1]*w.W[8][1 + j] + w.W[9][1]*w.W[9][1 + j] + w.W[10][1]*w.W[10][1 + j] + w.W[11][1]*w.W[11][1 + j];
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_3_to_W_4(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 3
-  {
-    const Scalar t0 = w.Z_trunk[3][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_trunk[3][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_trunk[3][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
-    const Scalar t5 = w.Z_trunk[3][3]*w.active[2];
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_trunk[3][4]*w.active[2] - w.L[34]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_trunk[3][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
-    const Scalar t10 = w.Z_trunk[3][6]*w.active[1];
-    const Scalar t11 = w.Linv[6]*t10;
-    const Scalar t12 = w.Z_trunk[3][7]*w.active[1] - w.L[58]*t11;
-    const Scalar t13 = w.Linv[7]*t12;
-    const Scalar t14 = w.Z_trunk[3][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
-    const Scalar t15 = w.Z_trunk[3][9]*w.active[3];
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_trunk[3][10]*w.active[3] - w.L[73]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_trunk[3][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
-    w.W[0][3] = w.Linv[0]*t0;
-    w.W[1][3] = w.Linv[1]*t2;
-    w.W[2][3] = w.Linv[2]*t4;
-    w.W[3][3] = w.Linv[3]*t5;
-    w.W[4][3] = w.Linv[4]*t7;
-    w.W[5][3] = w.Linv[5]*t9;
-    w.W[6][3] = w.Linv[6]*t10;
-    w.W[7][3] = w.Linv[7]*t12;
-    w.W[8][3] = w.Linv[8]*t14;
-    w.W[9][3] = w.Linv[9]*t15;
-    w.W[10][3] = w.Linv[10]*t17;
-    w.W[11][3] = w.Linv[11]*t19;
+  // W^T W, row 2, columns 2 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 4; ++j) {
+    w.WtW[2][2 + j] = w.W[0][2]*w.W[0][2 + j] + w.W[1][2]*w.W[1][2 + j] + w.W[2][2]*w.W[2][2 + j] + w.W[3][2]*w.W[3][2 + j] + w.W[4][2]*w.W[4][2 + j] + w.W[5][2]*w.W[5][2 + j] + w.W[6][2]*w.W[6][2 + j] + w.W[7][2]*w.W[7][2 + j] + w.W[8][2]*w.W[8][2 + j] + w.W[9][2]*w.W[9][2 + j] + w.W[10][2]*w.W[10][2 + j] + w.W[11][2]*w.W[11][2 + j];
   }
-  // W = L^-1 Z^T, column 4
-  {
-    const Scalar t20 = w.Z_trunk[4][0]*w.active[0];
-    const Scalar t21 = w.Linv[0]*t20;
-    const Scalar t22 = w.Z_trunk[4][1]*w.active[0] - w.L[1]*t21;
-    const Scalar t23 = w.Linv[1]*t22;
-    const Scalar t24 = w.Z_trunk[4][2]*w.active[0] - w.L[2]*t21 - w.L[13]*t23;
-    const Scalar t25 = w.Z_trunk[4][3]*w.active[2];
-    const Scalar t26 = w.Linv[3]*t25;
-    const Scalar t27 = w.Z_trunk[4][4]*w.active[2] - w.L[34]*t26;
-    const Scalar t28 = w.Linv[4]*t27;
-    const Scalar t29 = w.Z_trunk[4][5]*w.active[2] - w.L[35]*t26 - w.L[43]*t28;
-    const Scalar t30 = w.Z_trunk[4][6]*w.active[1];
-    const Scalar t31 = w.Linv[6]*t30;
-    const Scalar t32 = w.Z_trunk[4][7]*w.active[1] - w.L[58]*t31;
-    const Scalar t33 = w.Linv[7]*t32;
-    const Scalar t34 = w.Z_trunk[4][8]*w.active[1] - w.L[59]*t31 - w.L[64]*t33;
-    const Scalar t35 = w.Z_trunk[4][9]*w.active[3];
-    const Scalar t36 = w.Linv[9]*t35;
-    const Scalar t37 = w.Z_trunk[4][10]*w.active[3] - w.L[73]*t36;
-    const Scalar t38 = w.Linv[10]*t37;
-    const Scalar t39 = w.Z_trunk[4][11]*w.active[3] - w.L[74]*t36 - w.L[76]*t38;
-    w.W[0][4] = w.Linv[0]*t20;
-    w.W[1][4] = w.Linv[1]*t22;
-    w.W[2][4] = w.Linv[2]*t24;
-    w.W[3][4] = w.Linv[3]*t25;
-    w.W[4][4] = w.Linv[4]*t27;
-    w.W[5][4] = w.Linv[5]*t29;
-    w.W[6][4] = w.Linv[6]*t30;
-    w.W[7][4] = w.Linv[7]*t32;
-    w.W[8][4] = w.Linv[8]*t34;
-    w.W[9][4] = w.Linv[9]*t35;
-    w.W[10][4] = w.Linv[10]*t37;
-    w.W[11][4] = w.Linv[11]*t39;
+  // W^T W, row 3, columns 3 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
+    w.WtW[3][3 + j] = w.W[0][3]*w.W[0][3 + j] + w.W[1][3]*w.W[1][3 + j] + w.W[2][3]*w.W[2][3 + j] + w.W[3][3]*w.W[3][3 + j] + w.W[4][3]*w.W[4][3 + j] + w.W[5][3]*w.W[5][3 + j] + w.W[6][3]*w.W[6][3 + j] + w.W[7][3]*w.W[7][3 + j] + w.W[8][3]*w.W[8][3 + j] + w.W[9][3]*w.W[9][3 + j] + w.W[10][3]*w.W[10][3 + j] + w.W[11][3]*w.W[11][3 + j];
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_delassus_W_5_to_LS(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // W = L^-1 Z^T, column 5
-  {
-    const Scalar t0 = w.Z_trunk[5][0]*w.active[0];
-    const Scalar t1 = w.Linv[0]*t0;
-    const Scalar t2 = w.Z_trunk[5][1]*w.active[0] - w.L[1]*t1;
-    const Scalar t3 = w.Linv[1]*t2;
-    const Scalar t4 = w.Z_trunk[5][2]*w.active[0] - w.L[2]*t1 - w.L[13]*t3;
-    const Scalar t5 = w.Z_trunk[5][3]*w.active[2];
-    const Scalar t6 = w.Linv[3]*t5;
-    const Scalar t7 = w.Z_trunk[5][4]*w.active[2] - w.L[34]*t6;
-    const Scalar t8 = w.Linv[4]*t7;
-    const Scalar t9 = w.Z_trunk[5][5]*w.active[2] - w.L[35]*t6 - w.L[43]*t8;
-    const Scalar t10 = w.Z_trunk[5][6]*w.active[1];
-    const Scalar t11 = w.Linv[6]*t10;
-    const Scalar t12 = w.Z_trunk[5][7]*w.active[1] - w.L[58]*t11;
-    const Scalar t13 = w.Linv[7]*t12;
-    const Scalar t14 = w.Z_trunk[5][8]*w.active[1] - w.L[59]*t11 - w.L[64]*t13;
-    const Scalar t15 = w.Z_trunk[5][9]*w.active[3];
-    const Scalar t16 = w.Linv[9]*t15;
-    const Scalar t17 = w.Z_trunk[5][10]*w.active[3] - w.L[73]*t16;
-    const Scalar t18 = w.Linv[10]*t17;
-    const Scalar t19 = w.Z_trunk[5][11]*w.active[3] - w.L[74]*t16 - w.L[76]*t18;
-    w.W[0][5] = w.Linv[0]*t0;
-    w.W[1][5] = w.Linv[1]*t2;
-    w.W[2][5] = w.Linv[2]*t4;
-    w.W[3][5] = w.Linv[3]*t5;
-    w.W[4][5] = w.Linv[4]*t7;
-    w.W[5][5] = w.Linv[5]*t9;
-    w.W[6][5] = w.Linv[6]*t10;
-    w.W[7][5] = w.Linv[7]*t12;
-    w.W[8][5] = w.Linv[8]*t14;
-    w.W[9][5] = w.Linv[9]*t15;
-    w.W[10][5] = w.Linv[10]*t17;
-    w.W[11][5] = w.Linv[11]*t19;
+  // W^T W, row 4, columns 4 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
+    w.WtW[4][4 + j] = w.W[0][4]*w.W[0][4 + j] + w.W[1][4]*w.W[1][4 + j] + w.W[2][4]*w.W[2][4 + j] + w.W[3][4]*w.W[3][4 + j] + w.W[4][4]*w.W[4][4 + j] + w.W[5][4]*w.W[5][4 + j] + w.W[6][4]*w.W[6][4 + j] + w.W[7][4]*w.W[7][4 + j] + w.W[8][4]*w.W[8][4 + j] + w.W[9][4]*w.W[9][4 + j] + w.W[10][4]*w.W[10][4 + j] + w.W[11][4]*w.W[11][4 + j];
+  }
+  // W^T W, row 5, columns 5 to 5
+  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 1; ++j) {
+    w.WtW[5][5 + j] = w.W[0][5]*w.W[0][5 + j] + w.W[1][5]*w.W[1][5 + j] + w.W[2][5]*w.W[2][5 + j] + w.W[3][5]*w.W[3][5 + j] + w.W[4][5]*w.W[4][5 + j] + w.W[5][5]*w.W[5][5 + j] + w.W[6][5]*w.W[6][5 + j] + w.W[7][5]*w.W[7][5 + j] + w.W[8][5]*w.W[8][5 + j] + w.W[9][5]*w.W[9][5 + j] + w.W[10][5]*w.W[10][5 + j] + w.W[11][5]*w.W[11][5 + j];
   }
   // S = I + W^T W = LS LS^T
   {
-    const Scalar t20 = 1.0 + w.W[0][0]*w.W[0][0] + w.W[1][0]*w.W[1][0] + w.W[2][0]*w.W[2][0] + w.W[3][0]*w.W[3][0] + w.W[4][0]*w.W[4][0] + w.W[5][0]*w.W[5][0] + w.W[6][0]*w.W[6][0] + w.W[7][0]*w.W[7][0] + w.W[8][0]*w.W[8][0] + w.W[9][0]*w.W[9][0] + w.W[10][0]*w.W[10][0] + w.W[11][0]*w.W[11][0];
-    const Scalar r0 = std::sqrt(t20);
+    const Scalar t0 = 1.0 + w.WtW[0][0];
+    const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
     w.LSinv[0] = inv0;
-    const Scalar t21 = w.W[0][0]*w.W[0][1] + w.W[1][0]*w.W[1][1] + w.W[2][0]*w.W[2][1] + w.W[3][0]*w.W[3][1] + w.W[4][0]*w.W[4][1] + w.W[5][0]*w.W[5][1] + w.W[6][0]*w.W[6][1] + w.W[7][0]*w.W[7][1] + w.W[8][0]*w.W[8][1] + w.W[9][0]*w.W[9][1] + w.W[10][0]*w.W[10][1] + w.W[11][0]*w.W[11][1];
-    w.LS[1] = w.LSinv[0]*t21;
-    const Scalar t22 = w.W[0][0]*w.W[0][2] + w.W[1][0]*w.W[1][2] + w.W[2][0]*w.W[2][2] + w.W[3][0]*w.W[3][2] + w.W[4][0]*w.W[4][2] + w.W[5][0]*w.W[5][2] + w.W[6][0]*w.W[6][2] + w.W[7][0]*w.W[7][2] + w.W[8][0]*w.W[8][2] + w.W[9][0]*w.W[9][2] + w.W[10][0]*w.W[10][2] + w.W[11][0]*w.W[11][2];
-    w.LS[2] = w.LSinv[0]*t22;
-    const Scalar t23 = w.W[0][0]*w.W[0][3] + w.W[1][0]*w.W[1][3] + w.W[2][0]*w.W[2][3] + w.W[3][0]*w.W[3][3] + w.W[4][0]*w.W[4][3] + w.W[5][0]*w.W[5][3] + w.W[6][0]*w.W[6][3] + w.W[7][0]*w.W[7][3] + w.W[8][0]*w.W[8][3] + w.W[9][0]*w.W[9][3] + w.W[10][0]*w.W[10][3] + w.W[11][0]*w.W[11][3];
-    w.LS[3] = w.LSinv[0]*t23;
-    const Scalar t24 = w.W[0][0]*w.W[0][4] + w.W[1][0]*w.W[1][4] + w.W[2][0]*w.W[2][4] + w.W[3][0]*w.W[3][4] + w.W[4][0]*w.W[4][4] + w.W[5][0]*w.W[5][4] + w.W[6][0]*w.W[6][4] + w.W[7][0]*w.W[7][4] + w.W[8][0]*w.W[8][4] + w.W[9][0]*w.W[9][4] + w.W[10][0]*w.W[10][4] + w.W[11][0]*w.W[11][4];
-    w.LS[4] = w.LSinv[0]*t24;
-    const Scalar t25 = w.W[0][0]*w.W[0][5] + w.W[1][0]*w.W[1][5] + w.W[2][0]*w.W[2][5] + w.W[3][0]*w.W[3][5] + w.W[4][0]*w.W[4][5] + w.W[5][0]*w.W[5][5] + w.W[6][0]*w.W[6][5] + w.W[7][0]*w.W[7][5] + w.W[8][0]*w.W[8][5] + w.W[9][0]*w.W[9][5] + w.W[10][0]*w.W[10][5] + w.W[11][0]*w.W[11][5];
-    w.LS[5] = w.LSinv[0]*t25;
-    const Scalar t26 = 1.0 + w.W[0][1]*w.W[0][1] + w.W[1][1]*w.W[1][1] + w.W[2][1]*w.W[2][1] + w.W[3][1]*w.W[3][1] + w.W[4][1]*w.W[4][1] + w.W[5][1]*w.W[5][1] + w.W[6][1]*w.W[6][1] + w.W[7][1]*w.W[7][1] + w.W[8][1]*w.W[8][1] + w.W[9][1]*w.W[9][1] + w.W[10][1]*w.W[10][1] + w.W[11][1]*w.W[11][1] - w.LS[1]*w.LS[1];
-    const Scalar r1 = std::sqrt(t26);
+    w.LS[1] = w.WtW[0][1]*w.LSinv[0];
+    w.LS[2] = w.WtW[0][2]*w.LSinv[0];
+    w.LS[3] = w.WtW[0][3]*w.LSinv[0];
+    w.LS[4] = w.WtW[0][4]*w.LSinv[0];
+    w.LS[5] = w.WtW[0][5]*w.LSinv[0];
+    const Scalar t1 = 1.0 + w.WtW[1][1] - w.LS[1]*w.LS[1];
+    const Scalar r1 = std::sqrt(t1);
     const Scalar inv1 = 1.0 / r1;
     w.LSinv[1] = inv1;
-    const Scalar t27 = w.W[0][1]*w.W[0][2] + w.W[1][1]*w.W[1][2] + w.W[2][1]*w.W[2][2] + w.W[3][1]*w.W[3][2] + w.W[4][1]*w.W[4][2] + w.W[5][1]*w.W[5][2] + w.W[6][1]*w.W[6][2] + w.W[7][1]*w.W[7][2] + w.W[8][1]*w.W[8][2] + w.W[9][1]*w.W[9][2] + w.W[10][1]*w.W[10][2] + w.W[11][1]*w.W[11][2] - w.LS[1]*w.LS[2];
-    w.LS[7] = w.LSinv[1]*t27;
-    const Scalar t28 = w.W[0][1]*w.W[0][3] + w.W[1][1]*w.W[1][3] + w.W[2][1]*w.W[2][3] + w.W[3][1]*w.W[3][3] + w.W[4][1]*w.W[4][3] + w.W[5][1]*w.W[5][3] + w.W[6][1]*w.W[6][3] + w.W[7][1]*w.W[7][3] + w.W[8][1]*w.W[8][3] + w.W[9][1]*w.W[9][3] + w.W[10][1]*w.W[10][3] + w.W[11][1]*w.W[11][3] - w.LS[1]*w.LS[3];
-    w.LS[8] = w.LSinv[1]*t28;
-    const Scalar t29 = w.W[0][1]*w.W[0][4] + w.W[1][1]*w.W[1][4] + w.W[2][1]*w.W[2][4] + w.W[3][1]*w.W[3][4] + w.W[4][1]*w.W[4][4] + w.W[5][1]*w.W[5][4] + w.W[6][1]*w.W[6][4] + w.W[7][1]*w.W[7][4] + w.W[8][1]*w.W[8][4] + w.W[9][1]*w.W[9][4] + w.W[10][1]*w.W[10][4] + w.W[11][1]*w.W[11][4] - w.LS[1]*w.LS[4];
-    w.LS[9] = w.LSinv[1]*t29;
-    const Scalar t30 = w.W[0][1]*w.W[0][5] + w.W[1][1]*w.W[1][5] + w.W[2][1]*w.W[2][5] + w.W[3][1]*w.W[3][5] + w.W[4][1]*w.W[4][5] + w.W[5][1]*w.W[5][5] + w.W[6][1]*w.W[6][5] + w.W[7][1]*w.W[7][5] + w.W[8][1]*w.W[8][5] + w.W[9][1]*w.W[9][5] + w.W[10][1]*w.W[10][5] + w.W[11][1]*w.W[11][5] - w.LS[1]*w.LS[5];
-    w.LS[10] = w.LSinv[1]*t30;
-    const Scalar t31 = 1.0 + w.W[0][2]*w.W[0][2] + w.W[1][2]*w.W[1][2] + w.W[2][2]*w.W[2][2] + w.W[3][2]*w.W[3][2] + w.W[4][2]*w.W[4][2] + w.W[5][2]*w.W[5][2] + w.W[6][2]*w.W[6][2] + w.W[7][2]*w.W[7][2] + w.W[8][2]*w.W[8][2] + w.W[9][2]*w.W[9][2] + w.W[10][2]*w.W[10][2] + w.W[11][2]*w.W[11][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
-    const Scalar r2 = std::sqrt(t31);
+    const Scalar t2 = w.WtW[1][2] - w.LS[1]*w.LS[2];
+    w.LS[7] = w.LSinv[1]*t2;
+    const Scalar t3 = w.WtW[1][3] - w.LS[1]*w.LS[3];
+    w.LS[8] = w.LSinv[1]*t3;
+    const Scalar t4 = w.WtW[1][4] - w.LS[1]*w.LS[4];
+    w.LS[9] = w.LSinv[1]*t4;
+    const Scalar t5 = w.WtW[1][5] - w.LS[1]*w.LS[5];
+    w.LS[10] = w.LSinv[1]*t5;
+    const Scalar t6 = 1.0 + w.WtW[2][2] - w.LS[2]*w.LS[2] - w.LS[7]*w.LS[7];
+    const Scalar r2 = std::sqrt(t6);
     const Scalar inv2 = 1.0 / r2;
     w.LSinv[2] = inv2;
-    const Scalar t32 = w.W[0][2]*w.W[0][3] + w.W[1][2]*w.W[1][3] + w.W[2][2]*w.W[2][3] + w.W[3][2]*w.W[3][3] + w.W[4][2]*w.W[4][3] + w.W[5][2]*w.W[5][3] + w.W[6][2]*w.W[6][3] + w.W[7][2]*w.W[7][3] + w.W[8][2]*w.W[8][3] + w.W[9][2]*w.W[9][3] + w.W[10][2]*w.W[10][3] + w.W[11][2]*w.W[11][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
-    w.LS[12] = w.LSinv[2]*t32;
-    const Scalar t33 = w.W[0][2]*w.W[0][4] + w.W[1][2]*w.W[1][4] + w.W[2][2]*w.W[2][4] + w.W[3][2]*w.W[3][4] + w.W[4][2]*w.W[4][4] + w.W[5][2]*w.W[5][4] + w.W[6][2]*w.W[6][4] + w.W[7][2]*w.W[7][4] + w.W[8][2]*w.W[8][4] + w.W[9][2]*w.W[9][4] + w.W[10][2]*w.W[10][4] + w.W[11][2]*w.W[11][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
-    w.LS[13] = w.LSinv[2]*t33;
-    const Scalar t34 = w.W[0][2]*w.W[0][5] + w.W[1][2]*w.W[1][5] + w.W[2][2]*w.W[2][5] + w.W[3][2]*w.W[3][5] + w.W[4][2]*w.W[4][5] + w.W[5][2]*w.W[5][5] + w.W[6][2]*w.W[6][5] + w.W[7][2]*w.W[7][5] + w.W[8][2]*w.W[8][5] + w.W[9][2]*w.W[9][5] + w.W[10][2]*w.W[10][5] + w.W[11][2]*w.W[11][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
-    w.LS[14] = w.LSinv[2]*t34;
-    const Scalar t35 = 1.0 + w.W[0][3]*w.W[0][3] + w.W[1][3]*w.W[1][3] + w.W[2][3]*w.W[2][3] + w.W[3][3]*w.W[3][3] + w.W[4][3]*w.W[4][3] + w.W[5][3]*w.W[5][3] + w.W[6][3]*w.W[6][3] + w.W[7][3]*w.W[7][3] + w.W[8][3]*w.W[8][3] + w.W[9][3]*w.W[9][3] + w.W[10][3]*w.W[10][3] + w.W[11][3]*w.W[11][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
-    const Scalar r3 = std::sqrt(t35);
+    const Scalar t7 = w.WtW[2][3] - w.LS[2]*w.LS[3] - w.LS[7]*w.LS[8];
+    w.LS[12] = w.LSinv[2]*t7;
+    const Scalar t8 = w.WtW[2][4] - w.LS[2]*w.LS[4] - w.LS[7]*w.LS[9];
+    w.LS[13] = w.LSinv[2]*t8;
+    const Scalar t9 = w.WtW[2][5] - w.LS[2]*w.LS[5] - w.LS[7]*w.LS[10];
+    w.LS[14] = w.LSinv[2]*t9;
+    const Scalar t10 = 1.0 + w.WtW[3][3] - w.LS[3]*w.LS[3] - w.LS[8]*w.LS[8] - w.LS[12]*w.LS[12];
+    const Scalar r3 = std::sqrt(t10);
     const Scalar inv3 = 1.0 / r3;
     w.LSinv[3] = inv3;
-    const Scalar t36 = w.W[0][3]*w.W[0][4] + w.W[1][3]*w.W[1][4] + w.W[2][3]*w.W[2][4] + w.W[3][3]*w.W[3][4] + w.W[4][3]*w.W[4][4] + w.W[5][3]*w.W[5][4] + w.W[6][3]*w.W[6][4] + w.W[7][3]*w.W[7][4] + w.W[8][3]*w.W[8][4] + w.W[9][3]*w.W[9][4] + w.W[10][3]*w.W[10][4] + w.W[11][3]*w.W[11][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
-    w.LS[16] = w.LSinv[3]*t36;
-    const Scalar t37 = w.W[0][3]*w.W[0][5] + w.W[1][3]*w.W[1][5] + w.W[2][3]*w.W[2][5] + w.W[3][3]*w.W[3][5] + w.W[4][3]*w.W[4][5] + w.W[5][3]*w.W[5][5] + w.W[6][3]*w.W[6][5] + w.W[7][3]*w.W[7][5] + w.W[8][3]*w.W[8][5] + w.W[9][3]*w.W[9][5] + w.W[10][3]*w.W[10][5] + w.W[11][3]*w.W[11][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
-    w.LS[17] = w.LSinv[3]*t37;
-    const Scalar t38 = 1.0 + w.W[0][4]*w.W[0][4] + w.W[1][4]*w.W[1][4] + w.W[2][4]*w.W[2][4] + w.W[3][4]*w.W[3][4] + w.W[4][4]*w.W[4][4] + w.W[5][4]*w.W[5][4] + w.W[6][4]*w.W[6][4] + w.W[7][4]*w.W[7][4] + w.W[8][4]*w.W[8][4] + w.W[9][4]*w.W[9][4] + w.W[10][4]*w.W[10][4] + w.W[11][4]*w.W[11][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
-    const Scalar r4 = std::sqrt(t38);
+    const Scalar t11 = w.WtW[3][4] - w.LS[3]*w.LS[4] - w.LS[8]*w.LS[9] - w.LS[12]*w.LS[13];
+    w.LS[16] = w.LSinv[3]*t11;
+    const Scalar t12 = w.WtW[3][5] - w.LS[3]*w.LS[5] - w.LS[8]*w.LS[10] - w.LS[12]*w.LS[14];
+    w.LS[17] = w.LSinv[3]*t12;
+    const Scalar t13 = 1.0 + w.WtW[4][4] - w.LS[4]*w.LS[4] - w.LS[9]*w.LS[9] - w.LS[13]*w.LS[13] - w.LS[16]*w.LS[16];
+    const Scalar r4 = std::sqrt(t13);
     const Scalar inv4 = 1.0 / r4;
     w.LSinv[4] = inv4;
-    const Scalar t39 = w.W[0][4]*w.W[0][5] + w.W[1][4]*w.W[1][5] + w.W[2][4]*w.W[2][5] + w.W[3][4]*w.W[3][5] + w.W[4][4]*w.W[4][5] + w.W[5][4]*w.W[5][5] + w.W[6][4]*w.W[6][5] + w.W[7][4]*w.W[7][5] + w.W[8][4]*w.W[8][5] + w.W[9][4]*w.W[9][5] + w.W[10][4]*w.W[10][5] + w.W[11][4]*w.W[11][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
-    w.LS[19] = w.LSinv[4]*t39;
-    const Scalar t40 = 1.0 + w.W[0][5]*w.W[0][5] + w.W[1][5]*w.W[1][5] + w.W[2][5]*w.W[2][5] + w.W[3][5]*w.W[3][5] + w.W[4][5]*w.W[4][5] + w.W[5][5]*w.W[5][5] + w.W[6][5]*w.W[6][5] + w.W[7][5]*w.W[7][5] + w.W[8][5]*w.W[8][5] + w.W[9][5]*w.W[9][5] + w.W[10][5]*w.W[10][5] + w.W[11][5]*w.W[11][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
-    const Scalar r5 = std::sqrt(t40);
+    const Scalar t14 = w.WtW[4][5] - w.LS[4]*w.LS[5] - w.LS[9]*w.LS[10] - w.LS[13]*w.LS[14] - w.LS[16]*w.LS[17];
+    w.LS[19] = w.LSinv[4]*t14;
+    const Scalar t15 = 1.0 + w.WtW[5][5] - w.LS[5]*w.LS[5] - w.LS[10]*w.LS[10] - w.LS[14]*w.LS[14] - w.LS[17]*w.LS[17] - w.LS[19]*w.LS[19];
+    const Scalar r5 = std::sqrt(t15);
     const Scalar inv5 = 1.0 / r5;
     w.LSinv[5] = inv5;
   }
@@ -3136,10 +2999,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
   pv_delassus_column_0_to_column_6(inv_mu, w);
-  pv_delassus_column_7_to_W_0(inv_mu, w);
-  pv_delassus_W_1_to_W_2(w);
-  pv_delassus_W_3_to_W_4(w);
-  pv_delassus_W_5_to_LS(w);
+  pv_delassus_column_7_to_W(inv_mu, w);
+  pv_delassus_LS(w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
   const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};

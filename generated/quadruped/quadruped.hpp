@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
 //     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8537 + 475 K (= 9962 at K = 3)
-//     add/sub 3510 + 204 K, mul 4850 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
@@ -132,7 +132,7 @@ struct Settings {
   const Scalar* lambda0 = nullptr;
 };
 
-// Everything one solve writes (11288 bytes): per-body quantities named
+// Everything one solve writes (11576 bytes): per-body quantities named
 // <quantity>_<link>. Caller-owned, so the solvers are re-entrant and allocate nothing.
 struct Workspace {
   Scalar sq[12];               // sin q of the revolute joints (q order)
@@ -293,6 +293,7 @@ struct Workspace {
   Scalar Linv[12];             // 1 / diag(L)
   Scalar L[78];                // Cholesky factor of G + I/mu (lower, packed)
   Scalar W[12][6];             // L^-1 Z^T
+  Scalar WtW[6][6];            // W^T W (row a, column j)
   Scalar LSinv[6];             // 1 / diag(LS)
   Scalar LS[21];               // factor of I + W^T W (lower, packed)
 };

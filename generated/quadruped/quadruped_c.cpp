@@ -7,8 +7,8 @@
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
 //   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
 //     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8537 + 475 K (= 9962 at K = 3)
-//     add/sub 3510 + 204 K, mul 4850 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
 //   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip

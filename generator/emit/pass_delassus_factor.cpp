@@ -8,6 +8,8 @@
 // algorithms/prox_pv.cpp (Eigen's LLT of the assembled G).
 #include <fmt/format.h>
 
+#include <regex>
+
 #include "emit/passes.hpp"
 
 namespace proxgen::emit {
@@ -441,40 +443,127 @@ std::vector<Expr> lowRankBackward(CodeBuilder& cb, const DelassusFactor& f, cons
   return x;
 }
 
+// Z's entry (row j, column d) as a loop over d reads it, "w.Z_<body>[j][<col>]";
+// empty unless all six of the row are the members w.Z_<body>[d][<col>] (none folded).
+std::string zLoopRead(const CodeBuilder& cb, const ProxRows::Body& r, int j) {
+  static const std::regex slot(R"(^(w\.\w+)\[(\d+)\]\[(\d+)\]$)");
+  std::string prefix, col;
+  for (int d = 0; d < 6; ++d) {
+    const Expr& x = r.Z[std::size_t(j)][std::size_t(d)];
+    std::smatch m;
+    const std::string text = cb.describe(x);
+    if (x.isConstant() || !std::regex_match(text, m, slot) || std::stoi(m[2].str()) != d) return {};
+    if (d == 0) prefix = m[1].str(), col = m[3].str();
+    if (m[1].str() != prefix || m[3].str() != col) return {};
+  }
+  return fmt::format("{}[j][{}]", prefix, col);
+}
+
 // (A + Z^T Z)^-1 = L^-T (I - W S^-1 W^T) L^-1 with W = L^-1 Z^T, S = I + W^T W
 // (Woodbury): six forward solves and a 6 x 6 factor instead of a dense one.
-void woodbury(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
+// The six columns go through the same arithmetic on the same factor, so each
+// row of W and each row of S is one loop over the columns (woodburyRows): a
+// loop of a few iterations over contiguous W[t][0..5] that the compiler's loop
+// vectoriser takes two, four or eight at a time, where the columns unrolled
+// one after the other were scalar code (the Atlas t3x10: 45 KB for W and 25 KB
+// for S; docs/emitter.md, "Woodbury's rows as loops").
+//
+// So: W = L^-1 Z^T row by row, each row one loop over the six columns j (the
+// same statements as lowRankForward's, on W[k][j] in place of y[k]), then S =
+// I + W^T W a row per loop, and its factor.
+void woodburyRows(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
   const int nc = e.plan.nc;
   const BodyPlan& b = e.bp(ff);
+  const ProxRows::Body& r = rows.b[std::size_t(ff)];
   f.W.assign(std::size_t(nc), zero6());
-  for (int d = 0; d < 6; ++d) {
-    e.fn.boundary(fmt::format("W_{}", d));
-    e.cb().open("{", {fmt::format("W = L^-1 Z^T, column {}", d)});
-    std::vector<Expr> z(static_cast<std::size_t>(nc));
-    for (int j = 0; j < b.m(); ++j)  // Z F: an inactive row's column of Z is 0, so is its row of W
-      z[std::size_t(b.rowStart + j)] = e.cb().mul(activeRowFactor(e, e.plan.rootRows[std::size_t(b.rowStart + j)]),
-                                                  rows.b[std::size_t(ff)].Z[std::size_t(j)][std::size_t(d)]);
-    const std::vector<Expr> w = lowRankForward(e.cb(), f, z);
-    for (int t = 0; t < nc; ++t)
-      f.W[std::size_t(t)][std::size_t(d)] = e.put(e.ws.member("W", nc, 6, t, d, "L^-1 Z^T"), w[std::size_t(t)]);
+  e.fn.boundary("W");
+  // Row t of Z as the loops read it: its members, or (an entry folded: a zero
+  // of KA at the top of L^-1 KA) its six values copied to Wz[t] first.
+  std::vector<std::string> reads(static_cast<std::size_t>(nc));
+  for (int j = 0; j < b.m(); ++j) {
+    const int t = b.rowStart + j;
+    reads[std::size_t(t)] = zLoopRead(e.cb(), r, j);
+    if (!reads[std::size_t(t)].empty()) continue;
+    e.cb().open("{", {fmt::format("row {} of Z, some entries folded: staged for the loops", t)});
+    for (int d = 0; d < 6; ++d)
+      e.cb().store(e.ws.member("Wz", nc, 6, t, d, "Z^T rows with folded entries"), r.Z[std::size_t(j)][std::size_t(d)]);
     e.cb().close();
+    reads[std::size_t(t)] = e.ws.loopSlot("Wz", nc, 6, t, 0, "Z^T rows with folded entries");
   }
-  e.fn.boundary("LS");
-  CodeBuilder& cb = e.cb();
-  cb.open("{", {"S = I + W^T W = LS LS^T"});
-  Sym S(6);
-  for (int a = 0; a < 6; ++a)
-    for (int c = a; c < 6; ++c) {
-      Expr x = a == c ? Expr(1.0) : Expr();
-      for (int t = 0; t < nc; ++t) x += cb.mul(f.W[std::size_t(t)][std::size_t(a)], f.W[std::size_t(t)][std::size_t(c)]);
-      S(a, c) = x;
+  const std::string what = "L^-1 Z^T";
+  // Row t of W as a loop reads it: its constant (the same in every column) or w.W[t][j].
+  std::vector<Expr> fixed(static_cast<std::size_t>(nc));
+  std::vector<char> stored(static_cast<std::size_t>(nc), 0);
+  const auto rowAt = [&](CodeBuilder& cb, int t, int c0 = 0) {  // column c0 + j
+    return stored[std::size_t(t)] ? cb.member(e.ws.loopSlot("W", nc, 6, t, c0, what)) : fixed[std::size_t(t)];
+  };
+  // Per branch, w_l[p] = Y_l^T y_l of its solved blocks (member Wlr<b>[l * rank + p][j]).
+  const auto wlrSlot = [&](std::size_t bi, int lp) {
+    const DelassusFactor::Branch& br = f.branches[bi];
+    const int n = (int(br.blocks.size()) - 2) * br.rank;
+    return e.ws.loopSlot(fmt::format("Wlr{}", bi), n, 6, lp, 0, "Y_l^T (L^-1 Z^T)_l, the rows of block l");
+  };
+  for (int i = 0; i < nc; ++i) {
+    CodeBuilder& cb = e.cb();
+    cb.open(columnLoopHead(6), {fmt::format("W = L^-1 Z^T, row {}, columns 0 to 5", i)});
+    Expr x;
+    if (!reads[std::size_t(i)].empty())  // Z F: an inactive row's column of Z is 0, so is its row of W
+      x = cb.mul(activeRowFactor(e, e.plan.rootRows[std::size_t(i)]), cb.member(reads[std::size_t(i)]));
+    for (int k = 0; k < i; ++k)
+      if (inL(f, i, k) && !f.L(i, k).isZero()) x -= cb.mul(f.L(i, k), rowAt(cb, k));
+    const auto [bi, l] = branchBlock(f, i);
+    if (bi >= 0) {
+      const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+      const int rk = br.rank, s0 = br.blocks.front(), m = br.blocks.back() - s0;
+      for (int k = 0; k < l; ++k)
+        for (int p = 0; p < rk; ++p)
+          x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s0) * rk + p))],
+                      cb.member(wlrSlot(std::size_t(bi), k * rk + p)));
     }
+    const Expr y = e.put(e.ws.loopSlot("W", nc, 6, i, 0, what), cb.mul(cb.flat(x), f.Linv[std::size_t(i)]));
+    stored[std::size_t(i)] = !y.isConstant();
+    if (!stored[std::size_t(i)]) fixed[std::size_t(i)] = y;
+    cb.close();
+    if (bi < 0) continue;
+    const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+    if (i + 1 != br.blocks[std::size_t(l + 1)] || l + 2 >= int(br.blocks.size())) continue;
+    const int rk = br.rank, s0 = br.blocks.front();
+    for (int p = 0; p < rk; ++p) {  // block l solved, not the last: its w_l
+      CodeBuilder& lb = e.cb();
+      lb.open(columnLoopHead(6), {fmt::format("W's low-rank terms, branch {}, block {}, column {} of Y", bi, l, p)});
+      Expr z;
+      for (int t = br.blocks[std::size_t(l)]; t <= i; ++t)
+        z += lb.mul(f.lowRank[std::size_t(br.y + (t - s0) * rk + p)], rowAt(lb, t));
+      e.put(wlrSlot(std::size_t(bi), l * rk + p), z);
+      lb.close();
+    }
+  }
+  // After the loops each column's entries are in W: read them by their own names.
+  CodeBuilder& cb = e.cb();
+  for (int t = 0; t < nc; ++t)
+    for (int d = 0; d < 6; ++d)
+      f.W[std::size_t(t)][std::size_t(d)] =
+          stored[std::size_t(t)] ? cb.refresh(e.ws.member("W", nc, 6, t, d, what)) : fixed[std::size_t(t)];
+  e.fn.boundary("LS");
+  Sym S(6);
+  const std::string sWhat = "W^T W (row a, column j)";
+  for (int a = 0; a < 6; ++a) {  // the upper triangle: row a, columns a to 5
+    CodeBuilder& lb = e.cb();
+    lb.open(columnLoopHead(6 - a), {fmt::format("W^T W, row {}, columns {} to 5", a, a)});
+    Expr x;
+    for (int t = 0; t < nc; ++t) x += lb.mul(f.W[std::size_t(t)][std::size_t(a)], rowAt(lb, t, a));
+    const Expr sa = e.put(e.ws.loopSlot("WtW", 6, 6, a, a, sWhat), x);
+    lb.close();
+    for (int c = a; c < 6; ++c)
+      S(a, c) = (a == c ? Expr(1.0) : Expr()) + (sa.isConstant() ? sa : e.cb().refresh(e.ws.member("WtW", 6, 6, a, c, sWhat)));
+  }
+  e.cb().open("{", {"S = I + W^T W = LS LS^T"});
   const Cholesky ch = cholesky(
-      e, S, Expr(), [&](int r, int c) { return e.member("LS", 21, Sym::index(6, r, c), "factor of I + W^T W (lower, packed)"); },
-      [&](int r) { return e.member("LSinv", 6, r, "1 / diag(LS)"); });
+      e, S, Expr(), [&](int rr, int c) { return e.member("LS", 21, Sym::index(6, rr, c), "factor of I + W^T W (lower, packed)"); },
+      [&](int rr) { return e.member("LSinv", 6, rr, "1 / diag(LS)"); });
   f.LS = ch.L;
   f.LSinv = ch.inv;
-  cb.close();
+  e.cb().close();
 }
 
 }  // namespace
@@ -484,7 +573,7 @@ DelassusFactor factorDelassus(Emit& e, const ProxRows& rows) {
   const InScope<DelassusFactor> scope(e.fn.live().del, &f);
   const Assembly a{e.plan, rows, rowsAt(e.plan)};
   factorColumns(e, a, f);
-  if (const int ff = freeFlyerWithRows(e.plan); ff >= 0) woodbury(e, rows, ff, f);
+  if (const int ff = freeFlyerWithRows(e.plan); ff >= 0) woodburyRows(e, rows, ff, f);
   return f;
 }
 

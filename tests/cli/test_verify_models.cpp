@@ -3,7 +3,7 @@
 // runs, on every joint type and layout the test data holds (planar joints from
 // the world and below a moving body, a floating joint in the URDF, a base
 // placed by the layout, tools, gains, welds and points on free bodies,
-// prismatic, continuous and fixed joints, hostile names, redundant rows). The generated-solver
+// prismatic, continuous and fixed joints, hostile names, redundant rows, a Cartesian leg). The generated-solver
 // harnesses (tests/generated) hold every function on a few robots only, for the
 // build's time; a planar joint's mass_matrix_inverse and Delassus functions were
 // wrong for as long as no solver held them there (docs/dynamics.md, "Fixed on
@@ -68,6 +68,9 @@ const std::vector<Model>& models() {
       // about one state in fifty (1.03-1.24 times it): 200 states.
       {"redundant_rows", "tests/data/good/redundant_rows.urdf", "tests/data/good/redundant_rows.yaml", "double",
        "200"},
+      // Folded entries of Z at the free flyer: proxPV's Woodbury rows stage them (emit/pass_delassus_factor.cpp).
+      {"cartesian_leg", "tests/data/good/cartesian_leg.urdf", "tests/data/good/cartesian_leg.yaml", "double"},
+      {"cartesian_leg_float", "tests/data/good/cartesian_leg.urdf", "tests/data/good/cartesian_leg.yaml", "float"},
   };
   return list;
 }

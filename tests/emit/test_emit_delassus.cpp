@@ -1,0 +1,80 @@
+// The shape of proxPV's Delassus factor with a floating base
+// (emit/pass_delassus_factor.cpp): G + I/mu = A + I/mu + Z^T Z goes through
+// Woodbury, W = L^-1 Z^T and S = I + W^T W, and since the six columns of W go
+// through the same arithmetic each row of W and each row of S is one loop over
+// the columns (docs/emitter.md, "Woodbury's rows as loops"). The values are the
+// harnesses' business (tests/generated: the shared cases' prox_pv against the
+// generic one, double and float; tests/cli/test_verify_models.cpp: the
+// Cartesian leg below); this checks the code's shape.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "cases/cases.hpp"
+#include "emit/generate.hpp"
+#include "support.hpp"
+
+namespace proxgen::emit {
+namespace {
+
+long count(const std::string& text, const std::string& what) {
+  long n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+
+// The line after the first line holding `what`.
+std::string lineAfter(const std::string& text, const std::string& what) {
+  const std::size_t at = text.find(what);
+  if (at == std::string::npos) return {};
+  const std::size_t next = text.find('\n', at) + 1;
+  return text.substr(next, text.find('\n', next) - next);
+}
+
+// Every row of W is a loop over the six columns, S's rows loops over the
+// columns of its upper triangle, and no column of W is unrolled.
+void expectWoodburyRows(const std::string& source, int rows) {
+  EXPECT_EQ(count(source, "// W = L^-1 Z^T, row "), rows);
+  EXPECT_EQ(count(source, "// W = L^-1 Z^T, column"), 0) << "a column of W unrolled";
+  for (int t = 0; t < rows; ++t)
+    EXPECT_EQ(lineAfter(source, "// W = L^-1 Z^T, row " + std::to_string(t) + ","),
+              "  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {")
+        << "row " << t;
+  for (int a = 0; a < 6; ++a)
+    EXPECT_EQ(lineAfter(source, "// W^T W, row " + std::to_string(a) + ","),
+              "  PROXGEN_RT_NO_UNROLL for (int j = 0; j < " + std::to_string(6 - a) + "; ++j) {")
+        << "row " << a << " of S";
+}
+
+// Solo's four feet (12 rows, no branch) and the Atlas' feet and two hands of
+// ten fingertip rows each (42 rows; the hands' blocks meet through the torso
+// in low rank, so W's rows after the first hand's subtract its terms, Wlr0).
+TEST(DelassusCode, WoodburyRowsAreLoopsOverTheSixColumns) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  const SolverFiles solo = generateCase(cases, "solo_f3x4", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  expectWoodburyRows(solo.source, 12);
+  EXPECT_EQ(count(solo.source, "Wlr"), 0);
+  const SolverFiles atlas =
+      generateCase(cases, "atlas_shadow_f6x2_t3x10", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  expectWoodburyRows(atlas.source, 42);
+  EXPECT_GT(count(atlas.source, "// W's low-rank terms, branch 0"), 0);
+  EXPECT_GT(count(atlas.header, "Scalar Wlr0["), 0);
+}
+
+// A Cartesian leg's rows reach the free flyer unturned, so entries of Z fold
+// (zeros of KA at the top of L^-1 KA): such a row is copied to Wz first, and
+// the loops read it there (tests/data/good/cartesian_leg.urdf).
+TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
+  GenerateOptions g;
+  g.urdf = test::sourceDir() + "/tests/data/good/cartesian_leg.urdf";
+  g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
+  g.functions = "prox_pv";
+  const SolverFiles f = generateFiles(g);
+  expectWoodburyRows(f.source, 3);
+  EXPECT_GT(count(f.source, "some entries folded: staged for the loops"), 0);
+  EXPECT_GT(count(f.source, "w.Wz[0][j]"), 0);
+}
+
+}  // namespace
+}  // namespace proxgen::emit
