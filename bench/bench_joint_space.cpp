@@ -17,6 +17,8 @@
 // the last two without the copy (crba in Pinocchio 3.7's default LOCAL
 // convention), and mass_matrix/pinocchio_world for crba in its WORLD convention
 // with the copy (bench_pinocchio.cpp, pinocchioJointSpace), on the same states and qdd.
+// <case>/mass_matrix/zero_fill writes nv x nv zeros into mass_matrix's output
+// buffer and nothing else: the cost of returning the full matrix.
 //
 //   proxgen_bench_joint_space [Google Benchmark flags]
 //   proxgen_bench_joint_space --count CASE/FUNCTION/VARIANT N
@@ -27,6 +29,7 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -180,6 +183,14 @@ void registerCase(const char* name) {
     benchmark::DoNotOptimize(out->data());
   });
   reg("mass_matrix/generic", [=, &c](int k) { benchmark::DoNotOptimize(proxgen::crba(c.sys, *data, s(k).q).data()); });
+  // Writing all of M's nv x nv entries and nothing else (std::fill: glibc's memset), into the
+  // buffer mass_matrix/generated writes: the floor of returning the full matrix, 56 KB on the
+  // Atlas, more than a 48 KB first-level data cache (docs/benchmarks.md, "The full mass matrix").
+  reg("mass_matrix/zero_fill", [=](int) {
+    std::fill(out->data(), out->data() + std::size_t(nv) * std::size_t(nv), Scalar(0));
+    benchmark::DoNotOptimize(out->data());
+    benchmark::ClobberMemory();
+  });
   reg("mass_matrix_inverse/generated", [=](int k) {
     G::mass_matrix_inverse(q(k), *ws, out->data());
     benchmark::DoNotOptimize(out->data());
