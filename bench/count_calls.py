@@ -2,9 +2,13 @@
 """Instructions per call of each (case, algorithm) under callgrind.
 
 Runs `proxgen_bench_calls CASE ALGORITHM N` under `valgrind --tool=callgrind`
-twice, with N calls and with none, and reports (Ir(N) - Ir(0)) / N: loading the
+twice, with 2N calls and with N, and reports (Ir(2N) - Ir(N)) / N: loading the
 model, drawing the states and building the work space cost the same in both
-runs, so only the calls remain. Deterministic (same states, same code).
+runs, and so does whatever the first call does once (a lazily bound symbol, a
+first touch), so only the calls remain. Against a run with no call, that
+once-only work counted as calls: 827 instructions per call of 20 on the iiwa's
+inverse_dynamics (3,108 for 2,281; docs/benchmarks.md, "Instructions per
+call"). Deterministic (same states, same code).
 
     count_calls.py BUILD_DIR OUT.json [--calls N] [--cases a,b] [--algorithms x,y]
     count_calls.py BUILD_DIR OUT.json --library [--calls N] [--cases a,b] [--algorithms f/variant,...]
@@ -18,8 +22,7 @@ Pinocchio's rnea, nonLinearEffects, crba and computeMinverse where the build has
 --derivatives counts the derivative benchmarks (proxgen_bench_derivatives --count
 CASE/VARIANT N, bench_derivatives.cpp): the generated constrained_dynamics_derivatives,
 the central differences of prox_pv, their integrations alone, and Pinocchio's
-constraintDynamics + computeConstraintDynamicsDerivatives where the build has it. Its
-set-up checks the one variant it runs, so each (case, variant) has its own N = 0 run.
+constraintDynamics + computeConstraintDynamicsDerivatives where the build has it.
 """
 import argparse
 import json
@@ -38,12 +41,12 @@ LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "
     f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
     "mass_matrix/pinocchio_upper", "mass_matrix/pinocchio_world", "mass_matrix_inverse/pinocchio_upper"]
 DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio"]
-# The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, the
-# default list of what to count, and whether one N = 0 run serves every item of a case.
+# The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, and the
+# default list of what to count.
 DRIVERS = {
-    "calls": ("proxgen_bench_calls", False, ALGORITHMS, False),
-    "library": ("proxgen_bench_joint_space", True, LIBRARY, True),
-    "derivatives": ("proxgen_bench_derivatives", True, DERIVATIVES, False),
+    "calls": ("proxgen_bench_calls", False, ALGORITHMS),
+    "library": ("proxgen_bench_joint_space", True, LIBRARY),
+    "derivatives": ("proxgen_bench_derivatives", True, DERIVATIVES),
 }
 NOT_BUILT = 3  # proxgen_bench_calls' (and --count's) exit code for what this build lacks
 
@@ -84,7 +87,7 @@ def main():
     which.add_argument("--library", action="store_true", help="the dynamics library (proxgen_bench_joint_space)")
     which.add_argument("--derivatives", action="store_true", help="the derivatives (proxgen_bench_derivatives)")
     args = ap.parse_args()
-    exe, count_flag, default_list, shared_baseline = DRIVERS[
+    exe, count_flag, default_list = DRIVERS[
         "library" if args.library else "derivatives" if args.derivatives else "calls"]
     algorithms = args.algorithms.split(",") if args.algorithms else default_list
 
@@ -94,19 +97,14 @@ def main():
     driver = [os.path.join(args.build_dir, "bench", exe)] + (["--count"] if count_flag else [])
 
     results = []
-    baselines = {}
     with tempfile.TemporaryDirectory(prefix="proxgen-callgrind-") as work:
         for case in cases:
             for algorithm in algorithms:
-                full = instructions(driver, case, algorithm, args.calls, work)
-                if full is None:
+                base = instructions(driver, case, algorithm, args.calls, work)
+                if base is None:
                     print(f"{case:26s} {algorithm:20s} not built", flush=True)
                     continue
-                # The library driver's run without calls is the same for every function of a case.
-                key = case if shared_baseline else (case, algorithm)
-                if key not in baselines:
-                    baselines[key] = instructions(driver, case, algorithm, 0, work)
-                base = baselines[key]
+                full = instructions(driver, case, algorithm, 2 * args.calls, work)
                 per_call = (full - base) / args.calls
                 results.append({"case": case, "algorithm": algorithm, "ir_per_call": per_call,
                                 "ir_total": full, "ir_baseline": base, "calls": args.calls})
