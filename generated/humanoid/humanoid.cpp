@@ -6249,7 +6249,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 0, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t12 = w.Z_pelvis[j][0]*w.active[0];
+    const Scalar t12 = w.active[0]*w.Z_pelvis[j][0];
     w.W[0][j] = w.Linv[0]*t12;
   }
   // W = L^-1 Z^T, row 1, columns 0 to 5
@@ -6279,7 +6279,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 6, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t18 = w.Z_pelvis[j][6]*w.active[1];
+    const Scalar t18 = w.active[1]*w.Z_pelvis[j][6];
     w.W[6][j] = w.Linv[6]*t18;
   }
   // W = L^-1 Z^T, row 7, columns 0 to 5
@@ -6309,7 +6309,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 12, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t24 = w.Z_pelvis[j][12]*w.active[2];
+    const Scalar t24 = w.active[2]*w.Z_pelvis[j][12];
     w.W[12][j] = w.Linv[12]*t24;
   }
   // W = L^-1 Z^T, row 13, columns 0 to 5

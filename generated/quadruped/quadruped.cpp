@@ -2500,7 +2500,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 0, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t9 = w.Z_trunk[j][0]*w.active[0];
+    const Scalar t9 = w.active[0]*w.Z_trunk[j][0];
     w.W[0][j] = w.Linv[0]*t9;
   }
   // W = L^-1 Z^T, row 1, columns 0 to 5
@@ -2515,7 +2515,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 3, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t12 = w.Z_trunk[j][3]*w.active[2];
+    const Scalar t12 = w.active[2]*w.Z_trunk[j][3];
     w.W[3][j] = w.Linv[3]*t12;
   }
   // W = L^-1 Z^T, row 4, columns 0 to 5
@@ -2530,7 +2530,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 6, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t15 = w.Z_trunk[j][6]*w.active[1];
+    const Scalar t15 = w.active[1]*w.Z_trunk[j][6];
     w.W[6][j] = w.Linv[6]*t15;
   }
   // W = L^-1 Z^T, row 7, columns 0 to 5
@@ -2545,7 +2545,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
   }
   // W = L^-1 Z^T, row 9, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t18 = w.Z_trunk[j][9]*w.active[3];
+    const Scalar t18 = w.active[3]*w.Z_trunk[j][9];
     w.W[9][j] = w.Linv[9]*t18;
   }
   // W = L^-1 Z^T, row 10, columns 0 to 5

@@ -507,8 +507,13 @@ void woodburyRows(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
     CodeBuilder& cb = e.cb();
     cb.open(columnLoopHead(6), {fmt::format("W = L^-1 Z^T, row {}, columns 0 to 5", i)});
     Expr x;
-    if (!reads[std::size_t(i)].empty())  // Z F: an inactive row's column of Z is 0, so is its row of W
-      x = cb.mul(activeRowFactor(e, e.plan.rootRows[std::size_t(i)]), cb.member(reads[std::size_t(i)]));
+    if (!reads[std::size_t(i)].empty()) {  // Z F: an inactive row's column of Z is 0, so is its row of W
+      // Two statements: the printed order of the factors follows the order their atoms are made,
+      // which must not be the compiler's order of evaluating a call's arguments.
+      const Expr on = activeRowFactor(e, e.plan.rootRows[std::size_t(i)]);
+      const Expr z = cb.member(reads[std::size_t(i)]);
+      x = cb.mul(on, z);
+    }
     for (int k = 0; k < i; ++k)
       if (inL(f, i, k) && !f.L(i, k).isZero()) x -= cb.mul(f.L(i, k), rowAt(cb, k));
     const auto [bi, l] = branchBlock(f, i);
