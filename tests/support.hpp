@@ -85,6 +85,9 @@ std::string syntheticTreeUrdf(int links, int branching, const std::string& pad =
 /// "" = the two solvers).
 emit::SolverFiles syntheticChainFiles(int links, const std::string& functions = "");
 
+/// How many times `what` occurs in `text`, without overlaps (generated code's shape tests).
+long occurrences(const std::string& text, const std::string& what);
+
 // --- files and child processes (the tests that run the `proxgen` binary) -----
 
 /// The whole file as bytes ("" when it cannot be read).

@@ -17,12 +17,6 @@
 namespace proxgen::emit {
 namespace {
 
-long count(const std::string& text, const std::string& what) {
-  long n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
-  return n;
-}
-
 // The line after the first line holding `what`.
 std::string lineAfter(const std::string& text, const std::string& what) {
   const std::size_t at = text.find(what);
@@ -34,8 +28,8 @@ std::string lineAfter(const std::string& text, const std::string& what) {
 // Every row of W is a loop over the six columns, S's rows loops over the
 // columns of its upper triangle, and no column of W is unrolled.
 void expectWoodburyRows(const std::string& source, int rows) {
-  EXPECT_EQ(count(source, "// W = L^-1 Z^T, row "), rows);
-  EXPECT_EQ(count(source, "// W = L^-1 Z^T, column"), 0) << "a column of W unrolled";
+  EXPECT_EQ(test::occurrences(source, "// W = L^-1 Z^T, row "), rows);
+  EXPECT_EQ(test::occurrences(source, "// W = L^-1 Z^T, column"), 0) << "a column of W unrolled";
   for (int t = 0; t < rows; ++t)
     EXPECT_EQ(lineAfter(source, "// W = L^-1 Z^T, row " + std::to_string(t) + ","),
               "  PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {")
@@ -54,12 +48,12 @@ TEST(DelassusCode, WoodburyRowsAreLoopsOverTheSixColumns) {
   const std::string cases = test::modelsDir() + "/cases.yaml";
   const SolverFiles solo = generateCase(cases, "solo_f3x4", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
   expectWoodburyRows(solo.source, 12);
-  EXPECT_EQ(count(solo.source, "Wlr"), 0);
+  EXPECT_EQ(test::occurrences(solo.source, "Wlr"), 0);
   const SolverFiles atlas =
       generateCase(cases, "atlas_shadow_f6x2_t3x10", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
   expectWoodburyRows(atlas.source, 42);
-  EXPECT_GT(count(atlas.source, "// W's low-rank terms, branch 0"), 0);
-  EXPECT_GT(count(atlas.header, "Scalar Wlr0["), 0);
+  EXPECT_GT(test::occurrences(atlas.source, "// W's low-rank terms, branch 0"), 0);
+  EXPECT_GT(test::occurrences(atlas.header, "Scalar Wlr0["), 0);
 }
 
 // A Cartesian leg's rows reach the free flyer unturned, so entries of Z fold
@@ -72,8 +66,8 @@ TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
   g.functions = "prox_pv";
   const SolverFiles f = generateFiles(g);
   expectWoodburyRows(f.source, 3);
-  EXPECT_GT(count(f.source, "some entries folded: staged for the loops"), 0);
-  EXPECT_GT(count(f.source, "w.Wz[0][j]"), 0);
+  EXPECT_GT(test::occurrences(f.source, "some entries folded: staged for the loops"), 0);
+  EXPECT_GT(test::occurrences(f.source, "w.Wz[0][j]"), 0);
 }
 
 }  // namespace

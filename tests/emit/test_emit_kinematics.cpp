@@ -24,36 +24,30 @@ std::string chainSource(int links, const std::string& functions = "") {
   return test::syntheticChainFiles(links, functions).unsharedSource;
 }
 
-long count(const std::string& text, const std::string& what) {
-  long n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
-  return n;
-}
-
 TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   const std::string sixteen = chainSource(17), seventeen = chainSource(18);
-  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_joint(q["), 16);
-  EXPECT_EQ(count(sixteen, "proxgen_rt::sincos_joint_noinline("), 0);
-  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_joint_noinline(q["), 17);
-  EXPECT_EQ(count(seventeen, "proxgen_rt::sincos_joint("), 0);
+  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint(q["), 16);
+  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint_noinline("), 0);
+  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint_noinline(q["), 17);
+  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint("), 0);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
   const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
-  EXPECT_EQ(count(lanes, "sincos_joint_noinline"), 0);
-  EXPECT_EQ(count(lanes, "proxgen_rt::sincos_joint(q["), 17);
+  EXPECT_EQ(test::occurrences(lanes, "sincos_joint_noinline"), 0);
+  EXPECT_EQ(test::occurrences(lanes, "proxgen_rt::sincos_joint(q["), 17);
 }
 
 // The chain's angles are q[0..n): one run of all of them before the kinematics
 // (slots 0..n of w.sq and w.cq), which the joints' calls then read.
 TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
   const std::string src = chainSource(18);
-  EXPECT_EQ(count(src, "proxgen_rt::sincos_run<"), 1);
+  EXPECT_EQ(test::occurrences(src, "proxgen_rt::sincos_run<"), 1);
   const auto run = src.find("proxgen_rt::sincos_run<17>(&q[0], &w.sq[0], &w.cq[0]);");
   ASSERT_NE(run, std::string::npos);
   const auto host = src.rfind("void kinematics(");  // the host, after its parts
   EXPECT_GT(run, host);
   EXPECT_LT(run, src.find("kinematics_", host));  // before its first part's call
   for (int j = 0; j < 17; ++j)
-    EXPECT_EQ(count(src, "proxgen_rt::sincos_joint_noinline(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
+    EXPECT_EQ(test::occurrences(src, "proxgen_rt::sincos_joint_noinline(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
                              "], w.cq[" + std::to_string(j) + "]);"),
               1)
         << "joint " << j;
@@ -66,10 +60,10 @@ TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
 TEST(KinematicsCode, TheJointTransformsComeFirstWhereSinCosIsInlined) {
   const std::string functions = "constrained_aba,prox_pv,inverse_dynamics";
   const std::string inlined = chainSource(17, functions), called = chainSource(18, functions);
-  EXPECT_GT(count(inlined, "void kinematics_transforms_"), 0);
-  EXPECT_GT(count(inlined, "void rnea_transforms_"), 0);
-  EXPECT_EQ(count(called, "void kinematics_transforms_"), 0);
-  EXPECT_EQ(count(called, "void rnea_transforms_"), 0);
+  EXPECT_GT(test::occurrences(inlined, "void kinematics_transforms_"), 0);
+  EXPECT_GT(test::occurrences(inlined, "void rnea_transforms_"), 0);
+  EXPECT_EQ(test::occurrences(called, "void kinematics_transforms_"), 0);
+  EXPECT_EQ(test::occurrences(called, "void rnea_transforms_"), 0);
 }
 
 }  // namespace

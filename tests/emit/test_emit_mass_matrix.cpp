@@ -26,12 +26,6 @@ long massMatrixLines(int n) {
   return long(std::count(source.begin(), source.end(), '\n'));
 }
 
-long count(const std::string& text, const std::string& what) {
-  long n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
-  return n;
-}
-
 // From 16 to 64 links, code linear in n grows 4 times, and the fixed part of
 // the file (banner, entry point, the runtime's helpers) makes it a little less;
 // the column-by-column walk it replaced grew 11 times (1,459 -> 16,151 lines:
@@ -51,9 +45,9 @@ TEST(MassMatrixCode, TheWalkIsLinearInTheDepth) {
 // kept loops by the compiler").
 TEST(MassMatrixCode, ColumnLoopsAreKeptLoops) {
   const std::string source = massMatrixSource(16);
-  const long loops = count(source, "for (int j = 0; j < ");
+  const long loops = test::occurrences(source, "for (int j = 0; j < ");
   EXPECT_GT(loops, 0);
-  EXPECT_EQ(count(source, "PROXGEN_RT_NO_UNROLL for (int j = 0; j < "), loops);
+  EXPECT_EQ(test::occurrences(source, "PROXGEN_RT_NO_UNROLL for (int j = 0; j < "), loops);
 }
 
 // In a serial chain every body but the root's child has a single-child

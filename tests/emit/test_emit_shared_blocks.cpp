@@ -16,12 +16,6 @@
 namespace proxgen::emit {
 namespace {
 
-long count(const std::string& text, const std::string& what) {
-  long n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
-  return n;
-}
-
 // A part with one block for body `b` (dof `d`): the same statements for every
 // body, `c` its constant, `sign` the sign the printer put before it.
 std::string part(const std::string& name, const std::string& b, int d, const std::string& c, char sign = '+') {
@@ -60,7 +54,7 @@ TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
   // One kernel body over k[], each block's constants in its own table; the
   // sign before a literal goes into the table (a - 0.5*x == a + (-0.5)*x).
   // A constant the blocks have in common (1.5e-05) stays a literal.
-  EXPECT_EQ(count(s.parts, "PROXGEN_RT_NOINLINE void shared_0("), 1);
+  EXPECT_EQ(test::occurrences(s.parts, "PROXGEN_RT_NOINLINE void shared_0("), 1);
   EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k0[1] = {0.25};"), std::string::npos) << s.parts;
   EXPECT_NE(s.parts.find("constexpr Scalar shared_0_k1[1] = {-0.5};"), std::string::npos) << s.parts;
   // A scalar member the block only reads comes by value, arrays as pointers.
@@ -76,20 +70,20 @@ TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
             std::string::npos)
       << s.parts;
   // The blocks' statements are gone from the parts, their comment lines stay.
-  EXPECT_EQ(count(s.parts, "w.Dinv_"), 2);
-  EXPECT_EQ(count(s.parts, "// body 2 'left'"), 1);
+  EXPECT_EQ(test::occurrences(s.parts, "w.Dinv_"), 2);
+  EXPECT_EQ(test::occurrences(s.parts, "// body 2 'left'"), 1);
 }
 
 TEST(SharedBlocks, BlocksWithTheSameConstantsNeedNoTable) {
   const std::string text = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25", '-');
   const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
   ASSERT_EQ(s.kernels.size(), 1u);
-  EXPECT_EQ(count(s.parts, "constexpr Scalar shared_0_k"), 2);  // 0.25 and -0.25 differ: a table each
+  EXPECT_EQ(test::occurrences(s.parts, "constexpr Scalar shared_0_k"), 2);  // 0.25 and -0.25 differ: a table each
   EXPECT_NE(s.parts.find("- 1.5e-05*tau[1];"), std::string::npos) << s.parts;
   const std::string same = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25");
   const SharedParts t = shareBlocks(same, members({"left", "right"}), all);
   ASSERT_EQ(t.kernels.size(), 1u);
-  EXPECT_EQ(count(t.parts, "constexpr Scalar"), 0);
+  EXPECT_EQ(test::occurrences(t.parts, "constexpr Scalar"), 0);
   EXPECT_NE(t.parts.find("const Scalar x0 = IA_m0[0] + 0.25*Dinv_m1;"), std::string::npos) << t.parts;
   EXPECT_NE(t.parts.find("  shared_0(&tau[2], &w.IA_left[3], w.Dinv_left"), std::string::npos) << t.parts;
 }
@@ -135,14 +129,14 @@ TEST(SharedBlocks, SoloSharesItsLegsTheIiwaNothing) {
   const std::string cases = test::modelsDir() + "/cases.yaml";
   const SolverFiles solo = generateCase(cases, "solo_f3x4", "", ScalarType::Double);
   const SolverFiles iiwa = generateCase(cases, "iiwa_h3", "", ScalarType::Double);
-  EXPECT_EQ(count(iiwa.source, "shared_"), 0);
+  EXPECT_EQ(test::occurrences(iiwa.source, "shared_"), 0);
   EXPECT_EQ(iiwa.unsharedSource, iiwa.source);
-  EXPECT_GT(count(solo.source, "PROXGEN_RT_NOINLINE void shared_"), 4);
+  EXPECT_GT(test::occurrences(solo.source, "PROXGEN_RT_NOINLINE void shared_"), 4);
   // The banner says which blocks share a kernel; the four legs' lower links do.
   EXPECT_NE(solo.source.find("// Shared blocks"), std::string::npos);
   EXPECT_NE(solo.source.find("blocks of FL_LOWER_LEG, FR_LOWER_LEG, HL_LOWER_LEG, HR_LOWER_LEG"), std::string::npos);
   // The lane code is cut from the source without them.
-  EXPECT_EQ(count(solo.unsharedSource, "shared_"), 0);
+  EXPECT_EQ(test::occurrences(solo.unsharedSource, "shared_"), 0);
   EXPECT_NE(solo.unsharedSource, solo.source);
 }
 
