@@ -93,7 +93,7 @@ class Reader {
     onlyKeys(n, element, {"xyz", "rpy"});
     SE3 M;
     if (n["xyz"]) M.p = vec3(n["xyz"], element + ".xyz");
-    if (n["rpy"]) M.R = rpyToMatrix(vec3(n["rpy"], element + ".rpy"));
+    if (n["rpy"]) M.R = snapRotation(rpyToMatrix(vec3(n["rpy"], element + ".rpy")));  // as a URDF origin's
     return M;
   }
 

@@ -10,6 +10,8 @@
 //   M.actForce(f_B)      force  in B coords  -> A coords   (X^T, child to parent)
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -107,6 +109,47 @@ inline Mat3 rpyToMatrix(const Vec3& rpy) {
   return (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
           Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
       .toRotationMatrix();
+}
+
+/// A rotation read from a file (a URDF origin, a layout's offset or target),
+/// snapped when it is read, so the generic and the generated solvers see the
+/// same numbers and the generator can fold them. Entries within a few ulps of
+/// 0 or +-1 are what an rpy of pi/2 in decimal leaves behind
+/// (cos(1.5707963267948966) = 6.1e-17): the entries of a rotation are bounded
+/// by 1, so the absolute threshold 1e-15 (4.5 eps) is a relative one, the
+/// round-off of a product of three elementary rotations is a few eps, and no
+/// rotation a file means differs from an exact 0 or +-1 by less.
+///
+/// A whole rotation within kQuarterTurnTolerance of a signed permutation (every
+/// entry that close to 0 or +-1) is that permutation: the quarter turns
+/// exporters write as 1.57079632679 or 3.14159265359 (11-12 digits of pi/2 and
+/// pi: 4.9e-12 and 2.1e-12 off) leave entries of 1e-12 that no entry-wise
+/// threshold of a few ulps catches, and each costs live operations in every
+/// generated function (Talos: 4 % of constrained_aba's, docs/emitter.md,
+/// "Quarter turns"). The snapped matrix is a rotation exactly (a signed
+/// permutation with the determinant of R, +1); it is at most 1e-10 rad from
+/// the file's, far below the 1e-9 to which the solvers agree with Pinocchio on
+/// the file's numbers. A rotation that mixes a quarter turn with another angle
+/// keeps its entries (snapping some of them would leave a matrix that is not a
+/// rotation).
+inline constexpr double kQuarterTurnTolerance = 1e-10;
+
+inline Mat3 snapRotation(Mat3 R) {
+  Mat3 P;
+  bool permutation = true;
+  for (int k = 0; k < 9; ++k) {
+    const double x = R.data()[k], nearest = std::round(x);  // |x| <= 1: -1, 0 or 1
+    P.data()[k] = nearest == 0.0 ? 0.0 : nearest;  // no -0.0
+    permutation = permutation && std::abs(x - nearest) < kQuarterTurnTolerance;
+  }
+  if (permutation) return P;
+  for (int k = 0; k < 9; ++k) {
+    double& x = R.data()[k];
+    if (std::abs(x) < 1e-15) x = 0.0;
+    else if (std::abs(x - 1.0) < 1e-15) x = 1.0;
+    else if (std::abs(x + 1.0) < 1e-15) x = -1.0;
+  }
+  return R;
 }
 
 /// Rotation by angle q about a unit axis a (Rodrigues), exact for axis-aligned a.
