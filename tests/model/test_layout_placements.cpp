@@ -31,9 +31,10 @@ TEST(LayoutPlacements, QuarterTurnsAreExactAsInAUrdf) {
   EXPECT_EQ(offsetOf("[0, 0, 1.5707963267948966]"), Rz);
   EXPECT_EQ(offsetOf("[0, 0, 1.57079632679]"), Rz);
   // A target's rotation too: pi about x, 12 digits.
-  const Constraint& c = only(parseLayout(
+  const Layout L = parseLayout(
       "constraints:\n  - {name: c, link: l, type: 6d, kp: 10, target: {xyz: [0, 0, 1], rpy: [3.14159265359, 0, 0]}}\n",
-      "l.yaml"));
+      "l.yaml");
+  const Constraint& c = only(L);
   EXPECT_EQ(c.target.R, Vec3(1, -1, -1).asDiagonal().toDenseMatrix());
 }
 
