@@ -8,6 +8,7 @@
 // algorithms/prox_pv.cpp (Eigen's LLT of the assembled G).
 #include <fmt/format.h>
 
+#include <functional>
 #include <regex>
 
 #include "emit/passes.hpp"
@@ -377,6 +378,23 @@ bool inL(const DelassusFactor& f, int i, int k) {
   return bi.first < 0 || bi.first != bk.first || bi.second == bk.second;
 }
 
+// Row i of L y = b before its division by L(i, i): x - sum_k L(i, k) y_k - the
+// low-rank terms (g M_l)[i] . w_l of its branch's solved blocks. yOf(k): the
+// solved row k; wOf(branch, l * rank + p): w_l[p]. Shared by lowRankForward and
+// Woodbury's rows, which read y and w from registers and from W's loops.
+Expr forwardRow(CodeBuilder& cb, const DelassusFactor& f, int i, Expr x, const std::function<Expr(int)>& yOf,
+                const std::function<Expr(int, int)>& wOf) {
+  for (int k = 0; k < i; ++k)
+    if (inL(f, i, k) && !f.L(i, k).isZero()) x -= cb.mul(f.L(i, k), yOf(k));
+  const auto [bi, l] = branchBlock(f, i);
+  if (bi < 0) return x;
+  const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+  const int r = br.rank, s = br.blocks.front(), m = br.blocks.back() - s;
+  for (int k = 0; k < l; ++k)
+    for (int p = 0; p < r; ++p) x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s) * r + p))], wOf(bi, k * r + p));
+  return x;
+}
+
 // L y = b with L's cross-block parts in low rank: once block l is solved,
 // w_l = Y_l^T y_l (r values), and a later row i subtracts (g M_l)[i] . w_l.
 std::vector<Expr> lowRankForward(CodeBuilder& cb, const DelassusFactor& f, const std::vector<Expr>& b) {
@@ -385,17 +403,10 @@ std::vector<Expr> lowRankForward(CodeBuilder& cb, const DelassusFactor& f, const
   std::vector<Expr> y(static_cast<std::size_t>(n));
   std::vector<std::vector<Expr>> w(f.branches.size());  // per branch: w_l[p], l * rank + p
   for (int i = 0; i < n; ++i) {
-    Expr x = b[std::size_t(i)];
-    for (int k = 0; k < i; ++k)
-      if (inL(f, i, k)) x -= cb.mul(f.L(i, k), y[std::size_t(k)]);
+    const Expr x = forwardRow(
+        cb, f, i, b[std::size_t(i)], [&](int k) { return y[std::size_t(k)]; },
+        [&](int bi, int lp) { return w[std::size_t(bi)][std::size_t(lp)]; });
     const auto [bi, l] = branchBlock(f, i);
-    if (bi >= 0) {
-      const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
-      const int r = br.rank, s = br.blocks.front(), m = br.blocks.back() - s;
-      for (int k = 0; k < l; ++k)
-        for (int p = 0; p < r; ++p)
-          x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s) * r + p))], w[std::size_t(bi)][std::size_t(k * r + p)]);
-    }
     y[std::size_t(i)] = cb.flat(cb.mul(cb.flat(x), f.Linv[std::size_t(i)]), "y");
     if (bi >= 0) {
       const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
@@ -514,17 +525,10 @@ void woodburyRows(Emit& e, const ProxRows& rows, int ff, DelassusFactor& f) {
       const Expr z = cb.member(reads[std::size_t(i)]);
       x = cb.mul(on, z);
     }
-    for (int k = 0; k < i; ++k)
-      if (inL(f, i, k) && !f.L(i, k).isZero()) x -= cb.mul(f.L(i, k), rowAt(cb, k));
+    x = forwardRow(
+        cb, f, i, x, [&](int k) { return rowAt(cb, k); },
+        [&](int bi, int lp) { return cb.member(wlrSlot(std::size_t(bi), lp)); });
     const auto [bi, l] = branchBlock(f, i);
-    if (bi >= 0) {
-      const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
-      const int rk = br.rank, s0 = br.blocks.front(), m = br.blocks.back() - s0;
-      for (int k = 0; k < l; ++k)
-        for (int p = 0; p < rk; ++p)
-          x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s0) * rk + p))],
-                      cb.member(wlrSlot(std::size_t(bi), k * rk + p)));
-    }
     const Expr y = e.put(e.ws.loopSlot("W", nc, 6, i, 0, what), cb.mul(cb.flat(x), f.Linv[std::size_t(i)]));
     stored[std::size_t(i)] = !y.isConstant();
     if (!stored[std::size_t(i)]) fixed[std::size_t(i)] = y;
