@@ -16,6 +16,9 @@
 namespace proxgen::emit {
 namespace {
 
+// The rank of the free flyer's share of G, Z^T Z (Z: 6 x nc).
+constexpr int kWoodburyRank = 6;
+
 // Per tree row t: the support bodies whose subtree holds it (ascending) and its column there.
 std::vector<std::vector<std::pair<int, int>>> rowsAt(const Plan& plan) {
   std::vector<std::vector<std::pair<int, int>>> at(std::size_t(plan.nc));
@@ -66,8 +69,14 @@ Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, int split) {
 // support body j below it: j's subtree rows at most the support bodies of
 // that subtree plus j's ancestors below the free flyer; j's own rows at most
 // j and those ancestors.
+// Nor does the split pay with six rows or fewer: its capacitance S = I + W^T W
+// is 6 x 6 whatever nc is, so with nc <= 6 the split factors a matrix as large
+// as the whole one and adds W = L^-1 Z^T, W^T W and, per solve, W^T z and W x
+// (solo_f3x2, 6 rows: 0.91 of proxPV's time with the whole factor; with 12
+// rows the whole factor is 1.08-1.28: docs/emitter.md, "Woodbury from seven rows").
 int freeFlyerWithRows(const Plan& plan) {
   auto bp = [&](int i) -> const BodyPlan& { return plan.bodies[std::size_t(i)]; };
+  if (plan.nc <= kWoodburyRank) return -1;
   for (int i : plan.support) {
     const BodyPlan& ff = bp(i);
     if (ff.jointClass != JointClass::FreeFlyer || ff.m() == 0) continue;

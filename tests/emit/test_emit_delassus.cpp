@@ -5,7 +5,8 @@
 // the columns (docs/emitter.md, "Woodbury's rows as loops"). The values are the
 // harnesses' business (tests/generated: the shared cases' prox_pv against the
 // generic one, double and float; tests/cli/test_verify_models.cpp: the
-// Cartesian leg below); this checks the code's shape.
+// Cartesian legs below); this checks the code's shape. With six rows or fewer
+// there is no split: G + I/mu is factored whole.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -56,6 +57,24 @@ TEST(DelassusCode, WoodburyRowsAreLoopsOverTheSixColumns) {
   EXPECT_GT(test::occurrences(atlas.header, "Scalar Wlr0["), 0);
 }
 
+// With six rows or fewer the split would factor a 6 x 6 capacitance as large
+// as G itself on top of W: solo_f3x2 (two feet, 6 rows) factors G + I/mu
+// whole, the free flyer's Z^T Z in its entries (docs/emitter.md, "Woodbury
+// from seven rows"), and its four-foot case (12 rows) keeps the split.
+TEST(DelassusCode, SixRowsOrFewerFactorTheWholeMatrix) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  const SolverFiles two = generateCase(cases, "solo_f3x2", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  EXPECT_EQ(test::occurrences(two.source, "L^-1 Z^T"), 0);
+  EXPECT_EQ(test::occurrences(two.header, "Scalar LS["), 0);
+  const std::size_t at = two.source.find("// G + I/mu = L L^T, column 5 (");
+  ASSERT_NE(at, std::string::npos);
+  const std::string column5 = two.source.substr(at, 600);
+  EXPECT_GT(test::occurrences(column5, "w.Z_base_link[5][5]*w.Z_base_link[5][5]"), 0) << column5;
+  const SolverFiles four = generateCase(cases, "solo_f3x4", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  EXPECT_GT(test::occurrences(four.header, "Scalar LS["), 0);
+}
+
 // A Cartesian leg's rows reach the free flyer unturned, so entries of Z fold
 // (zeros of KA at the top of L^-1 KA): such a row is copied to Wz first, and
 // the loops read it there (tests/data/good/cartesian_leg.urdf).
@@ -65,7 +84,7 @@ TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
   g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
   g.functions = "prox_pv";
   const SolverFiles f = generateFiles(g);
-  expectWoodburyRows(f.source, 3);
+  expectWoodburyRows(f.source, 9);
   EXPECT_GT(test::occurrences(f.source, "some entries folded: staged for the loops"), 0);
   EXPECT_GT(test::occurrences(f.source, "w.Wz[0][j]"), 0);
 }
