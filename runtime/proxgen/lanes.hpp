@@ -442,6 +442,125 @@ inline void sincos_joint_noinline(S x, S& s, S& c) noexcept {
 
 }  // inline namespace PROXGEN_RT_SINCOS_RUN_NS
 
+// ---- One row of a dense product, in the lanes of the target.
+//
+// The derivative functions' dense products (C += s A B and its sparse forms,
+// printed in the generated source) run row by row: C's row plus a sum of B's
+// rows. Written as plain loops over the row, GCC unrolls a short row's loop
+// completely and the generated code's -fno-tree-slp-vectorize then leaves it
+// scalar, with C's row loaded and stored for every k (the iiwa's
+// constrained_dynamics_derivatives: 3.3 to 5.3 instructions per multiply-add).
+// row_madd holds the row in accumulators of the target's widest lanes (SSE2
+// and NEON: 2 doubles, AVX: 4, AVX-512: 8; twice as many floats) across all of
+// k, read once and written once, a block of eight accumulators at a time (the
+// registers of SSE2), the last block with the fewer than one vector's columns
+// left over as scalars in the same pass over k. Each entry adds its terms in the order of k, (s a_k) b_k, lane by
+// lane the scalar loop's operations: the same bits (tests/runtime/row_madd_checks.inc).
+// Other Scalars (a batched solver's lanes, a target without vector registers)
+// take the scalar accumulators. The width is part of the names (an inline
+// namespace), as for sincos_run above.
+#if PROXGEN_RT_LANES_VECTOR && defined(__AVX512F__)
+#define PROXGEN_RT_ROW_BYTES 64
+#define PROXGEN_RT_ROW_NS row_lanes64
+#elif PROXGEN_RT_LANES_VECTOR && defined(__AVX__)
+#define PROXGEN_RT_ROW_BYTES 32
+#define PROXGEN_RT_ROW_NS row_lanes32
+#elif PROXGEN_RT_LANES_VECTOR && (defined(__SSE2__) || defined(__ARM_NEON))
+#define PROXGEN_RT_ROW_BYTES 16
+#define PROXGEN_RT_ROW_NS row_lanes16
+#else
+#define PROXGEN_RT_ROW_BYTES 0
+#define PROXGEN_RT_ROW_NS row_scalar
+#endif
+
+inline namespace PROXGEN_RT_ROW_NS {
+namespace row_detail {
+
+// The widest lanes of S the target holds in a register (1: scalars).
+template <class S>
+constexpr int width() noexcept {
+  constexpr bool real = std::is_same<S, double>::value || std::is_same<S, float>::value;
+  return real && PROXGEN_RT_ROW_BYTES >= 2 * int(sizeof(S)) ? PROXGEN_RT_ROW_BYTES / int(sizeof(S)) : 1;
+}
+
+constexpr int kBlock = 8;  // accumulators at a time
+
+// c[0, N W + T) += (Add) or = the sum over the ranges of (s a[k as]) b[k ldb,
+// + N W + T), in N accumulators of W lanes and T scalars after them, over one
+// pass of k. (= starts from zeros, not from c: c's entries just written one by
+// one and read back as a vector would stall the store forwarding.)
+template <bool Add, class S, int W, int N, int T, int ldb>
+inline void block(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int as,
+                  const S* PROXGEN_RT_RESTRICT b, S s, const int* ranges, int nranges) noexcept {
+  using L = typename std::conditional<(W > 1), lanes<S, W>, S>::type;  // W = 1: N = 0, no lanes
+  L acc[N > 0 ? N : 1];
+  S tail[T > 0 ? T : 1];
+  if constexpr (N > 0) {
+    PROXGEN_RT_UNROLL
+    for (int j = 0; j < N; ++j) acc[j] = Add ? L::load(c + j * W) : L(S(0));
+  }
+  PROXGEN_RT_UNROLL
+  for (int j = 0; j < T; ++j) tail[j] = Add ? c[N * W + j] : S(0);
+  for (int g = 0; g < nranges; ++g)
+    for (int k = ranges[2 * g]; k < ranges[2 * g + 1]; ++k) {
+      const S x = s * a[k * as];
+      if constexpr (N > 0) {
+        const L xl(x);
+        PROXGEN_RT_UNROLL
+        for (int j = 0; j < N; ++j) acc[j] += xl * L::load(b + k * ldb + j * W);
+      }
+      PROXGEN_RT_UNROLL
+      for (int j = 0; j < T; ++j) tail[j] += x * b[k * ldb + N * W + j];
+    }
+  if constexpr (N > 0) {
+    PROXGEN_RT_UNROLL
+    for (int j = 0; j < N; ++j) acc[j].store(c + j * W);
+  }
+  PROXGEN_RT_UNROLL
+  for (int j = 0; j < T; ++j) c[N * W + j] = tail[j];
+}
+
+// c[0, p): blocks of kBlock accumulators of W lanes, the last one with the
+// fewer than W columns left as scalars (W = 1: kBlock scalars a block).
+template <bool Add, class S, int p, int ldb, int W>
+inline void row(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int as, const S* PROXGEN_RT_RESTRICT b,
+                S s, const int* ranges, int nranges) noexcept {
+  if constexpr (W == 1) {
+    if constexpr (p > 0) {
+      constexpr int t = p < kBlock ? p : kBlock;
+      block<Add, S, 1, 0, t, ldb>(c, a, as, b, s, ranges, nranges);
+      row<Add, S, p - t, ldb, 1>(c + t, a, as, b + t, s, ranges, nranges);
+    }
+  } else if constexpr (p > 0) {
+    constexpr int n = p / W < kBlock ? p / W : kBlock;
+    constexpr int t = p - n * W < W ? p - n * W : 0;
+    block<Add, S, W, n, t, ldb>(c, a, as, b, s, ranges, nranges);
+    row<Add, S, p - n * W - t, ldb, W>(c + n * W + t, a, as, b + n * W + t, s, ranges, nranges);
+  }
+}
+
+}  // namespace row_detail
+
+/// c[0, p) += sum over k in the index ranges [ranges[2 g], ranges[2 g + 1]),
+/// g < nranges, in that order, of (s a[k as]) times b[k ldb, + p): one row of
+/// C += s A B with A's row (as = 1) or column (as = A's row length) in `a` and
+/// B's rows ldb apart. c may not overlap a or b. The same bits as that loop.
+template <int p, int ldb, class S>
+inline void row_madd(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int as,
+                     const S* PROXGEN_RT_RESTRICT b, S s, const int* ranges, int nranges) noexcept {
+  row_detail::row<true, S, p, ldb, row_detail::width<S>()>(c, a, as, b, s, ranges, nranges);
+}
+
+/// The same from zeros, c not read: c[0, p) = the sum (a row of C = s A B;
+/// the sum starts from +0 as the loop `c = 0; c += ...` does).
+template <int p, int ldb, class S>
+inline void row_product(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int as,
+                        const S* PROXGEN_RT_RESTRICT b, S s, const int* ranges, int nranges) noexcept {
+  row_detail::row<false, S, p, ldb, row_detail::width<S>()>(c, a, as, b, s, ranges, nranges);
+}
+
+}  // inline namespace PROXGEN_RT_ROW_NS
+
 /// angle_axis (runtime.hpp) per lane: it branches on the pivot, so each lane
 /// runs the scalar function.
 template <class S, int W>
