@@ -267,9 +267,7 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
                         nc, nv, nv, nv, w3, rows.J, Xs[b], block(C, b)),
             {}, names, ops);
   // M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k % {}) * {} + {} + k / {}];", nv * nc, minvjt, C, nc, w3,
-                      2 * nv, nc),
-          {}, names);
+  copyBlock(cb, names, minvjt, C, nv, nc, w3, 2 * nv, true);
   ops.once = Ops{};
   ops.once.add = 3L * nc * nv;
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", 3 * nc * nv, C, C, rows.R2), {}, names, ops);
@@ -317,9 +315,7 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
     cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, w3, nv, minvjt,
                         block(L, b), Xs[b]),
             {}, names, ops);
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[(k / {}) * {} + {}];", nc * nv, Ls[b], L, nv, w3,
-                        block(fmt::format("k % {}", nv), b)),
-            {}, names);
+    copyBlock(cb, names, Ls[b], L, nc, nv, w3, b * nv, false);
   }
   std::string text = e.fn.endHost(names);
   e.fn.live() = Live{};

@@ -430,6 +430,17 @@ void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans)
   cb.line(fmt::format("static constexpr int {}_span[{}] = {{{}}};", name, span.size(), fmt::join(span, ", ")));
 }
 
+void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std::string& dst, const std::string& src,
+               int rows, int cols, int ld, int offset, bool transposed) {
+  cb.open(fmt::format("for (int i = 0; i < {}; ++i) {{", rows), {}, names);
+  cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", cols), {}, names);
+  const std::string at = offset == 0 ? "" : fmt::format(" + {}", offset);
+  const std::string from = transposed ? fmt::format("j * {}{} + i", ld, at) : fmt::format("i * {}{} + j", ld, at);
+  cb.line(fmt::format("{}[i * {} + j] = {}[{}];", dst, cols, src, from), {}, names);
+  cb.close();
+  cb.close();
+}
+
 // sparse_left_product_add<n, m, p> and sparse_transposed_product<n, m, p>:
 // per entry of the left factor, its scaling and p multiply-adds.
 Ops sparseLeftProductOps(const RowSpans& a, int p) {
@@ -463,9 +474,7 @@ void minvTimesDtau(Emit& e, const BodyTangents& t, const std::string& minv, cons
     cb.line(fmt::format("sparse_transposed_product<{0}, {0}, {0}>({1}, {2}_start, {2}_span, {3}, Scalar(-1), {4});", nv,
                         x == "dq" ? dq : dv, table, minv, scratch),
             {}, names, ops);
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_{}[k] = {}[(k % {}) * {} + k / {}];", nv * nv, x, scratch, nv,
-                        nv, nv),
-            {}, names);
+    copyBlock(cb, names, "dqdd_" + x, scratch, nv, nv, nv, 0, true);
   }
 }
 

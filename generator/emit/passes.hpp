@@ -221,6 +221,12 @@ RowSpans rowSpans(int rows, const std::set<std::pair<int, int>>& entries);
 /// Prints the tables the sparse products read, `<name>_start[rows + 1]` and
 /// `<name>_span[2 ranges]`, as static constants of the function being written.
 void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans);
+/// dst[i cols + j] = src[i ld + offset + j], or src[j ld + offset + i] (`transposed`),
+/// for i < rows, j < cols: a loop over the rows around one over the columns
+/// (the copy by one flat index, i = k / cols and j = k % cols worked out per
+/// entry, took some 15 instructions an entry; docs/benchmarks.md).
+void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std::string& dst, const std::string& src,
+               int rows, int cols, int ld, int offset, bool transposed);
 /// The arithmetic of sparse_left_product_add<n, m, p> and of
 /// sparse_transposed_product<n, m, p> over the left factor's spans.
 Ops sparseLeftProductOps(const RowSpans& a, int p);
