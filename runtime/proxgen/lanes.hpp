@@ -454,8 +454,9 @@ inline void sincos_joint_noinline(S x, S& s, S& c) noexcept {
 // and NEON: 2 doubles, AVX: 4, AVX-512: 8; twice as many floats) across all of
 // k, read once and written once, a block of eight accumulators at a time (the
 // registers of SSE2), the last block with the fewer than one vector's columns
-// left over as scalars in the same pass over k. Each entry adds its terms in the order of k, (s a_k) b_k, lane by
-// lane the scalar loop's operations: the same bits (tests/runtime/row_madd_checks.inc).
+// left over as scalars in the same pass over k. Each entry adds its terms in
+// the order of k, (s a_k) b_k, lane by lane the scalar loop's operations: the
+// same bits (tests/runtime/row_madd_checks.inc).
 // Other Scalars (a batched solver's lanes, a target without vector registers)
 // take the scalar accumulators. The width is part of the names (an inline
 // namespace), as for sincos_run above.
