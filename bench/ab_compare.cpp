@@ -8,7 +8,7 @@
 //   ab_compare check           the states on which any output differs in any bit
 //   ab_compare time N          A and B alternately, 21 repetitions of N calls each:
 //                              median and fastest repetition, and B / A
-//   ab_compare count A|B N     N calls of one side (callgrind: Ir(N) - Ir(0))
+//   ab_compare count A|B N     N calls of one side (callgrind: (Ir(2N) - Ir(N)) / N)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

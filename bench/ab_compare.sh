@@ -3,7 +3,8 @@
 # versions of the emitter"): generates CASE with two proxgen executables (or one,
 # compiled twice with other flags), links the two sources side by side into
 # bench/ab_compare.cpp and prints, for A and B: the object's text bytes, the
-# instructions per call (callgrind, (Ir(N) - Ir(0)) / N), whether the outputs
+# instructions per call (callgrind, (Ir(2N) - Ir(N)) / N, as bench/count_calls.py:
+# what the first call does once is not counted as calls), whether the outputs
 # agree bit for bit on 1000 random states, and the time of both in one process,
 # alternating (21 repetitions, medians and fastest).
 #
@@ -58,7 +59,7 @@ n=20
 echo "case $case, function $fn, folder $dir"
 for side in A B; do
   bytes=$(size "$dir/$side.o" | awk 'NR == 2 {print $1}')
-  per_call=$(( ($(ir "$side" "$n") - $(ir "$side" 0)) / n ))
+  per_call=$(( ($(ir "$side" $((2 * n))) - $(ir "$side" "$n")) / n ))
   echo "$side: text $bytes bytes, $per_call instructions per call"
 done
 "$dir/ab_compare" check
