@@ -6825,7 +6825,7 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  proxgen_rt::sincos_run<30>(&q[7], &w.sq[0], &w.cq[0]);
+  proxgen_rt::sincos_run<30, true>(&q[7], &w.sq[0], &w.cq[0]);
   kinematics_pelvis_to_l_hip_yaw_link(q, v, w);
   kinematics_l_hip_roll_link_to_l_thigh(q, v, w);
   kinematics_l_shank_to_l_ankle_link(q, v, w);

@@ -70,8 +70,10 @@ void sincosRuns(Emit& e, bool supportOnly) {
       written.push_back(cm);
       angles.push_back(cb.input(q(e.bp(all[j]).idx_q)));
     }
-    cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}>(&{}, &{}, &{});", b - a, q(e.bp(all[a]).idx_q), written[0],
-                               written[1]),
+    // `true`: the joints after it call sincos (sincos_joint_noinline), which the
+    // runtime replaces by the run in more targets (two lanes as well, lanes.hpp).
+    cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}{}>(&{}, &{}, &{});", b - a,
+                               sincosCalled(e.plan) ? ", true" : "", q(e.bp(all[a]).idx_q), written[0], written[1]),
                    written, angles);
     a = b;
   }

@@ -34,9 +34,11 @@ bool sincosCalled(const Plan& plan);
 /// the constraints' support): their revolute joints' sines and
 /// cosines, one proxgen_rt::sincos_run per run of consecutive angles in q
 /// (w.sq and w.cq, slot j for the j-th revolute joint in q order). It computes
-/// them where the target has 4 or more double lanes; elsewhere it is empty and
-/// each joint's sincos_joint computes its own (lanes.hpp). Every pass that calls
-/// jointTransform calls this first (jointTransformsFirst does).
+/// them where the target has 4 or more double lanes, and with 2 (x86-64's SSE2)
+/// where the joints call sincos (sincosCalled: `sincos_run<N, true>`); elsewhere
+/// it is empty and each joint's sincos_joint(_noinline) computes its own
+/// (lanes.hpp). Every pass that calls jointTransform calls this first
+/// (jointTransformsFirst does).
 void sincosRuns(Emit& e, bool supportOnly = false);
 /// The sincos runs of every body (sincosRuns), then, where sincos is inlined,
 /// a pass of every body's joint transform into kin

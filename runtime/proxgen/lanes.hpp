@@ -340,53 +340,92 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 // ---- The joint angles' sines and cosines of a scalar solver, many per call.
 //
 // A scalar solver computes each revolute joint's sine and cosine where its
-// body's step needs them (sincos_joint). On a target with four or more
-// double lanes (AVX: 4, AVX-512: 8) one call before the kinematics computes
-// a run of consecutive joint angles in the lanes instead (sincos_run), and
-// each joint's call is empty: with AVX-512 Talos' solvers take 0.88-0.92 of
-// the time and its inverse_dynamics 0.68, with AVX2 (a first version)
-// inverse_dynamics 0.95-0.98 (docs/benchmarks.md, "sincos in the lanes").
-// With two lanes (SSE2, NEON) the run was slower than the joints' calls
-// (1.12: their latency hides behind the bodies' arithmetic, the run's does
-// not), so there, and for float and lanes Scalars, the run is empty.
-// Either way every value is the scalar kernel's, bit for bit (see sincos
-// above). Define PROXGEN_RT_SINCOS_RUN to 0 to keep the joints' calls.
+// body's step needs them: inline (sincos_joint, robots of 16 revolute joints
+// or fewer) or through a call of the runtime's kernel (sincos_joint_noinline,
+// larger robots). Where the target's vector registers pay, one call before
+// the kinematics computes a run of consecutive joint angles in the lanes
+// instead (sincos_run<N> before inline joints, sincos_run<N, true> before
+// called ones), and each joint's call is empty:
+// - four or more double lanes (AVX: 4, AVX-512: 8), both forms: with
+//   AVX-512 Talos' solvers take 0.88-0.92 of the time and its
+//   inverse_dynamics 0.68;
+// - two lanes (x86-64's SSE2), before called joints only: a call in the
+//   middle of a body's block spills the live values around it (every xmm
+//   register is caller-saved), the run in two lanes does not, and computes
+//   two angles for about the instructions of one: Talos' inverse_dynamics
+//   0.79 of the time, its solvers 0.93-0.94, the Atlas' 0.94-0.99. Before
+//   inlined joints the run in two lanes was slower (the iiwa's
+//   inverse_dynamics 1.16, Solo's 1.04: the inlined kernel's latency hides
+//   behind the body's arithmetic), so there each joint computes its own;
+// - elsewhere (NEON, not measured; no vector lanes; float and lanes Scalars)
+//   the runs are empty and the joints compute.
+// docs/benchmarks.md, "sincos in the lanes". Either way every value is the
+// scalar kernel's, bit for bit (see sincos above). Define
+// PROXGEN_RT_SINCOS_RUN to 0 to keep the joints' calls in both forms, or to
+// 1 to take the runs in both forms wherever the target has vector lanes.
 //
 // The mode is part of the functions' names (an inline namespace), so
 // translation units compiled for different targets and linked together never
 // pick one another's definitions.
-#ifndef PROXGEN_RT_SINCOS_RUN
-#if PROXGEN_RT_LANES_VECTOR && (defined(__AVX__) || defined(__AVX512F__))
+#ifdef PROXGEN_RT_SINCOS_RUN  // the user's choice, for both forms
+#define PROXGEN_RT_SINCOS_RUN_CALLED PROXGEN_RT_SINCOS_RUN
+#elif PROXGEN_RT_LANES_VECTOR && (defined(__AVX__) || defined(__AVX512F__))
 #define PROXGEN_RT_SINCOS_RUN 1
+#define PROXGEN_RT_SINCOS_RUN_CALLED 1
+#elif PROXGEN_RT_LANES_VECTOR && defined(__SSE2__)
+#define PROXGEN_RT_SINCOS_RUN 0
+#define PROXGEN_RT_SINCOS_RUN_CALLED 1
 #else
 #define PROXGEN_RT_SINCOS_RUN 0
-#endif
+#define PROXGEN_RT_SINCOS_RUN_CALLED 0
 #endif
 
-#if PROXGEN_RT_SINCOS_RUN && defined(__AVX512F__)
-#define PROXGEN_RT_SINCOS_RUN_NS sincos_lanes8
-#define PROXGEN_RT_SINCOS_RUN_WIDTH 8
-#elif PROXGEN_RT_SINCOS_RUN
-#define PROXGEN_RT_SINCOS_RUN_NS sincos_lanes4
-#define PROXGEN_RT_SINCOS_RUN_WIDTH 4
+// The lanes of the run before inlined joints (PROXGEN_RT_SINCOS_RUN_WIDTH)
+// and before called ones (..._CALLED_WIDTH); 1: the run is empty.
+#if !PROXGEN_RT_LANES_VECTOR
+#define PROXGEN_RT_SINCOS_RUN_LANES 1
+#elif defined(__AVX512F__)
+#define PROXGEN_RT_SINCOS_RUN_LANES 8
+#elif defined(__AVX__)
+#define PROXGEN_RT_SINCOS_RUN_LANES 4
+#elif defined(__SSE2__) || defined(__ARM_NEON)
+#define PROXGEN_RT_SINCOS_RUN_LANES 2
 #else
-#define PROXGEN_RT_SINCOS_RUN_NS sincos_per_joint
+#define PROXGEN_RT_SINCOS_RUN_LANES 1
+#endif
+#if PROXGEN_RT_SINCOS_RUN
+#define PROXGEN_RT_SINCOS_RUN_WIDTH PROXGEN_RT_SINCOS_RUN_LANES
+#else
 #define PROXGEN_RT_SINCOS_RUN_WIDTH 1
 #endif
+#if PROXGEN_RT_SINCOS_RUN_CALLED
+#define PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH PROXGEN_RT_SINCOS_RUN_LANES
+#else
+#define PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH 1
+#endif
+// sincos_run_<inline>_<called>: sincos_run_1_1 (every joint computes its
+// own), sincos_run_1_2 (the x86-64 baseline), sincos_run_4_4, sincos_run_8_8.
+#define PROXGEN_RT_SINCOS_RUN_NS_(a, b) sincos_run_##a##_##b
+#define PROXGEN_RT_SINCOS_RUN_NS_OF(a, b) PROXGEN_RT_SINCOS_RUN_NS_(a, b)
+#define PROXGEN_RT_SINCOS_RUN_NS PROXGEN_RT_SINCOS_RUN_NS_OF(PROXGEN_RT_SINCOS_RUN_WIDTH, PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH)
 
 inline namespace PROXGEN_RT_SINCOS_RUN_NS {
 
-/// Whether sincos_run computes Scalar S's sines and cosines (else sincos_joint does).
-template <class S>
+/// Whether the run computes Scalar S's sines and cosines before joints that
+/// inline sincos (JointsCall false: sincos_joint) or call it (true:
+/// sincos_joint_noinline); else each joint does.
+template <class S, bool JointsCall = false>
 constexpr bool sincos_in_run() noexcept {
-  return PROXGEN_RT_SINCOS_RUN_WIDTH > 1 && std::is_same<S, double>::value;
+  return (JointsCall ? PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH : PROXGEN_RT_SINCOS_RUN_WIDTH) > 1 &&
+         std::is_same<S, double>::value;
 }
 
 namespace sincos_run_detail {
-// The widest lane count of the run that N values fill: 8, 4 or 2 (1: none).
-template <int N>
+// The widest lane count of the run that N values fill: Lanes, halved while
+// it exceeds N (1: a single angle, the scalar kernel).
+template <int N, int Lanes>
 constexpr int width() noexcept {
-  int w = PROXGEN_RT_SINCOS_RUN_WIDTH;
+  int w = Lanes;
   while (w > N) w /= 2;
   return w;
 }
@@ -398,11 +437,11 @@ inline void window(const double* x, double* s, double* c) noexcept {
   cl.store(c);
 }
 
-#if PROXGEN_RT_SINCOS_RUN_WIDTH > 1
+#if PROXGEN_RT_SINCOS_RUN_LANES > 1
 // The run's kernel, called: one copy per N.
 template <int N>
 PROXGEN_RT_NOINLINE void run(const double* x, double* s, double* c) noexcept {
-  constexpr int W = width<N>();
+  constexpr int W = width<N, PROXGEN_RT_SINCOS_RUN_LANES>();
   if constexpr (W == 1) {
     sincos(x[0], s[0], c[0]);
   } else {
@@ -413,30 +452,32 @@ PROXGEN_RT_NOINLINE void run(const double* x, double* s, double* c) noexcept {
 #endif
 }  // namespace sincos_run_detail
 
-/// s[i] = sin x[i], c[i] = cos x[i] for i < N where sincos_in_run<S>(), in
-/// windows of W lanes (W = PROXGEN_RT_SINCOS_RUN_WIDTH, halved while it
-/// exceeds N), the last window ending at N (it may overlap the one before:
-/// the same values again, never a read past x[N - 1]); else nothing (inline:
-/// no call either).
-template <int N, class S>
+/// s[i] = sin x[i], c[i] = cos x[i] for i < N where sincos_in_run<S,
+/// JointsCall>(), in windows of W lanes (W = PROXGEN_RT_SINCOS_RUN_LANES,
+/// halved while it exceeds N), the last window ending at N (it may overlap the
+/// one before: the same values again, never a read past x[N - 1]); else
+/// nothing (inline: no call either). JointsCall: the joints after it call
+/// sincos_joint_noinline (true) or sincos_joint (false).
+template <int N, bool JointsCall = false, class S>
 inline void sincos_run(const S* x, S* s, S* c) noexcept {
-#if PROXGEN_RT_SINCOS_RUN_WIDTH > 1
-  if constexpr (sincos_in_run<S>()) sincos_run_detail::run<N>(x, s, c);
+#if PROXGEN_RT_SINCOS_RUN_LANES > 1
+  if constexpr (sincos_in_run<S, JointsCall>()) sincos_run_detail::run<N>(x, s, c);
 #endif
   static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
 }
 
-/// One joint's s = sin x, c = cos x, inline, unless sincos_run computed them.
+/// One joint's s = sin x, c = cos x, inline, unless sincos_run<N> computed them.
 template <class S>
 inline void sincos_joint(S x, S& s, S& c) noexcept {
   if constexpr (!sincos_in_run<S>()) sincos(x, s, c);
   static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
 }
 
-/// The same through a call of the runtime's kernel (sincos_noinline).
+/// The same through a call of the runtime's kernel (sincos_noinline), unless
+/// sincos_run<N, true> computed them.
 template <class S>
 inline void sincos_joint_noinline(S x, S& s, S& c) noexcept {
-  if constexpr (!sincos_in_run<S>()) sincos_noinline(x, s, c);
+  if constexpr (!sincos_in_run<S, true>()) sincos_noinline(x, s, c);
   static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
 }
 

@@ -30,6 +30,10 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint_noinline("), 0);
   EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint_noinline(q["), 17);
   EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint("), 0);
+  // Each form's run says which form its joints take (lanes.hpp: the x86-64
+  // baseline runs in two lanes before called joints only).
+  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_run<16>("), 1);
+  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_run<17, true>("), 1);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
   const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
   EXPECT_EQ(test::occurrences(lanes, "sincos_joint_noinline"), 0);
@@ -41,7 +45,7 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
 TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
   const std::string src = chainSource(18);
   EXPECT_EQ(test::occurrences(src, "proxgen_rt::sincos_run<"), 1);
-  const auto run = src.find("proxgen_rt::sincos_run<17>(&q[0], &w.sq[0], &w.cq[0]);");
+  const auto run = src.find("proxgen_rt::sincos_run<17, true>(&q[0], &w.sq[0], &w.cq[0]);");
   ASSERT_NE(run, std::string::npos);
   const auto host = src.rfind("void kinematics(");  // the host, after its parts
   EXPECT_GT(run, host);

@@ -6,5 +6,6 @@
 #endif
 #include "sincos_run_checks.inc"
 #if defined(__AVX2__)
-static_assert(PROXGEN_RT_SINCOS_RUN == 1 && PROXGEN_RT_SINCOS_RUN_WIDTH == 4, "AVX2: the run in 4 lanes");
+static_assert(PROXGEN_RT_SINCOS_RUN == 1 && PROXGEN_RT_SINCOS_RUN_WIDTH == 4 &&
+                  PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH == 4, "AVX2: the run in 4 lanes");
 #endif

@@ -6,5 +6,6 @@
 #endif
 #include "sincos_run_checks.inc"
 #if defined(__AVX512F__)
-static_assert(PROXGEN_RT_SINCOS_RUN == 1 && PROXGEN_RT_SINCOS_RUN_WIDTH == 8, "AVX-512: the run in 8 lanes");
+static_assert(PROXGEN_RT_SINCOS_RUN == 1 && PROXGEN_RT_SINCOS_RUN_WIDTH == 8 &&
+                  PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH == 8, "AVX-512: the run in 8 lanes");
 #endif
