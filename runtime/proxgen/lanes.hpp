@@ -299,9 +299,19 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
   const typename L::mask inside = fabs(x) <= L(1e5);  // false for NaN and infinities
   const L xr = select(inside, x, L(0.0));  // no lane converts an out-of-range value to an integer
   // The scalar kernel, operation for operation (runtime.hpp: int(...) truncates, as the conversion here).
-  const IV k = __builtin_convertvector((xr * L(6.36619772367581382433e-01) + copysign(L(0.5), xr)).x, IV);
+  const L kx = xr * L(6.36619772367581382433e-01) + copysign(L(0.5), xr);
   L fk;
+#if defined(__AVX512F__)
+  const IV k = __builtin_convertvector(kx.x, IV);  // vcvttpd2qq
   fk.x = __builtin_convertvector(k, typename L::vec);
+#else
+  // k in 32-bit lanes (|k| < 2^17): SSE2 and AVX convert doubles to them in one
+  // instruction (cvttpd2dq, and back cvtdq2pd), to 64-bit lanes one by one.
+  typedef int K32 __attribute__((vector_size(4 * W)));
+  const K32 k32 = __builtin_convertvector(kx.x, K32);
+  fk.x = __builtin_convertvector(k32, typename L::vec);
+  const IV k = __builtin_convertvector(k32, IV);
+#endif
   const L r = ((xr - fk * L(1.57079632673412561417e+00)) - fk * L(6.07710050630396597660e-11)) -
               fk * L(2.02226624871116645580e-21);
   const L z = r * r;
@@ -319,7 +329,10 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
   const L hz = L(0.5) * z, w = L(1.0) - hz;
   const L cr = w + (((L(1.0) - w) - hz) + z * pc);
   // Quadrant k mod 4, as the scalar table look-ups: sin = sr, cr, -sr, -cr; cos = cr, -sr, -cr, sr.
-  const IV k1 = k + 1, zero = IV{};
+  const IV k1 = k + 1;
+#if defined(__AVX512F__)
+  // Comparisons into mask registers and blends.
+  const IV zero = IV{};
   typename L::mask odd, neg, odd1, neg1;
   odd.m = (k & 1) != zero;
   neg.m = (k & 2) != zero;
@@ -327,6 +340,19 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
   neg1.m = (k1 & 2) != zero;
   s = select(odd, cr, sr) * select(neg, L(-1.0), L(1.0));
   c = select(odd1, cr, sr) * select(neg1, L(-1.0), L(1.0));
+#else
+  // In bit operations, without a comparison (SSE2 has no 64-bit one, and GCC
+  // picked lane by lane through general registers: 60 of the 140 instructions
+  // of a window of two): `odd` all ones where k is odd (0 - (k & 1)), and the
+  // sign bit flipped where k & 2 is set, the same bits as the multiplication
+  // by -1 (the values are finite; -1 * 0 is -0 either way).
+  using V = typename L::vec;
+  const IV sign = (IV)(-L(0.0)).x;  // the sign bit alone
+  const IV odd = -(k & 1), odd1 = -(k1 & 1);
+  const IV flip = -(k & 2) & sign, flip1 = -(k1 & 2) & sign;  // -2 has the sign bit set
+  s.x = (V)((((IV)cr.x & odd) | ((IV)sr.x & ~odd)) ^ flip);
+  c.x = (V)((((IV)cr.x & odd1) | ((IV)sr.x & ~odd1)) ^ flip1);
+#endif
   if (any(!inside)) {
     for (int l = 0; l < W; ++l) {
       if (inside[l]) continue;
