@@ -82,7 +82,7 @@ using MultiplierRows = const Scalar*;
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
 PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
   v_m2[2] = v_m3[3] + v[0];
@@ -109,7 +109,7 @@ PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
 PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = 0.9950041652780258*v_m2[0] + 0.09983341664682815*v_m3[1];
   const Scalar x1 = -0.09983341664682815*v_m2[0] + 0.9950041652780258*v_m3[1];
   const Scalar x2 = 0.9950041652780258*v_m3[2] + 0.09983341664682815*v_m3[4];
@@ -142,7 +142,7 @@ PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
 PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] - 0.42875*v_m2[4];
   const Scalar x1 = v_m3[0] + 0.42875*v_m2[3];
   const Scalar x2 = -0.19866933079506124*v_m2[2] + 0.9800665778412416*x0;
@@ -178,7 +178,7 @@ PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
 PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] - 0.4305*v_m2[4];
   const Scalar x1 = v_m2[1] + 0.4305*v_m2[3];
   const Scalar x2 = 0.09983341664682815*v_m2[2] + 0.9950041652780258*x0;
@@ -207,7 +207,7 @@ PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
 PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
   v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
   v_m2[2] = v_m3[3] + v[0];
@@ -238,7 +238,7 @@ PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Sca
 constexpr Scalar shared_5_k0[16] = {-0.2555, 0.2555, 0.1, 0.001, 0.1, -0.001, -0.001, 3.5000000000000004e-05, 0.001, 3.5000000000000004e-05, 0.1, -0.1, 2.5e-05, 0.1, -2.5e-05, -0.1};
 constexpr Scalar shared_5_k1[16] = {0.29, -0.29, 0.5, 0.015, 0.5, -0.015, -0.015, 0.0007700000000000001, 0.015, 0.0007700000000000001, 0.5, -0.5, 0.00032, 0.5, -0.00032, -0.5};
 PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5) noexcept {
-  proxgen_rt::sincos_joint_noinline(q[0], sq_m0[0], cq_m1[0]);
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
   const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
   v_m3[0] = cq_m1[0]*x0 + sq_m0[0]*x1;
@@ -2224,7 +2224,7 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
   }
   // body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_joint_noinline(q[7], w.sq[0], w.cq[0]);
+    proxgen_rt::sincos_joint_called(q[7], w.sq[0], w.cq[0]);
     const Scalar t1 = v[0] - 0.0875*v[5];
     const Scalar t2 = v[2] + 0.0875*v[3];
     const Scalar t3 = 0.08718915247898762*v[1] + 0.9961917745544759*t1;
@@ -2277,7 +2277,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXG
   shared_4(&q[12], &v[11], &w.sq[5], &w.cq[5], &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_joint_noinline(q[13], w.sq[6], w.cq[6]);
+    proxgen_rt::sincos_joint_called(q[13], w.sq[6], w.cq[6]);
     const Scalar t0 = v[0] + 0.0875*v[5];
     const Scalar t1 = v[2] - 0.0875*v[3];
     const Scalar t2 = -0.08718915247898762*v[1] + 0.9961917745544759*t0;
@@ -2330,7 +2330,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
   shared_4(&q[18], &v[17], &w.sq[11], &w.cq[11], &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    proxgen_rt::sincos_joint_noinline(q[19], w.sq[12], w.cq[12]);
+    proxgen_rt::sincos_joint_called(q[19], w.sq[12], w.cq[12]);
     const Scalar t0 = v[0] + 0.1*v[4];
     const Scalar t1 = v[1] - 0.1*v[3];
     w.v_abdomen[0] = w.cq[12]*t0 + w.sq[12]*t1;
@@ -2360,7 +2360,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    proxgen_rt::sincos_joint_noinline(q[20], w.sq[13], w.cq[13]);
+    proxgen_rt::sincos_joint_called(q[20], w.sq[13], w.cq[13]);
     const Scalar t0 = w.v_abdomen[0] + 0.15*w.v_abdomen[4];
     const Scalar t1 = w.v_abdomen[1] - 0.15*w.v_abdomen[3];
     w.v_chest[0] = w.cq[13]*t0 - v[2]*w.sq[13];
@@ -2388,7 +2388,7 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
   }
   // body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[21], w.sq[14], w.cq[14]);
+    proxgen_rt::sincos_joint_called(q[21], w.sq[14], w.cq[14]);
     const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
     const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
@@ -2424,7 +2424,7 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
 PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[22], w.sq[15], w.cq[15]);
+    proxgen_rt::sincos_joint_called(q[22], w.sq[15], w.cq[15]);
     w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq[15] + w.v_l_shoulder_pitch_link[2]*w.sq[15];
     w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq[15] + w.v_l_shoulder_pitch_link[2]*w.cq[15];
     w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
@@ -2447,7 +2447,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
   }
   // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[23], w.sq[16], w.cq[16]);
+    proxgen_rt::sincos_joint_called(q[23], w.sq[16], w.cq[16]);
     w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq[16] + w.v_l_shoulder_roll_link[1]*w.sq[16];
     w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq[16] + w.v_l_shoulder_roll_link[1]*w.cq[16];
     w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq[16] + w.v_l_shoulder_roll_link[4]*w.sq[16];
@@ -2473,7 +2473,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Sc
 PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[24], w.sq[17], w.cq[17]);
+    proxgen_rt::sincos_joint_called(q[24], w.sq[17], w.cq[17]);
     const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
     const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -2508,7 +2508,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* 
 PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[26], w.sq[19], w.cq[19]);
+    proxgen_rt::sincos_joint_called(q[26], w.sq[19], w.cq[19]);
     w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq[19] - w.v_l_forearm[2]*w.sq[19];
     w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq[19] + w.v_l_forearm[2]*w.cq[19];
     w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq[19] - w.v_l_wrist_yaw_link[5]*w.sq[19];
@@ -2531,7 +2531,7 @@ PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* P
   }
   // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[27], w.sq[20], w.cq[20]);
+    proxgen_rt::sincos_joint_called(q[27], w.sq[20], w.cq[20]);
     w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq[20] + w.v_l_wrist_pitch_link[2]*w.sq[20];
     w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq[20] + w.v_l_wrist_pitch_link[2]*w.cq[20];
     w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
@@ -2559,7 +2559,7 @@ PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_R
   shared_5(shared_5_k1, &q[28], &v[27], &w.sq[21], &w.cq[21], w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
   // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    proxgen_rt::sincos_joint_noinline(q[29], w.sq[22], w.cq[22]);
+    proxgen_rt::sincos_joint_called(q[29], w.sq[22], w.cq[22]);
     const Scalar t2 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
     const Scalar t3 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
     w.v_head[0] = w.cq[22]*t2 - w.v_chest[2]*w.sq[22];
@@ -2588,7 +2588,7 @@ PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_R
 PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    proxgen_rt::sincos_joint_noinline(q[30], w.sq[23], w.cq[23]);
+    proxgen_rt::sincos_joint_called(q[30], w.sq[23], w.cq[23]);
     const Scalar t0 = w.v_chest[0] + 0.254*w.v_chest[4] + 0.19*w.v_chest[5];
     const Scalar t1 = w.v_chest[1] - 0.254*w.v_chest[3];
     const Scalar t2 = w.v_chest[2] - 0.19*w.v_chest[3];
@@ -2627,7 +2627,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
   }
   // body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    proxgen_rt::sincos_joint_noinline(q[31], w.sq[24], w.cq[24]);
+    proxgen_rt::sincos_joint_called(q[31], w.sq[24], w.cq[24]);
     w.v_r_shoulder_roll_link[1] = w.v_r_shoulder_pitch_link[1]*w.cq[24] + w.v_r_shoulder_pitch_link[2]*w.sq[24];
     w.v_r_shoulder_roll_link[2] = -w.v_r_shoulder_pitch_link[1]*w.sq[24] + w.v_r_shoulder_pitch_link[2]*w.cq[24];
     w.v_r_shoulder_roll_link[3] = w.v_r_shoulder_pitch_link[3] + v[30];
@@ -2655,7 +2655,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
 PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    proxgen_rt::sincos_joint_noinline(q[32], w.sq[25], w.cq[25]);
+    proxgen_rt::sincos_joint_called(q[32], w.sq[25], w.cq[25]);
     w.v_r_upper_arm[0] = w.v_r_shoulder_pitch_link[0]*w.cq[25] + w.v_r_shoulder_roll_link[1]*w.sq[25];
     w.v_r_upper_arm[1] = -w.v_r_shoulder_pitch_link[0]*w.sq[25] + w.v_r_shoulder_roll_link[1]*w.cq[25];
     w.v_r_upper_arm[3] = w.v_r_shoulder_roll_link[3]*w.cq[25] + w.v_r_shoulder_roll_link[4]*w.sq[25];
@@ -2680,7 +2680,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
   }
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    proxgen_rt::sincos_joint_noinline(q[33], w.sq[26], w.cq[26]);
+    proxgen_rt::sincos_joint_called(q[33], w.sq[26], w.cq[26]);
     const Scalar t0 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
     const Scalar t1 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
     const Scalar t2 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t0;
@@ -2717,7 +2717,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
 PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    proxgen_rt::sincos_joint_noinline(q[34], w.sq[27], w.cq[27]);
+    proxgen_rt::sincos_joint_called(q[34], w.sq[27], w.cq[27]);
     const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
     const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
     w.v_r_wrist_yaw_link[0] = w.cq[27]*t0 + w.sq[27]*t1;
@@ -2744,7 +2744,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
   }
   // body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    proxgen_rt::sincos_joint_noinline(q[35], w.sq[28], w.cq[28]);
+    proxgen_rt::sincos_joint_called(q[35], w.sq[28], w.cq[28]);
     w.v_r_wrist_pitch_link[0] = w.v_r_wrist_yaw_link[0]*w.cq[28] - w.v_r_forearm[2]*w.sq[28];
     w.v_r_wrist_pitch_link[2] = w.v_r_wrist_yaw_link[0]*w.sq[28] + w.v_r_forearm[2]*w.cq[28];
     w.v_r_wrist_pitch_link[3] = w.v_r_wrist_yaw_link[3]*w.cq[28] - w.v_r_wrist_yaw_link[5]*w.sq[28];
@@ -2772,7 +2772,7 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
 PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    proxgen_rt::sincos_joint_noinline(q[36], w.sq[29], w.cq[29]);
+    proxgen_rt::sincos_joint_called(q[36], w.sq[29], w.cq[29]);
     w.v_r_hand[1] = w.v_r_wrist_yaw_link[1]*w.cq[29] + w.v_r_wrist_pitch_link[2]*w.sq[29];
     w.v_r_hand[2] = -w.v_r_wrist_yaw_link[1]*w.sq[29] + w.v_r_wrist_pitch_link[2]*w.cq[29];
     w.v_r_hand[3] = w.v_r_wrist_pitch_link[3] + v[35];

@@ -70,7 +70,7 @@ std::string laneBody(const std::string& source, const std::string& name) {
   // 1.02-1.04 of the time with the call (its pair of vectors comes back
   // through memory), docs/batch.md.
   // (sincos_run does nothing for lanes: each joint's call computes its own.)
-  body = replaceAll(body, "proxgen_rt::sincos_joint_noinline(", "proxgen_rt::sincos_joint(");
+  body = replaceAll(body, "proxgen_rt::sincos_joint_called(", "proxgen_rt::sincos_joint(");
   if (body.find("std::") != std::string::npos)
     throw std::logic_error("batch: the scalar source calls a std:: function without a lane form");
   return body;

@@ -70,7 +70,7 @@ void sincosRuns(Emit& e, bool supportOnly) {
       written.push_back(cm);
       angles.push_back(cb.input(q(e.bp(all[j]).idx_q)));
     }
-    // `true`: the joints after it call sincos (sincos_joint_noinline), which the
+    // `true`: the joints after it call sincos (sincos_joint_called), which the
     // runtime replaces by the run in more targets (two lanes as well, lanes.hpp).
     cb.storeByCall(fmt::format("proxgen_rt::sincos_run<{}{}>(&{}, &{}, &{});", b - a,
                                sincosCalled(e.plan) ? ", true" : "", q(e.bp(all[a]).idx_q), written[0], written[1]),
@@ -161,7 +161,7 @@ void jointTransform(Emit& e, int i, Kinematics::Body& b) {
   const int slot = int(std::find(slots.begin(), slots.end(), i) - slots.begin());
   const auto [sm, cm] = sincosMembers(e, slot, int(slots.size()));
   const std::vector<Expr> sc = cb.storeByCall(
-      fmt::format("proxgen_rt::{}({}, {}, {});", sincosCalled(e.plan) ? "sincos_joint_noinline" : "sincos_joint",
+      fmt::format("proxgen_rt::{}({}, {}, {});", sincosCalled(e.plan) ? "sincos_joint_called" : "sincos_joint",
                   q(j.idx_q), sm, cm),
       {sm, cm}, {cb.input(q(j.idx_q))}, sincos());
   const Expr &s = sc[0], &c = sc[1];

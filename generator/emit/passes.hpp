@@ -22,7 +22,7 @@ namespace proxgen::emit {
 Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
-/// Whether jointTransform calls the runtime's sincos (sincos_joint_noinline) rather
+/// Whether jointTransform calls the runtime's sincos (sincos_joint_called) rather
 /// than inlining it: on a robot of more than 16 revolute joints. Measured with
 /// bench/ab_compare.sh (docs/benchmarks.md, "sincos called on the larger
 /// robots"): called, Talos' solvers take 0.95 of the time for 0.8 % more
@@ -36,7 +36,7 @@ bool sincosCalled(const Plan& plan);
 /// (w.sq and w.cq, slot j for the j-th revolute joint in q order). It computes
 /// them where the target has 4 or more double lanes, and with 2 (x86-64's SSE2)
 /// where the joints call sincos (sincosCalled: `sincos_run<N, true>`); elsewhere
-/// it is empty and each joint's sincos_joint(_noinline) computes its own
+/// it is empty and each joint's sincos_joint(_called) computes its own
 /// (lanes.hpp). Every pass that calls jointTransform calls this first
 /// (jointTransformsFirst does).
 void sincosRuns(Emit& e, bool supportOnly = false);

@@ -367,7 +367,7 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 //
 // A scalar solver computes each revolute joint's sine and cosine where its
 // body's step needs them: inline (sincos_joint, robots of 16 revolute joints
-// or fewer) or through a call of the runtime's kernel (sincos_joint_noinline,
+// or fewer) or through a call of the runtime's kernel (sincos_joint_called,
 // larger robots). Where the target's vector registers pay, one call before
 // the kinematics computes a run of consecutive joint angles in the lanes
 // instead (sincos_run<N> before inline joints, sincos_run<N, true> before
@@ -439,7 +439,7 @@ inline namespace PROXGEN_RT_SINCOS_RUN_NS {
 
 /// Whether the run computes Scalar S's sines and cosines before joints that
 /// inline sincos (JointsCall false: sincos_joint) or call it (true:
-/// sincos_joint_noinline); else each joint does.
+/// sincos_joint_called); else each joint does.
 template <class S, bool JointsCall = false>
 constexpr bool sincos_in_run() noexcept {
   return (JointsCall ? PROXGEN_RT_SINCOS_RUN_CALLED_WIDTH : PROXGEN_RT_SINCOS_RUN_WIDTH) > 1 &&
@@ -483,7 +483,7 @@ PROXGEN_RT_NOINLINE void run(const double* x, double* s, double* c) noexcept {
 /// halved while it exceeds N), the last window ending at N (it may overlap the
 /// one before: the same values again, never a read past x[N - 1]); else
 /// nothing (inline: no call either). JointsCall: the joints after it call
-/// sincos_joint_noinline (true) or sincos_joint (false).
+/// sincos_joint_called (true) or sincos_joint (false).
 template <int N, bool JointsCall = false, class S>
 inline void sincos_run(const S* x, S* s, S* c) noexcept {
 #if PROXGEN_RT_SINCOS_RUN_LANES > 1
@@ -500,9 +500,12 @@ inline void sincos_joint(S x, S& s, S& c) noexcept {
 }
 
 /// The same through a call of the runtime's kernel (sincos_noinline), unless
-/// sincos_run<N, true> computed them.
+/// sincos_run<N, true> computed them. (Named for its run since the called form
+/// got a run of its own: the name it had before, sincos_joint_noinline, paired
+/// with sincos_run<N>, so a source printed before fails to compile here
+/// instead of finding both calls empty at the x86-64 baseline.)
 template <class S>
-inline void sincos_joint_noinline(S x, S& s, S& c) noexcept {
+inline void sincos_joint_called(S x, S& s, S& c) noexcept {
   if constexpr (!sincos_in_run<S, true>()) sincos_noinline(x, s, c);
   static_cast<void>(x), static_cast<void>(s), static_cast<void>(c);
 }

@@ -27,8 +27,8 @@ std::string chainSource(int links, const std::string& functions = "") {
 TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   const std::string sixteen = chainSource(17), seventeen = chainSource(18);
   EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint(q["), 16);
-  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint_noinline("), 0);
-  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint_noinline(q["), 17);
+  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint_called("), 0);
+  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint_called(q["), 17);
   EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint("), 0);
   // Each form's run says which form its joints take (lanes.hpp: the x86-64
   // baseline runs in two lanes before called joints only).
@@ -36,7 +36,7 @@ TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
   EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_run<17, true>("), 1);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
   const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
-  EXPECT_EQ(test::occurrences(lanes, "sincos_joint_noinline"), 0);
+  EXPECT_EQ(test::occurrences(lanes, "sincos_joint_called"), 0);
   EXPECT_EQ(test::occurrences(lanes, "proxgen_rt::sincos_joint(q["), 17);
 }
 
@@ -51,7 +51,7 @@ TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
   EXPECT_GT(run, host);
   EXPECT_LT(run, src.find("kinematics_", host));  // before its first part's call
   for (int j = 0; j < 17; ++j)
-    EXPECT_EQ(test::occurrences(src, "proxgen_rt::sincos_joint_noinline(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
+    EXPECT_EQ(test::occurrences(src, "proxgen_rt::sincos_joint_called(q[" + std::to_string(j) + "], w.sq[" + std::to_string(j) +
                              "], w.cq[" + std::to_string(j) + "]);"),
               1)
         << "joint " << j;

@@ -140,7 +140,7 @@ Poly countLine(Source& src, const std::string& line) {
       ++p.once[2];
     } else if (t[k].kind == Token::Ident && k + 1 < t.size() && t[k + 1].text == "(") {
       if (x == "std::sqrt") ++p.once[4];
-      else if (x == "proxgen_rt::sincos_joint" || x == "proxgen_rt::sincos_joint_noinline") ++p.once[5];
+      else if (x == "proxgen_rt::sincos_joint" || x == "proxgen_rt::sincos_joint_called") ++p.once[5];
       else if (x == "proxgen_rt::log6") ++p.once[6];
       else if (x == "proxgen_rt::largest_magnitude") continue;  // compares and selects: no counted arithmetic
       else if (src.bodies.count(x)) addTo(p, count(src, x));
