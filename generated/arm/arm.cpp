@@ -27,43 +27,18 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-PROXGEN_RT_NOINLINE void kinematics_transforms_shoulder_link_to_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
   {
-    proxgen_rt::sincos_joint(q[0], w.sq[0], w.cq[0]);
-  }
-  // body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
-  {
-    proxgen_rt::sincos_joint(q[1], w.sq[1], w.cq[1]);
-  }
-  // body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
-  {
-    proxgen_rt::sincos_joint(q[2], w.sq[2], w.cq[2]);
-  }
-  // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
-  {
-    proxgen_rt::sincos_joint(q[3], w.sq[3], w.cq[3]);
-  }
-  // body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
-  {
-    proxgen_rt::sincos_joint(q[4], w.sq[4], w.cq[4]);
-  }
-  // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
-  {
-    proxgen_rt::sincos_joint(q[5], w.sq[5], w.cq[5]);
-  }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 1 'shoulder_link': joint 'shoulder_pan_joint' (revolute about z), parent the world
-  {
+    proxgen_rt::sincos_joint_called(q[0], w.sq[0], w.cq[0]);
     w.pA_shoulder_link[1] = 0.0072587300000000006*v[0]*v[0];
     w.pA_shoulder_link[3] = -0.0009936475497000002*v[0]*v[0];
   }
   // body 2 'upper_arm_link': joint 'shoulder_lift_joint' (revolute about z), parent 'shoulder_link'
   {
-    w.v_upper_arm_link[3] = w.sq[1]*v[0];
-    w.v_upper_arm_link[4] = w.cq[1]*v[0];
+    proxgen_rt::sincos_joint_called(q[1], w.sq[1], w.cq[1]);
+    w.v_upper_arm_link[3] = v[0]*w.sq[1];
+    w.v_upper_arm_link[4] = v[0]*w.cq[1];
     w.c_upper_arm_link[3] = v[1]*w.v_upper_arm_link[4];
     w.c_upper_arm_link[4] = -v[1]*w.v_upper_arm_link[3];
     const Scalar h0 = -1.7123249999999999*v[1] - 0.91345488*w.v_upper_arm_link[3];
@@ -80,11 +55,12 @@ PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* 
   }
   // body 3 'forearm_link': joint 'elbow_joint' (revolute about z), parent 'upper_arm_link'
   {
-    w.v_forearm_link[0] = -0.425*w.sq[2]*v[1];
-    w.v_forearm_link[1] = -0.425*w.cq[2]*v[1];
+    proxgen_rt::sincos_joint_called(q[2], w.sq[2], w.cq[2]);
+    w.v_forearm_link[0] = -0.425*v[1]*w.sq[2];
+    w.v_forearm_link[1] = -0.425*v[1]*w.cq[2];
     w.v_forearm_link[2] = 0.425*w.v_upper_arm_link[4];
-    w.v_forearm_link[3] = w.cq[2]*w.v_upper_arm_link[3] + w.sq[2]*w.v_upper_arm_link[4];
-    w.v_forearm_link[4] = -w.sq[2]*w.v_upper_arm_link[3] + w.cq[2]*w.v_upper_arm_link[4];
+    w.v_forearm_link[3] = w.v_upper_arm_link[3]*w.cq[2] + w.v_upper_arm_link[4]*w.sq[2];
+    w.v_forearm_link[4] = -w.v_upper_arm_link[3]*w.sq[2] + w.v_upper_arm_link[4]*w.cq[2];
     w.v_forearm_link[5] = v[1] + v[2];
     w.c_forearm_link[0] = v[2]*w.v_forearm_link[1];
     w.c_forearm_link[1] = -v[2]*w.v_forearm_link[0];
@@ -102,14 +78,15 @@ PROXGEN_RT_NOINLINE void kinematics_shoulder_link_to_forearm_link(const Scalar* 
     w.pA_forearm_link[3] = w.v_forearm_link[4]*h8 - w.v_forearm_link[5]*h7 + w.v_forearm_link[1]*h5 - w.v_forearm_link[2]*h4;
     w.pA_forearm_link[4] = w.v_forearm_link[5]*h6 - w.v_forearm_link[3]*h8 + w.v_forearm_link[2]*h3 - w.v_forearm_link[0]*h5;
     w.pA_forearm_link[5] = w.v_forearm_link[3]*h7 - w.v_forearm_link[4]*h6 + w.v_forearm_link[0]*h4 - w.v_forearm_link[1]*h3;
-    w.g_forearm_link[0] = w.cq[2]*w.g_upper_arm_link[0] + w.sq[2]*w.g_upper_arm_link[1];
-    w.g_forearm_link[1] = -w.sq[2]*w.g_upper_arm_link[0] + w.cq[2]*w.g_upper_arm_link[1];
+    w.g_forearm_link[0] = w.g_upper_arm_link[0]*w.cq[2] + w.g_upper_arm_link[1]*w.sq[2];
+    w.g_forearm_link[1] = -w.g_upper_arm_link[0]*w.sq[2] + w.g_upper_arm_link[1]*w.cq[2];
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 4 'wrist_1_link': joint 'wrist_1_joint' (revolute about z), parent 'forearm_link'
   {
+    proxgen_rt::sincos_joint_called(q[3], w.sq[3], w.cq[3]);
     const Scalar t0 = w.v_forearm_link[1] - 0.3922*w.v_forearm_link[5];
     const Scalar t1 = w.v_forearm_link[2] + 0.3922*w.v_forearm_link[4];
     w.v_wrist_1_link[0] = w.v_forearm_link[0]*w.cq[3] + w.sq[3]*t0;
@@ -139,13 +116,14 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* P
   }
   // body 5 'wrist_2_link': joint 'wrist_2_joint' (revolute about z), parent 'wrist_1_link'
   {
+    proxgen_rt::sincos_joint_called(q[4], w.sq[4], w.cq[4]);
     const Scalar t2 = w.v_wrist_1_link[0] + 0.1333*w.v_wrist_1_link[4];
     const Scalar t3 = -w.v_wrist_1_link[1] + 0.1333*w.v_wrist_1_link[3];
-    w.v_wrist_2_link[0] = w.cq[4]*t2 + w.sq[4]*w.v_wrist_1_link[2];
-    w.v_wrist_2_link[1] = -w.sq[4]*t2 + w.cq[4]*w.v_wrist_1_link[2];
+    w.v_wrist_2_link[0] = w.cq[4]*t2 + w.v_wrist_1_link[2]*w.sq[4];
+    w.v_wrist_2_link[1] = -w.sq[4]*t2 + w.v_wrist_1_link[2]*w.cq[4];
     w.v_wrist_2_link[2] = t3;
-    w.v_wrist_2_link[3] = w.cq[4]*w.v_wrist_1_link[3] + w.sq[4]*w.v_wrist_1_link[5];
-    w.v_wrist_2_link[4] = -w.sq[4]*w.v_wrist_1_link[3] + w.cq[4]*w.v_wrist_1_link[5];
+    w.v_wrist_2_link[3] = w.v_wrist_1_link[3]*w.cq[4] + w.v_wrist_1_link[5]*w.sq[4];
+    w.v_wrist_2_link[4] = -w.v_wrist_1_link[3]*w.sq[4] + w.v_wrist_1_link[5]*w.cq[4];
     w.v_wrist_2_link[5] = -w.v_wrist_1_link[4] + v[4];
     w.c_wrist_2_link[0] = v[4]*w.v_wrist_2_link[1];
     w.c_wrist_2_link[1] = -v[4]*w.v_wrist_2_link[0];
@@ -163,14 +141,15 @@ PROXGEN_RT_NOINLINE void kinematics_wrist_1_link_to_wrist_2_link(const Scalar* P
     w.pA_wrist_2_link[3] = w.v_wrist_2_link[4]*h11 - w.v_wrist_2_link[5]*h10 + w.v_wrist_2_link[1]*h8 - w.v_wrist_2_link[2]*h7;
     w.pA_wrist_2_link[4] = w.v_wrist_2_link[5]*h9 - w.v_wrist_2_link[3]*h11 + w.v_wrist_2_link[2]*h6 - w.v_wrist_2_link[0]*h8;
     w.pA_wrist_2_link[5] = w.v_wrist_2_link[3]*h10 - w.v_wrist_2_link[4]*h9 + w.v_wrist_2_link[0]*h7 - w.v_wrist_2_link[1]*h6;
-    w.g_wrist_2_link[0] = w.cq[4]*w.g_wrist_1_link[0];
-    w.g_wrist_2_link[1] = -w.sq[4]*w.g_wrist_1_link[0];
+    w.g_wrist_2_link[0] = w.g_wrist_1_link[0]*w.cq[4];
+    w.g_wrist_2_link[1] = -w.g_wrist_1_link[0]*w.sq[4];
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_wrist_3_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'wrist_3_link': joint 'wrist_3_joint' (revolute about z), parent 'wrist_2_link'
   {
+    proxgen_rt::sincos_joint_called(q[5], w.sq[5], w.cq[5]);
     const Scalar t0 = w.v_wrist_2_link[0] + 0.0997*w.v_wrist_2_link[4];
     const Scalar t1 = w.v_wrist_2_link[1] - 0.0997*w.v_wrist_2_link[3];
     w.v_wrist_3_link[0] = w.cq[5]*t0 - w.v_wrist_2_link[2]*w.sq[5];
@@ -1712,13 +1691,10 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  proxgen_rt::sincos_run<6>(&q[0], &w.sq[0], &w.cq[0]);
-  // ---- joint transforms X_J(q)
-  kinematics_transforms_shoulder_link_to_wrist_3_link(q, w);
-  // ---- velocities, bias forces, gravity, placements, constraint terms
-  kinematics_shoulder_link_to_forearm_link(v, w);
-  kinematics_wrist_1_link_to_wrist_2_link(v, w);
-  kinematics_wrist_3_link(v, w);
+  proxgen_rt::sincos_run<6, true>(&q[0], &w.sq[0], &w.cq[0]);
+  kinematics_shoulder_link_to_forearm_link(q, v, w);
+  kinematics_wrist_1_link_to_wrist_2_link(q, v, w);
+  kinematics_wrist_3_link(q, v, w);
 }
 
 }  // namespace

@@ -11,34 +11,30 @@
 //     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
-//   shared_1: 8 blocks of LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank
-//   shared_2: 2 blocks of LF_thigh, RF_thigh
-//   shared_3: 2 blocks of LF_shank, RF_shank
-//   shared_4: 2 blocks of LH_thigh, RH_thigh
-//   shared_5: 2 blocks of LH_shank, RH_shank
-//   shared_6: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_7: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_8: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_9: 2 blocks of trunk
-//   shared_10: 2 blocks of LF_hip
-//   shared_11: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_12: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_13: 6 blocks of LH_hip, RF_hip, RH_hip
-//   shared_14: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_15: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_16: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_17: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_18: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_19: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_20: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_5: 2 blocks of trunk
+//   shared_6: 2 blocks of LF_hip
+//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
 //   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
 //   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
 //   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_24: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_25: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_26: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_27: 3 blocks of LH_hip, RF_hip, RH_hip
 
 #include "quadruped.hpp"
 
@@ -57,171 +53,82 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
-// 4 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip, RF_hip, RH_hip.
-// The first: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_0_k0[11] = {0.9900990099009903, 0.009900990099009688, -0.09950371902099893, 0.09900990099009904, -0.09900990099009904, 0.09950371902099893, -0.9950371902099893, 0.09900990099009904, -0.09900990099009904, 0.9950371902099893, 0.009900990099009905};
-constexpr Scalar shared_0_k1[11] = {0.9900990099009901, 0.00990099009900991, 0.09950371902099892, -0.09900990099009901, 0.09900990099009901, -0.09950371902099892, -0.9950371902099892, -0.09900990099009901, 0.09900990099009901, 0.9950371902099892, 0.009900990099009901};
-PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col) noexcept {
-  proxgen_rt::sincos_joint(q[0], sq_m0[0], cq_m1[0]);
-  RJ_m2[0][RJ_m2_col + 0] = k[0] + k[1]*cq_m1[0];
-  RJ_m2[0][RJ_m2_col + 1] = k[2]*sq_m0[0];
-  RJ_m2[0][RJ_m2_col + 2] = k[3] + k[4]*cq_m1[0];
-  RJ_m2[1][RJ_m2_col + 0] = k[5]*sq_m0[0];
-  RJ_m2[1][RJ_m2_col + 2] = k[6]*sq_m0[0];
-  RJ_m2[2][RJ_m2_col + 0] = k[7] + k[8]*cq_m1[0];
-  RJ_m2[2][RJ_m2_col + 1] = k[9]*sq_m0[0];
-  RJ_m2[2][RJ_m2_col + 2] = k[10] + 0.9900990099009901*cq_m1[0];
-}
-
-// 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank.
+// 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1) noexcept {
-  proxgen_rt::sincos_joint(q[0], sq_m0[0], cq_m1[0]);
+constexpr Scalar shared_0_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
+constexpr Scalar shared_0_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
+PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = v_m2[0] + k[0]*v_m2[5];
+  const Scalar x1 = v_m2[2] + k[1]*v_m2[3];
+  v_m3[0] = cq_m1[0]*x0 - sq_m0[0]*x1;
+  v_m3[2] = sq_m0[0]*x0 + cq_m1[0]*x1;
+  v_m3[3] = v_m2[3]*cq_m1[0] - v_m2[5]*sq_m0[0];
+  v_m3[4] = v_m2[4] + v[0];
+  v_m3[5] = v_m2[3]*sq_m0[0] + v_m2[5]*cq_m1[0];
+  c_m4[0] = -v[0]*v_m3[2];
+  c_m4[2] = v[0]*v_m3[0];
+  c_m4[3] = -v[0]*v_m3[5];
+  c_m4[5] = v[0]*v_m3[3];
+  const Scalar x2 = 0.6890000000000001*v_m3[0] - 0.01268*v_m3[4] + k[2]*v_m3[5];
+  const Scalar x3 = 0.6890000000000001*v_m2[1] + 0.01268*v_m3[3];
+  const Scalar x4 = 0.6890000000000001*v_m3[2] + k[3]*v_m3[3];
+  const Scalar x5 = 0.01268*v_m2[1] + k[4]*v_m3[2] + 0.002431904*v_m3[3];
+  const Scalar x6 = -0.01268*v_m3[0] + 0.0024196*v_m3[4] + k[5]*v_m3[5];
+  const Scalar x7 = k[6]*v_m3[0] + k[7]*v_m3[4] + 0.0006033039999999999*v_m3[5];
+  pA_m5[0] = v_m3[4]*x4 - v_m3[5]*x3;
+  pA_m5[1] = v_m3[5]*x2 - v_m3[3]*x4;
+  pA_m5[2] = v_m3[3]*x3 - v_m3[4]*x2;
+  pA_m5[3] = v_m3[4]*x7 - v_m3[5]*x6 + v_m2[1]*x4 - v_m3[2]*x3;
+  pA_m5[4] = v_m3[5]*x5 - v_m3[3]*x7 + v_m3[2]*x2 - v_m3[0]*x4;
+  pA_m5[5] = v_m3[3]*x6 - v_m3[4]*x5 + v_m3[0]*x3 - v_m2[1]*x2;
+  g_m6[0] = g_m7[0]*cq_m1[0] - g_m7[2]*sq_m0[0];
+  g_m6[2] = g_m7[0]*sq_m0[0] + g_m7[2]*cq_m1[0];
 }
 
-// 2 blocks of the same code, each over its constants (k) and members: LF_thigh, RF_thigh.
-// The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_2_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
-constexpr Scalar shared_2_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
-PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
-  const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
-  v_m1[0] = cq_m2[0]*x0 - sq_m3[0]*x1;
-  v_m1[2] = sq_m3[0]*x0 + cq_m2[0]*x1;
-  v_m1[3] = cq_m2[0]*v_m0[3] - sq_m3[0]*v_m0[5];
-  v_m1[4] = v_m0[4] + v[0];
-  v_m1[5] = sq_m3[0]*v_m0[3] + cq_m2[0]*v_m0[5];
-  c_m4[0] = -v[0]*v_m1[2];
-  c_m4[2] = v[0]*v_m1[0];
-  c_m4[3] = -v[0]*v_m1[5];
-  c_m4[5] = v[0]*v_m1[3];
-  const Scalar x2 = 0.6890000000000001*v_m1[0] - 0.01268*v_m1[4] + k[2]*v_m1[5];
-  const Scalar x3 = 0.6890000000000001*v_m0[1] + 0.01268*v_m1[3];
-  const Scalar x4 = 0.6890000000000001*v_m1[2] + k[3]*v_m1[3];
-  const Scalar x5 = 0.01268*v_m0[1] + k[4]*v_m1[2] + 0.002431904*v_m1[3];
-  const Scalar x6 = -0.01268*v_m1[0] + 0.0024196*v_m1[4] + k[5]*v_m1[5];
-  const Scalar x7 = k[6]*v_m1[0] + k[7]*v_m1[4] + 0.0006033039999999999*v_m1[5];
-  pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
-  pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
-  pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
-  pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
-  pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
-  pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
-  g_m6[0] = cq_m2[0]*g_m7[0] - sq_m3[0]*g_m7[2];
-  g_m6[2] = sq_m3[0]*g_m7[0] + cq_m2[0]*g_m7[2];
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: LF_shank, RF_shank.
+// 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_3_k0[2] = {0.004, -0.004};
-constexpr Scalar shared_3_k1[2] = {-0.004, 0.004};
-PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
-  const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
-  const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
-  v_m2[0] = cq_m3[0]*x0 - v_m0[2]*sq_m4[0];
-  v_m2[1] = x1;
-  v_m2[2] = sq_m4[0]*x0 + v_m0[2]*cq_m3[0];
-  v_m2[3] = v_m0[3]*cq_m3[0] - v_m0[5]*sq_m4[0];
-  v_m2[4] = v_m0[4] + v[0];
-  v_m2[5] = v_m0[3]*sq_m4[0] + v_m0[5]*cq_m3[0];
-  c_m5[0] = -v[0]*v_m2[2];
-  c_m5[2] = v[0]*v_m2[0];
-  c_m5[3] = -v[0]*v_m2[5];
-  c_m5[5] = v[0]*v_m2[3];
-  const Scalar x2 = 0.064*v_m2[0] - 0.003904*v_m2[4];
-  const Scalar x3 = 0.064*v_m2[1] + 0.003904*v_m2[3];
-  const Scalar x4 = 0.003904*v_m2[1] + 0.000483144*v_m2[3];
-  const Scalar x5 = -0.003904*v_m2[0] + 0.000486144*v_m2[4];
-  pA_m6[0] = 0.064*v_m2[2]*v_m2[4] - v_m2[5]*x3;
-  pA_m6[1] = v_m2[5]*x2 - 0.064*v_m2[2]*v_m2[3];
-  pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
-  pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
-  pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
-  pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
-  g_m7[0] = g_m8[0]*cq_m3[0] - g_m8[2]*sq_m4[0];
-  g_m7[2] = g_m8[0]*sq_m4[0] + g_m8[2]*cq_m3[0];
-  const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
-  const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
-  const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
-  k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
-  k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
-  k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: LH_thigh, RH_thigh.
-// The first: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-constexpr Scalar shared_4_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
-constexpr Scalar shared_4_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
-PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  const Scalar x0 = v_m0[0] + k[0]*v_m0[5];
-  const Scalar x1 = v_m0[2] + k[1]*v_m0[3];
-  v_m1[0] = cq_m2[0]*x0 - sq_m3[0]*x1;
-  v_m1[2] = sq_m3[0]*x0 + cq_m2[0]*x1;
-  v_m1[3] = v_m0[3]*cq_m2[0] - v_m0[5]*sq_m3[0];
-  v_m1[4] = v_m0[4] + v[0];
-  v_m1[5] = v_m0[3]*sq_m3[0] + v_m0[5]*cq_m2[0];
-  c_m4[0] = -v[0]*v_m1[2];
-  c_m4[2] = v[0]*v_m1[0];
-  c_m4[3] = -v[0]*v_m1[5];
-  c_m4[5] = v[0]*v_m1[3];
-  const Scalar x2 = 0.6890000000000001*v_m1[0] - 0.01268*v_m1[4] + k[2]*v_m1[5];
-  const Scalar x3 = 0.6890000000000001*v_m0[1] + 0.01268*v_m1[3];
-  const Scalar x4 = 0.6890000000000001*v_m1[2] + k[3]*v_m1[3];
-  const Scalar x5 = 0.01268*v_m0[1] + k[4]*v_m1[2] + 0.002431904*v_m1[3];
-  const Scalar x6 = -0.01268*v_m1[0] + 0.0024196*v_m1[4] + k[5]*v_m1[5];
-  const Scalar x7 = k[6]*v_m1[0] + k[7]*v_m1[4] + 0.0006033039999999999*v_m1[5];
-  pA_m5[0] = v_m1[4]*x4 - v_m1[5]*x3;
-  pA_m5[1] = v_m1[5]*x2 - v_m1[3]*x4;
-  pA_m5[2] = v_m1[3]*x3 - v_m1[4]*x2;
-  pA_m5[3] = v_m1[4]*x7 - v_m1[5]*x6 + v_m0[1]*x4 - v_m1[2]*x3;
-  pA_m5[4] = v_m1[5]*x5 - v_m1[3]*x7 + v_m1[2]*x2 - v_m1[0]*x4;
-  pA_m5[5] = v_m1[3]*x6 - v_m1[4]*x5 + v_m1[0]*x3 - v_m0[1]*x2;
-  g_m6[0] = g_m7[0]*cq_m2[0] - g_m7[2]*sq_m3[0];
-  g_m6[2] = g_m7[0]*sq_m3[0] + g_m7[2]*cq_m2[0];
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: LH_shank, RH_shank.
-// The first: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-constexpr Scalar shared_5_k0[2] = {0.004, -0.004};
-constexpr Scalar shared_5_k1[2] = {-0.004, 0.004};
-PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT v_m0, Scalar* PROXGEN_RT_RESTRICT v_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
-  const Scalar x0 = v_m0[0] - 0.209*v_m0[4];
-  const Scalar x1 = v_m1[0] + 0.209*v_m0[3];
-  v_m2[0] = cq_m3[0]*x0 - sq_m4[0]*v_m0[2];
-  v_m2[1] = x1;
-  v_m2[2] = sq_m4[0]*x0 + cq_m3[0]*v_m0[2];
-  v_m2[3] = cq_m3[0]*v_m0[3] - sq_m4[0]*v_m0[5];
-  v_m2[4] = v_m0[4] + v[0];
-  v_m2[5] = sq_m4[0]*v_m0[3] + cq_m3[0]*v_m0[5];
-  c_m5[0] = -v[0]*v_m2[2];
-  c_m5[2] = v[0]*v_m2[0];
-  c_m5[3] = -v[0]*v_m2[5];
-  c_m5[5] = v[0]*v_m2[3];
-  const Scalar x2 = 0.064*v_m2[0] - 0.003904*v_m2[4];
-  const Scalar x3 = 0.064*v_m2[1] + 0.003904*v_m2[3];
-  const Scalar x4 = 0.003904*v_m2[1] + 0.000483144*v_m2[3];
-  const Scalar x5 = -0.003904*v_m2[0] + 0.000486144*v_m2[4];
-  pA_m6[0] = 0.064*v_m2[2]*v_m2[4] - v_m2[5]*x3;
-  pA_m6[1] = v_m2[5]*x2 - 0.064*v_m2[2]*v_m2[3];
-  pA_m6[2] = v_m2[3]*x3 - v_m2[4]*x2;
-  pA_m6[3] = 6e-06*v_m2[4]*v_m2[5] - v_m2[5]*x5 + 0.064*v_m2[1]*v_m2[2] - v_m2[2]*x3;
-  pA_m6[4] = v_m2[5]*x4 - 6e-06*v_m2[3]*v_m2[5] + v_m2[2]*x2 - 0.064*v_m2[0]*v_m2[2];
-  pA_m6[5] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x3 - v_m2[1]*x2;
-  g_m7[0] = cq_m3[0]*g_m8[0] - sq_m4[0]*g_m8[2];
-  g_m7[2] = sq_m4[0]*g_m8[0] + cq_m3[0]*g_m8[2];
-  const Scalar x6 = v_m2[2] + k[0]*v_m2[3];
-  const Scalar x7 = v_m2[1] + 0.195*v_m2[3];
-  const Scalar x8 = v_m2[0] - 0.195*v_m2[4] + k[1]*v_m2[5];
-  k_m9[0] = -g_m7[0] - v_m2[4]*x6 + v_m2[5]*x7;
-  k_m9[1] = -g_m10[0] - v_m2[5]*x8 + v_m2[3]*x6;
-  k_m9[2] = -g_m7[2] - v_m2[3]*x7 + v_m2[4]*x8;
+constexpr Scalar shared_1_k0[2] = {0.004, -0.004};
+constexpr Scalar shared_1_k1[2] = {-0.004, 0.004};
+PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
+  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
+  const Scalar x0 = v_m2[0] - 0.209*v_m2[4];
+  const Scalar x1 = v_m3[0] + 0.209*v_m2[3];
+  v_m4[0] = cq_m1[0]*x0 - v_m2[2]*sq_m0[0];
+  v_m4[1] = x1;
+  v_m4[2] = sq_m0[0]*x0 + v_m2[2]*cq_m1[0];
+  v_m4[3] = v_m2[3]*cq_m1[0] - v_m2[5]*sq_m0[0];
+  v_m4[4] = v_m2[4] + v[0];
+  v_m4[5] = v_m2[3]*sq_m0[0] + v_m2[5]*cq_m1[0];
+  c_m5[0] = -v[0]*v_m4[2];
+  c_m5[2] = v[0]*v_m4[0];
+  c_m5[3] = -v[0]*v_m4[5];
+  c_m5[5] = v[0]*v_m4[3];
+  const Scalar x2 = 0.064*v_m4[0] - 0.003904*v_m4[4];
+  const Scalar x3 = 0.064*v_m4[1] + 0.003904*v_m4[3];
+  const Scalar x4 = 0.003904*v_m4[1] + 0.000483144*v_m4[3];
+  const Scalar x5 = -0.003904*v_m4[0] + 0.000486144*v_m4[4];
+  pA_m6[0] = 0.064*v_m4[2]*v_m4[4] - v_m4[5]*x3;
+  pA_m6[1] = v_m4[5]*x2 - 0.064*v_m4[2]*v_m4[3];
+  pA_m6[2] = v_m4[3]*x3 - v_m4[4]*x2;
+  pA_m6[3] = 6e-06*v_m4[4]*v_m4[5] - v_m4[5]*x5 + 0.064*v_m4[1]*v_m4[2] - v_m4[2]*x3;
+  pA_m6[4] = v_m4[5]*x4 - 6e-06*v_m4[3]*v_m4[5] + v_m4[2]*x2 - 0.064*v_m4[0]*v_m4[2];
+  pA_m6[5] = v_m4[3]*x5 - v_m4[4]*x4 + v_m4[0]*x3 - v_m4[1]*x2;
+  g_m7[0] = g_m8[0]*cq_m1[0] - g_m8[2]*sq_m0[0];
+  g_m7[2] = g_m8[0]*sq_m0[0] + g_m8[2]*cq_m1[0];
+  const Scalar x6 = v_m4[2] + k[0]*v_m4[3];
+  const Scalar x7 = v_m4[1] + 0.195*v_m4[3];
+  const Scalar x8 = v_m4[0] - 0.195*v_m4[4] + k[1]*v_m4[5];
+  k_m9[0] = -g_m7[0] - v_m4[4]*x6 + v_m4[5]*x7;
+  k_m9[1] = -g_m10[0] - v_m4[5]*x8 + v_m4[3]*x6;
+  k_m9[2] = -g_m7[2] - v_m4[3]*x7 + v_m4[4]*x8;
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_6_k0[14] = {-0.004, -0.0007800000000000001, 0.004, -0.004, -0.004, -0.004, 0.004, -0.004, -0.002, 0.002, -0.002, -0.010144, 0.010144, 0.00020288};
-constexpr Scalar shared_6_k1[14] = {0.004, 0.0007800000000000001, -0.004, 0.004, 0.004, 0.004, -0.004, 0.004, 0.002, -0.002, 0.002, 0.010144, -0.010144, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar* PROXGEN_RT_RESTRICT cq_m8, Scalar* PROXGEN_RT_RESTRICT sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
+constexpr Scalar shared_2_k0[14] = {-0.004, -0.0007800000000000001, 0.004, -0.004, -0.004, -0.004, 0.004, -0.004, -0.002, 0.002, -0.002, -0.010144, 0.010144, 0.00020288};
+constexpr Scalar shared_2_k1[14] = {0.004, 0.0007800000000000001, -0.004, 0.004, 0.004, 0.004, -0.004, 0.004, 0.002, -0.002, 0.002, 0.010144, -0.010144, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar* PROXGEN_RT_RESTRICT cq_m8, Scalar* PROXGEN_RT_RESTRICT sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
   const Scalar x0 = mu*active_m0[0];
   const Scalar x1 = 0.195*k_m1[1] + k[0]*k_m1[2];
   U_m2[0] = -0.003904 - 0.195*x0;
@@ -284,9 +191,9 @@ PROXGEN_RT_NOINLINE void shared_6(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_7_k0[14] = {-0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062};
-constexpr Scalar shared_7_k1[14] = {0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
+constexpr Scalar shared_3_k0[14] = {-0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062};
+constexpr Scalar shared_3_k1[14] = {0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -360,10 +267,10 @@ PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
 // The first: eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_8_k0[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
-constexpr Scalar shared_8_k1[55] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
-constexpr Scalar shared_8_k2[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
+constexpr Scalar shared_4_k0[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19};
+constexpr Scalar shared_4_k1[55] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19};
+constexpr Scalar shared_4_k2[55] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
   U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
@@ -489,7 +396,7 @@ PROXGEN_RT_NOINLINE void shared_8(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: trunk.
 // The first: accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-PROXGEN_RT_NOINLINE void shared_9(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
+PROXGEN_RT_NOINLINE void shared_5(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PROXGEN_RT_RESTRICT RJ_m1)[3], int RJ_m1_col, Scalar* PROXGEN_RT_RESTRICT IA_m2, Scalar* PROXGEN_RT_RESTRICT Linv_m3, Scalar* PROXGEN_RT_RESTRICT L_m4, Scalar* PROXGEN_RT_RESTRICT qdd_m5, Scalar* PROXGEN_RT_RESTRICT a_m6) noexcept {
   const Scalar x0 = u_m0[0] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[0] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[2];
   const Scalar x1 = Linv_m3[0]*x0;
   const Scalar x2 = u_m0[1] - 9.81*RJ_m1[2][RJ_m1_col + 0]*IA_m2[1] - 9.81*RJ_m1[2][RJ_m1_col + 1]*IA_m2[6] - 9.81*RJ_m1[2][RJ_m1_col + 2]*IA_m2[7] - L_m4[0]*x1;
@@ -528,7 +435,7 @@ PROXGEN_RT_NOINLINE void shared_9(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: LF_hip.
 // The first: accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_6(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.049*a_m0[5];
   const Scalar x1 = a_m0[1] + 0.19*a_m0[5];
   const Scalar x2 = a_m0[2] + 0.049*a_m0[3] - 0.19*a_m0[4];
@@ -550,9 +457,9 @@ PROXGEN_RT_NOINLINE void shared_10(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_11_k0[2] = {-0.062, 0.062};
-constexpr Scalar shared_11_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+constexpr Scalar shared_7_k0[2] = {-0.062, 0.062};
+constexpr Scalar shared_7_k1[2] = {0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
@@ -571,7 +478,7 @@ PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_8(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
@@ -590,10 +497,10 @@ PROXGEN_RT_NOINLINE void shared_12(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 6 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
 // The first: accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_13_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_13_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_13_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+constexpr Scalar shared_9_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_9_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_9_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
@@ -615,7 +522,7 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 2 blocks of the same code, each over its constants (k) and members: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-PROXGEN_RT_NOINLINE void shared_14(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+PROXGEN_RT_NOINLINE void shared_10(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar* PROXGEN_RT_RESTRICT k_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
   const Scalar x0 = a_m0[0] - 0.195*a_m0[4] - 0.004*a_m0[5] - k_m1[0];
   residual_m2[0] = active_m3[0]*x0;
   dlambda_m4[0] = mu*residual_m2[0];
@@ -668,9 +575,9 @@ PROXGEN_RT_NOINLINE void shared_14(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_15_k0[2] = {-0.004, 0.004};
-constexpr Scalar shared_15_k1[2] = {0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+constexpr Scalar shared_11_k0[2] = {-0.004, 0.004};
+constexpr Scalar shared_11_k1[2] = {0.004, -0.004};
+PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] + 0.195*dlambda_m1[0];
   const Scalar x0 = 0.195*Dinv_m2*dlambda_m1[0];
   const Scalar x1 = dlambda_m1[0] + U_m3[0]*x0;
@@ -688,9 +595,9 @@ PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_16_k0[2] = {-0.062, 0.062};
-constexpr Scalar shared_16_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+constexpr Scalar shared_12_k0[2] = {-0.062, 0.062};
+constexpr Scalar shared_12_k1[2] = {0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   u_m0[0] = u_m0[0] - dp_m1[4];
   const Scalar x0 = -Dinv_m2*dp_m1[4];
   const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
@@ -708,10 +615,10 @@ PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
 // The first: reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_17_k0[7] = {-0.9950371902099893, -0.09950371902099893, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19};
-constexpr Scalar shared_17_k1[7] = {-0.9950371902099892, 0.09950371902099892, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19};
-constexpr Scalar shared_17_k2[7] = {-0.9950371902099893, -0.09950371902099893, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dp_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar (*PROXGEN_RT_RESTRICT RJ_m4)[3], int RJ_m4_col, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
+constexpr Scalar shared_13_k0[7] = {-0.9950371902099893, -0.09950371902099893, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19};
+constexpr Scalar shared_13_k1[7] = {-0.9950371902099892, 0.09950371902099892, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19};
+constexpr Scalar shared_13_k2[7] = {-0.9950371902099893, -0.09950371902099893, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT dp_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar (*PROXGEN_RT_RESTRICT RJ_m4)[3], int RJ_m4_col, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
   const Scalar x0 = k[0]*dp_m0[3] + k[1]*dp_m0[5];
   u_m1[0] = u_m1[0] + x0;
   const Scalar x1 = Dinv_m2*x0;
@@ -734,9 +641,9 @@ PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_18_k0[4] = {0.004, 0.004, -0.004, 0.004};
-constexpr Scalar shared_18_k1[4] = {-0.004, -0.004, 0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
+constexpr Scalar shared_14_k0[4] = {0.004, 0.004, -0.004, 0.004};
+constexpr Scalar shared_14_k1[4] = {-0.004, -0.004, 0.004, -0.004};
+PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
   u_m0[0] = -pA_m1[4] + tau[0];
   const Scalar x0 = 0.03264876250658241*c_m2[0] + pA_m1[0] - 8.030542390731965*u_m0[0];
   const Scalar x1 = 0.003904*c_m2[3] + pA_m1[1];
@@ -782,9 +689,9 @@ PROXGEN_RT_NOINLINE void shared_18(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_19_k0[32] = {-0.010144, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.00020288, -0.00010144, 0.005072, -0.00010144, -0.005072, 0.005072, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
-constexpr Scalar shared_19_k1[32] = {0.010144, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.00010144, -0.005072, 0.00010144, 0.005072, -0.005072, 0.00010144, 0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
+constexpr Scalar shared_15_k0[32] = {-0.010144, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.00020288, -0.00010144, 0.005072, -0.00010144, -0.005072, 0.005072, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
+constexpr Scalar shared_15_k1[32] = {0.010144, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.00010144, -0.005072, 0.00010144, 0.005072, -0.005072, 0.00010144, 0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
   Dinv_m0[0] = 1.0 / IA_m1[18];
   u_m2[0] = -pA_m3[4] + tau[0];
   const Scalar x0 = IA_m1[4]*Dinv_m0[0];
@@ -872,10 +779,10 @@ PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
 // The first: eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_20_k0[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
-constexpr Scalar shared_20_k1[82] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
-constexpr Scalar shared_20_k2[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
-PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
+constexpr Scalar shared_16_k0[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, -5.8e-05, 5.780668556524933e-05, -3.341612896039605e-09, -9.5e-07, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, 5.780668556524933e-05, -5.780668556524933e-05, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.049, -0.19, -0.049, 0.049, 0.19, -0.049, -0.19, -0.19, 0.049, 0.19, -0.19, 0.049, 0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19, 0.9950371902099893, 0.09950371902099893, 5.780668556524933e-05, -0.049, 5.780668556524933e-05, -0.19, 5.780668556524933e-05, 0.049, 0.19};
+constexpr Scalar shared_16_k1[82] = {0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, 0.9950371902099892, -0.09950371902099892, -0.9950371902099892, 0.09950371902099892, 5.8e-05, -5.7617628499109426e-05, -3.3197911138613866e-09, 9.5e-07, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, -5.7617628499109426e-05, 5.7617628499109426e-05, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.049, 0.049, 0.19, 0.049, -0.049, -0.19, 0.049, 0.19, 0.19, -0.049, -0.19, 0.19, -0.049, -0.19, -0.049, -0.19, 0.049, 0.19, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19, 0.9950371902099892, -0.09950371902099892, -5.7617628499109426e-05, 0.049, -5.7617628499109426e-05, 0.19, -5.7617628499109426e-05, -0.049, -0.19};
+constexpr Scalar shared_16_k2[82] = {0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, 0.9950371902099893, 0.09950371902099893, -0.9950371902099893, -0.09950371902099893, 5.8e-05, -5.780668556524933e-05, -3.341612896039605e-09, 9.5e-07, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, -5.780668556524933e-05, 5.780668556524933e-05, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.049, 0.049, -0.19, 0.049, -0.049, 0.19, 0.049, -0.19, -0.19, -0.049, 0.19, -0.19, -0.049, 0.19, -0.049, 0.19, 0.049, -0.19, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19, 0.9950371902099893, 0.09950371902099893, -5.780668556524933e-05, 0.049, -5.780668556524933e-05, -0.19, -5.780668556524933e-05, -0.049, 0.19};
+PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT U_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar (*PROXGEN_RT_RESTRICT RJ_m6)[3], int RJ_m6_col, Scalar* PROXGEN_RT_RESTRICT cq_m7, Scalar* PROXGEN_RT_RESTRICT IA_m8, Scalar* PROXGEN_RT_RESTRICT pA_m9, Scalar* PROXGEN_RT_RESTRICT KS_m10, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col, Scalar* PROXGEN_RT_RESTRICT KSD_m12, Scalar (*PROXGEN_RT_RESTRICT KA_m13)[13], int KA_m13_col) noexcept {
   U_m0[0] = k[0]*IA_m1[3] + k[1]*IA_m1[5];
   U_m0[1] = k[2]*IA_m1[8] + k[3]*IA_m1[10];
   U_m0[2] = k[4]*IA_m1[12] + k[5]*IA_m1[14];
@@ -1049,9 +956,9 @@ PROXGEN_RT_NOINLINE void shared_20(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_21_k0[3] = {-0.062, 0.062, 0.00020288};
-constexpr Scalar shared_21_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+constexpr Scalar shared_17_k0[3] = {-0.062, 0.062, 0.00020288};
+constexpr Scalar shared_17_k1[3] = {0.062, -0.062, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
@@ -1069,7 +976,7 @@ PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
+PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
@@ -1087,10 +994,10 @@ PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
 // The first: free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_23_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_23_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_23_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
+constexpr Scalar shared_19_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_19_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_19_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
@@ -1111,7 +1018,7 @@ PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 3 blocks of the same code, each over its constants (k) and members: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
 // The first: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-PROXGEN_RT_NOINLINE void shared_24(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
+PROXGEN_RT_NOINLINE void shared_20(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
   const Scalar x0 = 78.21756516587678 + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];
   const Scalar x1 = std::sqrt(x0);
   const Scalar x2 = 1.0 / x1;
@@ -1124,9 +1031,9 @@ PROXGEN_RT_NOINLINE void shared_24(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KS
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_25_k0[3] = {-0.062, 0.062, 0.00020288};
-constexpr Scalar shared_25_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+constexpr Scalar shared_21_k0[3] = {-0.062, 0.062, 0.00020288};
+constexpr Scalar shared_21_k1[3] = {0.062, -0.062, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
@@ -1145,7 +1052,7 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
+PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
   const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
@@ -1164,10 +1071,10 @@ PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
 // The first: accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_27_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_27_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_27_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_27(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
+constexpr Scalar shared_23_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+constexpr Scalar shared_23_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
+constexpr Scalar shared_23_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
   const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
   const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
@@ -1187,7 +1094,7 @@ PROXGEN_RT_NOINLINE void shared_27(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   a_m10[5] = x8 + k[6]*qdd_m8[0];
 }
 
-PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
@@ -1212,39 +1119,6 @@ PROXGEN_RT_NOINLINE void kinematics_transforms_trunk_to_LH_hip(const Scalar* PRO
     w.RJ_trunk[2][0] = 2.0*(qu0*qu2 - qu1*qu3);
     w.RJ_trunk[2][1] = 2.0*(qu1*qu2 + qu0*qu3);
     w.RJ_trunk[2][2] = 1.0 - 2.0*qu1*qu1 - 2.0*qu0*qu0;
-  }
-  // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k0, &q[7], w.sq, w.cq, w.RJ_LF_hip, 0);
-  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_1(&q[8], &w.sq[1], &w.cq[1]);
-  // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_1(&q[9], &w.sq[2], &w.cq[2]);
-  // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k1, &q[10], &w.sq[3], &w.cq[3], w.RJ_LH_hip, 0);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_transforms_LH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_1(&q[11], &w.sq[4], &w.cq[4]);
-  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_1(&q[12], &w.sq[5], &w.cq[5]);
-  // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k0, &q[13], &w.sq[6], &w.cq[6], w.RJ_RF_hip, 0);
-  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_1(&q[14], &w.sq[7], &w.cq[7]);
-  // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_1(&q[15], &w.sq[8], &w.cq[8]);
-  // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_0(shared_0_k1, &q[16], &w.sq[9], &w.cq[9], w.RJ_RH_hip, 0);
-  // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_1(&q[17], &w.sq[10], &w.cq[10]);
-  // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_1(&q[18], &w.sq[11], &w.cq[11]);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  {
     w.pA_trunk[0] = 3.5200000000000005*(v[2]*v[4] - v[1]*v[5]);
     w.pA_trunk[1] = 3.5200000000000005*(v[0]*v[5] - v[2]*v[3]);
     w.pA_trunk[2] = 3.5200000000000005*(v[1]*v[3] - v[0]*v[4]);
@@ -1257,15 +1131,24 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_R
   }
   // body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t0 = v[0] - 0.049*v[5];
-    const Scalar t1 = v[1] + 0.19*v[5];
-    const Scalar t2 = v[2] + 0.049*v[3] - 0.19*v[4];
-    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t0 + w.RJ_LF_hip[1][0]*t1 + w.RJ_LF_hip[2][0]*t2;
-    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t0 + w.cq[0]*t1 + w.RJ_LF_hip[2][1]*t2;
-    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t0 + w.RJ_LF_hip[1][2]*t1 + w.RJ_LF_hip[2][2]*t2;
-    w.v_LF_hip[3] = 0.9950371902099893*v[6] + w.RJ_LF_hip[0][0]*v[3] + w.RJ_LF_hip[1][0]*v[4] + w.RJ_LF_hip[2][0]*v[5];
-    w.v_LF_hip[4] = w.RJ_LF_hip[0][1]*v[3] + w.cq[0]*v[4] + w.RJ_LF_hip[2][1]*v[5];
-    w.v_LF_hip[5] = 0.09950371902099893*v[6] + w.RJ_LF_hip[0][2]*v[3] + w.RJ_LF_hip[1][2]*v[4] + w.RJ_LF_hip[2][2]*v[5];
+    proxgen_rt::sincos_joint_called(q[7], w.sq[0], w.cq[0]);
+    w.RJ_LF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq[0];
+    w.RJ_LF_hip[0][1] = -0.09950371902099893*w.sq[0];
+    w.RJ_LF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq[0];
+    w.RJ_LF_hip[1][0] = 0.09950371902099893*w.sq[0];
+    w.RJ_LF_hip[1][2] = -0.9950371902099893*w.sq[0];
+    w.RJ_LF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq[0];
+    w.RJ_LF_hip[2][1] = 0.9950371902099893*w.sq[0];
+    w.RJ_LF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq[0];
+    const Scalar t1 = v[0] - 0.049*v[5];
+    const Scalar t2 = v[1] + 0.19*v[5];
+    const Scalar t3 = v[2] + 0.049*v[3] - 0.19*v[4];
+    w.v_LF_hip[0] = w.RJ_LF_hip[0][0]*t1 + w.RJ_LF_hip[1][0]*t2 + w.RJ_LF_hip[2][0]*t3;
+    w.v_LF_hip[1] = w.RJ_LF_hip[0][1]*t1 + w.cq[0]*t2 + w.RJ_LF_hip[2][1]*t3;
+    w.v_LF_hip[2] = w.RJ_LF_hip[0][2]*t1 + w.RJ_LF_hip[1][2]*t2 + w.RJ_LF_hip[2][2]*t3;
+    w.v_LF_hip[3] = 0.9950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][0] + v[4]*w.RJ_LF_hip[1][0] + v[5]*w.RJ_LF_hip[2][0];
+    w.v_LF_hip[4] = v[3]*w.RJ_LF_hip[0][1] + v[4]*w.cq[0] + v[5]*w.RJ_LF_hip[2][1];
+    w.v_LF_hip[5] = 0.09950371902099893*v[6] + v[3]*w.RJ_LF_hip[0][2] + v[4]*w.RJ_LF_hip[1][2] + v[5]*w.RJ_LF_hip[2][2];
     w.c_LF_hip[0] = 0.09950371902099893*v[6]*w.v_LF_hip[1];
     w.c_LF_hip[1] = 0.9950371902099893*v[6]*w.v_LF_hip[2] - 0.09950371902099893*v[6]*w.v_LF_hip[0];
     w.c_LF_hip[2] = -0.9950371902099893*v[6]*w.v_LF_hip[1];
@@ -1283,25 +1166,37 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_thigh(const Scalar* PROXGEN_RT_R
     w.pA_LF_hip[3] = w.v_LF_hip[4]*h4 - w.v_LF_hip[5]*h3 + w.v_LF_hip[1]*h1 - 0.5950000000000001*w.v_LF_hip[1]*w.v_LF_hip[2];
     w.pA_LF_hip[4] = w.v_LF_hip[5]*h2 - w.v_LF_hip[3]*h4 + w.v_LF_hip[2]*h0 - w.v_LF_hip[0]*h1;
     w.pA_LF_hip[5] = w.v_LF_hip[3]*h3 - w.v_LF_hip[4]*h2 + 0.5950000000000001*w.v_LF_hip[0]*w.v_LF_hip[1] - w.v_LF_hip[1]*h0;
-    w.g_LF_hip[0] = w.RJ_LF_hip[0][0]*w.g_trunk[0] + w.RJ_LF_hip[1][0]*w.g_trunk[1] + w.RJ_LF_hip[2][0]*w.g_trunk[2];
-    w.g_LF_hip[1] = w.RJ_LF_hip[0][1]*w.g_trunk[0] + w.cq[0]*w.g_trunk[1] + w.RJ_LF_hip[2][1]*w.g_trunk[2];
-    w.g_LF_hip[2] = w.RJ_LF_hip[0][2]*w.g_trunk[0] + w.RJ_LF_hip[1][2]*w.g_trunk[1] + w.RJ_LF_hip[2][2]*w.g_trunk[2];
+    w.g_LF_hip[0] = w.g_trunk[0]*w.RJ_LF_hip[0][0] + w.g_trunk[1]*w.RJ_LF_hip[1][0] + w.g_trunk[2]*w.RJ_LF_hip[2][0];
+    w.g_LF_hip[1] = w.g_trunk[0]*w.RJ_LF_hip[0][1] + w.g_trunk[1]*w.cq[0] + w.g_trunk[2]*w.RJ_LF_hip[2][1];
+    w.g_LF_hip[2] = w.g_trunk[0]*w.RJ_LF_hip[0][2] + w.g_trunk[1]*w.RJ_LF_hip[1][2] + w.g_trunk[2]*w.RJ_LF_hip[2][2];
   }
-  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_2(shared_2_k0, &v[7], w.v_LF_hip, w.v_LF_thigh, &w.cq[1], &w.sq[1], w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  shared_0(shared_0_k0, &q[8], &v[7], &w.sq[1], &w.cq[1], w.v_LF_hip, w.v_LF_thigh, w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
   // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_3(shared_3_k0, &v[8], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, &w.cq[2], &w.sq[2], w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
+  shared_1(shared_1_k0, &q[9], &v[8], &w.sq[2], &w.cq[2], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t5 = v[0] - 0.049*v[5];
-    const Scalar t6 = v[1] - 0.19*v[5];
-    const Scalar t7 = v[2] + 0.049*v[3] + 0.19*v[4];
-    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t5 + w.RJ_LH_hip[1][0]*t6 + w.RJ_LH_hip[2][0]*t7;
-    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t5 + w.cq[3]*t6 + w.RJ_LH_hip[2][1]*t7;
-    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t5 + w.RJ_LH_hip[1][2]*t6 + w.RJ_LH_hip[2][2]*t7;
+    proxgen_rt::sincos_joint_called(q[10], w.sq[3], w.cq[3]);
+    w.RJ_LH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq[3];
+    w.RJ_LH_hip[0][1] = 0.09950371902099892*w.sq[3];
+    w.RJ_LH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq[3];
+    w.RJ_LH_hip[1][0] = -0.09950371902099892*w.sq[3];
+    w.RJ_LH_hip[1][2] = -0.9950371902099892*w.sq[3];
+    w.RJ_LH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq[3];
+    w.RJ_LH_hip[2][1] = 0.9950371902099892*w.sq[3];
+    w.RJ_LH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq[3];
+    const Scalar t0 = v[0] - 0.049*v[5];
+    const Scalar t1 = v[1] - 0.19*v[5];
+    const Scalar t2 = v[2] + 0.049*v[3] + 0.19*v[4];
+    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t0 + w.RJ_LH_hip[1][0]*t1 + w.RJ_LH_hip[2][0]*t2;
+    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t0 + w.cq[3]*t1 + w.RJ_LH_hip[2][1]*t2;
+    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t0 + w.RJ_LH_hip[1][2]*t1 + w.RJ_LH_hip[2][2]*t2;
     w.v_LH_hip[3] = 0.9950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][0] + v[4]*w.RJ_LH_hip[1][0] + v[5]*w.RJ_LH_hip[2][0];
     w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[0][1] + v[4]*w.cq[3] + v[5]*w.RJ_LH_hip[2][1];
     w.v_LH_hip[5] = -0.09950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][2] + v[4]*w.RJ_LH_hip[1][2] + v[5]*w.RJ_LH_hip[2][2];
@@ -1311,39 +1206,45 @@ PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_hip(const Scalar* PROXGEN_RT_
     w.c_LH_hip[3] = -0.09950371902099892*v[9]*w.v_LH_hip[4];
     w.c_LH_hip[4] = 0.9950371902099892*v[9]*w.v_LH_hip[5] + 0.09950371902099892*v[9]*w.v_LH_hip[3];
     w.c_LH_hip[5] = -0.9950371902099892*v[9]*w.v_LH_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
-    const Scalar h6 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
-    const Scalar h7 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
-    const Scalar h8 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
-    w.pA_LH_hip[0] = w.v_LH_hip[4]*h5 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
-    w.pA_LH_hip[1] = w.v_LH_hip[5]*h4 - w.v_LH_hip[3]*h5;
-    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h4;
-    w.pA_LH_hip[3] = w.v_LH_hip[4]*h8 - w.v_LH_hip[5]*h7 + w.v_LH_hip[1]*h5 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
-    w.pA_LH_hip[4] = w.v_LH_hip[5]*h6 - w.v_LH_hip[3]*h8 + w.v_LH_hip[2]*h4 - w.v_LH_hip[0]*h5;
-    w.pA_LH_hip[5] = w.v_LH_hip[3]*h7 - w.v_LH_hip[4]*h6 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h4;
+    const Scalar h0 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
+    const Scalar h2 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
+    const Scalar h3 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
+    const Scalar h4 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
+    w.pA_LH_hip[0] = w.v_LH_hip[4]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
+    w.pA_LH_hip[1] = w.v_LH_hip[5]*h0 - w.v_LH_hip[3]*h1;
+    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h0;
+    w.pA_LH_hip[3] = w.v_LH_hip[4]*h4 - w.v_LH_hip[5]*h3 + w.v_LH_hip[1]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
+    w.pA_LH_hip[4] = w.v_LH_hip[5]*h2 - w.v_LH_hip[3]*h4 + w.v_LH_hip[2]*h0 - w.v_LH_hip[0]*h1;
+    w.pA_LH_hip[5] = w.v_LH_hip[3]*h3 - w.v_LH_hip[4]*h2 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h0;
     w.g_LH_hip[0] = w.g_trunk[0]*w.RJ_LH_hip[0][0] + w.g_trunk[1]*w.RJ_LH_hip[1][0] + w.g_trunk[2]*w.RJ_LH_hip[2][0];
     w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[0][1] + w.g_trunk[1]*w.cq[3] + w.g_trunk[2]*w.RJ_LH_hip[2][1];
     w.g_LH_hip[2] = w.g_trunk[0]*w.RJ_LH_hip[0][2] + w.g_trunk[1]*w.RJ_LH_hip[1][2] + w.g_trunk[2]*w.RJ_LH_hip[2][2];
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LH_thigh_to_LH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_4(shared_4_k0, &v[10], w.v_LH_hip, w.v_LH_thigh, &w.cq[4], &w.sq[4], w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
-  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_5(shared_5_k0, &v[11], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, &w.cq[5], &w.sq[5], w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
+  shared_0(shared_0_k0, &q[11], &v[10], &w.sq[4], &w.cq[4], w.v_LH_hip, w.v_LH_thigh, w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_1(shared_1_k0, &q[12], &v[11], &w.sq[5], &w.cq[5], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t0 = v[0] + 0.049*v[5];
-    const Scalar t1 = v[1] + 0.19*v[5];
-    const Scalar t2 = v[2] - 0.049*v[3] - 0.19*v[4];
-    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t0 + w.RJ_RF_hip[1][0]*t1 + w.RJ_RF_hip[2][0]*t2;
-    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t0 + w.cq[6]*t1 + w.RJ_RF_hip[2][1]*t2;
-    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t0 + w.RJ_RF_hip[1][2]*t1 + w.RJ_RF_hip[2][2]*t2;
+    proxgen_rt::sincos_joint_called(q[13], w.sq[6], w.cq[6]);
+    w.RJ_RF_hip[0][0] = 0.9900990099009903 + 0.009900990099009688*w.cq[6];
+    w.RJ_RF_hip[0][1] = -0.09950371902099893*w.sq[6];
+    w.RJ_RF_hip[0][2] = 0.09900990099009904 - 0.09900990099009904*w.cq[6];
+    w.RJ_RF_hip[1][0] = 0.09950371902099893*w.sq[6];
+    w.RJ_RF_hip[1][2] = -0.9950371902099893*w.sq[6];
+    w.RJ_RF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq[6];
+    w.RJ_RF_hip[2][1] = 0.9950371902099893*w.sq[6];
+    w.RJ_RF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq[6];
+    const Scalar t5 = v[0] + 0.049*v[5];
+    const Scalar t6 = v[1] + 0.19*v[5];
+    const Scalar t7 = v[2] - 0.049*v[3] - 0.19*v[4];
+    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t5 + w.RJ_RF_hip[1][0]*t6 + w.RJ_RF_hip[2][0]*t7;
+    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t5 + w.cq[6]*t6 + w.RJ_RF_hip[2][1]*t7;
+    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t5 + w.RJ_RF_hip[1][2]*t6 + w.RJ_RF_hip[2][2]*t7;
     w.v_RF_hip[3] = 0.9950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][0] + v[4]*w.RJ_RF_hip[1][0] + v[5]*w.RJ_RF_hip[2][0];
     w.v_RF_hip[4] = v[3]*w.RJ_RF_hip[0][1] + v[4]*w.cq[6] + v[5]*w.RJ_RF_hip[2][1];
     w.v_RF_hip[5] = 0.09950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][2] + v[4]*w.RJ_RF_hip[1][2] + v[5]*w.RJ_RF_hip[2][2];
@@ -1353,36 +1254,48 @@ PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RF_thigh(const Scalar* PROXGEN_RT_
     w.c_RF_hip[3] = 0.09950371902099893*v[12]*w.v_RF_hip[4];
     w.c_RF_hip[4] = 0.9950371902099893*v[12]*w.v_RF_hip[5] - 0.09950371902099893*v[12]*w.v_RF_hip[3];
     w.c_RF_hip[5] = -0.9950371902099893*v[12]*w.v_RF_hip[4];
-    const Scalar h0 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
-    const Scalar h1 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
-    const Scalar h2 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
-    const Scalar h3 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
-    const Scalar h4 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
-    w.pA_RF_hip[0] = w.v_RF_hip[4]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
-    w.pA_RF_hip[1] = w.v_RF_hip[5]*h0 - w.v_RF_hip[3]*h1;
-    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h0;
-    w.pA_RF_hip[3] = w.v_RF_hip[4]*h4 - w.v_RF_hip[5]*h3 + w.v_RF_hip[1]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
-    w.pA_RF_hip[4] = w.v_RF_hip[5]*h2 - w.v_RF_hip[3]*h4 + w.v_RF_hip[2]*h0 - w.v_RF_hip[0]*h1;
-    w.pA_RF_hip[5] = w.v_RF_hip[3]*h3 - w.v_RF_hip[4]*h2 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h0;
+    const Scalar h4 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
+    const Scalar h5 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
+    const Scalar h6 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
+    const Scalar h7 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
+    const Scalar h8 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
+    w.pA_RF_hip[0] = w.v_RF_hip[4]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
+    w.pA_RF_hip[1] = w.v_RF_hip[5]*h4 - w.v_RF_hip[3]*h5;
+    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h4;
+    w.pA_RF_hip[3] = w.v_RF_hip[4]*h8 - w.v_RF_hip[5]*h7 + w.v_RF_hip[1]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
+    w.pA_RF_hip[4] = w.v_RF_hip[5]*h6 - w.v_RF_hip[3]*h8 + w.v_RF_hip[2]*h4 - w.v_RF_hip[0]*h5;
+    w.pA_RF_hip[5] = w.v_RF_hip[3]*h7 - w.v_RF_hip[4]*h6 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h4;
     w.g_RF_hip[0] = w.g_trunk[0]*w.RJ_RF_hip[0][0] + w.g_trunk[1]*w.RJ_RF_hip[1][0] + w.g_trunk[2]*w.RJ_RF_hip[2][0];
     w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[0][1] + w.g_trunk[1]*w.cq[6] + w.g_trunk[2]*w.RJ_RF_hip[2][1];
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[0][2] + w.g_trunk[1]*w.RJ_RF_hip[1][2] + w.g_trunk[2]*w.RJ_RF_hip[2][2];
   }
-  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_2(shared_2_k1, &v[13], w.v_RF_hip, w.v_RF_thigh, &w.cq[7], &w.sq[7], w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  shared_0(shared_0_k1, &q[14], &v[13], &w.sq[7], &w.cq[7], w.v_RF_hip, w.v_RF_thigh, w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
   // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_3(shared_3_k1, &v[14], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, &w.cq[8], &w.sq[8], w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
+  shared_1(shared_1_k1, &q[15], &v[14], &w.sq[8], &w.cq[8], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
-    const Scalar t5 = v[0] + 0.049*v[5];
-    const Scalar t6 = v[1] - 0.19*v[5];
-    const Scalar t7 = v[2] - 0.049*v[3] + 0.19*v[4];
-    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t5 + w.RJ_RH_hip[1][0]*t6 + w.RJ_RH_hip[2][0]*t7;
-    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t5 + w.cq[9]*t6 + w.RJ_RH_hip[2][1]*t7;
-    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t5 + w.RJ_RH_hip[1][2]*t6 + w.RJ_RH_hip[2][2]*t7;
+    proxgen_rt::sincos_joint_called(q[16], w.sq[9], w.cq[9]);
+    w.RJ_RH_hip[0][0] = 0.9900990099009901 + 0.00990099009900991*w.cq[9];
+    w.RJ_RH_hip[0][1] = 0.09950371902099892*w.sq[9];
+    w.RJ_RH_hip[0][2] = -0.09900990099009901 + 0.09900990099009901*w.cq[9];
+    w.RJ_RH_hip[1][0] = -0.09950371902099892*w.sq[9];
+    w.RJ_RH_hip[1][2] = -0.9950371902099892*w.sq[9];
+    w.RJ_RH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq[9];
+    w.RJ_RH_hip[2][1] = 0.9950371902099892*w.sq[9];
+    w.RJ_RH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq[9];
+    const Scalar t0 = v[0] + 0.049*v[5];
+    const Scalar t1 = v[1] - 0.19*v[5];
+    const Scalar t2 = v[2] - 0.049*v[3] + 0.19*v[4];
+    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t0 + w.RJ_RH_hip[1][0]*t1 + w.RJ_RH_hip[2][0]*t2;
+    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t0 + w.cq[9]*t1 + w.RJ_RH_hip[2][1]*t2;
+    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t0 + w.RJ_RH_hip[1][2]*t1 + w.RJ_RH_hip[2][2]*t2;
     w.v_RH_hip[3] = 0.9950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][0] + v[4]*w.RJ_RH_hip[1][0] + v[5]*w.RJ_RH_hip[2][0];
     w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[0][1] + v[4]*w.cq[9] + v[5]*w.RJ_RH_hip[2][1];
     w.v_RH_hip[5] = -0.09950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][2] + v[4]*w.RJ_RH_hip[1][2] + v[5]*w.RJ_RH_hip[2][2];
@@ -1392,38 +1305,38 @@ PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_hip(const Scalar* PROXGEN_RT_
     w.c_RH_hip[3] = -0.09950371902099892*v[15]*w.v_RH_hip[4];
     w.c_RH_hip[4] = 0.9950371902099892*v[15]*w.v_RH_hip[5] + 0.09950371902099892*v[15]*w.v_RH_hip[3];
     w.c_RH_hip[5] = -0.9950371902099892*v[15]*w.v_RH_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
-    const Scalar h6 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
-    const Scalar h7 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
-    const Scalar h8 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
-    w.pA_RH_hip[0] = w.v_RH_hip[4]*h5 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
-    w.pA_RH_hip[1] = w.v_RH_hip[5]*h4 - w.v_RH_hip[3]*h5;
-    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h4;
-    w.pA_RH_hip[3] = w.v_RH_hip[4]*h8 - w.v_RH_hip[5]*h7 + w.v_RH_hip[1]*h5 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
-    w.pA_RH_hip[4] = w.v_RH_hip[5]*h6 - w.v_RH_hip[3]*h8 + w.v_RH_hip[2]*h4 - w.v_RH_hip[0]*h5;
-    w.pA_RH_hip[5] = w.v_RH_hip[3]*h7 - w.v_RH_hip[4]*h6 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h4;
+    const Scalar h0 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
+    const Scalar h2 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
+    const Scalar h3 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
+    const Scalar h4 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
+    w.pA_RH_hip[0] = w.v_RH_hip[4]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
+    w.pA_RH_hip[1] = w.v_RH_hip[5]*h0 - w.v_RH_hip[3]*h1;
+    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h0;
+    w.pA_RH_hip[3] = w.v_RH_hip[4]*h4 - w.v_RH_hip[5]*h3 + w.v_RH_hip[1]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
+    w.pA_RH_hip[4] = w.v_RH_hip[5]*h2 - w.v_RH_hip[3]*h4 + w.v_RH_hip[2]*h0 - w.v_RH_hip[0]*h1;
+    w.pA_RH_hip[5] = w.v_RH_hip[3]*h3 - w.v_RH_hip[4]*h2 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h0;
     w.g_RH_hip[0] = w.g_trunk[0]*w.RJ_RH_hip[0][0] + w.g_trunk[1]*w.RJ_RH_hip[1][0] + w.g_trunk[2]*w.RJ_RH_hip[2][0];
     w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[0][1] + w.g_trunk[1]*w.cq[9] + w.g_trunk[2]*w.RJ_RH_hip[2][1];
     w.g_RH_hip[2] = w.g_trunk[0]*w.RJ_RH_hip[0][2] + w.g_trunk[1]*w.RJ_RH_hip[1][2] + w.g_trunk[2]*w.RJ_RH_hip[2][2];
   }
+  // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
+  shared_0(shared_0_k1, &q[17], &v[16], &w.sq[10], &w.cq[10], w.v_RH_hip, w.v_RH_thigh, w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_RH_thigh_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_4(shared_4_k1, &v[16], w.v_RH_hip, w.v_RH_thigh, &w.cq[10], &w.sq[10], w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
+PROXGEN_RT_NOINLINE void kinematics_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_5(shared_5_k1, &v[17], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, &w.cq[11], &w.sq[11], w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
+  shared_1(shared_1_k1, &q[18], &v[17], &w.sq[11], &w.cq[11], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_6(shared_6_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh);
+  shared_2(shared_2_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_7(shared_7_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip);
+  shared_3(shared_3_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1555,47 +1468,47 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_6(shared_6_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh);
+  shared_2(shared_2_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_7(shared_7_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip);
+  shared_3(shared_3_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk);
+  shared_4(shared_4_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_6(shared_6_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh);
+  shared_2(shared_2_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_7(shared_7_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip);
+  shared_3(shared_3_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk);
+  shared_4(shared_4_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_6(shared_6_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh);
+  shared_2(shared_2_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_7(shared_7_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip);
+  shared_3(shared_3_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_8(shared_8_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk);
+  shared_4(shared_4_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1660,55 +1573,55 @@ PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT t
 
 PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
+  shared_5(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_6(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_7(shared_7_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_8(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_9(shared_9_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_7(shared_7_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_8(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_9(shared_9_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_7(shared_7_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_8(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_9(shared_9_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_7(shared_7_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_8(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_14(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
+  shared_10(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_15(shared_15_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, &w.cq[11], &w.sq[11], w.dp_RH_thigh);
+  shared_11(shared_11_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, &w.cq[11], &w.sq[11], w.dp_RH_thigh);
   // reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_16(shared_16_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], &w.cq[10], &w.sq[10], w.dp_RH_hip);
+  shared_12(shared_12_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], &w.cq[10], &w.sq[10], w.dp_RH_hip);
   // reduced sweep: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar du0 = -0.9950371902099892*w.dp_RH_hip[3] + 0.09950371902099892*w.dp_RH_hip[5];
@@ -1734,29 +1647,29 @@ PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_R
 
 PROXGEN_RT_NOINLINE void caba_reduced_RF_shank_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_15(shared_15_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, &w.cq[8], &w.sq[8], w.dp_RF_thigh);
+  shared_11(shared_11_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, &w.cq[8], &w.sq[8], w.dp_RF_thigh);
   // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_16(shared_16_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], &w.cq[7], &w.sq[7], w.dp_RF_hip);
+  shared_12(shared_12_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], &w.cq[7], &w.sq[7], w.dp_RF_hip);
   // reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.dp_trunk);
+  shared_13(shared_13_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LH_shank_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_15(shared_15_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, &w.cq[5], &w.sq[5], w.dp_LH_thigh);
+  shared_11(shared_11_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, &w.cq[5], &w.sq[5], w.dp_LH_thigh);
   // reduced sweep: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_16(shared_16_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], &w.cq[4], &w.sq[4], w.dp_LH_hip);
+  shared_12(shared_12_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], &w.cq[4], &w.sq[4], w.dp_LH_hip);
   // reduced sweep: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.dp_trunk);
+  shared_13(shared_13_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_LF_shank_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_15(shared_15_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, &w.cq[2], &w.sq[2], w.dp_LF_thigh);
+  shared_11(shared_11_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, &w.cq[2], &w.sq[2], w.dp_LF_thigh);
   // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_16(shared_16_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], &w.cq[1], &w.sq[1], w.dp_LF_hip);
+  shared_12(shared_12_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], &w.cq[1], &w.sq[1], w.dp_LF_hip);
   // reduced sweep: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_17(shared_17_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq, w.dp_trunk);
+  shared_13(shared_13_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq, w.dp_trunk);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1773,58 +1686,58 @@ PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) no
 
 PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
-  shared_9(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
+  shared_5(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_10(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
+  shared_6(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_11(shared_11_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_7(shared_7_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_12(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
+  shared_8(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_9(shared_9_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_11(shared_11_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_7(shared_7_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_12(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+  shared_8(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_9(shared_9_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_11(shared_11_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_7(shared_7_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_12(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
+  shared_8(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_13(shared_13_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_9(shared_9_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_11(shared_11_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_7(shared_7_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_12(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_8(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_14(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
+  shared_10(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_18(shared_18_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
+  shared_14(shared_14_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_19(shared_19_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
+  shared_15(shared_15_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2004,47 +1917,47 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_18(shared_18_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
+  shared_14(shared_14_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_19(shared_19_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
+  shared_15(shared_15_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
+  shared_16(shared_16_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_18(shared_18_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
+  shared_14(shared_14_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_19(shared_19_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
+  shared_15(shared_15_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
+  shared_16(shared_16_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_18(shared_18_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
+  shared_14(shared_14_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_19(shared_19_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
+  shared_15(shared_15_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_20(shared_20_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
+  shared_16(shared_16_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2354,36 +2267,36 @@ PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT 
 
 PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
+  shared_17(shared_17_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
   // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_22(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.a_LF_shank);
+  shared_18(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.a_LF_shank);
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
+  shared_19(shared_19_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
+  shared_17(shared_17_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
   // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_22(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.a_LH_shank);
+  shared_18(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.a_LH_shank);
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
+  shared_19(shared_19_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
+  shared_17(shared_17_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
   // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_22(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.a_RF_shank);
+  shared_18(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.a_RF_shank);
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
+  shared_19(shared_19_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
+  shared_17(shared_17_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_22(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.a_RH_shank);
+  shared_18(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.a_RH_shank);
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -2442,7 +2355,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  shared_24(inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
+  shared_20(inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t9 = inv_mu + w.KSD_LH_hip[1]*w.KS_LH_hip[1] - w.L[34]*w.L[34];
@@ -2460,7 +2373,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
-  shared_24(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
+  shared_20(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2481,7 +2394,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
     w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  shared_24(inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
+  shared_20(inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
@@ -2791,36 +2704,36 @@ PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRI
 
 PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_25(shared_25_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
+  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_26(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
+  shared_22(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
   // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_25(shared_25_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
+  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_26(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
+  shared_22(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
+  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_25(shared_25_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
+  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
   // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_26(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
+  shared_22(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
   // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_27(shared_27_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
 }
 
 PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_25(shared_25_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_26(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
+  shared_22(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2856,17 +2769,14 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // Joint transforms, body velocities v, velocity-product accelerations c, bias
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
-  proxgen_rt::sincos_run<12>(&q[7], &w.sq[0], &w.cq[0]);
-  // ---- joint transforms X_J(q)
-  kinematics_transforms_trunk_to_LH_hip(q, w);
-  kinematics_transforms_LH_thigh_to_RH_shank(q, w);
-  // ---- velocities, bias forces, gravity, placements, constraint terms
-  kinematics_trunk_to_LF_thigh(v, w);
-  kinematics_LF_shank_to_LH_hip(v, w);
-  kinematics_LH_thigh_to_LH_shank(v, w);
-  kinematics_RF_hip_to_RF_thigh(v, w);
-  kinematics_RF_shank_to_RH_hip(v, w);
-  kinematics_RH_thigh_to_RH_shank(v, w);
+  proxgen_rt::sincos_run<12, true>(&q[7], &w.sq[0], &w.cq[0]);
+  kinematics_trunk_to_LF_hip(q, v, w);
+  kinematics_LF_thigh_to_LF_shank(q, v, w);
+  kinematics_LH_hip_to_LH_thigh(q, v, w);
+  kinematics_LH_shank_to_RF_hip(q, v, w);
+  kinematics_RF_thigh_to_RF_shank(q, v, w);
+  kinematics_RH_hip_to_RH_thigh(q, v, w);
+  kinematics_RH_shank(q, v, w);
 }
 
 }  // namespace

@@ -11,34 +11,30 @@
 //     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
-//   shared_1: 8 blocks of LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank
-//   shared_2: 2 blocks of LF_thigh, RF_thigh
-//   shared_3: 2 blocks of LF_shank, RF_shank
-//   shared_4: 2 blocks of LH_thigh, RH_thigh
-//   shared_5: 2 blocks of LH_shank, RH_shank
-//   shared_6: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_7: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_8: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_9: 2 blocks of trunk
-//   shared_10: 2 blocks of LF_hip
-//   shared_11: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_12: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_13: 6 blocks of LH_hip, RF_hip, RH_hip
-//   shared_14: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_15: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_16: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_17: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_18: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_19: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_20: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_5: 2 blocks of trunk
+//   shared_6: 2 blocks of LF_hip
+//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
 //   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
 //   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
 //   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_24: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_25: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_26: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_27: 3 blocks of LH_hip, RF_hip, RH_hip
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -138,12 +134,9 @@ struct Workspace {
   Scalar sq[12];               // sin q of the revolute joints (q order)
   Scalar cq[12];               // cos q of the revolute joints (q order)
   Scalar RJ_trunk[3][3];       // joint rotation, body 1
-  Scalar RJ_LF_hip[3][3];      // joint rotation, body 2
-  Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
-  Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
-  Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
   Scalar pA_trunk[6];          // bias force, body 1
   Scalar g_trunk[3];           // gravity in body coordinates, body 1
+  Scalar RJ_LF_hip[3][3];      // joint rotation, body 2
   Scalar v_LF_hip[6];          // velocity, body 2
   Scalar c_LF_hip[6];          // velocity-product acceleration, body 2
   Scalar pA_LF_hip[6];         // bias force, body 2
@@ -157,6 +150,7 @@ struct Workspace {
   Scalar pA_LF_shank[6];       // bias force, body 4
   Scalar g_LF_shank[3];        // gravity in body coordinates, body 4
   Scalar k_lf_foot[3];         // constraint right-hand side, constraint 0
+  Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
   Scalar v_LH_hip[6];          // velocity, body 5
   Scalar c_LH_hip[6];          // velocity-product acceleration, body 5
   Scalar pA_LH_hip[6];         // bias force, body 5
@@ -170,6 +164,7 @@ struct Workspace {
   Scalar pA_LH_shank[6];       // bias force, body 7
   Scalar g_LH_shank[3];        // gravity in body coordinates, body 7
   Scalar k_lh_foot[3];         // constraint right-hand side, constraint 2
+  Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
   Scalar v_RF_hip[6];          // velocity, body 8
   Scalar c_RF_hip[6];          // velocity-product acceleration, body 8
   Scalar pA_RF_hip[6];         // bias force, body 8
@@ -183,6 +178,7 @@ struct Workspace {
   Scalar pA_RF_shank[6];       // bias force, body 10
   Scalar g_RF_shank[3];        // gravity in body coordinates, body 10
   Scalar k_rf_foot[3];         // constraint right-hand side, constraint 1
+  Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
   Scalar v_RH_hip[6];          // velocity, body 11
   Scalar c_RH_hip[6];          // velocity-product acceleration, body 11
   Scalar pA_RH_hip[6];         // bias force, body 11

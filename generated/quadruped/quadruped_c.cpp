@@ -11,34 +11,30 @@
 //     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
 // same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_hip, LH_hip, RF_hip, RH_hip
-//   shared_1: 8 blocks of LF_thigh, LF_shank, LH_thigh, LH_shank, RF_thigh, RF_shank, RH_thigh, RH_shank
-//   shared_2: 2 blocks of LF_thigh, RF_thigh
-//   shared_3: 2 blocks of LF_shank, RF_shank
-//   shared_4: 2 blocks of LH_thigh, RH_thigh
-//   shared_5: 2 blocks of LH_shank, RH_shank
-//   shared_6: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_7: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_8: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_9: 2 blocks of trunk
-//   shared_10: 2 blocks of LF_hip
-//   shared_11: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_12: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_13: 6 blocks of LH_hip, RF_hip, RH_hip
-//   shared_14: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_15: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_16: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_17: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_18: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_19: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
-//   shared_20: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_5: 2 blocks of trunk
+//   shared_6: 2 blocks of LF_hip
+//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
+//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
+//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
+//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
 //   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
 //   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
 //   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_24: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_25: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_26: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_27: 3 blocks of LH_hip, RF_hip, RH_hip
 
 // The C interface of quadruped.hpp, declared in quadruped_c.h: each function
 // copies its scalar arguments into a Settings, makes the caller's buffer the

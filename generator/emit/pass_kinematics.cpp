@@ -47,7 +47,7 @@ std::pair<std::string, std::string> sincosMembers(Emit& e, int slot, int slots) 
 
 }  // namespace
 
-bool sincosCalled(const Plan& plan) { return revoluteBodies(plan).size() > 16; }
+bool sincosCalled(const Plan& plan) { return revoluteBodies(plan).size() > kSincosInlinedUpTo; }
 
 void sincosRuns(Emit& e, bool supportOnly) {
   const std::vector<int> all = revoluteBodies(e.plan);

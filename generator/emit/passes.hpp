@@ -23,12 +23,16 @@ Kinematics emitKinematics(Emit& e);
 /// One body's joint placement X_J(q), its motion subspace and tree placement.
 void jointTransform(Emit& e, int i, Kinematics::Body& b);
 /// Whether jointTransform calls the runtime's sincos (sincos_joint_called) rather
-/// than inlining it: on a robot of more than 16 revolute joints. Measured with
-/// bench/ab_compare.sh (docs/benchmarks.md, "sincos called on the larger
-/// robots"): called, Talos' solvers take 0.95 of the time for 0.8 % more
-/// instructions (the spills around the calls); Solo's (12 joints) solvers 0.95
-/// too, but for 0.7 % more instructions, past solo_f3x4's count when issue 20
-/// was filed, so Solo and smaller keep it inline; the iiwa (7) is 1-4 % slower called.
+/// than inlining it: on a robot of more than kSincosInlinedUpTo revolute joints.
+/// The called form's run computes the sines and cosines in two lanes at the
+/// x86-64 baseline (lanes.hpp), and with it the called form is faster than the
+/// inlined one on every shared case there (bench/ab_compare.sh: Solo's proxPV
+/// 0.90-0.92 of the time, its inverse_dynamics 0.93, the iiwa's 0.96-0.99, with
+/// fewer instructions) and the same with AVX-512 (0.99-1.01): docs/benchmarks.md,
+/// "The called form from five revolute joints". Without the run (the first
+/// measurements, docs/benchmarks.md "sincos called on the larger robots") only
+/// the robots past 16 joints gained.
+inline constexpr std::size_t kSincosInlinedUpTo = 4;
 bool sincosCalled(const Plan& plan);
 /// Before the joint transforms of every body (`supportOnly`: of the bodies on
 /// the constraints' support): their revolute joints' sines and

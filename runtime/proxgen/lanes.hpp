@@ -366,9 +366,9 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 // ---- The joint angles' sines and cosines of a scalar solver, many per call.
 //
 // A scalar solver computes each revolute joint's sine and cosine where its
-// body's step needs them: inline (sincos_joint, robots of 16 revolute joints
+// body's step needs them: inline (sincos_joint, robots of 4 revolute joints
 // or fewer) or through a call of the runtime's kernel (sincos_joint_called,
-// larger robots). Where the target's vector registers pay, one call before
+// larger robots: the generator's sincosCalled). Where the target's vector registers pay, one call before
 // the kinematics computes a run of consecutive joint angles in the lanes
 // instead (sincos_run<N> before inline joints, sincos_run<N, true> before
 // called ones), and each joint's call is empty:
@@ -382,7 +382,8 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 //   0.79 of the time, its solvers 0.93-0.94, the Atlas' 0.94-0.99. Before
 //   inlined joints the run in two lanes was slower (the iiwa's
 //   inverse_dynamics 1.16, Solo's 1.04: the inlined kernel's latency hides
-//   behind the body's arithmetic), so there each joint computes its own;
+//   behind the body's arithmetic), so there each joint computes its own
+//   (and the generator inlines only on robots of four joints or fewer);
 // - elsewhere (NEON, not measured; no vector lanes; float and lanes Scalars)
 //   the runs are empty and the joints compute.
 // docs/benchmarks.md, "sincos in the lanes". Either way every value is the

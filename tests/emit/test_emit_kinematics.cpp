@@ -1,12 +1,12 @@
 // The kinematics pass's choice of sine and cosine (emit/pass_kinematics.cpp,
-// sincosCalled): the runtime's sincos inlined at each revolute joint, or its
-// called form on a robot of more than 16 revolute joints, where one copy of
-// the kernel beats one per joint (docs/benchmarks.md, "sincos called on the
-// larger robots"); and before each pass of joint transforms the run of every
-// joint in the lanes of a wide vector target (sincosRuns, lanes.hpp's
-// sincos_run). They give the same bits (tests/runtime); this checks which one
-// the generated source uses, that every joint uses it, and where the joint
-// transforms go with each.
+// sincosCalled): the runtime's sincos inlined at each revolute joint on a
+// robot of four revolute joints or fewer, or its called form from five on,
+// whose run computes them in two lanes at the x86-64 baseline
+// (docs/benchmarks.md, "The called form from five revolute joints"); and
+// before each pass of joint transforms the run of every joint (sincosRuns,
+// lanes.hpp's sincos_run). They give the same bits (tests/runtime); this
+// checks which one the generated source uses, that every joint uses it, and
+// where the joint transforms go with each.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -24,16 +24,16 @@ std::string chainSource(int links, const std::string& functions = "") {
   return test::syntheticChainFiles(links, functions).unsharedSource;
 }
 
-TEST(KinematicsCode, SinCosIsCalledFromSeventeenRevoluteJointsOn) {
-  const std::string sixteen = chainSource(17), seventeen = chainSource(18);
-  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint(q["), 16);
-  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_joint_called("), 0);
-  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint_called(q["), 17);
-  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_joint("), 0);
+TEST(KinematicsCode, SinCosIsCalledFromFiveRevoluteJointsOn) {
+  const std::string four = chainSource(5), five = chainSource(6);
+  EXPECT_EQ(test::occurrences(four, "proxgen_rt::sincos_joint(q["), 4);
+  EXPECT_EQ(test::occurrences(four, "proxgen_rt::sincos_joint_called("), 0);
+  EXPECT_EQ(test::occurrences(five, "proxgen_rt::sincos_joint_called(q["), 5);
+  EXPECT_EQ(test::occurrences(five, "proxgen_rt::sincos_joint("), 0);
   // Each form's run says which form its joints take (lanes.hpp: the x86-64
   // baseline runs in two lanes before called joints only).
-  EXPECT_EQ(test::occurrences(sixteen, "proxgen_rt::sincos_run<16>("), 1);
-  EXPECT_EQ(test::occurrences(seventeen, "proxgen_rt::sincos_run<17, true>("), 1);
+  EXPECT_EQ(test::occurrences(four, "proxgen_rt::sincos_run<4>("), 1);
+  EXPECT_EQ(test::occurrences(five, "proxgen_rt::sincos_run<5, true>("), 1);
   // The lane code inlines the kernel again (batch.cpp: the call was slower there).
   const std::string lanes = batchFiles(test::syntheticChainFiles(18), 4).source;
   EXPECT_EQ(test::occurrences(lanes, "sincos_joint_called"), 0);
@@ -63,7 +63,7 @@ TEST(KinematicsCode, OneSinCosRunOfTheConsecutiveAnglesPrecedesTheKinematics) {
 // its own (jointTransformsFirst: the faster way for each, docs/benchmarks.md).
 TEST(KinematicsCode, TheJointTransformsComeFirstWhereSinCosIsInlined) {
   const std::string functions = "constrained_aba,prox_pv,inverse_dynamics";
-  const std::string inlined = chainSource(17, functions), called = chainSource(18, functions);
+  const std::string inlined = chainSource(5, functions), called = chainSource(6, functions);
   EXPECT_GT(test::occurrences(inlined, "void kinematics_transforms_"), 0);
   EXPECT_GT(test::occurrences(inlined, "void rnea_transforms_"), 0);
   EXPECT_EQ(test::occurrences(called, "void kinematics_transforms_"), 0);
