@@ -32,6 +32,19 @@
 #define PROXGEN_RT_LANES_VECTOR 0
 #endif
 
+// The bytes of the target's widest vector register the runtime's kernels
+// use (sincos_run, row_madd below): 64 with AVX-512, 32 with AVX, 16 with
+// SSE2 or NEON, 0 without vector lanes.
+#if PROXGEN_RT_LANES_VECTOR && defined(__AVX512F__)
+#define PROXGEN_RT_VECTOR_BYTES 64
+#elif PROXGEN_RT_LANES_VECTOR && defined(__AVX__)
+#define PROXGEN_RT_VECTOR_BYTES 32
+#elif PROXGEN_RT_LANES_VECTOR && (defined(__SSE2__) || defined(__ARM_NEON))
+#define PROXGEN_RT_VECTOR_BYTES 16
+#else
+#define PROXGEN_RT_VECTOR_BYTES 0
+#endif
+
 namespace proxgen_rt {
 
 namespace lanes_detail {
@@ -396,10 +409,10 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 // pick one another's definitions.
 #ifdef PROXGEN_RT_SINCOS_RUN  // the user's choice, for both forms
 #define PROXGEN_RT_SINCOS_RUN_CALLED PROXGEN_RT_SINCOS_RUN
-#elif PROXGEN_RT_LANES_VECTOR && (defined(__AVX__) || defined(__AVX512F__))
+#elif PROXGEN_RT_VECTOR_BYTES >= 32
 #define PROXGEN_RT_SINCOS_RUN 1
 #define PROXGEN_RT_SINCOS_RUN_CALLED 1
-#elif PROXGEN_RT_LANES_VECTOR && defined(__SSE2__)
+#elif PROXGEN_RT_VECTOR_BYTES == 16 && defined(__SSE2__)
 #define PROXGEN_RT_SINCOS_RUN 0
 #define PROXGEN_RT_SINCOS_RUN_CALLED 1
 #else
@@ -409,13 +422,12 @@ inline void sincos(const lanes<double, W>& x_in, lanes<double, W>& s, lanes<doub
 
 // The lanes of the run before inlined joints (PROXGEN_RT_SINCOS_RUN_WIDTH)
 // and before called ones (..._CALLED_WIDTH); 1: the run is empty.
-#if !PROXGEN_RT_LANES_VECTOR
-#define PROXGEN_RT_SINCOS_RUN_LANES 1
-#elif defined(__AVX512F__)
+// (Literals, not VECTOR_BYTES / 8: they are pasted into the namespace's name.)
+#if PROXGEN_RT_VECTOR_BYTES == 64
 #define PROXGEN_RT_SINCOS_RUN_LANES 8
-#elif defined(__AVX__)
+#elif PROXGEN_RT_VECTOR_BYTES == 32
 #define PROXGEN_RT_SINCOS_RUN_LANES 4
-#elif defined(__SSE2__) || defined(__ARM_NEON)
+#elif PROXGEN_RT_VECTOR_BYTES == 16
 #define PROXGEN_RT_SINCOS_RUN_LANES 2
 #else
 #define PROXGEN_RT_SINCOS_RUN_LANES 1
@@ -531,17 +543,14 @@ inline void sincos_joint_called(S x, S& s, S& c) noexcept {
 // Other Scalars (a batched solver's lanes, a target without vector registers)
 // take the scalar accumulators. The width is part of the names (an inline
 // namespace), as for sincos_run above.
-#if PROXGEN_RT_LANES_VECTOR && defined(__AVX512F__)
-#define PROXGEN_RT_ROW_BYTES 64
+#define PROXGEN_RT_ROW_BYTES PROXGEN_RT_VECTOR_BYTES
+#if PROXGEN_RT_ROW_BYTES == 64
 #define PROXGEN_RT_ROW_NS row_lanes64
-#elif PROXGEN_RT_LANES_VECTOR && defined(__AVX__)
-#define PROXGEN_RT_ROW_BYTES 32
+#elif PROXGEN_RT_ROW_BYTES == 32
 #define PROXGEN_RT_ROW_NS row_lanes32
-#elif PROXGEN_RT_LANES_VECTOR && (defined(__SSE2__) || defined(__ARM_NEON))
-#define PROXGEN_RT_ROW_BYTES 16
+#elif PROXGEN_RT_ROW_BYTES == 16
 #define PROXGEN_RT_ROW_NS row_lanes16
 #else
-#define PROXGEN_RT_ROW_BYTES 0
 #define PROXGEN_RT_ROW_NS row_scalar
 #endif
 
