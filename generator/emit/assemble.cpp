@@ -390,13 +390,23 @@ std::string helpers(const SolverTexts& texts) {
            "}\n\n"
            "// C = s A^T B, A m x n, B m x p, C n x p: A^T's row r (A's column r) nonzero only\n"
            "// in its ranges of k. With A's transpose on the left the sum still runs over\n"
-           "// B's full rows (fixed bounds), as in dense_product_add.\n"
-           "template <int n, int m, int p>\n"
+           "// B's full rows (fixed bounds), as in dense_product_add. A's, B's and C's rows\n"
+           "// are lda, ldb and ldc apart.\n"
+           "template <int n, int m, int p, int lda = n, int ldb = p, int ldc = p>\n"
            "void sparse_transposed_product(const Scalar* PROXGEN_RT_RESTRICT A, const int* start, const int* span,\n"
            "                               const Scalar* PROXGEN_RT_RESTRICT B, Scalar s,\n"
            "                               Scalar* PROXGEN_RT_RESTRICT C) noexcept {\n"
            "  for (int r = 0; r < n; ++r) {\n"
-           "    proxgen_rt::row_product<p, p>(C + r * p, A + r, n, B, s, span + 2 * start[r], start[r + 1] - start[r]);\n"
+           "    proxgen_rt::row_product<p, ldb>(C + r * ldc, A + r, lda, B, s, span + 2 * start[r], start[r + 1] - start[r]);\n"
+           "  }\n"
+           "}\n\n"
+           "// C += s A^T B (as sparse_transposed_product, into C).\n"
+           "template <int n, int m, int p, int lda = n, int ldb = p, int ldc = p>\n"
+           "void sparse_transposed_product_add(const Scalar* PROXGEN_RT_RESTRICT A, const int* start, const int* span,\n"
+           "                                   const Scalar* PROXGEN_RT_RESTRICT B, Scalar s,\n"
+           "                                   Scalar* PROXGEN_RT_RESTRICT C) noexcept {\n"
+           "  for (int r = 0; r < n; ++r) {\n"
+           "    proxgen_rt::row_madd<p, ldb>(C + r * ldc, A + r, lda, B, s, span + 2 * start[r], start[r + 1] - start[r]);\n"
            "  }\n"
            "}\n\n";
   if (cdd)
@@ -485,7 +495,7 @@ const std::vector<std::string>& fileFunctionNames() {
                                     "accelerate_free_bodies", "tangent_sweep", "bias_forces", "mass_matrix_inverse_passes",
                                     "residual",
                                     "dense_product", "dense_product_add", "sparse_left_product_add",
-                                    "sparse_transposed_product", "dense_cholesky", "proximal_step",
+                                    "sparse_transposed_product", "sparse_transposed_product_add", "dense_cholesky", "proximal_step",
                                     "se3_right_jacobian_inverse"};
     for (Function f : allFunctions()) out.push_back(functionName(f));
     return out;

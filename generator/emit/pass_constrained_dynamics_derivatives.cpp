@@ -3,13 +3,15 @@
 // theorem on M qdd + h + J^T lambda = tau, J qdd + gamma = a*:
 //   M X + J^T L = R1 = [-dtau/dq, -dtau/dv, I],   J X = R2 = d a*/dx - d alpha/dx  (x = q, v; 0 for tau),
 // L by the Settings' K proximal steps (G + I/mu) L+ = C + L/mu from 0,
-// C = J M^-1 R1 - R2, and X = M^-1 (R1 - J^T L). The host calls
+// C = J M^-1 R1 - R2, and X = M^-1 (R1 - J^T L), evaluated as
+// X_tau = P = M^-1 - W Lt, X_x = P R1_x + Lt^T R2_x, L_x = Lt R1_x - S_K R2_x
+// (W = M^-1 J^T, Lt = S_K W^T: docs/derivatives.md section 5). The host calls
 // mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
 // it); the constraint rows (J, R2) are printed straight-line from the sweep's
 // motion tangents of the constrained bodies, the path's columns only; the
-// matrix algebra (O(nv nnz(dtau) + nv^2 nc + nc^2 nv), plus K nc^3 for the
-// proximal operator S_K or K nc^2 nv for stepping C) is fixed-bound loops
-// printed once by assemble.cpp, the products with dtau and J over their
+// matrix algebra (O((nv + nc) nnz(dtau) + nv^2 nc + nc^2 nv), plus K nc^3 for
+// the proximal operator S_K or K nc^2 nv for stepping C) is fixed-bound loops
+// printed once by assemble.cpp, the products with dtau, J and R2 over their
 // nonzero patterns (constant tables of column ranges). The generic counterpart:
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
@@ -48,8 +50,9 @@ std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& k
 
 struct RowMembers {
   std::string J;   // nc x nv
-  std::string R2;  // nc x 3 nv: the q, v and tau columns side by side (tau's are 0)
-  std::set<std::pair<int, int>> Jnz;  // J's entries written (row, column): its pattern
+  std::string R2;  // nc x 2 nv: R2's q and v columns side by side
+  std::set<std::pair<int, int>> Jnz;     // J's entries written (row, column): its pattern
+  std::set<std::pair<int, int>> R2nz[2];  // R2_q's and R2_v's entries written
 };
 
 // entry = f * x into member[idx] (of `size` entries), skipping exact zeros
@@ -136,8 +139,10 @@ void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangen
     for (int j = 0; j < r; ++j) {
       const int nc = e.plan.nc, row = c.row + j;
       if (storeRow(e, m.J, nc * nv, row * nv + col, f, J6[std::size_t(j)])) m.Jnz.insert({row, col});
-      storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + col, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]);
-      storeRow(e, m.R2, 3 * nc * nv, row * 3 * nv + nv + col, f, Sv[std::size_t(j)] - Av[std::size_t(j)]);
+      if (storeRow(e, m.R2, 2 * nc * nv, row * 2 * nv + col, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]))
+        m.R2nz[0].insert({row, col});
+      if (storeRow(e, m.R2, 2 * nc * nv, row * 2 * nv + nv + col, f, Sv[std::size_t(j)] - Av[std::size_t(j)]))
+        m.R2nz[1].insert({row, col});
     }
   }
 }
@@ -196,16 +201,20 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const std::string dv = array("cdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
   const std::string xt = array("cdd_Xt", nv * nv, "d qdd / dq or d qdd / dv unconstrained, transposed (constrained_dynamics_derivatives)");
   RowMembers rows;
-  std::string minvjt, G, Lf, C, L;
+  std::string Ct, minvjt, G, Lf, S, PLt, LtS, Y;
+  const int w2 = nv + nc;  // the row length of [P | Lt^T], [Lt | -S_K] and Y
   if (nc > 0) {
     rows.J = "cdd_J", rows.R2 = "cdd_R2";
     array(rows.J, nc * nv, "J (nc x nv; constrained_dynamics_derivatives)");
-    array(rows.R2, 3 * nc * nv, "d a*/dx - d alpha/dx, x = q, v, tau side by side (constrained_dynamics_derivatives)");
-    minvjt = array("cdd_MinvJt", nv * nc, "M^-1 J^T (constrained_dynamics_derivatives)");
+    array(rows.R2, 2 * nc * nv, "R2 = d a*/dx - d alpha/dx, x = q, v side by side (constrained_dynamics_derivatives)");
+    Ct = array("cdd_JMinv", nc * nv, "J M^-1 (constrained_dynamics_derivatives)");
+    minvjt = array("cdd_MinvJt", nv * nc, "W = M^-1 J^T (constrained_dynamics_derivatives)");
     G = array("cdd_G", nc * nc, "G = J M^-1 J^T (constrained_dynamics_derivatives)");
     Lf = array("cdd_Lf", nc * nc, "G + I/mu = L L^T, 1/L_jj on the diagonal (constrained_dynamics_derivatives)");
-    C = array("cdd_C", 3 * nc * nv, "C = J M^-1 R1 - R2, the three inputs side by side (constrained_dynamics_derivatives)");
-    L = array("cdd_L", 3 * nc * nv, "the multipliers' tangents, the three inputs side by side (constrained_dynamics_derivatives)");
+    S = array("cdd_S", nc * nc, "S_K, the K proximal steps as one operator (constrained_dynamics_derivatives)");
+    PLt = array("cdd_PLt", nv * w2, "[P | Lt^T], P = d qdd / d tau, Lt = d lambda / d tau (constrained_dynamics_derivatives)");
+    LtS = array("cdd_LtS", nc * w2, "[Lt | -S_K] (constrained_dynamics_derivatives)");
+    Y = array("cdd_Y", nv * w2, "[d qdd / dx | d lambda / dx]^T, x = q or v (constrained_dynamics_derivatives)");
   }
   Kinematics kin = kinIn;
   e.fn.live() = Live{};
@@ -223,54 +232,46 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   host.line("bias_forces(v, w);", {}, names);
   host.line(fmt::format("tangent_sweep(v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
   OpCount ops;
-  if (nc > 0) {
-    // The rows of an inactive constraint are zeros: its lambda is 0 and its
-    // tangents too, the derivatives of the solver generated without it.
-    storeActiveFactors(e, "s.active");
-    host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, rows.J), {}, names);
-    host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", 3 * nc * nv, rows.R2), {}, names);
-    e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's tangents");
-    for (int i : plan.support)
-      for (int k : e.bp(i).constraints) {
-        e.fn.boundary(i);
-        e.openBody(i, "constraint rows:");
-        constraintRows(e, k, kin.b[std::size_t(i)], t, rows);
-        e.cb().close();
-      }
-    e.fn.endPart();
-  }
-  CodeBuilder& cb = e.cb();
-  // The unconstrained tangents M^-1 R1: X_q = -M^-1 dtau_dq, X_v = -M^-1
-  // dtau_dv over dtau's nonzero entries, X_tau = M^-1.
-  minvTimesDtau(e, t, minv, dq, dv, xt, names);
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_dtau[k] = {}[k];", nv * nv, minv), {}, names);
   if (nc == 0) {
+    // X_q = -M^-1 dtau_dq, X_v = -M^-1 dtau_dv over dtau's nonzero entries, X_tau = M^-1.
+    minvTimesDtau(e, t, minv, dq, dv, xt, names);
+    CodeBuilder& cb = e.cb();
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_dtau[k] = {}[k];", nv * nv, minv), {}, names);
     for (const char* p : {"dlambda_dq", "dlambda_dv", "dlambda_dtau"})
       cb.line(fmt::format("static_cast<void>({});", p), {}, names);
     return e.fn.endHost(names);
   }
-  // The three inputs side by side (nc x 3 nv, q | v | tau), so each step below
-  // is one product over rows of 3 nv: C = J [X_q X_v M^-1] - R2 (R2's tau block
-  // is 0, so C's is J M^-1 exactly), the multipliers' tangents L from C, then
-  // per input X -= M^-1 J^T L and the copy of L's block out.
-  const int w3 = 3 * nv;
-  const std::string Xs[] = {"dqdd_dq", "dqdd_dv", "dqdd_dtau"}, Ls[] = {"dlambda_dq", "dlambda_dv", "dlambda_dtau"};
-  const auto block = [&](const std::string& a, int b) { return b == 0 ? a : fmt::format("{} + {}", a, b * nv); };
-  // J's rows are nonzero only on the constrained body's path: the products
-  // with J on the left read its pattern (C starts at 0 for them).
+  // The rows of an inactive constraint are zeros: its lambda is 0 and its
+  // tangents too, the derivatives of the solver generated without it.
+  storeActiveFactors(e, "s.active");
+  host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, rows.J), {}, names);
+  host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", 2 * nc * nv, rows.R2), {}, names);
+  e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's tangents");
+  for (int i : plan.support)
+    for (int k : e.bp(i).constraints) {
+      e.fn.boundary(i);
+      e.openBody(i, "constraint rows:");
+      constraintRows(e, k, kin.b[std::size_t(i)], t, rows);
+      e.cb().close();
+    }
+  e.fn.endPart();
+  CodeBuilder& cb = e.cb();
+  // With W = M^-1 J^T and Lt = S_K W^T (= d lambda / d tau), section 3's
+  // L_x = S_K (W^T R1_x - R2_x) and X_x = M^-1 R1_x - W L_x are (S_K symmetric)
+  //   d qdd / d tau = P = M^-1 - W Lt, and per input x = q, v
+  //   X_x^T = -dtau_dx^T P + R2_x^T Lt,   L_x^T = -dtau_dx^T Lt^T - R2_x^T S_K,
+  // both in one pair of products over rows of nv + nc, Y = -dtau_dx^T [P | Lt^T]
+  // + R2_x^T [Lt | -S_K]: the inputs' tangents (dtau, R2) are the sparse factors,
+  // and W meets one nc x nv block, not one per input.
   const RowSpans jSpans = rowSpans(nc, rows.Jnz);
   printSpans(cb, "J_nz", jSpans);
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", 3 * nc * nv, C), {}, names);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nv, Ct), {}, names);
   ops.once = sparseLeftProductOps(jSpans, nv);
-  for (int b = 0; b < 3; ++b)
-    cb.line(fmt::format("sparse_left_product_add<{}, {}, {}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});",
-                        nc, nv, nv, nv, w3, rows.J, Xs[b], block(C, b)),
-            {}, names, ops);
-  // M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
-  copyBlock(cb, names, minvjt, C, nv, nc, w3, 2 * nv, true);
-  ops.once = Ops{};
-  ops.once.add = 3L * nc * nv;
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = {}[k] - w.{}[k];", 3 * nc * nv, C, C, rows.R2), {}, names, ops);
+  cb.line(fmt::format("sparse_left_product_add<{}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});", nc, nv, nv,
+                      rows.J, minv, Ct),
+          {}, names, ops);
+  // W = M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
+  copyBlock(cb, names, minvjt, Ct, nv, nc, nv, 0, true);
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, G), {}, names);
   ops.once = sparseLeftProductOps(jSpans, nc);
   cb.line(fmt::format("sparse_left_product_add<{}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});", nc, nv, nc,
@@ -280,42 +281,50 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   cb.line("const Scalar inv_mu = Scalar(1) / s.mu;", {}, names, ops);
   ops.once = denseCholeskyOps(nc);
   cb.line(fmt::format("dense_cholesky<{}>({}, inv_mu, {});", nc, G, Lf), {}, names, ops);
-  // The K proximal steps on the tangents are linear in C: L = S_K C with
-  // S_K = sum_j mu^(1-j) (G + I/mu)^-j (j = 1..K), itself K steps from C = I.
-  // Forming S_K (K nc^3) and applying it (3 nc^2 nv) beats stepping C
-  // (3 K nc^2 nv) unless there are many rows on few dofs; the layout's K
-  // decides, as it does the banner's count.
-  const long K = plan.iterations;
-  if (K * nc + 3L * nv < 3L * K * nv) {
-    const std::string id = array("cdd_Id", nc * nc, "the nc x nc identity (constrained_dynamics_derivatives)");
-    const std::string S = array("cdd_S", nc * nc, "S_K, the K proximal steps as one operator (constrained_dynamics_derivatives)");
-    cb.comment("S_K: the K proximal steps from C = I");
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, id), {}, names);
-    for (int r = 0; r < nc; ++r) cb.line(fmt::format("{}[{}] = Scalar(1);", id, r * (nc + 1)), {}, names);
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, S), {}, names);
-    cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
-    ops.once = choleskySolveOps(nc, nc);
-    ops.once.add += long(nc) * nc;
-    ops.once.mul += long(nc) * nc;
-    cb.line(fmt::format("proximal_step<{0}, {0}>({1}, {2}, inv_mu, {3});", nc, Lf, id, S), {}, names, ops);
-    cb.close();
-    ops.once = denseProductOps(nc, nc, w3);
-    cb.line(fmt::format("dense_product<{}, {}, {}>({}, {}, Scalar(1), {});", nc, nc, w3, S, C, L), {}, names, ops);
-  } else {
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", 3 * nc * nv, L), {}, names);
-    cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
-    ops.once = choleskySolveOps(nc, w3);
-    ops.once.add += 3L * nc * nv;
-    ops.once.mul += 3L * nc * nv;
-    cb.line(fmt::format("proximal_step<{}, {}>({}, {}, inv_mu, {});", nc, w3, Lf, C, L), {}, names, ops);
-    cb.close();
-  }
-  for (int b = 0; b < 3; ++b) {
-    ops.once = denseProductAddOps(nv, nc, nv);
-    cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, w3, nv, minvjt,
-                        block(L, b), Xs[b]),
+  // The K proximal steps on the tangents are linear: S_K = sum_j mu^(1-j)
+  // (G + I/mu)^-j (j = 1..K), itself K steps from I (K nc^3), applied to J M^-1
+  // and to R2's rows' paths; the Settings' K at run time.
+  const std::string id = array("cdd_Id", nc * nc, "the nc x nc identity (constrained_dynamics_derivatives)");
+  cb.comment("S_K: the K proximal steps from C = I");
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, id), {}, names);
+  for (int r = 0; r < nc; ++r) cb.line(fmt::format("{}[{}] = Scalar(1);", id, r * (nc + 1)), {}, names);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, S), {}, names);
+  cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
+  ops.once = choleskySolveOps(nc, nc);
+  ops.once.add += long(nc) * nc;
+  ops.once.mul += long(nc) * nc;
+  cb.line(fmt::format("proximal_step<{0}, {0}>({1}, {2}, inv_mu, {3});", nc, Lf, id, S), {}, names, ops);
+  cb.close();
+  // [Lt | -S_K], then [P | Lt^T] with P = M^-1 - W Lt, and their tau blocks out.
+  ops.once = denseProductOps(nc, nc, nv);
+  cb.line(fmt::format("dense_product<{}, {}, {}, {}, {}>({}, {}, Scalar(1), {});", nc, nc, nv, nv, w2, S, Ct, LtS), {}, names,
+          ops);
+  copyBlock(cb, names, LtS, S, nc, nc, nc, 0, false, {w2, nv, true});
+  copyBlock(cb, names, PLt, minv, nv, nv, nv, 0, false, {w2, 0, false});
+  ops.once = denseProductAddOps(nv, nc, nv);
+  cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, w2, w2, minvjt, LtS, PLt),
+          {}, names, ops);
+  copyBlock(cb, names, PLt, LtS, nv, nc, w2, 0, true, {w2, nv, false});
+  copyBlock(cb, names, "dqdd_dtau", PLt, nv, nv, w2, 0, false);
+  copyBlock(cb, names, "dlambda_dtau", LtS, nc, nv, w2, 0, false);
+  const std::string dtaus[2] = {dq, dv}, xs[2] = {"q", "v"};
+  for (int b = 0; b < 2; ++b) {
+    const RowSpans dSpans = rowSpans(nv, transpose(b == 0 ? t.dtauDq : t.dtauDv));
+    const RowSpans rSpans = rowSpans(nv, transpose(rows.R2nz[b]));
+    const std::string dt = fmt::format("dtau_d{}_t", xs[b]), rt = fmt::format("R2_{}_t", xs[b]);
+    printSpans(cb, dt, dSpans);
+    printSpans(cb, rt, rSpans);
+    ops.once = sparseLeftProductOps(dSpans, w2);
+    cb.line(fmt::format("sparse_transposed_product<{}, {}, {}>({}, {}_start, {}_span, {}, Scalar(-1), {});", nv, nv, w2,
+                        dtaus[b], dt, dt, PLt, Y),
             {}, names, ops);
-    copyBlock(cb, names, Ls[b], L, nc, nv, w3, b * nv, false);
+    ops.once = sparseLeftProductOps(rSpans, w2);
+    const std::string r2 = b == 0 ? "w." + rows.R2 : fmt::format("w.{} + {}", rows.R2, nv);
+    cb.line(fmt::format("sparse_transposed_product_add<{}, {}, {}, {}>({}, {}_start, {}_span, {}, Scalar(1), {});", nv, nc,
+                        w2, 2 * nv, r2, rt, rt, LtS, Y),
+            {}, names, ops);
+    copyBlock(cb, names, "dqdd_d" + xs[b], Y, nv, nv, w2, 0, true);
+    copyBlock(cb, names, "dlambda_d" + xs[b], Y, nc, nv, w2, nv, true);
   }
   std::string text = e.fn.endHost(names);
   e.fn.live() = Live{};

@@ -430,13 +430,30 @@ void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans)
   cb.line(fmt::format("static constexpr int {}_span[{}] = {{{}}};", name, span.size(), fmt::join(span, ", ")));
 }
 
+std::set<std::pair<int, int>> transpose(const std::set<std::pair<int, int>>& entries) {
+  std::set<std::pair<int, int>> out;
+  for (const auto& [r, c] : entries) out.insert({c, r});
+  return out;
+}
+
+long entries(const RowSpans& spans) {
+  long nnz = 0;
+  for (const auto& row : spans)
+    for (const auto& [lo, hi] : row) nnz += hi - lo;
+  return nnz;
+}
+
 void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std::string& dst, const std::string& src,
-               int rows, int cols, int ld, int offset, bool transposed) {
+               int rows, int cols, int ld, int offset, bool transposed, const CopyTo& to) {
   cb.open(fmt::format("for (int i = 0; i < {}; ++i) {{", rows), {}, names);
   cb.open(fmt::format("for (int j = 0; j < {}; ++j) {{", cols), {}, names);
   const std::string at = offset == 0 ? "" : fmt::format(" + {}", offset);
   const std::string from = transposed ? fmt::format("j * {}{} + i", ld, at) : fmt::format("i * {}{} + j", ld, at);
-  cb.line(fmt::format("{}[i * {} + j] = {}[{}];", dst, cols, src, from), {}, names);
+  const int dstLd = to.ld == 0 ? cols : to.ld;
+  const std::string dstAt = to.offset == 0 ? "" : fmt::format(" + {}", to.offset);
+  OpCount ops;  // per entry: the loops' trips multiply it
+  ops.once.neg = to.negate ? 1 : 0;
+  cb.line(fmt::format("{}[i * {}{} + j] = {}{}[{}];", dst, dstLd, dstAt, to.negate ? "-" : "", src, from), {}, names, ops);
   cb.close();
   cb.close();
 }
@@ -444,9 +461,7 @@ void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std
 // sparse_left_product_add<n, m, p> and sparse_transposed_product<n, m, p>:
 // per entry of the left factor, its scaling and p multiply-adds.
 Ops sparseLeftProductOps(const RowSpans& a, int p) {
-  long nnz = 0;
-  for (const auto& row : a)
-    for (const auto& [lo, hi] : row) nnz += hi - lo;
+  const long nnz = entries(a);
   Ops o;
   o.mul = nnz * (p + 1);
   o.add = nnz * p;
@@ -464,9 +479,7 @@ void minvTimesDtau(Emit& e, const BodyTangents& t, const std::string& minv, cons
   const std::pair<const std::set<std::pair<int, int>>*, std::string> products[] = {{&t.dtauDq, "dq"},
                                                                                    {&t.dtauDv, "dv"}};
   for (const auto& [entries, x] : products) {
-    std::set<std::pair<int, int>> transposed;
-    for (const auto& [r, c] : *entries) transposed.insert({c, r});
-    const RowSpans spans = rowSpans(nv, transposed);
+    const RowSpans spans = rowSpans(nv, transpose(*entries));
     const std::string table = "dtau_" + x + "_t";
     printSpans(cb, table, spans);
     OpCount ops;

@@ -227,12 +227,23 @@ RowSpans rowSpans(int rows, const std::set<std::pair<int, int>>& entries);
 /// Prints the tables the sparse products read, `<name>_start[rows + 1]` and
 /// `<name>_span[2 ranges]`, as static constants of the function being written.
 void printSpans(CodeBuilder& cb, const std::string& name, const RowSpans& spans);
+/// The (column, row) entries of (row, column) entries: the pattern of the transpose.
+std::set<std::pair<int, int>> transpose(const std::set<std::pair<int, int>>& entries);
+/// The number of entries the ranges cover.
+long entries(const RowSpans& spans);
+/// Where copyBlock writes: rows `ld` apart (0: `cols`), from `offset`, negated or not.
+struct CopyTo {
+  int ld = 0;
+  int offset = 0;
+  bool negate = false;
+};
 /// dst[i cols + j] = src[i ld + offset + j], or src[j ld + offset + i] (`transposed`),
-/// for i < rows, j < cols: a loop over the rows around one over the columns
-/// (the copy by one flat index, i = k / cols and j = k % cols worked out per
-/// entry, took some 15 instructions an entry; docs/benchmarks.md).
+/// for i < rows, j < cols (dst's rows and start as `to` says): a loop over the rows
+/// around one over the columns (the copy by one flat index, i = k / cols and
+/// j = k % cols worked out per entry, took some 15 instructions an entry;
+/// docs/benchmarks.md).
 void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std::string& dst, const std::string& src,
-               int rows, int cols, int ld, int offset, bool transposed);
+               int rows, int cols, int ld, int offset, bool transposed, const CopyTo& to = {});
 /// The arithmetic of sparse_left_product_add<n, m, p> and of
 /// sparse_transposed_product<n, m, p> over the left factor's spans.
 Ops sparseLeftProductOps(const RowSpans& a, int p);
