@@ -16,6 +16,8 @@
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include <set>
 
 #include "emit/identifiers.hpp"
@@ -186,6 +188,10 @@ Ops se3RightJacobianInverseOps() {
   return o;
 }
 
+// The rows of P = M^-1 - W Lt computed together up to their block's last
+// column (the rest mirrored): a template instance of the product per block.
+constexpr int kSymmetricRows = 8;
+
 std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn, const CodeBuilder* afterKinematics,
                                                const BodyTangents& t) {
   const Plan& plan = e.plan;
@@ -300,10 +306,22 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   cb.line(fmt::format("dense_product<{}, {}, {}, {}, {}>({}, {}, Scalar(1), {});", nc, nc, nv, nv, w2, S, Ct, LtS), {}, names,
           ops);
   copyBlock(cb, names, LtS, S, nc, nc, nc, 0, false, {w2, nv, true});
+  // P is symmetric: each block of kSymmetricRows rows up to its last column
+  // (the block's diagonal and what is left of it), then the rest of the upper
+  // triangle mirrored: nc nv^2 / 2 and a block's diagonal, not nc nv^2.
   copyBlock(cb, names, PLt, minv, nv, nv, nv, 0, false, {w2, 0, false});
-  ops.once = denseProductAddOps(nv, nc, nv);
-  cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", nv, nc, nv, w2, w2, minvjt, LtS, PLt),
-          {}, names, ops);
+  for (int r0 = 0; r0 < nv; r0 += kSymmetricRows) {
+    const int r1 = std::min(nv, r0 + kSymmetricRows);
+    const std::string a = r0 == 0 ? minvjt : fmt::format("{} + {}", minvjt, r0 * nc);
+    const std::string c = r0 == 0 ? PLt : fmt::format("{} + {}", PLt, r0 * w2);
+    ops.once = denseProductAddOps(r1 - r0, nc, r1);
+    cb.line(fmt::format("dense_product_add<{}, {}, {}, {}, {}>({}, {}, Scalar(-1), {});", r1 - r0, nc, r1, w2, w2, a, LtS, c),
+            {}, names, ops);
+  }
+  for (int r0 = 0; r0 + kSymmetricRows < nv; r0 += kSymmetricRows) {  // a block's columns right of it: the later rows'
+    const int r1 = r0 + kSymmetricRows;
+    copyBlock(cb, names, PLt, PLt, r1 - r0, nv - r1, w2, r1 * w2 + r0, true, {w2, r0 * w2 + r1, false});
+  }
   copyBlock(cb, names, PLt, LtS, nv, nc, w2, 0, true, {w2, nv, false});
   copyBlock(cb, names, "dqdd_dtau", PLt, nv, nv, w2, 0, false);
   copyBlock(cb, names, "dlambda_dtau", LtS, nc, nv, w2, 0, false);
