@@ -9,15 +9,14 @@
 // mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
 // it); the constraint rows (J, R2) are printed straight-line from the sweep's
 // motion tangents of the constrained bodies, the path's columns only; the
-// matrix algebra (O((nv + nc) nnz(dtau) + nv^2 nc + nc^2 nv), plus K nc^3 for
-// the proximal operator S_K or K nc^2 nv for stepping C) is fixed-bound loops
-// printed once by assemble.cpp, the products with dtau, J and R2 over their
-// nonzero patterns (constant tables of column ranges). The generic counterpart:
+// matrix algebra (O((nv + nc) (nnz(dtau) + nnz(R2)) + nv^2 nc / 2 + nc^2 nv), plus
+// K nc^3 for the proximal operator S_K) is fixed-bound loops printed once by
+// assemble.cpp, the products with dtau, J and R2 over their nonzero patterns
+// (constant tables of column ranges). The generic counterpart:
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
 
 #include <algorithm>
-
 #include <set>
 
 #include "emit/identifiers.hpp"
@@ -205,7 +204,6 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   const std::string minv = array("cdd_Minv", nv * nv, "M^-1 (constrained_dynamics_derivatives)");
   const std::string dq = array("cdd_dtau_dq", nv * nv, "d tau / dq at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
   const std::string dv = array("cdd_dtau_dv", nv * nv, "d tau / dv at (q, v, qdd*, lambda*) (constrained_dynamics_derivatives)");
-  const std::string xt = array("cdd_Xt", nv * nv, "d qdd / dq or d qdd / dv unconstrained, transposed (constrained_dynamics_derivatives)");
   RowMembers rows;
   std::string Ct, minvjt, G, Lf, S, PLt, LtS, Y;
   const int w2 = nv + nc;  // the row length of [P | Lt^T], [Lt | -S_K] and Y
@@ -240,6 +238,7 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   OpCount ops;
   if (nc == 0) {
     // X_q = -M^-1 dtau_dq, X_v = -M^-1 dtau_dv over dtau's nonzero entries, X_tau = M^-1.
+    const std::string xt = array("cdd_Xt", nv * nv, "d qdd / dq or d qdd / dv, transposed (constrained_dynamics_derivatives)");
     minvTimesDtau(e, t, minv, dq, dv, xt, names);
     CodeBuilder& cb = e.cb();
     cb.line(fmt::format("for (int k = 0; k < {}; ++k) dqdd_dtau[k] = {}[k];", nv * nv, minv), {}, names);
