@@ -277,6 +277,9 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
           {}, names, ops);
   // W = M^-1 J^T = (J M^-1)^T: M^-1 is symmetric.
   copyBlock(cb, names, minvjt, Ct, nv, nc, nv, 0, true);
+  // P starts as M^-1, written here, well before the product reads its rows as
+  // vectors (a vector load of entries just stored one by one stalls).
+  copyBlock(cb, names, PLt, minv, nv, nv, nv, 0, false, {w2, 0, false});
   cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, G), {}, names);
   ops.once = sparseLeftProductOps(jSpans, nc);
   cb.line(fmt::format("sparse_left_product_add<{}, {}, {}>(w.{}, J_nz_start, J_nz_span, {}, Scalar(1), {});", nc, nv, nc,
@@ -305,10 +308,9 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   cb.line(fmt::format("dense_product<{}, {}, {}, {}, {}>({}, {}, Scalar(1), {});", nc, nc, nv, nv, w2, S, Ct, LtS), {}, names,
           ops);
   copyBlock(cb, names, LtS, S, nc, nc, nc, 0, false, {w2, nv, true});
-  // P is symmetric: each block of kSymmetricRows rows up to its last column
-  // (the block's diagonal and what is left of it), then the rest of the upper
-  // triangle mirrored: nc nv^2 / 2 and a block's diagonal, not nc nv^2.
-  copyBlock(cb, names, PLt, minv, nv, nv, nv, 0, false, {w2, 0, false});
+  // P = M^-1 - W Lt is symmetric: each block of kSymmetricRows rows up to its
+  // last column (the block's diagonal and what is left of it), then the rest of
+  // the upper triangle mirrored: nc nv^2 / 2 and a block's diagonal, not nc nv^2.
   for (int r0 = 0; r0 < nv; r0 += kSymmetricRows) {
     const int r1 = std::min(nv, r0 + kSymmetricRows);
     const std::string a = r0 == 0 ? minvjt : fmt::format("{} + {}", minvjt, r0 * nc);
