@@ -1,14 +1,16 @@
 // The shape of the derivatives' tangent sweep (emit/pass_inverse_dynamics_derivatives.cpp):
 // a body's momentum I v, which every column's force tangent dv x* I v reads,
 // is computed once in the body's own block and stored for its carried columns,
-// whose parts used to compute it again each (docs/derivatives.md). The values
-// are the harness's business (tests/generated: harness_derivatives.cpp).
+// whose parts used to compute it again each (docs/derivatives.md); and the
+// shape of constrained_dynamics_derivatives' dense algebra (section 5 there).
+// The values are the harness's business (tests/generated: harness_derivatives.cpp).
 #include <gtest/gtest.h>
 
 #include <map>
 #include <regex>
 #include <string>
 
+#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
@@ -34,6 +36,32 @@ TEST(DerivativesCode, EachBodysMomentumIsStoredOnce) {
   long uses = 0;
   for (auto at = source.find("w.Iv_"); at != std::string::npos; at = source.find("w.Iv_", at + 1)) ++uses;
   EXPECT_GT(uses, long(stores.size()));
+}
+
+// constrained_dynamics_derivatives through the tau block: W = M^-1 J^T meets
+// one nc x nv block (P = M^-1 - W Lt, by blocks of 8 rows up to their last
+// column, the rest mirrored), and each input's two outputs come from one pair
+// of products over rows of nv + nc with its sparse tangents on the left. The
+// literal form multiplied W by each input's block (three full nv x nv products).
+TEST(DerivativesCode, TheConstrainedAlgebraGoesThroughTheTauBlock) {
+  // 11 revolute joints in a chain (nv = 11: two blocks of P), a 3d point on the tip (nc = 3).
+  const test::TempFile urdf("chain.urdf"), layout("point.yaml");
+  urdf.write(test::syntheticTreeUrdf(12, 1));
+  layout.write("base: fixed\nconstraints:\n  - {name: tip, link: l11, type: 3d}\n");
+  GenerateOptions g;
+  g.urdf = urdf.path();
+  g.layout = layout.path();
+  g.functions = "constrained_dynamics_derivatives";
+  const std::string source = generateFiles(g).source;
+  // W's products: the two blocks of P's rows, each up to its last column.
+  EXPECT_EQ(test::occurrences(source, "dense_product_add<"), 2);
+  EXPECT_EQ(test::occurrences(source, "dense_product_add<8, 3, 8, 14, 14>(w.cdd_MinvJt, w.cdd_LtS"), 1);
+  EXPECT_EQ(test::occurrences(source, "dense_product_add<3, 3, 11, 14, 14>(w.cdd_MinvJt + 24, w.cdd_LtS"), 1);
+  // Rows 0..7's columns 8..10 from rows 8..10.
+  EXPECT_EQ(test::occurrences(source, "w.cdd_PLt[i * 14 + 8 + j] = w.cdd_PLt[j * 14 + 112 + i];"), 1);
+  // Per input q, v: -dtau_dx^T [P | Lt^T] + R2_x^T [Lt | -S_K], rows of 14.
+  EXPECT_EQ(test::occurrences(source, "sparse_transposed_product<11, 11, 14>("), 2);
+  EXPECT_EQ(test::occurrences(source, "sparse_transposed_product_add<11, 3, 14, 22>("), 2);
 }
 
 }  // namespace
