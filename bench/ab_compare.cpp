@@ -6,7 +6,8 @@
 // (reading q, v, a, lam, s, w and writing o[0], o[1], ...).
 //
 //   ab_compare check           the states on which any output differs in any bit
-//   ab_compare time N          A and B alternately, 21 repetitions of N calls each:
+//   ab_compare time N          A and B alternately (which goes first alternates too),
+//                              21 repetitions of N calls each:
 //                              median and fastest repetition, and B / A
 //   ab_compare count A|B N     N calls of one side (callgrind: (Ir(2N) - Ir(N)) / N)
 #include <algorithm>
@@ -116,9 +117,10 @@ int main(int argc, char** argv) {
     const int calls = std::atoi(argv[2]);
     if (calls <= 0) return usage();
     std::vector<double> ta, tb;
-    for (int rep = 0; rep < 21; ++rep) {
+    for (int rep = 0; rep < 21; ++rep) {  // A first in even repetitions, B first in odd ones
+      if (rep % 2 == 1) tb.push_back(seconds(st, calls, sideB()) / calls * 1e6);
       ta.push_back(seconds(st, calls, sideA()) / calls * 1e6);
-      tb.push_back(seconds(st, calls, sideB()) / calls * 1e6);
+      if (rep % 2 == 0) tb.push_back(seconds(st, calls, sideB()) / calls * 1e6);
     }
     std::sort(ta.begin(), ta.end());
     std::sort(tb.begin(), tb.end());

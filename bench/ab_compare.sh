@@ -6,7 +6,8 @@
 # instructions per call (callgrind, (Ir(2N) - Ir(N)) / N, as bench/count_calls.py:
 # what the first call does once is not counted as calls), whether the outputs
 # agree bit for bit on 1000 random states, and the time of both in one process,
-# alternating (21 repetitions, medians and fastest).
+# alternating (21 repetitions, medians and fastest), once with A's object linked
+# first and once with B's, and the geometric mean of the two B / A.
 #
 #   bench/ab_compare.sh PROXGEN_A PROXGEN_B CASE FUNCTION [CALLS]
 #
@@ -49,8 +50,12 @@ done
 "$cxx" -std=c++17 "${aflags[@]}" -fno-exceptions -fno-rtti -I "$root/runtime" -c "$dir/A.cpp" -o "$dir/A.o" &
 "$cxx" -std=c++17 "${bflags[@]}" -fno-exceptions -fno-rtti -I "$root/runtime" -c "$dir/B.cpp" -o "$dir/B.o" &
 wait
-"$cxx" -std=c++17 -O2 -I "$root/runtime" -I "$dir" "-DCALL=$call" "$here/ab_compare.cpp" "$dir/A.o" "$dir/B.o" \
-  -o "$dir/ab_compare"
+"$cxx" -std=c++17 -O2 -I "$root/runtime" -I "$dir" "-DCALL=$call" -c "$here/ab_compare.cpp" -o "$dir/main.o"
+# Both link orders: where each side's code lands moves its time by up to a
+# tenth on the large cases (docs/benchmarks.md, "Comparing two versions of the
+# emitter"), so B / A is reported for A.o linked first and for B.o first.
+"$cxx" "$dir/main.o" "$dir/A.o" "$dir/B.o" -o "$dir/ab_compare"
+"$cxx" "$dir/main.o" "$dir/B.o" "$dir/A.o" -o "$dir/ab_compare_ba"
 ir() {  # instructions of N calls of one side
   valgrind --tool=callgrind --callgrind-out-file=/dev/null "$dir/ab_compare" count "$1" "$2" 2>&1 |
     sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
@@ -63,4 +68,12 @@ for side in A B; do
   echo "$side: text $bytes bytes, $per_call instructions per call"
 done
 "$dir/ab_compare" check
-"$dir/ab_compare" time "$calls"
+ab=$("$dir/ab_compare" time "$calls")
+ba=$("$dir/ab_compare_ba" time "$calls")
+echo "A.o first: $ab"
+echo "B.o first: $ba"
+ratio() { sed -n 's/.*B \/ A: median \([0-9.]*\), fastest \([0-9.]*\).*/\1 \2/p' <<< "$1"; }
+read -r m1 f1 <<< "$(ratio "$ab")"
+read -r m2 f2 <<< "$(ratio "$ba")"
+awk -v m1="$m1" -v m2="$m2" -v f1="$f1" -v f2="$f2" \
+  'BEGIN { printf "B / A over both link orders (geometric mean): median %.3f, fastest %.3f\n", sqrt(m1 * m2), sqrt(f1 * f2) }'
