@@ -35,10 +35,12 @@ struct Assembly {
   std::vector<std::vector<std::pair<int, int>>> at;
 };
 
-// G(t, u), rows in tree order (Z_i . Z_i at a free flyer or planar joint, but
-// at the free flyer `split` whose share goes through Woodbury).
-Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, int split) {
-  Expr g;
+// G(t, u)'s terms as (row t's factor, row u's factor), rows in tree order,
+// bodies ascending (Z_i . Z_i at a free flyer or planar joint, but at the
+// free flyer `split` whose share goes through Woodbury).
+using Terms = std::vector<std::pair<Expr, Expr>>;
+Terms delassusTerms(const Assembly& a, int t, int u, int split) {
+  Terms g;
   for (const auto& [i, jt] : a.at[std::size_t(t)]) {
     const BodyPlan& b = a.plan.bodies[std::size_t(i)];
     if (u < b.rowStart || u >= b.rowStart + b.m()) continue;
@@ -46,13 +48,21 @@ Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, int split) {
     const ProxRows::Body& r = a.rows.b[std::size_t(i)];
     if (const int n = int(pickedComponents(b.jointClass).size()); n > 0) {
       if (i == split) continue;
-      for (int d = 0; d < n; ++d) g += cb.mul(r.Z[std::size_t(jt)][std::size_t(d)], r.Z[std::size_t(ju)][std::size_t(d)]);
+      for (int d = 0; d < n; ++d) g.push_back({r.Z[std::size_t(jt)][std::size_t(d)], r.Z[std::size_t(ju)][std::size_t(d)]});
     } else {
-      g += cb.mul(r.KSD[std::size_t(jt)], r.KS[std::size_t(ju)][0]);
+      g.push_back({r.KSD[std::size_t(jt)], r.KS[std::size_t(ju)][0]});
     }
   }
   return g;
 }
+
+Expr sumOf(CodeBuilder& cb, const Terms& terms) {
+  Expr x;
+  for (const auto& [p, q] : terms) x += cb.mul(p, q);
+  return x;
+}
+
+Expr delassus(CodeBuilder& cb, const Assembly& a, int t, int u, int split) { return sumOf(cb, delassusTerms(a, t, u, split)); }
 
 // The free-flyer body when it carries constraint rows (floating base) and the
 // Woodbury split G = B + Z^T Z suits them, else -1: then G + I/mu is factored
@@ -105,14 +115,19 @@ int freeFlyerWithRows(const Plan& plan) {
 // with zero coupling and a zero right-hand side (F y, lambda0 0) its rows of
 // the factor's solves are exact zeros whatever the block holds, and the other
 // rows never read it; so the limbs of one contact each pay nothing here.
-Expr scheduled(Emit& e, int t, int u, const Expr& g) {
+// A loop over the rows t reads row t's factor from `rowActive` (active_rows[t]).
+bool sameConstraint(const Plan& plan, int t, int u) {
+  return rowConstraint(plan, plan.rootRows[std::size_t(t)]) == rowConstraint(plan, plan.rootRows[std::size_t(u)]);
+}
+
+Expr scheduled(Emit& e, int t, int u, const Expr& g, const Expr* rowActive = nullptr) {
   const std::vector<int>& tree = e.plan.rootRows;
   const int kt = rowConstraint(e.plan, tree[std::size_t(t)]), ku = rowConstraint(e.plan, tree[std::size_t(u)]);
   if (g.isZero() || kt == ku) return g;
   // One statement each, in this order: the order of C++ arguments' evaluation
   // is the compiler's, and these calls create the expressions whose order the
   // printed text follows (generation must not depend on the compiler).
-  const Expr at = activeFactor(e, kt);
+  const Expr at = rowActive ? *rowActive : activeFactor(e, kt);
   const Expr au = activeFactor(e, ku);
   const Expr both = e.cb().mul(at, au);
   const Expr flat = e.cb().flat(g);
@@ -265,7 +280,7 @@ class LowRank {
         }
       for (int t = br_.blocks[std::size_t(l)]; t < br_.blocks[std::size_t(l + 1)]; ++t)
         for (int p = 0; p < r; ++p)
-          at(s_.gp, t - s, p) = e_.put(member("gP", n * r, (t - s) * r + p, "g P_l, block l"), times(s_.pm, t - s, p));
+          at(s_.gp, t - s, p) = e_.put(member("gP", n * r, p * n + t - s, "g P_l, block l (column p, row t)"), times(s_.pm, t - s, p));
     }
     for (int t = br_.blocks[std::size_t(l + 1)]; t < br_.blocks.back(); ++t)
       for (int p = 0; p < r; ++p)
@@ -294,13 +309,15 @@ class LowRank {
       at(s_.y, j - s, p) = e_.put(member("Y", n * r, (j - s) * r + p, "L_ll^-1 g, block l"), y);
     }
   }
-  // The earlier blocks' share of entry (i, j) of one block: (g P_l)[i] . g[j].
-  Expr update(int i, int j) {
-    Expr x;
+  // The earlier blocks' share of entry (i, j) of one block: (g P_l)[i] . g[j],
+  // as (row i's factor, row j's factor).
+  Terms updateTerms(int i, int j) {
+    Terms x;
     if (blockOf(j) == 0) return x;
-    for (int p = 0; p < br_.rank(); ++p) x += e_.cb().mul(at(s_.gp, i - first(), p), at(s_.g, j - first(), p));
+    for (int p = 0; p < br_.rank(); ++p) x.push_back({at(s_.gp, i - first(), p), at(s_.g, j - first(), p)});
     return x;
   }
+  Expr update(int i, int j) { return sumOf(e_.cb(), updateTerms(i, j)); }
 
  private:
   int slots(int n) {
@@ -325,6 +342,93 @@ class LowRank {
   LowRankSlots s_;
 };
 
+constexpr const char* kLWhat = "Cholesky factor of G + I/mu (lower, packed)";
+
+// Entry (i, j) of the factor below the diagonal, as its terms:
+// L(i, j) = (G(i, j), scheduled, - (g P_l)[i] . g[j] - sum_k L(i, k) L(j, k)) / L(j, j).
+struct Entry {
+  Terms g, lowRank, chol;  // (row i's factor, row j's factor)
+  bool scheduled = false;  // i and j of two constraints: G(i, j) times both activity factors
+  bool inBranch = false;   // i and j in one branch's block: its low-rank update
+};
+
+// The entry's value: the same operations in the same order wherever it is
+// printed, unrolled or in a loop; rowActive: row i's activity factor as a loop reads it.
+Expr entryValue(Emit& e, const Entry& en, int i, int j, const Expr& linv, const Expr* rowActive = nullptr) {
+  CodeBuilder& cb = e.cb();
+  Expr x = en.scheduled ? scheduled(e, i, j, sumOf(cb, en.g), rowActive) : sumOf(cb, en.g);
+  if (en.inBranch) x -= sumOf(cb, en.lowRank);
+  for (const auto& [p, q] : en.chol) x -= cb.mul(p, q);
+  return cb.mul(cb.flat(x), linv);
+}
+
+// Row i's factors, the entries a loop over the rows reads at [idx + j].
+std::vector<Expr> rowFactors(const Entry& en) {
+  std::vector<Expr> out;
+  for (const Terms* t : {&en.g, &en.lowRank, &en.chol})
+    for (const auto& pq : *t) out.push_back(pq.first);
+  return out;
+}
+
+// What must be the same in every row of a loop: the flags, and the column's factors.
+std::string columnKey(const CodeBuilder& cb, const Entry& en) {
+  std::string key = fmt::format("{}{}|", int(en.scheduled), int(en.inBranch));
+  for (const Terms* t : {&en.g, &en.lowRank, &en.chol}) {
+    for (const auto& pq : *t) key += cb.describe(pq.second) + ";";
+    key += "|";
+  }
+  return key;
+}
+
+// Adjacent rows of one column whose entries are one statement over [idx + j]
+// (oneShape: each row factor the same constant, or a member slot one further
+// per row), as (first row, count); shorter runs than kShortestColumnLoop (a
+// threshold of 4 rows measured no better: docs/emitter.md, "The Delassus
+// columns as loops"), and runs that read no member, as single rows.
+std::vector<std::pair<int, int>> entryRuns(const CodeBuilder& cb, const std::vector<Entry>& entries, const std::vector<int>& rows) {
+  const auto factors = [&](int i) { return rowFactors(entries[std::size_t(i)]); };
+  std::vector<std::pair<int, int>> runs;
+  for (std::size_t n = 0; n < rows.size();) {
+    const int i0 = rows[n];
+    const std::string key = columnKey(cb, entries[std::size_t(i0)]);
+    std::size_t len = 1;
+    while (n + len < rows.size() && rows[n + len] == i0 + int(len) &&
+           columnKey(cb, entries[std::size_t(rows[n + len])]) == key && oneShape(cb, factors, rows[n + len], i0))
+      ++len;
+    bool reads = false;
+    for (const Expr& x : factors(i0)) reads = reads || !x.isConstant();
+    if (int(len) < kShortestColumnLoop || !reads) len = 1;
+    runs.push_back({i0, int(len)});
+    n += len;
+  }
+  return runs;
+}
+
+// Rows i0 .. i0 + len - 1 of column j as one loop: the compiler's loop
+// vectoriser takes two (SSE2) to eight (AVX-512) rows at a time, where the
+// unrolled entries were one long scalar expression each.
+void loopEntries(Emit& e, const std::vector<Entry>& entries, int i0, int len, int j, DelassusFactor& f, bool& activeRows) {
+  const int nc = e.plan.nc;
+  const Entry& first = entries[std::size_t(i0)];
+  if (first.scheduled && !activeRows) {  // the rows' activity factors, by row, for the loops to read
+    for (int t = 0; t < nc; ++t)
+      e.cb().store(e.member("active_rows", nc, t, "the activity factor of each row (tree order)"), activeRowFactor(e, e.plan.rootRows[std::size_t(t)]));
+    activeRows = true;
+  }
+  CodeBuilder& cb = e.cb();
+  cb.open(columnLoopHead(len), {fmt::format("rows {} to {}", i0, i0 + len - 1)});
+  const std::vector<Expr> reads = loopReads(cb, rowFactors(first));
+  Entry en = first;
+  std::size_t r = 0;
+  for (Terms* t : {&en.g, &en.lowRank, &en.chol})
+    for (auto& pq : *t) pq.first = reads[r++];
+  const Expr act = first.scheduled ? cb.member(e.ws.loopSlot("active_rows", nc, i0, "the activity factor of each row (tree order)")) : Expr();
+  e.put(e.ws.loopSlot("L", nc * (nc + 1) / 2, Sym::index(nc, i0, j), kLWhat),
+        entryValue(e, en, i0, j, f.Linv[std::size_t(j)], first.scheduled ? &act : nullptr));
+  cb.close();
+  for (int i = i0; i < i0 + len; ++i) f.L(i, j) = cb.refresh(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), kLWhat));
+}
+
 // G + I/mu = L L^T (or A + I/mu with a floating base), scheduled, one block
 // (and part) per column; the blocks of a branch meet through its low-rank terms.
 void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
@@ -336,6 +440,7 @@ void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
   std::vector<LowRank> lr;
   lr.reserve(branches.size());
   for (std::size_t b = 0; b < branches.size(); ++b) lr.emplace_back(e, f, branches[b], int(b));
+  bool activeRows = false;  // active_rows stored (loopEntries)
   std::vector<int> branchOf(std::size_t(nc), -1);
   for (std::size_t b = 0; b < branches.size(); ++b)
     for (int t = branches[b].blocks.front(); t < branches[b].blocks.back(); ++t) branchOf[std::size_t(t)] = int(b);
@@ -356,15 +461,28 @@ void factorColumns(Emit& e, const Assembly& a, DelassusFactor& f) {
     const Expr r = cb.sqrt(d, "r");
     f.Linv[std::size_t(j)] = e.put(e.member("Linv", nc, j, "1 / diag(L)"), cb.recip(r, "inv"));
     if (lj && !lj->last(lb)) lj->solveRow(j, f);
+    std::vector<Entry> entries(static_cast<std::size_t>(nc));
+    std::vector<int> below;  // the rows whose entry is formed
     for (int i = j + 1; i < nc; ++i) {
-      const std::string name = e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), "Cholesky factor of G + I/mu (lower, packed)");
+      e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i, j), kLWhat);  // declared in row order
       // between two blocks of a branch: (g M_l)[i] . Y[j], never formed (lowRankForward, lowRankBackward)
       if (lj && branchOf[std::size_t(i)] == branchOf[std::size_t(j)] && lj->blockOf(i) > lb) continue;
-      Expr x = scheduled(e, i, j, delassus(cb, a, i, j, split));
-      if (lj && branchOf[std::size_t(i)] == branchOf[std::size_t(j)]) x -= lj->update(i, j);
+      Entry& en = entries[std::size_t(i)];
+      en.g = delassusTerms(a, i, j, split);
+      en.scheduled = !sameConstraint(e.plan, i, j);
+      en.inBranch = lj && branchOf[std::size_t(i)] == branchOf[std::size_t(j)];
+      if (en.inBranch) en.lowRank = lj->updateTerms(i, j);
       for (int k = 0; k < j; ++k)
-        if (summed(i, k)) x -= cb.mul(f.L(i, k), f.L(j, k));
-      f.L(i, j) = e.put(name, cb.mul(cb.flat(x), f.Linv[std::size_t(j)]));
+        if (summed(i, k)) en.chol.push_back({f.L(i, k), f.L(j, k)});
+      below.push_back(i);
+    }
+    for (const auto& [i0, len] : entryRuns(cb, entries, below)) {
+      if (len == 1) {
+        f.L(i0, j) = e.put(e.member("L", nc * (nc + 1) / 2, Sym::index(nc, i0, j), kLWhat),
+                           entryValue(e, entries[std::size_t(i0)], i0, j, f.Linv[std::size_t(j)]));
+        continue;
+      }
+      loopEntries(e, entries, i0, len, j, f, activeRows);
     }
     cb.close();
   }

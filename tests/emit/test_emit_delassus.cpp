@@ -6,7 +6,9 @@
 // harnesses' business (tests/generated: the shared cases' prox_pv against the
 // generic one, double and float; tests/cli/test_verify_models.cpp: the
 // Cartesian legs below); this checks the code's shape. With six rows or fewer
-// there is no split: G + I/mu is factored whole.
+// there is no split: G + I/mu is factored whole. A column's entries below the
+// diagonal of one shape (the same terms, each read one slot further per row)
+// are one loop over the rows (docs/emitter.md, "The Delassus columns as loops").
 #include <gtest/gtest.h>
 
 #include <string>
@@ -87,6 +89,31 @@ TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
   expectWoodburyRows(f.source, 9);
   EXPECT_GT(test::occurrences(f.source, "some entries folded: staged for the loops"), 0);
   EXPECT_GT(test::occurrences(f.source, "w.Wz[0][j]"), 0);
+}
+
+// The Atlas' right hand holds rows 15 to 29 (five fingertips, three rows
+// each), which all meet at the palm: in column 19 (the second row of the
+// fingertip of rows 18 to 20) the rows of the other fingertips, 21 to 29,
+// are one loop that reads each row's activity factor from active_rows and the
+// earlier columns one slot further per row; row 20, of the same fingertip as
+// 19 (more bodies in common, no activity factors), stays unrolled.
+TEST(DelassusCode, TheRowsOfAColumnOfOneShapeAreOneLoop) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  const SolverFiles atlas =
+      generateCase(cases, "atlas_shadow_f6x2_t3x10", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  const std::size_t at = atlas.source.find("// G + I/mu = L L^T, column 19 (");
+  ASSERT_NE(at, std::string::npos);
+  const std::string column19 = atlas.source.substr(at, atlas.source.find("column 20 (", at) - at);
+  EXPECT_EQ(lineAfter(column19, "// rows 21 to 29"), "    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 9; ++j) {") << column19;
+  EXPECT_GT(test::occurrences(column19, "w.active_rows[21 + j]*w.active[6]"), 0) << column19;
+  EXPECT_GT(test::occurrences(column19, "w.L[604]*w.L[606 + j]"), 0) << column19;  // L(i, 18) L(19, 18)
+  EXPECT_GT(test::occurrences(column19, "w.L[629 + j] = w.Linv[19]*"), 0) << column19;
+  EXPECT_GT(test::occurrences(column19, "w.L[628] = "), 0) << "row 20 unrolled\n" << column19;
+  EXPECT_GT(test::occurrences(atlas.header, "Scalar active_rows[42];"), 0);
+  // Talos' four 6-d contacts fold a different set of terms into each row: no loop, no active_rows.
+  const SolverFiles talos = generateCase(cases, "talos_f6x2_h6x2", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  EXPECT_EQ(test::occurrences(talos.header, "active_rows"), 0);
 }
 
 }  // namespace
