@@ -51,9 +51,9 @@ done
 "$cxx" -std=c++17 "${bflags[@]}" -fno-exceptions -fno-rtti -I "$root/runtime" -c "$dir/B.cpp" -o "$dir/B.o" &
 wait
 "$cxx" -std=c++17 -O2 -I "$root/runtime" -I "$dir" "-DCALL=$call" -c "$here/ab_compare.cpp" -o "$dir/main.o"
-# Both link orders: where each side's code lands moves its time by up to a
-# tenth on the large cases (docs/benchmarks.md, "Comparing two versions of the
-# emitter"), so B / A is reported for A.o linked first and for B.o first.
+# Both link orders: one process's B / A can be off by a tenth on the large
+# cases (docs/benchmarks.md, "The Delassus columns as loops"), so it is taken
+# from two executables, A.o linked first and B.o first.
 "$cxx" "$dir/main.o" "$dir/A.o" "$dir/B.o" -o "$dir/ab_compare"
 "$cxx" "$dir/main.o" "$dir/B.o" "$dir/A.o" -o "$dir/ab_compare_ba"
 ir() {  # instructions of N calls of one side (empty where callgrind cannot run the code)
