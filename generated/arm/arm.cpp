@@ -1485,7 +1485,7 @@ PROXGEN_RT_NOINLINE void pv_free_wrist_3_link_to_yfree(Workspace& PROXGEN_RT_RES
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_5(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = w.KSD_shoulder_link[0]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[0]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[0]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[0]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[0]*w.KA_wrist_2_link[5][0] + inv_mu;
@@ -1496,60 +1496,60 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_5(Scalar inv_mu, Workspa
     w.L[1] = w.Linv[0]*t1;
     const Scalar t2 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][0];
     w.L[2] = w.Linv[0]*t2;
-    // rows 3 to 4
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t3 = w.KA_shoulder_link[5][0]*w.KSD_shoulder_link[3 + j] + w.KA_upper_arm_link[5][0]*w.KSD_upper_arm_link[3 + j] + w.KA_forearm_link[5][0]*w.KSD_forearm_link[3 + j] + w.KA_wrist_1_link[5][0]*w.KSD_wrist_1_link[3 + j] + w.KA_wrist_2_link[5][0]*w.KSD_wrist_2_link[3 + j];
-      w.L[3 + j] = w.Linv[0]*t3;
-    }
+    const Scalar t3 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][0];
+    w.L[3] = w.Linv[0]*t3;
+    const Scalar t4 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][0] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][0] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][0] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][0] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][0];
+    w.L[4] = w.Linv[0]*t4;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t4 = inv_mu + w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[1];
-    const Scalar r1 = std::sqrt(t4);
+    const Scalar t5 = inv_mu + w.KSD_shoulder_link[1]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[1]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[1]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[1]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[1]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[1];
+    const Scalar r1 = std::sqrt(t5);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t5 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][1] - w.L[1]*w.L[2];
-    w.L[7] = w.Linv[1]*t5;
-    // rows 3 to 4
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t6 = w.KA_shoulder_link[5][1]*w.KSD_shoulder_link[3 + j] + w.KA_upper_arm_link[5][1]*w.KSD_upper_arm_link[3 + j] + w.KA_forearm_link[5][1]*w.KSD_forearm_link[3 + j] + w.KA_wrist_1_link[5][1]*w.KSD_wrist_1_link[3 + j] + w.KA_wrist_2_link[5][1]*w.KSD_wrist_2_link[3 + j] - w.L[1]*w.L[3 + j];
-      w.L[8 + j] = w.Linv[1]*t6;
-    }
+    const Scalar t6 = w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][1] - w.L[1]*w.L[2];
+    w.L[7] = w.Linv[1]*t6;
+    const Scalar t7 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[3];
+    w.L[8] = w.Linv[1]*t7;
+    const Scalar t8 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][1] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][1] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][1] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][1] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][1] - w.L[1]*w.L[4];
+    w.L[9] = w.Linv[1]*t8;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t7 = inv_mu + w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[2] - w.L[7]*w.L[7];
-    const Scalar r2 = std::sqrt(t7);
+    const Scalar t9 = inv_mu + w.KSD_shoulder_link[2]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[2]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[2]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[2]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[2] - w.L[7]*w.L[7];
+    const Scalar r2 = std::sqrt(t9);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    // rows 3 to 4
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t8 = w.KA_shoulder_link[5][2]*w.KSD_shoulder_link[3 + j] + w.KA_upper_arm_link[5][2]*w.KSD_upper_arm_link[3 + j] + w.KA_forearm_link[5][2]*w.KSD_forearm_link[3 + j] + w.KA_wrist_1_link[5][2]*w.KSD_wrist_1_link[3 + j] - w.L[2]*w.L[3 + j] - w.L[7]*w.L[8 + j];
-      w.L[12 + j] = w.Linv[2]*t8;
-    }
+    const Scalar t10 = w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[3] - w.L[7]*w.L[8];
+    w.L[12] = w.Linv[2]*t10;
+    const Scalar t11 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][2] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][2] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][2] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][2] - w.L[2]*w.L[4] - w.L[7]*w.L[9];
+    w.L[13] = w.Linv[2]*t11;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
-    const Scalar r3 = std::sqrt(t9);
+    const Scalar t12 = inv_mu + w.KSD_shoulder_link[3]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[3]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[3]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[3]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[3]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[3] - w.L[8]*w.L[8] - w.L[12]*w.L[12];
+    const Scalar r3 = std::sqrt(t12);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
-    const Scalar t10 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
-    w.L[16] = w.Linv[3]*t10;
+    const Scalar t13 = w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][3] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][3] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][3] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][3] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][3] - w.L[3]*w.L[4] - w.L[8]*w.L[9] - w.L[12]*w.L[13];
+    w.L[16] = w.Linv[3]*t13;
   }
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t11 = inv_mu + w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][4] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][4] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][4] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][4] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][4] - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
-    const Scalar r4 = std::sqrt(t11);
+    const Scalar t14 = inv_mu + w.KSD_shoulder_link[4]*w.KA_shoulder_link[5][4] + w.KSD_upper_arm_link[4]*w.KA_upper_arm_link[5][4] + w.KSD_forearm_link[4]*w.KA_forearm_link[5][4] + w.KSD_wrist_1_link[4]*w.KA_wrist_1_link[5][4] + w.KSD_wrist_2_link[4]*w.KA_wrist_2_link[5][4] - w.L[4]*w.L[4] - w.L[9]*w.L[9] - w.L[13]*w.L[13] - w.L[16]*w.L[16];
+    const Scalar r4 = std::sqrt(t14);
     const Scalar inv4 = 1.0 / r4;
     w.Linv[4] = inv4;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_delassus_column_5(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = 2705.9022492812446 + inv_mu;
-    const Scalar r5 = std::sqrt(t12);
-    const Scalar inv5 = 1.0 / r5;
-    w.Linv[5] = inv5;
+    const Scalar t0 = 2705.9022492812446 + inv_mu;
+    const Scalar r0 = std::sqrt(t0);
+    const Scalar inv0 = 1.0 / r0;
+    w.Linv[5] = inv0;
   }
 }
 
@@ -1769,7 +1769,8 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_free_wrist_3_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
-  pv_delassus_column_0_to_column_5(inv_mu, w);
+  pv_delassus_column_0_to_column_4(inv_mu, w);
+  pv_delassus_column_5(inv_mu, w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);
   const MultiplierRows lambda0_if[2] = {proxgen_rt::initial_multipliers<nc, Scalar>(nullptr), lambda0};

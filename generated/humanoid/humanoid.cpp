@@ -6069,7 +6069,7 @@ PROXGEN_RT_NOINLINE void pv_free_r_wrist_pitch_link_to_yfree(Workspace& PROXGEN_
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_3(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // G + I/mu = L L^T, column 0 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t0 = w.KSD_l_hip_yaw_link[0]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[0]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[0]*w.KA_l_thigh[4][0] + w.KSD_l_shank[0]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[0]*w.KA_l_ankle_link[4][0] + inv_mu;
@@ -6082,253 +6082,245 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_4(Scalar inv_mu, Workspa
     w.L[2] = w.Linv[0]*t2;
     const Scalar t3 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][0] + w.KSD_l_shank[3]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][0];
     w.L[3] = w.Linv[0]*t3;
-    // rows 4 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t4 = w.KA_l_hip_yaw_link[5][0]*w.KSD_l_hip_yaw_link[4 + j] + w.KA_l_hip_roll_link[3][0]*w.KSD_l_hip_roll_link[4 + j] + w.KA_l_thigh[4][0]*w.KSD_l_thigh[4 + j] + w.KA_l_shank[4][0]*w.KSD_l_shank[4 + j] + w.KA_l_ankle_link[4][0]*w.KSD_l_ankle_link[4 + j];
-      w.L[4 + j] = w.Linv[0]*t4;
-    }
+    const Scalar t4 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][0] + w.KSD_l_shank[4]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][0];
+    w.L[4] = w.Linv[0]*t4;
+    const Scalar t5 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][0] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][0] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][0] + w.KSD_l_shank[5]*w.KA_l_shank[4][0] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][0];
+    w.L[5] = w.Linv[0]*t5;
   }
   // G + I/mu = L L^T, column 1 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t5 = 2.394677145741774 + inv_mu + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][1] + w.KSD_l_shank[1]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[1];
-    const Scalar r1 = std::sqrt(t5);
+    const Scalar t6 = 2.394677145741774 + inv_mu + w.KSD_l_hip_yaw_link[1]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[1]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[1]*w.KA_l_thigh[4][1] + w.KSD_l_shank[1]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[1]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[1];
+    const Scalar r1 = std::sqrt(t6);
     const Scalar inv1 = 1.0 / r1;
     w.Linv[1] = inv1;
-    const Scalar t6 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][1] + w.KSD_l_shank[2]*w.KA_l_shank[4][1] - w.L[1]*w.L[2];
-    w.L[16] = w.Linv[1]*t6;
-    const Scalar t7 = 35.0868446262531 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][1] + w.KSD_l_shank[3]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[3];
-    w.L[17] = w.Linv[1]*t7;
-    // rows 4 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t8 = w.KA_l_hip_yaw_link[5][1]*w.KSD_l_hip_yaw_link[4 + j] + w.KA_l_hip_roll_link[3][1]*w.KSD_l_hip_roll_link[4 + j] + w.KA_l_thigh[4][1]*w.KSD_l_thigh[4 + j] + w.KA_l_shank[4][1]*w.KSD_l_shank[4 + j] + w.KA_l_ankle_link[4][1]*w.KSD_l_ankle_link[4 + j] - w.L[1]*w.L[4 + j];
-      w.L[18 + j] = w.Linv[1]*t8;
-    }
+    const Scalar t7 = w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][1] + w.KSD_l_shank[2]*w.KA_l_shank[4][1] - w.L[1]*w.L[2];
+    w.L[16] = w.Linv[1]*t7;
+    const Scalar t8 = 35.0868446262531 + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][1] + w.KSD_l_shank[3]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[3];
+    w.L[17] = w.Linv[1]*t8;
+    const Scalar t9 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][1] + w.KSD_l_shank[4]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[4];
+    w.L[18] = w.Linv[1]*t9;
+    const Scalar t10 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][1] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][1] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][1] + w.KSD_l_shank[5]*w.KA_l_shank[4][1] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][1] - w.L[1]*w.L[5];
+    w.L[19] = w.Linv[1]*t10;
   }
   // G + I/mu = L L^T, column 2 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t9 = inv_mu + w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][2] + w.KSD_l_shank[2]*w.KA_l_shank[4][2] - w.L[2]*w.L[2] - w.L[16]*w.L[16];
-    const Scalar r2 = std::sqrt(t9);
+    const Scalar t11 = inv_mu + w.KSD_l_hip_yaw_link[2]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[2]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[2]*w.KA_l_thigh[4][2] + w.KSD_l_shank[2]*w.KA_l_shank[4][2] - w.L[2]*w.L[2] - w.L[16]*w.L[16];
+    const Scalar r2 = std::sqrt(t11);
     const Scalar inv2 = 1.0 / r2;
     w.Linv[2] = inv2;
-    const Scalar t10 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][2] + w.KSD_l_shank[3]*w.KA_l_shank[4][2] - w.L[2]*w.L[3] - w.L[16]*w.L[17];
-    w.L[30] = w.Linv[2]*t10;
-    // rows 4 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t11 = w.KA_l_hip_yaw_link[5][2]*w.KSD_l_hip_yaw_link[4 + j] + w.KA_l_hip_roll_link[3][2]*w.KSD_l_hip_roll_link[4 + j] + w.KA_l_thigh[4][2]*w.KSD_l_thigh[4 + j] + w.KA_l_shank[4][2]*w.KSD_l_shank[4 + j] - w.L[2]*w.L[4 + j] - w.L[16]*w.L[18 + j];
-      w.L[31 + j] = w.Linv[2]*t11;
-    }
+    const Scalar t12 = w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][2] + w.KSD_l_shank[3]*w.KA_l_shank[4][2] - w.L[2]*w.L[3] - w.L[16]*w.L[17];
+    w.L[30] = w.Linv[2]*t12;
+    const Scalar t13 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][2] + w.KSD_l_shank[4]*w.KA_l_shank[4][2] - w.L[2]*w.L[4] - w.L[16]*w.L[18];
+    w.L[31] = w.Linv[2]*t13;
+    const Scalar t14 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][2] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][2] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][2] + w.KSD_l_shank[5]*w.KA_l_shank[4][2] - w.L[2]*w.L[5] - w.L[16]*w.L[19];
+    w.L[32] = w.Linv[2]*t14;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t12 = 514.0929615568219 + inv_mu + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][3] + w.KSD_l_shank[3]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
-    const Scalar r3 = std::sqrt(t12);
+    const Scalar t15 = 514.0929615568219 + inv_mu + w.KSD_l_hip_yaw_link[3]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[3]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[3]*w.KA_l_thigh[4][3] + w.KSD_l_shank[3]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[3]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[3] - w.L[17]*w.L[17] - w.L[30]*w.L[30];
+    const Scalar r3 = std::sqrt(t15);
     const Scalar inv3 = 1.0 / r3;
     w.Linv[3] = inv3;
-    // rows 4 to 5
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t13 = w.KA_l_hip_yaw_link[5][3]*w.KSD_l_hip_yaw_link[4 + j] + w.KA_l_hip_roll_link[3][3]*w.KSD_l_hip_roll_link[4 + j] + w.KA_l_thigh[4][3]*w.KSD_l_thigh[4 + j] + w.KA_l_shank[4][3]*w.KSD_l_shank[4 + j] + w.KA_l_ankle_link[4][3]*w.KSD_l_ankle_link[4 + j] - w.L[3]*w.L[4 + j] - w.L[17]*w.L[18 + j] - w.L[30]*w.L[31 + j];
-      w.L[43 + j] = w.Linv[3]*t13;
-    }
-  }
-  // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t14 = inv_mu + w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][4] + w.KSD_l_shank[4]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][4] - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
-    const Scalar r4 = std::sqrt(t14);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[4] = inv4;
-    const Scalar t15 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][4] + w.KSD_l_shank[5]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][4] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
-    w.L[55] = w.Linv[4]*t15;
+    const Scalar t16 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][3] + w.KSD_l_shank[4]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[4] - w.L[17]*w.L[18] - w.L[30]*w.L[31];
+    w.L[43] = w.Linv[3]*t16;
+    const Scalar t17 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][3] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][3] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][3] + w.KSD_l_shank[5]*w.KA_l_shank[4][3] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][3] - w.L[3]*w.L[5] - w.L[17]*w.L[19] - w.L[30]*w.L[32];
+    w.L[44] = w.Linv[3]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_5_to_column_9(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
+PROXGEN_RT_NOINLINE void pv_delassus_column_4_to_column_8(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][5] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][5] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][5] + w.KSD_l_shank[5]*w.KA_l_shank[4][5] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][5] + inv_mu - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
+    const Scalar t0 = w.KSD_l_hip_yaw_link[4]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[4]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[4]*w.KA_l_thigh[4][4] + w.KSD_l_shank[4]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[4]*w.KA_l_ankle_link[4][4] + inv_mu - w.L[4]*w.L[4] - w.L[18]*w.L[18] - w.L[31]*w.L[31] - w.L[43]*w.L[43];
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
-    w.Linv[5] = inv0;
+    w.Linv[4] = inv0;
+    const Scalar t1 = w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][4] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][4] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][4] + w.KSD_l_shank[5]*w.KA_l_shank[4][4] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][4] - w.L[4]*w.L[5] - w.L[18]*w.L[19] - w.L[31]*w.L[32] - w.L[43]*w.L[44];
+    w.L[55] = w.Linv[4]*t1;
+  }
+  // G + I/mu = L L^T, column 5 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t2 = inv_mu + w.KSD_l_hip_yaw_link[5]*w.KA_l_hip_yaw_link[5][5] + w.KSD_l_hip_roll_link[5]*w.KA_l_hip_roll_link[3][5] + w.KSD_l_thigh[5]*w.KA_l_thigh[4][5] + w.KSD_l_shank[5]*w.KA_l_shank[4][5] + w.KSD_l_ankle_link[5]*w.KA_l_ankle_link[4][5] - w.L[5]*w.L[5] - w.L[19]*w.L[19] - w.L[32]*w.L[32] - w.L[44]*w.L[44] - w.L[55]*w.L[55];
+    const Scalar r1 = std::sqrt(t2);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[5] = inv1;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t1 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[0]*w.KA_r_thigh[4][0] + w.KSD_r_shank[0]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4][0];
-    const Scalar r1 = std::sqrt(t1);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[6] = inv1;
-    const Scalar t2 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][0] + w.KSD_r_shank[1]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][0];
-    w.L[76] = w.Linv[6]*t2;
-    const Scalar t3 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][0] + w.KSD_r_shank[2]*w.KA_r_shank[4][0];
-    w.L[77] = w.Linv[6]*t3;
-    const Scalar t4 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][0] + w.KSD_r_shank[3]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][0];
-    w.L[78] = w.Linv[6]*t4;
-    // rows 10 to 11
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t5 = w.KA_r_hip_yaw_link[5][0]*w.KSD_r_hip_yaw_link[4 + j] + w.KA_r_hip_roll_link[3][0]*w.KSD_r_hip_roll_link[4 + j] + w.KA_r_thigh[4][0]*w.KSD_r_thigh[4 + j] + w.KA_r_shank[4][0]*w.KSD_r_shank[4 + j] + w.KA_r_ankle_link[4][0]*w.KSD_r_ankle_link[4 + j];
-      w.L[79 + j] = w.Linv[6]*t5;
-    }
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[0]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[0]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[0]*w.KA_r_thigh[4][0] + w.KSD_r_shank[0]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[0]*w.KA_r_ankle_link[4][0];
+    const Scalar r2 = std::sqrt(t3);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[6] = inv2;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][0] + w.KSD_r_shank[1]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][0];
+    w.L[76] = w.Linv[6]*t4;
+    const Scalar t5 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][0] + w.KSD_r_shank[2]*w.KA_r_shank[4][0];
+    w.L[77] = w.Linv[6]*t5;
+    const Scalar t6 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][0] + w.KSD_r_shank[3]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][0];
+    w.L[78] = w.Linv[6]*t6;
+    const Scalar t7 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][0] + w.KSD_r_shank[4]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][0];
+    w.L[79] = w.Linv[6]*t7;
+    const Scalar t8 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][0] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][0] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][0] + w.KSD_r_shank[5]*w.KA_r_shank[4][0] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][0];
+    w.L[80] = w.Linv[6]*t8;
   }
   // G + I/mu = L L^T, column 7 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = 2.394677145741774 + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][1] + w.KSD_r_shank[1]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[76];
-    const Scalar r2 = std::sqrt(t6);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[7] = inv2;
-    const Scalar t7 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][1] + w.KSD_r_shank[2]*w.KA_r_shank[4][1] - w.L[76]*w.L[77];
-    w.L[85] = w.Linv[7]*t7;
-    const Scalar t8 = 35.0868446262531 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][1] + w.KSD_r_shank[3]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[78];
-    w.L[86] = w.Linv[7]*t8;
-    // rows 10 to 11
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t9 = w.KA_r_hip_yaw_link[5][1]*w.KSD_r_hip_yaw_link[4 + j] + w.KA_r_hip_roll_link[3][1]*w.KSD_r_hip_roll_link[4 + j] + w.KA_r_thigh[4][1]*w.KSD_r_thigh[4 + j] + w.KA_r_shank[4][1]*w.KSD_r_shank[4 + j] + w.KA_r_ankle_link[4][1]*w.KSD_r_ankle_link[4 + j] - w.L[76]*w.L[79 + j];
-      w.L[87 + j] = w.Linv[7]*t9;
-    }
+    const Scalar t9 = 2.394677145741774 + inv_mu + w.KSD_r_hip_yaw_link[1]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[1]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[1]*w.KA_r_thigh[4][1] + w.KSD_r_shank[1]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[1]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[76];
+    const Scalar r3 = std::sqrt(t9);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[7] = inv3;
+    const Scalar t10 = w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][1] + w.KSD_r_shank[2]*w.KA_r_shank[4][1] - w.L[76]*w.L[77];
+    w.L[85] = w.Linv[7]*t10;
+    const Scalar t11 = 35.0868446262531 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][1] + w.KSD_r_shank[3]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[78];
+    w.L[86] = w.Linv[7]*t11;
+    const Scalar t12 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][1] + w.KSD_r_shank[4]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[79];
+    w.L[87] = w.Linv[7]*t12;
+    const Scalar t13 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][1] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][1] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][1] + w.KSD_r_shank[5]*w.KA_r_shank[4][1] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][1] - w.L[76]*w.L[80];
+    w.L[88] = w.Linv[7]*t13;
   }
   // G + I/mu = L L^T, column 8 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t10 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][2] + w.KSD_r_shank[2]*w.KA_r_shank[4][2] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
-    const Scalar r3 = std::sqrt(t10);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[8] = inv3;
-    const Scalar t11 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][2] + w.KSD_r_shank[3]*w.KA_r_shank[4][2] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
-    w.L[93] = w.Linv[8]*t11;
-    // rows 10 to 11
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t12 = w.KA_r_hip_yaw_link[5][2]*w.KSD_r_hip_yaw_link[4 + j] + w.KA_r_hip_roll_link[3][2]*w.KSD_r_hip_roll_link[4 + j] + w.KA_r_thigh[4][2]*w.KSD_r_thigh[4 + j] + w.KA_r_shank[4][2]*w.KSD_r_shank[4 + j] - w.L[77]*w.L[79 + j] - w.L[85]*w.L[87 + j];
-      w.L[94 + j] = w.Linv[8]*t12;
-    }
-  }
-  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  {
-    const Scalar t13 = 514.0929615568219 + inv_mu + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
-    const Scalar r4 = std::sqrt(t13);
+    const Scalar t14 = inv_mu + w.KSD_r_hip_yaw_link[2]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[2]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[2]*w.KA_r_thigh[4][2] + w.KSD_r_shank[2]*w.KA_r_shank[4][2] - w.L[77]*w.L[77] - w.L[85]*w.L[85];
+    const Scalar r4 = std::sqrt(t14);
     const Scalar inv4 = 1.0 / r4;
-    w.Linv[9] = inv4;
-    // rows 10 to 11
-    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-      const Scalar t14 = w.KA_r_hip_yaw_link[5][3]*w.KSD_r_hip_yaw_link[4 + j] + w.KA_r_hip_roll_link[3][3]*w.KSD_r_hip_roll_link[4 + j] + w.KA_r_thigh[4][3]*w.KSD_r_thigh[4 + j] + w.KA_r_shank[4][3]*w.KSD_r_shank[4 + j] + w.KA_r_ankle_link[4][3]*w.KSD_r_ankle_link[4 + j] - w.L[78]*w.L[79 + j] - w.L[86]*w.L[87 + j] - w.L[93]*w.L[94 + j];
-      w.L[100 + j] = w.Linv[9]*t14;
-    }
+    w.Linv[8] = inv4;
+    const Scalar t15 = w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][2] + w.KSD_r_shank[3]*w.KA_r_shank[4][2] - w.L[77]*w.L[78] - w.L[85]*w.L[86];
+    w.L[93] = w.Linv[8]*t15;
+    const Scalar t16 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][2] + w.KSD_r_shank[4]*w.KA_r_shank[4][2] - w.L[77]*w.L[79] - w.L[85]*w.L[87];
+    w.L[94] = w.Linv[8]*t16;
+    const Scalar t17 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][2] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][2] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][2] + w.KSD_r_shank[5]*w.KA_r_shank[4][2] - w.L[77]*w.L[80] - w.L[85]*w.L[88];
+    w.L[95] = w.Linv[8]*t17;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_delassus_column_10_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
+PROXGEN_RT_NOINLINE void pv_delassus_column_9_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t0 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][4] + w.KSD_r_shank[4]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][4] + inv_mu - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
+    const Scalar t0 = 514.0929615568219 + w.KSD_r_hip_yaw_link[3]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[3]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[3]*w.KA_r_thigh[4][3] + w.KSD_r_shank[3]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[3]*w.KA_r_ankle_link[4][3] + inv_mu - w.L[78]*w.L[78] - w.L[86]*w.L[86] - w.L[93]*w.L[93];
     const Scalar r0 = std::sqrt(t0);
     const Scalar inv0 = 1.0 / r0;
-    w.Linv[10] = inv0;
-    const Scalar t1 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][4] + w.KSD_r_shank[5]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
-    w.L[106] = w.Linv[10]*t1;
+    w.Linv[9] = inv0;
+    const Scalar t1 = w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][3] + w.KSD_r_shank[4]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[79] - w.L[86]*w.L[87] - w.L[93]*w.L[94];
+    w.L[100] = w.Linv[9]*t1;
+    const Scalar t2 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][3] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][3] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][3] + w.KSD_r_shank[5]*w.KA_r_shank[4][3] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][3] - w.L[78]*w.L[80] - w.L[86]*w.L[88] - w.L[93]*w.L[95];
+    w.L[101] = w.Linv[9]*t2;
+  }
+  // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
+  {
+    const Scalar t3 = inv_mu + w.KSD_r_hip_yaw_link[4]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[4]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[4]*w.KA_r_thigh[4][4] + w.KSD_r_shank[4]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[4]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[79] - w.L[87]*w.L[87] - w.L[94]*w.L[94] - w.L[100]*w.L[100];
+    const Scalar r1 = std::sqrt(t3);
+    const Scalar inv1 = 1.0 / r1;
+    w.Linv[10] = inv1;
+    const Scalar t4 = w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][4] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][4] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][4] + w.KSD_r_shank[5]*w.KA_r_shank[4][4] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][4] - w.L[79]*w.L[80] - w.L[87]*w.L[88] - w.L[94]*w.L[95] - w.L[100]*w.L[101];
+    w.L[106] = w.Linv[10]*t4;
   }
   // G + I/mu = L L^T, column 11 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t2 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][5] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][5] + w.KSD_r_shank[5]*w.KA_r_shank[4][5] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][5] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
-    const Scalar r1 = std::sqrt(t2);
-    const Scalar inv1 = 1.0 / r1;
-    w.Linv[11] = inv1;
+    const Scalar t5 = inv_mu + w.KSD_r_hip_yaw_link[5]*w.KA_r_hip_yaw_link[5][5] + w.KSD_r_hip_roll_link[5]*w.KA_r_hip_roll_link[3][5] + w.KSD_r_thigh[5]*w.KA_r_thigh[4][5] + w.KSD_r_shank[5]*w.KA_r_shank[4][5] + w.KSD_r_ankle_link[5]*w.KA_r_ankle_link[4][5] - w.L[80]*w.L[80] - w.L[88]*w.L[88] - w.L[95]*w.L[95] - w.L[101]*w.L[101] - w.L[106]*w.L[106];
+    const Scalar r2 = std::sqrt(t5);
+    const Scalar inv2 = 1.0 / r2;
+    w.Linv[11] = inv2;
   }
   // G + I/mu = L L^T, column 12 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t3 = 3.272247652534548 + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5][0] + w.KSD_chest[0]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[0]*w.KA_r_forearm[4][0];
-    const Scalar r2 = std::sqrt(t3);
-    const Scalar inv2 = 1.0 / r2;
-    w.Linv[12] = inv2;
-    const Scalar t4 = w.KSD_abdomen[1]*w.KA_abdomen[5][0] + w.KSD_chest[1]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][0];
-    w.L[115] = w.Linv[12]*t4;
-    const Scalar t5 = w.KSD_abdomen[2]*w.KA_abdomen[5][0] + w.KSD_chest[2]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][0];
-    w.L[116] = w.Linv[12]*t5;
+    const Scalar t6 = 3.272247652534548 + inv_mu + w.KSD_abdomen[0]*w.KA_abdomen[5][0] + w.KSD_chest[0]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[0]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[0]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[0]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[0]*w.KA_r_forearm[4][0];
+    const Scalar r3 = std::sqrt(t6);
+    const Scalar inv3 = 1.0 / r3;
+    w.Linv[12] = inv3;
+    const Scalar t7 = w.KSD_abdomen[1]*w.KA_abdomen[5][0] + w.KSD_chest[1]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][0];
+    w.L[115] = w.Linv[12]*t7;
+    const Scalar t8 = w.KSD_abdomen[2]*w.KA_abdomen[5][0] + w.KSD_chest[2]*w.KA_chest[4][0] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][0] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][0] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][0] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][0];
+    w.L[116] = w.Linv[12]*t8;
   }
   // G + I/mu = L L^T, column 13 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t6 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[5][1] + w.KSD_chest[1]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][1] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[5][1] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[4][1] - w.L[115]*w.L[115];
-    const Scalar r3 = std::sqrt(t6);
-    const Scalar inv3 = 1.0 / r3;
-    w.Linv[13] = inv3;
-    const Scalar t7 = w.KSD_abdomen[2]*w.KA_abdomen[5][1] + w.KSD_chest[2]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][1] - w.L[115]*w.L[116];
-    w.L[118] = w.Linv[13]*t7;
+    const Scalar t9 = inv_mu + w.KSD_abdomen[1]*w.KA_abdomen[5][1] + w.KSD_chest[1]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[1]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[1]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[1]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[1]*w.KA_r_forearm[4][1] + w.KSD_r_wrist_yaw_link[1]*w.KA_r_wrist_yaw_link[5][1] + w.KSD_r_wrist_pitch_link[1]*w.KA_r_wrist_pitch_link[4][1] - w.L[115]*w.L[115];
+    const Scalar r4 = std::sqrt(t9);
+    const Scalar inv4 = 1.0 / r4;
+    w.Linv[13] = inv4;
+    const Scalar t10 = w.KSD_abdomen[2]*w.KA_abdomen[5][1] + w.KSD_chest[2]*w.KA_chest[4][1] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][1] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][1] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][1] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][1] - w.L[115]*w.L[116];
+    w.L[118] = w.Linv[13]*t10;
   }
   // G + I/mu = L L^T, column 14 (Cholesky, unrolled for the fixed row count)
   {
-    const Scalar t8 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[5][2] + w.KSD_chest[2]*w.KA_chest[4][2] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][2] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][2] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][2] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][2] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
-    const Scalar r4 = std::sqrt(t8);
-    const Scalar inv4 = 1.0 / r4;
-    w.Linv[14] = inv4;
+    const Scalar t11 = inv_mu + w.KSD_abdomen[2]*w.KA_abdomen[5][2] + w.KSD_chest[2]*w.KA_chest[4][2] + w.KSD_r_shoulder_pitch_link[2]*w.KA_r_shoulder_pitch_link[4][2] + w.KSD_r_shoulder_roll_link[2]*w.KA_r_shoulder_roll_link[3][2] + w.KSD_r_upper_arm[2]*w.KA_r_upper_arm[5][2] + w.KSD_r_forearm[2]*w.KA_r_forearm[4][2] - w.L[116]*w.L[116] - w.L[118]*w.L[118];
+    const Scalar r5 = std::sqrt(t11);
+    const Scalar inv5 = 1.0 / r5;
+    w.Linv[14] = inv5;
   }
   // W = L^-1 Z^T, row 0, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t9 = w.active[0]*w.Z_pelvis[j][0];
-    w.W[0][j] = w.Linv[0]*t9;
+    const Scalar t12 = w.active[0]*w.Z_pelvis[j][0];
+    w.W[0][j] = w.Linv[0]*t12;
   }
   // W = L^-1 Z^T, row 1, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t10 = w.active[0]*w.Z_pelvis[j][1] - w.L[1]*w.W[0][j];
-    w.W[1][j] = w.Linv[1]*t10;
+    const Scalar t13 = w.active[0]*w.Z_pelvis[j][1] - w.L[1]*w.W[0][j];
+    w.W[1][j] = w.Linv[1]*t13;
   }
   // W = L^-1 Z^T, row 2, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t11 = w.active[0]*w.Z_pelvis[j][2] - w.L[2]*w.W[0][j] - w.L[16]*w.W[1][j];
-    w.W[2][j] = w.Linv[2]*t11;
+    const Scalar t14 = w.active[0]*w.Z_pelvis[j][2] - w.L[2]*w.W[0][j] - w.L[16]*w.W[1][j];
+    w.W[2][j] = w.Linv[2]*t14;
   }
   // W = L^-1 Z^T, row 3, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t12 = w.active[0]*w.Z_pelvis[j][3] - w.L[3]*w.W[0][j] - w.L[17]*w.W[1][j] - w.L[30]*w.W[2][j];
-    w.W[3][j] = w.Linv[3]*t12;
+    const Scalar t15 = w.active[0]*w.Z_pelvis[j][3] - w.L[3]*w.W[0][j] - w.L[17]*w.W[1][j] - w.L[30]*w.W[2][j];
+    w.W[3][j] = w.Linv[3]*t15;
   }
   // W = L^-1 Z^T, row 4, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t13 = w.active[0]*w.Z_pelvis[j][4] - w.L[4]*w.W[0][j] - w.L[18]*w.W[1][j] - w.L[31]*w.W[2][j] - w.L[43]*w.W[3][j];
-    w.W[4][j] = w.Linv[4]*t13;
+    const Scalar t16 = w.active[0]*w.Z_pelvis[j][4] - w.L[4]*w.W[0][j] - w.L[18]*w.W[1][j] - w.L[31]*w.W[2][j] - w.L[43]*w.W[3][j];
+    w.W[4][j] = w.Linv[4]*t16;
   }
   // W = L^-1 Z^T, row 5, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t14 = w.active[0]*w.Z_pelvis[j][5] - w.L[5]*w.W[0][j] - w.L[19]*w.W[1][j] - w.L[32]*w.W[2][j] - w.L[44]*w.W[3][j] - w.L[55]*w.W[4][j];
-    w.W[5][j] = w.Linv[5]*t14;
+    const Scalar t17 = w.active[0]*w.Z_pelvis[j][5] - w.L[5]*w.W[0][j] - w.L[19]*w.W[1][j] - w.L[32]*w.W[2][j] - w.L[44]*w.W[3][j] - w.L[55]*w.W[4][j];
+    w.W[5][j] = w.Linv[5]*t17;
   }
   // W = L^-1 Z^T, row 6, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t15 = w.active[1]*w.Z_pelvis[j][6];
-    w.W[6][j] = w.Linv[6]*t15;
+    const Scalar t18 = w.active[1]*w.Z_pelvis[j][6];
+    w.W[6][j] = w.Linv[6]*t18;
   }
   // W = L^-1 Z^T, row 7, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t16 = w.active[1]*w.Z_pelvis[j][7] - w.L[76]*w.W[6][j];
-    w.W[7][j] = w.Linv[7]*t16;
+    const Scalar t19 = w.active[1]*w.Z_pelvis[j][7] - w.L[76]*w.W[6][j];
+    w.W[7][j] = w.Linv[7]*t19;
   }
   // W = L^-1 Z^T, row 8, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t17 = w.active[1]*w.Z_pelvis[j][8] - w.L[77]*w.W[6][j] - w.L[85]*w.W[7][j];
-    w.W[8][j] = w.Linv[8]*t17;
+    const Scalar t20 = w.active[1]*w.Z_pelvis[j][8] - w.L[77]*w.W[6][j] - w.L[85]*w.W[7][j];
+    w.W[8][j] = w.Linv[8]*t20;
   }
   // W = L^-1 Z^T, row 9, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t18 = w.active[1]*w.Z_pelvis[j][9] - w.L[78]*w.W[6][j] - w.L[86]*w.W[7][j] - w.L[93]*w.W[8][j];
-    w.W[9][j] = w.Linv[9]*t18;
+    const Scalar t21 = w.active[1]*w.Z_pelvis[j][9] - w.L[78]*w.W[6][j] - w.L[86]*w.W[7][j] - w.L[93]*w.W[8][j];
+    w.W[9][j] = w.Linv[9]*t21;
   }
   // W = L^-1 Z^T, row 10, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t19 = w.active[1]*w.Z_pelvis[j][10] - w.L[79]*w.W[6][j] - w.L[87]*w.W[7][j] - w.L[94]*w.W[8][j] - w.L[100]*w.W[9][j];
-    w.W[10][j] = w.Linv[10]*t19;
+    const Scalar t22 = w.active[1]*w.Z_pelvis[j][10] - w.L[79]*w.W[6][j] - w.L[87]*w.W[7][j] - w.L[94]*w.W[8][j] - w.L[100]*w.W[9][j];
+    w.W[10][j] = w.Linv[10]*t22;
   }
   // W = L^-1 Z^T, row 11, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t20 = w.active[1]*w.Z_pelvis[j][11] - w.L[80]*w.W[6][j] - w.L[88]*w.W[7][j] - w.L[95]*w.W[8][j] - w.L[101]*w.W[9][j] - w.L[106]*w.W[10][j];
-    w.W[11][j] = w.Linv[11]*t20;
+    const Scalar t23 = w.active[1]*w.Z_pelvis[j][11] - w.L[80]*w.W[6][j] - w.L[88]*w.W[7][j] - w.L[95]*w.W[8][j] - w.L[101]*w.W[9][j] - w.L[106]*w.W[10][j];
+    w.W[11][j] = w.Linv[11]*t23;
   }
   // W = L^-1 Z^T, row 12, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t21 = w.active[2]*w.Z_pelvis[j][12];
-    w.W[12][j] = w.Linv[12]*t21;
+    const Scalar t24 = w.active[2]*w.Z_pelvis[j][12];
+    w.W[12][j] = w.Linv[12]*t24;
   }
   // W = L^-1 Z^T, row 13, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t22 = w.active[2]*w.Z_pelvis[j][13] - w.L[115]*w.W[12][j];
-    w.W[13][j] = w.Linv[13]*t22;
+    const Scalar t25 = w.active[2]*w.Z_pelvis[j][13] - w.L[115]*w.W[12][j];
+    w.W[13][j] = w.Linv[13]*t25;
   }
   // W = L^-1 Z^T, row 14, columns 0 to 5
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    const Scalar t23 = w.active[2]*w.Z_pelvis[j][14] - w.L[116]*w.W[12][j] - w.L[118]*w.W[13][j];
-    w.W[14][j] = w.Linv[14]*t23;
+    const Scalar t26 = w.active[2]*w.Z_pelvis[j][14] - w.L[116]*w.W[12][j] - w.L[118]*w.W[13][j];
+    w.W[14][j] = w.Linv[14]*t26;
   }
 }
 
@@ -7052,9 +7044,9 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_free_r_wrist_pitch_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
-  pv_delassus_column_0_to_column_4(inv_mu, w);
-  pv_delassus_column_5_to_column_9(inv_mu, w);
-  pv_delassus_column_10_to_W(inv_mu, w);
+  pv_delassus_column_0_to_column_3(inv_mu, w);
+  pv_delassus_column_4_to_column_8(inv_mu, w);
+  pv_delassus_column_9_to_W(inv_mu, w);
   pv_delassus_LS(w);
   // ---- warm start: lambda = s.lambda0, or 0 when it is null or the constraint inactive
   const auto lambda0 = proxgen_rt::initial_multipliers<nc>(s.lambda0);

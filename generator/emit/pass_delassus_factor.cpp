@@ -344,6 +344,12 @@ class LowRank {
 
 constexpr const char* kLWhat = "Cholesky factor of G + I/mu (lower, packed)";
 
+// Rows of one column that loop: from four up. Loops of two or three rows (the
+// feet's 6-d blocks) made the Atlas f6x2's prox_pv 1.03 slower at the baseline,
+// and four left the t3x10's gain as it was (docs/emitter.md, "The Delassus
+// columns as loops").
+constexpr int kShortestEntryLoop = 4;
+
 // Entry (i, j) of the factor below the diagonal, as its terms:
 // L(i, j) = (G(i, j), scheduled, - (g P_l)[i] . g[j] - sum_k L(i, k) L(j, k)) / L(j, j).
 struct Entry {
@@ -382,9 +388,8 @@ std::string columnKey(const CodeBuilder& cb, const Entry& en) {
 
 // Adjacent rows of one column whose entries are one statement over [idx + j]
 // (oneShape: each row factor the same constant, or a member slot one further
-// per row), as (first row, count); shorter runs than kShortestColumnLoop (a
-// threshold of 4 rows measured no better: docs/emitter.md, "The Delassus
-// columns as loops"), and runs that read no member, as single rows.
+// per row), as (first row, count); runs shorter than kShortestEntryLoop, and
+// runs that read no member, as single rows.
 std::vector<std::pair<int, int>> entryRuns(const CodeBuilder& cb, const std::vector<Entry>& entries, const std::vector<int>& rows) {
   const auto factors = [&](int i) { return rowFactors(entries[std::size_t(i)]); };
   std::vector<std::pair<int, int>> runs;
@@ -397,7 +402,7 @@ std::vector<std::pair<int, int>> entryRuns(const CodeBuilder& cb, const std::vec
       ++len;
     bool reads = false;
     for (const Expr& x : factors(i0)) reads = reads || !x.isConstant();
-    if (int(len) < kShortestColumnLoop || !reads) len = 1;
+    if (int(len) < kShortestEntryLoop || !reads) len = 1;
     runs.push_back({i0, int(len)});
     n += len;
   }
