@@ -58,10 +58,10 @@ std::string syntheticTreeUrdf(int links, int branching, const std::string& pad) 
   return xml + pad + "</robot>\n";
 }
 
-emit::SolverFiles syntheticChainFiles(int links, const std::string& functions) {
+emit::SolverFiles syntheticChainFiles(int links, const std::string& functions, const std::string& constraints) {
   const TempFile urdf("chain.urdf"), layout("fixed.yaml");
   urdf.write(syntheticTreeUrdf(links, 1));
-  layout.write("base: fixed\n");
+  layout.write(constraints.empty() ? "base: fixed\n" : "base: fixed\nconstraints:\n  " + constraints + "\n");
   emit::GenerateOptions g;
   g.urdf = urdf.path();
   g.layout = layout.path();

@@ -82,8 +82,9 @@ std::string syntheticTreeUrdf(int links, int branching, const std::string& pad =
 
 /// The generated files of syntheticTreeUrdf(links, 1) on a fixed base (a chain
 /// of links - 1 revolute joints), named "chain", holding `functions` (--functions;
-/// "" = the two solvers).
-emit::SolverFiles syntheticChainFiles(int links, const std::string& functions = "");
+/// "" = the two solvers); `constraints`: the layout's constraints list (YAML
+/// flow items, "- {name: tip, link: l11, type: 3d}"), none when empty.
+emit::SolverFiles syntheticChainFiles(int links, const std::string& functions = "", const std::string& constraints = "");
 
 /// How many times `what` occurs in `text`, without overlaps (generated code's shape tests).
 long occurrences(const std::string& text, const std::string& what);

@@ -10,7 +10,6 @@
 #include <regex>
 #include <string>
 
-#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
@@ -45,14 +44,8 @@ TEST(DerivativesCode, EachBodysMomentumIsStoredOnce) {
 // literal form multiplied W by each input's block (three full nv x nv products).
 TEST(DerivativesCode, TheConstrainedAlgebraGoesThroughTheTauBlock) {
   // 11 revolute joints in a chain (nv = 11: two blocks of P), a 3d point on the tip (nc = 3).
-  const test::TempFile urdf("chain.urdf"), layout("point.yaml");
-  urdf.write(test::syntheticTreeUrdf(12, 1));
-  layout.write("base: fixed\nconstraints:\n  - {name: tip, link: l11, type: 3d}\n");
-  GenerateOptions g;
-  g.urdf = urdf.path();
-  g.layout = layout.path();
-  g.functions = "constrained_dynamics_derivatives";
-  const std::string source = generateFiles(g).source;
+  const std::string source =
+      test::syntheticChainFiles(12, "constrained_dynamics_derivatives", "- {name: tip, link: l11, type: 3d}").source;
   // W's products: the two blocks of P's rows, each up to its last column.
   EXPECT_EQ(test::occurrences(source, "dense_product_add<"), 2);
   EXPECT_EQ(test::occurrences(source, "dense_product_add<8, 3, 8, 14, 14>(w.cdd_MinvJt, w.cdd_LtS"), 1);
