@@ -551,9 +551,11 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
   std::string shared;
   if (!texts.sharedKernels.empty()) {
     shared = "// Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the\n"
-             "// same code up to their constants, over a table of each one's constants:\n";
+             "// same code up to their constants, over a table of each one's constants; two\n"
+             "// blocks \"in pairs\" run as one call, one in each lane of a vector register:\n";
     for (const SharedKernel& k : texts.sharedKernels)
-      shared += fmt::format("//   {}: {} blocks of {}\n", k.name, k.blocks.size(), fmt::join(k.bodies, ", "));
+      shared += fmt::format("//   {}: {} blocks of {}{}\n", k.name, k.blocks.size(), fmt::join(k.bodies, ", "),
+                            k.pairs > 0 ? fmt::format(" ({} in pairs)", 2 * k.pairs) : "");
   }
   auto bannerWith = [&](const std::string& sharedLines) {
     return fmt::format(fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION),

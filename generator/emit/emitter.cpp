@@ -39,9 +39,9 @@ void emitConstraintFunctions(Emit& e, const Kinematics& kin, const CodeBuilder* 
 
 SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& inputs, SolverStats* stats) {
   Members ws;
-  std::vector<std::string> bodyNames;
-  for (const BodyPlan& b : plan.bodies) bodyNames.push_back(b.ident);
-  FunctionWriter fn(plan.scalar, bodyNames);
+  std::vector<std::string> bodyNames, bodyShapes;
+  for (const BodyPlan& b : plan.bodies) bodyNames.push_back(b.ident), bodyShapes.push_back(b.shape);
+  FunctionWriter fn(plan.scalar, bodyNames, bodyShapes);
   for (const std::string& name : fileFunctionNames()) fn.reserveName(name);
   FreeAccelerations freeAccel;
   Emit e{sys, plan, ws, fn, &freeAccel};
@@ -213,7 +213,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   SharedParts shared = shareBlocks(texts.parts, ws, [&](const std::string& part) {
     const auto it = smallest.find(fn.hostOf(part));
     return it != smallest.end() && it->second >= kSharedBlocksMinOps;
-  });
+  }, true);
   texts.parts = std::move(shared.parts);
   texts.sharedKernels = std::move(shared.kernels);
 

@@ -60,8 +60,20 @@ void FunctionWriter::beginPass(const std::string& name, const std::string& banne
   hosts_.back().banner = banner;
 }
 
-void FunctionWriter::boundary(int body) { open(bodyNames_[std::size_t(body)]); }
-void FunctionWriter::boundary(const std::string& label) { open(label); }
+void FunctionWriter::boundary(int body) {
+  const bool twin = part_ && !joined_ && lastBody_ >= 0 && bodyShapes_[std::size_t(body)] == bodyShapes_[std::size_t(lastBody_)];
+  joined_ = twin;
+  lastBody_ = body;
+  if (twin) {
+    lastLabel_ = bodyNames_[std::size_t(body)];
+    return;
+  }
+  open(bodyNames_[std::size_t(body)]);
+}
+void FunctionWriter::boundary(const std::string& label) {
+  lastBody_ = -1;
+  open(label);
+}
 
 void FunctionWriter::open(const std::string& label) {
   if (part_ && part_->statementCount() >= kPartBudget) endPart();

@@ -24,9 +24,10 @@ namespace proxgen::emit {
 
 class FunctionWriter {
  public:
-  /// `bodyName(i)`: how part names spell body i (the plan's identifier).
-  FunctionWriter(ScalarType scalar, std::vector<std::string> bodyNames)
-      : scalar_(scalar), bodyNames_(std::move(bodyNames)) {}
+  /// `bodyName(i)`: how part names spell body i (the plan's identifier);
+  /// `bodyShapes(i)`: its subtree's shape (BodyPlan::shape).
+  FunctionWriter(ScalarType scalar, std::vector<std::string> bodyNames, std::vector<std::string> bodyShapes)
+      : scalar_(scalar), bodyNames_(std::move(bodyNames)), bodyShapes_(std::move(bodyShapes)) {}
 
   /// The builder statements go to now (a part, or the host between parts).
   CodeBuilder& cb() { return *cb_; }
@@ -42,7 +43,8 @@ class FunctionWriter {
   /// `banner` is printed as "// ---- banner" above the first of their calls.
   void beginPass(const std::string& name, const std::string& banner);
   /// Before a block of body `body`: opens a part function, or a new one when
-  /// this one is full.
+  /// this one is full; not when the block before was its twin's (the same
+  /// shape), so that the two can run as a pair (docs/emitter.md, "Blocks in pairs").
   void boundary(int body);
   /// Before a block that is not a body's: `label` names it ("column_3").
   void boundary(const std::string& label);
@@ -100,6 +102,9 @@ class FunctionWriter {
   Live live_;
   std::vector<std::string> bodyNames_;
   std::string firstLabel_, lastLabel_;  // the open part's first and last block
+  std::vector<std::string> bodyShapes_;
+  int lastBody_ = -1;    // the block before, when it was a body's in this pass
+  bool joined_ = false;  // it was joined to its twin before it
   std::set<std::string> partNames_;
   std::map<std::string, OpCount> hostOps_;
   std::string partsText_;

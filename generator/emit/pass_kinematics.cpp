@@ -83,7 +83,7 @@ bool jointTransformsFirst(Emit& e, Kinematics& kin) {
   sincosRuns(e);
   if (sincosCalled(e.plan)) return false;
   e.fn.beginPass("transforms", "joint transforms X_J(q)");
-  for (int i = 1; i < e.model().numBodies(); ++i) {
+  for (int i : e.plan.sweep) {
     e.fn.boundary(i);
     e.openBody(i, "");
     jointTransform(e, i, kin.b[std::size_t(i)]);
@@ -283,7 +283,7 @@ Kinematics emitKinematics(Emit& e) {
   kin.b[0].oM = constant(SE3::Identity());
   const bool transformsFirst = jointTransformsFirst(e, kin);
   if (transformsFirst) e.fn.beginPass("", "velocities, bias forces, gravity, placements, constraint terms");
-  for (int i = 1; i < m.numBodies(); ++i) {
+  for (int i : e.plan.sweep) {
     e.fn.boundary(i);
     e.openBody(i, "");
     Kinematics::Body& b = kin.b[std::size_t(i)];

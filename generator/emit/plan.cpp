@@ -1,5 +1,7 @@
 #include "emit/plan.hpp"
 
+#include <fmt/format.h>
+
 #include "emit/identifiers.hpp"
 
 namespace proxgen::emit {
@@ -113,21 +115,43 @@ Plan makePlan(const System& sys, const std::string& name, ScalarType scalar) {
   }
 
   const ConstraintTree tree = constraintTree(sys);
-  plan.support = tree.support;
   for (int i = 1; i < N; ++i) {
     BodyPlan& b = plan.bodies[std::size_t(i)];
     b.onSupport = tree.onSupport[std::size_t(i)] != 0;
     b.needsGravity = b.onSupport;
-    if (!b.onSupport) plan.offSupport.push_back(i);
   }
   for (int i = N - 1; i >= 0; --i) {  // children after their parent: leaves first
     BodyPlan& b = plan.bodies[std::size_t(i)];
+    b.shape = fmt::format("{}{}{}", int(b.jointClass), b.axis, b.onSupport ? "s" : "");
+    for (int k : b.constraints) b.shape += plan.constraints[std::size_t(k)].weld ? "w" : "p";
+    b.shape += "(";
+    for (int c : b.children) b.shape += plan.bodies[std::size_t(c)].shape + ",";
+    b.shape += ")";
     b.dofEnd = std::max(b.dofEnd, b.idx_v + b.nv);
     if (i > 0) {
       BodyPlan& parent = plan.bodies[std::size_t(b.parent)];
       parent.dofEnd = std::max(parent.dofEnd, b.dofEnd);
     }
   }
+  // The sweep: breadth first, one depth after the other; in a depth, the
+  // bodies of one shape together, shapes in the order they first appear (in
+  // the parents' order), so that the fingers of two hands form pairs across
+  // the hands too.
+  for (std::vector<int> depth = plan.bodies[0].children; !depth.empty();) {
+    std::vector<char> taken(depth.size(), 0);
+    std::vector<int> next;
+    for (std::size_t a = 0; a < depth.size(); ++a) {
+      if (taken[a]) continue;
+      for (std::size_t b = a; b < depth.size(); ++b) {
+        if (taken[b] || plan.bodies[std::size_t(depth[b])].shape != plan.bodies[std::size_t(depth[a])].shape) continue;
+        taken[b] = 1;
+        plan.sweep.push_back(depth[b]);
+        for (int c : plan.bodies[std::size_t(depth[b])].children) next.push_back(c);
+      }
+    }
+    depth = std::move(next);
+  }
+  for (int i : plan.sweep) (plan.bodies[std::size_t(i)].onSupport ? plan.support : plan.offSupport).push_back(i);
   for (int i = 0; i < N; ++i) {
     BodyPlan& b = plan.bodies[std::size_t(i)];
     b.subtreeRows = tree.subtreeRows[std::size_t(i)];

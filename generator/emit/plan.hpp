@@ -56,6 +56,11 @@ struct BodyPlan {
   int inertiaNonzeros = 0;          // of the 21 entries of the symmetric 6x6
   bool needsGravity = false;        // on the support: carries R_i^T g for the k_i terms
   bool needsPlacement = false;      // on a path to a constraint with kp != 0: world placement
+  /// The same for bodies whose subtrees are alike (joint classes and axes,
+  /// support, constraint kinds; not the constants): a left and a right leg's
+  /// links, a hand's fingers. Twins one after the other in the sweep share a
+  /// part function, so that their blocks can run as a pair.
+  std::string shape;
   int m() const { return int(subtreeRows.size()); }
 };
 
@@ -76,8 +81,13 @@ struct Plan {
   double mu = 1e4;
   int iterations = 3;
   std::vector<BodyPlan> bodies;      // [0] = the world
-  std::vector<int> support;          // ascending (tree order)
-  std::vector<int> offSupport;       // the other moving bodies, ascending
+  /// The moving bodies in the order the forward sweeps visit them (the
+  /// backward sweeps: reversed): breadth first, so the same link of limbs
+  /// that repeat (Talos' legs, a hand's fingers) comes one after the other and
+  /// their blocks can run side by side (docs/emitter.md, "Blocks in pairs").
+  std::vector<int> sweep;
+  std::vector<int> support;          // in sweep order: parents before children
+  std::vector<int> offSupport;       // the other moving bodies, in sweep order
   std::vector<int> rootRows;         // Delassus rows in tree order (= bodies[0].subtreeRows)
   std::vector<int> rowPosition;      // per layout row: its position in rootRows
   std::vector<ConstraintPlan> constraints;  // layout order

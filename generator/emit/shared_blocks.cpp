@@ -106,13 +106,14 @@ struct MemberUse {
   bool array = false;      // false: a scalar
   bool loose = false;      // a subscript that is not N or N + ...: no rebasing
   long base = LONG_MAX;    // the smallest leading index of its last subscript
-  bool written = false;    // a scalar the block stores or passes to a call (by pointer; else by value)
+  bool written = false;    // stored or passed to a call (a scalar: by pointer; else by value)
 };
 
 // How a block uses an input or output array of its part (q, tau, M, ...).
 struct PointerUse {
   bool loose = false;
   long base = LONG_MAX;
+  bool written = false;
 };
 
 struct Canonical {
@@ -121,6 +122,12 @@ struct Canonical {
   std::string signature;
   std::vector<std::string> constants;  // literal texts, signed
   std::vector<std::string> args;       // besides the table: the call's arguments
+  std::vector<std::string> argParams;  // per argument: the kernel's parameter it is
+  std::vector<char> argLanewise;       // per argument: 0 for a part's scalar (mu: the same for every block)
+  std::vector<char> argWritten;        // per argument: the block stores through it
+  // The elements it reads or stores: "w.v_x|3", "q|12", "w.KA_x|*" (a subscript
+  // that is not a number: any element), for pairing blocks that do not overlap.
+  std::set<std::string> touches, writes;
 };
 
 // The names a block may use besides its temporaries, members and parameters.
@@ -192,17 +199,20 @@ class Canonicalizer {
       const std::string& p = pointers_.at(n);
       params.push_back(fmt::format("{} {}", p, n));
       out.args.push_back(u.loose || u.base == 0 ? n : fmt::format("&{}[{}]", n, u.base));
+      out.argParams.push_back(n), out.argLanewise.push_back(1), out.argWritten.push_back(u.written);
       kinds += "p:" + n + p + (u.loose ? "L" : "") + ";";
     }
     for (const std::string& n : usedScalars_) {
       params.push_back(fmt::format("{} {}", scalars_.at(n), n));
       out.args.push_back(n);
+      out.argParams.push_back(n), out.argLanewise.push_back(0), out.argWritten.push_back(0);
       kinds += "s:" + n + ";";
     }
     for (std::size_t i = 0; i < memberUse_.size(); ++i) {
       const MemberUse& u = memberUse_[i];
       const long base = u.loose || u.base == LONG_MAX ? 0 : u.base;
       const std::string p = paramName(i);
+      out.argParams.push_back(p), out.argLanewise.push_back(1), out.argWritten.push_back(u.written);
       if (!u.array && !u.written) {
         params.push_back(fmt::format("Scalar {}", p));
         out.args.push_back("w." + u.name);
@@ -222,6 +232,7 @@ class Canonicalizer {
         if (!u.loose) {
           params.push_back(fmt::format("int {}_col", p));
           out.args.push_back(fmt::format("{}", base));
+          out.argParams.push_back(p + "_col"), out.argLanewise.push_back(1), out.argWritten.push_back(0);
           kinds += "o;";
         }
       }
@@ -230,6 +241,8 @@ class Canonicalizer {
     out.body = std::move(body);
     out.constants = std::move(constants_);
     out.key = kinds + "\n" + out.body;
+    out.touches = std::move(touches_);
+    out.writes = std::move(writes_);
     return true;
   }
 
@@ -256,7 +269,8 @@ class Canonicalizer {
         if (pointers_.count(id) && j < l.size() && l[j] == '[') {
           std::size_t e = j;
           std::vector<std::string> subs = readSubscripts(l, e);
-          pointer(id, subs, o);
+          const bool stored = l.find_first_not_of(' ') == i && l.compare(e, 3, " = ") == 0;
+          pointer(id, subs, stored || insideCall(l, i), o);
           i = e;
           continue;
         }
@@ -353,6 +367,7 @@ class Canonicalizer {
     if (u.array != !subs.empty() || (u.cols > 0 && subs.size() != 2) || (u.array && u.cols == 0 && subs.size() != 1))
       return false;
     if (!o) {
+      record("w." + name, subs, written);
       u.written = u.written || written;
       if (!subs.empty()) {
         const Subscript s = parseSubscript(subs.back());
@@ -372,10 +387,12 @@ class Canonicalizer {
     return true;
   }
 
-  void pointer(const std::string& name, const std::vector<std::string>& subs, std::string* o) {
+  void pointer(const std::string& name, const std::vector<std::string>& subs, bool written, std::string* o) {
     PointerUse& u = pointerUse_[name];
     const Subscript s = parseSubscript(subs.empty() ? std::string() : subs.back());
     if (!o) {
+      record(name, subs, written);
+      u.written = u.written || written;
       if (subs.size() != 1 || !s.numeric) u.loose = true;
       else u.base = std::min(u.base, s.lead);
       return;
@@ -385,7 +402,22 @@ class Canonicalizer {
     *o += rebased(s, u.loose, u.base);
   }
 
+  // One element the block reads or stores, for touches_ and writes_.
+  void record(const std::string& name, const std::vector<std::string>& subs, bool written) {
+    std::string key = name + "|";
+    for (const std::string& sub : subs) {
+      if (sub.empty() || sub.find_first_not_of("0123456789") != std::string::npos) {
+        key = name + "|*";
+        break;
+      }
+      key += sub + ",";
+    }
+    touches_.insert(key);
+    if (written) writes_.insert(key);
+  }
+
   const std::map<std::string, const Members::Member*>& members_;
+  std::set<std::string> touches_, writes_;
   std::map<std::string, std::string> pointers_, scalars_;
   std::map<std::string, PointerUse> pointerUse_;
   std::vector<std::string> usedScalars_;
@@ -462,10 +494,179 @@ std::string withCommonLiterals(const std::string& body, const std::vector<std::s
   return out;
 }
 
+// ---- Blocks in pairs: two blocks of one kernel, one after the other in a
+// part and independent of each other, run as one call of the kernel's paired
+// form, each value in a lane of proxgen_rt::lanes<Scalar, 2> (docs/emitter.md,
+// "Blocks in pairs").
+
+// `text` with each parameter of `lanewise` renamed to its lane's (v_m2 -> v_m2_a).
+std::string inLane(const std::string& text, const std::set<std::string>& lanewise, const std::string& lane) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (identStart(text[i]) && (i == 0 || (!identChar(text[i - 1]) && text[i - 1] != '.' && text[i - 1] != ':'))) {
+      std::size_t j = i;
+      while (j < text.size() && identChar(text[j])) ++j;
+      const std::string id = text.substr(i, j - i);
+      out += lanewise.count(id) ? id + lane : id;
+      i = j;
+      continue;
+    }
+    out += text[i++];
+  }
+  return out;
+}
+
+class Pairer {
+ public:
+  Pairer(const std::set<std::string>& lanewise, bool table) : lanewise_(lanewise), table_(table) {}
+
+  // The paired body, or false when a line has a form this does not know.
+  bool run(const std::string& body, std::string& out) {
+    std::size_t at = 0;
+    while (at < body.size()) {
+      std::size_t eol = body.find('\n', at);
+      if (eol == std::string::npos) eol = body.size();
+      const std::string l = body.substr(at, eol - at);
+      at = eol + 1;
+      const std::size_t first = l.find_first_not_of(' ');
+      if (first == std::string::npos) continue;
+      const std::string indent = l.substr(0, first), t = l.substr(first);
+      if (t == "}" || t.rfind("PROXGEN_RT_NO_UNROLL for (", 0) == 0 || t.rfind("for (", 0) == 0) {
+        if (inLane(t, lanewise_, "_a") != t) return false;  // a loop's bounds are the same for both
+        out += l + "\n";
+        continue;
+      }
+      if (t.back() != ';') return false;
+      const std::string stmt = t.substr(0, t.size() - 1);
+      const std::string decl = "const Scalar ";
+      if (stmt.rfind(decl, 0) == 0) {  // a temporary: a pair
+        const std::size_t eq = stmt.find(" = ");
+        std::string value;
+        if (eq == std::string::npos || !expression(stmt.substr(eq + 3), value)) return false;
+        out += indent + "const ScalarPair " + stmt.substr(decl.size(), eq - decl.size()) + " = " + value + ";\n";
+        continue;
+      }
+      std::size_t j = 0;
+      while (j < stmt.size() && (identChar(stmt[j]) || stmt[j] == ':')) ++j;
+      const std::string head = stmt.substr(0, j);
+      if (j < stmt.size() && stmt[j] == '(' && stmt.back() == ')') {  // a call (sincos_joint_called): once per lane
+        if (stmt.find("k[") != std::string::npos) return false;
+        for (std::size_t x = stmt.find('x'); x != std::string::npos; x = stmt.find('x', x + 1))
+          if ((x == 0 || !identChar(stmt[x - 1])) && x + 1 < stmt.size() && std::isdigit(static_cast<unsigned char>(stmt[x + 1])))
+            return false;  // a temporary: a pair, not a lane's scalar
+        out += indent + inLane(stmt, lanewise_, "_a") + ";\n" + indent + inLane(stmt, lanewise_, "_b") + ";\n";
+        continue;
+      }
+      if (!lanewise_.count(head) || j >= stmt.size() || stmt[j] != '[') return false;
+      std::size_t e = j;
+      const std::vector<std::string> subs = readSubscripts(stmt, e);
+      if (stmt.compare(e, 3, " = ") != 0) return false;
+      std::string value;
+      if (!expression(stmt.substr(e + 3), value)) return false;
+      const std::string target = stmt.substr(0, e);
+      out += indent + "proxgen_rt::scatter2<Scalar>(" + value + ", " + inLane(target, lanewise_, "_a") + ", " +
+             inLane(target, lanewise_, "_b") + ");\n";
+    }
+    return true;
+  }
+
+ private:
+  // An expression with each lanewise value gathered into a pair, each
+  // constant of the table read as the pair of the two blocks'.
+  bool expression(const std::string& e, std::string& out) const {
+    std::size_t i = 0;
+    while (i < e.size()) {
+      const char c = e[i];
+      if (identStart(c) && (i == 0 || (!identChar(e[i - 1]) && e[i - 1] != '.' && e[i - 1] != ':'))) {
+        std::size_t j = i;
+        while (j < e.size() && identChar(e[j])) ++j;
+        const std::string id = e.substr(i, j - i);
+        if (j < e.size() && e[j] == '(') return false;  // a call inside an expression: not known here
+        if (id == "k" && table_ && j < e.size() && e[j] == '[') {
+          std::size_t end = j;
+          const std::vector<std::string> subs = readSubscripts(e, end);
+          out += "proxgen_rt::pair_at(k, " + subs.front() + ")";
+          i = end;
+          continue;
+        }
+        if (lanewise_.count(id)) {
+          std::size_t end = j;
+          readSubscripts(e, end);
+          const std::string v = e.substr(i, end - i);
+          out += "proxgen_rt::gather2(" + inLane(v, lanewise_, "_a") + ", " + inLane(v, lanewise_, "_b") + ")";
+          i = end;
+          continue;
+        }
+        out += id;
+        i = j;
+        continue;
+      }
+      out += c;
+      ++i;
+    }
+    return true;
+  }
+
+  const std::set<std::string>& lanewise_;
+  bool table_;
+};
+
+// Whether two blocks' elements overlap: one stores what the other reads or stores.
+bool overlap(const std::set<std::string>& writes, const std::set<std::string>& touches) {
+  for (const std::string& w : writes) {
+    const std::string name = w.substr(0, w.find('|') + 1);
+    if (touches.count(w) || touches.count(name + "*")) return true;
+    if (w == name + "*") {
+      const auto it = touches.lower_bound(name);
+      if (it != touches.end() && it->compare(0, name.size(), name) == 0) return true;
+    }
+  }
+  return false;
+}
+
+// Two blocks that can run as a pair: the second right after the first in one
+// part, neither touching what the other stores.
+// A pointer stored through is restrict in the paired form, so the two blocks
+// must pass two of them (the columns of one matrix, w.dtau_dq at 4 and at 5,
+// would be one pointer twice: left as two calls).
+bool independent(const Block& a, const Canonical& ca, const Block& b, const Canonical& cb) {
+  if (a.part != b.part || b.comment != a.end + 1 || overlap(ca.writes, cb.touches) || overlap(cb.writes, ca.touches))
+    return false;
+  for (std::size_t i = 0; i < ca.args.size(); ++i)
+    if (ca.argWritten[i] && ca.args[i] == cb.args[i]) return false;
+  return true;
+}
+
+// The parameters of a signature ("T a, U b"); none of them has a comma inside.
+std::vector<std::string> splitParams(const std::string& signature) {
+  std::vector<std::string> out;
+  std::size_t at = 0;
+  while (at < signature.size()) {
+    std::size_t comma = signature.find(", ", at);
+    if (comma == std::string::npos) comma = signature.size();
+    out.push_back(signature.substr(at, comma - at));
+    at = comma + 2;
+  }
+  return out;
+}
+
+// `param` ("Scalar (*PROXGEN_RT_RESTRICT IA_m3)[6]") with its name `name` given `lane`.
+std::string paramInLane(const std::string& param, const std::string& name, const std::string& lane) {
+  std::size_t at = param.size();
+  while ((at = param.rfind(name, at == 0 ? std::string::npos : at - 1)) != std::string::npos) {
+    const std::size_t end = at + name.size();
+    if ((at == 0 || !identChar(param[at - 1])) && (end == param.size() || !identChar(param[end])))
+      return param.substr(0, end) + lane + param.substr(end);
+    if (at == 0) break;
+  }
+  return param;
+}
+
 }  // namespace
 
 SharedParts shareBlocks(const std::string& text, const Members& ws,
-                        const std::function<bool(const std::string&)>& eligible) {
+                        const std::function<bool(const std::string&)>& eligible, bool pairs) {
   std::map<std::string, const Members::Member*> members;
   for (const Members::Member& m : ws.all()) members[m.name] = &m;
   std::string before;
@@ -529,6 +730,7 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     std::set<std::string> bodies;
     std::string bodyList;
     std::map<std::string, std::string> tableOf;  // values -> table: blocks with the same constants share one
+    std::vector<std::string> values(g.size());
     for (std::size_t n = 0; n < g.size(); ++n) {
       const Found& f = found[g[n]];
       const std::string comment = parts[f.where.part].lines[f.where.comment];
@@ -538,13 +740,51 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
         bodyList += (bodyList.empty() ? "" : ", ") + bodyName;
         k.bodies.push_back(bodyName);
       }
-      std::string values;
       for (std::size_t c = 0; c < nk; ++c)
-        if (!common[c]) values += (values.empty() ? "" : ", ") + f.canon.constants[c];
+        if (!common[c]) values[n] += (values[n].empty() ? "" : ", ") + f.canon.constants[c];
+    }
+    // The paired form, when the kernel's lines are ones it knows.
+    std::set<std::string> lanewise;
+    for (std::size_t a = 0; a < first.argParams.size(); ++a)
+      if (first.argLanewise[a]) lanewise.insert(first.argParams[a]);
+    // Every constant of it in the table of pairs, common ones too (pair_at: an
+    // aligned load the compiler folds into the operation; a literal would be
+    // loaded and duplicated).
+    std::string pairedText;
+    const bool pairable = pairs && Pairer(lanewise, nk > 0).run(first.body, pairedText);
+    std::string pairTables;
+    std::map<std::string, std::string> pairTableOf;
+    bool single = false;
+    for (std::size_t n = 0; n < g.size(); ++n) {
+      const Found& f = found[g[n]];
+      if (pairable && n + 1 < g.size() && independent(f.where, f.canon, found[g[n + 1]].where, found[g[n + 1]].canon)) {
+        const Found& h = found[g[n + 1]];
+        std::string args;
+        if (nk > 0) {
+          std::string both;
+          for (std::size_t c = 0; c < nk; ++c)
+            both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
+          auto [t, fresh] = pairTableOf.emplace(both, fmt::format("{}_p{}", k.name, pairTableOf.size()));
+          if (fresh)
+            pairTables += fmt::format("alignas(2 * sizeof(Scalar)) constexpr Scalar {}[{}] = {{{}}};\n", t->second,
+                                      2 * nk, both);
+          args = t->second;
+        }
+        for (std::size_t a = 0; a < f.canon.args.size(); ++a) {
+          args += (args.empty() ? "" : ", ") + f.canon.args[a];
+          if (f.canon.argLanewise[a]) args += ", " + h.canon.args[a];
+        }
+        calls[f.where.part][f.where.comment] = {
+            h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
+        ++k.pairs;
+        ++n;
+        continue;
+      }
+      single = true;
       std::string args;
       if (varying > 0) {
-        auto [t, fresh] = tableOf.emplace(values, fmt::format("{}_k{}", k.name, tableOf.size()));
-        if (fresh) tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, varying, values);
+        auto [t, fresh] = tableOf.emplace(values[n], fmt::format("{}_k{}", k.name, tableOf.size()));
+        if (fresh) tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, varying, values[n]);
         args = t->second;
       }
       for (const std::string& a : f.canon.args) args += (args.empty() ? "" : ", ") + a;
@@ -552,15 +792,52 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     }
     kernels += fmt::format("// {} blocks of the same code, each over its constants (k) and members: {}.\n// The first: {}\n",
                            g.size(), bodyList, parts[found[g.front()].where.part].lines[found[g.front()].where.comment].substr(5));
-    kernels += tables;
-    kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, signature, body);
+    if (single) {
+      kernels += tables;
+      kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, signature, body);
+    }
+    if (k.pairs > 0) {
+      // The parameters of each lane, side by side; a part's scalar once.
+      std::vector<std::string> params = splitParams(first.signature), pairedParams;
+      std::size_t a = 0;
+      for (const std::string& param : params) {
+        if (param == tableParam) {
+          pairedParams.push_back(param);
+          continue;
+        }
+        const std::size_t at = a++;
+        const std::string& name = first.argParams[at];
+        if (first.argLanewise[at]) {
+          // Two blocks may read one member (their parent's velocity): only a
+          // pointer stored through is restrict, which is what the compiler
+          // needs, and reading one array through two pointers stays legal.
+          std::string p = param;
+          const std::string kRestrict = "PROXGEN_RT_RESTRICT ";
+          if (!first.argWritten[at] && p.find(kRestrict) != std::string::npos) p.erase(p.find(kRestrict), kRestrict.size());
+          pairedParams.push_back(paramInLane(p, name, "_a"));
+          pairedParams.push_back(paramInLane(p, name, "_b"));
+        } else {
+          pairedParams.push_back(param);
+        }
+      }
+      kernels += fmt::format("// {}'s blocks two at a time, one in each lane of a ScalarPair:\n// {} pair{}.\n", k.name,
+                             k.pairs, k.pairs > 1 ? "s" : "");
+      kernels += pairTables;
+      kernels += fmt::format("PROXGEN_RT_NOINLINE void {}_x2({}) noexcept {{\n{}}}\n\n", k.name,
+                             fmt::join(pairedParams, ", "), pairedText);
+    }
     out.kernels.push_back(std::move(k));
   }
   if (out.kernels.empty()) {
     out.parts = text;
     return out;
   }
-  out.parts = before + kernels;
+  bool paired = false;
+  for (const SharedKernel& k : out.kernels) paired = paired || k.pairs > 0;
+  out.parts = before + (paired ? "// Two blocks at once (the kernels' _x2 forms): a value of each in the lanes of a pair.\n"
+                                 "using ScalarPair = proxgen_rt::lanes<Scalar, 2>;\n\n"
+                               : "") +
+              kernels;
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const Part& part = parts[p];
     out.parts += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n", part.name, part.params);

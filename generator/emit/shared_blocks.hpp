@@ -23,6 +23,7 @@ struct SharedKernel {
   std::string name;                  // shared_<k>
   std::vector<std::string> blocks;   // each block's comment line (its body), in order of the file
   std::vector<std::string> bodies;   // the bodies of those blocks, each once, in that order
+  int pairs = 0;                     // calls of its paired form shared_<k>_x2, two blocks each
 };
 
 struct SharedParts {
@@ -33,9 +34,11 @@ struct SharedParts {
 /// `parts`: the part functions as FunctionWriter prints them; `eligible(name)`:
 /// whether the blocks of part function `name` may be shared. Blocks that read
 /// anything but their part's parameters, the workspace members and their own
-/// temporaries are left as they are.
+/// temporaries are left as they are. `pairs`: two blocks of a kernel, one
+/// right after the other in a part and independent, run as one call of the
+/// kernel's paired form (docs/emitter.md, "Blocks in pairs").
 SharedParts shareBlocks(const std::string& parts, const Members& ws,
-                        const std::function<bool(const std::string&)>& eligible);
+                        const std::function<bool(const std::string&)>& eligible, bool pairs);
 
 /// Entry points whose code is at least this many operations (once + per
 /// iteration, the code's size rather than its work) share their blocks: at

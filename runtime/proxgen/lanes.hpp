@@ -260,6 +260,48 @@ inline lanes<S, W> sqrt(const lanes<S, W>& a) noexcept {
   return r;
 }
 
+// ---- Blocks in pairs (the scalar solvers' shared kernels, docs/emitter.md).
+//
+// Two bodies whose blocks are the same code (a left and a right leg) run as
+// one: each value the block reads is gathered from the two bodies' members
+// into the two lanes of a pair, each value it stores is scattered back. The
+// arithmetic between is the scalar block's, lane by lane.
+
+/// The pair (a, b).
+template <class S>
+inline lanes<S, 2> gather2(S a, S b) noexcept {
+  lanes<S, 2> r;
+#if PROXGEN_RT_LANES_VECTOR
+  r.x = typename lanes<S, 2>::vec{a, b};
+#else
+  r.x[0] = a, r.x[1] = b;
+#endif
+  return r;
+}
+
+/// a = x[0], b = x[1]. Called as scatter2<Scalar>(...), so that a scalar
+/// expression (a constant the block stores) enters as the pair of it.
+template <class S>
+inline void scatter2(const lanes<S, 2>& x, S& a, S& b) noexcept {
+  a = x.x[0];
+  b = x.x[1];
+}
+
+/// Pair i of a table of pairs {a0, b0, a1, b1, ...}: the two blocks'
+/// constants. The table is aligned to a pair (alignas(2 * sizeof(S))), so the
+/// pair is one aligned load, which the compiler folds into the operation that
+/// uses it (a literal pair would be loaded and duplicated: two instructions).
+template <class S>
+inline lanes<S, 2> pair_at(const S* table, int i) noexcept {
+  lanes<S, 2> r;
+#if PROXGEN_RT_LANES_VECTOR
+  std::memcpy(&r.x, __builtin_assume_aligned(table + 2 * i, 2 * sizeof(S)), sizeof r.x);
+#else
+  r.x[0] = table[2 * i], r.x[1] = table[2 * i + 1];
+#endif
+  return r;
+}
+
 /// largest_magnitude (runtime.hpp) per lane: the same compares and selects.
 template <class S, int W>
 inline lanes<S, W> largest_magnitude(const lanes<S, W>& a, const lanes<S, W>& b, const lanes<S, W>& c,

@@ -4,6 +4,8 @@
 // its first call, and a part whose statements all folded away prints nothing.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <string>
 
 #include "emit/function.hpp"
@@ -27,7 +29,7 @@ struct Written {
 };
 
 Written write(bool foldSecond) {
-  FunctionWriter fn(ScalarType::Double, {"world", "hip", "knee"});
+  FunctionWriter fn(ScalarType::Double, {"world", "hip", "knee"}, {"", "h", "k"});
   fn.beginHost("caba", nullptr);
   fn.beginPass("backward", "backward: the elimination");
   for (int i : {2, 1}) {
@@ -72,6 +74,27 @@ TEST(FunctionWriter, AFoldedPartPrintsNoFunctionNoCallNoBanner) {
   const Written w = write(true);
   EXPECT_EQ(w.parts.find("caba_forward"), std::string::npos) << w.parts;
   EXPECT_EQ(w.host.find("forward"), std::string::npos) << w.host;
+}
+
+// Parts close when full, but a body right after its twin (the same shape: a
+// left and a right leg's link) stays in the part of its twin, so that their
+// blocks can run as a pair; a third body of that shape starts its own.
+TEST(FunctionWriter, TwinsShareAPart) {
+  FunctionWriter fn(ScalarType::Double, {"world", "l", "r", "m", "o"}, {"", "leg", "leg", "leg", "arm"});
+  fn.beginHost("kin", nullptr);
+  fn.beginPass("", "");
+  for (int i : {1, 2, 3, 4}) {
+    fn.boundary(i);
+    fn.cb().open("{");
+    for (int k = 0; k < FunctionWriter::kPartBudget; ++k)  // a full part per block
+      fn.cb().store(fmt::format("w.x_{}[{}]", i, k), fn.cb().input(fmt::format("q[{}]", k)));
+    fn.cb().close();
+  }
+  const std::string host = fn.endHost({"q", "w"});
+  EXPECT_EQ(host,
+            "  kin_l_to_r(q, w);\n"
+            "  kin_m(q, w);\n"
+            "  kin_o(q, w);\n");
 }
 
 }  // namespace

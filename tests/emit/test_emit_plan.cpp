@@ -5,6 +5,7 @@
 // parent links and the constraints alone, on the shared cases and the
 // repository's robots.
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <set>
@@ -59,7 +60,36 @@ TEST(Plan, TreeFactsAgreeWithAnIndependentDerivation) {
       for (const Constraint& c : sys.constraints) constrained |= inSubtree(m, c.body, i);
       if (constrained) support.push_back(i);
     }
-    EXPECT_EQ(plan.support, support);
+    // The sweep: every moving body once, breadth first (the depth never
+    // decreases); in a depth the bodies of one shape one after the other, in
+    // their parents' order (siblings in child order), so that the same link of
+    // two limbs comes one after the other.
+    ASSERT_EQ(int(plan.sweep.size()), N - 1);
+    std::vector<int> depth(std::size_t(N), 0), at(std::size_t(N), -1);
+    for (int i = 1; i < N; ++i) depth[std::size_t(i)] = depth[std::size_t(m.bodies[std::size_t(i)].parent)] + 1;
+    for (std::size_t k = 0; k < plan.sweep.size(); ++k) {
+      ASSERT_EQ(at[std::size_t(plan.sweep[k])], -1) << "body " << plan.sweep[k] << " twice";
+      at[std::size_t(plan.sweep[k])] = int(k);
+    }
+    std::set<std::pair<int, std::string>> done;  // (depth, shape) runs already closed
+    for (std::size_t k = 1; k < plan.sweep.size(); ++k) {
+      const int a = plan.sweep[k - 1], b = plan.sweep[k];
+      const BodyPlan &pa = plan.bodies[std::size_t(a)], &pb = plan.bodies[std::size_t(b)];
+      EXPECT_LE(depth[std::size_t(a)], depth[std::size_t(b)]) << a << " before " << b;
+      if (depth[std::size_t(a)] != depth[std::size_t(b)] || pa.shape != pb.shape) {
+        EXPECT_TRUE(done.insert({depth[std::size_t(a)], pa.shape}).second) << "body " << a << ": its shape's run is split";
+        continue;
+      }
+      EXPECT_LE(at[std::size_t(pa.parent)], at[std::size_t(pb.parent)]) << a << " before " << b;
+      if (pa.parent == pb.parent) EXPECT_LT(a, b);
+    }
+    // The support and the other bodies, in the sweep's order.
+    std::vector<int> supportInSweep;
+    for (int i : plan.sweep)
+      if (std::find(support.begin(), support.end(), i) != support.end()) supportInSweep.push_back(i);
+    EXPECT_EQ(plan.support, supportInSweep);
+    for (std::size_t k = 1; k < plan.offSupport.size(); ++k)
+      EXPECT_LT(at[std::size_t(plan.offSupport[k - 1])], at[std::size_t(plan.offSupport[k])]);
     std::set<int> all(plan.support.begin(), plan.support.end());
     for (int i : plan.offSupport) EXPECT_TRUE(all.insert(i).second) << "body " << i << " on and off the support";
     EXPECT_EQ(int(all.size()), N - 1);
@@ -118,12 +148,43 @@ TEST(Plan, DataReadsTheSameTreeFacts) {
     SCOPED_TRACE(name);
     const Plan plan = makePlan(sys, name, ScalarType::Double);
     const Data d(sys);
-    EXPECT_EQ(d.support, plan.support);
+    // The same bodies: Data's ascending, the plan's in the sweep's order.
+    std::vector<int> support = plan.support;
+    std::sort(support.begin(), support.end());
+    EXPECT_EQ(d.support, support);
     for (int i = 0; i < sys.model.numBodies(); ++i) {
       EXPECT_EQ(d.subtreeRows[std::size_t(i)], plan.bodies[std::size_t(i)].subtreeRows) << "body " << i;
       EXPECT_EQ(d.subtreeStart[std::size_t(i)], plan.bodies[std::size_t(i)].rowStart) << "body " << i;
     }
   }
+}
+
+// A body's shape is its subtree's joints and constraints, not its constants:
+// Talos' left and right leg links have one (their blocks can pair), a leg's and
+// an arm's link of the same joint class do not; in the sweep the two legs'
+// links come one after the other.
+TEST(Plan, TheLegsOfTalosAreTwins) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Case& c : test::sharedCases()) {
+    if (c.name != "talos_f6x2") continue;
+    const Plan plan = makePlan(loadCaseSystem(c), c.name, ScalarType::Double);
+    auto body = [&](const std::string& link) -> const BodyPlan& {
+      for (const BodyPlan& b : plan.bodies)
+        if (b.link == link) return b;
+      ADD_FAILURE() << "no link " << link;
+      return plan.bodies[0];
+    };
+    for (int k = 1; k <= 6; ++k) {
+      const BodyPlan &l = body(fmt::format("leg_left_{}_link", k)), &r = body(fmt::format("leg_right_{}_link", k));
+      EXPECT_EQ(l.shape, r.shape) << k;
+      const auto pos = [&](int i) { return std::find(plan.sweep.begin(), plan.sweep.end(), i) - plan.sweep.begin(); };
+      EXPECT_EQ(pos(r.index), pos(l.index) + 1) << k;
+    }
+    EXPECT_NE(body("leg_left_1_link").shape, body("arm_left_1_link").shape);  // both about z; other subtrees
+    EXPECT_NE(body("leg_left_1_link").shape, body("leg_left_2_link").shape);
+    return;
+  }
+  FAIL() << "no case talos_f6x2";
 }
 
 TEST(Plan, IdentifiersAreUnique) {

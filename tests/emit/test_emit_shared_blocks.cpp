@@ -47,7 +47,7 @@ const auto all = [](const std::string&) { return true; };
 
 TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
   const std::string text = part("caba_left", "left", 2, "0.25") + part("caba_right", "right", 4, "0.5", '-');
-  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all, false);
   ASSERT_EQ(s.kernels.size(), 1u);
   EXPECT_EQ(s.kernels[0].name, "shared_0");
   ASSERT_EQ(s.kernels[0].blocks.size(), 2u);
@@ -76,12 +76,12 @@ TEST(SharedBlocks, BlocksEqualUpToConstantsMembersAndOffsetsShareOneKernel) {
 
 TEST(SharedBlocks, BlocksWithTheSameConstantsNeedNoTable) {
   const std::string text = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25", '-');
-  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all, false);
   ASSERT_EQ(s.kernels.size(), 1u);
   EXPECT_EQ(test::occurrences(s.parts, "constexpr Scalar shared_0_k"), 2);  // 0.25 and -0.25 differ: a table each
   EXPECT_NE(s.parts.find("- 1.5e-05*tau[1];"), std::string::npos) << s.parts;
   const std::string same = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.25");
-  const SharedParts t = shareBlocks(same, members({"left", "right"}), all);
+  const SharedParts t = shareBlocks(same, members({"left", "right"}), all, false);
   ASSERT_EQ(t.kernels.size(), 1u);
   EXPECT_EQ(test::occurrences(t.parts, "constexpr Scalar"), 0);
   EXPECT_NE(t.parts.find("const Scalar x0 = IA_m0[0] + 0.25*Dinv_m1;"), std::string::npos) << t.parts;
@@ -94,17 +94,17 @@ TEST(SharedBlocks, OtherCodeAndIneligiblePartsStayAsPrinted) {
   odd.replace(odd.find("t6*w.u_odd[0]"), 13, "t6/w.u_odd[0]");
   const std::string text = part("caba_left", "left", 2, "0.25") + part("caba_right", "right", 4, "0.5") + odd;
   const Members ws = members({"left", "right", "odd"});
-  const SharedParts s = shareBlocks(text, ws, all);
+  const SharedParts s = shareBlocks(text, ws, all, false);
   ASSERT_EQ(s.kernels.size(), 1u);
   EXPECT_EQ(s.kernels[0].blocks.size(), 2u);
   EXPECT_NE(s.parts.find("t6/w.u_odd[0]"), std::string::npos);
   // Nothing eligible, or nothing to share: the text comes back byte for byte.
-  const SharedParts none = shareBlocks(text, ws, [](const std::string&) { return false; });
+  const SharedParts none = shareBlocks(text, ws, [](const std::string&) { return false; }, false);
   EXPECT_TRUE(none.kernels.empty());
   EXPECT_EQ(none.parts, text);
-  EXPECT_EQ(shareBlocks(odd, ws, all).parts, odd);
+  EXPECT_EQ(shareBlocks(odd, ws, all, false).parts, odd);
   // Only the eligible part's block would be shared: one block is no group.
-  const SharedParts one = shareBlocks(text, ws, [](const std::string& p) { return p == "caba_left"; });
+  const SharedParts one = shareBlocks(text, ws, [](const std::string& p) { return p == "caba_left"; }, false);
   EXPECT_EQ(one.parts, text);
 }
 
@@ -116,9 +116,74 @@ TEST(SharedBlocks, ABlockReadingWhatAKernelCouldNotIsLeftAlone) {
     return p;
   };
   const std::string text = reading("a", "left", 2) + reading("b", "right", 4);
-  const SharedParts s = shareBlocks(text, members({"left", "right"}), all);
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all, false);
   EXPECT_TRUE(s.kernels.empty());
   EXPECT_EQ(s.parts, text);
+}
+
+// One part holding the blocks of `part` for bodies a and b, one after the
+// other (a left and a right leg in the sweep's order).
+std::string onePart(const std::string& a, int da, const std::string& b, int db) {
+  const auto block = [](const std::string& p) {
+    const std::size_t open = p.find('\n') + 1;
+    return p.substr(open, p.rfind("}\n") - open);
+  };
+  const std::string first = part("caba", a, da, "0.25"), second = part("caba", b, db, "0.5", '-');
+  return first.substr(0, first.find('\n') + 1) + block(first) + block(second) + "}\n\n";
+}
+
+TEST(SharedBlocks, TwoIndependentBlocksOneAfterTheOtherRunAsAPair) {
+  const std::string text = onePart("left", 2, "right", 4);
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all, true);
+  ASSERT_EQ(s.kernels.size(), 1u);
+  EXPECT_EQ(s.kernels[0].pairs, 1);
+  // One call of the paired form, each lane's arguments side by side (a part's
+  // scalar would come once); no single form is printed when no block needs it.
+  EXPECT_NE(s.parts.find("  shared_0_x2(shared_0_p0, &tau[2], &tau[4], &w.IA_left[3], &w.IA_right[3], w.Dinv_left, "
+                         "w.Dinv_right, w.u_left, w.u_right, &w.pA_left[5], &w.pA_right[5], &w.IA_base[2], "
+                         "&w.IA_base[4]);"),
+            std::string::npos)
+      << s.parts;
+  EXPECT_EQ(test::occurrences(s.parts, "void shared_0("), 0) << s.parts;
+  EXPECT_EQ(test::occurrences(s.parts, "using ScalarPair = proxgen_rt::lanes<Scalar, 2>;"), 1);
+  // Every constant in the table of pairs, common ones too ({a0, b0, a1, b1}),
+  // aligned so that each pair is one load.
+  EXPECT_NE(s.parts.find("alignas(2 * sizeof(Scalar)) constexpr Scalar shared_0_p0[4] = {0.25, -0.5, -1.5e-05, "
+                         "-1.5e-05};"),
+            std::string::npos)
+      << s.parts;
+  // The block's statements over pairs: what it reads gathered, what it stores
+  // scattered, the member read by value gathered from the two values.
+  EXPECT_NE(s.parts.find("  const ScalarPair x0 = proxgen_rt::gather2(IA_m0_a[0], IA_m0_b[0]) + "
+                         "proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(Dinv_m1_a, Dinv_m1_b);"),
+            std::string::npos)
+      << s.parts;
+  EXPECT_NE(s.parts.find("  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + "
+                         "proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);"),
+            std::string::npos)
+      << s.parts;
+  // Both blocks' comment lines stay, their statements are gone.
+  EXPECT_EQ(test::occurrences(s.parts, "// body 2 'left'"), 1);
+  EXPECT_EQ(test::occurrences(s.parts, "// body 4 'right'"), 1);
+  EXPECT_EQ(test::occurrences(s.parts, "w.Dinv_"), 2);
+  // Without pairs: two calls of the single form.
+  const SharedParts single = shareBlocks(text, members({"left", "right"}), all, false);
+  EXPECT_EQ(single.kernels[0].pairs, 0);
+  EXPECT_EQ(test::occurrences(single.parts, "_x2"), 0);
+  EXPECT_EQ(test::occurrences(single.parts, "  shared_0(shared_0_k"), 2);
+}
+
+TEST(SharedBlocks, BlocksThatTouchWhatTheOtherStoresAreNoPair) {
+  // Both store w.IA_base[2] (two children's terms added into their parent's).
+  const std::string both = onePart("left", 2, "right", 2);
+  const SharedParts s = shareBlocks(both, members({"left", "right"}), all, true);
+  ASSERT_EQ(s.kernels.size(), 1u);
+  EXPECT_EQ(s.kernels[0].pairs, 0);
+  EXPECT_EQ(test::occurrences(s.parts, "_x2"), 0);
+  EXPECT_EQ(test::occurrences(s.parts, "  shared_0(shared_0_k"), 2);
+  // Not one after the other: two parts.
+  const std::string apart = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.5", '-');
+  EXPECT_EQ(shareBlocks(apart, members({"left", "right"}), all, true).kernels[0].pairs, 0);
 }
 
 // Which solvers share: the ones whose entry points' code is above the first-level
