@@ -5,62 +5,67 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
-//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
+//   constrained_aba: 8734 + 1645 K (= 13669 at K = 3)
+//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 157 + 49 K, sqrt 7, sincos 30, log6 0
 //   prox_pv: 16649 + 650 K (= 18599 at K = 3)
 //     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_1: 2 blocks of l_thigh, r_thigh
-//   shared_2: 2 blocks of l_shank, r_shank
-//   shared_3: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_4: 2 blocks of l_foot, r_foot
-//   shared_5: 2 blocks of l_wrist_yaw_link, neck_link
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_1: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_2: 2 blocks of neck_link, l_wrist_yaw_link
+//   shared_3: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_4: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_5: 2 blocks of l_foot, r_foot (2 in pairs)
 //   shared_6: 2 blocks of l_wrist_yaw_link, r_wrist_yaw_link
 //   shared_7: 2 blocks of l_forearm, r_forearm
 //   shared_8: 2 blocks of l_upper_arm, r_upper_arm
 //   shared_9: 2 blocks of l_shoulder_roll_link, r_shoulder_roll_link
-//   shared_10: 2 blocks of r_foot, l_foot
-//   shared_11: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_12: 2 blocks of r_shank, l_shank
-//   shared_13: 2 blocks of r_thigh, l_thigh
-//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_10: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_11: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_12: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_13: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
 //   shared_15: 2 blocks of pelvis
-//   shared_16: 2 blocks of l_hip_yaw_link
-//   shared_17: 4 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_18: 4 blocks of l_thigh, r_thigh
-//   shared_19: 4 blocks of l_shank, r_shank
-//   shared_20: 4 blocks of l_ankle_link, r_ankle_link
-//   shared_21: 4 blocks of l_foot, r_foot
-//   shared_22: 2 blocks of r_hip_yaw_link
-//   shared_23: 2 blocks of abdomen
-//   shared_24: 2 blocks of chest
-//   shared_25: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
-//   shared_26: 3 blocks of r_shoulder_roll_link, l_shoulder_roll_link
-//   shared_27: 2 blocks of r_upper_arm
-//   shared_28: 2 blocks of r_forearm
-//   shared_29: 3 blocks of r_wrist_yaw_link, l_wrist_yaw_link
-//   shared_30: 2 blocks of r_wrist_pitch_link
-//   shared_31: 2 blocks of r_hand
-//   shared_32: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_33: 2 blocks of r_foot, l_foot
-//   shared_34: 2 blocks of r_thigh, l_thigh
-//   shared_35: 2 blocks of r_foot, l_foot
-//   shared_36: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_37: 2 blocks of r_shank, l_shank
-//   shared_38: 2 blocks of r_thigh, l_thigh
-//   shared_39: 2 blocks of r_hip_roll_link, l_hip_roll_link
-//   shared_40: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_41: 2 blocks of l_thigh, r_thigh
-//   shared_42: 2 blocks of l_shank, r_shank
-//   shared_43: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_44: 2 blocks of l_foot, r_foot
-//   shared_45: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_46: 2 blocks of l_thigh, r_thigh
-//   shared_47: 2 blocks of l_shank, r_shank
-//   shared_48: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_49: 2 blocks of l_foot, r_foot
+//   shared_16: 4 blocks of l_hip_yaw_link, r_hip_yaw_link (4 in pairs)
+//   shared_17: 2 blocks of abdomen
+//   shared_18: 4 blocks of l_hip_roll_link, r_hip_roll_link (4 in pairs)
+//   shared_19: 2 blocks of chest
+//   shared_20: 4 blocks of l_thigh, r_thigh (4 in pairs)
+//   shared_21: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
+//   shared_22: 4 blocks of l_shank, r_shank (4 in pairs)
+//   shared_23: 2 blocks of r_shoulder_roll_link
+//   shared_24: 4 blocks of l_ankle_link, r_ankle_link (4 in pairs)
+//   shared_25: 3 blocks of r_upper_arm, l_upper_arm
+//   shared_26: 4 blocks of l_foot, r_foot (4 in pairs)
+//   shared_27: 2 blocks of r_forearm
+//   shared_28: 2 blocks of r_wrist_yaw_link
+//   shared_29: 2 blocks of r_wrist_pitch_link
+//   shared_30: 2 blocks of r_hand
+//   shared_31: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_32: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_33: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_34: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_35: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_36: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_37: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_38: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_39: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_40: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_41: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_42: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_43: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_44: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_45: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_46: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_47: 2 blocks of l_foot, r_foot (2 in pairs)
+//   shared_48: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_49: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_50: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_51: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_52: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_53: 2 blocks of l_foot, r_foot (2 in pairs)
 
 #include "humanoid.hpp"
 
@@ -79,165 +84,82 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
+// Two blocks at once (the kernels' _x2 forms): a value of each in the lanes of a pair.
+using ScalarPair = proxgen_rt::lanes<Scalar, 2>;
+
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
-  v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
-  v_m2[2] = v_m3[3] + v[0];
-  v_m2[3] = v_m3[4]*cq_m1[0] + v_m3[5]*sq_m0[0];
-  v_m2[4] = -v_m3[4]*sq_m0[0] + v_m3[5]*cq_m1[0];
-  c_m4[0] = v[0]*v_m2[1];
-  c_m4[1] = -v[0]*v_m2[0];
-  c_m4[3] = v[0]*v_m2[4];
-  c_m4[4] = -v[0]*v_m2[3];
-  const Scalar x0 = 0.5*v_m3[0] - 0.015*v_m2[3];
-  const Scalar x1 = 0.5*v_m2[0] + 0.015*v_m2[2];
-  const Scalar x2 = 0.015*v_m2[0] + 0.00095*v_m2[2];
-  const Scalar x3 = -0.015*v_m3[0] + 0.00095*v_m2[3];
-  pA_m5[0] = 0.5*v_m2[1]*v_m2[3] - v_m2[4]*x1;
-  pA_m5[1] = v_m2[4]*x0 - 0.5*v_m2[1]*v_m2[2];
-  pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
-  pA_m5[3] = 0.0005*v_m2[3]*v_m2[4] - v_m2[4]*x3 + 0.5*v_m2[0]*v_m2[1] - v_m2[1]*x1;
-  pA_m5[4] = v_m2[4]*x2 - 0.0005*v_m2[2]*v_m2[4] + v_m2[1]*x0 - 0.5*v_m3[0]*v_m2[1];
-  pA_m5[5] = v_m2[2]*x3 - v_m2[3]*x2 + v_m3[0]*x1 - v_m2[0]*x0;
-  g_m6[0] = g_m7[0]*cq_m1[0] + g_m8[0]*sq_m0[0];
-  g_m6[1] = -g_m7[0]*sq_m0[0] + g_m8[0]*cq_m1[0];
+// shared_0's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_0_p0[28] = {0.5, 0.5, -0.015, -0.015, 0.5, 0.5, 0.015, 0.015, 0.015, 0.015, 0.00095, 0.00095, -0.015, -0.015, 0.00095, 0.00095, 0.5, 0.5, -0.5, -0.5, 0.0005, 0.0005, 0.5, 0.5, -0.0005, -0.0005, -0.5, -0.5};
+PROXGEN_RT_NOINLINE void shared_0_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* PROXGEN_RT_RESTRICT v_m2_a, Scalar* PROXGEN_RT_RESTRICT v_m2_b, Scalar* v_m3_a, Scalar* v_m3_b, Scalar* PROXGEN_RT_RESTRICT c_m4_a, Scalar* PROXGEN_RT_RESTRICT c_m4_b, Scalar* PROXGEN_RT_RESTRICT pA_m5_a, Scalar* PROXGEN_RT_RESTRICT pA_m5_b, Scalar* PROXGEN_RT_RESTRICT g_m6_a, Scalar* PROXGEN_RT_RESTRICT g_m6_b, Scalar* g_m7_a, Scalar* g_m7_b, Scalar* g_m8_a, Scalar* g_m8_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m2_a[0], v_m2_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m2_a[1], v_m2_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m2_a[2], v_m2_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m2_a[3], v_m2_b[3]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m2_a[4], v_m2_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]), c_m4_a[0], c_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]), c_m4_a[1], c_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]), c_m4_a[3], c_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]), c_m4_a[4], c_m4_b[4]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]) - proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x1, pA_m5_a[0], pA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x0 + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]), pA_m5_a[1], pA_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x1 - proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x0, pA_m5_a[2], pA_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) - proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x3 + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0])*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) - proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x1, pA_m5_a[3], pA_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x2 + proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) + proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x0 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]), pA_m5_a[4], pA_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x3 - proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x2 + proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x1 - proxgen_rt::gather2(v_m2_a[0], v_m2_b[0])*x0, pA_m5_a[5], pA_m5_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), g_m6_a[0], g_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), g_m6_a[1], g_m6_b[1]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT g_m9) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = 0.9950041652780258*v_m2[0] + 0.09983341664682815*v_m3[1];
-  const Scalar x1 = -0.09983341664682815*v_m2[0] + 0.9950041652780258*v_m3[1];
-  const Scalar x2 = 0.9950041652780258*v_m3[2] + 0.09983341664682815*v_m3[4];
-  const Scalar x3 = -0.09983341664682815*v_m3[2] + 0.9950041652780258*v_m3[4];
-  v_m4[0] = cq_m1[0]*x0 - sq_m0[0]*x1;
-  v_m4[2] = sq_m0[0]*x0 + cq_m1[0]*x1;
-  v_m4[3] = cq_m1[0]*x2 - sq_m0[0]*x3;
-  v_m4[4] = v_m3[3] + v[0];
-  v_m4[5] = sq_m0[0]*x2 + cq_m1[0]*x3;
-  c_m5[0] = -v[0]*v_m4[2];
-  c_m5[2] = v[0]*v_m4[0];
-  c_m5[3] = -v[0]*v_m4[5];
-  c_m5[5] = v[0]*v_m4[3];
-  const Scalar x4 = 7.0*v_m4[0] - 1.29954125*v_m4[4];
-  const Scalar x5 = 7.0*v_m3[0] + 1.29954125*v_m4[3];
-  const Scalar x6 = 1.29954125*v_m3[0] + 0.3755072987089375*v_m4[3];
-  const Scalar x7 = -1.29954125*v_m4[0] + 0.3755072987089375*v_m4[4];
-  pA_m6[0] = 7.0*v_m4[2]*v_m4[4] - v_m4[5]*x5;
-  pA_m6[1] = v_m4[5]*x4 - 7.0*v_m4[2]*v_m4[3];
-  pA_m6[2] = v_m4[3]*x5 - v_m4[4]*x4;
-  pA_m6[3] = 0.0196875*v_m4[4]*v_m4[5] - v_m4[5]*x7 + 7.0*v_m3[0]*v_m4[2] - v_m4[2]*x5;
-  pA_m6[4] = v_m4[5]*x6 - 0.0196875*v_m4[3]*v_m4[5] + v_m4[2]*x4 - 7.0*v_m4[0]*v_m4[2];
-  pA_m6[5] = v_m4[3]*x7 - v_m4[4]*x6 + v_m4[0]*x5 - v_m3[0]*x4;
-  const Scalar x8 = 0.9950041652780258*g_m7[0] + 0.09983341664682815*g_m8[0];
-  const Scalar x9 = -0.09983341664682815*g_m7[0] + 0.9950041652780258*g_m8[0];
-  g_m9[0] = cq_m1[0]*x8 - sq_m0[0]*x9;
-  g_m9[2] = sq_m0[0]*x8 + cq_m1[0]*x9;
+// shared_1's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_1_p0[52] = {0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 7.0, 7.0, -1.29954125, -1.29954125, 7.0, 7.0, 1.29954125, 1.29954125, 1.29954125, 1.29954125, 0.3755072987089375, 0.3755072987089375, -1.29954125, -1.29954125, 0.3755072987089375, 0.3755072987089375, 7.0, 7.0, -7.0, -7.0, 0.0196875, 0.0196875, 7.0, 7.0, -0.0196875, -0.0196875, -7.0, -7.0, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_1_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* v_m2_a, Scalar* v_m2_b, Scalar* v_m3_a, Scalar* v_m3_b, Scalar* PROXGEN_RT_RESTRICT v_m4_a, Scalar* PROXGEN_RT_RESTRICT v_m4_b, Scalar* PROXGEN_RT_RESTRICT c_m5_a, Scalar* PROXGEN_RT_RESTRICT c_m5_b, Scalar* PROXGEN_RT_RESTRICT pA_m6_a, Scalar* PROXGEN_RT_RESTRICT pA_m6_b, Scalar* g_m7_a, Scalar* g_m7_b, Scalar* g_m8_a, Scalar* g_m8_b, Scalar* PROXGEN_RT_RESTRICT g_m9_a, Scalar* PROXGEN_RT_RESTRICT g_m9_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m3_a[1], v_m3_b[1]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(v_m3_a[1], v_m3_b[1]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x0 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x1, v_m4_a[0], v_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x0 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x1, v_m4_a[2], v_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x2 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x3, v_m4_a[3], v_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x2 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x3, v_m4_a[5], v_m4_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), c_m5_a[0], c_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]), c_m5_a[2], c_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]), c_m5_a[3], c_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), c_m5_a[5], c_m5_b[5]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x5, pA_m6_a[0], pA_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x4 + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), pA_m6_a[1], pA_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x5 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x4, pA_m6_a[2], pA_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x7 + proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]) - proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x5, pA_m6_a[3], pA_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x6 + proxgen_rt::pair_at(k, 20)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) + proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x4 + proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), pA_m6_a[4], pA_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x7 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x6 + proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*x5 - proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x4, pA_m6_a[5], pA_m6_b[5]);
+  const ScalarPair x8 = proxgen_rt::pair_at(k, 22)*proxgen_rt::gather2(g_m7_a[0], g_m7_b[0]) + proxgen_rt::pair_at(k, 23)*proxgen_rt::gather2(g_m8_a[0], g_m8_b[0]);
+  const ScalarPair x9 = proxgen_rt::pair_at(k, 24)*proxgen_rt::gather2(g_m7_a[0], g_m7_b[0]) + proxgen_rt::pair_at(k, 25)*proxgen_rt::gather2(g_m8_a[0], g_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x8 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x9, g_m9_a[0], g_m9_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x8 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x9, g_m9_a[2], g_m9_b[2]);
 }
 
-// 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
-// The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] - 0.42875*v_m2[4];
-  const Scalar x1 = v_m3[0] + 0.42875*v_m2[3];
-  const Scalar x2 = -0.19866933079506124*v_m2[2] + 0.9800665778412416*x0;
-  const Scalar x3 = 0.9800665778412416*v_m2[2] + 0.19866933079506124*x0;
-  const Scalar x4 = 0.9800665778412416*v_m2[3] - 0.19866933079506124*v_m2[5];
-  const Scalar x5 = 0.19866933079506124*v_m2[3] + 0.9800665778412416*v_m2[5];
-  v_m4[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
-  v_m4[1] = x1;
-  v_m4[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
-  v_m4[3] = cq_m1[0]*x4 - sq_m0[0]*x5;
-  v_m4[4] = v_m2[4] + v[0];
-  v_m4[5] = sq_m0[0]*x4 + cq_m1[0]*x5;
-  c_m5[0] = -v[0]*v_m4[2];
-  c_m5[2] = v[0]*v_m4[0];
-  c_m5[3] = -v[0]*v_m4[5];
-  c_m5[5] = v[0]*v_m4[3];
-  const Scalar x6 = 3.055*v_m4[0] - 0.5694718575000001*v_m4[4];
-  const Scalar x7 = 3.055*v_m4[1] + 0.5694718575000001*v_m4[3];
-  const Scalar x8 = 0.5694718575000001*v_m4[1] + 0.15779149347477375*v_m4[3];
-  const Scalar x9 = -0.5694718575000001*v_m4[0] + 0.15779149347477375*v_m4[4];
-  pA_m6[0] = 3.055*v_m4[2]*v_m4[4] - v_m4[5]*x7;
-  pA_m6[1] = v_m4[5]*x6 - 3.055*v_m4[2]*v_m4[3];
-  pA_m6[2] = v_m4[3]*x7 - v_m4[4]*x6;
-  pA_m6[3] = 0.00381875*v_m4[4]*v_m4[5] - v_m4[5]*x9 + 3.055*v_m4[1]*v_m4[2] - v_m4[2]*x7;
-  pA_m6[4] = v_m4[5]*x8 - 0.00381875*v_m4[3]*v_m4[5] + v_m4[2]*x6 - 3.055*v_m4[0]*v_m4[2];
-  pA_m6[5] = v_m4[3]*x9 - v_m4[4]*x8 + v_m4[0]*x7 - v_m4[1]*x6;
-  const Scalar x10 = 0.9800665778412416*g_m7[0] - 0.19866933079506124*g_m7[2];
-  const Scalar x11 = 0.19866933079506124*g_m7[0] + 0.9800665778412416*g_m7[2];
-  g_m8[0] = cq_m1[0]*x10 - sq_m0[0]*x11;
-  g_m8[2] = sq_m0[0]*x10 + cq_m1[0]*x11;
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
-// The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] - 0.4305*v_m2[4];
-  const Scalar x1 = v_m2[1] + 0.4305*v_m2[3];
-  const Scalar x2 = 0.09983341664682815*v_m2[2] + 0.9950041652780258*x0;
-  const Scalar x3 = 0.9950041652780258*v_m2[2] - 0.09983341664682815*x0;
-  const Scalar x4 = 0.9950041652780258*v_m2[3] + 0.09983341664682815*v_m2[5];
-  const Scalar x5 = -0.09983341664682815*v_m2[3] + 0.9950041652780258*v_m2[5];
-  v_m3[0] = cq_m1[0]*x2 - sq_m0[0]*x3;
-  v_m3[1] = x1;
-  v_m3[2] = sq_m0[0]*x2 + cq_m1[0]*x3;
-  v_m3[3] = cq_m1[0]*x4 - sq_m0[0]*x5;
-  v_m3[4] = v_m2[4] + v[0];
-  v_m3[5] = sq_m0[0]*x4 + cq_m1[0]*x5;
-  c_m4[0] = -v[0]*v_m3[2];
-  c_m4[2] = v[0]*v_m3[0];
-  c_m4[3] = -v[0]*v_m3[5];
-  c_m4[5] = v[0]*v_m3[3];
-  pA_m5[0] = 0.2*(v_m3[2]*v_m3[4] - v_m3[1]*v_m3[5]);
-  pA_m5[1] = 0.2*(v_m3[0]*v_m3[5] - v_m3[2]*v_m3[3]);
-  pA_m5[2] = 0.2*(v_m3[1]*v_m3[3] - v_m3[0]*v_m3[4]);
-  const Scalar x6 = 0.9950041652780258*g_m6[0] + 0.09983341664682815*g_m6[2];
-  const Scalar x7 = -0.09983341664682815*g_m6[0] + 0.9950041652780258*g_m6[2];
-  g_m7[0] = cq_m1[0]*x6 - sq_m0[0]*x7;
-  g_m7[2] = sq_m0[0]*x6 + cq_m1[0]*x7;
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
-// The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_4(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  v_m2[0] = v_m3[1]*cq_m1[0] + v_m3[2]*sq_m0[0];
-  v_m2[1] = -v_m3[1]*sq_m0[0] + v_m3[2]*cq_m1[0];
-  v_m2[2] = v_m3[3] + v[0];
-  v_m2[3] = v_m3[4]*cq_m1[0] + v_m3[5]*sq_m0[0];
-  v_m2[4] = -v_m3[4]*sq_m0[0] + v_m3[5]*cq_m1[0];
-  c_m4[0] = v[0]*v_m2[1];
-  c_m4[1] = -v[0]*v_m2[0];
-  c_m4[3] = v[0]*v_m2[4];
-  c_m4[4] = -v[0]*v_m2[3];
-  const Scalar x0 = 1.015*v_m3[0] - 0.027912499999999996*v_m2[3];
-  const Scalar x1 = 1.015*v_m2[0] + 0.027912499999999996*v_m2[2] + 0.06495999999999999*v_m2[4];
-  const Scalar x2 = 1.015*v_m2[1] - 0.06495999999999999*v_m2[3];
-  const Scalar x3 = 0.027912499999999996*v_m2[0] + 0.00194517348958*v_m2[2] + 0.0017863999999999998*v_m2[4];
-  const Scalar x4 = -0.027912499999999996*v_m3[0] - 0.06495999999999999*v_m2[1] + 0.00936987670937*v_m2[3];
-  const Scalar x5 = 0.06495999999999999*v_m2[0] + 0.0017863999999999998*v_m2[2] + 0.00860228295937*v_m2[4];
-  pA_m5[0] = v_m2[3]*x2 - v_m2[4]*x1;
-  pA_m5[1] = v_m2[4]*x0 - v_m2[2]*x2;
-  pA_m5[2] = v_m2[2]*x1 - v_m2[3]*x0;
-  pA_m5[3] = v_m2[3]*x5 - v_m2[4]*x4 + v_m2[0]*x2 - v_m2[1]*x1;
-  pA_m5[4] = v_m2[4]*x3 - v_m2[2]*x5 + v_m2[1]*x0 - v_m3[0]*x2;
-  pA_m5[5] = v_m2[2]*x4 - v_m2[3]*x3 + v_m3[0]*x1 - v_m2[0]*x0;
-  g_m6[0] = g_m7[0]*cq_m1[0] + g_m8[0]*sq_m0[0];
-  g_m6[1] = -g_m7[0]*sq_m0[0] + g_m8[0]*cq_m1[0];
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, neck_link.
-// The first: body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-constexpr Scalar shared_5_k0[16] = {-0.2555, 0.2555, 0.1, 0.001, 0.1, -0.001, -0.001, 3.5000000000000004e-05, 0.001, 3.5000000000000004e-05, 0.1, -0.1, 2.5e-05, 0.1, -2.5e-05, -0.1};
-constexpr Scalar shared_5_k1[16] = {0.29, -0.29, 0.5, 0.015, 0.5, -0.015, -0.015, 0.0007700000000000001, 0.015, 0.0007700000000000001, 0.5, -0.5, 0.00032, 0.5, -0.00032, -0.5};
-PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5) noexcept {
+// 2 blocks of the same code, each over its constants (k) and members: neck_link, l_wrist_yaw_link.
+// The first: body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
+constexpr Scalar shared_2_k0[16] = {0.29, -0.29, 0.5, 0.015, 0.5, -0.015, -0.015, 0.0007700000000000001, 0.015, 0.0007700000000000001, 0.5, -0.5, 0.00032, 0.5, -0.00032, -0.5};
+constexpr Scalar shared_2_k1[16] = {-0.2555, 0.2555, 0.1, 0.001, 0.1, -0.001, -0.001, 3.5000000000000004e-05, 0.001, 3.5000000000000004e-05, 0.1, -0.1, 2.5e-05, 0.1, -2.5e-05, -0.1};
+PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5) noexcept {
   proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
   const Scalar x0 = v_m2[0] + k[0]*v_m2[4];
   const Scalar x1 = v_m2[1] + k[1]*v_m2[3];
@@ -260,6 +182,112 @@ PROXGEN_RT_NOINLINE void shared_5(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
   pA_m5[3] = k[12]*v_m3[4]*v_m3[5] - v_m3[5]*x5 + k[13]*v_m2[2]*v_m3[1] - v_m2[2]*x3;
   pA_m5[4] = v_m3[5]*x4 + k[14]*v_m3[3]*v_m3[5] + v_m2[2]*x2 + k[15]*v_m2[2]*v_m3[0];
   pA_m5[5] = v_m3[3]*x5 - v_m3[4]*x4 + v_m3[0]*x3 - v_m3[1]*x2;
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+// shared_3's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_3_p0[56] = {-0.42875, -0.42875, 0.42875, 0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 3.055, 3.055, -0.5694718575000001, -0.5694718575000001, 3.055, 3.055, 0.5694718575000001, 0.5694718575000001, 0.5694718575000001, 0.5694718575000001, 0.15779149347477375, 0.15779149347477375, -0.5694718575000001, -0.5694718575000001, 0.15779149347477375, 0.15779149347477375, 3.055, 3.055, -3.055, -3.055, 0.00381875, 0.00381875, 3.055, 3.055, -0.00381875, -0.00381875, -3.055, -3.055, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_3_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* v_m2_a, Scalar* v_m2_b, Scalar* v_m3_a, Scalar* v_m3_b, Scalar* PROXGEN_RT_RESTRICT v_m4_a, Scalar* PROXGEN_RT_RESTRICT v_m4_b, Scalar* PROXGEN_RT_RESTRICT c_m5_a, Scalar* PROXGEN_RT_RESTRICT c_m5_b, Scalar* PROXGEN_RT_RESTRICT pA_m6_a, Scalar* PROXGEN_RT_RESTRICT pA_m6_b, Scalar* g_m7_a, Scalar* g_m7_b, Scalar* PROXGEN_RT_RESTRICT g_m8_a, Scalar* PROXGEN_RT_RESTRICT g_m8_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m2_a[5], v_m2_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m2_a[5], v_m2_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x2 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x3, v_m4_a[0], v_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, v_m4_a[1], v_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x2 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x3, v_m4_a[2], v_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x4 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x5, v_m4_a[3], v_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x4 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x5, v_m4_a[5], v_m4_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), c_m5_a[0], c_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]), c_m5_a[2], c_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]), c_m5_a[3], c_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), c_m5_a[5], c_m5_b[5]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1]) + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x8 = proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1]) + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x9 = proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x7, pA_m6_a[0], pA_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x6 + proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), pA_m6_a[1], pA_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x7 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x6, pA_m6_a[2], pA_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 20)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x9 + proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]) - proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x7, pA_m6_a[3], pA_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x8 + proxgen_rt::pair_at(k, 22)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) + proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x6 + proxgen_rt::pair_at(k, 23)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), pA_m6_a[4], pA_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x9 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x8 + proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*x7 - proxgen_rt::gather2(v_m4_a[1], v_m4_b[1])*x6, pA_m6_a[5], pA_m6_b[5]);
+  const ScalarPair x10 = proxgen_rt::pair_at(k, 24)*proxgen_rt::gather2(g_m7_a[0], g_m7_b[0]) + proxgen_rt::pair_at(k, 25)*proxgen_rt::gather2(g_m7_a[2], g_m7_b[2]);
+  const ScalarPair x11 = proxgen_rt::pair_at(k, 26)*proxgen_rt::gather2(g_m7_a[0], g_m7_b[0]) + proxgen_rt::pair_at(k, 27)*proxgen_rt::gather2(g_m7_a[2], g_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x10 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x11, g_m8_a[0], g_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x10 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x11, g_m8_a[2], g_m8_b[2]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+// shared_4's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_4_p0[34] = {-0.4305, -0.4305, 0.4305, 0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_4_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* v_m2_a, Scalar* v_m2_b, Scalar* PROXGEN_RT_RESTRICT v_m3_a, Scalar* PROXGEN_RT_RESTRICT v_m3_b, Scalar* PROXGEN_RT_RESTRICT c_m4_a, Scalar* PROXGEN_RT_RESTRICT c_m4_b, Scalar* PROXGEN_RT_RESTRICT pA_m5_a, Scalar* PROXGEN_RT_RESTRICT pA_m5_b, Scalar* g_m6_a, Scalar* g_m6_b, Scalar* PROXGEN_RT_RESTRICT g_m7_a, Scalar* PROXGEN_RT_RESTRICT g_m7_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m2_a[5], v_m2_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m2_a[5], v_m2_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x2 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x3, v_m3_a[0], v_m3_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, v_m3_a[1], v_m3_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x2 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x3, v_m3_a[2], v_m3_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x4 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x5, v_m3_a[3], v_m3_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m3_a[4], v_m3_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x4 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x5, v_m3_a[5], v_m3_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]), c_m4_a[0], c_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]), c_m4_a[2], c_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]), c_m4_a[3], c_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]), c_m4_a[5], c_m4_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 10)*(proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]) - proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])), pA_m5_a[0], pA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 11)*(proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]) - proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3])), pA_m5_a[1], pA_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12)*(proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]) - proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])), pA_m5_a[2], pA_m5_b[2]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(g_m6_a[0], g_m6_b[0]) + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(g_m6_a[2], g_m6_b[2]);
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(g_m6_a[0], g_m6_b[0]) + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(g_m6_a[2], g_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x6 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x7, g_m7_a[0], g_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x6 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x7, g_m7_a[2], g_m7_b[2]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+// shared_5's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_5_p0[32] = {1.015, 1.015, -0.027912499999999996, -0.027912499999999996, 1.015, 1.015, 0.027912499999999996, 0.027912499999999996, 0.06495999999999999, 0.06495999999999999, 1.015, 1.015, -0.06495999999999999, -0.06495999999999999, 0.027912499999999996, 0.027912499999999996, 0.00194517348958, 0.00194517348958, 0.0017863999999999998, 0.0017863999999999998, -0.027912499999999996, -0.027912499999999996, -0.06495999999999999, -0.06495999999999999, 0.00936987670937, 0.00936987670937, 0.06495999999999999, 0.06495999999999999, 0.0017863999999999998, 0.0017863999999999998, 0.00860228295937, 0.00860228295937};
+PROXGEN_RT_NOINLINE void shared_5_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* PROXGEN_RT_RESTRICT v_m2_a, Scalar* PROXGEN_RT_RESTRICT v_m2_b, Scalar* v_m3_a, Scalar* v_m3_b, Scalar* PROXGEN_RT_RESTRICT c_m4_a, Scalar* PROXGEN_RT_RESTRICT c_m4_b, Scalar* PROXGEN_RT_RESTRICT pA_m5_a, Scalar* PROXGEN_RT_RESTRICT pA_m5_b, Scalar* PROXGEN_RT_RESTRICT g_m6_a, Scalar* PROXGEN_RT_RESTRICT g_m6_b, Scalar* g_m7_a, Scalar* g_m7_b, Scalar* g_m8_a, Scalar* g_m8_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m2_a[0], v_m2_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_m3_a[1], v_m3_b[1])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m2_a[1], v_m2_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m2_a[2], v_m2_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m2_a[3], v_m2_b[3]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m2_a[4], v_m2_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]), c_m4_a[0], c_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]), c_m4_a[1], c_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]), c_m4_a[3], c_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]), c_m4_a[4], c_m4_b[4]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) + proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x2 - proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x1, pA_m5_a[0], pA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x0 - proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x2, pA_m5_a[1], pA_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x1 - proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x0, pA_m5_a[2], pA_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x5 - proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x4 + proxgen_rt::gather2(v_m2_a[0], v_m2_b[0])*x2 - proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x1, pA_m5_a[3], pA_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4])*x3 - proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x5 + proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x0 - proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x2, pA_m5_a[4], pA_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*x4 - proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*x3 + proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x1 - proxgen_rt::gather2(v_m2_a[0], v_m2_b[0])*x0, pA_m5_a[5], pA_m5_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) + proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), g_m6_a[0], g_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), g_m6_a[1], g_m6_b[1]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_wrist_yaw_link, r_wrist_yaw_link.
@@ -562,403 +590,418 @@ PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, const Sca
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_10(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT U_m1, Scalar* PROXGEN_RT_RESTRICT Dinv_m2, Scalar* PROXGEN_RT_RESTRICT u_m3, Scalar* PROXGEN_RT_RESTRICT pA_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT c_m8, Scalar* PROXGEN_RT_RESTRICT cq_m9, Scalar* PROXGEN_RT_RESTRICT sq_m10, Scalar* PROXGEN_RT_RESTRICT IA_m11, Scalar* PROXGEN_RT_RESTRICT pA_m12) noexcept {
-  const Scalar x0 = mu*active_m0[0];
-  U_m1[0] = 0.027912499999999996 + 0.06825*x0;
-  U_m1[2] = 0.00194517348958 + 1.0046580625*x0;
-  Dinv_m2[0] = 1.0 / U_m1[2];
-  u_m3[0] = -pA_m4[3] - 0.06825*lambda_m5[1] - lambda_m5[3] - 0.06825*g_m6[0]*x0 + tau[0];
-  const Scalar x1 = U_m1[0]*Dinv_m2[0];
-  const Scalar x2 = 1.015 + x0;
-  const Scalar x3 = -0.027912499999999996 - 0.06825*x0;
-  const Scalar x4 = 1.015 + x0 - U_m1[0]*x1;
-  const Scalar x5 = 0.06495999999999999 - 0.0017863999999999998*U_m1[0]*Dinv_m2[0];
-  const Scalar x6 = 0.00936987670937 + 1.0046580625*x0;
-  const Scalar x7 = 0.00860228295937 + x0 - 3.1912249599999995e-06*Dinv_m2[0];
-  const Scalar x8 = pA_m4[0] + lambda_m5[0] + g_m7[0]*x0 + c_m8[3]*x3;
-  const Scalar x9 = pA_m4[1] + lambda_m5[1] + g_m6[0]*x0 + u_m3[0]*x1 + c_m8[0]*x4 + c_m8[4]*x5;
-  const Scalar x10 = -0.06495999999999999*c_m8[3] + pA_m4[2] + lambda_m5[2] + g_m6[1]*x0 + c_m8[1]*x2;
-  const Scalar x11 = -0.06495999999999999*c_m8[1] + pA_m4[4] - 0.06825*lambda_m5[0] + lambda_m5[4] - 0.06825*g_m7[0]*x0 + c_m8[3]*x6;
-  const Scalar x12 = pA_m4[5] + lambda_m5[5] + 0.0017863999999999998*Dinv_m2[0]*u_m3[0] + c_m8[0]*x5 + c_m8[4]*x7;
-  const Scalar x13 = cq_m9[0]*cq_m9[0] - sq_m10[0]*sq_m10[0];
-  const Scalar x14 = 0.5*(-x2 + x4);
-  const Scalar x15 = 0.5*(x2 + x4);
-  const Scalar x16 = 2.0*cq_m9[0]*sq_m10[0];
-  const Scalar x17 = -0.032479999999999995 + 0.5*x5;
-  const Scalar x18 = 0.5*(x6 - x7);
-  const Scalar x19 = 0.5*(x6 + x7);
-  IA_m11[0] = 0.2 + x2;
-  IA_m11[4] = cq_m9[0]*x3;
-  IA_m11[5] = sq_m10[0]*x3;
-  IA_m11[6] = 0.2 + x15 + x13*x14;
-  IA_m11[7] = x14*x16;
-  IA_m11[9] = -x16*x17;
-  IA_m11[10] = 0.032479999999999995 + 0.5*x5 + x13*x17;
-  IA_m11[11] = 0.2 + x15 - x13*x14;
-  IA_m11[13] = -0.032479999999999995 - 0.5*x5 + x13*x17;
-  IA_m11[14] = x16*x17;
-  IA_m11[18] = 7.2e-05 + x19 + x13*x18;
-  IA_m11[19] = x16*x18;
-  IA_m11[20] = 7.2e-05 + x19 - x13*x18;
-  pA_m12[0] = pA_m12[0] + x8;
-  pA_m12[1] = pA_m12[1] + cq_m9[0]*x9 - sq_m10[0]*x10;
-  pA_m12[2] = pA_m12[2] + sq_m10[0]*x9 + cq_m9[0]*x10;
-  pA_m12[3] = tau[0];
-  pA_m12[4] = cq_m9[0]*x11 - sq_m10[0]*x12;
-  pA_m12[5] = sq_m10[0]*x11 + cq_m9[0]*x12;
+// shared_10's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_10_p0[76] = {0.027912499999999996, 0.027912499999999996, 0.06825, 0.06825, 0.00194517348958, 0.00194517348958, 1.0046580625, 1.0046580625, 1.0, 1.0, -0.06825, -0.06825, -0.06825, -0.06825, 1.015, 1.015, -0.027912499999999996, -0.027912499999999996, -0.06825, -0.06825, 1.015, 1.015, 0.06495999999999999, 0.06495999999999999, -0.0017863999999999998, -0.0017863999999999998, 0.00936987670937, 0.00936987670937, 1.0046580625, 1.0046580625, 0.00860228295937, 0.00860228295937, -3.1912249599999995e-06, -3.1912249599999995e-06, -0.06495999999999999, -0.06495999999999999, -0.06495999999999999, -0.06495999999999999, -0.06825, -0.06825, -0.06825, -0.06825, 0.0017863999999999998, 0.0017863999999999998, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, -0.032479999999999995, -0.032479999999999995, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.2, 0.2, 0.2, 0.2, 0.032479999999999995, 0.032479999999999995, 0.5, 0.5, 0.2, 0.2, -0.032479999999999995, -0.032479999999999995, -0.5, -0.5, 7.2e-05, 7.2e-05, 7.2e-05, 7.2e-05};
+PROXGEN_RT_NOINLINE void shared_10_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar mu, Scalar* active_m0_a, Scalar* active_m0_b, Scalar* PROXGEN_RT_RESTRICT U_m1_a, Scalar* PROXGEN_RT_RESTRICT U_m1_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m2_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m2_b, Scalar* PROXGEN_RT_RESTRICT u_m3_a, Scalar* PROXGEN_RT_RESTRICT u_m3_b, Scalar* pA_m4_a, Scalar* pA_m4_b, Scalar* lambda_m5_a, Scalar* lambda_m5_b, Scalar* g_m6_a, Scalar* g_m6_b, Scalar* g_m7_a, Scalar* g_m7_b, Scalar* c_m8_a, Scalar* c_m8_b, Scalar* cq_m9_a, Scalar* cq_m9_b, Scalar* sq_m10_a, Scalar* sq_m10_b, Scalar* PROXGEN_RT_RESTRICT IA_m11_a, Scalar* PROXGEN_RT_RESTRICT IA_m11_b, Scalar* PROXGEN_RT_RESTRICT pA_m12_a, Scalar* PROXGEN_RT_RESTRICT pA_m12_b) noexcept {
+  const ScalarPair x0 = mu*proxgen_rt::gather2(active_m0_a[0], active_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) + proxgen_rt::pair_at(k, 1)*x0, U_m1_a[0], U_m1_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 2) + proxgen_rt::pair_at(k, 3)*x0, U_m1_a[2], U_m1_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4) / proxgen_rt::gather2(U_m1_a[2], U_m1_b[2]), Dinv_m2_a[0], Dinv_m2_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m4_a[3], pA_m4_b[3]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(lambda_m5_a[1], lambda_m5_b[1]) - proxgen_rt::gather2(lambda_m5_a[3], lambda_m5_b[3]) + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(g_m6_a[0], g_m6_b[0])*x0 + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m3_a[0], u_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(U_m1_a[0], U_m1_b[0])*proxgen_rt::gather2(Dinv_m2_a[0], Dinv_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 7) + x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 8) + proxgen_rt::pair_at(k, 9)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 10) + x0 - proxgen_rt::gather2(U_m1_a[0], U_m1_b[0])*x1;
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 11) + proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(U_m1_a[0], U_m1_b[0])*proxgen_rt::gather2(Dinv_m2_a[0], Dinv_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 13) + proxgen_rt::pair_at(k, 14)*x0;
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 15) + x0 + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(Dinv_m2_a[0], Dinv_m2_b[0]);
+  const ScalarPair x8 = proxgen_rt::gather2(pA_m4_a[0], pA_m4_b[0]) + proxgen_rt::gather2(lambda_m5_a[0], lambda_m5_b[0]) + proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*x0 + proxgen_rt::gather2(c_m8_a[3], c_m8_b[3])*x3;
+  const ScalarPair x9 = proxgen_rt::gather2(pA_m4_a[1], pA_m4_b[1]) + proxgen_rt::gather2(lambda_m5_a[1], lambda_m5_b[1]) + proxgen_rt::gather2(g_m6_a[0], g_m6_b[0])*x0 + proxgen_rt::gather2(u_m3_a[0], u_m3_b[0])*x1 + proxgen_rt::gather2(c_m8_a[0], c_m8_b[0])*x4 + proxgen_rt::gather2(c_m8_a[4], c_m8_b[4])*x5;
+  const ScalarPair x10 = proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(c_m8_a[3], c_m8_b[3]) + proxgen_rt::gather2(pA_m4_a[2], pA_m4_b[2]) + proxgen_rt::gather2(lambda_m5_a[2], lambda_m5_b[2]) + proxgen_rt::gather2(g_m6_a[1], g_m6_b[1])*x0 + proxgen_rt::gather2(c_m8_a[1], c_m8_b[1])*x2;
+  const ScalarPair x11 = proxgen_rt::pair_at(k, 18)*proxgen_rt::gather2(c_m8_a[1], c_m8_b[1]) + proxgen_rt::gather2(pA_m4_a[4], pA_m4_b[4]) + proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(lambda_m5_a[0], lambda_m5_b[0]) + proxgen_rt::gather2(lambda_m5_a[4], lambda_m5_b[4]) + proxgen_rt::pair_at(k, 20)*proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*x0 + proxgen_rt::gather2(c_m8_a[3], c_m8_b[3])*x6;
+  const ScalarPair x12 = proxgen_rt::gather2(pA_m4_a[5], pA_m4_b[5]) + proxgen_rt::gather2(lambda_m5_a[5], lambda_m5_b[5]) + proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(Dinv_m2_a[0], Dinv_m2_b[0])*proxgen_rt::gather2(u_m3_a[0], u_m3_b[0]) + proxgen_rt::gather2(c_m8_a[0], c_m8_b[0])*x5 + proxgen_rt::gather2(c_m8_a[4], c_m8_b[4])*x7;
+  const ScalarPair x13 = proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0]) - proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0]);
+  const ScalarPair x14 = proxgen_rt::pair_at(k, 22)*(-x2 + x4);
+  const ScalarPair x15 = proxgen_rt::pair_at(k, 23)*(x2 + x4);
+  const ScalarPair x16 = proxgen_rt::pair_at(k, 24)*proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0]);
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 25) + proxgen_rt::pair_at(k, 26)*x5;
+  const ScalarPair x18 = proxgen_rt::pair_at(k, 27)*(x6 - x7);
+  const ScalarPair x19 = proxgen_rt::pair_at(k, 28)*(x6 + x7);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 29) + x2, IA_m11_a[0], IA_m11_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*x3, IA_m11_a[4], IA_m11_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*x3, IA_m11_a[5], IA_m11_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 30) + x15 + x13*x14, IA_m11_a[6], IA_m11_b[6]);
+  proxgen_rt::scatter2<Scalar>(x14*x16, IA_m11_a[7], IA_m11_b[7]);
+  proxgen_rt::scatter2<Scalar>(-x16*x17, IA_m11_a[9], IA_m11_b[9]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 31) + proxgen_rt::pair_at(k, 32)*x5 + x13*x17, IA_m11_a[10], IA_m11_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 33) + x15 - x13*x14, IA_m11_a[11], IA_m11_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 34) + proxgen_rt::pair_at(k, 35)*x5 + x13*x17, IA_m11_a[13], IA_m11_b[13]);
+  proxgen_rt::scatter2<Scalar>(x16*x17, IA_m11_a[14], IA_m11_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 36) + x19 + x13*x18, IA_m11_a[18], IA_m11_b[18]);
+  proxgen_rt::scatter2<Scalar>(x16*x18, IA_m11_a[19], IA_m11_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 37) + x19 - x13*x18, IA_m11_a[20], IA_m11_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m12_a[0], pA_m12_b[0]) + x8, pA_m12_a[0], pA_m12_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m12_a[1], pA_m12_b[1]) + proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*x9 - proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*x10, pA_m12_a[1], pA_m12_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m12_a[2], pA_m12_b[2]) + proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*x9 + proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*x10, pA_m12_a[2], pA_m12_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m12_a[3], pA_m12_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*x11 - proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*x12, pA_m12_a[4], pA_m12_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m10_a[0], sq_m10_b[0])*x11 + proxgen_rt::gather2(cq_m9_a[0], cq_m9_b[0])*x12, pA_m12_a[5], pA_m12_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x5 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x6 = IA_m1[6] - IA_m1[9]*x1;
-  const Scalar x7 = IA_m1[7] - IA_m1[13]*x1;
-  const Scalar x8 = IA_m1[10] - IA_m1[19]*x1;
-  const Scalar x9 = IA_m1[11] - IA_m1[13]*x2;
-  const Scalar x10 = IA_m1[14] - IA_m1[19]*x2;
-  const Scalar x11 = IA_m1[20] - IA_m1[19]*x3;
-  const Scalar x12 = -IA_m1[13]*x0;
-  const Scalar x13 = -IA_m1[9]*x0;
-  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
-  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
-  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
-  const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
-  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
-  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x20 = 0.5*(-x4 + x9);
-  const Scalar x21 = 0.5*(x4 + x9);
-  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x23 = x19*x20 - x12*x22;
-  const Scalar x24 = x20*x22 + x12*x19;
-  const Scalar x25 = 0.5*(x10*x19 - x5*x22);
-  const Scalar x26 = 0.5*(x10*x22 + x5*x19);
-  const Scalar x27 = -3.6e-05 + 0.5*x11;
-  const Scalar x28 = 3.6e-05 + 0.5*x11;
-  const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
-  const Scalar x30 = -0.09983341664682815*cq_m5[0]*x7 + 0.09983341664682815*sq_m6[0]*x13 + 0.9950041652780258*sq_m6[0]*x7 + 0.9950041652780258*cq_m5[0]*x13;
-  const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x32 = sq_m6[0]*x7 + cq_m5[0]*x13;
-  const Scalar x33 = cq_m5[0]*x7 - sq_m6[0]*x13;
-  const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
-  const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
-  const Scalar x37 = 0.4975020826390129*x5 - 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
-  const Scalar x38 = -0.4975020826390129*x5 + 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
-  const Scalar x39 = 0.04991670832341408*x5 + 0.4975020826390129*x10 + 0.9950041652780258*x25 + 0.09983341664682815*x26;
-  const Scalar x40 = 0.9950041652780258*x28 - 0.9950041652780258*x19*x27 - 0.09983341664682815*x22*x27;
-  const Scalar x41 = -0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
-  const Scalar x42 = 0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
-  const Scalar x43 = 0.9950041652780258*x28 + 0.9950041652780258*x19*x27 + 0.09983341664682815*x22*x27;
-  const Scalar x44 = 0.9950041652780258*x29 - 0.09983341664682815*x31;
-  const Scalar x45 = 0.09983341664682815*x29 + 0.9950041652780258*x31;
-  const Scalar x46 = 0.09983341664682815*x32 + 0.9950041652780258*x33;
-  const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
-  const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
-  const Scalar x50 = -0.09983341664682815*cq_m5[0]*x8 + 0.9950041652780258*sq_m6[0]*x8;
-  const Scalar x51 = 0.9950041652780258*cq_m5[0]*x8 + 0.09983341664682815*sq_m6[0]*x8;
-  const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
-  const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x54 = 0.4305*x30 + x48;
-  const Scalar x55 = 0.4305*x6 + x50;
-  const Scalar x56 = 0.4305*x46 + x52;
-  const Scalar x57 = cq_m5[0]*x14 + sq_m6[0]*x16;
-  const Scalar x58 = -sq_m6[0]*x14 + cq_m5[0]*x16;
-  const Scalar x59 = cq_m5[0]*x17 + sq_m6[0]*x18;
-  const Scalar x60 = -sq_m6[0]*x17 + cq_m5[0]*x18;
-  const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
-  const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
-  IA_m7[0] = 3.055 + x44;
-  IA_m7[1] = x30;
-  IA_m7[2] = x45;
-  IA_m7[3] = x54;
-  IA_m7[4] = -0.5694718575000001 - 0.4305*x44;
-  IA_m7[5] = x49;
-  IA_m7[6] = 3.055 + x6;
-  IA_m7[7] = x46;
-  IA_m7[8] = 0.5694718575000001 + x55;
-  IA_m7[9] = -0.4305*x30;
-  IA_m7[10] = x51;
-  IA_m7[11] = 3.055 + x47;
-  IA_m7[12] = x56;
-  IA_m7[13] = -0.4305*x45;
-  IA_m7[14] = x53;
-  IA_m7[15] = 0.15779149347477375 + 0.9950041652780258*x40 - 0.09983341664682815*x41 + 0.4305*x50 + 0.4305*x55;
-  IA_m7[16] = -0.18533025*x30 - 0.4305*x48;
-  IA_m7[17] = 0.09983341664682815*x40 + 0.9950041652780258*x41 + 0.4305*x51;
-  IA_m7[18] = 0.15779149347477375 + 0.18533025*x44;
-  IA_m7[19] = -0.4305*x49;
-  IA_m7[20] = 0.00381875 + 0.09983341664682815*x42 + 0.9950041652780258*x43;
-  pA_m8[0] = pA_m8[0] + x61;
-  pA_m8[1] = pA_m8[1] + x15;
-  pA_m8[2] = pA_m8[2] + x62;
-  pA_m8[3] = pA_m8[3] + 0.4305*x15 + 0.9950041652780258*x59 - 0.09983341664682815*x60;
-  pA_m8[4] = pA_m8[4] + tau[0] - 0.4305*x61;
-  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
+// shared_11's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_11_p0[224] = {1.0, 1.0, 7.2e-05, 7.2e-05, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, -3.6e-05, -3.6e-05, 0.5, 0.5, 3.6e-05, 3.6e-05, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.04991670832341408, 0.04991670832341408, 0.4975020826390129, 0.4975020826390129, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4975020826390129, 0.4975020826390129, -0.04991670832341408, -0.04991670832341408, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4975020826390129, -0.4975020826390129, 0.04991670832341408, 0.04991670832341408, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.04991670832341408, 0.04991670832341408, 0.4975020826390129, 0.4975020826390129, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.4305, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 3.055, 3.055, -0.5694718575000001, -0.5694718575000001, -0.4305, -0.4305, 3.055, 3.055, 0.5694718575000001, 0.5694718575000001, -0.4305, -0.4305, 3.055, 3.055, -0.4305, -0.4305, 0.15779149347477375, 0.15779149347477375, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4305, 0.4305, 0.4305, 0.4305, -0.18533025, -0.18533025, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.15779149347477375, 0.15779149347477375, 0.18533025, 0.18533025, -0.4305, -0.4305, 0.00381875, 0.00381875, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_11_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x2;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x12 = -proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x13 = -proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x14 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x4 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x5;
+  const ScalarPair x15 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x13 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x8;
+  const ScalarPair x16 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x12 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x9 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x10;
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]);
+  const ScalarPair x18 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x10 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x11;
+  const ScalarPair x19 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 2)*(-x4 + x9);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 3)*(x4 + x9);
+  const ScalarPair x22 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x23 = x19*x20 - x12*x22;
+  const ScalarPair x24 = x20*x22 + x12*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 5)*(x10*x19 - x5*x22);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 6)*(x10*x22 + x5*x19);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 7) + proxgen_rt::pair_at(k, 8)*x11;
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 9) + proxgen_rt::pair_at(k, 10)*x11;
+  const ScalarPair x29 = proxgen_rt::pair_at(k, 11)*x21 + proxgen_rt::pair_at(k, 12)*x23 + proxgen_rt::pair_at(k, 13)*x24;
+  const ScalarPair x30 = proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7 + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 18)*x21 + proxgen_rt::pair_at(k, 19)*x23 + proxgen_rt::pair_at(k, 20)*x24;
+  const ScalarPair x32 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13;
+  const ScalarPair x33 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13;
+  const ScalarPair x34 = proxgen_rt::pair_at(k, 21)*x21 + proxgen_rt::pair_at(k, 22)*x23 + proxgen_rt::pair_at(k, 23)*x24;
+  const ScalarPair x35 = proxgen_rt::pair_at(k, 24)*x21 + proxgen_rt::pair_at(k, 25)*x23 + proxgen_rt::pair_at(k, 26)*x24;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 27)*x5 + proxgen_rt::pair_at(k, 28)*x10 + proxgen_rt::pair_at(k, 29)*x25 + proxgen_rt::pair_at(k, 30)*x26;
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 31)*x5 + proxgen_rt::pair_at(k, 32)*x10 + proxgen_rt::pair_at(k, 33)*x25 + proxgen_rt::pair_at(k, 34)*x26;
+  const ScalarPair x38 = proxgen_rt::pair_at(k, 35)*x5 + proxgen_rt::pair_at(k, 36)*x10 + proxgen_rt::pair_at(k, 37)*x25 + proxgen_rt::pair_at(k, 38)*x26;
+  const ScalarPair x39 = proxgen_rt::pair_at(k, 39)*x5 + proxgen_rt::pair_at(k, 40)*x10 + proxgen_rt::pair_at(k, 41)*x25 + proxgen_rt::pair_at(k, 42)*x26;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 43)*x28 + proxgen_rt::pair_at(k, 44)*x19*x27 + proxgen_rt::pair_at(k, 45)*x22*x27;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 46)*x28 + proxgen_rt::pair_at(k, 47)*x19*x27 + proxgen_rt::pair_at(k, 48)*x22*x27;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 49)*x28 + proxgen_rt::pair_at(k, 50)*x19*x27 + proxgen_rt::pair_at(k, 51)*x22*x27;
+  const ScalarPair x43 = proxgen_rt::pair_at(k, 52)*x28 + proxgen_rt::pair_at(k, 53)*x19*x27 + proxgen_rt::pair_at(k, 54)*x22*x27;
+  const ScalarPair x44 = proxgen_rt::pair_at(k, 55)*x29 + proxgen_rt::pair_at(k, 56)*x31;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 57)*x29 + proxgen_rt::pair_at(k, 58)*x31;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 59)*x32 + proxgen_rt::pair_at(k, 60)*x33;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 61)*x34 + proxgen_rt::pair_at(k, 62)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 63)*x36 + proxgen_rt::pair_at(k, 64)*x37;
+  const ScalarPair x49 = proxgen_rt::pair_at(k, 65)*x36 + proxgen_rt::pair_at(k, 66)*x37;
+  const ScalarPair x50 = proxgen_rt::pair_at(k, 67)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x8 + proxgen_rt::pair_at(k, 68)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x8;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 69)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x8 + proxgen_rt::pair_at(k, 70)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x8;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 71)*x38 + proxgen_rt::pair_at(k, 72)*x39;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 73)*x38 + proxgen_rt::pair_at(k, 74)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 75)*x30 + x48;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 76)*x6 + x50;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 77)*x46 + x52;
+  const ScalarPair x57 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x14 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x16;
+  const ScalarPair x58 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x14 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x16;
+  const ScalarPair x59 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x17 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x18;
+  const ScalarPair x60 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x17 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x18;
+  const ScalarPair x61 = proxgen_rt::pair_at(k, 78)*x57 + proxgen_rt::pair_at(k, 79)*x58;
+  const ScalarPair x62 = proxgen_rt::pair_at(k, 80)*x57 + proxgen_rt::pair_at(k, 81)*x58;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 82) + x44, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x30, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x45, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x54, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 83) + proxgen_rt::pair_at(k, 84)*x44, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x49, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 85) + x6, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x46, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 86) + x55, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 87)*x30, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(x51, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 88) + x47, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(x56, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 89)*x45, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(x53, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 90) + proxgen_rt::pair_at(k, 91)*x40 + proxgen_rt::pair_at(k, 92)*x41 + proxgen_rt::pair_at(k, 93)*x50 + proxgen_rt::pair_at(k, 94)*x55, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 95)*x30 + proxgen_rt::pair_at(k, 96)*x48, IA_m7_a[16], IA_m7_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 97)*x40 + proxgen_rt::pair_at(k, 98)*x41 + proxgen_rt::pair_at(k, 99)*x51, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 100) + proxgen_rt::pair_at(k, 101)*x44, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 102)*x49, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 103) + proxgen_rt::pair_at(k, 104)*x42 + proxgen_rt::pair_at(k, 105)*x43, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x61, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x15, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x62, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 106)*x15 + proxgen_rt::pair_at(k, 107)*x59 + proxgen_rt::pair_at(k, 108)*x60, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 109)*x61, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 110)*x59 + proxgen_rt::pair_at(k, 111)*x60, pA_m8_a[5], pA_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
-  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
-  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
-  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
-  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
-  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
-  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
-  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
-  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
-  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
-  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
-  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
-  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
-  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
-  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
-  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x26 = 0.5*(-x5 + x14);
-  const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x29 = x25*x26 - x7*x28;
-  const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = 0.5*(-x8 + x16);
-  const Scalar x32 = 0.5*(x8 + x16);
-  const Scalar x33 = 0.5*(x9 + x15);
-  const Scalar x34 = x25*x31 - x28*x33;
-  const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = 0.5*(-x17 + x19);
-  const Scalar x37 = 0.5*(x17 + x19);
-  const Scalar x38 = x25*x36 - x18*x28;
-  const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
-  const Scalar x41 = 0.19866933079506124*cq_m5[0]*x11 - 0.19866933079506124*sq_m6[0]*x6 + 0.9800665778412416*sq_m6[0]*x11 + 0.9800665778412416*cq_m5[0]*x6;
-  const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
-  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
-  const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
-  const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
-  const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
-  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
-  const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
-  const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
-  const Scalar x54 = 0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
-  const Scalar x55 = -0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
-  const Scalar x56 = 0.9800665778412416*x37 + 0.9800665778412416*x38 - 0.19866933079506124*x39;
-  const Scalar x57 = 0.9800665778412416*x40 + 0.19866933079506124*x42;
-  const Scalar x58 = -0.19866933079506124*x40 + 0.9800665778412416*x42;
-  const Scalar x59 = -0.19866933079506124*x43 + 0.9800665778412416*x44;
-  const Scalar x60 = -0.19866933079506124*x45 + 0.9800665778412416*x46;
-  const Scalar x61 = 0.9800665778412416*x47 + 0.19866933079506124*x48;
-  const Scalar x62 = -0.19866933079506124*x47 + 0.9800665778412416*x48;
-  const Scalar x63 = 0.9800665778412416*x49 + 0.19866933079506124*x50;
-  const Scalar x64 = -0.19866933079506124*x49 + 0.9800665778412416*x50;
-  const Scalar x65 = 0.9800665778412416*x51 + 0.19866933079506124*x52;
-  const Scalar x66 = -0.19866933079506124*x51 + 0.9800665778412416*x52;
-  const Scalar x67 = 0.42875*x41 + x61;
-  const Scalar x68 = 0.42875*x10 + x63;
-  const Scalar x69 = 0.42875*x59 + x65;
-  const Scalar x70 = cq_m5[0]*x20 + sq_m6[0]*x22;
-  const Scalar x71 = -sq_m6[0]*x20 + cq_m5[0]*x22;
-  const Scalar x72 = cq_m5[0]*x23 + sq_m6[0]*x24;
-  const Scalar x73 = -sq_m6[0]*x23 + cq_m5[0]*x24;
-  const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
-  const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
-  IA_m7[0] = 7.0 + x57;
-  IA_m7[1] = x41;
-  IA_m7[2] = x58;
-  IA_m7[3] = x67;
-  IA_m7[4] = -1.29954125 - 0.42875*x57;
-  IA_m7[5] = x62;
-  IA_m7[6] = 7.0 + x10;
-  IA_m7[7] = x59;
-  IA_m7[8] = 1.29954125 + x68;
-  IA_m7[9] = -0.42875*x41;
-  IA_m7[10] = x64;
-  IA_m7[11] = 7.0 + x60;
-  IA_m7[12] = x69;
-  IA_m7[13] = -0.42875*x58;
-  IA_m7[14] = x66;
-  IA_m7[15] = 0.3755072987089375 + 0.9800665778412416*x53 + 0.19866933079506124*x54 + 0.42875*x63 + 0.42875*x68;
-  IA_m7[16] = -0.1838265625*x41 - 0.42875*x61;
-  IA_m7[17] = -0.19866933079506124*x53 + 0.9800665778412416*x54 + 0.42875*x64;
-  IA_m7[18] = 0.3755072987089375 + 0.1838265625*x57;
-  IA_m7[19] = -0.42875*x62;
-  IA_m7[20] = 0.0196875 - 0.19866933079506124*x55 + 0.9800665778412416*x56;
-  pA_m8[0] = pA_m8[0] + x74;
-  pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + x75;
-  pA_m8[3] = pA_m8[3] + 0.42875*x21 + 0.9800665778412416*x72 + 0.19866933079506124*x73;
-  pA_m8[4] = pA_m8[4] + tau[0] - 0.42875*x74;
-  pA_m8[5] = pA_m8[5] - 0.19866933079506124*x72 + 0.9800665778412416*x73;
+// shared_12's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_12_p0[228] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, -0.09933466539753062, -0.09933466539753062, 0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.4900332889206208, 0.4900332889206208, -0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.4900332889206208, -0.4900332889206208, 0.4900332889206208, 0.4900332889206208, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.09933466539753062, -0.09933466539753062, 0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 7.0, 7.0, -1.29954125, -1.29954125, -0.42875, -0.42875, 7.0, 7.0, 1.29954125, 1.29954125, -0.42875, -0.42875, 7.0, 7.0, -0.42875, -0.42875, 0.3755072987089375, 0.3755072987089375, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.42875, 0.42875, 0.42875, 0.42875, -0.1838265625, -0.1838265625, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.3755072987089375, 0.3755072987089375, 0.1838265625, 0.1838265625, -0.42875, -0.42875, 0.0196875, 0.0196875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_12_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x0;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x1;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x14 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x2;
+  const ScalarPair x15 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x2;
+  const ScalarPair x16 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x17 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x3;
+  const ScalarPair x18 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x19 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x4;
+  const ScalarPair x20 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x8 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x9;
+  const ScalarPair x21 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x6 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x11 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x13;
+  const ScalarPair x22 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x7 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x14 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x15 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x16;
+  const ScalarPair x23 = proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x15 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x17 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x18;
+  const ScalarPair x24 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x4 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x16 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x18 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x19;
+  const ScalarPair x25 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 1)*(-x5 + x14);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 2)*(x5 + x14);
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x29 = x25*x26 - x7*x28;
+  const ScalarPair x30 = x26*x28 + x7*x25;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 4)*(-x8 + x16);
+  const ScalarPair x32 = proxgen_rt::pair_at(k, 5)*(x8 + x16);
+  const ScalarPair x33 = proxgen_rt::pair_at(k, 6)*(x9 + x15);
+  const ScalarPair x34 = x25*x31 - x28*x33;
+  const ScalarPair x35 = x28*x31 + x25*x33;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 7)*(-x17 + x19);
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 8)*(x17 + x19);
+  const ScalarPair x38 = x25*x36 - x18*x28;
+  const ScalarPair x39 = x28*x36 + x18*x25;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 9)*x27 + proxgen_rt::pair_at(k, 10)*x29 + proxgen_rt::pair_at(k, 11)*x30;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6 + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 16)*x27 + proxgen_rt::pair_at(k, 17)*x29 + proxgen_rt::pair_at(k, 18)*x30;
+  const ScalarPair x43 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x44 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 19)*x27 + proxgen_rt::pair_at(k, 20)*x29 + proxgen_rt::pair_at(k, 21)*x30;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 22)*x27 + proxgen_rt::pair_at(k, 23)*x29 + proxgen_rt::pair_at(k, 24)*x30;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 25)*x9 + proxgen_rt::pair_at(k, 26)*x15 + proxgen_rt::pair_at(k, 27)*x32 + proxgen_rt::pair_at(k, 28)*x34 + proxgen_rt::pair_at(k, 29)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 30)*x9 + proxgen_rt::pair_at(k, 31)*x15 + proxgen_rt::pair_at(k, 32)*x32 + proxgen_rt::pair_at(k, 33)*x34 + proxgen_rt::pair_at(k, 34)*x35;
+  const ScalarPair x49 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x12;
+  const ScalarPair x50 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x12;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 35)*x9 + proxgen_rt::pair_at(k, 36)*x15 + proxgen_rt::pair_at(k, 37)*x32 + proxgen_rt::pair_at(k, 38)*x34 + proxgen_rt::pair_at(k, 39)*x35;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 40)*x9 + proxgen_rt::pair_at(k, 41)*x15 + proxgen_rt::pair_at(k, 42)*x32 + proxgen_rt::pair_at(k, 43)*x34 + proxgen_rt::pair_at(k, 44)*x35;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 45)*x37 + proxgen_rt::pair_at(k, 46)*x38 + proxgen_rt::pair_at(k, 47)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 48)*x37 + proxgen_rt::pair_at(k, 49)*x38 + proxgen_rt::pair_at(k, 50)*x39;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 51)*x37 + proxgen_rt::pair_at(k, 52)*x38 + proxgen_rt::pair_at(k, 53)*x39;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 54)*x37 + proxgen_rt::pair_at(k, 55)*x38 + proxgen_rt::pair_at(k, 56)*x39;
+  const ScalarPair x57 = proxgen_rt::pair_at(k, 57)*x40 + proxgen_rt::pair_at(k, 58)*x42;
+  const ScalarPair x58 = proxgen_rt::pair_at(k, 59)*x40 + proxgen_rt::pair_at(k, 60)*x42;
+  const ScalarPair x59 = proxgen_rt::pair_at(k, 61)*x43 + proxgen_rt::pair_at(k, 62)*x44;
+  const ScalarPair x60 = proxgen_rt::pair_at(k, 63)*x45 + proxgen_rt::pair_at(k, 64)*x46;
+  const ScalarPair x61 = proxgen_rt::pair_at(k, 65)*x47 + proxgen_rt::pair_at(k, 66)*x48;
+  const ScalarPair x62 = proxgen_rt::pair_at(k, 67)*x47 + proxgen_rt::pair_at(k, 68)*x48;
+  const ScalarPair x63 = proxgen_rt::pair_at(k, 69)*x49 + proxgen_rt::pair_at(k, 70)*x50;
+  const ScalarPair x64 = proxgen_rt::pair_at(k, 71)*x49 + proxgen_rt::pair_at(k, 72)*x50;
+  const ScalarPair x65 = proxgen_rt::pair_at(k, 73)*x51 + proxgen_rt::pair_at(k, 74)*x52;
+  const ScalarPair x66 = proxgen_rt::pair_at(k, 75)*x51 + proxgen_rt::pair_at(k, 76)*x52;
+  const ScalarPair x67 = proxgen_rt::pair_at(k, 77)*x41 + x61;
+  const ScalarPair x68 = proxgen_rt::pair_at(k, 78)*x10 + x63;
+  const ScalarPair x69 = proxgen_rt::pair_at(k, 79)*x59 + x65;
+  const ScalarPair x70 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x20 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x22;
+  const ScalarPair x71 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x20 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x22;
+  const ScalarPair x72 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x23 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x24;
+  const ScalarPair x73 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x23 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x24;
+  const ScalarPair x74 = proxgen_rt::pair_at(k, 80)*x70 + proxgen_rt::pair_at(k, 81)*x71;
+  const ScalarPair x75 = proxgen_rt::pair_at(k, 82)*x70 + proxgen_rt::pair_at(k, 83)*x71;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 84) + x57, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x41, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x58, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x67, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 85) + proxgen_rt::pair_at(k, 86)*x57, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x62, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 87) + x10, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x59, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 88) + x68, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 89)*x41, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(x64, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 90) + x60, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(x69, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 91)*x58, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(x66, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 92) + proxgen_rt::pair_at(k, 93)*x53 + proxgen_rt::pair_at(k, 94)*x54 + proxgen_rt::pair_at(k, 95)*x63 + proxgen_rt::pair_at(k, 96)*x68, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 97)*x41 + proxgen_rt::pair_at(k, 98)*x61, IA_m7_a[16], IA_m7_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 99)*x53 + proxgen_rt::pair_at(k, 100)*x54 + proxgen_rt::pair_at(k, 101)*x64, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 102) + proxgen_rt::pair_at(k, 103)*x57, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 104)*x62, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 105) + proxgen_rt::pair_at(k, 106)*x55 + proxgen_rt::pair_at(k, 107)*x56, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x74, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x21, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x75, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 108)*x21 + proxgen_rt::pair_at(k, 109)*x72 + proxgen_rt::pair_at(k, 110)*x73, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 111)*x74, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 112)*x72 + proxgen_rt::pair_at(k, 113)*x73, pA_m8_a[5], pA_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
-  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
-  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
-  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
-  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
-  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
-  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
-  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
-  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
-  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
-  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
-  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
-  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
-  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
-  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
-  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x26 = 0.5*(-x5 + x14);
-  const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x29 = x25*x26 - x7*x28;
-  const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = 0.5*(-x8 + x16);
-  const Scalar x32 = 0.5*(x8 + x16);
-  const Scalar x33 = 0.5*(x9 + x15);
-  const Scalar x34 = x25*x31 - x28*x33;
-  const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = 0.5*(-x17 + x19);
-  const Scalar x37 = 0.5*(x17 + x19);
-  const Scalar x38 = x25*x36 - x18*x28;
-  const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
-  const Scalar x41 = -0.09983341664682815*cq_m5[0]*x11 + 0.09983341664682815*sq_m6[0]*x6 + 0.9950041652780258*sq_m6[0]*x11 + 0.9950041652780258*cq_m5[0]*x6;
-  const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
-  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
-  const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
-  const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
-  const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
-  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
-  const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
-  const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
-  const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
-  const Scalar x57 = cq_m5[0]*x20 + sq_m6[0]*x22;
-  const Scalar x58 = -sq_m6[0]*x20 + cq_m5[0]*x22;
-  const Scalar x59 = cq_m5[0]*x23 + sq_m6[0]*x24;
-  const Scalar x60 = -sq_m6[0]*x23 + cq_m5[0]*x24;
-  IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
-  IA_m7[1] = x41;
-  IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
-  IA_m7[3] = 0.9950041652780258*x47 - 0.09983341664682815*x48;
-  IA_m7[5] = 0.09983341664682815*x47 + 0.9950041652780258*x48;
-  IA_m7[6] = 0.5 + x10;
-  IA_m7[7] = 0.09983341664682815*x43 + 0.9950041652780258*x44;
-  IA_m7[8] = 0.015 + 0.9950041652780258*x49 - 0.09983341664682815*x50;
-  IA_m7[10] = 0.09983341664682815*x49 + 0.9950041652780258*x50;
-  IA_m7[11] = 0.5 + 0.09983341664682815*x45 + 0.9950041652780258*x46;
-  IA_m7[12] = 0.9950041652780258*x51 - 0.09983341664682815*x52;
-  IA_m7[14] = 0.09983341664682815*x51 + 0.9950041652780258*x52;
-  IA_m7[15] = 0.00095 + 0.9950041652780258*x53 - 0.09983341664682815*x54;
-  IA_m7[17] = 0.09983341664682815*x53 + 0.9950041652780258*x54;
-  IA_m7[20] = 0.0005 + 0.09983341664682815*x55 + 0.9950041652780258*x56;
-  pA_m8[0] = pA_m8[0] + 0.9950041652780258*x57 - 0.09983341664682815*x58;
-  pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + 0.09983341664682815*x57 + 0.9950041652780258*x58;
-  pA_m8[3] = pA_m8[3] + 0.9950041652780258*x59 - 0.09983341664682815*x60;
-  pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
+// shared_13's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_13_p0[194] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.04991670832341408, 0.04991670832341408, -0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4975020826390129, 0.4975020826390129, -0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4975020826390129, -0.4975020826390129, 0.4975020826390129, 0.4975020826390129, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.04991670832341408, 0.04991670832341408, -0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.5, 0.5, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.015, 0.015, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.5, 0.5, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.00095, 0.00095, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.0005, 0.0005, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_13_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x0;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x1;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x14 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x2;
+  const ScalarPair x15 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x2;
+  const ScalarPair x16 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x17 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x3;
+  const ScalarPair x18 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x19 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x4;
+  const ScalarPair x20 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x8 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x9;
+  const ScalarPair x21 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x6 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x11 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x13;
+  const ScalarPair x22 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x7 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x14 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x15 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x16;
+  const ScalarPair x23 = proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x15 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x17 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x18;
+  const ScalarPair x24 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x4 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x16 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x18 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x19;
+  const ScalarPair x25 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 1)*(-x5 + x14);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 2)*(x5 + x14);
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x29 = x25*x26 - x7*x28;
+  const ScalarPair x30 = x26*x28 + x7*x25;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 4)*(-x8 + x16);
+  const ScalarPair x32 = proxgen_rt::pair_at(k, 5)*(x8 + x16);
+  const ScalarPair x33 = proxgen_rt::pair_at(k, 6)*(x9 + x15);
+  const ScalarPair x34 = x25*x31 - x28*x33;
+  const ScalarPair x35 = x28*x31 + x25*x33;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 7)*(-x17 + x19);
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 8)*(x17 + x19);
+  const ScalarPair x38 = x25*x36 - x18*x28;
+  const ScalarPair x39 = x28*x36 + x18*x25;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 9)*x27 + proxgen_rt::pair_at(k, 10)*x29 + proxgen_rt::pair_at(k, 11)*x30;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6 + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 16)*x27 + proxgen_rt::pair_at(k, 17)*x29 + proxgen_rt::pair_at(k, 18)*x30;
+  const ScalarPair x43 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x44 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 19)*x27 + proxgen_rt::pair_at(k, 20)*x29 + proxgen_rt::pair_at(k, 21)*x30;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 22)*x27 + proxgen_rt::pair_at(k, 23)*x29 + proxgen_rt::pair_at(k, 24)*x30;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 25)*x9 + proxgen_rt::pair_at(k, 26)*x15 + proxgen_rt::pair_at(k, 27)*x32 + proxgen_rt::pair_at(k, 28)*x34 + proxgen_rt::pair_at(k, 29)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 30)*x9 + proxgen_rt::pair_at(k, 31)*x15 + proxgen_rt::pair_at(k, 32)*x32 + proxgen_rt::pair_at(k, 33)*x34 + proxgen_rt::pair_at(k, 34)*x35;
+  const ScalarPair x49 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x12;
+  const ScalarPair x50 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x12;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 35)*x9 + proxgen_rt::pair_at(k, 36)*x15 + proxgen_rt::pair_at(k, 37)*x32 + proxgen_rt::pair_at(k, 38)*x34 + proxgen_rt::pair_at(k, 39)*x35;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 40)*x9 + proxgen_rt::pair_at(k, 41)*x15 + proxgen_rt::pair_at(k, 42)*x32 + proxgen_rt::pair_at(k, 43)*x34 + proxgen_rt::pair_at(k, 44)*x35;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 45)*x37 + proxgen_rt::pair_at(k, 46)*x38 + proxgen_rt::pair_at(k, 47)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 48)*x37 + proxgen_rt::pair_at(k, 49)*x38 + proxgen_rt::pair_at(k, 50)*x39;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 51)*x37 + proxgen_rt::pair_at(k, 52)*x38 + proxgen_rt::pair_at(k, 53)*x39;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 54)*x37 + proxgen_rt::pair_at(k, 55)*x38 + proxgen_rt::pair_at(k, 56)*x39;
+  const ScalarPair x57 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x20 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x22;
+  const ScalarPair x58 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x20 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x22;
+  const ScalarPair x59 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x23 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x24;
+  const ScalarPair x60 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x23 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x24;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 57) + proxgen_rt::pair_at(k, 58)*x40 + proxgen_rt::pair_at(k, 59)*x42, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x41, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 60)*x40 + proxgen_rt::pair_at(k, 61)*x42, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 62)*x47 + proxgen_rt::pair_at(k, 63)*x48, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 64)*x47 + proxgen_rt::pair_at(k, 65)*x48, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 66) + x10, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 67)*x43 + proxgen_rt::pair_at(k, 68)*x44, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 69) + proxgen_rt::pair_at(k, 70)*x49 + proxgen_rt::pair_at(k, 71)*x50, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 72)*x49 + proxgen_rt::pair_at(k, 73)*x50, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 74) + proxgen_rt::pair_at(k, 75)*x45 + proxgen_rt::pair_at(k, 76)*x46, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 77)*x51 + proxgen_rt::pair_at(k, 78)*x52, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 79)*x51 + proxgen_rt::pair_at(k, 80)*x52, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 81) + proxgen_rt::pair_at(k, 82)*x53 + proxgen_rt::pair_at(k, 83)*x54, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 84)*x53 + proxgen_rt::pair_at(k, 85)*x54, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 86) + proxgen_rt::pair_at(k, 87)*x55 + proxgen_rt::pair_at(k, 88)*x56, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + proxgen_rt::pair_at(k, 89)*x57 + proxgen_rt::pair_at(k, 90)*x58, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x21, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + proxgen_rt::pair_at(k, 91)*x57 + proxgen_rt::pair_at(k, 92)*x58, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 93)*x59 + proxgen_rt::pair_at(k, 94)*x60, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 95)*x59 + proxgen_rt::pair_at(k, 96)*x60, pA_m8_a[5], pA_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[15];
-  u_m2[0] = -pA_m3[3] + tau[0];
-  const Scalar x0 = IA_m1[3]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[8]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[12]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[0] - IA_m1[3]*x0;
-  const Scalar x5 = IA_m1[1] - IA_m1[8]*x0;
-  const Scalar x6 = IA_m1[2] - IA_m1[12]*x0;
-  const Scalar x7 = IA_m1[5] - IA_m1[17]*x0;
-  const Scalar x8 = IA_m1[6] - IA_m1[8]*x1;
-  const Scalar x9 = IA_m1[7] - IA_m1[12]*x1;
-  const Scalar x10 = IA_m1[10] - IA_m1[17]*x1;
-  const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
-  const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
-  const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
-  const Scalar x14 = -0.015*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
-  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
-  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
-  const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
-  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
-  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x20 = 0.5*(x8 - x11);
-  const Scalar x21 = 0.5*(x8 + x11);
-  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x23 = x19*x20 - x9*x22;
-  const Scalar x24 = x20*x22 + x9*x19;
-  const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
-  const Scalar x26 = 0.5*(-x12*x22 + x10*x19);
-  const Scalar x27 = 0.000475 - 0.5*x13;
-  const Scalar x28 = 0.000475 + 0.5*x13;
-  IA_m7[0] = 0.5 + x4;
-  IA_m7[1] = cq_m5[0]*x5 - sq_m6[0]*x6;
-  IA_m7[2] = sq_m6[0]*x5 + cq_m5[0]*x6;
-  IA_m7[4] = 0.02 - 0.015*cq_m5[0] - sq_m6[0]*x7;
-  IA_m7[5] = -0.015*sq_m6[0] + cq_m5[0]*x7;
-  IA_m7[6] = 0.5 + x21 + x23;
-  IA_m7[7] = x24;
-  IA_m7[9] = 0.5*x12 + x25;
-  IA_m7[10] = 0.5*x10 + x26;
-  IA_m7[11] = 0.5 + x21 - x23;
-  IA_m7[13] = -0.5*x10 + x26;
-  IA_m7[14] = 0.5*x12 - x25;
-  IA_m7[18] = 0.0013 + x28 + x19*x27;
-  IA_m7[19] = x22*x27;
-  IA_m7[20] = 0.0005 + x28 - x19*x27;
-  pA_m8[0] = pA_m8[0] + x14;
-  pA_m8[1] = pA_m8[1] + cq_m5[0]*x15 - sq_m6[0]*x16;
-  pA_m8[2] = pA_m8[2] + sq_m6[0]*x15 + cq_m5[0]*x16;
-  pA_m8[3] = pA_m8[3] + tau[0];
-  pA_m8[4] = pA_m8[4] + cq_m5[0]*x17 - sq_m6[0]*x18;
-  pA_m8[5] = pA_m8[5] + sq_m6[0]*x17 + cq_m5[0]*x18;
+// shared_14's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_14_p0[48] = {1.0, 1.0, -0.015, -0.015, 0.00095, 0.00095, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.000475, 0.000475, -0.5, -0.5, 0.000475, 0.000475, 0.5, 0.5, 0.5, 0.5, 0.02, 0.02, -0.015, -0.015, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, 0.5, 0.0013, 0.0013, 0.0005, 0.0005};
+PROXGEN_RT_NOINLINE void shared_14_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*x1;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x1;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x2;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x2;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x3;
+  const ScalarPair x14 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x6 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x7;
+  const ScalarPair x15 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x9 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x10;
+  const ScalarPair x16 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x11 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x12;
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]);
+  const ScalarPair x18 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x10 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x12 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x13;
+  const ScalarPair x19 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 3)*(x8 - x11);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 4)*(x8 + x11);
+  const ScalarPair x22 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x23 = x19*x20 - x9*x22;
+  const ScalarPair x24 = x20*x22 + x9*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 6)*(-x12*x19 - x10*x22);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 7)*(-x12*x22 + x10*x19);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 8) + proxgen_rt::pair_at(k, 9)*x13;
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 10) + proxgen_rt::pair_at(k, 11)*x13;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12) + x4, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x5 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x5 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 13) + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 16) + x21 + x23, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x24, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 17)*x12 + x25, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18)*x10 + x26, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 19) + x21 - x23, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 20)*x10 + x26, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 21)*x12 - x25, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 22) + x28 + x19*x27, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(x22*x27, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 23) + x28 - x19*x27, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x14, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x15 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x16, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x15 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x16, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x17 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x18, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x17 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x18, pA_m8_a[5], pA_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: pelvis.
@@ -1000,156 +1043,35 @@ PROXGEN_RT_NOINLINE void shared_15(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PR
   a_m6[5] = qdd_m5[5];
 }
 
-// 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link.
+// 4 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link, r_hip_yaw_link.
 // The first: accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_16(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] - 0.0875*a_m0[5];
-  const Scalar x1 = a_m0[2] + 0.0875*a_m0[3];
-  const Scalar x2 = 0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
-  const Scalar x3 = 0.9961917745544759*a_m0[1] - 0.08718915247898762*x0;
-  const Scalar x4 = 0.9961917745544759*a_m0[3] + 0.08718915247898762*a_m0[4];
-  const Scalar x5 = -0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 + sq_m3[0]*x3;
-  const Scalar x7 = c_m1[1] - sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 + sq_m3[0]*x5;
-  const Scalar x9 = c_m1[4] - sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - IA_m5[15]*a_m0[5];
-  qdd_m6[0] = Dinv_m7*x10;
-  a_m8[0] = x6;
-  a_m8[1] = x7;
-  a_m8[2] = x1;
-  a_m8[3] = x8;
-  a_m8[4] = x9;
-  a_m8[5] = a_m0[5] + qdd_m6[0];
-}
-
-// 4 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
-// The first: accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
-  const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
-  qdd_m6[0] = Dinv_m7*x4;
-  a_m8[0] = a_m1[0];
-  a_m8[1] = x0;
-  a_m8[2] = x1;
-  a_m8[3] = a_m1[3] + qdd_m6[0];
-  a_m8[4] = x2;
-  a_m8[5] = x3;
-}
-
-// 4 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
-// The first: accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
-  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
-  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
-  qdd_m6[0] = Dinv_m7*x8;
-  a_m8[0] = x4;
-  a_m8[1] = a_m0[1];
-  a_m8[2] = x5;
-  a_m8[3] = x6;
-  a_m8[4] = a_m0[4] + qdd_m6[0];
-  a_m8[5] = x7;
-}
-
-// 4 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
-// The first: accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
-  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
-  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
-  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
-  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
-  qdd_m6[0] = Dinv_m7*x10;
-  a_m8[0] = x6;
-  a_m8[1] = x1;
-  a_m8[2] = x7;
-  a_m8[3] = x8;
-  a_m8[4] = a_m0[4] + qdd_m6[0];
-  a_m8[5] = x9;
-}
-
-// 4 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
-// The first: accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_20(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
-  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
-  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
-  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
-  qdd_m6[0] = Dinv_m7*x10;
-  a_m8[0] = x6;
-  a_m8[1] = x1;
-  a_m8[2] = x7;
-  a_m8[3] = x8;
-  a_m8[4] = a_m0[4] + qdd_m6[0];
-  a_m8[5] = x9;
-}
-
-// 4 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
-// The first: accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_21(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
-  const Scalar x4 = u_m4[0] - 0.0017863999999999998*x3 - U_m5[0]*x0 - U_m5[2]*a_m2[3];
-  qdd_m6[0] = Dinv_m7*x4;
-  a_m8[0] = a_m2[0];
-  a_m8[1] = x0;
-  a_m8[2] = x1;
-  a_m8[3] = a_m2[3] + qdd_m6[0];
-  a_m8[4] = x2;
-  a_m8[5] = x3;
-}
-
-// 2 blocks of the same code, each over its constants (k) and members: r_hip_yaw_link.
-// The first: accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + 0.0875*a_m0[5];
-  const Scalar x1 = a_m0[2] - 0.0875*a_m0[3];
-  const Scalar x2 = -0.08718915247898762*a_m0[1] + 0.9961917745544759*x0;
-  const Scalar x3 = 0.9961917745544759*a_m0[1] + 0.08718915247898762*x0;
-  const Scalar x4 = 0.9961917745544759*a_m0[3] - 0.08718915247898762*a_m0[4];
-  const Scalar x5 = 0.08718915247898762*a_m0[3] + 0.9961917745544759*a_m0[4];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 + sq_m3[0]*x3;
-  const Scalar x7 = c_m1[1] - sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 + sq_m3[0]*x5;
-  const Scalar x9 = c_m1[4] - sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x7 - IA_m5[9]*x1 - IA_m5[14]*x9 - a_m0[5]*IA_m5[15];
-  qdd_m6[0] = Dinv_m7*x10;
-  a_m8[0] = x6;
-  a_m8[1] = x7;
-  a_m8[2] = x1;
-  a_m8[3] = x8;
-  a_m8[4] = x9;
-  a_m8[5] = a_m0[5] + qdd_m6[0];
+// shared_16's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_16_p0[20] = {-0.0875, 0.0875, 0.0875, -0.0875, 0.08718915247898762, -0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.08718915247898762, -0.08718915247898762, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759};
+PROXGEN_RT_NOINLINE void shared_16_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x7 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x1 - proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14])*x9 - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[5], a_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: abdomen.
 // The first: accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_17(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.1*a_m0[4];
   const Scalar x1 = a_m0[1] - 0.1*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 + sq_m3[0]*x1;
@@ -1166,16 +1088,35 @@ PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
   a_m8[5] = a_m0[5] + qdd_m6[0];
 }
 
+// 4 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
+// The first: accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+// shared_18's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+PROXGEN_RT_NOINLINE void shared_18_x2(Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(a_m1_a[0], a_m1_b[0])*proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0]) - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x0 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x1 - proxgen_rt::gather2(a_m1_a[3], a_m1_b[3])*proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12]) - proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14])*x3;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x4, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[5], a_m8_b[5]);
+}
+
 // 2 blocks of the same code, each over its constants (k) and members: chest.
 // The first: accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_19(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.15*a_m0[4];
   const Scalar x1 = a_m0[1] - 0.15*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - a_m0[2]*sq_m3[0];
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + a_m0[2]*cq_m2[0];
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
-  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x1 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
+  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
+  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
+  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
+  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x1 - IA_m5[9]*x3 - IA_m5[12]*x4 - IA_m5[14]*a_m0[4] - IA_m5[15]*x5;
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
   a_m8[1] = x1;
@@ -1185,11 +1126,35 @@ PROXGEN_RT_NOINLINE void shared_24(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
   a_m8[5] = x5;
 }
 
+// 4 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
+// The first: accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+// shared_20's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_20_p0[16] = {0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_20_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x4 - proxgen_rt::gather2(a_m0_a[1], a_m0_b[1])*proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5]) - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x5 - proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12])*x6 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x7;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x8, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[5], a_m8_b[5]);
+}
+
 // 3 blocks of the same code, each over its constants (k) and members: r_shoulder_pitch_link, l_shoulder_pitch_link.
 // The first: accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-constexpr Scalar shared_25_k0[8] = {0.19, -0.19, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848};
-constexpr Scalar shared_25_k1[8] = {-0.19, 0.19, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848};
-PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+constexpr Scalar shared_21_k0[8] = {0.19, -0.19, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848, 0.04493516596384369, -0.2548890642384102, 0.2588196364430848};
+constexpr Scalar shared_21_k1[8] = {-0.19, 0.19, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848, -0.04493516596384369, 0.2548890642384102, -0.2588196364430848};
+PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] + 0.254*a_m0[4] + k[0]*a_m0[5];
   const Scalar x1 = a_m0[1] - 0.254*a_m0[3];
   const Scalar x2 = a_m0[2] + k[1]*a_m0[3];
@@ -1213,26 +1178,78 @@ PROXGEN_RT_NOINLINE void shared_25(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
   a_m8[5] = x12;
 }
 
-// 3 blocks of the same code, each over its constants (k) and members: r_shoulder_roll_link, l_shoulder_roll_link.
+// 4 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
+// The first: accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+// shared_22's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_22_p0[20] = {-0.42875, -0.42875, 0.42875, 0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_22_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x1 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x7 - proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12])*x8 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m8_a[5], a_m8_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_shoulder_roll_link.
 // The first: accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-PROXGEN_RT_NOINLINE void shared_26(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
-  const Scalar x4 = u_m4[0] - IA_m5[0]*a_m2[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - IA_m5[12]*a_m2[3] - IA_m5[13]*x2;
+PROXGEN_RT_NOINLINE void shared_23(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
+  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
+  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
+  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
+  const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[13]*x2;
   qdd_m6[0] = Dinv_m7*x4;
-  a_m8[0] = a_m2[0];
+  a_m8[0] = a_m1[0];
   a_m8[1] = x0;
   a_m8[2] = x1;
-  a_m8[3] = a_m2[3] + qdd_m6[0];
+  a_m8[3] = a_m1[3] + qdd_m6[0];
   a_m8[4] = x2;
   a_m8[5] = x3;
 }
 
-// 2 blocks of the same code, each over its constants (k) and members: r_upper_arm.
+// 4 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
+// The first: accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+// shared_24's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_24_p0[20] = {-0.4305, -0.4305, 0.4305, 0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_24_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x1 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x7 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m8_a[5], a_m8_b[5]);
+}
+
+// 3 blocks of the same code, each over its constants (k) and members: r_upper_arm, l_upper_arm.
 // The first: accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_25(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2[0] + a_m1[1]*sq_m3[0];
   const Scalar x1 = c_m0[1] - a_m1[0]*sq_m3[0] + a_m1[1]*cq_m2[0];
   const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2[0] + a_m1[4]*sq_m3[0];
@@ -1247,9 +1264,29 @@ PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
   a_m8[5] = a_m1[5] + qdd_m6[0];
 }
 
+// 4 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
+// The first: accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+// shared_26's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_26_p0[2] = {-0.0017863999999999998, -0.0017863999999999998};
+PROXGEN_RT_NOINLINE void shared_26_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 0)*x3 - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x0 - proxgen_rt::gather2(a_m1_a[3], a_m1_b[3])*proxgen_rt::gather2(U_m5_a[2], U_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x4, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[5], a_m8_b[5]);
+}
+
 // 2 blocks of the same code, each over its constants (k) and members: r_forearm.
 // The first: accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_27(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.3255*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.3255*a_m0[3];
   const Scalar x2 = 0.29552020666133966*a_m0[2] + 0.955336489125606*x0;
@@ -1260,7 +1297,7 @@ PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
   const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
   const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
   const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4];
+  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - a_m0[4]*IA_m5[14];
   qdd_m6[0] = Dinv_m7*x10;
   a_m8[0] = x6;
   a_m8[1] = x1;
@@ -1270,16 +1307,16 @@ PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
   a_m8[5] = x9;
 }
 
-// 3 blocks of the same code, each over its constants (k) and members: r_wrist_yaw_link, l_wrist_yaw_link.
+// 2 blocks of the same code, each over its constants (k) and members: r_wrist_yaw_link.
 // The first: accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_28(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = a_m0[0] - 0.2555*a_m0[4];
   const Scalar x1 = a_m0[1] + 0.2555*a_m0[3];
   const Scalar x2 = c_m1[0] + cq_m2[0]*x0 + sq_m3[0]*x1;
   const Scalar x3 = c_m1[1] - sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] + sq_m3[0]*a_m0[4];
-  const Scalar x5 = c_m1[4] - sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[4];
-  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - IA_m5[9]*a_m0[2] - IA_m5[12]*x4 - IA_m5[15]*a_m0[5];
+  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] + a_m0[4]*sq_m3[0];
+  const Scalar x5 = c_m1[4] - a_m0[3]*sq_m3[0] + a_m0[4]*cq_m2[0];
+  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[5]*x3 - a_m0[2]*IA_m5[9] - IA_m5[12]*x4 - a_m0[5]*IA_m5[15];
   qdd_m6[0] = Dinv_m7*x6;
   a_m8[0] = x2;
   a_m8[1] = x3;
@@ -1291,24 +1328,24 @@ PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: r_wrist_pitch_link.
 // The first: accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[0]*cq_m2[0] - a_m1[2]*sq_m3[0];
-  const Scalar x1 = c_m0[2] + a_m1[0]*sq_m3[0] + a_m1[2]*cq_m2[0];
-  const Scalar x2 = c_m0[3] + a_m1[3]*cq_m2[0] - a_m1[5]*sq_m3[0];
-  const Scalar x3 = c_m0[5] + a_m1[3]*sq_m3[0] + a_m1[5]*cq_m2[0];
-  const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - a_m1[4]*IA_m5[14] - IA_m5[15]*x3;
+PROXGEN_RT_NOINLINE void shared_29(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[0] - sq_m3[0]*a_m2[2];
+  const Scalar x1 = c_m0[2] + sq_m3[0]*a_m2[0] + cq_m1[0]*a_m2[2];
+  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[3] - sq_m3[0]*a_m2[5];
+  const Scalar x3 = c_m0[5] + sq_m3[0]*a_m2[3] + cq_m1[0]*a_m2[5];
+  const Scalar x4 = u_m4[0] - IA_m5[0]*x0 - IA_m5[14]*a_m2[4] - IA_m5[15]*x3;
   qdd_m6[0] = Dinv_m7*x4;
   a_m8[0] = x0;
-  a_m8[1] = a_m1[1];
+  a_m8[1] = a_m2[1];
   a_m8[2] = x1;
   a_m8[3] = x2;
-  a_m8[4] = a_m1[4] + qdd_m6[0];
+  a_m8[4] = a_m2[4] + qdd_m6[0];
   a_m8[5] = x3;
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hand.
 // The first: accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
+PROXGEN_RT_NOINLINE void shared_30(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
   const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
   const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
   const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
@@ -1325,7 +1362,7 @@ PROXGEN_RT_NOINLINE void shared_31(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PRO
 
 // 2 blocks of the same code, each over its constants (k) and members: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
 // The first: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-PROXGEN_RT_NOINLINE void shared_32(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
+PROXGEN_RT_NOINLINE void shared_31(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT residual_m2, Scalar* PROXGEN_RT_RESTRICT active_m3, Scalar* PROXGEN_RT_RESTRICT dlambda_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT a_m8, Scalar* PROXGEN_RT_RESTRICT g_m9, Scalar* PROXGEN_RT_RESTRICT a_m10, Scalar* PROXGEN_RT_RESTRICT k_m11) noexcept {
   const Scalar x0 = g_m0[0] + a_m1[0] - 0.06825*a_m1[4];
   residual_m2[0] = active_m3[0]*x0;
   dlambda_m4[0] = mu*residual_m2[0];
@@ -1384,806 +1421,975 @@ PROXGEN_RT_NOINLINE void shared_32(Scalar mu, Scalar* PROXGEN_RT_RESTRICT g_m0, 
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_33(Scalar* PROXGEN_RT_RESTRICT dlambda_m0, Scalar* PROXGEN_RT_RESTRICT u_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT dp_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6) noexcept {
-  const Scalar x0 = -0.06825*dlambda_m0[1] - dlambda_m0[3];
-  u_m1[0] = u_m1[0] + x0;
-  const Scalar x1 = Dinv_m2*x0;
-  const Scalar x2 = dlambda_m0[1] + U_m3[0]*x1;
-  const Scalar x3 = -0.06825*dlambda_m0[0] + dlambda_m0[4];
-  const Scalar x4 = dlambda_m0[5] + 0.0017863999999999998*Dinv_m2*x0;
-  dp_m4[0] = dlambda_m0[0];
-  dp_m4[1] = cq_m5[0]*x2 - sq_m6[0]*dlambda_m0[2];
-  dp_m4[2] = sq_m6[0]*x2 + cq_m5[0]*dlambda_m0[2];
-  dp_m4[4] = cq_m5[0]*x3 - sq_m6[0]*x4;
-  dp_m4[5] = sq_m6[0]*x3 + cq_m5[0]*x4;
+// shared_32's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_32_p0[6] = {-0.06825, -0.06825, -0.06825, -0.06825, 0.0017863999999999998, 0.0017863999999999998};
+PROXGEN_RT_NOINLINE void shared_32_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* dlambda_m0_a, Scalar* dlambda_m0_b, Scalar* PROXGEN_RT_RESTRICT u_m1_a, Scalar* PROXGEN_RT_RESTRICT u_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* U_m3_a, Scalar* U_m3_b, Scalar* PROXGEN_RT_RESTRICT dp_m4_a, Scalar* PROXGEN_RT_RESTRICT dp_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(dlambda_m0_a[1], dlambda_m0_b[1]) - proxgen_rt::gather2(dlambda_m0_a[3], dlambda_m0_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(u_m1_a[0], u_m1_b[0]) + x0, u_m1_a[0], u_m1_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b)*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dlambda_m0_a[1], dlambda_m0_b[1]) + proxgen_rt::gather2(U_m3_a[0], U_m3_b[0])*x1;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(dlambda_m0_a[0], dlambda_m0_b[0]) + proxgen_rt::gather2(dlambda_m0_a[4], dlambda_m0_b[4]);
+  const ScalarPair x4 = proxgen_rt::gather2(dlambda_m0_a[5], dlambda_m0_b[5]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b)*x0;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(dlambda_m0_a[0], dlambda_m0_b[0]), dp_m4_a[0], dp_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x2 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(dlambda_m0_a[2], dlambda_m0_b[2]), dp_m4_a[1], dp_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x2 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(dlambda_m0_a[2], dlambda_m0_b[2]), dp_m4_a[2], dp_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x3 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x4, dp_m4_a[4], dp_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x3 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x4, dp_m4_a[5], dp_m4_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
+// The first: reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+// shared_33's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_33_p0[20] = {0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_33_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dp_m1_a, Scalar* dp_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* IA_m3_a, Scalar* IA_m3_b, Scalar* cq_m4_a, Scalar* cq_m4_b, Scalar* sq_m5_a, Scalar* sq_m5_b, Scalar* PROXGEN_RT_RESTRICT dp_m6_a, Scalar* PROXGEN_RT_RESTRICT dp_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]) - proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = -proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b)*proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(dp_m1_a[0], dp_m1_b[0]) + proxgen_rt::gather2(IA_m3_a[0], IA_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dp_m1_a[1], dp_m1_b[1]) + proxgen_rt::gather2(IA_m3_a[5], IA_m3_b[5])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(dp_m1_a[2], dp_m1_b[2]) + proxgen_rt::gather2(IA_m3_a[9], IA_m3_b[9])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(dp_m1_a[5], dp_m1_b[5]) + proxgen_rt::gather2(IA_m3_a[15], IA_m3_b[15])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x1 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x3;
+  const ScalarPair x6 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x1 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 0)*x5 + proxgen_rt::pair_at(k, 1)*x6;
+  const ScalarPair x8 = proxgen_rt::pair_at(k, 2)*x5 + proxgen_rt::pair_at(k, 3)*x6;
+  proxgen_rt::scatter2<Scalar>(x7, dp_m6_a[0], dp_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, dp_m6_a[1], dp_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x8, dp_m6_a[2], dp_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4)*x2 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x4 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x4, dp_m6_a[3], dp_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 7)*x7, dp_m6_a[4], dp_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x4 + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x4, dp_m6_a[5], dp_m6_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
+// The first: reduced sweep: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+// shared_34's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_34_p0[20] = {0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_34_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dp_m1_a, Scalar* dp_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* IA_m3_a, Scalar* IA_m3_b, Scalar* cq_m4_a, Scalar* cq_m4_b, Scalar* sq_m5_a, Scalar* sq_m5_b, Scalar* PROXGEN_RT_RESTRICT dp_m6_a, Scalar* PROXGEN_RT_RESTRICT dp_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4]) + proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = -proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4])*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b);
+  const ScalarPair x1 = proxgen_rt::gather2(dp_m1_a[0], dp_m1_b[0]) + proxgen_rt::gather2(IA_m3_a[0], IA_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dp_m1_a[1], dp_m1_b[1]) + proxgen_rt::gather2(IA_m3_a[5], IA_m3_b[5])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(dp_m1_a[2], dp_m1_b[2]) + proxgen_rt::gather2(IA_m3_a[9], IA_m3_b[9])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(dp_m1_a[3], dp_m1_b[3]) + proxgen_rt::gather2(IA_m3_a[12], IA_m3_b[12])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(dp_m1_a[5], dp_m1_b[5]) + proxgen_rt::gather2(IA_m3_a[15], IA_m3_b[15])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x1 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x3;
+  const ScalarPair x7 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x1 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x4 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x5;
+  const ScalarPair x9 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x4 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::pair_at(k, 0)*x6 + proxgen_rt::pair_at(k, 1)*x7;
+  const ScalarPair x11 = proxgen_rt::pair_at(k, 2)*x6 + proxgen_rt::pair_at(k, 3)*x7;
+  proxgen_rt::scatter2<Scalar>(x10, dp_m6_a[0], dp_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, dp_m6_a[1], dp_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x11, dp_m6_a[2], dp_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4)*x2 + proxgen_rt::pair_at(k, 5)*x8 + proxgen_rt::pair_at(k, 6)*x9, dp_m6_a[3], dp_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 7)*x10, dp_m6_a[4], dp_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 8)*x8 + proxgen_rt::pair_at(k, 9)*x9, dp_m6_a[5], dp_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_34(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
-  u_m0[0] = u_m0[0] - dp_m1[4];
-  const Scalar x0 = -Dinv_m2*dp_m1[4];
-  const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
-  const Scalar x2 = dp_m1[1] + IA_m3[5]*x0;
-  const Scalar x3 = dp_m1[2] + IA_m3[9]*x0;
-  const Scalar x4 = dp_m1[3] + IA_m3[12]*x0;
-  const Scalar x5 = dp_m1[5] + IA_m3[15]*x0;
-  const Scalar x6 = cq_m4[0]*x1 + sq_m5[0]*x3;
-  const Scalar x7 = -sq_m5[0]*x1 + cq_m4[0]*x3;
-  const Scalar x8 = cq_m4[0]*x4 + sq_m5[0]*x5;
-  const Scalar x9 = -sq_m5[0]*x4 + cq_m4[0]*x5;
-  dp_m6[0] = 0.9950041652780258*x6 - 0.09983341664682815*x7;
-  dp_m6[1] = x2;
-  dp_m6[2] = 0.09983341664682815*x6 + 0.9950041652780258*x7;
-  dp_m6[3] = 0.9950041652780258*x8 - 0.09983341664682815*x9;
-  dp_m6[5] = 0.09983341664682815*x8 + 0.9950041652780258*x9;
+// shared_35's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_35_p0[16] = {0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_35_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dp_m1_a, Scalar* dp_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* IA_m3_a, Scalar* IA_m3_b, Scalar* cq_m4_a, Scalar* cq_m4_b, Scalar* sq_m5_a, Scalar* sq_m5_b, Scalar* PROXGEN_RT_RESTRICT dp_m6_a, Scalar* PROXGEN_RT_RESTRICT dp_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4]) + proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = -proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4])*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b);
+  const ScalarPair x1 = proxgen_rt::gather2(dp_m1_a[0], dp_m1_b[0]) + proxgen_rt::gather2(IA_m3_a[0], IA_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dp_m1_a[1], dp_m1_b[1]) + proxgen_rt::gather2(IA_m3_a[5], IA_m3_b[5])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(dp_m1_a[2], dp_m1_b[2]) + proxgen_rt::gather2(IA_m3_a[9], IA_m3_b[9])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(dp_m1_a[3], dp_m1_b[3]) + proxgen_rt::gather2(IA_m3_a[12], IA_m3_b[12])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(dp_m1_a[5], dp_m1_b[5]) + proxgen_rt::gather2(IA_m3_a[15], IA_m3_b[15])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x1 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x3;
+  const ScalarPair x7 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x1 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x4 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x5;
+  const ScalarPair x9 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x4 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x5;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0)*x6 + proxgen_rt::pair_at(k, 1)*x7, dp_m6_a[0], dp_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, dp_m6_a[1], dp_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 2)*x6 + proxgen_rt::pair_at(k, 3)*x7, dp_m6_a[2], dp_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4)*x8 + proxgen_rt::pair_at(k, 5)*x9, dp_m6_a[3], dp_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 6)*x8 + proxgen_rt::pair_at(k, 7)*x9, dp_m6_a[5], dp_m6_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
+// The first: reduced sweep: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+// shared_36's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+PROXGEN_RT_NOINLINE void shared_36_x2(Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dp_m1_a, Scalar* dp_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* IA_m3_a, Scalar* IA_m3_b, Scalar* PROXGEN_RT_RESTRICT dp_m4_a, Scalar* PROXGEN_RT_RESTRICT dp_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(dp_m1_a[3], dp_m1_b[3]) + proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = -proxgen_rt::gather2(dp_m1_a[3], dp_m1_b[3])*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b);
+  const ScalarPair x1 = proxgen_rt::gather2(dp_m1_a[0], dp_m1_b[0]) + proxgen_rt::gather2(IA_m3_a[0], IA_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dp_m1_a[1], dp_m1_b[1]) + proxgen_rt::gather2(IA_m3_a[5], IA_m3_b[5])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(dp_m1_a[2], dp_m1_b[2]) + proxgen_rt::gather2(IA_m3_a[9], IA_m3_b[9])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(dp_m1_a[5], dp_m1_b[5]) + proxgen_rt::gather2(IA_m3_a[14], IA_m3_b[14])*x0;
+  proxgen_rt::scatter2<Scalar>(x1, dp_m4_a[0], dp_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x2 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x3, dp_m4_a[1], dp_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x2 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x3, dp_m4_a[2], dp_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x4, dp_m4_a[4], dp_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x4, dp_m4_a[5], dp_m4_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_foot, l_foot.
 // The first: eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-PROXGEN_RT_NOINLINE void shared_35(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[7], int KA_m7_col) noexcept {
-  u_m0[0] = -pA_m1[3] + tau[0];
-  const Scalar x0 = -0.027912499999999996*c_m2[3] + pA_m1[0];
-  const Scalar x1 = 0.614466237626843*c_m2[0] + 0.039325839208117955*c_m2[4] + pA_m1[1] + 14.34961978945479*u_m0[0];
-  const Scalar x2 = 1.015*c_m2[1] - 0.06495999999999999*c_m2[3] + pA_m1[2];
-  const Scalar x3 = -0.06495999999999999*c_m2[1] + 0.00936987670937*c_m2[3] + pA_m1[4];
-  const Scalar x4 = 0.039325839208117955*c_m2[0] + 0.006961696668689549*c_m2[4] + pA_m1[5] + 0.9183756665251066*u_m0[0];
-  const Scalar x5 = cq_m3[0]*cq_m3[0] - sq_m4[0]*sq_m4[0];
-  IA_m5[0] = -0.027912499999999996*cq_m3[0];
-  IA_m5[1] = -0.027912499999999996*sq_m4[0];
-  IA_m5[2] = 1.0147331188134214 - 0.20026688118657843*x5;
-  IA_m5[3] = -0.40053376237315685*cq_m3[0]*sq_m4[0];
-  IA_m5[5] = 0.025634160791882035*cq_m3[0]*sq_m4[0];
-  IA_m5[6] = 0.05214291960405897 - 0.012817080395941018*x5;
-  IA_m5[7] = 1.0147331188134214 + 0.20026688118657843*x5;
-  IA_m5[9] = -0.05214291960405897 - 0.012817080395941018*x5;
-  IA_m5[10] = -0.025634160791882035*cq_m3[0]*sq_m4[0];
-  IA_m5[14] = 0.008237786689029773 + 0.0012040900203402253*x5;
-  IA_m5[15] = 0.0024081800406804505*cq_m3[0]*sq_m4[0];
-  IA_m5[16] = 0.008237786689029773 - 0.0012040900203402253*x5;
-  pA_m6[0] = pA_m6[0] + x0;
-  pA_m6[1] = pA_m6[1] + cq_m3[0]*x1 - sq_m4[0]*x2;
-  pA_m6[2] = pA_m6[2] + sq_m4[0]*x1 + cq_m3[0]*x2;
-  pA_m6[3] = tau[0];
-  pA_m6[4] = cq_m3[0]*x3 - sq_m4[0]*x4;
-  pA_m6[5] = sq_m4[0]*x3 + cq_m3[0]*x4;
-  KA_m7[4][KA_m7_col + 0] = -0.06825*cq_m3[0];
-  KA_m7[5][KA_m7_col + 0] = -0.06825*sq_m4[0];
-  KA_m7[1][KA_m7_col + 1] = 0.020638449369710488*cq_m3[0];
-  KA_m7[2][KA_m7_col + 1] = 0.020638449369710488*sq_m4[0];
-  KA_m7[4][KA_m7_col + 1] = 0.06267913924033854*sq_m4[0];
-  KA_m7[5][KA_m7_col + 1] = -0.06267913924033854*cq_m3[0];
-  KA_m7[1][KA_m7_col + 2] = -sq_m4[0];
-  KA_m7[2][KA_m7_col + 2] = cq_m3[0];
-  KA_m7[1][KA_m7_col + 3] = -14.34961978945479*cq_m3[0];
-  KA_m7[2][KA_m7_col + 3] = -14.34961978945479*sq_m4[0];
-  KA_m7[4][KA_m7_col + 3] = 0.9183756665251066*sq_m4[0];
-  KA_m7[5][KA_m7_col + 3] = -0.9183756665251066*cq_m3[0];
-  KA_m7[4][KA_m7_col + 4] = cq_m3[0];
-  KA_m7[5][KA_m7_col + 4] = sq_m4[0];
-  KA_m7[4][KA_m7_col + 5] = -sq_m4[0];
-  KA_m7[5][KA_m7_col + 5] = cq_m3[0];
+// shared_37's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_37_p0[78] = {-0.027912499999999996, -0.027912499999999996, 0.614466237626843, 0.614466237626843, 0.039325839208117955, 0.039325839208117955, 14.34961978945479, 14.34961978945479, 1.015, 1.015, -0.06495999999999999, -0.06495999999999999, -0.06495999999999999, -0.06495999999999999, 0.00936987670937, 0.00936987670937, 0.039325839208117955, 0.039325839208117955, 0.006961696668689549, 0.006961696668689549, 0.9183756665251066, 0.9183756665251066, -0.027912499999999996, -0.027912499999999996, -0.027912499999999996, -0.027912499999999996, 1.0147331188134214, 1.0147331188134214, -0.20026688118657843, -0.20026688118657843, -0.40053376237315685, -0.40053376237315685, 0.025634160791882035, 0.025634160791882035, 0.05214291960405897, 0.05214291960405897, -0.012817080395941018, -0.012817080395941018, 1.0147331188134214, 1.0147331188134214, 0.20026688118657843, 0.20026688118657843, -0.05214291960405897, -0.05214291960405897, -0.012817080395941018, -0.012817080395941018, -0.025634160791882035, -0.025634160791882035, 0.008237786689029773, 0.008237786689029773, 0.0012040900203402253, 0.0012040900203402253, 0.0024081800406804505, 0.0024081800406804505, 0.008237786689029773, 0.008237786689029773, -0.0012040900203402253, -0.0012040900203402253, -0.06825, -0.06825, -0.06825, -0.06825, 0.020638449369710488, 0.020638449369710488, 0.020638449369710488, 0.020638449369710488, 0.06267913924033854, 0.06267913924033854, -0.06267913924033854, -0.06267913924033854, -14.34961978945479, -14.34961978945479, -14.34961978945479, -14.34961978945479, 0.9183756665251066, 0.9183756665251066, -0.9183756665251066, -0.9183756665251066};
+PROXGEN_RT_NOINLINE void shared_37_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* pA_m1_a, Scalar* pA_m1_b, Scalar* c_m2_a, Scalar* c_m2_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* sq_m4_a, Scalar* sq_m4_b, Scalar* PROXGEN_RT_RESTRICT IA_m5_a, Scalar* PROXGEN_RT_RESTRICT IA_m5_b, Scalar* PROXGEN_RT_RESTRICT pA_m6_a, Scalar* PROXGEN_RT_RESTRICT pA_m6_b, Scalar (*PROXGEN_RT_RESTRICT KA_m7_a)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m7_b)[7], int KA_m7_col_a, int KA_m7_col_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m1_a[3], pA_m1_b[3]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(c_m2_a[3], c_m2_b[3]) + proxgen_rt::gather2(pA_m1_a[0], pA_m1_b[0]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(c_m2_a[0], c_m2_b[0]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(c_m2_a[4], c_m2_b[4]) + proxgen_rt::gather2(pA_m1_a[1], pA_m1_b[1]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(c_m2_a[1], c_m2_b[1]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(c_m2_a[3], c_m2_b[3]) + proxgen_rt::gather2(pA_m1_a[2], pA_m1_b[2]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(c_m2_a[1], c_m2_b[1]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(c_m2_a[3], c_m2_b[3]) + proxgen_rt::gather2(pA_m1_a[4], pA_m1_b[4]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(c_m2_a[0], c_m2_b[0]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(c_m2_a[4], c_m2_b[4]) + proxgen_rt::gather2(pA_m1_a[5], pA_m1_b[5]) + proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) - proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), IA_m5_a[0], IA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[1], IA_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 13) + proxgen_rt::pair_at(k, 14)*x5, IA_m5_a[2], IA_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[3], IA_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[5], IA_m5_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 17) + proxgen_rt::pair_at(k, 18)*x5, IA_m5_a[6], IA_m5_b[6]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 19) + proxgen_rt::pair_at(k, 20)*x5, IA_m5_a[7], IA_m5_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 21) + proxgen_rt::pair_at(k, 22)*x5, IA_m5_a[9], IA_m5_b[9]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 23)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[10], IA_m5_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 24) + proxgen_rt::pair_at(k, 25)*x5, IA_m5_a[14], IA_m5_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 26)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[15], IA_m5_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 27) + proxgen_rt::pair_at(k, 28)*x5, IA_m5_a[16], IA_m5_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[0], pA_m6_b[0]) + x0, pA_m6_a[0], pA_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[1], pA_m6_b[1]) + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 - proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x2, pA_m6_a[1], pA_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[2], pA_m6_b[2]) + proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x1 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x2, pA_m6_a[2], pA_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m6_a[3], pA_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x3 - proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x4, pA_m6_a[4], pA_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x3 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x4, pA_m6_a[5], pA_m6_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 29)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[4][KA_m7_col_a + 0], KA_m7_b[4][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 30)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[5][KA_m7_col_a + 0], KA_m7_b[5][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 31)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[1][KA_m7_col_a + 1], KA_m7_b[1][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 32)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[2][KA_m7_col_a + 1], KA_m7_b[2][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 33)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[4][KA_m7_col_a + 1], KA_m7_b[4][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 34)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[5][KA_m7_col_a + 1], KA_m7_b[5][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[1][KA_m7_col_a + 2], KA_m7_b[1][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[2][KA_m7_col_a + 2], KA_m7_b[2][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 35)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[1][KA_m7_col_a + 3], KA_m7_b[1][KA_m7_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 36)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[2][KA_m7_col_a + 3], KA_m7_b[2][KA_m7_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 37)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[4][KA_m7_col_a + 3], KA_m7_b[4][KA_m7_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 38)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[5][KA_m7_col_a + 3], KA_m7_b[5][KA_m7_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[4][KA_m7_col_a + 4], KA_m7_b[4][KA_m7_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[5][KA_m7_col_a + 4], KA_m7_b[5][KA_m7_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[4][KA_m7_col_a + 5], KA_m7_b[4][KA_m7_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[5][KA_m7_col_a + 5], KA_m7_b[5][KA_m7_col_b + 5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_ankle_link, l_ankle_link.
 // The first: eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-PROXGEN_RT_NOINLINE void shared_36(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7], int KA_m11_col) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[14];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[0]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[5]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[15]*Dinv_m0[0];
-  const Scalar x4 = 1.2149999999999999 - IA_m1[0]*x0;
-  const Scalar x5 = IA_m1[1] - IA_m1[15]*x0;
-  const Scalar x6 = IA_m1[2] - IA_m1[5]*x1;
-  const Scalar x7 = IA_m1[3] - IA_m1[9]*x1;
-  const Scalar x8 = IA_m1[6] - IA_m1[15]*x1;
-  const Scalar x9 = IA_m1[7] - IA_m1[9]*x2;
-  const Scalar x10 = IA_m1[10] - IA_m1[15]*x2;
-  const Scalar x11 = IA_m1[16] - IA_m1[15]*x3;
-  const Scalar x12 = -IA_m1[9]*x0;
-  const Scalar x13 = -IA_m1[5]*x0;
-  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x12 + c_m4[5]*x5;
-  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x13 + c_m4[2]*x7 + c_m4[5]*x8;
-  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x12 + c_m4[2]*x9 + c_m4[5]*x10;
-  const Scalar x17 = 7.2e-05*c_m4[3] + pA_m3[3];
-  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x5 + c_m4[2]*x10 + c_m4[5]*x11;
-  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x20 = 0.5*(-x4 + x9);
-  const Scalar x21 = 0.5*(x4 + x9);
-  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x23 = x19*x20 - x12*x22;
-  const Scalar x24 = x20*x22 + x12*x19;
-  const Scalar x25 = 0.5*(x10*x19 - x5*x22);
-  const Scalar x26 = 0.5*(x10*x22 + x5*x19);
-  const Scalar x27 = -3.6e-05 + 0.5*x11;
-  const Scalar x28 = 3.6e-05 + 0.5*x11;
-  const Scalar x29 = 0.9950041652780258*x21 - 0.9950041652780258*x23 - 0.09983341664682815*x24;
-  const Scalar x30 = -0.09983341664682815*cq_m5[0]*x7 + 0.09983341664682815*sq_m6[0]*x13 + 0.9950041652780258*sq_m6[0]*x7 + 0.9950041652780258*cq_m5[0]*x13;
-  const Scalar x31 = -0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x32 = sq_m6[0]*x7 + cq_m5[0]*x13;
-  const Scalar x33 = cq_m5[0]*x7 - sq_m6[0]*x13;
-  const Scalar x34 = 0.09983341664682815*x21 - 0.09983341664682815*x23 + 0.9950041652780258*x24;
-  const Scalar x35 = 0.9950041652780258*x21 + 0.9950041652780258*x23 + 0.09983341664682815*x24;
-  const Scalar x36 = 0.04991670832341408*x5 + 0.4975020826390129*x10 - 0.9950041652780258*x25 - 0.09983341664682815*x26;
-  const Scalar x37 = 0.4975020826390129*x5 - 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
-  const Scalar x38 = -0.4975020826390129*x5 + 0.04991670832341408*x10 - 0.09983341664682815*x25 + 0.9950041652780258*x26;
-  const Scalar x39 = 0.04991670832341408*x5 + 0.4975020826390129*x10 + 0.9950041652780258*x25 + 0.09983341664682815*x26;
-  const Scalar x40 = 0.9950041652780258*x28 - 0.9950041652780258*x19*x27 - 0.09983341664682815*x22*x27;
-  const Scalar x41 = -0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
-  const Scalar x42 = 0.09983341664682815*x28 - 0.09983341664682815*x19*x27 + 0.9950041652780258*x22*x27;
-  const Scalar x43 = 0.9950041652780258*x28 + 0.9950041652780258*x19*x27 + 0.09983341664682815*x22*x27;
-  const Scalar x44 = 0.9950041652780258*x29 - 0.09983341664682815*x31;
-  const Scalar x45 = 0.09983341664682815*x29 + 0.9950041652780258*x31;
-  const Scalar x46 = 0.09983341664682815*x32 + 0.9950041652780258*x33;
-  const Scalar x47 = 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x48 = 0.9950041652780258*x36 - 0.09983341664682815*x37;
-  const Scalar x49 = 0.09983341664682815*x36 + 0.9950041652780258*x37;
-  const Scalar x50 = -0.09983341664682815*cq_m5[0]*x8 + 0.9950041652780258*sq_m6[0]*x8;
-  const Scalar x51 = 0.9950041652780258*cq_m5[0]*x8 + 0.09983341664682815*sq_m6[0]*x8;
-  const Scalar x52 = 0.9950041652780258*x38 - 0.09983341664682815*x39;
-  const Scalar x53 = 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x54 = 0.4305*x30 + x48;
-  const Scalar x55 = 0.4305*x6 + x50;
-  const Scalar x56 = 0.4305*x46 + x52;
-  const Scalar x57 = cq_m5[0]*x14 + sq_m6[0]*x16;
-  const Scalar x58 = -sq_m6[0]*x14 + cq_m5[0]*x16;
-  const Scalar x59 = cq_m5[0]*x17 + sq_m6[0]*x18;
-  const Scalar x60 = -sq_m6[0]*x17 + cq_m5[0]*x18;
-  const Scalar x61 = 0.9950041652780258*x57 - 0.09983341664682815*x58;
-  const Scalar x62 = 0.09983341664682815*x57 + 0.9950041652780258*x58;
-  IA_m7[0] = 3.055 + x44;
-  IA_m7[1] = x30;
-  IA_m7[2] = x45;
-  IA_m7[3] = x54;
-  IA_m7[4] = -0.5694718575000001 - 0.4305*x44;
-  IA_m7[5] = x49;
-  IA_m7[6] = 3.055 + x6;
-  IA_m7[7] = x46;
-  IA_m7[8] = 0.5694718575000001 + x55;
-  IA_m7[9] = -0.4305*x30;
-  IA_m7[10] = x51;
-  IA_m7[11] = 3.055 + x47;
-  IA_m7[12] = x56;
-  IA_m7[13] = -0.4305*x45;
-  IA_m7[14] = x53;
-  IA_m7[15] = 0.15779149347477375 + 0.9950041652780258*x40 - 0.09983341664682815*x41 + 0.4305*x50 + 0.4305*x55;
-  IA_m7[16] = -0.18533025*x30 - 0.4305*x48;
-  IA_m7[17] = 0.09983341664682815*x40 + 0.9950041652780258*x41 + 0.4305*x51;
-  IA_m7[18] = 0.15779149347477375 + 0.18533025*x44;
-  IA_m7[19] = -0.4305*x49;
-  IA_m7[20] = 0.00381875 + 0.09983341664682815*x42 + 0.9950041652780258*x43;
-  pA_m8[0] = pA_m8[0] + x61;
-  pA_m8[1] = pA_m8[1] + x15;
-  pA_m8[2] = pA_m8[2] + x62;
-  pA_m8[3] = pA_m8[3] + 0.4305*x15 + 0.9950041652780258*x59 - 0.09983341664682815*x60;
-  pA_m8[4] = pA_m8[4] + tau[0] - 0.4305*x61;
-  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
-  KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
-  const Scalar x63 = 1.0 - IA_m1[0]*KSD_m9[0];
-  const Scalar x64 = -IA_m1[9]*KSD_m9[0];
-  const Scalar x65 = KA_m10[5][KA_m10_col + 0] - IA_m1[15]*KSD_m9[0];
-  const Scalar x66 = cq_m5[0]*x63 + sq_m6[0]*x64;
-  const Scalar x67 = -sq_m6[0]*x63 + cq_m5[0]*x64;
-  const Scalar x68 = 0.9950041652780258*x66 - 0.09983341664682815*x67;
-  const Scalar x69 = 0.09983341664682815*x66 + 0.9950041652780258*x67;
-  KA_m11[0][KA_m11_col + 0] = x68;
-  KA_m11[1][KA_m11_col + 0] = -IA_m1[5]*KSD_m9[0];
-  KA_m11[2][KA_m11_col + 0] = x69;
-  KA_m11[3][KA_m11_col + 0] = -0.4305*IA_m1[5]*KSD_m9[0] + 0.9950041652780258*sq_m6[0]*x65 - 0.09983341664682815*cq_m5[0]*x65;
-  KA_m11[4][KA_m11_col + 0] = -0.4305*x68;
-  KA_m11[5][KA_m11_col + 0] = 0.09983341664682815*sq_m6[0]*x65 + 0.9950041652780258*cq_m5[0]*x65;
-  KSD_m9[1] = KA_m10[4][KA_m10_col + 1]*Dinv_m0[0];
-  const Scalar x70 = KA_m10[1][KA_m10_col + 1] - IA_m1[5]*KSD_m9[1];
-  const Scalar x71 = KA_m10[2][KA_m10_col + 1] - IA_m1[9]*KSD_m9[1];
-  const Scalar x72 = -IA_m1[0]*KSD_m9[1];
-  const Scalar x73 = KA_m10[5][KA_m10_col + 1] - IA_m1[15]*KSD_m9[1];
-  const Scalar x74 = cq_m5[0]*x72 + sq_m6[0]*x71;
-  const Scalar x75 = -sq_m6[0]*x72 + cq_m5[0]*x71;
-  const Scalar x76 = 0.9950041652780258*x74 - 0.09983341664682815*x75;
-  const Scalar x77 = 0.09983341664682815*x74 + 0.9950041652780258*x75;
-  KA_m11[0][KA_m11_col + 1] = x76;
-  KA_m11[1][KA_m11_col + 1] = x70;
-  KA_m11[2][KA_m11_col + 1] = x77;
-  KA_m11[3][KA_m11_col + 1] = 0.4305*x70 + 0.9950041652780258*sq_m6[0]*x73 - 0.09983341664682815*cq_m5[0]*x73;
-  KA_m11[4][KA_m11_col + 1] = -0.4305*x76;
-  KA_m11[5][KA_m11_col + 1] = 0.09983341664682815*sq_m6[0]*x73 + 0.9950041652780258*cq_m5[0]*x73;
-  const Scalar x78 = 0.9950041652780258*sq_m6[0]*KA_m10[2][KA_m10_col + 2] - 0.09983341664682815*cq_m5[0]*KA_m10[2][KA_m10_col + 2];
-  const Scalar x79 = 0.09983341664682815*sq_m6[0]*KA_m10[2][KA_m10_col + 2] + 0.9950041652780258*cq_m5[0]*KA_m10[2][KA_m10_col + 2];
-  KA_m11[0][KA_m11_col + 2] = x78;
-  KA_m11[1][KA_m11_col + 2] = KA_m10[1][KA_m10_col + 2];
-  KA_m11[2][KA_m11_col + 2] = x79;
-  KA_m11[3][KA_m11_col + 2] = 0.4305*KA_m10[1][KA_m10_col + 2];
-  KA_m11[4][KA_m11_col + 2] = -0.4305*x78;
-  KSD_m9[3] = KA_m10[4][KA_m10_col + 3]*Dinv_m0[0];
-  const Scalar x80 = KA_m10[1][KA_m10_col + 3] - IA_m1[5]*KSD_m9[3];
-  const Scalar x81 = KA_m10[2][KA_m10_col + 3] - IA_m1[9]*KSD_m9[3];
-  const Scalar x82 = -IA_m1[0]*KSD_m9[3];
-  const Scalar x83 = KA_m10[5][KA_m10_col + 3] - IA_m1[15]*KSD_m9[3];
-  const Scalar x84 = cq_m5[0]*x82 + sq_m6[0]*x81;
-  const Scalar x85 = -sq_m6[0]*x82 + cq_m5[0]*x81;
-  const Scalar x86 = 0.9950041652780258*x84 - 0.09983341664682815*x85;
-  const Scalar x87 = 0.09983341664682815*x84 + 0.9950041652780258*x85;
-  KA_m11[0][KA_m11_col + 3] = x86;
-  KA_m11[1][KA_m11_col + 3] = x80;
-  KA_m11[2][KA_m11_col + 3] = x87;
-  KA_m11[3][KA_m11_col + 3] = 0.4305*x80 + 0.9950041652780258*sq_m6[0]*x83 - 0.09983341664682815*cq_m5[0]*x83;
-  KA_m11[4][KA_m11_col + 3] = -0.4305*x86;
-  KA_m11[5][KA_m11_col + 3] = 0.09983341664682815*sq_m6[0]*x83 + 0.9950041652780258*cq_m5[0]*x83;
-  KSD_m9[4] = KA_m10[4][KA_m10_col + 4]*Dinv_m0[0];
-  const Scalar x88 = -IA_m1[0]*KSD_m9[4];
-  const Scalar x89 = -IA_m1[9]*KSD_m9[4];
-  const Scalar x90 = KA_m10[5][KA_m10_col + 4] - IA_m1[15]*KSD_m9[4];
-  const Scalar x91 = cq_m5[0]*x88 + sq_m6[0]*x89;
-  const Scalar x92 = -sq_m6[0]*x88 + cq_m5[0]*x89;
-  const Scalar x93 = 0.9950041652780258*x91 - 0.09983341664682815*x92;
-  const Scalar x94 = 0.09983341664682815*x91 + 0.9950041652780258*x92;
-  KA_m11[0][KA_m11_col + 4] = x93;
-  KA_m11[1][KA_m11_col + 4] = -IA_m1[5]*KSD_m9[4];
-  KA_m11[2][KA_m11_col + 4] = x94;
-  KA_m11[3][KA_m11_col + 4] = -0.4305*IA_m1[5]*KSD_m9[4] + 0.9950041652780258*sq_m6[0]*x90 - 0.09983341664682815*cq_m5[0]*x90;
-  KA_m11[4][KA_m11_col + 4] = -0.4305*x93;
-  KA_m11[5][KA_m11_col + 4] = 0.09983341664682815*sq_m6[0]*x90 + 0.9950041652780258*cq_m5[0]*x90;
-  KSD_m9[5] = KA_m10[4][KA_m10_col + 5]*Dinv_m0[0];
-  const Scalar x95 = -IA_m1[0]*KSD_m9[5];
-  const Scalar x96 = -IA_m1[9]*KSD_m9[5];
-  const Scalar x97 = KA_m10[5][KA_m10_col + 5] - IA_m1[15]*KSD_m9[5];
-  const Scalar x98 = cq_m5[0]*x95 + sq_m6[0]*x96;
-  const Scalar x99 = -sq_m6[0]*x95 + cq_m5[0]*x96;
-  const Scalar x100 = 0.9950041652780258*x98 - 0.09983341664682815*x99;
-  const Scalar x101 = 0.09983341664682815*x98 + 0.9950041652780258*x99;
-  KA_m11[0][KA_m11_col + 5] = x100;
-  KA_m11[1][KA_m11_col + 5] = -IA_m1[5]*KSD_m9[5];
-  KA_m11[2][KA_m11_col + 5] = x101;
-  KA_m11[3][KA_m11_col + 5] = -0.4305*IA_m1[5]*KSD_m9[5] + 0.9950041652780258*sq_m6[0]*x97 - 0.09983341664682815*cq_m5[0]*x97;
-  KA_m11[4][KA_m11_col + 5] = -0.4305*x100;
-  KA_m11[5][KA_m11_col + 5] = 0.09983341664682815*sq_m6[0]*x97 + 0.9950041652780258*cq_m5[0]*x97;
+// shared_38's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_38_p0[340] = {1.0, 1.0, 1.2149999999999999, 1.2149999999999999, 7.2e-05, 7.2e-05, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, -3.6e-05, -3.6e-05, 0.5, 0.5, 3.6e-05, 3.6e-05, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.04991670832341408, 0.04991670832341408, 0.4975020826390129, 0.4975020826390129, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4975020826390129, 0.4975020826390129, -0.04991670832341408, -0.04991670832341408, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4975020826390129, -0.4975020826390129, 0.04991670832341408, 0.04991670832341408, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.04991670832341408, 0.04991670832341408, 0.4975020826390129, 0.4975020826390129, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.4305, 0.4305, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 3.055, 3.055, -0.5694718575000001, -0.5694718575000001, -0.4305, -0.4305, 3.055, 3.055, 0.5694718575000001, 0.5694718575000001, -0.4305, -0.4305, 3.055, 3.055, -0.4305, -0.4305, 0.15779149347477375, 0.15779149347477375, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4305, 0.4305, 0.4305, 0.4305, -0.18533025, -0.18533025, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.15779149347477375, 0.15779149347477375, 0.18533025, 0.18533025, -0.4305, -0.4305, 0.00381875, 0.00381875, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 1.0, 1.0, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4305, -0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, -0.4305, -0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.4305, 0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4305, -0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4305, -0.4305, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.4305, -0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_38_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b, Scalar* PROXGEN_RT_RESTRICT KSD_m9_a, Scalar* PROXGEN_RT_RESTRICT KSD_m9_b, Scalar (*KA_m10_a)[7], Scalar (*KA_m10_b)[7], int KA_m10_col_a, int KA_m10_col_b, Scalar (*PROXGEN_RT_RESTRICT KA_m11_a)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_b)[7], int KA_m11_col_a, int KA_m11_col_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 1) - proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*x1;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*x1;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x2;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*x2;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*x3;
+  const ScalarPair x12 = -proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x13 = -proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*x0;
+  const ScalarPair x14 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x4 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x5;
+  const ScalarPair x15 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x13 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x8;
+  const ScalarPair x16 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x12 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x9 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x10;
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]);
+  const ScalarPair x18 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x10 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x11;
+  const ScalarPair x19 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 3)*(-x4 + x9);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 4)*(x4 + x9);
+  const ScalarPair x22 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x23 = x19*x20 - x12*x22;
+  const ScalarPair x24 = x20*x22 + x12*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 6)*(x10*x19 - x5*x22);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 7)*(x10*x22 + x5*x19);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 8) + proxgen_rt::pair_at(k, 9)*x11;
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 10) + proxgen_rt::pair_at(k, 11)*x11;
+  const ScalarPair x29 = proxgen_rt::pair_at(k, 12)*x21 + proxgen_rt::pair_at(k, 13)*x23 + proxgen_rt::pair_at(k, 14)*x24;
+  const ScalarPair x30 = proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7 + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7 + proxgen_rt::pair_at(k, 18)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 19)*x21 + proxgen_rt::pair_at(k, 20)*x23 + proxgen_rt::pair_at(k, 21)*x24;
+  const ScalarPair x32 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13;
+  const ScalarPair x33 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13;
+  const ScalarPair x34 = proxgen_rt::pair_at(k, 22)*x21 + proxgen_rt::pair_at(k, 23)*x23 + proxgen_rt::pair_at(k, 24)*x24;
+  const ScalarPair x35 = proxgen_rt::pair_at(k, 25)*x21 + proxgen_rt::pair_at(k, 26)*x23 + proxgen_rt::pair_at(k, 27)*x24;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 28)*x5 + proxgen_rt::pair_at(k, 29)*x10 + proxgen_rt::pair_at(k, 30)*x25 + proxgen_rt::pair_at(k, 31)*x26;
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 32)*x5 + proxgen_rt::pair_at(k, 33)*x10 + proxgen_rt::pair_at(k, 34)*x25 + proxgen_rt::pair_at(k, 35)*x26;
+  const ScalarPair x38 = proxgen_rt::pair_at(k, 36)*x5 + proxgen_rt::pair_at(k, 37)*x10 + proxgen_rt::pair_at(k, 38)*x25 + proxgen_rt::pair_at(k, 39)*x26;
+  const ScalarPair x39 = proxgen_rt::pair_at(k, 40)*x5 + proxgen_rt::pair_at(k, 41)*x10 + proxgen_rt::pair_at(k, 42)*x25 + proxgen_rt::pair_at(k, 43)*x26;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 44)*x28 + proxgen_rt::pair_at(k, 45)*x19*x27 + proxgen_rt::pair_at(k, 46)*x22*x27;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 47)*x28 + proxgen_rt::pair_at(k, 48)*x19*x27 + proxgen_rt::pair_at(k, 49)*x22*x27;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 50)*x28 + proxgen_rt::pair_at(k, 51)*x19*x27 + proxgen_rt::pair_at(k, 52)*x22*x27;
+  const ScalarPair x43 = proxgen_rt::pair_at(k, 53)*x28 + proxgen_rt::pair_at(k, 54)*x19*x27 + proxgen_rt::pair_at(k, 55)*x22*x27;
+  const ScalarPair x44 = proxgen_rt::pair_at(k, 56)*x29 + proxgen_rt::pair_at(k, 57)*x31;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 58)*x29 + proxgen_rt::pair_at(k, 59)*x31;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 60)*x32 + proxgen_rt::pair_at(k, 61)*x33;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 62)*x34 + proxgen_rt::pair_at(k, 63)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 64)*x36 + proxgen_rt::pair_at(k, 65)*x37;
+  const ScalarPair x49 = proxgen_rt::pair_at(k, 66)*x36 + proxgen_rt::pair_at(k, 67)*x37;
+  const ScalarPair x50 = proxgen_rt::pair_at(k, 68)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x8 + proxgen_rt::pair_at(k, 69)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x8;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 70)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x8 + proxgen_rt::pair_at(k, 71)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x8;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 72)*x38 + proxgen_rt::pair_at(k, 73)*x39;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 74)*x38 + proxgen_rt::pair_at(k, 75)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 76)*x30 + x48;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 77)*x6 + x50;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 78)*x46 + x52;
+  const ScalarPair x57 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x14 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x16;
+  const ScalarPair x58 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x14 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x16;
+  const ScalarPair x59 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x17 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x18;
+  const ScalarPair x60 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x17 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x18;
+  const ScalarPair x61 = proxgen_rt::pair_at(k, 79)*x57 + proxgen_rt::pair_at(k, 80)*x58;
+  const ScalarPair x62 = proxgen_rt::pair_at(k, 81)*x57 + proxgen_rt::pair_at(k, 82)*x58;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 83) + x44, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x30, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x45, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x54, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 84) + proxgen_rt::pair_at(k, 85)*x44, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x49, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 86) + x6, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x46, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 87) + x55, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 88)*x30, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(x51, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 89) + x47, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(x56, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 90)*x45, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(x53, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 91) + proxgen_rt::pair_at(k, 92)*x40 + proxgen_rt::pair_at(k, 93)*x41 + proxgen_rt::pair_at(k, 94)*x50 + proxgen_rt::pair_at(k, 95)*x55, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 96)*x30 + proxgen_rt::pair_at(k, 97)*x48, IA_m7_a[16], IA_m7_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 98)*x40 + proxgen_rt::pair_at(k, 99)*x41 + proxgen_rt::pair_at(k, 100)*x51, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 101) + proxgen_rt::pair_at(k, 102)*x44, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 103)*x49, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 104) + proxgen_rt::pair_at(k, 105)*x42 + proxgen_rt::pair_at(k, 106)*x43, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x61, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x15, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x62, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 107)*x15 + proxgen_rt::pair_at(k, 108)*x59 + proxgen_rt::pair_at(k, 109)*x60, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 110)*x61, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 111)*x59 + proxgen_rt::pair_at(k, 112)*x60, pA_m8_a[5], pA_m8_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 0], KA_m10_b[4][KA_m10_col_b + 0])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x63 = proxgen_rt::pair_at(k, 113) - proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x64 = -proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x65 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 0], KA_m10_b[5][KA_m10_col_b + 0]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x66 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x63 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x64;
+  const ScalarPair x67 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x63 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x64;
+  const ScalarPair x68 = proxgen_rt::pair_at(k, 114)*x66 + proxgen_rt::pair_at(k, 115)*x67;
+  const ScalarPair x69 = proxgen_rt::pair_at(k, 116)*x66 + proxgen_rt::pair_at(k, 117)*x67;
+  proxgen_rt::scatter2<Scalar>(x68, KA_m11_a[0][KA_m11_col_a + 0], KA_m11_b[0][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]), KA_m11_a[1][KA_m11_col_a + 0], KA_m11_b[1][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(x69, KA_m11_a[2][KA_m11_col_a + 0], KA_m11_b[2][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 118)*proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]) + proxgen_rt::pair_at(k, 119)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x65 + proxgen_rt::pair_at(k, 120)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x65, KA_m11_a[3][KA_m11_col_a + 0], KA_m11_b[3][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 121)*x68, KA_m11_a[4][KA_m11_col_a + 0], KA_m11_b[4][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 122)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x65 + proxgen_rt::pair_at(k, 123)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x65, KA_m11_a[5][KA_m11_col_a + 0], KA_m11_b[5][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 1], KA_m10_b[4][KA_m10_col_b + 1])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[1], KSD_m9_b[1]);
+  const ScalarPair x70 = proxgen_rt::gather2(KA_m10_a[1][KA_m10_col_a + 1], KA_m10_b[1][KA_m10_col_b + 1]) - proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[1], KSD_m9_b[1]);
+  const ScalarPair x71 = proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 1], KA_m10_b[2][KA_m10_col_b + 1]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[1], KSD_m9_b[1]);
+  const ScalarPair x72 = -proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(KSD_m9_a[1], KSD_m9_b[1]);
+  const ScalarPair x73 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 1], KA_m10_b[5][KA_m10_col_b + 1]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(KSD_m9_a[1], KSD_m9_b[1]);
+  const ScalarPair x74 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x72 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x71;
+  const ScalarPair x75 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x72 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x71;
+  const ScalarPair x76 = proxgen_rt::pair_at(k, 124)*x74 + proxgen_rt::pair_at(k, 125)*x75;
+  const ScalarPair x77 = proxgen_rt::pair_at(k, 126)*x74 + proxgen_rt::pair_at(k, 127)*x75;
+  proxgen_rt::scatter2<Scalar>(x76, KA_m11_a[0][KA_m11_col_a + 1], KA_m11_b[0][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(x70, KA_m11_a[1][KA_m11_col_a + 1], KA_m11_b[1][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(x77, KA_m11_a[2][KA_m11_col_a + 1], KA_m11_b[2][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 128)*x70 + proxgen_rt::pair_at(k, 129)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x73 + proxgen_rt::pair_at(k, 130)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x73, KA_m11_a[3][KA_m11_col_a + 1], KA_m11_b[3][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 131)*x76, KA_m11_a[4][KA_m11_col_a + 1], KA_m11_b[4][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 132)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x73 + proxgen_rt::pair_at(k, 133)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x73, KA_m11_a[5][KA_m11_col_a + 1], KA_m11_b[5][KA_m11_col_b + 1]);
+  const ScalarPair x78 = proxgen_rt::pair_at(k, 134)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 2], KA_m10_b[2][KA_m10_col_b + 2]) + proxgen_rt::pair_at(k, 135)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 2], KA_m10_b[2][KA_m10_col_b + 2]);
+  const ScalarPair x79 = proxgen_rt::pair_at(k, 136)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 2], KA_m10_b[2][KA_m10_col_b + 2]) + proxgen_rt::pair_at(k, 137)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 2], KA_m10_b[2][KA_m10_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(x78, KA_m11_a[0][KA_m11_col_a + 2], KA_m11_b[0][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[1][KA_m10_col_a + 2], KA_m10_b[1][KA_m10_col_b + 2]), KA_m11_a[1][KA_m11_col_a + 2], KA_m11_b[1][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(x79, KA_m11_a[2][KA_m11_col_a + 2], KA_m11_b[2][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 138)*proxgen_rt::gather2(KA_m10_a[1][KA_m10_col_a + 2], KA_m10_b[1][KA_m10_col_b + 2]), KA_m11_a[3][KA_m11_col_a + 2], KA_m11_b[3][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 139)*x78, KA_m11_a[4][KA_m11_col_a + 2], KA_m11_b[4][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 3], KA_m10_b[4][KA_m10_col_b + 3])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[3], KSD_m9_b[3]);
+  const ScalarPair x80 = proxgen_rt::gather2(KA_m10_a[1][KA_m10_col_a + 3], KA_m10_b[1][KA_m10_col_b + 3]) - proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[3], KSD_m9_b[3]);
+  const ScalarPair x81 = proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 3], KA_m10_b[2][KA_m10_col_b + 3]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[3], KSD_m9_b[3]);
+  const ScalarPair x82 = -proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(KSD_m9_a[3], KSD_m9_b[3]);
+  const ScalarPair x83 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 3], KA_m10_b[5][KA_m10_col_b + 3]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(KSD_m9_a[3], KSD_m9_b[3]);
+  const ScalarPair x84 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x82 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x81;
+  const ScalarPair x85 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x82 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x81;
+  const ScalarPair x86 = proxgen_rt::pair_at(k, 140)*x84 + proxgen_rt::pair_at(k, 141)*x85;
+  const ScalarPair x87 = proxgen_rt::pair_at(k, 142)*x84 + proxgen_rt::pair_at(k, 143)*x85;
+  proxgen_rt::scatter2<Scalar>(x86, KA_m11_a[0][KA_m11_col_a + 3], KA_m11_b[0][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(x80, KA_m11_a[1][KA_m11_col_a + 3], KA_m11_b[1][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(x87, KA_m11_a[2][KA_m11_col_a + 3], KA_m11_b[2][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 144)*x80 + proxgen_rt::pair_at(k, 145)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x83 + proxgen_rt::pair_at(k, 146)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x83, KA_m11_a[3][KA_m11_col_a + 3], KA_m11_b[3][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 147)*x86, KA_m11_a[4][KA_m11_col_a + 3], KA_m11_b[4][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 148)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x83 + proxgen_rt::pair_at(k, 149)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x83, KA_m11_a[5][KA_m11_col_a + 3], KA_m11_b[5][KA_m11_col_b + 3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 4], KA_m10_b[4][KA_m10_col_b + 4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[4], KSD_m9_b[4]);
+  const ScalarPair x88 = -proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(KSD_m9_a[4], KSD_m9_b[4]);
+  const ScalarPair x89 = -proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[4], KSD_m9_b[4]);
+  const ScalarPair x90 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 4], KA_m10_b[5][KA_m10_col_b + 4]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(KSD_m9_a[4], KSD_m9_b[4]);
+  const ScalarPair x91 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x88 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x89;
+  const ScalarPair x92 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x88 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x89;
+  const ScalarPair x93 = proxgen_rt::pair_at(k, 150)*x91 + proxgen_rt::pair_at(k, 151)*x92;
+  const ScalarPair x94 = proxgen_rt::pair_at(k, 152)*x91 + proxgen_rt::pair_at(k, 153)*x92;
+  proxgen_rt::scatter2<Scalar>(x93, KA_m11_a[0][KA_m11_col_a + 4], KA_m11_b[0][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[4], KSD_m9_b[4]), KA_m11_a[1][KA_m11_col_a + 4], KA_m11_b[1][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(x94, KA_m11_a[2][KA_m11_col_a + 4], KA_m11_b[2][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 154)*proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[4], KSD_m9_b[4]) + proxgen_rt::pair_at(k, 155)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x90 + proxgen_rt::pair_at(k, 156)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x90, KA_m11_a[3][KA_m11_col_a + 4], KA_m11_b[3][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 157)*x93, KA_m11_a[4][KA_m11_col_a + 4], KA_m11_b[4][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 158)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x90 + proxgen_rt::pair_at(k, 159)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x90, KA_m11_a[5][KA_m11_col_a + 4], KA_m11_b[5][KA_m11_col_b + 4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 5], KA_m10_b[4][KA_m10_col_b + 5])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[5], KSD_m9_b[5]);
+  const ScalarPair x95 = -proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0])*proxgen_rt::gather2(KSD_m9_a[5], KSD_m9_b[5]);
+  const ScalarPair x96 = -proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[5], KSD_m9_b[5]);
+  const ScalarPair x97 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 5], KA_m10_b[5][KA_m10_col_b + 5]) - proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15])*proxgen_rt::gather2(KSD_m9_a[5], KSD_m9_b[5]);
+  const ScalarPair x98 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x95 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x96;
+  const ScalarPair x99 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x95 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x96;
+  const ScalarPair x100 = proxgen_rt::pair_at(k, 160)*x98 + proxgen_rt::pair_at(k, 161)*x99;
+  const ScalarPair x101 = proxgen_rt::pair_at(k, 162)*x98 + proxgen_rt::pair_at(k, 163)*x99;
+  proxgen_rt::scatter2<Scalar>(x100, KA_m11_a[0][KA_m11_col_a + 5], KA_m11_b[0][KA_m11_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[5], KSD_m9_b[5]), KA_m11_a[1][KA_m11_col_a + 5], KA_m11_b[1][KA_m11_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(x101, KA_m11_a[2][KA_m11_col_a + 5], KA_m11_b[2][KA_m11_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 164)*proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5])*proxgen_rt::gather2(KSD_m9_a[5], KSD_m9_b[5]) + proxgen_rt::pair_at(k, 165)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x97 + proxgen_rt::pair_at(k, 166)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x97, KA_m11_a[3][KA_m11_col_a + 5], KA_m11_b[3][KA_m11_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 167)*x100, KA_m11_a[4][KA_m11_col_a + 5], KA_m11_b[4][KA_m11_col_b + 5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 168)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x97 + proxgen_rt::pair_at(k, 169)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x97, KA_m11_a[5][KA_m11_col_a + 5], KA_m11_b[5][KA_m11_col_b + 5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_shank, l_shank.
 // The first: eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-PROXGEN_RT_NOINLINE void shared_37(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
-  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
-  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
-  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
-  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
-  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
-  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
-  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
-  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
-  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
-  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
-  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
-  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
-  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
-  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
-  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x26 = 0.5*(-x5 + x14);
-  const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x29 = x25*x26 - x7*x28;
-  const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = 0.5*(-x8 + x16);
-  const Scalar x32 = 0.5*(x8 + x16);
-  const Scalar x33 = 0.5*(x9 + x15);
-  const Scalar x34 = x25*x31 - x28*x33;
-  const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = 0.5*(-x17 + x19);
-  const Scalar x37 = 0.5*(x17 + x19);
-  const Scalar x38 = x25*x36 - x18*x28;
-  const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = 0.9800665778412416*x27 - 0.9800665778412416*x29 + 0.19866933079506124*x30;
-  const Scalar x41 = 0.19866933079506124*cq_m5[0]*x11 - 0.19866933079506124*sq_m6[0]*x6 + 0.9800665778412416*sq_m6[0]*x11 + 0.9800665778412416*cq_m5[0]*x6;
-  const Scalar x42 = 0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
-  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
-  const Scalar x45 = -0.19866933079506124*x27 + 0.19866933079506124*x29 + 0.9800665778412416*x30;
-  const Scalar x46 = 0.9800665778412416*x27 + 0.9800665778412416*x29 - 0.19866933079506124*x30;
-  const Scalar x47 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 - 0.9800665778412416*x34 + 0.19866933079506124*x35;
-  const Scalar x48 = 0.4900332889206208*x9 - 0.4900332889206208*x15 + 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
-  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
-  const Scalar x51 = -0.4900332889206208*x9 + 0.4900332889206208*x15 - 0.19866933079506124*x32 + 0.19866933079506124*x34 + 0.9800665778412416*x35;
-  const Scalar x52 = -0.09933466539753062*x9 + 0.09933466539753062*x15 + 0.9800665778412416*x32 + 0.9800665778412416*x34 - 0.19866933079506124*x35;
-  const Scalar x53 = 0.9800665778412416*x37 - 0.9800665778412416*x38 + 0.19866933079506124*x39;
-  const Scalar x54 = 0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
-  const Scalar x55 = -0.19866933079506124*x37 + 0.19866933079506124*x38 + 0.9800665778412416*x39;
-  const Scalar x56 = 0.9800665778412416*x37 + 0.9800665778412416*x38 - 0.19866933079506124*x39;
-  const Scalar x57 = 0.9800665778412416*x40 + 0.19866933079506124*x42;
-  const Scalar x58 = -0.19866933079506124*x40 + 0.9800665778412416*x42;
-  const Scalar x59 = -0.19866933079506124*x43 + 0.9800665778412416*x44;
-  const Scalar x60 = -0.19866933079506124*x45 + 0.9800665778412416*x46;
-  const Scalar x61 = 0.9800665778412416*x47 + 0.19866933079506124*x48;
-  const Scalar x62 = -0.19866933079506124*x47 + 0.9800665778412416*x48;
-  const Scalar x63 = 0.9800665778412416*x49 + 0.19866933079506124*x50;
-  const Scalar x64 = -0.19866933079506124*x49 + 0.9800665778412416*x50;
-  const Scalar x65 = 0.9800665778412416*x51 + 0.19866933079506124*x52;
-  const Scalar x66 = -0.19866933079506124*x51 + 0.9800665778412416*x52;
-  const Scalar x67 = 0.42875*x41 + x61;
-  const Scalar x68 = 0.42875*x10 + x63;
-  const Scalar x69 = 0.42875*x59 + x65;
-  const Scalar x70 = cq_m5[0]*x20 + sq_m6[0]*x22;
-  const Scalar x71 = -sq_m6[0]*x20 + cq_m5[0]*x22;
-  const Scalar x72 = cq_m5[0]*x23 + sq_m6[0]*x24;
-  const Scalar x73 = -sq_m6[0]*x23 + cq_m5[0]*x24;
-  const Scalar x74 = 0.9800665778412416*x70 + 0.19866933079506124*x71;
-  const Scalar x75 = -0.19866933079506124*x70 + 0.9800665778412416*x71;
-  IA_m7[0] = 7.0 + x57;
-  IA_m7[1] = x41;
-  IA_m7[2] = x58;
-  IA_m7[3] = x67;
-  IA_m7[4] = -1.29954125 - 0.42875*x57;
-  IA_m7[5] = x62;
-  IA_m7[6] = 7.0 + x10;
-  IA_m7[7] = x59;
-  IA_m7[8] = 1.29954125 + x68;
-  IA_m7[9] = -0.42875*x41;
-  IA_m7[10] = x64;
-  IA_m7[11] = 7.0 + x60;
-  IA_m7[12] = x69;
-  IA_m7[13] = -0.42875*x58;
-  IA_m7[14] = x66;
-  IA_m7[15] = 0.3755072987089375 + 0.9800665778412416*x53 + 0.19866933079506124*x54 + 0.42875*x63 + 0.42875*x68;
-  IA_m7[16] = -0.1838265625*x41 - 0.42875*x61;
-  IA_m7[17] = -0.19866933079506124*x53 + 0.9800665778412416*x54 + 0.42875*x64;
-  IA_m7[18] = 0.3755072987089375 + 0.1838265625*x57;
-  IA_m7[19] = -0.42875*x62;
-  IA_m7[20] = 0.0196875 - 0.19866933079506124*x55 + 0.9800665778412416*x56;
-  pA_m8[0] = pA_m8[0] + x74;
-  pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + x75;
-  pA_m8[3] = pA_m8[3] + 0.42875*x21 + 0.9800665778412416*x72 + 0.19866933079506124*x73;
-  pA_m8[4] = pA_m8[4] + tau[0] - 0.42875*x74;
-  pA_m8[5] = pA_m8[5] - 0.19866933079506124*x72 + 0.9800665778412416*x73;
+// shared_39's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_39_p0[288] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, -0.09933466539753062, -0.09933466539753062, 0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.4900332889206208, 0.4900332889206208, -0.4900332889206208, -0.4900332889206208, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.4900332889206208, -0.4900332889206208, 0.4900332889206208, 0.4900332889206208, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.09933466539753062, -0.09933466539753062, 0.09933466539753062, 0.09933466539753062, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.9800665778412416, -0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.42875, 0.42875, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 7.0, 7.0, -1.29954125, -1.29954125, -0.42875, -0.42875, 7.0, 7.0, 1.29954125, 1.29954125, -0.42875, -0.42875, 7.0, 7.0, -0.42875, -0.42875, 0.3755072987089375, 0.3755072987089375, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.42875, 0.42875, 0.42875, 0.42875, -0.1838265625, -0.1838265625, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.3755072987089375, 0.3755072987089375, 0.1838265625, 0.1838265625, -0.42875, -0.42875, 0.0196875, 0.0196875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.42875, 0.42875, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, -0.42875, -0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_39_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b, Scalar* PROXGEN_RT_RESTRICT KSD_m9_a, Scalar* PROXGEN_RT_RESTRICT KSD_m9_b, Scalar (*KA_m10_a)[7], Scalar (*KA_m10_b)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_a)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_b)[7]) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x0;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x1;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x14 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x2;
+  const ScalarPair x15 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x2;
+  const ScalarPair x16 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x17 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x3;
+  const ScalarPair x18 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x19 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x4;
+  const ScalarPair x20 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x8 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x9;
+  const ScalarPair x21 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x6 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x11 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x13;
+  const ScalarPair x22 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x7 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x14 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x15 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x16;
+  const ScalarPair x23 = proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x15 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x17 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x18;
+  const ScalarPair x24 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x4 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x16 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x18 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x19;
+  const ScalarPair x25 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 1)*(-x5 + x14);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 2)*(x5 + x14);
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x29 = x25*x26 - x7*x28;
+  const ScalarPair x30 = x26*x28 + x7*x25;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 4)*(-x8 + x16);
+  const ScalarPair x32 = proxgen_rt::pair_at(k, 5)*(x8 + x16);
+  const ScalarPair x33 = proxgen_rt::pair_at(k, 6)*(x9 + x15);
+  const ScalarPair x34 = x25*x31 - x28*x33;
+  const ScalarPair x35 = x28*x31 + x25*x33;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 7)*(-x17 + x19);
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 8)*(x17 + x19);
+  const ScalarPair x38 = x25*x36 - x18*x28;
+  const ScalarPair x39 = x28*x36 + x18*x25;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 9)*x27 + proxgen_rt::pair_at(k, 10)*x29 + proxgen_rt::pair_at(k, 11)*x30;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6 + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 16)*x27 + proxgen_rt::pair_at(k, 17)*x29 + proxgen_rt::pair_at(k, 18)*x30;
+  const ScalarPair x43 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x44 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 19)*x27 + proxgen_rt::pair_at(k, 20)*x29 + proxgen_rt::pair_at(k, 21)*x30;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 22)*x27 + proxgen_rt::pair_at(k, 23)*x29 + proxgen_rt::pair_at(k, 24)*x30;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 25)*x9 + proxgen_rt::pair_at(k, 26)*x15 + proxgen_rt::pair_at(k, 27)*x32 + proxgen_rt::pair_at(k, 28)*x34 + proxgen_rt::pair_at(k, 29)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 30)*x9 + proxgen_rt::pair_at(k, 31)*x15 + proxgen_rt::pair_at(k, 32)*x32 + proxgen_rt::pair_at(k, 33)*x34 + proxgen_rt::pair_at(k, 34)*x35;
+  const ScalarPair x49 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x12;
+  const ScalarPair x50 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x12;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 35)*x9 + proxgen_rt::pair_at(k, 36)*x15 + proxgen_rt::pair_at(k, 37)*x32 + proxgen_rt::pair_at(k, 38)*x34 + proxgen_rt::pair_at(k, 39)*x35;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 40)*x9 + proxgen_rt::pair_at(k, 41)*x15 + proxgen_rt::pair_at(k, 42)*x32 + proxgen_rt::pair_at(k, 43)*x34 + proxgen_rt::pair_at(k, 44)*x35;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 45)*x37 + proxgen_rt::pair_at(k, 46)*x38 + proxgen_rt::pair_at(k, 47)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 48)*x37 + proxgen_rt::pair_at(k, 49)*x38 + proxgen_rt::pair_at(k, 50)*x39;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 51)*x37 + proxgen_rt::pair_at(k, 52)*x38 + proxgen_rt::pair_at(k, 53)*x39;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 54)*x37 + proxgen_rt::pair_at(k, 55)*x38 + proxgen_rt::pair_at(k, 56)*x39;
+  const ScalarPair x57 = proxgen_rt::pair_at(k, 57)*x40 + proxgen_rt::pair_at(k, 58)*x42;
+  const ScalarPair x58 = proxgen_rt::pair_at(k, 59)*x40 + proxgen_rt::pair_at(k, 60)*x42;
+  const ScalarPair x59 = proxgen_rt::pair_at(k, 61)*x43 + proxgen_rt::pair_at(k, 62)*x44;
+  const ScalarPair x60 = proxgen_rt::pair_at(k, 63)*x45 + proxgen_rt::pair_at(k, 64)*x46;
+  const ScalarPair x61 = proxgen_rt::pair_at(k, 65)*x47 + proxgen_rt::pair_at(k, 66)*x48;
+  const ScalarPair x62 = proxgen_rt::pair_at(k, 67)*x47 + proxgen_rt::pair_at(k, 68)*x48;
+  const ScalarPair x63 = proxgen_rt::pair_at(k, 69)*x49 + proxgen_rt::pair_at(k, 70)*x50;
+  const ScalarPair x64 = proxgen_rt::pair_at(k, 71)*x49 + proxgen_rt::pair_at(k, 72)*x50;
+  const ScalarPair x65 = proxgen_rt::pair_at(k, 73)*x51 + proxgen_rt::pair_at(k, 74)*x52;
+  const ScalarPair x66 = proxgen_rt::pair_at(k, 75)*x51 + proxgen_rt::pair_at(k, 76)*x52;
+  const ScalarPair x67 = proxgen_rt::pair_at(k, 77)*x41 + x61;
+  const ScalarPair x68 = proxgen_rt::pair_at(k, 78)*x10 + x63;
+  const ScalarPair x69 = proxgen_rt::pair_at(k, 79)*x59 + x65;
+  const ScalarPair x70 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x20 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x22;
+  const ScalarPair x71 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x20 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x22;
+  const ScalarPair x72 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x23 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x24;
+  const ScalarPair x73 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x23 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x24;
+  const ScalarPair x74 = proxgen_rt::pair_at(k, 80)*x70 + proxgen_rt::pair_at(k, 81)*x71;
+  const ScalarPair x75 = proxgen_rt::pair_at(k, 82)*x70 + proxgen_rt::pair_at(k, 83)*x71;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 84) + x57, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x41, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x58, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x67, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 85) + proxgen_rt::pair_at(k, 86)*x57, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x62, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 87) + x10, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x59, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 88) + x68, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 89)*x41, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(x64, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 90) + x60, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(x69, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 91)*x58, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(x66, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 92) + proxgen_rt::pair_at(k, 93)*x53 + proxgen_rt::pair_at(k, 94)*x54 + proxgen_rt::pair_at(k, 95)*x63 + proxgen_rt::pair_at(k, 96)*x68, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 97)*x41 + proxgen_rt::pair_at(k, 98)*x61, IA_m7_a[16], IA_m7_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 99)*x53 + proxgen_rt::pair_at(k, 100)*x54 + proxgen_rt::pair_at(k, 101)*x64, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 102) + proxgen_rt::pair_at(k, 103)*x57, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 104)*x62, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 105) + proxgen_rt::pair_at(k, 106)*x55 + proxgen_rt::pair_at(k, 107)*x56, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x74, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x21, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x75, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 108)*x21 + proxgen_rt::pair_at(k, 109)*x72 + proxgen_rt::pair_at(k, 110)*x73, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 111)*x74, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 112)*x72 + proxgen_rt::pair_at(k, 113)*x73, pA_m8_a[5], pA_m8_b[5]);
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 2; ++j) {
-    KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
-    const Scalar x76 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
-    const Scalar x77 = KA_m10[1][j] - IA_m1[9]*KSD_m9[j];
-    const Scalar x78 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
-    const Scalar x79 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
-    const Scalar x80 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
-    const Scalar x81 = cq_m5[0]*x76 + sq_m6[0]*x78;
-    const Scalar x82 = -sq_m6[0]*x76 + cq_m5[0]*x78;
-    const Scalar x83 = cq_m5[0]*x79 + sq_m6[0]*x80;
-    const Scalar x84 = -sq_m6[0]*x79 + cq_m5[0]*x80;
-    const Scalar x85 = 0.9800665778412416*x81 + 0.19866933079506124*x82;
-    const Scalar x86 = -0.19866933079506124*x81 + 0.9800665778412416*x82;
-    KA_m11[0][j] = x85;
-    KA_m11[1][j] = x77;
-    KA_m11[2][j] = x86;
-    KA_m11[3][j] = 0.42875*x77 + 0.9800665778412416*x83 + 0.19866933079506124*x84;
-    KA_m11[4][j] = -0.42875*x85;
-    KA_m11[5][j] = -0.19866933079506124*x83 + 0.9800665778412416*x84;
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0])*proxgen_rt::gather2(KA_m10_a[4][j], KA_m10_b[4][j]), KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x76 = proxgen_rt::gather2(KA_m10_a[0][j], KA_m10_b[0][j]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x77 = proxgen_rt::gather2(KA_m10_a[1][j], KA_m10_b[1][j]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x78 = proxgen_rt::gather2(KA_m10_a[2][j], KA_m10_b[2][j]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x79 = proxgen_rt::gather2(KA_m10_a[3][j], KA_m10_b[3][j]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x80 = proxgen_rt::gather2(KA_m10_a[5][j], KA_m10_b[5][j]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x81 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x76 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x78;
+    const ScalarPair x82 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x76 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x78;
+    const ScalarPair x83 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x79 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x80;
+    const ScalarPair x84 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x79 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x80;
+    const ScalarPair x85 = proxgen_rt::pair_at(k, 114)*x81 + proxgen_rt::pair_at(k, 115)*x82;
+    const ScalarPair x86 = proxgen_rt::pair_at(k, 116)*x81 + proxgen_rt::pair_at(k, 117)*x82;
+    proxgen_rt::scatter2<Scalar>(x85, KA_m11_a[0][j], KA_m11_b[0][j]);
+    proxgen_rt::scatter2<Scalar>(x77, KA_m11_a[1][j], KA_m11_b[1][j]);
+    proxgen_rt::scatter2<Scalar>(x86, KA_m11_a[2][j], KA_m11_b[2][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 118)*x77 + proxgen_rt::pair_at(k, 119)*x83 + proxgen_rt::pair_at(k, 120)*x84, KA_m11_a[3][j], KA_m11_b[3][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 121)*x85, KA_m11_a[4][j], KA_m11_b[4][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 122)*x83 + proxgen_rt::pair_at(k, 123)*x84, KA_m11_a[5][j], KA_m11_b[5][j]);
   }
-  KSD_m9[2] = KA_m10[4][2]*Dinv_m0[0];
-  const Scalar x87 = KA_m10[0][2] - IA_m1[4]*KSD_m9[2];
-  const Scalar x88 = KA_m10[1][2] - IA_m1[9]*KSD_m9[2];
-  const Scalar x89 = KA_m10[2][2] - IA_m1[13]*KSD_m9[2];
-  const Scalar x90 = KA_m10[3][2] - IA_m1[16]*KSD_m9[2];
-  const Scalar x91 = -IA_m1[19]*KSD_m9[2];
-  const Scalar x92 = cq_m5[0]*x87 + sq_m6[0]*x89;
-  const Scalar x93 = -sq_m6[0]*x87 + cq_m5[0]*x89;
-  const Scalar x94 = cq_m5[0]*x90 + sq_m6[0]*x91;
-  const Scalar x95 = -sq_m6[0]*x90 + cq_m5[0]*x91;
-  const Scalar x96 = 0.9800665778412416*x92 + 0.19866933079506124*x93;
-  const Scalar x97 = -0.19866933079506124*x92 + 0.9800665778412416*x93;
-  KA_m11[0][2] = x96;
-  KA_m11[1][2] = x88;
-  KA_m11[2][2] = x97;
-  KA_m11[3][2] = 0.42875*x88 + 0.9800665778412416*x94 + 0.19866933079506124*x95;
-  KA_m11[4][2] = -0.42875*x96;
-  KA_m11[5][2] = -0.19866933079506124*x94 + 0.9800665778412416*x95;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][2], KA_m10_b[4][2])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x87 = proxgen_rt::gather2(KA_m10_a[0][2], KA_m10_b[0][2]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x88 = proxgen_rt::gather2(KA_m10_a[1][2], KA_m10_b[1][2]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x89 = proxgen_rt::gather2(KA_m10_a[2][2], KA_m10_b[2][2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x90 = proxgen_rt::gather2(KA_m10_a[3][2], KA_m10_b[3][2]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x91 = -proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x92 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x87 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x89;
+  const ScalarPair x93 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x87 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x89;
+  const ScalarPair x94 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x90 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x91;
+  const ScalarPair x95 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x90 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x91;
+  const ScalarPair x96 = proxgen_rt::pair_at(k, 124)*x92 + proxgen_rt::pair_at(k, 125)*x93;
+  const ScalarPair x97 = proxgen_rt::pair_at(k, 126)*x92 + proxgen_rt::pair_at(k, 127)*x93;
+  proxgen_rt::scatter2<Scalar>(x96, KA_m11_a[0][2], KA_m11_b[0][2]);
+  proxgen_rt::scatter2<Scalar>(x88, KA_m11_a[1][2], KA_m11_b[1][2]);
+  proxgen_rt::scatter2<Scalar>(x97, KA_m11_a[2][2], KA_m11_b[2][2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 128)*x88 + proxgen_rt::pair_at(k, 129)*x94 + proxgen_rt::pair_at(k, 130)*x95, KA_m11_a[3][2], KA_m11_b[3][2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 131)*x96, KA_m11_a[4][2], KA_m11_b[4][2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 132)*x94 + proxgen_rt::pair_at(k, 133)*x95, KA_m11_a[5][2], KA_m11_b[5][2]);
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 3; ++j) {
-    KSD_m9[3 + j] = Dinv_m0[0]*KA_m10[4][3 + j];
-    const Scalar x98 = KA_m10[0][3 + j] - IA_m1[4]*KSD_m9[3 + j];
-    const Scalar x99 = KA_m10[1][3 + j] - IA_m1[9]*KSD_m9[3 + j];
-    const Scalar x100 = KA_m10[2][3 + j] - IA_m1[13]*KSD_m9[3 + j];
-    const Scalar x101 = KA_m10[3][3 + j] - IA_m1[16]*KSD_m9[3 + j];
-    const Scalar x102 = KA_m10[5][3 + j] - IA_m1[19]*KSD_m9[3 + j];
-    const Scalar x103 = cq_m5[0]*x98 + sq_m6[0]*x100;
-    const Scalar x104 = -sq_m6[0]*x98 + cq_m5[0]*x100;
-    const Scalar x105 = cq_m5[0]*x101 + sq_m6[0]*x102;
-    const Scalar x106 = -sq_m6[0]*x101 + cq_m5[0]*x102;
-    const Scalar x107 = 0.9800665778412416*x103 + 0.19866933079506124*x104;
-    const Scalar x108 = -0.19866933079506124*x103 + 0.9800665778412416*x104;
-    KA_m11[0][3 + j] = x107;
-    KA_m11[1][3 + j] = x99;
-    KA_m11[2][3 + j] = x108;
-    KA_m11[3][3 + j] = 0.42875*x99 + 0.9800665778412416*x105 + 0.19866933079506124*x106;
-    KA_m11[4][3 + j] = -0.42875*x107;
-    KA_m11[5][3 + j] = -0.19866933079506124*x105 + 0.9800665778412416*x106;
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0])*proxgen_rt::gather2(KA_m10_a[4][3 + j], KA_m10_b[4][3 + j]), KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x98 = proxgen_rt::gather2(KA_m10_a[0][3 + j], KA_m10_b[0][3 + j]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x99 = proxgen_rt::gather2(KA_m10_a[1][3 + j], KA_m10_b[1][3 + j]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x100 = proxgen_rt::gather2(KA_m10_a[2][3 + j], KA_m10_b[2][3 + j]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x101 = proxgen_rt::gather2(KA_m10_a[3][3 + j], KA_m10_b[3][3 + j]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x102 = proxgen_rt::gather2(KA_m10_a[5][3 + j], KA_m10_b[5][3 + j]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(KSD_m9_a[3 + j], KSD_m9_b[3 + j]);
+    const ScalarPair x103 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x98 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x100;
+    const ScalarPair x104 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x98 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x100;
+    const ScalarPair x105 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x101 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x102;
+    const ScalarPair x106 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x101 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x102;
+    const ScalarPair x107 = proxgen_rt::pair_at(k, 134)*x103 + proxgen_rt::pair_at(k, 135)*x104;
+    const ScalarPair x108 = proxgen_rt::pair_at(k, 136)*x103 + proxgen_rt::pair_at(k, 137)*x104;
+    proxgen_rt::scatter2<Scalar>(x107, KA_m11_a[0][3 + j], KA_m11_b[0][3 + j]);
+    proxgen_rt::scatter2<Scalar>(x99, KA_m11_a[1][3 + j], KA_m11_b[1][3 + j]);
+    proxgen_rt::scatter2<Scalar>(x108, KA_m11_a[2][3 + j], KA_m11_b[2][3 + j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 138)*x99 + proxgen_rt::pair_at(k, 139)*x105 + proxgen_rt::pair_at(k, 140)*x106, KA_m11_a[3][3 + j], KA_m11_b[3][3 + j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 141)*x107, KA_m11_a[4][3 + j], KA_m11_b[4][3 + j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 142)*x105 + proxgen_rt::pair_at(k, 143)*x106, KA_m11_a[5][3 + j], KA_m11_b[5][3 + j]);
   }
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_thigh, l_thigh.
 // The first: eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_38(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[9]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[16]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x5 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x6 = IA_m1[1] - IA_m1[9]*x0;
-  const Scalar x7 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x8 = IA_m1[3] - IA_m1[16]*x0;
-  const Scalar x9 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x10 = IA_m1[6] - IA_m1[9]*x1;
-  const Scalar x11 = IA_m1[7] - IA_m1[13]*x1;
-  const Scalar x12 = IA_m1[8] - IA_m1[16]*x1;
-  const Scalar x13 = IA_m1[10] - IA_m1[19]*x1;
-  const Scalar x14 = IA_m1[11] - IA_m1[13]*x2;
-  const Scalar x15 = IA_m1[12] - IA_m1[16]*x2;
-  const Scalar x16 = IA_m1[14] - IA_m1[19]*x2;
-  const Scalar x17 = IA_m1[15] - IA_m1[16]*x3;
-  const Scalar x18 = IA_m1[17] - IA_m1[19]*x3;
-  const Scalar x19 = IA_m1[20] - IA_m1[19]*x4;
-  const Scalar x20 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[2]*x7 + c_m4[3]*x8 + c_m4[5]*x9;
-  const Scalar x21 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x6 + c_m4[2]*x11 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x22 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x7 + c_m4[2]*x14 + c_m4[3]*x15 + c_m4[5]*x16;
-  const Scalar x23 = pA_m3[3] + u_m2[0]*x3 + c_m4[0]*x8 + c_m4[2]*x15 + c_m4[3]*x17 + c_m4[5]*x18;
-  const Scalar x24 = pA_m3[5] + u_m2[0]*x4 + c_m4[0]*x9 + c_m4[2]*x16 + c_m4[3]*x18 + c_m4[5]*x19;
-  const Scalar x25 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x26 = 0.5*(-x5 + x14);
-  const Scalar x27 = 0.5*(x5 + x14);
-  const Scalar x28 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x29 = x25*x26 - x7*x28;
-  const Scalar x30 = x26*x28 + x7*x25;
-  const Scalar x31 = 0.5*(-x8 + x16);
-  const Scalar x32 = 0.5*(x8 + x16);
-  const Scalar x33 = 0.5*(x9 + x15);
-  const Scalar x34 = x25*x31 - x28*x33;
-  const Scalar x35 = x28*x31 + x25*x33;
-  const Scalar x36 = 0.5*(-x17 + x19);
-  const Scalar x37 = 0.5*(x17 + x19);
-  const Scalar x38 = x25*x36 - x18*x28;
-  const Scalar x39 = x28*x36 + x18*x25;
-  const Scalar x40 = 0.9950041652780258*x27 - 0.9950041652780258*x29 - 0.09983341664682815*x30;
-  const Scalar x41 = -0.09983341664682815*cq_m5[0]*x11 + 0.09983341664682815*sq_m6[0]*x6 + 0.9950041652780258*sq_m6[0]*x11 + 0.9950041652780258*cq_m5[0]*x6;
-  const Scalar x42 = -0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x43 = sq_m6[0]*x11 + cq_m5[0]*x6;
-  const Scalar x44 = cq_m5[0]*x11 - sq_m6[0]*x6;
-  const Scalar x45 = 0.09983341664682815*x27 - 0.09983341664682815*x29 + 0.9950041652780258*x30;
-  const Scalar x46 = 0.9950041652780258*x27 + 0.9950041652780258*x29 + 0.09983341664682815*x30;
-  const Scalar x47 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 - 0.9950041652780258*x34 - 0.09983341664682815*x35;
-  const Scalar x48 = 0.4975020826390129*x9 - 0.4975020826390129*x15 - 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x49 = sq_m6[0]*x13 + cq_m5[0]*x12;
-  const Scalar x50 = cq_m5[0]*x13 - sq_m6[0]*x12;
-  const Scalar x51 = -0.4975020826390129*x9 + 0.4975020826390129*x15 + 0.09983341664682815*x32 - 0.09983341664682815*x34 + 0.9950041652780258*x35;
-  const Scalar x52 = 0.04991670832341408*x9 - 0.04991670832341408*x15 + 0.9950041652780258*x32 + 0.9950041652780258*x34 + 0.09983341664682815*x35;
-  const Scalar x53 = 0.9950041652780258*x37 - 0.9950041652780258*x38 - 0.09983341664682815*x39;
-  const Scalar x54 = -0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x55 = 0.09983341664682815*x37 - 0.09983341664682815*x38 + 0.9950041652780258*x39;
-  const Scalar x56 = 0.9950041652780258*x37 + 0.9950041652780258*x38 + 0.09983341664682815*x39;
-  const Scalar x57 = cq_m5[0]*x20 + sq_m6[0]*x22;
-  const Scalar x58 = -sq_m6[0]*x20 + cq_m5[0]*x22;
-  const Scalar x59 = cq_m5[0]*x23 + sq_m6[0]*x24;
-  const Scalar x60 = -sq_m6[0]*x23 + cq_m5[0]*x24;
-  IA_m7[0] = 0.5 + 0.9950041652780258*x40 - 0.09983341664682815*x42;
-  IA_m7[1] = x41;
-  IA_m7[2] = 0.09983341664682815*x40 + 0.9950041652780258*x42;
-  IA_m7[3] = 0.9950041652780258*x47 - 0.09983341664682815*x48;
-  IA_m7[5] = 0.09983341664682815*x47 + 0.9950041652780258*x48;
-  IA_m7[6] = 0.5 + x10;
-  IA_m7[7] = 0.09983341664682815*x43 + 0.9950041652780258*x44;
-  IA_m7[8] = 0.015 + 0.9950041652780258*x49 - 0.09983341664682815*x50;
-  IA_m7[10] = 0.09983341664682815*x49 + 0.9950041652780258*x50;
-  IA_m7[11] = 0.5 + 0.09983341664682815*x45 + 0.9950041652780258*x46;
-  IA_m7[12] = 0.9950041652780258*x51 - 0.09983341664682815*x52;
-  IA_m7[14] = 0.09983341664682815*x51 + 0.9950041652780258*x52;
-  IA_m7[15] = 0.00095 + 0.9950041652780258*x53 - 0.09983341664682815*x54;
-  IA_m7[17] = 0.09983341664682815*x53 + 0.9950041652780258*x54;
-  IA_m7[20] = 0.0005 + 0.09983341664682815*x55 + 0.9950041652780258*x56;
-  pA_m8[0] = pA_m8[0] + 0.9950041652780258*x57 - 0.09983341664682815*x58;
-  pA_m8[1] = pA_m8[1] + x21;
-  pA_m8[2] = pA_m8[2] + 0.09983341664682815*x57 + 0.9950041652780258*x58;
-  pA_m8[3] = pA_m8[3] + 0.9950041652780258*x59 - 0.09983341664682815*x60;
-  pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] + 0.09983341664682815*x59 + 0.9950041652780258*x60;
+// shared_40's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_40_p0[212] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.04991670832341408, 0.04991670832341408, -0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.4975020826390129, 0.4975020826390129, -0.4975020826390129, -0.4975020826390129, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.4975020826390129, -0.4975020826390129, 0.4975020826390129, 0.4975020826390129, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.04991670832341408, 0.04991670832341408, -0.04991670832341408, -0.04991670832341408, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, -0.9950041652780258, -0.9950041652780258, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, 0.5, 0.5, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.5, 0.5, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.015, 0.015, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.5, 0.5, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.00095, 0.00095, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.0005, 0.0005, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.0, 0.0, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_40_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b, Scalar* PROXGEN_RT_RESTRICT KSD_m9_a, Scalar* PROXGEN_RT_RESTRICT KSD_m9_b, Scalar (*KA_m10_a)[7], Scalar (*KA_m10_b)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_a)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_b)[7]) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x0;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x1;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x14 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x2;
+  const ScalarPair x15 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x2;
+  const ScalarPair x16 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x17 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x3;
+  const ScalarPair x18 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x19 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x4;
+  const ScalarPair x20 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x8 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x9;
+  const ScalarPair x21 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x6 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x11 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x13;
+  const ScalarPair x22 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x7 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x14 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x15 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x16;
+  const ScalarPair x23 = proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x15 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x17 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x18;
+  const ScalarPair x24 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x4 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x16 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x18 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x19;
+  const ScalarPair x25 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 1)*(-x5 + x14);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 2)*(x5 + x14);
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x29 = x25*x26 - x7*x28;
+  const ScalarPair x30 = x26*x28 + x7*x25;
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 4)*(-x8 + x16);
+  const ScalarPair x32 = proxgen_rt::pair_at(k, 5)*(x8 + x16);
+  const ScalarPair x33 = proxgen_rt::pair_at(k, 6)*(x9 + x15);
+  const ScalarPair x34 = x25*x31 - x28*x33;
+  const ScalarPair x35 = x28*x31 + x25*x33;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 7)*(-x17 + x19);
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 8)*(x17 + x19);
+  const ScalarPair x38 = x25*x36 - x18*x28;
+  const ScalarPair x39 = x28*x36 + x18*x25;
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 9)*x27 + proxgen_rt::pair_at(k, 10)*x29 + proxgen_rt::pair_at(k, 11)*x30;
+  const ScalarPair x41 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6 + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 16)*x27 + proxgen_rt::pair_at(k, 17)*x29 + proxgen_rt::pair_at(k, 18)*x30;
+  const ScalarPair x43 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6;
+  const ScalarPair x44 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 19)*x27 + proxgen_rt::pair_at(k, 20)*x29 + proxgen_rt::pair_at(k, 21)*x30;
+  const ScalarPair x46 = proxgen_rt::pair_at(k, 22)*x27 + proxgen_rt::pair_at(k, 23)*x29 + proxgen_rt::pair_at(k, 24)*x30;
+  const ScalarPair x47 = proxgen_rt::pair_at(k, 25)*x9 + proxgen_rt::pair_at(k, 26)*x15 + proxgen_rt::pair_at(k, 27)*x32 + proxgen_rt::pair_at(k, 28)*x34 + proxgen_rt::pair_at(k, 29)*x35;
+  const ScalarPair x48 = proxgen_rt::pair_at(k, 30)*x9 + proxgen_rt::pair_at(k, 31)*x15 + proxgen_rt::pair_at(k, 32)*x32 + proxgen_rt::pair_at(k, 33)*x34 + proxgen_rt::pair_at(k, 34)*x35;
+  const ScalarPair x49 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x13 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x12;
+  const ScalarPair x50 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x13 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x12;
+  const ScalarPair x51 = proxgen_rt::pair_at(k, 35)*x9 + proxgen_rt::pair_at(k, 36)*x15 + proxgen_rt::pair_at(k, 37)*x32 + proxgen_rt::pair_at(k, 38)*x34 + proxgen_rt::pair_at(k, 39)*x35;
+  const ScalarPair x52 = proxgen_rt::pair_at(k, 40)*x9 + proxgen_rt::pair_at(k, 41)*x15 + proxgen_rt::pair_at(k, 42)*x32 + proxgen_rt::pair_at(k, 43)*x34 + proxgen_rt::pair_at(k, 44)*x35;
+  const ScalarPair x53 = proxgen_rt::pair_at(k, 45)*x37 + proxgen_rt::pair_at(k, 46)*x38 + proxgen_rt::pair_at(k, 47)*x39;
+  const ScalarPair x54 = proxgen_rt::pair_at(k, 48)*x37 + proxgen_rt::pair_at(k, 49)*x38 + proxgen_rt::pair_at(k, 50)*x39;
+  const ScalarPair x55 = proxgen_rt::pair_at(k, 51)*x37 + proxgen_rt::pair_at(k, 52)*x38 + proxgen_rt::pair_at(k, 53)*x39;
+  const ScalarPair x56 = proxgen_rt::pair_at(k, 54)*x37 + proxgen_rt::pair_at(k, 55)*x38 + proxgen_rt::pair_at(k, 56)*x39;
+  const ScalarPair x57 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x20 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x22;
+  const ScalarPair x58 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x20 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x22;
+  const ScalarPair x59 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x23 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x24;
+  const ScalarPair x60 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x23 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x24;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 57) + proxgen_rt::pair_at(k, 58)*x40 + proxgen_rt::pair_at(k, 59)*x42, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x41, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 60)*x40 + proxgen_rt::pair_at(k, 61)*x42, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 62)*x47 + proxgen_rt::pair_at(k, 63)*x48, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 64)*x47 + proxgen_rt::pair_at(k, 65)*x48, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 66) + x10, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 67)*x43 + proxgen_rt::pair_at(k, 68)*x44, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 69) + proxgen_rt::pair_at(k, 70)*x49 + proxgen_rt::pair_at(k, 71)*x50, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 72)*x49 + proxgen_rt::pair_at(k, 73)*x50, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 74) + proxgen_rt::pair_at(k, 75)*x45 + proxgen_rt::pair_at(k, 76)*x46, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 77)*x51 + proxgen_rt::pair_at(k, 78)*x52, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 79)*x51 + proxgen_rt::pair_at(k, 80)*x52, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 81) + proxgen_rt::pair_at(k, 82)*x53 + proxgen_rt::pair_at(k, 83)*x54, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 84)*x53 + proxgen_rt::pair_at(k, 85)*x54, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 86) + proxgen_rt::pair_at(k, 87)*x55 + proxgen_rt::pair_at(k, 88)*x56, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + proxgen_rt::pair_at(k, 89)*x57 + proxgen_rt::pair_at(k, 90)*x58, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x21, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + proxgen_rt::pair_at(k, 91)*x57 + proxgen_rt::pair_at(k, 92)*x58, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::pair_at(k, 93)*x59 + proxgen_rt::pair_at(k, 94)*x60, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::pair_at(k, 95)*x59 + proxgen_rt::pair_at(k, 96)*x60, pA_m8_a[5], pA_m8_b[5]);
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    KSD_m9[j] = Dinv_m0[0]*KA_m10[4][j];
-    const Scalar x61 = KA_m10[0][j] - IA_m1[4]*KSD_m9[j];
-    const Scalar x62 = KA_m10[1][j] - IA_m1[9]*KSD_m9[j];
-    const Scalar x63 = KA_m10[2][j] - IA_m1[13]*KSD_m9[j];
-    const Scalar x64 = KA_m10[3][j] - IA_m1[16]*KSD_m9[j];
-    const Scalar x65 = KA_m10[5][j] - IA_m1[19]*KSD_m9[j];
-    const Scalar x66 = cq_m5[0]*x61 + sq_m6[0]*x63;
-    const Scalar x67 = -sq_m6[0]*x61 + cq_m5[0]*x63;
-    const Scalar x68 = cq_m5[0]*x64 + sq_m6[0]*x65;
-    const Scalar x69 = -sq_m6[0]*x64 + cq_m5[0]*x65;
-    KA_m11[0][j] = 0.9950041652780258*x66 - 0.09983341664682815*x67;
-    KA_m11[1][j] = x62;
-    KA_m11[2][j] = 0.09983341664682815*x66 + 0.9950041652780258*x67;
-    KA_m11[3][j] = 0.9950041652780258*x68 - 0.09983341664682815*x69;
-    KA_m11[4][j] = 0.0;
-    KA_m11[5][j] = 0.09983341664682815*x68 + 0.9950041652780258*x69;
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0])*proxgen_rt::gather2(KA_m10_a[4][j], KA_m10_b[4][j]), KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x61 = proxgen_rt::gather2(KA_m10_a[0][j], KA_m10_b[0][j]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x62 = proxgen_rt::gather2(KA_m10_a[1][j], KA_m10_b[1][j]) - proxgen_rt::gather2(IA_m1_a[9], IA_m1_b[9])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x63 = proxgen_rt::gather2(KA_m10_a[2][j], KA_m10_b[2][j]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x64 = proxgen_rt::gather2(KA_m10_a[3][j], KA_m10_b[3][j]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x65 = proxgen_rt::gather2(KA_m10_a[5][j], KA_m10_b[5][j]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x66 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x61 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x63;
+    const ScalarPair x67 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x61 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x63;
+    const ScalarPair x68 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x64 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x65;
+    const ScalarPair x69 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x64 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x65;
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 97)*x66 + proxgen_rt::pair_at(k, 98)*x67, KA_m11_a[0][j], KA_m11_b[0][j]);
+    proxgen_rt::scatter2<Scalar>(x62, KA_m11_a[1][j], KA_m11_b[1][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 99)*x66 + proxgen_rt::pair_at(k, 100)*x67, KA_m11_a[2][j], KA_m11_b[2][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 101)*x68 + proxgen_rt::pair_at(k, 102)*x69, KA_m11_a[3][j], KA_m11_b[3][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 103), KA_m11_a[4][j], KA_m11_b[4][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 104)*x68 + proxgen_rt::pair_at(k, 105)*x69, KA_m11_a[5][j], KA_m11_b[5][j]);
   }
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: r_hip_roll_link, l_hip_roll_link.
 // The first: eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_39(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11)[7]) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[15];
-  u_m2[0] = -pA_m3[3] + tau[0];
-  const Scalar x0 = IA_m1[3]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[8]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[12]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[17]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[0] - IA_m1[3]*x0;
-  const Scalar x5 = IA_m1[1] - IA_m1[8]*x0;
-  const Scalar x6 = IA_m1[2] - IA_m1[12]*x0;
-  const Scalar x7 = IA_m1[5] - IA_m1[17]*x0;
-  const Scalar x8 = IA_m1[6] - IA_m1[8]*x1;
-  const Scalar x9 = IA_m1[7] - IA_m1[12]*x1;
-  const Scalar x10 = IA_m1[10] - IA_m1[17]*x1;
-  const Scalar x11 = IA_m1[11] - IA_m1[12]*x2;
-  const Scalar x12 = IA_m1[14] - IA_m1[17]*x2;
-  const Scalar x13 = IA_m1[20] - IA_m1[17]*x3;
-  const Scalar x14 = -0.015*c_m4[3] + pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x5 + c_m4[1]*x6 + c_m4[4]*x7;
-  const Scalar x15 = pA_m3[1] + u_m2[0]*x1 + c_m4[0]*x8 + c_m4[1]*x9 + c_m4[4]*x10;
-  const Scalar x16 = pA_m3[2] + u_m2[0]*x2 + c_m4[0]*x9 + c_m4[1]*x11 + c_m4[4]*x12;
-  const Scalar x17 = 0.00095*c_m4[3] + pA_m3[4];
-  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x10 + c_m4[1]*x12 + c_m4[4]*x13;
-  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x20 = 0.5*(x8 - x11);
-  const Scalar x21 = 0.5*(x8 + x11);
-  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x23 = x19*x20 - x9*x22;
-  const Scalar x24 = x20*x22 + x9*x19;
-  const Scalar x25 = 0.5*(-x12*x19 - x10*x22);
-  const Scalar x26 = 0.5*(-x12*x22 + x10*x19);
-  const Scalar x27 = 0.000475 - 0.5*x13;
-  const Scalar x28 = 0.000475 + 0.5*x13;
-  IA_m7[0] = 0.5 + x4;
-  IA_m7[1] = cq_m5[0]*x5 - sq_m6[0]*x6;
-  IA_m7[2] = sq_m6[0]*x5 + cq_m5[0]*x6;
-  IA_m7[4] = 0.02 - 0.015*cq_m5[0] - sq_m6[0]*x7;
-  IA_m7[5] = -0.015*sq_m6[0] + cq_m5[0]*x7;
-  IA_m7[6] = 0.5 + x21 + x23;
-  IA_m7[7] = x24;
-  IA_m7[9] = 0.5*x12 + x25;
-  IA_m7[10] = 0.5*x10 + x26;
-  IA_m7[11] = 0.5 + x21 - x23;
-  IA_m7[13] = -0.5*x10 + x26;
-  IA_m7[14] = 0.5*x12 - x25;
-  IA_m7[18] = 0.0013 + x28 + x19*x27;
-  IA_m7[19] = x22*x27;
-  IA_m7[20] = 0.0005 + x28 - x19*x27;
-  pA_m8[0] = pA_m8[0] + x14;
-  pA_m8[1] = pA_m8[1] + cq_m5[0]*x15 - sq_m6[0]*x16;
-  pA_m8[2] = pA_m8[2] + sq_m6[0]*x15 + cq_m5[0]*x16;
-  pA_m8[3] = pA_m8[3] + tau[0];
-  pA_m8[4] = pA_m8[4] + cq_m5[0]*x17 - sq_m6[0]*x18;
-  pA_m8[5] = pA_m8[5] + sq_m6[0]*x17 + cq_m5[0]*x18;
+// shared_41's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_41_p0[50] = {1.0, 1.0, -0.015, -0.015, 0.00095, 0.00095, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.000475, 0.000475, -0.5, -0.5, 0.000475, 0.000475, 0.5, 0.5, 0.5, 0.5, 0.02, 0.02, -0.015, -0.015, -0.015, -0.015, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, 0.5, 0.5, 0.0013, 0.0013, 0.0005, 0.0005, 0.0, 0.0};
+PROXGEN_RT_NOINLINE void shared_41_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b, Scalar* PROXGEN_RT_RESTRICT KSD_m9_a, Scalar* PROXGEN_RT_RESTRICT KSD_m9_b, Scalar (*KA_m10_a)[7], Scalar (*KA_m10_b)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_a)[7], Scalar (*PROXGEN_RT_RESTRICT KA_m11_b)[7]) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[1], IA_m1_b[1]) - proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]) - proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*x1;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[7], IA_m1_b[7]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x1;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*x2;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x2;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x3;
+  const ScalarPair x14 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x6 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x7;
+  const ScalarPair x15 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x8 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x9 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x10;
+  const ScalarPair x16 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x9 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x11 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x12;
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]);
+  const ScalarPair x18 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x10 + proxgen_rt::gather2(c_m4_a[1], c_m4_b[1])*x12 + proxgen_rt::gather2(c_m4_a[4], c_m4_b[4])*x13;
+  const ScalarPair x19 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 3)*(x8 - x11);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 4)*(x8 + x11);
+  const ScalarPair x22 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x23 = x19*x20 - x9*x22;
+  const ScalarPair x24 = x20*x22 + x9*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 6)*(-x12*x19 - x10*x22);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 7)*(-x12*x22 + x10*x19);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 8) + proxgen_rt::pair_at(k, 9)*x13;
+  const ScalarPair x28 = proxgen_rt::pair_at(k, 10) + proxgen_rt::pair_at(k, 11)*x13;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12) + x4, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x5 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x6, IA_m7_a[1], IA_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x5 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x6, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 13) + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x7, IA_m7_a[4], IA_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x7, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 16) + x21 + x23, IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x24, IA_m7_a[7], IA_m7_b[7]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 17)*x12 + x25, IA_m7_a[9], IA_m7_b[9]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18)*x10 + x26, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 19) + x21 - x23, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 20)*x10 + x26, IA_m7_a[13], IA_m7_b[13]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 21)*x12 - x25, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 22) + x28 + x19*x27, IA_m7_a[18], IA_m7_b[18]);
+  proxgen_rt::scatter2<Scalar>(x22*x27, IA_m7_a[19], IA_m7_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 23) + x28 - x19*x27, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x14, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x15 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x16, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x15 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x16, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x17 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x18, pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x17 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x18, pA_m8_a[5], pA_m8_b[5]);
   PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
-    KSD_m9[j] = Dinv_m0[0]*KA_m10[3][j];
-    const Scalar x29 = KA_m10[0][j] - IA_m1[3]*KSD_m9[j];
-    const Scalar x30 = KA_m10[1][j] - IA_m1[8]*KSD_m9[j];
-    const Scalar x31 = KA_m10[2][j] - IA_m1[12]*KSD_m9[j];
-    const Scalar x32 = KA_m10[5][j] - IA_m1[17]*KSD_m9[j];
-    KA_m11[0][j] = x29;
-    KA_m11[1][j] = cq_m5[0]*x30 - sq_m6[0]*x31;
-    KA_m11[2][j] = sq_m6[0]*x30 + cq_m5[0]*x31;
-    KA_m11[3][j] = 0.0;
-    KA_m11[4][j] = cq_m5[0]*KA_m10[4][j] - sq_m6[0]*x32;
-    KA_m11[5][j] = sq_m6[0]*KA_m10[4][j] + cq_m5[0]*x32;
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0])*proxgen_rt::gather2(KA_m10_a[3][j], KA_m10_b[3][j]), KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x29 = proxgen_rt::gather2(KA_m10_a[0][j], KA_m10_b[0][j]) - proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x30 = proxgen_rt::gather2(KA_m10_a[1][j], KA_m10_b[1][j]) - proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x31 = proxgen_rt::gather2(KA_m10_a[2][j], KA_m10_b[2][j]) - proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    const ScalarPair x32 = proxgen_rt::gather2(KA_m10_a[5][j], KA_m10_b[5][j]) - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*proxgen_rt::gather2(KSD_m9_a[j], KSD_m9_b[j]);
+    proxgen_rt::scatter2<Scalar>(x29, KA_m11_a[0][j], KA_m11_b[0][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x30 - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x31, KA_m11_a[1][j], KA_m11_b[1][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x30 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x31, KA_m11_a[2][j], KA_m11_b[2][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 24), KA_m11_a[3][j], KA_m11_b[3][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[4][j], KA_m10_b[4][j]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x32, KA_m11_a[4][j], KA_m11_b[4][j]);
+    proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[4][j], KA_m10_b[4][j]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x32, KA_m11_a[5][j], KA_m11_b[5][j]);
   }
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link, r_hip_yaw_link.
+// The first: free acceleration (lambda = 0): body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
+// shared_42's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_42_p0[20] = {-0.0875, 0.0875, 0.0875, -0.0875, 0.08718915247898762, -0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.08718915247898762, -0.08718915247898762, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759};
+PROXGEN_RT_NOINLINE void shared_42_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x7 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x1 - proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14])*x9 - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, a_m6_a[5], a_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_40(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
-  const Scalar x4 = u_m4[0] - a_m1[0]*IA_m5[0] - IA_m5[5]*x0 - IA_m5[9]*x1 - a_m1[3]*IA_m5[12] - IA_m5[14]*x3;
-  a_m6[0] = a_m1[0];
-  a_m6[1] = x0;
-  a_m6[2] = x1;
-  a_m6[3] = a_m1[3] + Dinv_m7*x4;
-  a_m6[4] = x2;
-  a_m6[5] = x3;
+// shared_43's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+PROXGEN_RT_NOINLINE void shared_43_x2(Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(a_m1_a[0], a_m1_b[0])*proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0]) - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x0 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x1 - proxgen_rt::gather2(a_m1_a[3], a_m1_b[3])*proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12]) - proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14])*x3;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x4, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m6_a[5], a_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_41(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
-  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
-  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = u_m4[0] - IA_m5[0]*x4 - IA_m5[5]*a_m0[1] - IA_m5[9]*x5 - IA_m5[12]*x6 - IA_m5[14]*a_m0[4] - IA_m5[15]*x7;
-  a_m6[0] = x4;
-  a_m6[1] = a_m0[1];
-  a_m6[2] = x5;
-  a_m6[3] = x6;
-  a_m6[4] = a_m0[4] + Dinv_m7*x8;
-  a_m6[5] = x7;
+// shared_44's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_44_p0[16] = {0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_44_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x4 - proxgen_rt::gather2(a_m0_a[1], a_m0_b[1])*proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5]) - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x5 - proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12])*x6 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x7;
+  proxgen_rt::scatter2<Scalar>(x4, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x8, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[5], a_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_42(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
-  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
-  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
-  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
-  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - IA_m5[12]*x8 - IA_m5[14]*a_m0[4] - IA_m5[15]*x9;
-  a_m6[0] = x6;
-  a_m6[1] = x1;
-  a_m6[2] = x7;
-  a_m6[3] = x8;
-  a_m6[4] = a_m0[4] + Dinv_m7*x10;
-  a_m6[5] = x9;
+// shared_45's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_45_p0[20] = {-0.42875, -0.42875, 0.42875, 0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_45_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x1 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x7 - proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12])*x8 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(x6, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m6_a[5], a_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_43(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
-  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
-  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
-  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - IA_m5[0]*x6 - IA_m5[5]*x1 - IA_m5[9]*x7 - a_m0[4]*IA_m5[14] - IA_m5[15]*x9;
-  a_m6[0] = x6;
-  a_m6[1] = x1;
-  a_m6[2] = x7;
-  a_m6[3] = x8;
-  a_m6[4] = a_m0[4] + Dinv_m7*x10;
-  a_m6[5] = x9;
+// shared_46's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_46_p0[20] = {-0.4305, -0.4305, 0.4305, 0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_46_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x6 - proxgen_rt::gather2(IA_m5_a[5], IA_m5_b[5])*x1 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x7 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(x6, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x10, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m6_a[5], a_m6_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_44(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
-  const Scalar x4 = u_m4[0] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
-  a_m5[0] = a_m2[0];
-  a_m5[1] = x0;
-  a_m5[2] = x1;
-  a_m5[3] = a_m2[3] + 514.0929615568219*x4;
-  a_m5[4] = x2;
-  a_m5[5] = x3;
+// shared_47's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_47_p0[8] = {-0.00194517348958, -0.00194517348958, -0.027912499999999996, -0.027912499999999996, -0.0017863999999999998, -0.0017863999999999998, 514.0929615568219, 514.0929615568219};
+PROXGEN_RT_NOINLINE void shared_47_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* PROXGEN_RT_RESTRICT a_m5_a, Scalar* PROXGEN_RT_RESTRICT a_m5_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 1)*x0 + proxgen_rt::pair_at(k, 2)*x3;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m5_a[0], a_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m5_a[1], a_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m5_a[2], a_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::pair_at(k, 3)*x4, a_m5_a[3], a_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m5_a[4], a_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m5_a[5], a_m5_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: l_hip_yaw_link, r_hip_yaw_link.
+// The first: accelerate, with the multipliers of the subtree rows: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
+// shared_48's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_48_p0[20] = {-0.0875, 0.0875, 0.0875, -0.0875, 0.08718915247898762, -0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, 0.9961917745544759, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759, 0.08718915247898762, -0.08718915247898762, -0.08718915247898762, 0.08718915247898762, 0.9961917745544759, 0.9961917745544759};
+PROXGEN_RT_NOINLINE void shared_48_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[7], Scalar (*KA_m5_b)[7], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 0], KA_m5_b[5][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 1], KA_m5_b[5][KA_m5_col_b + 1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 2], KA_m5_b[5][KA_m5_col_b + 2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 3], KA_m5_b[5][KA_m5_col_b + 3])*proxgen_rt::gather2(lambda_m6_a[3], lambda_m6_b[3]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 4], KA_m5_b[5][KA_m5_col_b + 4])*proxgen_rt::gather2(lambda_m6_a[4], lambda_m6_b[4]) - proxgen_rt::gather2(KA_m5_a[5][KA_m5_col_a + 5], KA_m5_b[5][KA_m5_col_b + 5])*proxgen_rt::gather2(lambda_m6_a[5], lambda_m6_b[5]) - proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0])*x6 - proxgen_rt::gather2(IA_m7_a[5], IA_m7_b[5])*x7 - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x1 - proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14])*x9 - proxgen_rt::gather2(IA_m7_a[15], IA_m7_b[15])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x10, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[5], a_m10_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_hip_roll_link, r_hip_roll_link.
 // The first: accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-PROXGEN_RT_NOINLINE void shared_45(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT a_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = c_m0[0] + a_m1[1]*cq_m2[0] + a_m1[2]*sq_m3[0];
-  const Scalar x1 = c_m0[1] - a_m1[1]*sq_m3[0] + a_m1[2]*cq_m2[0];
-  const Scalar x2 = c_m0[3] + a_m1[4]*cq_m2[0] + a_m1[5]*sq_m3[0];
-  const Scalar x3 = c_m0[4] - a_m1[4]*sq_m3[0] + a_m1[5]*cq_m2[0];
-  const Scalar x4 = u_m4[0] - KA_m5[3][KA_m5_col + 0]*lambda_m6[0] - KA_m5[3][KA_m5_col + 1]*lambda_m6[1] - KA_m5[3][KA_m5_col + 2]*lambda_m6[2] - KA_m5[3][KA_m5_col + 3]*lambda_m6[3] - KA_m5[3][KA_m5_col + 4]*lambda_m6[4] - KA_m5[3][KA_m5_col + 5]*lambda_m6[5] - a_m1[0]*IA_m7[0] - IA_m7[5]*x0 - IA_m7[9]*x1 - a_m1[3]*IA_m7[12] - IA_m7[14]*x3;
-  qdd_m8[0] = Dinv_m9*x4;
-  a_m10[0] = a_m1[0];
-  a_m10[1] = x0;
-  a_m10[2] = x1;
-  a_m10[3] = a_m1[3] + qdd_m8[0];
-  a_m10[4] = x2;
-  a_m10[5] = x3;
+// shared_49's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+PROXGEN_RT_NOINLINE void shared_49_x2(Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[7], Scalar (*KA_m5_b)[7], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 0], KA_m5_b[3][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 1], KA_m5_b[3][KA_m5_col_b + 1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 2], KA_m5_b[3][KA_m5_col_b + 2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 3], KA_m5_b[3][KA_m5_col_b + 3])*proxgen_rt::gather2(lambda_m6_a[3], lambda_m6_b[3]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 4], KA_m5_b[3][KA_m5_col_b + 4])*proxgen_rt::gather2(lambda_m6_a[4], lambda_m6_b[4]) - proxgen_rt::gather2(KA_m5_a[3][KA_m5_col_a + 5], KA_m5_b[3][KA_m5_col_b + 5])*proxgen_rt::gather2(lambda_m6_a[5], lambda_m6_b[5]) - proxgen_rt::gather2(a_m1_a[0], a_m1_b[0])*proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0]) - proxgen_rt::gather2(IA_m7_a[5], IA_m7_b[5])*x0 - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x1 - proxgen_rt::gather2(a_m1_a[3], a_m1_b[3])*proxgen_rt::gather2(IA_m7_a[12], IA_m7_b[12]) - proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14])*x3;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x4, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m10_a[5], a_m10_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_thigh, r_thigh.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-PROXGEN_RT_NOINLINE void shared_46(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = 0.9950041652780258*a_m0[0] + 0.09983341664682815*a_m0[2];
-  const Scalar x1 = -0.09983341664682815*a_m0[0] + 0.9950041652780258*a_m0[2];
-  const Scalar x2 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x3 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x4 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x5 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x6 = c_m1[3] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[5] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x4 - IA_m7[5]*a_m0[1] - IA_m7[9]*x5 - IA_m7[12]*x6 - IA_m7[14]*a_m0[4] - IA_m7[15]*x7;
-  qdd_m8[0] = Dinv_m9*x8;
-  a_m10[0] = x4;
-  a_m10[1] = a_m0[1];
-  a_m10[2] = x5;
-  a_m10[3] = x6;
-  a_m10[4] = a_m0[4] + qdd_m8[0];
-  a_m10[5] = x7;
+// shared_50's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_50_p0[16] = {0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_50_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[7], Scalar (*KA_m5_b)[7], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 0], KA_m5_b[4][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 1], KA_m5_b[4][KA_m5_col_b + 1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 2], KA_m5_b[4][KA_m5_col_b + 2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 3], KA_m5_b[4][KA_m5_col_b + 3])*proxgen_rt::gather2(lambda_m6_a[3], lambda_m6_b[3]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 4], KA_m5_b[4][KA_m5_col_b + 4])*proxgen_rt::gather2(lambda_m6_a[4], lambda_m6_b[4]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 5], KA_m5_b[4][KA_m5_col_b + 5])*proxgen_rt::gather2(lambda_m6_a[5], lambda_m6_b[5]) - proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0])*x4 - proxgen_rt::gather2(a_m0_a[1], a_m0_b[1])*proxgen_rt::gather2(IA_m7_a[5], IA_m7_b[5]) - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x5 - proxgen_rt::gather2(IA_m7_a[12], IA_m7_b[12])*x6 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14]) - proxgen_rt::gather2(IA_m7_a[15], IA_m7_b[15])*x7;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x8, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[5], a_m10_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_shank, r_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-PROXGEN_RT_NOINLINE void shared_47(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] - 0.42875*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.42875*a_m0[3];
-  const Scalar x2 = -0.19866933079506124*a_m0[2] + 0.9800665778412416*x0;
-  const Scalar x3 = 0.9800665778412416*a_m0[2] + 0.19866933079506124*x0;
-  const Scalar x4 = 0.9800665778412416*a_m0[3] - 0.19866933079506124*a_m0[5];
-  const Scalar x5 = 0.19866933079506124*a_m0[3] + 0.9800665778412416*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - IA_m7[12]*x8 - IA_m7[14]*a_m0[4] - IA_m7[15]*x9;
-  qdd_m8[0] = Dinv_m9*x10;
-  a_m10[0] = x6;
-  a_m10[1] = x1;
-  a_m10[2] = x7;
-  a_m10[3] = x8;
-  a_m10[4] = a_m0[4] + qdd_m8[0];
-  a_m10[5] = x9;
+// shared_51's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_51_p0[20] = {-0.42875, -0.42875, 0.42875, 0.42875, -0.19866933079506124, -0.19866933079506124, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.9800665778412416, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416, -0.19866933079506124, -0.19866933079506124, 0.19866933079506124, 0.19866933079506124, 0.9800665778412416, 0.9800665778412416};
+PROXGEN_RT_NOINLINE void shared_51_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[7], Scalar (*KA_m5_b)[7], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 0], KA_m5_b[4][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 1], KA_m5_b[4][KA_m5_col_b + 1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 2], KA_m5_b[4][KA_m5_col_b + 2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 3], KA_m5_b[4][KA_m5_col_b + 3])*proxgen_rt::gather2(lambda_m6_a[3], lambda_m6_b[3]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 4], KA_m5_b[4][KA_m5_col_b + 4])*proxgen_rt::gather2(lambda_m6_a[4], lambda_m6_b[4]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 5], KA_m5_b[4][KA_m5_col_b + 5])*proxgen_rt::gather2(lambda_m6_a[5], lambda_m6_b[5]) - proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0])*x6 - proxgen_rt::gather2(IA_m7_a[5], IA_m7_b[5])*x1 - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x7 - proxgen_rt::gather2(IA_m7_a[12], IA_m7_b[12])*x8 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14]) - proxgen_rt::gather2(IA_m7_a[15], IA_m7_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x10, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m10_a[5], a_m10_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_ankle_link, r_ankle_link.
 // The first: accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-PROXGEN_RT_NOINLINE void shared_48(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[7], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] - 0.4305*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.4305*a_m0[3];
-  const Scalar x2 = 0.09983341664682815*a_m0[2] + 0.9950041652780258*x0;
-  const Scalar x3 = 0.9950041652780258*a_m0[2] - 0.09983341664682815*x0;
-  const Scalar x4 = 0.9950041652780258*a_m0[3] + 0.09983341664682815*a_m0[5];
-  const Scalar x5 = -0.09983341664682815*a_m0[3] + 0.9950041652780258*a_m0[5];
-  const Scalar x6 = c_m1[0] + cq_m2[0]*x2 - sq_m3[0]*x3;
-  const Scalar x7 = c_m1[2] + sq_m3[0]*x2 + cq_m2[0]*x3;
-  const Scalar x8 = c_m1[3] + cq_m2[0]*x4 - sq_m3[0]*x5;
-  const Scalar x9 = c_m1[5] + sq_m3[0]*x4 + cq_m2[0]*x5;
-  const Scalar x10 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 1]*lambda_m6[1] - KA_m5[4][KA_m5_col + 3]*lambda_m6[3] - KA_m5[4][KA_m5_col + 4]*lambda_m6[4] - KA_m5[4][KA_m5_col + 5]*lambda_m6[5] - IA_m7[0]*x6 - IA_m7[5]*x1 - IA_m7[9]*x7 - a_m0[4]*IA_m7[14] - IA_m7[15]*x9;
-  qdd_m8[0] = Dinv_m9*x10;
-  a_m10[0] = x6;
-  a_m10[1] = x1;
-  a_m10[2] = x7;
-  a_m10[3] = x8;
-  a_m10[4] = a_m0[4] + qdd_m8[0];
-  a_m10[5] = x9;
+// shared_52's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_52_p0[20] = {-0.4305, -0.4305, 0.4305, 0.4305, 0.09983341664682815, 0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, 0.9950041652780258, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258, 0.09983341664682815, 0.09983341664682815, -0.09983341664682815, -0.09983341664682815, 0.9950041652780258, 0.9950041652780258};
+PROXGEN_RT_NOINLINE void shared_52_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[7], Scalar (*KA_m5_b)[7], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 3)*x0;
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 5)*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x2 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x3;
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x2 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x3;
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x4 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x5;
+  const ScalarPair x9 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x4 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x5;
+  const ScalarPair x10 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 0], KA_m5_b[4][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 1], KA_m5_b[4][KA_m5_col_b + 1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 3], KA_m5_b[4][KA_m5_col_b + 3])*proxgen_rt::gather2(lambda_m6_a[3], lambda_m6_b[3]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 4], KA_m5_b[4][KA_m5_col_b + 4])*proxgen_rt::gather2(lambda_m6_a[4], lambda_m6_b[4]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 5], KA_m5_b[4][KA_m5_col_b + 5])*proxgen_rt::gather2(lambda_m6_a[5], lambda_m6_b[5]) - proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0])*x6 - proxgen_rt::gather2(IA_m7_a[5], IA_m7_b[5])*x1 - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x7 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14]) - proxgen_rt::gather2(IA_m7_a[15], IA_m7_b[15])*x9;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x10, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x6, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x8, a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x9, a_m10_a[5], a_m10_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: l_foot, r_foot.
 // The first: accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-PROXGEN_RT_NOINLINE void shared_49(Scalar* PROXGEN_RT_RESTRICT c_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT a_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
-  const Scalar x0 = c_m0[0] + cq_m1[0]*a_m2[1] + sq_m3[0]*a_m2[2];
-  const Scalar x1 = c_m0[1] - sq_m3[0]*a_m2[1] + cq_m1[0]*a_m2[2];
-  const Scalar x2 = c_m0[3] + cq_m1[0]*a_m2[4] + sq_m3[0]*a_m2[5];
-  const Scalar x3 = c_m0[4] - sq_m3[0]*a_m2[4] + cq_m1[0]*a_m2[5];
-  const Scalar x4 = u_m4[0] - 0.06825*lambda_m5[0] - lambda_m5[2] - 0.00194517348958*a_m2[3] - 0.027912499999999996*x0 - 0.0017863999999999998*x3;
-  qdd_m6[0] = 514.0929615568219*x4;
-  a_m7[0] = a_m2[0];
-  a_m7[1] = x0;
-  a_m7[2] = x1;
-  a_m7[3] = a_m2[3] + qdd_m6[0];
-  a_m7[4] = x2;
-  a_m7[5] = x3;
+// shared_53's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_53_p0[10] = {-0.00194517348958, -0.00194517348958, -0.06825, -0.06825, -0.027912499999999996, -0.027912499999999996, -0.0017863999999999998, -0.0017863999999999998, 514.0929615568219, 514.0929615568219};
+PROXGEN_RT_NOINLINE void shared_53_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* c_m0_a, Scalar* c_m0_b, Scalar* a_m1_a, Scalar* a_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* lambda_m5_a, Scalar* lambda_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar* PROXGEN_RT_RESTRICT a_m7_a, Scalar* PROXGEN_RT_RESTRICT a_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(c_m0_a[0], c_m0_b[0]) + proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(c_m0_a[1], c_m0_b[1]) - proxgen_rt::gather2(a_m1_a[1], a_m1_b[1])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[2], a_m1_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m0_a[3], c_m0_b[3]) + proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m0_a[4], c_m0_b[4]) - proxgen_rt::gather2(a_m1_a[4], a_m1_b[4])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m1_a[5], a_m1_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(lambda_m5_a[0], lambda_m5_b[0]) - proxgen_rt::gather2(lambda_m5_a[2], lambda_m5_b[2]) + proxgen_rt::pair_at(k, 2)*x0 + proxgen_rt::pair_at(k, 3)*x3;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4)*x4, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[0], a_m1_b[0]), a_m7_a[0], a_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x0, a_m7_a[1], a_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m7_a[2], a_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m1_a[3], a_m1_b[3]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m7_a[3], a_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m7_a[4], a_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m7_a[5], a_m7_b[5]);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_pelvis_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
@@ -2256,78 +2462,43 @@ PROXGEN_RT_NOINLINE void kinematics_pelvis_to_l_hip_yaw_link(const Scalar* PROXG
     w.g_l_hip_yaw_link[0] = w.cq[0]*t7 + w.sq[0]*t8;
     w.g_l_hip_yaw_link[1] = -w.sq[0]*t7 + w.cq[0]*t8;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_hip_roll_link_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_0(&q[8], &v[7], &w.sq[1], &w.cq[1], &w.v_l_hip_roll_link[1], w.v_l_hip_yaw_link, &w.c_l_hip_roll_link[1], w.pA_l_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_pelvis[2]);
-  // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_1(&q[9], &v[8], &w.sq[2], &w.cq[2], w.v_l_hip_yaw_link, &w.v_l_hip_roll_link[1], w.v_l_thigh, w.c_l_thigh, w.pA_l_thigh, w.g_l_hip_yaw_link, &w.g_l_hip_roll_link[2], w.g_l_thigh);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_shank_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_2(&q[10], &v[9], &w.sq[3], &w.cq[3], w.v_l_thigh, &w.v_l_hip_roll_link[1], w.v_l_shank, w.c_l_shank, w.pA_l_shank, w.g_l_thigh, w.g_l_shank);
-  // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_3(&q[11], &v[10], &w.sq[4], &w.cq[4], w.v_l_shank, w.v_l_ankle_link, w.c_l_ankle_link, w.pA_l_ankle_link, w.g_l_shank, w.g_l_ankle_link);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_4(&q[12], &v[11], &w.sq[5], &w.cq[5], &w.v_l_foot[1], w.v_l_ankle_link, &w.c_l_foot[1], w.pA_l_foot, &w.g_l_foot[1], &w.g_l_hip_roll_link[1], &w.g_l_ankle_link[2]);
   // body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_joint_called(q[13], w.sq[6], w.cq[6]);
-    const Scalar t0 = v[0] + 0.0875*v[5];
-    const Scalar t1 = v[2] - 0.0875*v[3];
-    const Scalar t2 = -0.08718915247898762*v[1] + 0.9961917745544759*t0;
-    const Scalar t3 = 0.9961917745544759*v[1] + 0.08718915247898762*t0;
-    const Scalar t4 = 0.9961917745544759*v[3] - 0.08718915247898762*v[4];
-    const Scalar t5 = 0.08718915247898762*v[3] + 0.9961917745544759*v[4];
-    w.v_r_hip_yaw_link[0] = w.cq[6]*t2 + w.sq[6]*t3;
-    w.v_r_hip_yaw_link[1] = -w.sq[6]*t2 + w.cq[6]*t3;
-    w.v_r_hip_yaw_link[2] = t1;
-    w.v_r_hip_yaw_link[3] = w.cq[6]*t4 + w.sq[6]*t5;
-    w.v_r_hip_yaw_link[4] = -w.sq[6]*t4 + w.cq[6]*t5;
+    const Scalar t9 = v[0] + 0.0875*v[5];
+    const Scalar t10 = v[2] - 0.0875*v[3];
+    const Scalar t11 = -0.08718915247898762*v[1] + 0.9961917745544759*t9;
+    const Scalar t12 = 0.9961917745544759*v[1] + 0.08718915247898762*t9;
+    const Scalar t13 = 0.9961917745544759*v[3] - 0.08718915247898762*v[4];
+    const Scalar t14 = 0.08718915247898762*v[3] + 0.9961917745544759*v[4];
+    w.v_r_hip_yaw_link[0] = w.cq[6]*t11 + w.sq[6]*t12;
+    w.v_r_hip_yaw_link[1] = -w.sq[6]*t11 + w.cq[6]*t12;
+    w.v_r_hip_yaw_link[2] = t10;
+    w.v_r_hip_yaw_link[3] = w.cq[6]*t13 + w.sq[6]*t14;
+    w.v_r_hip_yaw_link[4] = -w.sq[6]*t13 + w.cq[6]*t14;
     w.v_r_hip_yaw_link[5] = v[5] + v[12];
     w.c_r_hip_yaw_link[0] = v[12]*w.v_r_hip_yaw_link[1];
     w.c_r_hip_yaw_link[1] = -v[12]*w.v_r_hip_yaw_link[0];
     w.c_r_hip_yaw_link[3] = v[12]*w.v_r_hip_yaw_link[4];
     w.c_r_hip_yaw_link[4] = -v[12]*w.v_r_hip_yaw_link[3];
-    const Scalar h6 = 0.5*w.v_r_hip_yaw_link[0] + 0.02*w.v_r_hip_yaw_link[4];
-    const Scalar h7 = 0.5*w.v_r_hip_yaw_link[1] - 0.02*w.v_r_hip_yaw_link[3];
-    const Scalar h8 = -0.02*w.v_r_hip_yaw_link[1] + 0.0013*w.v_r_hip_yaw_link[3];
-    const Scalar h9 = 0.02*w.v_r_hip_yaw_link[0] + 0.0013*w.v_r_hip_yaw_link[4];
-    w.pA_r_hip_yaw_link[0] = 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[4] - w.v_r_hip_yaw_link[5]*h7;
-    w.pA_r_hip_yaw_link[1] = w.v_r_hip_yaw_link[5]*h6 - 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[3];
-    w.pA_r_hip_yaw_link[2] = w.v_r_hip_yaw_link[3]*h7 - w.v_r_hip_yaw_link[4]*h6;
-    w.pA_r_hip_yaw_link[3] = 0.0005*w.v_r_hip_yaw_link[4]*w.v_r_hip_yaw_link[5] - w.v_r_hip_yaw_link[5]*h9 + 0.5*w.v_r_hip_yaw_link[1]*w.v_r_hip_yaw_link[2] - w.v_r_hip_yaw_link[2]*h7;
-    w.pA_r_hip_yaw_link[4] = w.v_r_hip_yaw_link[5]*h8 - 0.0005*w.v_r_hip_yaw_link[3]*w.v_r_hip_yaw_link[5] + w.v_r_hip_yaw_link[2]*h6 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_yaw_link[2];
-    w.pA_r_hip_yaw_link[5] = w.v_r_hip_yaw_link[3]*h9 - w.v_r_hip_yaw_link[4]*h8 + w.v_r_hip_yaw_link[0]*h7 - w.v_r_hip_yaw_link[1]*h6;
-    const Scalar t6 = 0.9961917745544759*w.g_pelvis[0] - 0.08718915247898762*w.g_pelvis[1];
-    const Scalar t7 = 0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
-    w.g_r_hip_yaw_link[0] = w.cq[6]*t6 + w.sq[6]*t7;
-    w.g_r_hip_yaw_link[1] = -w.sq[6]*t6 + w.cq[6]*t7;
+    const Scalar h8 = 0.5*w.v_r_hip_yaw_link[0] + 0.02*w.v_r_hip_yaw_link[4];
+    const Scalar h9 = 0.5*w.v_r_hip_yaw_link[1] - 0.02*w.v_r_hip_yaw_link[3];
+    const Scalar h10 = -0.02*w.v_r_hip_yaw_link[1] + 0.0013*w.v_r_hip_yaw_link[3];
+    const Scalar h11 = 0.02*w.v_r_hip_yaw_link[0] + 0.0013*w.v_r_hip_yaw_link[4];
+    w.pA_r_hip_yaw_link[0] = 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[4] - w.v_r_hip_yaw_link[5]*h9;
+    w.pA_r_hip_yaw_link[1] = w.v_r_hip_yaw_link[5]*h8 - 0.5*w.v_r_hip_yaw_link[2]*w.v_r_hip_yaw_link[3];
+    w.pA_r_hip_yaw_link[2] = w.v_r_hip_yaw_link[3]*h9 - w.v_r_hip_yaw_link[4]*h8;
+    w.pA_r_hip_yaw_link[3] = 0.0005*w.v_r_hip_yaw_link[4]*w.v_r_hip_yaw_link[5] - w.v_r_hip_yaw_link[5]*h11 + 0.5*w.v_r_hip_yaw_link[1]*w.v_r_hip_yaw_link[2] - w.v_r_hip_yaw_link[2]*h9;
+    w.pA_r_hip_yaw_link[4] = w.v_r_hip_yaw_link[5]*h10 - 0.0005*w.v_r_hip_yaw_link[3]*w.v_r_hip_yaw_link[5] + w.v_r_hip_yaw_link[2]*h8 - 0.5*w.v_r_hip_yaw_link[0]*w.v_r_hip_yaw_link[2];
+    w.pA_r_hip_yaw_link[5] = w.v_r_hip_yaw_link[3]*h11 - w.v_r_hip_yaw_link[4]*h10 + w.v_r_hip_yaw_link[0]*h9 - w.v_r_hip_yaw_link[1]*h8;
+    const Scalar t15 = 0.9961917745544759*w.g_pelvis[0] - 0.08718915247898762*w.g_pelvis[1];
+    const Scalar t16 = 0.08718915247898762*w.g_pelvis[0] + 0.9961917745544759*w.g_pelvis[1];
+    w.g_r_hip_yaw_link[0] = w.cq[6]*t15 + w.sq[6]*t16;
+    w.g_r_hip_yaw_link[1] = -w.sq[6]*t15 + w.cq[6]*t16;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_r_hip_roll_link_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_0(&q[14], &v[13], &w.sq[7], &w.cq[7], &w.v_r_hip_roll_link[1], w.v_r_hip_yaw_link, &w.c_r_hip_roll_link[1], w.pA_r_hip_roll_link, &w.g_r_hip_roll_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2]);
-  // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_1(&q[15], &v[14], &w.sq[8], &w.cq[8], w.v_r_hip_yaw_link, &w.v_r_hip_roll_link[1], w.v_r_thigh, w.c_r_thigh, w.pA_r_thigh, w.g_r_hip_yaw_link, &w.g_r_hip_roll_link[2], w.g_r_thigh);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_r_shank_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_2(&q[16], &v[15], &w.sq[9], &w.cq[9], w.v_r_thigh, &w.v_r_hip_roll_link[1], w.v_r_shank, w.c_r_shank, w.pA_r_shank, w.g_r_thigh, w.g_r_shank);
-  // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_3(&q[17], &v[16], &w.sq[10], &w.cq[10], w.v_r_shank, w.v_r_ankle_link, w.c_r_ankle_link, w.pA_r_ankle_link, w.g_r_shank, w.g_r_ankle_link);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_4(&q[18], &v[17], &w.sq[11], &w.cq[11], &w.v_r_foot[1], w.v_r_ankle_link, &w.c_r_foot[1], w.pA_r_foot, &w.g_r_foot[1], &w.g_r_hip_roll_link[1], &w.g_r_ankle_link[2]);
+PROXGEN_RT_NOINLINE void kinematics_abdomen_to_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     proxgen_rt::sincos_joint_called(q[19], w.sq[12], w.cq[12]);
@@ -2342,22 +2513,25 @@ PROXGEN_RT_NOINLINE void kinematics_r_foot_to_abdomen(const Scalar* PROXGEN_RT_R
     w.c_abdomen[1] = -v[18]*w.v_abdomen[0];
     w.c_abdomen[3] = v[18]*w.v_abdomen[4];
     w.c_abdomen[4] = -v[18]*w.v_abdomen[3];
-    const Scalar h6 = 9.73*w.v_abdomen[0] + 0.81732*w.v_abdomen[4];
-    const Scalar h7 = 9.73*w.v_abdomen[1] - 0.81732*w.v_abdomen[3];
-    const Scalar h8 = -0.81732*w.v_abdomen[1] + 0.15987363*w.v_abdomen[3];
-    const Scalar h9 = 0.81732*w.v_abdomen[0] + 0.11933196333330001*w.v_abdomen[4];
-    w.pA_abdomen[0] = 9.73*v[2]*w.v_abdomen[4] - w.v_abdomen[5]*h7;
-    w.pA_abdomen[1] = w.v_abdomen[5]*h6 - 9.73*v[2]*w.v_abdomen[3];
-    w.pA_abdomen[2] = w.v_abdomen[3]*h7 - w.v_abdomen[4]*h6;
-    w.pA_abdomen[3] = 0.105408333333*w.v_abdomen[4]*w.v_abdomen[5] - w.v_abdomen[5]*h9 + 9.73*v[2]*w.v_abdomen[1] - v[2]*h7;
-    w.pA_abdomen[4] = w.v_abdomen[5]*h8 - 0.105408333333*w.v_abdomen[3]*w.v_abdomen[5] + v[2]*h6 - 9.73*v[2]*w.v_abdomen[0];
-    w.pA_abdomen[5] = w.v_abdomen[3]*h9 - w.v_abdomen[4]*h8 + w.v_abdomen[0]*h7 - w.v_abdomen[1]*h6;
+    const Scalar h0 = 9.73*w.v_abdomen[0] + 0.81732*w.v_abdomen[4];
+    const Scalar h1 = 9.73*w.v_abdomen[1] - 0.81732*w.v_abdomen[3];
+    const Scalar h2 = -0.81732*w.v_abdomen[1] + 0.15987363*w.v_abdomen[3];
+    const Scalar h3 = 0.81732*w.v_abdomen[0] + 0.11933196333330001*w.v_abdomen[4];
+    w.pA_abdomen[0] = 9.73*v[2]*w.v_abdomen[4] - w.v_abdomen[5]*h1;
+    w.pA_abdomen[1] = w.v_abdomen[5]*h0 - 9.73*v[2]*w.v_abdomen[3];
+    w.pA_abdomen[2] = w.v_abdomen[3]*h1 - w.v_abdomen[4]*h0;
+    w.pA_abdomen[3] = 0.105408333333*w.v_abdomen[4]*w.v_abdomen[5] - w.v_abdomen[5]*h3 + 9.73*v[2]*w.v_abdomen[1] - v[2]*h1;
+    w.pA_abdomen[4] = w.v_abdomen[5]*h2 - 0.105408333333*w.v_abdomen[3]*w.v_abdomen[5] + v[2]*h0 - 9.73*v[2]*w.v_abdomen[0];
+    w.pA_abdomen[5] = w.v_abdomen[3]*h3 - w.v_abdomen[4]*h2 + w.v_abdomen[0]*h1 - w.v_abdomen[1]*h0;
     w.g_abdomen[0] = w.g_pelvis[0]*w.cq[12] + w.g_pelvis[1]*w.sq[12];
     w.g_abdomen[1] = -w.g_pelvis[0]*w.sq[12] + w.g_pelvis[1]*w.cq[12];
   }
+  // body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  // body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  shared_0_x2(shared_0_p0, &q[8], &q[14], &v[7], &v[13], &w.sq[1], &w.sq[7], &w.cq[1], &w.cq[7], &w.v_l_hip_roll_link[1], &w.v_r_hip_roll_link[1], w.v_l_hip_yaw_link, w.v_r_hip_yaw_link, &w.c_l_hip_roll_link[1], &w.c_r_hip_roll_link[1], w.pA_l_hip_roll_link, w.pA_r_hip_roll_link, &w.g_l_hip_roll_link[1], &w.g_r_hip_roll_link[1], &w.g_l_hip_yaw_link[1], &w.g_r_hip_yaw_link[1], &w.g_pelvis[2], &w.g_pelvis[2]);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_chest_to_r_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     proxgen_rt::sincos_joint_called(q[20], w.sq[13], w.cq[13]);
@@ -2386,206 +2560,50 @@ PROXGEN_RT_NOINLINE void kinematics_chest_to_l_shoulder_pitch_link(const Scalar*
     w.g_chest[0] = w.g_abdomen[0]*w.cq[13] - w.g_pelvis[2]*w.sq[13];
     w.g_chest[2] = w.g_abdomen[0]*w.sq[13] + w.g_pelvis[2]*w.cq[13];
   }
+  // body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  // body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  shared_1_x2(shared_1_p0, &q[9], &q[15], &v[8], &v[14], &w.sq[2], &w.sq[8], &w.cq[2], &w.cq[8], w.v_l_hip_yaw_link, w.v_r_hip_yaw_link, &w.v_l_hip_roll_link[1], &w.v_r_hip_roll_link[1], w.v_l_thigh, w.v_r_thigh, w.c_l_thigh, w.c_r_thigh, w.pA_l_thigh, w.pA_r_thigh, w.g_l_hip_yaw_link, w.g_r_hip_yaw_link, &w.g_l_hip_roll_link[2], &w.g_r_hip_roll_link[2], w.g_l_thigh, w.g_r_thigh);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_l_shoulder_pitch_link_to_neck_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
   {
     proxgen_rt::sincos_joint_called(q[21], w.sq[14], w.cq[14]);
-    const Scalar t2 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
-    const Scalar t3 = w.v_chest[1] - 0.254*w.v_chest[3];
-    const Scalar t4 = w.v_chest[2] + 0.19*w.v_chest[3];
-    const Scalar t5 = 0.9848134698792882*t2 + 0.17361575258114187*t4;
-    const Scalar t6 = -0.04493516596384369*t2 + 0.9659256678396477*t3 + 0.2548890642384102*t4;
-    const Scalar t7 = -0.1676999117594225*t2 - 0.2588196364430848*t3 + 0.9512566085906322*t4;
-    const Scalar t8 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
-    const Scalar t9 = -0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] + 0.2548890642384102*w.v_chest[5];
-    const Scalar t10 = -0.1676999117594225*w.v_chest[3] - 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
-    w.v_l_shoulder_pitch_link[0] = w.cq[14]*t5 - w.sq[14]*t7;
-    w.v_l_shoulder_pitch_link[1] = t6;
-    w.v_l_shoulder_pitch_link[2] = w.sq[14]*t5 + w.cq[14]*t7;
-    w.v_l_shoulder_pitch_link[3] = w.cq[14]*t8 - w.sq[14]*t10;
-    w.v_l_shoulder_pitch_link[4] = v[20] + t9;
-    w.v_l_shoulder_pitch_link[5] = w.sq[14]*t8 + w.cq[14]*t10;
+    const Scalar t0 = w.v_chest[0] + 0.254*w.v_chest[4] - 0.19*w.v_chest[5];
+    const Scalar t1 = w.v_chest[1] - 0.254*w.v_chest[3];
+    const Scalar t2 = w.v_chest[2] + 0.19*w.v_chest[3];
+    const Scalar t3 = 0.9848134698792882*t0 + 0.17361575258114187*t2;
+    const Scalar t4 = -0.04493516596384369*t0 + 0.9659256678396477*t1 + 0.2548890642384102*t2;
+    const Scalar t5 = -0.1676999117594225*t0 - 0.2588196364430848*t1 + 0.9512566085906322*t2;
+    const Scalar t6 = 0.9848134698792882*w.v_chest[3] + 0.17361575258114187*w.v_chest[5];
+    const Scalar t7 = -0.04493516596384369*w.v_chest[3] + 0.9659256678396477*w.v_chest[4] + 0.2548890642384102*w.v_chest[5];
+    const Scalar t8 = -0.1676999117594225*w.v_chest[3] - 0.2588196364430848*w.v_chest[4] + 0.9512566085906322*w.v_chest[5];
+    w.v_l_shoulder_pitch_link[0] = w.cq[14]*t3 - w.sq[14]*t5;
+    w.v_l_shoulder_pitch_link[1] = t4;
+    w.v_l_shoulder_pitch_link[2] = w.sq[14]*t3 + w.cq[14]*t5;
+    w.v_l_shoulder_pitch_link[3] = w.cq[14]*t6 - w.sq[14]*t8;
+    w.v_l_shoulder_pitch_link[4] = v[20] + t7;
+    w.v_l_shoulder_pitch_link[5] = w.sq[14]*t6 + w.cq[14]*t8;
     w.c_l_shoulder_pitch_link[0] = -v[20]*w.v_l_shoulder_pitch_link[2];
     w.c_l_shoulder_pitch_link[2] = v[20]*w.v_l_shoulder_pitch_link[0];
     w.c_l_shoulder_pitch_link[3] = -v[20]*w.v_l_shoulder_pitch_link[5];
     w.c_l_shoulder_pitch_link[5] = v[20]*w.v_l_shoulder_pitch_link[3];
-    const Scalar h4 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_pitch_link[5];
-    const Scalar h5 = 0.3*w.v_l_shoulder_pitch_link[2] + 0.009*w.v_l_shoulder_pitch_link[3];
-    const Scalar h6 = 0.009*w.v_l_shoulder_pitch_link[2] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[3];
-    const Scalar h7 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[5];
-    w.pA_l_shoulder_pitch_link[0] = w.v_l_shoulder_pitch_link[4]*h5 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[5];
-    w.pA_l_shoulder_pitch_link[1] = w.v_l_shoulder_pitch_link[5]*h4 - w.v_l_shoulder_pitch_link[3]*h5;
-    w.pA_l_shoulder_pitch_link[2] = 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[3] - w.v_l_shoulder_pitch_link[4]*h4;
-    w.pA_l_shoulder_pitch_link[3] = w.v_l_shoulder_pitch_link[4]*h7 - 0.000192*w.v_l_shoulder_pitch_link[4]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[1]*h5 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[2];
-    w.pA_l_shoulder_pitch_link[4] = w.v_l_shoulder_pitch_link[5]*h6 - w.v_l_shoulder_pitch_link[3]*h7 + w.v_l_shoulder_pitch_link[2]*h4 - w.v_l_shoulder_pitch_link[0]*h5;
-    w.pA_l_shoulder_pitch_link[5] = 0.000192*w.v_l_shoulder_pitch_link[3]*w.v_l_shoulder_pitch_link[4] - w.v_l_shoulder_pitch_link[4]*h6 + 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_pitch_link[1] - w.v_l_shoulder_pitch_link[1]*h4;
+    const Scalar h0 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_pitch_link[5];
+    const Scalar h1 = 0.3*w.v_l_shoulder_pitch_link[2] + 0.009*w.v_l_shoulder_pitch_link[3];
+    const Scalar h2 = 0.009*w.v_l_shoulder_pitch_link[2] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[3];
+    const Scalar h3 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_pitch_link[5];
+    w.pA_l_shoulder_pitch_link[0] = w.v_l_shoulder_pitch_link[4]*h1 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[5];
+    w.pA_l_shoulder_pitch_link[1] = w.v_l_shoulder_pitch_link[5]*h0 - w.v_l_shoulder_pitch_link[3]*h1;
+    w.pA_l_shoulder_pitch_link[2] = 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[3] - w.v_l_shoulder_pitch_link[4]*h0;
+    w.pA_l_shoulder_pitch_link[3] = w.v_l_shoulder_pitch_link[4]*h3 - 0.000192*w.v_l_shoulder_pitch_link[4]*w.v_l_shoulder_pitch_link[5] + w.v_l_shoulder_pitch_link[1]*h1 - 0.3*w.v_l_shoulder_pitch_link[1]*w.v_l_shoulder_pitch_link[2];
+    w.pA_l_shoulder_pitch_link[4] = w.v_l_shoulder_pitch_link[5]*h2 - w.v_l_shoulder_pitch_link[3]*h3 + w.v_l_shoulder_pitch_link[2]*h0 - w.v_l_shoulder_pitch_link[0]*h1;
+    w.pA_l_shoulder_pitch_link[5] = 0.000192*w.v_l_shoulder_pitch_link[3]*w.v_l_shoulder_pitch_link[4] - w.v_l_shoulder_pitch_link[4]*h2 + 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_pitch_link[1] - w.v_l_shoulder_pitch_link[1]*h0;
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_l_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[22], w.sq[15], w.cq[15]);
-    w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq[15] + w.v_l_shoulder_pitch_link[2]*w.sq[15];
-    w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq[15] + w.v_l_shoulder_pitch_link[2]*w.cq[15];
-    w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
-    w.v_l_shoulder_roll_link[4] = w.v_l_shoulder_pitch_link[4]*w.cq[15] + w.v_l_shoulder_pitch_link[5]*w.sq[15];
-    w.v_l_shoulder_roll_link[5] = -w.v_l_shoulder_pitch_link[4]*w.sq[15] + w.v_l_shoulder_pitch_link[5]*w.cq[15];
-    w.c_l_shoulder_roll_link[1] = v[21]*w.v_l_shoulder_roll_link[2];
-    w.c_l_shoulder_roll_link[2] = -v[21]*w.v_l_shoulder_roll_link[1];
-    w.c_l_shoulder_roll_link[4] = v[21]*w.v_l_shoulder_roll_link[5];
-    w.c_l_shoulder_roll_link[5] = -v[21]*w.v_l_shoulder_roll_link[4];
-    const Scalar h0 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_roll_link[4];
-    const Scalar h1 = 0.3*w.v_l_shoulder_roll_link[1] + 0.009*w.v_l_shoulder_roll_link[3];
-    const Scalar h2 = 0.009*w.v_l_shoulder_roll_link[1] + 0.00046199999999999995*w.v_l_shoulder_roll_link[3];
-    const Scalar h3 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_roll_link[4];
-    w.pA_l_shoulder_roll_link[0] = 0.3*w.v_l_shoulder_roll_link[2]*w.v_l_shoulder_roll_link[4] - w.v_l_shoulder_roll_link[5]*h1;
-    w.pA_l_shoulder_roll_link[1] = w.v_l_shoulder_roll_link[5]*h0 - 0.3*w.v_l_shoulder_roll_link[2]*w.v_l_shoulder_roll_link[3];
-    w.pA_l_shoulder_roll_link[2] = w.v_l_shoulder_roll_link[3]*h1 - w.v_l_shoulder_roll_link[4]*h0;
-    w.pA_l_shoulder_roll_link[3] = 0.000192*w.v_l_shoulder_roll_link[4]*w.v_l_shoulder_roll_link[5] - w.v_l_shoulder_roll_link[5]*h3 + 0.3*w.v_l_shoulder_roll_link[1]*w.v_l_shoulder_roll_link[2] - w.v_l_shoulder_roll_link[2]*h1;
-    w.pA_l_shoulder_roll_link[4] = w.v_l_shoulder_roll_link[5]*h2 - 0.000192*w.v_l_shoulder_roll_link[3]*w.v_l_shoulder_roll_link[5] + w.v_l_shoulder_roll_link[2]*h0 - 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_roll_link[2];
-    w.pA_l_shoulder_roll_link[5] = w.v_l_shoulder_roll_link[3]*h3 - w.v_l_shoulder_roll_link[4]*h2 + w.v_l_shoulder_pitch_link[0]*h1 - w.v_l_shoulder_roll_link[1]*h0;
-  }
-  // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[23], w.sq[16], w.cq[16]);
-    w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq[16] + w.v_l_shoulder_roll_link[1]*w.sq[16];
-    w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq[16] + w.v_l_shoulder_roll_link[1]*w.cq[16];
-    w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq[16] + w.v_l_shoulder_roll_link[4]*w.sq[16];
-    w.v_l_upper_arm[4] = -w.v_l_shoulder_roll_link[3]*w.sq[16] + w.v_l_shoulder_roll_link[4]*w.cq[16];
-    w.v_l_upper_arm[5] = w.v_l_shoulder_roll_link[5] + v[22];
-    w.c_l_upper_arm[0] = v[22]*w.v_l_upper_arm[1];
-    w.c_l_upper_arm[1] = -v[22]*w.v_l_upper_arm[0];
-    w.c_l_upper_arm[3] = v[22]*w.v_l_upper_arm[4];
-    w.c_l_upper_arm[4] = -v[22]*w.v_l_upper_arm[3];
-    const Scalar h4 = 1.96*w.v_l_upper_arm[0] - 0.27815927999999995*w.v_l_upper_arm[4];
-    const Scalar h5 = 1.96*w.v_l_upper_arm[1] + 0.27815927999999995*w.v_l_upper_arm[3];
-    const Scalar h6 = 0.27815927999999995*w.v_l_upper_arm[1] + 0.061007086312239986*w.v_l_upper_arm[3];
-    const Scalar h7 = -0.27815927999999995*w.v_l_upper_arm[0] + 0.061007086312239986*w.v_l_upper_arm[4];
-    w.pA_l_upper_arm[0] = 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[4] - w.v_l_upper_arm[5]*h5;
-    w.pA_l_upper_arm[1] = w.v_l_upper_arm[5]*h4 - 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[3];
-    w.pA_l_upper_arm[2] = w.v_l_upper_arm[3]*h5 - w.v_l_upper_arm[4]*h4;
-    w.pA_l_upper_arm[3] = 0.0019845*w.v_l_upper_arm[4]*w.v_l_upper_arm[5] - w.v_l_upper_arm[5]*h7 + 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[1] - w.v_l_shoulder_roll_link[2]*h5;
-    w.pA_l_upper_arm[4] = w.v_l_upper_arm[5]*h6 - 0.0019845*w.v_l_upper_arm[3]*w.v_l_upper_arm[5] + w.v_l_shoulder_roll_link[2]*h4 - 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[0];
-    w.pA_l_upper_arm[5] = w.v_l_upper_arm[3]*h7 - w.v_l_upper_arm[4]*h6 + w.v_l_upper_arm[0]*h5 - w.v_l_upper_arm[1]*h4;
-  }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_l_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[24], w.sq[17], w.cq[17]);
-    const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
-    const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
-    const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
-    const Scalar t3 = 0.955336489125606*w.v_l_shoulder_roll_link[2] - 0.29552020666133966*t0;
-    const Scalar t4 = 0.955336489125606*w.v_l_upper_arm[3] + 0.29552020666133966*w.v_l_upper_arm[5];
-    const Scalar t5 = -0.29552020666133966*w.v_l_upper_arm[3] + 0.955336489125606*w.v_l_upper_arm[5];
-    w.v_l_forearm[0] = w.cq[17]*t2 - w.sq[17]*t3;
-    w.v_l_forearm[1] = t1;
-    w.v_l_forearm[2] = w.sq[17]*t2 + w.cq[17]*t3;
-    w.v_l_forearm[3] = w.cq[17]*t4 - w.sq[17]*t5;
-    w.v_l_forearm[4] = w.v_l_upper_arm[4] + v[23];
-    w.v_l_forearm[5] = w.sq[17]*t4 + w.cq[17]*t5;
-    w.c_l_forearm[0] = -v[23]*w.v_l_forearm[2];
-    w.c_l_forearm[2] = v[23]*w.v_l_forearm[0];
-    w.c_l_forearm[3] = -v[23]*w.v_l_forearm[5];
-    w.c_l_forearm[5] = v[23]*w.v_l_forearm[3];
-    const Scalar h0 = 0.92*w.v_l_forearm[0] - 0.10107580000000001*w.v_l_forearm[4];
-    const Scalar h1 = 0.92*w.v_l_forearm[1] + 0.10107580000000001*w.v_l_forearm[3];
-    const Scalar h2 = 0.10107580000000001*w.v_l_forearm[1] + 0.01661854208147*w.v_l_forearm[3];
-    const Scalar h3 = -0.10107580000000001*w.v_l_forearm[0] + 0.01661854208147*w.v_l_forearm[4];
-    w.pA_l_forearm[0] = 0.92*w.v_l_forearm[2]*w.v_l_forearm[4] - w.v_l_forearm[5]*h1;
-    w.pA_l_forearm[1] = w.v_l_forearm[5]*h0 - 0.92*w.v_l_forearm[2]*w.v_l_forearm[3];
-    w.pA_l_forearm[2] = w.v_l_forearm[3]*h1 - w.v_l_forearm[4]*h0;
-    w.pA_l_forearm[3] = 0.0005635*w.v_l_forearm[4]*w.v_l_forearm[5] - w.v_l_forearm[5]*h3 + 0.92*w.v_l_forearm[1]*w.v_l_forearm[2] - w.v_l_forearm[2]*h1;
-    w.pA_l_forearm[4] = w.v_l_forearm[5]*h2 - 0.0005635*w.v_l_forearm[3]*w.v_l_forearm[5] + w.v_l_forearm[2]*h0 - 0.92*w.v_l_forearm[0]*w.v_l_forearm[2];
-    w.pA_l_forearm[5] = w.v_l_forearm[3]*h3 - w.v_l_forearm[4]*h2 + w.v_l_forearm[0]*h1 - w.v_l_forearm[1]*h0;
-  }
-  // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_5(shared_5_k0, &q[25], &v[24], &w.sq[18], &w.cq[18], w.v_l_forearm, w.v_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.pA_l_wrist_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_l_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[26], w.sq[19], w.cq[19]);
-    w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq[19] - w.v_l_forearm[2]*w.sq[19];
-    w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq[19] + w.v_l_forearm[2]*w.cq[19];
-    w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq[19] - w.v_l_wrist_yaw_link[5]*w.sq[19];
-    w.v_l_wrist_pitch_link[4] = w.v_l_wrist_yaw_link[4] + v[25];
-    w.v_l_wrist_pitch_link[5] = w.v_l_wrist_yaw_link[3]*w.sq[19] + w.v_l_wrist_yaw_link[5]*w.cq[19];
-    w.c_l_wrist_pitch_link[0] = -v[25]*w.v_l_wrist_pitch_link[2];
-    w.c_l_wrist_pitch_link[2] = v[25]*w.v_l_wrist_pitch_link[0];
-    w.c_l_wrist_pitch_link[3] = -v[25]*w.v_l_wrist_pitch_link[5];
-    w.c_l_wrist_pitch_link[5] = v[25]*w.v_l_wrist_pitch_link[3];
-    const Scalar h0 = 0.1*w.v_l_wrist_pitch_link[0] - 0.001*w.v_l_wrist_pitch_link[4];
-    const Scalar h1 = 0.1*w.v_l_wrist_yaw_link[1] + 0.001*w.v_l_wrist_pitch_link[3];
-    const Scalar h2 = 0.001*w.v_l_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_l_wrist_pitch_link[3];
-    const Scalar h3 = -0.001*w.v_l_wrist_pitch_link[0] + 3.5000000000000004e-05*w.v_l_wrist_pitch_link[4];
-    w.pA_l_wrist_pitch_link[0] = 0.1*w.v_l_wrist_pitch_link[2]*w.v_l_wrist_pitch_link[4] - w.v_l_wrist_pitch_link[5]*h1;
-    w.pA_l_wrist_pitch_link[1] = w.v_l_wrist_pitch_link[5]*h0 - 0.1*w.v_l_wrist_pitch_link[2]*w.v_l_wrist_pitch_link[3];
-    w.pA_l_wrist_pitch_link[2] = w.v_l_wrist_pitch_link[3]*h1 - w.v_l_wrist_pitch_link[4]*h0;
-    w.pA_l_wrist_pitch_link[3] = 2.5e-05*w.v_l_wrist_pitch_link[4]*w.v_l_wrist_pitch_link[5] - w.v_l_wrist_pitch_link[5]*h3 + 0.1*w.v_l_wrist_yaw_link[1]*w.v_l_wrist_pitch_link[2] - w.v_l_wrist_pitch_link[2]*h1;
-    w.pA_l_wrist_pitch_link[4] = w.v_l_wrist_pitch_link[5]*h2 - 2.5e-05*w.v_l_wrist_pitch_link[3]*w.v_l_wrist_pitch_link[5] + w.v_l_wrist_pitch_link[2]*h0 - 0.1*w.v_l_wrist_pitch_link[0]*w.v_l_wrist_pitch_link[2];
-    w.pA_l_wrist_pitch_link[5] = w.v_l_wrist_pitch_link[3]*h3 - w.v_l_wrist_pitch_link[4]*h2 + w.v_l_wrist_pitch_link[0]*h1 - w.v_l_wrist_yaw_link[1]*h0;
-  }
-  // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[27], w.sq[20], w.cq[20]);
-    w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq[20] + w.v_l_wrist_pitch_link[2]*w.sq[20];
-    w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq[20] + w.v_l_wrist_pitch_link[2]*w.cq[20];
-    w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
-    w.v_l_hand[4] = w.v_l_wrist_pitch_link[4]*w.cq[20] + w.v_l_wrist_pitch_link[5]*w.sq[20];
-    w.v_l_hand[5] = -w.v_l_wrist_pitch_link[4]*w.sq[20] + w.v_l_wrist_pitch_link[5]*w.cq[20];
-    w.c_l_hand[1] = v[26]*w.v_l_hand[2];
-    w.c_l_hand[2] = -v[26]*w.v_l_hand[1];
-    w.c_l_hand[4] = v[26]*w.v_l_hand[5];
-    w.c_l_hand[5] = -v[26]*w.v_l_hand[4];
-    const Scalar h4 = 0.42*w.v_l_wrist_pitch_link[0] - 0.04016628*w.v_l_hand[4];
-    const Scalar h5 = 0.42*w.v_l_hand[1] + 0.04016628*w.v_l_hand[3];
-    const Scalar h6 = 0.04016628*w.v_l_hand[1] + 0.005164645770899999*w.v_l_hand[3];
-    const Scalar h7 = -0.04016628*w.v_l_wrist_pitch_link[0] + 0.005164645770899999*w.v_l_hand[4];
-    w.pA_l_hand[0] = 0.42*w.v_l_hand[2]*w.v_l_hand[4] - w.v_l_hand[5]*h5;
-    w.pA_l_hand[1] = w.v_l_hand[5]*h4 - 0.42*w.v_l_hand[2]*w.v_l_hand[3];
-    w.pA_l_hand[2] = w.v_l_hand[3]*h5 - w.v_l_hand[4]*h4;
-    w.pA_l_hand[3] = 0.000284375*w.v_l_hand[4]*w.v_l_hand[5] - w.v_l_hand[5]*h7 + 0.42*w.v_l_hand[1]*w.v_l_hand[2] - w.v_l_hand[2]*h5;
-    w.pA_l_hand[4] = w.v_l_hand[5]*h6 - 0.000284375*w.v_l_hand[3]*w.v_l_hand[5] + w.v_l_hand[2]*h4 - 0.42*w.v_l_wrist_pitch_link[0]*w.v_l_hand[2];
-    w.pA_l_hand[5] = w.v_l_hand[3]*h7 - w.v_l_hand[4]*h6 + w.v_l_wrist_pitch_link[0]*h5 - w.v_l_hand[1]*h4;
-  }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_neck_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
-  shared_5(shared_5_k1, &q[28], &v[27], &w.sq[21], &w.cq[21], w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
-  // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
-  {
-    proxgen_rt::sincos_joint_called(q[29], w.sq[22], w.cq[22]);
-    const Scalar t2 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
-    const Scalar t3 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
-    w.v_head[0] = w.cq[22]*t2 - w.v_chest[2]*w.sq[22];
-    w.v_head[1] = t3;
-    w.v_head[2] = w.sq[22]*t2 + w.v_chest[2]*w.cq[22];
-    w.v_head[3] = w.v_neck_link[3]*w.cq[22] - w.v_neck_link[5]*w.sq[22];
-    w.v_head[4] = w.v_neck_link[4] + v[28];
-    w.v_head[5] = w.v_neck_link[3]*w.sq[22] + w.v_neck_link[5]*w.cq[22];
-    w.c_head[0] = -v[28]*w.v_head[2];
-    w.c_head[2] = v[28]*w.v_head[0];
-    w.c_head[3] = -v[28]*w.v_head[5];
-    w.c_head[5] = v[28]*w.v_head[3];
-    const Scalar h4 = 5.17*w.v_head[0] + 0.4717625*w.v_head[4];
-    const Scalar h5 = 5.17*w.v_head[1] - 0.4717625*w.v_head[3];
-    const Scalar h6 = -0.4717625*w.v_head[1] + 0.07202788281129999*w.v_head[3];
-    const Scalar h7 = 0.4717625*w.v_head[0] + 0.07202788281129999*w.v_head[4];
-    w.pA_head[0] = 5.17*w.v_head[2]*w.v_head[4] - w.v_head[5]*h5;
-    w.pA_head[1] = w.v_head[5]*h4 - 5.17*w.v_head[2]*w.v_head[3];
-    w.pA_head[2] = w.v_head[3]*h5 - w.v_head[4]*h4;
-    w.pA_head[3] = 0.0167508*w.v_head[4]*w.v_head[5] - w.v_head[5]*h7 + 5.17*w.v_head[1]*w.v_head[2] - w.v_head[2]*h5;
-    w.pA_head[4] = w.v_head[5]*h6 - 0.0167508*w.v_head[3]*w.v_head[5] + w.v_head[2]*h4 - 5.17*w.v_head[0]*w.v_head[2];
-    w.pA_head[5] = w.v_head[3]*h7 - w.v_head[4]*h6 + w.v_head[0]*h5 - w.v_head[1]*h4;
-  }
+  shared_2(shared_2_k0, &q[28], &v[27], &w.sq[21], &w.cq[21], w.v_chest, w.v_neck_link, w.c_neck_link, w.pA_neck_link);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
     proxgen_rt::sincos_joint_called(q[30], w.sq[23], w.cq[23]);
@@ -2625,6 +2643,64 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
     w.g_r_shoulder_pitch_link[1] = t10;
     w.g_r_shoulder_pitch_link[2] = w.sq[23]*t9 + w.cq[23]*t11;
   }
+  // body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  // body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  shared_3_x2(shared_3_p0, &q[10], &q[16], &v[9], &v[15], &w.sq[3], &w.sq[9], &w.cq[3], &w.cq[9], w.v_l_thigh, w.v_r_thigh, &w.v_l_hip_roll_link[1], &w.v_r_hip_roll_link[1], w.v_l_shank, w.v_r_shank, w.c_l_shank, w.c_r_shank, w.pA_l_shank, w.pA_r_shank, w.g_l_thigh, w.g_r_thigh, w.g_l_shank, w.g_r_shank);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_l_shoulder_roll_link_to_head(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[22], w.sq[15], w.cq[15]);
+    w.v_l_shoulder_roll_link[1] = w.v_l_shoulder_pitch_link[1]*w.cq[15] + w.v_l_shoulder_pitch_link[2]*w.sq[15];
+    w.v_l_shoulder_roll_link[2] = -w.v_l_shoulder_pitch_link[1]*w.sq[15] + w.v_l_shoulder_pitch_link[2]*w.cq[15];
+    w.v_l_shoulder_roll_link[3] = w.v_l_shoulder_pitch_link[3] + v[21];
+    w.v_l_shoulder_roll_link[4] = w.v_l_shoulder_pitch_link[4]*w.cq[15] + w.v_l_shoulder_pitch_link[5]*w.sq[15];
+    w.v_l_shoulder_roll_link[5] = -w.v_l_shoulder_pitch_link[4]*w.sq[15] + w.v_l_shoulder_pitch_link[5]*w.cq[15];
+    w.c_l_shoulder_roll_link[1] = v[21]*w.v_l_shoulder_roll_link[2];
+    w.c_l_shoulder_roll_link[2] = -v[21]*w.v_l_shoulder_roll_link[1];
+    w.c_l_shoulder_roll_link[4] = v[21]*w.v_l_shoulder_roll_link[5];
+    w.c_l_shoulder_roll_link[5] = -v[21]*w.v_l_shoulder_roll_link[4];
+    const Scalar h0 = 0.3*w.v_l_shoulder_pitch_link[0] - 0.009*w.v_l_shoulder_roll_link[4];
+    const Scalar h1 = 0.3*w.v_l_shoulder_roll_link[1] + 0.009*w.v_l_shoulder_roll_link[3];
+    const Scalar h2 = 0.009*w.v_l_shoulder_roll_link[1] + 0.00046199999999999995*w.v_l_shoulder_roll_link[3];
+    const Scalar h3 = -0.009*w.v_l_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_l_shoulder_roll_link[4];
+    w.pA_l_shoulder_roll_link[0] = 0.3*w.v_l_shoulder_roll_link[2]*w.v_l_shoulder_roll_link[4] - w.v_l_shoulder_roll_link[5]*h1;
+    w.pA_l_shoulder_roll_link[1] = w.v_l_shoulder_roll_link[5]*h0 - 0.3*w.v_l_shoulder_roll_link[2]*w.v_l_shoulder_roll_link[3];
+    w.pA_l_shoulder_roll_link[2] = w.v_l_shoulder_roll_link[3]*h1 - w.v_l_shoulder_roll_link[4]*h0;
+    w.pA_l_shoulder_roll_link[3] = 0.000192*w.v_l_shoulder_roll_link[4]*w.v_l_shoulder_roll_link[5] - w.v_l_shoulder_roll_link[5]*h3 + 0.3*w.v_l_shoulder_roll_link[1]*w.v_l_shoulder_roll_link[2] - w.v_l_shoulder_roll_link[2]*h1;
+    w.pA_l_shoulder_roll_link[4] = w.v_l_shoulder_roll_link[5]*h2 - 0.000192*w.v_l_shoulder_roll_link[3]*w.v_l_shoulder_roll_link[5] + w.v_l_shoulder_roll_link[2]*h0 - 0.3*w.v_l_shoulder_pitch_link[0]*w.v_l_shoulder_roll_link[2];
+    w.pA_l_shoulder_roll_link[5] = w.v_l_shoulder_roll_link[3]*h3 - w.v_l_shoulder_roll_link[4]*h2 + w.v_l_shoulder_pitch_link[0]*h1 - w.v_l_shoulder_roll_link[1]*h0;
+  }
+  // body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[29], w.sq[22], w.cq[22]);
+    const Scalar t0 = w.v_neck_link[0] + 0.06*w.v_neck_link[4];
+    const Scalar t1 = w.v_neck_link[1] - 0.06*w.v_neck_link[3];
+    w.v_head[0] = w.cq[22]*t0 - w.v_chest[2]*w.sq[22];
+    w.v_head[1] = t1;
+    w.v_head[2] = w.sq[22]*t0 + w.v_chest[2]*w.cq[22];
+    w.v_head[3] = w.v_neck_link[3]*w.cq[22] - w.v_neck_link[5]*w.sq[22];
+    w.v_head[4] = w.v_neck_link[4] + v[28];
+    w.v_head[5] = w.v_neck_link[3]*w.sq[22] + w.v_neck_link[5]*w.cq[22];
+    w.c_head[0] = -v[28]*w.v_head[2];
+    w.c_head[2] = v[28]*w.v_head[0];
+    w.c_head[3] = -v[28]*w.v_head[5];
+    w.c_head[5] = v[28]*w.v_head[3];
+    const Scalar h4 = 5.17*w.v_head[0] + 0.4717625*w.v_head[4];
+    const Scalar h5 = 5.17*w.v_head[1] - 0.4717625*w.v_head[3];
+    const Scalar h6 = -0.4717625*w.v_head[1] + 0.07202788281129999*w.v_head[3];
+    const Scalar h7 = 0.4717625*w.v_head[0] + 0.07202788281129999*w.v_head[4];
+    w.pA_head[0] = 5.17*w.v_head[2]*w.v_head[4] - w.v_head[5]*h5;
+    w.pA_head[1] = w.v_head[5]*h4 - 5.17*w.v_head[2]*w.v_head[3];
+    w.pA_head[2] = w.v_head[3]*h5 - w.v_head[4]*h4;
+    w.pA_head[3] = 0.0167508*w.v_head[4]*w.v_head[5] - w.v_head[5]*h7 + 5.17*w.v_head[1]*w.v_head[2] - w.v_head[2]*h5;
+    w.pA_head[4] = w.v_head[5]*h6 - 0.0167508*w.v_head[3]*w.v_head[5] + w.v_head[2]*h4 - 5.17*w.v_head[0]*w.v_head[2];
+    w.pA_head[5] = w.v_head[3]*h7 - w.v_head[4]*h6 + w.v_head[0]*h5 - w.v_head[1]*h4;
+  }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_r_shoulder_roll_link_to_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
     proxgen_rt::sincos_joint_called(q[31], w.sq[24], w.cq[24]);
@@ -2637,22 +2713,48 @@ PROXGEN_RT_NOINLINE void kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_lin
     w.c_r_shoulder_roll_link[2] = -v[30]*w.v_r_shoulder_roll_link[1];
     w.c_r_shoulder_roll_link[4] = v[30]*w.v_r_shoulder_roll_link[5];
     w.c_r_shoulder_roll_link[5] = -v[30]*w.v_r_shoulder_roll_link[4];
-    const Scalar h4 = 0.3*w.v_r_shoulder_pitch_link[0] - 0.009*w.v_r_shoulder_roll_link[4];
-    const Scalar h5 = 0.3*w.v_r_shoulder_roll_link[1] + 0.009*w.v_r_shoulder_roll_link[3];
-    const Scalar h6 = 0.009*w.v_r_shoulder_roll_link[1] + 0.00046199999999999995*w.v_r_shoulder_roll_link[3];
-    const Scalar h7 = -0.009*w.v_r_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_r_shoulder_roll_link[4];
-    w.pA_r_shoulder_roll_link[0] = 0.3*w.v_r_shoulder_roll_link[2]*w.v_r_shoulder_roll_link[4] - w.v_r_shoulder_roll_link[5]*h5;
-    w.pA_r_shoulder_roll_link[1] = w.v_r_shoulder_roll_link[5]*h4 - 0.3*w.v_r_shoulder_roll_link[2]*w.v_r_shoulder_roll_link[3];
-    w.pA_r_shoulder_roll_link[2] = w.v_r_shoulder_roll_link[3]*h5 - w.v_r_shoulder_roll_link[4]*h4;
-    w.pA_r_shoulder_roll_link[3] = 0.000192*w.v_r_shoulder_roll_link[4]*w.v_r_shoulder_roll_link[5] - w.v_r_shoulder_roll_link[5]*h7 + 0.3*w.v_r_shoulder_roll_link[1]*w.v_r_shoulder_roll_link[2] - w.v_r_shoulder_roll_link[2]*h5;
-    w.pA_r_shoulder_roll_link[4] = w.v_r_shoulder_roll_link[5]*h6 - 0.000192*w.v_r_shoulder_roll_link[3]*w.v_r_shoulder_roll_link[5] + w.v_r_shoulder_roll_link[2]*h4 - 0.3*w.v_r_shoulder_pitch_link[0]*w.v_r_shoulder_roll_link[2];
-    w.pA_r_shoulder_roll_link[5] = w.v_r_shoulder_roll_link[3]*h7 - w.v_r_shoulder_roll_link[4]*h6 + w.v_r_shoulder_pitch_link[0]*h5 - w.v_r_shoulder_roll_link[1]*h4;
+    const Scalar h0 = 0.3*w.v_r_shoulder_pitch_link[0] - 0.009*w.v_r_shoulder_roll_link[4];
+    const Scalar h1 = 0.3*w.v_r_shoulder_roll_link[1] + 0.009*w.v_r_shoulder_roll_link[3];
+    const Scalar h2 = 0.009*w.v_r_shoulder_roll_link[1] + 0.00046199999999999995*w.v_r_shoulder_roll_link[3];
+    const Scalar h3 = -0.009*w.v_r_shoulder_pitch_link[0] + 0.00046199999999999995*w.v_r_shoulder_roll_link[4];
+    w.pA_r_shoulder_roll_link[0] = 0.3*w.v_r_shoulder_roll_link[2]*w.v_r_shoulder_roll_link[4] - w.v_r_shoulder_roll_link[5]*h1;
+    w.pA_r_shoulder_roll_link[1] = w.v_r_shoulder_roll_link[5]*h0 - 0.3*w.v_r_shoulder_roll_link[2]*w.v_r_shoulder_roll_link[3];
+    w.pA_r_shoulder_roll_link[2] = w.v_r_shoulder_roll_link[3]*h1 - w.v_r_shoulder_roll_link[4]*h0;
+    w.pA_r_shoulder_roll_link[3] = 0.000192*w.v_r_shoulder_roll_link[4]*w.v_r_shoulder_roll_link[5] - w.v_r_shoulder_roll_link[5]*h3 + 0.3*w.v_r_shoulder_roll_link[1]*w.v_r_shoulder_roll_link[2] - w.v_r_shoulder_roll_link[2]*h1;
+    w.pA_r_shoulder_roll_link[4] = w.v_r_shoulder_roll_link[5]*h2 - 0.000192*w.v_r_shoulder_roll_link[3]*w.v_r_shoulder_roll_link[5] + w.v_r_shoulder_roll_link[2]*h0 - 0.3*w.v_r_shoulder_pitch_link[0]*w.v_r_shoulder_roll_link[2];
+    w.pA_r_shoulder_roll_link[5] = w.v_r_shoulder_roll_link[3]*h3 - w.v_r_shoulder_roll_link[4]*h2 + w.v_r_shoulder_pitch_link[0]*h1 - w.v_r_shoulder_roll_link[1]*h0;
     w.g_r_shoulder_roll_link[1] = w.g_r_shoulder_pitch_link[1]*w.cq[24] + w.g_r_shoulder_pitch_link[2]*w.sq[24];
     w.g_r_shoulder_roll_link[2] = -w.g_r_shoulder_pitch_link[1]*w.sq[24] + w.g_r_shoulder_pitch_link[2]*w.cq[24];
   }
+  // body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  // body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  shared_4_x2(shared_4_p0, &q[11], &q[17], &v[10], &v[16], &w.sq[4], &w.sq[10], &w.cq[4], &w.cq[10], w.v_l_shank, w.v_r_shank, w.v_l_ankle_link, w.v_r_ankle_link, w.c_l_ankle_link, w.c_r_ankle_link, w.pA_l_ankle_link, w.pA_r_ankle_link, w.g_l_shank, w.g_r_shank, w.g_l_ankle_link, w.g_r_ankle_link);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_upper_arm_to_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[23], w.sq[16], w.cq[16]);
+    w.v_l_upper_arm[0] = w.v_l_shoulder_pitch_link[0]*w.cq[16] + w.v_l_shoulder_roll_link[1]*w.sq[16];
+    w.v_l_upper_arm[1] = -w.v_l_shoulder_pitch_link[0]*w.sq[16] + w.v_l_shoulder_roll_link[1]*w.cq[16];
+    w.v_l_upper_arm[3] = w.v_l_shoulder_roll_link[3]*w.cq[16] + w.v_l_shoulder_roll_link[4]*w.sq[16];
+    w.v_l_upper_arm[4] = -w.v_l_shoulder_roll_link[3]*w.sq[16] + w.v_l_shoulder_roll_link[4]*w.cq[16];
+    w.v_l_upper_arm[5] = w.v_l_shoulder_roll_link[5] + v[22];
+    w.c_l_upper_arm[0] = v[22]*w.v_l_upper_arm[1];
+    w.c_l_upper_arm[1] = -v[22]*w.v_l_upper_arm[0];
+    w.c_l_upper_arm[3] = v[22]*w.v_l_upper_arm[4];
+    w.c_l_upper_arm[4] = -v[22]*w.v_l_upper_arm[3];
+    const Scalar h0 = 1.96*w.v_l_upper_arm[0] - 0.27815927999999995*w.v_l_upper_arm[4];
+    const Scalar h1 = 1.96*w.v_l_upper_arm[1] + 0.27815927999999995*w.v_l_upper_arm[3];
+    const Scalar h2 = 0.27815927999999995*w.v_l_upper_arm[1] + 0.061007086312239986*w.v_l_upper_arm[3];
+    const Scalar h3 = -0.27815927999999995*w.v_l_upper_arm[0] + 0.061007086312239986*w.v_l_upper_arm[4];
+    w.pA_l_upper_arm[0] = 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[4] - w.v_l_upper_arm[5]*h1;
+    w.pA_l_upper_arm[1] = w.v_l_upper_arm[5]*h0 - 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[3];
+    w.pA_l_upper_arm[2] = w.v_l_upper_arm[3]*h1 - w.v_l_upper_arm[4]*h0;
+    w.pA_l_upper_arm[3] = 0.0019845*w.v_l_upper_arm[4]*w.v_l_upper_arm[5] - w.v_l_upper_arm[5]*h3 + 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[1] - w.v_l_shoulder_roll_link[2]*h1;
+    w.pA_l_upper_arm[4] = w.v_l_upper_arm[5]*h2 - 0.0019845*w.v_l_upper_arm[3]*w.v_l_upper_arm[5] + w.v_l_shoulder_roll_link[2]*h0 - 1.96*w.v_l_shoulder_roll_link[2]*w.v_l_upper_arm[0];
+    w.pA_l_upper_arm[5] = w.v_l_upper_arm[3]*h3 - w.v_l_upper_arm[4]*h2 + w.v_l_upper_arm[0]*h1 - w.v_l_upper_arm[1]*h0;
+  }
   // body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     proxgen_rt::sincos_joint_called(q[32], w.sq[25], w.cq[25]);
@@ -2665,34 +2767,73 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
     w.c_r_upper_arm[1] = -v[31]*w.v_r_upper_arm[0];
     w.c_r_upper_arm[3] = v[31]*w.v_r_upper_arm[4];
     w.c_r_upper_arm[4] = -v[31]*w.v_r_upper_arm[3];
-    const Scalar h0 = 1.96*w.v_r_upper_arm[0] - 0.27815927999999995*w.v_r_upper_arm[4];
-    const Scalar h1 = 1.96*w.v_r_upper_arm[1] + 0.27815927999999995*w.v_r_upper_arm[3];
-    const Scalar h2 = 0.27815927999999995*w.v_r_upper_arm[1] + 0.061007086312239986*w.v_r_upper_arm[3];
-    const Scalar h3 = -0.27815927999999995*w.v_r_upper_arm[0] + 0.061007086312239986*w.v_r_upper_arm[4];
-    w.pA_r_upper_arm[0] = 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[4] - w.v_r_upper_arm[5]*h1;
-    w.pA_r_upper_arm[1] = w.v_r_upper_arm[5]*h0 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[3];
-    w.pA_r_upper_arm[2] = w.v_r_upper_arm[3]*h1 - w.v_r_upper_arm[4]*h0;
-    w.pA_r_upper_arm[3] = 0.0019845*w.v_r_upper_arm[4]*w.v_r_upper_arm[5] - w.v_r_upper_arm[5]*h3 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[1] - w.v_r_shoulder_roll_link[2]*h1;
-    w.pA_r_upper_arm[4] = w.v_r_upper_arm[5]*h2 - 0.0019845*w.v_r_upper_arm[3]*w.v_r_upper_arm[5] + w.v_r_shoulder_roll_link[2]*h0 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[0];
-    w.pA_r_upper_arm[5] = w.v_r_upper_arm[3]*h3 - w.v_r_upper_arm[4]*h2 + w.v_r_upper_arm[0]*h1 - w.v_r_upper_arm[1]*h0;
+    const Scalar h4 = 1.96*w.v_r_upper_arm[0] - 0.27815927999999995*w.v_r_upper_arm[4];
+    const Scalar h5 = 1.96*w.v_r_upper_arm[1] + 0.27815927999999995*w.v_r_upper_arm[3];
+    const Scalar h6 = 0.27815927999999995*w.v_r_upper_arm[1] + 0.061007086312239986*w.v_r_upper_arm[3];
+    const Scalar h7 = -0.27815927999999995*w.v_r_upper_arm[0] + 0.061007086312239986*w.v_r_upper_arm[4];
+    w.pA_r_upper_arm[0] = 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[4] - w.v_r_upper_arm[5]*h5;
+    w.pA_r_upper_arm[1] = w.v_r_upper_arm[5]*h4 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[3];
+    w.pA_r_upper_arm[2] = w.v_r_upper_arm[3]*h5 - w.v_r_upper_arm[4]*h4;
+    w.pA_r_upper_arm[3] = 0.0019845*w.v_r_upper_arm[4]*w.v_r_upper_arm[5] - w.v_r_upper_arm[5]*h7 + 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[1] - w.v_r_shoulder_roll_link[2]*h5;
+    w.pA_r_upper_arm[4] = w.v_r_upper_arm[5]*h6 - 0.0019845*w.v_r_upper_arm[3]*w.v_r_upper_arm[5] + w.v_r_shoulder_roll_link[2]*h4 - 1.96*w.v_r_shoulder_roll_link[2]*w.v_r_upper_arm[0];
+    w.pA_r_upper_arm[5] = w.v_r_upper_arm[3]*h7 - w.v_r_upper_arm[4]*h6 + w.v_r_upper_arm[0]*h5 - w.v_r_upper_arm[1]*h4;
     w.g_r_upper_arm[0] = w.g_r_shoulder_pitch_link[0]*w.cq[25] + w.g_r_shoulder_roll_link[1]*w.sq[25];
     w.g_r_upper_arm[1] = -w.g_r_shoulder_pitch_link[0]*w.sq[25] + w.g_r_shoulder_roll_link[1]*w.cq[25];
+  }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_l_foot_to_r_foot(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  // body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  shared_5_x2(shared_5_p0, &q[12], &q[18], &v[11], &v[17], &w.sq[5], &w.sq[11], &w.cq[5], &w.cq[11], &w.v_l_foot[1], &w.v_r_foot[1], w.v_l_ankle_link, w.v_r_ankle_link, &w.c_l_foot[1], &w.c_r_foot[1], w.pA_l_foot, w.pA_r_foot, &w.g_l_foot[1], &w.g_r_foot[1], &w.g_l_hip_roll_link[1], &w.g_r_hip_roll_link[1], &w.g_l_ankle_link[2], &w.g_r_ankle_link[2]);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_l_forearm_to_r_forearm(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[24], w.sq[17], w.cq[17]);
+    const Scalar t0 = w.v_l_upper_arm[0] - 0.3255*w.v_l_upper_arm[4];
+    const Scalar t1 = w.v_l_upper_arm[1] + 0.3255*w.v_l_upper_arm[3];
+    const Scalar t2 = 0.29552020666133966*w.v_l_shoulder_roll_link[2] + 0.955336489125606*t0;
+    const Scalar t3 = 0.955336489125606*w.v_l_shoulder_roll_link[2] - 0.29552020666133966*t0;
+    const Scalar t4 = 0.955336489125606*w.v_l_upper_arm[3] + 0.29552020666133966*w.v_l_upper_arm[5];
+    const Scalar t5 = -0.29552020666133966*w.v_l_upper_arm[3] + 0.955336489125606*w.v_l_upper_arm[5];
+    w.v_l_forearm[0] = w.cq[17]*t2 - w.sq[17]*t3;
+    w.v_l_forearm[1] = t1;
+    w.v_l_forearm[2] = w.sq[17]*t2 + w.cq[17]*t3;
+    w.v_l_forearm[3] = w.cq[17]*t4 - w.sq[17]*t5;
+    w.v_l_forearm[4] = w.v_l_upper_arm[4] + v[23];
+    w.v_l_forearm[5] = w.sq[17]*t4 + w.cq[17]*t5;
+    w.c_l_forearm[0] = -v[23]*w.v_l_forearm[2];
+    w.c_l_forearm[2] = v[23]*w.v_l_forearm[0];
+    w.c_l_forearm[3] = -v[23]*w.v_l_forearm[5];
+    w.c_l_forearm[5] = v[23]*w.v_l_forearm[3];
+    const Scalar h0 = 0.92*w.v_l_forearm[0] - 0.10107580000000001*w.v_l_forearm[4];
+    const Scalar h1 = 0.92*w.v_l_forearm[1] + 0.10107580000000001*w.v_l_forearm[3];
+    const Scalar h2 = 0.10107580000000001*w.v_l_forearm[1] + 0.01661854208147*w.v_l_forearm[3];
+    const Scalar h3 = -0.10107580000000001*w.v_l_forearm[0] + 0.01661854208147*w.v_l_forearm[4];
+    w.pA_l_forearm[0] = 0.92*w.v_l_forearm[2]*w.v_l_forearm[4] - w.v_l_forearm[5]*h1;
+    w.pA_l_forearm[1] = w.v_l_forearm[5]*h0 - 0.92*w.v_l_forearm[2]*w.v_l_forearm[3];
+    w.pA_l_forearm[2] = w.v_l_forearm[3]*h1 - w.v_l_forearm[4]*h0;
+    w.pA_l_forearm[3] = 0.0005635*w.v_l_forearm[4]*w.v_l_forearm[5] - w.v_l_forearm[5]*h3 + 0.92*w.v_l_forearm[1]*w.v_l_forearm[2] - w.v_l_forearm[2]*h1;
+    w.pA_l_forearm[4] = w.v_l_forearm[5]*h2 - 0.0005635*w.v_l_forearm[3]*w.v_l_forearm[5] + w.v_l_forearm[2]*h0 - 0.92*w.v_l_forearm[0]*w.v_l_forearm[2];
+    w.pA_l_forearm[5] = w.v_l_forearm[3]*h3 - w.v_l_forearm[4]*h2 + w.v_l_forearm[0]*h1 - w.v_l_forearm[1]*h0;
   }
   // body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
     proxgen_rt::sincos_joint_called(q[33], w.sq[26], w.cq[26]);
-    const Scalar t0 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
-    const Scalar t1 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
-    const Scalar t2 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t0;
-    const Scalar t3 = 0.955336489125606*w.v_r_shoulder_roll_link[2] - 0.29552020666133966*t0;
-    const Scalar t4 = 0.955336489125606*w.v_r_upper_arm[3] + 0.29552020666133966*w.v_r_upper_arm[5];
-    const Scalar t5 = -0.29552020666133966*w.v_r_upper_arm[3] + 0.955336489125606*w.v_r_upper_arm[5];
-    w.v_r_forearm[0] = w.cq[26]*t2 - w.sq[26]*t3;
-    w.v_r_forearm[1] = t1;
-    w.v_r_forearm[2] = w.sq[26]*t2 + w.cq[26]*t3;
-    w.v_r_forearm[3] = w.cq[26]*t4 - w.sq[26]*t5;
+    const Scalar t6 = w.v_r_upper_arm[0] - 0.3255*w.v_r_upper_arm[4];
+    const Scalar t7 = w.v_r_upper_arm[1] + 0.3255*w.v_r_upper_arm[3];
+    const Scalar t8 = 0.29552020666133966*w.v_r_shoulder_roll_link[2] + 0.955336489125606*t6;
+    const Scalar t9 = 0.955336489125606*w.v_r_shoulder_roll_link[2] - 0.29552020666133966*t6;
+    const Scalar t10 = 0.955336489125606*w.v_r_upper_arm[3] + 0.29552020666133966*w.v_r_upper_arm[5];
+    const Scalar t11 = -0.29552020666133966*w.v_r_upper_arm[3] + 0.955336489125606*w.v_r_upper_arm[5];
+    w.v_r_forearm[0] = w.cq[26]*t8 - w.sq[26]*t9;
+    w.v_r_forearm[1] = t7;
+    w.v_r_forearm[2] = w.sq[26]*t8 + w.cq[26]*t9;
+    w.v_r_forearm[3] = w.cq[26]*t10 - w.sq[26]*t11;
     w.v_r_forearm[4] = w.v_r_upper_arm[4] + v[32];
-    w.v_r_forearm[5] = w.sq[26]*t4 + w.cq[26]*t5;
+    w.v_r_forearm[5] = w.sq[26]*t10 + w.cq[26]*t11;
     w.c_r_forearm[0] = -v[32]*w.v_r_forearm[2];
     w.c_r_forearm[2] = v[32]*w.v_r_forearm[0];
     w.c_r_forearm[3] = -v[32]*w.v_r_forearm[5];
@@ -2707,21 +2848,23 @@ PROXGEN_RT_NOINLINE void kinematics_r_upper_arm_to_r_forearm(const Scalar* PROXG
     w.pA_r_forearm[3] = 0.0005635*w.v_r_forearm[4]*w.v_r_forearm[5] - w.v_r_forearm[5]*h7 + 0.92*w.v_r_forearm[1]*w.v_r_forearm[2] - w.v_r_forearm[2]*h5;
     w.pA_r_forearm[4] = w.v_r_forearm[5]*h6 - 0.0005635*w.v_r_forearm[3]*w.v_r_forearm[5] + w.v_r_forearm[2]*h4 - 0.92*w.v_r_forearm[0]*w.v_r_forearm[2];
     w.pA_r_forearm[5] = w.v_r_forearm[3]*h7 - w.v_r_forearm[4]*h6 + w.v_r_forearm[0]*h5 - w.v_r_forearm[1]*h4;
-    const Scalar t6 = 0.29552020666133966*w.g_r_shoulder_roll_link[2] + 0.955336489125606*w.g_r_upper_arm[0];
-    const Scalar t7 = 0.955336489125606*w.g_r_shoulder_roll_link[2] - 0.29552020666133966*w.g_r_upper_arm[0];
-    w.g_r_forearm[0] = w.cq[26]*t6 - w.sq[26]*t7;
-    w.g_r_forearm[2] = w.sq[26]*t6 + w.cq[26]*t7;
+    const Scalar t12 = 0.29552020666133966*w.g_r_shoulder_roll_link[2] + 0.955336489125606*w.g_r_upper_arm[0];
+    const Scalar t13 = 0.955336489125606*w.g_r_shoulder_roll_link[2] - 0.29552020666133966*w.g_r_upper_arm[0];
+    w.g_r_forearm[0] = w.cq[26]*t12 - w.sq[26]*t13;
+    w.g_r_forearm[2] = w.sq[26]*t12 + w.cq[26]*t13;
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_wrist_yaw_link_to_r_wrist_yaw_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
+  shared_2(shared_2_k1, &q[25], &v[24], &w.sq[18], &w.cq[18], w.v_l_forearm, w.v_l_wrist_yaw_link, w.c_l_wrist_yaw_link, w.pA_l_wrist_yaw_link);
   // body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
     proxgen_rt::sincos_joint_called(q[34], w.sq[27], w.cq[27]);
-    const Scalar t0 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
-    const Scalar t1 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
-    w.v_r_wrist_yaw_link[0] = w.cq[27]*t0 + w.sq[27]*t1;
-    w.v_r_wrist_yaw_link[1] = -w.sq[27]*t0 + w.cq[27]*t1;
+    const Scalar t2 = w.v_r_forearm[0] - 0.2555*w.v_r_forearm[4];
+    const Scalar t3 = w.v_r_forearm[1] + 0.2555*w.v_r_forearm[3];
+    w.v_r_wrist_yaw_link[0] = w.cq[27]*t2 + w.sq[27]*t3;
+    w.v_r_wrist_yaw_link[1] = -w.sq[27]*t2 + w.cq[27]*t3;
     w.v_r_wrist_yaw_link[3] = w.v_r_forearm[3]*w.cq[27] + w.v_r_forearm[4]*w.sq[27];
     w.v_r_wrist_yaw_link[4] = -w.v_r_forearm[3]*w.sq[27] + w.v_r_forearm[4]*w.cq[27];
     w.v_r_wrist_yaw_link[5] = w.v_r_forearm[5] + v[33];
@@ -2729,18 +2872,44 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
     w.c_r_wrist_yaw_link[1] = -v[33]*w.v_r_wrist_yaw_link[0];
     w.c_r_wrist_yaw_link[3] = v[33]*w.v_r_wrist_yaw_link[4];
     w.c_r_wrist_yaw_link[4] = -v[33]*w.v_r_wrist_yaw_link[3];
-    const Scalar h0 = 0.1*w.v_r_wrist_yaw_link[0] + 0.001*w.v_r_wrist_yaw_link[4];
-    const Scalar h1 = 0.1*w.v_r_wrist_yaw_link[1] - 0.001*w.v_r_wrist_yaw_link[3];
-    const Scalar h2 = -0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[3];
-    const Scalar h3 = 0.001*w.v_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[4];
-    w.pA_r_wrist_yaw_link[0] = 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[4] - w.v_r_wrist_yaw_link[5]*h1;
-    w.pA_r_wrist_yaw_link[1] = w.v_r_wrist_yaw_link[5]*h0 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[3];
-    w.pA_r_wrist_yaw_link[2] = w.v_r_wrist_yaw_link[3]*h1 - w.v_r_wrist_yaw_link[4]*h0;
-    w.pA_r_wrist_yaw_link[3] = 2.5e-05*w.v_r_wrist_yaw_link[4]*w.v_r_wrist_yaw_link[5] - w.v_r_wrist_yaw_link[5]*h3 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[1] - w.v_r_forearm[2]*h1;
-    w.pA_r_wrist_yaw_link[4] = w.v_r_wrist_yaw_link[5]*h2 - 2.5e-05*w.v_r_wrist_yaw_link[3]*w.v_r_wrist_yaw_link[5] + w.v_r_forearm[2]*h0 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[0];
-    w.pA_r_wrist_yaw_link[5] = w.v_r_wrist_yaw_link[3]*h3 - w.v_r_wrist_yaw_link[4]*h2 + w.v_r_wrist_yaw_link[0]*h1 - w.v_r_wrist_yaw_link[1]*h0;
+    const Scalar h4 = 0.1*w.v_r_wrist_yaw_link[0] + 0.001*w.v_r_wrist_yaw_link[4];
+    const Scalar h5 = 0.1*w.v_r_wrist_yaw_link[1] - 0.001*w.v_r_wrist_yaw_link[3];
+    const Scalar h6 = -0.001*w.v_r_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[3];
+    const Scalar h7 = 0.001*w.v_r_wrist_yaw_link[0] + 3.5000000000000004e-05*w.v_r_wrist_yaw_link[4];
+    w.pA_r_wrist_yaw_link[0] = 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[4] - w.v_r_wrist_yaw_link[5]*h5;
+    w.pA_r_wrist_yaw_link[1] = w.v_r_wrist_yaw_link[5]*h4 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[3];
+    w.pA_r_wrist_yaw_link[2] = w.v_r_wrist_yaw_link[3]*h5 - w.v_r_wrist_yaw_link[4]*h4;
+    w.pA_r_wrist_yaw_link[3] = 2.5e-05*w.v_r_wrist_yaw_link[4]*w.v_r_wrist_yaw_link[5] - w.v_r_wrist_yaw_link[5]*h7 + 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[1] - w.v_r_forearm[2]*h5;
+    w.pA_r_wrist_yaw_link[4] = w.v_r_wrist_yaw_link[5]*h6 - 2.5e-05*w.v_r_wrist_yaw_link[3]*w.v_r_wrist_yaw_link[5] + w.v_r_forearm[2]*h4 - 0.1*w.v_r_forearm[2]*w.v_r_wrist_yaw_link[0];
+    w.pA_r_wrist_yaw_link[5] = w.v_r_wrist_yaw_link[3]*h7 - w.v_r_wrist_yaw_link[4]*h6 + w.v_r_wrist_yaw_link[0]*h5 - w.v_r_wrist_yaw_link[1]*h4;
     w.g_r_wrist_yaw_link[0] = w.g_r_forearm[0]*w.cq[27] + w.g_r_upper_arm[1]*w.sq[27];
     w.g_r_wrist_yaw_link[1] = -w.g_r_forearm[0]*w.sq[27] + w.g_r_upper_arm[1]*w.cq[27];
+  }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_l_wrist_pitch_link_to_r_wrist_pitch_link(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[26], w.sq[19], w.cq[19]);
+    w.v_l_wrist_pitch_link[0] = w.v_l_wrist_yaw_link[0]*w.cq[19] - w.v_l_forearm[2]*w.sq[19];
+    w.v_l_wrist_pitch_link[2] = w.v_l_wrist_yaw_link[0]*w.sq[19] + w.v_l_forearm[2]*w.cq[19];
+    w.v_l_wrist_pitch_link[3] = w.v_l_wrist_yaw_link[3]*w.cq[19] - w.v_l_wrist_yaw_link[5]*w.sq[19];
+    w.v_l_wrist_pitch_link[4] = w.v_l_wrist_yaw_link[4] + v[25];
+    w.v_l_wrist_pitch_link[5] = w.v_l_wrist_yaw_link[3]*w.sq[19] + w.v_l_wrist_yaw_link[5]*w.cq[19];
+    w.c_l_wrist_pitch_link[0] = -v[25]*w.v_l_wrist_pitch_link[2];
+    w.c_l_wrist_pitch_link[2] = v[25]*w.v_l_wrist_pitch_link[0];
+    w.c_l_wrist_pitch_link[3] = -v[25]*w.v_l_wrist_pitch_link[5];
+    w.c_l_wrist_pitch_link[5] = v[25]*w.v_l_wrist_pitch_link[3];
+    const Scalar h0 = 0.1*w.v_l_wrist_pitch_link[0] - 0.001*w.v_l_wrist_pitch_link[4];
+    const Scalar h1 = 0.1*w.v_l_wrist_yaw_link[1] + 0.001*w.v_l_wrist_pitch_link[3];
+    const Scalar h2 = 0.001*w.v_l_wrist_yaw_link[1] + 3.5000000000000004e-05*w.v_l_wrist_pitch_link[3];
+    const Scalar h3 = -0.001*w.v_l_wrist_pitch_link[0] + 3.5000000000000004e-05*w.v_l_wrist_pitch_link[4];
+    w.pA_l_wrist_pitch_link[0] = 0.1*w.v_l_wrist_pitch_link[2]*w.v_l_wrist_pitch_link[4] - w.v_l_wrist_pitch_link[5]*h1;
+    w.pA_l_wrist_pitch_link[1] = w.v_l_wrist_pitch_link[5]*h0 - 0.1*w.v_l_wrist_pitch_link[2]*w.v_l_wrist_pitch_link[3];
+    w.pA_l_wrist_pitch_link[2] = w.v_l_wrist_pitch_link[3]*h1 - w.v_l_wrist_pitch_link[4]*h0;
+    w.pA_l_wrist_pitch_link[3] = 2.5e-05*w.v_l_wrist_pitch_link[4]*w.v_l_wrist_pitch_link[5] - w.v_l_wrist_pitch_link[5]*h3 + 0.1*w.v_l_wrist_yaw_link[1]*w.v_l_wrist_pitch_link[2] - w.v_l_wrist_pitch_link[2]*h1;
+    w.pA_l_wrist_pitch_link[4] = w.v_l_wrist_pitch_link[5]*h2 - 2.5e-05*w.v_l_wrist_pitch_link[3]*w.v_l_wrist_pitch_link[5] + w.v_l_wrist_pitch_link[2]*h0 - 0.1*w.v_l_wrist_pitch_link[0]*w.v_l_wrist_pitch_link[2];
+    w.pA_l_wrist_pitch_link[5] = w.v_l_wrist_pitch_link[3]*h3 - w.v_l_wrist_pitch_link[4]*h2 + w.v_l_wrist_pitch_link[0]*h1 - w.v_l_wrist_yaw_link[1]*h0;
   }
   // body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
@@ -2769,7 +2938,30 @@ PROXGEN_RT_NOINLINE void kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(const
   }
 }
 
-PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_l_hand_to_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
+  {
+    proxgen_rt::sincos_joint_called(q[27], w.sq[20], w.cq[20]);
+    w.v_l_hand[1] = w.v_l_wrist_yaw_link[1]*w.cq[20] + w.v_l_wrist_pitch_link[2]*w.sq[20];
+    w.v_l_hand[2] = -w.v_l_wrist_yaw_link[1]*w.sq[20] + w.v_l_wrist_pitch_link[2]*w.cq[20];
+    w.v_l_hand[3] = w.v_l_wrist_pitch_link[3] + v[26];
+    w.v_l_hand[4] = w.v_l_wrist_pitch_link[4]*w.cq[20] + w.v_l_wrist_pitch_link[5]*w.sq[20];
+    w.v_l_hand[5] = -w.v_l_wrist_pitch_link[4]*w.sq[20] + w.v_l_wrist_pitch_link[5]*w.cq[20];
+    w.c_l_hand[1] = v[26]*w.v_l_hand[2];
+    w.c_l_hand[2] = -v[26]*w.v_l_hand[1];
+    w.c_l_hand[4] = v[26]*w.v_l_hand[5];
+    w.c_l_hand[5] = -v[26]*w.v_l_hand[4];
+    const Scalar h0 = 0.42*w.v_l_wrist_pitch_link[0] - 0.04016628*w.v_l_hand[4];
+    const Scalar h1 = 0.42*w.v_l_hand[1] + 0.04016628*w.v_l_hand[3];
+    const Scalar h2 = 0.04016628*w.v_l_hand[1] + 0.005164645770899999*w.v_l_hand[3];
+    const Scalar h3 = -0.04016628*w.v_l_wrist_pitch_link[0] + 0.005164645770899999*w.v_l_hand[4];
+    w.pA_l_hand[0] = 0.42*w.v_l_hand[2]*w.v_l_hand[4] - w.v_l_hand[5]*h1;
+    w.pA_l_hand[1] = w.v_l_hand[5]*h0 - 0.42*w.v_l_hand[2]*w.v_l_hand[3];
+    w.pA_l_hand[2] = w.v_l_hand[3]*h1 - w.v_l_hand[4]*h0;
+    w.pA_l_hand[3] = 0.000284375*w.v_l_hand[4]*w.v_l_hand[5] - w.v_l_hand[5]*h3 + 0.42*w.v_l_hand[1]*w.v_l_hand[2] - w.v_l_hand[2]*h1;
+    w.pA_l_hand[4] = w.v_l_hand[5]*h2 - 0.000284375*w.v_l_hand[3]*w.v_l_hand[5] + w.v_l_hand[2]*h0 - 0.42*w.v_l_wrist_pitch_link[0]*w.v_l_hand[2];
+    w.pA_l_hand[5] = w.v_l_hand[3]*h3 - w.v_l_hand[4]*h2 + w.v_l_wrist_pitch_link[0]*h1 - w.v_l_hand[1]*h0;
+  }
   // body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
     proxgen_rt::sincos_joint_called(q[36], w.sq[29], w.cq[29]);
@@ -2782,16 +2974,16 @@ PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, 
     w.c_r_hand[2] = -v[35]*w.v_r_hand[1];
     w.c_r_hand[4] = v[35]*w.v_r_hand[5];
     w.c_r_hand[5] = -v[35]*w.v_r_hand[4];
-    const Scalar h0 = 0.42*w.v_r_wrist_pitch_link[0] - 0.04016628*w.v_r_hand[4];
-    const Scalar h1 = 0.42*w.v_r_hand[1] + 0.04016628*w.v_r_hand[3];
-    const Scalar h2 = 0.04016628*w.v_r_hand[1] + 0.005164645770899999*w.v_r_hand[3];
-    const Scalar h3 = -0.04016628*w.v_r_wrist_pitch_link[0] + 0.005164645770899999*w.v_r_hand[4];
-    w.pA_r_hand[0] = 0.42*w.v_r_hand[2]*w.v_r_hand[4] - w.v_r_hand[5]*h1;
-    w.pA_r_hand[1] = w.v_r_hand[5]*h0 - 0.42*w.v_r_hand[2]*w.v_r_hand[3];
-    w.pA_r_hand[2] = w.v_r_hand[3]*h1 - w.v_r_hand[4]*h0;
-    w.pA_r_hand[3] = 0.000284375*w.v_r_hand[4]*w.v_r_hand[5] - w.v_r_hand[5]*h3 + 0.42*w.v_r_hand[1]*w.v_r_hand[2] - w.v_r_hand[2]*h1;
-    w.pA_r_hand[4] = w.v_r_hand[5]*h2 - 0.000284375*w.v_r_hand[3]*w.v_r_hand[5] + w.v_r_hand[2]*h0 - 0.42*w.v_r_wrist_pitch_link[0]*w.v_r_hand[2];
-    w.pA_r_hand[5] = w.v_r_hand[3]*h3 - w.v_r_hand[4]*h2 + w.v_r_wrist_pitch_link[0]*h1 - w.v_r_hand[1]*h0;
+    const Scalar h4 = 0.42*w.v_r_wrist_pitch_link[0] - 0.04016628*w.v_r_hand[4];
+    const Scalar h5 = 0.42*w.v_r_hand[1] + 0.04016628*w.v_r_hand[3];
+    const Scalar h6 = 0.04016628*w.v_r_hand[1] + 0.005164645770899999*w.v_r_hand[3];
+    const Scalar h7 = -0.04016628*w.v_r_wrist_pitch_link[0] + 0.005164645770899999*w.v_r_hand[4];
+    w.pA_r_hand[0] = 0.42*w.v_r_hand[2]*w.v_r_hand[4] - w.v_r_hand[5]*h5;
+    w.pA_r_hand[1] = w.v_r_hand[5]*h4 - 0.42*w.v_r_hand[2]*w.v_r_hand[3];
+    w.pA_r_hand[2] = w.v_r_hand[3]*h5 - w.v_r_hand[4]*h4;
+    w.pA_r_hand[3] = 0.000284375*w.v_r_hand[4]*w.v_r_hand[5] - w.v_r_hand[5]*h7 + 0.42*w.v_r_hand[1]*w.v_r_hand[2] - w.v_r_hand[2]*h5;
+    w.pA_r_hand[4] = w.v_r_hand[5]*h6 - 0.000284375*w.v_r_hand[3]*w.v_r_hand[5] + w.v_r_hand[2]*h4 - 0.42*w.v_r_wrist_pitch_link[0]*w.v_r_hand[2];
+    w.pA_r_hand[5] = w.v_r_hand[3]*h7 - w.v_r_hand[4]*h6 + w.v_r_wrist_pitch_link[0]*h5 - w.v_r_hand[1]*h4;
     w.g_r_hand[1] = w.g_r_wrist_yaw_link[1]*w.cq[29] + w.g_r_wrist_pitch_link[2]*w.sq[29];
     w.g_r_hand[2] = -w.g_r_wrist_yaw_link[1]*w.sq[29] + w.g_r_wrist_pitch_link[2]*w.cq[29];
     // constraint 'right_hand' (3d) on link 'r_hand_frame': rows 12..14
@@ -2800,96 +2992,6 @@ PROXGEN_RT_NOINLINE void kinematics_r_hand(const Scalar* PROXGEN_RT_RESTRICT q, 
     w.k_right_hand[0] = w.v_r_hand[2]*w.v_r_hand[3] - w.g_r_hand[1] + w.v_r_hand[5]*t0;
     w.k_right_hand[1] = w.g_r_wrist_pitch_link[0] + w.v_r_hand[2]*w.v_r_hand[4] - w.v_r_hand[5]*t1;
     w.k_right_hand[2] = -w.g_r_hand[2] - w.v_r_hand[4]*t0 - w.v_r_hand[3]*t1;
-  }
-}
-
-PROXGEN_RT_NOINLINE void eliminate_free_head_to_neck_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
-  {
-    w.u_head[0] = -w.pA_head[4] + tau[28];
-    const Scalar pa0 = 2.0800874866846146*w.c_head[0] + w.pA_head[0] + 6.549720491381543*w.u_head[0];
-    const Scalar pa1 = -0.4717625*w.c_head[3] + w.pA_head[1];
-    const Scalar pa2 = 5.17*w.c_head[2] + w.pA_head[2];
-    const Scalar pa3 = 0.07202788281129999*w.c_head[3] + w.pA_head[3];
-    const Scalar pa4 = 0.0167508*w.c_head[5] + w.pA_head[5];
-    const Scalar C20 = w.cq[22]*w.cq[22] - w.sq[22]*w.sq[22];
-    const Scalar t0 = 3.6250437433423075 - 1.5449562566576927*C20;
-    const Scalar t1 = 3.6250437433423075 + 1.5449562566576927*C20;
-    const Scalar t2 = -0.3102 - 0.4717625*w.cq[22];
-    const Scalar t3 = w.cq[22]*pa0 + w.sq[22]*pa2;
-    const Scalar t4 = -w.sq[22]*pa0 + w.cq[22]*pa2;
-    w.IA_neck_link[0] = 0.5 + t0;
-    w.IA_neck_link[2] = 3.0899125133153853*w.cq[22]*w.sq[22];
-    w.IA_neck_link[4] = 0.015 + 0.06*t0;
-    w.IA_neck_link[8] = -0.015 + t2;
-    w.IA_neck_link[10] = 0.4717625*w.sq[22];
-    w.IA_neck_link[11] = 0.5 + t1;
-    w.IA_neck_link[13] = 0.18539475079892312*w.cq[22]*w.sq[22];
-    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq[22] + 0.027638541405649995*C20 - 0.06*t2;
-    w.IA_neck_link[17] = -0.028305749999999998*w.sq[22] - 0.05527708281129999*w.cq[22]*w.sq[22];
-    w.IA_neck_link[18] = 0.0007700000000000001 + 0.0036*t0;
-    w.IA_neck_link[20] = 0.04470934140564999 - 0.027638541405649995*C20;
-    w.pA_neck_link[0] = w.pA_neck_link[0] + t3;
-    w.pA_neck_link[1] = w.pA_neck_link[1] + pa1;
-    w.pA_neck_link[2] = w.pA_neck_link[2] + t4;
-    w.pA_neck_link[3] = w.pA_neck_link[3] - 0.06*pa1 + w.cq[22]*pa3 + w.sq[22]*pa4;
-    w.pA_neck_link[4] = w.pA_neck_link[4] + tau[28] + 0.06*t3;
-    w.pA_neck_link[5] = w.pA_neck_link[5] - w.sq[22]*pa3 + w.cq[22]*pa4;
-  }
-  // eliminate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
-  {
-    w.Dinv_neck_link = 1.0 / w.IA_neck_link[20];
-    w.u_neck_link[0] = -w.pA_neck_link[5] + tau[27];
-    const Scalar t5 = w.IA_neck_link[10]*w.Dinv_neck_link;
-    const Scalar t6 = w.IA_neck_link[17]*w.Dinv_neck_link;
-    const Scalar Ia0 = 5.67 - w.IA_neck_link[10]*t5;
-    const Scalar Ia1 = w.IA_neck_link[8] - w.IA_neck_link[17]*t5;
-    const Scalar Ia2 = w.IA_neck_link[15] - w.IA_neck_link[17]*t6;
-    const Scalar pa5 = w.pA_neck_link[0] + w.c_neck_link[0]*w.IA_neck_link[0] + w.c_neck_link[4]*w.IA_neck_link[4];
-    const Scalar pa6 = w.pA_neck_link[1] + w.u_neck_link[0]*t5 + w.c_neck_link[1]*Ia0 + w.c_neck_link[3]*Ia1;
-    const Scalar pa7 = w.pA_neck_link[2] + w.c_neck_link[0]*w.IA_neck_link[2] + w.c_neck_link[4]*w.IA_neck_link[13];
-    const Scalar pa8 = w.pA_neck_link[3] + w.u_neck_link[0]*t6 + w.c_neck_link[1]*Ia1 + w.c_neck_link[3]*Ia2;
-    const Scalar pa9 = w.pA_neck_link[4] + w.c_neck_link[0]*w.IA_neck_link[4] + w.c_neck_link[4]*w.IA_neck_link[18];
-    const Scalar C21 = w.cq[21]*w.cq[21] - w.sq[21]*w.sq[21];
-    const Scalar h0 = 0.5*(w.IA_neck_link[0] - Ia0);
-    const Scalar m0 = 0.5*(w.IA_neck_link[0] + Ia0);
-    const Scalar t7 = 2.0*w.cq[21]*w.sq[21];
-    const Scalar t8 = 0.5*(w.IA_neck_link[4] + Ia1);
-    const Scalar h1 = 0.5*(-w.IA_neck_link[18] + Ia2);
-    const Scalar m1 = 0.5*(w.IA_neck_link[18] + Ia2);
-    const Scalar t9 = m0 + C21*h0;
-    const Scalar t10 = m0 - C21*h0;
-    const Scalar t11 = 0.5*w.IA_neck_link[4] - 0.5*Ia1 + C21*t8;
-    const Scalar t12 = -0.5*w.IA_neck_link[4] + 0.5*Ia1 + C21*t8;
-    const Scalar t13 = -0.29*h0*t7 - t7*t8;
-    const Scalar t14 = 0.29*t9 + t11;
-    const Scalar t15 = -0.29*t10 + t12;
-    const Scalar t16 = 0.29*h0*t7 + t7*t8;
-    const Scalar t17 = -0.29*w.sq[21]*w.IA_neck_link[2] - w.sq[21]*w.IA_neck_link[13];
-    const Scalar t18 = 0.29*w.cq[21]*w.IA_neck_link[2] + w.cq[21]*w.IA_neck_link[13];
-    const Scalar t19 = w.cq[21]*pa5 - w.sq[21]*pa6;
-    const Scalar t20 = w.sq[21]*pa5 + w.cq[21]*pa6;
-    w.IA_chest[0] = 13.92 + t9;
-    w.IA_chest[1] = h0*t7;
-    w.IA_chest[2] = w.cq[21]*w.IA_neck_link[2];
-    w.IA_chest[3] = t13;
-    w.IA_chest[4] = 0.726624 + t14;
-    w.IA_chest[6] = 13.92 + t10;
-    w.IA_chest[7] = w.sq[21]*w.IA_neck_link[2];
-    w.IA_chest[8] = -0.726624 + t15;
-    w.IA_chest[9] = t16;
-    w.IA_chest[11] = 13.92 + w.IA_neck_link[11];
-    w.IA_chest[12] = t17;
-    w.IA_chest[13] = t18;
-    w.IA_chest[15] = 0.2775857728 + m1 + C21*h1 - 0.29*t12 - 0.29*t15;
-    w.IA_chest[16] = -0.29*t7*t8 + t7*h1 - 0.29*t16;
-    w.IA_chest[18] = 0.19162977280000001 + m1 - C21*h1 + 0.29*t11 + 0.29*t14;
-    w.pA_chest[0] = w.pA_chest[0] + t19;
-    w.pA_chest[1] = w.pA_chest[1] + t20;
-    w.pA_chest[2] = w.pA_chest[2] + pa7;
-    w.pA_chest[3] = w.pA_chest[3] + w.cq[21]*pa8 - w.sq[21]*pa9 - 0.29*t20;
-    w.pA_chest[4] = w.pA_chest[4] + w.sq[21]*pa8 + w.cq[21]*pa9 + 0.29*t19;
-    w.pA_chest[5] = w.pA_chest[5] + tau[27];
   }
 }
 
@@ -2977,9 +3079,99 @@ PROXGEN_RT_NOINLINE void eliminate_free_l_upper_arm(const Scalar* PROXGEN_RT_RES
   shared_8(&tau[22], &w.Dinv_l_upper_arm, w.IA_l_upper_arm, w.u_l_upper_arm, w.pA_l_upper_arm, w.c_l_upper_arm, &w.cq[16], &w.sq[16], w.IA_l_shoulder_roll_link, w.pA_l_shoulder_roll_link);
 }
 
-PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void eliminate_free_head_to_l_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
+  {
+    w.u_head[0] = -w.pA_head[4] + tau[28];
+    const Scalar pa0 = 2.0800874866846146*w.c_head[0] + w.pA_head[0] + 6.549720491381543*w.u_head[0];
+    const Scalar pa1 = -0.4717625*w.c_head[3] + w.pA_head[1];
+    const Scalar pa2 = 5.17*w.c_head[2] + w.pA_head[2];
+    const Scalar pa3 = 0.07202788281129999*w.c_head[3] + w.pA_head[3];
+    const Scalar pa4 = 0.0167508*w.c_head[5] + w.pA_head[5];
+    const Scalar C20 = w.cq[22]*w.cq[22] - w.sq[22]*w.sq[22];
+    const Scalar t0 = 3.6250437433423075 - 1.5449562566576927*C20;
+    const Scalar t1 = 3.6250437433423075 + 1.5449562566576927*C20;
+    const Scalar t2 = -0.3102 - 0.4717625*w.cq[22];
+    const Scalar t3 = w.cq[22]*pa0 + w.sq[22]*pa2;
+    const Scalar t4 = -w.sq[22]*pa0 + w.cq[22]*pa2;
+    w.IA_neck_link[0] = 0.5 + t0;
+    w.IA_neck_link[2] = 3.0899125133153853*w.cq[22]*w.sq[22];
+    w.IA_neck_link[4] = 0.015 + 0.06*t0;
+    w.IA_neck_link[8] = -0.015 + t2;
+    w.IA_neck_link[10] = 0.4717625*w.sq[22];
+    w.IA_neck_link[11] = 0.5 + t1;
+    w.IA_neck_link[13] = 0.18539475079892312*w.cq[22]*w.sq[22];
+    w.IA_neck_link[15] = 0.04515934140564999 + 0.028305749999999998*w.cq[22] + 0.027638541405649995*C20 - 0.06*t2;
+    w.IA_neck_link[17] = -0.028305749999999998*w.sq[22] - 0.05527708281129999*w.cq[22]*w.sq[22];
+    w.IA_neck_link[18] = 0.0007700000000000001 + 0.0036*t0;
+    w.IA_neck_link[20] = 0.04470934140564999 - 0.027638541405649995*C20;
+    w.pA_neck_link[0] = w.pA_neck_link[0] + t3;
+    w.pA_neck_link[1] = w.pA_neck_link[1] + pa1;
+    w.pA_neck_link[2] = w.pA_neck_link[2] + t4;
+    w.pA_neck_link[3] = w.pA_neck_link[3] - 0.06*pa1 + w.cq[22]*pa3 + w.sq[22]*pa4;
+    w.pA_neck_link[4] = w.pA_neck_link[4] + tau[28] + 0.06*t3;
+    w.pA_neck_link[5] = w.pA_neck_link[5] - w.sq[22]*pa3 + w.cq[22]*pa4;
+  }
   // eliminate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
   shared_9(shared_9_k0, &tau[21], &w.Dinv_l_shoulder_roll_link, w.IA_l_shoulder_roll_link, w.u_l_shoulder_roll_link, w.pA_l_shoulder_roll_link, &w.c_l_shoulder_roll_link[1], &w.cq[15], &w.sq[15], w.IA_l_shoulder_pitch_link, w.pA_l_shoulder_pitch_link);
+}
+
+PROXGEN_RT_NOINLINE void eliminate_free_neck_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
+  {
+    w.Dinv_neck_link = 1.0 / w.IA_neck_link[20];
+    w.u_neck_link[0] = -w.pA_neck_link[5] + tau[27];
+    const Scalar t0 = w.IA_neck_link[10]*w.Dinv_neck_link;
+    const Scalar t1 = w.IA_neck_link[17]*w.Dinv_neck_link;
+    const Scalar Ia0 = 5.67 - w.IA_neck_link[10]*t0;
+    const Scalar Ia1 = w.IA_neck_link[8] - w.IA_neck_link[17]*t0;
+    const Scalar Ia2 = w.IA_neck_link[15] - w.IA_neck_link[17]*t1;
+    const Scalar pa0 = w.pA_neck_link[0] + w.c_neck_link[0]*w.IA_neck_link[0] + w.c_neck_link[4]*w.IA_neck_link[4];
+    const Scalar pa1 = w.pA_neck_link[1] + w.u_neck_link[0]*t0 + w.c_neck_link[1]*Ia0 + w.c_neck_link[3]*Ia1;
+    const Scalar pa2 = w.pA_neck_link[2] + w.c_neck_link[0]*w.IA_neck_link[2] + w.c_neck_link[4]*w.IA_neck_link[13];
+    const Scalar pa3 = w.pA_neck_link[3] + w.u_neck_link[0]*t1 + w.c_neck_link[1]*Ia1 + w.c_neck_link[3]*Ia2;
+    const Scalar pa4 = w.pA_neck_link[4] + w.c_neck_link[0]*w.IA_neck_link[4] + w.c_neck_link[4]*w.IA_neck_link[18];
+    const Scalar C20 = w.cq[21]*w.cq[21] - w.sq[21]*w.sq[21];
+    const Scalar h0 = 0.5*(w.IA_neck_link[0] - Ia0);
+    const Scalar m0 = 0.5*(w.IA_neck_link[0] + Ia0);
+    const Scalar t2 = 2.0*w.cq[21]*w.sq[21];
+    const Scalar t3 = 0.5*(w.IA_neck_link[4] + Ia1);
+    const Scalar h1 = 0.5*(-w.IA_neck_link[18] + Ia2);
+    const Scalar m1 = 0.5*(w.IA_neck_link[18] + Ia2);
+    const Scalar t4 = m0 + C20*h0;
+    const Scalar t5 = m0 - C20*h0;
+    const Scalar t6 = 0.5*w.IA_neck_link[4] - 0.5*Ia1 + C20*t3;
+    const Scalar t7 = -0.5*w.IA_neck_link[4] + 0.5*Ia1 + C20*t3;
+    const Scalar t8 = -0.29*h0*t2 - t2*t3;
+    const Scalar t9 = 0.29*t4 + t6;
+    const Scalar t10 = -0.29*t5 + t7;
+    const Scalar t11 = 0.29*h0*t2 + t2*t3;
+    const Scalar t12 = -0.29*w.sq[21]*w.IA_neck_link[2] - w.sq[21]*w.IA_neck_link[13];
+    const Scalar t13 = 0.29*w.cq[21]*w.IA_neck_link[2] + w.cq[21]*w.IA_neck_link[13];
+    const Scalar t14 = w.cq[21]*pa0 - w.sq[21]*pa1;
+    const Scalar t15 = w.sq[21]*pa0 + w.cq[21]*pa1;
+    w.IA_chest[0] = 13.92 + t4;
+    w.IA_chest[1] = h0*t2;
+    w.IA_chest[2] = w.cq[21]*w.IA_neck_link[2];
+    w.IA_chest[3] = t8;
+    w.IA_chest[4] = 0.726624 + t9;
+    w.IA_chest[6] = 13.92 + t5;
+    w.IA_chest[7] = w.sq[21]*w.IA_neck_link[2];
+    w.IA_chest[8] = -0.726624 + t10;
+    w.IA_chest[9] = t11;
+    w.IA_chest[11] = 13.92 + w.IA_neck_link[11];
+    w.IA_chest[12] = t12;
+    w.IA_chest[13] = t13;
+    w.IA_chest[15] = 0.2775857728 + m1 + C20*h1 - 0.29*t7 - 0.29*t10;
+    w.IA_chest[16] = -0.29*t2*t3 + t2*h1 - 0.29*t11;
+    w.IA_chest[18] = 0.19162977280000001 + m1 - C20*h1 + 0.29*t6 + 0.29*t9;
+    w.pA_chest[0] = w.pA_chest[0] + t14;
+    w.pA_chest[1] = w.pA_chest[1] + t15;
+    w.pA_chest[2] = w.pA_chest[2] + pa2;
+    w.pA_chest[3] = w.pA_chest[3] + w.cq[21]*pa3 - w.sq[21]*pa4 - 0.29*t15;
+    w.pA_chest[4] = w.pA_chest[4] + w.sq[21]*pa3 + w.cq[21]*pa4 + 0.29*t14;
+    w.pA_chest[5] = w.pA_chest[5] + tau[27];
+  }
 }
 
 PROXGEN_RT_NOINLINE void eliminate_free_l_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3189,14 +3381,32 @@ PROXGEN_RT_NOINLINE void caba_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRI
   shared_7(&tau[32], &w.Dinv_r_forearm, w.IA_r_forearm, w.u_r_forearm, w.pA_r_forearm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.IA_r_upper_arm, w.pA_r_upper_arm);
 }
 
+PROXGEN_RT_NOINLINE void caba_backward_r_foot_to_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  shared_10_x2(shared_10_p0, &tau[17], &tau[11], mu, &w.active[1], w.active, &w.U_r_foot[1], &w.U_l_foot[1], &w.Dinv_r_foot, &w.Dinv_l_foot, w.u_r_foot, w.u_l_foot, w.pA_r_foot, w.pA_l_foot, &w.lambda[6], w.lambda, &w.g_r_foot[1], &w.g_l_foot[1], w.g_r_ankle_link, w.g_l_ankle_link, &w.c_r_foot[1], &w.c_l_foot[1], &w.cq[11], &w.cq[5], &w.sq[11], &w.sq[5], w.IA_r_ankle_link, w.IA_l_ankle_link, w.pA_r_ankle_link, w.pA_l_ankle_link);
+}
+
 PROXGEN_RT_NOINLINE void caba_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   shared_8(&tau[31], &w.Dinv_r_upper_arm, w.IA_r_upper_arm, w.u_r_upper_arm, w.pA_r_upper_arm, w.c_r_upper_arm, &w.cq[25], &w.sq[25], w.IA_r_shoulder_roll_link, w.pA_r_shoulder_roll_link);
 }
 
+PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  shared_11_x2(shared_11_p0, &tau[16], &tau[10], &w.Dinv_r_ankle_link, &w.Dinv_l_ankle_link, w.IA_r_ankle_link, w.IA_l_ankle_link, w.u_r_ankle_link, w.u_l_ankle_link, w.pA_r_ankle_link, w.pA_l_ankle_link, w.c_r_ankle_link, w.c_l_ankle_link, &w.cq[10], &w.cq[4], &w.sq[10], &w.sq[4], w.IA_r_shank, w.IA_l_shank, w.pA_r_shank, w.pA_l_shank);
+}
+
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   shared_9(shared_9_k1, &tau[30], &w.Dinv_r_shoulder_roll_link, w.IA_r_shoulder_roll_link, w.u_r_shoulder_roll_link, w.pA_r_shoulder_roll_link, &w.c_r_shoulder_roll_link[1], &w.cq[24], &w.sq[24], w.IA_r_shoulder_pitch_link, w.pA_r_shoulder_pitch_link);
+}
+
+PROXGEN_RT_NOINLINE void caba_backward_r_shank_to_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  shared_12_x2(shared_12_p0, &tau[15], &tau[9], &w.Dinv_r_shank, &w.Dinv_l_shank, w.IA_r_shank, w.IA_l_shank, w.u_r_shank, w.u_l_shank, w.pA_r_shank, w.pA_l_shank, w.c_r_shank, w.c_l_shank, &w.cq[9], &w.cq[3], &w.sq[9], &w.sq[3], w.IA_r_thigh, w.IA_l_thigh, w.pA_r_thigh, w.pA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3312,6 +3522,12 @@ PROXGEN_RT_NOINLINE void caba_backward_r_shoulder_pitch_link(const Scalar* PROXG
   }
 }
 
+PROXGEN_RT_NOINLINE void caba_backward_r_thigh_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  shared_13_x2(shared_13_p0, &tau[14], &tau[8], &w.Dinv_r_thigh, &w.Dinv_l_thigh, w.IA_r_thigh, w.IA_l_thigh, w.u_r_thigh, w.u_l_thigh, w.pA_r_thigh, w.pA_l_thigh, w.c_r_thigh, w.c_l_thigh, &w.cq[8], &w.cq[2], &w.sq[8], &w.sq[2], w.IA_r_hip_roll_link, w.IA_l_hip_roll_link, w.pA_r_hip_roll_link, w.pA_l_hip_roll_link);
+}
+
 PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
@@ -3402,6 +3618,12 @@ PROXGEN_RT_NOINLINE void caba_backward_chest(const Scalar* PROXGEN_RT_RESTRICT t
   }
 }
 
+PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link_to_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  shared_14_x2(shared_14_p0, &tau[13], &tau[7], &w.Dinv_r_hip_roll_link, &w.Dinv_l_hip_roll_link, w.IA_r_hip_roll_link, w.IA_l_hip_roll_link, w.u_r_hip_roll_link, w.u_l_hip_roll_link, w.pA_r_hip_roll_link, w.pA_l_hip_roll_link, &w.c_r_hip_roll_link[1], &w.c_l_hip_roll_link[1], &w.cq[7], &w.cq[1], &w.sq[7], &w.sq[1], w.IA_r_hip_yaw_link, w.IA_l_hip_yaw_link, w.pA_r_hip_yaw_link, w.pA_l_hip_yaw_link);
+}
+
 PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
@@ -3489,32 +3711,7 @@ PROXGEN_RT_NOINLINE void caba_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_10(&tau[17], mu, &w.active[1], &w.U_r_foot[1], &w.Dinv_r_foot, w.u_r_foot, w.pA_r_foot, &w.lambda[6], &w.g_r_foot[1], w.g_r_ankle_link, &w.c_r_foot[1], &w.cq[11], &w.sq[11], w.IA_r_ankle_link, w.pA_r_ankle_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_11(&tau[16], &w.Dinv_r_ankle_link, w.IA_r_ankle_link, w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.IA_r_shank, w.pA_r_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_12(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, &w.cq[9], &w.sq[9], w.IA_r_thigh, w.pA_r_thigh);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_13(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, &w.cq[8], &w.sq[8], w.IA_r_hip_roll_link, w.pA_r_hip_roll_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_14(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], &w.cq[7], &w.sq[7], w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
@@ -3609,127 +3806,99 @@ PROXGEN_RT_NOINLINE void caba_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_R
     w.pA_pelvis[4] = w.pA_pelvis[4] - 0.08718915247898762*t36 + 0.9961917745544759*t37;
     w.pA_pelvis[5] = w.pA_pelvis[5] + tau[12] + 0.0875*t38;
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_10(&tau[11], mu, w.active, &w.U_l_foot[1], &w.Dinv_l_foot, w.u_l_foot, w.pA_l_foot, w.lambda, &w.g_l_foot[1], w.g_l_ankle_link, &w.c_l_foot[1], &w.cq[5], &w.sq[5], w.IA_l_ankle_link, w.pA_l_ankle_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_11(&tau[10], &w.Dinv_l_ankle_link, w.IA_l_ankle_link, w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.IA_l_shank, w.pA_l_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_12(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, &w.cq[3], &w.sq[3], w.IA_l_thigh, w.pA_l_thigh);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_13(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, &w.cq[2], &w.sq[2], w.IA_l_hip_roll_link, w.pA_l_hip_roll_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_14(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], &w.cq[1], &w.sq[1], w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
     w.u_l_hip_yaw_link[0] = -w.pA_l_hip_yaw_link[5] + tau[6];
-    const Scalar t0 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
-    const Scalar t1 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
-    const Scalar t2 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
-    const Scalar t3 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
-    const Scalar Ia0 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t0;
-    const Scalar Ia1 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t0;
-    const Scalar Ia2 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t0;
-    const Scalar Ia3 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t0;
-    const Scalar Ia4 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t1;
-    const Scalar Ia5 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t1;
-    const Scalar Ia6 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t1;
-    const Scalar Ia7 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t2;
-    const Scalar Ia8 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t2;
-    const Scalar Ia9 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t3;
-    const Scalar pa0 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t0 + w.c_l_hip_yaw_link[0]*Ia0 + w.c_l_hip_yaw_link[1]*Ia1 + w.c_l_hip_yaw_link[4]*Ia3;
-    const Scalar pa1 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t1 + w.c_l_hip_yaw_link[0]*Ia1 + w.c_l_hip_yaw_link[1]*Ia4 + w.c_l_hip_yaw_link[4]*Ia6;
-    const Scalar pa2 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t2 + w.c_l_hip_yaw_link[0]*Ia2 + w.c_l_hip_yaw_link[1]*Ia5 + w.c_l_hip_yaw_link[4]*Ia8;
-    const Scalar pa3 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
-    const Scalar pa4 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t3 + w.c_l_hip_yaw_link[0]*Ia3 + w.c_l_hip_yaw_link[1]*Ia6 + w.c_l_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
-    const Scalar h0 = 0.5*(Ia0 - Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq[0]*w.sq[0];
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar t5 = -0.01 + 0.5*Ia3;
-    const Scalar d1 = -0.5*Ia6*C20 - t4*t5;
-    const Scalar qq1 = -0.5*Ia6*t4 + C20*t5;
-    const Scalar h1 = 0.00065 - 0.5*Ia9;
-    const Scalar m1 = 0.00065 + 0.5*Ia9;
-    const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 - 0.08718915247898762*qq0;
-    const Scalar t7 = -0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq[0]*Ia2 - 0.9961917745544759*w.sq[0]*Ia5 - 0.08718915247898762*w.sq[0]*Ia2 - 0.08718915247898762*w.cq[0]*Ia5;
-    const Scalar t9 = 0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 + 0.08718915247898762*qq0;
-    const Scalar t11 = 0.08718915247898762*w.cq[0]*Ia2 - 0.08718915247898762*w.sq[0]*Ia5 + 0.9961917745544759*w.sq[0]*Ia2 + 0.9961917745544759*w.cq[0]*Ia5;
-    const Scalar t14 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 - 0.08718915247898762*qq1;
-    const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
-    const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
-    const Scalar t17 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 - 0.9961917745544759*d1 + 0.08718915247898762*qq1;
-    const Scalar t18 = 0.9961917745544759*m1 + 0.9961917745544759*C20*h1 - 0.08718915247898762*t4*h1;
-    const Scalar t19 = -0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t4*h1;
-    const Scalar t20 = 0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t4*h1;
-    const Scalar t21 = 0.9961917745544759*m1 - 0.9961917745544759*C20*h1 + 0.08718915247898762*t4*h1;
-    const Scalar t22 = 0.9961917745544759*t6 - 0.08718915247898762*t7;
-    const Scalar t23 = 0.08718915247898762*t6 + 0.9961917745544759*t7;
-    const Scalar t24 = 0.08718915247898762*t9 + 0.9961917745544759*t10;
-    const Scalar t25 = 0.9961917745544759*t14 - 0.08718915247898762*t15;
-    const Scalar t26 = 0.08718915247898762*t14 + 0.9961917745544759*t15;
-    const Scalar t27 = 0.9961917745544759*t16 - 0.08718915247898762*t17;
-    const Scalar t28 = 0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq[0]*Ia8 - 0.08718915247898762*w.cq[0]*Ia8;
-    const Scalar t30 = -0.08718915247898762*w.sq[0]*Ia8 + 0.9961917745544759*w.cq[0]*Ia8;
-    const Scalar t31 = 0.0875*t8 + t25;
-    const Scalar t32 = 0.0875*t11 + t27;
-    const Scalar t33 = 0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq[0]*pa0 - w.sq[0]*pa1;
-    const Scalar t35 = w.sq[0]*pa0 + w.cq[0]*pa1;
-    const Scalar t36 = w.cq[0]*pa3 - w.sq[0]*pa4;
-    const Scalar t37 = w.sq[0]*pa3 + w.cq[0]*pa4;
-    const Scalar t38 = 0.9961917745544759*t34 - 0.08718915247898762*t35;
-    const Scalar t39 = 0.08718915247898762*t34 + 0.9961917745544759*t35;
-    w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
-    w.IA_pelvis[1] = w.IA_pelvis[1] + t23;
-    w.IA_pelvis[2] = w.IA_pelvis[2] + t8;
-    w.IA_pelvis[3] = w.IA_pelvis[3] + t31;
-    w.IA_pelvis[4] = w.IA_pelvis[4] + t26;
-    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t22;
-    w.IA_pelvis[6] = w.IA_pelvis[6] + t24;
-    w.IA_pelvis[7] = w.IA_pelvis[7] + t11;
-    w.IA_pelvis[8] = w.IA_pelvis[8] + t32;
-    w.IA_pelvis[9] = w.IA_pelvis[9] + t28;
-    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t23;
-    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia7;
-    w.IA_pelvis[12] = w.IA_pelvis[12] + t33;
-    w.IA_pelvis[13] = w.IA_pelvis[13] + t30;
-    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t8;
-    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t18 - 0.08718915247898762*t19 + 0.0875*t29 + 0.0875*t33;
-    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t18 + 0.9961917745544759*t19 + 0.0875*t30;
-    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t8 - 0.0875*t25;
-    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t20 + 0.9961917745544759*t21;
-    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t26;
-    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t22;
-    w.pA_pelvis[0] = w.pA_pelvis[0] + t38;
-    w.pA_pelvis[1] = w.pA_pelvis[1] + t39;
-    w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
-    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa2 + 0.9961917745544759*t36 - 0.08718915247898762*t37;
-    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t36 + 0.9961917745544759*t37;
-    w.pA_pelvis[5] = w.pA_pelvis[5] + tau[6] - 0.0875*t38;
+    const Scalar t40 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
+    const Scalar t41 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
+    const Scalar t42 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
+    const Scalar t43 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
+    const Scalar Ia10 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t40;
+    const Scalar Ia11 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t40;
+    const Scalar Ia12 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t40;
+    const Scalar Ia13 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t40;
+    const Scalar Ia14 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t41;
+    const Scalar Ia15 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t41;
+    const Scalar Ia16 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t41;
+    const Scalar Ia17 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t42;
+    const Scalar Ia18 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t42;
+    const Scalar Ia19 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t43;
+    const Scalar pa5 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t40 + w.c_l_hip_yaw_link[0]*Ia10 + w.c_l_hip_yaw_link[1]*Ia11 + w.c_l_hip_yaw_link[4]*Ia13;
+    const Scalar pa6 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t41 + w.c_l_hip_yaw_link[0]*Ia11 + w.c_l_hip_yaw_link[1]*Ia14 + w.c_l_hip_yaw_link[4]*Ia16;
+    const Scalar pa7 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t42 + w.c_l_hip_yaw_link[0]*Ia12 + w.c_l_hip_yaw_link[1]*Ia15 + w.c_l_hip_yaw_link[4]*Ia18;
+    const Scalar pa8 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
+    const Scalar pa9 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t43 + w.c_l_hip_yaw_link[0]*Ia13 + w.c_l_hip_yaw_link[1]*Ia16 + w.c_l_hip_yaw_link[4]*Ia19;
+    const Scalar C21 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
+    const Scalar h2 = 0.5*(Ia10 - Ia14);
+    const Scalar m2 = 0.5*(Ia10 + Ia14);
+    const Scalar t44 = 2.0*w.cq[0]*w.sq[0];
+    const Scalar d2 = C21*h2 - Ia11*t44;
+    const Scalar qq2 = h2*t44 + Ia11*C21;
+    const Scalar t45 = -0.01 + 0.5*Ia13;
+    const Scalar d3 = -0.5*Ia16*C21 - t44*t45;
+    const Scalar qq3 = -0.5*Ia16*t44 + C21*t45;
+    const Scalar h3 = 0.00065 - 0.5*Ia19;
+    const Scalar m3 = 0.00065 + 0.5*Ia19;
+    const Scalar t46 = 0.9961917745544759*m2 + 0.9961917745544759*d2 - 0.08718915247898762*qq2;
+    const Scalar t47 = -0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
+    const Scalar t48 = 0.9961917745544759*w.cq[0]*Ia12 - 0.9961917745544759*w.sq[0]*Ia15 - 0.08718915247898762*w.sq[0]*Ia12 - 0.08718915247898762*w.cq[0]*Ia15;
+    const Scalar t49 = 0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
+    const Scalar t50 = 0.9961917745544759*m2 - 0.9961917745544759*d2 + 0.08718915247898762*qq2;
+    const Scalar t51 = 0.08718915247898762*w.cq[0]*Ia12 - 0.08718915247898762*w.sq[0]*Ia15 + 0.9961917745544759*w.sq[0]*Ia12 + 0.9961917745544759*w.cq[0]*Ia15;
+    const Scalar t54 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 + 0.9961917745544759*d3 - 0.08718915247898762*qq3;
+    const Scalar t55 = 0.00996191774554476 + 0.49809588727723797*Ia13 - 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
+    const Scalar t56 = -0.00996191774554476 - 0.49809588727723797*Ia13 + 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
+    const Scalar t57 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 - 0.9961917745544759*d3 + 0.08718915247898762*qq3;
+    const Scalar t58 = 0.9961917745544759*m3 + 0.9961917745544759*C21*h3 - 0.08718915247898762*t44*h3;
+    const Scalar t59 = -0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t44*h3;
+    const Scalar t60 = 0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t44*h3;
+    const Scalar t61 = 0.9961917745544759*m3 - 0.9961917745544759*C21*h3 + 0.08718915247898762*t44*h3;
+    const Scalar t62 = 0.9961917745544759*t46 - 0.08718915247898762*t47;
+    const Scalar t63 = 0.08718915247898762*t46 + 0.9961917745544759*t47;
+    const Scalar t64 = 0.08718915247898762*t49 + 0.9961917745544759*t50;
+    const Scalar t65 = 0.9961917745544759*t54 - 0.08718915247898762*t55;
+    const Scalar t66 = 0.08718915247898762*t54 + 0.9961917745544759*t55;
+    const Scalar t67 = 0.9961917745544759*t56 - 0.08718915247898762*t57;
+    const Scalar t68 = 0.08718915247898762*t56 + 0.9961917745544759*t57;
+    const Scalar t69 = -0.9961917745544759*w.sq[0]*Ia18 - 0.08718915247898762*w.cq[0]*Ia18;
+    const Scalar t70 = -0.08718915247898762*w.sq[0]*Ia18 + 0.9961917745544759*w.cq[0]*Ia18;
+    const Scalar t71 = 0.0875*t48 + t65;
+    const Scalar t72 = 0.0875*t51 + t67;
+    const Scalar t73 = 0.0875*Ia17 + t69;
+    const Scalar t74 = w.cq[0]*pa5 - w.sq[0]*pa6;
+    const Scalar t75 = w.sq[0]*pa5 + w.cq[0]*pa6;
+    const Scalar t76 = w.cq[0]*pa8 - w.sq[0]*pa9;
+    const Scalar t77 = w.sq[0]*pa8 + w.cq[0]*pa9;
+    const Scalar t78 = 0.9961917745544759*t74 - 0.08718915247898762*t75;
+    const Scalar t79 = 0.08718915247898762*t74 + 0.9961917745544759*t75;
+    w.IA_pelvis[0] = w.IA_pelvis[0] + t62;
+    w.IA_pelvis[1] = w.IA_pelvis[1] + t63;
+    w.IA_pelvis[2] = w.IA_pelvis[2] + t48;
+    w.IA_pelvis[3] = w.IA_pelvis[3] + t71;
+    w.IA_pelvis[4] = w.IA_pelvis[4] + t66;
+    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t62;
+    w.IA_pelvis[6] = w.IA_pelvis[6] + t64;
+    w.IA_pelvis[7] = w.IA_pelvis[7] + t51;
+    w.IA_pelvis[8] = w.IA_pelvis[8] + t72;
+    w.IA_pelvis[9] = w.IA_pelvis[9] + t68;
+    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t63;
+    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia17;
+    w.IA_pelvis[12] = w.IA_pelvis[12] + t73;
+    w.IA_pelvis[13] = w.IA_pelvis[13] + t70;
+    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t48;
+    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t58 - 0.08718915247898762*t59 + 0.0875*t69 + 0.0875*t73;
+    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t58 + 0.9961917745544759*t59 + 0.0875*t70;
+    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t48 - 0.0875*t65;
+    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t60 + 0.9961917745544759*t61;
+    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t66;
+    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t62;
+    w.pA_pelvis[0] = w.pA_pelvis[0] + t78;
+    w.pA_pelvis[1] = w.pA_pelvis[1] + t79;
+    w.pA_pelvis[2] = w.pA_pelvis[2] + pa7;
+    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa7 + 0.9961917745544759*t76 - 0.08718915247898762*t77;
+    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t76 + 0.9961917745544759*t77;
+    w.pA_pelvis[5] = w.pA_pelvis[5] + tau[6] - 0.0875*t78;
   }
 }
 
@@ -3793,77 +3962,68 @@ PROXGEN_RT_NOINLINE void caba_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT 
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_pelvis_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq, w.sq, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
-  // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
-  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
-  // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, &w.cq[6], &w.sq[6], w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_16_x2(shared_16_p0, w.a_pelvis, w.a_pelvis, w.c_l_hip_yaw_link, w.c_r_hip_yaw_link, w.cq, &w.cq[6], w.sq, &w.sq[6], w.u_l_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.IA_r_hip_yaw_link[5], &w.qdd[6], &w.qdd[12], w.Dinv_l_hip_yaw_link, w.Dinv_r_hip_yaw_link, w.a_l_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
-  // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
-  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
-  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+PROXGEN_RT_NOINLINE void caba_forward_abdomen_to_chest(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  shared_17(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  shared_18_x2(&w.c_l_hip_roll_link[1], &w.c_r_hip_roll_link[1], w.a_l_hip_yaw_link, w.a_r_hip_yaw_link, &w.cq[1], &w.cq[7], &w.sq[1], &w.sq[7], w.u_l_hip_roll_link, w.u_r_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.IA_r_hip_roll_link[3], &w.qdd[7], &w.qdd[13], w.Dinv_l_hip_roll_link, w.Dinv_r_hip_roll_link, w.a_l_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_19(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_l_thigh_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  shared_20_x2(shared_20_p0, w.a_l_hip_roll_link, w.a_r_hip_roll_link, w.c_l_thigh, w.c_r_thigh, &w.cq[2], &w.cq[8], &w.sq[2], &w.sq[8], w.u_l_thigh, w.u_r_thigh, &w.IA_l_thigh[4], &w.IA_r_thigh[4], &w.qdd[8], &w.qdd[14], w.Dinv_l_thigh, w.Dinv_r_thigh, w.a_l_thigh, w.a_r_thigh);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+  shared_21(shared_21_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_l_shank_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  shared_22_x2(shared_22_p0, w.a_l_thigh, w.a_r_thigh, w.c_l_shank, w.c_r_shank, &w.cq[3], &w.cq[9], &w.sq[3], &w.sq[9], w.u_l_shank, w.u_r_shank, &w.IA_l_shank[4], &w.IA_r_shank[4], &w.qdd[9], &w.qdd[15], w.Dinv_l_shank, w.Dinv_r_shank, w.a_l_shank, w.a_r_shank);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  shared_26(&w.c_r_shoulder_roll_link[1], &w.cq[24], w.a_r_shoulder_pitch_link, &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
+  shared_23(&w.c_r_shoulder_roll_link[1], w.a_r_shoulder_pitch_link, &w.cq[24], &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_l_ankle_link_to_r_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  shared_24_x2(shared_24_p0, w.a_l_shank, w.a_r_shank, w.c_l_ankle_link, w.c_r_ankle_link, &w.cq[4], &w.cq[10], &w.sq[4], &w.sq[10], w.u_l_ankle_link, w.u_r_ankle_link, &w.IA_l_ankle_link[4], &w.IA_r_ankle_link[4], &w.qdd[10], &w.qdd[16], w.Dinv_l_ankle_link, w.Dinv_r_ankle_link, w.a_l_ankle_link, w.a_r_ankle_link);
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
-  // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
-  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_25(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_l_foot_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  shared_26_x2(shared_26_p0, &w.c_l_foot[1], &w.c_r_foot[1], w.a_l_ankle_link, w.a_r_ankle_link, &w.cq[5], &w.cq[11], &w.sq[5], &w.sq[11], w.u_l_foot, w.u_r_foot, &w.U_l_foot[1], &w.U_r_foot[1], &w.qdd[11], &w.qdd[17], w.Dinv_l_foot, w.Dinv_r_foot, w.a_l_foot, w.a_r_foot);
+  // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
+  shared_27(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_r_wrist_yaw_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+  shared_28(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, &w.cq[28], &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
+  shared_29(w.c_r_wrist_pitch_link, &w.cq[28], w.a_r_wrist_yaw_link, &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  shared_31(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
+  shared_30(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_32(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
+  shared_31(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -3927,59 +4087,77 @@ PROXGEN_RT_NOINLINE void caba_reduced_r_hand_to_r_forearm(Workspace& PROXGEN_RT_
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_foot_to_l_ankle_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  shared_32_x2(shared_32_p0, &w.dlambda[6], w.dlambda, w.u_r_foot, w.u_l_foot, w.Dinv_r_foot, w.Dinv_l_foot, &w.U_r_foot[1], &w.U_l_foot[1], w.dp_r_ankle_link, w.dp_l_ankle_link, &w.cq[11], &w.cq[5], &w.sq[11], &w.sq[5]);
   // reduced sweep: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
     w.u_r_upper_arm[0] = -w.dp_r_upper_arm[5] + w.u_r_upper_arm[0];
-    const Scalar t0 = -w.dp_r_upper_arm[5]*w.Dinv_r_upper_arm;
-    const Scalar t1 = w.dp_r_upper_arm[0] + w.IA_r_upper_arm[5]*t0;
-    const Scalar t2 = w.dp_r_upper_arm[1] + w.IA_r_upper_arm[10]*t0;
-    const Scalar t3 = w.dp_r_upper_arm[2] + w.IA_r_upper_arm[14]*t0;
-    const Scalar t4 = w.dp_r_upper_arm[3] + w.IA_r_upper_arm[17]*t0;
-    const Scalar t5 = w.dp_r_upper_arm[4] + w.IA_r_upper_arm[19]*t0;
-    w.dp_r_shoulder_roll_link[0] = w.cq[25]*t1 - w.sq[25]*t2;
-    w.dp_r_shoulder_roll_link[1] = w.sq[25]*t1 + w.cq[25]*t2;
-    w.dp_r_shoulder_roll_link[2] = t3;
-    w.dp_r_shoulder_roll_link[3] = w.cq[25]*t4 - w.sq[25]*t5;
-    w.dp_r_shoulder_roll_link[4] = w.sq[25]*t4 + w.cq[25]*t5;
+    const Scalar t8 = -w.dp_r_upper_arm[5]*w.Dinv_r_upper_arm;
+    const Scalar t9 = w.dp_r_upper_arm[0] + w.IA_r_upper_arm[5]*t8;
+    const Scalar t10 = w.dp_r_upper_arm[1] + w.IA_r_upper_arm[10]*t8;
+    const Scalar t11 = w.dp_r_upper_arm[2] + w.IA_r_upper_arm[14]*t8;
+    const Scalar t12 = w.dp_r_upper_arm[3] + w.IA_r_upper_arm[17]*t8;
+    const Scalar t13 = w.dp_r_upper_arm[4] + w.IA_r_upper_arm[19]*t8;
+    w.dp_r_shoulder_roll_link[0] = w.cq[25]*t9 - w.sq[25]*t10;
+    w.dp_r_shoulder_roll_link[1] = w.sq[25]*t9 + w.cq[25]*t10;
+    w.dp_r_shoulder_roll_link[2] = t11;
+    w.dp_r_shoulder_roll_link[3] = w.cq[25]*t12 - w.sq[25]*t13;
+    w.dp_r_shoulder_roll_link[4] = w.sq[25]*t12 + w.cq[25]*t13;
   }
-  // reduced sweep: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    w.u_r_shoulder_roll_link[0] = w.u_r_shoulder_roll_link[0] - w.dp_r_shoulder_roll_link[3];
-    const Scalar t6 = -w.Dinv_r_shoulder_roll_link*w.dp_r_shoulder_roll_link[3];
-    const Scalar t7 = w.dp_r_shoulder_roll_link[0] + w.IA_r_shoulder_roll_link[3]*t6;
-    const Scalar t8 = w.dp_r_shoulder_roll_link[1] + w.IA_r_shoulder_roll_link[8]*t6;
-    const Scalar t9 = w.dp_r_shoulder_roll_link[2] + w.IA_r_shoulder_roll_link[12]*t6;
-    const Scalar t10 = w.dp_r_shoulder_roll_link[4] + w.IA_r_shoulder_roll_link[16]*t6;
-    w.dp_r_shoulder_pitch_link[0] = t7;
-    w.dp_r_shoulder_pitch_link[1] = w.cq[24]*t8 - w.sq[24]*t9;
-    w.dp_r_shoulder_pitch_link[2] = w.sq[24]*t8 + w.cq[24]*t9;
-    w.dp_r_shoulder_pitch_link[4] = w.cq[24]*t10;
-    w.dp_r_shoulder_pitch_link[5] = w.sq[24]*t10;
-  }
-  // reduced sweep: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    w.u_r_shoulder_pitch_link[0] = w.u_r_shoulder_pitch_link[0] - w.dp_r_shoulder_pitch_link[4];
-    const Scalar t11 = -w.Dinv_r_shoulder_pitch_link*w.dp_r_shoulder_pitch_link[4];
-    const Scalar t12 = w.dp_r_shoulder_pitch_link[0] + w.IA_r_shoulder_pitch_link[4]*t11;
-    const Scalar t13 = w.dp_r_shoulder_pitch_link[1] + w.IA_r_shoulder_pitch_link[9]*t11;
-    const Scalar t14 = w.dp_r_shoulder_pitch_link[2] + w.IA_r_shoulder_pitch_link[13]*t11;
-    const Scalar t15 = w.dp_r_shoulder_pitch_link[5] + w.IA_r_shoulder_pitch_link[19]*t11;
-    const Scalar t16 = w.cq[23]*t12 + w.sq[23]*t14;
-    const Scalar t17 = -w.sq[23]*t12 + w.cq[23]*t14;
-    const Scalar t18 = 0.04493516596384369*t13 + 0.9848134698792882*t16 - 0.1676999117594225*t17;
-    const Scalar t19 = 0.9659256678396477*t13 + 0.2588196364430848*t17;
-    const Scalar t20 = -0.2548890642384102*t13 + 0.17361575258114187*t16 + 0.9512566085906322*t17;
-    w.dp_chest[0] = t18;
-    w.dp_chest[1] = t19;
-    w.dp_chest[2] = t20;
-    w.dp_chest[3] = 0.9848134698792882*w.sq[23]*t15 - 0.1676999117594225*w.cq[23]*t15 - 0.254*t19 - 0.19*t20;
-    w.dp_chest[4] = 0.2588196364430848*w.cq[23]*t15 + 0.254*t18;
-    w.dp_chest[5] = 0.17361575258114187*w.sq[23]*t15 + 0.9512566085906322*w.cq[23]*t15 + 0.19*t18;
-  }
+  // reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  shared_33_x2(shared_33_p0, w.u_r_ankle_link, w.u_l_ankle_link, w.dp_r_ankle_link, w.dp_l_ankle_link, w.Dinv_r_ankle_link, w.Dinv_l_ankle_link, &w.IA_r_ankle_link[4], &w.IA_l_ankle_link[4], &w.cq[10], &w.cq[4], &w.sq[10], &w.sq[4], w.dp_r_shank, w.dp_l_shank);
 }
 
-PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_r_shoulder_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // reduced sweep: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+  {
+    w.u_r_shoulder_roll_link[0] = -w.dp_r_shoulder_roll_link[3] + w.u_r_shoulder_roll_link[0];
+    const Scalar t0 = -w.dp_r_shoulder_roll_link[3]*w.Dinv_r_shoulder_roll_link;
+    const Scalar t1 = w.dp_r_shoulder_roll_link[0] + w.IA_r_shoulder_roll_link[3]*t0;
+    const Scalar t2 = w.dp_r_shoulder_roll_link[1] + w.IA_r_shoulder_roll_link[8]*t0;
+    const Scalar t3 = w.dp_r_shoulder_roll_link[2] + w.IA_r_shoulder_roll_link[12]*t0;
+    const Scalar t4 = w.dp_r_shoulder_roll_link[4] + w.IA_r_shoulder_roll_link[16]*t0;
+    w.dp_r_shoulder_pitch_link[0] = t1;
+    w.dp_r_shoulder_pitch_link[1] = w.cq[24]*t2 - w.sq[24]*t3;
+    w.dp_r_shoulder_pitch_link[2] = w.sq[24]*t2 + w.cq[24]*t3;
+    w.dp_r_shoulder_pitch_link[4] = w.cq[24]*t4;
+    w.dp_r_shoulder_pitch_link[5] = w.sq[24]*t4;
+  }
+  // reduced sweep: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  // reduced sweep: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  shared_34_x2(shared_34_p0, w.u_r_shank, w.u_l_shank, w.dp_r_shank, w.dp_l_shank, w.Dinv_r_shank, w.Dinv_l_shank, &w.IA_r_shank[4], &w.IA_l_shank[4], &w.cq[9], &w.cq[3], &w.sq[9], &w.sq[3], w.dp_r_thigh, w.dp_l_thigh);
+}
+
+PROXGEN_RT_NOINLINE void caba_reduced_r_shoulder_pitch_link_to_l_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // reduced sweep: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+  {
+    w.u_r_shoulder_pitch_link[0] = -w.dp_r_shoulder_pitch_link[4] + w.u_r_shoulder_pitch_link[0];
+    const Scalar t0 = -w.dp_r_shoulder_pitch_link[4]*w.Dinv_r_shoulder_pitch_link;
+    const Scalar t1 = w.dp_r_shoulder_pitch_link[0] + w.IA_r_shoulder_pitch_link[4]*t0;
+    const Scalar t2 = w.dp_r_shoulder_pitch_link[1] + w.IA_r_shoulder_pitch_link[9]*t0;
+    const Scalar t3 = w.dp_r_shoulder_pitch_link[2] + w.IA_r_shoulder_pitch_link[13]*t0;
+    const Scalar t4 = w.dp_r_shoulder_pitch_link[5] + w.IA_r_shoulder_pitch_link[19]*t0;
+    const Scalar t5 = w.cq[23]*t1 + w.sq[23]*t3;
+    const Scalar t6 = -w.sq[23]*t1 + w.cq[23]*t3;
+    const Scalar t7 = 0.04493516596384369*t2 + 0.9848134698792882*t5 - 0.1676999117594225*t6;
+    const Scalar t8 = 0.9659256678396477*t2 + 0.2588196364430848*t6;
+    const Scalar t9 = -0.2548890642384102*t2 + 0.17361575258114187*t5 + 0.9512566085906322*t6;
+    w.dp_chest[0] = t7;
+    w.dp_chest[1] = t8;
+    w.dp_chest[2] = t9;
+    w.dp_chest[3] = 0.9848134698792882*w.sq[23]*t4 - 0.1676999117594225*w.cq[23]*t4 - 0.254*t8 - 0.19*t9;
+    w.dp_chest[4] = 0.2588196364430848*w.cq[23]*t4 + 0.254*t7;
+    w.dp_chest[5] = 0.17361575258114187*w.sq[23]*t4 + 0.9512566085906322*w.cq[23]*t4 + 0.19*t7;
+  }
+  // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  // reduced sweep: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  shared_35_x2(shared_35_p0, w.u_r_thigh, w.u_l_thigh, w.dp_r_thigh, w.dp_l_thigh, w.Dinv_r_thigh, w.Dinv_l_thigh, &w.IA_r_thigh[4], &w.IA_l_thigh[4], &w.cq[8], &w.cq[2], &w.sq[8], &w.sq[2], w.dp_r_hip_roll_link, w.dp_l_hip_roll_link);
+}
+
+PROXGEN_RT_NOINLINE void caba_reduced_chest_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
     w.u_chest[0] = -w.dp_chest[4] + w.u_chest[0];
@@ -3998,190 +4176,66 @@ PROXGEN_RT_NOINLINE void caba_reduced_chest_to_r_foot(Workspace& PROXGEN_RT_REST
     w.dp_abdomen[4] = 0.15*t6;
     w.dp_abdomen[5] = -w.sq[13]*t4 + w.cq[13]*t5;
   }
+  // reduced sweep: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  shared_36_x2(w.u_r_hip_roll_link, w.u_l_hip_roll_link, w.dp_r_hip_roll_link, w.dp_l_hip_roll_link, w.Dinv_r_hip_roll_link, w.Dinv_l_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.IA_l_hip_roll_link[3], w.dp_r_hip_yaw_link, w.dp_l_hip_yaw_link, &w.cq[7], &w.cq[1], &w.sq[7], &w.sq[1]);
   // reduced sweep: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
     w.u_abdomen[0] = w.u_abdomen[0] - w.dp_abdomen[5];
-    const Scalar t8 = -w.Dinv_abdomen*w.dp_abdomen[5];
-    const Scalar t9 = w.dp_abdomen[0] + w.IA_abdomen[5]*t8;
-    const Scalar t10 = w.dp_abdomen[1] + w.IA_abdomen[10]*t8;
-    const Scalar t11 = w.dp_abdomen[2] + w.IA_abdomen[14]*t8;
-    const Scalar t12 = w.dp_abdomen[3] + w.IA_abdomen[17]*t8;
-    const Scalar t13 = w.dp_abdomen[4] + w.IA_abdomen[19]*t8;
-    const Scalar t14 = w.cq[12]*t9 - w.sq[12]*t10;
-    const Scalar t15 = w.sq[12]*t9 + w.cq[12]*t10;
-    w.dp_pelvis[0] = t14;
-    w.dp_pelvis[1] = t15;
-    w.dp_pelvis[2] = t11;
-    w.dp_pelvis[3] = w.cq[12]*t12 - w.sq[12]*t13 - 0.1*t15;
-    w.dp_pelvis[4] = w.sq[12]*t12 + w.cq[12]*t13 + 0.1*t14;
+    const Scalar t18 = -w.Dinv_abdomen*w.dp_abdomen[5];
+    const Scalar t19 = w.dp_abdomen[0] + w.IA_abdomen[5]*t18;
+    const Scalar t20 = w.dp_abdomen[1] + w.IA_abdomen[10]*t18;
+    const Scalar t21 = w.dp_abdomen[2] + w.IA_abdomen[14]*t18;
+    const Scalar t22 = w.dp_abdomen[3] + w.IA_abdomen[17]*t18;
+    const Scalar t23 = w.dp_abdomen[4] + w.IA_abdomen[19]*t18;
+    const Scalar t24 = w.cq[12]*t19 - w.sq[12]*t20;
+    const Scalar t25 = w.sq[12]*t19 + w.cq[12]*t20;
+    w.dp_pelvis[0] = t24;
+    w.dp_pelvis[1] = t25;
+    w.dp_pelvis[2] = t21;
+    w.dp_pelvis[3] = w.cq[12]*t22 - w.sq[12]*t23 - 0.1*t25;
+    w.dp_pelvis[4] = w.sq[12]*t22 + w.cq[12]*t23 + 0.1*t24;
   }
-  // reduced sweep: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_33(&w.dlambda[6], w.u_r_foot, w.Dinv_r_foot, &w.U_r_foot[1], w.dp_r_ankle_link, &w.cq[11], &w.sq[11]);
 }
 
-PROXGEN_RT_NOINLINE void caba_reduced_r_ankle_link_to_r_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  {
-    w.u_r_ankle_link[0] = -w.dp_r_ankle_link[4] + w.u_r_ankle_link[0];
-    const Scalar t0 = -w.dp_r_ankle_link[4]*w.Dinv_r_ankle_link;
-    const Scalar t1 = w.dp_r_ankle_link[0] + w.IA_r_ankle_link[4]*t0;
-    const Scalar t2 = w.dp_r_ankle_link[1] + w.IA_r_ankle_link[9]*t0;
-    const Scalar t3 = w.dp_r_ankle_link[2] + w.IA_r_ankle_link[13]*t0;
-    const Scalar t4 = w.dp_r_ankle_link[5] + w.IA_r_ankle_link[19]*t0;
-    const Scalar t5 = w.cq[10]*t1 + w.sq[10]*t3;
-    const Scalar t6 = -w.sq[10]*t1 + w.cq[10]*t3;
-    const Scalar t7 = 0.9950041652780258*t5 - 0.09983341664682815*t6;
-    const Scalar t8 = 0.09983341664682815*t5 + 0.9950041652780258*t6;
-    w.dp_r_shank[0] = t7;
-    w.dp_r_shank[1] = t2;
-    w.dp_r_shank[2] = t8;
-    w.dp_r_shank[3] = 0.4305*t2 + 0.9950041652780258*w.sq[10]*t4 - 0.09983341664682815*w.cq[10]*t4;
-    w.dp_r_shank[4] = -0.4305*t7;
-    w.dp_r_shank[5] = 0.09983341664682815*w.sq[10]*t4 + 0.9950041652780258*w.cq[10]*t4;
-  }
-  // reduced sweep: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  {
-    w.u_r_shank[0] = w.u_r_shank[0] - w.dp_r_shank[4];
-    const Scalar t9 = -w.Dinv_r_shank*w.dp_r_shank[4];
-    const Scalar t10 = w.dp_r_shank[0] + w.IA_r_shank[4]*t9;
-    const Scalar t11 = w.dp_r_shank[1] + w.IA_r_shank[9]*t9;
-    const Scalar t12 = w.dp_r_shank[2] + w.IA_r_shank[13]*t9;
-    const Scalar t13 = w.dp_r_shank[3] + w.IA_r_shank[16]*t9;
-    const Scalar t14 = w.dp_r_shank[5] + w.IA_r_shank[19]*t9;
-    const Scalar t15 = w.cq[9]*t10 + w.sq[9]*t12;
-    const Scalar t16 = -w.sq[9]*t10 + w.cq[9]*t12;
-    const Scalar t17 = w.cq[9]*t13 + w.sq[9]*t14;
-    const Scalar t18 = -w.sq[9]*t13 + w.cq[9]*t14;
-    const Scalar t19 = 0.9800665778412416*t15 + 0.19866933079506124*t16;
-    const Scalar t20 = -0.19866933079506124*t15 + 0.9800665778412416*t16;
-    w.dp_r_thigh[0] = t19;
-    w.dp_r_thigh[1] = t11;
-    w.dp_r_thigh[2] = t20;
-    w.dp_r_thigh[3] = 0.42875*t11 + 0.9800665778412416*t17 + 0.19866933079506124*t18;
-    w.dp_r_thigh[4] = -0.42875*t19;
-    w.dp_r_thigh[5] = -0.19866933079506124*t17 + 0.9800665778412416*t18;
-  }
-  // reduced sweep: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_34(w.u_r_thigh, w.dp_r_thigh, w.Dinv_r_thigh, &w.IA_r_thigh[4], &w.cq[8], &w.sq[8], w.dp_r_hip_roll_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_r_hip_roll_link_to_l_ankle_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  {
-    w.u_r_hip_roll_link[0] = -w.dp_r_hip_roll_link[3] + w.u_r_hip_roll_link[0];
-    const Scalar t0 = -w.dp_r_hip_roll_link[3]*w.Dinv_r_hip_roll_link;
-    const Scalar t1 = w.dp_r_hip_roll_link[0] + w.IA_r_hip_roll_link[3]*t0;
-    const Scalar t2 = w.dp_r_hip_roll_link[1] + w.IA_r_hip_roll_link[8]*t0;
-    const Scalar t3 = w.dp_r_hip_roll_link[2] + w.IA_r_hip_roll_link[12]*t0;
-    const Scalar t4 = w.dp_r_hip_roll_link[5] + w.IA_r_hip_roll_link[17]*t0;
-    w.dp_r_hip_yaw_link[0] = t1;
-    w.dp_r_hip_yaw_link[1] = w.cq[7]*t2 - w.sq[7]*t3;
-    w.dp_r_hip_yaw_link[2] = w.sq[7]*t2 + w.cq[7]*t3;
-    w.dp_r_hip_yaw_link[4] = -w.sq[7]*t4;
-    w.dp_r_hip_yaw_link[5] = w.cq[7]*t4;
-  }
+PROXGEN_RT_NOINLINE void caba_reduced_r_hip_yaw_link_to_pelvis(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
-    w.u_r_hip_yaw_link[0] = w.u_r_hip_yaw_link[0] - w.dp_r_hip_yaw_link[5];
-    const Scalar t5 = -w.Dinv_r_hip_yaw_link*w.dp_r_hip_yaw_link[5];
-    const Scalar t6 = w.dp_r_hip_yaw_link[0] + w.IA_r_hip_yaw_link[5]*t5;
-    const Scalar t7 = w.dp_r_hip_yaw_link[1] + w.IA_r_hip_yaw_link[10]*t5;
-    const Scalar t8 = w.dp_r_hip_yaw_link[2] + w.IA_r_hip_yaw_link[14]*t5;
-    const Scalar t9 = w.dp_r_hip_yaw_link[4] + w.IA_r_hip_yaw_link[19]*t5;
-    const Scalar t10 = w.cq[6]*t6 - w.sq[6]*t7;
-    const Scalar t11 = w.sq[6]*t6 + w.cq[6]*t7;
-    const Scalar t12 = 0.9961917745544759*t10 + 0.08718915247898762*t11;
-    const Scalar t13 = -0.08718915247898762*t10 + 0.9961917745544759*t11;
-    w.dp_pelvis[0] = w.dp_pelvis[0] + t12;
-    w.dp_pelvis[1] = w.dp_pelvis[1] + t13;
-    w.dp_pelvis[2] = w.dp_pelvis[2] + t8;
-    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t8 - 0.9961917745544759*w.sq[6]*t9 + 0.08718915247898762*w.cq[6]*t9;
-    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*w.sq[6]*t9 + 0.9961917745544759*w.cq[6]*t9;
-    w.dp_pelvis[5] = 0.0875*t12;
-  }
-  // reduced sweep: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_33(w.dlambda, w.u_l_foot, w.Dinv_l_foot, &w.U_l_foot[1], w.dp_l_ankle_link, &w.cq[5], &w.sq[5]);
-  // reduced sweep: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  {
-    w.u_l_ankle_link[0] = w.u_l_ankle_link[0] - w.dp_l_ankle_link[4];
-    const Scalar t18 = -w.Dinv_l_ankle_link*w.dp_l_ankle_link[4];
-    const Scalar t19 = w.dp_l_ankle_link[0] + w.IA_l_ankle_link[4]*t18;
-    const Scalar t20 = w.dp_l_ankle_link[1] + w.IA_l_ankle_link[9]*t18;
-    const Scalar t21 = w.dp_l_ankle_link[2] + w.IA_l_ankle_link[13]*t18;
-    const Scalar t22 = w.dp_l_ankle_link[5] + w.IA_l_ankle_link[19]*t18;
-    const Scalar t23 = w.cq[4]*t19 + w.sq[4]*t21;
-    const Scalar t24 = -w.sq[4]*t19 + w.cq[4]*t21;
-    const Scalar t25 = 0.9950041652780258*t23 - 0.09983341664682815*t24;
-    const Scalar t26 = 0.09983341664682815*t23 + 0.9950041652780258*t24;
-    w.dp_l_shank[0] = t25;
-    w.dp_l_shank[1] = t20;
-    w.dp_l_shank[2] = t26;
-    w.dp_l_shank[3] = 0.4305*t20 + 0.9950041652780258*w.sq[4]*t22 - 0.09983341664682815*w.cq[4]*t22;
-    w.dp_l_shank[4] = -0.4305*t25;
-    w.dp_l_shank[5] = 0.09983341664682815*w.sq[4]*t22 + 0.9950041652780258*w.cq[4]*t22;
-  }
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_l_shank_to_l_hip_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  {
-    w.u_l_shank[0] = -w.dp_l_shank[4] + w.u_l_shank[0];
-    const Scalar t0 = -w.dp_l_shank[4]*w.Dinv_l_shank;
-    const Scalar t1 = w.dp_l_shank[0] + w.IA_l_shank[4]*t0;
-    const Scalar t2 = w.dp_l_shank[1] + w.IA_l_shank[9]*t0;
-    const Scalar t3 = w.dp_l_shank[2] + w.IA_l_shank[13]*t0;
-    const Scalar t4 = w.dp_l_shank[3] + w.IA_l_shank[16]*t0;
-    const Scalar t5 = w.dp_l_shank[5] + w.IA_l_shank[19]*t0;
-    const Scalar t6 = w.cq[3]*t1 + w.sq[3]*t3;
-    const Scalar t7 = -w.sq[3]*t1 + w.cq[3]*t3;
-    const Scalar t8 = w.cq[3]*t4 + w.sq[3]*t5;
-    const Scalar t9 = -w.sq[3]*t4 + w.cq[3]*t5;
-    const Scalar t10 = 0.9800665778412416*t6 + 0.19866933079506124*t7;
-    const Scalar t11 = -0.19866933079506124*t6 + 0.9800665778412416*t7;
-    w.dp_l_thigh[0] = t10;
-    w.dp_l_thigh[1] = t2;
-    w.dp_l_thigh[2] = t11;
-    w.dp_l_thigh[3] = 0.42875*t2 + 0.9800665778412416*t8 + 0.19866933079506124*t9;
-    w.dp_l_thigh[4] = -0.42875*t10;
-    w.dp_l_thigh[5] = -0.19866933079506124*t8 + 0.9800665778412416*t9;
-  }
-  // reduced sweep: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_34(w.u_l_thigh, w.dp_l_thigh, w.Dinv_l_thigh, &w.IA_l_thigh[4], &w.cq[2], &w.sq[2], w.dp_l_hip_roll_link);
-  // reduced sweep: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  {
-    w.u_l_hip_roll_link[0] = w.u_l_hip_roll_link[0] - w.dp_l_hip_roll_link[3];
-    const Scalar t22 = -w.Dinv_l_hip_roll_link*w.dp_l_hip_roll_link[3];
-    const Scalar t23 = w.dp_l_hip_roll_link[0] + w.IA_l_hip_roll_link[3]*t22;
-    const Scalar t24 = w.dp_l_hip_roll_link[1] + w.IA_l_hip_roll_link[8]*t22;
-    const Scalar t25 = w.dp_l_hip_roll_link[2] + w.IA_l_hip_roll_link[12]*t22;
-    const Scalar t26 = w.dp_l_hip_roll_link[5] + w.IA_l_hip_roll_link[17]*t22;
-    w.dp_l_hip_yaw_link[0] = t23;
-    w.dp_l_hip_yaw_link[1] = w.cq[1]*t24 - w.sq[1]*t25;
-    w.dp_l_hip_yaw_link[2] = w.sq[1]*t24 + w.cq[1]*t25;
-    w.dp_l_hip_yaw_link[4] = -w.sq[1]*t26;
-    w.dp_l_hip_yaw_link[5] = w.cq[1]*t26;
-  }
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_l_hip_yaw_link_to_pelvis(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    w.u_l_hip_yaw_link[0] = -w.dp_l_hip_yaw_link[5] + w.u_l_hip_yaw_link[0];
-    const Scalar t0 = -w.dp_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
-    const Scalar t1 = w.dp_l_hip_yaw_link[0] + w.IA_l_hip_yaw_link[5]*t0;
-    const Scalar t2 = w.dp_l_hip_yaw_link[1] + w.IA_l_hip_yaw_link[10]*t0;
-    const Scalar t3 = w.dp_l_hip_yaw_link[2] + w.IA_l_hip_yaw_link[14]*t0;
-    const Scalar t4 = w.dp_l_hip_yaw_link[4] + w.IA_l_hip_yaw_link[19]*t0;
-    const Scalar t5 = w.cq[0]*t1 - w.sq[0]*t2;
-    const Scalar t6 = w.sq[0]*t1 + w.cq[0]*t2;
-    const Scalar t7 = 0.9961917745544759*t5 - 0.08718915247898762*t6;
-    const Scalar t8 = 0.08718915247898762*t5 + 0.9961917745544759*t6;
+    w.u_r_hip_yaw_link[0] = -w.dp_r_hip_yaw_link[5] + w.u_r_hip_yaw_link[0];
+    const Scalar t0 = -w.dp_r_hip_yaw_link[5]*w.Dinv_r_hip_yaw_link;
+    const Scalar t1 = w.dp_r_hip_yaw_link[0] + w.IA_r_hip_yaw_link[5]*t0;
+    const Scalar t2 = w.dp_r_hip_yaw_link[1] + w.IA_r_hip_yaw_link[10]*t0;
+    const Scalar t3 = w.dp_r_hip_yaw_link[2] + w.IA_r_hip_yaw_link[14]*t0;
+    const Scalar t4 = w.dp_r_hip_yaw_link[4] + w.IA_r_hip_yaw_link[19]*t0;
+    const Scalar t5 = w.cq[6]*t1 - w.sq[6]*t2;
+    const Scalar t6 = w.sq[6]*t1 + w.cq[6]*t2;
+    const Scalar t7 = 0.9961917745544759*t5 + 0.08718915247898762*t6;
+    const Scalar t8 = -0.08718915247898762*t5 + 0.9961917745544759*t6;
     w.dp_pelvis[0] = w.dp_pelvis[0] + t7;
     w.dp_pelvis[1] = w.dp_pelvis[1] + t8;
     w.dp_pelvis[2] = w.dp_pelvis[2] + t3;
-    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t3 - 0.9961917745544759*w.sq[0]*t4 - 0.08718915247898762*w.cq[0]*t4;
-    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*w.sq[0]*t4 + 0.9961917745544759*w.cq[0]*t4;
-    w.dp_pelvis[5] = w.dp_pelvis[5] - 0.0875*t7;
+    w.dp_pelvis[3] = w.dp_pelvis[3] - 0.0875*t3 - 0.9961917745544759*w.sq[6]*t4 + 0.08718915247898762*w.cq[6]*t4;
+    w.dp_pelvis[4] = w.dp_pelvis[4] + 0.08718915247898762*w.sq[6]*t4 + 0.9961917745544759*w.cq[6]*t4;
+    w.dp_pelvis[5] = 0.0875*t7;
+  }
+  // reduced sweep: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
+  {
+    w.u_l_hip_yaw_link[0] = -w.dp_l_hip_yaw_link[5] + w.u_l_hip_yaw_link[0];
+    const Scalar t9 = -w.dp_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
+    const Scalar t10 = w.dp_l_hip_yaw_link[0] + w.IA_l_hip_yaw_link[5]*t9;
+    const Scalar t11 = w.dp_l_hip_yaw_link[1] + w.IA_l_hip_yaw_link[10]*t9;
+    const Scalar t12 = w.dp_l_hip_yaw_link[2] + w.IA_l_hip_yaw_link[14]*t9;
+    const Scalar t13 = w.dp_l_hip_yaw_link[4] + w.IA_l_hip_yaw_link[19]*t9;
+    const Scalar t14 = w.cq[0]*t10 - w.sq[0]*t11;
+    const Scalar t15 = w.sq[0]*t10 + w.cq[0]*t11;
+    const Scalar t16 = 0.9961917745544759*t14 - 0.08718915247898762*t15;
+    const Scalar t17 = 0.08718915247898762*t14 + 0.9961917745544759*t15;
+    w.dp_pelvis[0] = w.dp_pelvis[0] + t16;
+    w.dp_pelvis[1] = w.dp_pelvis[1] + t17;
+    w.dp_pelvis[2] = w.dp_pelvis[2] + t12;
+    w.dp_pelvis[3] = w.dp_pelvis[3] + 0.0875*t12 - 0.9961917745544759*w.sq[0]*t13 - 0.08718915247898762*w.cq[0]*t13;
+    w.dp_pelvis[4] = w.dp_pelvis[4] - 0.08718915247898762*w.sq[0]*t13 + 0.9961917745544759*w.cq[0]*t13;
+    w.dp_pelvis[5] = w.dp_pelvis[5] - 0.0875*t16;
   }
   // reduced sweep: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
@@ -4194,172 +4248,178 @@ PROXGEN_RT_NOINLINE void caba_reduced_l_hip_yaw_link_to_pelvis(Workspace& PROXGE
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_pelvis_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   shared_15(w.u_pelvis, w.RJ_pelvis, 0, w.IA_pelvis, w.Linv_pelvis, &w.L_pelvis[1], w.qdd, w.a_pelvis);
   // accelerate body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_16(w.a_pelvis, w.c_l_hip_yaw_link, w.cq, w.sq, w.u_l_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.qdd[6], w.Dinv_l_hip_yaw_link, w.a_l_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_17(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
-  // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_18(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
-  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_19(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_20(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
-  // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_21(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.U_l_foot[1], &w.qdd[11], w.Dinv_l_foot, w.a_l_foot);
   // accelerate body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  shared_22(w.a_pelvis, w.c_r_hip_yaw_link, &w.cq[6], &w.sq[6], w.u_r_hip_yaw_link, &w.IA_r_hip_yaw_link[5], &w.qdd[12], w.Dinv_r_hip_yaw_link, w.a_r_hip_yaw_link);
+  shared_16_x2(shared_16_p0, w.a_pelvis, w.a_pelvis, w.c_l_hip_yaw_link, w.c_r_hip_yaw_link, w.cq, &w.cq[6], w.sq, &w.sq[6], w.u_l_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.IA_r_hip_yaw_link[5], &w.qdd[6], &w.qdd[12], w.Dinv_l_hip_yaw_link, w.Dinv_r_hip_yaw_link, w.a_l_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_17(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
-  // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_18(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
-  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_19(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_20(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
-  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_21(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.U_r_foot[1], &w.qdd[17], w.Dinv_r_foot, w.a_r_foot);
+PROXGEN_RT_NOINLINE void caba_reforward_abdomen_to_chest(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
-  shared_23(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  shared_17(w.a_pelvis, w.c_abdomen, &w.cq[12], &w.sq[12], w.u_abdomen, &w.IA_abdomen[5], &w.qdd[18], w.Dinv_abdomen, w.a_abdomen);
+  // accelerate body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  // accelerate body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  shared_18_x2(&w.c_l_hip_roll_link[1], &w.c_r_hip_roll_link[1], w.a_l_hip_yaw_link, w.a_r_hip_yaw_link, &w.cq[1], &w.cq[7], &w.sq[1], &w.sq[7], w.u_l_hip_roll_link, w.u_r_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.IA_r_hip_roll_link[3], &w.qdd[7], &w.qdd[13], w.Dinv_l_hip_roll_link, w.Dinv_r_hip_roll_link, w.a_l_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
-  shared_24(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+  shared_19(w.a_abdomen, w.c_chest, &w.cq[13], &w.sq[13], w.u_chest, &w.IA_chest[4], &w.qdd[19], w.Dinv_chest, w.a_chest);
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_l_thigh_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  // accelerate body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  shared_20_x2(shared_20_p0, w.a_l_hip_roll_link, w.a_r_hip_roll_link, w.c_l_thigh, w.c_r_thigh, &w.cq[2], &w.cq[8], &w.sq[2], &w.sq[8], w.u_l_thigh, w.u_r_thigh, &w.IA_l_thigh[4], &w.IA_r_thigh[4], &w.qdd[8], &w.qdd[14], w.Dinv_l_thigh, w.Dinv_r_thigh, w.a_l_thigh, w.a_r_thigh);
   // accelerate body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  shared_25(shared_25_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+  shared_21(shared_21_k0, w.a_chest, w.c_r_shoulder_pitch_link, &w.cq[23], &w.sq[23], w.u_r_shoulder_pitch_link, &w.IA_r_shoulder_pitch_link[4], &w.qdd[29], w.Dinv_r_shoulder_pitch_link, w.a_r_shoulder_pitch_link);
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_l_shank_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  // accelerate body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  shared_22_x2(shared_22_p0, w.a_l_thigh, w.a_r_thigh, w.c_l_shank, w.c_r_shank, &w.cq[3], &w.cq[9], &w.sq[3], &w.sq[9], w.u_l_shank, w.u_r_shank, &w.IA_l_shank[4], &w.IA_r_shank[4], &w.qdd[9], &w.qdd[15], w.Dinv_l_shank, w.Dinv_r_shank, w.a_l_shank, w.a_r_shank);
   // accelerate body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  shared_26(&w.c_r_shoulder_roll_link[1], &w.cq[24], w.a_r_shoulder_pitch_link, &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
+  shared_23(&w.c_r_shoulder_roll_link[1], w.a_r_shoulder_pitch_link, &w.cq[24], &w.sq[24], w.u_r_shoulder_roll_link, &w.IA_r_shoulder_roll_link[3], &w.qdd[30], w.Dinv_r_shoulder_roll_link, w.a_r_shoulder_roll_link);
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_l_ankle_link_to_r_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  // accelerate body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  shared_24_x2(shared_24_p0, w.a_l_shank, w.a_r_shank, w.c_l_ankle_link, w.c_r_ankle_link, &w.cq[4], &w.cq[10], &w.sq[4], &w.sq[10], w.u_l_ankle_link, w.u_r_ankle_link, &w.IA_l_ankle_link[4], &w.IA_r_ankle_link[4], &w.qdd[10], &w.qdd[16], w.Dinv_l_ankle_link, w.Dinv_r_ankle_link, w.a_l_ankle_link, w.a_r_ankle_link);
   // accelerate body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
-  shared_27(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
-  // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  shared_28(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
-  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  shared_29(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
+  shared_25(w.c_r_upper_arm, w.a_r_shoulder_roll_link, &w.cq[25], &w.sq[25], w.u_r_upper_arm, &w.IA_r_upper_arm[5], &w.qdd[31], w.Dinv_r_upper_arm, w.a_r_upper_arm);
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_l_foot_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  // accelerate body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  shared_26_x2(shared_26_p0, &w.c_l_foot[1], &w.c_r_foot[1], w.a_l_ankle_link, w.a_r_ankle_link, &w.cq[5], &w.cq[11], &w.sq[5], &w.sq[11], w.u_l_foot, w.u_r_foot, &w.U_l_foot[1], &w.U_r_foot[1], &w.qdd[11], &w.qdd[17], w.Dinv_l_foot, w.Dinv_r_foot, w.a_l_foot, w.a_r_foot);
+  // accelerate body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
+  shared_27(w.a_r_upper_arm, w.c_r_forearm, &w.cq[26], &w.sq[26], w.u_r_forearm, &w.IA_r_forearm[4], &w.qdd[32], w.Dinv_r_forearm, w.a_r_forearm);
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_r_wrist_yaw_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+  shared_28(w.a_r_forearm, w.c_r_wrist_yaw_link, &w.cq[27], &w.sq[27], w.u_r_wrist_yaw_link, &w.IA_r_wrist_yaw_link[5], &w.qdd[33], w.Dinv_r_wrist_yaw_link, w.a_r_wrist_yaw_link);
   // accelerate body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
-  shared_30(w.c_r_wrist_pitch_link, w.a_r_wrist_yaw_link, &w.cq[28], &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
+  shared_29(w.c_r_wrist_pitch_link, &w.cq[28], w.a_r_wrist_yaw_link, &w.sq[28], w.u_r_wrist_pitch_link, &w.IA_r_wrist_pitch_link[4], &w.qdd[34], w.Dinv_r_wrist_pitch_link, w.a_r_wrist_pitch_link);
   // accelerate body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
-  shared_31(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
+  shared_30(&w.c_r_hand[1], &w.cq[29], w.a_r_wrist_pitch_link, &w.sq[29], w.u_r_hand, &w.U_r_hand[1], &w.qdd[35], w.Dinv_r_hand, w.a_r_hand);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-  shared_32(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
+  shared_31(mu, w.g_l_ankle_link, w.a_l_foot, w.residual, w.active, w.dlambda, w.lambda, &w.g_l_foot[1], w.g_r_ankle_link, w.a_r_foot, &w.g_r_foot[1], w.a_r_hand, w.k_right_hand);
 }
 
-PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void accelerate_free_l_shoulder_pitch_link_to_l_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 16 'l_shoulder_pitch_link': joint 'l_shoulder_pitch' (revolute about y), parent 'chest', off the support
-  shared_25(shared_25_k1, w.a_chest, w.c_l_shoulder_pitch_link, &w.cq[14], &w.sq[14], w.u_l_shoulder_pitch_link, &w.IA_l_shoulder_pitch_link[4], &w.qdd[20], w.Dinv_l_shoulder_pitch_link, w.a_l_shoulder_pitch_link);
-  // accelerate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
-  shared_26(&w.c_l_shoulder_roll_link[1], &w.cq[15], w.a_l_shoulder_pitch_link, &w.sq[15], w.u_l_shoulder_roll_link, &w.IA_l_shoulder_roll_link[3], &w.qdd[21], w.Dinv_l_shoulder_roll_link, w.a_l_shoulder_roll_link);
-  // accelerate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
-  {
-    const Scalar t19 = w.c_l_upper_arm[0] + w.cq[16]*w.a_l_shoulder_roll_link[0] + w.sq[16]*w.a_l_shoulder_roll_link[1];
-    const Scalar t20 = w.c_l_upper_arm[1] - w.sq[16]*w.a_l_shoulder_roll_link[0] + w.cq[16]*w.a_l_shoulder_roll_link[1];
-    const Scalar t21 = w.c_l_upper_arm[3] + w.cq[16]*w.a_l_shoulder_roll_link[3] + w.sq[16]*w.a_l_shoulder_roll_link[4];
-    const Scalar t22 = w.c_l_upper_arm[4] - w.sq[16]*w.a_l_shoulder_roll_link[3] + w.cq[16]*w.a_l_shoulder_roll_link[4];
-    const Scalar t23 = w.u_l_upper_arm[0] - w.IA_l_upper_arm[5]*t19 - w.IA_l_upper_arm[10]*t20 - w.IA_l_upper_arm[14]*w.a_l_shoulder_roll_link[2] - w.IA_l_upper_arm[17]*t21 - w.IA_l_upper_arm[19]*t22 - w.IA_l_upper_arm[20]*w.a_l_shoulder_roll_link[5];
-    w.qdd[22] = w.Dinv_l_upper_arm*t23;
-    w.a_l_upper_arm[0] = t19;
-    w.a_l_upper_arm[1] = t20;
-    w.a_l_upper_arm[2] = w.a_l_shoulder_roll_link[2];
-    w.a_l_upper_arm[3] = t21;
-    w.a_l_upper_arm[4] = t22;
-    w.a_l_upper_arm[5] = w.a_l_shoulder_roll_link[5] + w.qdd[22];
-  }
-}
-
-PROXGEN_RT_NOINLINE void accelerate_free_l_forearm_to_l_wrist_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
-  {
-    const Scalar t0 = w.a_l_upper_arm[0] - 0.3255*w.a_l_upper_arm[4];
-    const Scalar t1 = w.a_l_upper_arm[1] + 0.3255*w.a_l_upper_arm[3];
-    const Scalar t2 = 0.29552020666133966*w.a_l_upper_arm[2] + 0.955336489125606*t0;
-    const Scalar t3 = 0.955336489125606*w.a_l_upper_arm[2] - 0.29552020666133966*t0;
-    const Scalar t4 = 0.955336489125606*w.a_l_upper_arm[3] + 0.29552020666133966*w.a_l_upper_arm[5];
-    const Scalar t5 = -0.29552020666133966*w.a_l_upper_arm[3] + 0.955336489125606*w.a_l_upper_arm[5];
-    const Scalar t6 = w.c_l_forearm[0] + w.cq[17]*t2 - w.sq[17]*t3;
-    const Scalar t7 = w.c_l_forearm[2] + w.sq[17]*t2 + w.cq[17]*t3;
-    const Scalar t8 = w.c_l_forearm[3] + w.cq[17]*t4 - w.sq[17]*t5;
-    const Scalar t9 = w.c_l_forearm[5] + w.sq[17]*t4 + w.cq[17]*t5;
-    const Scalar t10 = w.u_l_forearm[0] - w.IA_l_forearm[4]*t6 - w.IA_l_forearm[9]*t1 - w.IA_l_forearm[13]*t7 - w.IA_l_forearm[16]*t8 - w.a_l_upper_arm[4]*w.IA_l_forearm[18];
-    w.qdd[23] = w.Dinv_l_forearm*t10;
-    w.a_l_forearm[0] = t6;
-    w.a_l_forearm[1] = t1;
-    w.a_l_forearm[2] = t7;
-    w.a_l_forearm[3] = t8;
-    w.a_l_forearm[4] = w.a_l_upper_arm[4] + w.qdd[23];
-    w.a_l_forearm[5] = t9;
-  }
-  // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
-  shared_29(w.a_l_forearm, w.c_l_wrist_yaw_link, &w.cq[18], &w.sq[18], w.u_l_wrist_yaw_link, &w.IA_l_wrist_yaw_link[5], &w.qdd[24], w.Dinv_l_wrist_yaw_link, w.a_l_wrist_yaw_link);
-  // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
-  {
-    const Scalar t18 = w.c_l_wrist_pitch_link[0] + w.cq[19]*w.a_l_wrist_yaw_link[0] - w.sq[19]*w.a_l_wrist_yaw_link[2];
-    const Scalar t19 = w.c_l_wrist_pitch_link[2] + w.sq[19]*w.a_l_wrist_yaw_link[0] + w.cq[19]*w.a_l_wrist_yaw_link[2];
-    const Scalar t20 = w.c_l_wrist_pitch_link[3] + w.cq[19]*w.a_l_wrist_yaw_link[3] - w.sq[19]*w.a_l_wrist_yaw_link[5];
-    const Scalar t21 = w.c_l_wrist_pitch_link[5] + w.sq[19]*w.a_l_wrist_yaw_link[3] + w.cq[19]*w.a_l_wrist_yaw_link[5];
-    const Scalar t22 = w.u_l_wrist_pitch_link[0] - w.IA_l_wrist_pitch_link[4]*t18 - w.IA_l_wrist_pitch_link[18]*w.a_l_wrist_yaw_link[4] - w.IA_l_wrist_pitch_link[19]*t21;
-    w.qdd[25] = w.Dinv_l_wrist_pitch_link*t22;
-    w.a_l_wrist_pitch_link[0] = t18;
-    w.a_l_wrist_pitch_link[1] = w.a_l_wrist_yaw_link[1];
-    w.a_l_wrist_pitch_link[2] = t19;
-    w.a_l_wrist_pitch_link[3] = t20;
-    w.a_l_wrist_pitch_link[4] = w.a_l_wrist_yaw_link[4] + w.qdd[25];
-    w.a_l_wrist_pitch_link[5] = t21;
-  }
-}
-
-PROXGEN_RT_NOINLINE void accelerate_free_l_hand_to_head(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
-  {
-    const Scalar t0 = w.c_l_hand[1] + w.a_l_wrist_pitch_link[1]*w.cq[20] + w.a_l_wrist_pitch_link[2]*w.sq[20];
-    const Scalar t4 = -0.005164645770899999*w.a_l_wrist_pitch_link[3] + w.u_l_hand[0] - 0.04016628*t0;
-    w.qdd[26] = 193.62412145174838*t4;
-  }
+  shared_21(shared_21_k1, w.a_chest, w.c_l_shoulder_pitch_link, &w.cq[14], &w.sq[14], w.u_l_shoulder_pitch_link, &w.IA_l_shoulder_pitch_link[4], &w.qdd[20], w.Dinv_l_shoulder_pitch_link, w.a_l_shoulder_pitch_link);
   // accelerate body 23 'neck_link': joint 'neck_yaw' (revolute about z), parent 'chest', off the support
   {
-    const Scalar t5 = w.a_chest[0] + 0.29*w.a_chest[4];
-    const Scalar t6 = w.a_chest[1] - 0.29*w.a_chest[3];
-    const Scalar t7 = w.c_neck_link[0] + w.cq[21]*t5 + w.sq[21]*t6;
-    const Scalar t8 = w.c_neck_link[1] - w.sq[21]*t5 + w.cq[21]*t6;
-    const Scalar t9 = w.c_neck_link[3] + w.a_chest[3]*w.cq[21] + w.a_chest[4]*w.sq[21];
-    const Scalar t10 = w.c_neck_link[4] - w.a_chest[3]*w.sq[21] + w.a_chest[4]*w.cq[21];
-    const Scalar t11 = w.u_neck_link[0] - w.IA_neck_link[10]*t8 - w.IA_neck_link[17]*t9 - w.a_chest[5]*w.IA_neck_link[20];
-    w.qdd[27] = w.Dinv_neck_link*t11;
-    w.a_neck_link[0] = t7;
-    w.a_neck_link[1] = t8;
+    const Scalar t14 = w.a_chest[0] + 0.29*w.a_chest[4];
+    const Scalar t15 = w.a_chest[1] - 0.29*w.a_chest[3];
+    const Scalar t16 = w.c_neck_link[0] + w.cq[21]*t14 + w.sq[21]*t15;
+    const Scalar t17 = w.c_neck_link[1] - w.sq[21]*t14 + w.cq[21]*t15;
+    const Scalar t18 = w.c_neck_link[3] + w.a_chest[3]*w.cq[21] + w.a_chest[4]*w.sq[21];
+    const Scalar t19 = w.c_neck_link[4] - w.a_chest[3]*w.sq[21] + w.a_chest[4]*w.cq[21];
+    const Scalar t20 = w.u_neck_link[0] - w.IA_neck_link[10]*t17 - w.IA_neck_link[17]*t18 - w.a_chest[5]*w.IA_neck_link[20];
+    w.qdd[27] = w.Dinv_neck_link*t20;
+    w.a_neck_link[0] = t16;
+    w.a_neck_link[1] = t17;
     w.a_neck_link[2] = w.a_chest[2];
-    w.a_neck_link[3] = t9;
-    w.a_neck_link[4] = t10;
+    w.a_neck_link[3] = t18;
+    w.a_neck_link[4] = t19;
     w.a_neck_link[5] = w.a_chest[5] + w.qdd[27];
   }
+  // accelerate body 17 'l_shoulder_roll_link': joint 'l_shoulder_roll' (revolute about x), parent 'l_shoulder_pitch_link', off the support
+  {
+    const Scalar t21 = w.c_l_shoulder_roll_link[1] + w.cq[15]*w.a_l_shoulder_pitch_link[1] + w.sq[15]*w.a_l_shoulder_pitch_link[2];
+    const Scalar t22 = w.c_l_shoulder_roll_link[2] - w.sq[15]*w.a_l_shoulder_pitch_link[1] + w.cq[15]*w.a_l_shoulder_pitch_link[2];
+    const Scalar t23 = w.c_l_shoulder_roll_link[4] + w.cq[15]*w.a_l_shoulder_pitch_link[4] + w.sq[15]*w.a_l_shoulder_pitch_link[5];
+    const Scalar t24 = w.c_l_shoulder_roll_link[5] - w.sq[15]*w.a_l_shoulder_pitch_link[4] + w.cq[15]*w.a_l_shoulder_pitch_link[5];
+    const Scalar t25 = w.u_l_shoulder_roll_link[0] - w.IA_l_shoulder_roll_link[3]*w.a_l_shoulder_pitch_link[0] - w.IA_l_shoulder_roll_link[8]*t21 - w.IA_l_shoulder_roll_link[12]*t22 - w.IA_l_shoulder_roll_link[15]*w.a_l_shoulder_pitch_link[3] - w.IA_l_shoulder_roll_link[16]*t23;
+    w.qdd[21] = w.Dinv_l_shoulder_roll_link*t25;
+    w.a_l_shoulder_roll_link[0] = w.a_l_shoulder_pitch_link[0];
+    w.a_l_shoulder_roll_link[1] = t21;
+    w.a_l_shoulder_roll_link[2] = t22;
+    w.a_l_shoulder_roll_link[3] = w.a_l_shoulder_pitch_link[3] + w.qdd[21];
+    w.a_l_shoulder_roll_link[4] = t23;
+    w.a_l_shoulder_roll_link[5] = t24;
+  }
+}
+
+PROXGEN_RT_NOINLINE void accelerate_free_head_to_l_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 24 'head': joint 'neck_pitch' (revolute about y), parent 'neck_link', off the support
   {
-    const Scalar t12 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
-    const Scalar t14 = w.c_head[0] + w.cq[22]*t12 - w.sq[22]*w.a_neck_link[2];
-    const Scalar t18 = w.u_head[0] - 0.07202788281129999*w.a_neck_link[4] - 0.4717625*t14;
-    w.qdd[28] = 13.88351234229415*t18;
+    const Scalar t0 = w.a_neck_link[0] + 0.06*w.a_neck_link[4];
+    const Scalar t2 = w.c_head[0] + w.cq[22]*t0 - w.a_neck_link[2]*w.sq[22];
+    const Scalar t6 = -0.07202788281129999*w.a_neck_link[4] + w.u_head[0] - 0.4717625*t2;
+    w.qdd[28] = 13.88351234229415*t6;
+  }
+  // accelerate body 18 'l_upper_arm': joint 'l_shoulder_yaw' (revolute about z), parent 'l_shoulder_roll_link', off the support
+  shared_25(w.c_l_upper_arm, w.a_l_shoulder_roll_link, &w.cq[16], &w.sq[16], w.u_l_upper_arm, &w.IA_l_upper_arm[5], &w.qdd[22], w.Dinv_l_upper_arm, w.a_l_upper_arm);
+  // accelerate body 19 'l_forearm': joint 'l_elbow' (revolute about y), parent 'l_upper_arm', off the support
+  {
+    const Scalar t12 = w.a_l_upper_arm[0] - 0.3255*w.a_l_upper_arm[4];
+    const Scalar t13 = w.a_l_upper_arm[1] + 0.3255*w.a_l_upper_arm[3];
+    const Scalar t14 = 0.29552020666133966*w.a_l_upper_arm[2] + 0.955336489125606*t12;
+    const Scalar t15 = 0.955336489125606*w.a_l_upper_arm[2] - 0.29552020666133966*t12;
+    const Scalar t16 = 0.955336489125606*w.a_l_upper_arm[3] + 0.29552020666133966*w.a_l_upper_arm[5];
+    const Scalar t17 = -0.29552020666133966*w.a_l_upper_arm[3] + 0.955336489125606*w.a_l_upper_arm[5];
+    const Scalar t18 = w.c_l_forearm[0] + w.cq[17]*t14 - w.sq[17]*t15;
+    const Scalar t19 = w.c_l_forearm[2] + w.sq[17]*t14 + w.cq[17]*t15;
+    const Scalar t20 = w.c_l_forearm[3] + w.cq[17]*t16 - w.sq[17]*t17;
+    const Scalar t21 = w.c_l_forearm[5] + w.sq[17]*t16 + w.cq[17]*t17;
+    const Scalar t22 = w.u_l_forearm[0] - w.IA_l_forearm[4]*t18 - w.IA_l_forearm[9]*t13 - w.IA_l_forearm[13]*t19 - w.IA_l_forearm[16]*t20 - w.IA_l_forearm[18]*w.a_l_upper_arm[4];
+    w.qdd[23] = w.Dinv_l_forearm*t22;
+    w.a_l_forearm[0] = t18;
+    w.a_l_forearm[1] = t13;
+    w.a_l_forearm[2] = t19;
+    w.a_l_forearm[3] = t20;
+    w.a_l_forearm[4] = w.a_l_upper_arm[4] + w.qdd[23];
+    w.a_l_forearm[5] = t21;
+  }
+  // accelerate body 20 'l_wrist_yaw_link': joint 'l_wrist_yaw' (revolute about z), parent 'l_forearm', off the support
+  {
+    const Scalar t23 = w.a_l_forearm[0] - 0.2555*w.a_l_forearm[4];
+    const Scalar t24 = w.a_l_forearm[1] + 0.2555*w.a_l_forearm[3];
+    const Scalar t25 = w.c_l_wrist_yaw_link[0] + w.cq[18]*t23 + w.sq[18]*t24;
+    const Scalar t26 = w.c_l_wrist_yaw_link[1] - w.sq[18]*t23 + w.cq[18]*t24;
+    const Scalar t27 = w.c_l_wrist_yaw_link[3] + w.cq[18]*w.a_l_forearm[3] + w.sq[18]*w.a_l_forearm[4];
+    const Scalar t28 = w.c_l_wrist_yaw_link[4] - w.sq[18]*w.a_l_forearm[3] + w.cq[18]*w.a_l_forearm[4];
+    const Scalar t29 = w.u_l_wrist_yaw_link[0] - w.IA_l_wrist_yaw_link[5]*t25 - w.IA_l_wrist_yaw_link[10]*t26 - w.IA_l_wrist_yaw_link[14]*w.a_l_forearm[2] - w.IA_l_wrist_yaw_link[17]*t27 - w.IA_l_wrist_yaw_link[20]*w.a_l_forearm[5];
+    w.qdd[24] = w.Dinv_l_wrist_yaw_link*t29;
+    w.a_l_wrist_yaw_link[0] = t25;
+    w.a_l_wrist_yaw_link[1] = t26;
+    w.a_l_wrist_yaw_link[2] = w.a_l_forearm[2];
+    w.a_l_wrist_yaw_link[3] = t27;
+    w.a_l_wrist_yaw_link[4] = t28;
+    w.a_l_wrist_yaw_link[5] = w.a_l_forearm[5] + w.qdd[24];
+  }
+}
+
+PROXGEN_RT_NOINLINE void accelerate_free_l_wrist_pitch_link_to_l_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 21 'l_wrist_pitch_link': joint 'l_wrist_pitch' (revolute about y), parent 'l_wrist_yaw_link', off the support
+  {
+    const Scalar t0 = w.c_l_wrist_pitch_link[0] + w.a_l_wrist_yaw_link[0]*w.cq[19] - w.a_l_wrist_yaw_link[2]*w.sq[19];
+    const Scalar t1 = w.c_l_wrist_pitch_link[2] + w.a_l_wrist_yaw_link[0]*w.sq[19] + w.a_l_wrist_yaw_link[2]*w.cq[19];
+    const Scalar t2 = w.c_l_wrist_pitch_link[3] + w.a_l_wrist_yaw_link[3]*w.cq[19] - w.a_l_wrist_yaw_link[5]*w.sq[19];
+    const Scalar t3 = w.c_l_wrist_pitch_link[5] + w.a_l_wrist_yaw_link[3]*w.sq[19] + w.a_l_wrist_yaw_link[5]*w.cq[19];
+    const Scalar t4 = w.u_l_wrist_pitch_link[0] - w.IA_l_wrist_pitch_link[4]*t0 - w.a_l_wrist_yaw_link[4]*w.IA_l_wrist_pitch_link[18] - w.IA_l_wrist_pitch_link[19]*t3;
+    w.qdd[25] = w.Dinv_l_wrist_pitch_link*t4;
+    w.a_l_wrist_pitch_link[0] = t0;
+    w.a_l_wrist_pitch_link[1] = w.a_l_wrist_yaw_link[1];
+    w.a_l_wrist_pitch_link[2] = t1;
+    w.a_l_wrist_pitch_link[3] = t2;
+    w.a_l_wrist_pitch_link[4] = w.a_l_wrist_yaw_link[4] + w.qdd[25];
+    w.a_l_wrist_pitch_link[5] = t3;
+  }
+  // accelerate body 22 'l_hand': joint 'l_wrist_roll' (revolute about x), parent 'l_wrist_pitch_link', off the support
+  {
+    const Scalar t5 = w.c_l_hand[1] + w.cq[20]*w.a_l_wrist_pitch_link[1] + w.sq[20]*w.a_l_wrist_pitch_link[2];
+    const Scalar t9 = w.u_l_hand[0] - 0.005164645770899999*w.a_l_wrist_pitch_link[3] - 0.04016628*t5;
+    w.qdd[26] = 193.62412145174838*t9;
   }
 }
 
@@ -4695,6 +4755,12 @@ PROXGEN_RT_NOINLINE void pv_backward_r_forearm(const Scalar* PROXGEN_RT_RESTRICT
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_backward_r_foot_to_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  shared_37_x2(shared_37_p0, &tau[17], &tau[11], w.u_r_foot, w.u_l_foot, w.pA_r_foot, w.pA_l_foot, &w.c_r_foot[1], &w.c_l_foot[1], &w.cq[11], &w.cq[5], &w.sq[11], &w.sq[5], &w.IA_r_ankle_link[4], &w.IA_l_ankle_link[4], w.pA_r_ankle_link, w.pA_l_ankle_link, w.KA_r_ankle_link, w.KA_l_ankle_link, 0, 0);
+}
+
 PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
@@ -4779,6 +4845,12 @@ PROXGEN_RT_NOINLINE void pv_backward_r_upper_arm(const Scalar* PROXGEN_RT_RESTRI
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link_to_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  shared_38_x2(shared_38_p0, &tau[16], &tau[10], &w.Dinv_r_ankle_link, &w.Dinv_l_ankle_link, &w.IA_r_ankle_link[4], &w.IA_l_ankle_link[4], w.u_r_ankle_link, w.u_l_ankle_link, w.pA_r_ankle_link, w.pA_l_ankle_link, w.c_r_ankle_link, w.c_l_ankle_link, &w.cq[10], &w.cq[4], &w.sq[10], &w.sq[4], w.IA_r_shank, w.IA_l_shank, w.pA_r_shank, w.pA_l_shank, w.KSD_r_ankle_link, w.KSD_l_ankle_link, w.KA_r_ankle_link, w.KA_l_ankle_link, 0, 0, w.KA_r_shank, w.KA_l_shank, 0, 0);
+}
+
 PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
@@ -4849,6 +4921,12 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_roll_link(const Scalar* PROXGEN_
       w.KA_r_shoulder_pitch_link[5][j] = w.sq[24]*t8 + w.cq[24]*w.KA_r_shoulder_roll_link[5][j];
     }
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_backward_r_shank_to_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  shared_39_x2(shared_39_p0, &tau[15], &tau[9], &w.Dinv_r_shank, &w.Dinv_l_shank, w.IA_r_shank, w.IA_l_shank, w.u_r_shank, w.u_l_shank, w.pA_r_shank, w.pA_l_shank, w.c_r_shank, w.c_l_shank, &w.cq[9], &w.cq[3], &w.sq[9], &w.sq[3], w.IA_r_thigh, w.IA_l_thigh, w.pA_r_thigh, w.pA_l_thigh, w.KSD_r_shank, w.KSD_l_shank, w.KA_r_shank, w.KA_l_shank, w.KA_r_thigh, w.KA_l_thigh);
 }
 
 PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -4985,6 +5063,12 @@ PROXGEN_RT_NOINLINE void pv_backward_r_shoulder_pitch_link(const Scalar* PROXGEN
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_backward_r_thigh_to_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  shared_40_x2(shared_40_p0, &tau[14], &tau[8], &w.Dinv_r_thigh, &w.Dinv_l_thigh, w.IA_r_thigh, w.IA_l_thigh, w.u_r_thigh, w.u_l_thigh, w.pA_r_thigh, w.pA_l_thigh, w.c_r_thigh, w.c_l_thigh, &w.cq[8], &w.cq[2], &w.sq[8], &w.sq[2], w.IA_r_hip_roll_link, w.IA_l_hip_roll_link, w.pA_r_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_r_thigh, w.KSD_l_thigh, w.KA_r_thigh, w.KA_l_thigh, w.KA_r_hip_roll_link, w.KA_l_hip_roll_link);
+}
+
 PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
@@ -5092,6 +5176,12 @@ PROXGEN_RT_NOINLINE void pv_backward_chest(const Scalar* PROXGEN_RT_RESTRICT tau
   }
 }
 
+PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link_to_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  shared_41_x2(shared_41_p0, &tau[13], &tau[7], &w.Dinv_r_hip_roll_link, &w.Dinv_l_hip_roll_link, w.IA_r_hip_roll_link, w.IA_l_hip_roll_link, w.u_r_hip_roll_link, w.u_l_hip_roll_link, w.pA_r_hip_roll_link, w.pA_l_hip_roll_link, &w.c_r_hip_roll_link[1], &w.c_l_hip_roll_link[1], &w.cq[7], &w.cq[1], &w.sq[7], &w.sq[1], w.IA_r_hip_yaw_link, w.IA_l_hip_yaw_link, w.pA_r_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_r_hip_roll_link, w.KSD_l_hip_roll_link, w.KA_r_hip_roll_link, w.KA_l_hip_roll_link, w.KA_r_hip_yaw_link, w.KA_l_hip_yaw_link);
+}
+
 PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
@@ -5196,32 +5286,7 @@ PROXGEN_RT_NOINLINE void pv_backward_abdomen(const Scalar* PROXGEN_RT_RESTRICT t
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_backward_r_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_35(&tau[17], w.u_r_foot, w.pA_r_foot, &w.c_r_foot[1], &w.cq[11], &w.sq[11], &w.IA_r_ankle_link[4], w.pA_r_ankle_link, w.KA_r_ankle_link, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_r_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_36(&tau[16], &w.Dinv_r_ankle_link, &w.IA_r_ankle_link[4], w.u_r_ankle_link, w.pA_r_ankle_link, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.IA_r_shank, w.pA_r_shank, w.KSD_r_ankle_link, w.KA_r_ankle_link, 0, w.KA_r_shank, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_r_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_37(&tau[15], &w.Dinv_r_shank, w.IA_r_shank, w.u_r_shank, w.pA_r_shank, w.c_r_shank, &w.cq[9], &w.sq[9], w.IA_r_thigh, w.pA_r_thigh, w.KSD_r_shank, w.KA_r_shank, w.KA_r_thigh);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_r_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_38(&tau[14], &w.Dinv_r_thigh, w.IA_r_thigh, w.u_r_thigh, w.pA_r_thigh, w.c_r_thigh, &w.cq[8], &w.sq[8], w.IA_r_hip_roll_link, w.pA_r_hip_roll_link, w.KSD_r_thigh, w.KA_r_thigh, w.KA_r_hip_roll_link);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_r_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_39(&tau[13], &w.Dinv_r_hip_roll_link, w.IA_r_hip_roll_link, w.u_r_hip_roll_link, w.pA_r_hip_roll_link, &w.c_r_hip_roll_link[1], &w.cq[7], &w.sq[7], w.IA_r_hip_yaw_link, w.pA_r_hip_yaw_link, w.KSD_r_hip_roll_link, w.KA_r_hip_roll_link, w.KA_r_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link_to_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_r_hip_yaw_link = 1.0 / w.IA_r_hip_yaw_link[20];
@@ -5336,146 +5401,118 @@ PROXGEN_RT_NOINLINE void pv_backward_r_hip_yaw_link(const Scalar* PROXGEN_RT_RES
       w.KA_pelvis[5][6 + j] = 0.0875*t48;
     }
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_foot(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_35(&tau[11], w.u_l_foot, w.pA_l_foot, &w.c_l_foot[1], &w.cq[5], &w.sq[5], &w.IA_l_ankle_link[4], w.pA_l_ankle_link, w.KA_l_ankle_link, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_ankle_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_36(&tau[10], &w.Dinv_l_ankle_link, &w.IA_l_ankle_link[4], w.u_l_ankle_link, w.pA_l_ankle_link, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.IA_l_shank, w.pA_l_shank, w.KSD_l_ankle_link, w.KA_l_ankle_link, 0, w.KA_l_shank, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_37(&tau[9], &w.Dinv_l_shank, w.IA_l_shank, w.u_l_shank, w.pA_l_shank, w.c_l_shank, &w.cq[3], &w.sq[3], w.IA_l_thigh, w.pA_l_thigh, w.KSD_l_shank, w.KA_l_shank, w.KA_l_thigh);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_38(&tau[8], &w.Dinv_l_thigh, w.IA_l_thigh, w.u_l_thigh, w.pA_l_thigh, w.c_l_thigh, &w.cq[2], &w.sq[2], w.IA_l_hip_roll_link, w.pA_l_hip_roll_link, w.KSD_l_thigh, w.KA_l_thigh, w.KA_l_hip_roll_link);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_hip_roll_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_39(&tau[7], &w.Dinv_l_hip_roll_link, w.IA_l_hip_roll_link, w.u_l_hip_roll_link, w.pA_l_hip_roll_link, &w.c_l_hip_roll_link[1], &w.cq[1], &w.sq[1], w.IA_l_hip_yaw_link, w.pA_l_hip_yaw_link, w.KSD_l_hip_roll_link, w.KA_l_hip_roll_link, w.KA_l_hip_yaw_link);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_l_hip_yaw_link(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
   {
     w.Dinv_l_hip_yaw_link = 1.0 / w.IA_l_hip_yaw_link[20];
     w.u_l_hip_yaw_link[0] = -w.pA_l_hip_yaw_link[5] + tau[6];
-    const Scalar t0 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
-    const Scalar t1 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
-    const Scalar t2 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
-    const Scalar t3 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
-    const Scalar Ia0 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t0;
-    const Scalar Ia1 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t0;
-    const Scalar Ia2 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t0;
-    const Scalar Ia3 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t0;
-    const Scalar Ia4 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t1;
-    const Scalar Ia5 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t1;
-    const Scalar Ia6 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t1;
-    const Scalar Ia7 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t2;
-    const Scalar Ia8 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t2;
-    const Scalar Ia9 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t3;
-    const Scalar pa0 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t0 + w.c_l_hip_yaw_link[0]*Ia0 + w.c_l_hip_yaw_link[1]*Ia1 + w.c_l_hip_yaw_link[4]*Ia3;
-    const Scalar pa1 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t1 + w.c_l_hip_yaw_link[0]*Ia1 + w.c_l_hip_yaw_link[1]*Ia4 + w.c_l_hip_yaw_link[4]*Ia6;
-    const Scalar pa2 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t2 + w.c_l_hip_yaw_link[0]*Ia2 + w.c_l_hip_yaw_link[1]*Ia5 + w.c_l_hip_yaw_link[4]*Ia8;
-    const Scalar pa3 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
-    const Scalar pa4 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t3 + w.c_l_hip_yaw_link[0]*Ia3 + w.c_l_hip_yaw_link[1]*Ia6 + w.c_l_hip_yaw_link[4]*Ia9;
-    const Scalar C20 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
-    const Scalar h0 = 0.5*(Ia0 - Ia4);
-    const Scalar m0 = 0.5*(Ia0 + Ia4);
-    const Scalar t4 = 2.0*w.cq[0]*w.sq[0];
-    const Scalar d0 = C20*h0 - Ia1*t4;
-    const Scalar qq0 = h0*t4 + Ia1*C20;
-    const Scalar t5 = -0.01 + 0.5*Ia3;
-    const Scalar d1 = -0.5*Ia6*C20 - t4*t5;
-    const Scalar qq1 = -0.5*Ia6*t4 + C20*t5;
-    const Scalar h1 = 0.00065 - 0.5*Ia9;
-    const Scalar m1 = 0.00065 + 0.5*Ia9;
-    const Scalar t6 = 0.9961917745544759*m0 + 0.9961917745544759*d0 - 0.08718915247898762*qq0;
-    const Scalar t7 = -0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t8 = 0.9961917745544759*w.cq[0]*Ia2 - 0.9961917745544759*w.sq[0]*Ia5 - 0.08718915247898762*w.sq[0]*Ia2 - 0.08718915247898762*w.cq[0]*Ia5;
-    const Scalar t9 = 0.08718915247898762*m0 + 0.08718915247898762*d0 + 0.9961917745544759*qq0;
-    const Scalar t10 = 0.9961917745544759*m0 - 0.9961917745544759*d0 + 0.08718915247898762*qq0;
-    const Scalar t11 = 0.08718915247898762*w.cq[0]*Ia2 - 0.08718915247898762*w.sq[0]*Ia5 + 0.9961917745544759*w.sq[0]*Ia2 + 0.9961917745544759*w.cq[0]*Ia5;
-    const Scalar t14 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 + 0.9961917745544759*d1 - 0.08718915247898762*qq1;
-    const Scalar t15 = 0.00996191774554476 + 0.49809588727723797*Ia3 - 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
-    const Scalar t16 = -0.00996191774554476 - 0.49809588727723797*Ia3 + 0.04359457623949381*Ia6 + 0.08718915247898762*d1 + 0.9961917745544759*qq1;
-    const Scalar t17 = 0.0008718915247898762 + 0.04359457623949381*Ia3 + 0.49809588727723797*Ia6 - 0.9961917745544759*d1 + 0.08718915247898762*qq1;
-    const Scalar t18 = 0.9961917745544759*m1 + 0.9961917745544759*C20*h1 - 0.08718915247898762*t4*h1;
-    const Scalar t19 = -0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t4*h1;
-    const Scalar t20 = 0.08718915247898762*m1 + 0.08718915247898762*C20*h1 + 0.9961917745544759*t4*h1;
-    const Scalar t21 = 0.9961917745544759*m1 - 0.9961917745544759*C20*h1 + 0.08718915247898762*t4*h1;
-    const Scalar t22 = 0.9961917745544759*t6 - 0.08718915247898762*t7;
-    const Scalar t23 = 0.08718915247898762*t6 + 0.9961917745544759*t7;
-    const Scalar t24 = 0.08718915247898762*t9 + 0.9961917745544759*t10;
-    const Scalar t25 = 0.9961917745544759*t14 - 0.08718915247898762*t15;
-    const Scalar t26 = 0.08718915247898762*t14 + 0.9961917745544759*t15;
-    const Scalar t27 = 0.9961917745544759*t16 - 0.08718915247898762*t17;
-    const Scalar t28 = 0.08718915247898762*t16 + 0.9961917745544759*t17;
-    const Scalar t29 = -0.9961917745544759*w.sq[0]*Ia8 - 0.08718915247898762*w.cq[0]*Ia8;
-    const Scalar t30 = -0.08718915247898762*w.sq[0]*Ia8 + 0.9961917745544759*w.cq[0]*Ia8;
-    const Scalar t31 = 0.0875*t8 + t25;
-    const Scalar t32 = 0.0875*t11 + t27;
-    const Scalar t33 = 0.0875*Ia7 + t29;
-    const Scalar t34 = w.cq[0]*pa0 - w.sq[0]*pa1;
-    const Scalar t35 = w.sq[0]*pa0 + w.cq[0]*pa1;
-    const Scalar t36 = w.cq[0]*pa3 - w.sq[0]*pa4;
-    const Scalar t37 = w.sq[0]*pa3 + w.cq[0]*pa4;
-    const Scalar t38 = 0.9961917745544759*t34 - 0.08718915247898762*t35;
-    const Scalar t39 = 0.08718915247898762*t34 + 0.9961917745544759*t35;
-    w.IA_pelvis[0] = w.IA_pelvis[0] + t22;
-    w.IA_pelvis[1] = w.IA_pelvis[1] + t23;
-    w.IA_pelvis[2] = w.IA_pelvis[2] + t8;
-    w.IA_pelvis[3] = w.IA_pelvis[3] + t31;
-    w.IA_pelvis[4] = w.IA_pelvis[4] + t26;
-    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t22;
-    w.IA_pelvis[6] = w.IA_pelvis[6] + t24;
-    w.IA_pelvis[7] = w.IA_pelvis[7] + t11;
-    w.IA_pelvis[8] = w.IA_pelvis[8] + t32;
-    w.IA_pelvis[9] = w.IA_pelvis[9] + t28;
-    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t23;
-    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia7;
-    w.IA_pelvis[12] = w.IA_pelvis[12] + t33;
-    w.IA_pelvis[13] = w.IA_pelvis[13] + t30;
-    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t8;
-    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t18 - 0.08718915247898762*t19 + 0.0875*t29 + 0.0875*t33;
-    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t18 + 0.9961917745544759*t19 + 0.0875*t30;
-    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t8 - 0.0875*t25;
-    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t20 + 0.9961917745544759*t21;
-    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t26;
-    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t22;
-    w.pA_pelvis[0] = w.pA_pelvis[0] + t38;
-    w.pA_pelvis[1] = w.pA_pelvis[1] + t39;
-    w.pA_pelvis[2] = w.pA_pelvis[2] + pa2;
-    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa2 + 0.9961917745544759*t36 - 0.08718915247898762*t37;
-    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t36 + 0.9961917745544759*t37;
-    w.pA_pelvis[5] = w.pA_pelvis[5] + tau[6] - 0.0875*t38;
+    const Scalar t50 = w.IA_l_hip_yaw_link[5]*w.Dinv_l_hip_yaw_link;
+    const Scalar t51 = w.IA_l_hip_yaw_link[10]*w.Dinv_l_hip_yaw_link;
+    const Scalar t52 = w.IA_l_hip_yaw_link[14]*w.Dinv_l_hip_yaw_link;
+    const Scalar t53 = w.IA_l_hip_yaw_link[19]*w.Dinv_l_hip_yaw_link;
+    const Scalar Ia10 = w.IA_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t50;
+    const Scalar Ia11 = w.IA_l_hip_yaw_link[1] - w.IA_l_hip_yaw_link[10]*t50;
+    const Scalar Ia12 = w.IA_l_hip_yaw_link[2] - w.IA_l_hip_yaw_link[14]*t50;
+    const Scalar Ia13 = w.IA_l_hip_yaw_link[4] - w.IA_l_hip_yaw_link[19]*t50;
+    const Scalar Ia14 = w.IA_l_hip_yaw_link[6] - w.IA_l_hip_yaw_link[10]*t51;
+    const Scalar Ia15 = w.IA_l_hip_yaw_link[7] - w.IA_l_hip_yaw_link[14]*t51;
+    const Scalar Ia16 = w.IA_l_hip_yaw_link[9] - w.IA_l_hip_yaw_link[19]*t51;
+    const Scalar Ia17 = w.IA_l_hip_yaw_link[11] - w.IA_l_hip_yaw_link[14]*t52;
+    const Scalar Ia18 = w.IA_l_hip_yaw_link[13] - w.IA_l_hip_yaw_link[19]*t52;
+    const Scalar Ia19 = w.IA_l_hip_yaw_link[18] - w.IA_l_hip_yaw_link[19]*t53;
+    const Scalar pa5 = w.pA_l_hip_yaw_link[0] + w.u_l_hip_yaw_link[0]*t50 + w.c_l_hip_yaw_link[0]*Ia10 + w.c_l_hip_yaw_link[1]*Ia11 + w.c_l_hip_yaw_link[4]*Ia13;
+    const Scalar pa6 = -0.02*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[1] + w.u_l_hip_yaw_link[0]*t51 + w.c_l_hip_yaw_link[0]*Ia11 + w.c_l_hip_yaw_link[1]*Ia14 + w.c_l_hip_yaw_link[4]*Ia16;
+    const Scalar pa7 = w.pA_l_hip_yaw_link[2] + w.u_l_hip_yaw_link[0]*t52 + w.c_l_hip_yaw_link[0]*Ia12 + w.c_l_hip_yaw_link[1]*Ia15 + w.c_l_hip_yaw_link[4]*Ia18;
+    const Scalar pa8 = -0.02*w.c_l_hip_yaw_link[1] + 0.0013*w.c_l_hip_yaw_link[3] + w.pA_l_hip_yaw_link[3];
+    const Scalar pa9 = w.pA_l_hip_yaw_link[4] + w.u_l_hip_yaw_link[0]*t53 + w.c_l_hip_yaw_link[0]*Ia13 + w.c_l_hip_yaw_link[1]*Ia16 + w.c_l_hip_yaw_link[4]*Ia19;
+    const Scalar C21 = w.cq[0]*w.cq[0] - w.sq[0]*w.sq[0];
+    const Scalar h2 = 0.5*(Ia10 - Ia14);
+    const Scalar m2 = 0.5*(Ia10 + Ia14);
+    const Scalar t54 = 2.0*w.cq[0]*w.sq[0];
+    const Scalar d2 = C21*h2 - Ia11*t54;
+    const Scalar qq2 = h2*t54 + Ia11*C21;
+    const Scalar t55 = -0.01 + 0.5*Ia13;
+    const Scalar d3 = -0.5*Ia16*C21 - t54*t55;
+    const Scalar qq3 = -0.5*Ia16*t54 + C21*t55;
+    const Scalar h3 = 0.00065 - 0.5*Ia19;
+    const Scalar m3 = 0.00065 + 0.5*Ia19;
+    const Scalar t56 = 0.9961917745544759*m2 + 0.9961917745544759*d2 - 0.08718915247898762*qq2;
+    const Scalar t57 = -0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
+    const Scalar t58 = 0.9961917745544759*w.cq[0]*Ia12 - 0.9961917745544759*w.sq[0]*Ia15 - 0.08718915247898762*w.sq[0]*Ia12 - 0.08718915247898762*w.cq[0]*Ia15;
+    const Scalar t59 = 0.08718915247898762*m2 + 0.08718915247898762*d2 + 0.9961917745544759*qq2;
+    const Scalar t60 = 0.9961917745544759*m2 - 0.9961917745544759*d2 + 0.08718915247898762*qq2;
+    const Scalar t61 = 0.08718915247898762*w.cq[0]*Ia12 - 0.08718915247898762*w.sq[0]*Ia15 + 0.9961917745544759*w.sq[0]*Ia12 + 0.9961917745544759*w.cq[0]*Ia15;
+    const Scalar t64 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 + 0.9961917745544759*d3 - 0.08718915247898762*qq3;
+    const Scalar t65 = 0.00996191774554476 + 0.49809588727723797*Ia13 - 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
+    const Scalar t66 = -0.00996191774554476 - 0.49809588727723797*Ia13 + 0.04359457623949381*Ia16 + 0.08718915247898762*d3 + 0.9961917745544759*qq3;
+    const Scalar t67 = 0.0008718915247898762 + 0.04359457623949381*Ia13 + 0.49809588727723797*Ia16 - 0.9961917745544759*d3 + 0.08718915247898762*qq3;
+    const Scalar t68 = 0.9961917745544759*m3 + 0.9961917745544759*C21*h3 - 0.08718915247898762*t54*h3;
+    const Scalar t69 = -0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t54*h3;
+    const Scalar t70 = 0.08718915247898762*m3 + 0.08718915247898762*C21*h3 + 0.9961917745544759*t54*h3;
+    const Scalar t71 = 0.9961917745544759*m3 - 0.9961917745544759*C21*h3 + 0.08718915247898762*t54*h3;
+    const Scalar t72 = 0.9961917745544759*t56 - 0.08718915247898762*t57;
+    const Scalar t73 = 0.08718915247898762*t56 + 0.9961917745544759*t57;
+    const Scalar t74 = 0.08718915247898762*t59 + 0.9961917745544759*t60;
+    const Scalar t75 = 0.9961917745544759*t64 - 0.08718915247898762*t65;
+    const Scalar t76 = 0.08718915247898762*t64 + 0.9961917745544759*t65;
+    const Scalar t77 = 0.9961917745544759*t66 - 0.08718915247898762*t67;
+    const Scalar t78 = 0.08718915247898762*t66 + 0.9961917745544759*t67;
+    const Scalar t79 = -0.9961917745544759*w.sq[0]*Ia18 - 0.08718915247898762*w.cq[0]*Ia18;
+    const Scalar t80 = -0.08718915247898762*w.sq[0]*Ia18 + 0.9961917745544759*w.cq[0]*Ia18;
+    const Scalar t81 = 0.0875*t58 + t75;
+    const Scalar t82 = 0.0875*t61 + t77;
+    const Scalar t83 = 0.0875*Ia17 + t79;
+    const Scalar t84 = w.cq[0]*pa5 - w.sq[0]*pa6;
+    const Scalar t85 = w.sq[0]*pa5 + w.cq[0]*pa6;
+    const Scalar t86 = w.cq[0]*pa8 - w.sq[0]*pa9;
+    const Scalar t87 = w.sq[0]*pa8 + w.cq[0]*pa9;
+    const Scalar t88 = 0.9961917745544759*t84 - 0.08718915247898762*t85;
+    const Scalar t89 = 0.08718915247898762*t84 + 0.9961917745544759*t85;
+    w.IA_pelvis[0] = w.IA_pelvis[0] + t72;
+    w.IA_pelvis[1] = w.IA_pelvis[1] + t73;
+    w.IA_pelvis[2] = w.IA_pelvis[2] + t58;
+    w.IA_pelvis[3] = w.IA_pelvis[3] + t81;
+    w.IA_pelvis[4] = w.IA_pelvis[4] + t76;
+    w.IA_pelvis[5] = w.IA_pelvis[5] - 0.0875*t72;
+    w.IA_pelvis[6] = w.IA_pelvis[6] + t74;
+    w.IA_pelvis[7] = w.IA_pelvis[7] + t61;
+    w.IA_pelvis[8] = w.IA_pelvis[8] + t82;
+    w.IA_pelvis[9] = w.IA_pelvis[9] + t78;
+    w.IA_pelvis[10] = w.IA_pelvis[10] - 0.0875*t73;
+    w.IA_pelvis[11] = w.IA_pelvis[11] + Ia17;
+    w.IA_pelvis[12] = w.IA_pelvis[12] + t83;
+    w.IA_pelvis[13] = w.IA_pelvis[13] + t80;
+    w.IA_pelvis[14] = w.IA_pelvis[14] - 0.0875*t58;
+    w.IA_pelvis[15] = w.IA_pelvis[15] + 0.9961917745544759*t68 - 0.08718915247898762*t69 + 0.0875*t79 + 0.0875*t83;
+    w.IA_pelvis[16] = w.IA_pelvis[16] + 0.08718915247898762*t68 + 0.9961917745544759*t69 + 0.0875*t80;
+    w.IA_pelvis[17] = w.IA_pelvis[17] - 0.007656249999999999*t58 - 0.0875*t75;
+    w.IA_pelvis[18] = w.IA_pelvis[18] + 0.08718915247898762*t70 + 0.9961917745544759*t71;
+    w.IA_pelvis[19] = w.IA_pelvis[19] - 0.0875*t76;
+    w.IA_pelvis[20] = w.IA_pelvis[20] + 0.007656249999999999*t72;
+    w.pA_pelvis[0] = w.pA_pelvis[0] + t88;
+    w.pA_pelvis[1] = w.pA_pelvis[1] + t89;
+    w.pA_pelvis[2] = w.pA_pelvis[2] + pa7;
+    w.pA_pelvis[3] = w.pA_pelvis[3] + 0.0875*pa7 + 0.9961917745544759*t86 - 0.08718915247898762*t87;
+    w.pA_pelvis[4] = w.pA_pelvis[4] + 0.08718915247898762*t86 + 0.9961917745544759*t87;
+    w.pA_pelvis[5] = w.pA_pelvis[5] + tau[6] - 0.0875*t88;
     // columns 0 to 5
     PROXGEN_RT_NO_UNROLL for (int j = 0; j < 6; ++j) {
       w.KSD_l_hip_yaw_link[j] = w.Dinv_l_hip_yaw_link*w.KA_l_hip_yaw_link[5][j];
-      const Scalar t40 = w.KA_l_hip_yaw_link[0][j] - w.IA_l_hip_yaw_link[5]*w.KSD_l_hip_yaw_link[j];
-      const Scalar t41 = w.KA_l_hip_yaw_link[1][j] - w.IA_l_hip_yaw_link[10]*w.KSD_l_hip_yaw_link[j];
-      const Scalar t42 = w.KA_l_hip_yaw_link[2][j] - w.IA_l_hip_yaw_link[14]*w.KSD_l_hip_yaw_link[j];
-      const Scalar t43 = w.KA_l_hip_yaw_link[4][j] - w.IA_l_hip_yaw_link[19]*w.KSD_l_hip_yaw_link[j];
-      const Scalar t44 = w.cq[0]*t40 - w.sq[0]*t41;
-      const Scalar t45 = w.sq[0]*t40 + w.cq[0]*t41;
-      const Scalar t46 = w.cq[0]*w.KA_l_hip_yaw_link[3][j] - w.sq[0]*t43;
-      const Scalar t47 = w.sq[0]*w.KA_l_hip_yaw_link[3][j] + w.cq[0]*t43;
-      const Scalar t48 = 0.9961917745544759*t44 - 0.08718915247898762*t45;
-      const Scalar t49 = 0.08718915247898762*t44 + 0.9961917745544759*t45;
-      w.KA_pelvis[0][j] = t48;
-      w.KA_pelvis[1][j] = t49;
-      w.KA_pelvis[2][j] = t42;
-      w.KA_pelvis[3][j] = 0.0875*t42 + 0.9961917745544759*t46 - 0.08718915247898762*t47;
-      w.KA_pelvis[4][j] = 0.08718915247898762*t46 + 0.9961917745544759*t47;
-      w.KA_pelvis[5][j] = -0.0875*t48;
+      const Scalar t90 = w.KA_l_hip_yaw_link[0][j] - w.IA_l_hip_yaw_link[5]*w.KSD_l_hip_yaw_link[j];
+      const Scalar t91 = w.KA_l_hip_yaw_link[1][j] - w.IA_l_hip_yaw_link[10]*w.KSD_l_hip_yaw_link[j];
+      const Scalar t92 = w.KA_l_hip_yaw_link[2][j] - w.IA_l_hip_yaw_link[14]*w.KSD_l_hip_yaw_link[j];
+      const Scalar t93 = w.KA_l_hip_yaw_link[4][j] - w.IA_l_hip_yaw_link[19]*w.KSD_l_hip_yaw_link[j];
+      const Scalar t94 = w.cq[0]*t90 - w.sq[0]*t91;
+      const Scalar t95 = w.sq[0]*t90 + w.cq[0]*t91;
+      const Scalar t96 = w.cq[0]*w.KA_l_hip_yaw_link[3][j] - w.sq[0]*t93;
+      const Scalar t97 = w.sq[0]*w.KA_l_hip_yaw_link[3][j] + w.cq[0]*t93;
+      const Scalar t98 = 0.9961917745544759*t94 - 0.08718915247898762*t95;
+      const Scalar t99 = 0.08718915247898762*t94 + 0.9961917745544759*t95;
+      w.KA_pelvis[0][j] = t98;
+      w.KA_pelvis[1][j] = t99;
+      w.KA_pelvis[2][j] = t92;
+      w.KA_pelvis[3][j] = 0.0875*t92 + 0.9961917745544759*t96 - 0.08718915247898762*t97;
+      w.KA_pelvis[4][j] = 0.08718915247898762*t96 + 0.9961917745544759*t97;
+      w.KA_pelvis[5][j] = -0.0875*t98;
     }
   }
 }
@@ -5780,7 +5817,7 @@ PROXGEN_RT_NOINLINE void pv_backward_pelvis(const Scalar* PROXGEN_RT_RESTRICT ta
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_pelvis_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
@@ -5813,201 +5850,156 @@ PROXGEN_RT_NOINLINE void pv_free_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_
     w.a_pelvis[5] = w.Linv_pelvis[5]*t11;
   }
   // free acceleration (lambda = 0): body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t24 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
-    const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
-    const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq[0]*t24 + w.sq[0]*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq[0]*t24 + w.cq[0]*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq[0]*t26 + w.sq[0]*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq[0]*t26 + w.cq[0]*t27;
-    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.a_l_hip_yaw_link[0] = t28;
-    w.a_l_hip_yaw_link[1] = t29;
-    w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = t30;
-    w.a_l_hip_yaw_link[4] = t31;
-    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_l_hip_yaw_link*t32;
-  }
-}
-
-PROXGEN_RT_NOINLINE void pv_free_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_40(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, &w.IA_l_hip_roll_link[3], w.a_l_hip_roll_link, w.Dinv_l_hip_roll_link);
-  // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_41(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, &w.IA_l_thigh[4], w.a_l_thigh, w.Dinv_l_thigh);
-  // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_42(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, &w.IA_l_shank[4], w.a_l_shank, w.Dinv_l_shank);
-}
-
-PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_43(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, &w.IA_l_ankle_link[4], w.a_l_ankle_link, w.Dinv_l_ankle_link);
-  // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_44(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, w.a_l_foot);
   // free acceleration (lambda = 0): body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t18 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
-    const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
-    const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq[6]*t18 + w.sq[6]*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq[6]*t18 + w.cq[6]*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq[6]*t20 + w.sq[6]*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq[6]*t20 + w.cq[6]*t21;
-    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.a_r_hip_yaw_link[0] = t22;
-    w.a_r_hip_yaw_link[1] = t23;
-    w.a_r_hip_yaw_link[2] = t17;
-    w.a_r_hip_yaw_link[3] = t24;
-    w.a_r_hip_yaw_link[4] = t25;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.Dinv_r_hip_yaw_link*t26;
-  }
+  shared_42_x2(shared_42_p0, w.a_pelvis, w.a_pelvis, w.c_l_hip_yaw_link, w.c_r_hip_yaw_link, w.cq, &w.cq[6], w.sq, &w.sq[6], w.u_l_hip_yaw_link, w.u_r_hip_yaw_link, &w.IA_l_hip_yaw_link[5], &w.IA_r_hip_yaw_link[5], w.a_l_hip_yaw_link, w.a_r_hip_yaw_link, w.Dinv_l_hip_yaw_link, w.Dinv_r_hip_yaw_link);
 }
 
-PROXGEN_RT_NOINLINE void pv_free_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_40(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, &w.IA_r_hip_roll_link[3], w.a_r_hip_roll_link, w.Dinv_r_hip_roll_link);
-  // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_41(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, &w.IA_r_thigh[4], w.a_r_thigh, w.Dinv_r_thigh);
-  // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_42(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, &w.IA_r_shank[4], w.a_r_shank, w.Dinv_r_shank);
-}
-
-PROXGEN_RT_NOINLINE void pv_free_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_43(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, &w.IA_r_ankle_link[4], w.a_r_ankle_link, w.Dinv_r_ankle_link);
-  // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_44(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, w.a_r_foot);
+PROXGEN_RT_NOINLINE void pv_free_abdomen_to_chest(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq[12]*t16 + w.sq[12]*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq[12]*t16 + w.cq[12]*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
-    const Scalar t22 = w.u_abdomen[0] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.a_abdomen[0] = t18;
-    w.a_abdomen[1] = t19;
+    const Scalar t0 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t1 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t2 = w.c_abdomen[0] + w.cq[12]*t0 + w.sq[12]*t1;
+    const Scalar t3 = w.c_abdomen[1] - w.sq[12]*t0 + w.cq[12]*t1;
+    const Scalar t4 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
+    const Scalar t5 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
+    const Scalar t6 = w.u_abdomen[0] - w.IA_abdomen[5]*t2 - w.IA_abdomen[10]*t3 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t4 - w.IA_abdomen[19]*t5 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.a_abdomen[0] = t2;
+    w.a_abdomen[1] = t3;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = t20;
-    w.a_abdomen[4] = t21;
-    w.a_abdomen[5] = w.a_pelvis[5] + w.Dinv_abdomen*t22;
+    w.a_abdomen[3] = t4;
+    w.a_abdomen[4] = t5;
+    w.a_abdomen[5] = w.a_pelvis[5] + w.Dinv_abdomen*t6;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_free_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  // free acceleration (lambda = 0): body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  shared_43_x2(&w.c_l_hip_roll_link[1], &w.c_r_hip_roll_link[1], w.a_l_hip_yaw_link, w.a_r_hip_yaw_link, &w.cq[1], &w.cq[7], &w.sq[1], &w.sq[7], w.u_l_hip_roll_link, w.u_r_hip_roll_link, &w.IA_l_hip_roll_link[3], &w.IA_r_hip_roll_link[3], w.a_l_hip_roll_link, w.a_r_hip_roll_link, w.Dinv_l_hip_roll_link, w.Dinv_r_hip_roll_link);
   // free acceleration (lambda = 0): body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq[13]*t0 - w.a_abdomen[2]*w.sq[13];
-    const Scalar t3 = w.c_chest[2] + w.sq[13]*t0 + w.a_abdomen[2]*w.cq[13];
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq[13] - w.a_abdomen[5]*w.sq[13];
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq[13] + w.a_abdomen[5]*w.cq[13];
-    const Scalar t6 = w.u_chest[0] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
-    w.a_chest[0] = t2;
-    w.a_chest[1] = t1;
-    w.a_chest[2] = t3;
-    w.a_chest[3] = t4;
-    w.a_chest[4] = w.a_abdomen[4] + w.Dinv_chest*t6;
-    w.a_chest[5] = t5;
-  }
-  // free acceleration (lambda = 0): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
-  {
-    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t10 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
-    const Scalar t11 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
-    const Scalar t12 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
-    const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t10 - w.sq[23]*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t10 + w.cq[23]*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t13 - w.sq[23]*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t13 + w.cq[23]*t15;
-    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
-    w.a_r_shoulder_pitch_link[0] = t16;
-    w.a_r_shoulder_pitch_link[1] = t11;
-    w.a_r_shoulder_pitch_link[2] = t17;
-    w.a_r_shoulder_pitch_link[3] = t18;
-    w.a_r_shoulder_pitch_link[4] = t14 + w.Dinv_r_shoulder_pitch_link*t20;
-    w.a_r_shoulder_pitch_link[5] = t19;
-  }
-  // free acceleration (lambda = 0): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
-  {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[1] + w.sq[24]*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq[24]*w.a_r_shoulder_pitch_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[4] + w.sq[24]*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq[24]*w.a_r_shoulder_pitch_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[5];
-    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
-    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = t21;
-    w.a_r_shoulder_roll_link[2] = t22;
-    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.Dinv_r_shoulder_roll_link*t25;
-    w.a_r_shoulder_roll_link[4] = t23;
-    w.a_r_shoulder_roll_link[5] = t24;
+    const Scalar t17 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t18 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t19 = w.c_chest[0] + w.cq[13]*t17 - w.sq[13]*w.a_abdomen[2];
+    const Scalar t20 = w.c_chest[2] + w.sq[13]*t17 + w.cq[13]*w.a_abdomen[2];
+    const Scalar t21 = w.c_chest[3] + w.cq[13]*w.a_abdomen[3] - w.sq[13]*w.a_abdomen[5];
+    const Scalar t22 = w.c_chest[5] + w.sq[13]*w.a_abdomen[3] + w.cq[13]*w.a_abdomen[5];
+    const Scalar t23 = w.u_chest[0] - w.IA_chest[4]*t19 - w.IA_chest[9]*t18 - w.IA_chest[13]*t20 - w.IA_chest[16]*t21 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t22;
+    w.a_chest[0] = t19;
+    w.a_chest[1] = t18;
+    w.a_chest[2] = t20;
+    w.a_chest[3] = t21;
+    w.a_chest[4] = w.a_abdomen[4] + w.Dinv_chest*t23;
+    w.a_chest[5] = t22;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_free_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_l_thigh_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  // free acceleration (lambda = 0): body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  shared_44_x2(shared_44_p0, w.a_l_hip_roll_link, w.a_r_hip_roll_link, w.c_l_thigh, w.c_r_thigh, &w.cq[2], &w.cq[8], &w.sq[2], &w.sq[8], w.u_l_thigh, w.u_r_thigh, &w.IA_l_thigh[4], &w.IA_r_thigh[4], w.a_l_thigh, w.a_r_thigh, w.Dinv_l_thigh, w.Dinv_r_thigh);
+  // free acceleration (lambda = 0): body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
+  {
+    const Scalar t18 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t19 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t20 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t21 = 0.9848134698792882*t18 + 0.17361575258114187*t20;
+    const Scalar t22 = 0.04493516596384369*t18 + 0.9659256678396477*t19 - 0.2548890642384102*t20;
+    const Scalar t23 = -0.1676999117594225*t18 + 0.2588196364430848*t19 + 0.9512566085906322*t20;
+    const Scalar t24 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t25 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t26 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t27 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t21 - w.sq[23]*t23;
+    const Scalar t28 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t21 + w.cq[23]*t23;
+    const Scalar t29 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t24 - w.sq[23]*t26;
+    const Scalar t30 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t24 + w.cq[23]*t26;
+    const Scalar t31 = w.u_r_shoulder_pitch_link[0] - w.IA_r_shoulder_pitch_link[4]*t27 - w.IA_r_shoulder_pitch_link[9]*t22 - w.IA_r_shoulder_pitch_link[13]*t28 - w.IA_r_shoulder_pitch_link[18]*t25 - w.IA_r_shoulder_pitch_link[19]*t30;
+    w.a_r_shoulder_pitch_link[0] = t27;
+    w.a_r_shoulder_pitch_link[1] = t22;
+    w.a_r_shoulder_pitch_link[2] = t28;
+    w.a_r_shoulder_pitch_link[3] = t29;
+    w.a_r_shoulder_pitch_link[4] = t25 + w.Dinv_r_shoulder_pitch_link*t31;
+    w.a_r_shoulder_pitch_link[5] = t30;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_free_l_shank_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  // free acceleration (lambda = 0): body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  shared_45_x2(shared_45_p0, w.a_l_thigh, w.a_r_thigh, w.c_l_shank, w.c_r_shank, &w.cq[3], &w.cq[9], &w.sq[3], &w.sq[9], w.u_l_shank, w.u_r_shank, &w.IA_l_shank[4], &w.IA_r_shank[4], w.a_l_shank, w.a_r_shank, w.Dinv_l_shank, w.Dinv_r_shank);
+  // free acceleration (lambda = 0): body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
+  {
+    const Scalar t22 = w.c_r_shoulder_roll_link[1] + w.a_r_shoulder_pitch_link[1]*w.cq[24] + w.a_r_shoulder_pitch_link[2]*w.sq[24];
+    const Scalar t23 = w.c_r_shoulder_roll_link[2] - w.a_r_shoulder_pitch_link[1]*w.sq[24] + w.a_r_shoulder_pitch_link[2]*w.cq[24];
+    const Scalar t24 = w.c_r_shoulder_roll_link[4] + w.a_r_shoulder_pitch_link[4]*w.cq[24] + w.a_r_shoulder_pitch_link[5]*w.sq[24];
+    const Scalar t25 = w.c_r_shoulder_roll_link[5] - w.a_r_shoulder_pitch_link[4]*w.sq[24] + w.a_r_shoulder_pitch_link[5]*w.cq[24];
+    const Scalar t26 = w.u_r_shoulder_roll_link[0] - w.a_r_shoulder_pitch_link[0]*w.IA_r_shoulder_roll_link[3] - w.IA_r_shoulder_roll_link[8]*t22 - w.IA_r_shoulder_roll_link[12]*t23 - w.a_r_shoulder_pitch_link[3]*w.IA_r_shoulder_roll_link[15] - w.IA_r_shoulder_roll_link[16]*t24;
+    w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
+    w.a_r_shoulder_roll_link[1] = t22;
+    w.a_r_shoulder_roll_link[2] = t23;
+    w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.Dinv_r_shoulder_roll_link*t26;
+    w.a_r_shoulder_roll_link[4] = t24;
+    w.a_r_shoulder_roll_link[5] = t25;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_free_l_ankle_link_to_r_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  // free acceleration (lambda = 0): body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  shared_46_x2(shared_46_p0, w.a_l_shank, w.a_r_shank, w.c_l_ankle_link, w.c_r_ankle_link, &w.cq[4], &w.cq[10], &w.sq[4], &w.sq[10], w.u_l_ankle_link, w.u_r_ankle_link, &w.IA_l_ankle_link[4], &w.IA_r_ankle_link[4], w.a_l_ankle_link, w.a_r_ankle_link, w.Dinv_l_ankle_link, w.Dinv_r_ankle_link);
   // free acceleration (lambda = 0): body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
-    const Scalar t4 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
-    w.a_r_upper_arm[0] = t0;
-    w.a_r_upper_arm[1] = t1;
+    const Scalar t22 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
+    const Scalar t23 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
+    const Scalar t24 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
+    const Scalar t25 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
+    const Scalar t26 = w.u_r_upper_arm[0] - w.IA_r_upper_arm[5]*t22 - w.IA_r_upper_arm[10]*t23 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t24 - w.IA_r_upper_arm[19]*t25 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    w.a_r_upper_arm[0] = t22;
+    w.a_r_upper_arm[1] = t23;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = t2;
-    w.a_r_upper_arm[4] = t3;
-    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.Dinv_r_upper_arm*t4;
+    w.a_r_upper_arm[3] = t24;
+    w.a_r_upper_arm[4] = t25;
+    w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.Dinv_r_upper_arm*t26;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_free_l_foot_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  // free acceleration (lambda = 0): body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  shared_47_x2(shared_47_p0, &w.c_l_foot[1], &w.c_r_foot[1], w.a_l_ankle_link, w.a_r_ankle_link, &w.cq[5], &w.cq[11], &w.sq[5], &w.sq[11], w.u_l_foot, w.u_r_foot, w.a_l_foot, w.a_r_foot);
   // free acceleration (lambda = 0): body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
   {
-    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t7 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
-    const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
-    const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq[26]*t7 - w.sq[26]*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq[26]*t7 + w.cq[26]*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq[26]*t9 - w.sq[26]*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq[26]*t9 + w.cq[26]*t10;
-    const Scalar t15 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.a_r_forearm[0] = t11;
-    w.a_r_forearm[1] = t6;
-    w.a_r_forearm[2] = t12;
-    w.a_r_forearm[3] = t13;
-    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.Dinv_r_forearm*t15;
-    w.a_r_forearm[5] = t14;
+    const Scalar t10 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t11 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t12 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t10;
+    const Scalar t13 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t10;
+    const Scalar t14 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t15 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t16 = w.c_r_forearm[0] + w.cq[26]*t12 - w.sq[26]*t13;
+    const Scalar t17 = w.c_r_forearm[2] + w.sq[26]*t12 + w.cq[26]*t13;
+    const Scalar t18 = w.c_r_forearm[3] + w.cq[26]*t14 - w.sq[26]*t15;
+    const Scalar t19 = w.c_r_forearm[5] + w.sq[26]*t14 + w.cq[26]*t15;
+    const Scalar t20 = w.u_r_forearm[0] - w.IA_r_forearm[4]*t16 - w.IA_r_forearm[9]*t11 - w.IA_r_forearm[13]*t17 - w.IA_r_forearm[16]*t18 - w.a_r_upper_arm[4]*w.IA_r_forearm[18];
+    w.a_r_forearm[0] = t16;
+    w.a_r_forearm[1] = t11;
+    w.a_r_forearm[2] = t17;
+    w.a_r_forearm[3] = t18;
+    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.Dinv_r_forearm*t20;
+    w.a_r_forearm[5] = t19;
   }
   // free acceleration (lambda = 0): body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
   {
-    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t16 + w.sq[27]*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t16 + w.cq[27]*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq[27]*w.a_r_forearm[3] + w.sq[27]*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq[27]*w.a_r_forearm[3] + w.cq[27]*w.a_r_forearm[4];
-    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.a_r_wrist_yaw_link[0] = t18;
-    w.a_r_wrist_yaw_link[1] = t19;
+    const Scalar t21 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t22 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t23 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t21 + w.sq[27]*t22;
+    const Scalar t24 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t21 + w.cq[27]*t22;
+    const Scalar t25 = w.c_r_wrist_yaw_link[3] + w.cq[27]*w.a_r_forearm[3] + w.sq[27]*w.a_r_forearm[4];
+    const Scalar t26 = w.c_r_wrist_yaw_link[4] - w.sq[27]*w.a_r_forearm[3] + w.cq[27]*w.a_r_forearm[4];
+    const Scalar t27 = w.u_r_wrist_yaw_link[0] - w.IA_r_wrist_yaw_link[5]*t23 - w.IA_r_wrist_yaw_link[10]*t24 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t25 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
+    w.a_r_wrist_yaw_link[0] = t23;
+    w.a_r_wrist_yaw_link[1] = t24;
     w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = t20;
-    w.a_r_wrist_yaw_link[4] = t21;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.Dinv_r_wrist_yaw_link*t22;
+    w.a_r_wrist_yaw_link[3] = t25;
+    w.a_r_wrist_yaw_link[4] = t26;
+    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.Dinv_r_wrist_yaw_link*t27;
   }
 }
 
@@ -6513,7 +6505,7 @@ PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRI
   w.lambda[14] = w.Linv[14]*z14;
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'pelvis': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_pelvis[0] - w.KA_pelvis[0][0]*w.lambda[0] - w.KA_pelvis[0][1]*w.lambda[1] - w.KA_pelvis[0][2]*w.lambda[2] - w.KA_pelvis[0][3]*w.lambda[3] - w.KA_pelvis[0][4]*w.lambda[4] - w.KA_pelvis[0][5]*w.lambda[5] - w.KA_pelvis[0][6]*w.lambda[6] - w.KA_pelvis[0][7]*w.lambda[7] - w.KA_pelvis[0][8]*w.lambda[8] - w.KA_pelvis[0][9]*w.lambda[9] - w.KA_pelvis[0][10]*w.lambda[10] - w.KA_pelvis[0][11]*w.lambda[11] - w.KA_pelvis[0][12]*w.lambda[12] - w.KA_pelvis[0][13]*w.lambda[13] - w.KA_pelvis[0][14]*w.lambda[14] - 9.81*w.RJ_pelvis[2][0]*w.IA_pelvis[0] - 9.81*w.RJ_pelvis[2][1]*w.IA_pelvis[1] - 9.81*w.RJ_pelvis[2][2]*w.IA_pelvis[2];
@@ -6552,243 +6544,196 @@ PROXGEN_RT_NOINLINE void pv_forward_pelvis_to_l_hip_yaw_link(Workspace& PROXGEN_
     w.a_pelvis[5] = w.qdd[5];
   }
   // accelerate, with the multipliers of the subtree rows: body 2 'l_hip_yaw_link': joint 'l_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t22 = w.a_pelvis[0] - 0.0875*w.a_pelvis[5];
-    const Scalar t23 = w.a_pelvis[2] + 0.0875*w.a_pelvis[3];
-    const Scalar t24 = 0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t22;
-    const Scalar t25 = 0.9961917745544759*w.a_pelvis[1] - 0.08718915247898762*t22;
-    const Scalar t26 = 0.9961917745544759*w.a_pelvis[3] + 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t27 = -0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t28 = w.c_l_hip_yaw_link[0] + w.cq[0]*t24 + w.sq[0]*t25;
-    const Scalar t29 = w.c_l_hip_yaw_link[1] - w.sq[0]*t24 + w.cq[0]*t25;
-    const Scalar t30 = w.c_l_hip_yaw_link[3] + w.cq[0]*t26 + w.sq[0]*t27;
-    const Scalar t31 = w.c_l_hip_yaw_link[4] - w.sq[0]*t26 + w.cq[0]*t27;
-    const Scalar t32 = w.u_l_hip_yaw_link[0] - w.KA_l_hip_yaw_link[5][0]*w.lambda[0] - w.KA_l_hip_yaw_link[5][1]*w.lambda[1] - w.KA_l_hip_yaw_link[5][2]*w.lambda[2] - w.KA_l_hip_yaw_link[5][3]*w.lambda[3] - w.KA_l_hip_yaw_link[5][4]*w.lambda[4] - w.KA_l_hip_yaw_link[5][5]*w.lambda[5] - w.IA_l_hip_yaw_link[5]*t28 - w.IA_l_hip_yaw_link[10]*t29 - w.IA_l_hip_yaw_link[14]*t23 - w.IA_l_hip_yaw_link[19]*t31 - w.IA_l_hip_yaw_link[20]*w.a_pelvis[5];
-    w.qdd[6] = w.Dinv_l_hip_yaw_link*t32;
-    w.a_l_hip_yaw_link[0] = t28;
-    w.a_l_hip_yaw_link[1] = t29;
-    w.a_l_hip_yaw_link[2] = t23;
-    w.a_l_hip_yaw_link[3] = t30;
-    w.a_l_hip_yaw_link[4] = t31;
-    w.a_l_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[6];
-  }
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_l_hip_roll_link_to_l_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
-  shared_45(&w.c_l_hip_roll_link[1], w.a_l_hip_yaw_link, &w.cq[1], &w.sq[1], w.u_l_hip_roll_link, w.KA_l_hip_roll_link, 0, w.lambda, &w.IA_l_hip_roll_link[3], &w.qdd[7], w.Dinv_l_hip_roll_link, w.a_l_hip_roll_link);
-  // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
-  shared_46(w.a_l_hip_roll_link, w.c_l_thigh, &w.cq[2], &w.sq[2], w.u_l_thigh, w.KA_l_thigh, 0, w.lambda, &w.IA_l_thigh[4], &w.qdd[8], w.Dinv_l_thigh, w.a_l_thigh);
-  // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
-  shared_47(w.a_l_thigh, w.c_l_shank, &w.cq[3], &w.sq[3], w.u_l_shank, w.KA_l_shank, 0, w.lambda, &w.IA_l_shank[4], &w.qdd[9], w.Dinv_l_shank, w.a_l_shank);
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_hip_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
-  shared_48(w.a_l_shank, w.c_l_ankle_link, &w.cq[4], &w.sq[4], w.u_l_ankle_link, w.KA_l_ankle_link, 0, w.lambda, &w.IA_l_ankle_link[4], &w.qdd[10], w.Dinv_l_ankle_link, w.a_l_ankle_link);
-  // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
-  shared_49(&w.c_l_foot[1], &w.cq[5], w.a_l_ankle_link, &w.sq[5], w.u_l_foot, &w.lambda[1], &w.qdd[11], w.a_l_foot);
   // accelerate, with the multipliers of the subtree rows: body 8 'r_hip_yaw_link': joint 'r_hip_yaw' (revolute about z), parent 'pelvis'
-  {
-    const Scalar t16 = w.a_pelvis[0] + 0.0875*w.a_pelvis[5];
-    const Scalar t17 = w.a_pelvis[2] - 0.0875*w.a_pelvis[3];
-    const Scalar t18 = -0.08718915247898762*w.a_pelvis[1] + 0.9961917745544759*t16;
-    const Scalar t19 = 0.9961917745544759*w.a_pelvis[1] + 0.08718915247898762*t16;
-    const Scalar t20 = 0.9961917745544759*w.a_pelvis[3] - 0.08718915247898762*w.a_pelvis[4];
-    const Scalar t21 = 0.08718915247898762*w.a_pelvis[3] + 0.9961917745544759*w.a_pelvis[4];
-    const Scalar t22 = w.c_r_hip_yaw_link[0] + w.cq[6]*t18 + w.sq[6]*t19;
-    const Scalar t23 = w.c_r_hip_yaw_link[1] - w.sq[6]*t18 + w.cq[6]*t19;
-    const Scalar t24 = w.c_r_hip_yaw_link[3] + w.cq[6]*t20 + w.sq[6]*t21;
-    const Scalar t25 = w.c_r_hip_yaw_link[4] - w.sq[6]*t20 + w.cq[6]*t21;
-    const Scalar t26 = w.u_r_hip_yaw_link[0] - w.KA_r_hip_yaw_link[5][0]*w.lambda[6] - w.KA_r_hip_yaw_link[5][1]*w.lambda[7] - w.KA_r_hip_yaw_link[5][2]*w.lambda[8] - w.KA_r_hip_yaw_link[5][3]*w.lambda[9] - w.KA_r_hip_yaw_link[5][4]*w.lambda[10] - w.KA_r_hip_yaw_link[5][5]*w.lambda[11] - w.IA_r_hip_yaw_link[5]*t22 - w.IA_r_hip_yaw_link[10]*t23 - w.IA_r_hip_yaw_link[14]*t17 - w.IA_r_hip_yaw_link[19]*t25 - w.a_pelvis[5]*w.IA_r_hip_yaw_link[20];
-    w.qdd[12] = w.Dinv_r_hip_yaw_link*t26;
-    w.a_r_hip_yaw_link[0] = t22;
-    w.a_r_hip_yaw_link[1] = t23;
-    w.a_r_hip_yaw_link[2] = t17;
-    w.a_r_hip_yaw_link[3] = t24;
-    w.a_r_hip_yaw_link[4] = t25;
-    w.a_r_hip_yaw_link[5] = w.a_pelvis[5] + w.qdd[12];
-  }
+  shared_48_x2(shared_48_p0, w.a_pelvis, w.a_pelvis, w.c_l_hip_yaw_link, w.c_r_hip_yaw_link, w.cq, &w.cq[6], w.sq, &w.sq[6], w.u_l_hip_yaw_link, w.u_r_hip_yaw_link, w.KA_l_hip_yaw_link, w.KA_r_hip_yaw_link, 0, 0, w.lambda, &w.lambda[6], &w.IA_l_hip_yaw_link[5], &w.IA_r_hip_yaw_link[5], &w.qdd[6], &w.qdd[12], w.Dinv_l_hip_yaw_link, w.Dinv_r_hip_yaw_link, w.a_l_hip_yaw_link, w.a_r_hip_yaw_link);
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_r_hip_roll_link_to_r_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
-  shared_45(&w.c_r_hip_roll_link[1], w.a_r_hip_yaw_link, &w.cq[7], &w.sq[7], w.u_r_hip_roll_link, w.KA_r_hip_roll_link, 0, &w.lambda[6], &w.IA_r_hip_roll_link[3], &w.qdd[13], w.Dinv_r_hip_roll_link, w.a_r_hip_roll_link);
-  // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
-  shared_46(w.a_r_hip_roll_link, w.c_r_thigh, &w.cq[8], &w.sq[8], w.u_r_thigh, w.KA_r_thigh, 0, &w.lambda[6], &w.IA_r_thigh[4], &w.qdd[14], w.Dinv_r_thigh, w.a_r_thigh);
-  // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
-  shared_47(w.a_r_thigh, w.c_r_shank, &w.cq[9], &w.sq[9], w.u_r_shank, w.KA_r_shank, 0, &w.lambda[6], &w.IA_r_shank[4], &w.qdd[15], w.Dinv_r_shank, w.a_r_shank);
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_r_ankle_link_to_abdomen(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
-  shared_48(w.a_r_shank, w.c_r_ankle_link, &w.cq[10], &w.sq[10], w.u_r_ankle_link, w.KA_r_ankle_link, 0, &w.lambda[6], &w.IA_r_ankle_link[4], &w.qdd[16], w.Dinv_r_ankle_link, w.a_r_ankle_link);
-  // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
-  shared_49(&w.c_r_foot[1], &w.cq[11], w.a_r_ankle_link, &w.sq[11], w.u_r_foot, &w.lambda[7], &w.qdd[17], w.a_r_foot);
+PROXGEN_RT_NOINLINE void pv_forward_abdomen_to_chest(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 14 'abdomen': joint 'torso_yaw' (revolute about z), parent 'pelvis'
   {
-    const Scalar t16 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
-    const Scalar t17 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
-    const Scalar t18 = w.c_abdomen[0] + w.cq[12]*t16 + w.sq[12]*t17;
-    const Scalar t19 = w.c_abdomen[1] - w.sq[12]*t16 + w.cq[12]*t17;
-    const Scalar t20 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
-    const Scalar t21 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
-    const Scalar t22 = w.u_abdomen[0] - w.KA_abdomen[5][0]*w.lambda[12] - w.KA_abdomen[5][1]*w.lambda[13] - w.KA_abdomen[5][2]*w.lambda[14] - w.IA_abdomen[5]*t18 - w.IA_abdomen[10]*t19 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t20 - w.IA_abdomen[19]*t21 - w.a_pelvis[5]*w.IA_abdomen[20];
-    w.qdd[18] = w.Dinv_abdomen*t22;
-    w.a_abdomen[0] = t18;
-    w.a_abdomen[1] = t19;
+    const Scalar t0 = w.a_pelvis[0] + 0.1*w.a_pelvis[4];
+    const Scalar t1 = w.a_pelvis[1] - 0.1*w.a_pelvis[3];
+    const Scalar t2 = w.c_abdomen[0] + w.cq[12]*t0 + w.sq[12]*t1;
+    const Scalar t3 = w.c_abdomen[1] - w.sq[12]*t0 + w.cq[12]*t1;
+    const Scalar t4 = w.c_abdomen[3] + w.a_pelvis[3]*w.cq[12] + w.a_pelvis[4]*w.sq[12];
+    const Scalar t5 = w.c_abdomen[4] - w.a_pelvis[3]*w.sq[12] + w.a_pelvis[4]*w.cq[12];
+    const Scalar t6 = w.u_abdomen[0] - w.KA_abdomen[5][0]*w.lambda[12] - w.KA_abdomen[5][1]*w.lambda[13] - w.KA_abdomen[5][2]*w.lambda[14] - w.IA_abdomen[5]*t2 - w.IA_abdomen[10]*t3 - w.a_pelvis[2]*w.IA_abdomen[14] - w.IA_abdomen[17]*t4 - w.IA_abdomen[19]*t5 - w.a_pelvis[5]*w.IA_abdomen[20];
+    w.qdd[18] = w.Dinv_abdomen*t6;
+    w.a_abdomen[0] = t2;
+    w.a_abdomen[1] = t3;
     w.a_abdomen[2] = w.a_pelvis[2];
-    w.a_abdomen[3] = t20;
-    w.a_abdomen[4] = t21;
+    w.a_abdomen[3] = t4;
+    w.a_abdomen[4] = t5;
     w.a_abdomen[5] = w.a_pelvis[5] + w.qdd[18];
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_chest_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 3 'l_hip_roll_link': joint 'l_hip_roll' (revolute about x), parent 'l_hip_yaw_link'
+  // accelerate, with the multipliers of the subtree rows: body 9 'r_hip_roll_link': joint 'r_hip_roll' (revolute about x), parent 'r_hip_yaw_link'
+  shared_49_x2(&w.c_l_hip_roll_link[1], &w.c_r_hip_roll_link[1], w.a_l_hip_yaw_link, w.a_r_hip_yaw_link, &w.cq[1], &w.cq[7], &w.sq[1], &w.sq[7], w.u_l_hip_roll_link, w.u_r_hip_roll_link, w.KA_l_hip_roll_link, w.KA_r_hip_roll_link, 0, 0, w.lambda, &w.lambda[6], &w.IA_l_hip_roll_link[3], &w.IA_r_hip_roll_link[3], &w.qdd[7], &w.qdd[13], w.Dinv_l_hip_roll_link, w.Dinv_r_hip_roll_link, w.a_l_hip_roll_link, w.a_r_hip_roll_link);
   // accelerate, with the multipliers of the subtree rows: body 15 'chest': joint 'torso_pitch' (revolute about y), parent 'abdomen'
   {
-    const Scalar t0 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
-    const Scalar t1 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
-    const Scalar t2 = w.c_chest[0] + w.cq[13]*t0 - w.a_abdomen[2]*w.sq[13];
-    const Scalar t3 = w.c_chest[2] + w.sq[13]*t0 + w.a_abdomen[2]*w.cq[13];
-    const Scalar t4 = w.c_chest[3] + w.a_abdomen[3]*w.cq[13] - w.a_abdomen[5]*w.sq[13];
-    const Scalar t5 = w.c_chest[5] + w.a_abdomen[3]*w.sq[13] + w.a_abdomen[5]*w.cq[13];
-    const Scalar t6 = w.u_chest[0] - w.KA_chest[4][0]*w.lambda[12] - w.KA_chest[4][1]*w.lambda[13] - w.KA_chest[4][2]*w.lambda[14] - w.IA_chest[4]*t2 - w.IA_chest[9]*t1 - w.IA_chest[13]*t3 - w.IA_chest[16]*t4 - w.a_abdomen[4]*w.IA_chest[18] - w.IA_chest[19]*t5;
-    w.qdd[19] = w.Dinv_chest*t6;
-    w.a_chest[0] = t2;
-    w.a_chest[1] = t1;
-    w.a_chest[2] = t3;
-    w.a_chest[3] = t4;
+    const Scalar t17 = w.a_abdomen[0] + 0.15*w.a_abdomen[4];
+    const Scalar t18 = w.a_abdomen[1] - 0.15*w.a_abdomen[3];
+    const Scalar t19 = w.c_chest[0] + w.cq[13]*t17 - w.sq[13]*w.a_abdomen[2];
+    const Scalar t20 = w.c_chest[2] + w.sq[13]*t17 + w.cq[13]*w.a_abdomen[2];
+    const Scalar t21 = w.c_chest[3] + w.cq[13]*w.a_abdomen[3] - w.sq[13]*w.a_abdomen[5];
+    const Scalar t22 = w.c_chest[5] + w.sq[13]*w.a_abdomen[3] + w.cq[13]*w.a_abdomen[5];
+    const Scalar t23 = w.u_chest[0] - w.KA_chest[4][0]*w.lambda[12] - w.KA_chest[4][1]*w.lambda[13] - w.KA_chest[4][2]*w.lambda[14] - w.IA_chest[4]*t19 - w.IA_chest[9]*t18 - w.IA_chest[13]*t20 - w.IA_chest[16]*t21 - w.IA_chest[18]*w.a_abdomen[4] - w.IA_chest[19]*t22;
+    w.qdd[19] = w.Dinv_chest*t23;
+    w.a_chest[0] = t19;
+    w.a_chest[1] = t18;
+    w.a_chest[2] = t20;
+    w.a_chest[3] = t21;
     w.a_chest[4] = w.a_abdomen[4] + w.qdd[19];
-    w.a_chest[5] = t5;
+    w.a_chest[5] = t22;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_forward_l_thigh_to_r_shoulder_pitch_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 4 'l_thigh': joint 'l_hip_pitch' (revolute about y), parent 'l_hip_roll_link'
+  // accelerate, with the multipliers of the subtree rows: body 10 'r_thigh': joint 'r_hip_pitch' (revolute about y), parent 'r_hip_roll_link'
+  shared_50_x2(shared_50_p0, w.a_l_hip_roll_link, w.a_r_hip_roll_link, w.c_l_thigh, w.c_r_thigh, &w.cq[2], &w.cq[8], &w.sq[2], &w.sq[8], w.u_l_thigh, w.u_r_thigh, w.KA_l_thigh, w.KA_r_thigh, 0, 0, w.lambda, &w.lambda[6], &w.IA_l_thigh[4], &w.IA_r_thigh[4], &w.qdd[8], &w.qdd[14], w.Dinv_l_thigh, w.Dinv_r_thigh, w.a_l_thigh, w.a_r_thigh);
   // accelerate, with the multipliers of the subtree rows: body 25 'r_shoulder_pitch_link': joint 'r_shoulder_pitch' (revolute about y), parent 'chest'
   {
-    const Scalar t7 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
-    const Scalar t8 = w.a_chest[1] - 0.254*w.a_chest[3];
-    const Scalar t9 = w.a_chest[2] - 0.19*w.a_chest[3];
-    const Scalar t10 = 0.9848134698792882*t7 + 0.17361575258114187*t9;
-    const Scalar t11 = 0.04493516596384369*t7 + 0.9659256678396477*t8 - 0.2548890642384102*t9;
-    const Scalar t12 = -0.1676999117594225*t7 + 0.2588196364430848*t8 + 0.9512566085906322*t9;
-    const Scalar t13 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
-    const Scalar t14 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
-    const Scalar t15 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
-    const Scalar t16 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t10 - w.sq[23]*t12;
-    const Scalar t17 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t10 + w.cq[23]*t12;
-    const Scalar t18 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t13 - w.sq[23]*t15;
-    const Scalar t19 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t13 + w.cq[23]*t15;
-    const Scalar t20 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4][0]*w.lambda[12] - w.KA_r_shoulder_pitch_link[4][1]*w.lambda[13] - w.KA_r_shoulder_pitch_link[4][2]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t16 - w.IA_r_shoulder_pitch_link[9]*t11 - w.IA_r_shoulder_pitch_link[13]*t17 - w.IA_r_shoulder_pitch_link[18]*t14 - w.IA_r_shoulder_pitch_link[19]*t19;
-    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t20;
-    w.a_r_shoulder_pitch_link[0] = t16;
-    w.a_r_shoulder_pitch_link[1] = t11;
-    w.a_r_shoulder_pitch_link[2] = t17;
-    w.a_r_shoulder_pitch_link[3] = t18;
-    w.a_r_shoulder_pitch_link[4] = t14 + w.qdd[29];
-    w.a_r_shoulder_pitch_link[5] = t19;
+    const Scalar t18 = w.a_chest[0] + 0.254*w.a_chest[4] + 0.19*w.a_chest[5];
+    const Scalar t19 = w.a_chest[1] - 0.254*w.a_chest[3];
+    const Scalar t20 = w.a_chest[2] - 0.19*w.a_chest[3];
+    const Scalar t21 = 0.9848134698792882*t18 + 0.17361575258114187*t20;
+    const Scalar t22 = 0.04493516596384369*t18 + 0.9659256678396477*t19 - 0.2548890642384102*t20;
+    const Scalar t23 = -0.1676999117594225*t18 + 0.2588196364430848*t19 + 0.9512566085906322*t20;
+    const Scalar t24 = 0.9848134698792882*w.a_chest[3] + 0.17361575258114187*w.a_chest[5];
+    const Scalar t25 = 0.04493516596384369*w.a_chest[3] + 0.9659256678396477*w.a_chest[4] - 0.2548890642384102*w.a_chest[5];
+    const Scalar t26 = -0.1676999117594225*w.a_chest[3] + 0.2588196364430848*w.a_chest[4] + 0.9512566085906322*w.a_chest[5];
+    const Scalar t27 = w.c_r_shoulder_pitch_link[0] + w.cq[23]*t21 - w.sq[23]*t23;
+    const Scalar t28 = w.c_r_shoulder_pitch_link[2] + w.sq[23]*t21 + w.cq[23]*t23;
+    const Scalar t29 = w.c_r_shoulder_pitch_link[3] + w.cq[23]*t24 - w.sq[23]*t26;
+    const Scalar t30 = w.c_r_shoulder_pitch_link[5] + w.sq[23]*t24 + w.cq[23]*t26;
+    const Scalar t31 = w.u_r_shoulder_pitch_link[0] - w.KA_r_shoulder_pitch_link[4][0]*w.lambda[12] - w.KA_r_shoulder_pitch_link[4][1]*w.lambda[13] - w.KA_r_shoulder_pitch_link[4][2]*w.lambda[14] - w.IA_r_shoulder_pitch_link[4]*t27 - w.IA_r_shoulder_pitch_link[9]*t22 - w.IA_r_shoulder_pitch_link[13]*t28 - w.IA_r_shoulder_pitch_link[18]*t25 - w.IA_r_shoulder_pitch_link[19]*t30;
+    w.qdd[29] = w.Dinv_r_shoulder_pitch_link*t31;
+    w.a_r_shoulder_pitch_link[0] = t27;
+    w.a_r_shoulder_pitch_link[1] = t22;
+    w.a_r_shoulder_pitch_link[2] = t28;
+    w.a_r_shoulder_pitch_link[3] = t29;
+    w.a_r_shoulder_pitch_link[4] = t25 + w.qdd[29];
+    w.a_r_shoulder_pitch_link[5] = t30;
   }
+}
+
+PROXGEN_RT_NOINLINE void pv_forward_l_shank_to_r_shoulder_roll_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 5 'l_shank': joint 'l_knee' (revolute about y), parent 'l_thigh'
+  // accelerate, with the multipliers of the subtree rows: body 11 'r_shank': joint 'r_knee' (revolute about y), parent 'r_thigh'
+  shared_51_x2(shared_51_p0, w.a_l_thigh, w.a_r_thigh, w.c_l_shank, w.c_r_shank, &w.cq[3], &w.cq[9], &w.sq[3], &w.sq[9], w.u_l_shank, w.u_r_shank, w.KA_l_shank, w.KA_r_shank, 0, 0, w.lambda, &w.lambda[6], &w.IA_l_shank[4], &w.IA_r_shank[4], &w.qdd[9], &w.qdd[15], w.Dinv_l_shank, w.Dinv_r_shank, w.a_l_shank, w.a_r_shank);
   // accelerate, with the multipliers of the subtree rows: body 26 'r_shoulder_roll_link': joint 'r_shoulder_roll' (revolute about x), parent 'r_shoulder_pitch_link'
   {
-    const Scalar t21 = w.c_r_shoulder_roll_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[1] + w.sq[24]*w.a_r_shoulder_pitch_link[2];
-    const Scalar t22 = w.c_r_shoulder_roll_link[2] - w.sq[24]*w.a_r_shoulder_pitch_link[1] + w.cq[24]*w.a_r_shoulder_pitch_link[2];
-    const Scalar t23 = w.c_r_shoulder_roll_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[4] + w.sq[24]*w.a_r_shoulder_pitch_link[5];
-    const Scalar t24 = w.c_r_shoulder_roll_link[5] - w.sq[24]*w.a_r_shoulder_pitch_link[4] + w.cq[24]*w.a_r_shoulder_pitch_link[5];
-    const Scalar t25 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3][0]*w.lambda[12] - w.KA_r_shoulder_roll_link[3][1]*w.lambda[13] - w.KA_r_shoulder_roll_link[3][2]*w.lambda[14] - w.IA_r_shoulder_roll_link[3]*w.a_r_shoulder_pitch_link[0] - w.IA_r_shoulder_roll_link[8]*t21 - w.IA_r_shoulder_roll_link[12]*t22 - w.IA_r_shoulder_roll_link[15]*w.a_r_shoulder_pitch_link[3] - w.IA_r_shoulder_roll_link[16]*t23;
-    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t25;
+    const Scalar t22 = w.c_r_shoulder_roll_link[1] + w.a_r_shoulder_pitch_link[1]*w.cq[24] + w.a_r_shoulder_pitch_link[2]*w.sq[24];
+    const Scalar t23 = w.c_r_shoulder_roll_link[2] - w.a_r_shoulder_pitch_link[1]*w.sq[24] + w.a_r_shoulder_pitch_link[2]*w.cq[24];
+    const Scalar t24 = w.c_r_shoulder_roll_link[4] + w.a_r_shoulder_pitch_link[4]*w.cq[24] + w.a_r_shoulder_pitch_link[5]*w.sq[24];
+    const Scalar t25 = w.c_r_shoulder_roll_link[5] - w.a_r_shoulder_pitch_link[4]*w.sq[24] + w.a_r_shoulder_pitch_link[5]*w.cq[24];
+    const Scalar t26 = w.u_r_shoulder_roll_link[0] - w.KA_r_shoulder_roll_link[3][0]*w.lambda[12] - w.KA_r_shoulder_roll_link[3][1]*w.lambda[13] - w.KA_r_shoulder_roll_link[3][2]*w.lambda[14] - w.a_r_shoulder_pitch_link[0]*w.IA_r_shoulder_roll_link[3] - w.IA_r_shoulder_roll_link[8]*t22 - w.IA_r_shoulder_roll_link[12]*t23 - w.a_r_shoulder_pitch_link[3]*w.IA_r_shoulder_roll_link[15] - w.IA_r_shoulder_roll_link[16]*t24;
+    w.qdd[30] = w.Dinv_r_shoulder_roll_link*t26;
     w.a_r_shoulder_roll_link[0] = w.a_r_shoulder_pitch_link[0];
-    w.a_r_shoulder_roll_link[1] = t21;
-    w.a_r_shoulder_roll_link[2] = t22;
+    w.a_r_shoulder_roll_link[1] = t22;
+    w.a_r_shoulder_roll_link[2] = t23;
     w.a_r_shoulder_roll_link[3] = w.a_r_shoulder_pitch_link[3] + w.qdd[30];
-    w.a_r_shoulder_roll_link[4] = t23;
-    w.a_r_shoulder_roll_link[5] = t24;
+    w.a_r_shoulder_roll_link[4] = t24;
+    w.a_r_shoulder_roll_link[5] = t25;
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_r_upper_arm_to_r_wrist_yaw_link(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_l_ankle_link_to_r_upper_arm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 6 'l_ankle_link': joint 'l_ankle_pitch' (revolute about y), parent 'l_shank'
+  // accelerate, with the multipliers of the subtree rows: body 12 'r_ankle_link': joint 'r_ankle_pitch' (revolute about y), parent 'r_shank'
+  shared_52_x2(shared_52_p0, w.a_l_shank, w.a_r_shank, w.c_l_ankle_link, w.c_r_ankle_link, &w.cq[4], &w.cq[10], &w.sq[4], &w.sq[10], w.u_l_ankle_link, w.u_r_ankle_link, w.KA_l_ankle_link, w.KA_r_ankle_link, 0, 0, w.lambda, &w.lambda[6], &w.IA_l_ankle_link[4], &w.IA_r_ankle_link[4], &w.qdd[10], &w.qdd[16], w.Dinv_l_ankle_link, w.Dinv_r_ankle_link, w.a_l_ankle_link, w.a_r_ankle_link);
   // accelerate, with the multipliers of the subtree rows: body 27 'r_upper_arm': joint 'r_shoulder_yaw' (revolute about z), parent 'r_shoulder_roll_link'
   {
-    const Scalar t0 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
-    const Scalar t1 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
-    const Scalar t2 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
-    const Scalar t3 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
-    const Scalar t4 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[5][0]*w.lambda[12] - w.KA_r_upper_arm[5][1]*w.lambda[13] - w.KA_r_upper_arm[5][2]*w.lambda[14] - w.IA_r_upper_arm[5]*t0 - w.IA_r_upper_arm[10]*t1 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t2 - w.IA_r_upper_arm[19]*t3 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
-    w.qdd[31] = w.Dinv_r_upper_arm*t4;
-    w.a_r_upper_arm[0] = t0;
-    w.a_r_upper_arm[1] = t1;
+    const Scalar t22 = w.c_r_upper_arm[0] + w.a_r_shoulder_roll_link[0]*w.cq[25] + w.a_r_shoulder_roll_link[1]*w.sq[25];
+    const Scalar t23 = w.c_r_upper_arm[1] - w.a_r_shoulder_roll_link[0]*w.sq[25] + w.a_r_shoulder_roll_link[1]*w.cq[25];
+    const Scalar t24 = w.c_r_upper_arm[3] + w.a_r_shoulder_roll_link[3]*w.cq[25] + w.a_r_shoulder_roll_link[4]*w.sq[25];
+    const Scalar t25 = w.c_r_upper_arm[4] - w.a_r_shoulder_roll_link[3]*w.sq[25] + w.a_r_shoulder_roll_link[4]*w.cq[25];
+    const Scalar t26 = w.u_r_upper_arm[0] - w.KA_r_upper_arm[5][0]*w.lambda[12] - w.KA_r_upper_arm[5][1]*w.lambda[13] - w.KA_r_upper_arm[5][2]*w.lambda[14] - w.IA_r_upper_arm[5]*t22 - w.IA_r_upper_arm[10]*t23 - w.a_r_shoulder_roll_link[2]*w.IA_r_upper_arm[14] - w.IA_r_upper_arm[17]*t24 - w.IA_r_upper_arm[19]*t25 - w.a_r_shoulder_roll_link[5]*w.IA_r_upper_arm[20];
+    w.qdd[31] = w.Dinv_r_upper_arm*t26;
+    w.a_r_upper_arm[0] = t22;
+    w.a_r_upper_arm[1] = t23;
     w.a_r_upper_arm[2] = w.a_r_shoulder_roll_link[2];
-    w.a_r_upper_arm[3] = t2;
-    w.a_r_upper_arm[4] = t3;
+    w.a_r_upper_arm[3] = t24;
+    w.a_r_upper_arm[4] = t25;
     w.a_r_upper_arm[5] = w.a_r_shoulder_roll_link[5] + w.qdd[31];
-  }
-  // accelerate, with the multipliers of the subtree rows: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
-  {
-    const Scalar t5 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
-    const Scalar t6 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
-    const Scalar t7 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t5;
-    const Scalar t8 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t5;
-    const Scalar t9 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
-    const Scalar t10 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
-    const Scalar t11 = w.c_r_forearm[0] + w.cq[26]*t7 - w.sq[26]*t8;
-    const Scalar t12 = w.c_r_forearm[2] + w.sq[26]*t7 + w.cq[26]*t8;
-    const Scalar t13 = w.c_r_forearm[3] + w.cq[26]*t9 - w.sq[26]*t10;
-    const Scalar t14 = w.c_r_forearm[5] + w.sq[26]*t9 + w.cq[26]*t10;
-    const Scalar t15 = w.u_r_forearm[0] - w.KA_r_forearm[4][0]*w.lambda[12] - w.KA_r_forearm[4][1]*w.lambda[13] - w.KA_r_forearm[4][2]*w.lambda[14] - w.IA_r_forearm[4]*t11 - w.IA_r_forearm[9]*t6 - w.IA_r_forearm[13]*t12 - w.IA_r_forearm[16]*t13 - w.IA_r_forearm[18]*w.a_r_upper_arm[4];
-    w.qdd[32] = w.Dinv_r_forearm*t15;
-    w.a_r_forearm[0] = t11;
-    w.a_r_forearm[1] = t6;
-    w.a_r_forearm[2] = t12;
-    w.a_r_forearm[3] = t13;
-    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
-    w.a_r_forearm[5] = t14;
-  }
-  // accelerate, with the multipliers of the subtree rows: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
-  {
-    const Scalar t16 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
-    const Scalar t17 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
-    const Scalar t18 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t16 + w.sq[27]*t17;
-    const Scalar t19 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t16 + w.cq[27]*t17;
-    const Scalar t20 = w.c_r_wrist_yaw_link[3] + w.cq[27]*w.a_r_forearm[3] + w.sq[27]*w.a_r_forearm[4];
-    const Scalar t21 = w.c_r_wrist_yaw_link[4] - w.sq[27]*w.a_r_forearm[3] + w.cq[27]*w.a_r_forearm[4];
-    const Scalar t22 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[5][1]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t18 - w.IA_r_wrist_yaw_link[10]*t19 - w.IA_r_wrist_yaw_link[14]*w.a_r_forearm[2] - w.IA_r_wrist_yaw_link[17]*t20 - w.IA_r_wrist_yaw_link[20]*w.a_r_forearm[5];
-    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t22;
-    w.a_r_wrist_yaw_link[0] = t18;
-    w.a_r_wrist_yaw_link[1] = t19;
-    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
-    w.a_r_wrist_yaw_link[3] = t20;
-    w.a_r_wrist_yaw_link[4] = t21;
-    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_r_wrist_pitch_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_l_foot_to_r_forearm(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 7 'l_foot': joint 'l_ankle_roll' (revolute about x), parent 'l_ankle_link'
+  // accelerate, with the multipliers of the subtree rows: body 13 'r_foot': joint 'r_ankle_roll' (revolute about x), parent 'r_ankle_link'
+  shared_53_x2(shared_53_p0, &w.c_l_foot[1], &w.c_r_foot[1], w.a_l_ankle_link, w.a_r_ankle_link, &w.cq[5], &w.cq[11], &w.sq[5], &w.sq[11], w.u_l_foot, w.u_r_foot, &w.lambda[1], &w.lambda[7], &w.qdd[11], &w.qdd[17], w.a_l_foot, w.a_r_foot);
+  // accelerate, with the multipliers of the subtree rows: body 28 'r_forearm': joint 'r_elbow' (revolute about y), parent 'r_upper_arm'
+  {
+    const Scalar t10 = w.a_r_upper_arm[0] - 0.3255*w.a_r_upper_arm[4];
+    const Scalar t11 = w.a_r_upper_arm[1] + 0.3255*w.a_r_upper_arm[3];
+    const Scalar t12 = 0.29552020666133966*w.a_r_upper_arm[2] + 0.955336489125606*t10;
+    const Scalar t13 = 0.955336489125606*w.a_r_upper_arm[2] - 0.29552020666133966*t10;
+    const Scalar t14 = 0.955336489125606*w.a_r_upper_arm[3] + 0.29552020666133966*w.a_r_upper_arm[5];
+    const Scalar t15 = -0.29552020666133966*w.a_r_upper_arm[3] + 0.955336489125606*w.a_r_upper_arm[5];
+    const Scalar t16 = w.c_r_forearm[0] + w.cq[26]*t12 - w.sq[26]*t13;
+    const Scalar t17 = w.c_r_forearm[2] + w.sq[26]*t12 + w.cq[26]*t13;
+    const Scalar t18 = w.c_r_forearm[3] + w.cq[26]*t14 - w.sq[26]*t15;
+    const Scalar t19 = w.c_r_forearm[5] + w.sq[26]*t14 + w.cq[26]*t15;
+    const Scalar t20 = w.u_r_forearm[0] - w.KA_r_forearm[4][0]*w.lambda[12] - w.KA_r_forearm[4][1]*w.lambda[13] - w.KA_r_forearm[4][2]*w.lambda[14] - w.IA_r_forearm[4]*t16 - w.IA_r_forearm[9]*t11 - w.IA_r_forearm[13]*t17 - w.IA_r_forearm[16]*t18 - w.a_r_upper_arm[4]*w.IA_r_forearm[18];
+    w.qdd[32] = w.Dinv_r_forearm*t20;
+    w.a_r_forearm[0] = t16;
+    w.a_r_forearm[1] = t11;
+    w.a_r_forearm[2] = t17;
+    w.a_r_forearm[3] = t18;
+    w.a_r_forearm[4] = w.a_r_upper_arm[4] + w.qdd[32];
+    w.a_r_forearm[5] = t19;
+  }
+}
+
+PROXGEN_RT_NOINLINE void pv_forward_r_wrist_yaw_link_to_r_hand(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 29 'r_wrist_yaw_link': joint 'r_wrist_yaw' (revolute about z), parent 'r_forearm'
+  {
+    const Scalar t0 = w.a_r_forearm[0] - 0.2555*w.a_r_forearm[4];
+    const Scalar t1 = w.a_r_forearm[1] + 0.2555*w.a_r_forearm[3];
+    const Scalar t2 = w.c_r_wrist_yaw_link[0] + w.cq[27]*t0 + w.sq[27]*t1;
+    const Scalar t3 = w.c_r_wrist_yaw_link[1] - w.sq[27]*t0 + w.cq[27]*t1;
+    const Scalar t4 = w.c_r_wrist_yaw_link[3] + w.a_r_forearm[3]*w.cq[27] + w.a_r_forearm[4]*w.sq[27];
+    const Scalar t5 = w.c_r_wrist_yaw_link[4] - w.a_r_forearm[3]*w.sq[27] + w.a_r_forearm[4]*w.cq[27];
+    const Scalar t6 = w.u_r_wrist_yaw_link[0] - w.KA_r_wrist_yaw_link[5][1]*w.lambda[13] - w.IA_r_wrist_yaw_link[5]*t2 - w.IA_r_wrist_yaw_link[10]*t3 - w.a_r_forearm[2]*w.IA_r_wrist_yaw_link[14] - w.IA_r_wrist_yaw_link[17]*t4 - w.a_r_forearm[5]*w.IA_r_wrist_yaw_link[20];
+    w.qdd[33] = w.Dinv_r_wrist_yaw_link*t6;
+    w.a_r_wrist_yaw_link[0] = t2;
+    w.a_r_wrist_yaw_link[1] = t3;
+    w.a_r_wrist_yaw_link[2] = w.a_r_forearm[2];
+    w.a_r_wrist_yaw_link[3] = t4;
+    w.a_r_wrist_yaw_link[4] = t5;
+    w.a_r_wrist_yaw_link[5] = w.a_r_forearm[5] + w.qdd[33];
+  }
   // accelerate, with the multipliers of the subtree rows: body 30 'r_wrist_pitch_link': joint 'r_wrist_pitch' (revolute about y), parent 'r_wrist_yaw_link'
   {
-    const Scalar t0 = w.c_r_wrist_pitch_link[0] + w.a_r_wrist_yaw_link[0]*w.cq[28] - w.a_r_wrist_yaw_link[2]*w.sq[28];
-    const Scalar t1 = w.c_r_wrist_pitch_link[2] + w.a_r_wrist_yaw_link[0]*w.sq[28] + w.a_r_wrist_yaw_link[2]*w.cq[28];
-    const Scalar t2 = w.c_r_wrist_pitch_link[3] + w.a_r_wrist_yaw_link[3]*w.cq[28] - w.a_r_wrist_yaw_link[5]*w.sq[28];
-    const Scalar t3 = w.c_r_wrist_pitch_link[5] + w.a_r_wrist_yaw_link[3]*w.sq[28] + w.a_r_wrist_yaw_link[5]*w.cq[28];
-    const Scalar t4 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[4][1]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t0 - w.a_r_wrist_yaw_link[4]*w.IA_r_wrist_pitch_link[18] - w.IA_r_wrist_pitch_link[19]*t3;
-    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t4;
-    w.a_r_wrist_pitch_link[0] = t0;
+    const Scalar t7 = w.c_r_wrist_pitch_link[0] + w.cq[28]*w.a_r_wrist_yaw_link[0] - w.sq[28]*w.a_r_wrist_yaw_link[2];
+    const Scalar t8 = w.c_r_wrist_pitch_link[2] + w.sq[28]*w.a_r_wrist_yaw_link[0] + w.cq[28]*w.a_r_wrist_yaw_link[2];
+    const Scalar t9 = w.c_r_wrist_pitch_link[3] + w.cq[28]*w.a_r_wrist_yaw_link[3] - w.sq[28]*w.a_r_wrist_yaw_link[5];
+    const Scalar t10 = w.c_r_wrist_pitch_link[5] + w.sq[28]*w.a_r_wrist_yaw_link[3] + w.cq[28]*w.a_r_wrist_yaw_link[5];
+    const Scalar t11 = w.u_r_wrist_pitch_link[0] - w.KA_r_wrist_pitch_link[4][1]*w.lambda[13] - w.IA_r_wrist_pitch_link[4]*t7 - w.IA_r_wrist_pitch_link[18]*w.a_r_wrist_yaw_link[4] - w.IA_r_wrist_pitch_link[19]*t10;
+    w.qdd[34] = w.Dinv_r_wrist_pitch_link*t11;
+    w.a_r_wrist_pitch_link[0] = t7;
     w.a_r_wrist_pitch_link[1] = w.a_r_wrist_yaw_link[1];
-    w.a_r_wrist_pitch_link[2] = t1;
-    w.a_r_wrist_pitch_link[3] = t2;
+    w.a_r_wrist_pitch_link[2] = t8;
+    w.a_r_wrist_pitch_link[3] = t9;
     w.a_r_wrist_pitch_link[4] = w.a_r_wrist_yaw_link[4] + w.qdd[34];
-    w.a_r_wrist_pitch_link[5] = t3;
+    w.a_r_wrist_pitch_link[5] = t10;
   }
   // accelerate, with the multipliers of the subtree rows: body 31 'r_hand': joint 'r_wrist_roll' (revolute about x), parent 'r_wrist_pitch_link'
   {
-    const Scalar t5 = w.c_r_hand[1] + w.cq[29]*w.a_r_wrist_pitch_link[1] + w.sq[29]*w.a_r_wrist_pitch_link[2];
-    const Scalar t6 = w.c_r_hand[2] - w.sq[29]*w.a_r_wrist_pitch_link[1] + w.cq[29]*w.a_r_wrist_pitch_link[2];
-    const Scalar t7 = w.c_r_hand[4] + w.cq[29]*w.a_r_wrist_pitch_link[4] + w.sq[29]*w.a_r_wrist_pitch_link[5];
-    const Scalar t8 = w.c_r_hand[5] - w.sq[29]*w.a_r_wrist_pitch_link[4] + w.cq[29]*w.a_r_wrist_pitch_link[5];
-    const Scalar t9 = w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t5;
-    w.qdd[35] = 193.62412145174838*t9;
+    const Scalar t12 = w.c_r_hand[1] + w.cq[29]*w.a_r_wrist_pitch_link[1] + w.sq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t13 = w.c_r_hand[2] - w.sq[29]*w.a_r_wrist_pitch_link[1] + w.cq[29]*w.a_r_wrist_pitch_link[2];
+    const Scalar t14 = w.c_r_hand[4] + w.cq[29]*w.a_r_wrist_pitch_link[4] + w.sq[29]*w.a_r_wrist_pitch_link[5];
+    const Scalar t15 = w.c_r_hand[5] - w.sq[29]*w.a_r_wrist_pitch_link[4] + w.cq[29]*w.a_r_wrist_pitch_link[5];
+    const Scalar t16 = w.u_r_hand[0] - 0.13*w.lambda[12] - 0.005164645770899999*w.a_r_wrist_pitch_link[3] - 0.04016628*t12;
+    w.qdd[35] = 193.62412145174838*t16;
     w.a_r_hand[0] = w.a_r_wrist_pitch_link[0];
-    w.a_r_hand[1] = t5;
-    w.a_r_hand[2] = t6;
+    w.a_r_hand[1] = t12;
+    w.a_r_hand[2] = t13;
     w.a_r_hand[3] = w.a_r_wrist_pitch_link[3] + w.qdd[35];
-    w.a_r_hand[4] = t7;
-    w.a_r_hand[5] = t8;
+    w.a_r_hand[4] = t14;
+    w.a_r_hand[5] = t15;
   }
 }
 
@@ -6826,41 +6771,38 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   proxgen_rt::sincos_run<30, true>(&q[7], &w.sq[0], &w.cq[0]);
-  kinematics_pelvis_to_l_hip_yaw_link(q, v, w);
-  kinematics_l_hip_roll_link_to_l_thigh(q, v, w);
-  kinematics_l_shank_to_l_ankle_link(q, v, w);
-  kinematics_l_foot_to_r_hip_yaw_link(q, v, w);
-  kinematics_r_hip_roll_link_to_r_thigh(q, v, w);
-  kinematics_r_shank_to_r_ankle_link(q, v, w);
-  kinematics_r_foot_to_abdomen(q, v, w);
-  kinematics_chest_to_l_shoulder_pitch_link(q, v, w);
-  kinematics_l_shoulder_roll_link_to_l_upper_arm(q, v, w);
-  kinematics_l_forearm_to_l_wrist_yaw_link(q, v, w);
-  kinematics_l_wrist_pitch_link_to_l_hand(q, v, w);
-  kinematics_neck_link_to_head(q, v, w);
-  kinematics_r_shoulder_pitch_link_to_r_shoulder_roll_link(q, v, w);
-  kinematics_r_upper_arm_to_r_forearm(q, v, w);
-  kinematics_r_wrist_yaw_link_to_r_wrist_pitch_link(q, v, w);
-  kinematics_r_hand(q, v, w);
+  kinematics_pelvis_to_r_hip_yaw_link(q, v, w);
+  kinematics_abdomen_to_r_hip_roll_link(q, v, w);
+  kinematics_chest_to_r_thigh(q, v, w);
+  kinematics_l_shoulder_pitch_link_to_neck_link(q, v, w);
+  kinematics_r_shoulder_pitch_link_to_r_shank(q, v, w);
+  kinematics_l_shoulder_roll_link_to_head(q, v, w);
+  kinematics_r_shoulder_roll_link_to_r_ankle_link(q, v, w);
+  kinematics_l_upper_arm_to_r_upper_arm(q, v, w);
+  kinematics_l_foot_to_r_foot(q, v, w);
+  kinematics_l_forearm_to_r_forearm(q, v, w);
+  kinematics_l_wrist_yaw_link_to_r_wrist_yaw_link(q, v, w);
+  kinematics_l_wrist_pitch_link_to_r_wrist_pitch_link(q, v, w);
+  kinematics_l_hand_to_r_hand(q, v, w);
 }
 
 // Articulated-body elimination of the bodies off the constraint support
 // (no constraint below them): the same in both algorithms.
 void eliminate_free_bodies(const Scalar* tau, Workspace& w) noexcept {
-  eliminate_free_head_to_neck_link(tau, w);
   eliminate_free_l_hand_to_l_wrist_pitch_link(tau, w);
   eliminate_free_l_wrist_yaw_link(tau, w);
   eliminate_free_l_forearm(tau, w);
   eliminate_free_l_upper_arm(tau, w);
-  eliminate_free_l_shoulder_roll_link(tau, w);
+  eliminate_free_head_to_l_shoulder_roll_link(tau, w);
+  eliminate_free_neck_link(tau, w);
   eliminate_free_l_shoulder_pitch_link(tau, w);
 }
 
 // Accelerations of the bodies off the support, once their ancestors are final.
 void accelerate_free_bodies(Workspace& w) noexcept {
-  accelerate_free_l_shoulder_pitch_link_to_l_upper_arm(w);
-  accelerate_free_l_forearm_to_l_wrist_pitch_link(w);
-  accelerate_free_l_hand_to_head(w);
+  accelerate_free_l_shoulder_pitch_link_to_l_shoulder_roll_link(w);
+  accelerate_free_head_to_l_wrist_yaw_link(w);
+  accelerate_free_l_wrist_pitch_link_to_l_hand(w);
 }
 
 }  // namespace
@@ -6897,54 +6839,45 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   caba_backward_r_hand_to_r_wrist_pitch_link(tau, mu, w);
   caba_backward_r_wrist_yaw_link(tau, w);
   caba_backward_r_forearm(tau, w);
+  caba_backward_r_foot_to_l_foot(tau, mu, w);
   caba_backward_r_upper_arm(tau, w);
+  caba_backward_r_ankle_link_to_l_ankle_link(tau, w);
   caba_backward_r_shoulder_roll_link(tau, w);
+  caba_backward_r_shank_to_l_shank(tau, w);
   caba_backward_r_shoulder_pitch_link(tau, w);
+  caba_backward_r_thigh_to_l_thigh(tau, w);
   caba_backward_chest(tau, w);
+  caba_backward_r_hip_roll_link_to_l_hip_roll_link(tau, w);
   caba_backward_abdomen(tau, w);
-  caba_backward_r_foot(tau, mu, w);
-  caba_backward_r_ankle_link(tau, w);
-  caba_backward_r_shank(tau, w);
-  caba_backward_r_thigh(tau, w);
-  caba_backward_r_hip_roll_link(tau, w);
-  caba_backward_r_hip_yaw_link(tau, w);
-  caba_backward_l_foot(tau, mu, w);
-  caba_backward_l_ankle_link(tau, w);
-  caba_backward_l_shank(tau, w);
-  caba_backward_l_thigh(tau, w);
-  caba_backward_l_hip_roll_link(tau, w);
-  caba_backward_l_hip_yaw_link(tau, w);
+  caba_backward_r_hip_yaw_link_to_l_hip_yaw_link(tau, w);
   caba_backward_pelvis(tau, w);
   // ---- forward: accelerations of the support
-  caba_forward_pelvis_to_l_hip_yaw_link(w);
-  caba_forward_l_hip_roll_link_to_l_shank(w);
-  caba_forward_l_ankle_link_to_r_hip_yaw_link(w);
-  caba_forward_r_hip_roll_link_to_r_shank(w);
-  caba_forward_r_ankle_link_to_abdomen(w);
-  caba_forward_chest_to_r_shoulder_roll_link(w);
-  caba_forward_r_upper_arm_to_r_wrist_yaw_link(w);
-  caba_forward_r_wrist_pitch_link_to_r_hand(w);
+  caba_forward_pelvis_to_r_hip_yaw_link(w);
+  caba_forward_abdomen_to_chest(w);
+  caba_forward_l_thigh_to_r_shoulder_pitch_link(w);
+  caba_forward_l_shank_to_r_shoulder_roll_link(w);
+  caba_forward_l_ankle_link_to_r_upper_arm(w);
+  caba_forward_l_foot_to_r_forearm(w);
+  caba_forward_r_wrist_yaw_link_to_r_hand(w);
   // ---- multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda
   caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
     // ---- reduced sweep: u -= S^T dp, dp passes to the parent
     caba_reduced_r_hand_to_r_forearm(w);
-    caba_reduced_r_upper_arm_to_r_shoulder_pitch_link(w);
-    caba_reduced_chest_to_r_foot(w);
-    caba_reduced_r_ankle_link_to_r_thigh(w);
-    caba_reduced_r_hip_roll_link_to_l_ankle_link(w);
-    caba_reduced_l_shank_to_l_hip_roll_link(w);
-    caba_reduced_l_hip_yaw_link_to_pelvis(w);
+    caba_reduced_r_foot_to_l_ankle_link(w);
+    caba_reduced_r_shoulder_roll_link_to_l_shank(w);
+    caba_reduced_r_shoulder_pitch_link_to_l_thigh(w);
+    caba_reduced_chest_to_abdomen(w);
+    caba_reduced_r_hip_yaw_link_to_pelvis(w);
     // ---- forward: accelerations of the support
-    caba_reforward_pelvis_to_l_hip_yaw_link(w);
-    caba_reforward_l_hip_roll_link_to_l_shank(w);
-    caba_reforward_l_ankle_link_to_r_hip_yaw_link(w);
-    caba_reforward_r_hip_roll_link_to_r_shank(w);
-    caba_reforward_r_ankle_link_to_abdomen(w);
-    caba_reforward_chest_to_r_shoulder_roll_link(w);
-    caba_reforward_r_upper_arm_to_r_wrist_yaw_link(w);
-    caba_reforward_r_wrist_pitch_link_to_r_hand(w);
+    caba_reforward_pelvis_to_r_hip_yaw_link(w);
+    caba_reforward_abdomen_to_chest(w);
+    caba_reforward_l_thigh_to_r_shoulder_pitch_link(w);
+    caba_reforward_l_shank_to_r_shoulder_roll_link(w);
+    caba_reforward_l_ankle_link_to_r_upper_arm(w);
+    caba_reforward_l_foot_to_r_forearm(w);
+    caba_reforward_r_wrist_yaw_link_to_r_hand(w);
     // ---- multipliers: dlambda = mu (K a - k), lambda += dlambda
     caba_update(mu, w);
   }
@@ -7015,32 +6948,25 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   pv_backward_r_hand_to_r_wrist_pitch_link(tau, w);
   pv_backward_r_wrist_yaw_link(tau, w);
   pv_backward_r_forearm(tau, w);
+  pv_backward_r_foot_to_l_foot(tau, w);
   pv_backward_r_upper_arm(tau, w);
+  pv_backward_r_ankle_link_to_l_ankle_link(tau, w);
   pv_backward_r_shoulder_roll_link(tau, w);
+  pv_backward_r_shank_to_l_shank(tau, w);
   pv_backward_r_shoulder_pitch_link(tau, w);
+  pv_backward_r_thigh_to_l_thigh(tau, w);
   pv_backward_chest(tau, w);
+  pv_backward_r_hip_roll_link_to_l_hip_roll_link(tau, w);
   pv_backward_abdomen(tau, w);
-  pv_backward_r_foot(tau, w);
-  pv_backward_r_ankle_link(tau, w);
-  pv_backward_r_shank(tau, w);
-  pv_backward_r_thigh(tau, w);
-  pv_backward_r_hip_roll_link(tau, w);
-  pv_backward_r_hip_yaw_link(tau, w);
-  pv_backward_l_foot(tau, w);
-  pv_backward_l_ankle_link(tau, w);
-  pv_backward_l_shank(tau, w);
-  pv_backward_l_thigh(tau, w);
-  pv_backward_l_hip_roll_link(tau, w);
-  pv_backward_l_hip_yaw_link(tau, w);
+  pv_backward_r_hip_yaw_link_to_l_hip_yaw_link(tau, w);
   pv_backward_pelvis(tau, w);
   // ---- free accelerations (lambda = 0) and the rows' y_free = K a - k
-  pv_free_pelvis_to_l_hip_yaw_link(w);
-  pv_free_l_hip_roll_link_to_l_shank(w);
-  pv_free_l_ankle_link_to_r_hip_yaw_link(w);
-  pv_free_r_hip_roll_link_to_r_shank(w);
-  pv_free_r_ankle_link_to_abdomen(w);
-  pv_free_chest_to_r_shoulder_roll_link(w);
-  pv_free_r_upper_arm_to_r_wrist_yaw_link(w);
+  pv_free_pelvis_to_r_hip_yaw_link(w);
+  pv_free_abdomen_to_chest(w);
+  pv_free_l_thigh_to_r_shoulder_pitch_link(w);
+  pv_free_l_shank_to_r_shoulder_roll_link(w);
+  pv_free_l_ankle_link_to_r_upper_arm(w);
+  pv_free_l_foot_to_r_wrist_yaw_link(w);
   pv_free_r_wrist_pitch_link_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
@@ -7072,14 +6998,13 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
     pv_proximal(inv_mu, w);
   }
   // ---- forward: accelerations, with the multipliers of the subtree rows
-  pv_forward_pelvis_to_l_hip_yaw_link(w);
-  pv_forward_l_hip_roll_link_to_l_shank(w);
-  pv_forward_l_ankle_link_to_r_hip_yaw_link(w);
-  pv_forward_r_hip_roll_link_to_r_shank(w);
-  pv_forward_r_ankle_link_to_abdomen(w);
-  pv_forward_chest_to_r_shoulder_roll_link(w);
-  pv_forward_r_upper_arm_to_r_wrist_yaw_link(w);
-  pv_forward_r_wrist_pitch_link_to_r_hand(w);
+  pv_forward_pelvis_to_r_hip_yaw_link(w);
+  pv_forward_abdomen_to_chest(w);
+  pv_forward_l_thigh_to_r_shoulder_pitch_link(w);
+  pv_forward_l_shank_to_r_shoulder_roll_link(w);
+  pv_forward_l_ankle_link_to_r_upper_arm(w);
+  pv_forward_l_foot_to_r_forearm(w);
+  pv_forward_r_wrist_yaw_link_to_r_hand(w);
   // ---- the rows' residual K a - k of the final accelerations
   pv_residual(w);
   accelerate_free_bodies(w);

@@ -5,62 +5,67 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
-//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
+//   constrained_aba: 8734 + 1645 K (= 13669 at K = 3)
+//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 157 + 49 K, sqrt 7, sincos 30, log6 0
 //   prox_pv: 16649 + 650 K (= 18599 at K = 3)
 //     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_1: 2 blocks of l_thigh, r_thigh
-//   shared_2: 2 blocks of l_shank, r_shank
-//   shared_3: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_4: 2 blocks of l_foot, r_foot
-//   shared_5: 2 blocks of l_wrist_yaw_link, neck_link
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_1: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_2: 2 blocks of neck_link, l_wrist_yaw_link
+//   shared_3: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_4: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_5: 2 blocks of l_foot, r_foot (2 in pairs)
 //   shared_6: 2 blocks of l_wrist_yaw_link, r_wrist_yaw_link
 //   shared_7: 2 blocks of l_forearm, r_forearm
 //   shared_8: 2 blocks of l_upper_arm, r_upper_arm
 //   shared_9: 2 blocks of l_shoulder_roll_link, r_shoulder_roll_link
-//   shared_10: 2 blocks of r_foot, l_foot
-//   shared_11: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_12: 2 blocks of r_shank, l_shank
-//   shared_13: 2 blocks of r_thigh, l_thigh
-//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_10: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_11: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_12: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_13: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
 //   shared_15: 2 blocks of pelvis
-//   shared_16: 2 blocks of l_hip_yaw_link
-//   shared_17: 4 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_18: 4 blocks of l_thigh, r_thigh
-//   shared_19: 4 blocks of l_shank, r_shank
-//   shared_20: 4 blocks of l_ankle_link, r_ankle_link
-//   shared_21: 4 blocks of l_foot, r_foot
-//   shared_22: 2 blocks of r_hip_yaw_link
-//   shared_23: 2 blocks of abdomen
-//   shared_24: 2 blocks of chest
-//   shared_25: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
-//   shared_26: 3 blocks of r_shoulder_roll_link, l_shoulder_roll_link
-//   shared_27: 2 blocks of r_upper_arm
-//   shared_28: 2 blocks of r_forearm
-//   shared_29: 3 blocks of r_wrist_yaw_link, l_wrist_yaw_link
-//   shared_30: 2 blocks of r_wrist_pitch_link
-//   shared_31: 2 blocks of r_hand
-//   shared_32: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_33: 2 blocks of r_foot, l_foot
-//   shared_34: 2 blocks of r_thigh, l_thigh
-//   shared_35: 2 blocks of r_foot, l_foot
-//   shared_36: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_37: 2 blocks of r_shank, l_shank
-//   shared_38: 2 blocks of r_thigh, l_thigh
-//   shared_39: 2 blocks of r_hip_roll_link, l_hip_roll_link
-//   shared_40: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_41: 2 blocks of l_thigh, r_thigh
-//   shared_42: 2 blocks of l_shank, r_shank
-//   shared_43: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_44: 2 blocks of l_foot, r_foot
-//   shared_45: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_46: 2 blocks of l_thigh, r_thigh
-//   shared_47: 2 blocks of l_shank, r_shank
-//   shared_48: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_49: 2 blocks of l_foot, r_foot
+//   shared_16: 4 blocks of l_hip_yaw_link, r_hip_yaw_link (4 in pairs)
+//   shared_17: 2 blocks of abdomen
+//   shared_18: 4 blocks of l_hip_roll_link, r_hip_roll_link (4 in pairs)
+//   shared_19: 2 blocks of chest
+//   shared_20: 4 blocks of l_thigh, r_thigh (4 in pairs)
+//   shared_21: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
+//   shared_22: 4 blocks of l_shank, r_shank (4 in pairs)
+//   shared_23: 2 blocks of r_shoulder_roll_link
+//   shared_24: 4 blocks of l_ankle_link, r_ankle_link (4 in pairs)
+//   shared_25: 3 blocks of r_upper_arm, l_upper_arm
+//   shared_26: 4 blocks of l_foot, r_foot (4 in pairs)
+//   shared_27: 2 blocks of r_forearm
+//   shared_28: 2 blocks of r_wrist_yaw_link
+//   shared_29: 2 blocks of r_wrist_pitch_link
+//   shared_30: 2 blocks of r_hand
+//   shared_31: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_32: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_33: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_34: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_35: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_36: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_37: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_38: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_39: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_40: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_41: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_42: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_43: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_44: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_45: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_46: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_47: 2 blocks of l_foot, r_foot (2 in pairs)
+//   shared_48: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_49: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_50: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_51: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_52: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_53: 2 blocks of l_foot, r_foot (2 in pairs)
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -200,121 +205,116 @@ struct Workspace {
   Scalar c_l_hip_yaw_link[6];  // velocity-product acceleration, body 2
   Scalar pA_l_hip_yaw_link[6]; // bias force, body 2
   Scalar g_l_hip_yaw_link[3];  // gravity in body coordinates, body 2
+  Scalar v_r_hip_yaw_link[6];  // velocity, body 8
+  Scalar c_r_hip_yaw_link[6];  // velocity-product acceleration, body 8
+  Scalar pA_r_hip_yaw_link[6]; // bias force, body 8
+  Scalar g_r_hip_yaw_link[3];  // gravity in body coordinates, body 8
+  Scalar v_abdomen[6];         // velocity, body 14
+  Scalar c_abdomen[6];         // velocity-product acceleration, body 14
+  Scalar pA_abdomen[6];        // bias force, body 14
+  Scalar g_abdomen[3];         // gravity in body coordinates, body 14
   Scalar v_l_hip_roll_link[6]; // velocity, body 3
   Scalar c_l_hip_roll_link[6]; // velocity-product acceleration, body 3
   Scalar pA_l_hip_roll_link[6]; // bias force, body 3
   Scalar g_l_hip_roll_link[3]; // gravity in body coordinates, body 3
+  Scalar v_r_hip_roll_link[6]; // velocity, body 9
+  Scalar c_r_hip_roll_link[6]; // velocity-product acceleration, body 9
+  Scalar pA_r_hip_roll_link[6]; // bias force, body 9
+  Scalar g_r_hip_roll_link[3]; // gravity in body coordinates, body 9
+  Scalar v_chest[6];           // velocity, body 15
+  Scalar c_chest[6];           // velocity-product acceleration, body 15
+  Scalar pA_chest[6];          // bias force, body 15
+  Scalar g_chest[3];           // gravity in body coordinates, body 15
   Scalar v_l_thigh[6];         // velocity, body 4
   Scalar c_l_thigh[6];         // velocity-product acceleration, body 4
   Scalar pA_l_thigh[6];        // bias force, body 4
   Scalar g_l_thigh[3];         // gravity in body coordinates, body 4
+  Scalar v_r_thigh[6];         // velocity, body 10
+  Scalar c_r_thigh[6];         // velocity-product acceleration, body 10
+  Scalar pA_r_thigh[6];        // bias force, body 10
+  Scalar g_r_thigh[3];         // gravity in body coordinates, body 10
+  Scalar v_l_shoulder_pitch_link[6]; // velocity, body 16
+  Scalar c_l_shoulder_pitch_link[6]; // velocity-product acceleration, body 16
+  Scalar pA_l_shoulder_pitch_link[6]; // bias force, body 16
+  Scalar v_neck_link[6];       // velocity, body 23
+  Scalar c_neck_link[6];       // velocity-product acceleration, body 23
+  Scalar pA_neck_link[6];      // bias force, body 23
+  Scalar v_r_shoulder_pitch_link[6]; // velocity, body 25
+  Scalar c_r_shoulder_pitch_link[6]; // velocity-product acceleration, body 25
+  Scalar pA_r_shoulder_pitch_link[6]; // bias force, body 25
+  Scalar g_r_shoulder_pitch_link[3]; // gravity in body coordinates, body 25
   Scalar v_l_shank[6];         // velocity, body 5
   Scalar c_l_shank[6];         // velocity-product acceleration, body 5
   Scalar pA_l_shank[6];        // bias force, body 5
   Scalar g_l_shank[3];         // gravity in body coordinates, body 5
+  Scalar v_r_shank[6];         // velocity, body 11
+  Scalar c_r_shank[6];         // velocity-product acceleration, body 11
+  Scalar pA_r_shank[6];        // bias force, body 11
+  Scalar g_r_shank[3];         // gravity in body coordinates, body 11
+  Scalar v_l_shoulder_roll_link[6]; // velocity, body 17
+  Scalar c_l_shoulder_roll_link[6]; // velocity-product acceleration, body 17
+  Scalar pA_l_shoulder_roll_link[6]; // bias force, body 17
+  Scalar v_head[6];            // velocity, body 24
+  Scalar c_head[6];            // velocity-product acceleration, body 24
+  Scalar pA_head[6];           // bias force, body 24
+  Scalar v_r_shoulder_roll_link[6]; // velocity, body 26
+  Scalar c_r_shoulder_roll_link[6]; // velocity-product acceleration, body 26
+  Scalar pA_r_shoulder_roll_link[6]; // bias force, body 26
+  Scalar g_r_shoulder_roll_link[3]; // gravity in body coordinates, body 26
   Scalar v_l_ankle_link[6];    // velocity, body 6
   Scalar c_l_ankle_link[6];    // velocity-product acceleration, body 6
   Scalar pA_l_ankle_link[6];   // bias force, body 6
   Scalar g_l_ankle_link[3];    // gravity in body coordinates, body 6
+  Scalar v_r_ankle_link[6];    // velocity, body 12
+  Scalar c_r_ankle_link[6];    // velocity-product acceleration, body 12
+  Scalar pA_r_ankle_link[6];   // bias force, body 12
+  Scalar g_r_ankle_link[3];    // gravity in body coordinates, body 12
+  Scalar v_l_upper_arm[6];     // velocity, body 18
+  Scalar c_l_upper_arm[6];     // velocity-product acceleration, body 18
+  Scalar pA_l_upper_arm[6];    // bias force, body 18
+  Scalar v_r_upper_arm[6];     // velocity, body 27
+  Scalar c_r_upper_arm[6];     // velocity-product acceleration, body 27
+  Scalar pA_r_upper_arm[6];    // bias force, body 27
+  Scalar g_r_upper_arm[3];     // gravity in body coordinates, body 27
   Scalar v_l_foot[6];          // velocity, body 7
   Scalar c_l_foot[6];          // velocity-product acceleration, body 7
   Scalar pA_l_foot[6];         // bias force, body 7
   Scalar g_l_foot[3];          // gravity in body coordinates, body 7
   Scalar k_left_foot[6];       // constraint right-hand side, constraint 0
-  Scalar v_r_hip_yaw_link[6];  // velocity, body 8
-  Scalar c_r_hip_yaw_link[6];  // velocity-product acceleration, body 8
-  Scalar pA_r_hip_yaw_link[6]; // bias force, body 8
-  Scalar g_r_hip_yaw_link[3];  // gravity in body coordinates, body 8
-  Scalar v_r_hip_roll_link[6]; // velocity, body 9
-  Scalar c_r_hip_roll_link[6]; // velocity-product acceleration, body 9
-  Scalar pA_r_hip_roll_link[6]; // bias force, body 9
-  Scalar g_r_hip_roll_link[3]; // gravity in body coordinates, body 9
-  Scalar v_r_thigh[6];         // velocity, body 10
-  Scalar c_r_thigh[6];         // velocity-product acceleration, body 10
-  Scalar pA_r_thigh[6];        // bias force, body 10
-  Scalar g_r_thigh[3];         // gravity in body coordinates, body 10
-  Scalar v_r_shank[6];         // velocity, body 11
-  Scalar c_r_shank[6];         // velocity-product acceleration, body 11
-  Scalar pA_r_shank[6];        // bias force, body 11
-  Scalar g_r_shank[3];         // gravity in body coordinates, body 11
-  Scalar v_r_ankle_link[6];    // velocity, body 12
-  Scalar c_r_ankle_link[6];    // velocity-product acceleration, body 12
-  Scalar pA_r_ankle_link[6];   // bias force, body 12
-  Scalar g_r_ankle_link[3];    // gravity in body coordinates, body 12
   Scalar v_r_foot[6];          // velocity, body 13
   Scalar c_r_foot[6];          // velocity-product acceleration, body 13
   Scalar pA_r_foot[6];         // bias force, body 13
   Scalar g_r_foot[3];          // gravity in body coordinates, body 13
   Scalar k_right_foot[6];      // constraint right-hand side, constraint 1
-  Scalar v_abdomen[6];         // velocity, body 14
-  Scalar c_abdomen[6];         // velocity-product acceleration, body 14
-  Scalar pA_abdomen[6];        // bias force, body 14
-  Scalar g_abdomen[3];         // gravity in body coordinates, body 14
-  Scalar v_chest[6];           // velocity, body 15
-  Scalar c_chest[6];           // velocity-product acceleration, body 15
-  Scalar pA_chest[6];          // bias force, body 15
-  Scalar g_chest[3];           // gravity in body coordinates, body 15
-  Scalar v_l_shoulder_pitch_link[6]; // velocity, body 16
-  Scalar c_l_shoulder_pitch_link[6]; // velocity-product acceleration, body 16
-  Scalar pA_l_shoulder_pitch_link[6]; // bias force, body 16
-  Scalar v_l_shoulder_roll_link[6]; // velocity, body 17
-  Scalar c_l_shoulder_roll_link[6]; // velocity-product acceleration, body 17
-  Scalar pA_l_shoulder_roll_link[6]; // bias force, body 17
-  Scalar v_l_upper_arm[6];     // velocity, body 18
-  Scalar c_l_upper_arm[6];     // velocity-product acceleration, body 18
-  Scalar pA_l_upper_arm[6];    // bias force, body 18
   Scalar v_l_forearm[6];       // velocity, body 19
   Scalar c_l_forearm[6];       // velocity-product acceleration, body 19
   Scalar pA_l_forearm[6];      // bias force, body 19
-  Scalar v_l_wrist_yaw_link[6]; // velocity, body 20
-  Scalar c_l_wrist_yaw_link[6]; // velocity-product acceleration, body 20
-  Scalar pA_l_wrist_yaw_link[6]; // bias force, body 20
-  Scalar v_l_wrist_pitch_link[6]; // velocity, body 21
-  Scalar c_l_wrist_pitch_link[6]; // velocity-product acceleration, body 21
-  Scalar pA_l_wrist_pitch_link[6]; // bias force, body 21
-  Scalar v_l_hand[6];          // velocity, body 22
-  Scalar c_l_hand[6];          // velocity-product acceleration, body 22
-  Scalar pA_l_hand[6];         // bias force, body 22
-  Scalar v_neck_link[6];       // velocity, body 23
-  Scalar c_neck_link[6];       // velocity-product acceleration, body 23
-  Scalar pA_neck_link[6];      // bias force, body 23
-  Scalar v_head[6];            // velocity, body 24
-  Scalar c_head[6];            // velocity-product acceleration, body 24
-  Scalar pA_head[6];           // bias force, body 24
-  Scalar v_r_shoulder_pitch_link[6]; // velocity, body 25
-  Scalar c_r_shoulder_pitch_link[6]; // velocity-product acceleration, body 25
-  Scalar pA_r_shoulder_pitch_link[6]; // bias force, body 25
-  Scalar g_r_shoulder_pitch_link[3]; // gravity in body coordinates, body 25
-  Scalar v_r_shoulder_roll_link[6]; // velocity, body 26
-  Scalar c_r_shoulder_roll_link[6]; // velocity-product acceleration, body 26
-  Scalar pA_r_shoulder_roll_link[6]; // bias force, body 26
-  Scalar g_r_shoulder_roll_link[3]; // gravity in body coordinates, body 26
-  Scalar v_r_upper_arm[6];     // velocity, body 27
-  Scalar c_r_upper_arm[6];     // velocity-product acceleration, body 27
-  Scalar pA_r_upper_arm[6];    // bias force, body 27
-  Scalar g_r_upper_arm[3];     // gravity in body coordinates, body 27
   Scalar v_r_forearm[6];       // velocity, body 28
   Scalar c_r_forearm[6];       // velocity-product acceleration, body 28
   Scalar pA_r_forearm[6];      // bias force, body 28
   Scalar g_r_forearm[3];       // gravity in body coordinates, body 28
+  Scalar v_l_wrist_yaw_link[6]; // velocity, body 20
+  Scalar c_l_wrist_yaw_link[6]; // velocity-product acceleration, body 20
+  Scalar pA_l_wrist_yaw_link[6]; // bias force, body 20
   Scalar v_r_wrist_yaw_link[6]; // velocity, body 29
   Scalar c_r_wrist_yaw_link[6]; // velocity-product acceleration, body 29
   Scalar pA_r_wrist_yaw_link[6]; // bias force, body 29
   Scalar g_r_wrist_yaw_link[3]; // gravity in body coordinates, body 29
+  Scalar v_l_wrist_pitch_link[6]; // velocity, body 21
+  Scalar c_l_wrist_pitch_link[6]; // velocity-product acceleration, body 21
+  Scalar pA_l_wrist_pitch_link[6]; // bias force, body 21
   Scalar v_r_wrist_pitch_link[6]; // velocity, body 30
   Scalar c_r_wrist_pitch_link[6]; // velocity-product acceleration, body 30
   Scalar pA_r_wrist_pitch_link[6]; // bias force, body 30
   Scalar g_r_wrist_pitch_link[3]; // gravity in body coordinates, body 30
+  Scalar v_l_hand[6];          // velocity, body 22
+  Scalar c_l_hand[6];          // velocity-product acceleration, body 22
+  Scalar pA_l_hand[6];         // bias force, body 22
   Scalar v_r_hand[6];          // velocity, body 31
   Scalar c_r_hand[6];          // velocity-product acceleration, body 31
   Scalar pA_r_hand[6];         // bias force, body 31
   Scalar g_r_hand[3];          // gravity in body coordinates, body 31
   Scalar k_right_hand[3];      // constraint right-hand side, constraint 2
-  Scalar u_head[1];            // tau - S^T pA, body 24
-  Scalar IA_neck_link[21];     // articulated inertia (upper triangle), body 23
-  Scalar Dinv_neck_link;       // 1 / (S^T IA S), body 23
-  Scalar u_neck_link[1];       // tau - S^T pA, body 23
-  Scalar IA_chest[21];         // articulated inertia (upper triangle), body 15
   Scalar u_l_hand[1];          // tau - S^T pA, body 22
   Scalar IA_l_wrist_pitch_link[21]; // articulated inertia (upper triangle), body 21
   Scalar Dinv_l_wrist_pitch_link; // 1 / (S^T IA S), body 21
@@ -329,9 +329,14 @@ struct Workspace {
   Scalar Dinv_l_upper_arm;     // 1 / (S^T IA S), body 18
   Scalar u_l_upper_arm[1];     // tau - S^T pA, body 18
   Scalar IA_l_shoulder_roll_link[21]; // articulated inertia (upper triangle), body 17
+  Scalar u_head[1];            // tau - S^T pA, body 24
+  Scalar IA_neck_link[21];     // articulated inertia (upper triangle), body 23
   Scalar Dinv_l_shoulder_roll_link; // 1 / (S^T IA S), body 17
   Scalar u_l_shoulder_roll_link[1]; // tau - S^T pA, body 17
   Scalar IA_l_shoulder_pitch_link[21]; // articulated inertia (upper triangle), body 16
+  Scalar Dinv_neck_link;       // 1 / (S^T IA S), body 23
+  Scalar u_neck_link[1];       // tau - S^T pA, body 23
+  Scalar IA_chest[21];         // articulated inertia (upper triangle), body 15
   Scalar Dinv_l_shoulder_pitch_link; // 1 / (S^T IA S), body 16
   Scalar u_l_shoulder_pitch_link[1]; // tau - S^T pA, body 16
   Scalar active[3];            // the schedule of the last call (Settings::active) as 0/1 factors
@@ -349,54 +354,54 @@ struct Workspace {
   Scalar Dinv_r_forearm;       // 1 / (S^T IA S), body 28
   Scalar u_r_forearm[1];       // tau - S^T pA, body 28
   Scalar IA_r_upper_arm[21];   // articulated inertia (upper triangle), body 27
-  Scalar Dinv_r_upper_arm;     // 1 / (S^T IA S), body 27
-  Scalar u_r_upper_arm[1];     // tau - S^T pA, body 27
-  Scalar IA_r_shoulder_roll_link[21]; // articulated inertia (upper triangle), body 26
-  Scalar Dinv_r_shoulder_roll_link; // 1 / (S^T IA S), body 26
-  Scalar u_r_shoulder_roll_link[1]; // tau - S^T pA, body 26
-  Scalar IA_r_shoulder_pitch_link[21]; // articulated inertia (upper triangle), body 25
-  Scalar Dinv_r_shoulder_pitch_link; // 1 / (S^T IA S), body 25
-  Scalar u_r_shoulder_pitch_link[1]; // tau - S^T pA, body 25
-  Scalar Dinv_chest;           // 1 / (S^T IA S), body 15
-  Scalar u_chest[1];           // tau - S^T pA, body 15
-  Scalar IA_abdomen[21];       // articulated inertia (upper triangle), body 14
-  Scalar Dinv_abdomen;         // 1 / (S^T IA S), body 14
-  Scalar u_abdomen[1];         // tau - S^T pA, body 14
-  Scalar IA_pelvis[21];        // articulated inertia (upper triangle), body 1
   Scalar U_r_foot[6];          // IA S, body 13
   Scalar Dinv_r_foot;          // 1 / (S^T IA S), body 13
   Scalar u_r_foot[1];          // tau - S^T pA, body 13
   Scalar IA_r_ankle_link[21];  // articulated inertia (upper triangle), body 12
-  Scalar Dinv_r_ankle_link;    // 1 / (S^T IA S), body 12
-  Scalar u_r_ankle_link[1];    // tau - S^T pA, body 12
-  Scalar IA_r_shank[21];       // articulated inertia (upper triangle), body 11
-  Scalar Dinv_r_shank;         // 1 / (S^T IA S), body 11
-  Scalar u_r_shank[1];         // tau - S^T pA, body 11
-  Scalar IA_r_thigh[21];       // articulated inertia (upper triangle), body 10
-  Scalar Dinv_r_thigh;         // 1 / (S^T IA S), body 10
-  Scalar u_r_thigh[1];         // tau - S^T pA, body 10
-  Scalar IA_r_hip_roll_link[21]; // articulated inertia (upper triangle), body 9
-  Scalar Dinv_r_hip_roll_link; // 1 / (S^T IA S), body 9
-  Scalar u_r_hip_roll_link[1]; // tau - S^T pA, body 9
-  Scalar IA_r_hip_yaw_link[21]; // articulated inertia (upper triangle), body 8
-  Scalar Dinv_r_hip_yaw_link;  // 1 / (S^T IA S), body 8
-  Scalar u_r_hip_yaw_link[1];  // tau - S^T pA, body 8
   Scalar U_l_foot[6];          // IA S, body 7
   Scalar Dinv_l_foot;          // 1 / (S^T IA S), body 7
   Scalar u_l_foot[1];          // tau - S^T pA, body 7
   Scalar IA_l_ankle_link[21];  // articulated inertia (upper triangle), body 6
+  Scalar Dinv_r_upper_arm;     // 1 / (S^T IA S), body 27
+  Scalar u_r_upper_arm[1];     // tau - S^T pA, body 27
+  Scalar IA_r_shoulder_roll_link[21]; // articulated inertia (upper triangle), body 26
+  Scalar Dinv_r_ankle_link;    // 1 / (S^T IA S), body 12
+  Scalar u_r_ankle_link[1];    // tau - S^T pA, body 12
+  Scalar IA_r_shank[21];       // articulated inertia (upper triangle), body 11
   Scalar Dinv_l_ankle_link;    // 1 / (S^T IA S), body 6
   Scalar u_l_ankle_link[1];    // tau - S^T pA, body 6
   Scalar IA_l_shank[21];       // articulated inertia (upper triangle), body 5
+  Scalar Dinv_r_shoulder_roll_link; // 1 / (S^T IA S), body 26
+  Scalar u_r_shoulder_roll_link[1]; // tau - S^T pA, body 26
+  Scalar IA_r_shoulder_pitch_link[21]; // articulated inertia (upper triangle), body 25
+  Scalar Dinv_r_shank;         // 1 / (S^T IA S), body 11
+  Scalar u_r_shank[1];         // tau - S^T pA, body 11
+  Scalar IA_r_thigh[21];       // articulated inertia (upper triangle), body 10
   Scalar Dinv_l_shank;         // 1 / (S^T IA S), body 5
   Scalar u_l_shank[1];         // tau - S^T pA, body 5
   Scalar IA_l_thigh[21];       // articulated inertia (upper triangle), body 4
+  Scalar Dinv_r_shoulder_pitch_link; // 1 / (S^T IA S), body 25
+  Scalar u_r_shoulder_pitch_link[1]; // tau - S^T pA, body 25
+  Scalar Dinv_r_thigh;         // 1 / (S^T IA S), body 10
+  Scalar u_r_thigh[1];         // tau - S^T pA, body 10
+  Scalar IA_r_hip_roll_link[21]; // articulated inertia (upper triangle), body 9
   Scalar Dinv_l_thigh;         // 1 / (S^T IA S), body 4
   Scalar u_l_thigh[1];         // tau - S^T pA, body 4
   Scalar IA_l_hip_roll_link[21]; // articulated inertia (upper triangle), body 3
+  Scalar Dinv_chest;           // 1 / (S^T IA S), body 15
+  Scalar u_chest[1];           // tau - S^T pA, body 15
+  Scalar IA_abdomen[21];       // articulated inertia (upper triangle), body 14
+  Scalar Dinv_r_hip_roll_link; // 1 / (S^T IA S), body 9
+  Scalar u_r_hip_roll_link[1]; // tau - S^T pA, body 9
+  Scalar IA_r_hip_yaw_link[21]; // articulated inertia (upper triangle), body 8
   Scalar Dinv_l_hip_roll_link; // 1 / (S^T IA S), body 3
   Scalar u_l_hip_roll_link[1]; // tau - S^T pA, body 3
   Scalar IA_l_hip_yaw_link[21]; // articulated inertia (upper triangle), body 2
+  Scalar Dinv_abdomen;         // 1 / (S^T IA S), body 14
+  Scalar u_abdomen[1];         // tau - S^T pA, body 14
+  Scalar IA_pelvis[21];        // articulated inertia (upper triangle), body 1
+  Scalar Dinv_r_hip_yaw_link;  // 1 / (S^T IA S), body 8
+  Scalar u_r_hip_yaw_link[1];  // tau - S^T pA, body 8
   Scalar Dinv_l_hip_yaw_link;  // 1 / (S^T IA S), body 2
   Scalar u_l_hip_yaw_link[1];  // tau - S^T pA, body 2
   Scalar Linv_pelvis[6];       // 1 / diag(L), body 1
@@ -405,22 +410,22 @@ struct Workspace {
   Scalar qdd[36];              // joint accelerations
   Scalar a_pelvis[6];          // acceleration (gravity-shifted), body 1
   Scalar a_l_hip_yaw_link[6];  // acceleration (gravity-shifted), body 2
-  Scalar a_l_hip_roll_link[6]; // acceleration (gravity-shifted), body 3
-  Scalar a_l_thigh[6];         // acceleration (gravity-shifted), body 4
-  Scalar a_l_shank[6];         // acceleration (gravity-shifted), body 5
-  Scalar a_l_ankle_link[6];    // acceleration (gravity-shifted), body 6
-  Scalar a_l_foot[6];          // acceleration (gravity-shifted), body 7
   Scalar a_r_hip_yaw_link[6];  // acceleration (gravity-shifted), body 8
-  Scalar a_r_hip_roll_link[6]; // acceleration (gravity-shifted), body 9
-  Scalar a_r_thigh[6];         // acceleration (gravity-shifted), body 10
-  Scalar a_r_shank[6];         // acceleration (gravity-shifted), body 11
-  Scalar a_r_ankle_link[6];    // acceleration (gravity-shifted), body 12
-  Scalar a_r_foot[6];          // acceleration (gravity-shifted), body 13
   Scalar a_abdomen[6];         // acceleration (gravity-shifted), body 14
+  Scalar a_l_hip_roll_link[6]; // acceleration (gravity-shifted), body 3
+  Scalar a_r_hip_roll_link[6]; // acceleration (gravity-shifted), body 9
   Scalar a_chest[6];           // acceleration (gravity-shifted), body 15
+  Scalar a_l_thigh[6];         // acceleration (gravity-shifted), body 4
+  Scalar a_r_thigh[6];         // acceleration (gravity-shifted), body 10
   Scalar a_r_shoulder_pitch_link[6]; // acceleration (gravity-shifted), body 25
+  Scalar a_l_shank[6];         // acceleration (gravity-shifted), body 5
+  Scalar a_r_shank[6];         // acceleration (gravity-shifted), body 11
   Scalar a_r_shoulder_roll_link[6]; // acceleration (gravity-shifted), body 26
+  Scalar a_l_ankle_link[6];    // acceleration (gravity-shifted), body 6
+  Scalar a_r_ankle_link[6];    // acceleration (gravity-shifted), body 12
   Scalar a_r_upper_arm[6];     // acceleration (gravity-shifted), body 27
+  Scalar a_l_foot[6];          // acceleration (gravity-shifted), body 7
+  Scalar a_r_foot[6];          // acceleration (gravity-shifted), body 13
   Scalar a_r_forearm[6];       // acceleration (gravity-shifted), body 28
   Scalar a_r_wrist_yaw_link[6]; // acceleration (gravity-shifted), body 29
   Scalar a_r_wrist_pitch_link[6]; // acceleration (gravity-shifted), body 30
@@ -431,28 +436,28 @@ struct Workspace {
   Scalar dp_r_wrist_yaw_link[6]; // reduced-sweep force, body 29
   Scalar dp_r_forearm[6];      // reduced-sweep force, body 28
   Scalar dp_r_upper_arm[6];    // reduced-sweep force, body 27
-  Scalar dp_r_shoulder_roll_link[6]; // reduced-sweep force, body 26
-  Scalar dp_r_shoulder_pitch_link[6]; // reduced-sweep force, body 25
-  Scalar dp_chest[6];          // reduced-sweep force, body 15
-  Scalar dp_abdomen[6];        // reduced-sweep force, body 14
-  Scalar dp_pelvis[6];         // reduced-sweep force, body 1
   Scalar dp_r_ankle_link[6];   // reduced-sweep force, body 12
-  Scalar dp_r_shank[6];        // reduced-sweep force, body 11
-  Scalar dp_r_thigh[6];        // reduced-sweep force, body 10
-  Scalar dp_r_hip_roll_link[6]; // reduced-sweep force, body 9
-  Scalar dp_r_hip_yaw_link[6]; // reduced-sweep force, body 8
   Scalar dp_l_ankle_link[6];   // reduced-sweep force, body 6
+  Scalar dp_r_shoulder_roll_link[6]; // reduced-sweep force, body 26
+  Scalar dp_r_shank[6];        // reduced-sweep force, body 11
   Scalar dp_l_shank[6];        // reduced-sweep force, body 5
+  Scalar dp_r_shoulder_pitch_link[6]; // reduced-sweep force, body 25
+  Scalar dp_r_thigh[6];        // reduced-sweep force, body 10
   Scalar dp_l_thigh[6];        // reduced-sweep force, body 4
+  Scalar dp_chest[6];          // reduced-sweep force, body 15
+  Scalar dp_r_hip_roll_link[6]; // reduced-sweep force, body 9
   Scalar dp_l_hip_roll_link[6]; // reduced-sweep force, body 3
+  Scalar dp_abdomen[6];        // reduced-sweep force, body 14
+  Scalar dp_r_hip_yaw_link[6]; // reduced-sweep force, body 8
   Scalar dp_l_hip_yaw_link[6]; // reduced-sweep force, body 2
+  Scalar dp_pelvis[6];         // reduced-sweep force, body 1
   Scalar a_l_shoulder_pitch_link[6]; // acceleration (gravity-shifted), body 16
+  Scalar a_neck_link[6];       // acceleration (gravity-shifted), body 23
   Scalar a_l_shoulder_roll_link[6]; // acceleration (gravity-shifted), body 17
   Scalar a_l_upper_arm[6];     // acceleration (gravity-shifted), body 18
   Scalar a_l_forearm[6];       // acceleration (gravity-shifted), body 19
   Scalar a_l_wrist_yaw_link[6]; // acceleration (gravity-shifted), body 20
   Scalar a_l_wrist_pitch_link[6]; // acceleration (gravity-shifted), body 21
-  Scalar a_neck_link[6];       // acceleration (gravity-shifted), body 23
   Scalar KA_r_wrist_pitch_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 30
   Scalar KA_r_wrist_yaw_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 29
   Scalar KSD_r_wrist_pitch_link[3]; // D^-1 S^T KA, body 30
@@ -460,35 +465,35 @@ struct Workspace {
   Scalar KSD_r_wrist_yaw_link[3]; // D^-1 S^T KA, body 29
   Scalar KSD_r_forearm[3];     // D^-1 S^T KA, body 28
   Scalar KA_r_upper_arm[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 27
+  Scalar KA_r_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 12
+  Scalar KA_l_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 6
   Scalar KSD_r_upper_arm[3];   // D^-1 S^T KA, body 27
   Scalar KA_r_shoulder_roll_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 26
-  Scalar KSD_r_shoulder_roll_link[3]; // D^-1 S^T KA, body 26
-  Scalar KA_r_shoulder_pitch_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 25
-  Scalar KSD_r_shoulder_pitch_link[3]; // D^-1 S^T KA, body 25
-  Scalar KA_chest[6][4];       // constraint force directions of the subtree rows (6 x m, one unused column), body 15
-  Scalar KSD_chest[3];         // D^-1 S^T KA, body 15
-  Scalar KA_abdomen[6][4];     // constraint force directions of the subtree rows (6 x m, one unused column), body 14
-  Scalar KSD_abdomen[3];       // D^-1 S^T KA, body 14
-  Scalar KA_pelvis[6][16];     // constraint force directions of the subtree rows (6 x m, one unused column), body 1
-  Scalar KA_r_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 12
   Scalar KSD_r_ankle_link[6];  // D^-1 S^T KA, body 12
   Scalar KA_r_shank[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 11
-  Scalar KSD_r_shank[6];       // D^-1 S^T KA, body 11
-  Scalar KA_r_thigh[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 10
-  Scalar KSD_r_thigh[6];       // D^-1 S^T KA, body 10
-  Scalar KA_r_hip_roll_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 9
-  Scalar KSD_r_hip_roll_link[6]; // D^-1 S^T KA, body 9
-  Scalar KA_r_hip_yaw_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 8
-  Scalar KSD_r_hip_yaw_link[6]; // D^-1 S^T KA, body 8
-  Scalar KA_l_ankle_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 6
   Scalar KSD_l_ankle_link[6];  // D^-1 S^T KA, body 6
   Scalar KA_l_shank[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 5
+  Scalar KSD_r_shoulder_roll_link[3]; // D^-1 S^T KA, body 26
+  Scalar KA_r_shoulder_pitch_link[6][4]; // constraint force directions of the subtree rows (6 x m, one unused column), body 25
+  Scalar KSD_r_shank[6];       // D^-1 S^T KA, body 11
+  Scalar KA_r_thigh[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 10
   Scalar KSD_l_shank[6];       // D^-1 S^T KA, body 5
   Scalar KA_l_thigh[6][7];     // constraint force directions of the subtree rows (6 x m, one unused column), body 4
+  Scalar KSD_r_shoulder_pitch_link[3]; // D^-1 S^T KA, body 25
+  Scalar KA_chest[6][4];       // constraint force directions of the subtree rows (6 x m, one unused column), body 15
+  Scalar KSD_r_thigh[6];       // D^-1 S^T KA, body 10
+  Scalar KA_r_hip_roll_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 9
   Scalar KSD_l_thigh[6];       // D^-1 S^T KA, body 4
   Scalar KA_l_hip_roll_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 3
+  Scalar KSD_chest[3];         // D^-1 S^T KA, body 15
+  Scalar KA_abdomen[6][4];     // constraint force directions of the subtree rows (6 x m, one unused column), body 14
+  Scalar KSD_r_hip_roll_link[6]; // D^-1 S^T KA, body 9
+  Scalar KA_r_hip_yaw_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 8
   Scalar KSD_l_hip_roll_link[6]; // D^-1 S^T KA, body 3
   Scalar KA_l_hip_yaw_link[6][7]; // constraint force directions of the subtree rows (6 x m, one unused column), body 2
+  Scalar KSD_abdomen[3];       // D^-1 S^T KA, body 14
+  Scalar KA_pelvis[6][16];     // constraint force directions of the subtree rows (6 x m, one unused column), body 1
+  Scalar KSD_r_hip_yaw_link[6]; // D^-1 S^T KA, body 8
   Scalar KSD_l_hip_yaw_link[6]; // D^-1 S^T KA, body 2
   Scalar Z_pelvis[6][16];      // L^-1 KA (6 x m, one unused column), body 1
   Scalar yfree[15];            // free row accelerations (tree order)

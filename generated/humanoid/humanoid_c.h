@@ -5,62 +5,67 @@
 // layout layout.yaml sha256 572bb9eae74728a43cfd1a5b248f581f6030e0eb12e3efcb73ad17422ae29094
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 8740 + 1639 K (= 13657 at K = 3)
-//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 163 + 43 K, sqrt 7, sincos 30, log6 0
+//   constrained_aba: 8734 + 1645 K (= 13669 at K = 3)
+//     add/sub 3540 + 686 K, mul 4964 + 910 K, div 36, neg 157 + 49 K, sqrt 7, sincos 30, log6 0
 //   prox_pv: 16649 + 650 K (= 18599 at K = 3)
 //     add/sub 6643 + 285 K, mul 9587 + 365 K, div 55, neg 306, sqrt 28, sincos 30, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_1: 2 blocks of l_thigh, r_thigh
-//   shared_2: 2 blocks of l_shank, r_shank
-//   shared_3: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_4: 2 blocks of l_foot, r_foot
-//   shared_5: 2 blocks of l_wrist_yaw_link, neck_link
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_1: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_2: 2 blocks of neck_link, l_wrist_yaw_link
+//   shared_3: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_4: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_5: 2 blocks of l_foot, r_foot (2 in pairs)
 //   shared_6: 2 blocks of l_wrist_yaw_link, r_wrist_yaw_link
 //   shared_7: 2 blocks of l_forearm, r_forearm
 //   shared_8: 2 blocks of l_upper_arm, r_upper_arm
 //   shared_9: 2 blocks of l_shoulder_roll_link, r_shoulder_roll_link
-//   shared_10: 2 blocks of r_foot, l_foot
-//   shared_11: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_12: 2 blocks of r_shank, l_shank
-//   shared_13: 2 blocks of r_thigh, l_thigh
-//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link
+//   shared_10: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_11: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_12: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_13: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_14: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
 //   shared_15: 2 blocks of pelvis
-//   shared_16: 2 blocks of l_hip_yaw_link
-//   shared_17: 4 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_18: 4 blocks of l_thigh, r_thigh
-//   shared_19: 4 blocks of l_shank, r_shank
-//   shared_20: 4 blocks of l_ankle_link, r_ankle_link
-//   shared_21: 4 blocks of l_foot, r_foot
-//   shared_22: 2 blocks of r_hip_yaw_link
-//   shared_23: 2 blocks of abdomen
-//   shared_24: 2 blocks of chest
-//   shared_25: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
-//   shared_26: 3 blocks of r_shoulder_roll_link, l_shoulder_roll_link
-//   shared_27: 2 blocks of r_upper_arm
-//   shared_28: 2 blocks of r_forearm
-//   shared_29: 3 blocks of r_wrist_yaw_link, l_wrist_yaw_link
-//   shared_30: 2 blocks of r_wrist_pitch_link
-//   shared_31: 2 blocks of r_hand
-//   shared_32: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_33: 2 blocks of r_foot, l_foot
-//   shared_34: 2 blocks of r_thigh, l_thigh
-//   shared_35: 2 blocks of r_foot, l_foot
-//   shared_36: 2 blocks of r_ankle_link, l_ankle_link
-//   shared_37: 2 blocks of r_shank, l_shank
-//   shared_38: 2 blocks of r_thigh, l_thigh
-//   shared_39: 2 blocks of r_hip_roll_link, l_hip_roll_link
-//   shared_40: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_41: 2 blocks of l_thigh, r_thigh
-//   shared_42: 2 blocks of l_shank, r_shank
-//   shared_43: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_44: 2 blocks of l_foot, r_foot
-//   shared_45: 2 blocks of l_hip_roll_link, r_hip_roll_link
-//   shared_46: 2 blocks of l_thigh, r_thigh
-//   shared_47: 2 blocks of l_shank, r_shank
-//   shared_48: 2 blocks of l_ankle_link, r_ankle_link
-//   shared_49: 2 blocks of l_foot, r_foot
+//   shared_16: 4 blocks of l_hip_yaw_link, r_hip_yaw_link (4 in pairs)
+//   shared_17: 2 blocks of abdomen
+//   shared_18: 4 blocks of l_hip_roll_link, r_hip_roll_link (4 in pairs)
+//   shared_19: 2 blocks of chest
+//   shared_20: 4 blocks of l_thigh, r_thigh (4 in pairs)
+//   shared_21: 3 blocks of r_shoulder_pitch_link, l_shoulder_pitch_link
+//   shared_22: 4 blocks of l_shank, r_shank (4 in pairs)
+//   shared_23: 2 blocks of r_shoulder_roll_link
+//   shared_24: 4 blocks of l_ankle_link, r_ankle_link (4 in pairs)
+//   shared_25: 3 blocks of r_upper_arm, l_upper_arm
+//   shared_26: 4 blocks of l_foot, r_foot (4 in pairs)
+//   shared_27: 2 blocks of r_forearm
+//   shared_28: 2 blocks of r_wrist_yaw_link
+//   shared_29: 2 blocks of r_wrist_pitch_link
+//   shared_30: 2 blocks of r_hand
+//   shared_31: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
+//   shared_32: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_33: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_34: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_35: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_36: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_37: 2 blocks of r_foot, l_foot (2 in pairs)
+//   shared_38: 2 blocks of r_ankle_link, l_ankle_link (2 in pairs)
+//   shared_39: 2 blocks of r_shank, l_shank (2 in pairs)
+//   shared_40: 2 blocks of r_thigh, l_thigh (2 in pairs)
+//   shared_41: 2 blocks of r_hip_roll_link, l_hip_roll_link (2 in pairs)
+//   shared_42: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_43: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_44: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_45: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_46: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_47: 2 blocks of l_foot, r_foot (2 in pairs)
+//   shared_48: 2 blocks of l_hip_yaw_link, r_hip_yaw_link (2 in pairs)
+//   shared_49: 2 blocks of l_hip_roll_link, r_hip_roll_link (2 in pairs)
+//   shared_50: 2 blocks of l_thigh, r_thigh (2 in pairs)
+//   shared_51: 2 blocks of l_shank, r_shank (2 in pairs)
+//   shared_52: 2 blocks of l_ankle_link, r_ankle_link (2 in pairs)
+//   shared_53: 2 blocks of l_foot, r_foot (2 in pairs)
 //
 // The C interface of the solver in humanoid.hpp (docs/design.md, "The C
 // interface"), for C firmware and other languages: plain arrays, a work buffer

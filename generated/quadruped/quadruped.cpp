@@ -5,36 +5,39 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
-//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
-//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4518 + 1192 K (= 8094 at K = 3)
+//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 56 + 30 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8492 + 475 K (= 9917 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 108, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
 //   shared_5: 2 blocks of trunk
-//   shared_6: 2 blocks of LF_hip
-//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_6: 4 blocks of LF_hip, LH_hip (4 in pairs)
+//   shared_7: 4 blocks of RF_hip, RH_hip (4 in pairs)
+//   shared_8: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (8 in pairs)
+//   shared_9: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank (8 in pairs)
 //   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_17: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_18: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_19: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_20: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_21: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+//   shared_22: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_23: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_24: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_25: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
 
 #include "quadruped.hpp"
 
@@ -53,216 +56,229 @@ namespace {
 using MultiplierRows = const Scalar*;
 
 // The parts the functions below call in order: each holds a few bodies' blocks.
+// Two blocks at once (the kernels' _x2 forms): a value of each in the lanes of a pair.
+using ScalarPair = proxgen_rt::lanes<Scalar, 2>;
+
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_0_k0[8] = {-0.062, 0.062, 0.010144, -0.010144, -0.010144, -0.00020288, 0.010144, -0.00020288};
-constexpr Scalar shared_0_k1[8] = {0.062, -0.062, -0.010144, 0.010144, 0.010144, 0.00020288, -0.010144, 0.00020288};
-PROXGEN_RT_NOINLINE void shared_0(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT g_m6, Scalar* PROXGEN_RT_RESTRICT g_m7) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] + k[0]*v_m2[5];
-  const Scalar x1 = v_m2[2] + k[1]*v_m2[3];
-  v_m3[0] = cq_m1[0]*x0 - sq_m0[0]*x1;
-  v_m3[2] = sq_m0[0]*x0 + cq_m1[0]*x1;
-  v_m3[3] = v_m2[3]*cq_m1[0] - v_m2[5]*sq_m0[0];
-  v_m3[4] = v_m2[4] + v[0];
-  v_m3[5] = v_m2[3]*sq_m0[0] + v_m2[5]*cq_m1[0];
-  c_m4[0] = -v[0]*v_m3[2];
-  c_m4[2] = v[0]*v_m3[0];
-  c_m4[3] = -v[0]*v_m3[5];
-  c_m4[5] = v[0]*v_m3[3];
-  const Scalar x2 = 0.6890000000000001*v_m3[0] - 0.01268*v_m3[4] + k[2]*v_m3[5];
-  const Scalar x3 = 0.6890000000000001*v_m2[1] + 0.01268*v_m3[3];
-  const Scalar x4 = 0.6890000000000001*v_m3[2] + k[3]*v_m3[3];
-  const Scalar x5 = 0.01268*v_m2[1] + k[4]*v_m3[2] + 0.002431904*v_m3[3];
-  const Scalar x6 = -0.01268*v_m3[0] + 0.0024196*v_m3[4] + k[5]*v_m3[5];
-  const Scalar x7 = k[6]*v_m3[0] + k[7]*v_m3[4] + 0.0006033039999999999*v_m3[5];
-  pA_m5[0] = v_m3[4]*x4 - v_m3[5]*x3;
-  pA_m5[1] = v_m3[5]*x2 - v_m3[3]*x4;
-  pA_m5[2] = v_m3[3]*x3 - v_m3[4]*x2;
-  pA_m5[3] = v_m3[4]*x7 - v_m3[5]*x6 + v_m2[1]*x4 - v_m3[2]*x3;
-  pA_m5[4] = v_m3[5]*x5 - v_m3[3]*x7 + v_m3[2]*x2 - v_m3[0]*x4;
-  pA_m5[5] = v_m3[3]*x6 - v_m3[4]*x5 + v_m3[0]*x3 - v_m2[1]*x2;
-  g_m6[0] = g_m7[0]*cq_m1[0] - g_m7[2]*sq_m0[0];
-  g_m6[2] = g_m7[0]*sq_m0[0] + g_m7[2]*cq_m1[0];
+// shared_0's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_0_p0[36] = {-0.062, -0.062, 0.062, 0.062, 0.6890000000000001, 0.6890000000000001, -0.01268, -0.01268, 0.010144, 0.010144, 0.6890000000000001, 0.6890000000000001, 0.01268, 0.01268, 0.6890000000000001, 0.6890000000000001, -0.010144, -0.010144, 0.01268, 0.01268, -0.010144, -0.010144, 0.002431904, 0.002431904, -0.01268, -0.01268, 0.0024196, 0.0024196, -0.00020288, -0.00020288, 0.010144, 0.010144, -0.00020288, -0.00020288, 0.0006033039999999999, 0.0006033039999999999};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_0_p1[36] = {0.062, 0.062, -0.062, -0.062, 0.6890000000000001, 0.6890000000000001, -0.01268, -0.01268, -0.010144, -0.010144, 0.6890000000000001, 0.6890000000000001, 0.01268, 0.01268, 0.6890000000000001, 0.6890000000000001, 0.010144, 0.010144, 0.01268, 0.01268, 0.010144, 0.010144, 0.002431904, 0.002431904, -0.01268, -0.01268, 0.0024196, 0.0024196, 0.00020288, 0.00020288, -0.010144, -0.010144, 0.00020288, 0.00020288, 0.0006033039999999999, 0.0006033039999999999};
+PROXGEN_RT_NOINLINE void shared_0_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* v_m2_a, Scalar* v_m2_b, Scalar* PROXGEN_RT_RESTRICT v_m3_a, Scalar* PROXGEN_RT_RESTRICT v_m3_b, Scalar* PROXGEN_RT_RESTRICT c_m4_a, Scalar* PROXGEN_RT_RESTRICT c_m4_b, Scalar* PROXGEN_RT_RESTRICT pA_m5_a, Scalar* PROXGEN_RT_RESTRICT pA_m5_b, Scalar* PROXGEN_RT_RESTRICT g_m6_a, Scalar* PROXGEN_RT_RESTRICT g_m6_b, Scalar* g_m7_a, Scalar* g_m7_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m2_a[5], v_m2_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(v_m2_a[2], v_m2_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x0 - proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x1, v_m3_a[0], v_m3_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x0 + proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x1, v_m3_a[2], v_m3_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) - proxgen_rt::gather2(v_m2_a[5], v_m2_b[5])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m3_a[3], v_m3_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m3_a[4], v_m3_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m2_a[5], v_m2_b[5])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m3_a[5], v_m3_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]), c_m4_a[0], c_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]), c_m4_a[2], c_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]), c_m4_a[3], c_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]), c_m4_a[5], c_m4_b[5]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]) + proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]) + proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m2_a[1], v_m2_b[1]) + proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m3_a[2], v_m3_b[2]) + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m3_a[3], v_m3_b[3]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]) + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]);
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(v_m3_a[4], v_m3_b[4]) + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(v_m3_a[5], v_m3_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*x4 - proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*x3, pA_m5_a[0], pA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*x2 - proxgen_rt::gather2(v_m3_a[3], v_m3_b[3])*x4, pA_m5_a[1], pA_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[3], v_m3_b[3])*x3 - proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*x2, pA_m5_a[2], pA_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*x7 - proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*x6 + proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x4 - proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*x3, pA_m5_a[3], pA_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[5], v_m3_b[5])*x5 - proxgen_rt::gather2(v_m3_a[3], v_m3_b[3])*x7 + proxgen_rt::gather2(v_m3_a[2], v_m3_b[2])*x2 - proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x4, pA_m5_a[4], pA_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m3_a[3], v_m3_b[3])*x6 - proxgen_rt::gather2(v_m3_a[4], v_m3_b[4])*x5 + proxgen_rt::gather2(v_m3_a[0], v_m3_b[0])*x3 - proxgen_rt::gather2(v_m2_a[1], v_m2_b[1])*x2, pA_m5_a[5], pA_m5_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) - proxgen_rt::gather2(g_m7_a[2], g_m7_b[2])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), g_m6_a[0], g_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m7_a[0], g_m7_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(g_m7_a[2], g_m7_b[2])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), g_m6_a[2], g_m6_b[2]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-constexpr Scalar shared_1_k0[2] = {0.004, -0.004};
-constexpr Scalar shared_1_k1[2] = {-0.004, 0.004};
-PROXGEN_RT_NOINLINE void shared_1(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Scalar* PROXGEN_RT_RESTRICT sq_m0, Scalar* PROXGEN_RT_RESTRICT cq_m1, Scalar* PROXGEN_RT_RESTRICT v_m2, Scalar* PROXGEN_RT_RESTRICT v_m3, Scalar* PROXGEN_RT_RESTRICT v_m4, Scalar* PROXGEN_RT_RESTRICT c_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar* PROXGEN_RT_RESTRICT g_m7, Scalar* PROXGEN_RT_RESTRICT g_m8, Scalar* PROXGEN_RT_RESTRICT k_m9, Scalar* PROXGEN_RT_RESTRICT g_m10) noexcept {
-  proxgen_rt::sincos_joint_called(q[0], sq_m0[0], cq_m1[0]);
-  const Scalar x0 = v_m2[0] - 0.209*v_m2[4];
-  const Scalar x1 = v_m3[0] + 0.209*v_m2[3];
-  v_m4[0] = cq_m1[0]*x0 - v_m2[2]*sq_m0[0];
-  v_m4[1] = x1;
-  v_m4[2] = sq_m0[0]*x0 + v_m2[2]*cq_m1[0];
-  v_m4[3] = v_m2[3]*cq_m1[0] - v_m2[5]*sq_m0[0];
-  v_m4[4] = v_m2[4] + v[0];
-  v_m4[5] = v_m2[3]*sq_m0[0] + v_m2[5]*cq_m1[0];
-  c_m5[0] = -v[0]*v_m4[2];
-  c_m5[2] = v[0]*v_m4[0];
-  c_m5[3] = -v[0]*v_m4[5];
-  c_m5[5] = v[0]*v_m4[3];
-  const Scalar x2 = 0.064*v_m4[0] - 0.003904*v_m4[4];
-  const Scalar x3 = 0.064*v_m4[1] + 0.003904*v_m4[3];
-  const Scalar x4 = 0.003904*v_m4[1] + 0.000483144*v_m4[3];
-  const Scalar x5 = -0.003904*v_m4[0] + 0.000486144*v_m4[4];
-  pA_m6[0] = 0.064*v_m4[2]*v_m4[4] - v_m4[5]*x3;
-  pA_m6[1] = v_m4[5]*x2 - 0.064*v_m4[2]*v_m4[3];
-  pA_m6[2] = v_m4[3]*x3 - v_m4[4]*x2;
-  pA_m6[3] = 6e-06*v_m4[4]*v_m4[5] - v_m4[5]*x5 + 0.064*v_m4[1]*v_m4[2] - v_m4[2]*x3;
-  pA_m6[4] = v_m4[5]*x4 - 6e-06*v_m4[3]*v_m4[5] + v_m4[2]*x2 - 0.064*v_m4[0]*v_m4[2];
-  pA_m6[5] = v_m4[3]*x5 - v_m4[4]*x4 + v_m4[0]*x3 - v_m4[1]*x2;
-  g_m7[0] = g_m8[0]*cq_m1[0] - g_m8[2]*sq_m0[0];
-  g_m7[2] = g_m8[0]*sq_m0[0] + g_m8[2]*cq_m1[0];
-  const Scalar x6 = v_m4[2] + k[0]*v_m4[3];
-  const Scalar x7 = v_m4[1] + 0.195*v_m4[3];
-  const Scalar x8 = v_m4[0] - 0.195*v_m4[4] + k[1]*v_m4[5];
-  k_m9[0] = -g_m7[0] - v_m4[4]*x6 + v_m4[5]*x7;
-  k_m9[1] = -g_m10[0] - v_m4[5]*x8 + v_m4[3]*x6;
-  k_m9[2] = -g_m7[2] - v_m4[3]*x7 + v_m4[4]*x8;
+// shared_1's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_1_p0[40] = {-0.209, -0.209, 0.209, 0.209, 0.064, 0.064, -0.003904, -0.003904, 0.064, 0.064, 0.003904, 0.003904, 0.003904, 0.003904, 0.000483144, 0.000483144, -0.003904, -0.003904, 0.000486144, 0.000486144, 0.064, 0.064, -0.064, -0.064, 6e-06, 6e-06, 0.064, 0.064, -6e-06, -6e-06, -0.064, -0.064, 0.004, 0.004, 0.195, 0.195, -0.195, -0.195, -0.004, -0.004};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_1_p1[40] = {-0.209, -0.209, 0.209, 0.209, 0.064, 0.064, -0.003904, -0.003904, 0.064, 0.064, 0.003904, 0.003904, 0.003904, 0.003904, 0.000483144, 0.000483144, -0.003904, -0.003904, 0.000486144, 0.000486144, 0.064, 0.064, -0.064, -0.064, 6e-06, 6e-06, 0.064, 0.064, -6e-06, -6e-06, -0.064, -0.064, -0.004, -0.004, 0.195, 0.195, -0.195, -0.195, 0.004, 0.004};
+PROXGEN_RT_NOINLINE void shared_1_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT q_a, const Scalar* PROXGEN_RT_RESTRICT q_b, const Scalar* v_a, const Scalar* v_b, Scalar* PROXGEN_RT_RESTRICT sq_m0_a, Scalar* PROXGEN_RT_RESTRICT sq_m0_b, Scalar* PROXGEN_RT_RESTRICT cq_m1_a, Scalar* PROXGEN_RT_RESTRICT cq_m1_b, Scalar* v_m2_a, Scalar* v_m2_b, Scalar* v_m3_a, Scalar* v_m3_b, Scalar* PROXGEN_RT_RESTRICT v_m4_a, Scalar* PROXGEN_RT_RESTRICT v_m4_b, Scalar* PROXGEN_RT_RESTRICT c_m5_a, Scalar* PROXGEN_RT_RESTRICT c_m5_b, Scalar* PROXGEN_RT_RESTRICT pA_m6_a, Scalar* PROXGEN_RT_RESTRICT pA_m6_b, Scalar* PROXGEN_RT_RESTRICT g_m7_a, Scalar* PROXGEN_RT_RESTRICT g_m7_b, Scalar* g_m8_a, Scalar* g_m8_b, Scalar* PROXGEN_RT_RESTRICT k_m9_a, Scalar* PROXGEN_RT_RESTRICT k_m9_b, Scalar* g_m10_a, Scalar* g_m10_b) noexcept {
+  proxgen_rt::sincos_joint_called(q_a[0], sq_m0_a[0], cq_m1_a[0]);
+  proxgen_rt::sincos_joint_called(q_b[0], sq_m0_b[0], cq_m1_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(v_m2_a[0], v_m2_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(v_m3_a[0], v_m3_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(v_m2_a[3], v_m2_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0])*x0 - proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m4_a[0], v_m4_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, v_m4_a[1], v_m4_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0])*x0 + proxgen_rt::gather2(v_m2_a[2], v_m2_b[2])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m4_a[2], v_m4_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) - proxgen_rt::gather2(v_m2_a[5], v_m2_b[5])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), v_m4_a[3], v_m4_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[4], v_m2_b[4]) + proxgen_rt::gather2(v_a[0], v_b[0]), v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m2_a[3], v_m2_b[3])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(v_m2_a[5], v_m2_b[5])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), v_m4_a[5], v_m4_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), c_m5_a[0], c_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]), c_m5_a[2], c_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]), c_m5_a[3], c_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_a[0], v_b[0])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), c_m5_a[5], c_m5_b[5]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1]) + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x3, pA_m6_a[0], pA_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x2 + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]), pA_m6_a[1], pA_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x3 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x2, pA_m6_a[2], pA_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x5 + proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(v_m4_a[1], v_m4_b[1])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]) - proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x3, pA_m6_a[3], pA_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x4 + proxgen_rt::pair_at(k, 14)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]) + proxgen_rt::gather2(v_m4_a[2], v_m4_b[2])*x2 + proxgen_rt::pair_at(k, 15)*proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]), pA_m6_a[4], pA_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x5 - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x4 + proxgen_rt::gather2(v_m4_a[0], v_m4_b[0])*x3 - proxgen_rt::gather2(v_m4_a[1], v_m4_b[1])*x2, pA_m6_a[5], pA_m6_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]) - proxgen_rt::gather2(g_m8_a[2], g_m8_b[2])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]), g_m7_a[0], g_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(g_m8_a[0], g_m8_b[0])*proxgen_rt::gather2(sq_m0_a[0], sq_m0_b[0]) + proxgen_rt::gather2(g_m8_a[2], g_m8_b[2])*proxgen_rt::gather2(cq_m1_a[0], cq_m1_b[0]), g_m7_a[2], g_m7_b[2]);
+  const ScalarPair x6 = proxgen_rt::gather2(v_m4_a[2], v_m4_b[2]) + proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x7 = proxgen_rt::gather2(v_m4_a[1], v_m4_b[1]) + proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(v_m4_a[3], v_m4_b[3]);
+  const ScalarPair x8 = proxgen_rt::gather2(v_m4_a[0], v_m4_b[0]) + proxgen_rt::pair_at(k, 18)*proxgen_rt::gather2(v_m4_a[4], v_m4_b[4]) + proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(v_m4_a[5], v_m4_b[5]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(g_m7_a[0], g_m7_b[0]) - proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x6 + proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x7, k_m9_a[0], k_m9_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(g_m10_a[0], g_m10_b[0]) - proxgen_rt::gather2(v_m4_a[5], v_m4_b[5])*x8 + proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x6, k_m9_a[1], k_m9_b[1]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(g_m7_a[2], g_m7_b[2]) - proxgen_rt::gather2(v_m4_a[3], v_m4_b[3])*x7 + proxgen_rt::gather2(v_m4_a[4], v_m4_b[4])*x8, k_m9_a[2], k_m9_b[2]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_2_k0[14] = {-0.004, -0.0007800000000000001, 0.004, -0.004, -0.004, -0.004, 0.004, -0.004, -0.002, 0.002, -0.002, -0.010144, 0.010144, 0.00020288};
-constexpr Scalar shared_2_k1[14] = {0.004, 0.0007800000000000001, -0.004, 0.004, 0.004, 0.004, -0.004, 0.004, 0.002, -0.002, 0.002, 0.010144, -0.010144, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Scalar* PROXGEN_RT_RESTRICT active_m0, Scalar* PROXGEN_RT_RESTRICT k_m1, Scalar* PROXGEN_RT_RESTRICT U_m2, Scalar* PROXGEN_RT_RESTRICT Dinv_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT pA_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT c_m7, Scalar* PROXGEN_RT_RESTRICT cq_m8, Scalar* PROXGEN_RT_RESTRICT sq_m9, Scalar* PROXGEN_RT_RESTRICT IA_m10, Scalar* PROXGEN_RT_RESTRICT pA_m11) noexcept {
-  const Scalar x0 = mu*active_m0[0];
-  const Scalar x1 = 0.195*k_m1[1] + k[0]*k_m1[2];
-  U_m2[0] = -0.003904 - 0.195*x0;
-  U_m2[4] = 0.000486144 + 0.038025*x0;
-  U_m2[5] = k[1]*x0;
-  Dinv_m3[0] = 1.0 / U_m2[4];
-  u_m4[0] = -pA_m5[4] + 0.195*lambda_m6[0] - 0.195*k_m1[0]*x0 + tau[0];
-  const Scalar x2 = U_m2[0]*Dinv_m3[0];
-  const Scalar x3 = U_m2[5]*Dinv_m3[0];
-  const Scalar x4 = 0.064 + x0 - U_m2[0]*x2;
-  const Scalar x5 = k[2]*x0 - U_m2[5]*x2;
-  const Scalar x6 = 0.064 + x0;
-  const Scalar x7 = 0.003904 + 0.195*x0;
-  const Scalar x8 = 0.000483144 + 0.038041000000000005*x0;
-  const Scalar x9 = 6e-06 + 1.6e-05*x0 - U_m2[5]*x3;
-  const Scalar x10 = pA_m5[0] + lambda_m6[0] - k_m1[0]*x0 + u_m4[0]*x2 + c_m7[0]*x4 + c_m7[5]*x5;
-  const Scalar x11 = pA_m5[1] + lambda_m6[1] - k_m1[1]*x0 + c_m7[3]*x7;
-  const Scalar x12 = pA_m5[2] + lambda_m6[2] - k_m1[2]*x0 + c_m7[2]*x6 + k[3]*c_m7[3]*x0;
-  const Scalar x13 = pA_m5[3] + 0.195*lambda_m6[1] + k[4]*lambda_m6[2] - x0*x1 + k[5]*c_m7[2]*x0 + c_m7[3]*x8;
-  const Scalar x14 = pA_m5[5] + k[6]*lambda_m6[0] + k[7]*k_m1[0]*x0 + u_m4[0]*x3 + c_m7[0]*x5 + c_m7[5]*x9;
-  const Scalar x15 = cq_m8[0]*cq_m8[0] - sq_m9[0]*sq_m9[0];
-  const Scalar x16 = 0.5*(-x4 + x6);
-  const Scalar x17 = 0.5*(x4 + x6);
-  const Scalar x18 = 2.0*cq_m8[0]*sq_m9[0];
-  const Scalar x19 = k[8]*x0 + 0.5*x5;
-  const Scalar x20 = 0.5*(-x8 + x9);
-  const Scalar x21 = 0.5*(x8 + x9);
-  const Scalar x22 = x17 - x15*x16;
-  const Scalar x23 = x17 + x15*x16;
-  const Scalar x24 = k[9]*x0 + 0.5*x5 + x15*x19;
-  const Scalar x25 = k[10]*x0 - 0.5*x5 + x15*x19;
-  const Scalar x26 = 0.209*x6 + cq_m8[0]*x7;
-  const Scalar x27 = cq_m8[0]*x10 + sq_m9[0]*x12;
-  const Scalar x28 = -sq_m9[0]*x10 + cq_m8[0]*x12;
-  IA_m10[0] = 0.6890000000000001 + x22;
-  IA_m10[2] = x16*x18;
-  IA_m10[3] = x18*x19;
-  IA_m10[4] = -0.01268 - 0.209*x22;
-  IA_m10[5] = k[11] + x24;
-  IA_m10[6] = 0.6890000000000001 + x6;
-  IA_m10[8] = 0.01268 + x26;
-  IA_m10[10] = -sq_m9[0]*x7;
-  IA_m10[11] = 0.6890000000000001 + x23;
-  IA_m10[12] = k[12] + x25;
-  IA_m10[13] = -0.209*x16*x18;
-  IA_m10[14] = -x18*x19;
-  IA_m10[15] = 0.002431904 + 0.209*cq_m8[0]*x7 + x21 - x15*x20 + 0.209*x26;
-  IA_m10[16] = -0.209*x18*x19;
-  IA_m10[17] = -0.209*sq_m9[0]*x7 + x18*x20;
-  IA_m10[18] = 0.0024196 + 0.043681*x22;
-  IA_m10[19] = k[13] - 0.209*x24;
-  IA_m10[20] = 0.0006033039999999999 + x21 + x15*x20;
-  pA_m11[0] = pA_m11[0] + x27;
-  pA_m11[1] = pA_m11[1] + x11;
-  pA_m11[2] = pA_m11[2] + x28;
-  pA_m11[3] = pA_m11[3] + 0.209*x11 + cq_m8[0]*x13 + sq_m9[0]*x14;
-  pA_m11[4] = pA_m11[4] + tau[0] - 0.209*x27;
-  pA_m11[5] = pA_m11[5] - sq_m9[0]*x13 + cq_m8[0]*x14;
+// shared_2's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_2_p0[116] = {0.195, 0.195, -0.004, -0.004, -0.003904, -0.003904, -0.195, -0.195, 0.000486144, 0.000486144, 0.038025, 0.038025, -0.0007800000000000001, -0.0007800000000000001, 1.0, 1.0, 0.195, 0.195, -0.195, -0.195, 0.064, 0.064, 0.004, 0.004, 0.064, 0.064, 0.003904, 0.003904, 0.195, 0.195, 0.000483144, 0.000483144, 0.038041000000000005, 0.038041000000000005, 6e-06, 6e-06, 1.6e-05, 1.6e-05, -0.004, -0.004, 0.195, 0.195, -0.004, -0.004, -0.004, -0.004, 0.004, 0.004, -0.004, -0.004, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, -0.002, -0.002, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.002, 0.002, 0.5, 0.5, -0.002, -0.002, -0.5, -0.5, 0.209, 0.209, 0.6890000000000001, 0.6890000000000001, -0.01268, -0.01268, -0.209, -0.209, -0.010144, -0.010144, 0.6890000000000001, 0.6890000000000001, 0.01268, 0.01268, 0.6890000000000001, 0.6890000000000001, 0.010144, 0.010144, -0.209, -0.209, 0.002431904, 0.002431904, 0.209, 0.209, 0.209, 0.209, -0.209, -0.209, -0.209, -0.209, 0.0024196, 0.0024196, 0.043681, 0.043681, 0.00020288, 0.00020288, -0.209, -0.209, 0.0006033039999999999, 0.0006033039999999999, 0.209, 0.209, -0.209, -0.209};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_2_p1[116] = {0.195, 0.195, 0.004, 0.004, -0.003904, -0.003904, -0.195, -0.195, 0.000486144, 0.000486144, 0.038025, 0.038025, 0.0007800000000000001, 0.0007800000000000001, 1.0, 1.0, 0.195, 0.195, -0.195, -0.195, 0.064, 0.064, -0.004, -0.004, 0.064, 0.064, 0.003904, 0.003904, 0.195, 0.195, 0.000483144, 0.000483144, 0.038041000000000005, 0.038041000000000005, 6e-06, 6e-06, 1.6e-05, 1.6e-05, 0.004, 0.004, 0.195, 0.195, 0.004, 0.004, 0.004, 0.004, -0.004, -0.004, 0.004, 0.004, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.002, 0.002, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.002, -0.002, 0.5, 0.5, 0.002, 0.002, -0.5, -0.5, 0.209, 0.209, 0.6890000000000001, 0.6890000000000001, -0.01268, -0.01268, -0.209, -0.209, 0.010144, 0.010144, 0.6890000000000001, 0.6890000000000001, 0.01268, 0.01268, 0.6890000000000001, 0.6890000000000001, -0.010144, -0.010144, -0.209, -0.209, 0.002431904, 0.002431904, 0.209, 0.209, 0.209, 0.209, -0.209, -0.209, -0.209, -0.209, 0.0024196, 0.0024196, 0.043681, 0.043681, -0.00020288, -0.00020288, -0.209, -0.209, 0.0006033039999999999, 0.0006033039999999999, 0.209, 0.209, -0.209, -0.209};
+PROXGEN_RT_NOINLINE void shared_2_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar mu, Scalar* active_m0_a, Scalar* active_m0_b, Scalar* k_m1_a, Scalar* k_m1_b, Scalar* PROXGEN_RT_RESTRICT U_m2_a, Scalar* PROXGEN_RT_RESTRICT U_m2_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m3_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m3_b, Scalar* PROXGEN_RT_RESTRICT u_m4_a, Scalar* PROXGEN_RT_RESTRICT u_m4_b, Scalar* pA_m5_a, Scalar* pA_m5_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* c_m7_a, Scalar* c_m7_b, Scalar* cq_m8_a, Scalar* cq_m8_b, Scalar* sq_m9_a, Scalar* sq_m9_b, Scalar* PROXGEN_RT_RESTRICT IA_m10_a, Scalar* PROXGEN_RT_RESTRICT IA_m10_b, Scalar* PROXGEN_RT_RESTRICT pA_m11_a, Scalar* PROXGEN_RT_RESTRICT pA_m11_b) noexcept {
+  const ScalarPair x0 = mu*proxgen_rt::gather2(active_m0_a[0], active_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(k_m1_a[1], k_m1_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(k_m1_a[2], k_m1_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 2) + proxgen_rt::pair_at(k, 3)*x0, U_m2_a[0], U_m2_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 4) + proxgen_rt::pair_at(k, 5)*x0, U_m2_a[4], U_m2_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 6)*x0, U_m2_a[5], U_m2_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 7) / proxgen_rt::gather2(U_m2_a[4], U_m2_b[4]), Dinv_m3_a[0], Dinv_m3_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m5_a[4], pA_m5_b[4]) + proxgen_rt::pair_at(k, 8)*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) + proxgen_rt::pair_at(k, 9)*proxgen_rt::gather2(k_m1_a[0], k_m1_b[0])*x0 + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m4_a[0], u_m4_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(U_m2_a[0], U_m2_b[0])*proxgen_rt::gather2(Dinv_m3_a[0], Dinv_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(U_m2_a[5], U_m2_b[5])*proxgen_rt::gather2(Dinv_m3_a[0], Dinv_m3_b[0]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 10) + x0 - proxgen_rt::gather2(U_m2_a[0], U_m2_b[0])*x2;
+  const ScalarPair x5 = proxgen_rt::pair_at(k, 11)*x0 - proxgen_rt::gather2(U_m2_a[5], U_m2_b[5])*x2;
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 12) + x0;
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 13) + proxgen_rt::pair_at(k, 14)*x0;
+  const ScalarPair x8 = proxgen_rt::pair_at(k, 15) + proxgen_rt::pair_at(k, 16)*x0;
+  const ScalarPair x9 = proxgen_rt::pair_at(k, 17) + proxgen_rt::pair_at(k, 18)*x0 - proxgen_rt::gather2(U_m2_a[5], U_m2_b[5])*x3;
+  const ScalarPair x10 = proxgen_rt::gather2(pA_m5_a[0], pA_m5_b[0]) + proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(k_m1_a[0], k_m1_b[0])*x0 + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0])*x2 + proxgen_rt::gather2(c_m7_a[0], c_m7_b[0])*x4 + proxgen_rt::gather2(c_m7_a[5], c_m7_b[5])*x5;
+  const ScalarPair x11 = proxgen_rt::gather2(pA_m5_a[1], pA_m5_b[1]) + proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(k_m1_a[1], k_m1_b[1])*x0 + proxgen_rt::gather2(c_m7_a[3], c_m7_b[3])*x7;
+  const ScalarPair x12 = proxgen_rt::gather2(pA_m5_a[2], pA_m5_b[2]) + proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - proxgen_rt::gather2(k_m1_a[2], k_m1_b[2])*x0 + proxgen_rt::gather2(c_m7_a[2], c_m7_b[2])*x6 + proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(c_m7_a[3], c_m7_b[3])*x0;
+  const ScalarPair x13 = proxgen_rt::gather2(pA_m5_a[3], pA_m5_b[3]) + proxgen_rt::pair_at(k, 20)*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) + proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) - x0*x1 + proxgen_rt::pair_at(k, 22)*proxgen_rt::gather2(c_m7_a[2], c_m7_b[2])*x0 + proxgen_rt::gather2(c_m7_a[3], c_m7_b[3])*x8;
+  const ScalarPair x14 = proxgen_rt::gather2(pA_m5_a[5], pA_m5_b[5]) + proxgen_rt::pair_at(k, 23)*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) + proxgen_rt::pair_at(k, 24)*proxgen_rt::gather2(k_m1_a[0], k_m1_b[0])*x0 + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0])*x3 + proxgen_rt::gather2(c_m7_a[0], c_m7_b[0])*x5 + proxgen_rt::gather2(c_m7_a[5], c_m7_b[5])*x9;
+  const ScalarPair x15 = proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0]) - proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0]);
+  const ScalarPair x16 = proxgen_rt::pair_at(k, 25)*(-x4 + x6);
+  const ScalarPair x17 = proxgen_rt::pair_at(k, 26)*(x4 + x6);
+  const ScalarPair x18 = proxgen_rt::pair_at(k, 27)*proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0]);
+  const ScalarPair x19 = proxgen_rt::pair_at(k, 28)*x0 + proxgen_rt::pair_at(k, 29)*x5;
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 30)*(-x8 + x9);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 31)*(x8 + x9);
+  const ScalarPair x22 = x17 - x15*x16;
+  const ScalarPair x23 = x17 + x15*x16;
+  const ScalarPair x24 = proxgen_rt::pair_at(k, 32)*x0 + proxgen_rt::pair_at(k, 33)*x5 + x15*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 34)*x0 + proxgen_rt::pair_at(k, 35)*x5 + x15*x19;
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 36)*x6 + proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x7;
+  const ScalarPair x27 = proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x10 + proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x12;
+  const ScalarPair x28 = -proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x10 + proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x12;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 37) + x22, IA_m10_a[0], IA_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x16*x18, IA_m10_a[2], IA_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x18*x19, IA_m10_a[3], IA_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 38) + proxgen_rt::pair_at(k, 39)*x22, IA_m10_a[4], IA_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 40) + x24, IA_m10_a[5], IA_m10_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 41) + x6, IA_m10_a[6], IA_m10_b[6]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 42) + x26, IA_m10_a[8], IA_m10_b[8]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x7, IA_m10_a[10], IA_m10_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 43) + x23, IA_m10_a[11], IA_m10_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 44) + x25, IA_m10_a[12], IA_m10_b[12]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 45)*x16*x18, IA_m10_a[13], IA_m10_b[13]);
+  proxgen_rt::scatter2<Scalar>(-x18*x19, IA_m10_a[14], IA_m10_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 46) + proxgen_rt::pair_at(k, 47)*proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x7 + x21 - x15*x20 + proxgen_rt::pair_at(k, 48)*x26, IA_m10_a[15], IA_m10_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 49)*x18*x19, IA_m10_a[16], IA_m10_b[16]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 50)*proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x7 + x18*x20, IA_m10_a[17], IA_m10_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 51) + proxgen_rt::pair_at(k, 52)*x22, IA_m10_a[18], IA_m10_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 53) + proxgen_rt::pair_at(k, 54)*x24, IA_m10_a[19], IA_m10_b[19]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 55) + x21 + x15*x20, IA_m10_a[20], IA_m10_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[0], pA_m11_b[0]) + x27, pA_m11_a[0], pA_m11_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[1], pA_m11_b[1]) + x11, pA_m11_a[1], pA_m11_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[2], pA_m11_b[2]) + x28, pA_m11_a[2], pA_m11_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[3], pA_m11_b[3]) + proxgen_rt::pair_at(k, 56)*x11 + proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x13 + proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x14, pA_m11_a[3], pA_m11_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[4], pA_m11_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 57)*x27, pA_m11_a[4], pA_m11_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m11_a[5], pA_m11_b[5]) - proxgen_rt::gather2(sq_m9_a[0], sq_m9_b[0])*x13 + proxgen_rt::gather2(cq_m8_a[0], cq_m8_b[0])*x14, pA_m11_a[5], pA_m11_b[5]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_3_k0[14] = {-0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062};
-constexpr Scalar shared_3_k1[14] = {0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_3(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[16]*Dinv_m0[0];
-  const Scalar x3 = IA_m1[19]*Dinv_m0[0];
-  const Scalar x4 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x5 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x6 = IA_m1[3] - IA_m1[16]*x0;
-  const Scalar x7 = IA_m1[5] - IA_m1[19]*x0;
-  const Scalar x8 = IA_m1[11] - IA_m1[13]*x1;
-  const Scalar x9 = IA_m1[12] - IA_m1[16]*x1;
-  const Scalar x10 = IA_m1[14] - IA_m1[19]*x1;
-  const Scalar x11 = IA_m1[15] - IA_m1[16]*x2;
-  const Scalar x12 = IA_m1[17] - IA_m1[19]*x2;
-  const Scalar x13 = IA_m1[20] - IA_m1[19]*x3;
-  const Scalar x14 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x4 + c_m4[2]*x5 + c_m4[3]*x6 + c_m4[5]*x7;
-  const Scalar x15 = pA_m3[1] + c_m4[3]*IA_m1[8] + c_m4[5]*IA_m1[10];
-  const Scalar x16 = pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x5 + c_m4[2]*x8 + c_m4[3]*x9 + c_m4[5]*x10;
-  const Scalar x17 = pA_m3[3] + u_m2[0]*x2 + c_m4[0]*x6 + c_m4[2]*x9 + c_m4[3]*x11 + c_m4[5]*x12;
-  const Scalar x18 = pA_m3[5] + u_m2[0]*x3 + c_m4[0]*x7 + c_m4[2]*x10 + c_m4[3]*x12 + c_m4[5]*x13;
-  const Scalar x19 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x20 = 0.5*(-x4 + x8);
-  const Scalar x21 = 0.5*(x4 + x8);
-  const Scalar x22 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x23 = x19*x20 - x5*x22;
-  const Scalar x24 = x20*x22 + x5*x19;
-  const Scalar x25 = 0.5*(-x6 + x10);
-  const Scalar x26 = 0.5*(x6 + x10);
-  const Scalar x27 = 0.5*(x7 + x9);
-  const Scalar x28 = x19*x25 - x22*x27;
-  const Scalar x29 = x22*x25 + x19*x27;
-  const Scalar x30 = 0.5*(-x11 + x13);
-  const Scalar x31 = 0.5*(x11 + x13);
-  const Scalar x32 = x19*x30 - x12*x22;
-  const Scalar x33 = x22*x30 + x12*x19;
-  const Scalar x34 = x21 - x23;
-  const Scalar x35 = x21 + x23;
-  const Scalar x36 = x26 - x28;
-  const Scalar x37 = 0.5*x7 - 0.5*x9 + x29;
-  const Scalar x38 = sq_m6[0]*IA_m1[10] + cq_m5[0]*IA_m1[8];
-  const Scalar x39 = cq_m5[0]*IA_m1[10] - sq_m6[0]*IA_m1[8];
-  const Scalar x40 = -0.5*x7 + 0.5*x9 + x29;
-  const Scalar x41 = x26 + x28;
-  const Scalar x42 = k[0]*x24 + x36;
-  const Scalar x43 = k[1]*x34 + x37;
-  const Scalar x44 = k[2]*x35 + x40;
-  const Scalar x45 = k[3]*x24 + x41;
-  const Scalar x46 = cq_m5[0]*x14 + sq_m6[0]*x16;
-  const Scalar x47 = -sq_m6[0]*x14 + cq_m5[0]*x16;
-  IA_m7[0] = 0.5950000000000001 + x34;
-  IA_m7[2] = x24;
-  IA_m7[3] = x42;
-  IA_m7[5] = k[4] + x43;
-  IA_m7[6] = 0.5950000000000001 + IA_m1[6];
-  IA_m7[8] = x38;
-  IA_m7[10] = x39;
-  IA_m7[11] = 0.5950000000000001 + x35;
-  IA_m7[12] = k[5] + x44;
-  IA_m7[14] = x45;
-  IA_m7[15] = 0.0012018399999999998 + x31 - x32 + k[6]*x40 + k[7]*x44;
-  IA_m7[17] = 4.5e-07 + x33 + k[8]*x36 + k[9]*x45;
-  IA_m7[20] = 0.00126484 + x31 + x32 + k[10]*x37 + k[11]*x43;
-  pA_m8[0] = pA_m8[0] + x46;
-  pA_m8[1] = pA_m8[1] + x15;
-  pA_m8[2] = pA_m8[2] + x47;
-  pA_m8[3] = pA_m8[3] + cq_m5[0]*x17 + sq_m6[0]*x18 + k[12]*x47;
-  pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6[0]*x17 + cq_m5[0]*x18 + k[13]*x46;
+// shared_3's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_3_p0[66] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, -0.5, -0.5, 0.5, 0.5, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.02164, 0.5950000000000001, 0.5950000000000001, 0.5950000000000001, 0.5950000000000001, -0.02164, -0.02164, 0.0012018399999999998, 0.0012018399999999998, -0.062, -0.062, -0.062, -0.062, 4.5e-07, 4.5e-07, 0.062, 0.062, -0.062, -0.062, 0.00126484, 0.00126484, 0.062, 0.062, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_3_p1[66] = {1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5, -0.5, -0.5, -0.5, 0.5, 0.5, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062, 0.5950000000000001, 0.5950000000000001, -0.02164, -0.02164, 0.5950000000000001, 0.5950000000000001, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.02164, 0.0012018399999999998, 0.0012018399999999998, 0.062, 0.062, 0.062, 0.062, 4.5e-07, 4.5e-07, -0.062, -0.062, 0.062, 0.062, 0.00126484, 0.00126484, -0.062, -0.062, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_3_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[3], IA_m1_b[3]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x0;
+  const ScalarPair x7 = proxgen_rt::gather2(IA_m1_a[5], IA_m1_b[5]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x0;
+  const ScalarPair x8 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x9 = proxgen_rt::gather2(IA_m1_a[12], IA_m1_b[12]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x1;
+  const ScalarPair x10 = proxgen_rt::gather2(IA_m1_a[14], IA_m1_b[14]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x1;
+  const ScalarPair x11 = proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) - proxgen_rt::gather2(IA_m1_a[16], IA_m1_b[16])*x2;
+  const ScalarPair x12 = proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x2;
+  const ScalarPair x13 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) - proxgen_rt::gather2(IA_m1_a[19], IA_m1_b[19])*x3;
+  const ScalarPair x14 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x4 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x5 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x6 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x7;
+  const ScalarPair x15 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]);
+  const ScalarPair x16 = proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x5 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x8 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x9 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x10;
+  const ScalarPair x17 = proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x2 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x6 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x9 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x11 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x12;
+  const ScalarPair x18 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x3 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x7 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x10 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*x12 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x13;
+  const ScalarPair x19 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 1)*(-x4 + x8);
+  const ScalarPair x21 = proxgen_rt::pair_at(k, 2)*(x4 + x8);
+  const ScalarPair x22 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x23 = x19*x20 - x5*x22;
+  const ScalarPair x24 = x20*x22 + x5*x19;
+  const ScalarPair x25 = proxgen_rt::pair_at(k, 4)*(-x6 + x10);
+  const ScalarPair x26 = proxgen_rt::pair_at(k, 5)*(x6 + x10);
+  const ScalarPair x27 = proxgen_rt::pair_at(k, 6)*(x7 + x9);
+  const ScalarPair x28 = x19*x25 - x22*x27;
+  const ScalarPair x29 = x22*x25 + x19*x27;
+  const ScalarPair x30 = proxgen_rt::pair_at(k, 7)*(-x11 + x13);
+  const ScalarPair x31 = proxgen_rt::pair_at(k, 8)*(x11 + x13);
+  const ScalarPair x32 = x19*x30 - x12*x22;
+  const ScalarPair x33 = x22*x30 + x12*x19;
+  const ScalarPair x34 = x21 - x23;
+  const ScalarPair x35 = x21 + x23;
+  const ScalarPair x36 = x26 - x28;
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 9)*x7 + proxgen_rt::pair_at(k, 10)*x9 + x29;
+  const ScalarPair x38 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]);
+  const ScalarPair x39 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]);
+  const ScalarPair x40 = proxgen_rt::pair_at(k, 11)*x7 + proxgen_rt::pair_at(k, 12)*x9 + x29;
+  const ScalarPair x41 = x26 + x28;
+  const ScalarPair x42 = proxgen_rt::pair_at(k, 13)*x24 + x36;
+  const ScalarPair x43 = proxgen_rt::pair_at(k, 14)*x34 + x37;
+  const ScalarPair x44 = proxgen_rt::pair_at(k, 15)*x35 + x40;
+  const ScalarPair x45 = proxgen_rt::pair_at(k, 16)*x24 + x41;
+  const ScalarPair x46 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x14 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x16;
+  const ScalarPair x47 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x14 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x16;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 17) + x34, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x24, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x42, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18) + x43, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 19) + proxgen_rt::gather2(IA_m1_a[6], IA_m1_b[6]), IA_m7_a[6], IA_m7_b[6]);
+  proxgen_rt::scatter2<Scalar>(x38, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(x39, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 20) + x35, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 21) + x44, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(x45, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 22) + x31 - x32 + proxgen_rt::pair_at(k, 23)*x40 + proxgen_rt::pair_at(k, 24)*x44, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 25) + x33 + proxgen_rt::pair_at(k, 26)*x36 + proxgen_rt::pair_at(k, 27)*x45, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 28) + x31 + x32 + proxgen_rt::pair_at(k, 29)*x37 + proxgen_rt::pair_at(k, 30)*x43, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x46, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x15, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x47, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x17 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x18 + proxgen_rt::pair_at(k, 31)*x47, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x17 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x18 + proxgen_rt::pair_at(k, 32)*x46, pA_m8_a[5], pA_m8_b[5]);
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -433,91 +449,99 @@ PROXGEN_RT_NOINLINE void shared_5(Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar (*PRO
   a_m6[5] = qdd_m5[5];
 }
 
-// 2 blocks of the same code, each over its constants (k) and members: LF_hip.
+// 4 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip.
 // The first: accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-PROXGEN_RT_NOINLINE void shared_6(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] - 0.049*a_m0[5];
-  const Scalar x1 = a_m0[1] + 0.19*a_m0[5];
-  const Scalar x2 = a_m0[2] + 0.049*a_m0[3] - 0.19*a_m0[4];
-  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
-  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
-  const Scalar x6 = c_m1[3] + RJ_m2[0][RJ_m2_col + 0]*a_m0[3] + RJ_m2[1][RJ_m2_col + 0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 0]*a_m0[5];
-  const Scalar x7 = c_m1[4] + RJ_m2[0][RJ_m2_col + 1]*a_m0[3] + cq_m3[0]*a_m0[4] + RJ_m2[2][RJ_m2_col + 1]*a_m0[5];
-  const Scalar x8 = c_m1[5] + RJ_m2[0][RJ_m2_col + 2]*a_m0[3] + RJ_m2[1][RJ_m2_col + 2]*a_m0[4] + RJ_m2[2][RJ_m2_col + 2]*a_m0[5];
-  const Scalar x9 = u_m4[0] - 5.780668556524933e-05*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
-  qdd_m6[0] = Dinv_m7*x9;
-  a_m8[0] = x3;
-  a_m8[1] = x4;
-  a_m8[2] = x5;
-  a_m8[3] = x6 + 0.9950371902099893*qdd_m6[0];
-  a_m8[4] = x7;
-  a_m8[5] = x8 + 0.09950371902099893*qdd_m6[0];
+// shared_6's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_6_p0[14] = {-0.049, -0.049, 0.19, -0.19, 0.049, 0.049, -0.19, 0.19, -5.780668556524933e-05, -5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_6_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x3 - proxgen_rt::gather2(U_m5_a[1], U_m5_b[1])*x4 - proxgen_rt::gather2(U_m5_a[2], U_m5_b[2])*x5 - proxgen_rt::gather2(U_m5_a[3], U_m5_b[3])*x6 - proxgen_rt::gather2(U_m5_a[5], U_m5_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[5], a_m8_b[5]);
+}
+
+// 4 blocks of the same code, each over its constants (k) and members: RF_hip, RH_hip.
+// The first: accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+// shared_7's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_7_p0[14] = {0.049, 0.049, 0.19, -0.19, -0.049, -0.049, -0.19, 0.19, 5.780668556524933e-05, 5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_7_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x3 - proxgen_rt::gather2(U_m5_a[1], U_m5_b[1])*x4 - proxgen_rt::gather2(U_m5_a[2], U_m5_b[2])*x5 - proxgen_rt::gather2(U_m5_a[3], U_m5_b[3])*x6 - proxgen_rt::gather2(U_m5_a[5], U_m5_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[5], a_m8_b[5]);
 }
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_7_k0[2] = {-0.062, 0.062};
-constexpr Scalar shared_7_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_7(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
-  const Scalar x6 = u_m4[0] - IA_m5[0]*x2 - IA_m5[9]*x3 - IA_m5[12]*x4 - a_m0[4]*IA_m5[14] - IA_m5[15]*x5;
-  qdd_m6[0] = Dinv_m7*x6;
-  a_m8[0] = x2;
-  a_m8[1] = a_m0[1];
-  a_m8[2] = x3;
-  a_m8[3] = x4;
-  a_m8[4] = a_m0[4] + qdd_m6[0];
-  a_m8[5] = x5;
+// shared_8's blocks two at a time, one in each lane of a ScalarPair:
+// 4 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_8_p0[4] = {-0.062, -0.062, 0.062, 0.062};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_8_p1[4] = {0.062, 0.062, -0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_8_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x2 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x3 - proxgen_rt::gather2(IA_m5_a[12], IA_m5_b[12])*x4 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]) - proxgen_rt::gather2(IA_m5_a[15], IA_m5_b[15])*x5;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x6, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m8_a[5], a_m8_b[5]);
 }
 
 // 8 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_8(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
-  const Scalar x6 = u_m4[0] - U_m5[0]*x2 - U_m5[4]*a_m0[4] - U_m5[5]*x5;
-  qdd_m6[0] = Dinv_m7*x6;
-  a_m8[0] = x2;
-  a_m8[1] = x1;
-  a_m8[2] = x3;
-  a_m8[3] = x4;
-  a_m8[4] = a_m0[4] + qdd_m6[0];
-  a_m8[5] = x5;
-}
-
-// 6 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
-// The first: accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_9_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_9_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_9_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_9(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar Dinv_m7, Scalar* PROXGEN_RT_RESTRICT a_m8) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
-  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
-  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
-  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
-  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
-  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
-  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
-  qdd_m6[0] = Dinv_m7*x9;
-  a_m8[0] = x3;
-  a_m8[1] = x4;
-  a_m8[2] = x5;
-  a_m8[3] = x6 + k[5]*qdd_m6[0];
-  a_m8[4] = x7;
-  a_m8[5] = x8 + k[6]*qdd_m6[0];
+// shared_9's blocks two at a time, one in each lane of a ScalarPair:
+// 4 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_9_p0[4] = {-0.209, -0.209, 0.209, 0.209};
+PROXGEN_RT_NOINLINE void shared_9_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b, Scalar* PROXGEN_RT_RESTRICT a_m8_a, Scalar* PROXGEN_RT_RESTRICT a_m8_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x2 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(U_m5_a[4], U_m5_b[4]) - proxgen_rt::gather2(U_m5_a[5], U_m5_b[5])*x5;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x6, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m8_a[0], a_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m8_a[1], a_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m8_a[2], a_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m8_a[3], a_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m8_a[4], a_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m8_a[5], a_m8_b[5]);
 }
 
 // 2 blocks of the same code, each over its constants (k) and members: multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint).
@@ -575,42 +599,46 @@ PROXGEN_RT_NOINLINE void shared_10(Scalar mu, Scalar* PROXGEN_RT_RESTRICT a_m0, 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_11_k0[2] = {-0.004, 0.004};
-constexpr Scalar shared_11_k1[2] = {0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_11(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dlambda_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT U_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
-  u_m0[0] = u_m0[0] + 0.195*dlambda_m1[0];
-  const Scalar x0 = 0.195*Dinv_m2*dlambda_m1[0];
-  const Scalar x1 = dlambda_m1[0] + U_m3[0]*x0;
-  const Scalar x2 = 0.195*dlambda_m1[1] + k[0]*dlambda_m1[2];
-  const Scalar x3 = k[1]*dlambda_m1[0] + U_m3[5]*x0;
-  const Scalar x4 = cq_m4[0]*x1 + sq_m5[0]*dlambda_m1[2];
-  const Scalar x5 = -sq_m5[0]*x1 + cq_m4[0]*dlambda_m1[2];
-  dp_m6[0] = x4;
-  dp_m6[1] = dlambda_m1[1];
-  dp_m6[2] = x5;
-  dp_m6[3] = 0.209*dlambda_m1[1] + cq_m4[0]*x2 + sq_m5[0]*x3;
-  dp_m6[4] = -0.209*x4;
-  dp_m6[5] = -sq_m5[0]*x2 + cq_m4[0]*x3;
+// shared_11's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_11_p0[14] = {0.195, 0.195, 0.195, 0.195, 0.195, 0.195, -0.004, -0.004, 0.004, 0.004, 0.209, 0.209, -0.209, -0.209};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_11_p1[14] = {0.195, 0.195, 0.195, 0.195, 0.195, 0.195, 0.004, 0.004, -0.004, -0.004, 0.209, 0.209, -0.209, -0.209};
+PROXGEN_RT_NOINLINE void shared_11_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dlambda_m1_a, Scalar* dlambda_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* U_m3_a, Scalar* U_m3_b, Scalar* cq_m4_a, Scalar* cq_m4_b, Scalar* sq_m5_a, Scalar* sq_m5_b, Scalar* PROXGEN_RT_RESTRICT dp_m6_a, Scalar* PROXGEN_RT_RESTRICT dp_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(dlambda_m1_a[0], dlambda_m1_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b)*proxgen_rt::gather2(dlambda_m1_a[0], dlambda_m1_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(dlambda_m1_a[0], dlambda_m1_b[0]) + proxgen_rt::gather2(U_m3_a[0], U_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(dlambda_m1_a[1], dlambda_m1_b[1]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(dlambda_m1_a[2], dlambda_m1_b[2]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(dlambda_m1_a[0], dlambda_m1_b[0]) + proxgen_rt::gather2(U_m3_a[5], U_m3_b[5])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x1 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*proxgen_rt::gather2(dlambda_m1_a[2], dlambda_m1_b[2]);
+  const ScalarPair x5 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x1 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*proxgen_rt::gather2(dlambda_m1_a[2], dlambda_m1_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, dp_m6_a[0], dp_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(dlambda_m1_a[1], dlambda_m1_b[1]), dp_m6_a[1], dp_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, dp_m6_a[2], dp_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(dlambda_m1_a[1], dlambda_m1_b[1]) + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x2 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x3, dp_m6_a[3], dp_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 6)*x4, dp_m6_a[4], dp_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x2 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x3, dp_m6_a[5], dp_m6_b[5]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_12_k0[2] = {-0.062, 0.062};
-constexpr Scalar shared_12_k1[2] = {0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_12(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT dp_m1, Scalar Dinv_m2, Scalar* PROXGEN_RT_RESTRICT IA_m3, Scalar* PROXGEN_RT_RESTRICT cq_m4, Scalar* PROXGEN_RT_RESTRICT sq_m5, Scalar* PROXGEN_RT_RESTRICT dp_m6) noexcept {
-  u_m0[0] = u_m0[0] - dp_m1[4];
-  const Scalar x0 = -Dinv_m2*dp_m1[4];
-  const Scalar x1 = dp_m1[0] + IA_m3[0]*x0;
-  const Scalar x2 = dp_m1[2] + IA_m3[9]*x0;
-  const Scalar x3 = dp_m1[3] + IA_m3[12]*x0;
-  const Scalar x4 = dp_m1[5] + IA_m3[15]*x0;
-  const Scalar x5 = cq_m4[0]*x1 + sq_m5[0]*x2;
-  const Scalar x6 = -sq_m5[0]*x1 + cq_m4[0]*x2;
-  dp_m6[0] = x5;
-  dp_m6[1] = dp_m1[1];
-  dp_m6[2] = x6;
-  dp_m6[3] = cq_m4[0]*x3 + sq_m5[0]*x4 + k[0]*x6;
-  dp_m6[5] = -sq_m5[0]*x3 + cq_m4[0]*x4 + k[1]*x5;
+// shared_12's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_12_p0[4] = {-0.062, -0.062, 0.062, 0.062};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_12_p1[4] = {0.062, 0.062, -0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_12_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* dp_m1_a, Scalar* dp_m1_b, Scalar Dinv_m2_a, Scalar Dinv_m2_b, Scalar* IA_m3_a, Scalar* IA_m3_b, Scalar* cq_m4_a, Scalar* cq_m4_b, Scalar* sq_m5_a, Scalar* sq_m5_b, Scalar* PROXGEN_RT_RESTRICT dp_m6_a, Scalar* PROXGEN_RT_RESTRICT dp_m6_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4]) + proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = -proxgen_rt::gather2(dp_m1_a[4], dp_m1_b[4])*proxgen_rt::gather2(Dinv_m2_a, Dinv_m2_b);
+  const ScalarPair x1 = proxgen_rt::gather2(dp_m1_a[0], dp_m1_b[0]) + proxgen_rt::gather2(IA_m3_a[0], IA_m3_b[0])*x0;
+  const ScalarPair x2 = proxgen_rt::gather2(dp_m1_a[2], dp_m1_b[2]) + proxgen_rt::gather2(IA_m3_a[9], IA_m3_b[9])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(dp_m1_a[3], dp_m1_b[3]) + proxgen_rt::gather2(IA_m3_a[12], IA_m3_b[12])*x0;
+  const ScalarPair x4 = proxgen_rt::gather2(dp_m1_a[5], dp_m1_b[5]) + proxgen_rt::gather2(IA_m3_a[15], IA_m3_b[15])*x0;
+  const ScalarPair x5 = proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x1 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x2;
+  const ScalarPair x6 = -proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x1 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x2;
+  proxgen_rt::scatter2<Scalar>(x5, dp_m6_a[0], dp_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(dp_m1_a[1], dp_m1_b[1]), dp_m6_a[1], dp_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x6, dp_m6_a[2], dp_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x3 + proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x4 + proxgen_rt::pair_at(k, 0)*x6, dp_m6_a[3], dp_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m5_a[0], sq_m5_b[0])*x3 + proxgen_rt::gather2(cq_m4_a[0], cq_m4_b[0])*x4 + proxgen_rt::pair_at(k, 1)*x5, dp_m6_a[5], dp_m6_b[5]);
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -641,140 +669,144 @@ PROXGEN_RT_NOINLINE void shared_13(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* 
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_shank, RF_shank, LH_shank, LF_shank.
 // The first: eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-constexpr Scalar shared_14_k0[4] = {0.004, 0.004, -0.004, 0.004};
-constexpr Scalar shared_14_k1[4] = {-0.004, -0.004, 0.004, -0.004};
-PROXGEN_RT_NOINLINE void shared_14(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT u_m0, Scalar* PROXGEN_RT_RESTRICT pA_m1, Scalar* PROXGEN_RT_RESTRICT c_m2, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT sq_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT pA_m6, Scalar (*PROXGEN_RT_RESTRICT KA_m7)[4], int KA_m7_col) noexcept {
-  u_m0[0] = -pA_m1[4] + tau[0];
-  const Scalar x0 = 0.03264876250658241*c_m2[0] + pA_m1[0] - 8.030542390731965*u_m0[0];
-  const Scalar x1 = 0.003904*c_m2[3] + pA_m1[1];
-  const Scalar x2 = 0.064*c_m2[2] + pA_m1[2];
-  const Scalar x3 = 0.000483144*c_m2[3] + pA_m1[3];
-  const Scalar x4 = 6e-06*c_m2[5] + pA_m1[5];
-  const Scalar x5 = cq_m3[0]*cq_m3[0] - sq_m4[0]*sq_m4[0];
-  const Scalar x6 = 0.04832438125329121 - 0.015675618746708794*x5;
-  const Scalar x7 = 0.04832438125329121 + 0.015675618746708794*x5;
-  const Scalar x8 = 0.013375999999999999 + 0.003904*cq_m3[0];
-  const Scalar x9 = cq_m3[0]*x0 + sq_m4[0]*x2;
-  const Scalar x10 = -sq_m4[0]*x0 + cq_m3[0]*x2;
-  IA_m5[0] = 0.6890000000000001 + x6;
-  IA_m5[2] = 0.03135123749341759*cq_m3[0]*sq_m4[0];
-  IA_m5[4] = -0.01268 - 0.209*x6;
-  IA_m5[8] = 0.01268 + x8;
-  IA_m5[10] = -0.003904*sq_m4[0];
-  IA_m5[11] = 0.6890000000000001 + x7;
-  IA_m5[13] = -0.006552408636124276*cq_m3[0]*sq_m4[0];
-  IA_m5[15] = 0.002676476 + 0.000815936*cq_m3[0] + 0.00023857200000000002*x5 + 0.209*x8;
-  IA_m5[17] = -0.000815936*sq_m4[0] - 0.00047714400000000004*cq_m3[0]*sq_m4[0];
-  IA_m5[18] = 0.0024196 + 0.043681*x6;
-  IA_m5[20] = 0.000847876 - 0.00023857200000000002*x5;
-  pA_m6[0] = pA_m6[0] + x9;
-  pA_m6[1] = pA_m6[1] + x1;
-  pA_m6[2] = pA_m6[2] + x10;
-  pA_m6[3] = pA_m6[3] + 0.209*x1 + cq_m3[0]*x3 + sq_m4[0]*x4;
-  pA_m6[4] = pA_m6[4] + tau[0] - 0.209*x9;
-  pA_m6[5] = pA_m6[5] - sq_m4[0]*x3 + cq_m3[0]*x4;
-  KA_m7[0][KA_m7_col + 0] = -0.5659557661927332*cq_m3[0];
-  KA_m7[2][KA_m7_col + 0] = 0.5659557661927332*sq_m4[0];
-  KA_m7[3][KA_m7_col + 0] = k[0]*sq_m4[0];
-  KA_m7[4][KA_m7_col + 0] = 0.11828475513428124*cq_m3[0];
-  KA_m7[5][KA_m7_col + 0] = k[1]*cq_m3[0];
-  KA_m7[3][KA_m7_col + 1] = 0.209 + 0.195*cq_m3[0];
-  KA_m7[5][KA_m7_col + 1] = -0.195*sq_m4[0];
-  KA_m7[0][KA_m7_col + 2] = sq_m4[0];
-  KA_m7[2][KA_m7_col + 2] = cq_m3[0];
-  KA_m7[3][KA_m7_col + 2] = k[2]*cq_m3[0];
-  KA_m7[4][KA_m7_col + 2] = -0.209*sq_m4[0];
-  KA_m7[5][KA_m7_col + 2] = k[3]*sq_m4[0];
+// shared_14's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_14_p0[86] = {0.03264876250658241, 0.03264876250658241, -8.030542390731965, -8.030542390731965, 0.003904, 0.003904, 0.064, 0.064, 0.000483144, 0.000483144, 6e-06, 6e-06, 0.04832438125329121, 0.04832438125329121, -0.015675618746708794, -0.015675618746708794, 0.04832438125329121, 0.04832438125329121, 0.015675618746708794, 0.015675618746708794, 0.013375999999999999, 0.013375999999999999, 0.003904, 0.003904, 0.6890000000000001, 0.6890000000000001, 0.03135123749341759, 0.03135123749341759, -0.01268, -0.01268, -0.209, -0.209, 0.01268, 0.01268, -0.003904, -0.003904, 0.6890000000000001, 0.6890000000000001, -0.006552408636124276, -0.006552408636124276, 0.002676476, 0.002676476, 0.000815936, 0.000815936, 0.00023857200000000002, 0.00023857200000000002, 0.209, 0.209, -0.000815936, -0.000815936, -0.00047714400000000004, -0.00047714400000000004, 0.0024196, 0.0024196, 0.043681, 0.043681, 0.000847876, 0.000847876, -0.00023857200000000002, -0.00023857200000000002, 0.209, 0.209, -0.209, -0.209, -0.5659557661927332, -0.5659557661927332, 0.5659557661927332, 0.5659557661927332, 0.004, 0.004, 0.11828475513428124, 0.11828475513428124, 0.004, 0.004, 0.209, 0.209, 0.195, 0.195, -0.195, -0.195, -0.004, -0.004, -0.209, -0.209, 0.004, 0.004};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_14_p1[86] = {0.03264876250658241, 0.03264876250658241, -8.030542390731965, -8.030542390731965, 0.003904, 0.003904, 0.064, 0.064, 0.000483144, 0.000483144, 6e-06, 6e-06, 0.04832438125329121, 0.04832438125329121, -0.015675618746708794, -0.015675618746708794, 0.04832438125329121, 0.04832438125329121, 0.015675618746708794, 0.015675618746708794, 0.013375999999999999, 0.013375999999999999, 0.003904, 0.003904, 0.6890000000000001, 0.6890000000000001, 0.03135123749341759, 0.03135123749341759, -0.01268, -0.01268, -0.209, -0.209, 0.01268, 0.01268, -0.003904, -0.003904, 0.6890000000000001, 0.6890000000000001, -0.006552408636124276, -0.006552408636124276, 0.002676476, 0.002676476, 0.000815936, 0.000815936, 0.00023857200000000002, 0.00023857200000000002, 0.209, 0.209, -0.000815936, -0.000815936, -0.00047714400000000004, -0.00047714400000000004, 0.0024196, 0.0024196, 0.043681, 0.043681, 0.000847876, 0.000847876, -0.00023857200000000002, -0.00023857200000000002, 0.209, 0.209, -0.209, -0.209, -0.5659557661927332, -0.5659557661927332, 0.5659557661927332, 0.5659557661927332, -0.004, -0.004, 0.11828475513428124, 0.11828475513428124, -0.004, -0.004, 0.209, 0.209, 0.195, 0.195, -0.195, -0.195, 0.004, 0.004, -0.209, -0.209, -0.004, -0.004};
+PROXGEN_RT_NOINLINE void shared_14_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT u_m0_a, Scalar* PROXGEN_RT_RESTRICT u_m0_b, Scalar* pA_m1_a, Scalar* pA_m1_b, Scalar* c_m2_a, Scalar* c_m2_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* sq_m4_a, Scalar* sq_m4_b, Scalar* PROXGEN_RT_RESTRICT IA_m5_a, Scalar* PROXGEN_RT_RESTRICT IA_m5_b, Scalar* PROXGEN_RT_RESTRICT pA_m6_a, Scalar* PROXGEN_RT_RESTRICT pA_m6_b, Scalar (*PROXGEN_RT_RESTRICT KA_m7_a)[4], Scalar (*PROXGEN_RT_RESTRICT KA_m7_b)[4], int KA_m7_col_a, int KA_m7_col_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m1_a[4], pA_m1_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x0 = proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(c_m2_a[0], c_m2_b[0]) + proxgen_rt::gather2(pA_m1_a[0], pA_m1_b[0]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(u_m0_a[0], u_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(c_m2_a[3], c_m2_b[3]) + proxgen_rt::gather2(pA_m1_a[1], pA_m1_b[1]);
+  const ScalarPair x2 = proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(c_m2_a[2], c_m2_b[2]) + proxgen_rt::gather2(pA_m1_a[2], pA_m1_b[2]);
+  const ScalarPair x3 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(c_m2_a[3], c_m2_b[3]) + proxgen_rt::gather2(pA_m1_a[3], pA_m1_b[3]);
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(c_m2_a[5], c_m2_b[5]) + proxgen_rt::gather2(pA_m1_a[5], pA_m1_b[5]);
+  const ScalarPair x5 = proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) - proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 6) + proxgen_rt::pair_at(k, 7)*x5;
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 8) + proxgen_rt::pair_at(k, 9)*x5;
+  const ScalarPair x8 = proxgen_rt::pair_at(k, 10) + proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]);
+  const ScalarPair x9 = proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x0 + proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x2;
+  const ScalarPair x10 = -proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x2;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 12) + x6, IA_m5_a[0], IA_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 13)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[2], IA_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 14) + proxgen_rt::pair_at(k, 15)*x6, IA_m5_a[4], IA_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 16) + x8, IA_m5_a[8], IA_m5_b[8]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 17)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[10], IA_m5_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 18) + x7, IA_m5_a[11], IA_m5_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 19)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[13], IA_m5_b[13]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 20) + proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) + proxgen_rt::pair_at(k, 22)*x5 + proxgen_rt::pair_at(k, 23)*x8, IA_m5_a[15], IA_m5_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 24)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]) + proxgen_rt::pair_at(k, 25)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), IA_m5_a[17], IA_m5_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 26) + proxgen_rt::pair_at(k, 27)*x6, IA_m5_a[18], IA_m5_b[18]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 28) + proxgen_rt::pair_at(k, 29)*x5, IA_m5_a[20], IA_m5_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[0], pA_m6_b[0]) + x9, pA_m6_a[0], pA_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[1], pA_m6_b[1]) + x1, pA_m6_a[1], pA_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[2], pA_m6_b[2]) + x10, pA_m6_a[2], pA_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[3], pA_m6_b[3]) + proxgen_rt::pair_at(k, 30)*x1 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x3 + proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x4, pA_m6_a[3], pA_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[4], pA_m6_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]) + proxgen_rt::pair_at(k, 31)*x9, pA_m6_a[4], pA_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m6_a[5], pA_m6_b[5]) - proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0])*x3 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x4, pA_m6_a[5], pA_m6_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 32)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[0][KA_m7_col_a + 0], KA_m7_b[0][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 33)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[2][KA_m7_col_a + 0], KA_m7_b[2][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 34)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[3][KA_m7_col_a + 0], KA_m7_b[3][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 35)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[4][KA_m7_col_a + 0], KA_m7_b[4][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 36)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[5][KA_m7_col_a + 0], KA_m7_b[5][KA_m7_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 37) + proxgen_rt::pair_at(k, 38)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[3][KA_m7_col_a + 1], KA_m7_b[3][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 39)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[5][KA_m7_col_a + 1], KA_m7_b[5][KA_m7_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[0][KA_m7_col_a + 2], KA_m7_b[0][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[2][KA_m7_col_a + 2], KA_m7_b[2][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 40)*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]), KA_m7_a[3][KA_m7_col_a + 2], KA_m7_b[3][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 41)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[4][KA_m7_col_a + 2], KA_m7_b[4][KA_m7_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 42)*proxgen_rt::gather2(sq_m4_a[0], sq_m4_b[0]), KA_m7_a[5][KA_m7_col_a + 2], KA_m7_b[5][KA_m7_col_b + 2]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: RH_thigh, RF_thigh, LH_thigh, LF_thigh.
 // The first: eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-constexpr Scalar shared_15_k0[32] = {-0.010144, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.00020288, -0.00010144, 0.005072, -0.00010144, -0.005072, 0.005072, -0.00010144, -0.062, 0.062, -0.062, 0.062, 0.02164, -0.02164, -0.062, -0.062, 0.062, -0.062, 0.062, 0.062, -0.062, 0.062, -0.00020288, -0.062, 0.062, -0.00020288, -0.062, 0.062};
-constexpr Scalar shared_15_k1[32] = {0.010144, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.00020288, 0.00010144, -0.005072, 0.00010144, 0.005072, -0.005072, 0.00010144, 0.062, -0.062, 0.062, -0.062, -0.02164, 0.02164, 0.062, 0.062, -0.062, 0.062, -0.062, -0.062, 0.062, -0.062, 0.00020288, 0.062, -0.062, 0.00020288, 0.062, -0.062};
-PROXGEN_RT_NOINLINE void shared_15(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* PROXGEN_RT_RESTRICT tau, Scalar* PROXGEN_RT_RESTRICT Dinv_m0, Scalar* PROXGEN_RT_RESTRICT IA_m1, Scalar* PROXGEN_RT_RESTRICT u_m2, Scalar* PROXGEN_RT_RESTRICT pA_m3, Scalar* PROXGEN_RT_RESTRICT c_m4, Scalar* PROXGEN_RT_RESTRICT cq_m5, Scalar* PROXGEN_RT_RESTRICT sq_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT pA_m8, Scalar* PROXGEN_RT_RESTRICT KSD_m9, Scalar (*PROXGEN_RT_RESTRICT KA_m10)[4], int KA_m10_col, Scalar (*PROXGEN_RT_RESTRICT KA_m11)[4], int KA_m11_col) noexcept {
-  Dinv_m0[0] = 1.0 / IA_m1[18];
-  u_m2[0] = -pA_m3[4] + tau[0];
-  const Scalar x0 = IA_m1[4]*Dinv_m0[0];
-  const Scalar x1 = IA_m1[13]*Dinv_m0[0];
-  const Scalar x2 = IA_m1[0] - IA_m1[4]*x0;
-  const Scalar x3 = IA_m1[2] - IA_m1[13]*x0;
-  const Scalar x4 = k[0] + k[1]*IA_m1[4]*Dinv_m0[0];
-  const Scalar x5 = IA_m1[11] - IA_m1[13]*x1;
-  const Scalar x6 = IA_m1[20] - 4.11602944e-08*Dinv_m0[0];
-  const Scalar x7 = k[2]*IA_m1[13]*Dinv_m0[0];
-  const Scalar x8 = pA_m3[0] + u_m2[0]*x0 + c_m4[0]*x2 + c_m4[2]*x3 + c_m4[5]*x4;
-  const Scalar x9 = pA_m3[1] + c_m4[3]*IA_m1[8] + c_m4[5]*IA_m1[10];
-  const Scalar x10 = k[3]*c_m4[3] + pA_m3[2] + u_m2[0]*x1 + c_m4[0]*x3 + c_m4[2]*x5 + c_m4[5]*x7;
-  const Scalar x11 = k[4]*c_m4[2] + pA_m3[3] + c_m4[3]*IA_m1[15] + c_m4[5]*IA_m1[17];
-  const Scalar x12 = pA_m3[5] + k[5]*Dinv_m0[0]*u_m2[0] + c_m4[0]*x4 + c_m4[2]*x7 + c_m4[3]*IA_m1[17] + c_m4[5]*x6;
-  const Scalar x13 = cq_m5[0]*cq_m5[0] - sq_m6[0]*sq_m6[0];
-  const Scalar x14 = 0.5*(-x2 + x5);
-  const Scalar x15 = 0.5*(x2 + x5);
-  const Scalar x16 = 2.0*cq_m5[0]*sq_m6[0];
-  const Scalar x17 = x13*x14 - x3*x16;
-  const Scalar x18 = x14*x16 + x3*x13;
-  const Scalar x19 = k[6]*IA_m1[13]*Dinv_m0[0];
-  const Scalar x20 = k[7] + 0.5*x4;
-  const Scalar x21 = x13*x19 - x16*x20;
-  const Scalar x22 = x16*x19 + x13*x20;
-  const Scalar x23 = 0.5*(-IA_m1[15] + x6);
-  const Scalar x24 = 0.5*(IA_m1[15] + x6);
-  const Scalar x25 = x13*x23 - IA_m1[17]*x16;
-  const Scalar x26 = x16*x23 + IA_m1[17]*x13;
-  const Scalar x27 = x15 - x17;
-  const Scalar x28 = x15 + x17;
-  const Scalar x29 = k[8]*IA_m1[13]*Dinv_m0[0] - x21;
-  const Scalar x30 = k[9] + 0.5*x4 + x22;
-  const Scalar x31 = sq_m6[0]*IA_m1[10] + cq_m5[0]*IA_m1[8];
-  const Scalar x32 = cq_m5[0]*IA_m1[10] - sq_m6[0]*IA_m1[8];
-  const Scalar x33 = k[10] - 0.5*x4 + x22;
-  const Scalar x34 = k[11]*IA_m1[13]*Dinv_m0[0] + x21;
-  const Scalar x35 = k[12]*x18 + x29;
-  const Scalar x36 = k[13]*x27 + x30;
-  const Scalar x37 = k[14]*x28 + x33;
-  const Scalar x38 = k[15]*x18 + x34;
-  const Scalar x39 = cq_m5[0]*x8 + sq_m6[0]*x10;
-  const Scalar x40 = -sq_m6[0]*x8 + cq_m5[0]*x10;
-  IA_m7[0] = 0.5950000000000001 + x27;
-  IA_m7[2] = x18;
-  IA_m7[3] = x35;
-  IA_m7[5] = k[16] + x36;
-  IA_m7[8] = x31;
-  IA_m7[10] = x32;
-  IA_m7[11] = 0.5950000000000001 + x28;
-  IA_m7[12] = k[17] + x37;
-  IA_m7[14] = x38;
-  IA_m7[15] = 0.0012018399999999998 + x24 - x25 + k[18]*x33 + k[19]*x37;
-  IA_m7[17] = 4.5e-07 + x26 + k[20]*x29 + k[21]*x38;
-  IA_m7[20] = 0.00126484 + x24 + x25 + k[22]*x30 + k[23]*x36;
-  pA_m8[0] = pA_m8[0] + x39;
-  pA_m8[1] = pA_m8[1] + x9;
-  pA_m8[2] = pA_m8[2] + x40;
-  pA_m8[3] = pA_m8[3] + cq_m5[0]*x11 + sq_m6[0]*x12 + k[24]*x40;
-  pA_m8[4] = pA_m8[4] + tau[0];
-  pA_m8[5] = pA_m8[5] - sq_m6[0]*x11 + cq_m5[0]*x12 + k[25]*x39;
-  KSD_m9[0] = KA_m10[4][KA_m10_col + 0]*Dinv_m0[0];
-  const Scalar x41 = KA_m10[0][KA_m10_col + 0] - IA_m1[4]*KSD_m9[0];
-  const Scalar x42 = KA_m10[2][KA_m10_col + 0] - IA_m1[13]*KSD_m9[0];
-  const Scalar x43 = KA_m10[5][KA_m10_col + 0] + k[26]*KSD_m9[0];
-  const Scalar x44 = cq_m5[0]*x41 + sq_m6[0]*x42;
-  const Scalar x45 = -sq_m6[0]*x41 + cq_m5[0]*x42;
-  KA_m11[0][KA_m11_col + 0] = x44;
-  KA_m11[2][KA_m11_col + 0] = x45;
-  KA_m11[3][KA_m11_col + 0] = cq_m5[0]*KA_m10[3][KA_m10_col + 0] + sq_m6[0]*x43 + k[27]*x45;
-  KA_m11[5][KA_m11_col + 0] = -sq_m6[0]*KA_m10[3][KA_m10_col + 0] + cq_m5[0]*x43 + k[28]*x44;
-  KA_m11[3][KA_m11_col + 1] = cq_m5[0]*KA_m10[3][KA_m10_col + 1] + sq_m6[0]*KA_m10[5][KA_m10_col + 1];
-  KA_m11[5][KA_m11_col + 1] = -sq_m6[0]*KA_m10[3][KA_m10_col + 1] + cq_m5[0]*KA_m10[5][KA_m10_col + 1];
-  KSD_m9[2] = KA_m10[4][KA_m10_col + 2]*Dinv_m0[0];
-  const Scalar x46 = KA_m10[0][KA_m10_col + 2] - IA_m1[4]*KSD_m9[2];
-  const Scalar x47 = KA_m10[2][KA_m10_col + 2] - IA_m1[13]*KSD_m9[2];
-  const Scalar x48 = KA_m10[5][KA_m10_col + 2] + k[29]*KSD_m9[2];
-  const Scalar x49 = cq_m5[0]*x46 + sq_m6[0]*x47;
-  const Scalar x50 = -sq_m6[0]*x46 + cq_m5[0]*x47;
-  KA_m11[0][KA_m11_col + 2] = x49;
-  KA_m11[2][KA_m11_col + 2] = x50;
-  KA_m11[3][KA_m11_col + 2] = cq_m5[0]*KA_m10[3][KA_m10_col + 2] + sq_m6[0]*x48 + k[30]*x50;
-  KA_m11[5][KA_m11_col + 2] = -sq_m6[0]*KA_m10[3][KA_m10_col + 2] + cq_m5[0]*x48 + k[31]*x49;
+// shared_15's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_15_p0[94] = {1.0, 1.0, -0.010144, -0.010144, -0.00020288, -0.00020288, -4.11602944e-08, -4.11602944e-08, -0.00020288, -0.00020288, 0.010144, 0.010144, 0.010144, 0.010144, 0.00020288, 0.00020288, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, -0.00010144, -0.00010144, 0.005072, 0.005072, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.00010144, -0.00010144, -0.005072, -0.005072, 0.5, 0.5, 0.005072, 0.005072, -0.5, -0.5, -0.00010144, -0.00010144, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.02164, 0.5950000000000001, 0.5950000000000001, -0.02164, -0.02164, 0.0012018399999999998, 0.0012018399999999998, -0.062, -0.062, -0.062, -0.062, 4.5e-07, 4.5e-07, 0.062, 0.062, -0.062, -0.062, 0.00126484, 0.00126484, 0.062, 0.062, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062, -0.00020288, -0.00020288, -0.062, -0.062, 0.062, 0.062, -0.00020288, -0.00020288, -0.062, -0.062, 0.062, 0.062};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_15_p1[94] = {1.0, 1.0, 0.010144, 0.010144, 0.00020288, 0.00020288, -4.11602944e-08, -4.11602944e-08, 0.00020288, 0.00020288, -0.010144, -0.010144, -0.010144, -0.010144, -0.00020288, -0.00020288, 0.5, 0.5, 0.5, 0.5, 2.0, 2.0, 0.00010144, 0.00010144, -0.005072, -0.005072, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.00010144, 0.00010144, 0.005072, 0.005072, 0.5, 0.5, -0.005072, -0.005072, -0.5, -0.5, 0.00010144, 0.00010144, 0.062, 0.062, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062, 0.5950000000000001, 0.5950000000000001, -0.02164, -0.02164, 0.5950000000000001, 0.5950000000000001, 0.02164, 0.02164, 0.0012018399999999998, 0.0012018399999999998, 0.062, 0.062, 0.062, 0.062, 4.5e-07, 4.5e-07, -0.062, -0.062, 0.062, 0.062, 0.00126484, 0.00126484, -0.062, -0.062, -0.062, -0.062, 0.062, 0.062, -0.062, -0.062, 0.00020288, 0.00020288, 0.062, 0.062, -0.062, -0.062, 0.00020288, 0.00020288, 0.062, 0.062, -0.062, -0.062};
+PROXGEN_RT_NOINLINE void shared_15_x2(const Scalar* PROXGEN_RT_RESTRICT k, const Scalar* tau_a, const Scalar* tau_b, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_a, Scalar* PROXGEN_RT_RESTRICT Dinv_m0_b, Scalar* IA_m1_a, Scalar* IA_m1_b, Scalar* PROXGEN_RT_RESTRICT u_m2_a, Scalar* PROXGEN_RT_RESTRICT u_m2_b, Scalar* pA_m3_a, Scalar* pA_m3_b, Scalar* c_m4_a, Scalar* c_m4_b, Scalar* cq_m5_a, Scalar* cq_m5_b, Scalar* sq_m6_a, Scalar* sq_m6_b, Scalar* PROXGEN_RT_RESTRICT IA_m7_a, Scalar* PROXGEN_RT_RESTRICT IA_m7_b, Scalar* PROXGEN_RT_RESTRICT pA_m8_a, Scalar* PROXGEN_RT_RESTRICT pA_m8_b, Scalar* PROXGEN_RT_RESTRICT KSD_m9_a, Scalar* PROXGEN_RT_RESTRICT KSD_m9_b, Scalar (*KA_m10_a)[4], Scalar (*KA_m10_b)[4], int KA_m10_col_a, int KA_m10_col_b, Scalar (*PROXGEN_RT_RESTRICT KA_m11_a)[4], Scalar (*PROXGEN_RT_RESTRICT KA_m11_b)[4], int KA_m11_col_a, int KA_m11_col_b) noexcept {
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 0) / proxgen_rt::gather2(IA_m1_a[18], IA_m1_b[18]), Dinv_m0_a[0], Dinv_m0_b[0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(pA_m3_a[4], pA_m3_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), u_m2_a[0], u_m2_b[0]);
+  const ScalarPair x0 = proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x1 = proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x2 = proxgen_rt::gather2(IA_m1_a[0], IA_m1_b[0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*x0;
+  const ScalarPair x3 = proxgen_rt::gather2(IA_m1_a[2], IA_m1_b[2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x0;
+  const ScalarPair x4 = proxgen_rt::pair_at(k, 1) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(IA_m1_a[11], IA_m1_b[11]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*x1;
+  const ScalarPair x6 = proxgen_rt::gather2(IA_m1_a[20], IA_m1_b[20]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x7 = proxgen_rt::pair_at(k, 4)*proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x8 = proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x0 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x2 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x3 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x4;
+  const ScalarPair x9 = proxgen_rt::gather2(pA_m3_a[1], pA_m3_b[1]) + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]) + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]);
+  const ScalarPair x10 = proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(c_m4_a[3], c_m4_b[3]) + proxgen_rt::gather2(pA_m3_a[2], pA_m3_b[2]) + proxgen_rt::gather2(u_m2_a[0], u_m2_b[0])*x1 + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x3 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x5 + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x7;
+  const ScalarPair x11 = proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(c_m4_a[2], c_m4_b[2]) + proxgen_rt::gather2(pA_m3_a[3], pA_m3_b[3]) + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]);
+  const ScalarPair x12 = proxgen_rt::gather2(pA_m3_a[5], pA_m3_b[5]) + proxgen_rt::pair_at(k, 7)*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0])*proxgen_rt::gather2(u_m2_a[0], u_m2_b[0]) + proxgen_rt::gather2(c_m4_a[0], c_m4_b[0])*x4 + proxgen_rt::gather2(c_m4_a[2], c_m4_b[2])*x7 + proxgen_rt::gather2(c_m4_a[3], c_m4_b[3])*proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17]) + proxgen_rt::gather2(c_m4_a[5], c_m4_b[5])*x6;
+  const ScalarPair x13 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x14 = proxgen_rt::pair_at(k, 8)*(-x2 + x5);
+  const ScalarPair x15 = proxgen_rt::pair_at(k, 9)*(x2 + x5);
+  const ScalarPair x16 = proxgen_rt::pair_at(k, 10)*proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0]);
+  const ScalarPair x17 = x13*x14 - x3*x16;
+  const ScalarPair x18 = x14*x16 + x3*x13;
+  const ScalarPair x19 = proxgen_rt::pair_at(k, 11)*proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]);
+  const ScalarPair x20 = proxgen_rt::pair_at(k, 12) + proxgen_rt::pair_at(k, 13)*x4;
+  const ScalarPair x21 = x13*x19 - x16*x20;
+  const ScalarPair x22 = x16*x19 + x13*x20;
+  const ScalarPair x23 = proxgen_rt::pair_at(k, 14)*(-proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) + x6);
+  const ScalarPair x24 = proxgen_rt::pair_at(k, 15)*(proxgen_rt::gather2(IA_m1_a[15], IA_m1_b[15]) + x6);
+  const ScalarPair x25 = x13*x23 - proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x16;
+  const ScalarPair x26 = x16*x23 + proxgen_rt::gather2(IA_m1_a[17], IA_m1_b[17])*x13;
+  const ScalarPair x27 = x15 - x17;
+  const ScalarPair x28 = x15 + x17;
+  const ScalarPair x29 = proxgen_rt::pair_at(k, 16)*proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]) - x21;
+  const ScalarPair x30 = proxgen_rt::pair_at(k, 17) + proxgen_rt::pair_at(k, 18)*x4 + x22;
+  const ScalarPair x31 = proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]);
+  const ScalarPair x32 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(IA_m1_a[10], IA_m1_b[10]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(IA_m1_a[8], IA_m1_b[8]);
+  const ScalarPair x33 = proxgen_rt::pair_at(k, 19) + proxgen_rt::pair_at(k, 20)*x4 + x22;
+  const ScalarPair x34 = proxgen_rt::pair_at(k, 21)*proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]) + x21;
+  const ScalarPair x35 = proxgen_rt::pair_at(k, 22)*x18 + x29;
+  const ScalarPair x36 = proxgen_rt::pair_at(k, 23)*x27 + x30;
+  const ScalarPair x37 = proxgen_rt::pair_at(k, 24)*x28 + x33;
+  const ScalarPair x38 = proxgen_rt::pair_at(k, 25)*x18 + x34;
+  const ScalarPair x39 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x8 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x10;
+  const ScalarPair x40 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x8 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x10;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 26) + x27, IA_m7_a[0], IA_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x18, IA_m7_a[2], IA_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x35, IA_m7_a[3], IA_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 27) + x36, IA_m7_a[5], IA_m7_b[5]);
+  proxgen_rt::scatter2<Scalar>(x31, IA_m7_a[8], IA_m7_b[8]);
+  proxgen_rt::scatter2<Scalar>(x32, IA_m7_a[10], IA_m7_b[10]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 28) + x28, IA_m7_a[11], IA_m7_b[11]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 29) + x37, IA_m7_a[12], IA_m7_b[12]);
+  proxgen_rt::scatter2<Scalar>(x38, IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 30) + x24 - x25 + proxgen_rt::pair_at(k, 31)*x33 + proxgen_rt::pair_at(k, 32)*x37, IA_m7_a[15], IA_m7_b[15]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 33) + x26 + proxgen_rt::pair_at(k, 34)*x29 + proxgen_rt::pair_at(k, 35)*x38, IA_m7_a[17], IA_m7_b[17]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 36) + x24 + x25 + proxgen_rt::pair_at(k, 37)*x30 + proxgen_rt::pair_at(k, 38)*x36, IA_m7_a[20], IA_m7_b[20]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[0], pA_m8_b[0]) + x39, pA_m8_a[0], pA_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[1], pA_m8_b[1]) + x9, pA_m8_a[1], pA_m8_b[1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[2], pA_m8_b[2]) + x40, pA_m8_a[2], pA_m8_b[2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[3], pA_m8_b[3]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x11 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x12 + proxgen_rt::pair_at(k, 39)*x40, pA_m8_a[3], pA_m8_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[4], pA_m8_b[4]) + proxgen_rt::gather2(tau_a[0], tau_b[0]), pA_m8_a[4], pA_m8_b[4]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(pA_m8_a[5], pA_m8_b[5]) - proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x11 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x12 + proxgen_rt::pair_at(k, 40)*x39, pA_m8_a[5], pA_m8_b[5]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 0], KA_m10_b[4][KA_m10_col_b + 0])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x41 = proxgen_rt::gather2(KA_m10_a[0][KA_m10_col_a + 0], KA_m10_b[0][KA_m10_col_b + 0]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x42 = proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 0], KA_m10_b[2][KA_m10_col_b + 0]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x43 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 0], KA_m10_b[5][KA_m10_col_b + 0]) + proxgen_rt::pair_at(k, 41)*proxgen_rt::gather2(KSD_m9_a[0], KSD_m9_b[0]);
+  const ScalarPair x44 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x41 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x42;
+  const ScalarPair x45 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x41 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x42;
+  proxgen_rt::scatter2<Scalar>(x44, KA_m11_a[0][KA_m11_col_a + 0], KA_m11_b[0][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(x45, KA_m11_a[2][KA_m11_col_a + 0], KA_m11_b[2][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 0], KA_m10_b[3][KA_m10_col_b + 0]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x43 + proxgen_rt::pair_at(k, 42)*x45, KA_m11_a[3][KA_m11_col_a + 0], KA_m11_b[3][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 0], KA_m10_b[3][KA_m10_col_b + 0]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x43 + proxgen_rt::pair_at(k, 43)*x44, KA_m11_a[5][KA_m11_col_a + 0], KA_m11_b[5][KA_m11_col_b + 0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 1], KA_m10_b[3][KA_m10_col_b + 1]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 1], KA_m10_b[5][KA_m10_col_b + 1]), KA_m11_a[3][KA_m11_col_a + 1], KA_m11_b[3][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 1], KA_m10_b[3][KA_m10_col_b + 1]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 1], KA_m10_b[5][KA_m10_col_b + 1]), KA_m11_a[5][KA_m11_col_a + 1], KA_m11_b[5][KA_m11_col_b + 1]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(KA_m10_a[4][KA_m10_col_a + 2], KA_m10_b[4][KA_m10_col_b + 2])*proxgen_rt::gather2(Dinv_m0_a[0], Dinv_m0_b[0]), KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x46 = proxgen_rt::gather2(KA_m10_a[0][KA_m10_col_a + 2], KA_m10_b[0][KA_m10_col_b + 2]) - proxgen_rt::gather2(IA_m1_a[4], IA_m1_b[4])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x47 = proxgen_rt::gather2(KA_m10_a[2][KA_m10_col_a + 2], KA_m10_b[2][KA_m10_col_b + 2]) - proxgen_rt::gather2(IA_m1_a[13], IA_m1_b[13])*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x48 = proxgen_rt::gather2(KA_m10_a[5][KA_m10_col_a + 2], KA_m10_b[5][KA_m10_col_b + 2]) + proxgen_rt::pair_at(k, 44)*proxgen_rt::gather2(KSD_m9_a[2], KSD_m9_b[2]);
+  const ScalarPair x49 = proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x46 + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x47;
+  const ScalarPair x50 = -proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x46 + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x47;
+  proxgen_rt::scatter2<Scalar>(x49, KA_m11_a[0][KA_m11_col_a + 2], KA_m11_b[0][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(x50, KA_m11_a[2][KA_m11_col_a + 2], KA_m11_b[2][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 2], KA_m10_b[3][KA_m10_col_b + 2]) + proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*x48 + proxgen_rt::pair_at(k, 45)*x50, KA_m11_a[3][KA_m11_col_a + 2], KA_m11_b[3][KA_m11_col_b + 2]);
+  proxgen_rt::scatter2<Scalar>(-proxgen_rt::gather2(sq_m6_a[0], sq_m6_b[0])*proxgen_rt::gather2(KA_m10_a[3][KA_m10_col_a + 2], KA_m10_b[3][KA_m10_col_b + 2]) + proxgen_rt::gather2(cq_m5_a[0], cq_m5_b[0])*x48 + proxgen_rt::pair_at(k, 46)*x49, KA_m11_a[5][KA_m11_col_a + 2], KA_m11_b[5][KA_m11_col_b + 2]);
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: RF_hip, LH_hip, LF_hip.
@@ -954,71 +986,100 @@ PROXGEN_RT_NOINLINE void shared_16(const Scalar* PROXGEN_RT_RESTRICT k, const Sc
   KA_m13[5][KA_m13_col + 2] = RJ_m6[2][RJ_m6_col + 0]*x106 + k[79]*RJ_m6[2][RJ_m6_col + 1]*KSD_m12[2] + RJ_m6[2][RJ_m6_col + 2]*x107 + k[80]*x108 + k[81]*x109;
 }
 
+// 2 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip.
+// The first: free acceleration (lambda = 0): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
+// shared_17's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_17_p0[14] = {-0.049, -0.049, 0.19, -0.19, 0.049, 0.049, -0.19, 0.19, -5.780668556524933e-05, -5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_17_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x3 - proxgen_rt::gather2(U_m5_a[1], U_m5_b[1])*x4 - proxgen_rt::gather2(U_m5_a[2], U_m5_b[2])*x5 - proxgen_rt::gather2(U_m5_a[3], U_m5_b[3])*x6 - proxgen_rt::gather2(U_m5_a[5], U_m5_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(x3, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, a_m6_a[5], a_m6_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: RF_hip, RH_hip.
+// The first: free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+// shared_18's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_18_p0[14] = {0.049, 0.049, 0.19, -0.19, -0.049, -0.049, -0.19, 0.19, 5.780668556524933e-05, 5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_18_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* U_m5_a, Scalar* U_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m5_a[0], U_m5_b[0])*x3 - proxgen_rt::gather2(U_m5_a[1], U_m5_b[1])*x4 - proxgen_rt::gather2(U_m5_a[2], U_m5_b[2])*x5 - proxgen_rt::gather2(U_m5_a[3], U_m5_b[3])*x6 - proxgen_rt::gather2(U_m5_a[5], U_m5_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(x3, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x9, a_m6_a[5], a_m6_b[5]);
+}
+
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_17_k0[3] = {-0.062, 0.062, 0.00020288};
-constexpr Scalar shared_17_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_17(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT IA_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
-  const Scalar x6 = u_m4[0] + k[2]*x5 - IA_m5[0]*x2 - IA_m5[9]*x3 - a_m0[4]*IA_m5[14];
-  a_m6[0] = x2;
-  a_m6[1] = a_m0[1];
-  a_m6[2] = x3;
-  a_m6[3] = x4;
-  a_m6[4] = a_m0[4] + Dinv_m7*x6;
-  a_m6[5] = x5;
+// shared_19's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_19_p0[6] = {-0.062, -0.062, 0.062, 0.062, 0.00020288, 0.00020288};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_19_p1[6] = {0.062, 0.062, -0.062, -0.062, -0.00020288, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_19_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* IA_m5_a, Scalar* IA_m5_b, Scalar* PROXGEN_RT_RESTRICT a_m6_a, Scalar* PROXGEN_RT_RESTRICT a_m6_b, Scalar Dinv_m7_a, Scalar Dinv_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 2)*x5 - proxgen_rt::gather2(IA_m5_a[0], IA_m5_b[0])*x2 - proxgen_rt::gather2(IA_m5_a[9], IA_m5_b[9])*x3 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m5_a[14], IA_m5_b[14]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m6_a[0], a_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m6_a[1], a_m6_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m6_a[2], a_m6_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m6_a[3], a_m6_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(Dinv_m7_a, Dinv_m7_b)*x6, a_m6_a[4], a_m6_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m6_a[5], a_m6_b[5]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_18(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT a_m5) noexcept {
-  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
-  const Scalar x6 = u_m4[0] - 0.000486144*a_m0[4] + 0.003904*x2;
-  a_m5[0] = x2;
-  a_m5[1] = x1;
-  a_m5[2] = x3;
-  a_m5[3] = x4;
-  a_m5[4] = a_m0[4] + 2057.0036861506055*x6;
-  a_m5[5] = x5;
-}
-
-// 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
-// The first: free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_19_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_19_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_19_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_19(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT U_m5, Scalar* PROXGEN_RT_RESTRICT a_m6, Scalar Dinv_m7) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
-  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
-  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
-  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
-  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
-  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
-  const Scalar x9 = u_m4[0] + k[4]*x7 - U_m5[0]*x3 - U_m5[1]*x4 - U_m5[2]*x5 - U_m5[3]*x6 - U_m5[5]*x8;
-  a_m6[0] = x3;
-  a_m6[1] = x4;
-  a_m6[2] = x5;
-  a_m6[3] = x6 + k[5]*Dinv_m7*x9;
-  a_m6[4] = x7;
-  a_m6[5] = x8 + k[6]*Dinv_m7*x9;
+// shared_20's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_20_p0[10] = {-0.209, -0.209, 0.209, 0.209, -0.000486144, -0.000486144, 0.003904, 0.003904, 2057.0036861506055, 2057.0036861506055};
+PROXGEN_RT_NOINLINE void shared_20_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* PROXGEN_RT_RESTRICT a_m5_a, Scalar* PROXGEN_RT_RESTRICT a_m5_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 3)*x2;
+  proxgen_rt::scatter2<Scalar>(x2, a_m5_a[0], a_m5_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m5_a[1], a_m5_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m5_a[2], a_m5_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m5_a[3], a_m5_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::pair_at(k, 4)*x6, a_m5_a[4], a_m5_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m5_a[5], a_m5_b[5]);
 }
 
 // 3 blocks of the same code, each over its constants (k) and members: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count).
 // The first: G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-PROXGEN_RT_NOINLINE void shared_20(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
+PROXGEN_RT_NOINLINE void shared_21(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KSD_m0, Scalar* PROXGEN_RT_RESTRICT KS_m1, Scalar* PROXGEN_RT_RESTRICT KSD_m2, Scalar (*PROXGEN_RT_RESTRICT KA_m3)[4], int KA_m3_col, Scalar* PROXGEN_RT_RESTRICT Linv_m4, Scalar* PROXGEN_RT_RESTRICT L_m5) noexcept {
   const Scalar x0 = 78.21756516587678 + inv_mu + KSD_m0[0]*KS_m1[0] + KSD_m2[0]*KA_m3[4][KA_m3_col + 0];
   const Scalar x1 = std::sqrt(x0);
   const Scalar x2 = 1.0 / x1;
@@ -1029,72 +1090,102 @@ PROXGEN_RT_NOINLINE void shared_20(Scalar inv_mu, Scalar* PROXGEN_RT_RESTRICT KS
   L_m5[1] = Linv_m4[0]*x4;
 }
 
+// 2 blocks of the same code, each over its constants (k) and members: LF_hip, LH_hip.
+// The first: accelerate, with the multipliers of the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
+// shared_22's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_22_p0[14] = {-0.049, -0.049, 0.19, -0.19, 0.049, 0.049, -0.19, 0.19, -5.780668556524933e-05, -5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_22_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* KS_m5_a, Scalar* KS_m5_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* U_m7_a, Scalar* U_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KS_m5_a[0], KS_m5_b[0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KS_m5_a[1], KS_m5_b[1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KS_m5_a[2], KS_m5_b[2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m7_a[0], U_m7_b[0])*x3 - proxgen_rt::gather2(U_m7_a[1], U_m7_b[1])*x4 - proxgen_rt::gather2(U_m7_a[2], U_m7_b[2])*x5 - proxgen_rt::gather2(U_m7_a[3], U_m7_b[3])*x6 - proxgen_rt::gather2(U_m7_a[5], U_m7_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x9, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[5], a_m10_b[5]);
+}
+
+// 2 blocks of the same code, each over its constants (k) and members: RF_hip, RH_hip.
+// The first: accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
+// shared_23's blocks two at a time, one in each lane of a ScalarPair:
+// 1 pair.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_23_p0[14] = {0.049, 0.049, 0.19, -0.19, -0.049, -0.049, -0.19, 0.19, 5.780668556524933e-05, 5.7617628499109426e-05, 0.9950371902099893, 0.9950371902099892, 0.09950371902099893, -0.09950371902099892};
+PROXGEN_RT_NOINLINE void shared_23_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar (*RJ_m2_a)[3], Scalar (*RJ_m2_b)[3], int RJ_m2_col_a, int RJ_m2_col_b, Scalar* cq_m3_a, Scalar* cq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* KS_m5_a, Scalar* KS_m5_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* U_m7_a, Scalar* U_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x2 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0])*x2;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[1], c_m1_b[1]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1])*x0 + proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1])*x2;
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2])*x0 + proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2])*x1 + proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2])*x2;
+  const ScalarPair x6 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 0], RJ_m2_b[0][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 0], RJ_m2_b[1][RJ_m2_col_b + 0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 0], RJ_m2_b[2][RJ_m2_col_b + 0]);
+  const ScalarPair x7 = proxgen_rt::gather2(c_m1_a[4], c_m1_b[4]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 1], RJ_m2_b[0][RJ_m2_col_b + 1]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(cq_m3_a[0], cq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 1], RJ_m2_b[2][RJ_m2_col_b + 1]);
+  const ScalarPair x8 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(RJ_m2_a[0][RJ_m2_col_a + 2], RJ_m2_b[0][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(RJ_m2_a[1][RJ_m2_col_a + 2], RJ_m2_b[1][RJ_m2_col_b + 2]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(RJ_m2_a[2][RJ_m2_col_a + 2], RJ_m2_b[2][RJ_m2_col_b + 2]);
+  const ScalarPair x9 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KS_m5_a[0], KS_m5_b[0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KS_m5_a[1], KS_m5_b[1])*proxgen_rt::gather2(lambda_m6_a[1], lambda_m6_b[1]) - proxgen_rt::gather2(KS_m5_a[2], KS_m5_b[2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) + proxgen_rt::pair_at(k, 4)*x7 - proxgen_rt::gather2(U_m7_a[0], U_m7_b[0])*x3 - proxgen_rt::gather2(U_m7_a[1], U_m7_b[1])*x4 - proxgen_rt::gather2(U_m7_a[2], U_m7_b[2])*x5 - proxgen_rt::gather2(U_m7_a[3], U_m7_b[3])*x6 - proxgen_rt::gather2(U_m7_a[5], U_m7_b[5])*x8;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x9, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x6 + proxgen_rt::pair_at(k, 5)*proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(x7, a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x8 + proxgen_rt::pair_at(k, 6)*proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[5], a_m10_b[5]);
+}
+
 // 4 blocks of the same code, each over its constants (k) and members: LF_thigh, LH_thigh, RF_thigh, RH_thigh.
 // The first: accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-constexpr Scalar shared_21_k0[3] = {-0.062, 0.062, 0.00020288};
-constexpr Scalar shared_21_k1[3] = {0.062, -0.062, -0.00020288};
-PROXGEN_RT_NOINLINE void shared_21(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar (*PROXGEN_RT_RESTRICT KA_m5)[4], int KA_m5_col, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT IA_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[2] + k[1]*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*x1;
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*x1;
-  const Scalar x4 = c_m1[3] + a_m0[3]*cq_m2[0] - a_m0[5]*sq_m3[0];
-  const Scalar x5 = c_m1[5] + a_m0[3]*sq_m3[0] + a_m0[5]*cq_m2[0];
-  const Scalar x6 = u_m4[0] - KA_m5[4][KA_m5_col + 0]*lambda_m6[0] - KA_m5[4][KA_m5_col + 2]*lambda_m6[2] + k[2]*x5 - IA_m7[0]*x2 - IA_m7[9]*x3 - a_m0[4]*IA_m7[14];
-  qdd_m8[0] = Dinv_m9*x6;
-  a_m10[0] = x2;
-  a_m10[1] = a_m0[1];
-  a_m10[2] = x3;
-  a_m10[3] = x4;
-  a_m10[4] = a_m0[4] + qdd_m8[0];
-  a_m10[5] = x5;
+// shared_24's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_24_p0[6] = {-0.062, -0.062, 0.062, 0.062, 0.00020288, 0.00020288};
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_24_p1[6] = {0.062, 0.062, -0.062, -0.062, -0.00020288, -0.00020288};
+PROXGEN_RT_NOINLINE void shared_24_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar (*KA_m5_a)[4], Scalar (*KA_m5_b)[4], int KA_m5_col_a, int KA_m5_col_b, Scalar* lambda_m6_a, Scalar* lambda_m6_b, Scalar* IA_m7_a, Scalar* IA_m7_b, Scalar* PROXGEN_RT_RESTRICT qdd_m8_a, Scalar* PROXGEN_RT_RESTRICT qdd_m8_b, Scalar Dinv_m9_a, Scalar Dinv_m9_b, Scalar* PROXGEN_RT_RESTRICT a_m10_a, Scalar* PROXGEN_RT_RESTRICT a_m10_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[5], a_m0_b[5]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[2], a_m0_b[2]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x1;
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x1;
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 0], KA_m5_b[4][KA_m5_col_b + 0])*proxgen_rt::gather2(lambda_m6_a[0], lambda_m6_b[0]) - proxgen_rt::gather2(KA_m5_a[4][KA_m5_col_a + 2], KA_m5_b[4][KA_m5_col_b + 2])*proxgen_rt::gather2(lambda_m6_a[2], lambda_m6_b[2]) + proxgen_rt::pair_at(k, 2)*x5 - proxgen_rt::gather2(IA_m7_a[0], IA_m7_b[0])*x2 - proxgen_rt::gather2(IA_m7_a[9], IA_m7_b[9])*x3 - proxgen_rt::gather2(a_m0_a[4], a_m0_b[4])*proxgen_rt::gather2(IA_m7_a[14], IA_m7_b[14]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(Dinv_m9_a, Dinv_m9_b)*x6, qdd_m8_a[0], qdd_m8_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m10_a[0], a_m10_b[0]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]), a_m10_a[1], a_m10_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m10_a[2], a_m10_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m10_a[3], a_m10_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m8_a[0], qdd_m8_b[0]), a_m10_a[4], a_m10_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m10_a[5], a_m10_b[5]);
 }
 
 // 4 blocks of the same code, each over its constants (k) and members: LF_shank, LH_shank, RF_shank, RH_shank.
 // The first: accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-PROXGEN_RT_NOINLINE void shared_22(Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar* PROXGEN_RT_RESTRICT cq_m2, Scalar* PROXGEN_RT_RESTRICT sq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT lambda_m5, Scalar* PROXGEN_RT_RESTRICT qdd_m6, Scalar* PROXGEN_RT_RESTRICT a_m7) noexcept {
-  const Scalar x0 = a_m0[0] - 0.209*a_m0[4];
-  const Scalar x1 = a_m0[1] + 0.209*a_m0[3];
-  const Scalar x2 = c_m1[0] + cq_m2[0]*x0 - sq_m3[0]*a_m0[2];
-  const Scalar x3 = c_m1[2] + sq_m3[0]*x0 + cq_m2[0]*a_m0[2];
-  const Scalar x4 = c_m1[3] + cq_m2[0]*a_m0[3] - sq_m3[0]*a_m0[5];
-  const Scalar x5 = c_m1[5] + sq_m3[0]*a_m0[3] + cq_m2[0]*a_m0[5];
-  const Scalar x6 = u_m4[0] + 0.195*lambda_m5[0] - 0.000486144*a_m0[4] + 0.003904*x2;
-  qdd_m6[0] = 2057.0036861506055*x6;
-  a_m7[0] = x2;
-  a_m7[1] = x1;
-  a_m7[2] = x3;
-  a_m7[3] = x4;
-  a_m7[4] = a_m0[4] + qdd_m6[0];
-  a_m7[5] = x5;
+// shared_25's blocks two at a time, one in each lane of a ScalarPair:
+// 2 pairs.
+alignas(2 * sizeof(Scalar)) constexpr Scalar shared_25_p0[12] = {-0.209, -0.209, 0.209, 0.209, -0.000486144, -0.000486144, 0.195, 0.195, 0.003904, 0.003904, 2057.0036861506055, 2057.0036861506055};
+PROXGEN_RT_NOINLINE void shared_25_x2(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* a_m0_a, Scalar* a_m0_b, Scalar* c_m1_a, Scalar* c_m1_b, Scalar* cq_m2_a, Scalar* cq_m2_b, Scalar* sq_m3_a, Scalar* sq_m3_b, Scalar* u_m4_a, Scalar* u_m4_b, Scalar* lambda_m5_a, Scalar* lambda_m5_b, Scalar* PROXGEN_RT_RESTRICT qdd_m6_a, Scalar* PROXGEN_RT_RESTRICT qdd_m6_b, Scalar* PROXGEN_RT_RESTRICT a_m7_a, Scalar* PROXGEN_RT_RESTRICT a_m7_b) noexcept {
+  const ScalarPair x0 = proxgen_rt::gather2(a_m0_a[0], a_m0_b[0]) + proxgen_rt::pair_at(k, 0)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]);
+  const ScalarPair x1 = proxgen_rt::gather2(a_m0_a[1], a_m0_b[1]) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(a_m0_a[3], a_m0_b[3]);
+  const ScalarPair x2 = proxgen_rt::gather2(c_m1_a[0], c_m1_b[0]) + proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0])*x0 - proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x3 = proxgen_rt::gather2(c_m1_a[2], c_m1_b[2]) + proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0])*x0 + proxgen_rt::gather2(a_m0_a[2], a_m0_b[2])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x4 = proxgen_rt::gather2(c_m1_a[3], c_m1_b[3]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]) - proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]);
+  const ScalarPair x5 = proxgen_rt::gather2(c_m1_a[5], c_m1_b[5]) + proxgen_rt::gather2(a_m0_a[3], a_m0_b[3])*proxgen_rt::gather2(sq_m3_a[0], sq_m3_b[0]) + proxgen_rt::gather2(a_m0_a[5], a_m0_b[5])*proxgen_rt::gather2(cq_m2_a[0], cq_m2_b[0]);
+  const ScalarPair x6 = proxgen_rt::pair_at(k, 2)*proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(u_m4_a[0], u_m4_b[0]) + proxgen_rt::pair_at(k, 3)*proxgen_rt::gather2(lambda_m5_a[0], lambda_m5_b[0]) + proxgen_rt::pair_at(k, 4)*x2;
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::pair_at(k, 5)*x6, qdd_m6_a[0], qdd_m6_b[0]);
+  proxgen_rt::scatter2<Scalar>(x2, a_m7_a[0], a_m7_b[0]);
+  proxgen_rt::scatter2<Scalar>(x1, a_m7_a[1], a_m7_b[1]);
+  proxgen_rt::scatter2<Scalar>(x3, a_m7_a[2], a_m7_b[2]);
+  proxgen_rt::scatter2<Scalar>(x4, a_m7_a[3], a_m7_b[3]);
+  proxgen_rt::scatter2<Scalar>(proxgen_rt::gather2(a_m0_a[4], a_m0_b[4]) + proxgen_rt::gather2(qdd_m6_a[0], qdd_m6_b[0]), a_m7_a[4], a_m7_b[4]);
+  proxgen_rt::scatter2<Scalar>(x5, a_m7_a[5], a_m7_b[5]);
 }
 
-// 3 blocks of the same code, each over its constants (k) and members: LH_hip, RF_hip, RH_hip.
-// The first: accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-constexpr Scalar shared_23_k0[7] = {-0.049, -0.19, 0.049, 0.19, -5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-constexpr Scalar shared_23_k1[7] = {0.049, 0.19, -0.049, -0.19, 5.780668556524933e-05, 0.9950371902099893, 0.09950371902099893};
-constexpr Scalar shared_23_k2[7] = {0.049, -0.19, -0.049, 0.19, 5.7617628499109426e-05, 0.9950371902099892, -0.09950371902099892};
-PROXGEN_RT_NOINLINE void shared_23(const Scalar* PROXGEN_RT_RESTRICT k, Scalar* PROXGEN_RT_RESTRICT a_m0, Scalar* PROXGEN_RT_RESTRICT c_m1, Scalar (*PROXGEN_RT_RESTRICT RJ_m2)[3], int RJ_m2_col, Scalar* PROXGEN_RT_RESTRICT cq_m3, Scalar* PROXGEN_RT_RESTRICT u_m4, Scalar* PROXGEN_RT_RESTRICT KS_m5, Scalar* PROXGEN_RT_RESTRICT lambda_m6, Scalar* PROXGEN_RT_RESTRICT U_m7, Scalar* PROXGEN_RT_RESTRICT qdd_m8, Scalar Dinv_m9, Scalar* PROXGEN_RT_RESTRICT a_m10) noexcept {
-  const Scalar x0 = a_m0[0] + k[0]*a_m0[5];
-  const Scalar x1 = a_m0[1] + k[1]*a_m0[5];
-  const Scalar x2 = a_m0[2] + k[2]*a_m0[3] + k[3]*a_m0[4];
-  const Scalar x3 = c_m1[0] + RJ_m2[0][RJ_m2_col + 0]*x0 + RJ_m2[1][RJ_m2_col + 0]*x1 + RJ_m2[2][RJ_m2_col + 0]*x2;
-  const Scalar x4 = c_m1[1] + RJ_m2[0][RJ_m2_col + 1]*x0 + cq_m3[0]*x1 + RJ_m2[2][RJ_m2_col + 1]*x2;
-  const Scalar x5 = c_m1[2] + RJ_m2[0][RJ_m2_col + 2]*x0 + RJ_m2[1][RJ_m2_col + 2]*x1 + RJ_m2[2][RJ_m2_col + 2]*x2;
-  const Scalar x6 = c_m1[3] + a_m0[3]*RJ_m2[0][RJ_m2_col + 0] + a_m0[4]*RJ_m2[1][RJ_m2_col + 0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 0];
-  const Scalar x7 = c_m1[4] + a_m0[3]*RJ_m2[0][RJ_m2_col + 1] + a_m0[4]*cq_m3[0] + a_m0[5]*RJ_m2[2][RJ_m2_col + 1];
-  const Scalar x8 = c_m1[5] + a_m0[3]*RJ_m2[0][RJ_m2_col + 2] + a_m0[4]*RJ_m2[1][RJ_m2_col + 2] + a_m0[5]*RJ_m2[2][RJ_m2_col + 2];
-  const Scalar x9 = u_m4[0] - KS_m5[0]*lambda_m6[0] - KS_m5[1]*lambda_m6[1] - KS_m5[2]*lambda_m6[2] + k[4]*x7 - U_m7[0]*x3 - U_m7[1]*x4 - U_m7[2]*x5 - U_m7[3]*x6 - U_m7[5]*x8;
-  qdd_m8[0] = Dinv_m9*x9;
-  a_m10[0] = x3;
-  a_m10[1] = x4;
-  a_m10[2] = x5;
-  a_m10[3] = x6 + k[5]*qdd_m8[0];
-  a_m10[4] = x7;
-  a_m10[5] = x8 + k[6]*qdd_m8[0];
-}
-
-PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_trunk_to_LH_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar qscale = proxgen_rt::largest_magnitude(q[3], q[4], q[5], q[6]);
@@ -1170,16 +1261,6 @@ PROXGEN_RT_NOINLINE void kinematics_trunk_to_LF_hip(const Scalar* PROXGEN_RT_RES
     w.g_LF_hip[1] = w.g_trunk[0]*w.RJ_LF_hip[0][1] + w.g_trunk[1]*w.cq[0] + w.g_trunk[2]*w.RJ_LF_hip[2][1];
     w.g_LF_hip[2] = w.g_trunk[0]*w.RJ_LF_hip[0][2] + w.g_trunk[1]*w.RJ_LF_hip[1][2] + w.g_trunk[2]*w.RJ_LF_hip[2][2];
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_0(shared_0_k0, &q[8], &v[7], &w.sq[1], &w.cq[1], w.v_LF_hip, w.v_LF_thigh, w.c_LF_thigh, w.pA_LF_thigh, w.g_LF_thigh, w.g_LF_hip);
-  // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_1(shared_1_k0, &q[9], &v[8], &w.sq[2], &w.cq[2], w.v_LF_thigh, &w.v_LF_hip[1], w.v_LF_shank, w.c_LF_shank, w.pA_LF_shank, w.g_LF_shank, w.g_LF_thigh, w.k_lf_foot, &w.g_LF_hip[1]);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   {
     proxgen_rt::sincos_joint_called(q[10], w.sq[3], w.cq[3]);
@@ -1191,12 +1272,12 @@ PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_
     w.RJ_LH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq[3];
     w.RJ_LH_hip[2][1] = 0.9950371902099892*w.sq[3];
     w.RJ_LH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq[3];
-    const Scalar t0 = v[0] - 0.049*v[5];
-    const Scalar t1 = v[1] - 0.19*v[5];
-    const Scalar t2 = v[2] + 0.049*v[3] + 0.19*v[4];
-    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t0 + w.RJ_LH_hip[1][0]*t1 + w.RJ_LH_hip[2][0]*t2;
-    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t0 + w.cq[3]*t1 + w.RJ_LH_hip[2][1]*t2;
-    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t0 + w.RJ_LH_hip[1][2]*t1 + w.RJ_LH_hip[2][2]*t2;
+    const Scalar t4 = v[0] - 0.049*v[5];
+    const Scalar t5 = v[1] - 0.19*v[5];
+    const Scalar t6 = v[2] + 0.049*v[3] + 0.19*v[4];
+    w.v_LH_hip[0] = w.RJ_LH_hip[0][0]*t4 + w.RJ_LH_hip[1][0]*t5 + w.RJ_LH_hip[2][0]*t6;
+    w.v_LH_hip[1] = w.RJ_LH_hip[0][1]*t4 + w.cq[3]*t5 + w.RJ_LH_hip[2][1]*t6;
+    w.v_LH_hip[2] = w.RJ_LH_hip[0][2]*t4 + w.RJ_LH_hip[1][2]*t5 + w.RJ_LH_hip[2][2]*t6;
     w.v_LH_hip[3] = 0.9950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][0] + v[4]*w.RJ_LH_hip[1][0] + v[5]*w.RJ_LH_hip[2][0];
     w.v_LH_hip[4] = v[3]*w.RJ_LH_hip[0][1] + v[4]*w.cq[3] + v[5]*w.RJ_LH_hip[2][1];
     w.v_LH_hip[5] = -0.09950371902099892*v[9] + v[3]*w.RJ_LH_hip[0][2] + v[4]*w.RJ_LH_hip[1][2] + v[5]*w.RJ_LH_hip[2][2];
@@ -1206,28 +1287,24 @@ PROXGEN_RT_NOINLINE void kinematics_LH_hip_to_LH_thigh(const Scalar* PROXGEN_RT_
     w.c_LH_hip[3] = -0.09950371902099892*v[9]*w.v_LH_hip[4];
     w.c_LH_hip[4] = 0.9950371902099892*v[9]*w.v_LH_hip[5] + 0.09950371902099892*v[9]*w.v_LH_hip[3];
     w.c_LH_hip[5] = -0.9950371902099892*v[9]*w.v_LH_hip[4];
-    const Scalar h0 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
-    const Scalar h1 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
-    const Scalar h2 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
-    const Scalar h3 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
-    const Scalar h4 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
-    w.pA_LH_hip[0] = w.v_LH_hip[4]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
-    w.pA_LH_hip[1] = w.v_LH_hip[5]*h0 - w.v_LH_hip[3]*h1;
-    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h0;
-    w.pA_LH_hip[3] = w.v_LH_hip[4]*h4 - w.v_LH_hip[5]*h3 + w.v_LH_hip[1]*h1 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
-    w.pA_LH_hip[4] = w.v_LH_hip[5]*h2 - w.v_LH_hip[3]*h4 + w.v_LH_hip[2]*h0 - w.v_LH_hip[0]*h1;
-    w.pA_LH_hip[5] = w.v_LH_hip[3]*h3 - w.v_LH_hip[4]*h2 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h0;
+    const Scalar h5 = 0.5950000000000001*w.v_LH_hip[0] - 0.02164*w.v_LH_hip[5];
+    const Scalar h6 = 0.5950000000000001*w.v_LH_hip[2] + 0.02164*w.v_LH_hip[3];
+    const Scalar h7 = 0.02164*w.v_LH_hip[2] + 0.0012018399999999998*w.v_LH_hip[3] + 5.8e-05*w.v_LH_hip[4] + 4.5e-07*w.v_LH_hip[5];
+    const Scalar h8 = 5.8e-05*w.v_LH_hip[3] + 0.000623*w.v_LH_hip[4] + 9.5e-07*w.v_LH_hip[5];
+    const Scalar h9 = -0.02164*w.v_LH_hip[0] + 4.5e-07*w.v_LH_hip[3] + 9.5e-07*w.v_LH_hip[4] + 0.00126484*w.v_LH_hip[5];
+    w.pA_LH_hip[0] = w.v_LH_hip[4]*h6 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[5];
+    w.pA_LH_hip[1] = w.v_LH_hip[5]*h5 - w.v_LH_hip[3]*h6;
+    w.pA_LH_hip[2] = 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[3] - w.v_LH_hip[4]*h5;
+    w.pA_LH_hip[3] = w.v_LH_hip[4]*h9 - w.v_LH_hip[5]*h8 + w.v_LH_hip[1]*h6 - 0.5950000000000001*w.v_LH_hip[1]*w.v_LH_hip[2];
+    w.pA_LH_hip[4] = w.v_LH_hip[5]*h7 - w.v_LH_hip[3]*h9 + w.v_LH_hip[2]*h5 - w.v_LH_hip[0]*h6;
+    w.pA_LH_hip[5] = w.v_LH_hip[3]*h8 - w.v_LH_hip[4]*h7 + 0.5950000000000001*w.v_LH_hip[0]*w.v_LH_hip[1] - w.v_LH_hip[1]*h5;
     w.g_LH_hip[0] = w.g_trunk[0]*w.RJ_LH_hip[0][0] + w.g_trunk[1]*w.RJ_LH_hip[1][0] + w.g_trunk[2]*w.RJ_LH_hip[2][0];
     w.g_LH_hip[1] = w.g_trunk[0]*w.RJ_LH_hip[0][1] + w.g_trunk[1]*w.cq[3] + w.g_trunk[2]*w.RJ_LH_hip[2][1];
     w.g_LH_hip[2] = w.g_trunk[0]*w.RJ_LH_hip[0][2] + w.g_trunk[1]*w.RJ_LH_hip[1][2] + w.g_trunk[2]*w.RJ_LH_hip[2][2];
   }
-  // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_0(shared_0_k0, &q[11], &v[10], &w.sq[4], &w.cq[4], w.v_LH_hip, w.v_LH_thigh, w.c_LH_thigh, w.pA_LH_thigh, w.g_LH_thigh, w.g_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_1(shared_1_k0, &q[12], &v[11], &w.sq[5], &w.cq[5], w.v_LH_thigh, &w.v_LH_hip[1], w.v_LH_shank, w.c_LH_shank, w.pA_LH_shank, w.g_LH_shank, w.g_LH_thigh, w.k_lh_foot, &w.g_LH_hip[1]);
+PROXGEN_RT_NOINLINE void kinematics_RF_hip_to_RH_hip(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   {
     proxgen_rt::sincos_joint_called(q[13], w.sq[6], w.cq[6]);
@@ -1239,12 +1316,12 @@ PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_
     w.RJ_RF_hip[2][0] = 0.09900990099009904 - 0.09900990099009904*w.cq[6];
     w.RJ_RF_hip[2][1] = 0.9950371902099893*w.sq[6];
     w.RJ_RF_hip[2][2] = 0.009900990099009905 + 0.9900990099009901*w.cq[6];
-    const Scalar t5 = v[0] + 0.049*v[5];
-    const Scalar t6 = v[1] + 0.19*v[5];
-    const Scalar t7 = v[2] - 0.049*v[3] - 0.19*v[4];
-    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t5 + w.RJ_RF_hip[1][0]*t6 + w.RJ_RF_hip[2][0]*t7;
-    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t5 + w.cq[6]*t6 + w.RJ_RF_hip[2][1]*t7;
-    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t5 + w.RJ_RF_hip[1][2]*t6 + w.RJ_RF_hip[2][2]*t7;
+    const Scalar t0 = v[0] + 0.049*v[5];
+    const Scalar t1 = v[1] + 0.19*v[5];
+    const Scalar t2 = v[2] - 0.049*v[3] - 0.19*v[4];
+    w.v_RF_hip[0] = w.RJ_RF_hip[0][0]*t0 + w.RJ_RF_hip[1][0]*t1 + w.RJ_RF_hip[2][0]*t2;
+    w.v_RF_hip[1] = w.RJ_RF_hip[0][1]*t0 + w.cq[6]*t1 + w.RJ_RF_hip[2][1]*t2;
+    w.v_RF_hip[2] = w.RJ_RF_hip[0][2]*t0 + w.RJ_RF_hip[1][2]*t1 + w.RJ_RF_hip[2][2]*t2;
     w.v_RF_hip[3] = 0.9950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][0] + v[4]*w.RJ_RF_hip[1][0] + v[5]*w.RJ_RF_hip[2][0];
     w.v_RF_hip[4] = v[3]*w.RJ_RF_hip[0][1] + v[4]*w.cq[6] + v[5]*w.RJ_RF_hip[2][1];
     w.v_RF_hip[5] = 0.09950371902099893*v[12] + v[3]*w.RJ_RF_hip[0][2] + v[4]*w.RJ_RF_hip[1][2] + v[5]*w.RJ_RF_hip[2][2];
@@ -1254,31 +1331,21 @@ PROXGEN_RT_NOINLINE void kinematics_LH_shank_to_RF_hip(const Scalar* PROXGEN_RT_
     w.c_RF_hip[3] = 0.09950371902099893*v[12]*w.v_RF_hip[4];
     w.c_RF_hip[4] = 0.9950371902099893*v[12]*w.v_RF_hip[5] - 0.09950371902099893*v[12]*w.v_RF_hip[3];
     w.c_RF_hip[5] = -0.9950371902099893*v[12]*w.v_RF_hip[4];
-    const Scalar h4 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
-    const Scalar h5 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
-    const Scalar h6 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
-    const Scalar h7 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
-    const Scalar h8 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
-    w.pA_RF_hip[0] = w.v_RF_hip[4]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
-    w.pA_RF_hip[1] = w.v_RF_hip[5]*h4 - w.v_RF_hip[3]*h5;
-    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h4;
-    w.pA_RF_hip[3] = w.v_RF_hip[4]*h8 - w.v_RF_hip[5]*h7 + w.v_RF_hip[1]*h5 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
-    w.pA_RF_hip[4] = w.v_RF_hip[5]*h6 - w.v_RF_hip[3]*h8 + w.v_RF_hip[2]*h4 - w.v_RF_hip[0]*h5;
-    w.pA_RF_hip[5] = w.v_RF_hip[3]*h7 - w.v_RF_hip[4]*h6 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h4;
+    const Scalar h0 = 0.5950000000000001*w.v_RF_hip[0] + 0.02164*w.v_RF_hip[5];
+    const Scalar h1 = 0.5950000000000001*w.v_RF_hip[2] - 0.02164*w.v_RF_hip[3];
+    const Scalar h2 = -0.02164*w.v_RF_hip[2] + 0.0012018399999999998*w.v_RF_hip[3] - 5.8e-05*w.v_RF_hip[4] + 4.5e-07*w.v_RF_hip[5];
+    const Scalar h3 = -5.8e-05*w.v_RF_hip[3] + 0.000623*w.v_RF_hip[4] - 9.5e-07*w.v_RF_hip[5];
+    const Scalar h4 = 0.02164*w.v_RF_hip[0] + 4.5e-07*w.v_RF_hip[3] - 9.5e-07*w.v_RF_hip[4] + 0.00126484*w.v_RF_hip[5];
+    w.pA_RF_hip[0] = w.v_RF_hip[4]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[5];
+    w.pA_RF_hip[1] = w.v_RF_hip[5]*h0 - w.v_RF_hip[3]*h1;
+    w.pA_RF_hip[2] = 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[3] - w.v_RF_hip[4]*h0;
+    w.pA_RF_hip[3] = w.v_RF_hip[4]*h4 - w.v_RF_hip[5]*h3 + w.v_RF_hip[1]*h1 - 0.5950000000000001*w.v_RF_hip[1]*w.v_RF_hip[2];
+    w.pA_RF_hip[4] = w.v_RF_hip[5]*h2 - w.v_RF_hip[3]*h4 + w.v_RF_hip[2]*h0 - w.v_RF_hip[0]*h1;
+    w.pA_RF_hip[5] = w.v_RF_hip[3]*h3 - w.v_RF_hip[4]*h2 + 0.5950000000000001*w.v_RF_hip[0]*w.v_RF_hip[1] - w.v_RF_hip[1]*h0;
     w.g_RF_hip[0] = w.g_trunk[0]*w.RJ_RF_hip[0][0] + w.g_trunk[1]*w.RJ_RF_hip[1][0] + w.g_trunk[2]*w.RJ_RF_hip[2][0];
     w.g_RF_hip[1] = w.g_trunk[0]*w.RJ_RF_hip[0][1] + w.g_trunk[1]*w.cq[6] + w.g_trunk[2]*w.RJ_RF_hip[2][1];
     w.g_RF_hip[2] = w.g_trunk[0]*w.RJ_RF_hip[0][2] + w.g_trunk[1]*w.RJ_RF_hip[1][2] + w.g_trunk[2]*w.RJ_RF_hip[2][2];
   }
-}
-
-PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_0(shared_0_k1, &q[14], &v[13], &w.sq[7], &w.cq[7], w.v_RF_hip, w.v_RF_thigh, w.c_RF_thigh, w.pA_RF_thigh, w.g_RF_thigh, w.g_RF_hip);
-  // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_1(shared_1_k1, &q[15], &v[14], &w.sq[8], &w.cq[8], w.v_RF_thigh, &w.v_RF_hip[1], w.v_RF_shank, w.c_RF_shank, w.pA_RF_shank, w.g_RF_shank, w.g_RF_thigh, w.k_rf_foot, &w.g_RF_hip[1]);
-}
-
-PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     proxgen_rt::sincos_joint_called(q[16], w.sq[9], w.cq[9]);
@@ -1290,12 +1357,12 @@ PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_
     w.RJ_RH_hip[2][0] = -0.09900990099009901 + 0.09900990099009901*w.cq[9];
     w.RJ_RH_hip[2][1] = 0.9950371902099892*w.sq[9];
     w.RJ_RH_hip[2][2] = 0.009900990099009901 + 0.9900990099009901*w.cq[9];
-    const Scalar t0 = v[0] + 0.049*v[5];
-    const Scalar t1 = v[1] - 0.19*v[5];
-    const Scalar t2 = v[2] - 0.049*v[3] + 0.19*v[4];
-    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t0 + w.RJ_RH_hip[1][0]*t1 + w.RJ_RH_hip[2][0]*t2;
-    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t0 + w.cq[9]*t1 + w.RJ_RH_hip[2][1]*t2;
-    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t0 + w.RJ_RH_hip[1][2]*t1 + w.RJ_RH_hip[2][2]*t2;
+    const Scalar t3 = v[0] + 0.049*v[5];
+    const Scalar t4 = v[1] - 0.19*v[5];
+    const Scalar t5 = v[2] - 0.049*v[3] + 0.19*v[4];
+    w.v_RH_hip[0] = w.RJ_RH_hip[0][0]*t3 + w.RJ_RH_hip[1][0]*t4 + w.RJ_RH_hip[2][0]*t5;
+    w.v_RH_hip[1] = w.RJ_RH_hip[0][1]*t3 + w.cq[9]*t4 + w.RJ_RH_hip[2][1]*t5;
+    w.v_RH_hip[2] = w.RJ_RH_hip[0][2]*t3 + w.RJ_RH_hip[1][2]*t4 + w.RJ_RH_hip[2][2]*t5;
     w.v_RH_hip[3] = 0.9950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][0] + v[4]*w.RJ_RH_hip[1][0] + v[5]*w.RJ_RH_hip[2][0];
     w.v_RH_hip[4] = v[3]*w.RJ_RH_hip[0][1] + v[4]*w.cq[9] + v[5]*w.RJ_RH_hip[2][1];
     w.v_RH_hip[5] = -0.09950371902099892*v[15] + v[3]*w.RJ_RH_hip[0][2] + v[4]*w.RJ_RH_hip[1][2] + v[5]*w.RJ_RH_hip[2][2];
@@ -1305,41 +1372,72 @@ PROXGEN_RT_NOINLINE void kinematics_RH_hip_to_RH_thigh(const Scalar* PROXGEN_RT_
     w.c_RH_hip[3] = -0.09950371902099892*v[15]*w.v_RH_hip[4];
     w.c_RH_hip[4] = 0.9950371902099892*v[15]*w.v_RH_hip[5] + 0.09950371902099892*v[15]*w.v_RH_hip[3];
     w.c_RH_hip[5] = -0.9950371902099892*v[15]*w.v_RH_hip[4];
-    const Scalar h0 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
-    const Scalar h1 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
-    const Scalar h2 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
-    const Scalar h3 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
-    const Scalar h4 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
-    w.pA_RH_hip[0] = w.v_RH_hip[4]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
-    w.pA_RH_hip[1] = w.v_RH_hip[5]*h0 - w.v_RH_hip[3]*h1;
-    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h0;
-    w.pA_RH_hip[3] = w.v_RH_hip[4]*h4 - w.v_RH_hip[5]*h3 + w.v_RH_hip[1]*h1 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
-    w.pA_RH_hip[4] = w.v_RH_hip[5]*h2 - w.v_RH_hip[3]*h4 + w.v_RH_hip[2]*h0 - w.v_RH_hip[0]*h1;
-    w.pA_RH_hip[5] = w.v_RH_hip[3]*h3 - w.v_RH_hip[4]*h2 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h0;
+    const Scalar h5 = 0.5950000000000001*w.v_RH_hip[0] + 0.02164*w.v_RH_hip[5];
+    const Scalar h6 = 0.5950000000000001*w.v_RH_hip[2] - 0.02164*w.v_RH_hip[3];
+    const Scalar h7 = -0.02164*w.v_RH_hip[2] + 0.0012018399999999998*w.v_RH_hip[3] - 5.8e-05*w.v_RH_hip[4] + 4.5e-07*w.v_RH_hip[5];
+    const Scalar h8 = -5.8e-05*w.v_RH_hip[3] + 0.000623*w.v_RH_hip[4] - 9.5e-07*w.v_RH_hip[5];
+    const Scalar h9 = 0.02164*w.v_RH_hip[0] + 4.5e-07*w.v_RH_hip[3] - 9.5e-07*w.v_RH_hip[4] + 0.00126484*w.v_RH_hip[5];
+    w.pA_RH_hip[0] = w.v_RH_hip[4]*h6 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[5];
+    w.pA_RH_hip[1] = w.v_RH_hip[5]*h5 - w.v_RH_hip[3]*h6;
+    w.pA_RH_hip[2] = 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[3] - w.v_RH_hip[4]*h5;
+    w.pA_RH_hip[3] = w.v_RH_hip[4]*h9 - w.v_RH_hip[5]*h8 + w.v_RH_hip[1]*h6 - 0.5950000000000001*w.v_RH_hip[1]*w.v_RH_hip[2];
+    w.pA_RH_hip[4] = w.v_RH_hip[5]*h7 - w.v_RH_hip[3]*h9 + w.v_RH_hip[2]*h5 - w.v_RH_hip[0]*h6;
+    w.pA_RH_hip[5] = w.v_RH_hip[3]*h8 - w.v_RH_hip[4]*h7 + 0.5950000000000001*w.v_RH_hip[0]*w.v_RH_hip[1] - w.v_RH_hip[1]*h5;
     w.g_RH_hip[0] = w.g_trunk[0]*w.RJ_RH_hip[0][0] + w.g_trunk[1]*w.RJ_RH_hip[1][0] + w.g_trunk[2]*w.RJ_RH_hip[2][0];
     w.g_RH_hip[1] = w.g_trunk[0]*w.RJ_RH_hip[0][1] + w.g_trunk[1]*w.cq[9] + w.g_trunk[2]*w.RJ_RH_hip[2][1];
     w.g_RH_hip[2] = w.g_trunk[0]*w.RJ_RH_hip[0][2] + w.g_trunk[1]*w.RJ_RH_hip[1][2] + w.g_trunk[2]*w.RJ_RH_hip[2][2];
   }
+}
+
+PROXGEN_RT_NOINLINE void kinematics_LF_thigh_to_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  // body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  shared_0_x2(shared_0_p0, &q[8], &q[11], &v[7], &v[10], &w.sq[1], &w.sq[4], &w.cq[1], &w.cq[4], w.v_LF_hip, w.v_LH_hip, w.v_LF_thigh, w.v_LH_thigh, w.c_LF_thigh, w.c_LH_thigh, w.pA_LF_thigh, w.pA_LH_thigh, w.g_LF_thigh, w.g_LH_thigh, w.g_LF_hip, w.g_LH_hip);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RF_thigh_to_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   // body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_0(shared_0_k1, &q[17], &v[16], &w.sq[10], &w.cq[10], w.v_RH_hip, w.v_RH_thigh, w.c_RH_thigh, w.pA_RH_thigh, w.g_RH_thigh, w.g_RH_hip);
+  shared_0_x2(shared_0_p1, &q[14], &q[17], &v[13], &v[16], &w.sq[7], &w.sq[10], &w.cq[7], &w.cq[10], w.v_RF_hip, w.v_RH_hip, w.v_RF_thigh, w.v_RH_thigh, w.c_RF_thigh, w.c_RH_thigh, w.pA_RF_thigh, w.pA_RH_thigh, w.g_RF_thigh, w.g_RH_thigh, w.g_RF_hip, w.g_RH_hip);
 }
 
-PROXGEN_RT_NOINLINE void kinematics_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void kinematics_LF_shank_to_LH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  // body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_1_x2(shared_1_p0, &q[9], &q[12], &v[8], &v[11], &w.sq[2], &w.sq[5], &w.cq[2], &w.cq[5], w.v_LF_thigh, w.v_LH_thigh, &w.v_LF_hip[1], &w.v_LH_hip[1], w.v_LF_shank, w.v_LH_shank, w.c_LF_shank, w.c_LH_shank, w.pA_LF_shank, w.pA_LH_shank, w.g_LF_shank, w.g_LH_shank, w.g_LF_thigh, w.g_LH_thigh, w.k_lf_foot, w.k_lh_foot, &w.g_LF_hip[1], &w.g_LH_hip[1]);
+}
+
+PROXGEN_RT_NOINLINE void kinematics_RF_shank_to_RH_shank(const Scalar* PROXGEN_RT_RESTRICT q, const Scalar* PROXGEN_RT_RESTRICT v, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   // body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_1(shared_1_k1, &q[18], &v[17], &w.sq[11], &w.cq[11], w.v_RH_thigh, &w.v_RH_hip[1], w.v_RH_shank, w.c_RH_shank, w.pA_RH_shank, w.g_RH_shank, w.g_RH_thigh, w.k_rh_foot, &w.g_RH_hip[1]);
+  shared_1_x2(shared_1_p1, &q[15], &q[18], &v[14], &v[17], &w.sq[8], &w.sq[11], &w.cq[8], &w.cq[11], w.v_RF_thigh, w.v_RH_thigh, &w.v_RF_hip[1], &w.v_RH_hip[1], w.v_RF_shank, w.v_RH_shank, w.c_RF_shank, w.c_RH_shank, w.pA_RF_shank, w.pA_RH_shank, w.g_RF_shank, w.g_RH_shank, w.g_RF_thigh, w.g_RH_thigh, w.k_rf_foot, w.k_rh_foot, &w.g_RF_hip[1], &w.g_RH_hip[1]);
 }
 
-PROXGEN_RT_NOINLINE void caba_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_RH_shank_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_2(shared_2_k0, &tau[17], mu, &w.active[3], w.k_rh_foot, w.U_RH_shank, &w.Dinv_RH_shank, w.u_RH_shank, w.pA_RH_shank, &w.lambda[9], w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh);
+  // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  shared_2_x2(shared_2_p0, &tau[17], &tau[14], mu, &w.active[3], &w.active[1], w.k_rh_foot, w.k_rf_foot, w.U_RH_shank, w.U_RF_shank, &w.Dinv_RH_shank, &w.Dinv_RF_shank, w.u_RH_shank, w.u_RF_shank, w.pA_RH_shank, w.pA_RF_shank, &w.lambda[9], &w.lambda[3], w.c_RH_shank, w.c_RF_shank, &w.cq[11], &w.cq[8], &w.sq[11], &w.sq[8], w.IA_RH_thigh, w.IA_RF_thigh, w.pA_RH_thigh, w.pA_RF_thigh);
 }
 
-PROXGEN_RT_NOINLINE void caba_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_shank_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  shared_2_x2(shared_2_p1, &tau[11], &tau[8], mu, &w.active[2], w.active, w.k_lh_foot, w.k_lf_foot, w.U_LH_shank, w.U_LF_shank, &w.Dinv_LH_shank, &w.Dinv_LF_shank, w.u_LH_shank, w.u_LF_shank, w.pA_LH_shank, w.pA_LF_shank, &w.lambda[6], w.lambda, w.c_LH_shank, w.c_LF_shank, &w.cq[5], &w.cq[2], &w.sq[5], &w.sq[2], w.IA_LH_thigh, w.IA_LF_thigh, w.pA_LH_thigh, w.pA_LF_thigh);
+}
+
+PROXGEN_RT_NOINLINE void caba_backward_RH_thigh_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_3(shared_3_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip);
+  // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  shared_3_x2(shared_3_p0, &tau[16], &tau[13], &w.Dinv_RH_thigh, &w.Dinv_RF_thigh, w.IA_RH_thigh, w.IA_RF_thigh, w.u_RH_thigh, w.u_RF_thigh, w.pA_RH_thigh, w.pA_RF_thigh, w.c_RH_thigh, w.c_RF_thigh, &w.cq[10], &w.cq[7], &w.sq[10], &w.sq[7], w.IA_RH_hip, w.IA_RF_hip, w.pA_RH_hip, w.pA_RF_hip);
 }
 
-PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_thigh_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  shared_3_x2(shared_3_p1, &tau[10], &tau[7], &w.Dinv_LH_thigh, &w.Dinv_LF_thigh, w.IA_LH_thigh, w.IA_LF_thigh, w.u_LH_thigh, w.u_LF_thigh, w.pA_LH_thigh, w.pA_LF_thigh, w.c_LH_thigh, w.c_LF_thigh, &w.cq[4], &w.cq[1], &w.sq[4], &w.sq[1], w.IA_LH_hip, w.IA_LF_hip, w.pA_LH_hip, w.pA_LF_hip);
+}
+
+PROXGEN_RT_NOINLINE void caba_backward_RH_hip_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -1464,49 +1562,13 @@ PROXGEN_RT_NOINLINE void caba_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT 
     w.pA_trunk[4] = w.pA_trunk[4] + w.RJ_RH_hip[1][0]*pa3 + w.cq[9]*pa4 + w.RJ_RH_hip[1][2]*pa5 + 0.19*t63;
     w.pA_trunk[5] = w.pA_trunk[5] + w.RJ_RH_hip[2][0]*pa3 + w.RJ_RH_hip[2][1]*pa4 + w.RJ_RH_hip[2][2]*pa5 + 0.049*t61 - 0.19*t62;
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_2(shared_2_k0, &tau[14], mu, &w.active[1], w.k_rf_foot, w.U_RF_shank, &w.Dinv_RF_shank, w.u_RF_shank, w.pA_RF_shank, &w.lambda[3], w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_3(shared_3_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_4(shared_4_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk);
 }
 
-PROXGEN_RT_NOINLINE void caba_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_2(shared_2_k1, &tau[11], mu, &w.active[2], w.k_lh_foot, w.U_LH_shank, &w.Dinv_LH_shank, w.u_LH_shank, w.pA_LH_shank, &w.lambda[6], w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_3(shared_3_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_backward_LH_hip_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_4(shared_4_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_2(shared_2_k1, &tau[8], mu, w.active, w.k_lf_foot, w.U_LF_shank, &w.Dinv_LF_shank, w.u_LF_shank, w.pA_LF_shank, w.lambda, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate (penalty at the constraints): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_3(shared_3_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate (penalty at the constraints): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   shared_4(shared_4_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk);
 }
@@ -1571,45 +1633,36 @@ PROXGEN_RT_NOINLINE void caba_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT t
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_trunk_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   shared_5(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_6(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_7(shared_7_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
-  // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_8(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_6_x2(shared_6_p0, w.a_trunk, w.a_trunk, w.c_LF_hip, w.c_LH_hip, w.RJ_LF_hip, w.RJ_LH_hip, 0, 0, w.cq, &w.cq[3], w.u_LF_hip, w.u_LH_hip, w.U_LF_hip, w.U_LH_hip, &w.qdd[6], &w.qdd[9], w.Dinv_LF_hip, w.Dinv_LH_hip, w.a_LF_hip, w.a_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_7(shared_7_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
-  // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_8(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+PROXGEN_RT_NOINLINE void caba_forward_RF_hip_to_LH_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_7(shared_7_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
-  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_8(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_7_x2(shared_7_p0, w.a_trunk, w.a_trunk, w.c_RF_hip, w.c_RH_hip, w.RJ_RF_hip, w.RJ_RH_hip, 0, 0, &w.cq[6], &w.cq[9], w.u_RF_hip, w.u_RH_hip, w.U_RF_hip, w.U_RH_hip, &w.qdd[12], &w.qdd[15], w.Dinv_RF_hip, w.Dinv_RH_hip, w.a_RF_hip, w.a_RH_hip);
+  // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  shared_8_x2(shared_8_p0, w.a_LF_hip, w.a_LH_hip, w.c_LF_thigh, w.c_LH_thigh, &w.cq[1], &w.cq[4], &w.sq[1], &w.sq[4], w.u_LF_thigh, w.u_LH_thigh, &w.IA_LF_thigh[4], &w.IA_LH_thigh[4], &w.qdd[7], &w.qdd[10], w.Dinv_LF_thigh, w.Dinv_LH_thigh, w.a_LF_thigh, w.a_LH_thigh);
 }
 
-PROXGEN_RT_NOINLINE void caba_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_forward_RF_thigh_to_LH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_7(shared_7_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_8_x2(shared_8_p1, w.a_RF_hip, w.a_RH_hip, w.c_RF_thigh, w.c_RH_thigh, &w.cq[7], &w.cq[10], &w.sq[7], &w.sq[10], w.u_RF_thigh, w.u_RH_thigh, &w.IA_RF_thigh[4], &w.IA_RH_thigh[4], &w.qdd[13], &w.qdd[16], w.Dinv_RF_thigh, w.Dinv_RH_thigh, w.a_RF_thigh, w.a_RH_thigh);
+  // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_9_x2(shared_9_p0, w.a_LF_thigh, w.a_LH_thigh, w.c_LF_shank, w.c_LH_shank, &w.cq[2], &w.cq[5], &w.sq[2], &w.sq[5], w.u_LF_shank, w.u_LH_shank, w.U_LF_shank, w.U_LH_shank, &w.qdd[8], &w.qdd[11], w.Dinv_LF_shank, w.Dinv_LH_shank, w.a_LF_shank, w.a_LH_shank);
+}
+
+PROXGEN_RT_NOINLINE void caba_forward_RF_shank_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_8(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_9_x2(shared_9_p0, w.a_RF_thigh, w.a_RH_thigh, w.c_RF_shank, w.c_RH_shank, &w.cq[8], &w.cq[11], &w.sq[8], &w.sq[11], w.u_RF_shank, w.u_RH_shank, w.U_RF_shank, w.U_RH_shank, &w.qdd[14], &w.qdd[17], w.Dinv_RF_shank, w.Dinv_RH_shank, w.a_RF_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1617,57 +1670,50 @@ PROXGEN_RT_NOINLINE void caba_multipliers(Scalar mu, Workspace& PROXGEN_RT_RESTR
   shared_10(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
-PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reduced_RH_shank_to_LF_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_11(shared_11_k0, w.u_RH_shank, &w.dlambda[9], w.Dinv_RH_shank, w.U_RH_shank, &w.cq[11], &w.sq[11], w.dp_RH_thigh);
+  // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  shared_11_x2(shared_11_p0, w.u_RH_shank, w.u_RF_shank, &w.dlambda[9], &w.dlambda[3], w.Dinv_RH_shank, w.Dinv_RF_shank, w.U_RH_shank, w.U_RF_shank, &w.cq[11], &w.cq[8], &w.sq[11], &w.sq[8], w.dp_RH_thigh, w.dp_RF_thigh);
+  // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  shared_11_x2(shared_11_p1, w.u_LH_shank, w.u_LF_shank, &w.dlambda[6], w.dlambda, w.Dinv_LH_shank, w.Dinv_LF_shank, w.U_LH_shank, w.U_LF_shank, &w.cq[5], &w.cq[2], &w.sq[5], &w.sq[2], w.dp_LH_thigh, w.dp_LF_thigh);
+}
+
+PROXGEN_RT_NOINLINE void caba_reduced_RH_thigh_to_LF_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_12(shared_12_k0, w.u_RH_thigh, w.dp_RH_thigh, w.Dinv_RH_thigh, &w.IA_RH_thigh[4], &w.cq[10], &w.sq[10], w.dp_RH_hip);
+  // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  shared_12_x2(shared_12_p0, w.u_RH_thigh, w.u_RF_thigh, w.dp_RH_thigh, w.dp_RF_thigh, w.Dinv_RH_thigh, w.Dinv_RF_thigh, &w.IA_RH_thigh[4], &w.IA_RF_thigh[4], &w.cq[10], &w.cq[7], &w.sq[10], &w.sq[7], w.dp_RH_hip, w.dp_RF_hip);
+  // reduced sweep: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  shared_12_x2(shared_12_p1, w.u_LH_thigh, w.u_LF_thigh, w.dp_LH_thigh, w.dp_LF_thigh, w.Dinv_LH_thigh, w.Dinv_LF_thigh, &w.IA_LH_thigh[4], &w.IA_LF_thigh[4], &w.cq[4], &w.cq[1], &w.sq[4], &w.sq[1], w.dp_LH_hip, w.dp_LF_hip);
+}
+
+PROXGEN_RT_NOINLINE void caba_reduced_RH_hip_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // reduced sweep: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     const Scalar du0 = -0.9950371902099892*w.dp_RH_hip[3] + 0.09950371902099892*w.dp_RH_hip[5];
     w.u_RH_hip[0] = w.u_RH_hip[0] + du0;
-    const Scalar t13 = w.Dinv_RH_hip*du0;
-    const Scalar t14 = w.dp_RH_hip[0] + w.U_RH_hip[0]*t13;
-    const Scalar t15 = w.dp_RH_hip[1] + w.U_RH_hip[1]*t13;
-    const Scalar t16 = w.dp_RH_hip[2] + w.U_RH_hip[2]*t13;
-    const Scalar t17 = w.dp_RH_hip[3] + w.U_RH_hip[3]*t13;
-    const Scalar t18 = w.dp_RH_hip[5] + w.U_RH_hip[5]*t13;
-    const Scalar t19 = -5.7617628499109426e-05*w.Dinv_RH_hip*du0;
-    const Scalar t20 = w.RJ_RH_hip[0][0]*t14 + w.RJ_RH_hip[0][1]*t15 + w.RJ_RH_hip[0][2]*t16;
-    const Scalar t21 = w.RJ_RH_hip[1][0]*t14 + w.cq[9]*t15 + w.RJ_RH_hip[1][2]*t16;
-    const Scalar t22 = w.RJ_RH_hip[2][0]*t14 + w.RJ_RH_hip[2][1]*t15 + w.RJ_RH_hip[2][2]*t16;
-    w.dp_trunk[0] = t20;
-    w.dp_trunk[1] = t21;
-    w.dp_trunk[2] = t22;
-    w.dp_trunk[3] = w.RJ_RH_hip[0][0]*t17 + w.RJ_RH_hip[0][1]*t19 + w.RJ_RH_hip[0][2]*t18 - 0.049*t22;
-    w.dp_trunk[4] = w.RJ_RH_hip[1][0]*t17 + w.cq[9]*t19 + w.RJ_RH_hip[1][2]*t18 + 0.19*t22;
-    w.dp_trunk[5] = w.RJ_RH_hip[2][0]*t17 + w.RJ_RH_hip[2][1]*t19 + w.RJ_RH_hip[2][2]*t18 + 0.049*t20 - 0.19*t21;
+    const Scalar t0 = w.Dinv_RH_hip*du0;
+    const Scalar t1 = w.dp_RH_hip[0] + w.U_RH_hip[0]*t0;
+    const Scalar t2 = w.dp_RH_hip[1] + w.U_RH_hip[1]*t0;
+    const Scalar t3 = w.dp_RH_hip[2] + w.U_RH_hip[2]*t0;
+    const Scalar t4 = w.dp_RH_hip[3] + w.U_RH_hip[3]*t0;
+    const Scalar t5 = w.dp_RH_hip[5] + w.U_RH_hip[5]*t0;
+    const Scalar t6 = -5.7617628499109426e-05*w.Dinv_RH_hip*du0;
+    const Scalar t7 = w.RJ_RH_hip[0][0]*t1 + w.RJ_RH_hip[0][1]*t2 + w.RJ_RH_hip[0][2]*t3;
+    const Scalar t8 = w.RJ_RH_hip[1][0]*t1 + w.cq[9]*t2 + w.RJ_RH_hip[1][2]*t3;
+    const Scalar t9 = w.RJ_RH_hip[2][0]*t1 + w.RJ_RH_hip[2][1]*t2 + w.RJ_RH_hip[2][2]*t3;
+    w.dp_trunk[0] = t7;
+    w.dp_trunk[1] = t8;
+    w.dp_trunk[2] = t9;
+    w.dp_trunk[3] = w.RJ_RH_hip[0][0]*t4 + w.RJ_RH_hip[0][1]*t6 + w.RJ_RH_hip[0][2]*t5 - 0.049*t9;
+    w.dp_trunk[4] = w.RJ_RH_hip[1][0]*t4 + w.cq[9]*t6 + w.RJ_RH_hip[1][2]*t5 + 0.19*t9;
+    w.dp_trunk[5] = w.RJ_RH_hip[2][0]*t4 + w.RJ_RH_hip[2][1]*t6 + w.RJ_RH_hip[2][2]*t5 + 0.049*t7 - 0.19*t8;
   }
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_RF_shank_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_11(shared_11_k0, w.u_RF_shank, &w.dlambda[3], w.Dinv_RF_shank, w.U_RF_shank, &w.cq[8], &w.sq[8], w.dp_RF_thigh);
-  // reduced sweep: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_12(shared_12_k0, w.u_RF_thigh, w.dp_RF_thigh, w.Dinv_RF_thigh, &w.IA_RF_thigh[4], &w.cq[7], &w.sq[7], w.dp_RF_hip);
   // reduced sweep: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k0, w.dp_RF_hip, w.u_RF_hip, w.Dinv_RF_hip, w.U_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.dp_trunk);
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_LH_shank_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_11(shared_11_k1, w.u_LH_shank, &w.dlambda[6], w.Dinv_LH_shank, w.U_LH_shank, &w.cq[5], &w.sq[5], w.dp_LH_thigh);
-  // reduced sweep: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_12(shared_12_k1, w.u_LH_thigh, w.dp_LH_thigh, w.Dinv_LH_thigh, &w.IA_LH_thigh[4], &w.cq[4], &w.sq[4], w.dp_LH_hip);
   // reduced sweep: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k1, w.dp_LH_hip, w.u_LH_hip, w.Dinv_LH_hip, w.U_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.dp_trunk);
-}
-
-PROXGEN_RT_NOINLINE void caba_reduced_LF_shank_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // reduced sweep: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_11(shared_11_k1, w.u_LF_shank, w.dlambda, w.Dinv_LF_shank, w.U_LF_shank, &w.cq[2], &w.sq[2], w.dp_LF_thigh);
-  // reduced sweep: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_12(shared_12_k1, w.u_LF_thigh, w.dp_LF_thigh, w.Dinv_LF_thigh, &w.IA_LF_thigh[4], &w.cq[1], &w.sq[1], w.dp_LF_hip);
   // reduced sweep: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   shared_13(shared_13_k2, w.dp_LF_hip, w.u_LF_hip, w.Dinv_LF_hip, w.U_LF_hip, w.RJ_LF_hip, 0, w.cq, w.dp_trunk);
 }
@@ -1684,45 +1730,36 @@ PROXGEN_RT_NOINLINE void caba_reduced_trunk(Workspace& PROXGEN_RT_RESTRICT w) no
   }
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_trunk_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   shared_5(w.u_trunk, w.RJ_trunk, 0, w.IA_trunk, w.Linv_trunk, &w.L_trunk[1], w.qdd, w.a_trunk);
   // accelerate body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_6(w.a_trunk, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.u_LF_hip, w.U_LF_hip, &w.qdd[6], w.Dinv_LF_hip, w.a_LF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_7(shared_7_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
-  // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_8(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.U_LF_shank, &w.qdd[8], w.Dinv_LF_shank, w.a_LF_shank);
   // accelerate body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_6_x2(shared_6_p0, w.a_trunk, w.a_trunk, w.c_LF_hip, w.c_LH_hip, w.RJ_LF_hip, w.RJ_LH_hip, 0, 0, w.cq, &w.cq[3], w.u_LF_hip, w.u_LH_hip, w.U_LF_hip, w.U_LH_hip, &w.qdd[6], &w.qdd[9], w.Dinv_LF_hip, w.Dinv_LH_hip, w.a_LF_hip, w.a_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_7(shared_7_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
-  // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_8(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.U_LH_shank, &w.qdd[11], w.Dinv_LH_shank, w.a_LH_shank);
+PROXGEN_RT_NOINLINE void caba_reforward_RF_hip_to_LH_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
-}
-
-PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_7(shared_7_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
-  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_8(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.U_RF_shank, &w.qdd[14], w.Dinv_RF_shank, w.a_RF_shank);
   // accelerate body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_9(shared_9_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_7_x2(shared_7_p0, w.a_trunk, w.a_trunk, w.c_RF_hip, w.c_RH_hip, w.RJ_RF_hip, w.RJ_RH_hip, 0, 0, &w.cq[6], &w.cq[9], w.u_RF_hip, w.u_RH_hip, w.U_RF_hip, w.U_RH_hip, &w.qdd[12], &w.qdd[15], w.Dinv_RF_hip, w.Dinv_RH_hip, w.a_RF_hip, w.a_RH_hip);
+  // accelerate body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  // accelerate body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  shared_8_x2(shared_8_p0, w.a_LF_hip, w.a_LH_hip, w.c_LF_thigh, w.c_LH_thigh, &w.cq[1], &w.cq[4], &w.sq[1], &w.sq[4], w.u_LF_thigh, w.u_LH_thigh, &w.IA_LF_thigh[4], &w.IA_LH_thigh[4], &w.qdd[7], &w.qdd[10], w.Dinv_LF_thigh, w.Dinv_LH_thigh, w.a_LF_thigh, w.a_LH_thigh);
 }
 
-PROXGEN_RT_NOINLINE void caba_reforward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void caba_reforward_RF_thigh_to_LH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   // accelerate body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_7(shared_7_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_8_x2(shared_8_p1, w.a_RF_hip, w.a_RH_hip, w.c_RF_thigh, w.c_RH_thigh, &w.cq[7], &w.cq[10], &w.sq[7], &w.sq[10], w.u_RF_thigh, w.u_RH_thigh, &w.IA_RF_thigh[4], &w.IA_RH_thigh[4], &w.qdd[13], &w.qdd[16], w.Dinv_RF_thigh, w.Dinv_RH_thigh, w.a_RF_thigh, w.a_RH_thigh);
+  // accelerate body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  // accelerate body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_9_x2(shared_9_p0, w.a_LF_thigh, w.a_LH_thigh, w.c_LF_shank, w.c_LH_shank, &w.cq[2], &w.cq[5], &w.sq[2], &w.sq[5], w.u_LF_shank, w.u_LH_shank, w.U_LF_shank, w.U_LH_shank, &w.qdd[8], &w.qdd[11], w.Dinv_LF_shank, w.Dinv_LH_shank, w.a_LF_shank, w.a_LH_shank);
+}
+
+PROXGEN_RT_NOINLINE void caba_reforward_RF_shank_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   // accelerate body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_8(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.U_RH_shank, &w.qdd[17], w.Dinv_RH_shank, w.a_RH_shank);
+  shared_9_x2(shared_9_p0, w.a_RF_thigh, w.a_RH_thigh, w.c_RF_shank, w.c_RH_shank, &w.cq[8], &w.cq[11], &w.sq[8], &w.sq[11], w.u_RF_shank, w.u_RH_shank, w.U_RF_shank, w.U_RH_shank, &w.qdd[14], &w.qdd[17], w.Dinv_RF_shank, w.Dinv_RH_shank, w.a_RF_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -1730,17 +1767,31 @@ PROXGEN_RT_NOINLINE void caba_update(Scalar mu, Workspace& PROXGEN_RT_RESTRICT w
   shared_10(mu, w.a_LF_shank, w.k_lf_foot, w.residual, w.active, w.dlambda, w.lambda, w.a_RF_shank, w.k_rf_foot, w.a_LH_shank, w.k_lh_foot, w.a_RH_shank, w.k_rh_foot);
 }
 
-PROXGEN_RT_NOINLINE void pv_backward_RH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_RH_shank_to_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_14(shared_14_k0, &tau[17], w.u_RH_shank, w.pA_RH_shank, w.c_RH_shank, &w.cq[11], &w.sq[11], w.IA_RH_thigh, w.pA_RH_thigh, w.KA_RH_thigh, 0);
+  // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
+  shared_14_x2(shared_14_p0, &tau[17], &tau[14], w.u_RH_shank, w.u_RF_shank, w.pA_RH_shank, w.pA_RF_shank, w.c_RH_shank, w.c_RF_shank, &w.cq[11], &w.cq[8], &w.sq[11], &w.sq[8], w.IA_RH_thigh, w.IA_RF_thigh, w.pA_RH_thigh, w.pA_RF_thigh, w.KA_RH_thigh, w.KA_RF_thigh, 0, 0);
 }
 
-PROXGEN_RT_NOINLINE void pv_backward_RH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_shank_to_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  shared_14_x2(shared_14_p1, &tau[11], &tau[8], w.u_LH_shank, w.u_LF_shank, w.pA_LH_shank, w.pA_LF_shank, w.c_LH_shank, w.c_LF_shank, &w.cq[5], &w.cq[2], &w.sq[5], &w.sq[2], w.IA_LH_thigh, w.IA_LF_thigh, w.pA_LH_thigh, w.pA_LF_thigh, w.KA_LH_thigh, w.KA_LF_thigh, 0, 0);
+}
+
+PROXGEN_RT_NOINLINE void pv_backward_RH_thigh_to_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_15(shared_15_k0, &tau[16], &w.Dinv_RH_thigh, w.IA_RH_thigh, w.u_RH_thigh, w.pA_RH_thigh, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.IA_RH_hip, w.pA_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, w.KA_RH_hip, 0);
+  // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
+  shared_15_x2(shared_15_p0, &tau[16], &tau[13], &w.Dinv_RH_thigh, &w.Dinv_RF_thigh, w.IA_RH_thigh, w.IA_RF_thigh, w.u_RH_thigh, w.u_RF_thigh, w.pA_RH_thigh, w.pA_RF_thigh, w.c_RH_thigh, w.c_RF_thigh, &w.cq[10], &w.cq[7], &w.sq[10], &w.sq[7], w.IA_RH_hip, w.IA_RF_hip, w.pA_RH_hip, w.pA_RF_hip, w.KSD_RH_thigh, w.KSD_RF_thigh, w.KA_RH_thigh, w.KA_RF_thigh, 0, 0, w.KA_RH_hip, w.KA_RF_hip, 0, 0);
 }
 
-PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_thigh_to_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  shared_15_x2(shared_15_p1, &tau[10], &tau[7], &w.Dinv_LH_thigh, &w.Dinv_LF_thigh, w.IA_LH_thigh, w.IA_LF_thigh, w.u_LH_thigh, w.u_LF_thigh, w.pA_LH_thigh, w.pA_LF_thigh, w.c_LH_thigh, w.c_LF_thigh, &w.cq[4], &w.cq[1], &w.sq[4], &w.sq[1], w.IA_LH_hip, w.IA_LF_hip, w.pA_LH_hip, w.pA_LF_hip, w.KSD_LH_thigh, w.KSD_LF_thigh, w.KA_LH_thigh, w.KA_LF_thigh, 0, 0, w.KA_LH_hip, w.KA_LF_hip, 0, 0);
+}
+
+PROXGEN_RT_NOINLINE void pv_backward_RH_hip_to_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
   {
     w.U_RH_hip[0] = 0.9950371902099892*w.IA_RH_hip[3] - 0.09950371902099892*w.IA_RH_hip[5];
@@ -1913,49 +1964,13 @@ PROXGEN_RT_NOINLINE void pv_backward_RH_hip(const Scalar* PROXGEN_RT_RESTRICT ta
     w.KA_trunk[4][11] = w.RJ_RH_hip[1][0]*t83 + 5.7617628499109426e-05*w.cq[9]*w.KSD_RH_hip[2] + w.RJ_RH_hip[1][2]*t84 + 0.19*t87;
     w.KA_trunk[5][11] = w.RJ_RH_hip[2][0]*t83 + 5.7617628499109426e-05*w.RJ_RH_hip[2][1]*w.KSD_RH_hip[2] + w.RJ_RH_hip[2][2]*t84 + 0.049*t85 - 0.19*t86;
   }
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_RF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_14(shared_14_k0, &tau[14], w.u_RF_shank, w.pA_RF_shank, w.c_RF_shank, &w.cq[8], &w.sq[8], w.IA_RF_thigh, w.pA_RF_thigh, w.KA_RF_thigh, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_RF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_15(shared_15_k0, &tau[13], &w.Dinv_RF_thigh, w.IA_RF_thigh, w.u_RF_thigh, w.pA_RF_thigh, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.IA_RF_hip, w.pA_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, w.KA_RF_hip, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_RF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
   shared_16(shared_16_k0, &tau[12], w.U_RF_hip, w.IA_RF_hip, &w.Dinv_RF_hip, w.u_RF_hip, w.pA_RF_hip, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.IA_trunk, w.pA_trunk, w.KS_RF_hip, w.KA_RF_hip, 0, w.KSD_RF_hip, w.KA_trunk, 6);
 }
 
-PROXGEN_RT_NOINLINE void pv_backward_LH_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_14(shared_14_k1, &tau[11], w.u_LH_shank, w.pA_LH_shank, w.c_LH_shank, &w.cq[5], &w.sq[5], w.IA_LH_thigh, w.pA_LH_thigh, w.KA_LH_thigh, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_LH_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_15(shared_15_k1, &tau[10], &w.Dinv_LH_thigh, w.IA_LH_thigh, w.u_LH_thigh, w.pA_LH_thigh, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.IA_LH_hip, w.pA_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, w.KA_LH_hip, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_LH_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_backward_LH_hip_to_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
   shared_16(shared_16_k1, &tau[9], w.U_LH_hip, w.IA_LH_hip, &w.Dinv_LH_hip, w.u_LH_hip, w.pA_LH_hip, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.IA_trunk, w.pA_trunk, w.KS_LH_hip, w.KA_LH_hip, 0, w.KSD_LH_hip, w.KA_trunk, 3);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_LF_shank(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_14(shared_14_k1, &tau[8], w.u_LF_shank, w.pA_LF_shank, w.c_LF_shank, &w.cq[2], &w.sq[2], w.IA_LF_thigh, w.pA_LF_thigh, w.KA_LF_thigh, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_LF_thigh(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // eliminate, carrying the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_15(shared_15_k1, &tau[7], &w.Dinv_LF_thigh, w.IA_LF_thigh, w.u_LF_thigh, w.pA_LF_thigh, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.IA_LF_hip, w.pA_LF_hip, w.KSD_LF_thigh, w.KA_LF_thigh, 0, w.KA_LF_hip, 0);
-}
-
-PROXGEN_RT_NOINLINE void pv_backward_LF_hip(const Scalar* PROXGEN_RT_RESTRICT tau, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // eliminate, carrying the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
   shared_16(shared_16_k2, &tau[6], w.U_LF_hip, w.IA_LF_hip, &w.Dinv_LF_hip, w.u_LF_hip, w.pA_LF_hip, w.c_LF_hip, w.RJ_LF_hip, 0, w.cq, w.IA_trunk, w.pA_trunk, w.KS_LF_hip, w.KA_LF_hip, 0, w.KSD_LF_hip, w.KA_trunk, 0);
 }
@@ -2212,7 +2227,7 @@ PROXGEN_RT_NOINLINE void pv_backward_trunk(const Scalar* PROXGEN_RT_RESTRICT tau
   }
 }
 
-PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_trunk_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[0] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[2];
@@ -2245,58 +2260,32 @@ PROXGEN_RT_NOINLINE void pv_free_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT 
     w.a_trunk[5] = w.Linv_trunk[5]*t11;
   }
   // free acceleration (lambda = 0): body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq[0]*t23 + w.RJ_LF_hip[2][1]*t24;
-    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq[0]*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
-    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
-    const Scalar t31 = w.u_LF_hip[0] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
-    w.a_LF_hip[0] = t25;
-    w.a_LF_hip[1] = t26;
-    w.a_LF_hip[2] = t27;
-    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.Dinv_LF_hip*t31;
-    w.a_LF_hip[4] = t29;
-    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.Dinv_LF_hip*t31;
-  }
-}
-
-PROXGEN_RT_NOINLINE void pv_free_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_17(shared_17_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, &w.IA_LF_thigh[4], w.a_LF_thigh, w.Dinv_LF_thigh);
-  // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_18(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.a_LF_shank);
   // free acceleration (lambda = 0): body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_19(shared_19_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.U_LH_hip, w.a_LH_hip, w.Dinv_LH_hip);
+  shared_17_x2(shared_17_p0, w.a_trunk, w.a_trunk, w.c_LF_hip, w.c_LH_hip, w.RJ_LF_hip, w.RJ_LH_hip, 0, 0, w.cq, &w.cq[3], w.u_LF_hip, w.u_LH_hip, w.U_LF_hip, w.U_LH_hip, w.a_LF_hip, w.a_LH_hip, w.Dinv_LF_hip, w.Dinv_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void pv_free_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_17(shared_17_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, &w.IA_LH_thigh[4], w.a_LH_thigh, w.Dinv_LH_thigh);
-  // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_18(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, w.a_LH_shank);
+PROXGEN_RT_NOINLINE void pv_free_RF_hip_to_LH_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // free acceleration (lambda = 0): body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_19(shared_19_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.U_RF_hip, w.a_RF_hip, w.Dinv_RF_hip);
-}
-
-PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_17(shared_17_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, &w.IA_RF_thigh[4], w.a_RF_thigh, w.Dinv_RF_thigh);
-  // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_18(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, w.a_RF_shank);
   // free acceleration (lambda = 0): body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_19(shared_19_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.U_RH_hip, w.a_RH_hip, w.Dinv_RH_hip);
+  shared_18_x2(shared_18_p0, w.a_trunk, w.a_trunk, w.c_RF_hip, w.c_RH_hip, w.RJ_RF_hip, w.RJ_RH_hip, 0, 0, &w.cq[6], &w.cq[9], w.u_RF_hip, w.u_RH_hip, w.U_RF_hip, w.U_RH_hip, w.a_RF_hip, w.a_RH_hip, w.Dinv_RF_hip, w.Dinv_RH_hip);
+  // free acceleration (lambda = 0): body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  // free acceleration (lambda = 0): body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  shared_19_x2(shared_19_p0, w.a_LF_hip, w.a_LH_hip, w.c_LF_thigh, w.c_LH_thigh, &w.cq[1], &w.cq[4], &w.sq[1], &w.sq[4], w.u_LF_thigh, w.u_LH_thigh, &w.IA_LF_thigh[4], &w.IA_LH_thigh[4], w.a_LF_thigh, w.a_LH_thigh, w.Dinv_LF_thigh, w.Dinv_LH_thigh);
 }
 
-PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_free_RF_thigh_to_LH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   // free acceleration (lambda = 0): body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_17(shared_17_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, &w.IA_RH_thigh[4], w.a_RH_thigh, w.Dinv_RH_thigh);
+  shared_19_x2(shared_19_p1, w.a_RF_hip, w.a_RH_hip, w.c_RF_thigh, w.c_RH_thigh, &w.cq[7], &w.cq[10], &w.sq[7], &w.sq[10], w.u_RF_thigh, w.u_RH_thigh, &w.IA_RF_thigh[4], &w.IA_RH_thigh[4], w.a_RF_thigh, w.a_RH_thigh, w.Dinv_RF_thigh, w.Dinv_RH_thigh);
+  // free acceleration (lambda = 0): body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  // free acceleration (lambda = 0): body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_20_x2(shared_20_p0, w.a_LF_thigh, w.a_LH_thigh, w.c_LF_shank, w.c_LH_shank, &w.cq[2], &w.cq[5], &w.sq[2], &w.sq[5], w.u_LF_shank, w.u_LH_shank, w.a_LF_shank, w.a_LH_shank);
+}
+
+PROXGEN_RT_NOINLINE void pv_free_RF_shank_to_yfree(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // free acceleration (lambda = 0): body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   // free acceleration (lambda = 0): body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_18(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, w.a_RH_shank);
+  shared_20_x2(shared_20_p0, w.a_RF_thigh, w.a_RH_thigh, w.c_RF_shank, w.c_RH_shank, &w.cq[8], &w.cq[11], &w.sq[8], &w.sq[11], w.u_RF_shank, w.u_RH_shank, w.a_RF_shank, w.a_RH_shank);
   // free row accelerations y_free = K a - k (tree order)
   {
     const Scalar t14 = w.a_LF_shank[0] - 0.195*w.a_LF_shank[4] - 0.004*w.a_LF_shank[5] - w.k_lf_foot[0];
@@ -2305,11 +2294,11 @@ PROXGEN_RT_NOINLINE void pv_free_RH_thigh_to_yfree(Workspace& PROXGEN_RT_RESTRIC
     w.yfree[1] = w.active[0]*t15;
     const Scalar t16 = w.a_LF_shank[2] + 0.004*w.a_LF_shank[3] - w.k_lf_foot[2];
     w.yfree[2] = w.active[0]*t16;
-    const Scalar t17 = w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5] - w.k_rf_foot[0];
+    const Scalar t17 = -w.k_rf_foot[0] + w.a_RF_shank[0] - 0.195*w.a_RF_shank[4] + 0.004*w.a_RF_shank[5];
     w.yfree[6] = w.active[1]*t17;
-    const Scalar t18 = w.a_RF_shank[1] + 0.195*w.a_RF_shank[3] - w.k_rf_foot[1];
+    const Scalar t18 = -w.k_rf_foot[1] + w.a_RF_shank[1] + 0.195*w.a_RF_shank[3];
     w.yfree[7] = w.active[1]*t18;
-    const Scalar t19 = w.a_RF_shank[2] - 0.004*w.a_RF_shank[3] - w.k_rf_foot[2];
+    const Scalar t19 = -w.k_rf_foot[2] + w.a_RF_shank[2] - 0.004*w.a_RF_shank[3];
     w.yfree[8] = w.active[1]*t19;
     const Scalar t20 = w.a_LH_shank[0] - 0.195*w.a_LH_shank[4] - 0.004*w.a_LH_shank[5] - w.k_lh_foot[0];
     w.yfree[3] = w.active[2]*t20;
@@ -2355,7 +2344,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[2] = inv2;
   }
   // G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count)
-  shared_20(inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
+  shared_21(inv_mu, w.KSD_LH_hip, w.KS_LH_hip, w.KSD_LH_thigh, w.KA_LH_thigh, 0, &w.Linv[3], &w.L[34]);
   // G + I/mu = L L^T, column 4 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t9 = inv_mu + w.KSD_LH_hip[1]*w.KS_LH_hip[1] - w.L[34]*w.L[34];
@@ -2373,7 +2362,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_0_to_column_6(Scalar inv_mu, Workspa
     w.Linv[5] = inv5;
   }
   // G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count)
-  shared_20(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
+  shared_21(inv_mu, w.KSD_RF_hip, w.KS_RF_hip, w.KSD_RF_thigh, w.KA_RF_thigh, 0, &w.Linv[6], &w.L[58]);
 }
 
 PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2394,7 +2383,7 @@ PROXGEN_RT_NOINLINE void pv_delassus_column_7_to_W(Scalar inv_mu, Workspace& PRO
     w.Linv[8] = inv1;
   }
   // G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-  shared_20(inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
+  shared_21(inv_mu, w.KSD_RH_hip, w.KS_RH_hip, w.KSD_RH_thigh, w.KA_RH_thigh, 0, &w.Linv[9], &w.L[73]);
   // G + I/mu = L L^T, column 10 (Cholesky, unrolled for the fixed row count)
   {
     const Scalar t6 = inv_mu + w.KSD_RH_hip[1]*w.KS_RH_hip[1] - w.L[73]*w.L[73];
@@ -2642,7 +2631,7 @@ PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRI
   w.lambda[11] = w.Linv[11]*z11;
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 1 'trunk': joint 'root_joint' (free flyer), parent the world
   {
     const Scalar t0 = w.u_trunk[0] - w.KA_trunk[0][0]*w.lambda[0] - w.KA_trunk[0][1]*w.lambda[1] - w.KA_trunk[0][2]*w.lambda[2] - w.KA_trunk[0][3]*w.lambda[6] - w.KA_trunk[0][4]*w.lambda[7] - w.KA_trunk[0][5]*w.lambda[8] - w.KA_trunk[0][6]*w.lambda[3] - w.KA_trunk[0][7]*w.lambda[4] - w.KA_trunk[0][8]*w.lambda[5] - w.KA_trunk[0][9]*w.lambda[9] - w.KA_trunk[0][10]*w.lambda[10] - w.KA_trunk[0][11]*w.lambda[11] - 9.81*w.RJ_trunk[2][0]*w.IA_trunk[0] - 9.81*w.RJ_trunk[2][1]*w.IA_trunk[1] - 9.81*w.RJ_trunk[2][2]*w.IA_trunk[2];
@@ -2681,59 +2670,32 @@ PROXGEN_RT_NOINLINE void pv_forward_trunk_to_LF_hip(Workspace& PROXGEN_RT_RESTRI
     w.a_trunk[5] = w.qdd[5];
   }
   // accelerate, with the multipliers of the subtree rows: body 2 'LF_hip': joint 'LF_HAA' (revolute about a general axis), parent 'trunk'
-  {
-    const Scalar t22 = w.a_trunk[0] - 0.049*w.a_trunk[5];
-    const Scalar t23 = w.a_trunk[1] + 0.19*w.a_trunk[5];
-    const Scalar t24 = w.a_trunk[2] + 0.049*w.a_trunk[3] - 0.19*w.a_trunk[4];
-    const Scalar t25 = w.c_LF_hip[0] + w.RJ_LF_hip[0][0]*t22 + w.RJ_LF_hip[1][0]*t23 + w.RJ_LF_hip[2][0]*t24;
-    const Scalar t26 = w.c_LF_hip[1] + w.RJ_LF_hip[0][1]*t22 + w.cq[0]*t23 + w.RJ_LF_hip[2][1]*t24;
-    const Scalar t27 = w.c_LF_hip[2] + w.RJ_LF_hip[0][2]*t22 + w.RJ_LF_hip[1][2]*t23 + w.RJ_LF_hip[2][2]*t24;
-    const Scalar t28 = w.c_LF_hip[3] + w.RJ_LF_hip[0][0]*w.a_trunk[3] + w.RJ_LF_hip[1][0]*w.a_trunk[4] + w.RJ_LF_hip[2][0]*w.a_trunk[5];
-    const Scalar t29 = w.c_LF_hip[4] + w.RJ_LF_hip[0][1]*w.a_trunk[3] + w.cq[0]*w.a_trunk[4] + w.RJ_LF_hip[2][1]*w.a_trunk[5];
-    const Scalar t30 = w.c_LF_hip[5] + w.RJ_LF_hip[0][2]*w.a_trunk[3] + w.RJ_LF_hip[1][2]*w.a_trunk[4] + w.RJ_LF_hip[2][2]*w.a_trunk[5];
-    const Scalar t31 = w.u_LF_hip[0] - w.KS_LF_hip[0]*w.lambda[0] - w.KS_LF_hip[1]*w.lambda[1] - w.KS_LF_hip[2]*w.lambda[2] - 5.780668556524933e-05*t29 - w.U_LF_hip[0]*t25 - w.U_LF_hip[1]*t26 - w.U_LF_hip[2]*t27 - w.U_LF_hip[3]*t28 - w.U_LF_hip[5]*t30;
-    w.qdd[6] = w.Dinv_LF_hip*t31;
-    w.a_LF_hip[0] = t25;
-    w.a_LF_hip[1] = t26;
-    w.a_LF_hip[2] = t27;
-    w.a_LF_hip[3] = t28 + 0.9950371902099893*w.qdd[6];
-    w.a_LF_hip[4] = t29;
-    w.a_LF_hip[5] = t30 + 0.09950371902099893*w.qdd[6];
-  }
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_LF_thigh_to_LH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
-  shared_21(shared_21_k0, w.a_LF_hip, w.c_LF_thigh, &w.cq[1], &w.sq[1], w.u_LF_thigh, w.KA_LF_thigh, 0, w.lambda, &w.IA_LF_thigh[4], &w.qdd[7], w.Dinv_LF_thigh, w.a_LF_thigh);
-  // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
-  shared_22(w.a_LF_thigh, w.c_LF_shank, &w.cq[2], &w.sq[2], w.u_LF_shank, w.lambda, &w.qdd[8], w.a_LF_shank);
   // accelerate, with the multipliers of the subtree rows: body 5 'LH_hip': joint 'LH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k0, w.a_trunk, w.c_LH_hip, w.RJ_LH_hip, 0, &w.cq[3], w.u_LH_hip, w.KS_LH_hip, &w.lambda[6], w.U_LH_hip, &w.qdd[9], w.Dinv_LH_hip, w.a_LH_hip);
+  shared_22_x2(shared_22_p0, w.a_trunk, w.a_trunk, w.c_LF_hip, w.c_LH_hip, w.RJ_LF_hip, w.RJ_LH_hip, 0, 0, w.cq, &w.cq[3], w.u_LF_hip, w.u_LH_hip, w.KS_LF_hip, w.KS_LH_hip, w.lambda, &w.lambda[6], w.U_LF_hip, w.U_LH_hip, &w.qdd[6], &w.qdd[9], w.Dinv_LF_hip, w.Dinv_LH_hip, w.a_LF_hip, w.a_LH_hip);
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_LH_thigh_to_RF_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
-  shared_21(shared_21_k0, w.a_LH_hip, w.c_LH_thigh, &w.cq[4], &w.sq[4], w.u_LH_thigh, w.KA_LH_thigh, 0, &w.lambda[6], &w.IA_LH_thigh[4], &w.qdd[10], w.Dinv_LH_thigh, w.a_LH_thigh);
-  // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
-  shared_22(w.a_LH_thigh, w.c_LH_shank, &w.cq[5], &w.sq[5], w.u_LH_shank, &w.lambda[6], &w.qdd[11], w.a_LH_shank);
+PROXGEN_RT_NOINLINE void pv_forward_RF_hip_to_LH_thigh(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
   // accelerate, with the multipliers of the subtree rows: body 8 'RF_hip': joint 'RF_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k1, w.a_trunk, w.c_RF_hip, w.RJ_RF_hip, 0, &w.cq[6], w.u_RF_hip, w.KS_RF_hip, &w.lambda[3], w.U_RF_hip, &w.qdd[12], w.Dinv_RF_hip, w.a_RF_hip);
-}
-
-PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_RH_hip(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
-  // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
-  shared_21(shared_21_k1, w.a_RF_hip, w.c_RF_thigh, &w.cq[7], &w.sq[7], w.u_RF_thigh, w.KA_RF_thigh, 0, &w.lambda[3], &w.IA_RF_thigh[4], &w.qdd[13], w.Dinv_RF_thigh, w.a_RF_thigh);
-  // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
-  shared_22(w.a_RF_thigh, w.c_RF_shank, &w.cq[8], &w.sq[8], w.u_RF_shank, &w.lambda[3], &w.qdd[14], w.a_RF_shank);
   // accelerate, with the multipliers of the subtree rows: body 11 'RH_hip': joint 'RH_HAA' (revolute about a general axis), parent 'trunk'
-  shared_23(shared_23_k2, w.a_trunk, w.c_RH_hip, w.RJ_RH_hip, 0, &w.cq[9], w.u_RH_hip, w.KS_RH_hip, &w.lambda[9], w.U_RH_hip, &w.qdd[15], w.Dinv_RH_hip, w.a_RH_hip);
+  shared_23_x2(shared_23_p0, w.a_trunk, w.a_trunk, w.c_RF_hip, w.c_RH_hip, w.RJ_RF_hip, w.RJ_RH_hip, 0, 0, &w.cq[6], &w.cq[9], w.u_RF_hip, w.u_RH_hip, w.KS_RF_hip, w.KS_RH_hip, &w.lambda[3], &w.lambda[9], w.U_RF_hip, w.U_RH_hip, &w.qdd[12], &w.qdd[15], w.Dinv_RF_hip, w.Dinv_RH_hip, w.a_RF_hip, w.a_RH_hip);
+  // accelerate, with the multipliers of the subtree rows: body 3 'LF_thigh': joint 'LF_HFE' (revolute about y), parent 'LF_hip'
+  // accelerate, with the multipliers of the subtree rows: body 6 'LH_thigh': joint 'LH_HFE' (revolute about y), parent 'LH_hip'
+  shared_24_x2(shared_24_p0, w.a_LF_hip, w.a_LH_hip, w.c_LF_thigh, w.c_LH_thigh, &w.cq[1], &w.cq[4], &w.sq[1], &w.sq[4], w.u_LF_thigh, w.u_LH_thigh, w.KA_LF_thigh, w.KA_LH_thigh, 0, 0, w.lambda, &w.lambda[6], &w.IA_LF_thigh[4], &w.IA_LH_thigh[4], &w.qdd[7], &w.qdd[10], w.Dinv_LF_thigh, w.Dinv_LH_thigh, w.a_LF_thigh, w.a_LH_thigh);
 }
 
-PROXGEN_RT_NOINLINE void pv_forward_RH_thigh_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+PROXGEN_RT_NOINLINE void pv_forward_RF_thigh_to_LH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 9 'RF_thigh': joint 'RF_HFE' (revolute about y), parent 'RF_hip'
   // accelerate, with the multipliers of the subtree rows: body 12 'RH_thigh': joint 'RH_HFE' (revolute about y), parent 'RH_hip'
-  shared_21(shared_21_k1, w.a_RH_hip, w.c_RH_thigh, &w.cq[10], &w.sq[10], w.u_RH_thigh, w.KA_RH_thigh, 0, &w.lambda[9], &w.IA_RH_thigh[4], &w.qdd[16], w.Dinv_RH_thigh, w.a_RH_thigh);
+  shared_24_x2(shared_24_p1, w.a_RF_hip, w.a_RH_hip, w.c_RF_thigh, w.c_RH_thigh, &w.cq[7], &w.cq[10], &w.sq[7], &w.sq[10], w.u_RF_thigh, w.u_RH_thigh, w.KA_RF_thigh, w.KA_RH_thigh, 0, 0, &w.lambda[3], &w.lambda[9], &w.IA_RF_thigh[4], &w.IA_RH_thigh[4], &w.qdd[13], &w.qdd[16], w.Dinv_RF_thigh, w.Dinv_RH_thigh, w.a_RF_thigh, w.a_RH_thigh);
+  // accelerate, with the multipliers of the subtree rows: body 4 'LF_shank': joint 'LF_KFE' (revolute about y), parent 'LF_thigh'
+  // accelerate, with the multipliers of the subtree rows: body 7 'LH_shank': joint 'LH_KFE' (revolute about y), parent 'LH_thigh'
+  shared_25_x2(shared_25_p0, w.a_LF_thigh, w.a_LH_thigh, w.c_LF_shank, w.c_LH_shank, &w.cq[2], &w.cq[5], &w.sq[2], &w.sq[5], w.u_LF_shank, w.u_LH_shank, w.lambda, &w.lambda[6], &w.qdd[8], &w.qdd[11], w.a_LF_shank, w.a_LH_shank);
+}
+
+PROXGEN_RT_NOINLINE void pv_forward_RF_shank_to_RH_shank(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
+  // accelerate, with the multipliers of the subtree rows: body 10 'RF_shank': joint 'RF_KFE' (revolute about y), parent 'RF_thigh'
   // accelerate, with the multipliers of the subtree rows: body 13 'RH_shank': joint 'RH_KFE' (revolute about y), parent 'RH_thigh'
-  shared_22(w.a_RH_thigh, w.c_RH_shank, &w.cq[11], &w.sq[11], w.u_RH_shank, &w.lambda[9], &w.qdd[17], w.a_RH_shank);
+  shared_25_x2(shared_25_p0, w.a_RF_thigh, w.a_RH_thigh, w.c_RF_shank, w.c_RH_shank, &w.cq[8], &w.cq[11], &w.sq[8], &w.sq[11], w.u_RF_shank, w.u_RH_shank, &w.lambda[3], &w.lambda[9], &w.qdd[14], &w.qdd[17], w.a_RF_shank, w.a_RH_shank);
 }
 
 PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept {
@@ -2770,13 +2732,12 @@ PROXGEN_RT_NOINLINE void pv_residual(Workspace& PROXGEN_RT_RESTRICT w) noexcept 
 // forces pA = v x* I v, gravity in the support bodies, constraint right-hand sides k.
 void kinematics(const Scalar* q, const Scalar* v, Workspace& w) noexcept {
   proxgen_rt::sincos_run<12, true>(&q[7], &w.sq[0], &w.cq[0]);
-  kinematics_trunk_to_LF_hip(q, v, w);
-  kinematics_LF_thigh_to_LF_shank(q, v, w);
-  kinematics_LH_hip_to_LH_thigh(q, v, w);
-  kinematics_LH_shank_to_RF_hip(q, v, w);
-  kinematics_RF_thigh_to_RF_shank(q, v, w);
-  kinematics_RH_hip_to_RH_thigh(q, v, w);
-  kinematics_RH_shank(q, v, w);
+  kinematics_trunk_to_LH_hip(q, v, w);
+  kinematics_RF_hip_to_RH_hip(q, v, w);
+  kinematics_LF_thigh_to_LH_thigh(q, v, w);
+  kinematics_RF_thigh_to_RH_thigh(q, v, w);
+  kinematics_LF_shank_to_LH_shank(q, v, w);
+  kinematics_RF_shank_to_RH_shank(q, v, w);
 }
 
 }  // namespace
@@ -2807,41 +2768,32 @@ void constrained_aba(const Scalar* q, const Scalar* v, const Scalar* tau, const 
   w.lambda[10] = lambda0_if[s.active[3]][10];
   w.lambda[11] = lambda0_if[s.active[3]][11];
   // ---- backward: eliminate the support, the penalty mu K^T K at the constrained bodies
-  caba_backward_RH_shank(tau, mu, w);
-  caba_backward_RH_thigh(tau, w);
-  caba_backward_RH_hip(tau, w);
-  caba_backward_RF_shank(tau, mu, w);
-  caba_backward_RF_thigh(tau, w);
-  caba_backward_RF_hip(tau, w);
-  caba_backward_LH_shank(tau, mu, w);
-  caba_backward_LH_thigh(tau, w);
-  caba_backward_LH_hip(tau, w);
-  caba_backward_LF_shank(tau, mu, w);
-  caba_backward_LF_thigh(tau, w);
-  caba_backward_LF_hip(tau, w);
+  caba_backward_RH_shank_to_RF_shank(tau, mu, w);
+  caba_backward_LH_shank_to_LF_shank(tau, mu, w);
+  caba_backward_RH_thigh_to_RF_thigh(tau, w);
+  caba_backward_LH_thigh_to_LF_thigh(tau, w);
+  caba_backward_RH_hip_to_RF_hip(tau, w);
+  caba_backward_LH_hip_to_LF_hip(tau, w);
   caba_backward_trunk(tau, w);
   // ---- forward: accelerations of the support
-  caba_forward_trunk_to_LF_hip(w);
-  caba_forward_LF_thigh_to_LH_hip(w);
-  caba_forward_LH_thigh_to_RF_hip(w);
-  caba_forward_RF_thigh_to_RH_hip(w);
-  caba_forward_RH_thigh_to_RH_shank(w);
+  caba_forward_trunk_to_LH_hip(w);
+  caba_forward_RF_hip_to_LH_thigh(w);
+  caba_forward_RF_thigh_to_LH_shank(w);
+  caba_forward_RF_shank_to_RH_shank(w);
   // ---- multipliers: dlambda = mu (K a - k), lambda = lambda0 + dlambda
   caba_multipliers(mu, w);
   // Iterations 2..K: reduced sweeps over the support (K = 0 or 1: no pass).
   for (int k = 2; k <= s.iterations; ++k) {
     // ---- reduced sweep: u -= S^T dp, dp passes to the parent
-    caba_reduced_RH_shank_to_RH_hip(w);
-    caba_reduced_RF_shank_to_RF_hip(w);
-    caba_reduced_LH_shank_to_LH_hip(w);
-    caba_reduced_LF_shank_to_LF_hip(w);
+    caba_reduced_RH_shank_to_LF_shank(w);
+    caba_reduced_RH_thigh_to_LF_thigh(w);
+    caba_reduced_RH_hip_to_LF_hip(w);
     caba_reduced_trunk(w);
     // ---- forward: accelerations of the support
-    caba_reforward_trunk_to_LF_hip(w);
-    caba_reforward_LF_thigh_to_LH_hip(w);
-    caba_reforward_LH_thigh_to_RF_hip(w);
-    caba_reforward_RF_thigh_to_RH_hip(w);
-    caba_reforward_RH_thigh_to_RH_shank(w);
+    caba_reforward_trunk_to_LH_hip(w);
+    caba_reforward_RF_hip_to_LH_thigh(w);
+    caba_reforward_RF_thigh_to_LH_shank(w);
+    caba_reforward_RF_shank_to_RH_shank(w);
     // ---- multipliers: dlambda = mu (K a - k), lambda += dlambda
     caba_update(mu, w);
   }
@@ -2887,25 +2839,18 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
   w.active[3] = Scalar(s.active[3]);
   kinematics(q, v, w);
   // ---- backward: eliminate the support, carrying the subtree rows KA, KS = S^T KA, D^-1 KS
-  pv_backward_RH_shank(tau, w);
-  pv_backward_RH_thigh(tau, w);
-  pv_backward_RH_hip(tau, w);
-  pv_backward_RF_shank(tau, w);
-  pv_backward_RF_thigh(tau, w);
-  pv_backward_RF_hip(tau, w);
-  pv_backward_LH_shank(tau, w);
-  pv_backward_LH_thigh(tau, w);
-  pv_backward_LH_hip(tau, w);
-  pv_backward_LF_shank(tau, w);
-  pv_backward_LF_thigh(tau, w);
-  pv_backward_LF_hip(tau, w);
+  pv_backward_RH_shank_to_RF_shank(tau, w);
+  pv_backward_LH_shank_to_LF_shank(tau, w);
+  pv_backward_RH_thigh_to_RF_thigh(tau, w);
+  pv_backward_LH_thigh_to_LF_thigh(tau, w);
+  pv_backward_RH_hip_to_RF_hip(tau, w);
+  pv_backward_LH_hip_to_LF_hip(tau, w);
   pv_backward_trunk(tau, w);
   // ---- free accelerations (lambda = 0) and the rows' y_free = K a - k
-  pv_free_trunk_to_LF_hip(w);
-  pv_free_LF_thigh_to_LH_hip(w);
-  pv_free_LH_thigh_to_RF_hip(w);
-  pv_free_RF_thigh_to_RH_hip(w);
-  pv_free_RH_thigh_to_yfree(w);
+  pv_free_trunk_to_LH_hip(w);
+  pv_free_RF_hip_to_LH_thigh(w);
+  pv_free_RF_thigh_to_LH_shank(w);
+  pv_free_RF_shank_to_yfree(w);
   const Scalar inv_mu = 1.0 / s.mu;
   // ---- G + I/mu = L L^T, G assembled from the carried rows
   pv_delassus_column_0_to_column_6(inv_mu, w);
@@ -2932,11 +2877,10 @@ void prox_pv(const Scalar* q, const Scalar* v, const Scalar* tau, const Settings
     pv_proximal(inv_mu, w);
   }
   // ---- forward: accelerations, with the multipliers of the subtree rows
-  pv_forward_trunk_to_LF_hip(w);
-  pv_forward_LF_thigh_to_LH_hip(w);
-  pv_forward_LH_thigh_to_RF_hip(w);
-  pv_forward_RF_thigh_to_RH_hip(w);
-  pv_forward_RH_thigh_to_RH_shank(w);
+  pv_forward_trunk_to_LH_hip(w);
+  pv_forward_RF_hip_to_LH_thigh(w);
+  pv_forward_RF_thigh_to_LH_shank(w);
+  pv_forward_RF_shank_to_RH_shank(w);
   // ---- the rows' residual K a - k of the final accelerations
   pv_residual(w);
   qdd[0] = w.qdd[0];

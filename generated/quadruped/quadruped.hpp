@@ -5,36 +5,39 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
-//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
-//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4518 + 1192 K (= 8094 at K = 3)
+//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 56 + 30 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8492 + 475 K (= 9917 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 108, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
 //   shared_5: 2 blocks of trunk
-//   shared_6: 2 blocks of LF_hip
-//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_6: 4 blocks of LF_hip, LH_hip (4 in pairs)
+//   shared_7: 4 blocks of RF_hip, RH_hip (4 in pairs)
+//   shared_8: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (8 in pairs)
+//   shared_9: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank (8 in pairs)
 //   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_17: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_18: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_19: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_20: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_21: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+//   shared_22: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_23: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_24: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_25: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
 //
 // Constrained forward dynamics of this robot and this constraint layout by
 // constrainedABA and proxPV (the seed paper's recursions), as straight-line
@@ -141,52 +144,52 @@ struct Workspace {
   Scalar c_LF_hip[6];          // velocity-product acceleration, body 2
   Scalar pA_LF_hip[6];         // bias force, body 2
   Scalar g_LF_hip[3];          // gravity in body coordinates, body 2
-  Scalar v_LF_thigh[6];        // velocity, body 3
-  Scalar c_LF_thigh[6];        // velocity-product acceleration, body 3
-  Scalar pA_LF_thigh[6];       // bias force, body 3
-  Scalar g_LF_thigh[3];        // gravity in body coordinates, body 3
-  Scalar v_LF_shank[6];        // velocity, body 4
-  Scalar c_LF_shank[6];        // velocity-product acceleration, body 4
-  Scalar pA_LF_shank[6];       // bias force, body 4
-  Scalar g_LF_shank[3];        // gravity in body coordinates, body 4
-  Scalar k_lf_foot[3];         // constraint right-hand side, constraint 0
   Scalar RJ_LH_hip[3][3];      // joint rotation, body 5
   Scalar v_LH_hip[6];          // velocity, body 5
   Scalar c_LH_hip[6];          // velocity-product acceleration, body 5
   Scalar pA_LH_hip[6];         // bias force, body 5
   Scalar g_LH_hip[3];          // gravity in body coordinates, body 5
-  Scalar v_LH_thigh[6];        // velocity, body 6
-  Scalar c_LH_thigh[6];        // velocity-product acceleration, body 6
-  Scalar pA_LH_thigh[6];       // bias force, body 6
-  Scalar g_LH_thigh[3];        // gravity in body coordinates, body 6
-  Scalar v_LH_shank[6];        // velocity, body 7
-  Scalar c_LH_shank[6];        // velocity-product acceleration, body 7
-  Scalar pA_LH_shank[6];       // bias force, body 7
-  Scalar g_LH_shank[3];        // gravity in body coordinates, body 7
-  Scalar k_lh_foot[3];         // constraint right-hand side, constraint 2
   Scalar RJ_RF_hip[3][3];      // joint rotation, body 8
   Scalar v_RF_hip[6];          // velocity, body 8
   Scalar c_RF_hip[6];          // velocity-product acceleration, body 8
   Scalar pA_RF_hip[6];         // bias force, body 8
   Scalar g_RF_hip[3];          // gravity in body coordinates, body 8
-  Scalar v_RF_thigh[6];        // velocity, body 9
-  Scalar c_RF_thigh[6];        // velocity-product acceleration, body 9
-  Scalar pA_RF_thigh[6];       // bias force, body 9
-  Scalar g_RF_thigh[3];        // gravity in body coordinates, body 9
-  Scalar v_RF_shank[6];        // velocity, body 10
-  Scalar c_RF_shank[6];        // velocity-product acceleration, body 10
-  Scalar pA_RF_shank[6];       // bias force, body 10
-  Scalar g_RF_shank[3];        // gravity in body coordinates, body 10
-  Scalar k_rf_foot[3];         // constraint right-hand side, constraint 1
   Scalar RJ_RH_hip[3][3];      // joint rotation, body 11
   Scalar v_RH_hip[6];          // velocity, body 11
   Scalar c_RH_hip[6];          // velocity-product acceleration, body 11
   Scalar pA_RH_hip[6];         // bias force, body 11
   Scalar g_RH_hip[3];          // gravity in body coordinates, body 11
+  Scalar v_LF_thigh[6];        // velocity, body 3
+  Scalar c_LF_thigh[6];        // velocity-product acceleration, body 3
+  Scalar pA_LF_thigh[6];       // bias force, body 3
+  Scalar g_LF_thigh[3];        // gravity in body coordinates, body 3
+  Scalar v_LH_thigh[6];        // velocity, body 6
+  Scalar c_LH_thigh[6];        // velocity-product acceleration, body 6
+  Scalar pA_LH_thigh[6];       // bias force, body 6
+  Scalar g_LH_thigh[3];        // gravity in body coordinates, body 6
+  Scalar v_RF_thigh[6];        // velocity, body 9
+  Scalar c_RF_thigh[6];        // velocity-product acceleration, body 9
+  Scalar pA_RF_thigh[6];       // bias force, body 9
+  Scalar g_RF_thigh[3];        // gravity in body coordinates, body 9
   Scalar v_RH_thigh[6];        // velocity, body 12
   Scalar c_RH_thigh[6];        // velocity-product acceleration, body 12
   Scalar pA_RH_thigh[6];       // bias force, body 12
   Scalar g_RH_thigh[3];        // gravity in body coordinates, body 12
+  Scalar v_LF_shank[6];        // velocity, body 4
+  Scalar c_LF_shank[6];        // velocity-product acceleration, body 4
+  Scalar pA_LF_shank[6];       // bias force, body 4
+  Scalar g_LF_shank[3];        // gravity in body coordinates, body 4
+  Scalar k_lf_foot[3];         // constraint right-hand side, constraint 0
+  Scalar v_LH_shank[6];        // velocity, body 7
+  Scalar c_LH_shank[6];        // velocity-product acceleration, body 7
+  Scalar pA_LH_shank[6];       // bias force, body 7
+  Scalar g_LH_shank[3];        // gravity in body coordinates, body 7
+  Scalar k_lh_foot[3];         // constraint right-hand side, constraint 2
+  Scalar v_RF_shank[6];        // velocity, body 10
+  Scalar c_RF_shank[6];        // velocity-product acceleration, body 10
+  Scalar pA_RF_shank[6];       // bias force, body 10
+  Scalar g_RF_shank[3];        // gravity in body coordinates, body 10
+  Scalar k_rf_foot[3];         // constraint right-hand side, constraint 1
   Scalar v_RH_shank[6];        // velocity, body 13
   Scalar c_RH_shank[6];        // velocity-product acceleration, body 13
   Scalar pA_RH_shank[6];       // bias force, body 13
@@ -198,40 +201,40 @@ struct Workspace {
   Scalar Dinv_RH_shank;        // 1 / (S^T IA S), body 13
   Scalar u_RH_shank[1];        // tau - S^T pA, body 13
   Scalar IA_RH_thigh[21];      // articulated inertia (upper triangle), body 12
-  Scalar Dinv_RH_thigh;        // 1 / (S^T IA S), body 12
-  Scalar u_RH_thigh[1];        // tau - S^T pA, body 12
-  Scalar IA_RH_hip[21];        // articulated inertia (upper triangle), body 11
-  Scalar U_RH_hip[6];          // IA S, body 11
-  Scalar Dinv_RH_hip;          // 1 / (S^T IA S), body 11
-  Scalar u_RH_hip[1];          // tau - S^T pA, body 11
-  Scalar IA_trunk[21];         // articulated inertia (upper triangle), body 1
   Scalar U_RF_shank[6];        // IA S, body 10
   Scalar Dinv_RF_shank;        // 1 / (S^T IA S), body 10
   Scalar u_RF_shank[1];        // tau - S^T pA, body 10
   Scalar IA_RF_thigh[21];      // articulated inertia (upper triangle), body 9
-  Scalar Dinv_RF_thigh;        // 1 / (S^T IA S), body 9
-  Scalar u_RF_thigh[1];        // tau - S^T pA, body 9
-  Scalar IA_RF_hip[21];        // articulated inertia (upper triangle), body 8
-  Scalar U_RF_hip[6];          // IA S, body 8
-  Scalar Dinv_RF_hip;          // 1 / (S^T IA S), body 8
-  Scalar u_RF_hip[1];          // tau - S^T pA, body 8
   Scalar U_LH_shank[6];        // IA S, body 7
   Scalar Dinv_LH_shank;        // 1 / (S^T IA S), body 7
   Scalar u_LH_shank[1];        // tau - S^T pA, body 7
   Scalar IA_LH_thigh[21];      // articulated inertia (upper triangle), body 6
-  Scalar Dinv_LH_thigh;        // 1 / (S^T IA S), body 6
-  Scalar u_LH_thigh[1];        // tau - S^T pA, body 6
-  Scalar IA_LH_hip[21];        // articulated inertia (upper triangle), body 5
-  Scalar U_LH_hip[6];          // IA S, body 5
-  Scalar Dinv_LH_hip;          // 1 / (S^T IA S), body 5
-  Scalar u_LH_hip[1];          // tau - S^T pA, body 5
   Scalar U_LF_shank[6];        // IA S, body 4
   Scalar Dinv_LF_shank;        // 1 / (S^T IA S), body 4
   Scalar u_LF_shank[1];        // tau - S^T pA, body 4
   Scalar IA_LF_thigh[21];      // articulated inertia (upper triangle), body 3
+  Scalar Dinv_RH_thigh;        // 1 / (S^T IA S), body 12
+  Scalar u_RH_thigh[1];        // tau - S^T pA, body 12
+  Scalar IA_RH_hip[21];        // articulated inertia (upper triangle), body 11
+  Scalar Dinv_RF_thigh;        // 1 / (S^T IA S), body 9
+  Scalar u_RF_thigh[1];        // tau - S^T pA, body 9
+  Scalar IA_RF_hip[21];        // articulated inertia (upper triangle), body 8
+  Scalar Dinv_LH_thigh;        // 1 / (S^T IA S), body 6
+  Scalar u_LH_thigh[1];        // tau - S^T pA, body 6
+  Scalar IA_LH_hip[21];        // articulated inertia (upper triangle), body 5
   Scalar Dinv_LF_thigh;        // 1 / (S^T IA S), body 3
   Scalar u_LF_thigh[1];        // tau - S^T pA, body 3
   Scalar IA_LF_hip[21];        // articulated inertia (upper triangle), body 2
+  Scalar U_RH_hip[6];          // IA S, body 11
+  Scalar Dinv_RH_hip;          // 1 / (S^T IA S), body 11
+  Scalar u_RH_hip[1];          // tau - S^T pA, body 11
+  Scalar IA_trunk[21];         // articulated inertia (upper triangle), body 1
+  Scalar U_RF_hip[6];          // IA S, body 8
+  Scalar Dinv_RF_hip;          // 1 / (S^T IA S), body 8
+  Scalar u_RF_hip[1];          // tau - S^T pA, body 8
+  Scalar U_LH_hip[6];          // IA S, body 5
+  Scalar Dinv_LH_hip;          // 1 / (S^T IA S), body 5
+  Scalar u_LH_hip[1];          // tau - S^T pA, body 5
   Scalar U_LF_hip[6];          // IA S, body 2
   Scalar Dinv_LF_hip;          // 1 / (S^T IA S), body 2
   Scalar u_LF_hip[1];          // tau - S^T pA, body 2
@@ -241,47 +244,47 @@ struct Workspace {
   Scalar qdd[18];              // joint accelerations
   Scalar a_trunk[6];           // acceleration (gravity-shifted), body 1
   Scalar a_LF_hip[6];          // acceleration (gravity-shifted), body 2
-  Scalar a_LF_thigh[6];        // acceleration (gravity-shifted), body 3
-  Scalar a_LF_shank[6];        // acceleration (gravity-shifted), body 4
   Scalar a_LH_hip[6];          // acceleration (gravity-shifted), body 5
-  Scalar a_LH_thigh[6];        // acceleration (gravity-shifted), body 6
-  Scalar a_LH_shank[6];        // acceleration (gravity-shifted), body 7
   Scalar a_RF_hip[6];          // acceleration (gravity-shifted), body 8
-  Scalar a_RF_thigh[6];        // acceleration (gravity-shifted), body 9
-  Scalar a_RF_shank[6];        // acceleration (gravity-shifted), body 10
   Scalar a_RH_hip[6];          // acceleration (gravity-shifted), body 11
+  Scalar a_LF_thigh[6];        // acceleration (gravity-shifted), body 3
+  Scalar a_LH_thigh[6];        // acceleration (gravity-shifted), body 6
+  Scalar a_RF_thigh[6];        // acceleration (gravity-shifted), body 9
   Scalar a_RH_thigh[6];        // acceleration (gravity-shifted), body 12
+  Scalar a_LF_shank[6];        // acceleration (gravity-shifted), body 4
+  Scalar a_LH_shank[6];        // acceleration (gravity-shifted), body 7
+  Scalar a_RF_shank[6];        // acceleration (gravity-shifted), body 10
   Scalar a_RH_shank[6];        // acceleration (gravity-shifted), body 13
   Scalar residual[12];         // rows of J qdd + gamma - a* of the last solve (residual(w))
   Scalar dlambda[12];          // latest multiplier increment
   Scalar dp_RH_thigh[6];       // reduced-sweep force, body 12
-  Scalar dp_RH_hip[6];         // reduced-sweep force, body 11
-  Scalar dp_trunk[6];          // reduced-sweep force, body 1
   Scalar dp_RF_thigh[6];       // reduced-sweep force, body 9
-  Scalar dp_RF_hip[6];         // reduced-sweep force, body 8
   Scalar dp_LH_thigh[6];       // reduced-sweep force, body 6
-  Scalar dp_LH_hip[6];         // reduced-sweep force, body 5
   Scalar dp_LF_thigh[6];       // reduced-sweep force, body 3
+  Scalar dp_RH_hip[6];         // reduced-sweep force, body 11
+  Scalar dp_RF_hip[6];         // reduced-sweep force, body 8
+  Scalar dp_LH_hip[6];         // reduced-sweep force, body 5
   Scalar dp_LF_hip[6];         // reduced-sweep force, body 2
+  Scalar dp_trunk[6];          // reduced-sweep force, body 1
   Scalar KA_RH_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 12
+  Scalar KA_RF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 9
+  Scalar KA_LH_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 6
+  Scalar KA_LF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 3
   Scalar KSD_RH_thigh[3];      // D^-1 S^T KA, body 12
   Scalar KA_RH_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 11
+  Scalar KSD_RF_thigh[3];      // D^-1 S^T KA, body 9
+  Scalar KA_RF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 8
+  Scalar KSD_LH_thigh[3];      // D^-1 S^T KA, body 6
+  Scalar KA_LH_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 5
+  Scalar KSD_LF_thigh[3];      // D^-1 S^T KA, body 3
+  Scalar KA_LF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 2
   Scalar KS_RH_hip[3];         // S^T KA, body 11
   Scalar KSD_RH_hip[3];        // D^-1 S^T KA, body 11
   Scalar KA_trunk[6][13];      // constraint force directions of the subtree rows (6 x m, one unused column), body 1
-  Scalar KA_RF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 9
-  Scalar KSD_RF_thigh[3];      // D^-1 S^T KA, body 9
-  Scalar KA_RF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 8
   Scalar KS_RF_hip[3];         // S^T KA, body 8
   Scalar KSD_RF_hip[3];        // D^-1 S^T KA, body 8
-  Scalar KA_LH_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 6
-  Scalar KSD_LH_thigh[3];      // D^-1 S^T KA, body 6
-  Scalar KA_LH_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 5
   Scalar KS_LH_hip[3];         // S^T KA, body 5
   Scalar KSD_LH_hip[3];        // D^-1 S^T KA, body 5
-  Scalar KA_LF_thigh[6][4];    // constraint force directions of the subtree rows (6 x m, one unused column), body 3
-  Scalar KSD_LF_thigh[3];      // D^-1 S^T KA, body 3
-  Scalar KA_LF_hip[6][4];      // constraint force directions of the subtree rows (6 x m, one unused column), body 2
   Scalar KS_LF_hip[3];         // S^T KA, body 2
   Scalar KSD_LF_hip[3];        // D^-1 S^T KA, body 2
   Scalar Z_trunk[6][13];       // L^-1 KA (6 x m, one unused column), body 1

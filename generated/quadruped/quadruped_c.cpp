@@ -5,36 +5,39 @@
 // layout layout.yaml sha256 0cdc2ac7258a53cb2f321865ed5fdcd51fb4e725203fe6eb0b4ad207f3f6adf3
 // Operations per call (the printed statements, everything each entry point
 // calls included; K = Settings::iterations; "a + b K": b per multiplier update):
-//   constrained_aba: 4522 + 1188 K (= 8086 at K = 3)
-//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 60 + 26 K, sqrt 7, sincos 12, log6 0
-//   prox_pv: 8489 + 475 K (= 9914 at K = 3)
-//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 105, sqrt 25, sincos 12, log6 0
+//   constrained_aba: 4518 + 1192 K (= 8094 at K = 3)
+//     add/sub 1916 + 527 K, mul 2507 + 635 K, div 20, neg 56 + 30 K, sqrt 7, sincos 12, log6 0
+//   prox_pv: 8492 + 475 K (= 9917 at K = 3)
+//     add/sub 3510 + 204 K, mul 4802 + 271 K, div 35, neg 108, sqrt 25, sincos 12, log6 0
 // Shared blocks (docs/emitter.md): each kernel below runs the blocks that are the
-// same code up to their constants, over a table of each one's constants:
-//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+// same code up to their constants, over a table of each one's constants; two
+// blocks "in pairs" run as one call, one in each lane of a vector register:
+//   shared_0: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_1: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_2: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_3: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_4: 3 blocks of RF_hip, LH_hip, LF_hip
 //   shared_5: 2 blocks of trunk
-//   shared_6: 2 blocks of LF_hip
-//   shared_7: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_8: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_9: 6 blocks of LH_hip, RF_hip, RH_hip
+//   shared_6: 4 blocks of LF_hip, LH_hip (4 in pairs)
+//   shared_7: 4 blocks of RF_hip, RH_hip (4 in pairs)
+//   shared_8: 8 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (8 in pairs)
+//   shared_9: 8 blocks of LF_shank, LH_shank, RF_shank, RH_shank (8 in pairs)
 //   shared_10: 2 blocks of multiplier update: dlambda = mu (K a - k), lambda += dlambda (0 for an inactive constraint)
-//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_11: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_12: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_13: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank
-//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh
+//   shared_14: 4 blocks of RH_shank, RF_shank, LH_shank, LF_shank (4 in pairs)
+//   shared_15: 4 blocks of RH_thigh, RF_thigh, LH_thigh, LF_thigh (4 in pairs)
 //   shared_16: 3 blocks of RF_hip, LH_hip, LF_hip
-//   shared_17: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_18: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_19: 3 blocks of LH_hip, RF_hip, RH_hip
-//   shared_20: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
-//   shared_21: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh
-//   shared_22: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank
-//   shared_23: 3 blocks of LH_hip, RF_hip, RH_hip
+//   shared_17: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_18: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_19: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_20: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
+//   shared_21: 3 blocks of G + I/mu = L L^T, column 3 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 6 (Cholesky, unrolled for the fixed row count), G + I/mu = L L^T, column 9 (Cholesky, unrolled for the fixed row count)
+//   shared_22: 2 blocks of LF_hip, LH_hip (2 in pairs)
+//   shared_23: 2 blocks of RF_hip, RH_hip (2 in pairs)
+//   shared_24: 4 blocks of LF_thigh, LH_thigh, RF_thigh, RH_thigh (4 in pairs)
+//   shared_25: 4 blocks of LF_shank, LH_shank, RF_shank, RH_shank (4 in pairs)
 
 // The C interface of quadruped.hpp, declared in quadruped_c.h: each function
 // copies its scalar arguments into a Settings, makes the caller's buffer the
