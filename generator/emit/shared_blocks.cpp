@@ -575,6 +575,10 @@ class Pairer {
   // An expression with each lanewise value gathered into a pair, each
   // constant of the table read as the pair of the two blocks'.
   bool expression(const std::string& e, std::string& out) const {
+    // A call inside an expression (std::sqrt(x), Scalar(1)): its argument
+    // would be a pair, which the scalar function does not take.
+    for (std::size_t p = e.find('('); p != std::string::npos; p = e.find('(', p + 1))
+      if (p > 0 && identChar(e[p - 1])) return false;
     std::size_t i = 0;
     while (i < e.size()) {
       const char c = e[i];
@@ -582,7 +586,6 @@ class Pairer {
         std::size_t j = i;
         while (j < e.size() && identChar(e[j])) ++j;
         const std::string id = e.substr(i, j - i);
-        if (j < e.size() && e[j] == '(') return false;  // a call inside an expression: not known here
         if (id == "k" && table_ && j < e.size() && e[j] == '[') {
           std::size_t end = j;
           const std::vector<std::string> subs = readSubscripts(e, end);

@@ -181,6 +181,17 @@ TEST(SharedBlocks, BlocksThatTouchWhatTheOtherStoresAreNoPair) {
   EXPECT_EQ(s.kernels[0].pairs, 0);
   EXPECT_EQ(test::occurrences(s.parts, "_x2"), 0);
   EXPECT_EQ(test::occurrences(s.parts, "  shared_0(shared_0_k"), 2);
+  // A call inside an expression would take a pair: the kernel keeps its single form.
+  std::string sqrt = onePart("left", 2, "right", 4);
+  for (std::size_t at = sqrt.find("w.Dinv_"); at != std::string::npos; at = sqrt.find("w.Dinv_", at + 12)) {
+    const std::size_t end = sqrt.find(';', at);
+    sqrt.insert(end, ")");
+    sqrt.insert(at, "std::sqrt(");
+  }
+  const SharedParts withCall = shareBlocks(sqrt, members({"left", "right"}), all, true);
+  ASSERT_EQ(withCall.kernels.size(), 1u) << withCall.parts;
+  EXPECT_EQ(withCall.kernels[0].pairs, 0);
+  EXPECT_EQ(test::occurrences(withCall.parts, "  shared_0(shared_0_k"), 2) << withCall.parts;
   // Not one after the other: two parts.
   const std::string apart = part("a", "left", 2, "0.25") + part("b", "right", 4, "0.5", '-');
   EXPECT_EQ(shareBlocks(apart, members({"left", "right"}), all, true).kernels[0].pairs, 0);
