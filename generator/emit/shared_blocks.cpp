@@ -116,15 +116,27 @@ struct PointerUse {
   bool written = false;
 };
 
+// A kernel parameter besides the table, and what the block passes for it.
+struct Param {
+  std::string before, name, after;  // the declaration: before + name + after
+  std::string arg;                  // the call's argument
+  bool lanewise = true;             // false for a part's scalar (mu: the same for every block)
+  bool written = false;             // the block stores through it
+  // The declaration with the name `name + lane`; in a paired kernel (lane
+  // given) a pointer only read is not restrict: two blocks may read one array.
+  std::string declaration(const std::string& lane = "") const {
+    static const std::string restrict_ = "PROXGEN_RT_RESTRICT ";
+    std::string b = before;
+    if (!lane.empty() && !written && b.find(restrict_) != std::string::npos) b.erase(b.find(restrict_), restrict_.size());
+    return b + name + lane + after;
+  }
+};
+
 struct Canonical {
   std::string key;    // the kernel's text and parameter kinds
   std::string body;   // the kernel's body lines
-  std::string signature;
   std::vector<std::string> constants;  // literal texts, signed
-  std::vector<std::string> args;       // besides the table: the call's arguments
-  std::vector<std::string> argParams;  // per argument: the kernel's parameter it is
-  std::vector<char> argLanewise;       // per argument: 0 for a part's scalar (mu: the same for every block)
-  std::vector<char> argWritten;        // per argument: the block stores through it
+  std::vector<Param> params;           // besides the table
   // The elements it reads or stores: "w.v_x|3", "q|12", "w.KA_x|*" (a subscript
   // that is not a number: any element), for pairing blocks that do not overlap.
   std::set<std::string> touches, writes;
@@ -191,53 +203,43 @@ class Canonicalizer {
       if (!scan(l, temps, &o)) return false;
       body += (o.compare(0, 2, "  ") == 0 ? o.substr(2) : o) + "\n";  // the block's indent, less the braces'
     }
-    // The table of constants, when the block has any.
-    std::vector<std::string> params;
-    if (!constants_.empty()) params.push_back("const Scalar* PROXGEN_RT_RESTRICT k");
     std::string kinds;
+    auto param = [&](const std::string& before, const std::string& name, const std::string& after,
+                     const std::string& arg, bool lanewise, bool written) {
+      out.params.push_back({before, name, after, arg, lanewise, written});
+    };
     for (const auto& [n, u] : pointerUse_) {  // in name order: a deterministic signature
       const std::string& p = pointers_.at(n);
-      params.push_back(fmt::format("{} {}", p, n));
-      out.args.push_back(u.loose || u.base == 0 ? n : fmt::format("&{}[{}]", n, u.base));
-      out.argParams.push_back(n), out.argLanewise.push_back(1), out.argWritten.push_back(u.written);
+      param(p + " ", n, "", u.loose || u.base == 0 ? n : fmt::format("&{}[{}]", n, u.base), true, u.written);
       kinds += "p:" + n + p + (u.loose ? "L" : "") + ";";
     }
     for (const std::string& n : usedScalars_) {
-      params.push_back(fmt::format("{} {}", scalars_.at(n), n));
-      out.args.push_back(n);
-      out.argParams.push_back(n), out.argLanewise.push_back(0), out.argWritten.push_back(0);
+      param(scalars_.at(n) + " ", n, "", n, false, false);
       kinds += "s:" + n + ";";
     }
     for (std::size_t i = 0; i < memberUse_.size(); ++i) {
       const MemberUse& u = memberUse_[i];
       const long base = u.loose || u.base == LONG_MAX ? 0 : u.base;
       const std::string p = paramName(i);
-      out.argParams.push_back(p), out.argLanewise.push_back(1), out.argWritten.push_back(u.written);
       if (!u.array && !u.written) {
-        params.push_back(fmt::format("Scalar {}", p));
-        out.args.push_back("w." + u.name);
+        param("Scalar ", p, "", "w." + u.name, true, false);
         kinds += "v" + p + ";";
       } else if (!u.array) {
-        params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
-        out.args.push_back("&w." + u.name);
+        param("Scalar* PROXGEN_RT_RESTRICT ", p, "", "&w." + u.name, true, true);
         kinds += "m" + p + ";";
       } else if (u.cols == 0) {
-        params.push_back(fmt::format("Scalar* PROXGEN_RT_RESTRICT {}", p));
-        out.args.push_back(base == 0 ? "w." + u.name : fmt::format("&w.{}[{}]", u.name, base));
+        param("Scalar* PROXGEN_RT_RESTRICT ", p, "", base == 0 ? "w." + u.name : fmt::format("&w.{}[{}]", u.name, base),
+              true, u.written);
         kinds += "a" + p + ";";
       } else {
-        params.push_back(fmt::format("Scalar (*PROXGEN_RT_RESTRICT {})[{}]", p, u.cols));
-        out.args.push_back("w." + u.name);
+        param("Scalar (*PROXGEN_RT_RESTRICT ", p, fmt::format(")[{}]", u.cols), "w." + u.name, true, u.written);
         kinds += fmt::format("x{}{};", p, u.cols);
         if (!u.loose) {
-          params.push_back(fmt::format("int {}_col", p));
-          out.args.push_back(fmt::format("{}", base));
-          out.argParams.push_back(p + "_col"), out.argLanewise.push_back(1), out.argWritten.push_back(0);
+          param("int ", p + "_col", "", fmt::format("{}", base), true, false);
           kinds += "o;";
         }
       }
     }
-    for (std::size_t i = 0; i < params.size(); ++i) out.signature += (i ? ", " : "") + params[i];
     out.body = std::move(body);
     out.constants = std::move(constants_);
     out.key = kinds + "\n" + out.body;
@@ -499,12 +501,17 @@ std::string withCommonLiterals(const std::string& body, const std::vector<std::s
 // form, each value in a lane of proxgen_rt::lanes<Scalar, 2> (docs/emitter.md,
 // "Blocks in pairs").
 
+// Whether a name of its own starts at `i` (not a member `.x` or a qualified `::x`).
+bool nameAt(const std::string& s, std::size_t i) {
+  return identStart(s[i]) && (i == 0 || (!identChar(s[i - 1]) && s[i - 1] != '.' && s[i - 1] != ':'));
+}
+
 // `text` with each parameter of `lanewise` renamed to its lane's (v_m2 -> v_m2_a).
 std::string inLane(const std::string& text, const std::set<std::string>& lanewise, const std::string& lane) {
   std::string out;
   std::size_t i = 0;
   while (i < text.size()) {
-    if (identStart(text[i]) && (i == 0 || (!identChar(text[i - 1]) && text[i - 1] != '.' && text[i - 1] != ':'))) {
+    if (nameAt(text, i)) {
       std::size_t j = i;
       while (j < text.size() && identChar(text[j])) ++j;
       const std::string id = text.substr(i, j - i);
@@ -582,7 +589,7 @@ class Pairer {
     std::size_t i = 0;
     while (i < e.size()) {
       const char c = e[i];
-      if (identStart(c) && (i == 0 || (!identChar(e[i - 1]) && e[i - 1] != '.' && e[i - 1] != ':'))) {
+      if (nameAt(e, i)) {
         std::size_t j = i;
         while (j < e.size() && identChar(e[j])) ++j;
         const std::string id = e.substr(i, j - i);
@@ -636,34 +643,26 @@ bool overlap(const std::set<std::string>& writes, const std::set<std::string>& t
 bool independent(const Block& a, const Canonical& ca, const Block& b, const Canonical& cb) {
   if (a.part != b.part || b.comment != a.end + 1 || overlap(ca.writes, cb.touches) || overlap(cb.writes, ca.touches))
     return false;
-  for (std::size_t i = 0; i < ca.args.size(); ++i)
-    if (ca.argWritten[i] && ca.args[i] == cb.args[i]) return false;
+  for (std::size_t i = 0; i < ca.params.size(); ++i)
+    if (ca.params[i].written && ca.params[i].arg == cb.params[i].arg) return false;
   return true;
 }
 
-// The parameters of a signature ("T a, U b"); none of them has a comma inside.
-std::vector<std::string> splitParams(const std::string& signature) {
+// A kernel's parameter list: the table of constants `k` when it has one, then
+// each parameter, twice (name_a, name_b) in the paired form (`paired`) unless
+// it is a part's scalar, passed once.
+std::string parameterList(bool table, const std::vector<Param>& params, bool paired) {
   std::vector<std::string> out;
-  std::size_t at = 0;
-  while (at < signature.size()) {
-    std::size_t comma = signature.find(", ", at);
-    if (comma == std::string::npos) comma = signature.size();
-    out.push_back(signature.substr(at, comma - at));
-    at = comma + 2;
+  if (table) out.push_back("const Scalar* PROXGEN_RT_RESTRICT k");
+  for (const Param& p : params) {
+    if (!paired || !p.lanewise) {
+      out.push_back(p.declaration());
+    } else {
+      out.push_back(p.declaration("_a"));
+      out.push_back(p.declaration("_b"));
+    }
   }
-  return out;
-}
-
-// `param` ("Scalar (*PROXGEN_RT_RESTRICT IA_m3)[6]") with its name `name` given `lane`.
-std::string paramInLane(const std::string& param, const std::string& name, const std::string& lane) {
-  std::size_t at = param.size();
-  while ((at = param.rfind(name, at == 0 ? std::string::npos : at - 1)) != std::string::npos) {
-    const std::size_t end = at + name.size();
-    if ((at == 0 || !identChar(param[at - 1])) && (end == param.size() || !identChar(param[end])))
-      return param.substr(0, end) + lane + param.substr(end);
-    if (at == 0) break;
-  }
-  return param;
+  return fmt::format("{}", fmt::join(out, ", "));
 }
 
 }  // namespace
@@ -725,10 +724,6 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     for (std::size_t c = 0; c < nk; ++c)
       if (!common[c]) slot[c] = varying++;
     const std::string body = withCommonLiterals(first.body, first.constants, common, slot);
-    std::string signature = first.signature;
-    const std::string tableParam = "const Scalar* PROXGEN_RT_RESTRICT k";
-    if (nk > 0 && varying == 0)
-      signature = signature.size() > tableParam.size() ? signature.substr(tableParam.size() + 2) : "";
     std::string tables;
     std::set<std::string> bodies;
     std::string bodyList;
@@ -748,8 +743,8 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     }
     // The paired form, when the kernel's lines are ones it knows.
     std::set<std::string> lanewise;
-    for (std::size_t a = 0; a < first.argParams.size(); ++a)
-      if (first.argLanewise[a]) lanewise.insert(first.argParams[a]);
+    for (const Param& p : first.params)
+      if (p.lanewise) lanewise.insert(p.name);
     // Every constant of it in the table of pairs, common ones too (pair_at: an
     // aligned load the compiler folds into the operation; a literal would be
     // loaded and duplicated).
@@ -773,9 +768,9 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
                                       2 * nk, both);
           args = t->second;
         }
-        for (std::size_t a = 0; a < f.canon.args.size(); ++a) {
-          args += (args.empty() ? "" : ", ") + f.canon.args[a];
-          if (f.canon.argLanewise[a]) args += ", " + h.canon.args[a];
+        for (std::size_t a = 0; a < f.canon.params.size(); ++a) {
+          args += (args.empty() ? "" : ", ") + f.canon.params[a].arg;
+          if (f.canon.params[a].lanewise) args += ", " + h.canon.params[a].arg;
         }
         calls[f.where.part][f.where.comment] = {
             h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
@@ -790,44 +785,22 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
         if (fresh) tables += fmt::format("constexpr Scalar {}[{}] = {{{}}};\n", t->second, varying, values[n]);
         args = t->second;
       }
-      for (const std::string& a : f.canon.args) args += (args.empty() ? "" : ", ") + a;
+      for (const Param& p : f.canon.params) args += (args.empty() ? "" : ", ") + p.arg;
       calls[f.where.part][f.where.comment] = {f.where.end, fmt::format("  {}({});", k.name, args)};
     }
     kernels += fmt::format("// {} blocks of the same code, each over its constants (k) and members: {}.\n// The first: {}\n",
                            g.size(), bodyList, parts[found[g.front()].where.part].lines[found[g.front()].where.comment].substr(5));
     if (single) {
       kernels += tables;
-      kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name, signature, body);
+      kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name,
+                             parameterList(varying > 0, first.params, false), body);
     }
     if (k.pairs > 0) {
-      // The parameters of each lane, side by side; a part's scalar once.
-      std::vector<std::string> params = splitParams(first.signature), pairedParams;
-      std::size_t a = 0;
-      for (const std::string& param : params) {
-        if (param == tableParam) {
-          pairedParams.push_back(param);
-          continue;
-        }
-        const std::size_t at = a++;
-        const std::string& name = first.argParams[at];
-        if (first.argLanewise[at]) {
-          // Two blocks may read one member (their parent's velocity): only a
-          // pointer stored through is restrict, which is what the compiler
-          // needs, and reading one array through two pointers stays legal.
-          std::string p = param;
-          const std::string kRestrict = "PROXGEN_RT_RESTRICT ";
-          if (!first.argWritten[at] && p.find(kRestrict) != std::string::npos) p.erase(p.find(kRestrict), kRestrict.size());
-          pairedParams.push_back(paramInLane(p, name, "_a"));
-          pairedParams.push_back(paramInLane(p, name, "_b"));
-        } else {
-          pairedParams.push_back(param);
-        }
-      }
       kernels += fmt::format("// {}'s blocks two at a time, one in each lane of a ScalarPair:\n// {} pair{}.\n", k.name,
                              k.pairs, k.pairs > 1 ? "s" : "");
       kernels += pairTables;
       kernels += fmt::format("PROXGEN_RT_NOINLINE void {}_x2({}) noexcept {{\n{}}}\n\n", k.name,
-                             fmt::join(pairedParams, ", "), pairedText);
+                             parameterList(nk > 0, first.params, true), pairedText);
     }
     out.kernels.push_back(std::move(k));
   }
