@@ -144,11 +144,28 @@ void rowsFreeFlyer(Emit& e, const Articulated& art, int i, ProxRows& rows) {
   for (int j = 0; j < m; ++j)
     for (int d = 0; d < 6; ++d) b.KS[std::size_t(j)][std::size_t(d)] = b.KA[std::size_t(j)][std::size_t(d)];
   b.Z.resize(std::size_t(m));
-  for (int j = 0; j < m; ++j) {
+  CodeBuilder& cb = e.cb();
+  const int stride = rowStride(m);
+  for (int c0 = 0; c0 < m;) {
+    if (const int len = loopableColumns(e, b, i, c0); len >= kShortestColumnLoop) {
+      // Columns c0 .. c0 + len - 1 hold stored KA entries: one loop (vectorised
+      // by the compiler, two columns per register) instead of len solves.
+      cb.open(columnLoopHead(len), {fmt::format("Z = L^-1 KA, columns {} to {}", c0, c0 + len - 1)});
+      std::vector<Expr> ka(6);
+      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
+      const std::vector<Expr> z = forwardSolve(cb, ab.L, ab.Linv, ka);
+      for (int d = 0; d < 6; ++d) cb.store(e.loopSlot(kZ, i, 6, stride, d, c0), z[std::size_t(d)]);
+      cb.close();
+      for (int c = c0; c < c0 + len; ++c)
+        for (int d = 0; d < 6; ++d) b.Z[std::size_t(c)][std::size_t(d)] = cb.member(e.member(kZ, i, 6, stride, d, c));
+      c0 += len;
+      continue;
+    }
     const std::vector<Expr> z =
-        forwardSolve(e.cb(), ab.L, ab.Linv, std::vector<Expr>(b.KA[std::size_t(j)].begin(), b.KA[std::size_t(j)].end()));
+        forwardSolve(cb, ab.L, ab.Linv, std::vector<Expr>(b.KA[std::size_t(c0)].begin(), b.KA[std::size_t(c0)].end()));
     for (int d = 0; d < 6; ++d)
-      b.Z[std::size_t(j)][std::size_t(d)] = e.keep(e.member(kZ, i, 6, rowStride(m), d, j), z[std::size_t(d)]);
+      b.Z[std::size_t(c0)][std::size_t(d)] = e.keep(e.member(kZ, i, 6, stride, d, c0), z[std::size_t(d)]);
+    ++c0;
   }
 }
 

@@ -91,6 +91,34 @@ TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
   EXPECT_GT(test::occurrences(f.source, "w.Wz[0][j]"), 0);
 }
 
+// At the free flyer every carried column goes through the same solve, Z = L^-1
+// KA: where KA's entries are all stored (rows turned by the joints below), the
+// columns are one loop, which the compiler vectorises, two columns per
+// register (docs/emitter.md, "The free flyer's Z as a loop"). A Cartesian leg's
+// columns have folded entries (zeros at the top of KA): they stay unrolled,
+// their zeros folded.
+TEST(DelassusCode, TheFreeFlyersColumnsOfZAreOneLoop) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  const SolverFiles solo = generateCase(cases, "solo_f3x4", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  EXPECT_EQ(lineAfter(solo.source, "// Z = L^-1 KA, columns 0 to 11"),
+            "    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 12; ++j) {")
+      << solo.source.substr(solo.source.find("Z = L^-1"), 400);
+  EXPECT_EQ(test::occurrences(solo.source, "w.Z_base_link[5][j] = "), 1);
+  EXPECT_EQ(test::occurrences(solo.source, "w.Z_base_link[0][0] = "), 0) << "a column of Z unrolled";
+  const SolverFiles atlas =
+      generateCase(cases, "atlas_shadow_f6x2_t3x10", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+  EXPECT_EQ(lineAfter(atlas.source, "// Z = L^-1 KA, columns 0 to 41"),
+            "    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 42; ++j) {");
+  GenerateOptions g;
+  g.urdf = test::sourceDir() + "/tests/data/good/cartesian_leg.urdf";
+  g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
+  g.functions = "prox_pv";
+  const SolverFiles leg = generateFiles(g);
+  EXPECT_EQ(test::occurrences(leg.source, "// Z = L^-1 KA, columns"), 0);
+  EXPECT_GT(test::occurrences(leg.source, "w.Z_hull[5][0] = "), 0);
+}
+
 // The Atlas' right hand holds rows 15 to 29 (five fingertips, three rows
 // each), which all meet at the palm: in column 19 (the second row of the
 // fingertip of rows 18 to 20) the rows of the other fingertips, 21 to 29,
