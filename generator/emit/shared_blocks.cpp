@@ -584,8 +584,11 @@ class Pairer {
   bool expression(const std::string& e, std::string& out) const {
     // A call inside an expression (std::sqrt(x), Scalar(1)): its argument
     // would be a pair, which the scalar function does not take.
+    // (A signed pair's flip takes pairs: signedBody below.)
+    static const std::string flip = "proxgen_rt::flip";
     for (std::size_t p = e.find('('); p != std::string::npos; p = e.find('(', p + 1))
-      if (p > 0 && identChar(e[p - 1])) return false;
+      if (p > 0 && identChar(e[p - 1]) && !(p >= flip.size() && e.compare(p - flip.size(), flip.size(), flip) == 0))
+        return false;
     std::size_t i = 0;
     while (i < e.size()) {
       const char c = e[i];
@@ -621,6 +624,117 @@ class Pairer {
   const std::set<std::string>& lanewise_;
   bool table_;
 };
+
+// ---- Signed pairs: two blocks whose canonical text is the same but for
+// signs (a left and a right arm whose joints turn about negated axes) run as
+// a pair, each sign where they differ a flip of one lane (docs/emitter.md,
+// "Mirrored blocks: signed pairs").
+
+// A body with its sign slots marked: each term's start (an expression's
+// first term, the first after "(": kTermStart, its sign '-' where a unary
+// minus stood) and each binary " + " / " - " (kBinary), outside subscripts.
+constexpr char kTermStart = '\x01';
+constexpr char kBinary = '\x02';
+struct SignSlots {
+  std::string text;   // the body, each slot a marker
+  std::string signs;  // '+' or '-' per slot, in order
+};
+
+// One statement's expression into `out`; false for a form it does not know.
+bool markExpression(const std::string& e, SignSlots& out) {
+  int bracket = 0;
+  bool termStart = true;
+  for (std::size_t i = 0; i < e.size();) {
+    const char c = e[i];
+    if (c == kTermStart || c == kBinary) return false;
+    if (c == '(' && i > 0 && identChar(e[i - 1])) return false;  // a call: its arguments are no terms here
+    if (bracket == 0 && termStart) {
+      termStart = false;
+      out.text += kTermStart;
+      if (c == '-') {
+        out.signs += '-';
+        ++i;
+        continue;
+      }
+      out.signs += '+';
+    }
+    if (c == '[') ++bracket;
+    if (c == ']') --bracket;
+    if (bracket == 0 && (e.compare(i, 3, " + ") == 0 || e.compare(i, 3, " - ") == 0)) {
+      out.text += std::string(" ") + kBinary + " ";
+      out.signs += e[i + 1];
+      i += 3;
+      if (i < e.size() && (e[i] == '-' || e[i] == '+')) return false;
+      continue;
+    }
+    out.text += c;
+    if (bracket == 0 && c == '(') termStart = true;
+    ++i;
+  }
+  return bracket == 0;
+}
+
+// The statements' expressions of a canonical body, marked; false when a
+// statement has a form the marking does not know (the block is not paired so).
+bool markSigns(const std::string& body, SignSlots& out) {
+  std::size_t at = 0;
+  while (at < body.size()) {
+    std::size_t eol = body.find('\n', at);
+    if (eol == std::string::npos) eol = body.size();
+    const std::string l = body.substr(at, eol - at);
+    at = eol + 1;
+    const std::size_t first = l.find_first_not_of(' ');
+    const std::size_t eq = l.find(" = ");
+    const bool statement = first != std::string::npos && l.back() == ';' && eq != std::string::npos &&
+                           l.compare(first, 4, "for ") != 0 && l.compare(first, 20, "PROXGEN_RT_NO_UNROLL") != 0;
+    if (!statement) {
+      if (l.find(kTermStart) != std::string::npos || l.find(kBinary) != std::string::npos) return false;
+      out.text += l + "\n";
+      continue;
+    }
+    out.text += l.substr(0, eq + 3);
+    if (!markExpression(l.substr(eq + 3, l.size() - eq - 4), out)) return false;
+    out.text += ";\n";
+  }
+  return true;
+}
+
+// The marked text printed back: `pattern` per slot, '+' or '-' (that sign, as
+// the printer writes it) or 'v' (the two lanes differ: a flip by the pair of
+// signs k[first + n] for the n-th such slot, around the slot's term).
+std::string signedBody(const std::string& text, const std::string& pattern, std::size_t first) {
+  std::string out;
+  std::size_t slot = 0, varying = first;
+  int depth = 0;
+  std::vector<int> open;  // the depths of the flips not closed yet
+  auto close = [&](int d) {
+    while (!open.empty() && open.back() == d) out += ")", open.pop_back();
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == kTermStart || (c == kBinary && i >= 1)) {
+      const char sign = pattern[slot++];
+      if (c == kBinary) {
+        out.pop_back();  // the space before the marker
+        close(depth);
+        ++i;  // the space after it
+        out += sign == '-' ? " - " : " + ";
+      } else if (sign == '-') {
+        out += "-";
+      }
+      if (sign == 'v') {
+        out += fmt::format("proxgen_rt::flip(k[{}], ", varying++);
+        open.push_back(depth);
+      }
+      continue;
+    }
+    if (c == '(') ++depth;
+    if (c == ')') close(depth), --depth;
+    if (c == ';' || c == '\n') close(depth);
+    out += c;
+  }
+  return out;
+}
 
 // Whether two blocks' elements overlap: one stores what the other reads or stores.
 bool overlap(const std::set<std::string>& writes, const std::set<std::string>& touches) {
@@ -802,6 +916,105 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       kernels += fmt::format("PROXGEN_RT_NOINLINE void {}_x2({}) noexcept {{\n{}}}\n\n", k.name,
                              parameterList(nk > 0, first.params, true), pairedText);
     }
+    out.kernels.push_back(std::move(k));
+  }
+  // Signed pairs: of the blocks no kernel took, two one after the other whose
+  // text is the same but for signs, and independent, run as one call of a
+  // paired kernel that turns one lane's sign where the two differ.
+  std::vector<std::size_t> alone;
+  for (const std::string& key : order)
+    if (pairs && groups.at(key).size() == 1) alone.push_back(groups.at(key).front());
+  std::sort(alone.begin(), alone.end());  // found is in file order
+  struct Signed {
+    std::string key;  // the parameter kinds and the marked body
+    SignSlots slots;
+  };
+  std::vector<Signed> marked(alone.size());
+  std::map<std::string, std::vector<std::size_t>> signedKernel;  // key + pattern -> the pairs' first blocks (in alone)
+  std::vector<std::string> signedOrder;
+  for (std::size_t n = 0; n + 1 < alone.size(); ++n) {
+    const Found& f = found[alone[n]];
+    const Found& h = found[alone[n + 1]];
+    for (std::size_t m : {n, n + 1}) {
+      const Canonical& c = found[alone[m]].canon;
+      if (!marked[m].key.empty()) continue;
+      if (!markSigns(c.body, marked[m].slots)) {
+        marked[m].key = "-";  // no pair
+        continue;
+      }
+      marked[m].key = c.key.substr(0, c.key.size() - c.body.size()) + marked[m].slots.text;
+    }
+    if (marked[n].key == "-" || marked[n].key != marked[n + 1].key || !independent(f.where, f.canon, h.where, h.canon))
+      continue;
+    std::string pattern;
+    for (std::size_t i = 0; i < marked[n].slots.signs.size(); ++i) {
+      const char a = marked[n].slots.signs[i], b = marked[n + 1].slots.signs[i];
+      pattern += a == b ? a : 'v';
+    }
+    const std::string key = marked[n].key + "\n" + pattern;
+    auto [it, fresh] = signedKernel.emplace(key, std::vector<std::size_t>{});
+    if (fresh) signedOrder.push_back(key);
+    it->second.push_back(n);
+    ++n;  // the second block is taken
+  }
+  for (const std::string& key : signedOrder) {
+    const std::vector<std::size_t>& firsts = signedKernel.at(key);
+    const Canonical& first = found[alone[firsts.front()]].canon;
+    const std::string pattern = key.substr(key.rfind('\n') + 1);
+    const std::size_t nk = first.constants.size();
+    std::set<std::string> lanewise;
+    for (const Param& p : first.params)
+      if (p.lanewise) lanewise.insert(p.name);
+    const std::size_t nv = std::size_t(std::count(pattern.begin(), pattern.end(), 'v'));
+    std::string pairedText;
+    if (!Pairer(lanewise, nk + nv > 0).run(signedBody(marked[firsts.front()].slots.text, pattern, nk), pairedText))
+      continue;  // left inline
+    SharedKernel k;
+    k.name = fmt::format("shared_{}", out.kernels.size());
+    std::string pairTables, bodyList;
+    std::map<std::string, std::string> pairTableOf;
+    for (std::size_t n : firsts) {
+      const Found& f = found[alone[n]];
+      const Found& h = found[alone[n + 1]];
+      for (const Found* b : {&f, &h}) {
+        const std::string comment = parts[b->where.part].lines[b->where.comment];
+        k.blocks.push_back(comment.substr(5));
+        const std::string bodyName = blockBody(comment.substr(5));
+        if (std::find(k.bodies.begin(), k.bodies.end(), bodyName) == k.bodies.end()) {
+          bodyList += (bodyList.empty() ? "" : ", ") + bodyName;
+          k.bodies.push_back(bodyName);
+        }
+      }
+      std::string both;
+      for (std::size_t c = 0; c < nk; ++c) both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
+      for (std::size_t i = 0; i < pattern.size(); ++i)
+        if (pattern[i] == 'v')
+          both += fmt::format("{}{}, {}", both.empty() ? "" : ", ", marked[n].slots.signs[i] == '-' ? "-1" : "1",
+                              marked[n + 1].slots.signs[i] == '-' ? "-1" : "1");
+      std::string args;
+      if (nk + nv > 0) {
+        auto [t, fresh] = pairTableOf.emplace(both, fmt::format("{}_p{}", k.name, pairTableOf.size()));
+        if (fresh)
+          pairTables += fmt::format("alignas(2 * sizeof(Scalar)) constexpr Scalar {}[{}] = {{{}}};\n", t->second,
+                                    2 * (nk + nv), both);
+        args = t->second;
+      }
+      for (std::size_t a = 0; a < f.canon.params.size(); ++a) {
+        args += (args.empty() ? "" : ", ") + f.canon.params[a].arg;
+        if (f.canon.params[a].lanewise) args += ", " + h.canon.params[a].arg;
+      }
+      calls[f.where.part][f.where.comment] = {
+          h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
+      ++k.pairs;
+    }
+    kernels += fmt::format(
+        "// {} blocks of the same code but for {} sign{} (mirrored: turned in one lane), two at a time: {}.\n"
+        "// The first: {}\n",
+        2 * k.pairs, nv, nv == 1 ? "" : "s", bodyList,
+        parts[found[alone[firsts.front()]].where.part].lines[found[alone[firsts.front()]].where.comment].substr(5));
+    kernels += pairTables;
+    kernels += fmt::format("PROXGEN_RT_NOINLINE void {}_x2({}) noexcept {{\n{}}}\n\n", k.name,
+                           parameterList(nk + nv > 0, first.params, true), pairedText);
     out.kernels.push_back(std::move(k));
   }
   if (out.kernels.empty()) {

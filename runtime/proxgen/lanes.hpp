@@ -287,6 +287,18 @@ inline void scatter2(const lanes<S, 2>& x, S& a, S& b) noexcept {
   b = x.x[1];
 }
 
+/// x with each lane's sign turned where that lane's sign is -1: `sign` holds
+/// +1 or -1 per lane (a pair of the table). Two mirrored blocks (a left and a
+/// right arm about negated axes) print the same code but for signs; where they
+/// differ, the pair turns one lane: `a - x` in one block and `a + x` in the
+/// other run as `a + flip(s, x)`. Exact: a product with +-1 only turns the sign
+/// bit, so each lane's value is its block's bit for bit (of a NaN, whose sign
+/// IEEE 754 leaves to the operation, that it is a NaN).
+template <class S, int W>
+inline lanes<S, W> flip(const lanes<S, W>& sign, const lanes<S, W>& x) noexcept {
+  return sign * x;
+}
+
 /// Pair i of a table of pairs {a0, b0, a1, b1, ...}: the two blocks'
 /// constants. The table is aligned to a pair (alignas(2 * sizeof(S))), so the
 /// pair is one aligned load, which the compiler folds into the operation that

@@ -122,8 +122,13 @@ Source functions(const std::string& text) {
 
 Poly count(Source& src, const std::string& fn);
 
-// One statement line: its operator tokens and calls.
-Poly countLine(Source& src, const std::string& line) {
+// One statement line: its operator tokens and calls. `flips`: a signed
+// pair's turns of one lane (proxgen_rt::flip, docs/emitter.md, "Mirrored
+// blocks: signed pairs") that stand for one block's negation: at a term's
+// start one block negated where the other did not (one negation, whichever
+// lane); after a `+` one block subtracted where the other added, which the `+`
+// already counts for both lanes.
+Poly countLine(Source& src, const std::string& line, long* flips = nullptr) {
   Poly p;
   const std::vector<Token> t = lex(line);
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -144,6 +149,10 @@ Poly countLine(Source& src, const std::string& line) {
       else if (x == "proxgen_rt::log6") ++p.once[6];
       else if (x == "proxgen_rt::largest_magnitude") continue;  // compares and selects: no counted arithmetic
       else if (x == "proxgen_rt::gather2" || x == "proxgen_rt::pair_at") continue;  // a pair's loads: no arithmetic
+      else if (x == "proxgen_rt::flip") {
+        if (!flips) ADD_FAILURE() << "a flip outside a paired kernel: " << line;
+        else if (!(k > 0 && t[k - 1].kind == Token::Punct && t[k - 1].text == "+")) ++*flips;
+      }
       else if (src.bodies.count(x)) addTo(p, count(src, x));
       else if (x != "Scalar") ADD_FAILURE() << "a call the count does not know: " << x << " in: " << line;
     }
@@ -209,7 +218,10 @@ Poly count(Source& src, const std::string& fn) {
     // A paired kernel (shared_<k>_x2) runs two blocks in the lanes of a pair:
     // each operation twice; a call statement (sincos) is printed per lane.
     const bool paired = fn.size() > 3 && fn.compare(fn.size() - 3, 3, "_x2") == 0;
-    addTo(stack.back().p, countLine(src, line), paired && line.rfind("proxgen_rt::sincos", 0) != 0 ? 2 : 1);
+    long flips = 0;
+    addTo(stack.back().p, countLine(src, line, paired ? &flips : nullptr),
+          paired && line.rfind("proxgen_rt::sincos", 0) != 0 ? 2 : 1);
+    stack.back().p.once[3] += flips;  // one block's negation each, not two
   }
   EXPECT_EQ(stack.size(), 1u) << "unbalanced braces in " << fn;
   src.memo[fn] = stack[0].p;
@@ -292,6 +304,12 @@ TEST(OperationCount, TheLexerReadsWhatItShould) {
   EXPECT_EQ(p.once, (Counts{1, 1, 0, 0, 0, 0, 0}));  // -1.5 is a literal
   p = countLine(src, "const Scalar r0 = std::sqrt(t3); proxgen_rt::sincos_joint(q[0], w.sq[0], w.cq[0]); x = 1.0 / r0;");
   EXPECT_EQ(p.once, (Counts{0, 0, 1, 0, 1, 1, 0}));
+  // A signed pair's flips: at a term's start one block's negation, after a + nothing (the + counts).
+  long flips = 0;
+  p = countLine(src, "const ScalarPair x0 = proxgen_rt::flip(proxgen_rt::pair_at(k, 2), a*b) + "
+                     "proxgen_rt::flip(proxgen_rt::pair_at(k, 3), c);", &flips);
+  EXPECT_EQ(p.once, (Counts{1, 1, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(flips, 1);
 }
 
 TEST(OperationCount, TheBannerCountsWhatTheExamplesCompute) {
@@ -347,6 +365,11 @@ TEST(OperationCount, SharedCases) {
   for (const char* name : {"iiwa_h3", "solo_f3x4"}) {
     expectCountsMatch(generateCase(test::modelPath("cases.yaml"), name, "", ScalarType::Double), name, 3);
   }
+  // The Atlas' arms turn about negated axes: its mirrored blocks run as signed
+  // pairs, whose flips the count reads as the one block's negation.
+  const SolverFiles atlas = generateCase(test::modelPath("cases.yaml"), "atlas_shadow_f6x2", "", ScalarType::Double);
+  EXPECT_GT(test::occurrences(atlas.source, "proxgen_rt::flip("), 0);
+  expectCountsMatch(atlas, "atlas_shadow_f6x2", 3);
 }
 
 }  // namespace

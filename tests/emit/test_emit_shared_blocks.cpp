@@ -197,6 +197,52 @@ TEST(SharedBlocks, BlocksThatTouchWhatTheOtherStoresAreNoPair) {
   EXPECT_EQ(shareBlocks(apart, members({"left", "right"}), all, true).kernels[0].pairs, 0);
 }
 
+// A left and a right block that print the same statements but for signs (a
+// joint about -z and one about z: `-pA + tau` against `pA + tau`, `+ t*u`
+// against `- t*u`) run as one call of a signed pair: where the signs differ,
+// the pair turns one lane (proxgen_rt::flip by a pair of signs from the table,
+// after the constants); where they agree, the sign is printed as it was. Only
+// blocks no kernel took pair so; without pairs nothing changes.
+TEST(SharedBlocks, MirroredBlocksThatDifferInSignsRunAsASignedPair) {
+  std::string text = onePart("left", 2, "right", 4);
+  const std::string negated = "w.u_right[0] = -w.pA_right[5]", subtracted = "w.IA_base[4] + t4*";
+  text.replace(text.find(negated), negated.size(), "w.u_right[0] = w.pA_right[5]");
+  text.replace(text.find(subtracted), subtracted.size(), "w.IA_base[4] - t4*");
+  const SharedParts s = shareBlocks(text, members({"left", "right"}), all, true);
+  ASSERT_EQ(s.kernels.size(), 1u) << s.parts;
+  EXPECT_EQ(s.kernels[0].pairs, 1);
+  EXPECT_EQ(s.kernels[0].blocks.size(), 2u);
+  EXPECT_EQ(test::occurrences(s.parts, "void shared_0("), 0) << s.parts;
+  EXPECT_NE(s.parts.find("// 2 blocks of the same code but for 2 signs (mirrored: turned in one lane), two at a "
+                         "time: left, right."),
+            std::string::npos)
+      << s.parts;
+  // Constants {a0, b0, a1, b1}, then the signs of the two differing slots.
+  EXPECT_NE(s.parts.find("alignas(2 * sizeof(Scalar)) constexpr Scalar shared_0_p0[8] = {0.25, -0.5, -1.5e-05, "
+                         "-1.5e-05, -1, 1, 1, -1};"),
+            std::string::npos)
+      << s.parts;
+  EXPECT_NE(s.parts.find("  proxgen_rt::scatter2<Scalar>(proxgen_rt::flip(proxgen_rt::pair_at(k, 2), "
+                         "proxgen_rt::gather2(pA_m3_a[0], pA_m3_b[0])) + proxgen_rt::gather2(tau_a[0], tau_b[0]), "
+                         "u_m2_a[0], u_m2_b[0]);"),
+            std::string::npos)
+      << s.parts;
+  EXPECT_NE(s.parts.find(" + proxgen_rt::flip(proxgen_rt::pair_at(k, 3), x0*proxgen_rt::gather2(u_m2_a[0], "
+                         "u_m2_b[0])) + proxgen_rt::pair_at(k, 1)*proxgen_rt::gather2(tau_a[1], tau_b[1]), "),
+            std::string::npos)
+      << s.parts;
+  EXPECT_NE(s.parts.find("  shared_0_x2(shared_0_p0, &tau[2], &tau[4], "), std::string::npos) << s.parts;
+  EXPECT_EQ(test::occurrences(s.parts, "w.Dinv_"), 2);
+  // Without pairs the two blocks are two texts: no kernel.
+  const SharedParts single = shareBlocks(text, members({"left", "right"}), all, false);
+  EXPECT_TRUE(single.kernels.empty());
+  EXPECT_EQ(single.parts, text);
+  // A block that also multiplies where the other adds is no mirror.
+  std::string other = text;
+  other.replace(other.find("t4*w.u_right[0]"), 15, "t4/w.u_right[0]");
+  EXPECT_TRUE(shareBlocks(other, members({"left", "right"}), all, true).kernels.empty());
+}
+
 // Which solvers share: the ones whose entry points' code is above the first-level
 // instruction cache (kSharedBlocksMinOps): Solo's legs, not the iiwa (no group
 // would pay there: measured 1.01-1.06 of the time, docs/benchmarks.md).
