@@ -555,7 +555,10 @@ SolverFiles assembleFiles(const System& sys, const Plan& plan, const SolverInput
              "// blocks \"in pairs\" run as one call, one in each lane of a vector register:\n";
     for (const SharedKernel& k : texts.sharedKernels)
       shared += fmt::format("//   {}: {} blocks of {}{}\n", k.name, k.blocks.size(), fmt::join(k.bodies, ", "),
-                            k.pairs > 0 ? fmt::format(" ({} in pairs)", 2 * k.pairs) : "");
+                            k.signs > 0   ? fmt::format(" ({} in pairs, mirrored: {} signs turned in one lane)",
+                                                        2 * k.pairs, k.signs)
+                            : k.pairs > 0 ? fmt::format(" ({} in pairs)", 2 * k.pairs)
+                                          : "");
   }
   auto bannerWith = [&](const std::string& sharedLines) {
     return fmt::format(fmt::runtime(kBannerTemplate), fmt::arg("version", PROXGEN_VERSION),

@@ -971,6 +971,7 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       continue;  // left inline
     SharedKernel k;
     k.name = fmt::format("shared_{}", out.kernels.size());
+    k.signs = int(nv);
     std::string pairTables, bodyList;
     std::map<std::string, std::string> pairTableOf;
     for (std::size_t n : firsts) {

@@ -24,6 +24,7 @@ struct SharedKernel {
   std::vector<std::string> blocks;   // each block's comment line (its body), in order of the file
   std::vector<std::string> bodies;   // the bodies of those blocks, each once, in that order
   int pairs = 0;                     // calls of its paired form shared_<k>_x2, two blocks each
+  int signs = 0;                     // a signed pair's kernel: the signs it turns in one lane (else 0)
 };
 
 struct SharedParts {

@@ -211,6 +211,7 @@ TEST(SharedBlocks, MirroredBlocksThatDifferInSignsRunAsASignedPair) {
   const SharedParts s = shareBlocks(text, members({"left", "right"}), all, true);
   ASSERT_EQ(s.kernels.size(), 1u) << s.parts;
   EXPECT_EQ(s.kernels[0].pairs, 1);
+  EXPECT_EQ(s.kernels[0].signs, 2);  // the banner's "mirrored: 2 signs turned in one lane"
   EXPECT_EQ(s.kernels[0].blocks.size(), 2u);
   EXPECT_EQ(test::occurrences(s.parts, "void shared_0("), 0) << s.parts;
   EXPECT_NE(s.parts.find("// 2 blocks of the same code but for 2 signs (mirrored: turned in one lane), two at a "
