@@ -762,6 +762,28 @@ bool independent(const Block& a, const Canonical& ca, const Block& b, const Cano
   return true;
 }
 
+// The arguments of a paired kernel's call for blocks a and b: the table of
+// pairs holding `values` (the two blocks' constants, then a signed pair's
+// signs; `size` pairs, none: no table), printed into `tables` the first time
+// those values come, then each parameter's two arguments (a part's scalar once).
+std::string pairArguments(const std::string& kernel, const std::string& values, std::size_t size,
+                          const std::vector<Param>& a, const std::vector<Param>& b,
+                          std::map<std::string, std::string>& tableOf, std::string& tables) {
+  std::string args;
+  if (size > 0) {
+    auto [t, fresh] = tableOf.emplace(values, fmt::format("{}_p{}", kernel, tableOf.size()));
+    if (fresh)
+      tables += fmt::format("alignas(2 * sizeof(Scalar)) constexpr Scalar {}[{}] = {{{}}};\n", t->second, 2 * size,
+                            values);
+    args = t->second;
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    args += (args.empty() ? "" : ", ") + a[i].arg;
+    if (a[i].lanewise) args += ", " + b[i].arg;
+  }
+  return args;
+}
+
 // A kernel's parameter list: the table of constants `k` when it has one, then
 // each parameter, twice (name_a, name_b) in the paired form (`paired`) unless
 // it is a part's scalar, passed once.
@@ -871,21 +893,9 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       const Found& f = found[g[n]];
       if (pairable && n + 1 < g.size() && independent(f.where, f.canon, found[g[n + 1]].where, found[g[n + 1]].canon)) {
         const Found& h = found[g[n + 1]];
-        std::string args;
-        if (nk > 0) {
-          std::string both;
-          for (std::size_t c = 0; c < nk; ++c)
-            both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
-          auto [t, fresh] = pairTableOf.emplace(both, fmt::format("{}_p{}", k.name, pairTableOf.size()));
-          if (fresh)
-            pairTables += fmt::format("alignas(2 * sizeof(Scalar)) constexpr Scalar {}[{}] = {{{}}};\n", t->second,
-                                      2 * nk, both);
-          args = t->second;
-        }
-        for (std::size_t a = 0; a < f.canon.params.size(); ++a) {
-          args += (args.empty() ? "" : ", ") + f.canon.params[a].arg;
-          if (f.canon.params[a].lanewise) args += ", " + h.canon.params[a].arg;
-        }
+        std::string both;
+        for (std::size_t c = 0; c < nk; ++c) both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
+        const std::string args = pairArguments(k.name, both, nk, f.canon.params, h.canon.params, pairTableOf, pairTables);
         calls[f.where.part][f.where.comment] = {
             h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
         ++k.pairs;
@@ -992,18 +1002,8 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
         if (pattern[i] == 'v')
           both += fmt::format("{}{}, {}", both.empty() ? "" : ", ", marked[n].slots.signs[i] == '-' ? "-1" : "1",
                               marked[n + 1].slots.signs[i] == '-' ? "-1" : "1");
-      std::string args;
-      if (nk + nv > 0) {
-        auto [t, fresh] = pairTableOf.emplace(both, fmt::format("{}_p{}", k.name, pairTableOf.size()));
-        if (fresh)
-          pairTables += fmt::format("alignas(2 * sizeof(Scalar)) constexpr Scalar {}[{}] = {{{}}};\n", t->second,
-                                    2 * (nk + nv), both);
-        args = t->second;
-      }
-      for (std::size_t a = 0; a < f.canon.params.size(); ++a) {
-        args += (args.empty() ? "" : ", ") + f.canon.params[a].arg;
-        if (f.canon.params[a].lanewise) args += ", " + h.canon.params[a].arg;
-      }
+      const std::string args =
+          pairArguments(k.name, both, nk + nv, f.canon.params, h.canon.params, pairTableOf, pairTables);
       calls[f.where.part][f.where.comment] = {
           h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
       ++k.pairs;
