@@ -524,18 +524,25 @@ std::string inLane(const std::string& text, const std::set<std::string>& lanewis
   return out;
 }
 
+// A body's lines, without their line ends.
+std::vector<std::string> linesOf(const std::string& body) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at < body.size();) {
+    std::size_t eol = body.find('\n', at);
+    if (eol == std::string::npos) eol = body.size();
+    out.push_back(body.substr(at, eol - at));
+    at = eol + 1;
+  }
+  return out;
+}
+
 class Pairer {
  public:
   Pairer(const std::set<std::string>& lanewise, bool table) : lanewise_(lanewise), table_(table) {}
 
   // The paired body, or false when a line has a form this does not know.
   bool run(const std::string& body, std::string& out) {
-    std::size_t at = 0;
-    while (at < body.size()) {
-      std::size_t eol = body.find('\n', at);
-      if (eol == std::string::npos) eol = body.size();
-      const std::string l = body.substr(at, eol - at);
-      at = eol + 1;
+    for (const std::string& l : linesOf(body)) {
       const std::size_t first = l.find_first_not_of(' ');
       if (first == std::string::npos) continue;
       const std::string indent = l.substr(0, first), t = l.substr(first);
@@ -677,12 +684,7 @@ bool markExpression(const std::string& e, SignSlots& out) {
 // The statements' expressions of a canonical body, marked; false when a
 // statement has a form the marking does not know (the block is not paired so).
 bool markSigns(const std::string& body, SignSlots& out) {
-  std::size_t at = 0;
-  while (at < body.size()) {
-    std::size_t eol = body.find('\n', at);
-    if (eol == std::string::npos) eol = body.size();
-    const std::string l = body.substr(at, eol - at);
-    at = eol + 1;
+  for (const std::string& l : linesOf(body)) {
     const std::size_t first = l.find_first_not_of(' ');
     const std::size_t eq = l.find(" = ");
     const bool statement = first != std::string::npos && l.back() == ';' && eq != std::string::npos &&
