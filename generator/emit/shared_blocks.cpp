@@ -714,7 +714,7 @@ std::string signedBody(const std::string& text, const std::string& pattern, std:
   };
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
-    if (c == kTermStart || (c == kBinary && i >= 1)) {
+    if (c == kTermStart || c == kBinary) {
       const char sign = pattern[slot++];
       if (c == kBinary) {
         out.pop_back();  // the space before the marker
@@ -938,25 +938,20 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     if (pairs && groups.at(key).size() == 1) alone.push_back(groups.at(key).front());
   std::sort(alone.begin(), alone.end());  // found is in file order
   struct Signed {
-    std::string key;  // the parameter kinds and the marked body
+    std::string key;  // the parameter kinds and the marked body; empty: not markable, no pair
     SignSlots slots;
   };
   std::vector<Signed> marked(alone.size());
+  for (std::size_t m = 0; m < alone.size(); ++m) {
+    const Canonical& c = found[alone[m]].canon;
+    if (markSigns(c.body, marked[m].slots)) marked[m].key = c.key.substr(0, c.key.size() - c.body.size()) + marked[m].slots.text;
+  }
   std::map<std::string, std::vector<std::size_t>> signedKernel;  // key + pattern -> the pairs' first blocks (in alone)
   std::vector<std::string> signedOrder;
   for (std::size_t n = 0; n + 1 < alone.size(); ++n) {
     const Found& f = found[alone[n]];
     const Found& h = found[alone[n + 1]];
-    for (std::size_t m : {n, n + 1}) {
-      const Canonical& c = found[alone[m]].canon;
-      if (!marked[m].key.empty()) continue;
-      if (!markSigns(c.body, marked[m].slots)) {
-        marked[m].key = "-";  // no pair
-        continue;
-      }
-      marked[m].key = c.key.substr(0, c.key.size() - c.body.size()) + marked[m].slots.text;
-    }
-    if (marked[n].key == "-" || marked[n].key != marked[n + 1].key || !independent(f.where, f.canon, h.where, h.canon))
+    if (marked[n].key.empty() || marked[n].key != marked[n + 1].key || !independent(f.where, f.canon, h.where, h.canon))
       continue;
     std::string pattern;
     for (std::size_t i = 0; i < marked[n].slots.signs.size(); ++i) {
