@@ -369,6 +369,7 @@ TEST(OperationCount, SharedCases) {
   // pairs, whose flips the count reads as the one block's negation.
   const SolverFiles atlas = generateCase(test::modelPath("cases.yaml"), "atlas_shadow_f6x2", "", ScalarType::Double);
   EXPECT_GT(test::occurrences(atlas.source, "proxgen_rt::flip("), 0);
+  EXPECT_GT(test::occurrences(atlas.source, " in pairs, mirrored: "), 0) << "the banner names the signed pairs";
   expectCountsMatch(atlas, "atlas_shadow_f6x2", 3);
 }
 
