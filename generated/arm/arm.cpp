@@ -1569,11 +1569,11 @@ PROXGEN_RT_NOINLINE void pv_proximal(Scalar inv_mu, Workspace& PROXGEN_RT_RESTRI
   const Scalar t12 = w.Linv[4]*t11;
   const Scalar t13 = w.Linv[3]*t6 - w.L[16]*t12;
   const Scalar t14 = w.Linv[3]*t13;
-  const Scalar t15 = w.Linv[2]*t4 - w.L[12]*t14 - w.L[13]*t12;
+  const Scalar t15 = w.Linv[2]*t4 - w.L[13]*t12 - w.L[12]*t14;
   const Scalar t16 = w.Linv[2]*t15;
-  const Scalar t17 = w.Linv[1]*t2 - w.L[7]*t16 - w.L[8]*t14 - w.L[9]*t12;
+  const Scalar t17 = w.Linv[1]*t2 - w.L[9]*t12 - w.L[8]*t14 - w.L[7]*t16;
   const Scalar t18 = w.Linv[1]*t17;
-  const Scalar t19 = w.Linv[0]*t0 - w.L[1]*t18 - w.L[2]*t16 - w.L[3]*t14 - w.L[4]*t12;
+  const Scalar t19 = w.Linv[0]*t0 - w.L[4]*t12 - w.L[3]*t14 - w.L[2]*t16 - w.L[1]*t18;
   w.lambda[0] = w.Linv[0]*t19;
   w.lambda[1] = w.Linv[1]*t17;
   w.lambda[2] = w.Linv[2]*t15;

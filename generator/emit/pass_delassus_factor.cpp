@@ -516,14 +516,20 @@ bool inL(const DelassusFactor& f, int i, int k) {
 // Woodbury's rows, which read y and w from registers and from W's loops.
 Expr forwardRow(CodeBuilder& cb, const DelassusFactor& f, int i, Expr x, const std::function<Expr(int)>& yOf,
                 const std::function<Expr(int, int)>& wOf) {
+  // The low-rank terms first, then L's in the order of k: each term comes after
+  // those known before it (w_l before the rows of block l + 1; y[i - 1] last), so
+  // the sum runs while the previous rows are solved, and each row adds one
+  // product and one subtraction to the chain of the solve, not its whole sum.
+  const auto [bi, l] = branchBlock(f, i);
+  if (bi >= 0) {
+    const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
+    const int r = br.rank, s = br.blocks.front(), m = br.blocks.back() - s;
+    for (int k = 0; k < l; ++k)
+      for (int p = 0; p < r; ++p)
+        x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s) * r + p))], wOf(bi, k * r + p));
+  }
   for (int k = 0; k < i; ++k)
     if (inL(f, i, k) && !f.L(i, k).isZero()) x -= cb.mul(f.L(i, k), yOf(k));
-  const auto [bi, l] = branchBlock(f, i);
-  if (bi < 0) return x;
-  const DelassusFactor::Branch& br = f.branches[std::size_t(bi)];
-  const int r = br.rank, s = br.blocks.front(), m = br.blocks.back() - s;
-  for (int k = 0; k < l; ++k)
-    for (int p = 0; p < r; ++p) x -= cb.mul(f.lowRank[std::size_t(br.gm + ((k * m + i - s) * r + p))], wOf(bi, k * r + p));
   return x;
 }
 
@@ -569,18 +575,20 @@ std::vector<Expr> lowRankBackward(CodeBuilder& cb, const DelassusFactor& f, cons
       const int r = br->rank, s = br->blocks.front(), m = br->blocks.back() - s;
       v.assign(std::size_t(r), Expr());
       for (int p = 0; p < r; ++p) {
-        Expr z;
-        for (int t = br->blocks[std::size_t(l + 1)]; t < br->blocks.back(); ++t)
+        Expr z;  // the rows in the order they were solved (from the bottom)
+        for (int t = br->blocks.back() - 1; t >= br->blocks[std::size_t(l + 1)]; --t)
           z += cb.mul(f.lowRank[std::size_t(br->gm + ((l * m + t - s) * r + p))], x[std::size_t(t)]);
         v[std::size_t(p)] = cb.flat(z, "v");
       }
     }
+    // As forwardRow: the terms known first come first (v_l, then the rows
+    // from the bottom), x[i + 1], the row just solved, last.
     Expr z = y[std::size_t(i)];
-    for (int k = i + 1; k < n; ++k)
-      if (inL(f, k, i)) z -= cb.mul(f.L(k, i), x[std::size_t(k)]);
     if (br && l + 2 < int(br->blocks.size()))
       for (int p = 0; p < br->rank; ++p)
         z -= cb.mul(f.lowRank[std::size_t(br->y + (i - br->blocks.front()) * br->rank + p)], v[std::size_t(p)]);
+    for (int k = n - 1; k > i; --k)
+      if (inL(f, k, i)) z -= cb.mul(f.L(k, i), x[std::size_t(k)]);
     x[std::size_t(i)] = cb.flat(cb.mul(cb.flat(z), f.Linv[std::size_t(i)]), "x");
   }
   return x;
@@ -726,8 +734,8 @@ std::vector<Expr> solveDelassus(Emit& e, const DelassusFactor& f, const std::vec
     for (int d = 0; d < 6; ++d)
       for (std::size_t t = 0; t < z.size(); ++t) v[std::size_t(d)] += cb.mul(f.W[t][std::size_t(d)], z[t]);
     const std::vector<Expr> x = choleskySolve(cb, f.LS, f.LSinv, v);
-    for (std::size_t t = 0; t < z.size(); ++t) {
-      for (int d = 0; d < 6; ++d) z[t] -= cb.mul(f.W[t][std::size_t(d)], x[std::size_t(d)]);
+    for (std::size_t t = 0; t < z.size(); ++t) {  // x[0] last: the backward solve's last
+      for (int d = 5; d >= 0; --d) z[t] -= cb.mul(f.W[t][std::size_t(d)], x[std::size_t(d)]);
       z[t] = cb.flat(z[t], "z");
     }
   }

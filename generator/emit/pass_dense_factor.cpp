@@ -40,7 +40,8 @@ std::vector<Expr> backwardSolve(CodeBuilder& cb, const Sym& L, const std::vector
   std::vector<Expr> x(static_cast<std::size_t>(n));
   for (int i = n - 1; i >= 0; --i) {
     Expr s = y[std::size_t(i)];
-    for (int k = i + 1; k < n; ++k) s -= cb.mul(L(k, i), x[std::size_t(k)]);
+    // x[i + 1] last: it is the one just solved, so the sum runs while it is being solved.
+    for (int k = n - 1; k > i; --k) s -= cb.mul(L(k, i), x[std::size_t(k)]);
     x[std::size_t(i)] = cb.flat(cb.mul(cb.flat(s), inv[std::size_t(i)]), "x");
   }
   return x;

@@ -11,7 +11,10 @@
 // are one loop over the rows (docs/emitter.md, "The Delassus columns as loops").
 #include <gtest/gtest.h>
 
+#include <map>
+#include <regex>
 #include <string>
+#include <vector>
 
 #include "cases/cases.hpp"
 #include "emit/generate.hpp"
@@ -26,6 +29,56 @@ std::string lineAfter(const std::string& text, const std::string& what) {
   if (at == std::string::npos) return {};
   const std::size_t next = text.find('\n', at) + 1;
   return text.substr(next, text.find('\n', next) - next);
+}
+
+// The body of the function `name` (from its signature to the next blank line).
+std::string functionBody(const std::string& source, const std::string& name) {
+  const std::size_t at = source.find(" " + name + "(");
+  if (at == std::string::npos) return {};
+  return source.substr(at, source.find("\n}\n", at) - at);
+}
+
+// The terms of a sum as printed: split at each " + " and " - " outside brackets.
+std::vector<std::string> termsOf(const std::string& sum) {
+  std::vector<std::string> terms(1);
+  int depth = 0;
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    const char c = sum[i];
+    depth += (c == '[' || c == '(') - (c == ']' || c == ')');
+    if (depth == 0 && c == ' ' && i + 2 < sum.size() && (sum[i + 1] == '+' || sum[i + 1] == '-') && sum[i + 2] == ' ') {
+      terms.emplace_back();
+      i += 2;
+      continue;
+    }
+    terms.back() += c;
+  }
+  return terms;
+}
+
+// In every statement of `body` that reads temporaries (t12, w0, v1, z3) of
+// earlier statements, the one defined last is read in the last term: a
+// solve's row subtracts the row solved just before it last, so the rest of
+// its sum runs while that row is being solved (docs/emitter.md, "The solves'
+// sums in the order their terms are known"). Returns the statements that
+// break it.
+std::vector<std::string> latestOperandNotLast(const std::string& body) {
+  static const std::regex statement(R"(const Scalar (\w+) = (.*);)");
+  static const std::regex temporary(R"(\b([twvz]\d+)\b)");
+  std::map<std::string, int> definedAt;
+  std::vector<std::string> broken;
+  int line = 0;
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), statement); it != std::sregex_iterator(); ++it, ++line) {
+    const std::string rhs = (*it)[2].str();
+    std::string latest;
+    for (auto t = std::sregex_iterator(rhs.begin(), rhs.end(), temporary); t != std::sregex_iterator(); ++t)
+      if (definedAt.count((*t)[1].str()) && (latest.empty() || definedAt[(*t)[1].str()] > definedAt[latest]))
+        latest = (*t)[1].str();
+    const std::vector<std::string> terms = termsOf(rhs);
+    if (!latest.empty() && !std::regex_search(terms.back(), std::regex("\\b" + latest + "\\b")))
+      broken.push_back((*it)[0].str());
+    definedAt[(*it)[1].str()] = line;
+  }
+  return broken;
 }
 
 // Every row of W is a loop over the six columns, S's rows loops over the
@@ -142,6 +195,24 @@ TEST(DelassusCode, TheRowsOfAColumnOfOneShapeAreOneLoop) {
   // Talos' four 6-d contacts fold a different set of terms into each row: no loop, no active_rows.
   const SolverFiles talos = generateCase(cases, "talos_f6x2_h6x2", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
   EXPECT_EQ(test::occurrences(talos.header, "active_rows"), 0);
+}
+
+// The proximal step is a chain of solves (L forward, Woodbury's 6 x 6, L
+// backward; on the Atlas t3x10 with its hands' blocks in low rank): every row
+// waits for the row before it, so each row's sum must take that row last.
+// Before 2026-12-07 the backward solves took x[i + 1] first, and the low-rank
+// terms came after the rows: each row's whole sum waited (the Atlas t3x10's
+// step took 0.61 us, now 0.46; docs/benchmarks.md, "The solves' sums in the
+// order their terms are known").
+TEST(DelassusCode, EachRowOfTheProximalSolvesSubtractsTheRowSolvedLastLast) {
+  PROXGEN_REQUIRE_MODELS();
+  const std::string cases = test::modelsDir() + "/cases.yaml";
+  for (const char* c : {"solo_f3x4", "talos_f6x2_h6x2", "atlas_shadow_f6x2_t3x10"}) {
+    const SolverFiles f = generateCase(cases, c, "", ScalarType::Double, nullptr, nullptr, "prox_pv");
+    const std::string step = functionBody(f.source, "pv_proximal");
+    ASSERT_GT(test::occurrences(step, "const Scalar "), 40) << c;
+    for (const std::string& s : latestOperandNotLast(step)) ADD_FAILURE() << c << ": " << s;
+  }
 }
 
 }  // namespace
