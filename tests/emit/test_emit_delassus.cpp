@@ -31,7 +31,7 @@ std::string lineAfter(const std::string& text, const std::string& what) {
   return text.substr(next, text.find('\n', next) - next);
 }
 
-// The body of the function `name` (from its signature to the next blank line).
+// The body of the function `name`: from its name to its closing brace (the first "}" alone on a line).
 std::string functionBody(const std::string& source, const std::string& name) {
   const std::size_t at = source.find(" " + name + "(");
   if (at == std::string::npos) return {};
@@ -204,7 +204,7 @@ TEST(DelassusCode, TheRowsOfAColumnOfOneShapeAreOneLoop) {
 // terms came after the rows: each row's whole sum waited (the Atlas t3x10's
 // step took 0.61 us, now 0.46; docs/benchmarks.md, "The solves' sums in the
 // order their terms are known").
-TEST(DelassusCode, EachRowOfTheProximalSolvesSubtractsTheRowSolvedLastLast) {
+TEST(DelassusCode, EachRowOfTheProximalSolvesTakesItsLatestTermLast) {
   PROXGEN_REQUIRE_MODELS();
   const std::string cases = test::modelsDir() + "/cases.yaml";
   for (const char* c : {"solo_f3x4", "talos_f6x2_h6x2", "atlas_shadow_f6x2_t3x10"}) {
