@@ -81,6 +81,16 @@ std::vector<std::string> latestOperandNotLast(const std::string& body) {
   return broken;
 }
 
+// proxPV of the Cartesian leg (tests/data/good/cartesian_leg.urdf and .yaml): a
+// floating base whose leg's rows reach the free flyer unturned.
+SolverFiles cartesianLegProxPv() {
+  GenerateOptions g;
+  g.urdf = test::sourceDir() + "/tests/data/good/cartesian_leg.urdf";
+  g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
+  g.functions = "prox_pv";
+  return generateFiles(g);
+}
+
 // Every row of W is a loop over the six columns, S's rows loops over the
 // columns of its upper triangle, and no column of W is unrolled.
 void expectWoodburyRows(const std::string& source, int rows) {
@@ -134,11 +144,7 @@ TEST(DelassusCode, SixRowsOrFewerFactorTheWholeMatrix) {
 // (zeros of KA at the top of L^-1 KA): such a row is copied to Wz first, and
 // the loops read it there (tests/data/good/cartesian_leg.urdf).
 TEST(DelassusCode, ARowOfZWithFoldedEntriesIsStagedForTheLoops) {
-  GenerateOptions g;
-  g.urdf = test::sourceDir() + "/tests/data/good/cartesian_leg.urdf";
-  g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
-  g.functions = "prox_pv";
-  const SolverFiles f = generateFiles(g);
+  const SolverFiles f = cartesianLegProxPv();
   expectWoodburyRows(f.source, 9);
   EXPECT_GT(test::occurrences(f.source, "some entries folded: staged for the loops"), 0);
   EXPECT_GT(test::occurrences(f.source, "w.Wz[0][j]"), 0);
@@ -163,11 +169,7 @@ TEST(DelassusCode, TheFreeFlyersColumnsOfZAreOneLoop) {
       generateCase(cases, "atlas_shadow_f6x2_t3x10", "", ScalarType::Double, nullptr, nullptr, "prox_pv");
   EXPECT_EQ(lineAfter(atlas.source, "// Z = L^-1 KA, columns 0 to 41"),
             "    PROXGEN_RT_NO_UNROLL for (int j = 0; j < 42; ++j) {");
-  GenerateOptions g;
-  g.urdf = test::sourceDir() + "/tests/data/good/cartesian_leg.urdf";
-  g.layout = test::sourceDir() + "/tests/data/good/cartesian_leg.yaml";
-  g.functions = "prox_pv";
-  const SolverFiles leg = generateFiles(g);
+  const SolverFiles leg = cartesianLegProxPv();
   EXPECT_EQ(test::occurrences(leg.source, "// Z = L^-1 KA, columns"), 0);
   EXPECT_GT(test::occurrences(leg.source, "w.Z_hull[5][0] = "), 0);
 }
