@@ -5,6 +5,7 @@
 // multipliers. The generic counterpart: algorithms/prox_pv.cpp.
 #include <fmt/format.h>
 
+#include <functional>
 #include <stdexcept>
 
 #include "emit/passes.hpp"
@@ -41,6 +42,21 @@ int loopableColumns(Emit& e, const ProxRows::Body& b, int i, int c0) {
     if (!canonical) break;
   }
   return c - c0;
+}
+
+// Body i's carried columns in order: each run of stored columns long enough
+// for a loop (loopableColumns) to `run(c0, len)`, every other column to `one(c)`.
+void forEachColumnRun(Emit& e, const ProxRows::Body& b, int i, const std::function<void(int, int)>& run,
+                      const std::function<void(int)>& one) {
+  const int m = e.bp(i).m();
+  for (int c0 = 0; c0 < m;) {
+    if (const int len = loopableColumns(e, b, i, c0); len >= kShortestColumnLoop) {
+      run(c0, len);
+      c0 += len;
+    } else {
+      one(c0++);
+    }
+  }
 }
 
 // KS = S^T KA ; KA_p[cols] = X^T (KA - U D^-1 KS). The LA recursion
@@ -97,32 +113,29 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
   };
   const int stride = rowStride(m), mp = passes ? e.bp(p.parent).m() : 0, pstride = rowStride(mp);
   ProxRows::Body& par = rows.b[std::size_t(p.parent)];
-  for (int c0 = 0; c0 < m;) {
-    const int len = loopableColumns(e, b, i, c0);
-    if (len >= kShortestColumnLoop) {
-      // Columns c0 .. c0 + len - 1 go through identical arithmetic: one loop
-      // (vectorised by the compiler) instead of len copies of the code.
-      cb.open(columnLoopHead(len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
-      V6 ka;
-      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
-      const auto out = column(ka, [&](const Quantity& qy) { return e.loopSlot(qy, i, m, c0); });
+  // A run of columns c0 .. c0 + len - 1 goes through identical arithmetic: one
+  // loop (vectorised by the compiler) instead of len copies of the code.
+  const auto run = [&](int c0, int len) {
+    cb.open(columnLoopHead(len), {fmt::format("columns {} to {}", c0, c0 + len - 1)});
+    V6 ka;
+    for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
+    const auto out = column(ka, [&](const Quantity& qy) { return e.loopSlot(qy, i, m, c0); });
+    if (passes)
+      for (int r = 0; r < 6; ++r)
+        cb.store(e.loopSlot(kKA, p.parent, 6, pstride, r, off + c0), out.f[std::size_t(r)]);
+    if (!out.ksdStored) throw std::logic_error("emitter: a looped column's D^-1 KS is not stored");
+    cb.close();
+    for (int c = c0; c < c0 + len; ++c) {
+      const auto cu = std::size_t(c);
+      const Expr ks = dot(cb, S, b.KA[cu]);  // the loop's KS for column c: a pick of KA prints nothing
+      b.KS[cu][0] = plain(ks) ? ks : cb.member(e.member(kKS, i, m, c));
+      b.KSD[cu] = cb.member(e.member(kKSD, i, m, c));
       if (passes)
         for (int r = 0; r < 6; ++r)
-          cb.store(e.loopSlot(kKA, p.parent, 6, pstride, r, off + c0), out.f[std::size_t(r)]);
-      if (!out.ksdStored) throw std::logic_error("emitter: a looped column's D^-1 KS is not stored");
-      cb.close();
-      for (int c = c0; c < c0 + len; ++c) {
-        const auto cu = std::size_t(c);
-        const Expr ks = dot(cb, S, b.KA[cu]);  // the loop's KS for column c: a pick of KA prints nothing
-        b.KS[cu][0] = plain(ks) ? ks : cb.member(e.member(kKS, i, m, c));
-        b.KSD[cu] = cb.member(e.member(kKSD, i, m, c));
-        if (passes)
-          for (int r = 0; r < 6; ++r)
-            par.KA[std::size_t(off + c)][std::size_t(r)] = cb.member(e.member(kKA, p.parent, 6, pstride, r, off + c));
-      }
-      c0 += len;
-      continue;
+          par.KA[std::size_t(off + c)][std::size_t(r)] = cb.member(e.member(kKA, p.parent, 6, pstride, r, off + c));
     }
+  };
+  const auto one = [&](int c0) {
     const auto out = column(b.KA[std::size_t(c0)], [&](const Quantity& qy) { return e.member(qy, i, m, c0); });
     b.KS[std::size_t(c0)][0] = out.ks;
     b.KSD[std::size_t(c0)] = out.ksd;
@@ -130,8 +143,8 @@ void rowsOneDof(Emit& e, const Kinematics& kin, const Articulated& art, int i, P
       for (int r = 0; r < 6; ++r)
         par.KA[std::size_t(off + c0)][std::size_t(r)] =
             e.put(e.member(kKA, p.parent, 6, pstride, r, off + c0), out.f[std::size_t(r)]);
-    ++c0;
-  }
+  };
+  forEachColumnRun(e, b, i, run, one);
 }
 
 // At the free flyer (S = I, D = IA = L L^T, parent the world, KA_0 = 0):
@@ -146,27 +159,25 @@ void rowsFreeFlyer(Emit& e, const Articulated& art, int i, ProxRows& rows) {
   b.Z.resize(std::size_t(m));
   CodeBuilder& cb = e.cb();
   const int stride = rowStride(m);
-  for (int c0 = 0; c0 < m;) {
-    if (const int len = loopableColumns(e, b, i, c0); len >= kShortestColumnLoop) {
-      // Columns c0 .. c0 + len - 1 hold stored KA entries: one loop (vectorised
-      // by the compiler, two columns per register) instead of len solves.
-      cb.open(columnLoopHead(len), {fmt::format("Z = L^-1 KA, columns {} to {}", c0, c0 + len - 1)});
-      std::vector<Expr> ka(6);
-      for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
-      const std::vector<Expr> z = forwardSolve(cb, ab.L, ab.Linv, ka);
-      for (int d = 0; d < 6; ++d) cb.store(e.loopSlot(kZ, i, 6, stride, d, c0), z[std::size_t(d)]);
-      cb.close();
-      for (int c = c0; c < c0 + len; ++c)
-        for (int d = 0; d < 6; ++d) b.Z[std::size_t(c)][std::size_t(d)] = cb.member(e.member(kZ, i, 6, stride, d, c));
-      c0 += len;
-      continue;
-    }
+  // A run of columns c0 .. c0 + len - 1 holding stored KA entries: one loop
+  // (vectorised by the compiler, two columns per register) instead of len solves.
+  const auto run = [&](int c0, int len) {
+    cb.open(columnLoopHead(len), {fmt::format("Z = L^-1 KA, columns {} to {}", c0, c0 + len - 1)});
+    std::vector<Expr> ka(6);
+    for (int r = 0; r < 6; ++r) ka[std::size_t(r)] = cb.member(e.loopSlot(kKA, i, 6, stride, r, c0));
+    const std::vector<Expr> z = forwardSolve(cb, ab.L, ab.Linv, ka);
+    for (int d = 0; d < 6; ++d) cb.store(e.loopSlot(kZ, i, 6, stride, d, c0), z[std::size_t(d)]);
+    cb.close();
+    for (int c = c0; c < c0 + len; ++c)
+      for (int d = 0; d < 6; ++d) b.Z[std::size_t(c)][std::size_t(d)] = cb.member(e.member(kZ, i, 6, stride, d, c));
+  };
+  const auto one = [&](int c0) {
     const std::vector<Expr> z =
         forwardSolve(cb, ab.L, ab.Linv, std::vector<Expr>(b.KA[std::size_t(c0)].begin(), b.KA[std::size_t(c0)].end()));
     for (int d = 0; d < 6; ++d)
       b.Z[std::size_t(c0)][std::size_t(d)] = e.keep(e.member(kZ, i, 6, stride, d, c0), z[std::size_t(d)]);
-    ++c0;
-  }
+  };
+  forEachColumnRun(e, b, i, run, one);
 }
 
 // At a planar joint (S picks sel, D = L L^T): KS = KA[sel], its share of G is

@@ -786,6 +786,22 @@ std::string pairArguments(const std::string& kernel, const std::string& values, 
   return args;
 }
 
+// Two blocks' constants interleaved (a0, b0, a1, b1, ...): a table of pairs' values.
+std::string pairedConstants(const Canonical& a, const Canonical& b) {
+  std::string both;
+  for (std::size_t c = 0; c < a.constants.size(); ++c)
+    both += (c ? ", " : "") + a.constants[c] + ", " + b.constants[c];
+  return both;
+}
+
+// The parameters a block's pair holds one value of each block in (a pair each).
+std::set<std::string> lanewiseOf(const Canonical& c) {
+  std::set<std::string> out;
+  for (const Param& p : c.params)
+    if (p.lanewise) out.insert(p.name);
+  return out;
+}
+
 // A kernel's parameter list: the table of constants `k` when it has one, then
 // each parameter, twice (name_a, name_b) in the paired form (`paired`) unless
 // it is a part's scalar, passed once.
@@ -844,6 +860,19 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
   std::string kernels;
   // Per part, the replaced blocks: comment line index -> (end, call line).
   std::map<std::size_t, std::map<std::size_t, std::pair<std::size_t, std::string>>> calls;
+  // A block's comment line without its "  // ".
+  const auto commentOf = [&](const Found& f) { return parts[f.where.part].lines[f.where.comment].substr(5); };
+  // Block f joins kernel k: its comment, and its body once in k.bodies.
+  const auto addBlock = [&](SharedKernel& k, const Found& f) {
+    k.blocks.push_back(commentOf(f));
+    const std::string body = blockBody(k.blocks.back());
+    if (std::find(k.bodies.begin(), k.bodies.end(), body) == k.bodies.end()) k.bodies.push_back(body);
+  };
+  // Blocks f and h, one after the other, as one call of k's paired form at f's place.
+  const auto callPair = [&](const std::string& kernel, const Found& f, const Found& h, const std::string& args) {
+    calls[f.where.part][f.where.comment] = {
+        h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], kernel, args)};
+  };
   for (const std::string& key : order) {
     const std::vector<std::size_t>& g = groups.at(key);
     if (g.size() < 2) continue;
@@ -863,31 +892,20 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       if (!common[c]) slot[c] = varying++;
     const std::string body = withCommonLiterals(first.body, first.constants, common, slot);
     std::string tables;
-    std::set<std::string> bodies;
-    std::string bodyList;
     std::map<std::string, std::string> tableOf;  // values -> table: blocks with the same constants share one
     std::vector<std::string> values(g.size());
     for (std::size_t n = 0; n < g.size(); ++n) {
       const Found& f = found[g[n]];
-      const std::string comment = parts[f.where.part].lines[f.where.comment];
-      k.blocks.push_back(comment.substr(5));
-      const std::string bodyName = blockBody(comment.substr(5));
-      if (bodies.insert(bodyName).second) {
-        bodyList += (bodyList.empty() ? "" : ", ") + bodyName;
-        k.bodies.push_back(bodyName);
-      }
+      addBlock(k, f);
       for (std::size_t c = 0; c < nk; ++c)
         if (!common[c]) values[n] += (values[n].empty() ? "" : ", ") + f.canon.constants[c];
     }
     // The paired form, when the kernel's lines are ones it knows.
-    std::set<std::string> lanewise;
-    for (const Param& p : first.params)
-      if (p.lanewise) lanewise.insert(p.name);
     // Every constant of it in the table of pairs, common ones too (pair_at: an
     // aligned load the compiler folds into the operation; a literal would be
     // loaded and duplicated).
     std::string pairedText;
-    const bool pairable = pairs && Pairer(lanewise, nk > 0).run(first.body, pairedText);
+    const bool pairable = pairs && Pairer(lanewiseOf(first), nk > 0).run(first.body, pairedText);
     std::string pairTables;
     std::map<std::string, std::string> pairTableOf;
     bool single = false;
@@ -895,11 +913,9 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       const Found& f = found[g[n]];
       if (pairable && n + 1 < g.size() && independent(f.where, f.canon, found[g[n + 1]].where, found[g[n + 1]].canon)) {
         const Found& h = found[g[n + 1]];
-        std::string both;
-        for (std::size_t c = 0; c < nk; ++c) both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
-        const std::string args = pairArguments(k.name, both, nk, f.canon.params, h.canon.params, pairTableOf, pairTables);
-        calls[f.where.part][f.where.comment] = {
-            h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
+        callPair(k.name, f, h,
+                 pairArguments(k.name, pairedConstants(f.canon, h.canon), nk, f.canon.params, h.canon.params,
+                               pairTableOf, pairTables));
         ++k.pairs;
         ++n;
         continue;
@@ -915,7 +931,7 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
       calls[f.where.part][f.where.comment] = {f.where.end, fmt::format("  {}({});", k.name, args)};
     }
     kernels += fmt::format("// {} blocks of the same code, each over its constants (k) and members: {}.\n// The first: {}\n",
-                           g.size(), bodyList, parts[found[g.front()].where.part].lines[found[g.front()].where.comment].substr(5));
+                           g.size(), fmt::join(k.bodies, ", "), commentOf(found[g.front()]));
     if (single) {
       kernels += tables;
       kernels += fmt::format("PROXGEN_RT_NOINLINE void {}({}) noexcept {{\n{}}}\n\n", k.name,
@@ -969,47 +985,32 @@ SharedParts shareBlocks(const std::string& text, const Members& ws,
     const Canonical& first = found[alone[firsts.front()]].canon;
     const std::string pattern = key.substr(key.rfind('\n') + 1);
     const std::size_t nk = first.constants.size();
-    std::set<std::string> lanewise;
-    for (const Param& p : first.params)
-      if (p.lanewise) lanewise.insert(p.name);
     const std::size_t nv = std::size_t(std::count(pattern.begin(), pattern.end(), 'v'));
     std::string pairedText;
-    if (!Pairer(lanewise, nk + nv > 0).run(signedBody(marked[firsts.front()].slots.text, pattern, nk), pairedText))
+    if (!Pairer(lanewiseOf(first), nk + nv > 0).run(signedBody(marked[firsts.front()].slots.text, pattern, nk), pairedText))
       continue;  // left inline
     SharedKernel k;
     k.name = fmt::format("shared_{}", out.kernels.size());
     k.signs = int(nv);
-    std::string pairTables, bodyList;
+    std::string pairTables;
     std::map<std::string, std::string> pairTableOf;
     for (std::size_t n : firsts) {
       const Found& f = found[alone[n]];
       const Found& h = found[alone[n + 1]];
-      for (const Found* b : {&f, &h}) {
-        const std::string comment = parts[b->where.part].lines[b->where.comment];
-        k.blocks.push_back(comment.substr(5));
-        const std::string bodyName = blockBody(comment.substr(5));
-        if (std::find(k.bodies.begin(), k.bodies.end(), bodyName) == k.bodies.end()) {
-          bodyList += (bodyList.empty() ? "" : ", ") + bodyName;
-          k.bodies.push_back(bodyName);
-        }
-      }
-      std::string both;
-      for (std::size_t c = 0; c < nk; ++c) both += (c ? ", " : "") + f.canon.constants[c] + ", " + h.canon.constants[c];
+      addBlock(k, f);
+      addBlock(k, h);
+      std::string both = pairedConstants(f.canon, h.canon);
       for (std::size_t i = 0; i < pattern.size(); ++i)
         if (pattern[i] == 'v')
           both += fmt::format("{}{}, {}", both.empty() ? "" : ", ", marked[n].slots.signs[i] == '-' ? "-1" : "1",
                               marked[n + 1].slots.signs[i] == '-' ? "-1" : "1");
-      const std::string args =
-          pairArguments(k.name, both, nk + nv, f.canon.params, h.canon.params, pairTableOf, pairTables);
-      calls[f.where.part][f.where.comment] = {
-          h.where.end, fmt::format("{}\n  {}_x2({});", parts[h.where.part].lines[h.where.comment], k.name, args)};
+      callPair(k.name, f, h, pairArguments(k.name, both, nk + nv, f.canon.params, h.canon.params, pairTableOf, pairTables));
       ++k.pairs;
     }
     kernels += fmt::format(
         "// {} blocks of the same code but for {} sign{} (mirrored: turned in one lane), two at a time: {}.\n"
         "// The first: {}\n",
-        2 * k.pairs, nv, nv == 1 ? "" : "s", bodyList,
-        parts[found[alone[firsts.front()]].where.part].lines[found[alone[firsts.front()]].where.comment].substr(5));
+        2 * k.pairs, nv, nv == 1 ? "" : "s", fmt::join(k.bodies, ", "), commentOf(found[alone[firsts.front()]]));
     kernels += pairTables;
     kernels += fmt::format("PROXGEN_RT_NOINLINE void {}_x2({}) noexcept {{\n{}}}\n\n", k.name,
                            parameterList(nk + nv > 0, first.params, true), pairedText);
