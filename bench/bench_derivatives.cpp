@@ -22,6 +22,19 @@
 //                                 pin_caba / pin_pv, mu = 1/proxgen's mu,
 //                                 max_iter = K, accuracy 0), where CMake found
 //                                 Pinocchio (PROXGEN_BENCH_PINOCCHIO)
+//   <case>/idd/generated          inverse_dynamics_derivatives(q, v, a, nullptr):
+//                                 dtau/dq and dtau/dv of RNEA, the kinematics pass
+//                                 and the tangent sweep that cdd runs after prox_pv
+//                                 (a = the state's tau, any vector does; no
+//                                 constraint forces); the file that holds
+//                                 constrained_dynamics_derivatives holds it too
+//   <case>/idd/pinocchio          pinocchio::computeRNEADerivatives(model, data, q,
+//                                 v, a), the same inputs, where CMake found
+//                                 Pinocchio: Carpentier and Mansard's derivatives
+//                                 in the world frame, which also fill M's upper
+//                                 triangle (the pair measures the tangent sweep
+//                                 against them; docs/benchmarks.md, "The tangent
+//                                 sweep against Pinocchio's RNEA derivatives")
 //
 // mu = 1e4, K = 3 (the suite's, bench/common.hpp). States: 1000 per case from
 // proxgen::randomState with seed 1, as bench_joint_space.cpp draws them, drawn
@@ -152,6 +165,10 @@ struct Generated {
   }
   const Scalar* at(const std::vector<Scalar>& x, int size, int k) const { return x.data() + std::size_t(k) * size; }
 
+  void idd(int k) {
+    G::inverse_dynamics_derivatives(at(q, nq, k), at(v, nv, k), at(tau, nv, k), nullptr, *w, dq.data(), dv.data());
+  }
+
   void cdd(int k) {
     G::constrained_dynamics_derivatives(at(q, nq, k), at(v, nv, k), at(tau, nv, k), settings, *w, qdd.data(),
                                         lambda.data(), dq.data(), dv.data(), dt.data(), lq.data(), lv.data(),
@@ -249,6 +266,38 @@ double checkCdd(Generated<G>& g) {
     for (const proxgen::verify::Compared& x : proxgen::verify::compareDerivatives(g.c.sys, d, cond, s, a)) {
       if (!x.finite || !(x.error <= x.bound))
         checkFailed(g.c.name + "/cdd/generated, state " + std::to_string(k) + ": " + x.what + " differs from the " +
+                    "generic twin by " + std::to_string(x.error) + " (bound " + std::to_string(x.bound) + ")");
+      worst = std::max(worst, x.error / x.bound);
+    }
+  }
+  return worst;
+}
+
+// dtau/dq, dtau/dv at state k (a = its tau, no constraint forces) against the
+// generic twin, inverseDynamicsDerivatives, with the bound `proxgen verify`
+// applies to the generated inverse_dynamics_derivatives (verify::compareDerivatives:
+// the same sweep with the sums in another order, c n u times the sizes of the
+// terms summed): one Compared per block, dtau_dq then dtau_dv.
+std::vector<proxgen::verify::Compared> compareIdd(const BenchCase& c, int k, const MatX& dq, const MatX& dv) {
+  const proxgen::State& s = c.states[std::size_t(k)];
+  proxgen::verify::DerivativeAnswer a;
+  a.qdd = s.tau, a.lambda = VecX::Zero(c.sys.nc);
+  a.dtau_dq = dq, a.dtau_dv = dv;
+  proxgen::Data d(c.sys);
+  const proxgen::verify::Conditioning cond = proxgen::verify::conditioningAt(c.sys, d, s, false);
+  return proxgen::verify::compareDerivatives(c.sys, d, cond, s, a);
+}
+
+// idd/generated against the twin (above); a failure aborts the run.
+template <class G>
+double checkIdd(Generated<G>& g) {
+  double worst = 0;
+  for (int k = 0; k < kChecked; ++k) {
+    g.idd(k);
+    for (const proxgen::verify::Compared& x :
+         compareIdd(g.c, k, rowMajor(g.dq, G::nv, G::nv), rowMajor(g.dv, G::nv, G::nv))) {
+      if (!x.finite || !(x.error <= x.bound))
+        checkFailed(g.c.name + "/idd/generated, state " + std::to_string(k) + ": " + x.what + " differs from the " +
                     "generic twin by " + std::to_string(x.error) + " (bound " + std::to_string(x.bound) + ")");
       worst = std::max(worst, x.error / x.bound);
     }
@@ -385,6 +434,32 @@ std::vector<std::pair<std::string, double>> pinocchioCheck(const BenchCase& c,
   counters.push_back({"check_ratio", worst});
   return counters;
 }
+
+// idd/pinocchio against the same twin and bound as idd/generated: measured,
+// printed and carried as counters (Pinocchio's tangent convention is the one
+// proxgen's derivatives use, so the blocks are compared as they are); only a
+// result that is not finite aborts the run.
+std::vector<std::pair<std::string, double>> pinocchioRneaCheck(const BenchCase& c,
+                                                               proxgen::bench::PinocchioRneaDerivatives& p) {
+  double worst = 0, e[2] = {}, bound[2] = {};
+  for (int k = 0; k < kChecked; ++k) {
+    p.call(k);
+    MatX dq, dv;
+    p.read(dq, dv);
+    const std::vector<proxgen::verify::Compared> cmp = compareIdd(c, k, dq, dv);
+    for (std::size_t b = 0; b < 2 && b < cmp.size(); ++b) {
+      if (!cmp[b].finite) checkFailed(c.name + "/idd/pinocchio: " + cmp[b].what + " is not finite");
+      e[b] = std::max(e[b], cmp[b].error);
+      bound[b] = std::max(bound[b], cmp[b].bound);
+      worst = std::max(worst, cmp[b].error / cmp[b].bound);
+    }
+  }
+  const char* names[2] = {"dtau_dq", "dtau_dv"};
+  for (int b = 0; b < 2; ++b)
+    std::fprintf(stderr, "%s/idd/pinocchio %-8s vs generic: %.3g (bound %.3g%s)\n", c.name.c_str(), names[b], e[b],
+                 bound[b], e[b] <= bound[b] ? "" : ", EXCEEDED");
+  return {{"gap_dtau_dq", e[0]}, {"gap_dtau_dv", e[1]}, {"check_ratio", worst}};
+}
 #endif
 
 // The variants of one case; `want(variant)` says which to set up (all but in --count).
@@ -420,12 +495,25 @@ void registerCase(const char* name, const std::function<bool(const std::string&)
     }, counters);
   }
   if (want("fd/integrate_only")) reg("fd/integrate_only", [g](int k) { g->integrateOnly(k); }, {});
+  if (want("idd/generated")) {
+    const double ratio = checkIdd(*g);
+    reg("idd/generated", [g](int k) {
+      g->idd(k);
+      benchmark::DoNotOptimize(g->dq.data());
+    }, {{"check_ratio", ratio}});
+  }
 #ifdef PROXGEN_BENCH_PINOCCHIO
   if (want("cdd/pinocchio")) {
     std::shared_ptr<proxgen::bench::PinocchioConstraintDerivatives> p =
         proxgen::bench::makePinocchioConstraintDerivatives(c.name, c.sys, c.states, kMu, kK);
     const auto counters = pinocchioCheck(c, *p);
     reg("cdd/pinocchio", [p](int k) { p->call(k); }, counters);
+  }
+  if (want("idd/pinocchio")) {
+    std::shared_ptr<proxgen::bench::PinocchioRneaDerivatives> p =
+        proxgen::bench::makePinocchioRneaDerivatives(c.name, c.sys, c.states);
+    const auto counters = pinocchioRneaCheck(c, *p);
+    reg("idd/pinocchio", [p](int k) { p->call(k); }, counters);
   }
 #endif
 }
@@ -443,6 +531,8 @@ void registerCase(const char* name, const std::function<bool(const std::string&)
     static constexpr auto prox_pv = &NS::prox_pv;                                    \
     static constexpr auto constrained_dynamics_derivatives =                         \
         &NS::constrained_dynamics_derivatives;                                       \
+    static constexpr auto inverse_dynamics_derivatives =                             \
+        &NS::inverse_dynamics_derivatives;                                           \
   };                                                                                 \
   }
 PROXGEN_BENCH_DERIVATIVE_CASES(PROXGEN_BENCH_API)

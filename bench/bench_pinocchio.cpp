@@ -35,6 +35,7 @@
 #ifdef PROXGEN_BENCH_PINOCCHIO_DERIVATIVES
 #include <pinocchio/algorithm/constrained-dynamics-derivatives.hpp>
 #include <pinocchio/algorithm/constrained-dynamics.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #endif
 #include <pinocchio/algorithm/contact-info.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -191,7 +192,39 @@ class PinocchioDerivatives final : public PinocchioConstraintDerivatives {
   pinocchio::ProximalSettings settings_;
 };
 
+// computeRNEADerivatives (bench_pinocchio.hpp). Its five-argument form writes
+// data.dtau_dq, data.dtau_dv and data.M, zeroed once by Data's constructor: each
+// call writes the same entries again (their pattern is the model's), as its
+// documentation asks of the zeros.
+class PinocchioRnea final : public PinocchioRneaDerivatives {
+ public:
+  PinocchioRnea(const std::string& caseName, const System& sys, const std::vector<State>& states)
+      : states_(states) {
+    buildPinocchioModel(caseName, sys.model, model_);
+    data_ = std::make_unique<pinocchio::Data>(model_);
+  }
+  void call(int k) override {
+    const State& s = states_[std::size_t(k)];
+    pinocchio::computeRNEADerivatives(model_, *data_, s.q, s.v, s.tau);
+  }
+  void read(MatX& dtau_dq, MatX& dtau_dv) const override {
+    dtau_dq = data_->dtau_dq;
+    dtau_dv = data_->dtau_dv;
+  }
+
+ private:
+  const std::vector<State>& states_;
+  pinocchio::Model model_;
+  std::unique_ptr<pinocchio::Data> data_;
+};
+
 }  // namespace
+
+std::unique_ptr<PinocchioRneaDerivatives> makePinocchioRneaDerivatives(const std::string& caseName,
+                                                                       const System& sys,
+                                                                       const std::vector<State>& states) {
+  return std::make_unique<PinocchioRnea>(caseName, sys, states);
+}
 
 std::unique_ptr<PinocchioConstraintDerivatives> makePinocchioConstraintDerivatives(const std::string& caseName,
                                                                                    const System& sys,

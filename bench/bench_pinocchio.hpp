@@ -42,4 +42,22 @@ std::unique_ptr<PinocchioConstraintDerivatives> makePinocchioConstraintDerivativ
                                                                                    const std::vector<State>& states,
                                                                                    double mu, int K);
 
+/// pinocchio::computeRNEADerivatives(model, data, q, v, a) on one case: Carpentier and
+/// Mansard's analytical RNEA derivatives, in the world frame. Its algorithm also
+/// fills the upper triangle of M (data.M), which it cannot skip.
+class PinocchioRneaDerivatives {
+ public:
+  virtual ~PinocchioRneaDerivatives() = default;
+  /// The call at state k of the pool given at construction, with a = that state's tau
+  /// (any vector does: the cost does not depend on it).
+  virtual void call(int k) = 0;
+  /// dtau/dq and dtau/dv of the last call (same tangent convention as proxgen's).
+  virtual void read(MatX& dtau_dq, MatX& dtau_dv) const = 0;
+};
+
+/// `states` must outlive the result.
+std::unique_ptr<PinocchioRneaDerivatives> makePinocchioRneaDerivatives(const std::string& caseName,
+                                                                       const System& sys,
+                                                                       const std::vector<State>& states);
+
 }  // namespace proxgen::bench

@@ -21,8 +21,9 @@ generic twin, the route to delassus_inverse through the generated mass_matrix, a
 Pinocchio's rnea, nonLinearEffects, crba and computeMinverse where the build has them.
 --derivatives counts the derivative benchmarks (proxgen_bench_derivatives --count
 CASE/VARIANT N, bench_derivatives.cpp): the generated constrained_dynamics_derivatives,
-the central differences of prox_pv, their integrations alone, and Pinocchio's
-constraintDynamics + computeConstraintDynamicsDerivatives where the build has it.
+the central differences of prox_pv, their integrations alone, the generated
+inverse_dynamics_derivatives, and Pinocchio's constraintDynamics +
+computeConstraintDynamicsDerivatives and computeRNEADerivatives where the build has it.
 """
 import argparse
 import json
@@ -40,7 +41,8 @@ LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "
     # Pinocchio's, where the build found it (bench_pinocchio.cpp, pinocchioJointSpace); exit 3 otherwise.
     f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
     "mass_matrix/pinocchio_upper", "mass_matrix/pinocchio_world", "mass_matrix_inverse/pinocchio_upper"]
-DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio"]
+DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio", "idd/generated",
+               "idd/pinocchio"]
 # The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, and the
 # default list of what to count.
 DRIVERS = {
