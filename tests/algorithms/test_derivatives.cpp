@@ -33,6 +33,7 @@
 #include "algorithms/derivatives.hpp"
 #include "algorithms/inverse_dynamics.hpp"
 #include "algorithms/prox_pv.hpp"
+#include "algorithms/rnea_derivatives_world.hpp"
 #include "model/layout.hpp"
 #include "numerics.hpp"
 #include "support.hpp"
@@ -155,6 +156,50 @@ TEST(Derivatives, InverseDynamicsMatchDifferences) {
       const double delta = 10 * sys.model.nv * kEps;
       EXPECT_LE(relErr(dd.dtau_dq, differences(sys.model, x, Input::Q, tau)), tolerance(Input::Q, delta)) << s.name;
       EXPECT_LE(relErr(dd.dtau_dv, differences(sys.model, x, Input::V, tau)), tolerance(Input::V, delta)) << s.name;
+    }
+  }
+}
+
+// The world-frame form (algorithms/rnea_derivatives_world.hpp) against the
+// body-frame tangent sweep: two derivations of the same exact quantity, so they
+// differ by round-off only. Each entry of either is a sum of at most 8 N
+// products (the two sides' terms together) of terms no larger than (1 + L)^2 S:
+// S the largest body-frame force or force tangent of the sweep (subtree sums,
+// dd.f, dd.df_dq, dd.df_dv), L the largest distance of a body from the world
+// origin, since the world-frame moments are the body-frame ones moved by at
+// most L, and its products of two moved quantities (Ic c, Bc u) by L^2. So
+// |world - body| <= c 8 N eps (1 + L)^2 S, with c = 10 for the few roundings
+// inside each term; relErr divides by max(1, |dtau|). A dropped or wrong term
+// (a Coriolis product, the gravity shift, the constraint forces' motion) is of
+// the size of the derivative itself.
+TEST(Derivatives, WorldFrameFormMatchesTheBodyFrameSweep) {
+  PROXGEN_REQUIRE_MODELS();
+  for (const Named& s : allSystems()) {
+    const System& sys = s.sys;
+    Data d(sys);
+    DerivativeData dd(sys);
+    std::mt19937 rng(37);
+    std::uniform_real_distribution<double> u(-5, 5);
+    for (int st = 0; st < statesPerSystem(); ++st) {
+      const State x = test::randomState(sys.model, rng);
+      VecX qdd(sys.model.nv), lambda(sys.nc);
+      for (int k = 0; k < qdd.size(); ++k) qdd[k] = u(rng);
+      for (int k = 0; k < lambda.size(); ++k) lambda[k] = 20 * u(rng);
+      const VecX* const withAndWithout[2] = {nullptr, &lambda};
+      for (const VecX* l : withAndWithout) {
+        inverseDynamicsDerivatives(sys, d, dd, x.q, x.v, qdd, l);
+        double S = 0, L = 0;
+        for (int b = 1; b < sys.model.numBodies(); ++b) {
+          S = std::max({S, maxAbs(dd.f[b]), maxAbs(dd.df_dq[b]), maxAbs(dd.df_dv[b])});
+          L = std::max(L, d.oMi[b].p.norm());
+        }
+        MatX wq, wv;
+        inverseDynamicsDerivativesWorld(sys, d, x.q, x.v, qdd, l, wq, wv);
+        const double bound = 10 * 8 * sys.model.numBodies() * kEps * (1 + L) * (1 + L) * S;
+        const std::string what = s.name + (l ? ", with lambda" : "");
+        EXPECT_LE(relErr(wq, dd.dtau_dq), bound / std::max(1.0, maxAbs(dd.dtau_dq))) << what;
+        EXPECT_LE(relErr(wv, dd.dtau_dv), bound / std::max(1.0, maxAbs(dd.dtau_dv))) << what;
+      }
     }
   }
 }
