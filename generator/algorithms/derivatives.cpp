@@ -121,10 +121,11 @@ void tangentSweep(const System& sys, Data& d, DerivativeData& dd, const VecX& q,
   }
 }
 
-// The constraint rows at fixed qdd (after tangentSweep): J, the derivatives of
-// alpha = J qdd + gamma (6d: the frame's spatial acceleration in C; 3d: the
-// classical acceleration of its origin in C, a_lin + w x v_lin) and of the
-// Baumgarte target a* = -kd v_C - kp e (docs/derivatives.md §2).
+}  // namespace
+
+// J, the derivatives of alpha = J qdd + gamma (6d: the frame's spatial
+// acceleration in C; 3d: the classical acceleration of its origin in C, a_lin +
+// w x v_lin) and of the Baumgarte target a* = -kd v_C - kp e (docs/derivatives.md §2).
 void constraintRowTangents(const System& sys, Data& d, DerivativeData& dd) {
   const int nv = sys.model.nv;
   for (const Constraint& c : sys.constraints) {
@@ -173,8 +174,6 @@ void constraintRowTangents(const System& sys, Data& d, DerivativeData& dd) {
     }
   }
 }
-
-}  // namespace
 
 void inverseDynamicsDerivatives(const System& sys, Data& d, DerivativeData& dd, const VecX& q, const VecX& v,
                                 const VecX& qdd, const VecX* lambda) {

@@ -68,6 +68,13 @@ struct DerivativeData {
 void inverseDynamicsDerivatives(const System& sys, Data& d, DerivativeData& dd, const VecX& q, const VecX& v,
                                 const VecX& qdd, const VecX* lambda);
 
+/// The constraint rows at fixed qdd from the body tangents at the constrained
+/// bodies (dd.dv_dq, dd.dv_dv, dd.da_dq, dd.da_dv, dd.dg_dq of each constraint's
+/// body, zero outside its path's columns) and d's kinematics: dd.J,
+/// dd.dalpha_dq, dd.dalpha_dv, dd.dastar_dq, dd.dastar_dv. The last step of
+/// inverseDynamicsDerivatives and of inverseDynamicsDerivativesWorld.
+void constraintRowTangents(const System& sys, Data& d, DerivativeData& dd);
+
 /// Derivatives of qdd = ABA(q, v, tau) (no constraints): dd.qdd, and
 /// dqdd/dq = -M^-1 dtau/dq, dqdd/dv = -M^-1 dtau/dv (at the ABA solution),
 /// dqdd/dtau = M^-1, with M from CRBA and its Cholesky factor.

@@ -41,8 +41,12 @@ Mat6 forceCrossOf(const Vec6& h) {
 //   d tau_k / dq_j = oS_k^T (Ic_k c - Bc_k u),   d tau_k / dqd_j = oS_k^T (Ic_k w + Bc_k s),
 // and for k a strict ancestor of j (oS_k fixed; F_k moves by j's subtree's force)
 //   d tau_k / dq_j = oS_k^T (s x* F_j + Ic_j c - Bc_j u),   d tau_k / dqd_j = oS_k^T (Ic_j w + Bc_j s).
-void inverseDynamicsDerivativesWorld(const System& sys, Data& d, const VecX& q, const VecX& v, const VecX& qdd,
-                                     const VecX* lambda, MatX& dtau_dq, MatX& dtau_dv) {
+// A constrained body b's own tangents, in its coordinates (oX_b moves by s too,
+// so d (oX_b^-1 m) = oX_b^-1 (dm - s x m)): along q_j, dv_b = oX_b^-1 (-u),
+// da_b = oX_b^-1 (c - u x ov_b), dg_b = oX_b^-1 (-s x oa_0); along qd_j,
+// dv_b = oX_b^-1 s, da_b = oX_b^-1 (s x ov_b + w).
+void inverseDynamicsDerivativesWorld(const System& sys, Data& d, DerivativeData& dd, const VecX& q, const VecX& v,
+                                     const VecX& qdd, const VecX* lambda) {
   const Model& m = sys.model;
   const int N = m.numBodies(), nv = m.nv;
   forwardKinematics(sys, d, q, v);  // liMi, oMi, v_i, c_i
@@ -95,6 +99,8 @@ void inverseDynamicsDerivativesWorld(const System& sys, Data& d, const VecX& q, 
     IS[j] = Ic[j] * oS[j];
     BS[j] = Bc[j].transpose() * oS[j];
   }
+  MatX& dtau_dq = dd.dtau_dq;
+  MatX& dtau_dv = dd.dtau_dv;
   dtau_dq.setZero(nv, nv);
   dtau_dv.setZero(nv, nv);
   for (int k = 1; k < N; ++k) {  // every (body k, ancestor-or-self j) pair once
@@ -110,6 +116,23 @@ void inverseDynamicsDerivativesWorld(const System& sys, Data& d, const VecX& q, 
       dtau_dv.block(cj, rk, nj, nk) = oS[j].transpose() * Pv[k];
     }
   }
+  for (const Constraint& c : sys.constraints) {  // the constrained bodies' tangents, then the rows
+    const int b = c.body;
+    if (b == 0) continue;
+    for (MatX* t : {&dd.dv_dq[b], &dd.dv_dv[b], &dd.da_dq[b], &dd.da_dv[b], &dd.dg_dq[b]}) t->setZero();
+    const SE3& oM = d.oMi[b];
+    for (int j = b; j != 0; j = m.bodies[j].parent)
+      for (int k = 0; k < int(oS[j].cols()); ++k) {
+        const int col = m.bodies[j].joint.idx_v + k;
+        const Vec6 s = oS[j].col(k), u = U[j].col(k);
+        dd.dv_dq[b].col(col) = oM.actInvMotion(-u);
+        dd.dv_dv[b].col(col) = oM.actInvMotion(s);
+        dd.da_dq[b].col(col) = oM.actInvMotion(C[j].col(k) - crossMotion(u, ov[b]));
+        dd.da_dv[b].col(col) = oM.actInvMotion(crossMotion(s, ov[b]) + W[j].col(k));
+        dd.dg_dq[b].col(col) = oM.actInvMotion(-crossMotion(s, oa[0]));
+      }
+  }
+  constraintRowTangents(sys, d, dd);
 }
 
 }  // namespace proxgen

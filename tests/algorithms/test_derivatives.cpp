@@ -161,23 +161,32 @@ TEST(Derivatives, InverseDynamicsMatchDifferences) {
 }
 
 // The world-frame form (algorithms/rnea_derivatives_world.hpp) against the
-// body-frame tangent sweep: two derivations of the same exact quantity, so they
-// differ by round-off only. Each entry of either is a sum of at most 8 N
-// products (the two sides' terms together) of terms no larger than (1 + L)^2 S:
-// S the largest body-frame force or force tangent of the sweep (subtree sums,
-// dd.f, dd.df_dq, dd.df_dv), L the largest distance of a body from the world
-// origin, since the world-frame moments are the body-frame ones moved by at
-// most L, and its products of two moved quantities (Ic c, Bc u) by L^2. So
-// |world - body| <= c 8 N eps (1 + L)^2 S, with c = 10 for the few roundings
-// inside each term; relErr divides by max(1, |dtau|). A dropped or wrong term
-// (a Coriolis product, the gravity shift, the constraint forces' motion) is of
-// the size of the derivative itself.
+// body-frame tangent sweep: two derivations of the same exact quantities, so
+// they differ by round-off only.
+//  - dtau: each entry of either side is a sum of at most 8 N products (the two
+//    sides' terms together) of terms no larger than (1 + L)^2 S: S the largest
+//    body-frame force or force tangent of the sweep (subtree sums: dd.f,
+//    dd.df_dq, dd.df_dv), L the largest distance of a body from the world
+//    origin, since the world-frame moments are the body-frame ones moved by at
+//    most L and its products of two moved quantities (Ic c, Bc u) by L^2. So
+//    |world - body| <= c 8 N eps (1 + L)^2 S, c = 10 for the few roundings inside
+//    each term.
+//  - the constraint rows: constraintRowTangents on both sides, from body
+//    tangents that the world form computes column by column (no sums over the
+//    tree) out of world-frame vectors of size up to (1 + L)^2 T (T: the largest
+//    tangent of the constrained bodies, or of the twist and acceleration they
+//    are products of), moved back; the rows multiply them by the frame's
+//    placement (lever 1 + |p_C|), the twist (3d rows) and the gains. So
+//    |world - body| <= c 8 eps (1 + L)^2 T (1 + |p_C|) (1 + |v|) (1 + kp + kd).
+// relErr divides by max(1, |reference|). A dropped or wrong term (a Coriolis
+// product, the gravity shift, the constraint forces' motion) is of the size of
+// the derivative itself.
 TEST(Derivatives, WorldFrameFormMatchesTheBodyFrameSweep) {
   PROXGEN_REQUIRE_MODELS();
   for (const Named& s : allSystems()) {
     const System& sys = s.sys;
     Data d(sys);
-    DerivativeData dd(sys);
+    DerivativeData body(sys), world(sys);
     std::mt19937 rng(37);
     std::uniform_real_distribution<double> u(-5, 5);
     for (int st = 0; st < statesPerSystem(); ++st) {
@@ -187,18 +196,33 @@ TEST(Derivatives, WorldFrameFormMatchesTheBodyFrameSweep) {
       for (int k = 0; k < lambda.size(); ++k) lambda[k] = 20 * u(rng);
       const VecX* const withAndWithout[2] = {nullptr, &lambda};
       for (const VecX* l : withAndWithout) {
-        inverseDynamicsDerivatives(sys, d, dd, x.q, x.v, qdd, l);
-        double S = 0, L = 0;
+        inverseDynamicsDerivatives(sys, d, body, x.q, x.v, qdd, l);
+        double S = 0, L = 0, rows = 0;
         for (int b = 1; b < sys.model.numBodies(); ++b) {
-          S = std::max({S, maxAbs(dd.f[b]), maxAbs(dd.df_dq[b]), maxAbs(dd.df_dv[b])});
+          S = std::max({S, maxAbs(body.f[b]), maxAbs(body.df_dq[b]), maxAbs(body.df_dv[b])});
           L = std::max(L, d.oMi[b].p.norm());
         }
-        MatX wq, wv;
-        inverseDynamicsDerivativesWorld(sys, d, x.q, x.v, qdd, l, wq, wv);
-        const double bound = 10 * 8 * sys.model.numBodies() * kEps * (1 + L) * (1 + L) * S;
+        for (const Constraint& c : sys.constraints) {
+          if (c.body == 0) continue;
+          const int b = c.body;
+          const double T = std::max({maxAbs(body.dv_dq[b]), maxAbs(body.dv_dv[b]), maxAbs(body.da_dq[b]),
+                                     maxAbs(body.da_dv[b]), maxAbs(body.dg_dq[b]), maxAbs(d.v[b]), maxAbs(body.a[b])});
+          rows = std::max(rows, T * (1 + c.placement.p.norm()) * (1 + maxAbs(d.v[b])) * (1 + c.kp + c.kd));
+        }
+        inverseDynamicsDerivativesWorld(sys, d, world, x.q, x.v, qdd, l);
+        const double tauBound = 10 * 8 * sys.model.numBodies() * kEps * (1 + L) * (1 + L) * S;
+        const double rowBound = 10 * 8 * kEps * (1 + L) * (1 + L) * rows;
         const std::string what = s.name + (l ? ", with lambda" : "");
-        EXPECT_LE(relErr(wq, dd.dtau_dq), bound / std::max(1.0, maxAbs(dd.dtau_dq))) << what;
-        EXPECT_LE(relErr(wv, dd.dtau_dv), bound / std::max(1.0, maxAbs(dd.dtau_dv))) << what;
+        const auto expectNear = [&](const char* name, const MatX& w, const MatX& b, double bound) {
+          EXPECT_LE(relErr(w, b), bound / std::max(1.0, maxAbs(b))) << what << ": " << name;
+        };
+        expectNear("dtau_dq", world.dtau_dq, body.dtau_dq, tauBound);
+        expectNear("dtau_dv", world.dtau_dv, body.dtau_dv, tauBound);
+        expectNear("J", world.J, body.J, rowBound);
+        expectNear("dalpha_dq", world.dalpha_dq, body.dalpha_dq, rowBound);
+        expectNear("dalpha_dv", world.dalpha_dv, body.dalpha_dv, rowBound);
+        expectNear("dastar_dq", world.dastar_dq, body.dastar_dq, rowBound);
+        expectNear("dastar_dv", world.dastar_dv, body.dastar_dv, rowBound);
       }
     }
   }
