@@ -110,21 +110,34 @@ V6 jointVelocity(Emit& e, const Kinematics::Body& kb, const BodyPlan& p) {
   return vJ;
 }
 
-// df = I da + dv x* I v + v x* I dv (I constant: I dv needs no products; I v
-// is the body's, computed once in its own block: Iv).
-V6 forceTangent(Emit& e, const Kinematics::Body& kb, const V6& Iv, const V6& da, const V6& dv) {
+// The velocity terms of the force tangent, dv x* I v + v x* I dv, are linear in
+// dv: B dv with B = H(I v) + (v x*) I (H(h) u = u x* h). Its columns B e_k are
+// the body's, formed once in its own block from I v and v with I's constants
+// (no products), so each column's tangent costs one product per nonzero entry
+// of B instead of two cross products and I dv.
+std::array<V6, 6> velocityMap(CodeBuilder& cb, const Kinematics::Body& kb, const V6& Iv) {
+  std::array<V6, 6> B;
+  for (std::size_t k = 0; k < 6; ++k) {
+    V6 ek = zero6();
+    ek[k] = Expr(1.0);
+    B[k] = add(crossForce(cb, ek, Iv), crossForce(cb, kb.v, mul(cb, kb.IA, ek)));
+  }
+  return B;
+}
+
+// df = I da + B dv (I constant: I da needs no products; B: velocityMap).
+V6 forceTangent(Emit& e, const Kinematics::Body& kb, const std::array<V6, 6>& B, const V6& da, const V6& dv) {
   CodeBuilder& cb = e.cb();
-  const V6 Ida = mul(cb, kb.IA, da);
-  const V6 t1 = crossForce(cb, dv, Iv);
-  const V6 Idv = mul(cb, kb.IA, dv);
-  const V6 t2 = crossForce(cb, kb.v, Idv);
-  return add(add(Ida, t1), t2);
+  V6 df = mul(cb, kb.IA, da);
+  for (std::size_t k = 0; k < 6; ++k)
+    if (!dv[k].isZero()) df = add(df, scale(cb, dv[k], B[k]));
+  return df;
 }
 
 // The forward tangents of one column k of body i, given its q and v motion
 // tangents before the velocity-product term; stores what the children and the
 // backward sweep read.
-void finishColumn(Emit& e, const Kinematics::Body& kb, const V6& Iv, int i, int k, const V6& vJ, const V6& dvq,
+void finishColumn(Emit& e, const Kinematics::Body& kb, const std::array<V6, 6>& B, int i, int k, const V6& vJ, const V6& dvq,
                   const V6& dvv, const V6& daq0, const V6& dav0, bool store, Sweep& s, bool loop = false) {
   CodeBuilder& cb = e.cb();
   V6 dq = dvq, dv = dvv;
@@ -142,9 +155,9 @@ void finishColumn(Emit& e, const Kinematics::Body& kb, const V6& Iv, int i, int 
     s.daq[b][k] = save(e, kDaq, i, k, daq, loop);
     s.dav[b][k] = save(e, kDav, i, k, dav, loop);
   }
-  const V6 fq = forceTangent(e, kb, Iv, daq, dq);
+  const V6 fq = forceTangent(e, kb, B, daq, dq);
   s.dfq[b][k] = save(e, kDfq, i, k, fq, loop);
-  const V6 fv = forceTangent(e, kb, Iv, dav, dv);
+  const V6 fv = forceTangent(e, kb, B, dav, dv);
   s.dfv[b][k] = save(e, kDfv, i, k, fv, loop);
 }
 
@@ -178,14 +191,23 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
       V6 f = add(Ia, kb.pA);
       if (withLambda) addConstraintForces(e, i, f);
       for (int k = 0; k < 6; ++k) fs.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
-      // I v once per body: every column's force tangent reads it, and the
+      // I v and B once per body: every column's force tangent reads B, and the
       // carried columns are parts of their own (stored if it has any).
       V6 Iv = mul(cb, kb.IA, kb.v);
-      if (p.parent > 0 && !s.dvq[std::size_t(p.parent)].empty())
-        for (int k = 0; k < 6; ++k) Iv[std::size_t(k)] = e.putQ(kIv, i, 6, k, Iv[std::size_t(k)]);
-      else
-        flatten(cb, Iv, "h");
+      flatten(cb, Iv, "h");
       fs.Iv[std::size_t(i)] = Iv;
+      std::array<V6, 6> B = velocityMap(cb, kb, Iv);
+      const bool carried = p.parent > 0 && !s.dvq[std::size_t(p.parent)].empty();
+      for (std::size_t c = 0; c < 6; ++c)
+        for (std::size_t r = 0; r < 6; ++r) {
+          Expr& x = B[c][r];
+          if (x.isConstant()) continue;
+          if (carried)
+            x = e.putQ(kBv, i, 36, int(6 * c + r), x);
+          else
+            x = cb.flat(x, "b");
+        }
+      fs.Bv[std::size_t(i)] = B;
       const V6 vJ = jointVelocity(e, kb, p);
       const V6 vp = sub(kb.v, vJ);  // X^-1 v_p
       for (int d = 0; d < p.nv; ++d) {
@@ -193,7 +215,7 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
         const V6 dvq = crossMotion(cb, vp, Sk);
         const V6 daq = crossMotion(cb, ap, Sk);
         const V6 dav = crossMotion(cb, kb.v, Sk);
-        finishColumn(e, kb, fs.Iv[std::size_t(i)], i, p.idx_v + d, vJ, dvq, Sk, daq, dav, store, s);
+        finishColumn(e, kb, fs.Bv[std::size_t(i)], i, p.idx_v + d, vJ, dvq, Sk, daq, dav, store, s);
       }
     }
     e.cb().close();
@@ -224,7 +246,7 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
       const V6 daq = e.motionToChild(kb, paq);
       const V6 pav = load(e.cb(), in(kDav, s.dav[par]));
       const V6 dav = e.motionToChild(kb, pav);
-      finishColumn(e, kb, fs.Iv[std::size_t(i)], i, k0, vJ, dvq, dvv, daq, dav, store, s, loop);
+      finishColumn(e, kb, fs.Bv[std::size_t(i)], i, k0, vJ, dvq, dvv, daq, dav, store, s, loop);
       e.cb().close();
       if (loop) {
         const std::size_t b = std::size_t(i);
@@ -361,7 +383,8 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
   Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
-                std::vector<Expr>(std::size_t(plan.nv)), std::vector<V6>(std::size_t(N), zero6())};
+                std::vector<Expr>(std::size_t(plan.nv)), std::vector<V6>(std::size_t(N), zero6()),
+                std::vector<std::array<V6, 6>>(std::size_t(N))};
   Sweep s;
   for (std::vector<Cols>* t : {&s.dvq, &s.dvv, &s.daq, &s.dav, &s.dfq, &s.dfv}) t->assign(std::size_t(N), Cols{});
   Outputs out;

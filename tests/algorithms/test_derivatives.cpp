@@ -137,6 +137,20 @@ void expectDifferences(const std::string& what, const MatX& analytic, const Mode
                                           << ")";
 }
 
+// A random state with random accelerations and multipliers: the inputs of
+// inverseDynamicsDerivatives (|qdd| <= 5, |lambda| <= 100).
+struct RneaInputs {
+  State x;
+  VecX qdd, lambda;
+};
+RneaInputs randomRneaInputs(const System& sys, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-5, 5);
+  RneaInputs in{test::randomState(sys.model, rng), VecX(sys.model.nv), VecX(sys.nc)};
+  for (int k = 0; k < in.qdd.size(); ++k) in.qdd[k] = u(rng);
+  for (int k = 0; k < in.lambda.size(); ++k) in.lambda[k] = 20 * u(rng);
+  return in;
+}
+
 TEST(Derivatives, InverseDynamicsMatchDifferences) {
   PROXGEN_REQUIRE_MODELS();
   for (const Named& s : allSystems()) {
@@ -144,12 +158,10 @@ TEST(Derivatives, InverseDynamicsMatchDifferences) {
     Data d(sys), fd(sys);
     DerivativeData dd(sys);
     std::mt19937 rng(31);
-    std::uniform_real_distribution<double> u(-5, 5);
     for (int st = 0; st < statesPerSystem(); ++st) {
-      const State x = test::randomState(sys.model, rng);
-      VecX qdd(sys.model.nv), lambda(sys.nc);
-      for (int k = 0; k < qdd.size(); ++k) qdd[k] = u(rng);
-      for (int k = 0; k < lambda.size(); ++k) lambda[k] = 20 * u(rng);
+      const RneaInputs in = randomRneaInputs(sys, rng);
+      const State& x = in.x;
+      const VecX &qdd = in.qdd, &lambda = in.lambda;  // named: the lambda below captures them
       inverseDynamicsDerivatives(sys, d, dd, x.q, x.v, qdd, &lambda);
       const auto tau = [&](const State& y) -> VecX { return inverseDynamics(sys, fd, y.q, y.v, qdd, &lambda); };
       // RNEA is a sum: delta = c n eps (no condition number).
@@ -188,12 +200,8 @@ TEST(Derivatives, WorldFrameFormMatchesTheBodyFrameSweep) {
     Data d(sys);
     DerivativeData body(sys), world(sys);
     std::mt19937 rng(37);
-    std::uniform_real_distribution<double> u(-5, 5);
     for (int st = 0; st < statesPerSystem(); ++st) {
-      const State x = test::randomState(sys.model, rng);
-      VecX qdd(sys.model.nv), lambda(sys.nc);
-      for (int k = 0; k < qdd.size(); ++k) qdd[k] = u(rng);
-      for (int k = 0; k < lambda.size(); ++k) lambda[k] = 20 * u(rng);
+      const auto [x, qdd, lambda] = randomRneaInputs(sys, rng);
       const VecX* const withAndWithout[2] = {nullptr, &lambda};
       for (const VecX* l : withAndWithout) {
         inverseDynamicsDerivatives(sys, d, body, x.q, x.v, qdd, l);
@@ -212,17 +220,16 @@ TEST(Derivatives, WorldFrameFormMatchesTheBodyFrameSweep) {
         inverseDynamicsDerivativesWorld(sys, d, world, x.q, x.v, qdd, l);
         const double tauBound = 10 * 8 * sys.model.numBodies() * kEps * (1 + L) * (1 + L) * S;
         const double rowBound = 10 * 8 * kEps * (1 + L) * (1 + L) * rows;
-        const std::string what = s.name + (l ? ", with lambda" : "");
-        const auto expectNear = [&](const char* name, const MatX& w, const MatX& b, double bound) {
-          EXPECT_LE(relErr(w, b), bound / std::max(1.0, maxAbs(b))) << what << ": " << name;
-        };
-        expectNear("dtau_dq", world.dtau_dq, body.dtau_dq, tauBound);
-        expectNear("dtau_dv", world.dtau_dv, body.dtau_dv, tauBound);
-        expectNear("J", world.J, body.J, rowBound);
-        expectNear("dalpha_dq", world.dalpha_dq, body.dalpha_dq, rowBound);
-        expectNear("dalpha_dv", world.dalpha_dv, body.dalpha_dv, rowBound);
-        expectNear("dastar_dq", world.dastar_dq, body.dastar_dq, rowBound);
-        expectNear("dastar_dv", world.dastar_dv, body.dastar_dv, rowBound);
+        const std::pair<const char*, MatX DerivativeData::*> outputs[] = {
+            {"dtau_dq", &DerivativeData::dtau_dq},     {"dtau_dv", &DerivativeData::dtau_dv},
+            {"J", &DerivativeData::J},                 {"dalpha_dq", &DerivativeData::dalpha_dq},
+            {"dalpha_dv", &DerivativeData::dalpha_dv}, {"dastar_dq", &DerivativeData::dastar_dq},
+            {"dastar_dv", &DerivativeData::dastar_dv}};
+        for (const auto& [name, member] : outputs) {
+          const MatX &w = world.*member, &b = body.*member;
+          const double bound = member == &DerivativeData::dtau_dq || member == &DerivativeData::dtau_dv ? tauBound : rowBound;
+          EXPECT_LE(relErr(w, b), bound / std::max(1.0, maxAbs(b))) << s.name << (l ? ", with lambda: " : ": ") << name;
+        }
       }
     }
   }

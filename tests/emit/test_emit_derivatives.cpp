@@ -1,8 +1,9 @@
 // The shape of the derivatives' tangent sweep (emit/pass_inverse_dynamics_derivatives.cpp):
-// a body's momentum I v, which every column's force tangent dv x* I v reads,
-// is computed once in the body's own block and stored for its carried columns,
-// whose parts used to compute it again each (docs/derivatives.md); and the
-// shape of constrained_dynamics_derivatives' dense algebra (section 5 there).
+// a body's velocity map B (dv -> dv x* I v + v x* I dv, B = H(I v) + (v x*) I),
+// which every column's force tangent reads, is formed once in the body's own
+// block and stored for its carried columns, whose parts would otherwise form
+// the cross products with I v and I dv again for each column (docs/derivatives.md);
+// and the shape of constrained_dynamics_derivatives' dense algebra (section 5 there).
 // The values are the harness's business (tests/generated: harness_derivatives.cpp).
 #include <gtest/gtest.h>
 
@@ -15,26 +16,31 @@
 namespace proxgen::emit {
 namespace {
 
-TEST(DerivativesCode, EachBodysMomentumIsStoredOnce) {
+TEST(DerivativesCode, EachBodysVelocityMapIsStoredOnce) {
   // 7 revolute joints in a chain, the source as the passes printed it (shared
   // blocks would print a store once for several bodies).
   const std::string source = test::syntheticChainFiles(8, "inverse_dynamics_derivatives").unsharedSource;
-  // Stores `w.Iv_<body>[r] = ...`, counted per (body, r).
+  // Stores `w.Bv_<body>[e] = ...` (entry e = 6 column + row), counted per (body, e).
   std::map<std::string, int> stores;
-  const std::regex store(R"(w\.(Iv_\w+\[\d\]) = )");
+  const std::regex store(R"(w\.(Bv_\w+\[\d+\]) = )");
   for (auto it = std::sregex_iterator(source.begin(), source.end(), store); it != std::sregex_iterator(); ++it)
     ++stores[(*it)[1].str()];
-  // The bodies below the first carry their ancestors' columns: 6 bodies.
+  // The bodies below the first carry their ancestors' columns: 6 bodies, each
+  // with the entries of B that are not constant (a revolute joint's body has
+  // some: at least the 18 of H(I v) and of the products with v's three angular entries).
   std::map<std::string, int> bodies;
   for (const auto& [slot, n] : stores) {
     EXPECT_EQ(n, 1) << slot << " stored more than once";
     ++bodies[slot.substr(0, slot.find('['))];
   }
   EXPECT_EQ(bodies.size(), 6u);
-  // And read back, not recomputed, by the carried columns' parts: more uses than stores.
+  for (const auto& [body, entries] : bodies) EXPECT_GE(entries, 18) << body;
+  // Read back, not recomputed, by the carried columns' parts: more uses than stores.
   long uses = 0;
-  for (auto at = source.find("w.Iv_"); at != std::string::npos; at = source.find("w.Iv_", at + 1)) ++uses;
+  for (auto at = source.find("w.Bv_"); at != std::string::npos; at = source.find("w.Bv_", at + 1)) ++uses;
   EXPECT_GT(uses, long(stores.size()));
+  // The momentum itself is not a member any more: only B reads it, in the body's block.
+  EXPECT_EQ(source.find("w.Iv_"), std::string::npos);
 }
 
 // constrained_dynamics_derivatives through the tau block: W = M^-1 J^T meets
