@@ -191,11 +191,10 @@ void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrain
       V6 f = add(Ia, kb.pA);
       if (withLambda) addConstraintForces(e, i, f);
       for (int k = 0; k < 6; ++k) fs.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
-      // I v and B once per body: every column's force tangent reads B, and the
+      // B once per body: every column's force tangent reads it, and the
       // carried columns are parts of their own (stored if it has any).
       V6 Iv = mul(cb, kb.IA, kb.v);
       flatten(cb, Iv, "h");
-      fs.Iv[std::size_t(i)] = Iv;
       std::array<V6, 6> B = velocityMap(cb, kb, Iv);
       const bool carried = p.parent > 0 && !s.dvq[std::size_t(p.parent)].empty();
       for (std::size_t c = 0; c < 6; ++c)
@@ -383,8 +382,7 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
   Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
-                std::vector<Expr>(std::size_t(plan.nv)), std::vector<V6>(std::size_t(N), zero6()),
-                std::vector<std::array<V6, 6>>(std::size_t(N))};
+                std::vector<Expr>(std::size_t(plan.nv)), std::vector<std::array<V6, 6>>(std::size_t(N))};
   Sweep s;
   for (std::vector<Cols>* t : {&s.dvq, &s.dvv, &s.daq, &s.dav, &s.dfq, &s.dfv}) t->assign(std::size_t(N), Cols{});
   Outputs out;
