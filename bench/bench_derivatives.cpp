@@ -35,6 +35,12 @@
 //                                 triangle (the pair measures the tangent sweep
 //                                 against them; docs/benchmarks.md, "The tangent
 //                                 sweep against Pinocchio's RNEA derivatives")
+//   <case>/idd/generic_body       the generic twins of idd, the same inputs:
+//   <case>/idd/generic_world      inverseDynamicsDerivatives (the body-frame
+//                                 sweep) and inverseDynamicsDerivativesWorld (the
+//                                 world-frame form, which allocates its per-call
+//                                 buffers), both with the constraint rows; their
+//                                 agreement is tests/algorithms/test_derivatives.cpp's
 //
 // mu = 1e4, K = 3 (the suite's, bench/common.hpp). States: 1000 per case from
 // proxgen::randomState with seed 1, as bench_joint_space.cpp draws them, drawn
@@ -67,6 +73,7 @@
 #include "algorithms/data.hpp"
 #include "algorithms/derivatives.hpp"
 #include "algorithms/prox_pv.hpp"
+#include "algorithms/rnea_derivatives_world.hpp"
 #include "bench_pinocchio.hpp"
 #include "bodies.hpp"
 #include "cases/cases.hpp"
@@ -495,6 +502,20 @@ void registerCase(const char* name, const std::function<bool(const std::string&)
     }, counters);
   }
   if (want("fd/integrate_only")) reg("fd/integrate_only", [g](int k) { g->integrateOnly(k); }, {});
+  for (const bool world : {false, true}) {  // the generic twins of idd, a = the state's tau
+    const std::string variant = world ? "idd/generic_world" : "idd/generic_body";
+    if (!want(variant)) continue;
+    const auto d = std::make_shared<proxgen::Data>(c.sys);
+    const auto dd = std::make_shared<proxgen::DerivativeData>(c.sys);
+    reg(variant, [bc = &c, d, dd, world](int k) {
+      const proxgen::State& x = bc->states[std::size_t(k)];
+      if (world)
+        proxgen::inverseDynamicsDerivativesWorld(bc->sys, *d, *dd, x.q, x.v, x.tau, nullptr);
+      else
+        proxgen::inverseDynamicsDerivatives(bc->sys, *d, *dd, x.q, x.v, x.tau, nullptr);
+      benchmark::DoNotOptimize(dd->dtau_dq.data());
+    }, {});
+  }
   if (want("idd/generated")) {
     const double ratio = checkIdd(*g);
     reg("idd/generated", [g](int k) {

@@ -22,7 +22,7 @@ Pinocchio's rnea, nonLinearEffects, crba and computeMinverse where the build has
 --derivatives counts the derivative benchmarks (proxgen_bench_derivatives --count
 CASE/VARIANT N, bench_derivatives.cpp): the generated constrained_dynamics_derivatives,
 the central differences of prox_pv, their integrations alone, the generated
-inverse_dynamics_derivatives, and Pinocchio's constraintDynamics +
+inverse_dynamics_derivatives and its two generic twins (body and world frame), and Pinocchio's constraintDynamics +
 computeConstraintDynamicsDerivatives and computeRNEADerivatives where the build has it.
 """
 import argparse
@@ -42,7 +42,7 @@ LIBRARY = [f"{f}/{variant}" for f in ["inverse_dynamics", "nonlinear_effects", "
     f"{f}/pinocchio" for f in ["inverse_dynamics", "nonlinear_effects", "mass_matrix", "mass_matrix_inverse"]] + [
     "mass_matrix/pinocchio_upper", "mass_matrix/pinocchio_world", "mass_matrix_inverse/pinocchio_upper"]
 DERIVATIVES = ["cdd/generated", "fd/generated_prox_pv", "fd/integrate_only", "cdd/pinocchio", "idd/generated",
-               "idd/pinocchio"]
+               "idd/pinocchio", "idd/generic_body", "idd/generic_world"]
 # The drivers: executable in BUILD_DIR/bench, whether it takes `--count CASE/WHAT N`, and the
 # default list of what to count.
 DRIVERS = {
