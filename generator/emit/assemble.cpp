@@ -178,7 +178,7 @@ const EntryPoint kEntryPoints[] = {
      "// as active. None of the arrays may be inside w.\n",
      "void inverse_dynamics_derivatives(const Scalar* q, const Scalar* v, const Scalar* qdd, const Scalar* lambda,\n"
      "                                  Workspace& w, Scalar* dtau_dq, Scalar* dtau_dv) noexcept",
-     "// The tangent sweep of RNEA along every q and v direction, the path's columns only.\n"},
+     "// RNEA in world axes, then per (dof, dof of its path) pair the derivatives' entries.\n"},
     {Function::ForwardDynamicsDerivatives,
      "\n// forward_dynamics_derivatives (no constraint forces: the free motion):\n"
      "// qdd = M^-1 (tau - h) (ABA's answer, to round-off), and at (q, v, qdd)\n"
@@ -415,16 +415,54 @@ std::string helpers(const SolverTexts& texts) {
          "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
          "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n",
          "mass_matrix_inverse_passes(const Scalar* q, Workspace& w, Scalar* Minv)", texts.minvPasses);
+  if (!texts.tangentSweep.empty())
+    out += "// The world-frame sweep's pairs (docs/derivatives.md section 5): its per-dof arrays are\n"
+           "// [6][n] (BS: [3][n]), column k dof k's vector. Rows: for every dof r and every dof c\n"
+           "// of its path (ancestors' and its own joint's: the ranges of span from start[r] to\n"
+           "// start[r + 1]), out[r][c] = IS_r . A_c + s BS_r . B_c, B's angular rows; dtau_dq is\n"
+           "// (A, B, s) = (C, U, -1), dtau_dv (W, S, +1). Columns: for every dof c and every dof r\n"
+           "// of its joint's strict subtree ([span[2 c], span[2 c + 1])), dq[c][r] = S_c . Pq_r and\n"
+           "// dv[c][r] = S_c . Pv_r. Inner loops over contiguous dofs; fixed tables, no branch on\n"
+           "// the data.\n"
+           "template <int n>\n"
+           "void world_frame_rows(const Scalar* PROXGEN_RT_RESTRICT IS, const Scalar* PROXGEN_RT_RESTRICT BS,\n"
+           "                      const Scalar* PROXGEN_RT_RESTRICT A, const Scalar* PROXGEN_RT_RESTRICT B, Scalar s,\n"
+           "                      const int* start, const int* span, Scalar* PROXGEN_RT_RESTRICT out) noexcept {\n"
+           "  for (int r = 0; r < n; ++r) {\n"
+           "    Scalar is[6], bs[3];\n"
+           "    for (int k = 0; k < 6; ++k) is[k] = IS[k * n + r];\n"
+           "    for (int k = 0; k < 3; ++k) bs[k] = s * BS[k * n + r];\n"
+           "    for (int j = start[r]; j < start[r + 1]; ++j) {\n"
+           "      for (int c = span[2 * j]; c < span[2 * j + 1]; ++c) {\n"
+           "        out[r * n + c] = is[0] * A[c] + is[1] * A[n + c] + is[2] * A[2 * n + c] + is[3] * A[3 * n + c] +\n"
+           "                         is[4] * A[4 * n + c] + is[5] * A[5 * n + c] +\n"
+           "                         (bs[0] * B[3 * n + c] + bs[1] * B[4 * n + c] + bs[2] * B[5 * n + c]);\n"
+           "      }\n"
+           "    }\n"
+           "  }\n"
+           "}\n\n"
+           "template <int n>\n"
+           "void world_frame_columns(const Scalar* PROXGEN_RT_RESTRICT S, const Scalar* PROXGEN_RT_RESTRICT Pq,\n"
+           "                         const Scalar* PROXGEN_RT_RESTRICT Pv, const int* span, Scalar* PROXGEN_RT_RESTRICT dq,\n"
+           "                         Scalar* PROXGEN_RT_RESTRICT dv) noexcept {\n"
+           "  for (int c = 0; c < n; ++c) {\n"
+           "    Scalar s[6];\n"
+           "    for (int k = 0; k < 6; ++k) s[k] = S[k * n + c];\n"
+           "    for (int r = span[2 * c]; r < span[2 * c + 1]; ++r) {\n"
+           "      dq[c * n + r] = s[0] * Pq[r] + s[1] * Pq[n + r] + s[2] * Pq[2 * n + r] + s[3] * Pq[3 * n + r] +\n"
+           "                      s[4] * Pq[4 * n + r] + s[5] * Pq[5 * n + r];\n"
+           "      dv[c * n + r] = s[0] * Pv[r] + s[1] * Pv[n + r] + s[2] * Pv[2 * n + r] + s[3] * Pv[3 * n + r] +\n"
+           "                      s[4] * Pv[4 * n + r] + s[5] * Pv[5 * n + r];\n"
+           "    }\n"
+           "  }\n"
+           "}\n\n";
   helper(!texts.tangentSweep.empty(),
-         "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) and its\n"
-         "// tangents along every q and v direction; reads the kinematics state in w.\n",
-         "tangent_sweep(const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
+         "// inverse_dynamics_derivatives after the kinematics pass: RNEA at (qdd, lambda) in world\n"
+         "// axes and its derivatives along every q and v direction; reads the joint transforms,\n"
+         "// v and c in w.\n",
+         "tangent_sweep(const Scalar* q, const Scalar* v, const Scalar* qdd, const Scalar* lambda, Workspace& w,\n"
          "                   Scalar* dtau_dq, Scalar* dtau_dv)",
          texts.tangentSweep);
-  helper(!texts.biasForces.empty(),
-         "// pA = v x* I v again for the bodies with children: the elimination of prox_pv\n"
-         "// leaves their articulated bias in those members, and the tangent sweep reads pA.\n",
-         "bias_forces(const Scalar* v, Workspace& w)", texts.biasForces);
   helper(!texts.constraintJoints.empty(), "// Joint transforms, for the constraint functions of q alone.\n",
          "constraint_joints(const Scalar* q, Workspace& w)", texts.constraintJoints);
   return out;
@@ -492,7 +530,7 @@ std::pair<int, int> versionNumbers() {
 const std::vector<std::string>& fileFunctionNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out = {"kinematics", "joint_transforms", "constraint_joints", "eliminate_free_bodies",
-                                    "accelerate_free_bodies", "tangent_sweep", "bias_forces", "mass_matrix_inverse_passes",
+                                    "accelerate_free_bodies", "tangent_sweep", "world_frame_rows", "world_frame_columns", "mass_matrix_inverse_passes",
                                     "residual",
                                     "dense_product", "dense_product_add", "sparse_left_product_add",
                                     "sparse_transposed_product", "sparse_transposed_product_add", "dense_cholesky", "proximal_step",

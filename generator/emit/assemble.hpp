@@ -31,7 +31,7 @@ struct SolverTexts {
   std::string jointTransforms;
   // inverse_dynamics_derivatives' sweep after the kinematics pass, and the bias
   // forces that constrained_dynamics_derivatives restores before it ("" when not held).
-  std::string tangentSweep, biasForces;
+  std::string tangentSweep;  // its helpers world_frame_rows and world_frame_columns are printed with it
   // mass_matrix_inverse's passes after the joint transforms ("" when not held).
   std::string minvPasses;
   bool withKinematics = false, withJointTransforms = false;

@@ -43,8 +43,6 @@ void forEachExpr(Live& s, const std::function<void(Expr&)>& f) {
     }
     if (ab) f(ab->Dinv), vec(ab->Linv), vec(ab->u);
     if (s.forces && i < s.forces->a.size()) v6(s.forces->a[i]), v6(s.forces->f[i]);
-    if (s.forces && i < s.forces->Bv.size())
-      for (V6& x : s.forces->Bv[i]) v6(x);
     if (s.js && i < s.js->Ic.size()) f(s.js->Ic[i].m), v3(s.js->Ic[i].h), sym(s.js->Ic[i].I);
     if (s.js && i < s.js->FA.size())
       for (V6& x : s.js->FA[i]) v6(x);

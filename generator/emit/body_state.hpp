@@ -95,9 +95,6 @@ struct DelassusFactor {
 struct Forces {
   std::vector<V6> a, f;
   std::vector<Expr> tau;
-  // The derivatives' tangent sweep: each body's map dv -> dv x* I v + v x* I dv,
-  // as six columns (B e_k), read by all its columns (else empty).
-  std::vector<std::array<V6, 6>> Bv;
 };
 
 /// The joint-space matrices (pass_mass_matrix.cpp, pass_mass_matrix_inverse.cpp):

@@ -1,8 +1,8 @@
 // Column loops: a run of adjacent columns that go through the same arithmetic
 // with the same coefficients, emitted as one loop over j instead of a copy of
-// the code per column. Used by the tangent sweep of inverse_dynamics_derivatives
-// and the forward pass of mass_matrix_inverse (docs/derivatives.md, "Column
-// loops"; docs/dynamics.md).
+// the code per column. Used by the forward pass of mass_matrix_inverse
+// (docs/dynamics.md; the body-frame tangent sweep of the derivatives used them
+// before the world-frame one replaced it: docs/derivatives.md, "Column loops").
 #include <fmt/format.h>
 
 #include <cmath>

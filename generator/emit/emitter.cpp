@@ -125,9 +125,8 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   if (want.has(Function::InverseDynamicsDerivatives)) {
     texts.tangentSweep = emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
     texts.library[Function::InverseDynamicsDerivatives] =
-        "  kinematics(q, v, w);\n  tangent_sweep(v, qdd, lambda, w, dtau_dq, dtau_dv);\n";
+        "  kinematics(q, v, w);\n  tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv);\n";
   }
-  if (cdd) texts.biasForces = emitBiasForces(e, afterKinematicsState, afterKinematics);
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);
     Kinematics transforms = emitJointTransforms(e);

@@ -24,7 +24,6 @@ inline constexpr Quantity kQ{"q", "joint offset q"},
     kKS{"KS", "S^T KA"}, kKSD{"KSD", "D^-1 S^T KA"}, kZ{"Z", "L^-1 KA (6 x m, one unused column)"},
     kK{"k", "constraint right-hand side"}, kF{"f", "spatial force (inverse dynamics)"},
     kIc{"Ic", "composite inertia: h = m c, then I about the origin (upper triangle)"},
-    kBv{"Bv", "columns of dv -> dv x* I v + v x* I dv (derivatives' sweep)"},
     kFA{"FA", "unit-torque forces, then accelerations, one column per dof (M^-1)"};
 
 class Members {

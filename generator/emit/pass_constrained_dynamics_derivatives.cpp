@@ -231,10 +231,9 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   // second transforms pass); M^-1's members (IA, U, D^-1, ...) are not read after it.
   host.line("prox_pv(q, v, tau, s, w, qdd, lambda);", {}, names);
   host.line(fmt::format("mass_matrix_inverse_passes(q, w, {});", minv), {}, names);
-  // The sweep at the solution reads prox_pv's kinematics state (same q, v), less
-  // the bias forces its elimination overwrote: bias_forces restores those.
-  host.line("bias_forces(v, w);", {}, names);
-  host.line(fmt::format("tangent_sweep(v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
+  // The sweep at the solution reads prox_pv's kinematics state (same q, v): the
+  // joint transforms, v and c, which its elimination does not write.
+  host.line(fmt::format("tangent_sweep(q, v, qdd, lambda, w, {}, {});", dq, dv), {}, names);
   OpCount ops;
   if (nc == 0) {
     // X_q = -M^-1 dtau_dq, X_v = -M^-1 dtau_dv over dtau's nonzero entries, X_tau = M^-1.

@@ -143,7 +143,7 @@ std::string emitInverseDynamics(Emit& e, Kinematics kin, const CodeBuilder* afte
   const bool withLambda = !nonlinearEffects && plan.nc > 0;
   const int N = int(plan.bodies.size());
   Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
-                std::vector<Expr>(std::size_t(plan.nv)), {}};
+                std::vector<Expr>(std::size_t(plan.nv))};
   // inverse_dynamics sweeps from q, v and qdd itself; nonlinear_effects
   // calls kinematics(q, v, w) and starts from its state.
   if (!nonlinearEffects) {

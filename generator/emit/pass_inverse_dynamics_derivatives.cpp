@@ -1,27 +1,34 @@
 // The derivatives of inverse dynamics, tau = RNEA(q, v, qdd) + J^T lambda, at
-// fixed qdd and lambda: one forward-mode tangent sweep along every q and v
-// direction (docs/derivatives.md section 2), straight-line, with the model's
-// zeros folded. Perturbing joint j by dq_j moves its placement to
-// X_J Exp(S_j dq_j), so for body i and a column k (an input direction):
-//   forward, root first, k among the dofs of i's path from the root:
-//     dv_i = X^-1 dv_p  (+ (X^-1 v_p) x S_k for i's own q dofs; = S_k for its own v dofs)
-//     da_i = X^-1 da_p + dv_i x vJ  (+ (X^-1 a_p) x S_k, own q dofs; + v_i x S_k, own v dofs)
-//     df_i = I da_i + dv_i x* I v_i + v_i x* I dv_i
-//   backward, leaves first, k among the path's and the subtree's dofs:
-//     dtau_i[k] = S_i^T df_i ;  df_p += X df_i  (+ X (S_k x* f_i), own q dofs),
-// f_i the accumulated subtree force with the constraint forces K_c^T lambda_c.
-// A column outside a body's path (forward) or path and subtree (backward) is
-// zero and never printed. The tangents move between the part functions in
-// workspace members (6 x nv per body, only the path's columns written); the
-// host copies the nonzero entries out and writes the zeros. A run of adjacent
-// columns of one shape is one loop over j instead of a block per column
-// (below, "Column loops"; docs/derivatives.md).
-// The generic counterpart: algorithms/derivatives.cpp (tangentSweep).
+// fixed qdd and lambda, in the world frame (Carpentier and Mansard's form;
+// docs/derivatives.md sections 2b and 5): tangent_sweep(q, v, qdd, lambda, w,
+// dtau_dq, dtau_dv), on the kinematics state in w. Every body's quantities are
+// moved to world axes once, in blocks with the model's constants folded:
+//   forward, root first:    oM_i = oM_p liM_i, ov_i, oa_i (oa_0 = -a_g), oS_i,
+//                           oI_i, of_i = oI_i oa_i + ov_i x* oI_i ov_i (+ K^T lambda), and
+//                           B_i = -oI_i (ov_i x) + H(oI_i ov_i) + (ov_i x*) oI_i, whose
+//                           blocks are [0, -2 [hl]x; 0, Baa] (hl: the linear momentum);
+//   backward, leaves first: the subtree sums Ic, HL, Baa, F, and per dof (s = oS e_k,
+//                           l the parent) u = s x ov_l, c = -s x oa_l + u x ov_l,
+//                           w = -s x (ov_l + ov_j), Pq = s x* F_j + Ic_j c - Bc_j u,
+//                           Pv = Ic_j w + Bc_j s, IS = Ic_j s, BS = Bc_j^T s (angular part),
+// into component-major per-dof arrays; then every (dof r, dof c of r's path) pair
+// is a few six-vector products in loops over constant tables (world_frame_rows,
+// world_frame_columns, printed by assemble.cpp):
+//   dtau_dq[r][c] = IS_r . C_c - BS_r . U_c,   dtau_dv[r][c] = IS_r . W_c + BS_r . oS_c,
+//   for c a strict ancestor's dof  dtau_dq[c][r] = oS_c . Pq_r,  dtau_dv[c][r] = oS_c . Pv_r.
+// O(N) blocks and O(N d) products in two loops, where a body-frame tangent
+// sweep carries every column through every body below its joint (O(N d)
+// blocks; docs/derivatives.md section 5 has the measurements). The constrained
+// bodies' own tangents, in their coordinates, for constrained_dynamics_derivatives'
+// rows: along q_c, dv_b = oX_b^-1 (-u), da_b = oX_b^-1 (c - u x ov_b); along qd_c,
+// dv_b = oX_b^-1 s, da_b = oX_b^-1 (s x ov_b + w); the joint's own columns as
+// section 2 forms them. The generic counterpart: algorithms/rnea_derivatives_world.cpp.
+// The file also holds forward_dynamics_derivatives and the helpers the derivative
+// functions share (the sparse patterns, the copies, the products with M^-1).
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <map>
 
 #include "emit/passes.hpp"
 #include "model/error.hpp"
@@ -29,343 +36,425 @@
 namespace proxgen::emit {
 namespace {
 
+constexpr Quantity kWR{"oRd", "world rotation (world-frame derivatives)"},
+    kWP{"opd", "world position (world-frame derivatives)"}, kWV{"ovd", "velocity in world axes"},
+    kWA{"oad", "acceleration in world axes (gravity-shifted)"},
+    kWI{"oIc", "composite inertia in world axes about the world origin: h = m c, then I (upper triangle)"},
+    kWH{"oHc", "composite linear momentum in world axes (B's linear-angular block is -2 [HL]x)"},
+    kWB{"oBc", "composite B's angular block (3 x 3, row-major)"}, kWF{"oFc", "subtree force in world axes"};
+// The constrained bodies' motion tangents in their coordinates: the members
+// the body-frame sweep uses (constrained_dynamics_derivatives reads either).
 constexpr Quantity kDvq{"dvq", "d v / dq (6 x nv, path columns)"}, kDvv{"dvv", "d v / dv (6 x nv, path columns)"},
-    kDaq{"daq", "d a / dq at fixed qdd (6 x nv, path columns)"}, kDav{"dav", "d a / dv at fixed qdd (6 x nv, path columns)"},
-    kDfq{"dfq", "d f / dq, subtree force (6 x nv)"}, kDfv{"dfv", "d f / dv, subtree force (6 x nv)"};
+    kDaq{"daq", "d a / dq at fixed qdd (6 x nv, path columns)"}, kDav{"dav", "d a / dv at fixed qdd (6 x nv, path columns)"};
 
-using Slot = TangentSlot;
-using Col = TangentCol;
-using Cols = TangentCols;
+// The per-dof arrays the pairs' loop reads, component-major ([6][nv]; BS [3][nv]):
+// column k of each is dof k's six-vector, and a run of dofs is contiguous in every row.
+enum ColumnArray { kS, kU, kC, kW, kPq, kPv, kIS, kBS, kColumnArrayCount };
+struct ColumnArrayInfo {
+  const char* name;
+  int rows;
+  const char* what;
+};
+constexpr ColumnArrayInfo kColumnArrays[] = {
+    {"oS", 6, "joint axes in world axes (column k: dof k)"},
+    {"oU", 6, "u = s x ov_parent per dof"},
+    {"oC", 6, "c = -s x oa_parent + u x ov_parent per dof"},
+    {"oW", 6, "w = -s x (ov_parent + ov) per dof"},
+    {"oPq", 6, "d F / dq of the joint's subtree per dof"},
+    {"oPv", 6, "d F / dqd of the joint's subtree per dof"},
+    {"oIS", 6, "Ic s per dof"},
+    {"oBS", 3, "Bc^T s per dof (its angular part: the linear one is zero)"}};
 
-// Stores x's non-constant entries as column `col` of the body's 6 x nv
-// member; in a loop over a run of columns (`loop`), as column col + j.
-Col save(Emit& e, const Quantity& qy, int body, int col, const V6& x, bool loop = false) {
-  Col s;
-  for (int r = 0; r < 6; ++r) {
-    const Expr& v = x[std::size_t(r)];
-    if (v.isConstant()) {
-      s[std::size_t(r)].value = v;
+// A stored value: a generation-time constant, or the member it was stored to.
+using Slots = std::vector<TangentSlot>;
+
+Slots keep(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x) {
+  Slots s(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k].isConstant()) {
+      s[k].value = x[k];
     } else {
-      s[std::size_t(r)].name =
-          loop ? e.loopSlot(qy, body, 6, e.plan.nv, r, col) : e.member(qy, body, 6, e.plan.nv, r, col);
-      e.cb().store(s[std::size_t(r)].name, v);
+      s[k].name = e.member(qy, body, int(x.size()), int(k));
+      e.cb().store(s[k].name, x[k]);
     }
   }
   return s;
 }
 
-// Column loops. The columns of a body's tangents go through the same
-// arithmetic with the same coefficients (the body's transform, inertia and
-// velocity); only which members they read differs. A run of adjacent columns
-// whose inputs have the same shape (each entry a stored member in all of
-// them, or the same constant in all) is one loop over j, the members indexed
-// [c0 + j], instead of a copy of the code per column: the sweep's code shrinks
-// by the depth of the tree, and the compiler vectorises the loop across
-// columns (columnRuns and openColumns: column_loops.cpp; docs/derivatives.md,
-// "Column loops").
+std::vector<Expr> read(CodeBuilder& cb, const Slots& s) {
+  std::vector<Expr> x;
+  for (const TangentSlot& t : s) x.push_back(t.name.empty() ? t.value : cb.member(t.name));
+  return x;
+}
 
-bool sameShape(const Col& a, const Col& b) {
-  for (std::size_t r = 0; r < 6; ++r) {
-    if (a[r].name.empty() != b[r].name.empty()) return false;
-    if (a[r].name.empty() && a[r].value.constant() != b[r].value.constant()) return false;
+V6 read6(CodeBuilder& cb, const Slots& s) { return toV6(read(cb, s)); }
+V3 read3(CodeBuilder& cb, const Slots& s) {
+  const std::vector<Expr> x = read(cb, s);
+  return {x[0], x[1], x[2]};
+}
+
+// child -> parent (world): [R l + p x R a; R a].
+V6 actMotion(CodeBuilder& cb, const XSym& X, const V6& m) {
+  V3 a = rotate(cb, X.R, ang(m));
+  for (Expr& x : a) x = cb.flat(x);
+  V3 l = rotate(cb, X.R, lin(m));
+  const V3 pxa = cross(cb, X.p, a);
+  for (std::size_t i = 0; i < 3; ++i) l[i] += pxa[i];
+  return stack(l, a);
+}
+
+// The rigid inertia's product [m x_l - h x x_a; h x x_l + I x_a] (symbolic.hpp, Rigid).
+V6 rigidMul(CodeBuilder& cb, const Rigid& r, const V6& x) {
+  const V3 hxa = cross(cb, r.h, ang(x)), hxl = cross(cb, r.h, lin(x));
+  V6 y;
+  for (std::size_t i = 0; i < 3; ++i) {
+    y[i] = cb.mul(r.m, x[i]) - hxa[i];
+    Expr s = hxl[i];
+    for (std::size_t j = 0; j < 3; ++j) s += cb.mul(r.I(int(i), int(j)), x[3 + j]);
+    y[3 + i] = s;
   }
-  return true;
+  return y;
 }
 
-// `c`'s stored entries read as the loop's column c0 + j (c: column c0's slots).
-Col loopColumn(Emit& e, const Quantity& qy, int body, const Col& c, int c0) {
-  Col out = c;
-  for (int r = 0; r < 6; ++r)
-    if (!c[std::size_t(r)].name.empty()) out[std::size_t(r)].name = e.loopSlot(qy, body, 6, e.plan.nv, r, c0);
-  return out;
+using M3v = std::array<Expr, 9>;  // row-major
+M3v skew(const V3& a) {
+  return {Expr(), -a[2], a[1], a[2], Expr(), -a[0], -a[1], a[0], Expr()};
 }
 
-// After the loop: column k's slots, with the shape the loop gave them; the
-// members the loop wrote under its own names are new values from here on.
-Col columnAfterLoop(Emit& e, const Quantity& qy, int body, const Col& looped, int k) {
-  Col out = looped;
-  for (int r = 0; r < 6; ++r)
-    if (!looped[std::size_t(r)].name.empty()) {
-      out[std::size_t(r)].name = e.member(qy, body, 6, e.plan.nv, r, k);
-      e.cb().refresh(out[std::size_t(r)].name);
+// B's angular block: -[hm]x[v]x - [v]x[hm]x - I [w]x + [w]x I - [ha]x (docs/derivatives.md
+// section 7: with hl = m v - hm x w, B's other blocks are 0, -2 [hl]x (linear-angular) and 0).
+M3v angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
+  const V3 v = lin(ov), w = ang(ov);
+  Expr hv;
+  for (std::size_t k = 0; k < 3; ++k) hv += cb.mul(r.h[k], v[k]);
+  hv = cb.flat(hv);
+  const M3v W = skew(w), Ha = skew(ang(h));
+  M3v B;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const std::size_t ui = std::size_t(i), uj = std::size_t(j);
+      Expr x = -(cb.mul(v[ui], r.h[uj]) + cb.mul(r.h[ui], v[uj])) - Ha[std::size_t(3 * i + j)];
+      if (i == j) x += 2.0 * hv;
+      for (int k = 0; k < 3; ++k) {
+        const Expr& wkj = W[std::size_t(3 * k + j)];
+        const Expr& wik = W[std::size_t(3 * i + k)];
+        if (!wkj.isZero()) x -= cb.mul(r.I(i, k), wkj);
+        if (!wik.isZero()) x += cb.mul(wik, r.I(k, j));
+      }
+      B[std::size_t(3 * i + j)] = x;
     }
-  return out;
-}
-
-std::string vIn(int k) { return fmt::format("v[{}]", k); }
-std::string qddIn(int k) { return fmt::format("qdd[{}]", k); }
-
-struct Sweep {
-  std::vector<Cols> dvq, dvv, daq, dav, dfq, dfv;  // per body
-};
-
-// vJ = S v_i (inputs: valid in every part).
-V6 jointVelocity(Emit& e, const Kinematics::Body& kb, const BodyPlan& p) {
-  CodeBuilder& cb = e.cb();
-  V6 vJ = zero6();
-  for (int d = 0; d < p.nv; ++d) {
-    const V6 t = scale(cb, cb.input(vIn(p.idx_v + d)), kb.S[std::size_t(d)]);
-    vJ = add(vJ, t);
-  }
-  return vJ;
-}
-
-// The velocity terms of the force tangent, dv x* I v + v x* I dv, are linear in
-// dv: B dv with B = H(I v) + (v x*) I (H(h) u = u x* h). Its columns B e_k are
-// the body's, formed once in its own block from I v and v with I's constants
-// (no products), so each column's tangent costs one product per nonzero entry
-// of B instead of two cross products and I dv.
-std::array<V6, 6> velocityMap(CodeBuilder& cb, const Kinematics::Body& kb, const V6& Iv) {
-  std::array<V6, 6> B;
-  for (std::size_t k = 0; k < 6; ++k) {
-    V6 ek = zero6();
-    ek[k] = Expr(1.0);
-    B[k] = add(crossForce(cb, ek, Iv), crossForce(cb, kb.v, mul(cb, kb.IA, ek)));
-  }
   return B;
 }
 
-// df = I da + B dv (I constant: I da needs no products; B: velocityMap).
-V6 forceTangent(Emit& e, const Kinematics::Body& kb, const std::array<V6, 6>& B, const V6& da, const V6& dv) {
-  CodeBuilder& cb = e.cb();
-  V6 df = mul(cb, kb.IA, da);
-  for (std::size_t k = 0; k < 6; ++k)
-    if (!dv[k].isZero()) df = add(df, scale(cb, dv[k], B[k]));
-  return df;
+V3 mul3(CodeBuilder& cb, const M3v& M, const V3& x, bool transposed) {
+  V3 y = zero3();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      y[std::size_t(i)] += cb.mul(transposed ? M[std::size_t(3 * j + i)] : M[std::size_t(3 * i + j)], x[std::size_t(j)]);
+  return y;
 }
 
-// The forward tangents of one column k of body i, given its q and v motion
-// tangents before the velocity-product term; stores what the children and the
-// backward sweep read.
-void finishColumn(Emit& e, const Kinematics::Body& kb, const std::array<V6, 6>& B, int i, int k, const V6& vJ, const V6& dvq,
-                  const V6& dvv, const V6& daq0, const V6& dav0, bool store, Sweep& s, bool loop = false) {
-  CodeBuilder& cb = e.cb();
-  V6 dq = dvq, dv = dvv;
-  flatten(cb, dq, "dv");
-  flatten(cb, dv, "dv");
-  const V6 cq = crossMotion(cb, dq, vJ);
-  const V6 cv = crossMotion(cb, dv, vJ);
-  V6 daq = add(daq0, cq), dav = add(dav0, cv);
-  flatten(cb, daq, "da");
-  flatten(cb, dav, "da");
-  const std::size_t b = std::size_t(i);
-  if (store) {
-    s.dvq[b][k] = save(e, kDvq, i, k, dq, loop);
-    s.dvv[b][k] = save(e, kDvv, i, k, dv, loop);
-    s.daq[b][k] = save(e, kDaq, i, k, daq, loop);
-    s.dav[b][k] = save(e, kDav, i, k, dav, loop);
+// Bc x = [-2 HL x x_a; Baa x_a].
+V6 applyB(CodeBuilder& cb, const V3& HL, const M3v& Baa, const V6& x) {
+  const V3 t = cross(cb, HL, ang(x));
+  const V3 a = mul3(cb, Baa, ang(x), false);
+  return {-2.0 * t[0], -2.0 * t[1], -2.0 * t[2], a[0], a[1], a[2]};
+}
+
+struct World {
+  std::vector<Slots> oR, op, ov, oa, Ic, HL, Baa, F;  // per body (Ic: h then I)
+  std::vector<std::array<Slots, kColumnArrayCount>> col;  // per dof: what each array holds
+  std::vector<double> mass;  // per body, then of its subtree: a constant of the model
+};
+
+// Column k of a component-major array: stored in full (the loop reads every entry).
+Slots storeColumn(Emit& e, int array, int k, const std::vector<Expr>& x) {
+  const ColumnArrayInfo& a = kColumnArrays[array];
+  Slots s(std::size_t(a.rows));
+  for (std::size_t r = 0; r < s.size(); ++r) {
+    const std::string name = e.ws.member(a.name, a.rows, e.plan.nv, int(r), k, a.what);
+    e.cb().store(name, x[r]);
+    if (x[r].isConstant())
+      s[r].value = x[r];  // read back as the constant it is
+    else
+      s[r].name = name;
   }
-  const V6 fq = forceTangent(e, kb, B, daq, dq);
-  s.dfq[b][k] = save(e, kDfq, i, k, fq, loop);
-  const V6 fv = forceTangent(e, kb, B, dav, dv);
-  s.dfv[b][k] = save(e, kDfv, i, k, fv, loop);
+  return s;
 }
 
-void forward(Emit& e, const Kinematics& kin, bool withLambda, bool keepConstrained, Forces& fs, Sweep& s) {
+std::vector<Expr> entriesOf(const Rigid& r) {
+  std::vector<Expr> x(r.h.begin(), r.h.end());
+  for (int k = 0; k < r.I.packedSize(); ++k) x.push_back(r.I.packed(k));
+  return x;
+}
+
+Rigid rigidFrom(const Expr& m, const std::vector<Expr>& x) {
+  Rigid r;
+  r.m = m;
+  for (std::size_t k = 0; k < 3; ++k) r.h[k] = x[k];
+  for (int k = 0; k < r.I.packedSize(); ++k) r.I.packed(k) = x[std::size_t(3 + k)];
+  return r;
+}
+
+V6 neg(const V6& x) { return sub(zero6(), x); }
+
+void forward(Emit& e, Kinematics& kin, bool withLambda, World& W) {
+  const Plan& plan = e.plan;
+  e.fn.beginPass("forward", "forward: world placements, ov, oa, oS, oI, of and B of every body");
+  for (int i : plan.sweep) {
+    Kinematics::Body& kb = kin.b[std::size_t(i)];
+    const BodyPlan& p = e.bp(i);
+    const std::size_t b = std::size_t(i), par = std::size_t(p.parent);
+    e.fn.boundary(i);
+    e.openBody(i, "world forward");
+    CodeBuilder& cb = e.cb();
+    XSym oM = compose(cb, kb.XT, kb.XJ);
+    V6 oap = e.rootAcceleration();
+    if (p.parent > 0) {
+      const std::vector<Expr> R = read(cb, W.oR[par]), t = read(cb, W.op[par]);
+      XSym parent;
+      std::copy(R.begin(), R.end(), parent.R.begin());
+      std::copy(t.begin(), t.end(), parent.p.begin());
+      oM = compose(cb, parent, oM);
+      oap = read6(cb, W.oa[par]);
+    }
+    W.oR[b] = keep(e, kWR, i, std::vector<Expr>(oM.R.begin(), oM.R.end()));
+    W.op[b] = keep(e, kWP, i, std::vector<Expr>(oM.p.begin(), oM.p.end()));
+    {
+      const std::vector<Expr> R = read(cb, W.oR[b]), t = read(cb, W.op[b]);
+      std::copy(R.begin(), R.end(), oM.R.begin());
+      std::copy(t.begin(), t.end(), oM.p.begin());
+    }
+    kb.oM = oM;
+    V6 ov = actMotion(cb, oM, kb.v);
+    flatten(cb, ov, "ov");
+    V6 x = kb.c;
+    for (int d = 0; d < p.nv; ++d)
+      x = add(x, scale(cb, cb.input(fmt::format("qdd[{}]", p.idx_v + d)), kb.S[std::size_t(d)]));
+    flatten(cb, x, "ax");
+    V6 oa = add(oap, actMotion(cb, oM, x));
+    flatten(cb, oa, "oa");
+    W.ov[b] = keep(e, kWV, i, entries(ov));
+    W.oa[b] = keep(e, kWA, i, entries(oa));
+    for (int d = 0; d < p.nv; ++d)
+      W.col[std::size_t(p.idx_v + d)][kS] = storeColumn(e, kS, p.idx_v + d, entries(actMotion(cb, oM, kb.S[std::size_t(d)])));
+    const Rigid own = rigidOf(kb.IA);
+    W.mass[b] = own.m.constant();
+    Rigid oI = rigidToParent(cb, oM, own);
+    for (Expr& y : oI.h) y = cb.flat(y, "hm");
+    for (int k = 0; k < oI.I.packedSize(); ++k) oI.I.packed(k) = cb.flat(oI.I.packed(k), "oI");
+    V6 h = rigidMul(cb, oI, ov);
+    flatten(cb, h, "h");
+    V6 f = add(rigidMul(cb, oI, oa), crossForce(cb, ov, h));
+    if (withLambda) {
+      V6 fc = zero6();
+      addConstraintForces(e, i, fc);  // K^T lambda in body coordinates
+      f = add(f, actForce(cb, oM, fc));
+    }
+    const M3v Baa = angularBlockOfB(cb, oI, ov, h);
+    W.Ic[b] = keep(e, kWI, i, entriesOf(oI));
+    W.HL[b] = keep(e, kWH, i, {h[0], h[1], h[2]});
+    W.Baa[b] = keep(e, kWB, i, std::vector<Expr>(Baa.begin(), Baa.end()));
+    W.F[b] = keep(e, kWF, i, entries(f));
+    cb.close();
+  }
+}
+
+// Leaves first: body j's columns from its subtree sums, then the sums into its parent.
+void backward(Emit& e, World& W) {
+  const Plan& plan = e.plan;
+  e.fn.beginPass("columns", "backward: the subtree sums Ic, HL, Baa, F and each dof's u, c, w, Pq, Pv, Ic s, Bc^T s");
+  for (auto it = plan.sweep.rbegin(); it != plan.sweep.rend(); ++it) {
+    const int j = *it;
+    const BodyPlan& p = e.bp(j);
+    const std::size_t b = std::size_t(j), par = std::size_t(p.parent);
+    e.fn.boundary(j);
+    e.openBody(j, "world columns");
+    CodeBuilder& cb = e.cb();
+    const Rigid Ic = rigidFrom(Expr(W.mass[b]), read(cb, W.Ic[b]));
+    const V3 HL = read3(cb, W.HL[b]);
+    M3v Baa;
+    {
+      const std::vector<Expr> x = read(cb, W.Baa[b]);
+      std::copy(x.begin(), x.end(), Baa.begin());
+    }
+    const V6 F = read6(cb, W.F[b]), ov = read6(cb, W.ov[b]);
+    const V6 ovl = p.parent > 0 ? read6(cb, W.ov[par]) : zero6();
+    const V6 oal = p.parent > 0 ? read6(cb, W.oa[par]) : e.rootAcceleration();
+    V6 vsum = add(ovl, ov);
+    flatten(cb, vsum, "vs");
+    for (int d = 0; d < p.nv; ++d) {
+      const int k = p.idx_v + d;
+      auto& col = W.col[std::size_t(k)];
+      const V6 s = read6(cb, col[kS]);
+      V6 u = crossMotion(cb, s, ovl);
+      flatten(cb, u, "u");
+      V6 c = add(neg(crossMotion(cb, s, oal)), crossMotion(cb, u, ovl));
+      flatten(cb, c, "c");
+      V6 w = neg(crossMotion(cb, s, vsum));
+      flatten(cb, w, "w");
+      const V6 pq = sub(add(crossForce(cb, s, F), rigidMul(cb, Ic, c)), applyB(cb, HL, Baa, u));
+      const V6 pv = add(rigidMul(cb, Ic, w), applyB(cb, HL, Baa, s));
+      const V3 hs = cross(cb, HL, lin(s)), bt = mul3(cb, Baa, ang(s), true);
+      col[kU] = storeColumn(e, kU, k, entries(u));
+      col[kC] = storeColumn(e, kC, k, entries(c));
+      col[kW] = storeColumn(e, kW, k, entries(w));
+      col[kPq] = storeColumn(e, kPq, k, entries(pq));
+      col[kPv] = storeColumn(e, kPv, k, entries(pv));
+      col[kIS] = storeColumn(e, kIS, k, entries(rigidMul(cb, Ic, s)));
+      col[kBS] = storeColumn(e, kBS, k, {2.0 * hs[0] + bt[0], 2.0 * hs[1] + bt[1], 2.0 * hs[2] + bt[2]});
+    }
+    if (p.parent > 0) {  // into the parent's sums
+      W.mass[par] += W.mass[b];
+      const std::pair<std::vector<Slots>*, const Quantity*> sums[] = {
+          {&W.Ic, &kWI}, {&W.HL, &kWH}, {&W.Baa, &kWB}, {&W.F, &kWF}};
+      for (const auto& [x, qy] : sums) {
+        const std::vector<Expr> mine = read(cb, (*x)[b]), theirs = read(cb, (*x)[par]);
+        std::vector<Expr> total(mine.size());
+        for (std::size_t k = 0; k < mine.size(); ++k) total[k] = theirs[k] + mine[k];
+        (*x)[par] = keep(e, *qy, p.parent, total);
+      }
+    }
+    cb.close();
+  }
+}
+
+// The constrained bodies' motion tangents (columns of their paths), stored in
+// the members the body-frame sweep uses.
+void constrainedTangents(Emit& e, const Kinematics& kin, World& W, BodyTangents& keepOut) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
-  e.fn.beginPass("forward", "forward: a, f, and their tangents along the path's q and v directions");
-  for (int i = 1; i < N; ++i) {
-    const Kinematics::Body& kb = kin.b[std::size_t(i)];
-    const BodyPlan& p = e.bp(i);
-    // The motion tangents are read by the children, and with keepConstrained by
-    // constrained_dynamics_derivatives' constraint rows.
-    const bool store = !p.children.empty() || (keepConstrained && !p.constraints.empty());
-    // The primal RNEA values and the body's own columns.
-    e.fn.boundary(i);
-    e.openBody(i, "forward");
+  e.fn.beginPass("constrained", "the constrained bodies' motion tangents in their coordinates");
+  const auto save = [&](const Quantity& qy, int body, int col, const V6& x) {
+    TangentCol s;
+    for (std::size_t r = 0; r < 6; ++r) {
+      if (x[r].isConstant()) {
+        s[r].value = x[r];
+      } else {
+        s[r].name = e.member(qy, body, 6, plan.nv, int(r), col);
+        e.cb().store(s[r].name, x[r]);
+      }
+    }
+    return s;
+  };
+  for (int bi = 1; bi < N; ++bi) {
+    const BodyPlan& p = e.bp(bi);
+    if (p.constraints.empty()) continue;
+    const std::size_t b = std::size_t(bi);
+    const Kinematics::Body& kb = kin.b[b];
+    // The joint's own columns as the body-frame sweep forms them (section 2: S_k
+    // is a constant there, so the rows' entries along it fold):
+    //   dv/dq = (X^-1 v_p) x S_k, dv/dqd = S_k, da/dq = (X^-1 a_p) x S_k + dv/dq x vJ,
+    //   da/dqd = v x S_k + S_k x vJ, with X^-1 a_p = oX^-1 oa - S qdd - c.
+    e.fn.boundary(bi);
+    e.cb().open("{", {fmt::format("body {} '{}', its joint's columns", bi, p.ident)});
     {
       CodeBuilder& cb = e.cb();
-      V6 ap = p.parent == 0 ? e.rootAcceleration() : fs.a[std::size_t(p.parent)];
-      ap = e.motionToChild(kb, ap);
-      flatten(cb, ap, "ap");
-      V6 a = add(ap, kb.c);
+      V6 vJ = zero6(), ap = actInvMotion(cb, kb.oM, read6(cb, W.oa[b]));
       for (int d = 0; d < p.nv; ++d) {
-        const V6 t = scale(cb, cb.input(qddIn(p.idx_v + d)), kb.S[std::size_t(d)]);
-        a = add(a, t);
+        vJ = add(vJ, scale(cb, cb.input(fmt::format("v[{}]", p.idx_v + d)), kb.S[std::size_t(d)]));
+        ap = sub(ap, scale(cb, cb.input(fmt::format("qdd[{}]", p.idx_v + d)), kb.S[std::size_t(d)]));
       }
-      flatten(cb, a, "a");
-      if (store)
-        for (int k = 0; k < 6; ++k) fs.a[std::size_t(i)][std::size_t(k)] = e.putQ(kA, i, 6, k, a[std::size_t(k)]);
-      const V6 Ia = mul(cb, kb.IA, a);
-      V6 f = add(Ia, kb.pA);
-      if (withLambda) addConstraintForces(e, i, f);
-      for (int k = 0; k < 6; ++k) fs.f[std::size_t(i)][std::size_t(k)] = e.putQ(kF, i, 6, k, f[std::size_t(k)]);
-      // B once per body: every column's force tangent reads it, and the
-      // carried columns are parts of their own (stored if it has any).
-      V6 Iv = mul(cb, kb.IA, kb.v);
-      flatten(cb, Iv, "h");
-      std::array<V6, 6> B = velocityMap(cb, kb, Iv);
-      const bool carried = p.parent > 0 && !s.dvq[std::size_t(p.parent)].empty();
-      for (std::size_t c = 0; c < 6; ++c)
-        for (std::size_t r = 0; r < 6; ++r) {
-          Expr& x = B[c][r];
-          if (x.isConstant()) continue;
-          if (carried)
-            x = e.putQ(kBv, i, 36, int(6 * c + r), x);
-          else
-            x = cb.flat(x, "b");
-        }
-      fs.Bv[std::size_t(i)] = B;
-      const V6 vJ = jointVelocity(e, kb, p);
-      const V6 vp = sub(kb.v, vJ);  // X^-1 v_p
+      ap = sub(ap, kb.c);
+      flatten(cb, ap, "ap");
+      V6 vp = sub(kb.v, vJ);
+      flatten(cb, vp, "vp");
       for (int d = 0; d < p.nv; ++d) {
+        const int k = p.idx_v + d;
         const V6& Sk = kb.S[std::size_t(d)];
-        const V6 dvq = crossMotion(cb, vp, Sk);
-        const V6 daq = crossMotion(cb, ap, Sk);
-        const V6 dav = crossMotion(cb, kb.v, Sk);
-        finishColumn(e, kb, fs.Bv[std::size_t(i)], i, p.idx_v + d, vJ, dvq, Sk, daq, dav, store, s);
+        V6 dvq = crossMotion(cb, vp, Sk);
+        flatten(cb, dvq, "dv");
+        keepOut.dvq[b][k] = save(kDvq, bi, k, dvq);
+        keepOut.dvv[b][k] = save(kDvv, bi, k, Sk);
+        keepOut.daq[b][k] = save(kDaq, bi, k, add(crossMotion(cb, ap, Sk), crossMotion(cb, dvq, vJ)));
+        keepOut.dav[b][k] = save(kDav, bi, k, add(crossMotion(cb, kb.v, Sk), crossMotion(cb, Sk, vJ)));
       }
     }
     e.cb().close();
-    // The ancestors' columns, carried from the parent: a loop per run of
-    // columns of one shape, a block per column elsewhere.
-    if (p.parent <= 0) continue;
-    const std::size_t par = std::size_t(p.parent);
-    std::vector<int> carried;
-    for (const auto& kv : s.dvq[par]) carried.push_back(kv.first);
-    const auto shapeOf = [&](int k, int k0) {
-      return sameShape(s.dvq[par].at(k), s.dvq[par].at(k0)) &&
-             sameShape(s.dvv[par].at(k), s.dvv[par].at(k0)) && sameShape(s.daq[par].at(k), s.daq[par].at(k0)) &&
-             sameShape(s.dav[par].at(k), s.dav[par].at(k0));
-    };
-    for (const auto& run : columnRuns(carried, shapeOf)) {
-      const int k0 = run.first, len = run.second;  // named: the lambdas below capture them
-      const bool loop = len > 1;
-      openColumns(e, p.ident, k0, len, fmt::format("body {} '{}',", i, p.ident));
-      const auto in = [&](const Quantity& qy, const Cols& c) {
-        return loop ? loopColumn(e, qy, p.parent, c.at(k0), k0) : c.at(k0);
-      };
-      const V6 vJ = jointVelocity(e, kb, p);
-      const V6 pq = load(e.cb(), in(kDvq, s.dvq[par]));
-      const V6 dvq = e.motionToChild(kb, pq);
-      const V6 pv = load(e.cb(), in(kDvv, s.dvv[par]));
-      const V6 dvv = e.motionToChild(kb, pv);
-      const V6 paq = load(e.cb(), in(kDaq, s.daq[par]));
-      const V6 daq = e.motionToChild(kb, paq);
-      const V6 pav = load(e.cb(), in(kDav, s.dav[par]));
-      const V6 dav = e.motionToChild(kb, pav);
-      finishColumn(e, kb, fs.Bv[std::size_t(i)], i, k0, vJ, dvq, dvv, daq, dav, store, s, loop);
-      e.cb().close();
-      if (loop) {
-        const std::size_t b = std::size_t(i);
-        const std::pair<const Quantity*, std::vector<Cols>*> stored[] = {
-            {&kDvq, &s.dvq}, {&kDvv, &s.dvv}, {&kDaq, &s.daq}, {&kDav, &s.dav}, {&kDfq, &s.dfq}, {&kDfv, &s.dfv}};
-        for (const auto& [qy, cols] : stored) {
-          Cols& c = (*cols)[b];
-          if (c.count(k0) == 0) continue;  // not stored (a leaf's motion tangents)
-          const Col looped = c.at(k0);
-          for (int k = k0; k < k0 + len; ++k) c[k] = columnAfterLoop(e, *qy, i, looped, k);
-        }
-      }
-    }
-  }
-}
-
-struct Outputs {
-  std::map<std::pair<int, int>, Slot> dq, dv;  // (row, column) -> entry
-};
-
-void backward(Emit& e, const Kinematics& kin, Forces& fs, Sweep& s, Outputs& out) {
-  const Plan& plan = e.plan;
-  const int N = int(plan.bodies.size()), nv = plan.nv;
-  e.fn.beginPass("backward", "backward: dtau = S^T df, df_parent += X df (+ X (S_k x* f) along the joint's own q)");
-  for (int i = N - 1; i >= 1; --i) {
-    const Kinematics::Body& kb = kin.b[std::size_t(i)];
-    const BodyPlan& p = e.bp(i);
-    const std::size_t b = std::size_t(i), par = std::size_t(std::max(p.parent, 0));
-    for (int pass = 0; pass < 2; ++pass) {
-      Cols& cols = pass == 0 ? s.dfq[b] : s.dfv[b];
-      const Quantity& qy = pass == 0 ? kDfq : kDfv;
-      Cols& pc = pass == 0 ? s.dfq[par] : s.dfv[par];
-      const char* dtau = pass == 0 ? "dtau_dq" : "dtau_dv";
-      const auto own = [&](int k) { return pass == 0 && k >= p.idx_v && k < p.idx_v + p.nv; };  // + X (S_k x* f)
-      // A run: adjacent columns of one shape, none of the joint's own q
-      // columns, each met or not met before in the parent, in one shape.
-      const auto runs = [&](int k, int k0) {
-        if (own(k) || own(k0) || !sameShape(cols.at(k), cols.at(k0))) return false;
-        if (p.parent <= 0) return true;
-        const auto a = pc.find(k), a0 = pc.find(k0);
-        if ((a == pc.end()) != (a0 == pc.end())) return false;
-        return a == pc.end() || sameShape(a->second, a0->second);
-      };
-      std::vector<int> ks;
-      for (const auto& kv : cols) ks.push_back(kv.first);
-      for (const auto& run : columnRuns(ks, runs)) {
-        const int k0 = run.first, len = run.second;
-        const bool loop = len > 1;
-        openColumns(e, p.ident, k0, len, fmt::format("body {} '{}', {}", i, p.ident, pass == 0 ? "q" : "v"));
+    const XSym& oM = kb.oM;
+    for (int j = p.parent; j > 0; j = e.bp(j).parent)
+      for (int d = 0; d < e.bp(j).nv; ++d) {
+        const int k = e.bp(j).idx_v + d;
+        e.fn.boundary(bi);
+        e.cb().open("{", {fmt::format("body {} '{}', column {}", bi, p.ident, k)});
         CodeBuilder& cb = e.cb();
-        V6 df = load(cb, loop ? loopColumn(e, qy, i, cols.at(k0), k0) : cols.at(k0));
-        std::vector<Slot> rows(std::size_t(p.nv));
-        for (int d = 0; d < p.nv; ++d) {
-          const int row = p.idx_v + d;
-          const Expr t = dot(cb, kb.S[std::size_t(d)], df);
-          Slot& slot = rows[std::size_t(d)];
-          if (t.isConstant()) {
-            slot.value = t;
-          } else {
-            const std::string what = "d tau / dq or d tau / dv (row-major)";
-            slot.name = loop ? e.ws.loopSlot(dtau, nv, nv, row, k0, what) : e.ws.member(dtau, nv, nv, row, k0, what);
-            cb.store(slot.name, t);
-          }
-        }
-        Col parentCol;
-        bool toParent = false;
-        if (p.parent > 0) {
-          if (own(k0)) {
-            const V6 carried = crossForce(cb, kb.S[std::size_t(k0 - p.idx_v)], fs.f[b]);
-            df = add(df, carried);
-          }
-          const V6 dp = e.forceToParent(kb, df);
-          V6 sum = dp;
-          if (const auto it = pc.find(k0); it != pc.end()) {
-            const V6 old = load(cb, loop ? loopColumn(e, qy, p.parent, it->second, k0) : it->second);
-            sum = add(old, dp);
-          }
-          parentCol = save(e, qy, p.parent, k0, sum, loop);
-          toParent = true;
-        }
+        const auto& col = W.col[std::size_t(k)];
+        const V6 ovb = read6(cb, W.ov[b]);
+        const V6 s = read6(cb, col[kS]), u = read6(cb, col[kU]), c = read6(cb, col[kC]), w = read6(cb, col[kW]);
+        keepOut.dvq[b][k] = save(kDvq, bi, k, actInvMotion(cb, oM, neg(u)));
+        keepOut.dvv[b][k] = save(kDvv, bi, k, actInvMotion(cb, oM, s));
+        keepOut.daq[b][k] = save(kDaq, bi, k, actInvMotion(cb, oM, sub(c, crossMotion(cb, u, ovb))));
+        keepOut.dav[b][k] = save(kDav, bi, k, actInvMotion(cb, oM, add(crossMotion(cb, s, ovb), w)));
         cb.close();
-        for (int k = k0; k < k0 + len; ++k) {
-          for (int d = 0; d < p.nv; ++d) {
-            Slot slot = rows[std::size_t(d)];
-            if (loop && !slot.name.empty()) {
-              slot.name = e.ws.member(dtau, nv, nv, p.idx_v + d, k, "d tau / dq or d tau / dv (row-major)");
-              cb.refresh(slot.name);
-            }
-            (pass == 0 ? out.dq : out.dv)[{p.idx_v + d, k}] = slot;
-          }
-          if (toParent) pc[k] = loop ? columnAfterLoop(e, qy, p.parent, parentCol, k) : parentCol;
-        }
       }
-    }
-    if (p.parent > 0) {
-      e.fn.boundary(i);
-      e.openBody(i, "backward");
-      const V6 dp = e.forceToParent(kb, fs.f[b]);
-      V6& pf = fs.f[par];
-      for (int k = 0; k < 6; ++k)
-        if (!dp[std::size_t(k)].isZero()) pf[std::size_t(k)] = e.putQ(kF, p.parent, 6, k, pf[std::size_t(k)] + dp[std::size_t(k)]);
-      e.cb().close();
-    }
   }
 }
 
-// out[r * nv + c] for every entry: zeros by a loop, then the nonzero ones;
-// returns the nonzero entries.
-std::set<std::pair<int, int>> copyOut(Emit& e, const std::map<std::pair<int, int>, Slot>& entries, const char* out) {
+bool allZero(const Slots& s, std::size_t from, std::size_t to) {
+  for (std::size_t r = from; r < to; ++r)
+    if (!s[r].name.empty() || !s[r].value.isZero()) return false;
+  return true;
+}
+
+// The pairs (world_frame_rows and world_frame_columns, assemble.cpp): per dof r the
+// columns of its path (its ancestors' dofs and its own joint's), for dtau_dq
+// less the columns whose c and u's angular part are exact zeros (a free
+// flyer's translations: nothing moves the robot's dynamics along them); per dof
+// c the rows of its joint's strict subtree, [below[2c], below[2c + 1]).
+void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<std::pair<int, int>>& dv) {
+  const Plan& plan = e.plan;
+  const int nv = plan.nv, N = int(plan.bodies.size());
+  std::set<std::pair<int, int>> pathQ, pathV;
+  std::vector<int> below;
+  long subtree = 0;
+  for (int i = 1; i < N; ++i)
+    for (int d = 0; d < e.bp(i).nv; ++d) {
+      const int r = e.bp(i).idx_v + d;
+      for (int j = i; j > 0; j = e.bp(j).parent)
+        for (int k = 0; k < e.bp(j).nv; ++k) {
+          const int c = e.bp(j).idx_v + k;
+          const auto& col = W.col[std::size_t(c)];
+          pathV.insert({r, c});
+          if (!allZero(col[kC], 0, 6) || !allZero(col[kU], 3, 6)) pathQ.insert({r, c});
+        }
+      below.insert(below.end(), {e.bp(i).idx_v + e.bp(i).nv, e.bp(i).dofEnd});
+      subtree += e.bp(i).dofEnd - e.bp(i).idx_v - e.bp(i).nv;
+    }
+  const RowSpans q = rowSpans(nv, pathQ), v = rowSpans(nv, pathV);
   CodeBuilder& cb = e.cb();
-  const int nv = e.plan.nv;
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
-  std::set<std::pair<int, int>> nonzero;
-  for (const auto& [rc, slot] : entries) {
-    const Expr x = slot.name.empty() ? slot.value : cb.member(slot.name);
-    if (x.isZero()) continue;
-    cb.line(fmt::format("{}[{}] = {};", out, rc.first * nv + rc.second, cb.print(x)), {x}, {out});
-    nonzero.insert(rc);
-  }
-  return nonzero;
+  printSpans(cb, "path_q", q);
+  printSpans(cb, "path_v", v);
+  cb.line(fmt::format("static constexpr int below[{}] = {{{}}};", below.size(), fmt::join(below, ", ")));
+  for (const char* out : {"dtau_dq", "dtau_dv"})
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
+  const auto arr = [](ColumnArray a) { return fmt::format("&w.{}[0][0]", kColumnArrays[a].name); };
+  const std::vector<std::string> names = {"w", "dtau_dq", "dtau_dv"};
+  OpCount rows;  // per entry a six- and a three-term product
+  rows.once.mul = 9 * entries(q) + 3 * nv;
+  rows.once.add = 8 * entries(q);
+  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(-1), path_q_start, path_q_span, dtau_dq);", nv,
+                      arr(kIS), arr(kBS), arr(kC), arr(kU)),
+          {}, names, rows);
+  rows.once.mul = 9 * entries(v) + 3 * nv;
+  rows.once.add = 8 * entries(v);
+  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(1), path_v_start, path_v_span, dtau_dv);", nv,
+                      arr(kIS), arr(kBS), arr(kW), arr(kS)),
+          {}, names, rows);
+  OpCount columns;  // per entry two six-term products
+  columns.once.mul = 12 * subtree;
+  columns.once.add = 10 * subtree;
+  cb.line(fmt::format("world_frame_columns<{}>({}, {}, {}, below, dtau_dq, dtau_dv);", nv, arr(kS), arr(kPq), arr(kPv)),
+          {}, names, columns);
+  dq = pathQ;
+  dv = pathV;
+  for (int i = 1; i < N; ++i)
+    for (int d = 0; d < e.bp(i).nv; ++d) {
+      const int c = e.bp(i).idx_v + d;
+      for (int r = e.bp(i).idx_v + e.bp(i).nv; r < e.bp(i).dofEnd; ++r) {
+        dq.insert({c, r});
+        dv.insert({c, r});
+      }
+    }
 }
 
 }  // namespace
@@ -374,58 +463,6 @@ V6 load(CodeBuilder& cb, const TangentCol& s) {
   V6 x;
   for (std::size_t r = 0; r < 6; ++r) x[r] = s[r].name.empty() ? s[r].value : cb.member(s[r].name);
   return x;
-}
-
-std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                           BodyTangents* keep, bool keepConstrained) {
-  const Plan& plan = e.plan;
-  const bool withLambda = plan.nc > 0;
-  const int N = int(plan.bodies.size());
-  Forces forces{std::vector<V6>(std::size_t(N), zero6()), std::vector<V6>(std::size_t(N), zero6()),
-                std::vector<Expr>(std::size_t(plan.nv)), std::vector<std::array<V6, 6>>(std::size_t(N))};
-  Sweep s;
-  for (std::vector<Cols>* t : {&s.dvq, &s.dvv, &s.daq, &s.dav, &s.dfq, &s.dfv}) t->assign(std::size_t(N), Cols{});
-  Outputs out;
-  e.fn.live() = Live{};
-  e.fn.live().kin = &kin;
-  e.fn.live().forces = &forces;
-  e.fn.beginHost("rnead", afterKinematics);
-  CodeBuilder& host = e.cb();
-  if (withLambda) {
-    // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
-    host.line(fmt::format("static constexpr Scalar kNoMultipliers[{}] = {{}};", plan.nc));
-    host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
-  }
-  forward(e, kin, withLambda, keepConstrained, forces, s);
-  if (keep != nullptr) *keep = BodyTangents{s.dvq, s.dvv, s.daq, s.dav, {}, {}};
-  backward(e, kin, forces, s, out);
-  e.fn.endPart();
-  std::set<std::pair<int, int>> dq = copyOut(e, out.dq, "dtau_dq");
-  std::set<std::pair<int, int>> dv = copyOut(e, out.dv, "dtau_dv");
-  if (keep != nullptr) {
-    keep->dtauDq = std::move(dq);
-    keep->dtauDv = std::move(dv);
-  }
-  std::string text = e.fn.endHost({"v", "qdd", "lambda", "w", "dtau_dq", "dtau_dv"});
-  e.fn.live() = Live{};
-  return text;
-}
-
-std::string emitBiasForces(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics) {
-  e.fn.live() = Live{};
-  e.fn.live().kin = &kin;
-  e.fn.beginHost("bias", afterKinematics);
-  e.fn.beginPass("", "pA = v x* I v of the bodies with children (the elimination's articulated bias in their members)");
-  for (int i = 1; i < int(e.plan.bodies.size()); ++i) {
-    if (e.bp(i).children.empty()) continue;  // a leaf's member still holds its own pA
-    e.fn.boundary(i);
-    e.openBody(i, "bias");
-    storeBiasForce(e, i, kin.b[std::size_t(i)]);
-    e.cb().close();
-  }
-  std::string text = e.fn.endHost({"v", "w"});  // v: a velocity equal to an input is read from it
-  e.fn.live() = Live{};
-  return text;
 }
 
 RowSpans rowSpans(int rows, const std::set<std::pair<int, int>>& entries) {
@@ -549,10 +586,41 @@ std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
   cb.line(fmt::format("dense_product<{0}, {0}, 1>(dqdd_dtau, {1}, Scalar(1), qdd);", nv, h), {}, names, ops);
   // The sweep reads the kinematics state nonlinear_effects left for the same (q, v):
   // neither RNEA nor mass_matrix_inverse writes v, c or pA (no second kinematics pass).
-  cb.line(fmt::format("tangent_sweep(v, qdd, nullptr, w, {}, {});", dq, dv), {}, names);
+  cb.line(fmt::format("tangent_sweep(q, v, qdd, nullptr, w, {}, {});", dq, dv), {}, names);
   // dqdd_dx = -M^-1 dtau_dx over dtau's nonzero entries (the tree's pattern).
   minvTimesDtau(e, t, "dqdd_dtau", dq, dv, xt, names);
   return e.fn.endHost(names);
+}
+
+std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
+                                                BodyTangents* keepOut, bool keepConstrained) {
+  const Plan& plan = e.plan;
+  const bool withLambda = plan.nc > 0;
+  const int N = int(plan.bodies.size());
+  World W;
+  for (std::vector<Slots>* x : {&W.oR, &W.op, &W.ov, &W.oa, &W.Ic, &W.HL, &W.Baa, &W.F}) x->assign(std::size_t(N), Slots{});
+  W.col.resize(std::size_t(plan.nv));
+  W.mass.assign(std::size_t(N), 0.0);
+  e.fn.live() = Live{};
+  e.fn.live().kin = &kin;
+  e.fn.beginHost("rnead", afterKinematics);
+  CodeBuilder& host = e.cb();
+  if (withLambda) {
+    // lambda == nullptr: no constraint forces (a pointer select, no branch in the arithmetic).
+    host.line(fmt::format("static constexpr Scalar kNoMultipliers[{}] = {{}};", plan.nc));
+    host.line("lambda = lambda != nullptr ? lambda : kNoMultipliers;", {}, {"lambda"});
+  }
+  forward(e, kin, withLambda, W);
+  backward(e, W);
+  BodyTangents t;
+  for (std::vector<TangentCols>* x : {&t.dvq, &t.dvv, &t.daq, &t.dav}) x->assign(std::size_t(N), TangentCols{});
+  if (keepConstrained) constrainedTangents(e, kin, W, t);
+  e.fn.endPart();
+  pairs(e, W, t.dtauDq, t.dtauDv);
+  if (keepOut != nullptr) *keepOut = std::move(t);
+  std::string text = e.fn.endHost({"q", "v", "qdd", "lambda", "w", "dtau_dq", "dtau_dv"});
+  e.fn.live() = Live{};
+  return text;
 }
 
 }  // namespace proxgen::emit

@@ -49,8 +49,7 @@ void sincosRuns(Emit& e, bool supportOnly = false);
 /// (true), which the sweep that follows then reads; else nothing (false) and
 /// each body's step computes its own (docs/benchmarks.md: the faster way for each).
 bool jointTransformsFirst(Emit& e, Kinematics& kin);
-/// pA = v x* (I v) of body i from b.v and b.IA, into its member (the kinematics
-/// pass, and bias_forces for constrained_dynamics_derivatives).
+/// pA = v x* (I v) of body i from b.v and b.IA, into its member (the kinematics pass).
 void storeBiasForce(Emit& e, int i, Kinematics::Body& b);
 // A weld's placement error e = log6(target^-1 oMc) through the runtime's log6,
 // printed as `<prefix>R_<id>[9]`, `<prefix>p_<id>[3]` -> `<prefix>e_<id>[6]`;
@@ -208,8 +207,8 @@ std::string emitConstraintWrenches(Emit& e, const ConstraintJoints& joints);
 std::string emitDelassus(Emit& e, const ConstraintJoints& joints, bool inverse);
 
 // ---- pass_inverse_dynamics_derivatives.cpp: d tau / dq and d tau / dv of
-// tau = RNEA(q, v, qdd) + J^T lambda at fixed qdd, lambda (the tangent sweep of
-// docs/derivatives.md section 2), from its copy of the state after kinematics.
+// tau = RNEA(q, v, qdd) + J^T lambda at fixed qdd, lambda (in the world frame:
+// docs/derivatives.md sections 2b and 5), from its copy of the state after kinematics.
 /// One entry of a tangent as a later function reads it: a generation-time
 /// constant, or the workspace member it was stored to.
 struct TangentSlot {
@@ -248,28 +247,25 @@ void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std
 /// sparse_transposed_product<n, m, p> over the left factor's spans.
 Ops sparseLeftProductOps(const RowSpans& a, int p);
 
-/// What the tangent sweep hands to the functions that call it: the motion
-/// tangents per body (columns of its path) it left in the workspace, and
+/// What the tangent sweep hands to the functions that call it: the constrained
+/// bodies' motion tangents (columns of their paths) it left in the workspace, and
 /// d tau / dq's and d tau / dv's nonzero pattern (the tree's: a joint's torque
-/// moves with its ancestors, itself and its subtree).
+/// moves with its ancestors, itself and its subtree; less a free flyer's
+/// translation columns of d tau / dq).
 struct BodyTangents {
   std::vector<TangentCols> dvq, dvv, daq, dav;
   std::set<std::pair<int, int>> dtauDq, dtauDv;  // (row, column) entries that can be nonzero
 };
 V6 load(CodeBuilder& cb, const TangentCol& s);
-/// The sweep's body, `tangent_sweep(v, qdd, lambda, w, dtau_dq, dtau_dv)`, which
-/// reads the kinematics state in the workspace: inverse_dynamics_derivatives is
-/// kinematics(q, v, w) and this; the derivative functions that have just run a
-/// solver or RNEA on the same (q, v) call it without a second kinematics pass.
-/// With `keep`, the tangents' slots and dtau's pattern are returned; with
-/// `keepConstrained` too, the constrained bodies' motion tangents are stored
-/// (constrained_dynamics_derivatives reads them).
+/// The sweep's body, `tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv)`, which
+/// reads the kinematics state in the workspace (joint transforms, v, c):
+/// inverse_dynamics_derivatives is kinematics(q, v, w) and this; the derivative
+/// functions that have just run a solver or RNEA on the same (q, v) call it
+/// without a second kinematics pass. With `keep`, dtau's pattern is returned;
+/// with `keepConstrained` too, the constrained bodies' motion tangents are stored
+/// and their slots returned (constrained_dynamics_derivatives reads them).
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
                                            BodyTangents* keep = nullptr, bool keepConstrained = false);
-/// The body of bias_forces(v, w): pA = v x* I v again for every body with children,
-/// whose member the solvers' elimination overwrites with the articulated bias
-/// (constrained_dynamics_derivatives calls it between prox_pv and the sweep).
-std::string emitBiasForces(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics);
 /// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
 /// and inverse_dynamics_derivatives (held with it) and the products with M^-1
 /// (dense_product<n, m, p>, and sparse_transposed_product over dtau's pattern

@@ -1,46 +1,85 @@
 // The shape of the derivatives' tangent sweep (emit/pass_inverse_dynamics_derivatives.cpp):
-// a body's velocity map B (dv -> dv x* I v + v x* I dv, B = H(I v) + (v x*) I),
-// which every column's force tangent reads, is formed once in the body's own
-// block and stored for its carried columns, whose parts would otherwise form
-// the cross products with I v and I dv again for each column (docs/derivatives.md);
+// in the world frame, one block per body forward and one backward, the (dof,
+// path dof) pairs in two loops over constant tables, the free flyer's
+// translation columns of dtau_dq left out (docs/derivatives.md section 5);
 // and the shape of constrained_dynamics_derivatives' dense algebra (section 5 there).
 // The values are the harness's business (tests/generated: harness_derivatives.cpp).
 #include <gtest/gtest.h>
 
-#include <map>
+#include <algorithm>
 #include <regex>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "emit/generate.hpp"
 #include "support.hpp"
 
 namespace proxgen::emit {
 namespace {
 
-TEST(DerivativesCode, EachBodysVelocityMapIsStoredOnce) {
-  // 7 revolute joints in a chain, the source as the passes printed it (shared
-  // blocks would print a store once for several bodies).
-  const std::string source = test::syntheticChainFiles(8, "inverse_dynamics_derivatives").unsharedSource;
-  // Stores `w.Bv_<body>[e] = ...` (entry e = 6 column + row), counted per (body, e).
-  std::map<std::string, int> stores;
-  const std::regex store(R"(w\.(Bv_\w+\[\d+\]) = )");
-  for (auto it = std::sregex_iterator(source.begin(), source.end(), store); it != std::sregex_iterator(); ++it)
-    ++stores[(*it)[1].str()];
-  // The bodies below the first carry their ancestors' columns: 6 bodies, each
-  // with the entries of B that are not constant (a revolute joint's body has
-  // some: at least the 18 of H(I v) and of the products with v's three angular entries).
-  std::map<std::string, int> bodies;
-  for (const auto& [slot, n] : stores) {
-    EXPECT_EQ(n, 1) << slot << " stored more than once";
-    ++bodies[slot.substr(0, slot.find('['))];
+// The ranges of a `static constexpr int <name>_span[...] = {lo, hi, ...};` table.
+std::vector<std::pair<int, int>> spanTable(const std::string& source, const std::string& name) {
+  const std::regex table("static constexpr int " + name + R"(_span\[\d+\] = \{([^}]*)\};)");
+  std::smatch m;
+  if (!std::regex_search(source, m, table)) return {};
+  std::vector<int> x;
+  const std::string list = m[1].str();
+  for (std::size_t at = 0; at < list.size();) {
+    std::size_t next = 0;
+    x.push_back(std::stoi(list.substr(at), &next));
+    at += next;
+    while (at < list.size() && (list[at] == ',' || list[at] == ' ')) ++at;
   }
-  EXPECT_EQ(bodies.size(), 6u);
-  for (const auto& [body, entries] : bodies) EXPECT_GE(entries, 18) << body;
-  // Read back, not recomputed, by the carried columns' parts: more uses than stores.
-  long uses = 0;
-  for (auto at = source.find("w.Bv_"); at != std::string::npos; at = source.find("w.Bv_", at + 1)) ++uses;
-  EXPECT_GT(uses, long(stores.size()));
-  // The momentum itself is not a member any more: only B reads it, in the body's block.
-  EXPECT_EQ(source.find("w.Iv_"), std::string::npos);
+  std::vector<std::pair<int, int>> out;
+  for (std::size_t k = 0; k + 1 < x.size(); k += 2) out.push_back({x[k], x[k + 1]});
+  return out;
+}
+
+TEST(DerivativesCode, TheWorldFrameSweepVisitsEachBodyOnceAndLoopsOverThePairs) {
+  // 7 revolute joints in a chain (nv = 7), the source as the passes printed it.
+  const std::string source = test::syntheticChainFiles(8, "inverse_dynamics_derivatives").unsharedSource;
+  // One block per body and pass: a body-frame sweep prints a block per carried
+  // column instead (28 forward blocks for this chain).
+  EXPECT_EQ(test::occurrences(source, "// world forward body "), 7);
+  EXPECT_EQ(test::occurrences(source, "// world columns body "), 7);
+  // No per-body tangent members: with no constraint nothing reads them.
+  EXPECT_EQ(source.find("w.dvq_"), std::string::npos);
+  // The pairs: rows of dtau_dq and dtau_dv, and the ancestors' rows, in loops.
+  EXPECT_EQ(test::occurrences(source, "world_frame_rows<7>("), 2);
+  EXPECT_EQ(test::occurrences(source, "world_frame_columns<7>("), 1);
+  // Row r's path in a chain is dofs 0..r; dof c's strict subtree is c + 1..6.
+  std::vector<std::pair<int, int>> path, below;
+  for (int r = 0; r < 7; ++r) path.push_back({0, r + 1});
+  EXPECT_EQ(spanTable(source, "path_v"), path);
+  EXPECT_EQ(spanTable(source, "path_q"), path);  // the first joint (about x) moves under gravity (along z)
+  for (int c = 0; c < 7; ++c) below.push_back({c + 1, 7});
+  const std::regex belowTable(R"(static constexpr int below\[14\] = \{([^}]*)\};)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(source, m, belowTable));
+  EXPECT_EQ(m[1].str(), "1, 7, 2, 7, 3, 7, 4, 7, 5, 7, 6, 7, 7, 7");
+}
+
+TEST(DerivativesCode, TheFreeFlyersTranslationsLeaveDtauDqOut) {
+  // Moving the whole robot along a straight line changes none of its dynamics
+  // (gravity is uniform): u = s x ov_0 = 0 and c = -s x oa_0 = 0 for a linear
+  // s, so those columns of dtau_dq are exact zeros and no row reads them; every
+  // row of dtau_dv does (the quadruped: q = [base position, quaternion, joints],
+  // dq = [linear; angular; joints]).
+  const std::string dir = test::sourceDir() + "/generated/quadruped";
+  GenerateOptions g;
+  g.urdf = dir + "/quadruped.urdf";
+  g.layout = dir + "/layout.yaml";
+  g.name = "quadruped";
+  g.functions = "inverse_dynamics_derivatives";
+  const std::string source = generateFiles(g).source;
+  const auto q = spanTable(source, "path_q"), v = spanTable(source, "path_v");
+  ASSERT_FALSE(q.empty());
+  ASSERT_FALSE(v.empty());
+  for (const auto& [lo, hi] : q) EXPECT_GE(lo, 3) << "a range of dtau_dq's rows reads a translation column";
+  long translations = 0;
+  for (const auto& [lo, hi] : v) translations += lo < 3 ? std::min(hi, 3) - lo : 0;
+  EXPECT_GT(translations, 0);
 }
 
 // constrained_dynamics_derivatives through the tau block: W = M^-1 J^T meets
