@@ -390,13 +390,6 @@ void constrainedTangents(Emit& e, const Kinematics& kin, World& W, BodyTangents&
   }
 }
 
-// Up to this many entries of dtau_dq and dtau_dv together, the pairs are
-// printed straight-line (each entry its products, the constants folded): the
-// loops' overhead per short range is more than the products on a small robot.
-// Measured (bench/ab_compare.sh, docs/derivatives.md section 5): the iiwa has 133
-// entries, Solo 462, Talos 2018.
-constexpr long kPairsInlinedUpTo = 1000;
-
 bool allZero(const Slots& s, std::size_t from, std::size_t to) {
   for (std::size_t r = from; r < to; ++r)
     if (!s[r].name.empty() || !s[r].value.isZero()) return false;
@@ -429,48 +422,11 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
     }
   const RowSpans q = rowSpans(nv, pathQ), v = rowSpans(nv, pathV);
   CodeBuilder& cb = e.cb();
-  for (const char* out : {"dtau_dq", "dtau_dv"})
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
-  dq = pathQ;
-  dv = pathV;
-  for (int i = 1; i < N; ++i)
-    for (int d = 0; d < e.bp(i).nv; ++d) {
-      const int c = e.bp(i).idx_v + d;
-      for (int r = e.bp(i).idx_v + e.bp(i).nv; r < e.bp(i).dofEnd; ++r) {
-        dq.insert({c, r});
-        dv.insert({c, r});
-      }
-    }
-  if (long(dq.size() + dv.size()) <= kPairsInlinedUpTo) {
-    // Straight-line: each entry its products, the arrays' constants folded.
-    const auto entry = [&](const char* out, int r, int c, const Expr& x) {
-      const Expr t = cb.flat(x, "d");
-      cb.line(fmt::format("{}[{}] = {};", out, r * nv + c, cb.print(t)), {t}, {out});
-    };
-    const auto col = [&](int k, ColumnArray a) { return read(cb, W.col[std::size_t(k)][a]); };
-    const auto dotN = [&](const std::vector<Expr>& a, std::size_t from, const std::vector<Expr>& b, std::size_t bfrom,
-                          std::size_t n) {
-      Expr sum;
-      for (std::size_t k = 0; k < n; ++k) sum += cb.mul(a[from + k], b[bfrom + k]);
-      return sum;
-    };
-    for (const auto& [r, c] : pathV) {
-      const std::vector<Expr> is = col(r, kIS), bs = col(r, kBS);
-      if (pathQ.count({r, c}))
-        entry("dtau_dq", r, c, dotN(is, 0, col(c, kC), 0, 6) - dotN(bs, 0, col(c, kU), 3, 3));
-      entry("dtau_dv", r, c, dotN(is, 0, col(c, kW), 0, 6) + dotN(bs, 0, col(c, kS), 3, 3));
-    }
-    for (const auto& [c, r] : dq) {
-      if (pathV.count({c, r})) continue;  // a path entry, above
-      const std::vector<Expr> s6 = col(c, kS);
-      entry("dtau_dq", c, r, dotN(s6, 0, col(r, kPq), 0, 6));
-      entry("dtau_dv", c, r, dotN(s6, 0, col(r, kPv), 0, 6));
-    }
-    return;
-  }
   printSpans(cb, "path_q", q);
   printSpans(cb, "path_v", v);
   cb.line(fmt::format("static constexpr int below[{}] = {{{}}};", below.size(), fmt::join(below, ", ")));
+  for (const char* out : {"dtau_dq", "dtau_dv"})
+    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
   const auto arr = [](ColumnArray a) { return fmt::format("&w.{}[0][0]", kColumnArrays[a].name); };
   const std::vector<std::string> names = {"w", "dtau_dq", "dtau_dv"};
   OpCount rows;  // per entry a six- and a three-term product
@@ -489,6 +445,16 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
   columns.once.add = 10 * subtree;
   cb.line(fmt::format("world_frame_columns<{}>({}, {}, {}, below, dtau_dq, dtau_dv);", nv, arr(kS), arr(kPq), arr(kPv)),
           {}, names, columns);
+  dq = pathQ;
+  dv = pathV;
+  for (int i = 1; i < N; ++i)
+    for (int d = 0; d < e.bp(i).nv; ++d) {
+      const int c = e.bp(i).idx_v + d;
+      for (int r = e.bp(i).idx_v + e.bp(i).nv; r < e.bp(i).dofEnd; ++r) {
+        dq.insert({c, r});
+        dv.insert({c, r});
+      }
+    }
 }
 
 }  // namespace

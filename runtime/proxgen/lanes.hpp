@@ -589,12 +589,9 @@ inline void sincos_joint_called(S x, S& s, S& c) noexcept {
 // constrained_dynamics_derivatives: 3.3 to 5.3 instructions per multiply-add).
 // row_madd holds the row in accumulators of the target's widest lanes (SSE2
 // and NEON: 2 doubles, AVX: 4, AVX-512: 8; twice as many floats) across all of
-// k, read once and written once, a block of twelve vector accumulators at a
-// time (with the broadcast factor and one loaded row entry, 14 of the 16
-// registers of SSE2 and AVX: blocks of eight, a fourth pass over k on rows of
-// 50 to 64, cost Talos' constrained_dynamics_derivatives 3 % more instructions;
-// docs/derivatives.md section 5), eight scalar ones, the last block with the fewer than one vector's columns left
-// over as scalars in the same pass over k. Each entry adds its terms in
+// k, read once and written once, a block of eight accumulators at a time (the
+// registers of SSE2), the last block with the fewer than one vector's columns
+// left over as scalars in the same pass over k. Each entry adds its terms in
 // the order of k, (s a_k) b_k, lane by lane the scalar loop's operations: the
 // same bits (tests/runtime/row_madd_checks.inc).
 // Other Scalars (a batched solver's lanes, a target without vector registers)
@@ -621,12 +618,7 @@ constexpr int width() noexcept {
   return real && PROXGEN_RT_ROW_BYTES >= 2 * int(sizeof(S)) ? PROXGEN_RT_ROW_BYTES / int(sizeof(S)) : 1;
 }
 
-// Accumulators at a time: vector ones, and scalars (W = 1: a batched solver's
-// lanes, a target without vector registers, whose register files differ).
-template <int W>
-constexpr int blockOf() noexcept {
-  return W > 1 ? 12 : 8;
-}
+constexpr int kBlock = 8;  // accumulators at a time
 
 // c[0, N W + T) += (Add) or = the sum over the ranges of (s a[k as]) b[k ldb,
 // + N W + T), in N accumulators of W lanes and T scalars after them, over one
@@ -663,19 +655,19 @@ inline void block(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int 
   for (int j = 0; j < T; ++j) c[N * W + j] = tail[j];
 }
 
-// c[0, p): blocks of blockOf<W>() accumulators of W lanes, the last one with the
-// fewer than W columns left as scalars (W = 1: blockOf<1>() scalars a block).
+// c[0, p): blocks of kBlock accumulators of W lanes, the last one with the
+// fewer than W columns left as scalars (W = 1: kBlock scalars a block).
 template <bool Add, class S, int p, int ldb, int W>
 inline void row(S* PROXGEN_RT_RESTRICT c, const S* PROXGEN_RT_RESTRICT a, int as, const S* PROXGEN_RT_RESTRICT b,
                 S s, const int* ranges, int nranges) noexcept {
   if constexpr (W == 1) {
     if constexpr (p > 0) {
-      constexpr int t = p < blockOf<1>() ? p : blockOf<1>();
+      constexpr int t = p < kBlock ? p : kBlock;
       block<Add, S, 1, 0, t, ldb>(c, a, as, b, s, ranges, nranges);
       row<Add, S, p - t, ldb, 1>(c + t, a, as, b + t, s, ranges, nranges);
     }
   } else if constexpr (p > 0) {
-    constexpr int n = p / W < blockOf<W>() ? p / W : blockOf<W>();
+    constexpr int n = p / W < kBlock ? p / W : kBlock;
     constexpr int t = p - n * W < W ? p - n * W : 0;
     block<Add, S, W, n, t, ldb>(c, a, as, b, s, ranges, nranges);
     row<Add, S, p - n * W - t, ldb, W>(c + n * W + t, a, as, b + n * W + t, s, ranges, nranges);
