@@ -29,9 +29,9 @@ struct SolverTexts {
   std::map<Function, std::string> library;
   std::map<Function, OpCount> libraryOps;
   std::string jointTransforms;
-  // inverse_dynamics_derivatives' sweep after the kinematics pass, and the bias
-  // forces that constrained_dynamics_derivatives restores before it ("" when not held).
-  std::string tangentSweep;  // its helpers world_frame_rows and world_frame_columns are printed with it
+  // inverse_dynamics_derivatives' sweep after the kinematics pass ("" when not held);
+  // its helpers world_frame_rows and world_frame_columns are printed with it.
+  std::string tangentSweep;
   // mass_matrix_inverse's passes after the joint transforms ("" when not held).
   std::string minvPasses;
   bool withKinematics = false, withJointTransforms = false;
