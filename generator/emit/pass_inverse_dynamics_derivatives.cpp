@@ -116,20 +116,19 @@ V6 rigidMul(CodeBuilder& cb, const Rigid& r, const V6& x) {
   return y;
 }
 
-using M3v = std::array<Expr, 9>;  // row-major
-M3v skew(const V3& a) {
+M3 skew(const V3& a) {
   return {Expr(), -a[2], a[1], a[2], Expr(), -a[0], -a[1], a[0], Expr()};
 }
 
 // B's angular block: -[hm]x[v]x - [v]x[hm]x - I [w]x + [w]x I - [ha]x (docs/derivatives.md
 // section 7: with hl = m v - hm x w, B's other blocks are 0, -2 [hl]x (linear-angular) and 0).
-M3v angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
+M3 angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
   const V3 v = lin(ov), w = ang(ov);
   Expr hv;
   for (std::size_t k = 0; k < 3; ++k) hv += cb.mul(r.h[k], v[k]);
   hv = cb.flat(hv);
-  const M3v W = skew(w), Ha = skew(ang(h));
-  M3v B;
+  const M3 W = skew(w), Ha = skew(ang(h));
+  M3 B;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const std::size_t ui = std::size_t(i), uj = std::size_t(j);
@@ -146,7 +145,7 @@ M3v angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) 
   return B;
 }
 
-V3 mul3(CodeBuilder& cb, const M3v& M, const V3& x, bool transposed) {
+V3 mul3(CodeBuilder& cb, const M3& M, const V3& x, bool transposed) {
   V3 y = zero3();
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -155,7 +154,7 @@ V3 mul3(CodeBuilder& cb, const M3v& M, const V3& x, bool transposed) {
 }
 
 // Bc x = [-2 HL x x_a; Baa x_a].
-V6 applyB(CodeBuilder& cb, const V3& HL, const M3v& Baa, const V6& x) {
+V6 applyB(CodeBuilder& cb, const V3& HL, const M3& Baa, const V6& x) {
   const V3 t = cross(cb, HL, ang(x));
   const V3 a = mul3(cb, Baa, ang(x), false);
   return {-2.0 * t[0], -2.0 * t[1], -2.0 * t[2], a[0], a[1], a[2]};
@@ -251,7 +250,7 @@ void forward(Emit& e, Kinematics& kin, bool withLambda, World& W) {
       addConstraintForces(e, i, fc);  // K^T lambda in body coordinates
       f = add(f, actForce(cb, oM, fc));
     }
-    const M3v Baa = angularBlockOfB(cb, oI, ov, h);
+    const M3 Baa = angularBlockOfB(cb, oI, ov, h);
     W.Ic[b] = keep(e, kWI, i, entriesOf(oI));
     W.HL[b] = keep(e, kWH, i, {h[0], h[1], h[2]});
     W.Baa[b] = keep(e, kWB, i, std::vector<Expr>(Baa.begin(), Baa.end()));
@@ -273,7 +272,7 @@ void backward(Emit& e, World& W) {
     CodeBuilder& cb = e.cb();
     const Rigid Ic = rigidFrom(Expr(W.mass[b]), read(cb, W.Ic[b]));
     const V3 HL = read3(cb, W.HL[b]);
-    M3v Baa;
+    M3 Baa;
     {
       const std::vector<Expr> x = read(cb, W.Baa[b]);
       std::copy(x.begin(), x.end(), Baa.begin());
