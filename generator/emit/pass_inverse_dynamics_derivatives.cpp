@@ -116,10 +116,6 @@ V6 rigidMul(CodeBuilder& cb, const Rigid& r, const V6& x) {
   return y;
 }
 
-M3 skew(const V3& a) {
-  return {Expr(), -a[2], a[1], a[2], Expr(), -a[0], -a[1], a[0], Expr()};
-}
-
 // B's angular block: -[hm]x[v]x - [v]x[hm]x - I [w]x + [w]x I - [ha]x (docs/derivatives.md
 // section 7: with hl = m v - hm x w, B's other blocks are 0, -2 [hl]x (linear-angular) and 0).
 M3 angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
@@ -127,7 +123,7 @@ M3 angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
   Expr hv;
   for (std::size_t k = 0; k < 3; ++k) hv += cb.mul(r.h[k], v[k]);
   hv = cb.flat(hv);
-  const M3 W = skew(w), Ha = skew(ang(h));
+  const M3 W = skewOf(w), Ha = skewOf(ang(h));
   M3 B;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -161,7 +157,7 @@ V6 applyB(CodeBuilder& cb, const V3& HL, const M3& Baa, const V6& x) {
 }
 
 struct World {
-  std::vector<Slots> oR, op, ov, oa, Ic, HL, Baa, F;  // per body (Ic: h then I)
+  std::vector<Slots> ov, oa, Ic, HL, Baa, F;  // per body (Ic: h then I)
   std::vector<std::array<Slots, kColumnArrayCount>> col;  // per dof: what each array holds
   std::vector<double> mass;  // per body, then of its subtree: a constant of the model
 };
@@ -207,23 +203,15 @@ void forward(Emit& e, Kinematics& kin, bool withLambda, World& W) {
     e.fn.boundary(i);
     e.openBody(i, "world forward");
     CodeBuilder& cb = e.cb();
+    // The world placement: stored, and carried to the children in kin (Live).
     XSym oM = compose(cb, kb.XT, kb.XJ);
     V6 oap = e.rootAcceleration();
     if (p.parent > 0) {
-      const std::vector<Expr> R = read(cb, W.oR[par]), t = read(cb, W.op[par]);
-      XSym parent;
-      std::copy(R.begin(), R.end(), parent.R.begin());
-      std::copy(t.begin(), t.end(), parent.p.begin());
-      oM = compose(cb, parent, oM);
+      oM = compose(cb, kin.b[par].oM, oM);
       oap = read6(cb, W.oa[par]);
     }
-    W.oR[b] = keep(e, kWR, i, std::vector<Expr>(oM.R.begin(), oM.R.end()));
-    W.op[b] = keep(e, kWP, i, std::vector<Expr>(oM.p.begin(), oM.p.end()));
-    {
-      const std::vector<Expr> R = read(cb, W.oR[b]), t = read(cb, W.op[b]);
-      std::copy(R.begin(), R.end(), oM.R.begin());
-      std::copy(t.begin(), t.end(), oM.p.begin());
-    }
+    for (int k = 0; k < 9; ++k) oM.R[std::size_t(k)] = e.putQ(kWR, i, 9, k, oM.R[std::size_t(k)]);
+    for (int k = 0; k < 3; ++k) oM.p[std::size_t(k)] = e.putQ(kWP, i, 3, k, oM.p[std::size_t(k)]);
     kb.oM = oM;
     V6 ov = actMotion(cb, oM, kb.v);
     flatten(cb, ov, "ov");
@@ -597,7 +585,7 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
   World W;
-  for (std::vector<Slots>* x : {&W.oR, &W.op, &W.ov, &W.oa, &W.Ic, &W.HL, &W.Baa, &W.F}) x->assign(std::size_t(N), Slots{});
+  for (std::vector<Slots>* x : {&W.ov, &W.oa, &W.Ic, &W.HL, &W.Baa, &W.F}) x->assign(std::size_t(N), Slots{});
   W.col.resize(std::size_t(plan.nv));
   W.mass.assign(std::size_t(N), 0.0);
   e.fn.live() = Live{};

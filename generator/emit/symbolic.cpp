@@ -76,10 +76,6 @@ using G3 = std::array<Expr, 9>;  // general 3x3, row-major
 
 Expr g(const G3& m, int i, int j) { return m[std::size_t(3 * i + j)]; }
 
-G3 skewOf(const V3& p) {
-  return {Expr(), -p[2], p[1], p[2], Expr(), -p[0], -p[1], p[0], Expr()};
-}
-
 bool sameExpr(const Expr& a, const Expr& b) { return (a - b).isZero(); }
 
 // A rotation about coordinate axis `a` by a run-time angle: R(a,a) = 1, zeros
@@ -177,6 +173,8 @@ void flatten3(CodeBuilder& cb, G3& a) {
 }
 
 }  // namespace
+
+M3 skewOf(const V3& p) { return {Expr(), -p[2], p[1], p[2], Expr(), -p[0], -p[1], p[0], Expr()}; }
 
 V3 rotate(CodeBuilder& cb, const M3& R, const V3& x0) {
   const V3 x = flatFor(cb, R, x0);

@@ -61,6 +61,8 @@ bool isSignedPermutation(const M3& R);
 V3 rotate(CodeBuilder& cb, const M3& R, const V3& x);     // R x
 V3 rotateT(CodeBuilder& cb, const M3& R, const V3& x);    // R^T x
 V3 cross(CodeBuilder& cb, const V3& a, const V3& b);
+/// [p]x, the cross product with p as a matrix: [p]x x = p x x.
+M3 skewOf(const V3& p);
 /// a*b + s c*d with the products made in this order, whatever the compiler
 /// (the order decides the emitted text; C++ does not fix an operator's).
 Expr mulAdd(CodeBuilder& cb, const Expr& a, const Expr& b, double s, const Expr& c, const Expr& d);
