@@ -165,10 +165,27 @@ Ops denseCholeskyOps(int n) {
   return o;
 }
 
-Ops choleskySolveOps(int n, int p) {
+// proximal_inverse: X's row i (i + 1 columns, i terms and the scaling), A's row i
+// (n - i columns, n - i terms); the mirror copies.
+Ops proximalInverseOps(int n) {
   Ops o;
-  o.mul = long(p) * (long(n) * (n - 1) + 2L * n);
-  o.add = long(p) * long(n) * (n - 1);
+  for (long i = 0; i < n; ++i) {
+    o.mul += i + i * (i + 1) + (i + 1);
+    o.add += i * (i + 1);
+    o.mul += (n - i) * (n - i);
+    o.add += (n - i) * (n - i);
+  }
+  return o;
+}
+
+// proximal_power: row i of A S / mu over n - i columns (n scalings of A's row),
+// plus A's row.
+Ops proximalPowerOps(int n) {
+  Ops o;
+  for (long i = 0; i < n; ++i) {
+    o.mul += n + long(n) * (n - i);
+    o.add += long(n) * (n - i) + (n - i);
+  }
   return o;
 }
 
@@ -289,18 +306,22 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   ops.once = denseCholeskyOps(nc);
   cb.line(fmt::format("dense_cholesky<{}>({}, inv_mu, {});", nc, G, Lf), {}, names, ops);
   // The K proximal steps on the tangents are linear: S_K = sum_j mu^(1-j)
-  // (G + I/mu)^-j (j = 1..K), itself K steps from I (K nc^3), applied to J M^-1
-  // and to R2's rows' paths; the Settings' K at run time.
-  const std::string id = array("cdd_Id", nc * nc, "the nc x nc identity (constrained_dynamics_derivatives)");
-  cb.comment("S_K: the K proximal steps from C = I");
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, id), {}, names);
-  for (int r = 0; r < nc; ++r) cb.line(fmt::format("{}[{}] = Scalar(1);", id, r * (nc + 1)), {}, names);
-  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nc * nc, S), {}, names);
-  cb.open("for (int k = 0; k < s.iterations; ++k) {", {}, names);
-  ops.once = choleskySolveOps(nc, nc);
-  ops.once.add += long(nc) * nc;
-  ops.once.mul += long(nc) * nc;
-  cb.line(fmt::format("proximal_step<{0}, {0}>({1}, {2}, inv_mu, {3});", nc, Lf, id, S), {}, names, ops);
+  // (G + I/mu)^-j (j = 1..K), applied to J M^-1 and to R2's rows' paths; the
+  // Settings' K at run time. Formed from A = (G + I/mu)^-1 by S := A + A S / mu
+  // (S_1 = A; S_0 = 0), each step's symmetric product by its upper triangle
+  // (assemble.cpp's proximal_inverse and proximal_power).
+  const std::string x = array("cdd_X", nc * nc, "L^-1 of G + I/mu = L L^T (constrained_dynamics_derivatives)");
+  const std::string a = array("cdd_A", nc * nc, "(G + I/mu)^-1 (constrained_dynamics_derivatives)");
+  const std::string tS = array("cdd_T", nc * nc, "L^-T, then the next S_k (constrained_dynamics_derivatives)");
+  cb.comment("S_K = sum_(j = 1..K) mu^(1-j) (G + I/mu)^-j: S_1 = A = (G + I/mu)^-1, S_k+1 = A + A S_k / mu");
+  ops.once = proximalInverseOps(nc);
+  cb.line(fmt::format("proximal_inverse<{}>({}, {}, {}, {});", nc, Lf, x, tS, a), {}, names, ops);
+  ops.once = Ops::multiplications(long(nc) * nc);
+  cb.line("const Scalar first = Scalar(s.iterations > 0);  // K = 0: no step, S_0 = 0", {}, names);
+  cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = first * {}[k];", nc * nc, S, a), {}, names, ops);
+  cb.open("for (int k = 1; k < s.iterations; ++k) {", {}, names);
+  ops.once = proximalPowerOps(nc);
+  cb.line(fmt::format("proximal_power<{}>({}, inv_mu, {}, {});", nc, a, tS, S), {}, names, ops);
   cb.close();
   // [Lt | -S_K], then [P | Lt^T] with P = M^-1 - W Lt, and their tau blocks out.
   ops.once = denseProductOps(nc, nc, nv);

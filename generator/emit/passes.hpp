@@ -287,7 +287,8 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kin, c
 /// What assemble.cpp's dense helpers compute, for the banner.
 Ops denseProductAddOps(int n, int m, int p);
 Ops denseCholeskyOps(int n);
-Ops choleskySolveOps(int n, int p);
+Ops proximalInverseOps(int n);
+Ops proximalPowerOps(int n);
 Ops se3RightJacobianInverseOps();
 
 }  // namespace proxgen::emit

@@ -56,19 +56,23 @@ bool identChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c
 
 // Every loop or branch construct of `code`, as "keyword: statement head".
 // Allowed: the constrainedABA loop (iterations 2..K), the proxPV loop (K
-// steps) and loops over constraint columns with a literal trip count.
+// steps), constrained_dynamics_derivatives' K - 1 steps of S_K, and loops over
+// constraint columns with a literal trip count.
 std::vector<std::string> forbiddenControlFlow(const std::string& code) {
   static const std::vector<std::string> allowed = {"for (int k = 2; k <= s.iterations; ++k) {",
-                                                   "for (int k = 0; k < s.iterations; ++k) {"};
+                                                   "for (int k = 0; k < s.iterations; ++k) {",
+                                                   "for (int k = 1; k < s.iterations; ++k) {"};
+  // S_K's row templates recurse over the row index at compile time.
+  static const std::regex rowRecursion(R"(if constexpr \(i < n\) \{)");
   static const std::regex columns(R"(for \(int j = 0; j < [1-9][0-9]*; \+\+j\) \{)");
   static const std::regex fixedLoop(
-      R"( *(for \(int k = (?:0|[1-9][0-9]*); k < [1-9][0-9]*; \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
+      R"( *(for \(int k = (?:0|[1-9][0-9]*); k < (?:[1-9][0-9]*|n \* n); \+\+k\) [A-Za-z_][A-Za-z0-9_.]*\[k\] = [^;{}?&|"']*;)"
       R"(|for \(int r = 0; r < n; \+\+r\)|for \(int c = 0; c < p; \+\+c\) \{)"
       R"(|for \(int k = 0; k < m; \+\+k\) sum \+= A\[r \* m \+ k\] \* B\[k \* p \+ c\];)"
       // constrained_dynamics_derivatives' helpers (Cholesky, proximal step, the
       // SE(3) Jacobian's series): a head alone, bounds a template argument, an
       // outer index or a literal.
-      R"(|for \(int ([a-z]) = (0|1|[a-z] \+ 1|n - 1); \2 (<|>=) ([a-z]|0|[1-9][0-9]*); (\+\+|--)\2\) \{)"
+      R"(|for \(int ([a-z]) = (0|1|[a-z]|[a-z] \+ 1|n - 1); \2 (<|<=|>=) ([a-z]|0|[1-9][0-9]*); (\+\+|--)\2\) \{)"
       // the sparse products' loops over a pattern's ranges, their bounds read
       // from the tables (constants: sparseTablesNotConstant below).
       R"(|for \(int ([a-z]) = (start|span)\[[^\]]+\]; \7 < \8\[[^\]]+\]; \+\+\7\) \{))");
@@ -106,7 +110,7 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
       const std::string head = code.substr(k, code.find('{', k) + 1 - k);
       bool ok = false;
       for (const std::string& a : allowed) ok |= head == a;
-      ok |= std::regex_match(head, columns);
+      ok |= std::regex_match(head, columns) || std::regex_match(head, rowRecursion);
       if (!ok) found.push_back(head);
     }
     k = end - 1;
@@ -131,6 +135,13 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.fdd_h[k] = tau[k] - w.fdd_h[k];\n").empty());
   EXPECT_TRUE(forbiddenControlFlow("    for (int i = n - 1; i >= 0; --i) {\n    }\n").empty());
   EXPECT_TRUE(forbiddenControlFlow("  for (int k = i + 1; k < n; ++k) {\n  }\n").empty());
+  EXPECT_TRUE(forbiddenControlFlow("    for (int c = i; c < n; ++c) {\n    }\n").empty());  // S_K's rows
+  EXPECT_TRUE(forbiddenControlFlow("    for (int c = 0; c <= i; ++c) {\n    }\n").empty());
+  EXPECT_TRUE(forbiddenControlFlow("  for (int k = 0; k < n * n; ++k) X[k] = Scalar(0);\n").empty());
+  EXPECT_EQ(forbiddenControlFlow("  for (int k = 0; k < n * m; ++k) X[k] = Scalar(0);\n").size(), 1u);
+  EXPECT_TRUE(forbiddenControlFlow("  if constexpr (i < n) {\n  }\n").empty());
+  EXPECT_EQ(forbiddenControlFlow("  if constexpr (i < w.n) {\n  }\n").size(), 1u);
+  EXPECT_EQ(forbiddenControlFlow("  if (i < n) {\n  }\n").size(), 1u);
   EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < w.n; ++k) {\n  }\n").size(), 1u);
   EXPECT_GE(forbiddenControlFlow("  for (int i = 0; i < n; ++i) { x(); }\n").size(), 1u);
   EXPECT_GE(forbiddenControlFlow("  for (int k = 0; k < 18; ++k) w.h[k] = c ? a : b;\n").size(), 1u);
