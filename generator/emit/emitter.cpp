@@ -5,6 +5,8 @@
 // joint_transforms, the off-support bodies' functions) only when one needs it.
 #include "emit/emitter.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <map>
 
@@ -124,8 +126,13 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   BodyTangents tangents;
   if (want.has(Function::InverseDynamicsDerivatives)) {
     texts.tangentSweep = emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
+    // The sweep writes dtau's pattern; the caller's outputs get zeros elsewhere.
+    const int nv2 = plan.nv * plan.nv;
     texts.library[Function::InverseDynamicsDerivatives] =
-        "  kinematics(q, v, w);\n  tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv);\n";
+        fmt::format("  kinematics(q, v, w);\n  for (int k = 0; k < {0}; ++k) dtau_dq[k] = Scalar(0);\n"
+                    "  for (int k = 0; k < {0}; ++k) dtau_dv[k] = Scalar(0);\n"
+                    "  tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv);\n",
+                    nv2);
   }
   if (texts.withJointTransforms) {
     fn.beginHost("joint_transforms", nullptr);

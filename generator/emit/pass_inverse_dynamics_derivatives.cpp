@@ -412,8 +412,10 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
   printSpans(cb, "path_q", q);
   printSpans(cb, "path_v", v);
   cb.line(fmt::format("static constexpr int below[{}] = {{{}}};", below.size(), fmt::join(below, ", ")));
-  for (const char* out : {"dtau_dq", "dtau_dv"})
-    cb.line(fmt::format("for (int k = 0; k < {}; ++k) {}[k] = Scalar(0);", nv * nv, out), {}, {out});
+  // The loops write exactly the entries of the pattern (rows: the path, own
+  // joint included; columns: the strict subtree), and the products of fdd and
+  // cdd read no other: only inverse_dynamics_derivatives zeroes the rest, in
+  // its caller's outputs (emitter.cpp).
   const auto arr = [](ColumnArray a) { return fmt::format("&w.{}[0][0]", kColumnArrays[a].name); };
   const std::vector<std::string> names = {"w", "dtau_dq", "dtau_dv"};
   OpCount rows;  // per entry a six- and a three-term product
