@@ -102,5 +102,24 @@ TEST(DerivativesCode, TheConstrainedAlgebraGoesThroughTheTauBlock) {
   EXPECT_EQ(test::occurrences(source, "sparse_transposed_product_add<11, 3, 14, 22>("), 2);
 }
 
+// S_K, the K proximal steps on the multipliers' tangents as one operator: from
+// (G + I/mu)^-1 (proximal_inverse, once) and K - 1 symmetric steps
+// (proximal_power), where the K steps from the identity were K forward and back
+// substitutions (proximal_step) whose rows each waited on the one before.
+TEST(DerivativesCode, TheKStepsOperatorIsFormedFromTheInverse) {
+  const std::string source =
+      test::syntheticChainFiles(12, "constrained_dynamics_derivatives", "- {name: tip, link: l11, type: 3d}").source;
+  EXPECT_EQ(test::occurrences(source, "proximal_step"), 0);
+  EXPECT_EQ(test::occurrences(source, "proximal_inverse<3>(w.cdd_Lf, w.cdd_X, w.cdd_T, w.cdd_A);"), 1);
+  EXPECT_EQ(test::occurrences(source, "for (int k = 0; k < 9; ++k) w.cdd_S[k] = first * w.cdd_A[k];"), 1);
+  EXPECT_EQ(test::occurrences(source, "  for (int k = 1; k < s.iterations; ++k) {\n"
+                                      "    proxgen_rt::row_product"),
+            0);
+  EXPECT_EQ(test::occurrences(source, "  for (int k = 1; k < s.iterations; ++k) {\n"
+                                      "    proximal_power<3>(w.cdd_A, inv_mu, w.cdd_T, w.cdd_S);\n"
+                                      "  }"),
+            1);
+}
+
 }  // namespace
 }  // namespace proxgen::emit

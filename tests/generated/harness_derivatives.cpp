@@ -212,16 +212,19 @@ TEST_F(GeneratedDerivatives, ForwardDynamicsDerivativesMatchTheGeneric) {
 // verify/compare.cpp: c n u times the sizes of the terms, kappa(M) for the
 // solves with M, and the K proximal steps' amplification of a perturbation of
 // their right-hand side, read from G's eigenvalues at each state).
-TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGeneric) {
+// The K steps' operator S_K at K = 0 (no step: the tangents of the motion under
+// lambda0's forces, S_0 = 0), 1 (S_1 = (G + I/mu)^-1 alone) and 2 (one symmetric
+// step, as every further one), on fewer states: the generated code forms S_K from
+// (G + I/mu)^-1 and K - 1 steps, so each K takes another path through it.
+void checkConstrainedDerivatives(const proxgen::System& sys, proxgen::Data& d, gen::Workspace& w,
+                                 const gen::Settings& settings, const std::vector<Sample>& states, double& worst) {
   const int nv = gen::nv, nc = gen::nc;
-  const gen::Settings settings;  // the layout's mu and K
-  double worst = 0.0;
-  for (const Sample& s : samples(sys_, 20261204)) {
+  for (const Sample& s : states) {
     const std::size_t n = std::size_t(nv), m = std::size_t(std::max(nc, 1)), n2 = n * n, mn = m * n;
     std::vector<gen::Scalar> qdd(n), lambda(m), xq(n2), xv(n2), xt(n2), lq(mn), lv(mn), lt(mn);
     gen::constrained_dynamics_derivatives(toScalar(s.q).data(), toScalar(s.v).data(), toScalar(s.tau).data(), settings,
-                                          workspace(), qdd.data(), lambda.data(), xq.data(), xv.data(), xt.data(),
-                                          lq.data(), lv.data(), lt.data());
+                                          w, qdd.data(), lambda.data(), xq.data(), xv.data(), xt.data(), lq.data(),
+                                          lv.data(), lt.data());
     proxgen::verify::DerivativeAnswer a;
     a.tau = s.tau;
     a.mu = double(settings.mu);
@@ -232,14 +235,32 @@ TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGeneric) {
     a.cLq = rowMajor(lq, nc, nv), a.cLv = rowMajor(lv, nc, nv), a.cLtau = rowMajor(lt, nc, nv);
     proxgen::State st;
     st.q = s.q, st.v = s.v, st.tau = s.tau;
-    const proxgen::verify::Conditioning c = proxgen::verify::conditioningAt(sys_, d_, st, kFloat);
-    for (const proxgen::verify::Compared& x : proxgen::verify::compareDerivatives(sys_, d_, c, st, a)) {
-      ASSERT_TRUE(x.finite) << x.what;
-      EXPECT_LE(x.error, x.bound) << x.what;
+    const proxgen::verify::Conditioning c = proxgen::verify::conditioningAt(sys, d, st, kFloat);
+    for (const proxgen::verify::Compared& x : proxgen::verify::compareDerivatives(sys, d, c, st, a)) {
+      ASSERT_TRUE(x.finite) << x.what << ", K = " << settings.iterations;
+      EXPECT_LE(x.error, x.bound) << x.what << ", K = " << settings.iterations;
       worst = std::max(worst, x.error / x.bound);
     }
   }
+}
+
+TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGeneric) {
+  const gen::Settings settings;  // the layout's mu and K
+  double worst = 0.0;
+  checkConstrainedDerivatives(sys_, d_, workspace(), settings, samples(sys_, 20261204), worst);
   std::printf("constrained_dynamics_derivatives: largest error %.2g of the bound\n", worst);
+}
+
+TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGenericAtEveryK) {
+  std::vector<Sample> states = samples(sys_, 20261207);
+  states.resize(std::min<std::size_t>(states.size(), 5));
+  for (const int K : {0, 1, 2}) {
+    gen::Settings settings;
+    settings.iterations = K;
+    double worst = 0.0;
+    checkConstrainedDerivatives(sys_, d_, workspace(), settings, states, worst);
+    std::printf("constrained_dynamics_derivatives at K = %d: largest error %.2g of the bound\n", K, worst);
+  }
 }
 #endif
 
