@@ -42,8 +42,8 @@ constexpr Quantity kWR{"oRd", "world rotation (world-frame derivatives)"},
     kWI{"oIc", "composite inertia in world axes about the world origin: h = m c, then I (upper triangle)"},
     kWH{"oHc", "composite linear momentum in world axes (B's linear-angular block is -2 [HL]x)"},
     kWB{"oBc", "composite B's angular block (3 x 3, row-major)"}, kWF{"oFc", "subtree force in world axes"};
-// The constrained bodies' motion tangents in their coordinates: the members
-// the body-frame sweep uses (constrained_dynamics_derivatives reads either).
+// The constrained bodies' motion tangents in their coordinates (6 x nv per body,
+// the columns of its path), which constrained_dynamics_derivatives' rows read.
 constexpr Quantity kDvq{"dvq", "d v / dq (6 x nv, path columns)"}, kDvv{"dvv", "d v / dv (6 x nv, path columns)"},
     kDaq{"daq", "d a / dq at fixed qdd (6 x nv, path columns)"}, kDav{"dav", "d a / dv at fixed qdd (6 x nv, path columns)"};
 
@@ -117,7 +117,7 @@ V6 rigidMul(CodeBuilder& cb, const Rigid& r, const V6& x) {
 }
 
 // B's angular block: -[hm]x[v]x - [v]x[hm]x - I [w]x + [w]x I - [ha]x (docs/derivatives.md
-// section 7: with hl = m v - hm x w, B's other blocks are 0, -2 [hl]x (linear-angular) and 0).
+// section 5: with hl = m v - hm x w, B's other blocks are 0, -2 [hl]x (linear-angular) and 0).
 M3 angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
   const V3 v = lin(ov), w = ang(ov);
   Expr hv;
@@ -141,18 +141,10 @@ M3 angularBlockOfB(CodeBuilder& cb, const Rigid& r, const V6& ov, const V6& h) {
   return B;
 }
 
-V3 mul3(CodeBuilder& cb, const M3& M, const V3& x, bool transposed) {
-  V3 y = zero3();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      y[std::size_t(i)] += cb.mul(transposed ? M[std::size_t(3 * j + i)] : M[std::size_t(3 * i + j)], x[std::size_t(j)]);
-  return y;
-}
-
 // Bc x = [-2 HL x x_a; Baa x_a].
 V6 applyB(CodeBuilder& cb, const V3& HL, const M3& Baa, const V6& x) {
   const V3 t = cross(cb, HL, ang(x));
-  const V3 a = mul3(cb, Baa, ang(x), false);
+  const V3 a = rotate(cb, Baa, ang(x));  // any 3 x 3 times a vector
   return {-2.0 * t[0], -2.0 * t[1], -2.0 * t[2], a[0], a[1], a[2]};
 }
 
@@ -282,7 +274,7 @@ void backward(Emit& e, World& W) {
       flatten(cb, w, "w");
       const V6 pq = sub(add(crossForce(cb, s, F), rigidMul(cb, Ic, c)), applyB(cb, HL, Baa, u));
       const V6 pv = add(rigidMul(cb, Ic, w), applyB(cb, HL, Baa, s));
-      const V3 hs = cross(cb, HL, lin(s)), bt = mul3(cb, Baa, ang(s), true);
+      const V3 hs = cross(cb, HL, lin(s)), bt = rotateT(cb, Baa, ang(s));
       col[kU] = storeColumn(e, kU, k, entries(u));
       col[kC] = storeColumn(e, kC, k, entries(c));
       col[kW] = storeColumn(e, kW, k, entries(w));
@@ -306,8 +298,8 @@ void backward(Emit& e, World& W) {
   }
 }
 
-// The constrained bodies' motion tangents (columns of their paths), stored in
-// the members the body-frame sweep uses.
+// The constrained bodies' motion tangents (columns of their paths), in their
+// coordinates.
 void constrainedTangents(Emit& e, const Kinematics& kin, World& W, BodyTangents& keepOut) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
@@ -329,8 +321,8 @@ void constrainedTangents(Emit& e, const Kinematics& kin, World& W, BodyTangents&
     if (p.constraints.empty()) continue;
     const std::size_t b = std::size_t(bi);
     const Kinematics::Body& kb = kin.b[b];
-    // The joint's own columns as the body-frame sweep forms them (section 2: S_k
-    // is a constant there, so the rows' entries along it fold):
+    // The joint's own columns in body coordinates (section 2's form: S_k is a
+    // constant there, so the rows' entries along it fold):
     //   dv/dq = (X^-1 v_p) x S_k, dv/dqd = S_k, da/dq = (X^-1 a_p) x S_k + dv/dq x vJ,
     //   da/dqd = v x S_k + S_k x vJ, with X^-1 a_p = oX^-1 oa - S qdd - c.
     e.fn.boundary(bi);
@@ -582,7 +574,7 @@ std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
 }
 
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                                BodyTangents* keepOut, bool keepConstrained) {
+                                           BodyTangents* keepOut, bool keepConstrained) {
   const Plan& plan = e.plan;
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());

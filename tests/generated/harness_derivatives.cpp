@@ -206,16 +206,12 @@ TEST_F(GeneratedDerivatives, ForwardDynamicsDerivativesMatchTheGeneric) {
 
 #if PROXGEN_SOLVER_HAS_CONSTRAINED_DYNAMICS_DERIVATIVES
 // constrained_dynamics_derivatives against constrainedDynamicsDerivatives at
-// the layout's mu and K (both return the K-step iterates on the tangents, so
+// the Settings' mu and K (both return the K-step iterates on the tangents, so
 // they answer the same question also where K has not converged), with the
 // bounds `proxgen verify` applies (verify::compareDerivatives, argued in
 // verify/compare.cpp: c n u times the sizes of the terms, kappa(M) for the
 // solves with M, and the K proximal steps' amplification of a perturbation of
 // their right-hand side, read from G's eigenvalues at each state).
-// The K steps' operator S_K at K = 0 (no step: the tangents of the motion under
-// lambda0's forces, S_0 = 0), 1 (S_1 = (G + I/mu)^-1 alone) and 2 (one symmetric
-// step, as every further one), on fewer states: the generated code forms S_K from
-// (G + I/mu)^-1 and K - 1 steps, so each K takes another path through it.
 void checkConstrainedDerivatives(const proxgen::System& sys, proxgen::Data& d, gen::Workspace& w,
                                  const gen::Settings& settings, const std::vector<Sample>& states, double& worst) {
   const int nv = gen::nv, nc = gen::nc;
@@ -251,6 +247,10 @@ TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGeneric) {
   std::printf("constrained_dynamics_derivatives: largest error %.2g of the bound\n", worst);
 }
 
+// The K steps' operator S_K at K = 0 (no step: the tangents of the motion under
+// lambda0's forces, S_0 = 0), 1 (S_1 = (G + I/mu)^-1 alone) and 2 (one symmetric
+// step, as every further one), on fewer states: the generated code forms S_K from
+// (G + I/mu)^-1 and K - 1 steps, so each K takes another path through it.
 TEST_F(GeneratedDerivatives, ConstrainedDynamicsDerivativesMatchTheGenericAtEveryK) {
   std::vector<Sample> states = samples(sys_, 20261207);
   states.resize(std::min<std::size_t>(states.size(), 5));
