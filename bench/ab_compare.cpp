@@ -5,13 +5,15 @@
 // the namespaces A and B and defines CALL, the call of the function under test
 // (reading q, v, a, lam, s, w and writing o[0], o[1], ...).
 //
-//   ab_compare check           the states on which any output differs in any bit
+//   ab_compare check           the states on which any output differs in any bit, and
+//                              the largest difference relative to max(1, |entry|)
 //   ab_compare time N          A and B alternately (which goes first alternates too),
 //                              21 repetitions of N calls each:
 //                              median and fastest repetition, and B / A
 //   ab_compare count A|B N     N calls of one side (callgrind: (Ir(2N) - Ir(N)) / N)
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -94,18 +96,24 @@ int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "check" && argc == 2) {
     int differ = 0;
-    long written = 0;  // nonzero output entries of A, over all states
+    long written = 0;   // nonzero output entries of A, over all states
+    double worst = 0;   // the largest |a - b| / max(1, |a|) over every entry
     for (int n = 0; n < kStates; ++n) {
       call(st, n, sideA());
       call(st, n, sideB());
       bool same = true;
       for (int k = 0; k < kOutputs; ++k) {
         same &= std::memcmp(sideA().o[k], sideB().o[k], sizeof(double) * kOutputSize) == 0;
-        for (int j = 0; j < kOutputSize; ++j) written += sideA().o[k][j] != 0.0;
+        for (int j = 0; j < kOutputSize; ++j) {
+          const double a = sideA().o[k][j], b = sideB().o[k][j];
+          written += a != 0.0;
+          worst = std::max(worst, std::abs(a - b) / std::max(1.0, std::abs(a)));
+        }
       }
       differ += same ? 0 : 1;
     }
-    std::printf("states whose outputs differ in any bit: %d of %d\n", differ, kStates);
+    std::printf("states whose outputs differ in any bit: %d of %d; largest |A - B| / max(1, |A|): %.3g\n", differ,
+                kStates, worst);
     // Outputs that stay zero would agree whatever the code: a comparison of nothing.
     if (written == 0) {
       std::fprintf(stderr, "ab_compare: the function wrote no nonzero output: nothing was compared\n");

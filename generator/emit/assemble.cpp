@@ -460,6 +460,10 @@ std::string helpers(const SolverTexts& texts) {
          "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
          "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n",
          "mass_matrix_inverse_passes(const Scalar* q, Workspace& w, Scalar* Minv)", texts.minvPasses);
+  helper(!texts.minvFactored.empty(),
+         "// The same after prox_pv of the same q: reads its elimination's U and D^-1 (and the\n"
+         "// free flyer's Cholesky factor) in w instead of forming them again.\n",
+         "mass_matrix_inverse_factored(const Scalar* q, Workspace& w, Scalar* Minv)", texts.minvFactored);
   if (!texts.tangentSweep.empty())
     out += "// The world-frame sweep's pairs (docs/derivatives.md section 5): its per-dof arrays are\n"
            "// [6][n] (BS: [3][n]), column k dof k's vector. Rows: for every dof r and every dof c\n"
@@ -576,6 +580,7 @@ const std::vector<std::string>& fileFunctionNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out = {"kinematics", "joint_transforms", "constraint_joints", "eliminate_free_bodies",
                                     "accelerate_free_bodies", "tangent_sweep", "world_frame_rows", "world_frame_columns", "mass_matrix_inverse_passes",
+                                    "mass_matrix_inverse_factored",
                                     "residual",
                                     "dense_product", "dense_product_add", "sparse_left_product_add",
                                     "sparse_transposed_product", "sparse_transposed_product_add", "dense_cholesky", "inverse_rows",

@@ -52,8 +52,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   // them as well (`calls`). Its operations per call are its host's, the whole
   // of calls.front() (the function that leaves the kinematics state of its
   // (q, v) in the workspace) and the hosts it calls after it without their
-  // transforms and kinematics: mass_matrix_inverse's passes ("minv"), the
-  // tangent sweep of inverse_dynamics_derivatives ("rnead") and, for cdd, "bias".
+  // transforms and kinematics: mass_matrix_inverse's passes ("minv"; for cdd
+  // "minvf", the variant on prox_pv's factors) and the tangent sweep of
+  // inverse_dynamics_derivatives ("rnead").
   struct Composite {
     Function f;
     const char* host;
@@ -66,7 +67,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
        {"minv", "rnead"}},
       {Function::ConstrainedDynamicsDerivatives, "cdd",
        {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
-       {"minv", "rnead", "bias"}}};
+       {"minvf", "rnead"}}};
   FunctionSet want = sys.functions;
   for (const Composite& c : composites)
     if (want.has(c.f))
@@ -91,6 +92,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   // The state as kinematics left it, in its host's values (the solvers' hosts
   // below move `kin` on into eliminate_free_bodies).
   const Kinematics afterKinematicsState = kin;
+  ProxPvEnd pvEnd;  // what prox_pv leaves in the workspace (read by cdd's M^-1)
 
   if (solvers) {
     // eliminate_free_bodies(tau, w): the off-support bodies, shared too (none
@@ -109,7 +111,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     // The entry points, each from its own copy of that state; the first one
     // also prints accelerate_free_bodies.
     if (want.has(Function::ConstrainedAba)) texts.caba = emitConstrainedAba(e, kin, free, afterElimination);
-    if (want.has(Function::ProxPv)) texts.pv = emitProxPv(e, kin, free, afterElimination);
+    if (want.has(Function::ProxPv)) texts.pv = emitProxPv(e, kin, free, afterElimination, &pvEnd);
     texts.accelerateFree = freeAccel.text;
   }
 
@@ -152,9 +154,12 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
 
   if (want.has(Function::ForwardDynamicsDerivatives))
     texts.library[Function::ForwardDynamicsDerivatives] = emitForwardDynamicsDerivatives(e, tangents);
-  if (cdd)
+  if (cdd) {
+    // M^-1 after prox_pv of the same q: its elimination's U and D^-1 (docs/derivatives.md section 5).
+    texts.minvFactored = emitMassMatrixInverse(e, pvEnd.kin, pvEnd.host, &pvEnd.art);
     texts.library[Function::ConstrainedDynamicsDerivatives] =
         emitConstrainedDynamicsDerivatives(e, afterKinematicsState, afterKinematics, tangents);
+  }
 
   // The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp).
   emitConstraintFunctions(e, afterKinematicsState, afterKinematics, texts);

@@ -245,9 +245,10 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
                                           "dqdd_dtau", "dlambda_dq", "dlambda_dv", "dlambda_dtau"};
   CodeBuilder& host = e.cb();
   // prox_pv's kinematics pass writes the joint transforms M^-1 reads (no
-  // second transforms pass); M^-1's members (IA, U, D^-1, ...) are not read after it.
+  // second transforms pass), its elimination U and D^-1 of the same q (M^-1
+  // reads them, docs/derivatives.md section 5).
   host.line("prox_pv(q, v, tau, s, w, qdd, lambda);", {}, names);
-  host.line(fmt::format("mass_matrix_inverse_passes(q, w, {});", minv), {}, names);
+  host.line(fmt::format("mass_matrix_inverse_factored(q, w, {});", minv), {}, names);
   // The sweep at the solution reads prox_pv's kinematics state (same q, v): the
   // joint transforms, v and c, which its elimination does not write.
   host.line(fmt::format("tangent_sweep(q, v, qdd, lambda, w, {}, {});", dq, dv), {}, names);

@@ -13,7 +13,11 @@
 // the members. The free flyer (always the root) uses the Cholesky factor of
 // its 6 x 6 IA for D^-1, a planar joint (anywhere) that of its 3 x 3 D
 // (backwardPicked, forwardPicked). Each one-dof body's columns go in loops
-// over runs of one shape ("Column loops" below). The generic counterpart:
+// over runs of one shape ("Column loops" below). Printed a second time for
+// constrained_dynamics_derivatives (mass_matrix_inverse_factored, host minvf):
+// after prox_pv of the same q, whose elimination left U, D^-1 and the Cholesky
+// factors in the same members, its backward pass reads them and forms neither
+// them nor the articulated inertias. The generic counterpart:
 // algorithms/mass_matrix_inverse.cpp.
 #include <fmt/format.h>
 
@@ -93,7 +97,10 @@ std::pair<Expr, Accumulated> eliminateColumn(Emit& e, const Kinematics::Body& kb
   return {x, out};
 }
 
-void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js) {
+// `factored`: art holds U and D^-1 of this q already (prox_pv's elimination
+// left them in the same members), so neither they nor the articulated
+// inertias passed up are formed again.
+void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js, bool factored) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
   const BodyPlan& p = e.bp(i);
@@ -105,15 +112,17 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   e.openBody(i, "eliminate");
   {
     CodeBuilder& cb = e.cb();
-    const V6& S = kb.S[0];
-    V6 U = mul(cb, b.IA, S);
-    b.U.assign(1, V6{});
-    for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
-    const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
-    if (D.isConstant()) {  // folded as in pass_aba_eliminate.cpp: correctly rounded in the solver's Scalar
-      b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
-    } else {
-      b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
+    if (!factored) {
+      const V6& S = kb.S[0];
+      V6 U = mul(cb, b.IA, S);
+      b.U.assign(1, V6{});
+      for (int r = 0; r < 6; ++r) b.U[0][std::size_t(r)] = e.keepQ(kU, i, 6, r, U[std::size_t(r)]);
+      const Expr D = cb.flat(dot(cb, S, b.U[0]), "D");
+      if (D.isConstant()) {  // folded as in pass_aba_eliminate.cpp: correctly rounded in the solver's Scalar
+        b.Dinv = e.plan.scalar == ScalarType::Float ? Expr(double(1.0f / float(D.constant()))) : Expr(1.0 / D.constant());
+      } else {
+        b.Dinv = cb.storeRaw(e.member(kDinv, i, 0, 0), cb.literal(1.0) + " / " + cb.print(D), {D}, Ops::divisions(1));
+      }
     }
     js.upper(s, s) = b.Dinv;
     if (toParent) {  // the body's own column: F_i[:, s] = 0, Minv(s, s) = D^-1
@@ -122,7 +131,7 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
         if (!dp[std::size_t(r)].isZero())
           Fp[std::size_t(s)][std::size_t(r)] =
               e.keepQ(kFA, p.parent, 6, nv, r, s, Fp[std::size_t(s)][std::size_t(r)] + dp[std::size_t(r)]);
-      passInertia(e, kin, i, art);
+      if (!factored) passInertia(e, kin, i, art);
     }
   }
   e.cb().close();
@@ -166,15 +175,16 @@ void backwardOneDof(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   }
 }
 
-// The free flyer at the root: D^-1 = IA^-1 through its Cholesky factor.
-void backwardFreeFlyer(Emit& e, int i, Articulated& art, JointSpace& js) {
+// The free flyer at the root: D^-1 = IA^-1 through its Cholesky factor (factored:
+// the one art holds).
+void backwardFreeFlyer(Emit& e, int i, Articulated& art, JointSpace& js, bool factored) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const int s = e.bp(i).idx_v;
   const auto Lname = [&](int r, int c) { return e.member(kL, i, 21, Sym::index(6, r, c)); };
   const auto invName = [&](int r) { return e.member(kLinv, i, 6, r); };
   e.fn.boundary(i);
   e.openBody(i, "eliminate");
-  Cholesky ch = cholesky(e, b.IA, Expr(), Lname, invName);
+  Cholesky ch = factored ? Cholesky{b.L, b.Linv} : cholesky(e, b.IA, Expr(), Lname, invName);
   const auto solve = [&](const std::vector<Expr>& rhs) {
     return choleskySolve(e.cb(), ch.L, ch.inv, rhs);
   };
@@ -239,7 +249,7 @@ void writeOut(Emit& e, int row, int k0, bool loop, const Expr& value) {
 // F_i[:, j] for the subtree's columns, F_p[:, j] += X^T (F_i[:, j] + U
 // Minv(s.., j)) and IA_p += X^T (IA - U D^-1 U^T) X. A planar joint is rare
 // (a mobile base, once per robot): its columns are printed one by one.
-void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js) {
+void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, JointSpace& js, bool factored) {
   Articulated::Body& b = art.b[std::size_t(i)];
   const Kinematics::Body& kb = kin.b[std::size_t(i)];
   const BodyPlan& p = e.bp(i);
@@ -250,7 +260,7 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
   e.fn.boundary(i);
   e.openBody(i, "eliminate");
   CodeBuilder& cb = e.cb();
-  factorPicked(e, i, b.IA, b);
+  if (!factored) factorPicked(e, i, b.IA, b);
   const std::vector<int> sel = pickedComponents(p.jointClass);
   const int n = int(sel.size());
   const auto solve = [&](const std::vector<Expr>& rhs) { return choleskySolve(cb, b.L, b.Linv, rhs); };  // D^-1 rhs
@@ -275,7 +285,7 @@ void backwardPicked(Emit& e, const Kinematics& kin, int i, Articulated& art, Joi
     for (int d = 0; d < n; ++d) f = add(f, scale(cb, x[std::size_t(d)], b.U[std::size_t(d)]));
     passOn(s + c, f);
   }
-  if (toParent) {  // IA_p += X^T (IA - U D^-1 U^T) X
+  if (toParent && !factored) {  // IA_p += X^T (IA - U D^-1 U^T) X
     const Sym dI = e.inertiaToParent(kb, reducedPicked(cb, b.IA, b, sel));
     Articulated::Body& par = art.b[std::size_t(p.parent)];
     for (int k = 0; k < 21; ++k)
@@ -423,10 +433,13 @@ void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, 
 
 }  // namespace
 
-std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms) {
+std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms,
+                                  const Articulated* eliminated) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
-  Articulated art = startElimination(kin);  // IA = I, pA = 0 (the transforms pass sets no bias)
+  const bool factored = eliminated != nullptr;
+  // IA = I, pA = 0 (the transforms pass sets no bias), or the elimination's factors.
+  Articulated art = factored ? *eliminated : startElimination(kin);
   JointSpace js;
   js.upper = Sym(plan.nv);
   js.FA.assign(std::size_t(N), std::vector<V6>(std::size_t(plan.nv), zero6()));
@@ -434,12 +447,13 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
   e.fn.live().kin = &kin;
   e.fn.live().art = &art;
   e.fn.live().js = &js;
-  e.fn.beginHost("minv", afterTransforms);
-  e.fn.beginPass("backward", "backward: D^-1 and the unit-torque forces, leaves first");
+  e.fn.beginHost(factored ? "minvf" : "minv", afterTransforms);
+  e.fn.beginPass("backward", factored ? "backward: the unit-torque forces, leaves first (U, D^-1 as the elimination left them)"
+                                      : "backward: D^-1 and the unit-torque forces, leaves first");
   for (int i = N - 1; i >= 1; --i) {
-    if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, art, js);
-    else if (e.bp(i).jointClass == JointClass::Planar) backwardPicked(e, kin, i, art, js);
-    else backwardOneDof(e, kin, i, art, js);
+    if (e.bp(i).jointClass == JointClass::FreeFlyer) backwardFreeFlyer(e, i, art, js, factored);
+    else if (e.bp(i).jointClass == JointClass::Planar) backwardPicked(e, kin, i, art, js, factored);
+    else backwardOneDof(e, kin, i, art, js, factored);
   }
   e.fn.beginPass("forward", "forward: the unit-torque accelerations, the upper triangle of M^-1");
   for (int i = 1; i < N; ++i) {

@@ -282,7 +282,7 @@ std::string fingerprint(const CodeBuilder& cb, const Multipliers& mult) {
 
 }  // namespace
 
-std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from) {
+std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from, ProxPvEnd* end) {
   const Plan& plan = e.plan;
   const int nc = plan.nc;
   Motion motion{std::vector<V6>(art.b.size(), zero6()), std::vector<Expr>(std::size_t(plan.nv))};
@@ -350,6 +350,7 @@ std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuild
   copyOut(e, motion, mult);
   std::string text = e.fn.endHost({"q", "v", "tau", "s", "w", "qdd", "lambda"});
   e.fn.live() = Live{};
+  if (end) *end = ProxPvEnd{kin, art, e.fn.lastHost()};  // kin and art are the host's values now
   return text;
 }
 

@@ -126,7 +126,15 @@ std::string residualMember(Emit& e, int row);
 std::string emitConstrainedAba(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
 
 // ---- pass_prox_pv.cpp: the prox_pv entry point (body text), as above.
-std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from);
+/// What prox_pv leaves in the workspace for a caller of the same (q, v):
+/// the kinematics state and its elimination's factors (U, D^-1, the free
+/// flyer's and planar joints' Cholesky factors), as values of `host`.
+struct ProxPvEnd {
+  Kinematics kin;
+  Articulated art;
+  const CodeBuilder* host = nullptr;
+};
+std::string emitProxPv(Emit& e, Kinematics kin, Articulated art, const CodeBuilder* from, ProxPvEnd* end = nullptr);
 /// rows.b[i].KA = K_i^T: body i's own rows (layout order) as force directions
 /// in its coordinates, the start of every pass that carries rows up the tree.
 void initOwnRows(Emit& e, int i, ProxRows& rows);
@@ -174,8 +182,12 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
 /// The body of mass_matrix_inverse_passes(q, w, Minv), which reads the joint
 /// transforms in the workspace: mass_matrix_inverse is joint_transforms(q, w)
 /// and this; the derivative functions call it after a kinematics pass of the
-/// same q, which writes the same transforms.
-std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms);
+/// same q, which writes the same transforms. With `eliminated` (prox_pv's
+/// elimination at the same q, ProxPvEnd), the body of
+/// mass_matrix_inverse_factored(q, w, Minv): its backward pass reads U and
+/// D^-1 from it instead of forming them and the articulated inertias again.
+std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms,
+                                  const Articulated* eliminated = nullptr);
 
 // ---- pass_constraint_kinematics.cpp: constraint_placements, constraint_jacobian,
 // constraint_drift, and the joint transforms the functions of q alone start from.

@@ -121,5 +121,38 @@ TEST(DerivativesCode, TheKStepsOperatorIsFormedFromTheInverse) {
             1);
 }
 
+// The part functions of a pass (name prefix `part`), their bodies joined.
+std::string partBodies(const std::string& source, const std::string& part) {
+  const std::regex head("PROXGEN_RT_NOINLINE void " + part + R"(\w*\([^)]*\) noexcept \{\n)");
+  std::string out;
+  for (auto it = std::sregex_iterator(source.begin(), source.end(), head); it != std::sregex_iterator(); ++it) {
+    const std::size_t from = std::size_t(it->position(0) + it->length(0));
+    out += source.substr(from, source.find("\n}\n", from) - from) + "\n";
+  }
+  return out;
+}
+
+// constrained_dynamics_derivatives' M^-1 comes after prox_pv of the same q,
+// whose elimination left U and D^-1 in the members M^-1's passes read: its
+// backward pass (mass_matrix_inverse_factored's) divides by nothing and writes
+// neither D^-1 nor an articulated inertia, where mass_matrix_inverse's own
+// forms both, body by body (a division per joint whose D = S^T IA S depends on
+// q: l1 .. l9; the last two links' D are constants in this chain, and fold).
+TEST(DerivativesCode, ItsMassMatrixInverseReadsTheEliminationsFactors) {
+  const std::string source =
+      test::syntheticChainFiles(12, "constrained_dynamics_derivatives", "- {name: tip, link: l11, type: 3d}").unsharedSource;
+  EXPECT_EQ(test::occurrences(source, "  mass_matrix_inverse_factored(q, w, w.cdd_Minv);\n"), 1);
+  const std::string own = partBodies(source, "minv_backward_"), factored = partBodies(source, "minvf_backward_");
+  ASSERT_FALSE(own.empty());
+  ASSERT_FALSE(factored.empty());
+  EXPECT_EQ(test::occurrences(own, " = 1.0 / "), 9);
+  EXPECT_GT(test::occurrences(own, "w.IA_"), 0);
+  EXPECT_EQ(test::occurrences(factored, " / "), 0);
+  EXPECT_EQ(std::regex_search(factored, std::regex(R"(w\.(Dinv|IA|U)_\w+(\[\d+\])? = )")), false);
+  // What it reads instead: the elimination's D^-1 of every joint that has one.
+  for (int l = 1; l <= 9; ++l)
+    EXPECT_GT(test::occurrences(factored, "w.Dinv_l" + std::to_string(l)), 0) << "l" << l;
+}
+
 }  // namespace
 }  // namespace proxgen::emit
