@@ -121,13 +121,12 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     texts.library[Function::InverseDynamics] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, false);
   if (want.has(Function::NonlinearEffects))
     texts.library[Function::NonlinearEffects] = emitInverseDynamics(e, afterKinematicsState, afterKinematics, true);
-  // With constrained_dynamics_derivatives the sweep also keeps the constrained
-  // bodies' motion tangents, which its constraint rows read.
-  // Both derivative functions that call the sweep read dtau's pattern.
+  // Both derivative functions that call the sweep read dtau's pattern, and
+  // constrained_dynamics_derivatives' rows the world-frame vectors it left.
   const bool cdd = want.has(Function::ConstrainedDynamicsDerivatives);
   BodyTangents tangents;
   if (want.has(Function::InverseDynamicsDerivatives)) {
-    texts.tangentSweep = emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents, cdd);
+    texts.tangentSweep = emitInverseDynamicsDerivatives(e, afterKinematicsState, afterKinematics, &tangents);
     // The sweep writes dtau's pattern; the caller's outputs get zeros elsewhere.
     const int nv2 = plan.nv * plan.nv;
     texts.library[Function::InverseDynamicsDerivatives] =
@@ -158,7 +157,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     // M^-1 after prox_pv of the same q: its elimination's U and D^-1 (docs/derivatives.md section 5).
     texts.minvFactored = emitMassMatrixInverse(e, pvEnd.kin, pvEnd.host, &pvEnd.art);
     texts.library[Function::ConstrainedDynamicsDerivatives] =
-        emitConstrainedDynamicsDerivatives(e, afterKinematicsState, afterKinematics, tangents);
+        emitConstrainedDynamicsDerivatives(e, tangents);
   }
 
   // The constraint functions (pass_constraint_kinematics.cpp, pass_delassus.cpp).

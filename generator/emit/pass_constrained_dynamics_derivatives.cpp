@@ -32,23 +32,6 @@ std::string rowsComment(const Emit& e, int k) {
                      escapeComment(c.link), c.row, c.row + c.rows - 1);
 }
 
-// Jr(e)^-1 of a weld's placement error e = log6(T^-1 oMc) (6 x 6, as inputs of
-// the block): log6 as the kinematics pass computes it, then the helper.
-std::vector<Expr> rightJacobianInverse(Emit& e, int k, const Kinematics::Body& kb) {
-  const Constraint& c = e.sys.constraints[std::size_t(k)];
-  const std::string id = e.plan.constraints[std::size_t(k)].ident;
-  CodeBuilder& cb = e.cb();
-  const XSym oMc = compose(cb, kb.oM, constant(c.placement));
-  weldError(cb, oMc, c, "jr", id);
-  cb.line(fmt::format("Scalar jri_{}[36];", id));
-  OpCount ops;
-  ops.once = se3RightJacobianInverseOps();
-  cb.line(fmt::format("se3_right_jacobian_inverse(jre_{0}, jri_{0});", id), {}, {}, ops);
-  std::vector<Expr> out;
-  for (int j = 0; j < 36; ++j) out.push_back(cb.input(fmt::format("jri_{}[{}]", id, j)));
-  return out;
-}
-
 struct RowMembers {
   std::string J;   // nc x nv
   std::string R2;  // nc x 2 nv: R2's q and v columns side by side
@@ -56,98 +39,215 @@ struct RowMembers {
   std::set<std::pair<int, int>> R2nz[2];  // R2_q's and R2_v's entries written
 };
 
-// entry = f * x into member[idx] (of `size` entries), skipping exact zeros
-// (the host zeroed the arrays); false for a zero.
-bool storeRow(Emit& e, const std::string& base, int size, int idx, const Expr& f, const Expr& x) {
-  if (x.isZero()) return false;
-  CodeBuilder& cb = e.cb();
-  const Expr flat = cb.flat(x);
-  const Expr y = cb.mul(f, flat);
-  cb.store(e.ws.member(base, size, idx, "constrained_dynamics_derivatives"), y);
-  return true;
+// What every column of one constraint's rows reads, stored once (a slot per
+// value: a constant, or the member it went to).
+struct RowFrame {
+  std::vector<TangentSlot> R, p, V, err, jri;  // R_C (row-major), p_C, sh(ov_b) (3d), e in world axes (3d, kp), Jr(e)^-1 (6d, kp)
+};
+
+std::vector<TangentSlot> keepSlots(Emit& e, const std::string& base, int offset, int size, const std::vector<Expr>& x) {
+  std::vector<TangentSlot> s(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k].isConstant()) {
+      s[k].value = x[k];
+      continue;
+    }
+    s[k].name = e.ws.member(base, size, offset + int(k), "the constraint frame's values the rows read (constrained_dynamics_derivatives)");
+    e.cb().store(s[k].name, x[k]);
+  }
+  return s;
 }
 
-// One constraint's rows: J, and R2 = d a*/dx - d alpha/dx for x = q, v at
-// fixed qdd (alpha = J qdd + gamma: the frame's acceleration in C, 6d; the
-// classical acceleration a_lin + w x v_lin of its origin, 3d), per column of
-// the body's path. The sweep's a is gravity-shifted (a_0 = -a_g): the true
-// acceleration's q tangent adds R^T g x w back (w the Jacobian column's
-// angular part: the body turns by w, its gravity by -w x R^T g).
-void constraintRows(Emit& e, int k, const Kinematics::Body& kb, const BodyTangents& t, RowMembers& m) {
+std::vector<Expr> loadAll(CodeBuilder& cb, const std::vector<TangentSlot>& s) {
+  std::vector<Expr> x;
+  for (const TangentSlot& t : s) x.push_back(load(cb, t));
+  return x;
+}
+
+V3 v3(const std::vector<Expr>& x, std::size_t from = 0) { return {x[from], x[from + 1], x[from + 2]}; }
+V3 plus(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V3 minus(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 times(double k, const V3& a) { return {k * a[0], k * a[1], k * a[2]}; }
+
+// The frame C = oM_b P in world axes from the sweep's placement of the body:
+// R_C, p_C, the body's velocity moved to C's origin (world axes), the 3d
+// position error in world axes (e = R_C^T (p_C - p_T), so R_C e = p_C - p_T),
+// and for a 6d weld with kp, Jr(e)^-1 of its error e = log6(T^-1 oMc) (as the
+// kinematics pass computes e, then the helper, into a member).
+RowFrame constraintFrame(Emit& e, int k, const BodyTangents::Body& tb) {
   const Constraint& c = e.sys.constraints[std::size_t(k)];
-  const int i = c.body, r = c.rows(), nv = e.plan.nv;
+  const std::string id = e.plan.constraints[std::size_t(k)].ident;
   const bool weld = c.type == ConstraintType::Weld6D;
   CodeBuilder& cb = e.cb();
-  cb.comment(rowsComment(e, k));
-  const XSym P = constant(c.placement);
-  const Expr f = activeFactor(e, k);
-  const V6 vC = actInvMotion(cb, P, kb.v);
-  std::vector<Expr> jri;
-  if (weld && c.kp != 0) jri = rightJacobianInverse(e, k, kb);
-  V3 err = zero3();
-  if (!weld && c.kp != 0) {
-    const XSym oMc = compose(cb, kb.oM, constant(c.placement));
-    V3 d;
-    for (int j = 0; j < 3; ++j) d[std::size_t(j)] = oMc.p[std::size_t(j)] - c.target.p[j];
-    err = rotateT(cb, oMc.R, d);
-    for (Expr& x : err) x = cb.flat(x, "e");
+  XSym oMb;
+  for (std::size_t j = 0; j < 9; ++j) oMb.R[j] = load(cb, tb.R[j]);
+  for (std::size_t j = 0; j < 3; ++j) oMb.p[j] = load(cb, tb.p[j]);
+  const XSym oMc = compose(cb, oMb, constant(c.placement));
+  const std::string base = "cdd_frame_" + id;
+  const int size = 9 + 3 + (weld ? 0 : 6 + 3);
+  RowFrame f;
+  f.R = keepSlots(e, base, 0, size, std::vector<Expr>(oMc.R.begin(), oMc.R.end()));
+  f.p = keepSlots(e, base, 9, size, std::vector<Expr>(oMc.p.begin(), oMc.p.end()));
+  if (!weld) {
+    const V6 ov = load(cb, tb.ov);
+    const V3 Vl = plus(lin(ov), cross(cb, ang(ov), oMc.p));
+    f.V = keepSlots(e, base, 12, size, {Vl[0], Vl[1], Vl[2], ov[3], ov[4], ov[5]});
+    if (c.kp != 0) {
+      std::vector<Expr> d;
+      for (int j = 0; j < 3; ++j) d.push_back(oMc.p[std::size_t(j)] - c.target.p[j]);
+      f.err = keepSlots(e, base, 18, size, d);
+    }
+  } else if (c.kp != 0) {
+    weldError(cb, oMc, c, "jr", id);
+    const std::string jri = "cdd_jri_" + id;
+    e.ws.member(jri, 36, 0, "Jr(e)^-1 of the weld's error (constrained_dynamics_derivatives)");
+    OpCount ops;
+    ops.once = se3RightJacobianInverseOps();
+    cb.line(fmt::format("se3_right_jacobian_inverse(jre_{}, w.{});", id, jri), {}, {"w"}, ops);
+    f.jri.resize(36);
+    for (int j = 0; j < 36; ++j) f.jri[std::size_t(j)].name = fmt::format("w.{}[{}]", jri, j);
   }
-  const std::size_t b = std::size_t(i);
-  for (const auto& [col, slots] : t.dvv[b]) {
-    const V6 dvv = load(cb, slots);
-    const V6 dvq = load(cb, t.dvq[b].at(col));
-    const V6 daq0 = load(cb, t.daq[b].at(col));
-    const V6 dav = load(cb, t.dav[b].at(col));
-    const V3 gw = cross(cb, kb.g, ang(dvv));
-    V6 daq = daq0;
-    for (int j = 0; j < 3; ++j) daq[std::size_t(j)] += gw[std::size_t(j)];
-    const V6 J6 = actInvMotion(cb, P, dvv);
-    const V6 vq = actInvMotion(cb, P, dvq);
-    const V6 aq = actInvMotion(cb, P, daq);
-    const V6 av = actInvMotion(cb, P, dav);
-    std::vector<Expr> Aq(aq.begin(), aq.begin() + r), Av(av.begin(), av.begin() + r);
-    if (!weld) {  // d(w x v) = dw x v + w x dv
-      const V3 t1 = cross(cb, ang(vq), lin(vC));
-      const V3 t2 = cross(cb, ang(vC), lin(vq));
-      const V3 t3 = cross(cb, ang(J6), lin(vC));
-      const V3 t4 = cross(cb, ang(vC), lin(J6));
-      for (std::size_t j = 0; j < 3; ++j) {
-        Aq[j] += t1[j] + t2[j];
-        Av[j] += t3[j] + t4[j];
-      }
+  return f;
+}
+
+// One column of one constraint's rows: J, and R2 = d a*/dx - d alpha/dx for
+// x = q, v at fixed qdd (alpha: the frame's spatial acceleration in C, 6d; the
+// classical acceleration a_lin + w x v_lin of its origin, 3d), from the
+// sweep's world-frame vectors of the column's dof (docs/derivatives.md
+// sections 2b and 5): moving q_j moves C with the joint's subtree, so in C's
+// coordinates dv_C = R_C^T sh(-u), da_C = R_C^T sh(c - u x ov_b + s x oa_0) (the
+// true acceleration: the gravity-shifted one less the gravity's tangent), and
+// along qd_j dv_C = R_C^T sh(s), da_C = R_C^T sh(s x ov_b + w), where sh(m) =
+// [m_lin + m_ang x p_C; m_ang] moves a world-frame motion to C's origin. The
+// cross products of the 3d rows commute with the rotation, so each row is
+// formed in world axes and turned into C once. A dof whose joint hangs from the
+// world (`rooted`: u = s x ov_0 = 0, c = -s x oa_0) turns the whole robot about
+// a fixed axis: nothing moves relative to the joint's frame, so dv_C and the
+// true da_C along it are zero, exactly (the terms above cancel). Entries are
+// multiplied by the constraint's schedule factor; a `store` per written entry
+// (false: an exact zero).
+void constraintColumn(Emit& e, int k, const RowFrame& frame, const std::vector<Expr>& in, bool rooted,
+                      const std::function<bool(int, int, const Expr&)>& store) {
+  const Constraint& c = e.sys.constraints[std::size_t(k)];
+  const bool weld = c.type == ConstraintType::Weld6D;
+  CodeBuilder& cb = e.cb();
+  const Expr f = activeFactor(e, k);
+  const std::vector<Expr> Rv = loadAll(cb, frame.R), pv = loadAll(cb, frame.p);
+  M3 R;
+  std::copy(Rv.begin(), Rv.end(), R.begin());
+  const V3 p = v3(pv);
+  const V6 s = toV6(in, 0), u = toV6(in, 6), cq = toV6(in, 12), w = toV6(in, 18);
+  const V6 ovb = toV6(in, 24);
+  const V6 a0 = e.rootAcceleration();
+  const auto shifted = [&](const V6& m) { return plus(lin(m), cross(cb, ang(m), p)); };
+  // The four tangents in world axes at C's origin (linear parts; angular parts are the vectors').
+  const V3 Jl = shifted(s), Ja = ang(s);
+  const V3 vql = rooted ? zero3() : times(-1.0, shifted(u)), vqa = rooted ? zero3() : times(-1.0, ang(u));
+  V6 mq = zero6();
+  if (!rooted) {
+    mq = sub(cq, crossMotion(cb, u, ovb));
+    const V3 g = cross(cb, ang(s), lin(a0));
+    for (std::size_t j = 0; j < 3; ++j) mq[j] += g[j];
+  }
+  const V3 aql = shifted(mq), aqa = ang(mq);
+  const V6 mv = add(crossMotion(cb, s, ovb), w);
+  const V3 avl = shifted(mv), ava = ang(mv);
+  std::vector<Expr> J, Rq, Rv2;
+  if (!weld) {
+    const std::vector<Expr> Vv = loadAll(cb, frame.V);
+    const V3 Vl = v3(Vv), Va = v3(Vv, 3);
+    // d(w x v) = dw x v + w x dv
+    const V3 Aq = plus(aql, plus(cross(cb, vqa, Vl), cross(cb, Va, vql)));
+    const V3 Av = plus(avl, plus(cross(cb, Ja, Vl), cross(cb, Va, Jl)));
+    V3 Sq = times(-c.kd, vql);
+    if (c.kp != 0) {  // de = J6_lin dq + e x J6_ang dq
+      const V3 ex = cross(cb, v3(loadAll(cb, frame.err)), Ja);
+      Sq = minus(Sq, times(c.kp, plus(Jl, ex)));
     }
-    std::vector<Expr> Sq(static_cast<std::size_t>(r)), Sv(static_cast<std::size_t>(r));
-    for (std::size_t j = 0; j < std::size_t(r); ++j) {
-      Sq[j] = -c.kd * vq[j];
-      Sv[j] = -c.kd * J6[j];
-    }
-    if (c.kp != 0 && weld) {  // de = Jr(e)^-1 J6 dq
+    const V3 Sv = times(-c.kd, Jl);
+    const V3 j3 = rotateT(cb, R, Jl), q3 = rotateT(cb, R, minus(Sq, Aq)), v3r = rotateT(cb, R, minus(Sv, Av));
+    J.assign(j3.begin(), j3.end());
+    Rq.assign(q3.begin(), q3.end());
+    Rv2.assign(v3r.begin(), v3r.end());
+  } else {
+    const V3 Jcl = rotateT(cb, R, Jl), Jca = rotateT(cb, R, Ja);
+    J = {Jcl[0], Jcl[1], Jcl[2], Jca[0], Jca[1], Jca[2]};
+    const V3 ql = rotateT(cb, R, minus(times(-c.kd, vql), aql)), qa = rotateT(cb, R, minus(times(-c.kd, vqa), aqa));
+    const V3 vl = rotateT(cb, R, minus(times(-c.kd, Jl), avl)), va = rotateT(cb, R, minus(times(-c.kd, Ja), ava));
+    Rq = {ql[0], ql[1], ql[2], qa[0], qa[1], qa[2]};
+    Rv2 = {vl[0], vl[1], vl[2], va[0], va[1], va[2]};
+    if (c.kp != 0) {  // de = Jr(e)^-1 J6 dq
+      const std::vector<Expr> jri = loadAll(cb, frame.jri);
       std::vector<Expr> J6f;
-      for (const Expr& x : J6) J6f.push_back(cb.flat(x));
+      for (const Expr& x : J) J6f.push_back(cb.flat(x));
+      J = J6f;
       for (std::size_t j = 0; j < 6; ++j) {
-        Expr s;
-        for (std::size_t l = 0; l < 6; ++l) {
-          if (J6f[l].isZero()) continue;
-          const Expr p = cb.mul(jri[6 * j + l], J6f[l]);
-          s += p;
-        }
-        Sq[j] -= c.kp * s;
+        Expr sum;
+        for (std::size_t l = 0; l < 6; ++l)
+          if (!J6f[l].isZero()) sum += cb.mul(jri[6 * j + l], J6f[l]);
+        Rq[j] -= c.kp * sum;
       }
-    } else if (c.kp != 0) {  // de = J6_lin dq + e x J6_ang dq
-      const V3 ex = cross(cb, err, ang(J6));
-      for (std::size_t j = 0; j < 3; ++j) Sq[j] -= c.kp * (J6[j] + ex[j]);
     }
-    for (int j = 0; j < r; ++j) {
-      const int nc = e.plan.nc, row = c.row + j;
-      if (storeRow(e, m.J, nc * nv, row * nv + col, f, J6[std::size_t(j)])) m.Jnz.insert({row, col});
-      if (storeRow(e, m.R2, 2 * nc * nv, row * 2 * nv + col, f, Sq[std::size_t(j)] - Aq[std::size_t(j)]))
-        m.R2nz[0].insert({row, col});
-      if (storeRow(e, m.R2, 2 * nc * nv, row * 2 * nv + nv + col, f, Sv[std::size_t(j)] - Av[std::size_t(j)]))
-        m.R2nz[1].insert({row, col});
-    }
+  }
+  for (int j = 0; j < c.rows(); ++j) {
+    store(0, j, cb.mul(f, cb.flat(J[std::size_t(j)])));
+    store(1, j, cb.mul(f, cb.flat(Rq[std::size_t(j)])));
+    store(2, j, cb.mul(f, cb.flat(Rv2[std::size_t(j)])));
   }
 }
 
+// One constraint's rows over the columns of its body's path (ascending), a loop
+// per run of columns whose inputs have one shape (column_loops.cpp).
+void constraintRows(Emit& e, int k, const BodyTangents& t, RowMembers& m) {
+  const Constraint& c = e.sys.constraints[std::size_t(k)];
+  const ConstraintPlan& cp = e.plan.constraints[std::size_t(k)];
+  const int i = c.body, nv = e.plan.nv, nc = e.plan.nc;
+  e.fn.boundary(i);
+  e.openBody(i, "constraint rows:");
+  e.cb().comment(rowsComment(e, k));
+  const RowFrame frame = constraintFrame(e, k, t.body[std::size_t(i)]);
+  e.cb().close();
+  std::vector<int> cols;
+  std::set<int> rooted;  // the dofs of a joint that hangs from the world
+  for (int j = i; j > 0; j = e.bp(j).parent)
+    for (int d = 0; d < e.bp(j).nv; ++d) {
+      cols.push_back(e.bp(j).idx_v + d);
+      if (e.bp(j).parent == 0) rooted.insert(e.bp(j).idx_v + d);
+    }
+  std::sort(cols.begin(), cols.end());
+  const auto inputs = [&](int col) {
+    std::vector<Expr> in;
+    for (const TangentCol& x : t.dof[std::size_t(col)])
+      for (const Expr& y : load(e.cb(), x)) in.push_back(y);
+    return in;
+  };
+  const auto sameShape = [&](int a, int a0) {
+    return rooted.count(a) == rooted.count(a0) && oneShape(e.cb(), inputs, a, a0);
+  };
+  for (const auto& run : columnRuns(cols, sameShape)) {
+    const int k0 = run.first, len = run.second;  // named: lambdas capture them (C++17)
+    openColumns(e, cp.ident, k0, len, fmt::format("constraint '{}' rows,", escapeComment(c.name)));
+    CodeBuilder& cb = e.cb();  // after openColumns: it may have started a new part
+    std::vector<Expr> in = len > 1 ? loopReads(cb, inputs(k0)) : inputs(k0);
+    for (const Expr& x : load(cb, t.body[std::size_t(i)].ov)) in.push_back(x);
+    const auto store = [&](int which, int j, const Expr& x) {
+      if (x.isZero()) return false;
+      const int row = c.row + j;
+      const std::string& base = which == 0 ? m.J : m.R2;
+      const int size = which == 0 ? nc * nv : 2 * nc * nv;
+      const int idx = which == 0 ? row * nv + k0 : row * 2 * nv + (which == 2 ? nv : 0) + k0;
+      const char* what = "constrained_dynamics_derivatives";
+      cb.store(len > 1 ? e.ws.loopSlot(base, size, idx, what) : e.ws.member(base, size, idx, what), x);
+      for (int col = k0; col < k0 + len; ++col) {
+        if (which == 0) m.Jnz.insert({row, col});
+        else m.R2nz[which - 1].insert({row, col});
+      }
+      return true;
+    };
+    constraintColumn(e, k, frame, in, rooted.count(k0) > 0, store);
+    cb.close();
+  }
+}
 }  // namespace
 
 // The helpers' arithmetic (assemble.cpp prints them; counted as they are written).
@@ -208,8 +308,7 @@ Ops se3RightJacobianInverseOps() {
 // column (the rest mirrored): a template instance of the product per block.
 constexpr int kSymmetricRows = 8;
 
-std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn, const CodeBuilder* afterKinematics,
-                                               const BodyTangents& t) {
+std::string emitConstrainedDynamicsDerivatives(Emit& e, const BodyTangents& t) {
   const Plan& plan = e.plan;
   const int nv = plan.nv, nc = plan.nc;
   if (nv == 0)
@@ -237,10 +336,10 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
     LtS = array("cdd_LtS", nc * w2, "[Lt | -S_K] (constrained_dynamics_derivatives)");
     Y = array("cdd_Y", nv * w2, "[d qdd / dx | d lambda / dx]^T, x = q or v (constrained_dynamics_derivatives)");
   }
-  Kinematics kin = kinIn;
+  // Everything the host and its parts read is in workspace members (the sweep's
+  // slots in `t`): no pass output moves in.
   e.fn.live() = Live{};
-  e.fn.live().kin = &kin;
-  e.fn.beginHost("cdd", afterKinematics);
+  e.fn.beginHost("cdd", nullptr);
   const std::vector<std::string> names = {"q", "v", "tau", "s", "w", "qdd", "lambda", "dqdd_dq", "dqdd_dv",
                                           "dqdd_dtau", "dlambda_dq", "dlambda_dv", "dlambda_dtau"};
   CodeBuilder& host = e.cb();
@@ -268,14 +367,9 @@ std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kinIn,
   storeActiveFactors(e, "s.active");
   host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", nc * nv, rows.J), {}, names);
   host.line(fmt::format("for (int k = 0; k < {}; ++k) w.{}[k] = Scalar(0);", 2 * nc * nv, rows.R2), {}, names);
-  e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's tangents");
+  e.fn.beginPass("rows", "constraint rows: J and d a*/dx - d alpha/dx (x = q, v) from the sweep's world-frame vectors");
   for (int i : plan.support)
-    for (int k : e.bp(i).constraints) {
-      e.fn.boundary(i);
-      e.openBody(i, "constraint rows:");
-      constraintRows(e, k, kin.b[std::size_t(i)], t, rows);
-      e.cb().close();
-    }
+    for (int k : e.bp(i).constraints) constraintRows(e, k, t, rows);
   e.fn.endPart();
   CodeBuilder& cb = e.cb();
   // With W = M^-1 J^T and Lt = S_K W^T (= d lambda / d tau), section 3's

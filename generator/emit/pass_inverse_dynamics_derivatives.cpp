@@ -18,11 +18,10 @@
 //   for c a strict ancestor's dof  dtau_dq[c][r] = oS_c . Pq_r,  dtau_dv[c][r] = oS_c . Pv_r.
 // O(N) blocks and O(N d) products in two loops, where a body-frame tangent
 // sweep carries every column through every body below its joint (O(N d)
-// blocks; docs/derivatives.md section 5 has the measurements). The constrained
-// bodies' own tangents, in their coordinates, for constrained_dynamics_derivatives'
-// rows: along q_c, dv_b = oX_b^-1 (-u), da_b = oX_b^-1 (c - u x ov_b); along qd_c,
-// dv_b = oX_b^-1 s, da_b = oX_b^-1 (s x ov_b + w); the joint's own columns as
-// section 2 forms them. The generic counterpart: algorithms/rnea_derivatives_world.cpp.
+// blocks; docs/derivatives.md section 5 has the measurements). The per-dof
+// arrays (s, u, c, w) and the world placements and velocities stay in the
+// workspace for constrained_dynamics_derivatives' constraint rows. The generic
+// counterpart: algorithms/rnea_derivatives_world.cpp.
 // The file also holds forward_dynamics_derivatives and the helpers the derivative
 // functions share (the sparse patterns, the copies, the products with M^-1).
 #include <fmt/format.h>
@@ -42,10 +41,6 @@ constexpr Quantity kWR{"oRd", "world rotation (world-frame derivatives)"},
     kWI{"oIc", "composite inertia in world axes about the world origin: h = m c, then I (upper triangle)"},
     kWH{"oHc", "composite linear momentum in world axes (B's linear-angular block is -2 [HL]x)"},
     kWB{"oBc", "composite B's angular block (3 x 3, row-major)"}, kWF{"oFc", "subtree force in world axes"};
-// The constrained bodies' motion tangents in their coordinates (6 x nv per body,
-// the columns of its path), which constrained_dynamics_derivatives' rows read.
-constexpr Quantity kDvq{"dvq", "d v / dq (6 x nv, path columns)"}, kDvv{"dvv", "d v / dv (6 x nv, path columns)"},
-    kDaq{"daq", "d a / dq at fixed qdd (6 x nv, path columns)"}, kDav{"dav", "d a / dv at fixed qdd (6 x nv, path columns)"};
 
 // The per-dof arrays the pairs' loop reads, component-major ([6][nv]; BS [3][nv]):
 // column k of each is dof k's six-vector, and a run of dofs is contiguous in every row.
@@ -77,6 +72,18 @@ Slots keep(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x) {
       s[k].name = e.member(qy, body, int(x.size()), int(k));
       e.cb().store(s[k].name, x[k]);
     }
+  }
+  return s;
+}
+
+// The slots of values putQ stored (or kept as the constants they are).
+Slots stored(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x) {
+  Slots s(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k].isConstant())
+      s[k].value = x[k];
+    else
+      s[k].name = e.member(qy, body, int(x.size()), int(k));
   }
   return s;
 }
@@ -149,7 +156,7 @@ V6 applyB(CodeBuilder& cb, const V3& HL, const M3& Baa, const V6& x) {
 }
 
 struct World {
-  std::vector<Slots> ov, oa, Ic, HL, Baa, F;  // per body (Ic: h then I)
+  std::vector<Slots> oR, op, ov, oa, Ic, HL, Baa, F;  // per body (Ic: h then I)
   std::vector<std::array<Slots, kColumnArrayCount>> col;  // per dof: what each array holds
   std::vector<double> mass;  // per body, then of its subtree: a constant of the model
 };
@@ -205,6 +212,8 @@ void forward(Emit& e, Kinematics& kin, bool withLambda, World& W) {
     for (int k = 0; k < 9; ++k) oM.R[std::size_t(k)] = e.putQ(kWR, i, 9, k, oM.R[std::size_t(k)]);
     for (int k = 0; k < 3; ++k) oM.p[std::size_t(k)] = e.putQ(kWP, i, 3, k, oM.p[std::size_t(k)]);
     kb.oM = oM;
+    W.oR[b] = stored(e, kWR, i, std::vector<Expr>(oM.R.begin(), oM.R.end()));
+    W.op[b] = stored(e, kWP, i, std::vector<Expr>(oM.p.begin(), oM.p.end()));
     V6 ov = actMotion(cb, oM, kb.v);
     flatten(cb, ov, "ov");
     V6 x = kb.c;
@@ -298,77 +307,6 @@ void backward(Emit& e, World& W) {
   }
 }
 
-// The constrained bodies' motion tangents (columns of their paths), in their
-// coordinates.
-void constrainedTangents(Emit& e, const Kinematics& kin, World& W, BodyTangents& keepOut) {
-  const Plan& plan = e.plan;
-  const int N = int(plan.bodies.size());
-  e.fn.beginPass("constrained", "the constrained bodies' motion tangents in their coordinates");
-  const auto save = [&](const Quantity& qy, int body, int col, const V6& x) {
-    TangentCol s;
-    for (std::size_t r = 0; r < 6; ++r) {
-      if (x[r].isConstant()) {
-        s[r].value = x[r];
-      } else {
-        s[r].name = e.member(qy, body, 6, plan.nv, int(r), col);
-        e.cb().store(s[r].name, x[r]);
-      }
-    }
-    return s;
-  };
-  for (int bi = 1; bi < N; ++bi) {
-    const BodyPlan& p = e.bp(bi);
-    if (p.constraints.empty()) continue;
-    const std::size_t b = std::size_t(bi);
-    const Kinematics::Body& kb = kin.b[b];
-    // The joint's own columns in body coordinates (section 2's form: S_k is a
-    // constant there, so the rows' entries along it fold):
-    //   dv/dq = (X^-1 v_p) x S_k, dv/dqd = S_k, da/dq = (X^-1 a_p) x S_k + dv/dq x vJ,
-    //   da/dqd = v x S_k + S_k x vJ, with X^-1 a_p = oX^-1 oa - S qdd - c.
-    e.fn.boundary(bi);
-    e.cb().open("{", {fmt::format("body {} '{}', its joint's columns", bi, p.ident)});
-    {
-      CodeBuilder& cb = e.cb();
-      V6 vJ = zero6(), ap = actInvMotion(cb, kb.oM, read6(cb, W.oa[b]));
-      for (int d = 0; d < p.nv; ++d) {
-        vJ = add(vJ, scale(cb, cb.input(fmt::format("v[{}]", p.idx_v + d)), kb.S[std::size_t(d)]));
-        ap = sub(ap, scale(cb, cb.input(fmt::format("qdd[{}]", p.idx_v + d)), kb.S[std::size_t(d)]));
-      }
-      ap = sub(ap, kb.c);
-      flatten(cb, ap, "ap");
-      V6 vp = sub(kb.v, vJ);
-      flatten(cb, vp, "vp");
-      for (int d = 0; d < p.nv; ++d) {
-        const int k = p.idx_v + d;
-        const V6& Sk = kb.S[std::size_t(d)];
-        V6 dvq = crossMotion(cb, vp, Sk);
-        flatten(cb, dvq, "dv");
-        keepOut.dvq[b][k] = save(kDvq, bi, k, dvq);
-        keepOut.dvv[b][k] = save(kDvv, bi, k, Sk);
-        keepOut.daq[b][k] = save(kDaq, bi, k, add(crossMotion(cb, ap, Sk), crossMotion(cb, dvq, vJ)));
-        keepOut.dav[b][k] = save(kDav, bi, k, add(crossMotion(cb, kb.v, Sk), crossMotion(cb, Sk, vJ)));
-      }
-    }
-    e.cb().close();
-    const XSym& oM = kb.oM;
-    for (int j = p.parent; j > 0; j = e.bp(j).parent)
-      for (int d = 0; d < e.bp(j).nv; ++d) {
-        const int k = e.bp(j).idx_v + d;
-        e.fn.boundary(bi);
-        e.cb().open("{", {fmt::format("body {} '{}', column {}", bi, p.ident, k)});
-        CodeBuilder& cb = e.cb();
-        const auto& col = W.col[std::size_t(k)];
-        const V6 ovb = read6(cb, W.ov[b]);
-        const V6 s = read6(cb, col[kS]), u = read6(cb, col[kU]), c = read6(cb, col[kC]), w = read6(cb, col[kW]);
-        keepOut.dvq[b][k] = save(kDvq, bi, k, actInvMotion(cb, oM, neg(u)));
-        keepOut.dvv[b][k] = save(kDvv, bi, k, actInvMotion(cb, oM, s));
-        keepOut.daq[b][k] = save(kDaq, bi, k, actInvMotion(cb, oM, sub(c, crossMotion(cb, u, ovb))));
-        keepOut.dav[b][k] = save(kDav, bi, k, actInvMotion(cb, oM, add(crossMotion(cb, s, ovb), w)));
-        cb.close();
-      }
-  }
-}
-
 bool allZero(const Slots& s, std::size_t from, std::size_t to) {
   for (std::size_t r = from; r < to; ++r)
     if (!s[r].name.empty() || !s[r].value.isZero()) return false;
@@ -440,9 +378,11 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
 
 }  // namespace
 
+Expr load(CodeBuilder& cb, const TangentSlot& s) { return s.name.empty() ? s.value : cb.member(s.name); }
+
 V6 load(CodeBuilder& cb, const TangentCol& s) {
   V6 x;
-  for (std::size_t r = 0; r < 6; ++r) x[r] = s[r].name.empty() ? s[r].value : cb.member(s[r].name);
+  for (std::size_t r = 0; r < 6; ++r) x[r] = load(cb, s[r]);
   return x;
 }
 
@@ -574,12 +514,12 @@ std::string emitForwardDynamicsDerivatives(Emit& e, const BodyTangents& t) {
 }
 
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                           BodyTangents* keepOut, bool keepConstrained) {
+                                           BodyTangents* keepOut) {
   const Plan& plan = e.plan;
   const bool withLambda = plan.nc > 0;
   const int N = int(plan.bodies.size());
   World W;
-  for (std::vector<Slots>* x : {&W.ov, &W.oa, &W.Ic, &W.HL, &W.Baa, &W.F}) x->assign(std::size_t(N), Slots{});
+  for (std::vector<Slots>* x : {&W.oR, &W.op, &W.ov, &W.oa, &W.Ic, &W.HL, &W.Baa, &W.F}) x->assign(std::size_t(N), Slots{});
   W.col.resize(std::size_t(plan.nv));
   W.mass.assign(std::size_t(N), 0.0);
   e.fn.live() = Live{};
@@ -594,8 +534,20 @@ std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBu
   forward(e, kin, withLambda, W);
   backward(e, W);
   BodyTangents t;
-  for (std::vector<TangentCols>* x : {&t.dvq, &t.dvv, &t.daq, &t.dav}) x->assign(std::size_t(N), TangentCols{});
-  if (keepConstrained) constrainedTangents(e, kin, W, t);
+  const auto col6 = [](const Slots& s) {
+    TangentCol c;
+    std::copy(s.begin(), s.end(), c.begin());
+    return c;
+  };
+  for (const auto& col : W.col)
+    t.dof.push_back({col6(col[ColumnArray::kS]), col6(col[ColumnArray::kU]), col6(col[ColumnArray::kC]),
+                     col6(col[ColumnArray::kW])});
+  t.body.resize(std::size_t(N));
+  for (std::size_t b = 1; b < std::size_t(N); ++b) {
+    t.body[b].ov = col6(W.ov[b]);
+    std::copy(W.oR[b].begin(), W.oR[b].end(), t.body[b].R.begin());
+    std::copy(W.op[b].begin(), W.op[b].end(), t.body[b].p.begin());
+  }
   e.fn.endPart();
   pairs(e, W, t.dtauDq, t.dtauDv);
   if (keepOut != nullptr) *keepOut = std::move(t);

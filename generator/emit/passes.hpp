@@ -228,7 +228,6 @@ struct TangentSlot {
   std::string name;  // empty: `value` is the constant
 };
 using TangentCol = std::array<TangentSlot, 6>;
-using TangentCols = std::map<int, TangentCol>;  // column -> the 6 entries (absent: zero)
 /// Which entries of a matrix can be nonzero: per row, its [lo, hi) column
 /// ranges (the entries the emitter printed). The sparse products of
 /// assemble.cpp (sparse_left_product_add, sparse_transposed_product) read only these.
@@ -259,25 +258,34 @@ void copyBlock(CodeBuilder& cb, const std::vector<std::string>& names, const std
 /// sparse_transposed_product<n, m, p> over the left factor's spans.
 Ops sparseLeftProductOps(const RowSpans& a, int p);
 
-/// What the tangent sweep hands to the functions that call it: the constrained
-/// bodies' motion tangents (columns of their paths) it left in the workspace, and
-/// d tau / dq's and d tau / dv's nonzero pattern (the tree's: a joint's torque
-/// moves with its ancestors, itself and its subtree; less a free flyer's
-/// translation columns of d tau / dq).
+/// What the tangent sweep hands to the functions that call it: where it left
+/// each dof's world-frame vectors (the joint axis s, u, c, w: the columns of the
+/// per-dof arrays, or the constants they fold to) and each body's placement and
+/// velocity in world axes, from which constrained_dynamics_derivatives forms the
+/// constraint rows; and d tau / dq's and d tau / dv's nonzero pattern (the
+/// tree's: a joint's torque moves with its ancestors, itself and its subtree;
+/// less a free flyer's translation columns of d tau / dq).
 struct BodyTangents {
-  std::vector<TangentCols> dvq, dvv, daq, dav;
+  std::vector<std::array<TangentCol, 4>> dof;  // per dof: s, u, c, w
+  struct Body {
+    TangentCol ov;                   // velocity in world axes
+    std::array<TangentSlot, 9> R;    // world rotation (row-major)
+    std::array<TangentSlot, 3> p;    // world position
+  };
+  std::vector<Body> body;
   std::set<std::pair<int, int>> dtauDq, dtauDv;  // (row, column) entries that can be nonzero
 };
+/// A slot's value: its constant, or a read of its member.
+Expr load(CodeBuilder& cb, const TangentSlot& s);
 V6 load(CodeBuilder& cb, const TangentCol& s);
 /// The sweep's body, `tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv)`, which
 /// reads the kinematics state in the workspace (joint transforms, v, c):
 /// inverse_dynamics_derivatives is kinematics(q, v, w) and this; the derivative
 /// functions that have just run a solver or RNEA on the same (q, v) call it
-/// without a second kinematics pass. With `keep`, dtau's pattern is returned;
-/// with `keepConstrained` too, the constrained bodies' motion tangents are stored
-/// and their slots returned (constrained_dynamics_derivatives reads them).
+/// without a second kinematics pass. With `keep`, dtau's pattern and the
+/// slots above are returned.
 std::string emitInverseDynamicsDerivatives(Emit& e, Kinematics kin, const CodeBuilder* afterKinematics,
-                                           BodyTangents* keep = nullptr, bool keepConstrained = false);
+                                           BodyTangents* keep = nullptr);
 /// forward_dynamics_derivatives: calls nonlinear_effects, mass_matrix_inverse
 /// and inverse_dynamics_derivatives (held with it) and the products with M^-1
 /// (dense_product<n, m, p>, and sparse_transposed_product over dtau's pattern
@@ -292,10 +300,10 @@ Ops denseProductOps(int n, int m, int p);
 
 // ---- pass_constrained_dynamics_derivatives.cpp: constrained_dynamics_derivatives
 // (docs/derivatives.md section 3): prox_pv, the sweep at its solution, the
-// constraint rows' derivatives (straight-line, from `t`), the dense algebra of
-// the implicit function theorem (fixed-bound loops printed by assemble.cpp).
-std::string emitConstrainedDynamicsDerivatives(Emit& e, const Kinematics& kin, const CodeBuilder* afterKinematics,
-                                               const BodyTangents& t);
+// constraint rows' derivatives (from the sweep's world-frame vectors in `t`, a
+// loop per run of path columns of one shape), the dense algebra of the
+// implicit function theorem (fixed-bound loops printed by assemble.cpp).
+std::string emitConstrainedDynamicsDerivatives(Emit& e, const BodyTangents& t);
 /// What assemble.cpp's dense helpers compute, for the banner.
 Ops denseProductAddOps(int n, int m, int p);
 Ops denseCholeskyOps(int n);

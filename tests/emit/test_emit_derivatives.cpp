@@ -154,5 +154,30 @@ TEST(DerivativesCode, ItsMassMatrixInverseReadsTheEliminationsFactors) {
     EXPECT_GT(test::occurrences(factored, "w.Dinv_l" + std::to_string(l)), 0) << "l" << l;
 }
 
+// The constraint rows come from the sweep's world-frame vectors of each path
+// dof (s, u, c, w in the per-dof arrays) and the body's world placement,
+// turned into the constraint frame once per row: no per-body motion tangents
+// in body coordinates (dvq_, dvv_, daq_, dav_) are formed for them. The tip's
+// path is all 11 joints: the first hangs from the world (its q-tangents are
+// exact zeros, a column of its own), the second's u keeps some of the first
+// joint's folded zeros (a column of its own), the other nine share one loop.
+TEST(DerivativesCode, TheConstraintRowsReadTheSweepsWorldFrameVectors) {
+  const std::string source = tipContactChain();
+  for (const char* tangent : {"w.dvq_", "w.dvv_", "w.daq_", "w.dav_"})
+    EXPECT_EQ(source.find(tangent), std::string::npos) << tangent;
+  const std::string rows = partBodies(source, "cdd_rows_");
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(test::occurrences(rows, "PROXGEN_RT_NO_UNROLL for (int j = 0; j < 9; ++j) {"), 1);
+  EXPECT_EQ(test::occurrences(rows, "// constraint 'tip' rows, columns 2 to 10"), 1);
+  for (const char* array : {"w.oS[", "w.oU[", "w.oC[", "w.oW[", "w.cdd_frame_tip["})
+    EXPECT_GT(test::occurrences(rows, array), 0) << array;
+  // Column 0 (the rooted joint): J and R2_v only, R2_q's entries fold to zero.
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_EQ(test::occurrences(rows, "w.cdd_J[" + std::to_string(11 * r) + "] = "), 1) << r;
+    EXPECT_EQ(test::occurrences(rows, "w.cdd_R2[" + std::to_string(22 * r) + "] = "), 0) << r;
+    EXPECT_EQ(test::occurrences(rows, "w.cdd_R2[" + std::to_string(22 * r + 11) + "] = "), 1) << r;
+  }
+}
+
 }  // namespace
 }  // namespace proxgen::emit
