@@ -6,17 +6,19 @@
 // C = J M^-1 R1 - R2, and X = M^-1 (R1 - J^T L), evaluated as
 // X_tau = P = M^-1 - W Lt, X_x = P R1_x + Lt^T R2_x, L_x = Lt R1_x - S_K R2_x
 // (W = M^-1 J^T, Lt = S_K W^T: docs/derivatives.md section 5). The host calls
-// mass_matrix_inverse, prox_pv and inverse_dynamics_derivatives (held with
-// it); the constraint rows (J, R2) are printed straight-line from the sweep's
-// motion tangents of the constrained bodies, the path's columns only; the
-// matrix algebra (O((nv + nc) (nnz(dtau) + nnz(R2)) + nv^2 nc / 2 + nc^2 nv), plus
-// K nc^3 for the proximal operator S_K) is fixed-bound loops printed once by
+// prox_pv, mass_matrix_inverse's passes on prox_pv's factors and
+// inverse_dynamics_derivatives' sweep (held with it); the constraint rows (J,
+// R2) are formed from the sweep's world-frame vectors of the path's dofs, a
+// loop per run of columns of one shape; the matrix algebra (O((nv + nc)
+// (nnz(dtau) + nnz(R2)) + nv^2 nc / 2 + nc^2 nv), plus about 2 nc^3 / 3 + (K - 1)
+// nc^3 / 2 for the proximal operator S_K) is fixed-bound loops printed once by
 // assemble.cpp, the products with dtau, J and R2 over their nonzero patterns
 // (constant tables of column ranges). The generic counterpart:
 // algorithms/derivatives.cpp (constrainedDynamicsDerivatives, constraintRowTangents).
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
 #include <set>
 
 #include "emit/identifiers.hpp"
@@ -121,13 +123,13 @@ RowFrame constraintFrame(Emit& e, int k, const BodyTangents::Body& tb) {
 // [m_lin + m_ang x p_C; m_ang] moves a world-frame motion to C's origin. The
 // cross products of the 3d rows commute with the rotation, so each row is
 // formed in world axes and turned into C once. A dof whose joint hangs from the
-// world (`rooted`: u = s x ov_0 = 0, c = -s x oa_0) turns the whole robot about
-// a fixed axis: nothing moves relative to the joint's frame, so dv_C and the
-// true da_C along it are zero, exactly (the terms above cancel). Entries are
-// multiplied by the constraint's schedule factor; a `store` per written entry
-// (false: an exact zero).
+// world (`rooted`: u = s x ov_0 = 0, c = -s x oa_0) moves the whole robot
+// rigidly: nothing moves relative to the joint's frame, so dv_C and the true
+// da_C along it are zero, exactly (the terms above cancel). Entries are
+// multiplied by the constraint's schedule factor; `store(which, row, entry)`
+// for J (0), R2_q (1) and R2_v (2), exact zeros included (it skips them).
 void constraintColumn(Emit& e, int k, const RowFrame& frame, const std::vector<Expr>& in, bool rooted,
-                      const std::function<bool(int, int, const Expr&)>& store) {
+                      const std::function<void(int, int, const Expr&)>& store) {
   const Constraint& c = e.sys.constraints[std::size_t(k)];
   const bool weld = c.type == ConstraintType::Weld6D;
   CodeBuilder& cb = e.cb();
@@ -231,7 +233,7 @@ void constraintRows(Emit& e, int k, const BodyTangents& t, RowMembers& m) {
     std::vector<Expr> in = len > 1 ? loopReads(cb, inputs(k0)) : inputs(k0);
     for (const Expr& x : load(cb, t.body[std::size_t(i)].ov)) in.push_back(x);
     const auto store = [&](int which, int j, const Expr& x) {
-      if (x.isZero()) return false;
+      if (x.isZero()) return;  // the host zeroed the arrays; not in the pattern
       const int row = c.row + j;
       const std::string& base = which == 0 ? m.J : m.R2;
       const int size = which == 0 ? nc * nv : 2 * nc * nv;
@@ -242,7 +244,6 @@ void constraintRows(Emit& e, int k, const BodyTangents& t, RowMembers& m) {
         if (which == 0) m.Jnz.insert({row, col});
         else m.R2nz[which - 1].insert({row, col});
       }
-      return true;
     };
     constraintColumn(e, k, frame, in, rooted.count(k0) > 0, store);
     cb.close();
