@@ -313,34 +313,38 @@ bool allZero(const Slots& s, std::size_t from, std::size_t to) {
   return true;
 }
 
-// The pairs (world_frame_rows and world_frame_columns, assemble.cpp): per dof r the
-// columns of its path (its ancestors' dofs and its own joint's), for dtau_dq
-// less the columns whose c and u's angular part are exact zeros (a free
-// flyer's translations: nothing moves the robot's dynamics along them); per dof
-// c the rows of its joint's strict subtree, [below[2c], below[2c + 1]).
+// The pairs (world_frame_rows and world_frame_columns, assemble.cpp): per dof c
+// the rows r whose path holds c (the dofs of c's joint's subtree, its own
+// joint's included: c is in r's path exactly when r's joint is c's or below
+// it, one range in depth-first order), [rows_v[2c], rows_v[2c + 1]); for
+// dtau_dq none for the columns whose c and u's angular part are exact zeros (a
+// free flyer's translations: nothing moves the robot's dynamics along them);
+// and per dof c the rows of its joint's strict subtree, [below[2c], below[2c + 1]).
 void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<std::pair<int, int>>& dv) {
   const Plan& plan = e.plan;
   const int nv = plan.nv, N = int(plan.bodies.size());
   std::set<std::pair<int, int>> pathQ, pathV;
-  std::vector<int> below;
-  long subtree = 0;
+  std::vector<int> rowsQ, rowsV, below;
+  long subtree = 0, entriesQ = 0, entriesV = 0;
   for (int i = 1; i < N; ++i)
     for (int d = 0; d < e.bp(i).nv; ++d) {
-      const int r = e.bp(i).idx_v + d;
-      for (int j = i; j > 0; j = e.bp(j).parent)
-        for (int k = 0; k < e.bp(j).nv; ++k) {
-          const int c = e.bp(j).idx_v + k;
-          const auto& col = W.col[std::size_t(c)];
-          pathV.insert({r, c});
-          if (!allZero(col[kC], 0, 6) || !allZero(col[kU], 3, 6)) pathQ.insert({r, c});
-        }
+      const int c = e.bp(i).idx_v + d, lo = e.bp(i).idx_v, hi = e.bp(i).dofEnd;
+      const auto& col = W.col[std::size_t(c)];
+      const bool moves = !allZero(col[kC], 0, 6) || !allZero(col[kU], 3, 6);
+      rowsV.insert(rowsV.end(), {lo, hi});
+      rowsQ.insert(rowsQ.end(), {moves ? lo : 0, moves ? hi : 0});
+      for (int r = lo; r < hi; ++r) {
+        pathV.insert({r, c});
+        if (moves) pathQ.insert({r, c});
+      }
+      entriesV += hi - lo;
+      entriesQ += moves ? hi - lo : 0;
       below.insert(below.end(), {e.bp(i).idx_v + e.bp(i).nv, e.bp(i).dofEnd});
       subtree += e.bp(i).dofEnd - e.bp(i).idx_v - e.bp(i).nv;
     }
-  const RowSpans q = rowSpans(nv, pathQ), v = rowSpans(nv, pathV);
   CodeBuilder& cb = e.cb();
-  printSpans(cb, "path_q", q);
-  printSpans(cb, "path_v", v);
+  cb.line(fmt::format("static constexpr int rows_q[{}] = {{{}}};", rowsQ.size(), fmt::join(rowsQ, ", ")));
+  cb.line(fmt::format("static constexpr int rows_v[{}] = {{{}}};", rowsV.size(), fmt::join(rowsV, ", ")));
   cb.line(fmt::format("static constexpr int below[{}] = {{{}}};", below.size(), fmt::join(below, ", ")));
   // The loops write exactly the entries of the pattern (rows: the path, own
   // joint included; columns: the strict subtree), and the products of fdd and
@@ -348,16 +352,16 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
   // its caller's outputs (emitter.cpp).
   const auto arr = [](ColumnArray a) { return fmt::format("&w.{}[0][0]", kColumnArrays[a].name); };
   const std::vector<std::string> names = {"w", "dtau_dq", "dtau_dv"};
-  OpCount rows;  // per entry a six- and a three-term product
-  rows.once.mul = 9 * entries(q) + 3 * nv;
-  rows.once.add = 8 * entries(q);
-  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(-1), path_q_start, path_q_span, dtau_dq);", nv,
-                      arr(kIS), arr(kBS), arr(kC), arr(kU)),
+  OpCount rows;  // per entry a six- and a three-term product, per column s B_c
+  rows.once.mul = 9 * entriesQ + 3 * nv;
+  rows.once.add = 8 * entriesQ;
+  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(-1), rows_q, dtau_dq);", nv, arr(kIS), arr(kBS),
+                      arr(kC), arr(kU)),
           {}, names, rows);
-  rows.once.mul = 9 * entries(v) + 3 * nv;
-  rows.once.add = 8 * entries(v);
-  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(1), path_v_start, path_v_span, dtau_dv);", nv,
-                      arr(kIS), arr(kBS), arr(kW), arr(kS)),
+  rows.once.mul = 9 * entriesV + 3 * nv;
+  rows.once.add = 8 * entriesV;
+  cb.line(fmt::format("world_frame_rows<{}>({}, {}, {}, {}, Scalar(1), rows_v, dtau_dv);", nv, arr(kIS), arr(kBS),
+                      arr(kW), arr(kS)),
           {}, names, rows);
   OpCount columns;  // per entry two six-term products
   columns.once.mul = 12 * subtree;

@@ -73,9 +73,11 @@ std::vector<std::string> forbiddenControlFlow(const std::string& code) {
       // SE(3) Jacobian's series): a head alone, bounds a template argument, an
       // outer index or a literal.
       R"(|for \(int ([a-z]) = (0|1|[a-z]|[a-z] \+ 1|n - 1); \2 (<|<=|>=) ([a-z]|0|[1-9][0-9]*); (\+\+|--)\2\) \{)"
-      // the sparse products' loops over a pattern's ranges, their bounds read
-      // from the tables (constants: sparseTablesNotConstant below).
-      R"(|for \(int ([a-z]) = (start|span)\[[^\]]+\]; \7 < \8\[[^\]]+\]; \+\+\7\) \{))");
+      // the sparse products' and the sweep's pairs' loops over a pattern's
+      // ranges, their bounds read from the tables (constants:
+      // sparseTablesNotConstant below; the pairs' rows_q, rows_v, below are
+      // printed `static constexpr int` beside their calls).
+      R"(|for \(int ([a-z]) = (start|span|rows)\[[^\]]+\]; \7 < \8\[[^\]]+\]; \+\+\7\) \{))");
   static const std::vector<std::string> keywords = {"for", "while", "do", "if", "else", "switch", "case", "goto"};
   std::vector<std::string> found;
   for (std::size_t k = 0; k < code.size(); ++k) {
@@ -153,11 +155,13 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsAndBranches) {
   EXPECT_EQ(forbiddenControlFlow(stripComments("#define X 1\n")).size(), 1u);
 }
 
-// The pattern tables the sparse products' calls pass (`<name>_start`,
-// `<name>_span`) that `code` does not declare `static constexpr int`: a
-// table that is not a constant would let data decide a trip count.
+// The pattern tables the sparse products' and the sweep's pairs' calls pass
+// (`<name>_start`, `<name>_span`; `rows_q`, `rows_v`, `below`) that `code`
+// does not declare `static constexpr int`: a table that is not a constant
+// would let data decide a trip count.
 std::vector<std::string> sparseTablesNotConstant(const std::string& code) {
-  static const std::regex call(R"(sparse_\w+<[^>]*>\(([^;]*)\);)"), table(R"(\b\w+_(start|span)\b)");
+  static const std::regex call(R"((?:sparse|world_frame)_\w+<[^>]*>\(([^;]*)\);)"),
+      table(R"(\b(\w+_(start|span)|rows_[qv]|below)\b)");
   std::vector<std::string> found;
   for (auto c = std::sregex_iterator(code.begin(), code.end(), call); c != std::sregex_iterator(); ++c) {
     const std::string args = (*c)[1].str();
@@ -171,12 +175,17 @@ TEST(GeneratedStructure, TheCheckerFindsLoopsOverNonConstantTables) {
   EXPECT_TRUE(forbiddenControlFlow("    for (int j = start[r]; j < start[r + 1]; ++j) {\n    }\n").empty());
   EXPECT_TRUE(forbiddenControlFlow("      for (int k = span[2 * j]; k < span[2 * j + 1]; ++k) {\n      }\n").empty());
   EXPECT_GE(forbiddenControlFlow("    for (int j = start[r]; j < w.n[r]; ++j) {\n    }\n").size(), 1u);
+  EXPECT_TRUE(forbiddenControlFlow("    for (int r = rows[2 * c]; r < rows[2 * c + 1]; ++r) {\n    }\n").empty());
+  EXPECT_GE(forbiddenControlFlow("    for (int r = rows[2 * c]; r < span[2 * c + 1]; ++r) {\n    }\n").size(), 1u);
   const std::string call = "  sparse_right_product<2, 2, 2>(A, B, t_start, t_span, Scalar(-1), C);\n";
   EXPECT_EQ(sparseTablesNotConstant(call).size(), 2u);
   EXPECT_EQ(sparseTablesNotConstant("  static constexpr int t_start[3] = {0, 1, 2};\n" + call).size(), 1u);
   EXPECT_TRUE(sparseTablesNotConstant("  static constexpr int t_start[3] = {0, 1, 2};\n"
                                       "  static constexpr int t_span[4] = {0, 1, 1, 2};\n" + call)
                   .empty());
+  const std::string pairs = "  world_frame_rows<2>(IS, BS, C, U, Scalar(-1), rows_q, dtau_dq);\n";
+  EXPECT_EQ(sparseTablesNotConstant(pairs).size(), 1u);
+  EXPECT_TRUE(sparseTablesNotConstant("  static constexpr int rows_q[4] = {0, 2, 1, 2};\n" + pairs).empty());
 }
 
 TEST(GeneratedStructure, TheSparseProductsReadConstantTables) {
