@@ -456,6 +456,10 @@ std::string helpers(const SolverTexts& texts) {
            "}\n\n";
   if (cdd)
     out += kConstrainedDerivativeHelpers;
+  helper(!texts.minvForward.empty(),
+         "// mass_matrix_inverse's forward pass: the unit-torque accelerations from what either\n"
+         "// backward pass (mass_matrix_inverse_passes, mass_matrix_inverse_factored) left in w.\n",
+         "mass_matrix_inverse_forward(Workspace& w, Scalar* Minv)", texts.minvForward);
   helper(!texts.minvPasses.empty(),
          "// mass_matrix_inverse after the joint transforms: ABA on the unit torques; reads the\n"
          "// joint transforms in w (joint_transforms or kinematics of the same q wrote them).\n",
@@ -579,7 +583,7 @@ const std::vector<std::string>& fileFunctionNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out = {"kinematics", "joint_transforms", "constraint_joints", "eliminate_free_bodies",
                                     "accelerate_free_bodies", "tangent_sweep", "world_frame_rows", "world_frame_columns", "mass_matrix_inverse_passes",
-                                    "mass_matrix_inverse_factored",
+                                    "mass_matrix_inverse_factored", "mass_matrix_inverse_forward",
                                     "residual",
                                     "dense_product", "dense_product_add", "sparse_left_product_add",
                                     "sparse_transposed_product", "sparse_transposed_product_add", "dense_cholesky", "inverse_rows",

@@ -33,8 +33,9 @@ struct SolverTexts {
   // its helpers world_frame_rows and world_frame_columns are printed with it.
   std::string tangentSweep;
   // mass_matrix_inverse's passes after the joint transforms ("" when not held),
-  // and after prox_pv's elimination of the same q (constrained_dynamics_derivatives).
-  std::string minvPasses, minvFactored;
+  // the same after prox_pv's elimination of the same q (constrained_dynamics_derivatives),
+  // and the forward pass both end with.
+  std::string minvPasses, minvFactored, minvForward;
   bool withKinematics = false, withJointTransforms = false;
   // The helper of the constraint functions of q alone ("" when none is held).
   std::string constraintJoints;

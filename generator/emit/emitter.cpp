@@ -52,9 +52,9 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   // them as well (`calls`). Its operations per call are its host's, the whole
   // of calls.front() (the function that leaves the kinematics state of its
   // (q, v) in the workspace) and the hosts it calls after it without their
-  // transforms and kinematics: mass_matrix_inverse's passes ("minv"; for cdd
-  // "minvf", the variant on prox_pv's factors) and the tangent sweep of
-  // inverse_dynamics_derivatives ("rnead").
+  // transforms and kinematics: mass_matrix_inverse's passes ("minv" and its
+  // forward pass "minv_forward"; for cdd "minvf", the backward pass on
+  // prox_pv's factors) and the tangent sweep of inverse_dynamics_derivatives ("rnead").
   struct Composite {
     Function f;
     const char* host;
@@ -64,10 +64,10 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   const Composite composites[] = {
       {Function::ForwardDynamicsDerivatives, "fdd",
        {Function::NonlinearEffects, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
-       {"minv", "rnead"}},
+       {"minv", "minv_forward", "rnead"}},
       {Function::ConstrainedDynamicsDerivatives, "cdd",
        {Function::ProxPv, Function::MassMatrixInverse, Function::InverseDynamicsDerivatives},
-       {"minvf", "rnead"}}};
+       {"minvf", "minv_forward", "rnead"}}};
   FunctionSet want = sys.functions;
   for (const Composite& c : composites)
     if (want.has(c.f))
@@ -145,7 +145,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
     if (want.has(Function::MassMatrix))
       texts.library[Function::MassMatrix] = emitMassMatrix(e, transforms, afterTransforms);
     if (want.has(Function::MassMatrixInverse)) {
-      texts.minvPasses = emitMassMatrixInverse(e, transforms, afterTransforms);
+      texts.minvPasses = emitMassMatrixInverse(e, transforms, afterTransforms, nullptr, &texts.minvForward);
       texts.library[Function::MassMatrixInverse] =
           "  joint_transforms(q, w);\n  mass_matrix_inverse_passes(q, w, Minv);\n";
     }
@@ -195,6 +195,7 @@ SolverFiles emitSolver(const System& sys, const Plan& plan, const SolverInputs& 
   for (const auto& l : library) {
     reach[l.f] = {l.host};
     if (l.helper) reach[l.f].push_back(l.helper);
+    if (l.f == Function::MassMatrixInverse) reach[l.f].push_back("minv_forward");  // its second helper
     texts.libraryOps[l.f] = sum(reach[l.f]);
   }
   // The derivatives: their host (the dense products included) and the functions it calls.

@@ -17,7 +17,9 @@
 // constrained_dynamics_derivatives (mass_matrix_inverse_factored, host minvf):
 // after prox_pv of the same q, whose elimination left U, D^-1 and the Cholesky
 // factors in the same members, its backward pass reads them and forms neither
-// them nor the articulated inertias. The generic counterpart:
+// them nor the articulated inertias. The forward pass reads only members either
+// backward pass writes: mass_matrix_inverse_forward, printed once, ends both.
+// The generic counterpart:
 // algorithms/mass_matrix_inverse.cpp.
 #include <fmt/format.h>
 
@@ -434,7 +436,7 @@ void forwardBody(Emit& e, const Kinematics& kin, int i, const Articulated& art, 
 }  // namespace
 
 std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms,
-                                  const Articulated* eliminated) {
+                                  const Articulated* eliminated, std::string* forwardText) {
   const Plan& plan = e.plan;
   const int N = int(plan.bodies.size());
   const bool factored = eliminated != nullptr;
@@ -455,12 +457,21 @@ std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* af
     else if (e.bp(i).jointClass == JointClass::Planar) backwardPicked(e, kin, i, art, js, factored);
     else backwardOneDof(e, kin, i, art, js, factored);
   }
-  e.fn.beginPass("forward", "forward: the unit-torque accelerations, the upper triangle of M^-1");
-  for (int i = 1; i < N; ++i) {
-    if (e.bp(i).jointClass == JointClass::Planar) forwardPicked(e, kin, i, art, js);
-    else forwardBody(e, kin, i, art, js);
-  }
+  // The forward pass reads only what either backward pass leaves in the same
+  // members (U, D^-1, the factors, the unit-torque forces, Minv's entries so
+  // far): one print, mass_matrix_inverse_forward, called by both variants.
+  e.fn.endPart();
+  e.cb().line("mass_matrix_inverse_forward(w, Minv);", {}, {"w", "Minv"});
   std::string text = e.fn.endHost({"q", "w", "Minv"});
+  if (forwardText != nullptr) {
+    e.fn.beginHost("minv_forward", e.fn.lastHost());
+    e.fn.beginPass("", "forward: the unit-torque accelerations, the upper triangle of M^-1");
+    for (int i = 1; i < N; ++i) {
+      if (e.bp(i).jointClass == JointClass::Planar) forwardPicked(e, kin, i, art, js);
+      else forwardBody(e, kin, i, art, js);
+    }
+    *forwardText = e.fn.endHost({"w", "Minv"});
+  }
   e.fn.live() = Live{};
   return text;
 }

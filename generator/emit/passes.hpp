@@ -186,8 +186,10 @@ std::string emitMassMatrix(Emit& e, Kinematics kin, const CodeBuilder* afterTran
 /// elimination at the same q, ProxPvEnd), the body of
 /// mass_matrix_inverse_factored(q, w, Minv): its backward pass reads U and
 /// D^-1 from it instead of forming them and the articulated inertias again.
+/// Both end with mass_matrix_inverse_forward(w, Minv), whose body is returned
+/// in `forwardText` when given (printed once, for either variant).
 std::string emitMassMatrixInverse(Emit& e, Kinematics kin, const CodeBuilder* afterTransforms,
-                                  const Articulated* eliminated = nullptr);
+                                  const Articulated* eliminated = nullptr, std::string* forwardText = nullptr);
 
 // ---- pass_constraint_kinematics.cpp: constraint_placements, constraint_jacobian,
 // constraint_drift, and the joint transforms the functions of q alone start from.

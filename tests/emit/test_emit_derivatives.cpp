@@ -154,6 +154,11 @@ TEST(DerivativesCode, ItsMassMatrixInverseReadsTheEliminationsFactors) {
   // What it reads instead: the elimination's D^-1 of every joint that has one.
   for (int l = 1; l <= 9; ++l)
     EXPECT_GT(test::occurrences(factored, "w.Dinv_l" + std::to_string(l)), 0) << "l" << l;
+  // The forward pass is the same for both (it reads only members either backward
+  // pass writes): printed once, called by both.
+  EXPECT_EQ(test::occurrences(source, "minvf_forward"), 0);
+  EXPECT_EQ(test::occurrences(source, "  mass_matrix_inverse_forward(w, Minv);\n"), 2);
+  EXPECT_FALSE(partBodies(source, "minv_forward_").empty());
 }
 
 // The constraint rows come from the sweep's world-frame vectors of each path

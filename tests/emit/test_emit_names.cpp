@@ -139,7 +139,7 @@ TEST(FileFunctions, EachNameIsDefinedOnceAndEveryHelperIsReserved) {
   EXPECT_EQ(defined.count("accelerate_free_bodies_2"), 1u);
   // The check sees the helpers at all (a regex that matched nothing would pass).
   for (const char* helper : {"kinematics", "tangent_sweep", "world_frame_rows", "world_frame_columns", "mass_matrix_inverse_passes",
-                             "mass_matrix_inverse_factored",
+                             "mass_matrix_inverse_factored", "mass_matrix_inverse_forward",
                              "dense_product_add", "residual", "constrained_dynamics_derivatives"})
     EXPECT_EQ(defined.count(helper), 1u) << helper;
 }
