@@ -47,23 +47,11 @@ struct RowFrame {
   std::vector<TangentSlot> R, p, V, err, jri;  // R_C (row-major), p_C, sh(ov_b) (3d), e in world axes (3d, kp), Jr(e)^-1 (6d, kp)
 };
 
+// x into entries offset.. of the member array `base` (of `size`).
 std::vector<TangentSlot> keepSlots(Emit& e, const std::string& base, int offset, int size, const std::vector<Expr>& x) {
-  std::vector<TangentSlot> s(x.size());
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    if (x[k].isConstant()) {
-      s[k].value = x[k];
-      continue;
-    }
-    s[k].name = e.ws.member(base, size, offset + int(k), "the constraint frame's values the rows read (constrained_dynamics_derivatives)");
-    e.cb().store(s[k].name, x[k]);
-  }
-  return s;
-}
-
-std::vector<Expr> loadAll(CodeBuilder& cb, const std::vector<TangentSlot>& s) {
-  std::vector<Expr> x;
-  for (const TangentSlot& t : s) x.push_back(load(cb, t));
-  return x;
+  return slotsOf(e, x, [&](int k) {
+    return e.ws.member(base, size, offset + k, "the constraint frame's values the rows read (constrained_dynamics_derivatives)");
+  });
 }
 
 V3 v3(const std::vector<Expr>& x, std::size_t from = 0) { return {x[from], x[from + 1], x[from + 2]}; }
@@ -134,7 +122,7 @@ void constraintColumn(Emit& e, int k, const RowFrame& frame, const std::vector<E
   const bool weld = c.type == ConstraintType::Weld6D;
   CodeBuilder& cb = e.cb();
   const Expr f = activeFactor(e, k);
-  const std::vector<Expr> Rv = loadAll(cb, frame.R), pv = loadAll(cb, frame.p);
+  const std::vector<Expr> Rv = load(cb, frame.R), pv = load(cb, frame.p);
   M3 R;
   std::copy(Rv.begin(), Rv.end(), R.begin());
   const V3 p = v3(pv);
@@ -156,14 +144,14 @@ void constraintColumn(Emit& e, int k, const RowFrame& frame, const std::vector<E
   const V3 avl = shifted(mv), ava = ang(mv);
   std::vector<Expr> J, Rq, Rv2;
   if (!weld) {
-    const std::vector<Expr> Vv = loadAll(cb, frame.V);
+    const std::vector<Expr> Vv = load(cb, frame.V);
     const V3 Vl = v3(Vv), Va = v3(Vv, 3);
     // d(w x v) = dw x v + w x dv
     const V3 Aq = plus(aql, plus(cross(cb, vqa, Vl), cross(cb, Va, vql)));
     const V3 Av = plus(avl, plus(cross(cb, Ja, Vl), cross(cb, Va, Jl)));
     V3 Sq = times(-c.kd, vql);
     if (c.kp != 0) {  // de = J6_lin dq + e x J6_ang dq
-      const V3 ex = cross(cb, v3(loadAll(cb, frame.err)), Ja);
+      const V3 ex = cross(cb, v3(load(cb, frame.err)), Ja);
       Sq = minus(Sq, times(c.kp, plus(Jl, ex)));
     }
     const V3 Sv = times(-c.kd, Jl);
@@ -179,7 +167,7 @@ void constraintColumn(Emit& e, int k, const RowFrame& frame, const std::vector<E
     Rq = {ql[0], ql[1], ql[2], qa[0], qa[1], qa[2]};
     Rv2 = {vl[0], vl[1], vl[2], va[0], va[1], va[2]};
     if (c.kp != 0) {  // de = Jr(e)^-1 J6 dq
-      const std::vector<Expr> jri = loadAll(cb, frame.jri);
+      const std::vector<Expr> jri = load(cb, frame.jri);
       std::vector<Expr> J6f;
       for (const Expr& x : J) J6f.push_back(cb.flat(x));
       J = J6f;

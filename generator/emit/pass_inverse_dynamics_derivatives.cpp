@@ -63,36 +63,13 @@ constexpr ColumnArrayInfo kColumnArrays[] = {
 // A stored value: a generation-time constant, or the member it was stored to.
 using Slots = std::vector<TangentSlot>;
 
-Slots keep(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x) {
-  Slots s(x.size());
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    if (x[k].isConstant()) {
-      s[k].value = x[k];
-    } else {
-      s[k].name = e.member(qy, body, int(x.size()), int(k));
-      e.cb().store(s[k].name, x[k]);
-    }
-  }
-  return s;
+// x into body's member of quantity qy (`store`), or the slots of values putQ
+// stored there already.
+Slots keep(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x, bool store = true) {
+  return slotsOf(e, x, [&](int k) { return e.member(qy, body, int(x.size()), k); }, store);
 }
 
-// The slots of values putQ stored (or kept as the constants they are).
-Slots stored(Emit& e, const Quantity& qy, int body, const std::vector<Expr>& x) {
-  Slots s(x.size());
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    if (x[k].isConstant())
-      s[k].value = x[k];
-    else
-      s[k].name = e.member(qy, body, int(x.size()), int(k));
-  }
-  return s;
-}
-
-std::vector<Expr> read(CodeBuilder& cb, const Slots& s) {
-  std::vector<Expr> x;
-  for (const TangentSlot& t : s) x.push_back(t.name.empty() ? t.value : cb.member(t.name));
-  return x;
-}
+std::vector<Expr> read(CodeBuilder& cb, const Slots& s) { return load(cb, s); }
 
 V6 read6(CodeBuilder& cb, const Slots& s) { return toV6(read(cb, s)); }
 V3 read3(CodeBuilder& cb, const Slots& s) {
@@ -212,8 +189,8 @@ void forward(Emit& e, Kinematics& kin, bool withLambda, World& W) {
     for (int k = 0; k < 9; ++k) oM.R[std::size_t(k)] = e.putQ(kWR, i, 9, k, oM.R[std::size_t(k)]);
     for (int k = 0; k < 3; ++k) oM.p[std::size_t(k)] = e.putQ(kWP, i, 3, k, oM.p[std::size_t(k)]);
     kb.oM = oM;
-    W.oR[b] = stored(e, kWR, i, std::vector<Expr>(oM.R.begin(), oM.R.end()));
-    W.op[b] = stored(e, kWP, i, std::vector<Expr>(oM.p.begin(), oM.p.end()));
+    W.oR[b] = keep(e, kWR, i, std::vector<Expr>(oM.R.begin(), oM.R.end()), false);
+    W.op[b] = keep(e, kWP, i, std::vector<Expr>(oM.p.begin(), oM.p.end()), false);
     V6 ov = actMotion(cb, oM, kb.v);
     flatten(cb, ov, "ov");
     V6 x = kb.c;
@@ -382,7 +359,27 @@ void pairs(Emit& e, const World& W, std::set<std::pair<int, int>>& dq, std::set<
 
 }  // namespace
 
+std::vector<TangentSlot> slotsOf(Emit& e, const std::vector<Expr>& x, const std::function<std::string(int)>& member,
+                                 bool store) {
+  std::vector<TangentSlot> s(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k].isConstant()) {
+      s[k].value = x[k];
+      continue;
+    }
+    s[k].name = member(int(k));
+    if (store) e.cb().store(s[k].name, x[k]);
+  }
+  return s;
+}
+
 Expr load(CodeBuilder& cb, const TangentSlot& s) { return s.name.empty() ? s.value : cb.member(s.name); }
+
+std::vector<Expr> load(CodeBuilder& cb, const std::vector<TangentSlot>& s) {
+  std::vector<Expr> x;
+  for (const TangentSlot& t : s) x.push_back(load(cb, t));
+  return x;
+}
 
 V6 load(CodeBuilder& cb, const TangentCol& s) {
   V6 x;

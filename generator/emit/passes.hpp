@@ -277,8 +277,13 @@ struct BodyTangents {
   std::vector<Body> body;
   std::set<std::pair<int, int>> dtauDq, dtauDv;  // (row, column) entries that can be nonzero
 };
+/// x as slots: each constant kept as it is, each other entry stored to
+/// member(k) (`store`; false: already stored there, only named).
+std::vector<TangentSlot> slotsOf(Emit& e, const std::vector<Expr>& x, const std::function<std::string(int)>& member,
+                                 bool store = true);
 /// A slot's value: its constant, or a read of its member.
 Expr load(CodeBuilder& cb, const TangentSlot& s);
+std::vector<Expr> load(CodeBuilder& cb, const std::vector<TangentSlot>& s);
 V6 load(CodeBuilder& cb, const TangentCol& s);
 /// The sweep's body, `tangent_sweep(q, v, qdd, lambda, w, dtau_dq, dtau_dv)`, which
 /// reads the kinematics state in the workspace (joint transforms, v, c):
